@@ -1,0 +1,2 @@
+//! Takagi-Sugeno fuzzy inference (section 4 of the paper).
+#![deny(missing_docs)]

@@ -1,0 +1,48 @@
+//! The error type of this crate.
+
+/// Why a dynamics computation was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DynError {
+    /// A chain was asked for with zero links.
+    #[error("a chain needs at least one link")]
+    NoLinks,
+    /// A link parameter was out of its domain.
+    #[error("link {index}: {quantity} must be {requirement}, got {value}")]
+    InvalidLink {
+        /// 0-based link index.
+        index: usize,
+        /// Which parameter (`"length"`, `"mass"`, `"inertia"`, `"centre of mass"`).
+        quantity: &'static str,
+        /// What it must be.
+        requirement: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// The gravitational acceleration was not finite.
+    #[error("gravity must be finite, got {0}")]
+    InvalidGravity(f64),
+    /// A slice or matrix had the wrong size.
+    #[error("{name} has {got} entries, expected {expected}")]
+    Dimension {
+        /// Which input or output.
+        name: &'static str,
+        /// The size the computation needs.
+        expected: usize,
+        /// The size it got.
+        got: usize,
+    },
+    /// An input that must be finite was NaN or infinite.
+    #[error("{name}[{index}] must be finite, got {value}")]
+    NonFinite {
+        /// Which input.
+        name: &'static str,
+        /// 0-based index of the first offending entry.
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// The mass matrix could not be factorised (it is positive definite for every valid chain,
+    /// so this signals numbers too extreme for double precision).
+    #[error("the mass matrix is not numerically positive definite")]
+    NotPositiveDefinite,
+}

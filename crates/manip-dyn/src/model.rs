@@ -1,0 +1,129 @@
+//! The immutable description of a planar serial chain (the "Model" of the Model/Data split).
+
+use crate::error::DynError;
+
+/// One rigid link of a planar chain: joint at its proximal end, revolute about `z`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Link {
+    /// Length from this link's joint to the next joint (m), positive.
+    pub length: f64,
+    /// Mass (kg), positive.
+    pub mass: f64,
+    /// Distance of the centre of mass from the link's joint, along the link (m).
+    pub com: f64,
+    /// Moment of inertia about the centre of mass, about `z` (kg m^2), positive.
+    pub inertia: f64,
+}
+
+impl Link {
+    /// A uniform beam: centre of mass at the midpoint, inertia `m L^2 / 12` (the paper's links).
+    pub fn uniform_beam(length: f64, mass: f64) -> Result<Self, DynError> {
+        Self::new(length, mass, 0.5 * length, mass * length * length / 12.0)
+    }
+
+    /// A link with explicit centre-of-mass offset and inertia; validated as in [`ChainModel::new`].
+    pub fn new(length: f64, mass: f64, com: f64, inertia: f64) -> Result<Self, DynError> {
+        let link = Self {
+            length,
+            mass,
+            com,
+            inertia,
+        };
+        link.validate(0)?;
+        Ok(link)
+    }
+
+    fn validate(&self, index: usize) -> Result<(), DynError> {
+        let positive = [
+            ("length", self.length),
+            ("mass", self.mass),
+            ("inertia", self.inertia),
+        ];
+        for (quantity, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(DynError::InvalidLink {
+                    index,
+                    quantity,
+                    requirement: "positive and finite",
+                    value,
+                });
+            }
+        }
+        if !self.com.is_finite() {
+            return Err(DynError::InvalidLink {
+                index,
+                quantity: "centre of mass",
+                requirement: "finite",
+                value: self.com,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A planar serial chain of revolute joints under gravity along `-y`.
+///
+/// Joint `i` sits at the proximal end of link `i`; `theta_i` is the angle of link `i` relative to
+/// link `i - 1` (`theta_1` from the `x` axis), so link `i`'s absolute angle is
+/// `phi_i = theta_1 + ... + theta_i`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainModel {
+    links: Vec<Link>,
+    gravity: f64,
+}
+
+impl ChainModel {
+    /// A chain of the given links, with gravitational acceleration `gravity` (m/s^2) along `-y`.
+    pub fn new(links: Vec<Link>, gravity: f64) -> Result<Self, DynError> {
+        if links.is_empty() {
+            return Err(DynError::NoLinks);
+        }
+        for (index, link) in links.iter().enumerate() {
+            link.validate(index)?;
+        }
+        if !gravity.is_finite() {
+            return Err(DynError::InvalidGravity(gravity));
+        }
+        Ok(Self { links, gravity })
+    }
+
+    /// `n` identical uniform beams: the paper's arm is `uniform(10, 0.1, 0.1, 9.81)`.
+    ///
+    /// ```
+    /// let arm = manip_dyn::ChainModel::uniform(10, 0.1, 0.1, 9.81)?;
+    /// assert_eq!(arm.n_links(), 10);
+    /// assert!((arm.total_length() - 1.0).abs() < 1e-15);
+    /// # Ok::<(), manip_dyn::DynError>(())
+    /// ```
+    pub fn uniform(n: usize, length: f64, mass: f64, gravity: f64) -> Result<Self, DynError> {
+        if n == 0 {
+            return Err(DynError::NoLinks);
+        }
+        Self::new(vec![Link::uniform_beam(length, mass)?; n], gravity)
+    }
+
+    /// Number of links (and joints) `n`.
+    pub fn n_links(&self) -> usize {
+        self.links.len()
+    }
+
+    /// The links, base first.
+    pub fn links(&self) -> &[Link] {
+        &self.links
+    }
+
+    /// Gravitational acceleration along `-y` (m/s^2).
+    pub fn gravity(&self) -> f64 {
+        self.gravity
+    }
+
+    /// Sum of the link lengths (m).
+    pub fn total_length(&self) -> f64 {
+        self.links.iter().map(|l| l.length).sum()
+    }
+
+    /// The link lengths, base first.
+    pub fn link_lengths(&self) -> impl ExactSizeIterator<Item = f64> + '_ {
+        self.links.iter().map(|l| l.length)
+    }
+}

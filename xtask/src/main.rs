@@ -1,0 +1,164 @@
+//! Project automation in the cargo-xtask pattern: `cargo xtask <command>`.
+//!
+//! - `ci`: what `.ci/run` runs: formatting, clippy with `-D warnings`, the whole test suite, and a
+//!   compile-only pass over the benches.
+//! - `props [--cases N]`: the test suite with `PROPTEST_CASES=N` (default 2048), so every property
+//!   test (energy conservation, Jacobian consistency, ...) runs many more cases than in CI.
+//! - `bench [FILTER]`: the Criterion benches, then `target/bench-summary.json` (bench id -> median
+//!   nanoseconds per iteration) printed as a table.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let result = match args.first().map(String::as_str) {
+        Some("ci") => ci(),
+        Some("props") => props(&args[1..]),
+        Some("bench") => bench(&args[1..]),
+        _ => Err(USAGE.to_string()),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("xtask: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+const USAGE: &str = "usage: cargo xtask ci | props [--cases N] | bench [FILTER]";
+
+fn ci() -> Result<(), String> {
+    cargo(&["fmt", "--all", "--", "--check"], &[])?;
+    cargo(
+        &[
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ],
+        &[],
+    )?;
+    cargo(&["test", "--workspace"], &[])?;
+    // Benches are compiled, never run, in CI.
+    cargo(&["test", "--workspace", "--benches", "--no-run"], &[])
+}
+
+fn props(args: &[String]) -> Result<(), String> {
+    let cases = match args {
+        [] => "2048".to_string(),
+        [flag, n] if flag == "--cases" && n.parse::<u32>().is_ok() => n.clone(),
+        _ => return Err(USAGE.to_string()),
+    };
+    println!("xtask: running the test suite with PROPTEST_CASES={cases}");
+    cargo(
+        &["test", "--workspace", "--release"],
+        &[("PROPTEST_CASES", &cases)],
+    )
+}
+
+fn bench(args: &[String]) -> Result<(), String> {
+    let mut cmd = vec!["bench", "--package", "hrm-benches", "--", "--noplot"];
+    cmd.extend(args.iter().map(String::as_str));
+    cargo(&cmd, &[])?;
+    let criterion = target_dir().join("criterion");
+    let mut rows = Vec::new();
+    collect_medians(&criterion, &mut rows)?;
+    if rows.is_empty() {
+        return Err(format!(
+            "no Criterion results under {}",
+            criterion.display()
+        ));
+    }
+    rows.sort_by(|a, b| a.0.cmp(&b.0));
+    let summary: serde_json::Map<String, serde_json::Value> = rows
+        .iter()
+        .map(|(id, ns)| (id.clone(), serde_json::Value::from(*ns)))
+        .collect();
+    let path = target_dir().join("bench-summary.json");
+    let text = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
+    std::fs::write(&path, text + "\n").map_err(|e| format!("{}: {e}", path.display()))?;
+    let width = rows.iter().map(|r| r.0.len()).max().unwrap_or(0).max(5);
+    println!("\n{:<width$}  {:>14}", "bench", "median");
+    for (id, ns) in &rows {
+        println!("{id:<width$}  {:>14}", human_time(*ns));
+    }
+    println!("\nwrote {}", path.display());
+    Ok(())
+}
+
+/// Walks Criterion's output folder and collects `(full id, median ns)` from every
+/// `new/benchmark.json` + `new/estimates.json` pair.
+fn collect_medians(dir: &Path, rows: &mut Vec<(String, f64)>) -> Result<(), String> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if !path.is_dir() {
+            continue;
+        }
+        if path.file_name().is_some_and(|n| n == "new") {
+            if let (Some(id), Some(median)) = (
+                read_json(&path.join("benchmark.json"), &["full_id"])
+                    .and_then(|v| v.as_str().map(str::to_owned)),
+                read_json(&path.join("estimates.json"), &["median", "point_estimate"])
+                    .and_then(|v| v.as_f64()),
+            ) {
+                rows.push((id, median));
+            }
+        } else {
+            collect_medians(&path, rows)?;
+        }
+    }
+    Ok(())
+}
+
+fn read_json(path: &Path, keys: &[&str]) -> Option<serde_json::Value> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut value: serde_json::Value = serde_json::from_str(&text).ok()?;
+    for key in keys {
+        value = value.get(key)?.clone();
+    }
+    Some(value)
+}
+
+fn human_time(ns: f64) -> String {
+    match ns {
+        ns if ns < 1e3 => format!("{ns:.1} ns"),
+        ns if ns < 1e6 => format!("{:.2} us", ns / 1e3),
+        ns if ns < 1e9 => format!("{:.2} ms", ns / 1e6),
+        ns => format!("{:.2} s", ns / 1e9),
+    }
+}
+
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives in the workspace")
+        .to_path_buf()
+}
+
+fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map_or_else(|| workspace_root().join("target"), PathBuf::from)
+}
+
+fn cargo(args: &[&str], envs: &[(&str, &str)]) -> Result<(), String> {
+    let program = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
+    println!("xtask: cargo {}", args.join(" "));
+    let status = Command::new(program)
+        .args(args)
+        .envs(envs.iter().copied())
+        .current_dir(workspace_root())
+        .status()
+        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("`cargo {}` failed ({status})", args.join(" ")))
+    }
+}
