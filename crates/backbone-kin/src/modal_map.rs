@@ -93,13 +93,13 @@ impl ModalMap {
                 });
             }
         }
-        if let BaseAngle::Fixed(alpha0) = base {
-            if !alpha0.is_finite() {
-                return Err(KinError::NonFinite {
-                    name: "alpha0",
-                    value: alpha0,
-                });
-            }
+        if let BaseAngle::Fixed(alpha0) = base
+            && !alpha0.is_finite()
+        {
+            return Err(KinError::NonFinite {
+                name: "alpha0",
+                value: alpha0,
+            });
         }
         let n = link_lengths.len();
         let n_modal = 2 * harmonics;
