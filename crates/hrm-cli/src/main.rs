@@ -1,12 +1,39 @@
 //! `hrm`: the command line of the hyper-redundant manipulator toolkit.
 
-use clap::Parser;
+mod arm;
+mod eval;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
 
 /// Models, controls and simulates hyper-redundant planar manipulators.
 #[derive(Parser)]
 #[command(name = "hrm", version, about)]
-struct Cli {}
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
 
-fn main() {
-    let _cli = Cli::parse();
+#[derive(Subcommand)]
+enum Command {
+    /// Answer JSON-lines requests on stdin, one JSON answer per line on stdout (docs/eval-protocol.md).
+    Eval,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Eval) => eval::run_stdio(),
+        None => {
+            use clap::CommandFactory;
+            Cli::command().print_help().map_err(|e| e.to_string())
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("hrm: {message}");
+            ExitCode::FAILURE
+        }
+    }
 }
