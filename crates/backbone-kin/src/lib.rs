@@ -1,6 +1,6 @@
 //! Backbone-curve kinematics of planar hyper-redundant manipulators.
 //!
-//! Implements sections 2-3 of Ahmadzadeh et al., *Modeling of Hyper-Redundant Manipulators
+//! Implements sections 2-3 of *Modeling of Hyper-Redundant Manipulators
 //! Dynamics and Design of Fuzzy Controller for the System*, with the corrections listed in
 //! `docs/theory.md`: the modal backbone curve (eqs 1-4), its closed-form end point, and the
 //! constant modal Jacobian that maps curve coordinates to joint angles (eqs 7-11).
