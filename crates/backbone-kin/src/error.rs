@@ -3,7 +3,8 @@
 /// Why a kinematics computation was refused.
 ///
 /// Every variant names the condition that failed, so a caller (or the `hrm` command line) can
-/// print it as one readable line.
+/// print it as one readable line. [`KinError::is_unreachable`] groups the variants that mean "the
+/// backbone curve cannot reach this target".
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum KinError {
     /// An input that must be a finite number was NaN or infinite.
@@ -38,4 +39,99 @@ pub enum KinError {
         /// The length it got.
         got: usize,
     },
+    /// Modal coordinates of a curve must come in `(a_{2k-1}, a_{2k})` pairs, one per harmonic.
+    #[error(
+        "modal coordinates come in (sin, 1 - cos) pairs, one pair per harmonic: got an odd count {got}"
+    )]
+    UnpairedModes {
+        /// The number of coordinates given.
+        got: usize,
+    },
+    /// An arc length outside the curve `[0, l]`.
+    #[error("arc length s = {s} is outside the curve [0, {length}]")]
+    ArcLength {
+        /// The requested arc length.
+        s: f64,
+        /// The curve length `l`.
+        length: f64,
+    },
+    /// The curve's modal amplitudes are so large that quadrature to the documented accuracy
+    /// would need more nodes than the crate allows.
+    #[error(
+        "the curve oscillates too fast for quadrature to the documented accuracy: {needed} nodes needed, at most {max} allowed"
+    )]
+    TooOscillatory {
+        /// Quadrature nodes the error bound asks for over the whole curve.
+        needed: f64,
+        /// The allowed maximum.
+        max: usize,
+    },
+    /// The restricted inverse of `J0` was asked for a value outside `J0`'s range `[0, 1]` on its
+    /// first branch.
+    #[error("the restricted inverse of J0 needs a value in [0, 1], got {value}")]
+    J0Domain {
+        /// The offending value.
+        value: f64,
+    },
+    /// The target is farther from the base than the curve is long (`r > l`).
+    #[error(
+        "target out of reach: its distance from the base r = {r} exceeds the curve length l = {length}"
+    )]
+    OutOfReach {
+        /// Distance of the target from the base.
+        r: f64,
+        /// The curve length `l`.
+        length: f64,
+    },
+    /// The target coincides with the base (`r / l` below machine epsilon), so its direction, and
+    /// with it `a2`, is undefined.
+    #[error(
+        "target at the base: its distance r = {r} is below the rounding level of the curve length l = {length}, so its direction (and a2) is undefined"
+    )]
+    AtBase {
+        /// Distance of the target from the base.
+        r: f64,
+        /// The curve length `l`.
+        length: f64,
+    },
+    /// With the given `alpha0` the target needs `|a2| > A`, so `a1 = ±sqrt(A^2 - a2^2)` is not
+    /// real (eq 6).
+    #[error(
+        "target unreachable with alpha0 = {alpha0}: it needs |a2| = {a2_abs} but the amplitude is only A = {amplitude} (eq 6 needs |a2| <= A)"
+    )]
+    A2ExceedsAmplitude {
+        /// `|a2|`, from the target's direction and `alpha0` (eq 5).
+        a2_abs: f64,
+        /// `A = J0^{-1}(r / l)`.
+        amplitude: f64,
+        /// The base angle used.
+        alpha0: f64,
+    },
+    /// A numerical inverse kinematics did not reach its tolerance.
+    #[error(
+        "numerical inverse kinematics did not converge: end-point error {residual} after {iterations} iterations (tolerance {tolerance})"
+    )]
+    NotConverged {
+        /// Iterations spent.
+        iterations: usize,
+        /// The smallest end-point error reached (distance to the target).
+        residual: f64,
+        /// The end-point error asked for.
+        tolerance: f64,
+    },
+}
+
+impl KinError {
+    /// Whether the error means the target cannot be reached by the backbone curve ([`OutOfReach`],
+    /// [`AtBase`], [`A2ExceedsAmplitude`]), as opposed to malformed input or a numerical failure.
+    ///
+    /// [`OutOfReach`]: KinError::OutOfReach
+    /// [`AtBase`]: KinError::AtBase
+    /// [`A2ExceedsAmplitude`]: KinError::A2ExceedsAmplitude
+    pub fn is_unreachable(&self) -> bool {
+        matches!(
+            self,
+            Self::OutOfReach { .. } | Self::AtBase { .. } | Self::A2ExceedsAmplitude { .. }
+        )
+    }
 }

@@ -13,6 +13,7 @@
 //! the map is affine with offset `theta_0 = alpha0 e_1`.
 
 use crate::error::KinError;
+use crate::validate::{check_finite, check_len, check_length, check_output_len};
 
 /// Whether the base inclination `alpha0` is a modal coordinate or a fixed parameter.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,11 +27,12 @@ pub enum BaseAngle {
 /// `sin(2 pi k s / l)` and `1 - cos(2 pi k s / l)`: the contributions of the coordinates
 /// `a_{2k-1}` and `a_{2k}` to the inclination `alpha(s)` (eq 2 generalised to harmonic `k`).
 ///
-/// `1 - cos(x)` is computed as `2 sin^2(x / 2)`, which keeps full relative accuracy near `s = 0`.
+/// Both come from one `sin_cos` of the half angle: `sin(x) = 2 sin(x/2) cos(x/2)` and
+/// `1 - cos(x) = 2 sin^2(x / 2)`, which keeps full relative accuracy near `s = 0`.
 pub fn harmonic_basis(k: usize, s: f64, length: f64) -> (f64, f64) {
     let x = std::f64::consts::TAU * k as f64 * s / length;
-    let half = (0.5 * x).sin();
-    (x.sin(), 2.0 * half * half)
+    let (sin_half, cos_half) = (0.5 * x).sin_cos();
+    (2.0 * sin_half * cos_half, 2.0 * sin_half * sin_half)
 }
 
 /// The affine map `theta = J a + theta_0` from modal coordinates to joint angles (eqs 8-9).
@@ -86,20 +88,10 @@ impl ModalMap {
             return Err(KinError::NoHarmonics);
         }
         for &len in link_lengths {
-            if !(len.is_finite() && len > 0.0) {
-                return Err(KinError::NonPositiveLength {
-                    name: "link length",
-                    value: len,
-                });
-            }
+            check_length("link length", len)?;
         }
-        if let BaseAngle::Fixed(alpha0) = base
-            && !alpha0.is_finite()
-        {
-            return Err(KinError::NonFinite {
-                name: "alpha0",
-                value: alpha0,
-            });
+        if let BaseAngle::Fixed(alpha0) = base {
+            check_finite("alpha0", alpha0)?;
         }
         let n = link_lengths.len();
         let n_modal = 2 * harmonics;
@@ -193,13 +185,7 @@ impl ModalMap {
 
     fn apply(&self, a: &[f64], out: &mut [f64], with_offset: bool) -> Result<(), KinError> {
         check_len("modal coordinates", a, self.n_coords)?;
-        if out.len() != self.n_joints {
-            return Err(KinError::Dimension {
-                name: "joint output",
-                expected: self.n_joints,
-                got: out.len(),
-            });
-        }
+        check_output_len("joint output", out.len(), self.n_joints)?;
         for (i, o) in out.iter_mut().enumerate() {
             let dot: f64 = self.row(i).iter().zip(a).map(|(j, x)| j * x).sum();
             *o = if with_offset {
@@ -210,23 +196,4 @@ impl ModalMap {
         }
         Ok(())
     }
-}
-
-/// Checks that `values` has `expected` entries, all finite.
-pub(crate) fn check_len(
-    name: &'static str,
-    values: &[f64],
-    expected: usize,
-) -> Result<(), KinError> {
-    if values.len() != expected {
-        return Err(KinError::Dimension {
-            name,
-            expected,
-            got: values.len(),
-        });
-    }
-    if let Some(&value) = values.iter().find(|v| !v.is_finite()) {
-        return Err(KinError::NonFinite { name, value });
-    }
-    Ok(())
 }

@@ -1,0 +1,228 @@
+//! Numerical inverse kinematics of the `K`-harmonic backbone curve (beyond the paper).
+//!
+//! With `alpha0` and the length fixed, the end point `p(a)` of the curve is a smooth map from the
+//! `2K` modal coordinates to the plane. [`HarmonicIk`] solves `p(a) = target` by
+//! Levenberg-Marquardt (damped least squares) from a caller's initial guess:
+//! `delta = -J^T (J J^T + mu I)^{-1} (p(a) - target)`, with the analytic end-point Jacobian
+//! `J = d p / d a` of [`BackboneCurve::end_point_jacobian`] and steps no longer than 0.5 rad (a
+//! trust region in modal space). The damping `mu` shrinks after every step that reduces the
+//! end-point error and grows after every step that does not, so near a solution the step is the
+//! minimum-norm Gauss-Newton step. For `K = 1` (`J` square) that is Newton's method on eqs 3-4:
+//! from a nearby guess it converges to the closed-form solution of eqs 5-6. For `K > 1` the
+//! problem is underdetermined and the solver returns a solution near the guess.
+//!
+//! The method is local. Measured on the end points of random curves (`alpha0` uniform in
+//! `[-0.5, 0.5]`), from guesses uniform in `[-0.5, 0.5]^{2K}`, 400 targets for each `K = 1, 2, 3`:
+//! with modal coordinates uniform in `[-0.5, 0.5]` it converges in 1199 of 1200 cases (6-7
+//! iterations on average), in `[-1, 1]` in 98%, in `[-2, 2]` in 99% (8-10 iterations); the test
+//! `numeric_ik_convergence_rates` keeps these rates. Failures are stationary points of the
+//! end-point error (where the tip cannot move radially) and are reported as
+//! [`KinError::NotConverged`].
+
+use crate::curve::BackboneCurve;
+use crate::error::KinError;
+use crate::validate::{check_finite, check_len};
+
+/// Stopping rules of [`HarmonicIk::solve`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IkOptions {
+    /// End-point error to reach, relative to the curve length: the solver stops once
+    /// `|p(a) - target| <= tolerance * l`. Default `1e-14`.
+    pub tolerance: f64,
+    /// Most trial steps (accepted or rejected) before giving up with
+    /// [`KinError::NotConverged`]; 0 only checks the guess. Default 100.
+    pub max_iterations: usize,
+}
+
+impl Default for IkOptions {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-14,
+            max_iterations: 100,
+        }
+    }
+}
+
+/// What a successful [`HarmonicIk::solve`] spent and reached.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IkReport {
+    /// Trial steps taken (0 if the initial guess already met the tolerance).
+    pub iterations: usize,
+    /// Final end-point error `|p(a) - target|`.
+    pub residual: f64,
+}
+
+/// Relative damping `mu / trace(J J^T)` of the first step and the smallest one used.
+const DAMPING_MIN: f64 = 1e-15;
+/// Relative damping after the first rejected step.
+const DAMPING_RESTART: f64 = 1e-6;
+/// Relative damping beyond which the solver has stalled.
+const DAMPING_MAX: f64 = 1e16;
+/// Longest step in modal space (radians, Euclidean norm): a trust region. Without it the first
+/// Gauss-Newton steps from a near-straight guess (where `J` is nearly rank one) jump to
+/// amplitudes of several radians, where the end-point map is full of stationary points.
+const MAX_STEP: f64 = 0.5;
+
+/// Reusable solver for the end point of a `K`-harmonic curve of fixed length and `alpha0`.
+/// Created once; [`solve`](Self::solve) allocates nothing.
+///
+/// ```
+/// use backbone_kin::{BackboneCurve, HarmonicIk};
+/// let mut ik = HarmonicIk::new(1.0, 2, 0.3)?;
+/// let target = [0.4, 0.6];
+/// let mut a = [0.5, 0.5, 0.1, -0.1]; // initial guess on entry, solution on return
+/// let report = ik.solve(target, &mut a)?;
+/// let tip = BackboneCurve::new(1.0, &a, 0.3)?.end_point();
+/// assert!((tip[0] - 0.4).abs() < 1e-13 && (tip[1] - 0.6).abs() < 1e-13);
+/// assert!(report.residual <= 1e-14);
+/// # Ok::<(), backbone_kin::KinError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct HarmonicIk {
+    curve: BackboneCurve,
+    options: IkOptions,
+    trial: Vec<f64>,
+    jacobian: Vec<f64>,
+    trial_jacobian: Vec<f64>,
+}
+
+impl HarmonicIk {
+    /// A solver for curves of length `length` with `harmonics` harmonics (`2 * harmonics`
+    /// unknowns) leaving the base at `alpha0`, with [`IkOptions::default`].
+    pub fn new(length: f64, harmonics: usize, alpha0: f64) -> Result<Self, KinError> {
+        if harmonics == 0 {
+            return Err(KinError::NoHarmonics);
+        }
+        let m = 2 * harmonics;
+        Ok(Self {
+            curve: BackboneCurve::new(length, &vec![0.0; m], alpha0)?,
+            options: IkOptions::default(),
+            trial: vec![0.0; m],
+            jacobian: vec![0.0; 2 * m],
+            trial_jacobian: vec![0.0; 2 * m],
+        })
+    }
+
+    /// Replaces the stopping rules; `tolerance` must be positive and finite.
+    pub fn with_options(mut self, options: IkOptions) -> Result<Self, KinError> {
+        check_finite("IK tolerance", options.tolerance)?;
+        if options.tolerance <= 0.0 {
+            return Err(KinError::NonPositiveLength {
+                name: "IK tolerance",
+                value: options.tolerance,
+            });
+        }
+        self.options = options;
+        Ok(self)
+    }
+
+    /// The number of harmonics `K` (the solver has `2K` unknowns).
+    pub fn harmonics(&self) -> usize {
+        self.curve.harmonics()
+    }
+
+    /// The stopping rules in use.
+    pub fn options(&self) -> IkOptions {
+        self.options
+    }
+
+    /// Solves `p(a) = target` for the modal coordinates `a` (`2K` entries), which hold the
+    /// initial guess on entry and the solution on success; after [`KinError::NotConverged`] they
+    /// hold the best iterate found.
+    ///
+    /// Errors: [`KinError::OutOfReach`] if `|target| > l` (no curve of length `l` reaches it);
+    /// [`KinError::NotConverged`] if the tolerance is not met within the iteration budget or the
+    /// iteration stalls (for instance from the straight guess `a = 0` towards a target on the
+    /// base direction, where the end point is stationary, or for a target the family cannot
+    /// reach with this `alpha0`); input errors for a non-finite target or guess, or a guess of
+    /// the wrong size.
+    pub fn solve(&mut self, target: [f64; 2], a: &mut [f64]) -> Result<IkReport, KinError> {
+        check_finite("target x", target[0])?;
+        check_finite("target y", target[1])?;
+        check_len("initial guess", a, self.trial.len())?;
+        let length = self.curve.length();
+        let r = target[0].hypot(target[1]);
+        if r > length {
+            return Err(KinError::OutOfReach { r, length });
+        }
+        let tolerance = self.options.tolerance * length;
+        self.curve.set_modes(a)?;
+        let mut point = self.curve.end_point_jacobian(&mut self.jacobian)?;
+        let mut residual = distance(point, target);
+        let mut damping = DAMPING_MIN;
+        let mut iterations = 0;
+        while residual > tolerance {
+            let error = [point[0] - target[0], point[1] - target[1]];
+            if iterations == self.options.max_iterations
+                || damping > DAMPING_MAX
+                || !damped_step(&self.jacobian, error, damping, a, &mut self.trial)
+            {
+                return Err(KinError::NotConverged {
+                    iterations,
+                    residual,
+                    tolerance,
+                });
+            }
+            iterations += 1;
+            let trial_point = self
+                .curve
+                .set_modes(&self.trial)
+                .and_then(|()| self.curve.end_point_jacobian(&mut self.trial_jacobian));
+            match trial_point {
+                Ok(trial_point) if distance(trial_point, target) < residual => {
+                    point = trial_point;
+                    residual = distance(point, target);
+                    a.copy_from_slice(&self.trial);
+                    std::mem::swap(&mut self.jacobian, &mut self.trial_jacobian);
+                    damping = (damping / 10.0).max(DAMPING_MIN);
+                }
+                _ => damping = (damping * 10.0).max(DAMPING_RESTART),
+            }
+        }
+        Ok(IkReport {
+            iterations,
+            residual,
+        })
+    }
+}
+
+/// `trial = a - J^T (J J^T + mu I)^{-1} error` with `mu = damping * trace(J J^T)`, `J` the
+/// `2 x m` row-major end-point Jacobian, the step shortened to at most [`MAX_STEP`]. Returns
+/// false when the step is undefined (`J = 0`).
+fn damped_step(
+    jacobian: &[f64],
+    error: [f64; 2],
+    damping: f64,
+    a: &[f64],
+    trial: &mut [f64],
+) -> bool {
+    let (jx, jy) = jacobian.split_at(a.len());
+    let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(p, q)| p * q).sum::<f64>();
+    let (gxx, gxy, gyy) = (dot(jx, jx), dot(jx, jy), dot(jy, jy));
+    let mu = damping * (gxx + gyy);
+    let (g00, g11) = (gxx + mu, gyy + mu);
+    let det = g00 * g11 - gxy * gxy;
+    if !(det > 0.0 && det.is_finite()) {
+        return false;
+    }
+    let y = [
+        (g11 * error[0] - gxy * error[1]) / det,
+        (g00 * error[1] - gxy * error[0]) / det,
+    ];
+    let step = |dx: f64, dy: f64| dx * y[0] + dy * y[1];
+    let norm = jx
+        .iter()
+        .zip(jy)
+        .map(|(&dx, &dy)| step(dx, dy).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let scale = (MAX_STEP / norm).min(1.0);
+    for (((t, &aj), &dx), &dy) in trial.iter_mut().zip(a).zip(jx).zip(jy) {
+        *t = aj - scale * step(dx, dy);
+    }
+    true
+}
+
+fn distance(p: [f64; 2], q: [f64; 2]) -> f64 {
+    (p[0] - q[0]).hypot(p[1] - q[1])
+}
