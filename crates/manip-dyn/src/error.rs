@@ -41,8 +41,17 @@ pub enum DynError {
         /// The offending value.
         value: f64,
     },
-    /// The mass matrix could not be factorised (it is positive definite for every valid chain,
-    /// so this signals numbers too extreme for double precision).
+    /// A computation on finite inputs overflowed (inputs too large for double precision).
+    #[error("{name} is not finite: the inputs are too large for double precision")]
+    NonFiniteResult {
+        /// Which output.
+        name: &'static str,
+    },
+    /// The mass matrix was not numerically positive definite: a pivot of its factorisation (a
+    /// Cholesky pivot, or an articulated inertia about a joint axis) was not positive beyond
+    /// rounding (at least about 2e-13 of the matching diagonal entry of `M`). `M` is positive
+    /// definite for every valid chain, so this signals link parameters too disparate for double
+    /// precision; the accelerations would have no reliable digits.
     #[error("the mass matrix is not numerically positive definite")]
     NotPositiveDefinite,
 }

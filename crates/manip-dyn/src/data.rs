@@ -1,0 +1,112 @@
+//! The reusable workspace of every algorithm (the "Data" of Pinocchio's Model/Data split).
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::llt;
+use faer::reborrow::ReborrowMut;
+use faer::{Mat, Par};
+
+use crate::aba::ArticulatedLink;
+use crate::coriolis_matrix::SubtreeMotion;
+use crate::crba::Subtree;
+use crate::kinematics::LinkFrame;
+use crate::model::ChainModel;
+use crate::rnea::LinkAcceleration;
+
+/// Scratch space for one [`ChainModel`]: build it once with [`ChainData::new`], then pass it to
+/// every algorithm. After construction, no algorithm of this crate allocates (on another thread
+/// than the one that built it, faer may allocate its matrix-multiply buffer once, in the first
+/// [`forward_dynamics`](crate::forward_dynamics()) of a chain of 100 links or more).
+///
+/// Its contents between calls are unspecified; it holds no state that outlives a call.
+pub struct ChainData {
+    /// Direction and angular velocity of each link.
+    pub(crate) frames: Vec<LinkFrame>,
+    /// Link accelerations of the Newton-Euler recursion.
+    pub(crate) accelerations: Vec<LinkAcceleration>,
+    /// Composite bodies `i..n` of the composite-rigid-body algorithm.
+    pub(crate) subtrees: Vec<Subtree>,
+    /// Velocity moments of the composite bodies (Coriolis matrix).
+    pub(crate) subtree_motions: Vec<SubtreeMotion>,
+    /// Articulated-body quantities of each joint.
+    pub(crate) articulated: Vec<ArticulatedLink>,
+    /// One row of the mass matrix during its assembly.
+    pub(crate) mass_row: Vec<f64>,
+    /// `n x n`: the mass matrix, then its Cholesky factor (lower triangle) in forward dynamics.
+    pub(crate) mass_factor: Mat<f64>,
+    /// Scratch memory of the in-place Cholesky factorisation and solve.
+    pub(crate) stack: MemBuffer,
+}
+
+impl ChainData {
+    /// Allocates the workspace for `model`.
+    ///
+    /// ```
+    /// use manip_dyn::{ChainData, ChainModel};
+    /// let arm = ChainModel::uniform(10, 0.1, 0.1, 9.81)?;
+    /// let data = ChainData::new(&arm);
+    /// assert_eq!(data.n_links(), 10);
+    /// # Ok::<(), manip_dyn::DynError>(())
+    /// ```
+    pub fn new(model: &ChainModel) -> ChainData {
+        Self::with_links(model.n_links())
+    }
+
+    /// Number of links of the chain this workspace was built for.
+    pub fn n_links(&self) -> usize {
+        self.frames.len()
+    }
+
+    fn with_links(n: usize) -> ChainData {
+        let stack = StackReq::or(
+            llt::factor::cholesky_in_place_scratch::<f64>(n, Par::Seq, Default::default()),
+            llt::solve::solve_in_place_scratch::<f64>(n, 1, Par::Seq),
+        );
+        let mut data = ChainData {
+            frames: vec![LinkFrame::default(); n],
+            accelerations: vec![LinkAcceleration::default(); n],
+            subtrees: vec![Subtree::default(); n],
+            subtree_motions: vec![SubtreeMotion::default(); n],
+            articulated: vec![ArticulatedLink::default(); n],
+            mass_row: vec![0.0; n],
+            mass_factor: Mat::zeros(n, n),
+            stack: MemBuffer::new(stack),
+        };
+        data.warm_up_factorisation();
+        data
+    }
+
+    /// faer's blocked Cholesky (from about 100 x 100) multiplies with a kernel that allocates a
+    /// packing buffer per thread on first use. Factoring an identity of up to `WARM_UP` rows here
+    /// takes that one-time allocation out of the first call of
+    /// [`forward_dynamics`](crate::forward_dynamics()) on this thread, for about 0.5 ms.
+    fn warm_up_factorisation(&mut self) {
+        const WARM_UP: usize = 256;
+        let size = self.n_links().min(WARM_UP);
+        let mut block = self.mass_factor.as_mut().submatrix_mut(0, 0, size, size);
+        block.rb_mut().fill(0.0);
+        block.rb_mut().diagonal_mut().fill(1.0);
+        let factored = llt::factor::cholesky_in_place(
+            block,
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut self.stack),
+            Default::default(),
+        );
+        debug_assert!(factored.is_ok(), "the identity is positive definite");
+    }
+}
+
+impl Clone for ChainData {
+    /// A fresh workspace of the same size (the contents are scratch, so nothing else is copied).
+    fn clone(&self) -> Self {
+        Self::with_links(self.n_links())
+    }
+}
+
+impl std::fmt::Debug for ChainData {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ChainData")
+            .field("n_links", &self.n_links())
+            .finish_non_exhaustive()
+    }
+}
