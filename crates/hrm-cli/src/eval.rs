@@ -6,7 +6,12 @@
 //! is documented in `docs/eval-protocol.md`.
 
 use crate::arm::ArmSpec;
-use backbone_kin::{BaseAngle, ModalMap};
+use backbone_kin::{
+    BaseAngle, Branch, KinError, ModalMap, end_point, inverse_kinematics, tip_position,
+};
+use manip_dyn::faer::Mat;
+use manip_dyn::{ChainData, ChainModel, DynError};
+use modal_reduce::{ReduceError, ReducedData, ReducedModel};
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
 use serde_json::{Map, Value, json};
@@ -186,11 +191,16 @@ fn answer(line: &[u8]) -> Value {
     }
 }
 
-const OPS: &str = "joints";
+const OPS: &str = "fk, ik, joints, dynamics, reduced, fuzzy";
 
 fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
     match op {
+        "fk" => fk(parse(request)?),
+        "ik" => ik(parse(request)?),
         "joints" => joints(parse(request)?),
+        "dynamics" => dynamics(parse(request)?),
+        "reduced" => reduced(parse(request)?),
+        "fuzzy" => fuzzy(parse(request)?),
         other => Err(EvalError::new(
             Kind::UnknownOp,
             format!("unknown op {other:?}; known ops: {OPS}"),
@@ -205,8 +215,7 @@ fn parse<T: DeserializeOwned>(request: Map<String, Value>) -> Result<T, EvalErro
 }
 
 /// Modal coordinates as requests give them: `[a1, a2, alpha0]`, or `[a1, a2]` with `"alpha0"`.
-fn modal_map(arm: &ArmSpec, a: &[f64], alpha0: Option<f64>) -> Result<ModalMap, EvalError> {
-    let chain = arm.to_chain().map_err(EvalError::input)?;
+fn modal_map(chain: &ChainModel, a: &[f64], alpha0: Option<f64>) -> Result<ModalMap, EvalError> {
     let lengths: Vec<f64> = chain.link_lengths().collect();
     let base = match (a.len(), alpha0) {
         (3, None) => BaseAngle::Free,
@@ -241,6 +250,64 @@ fn finite(name: &str, values: &[f64]) -> Result<(), EvalError> {
     }
 }
 
+/// Maps a kinematics error to its answer kind: unreachable targets apart from malformed input.
+fn kin_error(error: KinError) -> EvalError {
+    let kind = if error.is_unreachable() {
+        Kind::Unreachable
+    } else {
+        Kind::InvalidInput
+    };
+    EvalError::new(kind, error.to_string())
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FkRequest {
+    #[serde(default)]
+    arm: ArmSpec,
+    a: [f64; 2],
+    alpha0: f64,
+}
+
+/// `fk`: the closed-form end point of the backbone curve (eqs 3-4) and the discrete chain's tip.
+fn fk(request: FkRequest) -> EvalResult {
+    let chain = request.arm.to_chain().map_err(EvalError::input)?;
+    let map = modal_map(&chain, &request.a, Some(request.alpha0))?;
+    let lengths: Vec<f64> = chain.link_lengths().collect();
+    let tip = end_point(lengths.iter().sum(), request.a, request.alpha0).map_err(kin_error)?;
+    let mut theta = vec![0.0; map.n_joints()];
+    map.joint_angles(&request.a, &mut theta)
+        .map_err(kin_error)?;
+    let tip_chain = tip_position(&lengths, &theta).map_err(kin_error)?;
+    finite("tip", &[tip[0], tip[1], tip_chain[0], tip_chain[1]])?;
+    Ok(json_fields([
+        ("tip", json!(tip)),
+        ("tip_chain", json!(tip_chain)),
+    ]))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct IkRequest {
+    #[serde(default)]
+    arm: ArmSpec,
+    target: [f64; 2],
+    alpha0: f64,
+}
+
+/// `ik`: the closed-form inverse kinematics (eqs 5-6) on the branch `a1 >= 0`.
+fn ik(request: IkRequest) -> EvalResult {
+    let length = request
+        .arm
+        .to_chain()
+        .map_err(EvalError::input)?
+        .total_length();
+    let a = inverse_kinematics(length, request.target, request.alpha0, Branch::Positive)
+        .map_err(kin_error)?;
+    finite("a", &a)?;
+    Ok(json_fields([("a", json!(a))]))
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct JointsRequest {
@@ -252,7 +319,8 @@ struct JointsRequest {
 
 /// `joints`: joint angles `theta = J a (+ alpha0 e_1)` and the modal Jacobian (eqs 7-9).
 fn joints(request: JointsRequest) -> EvalResult {
-    let map = modal_map(&request.arm, &request.a, request.alpha0)?;
+    let chain = request.arm.to_chain().map_err(EvalError::input)?;
+    let map = modal_map(&chain, &request.a, request.alpha0)?;
     let mut theta = vec![0.0; map.n_joints()];
     map.joint_angles(&request.a, &mut theta)
         .map_err(EvalError::input)?;
@@ -262,6 +330,160 @@ fn joints(request: JointsRequest) -> EvalResult {
         ("theta", json!(theta)),
         ("jacobian", json!(jacobian)),
     ]))
+}
+
+/// Maps a dynamics error: a failed factorisation is numerical, everything else bad input.
+fn dyn_error(error: DynError) -> EvalError {
+    let kind = match error {
+        DynError::NotPositiveDefinite => Kind::Numerical,
+        _ => Kind::InvalidInput,
+    };
+    EvalError::new(kind, error.to_string())
+}
+
+/// Maps a modal-reduction error the same way.
+fn reduce_error(error: ReduceError) -> EvalError {
+    match error {
+        ReduceError::Dyn(e) => dyn_error(e),
+        ReduceError::NotPositiveDefinite | ReduceError::NonFiniteResult { .. } => {
+            EvalError::new(Kind::Numerical, error.to_string())
+        }
+        other => EvalError::input(other),
+    }
+}
+
+/// A matrix as JSON rows.
+fn rows(m: manip_dyn::faer::MatRef<'_, f64>) -> Result<Value, EvalError> {
+    let rows: Vec<Vec<f64>> = (0..m.nrows())
+        .map(|i| (0..m.ncols()).map(|j| m[(i, j)]).collect())
+        .collect();
+    finite("mass_matrix", &rows.concat())?;
+    Ok(json!(rows))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DynamicsRequest {
+    #[serde(default)]
+    arm: ArmSpec,
+    theta: Vec<f64>,
+    theta_dot: Vec<f64>,
+}
+
+/// `dynamics`: `M(theta)`, the Coriolis/centrifugal vector `C(theta, theta_dot)` and `G(theta)` of eq 12.
+fn dynamics(request: DynamicsRequest) -> EvalResult {
+    let chain = request.arm.to_chain().map_err(EvalError::input)?;
+    let n = chain.n_links();
+    let mut data = ChainData::new(&chain);
+    let mut mass = Mat::<f64>::zeros(n, n);
+    let (mut coriolis, mut gravity) = (vec![0.0; n], vec![0.0; n]);
+    manip_dyn::mass_matrix(&chain, &mut data, &request.theta, mass.as_mut()).map_err(dyn_error)?;
+    manip_dyn::coriolis(
+        &chain,
+        &mut data,
+        &request.theta,
+        &request.theta_dot,
+        &mut coriolis,
+    )
+    .map_err(dyn_error)?;
+    manip_dyn::gravity(&chain, &mut data, &request.theta, &mut gravity).map_err(dyn_error)?;
+    finite("coriolis", &coriolis)?;
+    finite("gravity", &gravity)?;
+    Ok(json_fields([
+        ("mass_matrix", rows(mass.as_ref())?),
+        ("coriolis", json!(coriolis)),
+        ("gravity", json!(gravity)),
+    ]))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ReducedRequest {
+    #[serde(default)]
+    arm: ArmSpec,
+    a: Vec<f64>,
+    a_dot: Vec<f64>,
+    tau_star: Vec<f64>,
+    alpha0: Option<f64>,
+}
+
+/// `reduced`: the reduced model `M*`, `C*`, `G*` (eqs 13-15), the modal accelerations for the
+/// given `tau*`, and the joint torques `tau = M J a_ddot + C + G` that realise them.
+fn reduced(request: ReducedRequest) -> EvalResult {
+    let chain = request.arm.to_chain().map_err(EvalError::input)?;
+    let map = modal_map(&chain, &request.a, request.alpha0)?;
+    let (n, m) = (map.n_joints(), map.n_coords());
+    let model = ReducedModel::new(chain, map).map_err(reduce_error)?;
+    let mut data = ReducedData::new(&model);
+    let (mut a_ddot, mut torques) = (vec![0.0; m], vec![0.0; n]);
+    modal_reduce::forward_dynamics(
+        &model,
+        &mut data,
+        &request.a,
+        &request.a_dot,
+        &request.tau_star,
+        &mut a_ddot,
+    )
+    .map_err(reduce_error)?;
+    let mass = rows(data.mass_matrix())?;
+    let (coriolis, gravity) = (data.coriolis().to_vec(), data.gravity().to_vec());
+    modal_reduce::joint_torques(
+        &model,
+        &mut data,
+        &request.a,
+        &request.a_dot,
+        &a_ddot,
+        &mut torques,
+    )
+    .map_err(reduce_error)?;
+    for (name, values) in [
+        ("coriolis", &coriolis),
+        ("gravity", &gravity),
+        ("a_ddot", &a_ddot),
+        ("joint_torques", &torques),
+    ] {
+        finite(name, values)?;
+    }
+    Ok(json_fields([
+        ("mass_matrix", mass),
+        ("coriolis", json!(coriolis)),
+        ("gravity", json!(gravity)),
+        ("a_ddot", json!(a_ddot)),
+        ("joint_torques", json!(torques)),
+    ]))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FuzzyRequest {
+    controller: Option<String>,
+    fis: Option<String>,
+    inputs: Vec<f64>,
+}
+
+/// `fuzzy`: the outputs of the paper's controller (eqs 19-24), or of a system given as `.fis` text.
+fn fuzzy(request: FuzzyRequest) -> EvalResult {
+    let system = match (request.controller.as_deref(), request.fis) {
+        (Some("paper"), None) => fuzzy_sugeno::paper_controller(),
+        (Some(other), None) => {
+            return Err(EvalError::input(format!(
+                "unknown controller {other:?}; known: \"paper\""
+            )));
+        }
+        (None, Some(text)) => crate::fis_cmd::load_system(&text).map_err(EvalError::input)?,
+        _ => {
+            return Err(EvalError::new(
+                Kind::InvalidRequest,
+                "give exactly one of \"controller\" and \"fis\"",
+            ));
+        }
+    };
+    let mut outputs = vec![0.0; system.outputs().len()];
+    fuzzy_sugeno::Evaluator::new(system)
+        .eval(&request.inputs, &mut outputs)
+        .map_err(EvalError::input)?;
+    finite("outputs", &outputs)?;
+    Ok(json_fields([("outputs", json!(outputs))]))
 }
 
 fn json_fields<const N: usize>(fields: [(&str, Value); N]) -> Map<String, Value> {
@@ -335,6 +557,103 @@ mod tests {
         let alpha = 0.5 + 0.3 * s.sin() - 0.2 * (1.0 - s.cos());
         approx::assert_abs_diff_eq!(theta.iter().sum::<f64>(), alpha, epsilon = 1e-14);
         assert_eq!(answers[0]["jacobian"].as_array().unwrap().len(), 10);
+    }
+
+    #[test]
+    fn fk_and_ik_invert_each_other_and_report_unreachable_targets() {
+        let answers = run(
+            b"{\"id\":1,\"op\":\"ik\",\"target\":[0.3,0.5],\"alpha0\":1.5707963267948966}\n\
+            {\"id\":2,\"op\":\"ik\",\"target\":[1.2,0.5],\"alpha0\":0}\n\
+            {\"id\":3,\"op\":\"fk\",\"a\":[0.0,0.0],\"alpha0\":0.5}\n",
+        );
+        let a: [f64; 2] = serde_json::from_value(answers[0]["a"].clone()).unwrap();
+        assert!(a[0] >= 0.0);
+        let fk = format!(
+            "{{\"op\":\"fk\",\"a\":[{},{}],\"alpha0\":1.5707963267948966}}\n",
+            a[0], a[1]
+        );
+        let tip: [f64; 2] = serde_json::from_value(run(fk.as_bytes())[0]["tip"].clone()).unwrap();
+        approx::assert_abs_diff_eq!(tip[0], 0.3, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(tip[1], 0.5, epsilon = 1e-12);
+        assert_eq!(answers[1]["error"]["kind"], "unreachable");
+        // A straight arm: both tips at distance l = 1 along alpha0.
+        for key in ["tip", "tip_chain"] {
+            let tip: [f64; 2] = serde_json::from_value(answers[2][key].clone()).unwrap();
+            approx::assert_abs_diff_eq!(tip[0], 0.5f64.cos(), epsilon = 1e-14);
+            approx::assert_abs_diff_eq!(tip[1], 0.5f64.sin(), epsilon = 1e-14);
+        }
+    }
+
+    fn vector(value: &Value) -> Vec<f64> {
+        serde_json::from_value(value.clone()).unwrap()
+    }
+
+    #[test]
+    fn dynamics_of_one_link_is_a_pendulum() {
+        // One uniform beam of 0.1 m, 0.1 kg: M = m L^2 / 3, C = 0, G = m g (L/2) cos(theta).
+        let answers = run(
+            b"{\"op\":\"dynamics\",\"arm\":{\"links\":1},\"theta\":[0.3],\"theta_dot\":[2.0]}\n",
+        );
+        approx::assert_relative_eq!(
+            answers[0]["mass_matrix"][0][0].as_f64().unwrap(),
+            0.1 * 0.01 / 3.0,
+            max_relative = 1e-14
+        );
+        approx::assert_abs_diff_eq!(
+            answers[0]["coriolis"][0].as_f64().unwrap(),
+            0.0,
+            epsilon = 1e-15
+        );
+        approx::assert_relative_eq!(
+            answers[0]["gravity"][0].as_f64().unwrap(),
+            0.1 * 9.81 * 0.05 * 0.3f64.cos(),
+            max_relative = 1e-14
+        );
+    }
+
+    #[test]
+    fn reduced_torques_project_back_to_tau_star() {
+        let request = b"{\"op\":\"reduced\",\"a\":[0.4,-0.3,1.2],\"a_dot\":[0.5,1.0,-0.2],\"tau_star\":[0.3,-0.1,0.2]}\n";
+        let answer = &run(request)[0];
+        let torques = vector(&answer["joint_torques"]);
+        let map = ModalMap::paper(10).unwrap();
+        for (j, expected) in [0.3, -0.1, 0.2].into_iter().enumerate() {
+            let projected: f64 = (0..10).map(|i| map.entry(i, j) * torques[i]).sum();
+            approx::assert_abs_diff_eq!(projected, expected, epsilon = 1e-12);
+        }
+        assert_eq!(answer["mass_matrix"].as_array().unwrap().len(), 3);
+        // Two coordinates with alpha0 fixed, and the refusal of a mismatched tau_star.
+        let two = b"{\"op\":\"reduced\",\"a\":[0.4,-0.3],\"alpha0\":1.2,\"a_dot\":[0,0],\"tau_star\":[0,0]}\n\
+            {\"op\":\"reduced\",\"a\":[0.4,-0.3],\"alpha0\":1.2,\"a_dot\":[0,0],\"tau_star\":[0]}\n";
+        let answers = run(two);
+        assert_eq!(vector(&answers[0]["a_ddot"]).len(), 2);
+        assert_eq!(answers[1]["error"]["kind"], "invalid_input");
+    }
+
+    #[test]
+    fn fuzzy_paper_controller_and_fis_text_agree() {
+        let fis = include_str!("../../fuzzy-sugeno/data/paper.fis");
+        let request = json!({"op": "fuzzy", "fis": fis, "inputs": [0.1, -0.2, 0.3, 0.5]});
+        let input = format!(
+            "{{\"op\":\"fuzzy\",\"controller\":\"paper\",\"inputs\":[0.1,-0.2,0.3,0.5]}}\n{request}\n\
+            {{\"op\":\"fuzzy\",\"controller\":\"paper\",\"inputs\":[0,0,0,0]}}\n\
+            {{\"op\":\"fuzzy\",\"controller\":\"paper\",\"inputs\":[0,0]}}\n"
+        );
+        let answers = run(input.as_bytes());
+        let (preset, loaded) = (
+            vector(&answers[0]["outputs"]),
+            vector(&answers[1]["outputs"]),
+        );
+        assert_eq!(preset.len(), 2);
+        for (p, l) in preset.iter().zip(&loaded) {
+            approx::assert_abs_diff_eq!(p, l, epsilon = 1e-12);
+        }
+        // da1 > 0 with a1 rising: the controller pushes a1 back (measured minus desired, notes).
+        assert!(preset[0] < 0.0);
+        for out in vector(&answers[2]["outputs"]) {
+            approx::assert_abs_diff_eq!(out, 0.0, epsilon = 1e-12);
+        }
+        assert_eq!(answers[3]["error"]["kind"], "invalid_input");
     }
 
     #[test]

@@ -2,6 +2,8 @@
 
 mod arm;
 mod eval;
+mod fis_cmd;
+mod plot;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -18,12 +20,15 @@ struct Cli {
 enum Command {
     /// Answer JSON-lines requests on stdin, one JSON answer per line on stdout (docs/eval-protocol.md).
     Eval,
+    /// Check, evaluate and plot Takagi-Sugeno systems stored as MATLAB .fis files.
+    Fis(fis_cmd::FisArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Eval) => eval::run_stdio(),
+        Some(Command::Fis(args)) => fis_cmd::run(args),
         None => {
             use clap::CommandFactory;
             Cli::command().print_help().map_err(|e| e.to_string())

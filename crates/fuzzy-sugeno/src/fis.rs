@@ -1,0 +1,993 @@
+//! MATLAB's `.fis` text format for Sugeno systems: `[System]`, `[InputN]`, `[OutputN]` and
+//! `[Rules]` sections, rule lines like `1 -2 0, 3 (0.5) : 1`.
+//!
+//! Writing then reading gives back the identical system (numbers are written in the shortest
+//! form that parses back to the same `f64`). Reading is strict: every malformed line is an error
+//! that gives its line number and what was expected, and Mamdani systems are refused.
+
+use crate::error::FuzzyError;
+use crate::membership::{MembershipFn, format_params};
+use crate::system::{
+    AndMethod, Antecedent, Connective, Defuzzification, FuzzySet, FuzzySystem, InputVariable,
+    Methods, OrMethod, OutputFn, OutputTerm, OutputVariable, Rule, check_name, check_rule,
+};
+use std::fmt::Write as _;
+
+impl FuzzySystem {
+    /// Reads a Sugeno system from the text of a MATLAB `.fis` file.
+    ///
+    /// ```
+    /// use fuzzy_sugeno::{paper_controller, FuzzySystem};
+    /// let text = paper_controller().to_fis();
+    /// assert_eq!(FuzzySystem::from_fis(&text)?, paper_controller());
+    ///
+    /// let error = FuzzySystem::from_fis("[System]\nName='x'\nType='mamdani'\n").unwrap_err();
+    /// assert!(error.to_string().starts_with("line 3: Mamdani systems are not supported"));
+    /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
+    /// ```
+    pub fn from_fis(text: &str) -> Result<Self, FuzzyError> {
+        Parser::split(text)?.system()
+    }
+
+    /// Writes the system as the text of a MATLAB `.fis` file.
+    pub fn to_fis(&self) -> String {
+        let mut out = String::new();
+        let methods = self.methods();
+        let and = match methods.and {
+            AndMethod::Product => "prod",
+            AndMethod::Minimum => "min",
+        };
+        let or = match methods.or {
+            OrMethod::ProbabilisticSum => "probor",
+            OrMethod::Maximum => "max",
+        };
+        let defuzz = match methods.defuzzification {
+            Defuzzification::WeightedAverage => "wtaver",
+            Defuzzification::WeightedSum => "wtsum",
+        };
+        // Writing to a String cannot fail.
+        let _ = write!(
+            out,
+            "[System]\nName='{}'\nType='sugeno'\nVersion=2.0\nNumInputs={}\nNumOutputs={}\nNumRules={}\n\
+             AndMethod='{and}'\nOrMethod='{or}'\nImpMethod='prod'\nAggMethod='sum'\nDefuzzMethod='{defuzz}'\n",
+            self.name(),
+            self.inputs().len(),
+            self.outputs().len(),
+            self.rules().len(),
+        );
+        for (i, input) in self.inputs().iter().enumerate() {
+            let _ = write!(out, "\n[Input{}]\n", i + 1);
+            write_variable_header(&mut out, &input.name, input.range, input.sets.len());
+            for (k, set) in input.sets.iter().enumerate() {
+                let mf = &set.membership;
+                let _ = writeln!(
+                    out,
+                    "MF{}='{}':'{}',{}",
+                    k + 1,
+                    set.name,
+                    mf.matlab_name(),
+                    fis_numbers(&mf.params())
+                );
+            }
+        }
+        for (o, output) in self.outputs().iter().enumerate() {
+            let _ = write!(out, "\n[Output{}]\n", o + 1);
+            write_variable_header(&mut out, &output.name, output.range, output.terms.len());
+            for (k, term) in output.terms.iter().enumerate() {
+                let (kind, params) = match &term.function {
+                    OutputFn::Constant(c) => ("constant", vec![*c]),
+                    OutputFn::Linear {
+                        coefficients,
+                        constant,
+                    } => (
+                        "linear",
+                        coefficients.iter().copied().chain([*constant]).collect(),
+                    ),
+                };
+                let _ = writeln!(
+                    out,
+                    "MF{}='{}':'{kind}',{}",
+                    k + 1,
+                    term.name,
+                    fis_numbers(&params)
+                );
+            }
+        }
+        out.push_str("\n[Rules]\n");
+        for rule in self.rules() {
+            let antecedents: Vec<String> = rule
+                .antecedents
+                .iter()
+                .map(|a| match *a {
+                    Antecedent::Any => "0".to_string(),
+                    Antecedent::Is(k) => (k + 1).to_string(),
+                    Antecedent::IsNot(k) => format!("-{}", k + 1),
+                })
+                .collect();
+            let consequents: Vec<String> = rule
+                .consequents
+                .iter()
+                .map(|c| c.map_or(0, |k| k + 1).to_string())
+                .collect();
+            let connective = match rule.connective {
+                Connective::And => 1,
+                Connective::Or => 2,
+            };
+            let _ = writeln!(
+                out,
+                "{}, {} ({}) : {connective}",
+                antecedents.join(" "),
+                consequents.join(" "),
+                fis_number(rule.weight)
+            );
+        }
+        out
+    }
+}
+
+fn write_variable_header(out: &mut String, name: &str, range: [f64; 2], count: usize) {
+    let _ = write!(
+        out,
+        "Name='{name}'\nRange={}\nNumMFs={count}\n",
+        fis_numbers(&range)
+    );
+}
+
+/// The shortest decimal that parses back to the same `f64`, in exponent form for very large or
+/// very small magnitudes.
+fn fis_number(x: f64) -> String {
+    let magnitude = x.abs();
+    if magnitude != 0.0 && !(1e-5..1e15).contains(&magnitude) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+fn fis_numbers(values: &[f64]) -> String {
+    let inner: Vec<String> = values.iter().map(|&v| fis_number(v)).collect();
+    format!("[{}]", inner.join(" "))
+}
+
+/// A `key=value` line or a rule line, with its 1-based line number.
+#[derive(Debug, Clone, Copy)]
+struct Line<'a> {
+    number: usize,
+    text: &'a str,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SectionKind {
+    System,
+    Input(usize),
+    Output(usize),
+    Rules,
+}
+
+#[derive(Debug)]
+struct Section<'a> {
+    kind: SectionKind,
+    header: usize,
+    lines: Vec<Line<'a>>,
+}
+
+/// The file split into sections; turned into a system by [`Parser::system`].
+struct Parser<'a> {
+    sections: Vec<Section<'a>>,
+}
+
+fn error(line: usize, message: impl Into<String>) -> FuzzyError {
+    FuzzyError::Fis {
+        line,
+        message: message.into(),
+    }
+}
+
+impl<'a> Parser<'a> {
+    /// Splits the text into sections, skipping blank lines and `%` comments.
+    fn split(text: &'a str) -> Result<Self, FuzzyError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let mut sections: Vec<Section<'a>> = Vec::new();
+        for (index, raw) in text.lines().enumerate() {
+            let number = index + 1;
+            let line = raw.trim();
+            if line.is_empty() || line.starts_with('%') {
+                continue;
+            }
+            if let Some(name) = line.strip_prefix('[').and_then(|l| l.strip_suffix(']')) {
+                let kind = section_kind(name.trim()).ok_or_else(|| {
+                    error(number, format!("unknown section [{name}]; expected [System], [InputN], [OutputN] or [Rules]"))
+                })?;
+                if let Some(first) = sections.iter().find(|s| s.kind == kind) {
+                    return Err(error(
+                        number,
+                        format!(
+                            "duplicate section [{name}] (first at line {})",
+                            first.header
+                        ),
+                    ));
+                }
+                sections.push(Section {
+                    kind,
+                    header: number,
+                    lines: Vec::new(),
+                });
+                continue;
+            }
+            match sections.last_mut() {
+                Some(section) => section.lines.push(Line { number, text: line }),
+                None => {
+                    return Err(error(
+                        number,
+                        format!("expected the [System] section header, found `{line}`"),
+                    ));
+                }
+            }
+        }
+        Ok(Self { sections })
+    }
+
+    fn section(&self, kind: SectionKind) -> Option<&Section<'a>> {
+        self.sections.iter().find(|s| s.kind == kind)
+    }
+
+    fn system(&self) -> Result<FuzzySystem, FuzzyError> {
+        let Some(section) = self.section(SectionKind::System) else {
+            return Err(error(1, "expected a [System] section"));
+        };
+        let keys = Keys::new(
+            section,
+            &[
+                "Name",
+                "Type",
+                "Version",
+                "NumInputs",
+                "NumOutputs",
+                "NumRules",
+                "AndMethod",
+                "OrMethod",
+                "ImpMethod",
+                "AggMethod",
+                "DefuzzMethod",
+            ],
+            false,
+        )?;
+        // The type first, so that a Mamdani file is named as such whatever else it contains.
+        let (line, kind) = keys.string("Type")?;
+        match kind {
+            "sugeno" => {}
+            "mamdani" => {
+                return Err(error(
+                    line,
+                    "Mamdani systems are not supported (this crate implements Takagi-Sugeno inference); \
+                     expected Type='sugeno'",
+                ));
+            }
+            other => {
+                return Err(error(
+                    line,
+                    format!("expected Type='sugeno', found Type='{other}'"),
+                ));
+            }
+        }
+        let (line, name) = keys.string("Name")?;
+        check_name("system", name).map_err(|reason| error(line, reason))?;
+        let n_inputs = keys.count("NumInputs", 1)?;
+        let n_outputs = keys.count("NumOutputs", 1)?;
+        let n_rules = keys.count("NumRules", 0)?;
+        let methods = Methods {
+            and: keys.choice(
+                "AndMethod",
+                &[("prod", AndMethod::Product), ("min", AndMethod::Minimum)],
+            )?,
+            or: keys.choice(
+                "OrMethod",
+                &[
+                    ("probor", OrMethod::ProbabilisticSum),
+                    ("max", OrMethod::Maximum),
+                ],
+            )?,
+            defuzzification: keys.choice(
+                "DefuzzMethod",
+                &[
+                    ("wtaver", Defuzzification::WeightedAverage),
+                    ("wtsum", Defuzzification::WeightedSum),
+                ],
+            )?,
+        };
+        // Sugeno systems imply by product and aggregate by sum; other choices are not Sugeno.
+        keys.choice("ImpMethod", &[("prod", ())])?;
+        keys.choice("AggMethod", &[("sum", ())])?;
+        for section in &self.sections {
+            match section.kind {
+                SectionKind::Input(k) if k > n_inputs => {
+                    return Err(error(
+                        section.header,
+                        format!("section [Input{k}] but NumInputs={n_inputs}"),
+                    ));
+                }
+                SectionKind::Output(k) if k > n_outputs => {
+                    return Err(error(
+                        section.header,
+                        format!("section [Output{k}] but NumOutputs={n_outputs}"),
+                    ));
+                }
+                _ => {}
+            }
+        }
+        let header = section.header;
+        let missing = |what: String, count: String| {
+            error(header, format!("missing section [{what}] ({count})"))
+        };
+        let mut names: Vec<(String, usize)> = Vec::new();
+        let mut inputs = Vec::with_capacity(n_inputs);
+        for i in 1..=n_inputs {
+            let section = self
+                .section(SectionKind::Input(i))
+                .ok_or_else(|| missing(format!("Input{i}"), format!("NumInputs={n_inputs}")))?;
+            inputs.push(parse_input(section, &mut names)?);
+        }
+        let mut outputs = Vec::with_capacity(n_outputs);
+        for o in 1..=n_outputs {
+            let section = self
+                .section(SectionKind::Output(o))
+                .ok_or_else(|| missing(format!("Output{o}"), format!("NumOutputs={n_outputs}")))?;
+            outputs.push(parse_output(section, n_inputs, &mut names)?);
+        }
+        let rules = match self.section(SectionKind::Rules) {
+            Some(section) => {
+                if section.lines.len() != n_rules {
+                    return Err(error(
+                        section.header,
+                        format!(
+                            "NumRules={n_rules} but [Rules] has {} rule lines",
+                            section.lines.len()
+                        ),
+                    ));
+                }
+                section
+                    .lines
+                    .iter()
+                    .map(|line| parse_rule(*line, &inputs, &outputs))
+                    .collect::<Result<Vec<_>, _>>()?
+            }
+            None if n_rules == 0 => Vec::new(),
+            None => return Err(missing("Rules".to_string(), format!("NumRules={n_rules}"))),
+        };
+        FuzzySystem::new(name.to_string(), inputs, outputs, rules, methods)
+            .map_err(|e| error(header, e.to_string()))
+    }
+}
+
+fn section_kind(name: &str) -> Option<SectionKind> {
+    let index = |digits: &str| digits.parse::<usize>().ok().filter(|&k| k >= 1);
+    match name {
+        "System" => Some(SectionKind::System),
+        "Rules" => Some(SectionKind::Rules),
+        _ => {
+            if let Some(k) = name.strip_prefix("Input").and_then(index) {
+                Some(SectionKind::Input(k))
+            } else {
+                name.strip_prefix("Output")
+                    .and_then(index)
+                    .map(SectionKind::Output)
+            }
+        }
+    }
+}
+
+/// The `key=value` lines of one section, each key at most once.
+struct Keys<'a> {
+    section: String,
+    header: usize,
+    entries: Vec<(&'a str, &'a str, usize)>,
+}
+
+impl<'a> Keys<'a> {
+    /// Collects the entries; `allowed` lists the plain keys, and `with_functions` allows the
+    /// `MF1`, `MF2`, ... keys too (checked later against `NumMFs`).
+    fn new(
+        section: &Section<'a>,
+        allowed: &[&str],
+        with_functions: bool,
+    ) -> Result<Self, FuzzyError> {
+        let title = match section.kind {
+            SectionKind::System => "[System]".to_string(),
+            SectionKind::Input(k) => format!("[Input{k}]"),
+            SectionKind::Output(k) => format!("[Output{k}]"),
+            SectionKind::Rules => "[Rules]".to_string(),
+        };
+        let mut entries: Vec<(&str, &str, usize)> = Vec::new();
+        for line in &section.lines {
+            let Some((key, value)) = line.text.split_once('=') else {
+                return Err(error(
+                    line.number,
+                    format!("expected key=value in {title}, found `{}`", line.text),
+                ));
+            };
+            let key = key.trim();
+            let is_mf = with_functions
+                && key
+                    .strip_prefix("MF")
+                    .is_some_and(|k| k.parse::<usize>().is_ok_and(|k| k >= 1));
+            if !allowed.contains(&key) && !is_mf {
+                let mut expected = allowed.join(", ");
+                if with_functions {
+                    expected.push_str(", MF1, MF2, ...");
+                }
+                return Err(error(
+                    line.number,
+                    format!("unknown key `{key}` in {title}; expected one of {expected}"),
+                ));
+            }
+            if let Some((_, _, first)) = entries.iter().find(|(k, _, _)| *k == key) {
+                return Err(error(
+                    line.number,
+                    format!("duplicate key `{key}` in {title} (first at line {first})"),
+                ));
+            }
+            entries.push((key, value.trim(), line.number));
+        }
+        Ok(Self {
+            section: title,
+            header: section.header,
+            entries,
+        })
+    }
+
+    /// The value and line of a required key.
+    fn get(&self, key: &str) -> Result<(usize, &'a str), FuzzyError> {
+        self.entries
+            .iter()
+            .find(|(k, _, _)| *k == key)
+            .map(|&(_, value, line)| (line, value))
+            .ok_or_else(|| error(self.header, format!("{} has no {key}= line", self.section)))
+    }
+
+    /// A `'quoted'` value.
+    fn string(&self, key: &str) -> Result<(usize, &'a str), FuzzyError> {
+        let (line, value) = self.get(key)?;
+        let (text, rest) = quoted(value).map_err(|m| error(line, format!("{key}: {m}")))?;
+        if !rest.trim().is_empty() {
+            return Err(error(
+                line,
+                format!(
+                    "{key}: unexpected text `{}` after the quoted value",
+                    rest.trim()
+                ),
+            ));
+        }
+        Ok((line, text))
+    }
+
+    /// A non-negative integer of at least `min`.
+    fn count(&self, key: &str, min: usize) -> Result<usize, FuzzyError> {
+        let (line, value) = self.get(key)?;
+        match value.parse::<usize>() {
+            Ok(n) if n >= min => Ok(n),
+            _ => Err(error(
+                line,
+                format!("expected {key}=<integer >= {min}>, found {key}={value}"),
+            )),
+        }
+    }
+
+    /// A quoted value from a closed list.
+    fn choice<T: Copy>(&self, key: &str, options: &[(&str, T)]) -> Result<T, FuzzyError> {
+        let (line, value) = self.string(key)?;
+        options
+            .iter()
+            .find(|(name, _)| *name == value)
+            .map(|&(_, v)| v)
+            .ok_or_else(|| {
+                let list: Vec<String> = options
+                    .iter()
+                    .map(|(name, _)| format!("'{name}'"))
+                    .collect();
+                error(
+                    line,
+                    format!(
+                        "expected {key}={}, found {key}='{value}'",
+                        list.join(" or ")
+                    ),
+                )
+            })
+    }
+
+    /// `[min max]`, finite with `min < max`.
+    fn range(&self) -> Result<[f64; 2], FuzzyError> {
+        let (line, value) = self.get("Range")?;
+        let numbers = bracketed(value).map_err(|m| error(line, format!("Range: {m}")))?;
+        match numbers[..] {
+            [min, max] if min.is_finite() && max.is_finite() && min < max => Ok([min, max]),
+            [min, max] => Err(error(
+                line,
+                format!("Range must be finite with min < max, found [{min} {max}]"),
+            )),
+            _ => Err(error(
+                line,
+                format!("expected Range=[min max], found Range={value}"),
+            )),
+        }
+    }
+
+    /// The `NumMFs` entries `MF1`..`MFn`, with unique names.
+    fn functions(&self) -> Result<Vec<FunctionLine<'a>>, FuzzyError> {
+        let n = self.count("NumMFs", 1)?;
+        if let Some(&(key, _, line)) = self.entries.iter().find(|(k, _, _)| {
+            k.strip_prefix("MF")
+                .and_then(|d| d.parse::<usize>().ok())
+                .is_some_and(|k| k > n)
+        }) {
+            return Err(error(line, format!("{key} but NumMFs={n}")));
+        }
+        let mut functions: Vec<FunctionLine<'a>> = Vec::with_capacity(n);
+        for k in 1..=n {
+            let (line, value) = self.get(&format!("MF{k}"))?;
+            let (name, kind, params) =
+                function(value).map_err(|m| error(line, format!("MF{k}: {m}")))?;
+            check_name("set", name).map_err(|m| error(line, m))?;
+            if functions.iter().any(|f| f.name == name) {
+                return Err(error(
+                    line,
+                    format!("two functions of {} are named '{name}'", self.section),
+                ));
+            }
+            functions.push(FunctionLine {
+                line,
+                name,
+                kind,
+                params,
+            });
+        }
+        Ok(functions)
+    }
+}
+
+/// One `MFk='name':'type',[params]` line.
+struct FunctionLine<'a> {
+    line: usize,
+    name: &'a str,
+    kind: &'a str,
+    params: Vec<f64>,
+}
+
+/// Parses the variable's `Name=` and checks it is new.
+fn variable_name<'a>(
+    keys: &Keys<'a>,
+    names: &mut Vec<(String, usize)>,
+) -> Result<&'a str, FuzzyError> {
+    let (line, name) = keys.string("Name")?;
+    check_name("variable", name).map_err(|m| error(line, m))?;
+    if let Some((_, first)) = names.iter().find(|(n, _)| n == name) {
+        return Err(error(
+            line,
+            format!("variable name '{name}' is already used at line {first}"),
+        ));
+    }
+    names.push((name.to_string(), line));
+    Ok(name)
+}
+
+fn parse_input(
+    section: &Section<'_>,
+    names: &mut Vec<(String, usize)>,
+) -> Result<InputVariable, FuzzyError> {
+    let keys = Keys::new(section, &["Name", "Range", "NumMFs"], true)?;
+    let name = variable_name(&keys, names)?;
+    let range = keys.range()?;
+    let sets = keys
+        .functions()?
+        .into_iter()
+        .map(
+            |FunctionLine {
+                 line,
+                 name: set,
+                 kind,
+                 params,
+             }| {
+                let membership = MembershipFn::from_matlab(kind, &params)
+                    .map_err(|e| error(line, e.to_string()))?;
+                Ok(FuzzySet {
+                    name: set.to_string(),
+                    membership,
+                })
+            },
+        )
+        .collect::<Result<Vec<_>, FuzzyError>>()?;
+    Ok(InputVariable {
+        name: name.to_string(),
+        range,
+        sets,
+    })
+}
+
+fn parse_output(
+    section: &Section<'_>,
+    n_inputs: usize,
+    names: &mut Vec<(String, usize)>,
+) -> Result<OutputVariable, FuzzyError> {
+    let keys = Keys::new(section, &["Name", "Range", "NumMFs"], true)?;
+    let name = variable_name(&keys, names)?;
+    let range = keys.range()?;
+    let terms = keys
+        .functions()?
+        .into_iter()
+        .map(|FunctionLine { line, name: term, kind, params }| {
+            let function = match (kind, params.len()) {
+                ("constant", 1) => OutputFn::Constant(params[0]),
+                ("linear", n) if n == n_inputs + 1 => {
+                    OutputFn::Linear { coefficients: params[..n_inputs].to_vec(), constant: params[n_inputs] }
+                }
+                ("constant", n) => return Err(error(line, format!("'constant' takes 1 parameter, found {n}"))),
+                ("linear", n) => {
+                    return Err(error(
+                        line,
+                        format!("'linear' takes NumInputs + 1 = {} parameters [p1 ... pn r], found {n}", n_inputs + 1),
+                    ));
+                }
+                (other, _) => {
+                    return Err(error(
+                        line,
+                        format!("a Sugeno output function must be 'constant' or 'linear', found '{other}'"),
+                    ));
+                }
+            };
+            if params.iter().any(|p| !p.is_finite()) {
+                return Err(error(line, format!("parameters must be finite, found {}", format_params(&params))));
+            }
+            Ok(OutputTerm { name: term.to_string(), function })
+        })
+        .collect::<Result<Vec<_>, FuzzyError>>()?;
+    Ok(OutputVariable {
+        name: name.to_string(),
+        range,
+        terms,
+    })
+}
+
+/// Parses `i1 i2 ... in, o1 ... om (weight) : connective`.
+fn parse_rule(
+    line: Line<'_>,
+    inputs: &[InputVariable],
+    outputs: &[OutputVariable],
+) -> Result<Rule, FuzzyError> {
+    let fail = |m: String| error(line.number, m);
+    let shape = "expected a rule `i1 ... in, o1 ... om (weight) : connective`";
+    let Some((left, right)) = line.text.split_once(',') else {
+        return Err(fail(format!("{shape}, found `{}` (no comma)", line.text)));
+    };
+    let (Some(open), Some(close)) = (right.find('('), right.find(')')) else {
+        return Err(fail(format!(
+            "{shape}, found `{}` (no weight in parentheses)",
+            line.text
+        )));
+    };
+    let Some(connective) = right[close + 1..].trim().strip_prefix(':') else {
+        return Err(fail(format!(
+            "{shape}, found `{}` (no `:` after the weight)",
+            line.text
+        )));
+    };
+    let integers = |text: &str, what: &str, expected: usize| -> Result<Vec<i64>, FuzzyError> {
+        let values = text
+            .split_whitespace()
+            .map(|t| {
+                t.parse::<i64>()
+                    .map_err(|_| fail(format!("expected an integer {what} index, found `{t}`")))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        if values.len() != expected {
+            return Err(fail(format!(
+                "expected {expected} {what} indices (one per {what}), found {}",
+                values.len()
+            )));
+        }
+        Ok(values)
+    };
+    let antecedents = integers(left, "input", inputs.len())?
+        .into_iter()
+        .map(|k| match k {
+            0 => Antecedent::Any,
+            k if k > 0 => Antecedent::Is(k.unsigned_abs() as usize - 1),
+            k => Antecedent::IsNot(k.unsigned_abs() as usize - 1),
+        })
+        .collect();
+    let consequents = integers(&right[..open], "output", outputs.len())?
+        .into_iter()
+        .map(|k| match k {
+            0 => Ok(None),
+            k if k > 0 => Ok(Some(k.unsigned_abs() as usize - 1)),
+            k => Err(fail(format!("negated consequent {k}: negation applies to Mamdani output sets, not to Sugeno functions"))),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let weight_text = right[open + 1..close].trim();
+    let weight = weight_text.parse::<f64>().map_err(|_| {
+        fail(format!(
+            "expected a rule weight between the parentheses, found `{weight_text}`"
+        ))
+    })?;
+    let connective = match connective.trim() {
+        "1" => Connective::And,
+        "2" => Connective::Or,
+        other => {
+            return Err(fail(format!(
+                "expected connective 1 (AND) or 2 (OR) after `:`, found `{other}`"
+            )));
+        }
+    };
+    let rule = Rule {
+        antecedents,
+        consequents,
+        weight,
+        connective,
+    };
+    check_rule(&rule, inputs, outputs).map_err(|m| fail(format!("rule {m}")))?;
+    Ok(rule)
+}
+
+/// Splits `'text'rest` into `text` and `rest`.
+fn quoted(value: &str) -> Result<(&str, &str), String> {
+    let inner = value
+        .strip_prefix('\'')
+        .ok_or_else(|| format!("expected a quoted string like 'name', found `{value}`"))?;
+    let end = inner
+        .find('\'')
+        .ok_or_else(|| format!("unterminated quoted string `{value}`"))?;
+    Ok((&inner[..end], &inner[end + 1..]))
+}
+
+/// Parses `[a b c]` (spaces or commas between the numbers).
+fn bracketed(value: &str) -> Result<Vec<f64>, String> {
+    let inner = value
+        .trim()
+        .strip_prefix('[')
+        .and_then(|v| v.strip_suffix(']'))
+        .ok_or_else(|| format!("expected numbers in brackets like [0 1], found `{value}`"))?;
+    inner
+        .split(|c: char| c.is_whitespace() || c == ',')
+        .filter(|t| !t.is_empty())
+        .map(|t| {
+            t.parse::<f64>()
+                .map_err(|_| format!("expected a number, found `{t}`"))
+        })
+        .collect()
+}
+
+/// Parses `'name':'type',[params]`.
+fn function(value: &str) -> Result<(&str, &str, Vec<f64>), String> {
+    let shape = "expected 'name':'type',[parameters]";
+    let (name, rest) = quoted(value).map_err(|m| format!("{shape}: {m}"))?;
+    let rest = rest
+        .trim_start()
+        .strip_prefix(':')
+        .ok_or_else(|| format!("{shape}, found `{value}` (no `:` after the name)"))?;
+    let (kind, rest) = quoted(rest.trim_start()).map_err(|m| format!("{shape}: {m}"))?;
+    let rest = rest
+        .trim_start()
+        .strip_prefix(',')
+        .ok_or_else(|| format!("{shape}, found `{value}` (no `,` after the type)"))?;
+    Ok((name, kind, bracketed(rest)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::paper_controller;
+
+    const TINY: &str = "[System]\nName='t'\nType='sugeno'\nVersion=2.0\nNumInputs=1\nNumOutputs=1\nNumRules=2\n\
+        AndMethod='prod'\nOrMethod='probor'\nImpMethod='prod'\nAggMethod='sum'\nDefuzzMethod='wtaver'\n\n\
+        [Input1]\nName='x'\nRange=[-5 5]\nNumMFs=2\nMF1='low':'gaussmf',[4 -5]\nMF2='high':'gaussmf',[4 5]\n\n\
+        [Output1]\nName='y'\nRange=[0 1]\nNumMFs=2\nMF1='line1':'linear',[-1 -1]\nMF2='line2':'constant',[0.5]\n\n\
+        [Rules]\n1, 1 (0.5) : 1\n-2, 2 (1) : 1\n";
+
+    fn parse_error(text: &str) -> String {
+        FuzzySystem::from_fis(text).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn reads_a_first_order_file_and_writes_it_back_verbatim() {
+        let system = FuzzySystem::from_fis(TINY).unwrap();
+        assert_eq!(
+            system.outputs()[0].terms[0].function,
+            OutputFn::Linear {
+                coefficients: vec![-1.0],
+                constant: -1.0
+            }
+        );
+        assert_eq!(system.rules()[0].weight, 0.5);
+        assert_eq!(system.rules()[1].antecedents, [Antecedent::IsNot(1)]);
+        assert_eq!(system.to_fis(), TINY);
+    }
+
+    #[test]
+    fn tolerates_matlab_variations() {
+        let variant = TINY
+            .replace(
+                "[Rules]\n1, 1 (0.5) : 1",
+                "% a comment\n[Rules]\n  1 ,1(0.5):1",
+            )
+            .replace("[4 -5]", "[4, -5]")
+            .replace('\n', "\r\n");
+        assert_eq!(
+            FuzzySystem::from_fis(&format!("\u{feff}{variant}")).unwrap(),
+            FuzzySystem::from_fis(TINY).unwrap()
+        );
+    }
+
+    #[test]
+    fn malformed_files_name_the_line_and_what_was_expected() {
+        let cases = [
+            (
+                TINY.replace("Range=[-5 5]", "Range=[-5]"),
+                "line 16: expected Range=[min max], found Range=[-5]",
+            ),
+            (
+                TINY.replace("Range=[-5 5]", "Range=[5 -5]"),
+                "line 16: Range must be finite with min < max, found [5 -5]",
+            ),
+            (
+                TINY.replace("[4 -5]", "[0 -5]"),
+                "line 18: gaussmf: sigma must be positive, got 0",
+            ),
+            (
+                TINY.replace("[4 -5]", "[4 x]"),
+                "line 18: MF1: expected a number, found `x`",
+            ),
+            (
+                TINY.replace("'gaussmf',[4 5]", "'gausmf',[4 5]"),
+                "line 19: gausmf: unknown membership function type",
+            ),
+            (
+                TINY.replace("NumRules=2", "NumRules=3"),
+                "line 28: NumRules=3 but [Rules] has 2 rule lines",
+            ),
+            (
+                TINY.replace("-2, 2 (1) : 1", "-2 1, 2 (1) : 1"),
+                "line 30: expected 1 input indices (one per input), found 2",
+            ),
+            (
+                TINY.replace("-2, 2 (1) : 1", "3, 2 (1) : 1"),
+                "line 30: rule input 'x' has 2 sets, there is no set 3",
+            ),
+            (
+                TINY.replace("-2, 2 (1) : 1", "-2, -2 (1) : 1"),
+                "line 30: negated consequent -2: negation applies",
+            ),
+            (
+                TINY.replace("-2, 2 (1) : 1", "-2, 2 (1) : 3"),
+                "line 30: expected connective 1 (AND) or 2 (OR)",
+            ),
+            (
+                TINY.replace("-2, 2 (1) : 1", "-2 2 (1) : 1"),
+                "line 30: expected a rule `i1 ... in, o1 ... om (weight) : connective`",
+            ),
+            (
+                TINY.replace("-2, 2 (1) : 1", "-2, 2 (1.5) : 1"),
+                "line 30: rule weight must lie in [0, 1], got 1.5",
+            ),
+            (
+                TINY.replace("AndMethod='prod'", "AndMethod='mean'"),
+                "line 8: expected AndMethod='prod' or 'min', found AndMethod='mean'",
+            ),
+            (
+                TINY.replace("ImpMethod='prod'", "ImpMethod='min'"),
+                "line 10: expected ImpMethod='prod', found ImpMethod='min'",
+            ),
+            (
+                TINY.replace("NumInputs=1", "NumInputs=x"),
+                "line 5: expected NumInputs=<integer >= 1>, found NumInputs=x",
+            ),
+            (
+                TINY.replace("NumInputs=1\n", ""),
+                "line 1: [System] has no NumInputs= line",
+            ),
+            (
+                TINY.replace("Name='y'", "Name='x'"),
+                "line 22: variable name 'x' is already used at line 15",
+            ),
+            (
+                TINY.replace("Name='y'", "Nome='y'"),
+                "line 22: unknown key `Nome` in [Output1]; expected one of Name, Range, NumMFs, MF1, MF2, ...",
+            ),
+            (
+                TINY.replace("MF2='line2'", "MF3='line2'"),
+                "line 26: MF3 but NumMFs=2",
+            ),
+            (
+                TINY.replace("[Output1]", "[Output2]"),
+                "line 21: section [Output2] but NumOutputs=1",
+            ),
+            (
+                TINY.replace("[Output1]", "[Outputs]"),
+                "line 21: unknown section [Outputs]",
+            ),
+            (
+                TINY.replace("'constant',[0.5]", "'trimf',[0 0.5 1]"),
+                "line 26: a Sugeno output function must be 'constant' or 'linear', found 'trimf'",
+            ),
+            (
+                TINY.replace("'linear',[-1 -1]", "'linear',[-1]"),
+                "line 25: 'linear' takes NumInputs + 1 = 2 parameters",
+            ),
+            (
+                TINY.replace("MF1='line1':'linear'", "MF1='line1''linear'"),
+                "line 25: MF1: expected 'name':'type',[parameters], found",
+            ),
+            (
+                format!("Name='x'\n{TINY}"),
+                "line 1: expected the [System] section header, found `Name='x'`",
+            ),
+            (
+                format!("{TINY}[Input1]\n"),
+                "line 31: duplicate section [Input1] (first at line 14)",
+            ),
+        ];
+        for (text, expected) in cases {
+            let message = parse_error(&text);
+            assert!(
+                message.starts_with(expected),
+                "got    {message}\nwanted {expected}"
+            );
+        }
+        // Version is optional (its value is not used).
+        assert!(FuzzySystem::from_fis(&TINY.replace("Version=2.0\n", "")).is_ok());
+        // A removed section is reported at the [System] header.
+        let no_output = TINY.split("[Output1]").next().unwrap().to_string()
+            + "[Rules]\n1, 1 (0.5) : 1\n-2, 2 (1) : 1\n";
+        assert_eq!(
+            parse_error(&no_output),
+            "line 1: missing section [Output1] (NumOutputs=1)"
+        );
+    }
+
+    #[test]
+    fn mamdani_files_are_refused_by_name() {
+        let mamdani = TINY
+            .replace("Type='sugeno'", "Type='mamdani'")
+            .replace("AndMethod='prod'", "AndMethod='bogus'");
+        assert_eq!(
+            parse_error(&mamdani),
+            "line 3: Mamdani systems are not supported (this crate implements Takagi-Sugeno inference); expected Type='sugeno'"
+        );
+        assert_eq!(
+            parse_error(&TINY.replace("'sugeno'", "'tsk'")),
+            "line 3: expected Type='sugeno', found Type='tsk'"
+        );
+    }
+
+    #[test]
+    fn numbers_are_written_in_their_shortest_exact_form() {
+        for x in [
+            0.3,
+            -0.3,
+            2.0,
+            0.0,
+            -0.0,
+            1e-20,
+            1.5e300,
+            123456.789,
+            0.1 + 0.2,
+            f64::MIN_POSITIVE,
+            1e15,
+            99999.0,
+        ] {
+            let text = fis_number(x);
+            assert_eq!(
+                text.parse::<f64>().unwrap().to_bits(),
+                x.to_bits(),
+                "{x} written as {text}"
+            );
+        }
+        assert_eq!(fis_numbers(&[0.3, 2.0, -0.3]), "[0.3 2 -0.3]");
+        assert_eq!(fis_number(1e-20), "1e-20");
+    }
+
+    #[test]
+    fn the_paper_controller_round_trips() {
+        let text = paper_controller().to_fis();
+        assert_eq!(FuzzySystem::from_fis(&text).unwrap(), paper_controller());
+        assert!(text.contains("MF1='N':'gbellmf',[0.3 2 -0.3]"));
+        assert!(text.contains("\n1 1 1 1, 4 4 (1) : 1\n"));
+    }
+}

@@ -1,0 +1,880 @@
+//! Membership functions of the input fuzzy sets, with MATLAB's names, parameter order and
+//! formulas (`gbellmf`, `gaussmf`, ...).
+//!
+//! [`MembershipFn`] is the description a user writes; a system compiles each one once, when it is
+//! built, into an evaluation form that picks the cheapest exact formula (for example repeated
+//! squaring instead of `powf` for the integer bell slopes the paper uses).
+
+use crate::error::FuzzyError;
+
+/// A membership function `mu(x) in [0, 1]` of one input fuzzy set.
+///
+/// Parameters follow MATLAB's Fuzzy Logic Toolbox, in the same order as in a `.fis` file; the
+/// formulas are MATLAB's, including its conventions at the edges (documented per variant).
+/// Parameters are checked by [`MembershipFn::validate`], which every system build calls.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MembershipFn {
+    /// `gbellmf [a b c]`: the generalized bell `1 / (1 + |(x - c) / a|^(2 b))` (the paper's
+    /// choice, section 4). Requires `a > 0` and `b > 0`.
+    Bell {
+        /// `a`: the half-width at membership 1/2.
+        width: f64,
+        /// `b`: the slope; `mu'(c ± a) = ∓ b / (2 a)`.
+        slope: f64,
+        /// `c`: the centre, where `mu = 1`.
+        center: f64,
+    },
+    /// `gaussmf [sigma c]`: `exp(-(x - c)^2 / (2 sigma^2))`. Requires `sigma > 0`.
+    Gaussian {
+        /// `sigma`: the standard deviation.
+        sigma: f64,
+        /// `c`: the centre.
+        center: f64,
+    },
+    /// `gauss2mf [sigma1 c1 sigma2 c2]`: the left Gaussian `(sigma1, c1)` for `x < c1`, the right
+    /// one `(sigma2, c2)` for `x > c2`, multiplied where both apply (MATLAB's definition, so with
+    /// `c1 > c2` the top stays below 1). Requires both sigmas positive.
+    Gaussian2 {
+        /// `sigma1`: the left side's standard deviation.
+        sigma1: f64,
+        /// `c1`: the left shoulder.
+        center1: f64,
+        /// `sigma2`: the right side's standard deviation.
+        sigma2: f64,
+        /// `c2`: the right shoulder.
+        center2: f64,
+    },
+    /// `trimf [a b c]`: 0 outside `(a, c)`, rising linearly on `(a, b)`, 1 at `b`, falling on
+    /// `(b, c)`. Requires `a <= b <= c`; `a = b` or `b = c` give a vertical side (MATLAB: 1 at `b`).
+    Triangle {
+        /// `a`: the left foot.
+        left: f64,
+        /// `b`: the peak.
+        peak: f64,
+        /// `c`: the right foot.
+        right: f64,
+    },
+    /// `trapmf [a b c d]`: 0 below `a` and above `d`, 1 on `[b, c]`, linear in between.
+    /// Requires `a <= b <= c <= d`.
+    Trapezoid {
+        /// `a`: the left foot.
+        left_foot: f64,
+        /// `b`: the left shoulder.
+        left_shoulder: f64,
+        /// `c`: the right shoulder.
+        right_shoulder: f64,
+        /// `d`: the right foot.
+        right_foot: f64,
+    },
+    /// `sigmf [a c]`: `1 / (1 + exp(-a (x - c)))`; `a > 0` opens to the right, `a < 0` to the left.
+    Sigmoid {
+        /// `a`: the slope at `c` is `a / 4`.
+        slope: f64,
+        /// `c`: the crossover point, where `mu = 1/2`.
+        center: f64,
+    },
+    /// `dsigmf [a1 c1 a2 c2]`: `|sig(a1, c1) - sig(a2, c2)|`.
+    SigmoidDifference {
+        /// `a1`: the first sigmoid's slope.
+        slope1: f64,
+        /// `c1`: the first sigmoid's crossover.
+        center1: f64,
+        /// `a2`: the second sigmoid's slope.
+        slope2: f64,
+        /// `c2`: the second sigmoid's crossover.
+        center2: f64,
+    },
+    /// `psigmf [a1 c1 a2 c2]`: `sig(a1, c1) * sig(a2, c2)`.
+    SigmoidProduct {
+        /// `a1`: the first sigmoid's slope.
+        slope1: f64,
+        /// `c1`: the first sigmoid's crossover.
+        center1: f64,
+        /// `a2`: the second sigmoid's slope.
+        slope2: f64,
+        /// `c2`: the second sigmoid's crossover.
+        center2: f64,
+    },
+    /// `constant [k]`: the same degree `k in [0, 1]` everywhere (written as `'constant'` in an
+    /// input section of a `.fis` file; MATLAB itself uses that name only for Sugeno outputs).
+    Constant {
+        /// `k`: the degree.
+        value: f64,
+    },
+}
+
+impl MembershipFn {
+    /// The generalized bell `gbellmf [width slope center]`.
+    pub fn bell(width: f64, slope: f64, center: f64) -> Self {
+        Self::Bell {
+            width,
+            slope,
+            center,
+        }
+    }
+
+    /// The Gaussian `gaussmf [sigma center]`.
+    pub fn gaussian(sigma: f64, center: f64) -> Self {
+        Self::Gaussian { sigma, center }
+    }
+
+    /// The triangle `trimf [left peak right]`.
+    pub fn triangle(left: f64, peak: f64, right: f64) -> Self {
+        Self::Triangle { left, peak, right }
+    }
+
+    /// The trapezoid `trapmf [a b c d]`.
+    pub fn trapezoid(a: f64, b: f64, c: f64, d: f64) -> Self {
+        Self::Trapezoid {
+            left_foot: a,
+            left_shoulder: b,
+            right_shoulder: c,
+            right_foot: d,
+        }
+    }
+
+    /// The sigmoid `sigmf [slope center]`.
+    pub fn sigmoid(slope: f64, center: f64) -> Self {
+        Self::Sigmoid { slope, center }
+    }
+
+    /// MATLAB's name of this type (`"gbellmf"`, `"gaussmf"`, ...).
+    pub fn matlab_name(&self) -> &'static str {
+        match self {
+            Self::Bell { .. } => "gbellmf",
+            Self::Gaussian { .. } => "gaussmf",
+            Self::Gaussian2 { .. } => "gauss2mf",
+            Self::Triangle { .. } => "trimf",
+            Self::Trapezoid { .. } => "trapmf",
+            Self::Sigmoid { .. } => "sigmf",
+            Self::SigmoidDifference { .. } => "dsigmf",
+            Self::SigmoidProduct { .. } => "psigmf",
+            Self::Constant { .. } => "constant",
+        }
+    }
+
+    /// The parameters in MATLAB's order (the `[...]` of a `.fis` line).
+    pub fn params(&self) -> Vec<f64> {
+        match *self {
+            Self::Bell {
+                width,
+                slope,
+                center,
+            } => vec![width, slope, center],
+            Self::Gaussian { sigma, center } => vec![sigma, center],
+            Self::Gaussian2 {
+                sigma1,
+                center1,
+                sigma2,
+                center2,
+            } => vec![sigma1, center1, sigma2, center2],
+            Self::Triangle { left, peak, right } => vec![left, peak, right],
+            Self::Trapezoid {
+                left_foot,
+                left_shoulder,
+                right_shoulder,
+                right_foot,
+            } => {
+                vec![left_foot, left_shoulder, right_shoulder, right_foot]
+            }
+            Self::Sigmoid { slope, center } => vec![slope, center],
+            Self::SigmoidDifference {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            }
+            | Self::SigmoidProduct {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            } => vec![slope1, center1, slope2, center2],
+            Self::Constant { value } => vec![value],
+        }
+    }
+
+    /// Builds a function from MATLAB's type name and parameter list, and validates it.
+    ///
+    /// ```
+    /// use fuzzy_sugeno::MembershipFn;
+    /// let mf = MembershipFn::from_matlab("gbellmf", &[0.3, 2.0, -0.3])?;
+    /// assert_eq!(mf, MembershipFn::bell(0.3, 2.0, -0.3));
+    /// assert!(MembershipFn::from_matlab("gbellmf", &[0.0, 2.0, 0.0]).is_err());
+    /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
+    /// ```
+    pub fn from_matlab(name: &str, params: &[f64]) -> Result<Self, FuzzyError> {
+        let expected = match name {
+            "gbellmf" | "trimf" => 3,
+            "gaussmf" | "sigmf" => 2,
+            "gauss2mf" | "trapmf" | "dsigmf" | "psigmf" => 4,
+            "constant" => 1,
+            _ => {
+                return Err(FuzzyError::InvalidMembership {
+                    function: name.to_string(),
+                    reason: "unknown membership function type; expected one of gbellmf, gaussmf, gauss2mf, \
+                             trimf, trapmf, sigmf, dsigmf, psigmf, constant"
+                        .to_string(),
+                });
+            }
+        };
+        if params.len() != expected {
+            return Err(FuzzyError::InvalidMembership {
+                function: name.to_string(),
+                reason: format!("expected {expected} parameters, got {}", params.len()),
+            });
+        }
+        let p = params;
+        let mf = match name {
+            "gbellmf" => Self::bell(p[0], p[1], p[2]),
+            "trimf" => Self::triangle(p[0], p[1], p[2]),
+            "gaussmf" => Self::gaussian(p[0], p[1]),
+            "sigmf" => Self::sigmoid(p[0], p[1]),
+            "gauss2mf" => Self::Gaussian2 {
+                sigma1: p[0],
+                center1: p[1],
+                sigma2: p[2],
+                center2: p[3],
+            },
+            "trapmf" => Self::trapezoid(p[0], p[1], p[2], p[3]),
+            "dsigmf" => Self::SigmoidDifference {
+                slope1: p[0],
+                center1: p[1],
+                slope2: p[2],
+                center2: p[3],
+            },
+            "psigmf" => Self::SigmoidProduct {
+                slope1: p[0],
+                center1: p[1],
+                slope2: p[2],
+                center2: p[3],
+            },
+            _ => Self::Constant { value: p[0] },
+        };
+        mf.validate()?;
+        Ok(mf)
+    }
+
+    /// Checks the parameters: all finite, widths and sigmas positive, bell slope positive, the
+    /// corners of triangles and trapezoids in order, a constant degree within `[0, 1]`.
+    pub fn validate(&self) -> Result<(), FuzzyError> {
+        let fail = |reason: String| {
+            Err(FuzzyError::InvalidMembership {
+                function: self.matlab_name().to_string(),
+                reason,
+            })
+        };
+        let params = self.params();
+        if let Some(v) = params.iter().find(|v| !v.is_finite()) {
+            return fail(format!(
+                "parameters must be finite, got {v} in {}",
+                format_params(&params)
+            ));
+        }
+        match *self {
+            Self::Bell { width, slope, .. } => {
+                if width <= 0.0 {
+                    return fail(format!("width a must be positive, got {width}"));
+                }
+                if slope <= 0.0 {
+                    return fail(format!("slope b must be positive, got {slope}"));
+                }
+            }
+            Self::Gaussian { sigma, .. } if sigma <= 0.0 => {
+                return fail(format!("sigma must be positive, got {sigma}"));
+            }
+            Self::Gaussian2 { sigma1, sigma2, .. } if sigma1 <= 0.0 || sigma2 <= 0.0 => {
+                return fail(format!(
+                    "sigma1 and sigma2 must be positive, got {sigma1} and {sigma2}"
+                ));
+            }
+            Self::Triangle { left, peak, right } if !(left <= peak && peak <= right) => {
+                return fail(format!(
+                    "corners must satisfy a <= b <= c, got {}",
+                    format_params(&params)
+                ));
+            }
+            Self::Trapezoid {
+                left_foot,
+                left_shoulder,
+                right_shoulder,
+                right_foot,
+            } if !(left_foot <= left_shoulder
+                && left_shoulder <= right_shoulder
+                && right_shoulder <= right_foot) =>
+            {
+                return fail(format!(
+                    "corners must satisfy a <= b <= c <= d, got {}",
+                    format_params(&params)
+                ));
+            }
+            Self::Constant { value } if !(0.0..=1.0).contains(&value) => {
+                return fail(format!("a constant degree must lie in [0, 1], got {value}"));
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// The degree of membership of `x`, or an error if the parameters are invalid.
+    ///
+    /// Systems evaluate their sets through a compiled form made once at build time; this is
+    /// the same code, for plotting or checking a single function.
+    ///
+    /// ```
+    /// use fuzzy_sugeno::MembershipFn;
+    /// let n = MembershipFn::bell(0.3, 2.0, -0.3);
+    /// assert_eq!(n.degree(0.0)?, 0.5); // |(0 + 0.3) / 0.3|^4 = 1
+    /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
+    /// ```
+    pub fn degree(&self, x: f64) -> Result<f64, FuzzyError> {
+        Ok(CompiledMf::new(self)?.eval(x))
+    }
+}
+
+/// Formats parameters the way a `.fis` file shows them: `[0.3 2 -0.3]`.
+pub(crate) fn format_params(params: &[f64]) -> String {
+    let inner: Vec<String> = params.iter().map(|v| v.to_string()).collect();
+    format!("[{}]", inner.join(" "))
+}
+
+/// The largest exponent `2 b` evaluated by repeated squaring; larger or non-integer ones use `powf`.
+const MAX_INTEGER_BELL_EXPONENT: f64 = 64.0;
+
+/// A validated membership function in evaluation form.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum CompiledMf {
+    /// Bell with `b = 1`: `1 / (1 + u^2)`, `u = (x - c) / a`.
+    BellSquare { center: f64, width: f64 },
+    /// Bell with `b = 2` (the paper's): `1 / (1 + (u^2)^2)`.
+    BellQuartic { center: f64, width: f64 },
+    /// Bell with an integer exponent `2 b <= 64`: `|u|^(2b)` by repeated squaring.
+    BellInteger {
+        center: f64,
+        width: f64,
+        exponent: u32,
+    },
+    /// Any other bell: `|u|^(2b)` by `powf`.
+    BellReal {
+        center: f64,
+        width: f64,
+        exponent: f64,
+    },
+    /// `exp(-(x - c)^2 * k)` with `k = 1 / (2 sigma^2)`.
+    Gaussian { center: f64, k: f64 },
+    /// Two-sided Gaussian (MATLAB's `gauss2mf`).
+    Gaussian2 {
+        center1: f64,
+        k1: f64,
+        center2: f64,
+        k2: f64,
+    },
+    /// `trimf`.
+    Triangle { left: f64, peak: f64, right: f64 },
+    /// `trapmf`.
+    Trapezoid { a: f64, b: f64, c: f64, d: f64 },
+    /// `sigmf`.
+    Sigmoid { slope: f64, center: f64 },
+    /// `dsigmf`.
+    SigmoidDifference {
+        slope1: f64,
+        center1: f64,
+        slope2: f64,
+        center2: f64,
+    },
+    /// `psigmf`.
+    SigmoidProduct {
+        slope1: f64,
+        center1: f64,
+        slope2: f64,
+        center2: f64,
+    },
+    /// `constant`.
+    Constant(f64),
+}
+
+impl CompiledMf {
+    /// Validates `mf` and picks its evaluation form.
+    pub(crate) fn new(mf: &MembershipFn) -> Result<Self, FuzzyError> {
+        mf.validate()?;
+        let gauss_k = |sigma: f64| 1.0 / (2.0 * sigma * sigma);
+        Ok(match *mf {
+            MembershipFn::Bell {
+                width,
+                slope,
+                center,
+            } => {
+                let exponent = 2.0 * slope;
+                if exponent == 2.0 {
+                    Self::BellSquare { center, width }
+                } else if exponent == 4.0 {
+                    Self::BellQuartic { center, width }
+                } else if exponent.fract() == 0.0 && exponent <= MAX_INTEGER_BELL_EXPONENT {
+                    Self::BellInteger {
+                        center,
+                        width,
+                        exponent: exponent as u32,
+                    }
+                } else {
+                    Self::BellReal {
+                        center,
+                        width,
+                        exponent,
+                    }
+                }
+            }
+            MembershipFn::Gaussian { sigma, center } => Self::Gaussian {
+                center,
+                k: gauss_k(sigma),
+            },
+            MembershipFn::Gaussian2 {
+                sigma1,
+                center1,
+                sigma2,
+                center2,
+            } => Self::Gaussian2 {
+                center1,
+                k1: gauss_k(sigma1),
+                center2,
+                k2: gauss_k(sigma2),
+            },
+            MembershipFn::Triangle { left, peak, right } => Self::Triangle { left, peak, right },
+            MembershipFn::Trapezoid {
+                left_foot,
+                left_shoulder,
+                right_shoulder,
+                right_foot,
+            } => Self::Trapezoid {
+                a: left_foot,
+                b: left_shoulder,
+                c: right_shoulder,
+                d: right_foot,
+            },
+            MembershipFn::Sigmoid { slope, center } => Self::Sigmoid { slope, center },
+            MembershipFn::SigmoidDifference {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            } => Self::SigmoidDifference {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            },
+            MembershipFn::SigmoidProduct {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            } => Self::SigmoidProduct {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            },
+            MembershipFn::Constant { value } => Self::Constant(value),
+        })
+    }
+
+    /// The degree of membership of `x` (finite `x`; never NaN for finite `x`).
+    #[inline]
+    pub(crate) fn eval(&self, x: f64) -> f64 {
+        match *self {
+            Self::BellSquare { center, width } => {
+                let u = (x - center) / width;
+                1.0 / (1.0 + u * u)
+            }
+            Self::BellQuartic { center, width } => {
+                let u = (x - center) / width;
+                let u2 = u * u;
+                1.0 / (1.0 + u2 * u2)
+            }
+            Self::BellInteger {
+                center,
+                width,
+                exponent,
+            } => 1.0 / (1.0 + integer_power(((x - center) / width).abs(), exponent)),
+            Self::BellReal {
+                center,
+                width,
+                exponent,
+            } => 1.0 / (1.0 + ((x - center) / width).abs().powf(exponent)),
+            Self::Gaussian { center, k } => gaussian(x, center, k),
+            Self::Gaussian2 {
+                center1,
+                k1,
+                center2,
+                k2,
+            } => {
+                let left = if x <= center1 {
+                    gaussian(x, center1, k1)
+                } else {
+                    1.0
+                };
+                let right = if x >= center2 {
+                    gaussian(x, center2, k2)
+                } else {
+                    1.0
+                };
+                left * right
+            }
+            Self::Triangle { left, peak, right } => {
+                if x == peak {
+                    1.0
+                } else if x <= left || x >= right {
+                    0.0
+                } else if x < peak {
+                    (x - left) / (peak - left)
+                } else {
+                    (right - x) / (right - peak)
+                }
+            }
+            Self::Trapezoid { a, b, c, d } => {
+                let rising = if x >= b {
+                    1.0
+                } else if x < a {
+                    0.0
+                } else {
+                    (x - a) / (b - a)
+                };
+                let falling = if x <= c {
+                    1.0
+                } else if x > d {
+                    0.0
+                } else {
+                    (d - x) / (d - c)
+                };
+                rising.min(falling)
+            }
+            Self::Sigmoid { slope, center } => sigmoid(x, slope, center),
+            Self::SigmoidDifference {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            } => (sigmoid(x, slope1, center1) - sigmoid(x, slope2, center2)).abs(),
+            Self::SigmoidProduct {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            } => sigmoid(x, slope1, center1) * sigmoid(x, slope2, center2),
+            Self::Constant(value) => value,
+        }
+    }
+}
+
+#[inline]
+fn gaussian(x: f64, center: f64, k: f64) -> f64 {
+    let d = x - center;
+    (-(d * d) * k).exp()
+}
+
+#[inline]
+fn sigmoid(x: f64, slope: f64, center: f64) -> f64 {
+    1.0 / (1.0 + (-slope * (x - center)).exp())
+}
+
+/// `base^exponent` by repeated squaring (exponentiation by squaring), no `powf`.
+#[inline]
+fn integer_power(mut base: f64, mut exponent: u32) -> f64 {
+    let mut result = 1.0;
+    while exponent > 0 {
+        if exponent & 1 == 1 {
+            result *= base;
+        }
+        base *= base;
+        exponent >>= 1;
+    }
+    result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use proptest::prelude::*;
+
+    fn mu(mf: MembershipFn, x: f64) -> f64 {
+        mf.degree(x).unwrap()
+    }
+
+    #[test]
+    fn bell_matches_its_formula_and_its_landmarks() {
+        // mu(c) = 1, mu(c +- a) = 1/2 for every slope; MATLAB's 1 / (1 + |(x-c)/a|^(2b)) elsewhere.
+        for slope in [0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 2.5, 7.0, 32.0, 40.0] {
+            let mf = MembershipFn::bell(0.4, slope, 0.1);
+            assert_eq!(mu(mf, 0.1), 1.0);
+            assert_relative_eq!(mu(mf, 0.5), 0.5, max_relative = 1e-15);
+            assert_relative_eq!(mu(mf, -0.3), 0.5, max_relative = 1e-15);
+            for x in [-3.0, -0.7, 0.0, 0.23, 0.9, 12.0] {
+                let formula = 1.0 / (1.0 + ((x - 0.1f64) / 0.4).abs().powf(2.0 * slope));
+                assert_relative_eq!(mu(mf, x), formula, max_relative = 1e-13);
+            }
+        }
+        // Far tails underflow to 0, never NaN.
+        assert_eq!(mu(MembershipFn::bell(1e-3, 40.0, 0.0), 1e300), 0.0);
+    }
+
+    #[test]
+    fn integer_slopes_are_compiled_without_powf() {
+        let compile = |b: f64| CompiledMf::new(&MembershipFn::bell(1.0, b, 0.0)).unwrap();
+        assert!(matches!(compile(1.0), CompiledMf::BellSquare { .. }));
+        assert!(matches!(compile(2.0), CompiledMf::BellQuartic { .. }));
+        assert!(matches!(
+            compile(1.5),
+            CompiledMf::BellInteger { exponent: 3, .. }
+        ));
+        assert!(matches!(
+            compile(32.0),
+            CompiledMf::BellInteger { exponent: 64, .. }
+        ));
+        assert!(matches!(compile(32.5), CompiledMf::BellReal { .. }));
+        assert!(matches!(compile(0.3), CompiledMf::BellReal { .. }));
+        // Exponentiation by squaring is exact for powers of two and small integers.
+        assert_eq!(integer_power(1.5, 0), 1.0);
+        assert_eq!(integer_power(1.5, 5), 7.59375);
+        assert_eq!(integer_power(2.0, 64), 2f64.powi(64));
+    }
+
+    #[test]
+    fn gaussians_match_their_formulas() {
+        let g = MembershipFn::gaussian(0.2, 0.5);
+        for x in [-1.0, 0.3, 0.5, 0.71, 4.0] {
+            assert_relative_eq!(
+                mu(g, x),
+                (-(x - 0.5f64).powi(2) / (2.0 * 0.04)).exp(),
+                max_relative = 1e-14
+            );
+        }
+        assert_eq!(mu(g, 0.5), 1.0);
+        // gauss2mf: left tail, flat top, right tail.
+        let g2 = MembershipFn::Gaussian2 {
+            sigma1: 0.1,
+            center1: -0.2,
+            sigma2: 0.3,
+            center2: 0.4,
+        };
+        assert_relative_eq!(mu(g2, -0.4), (-0.04f64 / 0.02).exp(), max_relative = 1e-14);
+        assert_eq!(mu(g2, -0.2), 1.0);
+        assert_eq!(mu(g2, 0.1), 1.0);
+        assert_eq!(mu(g2, 0.4), 1.0);
+        assert_relative_eq!(mu(g2, 0.7), (-0.09f64 / 0.18).exp(), max_relative = 1e-14);
+        // Crossed centres (c1 > c2): MATLAB multiplies both tails in between, so the top is < 1.
+        let crossed = MembershipFn::Gaussian2 {
+            sigma1: 1.0,
+            center1: 1.0,
+            sigma2: 1.0,
+            center2: -1.0,
+        };
+        assert_relative_eq!(
+            mu(crossed, 0.0),
+            (-0.5f64).exp() * (-0.5f64).exp(),
+            max_relative = 1e-14
+        );
+    }
+
+    #[test]
+    fn triangle_and_trapezoid_follow_matlab_at_every_edge() {
+        let t = MembershipFn::triangle(-1.0, 0.0, 2.0);
+        let expect = [
+            (-2.0, 0.0),
+            (-1.0, 0.0),
+            (-0.25, 0.75),
+            (0.0, 1.0),
+            (1.5, 0.25),
+            (2.0, 0.0),
+            (3.0, 0.0),
+        ];
+        for (x, y) in expect {
+            assert_eq!(mu(t, x), y, "trimf at {x}");
+        }
+        // Vertical sides: a = b gives 1 at b (MATLAB's centre rule wins over the shoulder).
+        let left_shoulder = MembershipFn::triangle(0.0, 0.0, 1.0);
+        assert_eq!(mu(left_shoulder, 0.0), 1.0);
+        assert_eq!(mu(left_shoulder, -1e-12), 0.0);
+        assert_eq!(mu(left_shoulder, 0.5), 0.5);
+        let spike = MembershipFn::triangle(0.5, 0.5, 0.5);
+        assert_eq!(
+            (mu(spike, 0.5), mu(spike, 0.49), mu(spike, 0.51)),
+            (1.0, 0.0, 0.0)
+        );
+
+        let z = MembershipFn::trapezoid(-1.0, 0.0, 1.0, 3.0);
+        let expect = [
+            (-1.5, 0.0),
+            (-1.0, 0.0),
+            (-0.5, 0.5),
+            (0.0, 1.0),
+            (0.7, 1.0),
+            (1.0, 1.0),
+            (2.5, 0.25),
+            (3.0, 0.0),
+        ];
+        for (x, y) in expect {
+            assert_eq!(mu(z, x), y, "trapmf at {x}");
+        }
+        let shoulder = MembershipFn::trapezoid(-5.0, -5.0, 0.0, 1.0);
+        assert_eq!(
+            (mu(shoulder, -5.0), mu(shoulder, -5.1), mu(shoulder, 0.5)),
+            (1.0, 0.0, 0.5)
+        );
+    }
+
+    #[test]
+    fn sigmoids_match_their_formulas() {
+        let s = |a: f64, c: f64, x: f64| 1.0 / (1.0 + (-a * (x - c)).exp());
+        let right = MembershipFn::sigmoid(8.0, 0.25);
+        let left = MembershipFn::sigmoid(-3.0, -0.5);
+        let d = MembershipFn::SigmoidDifference {
+            slope1: 5.0,
+            center1: -1.0,
+            slope2: 5.0,
+            center2: 1.0,
+        };
+        let p = MembershipFn::SigmoidProduct {
+            slope1: 5.0,
+            center1: -1.0,
+            slope2: -5.0,
+            center2: 1.0,
+        };
+        assert_eq!(mu(right, 0.25), 0.5);
+        for x in [-2.0, -0.5, 0.0, 0.25, 0.9, 2.0] {
+            assert_relative_eq!(mu(right, x), s(8.0, 0.25, x), max_relative = 1e-14);
+            assert_relative_eq!(mu(left, x), s(-3.0, -0.5, x), max_relative = 1e-14);
+            assert_relative_eq!(
+                mu(d, x),
+                (s(5.0, -1.0, x) - s(5.0, 1.0, x)).abs(),
+                max_relative = 1e-14
+            );
+            assert_relative_eq!(
+                mu(p, x),
+                s(5.0, -1.0, x) * s(-5.0, 1.0, x),
+                max_relative = 1e-14
+            );
+        }
+        // Saturation far out: exactly 0 or 1, never NaN.
+        assert_eq!(mu(right, -1e6), 0.0);
+        assert_eq!(mu(right, 1e6), 1.0);
+        assert_eq!(mu(MembershipFn::Constant { value: 0.3 }, 1e9), 0.3);
+    }
+
+    #[test]
+    fn invalid_parameters_are_refused_with_the_reason() {
+        let message = |mf: MembershipFn| mf.validate().unwrap_err().to_string();
+        assert_eq!(
+            message(MembershipFn::bell(0.0, 2.0, 0.0)),
+            "gbellmf: width a must be positive, got 0"
+        );
+        assert_eq!(
+            message(MembershipFn::bell(1.0, -2.0, 0.0)),
+            "gbellmf: slope b must be positive, got -2"
+        );
+        assert_eq!(
+            message(MembershipFn::gaussian(0.0, 0.0)),
+            "gaussmf: sigma must be positive, got 0"
+        );
+        assert_eq!(
+            message(MembershipFn::triangle(0.0, 2.0, 1.0)),
+            "trimf: corners must satisfy a <= b <= c, got [0 2 1]"
+        );
+        assert_eq!(
+            message(MembershipFn::trapezoid(0.0, 1.0, 0.5, 2.0)),
+            "trapmf: corners must satisfy a <= b <= c <= d, got [0 1 0.5 2]"
+        );
+        assert_eq!(
+            message(MembershipFn::sigmoid(f64::NAN, 0.0)),
+            "sigmf: parameters must be finite, got NaN in [NaN 0]"
+        );
+        assert_eq!(
+            message(MembershipFn::Constant { value: 1.5 }),
+            "constant: a constant degree must lie in [0, 1], got 1.5"
+        );
+        let g2 = MembershipFn::Gaussian2 {
+            sigma1: 1.0,
+            center1: 0.0,
+            sigma2: -1.0,
+            center2: 0.0,
+        };
+        assert!(message(g2).contains("sigma1 and sigma2 must be positive"));
+        assert!(
+            MembershipFn::from_matlab("pimf", &[0.0; 4])
+                .unwrap_err()
+                .to_string()
+                .contains("unknown membership")
+        );
+        assert!(
+            MembershipFn::from_matlab("trimf", &[0.0; 2])
+                .unwrap_err()
+                .to_string()
+                .contains("expected 3 parameters, got 2")
+        );
+    }
+
+    #[test]
+    fn matlab_names_and_params_round_trip() {
+        let all = [
+            MembershipFn::bell(0.3, 2.0, -0.3),
+            MembershipFn::gaussian(0.1, 0.2),
+            MembershipFn::Gaussian2 {
+                sigma1: 0.1,
+                center1: 0.2,
+                sigma2: 0.3,
+                center2: 0.4,
+            },
+            MembershipFn::triangle(0.0, 0.5, 1.0),
+            MembershipFn::trapezoid(0.0, 0.25, 0.5, 1.0),
+            MembershipFn::sigmoid(-2.0, 0.1),
+            MembershipFn::SigmoidDifference {
+                slope1: 1.0,
+                center1: 2.0,
+                slope2: 3.0,
+                center2: 4.0,
+            },
+            MembershipFn::SigmoidProduct {
+                slope1: 1.0,
+                center1: 2.0,
+                slope2: -3.0,
+                center2: 4.0,
+            },
+            MembershipFn::Constant { value: 0.25 },
+        ];
+        for mf in all {
+            assert_eq!(
+                MembershipFn::from_matlab(mf.matlab_name(), &mf.params()).unwrap(),
+                mf
+            );
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn every_degree_lies_in_the_unit_interval(
+            kind in 0usize..9, p in prop::array::uniform4(-3.0f64..3.0), x in -1e3f64..1e3,
+        ) {
+            let mut sorted = p;
+            sorted.sort_by(f64::total_cmp);
+            let mf = match kind {
+                0 => MembershipFn::bell(p[0].abs() + 1e-3, p[1].abs() * 10.0 + 1e-3, p[2]),
+                1 => MembershipFn::gaussian(p[0].abs() + 1e-3, p[1]),
+                2 => MembershipFn::Gaussian2 { sigma1: p[0].abs() + 1e-3, center1: p[1], sigma2: p[2].abs() + 1e-3, center2: p[3] },
+                3 => MembershipFn::triangle(sorted[0], sorted[1], sorted[2]),
+                4 => MembershipFn::trapezoid(sorted[0], sorted[1], sorted[2], sorted[3]),
+                5 => MembershipFn::sigmoid(p[0] * 10.0, p[1]),
+                6 => MembershipFn::SigmoidDifference { slope1: p[0], center1: p[1], slope2: p[2], center2: p[3] },
+                7 => MembershipFn::SigmoidProduct { slope1: p[0], center1: p[1], slope2: p[2], center2: p[3] },
+                _ => MembershipFn::Constant { value: p[0].abs() / 3.0 },
+            };
+            let y = mu(mf, x);
+            prop_assert!((0.0..=1.0).contains(&y), "{mf:?} at {x} gave {y}");
+        }
+
+        #[test]
+        fn triangle_is_the_min_of_its_two_sides(a in -2.0f64..0.0, b in 0.0f64..0.5, c in 0.5f64..2.0, x in -3.0f64..3.0) {
+            // An independent closed form for a < b < c: max(min((x-a)/(b-a), (c-x)/(c-b)), 0).
+            let formula = ((x - a) / (b - a)).min((c - x) / (c - b)).max(0.0);
+            prop_assert!((mu(MembershipFn::triangle(a, b, c), x) - formula).abs() <= 1e-12);
+        }
+    }
+}

@@ -1,0 +1,534 @@
+//! A validated Takagi-Sugeno fuzzy system: variables, fuzzy sets, rules and inference methods
+//! (section 4 of the paper, eqs 19-21).
+
+use crate::error::FuzzyError;
+use crate::membership::{CompiledMf, MembershipFn};
+
+/// An input variable: a name, the range it was designed for, and its fuzzy sets.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputVariable {
+    /// The variable's name (unique among all variables of a system).
+    pub name: String,
+    /// `[min, max]`, with `min < max`.
+    pub range: [f64; 2],
+    /// The fuzzy sets ("terms") of the variable, in the order rules index them.
+    pub sets: Vec<FuzzySet>,
+}
+
+/// A named fuzzy set of an input variable.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FuzzySet {
+    /// The set's name (unique within its variable), e.g. `"N"`.
+    pub name: String,
+    /// Its membership function.
+    pub membership: MembershipFn,
+}
+
+/// An output variable: a name, a range and its consequent functions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputVariable {
+    /// The variable's name (unique among all variables of a system).
+    pub name: String,
+    /// `[min, max]`, with `min < max`; its middle is the default output when no rule fires.
+    pub range: [f64; 2],
+    /// The consequent functions ("terms") of the variable, in the order rules index them.
+    pub terms: Vec<OutputTerm>,
+}
+
+/// A named consequent function of an output variable.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputTerm {
+    /// The term's name (unique within its variable), e.g. `"VP"`.
+    pub name: String,
+    /// The consequent `z = f(x)`.
+    pub function: OutputFn,
+}
+
+/// The consequent of a Sugeno rule (eq 19): a constant (zero order) or an affine function of all
+/// inputs (first order).
+#[derive(Debug, Clone, PartialEq)]
+pub enum OutputFn {
+    /// `z = c` (MATLAB `'constant'`, `[c]`).
+    Constant(f64),
+    /// `z = sum_i p_i x_i + r` (MATLAB `'linear'`, `[p_1 ... p_n r]`).
+    Linear {
+        /// `p_i`, one per input variable.
+        coefficients: Vec<f64>,
+        /// `r`.
+        constant: f64,
+    },
+}
+
+impl OutputFn {
+    /// The consequent's value at `inputs` (one value per input variable).
+    pub fn value(&self, inputs: &[f64]) -> f64 {
+        match self {
+            Self::Constant(c) => *c,
+            Self::Linear {
+                coefficients,
+                constant,
+            } => affine(coefficients, *constant, inputs),
+        }
+    }
+}
+
+/// `r + sum_i p_i x_i`, summed in input order.
+#[inline]
+pub(crate) fn affine(coefficients: &[f64], constant: f64, inputs: &[f64]) -> f64 {
+    coefficients
+        .iter()
+        .zip(inputs)
+        .fold(constant, |acc, (p, x)| acc + p * x)
+}
+
+/// One antecedent of a rule, for one input variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Antecedent {
+    /// "Don't care": the input does not take part in the rule (MATLAB `0`).
+    Any,
+    /// "input is set `k`" (0-based set index; MATLAB `k + 1`).
+    Is(usize),
+    /// "input is not set `k`", membership `1 - mu` (MATLAB `-(k + 1)`).
+    IsNot(usize),
+}
+
+/// How a rule combines its antecedents.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Connective {
+    /// All antecedents, combined with the system's [`AndMethod`] (MATLAB `1`).
+    #[default]
+    And,
+    /// Any antecedent, combined with the system's [`OrMethod`] (MATLAB `2`).
+    Or,
+}
+
+/// A fuzzy IF-THEN rule in index form (MATLAB's rule-list row).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rule {
+    /// One antecedent per input variable.
+    pub antecedents: Vec<Antecedent>,
+    /// One entry per output variable: the 0-based index of the output term, or `None` when the
+    /// rule says nothing about that output (MATLAB `0`; the rule then does not enter that
+    /// output's weighted average at all).
+    pub consequents: Vec<Option<usize>>,
+    /// The rule's weight in `[0, 1]`; it multiplies the firing strength.
+    pub weight: f64,
+    /// AND or OR of the antecedents.
+    pub connective: Connective,
+}
+
+/// The fuzzy AND (t-norm) of a rule's antecedents.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AndMethod {
+    /// `a * b` (MATLAB `'prod'`): the paper's product inference engine.
+    #[default]
+    Product,
+    /// `min(a, b)` (MATLAB `'min'`).
+    Minimum,
+}
+
+/// The fuzzy OR (s-norm) of a rule's antecedents.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OrMethod {
+    /// `a + b - a b` (MATLAB `'probor'`).
+    #[default]
+    ProbabilisticSum,
+    /// `max(a, b)` (MATLAB `'max'`).
+    Maximum,
+}
+
+/// How rule outputs combine into the crisp output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Defuzzification {
+    /// `sum w_r z_r / sum w_r`, the centre-average defuzzifier (eq 21; MATLAB `'wtaver'`).
+    #[default]
+    WeightedAverage,
+    /// `sum w_r z_r` (MATLAB `'wtsum'`).
+    WeightedSum,
+}
+
+/// The inference methods of a system.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Methods {
+    /// The AND of antecedents.
+    pub and: AndMethod,
+    /// The OR of antecedents.
+    pub or: OrMethod,
+    /// The defuzzifier.
+    pub defuzzification: Defuzzification,
+}
+
+/// A validated Takagi-Sugeno fuzzy system.
+///
+/// Build one with [`FuzzySystem::builder`], read one with [`FuzzySystem::from_fis`], or take
+/// the paper's controller from [`paper_controller`](crate::paper_controller). Evaluate it with an
+/// [`Evaluator`](crate::Evaluator).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FuzzySystem {
+    name: String,
+    inputs: Vec<InputVariable>,
+    outputs: Vec<OutputVariable>,
+    rules: Vec<Rule>,
+    methods: Methods,
+    compiled: Compiled,
+}
+
+impl FuzzySystem {
+    /// Starts a [`SystemBuilder`](crate::SystemBuilder).
+    pub fn builder(name: impl Into<String>) -> crate::SystemBuilder {
+        crate::SystemBuilder::new(name)
+    }
+
+    /// Validates every part and compiles the evaluation tables.
+    pub(crate) fn new(
+        name: String,
+        inputs: Vec<InputVariable>,
+        outputs: Vec<OutputVariable>,
+        rules: Vec<Rule>,
+        methods: Methods,
+    ) -> Result<Self, FuzzyError> {
+        check_name("system", &name).map_err(|reason| invalid("system", reason))?;
+        if inputs.is_empty() || outputs.is_empty() {
+            return Err(invalid("system", "needs at least one input and one output"));
+        }
+        let mut variable_names: Vec<&str> = Vec::new();
+        for input in &inputs {
+            let context = format!("input '{}'", input.name);
+            check_variable(
+                &input.name,
+                input.range,
+                input.sets.iter().map(|s| s.name.as_str()),
+                &mut variable_names,
+            )
+            .map_err(|reason| invalid(&context, reason))?;
+            for set in &input.sets {
+                set.membership.validate().map_err(|e| {
+                    invalid(&format!("{context} set '{}'", set.name), e.to_string())
+                })?;
+            }
+        }
+        for output in &outputs {
+            let context = format!("output '{}'", output.name);
+            check_variable(
+                &output.name,
+                output.range,
+                output.terms.iter().map(|t| t.name.as_str()),
+                &mut variable_names,
+            )
+            .map_err(|reason| invalid(&context, reason))?;
+            for term in &output.terms {
+                check_output_fn(&term.function, inputs.len()).map_err(|reason| {
+                    invalid(&format!("{context} term '{}'", term.name), reason)
+                })?;
+            }
+        }
+        for (r, rule) in rules.iter().enumerate() {
+            check_rule(rule, &inputs, &outputs)
+                .map_err(|reason| invalid(&format!("rule {}", r + 1), reason))?;
+        }
+        let compiled = Compiled::new(&inputs, &outputs, &rules)?;
+        Ok(Self {
+            name,
+            inputs,
+            outputs,
+            rules,
+            methods,
+            compiled,
+        })
+    }
+
+    /// The system's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The input variables, in evaluation order.
+    pub fn inputs(&self) -> &[InputVariable] {
+        &self.inputs
+    }
+
+    /// The output variables, in evaluation order.
+    pub fn outputs(&self) -> &[OutputVariable] {
+        &self.outputs
+    }
+
+    /// The rules, in order (messages and reports number them from 1, like MATLAB).
+    pub fn rules(&self) -> &[Rule] {
+        &self.rules
+    }
+
+    /// The inference methods.
+    pub fn methods(&self) -> Methods {
+        self.methods
+    }
+
+    pub(crate) fn compiled(&self) -> &Compiled {
+        &self.compiled
+    }
+}
+
+fn invalid(context: &str, reason: impl Into<String>) -> FuzzyError {
+    FuzzyError::InvalidSystem {
+        context: context.to_string(),
+        reason: reason.into(),
+    }
+}
+
+/// Names are written between single quotes in a `.fis` file, one per line.
+pub(crate) fn check_name(kind: &str, name: &str) -> Result<(), String> {
+    if name.is_empty() {
+        Err(format!("the {kind} name is empty"))
+    } else if name.contains('\'') || name.chars().any(char::is_control) {
+        Err(format!(
+            "the {kind} name {name:?} contains a quote or a control character"
+        ))
+    } else if name == "-" {
+        Err(format!(
+            "\"-\" is reserved for \"don't care\" and cannot be a {kind} name"
+        ))
+    } else {
+        Ok(())
+    }
+}
+
+fn check_variable<'a>(
+    name: &'a str,
+    range: [f64; 2],
+    term_names: impl Iterator<Item = &'a str>,
+    variable_names: &mut Vec<&'a str>,
+) -> Result<(), String> {
+    check_name("variable", name)?;
+    if variable_names.contains(&name) {
+        return Err("another variable has the same name".to_string());
+    }
+    variable_names.push(name);
+    let [min, max] = range;
+    if !(min.is_finite() && max.is_finite() && min < max) {
+        return Err(format!(
+            "range must be finite with min < max, got [{min}, {max}]"
+        ));
+    }
+    let mut seen: Vec<&str> = Vec::new();
+    for term in term_names {
+        check_name("set", term)?;
+        if seen.contains(&term) {
+            return Err(format!("two sets are named '{term}'"));
+        }
+        seen.push(term);
+    }
+    if seen.is_empty() {
+        return Err("has no sets".to_string());
+    }
+    Ok(())
+}
+
+fn check_output_fn(function: &OutputFn, n_inputs: usize) -> Result<(), String> {
+    match function {
+        OutputFn::Constant(c) if !c.is_finite() => Err(format!("constant must be finite, got {c}")),
+        OutputFn::Linear {
+            coefficients,
+            constant,
+        } => {
+            if coefficients.len() != n_inputs {
+                Err(format!(
+                    "linear consequent has {} coefficients for {n_inputs} inputs",
+                    coefficients.len()
+                ))
+            } else if !constant.is_finite() || coefficients.iter().any(|p| !p.is_finite()) {
+                Err("linear consequent coefficients must be finite".to_string())
+            } else {
+                Ok(())
+            }
+        }
+        OutputFn::Constant(_) => Ok(()),
+    }
+}
+
+/// Checks one rule against the variables; the reason is phrased for a `rule N: ...` prefix.
+pub(crate) fn check_rule(
+    rule: &Rule,
+    inputs: &[InputVariable],
+    outputs: &[OutputVariable],
+) -> Result<(), String> {
+    if rule.antecedents.len() != inputs.len() {
+        return Err(format!(
+            "has {} antecedents for {} inputs",
+            rule.antecedents.len(),
+            inputs.len()
+        ));
+    }
+    if rule.consequents.len() != outputs.len() {
+        return Err(format!(
+            "has {} consequents for {} outputs",
+            rule.consequents.len(),
+            outputs.len()
+        ));
+    }
+    for (antecedent, input) in rule.antecedents.iter().zip(inputs) {
+        if let Antecedent::Is(k) | Antecedent::IsNot(k) = *antecedent
+            && k >= input.sets.len()
+        {
+            return Err(format!(
+                "input '{}' has {} sets, there is no set {}",
+                input.name,
+                input.sets.len(),
+                k + 1
+            ));
+        }
+    }
+    for (consequent, output) in rule.consequents.iter().zip(outputs) {
+        if let Some(k) = *consequent
+            && k >= output.terms.len()
+        {
+            return Err(format!(
+                "output '{}' has {} terms, there is no term {}",
+                output.name,
+                output.terms.len(),
+                k + 1
+            ));
+        }
+    }
+    if rule.antecedents.iter().all(|a| *a == Antecedent::Any) {
+        return Err("has no antecedent (every input is \"don't care\")".to_string());
+    }
+    if rule.consequents.iter().all(Option::is_none) {
+        return Err("has no consequent".to_string());
+    }
+    if !(0.0..=1.0).contains(&rule.weight) {
+        return Err(format!("weight must lie in [0, 1], got {}", rule.weight));
+    }
+    Ok(())
+}
+
+/// Flat evaluation tables, built once from a validated system.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Compiled {
+    /// Every input set's compiled membership function, input by input.
+    pub mfs: Vec<CompiledMf>,
+    /// The input that each of `mfs` reads.
+    pub mf_inputs: Vec<usize>,
+    /// Whether any rule negates an antecedent (then the degree table holds `1 - mu` too).
+    pub has_complements: bool,
+    /// The length of the degree table: the memberships, their complements if any rule negates,
+    /// then the constants 1 and 0 (the neutral elements of AND and OR, for "don't care").
+    pub degree_count: usize,
+    /// One row per rule, one entry per input: the index of the antecedent in the degree table.
+    pub antecedents: Vec<u32>,
+    /// Each rule's weight.
+    pub weights: Vec<f64>,
+    /// Whether each rule is an OR rule.
+    pub is_or: Vec<bool>,
+    /// Each output term's value with constants filled in (first-order terms are recomputed).
+    pub term_values: Vec<f64>,
+    /// First-order terms: (index into `term_values`, offset of `[p_1 .. p_n r]` in `coefficients`).
+    pub linear_terms: Vec<(usize, usize)>,
+    /// The coefficients of the first-order terms, `n_inputs + 1` each.
+    pub coefficients: Vec<f64>,
+    /// One row per output, one entry per rule: the index in `term_values` of the rule's
+    /// consequent, or of the trailing 0 of `term_values` when the rule says nothing about it.
+    pub consequents: Vec<u32>,
+    /// Whether every rule concludes on each output (then its total strength is the sum of all).
+    pub every_rule_concludes: Vec<bool>,
+    /// One row per output, one entry per rule: 1 if the rule concludes on the output, else 0.
+    pub concludes: Vec<f64>,
+}
+
+impl Compiled {
+    fn new(
+        inputs: &[InputVariable],
+        outputs: &[OutputVariable],
+        rules: &[Rule],
+    ) -> Result<Self, FuzzyError> {
+        let mut mfs = Vec::new();
+        let mut mf_inputs = Vec::new();
+        let mut set_offsets = Vec::with_capacity(inputs.len());
+        for (i, input) in inputs.iter().enumerate() {
+            set_offsets.push(mfs.len());
+            for set in &input.sets {
+                mfs.push(CompiledMf::new(&set.membership)?);
+                mf_inputs.push(i);
+            }
+        }
+        let mut term_offsets = Vec::with_capacity(outputs.len());
+        let mut term_values = Vec::new();
+        let mut linear_terms = Vec::new();
+        let mut coefficients = Vec::new();
+        for output in outputs {
+            term_offsets.push(term_values.len());
+            for term in &output.terms {
+                match &term.function {
+                    OutputFn::Constant(c) => term_values.push(*c),
+                    OutputFn::Linear {
+                        coefficients: p,
+                        constant,
+                    } => {
+                        linear_terms.push((term_values.len(), coefficients.len()));
+                        coefficients.extend_from_slice(p);
+                        coefficients.push(*constant);
+                        term_values.push(*constant);
+                    }
+                }
+            }
+        }
+        let has_complements = rules
+            .iter()
+            .flat_map(|r| &r.antecedents)
+            .any(|a| matches!(a, Antecedent::IsNot(_)));
+        let n_mf = mfs.len();
+        let degree_count = n_mf * if has_complements { 2 } else { 1 } + 2;
+        let (one, zero) = (degree_count - 2, degree_count - 1);
+        let index = |k: usize| {
+            u32::try_from(k).map_err(|_| FuzzyError::InvalidSystem {
+                context: "system".to_string(),
+                reason: format!("too large to index with 32 bits ({k} entries)"),
+            })
+        };
+        let mut antecedents = Vec::with_capacity(rules.len() * inputs.len());
+        for rule in rules {
+            for (i, antecedent) in rule.antecedents.iter().enumerate() {
+                antecedents.push(index(match *antecedent {
+                    Antecedent::Any if rule.connective == Connective::Or => zero,
+                    Antecedent::Any => one,
+                    Antecedent::Is(k) => set_offsets[i] + k,
+                    Antecedent::IsNot(k) => n_mf + set_offsets[i] + k,
+                })?);
+            }
+        }
+        let no_conclusion = term_values.len();
+        term_values.push(0.0);
+        let mut consequents = Vec::with_capacity(outputs.len() * rules.len());
+        let mut concludes = Vec::with_capacity(outputs.len() * rules.len());
+        for (o, &first_term) in term_offsets.iter().enumerate() {
+            for rule in rules {
+                let term = rule.consequents[o].map_or(no_conclusion, |k| first_term + k);
+                consequents.push(index(term)?);
+                concludes.push(if rule.consequents[o].is_some() {
+                    1.0
+                } else {
+                    0.0
+                });
+            }
+        }
+        let every_rule_concludes = (0..outputs.len())
+            .map(|o| rules.iter().all(|r| r.consequents[o].is_some()))
+            .collect();
+        Ok(Self {
+            mfs,
+            mf_inputs,
+            has_complements,
+            degree_count,
+            antecedents,
+            weights: rules.iter().map(|r| r.weight).collect(),
+            is_or: rules
+                .iter()
+                .map(|r| r.connective == Connective::Or)
+                .collect(),
+            term_values,
+            linear_terms,
+            coefficients,
+            consequents,
+            every_rule_concludes,
+            concludes,
+        })
+    }
+}

@@ -1,0 +1,314 @@
+//! SVG charts with plotters: multi-series line charts and 2-D surfaces drawn as heat maps with a
+//! colour scale. Used by `hrm fis surface` and by the paper's figures.
+
+use plotters::prelude::*;
+use plotters::style::colors::colormaps::ViridisRGB;
+use std::ops::Range;
+use std::path::Path;
+
+/// Chart size in pixels.
+const SIZE: (u32, u32) = (800, 600);
+/// Width of the heat map's part of the picture; the rest holds the colour scale.
+const HEATMAP_WIDTH: u32 = 660;
+/// Chart titles.
+const TITLE_FONT: (&str, u32) = ("sans-serif", 22);
+/// Tick labels and legend entries.
+const TICK_FONT: (&str, u32) = ("sans-serif", 14);
+/// Axis descriptions.
+const AXIS_FONT: (&str, u32) = ("sans-serif", 16);
+
+/// The title and axis labels of a chart.
+pub struct Labels<'a> {
+    /// The caption above the chart.
+    pub title: &'a str,
+    /// The horizontal axis.
+    pub x: &'a str,
+    /// The vertical axis.
+    pub y: &'a str,
+}
+
+/// One named curve of a line chart.
+pub struct Series {
+    /// The legend entry.
+    pub label: String,
+    /// The points, in drawing order.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// Values on a rectangular grid: `z[iy * x.len() + ix]` at `(x[ix], y[iy])`, both axes ascending.
+pub struct Grid {
+    /// The horizontal sample positions.
+    pub x: Vec<f64>,
+    /// The vertical sample positions.
+    pub y: Vec<f64>,
+    /// The values, row by row (one row per `y`).
+    pub z: Vec<f64>,
+}
+
+/// Writes a line chart of `series` (with a legend) to the SVG file `path`. The vertical axis
+/// spans `y_range`, or the data with a 5% margin when it is `None`.
+pub fn line_chart(
+    path: &Path,
+    labels: &Labels<'_>,
+    series: &[Series],
+    y_range: Option<Range<f64>>,
+) -> Result<(), String> {
+    let points = || series.iter().flat_map(|s| s.points.iter());
+    let x_range = span(points().map(|p| p.0), "x")?;
+    let y_range = match y_range {
+        Some(range) if range.start < range.end => range,
+        Some(range) => return Err(format!("{}: empty y range {range:?}", path.display())),
+        None => {
+            let data = span(points().map(|p| p.1), "y")?;
+            let margin = 0.05 * (data.end - data.start);
+            data.start - margin..data.end + margin
+        }
+    };
+    let (x_ticks, y_ticks) = (tick_format(&x_range), tick_format(&y_range));
+    let root = SVGBackend::new(path, SIZE).into_drawing_area();
+    let draw = || -> Result<(), Box<dyn std::error::Error + '_>> {
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(labels.title, TITLE_FONT)
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(75)
+            .build_cartesian_2d(x_range.clone(), y_range.clone())?;
+        chart
+            .configure_mesh()
+            .x_desc(labels.x)
+            .y_desc(labels.y)
+            .label_style(TICK_FONT)
+            .axis_desc_style(AXIS_FONT)
+            .x_label_formatter(&x_ticks)
+            .y_label_formatter(&y_ticks)
+            .draw()?;
+        for (k, s) in series.iter().enumerate() {
+            let colour = Palette99::pick(k).to_rgba();
+            chart
+                .draw_series(LineSeries::new(
+                    s.points.iter().copied(),
+                    colour.stroke_width(2),
+                ))?
+                .label(s.label.as_str())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .label_font(TICK_FONT)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()?;
+        root.present()?;
+        Ok(())
+    };
+    draw().map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Writes `grid` as a heat map with a colour scale labelled `z_label` to the SVG file `path`.
+pub fn heatmap(path: &Path, labels: &Labels<'_>, z_label: &str, grid: &Grid) -> Result<(), String> {
+    let (nx, ny) = (grid.x.len(), grid.y.len());
+    if nx < 2 || ny < 2 || grid.z.len() != nx * ny {
+        return Err(format!(
+            "{}: a heat map needs at least 2 x 2 samples and one value per grid point ({nx} x {ny} grid, {} values)",
+            path.display(),
+            grid.z.len()
+        ));
+    }
+    let x_range = span(grid.x.iter().copied(), "x")?;
+    let y_range = span(grid.y.iter().copied(), "y")?;
+    let z_range = span(grid.z.iter().copied(), "z")?;
+    let (x_edges, y_edges) = (cell_edges(&grid.x), cell_edges(&grid.y));
+    let (x_ticks, y_ticks, z_ticks) = (
+        tick_format(&x_range),
+        tick_format(&y_range),
+        tick_format(&z_range),
+    );
+    let colour = |z: f64| ViridisRGB::get_color_normalized(z, z_range.start, z_range.end);
+    let root = SVGBackend::new(path, SIZE).into_drawing_area();
+    let draw = || -> Result<(), Box<dyn std::error::Error + '_>> {
+        root.fill(&WHITE)?;
+        let (map_area, scale_area) = root.split_horizontally(HEATMAP_WIDTH);
+        let mut chart = ChartBuilder::on(&map_area)
+            .caption(labels.title, TITLE_FONT)
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(75)
+            .build_cartesian_2d(x_range.clone(), y_range.clone())?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(labels.x)
+            .y_desc(labels.y)
+            .label_style(TICK_FONT)
+            .axis_desc_style(AXIS_FONT)
+            .x_label_formatter(&x_ticks)
+            .y_label_formatter(&y_ticks)
+            .draw()?;
+        let cells = (0..ny).flat_map(|iy| (0..nx).map(move |ix| (ix, iy)));
+        chart.draw_series(cells.map(|(ix, iy)| {
+            let corners = [
+                (x_edges[ix], y_edges[iy]),
+                (x_edges[ix + 1], y_edges[iy + 1]),
+            ];
+            Rectangle::new(corners, colour(grid.z[iy * nx + ix]).filled())
+        }))?;
+        let mut scale = ChartBuilder::on(&scale_area)
+            .margin_top(50)
+            .margin_bottom(65)
+            .margin_right(50)
+            .y_label_area_size(0)
+            .right_y_label_area_size(60)
+            .build_cartesian_2d(0.0..1.0, z_range.clone())?;
+        scale
+            .configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .y_desc(z_label)
+            .label_style(TICK_FONT)
+            .axis_desc_style(AXIS_FONT)
+            .y_label_formatter(&z_ticks)
+            .draw()?;
+        const STEPS: usize = 100;
+        let dz = (z_range.end - z_range.start) / STEPS as f64;
+        scale.draw_series((0..STEPS).map(|k| {
+            let z = z_range.start + k as f64 * dz;
+            Rectangle::new([(0.0, z), (1.0, z + dz)], colour(z + 0.5 * dz).filled())
+        }))?;
+        root.present()?;
+        Ok(())
+    };
+    draw().map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Tick labels rounded to five significant digits of the axis span, so that no label reads
+/// `-0` or `0.30000000000000004`.
+fn tick_format(range: &Range<f64>) -> impl Fn(&f64) -> String {
+    let exponent = (range.end - range.start).log10().floor() as i32 - 4;
+    let step = 10f64.powi(exponent);
+    let decimals = (-exponent).max(0) as usize;
+    move |v| {
+        // Adding 0.0 turns -0 into +0.
+        let text = format!("{:.decimals$}", (v / step).round() * step + 0.0);
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
+    }
+}
+
+/// The range spanned by `values`, widened when they are all equal; an error for no or
+/// non-finite values.
+fn span(values: impl Iterator<Item = f64>, axis: &str) -> Result<Range<f64>, String> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values {
+        if !v.is_finite() {
+            return Err(format!("cannot plot a non-finite {axis} value ({v})"));
+        }
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if lo > hi {
+        return Err(format!("nothing to plot: no {axis} values"));
+    }
+    if hi - lo <= 1e-12 * lo.abs().max(hi.abs()).max(1.0) {
+        let pad = 0.5 * lo.abs().max(1.0);
+        return Ok(lo - pad..hi + pad);
+    }
+    Ok(lo..hi)
+}
+
+/// Cell boundaries around ascending samples: the ends, and the midpoints between neighbours.
+fn cell_edges(samples: &[f64]) -> Vec<f64> {
+    let mut edges = Vec::with_capacity(samples.len() + 1);
+    edges.push(samples[0]);
+    edges.extend(samples.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+    edges.push(samples[samples.len() - 1]);
+    edges
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spans_and_cell_edges() {
+        assert_eq!(span([1.0, -2.0, 0.5].into_iter(), "x").unwrap(), -2.0..1.0);
+        assert_eq!(span([3.0, 3.0].into_iter(), "z").unwrap(), 1.5..4.5);
+        assert!(
+            span([1.0, f64::NAN].into_iter(), "y")
+                .unwrap_err()
+                .contains("non-finite y")
+        );
+        assert!(
+            span(std::iter::empty(), "x")
+                .unwrap_err()
+                .contains("no x values")
+        );
+        assert_eq!(cell_edges(&[0.0, 1.0, 3.0]), [0.0, 0.5, 2.0, 3.0]);
+        let ticks = tick_format(&(-0.3..0.3));
+        assert_eq!(
+            [
+                ticks(&-0.0),
+                ticks(&0.1),
+                ticks(&(0.1 + 0.2)),
+                ticks(&-0.25)
+            ],
+            ["0", "0.1", "0.3", "-0.25"]
+        );
+        let ticks = tick_format(&(-100.0..100.0));
+        assert_eq!(
+            [ticks(&-80.0), ticks(&12.5), ticks(&-1e-9)],
+            ["-80", "12.5", "0"]
+        );
+    }
+
+    #[test]
+    fn charts_are_written_as_svg() {
+        let dir = std::env::temp_dir().join(format!("hrm-plot-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let labels = Labels {
+            title: "t",
+            x: "x",
+            y: "y",
+        };
+        let line = dir.join("line.svg");
+        let series = [Series {
+            label: "sin".into(),
+            points: (0..50)
+                .map(|k| (k as f64, (k as f64 / 5.0).sin()))
+                .collect(),
+        }];
+        line_chart(&line, &labels, &series, None).unwrap();
+        assert!(
+            line_chart(&line, &labels, &series, Some(1.0..1.0))
+                .unwrap_err()
+                .contains("empty y range")
+        );
+        let text = std::fs::read_to_string(&line).unwrap();
+        assert!(text.starts_with("<svg") && text.contains("sin") && text.contains("<polyline"));
+        let map = dir.join("map.svg");
+        let grid = Grid {
+            x: vec![0.0, 1.0, 2.0],
+            y: vec![0.0, 1.0],
+            z: vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0],
+        };
+        heatmap(&map, &labels, "z", &grid).unwrap();
+        let text = std::fs::read_to_string(&map).unwrap();
+        assert!(text.starts_with("<svg") && text.matches("<rect").count() >= 6 + 100);
+        let bad = Grid {
+            x: vec![0.0, 1.0],
+            y: vec![0.0, 1.0],
+            z: vec![0.0; 3],
+        };
+        assert!(
+            heatmap(&map, &labels, "z", &bad)
+                .unwrap_err()
+                .contains("one value per grid point")
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
