@@ -1,0 +1,126 @@
+//! The reusable workspace of the reduced dynamics (the "Data" of the Model/Data split), and the
+//! reduced terms it holds after a computation.
+
+use faer::{Mat, MatRef};
+use manip_dyn::ChainData;
+
+use crate::error::{ReduceError, check_len};
+use crate::model::ReducedModel;
+use crate::terms::Pair;
+
+/// Workspace for one [`ReducedModel`]: create it once, reuse it for every call.
+///
+/// After [`reduced_terms`](crate::reduced_terms), [`reduced_terms_faer`](crate::reduced_terms_faer)
+/// or a forward-dynamics call it holds `M*`, `C*` and `G*` at the state passed in, readable with
+/// [`mass_matrix`](Self::mass_matrix), [`coriolis`](Self::coriolis) and
+/// [`gravity`](Self::gravity). Its memory is `O(n^2)` because the faer path
+/// ([`reduced_terms_faer`](crate::reduced_terms_faer)) and the full chain's workspace hold
+/// `n x n` matrices; the default path touches only an `O(m^2)` part of it.
+#[derive(Debug, Clone)]
+pub struct ReducedData {
+    pub(crate) n_links: usize,
+    pub(crate) n_coords: usize,
+    /// `M*`, row-major `m x m`, symmetric.
+    pub(crate) mass: Vec<f64>,
+    /// `C*`, length `m`.
+    pub(crate) coriolis: Vec<f64>,
+    /// `G*`, length `m`.
+    pub(crate) gravity: Vec<f64>,
+    /// Scratch `m x m`: the Cholesky factor of `M*`, or the matrix whose eigenvalues are sought.
+    pub(crate) factor: Vec<f64>,
+    /// Scratch `m`: the right-hand side `tau* - C* - G*` and the previous iterate of the eq-18
+    /// iteration.
+    pub(crate) rhs: Vec<f64>,
+    pub(crate) iterate: Vec<f64>,
+    /// Per-link buffers of the default path.
+    pub(crate) links: LinkBuffers,
+    /// Scratch of the default path for sizes without a specialised version.
+    pub(crate) scratch: TermScratch,
+    /// Joint-space state and torque buffers, length `n`.
+    pub(crate) theta: Vec<f64>,
+    pub(crate) theta_dot: Vec<f64>,
+    pub(crate) theta_ddot: Vec<f64>,
+    pub(crate) joint_torque: Vec<f64>,
+    /// The full mass matrix `M` (`n x n`) and `M J` (`n x m`), for the projection path.
+    pub(crate) joint_mass: Mat<f64>,
+    pub(crate) mass_times_jacobian: Mat<f64>,
+    /// The full chain's own workspace.
+    pub(crate) chain: ChainData,
+}
+
+/// Per link (length `n` each): absolute angle, its sine and cosine, squared angular rate, and the
+/// Coriolis/centrifugal force `c_l` in absolute angles (see [`crate::terms`]).
+#[derive(Debug, Clone)]
+pub(crate) struct LinkBuffers {
+    pub(crate) angle: Vec<f64>,
+    pub(crate) sin: Vec<f64>,
+    pub(crate) cos: Vec<f64>,
+    pub(crate) rate_squared: Vec<f64>,
+    pub(crate) force: Vec<f64>,
+}
+
+/// Scratch of the default path for sizes without a specialised version (see [`crate::terms`]).
+#[derive(Debug, Clone)]
+pub(crate) struct TermScratch {
+    /// `m`: the columns of the prefix sum `P_l`.
+    pub(crate) joint: Vec<Pair>,
+    /// `m`: `S_l v_l`.
+    pub(crate) cos_moment: Vec<f64>,
+}
+
+impl ReducedData {
+    /// A workspace sized for `model`.
+    pub fn new(model: &ReducedModel) -> Self {
+        let (n, m) = (model.n_links(), model.n_coords());
+        Self {
+            n_links: n,
+            n_coords: m,
+            mass: vec![0.0; m * m],
+            coriolis: vec![0.0; m],
+            gravity: vec![0.0; m],
+            factor: vec![0.0; m * m],
+            rhs: vec![0.0; m],
+            iterate: vec![0.0; m],
+            links: LinkBuffers {
+                angle: vec![0.0; n],
+                sin: vec![0.0; n],
+                cos: vec![0.0; n],
+                rate_squared: vec![0.0; n],
+                force: vec![0.0; n],
+            },
+            scratch: TermScratch {
+                joint: vec![[0.0; 2]; m],
+                cos_moment: vec![0.0; m],
+            },
+            theta: vec![0.0; n],
+            theta_dot: vec![0.0; n],
+            theta_ddot: vec![0.0; n],
+            joint_torque: vec![0.0; n],
+            joint_mass: Mat::zeros(n, n),
+            mass_times_jacobian: Mat::zeros(n, m),
+            chain: ChainData::new(model.chain()),
+        }
+    }
+
+    /// The reduced mass matrix `M* = J^T M J` (`m x m`, eq 14) of the last computation.
+    pub fn mass_matrix(&self) -> MatRef<'_, f64> {
+        MatRef::from_row_major_slice(&self.mass, self.n_coords, self.n_coords)
+    }
+
+    /// The reduced Coriolis/centrifugal vector `C* = J^T C` (length `m`, eq 14) of the last
+    /// computation.
+    pub fn coriolis(&self) -> &[f64] {
+        &self.coriolis
+    }
+
+    /// The reduced gravity vector `G* = J^T G` (length `m`, eq 14) of the last computation.
+    pub fn gravity(&self) -> &[f64] {
+        &self.gravity
+    }
+
+    /// Checks that this workspace was made for `model`.
+    pub(crate) fn check_model(&self, model: &ReducedModel) -> Result<(), ReduceError> {
+        check_len("workspace links", self.n_links, model.n_links())?;
+        check_len("workspace coordinates", self.n_coords, model.n_coords())
+    }
+}

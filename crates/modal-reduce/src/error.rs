@@ -1,0 +1,148 @@
+//! The error type of this crate, and the input checks that produce it.
+
+use backbone_kin::KinError;
+use manip_dyn::DynError;
+
+/// Why a reduced-dynamics computation was refused.
+///
+/// Every variant names the condition that failed, so a caller (or the `hrm` command line) can
+/// print it as one readable line.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ReduceError {
+    /// The full-chain dynamics refused the computation.
+    #[error("chain dynamics: {0}")]
+    Dyn(#[from] DynError),
+    /// The modal map refused the computation.
+    #[error("modal map: {0}")]
+    Kin(#[from] KinError),
+    /// The modal map and the chain disagree on the number of joints.
+    #[error("the modal map has {joints} joints but the chain has {links} links")]
+    LinkCountMismatch {
+        /// Rows of the modal Jacobian `J`.
+        joints: usize,
+        /// Links of the chain.
+        links: usize,
+    },
+    /// The modal Jacobian has dependent columns, so `M* = J^T M J` would be singular.
+    #[error(
+        "the modal Jacobian J ({links} x {coords}) is column-rank-deficient (smallest eigenvalue \
+         of its column-normalised Gram matrix is {min_eigenvalue:e}), so M* = J^T M J would be \
+         singular: use fewer modal coordinates or more links"
+    )]
+    RankDeficient {
+        /// Links (rows of `J`).
+        links: usize,
+        /// Modal coordinates (columns of `J`).
+        coords: usize,
+        /// Smallest eigenvalue of `D^-1/2 J^T J D^-1/2`, `D = diag(J^T J)` (1 for orthogonal
+        /// columns, 0 for dependent ones).
+        min_eigenvalue: f64,
+    },
+    /// A slice had the wrong number of entries, or a workspace belongs to another model.
+    #[error("{name} has {got} entries, expected {expected}")]
+    Dimension {
+        /// Which input, output or workspace.
+        name: &'static str,
+        /// The size the computation needs.
+        expected: usize,
+        /// The size it got.
+        got: usize,
+    },
+    /// An input that must be finite was NaN or infinite.
+    #[error("{name}[{index}] must be finite, got {value}")]
+    NonFinite {
+        /// Which input.
+        name: &'static str,
+        /// 0-based index of the first offending entry.
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// The Cholesky factorisation of `M*` met a non-positive pivot. `M*` is positive definite for
+    /// every valid chain and full-rank map, so this signals numbers too extreme for double
+    /// precision.
+    #[error("the reduced mass matrix M* is not numerically positive definite")]
+    NotPositiveDefinite,
+    /// A computed quantity overflowed although every input was finite.
+    #[error("the computed {name} is not finite (inputs too large for double precision)")]
+    NonFiniteResult {
+        /// Which quantity.
+        name: &'static str,
+    },
+    /// The eq-18 iteration cannot converge at this state.
+    #[error(
+        "the eq-18 Jacobi iteration diverges here: the spectral radius of M0*^-1 M1* is \
+         {spectral_radius:.4} >= 1 (M* is not diagonally dominant enough); solve M* a_ddot = rhs \
+         directly with forward_dynamics"
+    )]
+    JacobiDiverged {
+        /// Spectral radius of the iteration matrix `M0*^-1 M1*` (eq 16-18).
+        spectral_radius: f64,
+    },
+    /// The eq-18 iteration converges in theory but did not reach the tolerance in time.
+    #[error(
+        "the eq-18 Jacobi iteration did not reach the tolerance in {iterations} iterations \
+         (spectral radius {spectral_radius:.4}, last relative update {relative_update:e})"
+    )]
+    JacobiNotConverged {
+        /// Iterations performed.
+        iterations: usize,
+        /// Spectral radius of `M0*^-1 M1*` (below 1, but close to it).
+        spectral_radius: f64,
+        /// `|x_{k+1} - x_k|_inf / |x_{k+1}|_inf` at the last iteration.
+        relative_update: f64,
+    },
+    /// A setting of the eq-18 iteration was out of its domain.
+    #[error("Jacobi setting {name} must be {requirement}, got {value}")]
+    InvalidSetting {
+        /// Which setting.
+        name: &'static str,
+        /// What it must be.
+        requirement: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+}
+
+/// Checks that `values` has `expected` entries, all finite.
+pub(crate) fn check_input(
+    name: &'static str,
+    values: &[f64],
+    expected: usize,
+) -> Result<(), ReduceError> {
+    check_len(name, values.len(), expected)?;
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(ReduceError::NonFinite {
+            name,
+            index,
+            value: values[index],
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Checks that a slice or workspace has `expected` entries.
+pub(crate) fn check_len(
+    name: &'static str,
+    got: usize,
+    expected: usize,
+) -> Result<(), ReduceError> {
+    if got == expected {
+        Ok(())
+    } else {
+        Err(ReduceError::Dimension {
+            name,
+            expected,
+            got,
+        })
+    }
+}
+
+/// Checks that a computed vector is finite.
+pub(crate) fn check_finite_result(name: &'static str, values: &[f64]) -> Result<(), ReduceError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(ReduceError::NonFiniteResult { name })
+    }
+}

@@ -1,0 +1,192 @@
+//! The immutable reduced model: a chain and a constant modal map (the "Model" of the Model/Data
+//! split).
+
+use backbone_kin::ModalMap;
+use faer::Mat;
+use manip_dyn::ChainModel;
+
+use crate::error::ReduceError;
+use crate::small_linalg::symmetric_eigen_extremes;
+
+/// Below this smallest eigenvalue of the column-normalised Gram matrix of `J` (the square of the
+/// smallest singular value of `J` with unit columns) the map is treated as rank-deficient: `M*`
+/// would then be singular or too ill-conditioned for a solve to mean anything.
+const RANK_TOLERANCE: f64 = 1e-10;
+
+/// The per-link constants of the default path (see [`crate::terms`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct LinkConstants {
+    /// Link length `L_l`.
+    pub length: f64,
+    /// `S_l = m_l r_l + L_l mu_l`: the first moment of mass about joint `l` of the link and,
+    /// lumped at its far joint, all the mass `mu_l` beyond it.
+    pub first_moment: f64,
+    /// Absolute angle of the link at `a = 0`: `phi0_l = theta0_0 + ... + theta0_l`.
+    pub angle_offset: f64,
+}
+
+/// A planar chain constrained to a constant modal map `theta = J a + theta_0` (eqs 8-11), with
+/// what the reduced dynamics (eqs 13-18) needs precomputed.
+///
+/// Because `J` is constant the constraint is holonomic and exact, and the reduced model is itself
+/// Lagrangian with coordinates `a`: `M* = J^T M J`, `C* = J^T C(J a + theta_0, J a_dot)`,
+/// `G* = J^T G(J a + theta_0)` and `tau* = J^T tau` (eqs 14-15).
+///
+/// ```
+/// use backbone_kin::ModalMap;
+/// use manip_dyn::ChainModel;
+/// use modal_reduce::ReducedModel;
+///
+/// let model = ReducedModel::new(ChainModel::uniform(10, 0.1, 0.1, 9.81)?, ModalMap::paper(10)?)?;
+/// assert_eq!((model.n_links(), model.n_coords()), (10, 3));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct ReducedModel {
+    chain: ChainModel,
+    map: ModalMap,
+    /// `J` as a faer matrix (`n x m`), for the projection path.
+    jacobian: Mat<f64>,
+    /// Row `l` is `Phi_l = J_0 + ... + J_l`, the gradient of link `l`'s absolute angle with
+    /// respect to `a` (row-major, `n x m`).
+    angle_rows: Vec<f64>,
+    links: Vec<LinkConstants>,
+    /// `K = sum_l h_ll Phi_l^T Phi_l` (row-major `m x m`): the constant part of `M*`.
+    constant_mass: Vec<f64>,
+}
+
+impl ReducedModel {
+    /// Builds the reduced model of `chain` under `map`.
+    ///
+    /// Fails if the map's joint count differs from the chain's link count, or if `J` is
+    /// column-rank-deficient (for example three coordinates on fewer than three links, or more
+    /// harmonics than the links can resolve), since `M* = J^T M J` would then be singular.
+    pub fn new(chain: ChainModel, map: ModalMap) -> Result<Self, ReduceError> {
+        let (n, m) = (map.n_joints(), map.n_coords());
+        if n != chain.n_links() {
+            return Err(ReduceError::LinkCountMismatch {
+                joints: n,
+                links: chain.n_links(),
+            });
+        }
+        check_column_rank(&map)?;
+        let jacobian = Mat::from_fn(n, m, |i, j| map.entry(i, j));
+        // mu_l, the mass beyond link l (see the module `terms` for this and S_l, h_ll and K).
+        let chain_links = chain.links();
+        let mut beyond = vec![0.0; n];
+        for l in (0..n - 1).rev() {
+            beyond[l] = beyond[l + 1] + chain_links[l + 1].mass;
+        }
+        let mut angle_rows = vec![0.0; n * m];
+        let mut links = Vec::with_capacity(n);
+        let mut constant_mass = vec![0.0; m * m];
+        let mut running = vec![0.0; m];
+        let mut angle_offset = 0.0;
+        for (l, (link, phi)) in chain_links
+            .iter()
+            .zip(angle_rows.chunks_exact_mut(m))
+            .enumerate()
+        {
+            // Phi_l = Phi_{l-1} + J_l.
+            for (sum, &entry) in running.iter_mut().zip(map.row(l)) {
+                *sum += entry;
+            }
+            phi.copy_from_slice(&running);
+            angle_offset += map.offset()[l];
+            links.push(LinkConstants {
+                length: link.length,
+                first_moment: link.mass * link.com + link.length * beyond[l],
+                angle_offset,
+            });
+            let diagonal = link.inertia
+                + link.mass * link.com * link.com
+                + link.length * link.length * beyond[l];
+            for j in 0..m {
+                for k in 0..m {
+                    constant_mass[j * m + k] += diagonal * phi[j] * phi[k];
+                }
+            }
+        }
+        Ok(Self {
+            chain,
+            map,
+            jacobian,
+            angle_rows,
+            links,
+            constant_mass,
+        })
+    }
+
+    /// The full chain.
+    pub fn chain(&self) -> &ChainModel {
+        &self.chain
+    }
+
+    /// The modal map `theta = J a + theta_0`.
+    pub fn map(&self) -> &ModalMap {
+        &self.map
+    }
+
+    /// Number of links (and joints) `n`.
+    pub fn n_links(&self) -> usize {
+        self.links.len()
+    }
+
+    /// Number of modal coordinates `m`.
+    pub fn n_coords(&self) -> usize {
+        self.map.n_coords()
+    }
+
+    /// `J` as a faer matrix.
+    pub(crate) fn jacobian(&self) -> faer::MatRef<'_, f64> {
+        self.jacobian.as_ref()
+    }
+
+    /// Row-major `n x m` gradients of the absolute link angles, `Phi_i`.
+    pub(crate) fn angle_rows(&self) -> &[f64] {
+        &self.angle_rows
+    }
+
+    /// The constant part `K` of `M*`, row-major `m x m`.
+    pub(crate) fn constant_mass(&self) -> &[f64] {
+        &self.constant_mass
+    }
+
+    /// Per-link constants, base first.
+    pub(crate) fn link_constants(&self) -> &[LinkConstants] {
+        &self.links
+    }
+}
+
+/// Refuses a map whose `J` has (numerically) dependent columns.
+fn check_column_rank(map: &ModalMap) -> Result<(), ReduceError> {
+    let (n, m) = (map.n_joints(), map.n_coords());
+    let mut gram = vec![0.0; m * m];
+    for i in 0..n {
+        let row = map.row(i);
+        for j in 0..m {
+            for k in 0..m {
+                gram[j * m + k] += row[j] * row[k];
+            }
+        }
+    }
+    let scale: Vec<f64> = (0..m).map(|j| gram[j * m + j].sqrt()).collect();
+    let deficient = |min_eigenvalue| ReduceError::RankDeficient {
+        links: n,
+        coords: m,
+        min_eigenvalue,
+    };
+    if scale.contains(&0.0) {
+        return Err(deficient(0.0));
+    }
+    for j in 0..m {
+        for k in 0..m {
+            gram[j * m + k] /= scale[j] * scale[k];
+        }
+    }
+    let (min_eigenvalue, _) = symmetric_eigen_extremes(&mut gram, m);
+    if min_eigenvalue <= RANK_TOLERANCE {
+        return Err(deficient(min_eigenvalue));
+    }
+    Ok(())
+}

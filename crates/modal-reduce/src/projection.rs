@@ -1,0 +1,75 @@
+//! The projection path: form the full chain's `M`, `C` and `G` and project them onto the modal
+//! coordinates with faer (eq 14), `O(n^2 m)`. The reference against which the default
+//! [`reduced_terms`](crate::reduced_terms) is tested, and the method of the paper.
+
+use faer::linalg::matmul::matmul;
+use faer::{Accum, MatMut, Par};
+
+use crate::data::ReducedData;
+use crate::error::{ReduceError, check_input};
+use crate::model::ReducedModel;
+use crate::torques::project;
+
+/// Computes `M* = J^T M J`, `C* = J^T C(theta, J a_dot)` and `G* = J^T G(theta)` at
+/// `theta = J a + theta_0` (eq 14) into `data`, by forming the full `n x n` mass matrix with
+/// `manip_dyn::mass_matrix` and multiplying with faer (sequential, no allocation).
+///
+/// Gives the same terms as [`reduced_terms`](crate::reduced_terms) up to rounding, at
+/// `O(n^2 m)` instead of `O(n m^2)` cost.
+pub fn reduced_terms_faer(
+    model: &ReducedModel,
+    data: &mut ReducedData,
+    a: &[f64],
+    a_dot: &[f64],
+) -> Result<(), ReduceError> {
+    data.check_model(model)?;
+    let m = model.n_coords();
+    check_input("a", a, m)?;
+    check_input("a_dot", a_dot, m)?;
+    let (chain, map) = (model.chain(), model.map());
+    map.joint_angles(a, &mut data.theta)?;
+    map.joint_rates(a_dot, &mut data.theta_dot)?;
+
+    manip_dyn::mass_matrix(
+        chain,
+        &mut data.chain,
+        &data.theta,
+        data.joint_mass.as_mut(),
+    )?;
+    matmul(
+        data.mass_times_jacobian.as_mut(),
+        Accum::Replace,
+        data.joint_mass.as_ref(),
+        model.jacobian(),
+        1.0,
+        Par::Seq,
+    );
+    matmul(
+        MatMut::from_row_major_slice_mut(&mut data.mass, m, m),
+        Accum::Replace,
+        model.jacobian().transpose(),
+        data.mass_times_jacobian.as_ref(),
+        1.0,
+        Par::Seq,
+    );
+    // J^T (M J) is symmetric up to rounding: make it exactly so.
+    for j in 0..m {
+        for k in 0..j {
+            let mean = 0.5 * (data.mass[j * m + k] + data.mass[k * m + j]);
+            data.mass[j * m + k] = mean;
+            data.mass[k * m + j] = mean;
+        }
+    }
+
+    manip_dyn::coriolis(
+        chain,
+        &mut data.chain,
+        &data.theta,
+        &data.theta_dot,
+        &mut data.joint_torque,
+    )?;
+    project(map, &data.joint_torque, &mut data.coriolis);
+    manip_dyn::gravity(chain, &mut data.chain, &data.theta, &mut data.joint_torque)?;
+    project(map, &data.joint_torque, &mut data.gravity);
+    Ok(())
+}

@@ -1,0 +1,193 @@
+//! Dense linear algebra on the small `m x m` modal matrices (`m = 2K` or `2K + 1`, 2-3 for the
+//! paper), on plain row-major slices owned by a workspace: nothing allocates.
+//!
+//! At this size hand-written loops beat a general dense-matrix library several times over (the
+//! per-call overhead of faer's Cholesky exceeds the whole `3 x 3` solve), and they are short
+//! enough to check by eye.
+
+/// Factorises the symmetric positive-definite `m x m` matrix `a` (row-major) in place as
+/// `a = L D L^T`, `L` unit lower triangular and `D` diagonal: `L` below the diagonal, `1 / D` on
+/// it, scratch (`L^T D`) above it; only the lower triangle of the input is read.
+///
+/// Square-root free and with one division per column, which is most of the cost at this size;
+/// the solve then only multiplies.
+/// Returns `false` if a pivot `D_j` is not positive and finite (the matrix is not numerically
+/// positive definite); `a` then holds a partial factorisation.
+#[inline(always)]
+pub(crate) fn ldlt_in_place(a: &mut [f64], m: usize) -> bool {
+    let a = &mut a[..m * m];
+    for j in 0..m {
+        // a[k][j] (k < j) holds L_jk D_k.
+        let mut pivot = a[j * m + j];
+        for k in 0..j {
+            pivot -= a[j * m + k] * a[k * m + j];
+        }
+        if !(pivot > 0.0 && pivot.is_finite()) {
+            return false;
+        }
+        let inverse = 1.0 / pivot;
+        a[j * m + j] = inverse;
+        for i in j + 1..m {
+            let mut value = a[i * m + j];
+            for k in 0..j {
+                value -= a[i * m + k] * a[k * m + j];
+            }
+            // value = L_ij D_j.
+            a[j * m + i] = value;
+            a[i * m + j] = value * inverse;
+        }
+    }
+    true
+}
+
+/// Solves `L D L^T x = b` in place (`x` holds `b` on entry), with the factors left by
+/// [`ldlt_in_place`].
+#[inline(always)]
+pub(crate) fn ldlt_solve_in_place(factor: &[f64], m: usize, x: &mut [f64]) {
+    let (f, x) = (&factor[..m * m], &mut x[..m]);
+    for i in 0..m {
+        for k in 0..i {
+            x[i] -= f[i * m + k] * x[k];
+        }
+    }
+    for i in 0..m {
+        x[i] *= f[i * m + i];
+    }
+    for i in (0..m).rev() {
+        for k in i + 1..m {
+            x[i] -= f[k * m + i] * x[k];
+        }
+    }
+}
+
+/// The smallest and largest eigenvalues of the symmetric `m x m` matrix `a` (row-major), by
+/// cyclic Jacobi rotations; `a` is overwritten (its diagonal ends up holding the eigenvalues).
+///
+/// Each rotation zeroes one off-diagonal pair; sweeps repeat until the off-diagonal part is
+/// negligible against the diagonal (quadratic convergence: a handful of sweeps at this size).
+pub(crate) fn symmetric_eigen_extremes(a: &mut [f64], m: usize) -> (f64, f64) {
+    const MAX_SWEEPS: usize = 64;
+    let a = &mut a[..m * m];
+    for _ in 0..MAX_SWEEPS {
+        let mut off = 0.0;
+        let mut diag = 0.0;
+        for i in 0..m {
+            diag += a[i * m + i] * a[i * m + i];
+            for j in i + 1..m {
+                off += a[i * m + j] * a[i * m + j];
+            }
+        }
+        if off <= (f64::EPSILON * f64::EPSILON) * diag || off == 0.0 {
+            break;
+        }
+        for p in 0..m {
+            for q in p + 1..m {
+                rotate(a, m, p, q);
+            }
+        }
+    }
+    (0..m)
+        .map(|i| a[i * m + i])
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        })
+}
+
+/// Applies the Jacobi rotation in the `(p, q)` plane that zeroes `a[p][q]` (`a <- R^T a R`).
+fn rotate(a: &mut [f64], m: usize, p: usize, q: usize) {
+    let apq = a[p * m + q];
+    if apq == 0.0 {
+        return;
+    }
+    let theta = (a[q * m + q] - a[p * m + p]) / (2.0 * apq);
+    let t = theta.signum() / (theta.abs() + theta.hypot(1.0));
+    let c = 1.0 / t.hypot(1.0);
+    let s = t * c;
+    for k in 0..m {
+        let (akp, akq) = (a[k * m + p], a[k * m + q]);
+        a[k * m + p] = c * akp - s * akq;
+        a[k * m + q] = s * akp + c * akq;
+    }
+    for k in 0..m {
+        let (apk, aqk) = (a[p * m + k], a[q * m + k]);
+        a[p * m + k] = c * apk - s * aqk;
+        a[q * m + k] = s * apk + c * aqk;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A random symmetric positive-definite matrix `B B^T + m I` and the matrix `B`.
+    fn spd(entries: &[f64], m: usize) -> Vec<f64> {
+        let mut a = vec![0.0; m * m];
+        for i in 0..m {
+            for j in 0..m {
+                a[i * m + j] = (0..m)
+                    .map(|k| entries[i * m + k] * entries[j * m + k])
+                    .sum::<f64>();
+            }
+            a[i * m + i] += 0.1;
+        }
+        a
+    }
+
+    proptest! {
+        #[test]
+        fn ldlt_solves_spd_systems(
+            (m, entries, rhs) in (1usize..8).prop_flat_map(|m| (
+                Just(m),
+                prop::collection::vec(-2.0..2.0f64, m * m),
+                prop::collection::vec(-5.0..5.0f64, m),
+            ))
+        ) {
+            let a = spd(&entries, m);
+            let mut factor = a.clone();
+            prop_assert!(ldlt_in_place(&mut factor, m));
+            let mut x = rhs.clone();
+            ldlt_solve_in_place(&factor, m, &mut x);
+            for i in 0..m {
+                let ax: f64 = (0..m).map(|j| a[i * m + j] * x[j]).sum();
+                prop_assert!((ax - rhs[i]).abs() <= 1e-9 * (1.0 + rhs[i].abs()), "row {i}");
+            }
+        }
+
+        #[test]
+        fn eigen_extremes_match_nalgebra(
+            (m, entries) in (1usize..8).prop_flat_map(|m| (
+                Just(m),
+                prop::collection::vec(-3.0..3.0f64, m * m),
+            ))
+        ) {
+            // A symmetric, indefinite in general.
+            let mut a = vec![0.0; m * m];
+            for i in 0..m {
+                for j in 0..m {
+                    a[i * m + j] = entries[i * m + j] + entries[j * m + i];
+                }
+            }
+            let reference = nalgebra::DMatrix::from_row_slice(m, m, &a).symmetric_eigenvalues();
+            let (lo, hi) = symmetric_eigen_extremes(&mut a, m);
+            prop_assert!((lo - reference.min()).abs() <= 1e-12 * (1.0 + reference.amax()));
+            prop_assert!((hi - reference.max()).abs() <= 1e-12 * (1.0 + reference.amax()));
+        }
+    }
+
+    #[test]
+    fn ldlt_refuses_indefinite_and_nan() {
+        let mut indefinite = [1.0, 2.0, 2.0, 1.0];
+        assert!(!ldlt_in_place(&mut indefinite, 2));
+        let mut nan = [f64::NAN, 0.0, 0.0, 1.0];
+        assert!(!ldlt_in_place(&mut nan, 2));
+    }
+
+    #[test]
+    fn eigen_of_a_known_matrix() {
+        // [[2, 1], [1, 2]] has eigenvalues 1 and 3.
+        let mut a = [2.0, 1.0, 1.0, 2.0];
+        let (lo, hi) = symmetric_eigen_extremes(&mut a, 2);
+        assert!((lo - 1.0).abs() < 1e-15 && (hi - 3.0).abs() < 1e-15);
+    }
+}
