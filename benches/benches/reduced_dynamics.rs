@@ -1,0 +1,71 @@
+//! Reduced forward dynamics with the paper's three coordinates `(a1, a2, alpha0)`: `M*`, `C*`,
+//! `G*` and the Cholesky solve of eq 15, by the default `O(n m^2)` modal recursion
+//! (`reduced_fd/n`) and by projecting the full chain's `M`, `C`, `G` with faer
+//! (`reduced_fd_faer/n`, `O(n^2 m)`). Arms of `n` equal links with total length 1 m, mass 1 kg.
+
+use backbone_kin::ModalMap;
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use manip_dyn::ChainModel;
+use modal_reduce::{ReducedData, ReducedModel, forward_dynamics, forward_dynamics_faer};
+use std::hint::black_box;
+
+const SIZES: [usize; 3] = [10, 100, 1000];
+const A: [f64; 3] = [0.4, -0.3, 1.2];
+const A_DOT: [f64; 3] = [0.5, 0.2, -0.1];
+const TAU_STAR: [f64; 3] = [1.0, -0.5, 0.2];
+
+/// The paper's arm scaled to `n` links.
+fn model(n: usize) -> ReducedModel {
+    let link = 1.0 / n as f64;
+    ReducedModel::new(
+        ChainModel::uniform(n, link, link, 9.81).unwrap(),
+        ModalMap::paper(n).unwrap(),
+    )
+    .unwrap()
+}
+
+type ForwardDynamics = fn(
+    &ReducedModel,
+    &mut ReducedData,
+    &[f64],
+    &[f64],
+    &[f64],
+    &mut [f64],
+) -> Result<(), modal_reduce::ReduceError>;
+
+fn bench_group(c: &mut Criterion, name: &str, solve: ForwardDynamics, sample_size: usize) {
+    let mut group = c.benchmark_group(name);
+    group.sample_size(sample_size);
+    for n in SIZES {
+        let model = model(n);
+        let mut data = ReducedData::new(&model);
+        let mut a_ddot = [0.0; 3];
+        group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            b.iter(|| {
+                solve(
+                    &model,
+                    &mut data,
+                    black_box(&A),
+                    black_box(&A_DOT),
+                    black_box(&TAU_STAR),
+                    &mut a_ddot,
+                )
+                .unwrap();
+                black_box(a_ddot)
+            })
+        });
+    }
+    group.finish();
+}
+
+fn reduced_fd(c: &mut Criterion) {
+    bench_group(c, "reduced_fd", forward_dynamics, 100);
+}
+
+fn reduced_fd_faer(c: &mut Criterion) {
+    // Milliseconds per call at n = 1000: fewer samples keep the run short.
+    bench_group(c, "reduced_fd_faer", forward_dynamics_faer, 20);
+}
+
+criterion_group!(benches, reduced_fd, reduced_fd_faer);
+criterion_main!(benches);

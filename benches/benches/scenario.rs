@@ -1,0 +1,31 @@
+//! The whole `paper-tracking` closed loop (`sim-core`): the paper's 10-link arm tracking
+//! `y = 0.4 sin(5x) + 0.2` for 5.5 s with the fuzzy controller, RK4 at `dt = 1e-4` s and the
+//! controller sampled every step: 55,000 steps, 220,000 reduced forward-dynamics evaluations,
+//! 55,001 reference and controller samples, 5,501 recorded samples. No file is written.
+//!
+//! The simulation is built once (scenario parsing, path checks); each iteration is one
+//! complete run from the initial state, recording included. Target: at most 100 ms.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use sim_core::{ControllerKind, Scenario};
+use std::hint::black_box;
+use std::time::Duration;
+
+fn paper_tracking(c: &mut Criterion) {
+    let scenario = Scenario::builtin("paper-tracking").expect("the shipped scenario parses");
+    assert_eq!(scenario.controller.kind, ControllerKind::Fuzzy);
+    let mut simulation = scenario.build().expect("the shipped scenario builds");
+    let mut group = c.benchmark_group("scenario");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(10));
+    group.bench_function("paper_tracking", |b| {
+        b.iter(|| {
+            let run = simulation.run().expect("the paper's scenario runs");
+            black_box(run.summary.tip_error_rms_m)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, paper_tracking);
+criterion_main!(benches);

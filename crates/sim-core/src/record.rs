@@ -1,0 +1,250 @@
+//! What a closed-loop run records: time series at the recording rate, and summary metrics over
+//! every controller sample.
+
+use serde::Serialize;
+
+/// Time series of a run, one entry per recorded controller sample (the state at the sample
+/// time and the torques held from it).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Record {
+    /// Joints of the arm (the row length of [`joint_torques`](Self::joint_torques)).
+    pub n_joints: usize,
+    /// Sample times (s).
+    pub t: Vec<f64>,
+    /// Modal coordinates `(a1, a2)` (rad).
+    pub a: Vec<[f64; 2]>,
+    /// Modal rates (rad/s).
+    pub a_dot: Vec<[f64; 2]>,
+    /// The reference `(a1, a2)` without reference noise (rad).
+    pub a_ref: Vec<[f64; 2]>,
+    /// The reference rates (rad/s).
+    pub a_ref_dot: Vec<[f64; 2]>,
+    /// The reference as the controller received it, reference noise included (rad).
+    pub a_cmd: Vec<[f64; 2]>,
+    /// Modal torques `tau*` held from this sample to the next (N m).
+    pub tau_star: Vec<[f64; 2]>,
+    /// Tip of the discrete chain (m).
+    pub tip: Vec<[f64; 2]>,
+    /// The reference tip: the backbone curve's end point at `a_ref` (eqs 3-4), which for a
+    /// Cartesian path reference is the path point (m).
+    pub tip_ref: Vec<[f64; 2]>,
+    /// Joint torques `tau = M J a_dd + C + G` (eq 13) at the sample, `n_joints` per sample,
+    /// row-major (N m).
+    pub joint_torques: Vec<f64>,
+}
+
+impl Record {
+    /// Number of recorded samples.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    /// Whether nothing was recorded.
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+
+    /// The joint torques of sample `k` (N m).
+    pub fn joint_torques_at(&self, k: usize) -> &[f64] {
+        &self.joint_torques[k * self.n_joints..(k + 1) * self.n_joints]
+    }
+}
+
+/// One recorded sample, before it is pushed.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Sample {
+    pub t: f64,
+    pub a: [f64; 2],
+    pub a_dot: [f64; 2],
+    pub a_ref: [f64; 2],
+    pub a_ref_dot: [f64; 2],
+    pub a_cmd: [f64; 2],
+    pub tau_star: [f64; 2],
+    pub tip: [f64; 2],
+    pub tip_ref: [f64; 2],
+}
+
+impl Record {
+    pub(crate) fn with_capacity(n_joints: usize, samples: usize) -> Self {
+        Self {
+            n_joints,
+            t: Vec::with_capacity(samples),
+            a: Vec::with_capacity(samples),
+            a_dot: Vec::with_capacity(samples),
+            a_ref: Vec::with_capacity(samples),
+            a_ref_dot: Vec::with_capacity(samples),
+            a_cmd: Vec::with_capacity(samples),
+            tau_star: Vec::with_capacity(samples),
+            tip: Vec::with_capacity(samples),
+            tip_ref: Vec::with_capacity(samples),
+            joint_torques: Vec::with_capacity(samples * n_joints),
+        }
+    }
+
+    pub(crate) fn push(&mut self, s: &Sample, joint_torques: &[f64]) {
+        self.t.push(s.t);
+        self.a.push(s.a);
+        self.a_dot.push(s.a_dot);
+        self.a_ref.push(s.a_ref);
+        self.a_ref_dot.push(s.a_ref_dot);
+        self.a_cmd.push(s.a_cmd);
+        self.tau_star.push(s.tau_star);
+        self.tip.push(s.tip);
+        self.tip_ref.push(s.tip_ref);
+        self.joint_torques.extend_from_slice(joint_torques);
+    }
+}
+
+/// A joint whose torque exceeded its limit during a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TorqueLimitExceeded {
+    /// 0-based joint index.
+    pub joint: usize,
+    /// The limit (N m).
+    pub limit_nm: f64,
+    /// First recorded sample time at which `|tau| > limit` (s).
+    pub first_time_s: f64,
+    /// Largest `|tau|` over the run (N m).
+    pub peak_nm: f64,
+    /// Number of recorded samples over the limit.
+    pub samples_over: usize,
+}
+
+/// Summary metrics of a run.
+///
+/// Errors and peaks are taken over the recorded samples, so they agree with the time series of
+/// the [`Record`] (record every controller sample to take them over all); the control effort
+/// integrates the held torques over every controller period. Serialises to the fields of
+/// `summary.json` (units in the names where they are not radians).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// Controller samples taken (including the one at the final time).
+    pub controller_samples: usize,
+    /// Recorded samples (the ones the errors and peaks are taken over).
+    pub recorded_samples: usize,
+    /// Accepted integrator steps.
+    pub steps: usize,
+    /// Rejected integrator steps (adaptive integration only).
+    pub rejected_steps: usize,
+    /// Simulated time (s): the final sample time, or the last good one of a failed run.
+    pub simulated_s: f64,
+    /// Root mean square of the distance between the chain's tip and the reference tip (m).
+    pub tip_error_rms_m: f64,
+    /// Largest such distance (m).
+    pub tip_error_max_m: f64,
+    /// Root mean square of `a_i - a_i_ref` per coordinate (rad), against the noise-free reference.
+    pub modal_error_rms: [f64; 2],
+    /// Largest `|a_i - a_i_ref|` per coordinate (rad).
+    pub modal_error_max: [f64; 2],
+    /// Largest `|tau_i*|` per coordinate (N m).
+    pub peak_modal_torque: [f64; 2],
+    /// Largest `|tau_j|` over all joints (N m).
+    pub peak_joint_torque_nm: f64,
+    /// Largest `|tau_j|` of each joint (N m).
+    pub peak_joint_torques_nm: Vec<f64>,
+    /// Control effort `integral of |tau*|^2 dt` under the zero-order hold (N^2 m^2 s).
+    pub control_effort: f64,
+    /// Joints whose torque limit was exceeded (empty without limits or violations).
+    pub torque_limit_exceeded: Vec<TorqueLimitExceeded>,
+}
+
+/// Running sums behind a [`Summary`].
+#[derive(Debug, Clone)]
+pub(crate) struct Metrics {
+    controller_samples: usize,
+    samples: usize,
+    last_t: f64,
+    tip_sq: f64,
+    tip_max: f64,
+    modal_sq: [f64; 2],
+    modal_max: [f64; 2],
+    peak_tau_star: [f64; 2],
+    peak_joint: Vec<f64>,
+    effort: f64,
+    limits: Option<Vec<f64>>,
+    exceeded: Vec<Option<TorqueLimitExceeded>>,
+}
+
+impl Metrics {
+    pub(crate) fn new(n_joints: usize, limits: Option<Vec<f64>>) -> Self {
+        Self {
+            controller_samples: 0,
+            samples: 0,
+            last_t: 0.0,
+            tip_sq: 0.0,
+            tip_max: 0.0,
+            modal_sq: [0.0; 2],
+            modal_max: [0.0; 2],
+            peak_tau_star: [0.0; 2],
+            peak_joint: vec![0.0; n_joints],
+            effort: 0.0,
+            limits,
+            exceeded: vec![None; n_joints],
+        }
+    }
+
+    /// Counts a controller sample at `t` whose torque `tau_star` is held for `hold` seconds.
+    pub(crate) fn add_control(&mut self, t: f64, tau_star: [f64; 2], hold: f64) {
+        self.controller_samples += 1;
+        self.last_t = t;
+        self.effort += (tau_star[0] * tau_star[0] + tau_star[1] * tau_star[1]) * hold;
+    }
+
+    /// Adds recorded sample `s` with its joint torques.
+    pub(crate) fn add(&mut self, s: &Sample, joint_torques: &[f64]) {
+        self.samples += 1;
+        let tip_error = (s.tip[0] - s.tip_ref[0]).hypot(s.tip[1] - s.tip_ref[1]);
+        self.tip_sq += tip_error * tip_error;
+        self.tip_max = self.tip_max.max(tip_error);
+        for i in 0..2 {
+            let e = s.a[i] - s.a_ref[i];
+            self.modal_sq[i] += e * e;
+            self.modal_max[i] = self.modal_max[i].max(e.abs());
+            self.peak_tau_star[i] = self.peak_tau_star[i].max(s.tau_star[i].abs());
+        }
+        for (j, &tau) in joint_torques.iter().enumerate() {
+            self.peak_joint[j] = self.peak_joint[j].max(tau.abs());
+            if let Some(limits) = &self.limits
+                && tau.abs() > limits[j]
+            {
+                let entry = self.exceeded[j].get_or_insert(TorqueLimitExceeded {
+                    joint: j,
+                    limit_nm: limits[j],
+                    first_time_s: s.t,
+                    peak_nm: 0.0,
+                    samples_over: 0,
+                });
+                entry.samples_over += 1;
+            }
+        }
+    }
+
+    pub(crate) fn summary(&self, steps: usize, rejected_steps: usize) -> Summary {
+        let n = self.samples.max(1) as f64;
+        let torque_limit_exceeded = self
+            .exceeded
+            .iter()
+            .flatten()
+            .map(|e| TorqueLimitExceeded {
+                peak_nm: self.peak_joint[e.joint],
+                ..e.clone()
+            })
+            .collect();
+        Summary {
+            controller_samples: self.controller_samples,
+            recorded_samples: self.samples,
+            steps,
+            rejected_steps,
+            simulated_s: self.last_t,
+            tip_error_rms_m: (self.tip_sq / n).sqrt(),
+            tip_error_max_m: self.tip_max,
+            modal_error_rms: self.modal_sq.map(|s| (s / n).sqrt()),
+            modal_error_max: self.modal_max,
+            peak_modal_torque: self.peak_tau_star,
+            peak_joint_torque_nm: self.peak_joint.iter().copied().fold(0.0, f64::max),
+            peak_joint_torques_nm: self.peak_joint.clone(),
+            control_effort: self.effort,
+            torque_limit_exceeded,
+        }
+    }
+}

@@ -1,0 +1,258 @@
+//! A Cartesian path for the tip, followed through the closed-form inverse kinematics with
+//! `alpha0` fixed (eqs 5-6), with exact modal rates and accelerations.
+
+use super::{Reference, ReferenceSample};
+use crate::error::{SimError, check_finite, check_positive};
+use backbone_kin::{Branch, inverse_kinematics};
+
+/// How finely [`CartesianPath::new`] checks the path for reachability and singular points.
+const CHECK_SAMPLES: usize = 2000;
+/// Below this `|a1|` (rad) or `J1(A)` the inverse kinematics is treated as singular.
+const SINGULAR_TOLERANCE: f64 = 1e-8;
+
+/// The geometric shape of a tip path.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PathShape {
+    /// `y = amplitude sin(wavenumber x + phase) + offset` from `x = x_start` to `x = x_end`,
+    /// traversed at constant speed in `x` (the paper's eq 25 is amplitude 0.4, wavenumber 5,
+    /// phase 0, offset 0.2, x from 0.08 to 0.4).
+    Sine {
+        /// Amplitude (m).
+        amplitude: f64,
+        /// Wavenumber (rad/m).
+        wavenumber: f64,
+        /// Phase (rad).
+        phase: f64,
+        /// Offset (m).
+        offset: f64,
+        /// First `x` (m).
+        x_start: f64,
+        /// Last `x` (m), different from `x_start`.
+        x_end: f64,
+    },
+    /// The polyline through these points (m), linearly interpolated and traversed at constant
+    /// speed along its length.
+    Polyline(Vec<[f64; 2]>),
+}
+
+/// The tip position and its first two time derivatives.
+#[derive(Debug, Clone, Copy)]
+struct TipMotion {
+    p: [f64; 2],
+    v: [f64; 2],
+    acc: [f64; 2],
+}
+
+/// A tip path traversed in `travel_time` seconds, then held at its end point; before `t = 0` it
+/// holds its first point. The modal reference is its inverse kinematics for a curve of length
+/// `l` leaving the base at the fixed angle `alpha0`, on the chosen sign branch of `a1`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CartesianPath {
+    shape: PathShape,
+    /// Arc length at each vertex of a polyline (empty for a sine).
+    arc: Vec<f64>,
+    travel_time: f64,
+    length: f64,
+    alpha0: f64,
+    branch: Branch,
+}
+
+impl CartesianPath {
+    /// The path `shape` traversed in `travel_time` s by the tip of a backbone curve of length
+    /// `length` (m) with base angle `alpha0` (rad).
+    ///
+    /// Checks the shape's parameters, then samples the whole path densely: every point must be
+    /// reachable ([`SimError::Unreachable`] names the first that is not) and away from the
+    /// singular points of the inverse kinematics ([`SimError::SingularPoint`]).
+    ///
+    /// ```
+    /// use backbone_kin::Branch;
+    /// use sim_core::reference::{CartesianPath, PathShape, Reference};
+    /// // The paper's eq 25 over 5 s, alpha0 = pi/2, on the 1 m arm.
+    /// let shape = PathShape::Sine {
+    ///     amplitude: 0.4, wavenumber: 5.0, phase: 0.0, offset: 0.2, x_start: 0.08, x_end: 0.4,
+    /// };
+    /// let path = CartesianPath::new(shape, 5.0, 1.0, std::f64::consts::FRAC_PI_2, Branch::Positive)?;
+    /// let start = path.sample(0.0)?;
+    /// let tip = backbone_kin::end_point(1.0, start.a, std::f64::consts::FRAC_PI_2)?;
+    /// assert!((tip[0] - 0.08).abs() < 1e-12);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn new(
+        shape: PathShape,
+        travel_time: f64,
+        length: f64,
+        alpha0: f64,
+        branch: Branch,
+    ) -> Result<Self, SimError> {
+        check_positive("reference.travel_time", travel_time)?;
+        check_positive("arm length", length)?;
+        check_finite("alpha0", &[alpha0])?;
+        let arc = validate_shape(&shape)?;
+        let path = Self {
+            shape,
+            arc,
+            travel_time,
+            length,
+            alpha0,
+            branch,
+        };
+        for k in 0..=CHECK_SAMPLES {
+            path.sample(travel_time * k as f64 / CHECK_SAMPLES as f64)?;
+        }
+        if let PathShape::Polyline(_) = &path.shape {
+            let speed = path.arc[path.arc.len() - 1] / travel_time;
+            for &s in &path.arc {
+                path.sample(s / speed)?;
+            }
+        }
+        Ok(path)
+    }
+
+    /// The time the tip takes along the path (s); after it, the reference holds the end point.
+    pub fn travel_time(&self) -> f64 {
+        self.travel_time
+    }
+
+    /// The desired tip position at time `t` (m).
+    pub fn point(&self, t: f64) -> [f64; 2] {
+        self.tip_motion(t).p
+    }
+
+    /// The tip's position, velocity and acceleration at `t`.
+    fn tip_motion(&self, t: f64) -> TipMotion {
+        let moving = (0.0..self.travel_time).contains(&t);
+        let progress = (t / self.travel_time).clamp(0.0, 1.0);
+        let rate = if moving { 1.0 / self.travel_time } else { 0.0 };
+        match &self.shape {
+            PathShape::Sine {
+                amplitude,
+                wavenumber,
+                phase,
+                offset,
+                x_start,
+                x_end,
+            } => {
+                let x = x_start + (x_end - x_start) * progress;
+                let vx = (x_end - x_start) * rate;
+                let (sin, cos) = (wavenumber * x + phase).sin_cos();
+                TipMotion {
+                    p: [x, amplitude * sin + offset],
+                    v: [vx, amplitude * wavenumber * cos * vx],
+                    acc: [0.0, -amplitude * wavenumber * wavenumber * sin * vx * vx],
+                }
+            }
+            PathShape::Polyline(points) => {
+                let total = self.arc[self.arc.len() - 1];
+                let s = total * progress;
+                let segment = self
+                    .arc
+                    .partition_point(|&a| a <= s)
+                    .clamp(1, points.len() - 1)
+                    - 1;
+                let (p0, p1) = (points[segment], points[segment + 1]);
+                let seg_len = self.arc[segment + 1] - self.arc[segment];
+                let dir = [(p1[0] - p0[0]) / seg_len, (p1[1] - p0[1]) / seg_len];
+                let along = s - self.arc[segment];
+                let speed = total * rate;
+                TipMotion {
+                    p: [p0[0] + along * dir[0], p0[1] + along * dir[1]],
+                    v: [dir[0] * speed, dir[1] * speed],
+                    acc: [0.0, 0.0],
+                }
+            }
+        }
+    }
+}
+
+impl Reference for CartesianPath {
+    /// The inverse kinematics of the tip motion, differentiated exactly through the polar form of
+    /// eqs 5-6: `a2 = atan2(y, x) - alpha0`, `J0(A) = r / l`, `a1^2 = A^2 - a2^2`.
+    fn sample(&self, t: f64) -> Result<ReferenceSample, SimError> {
+        let TipMotion { p, v, acc } = self.tip_motion(t);
+        let [x, y] = p;
+        let [a1, a2] = inverse_kinematics(self.length, p, self.alpha0, self.branch)
+            .map_err(|source| SimError::Unreachable { t, x, y, source })?;
+        let amplitude = a1.hypot(a2);
+        let j1 = libm::j1(amplitude);
+        let singular = |what| SimError::SingularPoint { what, t, x, y };
+        if j1 <= SINGULAR_TOLERANCE {
+            return Err(singular("the curve is straight (A = 0, r = l)"));
+        }
+        if a1.abs() <= SINGULAR_TOLERANCE {
+            return Err(singular("a1 = 0, the branch point of eq 6"));
+        }
+        // Polar coordinates of the tip and their rates.
+        let r = x.hypot(y);
+        let r_dot = (x * v[0] + y * v[1]) / r;
+        let psi_dot = (x * v[1] - y * v[0]) / (r * r);
+        let r_ddot = (v[0] * v[0] + v[1] * v[1] + x * acc[0] + y * acc[1] - r_dot * r_dot) / r;
+        let psi_ddot = (x * acc[1] - y * acc[0]) / (r * r) - 2.0 * r_dot * psi_dot / r;
+        // J0(A) = r / l, with J0' = -J1 and J1' = J0 - J1 / A.
+        let amp_dot = -r_dot / (self.length * j1);
+        let j1_prime = libm::j0(amplitude) - j1 / amplitude;
+        let amp_ddot = -(r_ddot / self.length + j1_prime * amp_dot * amp_dot) / j1;
+        // a1 a1' = A A' - a2 a2', differentiated once more.
+        let (a2_dot, a2_ddot) = (psi_dot, psi_ddot);
+        let a1_dot = (amplitude * amp_dot - a2 * a2_dot) / a1;
+        let a1_ddot = (amp_dot * amp_dot + amplitude * amp_ddot
+            - a2_dot * a2_dot
+            - a2 * a2_ddot
+            - a1_dot * a1_dot)
+            / a1;
+        Ok(ReferenceSample {
+            a: [a1, a2],
+            a_dot: [a1_dot, a2_dot],
+            a_ddot: [a1_ddot, a2_ddot],
+        })
+    }
+}
+
+/// Checks a shape's numbers; returns the cumulative arc lengths of a polyline.
+fn validate_shape(shape: &PathShape) -> Result<Vec<f64>, SimError> {
+    match shape {
+        PathShape::Sine {
+            amplitude,
+            wavenumber,
+            phase,
+            offset,
+            x_start,
+            x_end,
+        } => {
+            check_finite(
+                "reference path",
+                &[*amplitude, *wavenumber, *phase, *offset, *x_start, *x_end],
+            )?;
+            if x_start == x_end {
+                return Err(SimError::setting(
+                    "reference.x_end",
+                    format!("must differ from x_start, both are {x_start}"),
+                ));
+            }
+            Ok(Vec::new())
+        }
+        PathShape::Polyline(points) => {
+            if points.len() < 2 {
+                return Err(SimError::setting(
+                    "reference.points",
+                    format!("needs at least 2 points, got {}", points.len()),
+                ));
+            }
+            let mut arc = Vec::with_capacity(points.len());
+            arc.push(0.0);
+            for (k, pair) in points.windows(2).enumerate() {
+                check_finite("reference.points", &pair[1])?;
+                check_finite("reference.points", &pair[0])?;
+                let seg = (pair[1][0] - pair[0][0]).hypot(pair[1][1] - pair[0][1]);
+                if seg == 0.0 {
+                    return Err(SimError::setting(
+                        "reference.points",
+                        format!("must not repeat a point, points {k} and {} coincide", k + 1),
+                    ));
+                }
+                arc.push(arc[k] + seg);
+            }
+            Ok(arc)
+        }
+    }
+}
