@@ -2,10 +2,12 @@
 
 mod arm;
 mod eval;
+mod experiment;
 mod fis_cmd;
 mod plot;
 
 use clap::{Parser, Subcommand};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Models, controls and simulates hyper-redundant planar manipulators.
@@ -18,6 +20,24 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The main job (also what `hrm` alone runs): every shipped scenario with every controller.
+    Run {
+        /// Output folder.
+        #[arg(long, default_value = "hrm-output")]
+        out: PathBuf,
+    },
+    /// Run one scenario (a shipped name such as `paper-tracking`, or a TOML file).
+    Simulate {
+        /// Scenario name or path.
+        #[arg(long)]
+        scenario: String,
+        /// Override the scenario's controller: fuzzy, pd, computed-torque or fuzzy-gc.
+        #[arg(long)]
+        controller: Option<String>,
+        /// Output folder.
+        #[arg(long, default_value = "hrm-output/simulate")]
+        out: PathBuf,
+    },
     /// Answer JSON-lines requests on stdin, one JSON answer per line on stdout (docs/eval-protocol.md).
     Eval,
     /// Check, evaluate and plot Takagi-Sugeno systems stored as MATLAB .fis files.
@@ -27,12 +47,15 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Some(Command::Run { out }) => experiment::main_job(&out),
+        Some(Command::Simulate {
+            scenario,
+            controller,
+            out,
+        }) => experiment::simulate(&scenario, controller.as_deref(), &out),
         Some(Command::Eval) => eval::run_stdio(),
         Some(Command::Fis(args)) => fis_cmd::run(args),
-        None => {
-            use clap::CommandFactory;
-            Cli::command().print_help().map_err(|e| e.to_string())
-        }
+        None => experiment::main_job(std::path::Path::new("hrm-output")),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
