@@ -5,7 +5,6 @@
 //! `{"id": ..., "error": {"kind": "...", "message": "..."}}` and the stream goes on. The protocol
 //! is documented in `docs/eval-protocol.md`.
 
-use crate::arm::ArmSpec;
 use backbone_kin::{
     BaseAngle, Branch, KinError, ModalMap, end_point, inverse_kinematics, tip_position,
 };
@@ -15,6 +14,7 @@ use modal_reduce::{ReduceError, ReducedData, ReducedModel};
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
 use serde_json::{Map, Value, json};
+use sim_core::ArmSpec;
 use std::io::{BufRead, Write};
 
 /// Longest request line accepted (bytes); longer lines are skipped with a `line_too_long` error.
@@ -662,7 +662,7 @@ mod tests {
         assert_eq!(answers[0]["error"]["kind"], "invalid_input");
         assert_eq!(
             answers[0]["error"]["message"],
-            "link 1: mass must be positive and finite, got -1"
+            "arm is invalid: link 1: mass must be positive and finite, got -1"
         );
         assert_eq!(answers[0]["id"], "x");
     }

@@ -1,6 +1,5 @@
 //! `hrm`: the command line of the hyper-redundant manipulator toolkit.
 
-mod arm;
 mod eval;
 mod experiment;
 mod fis_cmd;
