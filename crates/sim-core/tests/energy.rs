@@ -157,7 +157,9 @@ proptest! {
         let (q, v) = y.split_at(n);
         let kinetic = manip_dyn::kinetic_energy(&chain, &mut system.data, q, v).unwrap();
         let scale = energy_scale(&chain, kinetic);
+        let start = std::time::Instant::now();
         let drift = dp5_energy_drift(&mut system, FullChain::energy, &mut y, 10.0, scale);
+        eprintln!("TIMING n {n} {:?} drift {drift:e} v {:?}", start.elapsed(), &state[..n]);
         prop_assert!(drift < 1e-8, "relative energy drift {drift:e} over 10 s, {n} links");
     }
 
