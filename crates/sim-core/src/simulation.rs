@@ -25,7 +25,8 @@ pub enum Integrator {
         /// The step (s).
         dt: f64,
     },
-    /// Adaptive Dormand-Prince 5(4) with error control, restarted at every sample.
+    /// Adaptive Dormand-Prince 5(4) with error control, restarted at every sample (its step size
+    /// carries over).
     DormandPrince(Tolerances),
 }
 
@@ -38,7 +39,8 @@ pub struct LoopSettings {
     pub controller_period: f64,
     /// Simulated time (s): a whole number of controller periods.
     pub duration: f64,
-    /// Recording period (s): a whole number of controller periods. Metrics use every sample.
+    /// Recording period (s): a whole number of controller periods. The summary's errors and
+    /// peaks are taken over the recorded samples, the runaway check over every sample.
     pub record_period: f64,
     /// Seed of the noise sources.
     pub seed: u64,

@@ -466,3 +466,19 @@ fn a_fis_file_replaces_the_paper_system() {
     assert_ne!(with_file.record.tau_star, with_paper.record.tau_star);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn simulations_can_run_on_worker_threads() {
+    fn assert_send<T: Send>() {}
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send::<Simulation>();
+    assert_send_sync::<Scenario>();
+    let scenario = scenario("paper-responses-noise", ControllerKind::Pd, 0.1);
+    let on_thread = std::thread::spawn({
+        let scenario = scenario.clone();
+        move || scenario.build().unwrap().run().unwrap()
+    })
+    .join()
+    .unwrap();
+    assert_eq!(on_thread, scenario.build().unwrap().run().unwrap());
+}

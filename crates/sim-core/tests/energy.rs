@@ -7,6 +7,7 @@ use backbone_kin::ModalMap;
 use manip_dyn::{ChainData, ChainModel, Link};
 use modal_reduce::{ReducedData, ReducedModel};
 use proptest::prelude::*;
+use proptest::test_runner::{TestCaseError, TestRunner};
 use sim_core::ode::{DormandPrince, OdeSystem, Rk4, Tolerances};
 
 /// The full chain, `y = [theta; theta_dot]`, forward dynamics by the articulated-body algorithm.
@@ -136,53 +137,76 @@ fn arm(min_links: usize) -> impl Strategy<Value = ChainModel> {
     })
 }
 
-fn expensive() -> ProptestConfig {
-    ProptestConfig {
+/// Checks an expensive property (seconds of simulated motion per case) on
+/// `PROPTEST_CASES / 64` random cases, at least 4.
+///
+/// The `proptest!` macro lets the `PROPTEST_CASES` variable override an explicit `cases`
+/// setting, which would run these integrations thousands of times under `cargo xtask props`; an
+/// explicit runner keeps the division.
+fn check_expensive<S: Strategy>(strategy: S, test: impl Fn(S::Value) -> Result<(), TestCaseError>)
+where
+    S::Value: std::fmt::Debug,
+{
+    let config = ProptestConfig {
         cases: (ProptestConfig::default().cases / 64).max(4),
         ..ProptestConfig::default()
+    };
+    if let Err(failure) = TestRunner::new(config).run(&strategy, test) {
+        panic!("{failure}");
     }
 }
 
-proptest! {
-    #![proptest_config(expensive())]
-
-    #[test]
-    fn full_chain_conserves_energy(
-        chain in arm(1),
-        state in prop::collection::vec((-1.5f64..1.5, -2.0f64..2.0), 12),
-    ) {
+#[test]
+fn full_chain_conserves_energy() {
+    let states = prop::collection::vec((-1.5f64..1.5, -2.0f64..2.0), 12);
+    check_expensive((arm(1), states), |(chain, state)| {
         let n = chain.n_links();
-        let mut y: Vec<f64> = state[..n].iter().map(|s| s.0).chain(state[..n].iter().map(|s| s.1)).collect();
+        let mut y: Vec<f64> = state[..n]
+            .iter()
+            .map(|s| s.0)
+            .chain(state[..n].iter().map(|s| s.1))
+            .collect();
         let mut system = FullChain::new(chain.clone());
         let (q, v) = y.split_at(n);
         let kinetic = manip_dyn::kinetic_energy(&chain, &mut system.data, q, v).unwrap();
         let scale = energy_scale(&chain, kinetic);
-        let start = std::time::Instant::now();
         let drift = dp5_energy_drift(&mut system, FullChain::energy, &mut y, 10.0, scale);
-        eprintln!("TIMING n {n} {:?} drift {drift:e} v {:?}", start.elapsed(), &state[..n]);
-        prop_assert!(drift < 1e-8, "relative energy drift {drift:e} over 10 s, {n} links");
-    }
+        prop_assert!(
+            drift < 1e-8,
+            "relative energy drift {drift:e} over 10 s, {n} links"
+        );
+        Ok(())
+    });
+}
 
-    #[test]
-    fn reduced_model_conserves_energy(
-        chain in arm(3),
-        a in prop::collection::vec(-1.0f64..1.0, 3),
-        a_dot in prop::collection::vec(-2.0f64..2.0, 3),
-        alpha0_fixed in prop::option::of(-3.0f64..3.0),
-    ) {
+#[test]
+fn reduced_model_conserves_energy() {
+    let modal = (
+        prop::collection::vec(-1.0f64..1.0, 3),
+        prop::collection::vec(-2.0f64..2.0, 3),
+        prop::option::of(-3.0f64..3.0),
+    );
+    check_expensive((arm(3), modal), |(chain, (a, a_dot, alpha0_fixed))| {
         let lengths: Vec<f64> = chain.link_lengths().collect();
-        let map = match alpha0_fixed {
-            Some(alpha0) => ModalMap::new(&lengths, 1, backbone_kin::BaseAngle::Fixed(alpha0)).unwrap(),
-            None => ModalMap::new(&lengths, 1, backbone_kin::BaseAngle::Free).unwrap(),
+        let base = match alpha0_fixed {
+            Some(alpha0) => backbone_kin::BaseAngle::Fixed(alpha0),
+            None => backbone_kin::BaseAngle::Free,
         };
+        let map = ModalMap::new(&lengths, 1, base).unwrap();
         let m = map.n_coords();
         let mut y: Vec<f64> = a[..m].iter().chain(&a_dot[..m]).copied().collect();
         let mut system = Reduced::new(ReducedModel::new(chain.clone(), map).unwrap());
-        let kinetic = modal_reduce::kinetic_energy(&system.model, &mut system.data, &y[..m], &y[m..]).unwrap();
+        let (a, a_dot) = y.split_at(m);
+        let kinetic =
+            modal_reduce::kinetic_energy(&system.model, &mut system.data, a, a_dot).unwrap();
         let scale = energy_scale(&chain, kinetic);
         let drift = dp5_energy_drift(&mut system, Reduced::energy, &mut y, 10.0, scale);
-        prop_assert!(drift < 1e-8, "relative energy drift {drift:e} over 10 s, {m} coordinates");
-    }
+        prop_assert!(
+            drift < 1e-8,
+            "relative energy drift {drift:e} over 10 s, {m} coordinates"
+        );
+        Ok(())
+    });
 }
 
 /// Largest energy deviation of fixed-step RK4 at step `dt` over `duration`.
@@ -373,28 +397,33 @@ fn distance_from_backbone(model: ReducedModel, a: &[f64], a_dot: &[f64], duratio
     worst
 }
 
-proptest! {
-    #![proptest_config(expensive())]
-
-    #[test]
-    fn full_chain_driven_by_modal_joint_torques_stays_on_the_backbone(
-        chain in arm(3),
-        a in prop::collection::vec(-0.4f64..0.4, 3),
-        a_dot in prop::collection::vec(-1.0f64..1.0, 3),
-        alpha0_offset in -0.3f64..0.3,
-        alpha0_is_coordinate in any::<bool>(),
-    ) {
-        let lengths: Vec<f64> = chain.link_lengths().collect();
-        let hanging = -std::f64::consts::FRAC_PI_2 + alpha0_offset;
-        let (base, a) = if alpha0_is_coordinate {
-            (backbone_kin::BaseAngle::Free, vec![a[0], a[1], hanging])
-        } else {
-            (backbone_kin::BaseAngle::Fixed(hanging), a[..2].to_vec())
-        };
-        let map = ModalMap::new(&lengths, 1, base).unwrap();
-        let m = map.n_coords();
-        let model = ReducedModel::new(chain, map).unwrap();
-        let distance = distance_from_backbone(model, &a, &a_dot[..m], 2.0);
-        prop_assert!(distance < 1e-9, "the full chain left the backbone curve by {distance:e}");
-    }
+#[test]
+fn full_chain_driven_by_modal_joint_torques_stays_on_the_backbone() {
+    let modal = (
+        prop::collection::vec(-0.4f64..0.4, 3),
+        prop::collection::vec(-1.0f64..1.0, 3),
+        -0.3f64..0.3,
+        any::<bool>(),
+    );
+    check_expensive(
+        (arm(3), modal),
+        |(chain, (a, a_dot, alpha0_offset, alpha0_is_coordinate))| {
+            let lengths: Vec<f64> = chain.link_lengths().collect();
+            let hanging = -std::f64::consts::FRAC_PI_2 + alpha0_offset;
+            let (base, a) = if alpha0_is_coordinate {
+                (backbone_kin::BaseAngle::Free, vec![a[0], a[1], hanging])
+            } else {
+                (backbone_kin::BaseAngle::Fixed(hanging), a[..2].to_vec())
+            };
+            let map = ModalMap::new(&lengths, 1, base).unwrap();
+            let m = map.n_coords();
+            let model = ReducedModel::new(chain, map).unwrap();
+            let distance = distance_from_backbone(model, &a, &a_dot[..m], 2.0);
+            prop_assert!(
+                distance < 1e-9,
+                "the full chain left the backbone curve by {distance:e}"
+            );
+            Ok(())
+        },
+    );
 }
