@@ -1,5 +1,5 @@
 //! Closed-loop simulation of modal-coordinate controllers on hyper-redundant manipulators:
-//! section 5 of Ahmadzadeh et al., *Modeling of Hyper-Redundant Manipulators Dynamics and Design
+//! section 5 of the paper *Modeling of Hyper-Redundant Manipulators Dynamics and Design
 //! of Fuzzy Controller for the System*, made reproducible.
 //!
 //! The loop of the paper's Figures 6 and 8: a [`reference`](mod@reference) for the modal

@@ -27,12 +27,10 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-/// Allocations made by one run of `scenario` lasting `duration` seconds.
-fn allocations_of_run(name: &str, kind: ControllerKind, duration: f64) -> usize {
-    let mut scenario = Scenario::builtin(name).unwrap();
-    scenario.controller.kind = kind;
+/// Allocations made by one run of `scenario` cut to `duration` seconds (building excluded).
+fn allocations(scenario: &Scenario, duration: f64) -> usize {
+    let mut scenario = scenario.clone();
     scenario.duration = duration;
-    scenario.noise.sensor_a_std = [1e-3, 1e-3];
     let mut simulation = scenario.build().unwrap();
     let before = ALLOCATIONS.load(Ordering::Relaxed);
     let run = simulation.run().unwrap();
@@ -46,8 +44,10 @@ fn allocations_do_not_grow_with_the_number_of_steps() {
     // One test function only: the counter is global to the binary.
     for kind in ControllerKind::ALL {
         for name in ["paper-tracking", "paper-responses-noise"] {
-            let short = allocations_of_run(name, kind, 0.05);
-            let long = allocations_of_run(name, kind, 0.5);
+            let mut scenario = Scenario::builtin(name).unwrap();
+            scenario.controller.kind = kind;
+            scenario.noise.sensor_a_std = [1e-3, 1e-3];
+            let (short, long) = (allocations(&scenario, 0.05), allocations(&scenario, 0.5));
             assert_eq!(
                 short, long,
                 "{name} with {kind}: {short} vs {long} allocations"
@@ -61,13 +61,11 @@ fn allocations_do_not_grow_with_the_number_of_steps() {
         h_max: None,
         max_steps: None,
     };
-    let count = |duration: f64| {
-        let mut s = adaptive.clone();
-        s.duration = duration;
-        let mut simulation = s.build().unwrap();
-        let before = ALLOCATIONS.load(Ordering::Relaxed);
-        simulation.run().unwrap();
-        ALLOCATIONS.load(Ordering::Relaxed) - before
-    };
-    assert_eq!(count(0.05), count(0.5));
+    assert_eq!(allocations(&adaptive, 0.05), allocations(&adaptive, 0.5));
+    // A 100-link arm: the per-step work is O(n) and still allocation-free.
+    let mut large = Scenario::builtin("paper-responses-sine").unwrap();
+    large.arm.links = Some(100);
+    large.arm.link_length = Some(0.01);
+    large.arm.link_mass = Some(0.01);
+    assert_eq!(allocations(&large, 0.05), allocations(&large, 0.5));
 }
