@@ -1,8 +1,10 @@
 //! The main job (`hrm` with no arguments) and `hrm simulate`: closed-loop runs of the shipped
 //! scenarios (section 5 of the paper), a comparison table, and per-run output files.
 
+use crate::{figures, progress, report};
+use rayon::prelude::*;
 use serde_json::json;
-use sim_core::{ControllerKind, Run, Scenario};
+use sim_core::{ControllerKind, ReferenceSpec, Run, Scenario};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -23,7 +25,7 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
     }
     let outcome = run_one(&scenario, scenario.controller.kind);
     write_outcome(&outcome, out)?;
-    print!("{}", table(std::slice::from_ref(&outcome)));
+    print!("{}", table(&table_rows(std::slice::from_ref(&outcome))));
     println!("wrote {}", out.display());
     match outcome.result {
         Ok(_) => Ok(()),
@@ -31,28 +33,181 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
     }
 }
 
-/// The main job: every shipped scenario with every controller.
+/// The main job: every shipped scenario with every controller (see [`experiments`]).
 pub fn main_job(out: &Path) -> Result<(), String> {
-    let mut outcomes = Vec::new();
-    for name in Scenario::builtin_names() {
-        let scenario = Scenario::builtin(name).map_err(|e| e.to_string())?;
-        for kind in ControllerKind::ALL {
-            eprintln!("hrm: running {name} with {kind}");
-            let outcome = run_one(&scenario, kind);
-            write_outcome(&outcome, &out.join(name).join(kind.name()))?;
-            outcomes.push(outcome);
-        }
-    }
+    let scenarios = Scenario::builtin_names()
+        .map(|name| Scenario::builtin(name).map_err(|e| e.to_string()))
+        .collect::<Result<Vec<_>, _>>()?;
+    experiments(out, &scenarios)
+}
+
+/// Runs `scenarios` with every controller, in parallel (results in a fixed order), then writes
+/// the per-run files, the comparison table, the figures and `report.html` into `out`.
+fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
+    let jobs: Vec<(&Scenario, ControllerKind)> = scenarios
+        .iter()
+        .flat_map(|scenario| ControllerKind::ALL.map(|kind| (scenario, kind)))
+        .collect();
+    let bar = progress::bar(jobs.len() as u64, "runs");
+    let outcomes = jobs
+        .par_iter()
+        .map(|&(scenario, kind)| {
+            let outcome = run_one(scenario, kind);
+            write_outcome(&outcome, &out.join(&scenario.name).join(kind.name()))?;
+            bar.set_message(format!("{} with {kind}", scenario.name));
+            bar.inc(1);
+            Ok(outcome)
+        })
+        .collect::<Result<Vec<_>, String>>();
+    bar.finish_and_clear();
+    let outcomes = outcomes?;
     let summaries: Vec<_> = outcomes.iter().map(outcome_json).collect();
     write(&out.join("summary.json"), &pretty(&json!(summaries))?)?;
-    let table = table(&outcomes);
-    write(&out.join("comparison.txt"), &table)?;
-    print!("{table}");
+    let rows = table_rows(&outcomes);
+    let text = table(&rows);
+    write(&out.join("comparison.txt"), &text)?;
+    print!("{text}");
+    let sections = figures(out, scenarios, &outcomes)?;
+    let report_path = out.join("report.html");
+    let html_table = report::Table {
+        headers: HEADERS.map(String::from).to_vec(),
+        rows,
+    };
+    let intro = format!(
+        "Every scenario ({}) run with every controller ({}): the comparison table, then figures in the spirit of the paper's section 5. Per-run time series and metrics are in <scenario>/<controller>/timeseries.csv and summary.json next to this page.",
+        scenarios
+            .iter()
+            .map(|s| s.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", "),
+        ControllerKind::ALL.map(ControllerKind::name).join(", ")
+    );
+    report::write(
+        &report_path,
+        "hrm: the paper's experiments",
+        &intro,
+        &html_table,
+        &sections,
+    )?;
     println!(
-        "wrote {} (summary.json, comparison.txt, one folder per run)",
+        "wrote {} (summary.json, comparison.txt, figures/, one folder per run)",
         out.display()
     );
+    println!("report: {}", report_path.display());
     Ok(())
+}
+
+/// Interval between the drawn arm configurations of Figure 10 (s).
+const CONFIGURATION_INTERVAL_S: f64 = 0.5;
+/// Samples per axis of the fuzzy control surfaces.
+const SURFACE_RESOLUTION: usize = 61;
+
+/// Writes every figure into `out/figures` and returns the report's sections: Figure 9 for each
+/// scenario with a modal reference, Figures 10 and 11 for each path-tracking scenario (only
+/// runs that finished are drawn), then the fuzzy controller.
+fn figures(
+    out: &Path,
+    scenarios: &[Scenario],
+    outcomes: &[Outcome],
+) -> Result<Vec<report::Section>, String> {
+    let dir = out.join("figures");
+    std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let figure = |file: String, caption: String| report::Figure {
+        file: format!("figures/{file}"),
+        caption,
+    };
+    let finished = |name: &str| -> Vec<(ControllerKind, &Run)> {
+        outcomes
+            .iter()
+            .filter(|o| o.scenario == name)
+            .filter_map(|o| o.result.as_ref().ok().map(|run| (o.controller, run)))
+            .collect()
+    };
+    let (mut responses, mut backbones, mut residuals) = (Vec::new(), Vec::new(), Vec::new());
+    for scenario in scenarios {
+        let runs = finished(&scenario.name);
+        if runs.is_empty() {
+            continue;
+        }
+        let name = &scenario.name;
+        if !matches!(scenario.reference, ReferenceSpec::Path { .. }) {
+            let file = format!("fig9_{name}.svg");
+            figures::modal_responses(&dir.join(&file), name, &runs)?;
+            responses.push(figure(
+                file,
+                format!("{name}: a1(t) and a2(t) of every controller against the reference (paper Figure 9). Scenario: {}", scenario.description),
+            ));
+            continue;
+        }
+        for &(kind, run) in &runs {
+            let file = format!("fig10_{name}_{}.svg", kind.name());
+            figures::backbone_over_path(
+                &dir.join(&file),
+                scenario,
+                kind,
+                run,
+                CONFIGURATION_INTERVAL_S,
+            )?;
+            backbones.push(figure(
+                file,
+                format!("{name} with {kind}: the arm's backbone every {CONFIGURATION_INTERVAL_S} s (light to dark), base at the origin, over the reference path and the tip's path, equal scales (paper Figure 10)."),
+            ));
+        }
+        let file = format!("fig11_{name}.svg");
+        figures::tracking_residual(&dir.join(&file), name, &runs)?;
+        residuals.push(figure(
+            file,
+            format!("{name}: distance from the tip to the reference point on the path, in mm, for every controller (paper Figure 11)."),
+        ));
+    }
+    let fuzzy = figures::fuzzy_controller(&dir.join("fuzzy"), SURFACE_RESOLUTION)?
+        .into_iter()
+        .map(|path| {
+            let file = path
+                .file_name()
+                .map(|f| f.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let caption = if file.starts_with("mf_") {
+                format!(
+                    "Membership functions (generalised bells N and P) of input {} (eq 22).",
+                    &file[3..file.len() - 4]
+                )
+            } else {
+                format!(
+                    "Control surface {} (Table 1, eqs 21, 23-24), other inputs at zero.",
+                    &file[8..file.len() - 4]
+                )
+            };
+            figure(format!("fuzzy/{file}"), caption)
+        })
+        .collect();
+    let section = |title: &str, text: &str, figures: Vec<report::Figure>| report::Section {
+        title: title.into(),
+        text: text.into(),
+        figures,
+    };
+    Ok(vec![
+        section(
+            "Responses (Figure 9)",
+            "The modal coordinates (a1, a2) of the backbone curve following step, sinusoidal and noisy references.",
+            responses,
+        ),
+        section(
+            "Backbone on the tracking path (Figure 10)",
+            "The tip follows y = 0.4 sin(5x) + 0.2 (eq 25) for 0.08 <= x <= 0.4 m.",
+            backbones,
+        ),
+        section(
+            "Tracking residual (Figure 11)",
+            "Tip error along the path.",
+            residuals,
+        ),
+        section(
+            "The fuzzy controller (section 4)",
+            "Four inputs (modal errors da1, da2 and rates a1_dot, a2_dot), two bell sets each, 16 rules, constant (zero-order Sugeno) outputs.",
+            fuzzy,
+        ),
+    ])
 }
 
 fn run_one(scenario: &Scenario, kind: ControllerKind) -> Outcome {
@@ -117,45 +272,75 @@ fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// The comparison table: tip error RMS and maximum (mm), modal error RMS, peak torques, effort.
-fn table(outcomes: &[Outcome]) -> String {
-    let mut s = format!(
-        "{:<24} {:<16} {:>12} {:>12} {:>20} {:>20} {:>13} {:>12}\n",
-        "scenario",
-        "controller",
-        "tip rms mm",
-        "tip max mm",
-        "modal rms (rad)",
-        "peak tau* (N m)",
-        "peak tau N m",
-        "effort"
-    );
-    for o in outcomes {
-        let _ = match &o.result {
-            Ok(run) => {
-                let m = &run.summary;
-                writeln!(
-                    s,
-                    "{:<24} {:<16} {:>12.4} {:>12.4} {:>9.2e},{:>9.2e} {:>9.2},{:>9.2} {:>13.3} {:>12.4e}",
-                    o.scenario,
-                    o.controller.name(),
-                    m.tip_error_rms_m * 1e3,
-                    m.tip_error_max_m * 1e3,
-                    m.modal_error_rms[0],
-                    m.modal_error_rms[1],
-                    m.peak_modal_torque[0],
-                    m.peak_modal_torque[1],
-                    m.peak_joint_torque_nm,
-                    m.control_effort
-                )
+/// The comparison table's columns.
+const HEADERS: [&str; 8] = [
+    "scenario",
+    "controller",
+    "tip rms mm",
+    "tip max mm",
+    "modal rms (rad)",
+    "peak tau* (N m)",
+    "peak tau N m",
+    "effort",
+];
+
+/// The comparison table's rows: tip error RMS and maximum (mm), modal error RMS, peak torques,
+/// effort; a failed run has only its scenario and controller, and its error.
+fn table_rows(outcomes: &[Outcome]) -> Vec<report::Row> {
+    outcomes
+        .iter()
+        .map(|o| {
+            let mut cells = vec![o.scenario.clone(), o.controller.name().to_owned()];
+            match &o.result {
+                Ok(run) => {
+                    let m = &run.summary;
+                    cells.extend([
+                        format!("{:.4}", m.tip_error_rms_m * 1e3),
+                        format!("{:.4}", m.tip_error_max_m * 1e3),
+                        format!("{:.2e}, {:.2e}", m.modal_error_rms[0], m.modal_error_rms[1]),
+                        format!(
+                            "{:.2}, {:.2}",
+                            m.peak_modal_torque[0], m.peak_modal_torque[1]
+                        ),
+                        format!("{:.3}", m.peak_joint_torque_nm),
+                        format!("{:.4e}", m.control_effort),
+                    ]);
+                    report::Row { cells, error: None }
+                }
+                Err(e) => report::Row {
+                    cells,
+                    error: Some(e.clone()),
+                },
             }
-            Err(e) => writeln!(
-                s,
-                "{:<24} {:<16} stopped: {e}",
-                o.scenario,
-                o.controller.name()
-            ),
-        };
+        })
+        .collect()
+}
+
+/// The comparison table as text: the two name columns left-aligned, numbers right-aligned.
+fn table(rows: &[report::Row]) -> String {
+    let mut widths = HEADERS.map(str::len);
+    for row in rows {
+        for (width, cell) in widths.iter_mut().zip(&row.cells) {
+            *width = (*width).max(cell.len());
+        }
+    }
+    let line = |cells: &[String], error: Option<&String>| {
+        let mut s = String::new();
+        for (k, (cell, width)) in cells.iter().zip(widths).enumerate() {
+            let _ = if k < 2 {
+                write!(s, "{cell:<width$}  ")
+            } else {
+                write!(s, "{cell:>width$}  ")
+            };
+        }
+        if let Some(e) = error {
+            let _ = write!(s, "stopped: {e}");
+        }
+        s.trim_end().to_owned() + "\n"
+    };
+    let mut s = line(&HEADERS.map(String::from), None);
+    for row in rows {
+        s += &line(&row.cells, row.error.as_ref());
     }
     s
 }
@@ -202,8 +387,46 @@ mod tests {
             csv.lines().count(),
             outcome.result.as_ref().unwrap().record.len() + 1
         );
-        assert!(table(&[outcome]).contains("computed-torque"));
+        assert!(table(&table_rows(&[outcome])).contains("computed-torque"));
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn the_report_has_a_row_per_run_and_every_figure_it_shows() {
+        let dir = std::env::temp_dir().join(format!("hrm-main-job-test-{}", std::process::id()));
+        let mut scenarios: Vec<Scenario> = ["paper-tracking", "paper-responses-step"]
+            .into_iter()
+            .map(|name| Scenario::builtin(name).unwrap())
+            .collect();
+        for scenario in &mut scenarios {
+            scenario.duration = 0.15;
+        }
+        // A runaway bound so tight that every step run stops: a failed row.
+        scenarios[1].limits.max_modal_error = 1e-6;
+        experiments(&dir, &scenarios).unwrap();
+        let page = std::fs::read_to_string(dir.join("report.html")).unwrap();
+        let runs = scenarios.len() * ControllerKind::ALL.len();
+        assert_eq!(page.matches("<tr>").count(), 1 + runs);
+        assert_eq!(page.matches("<td class=\"error\"").count(), 4, "{page}");
+        let mut images = 0;
+        for piece in page.split("<img src=\"").skip(1) {
+            let file = &piece[..piece.find('"').unwrap()];
+            assert!(dir.join(file).is_file(), "{file} is missing");
+            images += 1;
+        }
+        // Figures 10 (one per controller) and 11, four membership plots and two surfaces; no
+        // Figure 9 as every step run failed.
+        assert_eq!(images, 4 + 1 + 4 + 2);
+        for name in ["summary.json", "comparison.txt"] {
+            assert!(dir.join(name).is_file());
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+        // An output folder that cannot be created is an error naming it.
+        let blocked = dir.with_extension("file");
+        std::fs::write(&blocked, "").unwrap();
+        let err = experiments(&blocked.join("out"), &scenarios[..1]).unwrap_err();
+        assert!(err.contains(&*blocked.to_string_lossy()), "{err}");
+        std::fs::remove_file(&blocked).unwrap();
     }
 
     #[test]

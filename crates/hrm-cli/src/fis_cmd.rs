@@ -9,7 +9,9 @@
 
 use crate::plot::{self, Grid, Labels, Series};
 use clap::{Args, Subcommand, ValueEnum};
-use fuzzy_sugeno::{AnalysisOptions, EvalOptions, Evaluator, FuzzySystem, OutOfRange};
+use fuzzy_sugeno::{
+    AnalysisOptions, EvalOptions, Evaluator, FuzzySystem, InputVariable, OutOfRange,
+};
 use std::path::{Path, PathBuf};
 
 /// The arguments of `hrm fis`.
@@ -170,7 +172,6 @@ fn surface(
     reference: Option<&[f64]>,
 ) -> Result<Vec<PathBuf>, String> {
     let inputs = system.inputs();
-    let outputs = system.outputs();
     if resolution < 2 {
         return Err(format!("--resolution must be at least 2, got {resolution}"));
     }
@@ -190,128 +191,177 @@ fn surface(
     };
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let mut written = Vec::new();
-    let samples = |range: [f64; 2], n: usize| -> Vec<f64> {
-        (0..n)
-            .map(|k| range[0] + (range[1] - range[0]) * k as f64 / (n - 1) as f64)
-            .collect()
-    };
     for input in inputs {
-        let xs = samples(input.range, resolution.max(201));
-        let series = input
-            .sets
-            .iter()
-            .map(|set| {
-                let points = xs
-                    .iter()
-                    .map(|&x| set.membership.degree(x).map(|mu| (x, mu)))
-                    .collect::<Result<_, _>>();
-                points
-                    .map(|points| Series {
-                        label: set.name.clone(),
-                        points,
-                    })
-                    .map_err(|e| e.to_string())
-            })
-            .collect::<Result<Vec<_>, String>>()?;
-        let path = dir.join(format!("mf_{}.svg", file_name(&input.name)));
-        let title = format!("Membership functions of {}", input.name);
+        written.push(membership_chart(input, dir)?);
+    }
+    if inputs.len() == 1 {
+        written.extend(output_curves(system, dir)?);
+        return Ok(written);
+    }
+    for i in 0..inputs.len() {
+        for j in i + 1..inputs.len() {
+            for output in 0..system.outputs().len() {
+                written.push(surface_chart(
+                    system,
+                    [i, j],
+                    output,
+                    &reference,
+                    resolution,
+                    dir,
+                )?);
+            }
+        }
+    }
+    Ok(written)
+}
+
+/// `n >= 2` evenly spaced samples of `range`, both ends included.
+fn samples(range: [f64; 2], n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|k| range[0] + (range[1] - range[0]) * k as f64 / (n - 1) as f64)
+        .collect()
+}
+
+/// Samples of a membership function or single-input curve.
+const CURVE_SAMPLES: usize = 201;
+
+/// Writes the membership functions of `input` (like MATLAB's `plotmf`) to `dir/mf_<input>.svg`
+/// and returns that path.
+pub fn membership_chart(input: &InputVariable, dir: &Path) -> Result<PathBuf, String> {
+    let xs = samples(input.range, CURVE_SAMPLES);
+    let series = input
+        .sets
+        .iter()
+        .map(|set| {
+            let points = xs
+                .iter()
+                .map(|&x| set.membership.degree(x).map(|mu| (x, mu)))
+                .collect::<Result<_, _>>();
+            points
+                .map(|points| Series {
+                    label: set.name.clone(),
+                    points,
+                })
+                .map_err(|e| e.to_string())
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let path = dir.join(format!("mf_{}.svg", file_name(&input.name)));
+    let title = format!("Membership functions of {}", input.name);
+    plot::line_chart(
+        &path,
+        &Labels {
+            title: &title,
+            x: &input.name,
+            y: "degree of membership",
+        },
+        &series,
+        Some(0.0..1.05),
+    )?;
+    Ok(path)
+}
+
+/// Writes every output of a single-input system over its input to
+/// `dir/curve_<output>_<input>.svg` and returns the paths.
+fn output_curves(system: &FuzzySystem, dir: &Path) -> Result<Vec<PathBuf>, String> {
+    let (input, outputs) = (&system.inputs()[0], system.outputs());
+    let mut evaluator = Evaluator::new(system.clone());
+    let mut y = vec![0.0; outputs.len()];
+    let xs = samples(input.range, CURVE_SAMPLES);
+    let mut curves = vec![Vec::with_capacity(xs.len()); outputs.len()];
+    for &x in &xs {
+        evaluator.eval(&[x], &mut y).map_err(|e| e.to_string())?;
+        for (curve, &value) in curves.iter_mut().zip(&y) {
+            curve.push((x, value));
+        }
+    }
+    let mut written = Vec::new();
+    for (output, points) in outputs.iter().zip(curves) {
+        let path = dir.join(format!(
+            "curve_{}_{}.svg",
+            file_name(&output.name),
+            file_name(&input.name)
+        ));
+        let title = format!("{} = f({})", output.name, input.name);
+        let series = [Series {
+            label: output.name.clone(),
+            points,
+        }];
         plot::line_chart(
             &path,
             &Labels {
                 title: &title,
                 x: &input.name,
-                y: "degree of membership",
+                y: &output.name,
             },
             &series,
-            Some(0.0..1.05),
+            None,
         )?;
         written.push(path);
     }
-    let mut evaluator = Evaluator::new(system.clone());
-    let mut point = reference.clone();
-    let mut y = vec![0.0; outputs.len()];
-    if inputs.len() == 1 {
-        let xs = samples(inputs[0].range, resolution.max(201));
-        let mut curves = vec![Vec::with_capacity(xs.len()); outputs.len()];
-        for &x in &xs {
-            evaluator.eval(&[x], &mut y).map_err(|e| e.to_string())?;
-            for (curve, &value) in curves.iter_mut().zip(&y) {
-                curve.push((x, value));
-            }
-        }
-        for (output, points) in outputs.iter().zip(curves) {
-            let path = dir.join(format!(
-                "curve_{}_{}.svg",
-                file_name(&output.name),
-                file_name(&inputs[0].name)
-            ));
-            let title = format!("{} = f({})", output.name, inputs[0].name);
-            let series = [Series {
-                label: output.name.clone(),
-                points,
-            }];
-            plot::line_chart(
-                &path,
-                &Labels {
-                    title: &title,
-                    x: &inputs[0].name,
-                    y: &output.name,
-                },
-                &series,
-                None,
-            )?;
-            written.push(path);
-        }
-        return Ok(written);
-    }
-    for i in 0..inputs.len() {
-        for j in i + 1..inputs.len() {
-            let (xs, ys) = (
-                samples(inputs[i].range, resolution),
-                samples(inputs[j].range, resolution),
-            );
-            let mut values = vec![Vec::with_capacity(xs.len() * ys.len()); outputs.len()];
-            for &yv in &ys {
-                for &xv in &xs {
-                    point[i] = xv;
-                    point[j] = yv;
-                    evaluator.eval(&point, &mut y).map_err(|e| e.to_string())?;
-                    for (z, &value) in values.iter_mut().zip(&y) {
-                        z.push(value);
-                    }
-                }
-            }
-            point[i] = reference[i];
-            point[j] = reference[j];
-            for (output, z) in outputs.iter().zip(values) {
-                let (xn, yn) = (&inputs[i].name, &inputs[j].name);
-                let path = dir.join(format!(
-                    "surface_{}_{}_{}.svg",
-                    file_name(&output.name),
-                    file_name(xn),
-                    file_name(yn)
-                ));
-                let title = format!("{} = f({xn}, {yn})", output.name);
-                let grid = Grid {
-                    x: xs.clone(),
-                    y: ys.clone(),
-                    z,
-                };
-                plot::heatmap(
-                    &path,
-                    &Labels {
-                        title: &title,
-                        x: xn,
-                        y: yn,
-                    },
-                    &output.name,
-                    &grid,
-                )?;
-                written.push(path);
-            }
-        }
-    }
     Ok(written)
+}
+
+/// Writes output `output` of `system` over the inputs `[i, j]` on a `resolution` x `resolution`
+/// grid, the other inputs at `reference` (like MATLAB's `gensurf`), as a heat map
+/// `dir/surface_<output>_<x>_<y>.svg`, and returns its path.
+pub fn surface_chart(
+    system: &FuzzySystem,
+    [i, j]: [usize; 2],
+    output: usize,
+    reference: &[f64],
+    resolution: usize,
+    dir: &Path,
+) -> Result<PathBuf, String> {
+    let (inputs, outputs) = (system.inputs(), system.outputs());
+    if i == j
+        || i.max(j) >= inputs.len()
+        || output >= outputs.len()
+        || reference.len() != inputs.len()
+        || resolution < 2
+    {
+        return Err(format!(
+            "a surface needs two distinct inputs and one output of the system ({} inputs, {} outputs), one reference value per input and at least 2 samples per axis (got inputs {i}, {j}, output {output}, {} reference values, resolution {resolution})",
+            inputs.len(),
+            outputs.len(),
+            reference.len()
+        ));
+    }
+    let mut evaluator = Evaluator::new(system.clone());
+    let mut point = reference.to_vec();
+    let mut y = vec![0.0; outputs.len()];
+    let (xs, ys) = (
+        samples(inputs[i].range, resolution),
+        samples(inputs[j].range, resolution),
+    );
+    let mut z = Vec::with_capacity(xs.len() * ys.len());
+    for &yv in &ys {
+        for &xv in &xs {
+            point[i] = xv;
+            point[j] = yv;
+            evaluator.eval(&point, &mut y).map_err(|e| e.to_string())?;
+            z.push(y[output]);
+        }
+    }
+    let (xn, yn, zn) = (&inputs[i].name, &inputs[j].name, &outputs[output].name);
+    let path = dir.join(format!(
+        "surface_{}_{}_{}.svg",
+        file_name(zn),
+        file_name(xn),
+        file_name(yn)
+    ));
+    let title = format!("{zn} = f({xn}, {yn})");
+    let grid = Grid { x: xs, y: ys, z };
+    plot::heatmap(
+        &path,
+        &Labels {
+            title: &title,
+            x: xn,
+            y: yn,
+        },
+        zn,
+        &grid,
+    )?;
+    Ok(path)
 }
 
 /// A name made safe for a file name.

@@ -2,8 +2,12 @@
 
 mod eval;
 mod experiment;
+mod figures;
 mod fis_cmd;
 mod plot;
+mod progress;
+mod report;
+mod sweep;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -41,6 +45,8 @@ enum Command {
     Eval,
     /// Check, evaluate and plot Takagi-Sugeno systems stored as MATLAB .fis files.
     Fis(fis_cmd::FisArgs),
+    /// Monte Carlo over noise levels and seeds: mean and spread of the errors per controller (docs/sweep.md).
+    Sweep(sweep::SweepCli),
 }
 
 fn main() -> ExitCode {
@@ -54,6 +60,7 @@ fn main() -> ExitCode {
         }) => experiment::simulate(&scenario, controller.as_deref(), &out),
         Some(Command::Eval) => eval::run_stdio(),
         Some(Command::Fis(args)) => fis_cmd::run(args),
+        Some(Command::Sweep(args)) => sweep::run(args),
         None => experiment::main_job(std::path::Path::new("hrm-output")),
     };
     match result {

@@ -1,6 +1,7 @@
 //! SVG charts with plotters: multi-series line charts and 2-D surfaces drawn as heat maps with a
 //! colour scale. Used by `hrm fis surface` and by the paper's figures.
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 use std::ops::Range;
@@ -53,26 +54,171 @@ pub fn line_chart(
     series: &[Series],
     y_range: Option<Range<f64>>,
 ) -> Result<(), String> {
-    let points = || series.iter().flat_map(|s| s.points.iter());
-    let x_range = span(points().map(|p| p.0), "x")?;
-    let y_range = match y_range {
-        Some(range) if range.start < range.end => range,
-        Some(range) => return Err(format!("{}: empty y range {range:?}", path.display())),
-        None => {
-            let data = span(points().map(|p| p.1), "y")?;
-            let margin = 0.05 * (data.end - data.start);
-            data.start - margin..data.end + margin
-        }
+    let panel = Panel {
+        y: labels.y,
+        series,
+        y_range,
     };
-    let (x_ticks, y_ticks) = (tick_format(&x_range), tick_format(&y_range));
+    let layout = panel_ranges(path, std::slice::from_ref(&panel))?;
     let root = SVGBackend::new(path, SIZE).into_drawing_area();
-    let draw = || -> Result<(), Box<dyn std::error::Error + '_>> {
+    let draw = || -> Result<(), Box<dyn std::error::Error>> {
         root.fill(&WHITE)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(labels.title, TITLE_FONT)
-            .margin(15)
-            .x_label_area_size(50)
-            .y_label_area_size(75)
+        let area = root.titled(labels.title, TITLE_FONT)?;
+        draw_panel(&area, labels.x, &panel, &layout[0])?;
+        root.present()?;
+        Ok(())
+    };
+    draw().map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// One panel of [`stacked_line_charts`]: its vertical axis label, curves and optional range.
+pub struct Panel<'a> {
+    /// The vertical axis.
+    pub y: &'a str,
+    /// The curves.
+    pub series: &'a [Series],
+    /// The vertical range, or the data with a 5% margin when `None`.
+    pub y_range: Option<Range<f64>>,
+}
+
+/// Writes `panels` stacked top to bottom, sharing the horizontal axis `x_label` (as in the
+/// paper's Figure 9: one panel per modal coordinate), under one `title`, to the SVG file `path`.
+pub fn stacked_line_charts(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    panels: &[Panel<'_>],
+) -> Result<(), String> {
+    if panels.is_empty() {
+        return Err(format!("{}: no panels to draw", path.display()));
+    }
+    let ranges = panel_ranges(path, panels)?;
+    let height = (SIZE.1 / 2 + 30) * panels.len() as u32 + 40;
+    let root = SVGBackend::new(path, (SIZE.0, height)).into_drawing_area();
+    let draw = || -> Result<(), Box<dyn std::error::Error>> {
+        root.fill(&WHITE)?;
+        let area = root.titled(title, TITLE_FONT)?;
+        let rows = area.split_evenly((panels.len(), 1));
+        for ((row, panel), range) in rows.iter().zip(panels).zip(&ranges) {
+            draw_panel(row, x_label, panel, range)?;
+        }
+        root.present()?;
+        Ok(())
+    };
+    draw().map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The horizontal and vertical ranges of each panel; every panel shares the horizontal range
+/// of all the data.
+fn panel_ranges(path: &Path, panels: &[Panel<'_>]) -> Result<Vec<[Range<f64>; 2]>, String> {
+    let context = |e: String| format!("{}: {e}", path.display());
+    let all = panels
+        .iter()
+        .flat_map(|p| p.series.iter().flat_map(|s| s.points.iter()));
+    let x_range = span(all.map(|p| p.0), "x").map_err(context)?;
+    panels
+        .iter()
+        .map(|panel| {
+            let y_range = match &panel.y_range {
+                Some(range) if range.start < range.end => range.clone(),
+                Some(range) => return Err(context(format!("empty y range {range:?}"))),
+                None => {
+                    let points = panel.series.iter().flat_map(|s| s.points.iter());
+                    let data = span(points.map(|p| p.1), "y").map_err(context)?;
+                    let margin = 0.05 * (data.end - data.start);
+                    data.start - margin..data.end + margin
+                }
+            };
+            Ok([x_range.clone(), y_range])
+        })
+        .collect()
+}
+
+/// Draws one line chart with a legend into `area`.
+fn draw_panel(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    x_label: &str,
+    panel: &Panel<'_>,
+    [x_range, y_range]: &[Range<f64>; 2],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let (x_ticks, y_ticks) = (tick_format(x_range), tick_format(y_range));
+    let mut chart = ChartBuilder::on(area)
+        .margin(15)
+        .x_label_area_size(50)
+        .y_label_area_size(75)
+        .build_cartesian_2d(x_range.clone(), y_range.clone())?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(panel.y)
+        .label_style(TICK_FONT)
+        .axis_desc_style(AXIS_FONT)
+        .x_label_formatter(&x_ticks)
+        .y_label_formatter(&y_ticks)
+        .draw()?;
+    for (k, s) in panel.series.iter().enumerate() {
+        let colour = Palette99::pick(k).to_rgba();
+        chart
+            .draw_series(LineSeries::new(
+                s.points.iter().copied(),
+                colour.stroke_width(2),
+            ))?
+            .label(s.label.as_str())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+    }
+    chart
+        .configure_series_labels()
+        .label_font(TICK_FONT)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
+}
+
+/// How a curve of an [`xy_chart`] is drawn.
+#[derive(Debug, Clone, Copy)]
+pub struct Style {
+    /// Stroke colour (red, green, blue).
+    pub colour: (u8, u8, u8),
+    /// Stroke width in pixels.
+    pub width: u32,
+    /// Whether every point gets a dot (e.g. the joints of an arm).
+    pub dots: bool,
+}
+
+/// Writes `curves` in the plane with equal scales on both axes (a metre is as long across as
+/// up) to the SVG file `path`; curves with an empty label get no legend entry.
+pub fn xy_chart(
+    path: &Path,
+    labels: &Labels<'_>,
+    curves: &[(Series, Style)],
+) -> Result<(), String> {
+    const MARGIN: u32 = 15;
+    const X_LABELS: u32 = 50;
+    const Y_LABELS: u32 = 75;
+    let context = |e: String| format!("{}: {e}", path.display());
+    let points = || curves.iter().flat_map(|(s, _)| s.points.iter());
+    let data = [
+        span(points().map(|p| p.0), "x").map_err(context)?,
+        span(points().map(|p| p.1), "y").map_err(context)?,
+    ];
+    let root = SVGBackend::new(path, SIZE).into_drawing_area();
+    let draw = || -> Result<(), Box<dyn std::error::Error>> {
+        root.fill(&WHITE)?;
+        let area = root.titled(labels.title, TITLE_FONT)?;
+        let (w, h) = area.dim_in_pixel();
+        let pixels = (
+            w.saturating_sub(2 * MARGIN + Y_LABELS).max(1),
+            h.saturating_sub(2 * MARGIN + X_LABELS).max(1),
+        );
+        let [x_range, y_range] = equal_aspect(&data, pixels, 0.05);
+        let (x_ticks, y_ticks) = (tick_format(&x_range), tick_format(&y_range));
+        let mut chart = ChartBuilder::on(&area)
+            .margin(MARGIN)
+            .x_label_area_size(X_LABELS)
+            .y_label_area_size(Y_LABELS)
             .build_cartesian_2d(x_range.clone(), y_range.clone())?;
         chart
             .configure_mesh()
@@ -83,28 +229,62 @@ pub fn line_chart(
             .x_label_formatter(&x_ticks)
             .y_label_formatter(&y_ticks)
             .draw()?;
-        for (k, s) in series.iter().enumerate() {
-            let colour = Palette99::pick(k).to_rgba();
-            chart
-                .draw_series(LineSeries::new(
-                    s.points.iter().copied(),
-                    colour.stroke_width(2),
-                ))?
-                .label(s.label.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+        for (series, style) in curves {
+            let (r, g, b) = style.colour;
+            let colour = RGBColor(r, g, b);
+            let width = style.width;
+            let drawn = chart.draw_series(LineSeries::new(
+                series.points.iter().copied(),
+                colour.stroke_width(width),
+            ))?;
+            if !series.label.is_empty() {
+                drawn.label(series.label.as_str()).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(width))
                 });
+            }
+            if style.dots {
+                chart.draw_series(
+                    series
+                        .points
+                        .iter()
+                        .map(|&p| Circle::new(p, width + 1, colour.filled())),
+                )?;
+            }
         }
-        chart
-            .configure_series_labels()
-            .label_font(TICK_FONT)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()?;
+        if curves.iter().any(|(s, _)| !s.label.is_empty()) {
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::LowerRight)
+                .label_font(TICK_FONT)
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .draw()?;
+        }
         root.present()?;
         Ok(())
     };
     draw().map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Ranges around `data` (widened by `margin` of the larger span on every side) whose units per
+/// pixel agree on both axes for a plotting area of `pixels` (width, height): the axis with room
+/// to spare is widened about its centre.
+fn equal_aspect(data: &[Range<f64>; 2], pixels: (u32, u32), margin: f64) -> [Range<f64>; 2] {
+    let pad = margin * (data[0].end - data[0].start).max(data[1].end - data[1].start);
+    let spans = [
+        data[0].end - data[0].start + 2.0 * pad,
+        data[1].end - data[1].start + 2.0 * pad,
+    ];
+    let per_pixel = (spans[0] / f64::from(pixels.0)).max(spans[1] / f64::from(pixels.1));
+    let widths = [
+        per_pixel * f64::from(pixels.0),
+        per_pixel * f64::from(pixels.1),
+    ];
+    let around = |range: &Range<f64>, width: f64| {
+        let centre = 0.5 * (range.start + range.end);
+        centre - 0.5 * width..centre + 0.5 * width
+    };
+    [around(&data[0], widths[0]), around(&data[1], widths[1])]
 }
 
 /// Writes `grid` as a heat map with a colour scale labelled `z_label` to the SVG file `path`.

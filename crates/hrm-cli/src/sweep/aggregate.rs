@@ -1,0 +1,182 @@
+//! Mean and spread of the runs' errors per (noise level, controller) cell, computed in index
+//! order so that a merged sweep gives bit for bit the numbers of an unsharded one.
+
+use super::plan::SweepConfig;
+use super::shard_file::{Outcome, RunMetrics, RunResult};
+use serde::Serialize;
+use sim_core::ControllerKind;
+
+/// Mean, sample standard deviation (`n - 1`; 0 for one value), minimum, median and maximum.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Stats {
+    /// Mean.
+    pub mean: f64,
+    /// Sample standard deviation.
+    pub std: f64,
+    /// Smallest value.
+    pub min: f64,
+    /// Median (the mean of the two middle values for an even count).
+    pub median: f64,
+    /// Largest value.
+    pub max: f64,
+}
+
+impl Stats {
+    /// The statistics of `values` (summed in the given order), `None` for no values.
+    pub fn of(values: &[f64]) -> Option<Stats> {
+        let n = values.len();
+        if n == 0 {
+            return None;
+        }
+        // Deviations from the first value: exact zeros (so std 0, mean exact) for equal values,
+        // and no cancellation when the spread is small against the values.
+        let shift = values[0];
+        let mean_dev = values.iter().map(|v| v - shift).sum::<f64>() / n as f64;
+        let mean = shift + mean_dev;
+        let std = if n > 1 {
+            let ss: f64 = values
+                .iter()
+                .map(|v| (v - shift - mean_dev) * (v - shift - mean_dev))
+                .sum();
+            (ss / (n - 1) as f64).sqrt()
+        } else {
+            0.0
+        };
+        let mut sorted = values.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        let median = if n % 2 == 1 {
+            sorted[n / 2]
+        } else {
+            0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+        };
+        Some(Stats {
+            mean,
+            std,
+            min: sorted[0],
+            median,
+            max: sorted[n - 1],
+        })
+    }
+}
+
+/// A run that stopped.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FailedRun {
+    /// Its index.
+    pub index: usize,
+    /// Its seed.
+    pub seed: u64,
+    /// Why and when it stopped.
+    pub error: String,
+}
+
+/// The runs of one noise level and controller. The statistics are over the completed runs and
+/// absent when none completed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Cell {
+    /// Noise level (rad).
+    pub noise_level: f64,
+    /// Controller.
+    pub controller: ControllerKind,
+    /// Runs in the cell.
+    pub runs: usize,
+    /// Runs that stopped before the end.
+    pub failed: usize,
+    /// Tip error RMS (mm).
+    pub tip_error_rms_mm: Option<Stats>,
+    /// Largest tip error (mm).
+    pub tip_error_max_mm: Option<Stats>,
+    /// Modal error RMS of `a1` (rad).
+    pub modal_error_rms_a1: Option<Stats>,
+    /// Modal error RMS of `a2` (rad).
+    pub modal_error_rms_a2: Option<Stats>,
+    /// Largest joint torque (N m).
+    pub peak_joint_torque_nm: Option<Stats>,
+    /// The failed runs, by index.
+    pub failures: Vec<FailedRun>,
+}
+
+/// The cells of a whole sweep, noise level slowest then controller, from its runs in index
+/// order (as [`super::shard_file::merge`] returns them).
+pub fn cells(config: &SweepConfig, runs: &[RunResult]) -> Vec<Cell> {
+    runs.chunks(config.seeds)
+        .map(|chunk| {
+            let completed: Vec<&RunMetrics> = chunk
+                .iter()
+                .filter_map(|r| match &r.outcome {
+                    Outcome::Completed(m) => Some(m),
+                    Outcome::Failed { .. } => None,
+                })
+                .collect();
+            let stats = |f: fn(&RunMetrics) -> f64| {
+                Stats::of(&completed.iter().map(|m| f(m)).collect::<Vec<_>>())
+            };
+            let failures: Vec<FailedRun> = chunk
+                .iter()
+                .filter_map(|r| match &r.outcome {
+                    Outcome::Failed { error, .. } => Some(FailedRun {
+                        index: r.index,
+                        seed: r.seed,
+                        error: error.clone(),
+                    }),
+                    Outcome::Completed(_) => None,
+                })
+                .collect();
+            Cell {
+                noise_level: chunk[0].noise_level,
+                controller: chunk[0].controller,
+                runs: chunk.len(),
+                failed: failures.len(),
+                tip_error_rms_mm: stats(|m| m.tip_error_rms_m * 1e3),
+                tip_error_max_mm: stats(|m| m.tip_error_max_m * 1e3),
+                modal_error_rms_a1: stats(|m| m.modal_error_rms[0]),
+                modal_error_rms_a2: stats(|m| m.modal_error_rms[1]),
+                peak_joint_torque_nm: stats(|m| m.peak_joint_torque_nm),
+                failures,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn statistics_of_known_samples() {
+        // 2, 4, 4, 4, 5, 5, 7, 9: mean 5, sum of squared deviations 32, so std sqrt(32/7).
+        let s = Stats::of(&[9.0, 2.0, 4.0, 4.0, 5.0, 5.0, 7.0, 4.0]).unwrap();
+        assert_eq!((s.mean, s.min, s.median, s.max), (5.0, 2.0, 4.5, 9.0));
+        assert!((s.std - (32.0f64 / 7.0).sqrt()).abs() < 1e-15);
+        // Equal values: the naive sum of ten 0.1 is 0.9999999999999999, not 1.
+        let same = Stats::of(&[0.1; 10]).unwrap();
+        assert_eq!((same.mean, same.std, same.median), (0.1, 0.0, 0.1));
+        let one = Stats::of(&[3.5]).unwrap();
+        assert_eq!((one.mean, one.std, one.median), (3.5, 0.0, 3.5));
+        assert_eq!(Stats::of(&[1.0, 10.0, 2.0]).unwrap().median, 2.0);
+        assert!(Stats::of(&[]).is_none());
+    }
+
+    proptest! {
+        #[test]
+        fn statistics_are_shift_and_scale_equivariant(
+            values in proptest::collection::vec(-1e3f64..1e3, 1..40),
+            shift in -1e3f64..1e3,
+            scale in 0.1f64..10.0,
+        ) {
+            let s = Stats::of(&values).unwrap();
+            let moved: Vec<f64> = values.iter().map(|v| scale * v + shift).collect();
+            let t = Stats::of(&moved).unwrap();
+            let tol = 1e-9 * (1e3 * scale + shift.abs());
+            prop_assert!((t.mean - (scale * s.mean + shift)).abs() <= tol);
+            prop_assert!((t.std - scale * s.std).abs() <= tol);
+            prop_assert!((t.median - (scale * s.median + shift)).abs() <= tol);
+            prop_assert!(s.min <= s.median && s.median <= s.max);
+            prop_assert!(s.min <= s.mean && s.mean <= s.max);
+            // Half the values lie on each side of the median.
+            let below = values.iter().filter(|&&v| v <= s.median).count();
+            prop_assert!(2 * below >= values.len());
+        }
+    }
+}

@@ -1,0 +1,342 @@
+//! What a sweep runs: its configuration, the fixed enumeration of its runs, each run's seed,
+//! and the slice of runs one shard takes.
+
+use serde::{Deserialize, Serialize};
+use sim_core::{ControllerKind, NoiseSpec, Scenario};
+use std::fmt;
+use std::str::FromStr;
+
+/// The SplitMix64 increment (the golden ratio in 64-bit fixed point).
+const SPLITMIX_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// Everything that defines a sweep's results; shards merge only when theirs are equal.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepConfig {
+    /// The `hrm` version that ran the sweep.
+    pub hrm_version: String,
+    /// The scenario, duration override applied; its `noise` and `seed` are replaced per run.
+    pub scenario: Scenario,
+    /// The controllers compared, in table order.
+    pub controllers: Vec<ControllerKind>,
+    /// The noise levels: the sensor noise standard deviation on `(a1, a2)` (rad).
+    pub noise_levels: Vec<f64>,
+    /// Sensor noise on `(a1_dot, a2_dot)` per unit of noise level (rad/s per rad, i.e. 1/s).
+    pub rate_noise_ratio: f64,
+    /// Noise on the reference `(a1_ref, a2_ref)` per unit of noise level.
+    pub reference_noise_ratio: f64,
+    /// Noise realisations per (noise level, controller) cell.
+    pub seeds: usize,
+    /// The seed every run's seed derives from ([`run_seed`]).
+    pub base_seed: u64,
+}
+
+/// Where run `index` sits in the sweep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunId {
+    /// The run's index in the fixed enumeration.
+    pub index: usize,
+    /// Position of its noise level in [`SweepConfig::noise_levels`].
+    pub level_index: usize,
+    /// Its noise level (rad).
+    pub noise_level: f64,
+    /// Its controller.
+    pub controller: ControllerKind,
+    /// Which of the cell's noise realisations (0-based).
+    pub seed_index: usize,
+    /// The seed of its noise sources.
+    pub seed: u64,
+}
+
+impl SweepConfig {
+    /// Checks the numbers that the scenario itself does not check.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.controllers.is_empty() {
+            return Err("--controllers: at least one controller is needed".into());
+        }
+        if self.noise_levels.is_empty() {
+            return Err("--noise: at least one noise level is needed".into());
+        }
+        if let Some(bad) = self
+            .noise_levels
+            .iter()
+            .find(|l| !(l.is_finite() && **l >= 0.0))
+        {
+            return Err(format!(
+                "--noise: noise levels must be finite and non-negative, got {bad}"
+            ));
+        }
+        if self.noise_levels.windows(2).any(|w| w[0] >= w[1]) {
+            return Err(format!(
+                "--noise: noise levels must be distinct and ascending, got {:?}",
+                self.noise_levels
+            ));
+        }
+        for (name, ratio) in [
+            ("--rate-noise-ratio", self.rate_noise_ratio),
+            ("--reference-noise-ratio", self.reference_noise_ratio),
+        ] {
+            if !(ratio.is_finite() && ratio >= 0.0) {
+                return Err(format!(
+                    "{name} must be finite and non-negative, got {ratio}"
+                ));
+            }
+        }
+        if self.seeds == 0 {
+            return Err("--seeds must be at least 1".into());
+        }
+        self.runs()
+            .map(|_| ())
+            .ok_or_else(|| "the sweep has too many runs to count".to_string())
+    }
+
+    /// Number of runs: noise levels x controllers x seeds (`None` on overflow).
+    pub fn runs(&self) -> Option<usize> {
+        self.noise_levels
+            .len()
+            .checked_mul(self.controllers.len())?
+            .checked_mul(self.seeds)
+    }
+
+    /// Run `index` of the enumeration `index = (level_index * controllers + controller_index)
+    /// * seeds + seed_index`: noise level slowest, seed fastest.
+    pub fn run_at(&self, index: usize) -> RunId {
+        let seed_index = index % self.seeds;
+        let cell = index / self.seeds;
+        let n_controllers = self.controllers.len();
+        let level_index = cell / n_controllers;
+        RunId {
+            index,
+            level_index,
+            noise_level: self.noise_levels[level_index],
+            controller: self.controllers[cell % n_controllers],
+            seed_index,
+            seed: run_seed(self.base_seed, seed_index),
+        }
+    }
+
+    /// The scenario of run `id`: its controller, seed and noise.
+    pub fn scenario_for(&self, id: &RunId) -> Scenario {
+        let mut scenario = self.scenario.clone();
+        let level = id.noise_level;
+        scenario.controller.kind = id.controller;
+        scenario.seed = id.seed;
+        scenario.noise = NoiseSpec {
+            reference_std: [self.reference_noise_ratio * level; 2],
+            sensor_a_std: [level; 2],
+            sensor_a_dot_std: [self.rate_noise_ratio * level; 2],
+        };
+        scenario
+    }
+
+    /// The name of the first field in which `other` differs, if any.
+    pub fn first_difference(&self, other: &Self) -> Option<&'static str> {
+        [
+            ("hrm_version", self.hrm_version == other.hrm_version),
+            ("scenario", self.scenario == other.scenario),
+            ("controllers", self.controllers == other.controllers),
+            ("noise_levels", self.noise_levels == other.noise_levels),
+            (
+                "rate_noise_ratio",
+                self.rate_noise_ratio == other.rate_noise_ratio,
+            ),
+            (
+                "reference_noise_ratio",
+                self.reference_noise_ratio == other.reference_noise_ratio,
+            ),
+            ("seeds", self.seeds == other.seeds),
+            ("base_seed", self.base_seed == other.base_seed),
+        ]
+        .into_iter()
+        .find(|(_, equal)| !equal)
+        .map(|(name, _)| name)
+    }
+}
+
+/// The seed of noise realisation `seed_index`: output number `seed_index + 1` of the SplitMix64
+/// generator (Steele, Lea and Flood 2014; Vigna's `splitmix64.c`) seeded with `base_seed`. It
+/// depends on nothing else, so every (noise level, controller) cell sees the same noise
+/// realisations (common random numbers) and no result depends on sharding or scheduling.
+pub fn run_seed(base_seed: u64, seed_index: usize) -> u64 {
+    let mut z = base_seed.wrapping_add(
+        (seed_index as u64)
+            .wrapping_add(1)
+            .wrapping_mul(SPLITMIX_GAMMA),
+    );
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Shard `index` of `count` (1-based, written `K/N`): the runs whose index `i` has
+/// `i % N == K - 1`. Round robin spreads every cell's costly and cheap runs over all shards.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Shard {
+    /// `K`, from 1 to `count`.
+    pub index: usize,
+    /// `N`, the number of shards.
+    pub count: usize,
+}
+
+impl Shard {
+    /// The whole sweep as one shard.
+    pub const WHOLE: Shard = Shard { index: 1, count: 1 };
+
+    /// Whether run `i` belongs to this shard.
+    pub fn contains(self, i: usize) -> bool {
+        i % self.count == self.index - 1
+    }
+
+    /// The run indices of this shard among `runs`, ascending.
+    pub fn indices(self, runs: usize) -> impl Iterator<Item = usize> {
+        (self.index - 1..runs).step_by(self.count)
+    }
+}
+
+impl fmt::Display for Shard {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl FromStr for Shard {
+    type Err = String;
+
+    /// Parses `K/N` with `1 <= K <= N`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || format!("a shard is written K/N with 1 <= K <= N, got '{s}'");
+        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        let index: usize = k.trim().parse().map_err(|_| bad())?;
+        let count: usize = n.trim().parse().map_err(|_| bad())?;
+        if index == 0 || index > count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn config(levels: usize, controllers: usize, seeds: usize) -> SweepConfig {
+        SweepConfig {
+            hrm_version: "test".into(),
+            scenario: Scenario::builtin("paper-responses-step").unwrap(),
+            controllers: ControllerKind::ALL[..controllers].to_vec(),
+            noise_levels: (0..levels).map(|l| l as f64 * 1e-3).collect(),
+            rate_noise_ratio: 10.0,
+            reference_noise_ratio: 0.5,
+            seeds,
+            base_seed: 9,
+        }
+    }
+
+    #[test]
+    fn seeds_are_the_splitmix64_reference_sequence() {
+        // Vigna's splitmix64.c seeded with 1234567 (the Rosetta Code test vector).
+        let expected = [
+            6457827717110365317,
+            3203168211198807973,
+            9817491932198370423,
+            4593380528125082431,
+            16408922859458223821,
+        ];
+        for (j, e) in expected.into_iter().enumerate() {
+            assert_eq!(run_seed(1234567, j), e, "output {}", j + 1);
+        }
+        // Seeded with 0, the first output is 0xe220a8397b1dcdaf.
+        assert_eq!(run_seed(0, 0), 0xE220_A839_7B1D_CDAF);
+    }
+
+    #[test]
+    fn runs_are_enumerated_level_then_controller_then_seed() {
+        let c = config(3, 4, 5);
+        assert_eq!(c.runs(), Some(60));
+        let id = c.run_at(2 * 20 + 3 * 5 + 4);
+        assert_eq!(
+            (id.level_index, id.controller, id.seed_index),
+            (2, ControllerKind::FuzzyGc, 4)
+        );
+        assert_eq!(id.noise_level, 2e-3);
+        assert_eq!(id.seed, run_seed(9, 4));
+        let scenario = c.scenario_for(&id);
+        assert_eq!(scenario.controller.kind, ControllerKind::FuzzyGc);
+        assert_eq!(scenario.seed, id.seed);
+        assert_eq!(scenario.noise.sensor_a_std, [2e-3; 2]);
+        assert_eq!(scenario.noise.sensor_a_dot_std, [2e-2; 2]);
+        assert_eq!(scenario.noise.reference_std, [1e-3; 2]);
+    }
+
+    #[test]
+    fn invalid_configurations_are_refused() {
+        let mut c = config(2, 2, 2);
+        assert!(c.validate().is_ok());
+        c.noise_levels[1] = -1.0;
+        assert!(c.validate().unwrap_err().contains("non-negative, got -1"));
+        c.noise_levels[1] = f64::NAN;
+        assert!(c.validate().unwrap_err().contains("got NaN"));
+        c.noise_levels = vec![0.01, 0.0];
+        assert!(c.validate().unwrap_err().contains("ascending"));
+        let mut c = config(2, 2, 0);
+        assert!(c.validate().unwrap_err().contains("--seeds"));
+        c.seeds = 1;
+        c.rate_noise_ratio = f64::INFINITY;
+        assert!(c.validate().unwrap_err().contains("--rate-noise-ratio"));
+        assert!(config(0, 2, 1).validate().unwrap_err().contains("--noise"));
+        assert!(
+            config(1, 0, 1)
+                .validate()
+                .unwrap_err()
+                .contains("--controllers")
+        );
+    }
+
+    #[test]
+    fn configurations_name_their_first_difference() {
+        let a = config(2, 2, 2);
+        assert_eq!(a.first_difference(&a.clone()), None);
+        let mut b = a.clone();
+        b.base_seed = 10;
+        assert_eq!(a.first_difference(&b), Some("base_seed"));
+        b.scenario.duration = 0.5;
+        assert_eq!(a.first_difference(&b), Some("scenario"));
+    }
+
+    #[test]
+    fn shards_parse_and_refuse_bad_text() {
+        assert_eq!("2/3".parse::<Shard>(), Ok(Shard { index: 2, count: 3 }));
+        for bad in ["0/3", "4/3", "3", "a/b", "1/0", "-1/2"] {
+            assert!(bad.parse::<Shard>().unwrap_err().contains("K/N"), "{bad}");
+        }
+        assert_eq!(Shard { index: 2, count: 3 }.to_string(), "2/3");
+    }
+
+    proptest! {
+        #[test]
+        fn shards_partition_the_runs(runs in 0usize..200, count in 1usize..12) {
+            let mut seen = vec![0u32; runs];
+            for index in 1..=count {
+                let shard = Shard { index, count };
+                for i in shard.indices(runs) {
+                    prop_assert!(shard.contains(i));
+                    seen[i] += 1;
+                }
+            }
+            prop_assert!(seen.iter().all(|&n| n == 1));
+        }
+
+        #[test]
+        fn every_run_is_enumerated_once(levels in 1usize..4, controllers in 1usize..=4, seeds in 1usize..6) {
+            let c = config(levels, controllers, seeds);
+            let mut seen = std::collections::HashSet::new();
+            for i in 0..c.runs().unwrap() {
+                let id = c.run_at(i);
+                prop_assert_eq!(id.index, i);
+                prop_assert!(seen.insert((id.level_index, id.controller, id.seed_index)));
+            }
+        }
+    }
+}

@@ -1,0 +1,175 @@
+//! The report of a whole sweep: a text table, `summary.json` and an SVG plot of the tip error
+//! against the noise level.
+
+use super::aggregate::{Cell, Stats};
+use super::plan::SweepConfig;
+use crate::plot::{Labels, Series, line_chart};
+use serde_json::json;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Failed runs listed under the table; the rest are counted.
+const LISTED_FAILURES: usize = 20;
+
+/// The table: per cell, completed runs and the statistics of the tip and modal errors.
+pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "sweep of {}: {} noise levels x {} controllers x {} seeds = {} runs, base seed {}, {} s each",
+        config.scenario.name,
+        config.noise_levels.len(),
+        config.controllers.len(),
+        config.seeds,
+        cells.iter().map(|c| c.runs).sum::<usize>(),
+        config.base_seed,
+        config.scenario.duration,
+    );
+    let _ = writeln!(
+        s,
+        "noise level L: sensor noise std L rad on (a1, a2), {} L rad/s on (a1_dot, a2_dot), {} L rad on the reference",
+        config.rate_noise_ratio, config.reference_noise_ratio
+    );
+    let _ = writeln!(
+        s,
+        "{:>10} {:<16} {:>7} | {:^49} | {:^29} | {:^19} | {:^19}",
+        "",
+        "",
+        "",
+        "tip error RMS (mm)",
+        "tip error max (mm)",
+        "a1 error RMS (rad)",
+        "a2 error RMS (rad)"
+    );
+    let _ = writeln!(
+        s,
+        "{:>10} {:<16} {:>7} | {:>9} {:>9} {:>9} {:>9} {:>9} | {:>9} {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9}",
+        "L (rad)",
+        "controller",
+        "ok/runs",
+        "mean",
+        "std",
+        "min",
+        "median",
+        "max",
+        "mean",
+        "std",
+        "max",
+        "mean",
+        "std",
+        "mean",
+        "std"
+    );
+    for c in cells {
+        let _ = write!(
+            s,
+            "{:>10} {:<16} {:>7}",
+            format!("{:.3e}", c.noise_level),
+            c.controller.name(),
+            format!("{}/{}", c.runs - c.failed, c.runs)
+        );
+        let cols = |s: &mut String,
+                    stats: &Option<Stats>,
+                    pick: &[fn(&Stats) -> f64],
+                    fmt: fn(f64) -> String| {
+            s.push_str(" |");
+            for f in pick {
+                let text = stats.as_ref().map_or("-".to_string(), |st| fmt(f(st)));
+                let _ = write!(s, " {text:>9}");
+            }
+        };
+        let mm = |v: f64| format!("{v:.4}");
+        let rad = |v: f64| format!("{v:.3e}");
+        cols(
+            &mut s,
+            &c.tip_error_rms_mm,
+            &[|t| t.mean, |t| t.std, |t| t.min, |t| t.median, |t| t.max],
+            mm,
+        );
+        cols(
+            &mut s,
+            &c.tip_error_max_mm,
+            &[|t| t.mean, |t| t.std, |t| t.max],
+            mm,
+        );
+        cols(&mut s, &c.modal_error_rms_a1, &[|t| t.mean, |t| t.std], rad);
+        cols(&mut s, &c.modal_error_rms_a2, &[|t| t.mean, |t| t.std], rad);
+        s.push('\n');
+    }
+    let failures: Vec<_> = cells
+        .iter()
+        .flat_map(|c| c.failures.iter().map(move |f| (c, f)))
+        .collect();
+    if !failures.is_empty() {
+        let _ = writeln!(s, "{} runs stopped before the end:", failures.len());
+        for (c, f) in failures.iter().take(LISTED_FAILURES) {
+            let _ = writeln!(
+                s,
+                "  run {} ({}, L = {:.3e} rad, seed {}): {}",
+                f.index,
+                c.controller.name(),
+                c.noise_level,
+                f.seed,
+                f.error
+            );
+        }
+        if failures.len() > LISTED_FAILURES {
+            let _ = writeln!(
+                s,
+                "  ... and {} more (see summary.json)",
+                failures.len() - LISTED_FAILURES
+            );
+        }
+    }
+    s
+}
+
+/// `summary.json`: the configuration and the cells.
+pub fn summary_json(config: &SweepConfig, cells: &[Cell]) -> serde_json::Value {
+    json!({ "config": config, "cells": cells })
+}
+
+/// The plot: mean tip error RMS against the noise level per controller, with the band
+/// mean ± one standard deviation drawn as a closed outline. `Ok(false)` when no cell has a
+/// completed run (nothing to draw, no file written).
+pub fn plot(path: &Path, config: &SweepConfig, cells: &[Cell]) -> Result<bool, String> {
+    let mut means = Vec::new();
+    let mut bands = Vec::new();
+    for &controller in &config.controllers {
+        let stats: Vec<(f64, Stats)> = cells
+            .iter()
+            .filter(|c| c.controller == controller)
+            .filter_map(|c| c.tip_error_rms_mm.map(|s| (c.noise_level, s)))
+            .collect();
+        if stats.is_empty() {
+            continue;
+        }
+        means.push(Series {
+            label: format!("{controller}: mean"),
+            points: stats.iter().map(|(l, s)| (*l, s.mean)).collect(),
+        });
+        let upper = stats.iter().map(|(l, s)| (*l, s.mean + s.std));
+        let lower = stats.iter().rev().map(|(l, s)| (*l, s.mean - s.std));
+        let mut outline: Vec<(f64, f64)> = upper.chain(lower).collect();
+        outline.push(outline[0]);
+        bands.push(Series {
+            label: format!("{controller}: mean ± std"),
+            points: outline,
+        });
+    }
+    if means.is_empty() {
+        return Ok(false);
+    }
+    means.extend(bands);
+    let title = format!(
+        "{}: tip error RMS vs noise level ({} seeds)",
+        config.scenario.name, config.seeds
+    );
+    let labels = Labels {
+        title: &title,
+        x: "noise level: sensor noise std on (a1, a2) (rad)",
+        y: "tip error RMS (mm)",
+    };
+    line_chart(path, &labels, &means, None)?;
+    Ok(true)
+}
