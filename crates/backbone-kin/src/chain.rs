@@ -7,7 +7,7 @@
 //! is the midpoint rule applied to the end-point integral of eqs 3-4.
 
 use crate::error::KinError;
-use crate::validate::{check_len, check_length, check_output_len};
+use crate::validate::{check_len, check_link_lengths, check_output_len};
 
 /// Every joint position from the base to the tip: `positions[0]` is the base (the origin),
 /// `positions[i]` the distal end of link `i` (0-based: of `link_lengths[i - 1]`), and
@@ -64,11 +64,6 @@ fn walk(link_lengths: &[f64], theta: &[f64], mut visit: impl FnMut([f64; 2])) {
 }
 
 fn check_chain(link_lengths: &[f64], theta: &[f64]) -> Result<(), KinError> {
-    if link_lengths.is_empty() {
-        return Err(KinError::NoLinks);
-    }
-    for &length in link_lengths {
-        check_length("link length", length)?;
-    }
+    check_link_lengths(link_lengths)?;
     check_len("joint angles", theta, link_lengths.len())
 }

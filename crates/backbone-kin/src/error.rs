@@ -29,6 +29,18 @@ pub enum KinError {
     /// A modal family was asked for with zero harmonics.
     #[error("a modal family needs at least one harmonic")]
     NoHarmonics,
+    /// A modal map or solver was asked for more links ([`MAX_LINKS`](crate::MAX_LINKS)) or
+    /// harmonics ([`MAX_HARMONICS`](crate::MAX_HARMONICS)) than the crate allows; it would
+    /// otherwise allocate without bound.
+    #[error("at most {max} {what} are supported, got {got}")]
+    TooMany {
+        /// `"links"` or `"harmonics"`.
+        what: &'static str,
+        /// The number asked for.
+        got: usize,
+        /// The limit.
+        max: usize,
+    },
     /// A slice had the wrong number of entries.
     #[error("{name} has {got} entries, expected {expected}")]
     Dimension {

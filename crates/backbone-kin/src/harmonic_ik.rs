@@ -21,6 +21,7 @@
 
 use crate::curve::BackboneCurve;
 use crate::error::KinError;
+use crate::modal_map::check_harmonics;
 use crate::validate::{check_finite, check_len};
 
 /// Stopping rules of [`HarmonicIk::solve`].
@@ -90,9 +91,7 @@ impl HarmonicIk {
     /// A solver for curves of length `length` with `harmonics` harmonics (`2 * harmonics`
     /// unknowns) leaving the base at `alpha0`, with [`IkOptions::default`].
     pub fn new(length: f64, harmonics: usize, alpha0: f64) -> Result<Self, KinError> {
-        if harmonics == 0 {
-            return Err(KinError::NoHarmonics);
-        }
+        check_harmonics(harmonics)?;
         let m = 2 * harmonics;
         Ok(Self {
             curve: BackboneCurve::new(length, &vec![0.0; m], alpha0)?,

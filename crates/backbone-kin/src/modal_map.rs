@@ -13,7 +13,23 @@
 //! the map is affine with offset `theta_0 = alpha0 e_1`.
 
 use crate::error::KinError;
-use crate::validate::{check_finite, check_len, check_length, check_output_len};
+use crate::validate::{check_count, check_finite, check_len, check_link_lengths, check_output_len};
+
+/// The most links a [`ModalMap`] may have (the same limit as `manip_dyn::MAX_LINKS`): `J` has a
+/// row per link, so this bounds its memory.
+pub const MAX_LINKS: usize = 4096;
+
+/// The most harmonics a [`ModalMap`] or a [`HarmonicIk`](crate::HarmonicIk) may have. A map needs
+/// at least `2K` links to resolve `K` harmonics, so this is `MAX_LINKS / 2`.
+pub const MAX_HARMONICS: usize = MAX_LINKS / 2;
+
+/// At least one harmonic and at most [`MAX_HARMONICS`].
+pub(crate) fn check_harmonics(harmonics: usize) -> Result<(), KinError> {
+    if harmonics == 0 {
+        return Err(KinError::NoHarmonics);
+    }
+    check_count("harmonics", harmonics, MAX_HARMONICS)
+}
 
 /// Whether the base inclination `alpha0` is a modal coordinate or a fixed parameter.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,6 +42,9 @@ pub enum BaseAngle {
 
 /// `sin(2 pi k s / l)` and `1 - cos(2 pi k s / l)`: the contributions of the coordinates
 /// `a_{2k-1}` and `a_{2k}` to the inclination `alpha(s)` (eq 2 generalised to harmonic `k`).
+///
+/// `length` must be positive and finite (a mathematical primitive: like `f64::sin` it returns NaN
+/// outside its domain; [`ModalMap`] calls it only on validated lengths).
 ///
 /// Both come from one `sin_cos` of the half angle: `sin(x) = 2 sin(x/2) cos(x/2)` and
 /// `1 - cos(x) = 2 sin^2(x / 2)`, which keeps full relative accuracy near `s = 0`.
@@ -74,6 +93,7 @@ impl ModalMap {
         if n_links == 0 {
             return Err(KinError::NoLinks);
         }
+        check_count("links", n_links, MAX_LINKS)?;
         Self::new(&vec![1.0; n_links], harmonics, base)
     }
 
@@ -81,22 +101,15 @@ impl ModalMap {
     /// inclination at the arc length of its midpoint, `s_i = L_1 + ... + L_{i-1} + L_i / 2`,
     /// on a curve of length `l = L_1 + ... + L_n`.
     pub fn new(link_lengths: &[f64], harmonics: usize, base: BaseAngle) -> Result<Self, KinError> {
-        if link_lengths.is_empty() {
-            return Err(KinError::NoLinks);
-        }
-        if harmonics == 0 {
-            return Err(KinError::NoHarmonics);
-        }
-        for &len in link_lengths {
-            check_length("link length", len)?;
-        }
+        let length = check_link_lengths(link_lengths)?;
+        check_count("links", link_lengths.len(), MAX_LINKS)?;
+        check_harmonics(harmonics)?;
         if let BaseAngle::Fixed(alpha0) = base {
             check_finite("alpha0", alpha0)?;
         }
         let n = link_lengths.len();
         let n_modal = 2 * harmonics;
         let m = n_modal + usize::from(base == BaseAngle::Free);
-        let length: f64 = link_lengths.iter().sum();
         // Rows of the inclination map phi = Phi a (+ alpha0), then theta_i = phi_i - phi_{i-1}.
         let mut jacobian = vec![0.0; n * m];
         let mut previous = vec![0.0; m];
@@ -159,13 +172,19 @@ impl ModalMap {
     }
 
     /// Row `i` of `J` (joint `i`, 0-based).
+    ///
+    /// # Panics
+    /// If `i >= n_joints()`, like slice indexing.
     pub fn row(&self, i: usize) -> &[f64] {
         &self.jacobian[i * self.n_coords..(i + 1) * self.n_coords]
     }
 
     /// `J(i, j)`, 0-based.
+    ///
+    /// # Panics
+    /// If `i >= n_joints()` or `j >= n_coords()`, like slice indexing.
     pub fn entry(&self, i: usize, j: usize) -> f64 {
-        self.jacobian[i * self.n_coords + j]
+        self.row(i)[j]
     }
 
     /// The constant offset `theta_0` (zero unless `alpha0` is fixed).

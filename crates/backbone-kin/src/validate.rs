@@ -21,6 +21,29 @@ pub(crate) fn check_length(name: &'static str, value: f64) -> Result<(), KinErro
     }
 }
 
+/// Checks a chain's link lengths: at least one, each positive and finite, and a finite total
+/// (the curve length), which is returned.
+pub(crate) fn check_link_lengths(link_lengths: &[f64]) -> Result<f64, KinError> {
+    if link_lengths.is_empty() {
+        return Err(KinError::NoLinks);
+    }
+    for &length in link_lengths {
+        check_length("link length", length)?;
+    }
+    let total = link_lengths.iter().sum();
+    check_length("curve length (the sum of the link lengths)", total)?;
+    Ok(total)
+}
+
+/// Checks that `got` does not exceed `max`: `what` is `"links"` or `"harmonics"`.
+pub(crate) fn check_count(what: &'static str, got: usize, max: usize) -> Result<(), KinError> {
+    if got <= max {
+        Ok(())
+    } else {
+        Err(KinError::TooMany { what, got, max })
+    }
+}
+
 /// Checks that `values` has `expected` entries, all finite.
 pub(crate) fn check_len(
     name: &'static str,

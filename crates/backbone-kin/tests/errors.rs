@@ -23,10 +23,11 @@ fn variant(error: &KinError) -> &'static str {
         KinError::AtBase { .. } => "AtBase",
         KinError::A2ExceedsAmplitude { .. } => "A2ExceedsAmplitude",
         KinError::NotConverged { .. } => "NotConverged",
+        KinError::TooMany { .. } => "TooMany",
     }
 }
 
-const ALL: [&str; 13] = [
+const ALL: [&str; 14] = [
     "NonFinite",
     "NonPositiveLength",
     "NoLinks",
@@ -40,6 +41,7 @@ const ALL: [&str; 13] = [
     "AtBase",
     "A2ExceedsAmplitude",
     "NotConverged",
+    "TooMany",
 ];
 
 /// Each case: the error, the variant expected, and words its message must contain.
@@ -54,6 +56,11 @@ fn cases() -> Vec<(KinError, &'static str, Vec<&'static str>)> {
         })
         .unwrap();
     vec![
+        (
+            HarmonicIk::new(1.0, usize::MAX, 0.0).unwrap_err(),
+            "TooMany",
+            vec!["at most", "harmonics"],
+        ),
         (
             end_point(1.0, [f64::NAN, 0.0], 0.0).unwrap_err(),
             "NonFinite",

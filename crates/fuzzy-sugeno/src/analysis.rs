@@ -205,7 +205,7 @@ impl FuzzySystem {
         Ok(AnalysisReport {
             completeness: self.completeness(options)?,
             consistency: self.consistency(),
-            continuity: self.continuity(options.max_relative_jump),
+            continuity: self.continuity(options.max_relative_jump)?,
             names,
         })
     }
@@ -301,7 +301,7 @@ impl FuzzySystem {
         Consistency { conflicts }
     }
 
-    fn continuity(&self, max_relative_jump: f64) -> Continuity {
+    fn continuity(&self, max_relative_jump: f64) -> Result<Continuity, FuzzyError> {
         let positions: Vec<Vec<f64>> = self.inputs().iter().map(set_positions).collect();
         let ranks: Vec<Vec<usize>> = positions.iter().map(|p| ranks(p)).collect();
         let rules = self.rules();
@@ -343,8 +343,8 @@ impl FuzzySystem {
                     let (Some(ta), Some(tb)) = (a.consequents[o], b.consequents[o]) else {
                         continue;
                     };
-                    let jump = (output.terms[ta].function.value(&point)
-                        - output.terms[tb].function.value(&point))
+                    let jump = (output.terms[ta].function.value(&point)?
+                        - output.terms[tb].function.value(&point)?)
                     .abs();
                     let relative = jump / (output.range[1] - output.range[0]);
                     if largest[o].is_none_or(|l| jump > l.jump) {
@@ -359,10 +359,10 @@ impl FuzzySystem {
                 }
             }
         }
-        Continuity {
+        Ok(Continuity {
             max_relative_jump,
             outputs: largest,
-        }
+        })
     }
 }
 

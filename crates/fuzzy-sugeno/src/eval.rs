@@ -67,6 +67,8 @@ pub struct Evaluator {
     strengths: Vec<f64>,
     /// Each output term's value at `x`.
     term_values: Vec<f64>,
+    /// The outputs, copied to the caller's buffer only once all of them are valid.
+    y: Vec<f64>,
 }
 
 impl Evaluator {
@@ -80,6 +82,7 @@ impl Evaluator {
         let strengths = vec![0.0; c.weights.len()];
         let term_values = c.term_values.clone();
         let x = vec![0.0; system.inputs().len()];
+        let y = vec![0.0; system.outputs().len()];
         Self {
             system,
             options: EvalOptions::default(),
@@ -87,6 +90,7 @@ impl Evaluator {
             degrees,
             strengths,
             term_values,
+            y,
         }
     }
 
@@ -123,7 +127,7 @@ impl Evaluator {
     }
 
     /// Evaluates the system: `inputs` has one value per input variable, `outputs` one slot per
-    /// output variable.
+    /// output variable. On error `outputs` is left untouched.
     pub fn eval(&mut self, inputs: &[f64], outputs: &mut [f64]) -> Result<(), FuzzyError> {
         let n_out = self.system.outputs().len();
         if outputs.len() != n_out {
@@ -137,7 +141,8 @@ impl Evaluator {
     }
 
     /// Evaluates many input vectors: `inputs` holds rows of one value per input variable,
-    /// `outputs` the matching rows of one slot per output. An error names the failing row.
+    /// `outputs` the matching rows of one slot per output. An error names the failing row; the
+    /// rows before it hold their results, that row and the ones after it are left untouched.
     pub fn eval_batch(&mut self, inputs: &[f64], outputs: &mut [f64]) -> Result<(), FuzzyError> {
         let (n_in, n_out) = (self.system.inputs().len(), self.system.outputs().len());
         let rows = inputs.len() / n_in;
@@ -247,7 +252,8 @@ impl Evaluator {
         Ok(())
     }
 
-    /// Eq 21 (or the weighted sum) for every output, from the strengths of the last firing.
+    /// Eq 21 (or the weighted sum) for every output, from the strengths of the last firing;
+    /// `outputs` is written only if every output is valid.
     fn defuzzify(&mut self, outputs: &mut [f64]) -> Result<(), FuzzyError> {
         let c = self.system.compiled();
         let n_in = self.x.len();
@@ -259,7 +265,7 @@ impl Evaluator {
         let strengths = &self.strengths[..];
         let n_rules = strengths.len();
         let total_of_all: f64 = strengths.iter().sum();
-        for (o, output) in outputs.iter_mut().enumerate() {
+        for (o, output) in self.y.iter_mut().enumerate() {
             let row = o * n_rules..(o + 1) * n_rules;
             let weighted = strengths
                 .iter()
@@ -303,6 +309,7 @@ impl Evaluator {
             }
             *output = value;
         }
+        outputs.copy_from_slice(&self.y);
         Ok(())
     }
 }

@@ -320,14 +320,15 @@ impl<'a> Parser<'a> {
             error(header, format!("missing section [{what}] ({count})"))
         };
         let mut names: Vec<(String, usize)> = Vec::new();
-        let mut inputs = Vec::with_capacity(n_inputs);
+        // No capacity from the counts: they are untrusted (a missing section ends the loop early).
+        let mut inputs = Vec::new();
         for i in 1..=n_inputs {
             let section = self
                 .section(SectionKind::Input(i))
                 .ok_or_else(|| missing(format!("Input{i}"), format!("NumInputs={n_inputs}")))?;
             inputs.push(parse_input(section, &mut names)?);
         }
-        let mut outputs = Vec::with_capacity(n_outputs);
+        let mut outputs = Vec::new();
         for o in 1..=n_outputs {
             let section = self
                 .section(SectionKind::Output(o))
@@ -521,7 +522,8 @@ impl<'a> Keys<'a> {
         }) {
             return Err(error(line, format!("{key} but NumMFs={n}")));
         }
-        let mut functions: Vec<FunctionLine<'a>> = Vec::with_capacity(n);
+        // No capacity from `n`: it is untrusted (a missing MFk= line ends the loop early).
+        let mut functions: Vec<FunctionLine<'a>> = Vec::new();
         for k in 1..=n {
             let (line, value) = self.get(&format!("MF{k}"))?;
             let (name, kind, params) =
@@ -657,7 +659,10 @@ fn parse_rule(
     let Some((left, right)) = line.text.split_once(',') else {
         return Err(fail(format!("{shape}, found `{}` (no comma)", line.text)));
     };
-    let (Some(open), Some(close)) = (right.find('('), right.find(')')) else {
+    let Some((open, close)) = right
+        .find('(')
+        .and_then(|open| Some((open, open + right[open..].find(')')?)))
+    else {
         return Err(fail(format!(
             "{shape}, found `{}` (no weight in parentheses)",
             line.text

@@ -256,7 +256,8 @@ impl MembershipFn {
     }
 
     /// Checks the parameters: all finite, widths and sigmas positive, bell slope positive, the
-    /// corners of triangles and trapezoids in order, a constant degree within `[0, 1]`.
+    /// corners of triangles and trapezoids in order with feet apart (a zero-width set would be
+    /// a single point, where a rule could essentially never fire), a constant degree within `[0, 1]`.
     pub fn validate(&self) -> Result<(), FuzzyError> {
         let fail = |reason: String| {
             Err(FuzzyError::InvalidMembership {
@@ -294,6 +295,12 @@ impl MembershipFn {
                     format_params(&params)
                 ));
             }
+            Self::Triangle { left, right, .. } if left == right => {
+                return fail(format!(
+                    "zero width: the feet must satisfy a < c, got {}",
+                    format_params(&params)
+                ));
+            }
             Self::Trapezoid {
                 left_foot,
                 left_shoulder,
@@ -305,6 +312,16 @@ impl MembershipFn {
             {
                 return fail(format!(
                     "corners must satisfy a <= b <= c <= d, got {}",
+                    format_params(&params)
+                ));
+            }
+            Self::Trapezoid {
+                left_foot,
+                right_foot,
+                ..
+            } if left_foot == right_foot => {
+                return fail(format!(
+                    "zero width: the feet must satisfy a < d, got {}",
                     format_params(&params)
                 ));
             }
@@ -695,11 +712,8 @@ mod tests {
         assert_eq!(mu(left_shoulder, 0.0), 1.0);
         assert_eq!(mu(left_shoulder, -1e-12), 0.0);
         assert_eq!(mu(left_shoulder, 0.5), 0.5);
-        let spike = MembershipFn::triangle(0.5, 0.5, 0.5);
-        assert_eq!(
-            (mu(spike, 0.5), mu(spike, 0.49), mu(spike, 0.51)),
-            (1.0, 0.0, 0.0)
-        );
+        // A spike (a = b = c) has zero width: a rule on it would essentially never fire.
+        assert!(MembershipFn::triangle(0.5, 0.5, 0.5).validate().is_err());
 
         let z = MembershipFn::trapezoid(-1.0, 0.0, 1.0, 3.0);
         let expect = [

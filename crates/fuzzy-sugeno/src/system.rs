@@ -60,14 +60,24 @@ pub enum OutputFn {
 }
 
 impl OutputFn {
-    /// The consequent's value at `inputs` (one value per input variable).
-    pub fn value(&self, inputs: &[f64]) -> f64 {
+    /// The consequent's value at `inputs` (one value per input variable); a linear consequent
+    /// refuses a slice of another length with [`FuzzyError::InputCount`]. Non-finite inputs give
+    /// a non-finite value ([`Evaluator`](crate::Evaluator) refuses those before it gets here).
+    pub fn value(&self, inputs: &[f64]) -> Result<f64, FuzzyError> {
         match self {
-            Self::Constant(c) => *c,
+            Self::Constant(c) => Ok(*c),
             Self::Linear {
                 coefficients,
                 constant,
-            } => affine(coefficients, *constant, inputs),
+            } => {
+                if coefficients.len() != inputs.len() {
+                    return Err(FuzzyError::InputCount {
+                        expected: coefficients.len(),
+                        got: inputs.len(),
+                    });
+                }
+                Ok(affine(coefficients, *constant, inputs))
+            }
         }
     }
 }

@@ -1,13 +1,15 @@
 //! `hrm eval`: a JSON-lines request/answer protocol for scripts in other languages.
 //!
-//! One JSON object per input line, one JSON object per output line, in order, flushed after each.
-//! A request may carry `"id"`, echoed in its answer. A bad request gets
-//! `{"id": ..., "error": {"kind": "...", "message": "..."}}` and the stream goes on. The protocol
+//! One JSON object per input line (blank lines skipped), one JSON object per output line, in
+//! order, flushed after each. A request may carry `"id"`, echoed in its answer (`null` if absent);
+//! every answer has `"ok": true` or `"ok": false`. A bad request gets
+//! `{"id": ..., "ok": false, "error": {"kind": "...", "message": "..."}}` and the stream goes on. The protocol
 //! is documented in `docs/eval-protocol.md`.
 
 use backbone_kin::{
     BaseAngle, Branch, KinError, ModalMap, end_point, inverse_kinematics, tip_position,
 };
+use fuzzy_sugeno::FuzzySystem;
 use manip_dyn::faer::Mat;
 use manip_dyn::{ChainData, ChainModel, DynError};
 use modal_reduce::{ReduceError, ReducedData, ReducedModel};
@@ -142,7 +144,7 @@ impl EvalError {
 type EvalResult = Result<Map<String, Value>, EvalError>;
 
 fn error_answer(id: Value, error: &EvalError) -> Value {
-    json!({"id": id, "error": {"kind": error.kind.as_str(), "message": error.message}})
+    json!({"id": id, "ok": false, "error": {"kind": error.kind.as_str(), "message": error.message}})
 }
 
 /// Answers one request line.
@@ -182,9 +184,8 @@ fn answer(line: &[u8]) -> Value {
     };
     match result {
         Ok(mut fields) => {
-            if let Some(id) = id {
-                fields.insert("id".to_string(), id);
-            }
+            fields.insert("id".to_string(), id.unwrap_or(Value::Null));
+            fields.insert("ok".to_string(), Value::Bool(true));
             Value::Object(fields)
         }
         Err(error) => error_answer(id.unwrap_or(Value::Null), &error),
@@ -470,7 +471,7 @@ fn fuzzy(request: FuzzyRequest) -> EvalResult {
                 "unknown controller {other:?}; known: \"paper\""
             )));
         }
-        (None, Some(text)) => crate::fis_cmd::load_system(&text).map_err(EvalError::input)?,
+        (None, Some(text)) => FuzzySystem::from_fis(&text).map_err(EvalError::input)?,
         _ => {
             return Err(EvalError::new(
                 Kind::InvalidRequest,

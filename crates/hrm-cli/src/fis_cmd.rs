@@ -122,8 +122,8 @@ pub fn run(args: FisArgs) -> Result<(), String> {
     }
 }
 
-/// Parses the text of a `.fis` file (for `hrm eval`'s `fuzzy` op and the subcommands).
-pub fn load_system(text: &str) -> Result<FuzzySystem, String> {
+/// Parses the text of a `.fis` file.
+fn load_system(text: &str) -> Result<FuzzySystem, String> {
     FuzzySystem::from_fis(text).map_err(|e| e.to_string())
 }
 

@@ -61,11 +61,7 @@ pub fn aba(
     tau: &[f64],
     qdd: &mut [f64],
 ) -> Result<(), DynError> {
-    let n = model.n_links();
-    check::workspace(model, data)?;
-    check::input("q", q, n)?;
-    check::input("v", v, n)?;
-    check::input("tau", tau, n)?;
+    let n = check::inputs(model, data, &[("q", q), ("v", v), ("tau", tau)])?;
     check::output("qdd", qdd, n)?;
     update_frames(&mut data.frames, q, Some(v));
     // The composite inertias about each joint (the diagonal of M) are the scale of the pivots.

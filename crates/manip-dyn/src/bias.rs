@@ -18,10 +18,7 @@ pub fn coriolis(
     v: &[f64],
     out: &mut [f64],
 ) -> Result<(), DynError> {
-    let n = model.n_links();
-    check::workspace(model, data)?;
-    check::input("q", q, n)?;
-    check::input("v", v, n)?;
+    let n = check::inputs(model, data, &[("q", q), ("v", v)])?;
     check::output("out", out, n)?;
     newton_euler(model, data, q, Some(v), None, 0.0, out);
     check::finite_result("coriolis", out)
@@ -38,9 +35,7 @@ pub fn gravity(
     q: &[f64],
     out: &mut [f64],
 ) -> Result<(), DynError> {
-    let n = model.n_links();
-    check::workspace(model, data)?;
-    check::input("q", q, n)?;
+    let n = check::inputs(model, data, &[("q", q)])?;
     check::output("out", out, n)?;
     newton_euler(model, data, q, None, None, model.gravity(), out);
     check::finite_result("gravity", out)
@@ -58,10 +53,7 @@ pub fn nonlinear_effects(
     v: &[f64],
     out: &mut [f64],
 ) -> Result<(), DynError> {
-    let n = model.n_links();
-    check::workspace(model, data)?;
-    check::input("q", q, n)?;
-    check::input("v", v, n)?;
+    let n = check::inputs(model, data, &[("q", q), ("v", v)])?;
     check::output("out", out, n)?;
     newton_euler(model, data, q, Some(v), None, model.gravity(), out);
     check::finite_result("nonlinear effects", out)

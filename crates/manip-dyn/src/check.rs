@@ -7,7 +7,7 @@ use crate::error::DynError;
 use crate::model::ChainModel;
 
 /// The workspace must have been built for a chain with as many links as `model`.
-pub(crate) fn workspace(model: &ChainModel, data: &ChainData) -> Result<(), DynError> {
+fn workspace(model: &ChainModel, data: &ChainData) -> Result<(), DynError> {
     length(
         "data (a ChainData built for another model)",
         data.n_links(),
@@ -15,8 +15,23 @@ pub(crate) fn workspace(model: &ChainModel, data: &ChainData) -> Result<(), DynE
     )
 }
 
+/// The preamble of every algorithm: `data` built for `model` and each named input `n` finite
+/// entries. Returns `n`; callers check their output's size next, before writing anything.
+pub(crate) fn inputs(
+    model: &ChainModel,
+    data: &ChainData,
+    inputs: &[(&'static str, &[f64])],
+) -> Result<usize, DynError> {
+    let n = model.n_links();
+    workspace(model, data)?;
+    for &(name, x) in inputs {
+        input(name, x, n)?;
+    }
+    Ok(n)
+}
+
 /// An input vector of `n` finite entries.
-pub(crate) fn input(name: &'static str, x: &[f64], n: usize) -> Result<(), DynError> {
+fn input(name: &'static str, x: &[f64], n: usize) -> Result<(), DynError> {
     length(name, x.len(), n)?;
     match x.iter().position(|value| !value.is_finite()) {
         Some(index) => Err(DynError::NonFinite {

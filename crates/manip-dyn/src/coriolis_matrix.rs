@@ -63,10 +63,7 @@ pub fn coriolis_matrix(
     v: &[f64],
     mut out: MatMut<'_, f64>,
 ) -> Result<(), DynError> {
-    let n = model.n_links();
-    check::workspace(model, data)?;
-    check::input("q", q, n)?;
-    check::input("v", v, n)?;
+    let n = check::inputs(model, data, &[("q", q), ("v", v)])?;
     check::square_output(&out, n)?;
     update_frames(&mut data.frames, q, Some(v));
     accumulate_subtrees(model, &data.frames, &mut data.subtrees);

@@ -50,9 +50,8 @@ pub fn mass_matrix(
     q: &[f64],
     mut out: MatMut<'_, f64>,
 ) -> Result<(), DynError> {
-    check::workspace(model, data)?;
-    check::input("q", q, model.n_links())?;
-    check::square_output(&out, model.n_links())?;
+    let n = check::inputs(model, data, &[("q", q)])?;
+    check::square_output(&out, n)?;
     update_frames(&mut data.frames, q, None);
     assemble(
         model,

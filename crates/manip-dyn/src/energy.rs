@@ -31,10 +31,7 @@ pub fn kinetic_energy(
     q: &[f64],
     v: &[f64],
 ) -> Result<f64, DynError> {
-    let n = model.n_links();
-    check::workspace(model, data)?;
-    check::input("q", q, n)?;
-    check::input("v", v, n)?;
+    check::inputs(model, data, &[("q", q), ("v", v)])?;
     update_frames(&mut data.frames, q, Some(v));
     let mut joint_velocity = [0.0, 0.0];
     let mut energy = 0.0;
@@ -75,8 +72,7 @@ pub fn potential_energy(
     data: &mut ChainData,
     q: &[f64],
 ) -> Result<f64, DynError> {
-    check::workspace(model, data)?;
-    check::input("q", q, model.n_links())?;
+    check::inputs(model, data, &[("q", q)])?;
     update_frames(&mut data.frames, q, None);
     let mut joint_height = 0.0;
     let mut weighted_height = 0.0;

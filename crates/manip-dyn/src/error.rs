@@ -6,12 +6,21 @@ pub enum DynError {
     /// A chain was asked for with zero links.
     #[error("a chain needs at least one link")]
     NoLinks,
+    /// A chain was asked for with more than [`MAX_LINKS`](crate::model::MAX_LINKS) links.
+    #[error("a chain may have at most {max} links, got {got}")]
+    TooManyLinks {
+        /// The number of links asked for.
+        got: usize,
+        /// The limit.
+        max: usize,
+    },
     /// A link parameter was out of its domain.
     #[error("link {index}: {quantity} must be {requirement}, got {value}")]
     InvalidLink {
         /// 0-based link index.
         index: usize,
-        /// Which parameter (`"length"`, `"mass"`, `"inertia"`, `"centre of mass"`).
+        /// Which parameter (`"length"`, `"mass"`, `"inertia"`, `"centre of mass"`, `"inertia
+        /// about the joint (inertia + mass * com^2)"`).
         quantity: &'static str,
         /// What it must be.
         requirement: &'static str,

@@ -43,11 +43,7 @@ pub fn forward_dynamics(
     tau: &[f64],
     qdd: &mut [f64],
 ) -> Result<(), DynError> {
-    let n = model.n_links();
-    check::workspace(model, data)?;
-    check::input("q", q, n)?;
-    check::input("v", v, n)?;
-    check::input("tau", tau, n)?;
+    let n = check::inputs(model, data, &[("q", q), ("v", v), ("tau", tau)])?;
     check::output("qdd", qdd, n)?;
 
     newton_euler(model, data, q, Some(v), None, model.gravity(), qdd);

@@ -53,5 +53,5 @@ pub use data::ChainData;
 pub use energy::{kinetic_energy, potential_energy};
 pub use error::DynError;
 pub use forward_dynamics::forward_dynamics;
-pub use model::{ChainModel, Link};
+pub use model::{ChainModel, Link, MAX_LINKS};
 pub use rnea::rnea;

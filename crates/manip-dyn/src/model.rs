@@ -11,7 +11,10 @@ pub struct Link {
     pub mass: f64,
     /// Distance of the centre of mass from the link's joint, along the link (m).
     pub com: f64,
-    /// Moment of inertia about the centre of mass, about `z` (kg m^2), positive.
+    /// Moment of inertia about the centre of mass, about `z` (kg m^2), non-negative: zero is a
+    /// point mass, allowed as long as the link's inertia about its own joint, `inertia + mass *
+    /// com^2`, is positive (a point mass must sit off the joint axis, or the joint would drive
+    /// nothing and the mass matrix would be singular).
     pub inertia: f64,
 }
 
@@ -34,32 +37,41 @@ impl Link {
     }
 
     fn validate(&self, index: usize) -> Result<(), DynError> {
-        let positive = [
-            ("length", self.length),
-            ("mass", self.mass),
-            ("inertia", self.inertia),
-        ];
-        for (quantity, value) in positive {
+        let invalid = |quantity, requirement, value| {
+            Err(DynError::InvalidLink {
+                index,
+                quantity,
+                requirement,
+                value,
+            })
+        };
+        for (quantity, value) in [("length", self.length), ("mass", self.mass)] {
             if !(value.is_finite() && value > 0.0) {
-                return Err(DynError::InvalidLink {
-                    index,
-                    quantity,
-                    requirement: "positive and finite",
-                    value,
-                });
+                return invalid(quantity, "positive and finite", value);
             }
         }
+        if !(self.inertia.is_finite() && self.inertia >= 0.0) {
+            return invalid("inertia", "non-negative and finite", self.inertia);
+        }
         if !self.com.is_finite() {
-            return Err(DynError::InvalidLink {
-                index,
-                quantity: "centre of mass",
-                requirement: "finite",
-                value: self.com,
-            });
+            return invalid("centre of mass", "finite", self.com);
+        }
+        let about_joint = self.inertia + self.mass * self.com * self.com;
+        if about_joint <= 0.0 {
+            return invalid(
+                "inertia about the joint (inertia + mass * com^2)",
+                "positive (a point mass must sit off the joint)",
+                about_joint,
+            );
         }
         Ok(())
     }
 }
+
+/// The most links a chain may have. A [`ChainData`](crate::ChainData) holds an `n x n` mass
+/// matrix, 128 MiB at this limit; a larger `n` is refused with [`DynError::TooManyLinks`] rather
+/// than risk aborting the process on a failed allocation.
+pub const MAX_LINKS: usize = 4096;
 
 /// A planar serial chain of revolute joints under gravity along `-y`.
 ///
@@ -75,9 +87,7 @@ pub struct ChainModel {
 impl ChainModel {
     /// A chain of the given links, with gravitational acceleration `gravity` (m/s^2) along `-y`.
     pub fn new(links: Vec<Link>, gravity: f64) -> Result<Self, DynError> {
-        if links.is_empty() {
-            return Err(DynError::NoLinks);
-        }
+        check_link_count(links.len())?;
         for (index, link) in links.iter().enumerate() {
             link.validate(index)?;
         }
@@ -96,9 +106,7 @@ impl ChainModel {
     /// # Ok::<(), manip_dyn::DynError>(())
     /// ```
     pub fn uniform(n: usize, length: f64, mass: f64, gravity: f64) -> Result<Self, DynError> {
-        if n == 0 {
-            return Err(DynError::NoLinks);
-        }
+        check_link_count(n)?;
         Self::new(vec![Link::uniform_beam(length, mass)?; n], gravity)
     }
 
@@ -125,5 +133,17 @@ impl ChainModel {
     /// The link lengths, base first.
     pub fn link_lengths(&self) -> impl ExactSizeIterator<Item = f64> + '_ {
         self.links.iter().map(|l| l.length)
+    }
+}
+
+/// At least one link and at most [`MAX_LINKS`].
+fn check_link_count(n: usize) -> Result<(), DynError> {
+    match n {
+        0 => Err(DynError::NoLinks),
+        n if n > MAX_LINKS => Err(DynError::TooManyLinks {
+            got: n,
+            max: MAX_LINKS,
+        }),
+        _ => Ok(()),
     }
 }

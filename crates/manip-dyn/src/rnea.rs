@@ -47,11 +47,7 @@ pub fn rnea(
     a: &[f64],
     tau: &mut [f64],
 ) -> Result<(), DynError> {
-    let n = model.n_links();
-    check::workspace(model, data)?;
-    check::input("q", q, n)?;
-    check::input("v", v, n)?;
-    check::input("a", a, n)?;
+    let n = check::inputs(model, data, &[("q", q), ("v", v), ("a", a)])?;
     check::output("tau", tau, n)?;
     newton_euler(model, data, q, Some(v), Some(a), model.gravity(), tau);
     check::finite_result("tau", tau)

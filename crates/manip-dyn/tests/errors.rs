@@ -380,7 +380,7 @@ fn invalid_models_are_refused() {
         ),
         (
             Link {
-                inertia: 0.0,
+                inertia: -1.0,
                 ..good
             },
             "inertia",

@@ -45,6 +45,9 @@ impl Record {
     }
 
     /// The joint torques of sample `k` (N m).
+    ///
+    /// # Panics
+    /// If `k >= len()`, like slice indexing.
     pub fn joint_torques_at(&self, k: usize) -> &[f64] {
         &self.joint_torques[k * self.n_joints..(k + 1) * self.n_joints]
     }
@@ -65,6 +68,11 @@ pub(crate) struct Sample {
 }
 
 impl Record {
+    /// The numbers one recorded sample holds: `t`, eight pairs, and a torque per joint.
+    pub(crate) fn values_per_sample(n_joints: usize) -> usize {
+        17 + n_joints
+    }
+
     pub(crate) fn with_capacity(n_joints: usize, samples: usize) -> Self {
         Self {
             n_joints,

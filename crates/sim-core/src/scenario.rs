@@ -70,6 +70,9 @@ const BUILTIN: &[(&str, &str)] = &[
     ),
 ];
 
+/// The most controller samples a scenario may ask for (days of computation).
+const MAX_CONTROLLER_SAMPLES: f64 = 1e12;
+
 /// Why a scenario could not be read.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ScenarioError {
@@ -113,8 +116,9 @@ pub struct Scenario {
     pub duration: f64,
     /// The fixed base inclination `alpha0` (rad).
     pub alpha0: f64,
-    /// Seed of the noise sources.
-    #[serde(default)]
+    /// Seed of the noise sources. TOML integers stop at `2^63 - 1`: larger seeds are written
+    /// (and may be given) as a decimal string, `seed = "18446744073709551615"`.
+    #[serde(default, with = "seed_text")]
     pub seed: u64,
     /// Recording period (s); default: the controller period.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -529,7 +533,8 @@ impl Scenario {
     }
 
     /// Builds the simulation: checks every setting and the whole reference path, loads the
-    /// `.fis` file if any. Errors name the setting that failed.
+    /// `.fis` file if any. Errors name the setting that failed. A duration of more than `10^12`
+    /// controller periods is refused (a run that would not end).
     pub fn build(&self) -> Result<Simulation, SimError> {
         let model = self.model()?;
         let reference = self
@@ -546,6 +551,17 @@ impl Scenario {
                 ));
             }
         };
+        // A guard against typos like 1e300 for 1e3: such a run would never end (and its sample
+        // count would overflow).
+        if self.duration / period > MAX_CONTROLLER_SAMPLES {
+            return Err(SimError::setting(
+                "duration",
+                format!(
+                    "must be at most {MAX_CONTROLLER_SAMPLES:e} controller periods ({period} s), got {:e} s",
+                    self.duration
+                ),
+            ));
+        }
         let mut settings = LoopSettings::new(self.integrator.build(), period, self.duration);
         settings.record_period = self.record_period.unwrap_or(period);
         settings.seed = self.seed;
@@ -569,7 +585,8 @@ impl Scenario {
 impl ArmSpec {
     /// The chain: `links` uniform beams of `link_length` and `link_mass` (the paper's by
     /// default), with per-link `lengths`, `masses` and `inertias` overriding; all given sizes must
-    /// agree.
+    /// agree, and the arm has between 1 and [`manip_dyn::MAX_LINKS`] links, checked before any
+    /// per-link array is allocated.
     pub fn to_chain(&self) -> Result<ChainModel, SimError> {
         let mut n = self.links;
         for (name, array) in [
@@ -592,6 +609,12 @@ impl ArmSpec {
         let n = n.unwrap_or(10);
         if n == 0 {
             return Err(SimError::setting("arm.links", "must be at least 1"));
+        }
+        if n > manip_dyn::MAX_LINKS {
+            return Err(SimError::setting(
+                "arm.links",
+                format!("must be at most {}, got {n}", manip_dyn::MAX_LINKS),
+            ));
         }
         let per_link = |array: &Option<Vec<f64>>, scalar: f64| match array {
             Some(values) => values.clone(),
@@ -739,6 +762,54 @@ impl IntegratorSpec {
                     ..defaults
                 })
             }
+        }
+    }
+}
+
+/// A `u64` seed as a TOML integer when it fits one (`i64`), else as a decimal string.
+mod seed_text {
+    use serde::de::{Error, Visitor};
+    use serde::{Deserializer, Serializer};
+    use std::fmt;
+
+    pub fn serialize<S: Serializer>(seed: &u64, serializer: S) -> Result<S::Ok, S::Error> {
+        match i64::try_from(*seed) {
+            Ok(seed) => serializer.serialize_i64(seed),
+            Err(_) => serializer.serialize_str(&seed.to_string()),
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<u64, D::Error> {
+        deserializer.deserialize_any(SeedVisitor)
+    }
+
+    struct SeedVisitor;
+
+    impl Visitor<'_> for SeedVisitor {
+        type Value = u64;
+
+        fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            f.write_str(
+                "a seed: an integer from 0 to 18446744073709551615 (as a string above 2^63 - 1)",
+            )
+        }
+
+        fn visit_u64<E: Error>(self, seed: u64) -> Result<u64, E> {
+            Ok(seed)
+        }
+
+        fn visit_i64<E: Error>(self, seed: i64) -> Result<u64, E> {
+            u64::try_from(seed)
+                .map_err(|_| E::custom(format!("seed must not be negative, got {seed}")))
+        }
+
+        fn visit_str<E: Error>(self, seed: &str) -> Result<u64, E> {
+            seed.parse().map_err(|_| {
+                E::custom(format!(
+                    "seed must be an integer from 0 to {}, got \"{seed}\"",
+                    u64::MAX
+                ))
+            })
         }
     }
 }

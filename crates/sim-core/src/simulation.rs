@@ -240,8 +240,7 @@ impl Simulation {
     pub fn run(&mut self) -> Result<Run, Box<RunFailure>> {
         let s = &self.settings;
         let period = s.controller_period;
-        let samples = whole_ratio(s.duration, period).unwrap_or(0);
-        let record_every = whole_ratio(s.record_period, period).unwrap_or(1).max(1);
+        let (samples, record_every) = sample_counts(s);
         let mut stepper = match s.integrator {
             Integrator::Rk4 { dt } => Stepper::Rk4(Rk4::new(4), dt),
             Integrator::DormandPrince(tol) => Stepper::DormandPrince(DormandPrince::new(4, tol)),
@@ -250,7 +249,7 @@ impl Simulation {
             GaussianNoise::new(s.seed, REFERENCE_NOISE_STREAM, s.reference_noise_std);
         let mut sensor_noise = GaussianNoise::new(s.seed, SENSOR_NOISE_STREAM, s.sensor_noise_std);
         let n = self.plant.model.n_links();
-        let mut record = Record::with_capacity(n, samples / record_every + 2);
+        let mut record = Record::with_capacity(n, recorded_samples(s));
         let mut metrics = Metrics::new(n, s.joint_torque_limits.clone());
         let (mut steps, mut rejected) = (0, 0);
         let mut y = [
@@ -439,6 +438,26 @@ fn whole_ratio(numerator: f64, denominator: f64) -> Option<usize> {
         .then_some(rounded as usize)
 }
 
+/// The most numbers a run may record (1 GiB of `f64`): [`Simulation::new`] refuses a duration and
+/// recording period that would record more, instead of failing to allocate during the run.
+pub const MAX_RECORDED_VALUES: usize = 1 << 27;
+
+/// How many samples a run of valid settings records (the `+ 2` covers the initial sample and
+/// a failing one).
+fn recorded_samples(s: &LoopSettings) -> usize {
+    let (samples, record_every) = sample_counts(s);
+    (samples / record_every).saturating_add(2)
+}
+
+/// The controller samples of a run and how many of them make one recording period.
+fn sample_counts(s: &LoopSettings) -> (usize, usize) {
+    let samples = whole_ratio(s.duration, s.controller_period).unwrap_or(0);
+    let record_every = whole_ratio(s.record_period, s.controller_period)
+        .unwrap_or(1)
+        .max(1);
+    (samples, record_every)
+}
+
 /// Checks the settings of a loop for a chain of `n_links`.
 fn validate(s: &LoopSettings, n_links: usize) -> Result<(), SimError> {
     check_positive("controller.period", s.controller_period)?;
@@ -475,16 +494,9 @@ fn validate(s: &LoopSettings, n_links: usize) -> Result<(), SimError> {
                 ));
             }
         }
-        Integrator::DormandPrince(tol) => {
-            check_positive("integrator.rtol", tol.rtol)?;
-            check_positive("integrator.atol", tol.atol)?;
-            if tol.h_max.is_nan() || tol.h_max <= 0.0 {
-                return Err(SimError::setting(
-                    "integrator.h_max",
-                    format!("must be positive, got {}", tol.h_max),
-                ));
-            }
-        }
+        Integrator::DormandPrince(tol) => tol
+            .check()
+            .map_err(|reason| SimError::setting("integrator", format!("setting: {reason}")))?,
     }
     for v in s.reference_noise_std {
         check_non_negative("noise.reference_std", v)?;
@@ -496,6 +508,17 @@ fn validate(s: &LoopSettings, n_links: usize) -> Result<(), SimError> {
         return Err(SimError::setting(
             "limits.max_modal_error",
             format!("must be positive, got {}", s.max_modal_error),
+        ));
+    }
+    let recorded = recorded_samples(s).saturating_mul(Record::values_per_sample(n_links));
+    if recorded > MAX_RECORDED_VALUES {
+        return Err(SimError::setting(
+            "record_period",
+            format!(
+                "would record {recorded} numbers over {} s, more than the {MAX_RECORDED_VALUES} \
+                 a run may hold: record less often or simulate less",
+                s.duration
+            ),
         ));
     }
     if let Some(limits) = &s.joint_torque_limits {

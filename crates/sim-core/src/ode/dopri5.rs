@@ -82,32 +82,26 @@ impl Default for Tolerances {
 }
 
 impl Tolerances {
-    fn validate<E>(&self) -> Result<(), OdeError<E>> {
+    /// The condition the settings fail, if any (checked by every
+    /// [`DormandPrince::integrate`] call and when a simulation is built).
+    pub(crate) fn check(&self) -> Result<(), &'static str> {
         let positive = |v: f64| v.is_finite() && v > 0.0;
         if !(positive(self.rtol) && positive(self.atol)) {
-            return Err(OdeError::InvalidSetting(
-                "rtol and atol must be positive and finite",
-            ));
+            return Err("rtol and atol must be positive and finite");
         }
         if !(self.h_min >= 0.0 && self.h_min.is_finite()) {
-            return Err(OdeError::InvalidSetting(
-                "h_min must be non-negative and finite",
-            ));
+            return Err("h_min must be non-negative and finite");
         }
         if !(self.h_max > 0.0 && self.h_max >= self.h_min) {
-            return Err(OdeError::InvalidSetting(
-                "h_max must be positive and at least h_min",
-            ));
+            return Err("h_max must be positive and at least h_min");
         }
         if let Some(h) = self.h_init
             && !positive(h)
         {
-            return Err(OdeError::InvalidSetting(
-                "h_init must be positive and finite",
-            ));
+            return Err("h_init must be positive and finite");
         }
         if self.max_steps == 0 {
-            return Err(OdeError::InvalidSetting("max_steps must be at least 1"));
+            return Err("max_steps must be at least 1");
         }
         Ok(())
     }
@@ -192,7 +186,7 @@ impl DormandPrince {
         y: &mut [f64],
     ) -> Result<Stats, OdeError<S::Error>> {
         check_call(self.dim(), y, t0, t1)?;
-        self.tolerances.validate()?;
+        self.tolerances.check().map_err(OdeError::InvalidSetting)?;
         let tol = self.tolerances;
         let mut stats = Stats::default();
         if t1 == t0 {
