@@ -1,4 +1,5 @@
 //! `hrm`: the command line of the hyper-redundant manipulator toolkit.
+#![deny(missing_docs)]
 
 mod eval;
 mod experiment;
