@@ -28,8 +28,9 @@ pub fn modal_responses(
             label: kind.name().into(),
             points: thin(&run.record, |r, k| (r.t[k], r.a[k][i])),
         });
-        std::iter::once(reference)
-            .chain(controllers)
+        // The reference last, so that it is drawn on top of a controller that tracks it exactly.
+        controllers
+            .chain(std::iter::once(reference))
             .collect::<Vec<_>>()
     };
     let (a1, a2) = (coordinate(0), coordinate(1));
