@@ -42,4 +42,7 @@ pub use scenario::{
     ArmSpec, BranchSpec, ControllerKind, ControllerSpec, InitialSpec, IntegratorSpec, LimitsSpec,
     NoiseSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec, TorqueLimit,
 };
-pub use simulation::{Integrator, LoopSettings, MAX_RECORDED_VALUES, Run, RunFailure, Simulation};
+pub use simulation::{
+    Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, Run, RunFailure,
+    Simulation,
+};

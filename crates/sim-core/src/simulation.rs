@@ -163,8 +163,9 @@ impl Simulation {
     /// Fails with [`SimError::InvalidSetting`] for a model with another coordinate set, and for
     /// settings out of their domain: non-positive periods or duration, periods that are not
     /// whole multiples (controller period of the RK4 step, duration and recording period of the
-    /// controller period), negative or non-finite noise, a non-positive error bound, or torque
-    /// limits of the wrong length or sign.
+    /// controller period), a duration of more than [`MAX_CONTROLLER_SAMPLES`] periods or a
+    /// record of more than [`MAX_RECORDED_VALUES`] numbers, negative or non-finite noise, a
+    /// non-positive error bound, or torque limits of the wrong length or sign.
     pub fn new(
         model: ReducedModel,
         reference: Box<dyn Reference>,
@@ -438,6 +439,10 @@ fn whole_ratio(numerator: f64, denominator: f64) -> Option<usize> {
         .then_some(rounded as usize)
 }
 
+/// The most controller samples a run may take: a guard against typos like `1e300` for `1e3`,
+/// whose run would never end and whose sample count would not fit a `usize`.
+pub const MAX_CONTROLLER_SAMPLES: f64 = 1e12;
+
 /// The most numbers a run may record (1 GiB of `f64`): [`Simulation::new`] refuses a duration and
 /// recording period that would record more, instead of failing to allocate during the run.
 pub const MAX_RECORDED_VALUES: usize = 1 << 27;
@@ -463,6 +468,15 @@ fn validate(s: &LoopSettings, n_links: usize) -> Result<(), SimError> {
     check_positive("controller.period", s.controller_period)?;
     check_positive("duration", s.duration)?;
     check_positive("record_period", s.record_period)?;
+    if s.duration / s.controller_period > MAX_CONTROLLER_SAMPLES {
+        return Err(SimError::setting(
+            "duration",
+            format!(
+                "must be at most {MAX_CONTROLLER_SAMPLES:e} controller periods ({} s), got {:e} s",
+                s.controller_period, s.duration
+            ),
+        ));
+    }
     if whole_ratio(s.duration, s.controller_period).is_none() {
         return Err(SimError::setting(
             "duration",

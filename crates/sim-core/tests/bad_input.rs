@@ -8,7 +8,9 @@ use modal_reduce::ReducedModel;
 use sim_core::controller::{ComputedTorque, FuzzyController, PdController};
 use sim_core::ode::{DormandPrince, OdeError, OdeSystem, Rk4, Tolerances};
 use sim_core::reference::{CartesianPath, PathShape, Sinusoid, Step};
-use sim_core::{Integrator, LoopSettings, MAX_RECORDED_VALUES, SimError, Simulation};
+use sim_core::{
+    Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, SimError, Simulation,
+};
 use std::f64::consts::FRAC_PI_2;
 
 fn paper_model() -> ReducedModel {
@@ -220,6 +222,25 @@ fn torque_limits_wrong_length_or_not_positive() {
         };
         assert_eq!(invalid(build(s)).0, "limits.joint_torque_nm", "{bad}");
     }
+}
+
+#[test]
+fn run_that_would_never_end() {
+    // Recording only at the end keeps the record small, so only the sample count refuses it.
+    let s = LoopSettings {
+        duration: 1e300,
+        record_period: 1e300,
+        ..settings()
+    };
+    let (name, message) = invalid(build(s));
+    assert_eq!(name, "duration");
+    assert_eq!(
+        message,
+        format!(
+            "duration must be at most {MAX_CONTROLLER_SAMPLES:e} controller periods (0.001 s), \
+             got 1e300 s"
+        )
+    );
 }
 
 #[test]
