@@ -8,10 +8,12 @@ use sim_core::{ControllerKind, ReferenceSpec, Run, Scenario};
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// One finished (or stopped) run: its scenario, controller and outcome.
+/// One finished (or stopped) run: its scenario, controller, the names of its modal
+/// coordinates and its outcome.
 struct Outcome {
     scenario: String,
     controller: ControllerKind,
+    coordinates: Vec<String>,
     result: Result<Run, String>,
 }
 
@@ -132,10 +134,11 @@ fn figures(
         let name = &scenario.name;
         if !matches!(scenario.reference, ReferenceSpec::Path { .. }) {
             let file = format!("fig9_{name}.svg");
-            figures::modal_responses(&dir.join(&file), name, &runs)?;
+            let names = scenario.coordinate_names();
+            figures::modal_responses(&dir.join(&file), name, &names, &runs)?;
             responses.push(figure(
                 file,
-                format!("{name}: a1(t) and a2(t) of every controller against the reference (paper Figure 9). Scenario: {}", scenario.description),
+                format!("{name}: {}(t) of every controller against the reference (paper Figure 9). Scenario: {}", names.join("(t), "), scenario.description),
             ));
             continue;
         }
@@ -220,6 +223,7 @@ fn run_one(scenario: &Scenario, kind: ControllerKind) -> Outcome {
     Outcome {
         scenario: scenario.name.clone(),
         controller: kind,
+        coordinates: scenario.coordinate_names(),
         result,
     }
 }
@@ -245,26 +249,23 @@ fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
     write(&dir.join("summary.json"), &pretty(&summary)?)?;
     if let Ok(run) = &outcome.result {
         let r = &run.record;
-        let mut csv = String::from(
-            "t,a1,a2,a1_dot,a2_dot,a1_ref,a2_ref,tau1,tau2,tip_x,tip_y,tip_ref_x,tip_ref_y\n",
-        );
+        let names = &outcome.coordinates;
+        let mut header = vec!["t".to_string()];
+        header.extend(names.iter().cloned());
+        header.extend(names.iter().map(|n| format!("{n}_dot")));
+        header.extend(names.iter().map(|n| format!("{n}_ref")));
+        header.extend((1..=names.len()).map(|i| format!("tau{i}")));
+        header.extend(["tip_x", "tip_y", "tip_ref_x", "tip_ref_y"].map(String::from));
+        let mut csv = header.join(",") + "\n";
         for k in 0..r.len() {
-            let row = [
-                r.t[k],
-                r.a[k][0],
-                r.a[k][1],
-                r.a_dot[k][0],
-                r.a_dot[k][1],
-                r.a_ref[k][0],
-                r.a_ref[k][1],
-                r.tau_star[k][0],
-                r.tau_star[k][1],
-                r.tip[k][0],
-                r.tip[k][1],
-                r.tip_ref[k][0],
-                r.tip_ref[k][1],
-            ];
-            let line: Vec<String> = row.iter().map(f64::to_string).collect();
+            let row = std::iter::once(r.t[k])
+                .chain(r.a_at(k).iter().copied())
+                .chain(r.a_dot_at(k).iter().copied())
+                .chain(r.a_ref_at(k).iter().copied())
+                .chain(r.tau_star_at(k).iter().copied())
+                .chain(r.tip[k])
+                .chain(r.tip_ref[k]);
+            let line: Vec<String> = row.map(|v| v.to_string()).collect();
             let _ = writeln!(csv, "{}", line.join(","));
         }
         write(&dir.join("timeseries.csv"), &csv)?;
@@ -297,11 +298,8 @@ fn table_rows(outcomes: &[Outcome]) -> Vec<report::Row> {
                     cells.extend([
                         format!("{:.4}", m.tip_error_rms_m * 1e3),
                         format!("{:.4}", m.tip_error_max_m * 1e3),
-                        format!("{:.2e}, {:.2e}", m.modal_error_rms[0], m.modal_error_rms[1]),
-                        format!(
-                            "{:.2}, {:.2}",
-                            m.peak_modal_torque[0], m.peak_modal_torque[1]
-                        ),
+                        list(&m.modal_error_rms, |v| format!("{v:.2e}")),
+                        list(&m.peak_modal_torque, |v| format!("{v:.2}")),
                         format!("{:.3}", m.peak_joint_torque_nm),
                         format!("{:.4e}", m.control_effort),
                     ]);
@@ -314,6 +312,15 @@ fn table_rows(outcomes: &[Outcome]) -> Vec<report::Row> {
             }
         })
         .collect()
+}
+
+/// `values` formatted by `format`, comma-separated.
+fn list(values: &[f64], format: impl Fn(f64) -> String) -> String {
+    values
+        .iter()
+        .map(|&v| format(v))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The comparison table as text: the two name columns left-aligned, numbers right-aligned.

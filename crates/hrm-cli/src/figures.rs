@@ -10,10 +10,12 @@ use std::path::{Path, PathBuf};
 /// At most this many points per curve: enough for a smooth line, small enough for a light SVG.
 const MAX_POINTS: usize = 1500;
 
-/// Figure 9: `a1(t)` and `a2(t)` of every run against the reference, one panel each.
+/// Figure 9: every modal coordinate `a_i(t)` (named `names`) of every run against the
+/// reference, one panel each.
 pub fn modal_responses(
     path: &Path,
     scenario: &str,
+    names: &[String],
     runs: &[(ControllerKind, &Run)],
 ) -> Result<(), String> {
     let first = runs
@@ -22,34 +24,33 @@ pub fn modal_responses(
     let coordinate = |i: usize| {
         let reference = Series {
             label: "reference".into(),
-            points: thin(&first.1.record, |r, k| (r.t[k], r.a_ref[k][i])),
+            points: thin(&first.1.record, |r, k| (r.t[k], r.a_ref_at(k)[i])),
         };
         let controllers = runs.iter().map(|(kind, run)| Series {
             label: kind.name().into(),
-            points: thin(&run.record, |r, k| (r.t[k], r.a[k][i])),
+            points: thin(&run.record, |r, k| (r.t[k], r.a_at(k)[i])),
         });
         // The reference last, so that it is drawn on top of a controller that tracks it exactly.
         controllers
             .chain(std::iter::once(reference))
             .collect::<Vec<_>>()
     };
-    let (a1, a2) = (coordinate(0), coordinate(1));
+    let series: Vec<Vec<Series>> = (0..first.1.record.n_coords).map(coordinate).collect();
+    let labels: Vec<String> = names.iter().map(|name| format!("{name} (rad)")).collect();
+    let panels: Vec<Panel> = series
+        .iter()
+        .zip(&labels)
+        .map(|(series, y)| Panel {
+            y,
+            series,
+            y_range: None,
+        })
+        .collect();
     plot::stacked_line_charts(
         path,
         &format!("Modal coordinates, {scenario}"),
         "t (s)",
-        &[
-            Panel {
-                y: "a1 (rad)",
-                series: &a1,
-                y_range: None,
-            },
-            Panel {
-                y: "a2 (rad)",
-                series: &a2,
-                y_range: None,
-            },
-        ],
+        &panels,
     )
 }
 
@@ -91,7 +92,7 @@ pub fn configurations(
         .map(|k| {
             model
                 .map()
-                .joint_angles(&record.a[k], &mut theta)
+                .joint_angles(record.a_at(k), &mut theta)
                 .map_err(|e| e.to_string())?;
             let mut joints = vec![[0.0; 2]; lengths.len() + 1];
             backbone_kin::joint_positions(&lengths, &theta, &mut joints)
@@ -329,9 +330,11 @@ mod tests {
         let (step_scenario, step) = short_run("paper-responses-step", 0.2, ControllerKind::Pd);
 
         let fig9 = dir.join("fig9.svg");
+        let names = ["a1".to_string(), "a2".to_string()];
         modal_responses(
             &fig9,
             "paper-responses-step",
+            &names,
             &[(ControllerKind::Pd, &step)],
         )
         .unwrap();
@@ -389,11 +392,12 @@ mod tests {
 
         // Unwritable destinations are errors naming the path.
         let blocked = dir.join("fig9.svg").join("inside-a-file.svg");
-        let err = modal_responses(&blocked, "s", &[(ControllerKind::Pd, &step)]).unwrap_err();
+        let err =
+            modal_responses(&blocked, "s", &names, &[(ControllerKind::Pd, &step)]).unwrap_err();
         assert!(err.contains("inside-a-file.svg"), "{err}");
         let err = fuzzy_controller(&blocked, 11).unwrap_err();
         assert!(err.contains("inside-a-file.svg"), "{err}");
-        assert!(modal_responses(&fig9, "s", &[]).is_err());
+        assert!(modal_responses(&fig9, "s", &names, &[]).is_err());
         drop(step_scenario);
         std::fs::remove_dir_all(&dir).unwrap();
     }

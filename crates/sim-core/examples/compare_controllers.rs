@@ -32,15 +32,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 continue;
             }
         };
+        let list = |values: &[f64], scale: f64, digits: usize| {
+            values
+                .iter()
+                .map(|v| format!("{:.digits$}", scale * v))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
         println!(
-            "{:<16} {:>13.3} {:>13.3} {:>9.3} {:>10.3} {:>8.2} {:>9.2} {:>15.3} {:>10.2}",
+            "{:<16} {:>13.3} {:>13.3} {:>20} {:>18} {:>15.3} {:>10.2}",
             kind.name(),
             1e3 * s.tip_error_rms_m,
             1e3 * s.tip_error_max_m,
-            1e3 * s.modal_error_rms[0],
-            1e3 * s.modal_error_rms[1],
-            s.peak_modal_torque[0],
-            s.peak_modal_torque[1],
+            list(&s.modal_error_rms, 1e3, 3),
+            list(&s.peak_modal_torque, 1.0, 2),
             s.peak_joint_torque_nm,
             s.control_effort
         );

@@ -3,6 +3,8 @@
 use crate::ode::OdeError;
 use backbone_kin::KinError;
 use modal_reduce::ReduceError;
+use std::fmt;
+use std::sync::Arc;
 
 /// Why a simulation could not be built or had to stop.
 ///
@@ -72,8 +74,16 @@ pub enum SimError {
     NonFiniteControl {
         /// When (s).
         t: f64,
-        /// The torque it produced.
-        tau_star: [f64; 2],
+        /// The torque it produced, one entry per coordinate.
+        tau_star: Vec<f64>,
+    },
+    /// A controller failed with an error of its own (one that is not a [`SimError`]).
+    #[error("the controller failed at t = {t} s: {source}")]
+    Controller {
+        /// When (s).
+        t: f64,
+        /// The controller's error.
+        source: ControllerFailure,
     },
     /// A modal tracking error grew beyond the configured bound.
     #[error(
@@ -83,7 +93,7 @@ pub enum SimError {
     RunawayError {
         /// When (s).
         t: f64,
-        /// Which coordinate (1 or 2).
+        /// Which coordinate (1-based: `a1, a2, ...`; the last is `alpha0` when it is free).
         coordinate: usize,
         /// The error's magnitude (rad).
         error: f64,
@@ -92,7 +102,42 @@ pub enum SimError {
     },
 }
 
+/// The error of a controller from outside this crate, shared so that a [`SimError`] stays
+/// cloneable; two failures are equal when their messages are.
+#[derive(Debug, Clone)]
+pub struct ControllerFailure(pub Arc<dyn std::error::Error + Send + Sync + 'static>);
+
+impl fmt::Display for ControllerFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for ControllerFailure {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        Some(&*self.0)
+    }
+}
+
+impl PartialEq for ControllerFailure {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.to_string() == other.0.to_string()
+    }
+}
+
 impl SimError {
+    /// The run's error for a controller failure at `t`: a [`SimError`] (the built-in
+    /// controllers') as it is, any other error as [`SimError::Controller`].
+    pub fn from_controller(t: f64, error: crate::controller::ControllerError) -> Self {
+        match error.downcast::<SimError>() {
+            Ok(error) => *error,
+            Err(source) => SimError::Controller {
+                t,
+                source: ControllerFailure(Arc::from(source)),
+            },
+        }
+    }
+
     /// An [`InvalidSetting`](Self::InvalidSetting) error.
     pub(crate) fn setting(name: impl Into<String>, requirement: impl Into<String>) -> Self {
         Self::InvalidSetting {

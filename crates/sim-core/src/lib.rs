@@ -36,13 +36,18 @@ pub mod reference;
 mod scenario;
 mod simulation;
 
-pub use error::SimError;
+/// The most modal coordinates a loop may have: `2K + 1` for the most harmonics a modal map may
+/// have ([`backbone_kin::MAX_HARMONICS`]).
+pub const MAX_COORDINATES: usize = 2 * backbone_kin::MAX_HARMONICS + 1;
+
+pub use error::{ControllerFailure, SimError};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use scenario::{
-    ArmSpec, BranchSpec, ControllerKind, ControllerSpec, InitialSpec, IntegratorSpec, LimitsSpec,
-    NoiseSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec, TorqueLimit,
+    Alpha0, ArmSpec, BranchSpec, ControllerKind, ControllerSpec, InitialSpec, IntegratorSpec,
+    LimitsSpec, ModalSpec, NoiseSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec,
+    TorqueLimit,
 };
 pub use simulation::{
-    Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, Run, RunFailure,
-    Simulation,
+    ControlSample, Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES,
+    Observation, Run, RunFailure, Simulation,
 };

@@ -12,25 +12,28 @@ use rand_distr::{Distribution, StandardNormal};
 
 /// Zero-mean Gaussian noise with per-component standard deviations.
 #[derive(Debug, Clone)]
-pub(crate) struct GaussianNoise<const N: usize> {
+pub(crate) struct GaussianNoise {
     rng: ChaCha8Rng,
-    std: [f64; N],
+    std: Vec<f64>,
 }
 
-impl<const N: usize> GaussianNoise<N> {
+impl GaussianNoise {
     /// Noise on stream `stream` of `seed`; `None` when every deviation is zero (no draws at all).
-    pub(crate) fn new(seed: u64, stream: u64, std: [f64; N]) -> Option<Self> {
+    pub(crate) fn new(seed: u64, stream: u64, std: &[f64]) -> Option<Self> {
         if std.iter().all(|&s| s == 0.0) {
             return None;
         }
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         rng.set_stream(stream);
-        Some(Self { rng, std })
+        Some(Self {
+            rng,
+            std: std.to_vec(),
+        })
     }
 
-    /// Adds one draw of the noise to `values`.
-    pub(crate) fn perturb(&mut self, values: &mut [f64; N]) {
-        for (v, s) in values.iter_mut().zip(self.std) {
+    /// Adds one draw of the noise to `values` (as many entries as deviations).
+    pub(crate) fn perturb(&mut self, values: &mut [f64]) {
+        for (v, &s) in values.iter_mut().zip(&self.std) {
             let z: f64 = StandardNormal.sample(&mut self.rng);
             *v += s * z;
         }
@@ -43,13 +46,13 @@ mod tests {
 
     #[test]
     fn zero_deviation_is_no_noise() {
-        assert!(GaussianNoise::new(7, 1, [0.0, 0.0]).is_none());
+        assert!(GaussianNoise::new(7, 1, &[0.0, 0.0]).is_none());
     }
 
     #[test]
     fn same_seed_same_noise_and_streams_are_independent() {
         let draw = |seed, stream| {
-            let mut noise = GaussianNoise::new(seed, stream, [1.0, 2.0]).unwrap();
+            let mut noise = GaussianNoise::new(seed, stream, &[1.0, 2.0]).unwrap();
             let mut values = [0.0; 2];
             noise.perturb(&mut values);
             values
@@ -61,7 +64,7 @@ mod tests {
 
     #[test]
     fn noise_has_the_requested_moments() {
-        let mut noise = GaussianNoise::new(11, 1, [0.5, 2.0]).unwrap();
+        let mut noise = GaussianNoise::new(11, 1, &[0.5, 2.0]).unwrap();
         let n = 200_000;
         let (mut sum, mut sum_sq) = ([0.0; 2], [0.0; 2]);
         for _ in 0..n {

@@ -4,25 +4,29 @@
 use serde::Serialize;
 
 /// Time series of a run, one entry per recorded controller sample (the state at the sample
-/// time and the torques held from it).
+/// time and the torques held from it). The modal series hold [`n_coords`](Self::n_coords)
+/// numbers per sample, row-major (`a[k * m + i]` is coordinate `i` at sample `k`); read a row
+/// with the `*_at` accessors.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Record {
     /// Joints of the arm (the row length of [`joint_torques`](Self::joint_torques)).
     pub n_joints: usize,
+    /// Modal coordinates `m` (the row length of the modal series).
+    pub n_coords: usize,
     /// Sample times (s).
     pub t: Vec<f64>,
-    /// Modal coordinates `(a1, a2)` (rad).
-    pub a: Vec<[f64; 2]>,
+    /// Modal coordinates (rad).
+    pub a: Vec<f64>,
     /// Modal rates (rad/s).
-    pub a_dot: Vec<[f64; 2]>,
-    /// The reference `(a1, a2)` without reference noise (rad).
-    pub a_ref: Vec<[f64; 2]>,
+    pub a_dot: Vec<f64>,
+    /// The reference without reference noise (rad).
+    pub a_ref: Vec<f64>,
     /// The reference rates (rad/s).
-    pub a_ref_dot: Vec<[f64; 2]>,
+    pub a_ref_dot: Vec<f64>,
     /// The reference as the controller received it, reference noise included (rad).
-    pub a_cmd: Vec<[f64; 2]>,
+    pub a_cmd: Vec<f64>,
     /// Modal torques `tau*` held from this sample to the next (N m).
-    pub tau_star: Vec<[f64; 2]>,
+    pub tau_star: Vec<f64>,
     /// Tip of the discrete chain (m).
     pub tip: Vec<[f64; 2]>,
     /// The reference tip: the backbone curve's end point at `a_ref` (eqs 3-4), which for a
@@ -51,52 +55,90 @@ impl Record {
     pub fn joint_torques_at(&self, k: usize) -> &[f64] {
         &self.joint_torques[k * self.n_joints..(k + 1) * self.n_joints]
     }
+
+    /// Row `k` of a modal series (`m` numbers).
+    fn row<'a>(&self, series: &'a [f64], k: usize) -> &'a [f64] {
+        &series[k * self.n_coords..(k + 1) * self.n_coords]
+    }
+
+    /// The modal coordinates at sample `k` (rad). Panics if `k >= len()`, like the others.
+    pub fn a_at(&self, k: usize) -> &[f64] {
+        self.row(&self.a, k)
+    }
+
+    /// The modal rates at sample `k` (rad/s).
+    pub fn a_dot_at(&self, k: usize) -> &[f64] {
+        self.row(&self.a_dot, k)
+    }
+
+    /// The noise-free reference at sample `k` (rad).
+    pub fn a_ref_at(&self, k: usize) -> &[f64] {
+        self.row(&self.a_ref, k)
+    }
+
+    /// The reference rates at sample `k` (rad/s).
+    pub fn a_ref_dot_at(&self, k: usize) -> &[f64] {
+        self.row(&self.a_ref_dot, k)
+    }
+
+    /// The reference the controller received at sample `k` (rad).
+    pub fn a_cmd_at(&self, k: usize) -> &[f64] {
+        self.row(&self.a_cmd, k)
+    }
+
+    /// The modal torques held from sample `k` (N m).
+    pub fn tau_star_at(&self, k: usize) -> &[f64] {
+        self.row(&self.tau_star, k)
+    }
 }
 
 /// One recorded sample, before it is pushed.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Sample {
+pub(crate) struct Sample<'a> {
     pub t: f64,
-    pub a: [f64; 2],
-    pub a_dot: [f64; 2],
-    pub a_ref: [f64; 2],
-    pub a_ref_dot: [f64; 2],
-    pub a_cmd: [f64; 2],
-    pub tau_star: [f64; 2],
+    pub a: &'a [f64],
+    pub a_dot: &'a [f64],
+    pub a_ref: &'a [f64],
+    pub a_ref_dot: &'a [f64],
+    pub a_cmd: &'a [f64],
+    pub tau_star: &'a [f64],
     pub tip: [f64; 2],
     pub tip_ref: [f64; 2],
 }
 
 impl Record {
-    /// The numbers one recorded sample holds: `t`, eight pairs, and a torque per joint.
-    pub(crate) fn values_per_sample(n_joints: usize) -> usize {
-        17 + n_joints
+    /// The numbers one recorded sample holds: `t`, six modal series of `n_coords`, two tips,
+    /// and a torque per joint.
+    pub(crate) fn values_per_sample(n_coords: usize, n_joints: usize) -> usize {
+        5 + 6 * n_coords + n_joints
     }
 
-    pub(crate) fn with_capacity(n_joints: usize, samples: usize) -> Self {
+    pub(crate) fn with_capacity(n_coords: usize, n_joints: usize, samples: usize) -> Self {
+        let series = || Vec::with_capacity(samples * n_coords);
         Self {
             n_joints,
+            n_coords,
             t: Vec::with_capacity(samples),
-            a: Vec::with_capacity(samples),
-            a_dot: Vec::with_capacity(samples),
-            a_ref: Vec::with_capacity(samples),
-            a_ref_dot: Vec::with_capacity(samples),
-            a_cmd: Vec::with_capacity(samples),
-            tau_star: Vec::with_capacity(samples),
+            a: series(),
+            a_dot: series(),
+            a_ref: series(),
+            a_ref_dot: series(),
+            a_cmd: series(),
+            tau_star: series(),
             tip: Vec::with_capacity(samples),
             tip_ref: Vec::with_capacity(samples),
             joint_torques: Vec::with_capacity(samples * n_joints),
         }
     }
 
-    pub(crate) fn push(&mut self, s: &Sample, joint_torques: &[f64]) {
+    pub(crate) fn push(&mut self, s: &Sample<'_>, joint_torques: &[f64]) {
         self.t.push(s.t);
-        self.a.push(s.a);
-        self.a_dot.push(s.a_dot);
-        self.a_ref.push(s.a_ref);
-        self.a_ref_dot.push(s.a_ref_dot);
-        self.a_cmd.push(s.a_cmd);
-        self.tau_star.push(s.tau_star);
+        self.a.extend_from_slice(s.a);
+        self.a_dot.extend_from_slice(s.a_dot);
+        self.a_ref.extend_from_slice(s.a_ref);
+        self.a_ref_dot.extend_from_slice(s.a_ref_dot);
+        self.a_cmd.extend_from_slice(s.a_cmd);
+        self.tau_star.extend_from_slice(s.tau_star);
         self.tip.push(s.tip);
         self.tip_ref.push(s.tip_ref);
         self.joint_torques.extend_from_slice(joint_torques);
@@ -141,11 +183,11 @@ pub struct Summary {
     /// Largest such distance (m).
     pub tip_error_max_m: f64,
     /// Root mean square of `a_i - a_i_ref` per coordinate (rad), against the noise-free reference.
-    pub modal_error_rms: [f64; 2],
+    pub modal_error_rms: Vec<f64>,
     /// Largest `|a_i - a_i_ref|` per coordinate (rad).
-    pub modal_error_max: [f64; 2],
+    pub modal_error_max: Vec<f64>,
     /// Largest `|tau_i*|` per coordinate (N m).
-    pub peak_modal_torque: [f64; 2],
+    pub peak_modal_torque: Vec<f64>,
     /// Largest `|tau_j|` over all joints (N m).
     pub peak_joint_torque_nm: f64,
     /// Largest `|tau_j|` of each joint (N m).
@@ -164,9 +206,9 @@ pub(crate) struct Metrics {
     last_t: f64,
     tip_sq: f64,
     tip_max: f64,
-    modal_sq: [f64; 2],
-    modal_max: [f64; 2],
-    peak_tau_star: [f64; 2],
+    modal_sq: Vec<f64>,
+    modal_max: Vec<f64>,
+    peak_tau_star: Vec<f64>,
     peak_joint: Vec<f64>,
     effort: f64,
     limits: Option<Vec<f64>>,
@@ -174,16 +216,16 @@ pub(crate) struct Metrics {
 }
 
 impl Metrics {
-    pub(crate) fn new(n_joints: usize, limits: Option<Vec<f64>>) -> Self {
+    pub(crate) fn new(n_coords: usize, n_joints: usize, limits: Option<Vec<f64>>) -> Self {
         Self {
             controller_samples: 0,
             samples: 0,
             last_t: 0.0,
             tip_sq: 0.0,
             tip_max: 0.0,
-            modal_sq: [0.0; 2],
-            modal_max: [0.0; 2],
-            peak_tau_star: [0.0; 2],
+            modal_sq: vec![0.0; n_coords],
+            modal_max: vec![0.0; n_coords],
+            peak_tau_star: vec![0.0; n_coords],
             peak_joint: vec![0.0; n_joints],
             effort: 0.0,
             limits,
@@ -192,19 +234,23 @@ impl Metrics {
     }
 
     /// Counts a controller sample at `t` whose torque `tau_star` is held for `hold` seconds.
-    pub(crate) fn add_control(&mut self, t: f64, tau_star: [f64; 2], hold: f64) {
+    pub(crate) fn add_control(&mut self, t: f64, tau_star: &[f64], hold: f64) {
         self.controller_samples += 1;
         self.last_t = t;
-        self.effort += (tau_star[0] * tau_star[0] + tau_star[1] * tau_star[1]) * hold;
+        let mut square = 0.0;
+        for tau in tau_star {
+            square += tau * tau;
+        }
+        self.effort += square * hold;
     }
 
     /// Adds recorded sample `s` with its joint torques.
-    pub(crate) fn add(&mut self, s: &Sample, joint_torques: &[f64]) {
+    pub(crate) fn add(&mut self, s: &Sample<'_>, joint_torques: &[f64]) {
         self.samples += 1;
         let tip_error = (s.tip[0] - s.tip_ref[0]).hypot(s.tip[1] - s.tip_ref[1]);
         self.tip_sq += tip_error * tip_error;
         self.tip_max = self.tip_max.max(tip_error);
-        for i in 0..2 {
+        for i in 0..self.modal_sq.len() {
             let e = s.a[i] - s.a_ref[i];
             self.modal_sq[i] += e * e;
             self.modal_max[i] = self.modal_max[i].max(e.abs());
@@ -246,9 +292,9 @@ impl Metrics {
             simulated_s: self.last_t,
             tip_error_rms_m: (self.tip_sq / n).sqrt(),
             tip_error_max_m: self.tip_max,
-            modal_error_rms: self.modal_sq.map(|s| (s / n).sqrt()),
-            modal_error_max: self.modal_max,
-            peak_modal_torque: self.peak_tau_star,
+            modal_error_rms: self.modal_sq.iter().map(|s| (s / n).sqrt()).collect(),
+            modal_error_max: self.modal_max.clone(),
+            peak_modal_torque: self.peak_tau_star.clone(),
             peak_joint_torque_nm: self.peak_joint.iter().copied().fold(0.0, f64::max),
             peak_joint_torques_nm: self.peak_joint.clone(),
             control_effort: self.effort,

@@ -2,12 +2,21 @@
 //! controller, integrator, step sizes, duration, noise, seed), and the paper's experiments
 //! shipped with the crate.
 //!
+//! Required keys: `name`, `duration`, `alpha0`, `reference` (with its `kind` and that kind's
+//! required keys) and `integrator` (with its `method`); everything else has a default. Every
+//! per-coordinate array (`initial`, `reference`, `noise`, the controller gains) has exactly `m`
+//! entries, the number of modal coordinates: `2K` with `alpha0` fixed, `2K + 1` with `alpha0`
+//! free (its last entry is then `alpha0`'s).
+//!
 //! ```toml
 //! name = "step"
 //! duration = 2.0          # s
-//! alpha0 = 1.5707963267948966
+//! alpha0 = 1.5707963267948966   # rad, or "free": alpha0 is the last modal coordinate
 //! seed = 1
 //! record_period = 0.001   # s, default: the controller period
+//!
+//! [modal]                 # the modal family, default: the paper's K = 1
+//! harmonics = 1
 //!
 //! [arm]                   # defaults: the paper's 10 links of 0.1 m and 0.1 kg, g = 9.81
 //! links = 10
@@ -21,6 +30,8 @@
 //! [controller]            # kind = "fuzzy" | "pd" | "computed-torque" | "fuzzy-gc"
 //! kind = "fuzzy"
 //! period = 0.0001         # s, default: the RK4 step
+//! # kp = [2500.0, 2500.0]   computed torque (1/s^2), kd = [100.0, 100.0] (1/s)
+//! # pd_kp = [600.0, 300.0]  PD (N m/rad), pd_kd = [20.0, 10.0] (N m s/rad); default: fuzzy slope
 //!
 //! [integrator]            # method = "rk4" (dt) | "dopri5" (rtol, atol, h_max, max_steps)
 //! method = "rk4"
@@ -50,7 +61,8 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-/// The scenarios shipped with the crate, by name: the paper's experiments (section 5).
+/// The scenarios shipped with the crate, by name: the paper's experiments (section 5), then the
+/// paper's tracking task with two harmonics and with `alpha0` free.
 const BUILTIN: &[(&str, &str)] = &[
     (
         "paper-tracking",
@@ -67,6 +79,14 @@ const BUILTIN: &[(&str, &str)] = &[
     (
         "paper-responses-noise",
         include_str!("../scenarios/paper-responses-noise.toml"),
+    ),
+    (
+        "harmonic-tracking",
+        include_str!("../scenarios/harmonic-tracking.toml"),
+    ),
+    (
+        "free-base-tracking",
+        include_str!("../scenarios/free-base-tracking.toml"),
     ),
 ];
 
@@ -111,8 +131,8 @@ pub struct Scenario {
     pub description: String,
     /// Simulated time (s).
     pub duration: f64,
-    /// The fixed base inclination `alpha0` (rad).
-    pub alpha0: f64,
+    /// The base inclination `alpha0`: fixed (rad) or free (the last modal coordinate).
+    pub alpha0: Alpha0,
     /// Seed of the noise sources. TOML integers stop at `2^63 - 1`: larger seeds are written
     /// (and may be given) as a decimal string, `seed = "18446744073709551615"`.
     #[serde(default, with = "seed_text")]
@@ -120,13 +140,16 @@ pub struct Scenario {
     /// Recording period (s); default: the controller period.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub record_period: Option<f64>,
+    /// The modal family (default: the paper's `K = 1`).
+    #[serde(default)]
+    pub modal: ModalSpec,
     /// The arm.
     #[serde(default)]
     pub arm: ArmSpec,
     /// The initial state; default: at rest at the reference's value at `t = 0`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial: Option<InitialSpec>,
-    /// The reference for `(a1, a2)`.
+    /// The reference for the modal coordinates.
     pub reference: ReferenceSpec,
     /// The controller.
     #[serde(default)]
@@ -139,6 +162,86 @@ pub struct Scenario {
     /// Runaway bound and torque limits.
     #[serde(default)]
     pub limits: LimitsSpec,
+}
+
+/// The base inclination `alpha0` of a scenario: a number (fixed, in rad) or `"free"`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Alpha0 {
+    /// Held at this angle (rad); not a coordinate.
+    Fixed(f64),
+    /// A modal coordinate, the last one.
+    Free,
+}
+
+impl Alpha0 {
+    /// As a [`BaseAngle`] of the modal map.
+    pub fn base_angle(self) -> BaseAngle {
+        match self {
+            Alpha0::Fixed(alpha0) => BaseAngle::Fixed(alpha0),
+            Alpha0::Free => BaseAngle::Free,
+        }
+    }
+}
+
+impl Serialize for Alpha0 {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Alpha0::Fixed(alpha0) => serializer.serialize_f64(*alpha0),
+            Alpha0::Free => serializer.serialize_str("free"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Alpha0 {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = Alpha0;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("alpha0: a number (rad) or \"free\"")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Alpha0, E> {
+                Ok(Alpha0::Fixed(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Alpha0, E> {
+                Ok(Alpha0::Fixed(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Alpha0, E> {
+                Ok(Alpha0::Fixed(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Alpha0, E> {
+                if v == "free" {
+                    Ok(Alpha0::Free)
+                } else {
+                    Err(E::custom(format!(
+                        "alpha0 must be a number (rad) or \"free\", got \"{v}\""
+                    )))
+                }
+            }
+        }
+        deserializer.deserialize_any(Visitor)
+    }
+}
+
+/// The modal family: `K` harmonics (`m = 2K` coordinates with `alpha0` fixed, `2K + 1` free).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModalSpec {
+    /// The number of harmonics `K` (default 1, the paper's).
+    #[serde(default = "default_harmonics")]
+    pub harmonics: usize,
+}
+
+fn default_harmonics() -> usize {
+    1
+}
+
+impl Default for ModalSpec {
+    fn default() -> Self {
+        Self {
+            harmonics: default_harmonics(),
+        }
+    }
 }
 
 /// The arm: the paper's by default; per-link arrays override the scalars.
@@ -168,33 +271,33 @@ pub struct ArmSpec {
     pub inertias: Option<Vec<f64>>,
 }
 
-/// The initial modal state.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// The initial modal state (`m` entries each).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
-    /// `(a1, a2)` (rad).
-    pub a: [f64; 2],
-    /// `(a1_dot, a2_dot)` (rad/s), default zero.
-    #[serde(default)]
-    pub a_dot: [f64; 2],
+    /// The coordinates (rad).
+    pub a: Vec<f64>,
+    /// Their rates (rad/s), default zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub a_dot: Option<Vec<f64>>,
 }
 
-/// The reference for `(a1, a2)`, tagged by `kind`.
+/// The reference for the `m` modal coordinates, tagged by `kind`; every array has `m` entries.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum ReferenceSpec {
     /// A constant `a` (rad).
     Constant {
         /// The value.
-        a: [f64; 2],
+        a: Vec<f64>,
     },
     /// `initial` until `time` (s), then `target` (rad).
     Step {
         /// Before the step (default zero).
-        #[serde(default)]
-        initial: [f64; 2],
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        initial: Option<Vec<f64>>,
         /// After the step.
-        target: [f64; 2],
+        target: Vec<f64>,
         /// When (s, default 0).
         #[serde(default)]
         time: f64,
@@ -202,17 +305,19 @@ pub enum ReferenceSpec {
     /// `offset + amplitude sin(2 pi frequency_hz t + phase)` per coordinate.
     Sinusoid {
         /// Offsets (rad, default zero).
-        #[serde(default)]
-        offset: [f64; 2],
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        offset: Option<Vec<f64>>,
         /// Amplitudes (rad).
-        amplitude: [f64; 2],
+        amplitude: Vec<f64>,
         /// Frequencies (Hz).
-        frequency_hz: [f64; 2],
+        frequency_hz: Vec<f64>,
         /// Phases (rad, default zero).
-        #[serde(default)]
-        phase: [f64; 2],
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        phase: Option<Vec<f64>>,
     },
-    /// A tip path followed through the inverse kinematics: exactly one of `sine` or `points`.
+    /// A tip path followed through the inverse kinematics of the modal family (closed form for
+    /// `K = 1` with `alpha0` fixed, numerical continuation otherwise, see
+    /// [`CartesianPath`]): exactly one of `sine` or `points`.
     Path {
         /// Time along the path (s); the end point is held afterwards.
         travel_time: f64,
@@ -319,7 +424,7 @@ impl FromStr for ControllerKind {
 }
 
 /// The controller and its sampling.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ControllerSpec {
     /// Which controller (default fuzzy).
@@ -332,33 +437,24 @@ pub struct ControllerSpec {
     /// path is relative to the scenario file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fis: Option<PathBuf>,
-    /// Computed-torque stiffness per coordinate (1/s^2, default 2500: 50 rad/s).
-    #[serde(default = "default_kp")]
-    pub kp: [f64; 2],
-    /// Computed-torque damping per coordinate (1/s, default 100: critically damped).
-    #[serde(default = "default_kd")]
-    pub kd: [f64; 2],
+    /// Computed-torque stiffness per coordinate (1/s^2, default 2500 each: 50 rad/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kp: Option<Vec<f64>>,
+    /// Computed-torque damping per coordinate (1/s, default 100 each: critically damped).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kd: Option<Vec<f64>>,
+    /// PD stiffness per coordinate (N m/rad); default: the fuzzy system's slope at the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pd_kp: Option<Vec<f64>>,
+    /// PD damping per coordinate (N m s/rad); default: the fuzzy system's slope at the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pd_kd: Option<Vec<f64>>,
 }
 
-fn default_kp() -> [f64; 2] {
-    [2500.0; 2]
-}
-
-fn default_kd() -> [f64; 2] {
-    [100.0; 2]
-}
-
-impl Default for ControllerSpec {
-    fn default() -> Self {
-        Self {
-            kind: ControllerKind::default(),
-            period: None,
-            fis: None,
-            kp: default_kp(),
-            kd: default_kd(),
-        }
-    }
-}
+/// The default computed-torque stiffness (1/s^2): 50 rad/s.
+const DEFAULT_KP: f64 = 2500.0;
+/// The default computed-torque damping (1/s): critically damped with [`DEFAULT_KP`].
+const DEFAULT_KD: f64 = 100.0;
 
 /// The integrator between controller samples, tagged by `method`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -394,19 +490,31 @@ fn default_atol() -> f64 {
     1e-12
 }
 
-/// Standard deviations of the seeded Gaussian noise (all default to zero).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+/// Standard deviations of the seeded Gaussian noise, `m` entries each (all default to zero).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct NoiseSpec {
-    /// On the reference `(a1_ref, a2_ref)` the controller receives (rad).
-    #[serde(default)]
-    pub reference_std: [f64; 2],
-    /// On the measured `(a1, a2)` (rad).
-    #[serde(default)]
-    pub sensor_a_std: [f64; 2],
-    /// On the measured `(a1_dot, a2_dot)` (rad/s).
-    #[serde(default)]
-    pub sensor_a_dot_std: [f64; 2],
+    /// On the reference `a_ref` the controller receives (rad).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_std: Option<Vec<f64>>,
+    /// On the measured coordinates `a` (rad).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor_a_std: Option<Vec<f64>>,
+    /// On the measured rates `a_dot` (rad/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor_a_dot_std: Option<Vec<f64>>,
+}
+
+impl NoiseSpec {
+    /// The same noise level on every one of `m` coordinates: `sensor` rad on `a`, `rate` rad/s
+    /// on `a_dot`, `reference` rad on `a_ref`.
+    pub fn uniform(m: usize, sensor: f64, rate: f64, reference: f64) -> Self {
+        Self {
+            reference_std: Some(vec![reference; m]),
+            sensor_a_std: Some(vec![sensor; m]),
+            sensor_a_dot_std: Some(vec![rate; m]),
+        }
+    }
 }
 
 /// The runaway bound and optional joint torque limits.
@@ -492,8 +600,10 @@ impl Scenario {
         }
     }
 
-    /// The names of the shipped scenarios: `paper-tracking` (Figures 10-11) and the
-    /// `paper-responses-*` step, sine and noise responses (Figure 9).
+    /// The names of the shipped scenarios: `paper-tracking` (Figures 10-11), the
+    /// `paper-responses-*` step, sine and noise responses (Figure 9), and the tracking task for
+    /// other modal families: `harmonic-tracking` (`K = 2`, `m = 4`) and `free-base-tracking`
+    /// (`alpha0` free, `m = 3`).
     pub fn builtin_names() -> impl Iterator<Item = &'static str> {
         BUILTIN.iter().map(|(name, _)| *name)
     }
@@ -521,11 +631,59 @@ impl Scenario {
         toml::to_string(self).expect("a scenario serialises to TOML")
     }
 
-    /// The reduced model of the arm with `alpha0` fixed: coordinates `(a1, a2)`.
+    /// The number of modal coordinates `m`: `2K` with `alpha0` fixed, `2K + 1` with it free.
+    pub fn n_coords(&self) -> usize {
+        2 * self.modal.harmonics + usize::from(self.alpha0 == Alpha0::Free)
+    }
+
+    /// The names of the modal coordinates, in order: `a1, ..., a{2K}`, then `alpha0` when it is
+    /// free (the column names of the outputs).
+    ///
+    /// ```
+    /// let mut scenario = sim_core::Scenario::builtin("paper-tracking")?;
+    /// assert_eq!(scenario.coordinate_names(), ["a1", "a2"]);
+    /// scenario.alpha0 = sim_core::Alpha0::Free;
+    /// assert_eq!(scenario.coordinate_names(), ["a1", "a2", "alpha0"]);
+    /// # Ok::<(), sim_core::ScenarioError>(())
+    /// ```
+    pub fn coordinate_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = (1..=2 * self.modal.harmonics)
+            .map(|i| format!("a{i}"))
+            .collect();
+        if self.alpha0 == Alpha0::Free {
+            names.push("alpha0".into());
+        }
+        names
+    }
+
+    /// The reduced model of the arm with the scenario's modal family. Refuses a family with no
+    /// harmonic or more coordinates than the arm has links (its reduced mass matrix would be
+    /// singular).
     pub fn model(&self) -> Result<ReducedModel, SimError> {
         let chain = self.arm.to_chain()?;
+        let k = self.modal.harmonics;
+        if k == 0 {
+            return Err(SimError::setting("modal.harmonics", "must be at least 1"));
+        }
+        let n = chain.n_links();
+        if k > n {
+            return Err(SimError::setting(
+                "modal.harmonics",
+                format!("must be at most the arm's {n} links, got {k}"),
+            ));
+        }
+        let m = self.n_coords();
+        if m > n {
+            return Err(SimError::setting(
+                "modal.harmonics",
+                format!(
+                    "= {k} gives {m} modal coordinates, more than the arm's {n} links: the \
+                     reduced mass matrix would be singular"
+                ),
+            ));
+        }
         let lengths: Vec<f64> = chain.link_lengths().collect();
-        let map = ModalMap::new(&lengths, 1, BaseAngle::Fixed(self.alpha0))?;
+        let map = ModalMap::new(&lengths, k, self.alpha0.base_angle())?;
         ReducedModel::new(chain, map).map_err(SimError::Model)
     }
 
@@ -534,9 +692,13 @@ impl Scenario {
     /// [`Simulation::new`]'s.
     pub fn build(&self) -> Result<Simulation, SimError> {
         let model = self.model()?;
-        let reference = self
-            .reference
-            .build(model.chain().total_length(), self.alpha0)?;
+        let m = model.n_coords();
+        let reference = self.reference.build(
+            model.chain().total_length(),
+            self.modal.harmonics,
+            self.alpha0,
+            m,
+        )?;
         let controller = self.controller.build(&model)?;
         let period = match (self.controller.period, self.integrator) {
             (Some(period), _) => period,
@@ -551,19 +713,29 @@ impl Scenario {
         let mut settings = LoopSettings::new(self.integrator.build(), period, self.duration);
         settings.record_period = self.record_period.unwrap_or(period);
         settings.seed = self.seed;
-        settings.reference_noise_std = self.noise.reference_std;
-        let [a1, a2] = self.noise.sensor_a_std;
-        let [v1, v2] = self.noise.sensor_a_dot_std;
-        settings.sensor_noise_std = [a1, a2, v1, v2];
+        let noise = |name: &str, values: &Option<Vec<f64>>| {
+            per_coordinate(name, values.as_deref(), m).map(|v| v.unwrap_or_else(|| vec![0.0; m]))
+        };
+        settings.reference_noise_std = noise("noise.reference_std", &self.noise.reference_std)?;
+        settings.sensor_noise_std = noise("noise.sensor_a_std", &self.noise.sensor_a_std)?;
+        settings.sensor_noise_std.extend(noise(
+            "noise.sensor_a_dot_std",
+            &self.noise.sensor_a_dot_std,
+        )?);
         settings.max_modal_error = self.limits.max_modal_error;
         settings.joint_torque_limits = self.limits.joint_torque_nm.as_ref().map(|l| match l {
             TorqueLimit::All(limit) => vec![*limit; model.n_links()],
             TorqueLimit::PerJoint(limits) => limits.clone(),
         });
-        let initial = self.initial.map(|i| ModalState {
-            a: i.a,
-            a_dot: i.a_dot,
-        });
+        let initial = match &self.initial {
+            None => None,
+            Some(i) => {
+                let a = per_coordinate("initial.a", Some(&i.a), m)?.unwrap_or_default();
+                let a_dot = per_coordinate("initial.a_dot", i.a_dot.as_deref(), m)?
+                    .unwrap_or_else(|| vec![0.0; m]);
+                Some(ModalState { a, a_dot })
+            }
+        };
         Simulation::new(model, reference, controller, settings, initial)
     }
 }
@@ -641,22 +813,64 @@ impl ArmSpec {
     }
 }
 
+/// `values` if given, checked to have exactly `m` entries (one per modal coordinate); the
+/// error names the field.
+fn per_coordinate(
+    name: &str,
+    values: Option<&[f64]>,
+    m: usize,
+) -> Result<Option<Vec<f64>>, SimError> {
+    match values {
+        None => Ok(None),
+        Some(values) if values.len() == m => Ok(Some(values.to_vec())),
+        Some(values) => Err(SimError::setting(
+            name,
+            format!(
+                "has {} entries, the modal family has {m} coordinates (one entry each)",
+                values.len()
+            ),
+        )),
+    }
+}
+
 impl ReferenceSpec {
-    /// The reference for a curve of length `length` with base angle `alpha0`.
-    fn build(&self, length: f64, alpha0: f64) -> Result<Box<dyn Reference>, SimError> {
+    /// The reference of `m` coordinates for a curve of length `length` with `harmonics`
+    /// harmonics and base angle `alpha0`.
+    fn build(
+        &self,
+        length: f64,
+        harmonics: usize,
+        alpha0: Alpha0,
+        m: usize,
+    ) -> Result<Box<dyn Reference>, SimError> {
+        let given = |name: &str, values: &[f64]| {
+            per_coordinate(name, Some(values), m).map(Option::unwrap_or_default)
+        };
+        let or_zero = |name: &str, values: &Option<Vec<f64>>| {
+            per_coordinate(name, values.as_deref(), m).map(|v| v.unwrap_or_else(|| vec![0.0; m]))
+        };
         Ok(match self {
-            ReferenceSpec::Constant { a } => Box::new(Step::constant(*a)?),
+            ReferenceSpec::Constant { a } => Box::new(Step::constant(&given("reference.a", a)?)?),
             ReferenceSpec::Step {
                 initial,
                 target,
                 time,
-            } => Box::new(Step::new(*initial, *target, *time)?),
+            } => Box::new(Step::new(
+                &or_zero("reference.initial", initial)?,
+                &given("reference.target", target)?,
+                *time,
+            )?),
             ReferenceSpec::Sinusoid {
                 offset,
                 amplitude,
                 frequency_hz,
                 phase,
-            } => Box::new(Sinusoid::new(*offset, *amplitude, *frequency_hz, *phase)?),
+            } => Box::new(Sinusoid::new(
+                &or_zero("reference.offset", offset)?,
+                &given("reference.amplitude", amplitude)?,
+                &given("reference.frequency_hz", frequency_hz)?,
+                &or_zero("reference.phase", phase)?,
+            )?),
             ReferenceSpec::Path {
                 travel_time,
                 branch,
@@ -688,7 +902,8 @@ impl ReferenceSpec {
                     shape,
                     *travel_time,
                     length,
-                    alpha0,
+                    harmonics,
+                    alpha0.base_angle(),
                     branch,
                 )?)
             }
@@ -713,17 +928,28 @@ impl ControllerSpec {
         }
     }
 
-    /// The controller for `model`.
+    /// The controller for `model`'s `m` coordinates; every gain array must have `m` entries.
     fn build(&self, model: &ReducedModel) -> Result<Box<dyn Controller>, SimError> {
+        let m = model.n_coords();
+        let gains = |name: &str, values: &Option<Vec<f64>>, default: f64| {
+            per_coordinate(name, values.as_deref(), m)
+                .map(|v| v.unwrap_or_else(|| vec![default; m]))
+        };
+        let kp = gains("controller.kp", &self.kp, DEFAULT_KP)?;
+        let kd = gains("controller.kd", &self.kd, DEFAULT_KD)?;
+        let pd_kp = per_coordinate("controller.pd_kp", self.pd_kp.as_deref(), m)?;
+        let pd_kd = per_coordinate("controller.pd_kd", self.pd_kd.as_deref(), m)?;
         Ok(match self.kind {
-            ControllerKind::Fuzzy => Box::new(FuzzyController::new(self.fuzzy_system()?)?),
-            ControllerKind::Pd => Box::new(PdController::from_fuzzy_slope(&self.fuzzy_system()?)?),
-            ControllerKind::ComputedTorque => {
-                Box::new(ComputedTorque::new(model.clone(), self.kp, self.kd)?)
+            ControllerKind::Fuzzy => Box::new(FuzzyController::new(self.fuzzy_system()?, m)?),
+            ControllerKind::Pd => {
+                let slope = PdController::from_fuzzy_slope(&self.fuzzy_system()?, m)?;
+                let kp = pd_kp.unwrap_or_else(|| slope.kp().to_vec());
+                let kd = pd_kd.unwrap_or_else(|| slope.kd().to_vec());
+                Box::new(PdController::new(slope.offset(), &kp, &kd)?)
             }
+            ControllerKind::ComputedTorque => Box::new(ComputedTorque::new(model, &kp, &kd)?),
             ControllerKind::FuzzyGc => Box::new(
-                FuzzyController::new(self.fuzzy_system()?)?
-                    .with_gravity_compensation(model.clone())?,
+                FuzzyController::new(self.fuzzy_system()?, m)?.with_gravity_compensation(model)?,
             ),
         })
     }

@@ -2,11 +2,12 @@
 //! reduced dynamics (eq 15) -> state, with the controller sampled at its own period and its
 //! output held in between (zero-order hold).
 
-use crate::controller::{Controller, ModalState};
+use crate::controller::{ControlContext, Controller, ModalState};
 use crate::error::{SimError, check_finite, check_non_negative, check_positive};
 use crate::noise::GaussianNoise;
 use crate::ode::{DormandPrince, OdeSystem, Rk4, Tolerances};
 use crate::record::{Metrics, Record, Sample, Summary};
+use crate::reference::continuation::Family;
 use crate::reference::{Reference, ReferenceSample};
 use backbone_kin::BaseAngle;
 use modal_reduce::{ReduceError, ReducedData, ReducedModel};
@@ -44,11 +45,12 @@ pub struct LoopSettings {
     pub record_period: f64,
     /// Seed of the noise sources.
     pub seed: u64,
-    /// Standard deviation of the Gaussian noise added to `(a1_ref, a2_ref)` at each sample (rad).
-    pub reference_noise_std: [f64; 2],
-    /// Standard deviation of the Gaussian sensor noise on the measured
-    /// `(a1, a2, a1_dot, a2_dot)` (rad, rad/s).
-    pub sensor_noise_std: [f64; 4],
+    /// Standard deviation of the Gaussian noise added to the reference `a_ref` at each sample
+    /// (rad): `m` entries, or none for no noise.
+    pub reference_noise_std: Vec<f64>,
+    /// Standard deviation of the Gaussian sensor noise on the measured `(a, a_dot)` (rad, rad/s):
+    /// `2m` entries (the `m` coordinates, then the `m` rates), or none for no noise.
+    pub sensor_noise_std: Vec<f64>,
     /// A run stops with [`SimError::RunawayError`] when `|a_i - a_i_ref|` exceeds this (rad).
     pub max_modal_error: f64,
     /// Optional per-joint torque limits (N m): exceeding one is reported in the summary.
@@ -64,8 +66,8 @@ impl LoopSettings {
             duration,
             record_period: controller_period,
             seed: 0,
-            reference_noise_std: [0.0; 2],
-            sensor_noise_std: [0.0; 4],
+            reference_noise_std: Vec::new(),
+            sensor_noise_std: Vec::new(),
             max_modal_error: std::f64::consts::PI,
             joint_torque_limits: None,
         }
@@ -93,24 +95,25 @@ pub struct RunFailure {
     pub summary: Summary,
 }
 
-/// The reduced dynamics with a held modal torque: `y = [a1, a2, a1_dot, a2_dot]`.
+/// The reduced dynamics with a held modal torque: `y = [a, a_dot]` (`2m` entries).
 struct Plant {
     model: ReducedModel,
     data: ReducedData,
-    tau_star: [f64; 2],
+    tau_star: Vec<f64>,
 }
 
 impl OdeSystem for Plant {
     type Error = ReduceError;
     fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), ReduceError> {
-        dy[..2].copy_from_slice(&y[2..]);
+        let m = self.tau_star.len();
+        dy[..m].copy_from_slice(&y[m..]);
         modal_reduce::forward_dynamics(
             &self.model,
             &mut self.data,
-            &y[..2],
-            &y[2..],
+            &y[..m],
+            &y[m..],
             &self.tau_star,
-            &mut dy[2..],
+            &mut dy[m..],
         )
     }
 }
@@ -121,8 +124,72 @@ enum Stepper {
     DormandPrince(DormandPrince),
 }
 
-/// A closed-loop simulation, built once and run any number of times (each run starts afresh
-/// from the initial state with the noise re-seeded; controllers keep no state between samples).
+impl Stepper {
+    fn new(integrator: Integrator, dim: usize) -> Self {
+        match integrator {
+            Integrator::Rk4 { dt } => Stepper::Rk4(Rk4::new(dim), dt),
+            Integrator::DormandPrince(tol) => Stepper::DormandPrince(DormandPrince::new(dim, tol)),
+        }
+    }
+}
+
+/// One controller sample: what the controller saw and did at time `t`. Its buffers are sized
+/// when the simulation is built and reused at every sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ControlSample {
+    /// The sample time (s).
+    pub t: f64,
+    /// The true state at `t`.
+    pub state: ModalState,
+    /// The noise-free reference at `t`.
+    pub reference: ReferenceSample,
+    /// The reference as the controller received it (reference noise on `a`).
+    pub command: ReferenceSample,
+    /// The state as the controller measured it (sensor noise included).
+    pub measured: ModalState,
+    /// The modal torques `tau*` held from `t` to the next sample (N m).
+    pub tau_star: Vec<f64>,
+    /// The acceleration at `t` under `tau*` (rad/s^2): the integrator's first stage, or the
+    /// forward dynamics for a sample that is not integrated.
+    pub a_ddot: Vec<f64>,
+    /// Accepted and rejected integrator steps from `t` to the next sample.
+    pub steps: (usize, usize),
+}
+
+impl ControlSample {
+    fn zeros(m: usize) -> Self {
+        Self {
+            t: 0.0,
+            state: ModalState::zeros(m),
+            reference: ReferenceSample::zeros(m),
+            command: ReferenceSample::zeros(m),
+            measured: ModalState::zeros(m),
+            tau_star: vec![0.0; m],
+            a_ddot: vec![0.0; m],
+            steps: (0, 0),
+        }
+    }
+}
+
+/// The recorded view of a controller sample ([`Simulation::observe`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Observation<'a> {
+    /// Joint torques `tau = M J a_dd + C + G` (eq 13) at the sample (N m).
+    pub joint_torques: &'a [f64],
+    /// The tip of the discrete chain (m).
+    pub tip: [f64; 2],
+    /// The reference tip: the backbone curve's end point at the noise-free reference (m).
+    pub tip_ref: [f64; 2],
+}
+
+/// A closed-loop simulation of `m` modal coordinates, built once and run any number of times
+/// (each [`run`](Self::run) starts afresh from the initial state with the noise re-seeded).
+///
+/// A caller may also own the loop: [`step`](Self::step) takes one controller sample and
+/// integrates one controller period, [`time`](Self::time) and [`state`](Self::state) give where
+/// the loop is, [`last_sample`](Self::last_sample) and [`observe`](Self::observe) what happened
+/// at the sample just taken, and [`reset`](Self::reset) starts over. [`run`](Self::run) is built
+/// on these.
 ///
 /// ```
 /// use backbone_kin::ModalMap;
@@ -134,13 +201,21 @@ enum Stepper {
 ///
 /// let arm = ChainModel::uniform(10, 0.1, 0.1, 9.81)?;
 /// let model = ReducedModel::new(arm, ModalMap::paper_fixed_alpha0(10, std::f64::consts::FRAC_PI_2)?)?;
-/// let reference = Step::new([0.0, 0.0], [0.2, -0.1], 0.0)?;
-/// let controller = FuzzyController::new(fuzzy_sugeno::paper_controller())?;
+/// let reference = Step::new(&[0.0, 0.0], &[0.2, -0.1], 0.0)?;
+/// let controller = FuzzyController::new(fuzzy_sugeno::paper_controller(), 2)?;
 /// let settings = LoopSettings::new(Integrator::Rk4 { dt: 1e-4 }, 1e-4, 0.5);
 /// let mut sim = Simulation::new(model, Box::new(reference), Box::new(controller), settings, None)?;
 /// let run = sim.run()?;
 /// assert_eq!(run.summary.controller_samples, 5001);
 /// assert!(run.summary.modal_error_rms[0] < 0.2);
+///
+/// // The same loop, stepped by hand for 0.1 s.
+/// sim.reset();
+/// while sim.time() < 0.1 - 1e-12 {
+///     let sample = sim.step()?;
+///     assert!(sample.tau_star.iter().all(|t| t.is_finite()));
+/// }
+/// assert_eq!(sim.samples_taken(), 1000);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub struct Simulation {
@@ -149,69 +224,122 @@ pub struct Simulation {
     controller: Box<dyn Controller>,
     settings: LoopSettings,
     initial: ModalState,
-    alpha0: f64,
-    curve_length: f64,
+    /// The end point of the backbone curve, for the reference tip.
+    family: Family,
     link_lengths: Vec<f64>,
     theta: Vec<f64>,
     joint_torques: Vec<f64>,
+    /// Controller samples taken since the last reset.
+    taken: usize,
+    /// The state `[a, a_dot]` at the current time.
+    y: Vec<f64>,
+    /// The current state as a [`ModalState`] (kept in step with `y`).
+    current: ModalState,
+    stepper: Stepper,
+    reference_noise: Option<GaussianNoise>,
+    sensor_noise: Option<GaussianNoise>,
+    /// Scratch for the measured `[a, a_dot]`.
+    measured: Vec<f64>,
+    sample: ControlSample,
 }
 
 impl Simulation {
-    /// A closed loop of `model` (two coordinates `(a1, a2)`, `alpha0` fixed) tracking `reference`
-    /// with `controller`. `initial` defaults to rest at the reference's value at `t = 0`.
+    /// A closed loop of `model` (any modal family: `m = 2K` coordinates with `alpha0` fixed, or
+    /// `2K + 1` with `alpha0` free) tracking `reference` with `controller`. `initial` defaults
+    /// to rest at the reference's value at `t = 0`.
     ///
-    /// Fails with [`SimError::InvalidSetting`] for a model with another coordinate set, and for
-    /// settings out of their domain: non-positive periods or duration, periods that are not
-    /// whole multiples (controller period of the RK4 step, duration and recording period of the
-    /// controller period), a duration of more than [`MAX_CONTROLLER_SAMPLES`] periods or a
-    /// record of more than [`MAX_RECORDED_VALUES`] numbers, negative or non-finite noise, a
-    /// non-positive error bound, or torque limits of the wrong length or sign.
+    /// Fails with [`SimError::InvalidSetting`] for a reference, controller, initial state, noise
+    /// or torque limits whose size does not match the model, and for settings out of their
+    /// domain: non-positive periods or duration, periods that are not whole multiples
+    /// (controller period of the RK4 step, duration and recording period of the controller
+    /// period), a duration of more than [`MAX_CONTROLLER_SAMPLES`] periods or a record of more
+    /// than [`MAX_RECORDED_VALUES`] numbers, negative or non-finite noise, a non-positive error
+    /// bound, or torque limits of the wrong sign.
     pub fn new(
         model: ReducedModel,
-        reference: Box<dyn Reference>,
+        mut reference: Box<dyn Reference>,
         controller: Box<dyn Controller>,
         settings: LoopSettings,
         initial: Option<ModalState>,
     ) -> Result<Self, SimError> {
-        let alpha0 = match (model.n_coords(), model.map().base_angle()) {
-            (2, BaseAngle::Fixed(alpha0)) => alpha0,
-            _ => {
-                return Err(SimError::setting(
-                    "model",
-                    "must have the two coordinates (a1, a2) with alpha0 fixed",
-                ));
-            }
-        };
-        validate(&settings, model.n_links())?;
+        let m = model.n_coords();
+        if reference.n_coords() != m {
+            return Err(SimError::setting(
+                "reference",
+                format!(
+                    "sets {} coordinates, the model has {m}",
+                    reference.n_coords()
+                ),
+            ));
+        }
+        if let Some(c) = controller.n_coords()
+            && c != m
+        {
+            return Err(SimError::setting(
+                "controller",
+                format!("is built for {c} coordinates, the model has {m}"),
+            ));
+        }
+        validate(&settings, m, model.n_links())?;
         let initial = match initial {
             Some(state) => state,
-            None => ModalState {
-                a: reference.sample(0.0)?.a,
-                a_dot: [0.0; 2],
-            },
+            None => {
+                let mut sample = ReferenceSample::zeros(m);
+                reference.sample(0.0, &mut sample)?;
+                ModalState {
+                    a: sample.a,
+                    a_dot: vec![0.0; m],
+                }
+            }
         };
-        check_finite("initial.a", &initial.a)?;
-        check_finite("initial.a_dot", &initial.a_dot)?;
+        for (name, values) in [("initial.a", &initial.a), ("initial.a_dot", &initial.a_dot)] {
+            if values.len() != m {
+                return Err(SimError::setting(
+                    name,
+                    format!(
+                        "has {} entries, the model has {m} coordinates",
+                        values.len()
+                    ),
+                ));
+            }
+            check_finite(name, values)?;
+        }
         let n = model.n_links();
         let link_lengths: Vec<f64> = model.chain().link_lengths().collect();
         let curve_length = link_lengths.iter().sum();
+        let map = model.map();
+        let fixed = match map.base_angle() {
+            BaseAngle::Fixed(alpha0) => Some(alpha0),
+            BaseAngle::Free => None,
+        };
+        let family = Family::new(curve_length, map.harmonics(), fixed)?;
         let data = ReducedData::new(&model);
-        Ok(Self {
+        let stepper = Stepper::new(settings.integrator, 2 * m);
+        let mut simulation = Self {
             plant: Plant {
                 model,
                 data,
-                tau_star: [0.0; 2],
+                tau_star: vec![0.0; m],
             },
             reference,
             controller,
             settings,
             initial,
-            alpha0,
-            curve_length,
+            family,
             link_lengths,
             theta: vec![0.0; n],
             joint_torques: vec![0.0; n],
-        })
+            taken: 0,
+            y: vec![0.0; 2 * m],
+            current: ModalState::zeros(m),
+            stepper,
+            reference_noise: None,
+            sensor_noise: None,
+            measured: vec![0.0; 2 * m],
+            sample: ControlSample::zeros(m),
+        };
+        simulation.reset();
+        Ok(simulation)
     }
 
     /// The reduced model being simulated.
@@ -225,41 +353,113 @@ impl Simulation {
     }
 
     /// The initial state.
-    pub fn initial_state(&self) -> ModalState {
-        self.initial
+    pub fn initial_state(&self) -> &ModalState {
+        &self.initial
     }
 
-    /// Runs the loop from the initial state for the whole duration.
+    /// The number of modal coordinates `m`.
+    pub fn n_coords(&self) -> usize {
+        self.plant.tau_star.len()
+    }
+
+    /// The current time: the time of the next controller sample (s).
+    pub fn time(&self) -> f64 {
+        self.taken as f64 * self.settings.controller_period
+    }
+
+    /// The controller samples taken since the last reset.
+    pub fn samples_taken(&self) -> usize {
+        self.taken
+    }
+
+    /// The true state at the current time.
+    pub fn state(&self) -> &ModalState {
+        &self.current
+    }
+
+    /// The controller sample taken last ([`ControlSample::t`] is its time); zeros before the
+    /// first.
+    pub fn last_sample(&self) -> &ControlSample {
+        &self.sample
+    }
+
+    /// Back to the initial state at `t = 0`, with the noise re-seeded and the integrator
+    /// restarted. Allocates the noise sources and the integrator's workspace (once per run).
+    pub fn reset(&mut self) {
+        let s = &self.settings;
+        let m = self.n_coords();
+        self.taken = 0;
+        self.y[..m].copy_from_slice(&self.initial.a);
+        self.y[m..].copy_from_slice(&self.initial.a_dot);
+        self.current.a.copy_from_slice(&self.initial.a);
+        self.current.a_dot.copy_from_slice(&self.initial.a_dot);
+        self.stepper = Stepper::new(s.integrator, 2 * m);
+        self.reference_noise =
+            GaussianNoise::new(s.seed, REFERENCE_NOISE_STREAM, &s.reference_noise_std);
+        self.sensor_noise = GaussianNoise::new(s.seed, SENSOR_NOISE_STREAM, &s.sensor_noise_std);
+        self.sample = ControlSample::zeros(m);
+    }
+
+    /// Advances one controller period: takes the controller sample at the current time `t_k`
+    /// (reference, noise, `tau*`), then integrates the dynamics to `t_{k+1}` with `tau*` held.
+    /// Returns the sample taken (its state is the one at `t_k`).
+    ///
+    /// Fails if the reference, the controller or the integration fails, or the controller's
+    /// torque is not finite; the simulation then stays at `t_k`.
+    pub fn step(&mut self) -> Result<&ControlSample, SimError> {
+        self.take_sample()?;
+        self.integrate()?;
+        Ok(&self.sample)
+    }
+
+    /// The joint torques `tau = M J a_dd + C + G` (eq 13), the chain's tip and the reference tip
+    /// of the last sample. Allocation-free.
+    pub fn observe(&mut self) -> Result<Observation<'_>, SimError> {
+        let t = self.sample.t;
+        let plant = &mut self.plant;
+        let state = &self.sample.state;
+        modal_reduce::joint_torques(
+            &plant.model,
+            &mut plant.data,
+            &state.a,
+            &state.a_dot,
+            &self.sample.a_ddot,
+            &mut self.joint_torques,
+        )
+        .map_err(|source| SimError::Dynamics { t, source })?;
+        plant.model.map().joint_angles(&state.a, &mut self.theta)?;
+        let tip = backbone_kin::tip_position(&self.link_lengths, &self.theta)?;
+        let tip_ref = self.family.end_point(&self.sample.reference.a)?;
+        Ok(Observation {
+            joint_torques: &self.joint_torques,
+            tip,
+            tip_ref,
+        })
+    }
+
+    /// Runs the loop from the initial state for the whole duration (it [`reset`](Self::reset)s
+    /// first).
     ///
     /// At each controller sample `t_k = k * period` it samples the reference, adds the noise,
     /// asks the controller for `tau*`, checks the tracking error against the runaway bound and
-    /// integrates the dynamics to `t_{k+1}` with `tau*` held. Every `record_period` it records
-    /// the sample (state, reference, `tau*`, tips, joint torques `tau = M J a_dd + C + G` with
-    /// `a_dd` the acceleration at the sample under `tau*`). A runaway error, a non-finite torque,
-    /// a failing reference, controller or integration stops the run with a [`RunFailure`] that
-    /// says when and why and keeps the data recorded so far (the runaway sample included).
+    /// integrates the dynamics to `t_{k+1}` with `tau*` held ([`step`](Self::step)); the final
+    /// sample is taken but not integrated. Every `record_period` it records the sample (state,
+    /// reference, `tau*`, tips, joint torques `tau = M J a_dd + C + G` with `a_dd` the
+    /// acceleration at the sample under `tau*`, [`observe`](Self::observe)). A runaway error, a
+    /// non-finite torque, a failing reference, controller or integration stops the run with a
+    /// [`RunFailure`] that says when and why and keeps the data recorded so far (the runaway
+    /// sample included).
     pub fn run(&mut self) -> Result<Run, Box<RunFailure>> {
+        self.reset();
         let s = &self.settings;
+        let m = self.n_coords();
         let period = s.controller_period;
-        let (samples, record_every) = sample_counts(s);
-        let mut stepper = match s.integrator {
-            Integrator::Rk4 { dt } => Stepper::Rk4(Rk4::new(4), dt),
-            Integrator::DormandPrince(tol) => Stepper::DormandPrince(DormandPrince::new(4, tol)),
-        };
-        let mut reference_noise =
-            GaussianNoise::new(s.seed, REFERENCE_NOISE_STREAM, s.reference_noise_std);
-        let mut sensor_noise = GaussianNoise::new(s.seed, SENSOR_NOISE_STREAM, s.sensor_noise_std);
-        let n = self.plant.model.n_links();
-        let mut record = Record::with_capacity(n, recorded_samples(s));
-        let mut metrics = Metrics::new(n, s.joint_torque_limits.clone());
-        let (mut steps, mut rejected) = (0, 0);
-        let mut y = [
-            self.initial.a[0],
-            self.initial.a[1],
-            self.initial.a_dot[0],
-            self.initial.a_dot[1],
-        ];
         let max_error = s.max_modal_error;
+        let (samples, record_every) = sample_counts(s);
+        let n = self.plant.model.n_links();
+        let mut record = Record::with_capacity(m, n, recorded_samples(s));
+        let mut metrics = Metrics::new(m, n, s.joint_torque_limits.clone());
+        let (mut steps, mut rejected) = (0, 0);
         let fail = |error, record, metrics: &Metrics, steps, rejected| {
             Box::new(RunFailure {
                 error,
@@ -268,30 +468,43 @@ impl Simulation {
             })
         };
         for k in 0..=samples {
-            let t = k as f64 * period;
             let last = k == samples;
-            let control = match self.control(
-                t,
-                &mut y,
-                &mut stepper,
-                &mut reference_noise,
-                &mut sensor_noise,
-                !last,
-            ) {
-                Ok(control) => control,
-                Err(error) => return Err(fail(error, record, &metrics, steps, rejected)),
-            };
-            steps += control.steps.0;
-            rejected += control.steps.1;
-            metrics.add_control(t, control.tau_star, if last { 0.0 } else { period });
-            let runaway = (0..2)
-                .map(|i| (i, (control.state.a[i] - control.reference.a[i]).abs()))
+            let taken = self.take_sample().and_then(|()| {
+                if last {
+                    self.acceleration()
+                } else {
+                    self.integrate()
+                }
+            });
+            if let Err(error) = taken {
+                return Err(fail(error, record, &metrics, steps, rejected));
+            }
+            let sample = &self.sample;
+            let t = sample.t;
+            steps += sample.steps.0;
+            rejected += sample.steps.1;
+            metrics.add_control(t, &sample.tau_star, if last { 0.0 } else { period });
+            let runaway = (0..m)
+                .map(|i| (i, (sample.state.a[i] - sample.reference.a[i]).abs()))
                 .find(|&(_, e)| e > max_error || e.is_nan());
             if k % record_every == 0 || last || runaway.is_some() {
-                match self.observe(t, &control) {
-                    Ok(sample) => {
-                        metrics.add(&sample, &self.joint_torques);
-                        record.push(&sample, &self.joint_torques);
+                match self.observe() {
+                    Ok(observation) => {
+                        let (tip, tip_ref) = (observation.tip, observation.tip_ref);
+                        let sample = &self.sample;
+                        let row = Sample {
+                            t,
+                            a: &sample.state.a,
+                            a_dot: &sample.state.a_dot,
+                            a_ref: &sample.reference.a,
+                            a_ref_dot: &sample.reference.a_dot,
+                            a_cmd: &sample.command.a,
+                            tau_star: &sample.tau_star,
+                            tip,
+                            tip_ref,
+                        };
+                        metrics.add(&row, &self.joint_torques);
+                        record.push(&row, &self.joint_torques);
                     }
                     Err(error) => return Err(fail(error, record, &metrics, steps, rejected)),
                 }
@@ -312,123 +525,97 @@ impl Simulation {
         })
     }
 
-    /// The controller sample at time `t`: reference, noise, `tau*`; then (if `integrate`) the
-    /// dynamics from `y` to the next sample under the held `tau*`, else the acceleration at `y`.
-    fn control(
-        &mut self,
-        t: f64,
-        y: &mut [f64; 4],
-        stepper: &mut Stepper,
-        reference_noise: &mut Option<GaussianNoise<2>>,
-        sensor_noise: &mut Option<GaussianNoise<4>>,
-        integrate: bool,
-    ) -> Result<Control, SimError> {
-        let state = ModalState {
-            a: [y[0], y[1]],
-            a_dot: [y[2], y[3]],
+    /// The controller sample at the current time: state, reference, noise, `tau*` (into
+    /// `self.sample`; its acceleration and steps are set by [`integrate`](Self::integrate) or
+    /// [`acceleration`](Self::acceleration)).
+    fn take_sample(&mut self) -> Result<(), SimError> {
+        let m = self.n_coords();
+        let t = self.time();
+        let sample = &mut self.sample;
+        sample.t = t;
+        sample.steps = (0, 0);
+        sample.state.a.copy_from_slice(&self.y[..m]);
+        sample.state.a_dot.copy_from_slice(&self.y[m..]);
+        self.reference.sample(t, &mut sample.reference)?;
+        // Field by field: a derived `clone_from` would allocate.
+        sample.command.a.copy_from_slice(&sample.reference.a);
+        sample
+            .command
+            .a_dot
+            .copy_from_slice(&sample.reference.a_dot);
+        sample
+            .command
+            .a_ddot
+            .copy_from_slice(&sample.reference.a_ddot);
+        if let Some(noise) = &mut self.reference_noise {
+            noise.perturb(&mut sample.command.a);
+        }
+        self.measured.copy_from_slice(&self.y);
+        if let Some(noise) = &mut self.sensor_noise {
+            noise.perturb(&mut self.measured);
+        }
+        sample.measured.a.copy_from_slice(&self.measured[..m]);
+        sample.measured.a_dot.copy_from_slice(&self.measured[m..]);
+        let ctx = ControlContext {
+            t,
+            measured: &sample.measured,
+            reference: &sample.command,
+            model: &self.plant.model,
         };
-        let reference = self.reference.sample(t)?;
-        let mut command = reference;
-        if let Some(noise) = reference_noise {
-            noise.perturb(&mut command.a);
+        self.controller
+            .control(&ctx, &mut sample.tau_star)
+            .map_err(|error| SimError::from_controller(t, error))?;
+        if !sample.tau_star.iter().all(|v| v.is_finite()) {
+            return Err(SimError::NonFiniteControl {
+                t,
+                tau_star: sample.tau_star.clone(),
+            });
         }
-        let mut measured = *y;
-        if let Some(noise) = sensor_noise {
-            noise.perturb(&mut measured);
-        }
-        let measured = ModalState {
-            a: [measured[0], measured[1]],
-            a_dot: [measured[2], measured[3]],
-        };
-        let tau_star = self.controller.control(t, &measured, &command)?;
-        if !tau_star.iter().all(|v| v.is_finite()) {
-            return Err(SimError::NonFiniteControl { t, tau_star });
-        }
-        let plant = &mut self.plant;
-        plant.tau_star = tau_star;
-        let mut a_ddot = [0.0; 2];
-        let mut steps = (0, 0);
-        if integrate {
-            let period = self.settings.controller_period;
-            // The integrator's first stage is the acceleration at this sample under tau*.
-            let (stats, start) = match stepper {
-                Stepper::Rk4(rk4, dt) => {
-                    let stats = rk4.integrate(plant, t, t + period, y, *dt);
-                    (stats, rk4.start_derivative())
-                }
-                Stepper::DormandPrince(dp) => {
-                    let stats = dp.integrate(plant, t, t + period, y);
-                    (stats, dp.start_derivative())
-                }
-            };
-            let stats = stats.map_err(SimError::Integration)?;
-            a_ddot.copy_from_slice(&start[2..]);
-            steps = (stats.accepted, stats.rejected);
-        } else {
-            modal_reduce::forward_dynamics(
-                &plant.model,
-                &mut plant.data,
-                &state.a,
-                &state.a_dot,
-                &tau_star,
-                &mut a_ddot,
-            )
-            .map_err(|source| SimError::Dynamics { t, source })?;
-        }
-        Ok(Control {
-            state,
-            reference,
-            command: command.a,
-            tau_star,
-            a_ddot,
-            steps,
-        })
+        self.plant.tau_star.copy_from_slice(&sample.tau_star);
+        Ok(())
     }
 
-    /// The recorded view of a controller sample: joint torques `tau = M J a_dd + C + G` (into
-    /// `self.joint_torques`), the chain's tip and the reference tip.
-    fn observe(&mut self, t: f64, control: &Control) -> Result<Sample, SimError> {
+    /// Integrates from the sample just taken to the next one under its held `tau*`; the
+    /// integrator's first stage is the acceleration at the sample.
+    fn integrate(&mut self) -> Result<(), SimError> {
+        let m = self.n_coords();
+        let t = self.sample.t;
+        let period = self.settings.controller_period;
         let plant = &mut self.plant;
-        let state = &control.state;
-        modal_reduce::joint_torques(
+        let (stats, start) = match &mut self.stepper {
+            Stepper::Rk4(rk4, dt) => {
+                let stats = rk4.integrate(plant, t, t + period, &mut self.y, *dt);
+                (stats, rk4.start_derivative())
+            }
+            Stepper::DormandPrince(dp) => {
+                let stats = dp.integrate(plant, t, t + period, &mut self.y);
+                (stats, dp.start_derivative())
+            }
+        };
+        let stats = stats.map_err(SimError::Integration)?;
+        self.sample.a_ddot.copy_from_slice(&start[m..]);
+        self.sample.steps = (stats.accepted, stats.rejected);
+        self.taken += 1;
+        self.current.a.copy_from_slice(&self.y[..m]);
+        self.current.a_dot.copy_from_slice(&self.y[m..]);
+        Ok(())
+    }
+
+    /// The acceleration at the sample just taken under its `tau*`, without integrating.
+    fn acceleration(&mut self) -> Result<(), SimError> {
+        let t = self.sample.t;
+        let plant = &mut self.plant;
+        let state = &self.sample.state;
+        modal_reduce::forward_dynamics(
             &plant.model,
             &mut plant.data,
             &state.a,
             &state.a_dot,
-            &control.a_ddot,
-            &mut self.joint_torques,
+            &plant.tau_star,
+            &mut self.sample.a_ddot,
         )
-        .map_err(|source| SimError::Dynamics { t, source })?;
-        plant.model.map().joint_angles(&state.a, &mut self.theta)?;
-        let tip = backbone_kin::tip_position(&self.link_lengths, &self.theta)?;
-        let tip_ref = backbone_kin::end_point(self.curve_length, control.reference.a, self.alpha0)?;
-        Ok(Sample {
-            t,
-            a: state.a,
-            a_dot: state.a_dot,
-            a_ref: control.reference.a,
-            a_ref_dot: control.reference.a_dot,
-            a_cmd: control.command,
-            tau_star: control.tau_star,
-            tip,
-            tip_ref,
-        })
+        .map_err(|source| SimError::Dynamics { t, source })
     }
-}
-
-/// One controller sample before it is observed.
-struct Control {
-    /// The true state at the sample.
-    state: ModalState,
-    /// The noise-free reference.
-    reference: ReferenceSample,
-    /// The reference as the controller saw it.
-    command: [f64; 2],
-    tau_star: [f64; 2],
-    /// The acceleration at the sample under `tau_star`.
-    a_ddot: [f64; 2],
-    /// Accepted and rejected integrator steps to the next sample.
-    steps: (usize, usize),
 }
 
 /// `numerator / denominator` if it is a whole number (up to [`PERIOD_SLACK`]).
@@ -463,8 +650,8 @@ fn sample_counts(s: &LoopSettings) -> (usize, usize) {
     (samples, record_every)
 }
 
-/// Checks the settings of a loop for a chain of `n_links`.
-fn validate(s: &LoopSettings, n_links: usize) -> Result<(), SimError> {
+/// Checks the settings of a loop of `m` coordinates for a chain of `n_links`.
+fn validate(s: &LoopSettings, m: usize, n_links: usize) -> Result<(), SimError> {
     check_positive("controller.period", s.controller_period)?;
     check_positive("duration", s.duration)?;
     check_positive("record_period", s.record_period)?;
@@ -512,11 +699,22 @@ fn validate(s: &LoopSettings, n_links: usize) -> Result<(), SimError> {
             .check()
             .map_err(|reason| SimError::setting("integrator", format!("setting: {reason}")))?,
     }
-    for v in s.reference_noise_std {
-        check_non_negative("noise.reference_std", v)?;
-    }
-    for v in s.sensor_noise_std {
-        check_non_negative("noise.sensor_std", v)?;
+    for (name, values, len) in [
+        ("noise.reference_std", &s.reference_noise_std, m),
+        ("noise.sensor_std", &s.sensor_noise_std, 2 * m),
+    ] {
+        if !values.is_empty() && values.len() != len {
+            return Err(SimError::setting(
+                name,
+                format!(
+                    "has {} entries, the loop needs {len} (or none)",
+                    values.len()
+                ),
+            ));
+        }
+        for &v in values {
+            check_non_negative(name, v)?;
+        }
     }
     if s.max_modal_error.is_nan() || s.max_modal_error <= 0.0 {
         return Err(SimError::setting(
@@ -524,7 +722,7 @@ fn validate(s: &LoopSettings, n_links: usize) -> Result<(), SimError> {
             format!("must be positive, got {}", s.max_modal_error),
         ));
     }
-    let recorded = recorded_samples(s).saturating_mul(Record::values_per_sample(n_links));
+    let recorded = recorded_samples(s).saturating_mul(Record::values_per_sample(m, n_links));
     if recorded > MAX_RECORDED_VALUES {
         return Err(SimError::setting(
             "record_period",

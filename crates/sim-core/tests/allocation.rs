@@ -1,7 +1,7 @@
 //! The closed loop allocates per run, never per step: the number of allocations of a run does
 //! not depend on how many steps it takes.
 
-use sim_core::{ControllerKind, Scenario};
+use sim_core::{Alpha0, ControllerKind, NoiseSpec, ReferenceSpec, Scenario};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -46,7 +46,7 @@ fn allocations_do_not_grow_with_the_number_of_steps() {
         for name in ["paper-tracking", "paper-responses-noise"] {
             let mut scenario = Scenario::builtin(name).unwrap();
             scenario.controller.kind = kind;
-            scenario.noise.sensor_a_std = [1e-3, 1e-3];
+            scenario.noise.sensor_a_std = Some(vec![1e-3, 1e-3]);
             let (short, long) = (allocations(&scenario, 0.05), allocations(&scenario, 0.5));
             assert_eq!(
                 short, long,
@@ -68,4 +68,26 @@ fn allocations_do_not_grow_with_the_number_of_steps() {
     large.arm.link_length = Some(0.01);
     large.arm.link_mass = Some(0.01);
     assert_eq!(allocations(&large, 0.05), allocations(&large, 0.5));
+    // Every modal family of m = 2, 3, 4, 5 coordinates, on a constant reference with noise and on
+    // the paper's path (through the numerical continuation for m > 2).
+    for m in 2..=5 {
+        for kind in ControllerKind::ALL {
+            for name in ["paper-responses-sine", "paper-tracking"] {
+                let mut scenario = Scenario::builtin(name).unwrap();
+                scenario.modal.harmonics = m / 2;
+                if m % 2 == 1 {
+                    scenario.alpha0 = Alpha0::Free;
+                }
+                scenario.controller.kind = kind;
+                scenario.noise = NoiseSpec::uniform(m, 1e-3, 1e-2, 1e-3);
+                if name == "paper-responses-sine" {
+                    let mut a = vec![0.1; m];
+                    a[m - 1] = if m % 2 == 1 { 1.5 } else { -0.1 };
+                    scenario.reference = ReferenceSpec::Constant { a };
+                }
+                let (short, long) = (allocations(&scenario, 0.05), allocations(&scenario, 0.5));
+                assert_eq!(short, long, "{name}, m = {m}, {kind}: {short} vs {long}");
+            }
+        }
+    }
 }

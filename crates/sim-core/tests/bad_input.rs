@@ -2,7 +2,7 @@
 //! each bad setting is refused with the named [`SimError`] or [`OdeError`] variant when the
 //! simulation is built, never half-way through a run, and a failing run keeps its data.
 
-use backbone_kin::{Branch, ModalMap};
+use backbone_kin::{BaseAngle, Branch, ModalMap};
 use manip_dyn::ChainModel;
 use modal_reduce::ReducedModel;
 use sim_core::controller::{ComputedTorque, FuzzyController, PdController};
@@ -27,9 +27,8 @@ fn settings() -> LoopSettings {
 
 /// Builds the paper's arm under `settings` with a PD law tracking a step.
 fn build(settings: LoopSettings) -> Result<Simulation, SimError> {
-    let reference = Step::new([0.0, 0.0], [0.2, -0.1], 0.0).unwrap();
-    let controller =
-        PdController::new([0.0; 2], [[-5.0, 0.0, -1.0, 0.0], [0.0, -5.0, 0.0, -1.0]]).unwrap();
+    let reference = Step::new(&[0.0, 0.0], &[0.2, -0.1], 0.0).unwrap();
+    let controller = PdController::new(&[0.0; 2], &[5.0, 5.0], &[1.0, 1.0]).unwrap();
     Simulation::new(
         paper_model(),
         Box::new(reference),
@@ -55,7 +54,7 @@ fn invalid(result: Result<Simulation, SimError>) -> (String, String) {
 }
 
 #[test]
-fn model_with_alpha0_free() {
+fn reference_and_controller_of_another_size_than_the_model() {
     let free = ReducedModel::new(
         ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
         ModalMap::paper(10).unwrap(),
@@ -63,14 +62,18 @@ fn model_with_alpha0_free() {
     .unwrap();
     let result = Simulation::new(
         free,
-        Box::new(Step::constant([0.0; 2]).unwrap()),
-        Box::new(PdController::new([0.0; 2], [[0.0; 4]; 2]).unwrap()),
+        Box::new(Step::constant(&[0.0; 2]).unwrap()),
+        Box::new(PdController::new(&[0.0; 2], &[0.0; 2], &[0.0; 2]).unwrap()),
         settings(),
         None,
     );
+    // The model with alpha0 free has 3 coordinates: the 2-coordinate reference is refused first.
     let (name, message) = invalid(result);
-    assert_eq!(name, "model");
-    assert!(message.contains("two coordinates (a1, a2) with alpha0 fixed"));
+    assert_eq!(name, "reference");
+    assert!(
+        message.contains("sets 2 coordinates, the model has 3"),
+        "{message}"
+    );
 }
 
 #[test]
@@ -182,12 +185,12 @@ fn dormand_prince_tolerances_out_of_domain() {
 #[test]
 fn noise_negative_or_non_finite() {
     let s = LoopSettings {
-        reference_noise_std: [0.0, -0.1],
+        reference_noise_std: vec![0.0, -0.1],
         ..settings()
     };
     assert_eq!(invalid(build(s)).0, "noise.reference_std");
     let s = LoopSettings {
-        sensor_noise_std: [0.0, 0.0, f64::INFINITY, 0.0],
+        sensor_noise_std: vec![0.0, 0.0, f64::INFINITY, 0.0],
         ..settings()
     };
     assert_eq!(invalid(build(s)).0, "noise.sensor_std");
@@ -269,12 +272,12 @@ fn run_too_long_to_record() {
 fn non_finite_initial_state() {
     let result = Simulation::new(
         paper_model(),
-        Box::new(Step::constant([0.0; 2]).unwrap()),
-        Box::new(PdController::new([0.0; 2], [[0.0; 4]; 2]).unwrap()),
+        Box::new(Step::constant(&[0.0; 2]).unwrap()),
+        Box::new(PdController::new(&[0.0; 2], &[0.0; 2], &[0.0; 2]).unwrap()),
         settings(),
         Some(sim_core::controller::ModalState {
-            a: [0.0, f64::NAN],
-            a_dot: [0.0; 2],
+            a: vec![0.0, f64::NAN],
+            a_dot: vec![0.0; 2],
         }),
     );
     assert_eq!(invalid(result).0, "initial.a");
@@ -283,11 +286,11 @@ fn non_finite_initial_state() {
 #[test]
 fn step_reference_non_finite_or_negative_time() {
     assert!(matches!(
-        Step::new([f64::NAN, 0.0], [0.0; 2], 0.0),
+        Step::new(&[f64::NAN, 0.0], &[0.0; 2], 0.0),
         Err(SimError::InvalidSetting { ref name, .. }) if name == "reference.initial"
     ));
     assert!(matches!(
-        Step::new([0.0; 2], [0.0; 2], -1.0),
+        Step::new(&[0.0; 2], &[0.0; 2], -1.0),
         Err(SimError::InvalidSetting { ref name, .. }) if name == "reference.time"
     ));
 }
@@ -295,7 +298,7 @@ fn step_reference_non_finite_or_negative_time() {
 #[test]
 fn sinusoid_negative_frequency() {
     assert!(matches!(
-        Sinusoid::new([0.0; 2], [0.1; 2], [-1.0, 1.0], [0.0; 2]),
+        Sinusoid::new(&[0.0; 2], &[0.1; 2], &[-1.0, 1.0], &[0.0; 2]),
         Err(SimError::InvalidSetting { ref name, .. }) if name == "reference.frequency_hz"
     ));
 }
@@ -303,7 +306,15 @@ fn sinusoid_negative_frequency() {
 #[test]
 fn path_point_out_of_reach() {
     let shape = PathShape::Polyline(vec![[0.3, 0.5], [1.5, 0.5]]);
-    let err = CartesianPath::new(shape, 5.0, 1.0, FRAC_PI_2, Branch::Positive).unwrap_err();
+    let err = CartesianPath::new(
+        shape,
+        5.0,
+        1.0,
+        1,
+        BaseAngle::Fixed(FRAC_PI_2),
+        Branch::Positive,
+    )
+    .unwrap_err();
     assert!(
         matches!(err, SimError::Unreachable { ref source, .. } if source.is_unreachable()),
         "{err:?}"
@@ -336,7 +347,15 @@ fn path_degenerate() {
         ),
     ];
     for (shape, setting) in cases {
-        let err = CartesianPath::new(shape, 5.0, 1.0, FRAC_PI_2, Branch::Positive).unwrap_err();
+        let err = CartesianPath::new(
+            shape,
+            5.0,
+            1.0,
+            1,
+            BaseAngle::Fixed(FRAC_PI_2),
+            Branch::Positive,
+        )
+        .unwrap_err();
         assert!(
             matches!(err, SimError::InvalidSetting { ref name, .. } if name == setting),
             "{err:?}"
@@ -345,7 +364,7 @@ fn path_degenerate() {
     let shape = PathShape::Polyline(vec![[0.3, 0.5], [0.4, 0.5]]);
     for travel_time in [0.0, -1.0, f64::INFINITY] {
         assert!(matches!(
-            CartesianPath::new(shape.clone(), travel_time, 1.0, FRAC_PI_2, Branch::Positive),
+            CartesianPath::new(shape.clone(), travel_time, 1.0, 1, BaseAngle::Fixed(FRAC_PI_2), Branch::Positive),
             Err(SimError::InvalidSetting { ref name, .. }) if name == "reference.travel_time"
         ));
     }
@@ -354,11 +373,11 @@ fn path_degenerate() {
 #[test]
 fn controller_gains_out_of_domain() {
     assert!(matches!(
-        PdController::new([0.0, f64::NAN], [[0.0; 4]; 2]),
+        PdController::new(&[0.0, f64::NAN], &[0.0; 2], &[0.0; 2]),
         Err(SimError::InvalidSetting { ref name, .. }) if name == "controller offset"
     ));
     assert!(matches!(
-        ComputedTorque::new(paper_model(), [-1.0, 1.0], [1.0, 1.0]),
+        ComputedTorque::new(&paper_model(), &[-1.0, 1.0], &[1.0, 1.0]),
         Err(SimError::InvalidSetting { ref name, .. }) if name == "controller.kp"
     ));
 }
@@ -379,7 +398,7 @@ fn fuzzy_controller_of_the_wrong_shape() {
         .rule(["z"], ["zero"])
         .build()
         .unwrap();
-    let err = FuzzyController::new(system).unwrap_err();
+    let err = FuzzyController::new(system, 2).unwrap_err();
     assert!(matches!(err, SimError::InvalidSetting { ref name, .. } if name == "controller.fis"));
     assert!(err.to_string().contains("has 1 inputs and 1 outputs"));
 }

@@ -6,11 +6,11 @@
 use backbone_kin::ModalMap;
 use manip_dyn::ChainModel;
 use modal_reduce::ReducedModel;
-use sim_core::controller::{Controller, ModalState, PdController};
-use sim_core::reference::{ReferenceSample, Step};
+use sim_core::controller::{ControlContext, Controller, ControllerError, ModalState, PdController};
+use sim_core::reference::Step;
 use sim_core::{
-    ControllerKind, InitialSpec, Integrator, IntegratorSpec, LoopSettings, ReferenceSpec, Scenario,
-    SimError, Simulation, TorqueLimit,
+    Alpha0, ControllerKind, InitialSpec, Integrator, IntegratorSpec, LoopSettings, ReferenceSpec,
+    Scenario, SimError, Simulation, TorqueLimit,
 };
 use std::f64::consts::{FRAC_PI_2, TAU};
 
@@ -48,9 +48,9 @@ fn computed_torque_holds_a_pose_exactly_and_converges_to_machine_precision() {
         .unwrap();
     let last = run.record.len() - 1;
     for i in 0..2 {
-        let e = run.record.a[last][i] - run.record.a_ref[last][i];
+        let e = run.record.a_at(last)[i] - run.record.a_ref_at(last)[i];
         assert!(e.abs() < 1e-13, "final error of a{} = {e:e}", i + 1);
-        assert!(run.record.a_dot[last][i].abs() < 1e-12);
+        assert!(run.record.a_dot_at(last)[i].abs() < 1e-12);
     }
     // The chain's tip then sits on the reference tip up to the chain's aliasing (model notes).
     let tip_error = (run.record.tip[last][0] - run.record.tip_ref[last][0])
@@ -68,8 +68,8 @@ fn computed_torque_tracking_error_is_first_order_in_the_hold_period() {
             s.controller.period = Some(period);
             s.record_period = Some(period);
             s.initial = Some(InitialSpec {
-                a: [0.0, 0.1],
-                a_dot: [0.3 * TAU * 0.5, 0.15 * TAU],
+                a: vec![0.0, 0.1],
+                a_dot: Some(vec![0.3 * TAU * 0.5, 0.15 * TAU]),
             });
             s.build().unwrap().run().unwrap().summary.modal_error_rms[0]
         })
@@ -94,7 +94,7 @@ fn recorded_joint_torques_realise_the_modal_torques() {
             let mut projected = [0.0; 2];
             modal_reduce::project_torques(&model, run.record.joint_torques_at(k), &mut projected)
                 .unwrap();
-            for (p, tau) in projected.iter().zip(run.record.tau_star[k]) {
+            for (p, tau) in projected.iter().zip(run.record.tau_star_at(k)) {
                 assert!(
                     (p - tau).abs() < 1e-10 * (1.0 + tau.abs()),
                     "{kind} at t = {}",
@@ -108,8 +108,8 @@ fn recorded_joint_torques_realise_the_modal_torques() {
 #[test]
 fn seeded_runs_are_reproducible_bit_for_bit() {
     let mut noisy = scenario("paper-responses-noise", ControllerKind::Fuzzy, 0.3);
-    noisy.noise.sensor_a_std = [1e-3, 1e-3];
-    noisy.noise.sensor_a_dot_std = [1e-2, 1e-2];
+    noisy.noise.sensor_a_std = Some(vec![1e-3, 1e-3]);
+    noisy.noise.sensor_a_dot_std = Some(vec![1e-2, 1e-2]);
     let first = noisy.build().unwrap().run().unwrap();
     let mut sim = noisy.build().unwrap();
     let second = sim.run().unwrap();
@@ -142,7 +142,7 @@ fn adaptive_and_fixed_step_integration_agree() {
     for k in 0..a.record.len() {
         for i in 0..2 {
             assert!(
-                (a.record.a[k][i] - b.record.a[k][i]).abs() < 1e-8,
+                (a.record.a_at(k)[i] - b.record.a_at(k)[i]).abs() < 1e-8,
                 "t = {}",
                 a.record.t[k]
             );
@@ -183,7 +183,7 @@ fn paper_tracking_matches_its_description() {
     let s = Scenario::builtin("paper-tracking").unwrap();
     let sim = s.build().unwrap();
     let start = sim.initial_state();
-    let tip = backbone_kin::end_point(1.0, start.a, FRAC_PI_2).unwrap();
+    let tip = backbone_kin::end_point(1.0, [start.a[0], start.a[1]], FRAC_PI_2).unwrap();
     assert!((tip[0] - 0.08).abs() < 1e-12 && (tip[1] - (0.4 * 0.4f64.sin() + 0.2)).abs() < 1e-12);
     assert_eq!(start.a_dot, [0.0; 2]);
     assert_eq!(sim.settings().controller_period, 1e-4);
@@ -214,16 +214,16 @@ fn fuzzy_tracking_of_the_paper_path_is_millimetre_level_and_gc_helps() {
 
 /// A controller that pushes away from the reference: the loop must stop it.
 fn unstable_pd() -> Box<dyn Controller> {
-    Box::new(PdController::new([0.0; 2], [[50.0, 0.0, 0.0, 0.0], [0.0, 50.0, 0.0, 0.0]]).unwrap())
+    Box::new(PdController::new(&[0.0; 2], &[-50.0, -50.0], &[0.0; 2]).unwrap())
 }
 
 #[test]
 fn runaway_error_stops_the_run_and_keeps_the_data() {
-    let reference = Step::new([0.0, 0.0], [0.05, 0.0], 0.0).unwrap();
+    let reference = Step::new(&[0.0, 0.0], &[0.05, 0.0], 0.0).unwrap();
     let mut settings = LoopSettings::new(Integrator::Rk4 { dt: 1e-4 }, 1e-4, 5.0);
     settings.record_period = 1e-2;
     settings.max_modal_error = 0.5;
-    let initial = Some(ModalState::default());
+    let initial = Some(ModalState::zeros(2));
     let mut sim = Simulation::new(
         paper_model(),
         Box::new(reference),
@@ -255,18 +255,18 @@ struct Constant([f64; 2]);
 impl Controller for Constant {
     fn control(
         &mut self,
-        _: f64,
-        _: &ModalState,
-        _: &ReferenceSample,
-    ) -> Result<[f64; 2], SimError> {
-        Ok(self.0)
+        _: &ControlContext<'_>,
+        tau_star: &mut [f64],
+    ) -> Result<(), ControllerError> {
+        tau_star.copy_from_slice(&self.0);
+        Ok(())
     }
 }
 
 #[test]
 fn non_finite_torques_and_blow_ups_stop_the_run() {
     let build = |tau: [f64; 2]| {
-        let reference = Step::constant([0.1, 0.1]).unwrap();
+        let reference = Step::constant(&[0.1, 0.1]).unwrap();
         let mut settings = LoopSettings::new(Integrator::Rk4 { dt: 1e-3 }, 1e-3, 1.0);
         settings.max_modal_error = f64::INFINITY;
         Simulation::new(
@@ -342,8 +342,8 @@ fn summary_metrics_are_the_record_statistics() {
     let peak = r.joint_torques.iter().fold(0.0f64, |m, t| m.max(t.abs()));
     assert_eq!(run.summary.peak_joint_torque_nm, peak);
     // Every controller period is recorded here, so the effort is the record's rectangle sum.
-    let effort: f64 = r.tau_star[..r.len() - 1]
-        .iter()
+    let effort: f64 = (0..r.len() - 1)
+        .map(|k| r.tau_star_at(k))
         .map(|t| (t[0] * t[0] + t[1] * t[1]) * 1e-3)
         .sum();
     assert_eq!(run.summary.controller_samples, 10_001);
@@ -387,7 +387,9 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
         .contains("whole number of RK4 steps")
     );
     assert!(invalid(|s| s.duration = 2.00005).contains("duration"));
-    assert!(invalid(|s| s.noise.reference_std = [-0.1, 0.0]).contains("noise.reference_std"));
+    assert!(
+        invalid(|s| s.noise.reference_std = Some(vec![-0.1, 0.0])).contains("noise.reference_std")
+    );
     assert!(
         invalid(|s| {
             s.arm.links = Some(10);
@@ -481,4 +483,210 @@ fn simulations_can_run_on_worker_threads() {
     .join()
     .unwrap();
     assert_eq!(on_thread, scenario.build().unwrap().run().unwrap());
+}
+
+/// A step of the reference in every coordinate of the family with `m` coordinates (`K = m / 2`
+/// harmonics, `alpha0` free when `m` is odd), from rest on the paper's arm.
+fn family_step(m: usize, kind: ControllerKind, duration: f64) -> Scenario {
+    let mut s = scenario("paper-responses-step", kind, duration);
+    s.modal.harmonics = m / 2;
+    let mut initial = vec![0.0; m];
+    let mut target: Vec<f64> = (0..m)
+        .map(|i| if i % 2 == 0 { 0.1 } else { -0.05 })
+        .collect();
+    if m % 2 == 1 {
+        s.alpha0 = Alpha0::Free;
+        initial[m - 1] = FRAC_PI_2;
+        target[m - 1] = FRAC_PI_2 + 0.1;
+    }
+    s.reference = ReferenceSpec::Step {
+        initial: Some(initial),
+        target,
+        time: 0.1,
+    };
+    s
+}
+
+#[test]
+fn the_loop_runs_every_controller_for_m_2_to_5() {
+    for m in 2..=5 {
+        // Computed torque with the exact model: the error dynamics e'' + 100 e' + 2500 e = 0
+        // leave only rounding after 1.5 s, whatever the family.
+        let run = family_step(m, ControllerKind::ComputedTorque, 2.0)
+            .build()
+            .unwrap()
+            .run()
+            .unwrap();
+        let last = run.record.len() - 1;
+        assert_eq!(run.record.n_coords, m);
+        assert_eq!(run.summary.modal_error_rms.len(), m);
+        for i in 0..m {
+            let e = run.record.a_at(last)[i] - run.record.a_ref_at(last)[i];
+            assert!(
+                e.abs() < 1e-11,
+                "m = {m}: final error of coordinate {i} = {e:e}"
+            );
+        }
+        // The recorded joint torques realise the modal torques: J^T tau = tau*.
+        let model = family_step(m, ControllerKind::Fuzzy, 1.0).model().unwrap();
+        let mut projected = vec![0.0; m];
+        for k in (0..run.record.len()).step_by(100) {
+            modal_reduce::project_torques(&model, run.record.joint_torques_at(k), &mut projected)
+                .unwrap();
+            for (p, tau) in projected.iter().zip(run.record.tau_star_at(k)) {
+                assert!((p - tau).abs() < 1e-9 * (1.0 + tau.abs()), "m = {m}");
+            }
+        }
+        // The other controllers hold the step without diverging.
+        for kind in [
+            ControllerKind::Fuzzy,
+            ControllerKind::Pd,
+            ControllerKind::FuzzyGc,
+        ] {
+            let run = family_step(m, kind, 1.0).build().unwrap().run().unwrap();
+            assert!(
+                run.summary.modal_error_max.iter().all(|e| *e < 0.5),
+                "m = {m}, {kind}: {:?}",
+                run.summary.modal_error_max
+            );
+        }
+    }
+}
+
+#[test]
+fn stepping_by_hand_is_the_run() {
+    let close = |x: &[f64], y: &[f64]| {
+        x.iter()
+            .zip(y)
+            .all(|(p, q)| (p - q).abs() <= 1e-12 * (1.0 + q.abs()))
+    };
+    for m in [2, 5] {
+        let mut scenario = family_step(m, ControllerKind::FuzzyGc, 0.2);
+        scenario.record_period = None; // record every controller sample
+        let mut sim = scenario.build().unwrap();
+        let run = sim.run().unwrap();
+        sim.reset();
+        assert_eq!(sim.time(), 0.0);
+        assert_eq!(sim.state(), sim.initial_state());
+        let mut k = 0;
+        while sim.samples_taken() < run.summary.controller_samples - 1 {
+            let sample = sim.step().unwrap();
+            assert_eq!(sample.state.a, run.record.a_at(k), "m = {m}, sample {k}");
+            assert_eq!(sample.tau_star, run.record.tau_star_at(k));
+            let observed = sim.observe().unwrap();
+            assert!(
+                close(observed.joint_torques, run.record.joint_torques_at(k)),
+                "m = {m}, sample {k}"
+            );
+            assert!(close(&observed.tip, &run.record.tip[k]));
+            k += 1;
+        }
+        assert!((sim.time() - 0.2).abs() < 1e-12);
+        assert_eq!(sim.state().a, run.record.a_at(k));
+    }
+}
+
+/// Fails with an error of its own after 0.05 s.
+struct Tired;
+
+#[derive(Debug)]
+struct TiredError(f64);
+
+impl std::fmt::Display for TiredError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "tired after {} s", self.0)
+    }
+}
+
+impl std::error::Error for TiredError {}
+
+impl Controller for Tired {
+    fn control(
+        &mut self,
+        ctx: &ControlContext<'_>,
+        tau_star: &mut [f64],
+    ) -> Result<(), ControllerError> {
+        if ctx.t >= 0.05 {
+            return Err(Box::new(TiredError(ctx.t)));
+        }
+        // Hold the arm against gravity with the model the loop lends.
+        let mut data = modal_reduce::ReducedData::new(ctx.model);
+        modal_reduce::reduced_terms(ctx.model, &mut data, &ctx.measured.a, &ctx.measured.a_dot)?;
+        tau_star.copy_from_slice(data.gravity());
+        Ok(())
+    }
+}
+
+#[test]
+fn a_foreign_controller_error_stops_the_run_with_its_source() {
+    let reference = Step::constant(&[0.1, 0.1]).unwrap();
+    let mut settings = LoopSettings::new(Integrator::Rk4 { dt: 1e-3 }, 1e-3, 1.0);
+    settings.record_period = 1e-2;
+    let mut sim = Simulation::new(
+        paper_model(),
+        Box::new(reference),
+        Box::new(Tired),
+        settings,
+        None,
+    )
+    .unwrap();
+    let failure = sim.run().unwrap_err();
+    let SimError::Controller { t, source } = &failure.error else {
+        panic!("unexpected {failure}");
+    };
+    assert!((t - 0.05).abs() < 1e-12);
+    let inner = std::error::Error::source(source).expect("the controller's error");
+    assert!(inner.downcast_ref::<TiredError>().is_some());
+    assert!(
+        failure.to_string().contains("tired after 0.05"),
+        "{failure}"
+    );
+    // Held against gravity until then, and recorded up to the last good sample.
+    assert_eq!(failure.record.t.last(), Some(&0.04));
+    assert!(failure.summary.modal_error_max.iter().all(|e| *e < 1e-6));
+}
+
+#[test]
+fn sizes_that_do_not_match_the_family_are_refused() {
+    // A two-coordinate controller on a three-coordinate model, and a reference of the wrong size.
+    let three = family_step(3, ControllerKind::Fuzzy, 0.1).model().unwrap();
+    let settings = LoopSettings::new(Integrator::Rk4 { dt: 1e-3 }, 1e-3, 0.1);
+    let err = Simulation::new(
+        three.clone(),
+        Box::new(Step::constant(&[0.1, 0.1, 1.5]).unwrap()),
+        unstable_pd(),
+        settings.clone(),
+        None,
+    )
+    .err()
+    .unwrap();
+    assert!(err.to_string().contains("built for 2"), "{err}");
+    let err = Simulation::new(
+        three,
+        Box::new(Step::constant(&[0.1, 0.1]).unwrap()),
+        Box::new(Tired),
+        settings,
+        None,
+    )
+    .err()
+    .unwrap();
+    assert!(err.to_string().contains("reference sets 2"), "{err}");
+}
+
+#[test]
+fn computed_torque_tracks_the_other_families_below_a_millimetre() {
+    // The shipped tracking task with two harmonics (m = 4) and with alpha0 free (m = 3): the
+    // exact model leaves only the hold's error, as on the paper's family.
+    for (name, m) in [("harmonic-tracking", 4), ("free-base-tracking", 3)] {
+        let mut scenario = Scenario::builtin(name).unwrap();
+        assert_eq!(scenario.n_coords(), m);
+        scenario.controller.kind = ControllerKind::ComputedTorque;
+        let run = scenario.build().unwrap().run().unwrap();
+        assert_eq!(run.summary.modal_error_rms.len(), m);
+        assert!(
+            run.summary.tip_error_rms_m < 1e-3,
+            "{name}: tip RMS {} m",
+            run.summary.tip_error_rms_m
+        );
+    }
 }

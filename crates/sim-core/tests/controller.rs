@@ -1,27 +1,56 @@
 //! Controllers against independent facts: the hand-computed slope of the paper's fuzzy system,
-//! and the reduced forward dynamics for computed torque and gravity compensation.
+//! the fuzzy system evaluated directly, and the reduced forward dynamics for computed torque and
+//! gravity compensation, for every modal family of `m = 2, 3, 4, 5` coordinates.
 
-use backbone_kin::ModalMap;
+use backbone_kin::{BaseAngle, ModalMap};
 use fuzzy_sugeno::{Evaluator, paper_controller};
 use manip_dyn::ChainModel;
 use modal_reduce::{ReducedData, ReducedModel, forward_dynamics};
 use proptest::prelude::*;
 use sim_core::SimError;
-use sim_core::controller::{ComputedTorque, Controller, FuzzyController, ModalState, PdController};
+use sim_core::controller::{
+    ComputedTorque, ControlContext, Controller, FuzzyController, ModalState, PdController,
+};
 use sim_core::reference::ReferenceSample;
 
-fn paper_model() -> ReducedModel {
+/// The paper's arm with `m` coordinates: `K = m / 2` harmonics, `alpha0` free when `m` is odd.
+fn model(m: usize) -> ReducedModel {
+    let base = if m.is_multiple_of(2) {
+        BaseAngle::Fixed(std::f64::consts::FRAC_PI_2)
+    } else {
+        BaseAngle::Free
+    };
     ReducedModel::new(
         ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
-        ModalMap::paper_fixed_alpha0(10, std::f64::consts::FRAC_PI_2).unwrap(),
+        ModalMap::uniform(10, m / 2, base).unwrap(),
     )
     .unwrap()
 }
 
-fn accelerations(model: &ReducedModel, state: &ModalState, tau: [f64; 2]) -> [f64; 2] {
+/// `controller`'s torque for `model` at `measured` and `reference`.
+fn control(
+    controller: &mut dyn Controller,
+    model: &ReducedModel,
+    measured: &ModalState,
+    reference: &ReferenceSample,
+) -> Result<Vec<f64>, SimError> {
+    let mut tau = vec![0.0; model.n_coords()];
+    let ctx = ControlContext {
+        t: 0.0,
+        measured,
+        reference,
+        model,
+    };
+    controller
+        .control(&ctx, &mut tau)
+        .map_err(|e| SimError::from_controller(0.0, e))?;
+    Ok(tau)
+}
+
+fn accelerations(model: &ReducedModel, state: &ModalState, tau: &[f64]) -> Vec<f64> {
     let mut data = ReducedData::new(model);
-    let mut a_ddot = [0.0; 2];
-    forward_dynamics(model, &mut data, &state.a, &state.a_dot, &tau, &mut a_ddot).unwrap();
+    let mut a_ddot = vec![0.0; tau.len()];
+    forward_dynamics(model, &mut data, &state.a, &state.a_dot, tau, &mut a_ddot).unwrap();
     a_ddot
 }
 
@@ -29,117 +58,160 @@ fn accelerations(model: &ReducedModel, state: &ModalState, tau: [f64; 2]) -> [f6
 fn pd_gains_are_the_paper_fuzzy_slope() {
     // By hand: at the origin each bell is 1/2 with slope -+1/r, so d tau1/d da1 =
     // (1/2r)(-(VP + P) + (N + VN)) = -180/0.3 and d tau1/d a1_dot = (1/2)(-(VP + N) + (P + VN)).
-    let pd = PdController::from_fuzzy_slope(&paper_controller()).unwrap();
-    let expected = [[-600.0, 0.0, -20.0, 0.0], [0.0, -300.0, 0.0, -10.0]];
-    for (row, expected_row) in pd.gains().iter().zip(expected) {
-        for (gain, value) in row.iter().zip(expected_row) {
-            assert!((gain - value).abs() < 1e-6, "K = {:?}", pd.gains());
+    // Per pair for more coordinates; a free alpha0 (last of an odd m) takes a1's rules.
+    let expected: [(&[f64], &[f64]); 4] = [
+        (&[600.0, 300.0], &[20.0, 10.0]),
+        (&[600.0, 300.0, 600.0], &[20.0, 10.0, 20.0]),
+        (&[600.0, 300.0, 600.0, 300.0], &[20.0, 10.0, 20.0, 10.0]),
+        (
+            &[600.0, 300.0, 600.0, 300.0, 600.0],
+            &[20.0, 10.0, 20.0, 10.0, 20.0],
+        ),
+    ];
+    for (m, (kp, kd)) in (2..=5).zip(expected) {
+        let pd = PdController::from_fuzzy_slope(&paper_controller(), m).unwrap();
+        for (got, want) in pd.kp().iter().zip(kp).chain(pd.kd().iter().zip(kd)) {
+            assert!((got - want).abs() < 1e-6, "m = {m}: {pd:?}");
         }
+        assert_eq!(pd.offset(), vec![0.0; m]);
     }
-    assert_eq!(pd.offset(), [0.0, 0.0]);
 }
 
 proptest! {
     #[test]
     fn pd_agrees_with_fuzzy_to_second_order_near_the_origin(
-        direction in prop::array::uniform4(-1.0f64..1.0),
+        m in 2usize..=5,
+        direction in prop::collection::vec(-1.0f64..1.0, 10),
         scale in 1e-4f64..1e-2,
     ) {
-        let mut fuzzy = FuzzyController::new(paper_controller()).unwrap();
-        let mut pd = PdController::from_fuzzy_slope(&paper_controller()).unwrap();
-        let x = direction.map(|d| d * scale);
-        let measured = ModalState { a: [x[0] + 0.3, x[1] - 0.2], a_dot: [x[2], x[3]] };
-        let reference = ReferenceSample { a: [0.3, -0.2], ..ReferenceSample::default() };
-        let f = fuzzy.control(0.0, &measured, &reference).unwrap();
-        let p = pd.control(0.0, &measured, &reference).unwrap();
+        let model = model(m);
+        let mut fuzzy = FuzzyController::new(paper_controller(), m).unwrap();
+        let mut pd = PdController::from_fuzzy_slope(&paper_controller(), m).unwrap();
+        let mut reference = ReferenceSample::zeros(m);
+        for (i, a) in reference.a.iter_mut().enumerate() {
+            *a = 0.3 - 0.1 * i as f64;
+        }
+        let a: Vec<f64> = (0..m).map(|i| reference.a[i] + scale * direction[i]).collect();
+        let a_dot: Vec<f64> = (0..m).map(|i| scale * direction[m + i]).collect();
+        let measured = ModalState::new(&a, &a_dot).unwrap();
+        let f = control(&mut fuzzy, &model, &measured, &reference).unwrap();
+        let p = control(&mut pd, &model, &measured, &reference).unwrap();
         // The paper's surface is odd, so the remainder is cubic; 1e6 bounds its coefficient
         // (third derivative of the bells ~ 1/r^3 with r = 0.3, times 100 N m).
-        for i in 0..2 {
+        for i in 0..m {
             prop_assert!((f[i] - p[i]).abs() < 1e6 * scale.powi(3) + 1e-9, "{f:?} vs {p:?}");
         }
     }
 
     #[test]
     fn computed_torque_imposes_the_error_dynamics(
-        a in prop::array::uniform2(-1.0f64..1.0),
-        a_dot in prop::array::uniform2(-2.0f64..2.0),
-        reference_a in prop::array::uniform2(-1.0f64..1.0),
-        reference_rates in prop::array::uniform4(-2.0f64..2.0),
+        m in 2usize..=5,
+        values in prop::collection::vec(-1.0f64..1.0, 25),
     ) {
-        let model = paper_model();
-        let (kp, kd) = ([400.0, 900.0], [40.0, 60.0]);
-        let mut controller = ComputedTorque::new(model.clone(), kp, kd).unwrap();
-        let measured = ModalState { a, a_dot };
+        let model = model(m);
+        let kp: Vec<f64> = (0..m).map(|i| 400.0 + 100.0 * i as f64).collect();
+        let kd: Vec<f64> = (0..m).map(|i| 40.0 + 5.0 * i as f64).collect();
+        let mut controller = ComputedTorque::new(&model, &kp, &kd).unwrap();
+        let v = |k: usize, i: usize, scale: f64| scale * values[k * 5 + i];
+        let a: Vec<f64> = (0..m).map(|i| v(0, i, 1.0)).collect();
+        let a_dot: Vec<f64> = (0..m).map(|i| v(1, i, 2.0)).collect();
+        let measured = ModalState::new(&a, &a_dot).unwrap();
         let reference = ReferenceSample {
-            a: reference_a,
-            a_dot: [reference_rates[0], reference_rates[1]],
-            a_ddot: [reference_rates[2], reference_rates[3]],
+            a: (0..m).map(|i| v(2, i, 1.0)).collect(),
+            a_dot: (0..m).map(|i| v(3, i, 2.0)).collect(),
+            a_ddot: (0..m).map(|i| v(4, i, 2.0)).collect(),
         };
-        let tau = controller.control(0.0, &measured, &reference).unwrap();
-        let a_ddot = accelerations(&model, &measured, tau);
-        for i in 0..2 {
-            let expected = reference.a_ddot[i] - kp[i] * (a[i] - reference.a[i]) - kd[i] * (a_dot[i] - reference.a_dot[i]);
-            prop_assert!((a_ddot[i] - expected).abs() < 1e-9 * (1.0 + expected.abs()), "{a_ddot:?}");
+        let tau = control(&mut controller, &model, &measured, &reference).unwrap();
+        let a_ddot = accelerations(&model, &measured, &tau);
+        for i in 0..m {
+            let expected = reference.a_ddot[i] - kp[i] * (a[i] - reference.a[i])
+                - kd[i] * (a_dot[i] - reference.a_dot[i]);
+            prop_assert!((a_ddot[i] - expected).abs() < 1e-8 * (1.0 + expected.abs()), "{a_ddot:?}");
         }
     }
 
     #[test]
     fn gravity_compensation_adds_exactly_g_star(
-        a in prop::array::uniform2(-1.0f64..1.0),
-        da in prop::array::uniform2(-0.5f64..0.5),
+        m in 2usize..=5,
+        a in prop::collection::vec(-1.0f64..1.0, 5),
+        da in prop::collection::vec(-0.5f64..0.5, 5),
     ) {
-        let model = paper_model();
-        let mut fuzzy = FuzzyController::new(paper_controller()).unwrap();
-        let mut fuzzy_gc = FuzzyController::new(paper_controller()).unwrap()
-            .with_gravity_compensation(model.clone()).unwrap();
-        let measured = ModalState { a, a_dot: [0.0; 2] };
-        let reference = ReferenceSample { a: [a[0] + da[0], a[1] + da[1]], ..ReferenceSample::default() };
-        let plain = fuzzy.control(0.0, &measured, &reference).unwrap();
-        let compensated = fuzzy_gc.control(0.0, &measured, &reference).unwrap();
+        let model = model(m);
+        let mut fuzzy = FuzzyController::new(paper_controller(), m).unwrap();
+        let mut fuzzy_gc = FuzzyController::new(paper_controller(), m).unwrap()
+            .with_gravity_compensation(&model).unwrap();
+        let measured = ModalState::new(&a[..m], &vec![0.0; m]).unwrap();
+        let mut reference = ReferenceSample::zeros(m);
+        for i in 0..m {
+            reference.a[i] = a[i] + da[i];
+        }
+        let plain = control(&mut fuzzy, &model, &measured, &reference).unwrap();
+        let compensated = control(&mut fuzzy_gc, &model, &measured, &reference).unwrap();
         // At rest, the difference G* alone holds the arm still.
-        let a_ddot = accelerations(&model, &measured, [compensated[0] - plain[0], compensated[1] - plain[1]]);
-        prop_assert!(a_ddot[0].abs() < 1e-9 && a_ddot[1].abs() < 1e-9, "{a_ddot:?}");
+        let difference: Vec<f64> = compensated.iter().zip(&plain).map(|(c, p)| c - p).collect();
+        let a_ddot = accelerations(&model, &measured, &difference);
+        prop_assert!(a_ddot.iter().all(|x| x.abs() < 1e-8), "{a_ddot:?}");
     }
 }
 
 #[test]
-fn fuzzy_controller_is_the_fuzzy_system() {
-    let mut controller = FuzzyController::new(paper_controller()).unwrap();
+fn fuzzy_controller_is_the_fuzzy_system_per_pair() {
     let mut evaluator = Evaluator::new(paper_controller());
-    let measured = ModalState {
-        a: [0.25, -0.1],
-        a_dot: [0.3, -0.7],
-    };
-    let reference = ReferenceSample {
-        a: [0.1, 0.05],
-        ..ReferenceSample::default()
-    };
-    let mut expected = [0.0; 2];
-    evaluator
-        .eval(&[0.15, -0.15, 0.3, -0.7], &mut expected)
-        .unwrap();
-    assert_eq!(
-        controller.control(0.0, &measured, &reference).unwrap(),
-        expected
-    );
+    let a = [0.25, -0.1, 0.05, 0.2, 1.0];
+    let a_dot = [0.3, -0.7, 0.2, 0.1, -0.4];
+    let a_ref = [0.1, 0.05, -0.05, 0.0, 1.2];
+    for m in 2..=5 {
+        let model = model(m);
+        let mut controller = FuzzyController::new(paper_controller(), m).unwrap();
+        let measured = ModalState::new(&a[..m], &a_dot[..m]).unwrap();
+        let mut reference = ReferenceSample::zeros(m);
+        reference.a.copy_from_slice(&a_ref[..m]);
+        let tau = control(&mut controller, &model, &measured, &reference).unwrap();
+        // Pairs (a1, a2), (a3, a4); a lone last coordinate takes the first slot.
+        let mut expected = vec![0.0; m];
+        for p in 0..m.div_ceil(2) {
+            let (i, j) = (2 * p, 2 * p + 1);
+            let pick = |v: &[f64], w: &[f64], k: usize| if k < m { v[k] - w[k] } else { 0.0 };
+            let x = [
+                pick(&a, &a_ref, i),
+                pick(&a, &a_ref, j),
+                a_dot[i],
+                pick(&a_dot, &[0.0; 5], j),
+            ];
+            let mut out = [0.0; 2];
+            evaluator.eval(&x, &mut out).unwrap();
+            expected[i] = out[0];
+            if j < m {
+                expected[j] = out[1];
+            }
+        }
+        assert_eq!(tau, expected, "m = {m}");
+    }
 }
 
 #[test]
 fn controllers_refuse_wrong_shapes_and_gains() {
-    let three_coords = ReducedModel::new(
-        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
-        ModalMap::paper(10).unwrap(),
-    )
-    .unwrap();
+    let (two, three) = (model(2), model(3));
     assert!(matches!(
-        ComputedTorque::new(three_coords.clone(), [1.0; 2], [1.0; 2]),
+        ComputedTorque::new(&three, &[1.0; 2], &[1.0; 2]),
         Err(SimError::InvalidSetting { .. })
     ));
-    let fuzzy = FuzzyController::new(paper_controller()).unwrap();
-    assert!(fuzzy.with_gravity_compensation(three_coords).is_err());
-    assert!(ComputedTorque::new(paper_model(), [-1.0, 1.0], [1.0; 2]).is_err());
-    assert!(ComputedTorque::new(paper_model(), [1.0, 1.0], [f64::NAN, 1.0]).is_err());
-    assert!(PdController::new([0.0, f64::INFINITY], [[0.0; 4]; 2]).is_err());
+    let fuzzy = FuzzyController::new(paper_controller(), 2).unwrap();
+    assert!(fuzzy.clone().with_gravity_compensation(&three).is_err());
+    assert!(ComputedTorque::new(&two, &[-1.0, 1.0], &[1.0; 2]).is_err());
+    assert!(ComputedTorque::new(&two, &[1.0, 1.0], &[f64::NAN, 1.0]).is_err());
+    assert!(PdController::new(&[0.0, f64::INFINITY], &[1.0; 2], &[1.0; 2]).is_err());
+    assert!(PdController::new(&[0.0; 2], &[1.0; 3], &[1.0; 2]).is_err());
+    // A controller built for 2 coordinates, called with 3, fails with a message.
+    let mut fuzzy = fuzzy;
+    let err = control(
+        &mut fuzzy,
+        &three,
+        &ModalState::zeros(3),
+        &ReferenceSample::zeros(3),
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("built for 2"), "{err}");
     let two_inputs = fuzzy_sugeno::FuzzySystem::builder("small")
         .input(
             "e",
@@ -159,7 +231,9 @@ fn controllers_refuse_wrong_shapes_and_gains() {
         .rule(["N", "N"], ["A"])
         .build()
         .unwrap();
-    let err = FuzzyController::new(two_inputs.clone()).unwrap_err();
-    assert!(err.to_string().contains("4 inputs"), "{err}");
-    assert!(PdController::from_fuzzy_slope(&two_inputs).is_err());
+    let err = FuzzyController::new(two_inputs.clone(), 2).unwrap_err();
+    assert!(err.to_string().contains("must have 4 inputs"), "{err}");
+    assert!(PdController::from_fuzzy_slope(&two_inputs, 3).is_err());
+    // Two inputs and one output is the shape of one coordinate.
+    assert!(FuzzyController::new(two_inputs, 1).is_ok());
 }

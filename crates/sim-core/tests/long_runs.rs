@@ -8,10 +8,10 @@ fn assert_finite(record: &Record, what: &str) {
     let rows = (0..record.len()).flat_map(|k| {
         [record.t[k]]
             .into_iter()
-            .chain(record.a[k])
-            .chain(record.a_dot[k])
-            .chain(record.a_ref[k])
-            .chain(record.tau_star[k])
+            .chain(record.a_at(k).iter().copied())
+            .chain(record.a_dot_at(k).iter().copied())
+            .chain(record.a_ref_at(k).iter().copied())
+            .chain(record.tau_star_at(k).iter().copied())
             .chain(record.tip[k])
             .chain(record.tip_ref[k])
             .chain(record.joint_torques_at(k).iter().copied())
@@ -82,7 +82,7 @@ fn a_sixty_second_run_stays_on_its_periodic_orbit() {
     let period_max = |from: f64, to: f64| {
         (0..run.record.len())
             .filter(|&k| run.record.t[k] >= from && run.record.t[k] < to)
-            .map(|k| (run.record.a[k][0] - run.record.a_ref[k][0]).abs())
+            .map(|k| (run.record.a_at(k)[0] - run.record.a_ref_at(k)[0]).abs())
             .fold(0.0, f64::max)
     };
     let (second, last) = (period_max(2.0, 4.0), period_max(58.0, 60.0));

@@ -1,10 +1,10 @@
 //! References against independent checks: the forward kinematics of the modal reference lands
 //! on the path, and the exact rates and accelerations match finite differences.
 
-use backbone_kin::{Branch, end_point};
+use backbone_kin::{BackboneCurve, BaseAngle, Branch, end_point};
 use proptest::prelude::*;
 use sim_core::SimError;
-use sim_core::reference::{CartesianPath, PathShape, Reference, Sinusoid, Step};
+use sim_core::reference::{CartesianPath, PathShape, Reference, ReferenceSample, Sinusoid, Step};
 use std::f64::consts::FRAC_PI_2;
 
 fn paper_path(branch: Branch) -> CartesianPath {
@@ -16,36 +16,45 @@ fn paper_path(branch: Branch) -> CartesianPath {
         x_start: 0.08,
         x_end: 0.4,
     };
-    CartesianPath::new(shape, 5.0, 1.0, FRAC_PI_2, branch).unwrap()
+    CartesianPath::new(shape, 5.0, 1.0, 1, BaseAngle::Fixed(FRAC_PI_2), branch).unwrap()
+}
+
+/// The sample of `reference` at `t`.
+fn at(reference: &mut dyn Reference, t: f64) -> ReferenceSample {
+    let mut sample = ReferenceSample::zeros(reference.n_coords());
+    reference.sample(t, &mut sample).unwrap();
+    sample
 }
 
 /// Central differences of `a` and `a_dot` of `reference` at `t`.
-fn finite_differences(reference: &dyn Reference, t: f64, h: f64) -> ([f64; 2], [f64; 2]) {
-    let (before, after) = (
-        reference.sample(t - h).unwrap(),
-        reference.sample(t + h).unwrap(),
-    );
-    let rate = |i: usize| (after.a[i] - before.a[i]) / (2.0 * h);
-    let accel = |i: usize| (after.a_dot[i] - before.a_dot[i]) / (2.0 * h);
-    ([rate(0), rate(1)], [accel(0), accel(1)])
+fn finite_differences(reference: &mut dyn Reference, t: f64, h: f64) -> (Vec<f64>, Vec<f64>) {
+    let (before, after) = (at(reference, t - h), at(reference, t + h));
+    let m = before.n_coords();
+    let rate = (0..m)
+        .map(|i| (after.a[i] - before.a[i]) / (2.0 * h))
+        .collect();
+    let accel = (0..m)
+        .map(|i| (after.a_dot[i] - before.a_dot[i]) / (2.0 * h))
+        .collect();
+    (rate, accel)
 }
 
 #[test]
 fn step_switches_at_its_time_and_has_no_rates() {
-    let step = Step::new([0.1, 0.2], [-0.3, 0.4], 1.5).unwrap();
-    assert_eq!(step.sample(1.4999).unwrap().a, [0.1, 0.2]);
-    let after = step.sample(1.5).unwrap();
+    let mut step = Step::new(&[0.1, 0.2], &[-0.3, 0.4], 1.5).unwrap();
+    assert_eq!(at(&mut step, 1.4999).a, [0.1, 0.2]);
+    let after = at(&mut step, 1.5);
     assert_eq!(after.a, [-0.3, 0.4]);
-    assert_eq!((after.a_dot, after.a_ddot), ([0.0; 2], [0.0; 2]));
+    assert_eq!((after.a_dot, after.a_ddot), (vec![0.0; 2], vec![0.0; 2]));
     assert_eq!(
-        Step::constant([0.5, 0.6]).unwrap().sample(0.0).unwrap().a,
+        at(&mut Step::constant(&[0.5, 0.6]).unwrap(), 0.0).a,
         [0.5, 0.6]
     );
     assert!(matches!(
-        Step::new([0.0; 2], [f64::NAN, 0.0], 1.0),
+        Step::new(&[0.0; 2], &[f64::NAN, 0.0], 1.0),
         Err(SimError::InvalidSetting { .. })
     ));
-    assert!(Step::new([0.0; 2], [0.0; 2], -1.0).is_err());
+    assert!(Step::new(&[0.0; 2], &[0.0; 2], -1.0).is_err());
 }
 
 proptest! {
@@ -57,9 +66,9 @@ proptest! {
         phase in prop::array::uniform2(-3.0f64..3.0),
         t in 0.0f64..10.0,
     ) {
-        let sine = Sinusoid::new(offset, amplitude, frequency, phase).unwrap();
-        let s = sine.sample(t).unwrap();
-        let (rate, accel) = finite_differences(&sine, t, 1e-5);
+        let mut sine = Sinusoid::new(&offset, &amplitude, &frequency, &phase).unwrap();
+        let s = at(&mut sine, t);
+        let (rate, accel) = finite_differences(&mut sine, t, 1e-5);
         for i in 0..2 {
             let w = std::f64::consts::TAU * frequency[i];
             let exact = offset[i] + amplitude[i] * (w * t + phase[i]).sin();
@@ -75,17 +84,17 @@ proptest! {
         positive in any::<bool>(),
     ) {
         let branch = if positive { Branch::Positive } else { Branch::Negative };
-        let path = paper_path(branch);
-        let s = path.sample(t).unwrap();
+        let mut path = paper_path(branch);
+        let s = at(&mut path, t);
         // The backbone curve's end point (eqs 3-4) is on y = 0.4 sin(5x) + 0.2, at constant x-speed.
-        let tip = end_point(1.0, s.a, FRAC_PI_2).unwrap();
+        let tip = end_point(1.0, [s.a[0], s.a[1]], FRAC_PI_2).unwrap();
         let x = 0.08 + 0.32 * t / 5.0;
         prop_assert!((tip[0] - x).abs() < 1e-12 && (tip[1] - (0.4 * (5.0 * x).sin() + 0.2)).abs() < 1e-12);
         let p = path.point(t);
         prop_assert!((p[0] - x).abs() < 1e-15 && (p[1] - (0.4 * (5.0 * x).sin() + 0.2)).abs() < 1e-15);
         let on_branch = if positive { s.a[0] > 0.0 } else { s.a[0] < 0.0 };
         prop_assert!(on_branch);
-        let (rate, accel) = finite_differences(&path, t, 1e-5);
+        let (rate, accel) = finite_differences(&mut path, t, 1e-5);
         for i in 0..2 {
             prop_assert!((s.a_dot[i] - rate[i]).abs() < 1e-8, "rate {i}: {} vs {}", s.a_dot[i], rate[i]);
             prop_assert!((s.a_ddot[i] - accel[i]).abs() < 1e-7, "accel {i}: {} vs {}", s.a_ddot[i], accel[i]);
@@ -98,9 +107,9 @@ proptest! {
         corner in prop::array::uniform2(0.2f64..0.5),
     ) {
         let points = vec![[0.3, 0.3], corner, [0.1, 0.6]];
-        let path = CartesianPath::new(PathShape::Polyline(points.clone()), 3.0, 1.0, 1.2, Branch::Positive).unwrap();
-        let s = path.sample(t).unwrap();
-        let tip = end_point(1.0, s.a, 1.2).unwrap();
+        let mut path = CartesianPath::new(PathShape::Polyline(points.clone()), 3.0, 1.0, 1, BaseAngle::Fixed(1.2), Branch::Positive).unwrap();
+        let s = at(&mut path, t);
+        let tip = end_point(1.0, [s.a[0], s.a[1]], 1.2).unwrap();
         let p = path.point(t);
         prop_assert!((tip[0] - p[0]).abs() < 1e-12 && (tip[1] - p[1]).abs() < 1e-12);
         // p lies on one of the two segments.
@@ -115,7 +124,7 @@ proptest! {
         let total = seg1 + (0.1 - corner[0]).hypot(0.6 - corner[1]);
         let t_corner = 3.0 * seg1 / total;
         if (t - t_corner).abs() > 1e-4 {
-            let (rate, accel) = finite_differences(&path, t, 1e-6);
+            let (rate, accel) = finite_differences(&mut path, t, 1e-6);
             for i in 0..2 {
                 prop_assert!((s.a_dot[i] - rate[i]).abs() < 1e-6 * (1.0 + s.a_dot[i].abs()));
                 prop_assert!((s.a_ddot[i] - accel[i]).abs() < 1e-4 * (1.0 + s.a_ddot[i].abs()));
@@ -126,17 +135,17 @@ proptest! {
 
 #[test]
 fn path_holds_its_ends() {
-    let path = paper_path(Branch::Positive);
+    let mut path = paper_path(Branch::Positive);
     for t in [5.0, 5.3, 100.0] {
-        let s = path.sample(t).unwrap();
-        assert_eq!((s.a_dot, s.a_ddot), ([0.0; 2], [0.0; 2]));
-        let tip = end_point(1.0, s.a, FRAC_PI_2).unwrap();
+        let s = at(&mut path, t);
+        assert_eq!((s.a_dot, s.a_ddot), (vec![0.0; 2], vec![0.0; 2]));
+        let tip = end_point(1.0, [s.a[0], s.a[1]], FRAC_PI_2).unwrap();
         assert!((tip[0] - 0.4).abs() < 1e-12);
     }
-    let before = path.sample(-1.0).unwrap();
-    assert_eq!(before.a, path.sample(0.0).unwrap().a);
+    let before = at(&mut path, -1.0);
+    assert_eq!(before.a, at(&mut path, 0.0).a);
     assert_eq!(before.a_dot, [0.0; 2]);
-    assert!(path.sample(0.0).unwrap().a_dot[0] != 0.0);
+    assert!(at(&mut path, 0.0).a_dot[0] != 0.0);
     assert_eq!(path.travel_time(), 5.0);
 }
 
@@ -151,7 +160,15 @@ fn bad_paths_are_refused_with_the_reason() {
         x_end,
     };
     // Beyond the arm's reach.
-    let err = CartesianPath::new(sine(1.2), 5.0, 1.0, FRAC_PI_2, Branch::Positive).unwrap_err();
+    let err = CartesianPath::new(
+        sine(1.2),
+        5.0,
+        1.0,
+        1,
+        BaseAngle::Fixed(FRAC_PI_2),
+        Branch::Positive,
+    )
+    .unwrap_err();
     match &err {
         SimError::Unreachable { t, x, .. } => assert!(*t > 0.0 && *x > 0.08, "{err}"),
         other => panic!("unexpected {other:?}"),
@@ -162,7 +179,8 @@ fn bad_paths_are_refused_with_the_reason() {
         PathShape::Polyline(vec![[0.3, 0.5], [0.0, 1.0]]),
         1.0,
         1.0,
-        FRAC_PI_2,
+        1,
+        BaseAngle::Fixed(FRAC_PI_2),
         Branch::Positive,
     )
     .unwrap_err();
@@ -183,7 +201,110 @@ fn bad_paths_are_refused_with_the_reason() {
             1.0,
         ),
     ] {
-        let err = CartesianPath::new(shape, time, 1.0, FRAC_PI_2, Branch::Positive).unwrap_err();
+        let err = CartesianPath::new(
+            shape,
+            time,
+            1.0,
+            1,
+            BaseAngle::Fixed(FRAC_PI_2),
+            Branch::Positive,
+        )
+        .unwrap_err();
         assert!(matches!(err, SimError::InvalidSetting { .. }), "{err}");
+    }
+}
+
+/// The paper's path for a family of `harmonics` harmonics with `alpha0` fixed at pi/2 or free.
+fn family_path(harmonics: usize, free: bool) -> CartesianPath {
+    let shape = PathShape::Sine {
+        amplitude: 0.4,
+        wavenumber: 5.0,
+        phase: 0.0,
+        offset: 0.2,
+        x_start: 0.08,
+        x_end: 0.4,
+    };
+    let base = if free {
+        BaseAngle::Free
+    } else {
+        BaseAngle::Fixed(FRAC_PI_2)
+    };
+    CartesianPath::new(shape, 5.0, 1.0, harmonics, base, Branch::Positive).unwrap()
+}
+
+/// The end point of the family's curve at `a` (a free alpha0 last).
+fn family_tip(a: &[f64], free: bool) -> [f64; 2] {
+    let (modes, alpha0) = if free {
+        (&a[..a.len() - 1], a[a.len() - 1])
+    } else {
+        (a, FRAC_PI_2)
+    };
+    BackboneCurve::new(1.0, modes, alpha0).unwrap().end_point()
+}
+
+#[test]
+fn the_continuation_follows_the_path_without_branch_jumps() {
+    for (harmonics, free) in [(2, false), (1, true), (2, true), (3, false)] {
+        let mut path = family_path(harmonics, free);
+        let m = 2 * harmonics + usize::from(free);
+        assert_eq!(path.n_coords(), m);
+        // Starts on the paper's K = 1 solution (higher harmonics zero, a free alpha0 at pi/2).
+        let start = at(&mut path, 0.0);
+        let closed = backbone_kin::inverse_kinematics(
+            1.0,
+            [0.08, 0.2 + 0.4 * 0.4f64.sin()],
+            FRAC_PI_2,
+            Branch::Positive,
+        )
+        .unwrap();
+        assert!((start.a[0] - closed[0]).abs() < 1e-10 && (start.a[1] - closed[1]).abs() < 1e-10);
+        assert!(start.a[2..2 * harmonics].iter().all(|a| a.abs() < 1e-10));
+        let h = 1e-3;
+        let mut previous = start;
+        for k in 1..=5000 {
+            let t = k as f64 * h;
+            let s = at(&mut path, t);
+            // On the path.
+            let tip = family_tip(&s.a, free);
+            let point = path.point(t);
+            assert!(
+                (tip[0] - point[0]).hypot(tip[1] - point[1]) < 1e-12,
+                "K = {harmonics}, free = {free}, t = {t}: {tip:?} vs {point:?}"
+            );
+            // No jump: the step is the one the rates predict, to second order.
+            for i in 0..m {
+                let predicted =
+                    previous.a[i] + h * previous.a_dot[i] + 0.5 * h * h * previous.a_ddot[i];
+                assert!(
+                    (s.a[i] - predicted).abs() < 1e-6,
+                    "K = {harmonics}, free = {free}, t = {t}, coordinate {i}: {} vs {predicted}",
+                    s.a[i]
+                );
+            }
+            previous = s;
+        }
+        // A function of t alone: sampling backwards gives the same numbers.
+        let forward = at(&mut path, 2.345_6);
+        let _ = at(&mut path, 4.9);
+        assert_eq!(at(&mut path, 2.345_6), forward);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    #[test]
+    fn continuation_rates_match_finite_differences(
+        t in 0.01f64..4.99,
+        family in 0usize..3,
+    ) {
+        let (harmonics, free) = [(2, false), (1, true), (2, true)][family];
+        let mut path = family_path(harmonics, free);
+        let s = at(&mut path, t);
+        let (rate, accel) = finite_differences(&mut path, t, 1e-5);
+        let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        for i in 0..s.n_coords() {
+            prop_assert!((s.a_dot[i] - rate[i]).abs() < 1e-6 * (1.0 + norm(&rate)), "{:?} vs {rate:?}", s.a_dot);
+            prop_assert!((s.a_ddot[i] - accel[i]).abs() < 1e-4 * (1.0 + norm(&accel)), "{:?} vs {accel:?}", s.a_ddot);
+        }
     }
 }

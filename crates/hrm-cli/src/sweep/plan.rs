@@ -121,11 +121,12 @@ impl SweepConfig {
         let level = id.noise_level;
         scenario.controller.kind = id.controller;
         scenario.seed = id.seed;
-        scenario.noise = NoiseSpec {
-            reference_std: [self.reference_noise_ratio * level; 2],
-            sensor_a_std: [level; 2],
-            sensor_a_dot_std: [self.rate_noise_ratio * level; 2],
-        };
+        scenario.noise = NoiseSpec::uniform(
+            scenario.n_coords(),
+            level,
+            self.rate_noise_ratio * level,
+            self.reference_noise_ratio * level,
+        );
         scenario
     }
 
@@ -265,9 +266,9 @@ mod tests {
         let scenario = c.scenario_for(&id);
         assert_eq!(scenario.controller.kind, ControllerKind::FuzzyGc);
         assert_eq!(scenario.seed, id.seed);
-        assert_eq!(scenario.noise.sensor_a_std, [2e-3; 2]);
-        assert_eq!(scenario.noise.sensor_a_dot_std, [2e-2; 2]);
-        assert_eq!(scenario.noise.reference_std, [1e-3; 2]);
+        assert_eq!(scenario.noise.sensor_a_std, Some(vec![2e-3; 2]));
+        assert_eq!(scenario.noise.sensor_a_dot_std, Some(vec![2e-2; 2]));
+        assert_eq!(scenario.noise.reference_std, Some(vec![1e-3; 2]));
     }
 
     #[test]

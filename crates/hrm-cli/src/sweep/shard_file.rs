@@ -7,7 +7,7 @@ use sim_core::{ControllerKind, Summary};
 use std::path::{Path, PathBuf};
 
 /// The `format` tag of a shard file.
-pub const FORMAT: &str = "hrm-sweep-shard/1";
+pub const FORMAT: &str = "hrm-sweep-shard/2";
 
 /// A slice of a sweep: its configuration, which shard, and the runs of that shard in index
 /// order. The whole sweep is shard 1/1.
@@ -58,15 +58,15 @@ pub enum Outcome {
 }
 
 /// The summary metrics a sweep keeps of a run (see [`Summary`]).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunMetrics {
     /// Tip error RMS (m).
     pub tip_error_rms_m: f64,
     /// Largest tip error (m).
     pub tip_error_max_m: f64,
-    /// Modal error RMS of `(a1, a2)` (rad).
-    pub modal_error_rms: [f64; 2],
+    /// Modal error RMS per coordinate (rad).
+    pub modal_error_rms: Vec<f64>,
     /// Largest joint torque (N m).
     pub peak_joint_torque_nm: f64,
     /// Control effort (N^2 m^2 s).
@@ -79,19 +79,21 @@ impl RunMetrics {
         let m = RunMetrics {
             tip_error_rms_m: s.tip_error_rms_m,
             tip_error_max_m: s.tip_error_max_m,
-            modal_error_rms: s.modal_error_rms,
+            modal_error_rms: s.modal_error_rms.clone(),
             peak_joint_torque_nm: s.peak_joint_torque_nm,
             control_effort: s.control_effort,
         };
         let values = [
             m.tip_error_rms_m,
             m.tip_error_max_m,
-            m.modal_error_rms[0],
-            m.modal_error_rms[1],
             m.peak_joint_torque_nm,
             m.control_effort,
         ];
-        if values.iter().all(|v| v.is_finite()) {
+        if values
+            .iter()
+            .chain(&m.modal_error_rms)
+            .all(|v| v.is_finite())
+        {
             Ok(m)
         } else {
             Err(format!("the run's summary metrics are not finite: {m:?}"))

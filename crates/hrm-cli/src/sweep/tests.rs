@@ -192,8 +192,8 @@ fn a_run_in_a_sweep_is_the_scenario_run_alone_with_its_seed() {
         scenario.duration = 0.15;
         scenario.controller.kind = run.controller;
         scenario.seed = plan::run_seed(42, run.seed_index);
-        scenario.noise.sensor_a_std = [run.noise_level; 2];
-        scenario.noise.sensor_a_dot_std = [10.0 * run.noise_level; 2];
+        scenario.noise.sensor_a_std = Some(vec![run.noise_level; 2]);
+        scenario.noise.sensor_a_dot_std = Some(vec![10.0 * run.noise_level; 2]);
         let alone = scenario.build().unwrap().run().unwrap();
         assert_eq!(
             run.outcome,

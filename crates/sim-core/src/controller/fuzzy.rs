@@ -1,51 +1,166 @@
-//! The paper's fuzzy controller (Figure 8), optionally with gravity compensation.
+//! The paper's fuzzy controller (Figure 8), for any number of modal coordinates, optionally with
+//! gravity compensation.
 
-use super::{Controller, ModalState, fuzzy_inputs};
+use super::{ControlContext, Controller, ControllerError, check_context, check_coordinate_count};
 use crate::error::SimError;
-use crate::reference::ReferenceSample;
 use fuzzy_sugeno::{Evaluator, FuzzySystem};
 use modal_reduce::{ReducedData, ReducedModel};
 
-/// A Takagi-Sugeno system with inputs `[a1 - a1_ref, a2 - a2_ref, a1_dot, a2_dot]` and outputs
-/// `[tau1*, tau2*]`: the paper's controller ([`fuzzy_sugeno::paper_controller`]) or any system
-/// of that shape, e.g. loaded from a `.fis` file. Inputs outside a variable's range are clamped
-/// to it (the evaluator's default), so large errors saturate the action.
+/// How a fuzzy system's inputs and outputs sit on the `m` coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Layout {
+    /// One system over all coordinates: inputs `[a_1 - a_1_ref, ..., a_m - a_m_ref, a_1_dot,
+    /// ..., a_m_dot]`, outputs `[tau_1*, ..., tau_m*]`.
+    Whole,
+    /// A two-coordinate system (4 inputs, 2 outputs, the paper's shape) applied to the pairs
+    /// `(a_1, a_2), (a_3, a_4), ...`; with `m` odd the last coordinate takes the first slot of a
+    /// pair whose second slot is zero.
+    Pairs,
+}
+
+impl Layout {
+    /// The layout of `system` on `m` coordinates.
+    pub(super) fn of(system: &FuzzySystem, m: usize) -> Result<Self, SimError> {
+        check_coordinate_count("controller", m)?;
+        let (inputs, outputs) = (system.inputs().len(), system.outputs().len());
+        if (inputs, outputs) == (2 * m, m) {
+            Ok(Layout::Whole)
+        } else if (inputs, outputs) == (4, 2) {
+            Ok(Layout::Pairs)
+        } else {
+            Err(SimError::setting(
+                "controller.fis",
+                format!(
+                    "must have {} inputs [da_1..da_{m}, a_1_dot..a_{m}_dot] and {m} outputs \
+                     [tau_1..tau_{m}] for {m} modal coordinates (or 4 inputs and 2 outputs, \
+                     applied per coordinate pair), '{}' has {inputs} inputs and {outputs} outputs",
+                    2 * m,
+                    system.name()
+                ),
+            ))
+        }
+    }
+
+    /// The system input that receives the error (`rate = false`) or the rate of coordinate `i`
+    /// of `m`.
+    pub(super) fn input_index(self, i: usize, m: usize, rate: bool) -> usize {
+        match self {
+            Layout::Whole => i + if rate { m } else { 0 },
+            Layout::Pairs => i % 2 + if rate { 2 } else { 0 },
+        }
+    }
+
+    /// Evaluates `evaluator` on the error `da = a - a_ref` and rate `a_dot` of every coordinate
+    /// (the inputs measured minus desired, the sign that makes Table 1 stabilising), using
+    /// `inputs` as scratch (`2m` entries, or 4 for pairs).
+    pub(super) fn eval(
+        self,
+        evaluator: &mut Evaluator,
+        da: impl Fn(usize) -> f64,
+        a_dot: impl Fn(usize) -> f64,
+        inputs: &mut [f64],
+        tau: &mut [f64],
+    ) -> Result<(), fuzzy_sugeno::FuzzyError> {
+        let m = tau.len();
+        match self {
+            Layout::Whole => {
+                for i in 0..m {
+                    inputs[i] = da(i);
+                    inputs[m + i] = a_dot(i);
+                }
+                evaluator.eval(&inputs[..2 * m], tau)
+            }
+            Layout::Pairs => {
+                for (p, pair) in tau.chunks_mut(2).enumerate() {
+                    let (i, j) = (2 * p, 2 * p + 1);
+                    let mut out = [0.0; 2];
+                    let second = |f: &dyn Fn(usize) -> f64| if j < m { f(j) } else { 0.0 };
+                    let x = [da(i), second(&da), a_dot(i), second(&a_dot)];
+                    evaluator.eval(&x, &mut out)?;
+                    pair.copy_from_slice(&out[..pair.len()]);
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// A Takagi-Sugeno controller of `m` modal coordinates: the paper's
+/// ([`fuzzy_sugeno::paper_controller`]) or any system of the right shape, e.g. loaded from a
+/// `.fis` file. Inputs outside a variable's range are clamped to it (the evaluator's default), so
+/// large errors saturate the action.
+///
+/// A system with `2m` inputs `[a_1 - a_1_ref, ..., a_m - a_m_ref, a_1_dot, ..., a_m_dot]` and `m`
+/// outputs is evaluated once per sample. A system of the paper's shape (4 inputs, 2 outputs) is
+/// applied per coordinate pair: `(tau_{2k-1}*, tau_{2k}*)` from `(da_{2k-1}, da_{2k}, a_{2k-1}_dot,
+/// a_{2k}_dot)`, so the paper's rule base (where each output depends on its own pair
+/// `(da_i, a_i_dot)`) acts on the sine-type coordinates `a_{2k-1}` as on `a1` and on the
+/// cosine-type `a_{2k}` as on `a2`; a free `alpha0` (the last of an odd `m`) is treated like `a1`.
+/// For `m = 2` the two readings coincide: the paper's controller.
 ///
 /// With gravity compensation ("fuzzy-gc") the reduced gravity vector `G*(a)` of the measured
 /// configuration is added to the fuzzy output.
 #[derive(Debug, Clone)]
 pub struct FuzzyController {
     evaluator: Evaluator,
-    gravity: Option<(ReducedModel, ReducedData)>,
+    layout: Layout,
+    m: usize,
+    inputs: Vec<f64>,
+    gravity: Option<ReducedData>,
 }
 
 impl FuzzyController {
-    /// The fuzzy controller `system`; fails unless it has 4 inputs and 2 outputs.
+    /// The fuzzy controller `system` for `m` coordinates; fails unless it has `2m` inputs and
+    /// `m` outputs, or 4 inputs and 2 outputs (applied per pair).
     ///
     /// ```
-    /// use sim_core::controller::{Controller, FuzzyController, ModalState};
+    /// use backbone_kin::ModalMap;
+    /// use manip_dyn::ChainModel;
+    /// use modal_reduce::ReducedModel;
+    /// use sim_core::controller::{ControlContext, Controller, FuzzyController, ModalState};
     /// use sim_core::reference::ReferenceSample;
-    /// let mut fuzzy = FuzzyController::new(fuzzy_sugeno::paper_controller())?;
+    ///
+    /// let map = ModalMap::paper_fixed_alpha0(10, std::f64::consts::FRAC_PI_2)?;
+    /// let model = ReducedModel::new(ChainModel::uniform(10, 0.1, 0.1, 9.81)?, map)?;
+    /// let mut fuzzy = FuzzyController::new(fuzzy_sugeno::paper_controller(), 2)?;
     /// // Above the reference in a1: push back.
-    /// let measured = ModalState { a: [0.1, 0.0], a_dot: [0.0, 0.0] };
-    /// let tau = fuzzy.control(0.0, &measured, &ReferenceSample::default())?;
+    /// let measured = ModalState::new(&[0.1, 0.0], &[0.0, 0.0])?;
+    /// let reference = ReferenceSample::zeros(2);
+    /// let ctx = ControlContext { t: 0.0, measured: &measured, reference: &reference, model: &model };
+    /// let mut tau = [0.0; 2];
+    /// fuzzy.control(&ctx, &mut tau)?;
     /// assert!(tau[0] < 0.0 && tau[1].abs() < 1e-12);
-    /// # Ok::<(), sim_core::SimError>(())
+    /// # Ok::<(), sim_core::controller::ControllerError>(())
     /// ```
-    pub fn new(system: FuzzySystem) -> Result<Self, SimError> {
-        check_shape(&system)?;
+    pub fn new(system: FuzzySystem, m: usize) -> Result<Self, SimError> {
+        let layout = Layout::of(&system, m)?;
+        let inputs = match layout {
+            Layout::Whole => 2 * m,
+            Layout::Pairs => 4,
+        };
         Ok(Self {
             evaluator: Evaluator::new(system),
+            layout,
+            m,
+            inputs: vec![0.0; inputs],
             gravity: None,
         })
     }
 
-    /// The same controller plus the gravity compensation `G*(a)` of `model` (two coordinates,
-    /// `alpha0` fixed).
-    pub fn with_gravity_compensation(mut self, model: ReducedModel) -> Result<Self, SimError> {
-        super::computed_torque::check_two_coordinates(&model)?;
-        let data = ReducedData::new(&model);
-        self.gravity = Some((model, data));
+    /// The same controller plus the gravity compensation `G*(a)` of the loop's model; `model`
+    /// (with the controller's `m` coordinates) sizes the workspace.
+    pub fn with_gravity_compensation(mut self, model: &ReducedModel) -> Result<Self, SimError> {
+        let m = self.m;
+        if model.n_coords() != m {
+            return Err(SimError::setting(
+                "model",
+                format!(
+                    "has {} coordinates, the fuzzy controller is built for {m}",
+                    model.n_coords()
+                ),
+            ));
+        }
+        self.gravity = Some(ReducedData::new(model));
         Ok(self)
     }
 
@@ -58,36 +173,31 @@ impl FuzzyController {
 impl Controller for FuzzyController {
     fn control(
         &mut self,
-        t: f64,
-        measured: &ModalState,
-        reference: &ReferenceSample,
-    ) -> Result<[f64; 2], SimError> {
-        let mut tau = [0.0; 2];
-        self.evaluator
-            .eval(&fuzzy_inputs(measured, reference), &mut tau)?;
-        if let Some((model, data)) = &mut self.gravity {
-            modal_reduce::reduced_terms(model, data, &measured.a, &measured.a_dot)
-                .map_err(|source| SimError::Dynamics { t, source })?;
-            tau[0] += data.gravity()[0];
-            tau[1] += data.gravity()[1];
+        ctx: &ControlContext<'_>,
+        tau_star: &mut [f64],
+    ) -> Result<(), ControllerError> {
+        check_context(ctx, self.m, tau_star)?;
+        let (measured, reference) = (ctx.measured, ctx.reference);
+        self.layout
+            .eval(
+                &mut self.evaluator,
+                |i| measured.a[i] - reference.a[i],
+                |i| measured.a_dot[i],
+                &mut self.inputs,
+                tau_star,
+            )
+            .map_err(SimError::from)?;
+        if let Some(data) = &mut self.gravity {
+            modal_reduce::reduced_terms(ctx.model, data, &measured.a, &measured.a_dot)
+                .map_err(|source| SimError::Dynamics { t: ctx.t, source })?;
+            for (tau, g) in tau_star.iter_mut().zip(data.gravity()) {
+                *tau += g;
+            }
         }
-        Ok(tau)
-    }
-}
-
-/// Checks that `system` maps `[da1, da2, a1_dot, a2_dot]` to `[tau1*, tau2*]`.
-pub(super) fn check_shape(system: &FuzzySystem) -> Result<(), SimError> {
-    let (inputs, outputs) = (system.inputs().len(), system.outputs().len());
-    if (inputs, outputs) == (4, 2) {
         Ok(())
-    } else {
-        Err(SimError::setting(
-            "controller.fis",
-            format!(
-                "must have 4 inputs [da1, da2, a1_dot, a2_dot] and 2 outputs [tau1, tau2], \
-                 '{}' has {inputs} inputs and {outputs} outputs",
-                system.name()
-            ),
-        ))
+    }
+
+    fn n_coords(&self) -> Option<usize> {
+        Some(self.m)
     }
 }

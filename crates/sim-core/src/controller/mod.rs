@@ -1,9 +1,35 @@
-//! Controllers of the two modal coordinates `(a1, a2)`, behind one trait: the paper's fuzzy
-//! controller (eqs 19-24, Figure 8), its linearisation at the origin (PD), computed torque with
-//! the exact reduced model, and the fuzzy controller plus gravity compensation `G*`.
+//! Controllers of the `m` modal coordinates, behind one trait: the paper's fuzzy controller
+//! (eqs 19-24, Figure 8) applied per coordinate pair or any `.fis` system with `2m` inputs and
+//! `m` outputs, its linearisation at the origin (PD), computed torque with the exact reduced
+//! model, and the fuzzy controller plus gravity compensation `G*`.
 //!
 //! The closed loop samples a controller at its own period and holds its output in between
-//! (zero-order hold).
+//! (zero-order hold). At each sample it hands the controller a [`ControlContext`] that borrows
+//! the time, the measured state, the reference sample and the [`ReducedModel`] being simulated,
+//! so no controller needs its own copy of the model.
+//!
+//! A controller written elsewhere implements [`Controller`] and may fail with an error of its
+//! own; the run reports it as [`SimError::Controller`](crate::SimError::Controller) with the error
+//! as its source:
+//!
+//! ```
+//! use sim_core::controller::{ControlContext, Controller, ControllerError};
+//!
+//! /// A spring towards the reference in every coordinate.
+//! struct Spring(f64);
+//!
+//! impl Controller for Spring {
+//!     fn control(&mut self, ctx: &ControlContext<'_>, tau: &mut [f64]) -> Result<(), ControllerError> {
+//!         if ctx.t > 10.0 {
+//!             return Err("the spring is tired".into());
+//!         }
+//!         for ((tau, a), a_ref) in tau.iter_mut().zip(&ctx.measured.a).zip(&ctx.reference.a) {
+//!             *tau = -self.0 * (a - a_ref);
+//!         }
+//!         Ok(())
+//!     }
+//! }
+//! ```
 
 mod computed_torque;
 mod fuzzy;
@@ -15,34 +41,121 @@ pub use pd::PdController;
 
 use crate::error::SimError;
 use crate::reference::ReferenceSample;
+use modal_reduce::ReducedModel;
 
-/// The modal state as the controller measures it (possibly with sensor noise).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+/// The error a controller may fail with: any error type, boxed. The built-in controllers fail
+/// with a boxed [`SimError`], which the run reports as it is; any other error is reported as
+/// [`SimError::Controller`] carrying it as its source.
+pub type ControllerError = Box<dyn std::error::Error + Send + Sync + 'static>;
+
+/// A modal state: the coordinates `a` and their rates `a_dot`, `m` entries each.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct ModalState {
-    /// `(a1, a2)` (rad).
-    pub a: [f64; 2],
-    /// `(a1_dot, a2_dot)` (rad/s).
-    pub a_dot: [f64; 2],
+    /// The modal coordinates (rad).
+    pub a: Vec<f64>,
+    /// Their rates (rad/s).
+    pub a_dot: Vec<f64>,
 }
 
-/// A feedback law producing the modal generalized forces `tau* = (tau1*, tau2*)` (N m).
+impl ModalState {
+    /// The state `a = 0`, `a_dot = 0` of `m` coordinates.
+    pub fn zeros(m: usize) -> Self {
+        Self {
+            a: vec![0.0; m],
+            a_dot: vec![0.0; m],
+        }
+    }
+
+    /// The state `(a, a_dot)`; both must have the same length.
+    ///
+    /// ```
+    /// let state = sim_core::controller::ModalState::new(&[0.1, 0.0, -0.2], &[0.0; 3])?;
+    /// assert_eq!(state.n_coords(), 3);
+    /// # Ok::<(), sim_core::SimError>(())
+    /// ```
+    pub fn new(a: &[f64], a_dot: &[f64]) -> Result<Self, SimError> {
+        if a.len() != a_dot.len() {
+            return Err(SimError::setting(
+                "initial.a_dot",
+                format!("has {} entries, initial.a has {}", a_dot.len(), a.len()),
+            ));
+        }
+        Ok(Self {
+            a: a.to_vec(),
+            a_dot: a_dot.to_vec(),
+        })
+    }
+
+    /// The number of coordinates `m`.
+    pub fn n_coords(&self) -> usize {
+        self.a.len()
+    }
+}
+
+/// What a controller may look at when it is sampled: borrowed from the loop, nothing copied.
+#[derive(Debug, Clone, Copy)]
+pub struct ControlContext<'a> {
+    /// The sample time (s).
+    pub t: f64,
+    /// The state as the controller measures it (sensor noise included).
+    pub measured: &'a ModalState,
+    /// The reference as the controller receives it (reference noise included in `a`).
+    pub reference: &'a ReferenceSample,
+    /// The reduced model being simulated.
+    pub model: &'a ReducedModel,
+}
+
+/// A feedback law producing the modal generalized forces `tau*` (N m), one per coordinate.
 pub trait Controller: Send {
-    /// The modal torques at time `t` for the measured state and the (possibly noisy) reference.
+    /// Writes the modal torques for `ctx` into `tau_star` (`m` entries, where `m` is
+    /// `ctx.model.n_coords()`). `&mut self`, so a controller may keep a workspace (sized when it
+    /// is built) or a state between samples.
     fn control(
         &mut self,
-        t: f64,
-        measured: &ModalState,
-        reference: &ReferenceSample,
-    ) -> Result<[f64; 2], SimError>;
+        ctx: &ControlContext<'_>,
+        tau_star: &mut [f64],
+    ) -> Result<(), ControllerError>;
+
+    /// The number of coordinates the controller is built for, if it is built for one:
+    /// [`Simulation::new`](crate::Simulation::new) refuses a model with another number. The
+    /// default, `None`, accepts any.
+    fn n_coords(&self) -> Option<usize> {
+        None
+    }
 }
 
-/// The fuzzy controller's input vector `[a1 - a1_ref, a2 - a2_ref, a1_dot, a2_dot]`: measured
-/// minus desired, the sign that makes Table 1 stabilising (model notes).
-fn fuzzy_inputs(measured: &ModalState, reference: &ReferenceSample) -> [f64; 4] {
-    [
-        measured.a[0] - reference.a[0],
-        measured.a[1] - reference.a[1],
-        measured.a_dot[0],
-        measured.a_dot[1],
-    ]
+/// Checks that `ctx` has the `m` coordinates a controller was built for, and that `tau_star`
+/// has room for them.
+fn check_context(ctx: &ControlContext<'_>, m: usize, tau_star: &[f64]) -> Result<(), SimError> {
+    let lengths = [
+        ("model coordinates", ctx.model.n_coords()),
+        ("measured a", ctx.measured.a.len()),
+        ("measured a_dot", ctx.measured.a_dot.len()),
+        ("reference a", ctx.reference.a.len()),
+        ("reference a_dot", ctx.reference.a_dot.len()),
+        ("reference a_ddot", ctx.reference.a_ddot.len()),
+        ("tau_star", tau_star.len()),
+    ];
+    match lengths.iter().find(|(_, len)| *len != m) {
+        None => Ok(()),
+        Some((name, len)) => Err(SimError::setting(
+            "controller",
+            format!("is built for {m} modal coordinates, but {name} has {len}"),
+        )),
+    }
+}
+
+/// Checks that `m` is a number of modal coordinates a controller can be built for.
+fn check_coordinate_count(name: &str, m: usize) -> Result<(), SimError> {
+    if (1..=crate::MAX_COORDINATES).contains(&m) {
+        Ok(())
+    } else {
+        Err(SimError::setting(
+            name,
+            format!(
+                "must have between 1 and {} modal coordinates, got {m}",
+                crate::MAX_COORDINATES
+            ),
+        ))
+    }
 }

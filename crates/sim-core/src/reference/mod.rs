@@ -1,135 +1,203 @@
-//! Reference motions for the two modal coordinates `(a1, a2)` (alpha0 held fixed, as in the
-//! paper's experiment): steps, sinusoids, and Cartesian paths followed through the closed-form
-//! inverse kinematics (eqs 5-6).
+//! Reference motions for the `m` modal coordinates: steps, sinusoids, and Cartesian tip paths
+//! followed through the inverse kinematics of the modal family (the closed form of eqs 5-6 for
+//! the paper's `K = 1` with `alpha0` fixed, a numerical continuation otherwise).
 //!
 //! A reference supplies the desired `a`, `a_dot` and `a_ddot` at any time; the controllers that
-//! need rates or accelerations (computed torque) get them exactly, not by differencing.
+//! need rates or accelerations (computed torque) get them from the reference, not by
+//! differencing the samples.
 
+pub(crate) mod continuation;
 mod path;
 
-pub use path::{CartesianPath, PathShape};
+pub use path::{CartesianPath, FREE_BASE_START, PathShape};
 
 use crate::error::{SimError, check_finite, check_non_negative};
 
-/// The desired modal motion at one instant.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+/// The desired modal motion at one instant, `m` entries per field.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct ReferenceSample {
-    /// Desired `(a1, a2)` (rad).
-    pub a: [f64; 2],
-    /// Desired `(a1_dot, a2_dot)` (rad/s).
-    pub a_dot: [f64; 2],
-    /// Desired `(a1_ddot, a2_ddot)` (rad/s^2).
-    pub a_ddot: [f64; 2],
+    /// Desired coordinates (rad).
+    pub a: Vec<f64>,
+    /// Desired rates (rad/s).
+    pub a_dot: Vec<f64>,
+    /// Desired accelerations (rad/s^2).
+    pub a_ddot: Vec<f64>,
 }
 
-/// A desired motion of the modal coordinates `(a1, a2)` over time.
+impl ReferenceSample {
+    /// A sample of `m` coordinates at rest at zero (also the buffer a reference fills).
+    pub fn zeros(m: usize) -> Self {
+        Self {
+            a: vec![0.0; m],
+            a_dot: vec![0.0; m],
+            a_ddot: vec![0.0; m],
+        }
+    }
+
+    /// The number of coordinates.
+    pub fn n_coords(&self) -> usize {
+        self.a.len()
+    }
+}
+
+/// A desired motion of the `m` modal coordinates over time.
 pub trait Reference: Send {
-    /// The desired motion at time `t` (s).
-    fn sample(&self, t: f64) -> Result<ReferenceSample, SimError>;
+    /// The number of coordinates `m` it sets.
+    fn n_coords(&self) -> usize;
+
+    /// Writes the desired motion at time `t` (s) into `out` (`m` entries per field). `&mut self`
+    /// only for workspaces: the sample is a function of `t` alone.
+    fn sample(&mut self, t: f64, out: &mut ReferenceSample) -> Result<(), SimError>;
+}
+
+/// Checks that the per-coordinate arrays `arrays` (named as in a scenario file) are non-empty and
+/// of one length; returns it.
+fn check_lengths(arrays: &[(&str, &[f64])]) -> Result<usize, SimError> {
+    let (first, values) = arrays[0];
+    let m = values.len();
+    if m == 0 || m > crate::MAX_COORDINATES {
+        return Err(SimError::setting(
+            first,
+            format!(
+                "must have between 1 and {} entries, got {m}",
+                crate::MAX_COORDINATES
+            ),
+        ));
+    }
+    for (name, values) in &arrays[1..] {
+        if values.len() != m {
+            return Err(SimError::setting(
+                *name,
+                format!("has {} entries, {first} has {m}", values.len()),
+            ));
+        }
+        check_finite(name, values)?;
+    }
+    check_finite(first, values)?;
+    Ok(m)
 }
 
 /// A step from `initial` to `target` at time `time` (a constant reference when `time = 0`);
 /// rates and accelerations are zero (the step's impulse is not part of the reference).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Step {
-    initial: [f64; 2],
-    target: [f64; 2],
+    initial: Vec<f64>,
+    target: Vec<f64>,
     time: f64,
 }
 
 impl Step {
-    /// A step from `initial` to `target` at `time` (s, non-negative); `a = target` from `time` on.
+    /// A step from `initial` to `target` (one entry per coordinate, equal lengths) at `time`
+    /// (s, non-negative); `a = target` from `time` on.
     ///
     /// ```
-    /// use sim_core::reference::{Reference, Step};
-    /// let step = Step::new([0.0, 0.0], [0.2, -0.1], 0.5)?;
-    /// assert_eq!(step.sample(0.4)?.a, [0.0, 0.0]);
-    /// assert_eq!(step.sample(0.5)?.a, [0.2, -0.1]);
+    /// use sim_core::reference::{Reference, ReferenceSample, Step};
+    /// let mut step = Step::new(&[0.0, 0.0, 0.0], &[0.2, -0.1, 0.05], 0.5)?;
+    /// let mut sample = ReferenceSample::zeros(3);
+    /// step.sample(0.4, &mut sample)?;
+    /// assert_eq!(sample.a, [0.0, 0.0, 0.0]);
+    /// step.sample(0.5, &mut sample)?;
+    /// assert_eq!(sample.a, [0.2, -0.1, 0.05]);
     /// # Ok::<(), sim_core::SimError>(())
     /// ```
-    pub fn new(initial: [f64; 2], target: [f64; 2], time: f64) -> Result<Self, SimError> {
-        check_finite("reference.initial", &initial)?;
-        check_finite("reference.target", &target)?;
+    pub fn new(initial: &[f64], target: &[f64], time: f64) -> Result<Self, SimError> {
+        check_lengths(&[("reference.target", target), ("reference.initial", initial)])?;
         check_non_negative("reference.time", time)?;
         Ok(Self {
-            initial,
-            target,
+            initial: initial.to_vec(),
+            target: target.to_vec(),
             time,
         })
     }
 
     /// A constant reference.
-    pub fn constant(a: [f64; 2]) -> Result<Self, SimError> {
+    pub fn constant(a: &[f64]) -> Result<Self, SimError> {
+        check_lengths(&[("reference.a", a)])?;
         Self::new(a, a, 0.0)
     }
 }
 
 impl Reference for Step {
-    fn sample(&self, t: f64) -> Result<ReferenceSample, SimError> {
+    fn n_coords(&self) -> usize {
+        self.target.len()
+    }
+
+    fn sample(&mut self, t: f64, out: &mut ReferenceSample) -> Result<(), SimError> {
         let a = if t < self.time {
-            self.initial
+            &self.initial
         } else {
-            self.target
+            &self.target
         };
-        Ok(ReferenceSample {
-            a,
-            ..ReferenceSample::default()
-        })
+        out.a.copy_from_slice(a);
+        out.a_dot.fill(0.0);
+        out.a_ddot.fill(0.0);
+        Ok(())
     }
 }
 
 /// `a_i(t) = offset_i + amplitude_i sin(2 pi frequency_i t + phase_i)` for each coordinate.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Sinusoid {
-    offset: [f64; 2],
-    amplitude: [f64; 2],
+    offset: Vec<f64>,
+    amplitude: Vec<f64>,
     /// Angular frequencies `2 pi f_i` (rad/s).
-    omega: [f64; 2],
-    phase: [f64; 2],
+    omega: Vec<f64>,
+    phase: Vec<f64>,
 }
 
 impl Sinusoid {
-    /// A sinusoid per coordinate; `frequency_hz` in Hz (non-negative), `phase` in rad.
+    /// A sinusoid per coordinate (equal lengths); `frequency_hz` in Hz (non-negative), `phase`
+    /// in rad.
     ///
     /// ```
-    /// use sim_core::reference::{Reference, Sinusoid};
-    /// let sine = Sinusoid::new([0.1, 0.0], [0.2, 0.1], [0.5, 1.0], [0.0, 0.0])?;
-    /// let s = sine.sample(0.0)?;
+    /// use sim_core::reference::{Reference, ReferenceSample, Sinusoid};
+    /// let mut sine = Sinusoid::new(&[0.1, 0.0], &[0.2, 0.1], &[0.5, 1.0], &[0.0, 0.0])?;
+    /// let mut s = ReferenceSample::zeros(2);
+    /// sine.sample(0.0, &mut s)?;
     /// assert_eq!(s.a, [0.1, 0.0]);
     /// assert!((s.a_dot[0] - 0.2 * std::f64::consts::PI).abs() < 1e-15);
     /// # Ok::<(), sim_core::SimError>(())
     /// ```
     pub fn new(
-        offset: [f64; 2],
-        amplitude: [f64; 2],
-        frequency_hz: [f64; 2],
-        phase: [f64; 2],
+        offset: &[f64],
+        amplitude: &[f64],
+        frequency_hz: &[f64],
+        phase: &[f64],
     ) -> Result<Self, SimError> {
-        check_finite("reference.offset", &offset)?;
-        check_finite("reference.amplitude", &amplitude)?;
-        check_finite("reference.phase", &phase)?;
-        for f in frequency_hz {
+        check_lengths(&[
+            ("reference.amplitude", amplitude),
+            ("reference.offset", offset),
+            ("reference.frequency_hz", frequency_hz),
+            ("reference.phase", phase),
+        ])?;
+        for &f in frequency_hz {
             check_non_negative("reference.frequency_hz", f)?;
         }
         Ok(Self {
-            offset,
-            amplitude,
-            omega: frequency_hz.map(|f| std::f64::consts::TAU * f),
-            phase,
+            offset: offset.to_vec(),
+            amplitude: amplitude.to_vec(),
+            omega: frequency_hz
+                .iter()
+                .map(|f| std::f64::consts::TAU * f)
+                .collect(),
+            phase: phase.to_vec(),
         })
     }
 }
 
 impl Reference for Sinusoid {
-    fn sample(&self, t: f64) -> Result<ReferenceSample, SimError> {
-        let mut s = ReferenceSample::default();
-        for i in 0..2 {
+    fn n_coords(&self) -> usize {
+        self.amplitude.len()
+    }
+
+    fn sample(&mut self, t: f64, s: &mut ReferenceSample) -> Result<(), SimError> {
+        for i in 0..self.amplitude.len() {
             let (sin, cos) = (self.omega[i] * t + self.phase[i]).sin_cos();
             let w = self.omega[i];
             s.a[i] = self.offset[i] + self.amplitude[i] * sin;
             s.a_dot[i] = self.amplitude[i] * w * cos;
             s.a_ddot[i] = -self.amplitude[i] * w * w * sin;
         }
-        Ok(s)
+        Ok(())
     }
 }

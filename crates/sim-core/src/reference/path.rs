@@ -1,14 +1,22 @@
-//! A Cartesian path for the tip, followed through the closed-form inverse kinematics with
-//! `alpha0` fixed (eqs 5-6), with exact modal rates and accelerations.
+//! A Cartesian path for the tip, followed through the inverse kinematics of the modal family:
+//! the closed form (eqs 5-6) with exact modal rates and accelerations for the paper's `K = 1`
+//! with `alpha0` fixed, a numerical continuation with minimum-norm rates otherwise.
 
+use super::continuation::{Family, ResolveError};
 use super::{Reference, ReferenceSample};
 use crate::error::{SimError, check_finite, check_positive};
-use backbone_kin::{Branch, inverse_kinematics};
+use backbone_kin::{BaseAngle, Branch, inverse_kinematics};
 
-/// How finely [`CartesianPath::new`] checks the path for reachability and singular points.
+/// How finely [`CartesianPath::new`] checks the path for reachability and singular points; also
+/// the number of intervals of the continuation grid.
 const CHECK_SAMPLES: usize = 2000;
 /// Below this `|a1|` (rad) or `J1(A)` the inverse kinematics is treated as singular.
 const SINGULAR_TOLERANCE: f64 = 1e-8;
+/// The base angle a free `alpha0` starts the continuation from (rad): the paper's `pi/2`.
+pub const FREE_BASE_START: f64 = std::f64::consts::FRAC_PI_2;
+/// Largest correction (rad, Euclidean) the inverse kinematics may make to the predicted
+/// configuration between two grid nodes; a larger one means the continuation left its branch.
+const MAX_CORRECTION: f64 = 0.05;
 
 /// The geometric shape of a tip path.
 #[derive(Debug, Clone, PartialEq)]
@@ -45,36 +53,61 @@ struct TipMotion {
 
 /// A tip path traversed in `travel_time` seconds, then held at its end point; before `t = 0` it
 /// holds its first point. The modal reference is its inverse kinematics for a curve of length
-/// `l` leaving the base at the fixed angle `alpha0`, on the chosen sign branch of `a1`.
-#[derive(Debug, Clone, PartialEq)]
+/// `l` with `K` harmonics, leaving the base at a fixed angle `alpha0` or with `alpha0` free:
+///
+/// - `K = 1` with `alpha0` fixed (the paper's): the closed form of eqs 5-6 on the chosen sign
+///   branch of `a1`, with exact rates and accelerations.
+/// - Otherwise: numerical continuation. The path starts at the closed-form `K = 1` solution on
+///   the chosen branch (higher harmonics zero; a free `alpha0` at [`FREE_BASE_START`]), and is
+///   resolved at the minimum-norm modal rate `a_dot = J^+ p_dot` (see `docs/theory.md`): the
+///   positions are solved on a grid of [`CHECK_SAMPLES`] intervals, each node warm-started from
+///   the previous one, and any time `t` is solved from its grid node, so a sample depends on `t`
+///   alone.
+#[derive(Debug, Clone)]
 pub struct CartesianPath {
     shape: PathShape,
     /// Arc length at each vertex of a polyline (empty for a sine).
     arc: Vec<f64>,
     travel_time: f64,
     length: f64,
-    alpha0: f64,
-    branch: Branch,
+    solver: Solver,
+}
+
+/// How the path's modal reference is resolved.
+#[derive(Debug, Clone)]
+enum Solver {
+    /// Eqs 5-6 with this `alpha0` and branch.
+    ClosedForm { alpha0: f64, branch: Branch },
+    /// Numerical continuation over a time grid.
+    Continuation {
+        family: Box<Family>,
+        /// Node `k` at `t = k * step`: `a`, `a_dot`, `a_ddot`, `m` entries each.
+        nodes: Vec<ReferenceSample>,
+        step: f64,
+    },
 }
 
 impl CartesianPath {
     /// The path `shape` traversed in `travel_time` s by the tip of a backbone curve of length
-    /// `length` (m) with base angle `alpha0` (rad).
+    /// `length` (m) with `harmonics` harmonics and base angle `base`; `branch` is the sign of
+    /// `a1` of the closed form (where a numerical continuation starts for other families).
     ///
     /// Checks the shape's parameters, then samples the whole path densely: every point must be
     /// reachable ([`SimError::Unreachable`] names the first that is not) and away from the
     /// singular points of the inverse kinematics ([`SimError::SingularPoint`]).
     ///
     /// ```
-    /// use backbone_kin::Branch;
-    /// use sim_core::reference::{CartesianPath, PathShape, Reference};
+    /// use backbone_kin::{BaseAngle, Branch};
+    /// use sim_core::reference::{CartesianPath, PathShape, Reference, ReferenceSample};
     /// // The paper's eq 25 over 5 s, alpha0 = pi/2, on the 1 m arm.
     /// let shape = PathShape::Sine {
     ///     amplitude: 0.4, wavenumber: 5.0, phase: 0.0, offset: 0.2, x_start: 0.08, x_end: 0.4,
     /// };
-    /// let path = CartesianPath::new(shape, 5.0, 1.0, std::f64::consts::FRAC_PI_2, Branch::Positive)?;
-    /// let start = path.sample(0.0)?;
-    /// let tip = backbone_kin::end_point(1.0, start.a, std::f64::consts::FRAC_PI_2)?;
+    /// let alpha0 = std::f64::consts::FRAC_PI_2;
+    /// let mut path = CartesianPath::new(shape, 5.0, 1.0, 1, BaseAngle::Fixed(alpha0), Branch::Positive)?;
+    /// let mut start = ReferenceSample::zeros(2);
+    /// path.sample(0.0, &mut start)?;
+    /// let tip = backbone_kin::end_point(1.0, [start.a[0], start.a[1]], alpha0)?;
     /// assert!((tip[0] - 0.08).abs() < 1e-12);
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
@@ -82,31 +115,81 @@ impl CartesianPath {
         shape: PathShape,
         travel_time: f64,
         length: f64,
-        alpha0: f64,
+        harmonics: usize,
+        base: BaseAngle,
         branch: Branch,
     ) -> Result<Self, SimError> {
         check_positive("reference.travel_time", travel_time)?;
         check_positive("arm length", length)?;
-        check_finite("alpha0", &[alpha0])?;
+        if let BaseAngle::Fixed(alpha0) = base {
+            check_finite("alpha0", &[alpha0])?;
+        }
         let arc = validate_shape(&shape)?;
-        let path = Self {
+        let mut path = Self {
             shape,
             arc,
             travel_time,
             length,
-            alpha0,
-            branch,
+            solver: Solver::ClosedForm {
+                alpha0: match base {
+                    BaseAngle::Fixed(alpha0) => alpha0,
+                    BaseAngle::Free => FREE_BASE_START,
+                },
+                branch,
+            },
         };
-        for k in 0..=CHECK_SAMPLES {
-            path.sample(travel_time * k as f64 / CHECK_SAMPLES as f64)?;
+        let fixed = match base {
+            BaseAngle::Fixed(alpha0) => Some(alpha0),
+            BaseAngle::Free => None,
+        };
+        let mut sample = ReferenceSample::zeros(2);
+        if harmonics == 1 && fixed.is_some() {
+            for k in 0..=CHECK_SAMPLES {
+                path.sample(travel_time * k as f64 / CHECK_SAMPLES as f64, &mut sample)?;
+            }
+        } else {
+            // The start: the closed-form K = 1 solution, padded with zero harmonics.
+            path.sample(0.0, &mut sample)?;
+            let mut family = Family::new(length, harmonics, fixed)?;
+            let m = family.n_coords();
+            let mut start = ReferenceSample::zeros(m);
+            start.a[..2].copy_from_slice(&sample.a);
+            if fixed.is_none() {
+                start.a[m - 1] = FREE_BASE_START;
+            }
+            let step = travel_time / CHECK_SAMPLES as f64;
+            let mut nodes = Vec::with_capacity(CHECK_SAMPLES + 1);
+            resolve(&mut family, 0.0, path.tip_motion(0.0), None, &mut start)?;
+            nodes.push(start);
+            for k in 1..=CHECK_SAMPLES {
+                let t = k as f64 * step;
+                let mut node = ReferenceSample::zeros(m);
+                let previous = Some((&nodes[k - 1], step));
+                resolve(&mut family, t, path.tip_motion(t), previous, &mut node)?;
+                nodes.push(node);
+            }
+            path.solver = Solver::Continuation {
+                family: Box::new(family),
+                nodes,
+                step,
+            };
+            sample = ReferenceSample::zeros(m);
         }
         if let PathShape::Polyline(_) = &path.shape {
             let speed = path.arc[path.arc.len() - 1] / travel_time;
-            for &s in &path.arc {
-                path.sample(s / speed)?;
+            for s in path.arc.clone() {
+                path.sample(s / speed, &mut sample)?;
             }
         }
         Ok(path)
+    }
+
+    /// The number of modal coordinates the path's reference sets.
+    pub fn n_coords(&self) -> usize {
+        match &self.solver {
+            Solver::ClosedForm { .. } => 2,
+            Solver::Continuation { family, .. } => family.n_coords(),
+        }
     }
 
     /// The time the tip takes along the path (s); after it, the reference holds the end point.
@@ -166,12 +249,34 @@ impl CartesianPath {
 }
 
 impl Reference for CartesianPath {
-    /// The inverse kinematics of the tip motion, differentiated exactly through the polar form of
-    /// eqs 5-6: `a2 = atan2(y, x) - alpha0`, `J0(A) = r / l`, `a1^2 = A^2 - a2^2`.
-    fn sample(&self, t: f64) -> Result<ReferenceSample, SimError> {
-        let TipMotion { p, v, acc } = self.tip_motion(t);
+    fn n_coords(&self) -> usize {
+        CartesianPath::n_coords(self)
+    }
+
+    /// For the closed form, the inverse kinematics of the tip motion, differentiated exactly
+    /// through the polar form of eqs 5-6: `a2 = atan2(y, x) - alpha0`, `J0(A) = r / l`,
+    /// `a1^2 = A^2 - a2^2`. For the continuation, the solution from the grid node at or before
+    /// `t` (see the type's docs).
+    fn sample(&mut self, t: f64, out: &mut ReferenceSample) -> Result<(), SimError> {
+        let motion = self.tip_motion(t);
+        let (alpha0, branch) = match &mut self.solver {
+            Solver::ClosedForm { alpha0, branch } => (*alpha0, *branch),
+            Solver::Continuation {
+                family,
+                nodes,
+                step,
+            } => {
+                let k = ((t / *step).floor().max(0.0) as usize).min(nodes.len() - 1);
+                let node = &nodes[k];
+                let dt = t.clamp(0.0, self.travel_time) - k as f64 * *step;
+                out.a.copy_from_slice(&node.a);
+                let previous = (dt > 0.0).then_some((node, dt));
+                return resolve(family, t, motion, previous, out);
+            }
+        };
+        let TipMotion { p, v, acc } = motion;
         let [x, y] = p;
-        let [a1, a2] = inverse_kinematics(self.length, p, self.alpha0, self.branch)
+        let [a1, a2] = inverse_kinematics(self.length, p, alpha0, branch)
             .map_err(|source| SimError::Unreachable { t, x, y, source })?;
         let amplitude = a1.hypot(a2);
         let j1 = libm::j1(amplitude);
@@ -200,12 +305,55 @@ impl Reference for CartesianPath {
             - a2 * a2_ddot
             - a1_dot * a1_dot)
             / a1;
-        Ok(ReferenceSample {
-            a: [a1, a2],
-            a_dot: [a1_dot, a2_dot],
-            a_ddot: [a1_ddot, a2_ddot],
-        })
+        out.a.copy_from_slice(&[a1, a2]);
+        out.a_dot.copy_from_slice(&[a1_dot, a2_dot]);
+        out.a_ddot.copy_from_slice(&[a1_ddot, a2_ddot]);
+        Ok(())
     }
+}
+
+/// The reference at `t` (tip motion `motion`) by the continuation: from `previous` (a node and the time from it to
+/// `t`) by a second-order prediction, or from `out.a` itself; then the inverse kinematics
+/// and the minimum-norm rates.
+fn resolve(
+    family: &mut Family,
+    t: f64,
+    motion: TipMotion,
+    previous: Option<(&ReferenceSample, f64)>,
+    out: &mut ReferenceSample,
+) -> Result<(), SimError> {
+    let TipMotion { p, v, acc } = motion;
+    let [x, y] = p;
+    if let Some((node, dt)) = previous {
+        for i in 0..out.a.len() {
+            out.a[i] = node.a[i] + dt * node.a_dot[i] + 0.5 * dt * dt * node.a_ddot[i];
+        }
+    }
+    let unreachable = |source| SimError::Unreachable { t, x, y, source };
+    // Keep the prediction to measure the correction, in the a_dot buffer (rewritten below).
+    out.a_dot.copy_from_slice(&out.a);
+    family.solve(p, &mut out.a).map_err(unreachable)?;
+    let correction = out
+        .a
+        .iter()
+        .zip(&out.a_dot)
+        .map(|(a, b)| (a - b) * (a - b))
+        .sum::<f64>()
+        .sqrt();
+    let singular = |what| SimError::SingularPoint { what, t, x, y };
+    if previous.is_some() && correction > MAX_CORRECTION {
+        return Err(singular(
+            "the numerical inverse kinematics left its branch between two grid nodes",
+        ));
+    }
+    family
+        .rates(&out.a, v, acc, &mut out.a_dot, &mut out.a_ddot)
+        .map_err(|e| match e {
+            ResolveError::Singular => {
+                singular("the end-point Jacobian is rank deficient (J J^T singular)")
+            }
+            ResolveError::Kinematics(source) => unreachable(source),
+        })
 }
 
 /// Checks a shape's numbers; returns the cumulative arc lengths of a polyline.

@@ -1,0 +1,200 @@
+//! The inverse kinematics of any modal family along a path, by numerical continuation: the
+//! redundancy resolution of the Cartesian path reference beyond the paper's closed form
+//! (`docs/theory.md`, "Tip paths for any modal family").
+//!
+//! The end point `p(a)` of a family with `m` coordinates (`2K` modes, plus `alpha0` when it is
+//! free) is a map from `m` coordinates to the plane, redundant for `m > 2`. Along a tip path
+//! `p(t)` the reference is resolved at the minimum-norm rate
+//! `a_dot = J^+ p_dot = J^T (J J^T)^{-1} p_dot` (`J = d p / d a`, `2 x m`), the rate of
+//! smallest Euclidean norm that moves the tip along the path; its acceleration is the time
+//! derivative of that field, `a_ddot = d(J^+)/da[a_dot] p_dot + J^+ p_ddot`. Positions come from
+//! Levenberg-Marquardt ([`backbone_kin::HarmonicIk`], minimum-norm Gauss-Newton steps near a
+//! solution) warm-started from a second-order prediction off the previous node of a fixed time
+//! grid; a free `alpha0` is held at its predicted value while the modes are corrected (the end
+//! point of a curve with base angle `alpha0` is that of `alpha0 = 0` rotated by `alpha0`).
+
+use backbone_kin::{BackboneCurve, HarmonicIk, KinError};
+
+/// `J J^T` counts as singular below this ratio of its eigenvalues: the tip cannot move in some
+/// direction (e.g. radially, for a straight curve).
+const SINGULAR_RATIO: f64 = 1e-10;
+/// Length of the modal step `delta` (rad) of the central difference of the rate field.
+const RATE_FIELD_STEP: f64 = 1e-5;
+
+/// Why the continuation could not resolve a point.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum ResolveError {
+    /// The end-point Jacobian is (nearly) rank deficient.
+    Singular,
+    /// The kinematics refused (out of reach, not converged).
+    Kinematics(KinError),
+}
+
+impl From<KinError> for ResolveError {
+    fn from(e: KinError) -> Self {
+        ResolveError::Kinematics(e)
+    }
+}
+
+/// End point, Jacobian and inverse kinematics of a family with `harmonics` harmonics and a fixed
+/// (`Some(alpha0)`) or free (`None`) base angle; all buffers sized at construction.
+#[derive(Debug, Clone)]
+pub(crate) struct Family {
+    /// `2K`.
+    modes: usize,
+    /// `m`: `2K`, or `2K + 1` with a free base angle.
+    m: usize,
+    free: bool,
+    /// The curve with the fixed `alpha0`, or with `alpha0 = 0` when it is free.
+    curve: BackboneCurve,
+    ik: HarmonicIk,
+    /// `2 x 2K` Jacobian of the curve's modes, row-major.
+    mode_jacobian: Vec<f64>,
+    /// `2 x m` Jacobian of the family, row-major.
+    jacobian: Vec<f64>,
+    /// Scratch: `m` entries each.
+    shifted: Vec<f64>,
+    plus: Vec<f64>,
+    minus: Vec<f64>,
+}
+
+impl Family {
+    pub(crate) fn new(
+        length: f64,
+        harmonics: usize,
+        alpha0: Option<f64>,
+    ) -> Result<Self, KinError> {
+        let modes = 2 * harmonics;
+        let m = modes + usize::from(alpha0.is_none());
+        let base = alpha0.unwrap_or(0.0);
+        Ok(Self {
+            modes,
+            m,
+            free: alpha0.is_none(),
+            curve: BackboneCurve::new(length, &vec![0.0; modes], base)?,
+            ik: HarmonicIk::new(length, harmonics, base)?,
+            mode_jacobian: vec![0.0; 2 * modes],
+            jacobian: vec![0.0; 2 * m],
+            shifted: vec![0.0; m],
+            plus: vec![0.0; m],
+            minus: vec![0.0; m],
+        })
+    }
+
+    /// The number of coordinates `m`.
+    pub(crate) fn n_coords(&self) -> usize {
+        self.m
+    }
+
+    /// The end point at `a` (by quadrature for `K > 1`, in closed form for `K = 1`).
+    pub(crate) fn end_point(&mut self, a: &[f64]) -> Result<[f64; 2], KinError> {
+        self.curve.set_modes(&a[..self.modes])?;
+        let p = self.curve.end_point();
+        Ok(if self.free {
+            rotate(p, a[self.modes])
+        } else {
+            p
+        })
+    }
+
+    /// The end point at `a` and its Jacobian into `self.jacobian`.
+    fn jacobian_at(&mut self, a: &[f64]) -> Result<[f64; 2], KinError> {
+        self.curve.set_modes(&a[..self.modes])?;
+        let p = self.curve.end_point_jacobian(&mut self.mode_jacobian)?;
+        let (k, m) = (self.modes, self.m);
+        if !self.free {
+            self.jacobian.copy_from_slice(&self.mode_jacobian);
+            return Ok(p);
+        }
+        let angle = a[k];
+        for j in 0..k {
+            let [x, y] = rotate([self.mode_jacobian[j], self.mode_jacobian[k + j]], angle);
+            self.jacobian[j] = x;
+            self.jacobian[m + j] = y;
+        }
+        let p = rotate(p, angle);
+        // d p / d alpha0 = (-y, x).
+        self.jacobian[k] = -p[1];
+        self.jacobian[m + k] = p[0];
+        Ok(p)
+    }
+
+    /// `out = J^+ v` with the Jacobian in `self.jacobian`.
+    fn pseudo_inverse(&self, v: [f64; 2], out: &mut [f64]) -> Result<(), ResolveError> {
+        let (jx, jy) = self.jacobian.split_at(self.m);
+        let dot = |u: &[f64], w: &[f64]| u.iter().zip(w).map(|(p, q)| p * q).sum::<f64>();
+        let (gxx, gxy, gyy) = (dot(jx, jx), dot(jx, jy), dot(jy, jy));
+        let det = gxx * gyy - gxy * gxy;
+        let trace = gxx + gyy;
+        if !(det > SINGULAR_RATIO * trace * trace && det.is_finite()) {
+            return Err(ResolveError::Singular);
+        }
+        let y = [
+            (gyy * v[0] - gxy * v[1]) / det,
+            (gxx * v[1] - gxy * v[0]) / det,
+        ];
+        for ((o, &dx), &dy) in out.iter_mut().zip(jx).zip(jy) {
+            *o = dx * y[0] + dy * y[1];
+        }
+        Ok(())
+    }
+
+    /// Solves `p(a) = target` from the guess in `a` (a free `alpha0` held at its guess).
+    pub(super) fn solve(&mut self, target: [f64; 2], a: &mut [f64]) -> Result<(), KinError> {
+        let target = if self.free {
+            rotate(target, -a[self.modes])
+        } else {
+            target
+        };
+        self.ik.solve(target, &mut a[..self.modes]).map(|_| ())
+    }
+
+    /// The minimum-norm rate `a_dot = J^+ p_dot` at `a` and its time derivative
+    /// `a_ddot = d(J^+)/da[a_dot] p_dot + J^+ p_ddot`, the first term by a central difference
+    /// along `a_dot`.
+    pub(super) fn rates(
+        &mut self,
+        a: &[f64],
+        p_dot: [f64; 2],
+        p_ddot: [f64; 2],
+        a_dot: &mut [f64],
+        a_ddot: &mut [f64],
+    ) -> Result<(), ResolveError> {
+        self.jacobian_at(a)?;
+        self.pseudo_inverse(p_dot, a_dot)?;
+        self.pseudo_inverse(p_ddot, a_ddot)?;
+        let speed = a_dot.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if speed == 0.0 {
+            return Ok(());
+        }
+        let delta = RATE_FIELD_STEP / speed;
+        let mut shifted = std::mem::take(&mut self.shifted);
+        let (mut plus, mut minus) = (
+            std::mem::take(&mut self.plus),
+            std::mem::take(&mut self.minus),
+        );
+        let result = (|| {
+            for (sign, out) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                for ((s, &x), &v) in shifted.iter_mut().zip(a).zip(a_dot.iter()) {
+                    *s = x + sign * delta * v;
+                }
+                self.jacobian_at(&shifted)?;
+                self.pseudo_inverse(p_dot, out)?;
+            }
+            Ok::<(), ResolveError>(())
+        })();
+        if result.is_ok() {
+            for ((dd, p), q) in a_ddot.iter_mut().zip(&plus).zip(&minus) {
+                *dd += (p - q) / (2.0 * delta);
+            }
+        }
+        (self.shifted, self.plus, self.minus) = (shifted, plus, minus);
+        result
+    }
+}
+
+/// `p` rotated by `angle`.
+fn rotate(p: [f64; 2], angle: f64) -> [f64; 2] {
+    let (sin, cos) = angle.sin_cos();
+    [cos * p[0] - sin * p[1], sin * p[0] + cos * p[1]]
+}
