@@ -1,7 +1,7 @@
 //! Project automation in the cargo-xtask pattern: `cargo xtask <command>`.
 //!
-//! - `ci`: what `.ci/run` runs: formatting, clippy with `-D warnings`, the whole test suite, and a
-//!   compile-only pass over the benches.
+//! - `ci`: what `.ci/run` runs: formatting, clippy with `-D warnings`, the whole test suite, the
+//!   `hrm` crate's `custom_controller` example, and a compile-only pass over the benches.
 //! - `props [--cases N]`: the test suite with `PROPTEST_CASES=N` (default 2048), so every property
 //!   test (energy conservation, Jacobian consistency, ...) runs many more cases than in CI.
 //! - `bench [FILTER]`: the Criterion benches, then `target/bench-summary.json` (bench id -> median
@@ -43,6 +43,8 @@ fn ci() -> Result<(), String> {
         &[],
     )?;
     cargo(&["test", "--workspace"], &[])?;
+    // The first program of the `hrm` crate's docs must run.
+    cargo(&["run", "-p", "hrm", "--example", "custom_controller"], &[])?;
     // Benches are compiled, never run, in CI.
     cargo(&["test", "--workspace", "--benches", "--no-run"], &[])
 }
