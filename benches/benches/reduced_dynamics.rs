@@ -2,8 +2,9 @@
 //! `G*` and the Cholesky solve of eq 15, by the default `O(n m^2)` modal recursion
 //! (`reduced_fd/n`) and by projecting the full chain's `M`, `C`, `G` with faer
 //! (`reduced_fd_faer/n`, `O(n^2 m)`). Arms of `n` equal links with total length 1 m, mass 1 kg.
+//! `reduced_fd/10_k2`: the 10-link arm with two harmonics and `alpha0` fixed (`m = 4`).
 
-use backbone_kin::ModalMap;
+use backbone_kin::{BaseAngle, ModalMap};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use manip_dyn::ChainModel;
 use modal_reduce::{ReducedData, ReducedModel, forward_dynamics, forward_dynamics_faer};
@@ -62,10 +63,39 @@ fn reduced_fd(c: &mut Criterion) {
     bench_group(c, "reduced_fd", forward_dynamics, 100);
 }
 
+/// The 10-link arm with the two-harmonic family, `alpha0 = pi/2` fixed: `m = 4`.
+fn reduced_fd_k2(c: &mut Criterion) {
+    let map = ModalMap::uniform(10, 2, BaseAngle::Fixed(std::f64::consts::FRAC_PI_2)).unwrap();
+    let model = ReducedModel::new(ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(), map).unwrap();
+    let mut data = ReducedData::new(&model);
+    let (a, a_dot, tau_star) = (
+        [0.4, -0.3, 0.1, -0.05],
+        [0.5, 0.2, -0.1, 0.05],
+        [1.0, -0.5, 0.2, 0.1],
+    );
+    let mut a_ddot = [0.0; 4];
+    let mut group = c.benchmark_group("reduced_fd");
+    group.bench_function("10_k2", |b| {
+        b.iter(|| {
+            forward_dynamics(
+                &model,
+                &mut data,
+                black_box(&a),
+                black_box(&a_dot),
+                black_box(&tau_star),
+                &mut a_ddot,
+            )
+            .unwrap();
+            black_box(a_ddot)
+        })
+    });
+    group.finish();
+}
+
 fn reduced_fd_faer(c: &mut Criterion) {
     // Milliseconds per call at n = 1000: fewer samples keep the run short.
     bench_group(c, "reduced_fd_faer", forward_dynamics_faer, 20);
 }
 
-criterion_group!(benches, reduced_fd, reduced_fd_faer);
+criterion_group!(benches, reduced_fd, reduced_fd_k2, reduced_fd_faer);
 criterion_main!(benches);
