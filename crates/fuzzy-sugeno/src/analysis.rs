@@ -451,6 +451,15 @@ fn set_landmarks(mf: &MembershipFn) -> Vec<f64> {
         } => {
             vec![center1, center2]
         }
+        MembershipFn::SShape { start, end } | MembershipFn::ZShape { start, end } => {
+            vec![start, 0.5 * (start + end), end]
+        }
+        MembershipFn::PiShape {
+            left_foot,
+            left_shoulder,
+            right_shoulder,
+            right_foot,
+        } => vec![left_foot, left_shoulder, right_shoulder, right_foot],
         MembershipFn::Constant { .. } => Vec::new(),
     }
 }

@@ -43,6 +43,7 @@ pub use analysis::{AnalysisOptions, AnalysisReport};
 pub use builder::SystemBuilder;
 pub use error::FuzzyError;
 pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange};
+pub use fis::FisNote;
 pub use membership::MembershipFn;
 pub use paper::{PaperController, paper_controller};
 pub use system::{

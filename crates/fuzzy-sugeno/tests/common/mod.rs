@@ -61,7 +61,7 @@ fn random_membership(rng: &mut Rng, lo: f64, hi: f64) -> MembershipFn {
         v
     };
     let p = sorted(4);
-    match rng.below(9) {
+    match rng.below(12) {
         0 => {
             let slope = [1.0, 2.0, 3.0, 1.5, 0.5, rng.range(0.3, 5.0)][rng.below(6)];
             MembershipFn::bell(rng.range(0.05, 1.0) * w, slope, rng.range(lo, hi))
@@ -87,6 +87,20 @@ fn random_membership(rng: &mut Rng, lo: f64, hi: f64) -> MembershipFn {
             center1: p[0],
             slope2: -rng.range(1.0, 20.0) / w,
             center2: p[3],
+        },
+        8 => MembershipFn::SShape {
+            start: p[0],
+            end: p[2],
+        },
+        9 => MembershipFn::ZShape {
+            start: p[1],
+            end: p[3],
+        },
+        10 => MembershipFn::PiShape {
+            left_foot: p[0],
+            left_shoulder: p[1],
+            right_shoulder: p[2],
+            right_foot: p[3],
         },
         _ => MembershipFn::Constant { value: rng.unit() },
     }
@@ -254,7 +268,49 @@ pub fn reference_mu(mf: &MembershipFn, x: f64) -> f64 {
             slope2,
             center2,
         } => sig(slope1, center1) * sig(slope2, center2),
+        MembershipFn::SShape { start, end } => reference_s(x, start, end),
+        MembershipFn::ZShape { start, end } => reference_z(x, start, end),
+        MembershipFn::PiShape {
+            left_foot,
+            left_shoulder,
+            right_shoulder,
+            right_foot,
+        } => reference_s(x, left_foot, left_shoulder) * reference_z(x, right_shoulder, right_foot),
         MembershipFn::Constant { value } => value,
+    }
+}
+
+/// MATLAB's `smf(x, [a b])`, its step for `a >= b` included.
+fn reference_s(x: f64, a: f64, b: f64) -> f64 {
+    if a >= b {
+        return if x >= (a + b) / 2.0 { 1.0 } else { 0.0 };
+    }
+    let m = (a + b) / 2.0;
+    if x <= a {
+        0.0
+    } else if x <= m {
+        2.0 * ((x - a) / (b - a)).powi(2)
+    } else if x < b {
+        1.0 - 2.0 * ((x - b) / (b - a)).powi(2)
+    } else {
+        1.0
+    }
+}
+
+/// MATLAB's `zmf(x, [a b])`, its step for `a >= b` included.
+fn reference_z(x: f64, a: f64, b: f64) -> f64 {
+    if a >= b {
+        return if x <= (a + b) / 2.0 { 1.0 } else { 0.0 };
+    }
+    let m = (a + b) / 2.0;
+    if x <= a {
+        1.0
+    } else if x <= m {
+        1.0 - 2.0 * ((x - a) / (b - a)).powi(2)
+    } else if x < b {
+        2.0 * ((x - b) / (b - a)).powi(2)
+    } else {
+        0.0
     }
 }
 
