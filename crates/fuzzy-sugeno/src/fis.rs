@@ -594,12 +594,17 @@ impl<'a> Keys<'a> {
                         format!("unknown key `{key}` in {title}; expected one of {expected}"),
                     ));
                 }
+                let consequence = if key == "Default" {
+                    "where no rule fires, the evaluator's no-rule-fired policy applies instead \
+                     (by default MATLAB's middle of the range)"
+                } else {
+                    "the system is evaluated as MATLAB evaluates it"
+                };
                 note(
                     notes,
                     line.number,
                     format!(
-                        "`{key}={}` in {title} is not a MATLAB key; ignored (such keys, like fuzzylite's \
-                         Enabled or LockRange, do not change a Sugeno evaluation)",
+                        "`{key}={}` in {title} is not a MATLAB key; ignored ({consequence})",
                         value.trim()
                     ),
                 );

@@ -1,7 +1,8 @@
 //! `hrm fis`: check, evaluate and plot Takagi-Sugeno systems stored as MATLAB `.fis` files.
 //!
-//! - `hrm fis check FILE`: Wang's completeness, consistency and continuity; exits non-zero if
-//!   one of them fails.
+//! - `hrm fis check FILE`: what the reader accepted but ignored (unused methods, extension
+//!   keys, extra parameters), then Wang's completeness, consistency and continuity; exits
+//!   non-zero if one of them fails.
 //! - `hrm fis eval FILE x1 x2 ...`: prints `name = value` for every output.
 //! - `hrm fis surface FILE --out DIR`: SVGs of every input's membership functions and of every
 //!   output over every pair of inputs (others at a reference value), like MATLAB's `plotmf` and
@@ -10,7 +11,7 @@
 use crate::plot::{self, Grid, Labels, Series};
 use clap::{Args, Subcommand, ValueEnum};
 use fuzzy_sugeno::{
-    AnalysisOptions, EvalOptions, Evaluator, FuzzySystem, InputVariable, OutOfRange,
+    AnalysisOptions, EvalOptions, Evaluator, FisNote, FuzzySystem, InputVariable, OutOfRange,
 };
 use std::path::{Path, PathBuf};
 
@@ -23,7 +24,7 @@ pub struct FisArgs {
 
 #[derive(Debug, Subcommand)]
 enum FisCommand {
-    /// Check the rule base for completeness, consistency and continuity (Wang); fails if one does not hold.
+    /// List what the file says that was accepted but ignored, then check the rule base for completeness, consistency and continuity (Wang); fails if one does not hold.
     Check {
         /// The `.fis` file.
         file: PathBuf,
@@ -90,7 +91,12 @@ pub fn run(args: FisArgs) -> Result<(), String> {
                 max_relative_jump: max_jump,
                 ..Default::default()
             };
-            let (report, passed) = check(&read_system(&file)?, &options)?;
+            let text =
+                std::fs::read_to_string(&file).map_err(|e| format!("{}: {e}", file.display()))?;
+            let (system, notes) = FuzzySystem::from_fis_with_notes(&text)
+                .map_err(|e| format!("{}: {e}", file.display()))?;
+            print!("{}", ignored_report(&file, &notes));
+            let (report, passed) = check(&system, &options)?;
             print!("{report}");
             if passed {
                 Ok(())
@@ -132,6 +138,19 @@ fn read_system(path: &Path) -> Result<FuzzySystem, String> {
     load_system(&text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
+/// The lines of `file` that were accepted but are neither kept nor used, one per line, so that
+/// nothing is dropped silently.
+fn ignored_report(file: &Path, notes: &[FisNote]) -> String {
+    if notes.is_empty() {
+        return format!("{}: nothing ignored\n", file.display());
+    }
+    let mut report = format!("{}: accepted but ignored:\n", file.display());
+    for note in notes {
+        report.push_str(&format!("  {note}\n"));
+    }
+    report
+}
+
 /// The analysis report and whether it passed.
 fn check(system: &FuzzySystem, options: &AnalysisOptions) -> Result<(String, bool), String> {
     let report = system.analyze(options).map_err(|e| e.to_string())?;
@@ -162,7 +181,8 @@ fn eval(
     Ok(names.zip(outputs).collect())
 }
 
-/// Writes the plots into `dir` and returns their paths: `mf_<input>.svg` for every input, then
+/// Writes the plots into `dir` and returns their paths: `mf_<input>.svg` for every input that
+/// has membership functions (a `NumMFs=0` input has none to draw), then
 /// `surface_<output>_<x>_<y>.svg` for every output and pair of inputs (or `curve_<output>_<x>.svg`
 /// for a single-input system).
 fn surface(
@@ -191,7 +211,7 @@ fn surface(
     };
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let mut written = Vec::new();
-    for input in inputs {
+    for input in inputs.iter().filter(|input| !input.sets.is_empty()) {
         written.push(membership_chart(input, dir)?);
     }
     if inputs.len() == 1 {
@@ -399,6 +419,28 @@ mod tests {
     }
 
     #[test]
+    fn check_lists_what_was_accepted_but_ignored() {
+        let file = Path::new("dimmer.fis");
+        let text = include_str!("../../fuzzy-sugeno/data/interop/fuzzylite_export.fis");
+        let (_, notes) = FuzzySystem::from_fis_with_notes(text).unwrap();
+        let report = ignored_report(file, &notes);
+        assert!(
+            report.starts_with("dimmer.fis: accepted but ignored:\n  line 4: Version=6.0"),
+            "{report}"
+        );
+        assert!(
+            report.contains("\n  line 8: AndMethod='' is not used by any rule"),
+            "{report}"
+        );
+        assert!(
+            report.contains("\n  line 16: `Enabled=1` in [Input1] is not a MATLAB key"),
+            "{report}"
+        );
+        assert_eq!(report.lines().count(), 1 + notes.len());
+        assert_eq!(ignored_report(file, &[]), "dimmer.fis: nothing ignored\n");
+    }
+
+    #[test]
     fn check_passes_the_paper_and_fails_narrow_bells() {
         let (report, passed) = check(&paper_controller(), &AnalysisOptions::default()).unwrap();
         assert!(passed, "{report}");
@@ -453,6 +495,17 @@ mod tests {
             surface(&paper_controller(), &dir, 9, Some(&[0.0])).unwrap_err(),
             "--reference has 1 values for 4 inputs"
         );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn an_input_without_membership_functions_gets_no_membership_plot() {
+        let text = include_str!("../../fuzzy-sugeno/data/interop/matlab_legacy.fis");
+        let dir = temp_dir("no-sets");
+        let written = surface(&load_system(text).unwrap(), &dir, 3, None).unwrap();
+        assert!(!written.contains(&dir.join("mf_load.svg")));
+        assert!(written.contains(&dir.join("mf_angle.svg")));
+        assert!(written.contains(&dir.join("surface_torque_rate_load.svg")));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
