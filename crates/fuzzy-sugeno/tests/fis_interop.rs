@@ -6,8 +6,9 @@
 
 mod common;
 
-use common::reference_eval;
+use common::{random_system, reference_eval};
 use fuzzy_sugeno::{EvalOptions, Evaluator, FuzzyError, FuzzySystem, NoRuleFired};
+use proptest::prelude::*;
 
 const LEGACY: &str = include_str!("../data/interop/matlab_legacy.fis");
 const OCTAVE: &str = include_str!("../data/interop/octave_style.fis");
@@ -357,5 +358,69 @@ fn other_spellings_of_the_same_file_give_the_same_system() {
     ];
     for text in variants {
         assert_eq!(FuzzySystem::from_fis(&text).unwrap(), legacy, "{text}");
+    }
+}
+
+/// Rewrites a file written by `to_fis` with the habits of real files: comment lines of both
+/// kinds, indentation, spaces around `=`, `:` and `,`, no `Version`, `ImpMethod='min'` and
+/// `AggMethod='max'`, fuzzylite's extension keys and `1.000` indices, one extra parameter on
+/// every function, trailing spaces. Returns the text and the number of notes it must give.
+fn with_habits(text: &str) -> (String, usize) {
+    let mut out = String::new();
+    let mut notes = 2; // ImpMethod and AggMethod
+    let (mut in_rules, mut in_system) = (false, false);
+    for line in text.lines() {
+        if line.starts_with('[') {
+            out.push_str("# a comment\n% another\n");
+            in_rules = line == "[Rules]";
+            in_system = line == "[System]";
+            out.push_str(line);
+            out.push('\n');
+            continue;
+        }
+        if line.starts_with("Version=") {
+            continue;
+        }
+        let rewritten = if in_rules {
+            let spaced = line.replace(',', " , ");
+            let tokens: Vec<String> = spaced
+                .split_whitespace()
+                .map(|t| match t.parse::<i64>() {
+                    Ok(k) => format!("{k}.000"),
+                    Err(_) => t.to_string(),
+                })
+                .collect();
+            format!("{}   ", tokens.join(" "))
+        } else if line.starts_with("MF") {
+            notes += 1;
+            line.replacen('=', " = ", 1)
+                .replace("':'", "' : '")
+                .replace("',[", "', [")
+                .replace(']', " 0.5]")
+        } else {
+            line.replacen('=', " = ", 1)
+                .replace("ImpMethod = 'prod'", "ImpMethod = 'min'")
+                .replace("AggMethod = 'sum'", "AggMethod = 'max'")
+        };
+        out.push('\t');
+        out.push_str(&rewritten);
+        out.push('\n');
+        if line.starts_with("Name=") && !in_system {
+            out.push_str("\tEnabled=1\n  LockRange = 0\n");
+            notes += 2;
+        }
+    }
+    (out, notes)
+}
+
+proptest! {
+    #[test]
+    fn the_habits_of_real_files_change_nothing(seed in any::<u64>(), zero_order in any::<bool>()) {
+        let system = random_system(seed, zero_order);
+        let (text, expected_notes) = with_habits(&system.to_fis());
+        let (read, notes) = FuzzySystem::from_fis_with_notes(&text)
+            .map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
+        prop_assert_eq!(&read, &system, "{}", text);
+        prop_assert_eq!(notes.len(), expected_notes, "{:#?}\n{}", notes, text);
     }
 }
