@@ -120,7 +120,8 @@ pub struct Jump {
     pub sets: [usize; 2],
     /// `|z_1 - z_2|`.
     pub jump: f64,
-    /// The jump divided by the width of the output's range.
+    /// The jump divided by the width of the output's range (0 for no jump, infinite for a jump
+    /// on an output whose range is a point).
     pub relative: f64,
 }
 
@@ -346,7 +347,12 @@ impl FuzzySystem {
                     let jump = (output.terms[ta].function.value(&point)?
                         - output.terms[tb].function.value(&point)?)
                     .abs();
-                    let relative = jump / (output.range[1] - output.range[0]);
+                    // A point range ([0 0] in some MATLAB files) makes any jump infinite.
+                    let relative = if jump == 0.0 {
+                        0.0
+                    } else {
+                        jump / (output.range[1] - output.range[0])
+                    };
                     if largest[o].is_none_or(|l| jump > l.jump) {
                         largest[o] = Some(Jump {
                             rules: [i, j],

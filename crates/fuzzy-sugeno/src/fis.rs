@@ -732,15 +732,24 @@ impl<'a> Keys<'a> {
         })
     }
 
-    /// `[min max]`, finite with `min < max`.
-    fn range(&self) -> Result<[f64; 2], FuzzyError> {
+    /// `[min max]`, finite with `min < max`, or `min <= max` for an output (`point_allowed`).
+    fn range(&self, point_allowed: bool) -> Result<[f64; 2], FuzzyError> {
         let (line, value) = self.get("Range")?;
         let numbers = bracketed(value).map_err(|m| error(line, format!("Range: {m}")))?;
         match numbers[..] {
-            [min, max] if min.is_finite() && max.is_finite() && min < max => Ok([min, max]),
+            [min, max]
+                if min.is_finite()
+                    && max.is_finite()
+                    && (min < max || point_allowed && min == max) =>
+            {
+                Ok([min, max])
+            }
             [min, max] => Err(error(
                 line,
-                format!("Range must be finite with min < max, found [{min} {max}]"),
+                format!(
+                    "Range must be finite with min {} max, found [{min} {max}]",
+                    if point_allowed { "<=" } else { "<" }
+                ),
             )),
             _ => Err(error(
                 line,
@@ -846,7 +855,7 @@ fn parse_input(
 ) -> Result<InputVariable, FuzzyError> {
     let keys = Keys::new(section, &["Name", "Range", "NumMFs"], true, notes)?;
     let name = variable_name(&keys, names)?;
-    let range = keys.range()?;
+    let range = keys.range(false)?;
     let sets = keys
         .functions(0)?
         .into_iter()
@@ -877,7 +886,7 @@ fn parse_output(
 ) -> Result<OutputVariable, FuzzyError> {
     let keys = Keys::new(section, &["Name", "Range", "NumMFs"], true, notes)?;
     let name = variable_name(&keys, names)?;
-    let range = keys.range()?;
+    let range = keys.range(true)?;
     let terms = keys
         .functions(1)?
         .into_iter()
@@ -1026,7 +1035,7 @@ fn quoted(value: &str) -> Result<(&str, &str), String> {
     Ok((&inner[..end], &inner[end + 1..]))
 }
 
-/// Parses `[a b c]` (spaces or commas between the numbers).
+/// Parses `[a b c]` (spaces or commas between the numbers; each a [`number`]).
 fn bracketed(value: &str) -> Result<Vec<f64>, String> {
     let inner = value
         .trim()
@@ -1036,11 +1045,54 @@ fn bracketed(value: &str) -> Result<Vec<f64>, String> {
     inner
         .split(|c: char| c.is_whitespace() || c == ',')
         .filter(|t| !t.is_empty())
-        .map(|t| {
-            t.parse::<f64>()
-                .map_err(|_| format!("expected a number, found `{t}`"))
-        })
+        .map(|t| number(t).ok_or_else(|| format!("expected a number, found `{t}`")))
         .collect()
+}
+
+/// A number, or the products and quotients of numbers and `pi` that MATLAB's `readfis`
+/// evaluates in its examples (`Range = [-pi/4 pi/4]`): `[+-]factor ([*/] [+-]factor)*` with
+/// each factor a decimal or `pi`.
+fn number(token: &str) -> Option<f64> {
+    let factor = |text: &str| -> Option<f64> {
+        let (sign, magnitude) = match text.strip_prefix('-') {
+            Some(rest) => (-1.0, rest),
+            None => (1.0, text.strip_prefix('+').unwrap_or(text)),
+        };
+        let value = if magnitude == "pi" {
+            std::f64::consts::PI
+        } else if magnitude.starts_with(['+', '-']) {
+            return None;
+        } else {
+            magnitude.parse::<f64>().ok()?
+        };
+        Some(sign * value)
+    };
+    if let Ok(x) = token.parse::<f64>() {
+        return Some(x);
+    }
+    let mut operators = token.match_indices(['*', '/']);
+    let mut start = 0;
+    let mut value: Option<f64> = None;
+    let mut pending = '*';
+    loop {
+        let (end, next) = match operators.next() {
+            Some((index, op)) => (index, op.chars().next()),
+            None => (token.len(), None),
+        };
+        let x = factor(&token[start..end])?;
+        value = Some(match (value, pending) {
+            (None, _) => x,
+            (Some(v), '*') => v * x,
+            (Some(v), _) => v / x,
+        });
+        match next {
+            Some(op) => {
+                pending = op;
+                start = end + 1;
+            }
+            None => return value,
+        }
+    }
 }
 
 /// Parses `'name':'type',[params]`.
@@ -1267,6 +1319,30 @@ mod tests {
             parse_error(&TINY.replace("'sugeno'", "'tsk'")),
             "line 3: expected Type='sugeno', found Type='tsk'"
         );
+    }
+
+    #[test]
+    fn numbers_may_be_written_as_matlab_expressions_of_pi() {
+        use std::f64::consts::PI;
+        let cases = [
+            ("-pi/4", Some(-PI / 4.0)),
+            ("pi", Some(PI)),
+            ("+pi", Some(PI)),
+            ("2*pi", Some(2.0 * PI)),
+            ("pi/-2", Some(PI / -2.0)),
+            ("3/4*pi", Some(3.0 / 4.0 * PI)),
+            ("1e-3", Some(1e-3)),
+            ("0.250", Some(0.25)),
+            ("pi/", None),
+            ("*2", None),
+            ("--1", None),
+            ("p", None),
+            ("pi+1", None),
+        ];
+        for (text, expected) in cases {
+            assert_eq!(number(text), expected, "{text}");
+        }
+        assert_eq!(bracketed("[-pi/4, pi/4]").unwrap(), [-PI / 4.0, PI / 4.0]);
     }
 
     #[test]

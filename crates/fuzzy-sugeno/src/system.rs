@@ -33,7 +33,8 @@ pub struct FuzzySet {
 pub struct OutputVariable {
     /// The variable's name (unique among all variables of a system).
     pub name: String,
-    /// `[min, max]`, with `min < max`; its middle is the default output when no rule fires.
+    /// `[min, max]`, with `min <= max` (MATLAB's examples include `[0 0]`); its middle is the
+    /// default output when no rule fires.
     pub range: [f64; 2],
     /// The consequent functions ("terms") of the variable, in the order rules index them.
     pub terms: Vec<OutputTerm>,
@@ -213,7 +214,7 @@ impl FuzzySystem {
                 input.range,
                 input.sets.iter().map(|s| s.name.as_str()),
                 &mut variable_names,
-                true,
+                VariableKind::Input,
             )
             .map_err(|reason| invalid(&context, reason))?;
             for set in &input.sets {
@@ -229,7 +230,7 @@ impl FuzzySystem {
                 output.range,
                 output.terms.iter().map(|t| t.name.as_str()),
                 &mut variable_names,
-                false,
+                VariableKind::Output,
             )
             .map_err(|reason| invalid(&context, reason))?;
             for term in &output.terms {
@@ -307,14 +308,22 @@ pub(crate) fn check_name(kind: &str, name: &str) -> Result<(), String> {
     }
 }
 
-/// Checks a variable's name (new among `variable_names`), range and term names; an input
-/// (`may_be_empty`) may have no terms, an output needs at least one.
+/// Whether a variable is an input or an output, for [`check_variable`].
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum VariableKind {
+    /// May have no sets (`NumMFs=0`); its range must have `min < max`.
+    Input,
+    /// Needs at least one term; its range may be a point (`min = max`).
+    Output,
+}
+
+/// Checks a variable's name (new among `variable_names`), range and term names.
 fn check_variable<'a>(
     name: &'a str,
     range: [f64; 2],
     term_names: impl Iterator<Item = &'a str>,
     variable_names: &mut Vec<&'a str>,
-    may_be_empty: bool,
+    kind: VariableKind,
 ) -> Result<(), String> {
     check_name("variable", name)?;
     if variable_names.contains(&name) {
@@ -322,9 +331,17 @@ fn check_variable<'a>(
     }
     variable_names.push(name);
     let [min, max] = range;
-    if !(min.is_finite() && max.is_finite() && min < max) {
+    let ordered = match kind {
+        VariableKind::Input => min < max,
+        VariableKind::Output => min <= max,
+    };
+    if !(min.is_finite() && max.is_finite() && ordered) {
+        let order = match kind {
+            VariableKind::Input => "min < max",
+            VariableKind::Output => "min <= max",
+        };
         return Err(format!(
-            "range must be finite with min < max, got [{min}, {max}]"
+            "range must be finite with {order}, got [{min}, {max}]"
         ));
     }
     let mut count = 0;
@@ -332,7 +349,7 @@ fn check_variable<'a>(
         check_name("set", term)?;
         count += 1;
     }
-    if count == 0 && !may_be_empty {
+    if count == 0 && kind == VariableKind::Output {
         return Err("has no sets".to_string());
     }
     Ok(())
