@@ -549,13 +549,15 @@ struct Keys<'a> {
     section: String,
     header: usize,
     entries: Vec<(&'a str, &'a str, usize)>,
+    /// The `MFk` lines, in file order (MATLAB's `readfis` reads them by position).
+    function_entries: Vec<(&'a str, &'a str, usize)>,
     /// Keys outside the format (fuzzylite's `Enabled`, ...), with their lines: ignored.
     ignored: Vec<(&'a str, usize)>,
 }
 
 impl<'a> Keys<'a> {
     /// Collects the entries; `allowed` lists the plain keys, and `with_functions` allows the
-    /// `MF1`, `MF2`, ... keys too (checked later against `NumMFs`). Other keys made of letters,
+    /// `MF1`, `MF2`, ... keys too (counted later against `NumMFs`). Other keys made of letters,
     /// digits and `_` are ignored, with a note; anything else is an error.
     fn new(
         section: &Section<'a>,
@@ -570,6 +572,7 @@ impl<'a> Keys<'a> {
             SectionKind::Rules => "[Rules]".to_string(),
         };
         let mut entries: Vec<(&str, &str, usize)> = Vec::new();
+        let mut function_entries = Vec::new();
         let mut ignored = Vec::new();
         for line in &section.lines {
             let Some((key, value)) = line.text.split_once('=') else {
@@ -611,6 +614,10 @@ impl<'a> Keys<'a> {
                 ignored.push((key, line.number));
                 continue;
             }
+            if is_mf {
+                function_entries.push((key, value.trim(), line.number));
+                continue;
+            }
             if let Some((_, _, first)) = entries.iter().find(|(k, _, _)| *k == key) {
                 return Err(error(
                     line.number,
@@ -623,6 +630,7 @@ impl<'a> Keys<'a> {
             section: title,
             header: section.header,
             entries,
+            function_entries,
             ignored,
         })
     }
@@ -758,22 +766,39 @@ impl<'a> Keys<'a> {
         }
     }
 
-    /// The `NumMFs` (at least `min`) entries `MF1`..`MFn`. Names may repeat, as in MATLAB.
-    fn functions(&self, min: usize) -> Result<Vec<FunctionLine<'a>>, FuzzyError> {
+    /// The `NumMFs` (at least `min`) functions. Like MATLAB's `readfis`, the k-th `MF` line
+    /// is function k whatever its key says (MATLAB's own `slcp1.fis` has two `MF2` lines); a
+    /// key that disagrees with its position is noted. Names may repeat, as in MATLAB.
+    fn functions(
+        &self,
+        min: usize,
+        notes: &mut Vec<FisNote>,
+    ) -> Result<Vec<FunctionLine<'a>>, FuzzyError> {
         let n = self.count("NumMFs", min)?;
-        if let Some(&(key, _, line)) = self.entries.iter().find(|(k, _, _)| {
-            k.strip_prefix("MF")
-                .is_some_and(|d| d.parse::<usize>().is_ok_and(|k| k == 0 || k > n))
-        }) {
+        if self.function_entries.len() != n {
+            let (line, _) = self.get("NumMFs")?;
             return Err(error(
                 line,
-                format!("{key} but NumMFs={n} (functions are numbered MF1 to MF{n})"),
+                format!(
+                    "NumMFs={n} but {} has {} MF lines",
+                    self.section,
+                    self.function_entries.len()
+                ),
             ));
         }
-        // No capacity from `n`: it is untrusted (a missing MFk= line ends the loop early).
-        let mut functions: Vec<FunctionLine<'a>> = Vec::new();
-        for k in 1..=n {
-            let (line, value) = self.get(&format!("MF{k}"))?;
+        let mut functions: Vec<FunctionLine<'a>> = Vec::with_capacity(n);
+        for (index, &(key, value, line)) in self.function_entries.iter().enumerate() {
+            let k = index + 1;
+            if key != format!("MF{k}") {
+                note(
+                    notes,
+                    line,
+                    format!(
+                        "`{key}` is the MF line number {k} of {}: read as MF{k}, by position, as MATLAB's readfis does",
+                        self.section
+                    ),
+                );
+            }
             let (name, kind, params) =
                 function(value).map_err(|m| error(line, format!("MF{k}: {m}")))?;
             check_name("set", name).map_err(|m| error(line, m))?;
@@ -857,7 +882,7 @@ fn parse_input(
     let name = variable_name(&keys, names)?;
     let range = keys.range(false)?;
     let sets = keys
-        .functions(0)?
+        .functions(0, notes)?
         .into_iter()
         .map(|mut function| {
             if let Some(needed) = MembershipFn::matlab_parameter_count(function.kind) {
@@ -888,7 +913,7 @@ fn parse_output(
     let name = variable_name(&keys, names)?;
     let range = keys.range(true)?;
     let terms = keys
-        .functions(1)?
+        .functions(1, notes)?
         .into_iter()
         .map(|mut f| {
             let line = f.line;
@@ -1232,8 +1257,8 @@ mod tests {
                 "line 26: 'constant' takes 1 parameter, found 0",
             ),
             (
-                TINY.replace("MF2='line2'", "MF0='line2'"),
-                "line 26: MF0 but NumMFs=2 (functions are numbered MF1 to MF2)",
+                TINY.replace("NumMFs=2\nMF1='low'", "NumMFs=3\nMF1='low'"),
+                "line 17: NumMFs=3 but [Input1] has 2 MF lines",
             ),
             (
                 TINY.replace("Name='y'", "Na me='y'"),
@@ -1256,8 +1281,8 @@ mod tests {
                 "line 21: [Output1] has no Name= line (the unknown key `Nome` at line 22 was ignored)",
             ),
             (
-                TINY.replace("MF2='line2'", "MF3='line2'"),
-                "line 26: MF3 but NumMFs=2",
+                TINY.replace("MF2='line2'", "MF2='line2'\nMF3='line3':'constant',[1]"),
+                "line 24: NumMFs=2 but [Output1] has 3 MF lines",
             ),
             (
                 TINY.replace("[Output1]", "[Output2]"),
@@ -1304,6 +1329,26 @@ mod tests {
             parse_error(&no_output),
             "line 1: missing section [Output1] (NumOutputs=1)"
         );
+    }
+
+    #[test]
+    fn functions_are_read_by_position_as_matlab_does() {
+        // MATLAB's slcp1.fis numbers its third function MF2 again; readfis goes by position.
+        let misnumbered = TINY.replace("MF2='high'", "MF1='high'");
+        let (system, notes) = FuzzySystem::from_fis_with_notes(&misnumbered).unwrap();
+        assert_eq!(system, FuzzySystem::from_fis(TINY).unwrap());
+        assert_eq!(notes.len(), 1);
+        assert_eq!(
+            notes[0].to_string(),
+            "line 19: `MF1` is the MF line number 2 of [Input1]: read as MF2, by position, as MATLAB's readfis does"
+        );
+        // Swapped keys: the first line is the first function, whatever its key.
+        let swapped = TINY
+            .replace("MF1='low'", "MF9='low'")
+            .replace("MF2='high'", "MF1='high'");
+        let (system, notes) = FuzzySystem::from_fis_with_notes(&swapped).unwrap();
+        assert_eq!(system.inputs()[0].sets[0].name, "low");
+        assert_eq!(notes.len(), 2);
     }
 
     #[test]

@@ -369,7 +369,10 @@ mod regressions {
     #[test]
     fn a_huge_function_count_is_refused_without_allocating() {
         let text = PAPER_FIS.replacen("NumMFs=2", "NumMFs=18446744073709551615", 1);
-        assert_eq!(refused(&text), "line 14: [Input1] has no MF3= line");
+        assert_eq!(
+            refused(&text),
+            "line 17: NumMFs=18446744073709551615 but [Input1] has 2 MF lines"
+        );
     }
 
     #[test]
