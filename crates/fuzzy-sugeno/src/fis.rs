@@ -37,7 +37,8 @@ impl FuzzySystem {
     /// `ImpMethod`/`AggMethod` values other than `'prod'`/`'sum'`, an `AndMethod` or `OrMethod`
     /// that no rule needs and this crate cannot evaluate (such as fuzzylite's `''`), unknown
     /// keys (fuzzylite's `Enabled=1`, `LockRange=0`, ...), parameters beyond those a function
-    /// takes, and a `Version` other than 2.0.
+    /// takes, `MF` keys that disagree with their position (functions are read by position, as
+    /// MATLAB does), and a `Version` other than 2.0.
     ///
     /// ```
     /// use fuzzy_sugeno::FuzzySystem;
