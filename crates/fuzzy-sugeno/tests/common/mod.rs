@@ -106,8 +106,10 @@ fn random_membership(rng: &mut Rng, lo: f64, hi: f64) -> MembershipFn {
     }
 }
 
-/// A random valid system: 1-4 inputs with 1-4 sets each, 1-3 outputs, 1-12 rules with
-/// negations, don't-cares, weights and OR rules; constant consequents only if `zero_order`.
+/// A random valid system: 1-4 inputs with 1-4 sets each (or none, as MATLAB's `NumMFs=0`, for
+/// inputs after the first), set and term names that sometimes repeat (as MATLAB allows), 1-3
+/// outputs, 1-12 rules with negations, don't-cares, weights and OR rules; constant consequents
+/// only if `zero_order`.
 pub fn random_system(seed: u64, zero_order: bool) -> FuzzySystem {
     let mut rng = Rng::new(seed);
     let n_in = 1 + rng.below(4);
@@ -132,11 +134,20 @@ pub fn random_system(seed: u64, zero_order: bool) -> FuzzySystem {
     for i in 0..n_in {
         let lo = rng.range(-5.0, 5.0);
         let hi = lo + rng.range(0.5, 10.0);
-        let n_sets = 1 + rng.below(4);
+        let n_sets = if i > 0 && rng.chance(0.15) {
+            0
+        } else {
+            1 + rng.below(4)
+        };
         set_counts.push(n_sets);
-        let sets: Vec<(String, MembershipFn)> = (0..n_sets)
-            .map(|k| (rng.name(k), random_membership(&mut rng, lo, hi)))
-            .collect();
+        let mut sets: Vec<(String, MembershipFn)> = Vec::new();
+        for k in 0..n_sets {
+            let name = match sets.last() {
+                Some((previous, _)) if rng.chance(0.15) => previous.clone(),
+                _ => rng.name(k),
+            };
+            sets.push((name, random_membership(&mut rng, lo, hi)));
+        }
         builder = builder.input(format!("in{i}"), [lo, hi], sets);
     }
     let mut term_counts = Vec::new();
@@ -156,7 +167,12 @@ pub fn random_system(seed: u64, zero_order: bool) -> FuzzySystem {
                         constant: rng.range(lo, hi),
                     }
                 };
-                (rng.name(k), function)
+                let name = if k > 0 && rng.chance(0.15) {
+                    "shared".to_string()
+                } else {
+                    rng.name(k)
+                };
+                (name, function)
             })
             .collect();
         builder = builder.output(format!("out{o}"), [lo, hi], terms);
@@ -165,6 +181,7 @@ pub fn random_system(seed: u64, zero_order: bool) -> FuzzySystem {
         let mut antecedents: Vec<Antecedent> = set_counts
             .iter()
             .map(|&n| match rng.unit() {
+                _ if n == 0 => Antecedent::Any,
                 u if u < 0.25 => Antecedent::Any,
                 u if u < 0.85 => Antecedent::Is(rng.below(n)),
                 _ => Antecedent::IsNot(rng.below(n)),
