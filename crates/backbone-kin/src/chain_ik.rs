@@ -20,8 +20,8 @@
 //! iteration of [`HarmonicIk`](crate::HarmonicIk) on the chain's tip and its analytic Jacobian
 //! `d tip / d a_j = sum_i L_i (-sin phi_i, cos phi_i) b_j(s_i)` ([`harmonic_basis`]), started
 //! from the closed form (eqs 5-6) or the caller's guess. For `K = 1` the problem is square and
-//! the iteration is Newton's method, which from the closed-form start converges in 2-4 steps
-//! whenever the chain is close to its curve.
+//! the iteration is Newton's method, which from the closed-form start converges in a few steps
+//! whenever the chain is close to its curve (at most 5 in the tests).
 
 use crate::closed_form::{Branch, inverse_kinematics};
 use crate::error::KinError;
