@@ -608,23 +608,9 @@ impl ArmSpec {
         };
         let lengths = per_link(&self.lengths, self.link_length.unwrap_or(0.1));
         let masses = per_link(&self.masses, self.link_mass.unwrap_or(0.1));
-        // A lone link validates as link 0: name the link's real index.
+        // A lone link has no index: name the link's real one.
         let arm_error = |i: usize, e: manip_dyn::DynError| {
-            let e = match e {
-                manip_dyn::DynError::InvalidLink {
-                    quantity,
-                    requirement,
-                    value,
-                    ..
-                } => manip_dyn::DynError::InvalidLink {
-                    index: i,
-                    quantity,
-                    requirement,
-                    value,
-                },
-                other => other,
-            };
-            SimError::setting("arm", format!("is invalid: {e}"))
+            SimError::setting("arm", format!("is invalid: {}", e.at_link(i)))
         };
         let mut links = Vec::with_capacity(n);
         for i in 0..n {
