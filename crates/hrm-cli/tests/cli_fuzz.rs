@@ -10,7 +10,7 @@
 //! second, small grids), so the whole test takes seconds in the dev profile.
 
 use proptest::prelude::*;
-use proptest::test_runner::Config;
+use proptest::test_runner::{Config, TestRunner};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -566,21 +566,35 @@ fn check(args: &[String], output: &Output) -> Result<(), TestCaseError> {
     Ok(())
 }
 
-proptest! {
-    #![proptest_config(Config { cases: 200, ..Config::default() })]
+/// Cases run by default; `PROPTEST_CASES` overrides it for a longer hunt.
+const CASES: u32 = 200;
 
-    #[test]
-    fn no_command_line_crashes_hrm(case in cases()) {
+#[test]
+fn no_command_line_crashes_hrm() {
+    fixture_is_sound();
+    let count = std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(CASES);
+    let mut runner = TestRunner::new(Config {
+        cases: count,
+        ..Config::default()
+    });
+    let result = runner.run(&cases(), |case| {
         let args = realise(&case);
         let refs: Vec<&str> = args.iter().map(String::as_str).collect();
         let output = hrm(&refs, &case.stdin);
-        check(&args, &output)?;
+        check(&args, &output)
+    });
+    match result {
+        // The files of a failing case are kept for a look.
+        Ok(()) => std::fs::remove_dir_all(&fixture().dir).unwrap(),
+        Err(e) => panic!("{e}"),
     }
 }
 
-#[test]
-fn the_fixture_is_sound() {
-    // The unmutated files are accepted: the fuzzing starts from working inputs.
+/// The unmutated files are accepted: the fuzzing starts from working inputs.
+fn fixture_is_sound() {
     let f = fixture();
     let fis = file("sound.fis", f.fis.as_bytes());
     let output = hrm(&["fis", "eval", &fis, "0.1", "0", "0", "0"], b"");
