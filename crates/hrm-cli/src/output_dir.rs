@@ -39,7 +39,7 @@ impl OutputDir {
         let absolute = std::path::absolute(target).map_err(|e| fail("output folder", e))?;
         let (Some(parent), Some(name)) = (absolute.parent(), absolute.file_name()) else {
             return Err(format!(
-                "output folder {}: cannot be replaced (it has no parent folder)",
+                "output folder {}: name it by a path that ends in its own name (not `/` or `..`)",
                 shown.display()
             ));
         };
@@ -287,6 +287,8 @@ mod tests {
         std::fs::write(&file, "x").unwrap();
         let err = OutputDir::create(&file, "run").unwrap_err();
         assert!(err.contains("not a folder"), "{err}");
+        let err = OutputDir::create(Path::new("/"), "run").unwrap_err();
+        assert!(err.contains("ends in its own name"), "{err}");
         assert_eq!(names(&root), ["file", "mine", "out"]);
         std::fs::remove_dir_all(&root).unwrap();
     }
