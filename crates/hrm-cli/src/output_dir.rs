@@ -76,6 +76,7 @@ impl OutputDir {
             }
             Ok(_) => {}
         }
+        remove_abandoned_staging(&target);
         let staging = sibling(&target, "staging");
         if staging.exists() {
             std::fs::remove_dir_all(&staging).map_err(|e| fail("cannot clear staging for", e))?;
@@ -180,6 +181,35 @@ fn sibling(path: &Path, what: &str) -> PathBuf {
     path.with_file_name(name)
 }
 
+/// Removes the staging folders of `target` left by commands that were killed (their process
+/// is gone), where the system lists its processes in `/proc`. Moved-aside old copies are kept:
+/// after a crash between the two renames of a commit, one may be the only copy of an output.
+fn remove_abandoned_staging(target: &Path) {
+    let (Some(dir), Some(name)) = (target.parent(), target.file_name()) else {
+        return;
+    };
+    let prefix = format!(".{}.hrm-staging-", name.to_string_lossy());
+    if !Path::new("/proc/self").is_dir() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let Some(pid) = file_name
+            .to_str()
+            .and_then(|n| n.strip_prefix(&prefix))
+            .and_then(|pid| pid.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
 /// Whether `dir` holds the [`MARKER`].
 fn is_output(dir: &Path) -> bool {
     dir.join(MARKER).is_file()
@@ -261,6 +291,13 @@ mod tests {
         dir.commit().unwrap();
         assert_eq!(names(&out), [MARKER, "two.txt"]);
         assert_eq!(names(&root.join("a")), ["out"]);
+        // The staging folder of a killed command (no such process) is cleared by the next one.
+        if Path::new("/proc/self").is_dir() {
+            let abandoned = root.join("a/.out.hrm-staging-4294967295");
+            std::fs::create_dir_all(&abandoned).unwrap();
+            OutputDir::create(&out, "test").unwrap().commit().unwrap();
+            assert_eq!(names(&root.join("a")), ["out"]);
+        }
         std::fs::remove_dir_all(&root).unwrap();
     }
 
