@@ -25,7 +25,11 @@ pub const MAX_LINE_BYTES: usize = 16 << 20;
 
 /// Serves stdin to stdout until end of input.
 pub fn run_stdio() -> Result<(), String> {
-    serve(std::io::stdin().lock(), std::io::stdout().lock()).map_err(|e| format!("eval: {e}"))
+    // A reader that went away (`hrm eval | head -1`) ends the stream quietly.
+    match serve(std::io::stdin().lock(), std::io::stdout().lock()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(format!("eval: {e}")),
+        _ => Ok(()),
+    }
 }
 
 /// Answers every line of `input` on `output`. Only I/O failures end the stream.
