@@ -27,8 +27,14 @@
 //! ```
 #![deny(missing_docs)]
 
+/// The README's example, compiled and run as a doctest.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 pub mod controller;
 mod error;
+mod input_file;
 mod noise;
 pub mod ode;
 mod record;
@@ -41,6 +47,7 @@ mod simulation;
 pub const MAX_COORDINATES: usize = 2 * backbone_kin::MAX_HARMONICS + 1;
 
 pub use error::{ControllerFailure, SimError};
+pub use input_file::{MAX_INPUT_FILE_BYTES, read_text_file};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use scenario::{
     Alpha0, ArmSpec, BranchSpec, ControllerKind, ControllerSpec, InitialSpec, IntegratorSpec,
@@ -49,5 +56,5 @@ pub use scenario::{
 };
 pub use simulation::{
     ControlSample, Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES,
-    Observation, Run, RunFailure, Simulation,
+    MAX_RK4_STEPS, Observation, Run, RunFailure, Simulation,
 };
