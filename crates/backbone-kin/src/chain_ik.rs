@@ -4,9 +4,9 @@
 //! a quadrature of that curve (eq 7 puts link `i` along `alpha(s_i)`, `s_i` its midpoint): the
 //! chain tip is `sum_i L_i (cos alpha(s_i), sin alpha(s_i))`, the midpoint rule applied to
 //! eqs 3-4. With equal links that rule is spectrally accurate (the difference is the aliasing sum
-//! of `docs/theory.md`, at most `2 l |J_n(A)|` for `A` up to about `n / 2`), but with unequal
-//! links it is a non-uniform midpoint rule whose error is only second order in the link lengths:
-//! per link at most `L_i^3 / 24 max |f''|` with `f = exp(i alpha)`, so for `K = 1`
+//! of `docs/theory.md`, at most `2 l sum_{m >= 1} |J_{mn}(A)|`, led by `2 l |J_n(A)|`), but with
+//! unequal links it is a non-uniform midpoint rule whose error is only second order in the link
+//! lengths: per link at most `L_i^3 / 24 max |f''|` with `f = exp(i alpha)`, so for `K = 1`
 //!
 //! `|tip_chain - tip_curve| <= (pi^2 / 6) A (1 + A) sum_i L_i^3 / l^2`
 //!

@@ -125,7 +125,7 @@ pub enum KinError {
     },
     /// A numerical inverse kinematics did not reach its tolerance.
     #[error(
-        "numerical inverse kinematics did not converge: end-point error {residual} after {iterations} iterations (tolerance {tolerance})"
+        "numerical inverse kinematics did not converge: end-point error {residual:e} after {iterations} iterations (tolerance {tolerance:e})"
     )]
     NotConverged {
         /// Iterations spent.

@@ -7,8 +7,8 @@
 //! is documented in `docs/eval-protocol.md`.
 
 use backbone_kin::{
-    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, KinError, MAX_HARMONICS, ModalMap,
-    end_point, inverse_kinematics, tip_position,
+    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, KinError, ModalMap, end_point,
+    inverse_kinematics, tip_position,
 };
 use fuzzy_sugeno::FuzzySystem;
 use manip_dyn::faer::Mat;
@@ -262,12 +262,25 @@ fn reduce_angle(alpha0: f64) -> f64 {
     }
 }
 
-/// `"harmonics"`: `K >= 1` (default 1), at most [`MAX_HARMONICS`].
-fn harmonics(requested: Option<usize>) -> Result<usize, EvalError> {
+/// Most harmonics a request may ask for. A `K`-harmonic end point by quadrature costs up to
+/// `K` times [`backbone_kin::MAX_QUADRATURE_NODES`] basis evaluations, so this keeps one `fk`
+/// under about a second; the library's own limit ([`backbone_kin::MAX_HARMONICS`]) is far larger.
+const MAX_REQUEST_HARMONICS: usize = 64;
+
+/// Most harmonics an `ik` request may ask for: its solvers evaluate the end point and its
+/// Jacobian up to 100 times, for the curve and for the chain.
+const MAX_IK_HARMONICS: usize = 8;
+
+/// Largest magnitude of an `ik` guess entry (rad). The solvers are local and take steps of at
+/// most 0.5 rad, so this bounds the amplitudes they visit, and with them the quadrature's cost.
+const MAX_GUESS: f64 = 10.0;
+
+/// `"harmonics"`: `K >= 1` (default 1), at most `max`.
+fn harmonics(requested: Option<usize>, max: usize) -> Result<usize, EvalError> {
     match requested.unwrap_or(1) {
         0 => Err(EvalError::input("harmonics must be at least 1, got 0")),
-        k if k > MAX_HARMONICS => Err(EvalError::input(format!(
-            "harmonics must be at most {MAX_HARMONICS}, got {k}"
+        k if k > max => Err(EvalError::input(format!(
+            "harmonics must be at most {max}, got {k}"
         ))),
         k => Ok(k),
     }
@@ -282,7 +295,7 @@ fn modal_map(
     alpha0: Option<f64>,
     requested: Option<usize>,
 ) -> Result<ModalMap, EvalError> {
-    let k = harmonics(requested)?;
+    let k = harmonics(requested, MAX_REQUEST_HARMONICS)?;
     let base = match (a.len(), alpha0) {
         (len, Some(alpha0)) if len == 2 * k => BaseAngle::Fixed(reduce_angle(alpha0)),
         (len, None) if len == 2 * k + 1 => {
@@ -394,12 +407,19 @@ struct IkRequest {
 /// branch of `J0`.
 fn ik(request: IkRequest) -> EvalResult {
     let chain = request.arm.to_chain().map_err(EvalError::input)?;
-    let k = harmonics(request.harmonics)?;
+    let k = harmonics(request.harmonics, MAX_IK_HARMONICS)?;
     let (length, alpha0) = (chain.total_length(), reduce_angle(request.alpha0));
     let lengths: Vec<f64> = chain.link_lengths().collect();
     let guessed = request.guess.is_some();
     let start = match request.guess {
-        Some(guess) if guess.len() == 2 * k => guess,
+        Some(guess) if guess.len() == 2 * k => {
+            if let Some(x) = guess.iter().find(|x| x.abs() > MAX_GUESS) {
+                return Err(EvalError::input(format!(
+                    "guess entries must lie within [-{MAX_GUESS}, {MAX_GUESS}] rad, got {x:e}"
+                )));
+            }
+            guess
+        }
         Some(guess) => {
             return Err(EvalError::input(format!(
                 "guess has {} entries, expected 2K = {} (K = {k} harmonics)",
@@ -834,6 +854,10 @@ mod tests {
             json!({"op": "joints", "a": [0.1, 0.2, 0.3], "alpha0": 1, "harmonics": 2}),
             json!({"op": "joints", "a": [0.1, 0.2], "alpha0": 1, "harmonics": 0}),
             json!({"op": "joints", "a": [0.1, 0.2], "alpha0": 1, "harmonics": 100_000}),
+            json!({"op": "joints", "a": [0.1, 0.2], "alpha0": 1, "harmonics": 65}),
+            json!({"op": "ik", "target": [0.3, 0.5], "alpha0": 1, "harmonics": 9}),
+            json!({"op": "ik", "target": [0.3, 0.5], "alpha0": 1, "guess": [11.0, 0.0]}),
+            json!({"op": "ik", "target": [0.3, 0.5], "alpha0": 1, "guess": [0.0, -1e300]}),
             json!({"op": "fk", "a": [0.1, 0.2, 0.3, 0.4], "harmonics": 2}),
         ] {
             let answer = request(line);
