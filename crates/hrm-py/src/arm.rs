@@ -1,7 +1,7 @@
 //! `hrm.Arm`: the planar chain and its dynamics (eq 12), from `manip-dyn`.
 
 use crate::array::{Output, States, evaluate};
-use crate::errors::{Error, check_finite};
+use crate::errors::{Error, check_finite, count};
 use manip_dyn::faer::MatMut;
 use manip_dyn::{ChainData, ChainModel};
 use numpy::{IntoPyArray, PyArray1};
@@ -54,7 +54,7 @@ impl Arm {
     #[new]
     #[pyo3(signature = (links=None, link_length=0.1, link_mass=0.1, gravity=9.81, lengths=None, masses=None, inertias=None))]
     fn new(
-        links: Option<i64>,
+        links: Option<&Bound<'_, PyAny>>,
         link_length: f64,
         link_mass: f64,
         gravity: f64,
@@ -62,12 +62,7 @@ impl Arm {
         masses: Option<Vec<f64>>,
         inertias: Option<Vec<f64>>,
     ) -> PyResult<Self> {
-        let links = links
-            .map(|n| {
-                usize::try_from(n)
-                    .map_err(|_| Error::input(format!("arm.links must be at least 1, got {n}")))
-            })
-            .transpose()?;
+        let links = links.map(|n| count(n, "arm.links", 1)).transpose()?;
         let spec = ArmSpec {
             links,
             link_length: Some(link_length),

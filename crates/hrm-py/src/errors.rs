@@ -177,6 +177,29 @@ impl From<SimError> for Error {
     }
 }
 
+/// A count argument (`links`, `harmonics`, `samples`) as a `usize`: a negative number or one
+/// beyond 64 bits is an [`InvalidInput`] naming `name`, not an `OverflowError`. `minimum` is
+/// the smallest count the message asks for; the libraries check the actual bounds.
+pub(crate) fn count(
+    value: &pyo3::Bound<'_, pyo3::PyAny>,
+    name: &str,
+    minimum: u32,
+) -> pyo3::PyResult<usize> {
+    use pyo3::types::PyAnyMethods;
+    if let Ok(count) = value.extract::<usize>() {
+        return Ok(count);
+    }
+    match value.extract::<i128>() {
+        Ok(n) if n < 0 => {
+            Err(Error::input(format!("{name} must be at least {minimum}, got {n}")).into())
+        }
+        _ => Err(Error::input(format!(
+            "{name} must be a whole number of at most 64 bits, got {value}"
+        ))
+        .into()),
+    }
+}
+
 /// Refuses a computed vector with a non-finite entry, as `hrm eval` does: "{name} came out
 /// non-finite ({value})".
 pub(crate) fn check_finite(name: &str, values: &[f64]) -> Result<()> {

@@ -1,7 +1,7 @@
 //! `hrm.fuzzy`: Takagi-Sugeno systems (eqs 19-24), from `fuzzy-sugeno`.
 
 use crate::array::{States, evaluate};
-use crate::errors::{Error, check_finite};
+use crate::errors::{Error, check_finite, count};
 use fuzzy_sugeno::{AnalysisOptions, AnalysisReport, Evaluator, FuzzySystem};
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyPermissionError};
 use pyo3::prelude::*;
@@ -128,17 +128,20 @@ impl System {
     /// `coverage`: the degree to which some rule's antecedent must hold at every point;
     /// `samples`: evenly spaced samples per input (set landmarks are added); `max_jump`: the
     /// largest allowed jump between neighbouring rules, as a fraction of the output's range.
-    #[pyo3(signature = (coverage=0.5, samples=21, max_jump=1.0))]
+    #[pyo3(
+        signature = (coverage=0.5, samples=None, max_jump=1.0),
+        text_signature = "($self, coverage=0.5, samples=21, max_jump=1.0)"
+    )]
     fn check<'py>(
         &self,
         py: Python<'py>,
         coverage: f64,
-        samples: usize,
+        samples: Option<&Bound<'py, PyAny>>,
         max_jump: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
         let options = AnalysisOptions {
             coverage,
-            samples_per_input: samples,
+            samples_per_input: samples.map_or(Ok(21), |s| count(s, "samples", 0))?,
             max_relative_jump: max_jump,
             ..AnalysisOptions::default()
         };

@@ -3,7 +3,7 @@
 
 use crate::arm::Arm;
 use crate::array::{States, evaluate};
-use crate::errors::{Error, check_finite};
+use crate::errors::{Error, check_finite, count};
 use backbone_kin::{BaseAngle, Branch, HarmonicIk, ModalMap};
 use modal_reduce::ReducedData;
 use numpy::ndarray::Array2;
@@ -77,10 +77,9 @@ impl ReducedModel {
 #[pymethods]
 impl ReducedModel {
     #[new]
-    #[pyo3(signature = (arm, harmonics=1, alpha0=None))]
-    fn new(arm: &Arm, harmonics: i64, alpha0: Option<f64>) -> PyResult<Self> {
-        let harmonics = usize::try_from(harmonics)
-            .map_err(|_| Error::input(format!("harmonics must be at least 1, got {harmonics}")))?;
+    #[pyo3(signature = (arm, harmonics=None, alpha0=None), text_signature = "(arm, harmonics=1, alpha0=None)")]
+    fn new(arm: &Arm, harmonics: Option<&Bound<'_, PyAny>>, alpha0: Option<f64>) -> PyResult<Self> {
+        let harmonics = harmonics.map_or(Ok(1), |k| count(k, "harmonics", 1))?;
         let chain = arm.chain().clone();
         let lengths: Vec<f64> = chain.link_lengths().collect();
         let base = alpha0.map_or(BaseAngle::Free, BaseAngle::Fixed);

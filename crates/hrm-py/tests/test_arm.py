@@ -77,6 +77,11 @@ def test_batch_equals_one_by_one(arm, rng, size):
         assert batch["E"][i] == arm.energy(q, v)
 
 
+def test_one_array_may_be_passed_as_several_arguments(arm, rng):
+    q = rng.normal(size=(3, arm.n_links))
+    np.testing.assert_array_equal(arm.coriolis(q, q), arm.coriolis(q, q.copy()))
+
+
 def test_inverse_and_forward_dynamics_invert_each_other(arm, rng):
     Q, V, T = rng.normal(size=(3, 40, arm.n_links))
     np.testing.assert_allclose(arm.rnea(Q, V, arm.aba(Q, V, T)), T, rtol=1e-10, atol=1e-12)
@@ -169,6 +174,8 @@ def test_arm_parameters_are_checked_as_the_cli_does():
         hrm.Arm(links=-3)
     with pytest.raises(hrm.InvalidInput, match=r"^arm.links must be at most 4096, got 1000000000$"):
         hrm.Arm(links=10**9)
+    with pytest.raises(hrm.InvalidInput, match=r"^arm.links must be a whole number of at most 64 bits, got 10{30}$"):
+        hrm.Arm(links=10**30)
     with pytest.raises(hrm.InvalidInput, match="gravity must be finite"):
         hrm.Arm(gravity=float("nan"))
 

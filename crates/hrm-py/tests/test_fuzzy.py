@@ -67,5 +67,7 @@ def test_errors(tmp_path):
         paper_controller().eval([0.0, 0.0])
     with pytest.raises(hrm.InvalidInput, match="must be finite|finite"):
         paper_controller().eval([0.0, np.nan, 0.0, 0.0])
-    with pytest.raises(hrm.InvalidInput, match="coverage"):
+    with pytest.raises(hrm.InvalidInput, match=r"coverage must lie in \(0, 1\], got 0"):
         paper_controller().check(coverage=0.0)
+    with pytest.raises(hrm.InvalidInput, match="^samples must be at least 0, got -1$"):
+        paper_controller().check(samples=-1)

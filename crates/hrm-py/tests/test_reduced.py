@@ -166,6 +166,10 @@ def test_model_errors(arm):
         hrm.ReducedModel(arm, harmonics=0)
     with pytest.raises(hrm.InvalidInput, match="harmonics must be at least 1, got -2"):
         hrm.ReducedModel(arm, harmonics=-2)
+    with pytest.raises(hrm.InvalidInput, match="harmonics must be a whole number of at most 64 bits"):
+        hrm.ReducedModel(arm, harmonics=2**70)
+    with pytest.raises(hrm.InvalidInput, match="at most 2048 harmonics"):
+        hrm.ReducedModel(arm, harmonics=10**6)
     with pytest.raises(hrm.InvalidInput, match="alpha0 must be finite"):
         hrm.ReducedModel(arm, alpha0=float("inf"))
     model = hrm.ReducedModel(arm)
