@@ -1,7 +1,12 @@
 //! Project automation in the cargo-xtask pattern: `cargo xtask <command>`.
 //!
-//! - `ci`: what `.ci/run` runs: formatting, clippy with `-D warnings`, the whole test suite, the
-//!   `hrm` crate's `custom_controller` example, and a compile-only pass over the benches.
+//! - `ci`: what `.ci/run` runs: formatting, clippy with `-D warnings`, `test`, and a compile-only
+//!   pass over the benches.
+//! - `test`: the whole Rust test suite, the `hrm` crate's `custom_controller` example, then the
+//!   Python package: a virtual environment under `target/python-venv` with numpy, pytest, maturin
+//!   and Pinocchio (`pin`) from PyPI, the extension built once in release mode and installed by
+//!   `pip install ./crates/hrm-py`, pytest over `crates/hrm-py/tests`, and every script of
+//!   `examples/python/`.
 //! - `props [--cases N]`: the test suite with `PROPTEST_CASES=N` (default 2048), so every property
 //!   test (energy conservation, Jacobian consistency, ...) runs many more cases than in CI.
 //! - `bench [FILTER]`: the Criterion benches, then `target/bench-summary.json` (bench id -> median
@@ -14,6 +19,7 @@ fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
         Some("ci") => ci(),
+        Some("test") => test(),
         Some("props") => props(&args[1..]),
         Some("bench") => bench(&args[1..]),
         _ => Err(USAGE.to_string()),
@@ -27,7 +33,7 @@ fn main() -> ExitCode {
     }
 }
 
-const USAGE: &str = "usage: cargo xtask ci | props [--cases N] | bench [FILTER]";
+const USAGE: &str = "usage: cargo xtask ci | test | props [--cases N] | bench [FILTER]";
 
 fn ci() -> Result<(), String> {
     cargo(&["fmt", "--all", "--", "--check"], &[])?;
@@ -42,11 +48,102 @@ fn ci() -> Result<(), String> {
         ],
         &[],
     )?;
+    test()?;
+    // Benches are compiled, never run, in CI.
+    cargo(&["test", "--workspace", "--benches", "--no-run"], &[])
+}
+
+/// The Rust tests, then the Python package's tests and examples in a virtual environment under
+/// `target/` (created on first use; needs `python3` (or `$PYTHON`) with `venv` and network
+/// access to PyPI). pytest's "no tests collected" (exit code 5) fails like any other failure.
+fn test() -> Result<(), String> {
     cargo(&["test", "--workspace"], &[])?;
     // The first program of the `hrm` crate's docs must run.
     cargo(&["run", "-p", "hrm", "--example", "custom_controller"], &[])?;
-    // Benches are compiled, never run, in CI.
-    cargo(&["test", "--workspace", "--benches", "--no-run"], &[])
+    let root = workspace_root();
+    let venv = target_dir().join("python-venv");
+    let python = venv
+        .join(if cfg!(windows) { "Scripts" } else { "bin" })
+        .join(if cfg!(windows) {
+            "python.exe"
+        } else {
+            "python"
+        });
+    if !python.exists() {
+        let system = std::env::var("PYTHON").unwrap_or_else(|_| "python3".to_string());
+        run(Path::new(&system), &["-m", "venv", &venv.to_string_lossy()])?;
+    }
+    let pip = [
+        "-m",
+        "pip",
+        "install",
+        "--quiet",
+        "--disable-pip-version-check",
+    ];
+    run(
+        &python,
+        &[&pip[..], &["numpy", "pytest", "pin", "maturin"]].concat(),
+    )?;
+    // The same command a user runs; maturin builds the extension in release mode, once.
+    let package = root.join("crates").join("hrm-py");
+    let install = ["--force-reinstall", "--no-deps", &package.to_string_lossy()];
+    run(&python, &[&pip[..], &install[..]].concat())?;
+    let tests = package.join("tests");
+    match status(&python, &["-m", "pytest", "-q", &tests.to_string_lossy()])?.code() {
+        Some(0) => {}
+        Some(5) => return Err(format!("pytest collected no tests in {}", tests.display())),
+        code => return Err(format!("pytest failed (exit code {code:?})")),
+    }
+    let examples = root.join("examples").join("python");
+    let mut scripts: Vec<PathBuf> = std::fs::read_dir(&examples)
+        .map_err(|e| format!("{}: {e}", examples.display()))?
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| path.extension().is_some_and(|ext| ext == "py"))
+        .collect();
+    scripts.sort();
+    if scripts.is_empty() {
+        return Err(format!("no example scripts in {}", examples.display()));
+    }
+    for script in &scripts {
+        run(&python, &[&*script.to_string_lossy()])?;
+    }
+    // Like the Criterion benches, the Python benchmarks are compiled, not run.
+    let benches = root.join("benches").join("python");
+    let mut compile = vec!["-m".to_string(), "py_compile".to_string()];
+    for entry in std::fs::read_dir(&benches).map_err(|e| format!("{}: {e}", benches.display()))? {
+        let path = entry.map_err(|e| e.to_string())?.path();
+        if path.extension().is_some_and(|ext| ext == "py") {
+            compile.push(path.to_string_lossy().into_owned());
+        }
+    }
+    run(
+        &python,
+        &compile.iter().map(String::as_str).collect::<Vec<_>>(),
+    )
+}
+
+/// Runs `program args...` in the workspace root and returns its exit status.
+fn status(program: &Path, args: &[&str]) -> Result<std::process::ExitStatus, String> {
+    println!("xtask: {} {}", program.display(), args.join(" "));
+    Command::new(program)
+        .args(args)
+        .current_dir(workspace_root())
+        .status()
+        .map_err(|e| format!("cannot run {}: {e}", program.display()))
+}
+
+/// Runs `program args...` in the workspace root; fails unless it succeeds.
+fn run(program: &Path, args: &[&str]) -> Result<(), String> {
+    let status = status(program, args)?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!(
+            "`{} {}` failed ({status})",
+            program.display(),
+            args.join(" ")
+        ))
+    }
 }
 
 fn props(args: &[String]) -> Result<(), String> {

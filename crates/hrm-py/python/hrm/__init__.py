@@ -1,0 +1,32 @@
+"""hrm: hyper-redundant manipulators from Python.
+
+Planar chain dynamics (``Arm``), the modal reduction of the paper's backbone-curve method
+(``ReducedModel``) and Takagi-Sugeno fuzzy systems (``hrm.fuzzy``), computed by the Rust crates
+of https://github.com/hrm-toolkit/hrm. Every method takes one state, shape ``(n,)``, or a batch,
+shape ``(N, n)``, as numpy arrays (or anything ``numpy.asarray`` turns into real numbers) and
+answers with the same leading dimension; batches release the GIL and run on all cores.
+
+Errors are ``InvalidInput`` (a ``ValueError``), ``Unreachable`` (a ``ValueError``) and
+``NumericalError`` (an ``ArithmeticError``), with the messages the ``hrm`` command prints.
+See docs/python.md.
+"""
+
+from . import fuzzy
+from ._hrm import (
+    Arm,
+    InvalidInput,
+    NumericalError,
+    ReducedModel,
+    Unreachable,
+    __version__,
+)
+
+__all__ = [
+    "Arm",
+    "InvalidInput",
+    "NumericalError",
+    "ReducedModel",
+    "Unreachable",
+    "__version__",
+    "fuzzy",
+]

@@ -1,0 +1,291 @@
+//! `hrm.Arm`: the planar chain and its dynamics (eq 12), from `manip-dyn`.
+
+use crate::array::{Output, States, evaluate};
+use crate::errors::{Error, check_finite, count};
+use manip_dyn::faer::MatMut;
+use manip_dyn::{ChainData, ChainModel};
+use numpy::{IntoPyArray, PyArray1};
+use pyo3::prelude::*;
+use sim_core::ArmSpec;
+use std::sync::Mutex;
+
+/// A planar serial chain of revolute joints under gravity along -y (the paper's eq 12:
+/// tau = M(theta) theta_ddot + C(theta, theta_dot) + G(theta)).
+///
+/// Arm(links=None, link_length=0.1, link_mass=0.1, gravity=9.81, lengths=None, masses=None,
+/// inertias=None)
+///
+/// `links` uniform beams (10 when neither `links` nor a per-link array is given) of
+/// `link_length` (m) and `link_mass` (kg), centre of mass at mid-link and inertia m L^2 / 12;
+/// `lengths`, `masses` and `inertias` (about the centre of mass, kg m^2) override them per link.
+/// theta_i is the angle of link i relative to link i - 1 (theta_1 from the x axis).
+///
+/// Every method takes one state (arrays of shape (n,)) or a batch (shape (N, n)) and answers
+/// with the same leading dimension. Raises InvalidInput for a bad parameter, naming it as the
+/// `hrm` command line does (e.g. "arm is invalid: link 1: mass must be positive and finite, got
+/// -1").
+#[pyclass(module = "hrm", frozen)]
+pub struct Arm {
+    chain: ChainModel,
+    workspace: Mutex<ChainData>,
+}
+
+impl Arm {
+    /// The chain.
+    pub(crate) fn chain(&self) -> &ChainModel {
+        &self.chain
+    }
+
+    fn fresh(&self) -> ChainData {
+        ChainData::new(&self.chain)
+    }
+
+    fn n(&self) -> usize {
+        self.chain.n_links()
+    }
+
+    fn column(&self, value: impl Fn(&manip_dyn::Link) -> f64) -> Vec<f64> {
+        self.chain.links().iter().map(value).collect()
+    }
+}
+
+#[pymethods]
+impl Arm {
+    #[new]
+    #[pyo3(signature = (links=None, link_length=0.1, link_mass=0.1, gravity=9.81, lengths=None, masses=None, inertias=None))]
+    fn new(
+        links: Option<&Bound<'_, PyAny>>,
+        link_length: f64,
+        link_mass: f64,
+        gravity: f64,
+        lengths: Option<Vec<f64>>,
+        masses: Option<Vec<f64>>,
+        inertias: Option<Vec<f64>>,
+    ) -> PyResult<Self> {
+        let links = links.map(|n| count(n, "arm.links", 1)).transpose()?;
+        let spec = ArmSpec {
+            links,
+            link_length: Some(link_length),
+            link_mass: Some(link_mass),
+            gravity: Some(gravity),
+            lengths,
+            masses,
+            inertias,
+        };
+        let chain = spec.to_chain().map_err(Error::from)?;
+        Ok(Self {
+            workspace: Mutex::new(ChainData::new(&chain)),
+            chain,
+        })
+    }
+
+    /// Number of links (and joints) n.
+    #[getter]
+    fn n_links(&self) -> usize {
+        self.n()
+    }
+
+    /// Gravitational acceleration along -y (m/s^2).
+    #[getter]
+    fn gravity_acceleration(&self) -> f64 {
+        self.chain.gravity()
+    }
+
+    /// Link lengths (m), base first, shape (n,).
+    #[getter]
+    fn lengths<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(|l| l.length).into_pyarray(py)
+    }
+
+    /// Link masses (kg), shape (n,).
+    #[getter]
+    fn masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(|l| l.mass).into_pyarray(py)
+    }
+
+    /// Link inertias about their centres of mass, about z (kg m^2), shape (n,).
+    #[getter]
+    fn inertias<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(|l| l.inertia).into_pyarray(py)
+    }
+
+    /// Distance of each link's centre of mass from its joint, along the link (m), shape (n,).
+    #[getter]
+    fn coms<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(|l| l.com).into_pyarray(py)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Arm(links={}, total_length={}, total_mass={}, gravity={})",
+            self.n(),
+            self.chain.total_length(),
+            self.chain.links().iter().map(|l| l.mass).sum::<f64>(),
+            self.chain.gravity()
+        )
+    }
+
+    /// The joint-space mass matrix M(theta) (CRBA), shape (n, n) or (N, n, n).
+    fn mass_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        theta: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.n();
+        let theta = States::read(theta, "theta", n)?;
+        let out = evaluate(
+            py,
+            [&theta],
+            n * n,
+            &self.workspace,
+            || self.fresh(),
+            |data, [q], out| {
+                manip_dyn::mass_matrix(
+                    &self.chain,
+                    data,
+                    q,
+                    MatMut::from_row_major_slice_mut(out, n, n),
+                )?;
+                check_finite("mass_matrix", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[n, n]))
+    }
+
+    /// The Coriolis and centrifugal torques C(theta, theta_dot) (the vector of eq 12, not a
+    /// matrix), shape (n,) or (N, n).
+    fn coriolis<'py>(
+        &self,
+        py: Python<'py>,
+        theta: &Bound<'py, PyAny>,
+        theta_dot: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.n();
+        let (theta, theta_dot) = (
+            States::read(theta, "theta", n)?,
+            States::read(theta_dot, "theta_dot", n)?,
+        );
+        let out = evaluate(
+            py,
+            [&theta, &theta_dot],
+            n,
+            &self.workspace,
+            || self.fresh(),
+            |data, [q, v], out| {
+                manip_dyn::coriolis(&self.chain, data, q, v, out)?;
+                check_finite("coriolis", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[n]))
+    }
+
+    /// The gravity torques G(theta), shape (n,) or (N, n).
+    fn gravity<'py>(
+        &self,
+        py: Python<'py>,
+        theta: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.n();
+        let theta = States::read(theta, "theta", n)?;
+        let out = evaluate(
+            py,
+            [&theta],
+            n,
+            &self.workspace,
+            || self.fresh(),
+            |data, [q], out| {
+                manip_dyn::gravity(&self.chain, data, q, out)?;
+                check_finite("gravity", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[n]))
+    }
+
+    /// Inverse dynamics (RNEA): the joint torques tau = M theta_ddot + C + G, shape (n,) or (N, n).
+    fn rnea<'py>(
+        &self,
+        py: Python<'py>,
+        theta: &Bound<'py, PyAny>,
+        theta_dot: &Bound<'py, PyAny>,
+        theta_ddot: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.n();
+        let inputs = [
+            States::read(theta, "theta", n)?,
+            States::read(theta_dot, "theta_dot", n)?,
+            States::read(theta_ddot, "theta_ddot", n)?,
+        ];
+        let [q, v, a] = &inputs;
+        let out = evaluate(
+            py,
+            [q, v, a],
+            n,
+            &self.workspace,
+            || self.fresh(),
+            |data, [q, v, a], out| {
+                manip_dyn::rnea(&self.chain, data, q, v, a, out)?;
+                check_finite("tau", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[n]))
+    }
+
+    /// Forward dynamics (ABA, O(n)): the joint accelerations theta_ddot under the torques tau,
+    /// shape (n,) or (N, n). Raises NumericalError if the mass matrix is not numerically positive
+    /// definite.
+    fn aba<'py>(
+        &self,
+        py: Python<'py>,
+        theta: &Bound<'py, PyAny>,
+        theta_dot: &Bound<'py, PyAny>,
+        tau: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.n();
+        let inputs = [
+            States::read(theta, "theta", n)?,
+            States::read(theta_dot, "theta_dot", n)?,
+            States::read(tau, "tau", n)?,
+        ];
+        let [q, v, t] = &inputs;
+        let out = evaluate(
+            py,
+            [q, v, t],
+            n,
+            &self.workspace,
+            || self.fresh(),
+            |data, [q, v, t], out| {
+                manip_dyn::aba(&self.chain, data, q, v, t, out)?;
+                check_finite("theta_ddot", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[n]))
+    }
+
+    /// Total mechanical energy, kinetic plus potential (J, zero potential at y = 0): a float for
+    /// one state, shape (N,) for a batch.
+    fn energy<'py>(
+        &self,
+        py: Python<'py>,
+        theta: &Bound<'py, PyAny>,
+        theta_dot: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.n();
+        let (theta, theta_dot) = (
+            States::read(theta, "theta", n)?,
+            States::read(theta_dot, "theta_dot", n)?,
+        );
+        let out: Output = evaluate(
+            py,
+            [&theta, &theta_dot],
+            1,
+            &self.workspace,
+            || self.fresh(),
+            |data, [q, v], out| {
+                out[0] = manip_dyn::kinetic_energy(&self.chain, data, q, v)?
+                    + manip_dyn::potential_energy(&self.chain, data, q)?;
+                check_finite("energy", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[]))
+    }
+}

@@ -1,0 +1,212 @@
+//! The three exceptions of the package and the mapping of every library error onto them.
+//!
+//! The classification is the one `hrm eval` uses for its error `kind` (`docs/eval-protocol.md`),
+//! and the messages are the libraries' own `Display` text, so Python sees what the CLI prints:
+//! malformed or out-of-domain input is [`InvalidInput`] (a `ValueError`), a target the backbone
+//! curve cannot reach is [`Unreachable`], and a computation that failed in double precision
+//! (a mass matrix that is not numerically positive definite, a non-finite result) is
+//! [`NumericalError`].
+
+use backbone_kin::KinError;
+use fuzzy_sugeno::FuzzyError;
+use manip_dyn::DynError;
+use modal_reduce::ReduceError;
+use pyo3::exceptions::{PyArithmeticError, PyValueError};
+use pyo3::{PyErr, create_exception};
+use sim_core::SimError;
+
+create_exception!(
+    hrm,
+    InvalidInput,
+    PyValueError,
+    "An input outside the model's domain: a wrong shape or dtype, a non-finite number, a \
+     non-positive length, mass or inertia, an unknown name. The message names the input and the \
+     problem."
+);
+create_exception!(
+    hrm,
+    Unreachable,
+    PyValueError,
+    "An inverse-kinematics target that the backbone curve cannot reach (farther than the arm's \
+     length, at the base, or outside the branch's range)."
+);
+create_exception!(
+    hrm,
+    NumericalError,
+    PyArithmeticError,
+    "A computation that failed in double precision: a mass matrix that is not numerically \
+     positive definite, an iteration that did not converge, or a result that came out non-finite."
+);
+
+/// Which exception an [`Error`] becomes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Kind {
+    /// [`InvalidInput`].
+    InvalidInput,
+    /// [`Unreachable`].
+    Unreachable,
+    /// [`NumericalError`].
+    Numerical,
+}
+
+/// A refused computation: which exception, and its one-line message. Unlike a `PyErr` it can be
+/// built and carried without the GIL, inside a batch running on other threads.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Error {
+    /// Which exception.
+    pub kind: Kind,
+    /// The message, as the CLI prints it.
+    pub message: String,
+}
+
+/// The result type of the computations behind every method.
+pub(crate) type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    /// An [`InvalidInput`] with this message.
+    pub fn input(message: impl Into<String>) -> Self {
+        Self {
+            kind: Kind::InvalidInput,
+            message: message.into(),
+        }
+    }
+
+    /// A [`NumericalError`] with this message.
+    pub fn numerical(message: impl Into<String>) -> Self {
+        Self {
+            kind: Kind::Numerical,
+            message: message.into(),
+        }
+    }
+
+    /// The same error with `context: ` in front of its message (e.g. the failing state of a
+    /// batch).
+    pub fn context(self, context: impl std::fmt::Display) -> Self {
+        Self {
+            kind: self.kind,
+            message: format!("{context}: {}", self.message),
+        }
+    }
+}
+
+impl From<Error> for PyErr {
+    fn from(error: Error) -> PyErr {
+        match error.kind {
+            Kind::InvalidInput => InvalidInput::new_err(error.message),
+            Kind::Unreachable => Unreachable::new_err(error.message),
+            Kind::Numerical => NumericalError::new_err(error.message),
+        }
+    }
+}
+
+impl From<KinError> for Error {
+    fn from(error: KinError) -> Self {
+        let kind = if error.is_unreachable() {
+            Kind::Unreachable
+        } else if matches!(error, KinError::NotConverged { .. }) {
+            Kind::Numerical
+        } else {
+            Kind::InvalidInput
+        };
+        Self {
+            kind,
+            message: error.to_string(),
+        }
+    }
+}
+
+impl From<DynError> for Error {
+    fn from(error: DynError) -> Self {
+        let kind = match error {
+            DynError::NotPositiveDefinite | DynError::NonFiniteResult { .. } => Kind::Numerical,
+            _ => Kind::InvalidInput,
+        };
+        Self {
+            kind,
+            message: error.to_string(),
+        }
+    }
+}
+
+impl From<ReduceError> for Error {
+    fn from(error: ReduceError) -> Self {
+        match error {
+            ReduceError::Dyn(e) => Self {
+                message: ReduceError::Dyn(e.clone()).to_string(),
+                kind: Error::from(e).kind,
+            },
+            ReduceError::Kin(e) => Self {
+                message: ReduceError::Kin(e.clone()).to_string(),
+                kind: Error::from(e).kind,
+            },
+            ReduceError::NotPositiveDefinite
+            | ReduceError::NonFiniteResult { .. }
+            | ReduceError::JacobiDiverged { .. }
+            | ReduceError::JacobiNotConverged { .. } => Self::numerical(error.to_string()),
+            other => Self::input(other.to_string()),
+        }
+    }
+}
+
+impl From<FuzzyError> for Error {
+    fn from(error: FuzzyError) -> Self {
+        match error {
+            FuzzyError::NonFiniteOutput { .. } => Self::numerical(error.to_string()),
+            other => Self::input(other.to_string()),
+        }
+    }
+}
+
+impl From<SimError> for Error {
+    fn from(error: SimError) -> Self {
+        match error {
+            SimError::Unreachable { .. } => Self {
+                kind: Kind::Unreachable,
+                message: error.to_string(),
+            },
+            SimError::Kinematics(e) => Self {
+                message: SimError::Kinematics(e.clone()).to_string(),
+                kind: Error::from(e).kind,
+            },
+            SimError::Dynamics { ref source, .. } => Self {
+                kind: Error::from(source.clone()).kind,
+                message: error.to_string(),
+            },
+            other => Self::input(other.to_string()),
+        }
+    }
+}
+
+/// A count argument (`links`, `harmonics`, `samples`) as a `usize`: a negative number or one
+/// beyond 64 bits is an [`InvalidInput`] naming `name`, not an `OverflowError`. `minimum` is
+/// the smallest count the message asks for; the libraries check the actual bounds.
+pub(crate) fn count(
+    value: &pyo3::Bound<'_, pyo3::PyAny>,
+    name: &str,
+    minimum: u32,
+) -> pyo3::PyResult<usize> {
+    use pyo3::types::PyAnyMethods;
+    if let Ok(count) = value.extract::<usize>() {
+        return Ok(count);
+    }
+    match value.extract::<i128>() {
+        Ok(n) if n < 0 => {
+            Err(Error::input(format!("{name} must be at least {minimum}, got {n}")).into())
+        }
+        _ => Err(Error::input(format!(
+            "{name} must be a whole number of at most 64 bits, got {value}"
+        ))
+        .into()),
+    }
+}
+
+/// Refuses a computed vector with a non-finite entry, as `hrm eval` does: "{name} came out
+/// non-finite ({value})".
+pub(crate) fn check_finite(name: &str, values: &[f64]) -> Result<()> {
+    match values.iter().find(|v| !v.is_finite()) {
+        Some(v) => Err(Error::numerical(format!(
+            "{name} came out non-finite ({v})"
+        ))),
+        None => Ok(()),
+    }
+}

@@ -1,0 +1,216 @@
+//! `hrm.fuzzy`: Takagi-Sugeno systems (eqs 19-24), from `fuzzy-sugeno`.
+
+use crate::array::{States, evaluate};
+use crate::errors::{Error, check_finite, count};
+use fuzzy_sugeno::{AnalysisOptions, AnalysisReport, Evaluator, FuzzySystem};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyPermissionError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+/// A zero- or first-order Takagi-Sugeno fuzzy system (eqs 19-21), with MATLAB .fis interop.
+///
+/// Build one with System.from_fis(path_or_text) or hrm.fuzzy.paper_controller(). Inputs outside
+/// a variable's range are evaluated at the nearest end of the range (the `hrm fis eval`
+/// default).
+#[pyclass(module = "hrm.fuzzy", frozen)]
+pub struct System {
+    system: FuzzySystem,
+    evaluator: Mutex<Evaluator>,
+}
+
+impl System {
+    fn wrap(system: FuzzySystem) -> Self {
+        Self {
+            evaluator: Mutex::new(Evaluator::new(system.clone())),
+            system,
+        }
+    }
+}
+
+/// Reads a `.fis` file as `hrm fis` does, the path in front of every error.
+fn read_fis(path: &PathBuf) -> PyResult<FuzzySystem> {
+    let shown = path.display();
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        let message = format!("{shown}: {e}");
+        match e.kind() {
+            std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(message),
+            std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(message),
+            _ => PyOSError::new_err(message),
+        }
+    })?;
+    Ok(FuzzySystem::from_fis(&text).map_err(|e| Error::from(e).context(shown))?)
+}
+
+#[pymethods]
+impl System {
+    /// Loads a MATLAB .fis system: `path_or_text` is a path (str or os.PathLike) or the text of a
+    /// .fis file (a str with a line break, or starting with "["). Raises InvalidInput for a
+    /// malformed or unsupported file (the message names the line), FileNotFoundError or OSError
+    /// when the file cannot be read.
+    #[staticmethod]
+    fn from_fis(path_or_text: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let system = match path_or_text.extract::<String>() {
+            Ok(text) if text.contains('\n') || text.trim_start().starts_with('[') => {
+                FuzzySystem::from_fis(&text).map_err(Error::from)?
+            }
+            _ => read_fis(&path_or_text.extract::<PathBuf>()?)?,
+        };
+        Ok(Self::wrap(system))
+    }
+
+    /// The system as the text of a MATLAB .fis file (System.from_fis reads it back).
+    fn to_fis(&self) -> String {
+        self.system.to_fis()
+    }
+
+    /// The system's name.
+    #[getter]
+    fn name(&self) -> &str {
+        self.system.name()
+    }
+
+    /// The input variables' names, in order.
+    #[getter]
+    fn inputs(&self) -> Vec<String> {
+        self.system
+            .inputs()
+            .iter()
+            .map(|v| v.name.clone())
+            .collect()
+    }
+
+    /// The output variables' names, in order.
+    #[getter]
+    fn outputs(&self) -> Vec<String> {
+        self.system
+            .outputs()
+            .iter()
+            .map(|v| v.name.clone())
+            .collect()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "System(name={:?}, inputs={}, outputs={}, rules={})",
+            self.system.name(),
+            self.system.inputs().len(),
+            self.system.outputs().len(),
+            self.system.rules().len()
+        )
+    }
+
+    /// The outputs at input vector(s) `x`: shape (n_inputs,) gives (n_outputs,), (N, n_inputs)
+    /// gives (N, n_outputs) (singleton fuzzification, rule firing, eq 21's defuzzifier).
+    fn eval<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let (n_in, n_out) = (self.system.inputs().len(), self.system.outputs().len());
+        let x = States::read(x, "x", n_in)?;
+        let fresh = || Evaluator::new(self.system.clone());
+        let out = evaluate(
+            py,
+            [&x],
+            n_out,
+            &self.evaluator,
+            fresh,
+            |evaluator, [x], out| {
+                evaluator.eval(x, out)?;
+                check_finite("outputs", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[n_out]))
+    }
+
+    /// Wang's completeness, consistency and continuity checks of the rule base (`hrm fis
+    /// check`), as a dict: "passed", "report" (the text `hrm fis check` prints) and one dict per
+    /// property with its own "passed" and details (0-based rule, input, set and output indices).
+    ///
+    /// `coverage`: the degree to which some rule's antecedent must hold at every point;
+    /// `samples`: evenly spaced samples per input (set landmarks are added); `max_jump`: the
+    /// largest allowed jump between neighbouring rules, as a fraction of the output's range.
+    #[pyo3(
+        signature = (coverage=0.5, samples=None, max_jump=1.0),
+        text_signature = "($self, coverage=0.5, samples=21, max_jump=1.0)"
+    )]
+    fn check<'py>(
+        &self,
+        py: Python<'py>,
+        coverage: f64,
+        samples: Option<&Bound<'py, PyAny>>,
+        max_jump: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let options = AnalysisOptions {
+            coverage,
+            samples_per_input: samples.map_or(Ok(21), |s| count(s, "samples", 0))?,
+            max_relative_jump: max_jump,
+            ..AnalysisOptions::default()
+        };
+        let report = py
+            .detach(|| self.system.analyze(&options))
+            .map_err(Error::from)?;
+        report_dict(py, &report)
+    }
+}
+
+/// The analysis report as nested dicts.
+fn report_dict<'py>(py: Python<'py>, report: &AnalysisReport) -> PyResult<Bound<'py, PyDict>> {
+    let completeness = PyDict::new(py);
+    completeness.set_item("passed", report.completeness.passed())?;
+    completeness.set_item("threshold", report.completeness.threshold)?;
+    completeness.set_item("grid", report.completeness.grid.clone())?;
+    let coverage = PyList::empty(py);
+    for output in &report.completeness.outputs {
+        let entry = PyDict::new(py);
+        entry.set_item("weakest_strength", output.weakest_strength)?;
+        entry.set_item("weakest_point", output.weakest_point.clone())?;
+        entry.set_item("strongest_rules", output.strongest_rules.clone())?;
+        coverage.append(entry)?;
+    }
+    completeness.set_item("outputs", coverage)?;
+
+    let consistency = PyDict::new(py);
+    consistency.set_item("passed", report.consistency.passed())?;
+    let conflicts = PyList::empty(py);
+    for conflict in &report.consistency.conflicts {
+        let entry = PyDict::new(py);
+        entry.set_item("rules", conflict.rules.to_vec())?;
+        entry.set_item("output", conflict.output)?;
+        conflicts.append(entry)?;
+    }
+    consistency.set_item("conflicts", conflicts)?;
+
+    let continuity = PyDict::new(py);
+    continuity.set_item("passed", report.continuity.passed())?;
+    continuity.set_item("max_relative_jump", report.continuity.max_relative_jump)?;
+    let jumps = PyList::empty(py);
+    for jump in &report.continuity.outputs {
+        match jump {
+            None => jumps.append(py.None())?,
+            Some(jump) => {
+                let entry = PyDict::new(py);
+                entry.set_item("rules", jump.rules.to_vec())?;
+                entry.set_item("input", jump.input)?;
+                entry.set_item("sets", jump.sets.to_vec())?;
+                entry.set_item("jump", jump.jump)?;
+                entry.set_item("relative", jump.relative)?;
+                jumps.append(entry)?;
+            }
+        }
+    }
+    continuity.set_item("outputs", jumps)?;
+
+    let dict = PyDict::new(py);
+    dict.set_item("passed", report.passed())?;
+    dict.set_item("completeness", completeness)?;
+    dict.set_item("consistency", consistency)?;
+    dict.set_item("continuity", continuity)?;
+    dict.set_item("report", report.to_string())?;
+    Ok(dict)
+}
+
+/// The paper's fuzzy controller (eqs 22-24, Table 1 as corrected in docs/theory.md): inputs
+/// (da1, da2, a1_dot, a2_dot) (measured minus desired), outputs (tau1*, tau2*), 16 rules.
+#[pyfunction]
+pub(crate) fn paper_controller() -> System {
+    System::wrap(fuzzy_sugeno::paper_controller())
+}

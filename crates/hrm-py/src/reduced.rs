@@ -1,0 +1,401 @@
+//! `hrm.ReducedModel`: the arm constrained to the backbone curve's modal coordinates (eqs 7-18),
+//! from `backbone-kin` and `modal-reduce`.
+
+use crate::arm::Arm;
+use crate::array::{States, evaluate};
+use crate::errors::{Error, check_finite, count};
+use backbone_kin::{BaseAngle, Branch, HarmonicIk, ModalMap};
+use modal_reduce::ReducedData;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::prelude::*;
+use std::sync::Mutex;
+
+/// The workspace of one thread: the reduced model's data and the joint angles of one state.
+struct Workspace {
+    data: ReducedData,
+    theta: Vec<f64>,
+    zeros: Vec<f64>,
+}
+
+/// The arm's dynamics in the modal coordinates a of its backbone curve (eqs 7-18 of the
+/// paper): theta = J a + theta_0 with a constant Jacobian J (n x m), and
+/// M*(a) a_ddot + C*(a, a_dot) + G*(a) = tau* with M* = J^T M J, C* = J^T C, G* = J^T G.
+///
+/// ReducedModel(arm, harmonics=1, alpha0=None)
+///
+/// `harmonics` K gives the coordinates (a_1, ..., a_2K) of the curvature's K harmonics (K = 1 is
+/// the paper's (a1, a2)). `alpha0=None` makes the base angle the last coordinate, so m = 2K + 1
+/// (the paper's (a1, a2, alpha0)); a number holds it fixed (m = 2K, theta_0 = alpha0 e_1, the
+/// paper's experiments). Raises InvalidInput if J is column-rank-deficient (fewer than m links).
+///
+/// Every method takes one state (shape (m,)) or a batch (shape (N, m)) and answers with the same
+/// leading dimension.
+#[pyclass(module = "hrm", frozen)]
+pub struct ReducedModel {
+    model: modal_reduce::ReducedModel,
+    lengths: Vec<f64>,
+    workspace: Mutex<Workspace>,
+}
+
+impl Workspace {
+    fn new(model: &modal_reduce::ReducedModel) -> Self {
+        Self {
+            data: ReducedData::new(model),
+            theta: vec![0.0; model.n_links()],
+            zeros: vec![0.0; model.n_coords()],
+        }
+    }
+}
+
+impl ReducedModel {
+    fn fresh(&self) -> Workspace {
+        Workspace::new(&self.model)
+    }
+
+    fn m(&self) -> usize {
+        self.model.n_coords()
+    }
+
+    fn n(&self) -> usize {
+        self.model.n_links()
+    }
+
+    /// `M*`, `C*` and `G*` at `(a, a_dot)` into the workspace (eq 14, the O(n m^2) path).
+    fn terms(
+        &self,
+        workspace: &mut Workspace,
+        a: &[f64],
+        a_dot: Option<&[f64]>,
+    ) -> crate::errors::Result<()> {
+        let a_dot = a_dot.unwrap_or(&workspace.zeros);
+        modal_reduce::reduced_terms(&self.model, &mut workspace.data, a, a_dot)?;
+        Ok(())
+    }
+}
+
+#[pymethods]
+impl ReducedModel {
+    #[new]
+    #[pyo3(signature = (arm, harmonics=None, alpha0=None), text_signature = "(arm, harmonics=1, alpha0=None)")]
+    fn new(arm: &Arm, harmonics: Option<&Bound<'_, PyAny>>, alpha0: Option<f64>) -> PyResult<Self> {
+        let harmonics = harmonics.map_or(Ok(1), |k| count(k, "harmonics", 1))?;
+        let chain = arm.chain().clone();
+        let lengths: Vec<f64> = chain.link_lengths().collect();
+        let base = alpha0.map_or(BaseAngle::Free, BaseAngle::Fixed);
+        let map = ModalMap::new(&lengths, harmonics, base).map_err(Error::from)?;
+        let model = modal_reduce::ReducedModel::new(chain, map).map_err(Error::from)?;
+        Ok(Self {
+            workspace: Mutex::new(Workspace::new(&model)),
+            model,
+            lengths,
+        })
+    }
+
+    /// Number of modal coordinates m (2 K, plus 1 when alpha0 is a coordinate).
+    #[getter]
+    fn n_coords(&self) -> usize {
+        self.m()
+    }
+
+    /// Number of links (and joints) n.
+    #[getter]
+    fn n_links(&self) -> usize {
+        self.n()
+    }
+
+    /// Number of harmonics K.
+    #[getter]
+    fn harmonics(&self) -> usize {
+        self.model.map().harmonics()
+    }
+
+    /// The fixed base angle alpha0 (rad), or None when it is the last coordinate.
+    #[getter]
+    fn alpha0(&self) -> Option<f64> {
+        match self.model.map().base_angle() {
+            BaseAngle::Free => None,
+            BaseAngle::Fixed(alpha0) => Some(alpha0),
+        }
+    }
+
+    /// The constant modal Jacobian J = d theta / d a (eqs 8-11), shape (n, m).
+    #[getter]
+    fn jacobian<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let map = self.model.map();
+        Array2::from_shape_vec((self.n(), self.m()), map.jacobian().to_vec())
+            .expect("J is n x m")
+            .into_pyarray(py)
+    }
+
+    /// The constant offset theta_0 of theta = J a + theta_0 (alpha0 e_1 when alpha0 is fixed,
+    /// zero otherwise), shape (n,).
+    #[getter]
+    fn offset<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.model.map().offset().to_vec().into_pyarray(py)
+    }
+
+    fn __repr__(&self) -> String {
+        let alpha0 = match self.alpha0() {
+            None => "None".to_string(),
+            Some(value) => value.to_string(),
+        };
+        format!(
+            "ReducedModel(links={}, harmonics={}, alpha0={alpha0}, n_coords={})",
+            self.n(),
+            self.harmonics(),
+            self.m()
+        )
+    }
+
+    /// Joint angles theta = J a + theta_0 (eq 8), shape (n,) or (N, n).
+    fn joint_angles<'py>(
+        &self,
+        py: Python<'py>,
+        a: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let a = States::read(a, "a", self.m())?;
+        let out = evaluate(
+            py,
+            [&a],
+            self.n(),
+            &self.workspace,
+            || self.fresh(),
+            |_, [a], out| {
+                self.model.map().joint_angles(a, out).map_err(Error::from)?;
+                check_finite("theta", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[self.n()]))
+    }
+
+    /// The tip of the discrete chain (the arm's end point, m) at the joint angles J a + theta_0,
+    /// shape (2,) or (N, 2). It lies within the discretisation error of the backbone curve's end
+    /// point, which `ik` inverts.
+    fn fk<'py>(&self, py: Python<'py>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let a = States::read(a, "a", self.m())?;
+        let out = evaluate(
+            py,
+            [&a],
+            2,
+            &self.workspace,
+            || self.fresh(),
+            |ws, [a], out| {
+                self.model
+                    .map()
+                    .joint_angles(a, &mut ws.theta)
+                    .map_err(Error::from)?;
+                let tip =
+                    backbone_kin::tip_position(&self.lengths, &ws.theta).map_err(Error::from)?;
+                out.copy_from_slice(&tip);
+                check_finite("tip", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[2]))
+    }
+
+    /// Inverse kinematics of the backbone curve: modal coordinates whose curve ends at `target`
+    /// (m), shape (m,) or (N, m) for targets of shape (2,) or (N, 2).
+    ///
+    /// For K = 1 the closed form of eqs 5-6 (through the restricted inverse of J0) on `branch`
+    /// ("positive": a1 >= 0, the paper's; or "negative"); for K > 1 Levenberg-Marquardt from that
+    /// solution, the higher harmonics starting at zero. The base angle is the model's fixed
+    /// alpha0; for a model whose alpha0 is a coordinate, pass `alpha0` (it becomes the last
+    /// coordinate of the result). Raises Unreachable for a target the curve cannot reach and
+    /// NumericalError if the iteration does not converge.
+    #[pyo3(signature = (target, alpha0=None, branch="positive"))]
+    fn ik<'py>(
+        &self,
+        py: Python<'py>,
+        target: &Bound<'py, PyAny>,
+        alpha0: Option<f64>,
+        branch: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let branch = match branch {
+            "positive" => Branch::Positive,
+            "negative" => Branch::Negative,
+            other => {
+                return Err(Error::input(format!(
+                    "branch must be \"positive\" or \"negative\", got {other:?}"
+                ))
+                .into());
+            }
+        };
+        let (alpha0, free) = match (self.model.map().base_angle(), alpha0) {
+            (BaseAngle::Fixed(fixed), None) => (fixed, false),
+            (BaseAngle::Free, Some(given)) => (given, true),
+            (BaseAngle::Fixed(fixed), Some(_)) => {
+                return Err(Error::input(format!(
+                    "this model holds alpha0 fixed at {fixed}: ik takes alpha0 only for a model \
+                     whose alpha0 is a coordinate"
+                ))
+                .into());
+            }
+            (BaseAngle::Free, None) => {
+                return Err(Error::input(
+                    "this model's alpha0 is a coordinate: give ik the base angle, ik(target, alpha0=...)",
+                )
+                .into());
+            }
+        };
+        let harmonics = self.model.map().harmonics();
+        let length = self.model.chain().total_length();
+        let solver = match harmonics {
+            1 => None,
+            k => Some(HarmonicIk::new(length, k, alpha0).map_err(Error::from)?),
+        };
+        let shared = Mutex::new(solver.clone());
+        let target = States::read(target, "target", 2)?;
+        let out = evaluate(
+            py,
+            [&target],
+            self.m(),
+            &shared,
+            || solver.clone(),
+            |solver, [target], out| {
+                let target = [target[0], target[1]];
+                let a = backbone_kin::inverse_kinematics(length, target, alpha0, branch)?;
+                out.fill(0.0);
+                out[..2].copy_from_slice(&a);
+                if let Some(solver) = solver {
+                    solver.solve(target, &mut out[..2 * harmonics])?;
+                }
+                if free {
+                    out[2 * harmonics] = alpha0;
+                }
+                check_finite("a", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[self.m()]))
+    }
+
+    /// The reduced mass matrix M* = J^T M J (eq 14), shape (m, m) or (N, m, m).
+    fn mass_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        a: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let m = self.m();
+        let a = States::read(a, "a", m)?;
+        let out = evaluate(
+            py,
+            [&a],
+            m * m,
+            &self.workspace,
+            || self.fresh(),
+            |ws, [a], out| {
+                self.terms(ws, a, None)?;
+                let mass = ws.data.mass_matrix();
+                for (k, entry) in out.iter_mut().enumerate() {
+                    *entry = mass[(k / m, k % m)];
+                }
+                check_finite("mass_matrix", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[m, m]))
+    }
+
+    /// The reduced Coriolis and centrifugal vector C* = J^T C(theta, J a_dot) (eq 14), shape (m,)
+    /// or (N, m).
+    fn coriolis<'py>(
+        &self,
+        py: Python<'py>,
+        a: &Bound<'py, PyAny>,
+        a_dot: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let m = self.m();
+        let (a, a_dot) = (States::read(a, "a", m)?, States::read(a_dot, "a_dot", m)?);
+        let out = evaluate(
+            py,
+            [&a, &a_dot],
+            m,
+            &self.workspace,
+            || self.fresh(),
+            |ws, [a, a_dot], out| {
+                self.terms(ws, a, Some(a_dot))?;
+                out.copy_from_slice(ws.data.coriolis());
+                check_finite("coriolis", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[m]))
+    }
+
+    /// The reduced gravity vector G* = J^T G(theta) (eq 14), shape (m,) or (N, m).
+    fn gravity<'py>(&self, py: Python<'py>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let m = self.m();
+        let a = States::read(a, "a", m)?;
+        let out = evaluate(
+            py,
+            [&a],
+            m,
+            &self.workspace,
+            || self.fresh(),
+            |ws, [a], out| {
+                self.terms(ws, a, None)?;
+                out.copy_from_slice(ws.data.gravity());
+                check_finite("gravity", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[m]))
+    }
+
+    /// Reduced forward dynamics (eq 15): a_ddot = M*^-1 (tau* - C* - G*), shape (m,) or (N, m).
+    /// Raises NumericalError if M* is not numerically positive definite.
+    fn forward_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        a: &Bound<'py, PyAny>,
+        a_dot: &Bound<'py, PyAny>,
+        tau_star: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let m = self.m();
+        let inputs = [
+            States::read(a, "a", m)?,
+            States::read(a_dot, "a_dot", m)?,
+            States::read(tau_star, "tau_star", m)?,
+        ];
+        let [a, a_dot, tau_star] = &inputs;
+        let out = evaluate(
+            py,
+            [a, a_dot, tau_star],
+            m,
+            &self.workspace,
+            || self.fresh(),
+            |ws, [a, a_dot, tau], out| {
+                modal_reduce::forward_dynamics(&self.model, &mut ws.data, a, a_dot, tau, out)?;
+                check_finite("a_ddot", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[m]))
+    }
+
+    /// The joint torques tau = M J a_ddot + C + G that the real arm's actuators must deliver for
+    /// the modal motion (a, a_dot, a_ddot) (eq 13), shape (n,) or (N, n); J^T tau = tau*.
+    fn joint_torques<'py>(
+        &self,
+        py: Python<'py>,
+        a: &Bound<'py, PyAny>,
+        a_dot: &Bound<'py, PyAny>,
+        a_ddot: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let m = self.m();
+        let inputs = [
+            States::read(a, "a", m)?,
+            States::read(a_dot, "a_dot", m)?,
+            States::read(a_ddot, "a_ddot", m)?,
+        ];
+        let [a, a_dot, a_ddot] = &inputs;
+        let out = evaluate(
+            py,
+            [a, a_dot, a_ddot],
+            self.n(),
+            &self.workspace,
+            || self.fresh(),
+            |ws, [a, a_dot, a_ddot], out| {
+                modal_reduce::joint_torques(&self.model, &mut ws.data, a, a_dot, a_ddot, out)?;
+                check_finite("joint_torques", out)
+            },
+        )?;
+        Ok(out.into_py(py, &[self.n()]))
+    }
+}
