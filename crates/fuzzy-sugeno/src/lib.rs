@@ -8,6 +8,7 @@
 //! - allocation-free evaluation with explicit policies for out-of-range inputs and for outputs
 //!   on which no rule fires, per-rule firing strengths and a batch API ([`Evaluator`]);
 //! - MATLAB `.fis` read and write ([`FuzzySystem::from_fis`], [`FuzzySystem::to_fis`]);
+//! - systems learned from data, `genfis` and ANFIS training ([`learn`]);
 //! - Wang's completeness, consistency and continuity checks ([`FuzzySystem::analyze`]);
 //! - the paper's controller as a preset ([`paper_controller`], [`PaperController`]).
 //!
@@ -30,6 +31,7 @@ mod builder;
 mod error;
 mod eval;
 mod fis;
+pub mod learn;
 mod membership;
 mod paper;
 mod system;
