@@ -48,6 +48,8 @@ enum FisCommand {
         #[arg(long, value_enum, default_value_t = RangePolicy::Clamp)]
         out_of_range: RangePolicy,
     },
+    /// Learn a system from a CSV of samples (genfis, then ANFIS) and write it as a .fis file.
+    Train(crate::fis_train::TrainArgs),
     /// Write SVG plots of the membership functions and control surfaces.
     Surface {
         /// The `.fis` file.
@@ -108,6 +110,7 @@ pub fn run(args: FisArgs) -> Result<(), String> {
             }
             Ok(())
         }
+        FisCommand::Train(args) => crate::fis_train::run(args),
         FisCommand::Surface {
             file,
             out,

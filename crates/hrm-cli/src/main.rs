@@ -5,6 +5,7 @@ mod eval;
 mod experiment;
 mod figures;
 mod fis_cmd;
+mod fis_train;
 mod plot;
 mod progress;
 mod report;

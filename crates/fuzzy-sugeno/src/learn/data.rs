@@ -2,6 +2,7 @@
 
 use super::learning;
 use crate::FuzzyError;
+use crate::system::check_name;
 
 /// The most rows a data set may hold.
 pub const MAX_ROWS: usize = 1_000_000;
@@ -16,6 +17,8 @@ pub struct TrainingData {
     n_inputs: usize,
     n_outputs: usize,
     values: Vec<f64>,
+    /// Column names (inputs, then outputs), if given.
+    names: Option<Vec<String>>,
 }
 
 impl TrainingData {
@@ -58,7 +61,43 @@ impl TrainingData {
             n_inputs,
             n_outputs,
             values,
+            names: None,
         })
+    }
+
+    /// Names the columns (inputs, then outputs; for example a CSV header), which systems built
+    /// by `genfis` give their variables. Names must be distinct and valid in a `.fis` file (not
+    /// empty, no quote or control character).
+    pub fn with_names(mut self, names: Vec<String>) -> Result<Self, FuzzyError> {
+        let width = self.n_inputs + self.n_outputs;
+        if names.len() != width {
+            return Err(learning(format!(
+                "{} column names for {width} columns",
+                names.len()
+            )));
+        }
+        for (k, name) in names.iter().enumerate() {
+            check_name("variable", name)
+                .map_err(|reason| learning(format!("column {}: {reason}", k + 1)))?;
+            if names[..k].contains(name) {
+                return Err(learning(format!(
+                    "column {}: another column is also named '{name}'",
+                    k + 1
+                )));
+            }
+        }
+        self.names = Some(names);
+        Ok(self)
+    }
+
+    /// The name of column `column` (inputs first, then outputs): the given name, or `in1`,
+    /// `in2`, ... and `out1`, ... (MATLAB's defaults).
+    pub fn column_name(&self, column: usize) -> String {
+        match &self.names {
+            Some(names) => names[column].clone(),
+            None if column < self.n_inputs => format!("in{}", column + 1),
+            None => format!("out{}", column - self.n_inputs + 1),
+        }
     }
 
     /// The number of rows.

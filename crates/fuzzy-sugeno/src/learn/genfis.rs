@@ -175,8 +175,9 @@ const ACCEPT_RATIO: f64 = 0.5;
 const REJECT_RATIO: f64 = 0.15;
 
 /// A grid-partition system for output `output` of `data` (MATLAB's `genfis1`), named `"genfis"`:
-/// inputs `in1 ...` with sets `in1mf1 ...`, output `out1` with one term per rule, rules in
-/// MATLAB's order (the last input's set varies fastest), consequents fitted by least squares.
+/// variables named after the data's columns ([`TrainingData::column_name`]), sets `in1mf1 ...`,
+/// one output term `out1mf1 ...` per rule, rules in MATLAB's order (the last input's set varies
+/// fastest), consequents fitted by least squares.
 pub fn genfis_grid(
     data: &TrainingData,
     output: usize,
@@ -213,7 +214,7 @@ pub fn genfis_grid(
             })
             .collect();
         inputs.push(InputVariable {
-            name: format!("in{}", i + 1),
+            name: data.column_name(i),
             range,
             sets,
         });
@@ -282,7 +283,7 @@ pub fn genfis_cluster(
                 })
                 .collect();
             InputVariable {
-                name: format!("in{}", i + 1),
+                name: data.column_name(i),
                 range: ranges[i],
                 sets,
             }
@@ -397,7 +398,7 @@ fn assemble(
         })
         .collect();
     let outputs = vec![OutputVariable {
-        name: "out1".to_string(),
+        name: data.column_name(n + output),
         range: [lo, hi],
         terms,
     }];
