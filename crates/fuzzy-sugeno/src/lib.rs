@@ -8,6 +8,8 @@
 //! - allocation-free evaluation with explicit policies for out-of-range inputs and for outputs
 //!   on which no rule fires, per-rule firing strengths and a batch API ([`Evaluator`]);
 //! - MATLAB `.fis` read and write ([`FuzzySystem::from_fis`], [`FuzzySystem::to_fis`]);
+//! - export as self-contained C99 ([`FuzzySystem::to_c`]); IEC 61131-7 FCL read and write
+//!   ([`FuzzySystem::from_fcl`], [`FuzzySystem::to_fcl`]);
 //! - systems learned from data, `genfis` and ANFIS training ([`learn`]);
 //! - Wang's completeness, consistency and continuity checks ([`FuzzySystem::analyze`]);
 //! - the paper's controller as a preset ([`paper_controller`], [`PaperController`]).
@@ -30,6 +32,8 @@ pub mod analysis;
 mod builder;
 mod error;
 mod eval;
+mod export_c;
+mod fcl;
 mod fis;
 pub mod learn;
 mod membership;
@@ -45,6 +49,7 @@ pub use analysis::{AnalysisOptions, AnalysisReport};
 pub use builder::SystemBuilder;
 pub use error::FuzzyError;
 pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange};
+pub use export_c::CSource;
 pub use membership::MembershipFn;
 pub use paper::{PaperController, paper_controller};
 pub use system::{
