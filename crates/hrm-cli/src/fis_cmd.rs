@@ -3,6 +3,9 @@
 //! - `hrm fis check FILE`: Wang's completeness, consistency and continuity; exits non-zero if
 //!   one of them fails.
 //! - `hrm fis eval FILE x1 x2 ...`: prints `name = value` for every output.
+//! - `hrm fis train ...` and `hrm fis export ...`: see `fis_train` and `fis_export`.
+//!
+//! A FILE whose name ends in `.fcl` is read as IEC 61131-7 FCL, any other as MATLAB `.fis`.
 //! - `hrm fis surface FILE --out DIR`: SVGs of every input's membership functions and of every
 //!   output over every pair of inputs (others at a reference value), like MATLAB's `plotmf` and
 //!   `gensurf`.
@@ -50,6 +53,8 @@ enum FisCommand {
     },
     /// Learn a system from a CSV of samples (genfis, then ANFIS) and write it as a .fis file.
     Train(crate::fis_train::TrainArgs),
+    /// Write the system as C99 source and header, or as IEC 61131-7 FCL.
+    Export(crate::fis_export::ExportArgs),
     /// Write SVG plots of the membership functions and control surfaces.
     Surface {
         /// The `.fis` file.
@@ -68,7 +73,7 @@ enum FisCommand {
 
 /// The out-of-range policies, as command-line values.
 #[derive(Debug, Clone, Copy, ValueEnum)]
-enum RangePolicy {
+pub(crate) enum RangePolicy {
     /// Evaluate at the nearest end of the range.
     Clamp,
     /// Evaluate the membership functions at the value as given.
@@ -111,6 +116,7 @@ pub fn run(args: FisArgs) -> Result<(), String> {
             Ok(())
         }
         FisCommand::Train(args) => crate::fis_train::run(args),
+        FisCommand::Export(args) => crate::fis_export::run(args),
         FisCommand::Surface {
             file,
             out,
@@ -130,9 +136,18 @@ fn load_system(text: &str) -> Result<FuzzySystem, String> {
     FuzzySystem::from_fis(text).map_err(|e| e.to_string())
 }
 
-fn read_system(path: &Path) -> Result<FuzzySystem, String> {
+/// Reads a `.fis` file, or an FCL file if the name ends in `.fcl`.
+pub(crate) fn read_system(path: &Path) -> Result<FuzzySystem, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    load_system(&text).map_err(|e| format!("{}: {e}", path.display()))
+    let is_fcl = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("fcl"));
+    let system = if is_fcl {
+        FuzzySystem::from_fcl(&text).map_err(|e| e.to_string())
+    } else {
+        load_system(&text)
+    };
+    system.map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// The analysis report and whether it passed.
