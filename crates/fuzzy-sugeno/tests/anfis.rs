@@ -233,3 +233,51 @@ fn undetermined_consequents_are_an_error_without_ridge_and_finite_with_it() {
     .unwrap();
     assert!(trained.history.iter().all(|h| h.training_rmse.is_finite()));
 }
+
+#[test]
+fn systems_learned_per_output_merge_into_one_that_evaluates_the_same() {
+    // Two outputs of the same inputs, learned one system per output with different partitions.
+    let values = (0..120)
+        .flat_map(|k| {
+            let (x1, x2) = ((k as f64 * 0.37).sin(), (k as f64 * 0.23).cos());
+            [x1, x2, x1 * x2 + x2, (2.0 * x1).sin() - x2]
+        })
+        .collect();
+    let data = TrainingData::new(2, 2, values).unwrap();
+    let options = AnfisOptions {
+        epochs: 10,
+        ..AnfisOptions::default()
+    };
+    let grids = [
+        GridPartition::default(),
+        GridPartition {
+            sets_per_input: 3,
+            shape: SetShape::Gaussian,
+            order: ConsequentOrder::Zero,
+        },
+    ];
+    let systems: Vec<FuzzySystem> = (0..2)
+        .map(|o| {
+            let initial = genfis_grid(&data, o, &grids[o]).unwrap();
+            anfis(initial, &data, None, o, &options).unwrap().system
+        })
+        .collect();
+    let merged = fuzzy_sugeno::learn::merge_outputs("both", &systems).unwrap();
+    assert_eq!(merged.rules().len(), 4 + 9);
+    assert_eq!(FuzzySystem::from_fis(&merged.to_fis()).unwrap(), merged);
+    let mut both = Evaluator::new(merged);
+    let mut alone: Vec<Evaluator> = systems.into_iter().map(Evaluator::new).collect();
+    let (mut y2, mut y1) = ([0.0; 2], [0.0]);
+    for r in 0..data.rows() {
+        both.eval(data.inputs(r), &mut y2).unwrap();
+        for (o, evaluator) in alone.iter_mut().enumerate() {
+            evaluator.eval(data.inputs(r), &mut y1).unwrap();
+            assert_eq!(y2[o], y1[0], "row {r} output {o}");
+        }
+    }
+    let refused = fuzzy_sugeno::learn::merge_outputs("x", &[both.system().clone()]).unwrap_err();
+    assert_eq!(
+        refused.to_string(),
+        "learning: system 1 ('both') has 2 outputs; merge single-output systems"
+    );
+}

@@ -4,7 +4,9 @@
 //!
 //! Data are [`TrainingData`]: rows of inputs followed by one or more outputs. Each learned
 //! system has a single output, picked by index, so a several-output data set (for example
-//! recorded controller inputs and torques) is learned as one system per output.
+//! recorded controller inputs and torques) is learned as one system per output, and
+//! [`merge_outputs`] joins those into one multi-output system that evaluates each output exactly
+//! as its own system does.
 //!
 //! ```
 //! use fuzzy_sugeno::learn::{anfis, genfis_grid, AnfisOptions, GridPartition, TrainingData};
@@ -33,6 +35,7 @@ mod anfis;
 mod data;
 mod genfis;
 mod least_squares;
+mod merge;
 mod premise;
 
 pub use anfis::{Anfis, AnfisOptions, EpochReport, Trained, anfis};
@@ -41,6 +44,7 @@ pub use genfis::{
     ConsequentOrder, GridPartition, MAX_CLUSTER_ROWS, MAX_RULES, SetShape, SubtractiveClustering,
     genfis_cluster, genfis_grid,
 };
+pub use merge::merge_outputs;
 
 use crate::FuzzyError;
 
