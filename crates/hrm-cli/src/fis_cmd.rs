@@ -3,12 +3,12 @@
 //! - `hrm fis check FILE`: Wang's completeness, consistency and continuity; exits non-zero if
 //!   one of them fails.
 //! - `hrm fis eval FILE x1 x2 ...`: prints `name = value` for every output.
-//! - `hrm fis train ...` and `hrm fis export ...`: see `fis_train` and `fis_export`.
-//!
-//! A FILE whose name ends in `.fcl` is read as IEC 61131-7 FCL, any other as MATLAB `.fis`.
 //! - `hrm fis surface FILE --out DIR`: SVGs of every input's membership functions and of every
 //!   output over every pair of inputs (others at a reference value), like MATLAB's `plotmf` and
 //!   `gensurf`.
+//! - `hrm fis train ...` and `hrm fis export ...`: see `fis_train` and `fis_export`.
+//!
+//! A FILE whose name ends in `.fcl` is read as IEC 61131-7 FCL, any other as MATLAB `.fis`.
 
 use crate::plot::{self, Grid, Labels, Series};
 use clap::{Args, Subcommand, ValueEnum};
