@@ -59,7 +59,9 @@ pub(crate) fn bessel_end_point(length: f64, a: [f64; 2], alpha0: f64) -> [f64; 2
 ///
 /// Errors, each naming its condition: [`KinError::OutOfReach`] when `r > l`;
 /// [`KinError::AtBase`] when `r <= l * f64::EPSILON`, where the target's direction (and so `a2`)
-/// is lost in rounding; [`KinError::A2ExceedsAmplitude`] when `|a2| > A` for this `alpha0`;
+/// is lost in rounding; [`KinError::A2ExceedsAmplitude`] when `|a2| > A` for this `alpha0`
+/// (the target is then not reachable on the first branch of `J0`; a curve with `A > j_{0,1}`
+/// may still reach it, and [`HarmonicIk`](crate::HarmonicIk) finds it from a guess there);
 /// [`KinError::NonFinite`] and [`KinError::NonPositiveLength`] for bad input.
 ///
 /// Rounding at the edges of the reachable set is absorbed rather than reported: `r` up to

@@ -106,22 +106,26 @@ pub enum KinError {
         /// The curve length `l`.
         length: f64,
     },
-    /// With the given `alpha0` the target needs `|a2| > A`, so `a1 = ±sqrt(A^2 - a2^2)` is not
-    /// real (eq 6).
+    /// With the given `alpha0` the target needs `|a2| > A` on the first branch of `J0`, so
+    /// `a1 = ±sqrt(A^2 - a2^2)` is not real (eq 6). The closed form searches only amplitudes
+    /// `A <= j_{0,1}` ([`inverse_j0`](crate::inverse_j0)); a curve with a larger amplitude, whose
+    /// end point lies behind the base, may still reach the target (for example
+    /// `a = [3.127, 0]` with `alpha0 = pi/2` reaches `(0, -0.3 l)`), and [`HarmonicIk`](crate::HarmonicIk)
+    /// or [`ChainIk`](crate::ChainIk) with a guess finds such solutions.
     #[error(
-        "target unreachable with alpha0 = {alpha0}: it needs |a2| = {a2_abs} but the amplitude is only A = {amplitude} (eq 6 needs |a2| <= A)"
+        "target not reachable on the first branch of J0 with alpha0 = {alpha0}: it needs |a2| = {a2_abs} but the amplitude there is only A = {amplitude} (eq 6 needs |a2| <= A; amplitudes beyond the first zero of J0, A > 2.405, are not searched)"
     )]
     A2ExceedsAmplitude {
         /// `|a2|`, from the target's direction and `alpha0` (eq 5).
         a2_abs: f64,
-        /// `A = J0^{-1}(r / l)`.
+        /// `A = J0^{-1}(r / l)` on the first branch.
         amplitude: f64,
         /// The base angle used.
         alpha0: f64,
     },
     /// A numerical inverse kinematics did not reach its tolerance.
     #[error(
-        "numerical inverse kinematics did not converge: end-point error {residual} after {iterations} iterations (tolerance {tolerance})"
+        "numerical inverse kinematics did not converge: end-point error {residual:e} after {iterations} iterations (tolerance {tolerance:e})"
     )]
     NotConverged {
         /// Iterations spent.
@@ -134,8 +138,10 @@ pub enum KinError {
 }
 
 impl KinError {
-    /// Whether the error means the target cannot be reached by the backbone curve ([`OutOfReach`],
-    /// [`AtBase`], [`A2ExceedsAmplitude`]), as opposed to malformed input or a numerical failure.
+    /// Whether the error means the closed form cannot reach the target ([`OutOfReach`]: no curve
+    /// of this length can; [`AtBase`]: its direction is undefined; [`A2ExceedsAmplitude`]: not on
+    /// the first branch of `J0` with this `alpha0`), as opposed to malformed input or a numerical
+    /// failure.
     ///
     /// [`OutOfReach`]: KinError::OutOfReach
     /// [`AtBase`]: KinError::AtBase

@@ -145,44 +145,80 @@ impl HarmonicIk {
             return Err(KinError::OutOfReach { r, length });
         }
         let tolerance = self.options.tolerance * length;
-        self.curve.set_modes(a)?;
-        let mut point = self.curve.end_point_jacobian(&mut self.jacobian)?;
-        let mut residual = distance(point, target);
-        let mut damping = DAMPING_MIN;
-        let mut iterations = 0;
-        while residual > tolerance {
-            let error = [point[0] - target[0], point[1] - target[1]];
-            if iterations == self.options.max_iterations
-                || damping > DAMPING_MAX
-                || !damped_step(&self.jacobian, error, damping, a, &mut self.trial)
-            {
-                return Err(KinError::NotConverged {
-                    iterations,
-                    residual,
-                    tolerance,
-                });
-            }
-            iterations += 1;
-            let trial_point = self
-                .curve
-                .set_modes(&self.trial)
-                .and_then(|()| self.curve.end_point_jacobian(&mut self.trial_jacobian));
-            match trial_point {
-                Ok(trial_point) if distance(trial_point, target) < residual => {
-                    point = trial_point;
-                    residual = distance(point, target);
-                    a.copy_from_slice(&self.trial);
-                    std::mem::swap(&mut self.jacobian, &mut self.trial_jacobian);
-                    damping = (damping / 10.0).max(DAMPING_MIN);
-                }
-                _ => damping = (damping * 10.0).max(DAMPING_RESTART),
-            }
-        }
-        Ok(IkReport {
-            iterations,
-            residual,
-        })
+        let curve = &mut self.curve;
+        least_squares(
+            target,
+            a,
+            tolerance,
+            self.options.max_iterations,
+            Workspace {
+                trial: &mut self.trial,
+                jacobian: &mut self.jacobian,
+                trial_jacobian: &mut self.trial_jacobian,
+            },
+            |modes, jacobian| {
+                curve.set_modes(modes)?;
+                curve.end_point_jacobian(jacobian)
+            },
+        )
     }
+}
+
+/// The buffers of [`least_squares`]: a trial point (`m` entries) and two `2 x m` Jacobians.
+pub(crate) struct Workspace<'w> {
+    pub(crate) trial: &'w mut [f64],
+    pub(crate) jacobian: &'w mut Vec<f64>,
+    pub(crate) trial_jacobian: &'w mut Vec<f64>,
+}
+
+/// The damped least-squares iteration of the module docs on any end-point map:
+/// `point_and_jacobian(a, J)` returns `p(a)` and writes `J = d p / d a` (`2 x m`, row-major).
+/// `a` holds the guess on entry and the solution (or the best iterate) on return.
+pub(crate) fn least_squares(
+    target: [f64; 2],
+    a: &mut [f64],
+    tolerance: f64,
+    max_iterations: usize,
+    work: Workspace<'_>,
+    mut point_and_jacobian: impl FnMut(&[f64], &mut [f64]) -> Result<[f64; 2], KinError>,
+) -> Result<IkReport, KinError> {
+    let Workspace {
+        trial,
+        jacobian,
+        trial_jacobian,
+    } = work;
+    let mut point = point_and_jacobian(a, jacobian)?;
+    let mut residual = distance(point, target);
+    let mut damping = DAMPING_MIN;
+    let mut iterations = 0;
+    while residual > tolerance {
+        let error = [point[0] - target[0], point[1] - target[1]];
+        if iterations == max_iterations
+            || damping > DAMPING_MAX
+            || !damped_step(jacobian, error, damping, a, trial)
+        {
+            return Err(KinError::NotConverged {
+                iterations,
+                residual,
+                tolerance,
+            });
+        }
+        iterations += 1;
+        match point_and_jacobian(trial, trial_jacobian) {
+            Ok(trial_point) if distance(trial_point, target) < residual => {
+                point = trial_point;
+                residual = distance(point, target);
+                a.copy_from_slice(trial);
+                std::mem::swap(jacobian, trial_jacobian);
+                damping = (damping / 10.0).max(DAMPING_MIN);
+            }
+            _ => damping = (damping * 10.0).max(DAMPING_RESTART),
+        }
+    }
+    Ok(IkReport {
+        iterations,
+        residual,
+    })
 }
 
 /// `trial = a - J^T (J J^T + mu I)^{-1} error` with `mu = damping * trace(J J^T)`, `J` the

@@ -12,6 +12,8 @@
 //!   eq 9 with its sign corrected), for `K` harmonics and arbitrary link lengths.
 //! - [`joint_positions`] and [`tip_position`]: forward kinematics of the discrete chain.
 //! - [`HarmonicIk`]: numerical inverse kinematics of the `K`-harmonic family.
+//! - [`ChainIk`] and [`chain_inverse_kinematics`]: inverse kinematics of the discrete chain
+//!   itself (any link lengths), the closed form polished by Newton's method on the chain's tip.
 //!
 //! Every fallible function returns a [`KinError`] that names the failed condition.
 //!
@@ -36,6 +38,7 @@
 
 pub mod bessel;
 pub mod chain;
+pub mod chain_ik;
 pub mod closed_form;
 pub mod curve;
 pub mod error;
@@ -51,6 +54,7 @@ pub struct ReadmeDoctests;
 
 pub use bessel::{J0_FIRST_ZERO, inverse_j0};
 pub use chain::{joint_positions, tip_position};
+pub use chain_ik::{ChainIk, chain_inverse_kinematics};
 pub use closed_form::{Branch, end_point, inverse_kinematics};
 pub use curve::{BackboneCurve, MAX_QUADRATURE_NODES, QUADRATURE_TOLERANCE};
 pub use error::KinError;

@@ -15,8 +15,10 @@
 use crate::error::KinError;
 use crate::validate::{check_count, check_finite, check_len, check_link_lengths, check_output_len};
 
-/// The most links a [`ModalMap`] may have (the same limit as `manip_dyn::MAX_LINKS`): `J` has a
-/// row per link, so this bounds its memory.
+/// The most links any crate of the workspace accepts: `manip_dyn::MAX_LINKS` is this constant,
+/// re-exported. A [`ModalMap`]'s `J` has a row per link and a chain's `n x n` mass matrix takes
+/// 128 MiB at this limit, so a larger `n` is refused before anything is allocated rather than
+/// risk aborting the process on a failed allocation.
 pub const MAX_LINKS: usize = 4096;
 
 /// The most harmonics a [`ModalMap`] or a [`HarmonicIk`](crate::HarmonicIk) may have. A map needs
@@ -64,6 +66,7 @@ pub struct ModalMap {
     n_coords: usize,
     harmonics: usize,
     base: BaseAngle,
+    link_lengths: Vec<f64>,
     jacobian: Vec<f64>,
     offset: Vec<f64>,
 }
@@ -141,6 +144,7 @@ impl ModalMap {
             n_coords: m,
             harmonics,
             base,
+            link_lengths: link_lengths.to_vec(),
             jacobian,
             offset,
         })
@@ -164,6 +168,13 @@ impl ModalMap {
     /// Whether `alpha0` is a coordinate or held fixed.
     pub fn base_angle(&self) -> BaseAngle {
         self.base
+    }
+
+    /// The link lengths the map was built from, base first (all 1 for [`uniform`](Self::uniform)
+    /// and [`paper`](Self::paper)). Only their ratios `L_i / l` enter `J`, so a chain matches the
+    /// map when its links are proportional to these.
+    pub fn link_lengths(&self) -> &[f64] {
+        &self.link_lengths
     }
 
     /// `J`, row-major, `n_joints * n_coords` entries.

@@ -363,6 +363,12 @@ fn numerical_ik_not_converged() {
         matches!(err, KinError::NotConverged { iterations: 0, .. }),
         "{err:?}"
     );
+    // Small numbers in exponent form, not as 17-digit decimals.
+    let message = err.to_string();
+    assert!(
+        message.contains("e-1 after 0 iterations (tolerance 1e-14)"),
+        "{message}"
+    );
     assert!(err.to_string().contains("did not converge"));
     assert!(a.iter().all(|x| x.is_finite()));
 }

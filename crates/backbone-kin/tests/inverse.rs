@@ -238,3 +238,25 @@ fn numeric_ik_convergence_rates() {
         }
     }
 }
+
+#[test]
+fn targets_beyond_the_first_branch_are_named_as_such_and_solvable_from_a_guess() {
+    // a = [3.127, 0] is past the first zero of J0: the end point lies behind the base.
+    let (alpha0, a) = (PI / 2.0, [3.127, 0.0]);
+    let target = end_point(1.0, a, alpha0).unwrap();
+    assert!(
+        target[0].abs() < 1e-15 && (target[1] + 0.3).abs() < 1e-3,
+        "{target:?}"
+    );
+    // The closed form searches the first branch only, and says so.
+    let err = inverse_kinematics(1.0, target, alpha0, Branch::Positive).unwrap_err();
+    assert!(matches!(err, KinError::A2ExceedsAmplitude { .. }), "{err}");
+    assert!(err.to_string().contains("first branch of J0"), "{err}");
+    // A guess on the second branch reaches it numerically.
+    let mut ik = HarmonicIk::new(1.0, 1, alpha0).unwrap();
+    let mut guess = [3.0, 0.2];
+    ik.solve(target, &mut guess).unwrap();
+    let reached = end_point(1.0, guess, alpha0).unwrap();
+    assert!((reached[0] - target[0]).abs() < 1e-13 && (reached[1] - target[1]).abs() < 1e-13);
+    assert!(guess[0].hypot(guess[1]) > J0_FIRST_ZERO);
+}

@@ -120,7 +120,8 @@ pub struct Jump {
     pub sets: [usize; 2],
     /// `|z_1 - z_2|`.
     pub jump: f64,
-    /// The jump divided by the width of the output's range.
+    /// The jump divided by the width of the output's range (0 for no jump, infinite for a jump
+    /// on an output whose range is a point).
     pub relative: f64,
 }
 
@@ -346,7 +347,12 @@ impl FuzzySystem {
                     let jump = (output.terms[ta].function.value(&point)?
                         - output.terms[tb].function.value(&point)?)
                     .abs();
-                    let relative = jump / (output.range[1] - output.range[0]);
+                    // A point range ([0 0] in some MATLAB files) makes any jump infinite.
+                    let relative = if jump == 0.0 {
+                        0.0
+                    } else {
+                        jump / (output.range[1] - output.range[0])
+                    };
                     if largest[o].is_none_or(|l| jump > l.jump) {
                         largest[o] = Some(Jump {
                             rules: [i, j],
@@ -367,29 +373,45 @@ impl FuzzySystem {
 }
 
 /// Points along each input: even samples, the sets' landmarks and the midpoints between
-/// landmarks, all within the range; the even samples are thinned until the grid fits.
+/// landmarks, all within the range; the even samples are thinned until the grid fits. An axis
+/// holds at least its even samples, so more than `max_points` of them never fit and are not
+/// built; the largest count that fits is found by bisection (the grid grows with the count),
+/// so a huge `samples` costs a few dozen axis constructions, not one per count.
 fn grid_axes(
     inputs: &[InputVariable],
     samples: usize,
     max_points: usize,
 ) -> Result<Vec<Vec<f64>>, FuzzyError> {
-    let mut samples = samples.max(2);
-    loop {
-        let axes: Vec<Vec<f64>> = inputs.iter().map(|input| axis(input, samples)).collect();
-        let total = axes
-            .iter()
-            .try_fold(1usize, |acc, a| acc.checked_mul(a.len()));
-        match total {
-            Some(total) if total <= max_points => return Ok(axes),
-            _ if samples > 2 => samples -= 1,
-            _ => {
-                return Err(FuzzyError::Analysis(format!(
-                    "the completeness grid needs more than max_grid_points = {max_points} points even with \
-                     2 samples per input; raise max_grid_points"
-                )));
-            }
+    let build = |samples: usize| -> Vec<Vec<f64>> {
+        inputs.iter().map(|input| axis(input, samples)).collect()
+    };
+    let fits = |axes: &[Vec<f64>]| {
+        axes.iter()
+            .try_fold(1usize, |acc, a| acc.checked_mul(a.len()))
+            .is_some_and(|total| total <= max_points)
+    };
+    let mut high = samples.max(2).min(max_points.max(2));
+    let axes = build(high);
+    if fits(&axes) {
+        return Ok(axes);
+    }
+    let mut low = 2;
+    if !fits(&build(low)) {
+        return Err(FuzzyError::Analysis(format!(
+            "the completeness grid needs more than max_grid_points = {max_points} points even with \
+             2 samples per input; raise max_grid_points"
+        )));
+    }
+    // `low` fits and `high` does not.
+    while high - low > 1 {
+        let middle = low + (high - low) / 2;
+        if fits(&build(middle)) {
+            low = middle;
+        } else {
+            high = middle;
         }
     }
+    Ok(build(low))
 }
 
 fn axis(input: &InputVariable, samples: usize) -> Vec<f64> {
@@ -451,6 +473,15 @@ fn set_landmarks(mf: &MembershipFn) -> Vec<f64> {
         } => {
             vec![center1, center2]
         }
+        MembershipFn::SShape { start, end } | MembershipFn::ZShape { start, end } => {
+            vec![start, 0.5 * (start + end), end]
+        }
+        MembershipFn::PiShape {
+            left_foot,
+            left_shoulder,
+            right_shoulder,
+            right_foot,
+        } => vec![left_foot, left_shoulder, right_shoulder, right_foot],
         MembershipFn::Constant { .. } => Vec::new(),
     }
 }
@@ -784,5 +815,18 @@ mod tests {
         assert!(
             matches!(refused, Err(FuzzyError::Analysis(m)) if m.contains("max_grid_points = 7"))
         );
+    }
+
+    #[test]
+    fn a_huge_sample_count_is_thinned_without_allocating_it() {
+        // 10^12 samples per input would be 8 TB per axis; the grid is capped at its limit.
+        let report = paper_controller()
+            .analyze(&AnalysisOptions {
+                samples_per_input: 1_000_000_000_000,
+                ..AnalysisOptions::default()
+            })
+            .unwrap();
+        let points: usize = report.completeness.grid.iter().product();
+        assert!(points <= 1_000_000 && points > 500_000, "{points}");
     }
 }

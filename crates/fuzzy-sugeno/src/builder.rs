@@ -215,17 +215,23 @@ fn resolve(
         .iter()
         .zip(inputs)
         .map(|(token, input)| {
-            let find = |name: &str| input.sets.iter().position(|s| s.name == name);
             let token = token.trim();
             if token == "-" {
                 return Ok(Antecedent::Any);
             }
-            if let Some(k) = find(token) {
+            let named = |wanted: &str| {
+                unique_position(
+                    input.sets.iter().map(|s| s.name.as_str()),
+                    wanted,
+                    &input.name,
+                    "sets",
+                )
+            };
+            if let Some(k) = named(token)? {
                 return Ok(Antecedent::Is(k));
             }
-            if let Some(k) = token
-                .strip_prefix("not ")
-                .and_then(|rest| find(rest.trim()))
+            if let Some(rest) = token.strip_prefix("not ")
+                && let Some(k) = named(rest.trim())?
             {
                 return Ok(Antecedent::IsNot(k));
             }
@@ -245,7 +251,12 @@ fn resolve(
             if token == "-" {
                 return Ok(None);
             }
-            match output.terms.iter().position(|t| t.name == token) {
+            match unique_position(
+                output.terms.iter().map(|t| t.name.as_str()),
+                token,
+                &output.name,
+                "terms",
+            )? {
                 Some(k) => Ok(Some(k)),
                 None => {
                     let names: Vec<&str> = output.terms.iter().map(|t| t.name.as_str()).collect();
@@ -264,6 +275,30 @@ fn resolve(
         weight,
         connective,
     })
+}
+
+/// The index of the one name equal to `wanted`, `None` if there is none, an error if several
+/// share it (MATLAB allows that; such sets can only be used by index).
+fn unique_position<'a>(
+    names: impl Iterator<Item = &'a str>,
+    wanted: &str,
+    variable: &str,
+    kind: &str,
+) -> Result<Option<usize>, String> {
+    let matches: Vec<usize> = names
+        .enumerate()
+        .filter(|(_, name)| *name == wanted)
+        .map(|(k, _)| k)
+        .collect();
+    match matches[..] {
+        [] => Ok(None),
+        [k] => Ok(Some(k)),
+        [first, second, ..] => Err(format!(
+            "'{variable}' has several {kind} named '{wanted}' ({} and {}); use an indexed rule",
+            first + 1,
+            second + 1
+        )),
+    }
 }
 
 #[cfg(test)]

@@ -23,7 +23,9 @@ pub enum OutOfRange {
 /// What an output is when none of the rules that conclude on it fires (total strength 0).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub enum NoRuleFired {
-    /// The middle of the output's range (the default; MATLAB does the same).
+    /// The middle of the output's range (the default). MATLAB's `evalfis` does the same: "No
+    /// rules fired for Output 1. Defuzzified output value set to its mean range value", a
+    /// warning by default (`evalfisOptions`' `NoRuleFiredMessage`).
     #[default]
     MiddleOfRange,
     /// One fixed value per output.

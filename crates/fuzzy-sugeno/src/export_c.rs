@@ -211,6 +211,32 @@ fn source(system: &FuzzySystem, prefix: &str, options: &EvalOptions) -> String {
              double d = x - center;\n    return exp(-(d * d) * k);\n}}\n"
         );
     }
+    if uses(|m| matches!(m, CompiledMf::SShape { .. } | CompiledMf::PiShape { .. })) {
+        let _ = writeln!(
+            s,
+            "/* MATLAB's smf: quadratic spline from 0 at a to 1 at b, a step at (a + b) / 2 if a >= b. */\n\
+             static double {prefix}_smf(double x, double a, double b)\n{{\n    \
+             double middle = 0.5 * (a + b);\n    double t;\n    \
+             if (a >= b) {{\n        return x >= middle ? 1.0 : 0.0;\n    }}\n    \
+             if (x <= a) {{\n        return 0.0;\n    }}\n    \
+             if (x <= middle) {{\n        t = (x - a) / (b - a);\n        return 2.0 * t * t;\n    }}\n    \
+             if (x <= b) {{\n        t = (b - x) / (b - a);\n        return 1.0 - 2.0 * t * t;\n    }}\n    \
+             return 1.0;\n}}\n"
+        );
+    }
+    if uses(|m| matches!(m, CompiledMf::ZShape { .. } | CompiledMf::PiShape { .. })) {
+        let _ = writeln!(
+            s,
+            "/* MATLAB's zmf: quadratic spline from 1 at a to 0 at b, a step at (a + b) / 2 if a >= b. */\n\
+             static double {prefix}_zmf(double x, double a, double b)\n{{\n    \
+             double middle = 0.5 * (a + b);\n    double t;\n    \
+             if (a >= b) {{\n        return x <= middle ? 1.0 : 0.0;\n    }}\n    \
+             if (x <= a) {{\n        return 1.0;\n    }}\n    \
+             if (x <= middle) {{\n        t = (x - a) / (b - a);\n        return 1.0 - 2.0 * t * t;\n    }}\n    \
+             if (x <= b) {{\n        t = (b - x) / (b - a);\n        return 2.0 * t * t;\n    }}\n    \
+             return 0.0;\n}}\n"
+        );
+    }
     let methods = system.methods();
     // First-order terms by their index in the term table, and whether any rule uses one.
     let linear: std::collections::HashMap<usize, usize> = c.linear_terms.iter().copied().collect();
@@ -457,6 +483,23 @@ fn degree(mf: &CompiledMf, x: &str, target: &str, prefix: &str) -> String {
             lit(center1),
             lit(slope2),
             lit(center2)
+        ),
+        CompiledMf::SShape { start, end } => format!(
+            "{target} = {prefix}_smf({x}, {}, {});",
+            lit(start),
+            lit(end)
+        ),
+        CompiledMf::ZShape { start, end } => format!(
+            "{target} = {prefix}_zmf({x}, {}, {});",
+            lit(start),
+            lit(end)
+        ),
+        CompiledMf::PiShape { a, b, c, d } => format!(
+            "{target} = {prefix}_smf({x}, {}, {}) * {prefix}_zmf({x}, {}, {});",
+            lit(a),
+            lit(b),
+            lit(c),
+            lit(d)
         ),
         CompiledMf::Constant(value) => format!("{target} = {};", lit(value)),
     }

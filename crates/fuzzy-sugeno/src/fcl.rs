@@ -220,6 +220,14 @@ fn term(mf: &MembershipFn) -> String {
             slope2,
             center2,
         } => format!("SigmoidProduct {center1:?} {slope1:?} {slope2:?} {center2:?}"),
+        MembershipFn::SShape { start, end } => format!("SShape {start:?} {end:?}"),
+        MembershipFn::ZShape { start, end } => format!("ZShape {start:?} {end:?}"),
+        MembershipFn::PiShape {
+            left_foot,
+            left_shoulder,
+            right_shoulder,
+            right_foot,
+        } => format!("PiShape {left_foot:?} {left_shoulder:?} {right_shoulder:?} {right_foot:?}"),
         MembershipFn::Constant { value } => format!("Constant {value:?}"),
     }
 }
@@ -755,8 +763,9 @@ fn input_term(line: usize, value: &str) -> Result<MembershipFn, FuzzyError> {
         let (class, p) = class_parameters(line, value)?;
         let expected = match class {
             "Triangle" | "Bell" => 3,
-            "Gaussian" | "Sigmoid" => 2,
-            "Trapezoid" | "GaussianProduct" | "SigmoidDifference" | "SigmoidProduct" => 4,
+            "Gaussian" | "Sigmoid" | "SShape" | "ZShape" => 2,
+            "Trapezoid" | "GaussianProduct" | "SigmoidDifference" | "SigmoidProduct"
+            | "PiShape" => 4,
             "Constant" => 1,
             _ if class.parse::<f64>().is_ok() => {
                 return Err(error(line, "singleton input terms are not supported"));
@@ -767,7 +776,7 @@ fn input_term(line: usize, value: &str) -> Result<MembershipFn, FuzzyError> {
                     format!(
                         "input term class '{class}' is not supported; expected a point list or one \
                          of Triangle, Trapezoid, Bell, Gaussian, GaussianProduct, Sigmoid, \
-                         SigmoidDifference, SigmoidProduct, Constant"
+                         SigmoidDifference, SigmoidProduct, SShape, ZShape, PiShape, Constant"
                     ),
                 ));
             }
@@ -796,6 +805,22 @@ fn input_term(line: usize, value: &str) -> Result<MembershipFn, FuzzyError> {
                 center1: p[0],
                 slope2: p[2],
                 center2: p[3],
+            },
+            // fuzzylite's SShape(start, end), ZShape(start, end) and
+            // PiShape(bottomLeft, topLeft, topRight, bottomRight): MATLAB's order.
+            "SShape" => MembershipFn::SShape {
+                start: p[0],
+                end: p[1],
+            },
+            "ZShape" => MembershipFn::ZShape {
+                start: p[0],
+                end: p[1],
+            },
+            "PiShape" => MembershipFn::PiShape {
+                left_foot: p[0],
+                left_shoulder: p[1],
+                right_shoulder: p[2],
+                right_foot: p[3],
             },
             _ => MembershipFn::Constant { value: p[0] },
         }

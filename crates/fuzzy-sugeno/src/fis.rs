@@ -2,8 +2,11 @@
 //! `[Rules]` sections, rule lines like `1 -2 0, 3 (0.5) : 1`.
 //!
 //! Writing then reading gives back the identical system (numbers are written in the shortest
-//! form that parses back to the same `f64`). Reading is strict: every malformed line is an error
-//! that gives its line number and what was expected, and Mamdani systems are refused.
+//! form that parses back to the same `f64`). Reading accepts what MATLAB's `readfis` reads,
+//! including the habits of files written by older MATLAB releases, Octave's fuzzy-logic-toolkit
+//! and fuzzylite (`docs/fis-format.md` lists them); what it accepts but does not keep or use is
+//! reported as [`FisNote`]s. Every malformed line is an error that gives its line number and
+//! what was expected, and Mamdani systems are refused.
 
 use crate::error::FuzzyError;
 use crate::membership::{MembershipFn, format_params};
@@ -26,7 +29,35 @@ impl FuzzySystem {
     /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
     /// ```
     pub fn from_fis(text: &str) -> Result<Self, FuzzyError> {
-        Parser::split(text)?.system()
+        Self::from_fis_with_notes(text).map(|(system, _)| system)
+    }
+
+    /// Reads a Sugeno system like [`from_fis`](Self::from_fis), and also returns what the file
+    /// said that was accepted but is neither kept in the system nor used by its evaluation:
+    /// `ImpMethod`/`AggMethod` values other than `'prod'`/`'sum'`, an `AndMethod` or `OrMethod`
+    /// that no rule needs and this crate cannot evaluate (such as fuzzylite's `''`), unknown
+    /// keys (fuzzylite's `Enabled=1`, `LockRange=0`, ...), parameters beyond those a function
+    /// takes, `MF` keys that disagree with their position (functions are read by position, as
+    /// MATLAB does), and a `Version` other than 2.0.
+    ///
+    /// ```
+    /// use fuzzy_sugeno::FuzzySystem;
+    /// let text = "[System]\nName='s'\nType='sugeno'\nNumInputs=1\nNumOutputs=1\nNumRules=1\n\
+    ///     AndMethod=''\nOrMethod=''\nImpMethod='min'\nAggMethod='max'\nDefuzzMethod='wtaver'\n\
+    ///     [Input1]\nName='x'\nRange=[0 1]\nEnabled=1\nNumMFs=1\nMF1='a':'gbellmf',[1 2 0 9]\n\
+    ///     [Output1]\nName='y'\nRange=[0 1]\nNumMFs=1\nMF1='c':'constant',[0.5]\n\
+    ///     [Rules]\n1.000 , 1.000 (1.000) : 1\n";
+    /// let (system, notes) = FuzzySystem::from_fis_with_notes(text)?;
+    /// assert_eq!(system.inputs()[0].sets.len(), 1);
+    /// assert_eq!(notes.len(), 6); // AndMethod, OrMethod, ImpMethod, AggMethod, Enabled, [... 9]
+    /// assert!(notes[0].to_string().starts_with("line 7: AndMethod=''"));
+    /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
+    /// ```
+    pub fn from_fis_with_notes(text: &str) -> Result<(Self, Vec<FisNote>), FuzzyError> {
+        let mut notes = Vec::new();
+        let system = Parser::split(text)?.system(&mut notes)?;
+        notes.sort_by_key(|note| note.line);
+        Ok((system, notes))
     }
 
     /// Writes the system as the text of a MATLAB `.fis` file.
@@ -149,6 +180,30 @@ fn fis_numbers(values: &[f64]) -> String {
     format!("[{}]", inner.join(" "))
 }
 
+/// Something a `.fis` file said that [`FuzzySystem::from_fis_with_notes`] accepted but neither
+/// kept in the system nor used to evaluate it (so [`FuzzySystem::to_fis`] does not write it
+/// back). Displayed as `line N: message`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FisNote {
+    /// The 1-based line number.
+    pub line: usize,
+    /// What was ignored, and why that is harmless.
+    pub message: String,
+}
+
+impl std::fmt::Display for FisNote {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "line {}: {}", self.line, self.message)
+    }
+}
+
+fn note(notes: &mut Vec<FisNote>, line: usize, message: impl Into<String>) {
+    notes.push(FisNote {
+        line,
+        message: message.into(),
+    });
+}
+
 /// A `key=value` line or a rule line, with its 1-based line number.
 #[derive(Debug, Clone, Copy)]
 struct Line<'a> {
@@ -184,14 +239,15 @@ fn error(line: usize, message: impl Into<String>) -> FuzzyError {
 }
 
 impl<'a> Parser<'a> {
-    /// Splits the text into sections, skipping blank lines and `%` comments.
+    /// Splits the text into sections, skipping blank lines and comment lines (`%` in MATLAB's
+    /// files, `#` in Octave's and fuzzylite's).
     fn split(text: &'a str) -> Result<Self, FuzzyError> {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut sections: Vec<Section<'a>> = Vec::new();
         for (index, raw) in text.lines().enumerate() {
             let number = index + 1;
             let line = raw.trim();
-            if line.is_empty() || line.starts_with('%') {
+            if line.is_empty() || line.starts_with('%') || line.starts_with('#') {
                 continue;
             }
             if let Some(name) = line.strip_prefix('[').and_then(|l| l.strip_suffix(']')) {
@@ -231,7 +287,7 @@ impl<'a> Parser<'a> {
         self.sections.iter().find(|s| s.kind == kind)
     }
 
-    fn system(&self) -> Result<FuzzySystem, FuzzyError> {
+    fn system(&self, notes: &mut Vec<FisNote>) -> Result<FuzzySystem, FuzzyError> {
         let Some(section) = self.section(SectionKind::System) else {
             return Err(error(1, "expected a [System] section"));
         };
@@ -251,6 +307,7 @@ impl<'a> Parser<'a> {
                 "DefuzzMethod",
             ],
             false,
+            notes,
         )?;
         // The type first, so that a Mamdani file is named as such whatever else it contains.
         let (line, kind) = keys.string("Type")?;
@@ -272,32 +329,58 @@ impl<'a> Parser<'a> {
         }
         let (line, name) = keys.string("Name")?;
         check_name("system", name).map_err(|reason| error(line, reason))?;
+        if let Some((line, version)) = keys.find("Version")
+            && !matches!(version.trim_matches('\''), "2.0" | "2")
+        {
+            note(
+                notes,
+                line,
+                format!(
+                    "Version={version} is not used (every version is read alike; files are written with Version=2.0)"
+                ),
+            );
+        }
         let n_inputs = keys.count("NumInputs", 1)?;
         let n_outputs = keys.count("NumOutputs", 1)?;
-        let n_rules = keys.count("NumRules", 0)?;
-        let methods = Methods {
-            and: keys.choice(
-                "AndMethod",
-                &[("prod", AndMethod::Product), ("min", AndMethod::Minimum)],
-            )?,
-            or: keys.choice(
-                "OrMethod",
-                &[
-                    ("probor", OrMethod::ProbabilisticSum),
-                    ("max", OrMethod::Maximum),
-                ],
-            )?,
-            defuzzification: keys.choice(
-                "DefuzzMethod",
-                &[
-                    ("wtaver", Defuzzification::WeightedAverage),
-                    ("wtsum", Defuzzification::WeightedSum),
-                ],
-            )?,
+        let n_rules = match keys.find("NumRules") {
+            Some(_) => Some(keys.count("NumRules", 0)?),
+            None => None,
         };
-        // Sugeno systems imply by product and aggregate by sum; other choices are not Sugeno.
-        keys.choice("ImpMethod", &[("prod", ())])?;
-        keys.choice("AggMethod", &[("sum", ())])?;
+        let and = keys.method(
+            "AndMethod",
+            &[("prod", AndMethod::Product), ("min", AndMethod::Minimum)],
+        )?;
+        let or = keys.method(
+            "OrMethod",
+            &[
+                ("probor", OrMethod::ProbabilisticSum),
+                ("max", OrMethod::Maximum),
+            ],
+        )?;
+        let defuzzification = keys.choice(
+            "DefuzzMethod",
+            &[
+                ("wtaver", Defuzzification::WeightedAverage),
+                ("wtsum", Defuzzification::WeightedSum),
+            ],
+        )?;
+        // MATLAB evaluates a Sugeno system as the weighted average (or sum) of its rule outputs
+        // whatever these two say; any value is accepted and reported.
+        for (key, standard) in [("ImpMethod", "prod"), ("AggMethod", "sum")] {
+            if keys.find(key).is_some() {
+                let (line, value) = keys.string(key)?;
+                if value != standard {
+                    note(
+                        notes,
+                        line,
+                        format!(
+                            "{key}='{value}' is not used: a Sugeno output is the weighted average (or sum) \
+                             of the rule outputs whatever {key} says, as in MATLAB"
+                        ),
+                    );
+                }
+            }
+        }
         for section in &self.sections {
             match section.kind {
                 SectionKind::Input(k) if k > n_inputs => {
@@ -326,18 +409,21 @@ impl<'a> Parser<'a> {
             let section = self
                 .section(SectionKind::Input(i))
                 .ok_or_else(|| missing(format!("Input{i}"), format!("NumInputs={n_inputs}")))?;
-            inputs.push(parse_input(section, &mut names)?);
+            inputs.push(parse_input(section, &mut names, notes)?);
         }
         let mut outputs = Vec::new();
         for o in 1..=n_outputs {
             let section = self
                 .section(SectionKind::Output(o))
                 .ok_or_else(|| missing(format!("Output{o}"), format!("NumOutputs={n_outputs}")))?;
-            outputs.push(parse_output(section, n_inputs, &mut names)?);
+            outputs.push(parse_output(section, n_inputs, &mut names, notes)?);
         }
-        let rules = match self.section(SectionKind::Rules) {
-            Some(section) => {
-                if section.lines.len() != n_rules {
+        let mut rule_lines = Vec::new();
+        let rules = match (self.section(SectionKind::Rules), n_rules) {
+            (Some(section), n_rules) => {
+                if let Some(n_rules) = n_rules
+                    && section.lines.len() != n_rules
+                {
                     return Err(error(
                         section.header,
                         format!(
@@ -346,17 +432,99 @@ impl<'a> Parser<'a> {
                         ),
                     ));
                 }
+                rule_lines.extend(section.lines.iter().map(|line| line.number));
                 section
                     .lines
                     .iter()
                     .map(|line| parse_rule(*line, &inputs, &outputs))
                     .collect::<Result<Vec<_>, _>>()?
             }
-            None if n_rules == 0 => Vec::new(),
-            None => return Err(missing("Rules".to_string(), format!("NumRules={n_rules}"))),
+            (None, None | Some(0)) => Vec::new(),
+            (None, Some(n_rules)) => {
+                return Err(missing("Rules".to_string(), format!("NumRules={n_rules}")));
+            }
+        };
+        let methods = Methods {
+            and: and.resolve(&rules, &rule_lines, Connective::And, notes)?,
+            or: or.resolve(&rules, &rule_lines, Connective::Or, notes)?,
+            defuzzification,
         };
         FuzzySystem::new(name.to_string(), inputs, outputs, rules, methods)
             .map_err(|e| error(header, e.to_string()))
+    }
+}
+
+/// An `AndMethod` or `OrMethod` as read: one this crate evaluates, or another value (such as
+/// fuzzylite's `''`) that is acceptable only if no rule needs it.
+enum Method<'a, T> {
+    Known(T),
+    Other {
+        key: &'static str,
+        /// The line and value, `None` when the key is absent.
+        found: Option<(usize, &'a str)>,
+        /// The names this crate evaluates, and the default written back.
+        options: &'a [(&'a str, T)],
+    },
+}
+
+impl<T: Copy + Default> Method<'_, T> {
+    /// The method, or the default if no rule needs it (noted), or an error naming the first
+    /// rule that does. A rule needs its connective only to combine two or more antecedents:
+    /// with a single one, every t-norm and s-norm gives that antecedent's degree.
+    fn resolve(
+        self,
+        rules: &[Rule],
+        rule_lines: &[usize],
+        connective: Connective,
+        notes: &mut Vec<FisNote>,
+    ) -> Result<T, FuzzyError> {
+        let (key, found, options) = match self {
+            Self::Known(method) => return Ok(method),
+            Self::Other {
+                key,
+                found,
+                options,
+            } => (key, found, options),
+        };
+        let list: Vec<String> = options.iter().map(|(n, _)| format!("'{n}'")).collect();
+        let needs = rules.iter().zip(rule_lines).find(|(rule, _)| {
+            rule.connective == connective
+                && rule
+                    .antecedents
+                    .iter()
+                    .filter(|a| **a != Antecedent::Any)
+                    .count()
+                    >= 2
+        });
+        match (needs, found) {
+            (Some((_, &rule_line)), Some((line, value))) => Err(error(
+                line,
+                format!(
+                    "expected {key}={}, found {key}='{value}' (the rule at line {rule_line} needs it)",
+                    list.join(" or ")
+                ),
+            )),
+            (Some((_, &rule_line)), None) => Err(error(
+                rule_line,
+                format!(
+                    "this rule combines inputs but [System] has no {key}= line; expected {key}={}",
+                    list.join(" or ")
+                ),
+            )),
+            (None, Some((line, value))) => {
+                note(
+                    notes,
+                    line,
+                    format!(
+                        "{key}='{value}' is not used by any rule (none combines two inputs with it); \
+                         written back as '{}'",
+                        options[0].0
+                    ),
+                );
+                Ok(T::default())
+            }
+            (None, None) => Ok(T::default()),
+        }
     }
 }
 
@@ -382,15 +550,21 @@ struct Keys<'a> {
     section: String,
     header: usize,
     entries: Vec<(&'a str, &'a str, usize)>,
+    /// The `MFk` lines, in file order (MATLAB's `readfis` reads them by position).
+    function_entries: Vec<(&'a str, &'a str, usize)>,
+    /// Keys outside the format (fuzzylite's `Enabled`, ...), with their lines: ignored.
+    ignored: Vec<(&'a str, usize)>,
 }
 
 impl<'a> Keys<'a> {
     /// Collects the entries; `allowed` lists the plain keys, and `with_functions` allows the
-    /// `MF1`, `MF2`, ... keys too (checked later against `NumMFs`).
+    /// `MF1`, `MF2`, ... keys too (counted later against `NumMFs`). Other keys made of letters,
+    /// digits and `_` are ignored, with a note; anything else is an error.
     fn new(
         section: &Section<'a>,
         allowed: &[&str],
         with_functions: bool,
+        notes: &mut Vec<FisNote>,
     ) -> Result<Self, FuzzyError> {
         let title = match section.kind {
             SectionKind::System => "[System]".to_string(),
@@ -399,6 +573,8 @@ impl<'a> Keys<'a> {
             SectionKind::Rules => "[Rules]".to_string(),
         };
         let mut entries: Vec<(&str, &str, usize)> = Vec::new();
+        let mut function_entries = Vec::new();
+        let mut ignored = Vec::new();
         for line in &section.lines {
             let Some((key, value)) = line.text.split_once('=') else {
                 return Err(error(
@@ -410,16 +586,38 @@ impl<'a> Keys<'a> {
             let is_mf = with_functions
                 && key
                     .strip_prefix("MF")
-                    .is_some_and(|k| k.parse::<usize>().is_ok_and(|k| k >= 1));
+                    .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()));
             if !allowed.contains(&key) && !is_mf {
                 let mut expected = allowed.join(", ");
                 if with_functions {
                     expected.push_str(", MF1, MF2, ...");
                 }
-                return Err(error(
+                if key.is_empty() || !key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+                    return Err(error(
+                        line.number,
+                        format!("unknown key `{key}` in {title}; expected one of {expected}"),
+                    ));
+                }
+                let consequence = if key == "Default" {
+                    "where no rule fires, the evaluator's no-rule-fired policy applies instead \
+                     (by default MATLAB's middle of the range)"
+                } else {
+                    "the system is evaluated as MATLAB evaluates it"
+                };
+                note(
+                    notes,
                     line.number,
-                    format!("unknown key `{key}` in {title}; expected one of {expected}"),
-                ));
+                    format!(
+                        "`{key}={}` in {title} is not a MATLAB key; ignored ({consequence})",
+                        value.trim()
+                    ),
+                );
+                ignored.push((key, line.number));
+                continue;
+            }
+            if is_mf {
+                function_entries.push((key, value.trim(), line.number));
+                continue;
             }
             if let Some((_, _, first)) = entries.iter().find(|(k, _, _)| *k == key) {
                 return Err(error(
@@ -433,16 +631,32 @@ impl<'a> Keys<'a> {
             section: title,
             header: section.header,
             entries,
+            function_entries,
+            ignored,
         })
     }
 
-    /// The value and line of a required key.
-    fn get(&self, key: &str) -> Result<(usize, &'a str), FuzzyError> {
+    /// The line and value of a key, if present.
+    fn find(&self, key: &str) -> Option<(usize, &'a str)> {
         self.entries
             .iter()
             .find(|(k, _, _)| *k == key)
             .map(|&(_, value, line)| (line, value))
-            .ok_or_else(|| error(self.header, format!("{} has no {key}= line", self.section)))
+    }
+
+    /// The value and line of a required key; a missing key's message points at the ignored
+    /// unknown keys, in case one of them is a misspelling.
+    fn get(&self, key: &str) -> Result<(usize, &'a str), FuzzyError> {
+        self.find(key).ok_or_else(|| {
+            let mut message = format!("{} has no {key}= line", self.section);
+            if let Some((unknown, line)) = self.ignored.first() {
+                let _ = write!(
+                    message,
+                    " (the unknown key `{unknown}` at line {line} was ignored)"
+                );
+            }
+            error(self.header, message)
+        })
     }
 
     /// A `'quoted'` value.
@@ -461,11 +675,16 @@ impl<'a> Keys<'a> {
         Ok((line, text))
     }
 
-    /// A non-negative integer of at least `min`.
+    /// A non-negative integer of at least `min`, written as an integer or an integer-valued
+    /// decimal (`3.000`), as MATLAB's `readfis` reads it.
     fn count(&self, key: &str, min: usize) -> Result<usize, FuzzyError> {
         let (line, value) = self.get(key)?;
-        match value.parse::<usize>() {
-            Ok(n) if n >= min => Ok(n),
+        let n = value
+            .parse::<usize>()
+            .ok()
+            .or_else(|| integer(value).and_then(|n| usize::try_from(n).ok()));
+        match n {
+            Some(n) if n >= min => Ok(n),
             _ => Err(error(
                 line,
                 format!("expected {key}=<integer >= {min}>, found {key}={value}"),
@@ -495,15 +714,51 @@ impl<'a> Keys<'a> {
             })
     }
 
-    /// `[min max]`, finite with `min < max`.
-    fn range(&self) -> Result<[f64; 2], FuzzyError> {
+    /// An optional quoted AND or OR method: one of `options`, or another value to be checked
+    /// against the rules by [`Method::resolve`].
+    fn method<T: Copy>(
+        &self,
+        key: &'static str,
+        options: &'a [(&'a str, T)],
+    ) -> Result<Method<'a, T>, FuzzyError> {
+        let found = match self.find(key) {
+            Some(_) => Some(self.string(key)?),
+            None => None,
+        };
+        let known = found.and_then(|(_, value)| {
+            options
+                .iter()
+                .find(|(name, _)| *name == value)
+                .map(|&(_, v)| v)
+        });
+        Ok(match known {
+            Some(method) => Method::Known(method),
+            None => Method::Other {
+                key,
+                found,
+                options,
+            },
+        })
+    }
+
+    /// `[min max]`, finite with `min < max`, or `min <= max` for an output (`point_allowed`).
+    fn range(&self, point_allowed: bool) -> Result<[f64; 2], FuzzyError> {
         let (line, value) = self.get("Range")?;
         let numbers = bracketed(value).map_err(|m| error(line, format!("Range: {m}")))?;
         match numbers[..] {
-            [min, max] if min.is_finite() && max.is_finite() && min < max => Ok([min, max]),
+            [min, max]
+                if min.is_finite()
+                    && max.is_finite()
+                    && (min < max || point_allowed && min == max) =>
+            {
+                Ok([min, max])
+            }
             [min, max] => Err(error(
                 line,
-                format!("Range must be finite with min < max, found [{min} {max}]"),
+                format!(
+                    "Range must be finite with min {} max, found [{min} {max}]",
+                    if point_allowed { "<=" } else { "<" }
+                ),
             )),
             _ => Err(error(
                 line,
@@ -512,31 +767,45 @@ impl<'a> Keys<'a> {
         }
     }
 
-    /// The `NumMFs` entries `MF1`..`MFn`, with unique names.
-    fn functions(&self) -> Result<Vec<FunctionLine<'a>>, FuzzyError> {
-        let n = self.count("NumMFs", 1)?;
-        if let Some(&(key, _, line)) = self.entries.iter().find(|(k, _, _)| {
-            k.strip_prefix("MF")
-                .and_then(|d| d.parse::<usize>().ok())
-                .is_some_and(|k| k > n)
-        }) {
-            return Err(error(line, format!("{key} but NumMFs={n}")));
+    /// The `NumMFs` (at least `min`) functions. Like MATLAB's `readfis`, the k-th `MF` line
+    /// is function k whatever its key says (MATLAB's own `slcp1.fis` has two `MF2` lines); a
+    /// key that disagrees with its position is noted. Names may repeat, as in MATLAB.
+    fn functions(
+        &self,
+        min: usize,
+        notes: &mut Vec<FisNote>,
+    ) -> Result<Vec<FunctionLine<'a>>, FuzzyError> {
+        let n = self.count("NumMFs", min)?;
+        if self.function_entries.len() != n {
+            let (line, _) = self.get("NumMFs")?;
+            return Err(error(
+                line,
+                format!(
+                    "NumMFs={n} but {} has {} MF lines",
+                    self.section,
+                    self.function_entries.len()
+                ),
+            ));
         }
-        // No capacity from `n`: it is untrusted (a missing MFk= line ends the loop early).
-        let mut functions: Vec<FunctionLine<'a>> = Vec::new();
-        for k in 1..=n {
-            let (line, value) = self.get(&format!("MF{k}"))?;
+        let mut functions: Vec<FunctionLine<'a>> = Vec::with_capacity(n);
+        for (index, &(key, value, line)) in self.function_entries.iter().enumerate() {
+            let k = index + 1;
+            if key != format!("MF{k}") {
+                note(
+                    notes,
+                    line,
+                    format!(
+                        "`{key}` is the MF line number {k} of {}: read as MF{k}, by position, as MATLAB's readfis does",
+                        self.section
+                    ),
+                );
+            }
             let (name, kind, params) =
                 function(value).map_err(|m| error(line, format!("MF{k}: {m}")))?;
             check_name("set", name).map_err(|m| error(line, m))?;
-            if functions.iter().any(|f| f.name == name) {
-                return Err(error(
-                    line,
-                    format!("two functions of {} are named '{name}'", self.section),
-                ));
-            }
             functions.push(FunctionLine {
                 line,
+                key: k,
                 name,
                 kind,
                 params,
@@ -549,9 +818,43 @@ impl<'a> Keys<'a> {
 /// One `MFk='name':'type',[params]` line.
 struct FunctionLine<'a> {
     line: usize,
+    /// `k`.
+    key: usize,
     name: &'a str,
     kind: &'a str,
     params: Vec<f64>,
+}
+
+impl FunctionLine<'_> {
+    /// Keeps the leading `needed` parameters, as MATLAB does, noting the ignored rest.
+    fn leading_params(&mut self, needed: usize, section: &str, notes: &mut Vec<FisNote>) {
+        if self.params.len() > needed {
+            let extra = self.params.split_off(needed);
+            note(
+                notes,
+                self.line,
+                format!(
+                    "{section} MF{} '{}': '{}' takes {needed} parameter{}; the extra {} ignored, as MATLAB does",
+                    self.key,
+                    self.name,
+                    self.kind,
+                    if needed == 1 { "" } else { "s" },
+                    format_params(&extra)
+                ),
+            );
+        }
+    }
+}
+
+/// An integer written as such or as an integer-valued decimal (`1.000`, `2e0`), within
+/// `±2^53`; `None` otherwise.
+fn integer(text: &str) -> Option<i64> {
+    const EXACT: f64 = 9_007_199_254_740_992.0; // 2^53
+    let text = text.trim();
+    text.parse::<i64>().ok().or_else(|| {
+        let x = text.parse::<f64>().ok()?;
+        (x.is_finite() && x.fract() == 0.0 && x.abs() <= EXACT).then_some(x as i64)
+    })
 }
 
 /// Parses the variable's `Name=` and checks it is new.
@@ -574,28 +877,25 @@ fn variable_name<'a>(
 fn parse_input(
     section: &Section<'_>,
     names: &mut Vec<(String, usize)>,
+    notes: &mut Vec<FisNote>,
 ) -> Result<InputVariable, FuzzyError> {
-    let keys = Keys::new(section, &["Name", "Range", "NumMFs"], true)?;
+    let keys = Keys::new(section, &["Name", "Range", "NumMFs"], true, notes)?;
     let name = variable_name(&keys, names)?;
-    let range = keys.range()?;
+    let range = keys.range(false)?;
     let sets = keys
-        .functions()?
+        .functions(0, notes)?
         .into_iter()
-        .map(
-            |FunctionLine {
-                 line,
-                 name: set,
-                 kind,
-                 params,
-             }| {
-                let membership = MembershipFn::from_matlab(kind, &params)
-                    .map_err(|e| error(line, e.to_string()))?;
-                Ok(FuzzySet {
-                    name: set.to_string(),
-                    membership,
-                })
-            },
-        )
+        .map(|mut function| {
+            if let Some(needed) = MembershipFn::matlab_parameter_count(function.kind) {
+                function.leading_params(needed, &keys.section, notes);
+            }
+            let membership = MembershipFn::from_matlab(function.kind, &function.params)
+                .map_err(|e| error(function.line, e.to_string()))?;
+            Ok(FuzzySet {
+                name: function.name.to_string(),
+                membership,
+            })
+        })
         .collect::<Result<Vec<_>, FuzzyError>>()?;
     Ok(InputVariable {
         name: name.to_string(),
@@ -608,37 +908,48 @@ fn parse_output(
     section: &Section<'_>,
     n_inputs: usize,
     names: &mut Vec<(String, usize)>,
+    notes: &mut Vec<FisNote>,
 ) -> Result<OutputVariable, FuzzyError> {
-    let keys = Keys::new(section, &["Name", "Range", "NumMFs"], true)?;
+    let keys = Keys::new(section, &["Name", "Range", "NumMFs"], true, notes)?;
     let name = variable_name(&keys, names)?;
-    let range = keys.range()?;
+    let range = keys.range(true)?;
     let terms = keys
-        .functions()?
+        .functions(1, notes)?
         .into_iter()
-        .map(|FunctionLine { line, name: term, kind, params }| {
-            let function = match (kind, params.len()) {
-                ("constant", 1) => OutputFn::Constant(params[0]),
-                ("linear", n) if n == n_inputs + 1 => {
-                    OutputFn::Linear { coefficients: params[..n_inputs].to_vec(), constant: params[n_inputs] }
-                }
-                ("constant", n) => return Err(error(line, format!("'constant' takes 1 parameter, found {n}"))),
-                ("linear", n) => {
-                    return Err(error(
-                        line,
-                        format!("'linear' takes NumInputs + 1 = {} parameters [p1 ... pn r], found {n}", n_inputs + 1),
-                    ));
-                }
-                (other, _) => {
+        .map(|mut f| {
+            let line = f.line;
+            let needed = match f.kind {
+                "constant" => 1,
+                "linear" => n_inputs + 1,
+                other => {
                     return Err(error(
                         line,
                         format!("a Sugeno output function must be 'constant' or 'linear', found '{other}'"),
                     ));
                 }
             };
+            if f.params.len() < needed {
+                let found = f.params.len();
+                return Err(error(
+                    line,
+                    if needed == 1 {
+                        format!("'constant' takes 1 parameter, found {found}")
+                    } else {
+                        format!("'linear' takes NumInputs + 1 = {needed} parameters [p1 ... pn r], found {found}")
+                    },
+                ));
+            }
+            f.leading_params(needed, &keys.section, notes);
+            let params = f.params;
             if params.iter().any(|p| !p.is_finite()) {
                 return Err(error(line, format!("parameters must be finite, found {}", format_params(&params))));
             }
-            Ok(OutputTerm { name: term.to_string(), function })
+            let function = if f.kind == "constant" {
+                OutputFn::Constant(params[0])
+            } else {
+                OutputFn::Linear { coefficients: params[..n_inputs].to_vec(), constant: params[n_inputs] }
+            };
+            Ok(OutputTerm { name: f.name.to_string(), function })
         })
         .collect::<Result<Vec<_>, FuzzyError>>()?;
     Ok(OutputVariable {
@@ -648,7 +959,8 @@ fn parse_output(
     })
 }
 
-/// Parses `i1 i2 ... in, o1 ... om (weight) : connective`.
+/// Parses `i1 i2 ... in, o1 ... om (weight) : connective`; indices and the connective may be
+/// written as integer-valued decimals (`1.000`, fuzzylite).
 fn parse_rule(
     line: Line<'_>,
     inputs: &[InputVariable],
@@ -678,8 +990,14 @@ fn parse_rule(
         let values = text
             .split_whitespace()
             .map(|t| {
-                t.parse::<i64>()
-                    .map_err(|_| fail(format!("expected an integer {what} index, found `{t}`")))
+                integer(t).ok_or_else(|| {
+                    let hedge = if t.parse::<f64>().is_ok_and(f64::is_finite) {
+                        " (fuzzylite writes hedges such as `very` as fractions; they are not supported)"
+                    } else {
+                        ""
+                    };
+                    fail(format!("expected an integer {what} index, found `{t}`{hedge}"))
+                })
             })
             .collect::<Result<Vec<_>, _>>()?;
         if values.len() != expected {
@@ -712,12 +1030,13 @@ fn parse_rule(
             "expected a rule weight between the parentheses, found `{weight_text}`"
         ))
     })?;
-    let connective = match connective.trim() {
-        "1" => Connective::And,
-        "2" => Connective::Or,
-        other => {
+    let connective = match integer(connective) {
+        Some(1) => Connective::And,
+        Some(2) => Connective::Or,
+        _ => {
             return Err(fail(format!(
-                "expected connective 1 (AND) or 2 (OR) after `:`, found `{other}`"
+                "expected connective 1 (AND) or 2 (OR) after `:`, found `{}`",
+                connective.trim()
             )));
         }
     };
@@ -742,7 +1061,7 @@ fn quoted(value: &str) -> Result<(&str, &str), String> {
     Ok((&inner[..end], &inner[end + 1..]))
 }
 
-/// Parses `[a b c]` (spaces or commas between the numbers).
+/// Parses `[a b c]` (spaces or commas between the numbers; each a [`number`]).
 fn bracketed(value: &str) -> Result<Vec<f64>, String> {
     let inner = value
         .trim()
@@ -752,11 +1071,54 @@ fn bracketed(value: &str) -> Result<Vec<f64>, String> {
     inner
         .split(|c: char| c.is_whitespace() || c == ',')
         .filter(|t| !t.is_empty())
-        .map(|t| {
-            t.parse::<f64>()
-                .map_err(|_| format!("expected a number, found `{t}`"))
-        })
+        .map(|t| number(t).ok_or_else(|| format!("expected a number, found `{t}`")))
         .collect()
+}
+
+/// A number, or the products and quotients of numbers and `pi` that MATLAB's `readfis`
+/// evaluates in its examples (`Range = [-pi/4 pi/4]`): `[+-]factor ([*/] [+-]factor)*` with
+/// each factor a decimal or `pi`.
+fn number(token: &str) -> Option<f64> {
+    let factor = |text: &str| -> Option<f64> {
+        let (sign, magnitude) = match text.strip_prefix('-') {
+            Some(rest) => (-1.0, rest),
+            None => (1.0, text.strip_prefix('+').unwrap_or(text)),
+        };
+        let value = if magnitude == "pi" {
+            std::f64::consts::PI
+        } else if magnitude.starts_with(['+', '-']) {
+            return None;
+        } else {
+            magnitude.parse::<f64>().ok()?
+        };
+        Some(sign * value)
+    };
+    if let Ok(x) = token.parse::<f64>() {
+        return Some(x);
+    }
+    let mut operators = token.match_indices(['*', '/']);
+    let mut start = 0;
+    let mut value: Option<f64> = None;
+    let mut pending = '*';
+    loop {
+        let (end, next) = match operators.next() {
+            Some((index, op)) => (index, op.chars().next()),
+            None => (token.len(), None),
+        };
+        let x = factor(&token[start..end])?;
+        value = Some(match (value, pending) {
+            (None, _) => x,
+            (Some(v), '*') => v * x,
+            (Some(v), _) => v / x,
+        });
+        match next {
+            Some(op) => {
+                pending = op;
+                start = end + 1;
+            }
+            None => return value,
+        }
+    }
 }
 
 /// Parses `'name':'type',[params]`.
@@ -872,12 +1234,36 @@ mod tests {
                 "line 30: rule weight must lie in [0, 1], got 1.5",
             ),
             (
-                TINY.replace("AndMethod='prod'", "AndMethod='mean'"),
-                "line 8: expected AndMethod='prod' or 'min', found AndMethod='mean'",
+                TINY.replace("DefuzzMethod='wtaver'", "DefuzzMethod='centroid'"),
+                "line 12: expected DefuzzMethod='wtaver' or 'wtsum', found DefuzzMethod='centroid'",
             ),
             (
-                TINY.replace("ImpMethod='prod'", "ImpMethod='min'"),
-                "line 10: expected ImpMethod='prod', found ImpMethod='min'",
+                TINY.replace("-2, 2 (1) : 1", "-2, 2 (1) : 1 x"),
+                "line 30: expected connective 1 (AND) or 2 (OR) after `:`, found `1 x`",
+            ),
+            (
+                TINY.replace("-2, 2 (1) : 1", "-2.5, 2 (1) : 1"),
+                "line 30: expected an integer input index, found `-2.5` (fuzzylite writes hedges",
+            ),
+            (
+                TINY.replace("NumMFs=2\nMF1='low'", "NumMFs=2.5\nMF1='low'"),
+                "line 17: expected NumMFs=<integer >= 0>, found NumMFs=2.5",
+            ),
+            (
+                TINY.replace("[4 5]", "[4]"),
+                "line 19: gaussmf: expected 2 parameters, got 1",
+            ),
+            (
+                TINY.replace("'constant',[0.5]", "'constant',[]"),
+                "line 26: 'constant' takes 1 parameter, found 0",
+            ),
+            (
+                TINY.replace("NumMFs=2\nMF1='low'", "NumMFs=3\nMF1='low'"),
+                "line 17: NumMFs=3 but [Input1] has 2 MF lines",
+            ),
+            (
+                TINY.replace("Name='y'", "Na me='y'"),
+                "line 22: unknown key `Na me` in [Output1]",
             ),
             (
                 TINY.replace("NumInputs=1", "NumInputs=x"),
@@ -893,11 +1279,11 @@ mod tests {
             ),
             (
                 TINY.replace("Name='y'", "Nome='y'"),
-                "line 22: unknown key `Nome` in [Output1]; expected one of Name, Range, NumMFs, MF1, MF2, ...",
+                "line 21: [Output1] has no Name= line (the unknown key `Nome` at line 22 was ignored)",
             ),
             (
-                TINY.replace("MF2='line2'", "MF3='line2'"),
-                "line 26: MF3 but NumMFs=2",
+                TINY.replace("MF2='line2'", "MF2='line2'\nMF3='line3':'constant',[1]"),
+                "line 24: NumMFs=2 but [Output1] has 3 MF lines",
             ),
             (
                 TINY.replace("[Output1]", "[Output2]"),
@@ -947,6 +1333,26 @@ mod tests {
     }
 
     #[test]
+    fn functions_are_read_by_position_as_matlab_does() {
+        // MATLAB's slcp1.fis numbers its third function MF2 again; readfis goes by position.
+        let misnumbered = TINY.replace("MF2='high'", "MF1='high'");
+        let (system, notes) = FuzzySystem::from_fis_with_notes(&misnumbered).unwrap();
+        assert_eq!(system, FuzzySystem::from_fis(TINY).unwrap());
+        assert_eq!(notes.len(), 1);
+        assert_eq!(
+            notes[0].to_string(),
+            "line 19: `MF1` is the MF line number 2 of [Input1]: read as MF2, by position, as MATLAB's readfis does"
+        );
+        // Swapped keys: the first line is the first function, whatever its key.
+        let swapped = TINY
+            .replace("MF1='low'", "MF9='low'")
+            .replace("MF2='high'", "MF1='high'");
+        let (system, notes) = FuzzySystem::from_fis_with_notes(&swapped).unwrap();
+        assert_eq!(system.inputs()[0].sets[0].name, "low");
+        assert_eq!(notes.len(), 2);
+    }
+
+    #[test]
     fn mamdani_files_are_refused_by_name() {
         let mamdani = TINY
             .replace("Type='sugeno'", "Type='mamdani'")
@@ -959,6 +1365,30 @@ mod tests {
             parse_error(&TINY.replace("'sugeno'", "'tsk'")),
             "line 3: expected Type='sugeno', found Type='tsk'"
         );
+    }
+
+    #[test]
+    fn numbers_may_be_written_as_matlab_expressions_of_pi() {
+        use std::f64::consts::PI;
+        let cases = [
+            ("-pi/4", Some(-PI / 4.0)),
+            ("pi", Some(PI)),
+            ("+pi", Some(PI)),
+            ("2*pi", Some(2.0 * PI)),
+            ("pi/-2", Some(PI / -2.0)),
+            ("3/4*pi", Some(3.0 / 4.0 * PI)),
+            ("1e-3", Some(1e-3)),
+            ("0.250", Some(0.25)),
+            ("pi/", None),
+            ("*2", None),
+            ("--1", None),
+            ("p", None),
+            ("pi+1", None),
+        ];
+        for (text, expected) in cases {
+            assert_eq!(number(text), expected, "{text}");
+        }
+        assert_eq!(bracketed("[-pi/4, pi/4]").unwrap(), [-PI / 4.0, PI / 4.0]);
     }
 
     #[test]

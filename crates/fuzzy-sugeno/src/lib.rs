@@ -7,7 +7,9 @@
 //! - MATLAB's membership functions, validated when a system is built ([`MembershipFn`]);
 //! - allocation-free evaluation with explicit policies for out-of-range inputs and for outputs
 //!   on which no rule fires, per-rule firing strengths and a batch API ([`Evaluator`]);
-//! - MATLAB `.fis` read and write ([`FuzzySystem::from_fis`], [`FuzzySystem::to_fis`]);
+//! - MATLAB `.fis` read and write ([`FuzzySystem::from_fis`], [`FuzzySystem::to_fis`]),
+//!   reading the habits of files from older MATLAB releases, Octave and fuzzylite, with notes of
+//!   what was accepted but ignored ([`FuzzySystem::from_fis_with_notes`], [`FisNote`]);
 //! - export as self-contained C99 ([`FuzzySystem::to_c`]); IEC 61131-7 FCL read and write
 //!   ([`FuzzySystem::from_fcl`], [`FuzzySystem::to_fcl`]);
 //! - systems learned from data, `genfis` and ANFIS training ([`learn`]);
@@ -50,6 +52,7 @@ pub use builder::SystemBuilder;
 pub use error::FuzzyError;
 pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange};
 pub use export_c::CSource;
+pub use fis::FisNote;
 pub use membership::MembershipFn;
 pub use paper::{PaperController, paper_controller};
 pub use system::{

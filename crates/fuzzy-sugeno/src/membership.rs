@@ -95,6 +95,36 @@ pub enum MembershipFn {
         /// `c2`: the second sigmoid's crossover.
         center2: f64,
     },
+    /// `smf [a b]`: MATLAB's S-shaped spline, 0 up to `a`, `2 ((x - a) / (b - a))^2` up to the
+    /// midpoint `(a + b) / 2`, `1 - 2 ((b - x) / (b - a))^2` up to `b`, then 1. With `a >= b`
+    /// it is MATLAB's step: 1 where `x >= (a + b) / 2`, else 0.
+    SShape {
+        /// `a`: the foot, where the rise starts.
+        start: f64,
+        /// `b`: the shoulder, where the rise ends.
+        end: f64,
+    },
+    /// `zmf [a b]`: MATLAB's Z-shaped spline, the mirror image of `smf`: 1 up to `a`,
+    /// `1 - 2 ((x - a) / (b - a))^2` up to `(a + b) / 2`, `2 ((b - x) / (b - a))^2` up to `b`,
+    /// then 0. With `a >= b` it is MATLAB's step: 1 where `x <= (a + b) / 2`, else 0.
+    ZShape {
+        /// `a`: the shoulder, where the fall starts.
+        start: f64,
+        /// `b`: the foot, where the fall ends.
+        end: f64,
+    },
+    /// `pimf [a b c d]`: MATLAB's product `smf(x, [a b]) * zmf(x, [c d])`, a smooth trapezoid
+    /// (0 below `a` and above `d`, 1 on `[b, c]` when `b <= c`).
+    PiShape {
+        /// `a`: the left foot.
+        left_foot: f64,
+        /// `b`: the left shoulder.
+        left_shoulder: f64,
+        /// `c`: the right shoulder.
+        right_shoulder: f64,
+        /// `d`: the right foot.
+        right_foot: f64,
+    },
     /// `constant [k]`: the same degree `k in [0, 1]` everywhere (written as `'constant'` in an
     /// input section of a `.fis` file; MATLAB itself uses that name only for Sugeno outputs).
     Constant {
@@ -149,6 +179,9 @@ impl MembershipFn {
             Self::Sigmoid { .. } => "sigmf",
             Self::SigmoidDifference { .. } => "dsigmf",
             Self::SigmoidProduct { .. } => "psigmf",
+            Self::SShape { .. } => "smf",
+            Self::ZShape { .. } => "zmf",
+            Self::PiShape { .. } => "pimf",
             Self::Constant { .. } => "constant",
         }
     }
@@ -195,7 +228,36 @@ impl MembershipFn {
                 slope2,
                 center2,
             } => ([slope1, center1, slope2, center2], 4),
+            Self::SShape { start, end } | Self::ZShape { start, end } => {
+                ([start, end, 0.0, 0.0], 2)
+            }
+            Self::PiShape {
+                left_foot,
+                left_shoulder,
+                right_shoulder,
+                right_foot,
+            } => ([left_foot, left_shoulder, right_shoulder, right_foot], 4),
             Self::Constant { value } => ([value, 0.0, 0.0, 0.0], 1),
+        }
+    }
+
+    /// How many parameters MATLAB's type `name` takes (`None` for an unknown type). A `.fis`
+    /// file may list more; MATLAB, and [`FuzzySystem::from_fis`](crate::FuzzySystem::from_fis),
+    /// use the leading ones.
+    ///
+    /// ```
+    /// use fuzzy_sugeno::MembershipFn;
+    /// assert_eq!(MembershipFn::matlab_parameter_count("gbellmf"), Some(3));
+    /// assert_eq!(MembershipFn::matlab_parameter_count("pimf"), Some(4));
+    /// assert_eq!(MembershipFn::matlab_parameter_count("rampmf"), None);
+    /// ```
+    pub fn matlab_parameter_count(name: &str) -> Option<usize> {
+        match name {
+            "gbellmf" | "trimf" => Some(3),
+            "gaussmf" | "sigmf" | "smf" | "zmf" => Some(2),
+            "gauss2mf" | "trapmf" | "dsigmf" | "psigmf" | "pimf" => Some(4),
+            "constant" => Some(1),
+            _ => None,
         }
     }
 
@@ -209,19 +271,14 @@ impl MembershipFn {
     /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
     /// ```
     pub fn from_matlab(name: &str, params: &[f64]) -> Result<Self, FuzzyError> {
-        let expected = match name {
-            "gbellmf" | "trimf" => 3,
-            "gaussmf" | "sigmf" => 2,
-            "gauss2mf" | "trapmf" | "dsigmf" | "psigmf" => 4,
-            "constant" => 1,
-            _ => {
-                return Err(FuzzyError::InvalidMembership {
-                    function: name.to_string(),
-                    reason: "unknown membership function type; expected one of gbellmf, gaussmf, gauss2mf, \
-                             trimf, trapmf, sigmf, dsigmf, psigmf, constant"
+        let Some(expected) = Self::matlab_parameter_count(name) else {
+            return Err(FuzzyError::InvalidMembership {
+                function: name.to_string(),
+                reason:
+                    "unknown membership function type; expected one of trimf, trapmf, gaussmf, \
+                         gauss2mf, gbellmf, sigmf, dsigmf, psigmf, smf, zmf, pimf, constant"
                         .to_string(),
-                });
-            }
+            });
         };
         if params.len() != expected {
             return Err(FuzzyError::InvalidMembership {
@@ -260,6 +317,20 @@ impl MembershipFn {
                 center1: p[1],
                 slope2: p[2],
                 center2: p[3],
+            },
+            "smf" => Self::SShape {
+                start: p[0],
+                end: p[1],
+            },
+            "zmf" => Self::ZShape {
+                start: p[0],
+                end: p[1],
+            },
+            "pimf" => Self::PiShape {
+                left_foot: p[0],
+                left_shoulder: p[1],
+                right_shoulder: p[2],
+                right_foot: p[3],
             },
             _ => Self::Constant { value: p[0] },
         }
@@ -417,6 +488,12 @@ pub(crate) enum CompiledMf {
         slope2: f64,
         center2: f64,
     },
+    /// `smf`, or its step when `a >= b`.
+    SShape { start: f64, end: f64 },
+    /// `zmf`, or its step when `a >= b`.
+    ZShape { start: f64, end: f64 },
+    /// `pimf`: `smf(x, [a b]) * zmf(x, [c d])`.
+    PiShape { a: f64, b: f64, c: f64, d: f64 },
     /// `constant`.
     Constant(f64),
 }
@@ -500,6 +577,19 @@ impl CompiledMf {
                 center1,
                 slope2,
                 center2,
+            },
+            MembershipFn::SShape { start, end } => Self::SShape { start, end },
+            MembershipFn::ZShape { start, end } => Self::ZShape { start, end },
+            MembershipFn::PiShape {
+                left_foot,
+                left_shoulder,
+                right_shoulder,
+                right_foot,
+            } => Self::PiShape {
+                a: left_foot,
+                b: left_shoulder,
+                c: right_shoulder,
+                d: right_foot,
             },
             MembershipFn::Constant { value } => Self::Constant(value),
         })
@@ -588,8 +678,53 @@ impl CompiledMf {
                 slope2,
                 center2,
             } => sigmoid(x, slope1, center1) * sigmoid(x, slope2, center2),
+            Self::SShape { start, end } => s_shape(x, start, end),
+            Self::ZShape { start, end } => z_shape(x, start, end),
+            Self::PiShape { a, b, c, d } => s_shape(x, a, b) * z_shape(x, c, d),
             Self::Constant(value) => value,
         }
+    }
+}
+
+/// MATLAB's `smf(x, [a b])`: the quadratic spline from 0 at `a` to 1 at `b` (value 1/2 at the
+/// midpoint), or the step `x >= (a + b) / 2` when `a >= b`.
+#[inline]
+fn s_shape(x: f64, a: f64, b: f64) -> f64 {
+    let middle = 0.5 * (a + b);
+    if a >= b {
+        return if x >= middle { 1.0 } else { 0.0 };
+    }
+    if x <= a {
+        0.0
+    } else if x <= middle {
+        let t = (x - a) / (b - a);
+        2.0 * t * t
+    } else if x <= b {
+        let t = (b - x) / (b - a);
+        1.0 - 2.0 * t * t
+    } else {
+        1.0
+    }
+}
+
+/// MATLAB's `zmf(x, [a b])`: the quadratic spline from 1 at `a` to 0 at `b`, or the step
+/// `x <= (a + b) / 2` when `a >= b`.
+#[inline]
+fn z_shape(x: f64, a: f64, b: f64) -> f64 {
+    let middle = 0.5 * (a + b);
+    if a >= b {
+        return if x <= middle { 1.0 } else { 0.0 };
+    }
+    if x <= a {
+        1.0
+    } else if x <= middle {
+        let t = (x - a) / (b - a);
+        1.0 - 2.0 * t * t
+    } else if x <= b {
+        let t = (b - x) / (b - a);
+        2.0 * t * t
+    } else {
+        0.0
     }
 }
 
@@ -786,6 +921,73 @@ mod tests {
     }
 
     #[test]
+    fn s_z_and_pi_shapes_follow_matlab_at_their_landmarks() {
+        let s = MembershipFn::SShape {
+            start: 1.0,
+            end: 3.0,
+        };
+        let z = MembershipFn::ZShape {
+            start: 1.0,
+            end: 3.0,
+        };
+        // Feet, midpoint (1/2), quarter points (2 (1/4)^2 = 1/8 and 1 - 1/8), shoulders.
+        let expect = [
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (1.5, 0.125),
+            (2.0, 0.5),
+            (2.5, 0.875),
+            (3.0, 1.0),
+            (9.0, 1.0),
+        ];
+        for (x, y) in expect {
+            assert_eq!(mu(s, x), y, "smf at {x}");
+            assert_eq!(mu(z, x), 1.0 - y, "zmf at {x}");
+        }
+        // a >= b: MATLAB's steps at (a + b) / 2, the midpoint itself included on both sides.
+        let step_up = MembershipFn::SShape {
+            start: 2.0,
+            end: 1.0,
+        };
+        let step_down = MembershipFn::ZShape {
+            start: 1.0,
+            end: 1.0,
+        };
+        assert_eq!((mu(step_up, 1.49), mu(step_up, 1.5)), (0.0, 1.0));
+        assert_eq!((mu(step_down, 1.0), mu(step_down, 1.01)), (1.0, 0.0));
+        // pimf is smf on the left times zmf on the right.
+        let pi = MembershipFn::PiShape {
+            left_foot: 0.0,
+            left_shoulder: 2.0,
+            right_shoulder: 4.0,
+            right_foot: 8.0,
+        };
+        for (x, y) in [
+            (-1.0, 0.0),
+            (0.5, 0.125),
+            (1.0, 0.5),
+            (3.0, 1.0),
+            (5.0, 0.875),
+            (6.0, 0.5),
+            (8.0, 0.0),
+        ] {
+            assert_eq!(mu(pi, x), y, "pimf at {x}");
+        }
+        for mf in [s, z, pi, step_up] {
+            assert_eq!(
+                MembershipFn::from_matlab(mf.matlab_name(), &mf.params()).unwrap(),
+                mf
+            );
+        }
+        assert!(
+            MembershipFn::from_matlab("smf", &[f64::NAN, 1.0])
+                .unwrap_err()
+                .to_string()
+                .starts_with("smf: parameters must be finite")
+        );
+    }
+
+    #[test]
     fn invalid_parameters_are_refused_with_the_reason() {
         let message = |mf: MembershipFn| mf.validate().unwrap_err().to_string();
         assert_eq!(
@@ -824,7 +1026,7 @@ mod tests {
         };
         assert!(message(g2).contains("sigma1 and sigma2 must be positive"));
         assert!(
-            MembershipFn::from_matlab("pimf", &[0.0; 4])
+            MembershipFn::from_matlab("rampmf", &[0.0; 2])
                 .unwrap_err()
                 .to_string()
                 .contains("unknown membership")
@@ -876,7 +1078,7 @@ mod tests {
     proptest! {
         #[test]
         fn every_degree_lies_in_the_unit_interval(
-            kind in 0usize..9, p in prop::array::uniform4(-3.0f64..3.0), x in -1e3f64..1e3,
+            kind in 0usize..12, p in prop::array::uniform4(-3.0f64..3.0), x in -1e3f64..1e3,
         ) {
             let mut sorted = p;
             sorted.sort_by(f64::total_cmp);
@@ -889,6 +1091,9 @@ mod tests {
                 5 => MembershipFn::sigmoid(p[0] * 10.0, p[1]),
                 6 => MembershipFn::SigmoidDifference { slope1: p[0], center1: p[1], slope2: p[2], center2: p[3] },
                 7 => MembershipFn::SigmoidProduct { slope1: p[0], center1: p[1], slope2: p[2], center2: p[3] },
+                8 => MembershipFn::SShape { start: p[0], end: p[1] },
+                9 => MembershipFn::ZShape { start: p[0], end: p[1] },
+                10 => MembershipFn::PiShape { left_foot: p[0], left_shoulder: p[1], right_shoulder: p[2], right_foot: p[3] },
                 _ => MembershipFn::Constant { value: p[0].abs() / 3.0 },
             };
             let y = mu(mf, x);

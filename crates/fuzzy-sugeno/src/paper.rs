@@ -223,15 +223,26 @@ mod tests {
             error.to_string(),
             "input 'da1' set 'N': gbellmf: slope b must be positive, got 0"
         );
+        // A flat table gives a point output range, which MATLAB accepts too (its juggler
+        // example has one): tau1 is then 1 everywhere. A non-finite torque is refused.
         let flat = PaperController {
             tau1: [1.0; 4],
             ..PaperController::default()
         }
         .build()
+        .unwrap();
+        assert_eq!(flat.outputs()[0].range, [1.0, 1.0]);
+        let infinite = PaperController {
+            tau1: [1.0, 2.0, 3.0, f64::INFINITY],
+            ..PaperController::default()
+        }
+        .build()
         .unwrap_err();
         assert!(
-            flat.to_string()
-                .starts_with("output 'tau1': range must be finite with min < max")
+            infinite
+                .to_string()
+                .starts_with("output 'tau1': range must be finite with min <= max"),
+            "{infinite}"
         );
     }
 

@@ -11,14 +11,18 @@ pub struct InputVariable {
     pub name: String,
     /// `[min, max]`, with `min < max`.
     pub range: [f64; 2],
-    /// The fuzzy sets ("terms") of the variable, in the order rules index them.
+    /// The fuzzy sets ("terms") of the variable, in the order rules index them. It may be empty
+    /// (MATLAB's `NumMFs=0`): such an input takes part only in first-order consequents, and
+    /// every rule must say "don't care" for it.
     pub sets: Vec<FuzzySet>,
 }
 
 /// A named fuzzy set of an input variable.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FuzzySet {
-    /// The set's name (unique within its variable), e.g. `"N"`.
+    /// The set's name, e.g. `"N"`. Names may repeat within a variable, as MATLAB allows (rules
+    /// refer to sets by index); [`SystemBuilder`](crate::SystemBuilder)'s named rules then
+    /// refuse the ambiguous name.
     pub name: String,
     /// Its membership function.
     pub membership: MembershipFn,
@@ -29,7 +33,8 @@ pub struct FuzzySet {
 pub struct OutputVariable {
     /// The variable's name (unique among all variables of a system).
     pub name: String,
-    /// `[min, max]`, with `min < max`; its middle is the default output when no rule fires.
+    /// `[min, max]`, with `min <= max` (MATLAB's examples include `[0 0]`); its middle is the
+    /// default output when no rule fires.
     pub range: [f64; 2],
     /// The consequent functions ("terms") of the variable, in the order rules index them.
     pub terms: Vec<OutputTerm>,
@@ -38,7 +43,7 @@ pub struct OutputVariable {
 /// A named consequent function of an output variable.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutputTerm {
-    /// The term's name (unique within its variable), e.g. `"VP"`.
+    /// The term's name, e.g. `"VP"`. Names may repeat within a variable, as for [`FuzzySet`].
     pub name: String,
     /// The consequent `z = f(x)`.
     pub function: OutputFn,
@@ -209,6 +214,7 @@ impl FuzzySystem {
                 input.range,
                 input.sets.iter().map(|s| s.name.as_str()),
                 &mut variable_names,
+                VariableKind::Input,
             )
             .map_err(|reason| invalid(&context, reason))?;
             for set in &input.sets {
@@ -224,6 +230,7 @@ impl FuzzySystem {
                 output.range,
                 output.terms.iter().map(|t| t.name.as_str()),
                 &mut variable_names,
+                VariableKind::Output,
             )
             .map_err(|reason| invalid(&context, reason))?;
             for term in &output.terms {
@@ -301,11 +308,22 @@ pub(crate) fn check_name(kind: &str, name: &str) -> Result<(), String> {
     }
 }
 
+/// Whether a variable is an input or an output, for [`check_variable`].
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum VariableKind {
+    /// May have no sets (`NumMFs=0`); its range must have `min < max`.
+    Input,
+    /// Needs at least one term; its range may be a point (`min = max`).
+    Output,
+}
+
+/// Checks a variable's name (new among `variable_names`), range and term names.
 fn check_variable<'a>(
     name: &'a str,
     range: [f64; 2],
     term_names: impl Iterator<Item = &'a str>,
     variable_names: &mut Vec<&'a str>,
+    kind: VariableKind,
 ) -> Result<(), String> {
     check_name("variable", name)?;
     if variable_names.contains(&name) {
@@ -313,20 +331,25 @@ fn check_variable<'a>(
     }
     variable_names.push(name);
     let [min, max] = range;
-    if !(min.is_finite() && max.is_finite() && min < max) {
+    let ordered = match kind {
+        VariableKind::Input => min < max,
+        VariableKind::Output => min <= max,
+    };
+    if !(min.is_finite() && max.is_finite() && ordered) {
+        let order = match kind {
+            VariableKind::Input => "min < max",
+            VariableKind::Output => "min <= max",
+        };
         return Err(format!(
-            "range must be finite with min < max, got [{min}, {max}]"
+            "range must be finite with {order}, got [{min}, {max}]"
         ));
     }
-    let mut seen: Vec<&str> = Vec::new();
+    let mut count = 0;
     for term in term_names {
         check_name("set", term)?;
-        if seen.contains(&term) {
-            return Err(format!("two sets are named '{term}'"));
-        }
-        seen.push(term);
+        count += 1;
     }
-    if seen.is_empty() {
+    if count == 0 && kind == VariableKind::Output {
         return Err("has no sets".to_string());
     }
     Ok(())

@@ -126,6 +126,19 @@ fn system_with_an_empty_or_non_finite_range() {
                 .contains("range must be finite with min < max")
         );
     }
+    // An output's range may be a point (MATLAB's juggler example has [0 0]), not reversed.
+    let output = |range| {
+        FuzzySystem::builder("output range")
+            .input("x", [0.0, 1.0], [("a", MembershipFn::gaussian(0.3, 0.0))])
+            .output("y", range, [("one", OutputFn::Constant(1.0))])
+            .rule(["a"], ["one"])
+            .build()
+    };
+    assert!(output([0.0, 0.0]).is_ok());
+    assert_eq!(
+        output([2.0, 1.0]).unwrap_err().to_string(),
+        "output 'y': range must be finite with min <= max, got [2, 1]"
+    );
 }
 
 #[test]

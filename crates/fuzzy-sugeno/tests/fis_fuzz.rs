@@ -39,6 +39,8 @@ const NUMBERS: &[&str] = &[
     "-9223372036854775808",
     "x",
     "",
+    "1.000",
+    "2.5",
 ];
 
 /// Whole lines a mutation may insert or put in place of another.
@@ -78,6 +80,17 @@ const LINES: &[&str] = &[
     "Range=[0]",
     "Range=[]",
     "MF1='X':'unknownmf',[1 2 3]",
+    "# comment",
+    "Enabled=1",
+    "LockRange = 0",
+    "AndMethod=''",
+    "OrMethod=''",
+    "ImpMethod='min'",
+    "AggMethod=''",
+    "MF1='X':'pimf',[1 2 3 4]",
+    "MF2='X':'smf',[2 1]",
+    "MF1 = 'X' : 'gbellmf', [1 2 3 4]",
+    "1.000 1.000 0 0, 1.000 0 (1.000) : 2.000",
     "MF3='Z':'trimf',[0 0 0]",
     "MF1='N':'gbellmf',[0 2 -0.3]",
     "MF1='N':'gbellmf',[1e308 1e308 1e308]",
@@ -356,7 +369,10 @@ mod regressions {
     #[test]
     fn a_huge_function_count_is_refused_without_allocating() {
         let text = PAPER_FIS.replacen("NumMFs=2", "NumMFs=18446744073709551615", 1);
-        assert_eq!(refused(&text), "line 14: [Input1] has no MF3= line");
+        assert_eq!(
+            refused(&text),
+            "line 17: NumMFs=18446744073709551615 but [Input1] has 2 MF lines"
+        );
     }
 
     #[test]

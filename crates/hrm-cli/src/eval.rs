@@ -7,14 +7,15 @@
 //! is documented in `docs/eval-protocol.md`.
 
 use backbone_kin::{
-    BaseAngle, Branch, KinError, ModalMap, end_point, inverse_kinematics, tip_position,
+    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, KinError, ModalMap, end_point,
+    inverse_kinematics, tip_position,
 };
 use fuzzy_sugeno::FuzzySystem;
 use manip_dyn::faer::Mat;
 use manip_dyn::{ChainData, ChainModel, DynError};
 use modal_reduce::{ReduceError, ReducedData, ReducedModel};
-use serde::Deserialize;
 use serde::de::DeserializeOwned;
+use serde::{Deserialize, Deserializer};
 use serde_json::{Map, Value, json};
 use sim_core::ArmSpec;
 use std::io::{BufRead, Write};
@@ -24,7 +25,11 @@ pub const MAX_LINE_BYTES: usize = 16 << 20;
 
 /// Serves stdin to stdout until end of input.
 pub fn run_stdio() -> Result<(), String> {
-    serve(std::io::stdin().lock(), std::io::stdout().lock()).map_err(|e| format!("eval: {e}"))
+    // A reader that went away (`hrm eval | head -1`) ends the stream quietly.
+    match serve(std::io::stdin().lock(), std::io::stdout().lock()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(format!("eval: {e}")),
+        _ => Ok(()),
+    }
 }
 
 /// Answers every line of `input` on `output`. Only I/O failures end the stream.
@@ -215,29 +220,109 @@ fn parse<T: DeserializeOwned>(request: Map<String, Value>) -> Result<T, EvalErro
         .map_err(|e| EvalError::new(Kind::InvalidRequest, e.to_string()))
 }
 
-/// Modal coordinates as requests give them: `[a1, a2, alpha0]`, or `[a1, a2]` with `"alpha0"`.
-fn modal_map(chain: &ChainModel, a: &[f64], alpha0: Option<f64>) -> Result<ModalMap, EvalError> {
-    let lengths: Vec<f64> = chain.link_lengths().collect();
+/// `"arm"`: an object of [`ArmSpec`] fields. Serde would also read a struct from an array of its
+/// fields in order, which no user means; anything but an object is refused.
+fn arm_object<'de, D: Deserializer<'de>>(deserializer: D) -> Result<ArmSpec, D::Error> {
+    match Value::deserialize(deserializer)? {
+        Value::Object(fields) => {
+            serde_json::from_value(Value::Object(fields)).map_err(serde::de::Error::custom)
+        }
+        other => Err(serde::de::Error::custom(format!(
+            "\"arm\" must be an object of arm fields, got {}",
+            json_type(&other)
+        ))),
+    }
+}
+
+/// The JSON type of a value, for messages.
+fn json_type(value: &Value) -> &'static str {
+    match value {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    }
+}
+
+/// An angle in `(-pi, pi]` equal to `alpha0` modulo `2 pi`. Values already there are kept bit for
+/// bit; larger ones are reduced through their sine and cosine, whose argument reduction is exact
+/// (reducing by the double nearest `2 pi` would be off by `alpha0 / 2 pi` times its rounding
+/// error, thousands of radians at `alpha0 = 1e20`). Only `alpha0` is reduced: it enters every
+/// answer only through the link angles' sines and cosines, but `theta_1 = alpha0 + ...` would
+/// otherwise lose the modal part in rounding.
+fn reduce_angle(alpha0: f64) -> f64 {
+    use std::f64::consts::PI;
+    if alpha0 > -PI && alpha0 <= PI {
+        alpha0
+    } else {
+        let (sin, cos) = alpha0.sin_cos();
+        sin.atan2(cos)
+    }
+}
+
+/// Most harmonics a request may ask for. A `K`-harmonic end point by quadrature costs up to
+/// `K` times [`backbone_kin::MAX_QUADRATURE_NODES`] basis evaluations, so this keeps one `fk`
+/// under about a second; the library's own limit ([`backbone_kin::MAX_HARMONICS`]) is far larger.
+const MAX_REQUEST_HARMONICS: usize = 64;
+
+/// Most harmonics an `ik` request may ask for: its solvers evaluate the end point and its
+/// Jacobian up to 100 times, for the curve and for the chain.
+const MAX_IK_HARMONICS: usize = 8;
+
+/// Largest magnitude of an `ik` guess entry (rad). The solvers are local and take steps of at
+/// most 0.5 rad, so this bounds the amplitudes they visit, and with them the quadrature's cost.
+const MAX_GUESS: f64 = 10.0;
+
+/// `"harmonics"`: `K >= 1` (default 1), at most `max`.
+fn harmonics(requested: Option<usize>, max: usize) -> Result<usize, EvalError> {
+    match requested.unwrap_or(1) {
+        0 => Err(EvalError::input("harmonics must be at least 1, got 0")),
+        k if k > max => Err(EvalError::input(format!(
+            "harmonics must be at most {max}, got {k}"
+        ))),
+        k => Ok(k),
+    }
+}
+
+/// Modal coordinates as requests give them: with `"alpha0"`, `a` has `2K` entries and `alpha0` is
+/// fixed; without it, `2K + 1` entries with `alpha0` last. Reduces `alpha0` (in `a` or the field)
+/// to `(-pi, pi]` and returns the modal map of the chain's own links.
+fn modal_map(
+    chain: &ChainModel,
+    a: &mut [f64],
+    alpha0: Option<f64>,
+    requested: Option<usize>,
+) -> Result<ModalMap, EvalError> {
+    let k = harmonics(requested, MAX_REQUEST_HARMONICS)?;
     let base = match (a.len(), alpha0) {
-        (3, None) => BaseAngle::Free,
-        (2, Some(alpha0)) => BaseAngle::Fixed(alpha0),
-        (3, Some(_)) => {
+        (len, Some(alpha0)) if len == 2 * k => BaseAngle::Fixed(reduce_angle(alpha0)),
+        (len, None) if len == 2 * k + 1 => {
+            a[2 * k] = reduce_angle(a[2 * k]);
+            BaseAngle::Free
+        }
+        (len, Some(_)) if len == 2 * k + 1 => {
             return Err(EvalError::input(
-                "give alpha0 either as a[2] or as \"alpha0\", not both",
+                "give alpha0 either as the last entry of a or as \"alpha0\", not both",
             ));
         }
-        (2, None) => {
-            return Err(EvalError::input(
-                "with two coordinates [a1, a2], \"alpha0\" is required",
-            ));
-        }
-        (k, _) => {
+        (len, None) if len == 2 * k => {
             return Err(EvalError::input(format!(
-                "a has {k} entries, expected [a1, a2, alpha0] or [a1, a2]"
+                "with {len} coordinates (2K, K = {k}), \"alpha0\" is required"
+            )));
+        }
+        (len, _) => {
+            return Err(EvalError::input(format!(
+                "a has {len} entries, expected 2K = {} with \"alpha0\" given, or 2K + 1 = {} \
+                 with alpha0 last (K = {k} harmonics)",
+                2 * k,
+                2 * k + 1
             )));
         }
     };
-    ModalMap::new(&lengths, 1, base).map_err(EvalError::input)
+    let lengths: Vec<f64> = chain.link_lengths().collect();
+    ModalMap::new(&lengths, k, base).map_err(EvalError::input)
 }
 
 /// Refuses to answer with a non-finite number (JSON has none).
@@ -251,10 +336,13 @@ fn finite(name: &str, values: &[f64]) -> Result<(), EvalError> {
     }
 }
 
-/// Maps a kinematics error to its answer kind: unreachable targets apart from malformed input.
+/// Maps a kinematics error to its answer kind: unreachable targets and a numerical inverse that
+/// did not converge apart from malformed input.
 fn kin_error(error: KinError) -> EvalError {
     let kind = if error.is_unreachable() {
         Kind::Unreachable
+    } else if matches!(error, KinError::NotConverged { .. }) {
+        Kind::Numerical
     } else {
         Kind::InvalidInput
     };
@@ -264,21 +352,34 @@ fn kin_error(error: KinError) -> EvalError {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct FkRequest {
-    #[serde(default)]
+    #[serde(default, deserialize_with = "arm_object")]
     arm: ArmSpec,
-    a: [f64; 2],
-    alpha0: f64,
+    a: Vec<f64>,
+    alpha0: Option<f64>,
+    harmonics: Option<usize>,
 }
 
-/// `fk`: the closed-form end point of the backbone curve (eqs 3-4) and the discrete chain's tip.
-fn fk(request: FkRequest) -> EvalResult {
+/// `fk`: the end point of the backbone curve (closed form, eqs 3-4, for `K = 1`; quadrature for
+/// `K > 1`) and the tip of the discrete chain whose joint angles follow the curve (eq 7).
+fn fk(mut request: FkRequest) -> EvalResult {
     let chain = request.arm.to_chain().map_err(EvalError::input)?;
-    let map = modal_map(&chain, &request.a, Some(request.alpha0))?;
-    let lengths: Vec<f64> = chain.link_lengths().collect();
-    let tip = end_point(lengths.iter().sum(), request.a, request.alpha0).map_err(kin_error)?;
+    let map = modal_map(&chain, &mut request.a, request.alpha0, request.harmonics)?;
+    let modes = &request.a[..2 * map.harmonics()];
+    let alpha0 = match map.base_angle() {
+        BaseAngle::Fixed(alpha0) => alpha0,
+        BaseAngle::Free => request.a[2 * map.harmonics()],
+    };
+    let length = chain.total_length();
+    // The closed form takes any amplitude; quadrature refuses amplitudes it cannot resolve.
+    let tip = match *modes {
+        [a1, a2] => end_point(length, [a1, a2], alpha0),
+        _ => BackboneCurve::new(length, modes, alpha0).map(|curve| curve.end_point()),
+    }
+    .map_err(kin_error)?;
     let mut theta = vec![0.0; map.n_joints()];
     map.joint_angles(&request.a, &mut theta)
         .map_err(kin_error)?;
+    let lengths: Vec<f64> = chain.link_lengths().collect();
     let tip_chain = tip_position(&lengths, &theta).map_err(kin_error)?;
     finite("tip", &[tip[0], tip[1], tip_chain[0], tip_chain[1]])?;
     Ok(json_fields([
@@ -290,38 +391,79 @@ fn fk(request: FkRequest) -> EvalResult {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct IkRequest {
-    #[serde(default)]
+    #[serde(default, deserialize_with = "arm_object")]
     arm: ArmSpec,
     target: [f64; 2],
     alpha0: f64,
+    harmonics: Option<usize>,
+    guess: Option<Vec<f64>>,
 }
 
-/// `ik`: the closed-form inverse kinematics (eqs 5-6) on the branch `a1 >= 0`.
+/// `ik`: modal coordinates whose curve ends on the target (`a`) and whose discrete chain does
+/// (`a_chain`). Without a guess both start from the closed form (eqs 5-6, branch `a1 >= 0`,
+/// higher harmonics zero): `a` is the closed form itself for `K = 1` and its refinement by
+/// [`HarmonicIk`] for `K > 1`; `a_chain` is [`ChainIk`]'s refinement. With `"guess"` (`2K`
+/// entries) both solvers start there instead, which reaches targets off the closed form's first
+/// branch of `J0`.
 fn ik(request: IkRequest) -> EvalResult {
-    let length = request
-        .arm
-        .to_chain()
-        .map_err(EvalError::input)?
-        .total_length();
-    let a = inverse_kinematics(length, request.target, request.alpha0, Branch::Positive)
+    let chain = request.arm.to_chain().map_err(EvalError::input)?;
+    let k = harmonics(request.harmonics, MAX_IK_HARMONICS)?;
+    let (length, alpha0) = (chain.total_length(), reduce_angle(request.alpha0));
+    let lengths: Vec<f64> = chain.link_lengths().collect();
+    let guessed = request.guess.is_some();
+    let start = match request.guess {
+        Some(guess) if guess.len() == 2 * k => {
+            if let Some(x) = guess.iter().find(|x| x.abs() > MAX_GUESS) {
+                return Err(EvalError::input(format!(
+                    "guess entries must lie within [-{MAX_GUESS}, {MAX_GUESS}] rad, got {x:e}"
+                )));
+            }
+            guess
+        }
+        Some(guess) => {
+            return Err(EvalError::input(format!(
+                "guess has {} entries, expected 2K = {} (K = {k} harmonics)",
+                guess.len(),
+                2 * k
+            )));
+        }
+        None => {
+            let closed = inverse_kinematics(length, request.target, alpha0, Branch::Positive)
+                .map_err(kin_error)?;
+            let mut start = vec![0.0; 2 * k];
+            start[..2].copy_from_slice(&closed);
+            start
+        }
+    };
+    let mut a = start.clone();
+    if k > 1 || guessed {
+        HarmonicIk::new(length, k, alpha0)
+            .and_then(|mut solver| solver.solve(request.target, &mut a))
+            .map_err(kin_error)?;
+    }
+    let mut a_chain = start;
+    ChainIk::new(&lengths, k, alpha0)
+        .and_then(|mut solver| solver.solve(request.target, &mut a_chain))
         .map_err(kin_error)?;
     finite("a", &a)?;
-    Ok(json_fields([("a", json!(a))]))
+    finite("a_chain", &a_chain)?;
+    Ok(json_fields([("a", json!(a)), ("a_chain", json!(a_chain))]))
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct JointsRequest {
-    #[serde(default)]
+    #[serde(default, deserialize_with = "arm_object")]
     arm: ArmSpec,
     a: Vec<f64>,
     alpha0: Option<f64>,
+    harmonics: Option<usize>,
 }
 
-/// `joints`: joint angles `theta = J a (+ alpha0 e_1)` and the modal Jacobian (eqs 7-9).
-fn joints(request: JointsRequest) -> EvalResult {
+/// `joints`: joint angles `theta = J a (+ alpha0 e_1)` and the `n x m` modal Jacobian (eqs 7-9).
+fn joints(mut request: JointsRequest) -> EvalResult {
     let chain = request.arm.to_chain().map_err(EvalError::input)?;
-    let map = modal_map(&chain, &request.a, request.alpha0)?;
+    let map = modal_map(&chain, &mut request.a, request.alpha0, request.harmonics)?;
     let mut theta = vec![0.0; map.n_joints()];
     map.joint_angles(&request.a, &mut theta)
         .map_err(EvalError::input)?;
@@ -333,10 +475,11 @@ fn joints(request: JointsRequest) -> EvalResult {
     ]))
 }
 
-/// Maps a dynamics error: a failed factorisation is numerical, everything else bad input.
+/// Maps a dynamics error: a failed factorisation or a result that overflowed from finite inputs
+/// is numerical, everything else bad input.
 fn dyn_error(error: DynError) -> EvalError {
     let kind = match error {
-        DynError::NotPositiveDefinite => Kind::Numerical,
+        DynError::NotPositiveDefinite | DynError::NonFiniteResult { .. } => Kind::Numerical,
         _ => Kind::InvalidInput,
     };
     EvalError::new(kind, error.to_string())
@@ -365,7 +508,7 @@ fn rows(m: manip_dyn::faer::MatRef<'_, f64>) -> Result<Value, EvalError> {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct DynamicsRequest {
-    #[serde(default)]
+    #[serde(default, deserialize_with = "arm_object")]
     arm: ArmSpec,
     theta: Vec<f64>,
     theta_dot: Vec<f64>,
@@ -400,19 +543,20 @@ fn dynamics(request: DynamicsRequest) -> EvalResult {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ReducedRequest {
-    #[serde(default)]
+    #[serde(default, deserialize_with = "arm_object")]
     arm: ArmSpec,
     a: Vec<f64>,
     a_dot: Vec<f64>,
     tau_star: Vec<f64>,
     alpha0: Option<f64>,
+    harmonics: Option<usize>,
 }
 
 /// `reduced`: the reduced model `M*`, `C*`, `G*` (eqs 13-15), the modal accelerations for the
 /// given `tau*`, and the joint torques `tau = M J a_ddot + C + G` that realise them.
-fn reduced(request: ReducedRequest) -> EvalResult {
+fn reduced(mut request: ReducedRequest) -> EvalResult {
     let chain = request.arm.to_chain().map_err(EvalError::input)?;
-    let map = modal_map(&chain, &request.a, request.alpha0)?;
+    let map = modal_map(&chain, &mut request.a, request.alpha0, request.harmonics)?;
     let (n, m) = (map.n_joints(), map.n_coords());
     let model = ReducedModel::new(chain, map).map_err(reduce_error)?;
     let mut data = ReducedData::new(&model);
@@ -666,5 +810,192 @@ mod tests {
             "arm is invalid: link 1: mass must be positive and finite, got -1"
         );
         assert_eq!(answers[0]["id"], "x");
+    }
+
+    fn request(line: Value) -> Value {
+        run(format!("{line}\n").as_bytes()).remove(0)
+    }
+
+    fn distance(p: &[f64], q: &[f64]) -> f64 {
+        (p[0] - q[0]).hypot(p[1] - q[1])
+    }
+
+    #[test]
+    fn harmonics_set_the_number_of_coordinates() {
+        // K = 2: 4 coordinates with alpha0 given, 5 with alpha0 last; the Jacobian is n x m.
+        for (a, alpha0, m) in [
+            (json!([0.3, 0.2, 0.1, -0.1]), json!(0.5), 4),
+            (json!([0.3, 0.2, 0.1, -0.1, 0.5]), Value::Null, 5),
+        ] {
+            let mut line = json!({"op": "joints", "a": a, "harmonics": 2});
+            if !alpha0.is_null() {
+                line["alpha0"] = alpha0;
+            }
+            let answer = request(line);
+            let jacobian = answer["jacobian"].as_array().unwrap();
+            assert_eq!(jacobian.len(), 10);
+            assert!(
+                jacobian
+                    .iter()
+                    .all(|row| row.as_array().unwrap().len() == m)
+            );
+            // The tip link's inclination alpha(l - L/2) is the sum of the joint angles.
+            let s = 0.95 * std::f64::consts::TAU;
+            let alpha = 0.5 + 0.3 * s.sin() + 0.2 * (1.0 - s.cos()) + 0.1 * (2.0 * s).sin()
+                - 0.1 * (1.0 - (2.0 * s).cos());
+            approx::assert_abs_diff_eq!(
+                vector(&answer["theta"]).iter().sum::<f64>(),
+                alpha,
+                epsilon = 1e-14
+            );
+        }
+        // Wrong counts name both forms; K = 0 and K beyond the limit are refused.
+        for line in [
+            json!({"op": "joints", "a": [0.1, 0.2, 0.3], "alpha0": 1, "harmonics": 2}),
+            json!({"op": "joints", "a": [0.1, 0.2], "alpha0": 1, "harmonics": 0}),
+            json!({"op": "joints", "a": [0.1, 0.2], "alpha0": 1, "harmonics": 100_000}),
+            json!({"op": "joints", "a": [0.1, 0.2], "alpha0": 1, "harmonics": 65}),
+            json!({"op": "ik", "target": [0.3, 0.5], "alpha0": 1, "harmonics": 9}),
+            json!({"op": "ik", "target": [0.3, 0.5], "alpha0": 1, "guess": [11.0, 0.0]}),
+            json!({"op": "ik", "target": [0.3, 0.5], "alpha0": 1, "guess": [0.0, -1e300]}),
+            json!({"op": "fk", "a": [0.1, 0.2, 0.3, 0.4], "harmonics": 2}),
+        ] {
+            let answer = request(line);
+            assert_eq!(answer["error"]["kind"], "invalid_input", "{answer}");
+        }
+    }
+
+    #[test]
+    fn fk_with_more_harmonics_is_the_quadrature_end_point() {
+        // Zero higher harmonics: the K = 2 quadrature equals the K = 1 closed form.
+        let one = request(json!({"op": "fk", "a": [0.8, -0.4], "alpha0": 0.3}));
+        let two = request(json!({"op": "fk", "a": [0.8, -0.4, 0.0, 0.0, 0.3], "harmonics": 2}));
+        for key in ["tip", "tip_chain"] {
+            let (p, q) = (vector(&one[key]), vector(&two[key]));
+            assert!(distance(&p, &q) < 1e-14, "{key}: {p:?} {q:?}");
+        }
+        // A true second harmonic: the chain follows the curve to the aliasing error.
+        let two =
+            request(json!({"op": "fk", "a": [0.3, 0.2, 0.1, -0.1], "alpha0": 0.5, "harmonics": 2}));
+        let (tip, chain) = (vector(&two["tip"]), vector(&two["tip_chain"]));
+        assert!(distance(&tip, &chain) < 1e-6 && distance(&tip, &chain) > 0.0);
+    }
+
+    #[test]
+    fn ik_puts_the_curve_and_the_chain_on_the_target() {
+        let alpha0 = std::f64::consts::FRAC_PI_2;
+        let target = [0.3, 0.5];
+        let tapered: Vec<f64> = (0..20)
+            .map(|i| 0.075 - 0.05 * f64::from(i) / 19.0)
+            .collect();
+        for (arm, harmonics) in [
+            (json!({}), 1),
+            (json!({}), 2),
+            (json!({"lengths": tapered}), 1),
+            (json!({"lengths": tapered}), 2),
+        ] {
+            let answer = request(json!({"op": "ik", "arm": arm, "target": target,
+                "alpha0": alpha0, "harmonics": harmonics}));
+            let (a, a_chain) = (answer["a"].clone(), answer["a_chain"].clone());
+            assert_eq!(vector(&a).len(), 2 * harmonics, "{answer}");
+            let fk = |a: Value| {
+                request(json!({"op": "fk", "arm": arm, "a": a, "alpha0": alpha0,
+                    "harmonics": harmonics}))
+            };
+            let curve = fk(a);
+            assert!(distance(&vector(&curve["tip"]), &target) < 1e-13, "{curve}");
+            let chain = fk(a_chain);
+            assert!(
+                distance(&vector(&chain["tip_chain"]), &target) < 1e-13,
+                "{chain}"
+            );
+            // With tapered links the curve's solution leaves the chain off the target.
+            if arm.get("lengths").is_some() {
+                assert!(distance(&vector(&curve["tip_chain"]), &target) > 1e-4);
+            }
+        }
+        // Beyond the first branch of J0: refused by name without a guess, solved with one.
+        let target = [0.0, -0.3];
+        let refused = request(json!({"op": "ik", "target": target, "alpha0": alpha0}));
+        assert_eq!(refused["error"]["kind"], "unreachable");
+        assert!(
+            refused["error"]["message"]
+                .as_str()
+                .unwrap()
+                .contains("first branch")
+        );
+        let solved = request(json!({"op": "ik", "target": target, "alpha0": alpha0,
+            "guess": [3.0, 0.2]}));
+        let fk = request(json!({"op": "fk", "a": solved["a"], "alpha0": alpha0}));
+        assert!(distance(&vector(&fk["tip"]), &target) < 1e-13, "{fk}");
+        let wrong = request(json!({"op": "ik", "target": target, "alpha0": alpha0,
+            "guess": [3.0]}));
+        assert_eq!(wrong["error"]["kind"], "invalid_input");
+    }
+
+    #[test]
+    fn reduced_works_for_any_number_of_coordinates() {
+        let line = json!({"op": "reduced", "harmonics": 2, "a": [0.1, 0.2, 0.1, 0.1, 0.3],
+            "a_dot": [0.2, -0.1, 0.3, 0.0, 0.5], "tau_star": [0.3, -0.1, 0.2, 0.05, -0.2]});
+        let answer = request(line);
+        assert_eq!(answer["mass_matrix"].as_array().unwrap().len(), 5);
+        let torques = vector(&answer["joint_torques"]);
+        let map = ModalMap::uniform(10, 2, BaseAngle::Free).unwrap();
+        for (j, expected) in [0.3, -0.1, 0.2, 0.05, -0.2].into_iter().enumerate() {
+            let projected: f64 = (0..10).map(|i| map.entry(i, j) * torques[i]).sum();
+            approx::assert_abs_diff_eq!(projected, expected, epsilon = 1e-12);
+        }
+    }
+
+    #[test]
+    fn overflow_is_numerical_and_a_non_object_arm_is_refused() {
+        let answer = request(
+            json!({"op": "dynamics", "arm": {"links": 2}, "theta": [0.1, 0.2],
+            "theta_dot": [1e200, 1e200]}),
+        );
+        assert_eq!(answer["error"]["kind"], "numerical", "{answer}");
+        for arm in [json!([10]), json!(5), json!("paper"), json!(null)] {
+            let answer = request(json!({"op": "joints", "arm": arm, "a": [0, 0, 0]}));
+            assert_eq!(answer["error"]["kind"], "invalid_request", "{answer}");
+            assert!(
+                answer["error"]["message"]
+                    .as_str()
+                    .unwrap()
+                    .contains("\"arm\" must be an object"),
+                "{answer}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_huge_alpha0_gives_the_answer_of_its_angle() {
+        // alpha0 only turns the whole arm: every tip is the alpha0 = 0 tip rotated by
+        // (cos alpha0, sin alpha0), whose argument reduction libm does exactly.
+        let huge = 1e20f64;
+        let (sin, cos) = huge.sin_cos();
+        let base = request(json!({"op": "fk", "a": [0.7, 0.2], "alpha0": 0.0}));
+        for line in [
+            json!({"op": "fk", "a": [0.7, 0.2], "alpha0": huge}),
+            json!({"op": "fk", "a": [0.7, 0.2, huge]}),
+        ] {
+            let turned = request(line);
+            for key in ["tip", "tip_chain"] {
+                let (p, q) = (vector(&base[key]), vector(&turned[key]));
+                let rotated = [cos * p[0] - sin * p[1], sin * p[0] + cos * p[1]];
+                assert!(distance(&rotated, &q) < 1e-15, "{key}: {rotated:?} {q:?}");
+            }
+        }
+        // The joint angles keep their modal part: theta_1 - alpha0 is the same.
+        let base = request(json!({"op": "joints", "a": [0.7, 0.2], "alpha0": 0.0}));
+        let turned = request(json!({"op": "joints", "a": [0.7, 0.2], "alpha0": huge}));
+        let (p, q) = (vector(&base["theta"]), vector(&turned["theta"]));
+        assert_eq!(p[1..], q[1..]);
+        let offset = q[0] - p[0];
+        assert!((offset.cos() - cos).abs() < 1e-15 && (offset.sin() - sin).abs() < 1e-15);
+        // And ik answers as for the reduced angle.
+        let target = [cos * 0.5 - sin * 0.3, sin * 0.5 + cos * 0.3];
+        let ik = request(json!({"op": "ik", "target": target, "alpha0": huge}));
+        let fk = request(json!({"op": "fk", "a": ik["a"], "alpha0": huge}));
+        assert!(distance(&vector(&fk["tip"]), &target) < 1e-13, "{ik} {fk}");
     }
 }

@@ -1,7 +1,8 @@
 //! The main job (`hrm` with no arguments) and `hrm simulate`: closed-loop runs of the shipped
 //! scenarios (section 5 of the paper), a comparison table, and per-run output files.
 
-use crate::{figures, progress, report};
+use crate::output_dir::OutputDir;
+use crate::{console, figures, progress, report};
 use rayon::prelude::*;
 use serde_json::json;
 use sim_core::{ControllerKind, ReferenceSpec, Run, Scenario};
@@ -12,10 +13,19 @@ use std::path::Path;
 struct Outcome {
     scenario: String,
     controller: ControllerKind,
-    result: Result<Run, String>,
+    result: Result<Run, Stopped>,
+}
+
+/// Why a run stopped, and what it recorded until then (nothing if it could not be built).
+#[derive(Debug)]
+struct Stopped {
+    error: String,
+    partial: Option<Run>,
 }
 
 /// Runs `scenario` with `controller` (or the scenario's own) and writes its files into `out`.
+/// A scenario that cannot be built is refused before anything is written; a run that stops
+/// (diverges) writes its data up to the stop, then fails with the reason.
 pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Result<(), String> {
     let mut scenario = Scenario::resolve(name_or_path).map_err(|e| e.to_string())?;
     if let Some(kind) = controller {
@@ -23,14 +33,14 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
             .parse()
             .map_err(|e: sim_core::SimError| e.to_string())?;
     }
+    scenario.build().map_err(|e| e.to_string())?;
+    let staging = OutputDir::create(out, "simulate")?;
     let outcome = run_one(&scenario, scenario.controller.kind);
-    write_outcome(&outcome, out)?;
-    print!("{}", table(&table_rows(std::slice::from_ref(&outcome))));
-    println!("wrote {}", out.display());
-    match outcome.result {
-        Ok(_) => Ok(()),
-        Err(message) => Err(message),
-    }
+    write_outcome(&outcome, staging.path())?;
+    staging.commit()?;
+    console::print(&table(&table_rows(std::slice::from_ref(&outcome))))?;
+    console::print(&format!("wrote {}\n", out.display()))?;
+    outcome.result.map(|_| ()).map_err(|stopped| stopped.error)
 }
 
 /// The main job: every shipped scenario with every controller (see [`experiments`]).
@@ -44,6 +54,8 @@ pub fn main_job(out: &Path) -> Result<(), String> {
 /// Runs `scenarios` with every controller, in parallel (results in a fixed order), then writes
 /// the per-run files, the comparison table, the figures and `report.html` into `out`.
 fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
+    let staging = OutputDir::create(out, "run")?;
+    let dir = staging.path();
     let jobs: Vec<(&Scenario, ControllerKind)> = scenarios
         .iter()
         .flat_map(|scenario| ControllerKind::ALL.map(|kind| (scenario, kind)))
@@ -53,7 +65,7 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
         .par_iter()
         .map(|&(scenario, kind)| {
             let outcome = run_one(scenario, kind);
-            write_outcome(&outcome, &out.join(&scenario.name).join(kind.name()))?;
+            write_outcome(&outcome, &dir.join(&scenario.name).join(kind.name()))?;
             bar.set_message(format!("{} with {kind}", scenario.name));
             bar.inc(1);
             Ok(outcome)
@@ -62,13 +74,11 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
     bar.finish_and_clear();
     let outcomes = outcomes?;
     let summaries: Vec<_> = outcomes.iter().map(outcome_json).collect();
-    write(&out.join("summary.json"), &pretty(&json!(summaries))?)?;
+    write(&dir.join("summary.json"), &pretty(&json!(summaries))?)?;
     let rows = table_rows(&outcomes);
     let text = table(&rows);
-    write(&out.join("comparison.txt"), &text)?;
-    print!("{text}");
-    let sections = figures(out, scenarios, &outcomes)?;
-    let report_path = out.join("report.html");
+    write(&dir.join("comparison.txt"), &text)?;
+    let sections = figures(dir, scenarios, &outcomes)?;
     let html_table = report::Table {
         headers: HEADERS.map(String::from).to_vec(),
         rows,
@@ -83,18 +93,19 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
         ControllerKind::ALL.map(ControllerKind::name).join(", ")
     );
     report::write(
-        &report_path,
+        &dir.join("report.html"),
         "hrm: the paper's experiments",
         &intro,
         &html_table,
         &sections,
     )?;
-    println!(
-        "wrote {} (summary.json, comparison.txt, figures/, one folder per run)",
-        out.display()
-    );
-    println!("report: {}", report_path.display());
-    Ok(())
+    staging.commit()?;
+    console::print(&text)?;
+    console::print(&format!(
+        "wrote {} (summary.json, comparison.txt, figures/, one folder per run)\nreport: {}\n",
+        out.display(),
+        out.join("report.html").display()
+    ))
 }
 
 /// Interval between the drawn arm configurations of Figure 10 (s).
@@ -213,10 +224,19 @@ fn figures(
 fn run_one(scenario: &Scenario, kind: ControllerKind) -> Outcome {
     let mut scenario = scenario.clone();
     scenario.controller.kind = kind;
-    let result = scenario
-        .build()
-        .map_err(|e| e.to_string())
-        .and_then(|mut sim| sim.run().map_err(|failure| failure.error.to_string()));
+    let result = match scenario.build() {
+        Err(e) => Err(Stopped {
+            error: e.to_string(),
+            partial: None,
+        }),
+        Ok(mut simulation) => simulation.run().map_err(|failure| Stopped {
+            error: failure.error.to_string(),
+            partial: Some(Run {
+                record: failure.record,
+                summary: failure.summary,
+            }),
+        }),
+    };
     Outcome {
         scenario: scenario.name.clone(),
         controller: kind,
@@ -230,20 +250,39 @@ fn outcome_json(outcome: &Outcome) -> serde_json::Value {
             json!({"scenario": outcome.scenario, "controller": outcome.controller.name(), "summary": run.summary})
         }
         Err(e) => {
-            json!({"scenario": outcome.scenario, "controller": outcome.controller.name(), "error": e})
+            json!({"scenario": outcome.scenario, "controller": outcome.controller.name(), "error": e.error})
         }
     }
 }
 
-/// Writes `summary.json` and `timeseries.csv` of one run into `dir`.
+/// Writes `summary.json` and `timeseries.csv` of one run into `dir`. A run that stopped has
+/// its time series up to the stop, and a summary of the metrics up to it with the `error`
+/// and the time it `stopped_at_s`.
 fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    let summary = match &outcome.result {
-        Ok(run) => serde_json::to_value(&run.summary).map_err(|e| e.to_string())?,
-        Err(e) => json!({"error": e}),
+    let (run, summary) = match &outcome.result {
+        Ok(run) => (
+            Some(run),
+            serde_json::to_value(&run.summary).map_err(|e| e.to_string())?,
+        ),
+        Err(Stopped {
+            error,
+            partial: None,
+        }) => (None, json!({ "error": error })),
+        Err(Stopped {
+            error,
+            partial: Some(run),
+        }) => {
+            let mut summary = serde_json::to_value(&run.summary).map_err(|e| e.to_string())?;
+            if let Some(fields) = summary.as_object_mut() {
+                fields.insert("error".into(), json!(error));
+                fields.insert("stopped_at_s".into(), json!(run.summary.simulated_s));
+            }
+            (Some(run), summary)
+        }
     };
     write(&dir.join("summary.json"), &pretty(&summary)?)?;
-    if let Ok(run) = &outcome.result {
+    if let Some(run) = run {
         let r = &run.record;
         let mut csv = String::from(
             "t,a1,a2,a1_dot,a2_dot,a1_ref,a2_ref,tau1,tau2,tip_x,tip_y,tip_ref_x,tip_ref_y\n",
@@ -309,7 +348,7 @@ fn table_rows(outcomes: &[Outcome]) -> Vec<report::Row> {
                 }
                 Err(e) => report::Row {
                     cells,
-                    error: Some(e.clone()),
+                    error: Some(e.error.clone()),
                 },
             }
         })

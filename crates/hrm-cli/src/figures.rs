@@ -207,16 +207,18 @@ pub fn tracking_residual(
 pub fn fuzzy_controller(dir: &Path, resolution: usize) -> Result<Vec<PathBuf>, String> {
     let system = fuzzy_sugeno::paper_controller();
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let names = fis_cmd::PlotNames::new(&system);
     let mut written = system
         .inputs()
         .iter()
-        .map(|input| fis_cmd::membership_chart(input, dir))
+        .zip(&names.inputs)
+        .map(|(input, name)| fis_cmd::membership_chart(input, name, dir))
         .collect::<Result<Vec<_>, _>>()?;
     let zero = vec![0.0; system.inputs().len()];
     // Inputs: da1, da2, a1_dot, a2_dot; outputs: tau1, tau2.
     for (pair, output) in [([0, 2], 0), ([1, 3], 1)] {
         written.push(fis_cmd::surface_chart(
-            &system, pair, output, &zero, resolution, dir,
+            &system, pair, output, &zero, resolution, &names, dir,
         )?);
     }
     Ok(written)

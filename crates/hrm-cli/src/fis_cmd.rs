@@ -1,7 +1,8 @@
 //! `hrm fis`: check, evaluate and plot Takagi-Sugeno systems stored as MATLAB `.fis` files.
 //!
-//! - `hrm fis check FILE`: Wang's completeness, consistency and continuity; exits non-zero if
-//!   one of them fails.
+//! - `hrm fis check FILE`: what the reader accepted but ignored (unused methods, extension
+//!   keys, extra parameters; skipped for an FCL file, whose reader keeps no such notes), then Wang's completeness, consistency and continuity; exits
+//!   non-zero if one of them fails.
 //! - `hrm fis eval FILE x1 x2 ...`: prints `name = value` for every output.
 //! - `hrm fis surface FILE --out DIR`: SVGs of every input's membership functions and of every
 //!   output over every pair of inputs (others at a reference value), like MATLAB's `plotmf` and
@@ -10,10 +11,13 @@
 //!
 //! A FILE whose name ends in `.fcl` is read as IEC 61131-7 FCL, any other as MATLAB `.fis`.
 
+use crate::args;
+use crate::console;
+use crate::output_dir::OutputDir;
 use crate::plot::{self, Grid, Labels, Series};
 use clap::{Args, Subcommand, ValueEnum};
 use fuzzy_sugeno::{
-    AnalysisOptions, EvalOptions, Evaluator, FuzzySystem, InputVariable, OutOfRange,
+    AnalysisOptions, EvalOptions, Evaluator, FisNote, FuzzySystem, InputVariable, OutOfRange,
 };
 use std::path::{Path, PathBuf};
 
@@ -26,18 +30,18 @@ pub struct FisArgs {
 
 #[derive(Debug, Subcommand)]
 enum FisCommand {
-    /// Check the rule base for completeness, consistency and continuity (Wang); fails if one does not hold.
+    /// List what the file says that was accepted but ignored, then check the rule base for completeness, consistency and continuity (Wang); fails if one does not hold.
     Check {
         /// The `.fis` file.
         file: PathBuf,
         /// Completeness: the degree to which every antecedent of some rule must hold everywhere.
-        #[arg(long, default_value_t = 0.5)]
+        #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
         coverage: f64,
-        /// Completeness: evenly spaced samples per input (set landmarks are added).
-        #[arg(long, default_value_t = 21)]
-        samples: usize,
+        /// Completeness: evenly spaced samples per input (set landmarks are added; thinned so the grid stays within a million points).
+        #[arg(long, default_value_t = 21, allow_negative_numbers = true)]
+        samples: i128,
         /// Continuity: the largest allowed jump between neighbouring rules, as a fraction of the output range.
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         max_jump: f64,
     },
     /// Evaluate the system at one input vector and print its outputs.
@@ -59,12 +63,12 @@ enum FisCommand {
     Surface {
         /// The `.fis` file.
         file: PathBuf,
-        /// The directory to write into (created if missing).
+        /// The directory to write (created, or replaced whole if hrm wrote it).
         #[arg(long)]
         out: PathBuf,
-        /// Samples per axis of each surface.
-        #[arg(long, default_value_t = 41)]
-        resolution: usize,
+        /// Samples per axis of each surface (2 to 600).
+        #[arg(long, default_value_t = 41, allow_negative_numbers = true)]
+        resolution: i128,
         /// Values of the inputs not on a surface's axes, comma-separated (default: the middle of each range).
         #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
         reference: Option<Vec<f64>>,
@@ -93,12 +97,16 @@ pub fn run(args: FisArgs) -> Result<(), String> {
         } => {
             let options = AnalysisOptions {
                 coverage,
-                samples_per_input: samples,
+                samples_per_input: args::count("--samples", samples, 2, MAX_SAMPLES)?,
                 max_relative_jump: max_jump,
                 ..Default::default()
             };
-            let (report, passed) = check(&read_system(&file)?, &options)?;
-            print!("{report}");
+            let (system, notes) = read_system_with_notes(&file)?;
+            if let Some(notes) = notes {
+                console::print(&ignored_report(&file, &notes))?;
+            }
+            let (report, passed) = check(&system, &options)?;
+            console::print(&report)?;
             if passed {
                 Ok(())
             } else {
@@ -110,10 +118,11 @@ pub fn run(args: FisArgs) -> Result<(), String> {
             inputs,
             out_of_range,
         } => {
-            for (name, value) in eval(read_system(&file)?, &inputs, out_of_range)? {
-                println!("{name} = {value}");
-            }
-            Ok(())
+            let lines: String = eval(read_system(&file)?, &inputs, out_of_range)?
+                .into_iter()
+                .map(|(name, value)| format!("{name} = {value}\n"))
+                .collect();
+            console::print(&lines)
         }
         FisCommand::Train(args) => crate::fis_train::run(args),
         FisCommand::Export(args) => crate::fis_export::run(args),
@@ -123,37 +132,93 @@ pub fn run(args: FisArgs) -> Result<(), String> {
             resolution,
             reference,
         } => {
-            for path in surface(&read_system(&file)?, &out, resolution, reference.as_deref())? {
-                println!("{}", path.display());
-            }
-            Ok(())
+            let resolution = args::count("--resolution", resolution, 2, MAX_RESOLUTION)?;
+            let system = read_system(&file)?;
+            let staging = OutputDir::create(&out, "fis surface")?;
+            let written = surface(&system, staging.path(), resolution, reference.as_deref())?;
+            staging.commit()?;
+            let lines: String = written
+                .iter()
+                .filter_map(|path| path.file_name())
+                .map(|name| format!("{}\n", out.join(name).display()))
+                .collect();
+            console::print(&lines)
         }
     }
 }
 
 /// Parses the text of a `.fis` file.
+#[cfg(test)]
 fn load_system(text: &str) -> Result<FuzzySystem, String> {
     FuzzySystem::from_fis(text).map_err(|e| e.to_string())
 }
 
+/// The text of `path`, read up to [`sim_core::MAX_INPUT_FILE_BYTES`].
+fn read_text(path: &Path) -> Result<String, String> {
+    sim_core::read_text_file(path, sim_core::MAX_INPUT_FILE_BYTES)
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
 /// Reads a `.fis` file, or an FCL file if the name ends in `.fcl`.
 pub(crate) fn read_system(path: &Path) -> Result<FuzzySystem, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    read_system_with_notes(path).map(|(system, _)| system)
+}
+
+/// Reads a system as [`read_system`] does, with the `.fis` reader's notes of what it accepted
+/// but ignored; `None` for an FCL file, whose reader keeps no such notes.
+fn read_system_with_notes(path: &Path) -> Result<(FuzzySystem, Option<Vec<FisNote>>), String> {
+    let text = read_text(path)?;
     let is_fcl = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("fcl"));
     let system = if is_fcl {
-        FuzzySystem::from_fcl(&text).map_err(|e| e.to_string())
+        FuzzySystem::from_fcl(&text).map(|system| (system, None))
     } else {
-        load_system(&text)
+        FuzzySystem::from_fis_with_notes(&text).map(|(system, notes)| (system, Some(notes)))
     };
     system.map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// The analysis report and whether it passed.
+/// The lines of `file` that were accepted but are neither kept nor used, one per line, so that
+/// nothing is dropped silently.
+fn ignored_report(file: &Path, notes: &[FisNote]) -> String {
+    if notes.is_empty() {
+        return format!("{}: nothing ignored\n", file.display());
+    }
+    let mut report = format!("{}: accepted but ignored:\n", file.display());
+    for note in notes {
+        report.push_str(&format!("  {note}\n"));
+    }
+    report
+}
+
+/// Largest `--samples`: the completeness grid holds at most this many points
+/// ([`AnalysisOptions::max_grid_points`]).
+const MAX_SAMPLES: usize = 1_000_000;
+/// Largest `--resolution`: a heat map cell per pixel of the 660-pixel-wide map.
+const MAX_RESOLUTION: usize = 600;
+/// Most SVG files `fis surface` writes (membership charts and surfaces).
+const MAX_PLOTS: usize = 1000;
+/// Most bytes of SVG `fis surface` writes, estimated before drawing (1 GiB).
+const MAX_SVG_BYTES: f64 = (1u64 << 30) as f64;
+/// Bytes of SVG per heat map cell (a filled rectangle), measured.
+const SVG_BYTES_PER_CELL: f64 = 90.0;
+
+/// The analysis report and whether it passed; a note says when the even samples were thinned
+/// to keep the grid within [`AnalysisOptions::max_grid_points`].
 fn check(system: &FuzzySystem, options: &AnalysisOptions) -> Result<(String, bool), String> {
     let report = system.analyze(options).map_err(|e| e.to_string())?;
-    Ok((report.to_string(), report.passed()))
+    let mut text = report.to_string();
+    let grid = &report.completeness.grid;
+    if grid.iter().any(|&n| n < options.samples_per_input) {
+        let asked = (options.samples_per_input as f64).powi(grid.len() as i32);
+        text.push_str(&format!(
+            "note: --samples {} per input would make a grid of {asked:e} points, more than the {} \
+             the check evaluates: the even samples were thinned to fit\n",
+            options.samples_per_input, options.max_grid_points
+        ));
+    }
+    Ok((text, report.passed()))
 }
 
 /// Each output's name and value at `inputs`.
@@ -180,7 +245,8 @@ fn eval(
     Ok(names.zip(outputs).collect())
 }
 
-/// Writes the plots into `dir` and returns their paths: `mf_<input>.svg` for every input, then
+/// Writes the plots into `dir` and returns their paths: `mf_<input>.svg` for every input that
+/// has membership functions (a `NumMFs=0` input has none to draw), then
 /// `surface_<output>_<x>_<y>.svg` for every output and pair of inputs (or `curve_<output>_<x>.svg`
 /// for a single-input system).
 fn surface(
@@ -190,9 +256,36 @@ fn surface(
     reference: Option<&[f64]>,
 ) -> Result<Vec<PathBuf>, String> {
     let inputs = system.inputs();
-    if resolution < 2 {
-        return Err(format!("--resolution must be at least 2, got {resolution}"));
+    let (n_in, n_out) = (inputs.len(), system.outputs().len());
+    if !(2..=MAX_RESOLUTION).contains(&resolution) {
+        return Err(format!(
+            "--resolution must be at least 2 and at most {MAX_RESOLUTION}, got {resolution}"
+        ));
     }
+    // Membership charts, then one surface per output and pair of inputs (curves for one input).
+    let surfaces = if n_in == 1 {
+        0.0
+    } else {
+        n_out as f64 * (n_in as f64 * (n_in as f64 - 1.0) / 2.0)
+    };
+    let plots = n_in as f64 + if n_in == 1 { n_out as f64 } else { surfaces };
+    if plots > MAX_PLOTS as f64 {
+        return Err(format!(
+            "the system's {n_in} inputs and {n_out} outputs need {plots} plots, more than the \
+             {MAX_PLOTS} fis surface writes"
+        ));
+    }
+    let bytes = surfaces * (resolution * resolution) as f64 * SVG_BYTES_PER_CELL;
+    if bytes > MAX_SVG_BYTES {
+        return Err(format!(
+            "--resolution {resolution} would write {surfaces} surfaces of {resolution} x \
+             {resolution} cells, about {:.1} GB of SVG, more than the {:.1} GB limit: lower \
+             --resolution",
+            bytes / 1e9,
+            MAX_SVG_BYTES / 1e9
+        ));
+    }
+    let names = PlotNames::new(system);
     let reference: Vec<f64> = match reference {
         None => inputs
             .iter()
@@ -209,11 +302,15 @@ fn surface(
     };
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let mut written = Vec::new();
-    for input in inputs {
-        written.push(membership_chart(input, dir)?);
+    for (input, name) in inputs
+        .iter()
+        .zip(&names.inputs)
+        .filter(|(input, _)| !input.sets.is_empty())
+    {
+        written.push(membership_chart(input, name, dir)?);
     }
     if inputs.len() == 1 {
-        written.extend(output_curves(system, dir)?);
+        written.extend(output_curves(system, &names, dir)?);
         return Ok(written);
     }
     for i in 0..inputs.len() {
@@ -225,6 +322,7 @@ fn surface(
                     output,
                     &reference,
                     resolution,
+                    &names,
                     dir,
                 )?);
             }
@@ -233,19 +331,85 @@ fn surface(
     Ok(written)
 }
 
-/// `n >= 2` evenly spaced samples of `range`, both ends included.
+/// `n >= 2` evenly spaced samples of `range`, both ends included; `lo (1 - t) + hi t` stays
+/// finite for ranges near `±f64::MAX`, whose width overflows.
 fn samples(range: [f64; 2], n: usize) -> Vec<f64> {
     (0..n)
-        .map(|k| range[0] + (range[1] - range[0]) * k as f64 / (n - 1) as f64)
+        .map(|k| {
+            let t = k as f64 / (n - 1) as f64;
+            range[0] * (1.0 - t) + range[1] * t
+        })
         .collect()
+}
+
+/// The names that stand for a system's inputs and outputs in file names. A variable's name
+/// with every character but ASCII letters, digits, `-` and `_` replaced by `_` (at most 64),
+/// unless two of the files would then share a name (also ignoring case, for case-insensitive
+/// file systems) or a name is empty: then every variable is named by its position (`in1`,
+/// `out2`). No file name can leave the output folder or overwrite another.
+pub struct PlotNames {
+    /// One per input.
+    pub inputs: Vec<String>,
+    /// One per output.
+    pub outputs: Vec<String>,
+}
+
+impl PlotNames {
+    /// The names for `system`.
+    pub fn new(system: &FuzzySystem) -> Self {
+        let readable = PlotNames {
+            inputs: system.inputs().iter().map(|v| file_name(&v.name)).collect(),
+            outputs: system
+                .outputs()
+                .iter()
+                .map(|v| file_name(&v.name))
+                .collect(),
+        };
+        let files = readable.files();
+        let mut lowered: Vec<String> = files.iter().map(|f| f.to_ascii_lowercase()).collect();
+        lowered.sort();
+        lowered.dedup();
+        let empty = readable
+            .inputs
+            .iter()
+            .chain(&readable.outputs)
+            .any(String::is_empty);
+        if lowered.len() == files.len() && !empty {
+            return readable;
+        }
+        PlotNames {
+            inputs: (1..=readable.inputs.len())
+                .map(|k| format!("in{k}"))
+                .collect(),
+            outputs: (1..=readable.outputs.len())
+                .map(|k| format!("out{k}"))
+                .collect(),
+        }
+    }
+
+    /// Every file name `fis surface` writes with these names.
+    fn files(&self) -> Vec<String> {
+        let mut files: Vec<String> = self.inputs.iter().map(|x| format!("mf_{x}.svg")).collect();
+        for out in &self.outputs {
+            if let [x] = self.inputs.as_slice() {
+                files.push(format!("curve_{out}_{x}.svg"));
+            }
+            for (i, x) in self.inputs.iter().enumerate() {
+                for y in &self.inputs[i + 1..] {
+                    files.push(format!("surface_{out}_{x}_{y}.svg"));
+                }
+            }
+        }
+        files
+    }
 }
 
 /// Samples of a membership function or single-input curve.
 const CURVE_SAMPLES: usize = 201;
 
-/// Writes the membership functions of `input` (like MATLAB's `plotmf`) to `dir/mf_<input>.svg`
-/// and returns that path.
-pub fn membership_chart(input: &InputVariable, dir: &Path) -> Result<PathBuf, String> {
+/// Writes the membership functions of `input` (like MATLAB's `plotmf`) to `dir/mf_<name>.svg`
+/// (`name` from [`PlotNames`]) and returns that path.
+pub fn membership_chart(input: &InputVariable, name: &str, dir: &Path) -> Result<PathBuf, String> {
     let xs = samples(input.range, CURVE_SAMPLES);
     let series = input
         .sets
@@ -263,7 +427,7 @@ pub fn membership_chart(input: &InputVariable, dir: &Path) -> Result<PathBuf, St
                 .map_err(|e| e.to_string())
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let path = dir.join(format!("mf_{}.svg", file_name(&input.name)));
+    let path = dir.join(format!("mf_{name}.svg"));
     let title = format!("Membership functions of {}", input.name);
     plot::line_chart(
         &path,
@@ -280,7 +444,11 @@ pub fn membership_chart(input: &InputVariable, dir: &Path) -> Result<PathBuf, St
 
 /// Writes every output of a single-input system over its input to
 /// `dir/curve_<output>_<input>.svg` and returns the paths.
-fn output_curves(system: &FuzzySystem, dir: &Path) -> Result<Vec<PathBuf>, String> {
+fn output_curves(
+    system: &FuzzySystem,
+    names: &PlotNames,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, String> {
     let (input, outputs) = (&system.inputs()[0], system.outputs());
     let mut evaluator = Evaluator::new(system.clone());
     let mut y = vec![0.0; outputs.len()];
@@ -293,12 +461,8 @@ fn output_curves(system: &FuzzySystem, dir: &Path) -> Result<Vec<PathBuf>, Strin
         }
     }
     let mut written = Vec::new();
-    for (output, points) in outputs.iter().zip(curves) {
-        let path = dir.join(format!(
-            "curve_{}_{}.svg",
-            file_name(&output.name),
-            file_name(&input.name)
-        ));
+    for ((output, points), name) in outputs.iter().zip(curves).zip(&names.outputs) {
+        let path = dir.join(format!("curve_{name}_{}.svg", names.inputs[0]));
         let title = format!("{} = f({})", output.name, input.name);
         let series = [Series {
             label: output.name.clone(),
@@ -321,13 +485,14 @@ fn output_curves(system: &FuzzySystem, dir: &Path) -> Result<Vec<PathBuf>, Strin
 
 /// Writes output `output` of `system` over the inputs `[i, j]` on a `resolution` x `resolution`
 /// grid, the other inputs at `reference` (like MATLAB's `gensurf`), as a heat map
-/// `dir/surface_<output>_<x>_<y>.svg`, and returns its path.
+/// `dir/surface_<output>_<x>_<y>.svg` (names from [`PlotNames`]), and returns its path.
 pub fn surface_chart(
     system: &FuzzySystem,
     [i, j]: [usize; 2],
     output: usize,
     reference: &[f64],
     resolution: usize,
+    names: &PlotNames,
     dir: &Path,
 ) -> Result<PathBuf, String> {
     let (inputs, outputs) = (system.inputs(), system.outputs());
@@ -363,9 +528,7 @@ pub fn surface_chart(
     let (xn, yn, zn) = (&inputs[i].name, &inputs[j].name, &outputs[output].name);
     let path = dir.join(format!(
         "surface_{}_{}_{}.svg",
-        file_name(zn),
-        file_name(xn),
-        file_name(yn)
+        names.outputs[output], names.inputs[i], names.inputs[j]
     ));
     let title = format!("{zn} = f({xn}, {yn})");
     let grid = Grid { x: xs, y: ys, z };
@@ -382,9 +545,10 @@ pub fn surface_chart(
     Ok(path)
 }
 
-/// A name made safe for a file name.
+/// A name made safe for a file name (see [`PlotNames`]).
 fn file_name(name: &str) -> String {
     name.chars()
+        .take(64)
         .map(|c| {
             if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
                 c
@@ -414,6 +578,28 @@ mod tests {
             load_system(&broken).unwrap_err(),
             "line 45: expected NumMFs=<integer >= 1>, found NumMFs=x"
         );
+    }
+
+    #[test]
+    fn check_lists_what_was_accepted_but_ignored() {
+        let file = Path::new("dimmer.fis");
+        let text = include_str!("../../fuzzy-sugeno/data/interop/fuzzylite_export.fis");
+        let (_, notes) = FuzzySystem::from_fis_with_notes(text).unwrap();
+        let report = ignored_report(file, &notes);
+        assert!(
+            report.starts_with("dimmer.fis: accepted but ignored:\n  line 4: Version=6.0"),
+            "{report}"
+        );
+        assert!(
+            report.contains("\n  line 8: AndMethod='' is not used by any rule"),
+            "{report}"
+        );
+        assert!(
+            report.contains("\n  line 16: `Enabled=1` in [Input1] is not a MATLAB key"),
+            "{report}"
+        );
+        assert_eq!(report.lines().count(), 1 + notes.len());
+        assert_eq!(ignored_report(file, &[]), "dimmer.fis: nothing ignored\n");
     }
 
     #[test]
@@ -471,6 +657,112 @@ mod tests {
             surface(&paper_controller(), &dir, 9, Some(&[0.0])).unwrap_err(),
             "--reference has 1 values for 4 inputs"
         );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A two-input, one-output system with the given names and constant outputs `lo`, `hi`.
+    fn two_inputs(x: &str, y: &str, u: &str, [lo, hi]: [f64; 2]) -> FuzzySystem {
+        let text = format!(
+            "[System]\nName='two'\nType='sugeno'\nNumInputs=2\nNumOutputs=1\nNumRules=2\nAndMethod='prod'\n\
+             OrMethod='probor'\nImpMethod='prod'\nAggMethod='sum'\nDefuzzMethod='wtaver'\n\
+             [Input1]\nName='{x}'\nRange=[0 1]\nNumMFs=2\nMF1='lo':'trimf',[-1 0 1]\nMF2='hi':'trimf',[0 1 2]\n\
+             [Input2]\nName='{y}'\nRange=[0 1]\nNumMFs=1\nMF1='all':'trimf',[-1 0.5 2]\n\
+             [Output1]\nName='{u}'\nRange=[{lo:e} {hi:e}]\nNumMFs=2\nMF1='a':'constant',[{lo:e}]\nMF2='b':'constant',[{hi:e}]\n\
+             [Rules]\n1 1, 1 (1) : 1\n2 1, 2 (1) : 1\n"
+        );
+        load_system(&text).unwrap()
+    }
+
+    #[test]
+    fn file_names_from_variable_names_neither_collide_nor_escape() {
+        // `a b` and `a_b` would both become `a_b`; `A_B` differs only in case: positions instead.
+        for (x, y) in [("a b", "a_b"), ("a_b", "A_B"), ("../a", "//.a")] {
+            let system = two_inputs(x, y, "u", [0.0, 1.0]);
+            let names = PlotNames::new(&system);
+            assert_eq!(names.inputs, ["in1", "in2"], "{x}, {y}");
+            assert_eq!(names.outputs, ["out1"]);
+        }
+        // Distinct names stay readable; anything but [A-Za-z0-9_-] becomes `_`, at most 64.
+        let long = "y".repeat(300);
+        let names = PlotNames::new(&two_inputs("../etc/passwd", &long, "u/v", [0.0, 1.0]));
+        assert_eq!(names.inputs[0], "___etc_passwd");
+        assert_eq!(names.inputs[1], "y".repeat(64));
+        assert_eq!(names.outputs, ["u_v"]);
+        let dir = temp_dir("names");
+        let written = surface(&two_inputs("a b", "a_b", "u", [0.0, 1.0]), &dir, 3, None).unwrap();
+        let files: Vec<_> = written
+            .iter()
+            .map(|p| p.strip_prefix(&dir).unwrap())
+            .collect();
+        assert_eq!(
+            files,
+            [
+                Path::new("mf_in1.svg"),
+                Path::new("mf_in2.svg"),
+                Path::new("surface_out1_in1_in2.svg")
+            ]
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn outputs_too_large_to_plot_get_the_non_finite_error() {
+        // Finite outputs from -1.7e308 to 1.7e308: their span overflows double precision.
+        let system = two_inputs("x", "y", "u", [-1.7e308, 1.7e308]);
+        let dir = temp_dir("huge-outputs");
+        let err = surface(&system, &dir, 3, None).unwrap_err();
+        assert!(err.contains("cannot plot a non-finite z span"), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn surface_output_size_is_capped_up_front() {
+        let dir = temp_dir("caps");
+        let err = surface(&paper_controller(), &dir, 601, None).unwrap_err();
+        assert!(
+            err.contains("--resolution must be at least 2 and at most 600"),
+            "{err}"
+        );
+        // 12 surfaces of 600 x 600 cells are about 0.4 GB: allowed. A system with 20 inputs
+        // and 2 outputs has 380 surfaces: 12 GB at that resolution, refused before drawing.
+        let mut builder = FuzzySystem::builder("wide");
+        for i in 0..20 {
+            builder = builder.input(
+                format!("x{i}"),
+                [0.0, 1.0],
+                [("A", fuzzy_sugeno::MembershipFn::gaussian(1.0, 0.0))],
+            );
+        }
+        let wide = builder
+            .output(
+                "u",
+                [0.0, 1.0],
+                [("c", fuzzy_sugeno::OutputFn::Constant(0.5))],
+            )
+            .output(
+                "v",
+                [0.0, 1.0],
+                [("c", fuzzy_sugeno::OutputFn::Constant(0.5))],
+            )
+            .rule(["A"; 20], ["c", "c"])
+            .build()
+            .unwrap();
+        let err = surface(&wide, &dir, 600, None).unwrap_err();
+        assert!(
+            err.contains("380 surfaces") && err.contains("12.3 GB"),
+            "{err}"
+        );
+        assert!(!dir.exists(), "nothing is written");
+    }
+
+    #[test]
+    fn an_input_without_membership_functions_gets_no_membership_plot() {
+        let text = include_str!("../../fuzzy-sugeno/data/interop/matlab_legacy.fis");
+        let dir = temp_dir("no-sets");
+        let written = surface(&load_system(text).unwrap(), &dir, 3, None).unwrap();
+        assert!(!written.contains(&dir.join("mf_load.svg")));
+        assert!(written.contains(&dir.join("mf_angle.svg")));
+        assert!(written.contains(&dir.join("surface_torque_rate_load.svg")));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

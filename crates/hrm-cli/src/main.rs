@@ -1,12 +1,15 @@
 //! `hrm`: the command line of the hyper-redundant manipulator toolkit.
 #![deny(missing_docs)]
 
+mod args;
+mod console;
 mod eval;
 mod experiment;
 mod figures;
 mod fis_cmd;
 mod fis_export;
 mod fis_train;
+mod output_dir;
 mod plot;
 mod progress;
 mod report;
@@ -69,7 +72,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
-            eprintln!("hrm: {message}");
+            eprintln!("{}", console::error_line(&message));
             ExitCode::FAILURE
         }
     }

@@ -394,11 +394,22 @@ fn span(values: impl Iterator<Item = f64>, axis: &str) -> Result<Range<f64>, Str
     if lo > hi {
         return Err(format!("nothing to plot: no {axis} values"));
     }
+    // A span beyond double precision (values near ±f64::MAX) cannot be scaled to a chart.
+    let unplottable = |range: Range<f64>| {
+        if (range.end - range.start).is_finite() {
+            Ok(range)
+        } else {
+            Err(format!(
+                "cannot plot a non-finite {axis} span: the values run from {lo:e} to {hi:e}, \
+                 beyond double precision"
+            ))
+        }
+    };
     if hi - lo <= 1e-12 * lo.abs().max(hi.abs()).max(1.0) {
         let pad = 0.5 * lo.abs().max(1.0);
-        return Ok(lo - pad..hi + pad);
+        return unplottable(lo - pad..hi + pad);
     }
-    Ok(lo..hi)
+    unplottable(lo..hi)
 }
 
 /// Cell boundaries around ascending samples: the ends, and the midpoints between neighbours.
@@ -413,6 +424,18 @@ fn cell_edges(samples: &[f64]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spans_beyond_double_precision_are_refused() {
+        let err = span([-1e308, 1e308].into_iter(), "z").unwrap_err();
+        assert!(
+            err.contains("non-finite z span") && err.contains("1e308"),
+            "{err}"
+        );
+        let err = span([f64::MAX, f64::MAX].into_iter(), "z").unwrap_err();
+        assert!(err.contains("non-finite z span"), "{err}");
+        assert_eq!(span([1e300, 2e300].into_iter(), "z").unwrap(), 1e300..2e300);
+    }
 
     #[test]
     fn spans_and_cell_edges() {

@@ -436,7 +436,9 @@ fn edge_case_lines_get_one_error_each_and_the_stream_goes_on() {
         (r#"{"id":9,"op":"fk","a":["NaN",0],"alpha0":0}"#.into(), "invalid_request"),
         (r#"{"id":10,"op":"dynamics","theta":[],"theta_dot":[]}"#.into(), "invalid_input"),
         (format!(r#"{{"id":11,"op":"fuzzy","fis":{huge_fis},"inputs":[0,0,0,0]}}"#), "invalid_input"),
-        (r#"{"id":12,"op":"joints","a":[1.7e308,1.7e308,1.7e308]}"#.into(), "numerical"),
+        // theta = J a overflows; a huge alpha0 alone does not (it is reduced modulo 2 pi).
+        (r#"{"id":12,"op":"joints","harmonics":2,"a":[1.7e308,1.7e308,1.7e308,1.7e308,0]}"#.into(), "numerical"),
+        (r#"{"id":12.5,"op":"joints","a":[0,0,1.7e308]}"#.into(), "ok"),
         ("\u{feff}{\"id\":13,\"op\":\"fk\"}".into(), "parse"),
         (r#"{"id":-0,"op":"joints","a":[-0,-0,-0]}"#.into(), "ok"),
     ];

@@ -27,6 +27,18 @@ pub enum DynError {
         /// The offending value.
         value: f64,
     },
+    /// A parameter of a lone link (from [`Link::new`](crate::Link::new) or
+    /// [`Link::uniform_beam`](crate::Link::uniform_beam), which know no index) was out of its
+    /// domain; [`DynError::at_link`] names the link once the caller knows where it goes.
+    #[error("link {quantity} must be {requirement}, got {value}")]
+    InvalidLinkParameter {
+        /// Which parameter, as in [`DynError::InvalidLink`].
+        quantity: &'static str,
+        /// What it must be.
+        requirement: &'static str,
+        /// The offending value.
+        value: f64,
+    },
     /// The gravitational acceleration was not finite.
     #[error("gravity must be finite, got {0}")]
     InvalidGravity(f64),
@@ -63,4 +75,30 @@ pub enum DynError {
     /// precision; the accelerations would have no reliable digits.
     #[error("the mass matrix is not numerically positive definite")]
     NotPositiveDefinite,
+}
+
+impl DynError {
+    /// Names the link of a [`DynError::InvalidLinkParameter`]: it becomes
+    /// [`DynError::InvalidLink`] with this 0-based `index`. Every other error is returned as is.
+    ///
+    /// ```
+    /// let err = manip_dyn::Link::new(0.1, -1.0, 0.05, 0.0).unwrap_err();
+    /// assert_eq!(err.to_string(), "link mass must be positive and finite, got -1");
+    /// assert_eq!(err.at_link(3).to_string(), "link 3: mass must be positive and finite, got -1");
+    /// ```
+    pub fn at_link(self, index: usize) -> Self {
+        match self {
+            Self::InvalidLinkParameter {
+                quantity,
+                requirement,
+                value,
+            } => Self::InvalidLink {
+                index,
+                quantity,
+                requirement,
+                value,
+            },
+            other => other,
+        }
+    }
 }

@@ -29,6 +29,11 @@
 //! ```
 #![deny(missing_docs)]
 
+/// The README's example, compiled and run as a doctest.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 mod aba;
 mod bias;
 mod check;

@@ -24,7 +24,9 @@ impl Link {
         Self::new(length, mass, 0.5 * length, mass * length * length / 12.0)
     }
 
-    /// A link with explicit centre-of-mass offset and inertia; validated as in [`ChainModel::new`].
+    /// A link with explicit centre-of-mass offset and inertia; validated as in [`ChainModel::new`],
+    /// but a lone link has no index, so a failure is [`DynError::InvalidLinkParameter`] (see
+    /// [`DynError::at_link`]).
     pub fn new(length: f64, mass: f64, com: f64, inertia: f64) -> Result<Self, DynError> {
         let link = Self {
             length,
@@ -32,14 +34,14 @@ impl Link {
             com,
             inertia,
         };
-        link.validate(0)?;
+        link.validate()?;
         Ok(link)
     }
 
-    fn validate(&self, index: usize) -> Result<(), DynError> {
+    /// Checks the parameters; a failure is [`DynError::InvalidLinkParameter`], without an index.
+    fn validate(&self) -> Result<(), DynError> {
         let invalid = |quantity, requirement, value| {
-            Err(DynError::InvalidLink {
-                index,
+            Err(DynError::InvalidLinkParameter {
                 quantity,
                 requirement,
                 value,
@@ -68,10 +70,11 @@ impl Link {
     }
 }
 
-/// The most links a chain may have. A [`ChainData`](crate::ChainData) holds an `n x n` mass
-/// matrix, 128 MiB at this limit; a larger `n` is refused with [`DynError::TooManyLinks`] rather
-/// than risk aborting the process on a failed allocation.
-pub const MAX_LINKS: usize = 4096;
+/// The most links a chain may have: the workspace's one limit, `backbone_kin::MAX_LINKS`. A
+/// [`ChainData`](crate::ChainData) holds an `n x n` mass matrix, 128 MiB at this limit; a larger
+/// `n` is refused with [`DynError::TooManyLinks`] rather than risk aborting the process on a
+/// failed allocation.
+pub use backbone_kin::MAX_LINKS;
 
 /// A planar serial chain of revolute joints under gravity along `-y`.
 ///
@@ -89,7 +92,7 @@ impl ChainModel {
     pub fn new(links: Vec<Link>, gravity: f64) -> Result<Self, DynError> {
         check_link_count(links.len())?;
         for (index, link) in links.iter().enumerate() {
-            link.validate(index)?;
+            link.validate().map_err(|e| e.at_link(index))?;
         }
         if !gravity.is_finite() {
             return Err(DynError::InvalidGravity(gravity));

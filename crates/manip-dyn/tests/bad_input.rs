@@ -19,7 +19,10 @@ fn arm() -> ChainModel {
 /// The link parameter an `InvalidLink` error names.
 fn invalid_quantity(result: Result<ChainModel, DynError>) -> &'static str {
     match result {
-        Err(DynError::InvalidLink { quantity, .. }) => quantity,
+        Err(
+            DynError::InvalidLink { quantity, .. }
+            | DynError::InvalidLinkParameter { quantity, .. },
+        ) => quantity,
         other => panic!("expected InvalidLink, got {other:?}"),
     }
 }
@@ -69,7 +72,7 @@ fn non_positive_or_non_finite_mass() {
         assert!(
             matches!(
                 err,
-                DynError::InvalidLink {
+                DynError::InvalidLinkParameter {
                     quantity: "mass",
                     ..
                 }
@@ -86,7 +89,7 @@ fn negative_or_non_finite_inertia() {
         assert!(
             matches!(
                 err,
-                DynError::InvalidLink {
+                DynError::InvalidLinkParameter {
                     quantity: "inertia",
                     requirement: "non-negative and finite",
                     ..
@@ -118,7 +121,7 @@ fn point_mass_on_the_joint() {
     assert!(
         matches!(
             err,
-            DynError::InvalidLink {
+            DynError::InvalidLinkParameter {
                 quantity: "inertia about the joint (inertia + mass * com^2)",
                 ..
             }
@@ -262,4 +265,23 @@ fn overflowing_result() {
     let err = kinetic_energy(&arm, &mut data, &[0.0; 3], &[1e200; 3]).unwrap_err();
     assert!(matches!(err, DynError::NonFiniteResult { .. }), "{err:?}");
     assert!(err.to_string().contains("too large for double precision"));
+}
+
+#[test]
+fn a_bad_link_is_named_by_its_real_index_or_by_none() {
+    // A lone link has no index, so its message claims none ...
+    let err = Link::new(0.1, -1.0, 0.05, 0.0).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "link mass must be positive and finite, got -1"
+    );
+    // ... and a chain names the link where it sits.
+    let good = Link::uniform_beam(0.1, 0.1).unwrap();
+    let bad = Link { mass: -1.0, ..good };
+    let err = ChainModel::new(vec![good, good, bad], 9.81).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "link 2: mass must be positive and finite, got -1"
+    );
+    assert_eq!(Link::new(0.1, -1.0, 0.05, 0.0).unwrap_err().at_link(2), err);
 }

@@ -23,6 +23,19 @@ pub enum ReduceError {
         /// Links of the chain.
         links: usize,
     },
+    /// The modal map was built for links of other relative lengths than the chain's, so its `J`
+    /// would put the links at the wrong arc lengths of the curve (eq 7).
+    #[error(
+        "the modal map's link {link} spans {map_fraction:e} of the curve but the chain's link          {link} spans {chain_fraction:e}: build the map from the chain's link lengths          (ReducedModel::from_chain or ModalMap::new)"
+    )]
+    GeometryMismatch {
+        /// 0-based index of the first link that differs.
+        link: usize,
+        /// `L_i / l` of the map's links.
+        map_fraction: f64,
+        /// `L_i / l` of the chain's links.
+        chain_fraction: f64,
+    },
     /// The modal Jacobian has dependent columns, so `M* = J^T M J` would be singular.
     #[error(
         "the modal Jacobian J ({links} x {coords}) is column-rank-deficient (smallest eigenvalue \

@@ -1,7 +1,7 @@
 //! The immutable reduced model: a chain and a constant modal map (the "Model" of the Model/Data
 //! split).
 
-use backbone_kin::ModalMap;
+use backbone_kin::{BaseAngle, ModalMap};
 use faer::Mat;
 use manip_dyn::ChainModel;
 
@@ -12,6 +12,10 @@ use crate::small_linalg::symmetric_eigen_extremes;
 /// smallest singular value of `J` with unit columns) the map is treated as rank-deficient: `M*`
 /// would then be singular or too ill-conditioned for a solve to mean anything.
 const RANK_TOLERANCE: f64 = 1e-10;
+
+/// Largest relative difference between a map's and a chain's link fractions `L_i / l` that counts
+/// as the same geometry: rounding of the two sums, far below any real difference in design.
+const GEOMETRY_TOLERANCE: f64 = 1e-12;
 
 /// The per-link constants of the default path (see [`crate::terms`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,11 +60,41 @@ pub struct ReducedModel {
 }
 
 impl ReducedModel {
+    /// The reduced model of `chain` under the `harmonics`-mode map built from the chain's own
+    /// link lengths (eq 7 with `s_i` the midpoints of its links), `alpha0` a coordinate or fixed
+    /// as `base` says. Fails as [`new`](Self::new) does, and with
+    /// [`ReduceError::Kin`] for a bad harmonic count or `alpha0`.
+    ///
+    /// ```
+    /// use backbone_kin::BaseAngle;
+    /// use manip_dyn::{ChainModel, Link};
+    /// use modal_reduce::ReducedModel;
+    ///
+    /// let links = [0.3, 0.2, 0.2, 0.1].map(|length| Link::uniform_beam(length, 0.1));
+    /// let chain = ChainModel::new(links.into_iter().collect::<Result<_, _>>()?, 9.81)?;
+    /// let model = ReducedModel::from_chain(chain, 1, BaseAngle::Fixed(1.0))?;
+    /// assert_eq!(model.n_coords(), 2);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn from_chain(
+        chain: ChainModel,
+        harmonics: usize,
+        base: BaseAngle,
+    ) -> Result<Self, ReduceError> {
+        let lengths: Vec<f64> = chain.link_lengths().collect();
+        let map = ModalMap::new(&lengths, harmonics, base)?;
+        Self::new(chain, map)
+    }
+
     /// Builds the reduced model of `chain` under `map`.
     ///
-    /// Fails if the map's joint count differs from the chain's link count, or if `J` is
-    /// column-rank-deficient (for example three coordinates on fewer than three links, or more
-    /// harmonics than the links can resolve), since `M* = J^T M J` would then be singular.
+    /// Fails if the map's joint count differs from the chain's link count, if the map was built
+    /// for links of other relative lengths (`L_i / l` differing by more than `1e-12` relative:
+    /// for example [`ModalMap::paper`] with a chain of unequal links, whose `J` would be
+    /// silently wrong), or if `J` is column-rank-deficient (for example three coordinates on
+    /// fewer than three links, or more harmonics than the links can resolve), since
+    /// `M* = J^T M J` would then be singular. [`from_chain`](Self::from_chain) builds the map
+    /// that fits.
     pub fn new(chain: ChainModel, map: ModalMap) -> Result<Self, ReduceError> {
         let (n, m) = (map.n_joints(), map.n_coords());
         if n != chain.n_links() {
@@ -69,6 +103,7 @@ impl ReducedModel {
                 links: chain.n_links(),
             });
         }
+        check_geometry(&chain, &map)?;
         check_column_rank(&map)?;
         let jacobian = Mat::from_fn(n, m, |i, j| map.entry(i, j));
         // mu_l, the mass beyond link l (see the module `terms` for this and S_l, h_ll and K).
@@ -156,6 +191,28 @@ impl ReducedModel {
     pub(crate) fn link_constants(&self) -> &[LinkConstants] {
         &self.links
     }
+}
+
+/// Refuses a map built for links of other relative lengths than the chain's.
+fn check_geometry(chain: &ChainModel, map: &ModalMap) -> Result<(), ReduceError> {
+    let map_total: f64 = map.link_lengths().iter().sum();
+    let chain_total = chain.total_length();
+    for (link, (&map_length, chain_length)) in map
+        .link_lengths()
+        .iter()
+        .zip(chain.link_lengths())
+        .enumerate()
+    {
+        let (map_fraction, chain_fraction) = (map_length / map_total, chain_length / chain_total);
+        if (map_fraction - chain_fraction).abs() > GEOMETRY_TOLERANCE * chain_fraction {
+            return Err(ReduceError::GeometryMismatch {
+                link,
+                map_fraction,
+                chain_fraction,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Refuses a map whose `J` has (numerically) dependent columns.

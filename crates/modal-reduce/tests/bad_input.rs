@@ -37,6 +37,49 @@ fn map_and_chain_link_counts_differ() {
 }
 
 #[test]
+fn map_built_for_other_link_lengths() {
+    // 20 tapered links: the paper's equal-link map would put them at the wrong arc lengths.
+    let lengths: Vec<f64> = (0..20)
+        .map(|i| 0.075 - 0.05 * f64::from(i) / 19.0)
+        .collect();
+    let links = lengths
+        .iter()
+        .map(|&length| manip_dyn::Link::uniform_beam(length, 0.1).unwrap())
+        .collect();
+    let tapered = ChainModel::new(links, 9.81).unwrap();
+    let err = ReducedModel::new(tapered.clone(), ModalMap::paper(20).unwrap()).unwrap_err();
+    assert!(
+        matches!(err, ReduceError::GeometryMismatch { link: 0, .. }),
+        "{err:?}"
+    );
+    assert!(
+        err.to_string().contains("ReducedModel::from_chain"),
+        "{err}"
+    );
+    // The map of the chain's own links, or proportional ones, is accepted, and from_chain
+    // builds the same model.
+    let scaled: Vec<f64> = lengths.iter().map(|x| 3.0 * x).collect();
+    let own = ModalMap::new(&scaled, 1, BaseAngle::Free).unwrap();
+    let by_map = ReducedModel::new(tapered.clone(), own).unwrap();
+    let direct = ReducedModel::from_chain(tapered, 1, BaseAngle::Free).unwrap();
+    for i in 0..20 {
+        for j in 0..3 {
+            approx::assert_abs_diff_eq!(
+                by_map.map().entry(i, j),
+                direct.map().entry(i, j),
+                epsilon = 1e-14
+            );
+        }
+    }
+    // Equal links of any length match the paper's map.
+    ReducedModel::new(chain(7), ModalMap::paper(7).unwrap()).unwrap();
+    assert!(matches!(
+        ReducedModel::from_chain(chain(4), 0, BaseAngle::Free),
+        Err(ReduceError::Kin(KinError::NoHarmonics))
+    ));
+}
+
+#[test]
 fn three_coordinates_on_fewer_than_three_links() {
     for n in [1, 2] {
         let err = ReducedModel::new(chain(n), ModalMap::paper(n).unwrap()).unwrap_err();

@@ -109,7 +109,7 @@ pub(crate) fn check_positive(name: &str, value: f64) -> Result<(), SimError> {
     } else {
         Err(SimError::setting(
             name,
-            format!("must be positive and finite, got {value}"),
+            format!("must be positive and finite, got {}", Readable(value)),
         ))
     }
 }
@@ -121,7 +121,7 @@ pub(crate) fn check_non_negative(name: &str, value: f64) -> Result<(), SimError>
     } else {
         Err(SimError::setting(
             name,
-            format!("must be non-negative and finite, got {value}"),
+            format!("must be non-negative and finite, got {}", Readable(value)),
         ))
     }
 }
@@ -131,5 +131,43 @@ pub(crate) fn check_finite(name: &str, values: &[f64]) -> Result<(), SimError> {
     match values.iter().find(|v| !v.is_finite()) {
         None => Ok(()),
         Some(v) => Err(SimError::setting(name, format!("must be finite, got {v}"))),
+    }
+}
+
+/// A number in an error message as a person reads it: plain decimals from `1e-4` up to `1e15`
+/// (`0.001`, `-0.5`, `250`), exponents beyond (`1e-300`, `1e300`), never a 300-digit decimal.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Readable(pub f64);
+
+impl std::fmt::Display for Readable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let magnitude = self.0.abs();
+        if self.0 == 0.0 || !self.0.is_finite() || (1e-4..1e15).contains(&magnitude) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Readable;
+
+    #[test]
+    fn numbers_are_readable() {
+        for (x, text) in [
+            (0.0, "0"),
+            (-0.5, "-0.5"),
+            (0.001, "0.001"),
+            (250.0, "250"),
+            (1e-300, "1e-300"),
+            (-1e300, "-1e300"),
+            (f64::MAX, "1.7976931348623157e308"),
+            (f64::NAN, "NaN"),
+            (f64::INFINITY, "inf"),
+        ] {
+            assert_eq!(Readable(x).to_string(), text);
+        }
     }
 }

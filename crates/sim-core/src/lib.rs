@@ -27,8 +27,14 @@
 //! ```
 #![deny(missing_docs)]
 
+/// The README's example, compiled and run as a doctest.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 pub mod controller;
 mod error;
+mod input_file;
 mod noise;
 pub mod ode;
 mod record;
@@ -37,12 +43,13 @@ mod scenario;
 mod simulation;
 
 pub use error::SimError;
+pub use input_file::{MAX_INPUT_FILE_BYTES, read_text_file};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use scenario::{
     ArmSpec, BranchSpec, ControllerKind, ControllerSpec, InitialSpec, IntegratorSpec, LimitsSpec,
     NoiseSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec, TorqueLimit,
 };
 pub use simulation::{
-    Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, Run, RunFailure,
-    Simulation,
+    Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS, Run,
+    RunFailure, Simulation,
 };

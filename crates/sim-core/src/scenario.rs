@@ -465,9 +465,11 @@ impl Scenario {
 
     /// Reads a scenario file; a relative `controller.fis` path is taken relative to the file.
     pub fn load(path: &Path) -> Result<Self, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
-            path: path.to_path_buf(),
-            message: e.to_string(),
+        let text = crate::read_text_file(path, crate::MAX_INPUT_FILE_BYTES).map_err(|e| {
+            ScenarioError::Io {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            }
         })?;
         let mut scenario = parse(&text, &path.display().to_string())?;
         if let (Some(fis), Some(dir)) = (&scenario.controller.fis, path.parent())
@@ -608,23 +610,9 @@ impl ArmSpec {
         };
         let lengths = per_link(&self.lengths, self.link_length.unwrap_or(0.1));
         let masses = per_link(&self.masses, self.link_mass.unwrap_or(0.1));
-        // A lone link validates as link 0: name the link's real index.
+        // A lone link has no index: name the link's real one.
         let arm_error = |i: usize, e: manip_dyn::DynError| {
-            let e = match e {
-                manip_dyn::DynError::InvalidLink {
-                    quantity,
-                    requirement,
-                    value,
-                    ..
-                } => manip_dyn::DynError::InvalidLink {
-                    index: i,
-                    quantity,
-                    requirement,
-                    value,
-                },
-                other => other,
-            };
-            SimError::setting("arm", format!("is invalid: {e}"))
+            SimError::setting("arm", format!("is invalid: {}", e.at_link(i)))
         };
         let mut links = Vec::with_capacity(n);
         for i in 0..n {
@@ -702,12 +690,13 @@ impl ControllerSpec {
         match &self.fis {
             None => Ok(fuzzy_sugeno::paper_controller()),
             Some(path) => {
-                let text = std::fs::read_to_string(path).map_err(|e| {
-                    SimError::setting(
-                        "controller.fis",
-                        format!("cannot be read from {}: {e}", path.display()),
-                    )
-                })?;
+                let text =
+                    crate::read_text_file(path, crate::MAX_INPUT_FILE_BYTES).map_err(|e| {
+                        SimError::setting(
+                            "controller.fis",
+                            format!("cannot be read from {}: {e}", path.display()),
+                        )
+                    })?;
                 Ok(FuzzySystem::from_fis(&text)?)
             }
         }
@@ -800,10 +789,36 @@ mod seed_text {
     }
 }
 
+/// Parses scenario text; a refusal is one line: `line L, column C (`<that line>`): <what is
+/// wrong>` (toml's own message spans several lines around the quoted text).
 fn parse(text: &str, origin: &str) -> Result<Scenario, ScenarioError> {
-    toml::from_str(text).map_err(|e| ScenarioError::Parse {
-        origin: origin.to_string(),
-        message: e.to_string().trim_end().to_string(),
+    toml::from_str(text).map_err(|e| {
+        let what = e.message().trim_end().replace('\n', "; ");
+        let message = match e.span() {
+            Some(span) => {
+                let mut end = span.start.min(text.len());
+                while !text.is_char_boundary(end) {
+                    end -= 1;
+                }
+                let before = &text[..end];
+                let line = before.matches('\n').count() + 1;
+                let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+                let quoted: String = text
+                    .lines()
+                    .nth(line - 1)
+                    .unwrap_or_default()
+                    .trim()
+                    .chars()
+                    .take(80)
+                    .collect();
+                format!("line {line}, column {column} (`{quoted}`): {what}")
+            }
+            None => what,
+        };
+        ScenarioError::Parse {
+            origin: origin.to_string(),
+            message,
+        }
     })
 }
 

@@ -3,7 +3,7 @@
 //! output held in between (zero-order hold).
 
 use crate::controller::{Controller, ModalState};
-use crate::error::{SimError, check_finite, check_non_negative, check_positive};
+use crate::error::{Readable, SimError, check_finite, check_non_negative, check_positive};
 use crate::noise::GaussianNoise;
 use crate::ode::{DormandPrince, OdeSystem, Rk4, Tolerances};
 use crate::record::{Metrics, Record, Sample, Summary};
@@ -163,8 +163,9 @@ impl Simulation {
     /// Fails with [`SimError::InvalidSetting`] for a model with another coordinate set, and for
     /// settings out of their domain: non-positive periods or duration, periods that are not
     /// whole multiples (controller period of the RK4 step, duration and recording period of the
-    /// controller period), a duration of more than [`MAX_CONTROLLER_SAMPLES`] periods or a
-    /// record of more than [`MAX_RECORDED_VALUES`] numbers, negative or non-finite noise, a
+    /// controller period), a duration of more than [`MAX_CONTROLLER_SAMPLES`] periods or
+    /// [`MAX_RK4_STEPS`] RK4 steps, a record of more than [`MAX_RECORDED_VALUES`] numbers,
+    /// negative or non-finite noise, a
     /// non-positive error bound, or torque limits of the wrong length or sign.
     pub fn new(
         model: ReducedModel,
@@ -440,8 +441,15 @@ fn whole_ratio(numerator: f64, denominator: f64) -> Option<usize> {
 }
 
 /// The most controller samples a run may take: a guard against typos like `1e300` for `1e3`,
-/// whose run would never end and whose sample count would not fit a `usize`.
-pub const MAX_CONTROLLER_SAMPLES: f64 = 1e12;
+/// whose run would never end and whose sample count would not fit a `usize`. Every period
+/// takes at least one integrator step, so this also bounds a Dormand-Prince run to hours, as
+/// [`MAX_RK4_STEPS`] bounds an RK4 run.
+pub const MAX_CONTROLLER_SAMPLES: f64 = 1e9;
+
+/// The most fixed steps an RK4 run may take (`duration / integrator.dt`): about half an hour of
+/// computing for a 10-link arm, so a step typed `1e-12` for `1e-4` is refused up front rather
+/// than running for days.
+pub const MAX_RK4_STEPS: f64 = 1e9;
 
 /// The most numbers a run may record (1 GiB of `f64`): [`Simulation::new`] refuses a duration and
 /// recording period that would record more, instead of failing to allocate during the run.
@@ -473,7 +481,8 @@ fn validate(s: &LoopSettings, n_links: usize) -> Result<(), SimError> {
             "duration",
             format!(
                 "must be at most {MAX_CONTROLLER_SAMPLES:e} controller periods ({} s), got {:e} s",
-                s.controller_period, s.duration
+                Readable(s.controller_period),
+                s.duration
             ),
         ));
     }
@@ -482,7 +491,8 @@ fn validate(s: &LoopSettings, n_links: usize) -> Result<(), SimError> {
             "duration",
             format!(
                 "must be a whole number of controller periods ({} s), got {} s",
-                s.controller_period, s.duration
+                Readable(s.controller_period),
+                Readable(s.duration)
             ),
         ));
     }
@@ -491,7 +501,8 @@ fn validate(s: &LoopSettings, n_links: usize) -> Result<(), SimError> {
             "record_period",
             format!(
                 "must be a whole number of controller periods ({} s), got {} s",
-                s.controller_period, s.record_period
+                Readable(s.controller_period),
+                Readable(s.record_period)
             ),
         ));
     }
@@ -502,8 +513,9 @@ fn validate(s: &LoopSettings, n_links: usize) -> Result<(), SimError> {
                 return Err(SimError::setting(
                     "controller.period",
                     format!(
-                        "must be a whole number of RK4 steps ({dt} s), got {} s",
-                        s.controller_period
+                        "must be a whole number of RK4 steps ({} s), got {} s",
+                        Readable(dt),
+                        Readable(s.controller_period)
                     ),
                 ));
             }
@@ -534,6 +546,20 @@ fn validate(s: &LoopSettings, n_links: usize) -> Result<(), SimError> {
                 s.duration
             ),
         ));
+    }
+    if let Integrator::Rk4 { dt } = s.integrator {
+        let steps = s.duration / dt;
+        if steps > MAX_RK4_STEPS {
+            return Err(SimError::setting(
+                "integrator.dt",
+                format!(
+                    "would take {steps:.3e} RK4 steps over {} s, more than the \
+                     {MAX_RK4_STEPS:e} a run may take (hours of computing): use a larger step \
+                     or simulate less",
+                    Readable(s.duration)
+                ),
+            ));
+        }
     }
     if let Some(limits) = &s.joint_torque_limits {
         if limits.len() != n_links {

@@ -9,7 +9,8 @@ use sim_core::controller::{ComputedTorque, FuzzyController, PdController};
 use sim_core::ode::{DormandPrince, OdeError, OdeSystem, Rk4, Tolerances};
 use sim_core::reference::{CartesianPath, PathShape, Sinusoid, Step};
 use sim_core::{
-    Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, SimError, Simulation,
+    Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS, SimError,
+    Simulation,
 };
 use std::f64::consts::FRAC_PI_2;
 
@@ -244,10 +245,34 @@ fn run_that_would_never_end() {
 }
 
 #[test]
-fn run_too_long_to_record() {
-    // 1e12 samples would be recorded: refused up front instead of failing to allocate.
+fn run_of_astronomically_many_rk4_steps() {
+    // 0.1 s in steps of 1e-12 s: 1e11 steps, days of computing, refused up front with the count.
+    let s = LoopSettings::new(Integrator::Rk4 { dt: 1e-12 }, 1e-3, 0.1);
+    let (name, message) = invalid(build(s));
+    assert_eq!(name, "integrator.dt");
+    assert!(
+        message.contains("1.000e11 RK4 steps over 0.1 s")
+            && message.contains(&format!("more than the {MAX_RK4_STEPS:e}")),
+        "{message}"
+    );
+    // A step of 1e-300 s is refused the same way, its numbers readable (no 300-digit decimal).
+    let s = LoopSettings::new(Integrator::Rk4 { dt: 1e-300 }, 1e-3, 0.1);
+    let (_, message) = invalid(build(s));
+    assert!(message.contains("1.000e299 RK4 steps"), "{message}");
+    // A duration of 1e-300 s is not a whole number of periods; the message shows it as 1e-300.
     let s = LoopSettings {
-        duration: 1e9,
+        duration: 1e-300,
+        ..settings()
+    };
+    let (_, message) = invalid(build(s));
+    assert!(message.ends_with("got 1e-300 s"), "{message}");
+}
+
+#[test]
+fn run_too_long_to_record() {
+    // 1e8 samples would be recorded: refused up front instead of failing to allocate.
+    let s = LoopSettings {
+        duration: 1e5,
         ..settings()
     };
     let (name, message) = invalid(build(s));

@@ -342,7 +342,7 @@ mod regressions {
             .to_string();
         assert_eq!(
             message,
-            "duration must be at most 1e12 controller periods (0.001 s), got 1e300 s"
+            "duration must be at most 1e9 controller periods (0.001 s), got 1e300 s"
         );
     }
 
@@ -400,6 +400,7 @@ mod regressions {
         ] {
             let message = Scenario::from_toml(&text).unwrap_err().to_string();
             assert!(message.contains("line "), "{message}");
+            assert!(!message.contains('\n'), "one line: {message}");
         }
     }
 }

@@ -551,8 +551,9 @@ impl Anfis {
             for (p, g) in params[..count].iter_mut().zip(&self.grad[offset..]) {
                 *p -= eta * g;
             }
+            let before = *mf;
             *mf = MembershipFn::from_matlab_unchecked(mf.matlab_name(), &params[..count]);
-            repair(mf, self.mf_span[m]);
+            repair(mf, &before, self.mf_span[m]);
             self.net.compiled[m] = CompiledMf::new(mf)?;
         }
         Ok(())

@@ -125,7 +125,55 @@ pub(crate) fn gradient(mf: &MembershipFn, x: f64, mu: f64, grad: &mut [f64; 4]) 
             let (d2a, d2c) = sigmoid_gradient(x, slope2, center2);
             *grad = [d1a * s2, d1c * s2, s1 * d2a, s1 * d2c];
         }
+        MembershipFn::SShape { start, end } => {
+            let (da, db) = s_shape_gradient(x, start, end);
+            grad[0] = da;
+            grad[1] = db;
+        }
+        MembershipFn::ZShape { start, end } => {
+            // zmf = 1 - smf where a < b; both are constant steps otherwise.
+            let (da, db) = s_shape_gradient(x, start, end);
+            grad[0] = -da;
+            grad[1] = -db;
+        }
+        MembershipFn::PiShape {
+            left_foot: a,
+            left_shoulder: b,
+            right_shoulder: c,
+            right_foot: d,
+        } => {
+            // pimf = smf(a, b) zmf(c, d).
+            let rising = mf_degree(&MembershipFn::SShape { start: a, end: b }, x);
+            let falling = mf_degree(&MembershipFn::ZShape { start: c, end: d }, x);
+            let (da, db) = s_shape_gradient(x, a, b);
+            let (dc, dd) = s_shape_gradient(x, c, d);
+            *grad = [da * falling, db * falling, -dc * rising, -dd * rising];
+        }
         MembershipFn::Constant { .. } => {}
+    }
+}
+
+/// The degree of a function whose parameters were validated (smf and zmf accept any finite
+/// parameters, so this cannot fail for them).
+fn mf_degree(mf: &MembershipFn, x: f64) -> f64 {
+    mf.degree(x).unwrap_or(0.0)
+}
+
+/// `(d mu / d a, d mu / d b)` of MATLAB's `smf(x, [a b])`: on the rising half
+/// `mu = 2 t^2`, `t = (x - a) / (b - a)`; on the upper half `mu = 1 - 2 s^2`,
+/// `s = (b - x) / (b - a)`; zero outside `(a, b]` and for the step `a >= b`. At the middle
+/// `(a + b) / 2` the rising half is the piece MATLAB evaluates.
+fn s_shape_gradient(x: f64, a: f64, b: f64) -> (f64, f64) {
+    if a >= b || x <= a || x > b {
+        return (0.0, 0.0);
+    }
+    let w = b - a;
+    if x <= 0.5 * (a + b) {
+        let t = (x - a) / w;
+        (4.0 * t * (x - b) / (w * w), -4.0 * t * (x - a) / (w * w))
+    } else {
+        let s = (b - x) / w;
+        (-4.0 * s * (b - x) / (w * w), -4.0 * s * (x - a) / (w * w))
     }
 }
 
@@ -148,9 +196,56 @@ const MIN_BELL_SLOPE: f64 = 1e-3;
 
 /// Moves the parameters of `mf` back to valid values after a gradient step: positive widths,
 /// sigmas and bell slopes, triangle and trapezoid corners in order with the feet apart. `span`
-/// is the width of the input's range.
-pub(crate) fn repair(mf: &mut MembershipFn, span: f64) {
+/// is the width of the input's range. `before` is the function before the step: a spline of
+/// `smf`, `zmf` or either side of `pimf` that was one (`a < b`) stays one, with its ends at
+/// least the floor apart, rather than turning into the step `a >= b` (whose gradient is zero,
+/// so it would never move again); a step stays a step, since its parameters never move.
+pub(crate) fn repair(mf: &mut MembershipFn, before: &MembershipFn, span: f64) {
     let floor = span * MIN_WIDTH_FRACTION;
+    // Keeps `(a, b)` a spline with `b - a >= floor` if `was_spline`.
+    let spline = |a: &mut f64, b: &mut f64, was_spline: bool| {
+        if was_spline {
+            if *a > *b {
+                std::mem::swap(a, b);
+            }
+            *b = b.max(*a + floor);
+        }
+    };
+    match (mf, *before) {
+        (
+            MembershipFn::SShape { start, end } | MembershipFn::ZShape { start, end },
+            MembershipFn::SShape {
+                start: was_start,
+                end: was_end,
+            }
+            | MembershipFn::ZShape {
+                start: was_start,
+                end: was_end,
+            },
+        ) => spline(start, end, was_start < was_end),
+        (
+            MembershipFn::PiShape {
+                left_foot,
+                left_shoulder,
+                right_shoulder,
+                right_foot,
+            },
+            MembershipFn::PiShape {
+                left_foot: a,
+                left_shoulder: b,
+                right_shoulder: c,
+                right_foot: d,
+            },
+        ) => {
+            spline(left_foot, left_shoulder, a < b);
+            spline(right_shoulder, right_foot, c < d);
+        }
+        (mf, _) => repair_shape(mf, floor),
+    }
+}
+
+/// [`repair`] for the shapes whose validity does not depend on the function before the step.
+fn repair_shape(mf: &mut MembershipFn, floor: f64) {
     match mf {
         MembershipFn::Bell { width, slope, .. } => {
             *width = width.max(floor);
@@ -181,6 +276,9 @@ pub(crate) fn repair(mf: &mut MembershipFn, span: f64) {
         MembershipFn::Sigmoid { .. }
         | MembershipFn::SigmoidDifference { .. }
         | MembershipFn::SigmoidProduct { .. }
+        | MembershipFn::SShape { .. }
+        | MembershipFn::ZShape { .. }
+        | MembershipFn::PiShape { .. }
         | MembershipFn::Constant { .. } => {}
     }
 }
@@ -192,7 +290,7 @@ mod tests {
 
     /// Every type with random valid parameters, away from its kinks.
     fn arbitrary_mf() -> impl Strategy<Value = MembershipFn> {
-        (0usize..8, prop::array::uniform4(-1.0f64..1.0)).prop_map(|(kind, p)| {
+        (0usize..11, prop::array::uniform4(-1.0f64..1.0)).prop_map(|(kind, p)| {
             let mut s = p;
             s.sort_by(f64::total_cmp);
             let spread = |k: usize| s[0] + 0.5 * k as f64 + (s[k] - s[0]) * 0.1;
@@ -214,11 +312,27 @@ mod tests {
                     slope2: 4.0 * p[2],
                     center2: p[3],
                 },
-                _ => MembershipFn::SigmoidProduct {
+                7 => MembershipFn::SigmoidProduct {
                     slope1: 4.0 * p[0],
                     center1: p[1],
                     slope2: 4.0 * p[2],
                     center2: p[3],
+                },
+                // A spline, or the step a >= b when p[3] > 0.6.
+                8 | 9 => {
+                    let (a, b) = (spread(0), spread(1));
+                    let (start, end) = if p[3] > 0.6 { (b, a) } else { (a, b) };
+                    if kind == 8 {
+                        MembershipFn::SShape { start, end }
+                    } else {
+                        MembershipFn::ZShape { start, end }
+                    }
+                }
+                _ => MembershipFn::PiShape {
+                    left_foot: spread(0),
+                    left_shoulder: spread(1),
+                    right_shoulder: spread(2),
+                    right_foot: spread(3),
                 },
             }
         })
@@ -244,7 +358,17 @@ mod tests {
                 let (Ok(up), Ok(down)) = (degree_at(h), degree_at(-h)) else { continue };
                 // Skip points near a kink, where one side uses the other piece: a corner or
                 // shoulder at a parameter, or where dsigmf's |s1 - s2| crosses zero.
-                let kinked = params[..count].iter().any(|&q| (x - q).abs() < 1e-4)
+                // For smf, zmf and pimf the middle of each spline, and the step, are kinks too.
+                let middles = match mf {
+                    MembershipFn::SShape { start, end } | MembershipFn::ZShape { start, end } => {
+                        [0.5 * (start + end); 2]
+                    }
+                    MembershipFn::PiShape { left_foot, left_shoulder, right_shoulder, right_foot } => {
+                        [0.5 * (left_foot + left_shoulder), 0.5 * (right_shoulder + right_foot)]
+                    }
+                    _ => [f64::NAN; 2],
+                };
+                let kinked = params[..count].iter().chain(&middles).any(|&q| (x - q).abs() < 1e-4)
                     || (matches!(mf, MembershipFn::SigmoidDifference { .. }) && mu < 1e-4);
                 prop_assume!(!kinked);
                 let numeric = (up - down) / (2.0 * h);
@@ -263,8 +387,22 @@ mod tests {
                 *p += s;
             }
             let mut moved = MembershipFn::from_matlab_unchecked(mf.matlab_name(), &params[..count]);
-            repair(&mut moved, 2.0);
+            repair(&mut moved, &mf, 2.0);
             prop_assert!(moved.validate().is_ok(), "{moved:?}");
+            // A spline of smf, zmf or pimf stays a spline.
+            let pairs = |f: &MembershipFn| -> Vec<(f64, f64)> {
+                let (p, _) = f.param_array();
+                match f {
+                    MembershipFn::SShape { .. } | MembershipFn::ZShape { .. } => vec![(p[0], p[1])],
+                    MembershipFn::PiShape { .. } => vec![(p[0], p[1]), (p[2], p[3])],
+                    _ => vec![],
+                }
+            };
+            for ((a0, b0), (a1, b1)) in pairs(&mf).into_iter().zip(pairs(&moved)) {
+                if a0 < b0 {
+                    prop_assert!(b1 - a1 >= 2.0 * MIN_WIDTH_FRACTION * (1.0 - 1e-9), "{moved:?}");
+                }
+            }
         }
     }
 }

@@ -61,7 +61,7 @@ fn random_membership(rng: &mut Rng, lo: f64, hi: f64) -> MembershipFn {
         v
     };
     let p = sorted(4);
-    match rng.below(9) {
+    match rng.below(12) {
         0 => {
             let slope = [1.0, 2.0, 3.0, 1.5, 0.5, rng.range(0.3, 5.0)][rng.below(6)];
             MembershipFn::bell(rng.range(0.05, 1.0) * w, slope, rng.range(lo, hi))
@@ -88,12 +88,28 @@ fn random_membership(rng: &mut Rng, lo: f64, hi: f64) -> MembershipFn {
             slope2: -rng.range(1.0, 20.0) / w,
             center2: p[3],
         },
+        8 => MembershipFn::SShape {
+            start: p[0],
+            end: p[2],
+        },
+        9 => MembershipFn::ZShape {
+            start: p[1],
+            end: p[3],
+        },
+        10 => MembershipFn::PiShape {
+            left_foot: p[0],
+            left_shoulder: p[1],
+            right_shoulder: p[2],
+            right_foot: p[3],
+        },
         _ => MembershipFn::Constant { value: rng.unit() },
     }
 }
 
-/// A random valid system: 1-4 inputs with 1-4 sets each, 1-3 outputs, 1-12 rules with
-/// negations, don't-cares, weights and OR rules; constant consequents only if `zero_order`.
+/// A random valid system: 1-4 inputs with 1-4 sets each (or none, as MATLAB's `NumMFs=0`, for
+/// inputs after the first), set and term names that sometimes repeat (as MATLAB allows), 1-3
+/// outputs, 1-12 rules with negations, don't-cares, weights and OR rules; constant consequents
+/// only if `zero_order`.
 pub fn random_system(seed: u64, zero_order: bool) -> FuzzySystem {
     let mut rng = Rng::new(seed);
     let n_in = 1 + rng.below(4);
@@ -118,11 +134,20 @@ pub fn random_system(seed: u64, zero_order: bool) -> FuzzySystem {
     for i in 0..n_in {
         let lo = rng.range(-5.0, 5.0);
         let hi = lo + rng.range(0.5, 10.0);
-        let n_sets = 1 + rng.below(4);
+        let n_sets = if i > 0 && rng.chance(0.15) {
+            0
+        } else {
+            1 + rng.below(4)
+        };
         set_counts.push(n_sets);
-        let sets: Vec<(String, MembershipFn)> = (0..n_sets)
-            .map(|k| (rng.name(k), random_membership(&mut rng, lo, hi)))
-            .collect();
+        let mut sets: Vec<(String, MembershipFn)> = Vec::new();
+        for k in 0..n_sets {
+            let name = match sets.last() {
+                Some((previous, _)) if rng.chance(0.15) => previous.clone(),
+                _ => rng.name(k),
+            };
+            sets.push((name, random_membership(&mut rng, lo, hi)));
+        }
         builder = builder.input(format!("in{i}"), [lo, hi], sets);
     }
     let mut term_counts = Vec::new();
@@ -142,7 +167,12 @@ pub fn random_system(seed: u64, zero_order: bool) -> FuzzySystem {
                         constant: rng.range(lo, hi),
                     }
                 };
-                (rng.name(k), function)
+                let name = if k > 0 && rng.chance(0.15) {
+                    "shared".to_string()
+                } else {
+                    rng.name(k)
+                };
+                (name, function)
             })
             .collect();
         builder = builder.output(format!("out{o}"), [lo, hi], terms);
@@ -151,6 +181,7 @@ pub fn random_system(seed: u64, zero_order: bool) -> FuzzySystem {
         let mut antecedents: Vec<Antecedent> = set_counts
             .iter()
             .map(|&n| match rng.unit() {
+                _ if n == 0 => Antecedent::Any,
                 u if u < 0.25 => Antecedent::Any,
                 u if u < 0.85 => Antecedent::Is(rng.below(n)),
                 _ => Antecedent::IsNot(rng.below(n)),
@@ -254,7 +285,49 @@ pub fn reference_mu(mf: &MembershipFn, x: f64) -> f64 {
             slope2,
             center2,
         } => sig(slope1, center1) * sig(slope2, center2),
+        MembershipFn::SShape { start, end } => reference_s(x, start, end),
+        MembershipFn::ZShape { start, end } => reference_z(x, start, end),
+        MembershipFn::PiShape {
+            left_foot,
+            left_shoulder,
+            right_shoulder,
+            right_foot,
+        } => reference_s(x, left_foot, left_shoulder) * reference_z(x, right_shoulder, right_foot),
         MembershipFn::Constant { value } => value,
+    }
+}
+
+/// MATLAB's `smf(x, [a b])`, its step for `a >= b` included.
+fn reference_s(x: f64, a: f64, b: f64) -> f64 {
+    if a >= b {
+        return if x >= (a + b) / 2.0 { 1.0 } else { 0.0 };
+    }
+    let m = (a + b) / 2.0;
+    if x <= a {
+        0.0
+    } else if x <= m {
+        2.0 * ((x - a) / (b - a)).powi(2)
+    } else if x < b {
+        1.0 - 2.0 * ((x - b) / (b - a)).powi(2)
+    } else {
+        1.0
+    }
+}
+
+/// MATLAB's `zmf(x, [a b])`, its step for `a >= b` included.
+fn reference_z(x: f64, a: f64, b: f64) -> f64 {
+    if a >= b {
+        return if x <= (a + b) / 2.0 { 1.0 } else { 0.0 };
+    }
+    let m = (a + b) / 2.0;
+    if x <= a {
+        1.0
+    } else if x <= m {
+        1.0 - 2.0 * ((x - a) / (b - a)).powi(2)
+    } else if x < b {
+        2.0 * ((x - b) / (b - a)).powi(2)
+    } else {
+        0.0
     }
 }
 

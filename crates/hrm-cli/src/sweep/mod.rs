@@ -14,6 +14,8 @@ mod plan;
 mod report;
 mod shard_file;
 
+use crate::console;
+use crate::output_dir::{self, OutputDir};
 use clap::{Args, Subcommand};
 use plan::{RunId, Shard, SweepConfig};
 use rayon::prelude::*;
@@ -59,19 +61,19 @@ struct SweepArgs {
           default_values_t = [0.0, 0.005, 0.01, 0.02, 0.05, 0.1])]
     noise: Vec<f64>,
     /// Sensor noise std on (a1_dot, a2_dot) per unit of L (rad/s per rad).
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     rate_noise_ratio: f64,
     /// Noise std on the reference (a1_ref, a2_ref) per unit of L.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     reference_noise_ratio: f64,
-    /// Noise realisations (seeds) per noise level and controller.
-    #[arg(long, default_value_t = 10)]
-    seeds: usize,
-    /// The seed the runs' seeds derive from (SplitMix64).
-    #[arg(long, default_value_t = 1)]
-    base_seed: u64,
+    /// Noise realisations (seeds) per noise level and controller (at most 1000000).
+    #[arg(long, default_value_t = 10, allow_negative_numbers = true)]
+    seeds: i128,
+    /// The seed the runs' seeds derive from (SplitMix64), from 0 to 2^64 - 1.
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    base_seed: i128,
     /// Override the scenario's duration (s).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     duration: Option<f64>,
     /// Run only shard K of N (the runs i with i % N == K - 1) and write DIR/shard-K-of-N.json.
     #[arg(long, value_name = "K/N")]
@@ -85,13 +87,13 @@ struct SweepArgs {
 pub fn run(cli: SweepCli) -> Result<(), String> {
     match cli.command {
         Some(SweepCommand::Merge { out, shards }) => {
-            let table = merge_files(&shards, &out)?;
-            print!("{table}");
-            println!(
-                "wrote {} (runs.json, summary.json, table.txt, tip_error_rms.svg)",
+            let staging = OutputDir::create(&out, "sweep merge")?;
+            let table = merge_files(&shards, staging.path(), &out)?;
+            staging.commit()?;
+            console::print(&format!(
+                "{table}wrote {} (runs.json, summary.json, table.txt, tip_error_rms.svg)\n",
                 out.display()
-            );
-            Ok(())
+            ))
         }
         None => {
             let args = cli.sweep;
@@ -102,37 +104,73 @@ pub fn run(cli: SweepCli) -> Result<(), String> {
                     let path = args
                         .out
                         .join(format!("shard-{}-of-{}.json", shard.index, shard.count));
-                    write(&path, &to_json(&file)?)?;
+                    output_dir::write_file(&path, &to_json(&file)?, "sweep --shard")?;
                     let failed = file
                         .runs
                         .iter()
                         .filter(|r| matches!(r.outcome, Outcome::Failed { .. }))
                         .count();
-                    println!(
-                        "wrote {} ({} runs, {failed} stopped)",
+                    console::print(&format!(
+                        "wrote {} ({} runs, {failed} stopped)\n",
                         path.display(),
                         file.runs.len()
-                    );
-                    Ok(())
+                    ))
                 }
                 None => {
-                    let table = sweep_whole(&config, &args.out)?;
-                    print!("{table}");
-                    println!(
-                        "wrote {} (runs.json, summary.json, table.txt, tip_error_rms.svg)",
+                    let staging = OutputDir::create(&args.out, "sweep")?;
+                    let table = sweep_whole(&config, staging.path())?;
+                    staging.commit()?;
+                    console::print(&format!(
+                        "{table}wrote {} (runs.json, summary.json, table.txt, tip_error_rms.svg)\n",
                         args.out.display()
-                    );
-                    Ok(())
+                    ))
                 }
             }
         }
     }
 }
 
+/// Most noise levels a sweep takes.
+const MAX_NOISE_LEVELS: usize = 1000;
+/// Most noise realisations per cell.
+const MAX_SEEDS: usize = 1_000_000;
+/// Most runs in a sweep (noise levels x controllers x seeds).
+const MAX_RUNS: usize = 10_000_000;
+
+/// The command line's counts checked before anything is built: `--seeds` and `--base-seed` in
+/// range, at most [`MAX_NOISE_LEVELS`] noise levels, no controller twice, at most
+/// [`MAX_RUNS`] runs.
+fn check_counts(args: &SweepArgs) -> Result<(usize, u64), String> {
+    let seeds = crate::args::count("--seeds", args.seeds, 1, MAX_SEEDS)?;
+    let base_seed = crate::args::count("--base-seed", args.base_seed, 0, usize::MAX)? as u64;
+    if args.noise.len() > MAX_NOISE_LEVELS {
+        return Err(format!(
+            "--noise lists {} levels, more than the {MAX_NOISE_LEVELS} a sweep takes",
+            args.noise.len()
+        ));
+    }
+    for (k, c) in args.controllers.iter().enumerate() {
+        if args.controllers[..k].contains(c) {
+            return Err(format!("--controllers lists {c} twice"));
+        }
+    }
+    let runs = args.noise.len() * args.controllers.len() * seeds;
+    if runs > MAX_RUNS {
+        return Err(format!(
+            "the sweep would make {} noise levels x {} controllers x {seeds} seeds = {runs} runs, \
+             more than the {MAX_RUNS} allowed: lower --seeds or use fewer noise levels",
+            args.noise.len(),
+            args.controllers.len()
+        ));
+    }
+    Ok((seeds, base_seed))
+}
+
 /// The sweep's configuration: the scenario resolved, the duration applied, everything
 /// checked, and every controller's simulation built once so that a bad setting fails here
 /// rather than in every run.
 fn configure(args: &SweepArgs) -> Result<SweepConfig, String> {
+    let (seeds, base_seed) = check_counts(args)?;
     let mut scenario = Scenario::resolve(&args.scenario).map_err(|e| e.to_string())?;
     if let Some(duration) = args.duration {
         scenario.duration = duration;
@@ -146,8 +184,8 @@ fn configure(args: &SweepArgs) -> Result<SweepConfig, String> {
         noise_levels: args.noise.clone(),
         rate_noise_ratio: args.rate_noise_ratio,
         reference_noise_ratio: args.reference_noise_ratio,
-        seeds: args.seeds,
-        base_seed: args.base_seed,
+        seeds,
+        base_seed,
     };
     config.validate()?;
     let cells = config.noise_levels.len() * config.controllers.len();
@@ -223,9 +261,24 @@ fn sweep_whole(config: &SweepConfig, out: &Path) -> Result<String, String> {
     write_report(&parsed, out)
 }
 
-/// Merges the shard files named by `inputs` into `out` and returns the table.
-fn merge_files(inputs: &[PathBuf], out: &Path) -> Result<String, String> {
-    let shards = shard_file::shard_paths(inputs)?
+/// Merges the shard files named by `inputs` into `out` (the staging folder of `target`) and
+/// returns the table. Shard files inside `target` are refused: replacing `target` would
+/// delete them.
+fn merge_files(inputs: &[PathBuf], out: &Path, target: &Path) -> Result<String, String> {
+    let paths = shard_file::shard_paths(inputs)?;
+    if let Ok(target_abs) = std::fs::canonicalize(target) {
+        for path in &paths {
+            if std::fs::canonicalize(path).is_ok_and(|p| p.starts_with(&target_abs)) {
+                return Err(format!(
+                    "--out {} holds the shard file {} that is being merged, and the merge \
+                     replaces that folder whole: merge into another folder",
+                    target.display(),
+                    path.display()
+                ));
+            }
+        }
+    }
+    let shards = paths
         .into_iter()
         .map(|path| ShardFile::read(&path).map(|file| (path, file)))
         .collect::<Result<Vec<_>, _>>()?;

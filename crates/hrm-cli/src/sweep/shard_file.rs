@@ -9,6 +9,9 @@ use std::path::{Path, PathBuf};
 /// The `format` tag of a shard file.
 pub const FORMAT: &str = "hrm-sweep-shard/1";
 
+/// Largest shard file read (1 GiB, about two million runs as written).
+pub const MAX_SHARD_FILE_BYTES: u64 = 1 << 30;
+
 /// A slice of a sweep: its configuration, which shard, and the runs of that shard in index
 /// order. The whole sweep is shard 1/1.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -147,9 +150,9 @@ impl ShardFile {
         Ok(file)
     }
 
-    /// Reads a shard file.
+    /// Reads a shard file (at most [`MAX_SHARD_FILE_BYTES`]).
     pub fn read(path: &Path) -> Result<Self, String> {
-        let text = std::fs::read_to_string(path)
+        let text = sim_core::read_text_file(path, MAX_SHARD_FILE_BYTES)
             .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
         Self::parse(&text, path)
     }

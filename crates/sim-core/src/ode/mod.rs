@@ -3,8 +3,8 @@
 //! Two methods, both with their stage vectors allocated once at construction so that a step
 //! allocates nothing:
 //!
-//! - [`Rk4`]: the classical fixed-step fourth-order method (the paper integrates with it at
-//!   `dt = 1e-4` s);
+//! - [`Rk4`]: the classical fixed-step fourth-order method (the paper names neither an integrator
+//!   nor a step size; the shipped scenarios choose this one at `1e-4` s);
 //! - [`DormandPrince`]: the adaptive Dormand-Prince 5(4) pair with the first-same-as-last property,
 //!   an embedded fourth-order error estimate and the standard step-size controller.
 //!

@@ -1,0 +1,28 @@
+//! Numbers from the command line checked against their bounds before they reach an allocation
+//! or a loop. Counts are parsed as wide signed integers (with negative numbers allowed), so that
+//! `--seeds -1` gets the option's own message rather than a parse error.
+
+/// `value` of option `option` as a count from `min` to `max`, or the one-line message
+/// "`option` must be at least `min` and at most `max`, got `value`".
+pub fn count(option: &str, value: i128, min: usize, max: usize) -> Result<usize, String> {
+    usize::try_from(value)
+        .ok()
+        .filter(|v| (min..=max).contains(v))
+        .ok_or_else(|| format!("{option} must be at least {min} and at most {max}, got {value}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_are_bounded_with_the_option_named() {
+        assert_eq!(count("--seeds", 3, 1, 10), Ok(3));
+        assert_eq!(
+            count("--seeds", -1, 1, 10).unwrap_err(),
+            "--seeds must be at least 1 and at most 10, got -1"
+        );
+        assert!(count("--samples", 1_000_000_000_000, 2, 1_000_000).is_err());
+        assert!(count("--seeds", i128::MAX, 1, usize::MAX).is_err());
+    }
+}

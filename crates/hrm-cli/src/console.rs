@@ -1,0 +1,108 @@
+//! What `hrm` prints: text on standard output that ends quietly when the reader goes away
+//! (`hrm ... | head`), and error lines with the control characters of untrusted text escaped
+//! and very long numbers written with exponents.
+
+use std::io::Write;
+
+/// Writes `text` to standard output, with the control characters other than newline and tab
+/// escaped. A reader that has gone away (a broken pipe) is not an error: the rest of the
+/// output is dropped and the command goes on.
+pub fn print(text: &str) -> Result<(), String> {
+    let mut out = std::io::stdout().lock();
+    match out
+        .write_all(escape_controls(text, &['\n', '\t']).as_bytes())
+        .and_then(|()| out.flush())
+    {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(format!("cannot write to standard output: {e}"))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// `text` with every control character except those in `keep` written as a Rust escape
+/// (`\n`, `\u{1b}`), so that a message quoting a file cannot move the cursor, recolour the
+/// terminal or break into several lines.
+pub fn escape_controls(text: &str, keep: &[char]) -> String {
+    let mut escaped = String::with_capacity(text.len());
+    for c in text.chars() {
+        if c.is_control() && !keep.contains(&c) {
+            escaped.extend(c.escape_default());
+        } else {
+            escaped.push(c);
+        }
+    }
+    escaped
+}
+
+/// The one line `hrm` writes to standard error for a failure: control characters escaped and
+/// very long numbers in exponent form.
+pub fn error_line(message: &str) -> String {
+    format!("hrm: {}", readable_numbers(&escape_controls(message, &[])))
+}
+
+/// Digits beyond which a number is written with an exponent: more than any integer option
+/// (`u128::MAX` has 39 digits), so exact integers such as seeds are kept as they are.
+const MAX_DIGITS: usize = 39;
+
+/// `text` with every decimal number of more than [`MAX_DIGITS`] digits (a value near `1e300`
+/// or `1e-300` written out by `{}`, as some library messages do) in exponent form: `1e300`,
+/// `1.7e308`, `1e-300`.
+pub fn readable_numbers(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(start) = rest.find(|c: char| c.is_ascii_digit()) {
+        out.push_str(&rest[..start]);
+        rest = &rest[start..];
+        let mut dot = false;
+        let end = rest
+            .char_indices()
+            .find(|&(_, c)| {
+                let part = c.is_ascii_digit() || (c == '.' && !dot);
+                dot |= c == '.';
+                !part
+            })
+            .map_or(rest.len(), |(i, _)| i);
+        let number = rest[..end].trim_end_matches('.');
+        let digits = number.bytes().filter(u8::is_ascii_digit).count();
+        match number.parse::<f64>() {
+            Ok(value) if digits > MAX_DIGITS => out.push_str(&format!("{value:e}")),
+            _ => out.push_str(number),
+        }
+        rest = &rest[number.len()..];
+    }
+    out.push_str(rest);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn control_characters_are_escaped_and_text_kept() {
+        assert_eq!(
+            error_line("line 2: found `\u{1b}[31mred\r\nx` in é"),
+            "hrm: line 2: found `\\u{1b}[31mred\\r\\nx` in é"
+        );
+        assert_eq!(
+            escape_controls("a\tb\nc\u{7}", &['\n', '\t']),
+            "a\tb\nc\\u{7}"
+        );
+    }
+
+    #[test]
+    fn numbers_of_hundreds_of_digits_get_exponents() {
+        let (huge, tiny) = (format!("{}", -1.7e308), format!("{}", 1e-300));
+        assert!(huge.len() > 300 && tiny.len() > 300);
+        assert_eq!(
+            error_line(&format!(
+                "weight must lie in [0, 1], got {huge}; bound {tiny}."
+            )),
+            "hrm: weight must lie in [0, 1], got -1.7e308; bound 1e-300."
+        );
+        // Integers up to 39 digits (seeds, counts) and ordinary decimals stay as written.
+        let text = "seed 340282366920938463463374607431768211455, t = 0.25 s, v1.2.3.";
+        assert_eq!(readable_numbers(text), text);
+    }
+}

@@ -1,0 +1,345 @@
+//! Output folders written whole: a command writes into a fresh staging folder beside its
+//! output folder and renames it into place only when everything is written. A command that
+//! fails leaves an existing output folder exactly as it was; one that succeeds replaces it
+//! whole, so no file of an earlier run is left beside the new ones.
+//!
+//! Every output folder holds a marker file, [`MARKER`]. An existing folder is replaced only if
+//! it is empty, carries the marker, or holds nothing but marked folders (the parent of nested
+//! outputs, such as `hrm-output` after `hrm simulate`), so `--out .` or a typo never deletes a
+//! user's files. Marked folders nested in a replaced folder (`hrm-output/simulate` inside the
+//! main job's `hrm-output`) are the outputs of other commands: they are carried into the new
+//! folder unless it has an entry of the same name.
+
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+
+/// The marker file of an output folder; it names the command that wrote the folder.
+pub const MARKER: &str = ".hrm-output";
+
+/// An output folder being written: write into [`OutputDir::path`], then [`OutputDir::commit`].
+/// Dropped without a commit, the staging folder is removed and the output left as it was.
+#[derive(Debug)]
+pub struct OutputDir {
+    /// The folder as the user named it (for messages).
+    shown: PathBuf,
+    /// The folder's absolute path.
+    target: PathBuf,
+    /// The staging folder, a sibling of `target`.
+    staging: PathBuf,
+    /// Whether the staging folder became the output.
+    committed: bool,
+}
+
+impl OutputDir {
+    /// Checks that `target` may be replaced, creates its parent folders and an empty staging
+    /// folder beside it (holding the [`MARKER`] that names `command`).
+    pub fn create(target: &Path, command: &str) -> Result<Self, String> {
+        let shown = target.to_path_buf();
+        let fail = |what: &str, e: std::io::Error| format!("{what} {}: {e}", shown.display());
+        let absolute = std::path::absolute(target).map_err(|e| fail("output folder", e))?;
+        let (Some(parent), Some(name)) = (absolute.parent(), absolute.file_name()) else {
+            return Err(format!(
+                "output folder {}: name it by a path that ends in its own name (not `/` or `..`)",
+                shown.display()
+            ));
+        };
+        if let Some(file) = parent
+            .ancestors()
+            .find(|a| a.exists())
+            .filter(|a| !a.is_dir())
+        {
+            return Err(format!(
+                "output folder {}: {} is a file, not a folder",
+                shown.display(),
+                file.display()
+            ));
+        }
+        std::fs::create_dir_all(parent).map_err(|e| fail("cannot create the parent of", e))?;
+        // `..` and symbolic links are resolved, so that the staging folder is a true sibling.
+        let parent = std::fs::canonicalize(parent).map_err(|e| fail("output folder", e))?;
+        let target = parent.join(name);
+        match std::fs::symlink_metadata(&target) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(fail("output folder", e)),
+            Ok(meta) if !meta.is_dir() => {
+                return Err(format!(
+                    "output folder {}: exists and is not a folder",
+                    shown.display()
+                ));
+            }
+            Ok(_) if !replaceable(&target) => {
+                return Err(format!(
+                    "output folder {}: exists and holds files that hrm did not write (no {MARKER} \
+                     marker); choose a new folder or empty this one",
+                    shown.display()
+                ));
+            }
+            Ok(_) => {}
+        }
+        remove_abandoned_staging(&target);
+        let staging = sibling(&target, "staging");
+        if staging.exists() {
+            std::fs::remove_dir_all(&staging).map_err(|e| fail("cannot clear staging for", e))?;
+        }
+        std::fs::create_dir(&staging).map_err(|e| fail("cannot create staging for", e))?;
+        let dir = OutputDir {
+            shown: shown.clone(),
+            target,
+            staging,
+            committed: false,
+        };
+        std::fs::write(
+            dir.staging.join(MARKER),
+            format!("written by `hrm {command}`\n"),
+        )
+        .map_err(|e| fail("cannot write the marker of", e))?;
+        Ok(dir)
+    }
+
+    /// The folder to write into (the staging folder until [`OutputDir::commit`]).
+    pub fn path(&self) -> &Path {
+        &self.staging
+    }
+
+    /// Puts the staging folder in place of the output folder: the old folder is moved aside,
+    /// the nested outputs of other commands are carried over, the new one takes its name and
+    /// the old one is deleted. On failure the old folder is put back.
+    pub fn commit(mut self) -> Result<(), String> {
+        let old = sibling(&self.target, "old");
+        let had_old = self.target.exists();
+        let fail = |what: &str, e: std::io::Error| format!("{what} {}: {e}", self.shown.display());
+        if had_old {
+            if old.exists() {
+                std::fs::remove_dir_all(&old)
+                    .map_err(|e| fail("cannot clear the previous copy of", e))?;
+            }
+            std::fs::rename(&self.target, &old)
+                .map_err(|e| fail("cannot move aside the previous", e))?;
+        }
+        let carried = if had_old {
+            carry_nested(&old, &self.staging)
+        } else {
+            Ok(Vec::new())
+        };
+        let result = carried.and_then(|moved| {
+            std::fs::rename(&self.staging, &self.target).inspect_err(|_| {
+                for name in &moved {
+                    let _ = std::fs::rename(self.staging.join(name), old.join(name));
+                }
+            })
+        });
+        if let Err(e) = result {
+            if had_old {
+                let _ = std::fs::rename(&old, &self.target);
+            }
+            return Err(fail("cannot put in place the output folder", e));
+        }
+        self.committed = true;
+        if had_old {
+            // The new output is in place; a leftover old copy is only untidy.
+            let _ = std::fs::remove_dir_all(&old);
+        }
+        Ok(())
+    }
+}
+
+impl Drop for OutputDir {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_dir_all(&self.staging);
+        }
+    }
+}
+
+/// Writes `text` to the file `path` whole: into a temporary sibling, then renamed over `path`.
+/// A folder created for it gets the [`MARKER`] naming `command`.
+pub fn write_file(path: &Path, text: &str, command: &str) -> Result<(), String> {
+    let fail = |what: &str, e: std::io::Error| format!("{what} {}: {e}", path.display());
+    let Some(name) = path.file_name() else {
+        return Err(format!("{}: not a file name", path.display()));
+    };
+    let dir = path.parent().unwrap_or(Path::new(""));
+    if !dir.as_os_str().is_empty() && !dir.exists() {
+        std::fs::create_dir_all(dir).map_err(|e| fail("cannot create the folder of", e))?;
+        std::fs::write(dir.join(MARKER), format!("written by `hrm {command}`\n"))
+            .map_err(|e| fail("cannot create the folder of", e))?;
+    }
+    let temporary = sibling(&dir.join(name), "partial");
+    std::fs::write(&temporary, text)
+        .and_then(|()| std::fs::rename(&temporary, path))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&temporary);
+            fail("cannot write", e)
+        })
+}
+
+/// `.<name>.hrm-<what>-<pid>` beside `path`.
+fn sibling(path: &Path, what: &str) -> PathBuf {
+    let mut name = OsString::from(".");
+    name.push(path.file_name().unwrap_or_default());
+    name.push(format!(".hrm-{what}-{}", std::process::id()));
+    path.with_file_name(name)
+}
+
+/// Removes the staging folders of `target` left by commands that were killed (their process
+/// is gone), where the system lists its processes in `/proc`. Moved-aside old copies are kept:
+/// after a crash between the two renames of a commit, one may be the only copy of an output.
+fn remove_abandoned_staging(target: &Path) {
+    let (Some(dir), Some(name)) = (target.parent(), target.file_name()) else {
+        return;
+    };
+    let prefix = format!(".{}.hrm-staging-", name.to_string_lossy());
+    if !Path::new("/proc/self").is_dir() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let Some(pid) = file_name
+            .to_str()
+            .and_then(|n| n.strip_prefix(&prefix))
+            .and_then(|pid| pid.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
+/// Whether `dir` holds the [`MARKER`].
+fn is_output(dir: &Path) -> bool {
+    dir.join(MARKER).is_file()
+}
+
+/// Whether the folder `dir` may be replaced: it is an output folder, or holds only output
+/// folders (or nothing).
+fn replaceable(dir: &Path) -> bool {
+    if is_output(dir) {
+        return true;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return false;
+    };
+    entries
+        .into_iter()
+        .all(|entry| entry.is_ok_and(|e| e.path().is_dir() && is_output(&e.path())))
+}
+
+/// Moves the output folders nested in `old` into `new`, except where `new` has an entry of the
+/// same name; returns the names moved. On failure, what was moved goes back.
+fn carry_nested(old: &Path, new: &Path) -> std::io::Result<Vec<OsString>> {
+    let mut moved = Vec::new();
+    for entry in std::fs::read_dir(old)? {
+        let entry = entry?;
+        let (path, name) = (entry.path(), entry.file_name());
+        if !path.is_dir() || !is_output(&path) || new.join(&name).exists() {
+            continue;
+        }
+        if let Err(e) = std::fs::rename(&path, new.join(&name)) {
+            for name in &moved {
+                let _ = std::fs::rename(new.join(name), old.join(name));
+            }
+            return Err(e);
+        }
+        moved.push(name);
+    }
+    Ok(moved)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("hrm-output-dir-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    }
+
+    #[test]
+    fn a_commit_replaces_the_folder_whole_and_a_drop_leaves_it_alone() {
+        let root = scratch("replace");
+        let out = root.join("a/out");
+        let dir = OutputDir::create(&out, "test").unwrap();
+        std::fs::write(dir.path().join("one.txt"), "1").unwrap();
+        assert!(!out.exists(), "nothing appears before the commit");
+        dir.commit().unwrap();
+        assert_eq!(names(&out), [MARKER, "one.txt"]);
+        // A second run that fails: the first run's output stays exactly as it was.
+        let dir = OutputDir::create(&out, "test").unwrap();
+        std::fs::write(dir.path().join("two.txt"), "2").unwrap();
+        drop(dir);
+        assert_eq!(names(&out), [MARKER, "one.txt"]);
+        // A second run that succeeds: no stale file; no staging or old copy is left behind.
+        let dir = OutputDir::create(&out, "test").unwrap();
+        std::fs::write(dir.path().join("two.txt"), "2").unwrap();
+        dir.commit().unwrap();
+        assert_eq!(names(&out), [MARKER, "two.txt"]);
+        assert_eq!(names(&root.join("a")), ["out"]);
+        // The staging folder of a killed command (no such process) is cleared by the next one.
+        if Path::new("/proc/self").is_dir() {
+            let abandoned = root.join("a/.out.hrm-staging-4294967295");
+            std::fs::create_dir_all(&abandoned).unwrap();
+            OutputDir::create(&out, "test").unwrap().commit().unwrap();
+            assert_eq!(names(&root.join("a")), ["out"]);
+        }
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn nested_outputs_are_carried_over_and_foreign_folders_are_refused() {
+        let root = scratch("nested");
+        let (outer, inner) = (root.join("out"), root.join("out/simulate"));
+        // `hrm simulate` first: `out` holds only an output folder, so it may be replaced.
+        let dir = OutputDir::create(&inner, "simulate").unwrap();
+        std::fs::write(dir.path().join("timeseries.csv"), "t").unwrap();
+        dir.commit().unwrap();
+        let dir = OutputDir::create(&outer, "run").unwrap();
+        std::fs::write(dir.path().join("report.html"), "r").unwrap();
+        dir.commit().unwrap();
+        assert_eq!(names(&outer), [MARKER, "report.html", "simulate"]);
+        assert_eq!(names(&inner), [MARKER, "timeseries.csv"]);
+        // A folder of the user's is never replaced.
+        let foreign = root.join("mine");
+        std::fs::create_dir_all(&foreign).unwrap();
+        std::fs::write(foreign.join("thesis.tex"), "x").unwrap();
+        let err = OutputDir::create(&foreign, "run").unwrap_err();
+        assert!(err.contains("hrm did not write"), "{err}");
+        let file = root.join("file");
+        std::fs::write(&file, "x").unwrap();
+        let err = OutputDir::create(&file, "run").unwrap_err();
+        assert!(err.contains("not a folder"), "{err}");
+        let err = OutputDir::create(Path::new("/"), "run").unwrap_err();
+        assert!(err.contains("ends in its own name"), "{err}");
+        assert_eq!(names(&root), ["file", "mine", "out"]);
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn files_are_written_whole() {
+        let root = scratch("file");
+        let path = root.join("shards/shard-1-of-2.json");
+        write_file(&path, "{}", "sweep").unwrap();
+        write_file(&path, "{\"a\":1}", "sweep").unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "{\"a\":1}");
+        assert_eq!(names(&root.join("shards")), [MARKER, "shard-1-of-2.json"]);
+        let err = write_file(&root.join("shards"), "x", "sweep").unwrap_err();
+        assert!(err.contains("cannot write"), "{err}");
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+}
