@@ -109,6 +109,41 @@ fn iec_point_lists_comments_and_weights() {
     assert_eq!(y, [1.0]);
 }
 
+/// fuzzylite's `SShape start end`, `ZShape start end` and
+/// `PiShape bottomLeft topLeft topRight bottomRight` read as MATLAB's smf, zmf and pimf with the
+/// parameters in the same order, the step `start >= end` included.
+#[test]
+fn fuzzylite_s_z_and_pi_shapes_keep_their_parameter_order() {
+    use fuzzy_sugeno::MembershipFn;
+    let term = |text: &str| {
+        let fcl = FUZZYLITE_FCL.replacen("Bell -0.300 0.300 2.000", text, 1);
+        FuzzySystem::from_fcl(&fcl).unwrap().inputs()[0].sets[0].membership
+    };
+    assert_eq!(
+        term("SShape -0.5 0.25"),
+        MembershipFn::SShape {
+            start: -0.5,
+            end: 0.25
+        }
+    );
+    assert_eq!(
+        term("ZShape 0.25 -0.5"),
+        MembershipFn::ZShape {
+            start: 0.25,
+            end: -0.5
+        }
+    );
+    assert_eq!(
+        term("PiShape -0.5 -0.25 0.25 0.5"),
+        MembershipFn::PiShape {
+            left_foot: -0.5,
+            left_shoulder: -0.25,
+            right_shoulder: 0.25,
+            right_foot: 0.5
+        }
+    );
+}
+
 #[test]
 fn malformed_files_name_the_line_and_the_problem() {
     let message = |text: &str| FuzzySystem::from_fcl(text).unwrap_err().to_string();
@@ -119,7 +154,7 @@ fn malformed_files_name_the_line_and_the_problem() {
     );
     assert_eq!(
         swap("TERM N := Bell -0.300 0.300 2.000;", "TERM N := Ramp 0 1;"),
-        "FCL line 19: input term class 'Ramp' is not supported; expected a point list or one of Triangle, Trapezoid, Bell, Gaussian, GaussianProduct, Sigmoid, SigmoidDifference, SigmoidProduct, Constant"
+        "FCL line 19: input term class 'Ramp' is not supported; expected a point list or one of Triangle, Trapezoid, Bell, Gaussian, GaussianProduct, Sigmoid, SigmoidDifference, SigmoidProduct, SShape, ZShape, PiShape, Constant"
     );
     assert_eq!(
         swap(

@@ -88,9 +88,18 @@ fn random_membership(rng: &mut Rng, lo: f64, hi: f64) -> MembershipFn {
             slope2: -rng.range(1.0, 20.0) / w,
             center2: p[3],
         },
+        // Sometimes MATLAB's step (start >= end).
+        8 if rng.chance(0.2) => MembershipFn::SShape {
+            start: p[2],
+            end: p[0],
+        },
         8 => MembershipFn::SShape {
             start: p[0],
             end: p[2],
+        },
+        9 if rng.chance(0.2) => MembershipFn::ZShape {
+            start: p[3],
+            end: p[1],
         },
         9 => MembershipFn::ZShape {
             start: p[1],
