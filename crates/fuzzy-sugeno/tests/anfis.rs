@@ -1,6 +1,8 @@
 //! ANFIS on Jang's (1993) benchmark, Mackey-Glass chaotic time-series prediction, with the
 //! series generated here; and the trained system evaluated by the crate's own evaluator.
 
+mod common;
+
 use fuzzy_sugeno::learn::{
     AnfisOptions, ConsequentOrder, GridPartition, SetShape, TrainingData, anfis, genfis_grid,
 };
@@ -279,5 +281,57 @@ fn systems_learned_per_output_merge_into_one_that_evaluates_the_same() {
     assert_eq!(
         refused.to_string(),
         "learning: system 1 ('both') has 2 outputs; merge single-output systems"
+    );
+}
+
+/// ANFIS trains a system with an input that has no sets and a point output range (both allowed
+/// by validation): the empty input stays empty, the range stays the point, the step set (whose
+/// gradient is zero) stays put, the smf/zmf/pimf sets move and the error falls.
+#[test]
+fn anfis_trains_empty_inputs_and_point_output_ranges() {
+    let system = common::relaxed_system();
+    let mut values = Vec::new();
+    for i in 0..15 {
+        for j in 0..15 {
+            let (a, b, c) = (
+                i as f64 / 14.0,
+                (i + j) as f64 / 14.0 - 1.0,
+                j as f64 / 14.0,
+            );
+            values.extend([a, b, c, (3.0 * a).sin() + c * c]);
+        }
+    }
+    let data = TrainingData::new(3, 1, values).unwrap();
+    let options = AnfisOptions {
+        epochs: 30,
+        ..Default::default()
+    };
+    let trained = anfis(system.clone(), &data, None, 0, &options).unwrap();
+    let first = trained.history[0].training_rmse;
+    let best = trained.history[trained.best_epoch - 1].training_rmse;
+    assert!(best.is_finite() && best < first, "{first} -> {best}");
+    let learned = &trained.system;
+    assert!(learned.inputs()[1].sets.is_empty());
+    assert_eq!(learned.outputs()[0].range, [2.0, 2.0]);
+    assert_eq!(
+        learned.inputs()[0].sets[2].membership,
+        system.inputs()[0].sets[2].membership
+    );
+    assert_ne!(
+        learned.inputs()[0].sets[1].membership,
+        system.inputs()[0].sets[1].membership
+    );
+    // The learned system evaluates to the error it reports.
+    let mut evaluator = Evaluator::new(learned.clone());
+    let mut squared = 0.0;
+    for r in 0..data.rows() {
+        let mut y = [0.0];
+        evaluator.eval(data.inputs(r), &mut y).unwrap();
+        squared += (y[0] - data.target(r, 0)).powi(2);
+    }
+    let rmse = (squared / data.rows() as f64).sqrt();
+    assert!(
+        (rmse - best).abs() < 1e-9 * (1.0 + best),
+        "{rmse} vs {best}"
     );
 }

@@ -256,3 +256,23 @@ fn the_source_is_self_contained() {
             .starts_with("export: the prefix must be a C identifier")
     );
 }
+
+/// An input with no sets and a point output range (both allowed by validation) export and
+/// evaluate as in Rust, including where no rule fires (the fallback is the point).
+#[test]
+fn empty_inputs_and_point_output_ranges_in_c_match_rust() {
+    let system = common::relaxed_system();
+    let mut rng = Rng::new(5);
+    let points = (0..5_000)
+        .map(|_| (rng.below(2), random_point(&system, &mut rng)))
+        .collect();
+    let strict = EvalOptions {
+        out_of_range: OutOfRange::Error,
+        no_rule_fired: NoRuleFired::Error,
+    };
+    compare(
+        vec![(system.clone(), EvalOptions::default()), (system, strict)],
+        points,
+        "relaxed",
+    );
+}

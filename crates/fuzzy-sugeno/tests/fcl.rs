@@ -230,3 +230,13 @@ proptest! {
         let _ = FuzzySystem::from_fcl(&text);
     }
 }
+
+/// An input with no sets and a point output range (both allowed by validation) survive the
+/// round trip through FCL exactly.
+#[test]
+fn empty_inputs_and_point_output_ranges_round_trip() {
+    let system = common::relaxed_system();
+    let fcl = system.to_fcl().unwrap();
+    assert!(fcl.contains("RANGE := (2.0 .. 2.0);"), "{fcl}");
+    assert_eq!(FuzzySystem::from_fcl(&fcl).unwrap(), system);
+}
