@@ -32,7 +32,7 @@ pub struct TrainArgs {
     /// Grid partition: sets per input (the rule count is this to the power of the inputs).
     #[arg(long, default_value_t = 2)]
     mfs: usize,
-    /// Grid partition: the sets' MATLAB type (gbellmf, gaussmf, gauss2mf, trimf, trapmf, sigmf, dsigmf, psigmf).
+    /// Grid partition: the sets' MATLAB type (gbellmf, gaussmf, gauss2mf, trimf, trapmf, sigmf, dsigmf, psigmf, pimf).
     #[arg(long, default_value = "gbellmf")]
     mf_type: String,
     /// The consequents' order: 0 (constant) or 1 (linear).

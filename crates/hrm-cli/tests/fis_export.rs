@@ -87,3 +87,14 @@ fn c_export_writes_the_header_and_source() {
     assert_eq!(stderr.lines().count(), 1);
     assert!(stderr.starts_with("hrm: export: the prefix must be a C identifier"));
 }
+
+/// `hrm fis check` reads an FCL file: the same analysis as for the `.fis` file, without the
+/// `.fis` reader's line of ignored items (the FCL reader keeps no such notes).
+#[test]
+fn check_reads_fcl_without_the_notes_line() {
+    let from_fis = stdout(&hrm(&["fis", "check", PAPER_FIS]));
+    let from_fcl = stdout(&hrm(&["fis", "check", FUZZYLITE_FCL]));
+    let (notes, analysis) = from_fis.split_once('\n').unwrap();
+    assert!(notes.ends_with("paper.fis: nothing ignored"), "{notes}");
+    assert_eq!(from_fcl, analysis);
+}

@@ -49,6 +49,10 @@ pub enum SetShape {
     SigmoidDifference,
     /// `psigmf`: a product of the same sigmoids.
     SigmoidProduct,
+    /// `pimf`: the trapezoid's corners joined by MATLAB's quadratic splines, so neighbours
+    /// cross at 1/2 and sum to 1. (`smf` and `zmf`, open to one side, partition no range and
+    /// are not offered.)
+    PiShape,
 }
 
 impl SetShape {
@@ -63,10 +67,11 @@ impl SetShape {
             "sigmf" => Self::Sigmoid,
             "dsigmf" => Self::SigmoidDifference,
             "psigmf" => Self::SigmoidProduct,
+            "pimf" => Self::PiShape,
             _ => {
                 return Err(learning(format!(
                     "unknown set type '{name}' for a grid partition; expected one of gbellmf, \
-                     gaussmf, gauss2mf, trimf, trapmf, sigmf, dsigmf, psigmf"
+                     gaussmf, gauss2mf, trimf, trapmf, sigmf, dsigmf, psigmf, pimf"
                 )));
             }
         })
@@ -117,6 +122,12 @@ impl SetShape {
                 center1: c - 0.5 * spacing,
                 slope2: -slope,
                 center2: c + 0.5 * spacing,
+            },
+            Self::PiShape => MembershipFn::PiShape {
+                left_foot: c - 0.75 * spacing,
+                left_shoulder: c - 0.25 * spacing,
+                right_shoulder: c + 0.25 * spacing,
+                right_foot: c + 0.75 * spacing,
             },
         }
     }
@@ -435,7 +446,7 @@ mod tests {
         TrainingData::new(2, 1, values).unwrap()
     }
 
-    const SHAPES: [SetShape; 8] = [
+    const SHAPES: [SetShape; 9] = [
         SetShape::Bell,
         SetShape::Gaussian,
         SetShape::Gaussian2,
@@ -444,13 +455,14 @@ mod tests {
         SetShape::Sigmoid,
         SetShape::SigmoidDifference,
         SetShape::SigmoidProduct,
+        SetShape::PiShape,
     ];
 
     proptest! {
         /// Every point of the range belongs to some set to degree at least 1/2, neighbouring sets
         /// are in order, and the sets validate.
         #[test]
-        fn grid_sets_cover_the_range(shape in 0usize..8, k in 1usize..9, lo in -5.0f64..5.0, width in 0.1f64..10.0, t in 0.0f64..=1.0) {
+        fn grid_sets_cover_the_range(shape in 0usize..SHAPES.len(), k in 1usize..9, lo in -5.0f64..5.0, width in 0.1f64..10.0, t in 0.0f64..=1.0) {
             let shape = SHAPES[shape];
             let k = if shape == SetShape::Sigmoid { 2 } else { k };
             let range = [lo, lo + width];
@@ -550,7 +562,7 @@ mod tests {
             SetShape::from_matlab_name("constant")
                 .unwrap_err()
                 .to_string(),
-            "learning: unknown set type 'constant' for a grid partition; expected one of gbellmf, gaussmf, gauss2mf, trimf, trapmf, sigmf, dsigmf, psigmf"
+            "learning: unknown set type 'constant' for a grid partition; expected one of gbellmf, gaussmf, gauss2mf, trimf, trapmf, sigmf, dsigmf, psigmf, pimf"
         );
         let wide = TrainingData::new(13, 1, (0..14 * 3).map(|v| (v % 5) as f64).collect()).unwrap();
         assert_eq!(
