@@ -689,7 +689,7 @@ impl CompiledMf {
 /// MATLAB's `smf(x, [a b])`: the quadratic spline from 0 at `a` to 1 at `b` (value 1/2 at the
 /// midpoint), or the step `x >= (a + b) / 2` when `a >= b`.
 #[inline]
-fn s_shape(x: f64, a: f64, b: f64) -> f64 {
+pub(crate) fn s_shape(x: f64, a: f64, b: f64) -> f64 {
     let middle = 0.5 * (a + b);
     if a >= b {
         return if x >= middle { 1.0 } else { 0.0 };
@@ -710,7 +710,7 @@ fn s_shape(x: f64, a: f64, b: f64) -> f64 {
 /// MATLAB's `zmf(x, [a b])`: the quadratic spline from 1 at `a` to 0 at `b`, or the step
 /// `x <= (a + b) / 2` when `a >= b`.
 #[inline]
-fn z_shape(x: f64, a: f64, b: f64) -> f64 {
+pub(crate) fn z_shape(x: f64, a: f64, b: f64) -> f64 {
     let middle = 0.5 * (a + b);
     if a >= b {
         return if x <= middle { 1.0 } else { 0.0 };

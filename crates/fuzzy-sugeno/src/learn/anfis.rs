@@ -712,7 +712,8 @@ mod tests {
     use super::*;
     use crate::MembershipFn as Mf;
 
-    /// Two inputs with sets of several types, a shared term, a don't-care and a rule weight.
+    /// Two inputs with sets of several types (pimf and zmf among them), a shared term, a
+    /// don't-care and a rule weight.
     fn mixed_system() -> FuzzySystem {
         let linear = |p: [f64; 3]| OutputFn::Linear {
             coefficients: vec![p[0], p[1]],
@@ -734,6 +735,15 @@ mod tests {
                             center2: 0.9,
                         },
                     ),
+                    (
+                        "d",
+                        Mf::PiShape {
+                            left_foot: -0.8,
+                            left_shoulder: -0.2,
+                            right_shoulder: 0.25,
+                            right_foot: 0.75,
+                        },
+                    ),
                 ],
             )
             .input(
@@ -751,6 +761,13 @@ mod tests {
                     ),
                     ("q", Mf::sigmoid(2.5, 1.2)),
                     ("r", Mf::trapezoid(0.8, 1.3, 1.6, 2.6)),
+                    (
+                        "s",
+                        Mf::ZShape {
+                            start: 0.3,
+                            end: 1.7,
+                        },
+                    ),
                 ],
             )
             .output(
@@ -767,6 +784,7 @@ mod tests {
             .rule(["c", "-"], ["w"])
             .weighted_rule(["a", "r"], ["v"], 0.6, Connective::And)
             .rule(["b", "r"], ["u"])
+            .rule(["d", "s"], ["w"])
             .build()
             .unwrap()
     }
@@ -827,7 +845,7 @@ mod tests {
                 checked += 1;
             }
         }
-        assert_eq!(checked, 3 + 2 + 4 + 4 + 2 + 4);
+        assert_eq!(checked, 3 + 2 + 4 + 4 + 4 + 2 + 4 + 2);
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! parameters (layer 1 of Jang 1993, the `d O / d alpha` of eq 12), and the repair that keeps a
 //! function valid after a gradient step.
 
-use crate::membership::MembershipFn;
+use crate::membership::{MembershipFn, s_shape, z_shape};
 
 /// Writes `d mu / d p` at `x` into `grad`, for the parameters `p` in MATLAB's order; `mu` is the
 /// degree at `x`. Where a function has a kink (triangle corners, the shoulders of `gauss2mf`),
@@ -143,20 +143,13 @@ pub(crate) fn gradient(mf: &MembershipFn, x: f64, mu: f64, grad: &mut [f64; 4]) 
             right_foot: d,
         } => {
             // pimf = smf(a, b) zmf(c, d).
-            let rising = mf_degree(&MembershipFn::SShape { start: a, end: b }, x);
-            let falling = mf_degree(&MembershipFn::ZShape { start: c, end: d }, x);
+            let (rising, falling) = (s_shape(x, a, b), z_shape(x, c, d));
             let (da, db) = s_shape_gradient(x, a, b);
             let (dc, dd) = s_shape_gradient(x, c, d);
             *grad = [da * falling, db * falling, -dc * rising, -dd * rising];
         }
         MembershipFn::Constant { .. } => {}
     }
-}
-
-/// The degree of a function whose parameters were validated (smf and zmf accept any finite
-/// parameters, so this cannot fail for them).
-fn mf_degree(mf: &MembershipFn, x: f64) -> f64 {
-    mf.degree(x).unwrap_or(0.0)
 }
 
 /// `(d mu / d a, d mu / d b)` of MATLAB's `smf(x, [a b])`: on the rising half
