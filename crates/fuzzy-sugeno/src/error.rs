@@ -109,4 +109,19 @@ pub enum FuzzyError {
     /// A rule-base analysis that cannot be carried out as asked.
     #[error("analysis: {0}")]
     Analysis(String),
+    /// Learning from data (`genfis`, ANFIS) cannot proceed: bad data or options, a system that
+    /// ANFIS cannot train, or a least-squares problem the data do not determine.
+    #[error("learning: {0}")]
+    Learning(String),
+    /// A malformed or unsupported IEC 61131-7 FCL file.
+    #[error("FCL line {line}: {message}")]
+    Fcl {
+        /// The 1-based line number.
+        line: usize,
+        /// What was found and what was expected.
+        message: String,
+    },
+    /// A system that an export format cannot carry, or an invalid export option.
+    #[error("export: {0}")]
+    Export(String),
 }

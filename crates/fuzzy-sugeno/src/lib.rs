@@ -10,6 +10,9 @@
 //! - MATLAB `.fis` read and write ([`FuzzySystem::from_fis`], [`FuzzySystem::to_fis`]),
 //!   reading the habits of files from older MATLAB releases, Octave and fuzzylite, with notes of
 //!   what was accepted but ignored ([`FuzzySystem::from_fis_with_notes`], [`FisNote`]);
+//! - export as self-contained C99 ([`FuzzySystem::to_c`]); IEC 61131-7 FCL read and write
+//!   ([`FuzzySystem::from_fcl`], [`FuzzySystem::to_fcl`]);
+//! - systems learned from data, `genfis` and ANFIS training ([`learn`]);
 //! - Wang's completeness, consistency and continuity checks ([`FuzzySystem::analyze`]);
 //! - the paper's controller as a preset ([`paper_controller`], [`PaperController`]).
 //!
@@ -31,7 +34,10 @@ pub mod analysis;
 mod builder;
 mod error;
 mod eval;
+mod export_c;
+mod fcl;
 mod fis;
+pub mod learn;
 mod membership;
 mod paper;
 mod system;
@@ -45,6 +51,7 @@ pub use analysis::{AnalysisOptions, AnalysisReport};
 pub use builder::SystemBuilder;
 pub use error::FuzzyError;
 pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange};
+pub use export_c::CSource;
 pub use fis::FisNote;
 pub use membership::MembershipFn;
 pub use paper::{PaperController, paper_controller};

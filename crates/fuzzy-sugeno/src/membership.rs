@@ -188,29 +188,34 @@ impl MembershipFn {
 
     /// The parameters in MATLAB's order (the `[...]` of a `.fis` line).
     pub fn params(&self) -> Vec<f64> {
+        let (params, count) = self.param_array();
+        params[..count].to_vec()
+    }
+
+    /// The parameters in MATLAB's order in a fixed array, and how many there are (at most 4):
+    /// [`params`](Self::params) without allocating.
+    pub(crate) fn param_array(&self) -> ([f64; 4], usize) {
         match *self {
             Self::Bell {
                 width,
                 slope,
                 center,
-            } => vec![width, slope, center],
-            Self::Gaussian { sigma, center } => vec![sigma, center],
+            } => ([width, slope, center, 0.0], 3),
+            Self::Gaussian { sigma, center } => ([sigma, center, 0.0, 0.0], 2),
             Self::Gaussian2 {
                 sigma1,
                 center1,
                 sigma2,
                 center2,
-            } => vec![sigma1, center1, sigma2, center2],
-            Self::Triangle { left, peak, right } => vec![left, peak, right],
+            } => ([sigma1, center1, sigma2, center2], 4),
+            Self::Triangle { left, peak, right } => ([left, peak, right, 0.0], 3),
             Self::Trapezoid {
                 left_foot,
                 left_shoulder,
                 right_shoulder,
                 right_foot,
-            } => {
-                vec![left_foot, left_shoulder, right_shoulder, right_foot]
-            }
-            Self::Sigmoid { slope, center } => vec![slope, center],
+            } => ([left_foot, left_shoulder, right_shoulder, right_foot], 4),
+            Self::Sigmoid { slope, center } => ([slope, center, 0.0, 0.0], 2),
             Self::SigmoidDifference {
                 slope1,
                 center1,
@@ -222,15 +227,17 @@ impl MembershipFn {
                 center1,
                 slope2,
                 center2,
-            } => vec![slope1, center1, slope2, center2],
-            Self::SShape { start, end } | Self::ZShape { start, end } => vec![start, end],
+            } => ([slope1, center1, slope2, center2], 4),
+            Self::SShape { start, end } | Self::ZShape { start, end } => {
+                ([start, end, 0.0, 0.0], 2)
+            }
             Self::PiShape {
                 left_foot,
                 left_shoulder,
                 right_shoulder,
                 right_foot,
-            } => vec![left_foot, left_shoulder, right_shoulder, right_foot],
-            Self::Constant { value } => vec![value],
+            } => ([left_foot, left_shoulder, right_shoulder, right_foot], 4),
+            Self::Constant { value } => ([value, 0.0, 0.0, 0.0], 1),
         }
     }
 
@@ -279,8 +286,15 @@ impl MembershipFn {
                 reason: format!("expected {expected} parameters, got {}", params.len()),
             });
         }
-        let p = params;
-        let mf = match name {
+        let mf = Self::from_matlab_unchecked(name, params);
+        mf.validate()?;
+        Ok(mf)
+    }
+
+    /// The function of MATLAB type `name` (one of the names [`from_matlab`](Self::from_matlab)
+    /// accepts) with parameters `p` of that type's length, not validated.
+    pub(crate) fn from_matlab_unchecked(name: &str, p: &[f64]) -> Self {
+        match name {
             "gbellmf" => Self::bell(p[0], p[1], p[2]),
             "trimf" => Self::triangle(p[0], p[1], p[2]),
             "gaussmf" => Self::gaussian(p[0], p[1]),
@@ -319,9 +333,7 @@ impl MembershipFn {
                 right_foot: p[3],
             },
             _ => Self::Constant { value: p[0] },
-        };
-        mf.validate()?;
-        Ok(mf)
+        }
     }
 
     /// Checks the parameters: all finite, widths and sigmas positive, bell slope positive, the
@@ -334,11 +346,12 @@ impl MembershipFn {
                 reason,
             })
         };
-        let params = self.params();
+        let (params, count) = self.param_array();
+        let params = &params[..count];
         if let Some(v) = params.iter().find(|v| !v.is_finite()) {
             return fail(format!(
                 "parameters must be finite, got {v} in {}",
-                format_params(&params)
+                format_params(params)
             ));
         }
         match *self {
@@ -361,13 +374,13 @@ impl MembershipFn {
             Self::Triangle { left, peak, right } if !(left <= peak && peak <= right) => {
                 return fail(format!(
                     "corners must satisfy a <= b <= c, got {}",
-                    format_params(&params)
+                    format_params(params)
                 ));
             }
             Self::Triangle { left, right, .. } if left == right => {
                 return fail(format!(
                     "zero width: the feet must satisfy a < c, got {}",
-                    format_params(&params)
+                    format_params(params)
                 ));
             }
             Self::Trapezoid {
@@ -381,7 +394,7 @@ impl MembershipFn {
             {
                 return fail(format!(
                     "corners must satisfy a <= b <= c <= d, got {}",
-                    format_params(&params)
+                    format_params(params)
                 ));
             }
             Self::Trapezoid {
@@ -391,7 +404,7 @@ impl MembershipFn {
             } if left_foot == right_foot => {
                 return fail(format!(
                     "zero width: the feet must satisfy a < d, got {}",
-                    format_params(&params)
+                    format_params(params)
                 ));
             }
             Self::Constant { value } if !(0.0..=1.0).contains(&value) => {
@@ -676,7 +689,7 @@ impl CompiledMf {
 /// MATLAB's `smf(x, [a b])`: the quadratic spline from 0 at `a` to 1 at `b` (value 1/2 at the
 /// midpoint), or the step `x >= (a + b) / 2` when `a >= b`.
 #[inline]
-fn s_shape(x: f64, a: f64, b: f64) -> f64 {
+pub(crate) fn s_shape(x: f64, a: f64, b: f64) -> f64 {
     let middle = 0.5 * (a + b);
     if a >= b {
         return if x >= middle { 1.0 } else { 0.0 };
@@ -697,7 +710,7 @@ fn s_shape(x: f64, a: f64, b: f64) -> f64 {
 /// MATLAB's `zmf(x, [a b])`: the quadratic spline from 1 at `a` to 0 at `b`, or the step
 /// `x <= (a + b) / 2` when `a >= b`.
 #[inline]
-fn z_shape(x: f64, a: f64, b: f64) -> f64 {
+pub(crate) fn z_shape(x: f64, a: f64, b: f64) -> f64 {
     let middle = 0.5 * (a + b);
     if a >= b {
         return if x <= middle { 1.0 } else { 0.0 };

@@ -1,12 +1,15 @@
 //! `hrm fis`: check, evaluate and plot Takagi-Sugeno systems stored as MATLAB `.fis` files.
 //!
 //! - `hrm fis check FILE`: what the reader accepted but ignored (unused methods, extension
-//!   keys, extra parameters), then Wang's completeness, consistency and continuity; exits
+//!   keys, extra parameters; skipped for an FCL file, whose reader keeps no such notes), then Wang's completeness, consistency and continuity; exits
 //!   non-zero if one of them fails.
 //! - `hrm fis eval FILE x1 x2 ...`: prints `name = value` for every output.
 //! - `hrm fis surface FILE --out DIR`: SVGs of every input's membership functions and of every
 //!   output over every pair of inputs (others at a reference value), like MATLAB's `plotmf` and
 //!   `gensurf`.
+//! - `hrm fis train ...` and `hrm fis export ...`: see `fis_train` and `fis_export`.
+//!
+//! A FILE whose name ends in `.fcl` is read as IEC 61131-7 FCL, any other as MATLAB `.fis`.
 
 use crate::args;
 use crate::console;
@@ -52,6 +55,10 @@ enum FisCommand {
         #[arg(long, value_enum, default_value_t = RangePolicy::Clamp)]
         out_of_range: RangePolicy,
     },
+    /// Learn a system from a CSV of samples (genfis, then ANFIS) and write it as a .fis file.
+    Train(crate::fis_train::TrainArgs),
+    /// Write the system as C99 source and header, or as IEC 61131-7 FCL.
+    Export(crate::fis_export::ExportArgs),
     /// Write SVG plots of the membership functions and control surfaces.
     Surface {
         /// The `.fis` file.
@@ -70,7 +77,7 @@ enum FisCommand {
 
 /// The out-of-range policies, as command-line values.
 #[derive(Debug, Clone, Copy, ValueEnum)]
-enum RangePolicy {
+pub(crate) enum RangePolicy {
     /// Evaluate at the nearest end of the range.
     Clamp,
     /// Evaluate the membership functions at the value as given.
@@ -94,10 +101,10 @@ pub fn run(args: FisArgs) -> Result<(), String> {
                 max_relative_jump: max_jump,
                 ..Default::default()
             };
-            let text = read_text(&file)?;
-            let (system, notes) = FuzzySystem::from_fis_with_notes(&text)
-                .map_err(|e| format!("{}: {e}", file.display()))?;
-            console::print(&ignored_report(&file, &notes))?;
+            let (system, notes) = read_system_with_notes(&file)?;
+            if let Some(notes) = notes {
+                console::print(&ignored_report(&file, &notes))?;
+            }
             let (report, passed) = check(&system, &options)?;
             console::print(&report)?;
             if passed {
@@ -117,6 +124,8 @@ pub fn run(args: FisArgs) -> Result<(), String> {
                 .collect();
             console::print(&lines)
         }
+        FisCommand::Train(args) => crate::fis_train::run(args),
+        FisCommand::Export(args) => crate::fis_export::run(args),
         FisCommand::Surface {
             file,
             out,
@@ -139,6 +148,7 @@ pub fn run(args: FisArgs) -> Result<(), String> {
 }
 
 /// Parses the text of a `.fis` file.
+#[cfg(test)]
 fn load_system(text: &str) -> Result<FuzzySystem, String> {
     FuzzySystem::from_fis(text).map_err(|e| e.to_string())
 }
@@ -149,8 +159,24 @@ fn read_text(path: &Path) -> Result<String, String> {
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 
-fn read_system(path: &Path) -> Result<FuzzySystem, String> {
-    load_system(&read_text(path)?).map_err(|e| format!("{}: {e}", path.display()))
+/// Reads a `.fis` file, or an FCL file if the name ends in `.fcl`.
+pub(crate) fn read_system(path: &Path) -> Result<FuzzySystem, String> {
+    read_system_with_notes(path).map(|(system, _)| system)
+}
+
+/// Reads a system as [`read_system`] does, with the `.fis` reader's notes of what it accepted
+/// but ignored; `None` for an FCL file, whose reader keeps no such notes.
+fn read_system_with_notes(path: &Path) -> Result<(FuzzySystem, Option<Vec<FisNote>>), String> {
+    let text = read_text(path)?;
+    let is_fcl = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("fcl"));
+    let system = if is_fcl {
+        FuzzySystem::from_fcl(&text).map(|system| (system, None))
+    } else {
+        FuzzySystem::from_fis_with_notes(&text).map(|(system, notes)| (system, Some(notes)))
+    };
+    system.map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// The lines of `file` that were accepted but are neither kept nor used, one per line, so that

@@ -7,6 +7,8 @@ mod eval;
 mod experiment;
 mod figures;
 mod fis_cmd;
+mod fis_export;
+mod fis_train;
 mod output_dir;
 mod plot;
 mod progress;
@@ -47,7 +49,7 @@ enum Command {
     },
     /// Answer JSON-lines requests on stdin, one JSON answer per line on stdout (docs/eval-protocol.md).
     Eval,
-    /// Check, evaluate and plot Takagi-Sugeno systems stored as MATLAB .fis files.
+    /// Check, evaluate, plot, train and export Takagi-Sugeno systems (MATLAB .fis or FCL files).
     Fis(fis_cmd::FisArgs),
     /// Monte Carlo over noise levels and seeds: mean and spread of the errors per controller (docs/sweep.md).
     Sweep(sweep::SweepCli),

@@ -88,9 +88,18 @@ fn random_membership(rng: &mut Rng, lo: f64, hi: f64) -> MembershipFn {
             slope2: -rng.range(1.0, 20.0) / w,
             center2: p[3],
         },
+        // Sometimes MATLAB's step (start >= end).
+        8 if rng.chance(0.2) => MembershipFn::SShape {
+            start: p[2],
+            end: p[0],
+        },
         8 => MembershipFn::SShape {
             start: p[0],
             end: p[2],
+        },
+        9 if rng.chance(0.2) => MembershipFn::ZShape {
+            start: p[3],
+            end: p[1],
         },
         9 => MembershipFn::ZShape {
             start: p[1],
@@ -404,4 +413,67 @@ pub fn reference_eval(system: &FuzzySystem, x: &[f64]) -> (Vec<f64>, Vec<Option<
         })
         .collect();
     (strengths, outputs)
+}
+
+/// A system using what validation allows beyond MATLAB's usual files: an input `b` with no sets
+/// (`NumMFs=0`) between two that have sets, and an output whose range is the single point 2
+/// (so "no rule fired" falls back to 2), with a linear and a constant term, smf/zmf/pimf sets
+/// and a step.
+pub fn relaxed_system() -> FuzzySystem {
+    let sets = |a: f64| {
+        vec![
+            (
+                "low".to_string(),
+                MembershipFn::ZShape {
+                    start: a,
+                    end: a + 0.6,
+                },
+            ),
+            (
+                "mid".to_string(),
+                MembershipFn::PiShape {
+                    left_foot: a + 0.1,
+                    left_shoulder: a + 0.4,
+                    right_shoulder: a + 0.6,
+                    right_foot: a + 0.9,
+                },
+            ),
+            (
+                "high".to_string(),
+                MembershipFn::SShape {
+                    start: a + 0.7,
+                    end: a + 0.3,
+                },
+            ),
+        ]
+    };
+    let rule = |a: usize, c: usize, term: usize| Rule {
+        antecedents: vec![Antecedent::Is(a), Antecedent::Any, Antecedent::Is(c)],
+        consequents: vec![Some(term)],
+        weight: 1.0,
+        connective: Connective::And,
+    };
+    FuzzySystem::builder("relaxed")
+        .input("a", [0.0, 1.0], sets(0.0))
+        .input("b", [-1.0, 1.0], Vec::<(String, MembershipFn)>::new())
+        .input("c", [0.0, 1.0], sets(0.0))
+        .output(
+            "y",
+            [2.0, 2.0],
+            vec![
+                (
+                    "slope".to_string(),
+                    OutputFn::Linear {
+                        coefficients: vec![1.0, 5.0, -2.0],
+                        constant: 0.5,
+                    },
+                ),
+                ("level".to_string(), OutputFn::Constant(-1.0)),
+            ],
+        )
+        .indexed_rule(rule(0, 0, 0))
+        .indexed_rule(rule(1, 2, 1))
+        .indexed_rule(rule(2, 1, 0))
+        .build()
+        .expect("validation accepts empty inputs and point output ranges")
 }

@@ -1,0 +1,1024 @@
+//! IEC 61131-7 Fuzzy Control Language (FCL) for Sugeno systems, read and written, including
+//! the files fuzzylite's FCL exporter writes.
+//!
+//! Written files use the standard's blocks (`FUNCTION_BLOCK`, `VAR_INPUT`, `FUZZIFY`,
+//! `DEFUZZIFY` with singleton terms and `METHOD : COGS`, `RULEBLOCK` with `IF ... THEN ...
+//! WITH w;` rules) and its point lists for triangles and trapezoids. The standard has no bell,
+//! Gaussian, sigmoid or linear terms; those are written as fuzzylite writes them (`TERM N :=
+//! Bell -0.3 0.3 2;`, `TERM z := Linear 1 2 0.5;`), and a `RANGE` is written in every `FUZZIFY`
+//! block as fuzzylite does. Reading accepts both forms, `(* *)` and `//` comments, any case of
+//! the keywords, and rules with or without the final `;`. Numbers are written in their
+//! shortest exact form, so writing then reading gives back the identical system.
+
+use crate::error::FuzzyError;
+use crate::membership::MembershipFn;
+use crate::system::{
+    AndMethod, Antecedent, Connective, Defuzzification, FuzzySet, FuzzySystem, InputVariable,
+    Methods, OrMethod, OutputFn, OutputTerm, OutputVariable, Rule,
+};
+use std::fmt::Write as _;
+
+/// The largest FCL text read, in bytes.
+const MAX_FCL_BYTES: usize = 16 << 20;
+
+/// FCL keywords, which cannot be variable or term names.
+const KEYWORDS: [&str; 9] = [
+    "IF", "THEN", "IS", "NOT", "AND", "OR", "WITH", "RULE", "TERM",
+];
+
+impl FuzzySystem {
+    /// Writes the system as IEC 61131-7 FCL (see the module documentation). Fails if a name
+    /// is not an FCL identifier (letters, digits and `_`, not starting with a digit, not a
+    /// keyword).
+    ///
+    /// ```
+    /// use fuzzy_sugeno::{paper_controller, FuzzySystem};
+    /// let fcl = paper_controller().to_fcl()?;
+    /// assert!(fcl.contains("TERM N := Bell -0.3 0.3 2.0;"));
+    /// assert_eq!(FuzzySystem::from_fcl(&fcl)?, paper_controller());
+    /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
+    /// ```
+    pub fn to_fcl(&self) -> Result<String, FuzzyError> {
+        let identifier = |kind: &str, name: &str| {
+            if is_identifier(name) {
+                Ok(())
+            } else {
+                Err(FuzzyError::Export(format!(
+                    "the {kind} name '{name}' is not an FCL identifier (letters, digits and _, \
+                     not starting with a digit, not a keyword)"
+                )))
+            }
+        };
+        identifier("system", self.name())?;
+        let mut out = format!(
+            "(* Sugeno system '{}', written by hrm (fuzzy-sugeno) as IEC 61131-7 FCL; bell, \
+             Gaussian, sigmoid and linear terms use fuzzylite's names. *)\n\
+             FUNCTION_BLOCK {}\n\nVAR_INPUT\n",
+            self.name(),
+            self.name()
+        );
+        for input in self.inputs() {
+            identifier("input", &input.name)?;
+            let _ = writeln!(out, "    {} : REAL;", input.name);
+        }
+        out.push_str("END_VAR\n\nVAR_OUTPUT\n");
+        for output in self.outputs() {
+            identifier("output", &output.name)?;
+            let _ = writeln!(out, "    {} : REAL;", output.name);
+        }
+        out.push_str("END_VAR\n");
+        for input in self.inputs() {
+            let _ = write!(
+                out,
+                "\nFUZZIFY {}\n    RANGE := ({:?} .. {:?});\n",
+                input.name, input.range[0], input.range[1]
+            );
+            for set in &input.sets {
+                identifier("set", &set.name)?;
+                let _ = writeln!(out, "    TERM {} := {};", set.name, term(&set.membership));
+            }
+            out.push_str("END_FUZZIFY\n");
+        }
+        let methods = self.methods();
+        for output in self.outputs() {
+            let _ = write!(
+                out,
+                "\nDEFUZZIFY {}\n    RANGE := ({:?} .. {:?});\n",
+                output.name, output.range[0], output.range[1]
+            );
+            for t in &output.terms {
+                identifier("term", &t.name)?;
+                let value = match &t.function {
+                    OutputFn::Constant(c) => format!("{c:?}"),
+                    OutputFn::Linear {
+                        coefficients,
+                        constant,
+                    } => {
+                        let mut s = "Linear".to_string();
+                        for p in coefficients.iter().chain([constant]) {
+                            let _ = write!(s, " {p:?}");
+                        }
+                        s
+                    }
+                };
+                let _ = writeln!(out, "    TERM {} := {value};", t.name);
+            }
+            let method = match methods.defuzzification {
+                Defuzzification::WeightedAverage => "COGS",
+                Defuzzification::WeightedSum => "COGSS",
+            };
+            let _ = writeln!(
+                out,
+                "    METHOD : {method};\n    DEFAULT := {:?};\nEND_DEFUZZIFY",
+                0.5 * (output.range[0] + output.range[1])
+            );
+        }
+        let and = match methods.and {
+            AndMethod::Product => "PROD",
+            AndMethod::Minimum => "MIN",
+        };
+        let or = match methods.or {
+            OrMethod::ProbabilisticSum => "ASUM",
+            OrMethod::Maximum => "MAX",
+        };
+        let _ = writeln!(out, "\nRULEBLOCK rules\n    AND : {and};\n    OR : {or};");
+        for (r, rule) in self.rules().iter().enumerate() {
+            let connective = match rule.connective {
+                Connective::And => " AND ",
+                Connective::Or => " OR ",
+            };
+            let premises: Vec<String> = rule
+                .antecedents
+                .iter()
+                .zip(self.inputs())
+                .filter_map(|(a, input)| match *a {
+                    Antecedent::Any => None,
+                    Antecedent::Is(k) => Some(format!("{} IS {}", input.name, input.sets[k].name)),
+                    Antecedent::IsNot(k) => {
+                        Some(format!("{} IS NOT {}", input.name, input.sets[k].name))
+                    }
+                })
+                .collect();
+            let conclusions: Vec<String> = rule
+                .consequents
+                .iter()
+                .zip(self.outputs())
+                .filter_map(|(c, output)| {
+                    c.map(|k| format!("{} IS {}", output.name, output.terms[k].name))
+                })
+                .collect();
+            let weight = if rule.weight == 1.0 {
+                String::new()
+            } else {
+                format!(" WITH {:?}", rule.weight)
+            };
+            let _ = writeln!(
+                out,
+                "    RULE {} : IF {} THEN {}{weight};",
+                r + 1,
+                premises.join(connective),
+                conclusions.join(", ")
+            );
+        }
+        out.push_str("END_RULEBLOCK\n\nEND_FUNCTION_BLOCK\n");
+        Ok(out)
+    }
+
+    /// Reads a Sugeno system from FCL text (IEC 61131-7, or as fuzzylite writes it). Errors
+    /// give the line and what was expected; Mamdani defuzzifiers, membership shapes this crate
+    /// does not have and hedges other than `NOT` are refused by name. `DEFAULT`, `ACT` and
+    /// `ACCU` are read and ignored: a Sugeno system has no implication or accumulation, and the
+    /// output when no rule fires is an evaluation policy ([`EvalOptions`](crate::EvalOptions)).
+    pub fn from_fcl(text: &str) -> Result<Self, FuzzyError> {
+        if text.len() > MAX_FCL_BYTES {
+            return Err(error(
+                1,
+                format!("{} bytes exceed the limit of {MAX_FCL_BYTES}", text.len()),
+            ));
+        }
+        Reader::default().read(text)
+    }
+}
+
+/// A term's FCL value: IEC point lists for triangles and trapezoids, fuzzylite's class names
+/// and parameter order otherwise.
+fn term(mf: &MembershipFn) -> String {
+    match *mf {
+        MembershipFn::Triangle { left, peak, right } => {
+            format!("({left:?}, 0.0) ({peak:?}, 1.0) ({right:?}, 0.0)")
+        }
+        MembershipFn::Trapezoid {
+            left_foot,
+            left_shoulder,
+            right_shoulder,
+            right_foot,
+        } => format!(
+            "({left_foot:?}, 0.0) ({left_shoulder:?}, 1.0) ({right_shoulder:?}, 1.0) ({right_foot:?}, 0.0)"
+        ),
+        MembershipFn::Bell {
+            width,
+            slope,
+            center,
+        } => format!("Bell {center:?} {width:?} {slope:?}"),
+        MembershipFn::Gaussian { sigma, center } => format!("Gaussian {center:?} {sigma:?}"),
+        MembershipFn::Gaussian2 {
+            sigma1,
+            center1,
+            sigma2,
+            center2,
+        } => format!("GaussianProduct {center1:?} {sigma1:?} {center2:?} {sigma2:?}"),
+        MembershipFn::Sigmoid { slope, center } => format!("Sigmoid {center:?} {slope:?}"),
+        MembershipFn::SigmoidDifference {
+            slope1,
+            center1,
+            slope2,
+            center2,
+        } => format!("SigmoidDifference {center1:?} {slope1:?} {slope2:?} {center2:?}"),
+        MembershipFn::SigmoidProduct {
+            slope1,
+            center1,
+            slope2,
+            center2,
+        } => format!("SigmoidProduct {center1:?} {slope1:?} {slope2:?} {center2:?}"),
+        MembershipFn::SShape { start, end } => format!("SShape {start:?} {end:?}"),
+        MembershipFn::ZShape { start, end } => format!("ZShape {start:?} {end:?}"),
+        MembershipFn::PiShape {
+            left_foot,
+            left_shoulder,
+            right_shoulder,
+            right_foot,
+        } => format!("PiShape {left_foot:?} {left_shoulder:?} {right_shoulder:?} {right_foot:?}"),
+        MembershipFn::Constant { value } => format!("Constant {value:?}"),
+    }
+}
+
+fn is_identifier(name: &str) -> bool {
+    let mut chars = name.chars();
+    chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && !KEYWORDS.iter().any(|k| k.eq_ignore_ascii_case(name))
+}
+
+fn error(line: usize, message: impl Into<String>) -> FuzzyError {
+    FuzzyError::Fcl {
+        line,
+        message: message.into(),
+    }
+}
+
+/// The block being read (FCL calls them blocks).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+enum Section {
+    #[default]
+    Outside,
+    FunctionBlock,
+    VarInput,
+    VarOutput,
+    Fuzzify(usize),
+    Defuzzify(usize),
+    RuleBlock,
+    Done,
+}
+
+/// A variable as declared and then defined, with the line of its declaration.
+#[derive(Debug, Default)]
+struct Variable {
+    name: String,
+    line: usize,
+    range: Option<[f64; 2]>,
+    input_sets: Vec<FuzzySet>,
+    output_terms: Vec<OutputTerm>,
+    defined: bool,
+}
+
+#[derive(Debug, Default)]
+struct Reader {
+    block: Section,
+    name: String,
+    inputs: Vec<Variable>,
+    outputs: Vec<Variable>,
+    and: Option<(AndMethod, usize)>,
+    or: Option<(OrMethod, usize)>,
+    defuzzification: Option<(Defuzzification, usize)>,
+    /// Rules as text with their lines, resolved once every variable is known.
+    rules: Vec<(usize, String)>,
+}
+
+impl Reader {
+    fn read(mut self, text: &str) -> Result<FuzzySystem, FuzzyError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let mut in_comment = false;
+        let mut last_line = 1;
+        for (index, raw) in text.lines().enumerate() {
+            let number = index + 1;
+            last_line = number;
+            let line = strip_comments(raw, &mut in_comment);
+            for statement in split_statements(&line) {
+                self.statement(number, statement)?;
+            }
+        }
+        if in_comment {
+            return Err(error(last_line, "unterminated (* comment"));
+        }
+        if self.block != Section::Done {
+            return Err(error(
+                last_line,
+                "expected END_FUNCTION_BLOCK before the end of the text",
+            ));
+        }
+        self.finish()
+    }
+
+    fn statement(&mut self, line: usize, statement: &str) -> Result<(), FuzzyError> {
+        let (head, rest) = split_word(statement);
+        let keyword = head.to_ascii_uppercase();
+        match (self.block, keyword.as_str()) {
+            (Section::Outside, "FUNCTION_BLOCK") => {
+                self.name = if rest.is_empty() {
+                    "fcl".to_string()
+                } else {
+                    rest.to_string()
+                };
+                self.block = Section::FunctionBlock;
+            }
+            (Section::Outside, _) => {
+                return Err(error(
+                    line,
+                    format!("expected FUNCTION_BLOCK, found `{statement}`"),
+                ));
+            }
+            (Section::FunctionBlock, "VAR_INPUT" | "VAR_OUTPUT") => {
+                self.block = if keyword == "VAR_INPUT" {
+                    Section::VarInput
+                } else {
+                    Section::VarOutput
+                };
+                // A declaration may follow on the same line: `VAR_INPUT x : REAL;`.
+                if !rest.is_empty() {
+                    self.statement(line, rest)?;
+                }
+            }
+            (Section::FunctionBlock, "FUZZIFY") => {
+                let k = find(&self.inputs, rest).ok_or_else(|| {
+                    error(
+                        line,
+                        format!("FUZZIFY of '{rest}', which VAR_INPUT does not declare"),
+                    )
+                })?;
+                if self.inputs[k].defined {
+                    return Err(error(line, format!("a second FUZZIFY block for '{rest}'")));
+                }
+                self.inputs[k].defined = true;
+                self.block = Section::Fuzzify(k);
+            }
+            (Section::FunctionBlock, "DEFUZZIFY") => {
+                let k = find(&self.outputs, rest).ok_or_else(|| {
+                    error(
+                        line,
+                        format!("DEFUZZIFY of '{rest}', which VAR_OUTPUT does not declare"),
+                    )
+                })?;
+                if self.outputs[k].defined {
+                    return Err(error(
+                        line,
+                        format!("a second DEFUZZIFY block for '{rest}'"),
+                    ));
+                }
+                self.outputs[k].defined = true;
+                self.block = Section::Defuzzify(k);
+            }
+            (Section::FunctionBlock, "RULEBLOCK") => self.block = Section::RuleBlock,
+            (Section::FunctionBlock, "END_FUNCTION_BLOCK") => self.block = Section::Done,
+            (Section::FunctionBlock, _) => {
+                return Err(error(
+                    line,
+                    format!(
+                        "expected VAR_INPUT, VAR_OUTPUT, FUZZIFY, DEFUZZIFY, RULEBLOCK or \
+                         END_FUNCTION_BLOCK, found `{statement}`"
+                    ),
+                ));
+            }
+            (Section::VarInput | Section::VarOutput, "END_VAR") => {
+                self.block = Section::FunctionBlock
+            }
+            (Section::VarInput | Section::VarOutput, _) => {
+                let (name, kind) = statement
+                    .split_once(':')
+                    .map(|(n, k)| (n.trim(), k.trim()))
+                    .ok_or_else(|| {
+                        error(line, format!("expected `name : REAL`, found `{statement}`"))
+                    })?;
+                if !kind.eq_ignore_ascii_case("REAL") {
+                    return Err(error(
+                        line,
+                        format!("variable '{name}' has type {kind}; expected REAL"),
+                    ));
+                }
+                if !is_identifier(name) {
+                    return Err(error(line, format!("'{name}' is not an FCL identifier")));
+                }
+                if find(&self.inputs, name).is_some() || find(&self.outputs, name).is_some() {
+                    return Err(error(line, format!("variable '{name}' is declared twice")));
+                }
+                let variable = Variable {
+                    name: name.to_string(),
+                    line,
+                    ..Variable::default()
+                };
+                if self.block == Section::VarInput {
+                    self.inputs.push(variable);
+                } else {
+                    self.outputs.push(variable);
+                }
+            }
+            (Section::Fuzzify(_), "END_FUZZIFY") | (Section::Defuzzify(_), "END_DEFUZZIFY") => {
+                self.block = Section::FunctionBlock;
+            }
+            (Section::Fuzzify(k) | Section::Defuzzify(k), "RANGE") => {
+                let variable = match self.block {
+                    Section::Fuzzify(_) => &mut self.inputs[k],
+                    _ => &mut self.outputs[k],
+                };
+                variable.range = Some(parse_range(line, rest)?);
+            }
+            (Section::Fuzzify(k), "TERM") => {
+                let (name, value) = term_definition(line, rest)?;
+                let membership = input_term(line, value)?;
+                self.inputs[k].input_sets.push(FuzzySet {
+                    name: name.to_string(),
+                    membership,
+                });
+            }
+            (Section::Defuzzify(k), "TERM") => {
+                let (name, value) = term_definition(line, rest)?;
+                let n_inputs = self.inputs.len();
+                let function = output_term(line, value, n_inputs)?;
+                self.outputs[k].output_terms.push(OutputTerm {
+                    name: name.to_string(),
+                    function,
+                });
+            }
+            (Section::Defuzzify(_), "METHOD") => {
+                let method = setting(line, rest)?;
+                let value = match method.to_ascii_uppercase().as_str() {
+                    "COGS" => Defuzzification::WeightedAverage,
+                    "COGSS" => Defuzzification::WeightedSum,
+                    _ => {
+                        return Err(error(
+                            line,
+                            format!(
+                                "METHOD {method} is a Mamdani defuzzifier; this crate reads Sugeno \
+                                 systems (COGS, or fuzzylite's COGSS)"
+                            ),
+                        ));
+                    }
+                };
+                match self.defuzzification {
+                    Some((other, first)) if other != value => {
+                        return Err(error(
+                            line,
+                            format!(
+                                "METHOD differs from the one at line {first}; a system has one defuzzifier"
+                            ),
+                        ));
+                    }
+                    _ => self.defuzzification = Some((value, line)),
+                }
+            }
+            (Section::Defuzzify(_), "DEFAULT" | "ACCU" | "LOCK")
+            | (Section::RuleBlock, "ACT" | "ACCU") => {}
+            (Section::Fuzzify(_), _) => {
+                return Err(error(
+                    line,
+                    format!("expected RANGE, TERM or END_FUZZIFY, found `{statement}`"),
+                ));
+            }
+            (Section::Defuzzify(_), _) => {
+                return Err(error(
+                    line,
+                    format!(
+                        "expected RANGE, TERM, METHOD, DEFAULT, ACCU or END_DEFUZZIFY, found `{statement}`"
+                    ),
+                ));
+            }
+            (Section::RuleBlock, "AND") => {
+                let value = match setting(line, rest)?.to_ascii_uppercase().as_str() {
+                    "PROD" => AndMethod::Product,
+                    "MIN" => AndMethod::Minimum,
+                    other => {
+                        return Err(error(
+                            line,
+                            format!("AND : {other} is not supported; expected PROD or MIN"),
+                        ));
+                    }
+                };
+                agree(&mut self.and, value, line, "AND")?;
+            }
+            (Section::RuleBlock, "OR") => {
+                let value = match setting(line, rest)?.to_ascii_uppercase().as_str() {
+                    "ASUM" => OrMethod::ProbabilisticSum,
+                    "MAX" => OrMethod::Maximum,
+                    other => {
+                        return Err(error(
+                            line,
+                            format!("OR : {other} is not supported; expected ASUM or MAX"),
+                        ));
+                    }
+                };
+                agree(&mut self.or, value, line, "OR")?;
+            }
+            (Section::RuleBlock, "RULE") => {
+                let body = rest
+                    .split_once(':')
+                    .map(|(_, body)| body.trim())
+                    .ok_or_else(|| {
+                        error(
+                            line,
+                            format!("expected `RULE n : IF ...`, found `{statement}`"),
+                        )
+                    })?;
+                self.rules.push((line, body.to_string()));
+            }
+            (Section::RuleBlock, "END_RULEBLOCK") => self.block = Section::FunctionBlock,
+            (Section::RuleBlock, _) => {
+                return Err(error(
+                    line,
+                    format!(
+                        "expected AND, OR, ACT, ACCU, RULE or END_RULEBLOCK, found `{statement}`"
+                    ),
+                ));
+            }
+            (Section::Done, _) => {
+                return Err(error(
+                    line,
+                    format!("text after END_FUNCTION_BLOCK: `{statement}`"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn finish(self) -> Result<FuzzySystem, FuzzyError> {
+        let mut inputs = Vec::with_capacity(self.inputs.len());
+        for v in &self.inputs {
+            if !v.defined {
+                return Err(error(
+                    v.line,
+                    format!("input '{}' has no FUZZIFY block", v.name),
+                ));
+            }
+            let range = v.range.ok_or_else(|| {
+                error(
+                    v.line,
+                    format!(
+                        "input '{}' has no RANGE (this crate needs every variable's range)",
+                        v.name
+                    ),
+                )
+            })?;
+            inputs.push(InputVariable {
+                name: v.name.clone(),
+                range,
+                sets: v.input_sets.clone(),
+            });
+        }
+        let mut outputs = Vec::with_capacity(self.outputs.len());
+        for v in &self.outputs {
+            if !v.defined {
+                return Err(error(
+                    v.line,
+                    format!("output '{}' has no DEFUZZIFY block", v.name),
+                ));
+            }
+            let range = v.range.ok_or_else(|| {
+                error(
+                    v.line,
+                    format!(
+                        "output '{}' has no RANGE (this crate needs every variable's range)",
+                        v.name
+                    ),
+                )
+            })?;
+            outputs.push(OutputVariable {
+                name: v.name.clone(),
+                range,
+                terms: v.output_terms.clone(),
+            });
+        }
+        let mut rules = Vec::with_capacity(self.rules.len());
+        for (line, text) in &self.rules {
+            rules.push(parse_rule(*line, text, &inputs, &outputs)?);
+        }
+        let methods = Methods {
+            and: self.and.map_or(AndMethod::default(), |(m, _)| m),
+            or: self.or.map_or(OrMethod::default(), |(m, _)| m),
+            defuzzification: self
+                .defuzzification
+                .map_or(Defuzzification::default(), |(m, _)| m),
+        };
+        FuzzySystem::new(self.name, inputs, outputs, rules, methods)
+            .map_err(|e| error(1, e.to_string()))
+    }
+}
+
+fn agree<T: PartialEq + Copy>(
+    slot: &mut Option<(T, usize)>,
+    value: T,
+    line: usize,
+    what: &str,
+) -> Result<(), FuzzyError> {
+    match *slot {
+        Some((other, first)) if other != value => Err(error(
+            line,
+            format!("{what} differs from the one at line {first}; a system has one {what} method"),
+        )),
+        _ => {
+            *slot = Some((value, line));
+            Ok(())
+        }
+    }
+}
+
+fn find(variables: &[Variable], name: &str) -> Option<usize> {
+    variables.iter().position(|v| v.name == name)
+}
+
+/// The line without its comments; `in_comment` carries an open `(*` to the next line.
+fn strip_comments(raw: &str, in_comment: &mut bool) -> String {
+    let mut out = String::new();
+    let mut rest = raw;
+    loop {
+        if *in_comment {
+            match rest.find("*)") {
+                Some(end) => {
+                    rest = &rest[end + 2..];
+                    *in_comment = false;
+                }
+                None => return out,
+            }
+        }
+        let open = rest.find("(*");
+        let slash = rest.find("//");
+        match (open, slash) {
+            (Some(o), Some(s)) if s < o => return out + &rest[..s],
+            (None, Some(s)) => return out + &rest[..s],
+            (Some(o), _) => {
+                out.push_str(&rest[..o]);
+                out.push(' ');
+                rest = &rest[o + 2..];
+                *in_comment = true;
+            }
+            (None, None) => return out + rest,
+        }
+    }
+}
+
+/// The `;`-separated statements of a line, trimmed, empty ones dropped.
+fn split_statements(line: &str) -> impl Iterator<Item = &str> {
+    line.split(';').map(str::trim).filter(|s| !s.is_empty())
+}
+
+/// The first word (up to whitespace or `:`) and the rest, trimmed.
+fn split_word(statement: &str) -> (&str, &str) {
+    let end = statement
+        .find(|c: char| c.is_whitespace() || c == ':')
+        .unwrap_or(statement.len());
+    (&statement[..end], statement[end..].trim())
+}
+
+/// The value of `: VALUE`.
+fn setting(line: usize, rest: &str) -> Result<&str, FuzzyError> {
+    rest.strip_prefix(':')
+        .map(str::trim)
+        .filter(|v| !v.is_empty())
+        .ok_or_else(|| error(line, format!("expected `: VALUE`, found `{rest}`")))
+}
+
+fn number(line: usize, text: &str) -> Result<f64, FuzzyError> {
+    let value: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| error(line, format!("expected a number, found `{}`", text.trim())))?;
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(error(
+            line,
+            format!("expected a finite number, found {value}"),
+        ))
+    }
+}
+
+/// `:= (min .. max)`.
+fn parse_range(line: usize, rest: &str) -> Result<[f64; 2], FuzzyError> {
+    let inner = rest
+        .strip_prefix(":=")
+        .map(str::trim)
+        .and_then(|r| r.strip_prefix('('))
+        .and_then(|r| r.strip_suffix(')'))
+        .ok_or_else(|| {
+            error(
+                line,
+                format!("expected `RANGE := (min .. max)`, found `RANGE {rest}`"),
+            )
+        })?;
+    let (lo, hi) = inner
+        .split_once("..")
+        .ok_or_else(|| error(line, format!("expected `min .. max`, found `{inner}`")))?;
+    Ok([number(line, lo)?, number(line, hi)?])
+}
+
+/// `name := value`.
+fn term_definition(line: usize, rest: &str) -> Result<(&str, &str), FuzzyError> {
+    let (name, value) = rest
+        .split_once(":=")
+        .map(|(n, v)| (n.trim(), v.trim()))
+        .ok_or_else(|| {
+            error(
+                line,
+                format!("expected `TERM name := ...`, found `TERM {rest}`"),
+            )
+        })?;
+    if !is_identifier(name) {
+        return Err(error(line, format!("'{name}' is not an FCL identifier")));
+    }
+    Ok((name, value))
+}
+
+/// A fuzzylite class name and its parameters, the last one a height that must be 1 if present.
+fn class_parameters(line: usize, value: &str) -> Result<(&str, Vec<f64>), FuzzyError> {
+    let mut words = value.split_whitespace();
+    let class = words.next().unwrap_or("");
+    let params = words
+        .map(|w| number(line, w))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((class, params))
+}
+
+fn arity(line: usize, class: &str, params: &[f64], n: usize) -> Result<(), FuzzyError> {
+    match params.len() {
+        k if k == n => Ok(()),
+        k if k == n + 1 && params[n] == 1.0 => Ok(()),
+        k if k == n + 1 => Err(error(
+            line,
+            format!(
+                "{class} with height {}: only height 1 is supported",
+                params[n]
+            ),
+        )),
+        k => Err(error(
+            line,
+            format!("{class} takes {n} parameters, got {k}"),
+        )),
+    }
+}
+
+/// An input term: an IEC point list (triangle, trapezoid or shoulder) or a fuzzylite class.
+fn input_term(line: usize, value: &str) -> Result<MembershipFn, FuzzyError> {
+    let mf = if value.starts_with('(') {
+        points(line, value)?
+    } else {
+        let (class, p) = class_parameters(line, value)?;
+        let expected = match class {
+            "Triangle" | "Bell" => 3,
+            "Gaussian" | "Sigmoid" | "SShape" | "ZShape" => 2,
+            "Trapezoid" | "GaussianProduct" | "SigmoidDifference" | "SigmoidProduct"
+            | "PiShape" => 4,
+            "Constant" => 1,
+            _ if class.parse::<f64>().is_ok() => {
+                return Err(error(line, "singleton input terms are not supported"));
+            }
+            _ => {
+                return Err(error(
+                    line,
+                    format!(
+                        "input term class '{class}' is not supported; expected a point list or one \
+                         of Triangle, Trapezoid, Bell, Gaussian, GaussianProduct, Sigmoid, \
+                         SigmoidDifference, SigmoidProduct, SShape, ZShape, PiShape, Constant"
+                    ),
+                ));
+            }
+        };
+        arity(line, class, &p, expected)?;
+        match class {
+            "Triangle" => MembershipFn::triangle(p[0], p[1], p[2]),
+            "Trapezoid" => MembershipFn::trapezoid(p[0], p[1], p[2], p[3]),
+            "Bell" => MembershipFn::bell(p[1], p[2], p[0]),
+            "Gaussian" => MembershipFn::gaussian(p[1], p[0]),
+            "GaussianProduct" => MembershipFn::Gaussian2 {
+                sigma1: p[1],
+                center1: p[0],
+                sigma2: p[3],
+                center2: p[2],
+            },
+            "Sigmoid" => MembershipFn::sigmoid(p[1], p[0]),
+            "SigmoidDifference" => MembershipFn::SigmoidDifference {
+                slope1: p[1],
+                center1: p[0],
+                slope2: p[2],
+                center2: p[3],
+            },
+            "SigmoidProduct" => MembershipFn::SigmoidProduct {
+                slope1: p[1],
+                center1: p[0],
+                slope2: p[2],
+                center2: p[3],
+            },
+            // fuzzylite's SShape(start, end), ZShape(start, end) and
+            // PiShape(bottomLeft, topLeft, topRight, bottomRight): MATLAB's order.
+            "SShape" => MembershipFn::SShape {
+                start: p[0],
+                end: p[1],
+            },
+            "ZShape" => MembershipFn::ZShape {
+                start: p[0],
+                end: p[1],
+            },
+            "PiShape" => MembershipFn::PiShape {
+                left_foot: p[0],
+                left_shoulder: p[1],
+                right_shoulder: p[2],
+                right_foot: p[3],
+            },
+            _ => MembershipFn::Constant { value: p[0] },
+        }
+    };
+    mf.validate().map_err(|e| error(line, e.to_string()))?;
+    Ok(mf)
+}
+
+/// A point list `(x1, y1) (x2, y2) ...` of the shapes MATLAB has: a triangle (0 1 0) or a
+/// trapezoid (0 1 1 0).
+fn points(line: usize, value: &str) -> Result<MembershipFn, FuzzyError> {
+    let mut pts = Vec::new();
+    let mut rest = value.trim();
+    while !rest.is_empty() {
+        let inner = rest
+            .strip_prefix('(')
+            .and_then(|r| r.split_once(')'))
+            .ok_or_else(|| error(line, format!("expected `(x, y)` points, found `{rest}`")))?;
+        let (x, y) = inner
+            .0
+            .split_once(',')
+            .ok_or_else(|| error(line, format!("expected `(x, y)`, found `({})`", inner.0)))?;
+        pts.push((number(line, x)?, number(line, y)?));
+        rest = inner.1.trim();
+        if pts.len() > 4 {
+            break;
+        }
+    }
+    let xs: Vec<f64> = pts.iter().map(|p| p.0).collect();
+    let ys: Vec<f64> = pts.iter().map(|p| p.1).collect();
+    match ys.as_slice() {
+        [0.0, 1.0, 0.0] => Ok(MembershipFn::triangle(xs[0], xs[1], xs[2])),
+        [0.0, 1.0, 1.0, 0.0] => Ok(MembershipFn::trapezoid(xs[0], xs[1], xs[2], xs[3])),
+        _ => Err(error(
+            line,
+            format!(
+                "the point list `{value}` is not a triangle (0 1 0) or a trapezoid (0 1 1 0), the \
+                 piecewise-linear shapes MATLAB's .fis has"
+            ),
+        )),
+    }
+}
+
+/// An output term: a singleton (IEC), `Constant c` or `Linear p1 .. pn r` (fuzzylite).
+fn output_term(line: usize, value: &str, n_inputs: usize) -> Result<OutputFn, FuzzyError> {
+    if let Ok(c) = value.parse::<f64>() {
+        return Ok(OutputFn::Constant(number(line, value).map(|_| c)?));
+    }
+    let (class, p) = class_parameters(line, value)?;
+    match class {
+        "Constant" => {
+            arity(line, class, &p, 1)?;
+            Ok(OutputFn::Constant(p[0]))
+        }
+        "Linear" if p.len() == n_inputs + 1 => Ok(OutputFn::Linear {
+            coefficients: p[..n_inputs].to_vec(),
+            constant: p[n_inputs],
+        }),
+        "Linear" => Err(error(
+            line,
+            format!(
+                "Linear has {} parameters; with {n_inputs} inputs it needs {}",
+                p.len(),
+                n_inputs + 1
+            ),
+        )),
+        _ => Err(error(
+            line,
+            format!(
+                "output term `{value}` is not a Sugeno consequent; expected a number, Constant or Linear"
+            ),
+        )),
+    }
+}
+
+/// `IF x IS [NOT] a AND|OR ... THEN z IS c [, AND ...] [WITH w]`.
+fn parse_rule(
+    line: usize,
+    text: &str,
+    inputs: &[InputVariable],
+    outputs: &[OutputVariable],
+) -> Result<Rule, FuzzyError> {
+    let words: Vec<&str> = text.split_whitespace().collect();
+    let upper: Vec<String> = words.iter().map(|w| w.to_ascii_uppercase()).collect();
+    let fail = |message: String| error(line, message);
+    if upper.first().map(String::as_str) != Some("IF") {
+        return Err(fail(format!(
+            "expected the rule to start with IF, found `{text}`"
+        )));
+    }
+    if words.iter().any(|w| w.contains('(') || w.contains(')')) {
+        return Err(fail(
+            "parentheses in rules are not supported (a .fis rule has one connective)".to_string(),
+        ));
+    }
+    let then = upper
+        .iter()
+        .position(|w| w == "THEN")
+        .ok_or_else(|| fail("expected THEN".to_string()))?;
+    let with = upper.iter().position(|w| w == "WITH");
+    let weight = match with {
+        Some(k) if k + 2 == words.len() => number(line, words[k + 1])?,
+        Some(_) => {
+            return Err(fail(
+                "expected one number after WITH, at the end of the rule".to_string(),
+            ));
+        }
+        None => 1.0,
+    };
+    let mut antecedents = vec![Antecedent::Any; inputs.len()];
+    let mut connective = None;
+    let mut k = 1;
+    while k < then {
+        if k > 1 {
+            let c = match upper[k].as_str() {
+                "AND" => Connective::And,
+                "OR" => Connective::Or,
+                other => return Err(fail(format!("expected AND or OR, found `{other}`"))),
+            };
+            if connective.is_some_and(|first| first != c) {
+                return Err(fail(
+                    "the rule mixes AND and OR; a .fis rule has one connective".to_string(),
+                ));
+            }
+            connective = Some(c);
+            k += 1;
+        }
+        let negated = upper.get(k + 2).is_some_and(|w| w == "NOT");
+        let end = k + 3 + usize::from(negated);
+        if end > then || upper[k + 1] != "IS" {
+            return Err(fail(format!(
+                "expected `variable IS [NOT] term` at `{}`",
+                words[k..then].join(" ")
+            )));
+        }
+        let (variable, term) = (words[k], words[end - 1]);
+        let i = inputs
+            .iter()
+            .position(|v| v.name == variable)
+            .ok_or_else(|| fail(format!("'{variable}' is not an input")))?;
+        let set = inputs[i]
+            .sets
+            .iter()
+            .position(|s| s.name == term)
+            .ok_or_else(|| {
+                fail(format!(
+                    "input '{variable}' has no term '{term}' (hedges other than NOT are not supported)"
+                ))
+            })?;
+        if antecedents[i] != Antecedent::Any {
+            return Err(fail(format!(
+                "input '{variable}' appears twice in the premise"
+            )));
+        }
+        antecedents[i] = if negated {
+            Antecedent::IsNot(set)
+        } else {
+            Antecedent::Is(set)
+        };
+        k = end;
+    }
+    let mut consequents = vec![None; outputs.len()];
+    let conclusion_end = with.unwrap_or(words.len());
+    let mut k = then + 1;
+    while k < conclusion_end {
+        if k > then + 1 && (upper[k] == "AND" || upper[k] == ",") {
+            k += 1;
+        }
+        let (variable, term) = match words.get(k..k + 3) {
+            Some([v, is, t]) if is.eq_ignore_ascii_case("IS") => (*v, t.trim_end_matches(',')),
+            _ => {
+                return Err(fail(format!(
+                    "expected `variable IS term` after THEN, at `{}`",
+                    words[k..conclusion_end].join(" ")
+                )));
+            }
+        };
+        let o = outputs
+            .iter()
+            .position(|v| v.name == variable.trim_start_matches(','))
+            .ok_or_else(|| fail(format!("'{variable}' is not an output")))?;
+        let t = outputs[o]
+            .terms
+            .iter()
+            .position(|t| t.name == term)
+            .ok_or_else(|| fail(format!("output '{variable}' has no term '{term}'")))?;
+        if consequents[o].is_some() {
+            return Err(fail(format!(
+                "output '{variable}' appears twice in the conclusion"
+            )));
+        }
+        consequents[o] = Some(t);
+        k += 3;
+    }
+    Ok(Rule {
+        antecedents,
+        consequents,
+        weight,
+        connective: connective.unwrap_or_default(),
+    })
+}

@@ -1,0 +1,184 @@
+//! Samples to learn from: rows of input values followed by output values.
+
+use super::learning;
+use crate::FuzzyError;
+use crate::system::check_name;
+
+/// The most rows a data set may hold.
+pub const MAX_ROWS: usize = 1_000_000;
+/// The most inputs a data set may have.
+pub const MAX_INPUTS: usize = 64;
+/// The most outputs a data set may have.
+const MAX_OUTPUTS: usize = 64;
+
+/// Rows of `n_inputs` input values followed by `n_outputs` output values, all finite.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainingData {
+    n_inputs: usize,
+    n_outputs: usize,
+    values: Vec<f64>,
+    /// Column names (inputs, then outputs), if given.
+    names: Option<Vec<String>>,
+}
+
+impl TrainingData {
+    /// Takes `values` row by row; refuses an empty set, a length that is not a whole number of
+    /// rows, a non-finite value (naming its row and column), more than [`MAX_ROWS`] rows or more
+    /// than [`MAX_INPUTS`] inputs.
+    pub fn new(n_inputs: usize, n_outputs: usize, values: Vec<f64>) -> Result<Self, FuzzyError> {
+        if n_inputs == 0 || n_inputs > MAX_INPUTS {
+            return Err(learning(format!(
+                "the number of inputs must lie in 1..={MAX_INPUTS}, got {n_inputs}"
+            )));
+        }
+        if n_outputs == 0 || n_outputs > MAX_OUTPUTS {
+            return Err(learning(format!(
+                "the number of outputs must lie in 1..={MAX_OUTPUTS}, got {n_outputs}"
+            )));
+        }
+        let width = n_inputs + n_outputs;
+        if values.is_empty() || !values.len().is_multiple_of(width) {
+            return Err(learning(format!(
+                "{} values are not a whole, non-zero number of rows of {width}",
+                values.len()
+            )));
+        }
+        let rows = values.len() / width;
+        if rows > MAX_ROWS {
+            return Err(learning(format!(
+                "{rows} rows exceed the limit of {MAX_ROWS}"
+            )));
+        }
+        if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+            return Err(learning(format!(
+                "row {} column {} is not finite ({})",
+                k / width + 1,
+                k % width + 1,
+                values[k]
+            )));
+        }
+        Ok(Self {
+            n_inputs,
+            n_outputs,
+            values,
+            names: None,
+        })
+    }
+
+    /// Names the columns (inputs, then outputs; for example a CSV header), which systems built
+    /// by `genfis` give their variables. Names must be distinct and valid in a `.fis` file (not
+    /// empty, no quote or control character).
+    pub fn with_names(mut self, names: Vec<String>) -> Result<Self, FuzzyError> {
+        let width = self.n_inputs + self.n_outputs;
+        if names.len() != width {
+            return Err(learning(format!(
+                "{} column names for {width} columns",
+                names.len()
+            )));
+        }
+        for (k, name) in names.iter().enumerate() {
+            check_name("variable", name)
+                .map_err(|reason| learning(format!("column {}: {reason}", k + 1)))?;
+            if names[..k].contains(name) {
+                return Err(learning(format!(
+                    "column {}: another column is also named '{name}'",
+                    k + 1
+                )));
+            }
+        }
+        self.names = Some(names);
+        Ok(self)
+    }
+
+    /// The name of column `column` (inputs first, then outputs): the given name, or `in1`,
+    /// `in2`, ... and `out1`, ... (MATLAB's defaults).
+    pub fn column_name(&self, column: usize) -> String {
+        match &self.names {
+            Some(names) => names[column].clone(),
+            None if column < self.n_inputs => format!("in{}", column + 1),
+            None => format!("out{}", column - self.n_inputs + 1),
+        }
+    }
+
+    /// The number of rows.
+    pub fn rows(&self) -> usize {
+        self.values.len() / (self.n_inputs + self.n_outputs)
+    }
+
+    /// The number of inputs per row.
+    pub fn n_inputs(&self) -> usize {
+        self.n_inputs
+    }
+
+    /// The number of outputs per row.
+    pub fn n_outputs(&self) -> usize {
+        self.n_outputs
+    }
+
+    /// The whole of row `row` (0-based): its inputs, then its outputs.
+    pub fn row(&self, row: usize) -> &[f64] {
+        let width = self.n_inputs + self.n_outputs;
+        &self.values[row * width..(row + 1) * width]
+    }
+
+    /// The inputs of row `row`.
+    pub fn inputs(&self, row: usize) -> &[f64] {
+        &self.row(row)[..self.n_inputs]
+    }
+
+    /// Output `output` of row `row`.
+    pub fn target(&self, row: usize, output: usize) -> f64 {
+        self.row(row)[self.n_inputs + output]
+    }
+
+    /// `[min, max]` of column `column` (inputs first, then outputs).
+    pub fn column_range(&self, column: usize) -> [f64; 2] {
+        (0..self.rows()).fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], r| {
+            let v = self.row(r)[column];
+            [lo.min(v), hi.max(v)]
+        })
+    }
+
+    /// Refuses an output index this data set does not have.
+    pub(crate) fn check_output(&self, output: usize) -> Result<(), FuzzyError> {
+        if output >= self.n_outputs {
+            return Err(learning(format!(
+                "output {} asked of data with {} outputs",
+                output + 1,
+                self.n_outputs
+            )));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_and_columns() {
+        let data = TrainingData::new(2, 1, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]).unwrap();
+        assert_eq!(data.rows(), 2);
+        assert_eq!(data.inputs(1), [4.0, 5.0]);
+        assert_eq!(data.target(0, 0), 3.0);
+        assert_eq!(data.column_range(1), [2.0, 5.0]);
+    }
+
+    #[test]
+    fn bad_data_is_refused_with_its_place() {
+        let message = |n, m, v: Vec<f64>| TrainingData::new(n, m, v).unwrap_err().to_string();
+        assert_eq!(
+            message(2, 1, vec![1.0, 2.0, 3.0, 4.0, f64::NAN, 6.0]),
+            "learning: row 2 column 2 is not finite (NaN)"
+        );
+        assert_eq!(
+            message(2, 1, vec![1.0; 4]),
+            "learning: 4 values are not a whole, non-zero number of rows of 3"
+        );
+        assert_eq!(
+            message(0, 1, vec![1.0]),
+            "learning: the number of inputs must lie in 1..=64, got 0"
+        );
+    }
+}
