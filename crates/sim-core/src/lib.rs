@@ -31,6 +31,7 @@ pub mod controller;
 mod error;
 mod noise;
 pub mod ode;
+pub mod optimal;
 mod record;
 pub mod reference;
 mod scenario;
