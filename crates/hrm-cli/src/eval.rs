@@ -20,6 +20,8 @@ use serde_json::{Map, Value, json};
 use sim_core::ArmSpec;
 use std::io::{BufRead, Write};
 
+mod derivatives;
+
 /// Longest request line accepted (bytes); longer lines are skipped with a `line_too_long` error.
 pub const MAX_LINE_BYTES: usize = 16 << 20;
 
@@ -197,7 +199,7 @@ fn answer(line: &[u8]) -> Value {
     }
 }
 
-const OPS: &str = "fk, ik, joints, dynamics, reduced, fuzzy";
+const OPS: &str = "fk, ik, joints, dynamics, reduced, fuzzy, rnea_derivatives, aba_derivatives, reduced_derivatives";
 
 fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
     match op {
@@ -207,6 +209,9 @@ fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
         "dynamics" => dynamics(parse(request)?),
         "reduced" => reduced(parse(request)?),
         "fuzzy" => fuzzy(parse(request)?),
+        "rnea_derivatives" => derivatives::rnea_derivatives(parse(request)?),
+        "aba_derivatives" => derivatives::aba_derivatives(parse(request)?),
+        "reduced_derivatives" => derivatives::reduced_derivatives(parse(request)?),
         other => Err(EvalError::new(
             Kind::UnknownOp,
             format!("unknown op {other:?}; known ops: {OPS}"),

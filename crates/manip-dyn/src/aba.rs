@@ -26,9 +26,9 @@ use crate::model::ChainModel;
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct ArticulatedLink {
     /// The translational part of `U_i = IA_i S` (its rotational part is `D_i`).
-    u_lin: [f64; 2],
+    pub(crate) u_lin: [f64; 2],
     /// `D_i = S^T IA_i S`: the articulated inertia about the joint axis.
-    d: f64,
+    pub(crate) d: f64,
     /// `tau_i - S^T pA_i`: the joint torque left after the articulated bias force.
     residual: f64,
 }
@@ -63,6 +63,20 @@ pub fn aba(
 ) -> Result<(), DynError> {
     let n = check::inputs(model, data, &[("q", q), ("v", v), ("tau", tau)])?;
     check::output("qdd", qdd, n)?;
+    articulated_body(model, data, q, v, tau, qdd)?;
+    check::finite_result("qdd", qdd)
+}
+
+/// The articulated-body algorithm on validated inputs. Leaves the link frames of `(q, v)` in
+/// `data.frames` and each joint's articulated inertia in `data.articulated`.
+pub(crate) fn articulated_body(
+    model: &ChainModel,
+    data: &mut ChainData,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    qdd: &mut [f64],
+) -> Result<(), DynError> {
     update_frames(&mut data.frames, q, Some(v));
     // The composite inertias about each joint (the diagonal of M) are the scale of the pivots.
     accumulate_subtrees(model, &data.frames, &mut data.subtrees);
@@ -74,7 +88,7 @@ pub fn aba(
         &mut data.articulated,
     )?;
     forward_sweep(model, &data.frames, &data.articulated, qdd);
-    check::finite_result("qdd", qdd)
+    Ok(())
 }
 
 /// What link `i` sees of the links beyond it once their joint accelerations are solved out,

@@ -3,6 +3,7 @@
 use faer::MatMut;
 
 use crate::data::ChainData;
+use crate::derivative_data::DerivativeData;
 use crate::error::DynError;
 use crate::model::ChainModel;
 
@@ -12,6 +13,15 @@ fn workspace(model: &ChainModel, data: &ChainData) -> Result<(), DynError> {
         "data (a ChainData built for another model)",
         data.n_links(),
         model.n_links(),
+    )
+}
+
+/// A derivative workspace built for a chain of `n` links.
+pub(crate) fn derivative_workspace(derivatives: &DerivativeData, n: usize) -> Result<(), DynError> {
+    length(
+        "derivatives (a DerivativeData built for another model)",
+        derivatives.n_links(),
+        n,
     )
 }
 

@@ -13,6 +13,8 @@
 //! | Coriolis matrix (Christoffel symbols) | [`coriolis_matrix`] | O(n^2) |
 //! | forward dynamics | [`aba`] / [`forward_dynamics`] (Cholesky) | O(n) / O(n^3) |
 //! | energies | [`kinetic_energy`], [`potential_energy`] | O(n) |
+//! | `d tau / d (q, v, qdd)` (analytic) | [`rnea_derivatives`] into [`DerivativeData`] | O(n^2) |
+//! | `d qdd / d (q, v, tau)` (analytic) | [`aba_derivatives`] into [`DerivativeData`] | O(n^2) |
 //!
 //! ```
 //! use manip_dyn::{ChainData, ChainModel, aba, rnea};
@@ -35,28 +37,34 @@
 pub struct ReadmeDoctests;
 
 mod aba;
+mod aba_derivatives;
 mod bias;
 mod check;
 mod coriolis_matrix;
 mod crba;
 mod data;
+mod derivative_data;
 mod energy;
 pub mod error;
 mod forward_dynamics;
 mod kinematics;
 pub mod model;
 mod rnea;
+mod rnea_derivatives;
 
 /// The faer version whose matrices [`mass_matrix`] and [`coriolis_matrix`] fill.
 pub use faer;
 
 pub use aba::aba;
+pub use aba_derivatives::aba_derivatives;
 pub use bias::{coriolis, gravity, nonlinear_effects};
 pub use coriolis_matrix::coriolis_matrix;
 pub use crba::mass_matrix;
 pub use data::ChainData;
+pub use derivative_data::DerivativeData;
 pub use energy::{kinetic_energy, potential_energy};
 pub use error::DynError;
 pub use forward_dynamics::forward_dynamics;
 pub use model::{ChainModel, Link, MAX_LINKS};
 pub use rnea::rnea;
+pub use rnea_derivatives::rnea_derivatives;

@@ -5,8 +5,9 @@ use std::cell::Cell;
 
 use faer::Mat;
 use manip_dyn::{
-    ChainData, ChainModel, aba, coriolis, coriolis_matrix, forward_dynamics, gravity,
-    kinetic_energy, mass_matrix, nonlinear_effects, potential_energy, rnea,
+    ChainData, ChainModel, DerivativeData, aba, aba_derivatives, coriolis, coriolis_matrix,
+    forward_dynamics, gravity, kinetic_energy, mass_matrix, nonlinear_effects, potential_energy,
+    rnea, rnea_derivatives,
 };
 
 /// Counts the allocations of the current thread (the test harness runs others in parallel).
@@ -54,6 +55,7 @@ fn per_step_algorithms_allocate_nothing() {
 fn check_chain(n: usize) {
     let arm = ChainModel::uniform(n, 0.1, 0.1, 9.81).unwrap();
     let mut data = ChainData::new(&arm);
+    let mut derivatives = DerivativeData::new(&arm);
     let q: Vec<f64> = (0..n).map(|i| 0.1 + 0.01 * i as f64).collect();
     let v: Vec<f64> = (0..n).map(|i| 0.5 - 0.02 * i as f64).collect();
     let tau: Vec<f64> = (0..n).map(|i| 0.3 * (i as f64).sin()).collect();
@@ -72,6 +74,8 @@ fn check_chain(n: usize) {
         forward_dynamics(&arm, &mut data, &q, &v, &tau, &mut out).unwrap();
         energy += kinetic_energy(&arm, &mut data, &q, &v).unwrap();
         energy += potential_energy(&arm, &mut data, &q).unwrap();
+        rnea_derivatives(&arm, &mut data, &mut derivatives, &q, &v, &tau).unwrap();
+        aba_derivatives(&arm, &mut data, &mut derivatives, &q, &v, &tau).unwrap();
     });
     assert_eq!(count, 0, "n = {n}: {count} allocations");
     assert!(energy.is_finite() && out.iter().all(|x| x.is_finite()));

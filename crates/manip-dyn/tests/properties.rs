@@ -5,7 +5,6 @@ mod common;
 
 use common::*;
 use faer::Side;
-use faer::linalg::solvers::DenseSolveCore;
 use manip_dyn::{
     ChainData, aba, coriolis, forward_dynamics, gravity, kinetic_energy, nonlinear_effects,
     potential_energy, rnea,
@@ -293,14 +292,4 @@ fn total_rate(v: &[f64]) -> f64 {
             Some(f64::abs(*omega))
         })
         .fold(0.0, f64::max)
-}
-
-/// An upper bound of the 2-norm condition number of an SPD matrix: `lambda_max(M) <= trace(M)
-/// <= n max_i M_ii`, and the same for `M^-1`.
-fn condition_estimate(m: &faer::Mat<f64>) -> f64 {
-    let n = m.nrows();
-    let inverse = m.llt(Side::Lower).unwrap().inverse();
-    let largest = (0..n).map(|i| m[(i, i)]).fold(0.0, f64::max) * n as f64;
-    let inverse_largest = (0..n).map(|i| inverse[(i, i)]).fold(0.0, f64::max) * n as f64;
-    largest * inverse_largest
 }

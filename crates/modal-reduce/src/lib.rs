@@ -15,6 +15,8 @@
 //!   absolute link angles, never forming `M` (the default; derivation in [`terms`]). [`reduced_terms_faer`]: the same by forming `M`
 //!   and projecting it with faer, `O(n^2 m)` (the reference).
 //! - [`forward_dynamics`] / [`forward_dynamics_faer`]: solve eq 15 for `a_ddot` by Cholesky.
+//! - [`reduced_derivatives`]: the analytic derivatives of eq 15, `d a_ddot / d (a, a_dot, tau*)`,
+//!   in `O(n m^2)` into a [`ReducedDerivatives`] workspace.
 //! - [`jacobi_forward_dynamics`]: the paper's eq 16-18 iteration, which reports divergence
 //!   instead of returning garbage (see [`jacobi`]).
 //! - [`joint_torques`]: `tau = M J a_ddot + C + G` for the real arm's actuators (eq 13), and
@@ -50,6 +52,7 @@
 pub struct ReadmeDoctests;
 
 mod data;
+mod derivatives;
 mod energy;
 mod error;
 mod forward;
@@ -62,6 +65,7 @@ mod torques;
 mod trig;
 
 pub use data::ReducedData;
+pub use derivatives::{ReducedDerivatives, reduced_derivatives};
 pub use energy::{kinetic_energy, potential_energy};
 pub use error::ReduceError;
 pub use forward::{forward_dynamics, forward_dynamics_faer};

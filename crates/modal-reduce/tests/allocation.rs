@@ -10,9 +10,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use backbone_kin::{BaseAngle, ModalMap};
 use manip_dyn::ChainModel;
 use modal_reduce::{
-    JacobiSettings, ReducedData, ReducedModel, forward_dynamics, forward_dynamics_faer,
-    jacobi_forward_dynamics, joint_torques, kinetic_energy, potential_energy, project_torques,
-    reduced_terms, reduced_terms_faer,
+    JacobiSettings, ReducedData, ReducedDerivatives, ReducedModel, forward_dynamics,
+    forward_dynamics_faer, jacobi_forward_dynamics, joint_torques, kinetic_energy,
+    potential_energy, project_torques, reduced_derivatives, reduced_terms, reduced_terms_faer,
 };
 
 struct Counting;
@@ -43,6 +43,7 @@ fn per_step_functions_do_not_allocate() {
             ReducedModel::new(ChainModel::uniform(n, 0.1, 0.1, 9.81).unwrap(), map).unwrap();
         let m = model.n_coords();
         let mut data = ReducedData::new(&model);
+        let mut derivatives = ReducedDerivatives::new(&model);
         let (a, a_dot, tau_star) = (vec![0.3; m], vec![-0.2; m], vec![0.5; m]);
         let (mut a_ddot, mut tau, mut projected) = (vec![0.0; m], vec![0.0; n], vec![0.0; m]);
         let settings = JacobiSettings::default();
@@ -66,6 +67,8 @@ fn per_step_functions_do_not_allocate() {
             project_torques(&model, &tau, &mut projected).unwrap();
             kinetic_energy(&model, &mut data, &a, &a_dot).unwrap();
             potential_energy(&model, &mut data, &a).unwrap();
+            reduced_derivatives(&model, &mut data, &mut derivatives, &a, &a_dot, &tau_star)
+                .unwrap();
         };
         run();
         let before = ALLOCATIONS.load(Ordering::SeqCst);

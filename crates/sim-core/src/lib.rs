@@ -37,6 +37,7 @@ mod error;
 mod input_file;
 mod noise;
 pub mod ode;
+pub mod optimal;
 mod record;
 pub mod reference;
 mod scenario;

@@ -1,7 +1,8 @@
 //! Shared strategies and helpers of the integration tests.
 #![allow(dead_code)] // each test binary uses a different subset
 
-use faer::Mat;
+use faer::linalg::solvers::DenseSolveCore;
+use faer::{Mat, Side};
 use manip_dyn::{ChainData, ChainModel, Link};
 use proptest::collection::vec;
 use proptest::prelude::*;
@@ -100,4 +101,59 @@ pub fn com_positions(model: &ChainModel, q: &[f64]) -> Vec<[f64; 2]> {
         joint = [joint[0] + link.length * c, joint[1] + link.length * s];
     }
     out
+}
+
+/// The derivative of `f: R -> R^k` at `x` by central differences with step-size control
+/// (Ridders' extrapolation: central differences at steps `h, h/1.4, h/1.4^2, ...`, extrapolated
+/// to zero step by Neville's scheme, keeping the estimate whose error estimate is smallest).
+/// Returns the derivative and its error estimate (largest absolute entry).
+pub fn ridders(mut f: impl FnMut(f64) -> Vec<f64>, x: f64, h: f64) -> (Vec<f64>, f64) {
+    const SHRINK: f64 = 1.4;
+    const STEPS: usize = 10;
+    let central = |f: &mut dyn FnMut(f64) -> Vec<f64>, step: f64| -> Vec<f64> {
+        let (plus, minus) = (f(x + step), f(x - step));
+        plus.iter()
+            .zip(&minus)
+            .map(|(p, m)| (p - m) / (2.0 * step))
+            .collect()
+    };
+    let distance = |a: &[f64], b: &[f64]| max_abs(&axpy(a, -1.0, b));
+    let mut table: Vec<Vec<Vec<f64>>> = vec![vec![central(&mut f, h)]];
+    let (mut best, mut error) = (table[0][0].clone(), f64::INFINITY);
+    let mut step = h;
+    for i in 1..STEPS {
+        step /= SHRINK;
+        let mut row = vec![central(&mut f, step)];
+        let mut factor = SHRINK * SHRINK;
+        for j in 1..=i {
+            let next: Vec<f64> = row[j - 1]
+                .iter()
+                .zip(&table[i - 1][j - 1])
+                .map(|(a, b)| (a * factor - b) / (factor - 1.0))
+                .collect();
+            factor *= SHRINK * SHRINK;
+            let estimate = distance(&next, &row[j - 1]).max(distance(&next, &table[i - 1][j - 1]));
+            if estimate <= error {
+                error = estimate;
+                best = next.clone();
+            }
+            row.push(next);
+        }
+        let diverging = distance(&row[i], &table[i - 1][i - 1]);
+        table.push(row);
+        if diverging >= 2.0 * error {
+            break;
+        }
+    }
+    (best, error)
+}
+
+/// An upper bound of the 2-norm condition number of an SPD matrix: `lambda_max(M) <= trace(M)
+/// <= n max_i M_ii`, and the same for `M^-1`.
+pub fn condition_estimate(m: &Mat<f64>) -> f64 {
+    let n = m.nrows();
+    let inverse = m.llt(Side::Lower).unwrap().inverse();
+    let largest = (0..n).map(|i| m[(i, i)]).fold(0.0, f64::max) * n as f64;
+    let inverse_largest = (0..n).map(|i| inverse[(i, i)]).fold(0.0, f64::max) * n as f64;
+    largest * inverse_largest
 }

@@ -25,9 +25,17 @@ fn link() -> impl Strategy<Value = Link> {
 /// A random reduced model with `links` links: 1-2 harmonics, `alpha0` free or fixed, the map built
 /// for the actual link lengths, gravity 0-20 m/s^2.
 pub fn model(links: std::ops::RangeInclusive<usize>) -> impl Strategy<Value = ReducedModel> {
+    model_with_harmonics(links, 2)
+}
+
+/// [`model`] with 1 to `max_harmonics` harmonics.
+pub fn model_with_harmonics(
+    links: std::ops::RangeInclusive<usize>,
+    max_harmonics: usize,
+) -> impl Strategy<Value = ReducedModel> {
     (
         prop::collection::vec(link(), links),
-        1usize..=2,
+        1usize..=max_harmonics,
         prop::option::of(-3.0..3.0f64),
         0.0..20.0f64,
     )
@@ -134,4 +142,52 @@ pub fn to_vec(mat: faer::MatRef<'_, f64>) -> Vec<f64> {
         }
     }
     out
+}
+
+/// The derivative of `f: R -> R^k` at `x` by central differences with step-size control
+/// (Ridders' extrapolation: central differences at steps `h, h/1.4, h/1.4^2, ...`, extrapolated
+/// to zero step by Neville's scheme, keeping the estimate whose error estimate is smallest).
+pub fn ridders(mut f: impl FnMut(f64) -> Vec<f64>, x: f64, h: f64) -> Vec<f64> {
+    const SHRINK: f64 = 1.4;
+    const STEPS: usize = 10;
+    let mut central = |step: f64| -> Vec<f64> {
+        let (plus, minus) = (f(x + step), f(x - step));
+        plus.iter()
+            .zip(&minus)
+            .map(|(p, m)| (p - m) / (2.0 * step))
+            .collect()
+    };
+    let distance = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |acc, (x, y)| acc.max((x - y).abs()))
+    };
+    let mut previous: Vec<Vec<f64>> = vec![central(h)];
+    let (mut best, mut error) = (previous[0].clone(), f64::INFINITY);
+    let mut step = h;
+    for i in 1..STEPS {
+        step /= SHRINK;
+        let mut row = vec![central(step)];
+        let mut factor = SHRINK * SHRINK;
+        for j in 1..=i {
+            let next: Vec<f64> = row[j - 1]
+                .iter()
+                .zip(&previous[j - 1])
+                .map(|(a, b)| (a * factor - b) / (factor - 1.0))
+                .collect();
+            factor *= SHRINK * SHRINK;
+            let estimate = distance(&next, &row[j - 1]).max(distance(&next, &previous[j - 1]));
+            if estimate <= error {
+                error = estimate;
+                best = next.clone();
+            }
+            row.push(next);
+        }
+        let diverging = distance(&row[i], &previous[i - 1]);
+        previous = row;
+        if diverging >= 2.0 * error {
+            break;
+        }
+    }
+    best
 }

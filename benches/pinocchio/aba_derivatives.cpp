@@ -1,0 +1,76 @@
+// Times Pinocchio's computeABADerivatives (and computeRNEADerivatives) on the planar chain of
+// hrm's `aba_derivatives` bench: n revolute-z joints, uniform links of 0.1 m and 0.1 kg (centre
+// of mass at the midpoint, inertia m L^2 / 12 about it), gravity 9.81 m/s^2 along -y, at the
+// same curled, moving state (benches/benches/derivatives.rs). Prints one line per size: the
+// median over batches of the time per call, in nanoseconds.
+//
+// Build and run with ./run.sh (it compiles against the headers and library of the `pin` wheel).
+
+#include <pinocchio/algorithm/aba-derivatives.hpp>
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
+#include <pinocchio/multibody.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+using namespace pinocchio;
+
+static Model planar_chain(int n, double length, double mass) {
+  Model model;
+  model.gravity.linear(Eigen::Vector3d(0.0, -9.81, 0.0));
+  JointIndex parent = 0;
+  for (int i = 0; i < n; ++i) {
+    // Joint i sits at the far end of link i - 1 (at the origin for the base joint).
+    SE3 placement = SE3::Identity();
+    if (i > 0) placement.translation() = Eigen::Vector3d(length, 0.0, 0.0);
+    parent = model.addJoint(parent, JointModelRZ(), placement, "joint" + std::to_string(i));
+    Eigen::Matrix3d rotational = Eigen::Matrix3d::Zero();
+    // A thin beam along x: only the z axis matters in the plane.
+    rotational(2, 2) = mass * length * length / 12.0;
+    rotational(1, 1) = rotational(2, 2);
+    rotational(0, 0) = 1e-9;
+    model.appendBodyToJoint(parent, Inertia(mass, Eigen::Vector3d(0.5 * length, 0.0, 0.0), rotational));
+  }
+  return model;
+}
+
+template <typename F>
+static double median_ns(F&& call, int calls_per_batch, int batches) {
+  std::vector<double> times;
+  for (int b = 0; b < batches; ++b) {
+    auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < calls_per_batch; ++i) call();
+    auto stop = std::chrono::steady_clock::now();
+    times.push_back(std::chrono::duration<double, std::nano>(stop - start).count() / calls_per_batch);
+  }
+  std::sort(times.begin(), times.end());
+  return times[times.size() / 2];
+}
+
+int main() {
+  for (int n : {10, 100}) {
+    Model model = planar_chain(n, 0.1, 0.1);
+    Data data(model);
+    Eigen::VectorXd q(n), v(n), tau(n);
+    for (int i = 0; i < n; ++i) {
+      double x = double(i) / n;
+      q[i] = 0.3 * std::sin(6.0 * x);
+      v[i] = 0.5 * std::sin(3.0 * x);
+      tau[i] = 0.01 * std::sin(2.0 * x);
+    }
+    int calls = n <= 10 ? 20000 : 500;
+    double aba_ns = median_ns([&] { computeABADerivatives(model, data, q, v, tau); }, calls, 51);
+    // The qdd that ABA finds, for RNEA's derivatives at the same state.
+    Eigen::VectorXd a = data.ddq;
+    double rnea_ns = median_ns([&] { computeRNEADerivatives(model, data, q, v, a); }, calls, 51);
+    std::printf("pinocchio computeABADerivatives/%d %.1f ns\n", n, aba_ns);
+    std::printf("pinocchio computeRNEADerivatives/%d %.1f ns\n", n, rnea_ns);
+    // A check that the harness times the same chain: the acceleration of the last joint.
+    std::printf("  check: qdd[n-1] = %.12g, dqdd/dtau[0][0] = %.12g\n", data.ddq[n - 1],
+                data.Minv(0, 0));
+  }
+  return 0;
+}

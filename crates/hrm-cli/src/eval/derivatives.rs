@@ -1,0 +1,210 @@
+//! The `hrm eval` ops of the analytic derivatives: `rnea_derivatives`, `aba_derivatives` and
+//! `reduced_derivatives` (`docs/eval-protocol.md`). Matrices are lists of rows with entry
+//! `[i][j] = d out_i / d in_j`.
+
+use backbone_kin::{BaseAngle, MAX_HARMONICS, ModalMap};
+use manip_dyn::faer::MatRef;
+use manip_dyn::{ChainData, ChainModel, DerivativeData};
+use modal_reduce::{ReducedData, ReducedDerivatives, ReducedModel};
+use serde::Deserialize;
+use serde_json::{Value, json};
+use sim_core::ArmSpec;
+
+use super::{EvalError, EvalResult, dyn_error, finite, json_fields, modal_map, reduce_error};
+
+/// The most links the joint-space derivative ops accept: their answer holds `2 n^2` or `3 n^2`
+/// numbers (3 million, some 60 MB of JSON, at this limit) and their workspace `24 n^2` bytes.
+pub(super) const MAX_DERIVATIVE_LINKS: usize = 1024;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RneaDerivativesRequest {
+    #[serde(default)]
+    arm: ArmSpec,
+    theta: Vec<f64>,
+    theta_dot: Vec<f64>,
+    theta_ddot: Vec<f64>,
+}
+
+/// `rnea_derivatives`: `tau` of eq 12 and its Jacobians with respect to `theta` and `theta_dot`.
+pub(super) fn rnea_derivatives(request: RneaDerivativesRequest) -> EvalResult {
+    let chain = chain(&request.arm)?;
+    joint_vectors(
+        &chain,
+        [
+            ("theta", &request.theta),
+            ("theta_dot", &request.theta_dot),
+            ("theta_ddot", &request.theta_ddot),
+        ],
+    )?;
+    let mut derivatives = DerivativeData::new(&chain);
+    manip_dyn::rnea_derivatives(
+        &chain,
+        &mut ChainData::new(&chain),
+        &mut derivatives,
+        &request.theta,
+        &request.theta_dot,
+        &request.theta_ddot,
+    )
+    .map_err(dyn_error)?;
+    finite("tau", derivatives.value())?;
+    Ok(json_fields([
+        ("tau", json!(derivatives.value())),
+        ("d_theta", rows("d_theta", derivatives.d_q())?),
+        ("d_theta_dot", rows("d_theta_dot", derivatives.d_v())?),
+    ]))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct AbaDerivativesRequest {
+    #[serde(default)]
+    arm: ArmSpec,
+    theta: Vec<f64>,
+    theta_dot: Vec<f64>,
+    tau: Vec<f64>,
+}
+
+/// `aba_derivatives`: `theta_ddot` of eq 12 and its Jacobians with respect to `theta`,
+/// `theta_dot` and `tau` (`M^-1`).
+pub(super) fn aba_derivatives(request: AbaDerivativesRequest) -> EvalResult {
+    let chain = chain(&request.arm)?;
+    joint_vectors(
+        &chain,
+        [
+            ("theta", &request.theta),
+            ("theta_dot", &request.theta_dot),
+            ("tau", &request.tau),
+        ],
+    )?;
+    let mut derivatives = DerivativeData::new(&chain);
+    manip_dyn::aba_derivatives(
+        &chain,
+        &mut ChainData::new(&chain),
+        &mut derivatives,
+        &request.theta,
+        &request.theta_dot,
+        &request.tau,
+    )
+    .map_err(dyn_error)?;
+    finite("theta_ddot", derivatives.value())?;
+    Ok(json_fields([
+        ("theta_ddot", json!(derivatives.value())),
+        ("d_theta", rows("d_theta", derivatives.d_q())?),
+        ("d_theta_dot", rows("d_theta_dot", derivatives.d_v())?),
+        ("d_tau", rows("d_tau", derivatives.d_input())?),
+    ]))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ReducedDerivativesRequest {
+    #[serde(default)]
+    arm: ArmSpec,
+    a: Vec<f64>,
+    a_dot: Vec<f64>,
+    tau_star: Vec<f64>,
+    alpha0: Option<f64>,
+    harmonics: Option<usize>,
+}
+
+/// `reduced_derivatives`: `a_ddot` of eq 15 and its Jacobians with respect to `a`, `a_dot` and
+/// `tau*` (`M*^-1`), for `K` harmonics (default 1) with `alpha0` free or fixed.
+pub(super) fn reduced_derivatives(request: ReducedDerivativesRequest) -> EvalResult {
+    let chain = request.arm.to_chain().map_err(EvalError::input)?;
+    let map = match request.harmonics {
+        None => modal_map(&chain, &request.a, request.alpha0)?,
+        Some(harmonics) => harmonic_map(&chain, harmonics, request.a.len(), request.alpha0)?,
+    };
+    let model = ReducedModel::new(chain, map).map_err(reduce_error)?;
+    let mut derivatives = ReducedDerivatives::new(&model);
+    modal_reduce::reduced_derivatives(
+        &model,
+        &mut ReducedData::new(&model),
+        &mut derivatives,
+        &request.a,
+        &request.a_dot,
+        &request.tau_star,
+    )
+    .map_err(reduce_error)?;
+    finite("a_ddot", derivatives.a_ddot())?;
+    Ok(json_fields([
+        ("a_ddot", json!(derivatives.a_ddot())),
+        ("d_a", rows("d_a", derivatives.d_a())?),
+        ("d_a_dot", rows("d_a_dot", derivatives.d_a_dot())?),
+        ("d_tau_star", rows("d_tau_star", derivatives.d_tau_star())?),
+    ]))
+}
+
+/// The arm, refused beyond [`MAX_DERIVATIVE_LINKS`] before the `n x n` workspaces exist.
+fn chain(arm: &ArmSpec) -> Result<ChainModel, EvalError> {
+    let chain = arm.to_chain().map_err(EvalError::input)?;
+    if chain.n_links() > MAX_DERIVATIVE_LINKS {
+        return Err(EvalError::input(format!(
+            "arm.links must be at most {MAX_DERIVATIVE_LINKS} for the derivative ops, got {}",
+            chain.n_links()
+        )));
+    }
+    Ok(chain)
+}
+
+/// Each joint-space vector has one entry per link (named by its request field).
+fn joint_vectors<const N: usize>(
+    chain: &ChainModel,
+    vectors: [(&str, &Vec<f64>); N],
+) -> Result<(), EvalError> {
+    let n = chain.n_links();
+    for (name, values) in vectors {
+        if values.len() != n {
+            return Err(EvalError::input(format!(
+                "{name} has {} entries, expected {n} (one per link)",
+                values.len()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The map of `K` harmonics: `2K + 1` coordinates (`alpha0` free, the last one), or `2K` with
+/// `"alpha0"` fixed.
+fn harmonic_map(
+    chain: &ChainModel,
+    harmonics: usize,
+    coords: usize,
+    alpha0: Option<f64>,
+) -> Result<ModalMap, EvalError> {
+    if !(1..=MAX_HARMONICS).contains(&harmonics) {
+        return Err(EvalError::input(format!(
+            "harmonics must be between 1 and {MAX_HARMONICS}, got {harmonics}"
+        )));
+    }
+    let base = match alpha0 {
+        None if coords == 2 * harmonics + 1 => BaseAngle::Free,
+        Some(alpha0) if coords == 2 * harmonics => BaseAngle::Fixed(alpha0),
+        None => {
+            return Err(EvalError::input(format!(
+                "a has {coords} entries; with {harmonics} harmonics expected {} (alpha0 last), \
+                 or {} with \"alpha0\"",
+                2 * harmonics + 1,
+                2 * harmonics
+            )));
+        }
+        Some(_) => {
+            return Err(EvalError::input(format!(
+                "a has {coords} entries; with {harmonics} harmonics and \"alpha0\" expected {}",
+                2 * harmonics
+            )));
+        }
+    };
+    let lengths: Vec<f64> = chain.link_lengths().collect();
+    ModalMap::new(&lengths, harmonics, base).map_err(EvalError::input)
+}
+
+/// A matrix as JSON rows, refused if an entry is not finite.
+fn rows(name: &str, m: MatRef<'_, f64>) -> Result<Value, EvalError> {
+    let rows: Vec<Vec<f64>> = (0..m.nrows())
+        .map(|i| (0..m.ncols()).map(|j| m[(i, j)]).collect())
+        .collect();
+    finite(name, &rows.concat())?;
+    Ok(json!(rows))
+}

@@ -1,0 +1,63 @@
+//! Model-based optimal control in modal coordinates, on the analytic derivatives of the reduced
+//! dynamics (`modal_reduce::reduced_derivatives`): the state is `x = (a, a_dot)` (`2m` entries)
+//! and the control `u = tau*` (`m` entries), for any modal family.
+//!
+//! - [`Linearisation`]: the continuous `(A, B)` of `x_dot = f(x, u)` about a state and control,
+//!   and the discrete `(A_d, B_d)` of a zero-order hold over a sampling period (matrix
+//!   exponential).
+//! - [`Lqr`]: the discrete infinite-horizon LQR gain by the Riccati recursion, for regulating
+//!   about a reference (`u = u_ref - K (x - x_ref)`).
+//!
+//! These depend only on `modal-reduce`; wrapping them as controllers of the closed loop is a
+//! separate step. Every type is built once for a model and then allocates nothing.
+
+mod dense;
+mod linearise;
+mod lqr;
+
+pub use linearise::Linearisation;
+pub use lqr::{Lqr, LqrSettings};
+
+use modal_reduce::ReduceError;
+
+/// Why an optimal-control computation was refused or failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OptimalError {
+    /// The reduced dynamics refused the state (sizes, non-finite values, or a singular `M*`).
+    #[error("reduced dynamics: {0}")]
+    Dynamics(#[from] ReduceError),
+    /// A setting was out of its domain.
+    #[error("{name} must be {requirement}, got {value}")]
+    InvalidSetting {
+        /// Which setting.
+        name: &'static str,
+        /// What it must be.
+        requirement: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// A matrix had the wrong size.
+    #[error("{name} has {got} entries, expected {expected}")]
+    Dimension {
+        /// Which matrix.
+        name: &'static str,
+        /// The size expected.
+        expected: usize,
+        /// The size given.
+        got: usize,
+    },
+    /// The Riccati recursion did not converge within its iteration limit (the pair `(A, B)` is
+    /// not stabilisable, or the weights make it too slow).
+    #[error(
+        "the Riccati recursion did not converge in {iterations} iterations (last change {change:e})"
+    )]
+    NoConvergence {
+        /// Iterations run.
+        iterations: usize,
+        /// The relative change of `P` in the last iteration.
+        change: f64,
+    },
+    /// A matrix that must be positive definite (`R + B^T P B`) was not, numerically.
+    #[error("{0} is not numerically positive definite")]
+    NotPositiveDefinite(&'static str),
+}
