@@ -2,20 +2,11 @@
 //! scenarios (section 5 of the paper), a comparison table, and per-run output files.
 
 use crate::{figures, progress, report};
-use rayon::prelude::*;
 use serde_json::json;
+use sim_core::study::{self, ComparisonRun as Outcome, run_one};
 use sim_core::{ControllerKind, ReferenceSpec, Run, Scenario};
 use std::fmt::Write as _;
 use std::path::Path;
-
-/// One finished (or stopped) run: its scenario, controller, the names of its modal
-/// coordinates and its outcome.
-struct Outcome {
-    scenario: String,
-    controller: ControllerKind,
-    coordinates: Vec<String>,
-    result: Result<Run, String>,
-}
 
 /// Runs `scenario` with `controller` (or the scenario's own) and writes its files into `out`.
 pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Result<(), String> {
@@ -37,30 +28,22 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
 
 /// The main job: every shipped scenario with every controller (see [`experiments`]).
 pub fn main_job(out: &Path) -> Result<(), String> {
-    let scenarios = Scenario::builtin_names()
-        .map(|name| Scenario::builtin(name).map_err(|e| e.to_string()))
-        .collect::<Result<Vec<_>, _>>()?;
+    let scenarios = study::builtin_scenarios().map_err(|e| e.to_string())?;
     experiments(out, &scenarios)
 }
 
 /// Runs `scenarios` with every controller, in parallel (results in a fixed order), then writes
 /// the per-run files, the comparison table, the figures and `report.html` into `out`.
 fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
-    let jobs: Vec<(&Scenario, ControllerKind)> = scenarios
-        .iter()
-        .flat_map(|scenario| ControllerKind::ALL.map(|kind| (scenario, kind)))
-        .collect();
-    let bar = progress::bar(jobs.len() as u64, "runs");
-    let outcomes = jobs
-        .par_iter()
-        .map(|&(scenario, kind)| {
-            let outcome = run_one(scenario, kind);
-            write_outcome(&outcome, &out.join(&scenario.name).join(kind.name()))?;
-            bar.set_message(format!("{} with {kind}", scenario.name));
-            bar.inc(1);
-            Ok(outcome)
-        })
-        .collect::<Result<Vec<_>, String>>();
+    let runs = scenarios.len() * ControllerKind::ALL.len();
+    let bar = progress::bar(runs as u64, "runs");
+    let outcomes = study::compare(scenarios, |outcome| {
+        let kind = outcome.controller;
+        write_outcome(outcome, &out.join(&outcome.scenario).join(kind.name()))?;
+        bar.set_message(format!("{} with {kind}", outcome.scenario));
+        bar.inc(1);
+        Ok(())
+    });
     bar.finish_and_clear();
     let outcomes = outcomes?;
     let summaries: Vec<_> = outcomes.iter().map(outcome_json).collect();
@@ -211,21 +194,6 @@ fn figures(
             fuzzy,
         ),
     ])
-}
-
-fn run_one(scenario: &Scenario, kind: ControllerKind) -> Outcome {
-    let mut scenario = scenario.clone();
-    scenario.controller.kind = kind;
-    let result = scenario
-        .build()
-        .map_err(|e| e.to_string())
-        .and_then(|mut sim| sim.run().map_err(|failure| failure.error.to_string()));
-    Outcome {
-        scenario: scenario.name.clone(),
-        controller: kind,
-        coordinates: scenario.coordinate_names(),
-        result,
-    }
 }
 
 fn outcome_json(outcome: &Outcome) -> serde_json::Value {
