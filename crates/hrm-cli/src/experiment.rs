@@ -3,27 +3,11 @@
 
 use crate::output_dir::OutputDir;
 use crate::{console, figures, progress, report};
-use rayon::prelude::*;
 use serde_json::json;
+use sim_core::study::{self, ComparisonRun as Outcome, Stopped, run_one};
 use sim_core::{ControllerKind, ReferenceSpec, Run, Scenario};
 use std::fmt::Write as _;
 use std::path::Path;
-
-/// One finished (or stopped) run: its scenario, controller, the names of its modal
-/// coordinates and its outcome.
-struct Outcome {
-    scenario: String,
-    controller: ControllerKind,
-    coordinates: Vec<String>,
-    result: Result<Run, Stopped>,
-}
-
-/// Why a run stopped, and what it recorded until then (nothing if it could not be built).
-#[derive(Debug)]
-struct Stopped {
-    error: String,
-    partial: Option<Run>,
-}
 
 /// Runs `scenario` with `controller` (or the scenario's own) and writes its files into `out`.
 /// A scenario that cannot be built is refused before anything is written; a run that stops
@@ -47,9 +31,7 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
 
 /// The main job: every shipped scenario with every controller (see [`experiments`]).
 pub fn main_job(out: &Path) -> Result<(), String> {
-    let scenarios = Scenario::builtin_names()
-        .map(|name| Scenario::builtin(name).map_err(|e| e.to_string()))
-        .collect::<Result<Vec<_>, _>>()?;
+    let scenarios = study::builtin_scenarios().map_err(|e| e.to_string())?;
     experiments(out, &scenarios)
 }
 
@@ -58,21 +40,15 @@ pub fn main_job(out: &Path) -> Result<(), String> {
 fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
     let staging = OutputDir::create(out, "run")?;
     let dir = staging.path();
-    let jobs: Vec<(&Scenario, ControllerKind)> = scenarios
-        .iter()
-        .flat_map(|scenario| ControllerKind::ALL.map(|kind| (scenario, kind)))
-        .collect();
-    let bar = progress::bar(jobs.len() as u64, "runs");
-    let outcomes = jobs
-        .par_iter()
-        .map(|&(scenario, kind)| {
-            let outcome = run_one(scenario, kind);
-            write_outcome(&outcome, &dir.join(&scenario.name).join(kind.name()))?;
-            bar.set_message(format!("{} with {kind}", scenario.name));
-            bar.inc(1);
-            Ok(outcome)
-        })
-        .collect::<Result<Vec<_>, String>>();
+    let runs = scenarios.len() * ControllerKind::ALL.len();
+    let bar = progress::bar(runs as u64, "runs");
+    let outcomes = study::compare(scenarios, |outcome| {
+        let kind = outcome.controller;
+        write_outcome(outcome, &dir.join(&outcome.scenario).join(kind.name()))?;
+        bar.set_message(format!("{} with {kind}", outcome.scenario));
+        bar.inc(1);
+        Ok(())
+    });
     bar.finish_and_clear();
     let outcomes = outcomes?;
     let summaries: Vec<_> = outcomes.iter().map(outcome_json).collect();
@@ -222,30 +198,6 @@ fn figures(
             fuzzy,
         ),
     ])
-}
-
-fn run_one(scenario: &Scenario, kind: ControllerKind) -> Outcome {
-    let mut scenario = scenario.clone();
-    scenario.controller.kind = kind;
-    let result = match scenario.build() {
-        Err(e) => Err(Stopped {
-            error: e.to_string(),
-            partial: None,
-        }),
-        Ok(mut simulation) => simulation.run().map_err(|failure| Stopped {
-            error: failure.error.to_string(),
-            partial: Some(Run {
-                record: failure.record,
-                summary: failure.summary,
-            }),
-        }),
-    };
-    Outcome {
-        scenario: scenario.name.clone(),
-        controller: kind,
-        coordinates: scenario.coordinate_names(),
-        result,
-    }
 }
 
 fn outcome_json(outcome: &Outcome) -> serde_json::Value {

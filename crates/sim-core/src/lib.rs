@@ -42,6 +42,7 @@ mod record;
 pub mod reference;
 mod scenario;
 mod simulation;
+pub mod study;
 
 /// The most modal coordinates a loop may have: `2K + 1` for the most harmonics a modal map may
 /// have ([`backbone_kin::MAX_HARMONICS`]).

@@ -9,17 +9,12 @@
 //! - `hrm sweep merge --out DIR SHARDS...` combines shard files into the report of the whole
 //!   sweep, the same as an unsharded run's.
 
-mod aggregate;
-mod plan;
 mod report;
-mod shard_file;
 
 use crate::console;
 use crate::output_dir::{self, OutputDir};
 use clap::{Args, Subcommand};
-use plan::{RunId, Shard, SweepConfig};
-use rayon::prelude::*;
-use shard_file::{FORMAT, Outcome, RunMetrics, RunResult, ShardFile};
+use sim_core::study::{self, Outcome, Shard, ShardFile, SweepConfig};
 use sim_core::{ControllerKind, Scenario};
 use std::path::{Path, PathBuf};
 
@@ -104,7 +99,7 @@ pub fn run(cli: SweepCli) -> Result<(), String> {
                     let path = args
                         .out
                         .join(format!("shard-{}-of-{}.json", shard.index, shard.count));
-                    output_dir::write_file(&path, &to_json(&file)?, "sweep --shard")?;
+                    output_dir::write_file(&path, &ShardFile::to_json(&file)?, "sweep --shard")?;
                     let failed = file
                         .runs
                         .iter()
@@ -178,7 +173,7 @@ fn configure(args: &SweepArgs) -> Result<SweepConfig, String> {
     scenario.noise = Default::default();
     scenario.seed = 0;
     let config = SweepConfig {
-        hrm_version: env!("CARGO_PKG_VERSION").to_string(),
+        hrm_version: study::VERSION.to_string(),
         scenario,
         controllers: args.controllers.clone(),
         noise_levels: args.noise.clone(),
@@ -188,74 +183,29 @@ fn configure(args: &SweepArgs) -> Result<SweepConfig, String> {
         base_seed,
     };
     config.validate()?;
-    let cells = config.noise_levels.len() * config.controllers.len();
-    // The first run of each controller at the largest noise level.
-    for c in 0..config.controllers.len() {
-        let id = config.run_at((cells - config.controllers.len() + c) * config.seeds);
-        config
-            .scenario_for(&id)
-            .build()
-            .map_err(|e| format!("scenario {} with {}: {e}", args.scenario, id.controller))?;
-    }
+    config.check_builds()?;
     Ok(config)
 }
 
-/// Runs one run and keeps its summary metrics (the time series are dropped at once).
-fn execute(config: &SweepConfig, id: &RunId) -> RunResult {
-    let outcome = match config.scenario_for(id).build() {
-        Err(e) => Outcome::Failed {
-            error: e.to_string(),
-            simulated_s: 0.0,
-        },
-        Ok(mut simulation) => match simulation.run() {
-            Ok(run) => match RunMetrics::from_summary(&run.summary) {
-                Ok(metrics) => Outcome::Completed(metrics),
-                Err(error) => Outcome::Failed {
-                    error,
-                    simulated_s: run.summary.simulated_s,
-                },
-            },
-            Err(failure) => Outcome::Failed {
-                error: failure.error.to_string(),
-                simulated_s: failure.summary.simulated_s,
-            },
-        },
-    };
-    RunResult::new(id, outcome)
-}
-
-/// Runs the runs of `shard` in parallel, with a progress bar; results in index order.
+/// Runs the runs of `shard` with a progress bar (the library's [`study::run_shard`]).
 fn run_shard(config: &SweepConfig, shard: Shard) -> ShardFile {
     let total = config.runs().unwrap_or(0);
-    let indices: Vec<usize> = shard.indices(total).collect();
     let label = if shard == Shard::WHOLE {
         "sweep".to_string()
     } else {
         format!("shard {shard}")
     };
-    let bar = crate::progress::bar(indices.len() as u64, &label);
-    let runs = indices
-        .par_iter()
-        .map(|&i| {
-            let result = execute(config, &config.run_at(i));
-            bar.inc(1);
-            result
-        })
-        .collect();
+    let bar = crate::progress::bar(shard.indices(total).count() as u64, &label);
+    let file = study::run_shard(config, shard, || bar.inc(1));
     bar.finish_and_clear();
-    ShardFile {
-        format: FORMAT.into(),
-        config: config.clone(),
-        shard,
-        runs,
-    }
+    file
 }
 
 /// Runs the whole sweep into `out` and returns the table. The report is made from `runs.json`
 /// as read back, exactly as `merge` makes it from shard files, so both give identical numbers.
 fn sweep_whole(config: &SweepConfig, out: &Path) -> Result<String, String> {
     let path = out.join("runs.json");
-    let text = to_json(&run_shard(config, Shard::WHOLE))?;
+    let text = ShardFile::to_json(&run_shard(config, Shard::WHOLE))?;
     write(&path, &text)?;
     let parsed = ShardFile::parse(&text, &path)?;
     write_report(&parsed, out)
@@ -265,7 +215,7 @@ fn sweep_whole(config: &SweepConfig, out: &Path) -> Result<String, String> {
 /// returns the table. Shard files inside `target` are refused: replacing `target` would
 /// delete them.
 fn merge_files(inputs: &[PathBuf], out: &Path, target: &Path) -> Result<String, String> {
-    let paths = shard_file::shard_paths(inputs)?;
+    let paths = study::shard_paths(inputs)?;
     if let Ok(target_abs) = std::fs::canonicalize(target) {
         for path in &paths {
             if std::fs::canonicalize(path).is_ok_and(|p| p.starts_with(&target_abs)) {
@@ -282,15 +232,15 @@ fn merge_files(inputs: &[PathBuf], out: &Path, target: &Path) -> Result<String, 
         .into_iter()
         .map(|path| ShardFile::read(&path).map(|file| (path, file)))
         .collect::<Result<Vec<_>, _>>()?;
-    let whole = shard_file::merge(shards)?;
-    write(&out.join("runs.json"), &to_json(&whole)?)?;
+    let whole = study::merge(shards)?;
+    write(&out.join("runs.json"), &ShardFile::to_json(&whole)?)?;
     write_report(&whole, out)
 }
 
 /// Writes `summary.json`, `table.txt` and `tip_error_rms.svg` of a whole sweep; returns the
 /// table.
 fn write_report(whole: &ShardFile, out: &Path) -> Result<String, String> {
-    let cells = aggregate::cells(&whole.config, &whole.runs);
+    let cells = study::cells(&whole.config, &whole.runs);
     let summary = report::summary_json(&whole.config, &cells);
     let summary = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())? + "\n";
     write(&out.join("summary.json"), &summary)?;
@@ -300,12 +250,6 @@ fn write_report(whole: &ShardFile, out: &Path) -> Result<String, String> {
     }
     write(&out.join("table.txt"), &table)?;
     Ok(table)
-}
-
-fn to_json(file: &ShardFile) -> Result<String, String> {
-    serde_json::to_string_pretty(file)
-        .map(|s| s + "\n")
-        .map_err(|e| e.to_string())
 }
 
 /// Writes `text` to `path`, creating its folder.

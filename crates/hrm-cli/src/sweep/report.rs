@@ -1,10 +1,9 @@
 //! The report of a whole sweep: a text table, `summary.json` and an SVG plot of the tip error
 //! against the noise level.
 
-use super::aggregate::{Cell, Stats};
-use super::plan::SweepConfig;
 use crate::plot::{Labels, Series, line_chart};
 use serde_json::json;
+use sim_core::study::{Cell, Stats, SweepConfig};
 use std::fmt::Write as _;
 use std::path::Path;
 

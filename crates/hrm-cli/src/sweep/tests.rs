@@ -1,5 +1,6 @@
 use super::*;
 use clap::Parser;
+use sim_core::study::RunMetrics;
 
 /// `hrm` reduced to its `sweep` subcommand.
 #[derive(Parser)]
@@ -191,7 +192,7 @@ fn a_run_in_a_sweep_is_the_scenario_run_alone_with_its_seed() {
         let mut scenario = Scenario::builtin("paper-responses-step").unwrap();
         scenario.duration = 0.15;
         scenario.controller.kind = run.controller;
-        scenario.seed = plan::run_seed(42, run.seed_index);
+        scenario.seed = study::run_seed(42, run.seed_index);
         scenario.noise.sensor_a_std = Some(vec![run.noise_level; 2]);
         scenario.noise.sensor_a_dot_std = Some(vec![10.0 * run.noise_level; 2]);
         let alone = scenario.build().unwrap().run().unwrap();
@@ -208,7 +209,7 @@ fn a_run_in_a_sweep_is_the_scenario_run_alone_with_its_seed() {
 fn noise_spreads_the_errors_and_no_noise_does_not() {
     let config = small_config(&[0.0, 0.01], 4);
     let whole = run_shard(&config, Shard::WHOLE);
-    let cells = aggregate::cells(&config, &whole.runs);
+    let cells = study::cells(&config, &whole.runs);
     assert_eq!(cells.len(), 8);
     for (quiet, noisy) in cells[..4].iter().zip(&cells[4..]) {
         assert_eq!(quiet.controller, noisy.controller);
@@ -284,7 +285,7 @@ fn a_thousand_short_runs_complete_without_nan() {
     let whole = run_shard(&config, Shard::WHOLE);
     let text = to_json(&whole).unwrap();
     let parsed = ShardFile::parse(&text, Path::new("memory")).unwrap();
-    let cells = aggregate::cells(&parsed.config, &parsed.runs);
+    let cells = study::cells(&parsed.config, &parsed.runs);
     assert_eq!(cells.len(), 20);
     for cell in &cells {
         assert_eq!((cell.runs, cell.failed), (50, 0), "{cell:?}");

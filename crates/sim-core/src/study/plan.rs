@@ -1,8 +1,8 @@
 //! What a sweep runs: its configuration, the fixed enumeration of its runs, each run's seed,
 //! and the slice of runs one shard takes.
 
+use crate::{ControllerKind, NoiseSpec, Scenario};
 use serde::{Deserialize, Serialize};
-use sim_core::{ControllerKind, NoiseSpec, Scenario};
 use std::fmt;
 use std::str::FromStr;
 
@@ -49,6 +49,51 @@ pub struct RunId {
 }
 
 impl SweepConfig {
+    /// A sweep of `scenario` (its noise and seed are replaced per run) over `controllers`,
+    /// sensor noise levels `noise_levels` (rad; rate noise 10 L rad/s, no reference noise, as
+    /// `hrm sweep`'s defaults) and `seeds` realisations from `base_seed`; checked by
+    /// [`validate`](Self::validate) and [`check_builds`](Self::check_builds).
+    pub fn new(
+        scenario: Scenario,
+        controllers: Vec<ControllerKind>,
+        noise_levels: Vec<f64>,
+        seeds: usize,
+        base_seed: u64,
+    ) -> Result<Self, String> {
+        let mut scenario = scenario;
+        scenario.noise = NoiseSpec::default();
+        scenario.seed = 0;
+        let config = SweepConfig {
+            hrm_version: super::VERSION.to_string(),
+            scenario,
+            controllers,
+            noise_levels,
+            rate_noise_ratio: 10.0,
+            reference_noise_ratio: 0.0,
+            seeds,
+            base_seed,
+        };
+        config.validate()?;
+        config.check_builds()?;
+        Ok(config)
+    }
+
+    /// Builds the simulation of the first run of each controller at the largest noise level, so
+    /// that a bad setting fails once here rather than in every run.
+    pub fn check_builds(&self) -> Result<(), String> {
+        let cells = self.noise_levels.len() * self.controllers.len();
+        for c in 0..self.controllers.len() {
+            let id = self.run_at((cells - self.controllers.len() + c) * self.seeds);
+            self.scenario_for(&id).build().map_err(|e| {
+                format!(
+                    "scenario {} with {}: {e}",
+                    self.scenario.name, id.controller
+                )
+            })?;
+        }
+        Ok(())
+    }
+
     /// Checks the numbers that the scenario itself does not check.
     pub fn validate(&self) -> Result<(), String> {
         if self.controllers.is_empty() {

@@ -3,8 +3,8 @@
 
 use super::plan::SweepConfig;
 use super::shard_file::{Outcome, RunMetrics, RunResult};
+use crate::ControllerKind;
 use serde::Serialize;
-use sim_core::ControllerKind;
 
 /// Mean, sample standard deviation (`n - 1`; 0 for one value), minimum, median and maximum.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -97,7 +97,7 @@ pub struct Cell {
 }
 
 /// The cells of a whole sweep, noise level slowest then controller, from its runs in index
-/// order (as [`super::shard_file::merge`] returns them).
+/// order (as [`merge`](super::merge) returns them).
 pub fn cells(config: &SweepConfig, runs: &[RunResult]) -> Vec<Cell> {
     runs.chunks(config.seeds)
         .map(|chunk| {

@@ -2,8 +2,8 @@
 //! shard files back into the whole sweep.
 
 use super::plan::{RunId, Shard, SweepConfig};
+use crate::{ControllerKind, Summary};
 use serde::{Deserialize, Serialize};
-use sim_core::{ControllerKind, Summary};
 use std::path::{Path, PathBuf};
 
 /// The `format` tag of a shard file.
@@ -152,9 +152,16 @@ impl ShardFile {
         Ok(file)
     }
 
+    /// The file's text: pretty JSON with a final newline (what `hrm sweep` writes).
+    pub fn to_json(&self) -> Result<String, String> {
+        serde_json::to_string_pretty(self)
+            .map(|s| s + "\n")
+            .map_err(|e| e.to_string())
+    }
+
     /// Reads a shard file (at most [`MAX_SHARD_FILE_BYTES`]).
     pub fn read(path: &Path) -> Result<Self, String> {
-        let text = sim_core::read_text_file(path, MAX_SHARD_FILE_BYTES)
+        let text = crate::read_text_file(path, MAX_SHARD_FILE_BYTES)
             .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
         Self::parse(&text, path)
     }
