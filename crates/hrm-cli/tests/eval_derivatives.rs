@@ -203,7 +203,7 @@ fn bad_requests_get_one_clear_error_each() {
         (
             json!({"op": "reduced_derivatives", "harmonics": 0, "a": (vec![0.0; 3]), "a_dot": (vec![0.0; 3]), "tau_star": (vec![0.0; 3])}),
             "invalid_input",
-            "harmonics must be between 1",
+            "harmonics must be at least 1",
         ),
         (
             json!({"op": "reduced_derivatives", "harmonics": 2, "a": (vec![0.0; 3]), "a_dot": (vec![0.0; 3]), "tau_star": (vec![0.0; 3])}),

@@ -633,9 +633,13 @@ impl Scenario {
         toml::to_string(self).expect("a scenario serialises to TOML")
     }
 
-    /// The number of modal coordinates `m`: `2K` with `alpha0` fixed, `2K + 1` with it free.
+    /// The number of modal coordinates `m`: `2K` with `alpha0` fixed, `2K + 1` with it free
+    /// (saturating, for a scenario read from a file whose `harmonics` is not yet validated).
     pub fn n_coords(&self) -> usize {
-        2 * self.modal.harmonics + usize::from(self.alpha0 == Alpha0::Free)
+        self.modal
+            .harmonics
+            .saturating_mul(2)
+            .saturating_add(usize::from(self.alpha0 == Alpha0::Free))
     }
 
     /// The names of the modal coordinates, in order: `a1, ..., a{2K}`, then `alpha0` when it is

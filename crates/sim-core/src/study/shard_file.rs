@@ -149,6 +149,19 @@ impl ShardFile {
                 origin.display()
             )
         })?;
+        let m = file.config.scenario.n_coords();
+        for run in &file.runs {
+            if let Outcome::Completed(metrics) = &run.outcome
+                && metrics.modal_error_rms.len() != m
+            {
+                return Err(format!(
+                    "{}: run {} has {} modal errors, but its scenario has {m} modal coordinates",
+                    origin.display(),
+                    run.index,
+                    metrics.modal_error_rms.len()
+                ));
+            }
+        }
         Ok(file)
     }
 
