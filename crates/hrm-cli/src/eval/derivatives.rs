@@ -2,7 +2,6 @@
 //! `reduced_derivatives` (`docs/eval-protocol.md`). Matrices are lists of rows with entry
 //! `[i][j] = d out_i / d in_j`.
 
-use backbone_kin::{BaseAngle, MAX_HARMONICS, ModalMap};
 use manip_dyn::faer::MatRef;
 use manip_dyn::{ChainData, ChainModel, DerivativeData};
 use modal_reduce::{ReducedData, ReducedDerivatives, ReducedModel};
@@ -110,12 +109,9 @@ pub(super) struct ReducedDerivativesRequest {
 
 /// `reduced_derivatives`: `a_ddot` of eq 15 and its Jacobians with respect to `a`, `a_dot` and
 /// `tau*` (`M*^-1`), for `K` harmonics (default 1) with `alpha0` free or fixed.
-pub(super) fn reduced_derivatives(request: ReducedDerivativesRequest) -> EvalResult {
+pub(super) fn reduced_derivatives(mut request: ReducedDerivativesRequest) -> EvalResult {
     let chain = request.arm.to_chain().map_err(EvalError::input)?;
-    let map = match request.harmonics {
-        None => modal_map(&chain, &request.a, request.alpha0)?,
-        Some(harmonics) => harmonic_map(&chain, harmonics, request.a.len(), request.alpha0)?,
-    };
+    let map = modal_map(&chain, &mut request.a, request.alpha0, request.harmonics)?;
     let model = ReducedModel::new(chain, map).map_err(reduce_error)?;
     let mut derivatives = ReducedDerivatives::new(&model);
     modal_reduce::reduced_derivatives(
@@ -163,41 +159,6 @@ fn joint_vectors<const N: usize>(
         }
     }
     Ok(())
-}
-
-/// The map of `K` harmonics: `2K + 1` coordinates (`alpha0` free, the last one), or `2K` with
-/// `"alpha0"` fixed.
-fn harmonic_map(
-    chain: &ChainModel,
-    harmonics: usize,
-    coords: usize,
-    alpha0: Option<f64>,
-) -> Result<ModalMap, EvalError> {
-    if !(1..=MAX_HARMONICS).contains(&harmonics) {
-        return Err(EvalError::input(format!(
-            "harmonics must be between 1 and {MAX_HARMONICS}, got {harmonics}"
-        )));
-    }
-    let base = match alpha0 {
-        None if coords == 2 * harmonics + 1 => BaseAngle::Free,
-        Some(alpha0) if coords == 2 * harmonics => BaseAngle::Fixed(alpha0),
-        None => {
-            return Err(EvalError::input(format!(
-                "a has {coords} entries; with {harmonics} harmonics expected {} (alpha0 last), \
-                 or {} with \"alpha0\"",
-                2 * harmonics + 1,
-                2 * harmonics
-            )));
-        }
-        Some(_) => {
-            return Err(EvalError::input(format!(
-                "a has {coords} entries; with {harmonics} harmonics and \"alpha0\" expected {}",
-                2 * harmonics
-            )));
-        }
-    };
-    let lengths: Vec<f64> = chain.link_lengths().collect();
-    ModalMap::new(&lengths, harmonics, base).map_err(EvalError::input)
 }
 
 /// A matrix as JSON rows, refused if an entry is not finite.
