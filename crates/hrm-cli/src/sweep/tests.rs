@@ -149,19 +149,19 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
     let mut cut = ShardFile::read(&shard(2)).unwrap();
     cut.runs.pop();
     let cut_path = root.join("cut").join("shard-2-of-3.json");
-    write(&cut_path, &to_json(&cut).unwrap()).unwrap();
+    write(&cut_path, &cut.to_json().unwrap()).unwrap();
     let err = merge(&[shard(1), cut_path.clone(), shard(3)]);
     assert!(err.contains("1 of 24 runs are missing"), "{err}");
     // A run moved to a shard it does not belong to.
     let mut moved = ShardFile::read(&shard(2)).unwrap();
     moved.runs[0].index = 0;
-    write(&cut_path, &to_json(&moved).unwrap()).unwrap();
+    write(&cut_path, &moved.to_json().unwrap()).unwrap();
     let err = merge(&[shard(1), cut_path.clone(), shard(3)]);
     assert!(err.contains("not run 0 of its shard"), "{err}");
     // A hand-edited configuration that makes no sweep.
     let mut empty = ShardFile::read(&shard(2)).unwrap();
     empty.config.seeds = 0;
-    write(&cut_path, &to_json(&empty).unwrap()).unwrap();
+    write(&cut_path, &empty.to_json().unwrap()).unwrap();
     let err = merge(&[shard(1), cut_path.clone(), shard(3)]);
     assert!(
         err.contains("invalid sweep configuration: --seeds"),
@@ -283,7 +283,7 @@ fn a_thousand_short_runs_complete_without_nan() {
     let config = configure(&args.sweep).unwrap();
     assert_eq!(config.runs(), Some(1000));
     let whole = run_shard(&config, Shard::WHOLE);
-    let text = to_json(&whole).unwrap();
+    let text = whole.to_json().unwrap();
     let parsed = ShardFile::parse(&text, Path::new("memory")).unwrap();
     let cells = study::cells(&parsed.config, &parsed.runs);
     assert_eq!(cells.len(), 20);
