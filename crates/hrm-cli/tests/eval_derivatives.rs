@@ -208,7 +208,7 @@ fn bad_requests_get_one_clear_error_each() {
         (
             json!({"op": "reduced_derivatives", "harmonics": 2, "a": (vec![0.0; 3]), "a_dot": (vec![0.0; 3]), "tau_star": (vec![0.0; 3])}),
             "invalid_input",
-            "expected 5",
+            "2K + 1 = 5",
         ),
         (
             json!({"op": "reduced_derivatives", "harmonics": 6, "a": (vec![0.0; 13]), "a_dot": (vec![0.0; 13]), "tau_star": (vec![0.0; 13])}),

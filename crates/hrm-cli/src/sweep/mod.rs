@@ -49,16 +49,24 @@ struct SweepArgs {
     #[arg(long, default_value = "paper-tracking")]
     scenario: String,
     /// Controllers to compare, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = ControllerKind::ALL)]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "fuzzy,pd,computed-torque,fuzzy-gc"
+    )]
     controllers: Vec<ControllerKind>,
-    /// Noise levels L, comma-separated: the sensor noise std on (a1, a2) in rad.
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true,
-          default_values_t = [0.0, 0.005, 0.01, 0.02, 0.05, 0.1])]
+    /// Noise levels L, comma-separated: the sensor noise std on every modal coordinate in rad.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        default_value = "0,0.005,0.01,0.02,0.05,0.1"
+    )]
     noise: Vec<f64>,
-    /// Sensor noise std on (a1_dot, a2_dot) per unit of L (rad/s per rad).
+    /// Sensor noise std on every modal rate per unit of L (rad/s per rad).
     #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     rate_noise_ratio: f64,
-    /// Noise std on the reference (a1_ref, a2_ref) per unit of L.
+    /// Noise std on every coordinate of the reference per unit of L.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     reference_noise_ratio: f64,
     /// Noise realisations (seeds) per noise level and controller (at most 1000000).

@@ -24,25 +24,28 @@ pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
         config.base_seed,
         config.scenario.duration,
     );
+    let names = config.scenario.coordinate_names();
+    let rates: Vec<String> = names.iter().map(|n| format!("{n}_dot")).collect();
     let _ = writeln!(
         s,
-        "noise level L: sensor noise std L rad on (a1, a2), {} L rad/s on (a1_dot, a2_dot), {} L rad on the reference",
-        config.rate_noise_ratio, config.reference_noise_ratio
+        "noise level L: sensor noise std L rad on ({}), {} L rad/s on ({}), {} L rad on the reference",
+        names.join(", "),
+        config.rate_noise_ratio,
+        rates.join(", "),
+        config.reference_noise_ratio
     );
-    let _ = writeln!(
+    let _ = write!(
         s,
-        "{:>10} {:<16} {:>7} | {:^49} | {:^29} | {:^19} | {:^19}",
-        "",
-        "",
-        "",
-        "tip error RMS (mm)",
-        "tip error max (mm)",
-        "a1 error RMS (rad)",
-        "a2 error RMS (rad)"
+        "{:>10} {:<16} {:>7} | {:^49} | {:^29}",
+        "", "", "", "tip error RMS (mm)", "tip error max (mm)"
     );
-    let _ = writeln!(
+    for name in &names {
+        let _ = write!(s, " | {:^19}", format!("{name} error RMS (rad)"));
+    }
+    s.push('\n');
+    let _ = write!(
         s,
-        "{:>10} {:<16} {:>7} | {:>9} {:>9} {:>9} {:>9} {:>9} | {:>9} {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9}",
+        "{:>10} {:<16} {:>7} | {:>9} {:>9} {:>9} {:>9} {:>9} | {:>9} {:>9} {:>9}",
         "L (rad)",
         "controller",
         "ok/runs",
@@ -53,12 +56,12 @@ pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
         "max",
         "mean",
         "std",
-        "max",
-        "mean",
-        "std",
-        "mean",
-        "std"
+        "max"
     );
+    for _ in &names {
+        let _ = write!(s, " | {:>9} {:>9}", "mean", "std");
+    }
+    s.push('\n');
     for c in cells {
         let _ = write!(
             s,
@@ -91,8 +94,9 @@ pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
             &[|t| t.mean, |t| t.std, |t| t.max],
             mm,
         );
-        cols(&mut s, &c.modal_error_rms_a1, &[|t| t.mean, |t| t.std], rad);
-        cols(&mut s, &c.modal_error_rms_a2, &[|t| t.mean, |t| t.std], rad);
+        for stats in &c.modal_error_rms {
+            cols(&mut s, stats, &[|t| t.mean, |t| t.std], rad);
+        }
         s.push('\n');
     }
     let failures: Vec<_> = cells
@@ -166,7 +170,7 @@ pub fn plot(path: &Path, config: &SweepConfig, cells: &[Cell]) -> Result<bool, S
     );
     let labels = Labels {
         title: &title,
-        x: "noise level: sensor noise std on (a1, a2) (rad)",
+        x: "noise level: sensor noise std on the modal coordinates (rad)",
         y: "tip error RMS (mm)",
     };
     line_chart(path, &labels, &means, None)?;

@@ -55,6 +55,25 @@ fn with<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
 }
 
 #[test]
+fn help_shows_list_defaults_as_they_are_typed() {
+    use clap::CommandFactory;
+    let mut command = Hrm::command();
+    let help = command
+        .find_subcommand_mut("sweep")
+        .unwrap()
+        .render_long_help()
+        .to_string();
+    assert!(
+        help.contains("[default: 0,0.005,0.01,0.02,0.05,0.1]"),
+        "{help}"
+    );
+    assert!(
+        help.contains("[default: fuzzy,pd,computed-torque,fuzzy-gc]"),
+        "{help}"
+    );
+}
+
+#[test]
 fn the_command_line_parses_with_defaults_and_merge() {
     let cli = parse(&[]).unwrap();
     assert!(cli.command.is_none());
@@ -218,7 +237,7 @@ fn noise_spreads_the_errors_and_no_noise_does_not() {
         let q = quiet.tip_error_rms_mm.unwrap();
         assert_eq!((q.std, q.min), (0.0, q.max), "{}", quiet.controller);
         // With noise the seeds differ.
-        let n = noisy.modal_error_rms_a1.unwrap();
+        let n = noisy.modal_error_rms[0].unwrap();
         assert!(n.std > 0.0 && n.min < n.max, "{}", noisy.controller);
     }
 }
@@ -289,13 +308,15 @@ fn a_thousand_short_runs_complete_without_nan() {
     assert_eq!(cells.len(), 20);
     for cell in &cells {
         assert_eq!((cell.runs, cell.failed), (50, 0), "{cell:?}");
+        assert_eq!(cell.modal_error_rms.len(), 2);
         for stats in [
             cell.tip_error_rms_mm,
             cell.tip_error_max_mm,
-            cell.modal_error_rms_a1,
-            cell.modal_error_rms_a2,
             cell.peak_joint_torque_nm,
-        ] {
+        ]
+        .into_iter()
+        .chain(cell.modal_error_rms.iter().copied())
+        {
             let s = stats.unwrap();
             assert!(
                 [s.mean, s.std, s.min, s.median, s.max]

@@ -86,10 +86,9 @@ pub struct Cell {
     pub tip_error_rms_mm: Option<Stats>,
     /// Largest tip error (mm).
     pub tip_error_max_mm: Option<Stats>,
-    /// Modal error RMS of `a1` (rad).
-    pub modal_error_rms_a1: Option<Stats>,
-    /// Modal error RMS of `a2` (rad).
-    pub modal_error_rms_a2: Option<Stats>,
+    /// Modal error RMS of each coordinate (rad), in the order of the scenario's coordinates
+    /// ([`Scenario::coordinate_names`](crate::Scenario::coordinate_names)).
+    pub modal_error_rms: Vec<Option<Stats>>,
     /// Largest joint torque (N m).
     pub peak_joint_torque_nm: Option<Stats>,
     /// The failed runs, by index.
@@ -99,6 +98,7 @@ pub struct Cell {
 /// The cells of a whole sweep, noise level slowest then controller, from its runs in index
 /// order (as [`merge`](super::merge) returns them).
 pub fn cells(config: &SweepConfig, runs: &[RunResult]) -> Vec<Cell> {
+    let m = config.scenario.n_coords();
     runs.chunks(config.seeds)
         .map(|chunk| {
             let completed: Vec<&RunMetrics> = chunk
@@ -129,8 +129,15 @@ pub fn cells(config: &SweepConfig, runs: &[RunResult]) -> Vec<Cell> {
                 failed: failures.len(),
                 tip_error_rms_mm: stats(|m| m.tip_error_rms_m * 1e3),
                 tip_error_max_mm: stats(|m| m.tip_error_max_m * 1e3),
-                modal_error_rms_a1: stats(|m| m.modal_error_rms[0]),
-                modal_error_rms_a2: stats(|m| m.modal_error_rms[1]),
+                modal_error_rms: (0..m)
+                    .map(|i| {
+                        let values: Vec<f64> = completed
+                            .iter()
+                            .filter_map(|r| r.modal_error_rms.get(i).copied())
+                            .collect();
+                        Stats::of(&values)
+                    })
+                    .collect(),
                 peak_joint_torque_nm: stats(|m| m.peak_joint_torque_nm),
                 failures,
             }
