@@ -137,12 +137,10 @@ pub fn run(cli: SweepCli) -> Result<(), String> {
 const MAX_NOISE_LEVELS: usize = 1000;
 /// Most noise realisations per cell.
 const MAX_SEEDS: usize = 1_000_000;
-/// Most runs in a sweep (noise levels x controllers x seeds).
-const MAX_RUNS: usize = 10_000_000;
 
 /// The command line's counts checked before anything is built: `--seeds` and `--base-seed` in
 /// range, at most [`MAX_NOISE_LEVELS`] noise levels, no controller twice, at most
-/// [`MAX_RUNS`] runs.
+/// [`study::MAX_RUNS`] runs.
 fn check_counts(args: &SweepArgs) -> Result<(usize, u64), String> {
     let seeds = crate::args::count("--seeds", args.seeds, 1, MAX_SEEDS)?;
     let base_seed = crate::args::count("--base-seed", args.base_seed, 0, usize::MAX)? as u64;
@@ -158,12 +156,13 @@ fn check_counts(args: &SweepArgs) -> Result<(usize, u64), String> {
         }
     }
     let runs = args.noise.len() * args.controllers.len() * seeds;
-    if runs > MAX_RUNS {
+    if runs > study::MAX_RUNS {
         return Err(format!(
             "the sweep would make {} noise levels x {} controllers x {seeds} seeds = {runs} runs, \
-             more than the {MAX_RUNS} allowed: lower --seeds or use fewer noise levels",
+             more than the {} allowed: lower --seeds or use fewer noise levels",
             args.noise.len(),
-            args.controllers.len()
+            args.controllers.len(),
+            study::MAX_RUNS
         ));
     }
     Ok((seeds, base_seed))

@@ -31,7 +31,7 @@ mod shard_file;
 
 pub use aggregate::{Cell, FailedRun, Stats, cells};
 pub use comparison::{ComparisonRun, Stopped, builtin_scenarios, compare, run_one};
-pub use plan::{RunId, Shard, SweepConfig, run_seed};
+pub use plan::{MAX_RUNS, MAX_SHARDS, RunId, Shard, SweepConfig, run_seed};
 pub use shard_file::{FORMAT, Outcome, RunMetrics, RunResult, ShardFile, merge, shard_paths};
 
 use rayon::prelude::*;

@@ -9,6 +9,12 @@ use std::str::FromStr;
 /// The SplitMix64 increment (the golden ratio in 64-bit fixed point).
 const SPLITMIX_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
 
+/// Most runs in a sweep (noise levels x controllers x seeds), checked by
+/// [`SweepConfig::validate`] before any per-run buffer exists.
+pub const MAX_RUNS: usize = 10_000_000;
+/// Most shards a sweep splits into (one run each at most, so no more than [`MAX_RUNS`]).
+pub const MAX_SHARDS: usize = MAX_RUNS;
+
 /// Everything that defines a sweep's results; shards merge only when theirs are equal.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -130,9 +136,16 @@ impl SweepConfig {
         if self.seeds == 0 {
             return Err("--seeds must be at least 1".into());
         }
-        self.runs()
-            .map(|_| ())
-            .ok_or_else(|| "the sweep has too many runs to count".to_string())
+        match self.runs() {
+            Some(runs) if runs <= MAX_RUNS => Ok(()),
+            _ => Err(format!(
+                "the sweep has {} noise levels x {} controllers x {} seeds, more than the \
+                 {MAX_RUNS} runs allowed",
+                self.noise_levels.len(),
+                self.controllers.len(),
+                self.seeds
+            )),
+        }
     }
 
     /// Number of runs: noise levels x controllers x seeds (`None` on overflow).
@@ -249,13 +262,13 @@ impl fmt::Display for Shard {
 impl FromStr for Shard {
     type Err = String;
 
-    /// Parses `K/N` with `1 <= K <= N`.
+    /// Parses `K/N` with `1 <= K <= N <= MAX_SHARDS`.
     fn from_str(s: &str) -> Result<Self, String> {
-        let bad = || format!("a shard is written K/N with 1 <= K <= N, got '{s}'");
+        let bad = || format!("a shard is written K/N with 1 <= K <= N <= {MAX_SHARDS}, got '{s}'");
         let (k, n) = s.split_once('/').ok_or_else(bad)?;
         let index: usize = k.trim().parse().map_err(|_| bad())?;
         let count: usize = n.trim().parse().map_err(|_| bad())?;
-        if index == 0 || index > count {
+        if index == 0 || index > count || count > MAX_SHARDS {
             return Err(bad());
         }
         Ok(Shard { index, count })

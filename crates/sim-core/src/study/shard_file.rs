@@ -1,7 +1,7 @@
 //! The outcome of each run, the shard file that stores a slice of a sweep's runs, and merging
 //! shard files back into the whole sweep.
 
-use super::plan::{RunId, Shard, SweepConfig};
+use super::plan::{MAX_SHARDS, RunId, Shard, SweepConfig};
 use crate::{ControllerKind, Summary};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -215,10 +215,21 @@ pub fn merge(shards: Vec<(PathBuf, ShardFile)>) -> Result<ShardFile, String> {
         return Err("nothing to merge: no shard files given".into());
     };
     let config = first.config.clone();
+    config.validate().map_err(|e| {
+        format!(
+            "{} holds an invalid sweep configuration: {e}",
+            first_path.display()
+        )
+    })?;
     let count = first.shard.count;
-    let total = config
-        .runs()
-        .ok_or("the sweep has too many runs to count")?;
+    if !(1..=MAX_SHARDS).contains(&count) {
+        return Err(format!(
+            "{} is shard {} of a split into {count} shards; a split has 1 to {MAX_SHARDS}",
+            first_path.display(),
+            first.shard.index
+        ));
+    }
+    let total = config.runs().unwrap_or(0);
     let mut shard_files: Vec<Option<PathBuf>> = vec![None; count];
     let mut slots: Vec<Option<RunResult>> = vec![None; total];
     for (path, file) in &shards {
