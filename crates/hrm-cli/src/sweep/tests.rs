@@ -190,12 +190,12 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
     let mut huge = ShardFile::read(&shard(2)).unwrap();
     huge.config.seeds = 1 << 50;
     write(&cut_path, &huge.to_json().unwrap()).unwrap();
-    let err = merge(&[cut_path.clone()]);
+    let err = merge(std::slice::from_ref(&cut_path));
     assert!(err.contains("runs allowed"), "{err}");
     let mut split = ShardFile::read(&shard(2)).unwrap();
     split.shard.count = usize::MAX;
     write(&cut_path, &split.to_json().unwrap()).unwrap();
-    let err = merge(&[cut_path.clone()]);
+    let err = merge(std::slice::from_ref(&cut_path));
     assert!(err.contains("a split has 1 to 10000000"), "{err}");
     assert!(parse(&["--shard", "1/10000001"]).is_err());
     let err = merge(&[whole.join("summary.json")]);
