@@ -198,6 +198,16 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
     let err = merge(std::slice::from_ref(&cut_path));
     assert!(err.contains("a split has 1 to 10000000"), "{err}");
     assert!(parse(&["--shard", "1/10000001"]).is_err());
+    let mut short = ShardFile::read(&shard(2)).unwrap();
+    if let Outcome::Completed(metrics) = &mut short.runs[0].outcome {
+        metrics.modal_error_rms.pop();
+    }
+    write(&cut_path, &short.to_json().unwrap()).unwrap();
+    let err = merge(&[shard(1), cut_path.clone(), shard(3)]);
+    assert!(
+        err.contains("has 1 modal errors, but its scenario has 2"),
+        "{err}"
+    );
     let err = merge(&[whole.join("summary.json")]);
     assert!(err.contains("not an hrm sweep shard file"), "{err}");
     let err = merge(std::slice::from_ref(&whole));
