@@ -94,13 +94,7 @@ impl ChainIk {
     /// Replaces the stopping rules; `tolerance` (relative to the chain's length) must be positive
     /// and finite.
     pub fn with_options(mut self, options: IkOptions) -> Result<Self, KinError> {
-        check_finite("IK tolerance", options.tolerance)?;
-        if options.tolerance <= 0.0 {
-            return Err(KinError::NonPositiveLength {
-                name: "IK tolerance",
-                value: options.tolerance,
-            });
-        }
+        options.validate()?;
         self.options = options;
         Ok(self)
     }

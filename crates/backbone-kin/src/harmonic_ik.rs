@@ -44,6 +44,20 @@ impl Default for IkOptions {
     }
 }
 
+impl IkOptions {
+    /// Checks that `tolerance` is positive and finite.
+    pub(crate) fn validate(&self) -> Result<(), KinError> {
+        check_finite("IK tolerance", self.tolerance)?;
+        if self.tolerance <= 0.0 {
+            return Err(KinError::NonPositiveLength {
+                name: "IK tolerance",
+                value: self.tolerance,
+            });
+        }
+        Ok(())
+    }
+}
+
 /// What a successful [`HarmonicIk::solve`] spent and reached.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IkReport {
@@ -104,13 +118,7 @@ impl HarmonicIk {
 
     /// Replaces the stopping rules; `tolerance` must be positive and finite.
     pub fn with_options(mut self, options: IkOptions) -> Result<Self, KinError> {
-        check_finite("IK tolerance", options.tolerance)?;
-        if options.tolerance <= 0.0 {
-            return Err(KinError::NonPositiveLength {
-                name: "IK tolerance",
-                value: options.tolerance,
-            });
-        }
+        options.validate()?;
         self.options = options;
         Ok(self)
     }
