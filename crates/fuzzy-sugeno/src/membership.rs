@@ -649,20 +649,7 @@ impl CompiledMf {
                 }
             }
             Self::Trapezoid { a, b, c, d } => {
-                let rising = if x >= b {
-                    1.0
-                } else if x < a {
-                    0.0
-                } else {
-                    (x - a) / (b - a)
-                };
-                let falling = if x <= c {
-                    1.0
-                } else if x > d {
-                    0.0
-                } else {
-                    (d - x) / (d - c)
-                };
+                let (rising, falling) = trapezoid_sides(x, a, b, c, d);
                 rising.min(falling)
             }
             Self::Sigmoid { slope, center } => sigmoid(x, slope, center),
@@ -684,6 +671,26 @@ impl CompiledMf {
             Self::Constant(value) => value,
         }
     }
+}
+
+/// The rising and falling sides of `trapmf [a b c d]` at `x`: the degree is their minimum.
+#[inline]
+pub(crate) fn trapezoid_sides(x: f64, a: f64, b: f64, c: f64, d: f64) -> (f64, f64) {
+    let rising = if x >= b {
+        1.0
+    } else if x < a {
+        0.0
+    } else {
+        (x - a) / (b - a)
+    };
+    let falling = if x <= c {
+        1.0
+    } else if x > d {
+        0.0
+    } else {
+        (d - x) / (d - c)
+    };
+    (rising, falling)
 }
 
 /// MATLAB's `smf(x, [a b])`: the quadratic spline from 0 at `a` to 1 at `b` (value 1/2 at the

@@ -2,7 +2,7 @@
 //! parameters (layer 1 of Jang 1993, the `d O / d alpha` of eq 12), and the repair that keeps a
 //! function valid after a gradient step.
 
-use crate::membership::{MembershipFn, s_shape, z_shape};
+use crate::membership::{MembershipFn, s_shape, trapezoid_sides, z_shape};
 
 /// Writes `d mu / d p` at `x` into `grad`, for the parameters `p` in MATLAB's order; `mu` is the
 /// degree at `x`. Where a function has a kink (triangle corners, the shoulders of `gauss2mf`),
@@ -73,20 +73,7 @@ pub(crate) fn gradient(mf: &MembershipFn, x: f64, mu: f64, grad: &mut [f64; 4]) 
             right_foot: d,
         } => {
             // mu = min(rising, falling): the smaller side carries the derivative.
-            let rising = if x >= b {
-                1.0
-            } else if x < a {
-                0.0
-            } else {
-                (x - a) / (b - a)
-            };
-            let falling = if x <= c {
-                1.0
-            } else if x > d {
-                0.0
-            } else {
-                (d - x) / (d - c)
-            };
+            let (rising, falling) = trapezoid_sides(x, a, b, c, d);
             if rising <= falling && x >= a && x < b {
                 let w = b - a;
                 grad[0] = (x - b) / (w * w);
