@@ -52,7 +52,7 @@ struct SweepArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "fuzzy,pd,computed-torque,fuzzy-gc"
+        default_value = crate::args::ALL_CONTROLLERS.as_str()
     )]
     controllers: Vec<ControllerKind>,
     /// Noise levels L, comma-separated: the sensor noise std on every modal coordinate in rad.
