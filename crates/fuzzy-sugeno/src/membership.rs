@@ -179,21 +179,56 @@ impl MembershipFn {
 
     /// This function's kind: its entry in [`KINDS`].
     pub(crate) fn kind(&self) -> &'static Kind {
-        let index = match self {
-            Self::Triangle { .. } => 0,
-            Self::Trapezoid { .. } => 1,
-            Self::Bell { .. } => 2,
-            Self::Gaussian { .. } => 3,
-            Self::Gaussian2 { .. } => 4,
-            Self::Sigmoid { .. } => 5,
-            Self::SigmoidDifference { .. } => 6,
-            Self::SigmoidProduct { .. } => 7,
-            Self::SShape { .. } => 8,
-            Self::ZShape { .. } => 9,
-            Self::PiShape { .. } => 10,
-            Self::Constant { .. } => 11,
+        self.described().0
+    }
+
+    /// The function's kind and its parameters in MATLAB's order (unused slots 0): the one place
+    /// that takes a variant apart, as [`Kind::build`] is the one that puts it together.
+    fn described(&self) -> (&'static Kind, [f64; 4]) {
+        let (index, params) = match *self {
+            Self::Triangle { left, peak, right } => (0, [left, peak, right, 0.0]),
+            Self::Trapezoid {
+                left_foot,
+                left_shoulder,
+                right_shoulder,
+                right_foot,
+            } => (1, [left_foot, left_shoulder, right_shoulder, right_foot]),
+            Self::Bell {
+                width,
+                slope,
+                center,
+            } => (2, [width, slope, center, 0.0]),
+            Self::Gaussian { sigma, center } => (3, [sigma, center, 0.0, 0.0]),
+            Self::Gaussian2 {
+                sigma1,
+                center1,
+                sigma2,
+                center2,
+            } => (4, [sigma1, center1, sigma2, center2]),
+            Self::Sigmoid { slope, center } => (5, [slope, center, 0.0, 0.0]),
+            Self::SigmoidDifference {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            } => (6, [slope1, center1, slope2, center2]),
+            Self::SigmoidProduct {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            } => (7, [slope1, center1, slope2, center2]),
+            Self::SShape { start, end } => (8, [start, end, 0.0, 0.0]),
+            Self::ZShape { start, end } => (9, [start, end, 0.0, 0.0]),
+            Self::PiShape {
+                left_foot,
+                left_shoulder,
+                right_shoulder,
+                right_foot,
+            } => (10, [left_foot, left_shoulder, right_shoulder, right_foot]),
+            Self::Constant { value } => (11, [value, 0.0, 0.0, 0.0]),
         };
-        &KINDS[index]
+        (&KINDS[index], params)
     }
 
     /// The function of the same kind with parameters `p` (MATLAB's order, this kind's count),
@@ -211,50 +246,8 @@ impl MembershipFn {
     /// The parameters in MATLAB's order in a fixed array, and how many there are (at most 4):
     /// [`params`](Self::params) without allocating.
     pub(crate) fn param_array(&self) -> ([f64; 4], usize) {
-        match *self {
-            Self::Bell {
-                width,
-                slope,
-                center,
-            } => ([width, slope, center, 0.0], 3),
-            Self::Gaussian { sigma, center } => ([sigma, center, 0.0, 0.0], 2),
-            Self::Gaussian2 {
-                sigma1,
-                center1,
-                sigma2,
-                center2,
-            } => ([sigma1, center1, sigma2, center2], 4),
-            Self::Triangle { left, peak, right } => ([left, peak, right, 0.0], 3),
-            Self::Trapezoid {
-                left_foot,
-                left_shoulder,
-                right_shoulder,
-                right_foot,
-            } => ([left_foot, left_shoulder, right_shoulder, right_foot], 4),
-            Self::Sigmoid { slope, center } => ([slope, center, 0.0, 0.0], 2),
-            Self::SigmoidDifference {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            }
-            | Self::SigmoidProduct {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            } => ([slope1, center1, slope2, center2], 4),
-            Self::SShape { start, end } | Self::ZShape { start, end } => {
-                ([start, end, 0.0, 0.0], 2)
-            }
-            Self::PiShape {
-                left_foot,
-                left_shoulder,
-                right_shoulder,
-                right_foot,
-            } => ([left_foot, left_shoulder, right_shoulder, right_foot], 4),
-            Self::Constant { value } => ([value, 0.0, 0.0, 0.0], 1),
-        }
+        let (kind, params) = self.described();
+        (params, kind.parameters)
     }
 
     /// How many parameters MATLAB's type `name` takes (`None` for an unknown type). A `.fis`
