@@ -697,6 +697,24 @@ impl Scenario {
     /// `.fis` file if any. Errors name the setting that failed; the loop's own limits are
     /// [`Simulation::new`]'s.
     pub fn build(&self) -> Result<Simulation, SimError> {
+        self.assemble(|model| self.controller.build(model))
+    }
+
+    /// Builds the simulation as [`build`](Self::build) does, but closed by `controller` (a
+    /// controller written elsewhere, e.g. in Python) instead of the one `controller.kind` names;
+    /// `controller.period` still sets its sampling, and the other `[controller]` keys are unused.
+    pub fn build_with_controller(
+        &self,
+        controller: Box<dyn Controller>,
+    ) -> Result<Simulation, SimError> {
+        self.assemble(|_| Ok(controller))
+    }
+
+    /// The simulation with the controller `controller(model)` makes.
+    fn assemble(
+        &self,
+        controller: impl FnOnce(&ReducedModel) -> Result<Box<dyn Controller>, SimError>,
+    ) -> Result<Simulation, SimError> {
         let model = self.model()?;
         let m = model.n_coords();
         let reference = self.reference.build(
@@ -705,7 +723,7 @@ impl Scenario {
             self.alpha0,
             m,
         )?;
-        let controller = self.controller.build(&model)?;
+        let controller = controller(&model)?;
         let period = match (self.controller.period, self.integrator) {
             (Some(period), _) => period,
             (None, IntegratorSpec::Rk4 { dt }) => dt,
