@@ -23,7 +23,8 @@ use serde_json::{Value, json};
 /// scenario.duration = 0.05;
 /// let summary = sim_core::summary_json::run(&run_one(&scenario, ControllerKind::Pd).result);
 /// assert!(summary["tip_error_rms_m"].is_number() && summary.get("error").is_none());
-/// scenario.limits.max_modal_error = 1e-9; // every run stops at once
+/// scenario.duration = 0.15;
+/// scenario.limits.max_modal_error = 1e-9; // stops at the step, t = 0.1 s
 /// let summary = sim_core::summary_json::run(&run_one(&scenario, ControllerKind::Pd).result);
 /// assert!(summary["error"].as_str().unwrap().contains("runaway"));
 /// assert_eq!(summary["stopped_at_s"], summary["simulated_s"]);
