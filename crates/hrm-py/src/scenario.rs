@@ -198,10 +198,34 @@ fn toml_to_py(py: Python<'_>, value: &toml::Value) -> PyResult<Py<PyAny>> {
     })
 }
 
+/// The deepest nesting of lists and dicts a setting may have (a scenario's deepest, a polyline
+/// in a table of the reference, is 3): deeper values are refused before the recursion goes on.
+const MAX_SETTING_DEPTH: usize = 16;
+
+/// The most items a list (or array) of a setting may have, checked before it is converted.
+const MAX_SETTING_ITEMS: usize = 1 << 20;
+
 /// A Python value as a TOML value for setting `name`: bools, integers (beyond 64 bits signed
 /// as a decimal string, as TOML writes large seeds), floats, strings, paths, dicts, and lists,
-/// tuples and numpy arrays of those.
+/// tuples and numpy arrays of those, nested at most [`MAX_SETTING_DEPTH`] deep with at most
+/// [`MAX_SETTING_ITEMS`] items per list.
 fn py_to_toml(value: &Bound<'_, PyAny>, name: &str) -> PyResult<toml::Value> {
+    to_toml_at(value, name, 0)
+}
+
+/// [`py_to_toml`] at nesting `depth`.
+fn to_toml_at(value: &Bound<'_, PyAny>, name: &str, depth: usize) -> PyResult<toml::Value> {
+    if depth > MAX_SETTING_DEPTH {
+        return Err(Error::input(format!(
+            "{name} is nested more than {MAX_SETTING_DEPTH} levels deep"
+        ))
+        .into());
+    }
+    let too_many = |items: usize| {
+        Error::input(format!(
+            "{name} has {items} items, more than the {MAX_SETTING_ITEMS} a setting may have"
+        ))
+    };
     if let Ok(b) = value.cast::<PyBool>() {
         return Ok(toml::Value::Boolean(b.is_true()));
     }
@@ -229,30 +253,39 @@ fn py_to_toml(value: &Bound<'_, PyAny>, name: &str) -> PyResult<toml::Value> {
             let key: String = key
                 .extract()
                 .map_err(|_| Error::input(format!("{name}: table keys must be strings")))?;
-            let item = py_to_toml(&item, &format!("{name}.{key}"))?;
+            let item = to_toml_at(&item, &format!("{name}.{key}"), depth + 1)?;
             table.insert(key, item);
         }
         return Ok(toml::Value::Table(table));
     }
     if value.cast::<PyList>().is_ok() || value.cast::<PyTuple>().is_ok() {
+        let items = value.len()?;
+        if items > MAX_SETTING_ITEMS {
+            return Err(too_many(items).into());
+        }
         let items = value
             .try_iter()?
-            .map(|item| py_to_toml(&item?, name))
+            .map(|item| to_toml_at(&item?, name, depth + 1))
             .collect::<PyResult<Vec<_>>>()?;
         return Ok(toml::Value::Array(items));
     }
     if value.hasattr("__fspath__")? {
         let os = value.py().import("os")?;
-        return py_to_toml(&os.call_method1("fspath", (value,))?, name);
+        return to_toml_at(&os.call_method1("fspath", (value,))?, name, depth);
     }
     // numpy arrays and scalars (float32, int64, ...) become Python lists and numbers.
     if value.hasattr("tolist")? {
+        if let Ok(size) = value.getattr("size").and_then(|s| s.extract::<usize>())
+            && size > MAX_SETTING_ITEMS
+        {
+            return Err(too_many(size).into());
+        }
         let plain = value.call_method0("tolist")?;
         if plain.cast::<PyList>().is_ok()
             || plain.cast::<PyFloat>().is_ok()
             || plain.cast::<PyInt>().is_ok()
         {
-            return py_to_toml(&plain, name);
+            return to_toml_at(&plain, name, depth);
         }
     }
     Err(Error::input(format!(

@@ -100,7 +100,16 @@ def test_settings_are_checked_with_the_library_messages():
         scenario.colour
     with pytest.raises(hrm.InvalidInput, match="cannot be set to a object"):
         scenario.duration = object()
-    assert scenario.duration == 5.5  # refused writes change nothing
+    # Hostile values are refused before they are converted: deep nesting, huge lists.
+    deep = []
+    for _ in range(100_000):
+        deep = [deep]
+    with pytest.raises(hrm.InvalidInput, match="arm.lengths is nested more than 16 levels deep"):
+        scenario.arm.lengths = deep
+    for huge in ([0.1] * (2**20 + 1), np.full(2**20 + 1, 0.1)):
+        with pytest.raises(hrm.InvalidInput, match="has 1048577 items, more than the 1048576"):
+            scenario.arm.lengths = huge
+    assert scenario.duration == 5.5 and scenario.arm.lengths is None  # refused writes change nothing
     # Domains are checked when the scenario is run, with the messages of `hrm simulate`.
     scenario.duration = -1.0
     with pytest.raises(hrm.InvalidInput, match="duration must be positive and finite, got -1"):
