@@ -4,7 +4,7 @@
 use crate::output_dir::OutputDir;
 use crate::{console, figures, progress, report};
 use serde_json::json;
-use sim_core::study::{self, ComparisonRun as Outcome, Stopped, run_one};
+use sim_core::study::{self, ComparisonRun as Outcome, run_one};
 use sim_core::{ControllerKind, ReferenceSpec, Run, Scenario};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -216,26 +216,10 @@ fn outcome_json(outcome: &Outcome) -> serde_json::Value {
 /// and the time it `stopped_at_s`.
 fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    let (run, summary) = match &outcome.result {
-        Ok(run) => (
-            Some(run),
-            serde_json::to_value(&run.summary).map_err(|e| e.to_string())?,
-        ),
-        Err(Stopped {
-            error,
-            partial: None,
-        }) => (None, json!({ "error": error })),
-        Err(Stopped {
-            error,
-            partial: Some(run),
-        }) => {
-            let mut summary = serde_json::to_value(&run.summary).map_err(|e| e.to_string())?;
-            if let Some(fields) = summary.as_object_mut() {
-                fields.insert("error".into(), json!(error));
-                fields.insert("stopped_at_s".into(), json!(run.summary.simulated_s));
-            }
-            (Some(run), summary)
-        }
+    let summary = sim_core::summary_json::run(&outcome.result);
+    let run = match &outcome.result {
+        Ok(run) => Some(run),
+        Err(stopped) => stopped.partial.as_ref(),
     };
     write(&dir.join("summary.json"), &pretty(&summary)?)?;
     if let Some(run) = run {

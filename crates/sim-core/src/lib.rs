@@ -43,6 +43,7 @@ pub mod reference;
 mod scenario;
 mod simulation;
 pub mod study;
+pub mod summary_json;
 
 /// The most modal coordinates a loop may have: `2K + 1` for the most harmonics a modal map may
 /// have ([`backbone_kin::MAX_HARMONICS`]).

@@ -5,7 +5,7 @@ use super::controllers::ControllerSetup;
 use super::schema::{
     Alpha0, ArmSpec, BranchSpec, IntegratorSpec, ReferenceSpec, Scenario, TorqueLimit,
 };
-use crate::controller::ModalState;
+use crate::controller::{Controller, ModalState};
 use crate::error::SimError;
 use crate::ode::Tolerances;
 use crate::reference::{CartesianPath, PathShape, Reference, Sinusoid, Step};
@@ -50,6 +50,31 @@ impl Scenario {
     /// `.fis` file if any. Errors name the setting that failed; the loop's own limits are
     /// [`Simulation::new`]'s.
     pub fn build(&self) -> Result<Simulation, SimError> {
+        self.assemble(|model, period| {
+            ControllerSetup {
+                spec: &self.controller,
+                model,
+                period,
+            }
+            .build()
+        })
+    }
+
+    /// Builds the simulation as [`build`](Self::build) does, but closed by `controller` (a
+    /// controller written elsewhere, e.g. in Python) instead of the one `controller.kind` names;
+    /// `controller.period` still sets its sampling, and the other `[controller]` keys are unused.
+    pub fn build_with_controller(
+        &self,
+        controller: Box<dyn Controller>,
+    ) -> Result<Simulation, SimError> {
+        self.assemble(|_, _| Ok(controller))
+    }
+
+    /// The simulation closed by the controller `controller(model, period)` makes.
+    fn assemble(
+        &self,
+        controller: impl FnOnce(&ReducedModel, f64) -> Result<Box<dyn Controller>, SimError>,
+    ) -> Result<Simulation, SimError> {
         let model = self.model()?;
         let m = model.n_coords();
         let reference = self.reference.build(
@@ -68,12 +93,7 @@ impl Scenario {
                 ));
             }
         };
-        let controller = ControllerSetup {
-            spec: &self.controller,
-            model: &model,
-            period,
-        }
-        .build()?;
+        let controller = controller(&model, period)?;
         let mut settings = LoopSettings::new(self.integrator.build(), period, self.duration);
         settings.record_period = self.record_period.unwrap_or(period);
         settings.seed = self.seed;
