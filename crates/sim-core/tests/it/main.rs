@@ -1,7 +1,8 @@
 //! The integration tests of sim-core, one binary: a module per `src` module it tests (`ode`,
 //! `reference`, `controller`, `optimal`), the closed loop (`closed_loop`, `energy`, `replay` on
 //! the full chain, `long_runs`, `paper_pinned` for the paper's figures), `scenario_fuzz` for
-//! scenario files, `bad_input` for every refusal and `allocation` for the allocation-free loop.
+//! scenario files, `scenario_controller` for a scenario closed by an outside controller,
+//! `bad_input` for every refusal and `allocation` for the allocation-free loop.
 
 // Counts each thread's allocations; the allocation tests measure their own thread only, so the
 // other tests of this binary may run in parallel.
@@ -19,4 +20,5 @@ mod optimal;
 mod paper_pinned;
 mod reference;
 mod replay;
+mod scenario_controller;
 mod scenario_fuzz;
