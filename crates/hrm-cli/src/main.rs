@@ -8,6 +8,7 @@ mod experiment;
 mod figures;
 mod fis_cmd;
 mod fis_export;
+mod fis_imitate;
 mod fis_train;
 mod output_dir;
 mod plot;

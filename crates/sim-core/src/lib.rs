@@ -11,7 +11,8 @@
 //!
 //! Experiments are [`Scenario`]s, TOML files; the paper's are shipped with the crate
 //! ([`Scenario::builtin_names`]): `paper-tracking` (Figures 10-11) and the
-//! `paper-responses-{step,sine,noise}` responses (Figure 9).
+//! `paper-responses-{step,sine,noise}` responses (Figure 9). [`imitation`] learns a fuzzy
+//! controller from a better teacher (computed torque) on such scenarios.
 //!
 //! ```
 //! use sim_core::{ControllerKind, Scenario};
@@ -34,6 +35,7 @@ pub struct ReadmeDoctests;
 
 pub mod controller;
 mod error;
+pub mod imitation;
 mod input_file;
 mod noise;
 pub mod ode;

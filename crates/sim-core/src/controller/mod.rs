@@ -37,6 +37,7 @@ mod pd;
 
 pub use computed_torque::ComputedTorque;
 pub use fuzzy::FuzzyController;
+pub(crate) use fuzzy::{SCHEDULED_INPUTS_PER_COORDINATE, scheduled_inputs};
 pub use pd::PdController;
 
 use crate::error::SimError;
