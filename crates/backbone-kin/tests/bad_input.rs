@@ -129,8 +129,11 @@ fn link_lengths_overflowing_their_sum() {
 fn non_finite_joint_angle() {
     let mut points = [[SENTINEL; 2]; 3];
     let err = joint_positions(&[0.1; 2], &[0.0, f64::NAN], &mut points).unwrap_err();
-    assert!(matches!(err, KinError::NonFinite { name: "joint angles", value } if value.is_nan()));
-    assert_eq!(err.to_string(), "joint angles must be finite, got NaN");
+    assert!(matches!(
+        err,
+        KinError::NonFinite { name: "joint angles", index: Some(1), value } if value.is_nan()
+    ));
+    assert_eq!(err.to_string(), "joint angles[1] must be finite, got NaN");
     assert_eq!(points, [[SENTINEL; 2]; 3]);
 }
 
@@ -142,7 +145,7 @@ fn mismatched_joint_angles() {
         KinError::Dimension {
             name: "joint angles",
             expected: 3,
-            got: 2
+            found: 2
         }
     );
 }
@@ -156,7 +159,7 @@ fn output_buffer_of_wrong_size() {
         KinError::Dimension {
             name: "joint positions",
             expected: 4,
-            got: 3
+            found: 3
         }
     ));
     assert_eq!(points, [[SENTINEL; 2]; 3]);
@@ -167,7 +170,7 @@ fn output_buffer_of_wrong_size() {
         Err(KinError::Dimension {
             name: "joint output",
             expected: 10,
-            got: 9
+            found: 9
         })
     ));
     assert_eq!(theta, [SENTINEL; 9]);
@@ -341,7 +344,7 @@ fn numerical_ik_guess_of_wrong_size() {
         Err(KinError::Dimension {
             name: "initial guess",
             expected: 4,
-            got: 3
+            found: 3
         })
     ));
     assert_eq!(a, [SENTINEL; 3]);

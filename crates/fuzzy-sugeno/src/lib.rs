@@ -49,7 +49,7 @@ pub struct ReadmeDoctests;
 
 pub use analysis::{AnalysisOptions, AnalysisReport};
 pub use builder::SystemBuilder;
-pub use error::FuzzyError;
+pub use error::{FuzzyError, SystemProblem};
 pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange};
 pub use export_c::CSource;
 pub use fis::FisNote;

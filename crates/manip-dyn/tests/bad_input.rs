@@ -170,7 +170,7 @@ fn input_of_wrong_length() {
         DynError::Dimension {
             name: "q",
             expected: 3,
-            got: 2
+            found: 2
         }
     );
     assert_eq!(err.to_string(), "q has 2 entries, expected 3");
@@ -188,7 +188,7 @@ fn output_of_wrong_length() {
         DynError::Dimension {
             name: "qdd",
             expected: 3,
-            got: 4
+            found: 4
         }
     ));
     assert_eq!(qdd, [SENTINEL; 4]);
@@ -205,7 +205,7 @@ fn matrix_output_of_wrong_shape() {
         DynError::Dimension {
             name: "out (columns)",
             expected: 3,
-            got: 4
+            found: 4
         }
     ));
     assert!((0..3).all(|i| (0..4).all(|j| m[(i, j)] == SENTINEL)));
@@ -247,7 +247,7 @@ fn workspace_of_another_chain() {
         err,
         DynError::Dimension {
             expected: 3,
-            got: 5,
+            found: 5,
             ..
         }
     ));

@@ -148,13 +148,13 @@ fn wrong_input_lengths_are_refused() {
     let mut data = ChainData::new(&arm);
     for algorithm in &ALGORITHMS {
         for &input in algorithm.inputs {
-            for got in [0, N - 1, N + 1] {
+            for found in [0, N - 1, N + 1] {
                 let mut args = Args::new(N);
-                args.input(input).resize(got, 0.1);
+                args.input(input).resize(found, 0.1);
                 let expected = DynError::Dimension {
                     name: input,
                     expected: N,
-                    got,
+                    found,
                 };
                 assert_eq!(
                     (algorithm.call)(&arm, &mut data, &mut args),
@@ -198,13 +198,13 @@ fn wrong_output_sizes_are_refused() {
     let mut data = ChainData::new(&arm);
     for algorithm in &ALGORITHMS {
         if let Some(output) = algorithm.output {
-            for got in [0, N + 1] {
+            for found in [0, N + 1] {
                 let mut args = Args::new(N);
-                args.out.resize(got, 0.0);
+                args.out.resize(found, 0.0);
                 let expected = DynError::Dimension {
                     name: output,
                     expected: N,
-                    got,
+                    found,
                 };
                 assert_eq!(
                     (algorithm.call)(&arm, &mut data, &mut args),
@@ -222,7 +222,7 @@ fn wrong_output_sizes_are_refused() {
                     DynError::Dimension {
                         name: "out (rows)",
                         expected: N,
-                        got: N + 1,
+                        found: N + 1,
                     },
                 ),
                 (
@@ -231,7 +231,7 @@ fn wrong_output_sizes_are_refused() {
                     DynError::Dimension {
                         name: "out (columns)",
                         expected: N,
-                        got: N - 1,
+                        found: N - 1,
                     },
                 ),
             ];
@@ -259,10 +259,10 @@ fn a_workspace_of_another_chain_is_refused() {
             Err(DynError::Dimension {
                 name,
                 expected: N,
-                got,
+                found,
             }) => {
                 assert!(name.starts_with("data"), "{}: {name}", algorithm.name);
-                assert_eq!(got, N + 2);
+                assert_eq!(found, N + 2);
             }
             other => panic!("{}: {other:?}", algorithm.name),
         }
@@ -306,6 +306,8 @@ fn overflow_is_reported_not_returned() {
             matches!(result, Err(DynError::NonFiniteResult { .. })),
             "{name}: {result:?}"
         );
+        let error = result.unwrap_err();
+        assert!(error.is_numerical() && !error.is_invalid_input(), "{name}");
     }
     let mut args = Args::new(2);
     assert_eq!(
@@ -337,6 +339,7 @@ fn a_numerically_singular_mass_matrix_is_reported() {
         forward_dynamics(&arm, &mut data, &zero, &zero, &zero, &mut qdd),
         Err(DynError::NotPositiveDefinite)
     );
+    assert!(DynError::NotPositiveDefinite.is_numerical());
     // The same arm still has a well-defined mass matrix and inverse dynamics.
     let mut m = Mat::zeros(2, 2);
     assert_eq!(mass_matrix(&arm, &mut data, &zero, m.as_mut()), Ok(()));

@@ -153,7 +153,7 @@ fn state_of_wrong_length() {
         ReduceError::Dimension {
             name: "a",
             expected: 3,
-            got: 2
+            found: 2
         }
     ));
     assert_eq!(a_ddot, [SENTINEL; 3]);
@@ -170,7 +170,7 @@ fn output_of_wrong_length() {
         err,
         ReduceError::Dimension {
             expected: 10,
-            got: 9,
+            found: 9,
             ..
         }
     ));

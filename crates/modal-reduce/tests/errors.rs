@@ -77,10 +77,10 @@ fn wrong_sizes_are_refused() {
     let model = paper();
     let mut data = ReducedData::new(&model);
     let (ok, short, mut out, mut out_short) = ([0.1; 3], [0.1; 2], [0.0; 3], [0.0; 2]);
-    let dim = |name: &'static str, expected: usize, got: usize| ReduceError::Dimension {
+    let dim = |name: &'static str, expected: usize, found: usize| ReduceError::Dimension {
         name,
         expected,
-        got,
+        found,
     };
     assert_eq!(
         reduced_terms(&model, &mut data, &short, &ok),
@@ -254,6 +254,7 @@ fn overflow_is_an_error_not_a_nan() {
         matches!(error, ReduceError::NonFiniteResult { name: "a_ddot" }),
         "{error:?}"
     );
+    assert!(error.is_numerical() && !error.is_invalid_input() && !error.is_unreachable());
     let mut tau = [0.0; 10];
     let error = joint_torques(
         &model,
@@ -304,4 +305,22 @@ fn jacobi_settings_are_checked() {
             "{error:?}"
         );
     }
+}
+
+#[test]
+fn wrapped_errors_keep_their_class() {
+    let numerical = ReduceError::Dyn(manip_dyn::DynError::NotPositiveDefinite);
+    assert!(numerical.is_numerical() && !numerical.is_invalid_input());
+    let unreachable = ReduceError::Kin(backbone_kin::KinError::OutOfReach {
+        r: 2.0,
+        length: 1.0,
+    });
+    assert!(unreachable.is_unreachable() && !unreachable.is_numerical());
+    assert!(!unreachable.is_invalid_input());
+    let input = ReduceError::Dyn(manip_dyn::DynError::NoLinks);
+    assert!(input.is_invalid_input() && !input.is_numerical() && !input.is_unreachable());
+    let diverged = ReduceError::JacobiDiverged {
+        spectral_radius: 1.5,
+    };
+    assert!(diverged.is_numerical());
 }

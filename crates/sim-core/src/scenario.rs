@@ -92,6 +92,7 @@ const BUILTIN: &[(&str, &str)] = &[
 
 /// Why a scenario could not be read.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum ScenarioError {
     /// The file could not be read.
     #[error("cannot read scenario file {path}: {message}")]

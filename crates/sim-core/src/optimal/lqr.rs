@@ -68,7 +68,7 @@ impl Lqr {
                 return Err(OptimalError::Dimension {
                     name,
                     expected: size * size,
-                    got: values.len(),
+                    found: values.len(),
                 });
             }
             for i in 0..size {
@@ -119,7 +119,7 @@ impl Lqr {
             return Err(OptimalError::Dimension {
                 name: "linearisation coordinates",
                 expected: self.m,
-                got: linearisation.n_coords(),
+                found: linearisation.n_coords(),
             });
         }
         if !(settings.tolerance.is_finite() && settings.tolerance > 0.0) {
@@ -222,17 +222,17 @@ impl Lqr {
         u: &mut [f64],
     ) -> Result<(), OptimalError> {
         let (m, n) = (self.m, 2 * self.m);
-        for (name, got, expected) in [
+        for (name, found, expected) in [
             ("u_ref", u_ref.len(), m),
             ("x", x.len(), n),
             ("x_ref", x_ref.len(), n),
             ("u", u.len(), m),
         ] {
-            if got != expected {
+            if found != expected {
                 return Err(OptimalError::Dimension {
                     name,
                     expected,
-                    got,
+                    found,
                 });
             }
         }
