@@ -972,6 +972,22 @@ mod tests {
     }
 
     #[test]
+    fn an_overflowing_result_is_numerical_in_every_dynamics_op() {
+        // Finite inputs whose result overflows: the library's NonFiniteResult, classified by
+        // its is_numerical(), for the full chain and for the reduced model alike.
+        for line in [
+            json!({"op": "dynamics", "theta": vec![0.1; 10], "theta_dot": vec![1e200; 10]}),
+            json!({"op": "reduced", "a": [0.1, 0.2, 0.3], "a_dot": [1e200, 1e200, 1e200],
+                "tau_star": [0.0, 0.0, 0.0]}),
+        ] {
+            let answer = request(line);
+            assert_eq!(answer["error"]["kind"], "numerical", "{answer}");
+            let message = answer["error"]["message"].as_str().unwrap();
+            assert!(message.contains("not finite"), "{answer}");
+        }
+    }
+
+    #[test]
     fn a_huge_alpha0_gives_the_answer_of_its_angle() {
         // alpha0 only turns the whole arm: every tip is the alpha0 = 0 tip rotated by
         // (cos alpha0, sin alpha0), whose argument reduction libm does exactly.
