@@ -4,8 +4,8 @@ use backbone_kin::{BaseAngle, ModalMap};
 use manip_dyn::ChainModel;
 use modal_reduce::{
     JacobiSettings, ReduceError, ReducedData, ReducedModel, forward_dynamics,
-    forward_dynamics_faer, jacobi_forward_dynamics, joint_torques, kinetic_energy,
-    potential_energy, project_torques, reduced_terms, reduced_terms_faer,
+    forward_dynamics_by_projection, jacobi_forward_dynamics, joint_torques, kinetic_energy,
+    potential_energy, project_torques, reduced_terms, reduced_terms_by_projection,
 };
 
 fn paper() -> ReducedModel {
@@ -87,7 +87,7 @@ fn wrong_sizes_are_refused() {
         Err(dim("a", 3, 2))
     );
     assert_eq!(
-        reduced_terms_faer(&model, &mut data, &ok, &short),
+        reduced_terms_by_projection(&model, &mut data, &ok, &short),
         Err(dim("a_dot", 3, 2))
     );
     assert_eq!(
@@ -95,7 +95,7 @@ fn wrong_sizes_are_refused() {
         Err(dim("tau_star", 3, 2))
     );
     assert_eq!(
-        forward_dynamics_faer(&model, &mut data, &ok, &ok, &ok, &mut out_short),
+        forward_dynamics_by_projection(&model, &mut data, &ok, &ok, &ok, &mut out_short),
         Err(dim("a_ddot", 3, 2))
     );
     let mut tau = [0.0; 9];
@@ -182,7 +182,7 @@ fn non_finite_inputs_are_refused() {
         ),
         "{error:?}"
     );
-    let error = forward_dynamics_faer(
+    let error = forward_dynamics_by_projection(
         &model,
         &mut data,
         &[0.0; 3],
