@@ -289,10 +289,10 @@ fn table_rows(outcomes: &[Outcome]) -> Vec<report::Row> {
                     cells.extend([
                         format!("{:.4}", m.tip_error_rms_m * 1e3),
                         format!("{:.4}", m.tip_error_max_m * 1e3),
-                        list(&m.modal_error_rms, |v| format!("{v:.2e}")),
-                        list(&m.peak_modal_torque, |v| format!("{v:.2}")),
+                        list(&m.modal_error_rms_rad, |v| format!("{v:.2e}")),
+                        list(&m.peak_modal_torques_nm, |v| format!("{v:.2}")),
                         format!("{:.3}", m.peak_joint_torque_nm),
-                        format!("{:.4e}", m.control_effort),
+                        format!("{:.4e}", m.control_effort_n2m2s),
                     ]);
                     report::Row { cells, error: None }
                 }
@@ -370,8 +370,8 @@ mod tests {
         for key in [
             "tip_error_rms_m",
             "tip_error_max_m",
-            "modal_error_rms",
-            "peak_modal_torque",
+            "modal_error_rms_rad",
+            "peak_modal_torques_nm",
             "peak_joint_torque_nm",
             "steps",
         ] {
