@@ -177,8 +177,8 @@ fn link_terms(
     }
     // From the base: absolute accelerations (needed by E before the sweep from the tip).
     let mut alpha = 0.0;
-    for (accel, &a) in terms.accel.iter_mut().zip(qdd) {
-        alpha += a;
+    for (accel, &qdd_i) in terms.accel.iter_mut().zip(qdd) {
+        alpha += qdd_i;
         *accel = alpha;
     }
     for j in (0..n).rev() {

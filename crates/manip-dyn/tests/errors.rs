@@ -7,7 +7,7 @@ use manip_dyn::{
     gravity, kinetic_energy, mass_matrix, nonlinear_effects, potential_energy, rnea,
 };
 
-/// Arguments of one call; `third` is `a` for RNEA and `tau` for forward dynamics.
+/// Arguments of one call; `third` is `qdd` for RNEA and `tau` for forward dynamics.
 struct Args {
     q: Vec<f64>,
     v: Vec<f64>,
@@ -52,7 +52,7 @@ const ALGORITHMS: [Algorithm; 10] = [
     Algorithm {
         name: "rnea",
         call: |m, d, x| rnea(m, d, &x.q, &x.v, &x.third, &mut x.out),
-        inputs: &["q", "v", "a"],
+        inputs: &["q", "v", "qdd"],
         output: Some("tau"),
         matrix_output: false,
     },
