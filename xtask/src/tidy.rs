@@ -2,7 +2,8 @@
 //! remember, checked by machine. `cargo xtask ci` runs it before the tests.
 //!
 //! - Every test that `docs/bad-input.md` names exists: each `` `crate/path.rs::name` `` (also
-//!   `::module::name` and `::{a, b}`) points at a file that defines `fn name`.
+//!   `::module::name`, `::{a, b}`, and `::tests::*` for every test of a file) points at a file
+//!   that defines `fn name`.
 //! - Every crate's README is its crate documentation (`#![doc = include_str!("../README.md")]`
 //!   in `src/lib.rs` or `src/main.rs`), so its Rust blocks are doctests.
 //! - No README cites a file outside the repository: a relative link or a quoted path
@@ -183,8 +184,12 @@ pub fn test_references(text: &str) -> Vec<TestReference> {
     references
 }
 
-/// Whether `source` defines a function `name` (`fn name(` or `fn name<`).
+/// Whether `source` defines a function `name` (`fn name(` or `fn name<`); the name `*` (every
+/// test of a module) asks for at least one `#[test]`.
 pub fn defines_fn(source: &str, name: &str) -> bool {
+    if name == "*" {
+        return source.contains("#[test]");
+    }
     source.match_indices("fn ").any(|(at, _)| {
         let rest = source[at + 3..].trim_start();
         rest.strip_prefix(name)
@@ -448,6 +453,8 @@ mod tests {
         assert!(!defines_fn(source, "absent"));
         assert!(!defines_fn(source, "present_too"));
         assert!(!defines_fn("fn unpresent() {}", "present"));
+        assert!(defines_fn(source, "*"));
+        assert!(!defines_fn("fn helper() {}", "*"));
     }
 
     #[test]
