@@ -2,7 +2,7 @@
 //!
 //! - `ci`: what `.ci/run` runs: formatting, clippy with `-D warnings`, `tidy`, `test`, and a
 //!   compile-only pass over the benches.
-//! - `tidy`: the repository's rules checked by machine ([`tidy`]): the tests `docs/bad-input.md`
+//! - `tidy`: the repository's rules checked by machine ([`mod@tidy`]): the tests `docs/bad-input.md`
 //!   names exist, crate READMEs are crate docs, no README cites a file outside the repository,
 //!   invariants of `docs/architecture.md`, and `cargo doc` without warnings.
 //! - `test`: the whole Rust test suite, the `hrm` crate's `custom_controller` example, then the
@@ -60,7 +60,7 @@ fn ci() -> Result<(), String> {
     cargo(&["test", "--workspace", "--benches", "--no-run"], &[])
 }
 
-/// The repository's rules ([`tidy`]); every problem is printed, then the command fails.
+/// The repository's rules ([`mod@tidy`]); every problem is printed, then the command fails.
 fn tidy() -> Result<(), String> {
     let problems = tidy::run(&workspace_root(), || {
         cargo(

@@ -172,7 +172,7 @@ impl ShardFile {
             .map_err(|e| e.to_string())
     }
 
-    /// Reads a shard file (at most [`MAX_SHARD_FILE_BYTES`]).
+    /// Reads a shard file (at most `MAX_SHARD_FILE_BYTES`, 1 GiB).
     pub fn read(path: &Path) -> Result<Self, String> {
         let text = crate::read_text_file(path, MAX_SHARD_FILE_BYTES)
             .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
