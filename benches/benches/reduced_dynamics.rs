@@ -1,13 +1,13 @@
 //! Reduced forward dynamics with the paper's three coordinates `(a1, a2, alpha0)`: `M*`, `C*`,
 //! `G*` and the Cholesky solve of eq 15, by the default `O(n m^2)` modal recursion
 //! (`reduced_fd/n`) and by projecting the full chain's `M`, `C`, `G` with faer
-//! (`reduced_fd_faer/n`, `O(n^2 m)`). Arms of `n` equal links with total length 1 m, mass 1 kg.
+//! (`reduced_fd_projection/n`, `O(n^2 m)`). Arms of `n` equal links with total length 1 m, mass 1 kg.
 //! `reduced_fd/10_k2`: the 10-link arm with two harmonics and `alpha0` fixed (`m = 4`).
 
 use backbone_kin::{BaseAngle, ModalMap};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use manip_dyn::ChainModel;
-use modal_reduce::{ReducedData, ReducedModel, forward_dynamics, forward_dynamics_faer};
+use modal_reduce::{ReducedData, ReducedModel, forward_dynamics, forward_dynamics_by_projection};
 use std::hint::black_box;
 
 const SIZES: [usize; 3] = [10, 100, 1000];
@@ -92,10 +92,15 @@ fn reduced_fd_k2(c: &mut Criterion) {
     group.finish();
 }
 
-fn reduced_fd_faer(c: &mut Criterion) {
+fn reduced_fd_projection(c: &mut Criterion) {
     // Milliseconds per call at n = 1000: fewer samples keep the run short.
-    bench_group(c, "reduced_fd_faer", forward_dynamics_faer, 20);
+    bench_group(
+        c,
+        "reduced_fd_projection",
+        forward_dynamics_by_projection,
+        20,
+    );
 }
 
-criterion_group!(benches, reduced_fd, reduced_fd_k2, reduced_fd_faer);
+criterion_group!(benches, reduced_fd, reduced_fd_k2, reduced_fd_projection);
 criterion_main!(benches);

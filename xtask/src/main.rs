@@ -1,7 +1,10 @@
 //! Project automation in the cargo-xtask pattern: `cargo xtask <command>`.
 //!
-//! - `ci`: what `.ci/run` runs: formatting, clippy with `-D warnings`, `test`, and a compile-only
-//!   pass over the benches.
+//! - `ci`: what `.ci/run` runs: formatting, clippy with `-D warnings`, `tidy`, `test`, and a
+//!   compile-only pass over the benches.
+//! - `tidy`: the repository's rules checked by machine ([`mod@tidy`]): the tests `docs/bad-input.md`
+//!   names exist, crate READMEs are crate docs, no README cites a file outside the repository,
+//!   invariants of `docs/architecture.md`, and `cargo doc` without warnings.
 //! - `test`: the whole Rust test suite, the `hrm` crate's `custom_controller` example, then the
 //!   Python package: a virtual environment under `target/python-venv` with numpy, pytest, maturin
 //!   and Pinocchio (`pin`) from PyPI, the extension built once in release mode and installed by
@@ -12,6 +15,8 @@
 //! - `bench [FILTER]`: the Criterion benches, then `target/bench-summary.json` (bench id -> median
 //!   nanoseconds per iteration) printed as a table.
 
+mod tidy;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
@@ -20,6 +25,7 @@ fn main() -> ExitCode {
     let result = match args.first().map(String::as_str) {
         Some("ci") => ci(),
         Some("test") => test(),
+        Some("tidy") => tidy(),
         Some("props") => props(&args[1..]),
         Some("bench") => bench(&args[1..]),
         _ => Err(USAGE.to_string()),
@@ -33,7 +39,7 @@ fn main() -> ExitCode {
     }
 }
 
-const USAGE: &str = "usage: cargo xtask ci | test | props [--cases N] | bench [FILTER]";
+const USAGE: &str = "usage: cargo xtask ci | test | tidy | props [--cases N] | bench [FILTER]";
 
 fn ci() -> Result<(), String> {
     cargo(&["fmt", "--all", "--", "--check"], &[])?;
@@ -48,9 +54,27 @@ fn ci() -> Result<(), String> {
         ],
         &[],
     )?;
+    tidy()?;
     test()?;
     // Benches are compiled, never run, in CI.
     cargo(&["test", "--workspace", "--benches", "--no-run"], &[])
+}
+
+/// The repository's rules ([`mod@tidy`]); every problem is printed, then the command fails.
+fn tidy() -> Result<(), String> {
+    let problems = tidy::run(&workspace_root(), || {
+        cargo(
+            &["doc", "--workspace", "--no-deps"],
+            &[("RUSTDOCFLAGS", "-D warnings")],
+        )
+    });
+    for problem in &problems {
+        eprintln!("tidy: {problem}");
+    }
+    match problems.len() {
+        0 => Ok(()),
+        n => Err(format!("tidy found {n} problem(s)")),
+    }
 }
 
 /// The Rust tests, then the Python package's tests and examples in a virtual environment under

@@ -34,8 +34,8 @@ const MAX_STEPS: usize = 64;
 ///
 /// ```
 /// use backbone_kin::{inverse_j0, J0_FIRST_ZERO};
-/// let a = inverse_j0(0.5)?;
-/// assert!((libm::j0(a) - 0.5).abs() < 1e-15);
+/// let amplitude = inverse_j0(0.5)?;
+/// assert!((libm::j0(amplitude) - 0.5).abs() < 1e-15);
 /// assert_eq!(inverse_j0(1.0)?, 0.0);
 /// assert_eq!(inverse_j0(0.0)?, J0_FIRST_ZERO);
 /// assert!(inverse_j0(1.5).is_err());
@@ -67,35 +67,37 @@ pub fn inverse_j0(value: f64) -> Result<f64, KinError> {
 /// with `J0(lo) >= value >= J0(hi)` and bisecting whenever a Newton step would leave it.
 fn newton_bisection(value: f64, start: f64) -> f64 {
     let (mut lo, mut hi) = (0.0, J0_FIRST_ZERO);
-    let mut a = start;
-    let mut best = (f64::INFINITY, a);
+    let mut amplitude = start;
+    let mut best = (f64::INFINITY, amplitude);
     for _ in 0..MAX_STEPS {
-        let g = libm::j0(a) - value;
+        let g = libm::j0(amplitude) - value;
         if g.abs() < best.0 {
-            best = (g.abs(), a);
+            best = (g.abs(), amplitude);
         }
         if g == 0.0 {
             break;
         }
         if g > 0.0 {
-            lo = a;
+            lo = amplitude;
         } else {
-            hi = a;
+            hi = amplitude;
         }
-        let newton = a + g / libm::j1(a);
+        let newton = amplitude + g / libm::j1(amplitude);
         let next = if newton > lo && newton < hi {
             newton
         } else {
             0.5 * (lo + hi)
         };
-        if (next - a).abs() <= 2.0 * f64::EPSILON * a || hi - lo <= 2.0 * f64::EPSILON * hi {
+        if (next - amplitude).abs() <= 2.0 * f64::EPSILON * amplitude
+            || hi - lo <= 2.0 * f64::EPSILON * hi
+        {
             let g_next = (libm::j0(next) - value).abs();
             if g_next < best.0 {
                 best = (g_next, next);
             }
             break;
         }
-        a = next;
+        amplitude = next;
     }
     best.1
 }
@@ -131,8 +133,11 @@ mod tests {
     #[test]
     fn bisection_rescues_a_bad_start() {
         for start in [0.0, 1e-300, J0_FIRST_ZERO, 0.5] {
-            let a = newton_bisection(0.3, start);
-            assert!((libm::j0(a) - 0.3).abs() < 1e-15, "start {start}: {a}");
+            let amplitude = newton_bisection(0.3, start);
+            assert!(
+                (libm::j0(amplitude) - 0.3).abs() < 1e-15,
+                "start {start}: {amplitude}"
+            );
         }
     }
 }

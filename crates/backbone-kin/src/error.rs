@@ -3,15 +3,21 @@
 /// Why a kinematics computation was refused.
 ///
 /// Every variant names the condition that failed, so a caller (or the `hrm` command line) can
-/// print it as one readable line. [`KinError::is_unreachable`] groups the variants that mean "the
-/// backbone curve cannot reach this target".
+/// print it as one readable line. Three predicates sort the variants into the classes a caller
+/// acts on, exactly one of which holds for every error: [`KinError::is_unreachable`] ("the
+/// backbone curve cannot reach this target"), [`KinError::is_numerical`] (a numerical method
+/// failed on valid input) and [`KinError::is_invalid_input`] (everything else: the input is
+/// malformed or outside the model's domain).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum KinError {
     /// An input that must be a finite number was NaN or infinite.
-    #[error("{name} must be finite, got {value}")]
+    #[error("{name}{} must be finite, got {value}", Index(*index))]
     NonFinite {
         /// Which input.
         name: &'static str,
+        /// 0-based index of the first offending entry of a slice; `None` for a scalar input.
+        index: Option<usize>,
         /// The offending value.
         value: f64,
     },
@@ -42,14 +48,14 @@ pub enum KinError {
         max: usize,
     },
     /// A slice had the wrong number of entries.
-    #[error("{name} has {got} entries, expected {expected}")]
+    #[error("{name} has {found} entries, expected {expected}")]
     Dimension {
         /// Which input.
         name: &'static str,
         /// The length the computation needs.
         expected: usize,
         /// The length it got.
-        got: usize,
+        found: usize,
     },
     /// Modal coordinates of a curve must come in `(a_{2k-1}, a_{2k})` pairs, one per harmonic.
     #[error(
@@ -151,5 +157,29 @@ impl KinError {
             self,
             Self::OutOfReach { .. } | Self::AtBase { .. } | Self::A2ExceedsAmplitude { .. }
         )
+    }
+
+    /// Whether a numerical method failed on valid input: a numerical inverse kinematics that did
+    /// not reach its tolerance ([`NotConverged`](KinError::NotConverged)).
+    pub fn is_numerical(&self) -> bool {
+        matches!(self, Self::NotConverged { .. })
+    }
+
+    /// Whether the input was malformed or outside the model's domain: neither
+    /// [`is_unreachable`](Self::is_unreachable) nor [`is_numerical`](Self::is_numerical).
+    pub fn is_invalid_input(&self) -> bool {
+        !(self.is_unreachable() || self.is_numerical())
+    }
+}
+
+/// `[i]` after an input's name when the offending value is entry `i` of a slice.
+struct Index(Option<usize>);
+
+impl std::fmt::Display for Index {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            Some(index) => write!(f, "[{index}]"),
+            None => Ok(()),
+        }
     }
 }

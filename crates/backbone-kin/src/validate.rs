@@ -3,12 +3,16 @@
 
 use crate::error::KinError;
 
-/// Checks that `value` is finite.
+/// Checks that the scalar `value` is finite.
 pub(crate) fn check_finite(name: &'static str, value: f64) -> Result<(), KinError> {
     if value.is_finite() {
         Ok(())
     } else {
-        Err(KinError::NonFinite { name, value })
+        Err(KinError::NonFinite {
+            name,
+            index: None,
+            value,
+        })
     }
 }
 
@@ -54,27 +58,32 @@ pub(crate) fn check_len(
         return Err(KinError::Dimension {
             name,
             expected,
-            got: values.len(),
+            found: values.len(),
         });
     }
-    values
-        .iter()
-        .try_for_each(|&value| check_finite(name, value))
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(KinError::NonFinite {
+            name,
+            index: Some(index),
+            value: values[index],
+        }),
+        None => Ok(()),
+    }
 }
 
 /// Checks that an output buffer has room for exactly `expected` entries.
 pub(crate) fn check_output_len(
     name: &'static str,
-    got: usize,
+    found: usize,
     expected: usize,
 ) -> Result<(), KinError> {
-    if got == expected {
+    if found == expected {
         Ok(())
     } else {
         Err(KinError::Dimension {
             name,
             expected,
-            got,
+            found,
         })
     }
 }

@@ -179,16 +179,18 @@ impl FuzzySystem {
     /// ```
     pub fn analyze(&self, options: &AnalysisOptions) -> Result<AnalysisReport, FuzzyError> {
         if !(options.coverage > 0.0 && options.coverage <= 1.0) {
-            return Err(FuzzyError::Analysis(format!(
-                "coverage must lie in (0, 1], got {}",
-                options.coverage
-            )));
+            return Err(FuzzyError::AnalysisOption {
+                name: "coverage",
+                requirement: "lie in (0, 1]",
+                value: options.coverage,
+            });
         }
         if options.max_relative_jump.is_nan() || options.max_relative_jump <= 0.0 {
-            return Err(FuzzyError::Analysis(format!(
-                "max_relative_jump must be positive, got {}",
-                options.max_relative_jump
-            )));
+            return Err(FuzzyError::AnalysisOption {
+                name: "max_relative_jump",
+                requirement: "be positive",
+                value: options.max_relative_jump,
+            });
         }
         let names = Names {
             inputs: self.inputs().iter().map(|i| i.name.clone()).collect(),
@@ -397,10 +399,9 @@ fn grid_axes(
     }
     let mut low = 2;
     if !fits(&build(low)) {
-        return Err(FuzzyError::Analysis(format!(
-            "the completeness grid needs more than max_grid_points = {max_points} points even with \
-             2 samples per input; raise max_grid_points"
-        )));
+        return Err(FuzzyError::AnalysisGrid {
+            max_grid_points: max_points,
+        });
     }
     // `low` fits and `high` does not.
     while high - low > 1 {
@@ -773,9 +774,10 @@ mod tests {
             max_grid_points: 7,
             ..AnalysisOptions::default()
         });
-        assert!(
-            matches!(refused, Err(FuzzyError::Analysis(m)) if m.contains("max_grid_points = 7"))
-        );
+        assert!(matches!(
+            refused,
+            Err(FuzzyError::AnalysisGrid { max_grid_points: 7 })
+        ));
     }
 
     #[test]

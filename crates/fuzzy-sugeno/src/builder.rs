@@ -1,7 +1,7 @@
 //! A builder whose rules read like a rule table.
 
 use crate::AndMethod;
-use crate::error::FuzzyError;
+use crate::error::{FuzzyError, SystemProblem};
 use crate::membership::MembershipFn;
 use crate::system::{
     Antecedent, Connective, Defuzzification, FuzzySet, FuzzySystem, InputVariable, Methods,
@@ -178,9 +178,9 @@ impl SystemBuilder {
                     &self.inputs,
                     &self.outputs,
                 )
-                .map_err(|reason| FuzzyError::InvalidSystem {
+                .map_err(|problem| FuzzyError::InvalidSystem {
                     context: format!("rule {}", r + 1),
-                    reason,
+                    problem,
                 })?,
             });
         }
@@ -196,20 +196,18 @@ fn resolve(
     connective: Connective,
     inputs: &[InputVariable],
     outputs: &[OutputVariable],
-) -> Result<Rule, String> {
+) -> Result<Rule, SystemProblem> {
     if when.len() != inputs.len() {
-        return Err(format!(
-            "has {} antecedents for {} inputs",
-            when.len(),
-            inputs.len()
-        ));
+        return Err(SystemProblem::AntecedentCount {
+            expected: inputs.len(),
+            found: when.len(),
+        });
     }
     if then.len() != outputs.len() {
-        return Err(format!(
-            "has {} consequents for {} outputs",
-            then.len(),
-            outputs.len()
-        ));
+        return Err(SystemProblem::ConsequentCount {
+            expected: outputs.len(),
+            found: then.len(),
+        });
     }
     let antecedents = when
         .iter()
@@ -236,13 +234,13 @@ fn resolve(
                 return Ok(Antecedent::IsNot(k));
             }
             let names: Vec<&str> = input.sets.iter().map(|s| s.name.as_str()).collect();
-            Err(format!(
-                "input '{}' has no set '{token}' (its sets: {})",
-                input.name,
-                names.join(", ")
-            ))
+            Err(SystemProblem::UnknownSet {
+                input: input.name.clone(),
+                set: token.to_string(),
+                available: names.join(", "),
+            })
         })
-        .collect::<Result<Vec<_>, String>>()?;
+        .collect::<Result<Vec<_>, SystemProblem>>()?;
     let consequents = then
         .iter()
         .zip(outputs)
@@ -260,15 +258,15 @@ fn resolve(
                 Some(k) => Ok(Some(k)),
                 None => {
                     let names: Vec<&str> = output.terms.iter().map(|t| t.name.as_str()).collect();
-                    Err(format!(
-                        "output '{}' has no term '{token}' (its terms: {})",
-                        output.name,
-                        names.join(", ")
-                    ))
+                    Err(SystemProblem::UnknownTerm {
+                        output: output.name.clone(),
+                        term: token.to_string(),
+                        available: names.join(", "),
+                    })
                 }
             }
         })
-        .collect::<Result<Vec<_>, String>>()?;
+        .collect::<Result<Vec<_>, SystemProblem>>()?;
     Ok(Rule {
         antecedents,
         consequents,
@@ -283,8 +281,8 @@ fn unique_position<'a>(
     names: impl Iterator<Item = &'a str>,
     wanted: &str,
     variable: &str,
-    kind: &str,
-) -> Result<Option<usize>, String> {
+    kind: &'static str,
+) -> Result<Option<usize>, SystemProblem> {
     let matches: Vec<usize> = names
         .enumerate()
         .filter(|(_, name)| *name == wanted)
@@ -293,11 +291,13 @@ fn unique_position<'a>(
     match matches[..] {
         [] => Ok(None),
         [k] => Ok(Some(k)),
-        [first, second, ..] => Err(format!(
-            "'{variable}' has several {kind} named '{wanted}' ({} and {}); use an indexed rule",
-            first + 1,
-            second + 1
-        )),
+        [first, second, ..] => Err(SystemProblem::AmbiguousName {
+            variable: variable.to_string(),
+            kind,
+            name: wanted.to_string(),
+            first: first + 1,
+            second: second + 1,
+        }),
     }
 }
 

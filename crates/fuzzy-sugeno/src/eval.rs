@@ -44,6 +44,25 @@ pub struct EvalOptions {
     pub no_rule_fired: NoRuleFired,
 }
 
+impl EvalOptions {
+    /// Checks the options for a system of `n_outputs` outputs: [`NoRuleFired::Values`] must hold
+    /// one finite value per output.
+    pub(crate) fn check(&self, n_outputs: usize) -> Result<(), FuzzyError> {
+        if let NoRuleFired::Values(values) = &self.no_rule_fired {
+            if values.len() != n_outputs {
+                return Err(FuzzyError::FallbackCount {
+                    expected: n_outputs,
+                    found: values.len(),
+                });
+            }
+            if let Some(&value) = values.iter().find(|v| !v.is_finite()) {
+                return Err(FuzzyError::NonFiniteFallback { value });
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Evaluates a [`FuzzySystem`] with its own scratch space: after [`Evaluator::new`], evaluating
 /// allocates nothing. Clone it to evaluate on several threads.
 ///
@@ -100,20 +119,7 @@ impl Evaluator {
     /// An evaluator with the given options; fails if [`NoRuleFired::Values`] does not hold one
     /// finite value per output.
     pub fn with_options(system: FuzzySystem, options: EvalOptions) -> Result<Self, FuzzyError> {
-        if let NoRuleFired::Values(values) = &options.no_rule_fired {
-            let n = system.outputs().len();
-            if values.len() != n {
-                return Err(FuzzyError::InvalidOptions(format!(
-                    "no-rule-fired values have {} entries for {n} outputs",
-                    values.len()
-                )));
-            }
-            if let Some(v) = values.iter().find(|v| !v.is_finite()) {
-                return Err(FuzzyError::InvalidOptions(format!(
-                    "no-rule-fired values must be finite, got {v}"
-                )));
-            }
-        }
+        options.check(system.outputs().len())?;
         let mut evaluator = Self::new(system);
         evaluator.options = options;
         Ok(evaluator)
@@ -136,7 +142,7 @@ impl Evaluator {
         if outputs.len() != n_out {
             return Err(FuzzyError::OutputCount {
                 expected: n_out,
-                got: outputs.len(),
+                found: outputs.len(),
             });
         }
         self.fire(inputs)?;
@@ -158,7 +164,7 @@ impl Evaluator {
         if outputs.len() != rows * n_out {
             return Err(FuzzyError::OutputCount {
                 expected: rows * n_out,
-                got: outputs.len(),
+                found: outputs.len(),
             });
         }
         for (row, (x, y)) in inputs
@@ -223,7 +229,7 @@ impl Evaluator {
         if inputs.len() != variables.len() {
             return Err(FuzzyError::InputCount {
                 expected: variables.len(),
-                got: inputs.len(),
+                found: inputs.len(),
             });
         }
         for (index, ((slot, &value), variable)) in

@@ -53,14 +53,7 @@ impl FuzzySystem {
     /// ```
     pub fn to_c(&self, prefix: &str, options: &EvalOptions) -> Result<CSource, FuzzyError> {
         check_prefix(prefix)?;
-        if let NoRuleFired::Values(values) = &options.no_rule_fired
-            && (values.len() != self.outputs().len() || values.iter().any(|v| !v.is_finite()))
-        {
-            return Err(FuzzyError::Export(format!(
-                "no-rule-fired values must be {} finite numbers, got {values:?}",
-                self.outputs().len()
-            )));
-        }
+        options.check(self.outputs().len())?;
         Ok(CSource {
             header_name: format!("{prefix}.h"),
             header: header(self, prefix, options),
@@ -80,10 +73,10 @@ fn check_prefix(prefix: &str) -> Result<(), FuzzyError> {
         || prefix.len() > MAX_PREFIX
         || prefix.starts_with("__")
     {
-        return Err(FuzzyError::Export(format!(
-            "the prefix must be a C identifier of 1 to {MAX_PREFIX} ASCII letters, digits and \
-             underscores, not starting with a digit or two underscores; got {prefix:?}"
-        )));
+        return Err(FuzzyError::CPrefix {
+            prefix: prefix.to_string(),
+            max: MAX_PREFIX,
+        });
     }
     Ok(())
 }

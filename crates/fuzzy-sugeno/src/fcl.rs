@@ -39,14 +39,14 @@ impl FuzzySystem {
     /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
     /// ```
     pub fn to_fcl(&self) -> Result<String, FuzzyError> {
-        let identifier = |kind: &str, name: &str| {
+        let identifier = |kind: &'static str, name: &str| {
             if is_identifier(name) {
                 Ok(())
             } else {
-                Err(FuzzyError::Export(format!(
-                    "the {kind} name '{name}' is not an FCL identifier (letters, digits and _, \
-                     not starting with a digit, not a keyword)"
-                )))
+                Err(FuzzyError::FclName {
+                    kind,
+                    name: name.to_string(),
+                })
             }
         };
         identifier("system", self.name())?;

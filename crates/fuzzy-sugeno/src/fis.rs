@@ -328,7 +328,7 @@ impl<'a> Parser<'a> {
             }
         }
         let (line, name) = keys.string("Name")?;
-        check_name("system", name).map_err(|reason| error(line, reason))?;
+        check_name("system", name).map_err(|problem| error(line, problem.to_string()))?;
         if let Some((line, version)) = keys.find("Version")
             && !matches!(version.trim_matches('\''), "2.0" | "2")
         {
@@ -802,7 +802,7 @@ impl<'a> Keys<'a> {
             }
             let (name, kind, params) =
                 function(value).map_err(|m| error(line, format!("MF{k}: {m}")))?;
-            check_name("set", name).map_err(|m| error(line, m))?;
+            check_name("set", name).map_err(|problem| error(line, problem.to_string()))?;
             functions.push(FunctionLine {
                 line,
                 key: k,
@@ -863,7 +863,7 @@ fn variable_name<'a>(
     names: &mut Vec<(String, usize)>,
 ) -> Result<&'a str, FuzzyError> {
     let (line, name) = keys.string("Name")?;
-    check_name("variable", name).map_err(|m| error(line, m))?;
+    check_name("variable", name).map_err(|problem| error(line, problem.to_string()))?;
     if let Some((_, first)) = names.iter().find(|(n, _)| n == name) {
         return Err(error(
             line,

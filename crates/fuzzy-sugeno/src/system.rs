@@ -1,7 +1,7 @@
 //! A validated Takagi-Sugeno fuzzy system: variables, fuzzy sets, rules and inference methods
 //! (section 4 of the paper, eqs 19-21).
 
-use crate::error::FuzzyError;
+use crate::error::{FuzzyError, SystemProblem};
 use crate::eval::CompiledMf;
 use crate::membership::MembershipFn;
 
@@ -79,7 +79,7 @@ impl OutputFn {
                 if coefficients.len() != inputs.len() {
                     return Err(FuzzyError::InputCount {
                         expected: coefficients.len(),
-                        got: inputs.len(),
+                        found: inputs.len(),
                     });
                 }
                 Ok(affine(coefficients, *constant, inputs))
@@ -203,9 +203,9 @@ impl FuzzySystem {
         rules: Vec<Rule>,
         methods: Methods,
     ) -> Result<Self, FuzzyError> {
-        check_name("system", &name).map_err(|reason| invalid("system", reason))?;
+        check_name("system", &name).map_err(|problem| invalid("system", problem))?;
         if inputs.is_empty() || outputs.is_empty() {
-            return Err(invalid("system", "needs at least one input and one output"));
+            return Err(invalid("system", SystemProblem::NoVariables));
         }
         let mut variable_names: Vec<&str> = Vec::new();
         for input in &inputs {
@@ -217,10 +217,13 @@ impl FuzzySystem {
                 &mut variable_names,
                 VariableKind::Input,
             )
-            .map_err(|reason| invalid(&context, reason))?;
+            .map_err(|problem| invalid(&context, problem))?;
             for set in &input.sets {
                 set.membership.validate().map_err(|e| {
-                    invalid(&format!("{context} set '{}'", set.name), e.to_string())
+                    invalid(
+                        &format!("{context} set '{}'", set.name),
+                        SystemProblem::Membership(Box::new(e)),
+                    )
                 })?;
             }
         }
@@ -233,16 +236,16 @@ impl FuzzySystem {
                 &mut variable_names,
                 VariableKind::Output,
             )
-            .map_err(|reason| invalid(&context, reason))?;
+            .map_err(|problem| invalid(&context, problem))?;
             for term in &output.terms {
-                check_output_fn(&term.function, inputs.len()).map_err(|reason| {
-                    invalid(&format!("{context} term '{}'", term.name), reason)
+                check_output_fn(&term.function, inputs.len()).map_err(|problem| {
+                    invalid(&format!("{context} term '{}'", term.name), problem)
                 })?;
             }
         }
         for (r, rule) in rules.iter().enumerate() {
             check_rule(rule, &inputs, &outputs)
-                .map_err(|reason| invalid(&format!("rule {}", r + 1), reason))?;
+                .map_err(|problem| invalid(&format!("rule {}", r + 1), problem))?;
         }
         let compiled = Compiled::new(&inputs, &outputs, &rules)?;
         Ok(Self {
@@ -285,25 +288,24 @@ impl FuzzySystem {
     }
 }
 
-fn invalid(context: &str, reason: impl Into<String>) -> FuzzyError {
+fn invalid(context: &str, problem: SystemProblem) -> FuzzyError {
     FuzzyError::InvalidSystem {
         context: context.to_string(),
-        reason: reason.into(),
+        problem,
     }
 }
 
 /// Names are written between single quotes in a `.fis` file, one per line.
-pub(crate) fn check_name(kind: &str, name: &str) -> Result<(), String> {
+pub(crate) fn check_name(kind: &'static str, name: &str) -> Result<(), SystemProblem> {
     if name.is_empty() {
-        Err(format!("the {kind} name is empty"))
+        Err(SystemProblem::EmptyName { kind })
     } else if name.contains('\'') || name.chars().any(char::is_control) {
-        Err(format!(
-            "the {kind} name {name:?} contains a quote or a control character"
-        ))
+        Err(SystemProblem::UnwritableName {
+            kind,
+            name: name.to_string(),
+        })
     } else if name == "-" {
-        Err(format!(
-            "\"-\" is reserved for \"don't care\" and cannot be a {kind} name"
-        ))
+        Err(SystemProblem::ReservedName { kind })
     } else {
         Ok(())
     }
@@ -325,10 +327,10 @@ fn check_variable<'a>(
     term_names: impl Iterator<Item = &'a str>,
     variable_names: &mut Vec<&'a str>,
     kind: VariableKind,
-) -> Result<(), String> {
+) -> Result<(), SystemProblem> {
     check_name("variable", name)?;
     if variable_names.contains(&name) {
-        return Err("another variable has the same name".to_string());
+        return Err(SystemProblem::DuplicateVariable);
     }
     variable_names.push(name);
     let [min, max] = range;
@@ -341,9 +343,7 @@ fn check_variable<'a>(
             VariableKind::Input => "min < max",
             VariableKind::Output => "min <= max",
         };
-        return Err(format!(
-            "range must be finite with {order}, got [{min}, {max}]"
-        ));
+        return Err(SystemProblem::Range { order, min, max });
     }
     let mut count = 0;
     for term in term_names {
@@ -351,25 +351,27 @@ fn check_variable<'a>(
         count += 1;
     }
     if count == 0 && kind == VariableKind::Output {
-        return Err("has no sets".to_string());
+        return Err(SystemProblem::NoTerms);
     }
     Ok(())
 }
 
-fn check_output_fn(function: &OutputFn, n_inputs: usize) -> Result<(), String> {
+fn check_output_fn(function: &OutputFn, n_inputs: usize) -> Result<(), SystemProblem> {
     match function {
-        OutputFn::Constant(c) if !c.is_finite() => Err(format!("constant must be finite, got {c}")),
+        OutputFn::Constant(c) if !c.is_finite() => {
+            Err(SystemProblem::NonFiniteConstant { value: *c })
+        }
         OutputFn::Linear {
             coefficients,
             constant,
         } => {
             if coefficients.len() != n_inputs {
-                Err(format!(
-                    "linear consequent has {} coefficients for {n_inputs} inputs",
-                    coefficients.len()
-                ))
+                Err(SystemProblem::CoefficientCount {
+                    expected: n_inputs,
+                    found: coefficients.len(),
+                })
             } else if !constant.is_finite() || coefficients.iter().any(|p| !p.is_finite()) {
-                Err("linear consequent coefficients must be finite".to_string())
+                Err(SystemProblem::NonFiniteCoefficient)
             } else {
                 Ok(())
             }
@@ -378,58 +380,56 @@ fn check_output_fn(function: &OutputFn, n_inputs: usize) -> Result<(), String> {
     }
 }
 
-/// Checks one rule against the variables; the reason is phrased for a `rule N: ...` prefix.
+/// Checks one rule against the variables; the problem is phrased for a `rule N: ...` prefix.
 pub(crate) fn check_rule(
     rule: &Rule,
     inputs: &[InputVariable],
     outputs: &[OutputVariable],
-) -> Result<(), String> {
+) -> Result<(), SystemProblem> {
     if rule.antecedents.len() != inputs.len() {
-        return Err(format!(
-            "has {} antecedents for {} inputs",
-            rule.antecedents.len(),
-            inputs.len()
-        ));
+        return Err(SystemProblem::AntecedentCount {
+            expected: inputs.len(),
+            found: rule.antecedents.len(),
+        });
     }
     if rule.consequents.len() != outputs.len() {
-        return Err(format!(
-            "has {} consequents for {} outputs",
-            rule.consequents.len(),
-            outputs.len()
-        ));
+        return Err(SystemProblem::ConsequentCount {
+            expected: outputs.len(),
+            found: rule.consequents.len(),
+        });
     }
     for (antecedent, input) in rule.antecedents.iter().zip(inputs) {
         if let Antecedent::Is(k) | Antecedent::IsNot(k) = *antecedent
             && k >= input.sets.len()
         {
-            return Err(format!(
-                "input '{}' has {} sets, there is no set {}",
-                input.name,
-                input.sets.len(),
-                k + 1
-            ));
+            return Err(SystemProblem::NoSuchSet {
+                input: input.name.clone(),
+                count: input.sets.len(),
+                set: k + 1,
+            });
         }
     }
     for (consequent, output) in rule.consequents.iter().zip(outputs) {
         if let Some(k) = *consequent
             && k >= output.terms.len()
         {
-            return Err(format!(
-                "output '{}' has {} terms, there is no term {}",
-                output.name,
-                output.terms.len(),
-                k + 1
-            ));
+            return Err(SystemProblem::NoSuchTerm {
+                output: output.name.clone(),
+                count: output.terms.len(),
+                term: k + 1,
+            });
         }
     }
     if rule.antecedents.iter().all(|a| *a == Antecedent::Any) {
-        return Err("has no antecedent (every input is \"don't care\")".to_string());
+        return Err(SystemProblem::NoAntecedent);
     }
     if rule.consequents.iter().all(Option::is_none) {
-        return Err("has no consequent".to_string());
+        return Err(SystemProblem::NoConsequent);
     }
     if !(0.0..=1.0).contains(&rule.weight) {
-        return Err(format!("weight must lie in [0, 1], got {}", rule.weight));
+        return Err(SystemProblem::Weight {
+            weight: rule.weight,
+        });
     }
     Ok(())
 }
@@ -512,10 +512,7 @@ impl Compiled {
         let degree_count = n_mf * if has_complements { 2 } else { 1 } + 2;
         let (one, zero) = (degree_count - 2, degree_count - 1);
         let index = |k: usize| {
-            u32::try_from(k).map_err(|_| FuzzyError::InvalidSystem {
-                context: "system".to_string(),
-                reason: format!("too large to index with 32 bits ({k} entries)"),
-            })
+            u32::try_from(k).map_err(|_| invalid("system", SystemProblem::TooLarge { entries: k }))
         };
         let mut antecedents = Vec::with_capacity(rules.len() * inputs.len());
         for rule in rules {

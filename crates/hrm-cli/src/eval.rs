@@ -10,14 +10,14 @@ use backbone_kin::{
     BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, KinError, ModalMap, end_point,
     inverse_kinematics, tip_position,
 };
-use fuzzy_sugeno::FuzzySystem;
+use fuzzy_sugeno::{FuzzyError, FuzzySystem};
 use manip_dyn::faer::Mat;
 use manip_dyn::{ChainData, ChainModel, DynError};
 use modal_reduce::{ReduceError, ReducedData, ReducedModel};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer};
 use serde_json::{Map, Value, json};
-use sim_core::ArmSpec;
+use sim_core::{ArmSpec, SimError};
 use std::io::{BufRead, Write};
 
 mod derivatives;
@@ -145,6 +145,50 @@ impl EvalError {
 
     fn input(message: impl ToString) -> Self {
         Self::new(Kind::InvalidInput, message.to_string())
+    }
+
+    /// A library error as an answer: its kind read off the error's own predicates
+    /// (`is_unreachable`, `is_numerical`; everything else is invalid input), its message the
+    /// error's text.
+    fn library(unreachable: bool, numerical: bool, error: impl ToString) -> Self {
+        let kind = if unreachable {
+            Kind::Unreachable
+        } else if numerical {
+            Kind::Numerical
+        } else {
+            Kind::InvalidInput
+        };
+        Self::new(kind, error.to_string())
+    }
+}
+
+impl From<KinError> for EvalError {
+    fn from(error: KinError) -> Self {
+        Self::library(error.is_unreachable(), error.is_numerical(), error)
+    }
+}
+
+impl From<DynError> for EvalError {
+    fn from(error: DynError) -> Self {
+        Self::library(false, error.is_numerical(), error)
+    }
+}
+
+impl From<ReduceError> for EvalError {
+    fn from(error: ReduceError) -> Self {
+        Self::library(error.is_unreachable(), error.is_numerical(), error)
+    }
+}
+
+impl From<FuzzyError> for EvalError {
+    fn from(error: FuzzyError) -> Self {
+        Self::library(false, error.is_numerical(), error)
+    }
+}
+
+impl From<SimError> for EvalError {
+    fn from(error: SimError) -> Self {
+        Self::library(error.is_unreachable(), error.is_numerical(), error)
     }
 }
 
@@ -327,7 +371,7 @@ fn modal_map(
         }
     };
     let lengths: Vec<f64> = chain.link_lengths().collect();
-    ModalMap::new(&lengths, k, base).map_err(EvalError::input)
+    ModalMap::new(&lengths, k, base).map_err(EvalError::from)
 }
 
 /// Refuses to answer with a non-finite number (JSON has none).
@@ -339,19 +383,6 @@ fn finite(name: &str, values: &[f64]) -> Result<(), EvalError> {
         )),
         None => Ok(()),
     }
-}
-
-/// Maps a kinematics error to its answer kind: unreachable targets and a numerical inverse that
-/// did not converge apart from malformed input.
-fn kin_error(error: KinError) -> EvalError {
-    let kind = if error.is_unreachable() {
-        Kind::Unreachable
-    } else if matches!(error, KinError::NotConverged { .. }) {
-        Kind::Numerical
-    } else {
-        Kind::InvalidInput
-    };
-    EvalError::new(kind, error.to_string())
 }
 
 #[derive(Deserialize)]
@@ -367,7 +398,7 @@ struct FkRequest {
 /// `fk`: the end point of the backbone curve (closed form, eqs 3-4, for `K = 1`; quadrature for
 /// `K > 1`) and the tip of the discrete chain whose joint angles follow the curve (eq 7).
 fn fk(mut request: FkRequest) -> EvalResult {
-    let chain = request.arm.to_chain().map_err(EvalError::input)?;
+    let chain = request.arm.to_chain()?;
     let map = modal_map(&chain, &mut request.a, request.alpha0, request.harmonics)?;
     let modes = &request.a[..2 * map.harmonics()];
     let alpha0 = match map.base_angle() {
@@ -379,13 +410,11 @@ fn fk(mut request: FkRequest) -> EvalResult {
     let tip = match *modes {
         [a1, a2] => end_point(length, [a1, a2], alpha0),
         _ => BackboneCurve::new(length, modes, alpha0).map(|curve| curve.end_point()),
-    }
-    .map_err(kin_error)?;
+    }?;
     let mut theta = vec![0.0; map.n_joints()];
-    map.joint_angles(&request.a, &mut theta)
-        .map_err(kin_error)?;
+    map.joint_angles(&request.a, &mut theta)?;
     let lengths: Vec<f64> = chain.link_lengths().collect();
-    let tip_chain = tip_position(&lengths, &theta).map_err(kin_error)?;
+    let tip_chain = tip_position(&lengths, &theta)?;
     finite("tip", &[tip[0], tip[1], tip_chain[0], tip_chain[1]])?;
     Ok(json_fields([
         ("tip", json!(tip)),
@@ -411,7 +440,7 @@ struct IkRequest {
 /// entries) both solvers start there instead, which reaches targets off the closed form's first
 /// branch of `J0`.
 fn ik(request: IkRequest) -> EvalResult {
-    let chain = request.arm.to_chain().map_err(EvalError::input)?;
+    let chain = request.arm.to_chain()?;
     let k = harmonics(request.harmonics, MAX_IK_HARMONICS)?;
     let (length, alpha0) = (chain.total_length(), reduce_angle(request.alpha0));
     let lengths: Vec<f64> = chain.link_lengths().collect();
@@ -433,8 +462,7 @@ fn ik(request: IkRequest) -> EvalResult {
             )));
         }
         None => {
-            let closed = inverse_kinematics(length, request.target, alpha0, Branch::Positive)
-                .map_err(kin_error)?;
+            let closed = inverse_kinematics(length, request.target, alpha0, Branch::Positive)?;
             let mut start = vec![0.0; 2 * k];
             start[..2].copy_from_slice(&closed);
             start
@@ -443,13 +471,11 @@ fn ik(request: IkRequest) -> EvalResult {
     let mut a = start.clone();
     if k > 1 || guessed {
         HarmonicIk::new(length, k, alpha0)
-            .and_then(|mut solver| solver.solve(request.target, &mut a))
-            .map_err(kin_error)?;
+            .and_then(|mut solver| solver.solve(request.target, &mut a))?;
     }
     let mut a_chain = start;
     ChainIk::new(&lengths, k, alpha0)
-        .and_then(|mut solver| solver.solve(request.target, &mut a_chain))
-        .map_err(kin_error)?;
+        .and_then(|mut solver| solver.solve(request.target, &mut a_chain))?;
     finite("a", &a)?;
     finite("a_chain", &a_chain)?;
     Ok(json_fields([("a", json!(a)), ("a_chain", json!(a_chain))]))
@@ -467,38 +493,16 @@ struct JointsRequest {
 
 /// `joints`: joint angles `theta = J a (+ alpha0 e_1)` and the `n x m` modal Jacobian (eqs 7-9).
 fn joints(mut request: JointsRequest) -> EvalResult {
-    let chain = request.arm.to_chain().map_err(EvalError::input)?;
+    let chain = request.arm.to_chain()?;
     let map = modal_map(&chain, &mut request.a, request.alpha0, request.harmonics)?;
     let mut theta = vec![0.0; map.n_joints()];
-    map.joint_angles(&request.a, &mut theta)
-        .map_err(EvalError::input)?;
+    map.joint_angles(&request.a, &mut theta)?;
     finite("theta", &theta)?;
     let jacobian: Vec<&[f64]> = (0..map.n_joints()).map(|i| map.row(i)).collect();
     Ok(json_fields([
         ("theta", json!(theta)),
         ("jacobian", json!(jacobian)),
     ]))
-}
-
-/// Maps a dynamics error: a failed factorisation or a result that overflowed from finite inputs
-/// is numerical, everything else bad input.
-fn dyn_error(error: DynError) -> EvalError {
-    let kind = match error {
-        DynError::NotPositiveDefinite | DynError::NonFiniteResult { .. } => Kind::Numerical,
-        _ => Kind::InvalidInput,
-    };
-    EvalError::new(kind, error.to_string())
-}
-
-/// Maps a modal-reduction error the same way.
-fn reduce_error(error: ReduceError) -> EvalError {
-    match error {
-        ReduceError::Dyn(e) => dyn_error(e),
-        ReduceError::NotPositiveDefinite | ReduceError::NonFiniteResult { .. } => {
-            EvalError::new(Kind::Numerical, error.to_string())
-        }
-        other => EvalError::input(other),
-    }
 }
 
 /// A matrix as JSON rows.
@@ -521,21 +525,20 @@ struct DynamicsRequest {
 
 /// `dynamics`: `M(theta)`, the Coriolis/centrifugal vector `C(theta, theta_dot)` and `G(theta)` of eq 12.
 fn dynamics(request: DynamicsRequest) -> EvalResult {
-    let chain = request.arm.to_chain().map_err(EvalError::input)?;
+    let chain = request.arm.to_chain()?;
     let n = chain.n_links();
     let mut data = ChainData::new(&chain);
     let mut mass = Mat::<f64>::zeros(n, n);
     let (mut coriolis, mut gravity) = (vec![0.0; n], vec![0.0; n]);
-    manip_dyn::mass_matrix(&chain, &mut data, &request.theta, mass.as_mut()).map_err(dyn_error)?;
+    manip_dyn::mass_matrix(&chain, &mut data, &request.theta, mass.as_mut())?;
     manip_dyn::coriolis(
         &chain,
         &mut data,
         &request.theta,
         &request.theta_dot,
         &mut coriolis,
-    )
-    .map_err(dyn_error)?;
-    manip_dyn::gravity(&chain, &mut data, &request.theta, &mut gravity).map_err(dyn_error)?;
+    )?;
+    manip_dyn::gravity(&chain, &mut data, &request.theta, &mut gravity)?;
     finite("coriolis", &coriolis)?;
     finite("gravity", &gravity)?;
     Ok(json_fields([
@@ -560,10 +563,10 @@ struct ReducedRequest {
 /// `reduced`: the reduced model `M*`, `C*`, `G*` (eqs 13-15), the modal accelerations for the
 /// given `tau*`, and the joint torques `tau = M J a_ddot + C + G` that realise them.
 fn reduced(mut request: ReducedRequest) -> EvalResult {
-    let chain = request.arm.to_chain().map_err(EvalError::input)?;
+    let chain = request.arm.to_chain()?;
     let map = modal_map(&chain, &mut request.a, request.alpha0, request.harmonics)?;
     let (n, m) = (map.n_joints(), map.n_coords());
-    let model = ReducedModel::new(chain, map).map_err(reduce_error)?;
+    let model = ReducedModel::new(chain, map)?;
     let mut data = ReducedData::new(&model);
     let (mut a_ddot, mut torques) = (vec![0.0; m], vec![0.0; n]);
     modal_reduce::forward_dynamics(
@@ -573,8 +576,7 @@ fn reduced(mut request: ReducedRequest) -> EvalResult {
         &request.a_dot,
         &request.tau_star,
         &mut a_ddot,
-    )
-    .map_err(reduce_error)?;
+    )?;
     let mass = rows(data.mass_matrix())?;
     let (coriolis, gravity) = (data.coriolis().to_vec(), data.gravity().to_vec());
     modal_reduce::joint_torques(
@@ -584,8 +586,7 @@ fn reduced(mut request: ReducedRequest) -> EvalResult {
         &request.a_dot,
         &a_ddot,
         &mut torques,
-    )
-    .map_err(reduce_error)?;
+    )?;
     for (name, values) in [
         ("coriolis", &coriolis),
         ("gravity", &gravity),
@@ -620,7 +621,7 @@ fn fuzzy(request: FuzzyRequest) -> EvalResult {
                 "unknown controller {other:?}; known: \"paper\""
             )));
         }
-        (None, Some(text)) => FuzzySystem::from_fis(&text).map_err(EvalError::input)?,
+        (None, Some(text)) => FuzzySystem::from_fis(&text)?,
         _ => {
             return Err(EvalError::new(
                 Kind::InvalidRequest,
@@ -629,9 +630,7 @@ fn fuzzy(request: FuzzyRequest) -> EvalResult {
         }
     };
     let mut outputs = vec![0.0; system.outputs().len()];
-    fuzzy_sugeno::Evaluator::new(system)
-        .eval(&request.inputs, &mut outputs)
-        .map_err(EvalError::input)?;
+    fuzzy_sugeno::Evaluator::new(system).eval(&request.inputs, &mut outputs)?;
     finite("outputs", &outputs)?;
     Ok(json_fields([("outputs", json!(outputs))]))
 }
@@ -969,6 +968,22 @@ mod tests {
                     .contains("\"arm\" must be an object"),
                 "{answer}"
             );
+        }
+    }
+
+    #[test]
+    fn an_overflowing_result_is_numerical_in_every_dynamics_op() {
+        // Finite inputs whose result overflows: the library's NonFiniteResult, classified by
+        // its is_numerical(), for the full chain and for the reduced model alike.
+        for line in [
+            json!({"op": "dynamics", "theta": vec![0.1; 10], "theta_dot": vec![1e200; 10]}),
+            json!({"op": "reduced", "a": [0.1, 0.2, 0.3], "a_dot": [1e200, 1e200, 1e200],
+                "tau_star": [0.0, 0.0, 0.0]}),
+        ] {
+            let answer = request(line);
+            assert_eq!(answer["error"]["kind"], "numerical", "{answer}");
+            let message = answer["error"]["message"].as_str().unwrap();
+            assert!(message.contains("not finite"), "{answer}");
         }
     }
 

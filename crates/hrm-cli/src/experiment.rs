@@ -5,7 +5,7 @@ use crate::output_dir::OutputDir;
 use crate::{console, figures, progress, report};
 use serde_json::json;
 use sim_core::imitation::{self, ImitationOptions};
-use sim_core::study::{self, ComparisonRun as Outcome, Stopped, run_one};
+use sim_core::study::{self, ComparisonRun as Outcome, run_one};
 use sim_core::{ControllerKind, ReferenceSpec, Run, Scenario};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -316,10 +316,10 @@ fn table_rows(outcomes: &[Outcome]) -> Vec<report::Row> {
                     cells.extend([
                         format!("{:.4}", m.tip_error_rms_m * 1e3),
                         format!("{:.4}", m.tip_error_max_m * 1e3),
-                        list(&m.modal_error_rms, |v| format!("{v:.2e}")),
-                        list(&m.peak_modal_torque, |v| format!("{v:.2}")),
+                        list(&m.modal_error_rms_rad, |v| format!("{v:.2e}")),
+                        list(&m.peak_modal_torques_nm, |v| format!("{v:.2}")),
                         format!("{:.3}", m.peak_joint_torque_nm),
-                        format!("{:.4e}", m.control_effort),
+                        format!("{:.4e}", m.control_effort_n2m2s),
                     ]);
                     report::Row { cells, error: None }
                 }
@@ -398,8 +398,8 @@ mod tests {
         for key in [
             "tip_error_rms_m",
             "tip_error_max_m",
-            "modal_error_rms",
-            "peak_modal_torque",
+            "modal_error_rms_rad",
+            "peak_modal_torques_nm",
             "peak_joint_torque_nm",
             "steps",
         ] {

@@ -1,5 +1,4 @@
-//! `hrm`: the command line of the hyper-redundant manipulator toolkit.
-#![deny(missing_docs)]
+#![doc = include_str!("../README.md")]
 
 mod args;
 mod console;

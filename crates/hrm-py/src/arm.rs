@@ -215,15 +215,15 @@ impl Arm {
             States::read(theta_dot, "theta_dot", n)?,
             States::read(theta_ddot, "theta_ddot", n)?,
         ];
-        let [q, v, a] = &inputs;
+        let [q, v, qdd] = &inputs;
         let out = evaluate(
             py,
-            [q, v, a],
+            [q, v, qdd],
             n,
             &self.workspace,
             || self.fresh(),
-            |data, [q, v, a], out| {
-                manip_dyn::rnea(&self.chain, data, q, v, a, out)?;
+            |data, [q, v, qdd], out| {
+                manip_dyn::rnea(&self.chain, data, q, v, qdd, out)?;
                 check_finite("tau", out)
             },
         )?;

@@ -1,7 +1,9 @@
 //! The three exceptions of the package and the mapping of every library error onto them.
 //!
 //! The classification is the one `hrm eval` uses for its error `kind` (`docs/eval-protocol.md`),
-//! and the messages are the libraries' own `Display` text, so Python sees what the CLI prints:
+//! read off each library error's predicates (`is_unreachable`, `is_numerical`,
+//! `is_invalid_input`), and the messages are the libraries' own `Display` text, so Python sees
+//! what the CLI prints:
 //! malformed or out-of-domain input is [`InvalidInput`] (a `ValueError`), a target the backbone
 //! curve cannot reach is [`Unreachable`], and a computation that failed in double precision
 //! (a mass matrix that is not numerically positive definite, a non-finite result) is
@@ -99,17 +101,24 @@ impl From<Error> for PyErr {
     }
 }
 
-impl From<KinError> for Error {
-    fn from(error: KinError) -> Self {
-        let kind = if error.is_unreachable() {
+impl Kind {
+    /// The class of a library error, from its predicates (`is_unreachable`, `is_numerical`;
+    /// everything else is invalid input).
+    fn of(unreachable: bool, numerical: bool) -> Self {
+        if unreachable {
             Kind::Unreachable
-        } else if matches!(error, KinError::NotConverged { .. }) {
+        } else if numerical {
             Kind::Numerical
         } else {
             Kind::InvalidInput
-        };
+        }
+    }
+}
+
+impl From<KinError> for Error {
+    fn from(error: KinError) -> Self {
         Self {
-            kind,
+            kind: Kind::of(error.is_unreachable(), error.is_numerical()),
             message: error.to_string(),
         }
     }
@@ -117,12 +126,8 @@ impl From<KinError> for Error {
 
 impl From<DynError> for Error {
     fn from(error: DynError) -> Self {
-        let kind = match error {
-            DynError::NotPositiveDefinite | DynError::NonFiniteResult { .. } => Kind::Numerical,
-            _ => Kind::InvalidInput,
-        };
         Self {
-            kind,
+            kind: Kind::of(false, error.is_numerical()),
             message: error.to_string(),
         }
     }
@@ -130,49 +135,27 @@ impl From<DynError> for Error {
 
 impl From<ReduceError> for Error {
     fn from(error: ReduceError) -> Self {
-        match error {
-            ReduceError::Dyn(e) => Self {
-                message: ReduceError::Dyn(e.clone()).to_string(),
-                kind: Error::from(e).kind,
-            },
-            ReduceError::Kin(e) => Self {
-                message: ReduceError::Kin(e.clone()).to_string(),
-                kind: Error::from(e).kind,
-            },
-            ReduceError::NotPositiveDefinite
-            | ReduceError::NonFiniteResult { .. }
-            | ReduceError::JacobiDiverged { .. }
-            | ReduceError::JacobiNotConverged { .. } => Self::numerical(error.to_string()),
-            other => Self::input(other.to_string()),
+        Self {
+            kind: Kind::of(error.is_unreachable(), error.is_numerical()),
+            message: error.to_string(),
         }
     }
 }
 
 impl From<FuzzyError> for Error {
     fn from(error: FuzzyError) -> Self {
-        match error {
-            FuzzyError::NonFiniteOutput { .. } => Self::numerical(error.to_string()),
-            other => Self::input(other.to_string()),
+        Self {
+            kind: Kind::of(false, error.is_numerical()),
+            message: error.to_string(),
         }
     }
 }
 
 impl From<SimError> for Error {
     fn from(error: SimError) -> Self {
-        match error {
-            SimError::Unreachable { .. } => Self {
-                kind: Kind::Unreachable,
-                message: error.to_string(),
-            },
-            SimError::Kinematics(e) => Self {
-                message: SimError::Kinematics(e.clone()).to_string(),
-                kind: Error::from(e).kind,
-            },
-            SimError::Dynamics { ref source, .. } => Self {
-                kind: Error::from(source.clone()).kind,
-                message: error.to_string(),
-            },
-            other => Self::input(other.to_string()),
+        Self {
+            kind: Kind::of(error.is_unreachable(), error.is_numerical()),
+            message: error.to_string(),
         }
     }
 }

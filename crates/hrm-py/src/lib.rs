@@ -1,21 +1,4 @@
-//! `import hrm`: Python bindings of the hrm crates (PyO3, numpy).
-//!
-//! The extension module `hrm._hrm`; the Python package `hrm` (in `python/hrm/`) re-exports it,
-//! with `hrm.fuzzy` as a submodule, type stubs and `py.typed`. One module per concept:
-//!
-//! - [`errors`]: the exceptions `InvalidInput`, `Unreachable`, `NumericalError` and the mapping
-//!   of every library error onto them;
-//! - [`array`]: numpy inputs (one state or a batch, any real dtype, any layout) and the batch
-//!   driver (GIL released, rayon);
-//! - [`arm`]: `hrm.Arm` (`manip-dyn`);
-//! - [`reduced`]: `hrm.ReducedModel` (`backbone-kin`, `modal-reduce`);
-//! - [`fuzzy`]: `hrm.fuzzy.System`, `hrm.fuzzy.paper_controller` (`fuzzy-sugeno`);
-//! - [`scenario`]: `hrm.Scenario`, `hrm.Settings`, `hrm.ReferenceSample`, `hrm.Run`: closed-loop
-//!   runs with built-in or Python controllers (`sim-core`);
-//! - [`sweep`]: `hrm.Sweep`: Monte Carlo sweeps, whole or shard by shard (`sim_core::study`).
-//!
-//! The tests are Python (`tests/`, run by `cargo xtask test`); `docs/python.md` is the guide.
-#![deny(missing_docs)]
+#![doc = include_str!("../README.md")]
 
 mod arm;
 mod array;

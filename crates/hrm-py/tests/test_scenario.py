@@ -140,7 +140,7 @@ def test_run_arrays_and_summary():
     tip_error = np.hypot(*(run.tip - run.tip_ref).T)
     assert math.isclose(run.summary["tip_error_rms_m"], np.sqrt(np.mean(tip_error**2)), rel_tol=1e-12)
     assert math.isclose(run.summary["tip_error_max_m"], tip_error.max(), rel_tol=1e-14)
-    assert run.summary["modal_error_max"] == list(np.abs(run.a - run.a_ref).max(axis=0))
+    assert run.summary["modal_error_max_rad"] == list(np.abs(run.a - run.a_ref).max(axis=0))
     # The joint torques are tau = M J a_ddot + C + G with J^T tau = tau* (eq 14).
     model = hrm.ReducedModel(hrm.Arm(), alpha0=scenario.alpha0)
     assert np.allclose(run.joint_torques @ model.jacobian, run.tau_star, atol=1e-9)

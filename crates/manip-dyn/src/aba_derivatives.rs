@@ -23,7 +23,7 @@ use crate::rnea_derivatives::fill_partials;
 /// `d qdd / d q`, `d qdd / d v` and `d qdd / d tau = M^-1`, into `derivatives` (read them with
 /// [`DerivativeData::value`], [`d_q`](DerivativeData::d_q), [`d_v`](DerivativeData::d_v) and
 /// [`d_input`](DerivativeData::d_input)). `O(n^2)` and allocation-free; the method is in the
-/// [module documentation](self).
+/// module documentation of `src/aba_derivatives.rs`.
 ///
 /// [`aba`]: crate::aba()
 ///

@@ -112,14 +112,14 @@ pub(crate) fn finite_scalar(name: &'static str, x: f64) -> Result<f64, DynError>
     }
 }
 
-fn length(name: &'static str, got: usize, expected: usize) -> Result<(), DynError> {
-    if got == expected {
+fn length(name: &'static str, found: usize, expected: usize) -> Result<(), DynError> {
+    if found == expected {
         Ok(())
     } else {
         Err(DynError::Dimension {
             name,
             expected,
-            got,
+            found,
         })
     }
 }

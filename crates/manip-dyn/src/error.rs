@@ -1,7 +1,13 @@
 //! The error type of this crate.
 
 /// Why a dynamics computation was refused.
+///
+/// Every variant names the condition that failed. Two predicates sort the variants into the
+/// classes a caller acts on, exactly one of which holds for every error:
+/// [`DynError::is_numerical`] (a computation on valid input failed in double precision) and
+/// [`DynError::is_invalid_input`] (the input is malformed or outside the model's domain).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum DynError {
     /// A chain was asked for with zero links.
     #[error("a chain needs at least one link")]
@@ -43,14 +49,14 @@ pub enum DynError {
     #[error("gravity must be finite, got {0}")]
     InvalidGravity(f64),
     /// A slice or matrix had the wrong size.
-    #[error("{name} has {got} entries, expected {expected}")]
+    #[error("{name} has {found} entries, expected {expected}")]
     Dimension {
         /// Which input or output.
         name: &'static str,
         /// The size the computation needs.
         expected: usize,
         /// The size it got.
-        got: usize,
+        found: usize,
     },
     /// An input that must be finite was NaN or infinite.
     #[error("{name}[{index}] must be finite, got {value}")]
@@ -78,6 +84,23 @@ pub enum DynError {
 }
 
 impl DynError {
+    /// Whether a computation on valid input failed in double precision: a mass matrix that is
+    /// not numerically positive definite, or a result that overflowed
+    /// ([`NotPositiveDefinite`](DynError::NotPositiveDefinite),
+    /// [`NonFiniteResult`](DynError::NonFiniteResult)).
+    pub fn is_numerical(&self) -> bool {
+        matches!(
+            self,
+            Self::NotPositiveDefinite | Self::NonFiniteResult { .. }
+        )
+    }
+
+    /// Whether the input was malformed or outside the model's domain (every error that is not
+    /// [`is_numerical`](Self::is_numerical)).
+    pub fn is_invalid_input(&self) -> bool {
+        !self.is_numerical()
+    }
+
     /// Names the link of a [`DynError::InvalidLinkParameter`]: it becomes
     /// [`DynError::InvalidLink`] with this 0-based `index`. Every other error is returned as is.
     ///

@@ -1,40 +1,4 @@
-//! Dynamics of planar serial chains (section 3 of the paper, eq 12):
-//! `tau = M(theta) theta_ddot + C(theta, theta_dot) + G(theta)`.
-//!
-//! Follows Pinocchio's Model/Data split: a [`ChainModel`] is immutable, and every algorithm takes
-//! it together with a reusable [`ChainData`] workspace, built once, so that per-step calls
-//! allocate nothing. Every algorithm validates the sizes and finiteness of its inputs.
-//!
-//! | quantity | function | cost |
-//! |---|---|---|
-//! | inverse dynamics `tau` | [`rnea`] | O(n) |
-//! | `C(q, v)`, `G(q)`, `C + G` | [`coriolis`], [`gravity`], [`nonlinear_effects`] | O(n) |
-//! | mass matrix `M(q)` (faer) | [`mass_matrix`] | O(n^2) |
-//! | Coriolis matrix (Christoffel symbols) | [`coriolis_matrix`] | O(n^2) |
-//! | forward dynamics | [`aba`] / [`forward_dynamics`] (Cholesky) | O(n) / O(n^3) |
-//! | energies | [`kinetic_energy`], [`potential_energy`] | O(n) |
-//! | `d tau / d (q, v, qdd)` (analytic) | [`rnea_derivatives`] into [`DerivativeData`] | O(n^2) |
-//! | `d qdd / d (q, v, tau)` (analytic) | [`aba_derivatives`] into [`DerivativeData`] | O(n^2) |
-//!
-//! ```
-//! use manip_dyn::{ChainData, ChainModel, aba, rnea};
-//! // The paper's arm: ten 0.1 m, 0.1 kg uniform links.
-//! let arm = ChainModel::uniform(10, 0.1, 0.1, 9.81)?;
-//! let mut data = ChainData::new(&arm);
-//! let (q, v) = ([0.1; 10], [0.2; 10]);
-//! let mut qdd = [0.0; 10];
-//! aba(&arm, &mut data, &q, &v, &[0.0; 10], &mut qdd)?; // falling freely
-//! let mut tau = [0.0; 10];
-//! rnea(&arm, &mut data, &q, &v, &qdd, &mut tau)?; // ...needs no torque
-//! assert!(tau.iter().all(|t| t.abs() < 1e-12));
-//! # Ok::<(), manip_dyn::DynError>(())
-//! ```
-#![deny(missing_docs)]
-
-/// The README's example, compiled and run as a doctest.
-#[doc = include_str!("../README.md")]
-#[cfg(doctest)]
-pub struct ReadmeDoctests;
+#![doc = include_str!("../README.md")]
 
 mod aba;
 mod aba_derivatives;

@@ -1,5 +1,5 @@
 //! Inverse dynamics by the recursive Newton-Euler algorithm (RNEA), O(n): the joint torques of
-//! eq 12, `tau = M(q) a + C(q, v) + G(q)`.
+//! eq 12, `tau = M(q) qdd + C(q, v) + G(q)`.
 
 use crate::check;
 use crate::data::ChainData;
@@ -17,7 +17,7 @@ pub(crate) struct LinkAcceleration {
     com: [f64; 2],
 }
 
-/// Inverse dynamics: the joint torques `tau` that give the joint accelerations `a` at the state
+/// Inverse dynamics: the joint torques `tau` that give the joint accelerations `qdd` at the state
 /// `(q, v)` (eq 12).
 ///
 /// Forward sweep: absolute angles, angular velocities and accelerations, and the acceleration of
@@ -44,12 +44,12 @@ pub fn rnea(
     data: &mut ChainData,
     q: &[f64],
     v: &[f64],
-    a: &[f64],
+    qdd: &[f64],
     tau: &mut [f64],
 ) -> Result<(), DynError> {
-    let n = check::inputs(model, data, &[("q", q), ("v", v), ("a", a)])?;
+    let n = check::inputs(model, data, &[("q", q), ("v", v), ("qdd", qdd)])?;
     check::output("tau", tau, n)?;
-    newton_euler(model, data, q, Some(v), Some(a), model.gravity(), tau);
+    newton_euler(model, data, q, Some(v), Some(qdd), model.gravity(), tau);
     check::finite_result("tau", tau)
 }
 
@@ -60,12 +60,12 @@ pub(crate) fn newton_euler(
     data: &mut ChainData,
     q: &[f64],
     v: Option<&[f64]>,
-    a: Option<&[f64]>,
+    qdd: Option<&[f64]>,
     gravity: f64,
     tau: &mut [f64],
 ) {
     update_frames(&mut data.frames, q, v);
-    forward_sweep(model, &data.frames, &mut data.accelerations, a, gravity);
+    forward_sweep(model, &data.frames, &mut data.accelerations, qdd, gravity);
     backward_sweep(model, &data.frames, &data.accelerations, tau);
 }
 
@@ -73,7 +73,7 @@ fn forward_sweep(
     model: &ChainModel,
     frames: &[LinkFrame],
     accelerations: &mut [LinkAcceleration],
-    a: Option<&[f64]>,
+    qdd: Option<&[f64]>,
     gravity: f64,
 ) {
     let mut alpha = 0.0;
@@ -85,7 +85,7 @@ fn forward_sweep(
         .zip(accelerations)
         .enumerate()
     {
-        alpha += a.map_or(0.0, |a| a[i]);
+        alpha += qdd.map_or(0.0, |qdd| qdd[i]);
         // Acceleration of a point at unit distance along the link, relative to the joint:
         // tangential alpha (e_z x u) plus centripetal -omega^2 u.
         let [ux, uy] = frame.axis;

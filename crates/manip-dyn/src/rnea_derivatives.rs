@@ -57,7 +57,8 @@ use crate::rnea::newton_euler;
 /// `d tau / d q`, `d tau / d v` and `d tau / d qdd = M`, into `derivatives` (read them with
 /// [`DerivativeData::value`], [`d_q`](DerivativeData::d_q), [`d_v`](DerivativeData::d_v) and
 /// [`d_input`](DerivativeData::d_input)). `O(n^2)`, dominated by writing the three matrices;
-/// allocation-free. The closed form is derived in the [module documentation](self).
+/// allocation-free. The closed form is derived in the
+/// module documentation of `src/rnea_derivatives.rs`.
 ///
 /// [`rnea`]: crate::rnea()
 ///
@@ -177,8 +178,8 @@ fn link_terms(
     }
     // From the base: absolute accelerations (needed by E before the sweep from the tip).
     let mut alpha = 0.0;
-    for (accel, &a) in terms.accel.iter_mut().zip(qdd) {
-        alpha += a;
+    for (accel, &qdd_i) in terms.accel.iter_mut().zip(qdd) {
+        alpha += qdd_i;
         *accel = alpha;
     }
     for j in (0..n).rev() {

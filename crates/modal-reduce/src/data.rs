@@ -10,11 +10,11 @@ use crate::terms::Pair;
 
 /// Workspace for one [`ReducedModel`]: create it once, reuse it for every call.
 ///
-/// After [`reduced_terms`](crate::reduced_terms), [`reduced_terms_faer`](crate::reduced_terms_faer)
+/// After [`reduced_terms`](crate::reduced_terms), [`reduced_terms_by_projection`](crate::reduced_terms_by_projection)
 /// or a forward-dynamics call it holds `M*`, `C*` and `G*` at the state passed in, readable with
 /// [`mass_matrix`](Self::mass_matrix), [`coriolis`](Self::coriolis) and
-/// [`gravity`](Self::gravity). Its memory is `O(n^2)` because the faer path
-/// ([`reduced_terms_faer`](crate::reduced_terms_faer)) and the full chain's workspace hold
+/// [`gravity`](Self::gravity). Its memory is `O(n^2)` because the projection path
+/// ([`reduced_terms_by_projection`](crate::reduced_terms_by_projection)) and the full chain's workspace hold
 /// `n x n` matrices; the default path touches only an `O(m^2)` part of it.
 #[derive(Debug, Clone)]
 pub struct ReducedData {

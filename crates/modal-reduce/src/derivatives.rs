@@ -113,7 +113,7 @@ impl ReducedDerivatives {
 /// respect to `a`, `a_dot` and `tau*` at one state, into `derivatives`, for any modal map (any
 /// number of harmonics, `alpha0` free or fixed). `O(n m^2)` like [`crate::reduced_terms`], never
 /// forming an `n x n` matrix; allocation-free. `data` holds `M*`, `C*` and `G*` afterwards. The
-/// derivation is in the [module documentation](self).
+/// derivation is in the module documentation of `src/derivatives.rs`.
 ///
 /// ```
 /// use backbone_kin::ModalMap;

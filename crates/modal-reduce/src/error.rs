@@ -6,8 +6,14 @@ use manip_dyn::DynError;
 /// Why a reduced-dynamics computation was refused.
 ///
 /// Every variant names the condition that failed, so a caller (or the `hrm` command line) can
-/// print it as one readable line.
+/// print it as one readable line. Three predicates sort the variants into the classes a caller
+/// acts on, exactly one of which holds for every error: [`ReduceError::is_numerical`] (a
+/// computation on valid input failed in double precision), [`ReduceError::is_unreachable`] (a
+/// kinematic target the curve cannot reach, from [`KinError`]) and
+/// [`ReduceError::is_invalid_input`] (the input is malformed or outside the model's domain). A
+/// wrapped [`DynError`] or [`KinError`] keeps its own class.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum ReduceError {
     /// The full-chain dynamics refused the computation.
     #[error("chain dynamics: {0}")]
@@ -52,14 +58,14 @@ pub enum ReduceError {
         min_eigenvalue: f64,
     },
     /// A slice had the wrong number of entries, or a workspace belongs to another model.
-    #[error("{name} has {got} entries, expected {expected}")]
+    #[error("{name} has {found} entries, expected {expected}")]
     Dimension {
         /// Which input, output or workspace.
         name: &'static str,
         /// The size the computation needs.
         expected: usize,
         /// The size it got.
-        got: usize,
+        found: usize,
     },
     /// An input that must be finite was NaN or infinite.
     #[error("{name}[{index}] must be finite, got {value}")]
@@ -117,6 +123,34 @@ pub enum ReduceError {
     },
 }
 
+impl ReduceError {
+    /// Whether a computation on valid input failed in double precision: `M*` not numerically
+    /// positive definite, a result that overflowed, the eq-18 iteration diverging or not
+    /// converging, or a wrapped [`DynError`] or [`KinError`] of that class.
+    pub fn is_numerical(&self) -> bool {
+        match self {
+            Self::Dyn(e) => e.is_numerical(),
+            Self::Kin(e) => e.is_numerical(),
+            Self::NotPositiveDefinite
+            | Self::NonFiniteResult { .. }
+            | Self::JacobiDiverged { .. }
+            | Self::JacobiNotConverged { .. } => true,
+            _ => false,
+        }
+    }
+
+    /// Whether a wrapped [`KinError`] says the curve cannot reach a target.
+    pub fn is_unreachable(&self) -> bool {
+        matches!(self, Self::Kin(e) if e.is_unreachable())
+    }
+
+    /// Whether the input was malformed or outside the model's domain: neither
+    /// [`is_numerical`](Self::is_numerical) nor [`is_unreachable`](Self::is_unreachable).
+    pub fn is_invalid_input(&self) -> bool {
+        !(self.is_numerical() || self.is_unreachable())
+    }
+}
+
 /// Checks that `values` has `expected` entries, all finite.
 pub(crate) fn check_input(
     name: &'static str,
@@ -137,16 +171,16 @@ pub(crate) fn check_input(
 /// Checks that a slice or workspace has `expected` entries.
 pub(crate) fn check_len(
     name: &'static str,
-    got: usize,
+    found: usize,
     expected: usize,
 ) -> Result<(), ReduceError> {
-    if got == expected {
+    if found == expected {
         Ok(())
     } else {
         Err(ReduceError::Dimension {
             name,
             expected,
-            got,
+            found,
         })
     }
 }

@@ -4,7 +4,7 @@
 use crate::data::ReducedData;
 use crate::error::{ReduceError, check_finite_result, check_input, check_len};
 use crate::model::ReducedModel;
-use crate::projection::reduced_terms_faer;
+use crate::projection::reduced_terms_by_projection;
 use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
 use crate::terms::reduced_terms;
 
@@ -41,8 +41,8 @@ pub fn forward_dynamics(
 }
 
 /// [`forward_dynamics`] with `M*`, `C*` and `G*` from the projection path
-/// ([`reduced_terms_faer`], `O(n^2 m)`): the paper's method, kept as a reference and a benchmark.
-pub fn forward_dynamics_faer(
+/// ([`reduced_terms_by_projection`], `O(n^2 m)`): the paper's method, kept as a reference and a benchmark.
+pub fn forward_dynamics_by_projection(
     model: &ReducedModel,
     data: &mut ReducedData,
     a: &[f64],
@@ -51,7 +51,7 @@ pub fn forward_dynamics_faer(
     a_ddot: &mut [f64],
 ) -> Result<(), ReduceError> {
     check_forces(model, tau_star, a_ddot)?;
-    reduced_terms_faer(model, data, a, a_dot)?;
+    reduced_terms_by_projection(model, data, a, a_dot)?;
     solve(data, tau_star, a_ddot)
 }
 

@@ -16,7 +16,7 @@ use crate::torques::project;
 ///
 /// Gives the same terms as [`reduced_terms`](crate::reduced_terms) up to rounding, at
 /// `O(n^2 m)` instead of `O(n m^2)` cost.
-pub fn reduced_terms_faer(
+pub fn reduced_terms_by_projection(
     model: &ReducedModel,
     data: &mut ReducedData,
     a: &[f64],

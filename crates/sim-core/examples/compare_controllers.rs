@@ -44,10 +44,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             kind.name(),
             1e3 * s.tip_error_rms_m,
             1e3 * s.tip_error_max_m,
-            list(&s.modal_error_rms, 1e3, 3),
-            list(&s.peak_modal_torque, 1.0, 2),
+            list(&s.modal_error_rms_rad, 1e3, 3),
+            list(&s.peak_modal_torques_nm, 1.0, 2),
             s.peak_joint_torque_nm,
-            s.control_effort
+            s.control_effort_n2m2s
         );
     }
     Ok(())

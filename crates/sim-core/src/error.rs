@@ -8,8 +8,14 @@ use std::sync::Arc;
 
 /// Why a simulation could not be built or had to stop.
 ///
-/// Every variant names the condition that failed; the ones raised during a run say when.
+/// Every variant names the condition that failed; the ones raised during a run say when. Three
+/// predicates sort the variants into the classes a caller acts on, exactly one of which holds
+/// for every error: [`SimError::is_unreachable`] (a reference the curve cannot reach),
+/// [`SimError::is_numerical`] (a computation or a run on valid input failed numerically) and
+/// [`SimError::is_invalid_input`] (a setting, file or model outside its domain). A wrapped
+/// library error keeps its own class.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum SimError {
     /// A setting was out of its domain.
     #[error("{name} {requirement}")]
@@ -126,6 +132,39 @@ impl PartialEq for ControllerFailure {
 }
 
 impl SimError {
+    /// Whether a reference point cannot be reached by the backbone curve
+    /// ([`Unreachable`](SimError::Unreachable), or a wrapped [`KinError`] of that class).
+    pub fn is_unreachable(&self) -> bool {
+        match self {
+            Self::Unreachable { .. } => true,
+            Self::Kinematics(e) => e.is_unreachable(),
+            Self::Dynamics { source, .. } | Self::Model(source) => source.is_unreachable(),
+            _ => false,
+        }
+    }
+
+    /// Whether a computation or a run on valid input failed numerically: a wrapped library error
+    /// of that class, an integration that diverged, a non-finite control, a runaway tracking
+    /// error, or a controller's own failure during the run.
+    pub fn is_numerical(&self) -> bool {
+        match self {
+            Self::Kinematics(e) => e.is_numerical(),
+            Self::Dynamics { source, .. } | Self::Model(source) => source.is_numerical(),
+            Self::Fuzzy(e) => e.is_numerical(),
+            Self::Integration(_)
+            | Self::NonFiniteControl { .. }
+            | Self::Controller { .. }
+            | Self::RunawayError { .. } => true,
+            _ => false,
+        }
+    }
+
+    /// Whether a setting, file or model was outside its domain: neither
+    /// [`is_unreachable`](Self::is_unreachable) nor [`is_numerical`](Self::is_numerical).
+    pub fn is_invalid_input(&self) -> bool {
+        !(self.is_unreachable() || self.is_numerical())
+    }
+
     /// The run's error for a controller failure at `t`: a [`SimError`] (the built-in
     /// controllers') as it is, any other error as [`SimError::Controller`].
     pub fn from_controller(t: f64, error: crate::controller::ControllerError) -> Self {
@@ -184,8 +223,8 @@ pub(crate) fn check_finite(name: &str, values: &[f64]) -> Result<(), SimError> {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Readable(pub f64);
 
-impl std::fmt::Display for Readable {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+impl fmt::Display for Readable {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let magnitude = self.0.abs();
         if self.0 == 0.0 || !self.0.is_finite() || (1e-4..1e15).contains(&magnitude) {
             write!(f, "{}", self.0)

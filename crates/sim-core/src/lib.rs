@@ -1,37 +1,4 @@
-//! Closed-loop simulation of modal-coordinate controllers on hyper-redundant manipulators:
-//! section 5 of the paper *Modeling of Hyper-Redundant Manipulators Dynamics and Design
-//! of Fuzzy Controller for the System*, made reproducible.
-//!
-//! The loop of the paper's Figures 6 and 8: a [`reference`](mod@reference) for the modal
-//! coordinates `(a1, a2)` (alpha0 held fixed), a [`controller`] sampled at its own period with a
-//! zero-order hold, the reduced dynamics `M* a_dd + C* + G* = tau*` (eq 15, from `modal-reduce`)
-//! integrated by fixed-step RK4 or adaptive Dormand-Prince 5(4) ([`ode`]), and a [`Record`] of
-//! the time series with [`Summary`] metrics (tip and modal errors, modal and joint torques,
-//! control effort). Divergence stops a run with a [`RunFailure`] that keeps the data so far.
-//!
-//! Experiments are [`Scenario`]s, TOML files; the paper's are shipped with the crate
-//! ([`Scenario::builtin_names`]): `paper-tracking` (Figures 10-11) and the
-//! `paper-responses-{step,sine,noise}` responses (Figure 9). [`imitation`] learns a fuzzy
-//! controller from a better teacher (computed torque) on such scenarios.
-//!
-//! ```
-//! use sim_core::{ControllerKind, Scenario};
-//!
-//! let mut scenario = Scenario::builtin("paper-tracking")?;
-//! scenario.duration = 0.5; // the first half second of the paper's path
-//! for kind in [ControllerKind::Fuzzy, ControllerKind::ComputedTorque] {
-//!     scenario.controller.kind = kind;
-//!     let run = scenario.build()?.run()?;
-//!     assert!(run.summary.tip_error_rms_m < 0.01, "{kind}");
-//! }
-//! # Ok::<(), Box<dyn std::error::Error>>(())
-//! ```
-#![deny(missing_docs)]
-
-/// The README's example, compiled and run as a doctest.
-#[doc = include_str!("../README.md")]
-#[cfg(doctest)]
-pub struct ReadmeDoctests;
+#![doc = include_str!("../README.md")]
 
 pub mod controller;
 mod error;

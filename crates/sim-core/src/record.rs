@@ -165,7 +165,8 @@ pub struct TorqueLimitExceeded {
 /// Errors and peaks are taken over the recorded samples, so they agree with the time series of
 /// the [`Record`] (record every controller sample to take them over all); the control effort
 /// integrates the held torques over every controller period. Serialises to the fields of
-/// `summary.json` (units in the names where they are not radians).
+/// `summary.json`; the key of every physical quantity ends in its unit (`_m`, `_rad`, `_nm`, `_s`,
+/// `_n2m2s`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
     /// Controller samples taken (including the one at the final time).
@@ -183,17 +184,17 @@ pub struct Summary {
     /// Largest such distance (m).
     pub tip_error_max_m: f64,
     /// Root mean square of `a_i - a_i_ref` per coordinate (rad), against the noise-free reference.
-    pub modal_error_rms: Vec<f64>,
+    pub modal_error_rms_rad: Vec<f64>,
     /// Largest `|a_i - a_i_ref|` per coordinate (rad).
-    pub modal_error_max: Vec<f64>,
+    pub modal_error_max_rad: Vec<f64>,
     /// Largest `|tau_i*|` per coordinate (N m).
-    pub peak_modal_torque: Vec<f64>,
+    pub peak_modal_torques_nm: Vec<f64>,
     /// Largest `|tau_j|` over all joints (N m).
     pub peak_joint_torque_nm: f64,
     /// Largest `|tau_j|` of each joint (N m).
     pub peak_joint_torques_nm: Vec<f64>,
     /// Control effort `integral of |tau*|^2 dt` under the zero-order hold (N^2 m^2 s).
-    pub control_effort: f64,
+    pub control_effort_n2m2s: f64,
     /// Joints whose torque limit was exceeded (empty without limits or violations).
     pub torque_limit_exceeded: Vec<TorqueLimitExceeded>,
 }
@@ -292,12 +293,12 @@ impl Metrics {
             simulated_s: self.last_t,
             tip_error_rms_m: (self.tip_sq / n).sqrt(),
             tip_error_max_m: self.tip_max,
-            modal_error_rms: self.modal_sq.iter().map(|s| (s / n).sqrt()).collect(),
-            modal_error_max: self.modal_max.clone(),
-            peak_modal_torque: self.peak_tau_star.clone(),
+            modal_error_rms_rad: self.modal_sq.iter().map(|s| (s / n).sqrt()).collect(),
+            modal_error_max_rad: self.modal_max.clone(),
+            peak_modal_torques_nm: self.peak_tau_star.clone(),
             peak_joint_torque_nm: self.peak_joint.iter().copied().fold(0.0, f64::max),
             peak_joint_torques_nm: self.peak_joint.clone(),
-            control_effort: self.effort,
+            control_effort_n2m2s: self.effort,
             torque_limit_exceeded,
         }
     }

@@ -207,7 +207,7 @@ pub struct Observation<'a> {
 /// let mut sim = Simulation::new(model, Box::new(reference), Box::new(controller), settings, None)?;
 /// let run = sim.run()?;
 /// assert_eq!(run.summary.controller_samples, 5001);
-/// assert!(run.summary.modal_error_rms[0] < 0.2);
+/// assert!(run.summary.modal_error_rms_rad[0] < 0.2);
 ///
 /// // The same loop, stepped by hand for 0.1 s.
 /// sim.reset();

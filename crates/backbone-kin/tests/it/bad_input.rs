@@ -12,7 +12,8 @@ use std::collections::BTreeSet;
 use std::f64::consts::FRAC_PI_2;
 use test_support::refusal::{Row, SENTINEL, check, exactly, row, starts, untouched, words};
 
-/// The variant's name; exhaustive, so a new variant fails to compile until it is covered here.
+/// The variant's name. `KinError` is `#[non_exhaustive]`, so a variant added later reaches the
+/// last arm and fails the test until it is covered here.
 fn variant(error: &KinError) -> &'static str {
     match error {
         KinError::NonFinite { .. } => "NonFinite",
@@ -29,6 +30,7 @@ fn variant(error: &KinError) -> &'static str {
         KinError::A2ExceedsAmplitude { .. } => "A2ExceedsAmplitude",
         KinError::NotConverged { .. } => "NotConverged",
         KinError::TooMany { .. } => "TooMany",
+        other => panic!("a variant this test does not cover: {other:?}"),
     }
 }
 
@@ -188,8 +190,14 @@ fn rows() -> Vec<Row<KinError>> {
             untouched([[SENTINEL; 2]; 3], |points| {
                 joint_positions(&[0.1; 2], &[0.0, f64::NAN], points)
             }),
-            |e| matches!(e, KinError::NonFinite { name: "joint angles", value } if value.is_nan()),
-            "joint angles must be finite, got NaN",
+            |e| {
+                matches!(
+                    e,
+                    KinError::NonFinite { name: "joint angles", index: Some(1), value }
+                        if value.is_nan()
+                )
+            },
+            "joint angles[1] must be finite, got NaN",
         ),
         words(
             "non_finite_modal_coordinate",
@@ -272,7 +280,7 @@ fn rows() -> Vec<Row<KinError>> {
                 *e == KinError::Dimension {
                     name: "joint angles",
                     expected: 3,
-                    got: 2,
+                    found: 2,
                 }
             },
             &["joint angles", "expected 3"],
@@ -286,7 +294,7 @@ fn rows() -> Vec<Row<KinError>> {
                 *e == KinError::Dimension {
                     name: "joint positions",
                     expected: 4,
-                    got: 3,
+                    found: 3,
                 }
             },
             &["joint positions", "3 entries", "expected 4"],
@@ -300,7 +308,7 @@ fn rows() -> Vec<Row<KinError>> {
                 *e == KinError::Dimension {
                     name: "joint output",
                     expected: 10,
-                    got: 9,
+                    found: 9,
                 }
             },
         ),
@@ -457,7 +465,7 @@ fn rows() -> Vec<Row<KinError>> {
                 *e == KinError::Dimension {
                     name: "initial guess",
                     expected: 4,
-                    got: 3,
+                    found: 3,
                 }
             },
         ),
@@ -634,13 +642,20 @@ fn every_refusal_is_the_expected_error_and_says_what_failed() {
 }
 
 #[test]
-fn unreachable_targets_are_classified() {
+fn every_error_is_in_exactly_one_class() {
     for Row { name, error, .. } in rows() {
-        let expected = matches!(
+        let unreachable = matches!(
             variant(&error),
             "OutOfReach" | "AtBase" | "A2ExceedsAmplitude"
         );
-        assert_eq!(error.is_unreachable(), expected, "{name}: {error}");
+        let numerical = variant(&error) == "NotConverged";
+        assert_eq!(error.is_unreachable(), unreachable, "{name}: {error}");
+        assert_eq!(error.is_numerical(), numerical, "{name}: {error}");
+        assert_eq!(
+            error.is_invalid_input(),
+            !(unreachable || numerical),
+            "{name}: {error}"
+        );
     }
 }
 

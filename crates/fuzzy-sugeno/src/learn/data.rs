@@ -78,7 +78,7 @@ impl TrainingData {
         }
         for (k, name) in names.iter().enumerate() {
             check_name("variable", name)
-                .map_err(|reason| learning(format!("column {}: {reason}", k + 1)))?;
+                .map_err(|problem| learning(format!("column {}: {problem}", k + 1)))?;
             if names[..k].contains(name) {
                 return Err(learning(format!(
                     "column {}: another column is also named '{name}'",

@@ -4,7 +4,7 @@
 
 use fuzzy_sugeno::{
     AnalysisOptions, EvalOptions, Evaluator, FuzzyError, FuzzySystem, MembershipFn, NoRuleFired,
-    OutOfRange, OutputFn, paper_controller,
+    OutOfRange, OutputFn, SystemProblem, paper_controller,
 };
 
 /// A value no evaluation writes: an output still holding it was left untouched.
@@ -102,7 +102,8 @@ fn system_with_an_invalid_set() {
         .build()
         .unwrap_err();
     assert!(
-        matches!(&err, FuzzyError::InvalidSystem { context, .. } if context == "input 'x' set 'flat'"),
+        matches!(&err, FuzzyError::InvalidSystem { context, problem: SystemProblem::Membership(_) }
+            if context == "input 'x' set 'flat'"),
         "{err:?}"
     );
     assert!(err.to_string().contains("zero width"), "{err}");
@@ -118,7 +119,8 @@ fn system_with_an_empty_or_non_finite_range() {
             .build()
             .unwrap_err();
         assert!(
-            matches!(&err, FuzzyError::InvalidSystem { context, .. } if context == "input 'x'"),
+            matches!(&err, FuzzyError::InvalidSystem { context, problem: SystemProblem::Range { .. } }
+                if context == "input 'x'"),
             "{err:?}"
         );
         assert!(
@@ -162,7 +164,7 @@ fn wrong_number_of_inputs() {
         err,
         FuzzyError::InputCount {
             expected: 4,
-            got: 3
+            found: 3
         }
     );
     assert_eq!(err.to_string(), "expected 4 inputs, got 3");
@@ -178,7 +180,7 @@ fn wrong_number_of_output_slots() {
         err,
         FuzzyError::OutputCount {
             expected: 2,
-            got: 3
+            found: 3
         }
     ));
     assert_eq!(out, [SENTINEL; 3]);
@@ -294,8 +296,20 @@ fn no_rule_fired_values_of_wrong_length_or_non_finite() {
             no_rule_fired: NoRuleFired::Values(values),
             ..EvalOptions::default()
         };
-        let err = Evaluator::with_options(half_covered(), options).unwrap_err();
-        assert!(matches!(err, FuzzyError::InvalidOptions(_)), "{err:?}");
+        let err = Evaluator::with_options(half_covered(), options.clone()).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                FuzzyError::FallbackCount {
+                    expected: 1,
+                    found: 2
+                } | FuzzyError::NonFiniteFallback { .. }
+            ),
+            "{err:?}"
+        );
+        // The C export checks the options the same way.
+        let exported = half_covered().to_c("x", &options).unwrap_err();
+        assert_eq!(exported.to_string(), err.to_string());
     }
 }
 
@@ -342,7 +356,7 @@ fn linear_consequent_at_inputs_of_wrong_length() {
         f.value(&[1.0]),
         Err(FuzzyError::InputCount {
             expected: 2,
-            got: 1
+            found: 1
         })
     );
 }
@@ -391,7 +405,10 @@ fn analysis_options_out_of_domain() {
         },
     ] {
         assert!(
-            matches!(system.analyze(&options), Err(FuzzyError::Analysis(_))),
+            matches!(
+                system.analyze(&options),
+                Err(FuzzyError::AnalysisOption { .. })
+            ),
             "{options:?}"
         );
     }

@@ -142,7 +142,7 @@ fn the_no_rule_fired_policy_is_applied() {
     );
     let nan = Evaluator::with_options(gapped(), options(NoRuleFired::Values(vec![f64::NAN])))
         .unwrap_err();
-    assert!(matches!(nan, FuzzyError::InvalidOptions(_)));
+    assert!(matches!(nan, FuzzyError::NonFiniteFallback { value } if value.is_nan()));
 }
 
 #[test]

@@ -9,7 +9,7 @@ use serde::Deserialize;
 use serde_json::{Value, json};
 use sim_core::ArmSpec;
 
-use super::{EvalError, EvalResult, dyn_error, finite, json_fields, modal_map, reduce_error};
+use super::{EvalError, EvalResult, finite, json_fields, modal_map};
 
 /// The most links the joint-space derivative ops accept: their answer holds `2 n^2` or `3 n^2`
 /// numbers (3 million, some 60 MB of JSON, at this limit) and their workspace `24 n^2` bytes.
@@ -44,8 +44,7 @@ pub(super) fn rnea_derivatives(request: RneaDerivativesRequest) -> EvalResult {
         &request.theta,
         &request.theta_dot,
         &request.theta_ddot,
-    )
-    .map_err(dyn_error)?;
+    )?;
     finite("tau", derivatives.value())?;
     Ok(json_fields([
         ("tau", json!(derivatives.value())),
@@ -84,8 +83,7 @@ pub(super) fn aba_derivatives(request: AbaDerivativesRequest) -> EvalResult {
         &request.theta,
         &request.theta_dot,
         &request.tau,
-    )
-    .map_err(dyn_error)?;
+    )?;
     finite("theta_ddot", derivatives.value())?;
     Ok(json_fields([
         ("theta_ddot", json!(derivatives.value())),
@@ -110,9 +108,9 @@ pub(super) struct ReducedDerivativesRequest {
 /// `reduced_derivatives`: `a_ddot` of eq 15 and its Jacobians with respect to `a`, `a_dot` and
 /// `tau*` (`M*^-1`), for `K` harmonics (default 1) with `alpha0` free or fixed.
 pub(super) fn reduced_derivatives(mut request: ReducedDerivativesRequest) -> EvalResult {
-    let chain = request.arm.to_chain().map_err(EvalError::input)?;
+    let chain = request.arm.to_chain()?;
     let map = modal_map(&chain, &mut request.a, request.alpha0, request.harmonics)?;
-    let model = ReducedModel::new(chain, map).map_err(reduce_error)?;
+    let model = ReducedModel::new(chain, map)?;
     let mut derivatives = ReducedDerivatives::new(&model);
     modal_reduce::reduced_derivatives(
         &model,
@@ -121,8 +119,7 @@ pub(super) fn reduced_derivatives(mut request: ReducedDerivativesRequest) -> Eva
         &request.a,
         &request.a_dot,
         &request.tau_star,
-    )
-    .map_err(reduce_error)?;
+    )?;
     finite("a_ddot", derivatives.a_ddot())?;
     Ok(json_fields([
         ("a_ddot", json!(derivatives.a_ddot())),
@@ -134,7 +131,7 @@ pub(super) fn reduced_derivatives(mut request: ReducedDerivativesRequest) -> Eva
 
 /// The arm, refused beyond [`MAX_DERIVATIVE_LINKS`] before the `n x n` workspaces exist.
 fn chain(arm: &ArmSpec) -> Result<ChainModel, EvalError> {
-    let chain = arm.to_chain().map_err(EvalError::input)?;
+    let chain = arm.to_chain()?;
     if chain.n_links() > MAX_DERIVATIVE_LINKS {
         return Err(EvalError::input(format!(
             "arm.links must be at most {MAX_DERIVATIVE_LINKS} for the derivative ops, got {}",

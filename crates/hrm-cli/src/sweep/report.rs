@@ -93,7 +93,7 @@ pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
             &[|t| t.mean, |t| t.std, |t| t.max],
             mm,
         );
-        for stats in &c.modal_error_rms {
+        for stats in &c.modal_error_rms_rad {
             cols(&mut s, stats, &[|t| t.mean, |t| t.std], rad);
         }
         s.push('\n');

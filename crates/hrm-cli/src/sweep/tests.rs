@@ -200,7 +200,7 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
     assert!(parse(&["--shard", "1/10000001"]).is_err());
     let mut short = ShardFile::read(&shard(2)).unwrap();
     if let Outcome::Completed(metrics) = &mut short.runs[0].outcome {
-        metrics.modal_error_rms.pop();
+        metrics.modal_error_rms_rad.pop();
     }
     write(&cut_path, &short.to_json().unwrap()).unwrap();
     let err = merge(&[shard(1), cut_path.clone(), shard(3)]);
@@ -259,7 +259,7 @@ fn noise_spreads_the_errors_and_no_noise_does_not() {
         let q = quiet.tip_error_rms_mm.unwrap();
         assert_eq!((q.std, q.min), (0.0, q.max), "{}", quiet.controller);
         // With noise the seeds differ.
-        let n = noisy.modal_error_rms[0].unwrap();
+        let n = noisy.modal_error_rms_rad[0].unwrap();
         assert!(n.std > 0.0 && n.min < n.max, "{}", noisy.controller);
     }
 }
@@ -330,14 +330,14 @@ fn a_thousand_short_runs_complete_without_nan() {
     assert_eq!(cells.len(), 20);
     for cell in &cells {
         assert_eq!((cell.runs, cell.failed), (50, 0), "{cell:?}");
-        assert_eq!(cell.modal_error_rms.len(), 2);
+        assert_eq!(cell.modal_error_rms_rad.len(), 2);
         for stats in [
             cell.tip_error_rms_mm,
             cell.tip_error_max_mm,
             cell.peak_joint_torque_nm,
         ]
         .into_iter()
-        .chain(cell.modal_error_rms.iter().copied())
+        .chain(cell.modal_error_rms_rad.iter().copied())
         {
             let s = stats.unwrap();
             assert!(

@@ -240,7 +240,7 @@ fn call_rows() -> Vec<Row<DynError>> {
                 *e == DynError::Dimension {
                     name: "q",
                     expected: 3,
-                    got: 2,
+                    found: 2,
                 }
             },
             "q has 2 entries, expected 3",
@@ -254,7 +254,7 @@ fn call_rows() -> Vec<Row<DynError>> {
                 *e == DynError::Dimension {
                     name: "qdd",
                     expected: 3,
-                    got: 4,
+                    found: 4,
                 }
             },
         ),
@@ -283,7 +283,7 @@ fn call_rows() -> Vec<Row<DynError>> {
                     e,
                     DynError::Dimension {
                         expected: 3,
-                        got: 5,
+                        found: 5,
                         ..
                     }
                 )
@@ -326,7 +326,7 @@ fn matrix_output_of_wrong_shape() {
         DynError::Dimension {
             name: "out (columns)",
             expected: 3,
-            got: 4
+            found: 4
         }
     );
     assert!((0..3).all(|i| (0..4).all(|j| m[(i, j)] == SENTINEL)));
@@ -361,7 +361,7 @@ fn point_mass_link_is_allowed() {
     assert!((qdd[0] + g * q.cos() / c).abs() < 1e-12, "{qdd:?}");
 }
 
-/// Arguments of one call; `third` is `a` for RNEA and `tau` for forward dynamics.
+/// Arguments of one call; `third` is `qdd` for RNEA and `tau` for forward dynamics.
 struct Args {
     q: Vec<f64>,
     v: Vec<f64>,
@@ -418,7 +418,7 @@ const ALGORITHMS: [Algorithm; 10] = [
     Algorithm {
         name: "rnea",
         call: |m, d, x| rnea(m, d, &x.q, &x.v, &x.third, &mut x.out),
-        inputs: &["q", "v", "a"],
+        inputs: &["q", "v", "qdd"],
         output: Some("tau"),
         matrix_output: false,
     },
@@ -514,13 +514,13 @@ fn wrong_input_lengths_are_refused() {
     let mut data = ChainData::new(&arm);
     for algorithm in &ALGORITHMS {
         for &input in algorithm.inputs {
-            for got in [0, N - 1, N + 1] {
+            for found in [0, N - 1, N + 1] {
                 let mut args = Args::new(N);
-                args.input(input).resize(got, 0.1);
+                args.input(input).resize(found, 0.1);
                 let expected = DynError::Dimension {
                     name: input,
                     expected: N,
-                    got,
+                    found,
                 };
                 assert_eq!(
                     (algorithm.call)(&arm, &mut data, &mut args),
@@ -566,13 +566,13 @@ fn wrong_output_sizes_are_refused() {
     let mut data = ChainData::new(&arm);
     for algorithm in &ALGORITHMS {
         if let Some(output) = algorithm.output {
-            for got in [0, N + 1] {
+            for found in [0, N + 1] {
                 let mut args = Args::new(N);
-                args.out.resize(got, SENTINEL);
+                args.out.resize(found, SENTINEL);
                 let expected = DynError::Dimension {
                     name: output,
                     expected: N,
-                    got,
+                    found,
                 };
                 assert_eq!(
                     (algorithm.call)(&arm, &mut data, &mut args),
@@ -591,7 +591,7 @@ fn wrong_output_sizes_are_refused() {
                     DynError::Dimension {
                         name: "out (rows)",
                         expected: N,
-                        got: N + 1,
+                        found: N + 1,
                     },
                 ),
                 (
@@ -600,7 +600,7 @@ fn wrong_output_sizes_are_refused() {
                     DynError::Dimension {
                         name: "out (columns)",
                         expected: N,
-                        got: N - 1,
+                        found: N - 1,
                     },
                 ),
             ];
@@ -629,10 +629,10 @@ fn a_workspace_of_another_chain_is_refused() {
             Err(DynError::Dimension {
                 name,
                 expected: N,
-                got,
+                found,
             }) => {
                 assert!(name.starts_with("data"), "{}: {name}", algorithm.name);
-                assert_eq!(got, N + 2);
+                assert_eq!(found, N + 2);
             }
             other => panic!("{}: {other:?}", algorithm.name),
         }
@@ -677,6 +677,8 @@ fn overflow_is_reported_not_returned() {
             matches!(result, Err(DynError::NonFiniteResult { .. })),
             "{name}: {result:?}"
         );
+        let error = result.unwrap_err();
+        assert!(error.is_numerical() && !error.is_invalid_input(), "{name}");
     }
     let mut args = Args::new(2);
     assert_eq!(
@@ -708,6 +710,7 @@ fn a_numerically_singular_mass_matrix_is_reported() {
         forward_dynamics(&arm, &mut data, &zero, &zero, &zero, &mut qdd),
         Err(DynError::NotPositiveDefinite)
     );
+    assert!(DynError::NotPositiveDefinite.is_numerical());
     // The same arm still has a well-defined mass matrix and inverse dynamics.
     let mut m = Mat::zeros(2, 2);
     assert_eq!(mass_matrix(&arm, &mut data, &zero, m.as_mut()), Ok(()));

@@ -186,7 +186,7 @@ fn workspaces_are_checked() {
             error,
             DynError::Dimension {
                 expected: 10,
-                got: 4,
+                found: 4,
                 ..
             }
         ),

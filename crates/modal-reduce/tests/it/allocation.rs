@@ -1,15 +1,16 @@
 //! After `ReducedData::new` and one warm-up call, no per-step function allocates (checked with
 //! the binary's counting allocator, which counts this test's thread only).
 //!
-//! The warm-up matters for the faer path only: for large matrices faer's product kernel grows a
+//! The warm-up matters for the projection path only: for large matrices faer's product kernel grows a
 //! thread-local packing buffer once, on its first call at a new size.
 
 use backbone_kin::{BaseAngle, ModalMap};
 use manip_dyn::ChainModel;
 use modal_reduce::{
     JacobiSettings, ReducedData, ReducedDerivatives, ReducedModel, forward_dynamics,
-    forward_dynamics_faer, jacobi_forward_dynamics, joint_torques, kinetic_energy,
-    potential_energy, project_torques, reduced_derivatives, reduced_terms, reduced_terms_faer,
+    forward_dynamics_by_projection, jacobi_forward_dynamics, joint_torques, kinetic_energy,
+    potential_energy, project_torques, reduced_derivatives, reduced_terms,
+    reduced_terms_by_projection,
 };
 use test_support::alloc::{allocations_during, is_counting};
 
@@ -31,9 +32,10 @@ fn per_step_functions_do_not_allocate() {
         let settings = JacobiSettings::default();
         let mut run = || {
             reduced_terms(&model, &mut data, &a, &a_dot).unwrap();
-            reduced_terms_faer(&model, &mut data, &a, &a_dot).unwrap();
+            reduced_terms_by_projection(&model, &mut data, &a, &a_dot).unwrap();
             forward_dynamics(&model, &mut data, &a, &a_dot, &tau_star, &mut a_ddot).unwrap();
-            forward_dynamics_faer(&model, &mut data, &a, &a_dot, &tau_star, &mut a_ddot).unwrap();
+            forward_dynamics_by_projection(&model, &mut data, &a, &a_dot, &tau_star, &mut a_ddot)
+                .unwrap();
             // Converges (two coordinates) or reports divergence; either way without allocating.
             let jacobi = jacobi_forward_dynamics(
                 &model,

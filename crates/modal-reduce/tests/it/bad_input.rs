@@ -8,8 +8,8 @@ use backbone_kin::{BaseAngle, KinError, ModalMap};
 use manip_dyn::{ChainModel, DynError};
 use modal_reduce::{
     JacobiSettings, ReduceError, ReducedData, ReducedModel, forward_dynamics,
-    forward_dynamics_faer, jacobi_forward_dynamics, joint_torques, kinetic_energy,
-    potential_energy, project_torques, reduced_terms, reduced_terms_faer,
+    forward_dynamics_by_projection, jacobi_forward_dynamics, joint_torques, kinetic_energy,
+    potential_energy, project_torques, reduced_terms, reduced_terms_by_projection,
 };
 use test_support::refusal::{Row, SENTINEL, check, exactly, row, starts, untouched, words};
 use test_support::sample::{paper_reduced, tapered_lengths, uniform_chain};
@@ -20,11 +20,11 @@ fn chain(n: usize) -> ChainModel {
 }
 
 /// `ReduceError::Dimension`.
-fn dim(name: &'static str, expected: usize, got: usize) -> ReduceError {
+fn dim(name: &'static str, expected: usize, found: usize) -> ReduceError {
     ReduceError::Dimension {
         name,
         expected,
-        got,
+        found,
     }
 }
 
@@ -156,7 +156,7 @@ fn call_rows() -> Vec<Row<ReduceError>> {
         ),
         row(
             "state_of_wrong_length",
-            reduced_terms_faer(&model, &mut data, &ok, &short).unwrap_err(),
+            reduced_terms_by_projection(&model, &mut data, &ok, &short).unwrap_err(),
             |e| *e == dim("a_dot", 3, 2),
         ),
         row(
@@ -179,7 +179,7 @@ fn call_rows() -> Vec<Row<ReduceError>> {
         row(
             "output_of_wrong_length",
             untouched([SENTINEL; 2], |out| {
-                forward_dynamics_faer(&model, &mut data, &ok, &ok, &ok, out)
+                forward_dynamics_by_projection(&model, &mut data, &ok, &ok, &ok, out)
             }),
             |e| *e == dim("a_ddot", 3, 2),
         ),
@@ -269,7 +269,14 @@ fn call_rows() -> Vec<Row<ReduceError>> {
         row(
             "non_finite_state_leaves_output_and_workspace_usable",
             untouched([SENTINEL; 3], |out| {
-                forward_dynamics_faer(&model, &mut data, &[0.0; 3], &[0.0; 3], &[f64::NAN; 3], out)
+                forward_dynamics_by_projection(
+                    &model,
+                    &mut data,
+                    &[0.0; 3],
+                    &[0.0; 3],
+                    &[f64::NAN; 3],
+                    out,
+                )
             }),
             |e| {
                 matches!(
@@ -505,4 +512,39 @@ fn a_refused_call_leaves_the_workspace_usable() {
     let mut fresh_data = ReducedData::new(&model);
     forward_dynamics(&model, &mut fresh_data, &a, &a_dot, &tau, &mut fresh).unwrap();
     assert_eq!(a_ddot, fresh);
+}
+
+#[test]
+fn every_refusal_is_in_exactly_one_class() {
+    for Row { name, error, .. } in model_rows().into_iter().chain(call_rows()) {
+        let numerical = matches!(
+            error,
+            ReduceError::NonFiniteResult { .. } | ReduceError::JacobiDiverged { .. }
+        ) || matches!(error, ReduceError::Dyn(ref e) if e.is_numerical());
+        let unreachable = error.is_unreachable();
+        assert_eq!(error.is_numerical(), numerical, "{name}: {error}");
+        assert_eq!(
+            error.is_invalid_input(),
+            !(numerical || unreachable),
+            "{name}: {error}"
+        );
+    }
+}
+
+#[test]
+fn wrapped_errors_keep_their_class() {
+    let numerical = ReduceError::Dyn(DynError::NotPositiveDefinite);
+    assert!(numerical.is_numerical() && !numerical.is_invalid_input());
+    let unreachable = ReduceError::Kin(KinError::OutOfReach {
+        r: 2.0,
+        length: 1.0,
+    });
+    assert!(unreachable.is_unreachable() && !unreachable.is_numerical());
+    assert!(!unreachable.is_invalid_input());
+    let input = ReduceError::Dyn(DynError::NoLinks);
+    assert!(input.is_invalid_input() && !input.is_numerical() && !input.is_unreachable());
+    let diverged = ReduceError::JacobiDiverged {
+        spectral_radius: 1.5,
+    };
+    assert!(diverged.is_numerical());
 }

@@ -3,7 +3,7 @@
 
 use backbone_kin::{BaseAngle, ModalMap};
 use manip_dyn::{ChainModel, Link};
-use modal_reduce::{ReducedData, ReducedModel, reduced_terms, reduced_terms_faer};
+use modal_reduce::{ReducedData, ReducedModel, reduced_terms, reduced_terms_by_projection};
 
 struct Pendulum {
     m: [f64; 2],
@@ -59,7 +59,7 @@ fn two_link_arm_matches_the_double_pendulum() {
             let theta_dot = [0, 1].map(|i| map.entry(i, 0) * a_dot[0] + map.entry(i, 1) * a_dot[1]);
             let (mass, coriolis, gravity) = p.terms(theta, theta_dot);
             let j = |i: usize, k: usize| map.entry(i, k);
-            for compute in [reduced_terms, reduced_terms_faer] {
+            for compute in [reduced_terms, reduced_terms_by_projection] {
                 compute(&model, &mut data, &a, &a_dot).unwrap();
                 for r in 0..2 {
                     for c in 0..2 {

@@ -5,8 +5,8 @@
 
 use crate::common::*;
 use modal_reduce::{
-    ReducedData, ReducedModel, forward_dynamics, forward_dynamics_faer, joint_torques,
-    kinetic_energy, potential_energy, project_torques, reduced_terms, reduced_terms_faer,
+    ReducedData, ReducedModel, forward_dynamics, forward_dynamics_by_projection, joint_torques,
+    kinetic_energy, potential_energy, project_torques, reduced_terms, reduced_terms_by_projection,
 };
 use nalgebra::DMatrix;
 use proptest::prelude::*;
@@ -47,15 +47,15 @@ fn shifted(a: &[f64], d: &[f64], h: f64) -> Vec<f64> {
 proptest! {
     #![proptest_config(expensive())]
 
-    /// The default O(n m^2) path equals the faer projection of the full model to 1e-12.
+    /// The default O(n m^2) path equals the projection of the full model to 1e-12.
     #[test]
-    fn fast_path_equals_faer_path((model, a, a_dot) in model_and_state(1..=200)) {
+    fn fast_path_equals_the_projection((model, a, a_dot) in model_and_state(1..=200)) {
         let mut data = ReducedData::new(&model);
         let (mass, coriolis, gravity) = fast_terms(&model, &mut data, &a, &a_dot);
-        reduced_terms_faer(&model, &mut data, &a, &a_dot).unwrap();
-        let mass_faer = to_vec(data.mass_matrix());
+        reduced_terms_by_projection(&model, &mut data, &a, &a_dot).unwrap();
+        let mass_projected = to_vec(data.mass_matrix());
         let errors = [
-            relative_difference(&mass, &mass_faer, 0.0),
+            relative_difference(&mass, &mass_projected, 0.0),
             relative_difference(&coriolis, data.coriolis(), 1e-300),
             relative_difference(&gravity, data.gravity(), 1e-300),
         ];
@@ -193,11 +193,11 @@ proptest! {
         prop_assert!(relative_difference(&projected, tau_star, scale) < 1e-11,
             "{projected:?} vs {tau_star:?}");
 
-        let mut a_ddot_faer = vec![0.0; m];
-        forward_dynamics_faer(&model, &mut data, &a, &a_dot, tau_star, &mut a_ddot_faer).unwrap();
+        let mut a_ddot_projected = vec![0.0; m];
+        forward_dynamics_by_projection(&model, &mut data, &a, &a_dot, tau_star, &mut a_ddot_projected).unwrap();
         // Compare through M*, which removes the conditioning of the solve.
         let difference: Vec<f64> = (0..m)
-            .map(|j| (0..m).map(|k| mass[j * m + k] * (a_ddot[k] - a_ddot_faer[k])).sum())
+            .map(|j| (0..m).map(|k| mass[j * m + k] * (a_ddot[k] - a_ddot_projected[k])).sum())
             .collect();
         prop_assert!(max_abs(&difference) <= 1e-11 * scale);
     }

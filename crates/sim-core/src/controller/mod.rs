@@ -9,7 +9,7 @@
 //! so no controller needs its own copy of the model.
 //!
 //! A controller written elsewhere implements [`Controller`] and may fail with an error of its
-//! own; the run reports it as [`SimError::Controller`](crate::SimError::Controller) with the error
+//! own; the run reports it as [`SimError::Controller`] with the error
 //! as its source:
 //!
 //! ```

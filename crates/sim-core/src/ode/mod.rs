@@ -39,6 +39,7 @@ pub struct Stats {
 
 /// Why an integration stopped; `E` is the right-hand side's error type.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum OdeError<E> {
     /// The right-hand side reported an error.
     #[error("the right-hand side failed at t = {t}: {source}")]
@@ -77,12 +78,12 @@ pub enum OdeError<E> {
         max_steps: usize,
     },
     /// The state vector does not have the integrator's dimension.
-    #[error("the state has {got} entries, the integrator was built for {expected}")]
+    #[error("the state has {found} entries, the integrator was built for {expected}")]
     Dimension {
         /// The integrator's dimension.
         expected: usize,
         /// The state's length.
-        got: usize,
+        found: usize,
     },
     /// The interval, step size or tolerances were not usable.
     #[error("invalid integration setting: {0}")]
@@ -94,7 +95,7 @@ fn check_call<E>(dim: usize, y: &[f64], t0: f64, t1: f64) -> Result<(), OdeError
     if y.len() != dim {
         return Err(OdeError::Dimension {
             expected: dim,
-            got: y.len(),
+            found: y.len(),
         });
     }
     if !(t0.is_finite() && t1.is_finite()) {

@@ -27,9 +27,9 @@ pub struct Linearisation {
     augmented: Vec<f64>,
     exponential: Vec<f64>,
     work: Vec<f64>,
-    /// Row-major: `A` (`2m x 2m`), `B` (`2m x m`), `A_d`, `B_d`.
-    a: Vec<f64>,
-    b: Vec<f64>,
+    /// Row-major: `A` (`2m x 2m`), `B` (`2m x m`), `A_d`, `B_d` (`a` is kept for modal coordinates).
+    state_matrix: Vec<f64>,
+    input_matrix: Vec<f64>,
     a_d: Vec<f64>,
     b_d: Vec<f64>,
     /// `f(x, u)`: `(a_dot, a_ddot)` at the linearisation point.
@@ -48,8 +48,8 @@ impl Linearisation {
             augmented: vec![0.0; s * s],
             exponential: vec![0.0; s * s],
             work: vec![0.0; 2 * s * s],
-            a: vec![0.0; 4 * m * m],
-            b: vec![0.0; 2 * m * m],
+            state_matrix: vec![0.0; 4 * m * m],
+            input_matrix: vec![0.0; 2 * m * m],
             a_d: vec![0.0; 4 * m * m],
             b_d: vec![0.0; 2 * m * m],
             drift: vec![0.0; 2 * m],
@@ -88,14 +88,14 @@ impl Linearisation {
         let m = self.m;
         let n = 2 * m;
         let d = &self.derivatives;
-        self.a.fill(0.0);
-        self.b.fill(0.0);
+        self.state_matrix.fill(0.0);
+        self.input_matrix.fill(0.0);
         for i in 0..m {
-            self.a[i * n + m + i] = 1.0;
+            self.state_matrix[i * n + m + i] = 1.0;
             for j in 0..m {
-                self.a[(m + i) * n + j] = d.d_a()[(i, j)];
-                self.a[(m + i) * n + m + j] = d.d_a_dot()[(i, j)];
-                self.b[(m + i) * m + j] = d.d_tau_star()[(i, j)];
+                self.state_matrix[(m + i) * n + j] = d.d_a()[(i, j)];
+                self.state_matrix[(m + i) * n + m + j] = d.d_a_dot()[(i, j)];
+                self.input_matrix[(m + i) * m + j] = d.d_tau_star()[(i, j)];
             }
         }
         self.drift[..m].copy_from_slice(a_dot);
@@ -105,10 +105,10 @@ impl Linearisation {
         self.augmented.fill(0.0);
         for i in 0..n {
             for j in 0..n {
-                self.augmented[i * s + j] = self.a[i * n + j] * period;
+                self.augmented[i * s + j] = self.state_matrix[i * n + j] * period;
             }
             for j in 0..m {
-                self.augmented[i * s + n + j] = self.b[i * m + j] * period;
+                self.augmented[i * s + n + j] = self.input_matrix[i * m + j] * period;
             }
         }
         exponential(&self.augmented, &mut self.exponential, &mut self.work, s);
@@ -134,12 +134,12 @@ impl Linearisation {
 
     /// Continuous `A` (`2m x 2m`).
     pub fn continuous_a(&self) -> MatRef<'_, f64> {
-        MatRef::from_row_major_slice(&self.a, 2 * self.m, 2 * self.m)
+        MatRef::from_row_major_slice(&self.state_matrix, 2 * self.m, 2 * self.m)
     }
 
     /// Continuous `B` (`2m x m`).
     pub fn continuous_b(&self) -> MatRef<'_, f64> {
-        MatRef::from_row_major_slice(&self.b, 2 * self.m, self.m)
+        MatRef::from_row_major_slice(&self.input_matrix, 2 * self.m, self.m)
     }
 
     /// Discrete `A_d = exp(A h)` (`2m x 2m`).

@@ -68,7 +68,7 @@ impl Lqr {
                 return Err(OptimalError::Dimension {
                     name,
                     expected: size * size,
-                    got: values.len(),
+                    found: values.len(),
                 });
             }
             for i in 0..size {
@@ -119,7 +119,7 @@ impl Lqr {
             return Err(OptimalError::Dimension {
                 name: "linearisation coordinates",
                 expected: self.m,
-                got: linearisation.n_coords(),
+                found: linearisation.n_coords(),
             });
         }
         if !(settings.tolerance.is_finite() && settings.tolerance > 0.0) {
@@ -136,11 +136,11 @@ impl Lqr {
                 value: settings.max_iterations as f64,
             });
         }
-        let (a, b) = linearisation.discrete();
+        let (a_d, b_d) = linearisation.discrete();
         self.p.copy_from_slice(&self.q);
         let mut change = f64::INFINITY;
         for iteration in 1..=settings.max_iterations {
-            self.riccati_step(a, b)?;
+            self.riccati_step(a_d, b_d)?;
             let scale = self.next.iter().fold(0.0f64, |acc, x| acc.max(x.abs()));
             change = self
                 .next
@@ -153,7 +153,7 @@ impl Lqr {
                 break;
             }
             if change <= settings.tolerance {
-                self.gain_at(a, b)?;
+                self.gain_at(a_d, b_d)?;
                 return Ok(iteration);
             }
         }
@@ -164,11 +164,11 @@ impl Lqr {
     }
 
     /// `next = Q + A^T P A - A^T P B (R + B^T P B)^-1 B^T P A`, leaving `K` in `gain`.
-    fn riccati_step(&mut self, a: &[f64], b: &[f64]) -> Result<(), OptimalError> {
-        self.gain_at(a, b)?;
+    fn riccati_step(&mut self, a_d: &[f64], b_d: &[f64]) -> Result<(), OptimalError> {
+        self.gain_at(a_d, b_d)?;
         let (m, n) = (self.m, 2 * self.m);
         // next = Q + A^T (P A) - (B^T P A)^T K.
-        multiply_transposed(a, &self.pa, &mut self.next, n, n, n);
+        multiply_transposed(a_d, &self.pa, &mut self.next, n, n, n);
         multiply_transposed(&self.bpa, &self.gain, &mut self.pa, n, m, n);
         for ((next, q), correction) in self.next.iter_mut().zip(&self.q).zip(&self.pa) {
             *next += q - correction;
@@ -185,15 +185,15 @@ impl Lqr {
     }
 
     /// `K = (R + B^T P B)^-1 B^T P A` at the current `P`; leaves `P A` and `B^T P A` in scratch.
-    fn gain_at(&mut self, a: &[f64], b: &[f64]) -> Result<(), OptimalError> {
+    fn gain_at(&mut self, a_d: &[f64], b_d: &[f64]) -> Result<(), OptimalError> {
         let (m, n) = (self.m, 2 * self.m);
-        multiply(&self.p, b, &mut self.pb, n, n, m);
-        multiply(&self.p, a, &mut self.pa, n, n, n);
-        multiply_transposed(b, &self.pb, &mut self.s, m, n, m);
+        multiply(&self.p, b_d, &mut self.pb, n, n, m);
+        multiply(&self.p, a_d, &mut self.pa, n, n, n);
+        multiply_transposed(b_d, &self.pb, &mut self.s, m, n, m);
         for (s, r) in self.s.iter_mut().zip(&self.r) {
             *s += r;
         }
-        multiply_transposed(b, &self.pa, &mut self.bpa, m, n, n);
+        multiply_transposed(b_d, &self.pa, &mut self.bpa, m, n, n);
         self.gain.copy_from_slice(&self.bpa);
         if !cholesky(&mut self.s, m) {
             return Err(OptimalError::NotPositiveDefinite("R + B^T P B"));
@@ -222,17 +222,17 @@ impl Lqr {
         u: &mut [f64],
     ) -> Result<(), OptimalError> {
         let (m, n) = (self.m, 2 * self.m);
-        for (name, got, expected) in [
+        for (name, found, expected) in [
             ("u_ref", u_ref.len(), m),
             ("x", x.len(), n),
             ("x_ref", x_ref.len(), n),
             ("u", u.len(), m),
         ] {
-            if got != expected {
+            if found != expected {
                 return Err(OptimalError::Dimension {
                     name,
                     expected,
-                    got,
+                    found,
                 });
             }
         }

@@ -21,7 +21,11 @@ pub use lqr::{Lqr, LqrSettings};
 use modal_reduce::ReduceError;
 
 /// Why an optimal-control computation was refused or failed.
+///
+/// [`OptimalError::is_numerical`] and [`OptimalError::is_invalid_input`] sort the variants into
+/// the two classes a caller acts on; exactly one holds for every error.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum OptimalError {
     /// The reduced dynamics refused the state (sizes, non-finite values, or a singular `M*`).
     #[error("reduced dynamics: {0}")]
@@ -37,14 +41,14 @@ pub enum OptimalError {
         value: f64,
     },
     /// A matrix had the wrong size.
-    #[error("{name} has {got} entries, expected {expected}")]
+    #[error("{name} has {found} entries, expected {expected}")]
     Dimension {
         /// Which matrix.
         name: &'static str,
         /// The size expected.
         expected: usize,
         /// The size given.
-        got: usize,
+        found: usize,
     },
     /// The Riccati recursion did not converge within its iteration limit (the pair `(A, B)` is
     /// not stabilisable, or the weights make it too slow).
@@ -60,4 +64,23 @@ pub enum OptimalError {
     /// A matrix that must be positive definite (`R + B^T P B`) was not, numerically.
     #[error("{0} is not numerically positive definite")]
     NotPositiveDefinite(&'static str),
+}
+
+impl OptimalError {
+    /// Whether a computation on valid input failed numerically: the reduced dynamics' numerical
+    /// failures ([`ReduceError::is_numerical`]), a Riccati recursion that did not converge, or a
+    /// matrix that is not numerically positive definite.
+    pub fn is_numerical(&self) -> bool {
+        match self {
+            Self::Dynamics(e) => e.is_numerical(),
+            Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) => true,
+            _ => false,
+        }
+    }
+
+    /// Whether the input was malformed or outside its domain (every error that is not
+    /// [`is_numerical`](Self::is_numerical)).
+    pub fn is_invalid_input(&self) -> bool {
+        !self.is_numerical()
+    }
 }

@@ -60,9 +60,9 @@ struct TipMotion {
 /// - Otherwise: numerical continuation. The path starts at the closed-form `K = 1` solution on
 ///   the chosen branch (higher harmonics zero; a free `alpha0` at [`FREE_BASE_START`]), and is
 ///   resolved at the minimum-norm modal rate `a_dot = J^+ p_dot` (see `docs/theory.md`): the
-///   positions are solved on a grid of [`CHECK_SAMPLES`] intervals, each node warm-started from
-///   the previous one, and any time `t` is solved from its grid node, so a sample depends on `t`
-///   alone.
+///   positions are solved on a grid of 2000 intervals (`CHECK_SAMPLES`), each node
+///   warm-started from the previous one, and any time `t` is solved from its grid node, so a
+///   sample depends on `t` alone.
 #[derive(Debug, Clone)]
 pub struct CartesianPath {
     shape: PathShape,

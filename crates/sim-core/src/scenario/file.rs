@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 /// Why a scenario could not be read.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum ScenarioError {
     /// The file could not be read.
     #[error("cannot read scenario file {path}: {message}")]

@@ -88,7 +88,7 @@ pub struct Cell {
     pub tip_error_max_mm: Option<Stats>,
     /// Modal error RMS of each coordinate (rad), in the order of the scenario's coordinates
     /// ([`Scenario::coordinate_names`](crate::Scenario::coordinate_names)).
-    pub modal_error_rms: Vec<Option<Stats>>,
+    pub modal_error_rms_rad: Vec<Option<Stats>>,
     /// Largest joint torque (N m).
     pub peak_joint_torque_nm: Option<Stats>,
     /// The failed runs, by index.
@@ -129,11 +129,11 @@ pub fn cells(config: &SweepConfig, runs: &[RunResult]) -> Vec<Cell> {
                 failed: failures.len(),
                 tip_error_rms_mm: stats(|m| m.tip_error_rms_m * 1e3),
                 tip_error_max_mm: stats(|m| m.tip_error_max_m * 1e3),
-                modal_error_rms: (0..m)
+                modal_error_rms_rad: (0..m)
                     .map(|i| {
                         let values: Vec<f64> = completed
                             .iter()
-                            .filter_map(|r| r.modal_error_rms.get(i).copied())
+                            .filter_map(|r| r.modal_error_rms_rad.get(i).copied())
                             .collect();
                         Stats::of(&values)
                     })

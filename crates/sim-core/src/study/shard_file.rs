@@ -69,11 +69,11 @@ pub struct RunMetrics {
     /// Largest tip error (m).
     pub tip_error_max_m: f64,
     /// Modal error RMS per coordinate (rad).
-    pub modal_error_rms: Vec<f64>,
+    pub modal_error_rms_rad: Vec<f64>,
     /// Largest joint torque (N m).
     pub peak_joint_torque_nm: f64,
     /// Control effort (N^2 m^2 s).
-    pub control_effort: f64,
+    pub control_effort_n2m2s: f64,
 }
 
 impl RunMetrics {
@@ -82,19 +82,19 @@ impl RunMetrics {
         let m = RunMetrics {
             tip_error_rms_m: s.tip_error_rms_m,
             tip_error_max_m: s.tip_error_max_m,
-            modal_error_rms: s.modal_error_rms.clone(),
+            modal_error_rms_rad: s.modal_error_rms_rad.clone(),
             peak_joint_torque_nm: s.peak_joint_torque_nm,
-            control_effort: s.control_effort,
+            control_effort_n2m2s: s.control_effort_n2m2s,
         };
         let values = [
             m.tip_error_rms_m,
             m.tip_error_max_m,
             m.peak_joint_torque_nm,
-            m.control_effort,
+            m.control_effort_n2m2s,
         ];
         if values
             .iter()
-            .chain(&m.modal_error_rms)
+            .chain(&m.modal_error_rms_rad)
             .all(|v| v.is_finite())
         {
             Ok(m)
@@ -152,13 +152,13 @@ impl ShardFile {
         let m = file.config.scenario.n_coords();
         for run in &file.runs {
             if let Outcome::Completed(metrics) = &run.outcome
-                && metrics.modal_error_rms.len() != m
+                && metrics.modal_error_rms_rad.len() != m
             {
                 return Err(format!(
                     "{}: run {} has {} modal errors, but its scenario has {m} modal coordinates",
                     origin.display(),
                     run.index,
-                    metrics.modal_error_rms.len()
+                    metrics.modal_error_rms_rad.len()
                 ));
             }
         }
@@ -172,7 +172,7 @@ impl ShardFile {
             .map_err(|e| e.to_string())
     }
 
-    /// Reads a shard file (at most [`MAX_SHARD_FILE_BYTES`]).
+    /// Reads a shard file (at most `MAX_SHARD_FILE_BYTES`, 1 GiB).
     pub fn read(path: &Path) -> Result<Self, String> {
         let text = crate::read_text_file(path, MAX_SHARD_FILE_BYTES)
             .map_err(|e| format!("cannot read {}: {e}", path.display()))?;

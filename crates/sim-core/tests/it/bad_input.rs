@@ -449,7 +449,7 @@ fn ode_state_of_wrong_dimension() {
         err,
         OdeError::Dimension {
             expected: 1,
-            got: 2
+            found: 2
         }
     ));
     assert_eq!(y, [1.0, 2.0]);

@@ -36,7 +36,7 @@ fn computed_torque_holds_a_pose_exactly_and_converges_to_machine_precision() {
     let mut hold = scenario("paper-responses-noise", ControllerKind::ComputedTorque, 1.0);
     hold.noise = Default::default();
     let run = hold.build().unwrap().run().unwrap();
-    for e in run.summary.modal_error_max {
+    for e in run.summary.modal_error_max_rad {
         assert!(e < 1e-14, "hold error {e:e}");
     }
     // From the step: e'' + kd e' + kp e = 0 with kp = 2500, kd = 100 decays like
@@ -71,7 +71,12 @@ fn computed_torque_tracking_error_is_first_order_in_the_hold_period() {
                 a: vec![0.0, 0.1],
                 a_dot: Some(vec![0.3 * TAU * 0.5, 0.15 * TAU]),
             });
-            s.build().unwrap().run().unwrap().summary.modal_error_rms[0]
+            s.build()
+                .unwrap()
+                .run()
+                .unwrap()
+                .summary
+                .modal_error_rms_rad[0]
         })
         .collect();
     for pair in errors.windows(2) {
@@ -348,7 +353,7 @@ fn summary_metrics_are_the_record_statistics() {
         .sum();
     assert_eq!(run.summary.controller_samples, 10_001);
     assert_eq!(run.summary.recorded_samples, 1_001);
-    assert!(effort > 0.0 && (run.summary.control_effort - effort).abs() < 0.05 * effort);
+    assert!(effort > 0.0 && (run.summary.control_effort_n2m2s - effort).abs() < 0.05 * effort);
 }
 
 #[test]
@@ -519,7 +524,7 @@ fn the_loop_runs_every_controller_for_m_2_to_5() {
             .unwrap();
         let last = run.record.len() - 1;
         assert_eq!(run.record.n_coords, m);
-        assert_eq!(run.summary.modal_error_rms.len(), m);
+        assert_eq!(run.summary.modal_error_rms_rad.len(), m);
         for i in 0..m {
             let e = run.record.a_at(last)[i] - run.record.a_ref_at(last)[i];
             assert!(
@@ -545,9 +550,9 @@ fn the_loop_runs_every_controller_for_m_2_to_5() {
         ] {
             let run = family_step(m, kind, 1.0).build().unwrap().run().unwrap();
             assert!(
-                run.summary.modal_error_max.iter().all(|e| *e < 0.5),
+                run.summary.modal_error_max_rad.iter().all(|e| *e < 0.5),
                 "m = {m}, {kind}: {:?}",
-                run.summary.modal_error_max
+                run.summary.modal_error_max_rad
             );
         }
     }
@@ -643,7 +648,13 @@ fn a_foreign_controller_error_stops_the_run_with_its_source() {
     );
     // Held against gravity until then, and recorded up to the last good sample.
     assert_eq!(failure.record.t.last(), Some(&0.04));
-    assert!(failure.summary.modal_error_max.iter().all(|e| *e < 1e-6));
+    assert!(
+        failure
+            .summary
+            .modal_error_max_rad
+            .iter()
+            .all(|e| *e < 1e-6)
+    );
 }
 
 #[test]
@@ -682,7 +693,7 @@ fn computed_torque_tracks_the_other_families_below_a_millimetre() {
         assert_eq!(scenario.n_coords(), m);
         scenario.controller.kind = ControllerKind::ComputedTorque;
         let run = scenario.build().unwrap().run().unwrap();
-        assert_eq!(run.summary.modal_error_rms.len(), m);
+        assert_eq!(run.summary.modal_error_rms_rad.len(), m);
         assert!(
             run.summary.tip_error_rms_m < 1e-3,
             "{name}: tip RMS {} m",

@@ -277,7 +277,7 @@ fn operating_points_shift_the_reference_and_nothing_else() {
         original.build().unwrap().run().unwrap(),
         moved.build().unwrap().run().unwrap(),
     );
-    let (ea, eb) = (a.summary.modal_error_rms, b.summary.modal_error_rms);
+    let (ea, eb) = (a.summary.modal_error_rms_rad, b.summary.modal_error_rms_rad);
     assert!((ea[0] - eb[0]).abs() < 0.05 * ea[0], "{ea:?} vs {eb:?}");
     let path = Scenario::builtin("paper-tracking").unwrap();
     assert_eq!(

@@ -45,7 +45,10 @@ fn a_hundred_link_arm_runs_with_every_controller() {
         // within 1% (measured: 3e-4 relative).
         let reference = small.build().unwrap().run().unwrap().summary;
         for i in 0..2 {
-            let (large, small) = (run.summary.modal_error_rms[i], reference.modal_error_rms[i]);
+            let (large, small) = (
+                run.summary.modal_error_rms_rad[i],
+                reference.modal_error_rms_rad[i],
+            );
             assert!(
                 (large - small).abs() <= 0.01 * small,
                 "{kind}: a{} error rms {large:e} (100 links) vs {small:e} (10 links)",
@@ -71,11 +74,11 @@ fn a_sixty_second_run_stays_on_its_periodic_orbit() {
     let first = short.build().unwrap().run().unwrap().summary;
     for i in 0..2 {
         assert!(
-            run.summary.modal_error_max[i] <= first.modal_error_max[i] * (1.0 + 1e-9),
+            run.summary.modal_error_max_rad[i] <= first.modal_error_max_rad[i] * (1.0 + 1e-9),
             "a{}: max error {:e} over 60 s vs {:e} over 4 s",
             i + 1,
-            run.summary.modal_error_max[i],
-            first.modal_error_max[i]
+            run.summary.modal_error_max_rad[i],
+            first.modal_error_max_rad[i]
         );
     }
     // The last period's error repeats the second period's (measured: equal to 1e-8 relative).

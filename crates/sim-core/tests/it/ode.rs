@@ -313,14 +313,14 @@ fn bad_calls_are_refused() {
         rk4.integrate(&mut osc, 0.0, 1.0, &mut short, 0.1),
         Err(OdeError::Dimension {
             expected: 2,
-            got: 1
+            found: 1
         })
     ));
     assert!(matches!(
         dp5.integrate(&mut osc, 0.0, 1.0, &mut short),
         Err(OdeError::Dimension {
             expected: 2,
-            got: 1
+            found: 1
         })
     ));
     let mut y = [1.0, 0.0];

@@ -251,13 +251,13 @@ fn check(text: &str) -> Result<(), TestCaseError> {
                 s.tip_error_rms_m,
                 s.tip_error_max_m,
                 s.peak_joint_torque_nm,
-                s.control_effort,
+                s.control_effort_n2m2s,
             ];
             let all = numbers
                 .iter()
-                .chain(&s.modal_error_rms)
-                .chain(&s.modal_error_max)
-                .chain(&s.peak_modal_torque)
+                .chain(&s.modal_error_rms_rad)
+                .chain(&s.modal_error_max_rad)
+                .chain(&s.peak_modal_torques_nm)
                 .chain(&s.peak_joint_torques_nm);
             for x in all {
                 prop_assert!(x.is_finite(), "non-finite summary {:?}\n{}", s, text);

@@ -1,0 +1,533 @@
+//! `cargo xtask tidy`: the rules of the repository that a reviewer would otherwise have to
+//! remember, checked by machine. `cargo xtask ci` runs it before the tests.
+//!
+//! - Every test that `docs/bad-input.md` names exists: each `` `crate/path.rs::name` `` (also
+//!   `::module::name`, `::{a, b}`, and `::tests::*` for every test of a file) points at a file
+//!   that defines `fn name`.
+//! - Every crate's README is its crate documentation (`#![doc = include_str!("../README.md")]`
+//!   in `src/lib.rs` or `src/main.rs`), so its Rust blocks are doctests.
+//! - No README cites a file outside the repository: a relative link or a quoted path
+//!   (`` `docs/theory.md` ``) resolves to a file of the repository (from the README's folder or
+//!   the root), a link into the repository's URL names a file that exists, a crate README (which
+//!   crates.io and docs.rs show without the rest of the repository) has no relative link leaving
+//!   its crate, and no README names an absolute path.
+//! - Invariants of `docs/architecture.md`: every crate takes its lints from `[workspace.lints]`;
+//!   every public error enum of a library crate is `#[non_exhaustive]`; `fuzzy-sugeno` depends
+//!   on none of the other crates, and no library crate depends on the command line.
+//! - `cargo doc --workspace --no-deps` with `RUSTDOCFLAGS=-D warnings`.
+//!
+//! Each check is a function of file contents (the file system is read in [`run`] only), with a
+//! unit test that feeds it a bad input.
+
+use std::path::{Component, Path, PathBuf};
+
+/// The repository's address; links into it must name files that exist.
+const REPOSITORY: &str = "https://github.com/hrm-toolkit/hrm";
+
+/// The workspace's library crates (published, usable alone).
+const LIBRARIES: [&str; 6] = [
+    "backbone-kin",
+    "manip-dyn",
+    "modal-reduce",
+    "fuzzy-sugeno",
+    "sim-core",
+    "hrm",
+];
+
+/// Runs every check against the repository at `root` (then `cargo doc` through `doc`) and
+/// returns the problems found, one line each.
+pub fn run(root: &Path, doc: impl FnOnce() -> Result<(), String>) -> Vec<String> {
+    let mut problems = Vec::new();
+    let read = |path: &Path| std::fs::read_to_string(root.join(path));
+
+    match read(Path::new("docs/bad-input.md")) {
+        Ok(text) => {
+            for reference in test_references(&text) {
+                let path = Path::new("crates").join(&reference.file);
+                let source = read(&path).unwrap_or_default();
+                for name in reference.names {
+                    if !defines_fn(&source, &name) {
+                        problems.push(format!(
+                            "docs/bad-input.md names {}::{name}, but {} defines no `fn {name}`",
+                            reference.file,
+                            path.display()
+                        ));
+                    }
+                }
+            }
+        }
+        Err(e) => problems.push(format!("docs/bad-input.md: {e}")),
+    }
+
+    let crates = list_dir(&root.join("crates"));
+    for krate in &crates {
+        let dir = Path::new("crates").join(krate);
+        let roots = ["src/lib.rs", "src/main.rs"].map(|file| read(&dir.join(file)).ok());
+        if !roots.iter().flatten().any(|source| includes_readme(source)) {
+            problems.push(format!(
+                "{}: the crate root does not include README.md as its documentation \
+                 (#![doc = include_str!(\"../README.md\")])",
+                dir.display()
+            ));
+        }
+        match read(&dir.join("Cargo.toml")) {
+            Ok(manifest) => {
+                if !uses_workspace_lints(&manifest) {
+                    problems.push(format!(
+                        "{}/Cargo.toml: no `[lints] workspace = true`",
+                        dir.display()
+                    ));
+                }
+                let forbidden: &[&str] = match krate.as_str() {
+                    "fuzzy-sugeno" => &[
+                        "backbone-kin",
+                        "manip-dyn",
+                        "modal-reduce",
+                        "sim-core",
+                        "hrm",
+                        "hrm-cli",
+                    ],
+                    k if LIBRARIES.contains(&k) => &["hrm-cli"],
+                    _ => &[],
+                };
+                for dependency in dependencies(&manifest) {
+                    if forbidden.contains(&dependency.as_str()) {
+                        problems.push(format!(
+                            "{}/Cargo.toml: {krate} must not depend on {dependency} \
+                             (docs/architecture.md, \"Library crates are usable alone\")",
+                            dir.display()
+                        ));
+                    }
+                }
+            }
+            Err(e) => problems.push(format!("{}/Cargo.toml: {e}", dir.display())),
+        }
+        if LIBRARIES.contains(&krate.as_str()) {
+            for file in rust_files(&root.join(&dir).join("src")) {
+                let source = std::fs::read_to_string(&file).unwrap_or_default();
+                for name in exhaustive_error_enums(&source) {
+                    problems.push(format!(
+                        "{}: the public error enum {name} is not #[non_exhaustive]",
+                        file.strip_prefix(root).unwrap_or(&file).display()
+                    ));
+                }
+            }
+        }
+    }
+
+    let mut readmes: Vec<(PathBuf, bool)> = vec![(PathBuf::from("README.md"), false)];
+    readmes.extend(
+        crates
+            .iter()
+            .map(|krate| (Path::new("crates").join(krate).join("README.md"), true)),
+    );
+    readmes.push((PathBuf::from("fuzz/README.md"), false));
+    for (readme, is_crate) in readmes {
+        match read(&readme) {
+            Ok(text) => {
+                let exists = |path: &Path| root.join(path).exists();
+                problems.extend(
+                    citation_problems(&readme, &text, is_crate, exists)
+                        .into_iter()
+                        .map(|problem| format!("{}: {problem}", readme.display())),
+                );
+            }
+            Err(e) => problems.push(format!("{}: {e}", readme.display())),
+        }
+    }
+
+    if let Err(e) = doc() {
+        problems.push(e);
+    }
+    problems
+}
+
+/// Tests named by a row of `docs/bad-input.md`: a file under `crates/` and the functions in it.
+#[derive(Debug, PartialEq)]
+pub struct TestReference {
+    /// `crate/path.rs`, relative to `crates/`.
+    pub file: String,
+    /// The test functions (the last segment of each path).
+    pub names: Vec<String>,
+}
+
+/// Every `` `crate/path.rs::name` `` in `text`; `::module::name` names `name`, `::{a, b}` names
+/// both.
+pub fn test_references(text: &str) -> Vec<TestReference> {
+    let mut references = Vec::new();
+    for span in text.split('`').skip(1).step_by(2) {
+        let Some((file, item)) = span.split_once("::") else {
+            continue;
+        };
+        let is_path = file.ends_with(".rs")
+            && file.contains('/')
+            && file
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "-_/.".contains(c));
+        if !is_path {
+            continue;
+        }
+        let item = item.trim();
+        let names = match item.strip_prefix('{').and_then(|i| i.strip_suffix('}')) {
+            Some(list) => list.split(',').map(str::trim).collect(),
+            None => vec![item],
+        };
+        let names = names
+            .into_iter()
+            .map(|name| name.rsplit("::").next().unwrap_or(name).to_string())
+            .collect();
+        references.push(TestReference {
+            file: file.to_string(),
+            names,
+        });
+    }
+    references
+}
+
+/// Whether `source` defines a function `name` (`fn name(` or `fn name<`); the name `*` (every
+/// test of a module) asks for at least one `#[test]`.
+pub fn defines_fn(source: &str, name: &str) -> bool {
+    if name == "*" {
+        return source.contains("#[test]");
+    }
+    source.match_indices("fn ").any(|(at, _)| {
+        let rest = source[at + 3..].trim_start();
+        rest.strip_prefix(name)
+            .is_some_and(|after| after.trim_start().starts_with(['(', '<']))
+            && source[..at]
+                .chars()
+                .last()
+                .is_none_or(|c| !(c.is_alphanumeric() || c == '_'))
+    })
+}
+
+/// Whether a crate root takes its documentation from the crate's README.
+pub fn includes_readme(source: &str) -> bool {
+    source
+        .lines()
+        .any(|line| line.trim() == "#![doc = include_str!(\"../README.md\")]")
+}
+
+/// Whether a manifest takes its lints from the workspace.
+pub fn uses_workspace_lints(manifest: &str) -> bool {
+    let mut in_lints = false;
+    for line in manifest.lines().map(str::trim) {
+        if line.starts_with('[') {
+            in_lints = line == "[lints]";
+        } else if in_lints && line.replace(' ', "") == "workspace=true" {
+            return true;
+        }
+    }
+    manifest
+        .lines()
+        .any(|line| line.replace(' ', "") == "lints.workspace=true")
+}
+
+/// The names of a manifest's normal dependencies (not dev- or build-dependencies).
+pub fn dependencies(manifest: &str) -> Vec<String> {
+    let mut names = Vec::new();
+    let mut in_dependencies = false;
+    for line in manifest.lines().map(str::trim) {
+        if line.starts_with('[') {
+            in_dependencies = line == "[dependencies]";
+        } else if in_dependencies
+            && let Some(name) = line.split(['=', '.', ' ']).next()
+            && !name.is_empty()
+            && !name.starts_with('#')
+        {
+            names.push(name.to_string());
+        }
+    }
+    names
+}
+
+/// The public error enums (`pub enum ...Error`) of `source` that lack `#[non_exhaustive]` among
+/// the attributes above them.
+pub fn exhaustive_error_enums(source: &str) -> Vec<String> {
+    let lines: Vec<&str> = source.lines().collect();
+    let mut found = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let Some(rest) = line.trim().strip_prefix("pub enum ") else {
+            continue;
+        };
+        let name: String = rest
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
+        if !name.ends_with("Error") {
+            continue;
+        }
+        let attributes = lines[..i]
+            .iter()
+            .rev()
+            .map(|l| l.trim())
+            .take_while(|l| l.starts_with("#[") || l.starts_with("///") || l.starts_with(')'));
+        if !attributes.into_iter().any(|l| l == "#[non_exhaustive]") {
+            found.push(name);
+        }
+    }
+    found
+}
+
+/// What is wrong with the files a README cites: `readme` is its path from the root, `exists`
+/// answers for paths from the root, and `is_crate` marks a crate's README (published alone).
+pub fn citation_problems(
+    readme: &Path,
+    text: &str,
+    is_crate: bool,
+    exists: impl Fn(&Path) -> bool,
+) -> Vec<String> {
+    let dir = readme.parent().unwrap_or(Path::new(""));
+    let text = &without_code_blocks(text);
+    let mut problems = Vec::new();
+    for target in link_targets(text) {
+        let target = target.split('#').next().unwrap_or_default();
+        if target.is_empty() || target.starts_with("mailto:") {
+            continue;
+        }
+        if let Some(rest) = target.strip_prefix(REPOSITORY) {
+            let path = ["/blob/main/", "/tree/main/"]
+                .iter()
+                .find_map(|prefix| rest.strip_prefix(prefix));
+            match path {
+                Some(path) if !exists(Path::new(path)) => problems.push(format!(
+                    "the link {target} names {path}, which is not in the repository"
+                )),
+                None if !rest.is_empty() => problems.push(format!(
+                    "the link {target} is not a file of the repository's main branch"
+                )),
+                _ => {}
+            }
+            continue;
+        }
+        if target.contains("://") {
+            continue;
+        }
+        if target.starts_with('/') || target.starts_with('~') {
+            problems.push(format!("the link {target} is an absolute path"));
+            continue;
+        }
+        match normalise(&dir.join(target)) {
+            None => problems.push(format!("the link {target} leaves the repository")),
+            Some(path) if !exists(&path) => problems.push(format!(
+                "the link {target} names {}, which does not exist",
+                path.display()
+            )),
+            Some(path) if is_crate && !path.starts_with(dir) => problems.push(format!(
+                "the link {target} leaves the crate, whose README is also its crates.io page: \
+                 link {REPOSITORY}/blob/main/{} instead",
+                path.display()
+            )),
+            Some(_) => {}
+        }
+    }
+    for span in text.split('`').skip(1).step_by(2) {
+        let looks_like_file = span.contains('/')
+            && !span.contains(char::is_whitespace)
+            && !span.contains("::")
+            && [".md", ".rs", ".toml", ".fis", ".fcl", ".py", ".csv"]
+                .iter()
+                .any(|ext| span.ends_with(ext));
+        if !looks_like_file {
+            continue;
+        }
+        if span.starts_with('/') || span.starts_with('~') {
+            problems.push(format!("`{span}` is an absolute path"));
+            continue;
+        }
+        let found = [dir.join(span), PathBuf::from(span)]
+            .iter()
+            .any(|path| normalise(path).is_some_and(|path| exists(&path)));
+        if !found {
+            problems.push(format!("`{span}` is not a file of the repository"));
+        }
+    }
+    problems
+}
+
+/// `text` without its fenced code blocks (whose backticks and brackets are code, not Markdown).
+fn without_code_blocks(text: &str) -> String {
+    let mut inside = false;
+    let mut kept = String::new();
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            inside = !inside;
+        } else if !inside {
+            kept.push_str(line);
+            kept.push('\n');
+        }
+    }
+    kept
+}
+
+/// The targets of the Markdown links `[text](target)` of `text`.
+fn link_targets(text: &str) -> Vec<&str> {
+    text.match_indices("](")
+        .filter_map(|(at, _)| {
+            let rest = &text[at + 2..];
+            rest.find(')').map(|end| rest[..end].trim())
+        })
+        .collect()
+}
+
+/// `path` with `.` and `..` resolved, or `None` if it climbs above its start.
+fn normalise(path: &Path) -> Option<PathBuf> {
+    let mut out = PathBuf::new();
+    for component in path.components() {
+        match component {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                if !out.pop() {
+                    return None;
+                }
+            }
+            Component::Normal(part) => out.push(part),
+            Component::RootDir | Component::Prefix(_) => return None,
+        }
+    }
+    Some(out)
+}
+
+/// The names of the folders in `dir`, sorted.
+fn list_dir(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter(|entry| entry.path().is_dir())
+        .map(|entry| entry.file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Every `.rs` file under `dir`.
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            files.extend(rust_files(&path));
+        } else if path.extension().is_some_and(|ext| ext == "rs") {
+            files.push(path);
+        }
+    }
+    files.sort();
+    files
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn test_references_are_parsed_in_every_form() {
+        let doc = "| a | b | `manip-dyn/tests/bad_input.rs::non_finite_gravity` |\n\
+                   | c | `fuzzy-sugeno/src/learn/genfis.rs::tests::bad_requests` |\n\
+                   `hrm-cli/tests/eval_stream.rs::{one, two_three}` and `<crate>/tests/<file>.rs::<test>` \
+                   and `Scenario::build` and `docs/sweep.md`";
+        assert_eq!(
+            test_references(doc),
+            [
+                TestReference {
+                    file: "manip-dyn/tests/bad_input.rs".into(),
+                    names: vec!["non_finite_gravity".into()],
+                },
+                TestReference {
+                    file: "fuzzy-sugeno/src/learn/genfis.rs".into(),
+                    names: vec!["bad_requests".into()],
+                },
+                TestReference {
+                    file: "hrm-cli/tests/eval_stream.rs".into(),
+                    names: vec!["one".into(), "two_three".into()],
+                },
+            ]
+        );
+    }
+
+    #[test]
+    fn a_missing_test_function_is_found() {
+        let source = "#[test]\nfn present() {}\nfn generic<T>() {}\nfn present_too_long() {}";
+        assert!(defines_fn(source, "present"));
+        assert!(defines_fn(source, "generic"));
+        assert!(!defines_fn(source, "absent"));
+        assert!(!defines_fn(source, "present_too"));
+        assert!(!defines_fn("fn unpresent() {}", "present"));
+        assert!(defines_fn(source, "*"));
+        assert!(!defines_fn("fn helper() {}", "*"));
+    }
+
+    #[test]
+    fn a_crate_root_without_its_readme_is_found() {
+        assert!(includes_readme(
+            "#![doc = include_str!(\"../README.md\")]\n\nmod a;"
+        ));
+        assert!(!includes_readme(
+            "//! Docs.\n#[doc = include_str!(\"../README.md\")]\n#[cfg(doctest)]\npub struct R;"
+        ));
+    }
+
+    #[test]
+    fn a_manifest_without_workspace_lints_is_found() {
+        assert!(uses_workspace_lints(
+            "[package]\nname = \"a\"\n\n[lints]\nworkspace = true\n"
+        ));
+        assert!(uses_workspace_lints("[package]\nlints.workspace = true\n"));
+        assert!(!uses_workspace_lints(
+            "[package]\nname = \"a\"\n[lints.rust]\nmissing_docs = \"deny\"\n"
+        ));
+    }
+
+    #[test]
+    fn only_normal_dependencies_are_listed() {
+        let manifest = "[package]\nname = \"x\"\n[dependencies]\nthiserror.workspace = true\n\
+                        # a comment\nsim-core = { workspace = true }\n[dev-dependencies]\n\
+                        manip-dyn.workspace = true\n";
+        assert_eq!(dependencies(manifest), ["thiserror", "sim-core"]);
+    }
+
+    #[test]
+    fn an_exhaustive_error_enum_is_found() {
+        let source = "/// Doc.\n#[derive(Debug)]\n#[non_exhaustive]\npub enum GoodError {\n}\n\
+                      /// Doc.\n#[derive(Debug)]\npub enum BadError {\n}\n\
+                      pub enum Kind {}\npub(crate) enum PrivateError {}\n";
+        assert_eq!(exhaustive_error_enums(source), ["BadError"]);
+    }
+
+    #[test]
+    fn citations_outside_the_repository_are_found() {
+        let files = [
+            "docs/theory.md",
+            "crates/a/README.md",
+            "crates/a/src/lib.rs",
+        ];
+        let exists = |path: &Path| files.iter().any(|f| Path::new(f) == path);
+        let readme = Path::new("crates/a/README.md");
+        let good = "[theory](https://github.com/hrm-toolkit/hrm/blob/main/docs/theory.md), \
+                    [home](https://github.com/hrm-toolkit/hrm), [lib](src/lib.rs#L3), \
+                    [rust](https://www.rust-lang.org/x.md), `docs/theory.md`, `src/lib.rs`, \
+                    `hrm::prelude`, `timeseries.csv`";
+        assert_eq!(
+            citation_problems(readme, good, true, exists),
+            Vec::<String>::new()
+        );
+        let bad = "[a](../../docs/theory.md) [b](../../../outside.md) [c](/work/shared/notes.md) \
+                   [d](https://github.com/hrm-toolkit/hrm/blob/main/docs/gone.md) [e](src/gone.rs) \
+                   `/work/shared/seed/paper.md` `docs/gone.md`\n\
+                   ```rust\nlet odd = '`'; let link = v[0](x);\n```\n";
+        let problems = citation_problems(readme, bad, true, exists);
+        assert_eq!(problems.len(), 7, "{problems:#?}");
+        assert!(problems[0].contains("leaves the crate"), "{}", problems[0]);
+        assert!(
+            problems[1].contains("leaves the repository"),
+            "{}",
+            problems[1]
+        );
+        assert!(problems[2].contains("absolute"), "{}", problems[2]);
+        // The root README may link into the crates.
+        assert_eq!(
+            citation_problems(Path::new("README.md"), "[t](docs/theory.md)", false, exists),
+            Vec::<String>::new()
+        );
+    }
+}
