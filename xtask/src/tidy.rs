@@ -48,7 +48,7 @@ pub fn run(root: &Path, doc: impl FnOnce() -> Result<(), String>) -> Vec<String>
                 for name in reference.names {
                     if !defines_fn(&source, &name) {
                         problems.push(format!(
-                            "docs/bad-input.md names {}::{name}, but {} defines no `fn {name}`",
+                            "docs/bad-input.md names {}::{name}, but {} defines no `fn {name}` and no refusal-table row \"{name}\"",
                             reference.file,
                             path.display()
                         ));
@@ -184,11 +184,15 @@ pub fn test_references(text: &str) -> Vec<TestReference> {
     references
 }
 
-/// Whether `source` defines a function `name` (`fn name(` or `fn name<`); the name `*` (every
-/// test of a module) asks for at least one `#[test]`.
+/// Whether `source` defines the test `name`: a function `fn name(` or `fn name<`, or a row of a
+/// refusal table named by the string literal `"name"` (the tables of `test_support::refusal`);
+/// the name `*` (every test of a module) asks for at least one `#[test]`.
 pub fn defines_fn(source: &str, name: &str) -> bool {
     if name == "*" {
         return source.contains("#[test]");
+    }
+    if source.contains(&format!("\"{name}\"")) {
+        return true;
     }
     source.match_indices("fn ").any(|(at, _)| {
         let rest = source[at + 3..].trim_start();
@@ -455,6 +459,9 @@ mod tests {
         assert!(!defines_fn("fn unpresent() {}", "present"));
         assert!(defines_fn(source, "*"));
         assert!(!defines_fn("fn helper() {}", "*"));
+        let table = "row(\n    \"zero_links\",\n    err,\n)";
+        assert!(defines_fn(table, "zero_links"));
+        assert!(!defines_fn(table, "zero"));
     }
 
     #[test]
