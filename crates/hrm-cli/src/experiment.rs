@@ -24,7 +24,10 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
     let outcome = run_one(&scenario, scenario.controller.kind);
     write_outcome(&outcome, staging.path())?;
     staging.commit()?;
-    console::print(&table(&table_rows(std::slice::from_ref(&outcome))))?;
+    console::print(&table(&table_rows(
+        std::slice::from_ref(&outcome),
+        std::slice::from_ref(&scenario),
+    )))?;
     console::print(&format!("wrote {}\n", out.display()))?;
     outcome.result.map(|_| ()).map_err(|stopped| stopped.error)
 }
@@ -53,7 +56,7 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
     let outcomes = outcomes?;
     let summaries: Vec<_> = outcomes.iter().map(outcome_json).collect();
     write(&dir.join("summary.json"), &pretty(&json!(summaries))?)?;
-    let rows = table_rows(&outcomes);
+    let rows = table_rows(&outcomes, scenarios);
     let text = table(&rows);
     write(&dir.join("comparison.txt"), &text)?;
     let sections = figures(dir, scenarios, &outcomes)?;
@@ -247,6 +250,7 @@ fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
         header.extend(names.iter().map(|n| format!("{n}_ref")));
         header.extend((1..=names.len()).map(|i| format!("tau{i}")));
         header.extend(["tip_x", "tip_y", "tip_ref_x", "tip_ref_y"].map(String::from));
+        header.extend((1..=names.len()).map(|i| format!("clamped{i}")));
         let mut csv = header.join(",") + "\n";
         for k in 0..r.len() {
             let row = std::iter::once(r.t[k])
@@ -255,7 +259,8 @@ fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
                 .chain(r.a_ref_at(k).iter().copied())
                 .chain(r.tau_star_at(k).iter().copied())
                 .chain(r.tip[k])
-                .chain(r.tip_ref[k]);
+                .chain(r.tip_ref[k])
+                .chain(r.clamped_at(k).iter().map(|&c| f64::from(u8::from(c))));
             let line: Vec<String> = row.map(|v| v.to_string()).collect();
             let _ = writeln!(csv, "{}", line.join(","));
         }
@@ -265,7 +270,7 @@ fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
 }
 
 /// The comparison table's columns.
-const HEADERS: [&str; 8] = [
+const HEADERS: [&str; 9] = [
     "scenario",
     "controller",
     "tip rms mm",
@@ -274,14 +279,19 @@ const HEADERS: [&str; 8] = [
     "peak tau* (N m)",
     "peak tau N m",
     "effort",
+    "clamped %",
 ];
 
 /// The comparison table's rows: tip error RMS and maximum (mm), modal error RMS, peak torques,
-/// effort; a failed run has only its scenario and controller, and its error.
-fn table_rows(outcomes: &[Outcome]) -> Vec<report::Row> {
+/// effort, and the percentage of controller samples whose `tau_i*` the actuator limits clamped
+/// (`-` for a scenario without limits); a failed run has only its scenario and controller, and its error.
+fn table_rows(outcomes: &[Outcome], scenarios: &[Scenario]) -> Vec<report::Row> {
     outcomes
         .iter()
         .map(|o| {
+            let limited = scenarios
+                .iter()
+                .any(|s| s.name == o.scenario && s.limits.tau_star.is_some());
             let mut cells = vec![o.scenario.clone(), o.controller.name().to_owned()];
             match &o.result {
                 Ok(run) => {
@@ -293,6 +303,13 @@ fn table_rows(outcomes: &[Outcome]) -> Vec<report::Row> {
                         list(&m.peak_modal_torque, |v| format!("{v:.2}")),
                         format!("{:.3}", m.peak_joint_torque_nm),
                         format!("{:.4e}", m.control_effort),
+                        if limited {
+                            list(&m.tau_star_clamped_fraction, |v| {
+                                format!("{:.1}", 100.0 * v)
+                            })
+                        } else {
+                            "-".to_owned()
+                        },
                     ]);
                     report::Row { cells, error: None }
                 }
@@ -385,7 +402,7 @@ mod tests {
             csv.lines().count(),
             outcome.result.as_ref().unwrap().record.len() + 1
         );
-        assert!(table(&table_rows(&[outcome])).contains("computed-torque"));
+        assert!(table(&table_rows(&[outcome], &[scenario])).contains("computed-torque"));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

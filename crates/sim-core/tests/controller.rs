@@ -40,6 +40,7 @@ fn control(
         measured,
         reference,
         model,
+        tau_star_limits: None,
     };
     controller
         .control(&ctx, &mut tau)

@@ -103,6 +103,10 @@ pub struct ControlContext<'a> {
     pub reference: &'a ReferenceSample,
     /// The reduced model being simulated.
     pub model: &'a ReducedModel,
+    /// The actuator limits on `tau*` (N m, `m` entries) if the loop has any: the loop clamps
+    /// whatever the controller asks for to `[-limit_i, limit_i]`, so a controller that plans
+    /// (e.g. model-predictive control) can respect them itself. `None` without limits.
+    pub tau_star_limits: Option<&'a [f64]>,
 }
 
 /// A feedback law producing the modal generalized forces `tau*` (N m), one per coordinate.

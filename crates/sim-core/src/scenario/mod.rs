@@ -44,7 +44,8 @@
 //!
 //! [limits]
 //! max_modal_error = 3.14  # rad, runaway bound
-//! joint_torque_nm = 5.0   # or one limit per joint
+//! joint_torque_nm = 5.0   # or one limit per joint; exceeding is reported
+//! tau_star = [2.0, 0.5]   # N m, or one limit for all: the loop clamps tau* to +-limit
 //! ```
 
 mod builtin;
@@ -57,5 +58,5 @@ pub use controllers::{CONTROLLERS, ControllerEntry, ControllerKind, ControllerSe
 pub use file::ScenarioError;
 pub use schema::{
     Alpha0, ArmSpec, BranchSpec, ControllerSpec, InitialSpec, IntegratorSpec, LimitsSpec,
-    ModalSpec, NoiseSpec, ReferenceSpec, Scenario, SineSpec, TorqueLimit,
+    ModalSpec, ModalTorqueLimit, NoiseSpec, ReferenceSpec, Scenario, SineSpec, TorqueLimit,
 };
