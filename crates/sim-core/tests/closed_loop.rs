@@ -534,7 +534,11 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
         "computed-torque".parse::<ControllerKind>().unwrap(),
         ControllerKind::ComputedTorque
     );
-    assert!("lqr".parse::<ControllerKind>().is_err());
+    assert!("bang-bang".parse::<ControllerKind>().is_err());
+    assert_eq!(
+        "lqr".parse::<ControllerKind>().unwrap(),
+        ControllerKind::Lqr
+    );
 }
 
 #[test]
@@ -785,5 +789,32 @@ fn computed_torque_tracks_the_other_families_below_a_millimetre() {
             "{name}: tip RMS {} m",
             run.summary.tip_error_rms_m
         );
+    }
+}
+
+#[test]
+fn lqr_tracks_a_step_to_rounding_for_m_2_3_4() {
+    for m in 2..=4 {
+        // After the step the reference is constant, the feedforward is G*(a_ref) and holds the
+        // arm there exactly, so the locally stable LQR loop converges to machine precision.
+        let run = family_step(m, ControllerKind::Lqr, 2.0)
+            .build()
+            .unwrap()
+            .run()
+            .unwrap();
+        let last = run.record.len() - 1;
+        for i in 0..m {
+            let e = run.record.a_at(last)[i] - run.record.a_ref_at(last)[i];
+            assert!(
+                e.abs() < 1e-10,
+                "m = {m}: final error of coordinate {i} = {e:e}"
+            );
+        }
+        // The transient stays bounded: the cost weighs errors by M0^2, in which the higher
+        // harmonics are light, so they swing more than the 0.1 rad step (0.27 rad for a3 at m = 4)
+        // while a1 and a2 move fast.
+        for (i, e) in run.summary.modal_error_max.iter().enumerate() {
+            assert!(*e < 0.5, "m = {m}, coordinate {i}: {e}");
+        }
     }
 }

@@ -278,6 +278,14 @@ pub struct ControllerSpec {
     /// PD damping per coordinate (N m s/rad); default: the fuzzy system's slope at the origin.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pd_kd: Option<Vec<f64>>,
+    /// LQR design frequency `omega` (rad/s, default 50): the weights place the poles of the
+    /// straight arm without gravity at a Butterworth pair of radius `omega`
+    /// ([`LqrController`](crate::controller::LqrController)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lqr_frequency: Option<f64>,
+    /// LQR re-linearisation period (s, default 0.01; at least the controller period).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lqr_relinearise: Option<f64>,
 }
 
 /// The integrator between controller samples, tagged by `method`.
