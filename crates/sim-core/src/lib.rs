@@ -10,8 +10,9 @@
 //! control effort). Divergence stops a run with a [`RunFailure`] that keeps the data so far.
 //!
 //! Experiments are [`Scenario`]s, TOML files; the paper's are shipped with the crate
-//! ([`Scenario::builtin_names`]): `paper-tracking` (Figures 10-11) and the
-//! `paper-responses-{step,sine,noise}` responses (Figure 9).
+//! ([`Scenario::builtin_names`]): `paper-tracking` (Figures 10-11), the same path in 1 s under
+//! actuator limits (`paper-tracking-fast`), and the `paper-responses-{step,sine,noise}` responses
+//! (Figure 9).
 //!
 //! ```
 //! use sim_core::{ControllerKind, Scenario};
