@@ -27,7 +27,13 @@
 //! // The paper's fuzzy controller, evaluated once.
 //! let mut fuzzy = FuzzyController::new(paper_controller(), 2)?;
 //! let (measured, reference) = (ModalState::new(&[0.1, 0.0], &[0.0, 0.0])?, ReferenceSample::zeros(2));
-//! let ctx = ControlContext { t: 0.0, measured: &measured, reference: &reference, model: &model, tau_star_limits: None };
+//! let ctx = ControlContext {
+//!     t: 0.0,
+//!     measured: &measured,
+//!     reference: &reference,
+//!     model: &model,
+//!     tau_star_limits: None,
+//! };
 //! let mut tau = [0.0; 2];
 //! fuzzy.control(&ctx, &mut tau)?;
 //! assert!(tau[0] < 0.0);
