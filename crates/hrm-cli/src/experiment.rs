@@ -25,7 +25,10 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
     let outcome = run_one(&scenario, scenario.controller.kind);
     write_outcome(&outcome, staging.path())?;
     staging.commit()?;
-    console::print(&table(&table_rows(std::slice::from_ref(&outcome))))?;
+    console::print(&table(&table_rows(
+        std::slice::from_ref(&outcome),
+        std::slice::from_ref(&scenario),
+    )))?;
     console::print(&format!("wrote {}\n", out.display()))?;
     outcome.result.map(|_| ()).map_err(|stopped| stopped.error)
 }
@@ -60,8 +63,8 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
         summary
     }));
     write(&dir.join("summary.json"), &pretty(&json!(summaries))?)?;
-    let mut rows = table_rows(&outcomes);
-    rows.extend(table_rows(&learned).into_iter().map(|mut row| {
+    let mut rows = table_rows(&outcomes, scenarios);
+    rows.extend(table_rows(&learned, scenarios).into_iter().map(|mut row| {
         row.cells[1] = LEARNED.to_owned();
         row
     }));
@@ -274,6 +277,7 @@ fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
         header.extend(names.iter().map(|n| format!("{n}_ref")));
         header.extend((1..=names.len()).map(|i| format!("tau{i}")));
         header.extend(["tip_x", "tip_y", "tip_ref_x", "tip_ref_y"].map(String::from));
+        header.extend((1..=names.len()).map(|i| format!("clamped{i}")));
         let mut csv = header.join(",") + "\n";
         for k in 0..r.len() {
             let row = std::iter::once(r.t[k])
@@ -282,7 +286,8 @@ fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
                 .chain(r.a_ref_at(k).iter().copied())
                 .chain(r.tau_star_at(k).iter().copied())
                 .chain(r.tip[k])
-                .chain(r.tip_ref[k]);
+                .chain(r.tip_ref[k])
+                .chain(r.clamped_at(k).iter().map(|&c| f64::from(u8::from(c))));
             let line: Vec<String> = row.map(|v| v.to_string()).collect();
             let _ = writeln!(csv, "{}", line.join(","));
         }
@@ -292,7 +297,7 @@ fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
 }
 
 /// The comparison table's columns.
-const HEADERS: [&str; 8] = [
+const HEADERS: [&str; 9] = [
     "scenario",
     "controller",
     "tip rms mm",
@@ -301,14 +306,19 @@ const HEADERS: [&str; 8] = [
     "peak tau* (N m)",
     "peak tau N m",
     "effort",
+    "clamped %",
 ];
 
 /// The comparison table's rows: tip error RMS and maximum (mm), modal error RMS, peak torques,
-/// effort; a failed run has only its scenario and controller, and its error.
-fn table_rows(outcomes: &[Outcome]) -> Vec<report::Row> {
+/// effort, and the percentage of controller samples whose `tau_i*` the actuator limits clamped
+/// (`-` for a scenario without limits); a failed run has only its scenario and controller, and its error.
+fn table_rows(outcomes: &[Outcome], scenarios: &[Scenario]) -> Vec<report::Row> {
     outcomes
         .iter()
         .map(|o| {
+            let limited = scenarios
+                .iter()
+                .any(|s| s.name == o.scenario && s.limits.tau_star.is_some());
             let mut cells = vec![o.scenario.clone(), o.controller.name().to_owned()];
             match &o.result {
                 Ok(run) => {
@@ -320,6 +330,13 @@ fn table_rows(outcomes: &[Outcome]) -> Vec<report::Row> {
                         list(&m.peak_modal_torques_nm, |v| format!("{v:.2}")),
                         format!("{:.3}", m.peak_joint_torque_nm),
                         format!("{:.4e}", m.control_effort_n2m2s),
+                        if limited {
+                            list(&m.tau_star_clamped_fraction, |v| {
+                                format!("{:.1}", 100.0 * v)
+                            })
+                        } else {
+                            "-".to_owned()
+                        },
                     ]);
                     report::Row { cells, error: None }
                 }
@@ -413,7 +430,7 @@ mod tests {
             csv.lines().count(),
             outcome.result.as_ref().unwrap().record.len() + 1
         );
-        assert!(table(&table_rows(&[outcome])).contains("computed-torque"));
+        assert!(table(&table_rows(&[outcome], &[scenario])).contains("computed-torque"));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -439,7 +456,11 @@ mod tests {
             FuzzySystem::from_fis(&std::fs::read_to_string(dir.join("learned.fis")).unwrap());
         assert_eq!(learned.unwrap().inputs().len(), 8);
         assert!(dir.join("paper-tracking/learned/timeseries.csv").is_file());
-        assert_eq!(page.matches("<td class=\"error\"").count(), 4, "{page}");
+        assert_eq!(
+            page.matches("<td class=\"error\"").count(),
+            ControllerKind::ALL.len(),
+            "{page}"
+        );
         let mut images = 0;
         for piece in page.split("<img src=\"").skip(1) {
             let file = &piece[..piece.find('"').unwrap()];
@@ -448,7 +469,7 @@ mod tests {
         }
         // Figures 10 (one per controller) and 11, four membership plots and two surfaces; no
         // Figure 9 as every step run failed.
-        assert_eq!(images, 4 + 1 + 4 + 2);
+        assert_eq!(images, ControllerKind::ALL.len() + 1 + 4 + 2);
         for name in ["summary.json", "comparison.txt"] {
             assert!(dir.join(name).is_file());
         }

@@ -58,6 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
         measured: &measured,
         reference: &reference,
         model: &model,
+        tau_star_limits: None,
     };
     let mut tau = [0.0; 2];
     fuzzy.control(&ctx, &mut tau)?;

@@ -25,8 +25,11 @@ pub struct Record {
     pub a_ref_dot: Vec<f64>,
     /// The reference as the controller received it, reference noise included (rad).
     pub a_cmd: Vec<f64>,
-    /// Modal torques `tau*` held from this sample to the next (N m).
+    /// Modal torques `tau*` held from this sample to the next (N m), after the actuator limits.
     pub tau_star: Vec<f64>,
+    /// Whether the actuator limit clamped the controller's `tau_i*` at this sample, per
+    /// coordinate (row-major like the modal series; all `false` without limits).
+    pub clamped: Vec<bool>,
     /// Tip of the discrete chain (m).
     pub tip: Vec<[f64; 2]>,
     /// The reference tip: the backbone curve's end point at `a_ref` (eqs 3-4), which for a
@@ -90,6 +93,11 @@ impl Record {
     pub fn tau_star_at(&self, k: usize) -> &[f64] {
         self.row(&self.tau_star, k)
     }
+
+    /// Which coordinates' torques the actuator limits clamped at sample `k`.
+    pub fn clamped_at(&self, k: usize) -> &[bool] {
+        &self.clamped[k * self.n_coords..(k + 1) * self.n_coords]
+    }
 }
 
 /// One recorded sample, before it is pushed.
@@ -102,15 +110,16 @@ pub(crate) struct Sample<'a> {
     pub a_ref_dot: &'a [f64],
     pub a_cmd: &'a [f64],
     pub tau_star: &'a [f64],
+    pub clamped: &'a [bool],
     pub tip: [f64; 2],
     pub tip_ref: [f64; 2],
 }
 
 impl Record {
-    /// The numbers one recorded sample holds: `t`, six modal series of `n_coords`, two tips,
-    /// and a torque per joint.
+    /// The values one recorded sample holds: `t`, seven modal series of `n_coords` (the
+    /// clamping flags counted as one value each), two tips, and a torque per joint.
     pub(crate) fn values_per_sample(n_coords: usize, n_joints: usize) -> usize {
-        5 + 6 * n_coords + n_joints
+        5 + 7 * n_coords + n_joints
     }
 
     pub(crate) fn with_capacity(n_coords: usize, n_joints: usize, samples: usize) -> Self {
@@ -125,6 +134,7 @@ impl Record {
             a_ref_dot: series(),
             a_cmd: series(),
             tau_star: series(),
+            clamped: Vec::with_capacity(samples * n_coords),
             tip: Vec::with_capacity(samples),
             tip_ref: Vec::with_capacity(samples),
             joint_torques: Vec::with_capacity(samples * n_joints),
@@ -139,6 +149,7 @@ impl Record {
         self.a_ref_dot.extend_from_slice(s.a_ref_dot);
         self.a_cmd.extend_from_slice(s.a_cmd);
         self.tau_star.extend_from_slice(s.tau_star);
+        self.clamped.extend_from_slice(s.clamped);
         self.tip.push(s.tip);
         self.tip_ref.push(s.tip_ref);
         self.joint_torques.extend_from_slice(joint_torques);
@@ -195,6 +206,9 @@ pub struct Summary {
     pub peak_joint_torques_nm: Vec<f64>,
     /// Control effort `integral of |tau*|^2 dt` under the zero-order hold (N^2 m^2 s).
     pub control_effort_n2m2s: f64,
+    /// Per coordinate, the fraction of controller samples (from 0 to 1) at which the actuator
+    /// limit `limits.tau_star` clamped the controller's output (zeros without limits).
+    pub tau_star_clamped_fraction: Vec<f64>,
     /// Joints whose torque limit was exceeded (empty without limits or violations).
     pub torque_limit_exceeded: Vec<TorqueLimitExceeded>,
 }
@@ -212,6 +226,7 @@ pub(crate) struct Metrics {
     peak_tau_star: Vec<f64>,
     peak_joint: Vec<f64>,
     effort: f64,
+    clamped: Vec<usize>,
     limits: Option<Vec<f64>>,
     exceeded: Vec<Option<TorqueLimitExceeded>>,
 }
@@ -229,14 +244,19 @@ impl Metrics {
             peak_tau_star: vec![0.0; n_coords],
             peak_joint: vec![0.0; n_joints],
             effort: 0.0,
+            clamped: vec![0; n_coords],
             limits,
             exceeded: vec![None; n_joints],
         }
     }
 
-    /// Counts a controller sample at `t` whose torque `tau_star` is held for `hold` seconds.
-    pub(crate) fn add_control(&mut self, t: f64, tau_star: &[f64], hold: f64) {
+    /// Counts a controller sample at `t` whose torque `tau_star` (with its clamping flags) is
+    /// held for `hold` seconds.
+    pub(crate) fn add_control(&mut self, t: f64, tau_star: &[f64], clamped: &[bool], hold: f64) {
         self.controller_samples += 1;
+        for (count, &c) in self.clamped.iter_mut().zip(clamped) {
+            *count += usize::from(c);
+        }
         self.last_t = t;
         let mut square = 0.0;
         for tau in tau_star {
@@ -299,6 +319,11 @@ impl Metrics {
             peak_joint_torque_nm: self.peak_joint.iter().copied().fold(0.0, f64::max),
             peak_joint_torques_nm: self.peak_joint.clone(),
             control_effort_n2m2s: self.effort,
+            tau_star_clamped_fraction: self
+                .clamped
+                .iter()
+                .map(|&c| c as f64 / self.controller_samples.max(1) as f64)
+                .collect(),
             torque_limit_exceeded,
         }
     }

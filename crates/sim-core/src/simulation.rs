@@ -55,6 +55,12 @@ pub struct LoopSettings {
     pub max_modal_error: f64,
     /// Optional per-joint torque limits (N m): exceeding one is reported in the summary.
     pub joint_torque_limits: Option<Vec<f64>>,
+    /// Optional actuator limits on the modal torques (N m, `m` entries, finite and positive):
+    /// every controller's output is clamped to `[-limit_i, limit_i]` before it is applied
+    /// (the clamped torque is what is held, recorded and summed into the effort), and each
+    /// sample records which coordinates were clamped. Controllers see them in
+    /// [`ControlContext::tau_star_limits`].
+    pub tau_star_limits: Option<Vec<f64>>,
 }
 
 impl LoopSettings {
@@ -70,6 +76,7 @@ impl LoopSettings {
             sensor_noise_std: Vec::new(),
             max_modal_error: std::f64::consts::PI,
             joint_torque_limits: None,
+            tau_star_limits: None,
         }
     }
 }
@@ -147,8 +154,12 @@ pub struct ControlSample {
     pub command: ReferenceSample,
     /// The state as the controller measured it (sensor noise included).
     pub measured: ModalState,
-    /// The modal torques `tau*` held from `t` to the next sample (N m).
+    /// The modal torques `tau*` held from `t` to the next sample (N m): the controller's
+    /// output, clamped to the actuator limits if there are any.
     pub tau_star: Vec<f64>,
+    /// Per coordinate, whether the actuator limit clamped the controller's output (all `false`
+    /// without limits).
+    pub clamped: Vec<bool>,
     /// The acceleration at `t` under `tau*` (rad/s^2): the integrator's first stage, or the
     /// forward dynamics for a sample that is not integrated.
     pub a_ddot: Vec<f64>,
@@ -165,6 +176,7 @@ impl ControlSample {
             command: ReferenceSample::zeros(m),
             measured: ModalState::zeros(m),
             tau_star: vec![0.0; m],
+            clamped: vec![false; m],
             a_ddot: vec![0.0; m],
             steps: (0, 0),
         }
@@ -483,7 +495,12 @@ impl Simulation {
             let t = sample.t;
             steps += sample.steps.0;
             rejected += sample.steps.1;
-            metrics.add_control(t, &sample.tau_star, if last { 0.0 } else { period });
+            metrics.add_control(
+                t,
+                &sample.tau_star,
+                &sample.clamped,
+                if last { 0.0 } else { period },
+            );
             let runaway = (0..m)
                 .map(|i| (i, (sample.state.a[i] - sample.reference.a[i]).abs()))
                 .find(|&(_, e)| e > max_error || e.is_nan());
@@ -500,6 +517,7 @@ impl Simulation {
                             a_ref_dot: &sample.reference.a_dot,
                             a_cmd: &sample.command.a,
                             tau_star: &sample.tau_star,
+                            clamped: &sample.clamped,
                             tip,
                             tip_ref,
                         };
@@ -561,6 +579,7 @@ impl Simulation {
             measured: &sample.measured,
             reference: &sample.command,
             model: &self.plant.model,
+            tau_star_limits: self.settings.tau_star_limits.as_deref(),
         };
         self.controller
             .control(&ctx, &mut sample.tau_star)
@@ -570,6 +589,10 @@ impl Simulation {
                 t,
                 tau_star: sample.tau_star.clone(),
             });
+        }
+        match &self.settings.tau_star_limits {
+            Some(limits) => saturate(&mut sample.tau_star, limits, &mut sample.clamped),
+            None => sample.clamped.fill(false),
         }
         self.plant.tau_star.copy_from_slice(&sample.tau_star);
         Ok(())
@@ -615,6 +638,15 @@ impl Simulation {
             &mut self.sample.a_ddot,
         )
         .map_err(|source| SimError::Dynamics { t, source })
+    }
+}
+
+/// Actuator saturation: clamps every `tau_i*` to `[-limits_i, limits_i]` (exactly `+-limits_i`
+/// when it is beyond), setting `clamped_i` to whether it was.
+fn saturate(tau_star: &mut [f64], limits: &[f64], clamped: &mut [bool]) {
+    for ((tau, &limit), clamped) in tau_star.iter_mut().zip(limits).zip(clamped) {
+        *clamped = tau.abs() > limit;
+        *tau = tau.clamp(-limit, limit);
     }
 }
 
@@ -767,6 +799,21 @@ fn validate(s: &LoopSettings, m: usize, n_links: usize) -> Result<(), SimError> 
         }
         for &l in limits {
             check_positive("limits.joint_torque_nm", l)?;
+        }
+    }
+    if let Some(limits) = &s.tau_star_limits {
+        if limits.len() != m {
+            return Err(SimError::setting(
+                "limits.tau_star",
+                format!(
+                    "has {} entries, the modal family has {m} coordinates (one limit each, or \
+                     one number for all)",
+                    limits.len()
+                ),
+            ));
+        }
+        for &l in limits {
+            check_positive("limits.tau_star", l)?;
         }
     }
     Ok(())

@@ -334,7 +334,15 @@ fn counts_are_bounded_before_use_with_the_option_named() {
             "--controllers lists pd twice",
         ),
         (
-            vec!["sweep", "--seeds", "1000000", "--out", path(&out)],
+            vec![
+                "sweep",
+                "--seeds",
+                "1000000",
+                "--controllers",
+                "fuzzy,pd,computed-torque,fuzzy-gc",
+                "--out",
+                path(&out),
+            ],
             "24000000 runs",
         ),
     ] {

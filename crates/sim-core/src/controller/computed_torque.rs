@@ -33,7 +33,13 @@ impl ComputedTorque {
     /// let model = ReducedModel::new(ChainModel::uniform(10, 0.1, 0.1, 9.81)?, map)?;
     /// let mut ct = ComputedTorque::new(&model, &[2500.0; 5], &[100.0; 5])?;
     /// let (measured, reference) = (ModalState::zeros(5), ReferenceSample::zeros(5));
-    /// let ctx = ControlContext { t: 0.0, measured: &measured, reference: &reference, model: &model };
+    /// let ctx = ControlContext {
+    ///     t: 0.0,
+    ///     measured: &measured,
+    ///     reference: &reference,
+    ///     model: &model,
+    ///     tau_star_limits: None,
+    /// };
     /// let mut tau = [0.0; 5];
     /// ct.control(&ctx, &mut tau)?;
     /// // At rest on the reference, computed torque holds the arm against gravity: tau* = G*.

@@ -186,7 +186,13 @@ impl FuzzyController {
     /// // Above the reference in a1: push back.
     /// let measured = ModalState::new(&[0.1, 0.0], &[0.0, 0.0])?;
     /// let reference = ReferenceSample::zeros(2);
-    /// let ctx = ControlContext { t: 0.0, measured: &measured, reference: &reference, model: &model };
+    /// let ctx = ControlContext {
+    ///     t: 0.0,
+    ///     measured: &measured,
+    ///     reference: &reference,
+    ///     model: &model,
+    ///     tau_star_limits: None,
+    /// };
     /// let mut tau = [0.0; 2];
     /// fuzzy.control(&ctx, &mut tau)?;
     /// assert!(tau[0] < 0.0 && tau[1].abs() < 1e-12);

@@ -1,7 +1,8 @@
 //! Controllers of the `m` modal coordinates, behind one trait: the paper's fuzzy controller
 //! (eqs 19-24, Figure 8) applied per coordinate pair or any `.fis` system with `2m` inputs and
 //! `m` outputs, its linearisation at the origin (PD), computed torque with the exact reduced
-//! model, and the fuzzy controller plus gravity compensation `G*`.
+//! model, the fuzzy controller plus gravity compensation `G*`, and the LQR about the reference,
+//! re-linearised along it ([`LqrController`]).
 //!
 //! The closed loop samples a controller at its own period and holds its output in between
 //! (zero-order hold). At each sample it hands the controller a [`ControlContext`] that borrows
@@ -33,11 +34,13 @@
 
 mod computed_torque;
 mod fuzzy;
+mod lqr;
 mod pd;
 
 pub use computed_torque::ComputedTorque;
 pub use fuzzy::FuzzyController;
 pub(crate) use fuzzy::{SCHEDULED_INPUTS_PER_COORDINATE, scheduled_inputs};
+pub use lqr::LqrController;
 pub use pd::PdController;
 
 use crate::error::SimError;
@@ -104,6 +107,10 @@ pub struct ControlContext<'a> {
     pub reference: &'a ReferenceSample,
     /// The reduced model being simulated.
     pub model: &'a ReducedModel,
+    /// The actuator limits on `tau*` (N m, `m` entries) if the loop has any: the loop clamps
+    /// whatever the controller asks for to `[-limit_i, limit_i]`, so a controller that plans
+    /// (e.g. model-predictive control) can respect them itself. `None` without limits.
+    pub tau_star_limits: Option<&'a [f64]>,
 }
 
 /// A feedback law producing the modal generalized forces `tau*` (N m), one per coordinate.

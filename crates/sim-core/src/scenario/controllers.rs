@@ -3,7 +3,7 @@
 
 use super::factory::per_coordinate;
 use super::schema::ControllerSpec;
-use crate::controller::{ComputedTorque, Controller, FuzzyController, PdController};
+use crate::controller::{ComputedTorque, Controller, FuzzyController, LqrController, PdController};
 use crate::error::SimError;
 use fuzzy_sugeno::FuzzySystem;
 use modal_reduce::ReducedModel;
@@ -25,6 +25,8 @@ pub enum ControllerKind {
     ComputedTorque,
     /// The fuzzy controller plus gravity compensation `G*`.
     FuzzyGc,
+    /// LQR about the reference, re-linearised along it ([`LqrController`]).
+    Lqr,
 }
 
 /// What a controller's constructor is given: the scenario's `[controller]` settings, with every
@@ -117,6 +119,24 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         build: |s| {
             let fuzzy = FuzzyController::new(s.spec.fuzzy_system()?, m(s))?;
             Ok(Box::new(fuzzy.with_gravity_compensation(s.model)?))
+        },
+    },
+    ControllerEntry {
+        kind: ControllerKind::Lqr,
+        name: "lqr",
+        description: "LQR about the reference (feedforward M* a_ref_dd + C* + G*), re-linearised \
+                      along it every lqr_relinearise s, design frequency lqr_frequency",
+        build: |s| {
+            Ok(Box::new(LqrController::new(
+                s.model,
+                s.period,
+                s.spec
+                    .lqr_frequency
+                    .unwrap_or(LqrController::DEFAULT_FREQUENCY),
+                s.spec
+                    .lqr_relinearise
+                    .unwrap_or(LqrController::DEFAULT_RELINEARISE_PERIOD),
+            )?))
         },
     },
 ];

@@ -3,7 +3,8 @@
 
 use super::controllers::ControllerSetup;
 use super::schema::{
-    Alpha0, ArmSpec, BranchSpec, IntegratorSpec, ReferenceSpec, Scenario, TorqueLimit,
+    Alpha0, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, ReferenceSpec, Scenario,
+    TorqueLimit,
 };
 use crate::controller::{Controller, ModalState};
 use crate::error::SimError;
@@ -111,6 +112,13 @@ impl Scenario {
             TorqueLimit::All(limit) => vec![*limit; model.n_links()],
             TorqueLimit::PerJoint(limits) => limits.clone(),
         });
+        settings.tau_star_limits = match &self.limits.tau_star {
+            None => None,
+            Some(ModalTorqueLimit::All(limit)) => Some(vec![*limit; m]),
+            Some(ModalTorqueLimit::PerCoordinate(limits)) => {
+                per_coordinate("limits.tau_star", Some(limits), m)?
+            }
+        };
         let initial = match &self.initial {
             None => None,
             Some(i) => {

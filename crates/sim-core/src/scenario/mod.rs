@@ -27,11 +27,12 @@
 //! target = [0.2, -0.2]
 //! time = 0.1
 //!
-//! [controller]            # kind = "fuzzy" | "pd" | "computed-torque" | "fuzzy-gc"
+//! [controller]            # kind = "fuzzy" | "pd" | "computed-torque" | "fuzzy-gc" | "lqr"
 //! kind = "fuzzy"
 //! period = 0.0001         # s, default: the RK4 step
 //! # kp = [2500.0, 2500.0]   computed torque (1/s^2), kd = [100.0, 100.0] (1/s)
 //! # pd_kp = [600.0, 300.0]  PD (N m/rad), pd_kd = [20.0, 10.0] (N m s/rad); default: fuzzy slope
+//! # lqr_frequency = 50.0    LQR design frequency (rad/s), lqr_relinearise = 0.01 (s)
 //!
 //! [integrator]            # method = "rk4" (dt) | "dopri5" (rtol, atol, h_max, max_steps)
 //! method = "rk4"
@@ -44,7 +45,8 @@
 //!
 //! [limits]
 //! max_modal_error = 3.14  # rad, runaway bound
-//! joint_torque_nm = 5.0   # or one limit per joint
+//! joint_torque_nm = 5.0   # or one limit per joint; exceeding is reported
+//! tau_star = [2.0, 0.5]   # N m, or one limit for all: the loop clamps tau* to +-limit
 //! ```
 
 mod builtin;
@@ -57,5 +59,5 @@ pub use controllers::{CONTROLLERS, ControllerEntry, ControllerKind, ControllerSe
 pub use file::ScenarioError;
 pub use schema::{
     Alpha0, ArmSpec, BranchSpec, ControllerSpec, InitialSpec, IntegratorSpec, LimitsSpec,
-    ModalSpec, NoiseSpec, ReferenceSpec, Scenario, SineSpec, TorqueLimit,
+    ModalSpec, ModalTorqueLimit, NoiseSpec, ReferenceSpec, Scenario, SineSpec, TorqueLimit,
 };

@@ -278,6 +278,14 @@ pub struct ControllerSpec {
     /// PD damping per coordinate (N m s/rad); default: the fuzzy system's slope at the origin.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pd_kd: Option<Vec<f64>>,
+    /// LQR design frequency `omega` (rad/s, default 50): the weights place the poles of the
+    /// straight arm without gravity at a Butterworth pair of radius `omega`
+    /// ([`LqrController`](crate::controller::LqrController)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lqr_frequency: Option<f64>,
+    /// LQR re-linearisation period (s, default 0.01; at least the controller period).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lqr_relinearise: Option<f64>,
 }
 
 /// The integrator between controller samples, tagged by `method`.
@@ -341,7 +349,8 @@ impl NoiseSpec {
     }
 }
 
-/// The runaway bound and optional joint torque limits.
+/// The runaway bound, optional joint torque limits (reported) and optional actuator limits on
+/// `tau*` (enforced).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LimitsSpec {
@@ -351,6 +360,11 @@ pub struct LimitsSpec {
     /// Joint torque limits (N m): one for all joints or one per joint; exceeding is reported.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joint_torque_nm: Option<TorqueLimit>,
+    /// Actuator saturation on the modal torques (N m): one limit for every coordinate or one per
+    /// coordinate (`m` entries), each finite and positive. The loop clamps every controller's
+    /// output to `[-limit_i, limit_i]` before applying it and records when it did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tau_star: Option<ModalTorqueLimit>,
 }
 
 fn default_max_modal_error() -> f64 {
@@ -362,8 +376,19 @@ impl Default for LimitsSpec {
         Self {
             max_modal_error: default_max_modal_error(),
             joint_torque_nm: None,
+            tau_star: None,
         }
     }
+}
+
+/// A limit on the modal torques `tau*`: the same for every coordinate, or one per coordinate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ModalTorqueLimit {
+    /// The same limit for every coordinate (N m).
+    All(f64),
+    /// One limit per coordinate, in coordinate order (N m).
+    PerCoordinate(Vec<f64>),
 }
 
 /// A torque limit for every joint, or one per joint.

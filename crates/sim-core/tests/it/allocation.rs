@@ -30,6 +30,17 @@ fn allocations_do_not_grow_with_the_number_of_steps() {
             );
         }
     }
+    // Actuator limits that clamp part of the time: the clamp and its flags reuse their buffers.
+    for kind in ControllerKind::ALL {
+        let mut limited = Scenario::builtin("paper-tracking").unwrap();
+        limited.controller.kind = kind;
+        limited.limits.tau_star = Some(sim_core::ModalTorqueLimit::PerCoordinate(vec![3.0, 2.0]));
+        assert_eq!(
+            allocations(&limited, 0.05),
+            allocations(&limited, 0.5),
+            "{kind} with limits"
+        );
+    }
     let mut adaptive = Scenario::builtin("paper-responses-step").unwrap();
     adaptive.integrator = sim_core::IntegratorSpec::Dopri5 {
         rtol: 1e-9,

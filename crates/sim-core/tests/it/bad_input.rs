@@ -229,6 +229,35 @@ fn torque_limits_wrong_length_or_not_positive() {
 }
 
 #[test]
+fn actuator_limits_wrong_length_or_not_positive() {
+    let s = LoopSettings {
+        tau_star_limits: Some(vec![1.0; 3]),
+        ..settings()
+    };
+    let (name, message) = invalid(build(s));
+    assert_eq!(name, "limits.tau_star");
+    assert!(
+        message.contains("has 3 entries, the modal family has 2 coordinates"),
+        "{message}"
+    );
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let s = LoopSettings {
+            tau_star_limits: Some(vec![1.0, bad]),
+            ..settings()
+        };
+        let (name, message) = invalid(build(s));
+        assert_eq!(name, "limits.tau_star", "{bad}");
+        assert!(message.contains("must be positive and finite"), "{message}");
+    }
+    // From a scenario file: one number for all, or one per coordinate, checked the same way.
+    let mut scenario = sim_core::Scenario::builtin("paper-responses-step").unwrap();
+    scenario.limits.tau_star = Some(sim_core::ModalTorqueLimit::PerCoordinate(vec![1.0; 3]));
+    assert_eq!(invalid(scenario.build()).0, "limits.tau_star");
+    scenario.limits.tau_star = Some(sim_core::ModalTorqueLimit::All(-2.0));
+    assert_eq!(invalid(scenario.build()).0, "limits.tau_star");
+}
+
+#[test]
 fn run_that_would_never_end() {
     // Recording only at the end keeps the record small, so only the sample count refuses it.
     let s = LoopSettings {

@@ -9,9 +9,12 @@ use modal_reduce::{ReducedData, ReducedModel, forward_dynamics};
 use proptest::prelude::*;
 use sim_core::SimError;
 use sim_core::controller::{
-    ComputedTorque, ControlContext, Controller, FuzzyController, ModalState, PdController,
+    ComputedTorque, ControlContext, Controller, FuzzyController, LqrController, ModalState,
+    PdController,
 };
-use sim_core::reference::ReferenceSample;
+use sim_core::optimal::Linearisation;
+use sim_core::reference::{ReferenceSample, Step};
+use sim_core::{Integrator, LoopSettings, Simulation};
 
 /// The paper's arm with `m` coordinates: `K = m / 2` harmonics, `alpha0` free when `m` is odd.
 fn model(m: usize) -> ReducedModel {
@@ -40,6 +43,7 @@ fn control(
         measured,
         reference,
         model,
+        tau_star_limits: None,
     };
     controller
         .control(&ctx, &mut tau)
@@ -236,4 +240,121 @@ fn controllers_refuse_wrong_shapes_and_gains() {
     assert!(PdController::from_fuzzy_slope(&two_inputs, 3).is_err());
     // Two inputs and one output is the shape of one coordinate.
     assert!(FuzzyController::new(two_inputs, 1).is_ok());
+}
+
+/// The paper's arm with `m` coordinates without gravity: at rest at `a = 0` eq 15 is the double
+/// integrator `M*(0) a_ddot = tau*` to first order.
+fn weightless(m: usize) -> ReducedModel {
+    let base = if m.is_multiple_of(2) {
+        BaseAngle::Fixed(std::f64::consts::FRAC_PI_2)
+    } else {
+        BaseAngle::Free
+    };
+    ReducedModel::new(
+        ChainModel::uniform(10, 0.1, 0.1, 0.0).unwrap(),
+        ModalMap::uniform(10, m / 2, base).unwrap(),
+    )
+    .unwrap()
+}
+
+#[test]
+fn lqr_gain_is_the_double_integrator_closed_form_without_gravity() {
+    // For M0 a_ddot = tau* with Q = diag(omega^4 M0^2, 0) and R = I the continuous LQR gain is
+    // K = M0 [omega^2 I, sqrt(2) omega I]; sampled every h it differs by O(omega h).
+    let (omega, h) = (50.0, 1e-4);
+    for m in 2..=4 {
+        let model = weightless(m);
+        let mut lqr = LqrController::new(&model, h, omega, 0.01).unwrap();
+        control(
+            &mut lqr,
+            &model,
+            &ModalState::zeros(m),
+            &ReferenceSample::zeros(m),
+        )
+        .unwrap();
+        let mut data = ReducedData::new(&model);
+        modal_reduce::reduced_terms(&model, &mut data, &vec![0.0; m], &vec![0.0; m]).unwrap();
+        let mass = data.mass_matrix();
+        let gain = lqr.gain();
+        let scale = (0..m).fold(0.0f64, |s, i| s.max(mass[(i, i)])) * omega * omega;
+        for i in 0..m {
+            for j in 0..m {
+                let (kp, kd) = (
+                    mass[(i, j)] * omega * omega,
+                    mass[(i, j)] * std::f64::consts::SQRT_2 * omega,
+                );
+                assert!(
+                    (gain[(i, j)] - kp).abs() < 0.01 * scale,
+                    "m = {m}, K[{i}][{j}] = {} vs {kp}",
+                    gain[(i, j)]
+                );
+                assert!(
+                    (gain[(i, m + j)] - kd).abs() < 0.01 * scale / omega,
+                    "m = {m}, K[{i}][{}] = {} vs {kd}",
+                    m + j,
+                    gain[(i, m + j)]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn lqr_loop_is_its_linearisation_near_an_equilibrium() {
+    // Without gravity a = 0 is an equilibrium with u_ref = 0: from an offset of size eps the
+    // nonlinear loop follows x_{k+1} = (A_d - B_d K) x_k up to O(eps^2).
+    let (omega, h) = (50.0, 1e-3);
+    for m in [2, 3] {
+        let model = weightless(m);
+        let settings = LoopSettings::new(Integrator::Rk4 { dt: h / 10.0 }, h, 0.1);
+        let reference = Step::constant(&vec![0.0; m]).unwrap();
+        let eps = 1e-6;
+        let a0: Vec<f64> = (0..m).map(|i| eps * (1.0 + i as f64)).collect();
+        let initial = ModalState::new(&a0, &vec![0.0; m]).unwrap();
+        let controller = LqrController::new(&model, h, omega, 1.0).unwrap();
+        let mut lin = Linearisation::new(&model);
+        lin.linearise(&model, &vec![0.0; m], &vec![0.0; m], &vec![0.0; m], h)
+            .unwrap();
+        let mut sim = Simulation::new(
+            model,
+            Box::new(reference),
+            Box::new(controller),
+            settings,
+            Some(initial),
+        )
+        .unwrap();
+        let run = sim.run().unwrap();
+        // The gain, from a controller of its own on the same model.
+        let mut probe = LqrController::new(sim.model(), h, omega, 1.0).unwrap();
+        control(
+            &mut probe,
+            sim.model(),
+            &ModalState::zeros(m),
+            &ReferenceSample::zeros(m),
+        )
+        .unwrap();
+        let (a_d, b_d, k) = (lin.discrete_a(), lin.discrete_b(), probe.gain());
+        let n = 2 * m;
+        let mut x: Vec<f64> = [a0.clone(), vec![0.0; m]].concat();
+        for step in 0..run.record.len() {
+            let recorded = [run.record.a_at(step), run.record.a_dot_at(step)].concat();
+            let worst = x
+                .iter()
+                .zip(&recorded)
+                .fold(0.0f64, |w, (p, q)| w.max((p - q).abs()));
+            assert!(worst < 1e-4 * eps, "m = {m}, step {step}: {worst:e}");
+            let u: Vec<f64> = (0..m)
+                .map(|i| -(0..n).map(|j| k[(i, j)] * x[j]).sum::<f64>())
+                .collect();
+            x = (0..n)
+                .map(|i| {
+                    (0..n).map(|j| a_d[(i, j)] * x[j]).sum::<f64>()
+                        + (0..m).map(|j| b_d[(i, j)] * u[j]).sum::<f64>()
+                })
+                .collect();
+        }
+        // The loop is stable: the offset has decayed.
+        let last = run.record.len() - 1;
+        assert!(run.record.a_at(last).iter().all(|a| a.abs() < 0.2 * eps));
+    }
 }

@@ -113,6 +113,7 @@ fn the_scheduled_layout_feeds_the_documented_quantities() {
             measured: &measured,
             reference: &reference,
             model: &model,
+            tau_star_limits: None,
         };
         let mut tau = [0.0; 2];
         controller.control(&ctx, &mut tau).unwrap();
