@@ -1,5 +1,7 @@
 //! Mean and spread of the runs' errors per (noise level, controller) cell, computed in index
-//! order so that a merged sweep gives bit for bit the numbers of an unsharded one.
+//! order so that a merged sweep gives bit for bit the numbers of an unsharded one. The runs of
+//! a cell are consecutive in that order, so the cells are built from a stream of runs holding
+//! only the current cell's values.
 
 use super::plan::SweepConfig;
 use super::shard_file::{Outcome, RunMetrics, RunResult};
@@ -91,58 +93,127 @@ pub struct Cell {
     pub modal_error_rms: Vec<Option<Stats>>,
     /// Largest joint torque (N m).
     pub peak_joint_torque_nm: Option<Stats>,
-    /// The failed runs, by index.
+    /// The failed runs, by index: the first [`MAX_LISTED_FAILURES`] (`failed` counts them all;
+    /// the shard files hold every one).
     pub failures: Vec<FailedRun>,
 }
+
+/// Failed runs a cell lists (with their errors); the rest are counted.
+pub const MAX_LISTED_FAILURES: usize = 100;
 
 /// The cells of a whole sweep, noise level slowest then controller, from its runs in index
 /// order (as [`merge`](super::merge) returns them).
 pub fn cells(config: &SweepConfig, runs: &[RunResult]) -> Vec<Cell> {
-    let m = config.scenario.n_coords();
-    runs.chunks(config.seeds)
-        .map(|chunk| {
-            let completed: Vec<&RunMetrics> = chunk
-                .iter()
-                .filter_map(|r| match &r.outcome {
-                    Outcome::Completed(m) => Some(m),
-                    Outcome::Failed { .. } => None,
-                })
-                .collect();
-            let stats = |f: fn(&RunMetrics) -> f64| {
-                Stats::of(&completed.iter().map(|m| f(m)).collect::<Vec<_>>())
-            };
-            let failures: Vec<FailedRun> = chunk
-                .iter()
-                .filter_map(|r| match &r.outcome {
-                    Outcome::Failed { error, .. } => Some(FailedRun {
-                        index: r.index,
-                        seed: r.seed,
+    let mut builder = CellBuilder::new(config);
+    runs.iter().for_each(|run| builder.add(run));
+    builder.finish()
+}
+
+/// Builds the cells from a sweep's runs given one at a time in index order, keeping the values
+/// of the current cell only: `8 (3 + m)` bytes per completed run of one cell (`m` modal
+/// coordinates), whatever the number of runs.
+#[derive(Debug)]
+pub struct CellBuilder {
+    seeds: usize,
+    n_coords: usize,
+    done: Vec<Cell>,
+    current: Option<Values>,
+}
+
+/// The values of the runs of one cell so far.
+#[derive(Debug)]
+struct Values {
+    noise_level: f64,
+    controller: ControllerKind,
+    runs: usize,
+    failed: usize,
+    tip_error_rms_mm: Vec<f64>,
+    tip_error_max_mm: Vec<f64>,
+    modal_error_rms: Vec<Vec<f64>>,
+    peak_joint_torque_nm: Vec<f64>,
+    failures: Vec<FailedRun>,
+}
+
+impl Values {
+    /// Adds a completed run's metrics.
+    fn push(&mut self, m: &RunMetrics) {
+        self.tip_error_rms_mm.push(m.tip_error_rms_m * 1e3);
+        self.tip_error_max_mm.push(m.tip_error_max_m * 1e3);
+        for (values, v) in self.modal_error_rms.iter_mut().zip(&m.modal_error_rms) {
+            values.push(*v);
+        }
+        self.peak_joint_torque_nm.push(m.peak_joint_torque_nm);
+    }
+
+    /// The statistics of the cell.
+    fn cell(self) -> Cell {
+        Cell {
+            noise_level: self.noise_level,
+            controller: self.controller,
+            runs: self.runs,
+            failed: self.failed,
+            tip_error_rms_mm: Stats::of(&self.tip_error_rms_mm),
+            tip_error_max_mm: Stats::of(&self.tip_error_max_mm),
+            modal_error_rms: self.modal_error_rms.iter().map(|v| Stats::of(v)).collect(),
+            peak_joint_torque_nm: Stats::of(&self.peak_joint_torque_nm),
+            failures: self.failures,
+        }
+    }
+}
+
+impl CellBuilder {
+    /// A builder for the cells of `config`.
+    pub fn new(config: &SweepConfig) -> Self {
+        CellBuilder {
+            seeds: config.seeds.max(1),
+            n_coords: config.scenario.n_coords(),
+            done: Vec::new(),
+            current: None,
+        }
+    }
+
+    /// Adds the next run in index order; a run with another cell index than the last one
+    /// closes that cell.
+    pub fn add(&mut self, run: &RunResult) {
+        let first_of_cell = run.index % self.seeds == 0;
+        if first_of_cell && let Some(values) = self.current.take() {
+            self.done.push(values.cell());
+        }
+        let m = self.n_coords;
+        let values = self.current.get_or_insert_with(|| Values {
+            noise_level: run.noise_level,
+            controller: run.controller,
+            runs: 0,
+            failed: 0,
+            tip_error_rms_mm: Vec::new(),
+            tip_error_max_mm: Vec::new(),
+            modal_error_rms: vec![Vec::new(); m],
+            peak_joint_torque_nm: Vec::new(),
+            failures: Vec::new(),
+        });
+        values.runs += 1;
+        match &run.outcome {
+            Outcome::Completed(metrics) => values.push(metrics),
+            Outcome::Failed { error, .. } => {
+                values.failed += 1;
+                if values.failures.len() < MAX_LISTED_FAILURES {
+                    values.failures.push(FailedRun {
+                        index: run.index,
+                        seed: run.seed,
                         error: error.clone(),
-                    }),
-                    Outcome::Completed(_) => None,
-                })
-                .collect();
-            Cell {
-                noise_level: chunk[0].noise_level,
-                controller: chunk[0].controller,
-                runs: chunk.len(),
-                failed: failures.len(),
-                tip_error_rms_mm: stats(|m| m.tip_error_rms_m * 1e3),
-                tip_error_max_mm: stats(|m| m.tip_error_max_m * 1e3),
-                modal_error_rms: (0..m)
-                    .map(|i| {
-                        let values: Vec<f64> = completed
-                            .iter()
-                            .filter_map(|r| r.modal_error_rms.get(i).copied())
-                            .collect();
-                        Stats::of(&values)
-                    })
-                    .collect(),
-                peak_joint_torque_nm: stats(|m| m.peak_joint_torque_nm),
-                failures,
+                    });
+                }
             }
-        })
-        .collect()
+        }
+    }
+
+    /// The cells of the runs added.
+    pub fn finish(mut self) -> Vec<Cell> {
+        if let Some(values) = self.current.take() {
+            self.done.push(values.cell());
+        }
+        self.done
+    }
 }
 
 #[cfg(test)]
