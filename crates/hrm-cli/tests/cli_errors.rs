@@ -462,16 +462,54 @@ fn output_ends_quietly_when_the_reader_goes_away() {
         "/../fuzzy-sugeno/data/paper.fis"
     );
     let requests = "{\"op\":\"fk\",\"a\":[0.3,-0.2],\"alpha0\":1.2}\n".repeat(2000);
+    let dir = scratch("reader-gone");
+    let csv = dir.join("train.csv");
+    let rows: String = (0..20)
+        .map(|i| {
+            let (x1, x2) = (f64::from(i) / 19.0, f64::from(i * 7 % 20) / 19.0);
+            format!("{x1},{x2},{}\n", x1 * x2)
+        })
+        .collect();
+    std::fs::write(&csv, rows).unwrap();
+    let (trained, exported) = (dir.join("t.fis"), dir.join("c"));
     for (args, stdin) in [
         (vec!["eval"], requests.as_bytes()),
         (vec!["fis", "eval", fis, "0.1", "0", "0", "0"], &b""[..]),
         (vec!["fis", "check", fis], &b""[..]),
+        (
+            vec![
+                "fis",
+                "train",
+                "--data",
+                path(&csv),
+                "--epochs",
+                "30",
+                "--out",
+                path(&trained),
+            ],
+            &b""[..],
+        ),
+        (
+            vec![
+                "fis",
+                "export",
+                fis,
+                "--format",
+                "c",
+                "--out",
+                path(&exported),
+            ],
+            &b""[..],
+        ),
     ] {
         let output = with_reader_gone(&args, stdin);
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert_eq!(output.status.code(), Some(0), "{args:?}: {stderr}");
         assert!(stderr.is_empty(), "{args:?}: {stderr}");
     }
+    // The commands went on to the end.
+    assert!(trained.is_file() && exported.join("hrm_fis.c").is_file());
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
