@@ -172,10 +172,10 @@ impl CellBuilder {
         }
     }
 
-    /// Adds the next run in index order; a run with another cell index than the last one
-    /// closes that cell.
+    /// Adds the next run in index order; the first run of a cell (an index that is a multiple
+    /// of the seeds) closes the cell before it.
     pub fn add(&mut self, run: &RunResult) {
-        let first_of_cell = run.index % self.seeds == 0;
+        let first_of_cell = run.index.is_multiple_of(self.seeds);
         if first_of_cell && let Some(values) = self.current.take() {
             self.done.push(values.cell());
         }
