@@ -152,15 +152,8 @@ fn path(p: Option<&Path>) -> String {
 /// Reads a CSV file of samples (see the module documentation).
 fn read_csv(file: &Path) -> Result<TrainingData, String> {
     let fail = |message: String| format!("{}: {message}", file.display());
-    let size = std::fs::metadata(file)
-        .map_err(|e| fail(e.to_string()))?
-        .len();
-    if size > MAX_CSV_BYTES {
-        return Err(fail(format!(
-            "{size} bytes exceed the limit of {MAX_CSV_BYTES}"
-        )));
-    }
-    let text = std::fs::read_to_string(file).map_err(|e| fail(e.to_string()))?;
+    // Read with the limit, not by the size alone: `/dev/zero` or a pipe reports size 0.
+    let text = sim_core::read_text_file(file, MAX_CSV_BYTES).map_err(|e| fail(e.to_string()))?;
     parse_csv(&text).map_err(fail)
 }
 

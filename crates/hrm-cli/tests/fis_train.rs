@@ -135,5 +135,17 @@ fn bad_input_is_one_line() {
         with(["--order", "-1"]),
         "hrm: --order must be 0 or 1, got -1\n"
     );
+    // An endless stream (its size reads 0) stops at the 64 MiB limit instead of filling memory.
+    if std::path::Path::new("/dev/zero").exists() {
+        let endless = [
+            "fis",
+            "train",
+            "--data",
+            "/dev/zero",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        assert!(refused(&endless).contains("more than the 67108864 bytes allowed"));
+    }
     assert!(!out.exists());
 }
