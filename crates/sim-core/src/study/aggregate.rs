@@ -33,14 +33,25 @@ impl Stats {
         // Deviations from the first value: exact zeros (so std 0, mean exact) for equal values,
         // and no cancellation when the spread is small against the values.
         let shift = values[0];
-        let mean_dev = values.iter().map(|v| v - shift).sum::<f64>() / n as f64;
-        let mean = shift + mean_dev;
+        // Deviations whose squares or sums could overflow (beyond 1e150) are divided by a power
+        // of two, exactly: finite values of one sign always give finite statistics, and
+        // ordinary values (scale 1) give the same bits as without scaling.
+        let spread = values.iter().fold(0.0f64, |s, v| s.max((v - shift).abs()));
+        let scale = if spread > 1e150 && spread.is_finite() {
+            // The largest power of two not above the spread: its exponent bits alone.
+            f64::from_bits(spread.to_bits() & 0x7FF0_0000_0000_0000)
+        } else {
+            1.0
+        };
+        let dev = |v: &f64| (v - shift) / scale;
+        let mean_dev = values.iter().map(dev).sum::<f64>() / n as f64;
+        let mean = shift + scale * mean_dev;
         let std = if n > 1 {
             let ss: f64 = values
                 .iter()
-                .map(|v| (v - shift - mean_dev) * (v - shift - mean_dev))
+                .map(|v| (dev(v) - mean_dev) * (dev(v) - mean_dev))
                 .sum();
-            (ss / (n - 1) as f64).sqrt()
+            scale * (ss / (n - 1) as f64).sqrt()
         } else {
             0.0
         };
@@ -49,7 +60,8 @@ impl Stats {
         let median = if n % 2 == 1 {
             sorted[n / 2]
         } else {
-            0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+            // Halving is exact: the same bits as 0.5 (a + b), without its overflow.
+            0.5 * sorted[n / 2 - 1] + 0.5 * sorted[n / 2]
         };
         Some(Stats {
             mean,
@@ -234,6 +246,21 @@ mod tests {
         assert_eq!((one.mean, one.std, one.median), (3.5, 0.0, 3.5));
         assert_eq!(Stats::of(&[1.0, 10.0, 2.0]).unwrap().median, 2.0);
         assert!(Stats::of(&[]).is_none());
+    }
+
+    /// Issue 11: what a summary holds must be JSON, so finite values (of one sign) give finite
+    /// statistics even near the largest double: `[0, M, M]` has mean `2M/3`, std `M/sqrt(3)`.
+    #[test]
+    fn statistics_of_huge_values_are_finite() {
+        let m = f64::MAX;
+        let s = Stats::of(&[0.0, m, m]).unwrap();
+        assert_eq!((s.min, s.median, s.max), (0.0, m, m));
+        assert!((s.mean / (2.0 * (m / 3.0)) - 1.0).abs() < 1e-15, "{s:?}");
+        assert!((s.std / (m / 3f64.sqrt()) - 1.0).abs() < 1e-15, "{s:?}");
+        let pair = Stats::of(&[m, m]).unwrap();
+        assert_eq!((pair.mean, pair.std, pair.median), (m, 0.0, m));
+        let many = Stats::of(&vec![1e300; 100_000]).unwrap();
+        assert_eq!((many.mean, many.std), (1e300, 0.0));
     }
 
     proptest! {
