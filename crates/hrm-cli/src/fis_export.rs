@@ -81,7 +81,7 @@ pub fn run(args: ExportArgs) -> Result<(), String> {
     for (name, text) in files {
         let path: PathBuf = Path::new(&args.out).join(name);
         std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
-        println!("{}", path.display());
+        crate::console::print(&format!("{}\n", path.display()))?;
     }
     Ok(())
 }

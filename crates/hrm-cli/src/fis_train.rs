@@ -5,11 +5,11 @@
 //! with an optional header line of column names (taken as the variables' names). Every size is
 //! bounded before it is used: the file, its rows and columns, the epochs and the rule count.
 
-use crate::{output_dir, progress};
+use crate::{console, output_dir, progress};
 use clap::Args;
 use fuzzy_sugeno::learn::{
-    Anfis, AnfisOptions, ConsequentOrder, GridPartition, MAX_INPUTS, MAX_ROWS, SetShape,
-    SubtractiveClustering, TrainingData, genfis_cluster, genfis_grid,
+    Anfis, AnfisOptions, ConsequentOrder, GridPartition, MAX_INPUTS, MAX_ROWS, MAX_SETS_PER_INPUT,
+    SetShape, SubtractiveClustering, TrainingData, genfis_cluster, genfis_grid,
 };
 use std::path::{Path, PathBuf};
 
@@ -30,25 +30,25 @@ pub struct TrainArgs {
     #[arg(long)]
     check: Option<PathBuf>,
     /// Grid partition: sets per input (the rule count is this to the power of the inputs).
-    #[arg(long, default_value_t = 2)]
-    mfs: usize,
+    #[arg(long, default_value_t = 2, allow_negative_numbers = true)]
+    mfs: i128,
     /// Grid partition: the sets' MATLAB type (gbellmf, gaussmf, gauss2mf, trimf, trapmf, sigmf, dsigmf, psigmf, pimf).
     #[arg(long, default_value = "gbellmf")]
     mf_type: String,
     /// The consequents' order: 0 (constant) or 1 (linear).
-    #[arg(long, default_value_t = 1)]
-    order: u8,
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    order: i128,
     /// ANFIS epochs (0: the genfis system with least-squares consequents, untrained).
-    #[arg(long, default_value_t = 100)]
-    epochs: usize,
+    #[arg(long, default_value_t = 100, allow_negative_numbers = true)]
+    epochs: i128,
     /// Subtractive clustering with this radius (in (0, 1], of each column's range) instead of a grid partition.
-    #[arg(long, conflicts_with_all = ["mfs", "mf_type"])]
+    #[arg(long, conflicts_with_all = ["mfs", "mf_type"], allow_negative_numbers = true)]
     cluster_radius: Option<f64>,
     /// The initial premise step size (Jang's kappa).
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     step: f64,
     /// The least-squares ridge, relative to the mean squared column norm (0: plain least squares).
-    #[arg(long, default_value_t = 1e-10)]
+    #[arg(long, default_value_t = 1e-10, allow_negative_numbers = true)]
     ridge: f64,
     /// The learned system, a MATLAB .fis file.
     #[arg(long)]
@@ -57,12 +57,8 @@ pub struct TrainArgs {
 
 /// Runs `hrm fis train`.
 pub fn run(args: TrainArgs) -> Result<(), String> {
-    if args.epochs > MAX_EPOCHS {
-        return Err(format!(
-            "--epochs must be at most {MAX_EPOCHS}, got {}",
-            args.epochs
-        ));
-    }
+    let epochs = crate::args::count("--epochs", args.epochs, 0, MAX_EPOCHS)?;
+    let mfs = crate::args::count("--mfs", args.mfs, 1, MAX_SETS_PER_INPUT)?;
     let order = match args.order {
         0 => ConsequentOrder::Zero,
         1 => ConsequentOrder::First,
@@ -84,7 +80,7 @@ pub fn run(args: TrainArgs) -> Result<(), String> {
         Some(radius) => genfis_cluster(&train, 0, &SubtractiveClustering { radius, order }),
         None => SetShape::from_matlab_name(&args.mf_type).and_then(|shape| {
             let grid = GridPartition {
-                sets_per_input: args.mfs,
+                sets_per_input: mfs,
                 shape,
                 order,
             };
@@ -92,29 +88,28 @@ pub fn run(args: TrainArgs) -> Result<(), String> {
         }),
     }
     .map_err(|e| e.to_string())?;
-    println!(
-        "{} inputs, {} rules, {} training samples{}",
+    console::print(&format!(
+        "{} inputs, {} rules, {} training samples{}\n",
         initial.inputs().len(),
         initial.rules().len(),
         train.rows(),
         check
             .as_ref()
             .map_or(String::new(), |c| format!(", {} check samples", c.rows()))
-    );
-    let system = if args.epochs == 0 {
+    ))?;
+    let system = if epochs == 0 {
         initial
     } else {
         let options = AnfisOptions {
-            epochs: args.epochs,
+            epochs,
             initial_step: args.step,
             ridge: args.ridge,
             ..AnfisOptions::default()
         };
-        let bar =
-            (args.epochs >= LONG_RUN_EPOCHS).then(|| progress::bar(args.epochs as u64, "epochs"));
+        let bar = (epochs >= LONG_RUN_EPOCHS).then(|| progress::bar(epochs as u64, "epochs"));
         let mut trainer =
             Anfis::new(initial, &train, check.as_ref(), 0, options).map_err(|e| e.to_string())?;
-        for _ in 0..args.epochs {
+        for _ in 0..epochs {
             let report = trainer.epoch().map_err(|e| e.to_string())?;
             let line = match report.check_rmse {
                 Some(check) => format!(
@@ -128,24 +123,24 @@ pub fn run(args: TrainArgs) -> Result<(), String> {
             };
             match &bar {
                 Some(bar) => {
-                    bar.suspend(|| println!("{line}"));
+                    bar.suspend(|| console::print(&format!("{line}\n")))?;
                     bar.inc(1);
                 }
-                None => println!("{line}"),
+                None => console::print(&format!("{line}\n"))?,
             }
         }
         if let Some(bar) = bar {
             bar.finish_and_clear();
         }
-        println!(
-            "kept the system of epoch {} (smallest {} error)",
+        console::print(&format!(
+            "kept the system of epoch {} (smallest {} error)\n",
             trainer.best_epoch(),
             if check.is_some() { "check" } else { "training" }
-        );
+        ))?;
         trainer.best_system().map_err(|e| e.to_string())?
     };
     output_dir::write_file(&args.out, &system.to_fis(), "fis train")?;
-    println!("wrote {}", args.out.display());
+    console::print(&format!("wrote {}\n", args.out.display()))?;
     Ok(())
 }
 
@@ -156,15 +151,8 @@ fn path(p: Option<&Path>) -> String {
 /// Reads a CSV file of samples (see the module documentation).
 fn read_csv(file: &Path) -> Result<TrainingData, String> {
     let fail = |message: String| format!("{}: {message}", file.display());
-    let size = std::fs::metadata(file)
-        .map_err(|e| fail(e.to_string()))?
-        .len();
-    if size > MAX_CSV_BYTES {
-        return Err(fail(format!(
-            "{size} bytes exceed the limit of {MAX_CSV_BYTES}"
-        )));
-    }
-    let text = std::fs::read_to_string(file).map_err(|e| fail(e.to_string()))?;
+    // Read with the limit, not by the size alone: `/dev/zero` or a pipe reports size 0.
+    let text = sim_core::read_text_file(file, MAX_CSV_BYTES).map_err(|e| fail(e.to_string()))?;
     parse_csv(&text).map_err(fail)
 }
 

@@ -11,6 +11,7 @@
 //! folder unless it has an entry of the same name.
 
 use std::ffi::OsString;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The marker file of an output folder; it names the command that wrote the folder.
@@ -151,26 +152,44 @@ impl Drop for OutputDir {
     }
 }
 
-/// Writes `text` to the file `path` whole: into a temporary sibling, then renamed over `path`.
-/// A folder created for it gets the [`MARKER`] naming `command`.
+/// Writes the file `path` whole with the contents `text`, as [`write_file_with`] does.
 pub fn write_file(path: &Path, text: &str, command: &str) -> Result<(), String> {
-    let fail = |what: &str, e: std::io::Error| format!("{what} {}: {e}", path.display());
+    write_file_with(path, command, |out| {
+        out.write_all(text.as_bytes()).map_err(|e| e.to_string())
+    })
+}
+
+/// Writes the file `path` whole with `write`, which may write it piece by piece: into a
+/// temporary sibling (buffered), renamed over `path` only when `write` succeeded. A folder
+/// created for it gets the [`MARKER`] naming `command`.
+pub fn write_file_with(
+    path: &Path,
+    command: &str,
+    write: impl FnOnce(&mut dyn Write) -> Result<(), String>,
+) -> Result<(), String> {
+    let fail = |what: &str, e: &dyn std::fmt::Display| format!("{what} {}: {e}", path.display());
     let Some(name) = path.file_name() else {
         return Err(format!("{}: not a file name", path.display()));
     };
     let dir = path.parent().unwrap_or(Path::new(""));
     if !dir.as_os_str().is_empty() && !dir.exists() {
-        std::fs::create_dir_all(dir).map_err(|e| fail("cannot create the folder of", e))?;
+        std::fs::create_dir_all(dir).map_err(|e| fail("cannot create the folder of", &e))?;
         std::fs::write(dir.join(MARKER), format!("written by `hrm {command}`\n"))
-            .map_err(|e| fail("cannot create the folder of", e))?;
+            .map_err(|e| fail("cannot create the folder of", &e))?;
     }
     let temporary = sibling(&dir.join(name), "partial");
-    std::fs::write(&temporary, text)
-        .and_then(|()| std::fs::rename(&temporary, path))
-        .map_err(|e| {
-            let _ = std::fs::remove_file(&temporary);
-            fail("cannot write", e)
+    let written = std::fs::File::create(&temporary)
+        .map_err(|e| fail("cannot write", &e))
+        .and_then(|file| {
+            let mut out = std::io::BufWriter::new(file);
+            write(&mut out)?;
+            out.flush().map_err(|e| fail("cannot write", &e))
         })
+        .and_then(|()| std::fs::rename(&temporary, path).map_err(|e| fail("cannot write", &e)));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&temporary);
+    }
+    written
 }
 
 /// `.<name>.hrm-<what>-<pid>` beside `path`.
@@ -340,6 +359,15 @@ mod tests {
         assert_eq!(names(&root.join("shards")), [MARKER, "shard-1-of-2.json"]);
         let err = write_file(&root.join("shards"), "x", "sweep").unwrap_err();
         assert!(err.contains("cannot write"), "{err}");
+        // A writer that fails half-way leaves the earlier file as it was, and no partial file.
+        let err = write_file_with(&path, "sweep", |out| {
+            out.write_all(b"{\"b\"").map_err(|e| e.to_string())?;
+            Err("the runs stopped".into())
+        })
+        .unwrap_err();
+        assert_eq!(err, "the runs stopped");
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "{\"a\":1}");
+        assert_eq!(names(&root.join("shards")), [MARKER, "shard-1-of-2.json"]);
         std::fs::remove_dir_all(&root).unwrap();
     }
 }

@@ -93,6 +93,7 @@ impl Sweep {
         };
         Self::checked(SweepConfig {
             hrm_version: study::VERSION.to_string(),
+            inputs: study::input_digests(&scenario).map_err(input)?,
             scenario,
             controllers,
             noise_levels,

@@ -1,6 +1,7 @@
-//! Reading the text files a user points the toolkit at (scenario TOML, MATLAB `.fis`, sweep
-//! shards) with a size limit, so that a huge file or an endless stream (`/dev/zero`, a pipe)
-//! is a clear error rather than memory exhaustion.
+//! Reading the text files a user points the toolkit at (scenario TOML, MATLAB `.fis`) with a
+//! size limit, so that a huge file or an endless stream (`/dev/zero`, a pipe) is a clear error
+//! rather than memory exhaustion. (Sweep shard files are read a line at a time, each line with
+//! its own limit: `study::ShardReader`.)
 
 use std::io::{Error, ErrorKind, Read};
 use std::path::Path;

@@ -17,7 +17,7 @@ pub const MAX_RULES: usize = 4096;
 /// The most rows subtractive clustering accepts (its cost grows as the square of the rows).
 pub const MAX_CLUSTER_ROWS: usize = 10_000;
 /// The most sets per input of a grid partition.
-const MAX_SETS_PER_INPUT: usize = 64;
+pub const MAX_SETS_PER_INPUT: usize = 64;
 
 /// The consequents' order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

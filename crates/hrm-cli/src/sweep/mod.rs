@@ -14,7 +14,7 @@ mod report;
 use crate::console;
 use crate::output_dir::{self, OutputDir};
 use clap::{Args, Subcommand};
-use sim_core::study::{self, Outcome, Shard, ShardFile, SweepConfig};
+use sim_core::study::{self, Cell, CellBuilder, Shard, ShardHeader, ShardReader, SweepConfig};
 use sim_core::{ControllerKind, Scenario};
 use std::path::{Path, PathBuf};
 
@@ -103,20 +103,18 @@ pub fn run(cli: SweepCli) -> Result<(), String> {
             let config = configure(&args)?;
             match args.shard {
                 Some(shard) => {
-                    let file = run_shard(&config, shard);
                     let path = args
                         .out
                         .join(format!("shard-{}-of-{}.json", shard.index, shard.count));
-                    output_dir::write_file(&path, &ShardFile::to_json(&file)?, "sweep --shard")?;
-                    let failed = file
-                        .runs
-                        .iter()
-                        .filter(|r| matches!(r.outcome, Outcome::Failed { .. }))
-                        .count();
+                    let mut counts = (0, 0);
+                    output_dir::write_file_with(&path, "sweep --shard", |out| {
+                        counts = write_shard(&config, shard, out)?;
+                        Ok(())
+                    })?;
+                    let (runs, stopped) = counts;
                     console::print(&format!(
-                        "wrote {} ({} runs, {failed} stopped)\n",
-                        path.display(),
-                        file.runs.len()
+                        "wrote {} ({runs} runs, {stopped} stopped)\n",
+                        path.display()
                     ))
                 }
                 None => {
@@ -179,8 +177,10 @@ fn configure(args: &SweepArgs) -> Result<SweepConfig, String> {
     }
     scenario.noise = Default::default();
     scenario.seed = 0;
+    study::check_json_safe(&scenario)?;
     let config = SweepConfig {
         hrm_version: study::VERSION.to_string(),
+        inputs: study::input_digests(&scenario)?,
         scenario,
         controllers: args.controllers.clone(),
         noise_levels: args.noise.clone(),
@@ -194,33 +194,44 @@ fn configure(args: &SweepArgs) -> Result<SweepConfig, String> {
     Ok(config)
 }
 
-/// Runs the runs of `shard` with a progress bar (the library's [`study::run_shard`]).
-fn run_shard(config: &SweepConfig, shard: Shard) -> ShardFile {
+/// Runs the runs of `shard` with a progress bar, writing its shard file to `out` as they finish
+/// (the library's [`study::write_shard`]); returns the number of runs and of those that stopped.
+fn write_shard(
+    config: &SweepConfig,
+    shard: Shard,
+    out: &mut dyn std::io::Write,
+) -> Result<(usize, usize), String> {
     let total = config.runs().unwrap_or(0);
     let label = if shard == Shard::WHOLE {
         "sweep".to_string()
     } else {
         format!("shard {shard}")
     };
-    let bar = crate::progress::bar(shard.indices(total).count() as u64, &label);
-    let file = study::run_shard(config, shard, || bar.inc(1));
+    let bar = crate::progress::bar(shard.run_count(total) as u64, &label);
+    let counts = study::write_shard(config, shard, out, || bar.inc(1));
     bar.finish_and_clear();
-    file
+    counts
 }
 
 /// Runs the whole sweep into `out` and returns the table. The report is made from `runs.json`
 /// as read back, exactly as `merge` makes it from shard files, so both give identical numbers.
 fn sweep_whole(config: &SweepConfig, out: &Path) -> Result<String, String> {
     let path = out.join("runs.json");
-    let text = ShardFile::to_json(&run_shard(config, Shard::WHOLE))?;
-    write(&path, &text)?;
-    let parsed = ShardFile::parse(&text, &path)?;
-    write_report(&parsed, out)
+    let mut file = create(&path)?;
+    write_shard(config, Shard::WHOLE, &mut file)?;
+    std::io::Write::flush(&mut file)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    let mut reader = ShardReader::open(&path)?;
+    let mut cells = CellBuilder::new(&reader.header().config);
+    while let Some(run) = reader.next_run()? {
+        cells.add(&run);
+    }
+    write_report(config, &cells.finish(), out)
 }
 
 /// Merges the shard files named by `inputs` into `out` (the staging folder of `target`) and
-/// returns the table. Shard files inside `target` are refused: replacing `target` would
-/// delete them.
+/// returns the table; the runs are read and written one at a time. Shard files inside `target`
+/// are refused: replacing `target` would delete them.
 fn merge_files(inputs: &[PathBuf], out: &Path, target: &Path) -> Result<String, String> {
     let paths = study::shard_paths(inputs)?;
     if let Ok(target_abs) = std::fs::canonicalize(target) {
@@ -236,23 +247,45 @@ fn merge_files(inputs: &[PathBuf], out: &Path, target: &Path) -> Result<String, 
         }
     }
     let shards = paths
-        .into_iter()
-        .map(|path| ShardFile::read(&path).map(|file| (path, file)))
+        .iter()
+        .map(|path| ShardReader::open(path))
         .collect::<Result<Vec<_>, _>>()?;
-    let whole = study::merge(shards)?;
-    write(&out.join("runs.json"), &ShardFile::to_json(&whole)?)?;
-    write_report(&whole, out)
+    let Some(first) = shards.first() else {
+        return Err("nothing to merge: no shard files given".into());
+    };
+    let whole = ShardHeader::new(&first.header().config, Shard::WHOLE);
+    let path = out.join("runs.json");
+    let mut file = create(&path)?;
+    let written = |e: std::io::Error| format!("cannot write {}: {e}", path.display());
+    study::write_json_line(&mut file, &whole)?;
+    let mut cells = CellBuilder::new(&whole.config);
+    study::merge_readers(shards, |run| {
+        cells.add(&run);
+        study::write_json_line(&mut file, &run)
+    })?;
+    std::io::Write::flush(&mut file).map_err(written)?;
+    write_report(&whole.config, &cells.finish(), out)
 }
 
-/// Writes `summary.json`, `table.txt` and `tip_error_rms.svg` of a whole sweep; returns the
-/// table.
-fn write_report(whole: &ShardFile, out: &Path) -> Result<String, String> {
-    let cells = study::cells(&whole.config, &whole.runs);
-    let summary = sim_core::summary_json::sweep(&whole.config, &cells);
+/// A buffered new file at `path`, its folder created.
+fn create(path: &Path) -> Result<std::io::BufWriter<std::fs::File>, String> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
+    std::fs::File::create(path)
+        .map(std::io::BufWriter::new)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+/// Writes `summary.json`, `table.txt` and `tip_error_rms.svg` of a whole sweep from its cells;
+/// returns the table.
+fn write_report(config: &SweepConfig, cells: &[Cell], out: &Path) -> Result<String, String> {
+    let summary = sim_core::summary_json::sweep(config, cells);
     let summary = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())? + "\n";
     write(&out.join("summary.json"), &summary)?;
-    let mut table = report::table(&whole.config, &cells);
-    if !report::plot(&out.join("tip_error_rms.svg"), &whole.config, &cells)? {
+    let mut table = report::table(config, cells);
+    if !report::plot(&out.join("tip_error_rms.svg"), config, cells)? {
         table.push_str("no run completed: no plot drawn\n");
     }
     write(&out.join("table.txt"), &table)?;

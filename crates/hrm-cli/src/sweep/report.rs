@@ -98,13 +98,15 @@ pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
         }
         s.push('\n');
     }
+    let stopped: usize = cells.iter().map(|c| c.failed).sum();
     let failures: Vec<_> = cells
         .iter()
         .flat_map(|c| c.failures.iter().map(move |f| (c, f)))
+        .take(LISTED_FAILURES)
         .collect();
-    if !failures.is_empty() {
-        let _ = writeln!(s, "{} runs stopped before the end:", failures.len());
-        for (c, f) in failures.iter().take(LISTED_FAILURES) {
+    if stopped > 0 {
+        let _ = writeln!(s, "{stopped} runs stopped before the end:");
+        for (c, f) in &failures {
             let _ = writeln!(
                 s,
                 "  run {} ({}, L = {:.3e} rad, seed {}): {}",
@@ -115,11 +117,11 @@ pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
                 f.error
             );
         }
-        if failures.len() > LISTED_FAILURES {
+        if stopped > failures.len() {
             let _ = writeln!(
                 s,
-                "  ... and {} more (see summary.json)",
-                failures.len() - LISTED_FAILURES
+                "  ... and {} more (see summary.json and runs.json)",
+                stopped - failures.len()
             );
         }
     }

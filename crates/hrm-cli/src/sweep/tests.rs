@@ -1,6 +1,6 @@
 use super::*;
 use clap::Parser;
-use sim_core::study::RunMetrics;
+use sim_core::study::{Outcome, RunMetrics, ShardFile};
 
 /// `hrm` reduced to its `sweep` subcommand.
 #[derive(Parser)]
@@ -174,14 +174,19 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
     let cut_path = root.join("cut").join("shard-2-of-3.json");
     write(&cut_path, &cut.to_json().unwrap()).unwrap();
     let err = merge(&[shard(1), cut_path.clone(), shard(3)]);
-    let missing = format!("1 of {} runs are missing", whole_runs.runs.len());
-    assert!(err.contains(&missing), "{err}");
+    assert!(
+        err.contains("is cut short: it holds 7 of the 8 runs of shard 2/3"),
+        "{err}"
+    );
     // A run moved to a shard it does not belong to.
     let mut moved = ShardFile::read(&shard(2)).unwrap();
     moved.runs[0].index = 0;
     write(&cut_path, &moved.to_json().unwrap()).unwrap();
     let err = merge(&[shard(1), cut_path.clone(), shard(3)]);
-    assert!(err.contains("not run 0 of its shard"), "{err}");
+    assert!(
+        err.contains("holds run 0, which is not run 1 of this sweep"),
+        "{err}"
+    );
     // A hand-edited configuration that makes no sweep.
     let mut empty = ShardFile::read(&shard(2)).unwrap();
     empty.config.seeds = 0;
@@ -233,7 +238,7 @@ fn small_config(levels: &[f64], seeds: usize) -> SweepConfig {
 #[test]
 fn a_run_in_a_sweep_is_the_scenario_run_alone_with_its_seed() {
     let config = small_config(&[0.0, 0.01], 2);
-    let whole = run_shard(&config, Shard::WHOLE);
+    let whole = study::run_shard(&config, Shard::WHOLE, || {});
     for run in &whole.runs {
         let mut scenario = Scenario::builtin("paper-responses-step").unwrap();
         scenario.duration = 0.15;
@@ -254,7 +259,7 @@ fn a_run_in_a_sweep_is_the_scenario_run_alone_with_its_seed() {
 #[test]
 fn noise_spreads_the_errors_and_no_noise_does_not() {
     let config = small_config(&[0.0, 0.01], 4);
-    let whole = run_shard(&config, Shard::WHOLE);
+    let whole = study::run_shard(&config, Shard::WHOLE, || {});
     let cells = study::cells(&config, &whole.runs);
     let kinds = ControllerKind::ALL.len();
     assert_eq!(cells.len(), 2 * kinds);
@@ -331,7 +336,7 @@ fn a_thousand_short_runs_complete_without_nan() {
     .unwrap();
     let config = configure(&args.sweep).unwrap();
     assert_eq!(config.runs(), Some(1000));
-    let whole = run_shard(&config, Shard::WHOLE);
+    let whole = study::run_shard(&config, Shard::WHOLE, || {});
     let text = whole.to_json().unwrap();
     let parsed = ShardFile::parse(&text, Path::new("memory")).unwrap();
     let cells = study::cells(&parsed.config, &parsed.runs);
@@ -356,4 +361,197 @@ fn a_thousand_short_runs_complete_without_nan() {
             );
         }
     }
+}
+
+/// Issue 11: a shard carries the SHA-256 of its scenario and of the `.fis` it references. The
+/// same `.fis` merges into exactly the unsharded `runs.json`; an edited one is refused by name.
+#[test]
+fn shards_run_with_an_edited_fis_are_not_merged() {
+    let root = temp_dir("fis-edit");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let fis = root.join("controller.fis");
+    let paper = read(Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../fuzzy-sugeno/data/paper.fis"
+    )));
+    write(&fis, &paper).unwrap();
+    let mut scenario = Scenario::builtin("paper-responses-step").unwrap();
+    scenario.controller.fis = Some(fis.clone());
+    let toml = root.join("custom.toml");
+    write(&toml, &scenario.to_toml()).unwrap();
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "--scenario".to_string(),
+            s(&toml),
+            "--duration".into(),
+            "0.02".into(),
+            "--noise".into(),
+            "0,0.01".into(),
+            "--seeds".into(),
+            "3".into(),
+            "--controllers".into(),
+            "fuzzy,pd".into(),
+        ];
+        a.extend(extra.iter().map(|e| e.to_string()));
+        a
+    };
+    let sweep = |a: Vec<String>| hrm_sweep(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let (whole, shards, edited) = (root.join("whole"), root.join("shards"), root.join("edited"));
+    sweep(args(&["--out", &s(&whole)])).unwrap();
+    sweep(args(&["--shard", "1/2", "--out", &s(&shards)])).unwrap();
+    sweep(args(&["--shard", "2/2", "--out", &s(&shards)])).unwrap();
+    let merged = root.join("merged");
+    hrm_sweep(&["merge", "--out", &s(&merged), &s(&shards)]).unwrap();
+    let bytes = |p: &Path| std::fs::read(p).unwrap();
+    assert_eq!(
+        bytes(&whole.join("runs.json")),
+        bytes(&merged.join("runs.json"))
+    );
+    assert_eq!(
+        bytes(&whole.join("summary.json")),
+        bytes(&merged.join("summary.json"))
+    );
+    let header = ShardFile::read(&merged.join("runs.json"))
+        .unwrap()
+        .config
+        .inputs;
+    assert_eq!(header.len(), 2);
+    assert_eq!(header[1].path.as_deref(), Some(fis.as_path()));
+
+    // One rule weight changed between the two shards.
+    let before_args = args(&[]);
+    let before_args: Vec<&str> = before_args.iter().map(String::as_str).collect();
+    let before = configure(&parse(&before_args).unwrap().sweep).unwrap();
+    let edited_text = paper.replacen("(1) : 1", "(0.5) : 1", 1);
+    assert_ne!(edited_text, paper);
+    write(&fis, &edited_text).unwrap();
+    // A shard whose `.fis` changes while it runs is refused after its runs, nothing written.
+    let during = shards.join("during.json");
+    let err = output_dir::write_file_with(&during, "test", |out| {
+        write_shard(&before, Shard { index: 1, count: 2 }, out).map(drop)
+    })
+    .unwrap_err();
+    assert!(
+        err.contains(&format!(
+            "controller.fis ({}) changed while the sweep ran",
+            fis.display()
+        )),
+        "{err}"
+    );
+    assert!(!during.exists());
+    sweep(args(&["--shard", "2/2", "--out", &s(&edited)])).unwrap();
+    let err = hrm_sweep(&[
+        "merge",
+        "--out",
+        &s(&root.join("mixed")),
+        &s(&shards.join("shard-1-of-2.json")),
+        &s(&edited.join("shard-2-of-2.json")),
+    ])
+    .unwrap_err();
+    assert!(
+        err.contains(&format!(
+            "were run with different contents of controller.fis ({})",
+            fis.display()
+        )),
+        "{err}"
+    );
+    assert!(!err.contains('\n'), "{err}");
+    assert!(!root.join("mixed").exists());
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+/// Issue 11: a setting JSON cannot hold is refused before any run, by name.
+#[test]
+fn a_setting_json_cannot_hold_is_refused_before_running() {
+    let root = temp_dir("json-safe");
+    let mut scenario = Scenario::builtin("paper-responses-step").unwrap();
+    scenario.limits.max_modal_error = f64::INFINITY;
+    let toml = root.join("unbounded.toml");
+    write(&toml, &scenario.to_toml()).unwrap();
+    assert!(read(&toml).contains("max_modal_error = inf"));
+    let out = root.join("out");
+    let err = hrm_sweep(&[
+        "--scenario",
+        toml.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ])
+    .unwrap_err();
+    assert!(
+        err.contains("scenario setting limits.max_modal_error = inf cannot be written"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+/// Shard files are JSON lines read one run at a time: older formats are refused by name, a
+/// line cut or added is refused, and more shards than the merge keeps open merge the same.
+#[test]
+fn shard_files_are_streamed_and_checked_line_by_line() {
+    let root = temp_dir("stream");
+    let args = parse(&[
+        "--scenario",
+        "paper-responses-step",
+        "--duration",
+        "0.02",
+        "--noise",
+        "0",
+        "--controllers",
+        "pd",
+        "--seeds",
+        "70",
+    ])
+    .unwrap();
+    let config = configure(&args.sweep).unwrap();
+    let whole = root.join("whole");
+    std::fs::create_dir_all(&whole).unwrap();
+    let table = sweep_whole(&config, &whole).unwrap();
+    assert!(table.contains("70 runs"), "{table}");
+    let shards = root.join("shards");
+    for index in 1..=70 {
+        let shard = Shard { index, count: 70 };
+        let path = shards.join(format!("shard-{index}-of-70.json"));
+        output_dir::write_file_with(&path, "test", |out| {
+            write_shard(&config, shard, out).map(drop)
+        })
+        .unwrap();
+    }
+    let merged = root.join("merged");
+    std::fs::create_dir_all(&merged).unwrap();
+    merge_files(std::slice::from_ref(&shards), &merged, &merged.join("x")).unwrap();
+    let runs = read(&whole.join("runs.json"));
+    assert_eq!(runs, read(&merged.join("runs.json")));
+    assert_eq!(runs.lines().count(), 71);
+
+    let check = |text: &str| ShardFile::parse(text, Path::new("f.json")).unwrap_err();
+    let lines: Vec<&str> = runs.lines().collect();
+    let err = check(&runs[..runs.len() - 10]);
+    assert!(err.contains("f.json: line 71 is not a run"), "{err}");
+    let err = check(&(lines[..70].join("\n") + "\n"));
+    assert!(
+        err.contains("cut short: it holds 69 of the 70 runs"),
+        "{err}"
+    );
+    let err = check(&(runs.clone() + lines[70] + "\n"));
+    assert!(
+        err.contains("line 72: more lines than the 70 runs"),
+        "{err}"
+    );
+    let err = check(&runs.replacen("\"index\":5,", "\"index\":18446744073709551615,", 1));
+    assert!(
+        err.contains("holds run 18446744073709551615, which is not run 5"),
+        "{err}"
+    );
+    let older = "{\n  \"format\": \"hrm-sweep-shard/2\",\n  \"runs\": []\n}\n";
+    let err = check(older);
+    assert!(
+        err.contains("(format \"hrm-sweep-shard/2\", expected \"hrm-sweep-shard/3\")")
+            && err.contains("older versions cannot be merged"),
+        "{err}"
+    );
+    let edited = runs.replacen("\"duration\":0.02", "\"duration\":0.03", 1);
+    let err = check(&edited);
+    assert!(err.contains("SHA-256 does not match its content"), "{err}");
+    std::fs::remove_dir_all(&root).unwrap();
 }

@@ -380,15 +380,22 @@ fn input_files_are_read_with_a_size_limit() {
         line.contains("huge.toml") && line.contains("more than the 16777216"),
         "{line}"
     );
-    let shard = huge("shard-1-of-1.json", (1 << 30) + 1);
-    let line = refused(&hrm(&[
-        "sweep",
-        "merge",
-        "--out",
-        path(&dir.join("o")),
-        path(&shard),
-    ]));
-    assert!(line.contains("more than the 1073741824 allowed"), "{line}");
+    // Shard files are read a line at a time, each line up to 64 MiB.
+    let shard = huge("shard-1-of-1.json", 1 << 40);
+    let merge = |shard: &str| {
+        refused(&hrm(&[
+            "sweep",
+            "merge",
+            "--out",
+            path(&dir.join("o")),
+            shard,
+        ]))
+    };
+    let line = merge(path(&shard));
+    assert!(
+        line.contains("line 1 is longer than the 67108864 bytes a shard file's line may have"),
+        "{line}"
+    );
     // An endless stream stops at the limit.
     if Path::new("/dev/zero").exists() {
         let line = refused(&hrm(&["fis", "eval", "/dev/zero", "0"]));
@@ -396,6 +403,8 @@ fn input_files_are_read_with_a_size_limit() {
             line.contains("more than the 16777216 bytes allowed"),
             "{line}"
         );
+        let line = merge("/dev/zero");
+        assert!(line.contains("line 1 is longer than"), "{line}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -447,16 +456,54 @@ fn output_ends_quietly_when_the_reader_goes_away() {
         "/../fuzzy-sugeno/data/paper.fis"
     );
     let requests = "{\"op\":\"fk\",\"a\":[0.3,-0.2],\"alpha0\":1.2}\n".repeat(2000);
+    let dir = scratch("reader-gone");
+    let csv = dir.join("train.csv");
+    let rows: String = (0..20)
+        .map(|i| {
+            let (x1, x2) = (f64::from(i) / 19.0, f64::from(i * 7 % 20) / 19.0);
+            format!("{x1},{x2},{}\n", x1 * x2)
+        })
+        .collect();
+    std::fs::write(&csv, rows).unwrap();
+    let (trained, exported) = (dir.join("t.fis"), dir.join("c"));
     for (args, stdin) in [
         (vec!["eval"], requests.as_bytes()),
         (vec!["fis", "eval", fis, "0.1", "0", "0", "0"], &b""[..]),
         (vec!["fis", "check", fis], &b""[..]),
+        (
+            vec![
+                "fis",
+                "train",
+                "--data",
+                path(&csv),
+                "--epochs",
+                "30",
+                "--out",
+                path(&trained),
+            ],
+            &b""[..],
+        ),
+        (
+            vec![
+                "fis",
+                "export",
+                fis,
+                "--format",
+                "c",
+                "--out",
+                path(&exported),
+            ],
+            &b""[..],
+        ),
     ] {
         let output = with_reader_gone(&args, stdin);
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert_eq!(output.status.code(), Some(0), "{args:?}: {stderr}");
         assert!(stderr.is_empty(), "{args:?}: {stderr}");
     }
+    // The commands went on to the end.
+    assert!(trained.is_file() && exported.join("hrm_fis.c").is_file());
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! Process-level fuzzing of every `hrm` subcommand: random and hostile option values, mutated
-//! `.fis`, scenario and shard files, random bytes on standard input, stray arguments.
+//! `.fis`, scenario, CSV and shard files (their counts, indices and seeds too), random bytes on
+//! standard input, stray arguments.
 //!
 //! Properties of every invocation: it ends within [`DEADLINE`]; its exit status is 0, 1 or 2
 //! (success, a refusal, a usage error); nothing it prints contains `panicked`; a refusal is
@@ -60,13 +61,22 @@ const STRAY: &[&str] = &[
     "--",
 ];
 
-/// Files shared by every case: the paper's `.fis`, a 10 ms scenario, a shard of a tiny sweep.
+/// Files shared by every case: the paper's `.fis`, a 10 ms scenario, the shard files of a tiny
+/// sweep (whole, and split in two), a small training CSV.
 struct Fixture {
     dir: PathBuf,
     fis: String,
     scenario: String,
-    shard: String,
+    shards: [String; 3],
+    csv: String,
 }
+
+/// The shard files of the fixture's sweep: `(shard, file name)`.
+const SHARD_FILES: [(&str, &str); 3] = [
+    ("1/1", "shard-1-of-1.json"),
+    ("1/2", "shard-1-of-2.json"),
+    ("2/2", "shard-2-of-2.json"),
+];
 
 const SHORT_SCENARIO: &str = r#"name = "short"
 duration = 0.01
@@ -100,25 +110,33 @@ fn fixture() -> &'static Fixture {
         let scenario = dir.join("short.toml");
         std::fs::write(&scenario, SHORT_SCENARIO).unwrap();
         let shards = dir.join("shards");
-        let output = hrm(
-            &[
-                "sweep",
-                "--scenario",
-                scenario.to_str().unwrap(),
-                "--noise",
-                "0,0.01",
-                "--seeds",
-                "2",
-                "--controllers",
-                "pd,fuzzy",
-                "--shard",
-                "1/1",
-                "--out",
-                shards.to_str().unwrap(),
-            ],
-            b"",
-        );
-        assert!(output.status.success(), "{output:?}");
+        for (shard, _) in SHARD_FILES {
+            let output = hrm(
+                &[
+                    "sweep",
+                    "--scenario",
+                    scenario.to_str().unwrap(),
+                    "--noise",
+                    "0,0.01",
+                    "--seeds",
+                    "2",
+                    "--controllers",
+                    "pd,fuzzy",
+                    "--shard",
+                    shard,
+                    "--out",
+                    shards.to_str().unwrap(),
+                ],
+                b"",
+            );
+            assert!(output.status.success(), "{output:?}");
+        }
+        let csv: String = (0..12)
+            .map(|i| {
+                let (x1, x2) = (i as f64 / 11.0, (i * 7 % 12) as f64 / 11.0);
+                format!("{x1},{x2},{}\n", x1 * x2 + 0.5 * x1)
+            })
+            .collect();
         Fixture {
             fis: std::fs::read_to_string(concat!(
                 env!("CARGO_MANIFEST_DIR"),
@@ -126,7 +144,9 @@ fn fixture() -> &'static Fixture {
             ))
             .unwrap(),
             scenario: SHORT_SCENARIO.to_string(),
-            shard: std::fs::read_to_string(shards.join("shard-1-of-1.json")).unwrap(),
+            shards: SHARD_FILES
+                .map(|(_, name)| std::fs::read_to_string(shards.join(name)).unwrap()),
+            csv,
             dir,
         }
     })
@@ -178,7 +198,46 @@ enum Mutation {
     Insert(f64, Vec<u8>),
     /// Remove line `k` (mod the line count).
     DropLine(usize),
+    /// Repeat line `k` (mod the line count).
+    RepeatLine(usize),
+    /// Replace the value of the `k`-th occurrence (mod their count) of a JSON key: a shard's
+    /// counts, indices and seeds.
+    Key(&'static str, usize, &'static str),
 }
+
+/// The keys of a shard file whose values a [`Mutation::Key`] replaces.
+const SHARD_KEYS: &[&str] = &[
+    "index",
+    "count",
+    "seeds",
+    "seed",
+    "seed_index",
+    "base_seed",
+    "noise_level",
+    "harmonics",
+    "sha256",
+    "format",
+];
+
+/// Values a [`Mutation::Key`] writes.
+const KEY_VALUES: &[&str] = &[
+    "0",
+    "1",
+    "2",
+    "3",
+    "-1",
+    "4294967296",
+    "10000000",
+    "10000001",
+    "18446744073709551615",
+    "18446744073709551616",
+    "1e300",
+    "0.5",
+    "null",
+    "\"x\"",
+    "[]",
+    "{}",
+];
 
 fn mutation() -> impl Strategy<Value = Mutation> {
     prop_oneof![
@@ -186,11 +245,13 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         1 => (0.0..1.0f64).prop_map(Mutation::Truncate),
         1 => ((0.0..1.0f64), prop::collection::vec(any::<u8>(), 1..8)).prop_map(|(at, b)| Mutation::Insert(at, b)),
         1 => any::<usize>().prop_map(Mutation::DropLine),
+        1 => any::<usize>().prop_map(Mutation::RepeatLine),
+        4 => (prop::sample::select(SHARD_KEYS), any::<usize>(), prop::sample::select(KEY_VALUES))
+            .prop_map(|(key, k, v)| Mutation::Key(key, k, v)),
     ]
 }
 
-/// `text` with `mutations` applied. Only numbers outside a JSON shard's `shard` object and
-/// its `seeds` are replaced: the bounds of those counts come with the sweep's own hardening.
+/// `text` with `mutations` applied.
 fn mutate(text: &str, mutations: &[Mutation]) -> Vec<u8> {
     let mut bytes = text.as_bytes().to_vec();
     for m in mutations {
@@ -213,13 +274,25 @@ fn mutate(text: &str, mutations: &[Mutation]) -> Vec<u8> {
                 lines.remove(k);
                 bytes = lines.join(&b'\n');
             }
+            Mutation::RepeatLine(k) => {
+                let mut lines: Vec<&[u8]> = bytes.split(|&b| b == b'\n').collect();
+                let k = k % lines.len();
+                lines.insert(k, lines[k]);
+                bytes = lines.join(&b'\n');
+            }
+            Mutation::Key(key, k, value) => {
+                let spans = value_spans(&bytes, key);
+                if !spans.is_empty() {
+                    let (start, end) = spans[k % spans.len()];
+                    bytes.splice(start..end, value.bytes());
+                }
+            }
         }
     }
     bytes
 }
 
-/// The byte ranges of the numbers in `text`, except the values of the keys `index`, `count`
-/// and `seeds` (a shard's counts).
+/// The byte ranges of the numbers in `text`.
 fn number_spans(text: &[u8]) -> Vec<(usize, usize)> {
     let mut spans = Vec::new();
     let mut i = 0;
@@ -234,12 +307,25 @@ fn number_spans(text: &[u8]) -> Vec<(usize, usize)> {
         while i < text.len() && (text[i].is_ascii_digit() || b".eE+-".contains(&text[i])) {
             i += 1;
         }
-        let before = String::from_utf8_lossy(&text[start.saturating_sub(12)..start]);
-        if !["\"index\": ", "\"count\": ", "\"seeds\": "]
-            .iter()
-            .any(|key| before.ends_with(key))
-        {
-            spans.push((start, i));
+        spans.push((start, i));
+    }
+    spans
+}
+
+/// The byte ranges of the scalar values (up to the next `,`, `}` or `]`) of the JSON key `key`
+/// in `text`.
+fn value_spans(text: &[u8], key: &str) -> Vec<(usize, usize)> {
+    let pattern = format!("\"{key}\":");
+    let pattern = pattern.as_bytes();
+    let mut spans = Vec::new();
+    for start in 0..text.len().saturating_sub(pattern.len()) {
+        if text[start..].starts_with(pattern) {
+            let from = start + pattern.len();
+            let to = text[from..]
+                .iter()
+                .position(|b| b",}]\n".contains(b))
+                .map_or(text.len(), |p| from + p);
+            spans.push((from, to));
         }
     }
     spans
@@ -276,7 +362,10 @@ impl FileArg {
                 let text = match *which {
                     "fis" => &f.fis,
                     "scenario" => &f.scenario,
-                    _ => &f.shard,
+                    "csv" => &f.csv,
+                    "shard-1-of-2" => &f.shards[1],
+                    "shard-2-of-2" => &f.shards[2],
+                    _ => &f.shards[0],
                 };
                 file(name, &mutate(text, mutations))
             }
@@ -358,7 +447,19 @@ const SMALL_COUNTS: &[&str] = &["-1", "0", "1", "2", "3", "1000001", "1844674407
 const RESOLUTIONS: &[&str] = &["-1", "0", "1", "2", "3", "5", "601", "1000000000000"];
 const NOISE: &[&str] = &["0", "0,0.01", "0.01,0", "-0.1", "nan", "1e308", "0,0,0"];
 const CONTROLLERS: &[&str] = &["pd", "fuzzy,computed-torque", "fuzzy-gc", "pd,pd"];
-const SHARDS: &[&str] = &["1/1", "1/2", "2/2", "0/1", "2/1", "1/18446744073709551616"];
+const SHARDS: &[&str] = &[
+    "1/1",
+    "1/2",
+    "2/2",
+    "0/1",
+    "2/1",
+    "3/3",
+    "10000000/10000000",
+    "1/10000001",
+    "18446744073709551615/18446744073709551615",
+    "1/18446744073709551616",
+];
+const EPOCHS: &[&str] = &["0", "1", "2", "-1", "100001", "18446744073709551616"];
 const FRACTIONS: &[&str] = &["0.5", "0.9", "1", "10", "0", "-1", "nan", "1e-300"];
 const INPUTS: &[&str] = &[
     "0", "0.1", "-0.3", "1e308", "-1e308", "nan", "inf", "1e-300",
@@ -446,11 +547,14 @@ fn cases() -> impl Strategy<Value = Case> {
         value(CONTROLLERS),
         option("--base-seed", SMALL_COUNTS),
         option("--shard", SHARDS),
-        option("--rate-noise-ratio", FRACTIONS),
+        (
+            option("--rate-noise-ratio", FRACTIONS),
+            option("--reference-noise-ratio", FRACTIONS),
+        ),
         outs(),
     )
         .prop_map(
-            |(scenario, duration, seeds, noise, controllers, base, shard, ratio, out)| {
+            |(scenario, duration, seeds, noise, controllers, base, shard, ratios, out)| {
                 let fixed = vec![
                     "--duration".to_string(),
                     duration.to_string(),
@@ -462,18 +566,67 @@ fn cases() -> impl Strategy<Value = Case> {
                 case(
                     &["sweep"],
                     vec![("--scenario", scenario)],
-                    vec![fixed, seeds, base, shard, ratio],
+                    vec![fixed, seeds, base, shard, ratios.0, ratios.1],
                     Some(out),
                 )
             },
         );
-    let merge = (
-        prop::collection::vec(file_arg("shard-1-of-1.json", "shard"), 1..3),
+    let shard_file = prop_oneof![
+        file_arg("shard-1-of-1.json", "shard-1-of-1"),
+        file_arg("shard-1-of-2.json", "shard-1-of-2"),
+        file_arg("shard-2-of-2.json", "shard-2-of-2"),
+    ];
+    let merge = (prop::collection::vec(shard_file, 1..4), outs()).prop_map(|(shards, out)| {
+        let files = shards.into_iter().map(|s| ("", s)).collect();
+        case(&["sweep", "merge"], files, vec![], Some(out))
+    });
+    let fis_train = (
+        file_arg("train.csv", "csv"),
+        prop::option::of(file_arg("check.csv", "csv")),
+        option("--mfs", SMALL_COUNTS),
+        option("--mf-type", &["gbellmf", "trimf", "gaussmf", "x"]),
+        option("--order", &["0", "1", "2", "-1", "256"]),
+        option("--epochs", EPOCHS),
+        (
+            option("--step", FRACTIONS),
+            option("--ridge", FRACTIONS),
+            prop::option::weighted(0.2, value(FRACTIONS)),
+        ),
+    )
+        .prop_map(|(data, check, mfs, mf_type, order, epochs, rest)| {
+            let (step, ridge, radius) = rest;
+            let radius = radius.map_or(Vec::new(), |r| {
+                vec!["--cluster-radius".to_string(), r.to_string()]
+            });
+            let out = vec![
+                "--out".to_string(),
+                fresh("trained.fis").to_str().unwrap().to_string(),
+            ];
+            let mut files = vec![("--data", data)];
+            files.extend(check.map(|c| ("--check", c)));
+            case(
+                &["fis", "train"],
+                files,
+                vec![mfs, mf_type, order, epochs, step, ridge, radius, out],
+                None,
+            )
+        });
+    let fis_export = (
+        file_arg("export.fis", "fis"),
+        value(&["c", "fcl", "x"]),
+        option("--prefix", &["hrm_fis", "a-b", "", "9x", "\u{1b}"]),
+        option("--out-of-range", &["clamp", "as-given", "error"]),
+        option("--no-rule-fired", &["middle", "error"]),
         outs(),
     )
-        .prop_map(|(shards, out)| {
-            let files = shards.into_iter().map(|s| ("", s)).collect();
-            case(&["sweep", "merge"], files, vec![], Some(out))
+        .prop_map(|(fis, format, prefix, range, no_rule, out)| {
+            let format = vec!["--format".to_string(), format.to_string()];
+            case(
+                &["fis", "export"],
+                vec![("", fis)],
+                vec![format, prefix, range, no_rule],
+                Some(out),
+            )
         });
     let stray = prop::option::weighted(0.1, (any::<usize>(), prop::sample::select(STRAY)));
     (
@@ -484,6 +637,8 @@ fn cases() -> impl Strategy<Value = Case> {
             fis_check,
             fis_eval,
             fis_surface,
+            fis_train,
+            fis_export,
             sweep,
             merge
         ],
@@ -612,13 +767,37 @@ fn fixture_is_sound() {
         b"",
     );
     assert!(output.status.success(), "{output:?}");
-    let shard = file("shard-1-of-1.json", f.shard.as_bytes());
-    let out = fresh("sound-merge");
+    let whole = file("shard-1-of-1.json", f.shards[0].as_bytes());
+    let halves = [1, 2].map(|k| file(SHARD_FILES[k].1, f.shards[k].as_bytes()));
+    for shards in [vec![whole], halves.to_vec()] {
+        let out = fresh("sound-merge");
+        let mut args = vec!["sweep", "merge", "--out", out.to_str().unwrap()];
+        args.extend(shards.iter().map(String::as_str));
+        let output = hrm(&args, b"");
+        assert!(output.status.success(), "{output:?}");
+    }
+    for key in SHARD_KEYS {
+        assert!(
+            !value_spans(f.shards[1].as_bytes(), key).is_empty(),
+            "{key}"
+        );
+    }
+    assert!(!number_spans(f.shards[0].as_bytes()).is_empty());
+    let csv = file("sound.csv", f.csv.as_bytes());
+    let trained = fresh("sound.fis");
     let output = hrm(
-        &["sweep", "merge", "--out", out.to_str().unwrap(), &shard],
+        &[
+            "fis",
+            "train",
+            "--data",
+            &csv,
+            "--epochs",
+            "2",
+            "--out",
+            trained.to_str().unwrap(),
+        ],
         b"",
     );
     assert!(output.status.success(), "{output:?}");
-    assert!(!number_spans(f.shard.as_bytes()).is_empty());
     assert!(Path::new(&fixture().dir).is_dir());
 }

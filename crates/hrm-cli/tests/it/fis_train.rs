@@ -95,14 +95,43 @@ fn bad_input_is_one_line() {
             .ends_with("input 1 is constant (1) over the data; a fuzzy partition needs a range\n")
     );
     write_csv(&csv, 20, 0, false);
-    let mut many = args.to_vec();
-    many.extend(["--mfs", "100"]);
+    let with = |extra: [&'static str; 2]| {
+        let mut a = args.to_vec();
+        a.extend(extra);
+        refused(&a)
+    };
     assert_eq!(
-        refused(&many),
-        "hrm: learning: sets per input must lie in 1..=64, got 100\n"
+        with(["--mfs", "100"]),
+        "hrm: --mfs must be at least 1 and at most 64, got 100\n"
     );
-    let mut order = args.to_vec();
-    order.extend(["--order", "2"]);
-    assert_eq!(refused(&order), "hrm: --order must be 0 or 1, got 2\n");
+    // Negative counts reach the options' own checks, not a parse error.
+    assert_eq!(
+        with(["--mfs", "-1"]),
+        "hrm: --mfs must be at least 1 and at most 64, got -1\n"
+    );
+    assert_eq!(
+        with(["--epochs", "-1"]),
+        "hrm: --epochs must be at least 0 and at most 100000, got -1\n"
+    );
+    assert_eq!(
+        with(["--order", "2"]),
+        "hrm: --order must be 0 or 1, got 2\n"
+    );
+    assert_eq!(
+        with(["--order", "-1"]),
+        "hrm: --order must be 0 or 1, got -1\n"
+    );
+    // An endless stream (its size reads 0) stops at the 64 MiB limit instead of filling memory.
+    if std::path::Path::new("/dev/zero").exists() {
+        let endless = [
+            "fis",
+            "train",
+            "--data",
+            "/dev/zero",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        assert!(refused(&endless).contains("more than the 67108864 bytes allowed"));
+    }
     assert!(!out.exists());
 }

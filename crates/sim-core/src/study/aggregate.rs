@@ -1,5 +1,7 @@
 //! Mean and spread of the runs' errors per (noise level, controller) cell, computed in index
-//! order so that a merged sweep gives bit for bit the numbers of an unsharded one.
+//! order so that a merged sweep gives bit for bit the numbers of an unsharded one. The runs of
+//! a cell are consecutive in that order, so the cells are built from a stream of runs holding
+//! only the current cell's values.
 
 use super::plan::SweepConfig;
 use super::shard_file::{Outcome, RunMetrics, RunResult};
@@ -31,14 +33,25 @@ impl Stats {
         // Deviations from the first value: exact zeros (so std 0, mean exact) for equal values,
         // and no cancellation when the spread is small against the values.
         let shift = values[0];
-        let mean_dev = values.iter().map(|v| v - shift).sum::<f64>() / n as f64;
-        let mean = shift + mean_dev;
+        // Deviations whose squares or sums could overflow (beyond 1e150) are divided by a power
+        // of two, exactly: finite values of one sign always give finite statistics, and
+        // ordinary values (scale 1) give the same bits as without scaling.
+        let spread = values.iter().fold(0.0f64, |s, v| s.max((v - shift).abs()));
+        let scale = if spread > 1e150 && spread.is_finite() {
+            // The largest power of two not above the spread: its exponent bits alone.
+            f64::from_bits(spread.to_bits() & 0x7FF0_0000_0000_0000)
+        } else {
+            1.0
+        };
+        let dev = |v: &f64| (v - shift) / scale;
+        let mean_dev = values.iter().map(dev).sum::<f64>() / n as f64;
+        let mean = shift + scale * mean_dev;
         let std = if n > 1 {
             let ss: f64 = values
                 .iter()
-                .map(|v| (v - shift - mean_dev) * (v - shift - mean_dev))
+                .map(|v| (dev(v) - mean_dev) * (dev(v) - mean_dev))
                 .sum();
-            (ss / (n - 1) as f64).sqrt()
+            scale * (ss / (n - 1) as f64).sqrt()
         } else {
             0.0
         };
@@ -47,7 +60,8 @@ impl Stats {
         let median = if n % 2 == 1 {
             sorted[n / 2]
         } else {
-            0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+            // Halving is exact: the same bits as 0.5 (a + b), without its overflow.
+            0.5 * sorted[n / 2 - 1] + 0.5 * sorted[n / 2]
         };
         Some(Stats {
             mean,
@@ -91,58 +105,135 @@ pub struct Cell {
     pub modal_error_rms_rad: Vec<Option<Stats>>,
     /// Largest joint torque (N m).
     pub peak_joint_torque_nm: Option<Stats>,
-    /// The failed runs, by index.
+    /// The failed runs, by index: the first [`MAX_LISTED_FAILURES`] (`failed` counts them all;
+    /// the shard files hold every one).
     pub failures: Vec<FailedRun>,
 }
+
+/// Failed runs a cell lists (with their errors); the rest are counted.
+pub const MAX_LISTED_FAILURES: usize = 100;
 
 /// The cells of a whole sweep, noise level slowest then controller, from its runs in index
 /// order (as [`merge`](super::merge) returns them).
 pub fn cells(config: &SweepConfig, runs: &[RunResult]) -> Vec<Cell> {
-    let m = config.scenario.n_coords();
-    runs.chunks(config.seeds)
-        .map(|chunk| {
-            let completed: Vec<&RunMetrics> = chunk
+    let mut builder = CellBuilder::new(config);
+    runs.iter().for_each(|run| builder.add(run));
+    builder.finish()
+}
+
+/// Builds the cells from a sweep's runs given one at a time in index order, keeping the values
+/// of the current cell only: `8 (3 + m)` bytes per completed run of one cell (`m` modal
+/// coordinates), whatever the number of runs.
+#[derive(Debug)]
+pub struct CellBuilder {
+    seeds: usize,
+    n_coords: usize,
+    done: Vec<Cell>,
+    current: Option<Values>,
+}
+
+/// The values of the runs of one cell so far.
+#[derive(Debug)]
+struct Values {
+    noise_level: f64,
+    controller: ControllerKind,
+    runs: usize,
+    failed: usize,
+    tip_error_rms_mm: Vec<f64>,
+    tip_error_max_mm: Vec<f64>,
+    modal_error_rms_rad: Vec<Vec<f64>>,
+    peak_joint_torque_nm: Vec<f64>,
+    failures: Vec<FailedRun>,
+}
+
+impl Values {
+    /// Adds a completed run's metrics.
+    fn push(&mut self, m: &RunMetrics) {
+        self.tip_error_rms_mm.push(m.tip_error_rms_m * 1e3);
+        self.tip_error_max_mm.push(m.tip_error_max_m * 1e3);
+        for (values, v) in self
+            .modal_error_rms_rad
+            .iter_mut()
+            .zip(&m.modal_error_rms_rad)
+        {
+            values.push(*v);
+        }
+        self.peak_joint_torque_nm.push(m.peak_joint_torque_nm);
+    }
+
+    /// The statistics of the cell.
+    fn cell(self) -> Cell {
+        Cell {
+            noise_level: self.noise_level,
+            controller: self.controller,
+            runs: self.runs,
+            failed: self.failed,
+            tip_error_rms_mm: Stats::of(&self.tip_error_rms_mm),
+            tip_error_max_mm: Stats::of(&self.tip_error_max_mm),
+            modal_error_rms_rad: self
+                .modal_error_rms_rad
                 .iter()
-                .filter_map(|r| match &r.outcome {
-                    Outcome::Completed(m) => Some(m),
-                    Outcome::Failed { .. } => None,
-                })
-                .collect();
-            let stats = |f: fn(&RunMetrics) -> f64| {
-                Stats::of(&completed.iter().map(|m| f(m)).collect::<Vec<_>>())
-            };
-            let failures: Vec<FailedRun> = chunk
-                .iter()
-                .filter_map(|r| match &r.outcome {
-                    Outcome::Failed { error, .. } => Some(FailedRun {
-                        index: r.index,
-                        seed: r.seed,
+                .map(|v| Stats::of(v))
+                .collect(),
+            peak_joint_torque_nm: Stats::of(&self.peak_joint_torque_nm),
+            failures: self.failures,
+        }
+    }
+}
+
+impl CellBuilder {
+    /// A builder for the cells of `config`.
+    pub fn new(config: &SweepConfig) -> Self {
+        CellBuilder {
+            seeds: config.seeds.max(1),
+            n_coords: config.scenario.n_coords(),
+            done: Vec::new(),
+            current: None,
+        }
+    }
+
+    /// Adds the next run in index order; the first run of a cell (an index that is a multiple
+    /// of the seeds) closes the cell before it.
+    pub fn add(&mut self, run: &RunResult) {
+        let first_of_cell = run.index.is_multiple_of(self.seeds);
+        if first_of_cell && let Some(values) = self.current.take() {
+            self.done.push(values.cell());
+        }
+        let m = self.n_coords;
+        let values = self.current.get_or_insert_with(|| Values {
+            noise_level: run.noise_level,
+            controller: run.controller,
+            runs: 0,
+            failed: 0,
+            tip_error_rms_mm: Vec::new(),
+            tip_error_max_mm: Vec::new(),
+            modal_error_rms_rad: vec![Vec::new(); m],
+            peak_joint_torque_nm: Vec::new(),
+            failures: Vec::new(),
+        });
+        values.runs += 1;
+        match &run.outcome {
+            Outcome::Completed(metrics) => values.push(metrics),
+            Outcome::Failed { error, .. } => {
+                values.failed += 1;
+                if values.failures.len() < MAX_LISTED_FAILURES {
+                    values.failures.push(FailedRun {
+                        index: run.index,
+                        seed: run.seed,
                         error: error.clone(),
-                    }),
-                    Outcome::Completed(_) => None,
-                })
-                .collect();
-            Cell {
-                noise_level: chunk[0].noise_level,
-                controller: chunk[0].controller,
-                runs: chunk.len(),
-                failed: failures.len(),
-                tip_error_rms_mm: stats(|m| m.tip_error_rms_m * 1e3),
-                tip_error_max_mm: stats(|m| m.tip_error_max_m * 1e3),
-                modal_error_rms_rad: (0..m)
-                    .map(|i| {
-                        let values: Vec<f64> = completed
-                            .iter()
-                            .filter_map(|r| r.modal_error_rms_rad.get(i).copied())
-                            .collect();
-                        Stats::of(&values)
-                    })
-                    .collect(),
-                peak_joint_torque_nm: stats(|m| m.peak_joint_torque_nm),
-                failures,
+                    });
+                }
             }
-        })
-        .collect()
+        }
+    }
+
+    /// The cells of the runs added.
+    pub fn finish(mut self) -> Vec<Cell> {
+        if let Some(values) = self.current.take() {
+            self.done.push(values.cell());
+        }
+        self.done
+    }
 }
 
 #[cfg(test)]
@@ -163,6 +254,21 @@ mod tests {
         assert_eq!((one.mean, one.std, one.median), (3.5, 0.0, 3.5));
         assert_eq!(Stats::of(&[1.0, 10.0, 2.0]).unwrap().median, 2.0);
         assert!(Stats::of(&[]).is_none());
+    }
+
+    /// Issue 11: what a summary holds must be JSON, so finite values (of one sign) give finite
+    /// statistics even near the largest double: `[0, M, M]` has mean `2M/3`, std `M/sqrt(3)`.
+    #[test]
+    fn statistics_of_huge_values_are_finite() {
+        let m = f64::MAX;
+        let s = Stats::of(&[0.0, m, m]).unwrap();
+        assert_eq!((s.min, s.median, s.max), (0.0, m, m));
+        assert!((s.mean / (2.0 * (m / 3.0)) - 1.0).abs() < 1e-15, "{s:?}");
+        assert!((s.std / (m / 3f64.sqrt()) - 1.0).abs() < 1e-15, "{s:?}");
+        let pair = Stats::of(&[m, m]).unwrap();
+        assert_eq!((pair.mean, pair.std, pair.median), (m, 0.0, m));
+        let many = Stats::of(&vec![1e300; 100_000]).unwrap();
+        assert_eq!((many.mean, many.std), (1e300, 0.0));
     }
 
     proptest! {

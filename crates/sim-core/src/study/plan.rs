@@ -1,6 +1,7 @@
 //! What a sweep runs: its configuration, the fixed enumeration of its runs, each run's seed,
 //! and the slice of runs one shard takes.
 
+use super::inputs::{self, InputDigest};
 use crate::{ControllerKind, NoiseSpec, Scenario};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -35,6 +36,9 @@ pub struct SweepConfig {
     pub seeds: usize,
     /// The seed every run's seed derives from ([`run_seed`]).
     pub base_seed: u64,
+    /// The SHA-256 of the scenario and of every file it references
+    /// ([`input_digests`](super::input_digests) of `scenario`).
+    pub inputs: Vec<InputDigest>,
 }
 
 /// Where run `index` sits in the sweep.
@@ -57,8 +61,8 @@ pub struct RunId {
 impl SweepConfig {
     /// A sweep of `scenario` (its noise and seed are replaced per run) over `controllers`,
     /// sensor noise levels `noise_levels` (rad; rate noise 10 L rad/s, no reference noise, as
-    /// `hrm sweep`'s defaults) and `seeds` realisations from `base_seed`; checked by
-    /// [`validate`](Self::validate) and [`check_builds`](Self::check_builds).
+    /// `hrm sweep`'s defaults) and `seeds` realisations from `base_seed`, with the digests of its
+    /// inputs; checked by [`validate`](Self::validate) and [`check_builds`](Self::check_builds).
     pub fn new(
         scenario: Scenario,
         controllers: Vec<ControllerKind>,
@@ -69,8 +73,10 @@ impl SweepConfig {
         let mut scenario = scenario;
         scenario.noise = NoiseSpec::default();
         scenario.seed = 0;
+        inputs::check_json_safe(&scenario)?;
         let config = SweepConfig {
             hrm_version: super::VERSION.to_string(),
+            inputs: inputs::input_digests(&scenario)?,
             scenario,
             controllers,
             noise_levels,
@@ -100,8 +106,13 @@ impl SweepConfig {
         Ok(())
     }
 
-    /// Checks the numbers that the scenario itself does not check.
+    /// Checks the numbers that the scenario itself does not check, that every scenario setting
+    /// survives JSON ([`check_json_safe`](super::check_json_safe)) and that
+    /// [`inputs`](Self::inputs) lists the scenario, with the digest of its content, and the
+    /// files it references ([`check_digests`](super::check_digests)).
     pub fn validate(&self) -> Result<(), String> {
+        inputs::check_json_safe(&self.scenario)?;
+        inputs::check_digests(&self.scenario, &self.inputs)?;
         if self.controllers.is_empty() {
             return Err("--controllers: at least one controller is needed".into());
         }
@@ -205,6 +216,7 @@ impl SweepConfig {
             ),
             ("seeds", self.seeds == other.seeds),
             ("base_seed", self.base_seed == other.base_seed),
+            ("inputs", self.inputs == other.inputs),
         ]
         .into_iter()
         .find(|(_, equal)| !equal)
@@ -247,6 +259,15 @@ impl Shard {
         i % self.count == self.index - 1
     }
 
+    /// The number of runs of this shard among `runs`.
+    pub fn run_count(self, runs: usize) -> usize {
+        if runs < self.index {
+            0
+        } else {
+            (runs - self.index) / self.count + 1
+        }
+    }
+
     /// The run indices of this shard among `runs`, ascending.
     pub fn indices(self, runs: usize) -> impl Iterator<Item = usize> {
         (self.index - 1..runs).step_by(self.count)
@@ -281,9 +302,11 @@ mod tests {
     use proptest::prelude::*;
 
     fn config(levels: usize, controllers: usize, seeds: usize) -> SweepConfig {
+        let scenario = Scenario::builtin("paper-responses-step").unwrap();
         SweepConfig {
+            inputs: inputs::input_digests(&scenario).unwrap(),
             hrm_version: "test".into(),
-            scenario: Scenario::builtin("paper-responses-step").unwrap(),
+            scenario,
             controllers: ControllerKind::ALL[..controllers].to_vec(),
             noise_levels: (0..levels).map(|l| l as f64 * 1e-3).collect(),
             rate_noise_ratio: 10.0,
@@ -379,6 +402,7 @@ mod tests {
             let mut seen = vec![0u32; runs];
             for index in 1..=count {
                 let shard = Shard { index, count };
+                prop_assert_eq!(shard.run_count(runs), shard.indices(runs).count());
                 for i in shard.indices(runs) {
                     prop_assert!(shard.contains(i));
                     seen[i] += 1;
