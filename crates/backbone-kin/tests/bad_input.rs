@@ -55,7 +55,10 @@ fn huge_link_count() {
     assert!(matches!(err, KinError::TooMany { what: "links", .. }));
     assert_eq!(
         err.to_string(),
-        "at most 4096 links are supported, got 4097"
+        format!(
+            "at most {MAX_LINKS} links are supported, got {}",
+            MAX_LINKS + 1
+        )
     );
 }
 

@@ -5,6 +5,10 @@
 //! it together with a reusable [`ChainData`] workspace, built once, so that per-step calls
 //! allocate nothing. Every algorithm validates the sizes and finiteness of its inputs.
 //!
+//! A chain may have up to [`MAX_LINKS`] (10^6) links, and the `O(n)` algorithms accept them all;
+//! the `O(n^2)` and `O(n^3)` ones below, which fill or factorise `n x n` matrices, accept up to
+//! [`MAX_DENSE_LINKS`] (4096).
+//!
 //! | quantity | function | cost |
 //! |---|---|---|
 //! | inverse dynamics `tau` | [`rnea`] | O(n) |
@@ -65,6 +69,6 @@ pub use derivative_data::DerivativeData;
 pub use energy::{kinetic_energy, potential_energy};
 pub use error::DynError;
 pub use forward_dynamics::forward_dynamics;
-pub use model::{ChainModel, Link, MAX_LINKS};
+pub use model::{ChainModel, Link, MAX_DENSE_LINKS, MAX_LINKS};
 pub use rnea::rnea;
 pub use rnea_derivatives::rnea_derivatives;

@@ -10,11 +10,15 @@
 //! ```
 //!
 //! - [`ReducedModel`] (immutable) and [`ReducedData`] (reusable workspace): nothing allocates
-//!   per call.
+//!   per call, and both take `O(n m)` memory, so chains of up to [`manip_dyn::MAX_LINKS`]
+//!   (10^6) links reduce; only the faer path, which forms the `n x n` mass matrix, stops at
+//!   [`manip_dyn::MAX_DENSE_LINKS`] (4096).
 //! - [`reduced_terms`]: `M*`, `C*`, `G*` in `O(n m^2)` from prefix sums along the chain in
 //!   absolute link angles, never forming `M` (the default; derivation in [`terms`]). [`reduced_terms_faer`]: the same by forming `M`
 //!   and projecting it with faer, `O(n^2 m)` (the reference).
 //! - [`forward_dynamics`] / [`forward_dynamics_faer`]: solve eq 15 for `a_ddot` by Cholesky.
+//! - [`forward_dynamics_batch`]: the same for many states at once, SIMD across states (AVX-512 or
+//!   AVX2 when the processor has them), into a [`ReducedBatchData`] workspace.
 //! - [`reduced_derivatives`]: the analytic derivatives of eq 15, `d a_ddot / d (a, a_dot, tau*)`,
 //!   in `O(n m^2)` into a [`ReducedDerivatives`] workspace.
 //! - [`jacobi_forward_dynamics`]: the paper's eq 16-18 iteration, which reports divergence
@@ -51,12 +55,14 @@
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
 
+mod batch;
 mod data;
 mod derivatives;
 mod energy;
 mod error;
 mod forward;
 pub mod jacobi;
+mod lanes;
 mod model;
 mod projection;
 mod small_linalg;
@@ -64,6 +70,7 @@ pub mod terms;
 mod torques;
 mod trig;
 
+pub use batch::{BatchError, MAX_BATCH_COORDS, ReducedBatchData, forward_dynamics_batch};
 pub use data::ReducedData;
 pub use derivatives::{ReducedDerivatives, reduced_derivatives};
 pub use energy::{kinetic_energy, potential_energy};

@@ -130,7 +130,7 @@ fn huge_link_count_is_refused_upstream() {
     assert!(
         kin_err
             .to_string()
-            .starts_with("modal map: at most 4096 links")
+            .starts_with("modal map: at most 1000000 links")
     );
 }
 
