@@ -13,7 +13,11 @@
 //! - `props [--cases N]`: the test suite with `PROPTEST_CASES=N` (default 2048), so every property
 //!   test (energy conservation, Jacobian consistency, ...) runs many more cases than in CI.
 //! - `bench [FILTER]`: the Criterion benches, then `target/bench-summary.json` (bench id -> median
-//!   nanoseconds per iteration) printed as a table.
+//!   nanoseconds per iteration, or per element for a bench with Criterion's throughput set, such
+//!   as the states of a batch) printed as a table.
+//! - `bench --check`: compares `target/bench-summary.json` with the targets of
+//!   `benches/targets.toml` and prints what falls short (fails if anything does). Not part of CI:
+//!   timings on a shared machine are noisy.
 
 mod tidy;
 
@@ -27,6 +31,7 @@ fn main() -> ExitCode {
         Some("test") => test(),
         Some("tidy") => tidy(),
         Some("props") => props(&args[1..]),
+        Some("bench") if args.get(1).is_some_and(|a| a == "--check") => check_targets(),
         Some("bench") => bench(&args[1..]),
         _ => Err(USAGE.to_string()),
     };
@@ -39,7 +44,8 @@ fn main() -> ExitCode {
     }
 }
 
-const USAGE: &str = "usage: cargo xtask ci | test | tidy | props [--cases N] | bench [FILTER]";
+const USAGE: &str =
+    "usage: cargo xtask ci | test | tidy | props [--cases N] | bench [FILTER] | bench --check";
 
 fn ci() -> Result<(), String> {
     cargo(&["fmt", "--all", "--", "--check"], &[])?;
@@ -231,13 +237,122 @@ fn collect_medians(dir: &Path, rows: &mut Vec<(String, f64)>) -> Result<(), Stri
                 read_json(&path.join("estimates.json"), &["median", "point_estimate"])
                     .and_then(|v| v.as_f64()),
             ) {
-                rows.push((id, median));
+                // A bench with Criterion's throughput set counts per element (a batch's states).
+                let elements = read_json(&path.join("benchmark.json"), &["throughput", "Elements"])
+                    .and_then(|v| v.as_f64())
+                    .filter(|&e| e > 0.0)
+                    .unwrap_or(1.0);
+                rows.push((id, median / elements));
             }
         } else {
             collect_medians(&path, rows)?;
         }
     }
     Ok(())
+}
+
+/// `bench --check`: every target of `benches/targets.toml` against `target/bench-summary.json`.
+/// A `[[max]]` target bounds a bench's median (`id`, `ns`); a `[[speedup]]` target asks bench `id`
+/// to be at least `at_least` times faster than bench `over`, both from the same summary.
+fn check_targets() -> Result<(), String> {
+    let targets_path = workspace_root().join("benches").join("targets.toml");
+    let text = std::fs::read_to_string(&targets_path)
+        .map_err(|e| format!("{}: {e}", targets_path.display()))?;
+    let targets: toml::Table =
+        toml::from_str(&text).map_err(|e| format!("{}: {e}", targets_path.display()))?;
+    let summary_path = target_dir().join("bench-summary.json");
+    let summary: serde_json::Map<String, serde_json::Value> =
+        std::fs::read_to_string(&summary_path)
+            .ok()
+            .and_then(|text| serde_json::from_str(&text).ok())
+            .ok_or_else(|| {
+                format!(
+                    "cannot read {}: run `cargo xtask bench` first",
+                    summary_path.display()
+                )
+            })?;
+    let median = |id: &str| summary.get(id).and_then(serde_json::Value::as_f64);
+    let entries = |kind: &str| -> Result<Vec<toml::Table>, String> {
+        match targets.get(kind) {
+            None => Ok(Vec::new()),
+            Some(toml::Value::Array(items)) => items
+                .iter()
+                .map(|item| {
+                    item.as_table()
+                        .cloned()
+                        .ok_or_else(|| format!("[[{kind}]] entries must be tables"))
+                })
+                .collect(),
+            Some(_) => Err(format!("`{kind}` must be an array of tables ([[{kind}]])")),
+        }
+    };
+    let field = |table: &toml::Table, kind: &str, key: &str| -> Result<toml::Value, String> {
+        table
+            .get(key)
+            .cloned()
+            .ok_or_else(|| format!("a [[{kind}]] entry lacks `{key}`: {table}"))
+    };
+    let number = |value: toml::Value| match value {
+        toml::Value::Float(x) => Some(x),
+        toml::Value::Integer(x) => Some(x as f64),
+        _ => None,
+    };
+    let (mut short, mut unmeasured) = (0, 0);
+    println!(
+        "{:<28}  {:>12}  {:>16}  result",
+        "bench", "measured", "target"
+    );
+    for target in entries("max")? {
+        let id = field(&target, "max", "id")?;
+        let id = id.as_str().ok_or("`id` must be a string")?;
+        let limit = number(field(&target, "max", "ns")?).ok_or("`ns` must be a number")?;
+        let wanted = format!("<= {}", human_time(limit));
+        match median(id) {
+            None => {
+                unmeasured += 1;
+                println!("{id:<28}  {:>12}  {wanted:>16}  not measured", "-");
+            }
+            Some(ns) => {
+                let ok = ns <= limit;
+                short += usize::from(!ok);
+                let verdict = if ok { "ok" } else { "SHORT" };
+                println!("{id:<28}  {:>12}  {wanted:>16}  {verdict}", human_time(ns));
+            }
+        }
+    }
+    for target in entries("speedup")? {
+        let id = field(&target, "speedup", "id")?;
+        let over = field(&target, "speedup", "over")?;
+        let (id, over) = (
+            id.as_str().ok_or("`id` must be a string")?,
+            over.as_str().ok_or("`over` must be a string")?,
+        );
+        let factor =
+            number(field(&target, "speedup", "at_least")?).ok_or("`at_least` must be a number")?;
+        let wanted = format!(">= {factor}x {over}");
+        match (median(id), median(over)) {
+            (Some(fast), Some(slow)) => {
+                let ratio = slow / fast;
+                let ok = ratio >= factor;
+                short += usize::from(!ok);
+                let verdict = if ok { "ok" } else { "SHORT" };
+                println!("{id:<28}  {:>11.2}x  {wanted:>16}  {verdict}", ratio);
+            }
+            _ => {
+                unmeasured += 1;
+                println!("{id:<28}  {:>12}  {wanted:>16}  not measured", "-");
+            }
+        }
+    }
+    println!(
+        "\n{short} target(s) short, {unmeasured} not measured (from {})",
+        summary_path.display()
+    );
+    if short == 0 {
+        Ok(())
+    } else {
+        Err(format!("{short} bench target(s) fall short"))
+    }
 }
 
 fn read_json(path: &Path, keys: &[&str]) -> Option<serde_json::Value> {

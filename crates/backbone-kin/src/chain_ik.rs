@@ -35,7 +35,7 @@ use crate::validate::{check_count, check_finite, check_len, check_link_lengths, 
 /// nothing.
 ///
 /// The default tolerance is `max(1e-14, 8 n eps)` relative to the chain's length `l` (the tip is a
-/// sum of `n` terms, so its rounding grows with `n`): `4e-14 l` for 20 links, `7e-12 l` at
+/// sum of `n` terms, so its rounding grows with `n`): `4e-14 l` for 20 links, `2e-9 l` at
 /// [`MAX_LINKS`](crate::MAX_LINKS).
 ///
 /// ```

@@ -35,12 +35,13 @@ pub enum KinError {
     /// A modal family was asked for with zero harmonics.
     #[error("a modal family needs at least one harmonic")]
     NoHarmonics,
-    /// A modal map or solver was asked for more links ([`MAX_LINKS`](crate::MAX_LINKS)) or
-    /// harmonics ([`MAX_HARMONICS`](crate::MAX_HARMONICS)) than the crate allows; it would
-    /// otherwise allocate without bound.
+    /// A modal map or solver was asked for more links ([`MAX_LINKS`](crate::MAX_LINKS)),
+    /// harmonics ([`MAX_HARMONICS`](crate::MAX_HARMONICS)) or modal Jacobian entries
+    /// ([`MAX_MAP_ENTRIES`](crate::MAX_MAP_ENTRIES)) than the crate allows; it would otherwise
+    /// allocate without bound.
     #[error("at most {max} {what} are supported, got {got}")]
     TooMany {
-        /// `"links"` or `"harmonics"`.
+        /// `"links"`, `"harmonics"` or `"modal Jacobian entries (links x coordinates)"`.
         what: &'static str,
         /// The number asked for.
         got: usize,

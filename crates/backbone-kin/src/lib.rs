@@ -18,4 +18,6 @@ pub use closed_form::{Branch, end_point, inverse_kinematics};
 pub use curve::{BackboneCurve, MAX_QUADRATURE_NODES, QUADRATURE_TOLERANCE};
 pub use error::KinError;
 pub use harmonic_ik::{HarmonicIk, IkOptions, IkReport};
-pub use modal_map::{BaseAngle, MAX_HARMONICS, MAX_LINKS, ModalMap, harmonic_basis};
+pub use modal_map::{
+    BaseAngle, MAX_HARMONICS, MAX_LINKS, MAX_MAP_ENTRIES, ModalMap, harmonic_basis,
+};

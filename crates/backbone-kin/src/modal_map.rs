@@ -16,14 +16,22 @@ use crate::error::KinError;
 use crate::validate::{check_count, check_finite, check_len, check_link_lengths, check_output_len};
 
 /// The most links any crate of the workspace accepts: `manip_dyn::MAX_LINKS` is this constant,
-/// re-exported. A [`ModalMap`]'s `J` has a row per link and a chain's `n x n` mass matrix takes
-/// 128 MiB at this limit, so a larger `n` is refused before anything is allocated rather than
-/// risk aborting the process on a failed allocation.
-pub const MAX_LINKS: usize = 4096;
+/// re-exported. Everything a chain or a reduced model holds grows as `O(n)` (a [`ModalMap`]'s `J`
+/// as `O(n m)`, bounded by [`MAX_MAP_ENTRIES`]), so this limit only keeps a request for
+/// `usize::MAX` links from reaching an allocation. The full chain's `n x n` algorithms (the mass
+/// matrix, Cholesky forward dynamics, the analytic derivatives) have their own, lower limit,
+/// `manip_dyn::MAX_DENSE_LINKS`.
+pub const MAX_LINKS: usize = 1_000_000;
 
 /// The most harmonics a [`ModalMap`] or a [`HarmonicIk`](crate::HarmonicIk) may have. A map needs
-/// at least `2K` links to resolve `K` harmonics, so this is `MAX_LINKS / 2`.
-pub const MAX_HARMONICS: usize = MAX_LINKS / 2;
+/// at least `2K` links to resolve `K` harmonics; `2048` harmonics suit the 4096 links of the
+/// dense algorithms' limit, and a map's size is bounded by [`MAX_MAP_ENTRIES`] as well.
+pub const MAX_HARMONICS: usize = 2048;
+
+/// The most entries (links times modal coordinates) of a [`ModalMap`]'s `J`: `2^25`, 256 MiB,
+/// enough for 4096 links with every harmonic up to [`MAX_HARMONICS`], or 10^6 links with up to 16
+/// harmonics.
+pub const MAX_MAP_ENTRIES: usize = 1 << 25;
 
 /// At least one harmonic and at most [`MAX_HARMONICS`].
 pub(crate) fn check_harmonics(harmonics: usize) -> Result<(), KinError> {
@@ -113,6 +121,11 @@ impl ModalMap {
         let n = link_lengths.len();
         let n_modal = 2 * harmonics;
         let m = n_modal + usize::from(base == BaseAngle::Free);
+        check_count(
+            "modal Jacobian entries (links x coordinates)",
+            n.saturating_mul(m),
+            MAX_MAP_ENTRIES,
+        )?;
         // Rows of the inclination map phi = Phi a (+ alpha0), then theta_i = phi_i - phi_{i-1}.
         let mut jacobian = vec![0.0; n * m];
         let mut previous = vec![0.0; m];

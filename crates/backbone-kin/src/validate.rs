@@ -39,7 +39,8 @@ pub(crate) fn check_link_lengths(link_lengths: &[f64]) -> Result<f64, KinError> 
     Ok(total)
 }
 
-/// Checks that `got` does not exceed `max`: `what` is `"links"` or `"harmonics"`.
+/// Checks that `got` does not exceed `max`: `what` is `"links"`, `"harmonics"` or `"modal Jacobian
+/// entries (links x coordinates)"`.
 pub(crate) fn check_count(what: &'static str, got: usize, max: usize) -> Result<(), KinError> {
     if got <= max {
         Ok(())

@@ -527,6 +527,12 @@ struct DynamicsRequest {
 fn dynamics(request: DynamicsRequest) -> EvalResult {
     let chain = request.arm.to_chain()?;
     let n = chain.n_links();
+    if n > manip_dyn::MAX_DENSE_LINKS {
+        return Err(EvalError::input(format!(
+            "arm.links must be at most {} for the dynamics op (an n x n mass matrix), got {n}",
+            manip_dyn::MAX_DENSE_LINKS
+        )));
+    }
     let mut data = ChainData::new(&chain);
     let mut mass = Mat::<f64>::zeros(n, n);
     let (mut coriolis, mut gravity) = (vec![0.0; n], vec![0.0; n]);

@@ -3,7 +3,7 @@
 use crate::array::{Output, States, evaluate};
 use crate::errors::{Error, check_finite, count};
 use manip_dyn::faer::MatMut;
-use manip_dyn::{ChainData, ChainModel};
+use manip_dyn::{ChainData, ChainModel, DynError, MAX_DENSE_LINKS};
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
 use sim_core::ArmSpec;
@@ -36,8 +36,9 @@ impl Arm {
         &self.chain
     }
 
+    /// A workspace of the recursive algorithms: `O(n)`, since no method here factorises `M`.
     fn fresh(&self) -> ChainData {
-        ChainData::new(&self.chain)
+        ChainData::recursive(&self.chain)
     }
 
     fn n(&self) -> usize {
@@ -74,7 +75,7 @@ impl Arm {
         };
         let chain = spec.to_chain().map_err(Error::from)?;
         Ok(Self {
-            workspace: Mutex::new(ChainData::new(&chain)),
+            workspace: Mutex::new(ChainData::recursive(&chain)),
             chain,
         })
     }
@@ -125,13 +126,23 @@ impl Arm {
         )
     }
 
-    /// The joint-space mass matrix M(theta) (CRBA), shape (n, n) or (N, n, n).
+    /// The joint-space mass matrix M(theta) (CRBA), shape (n, n) or (N, n, n). Raises
+    /// InvalidInput for an arm of more than 4096 links (`manip_dyn::MAX_DENSE_LINKS`, the limit of
+    /// the n x n algorithms; every other method takes arms of up to 10^6 links).
     fn mass_matrix<'py>(
         &self,
         py: Python<'py>,
         theta: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.n();
+        if n > MAX_DENSE_LINKS {
+            return Err(Error::from(DynError::TooManyLinks {
+                what: "Arm.mass_matrix (an n x n matrix)",
+                got: n,
+                max: MAX_DENSE_LINKS,
+            })
+            .into());
+        }
         let theta = States::read(theta, "theta", n)?;
         let out = evaluate(
             py,

@@ -188,14 +188,46 @@ pub(crate) fn evaluate<const K: usize, W: Send>(
     fresh: impl Fn() -> W + Sync,
     compute: impl Fn(&mut W, [&[f64]; K], &mut [f64]) -> Result<()> + Sync,
 ) -> PyResult<Output> {
+    evaluate_chunks(
+        py,
+        inputs,
+        per_state,
+        shared,
+        fresh,
+        |workspace, chunk, out| {
+            let states = out.len() / per_state;
+            for (i, state_out) in out.chunks_exact_mut(per_state).enumerate() {
+                let rows = std::array::from_fn(|k| {
+                    let width = chunk[k].len() / states;
+                    &chunk[k][i * width..(i + 1) * width]
+                });
+                compute(workspace, rows, state_out).map_err(|e| (i, e))?;
+            }
+            Ok(())
+        },
+    )
+}
+
+/// [`evaluate`] with `compute_chunk(workspace, [rows of each input], out)` called on runs of
+/// consecutive states at once (a batch entry point of the library); a failure names its state,
+/// counted from the start of the run.
+pub(crate) fn evaluate_chunks<const K: usize, W: Send>(
+    py: Python<'_>,
+    inputs: [&States<'_>; K],
+    per_state: usize,
+    shared: &Mutex<W>,
+    fresh: impl Fn() -> W + Sync,
+    compute_chunk: impl Fn(&mut W, [&[f64]; K], &mut [f64]) -> std::result::Result<(), (usize, Error)>
+    + Sync,
+) -> PyResult<Output> {
     let batch = common_batch(&inputs)?;
     let widths: [usize; K] = std::array::from_fn(|k| match inputs[k].array.shape() {
         [.., w] => *w,
         [] => unreachable!("checked in States::read"),
     });
     let values: [&[f64]; K] = std::array::from_fn(|k| inputs[k].values());
-    let rows = |state: usize| -> [&[f64]; K] {
-        std::array::from_fn(|k| &values[k][state * widths[k]..(state + 1) * widths[k]])
+    let rows = |first: usize, count: usize| -> [&[f64]; K] {
+        std::array::from_fn(|k| &values[k][first * widths[k]..(first + count) * widths[k]])
     };
     let lock = || {
         shared
@@ -204,7 +236,7 @@ pub(crate) fn evaluate<const K: usize, W: Send>(
     };
     let Some(n_states) = batch else {
         let mut out = vec![0.0; per_state];
-        compute(&mut lock(), rows(0), &mut out)?;
+        compute_chunk(&mut lock(), rows(0, 1), &mut out).map_err(|(_, e)| e)?;
         return Ok(Output { batch, values: out });
     };
     let total = n_states
@@ -218,11 +250,8 @@ pub(crate) fn evaluate<const K: usize, W: Send>(
         })?;
     let mut out = vec![0.0; total];
     let run_chunk = |workspace: &mut W, first: usize, chunk: &mut [f64]| {
-        for (i, state_out) in chunk.chunks_exact_mut(per_state).enumerate() {
-            let state = first + i;
-            compute(workspace, rows(state), state_out).map_err(|e| (state, e))?;
-        }
-        Ok(())
+        let count = chunk.len() / per_state;
+        compute_chunk(workspace, rows(first, count), chunk).map_err(|(state, e)| (first + state, e))
     };
     let result: std::result::Result<(), (usize, Error)> = py.detach(|| {
         if n_states < PARALLEL_MIN_STATES {

@@ -2,18 +2,20 @@
 //! from `backbone-kin` and `modal-reduce`.
 
 use crate::arm::Arm;
-use crate::array::{States, evaluate};
+use crate::array::{States, evaluate, evaluate_chunks};
 use crate::errors::{Error, check_finite, count};
 use backbone_kin::{BaseAngle, Branch, HarmonicIk, ModalMap};
-use modal_reduce::ReducedData;
+use modal_reduce::{BatchError, ReducedBatchData, ReducedData};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use std::sync::Mutex;
 
-/// The workspace of one thread: the reduced model's data and the joint angles of one state.
+/// The workspace of one thread: the reduced model's data (one state and batches) and the joint
+/// angles of one state.
 struct Workspace {
     data: ReducedData,
+    batch: ReducedBatchData,
     theta: Vec<f64>,
     zeros: Vec<f64>,
 }
@@ -42,6 +44,7 @@ impl Workspace {
     fn new(model: &modal_reduce::ReducedModel) -> Self {
         Self {
             data: ReducedData::new(model),
+            batch: ReducedBatchData::new(model),
             theta: vec![0.0; model.n_links()],
             zeros: vec![0.0; model.n_coords()],
         }
@@ -340,7 +343,8 @@ impl ReducedModel {
     }
 
     /// Reduced forward dynamics (eq 15): a_ddot = M*^-1 (tau* - C* - G*), shape (m,) or (N, m).
-    /// Raises NumericalError if M* is not numerically positive definite.
+    /// A batch runs SIMD across states (AVX-512 or AVX2 when the processor has them). Raises
+    /// NumericalError if M* is not numerically positive definite.
     fn forward_dynamics<'py>(
         &self,
         py: Python<'py>,
@@ -355,15 +359,19 @@ impl ReducedModel {
             States::read(tau_star, "tau_star", m)?,
         ];
         let [a, a_dot, tau_star] = &inputs;
-        let out = evaluate(
+        let out = evaluate_chunks(
             py,
             [a, a_dot, tau_star],
             m,
             &self.workspace,
             || self.fresh(),
             |ws, [a, a_dot, tau], out| {
-                modal_reduce::forward_dynamics(&self.model, &mut ws.data, a, a_dot, tau, out)?;
-                check_finite("a_ddot", out)
+                modal_reduce::forward_dynamics_batch(&self.model, &mut ws.batch, a, a_dot, tau, out)
+                    .map_err(|error| match error {
+                        BatchError::State { state, error } => (state, Error::from(error)),
+                        // The driver passes whole states: a shape error cannot happen.
+                        other => (0, Error::input(other.to_string())),
+                    })
             },
         )?;
         Ok(out.into_py(py, &[m]))

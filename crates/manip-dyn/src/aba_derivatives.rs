@@ -41,6 +41,8 @@ use crate::rnea_derivatives::fill_partials;
 /// ```
 ///
 /// # Errors
+/// [`DynError::TooManyLinks`] for a chain of more than [`MAX_DENSE_LINKS`](crate::MAX_DENSE_LINKS)
+/// links;
 /// [`DynError::Dimension`] if a slice does not have `n` entries or `data` or `derivatives` was
 /// built for another chain, [`DynError::NonFinite`] for a NaN or infinite input,
 /// [`DynError::NotPositiveDefinite`] if an articulated inertia is not positive beyond rounding
@@ -53,6 +55,7 @@ pub fn aba_derivatives(
     v: &[f64],
     tau: &[f64],
 ) -> Result<(), DynError> {
+    check::dense("the ABA derivatives", model)?;
     let n = check::inputs(model, data, &[("q", q), ("v", v), ("tau", tau)])?;
     check::derivative_workspace(derivatives, n)?;
     articulated_body(model, data, q, v, tau, &mut derivatives.value)?;

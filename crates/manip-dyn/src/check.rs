@@ -5,7 +5,7 @@ use faer::MatMut;
 use crate::data::ChainData;
 use crate::derivative_data::DerivativeData;
 use crate::error::DynError;
-use crate::model::ChainModel;
+use crate::model::{ChainModel, MAX_DENSE_LINKS};
 
 /// The workspace must have been built for a chain with as many links as `model`.
 fn workspace(model: &ChainModel, data: &ChainData) -> Result<(), DynError> {
@@ -56,6 +56,20 @@ fn input(name: &'static str, x: &[f64], n: usize) -> Result<(), DynError> {
 /// An output vector of `n` entries.
 pub(crate) fn output(name: &'static str, x: &[f64], n: usize) -> Result<(), DynError> {
     length(name, x.len(), n)
+}
+
+/// An `n x n` algorithm (named by `what`) accepts at most [`MAX_DENSE_LINKS`] links.
+pub(crate) fn dense(what: &'static str, model: &ChainModel) -> Result<(), DynError> {
+    let got = model.n_links();
+    if got <= MAX_DENSE_LINKS {
+        Ok(())
+    } else {
+        Err(DynError::TooManyLinks {
+            what,
+            got,
+            max: MAX_DENSE_LINKS,
+        })
+    }
 }
 
 /// An `n x n` output matrix (always the parameter `out`).

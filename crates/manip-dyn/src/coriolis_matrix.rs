@@ -53,6 +53,8 @@ pub(crate) struct SubtreeMotion {
 /// ```
 ///
 /// # Errors
+/// [`DynError::TooManyLinks`] for a chain of more than [`MAX_DENSE_LINKS`](crate::MAX_DENSE_LINKS)
+/// links;
 /// [`DynError::Dimension`] if `q` or `v` does not have `n` entries, `out` is not `n x n`, or
 /// `data` was built for another chain; [`DynError::NonFinite`] for a NaN or infinite input;
 /// [`DynError::NonFiniteResult`] if an entry overflows.
@@ -63,6 +65,7 @@ pub fn coriolis_matrix(
     v: &[f64],
     mut out: MatMut<'_, f64>,
 ) -> Result<(), DynError> {
+    check::dense("the Coriolis matrix", model)?;
     let n = check::inputs(model, data, &[("q", q), ("v", v)])?;
     check::square_output(&out, n)?;
     update_frames(&mut data.frames, q, Some(v));

@@ -41,6 +41,8 @@ pub(crate) struct Subtree {
 /// ```
 ///
 /// # Errors
+/// [`DynError::TooManyLinks`] for a chain of more than [`MAX_DENSE_LINKS`](crate::MAX_DENSE_LINKS)
+/// links;
 /// [`DynError::Dimension`] if `q` does not have `n` entries, `out` is not `n x n`, or `data` was
 /// built for another chain; [`DynError::NonFinite`] for a NaN or infinite angle;
 /// [`DynError::NonFiniteResult`] if an entry overflows.
@@ -50,6 +52,7 @@ pub fn mass_matrix(
     q: &[f64],
     mut out: MatMut<'_, f64>,
 ) -> Result<(), DynError> {
+    check::dense("the mass matrix", model)?;
     let n = check::inputs(model, data, &[("q", q)])?;
     check::square_output(&out, n)?;
     update_frames(&mut data.frames, q, None);

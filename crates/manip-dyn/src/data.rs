@@ -9,13 +9,19 @@ use crate::aba::ArticulatedLink;
 use crate::coriolis_matrix::SubtreeMotion;
 use crate::crba::Subtree;
 use crate::kinematics::LinkFrame;
-use crate::model::ChainModel;
+use crate::model::{ChainModel, MAX_DENSE_LINKS};
 use crate::rnea::LinkAcceleration;
 
 /// Scratch space for one [`ChainModel`]: build it once with [`ChainData::new`], then pass it to
 /// every algorithm. After construction, no algorithm of this crate allocates (on another thread
 /// than the one that built it, faer may allocate its matrix-multiply buffer once, in the first
 /// [`forward_dynamics`](crate::forward_dynamics()) of a chain of 100 links or more).
+///
+/// Its memory is `O(n)` (a few hundred bytes a link) plus, for the Cholesky
+/// [`forward_dynamics`](crate::forward_dynamics()), an `n x n` factor (`8 n^2` bytes): `new`
+/// allocates the factor for chains of up to [`MAX_DENSE_LINKS`] links (beyond, that algorithm
+/// refuses the chain), [`recursive`](Self::recursive) leaves it out until the first call that
+/// needs it.
 ///
 /// Its contents between calls are unspecified; it holds no state that outlives a call.
 pub struct ChainData {
@@ -31,14 +37,22 @@ pub struct ChainData {
     pub(crate) articulated: Vec<ArticulatedLink>,
     /// One row of the mass matrix during its assembly.
     pub(crate) mass_row: Vec<f64>,
-    /// `n x n`: the mass matrix, then its Cholesky factor (lower triangle) in forward dynamics.
+    /// The Cholesky forward dynamics' `n x n` matrix and scratch, once allocated.
+    pub(crate) factorisation: Option<Factorisation>,
+}
+
+/// The `n x n` part of a [`ChainData`], used by the Cholesky forward dynamics only.
+pub(crate) struct Factorisation {
+    /// `n x n`: the mass matrix, then its Cholesky factor (lower triangle).
     pub(crate) mass_factor: Mat<f64>,
     /// Scratch memory of the in-place Cholesky factorisation and solve.
     pub(crate) stack: MemBuffer,
 }
 
 impl ChainData {
-    /// Allocates the workspace for `model`.
+    /// Allocates the workspace for `model`, with the `n x n` factor of the Cholesky
+    /// [`forward_dynamics`](crate::forward_dynamics()) if the chain has at most
+    /// [`MAX_DENSE_LINKS`] links.
     ///
     /// ```
     /// use manip_dyn::{ChainData, ChainModel};
@@ -48,6 +62,30 @@ impl ChainData {
     /// # Ok::<(), manip_dyn::DynError>(())
     /// ```
     pub fn new(model: &ChainModel) -> ChainData {
+        let mut data = Self::with_links(model.n_links());
+        if data.n_links() <= MAX_DENSE_LINKS {
+            data.allocate_factorisation();
+        }
+        data
+    }
+
+    /// Allocates the `O(n)` workspace of the recursive algorithms only (RNEA, ABA, the bias
+    /// terms, the energies, and the mass and Coriolis matrices into the caller's matrix): the
+    /// first call of the Cholesky [`forward_dynamics`](crate::forward_dynamics()) allocates its
+    /// `n x n` factor. What a workspace that never needs that factor (such as a reduced model's)
+    /// is built with.
+    ///
+    /// ```
+    /// use manip_dyn::{ChainData, ChainModel, gravity};
+    /// let arm = ChainModel::uniform(100_000, 1e-5, 1e-5, 9.81)?;
+    /// let mut data = ChainData::recursive(&arm);
+    /// let (q, mut g) = (vec![0.0; 100_000], vec![0.0; 100_000]);
+    /// gravity(&arm, &mut data, &q, &mut g)?;
+    /// // Held out straight, the base carries the whole arm's weight at half its length.
+    /// assert!((g[0] - 9.81 * 1.0 * 0.5).abs() < 1e-9);
+    /// # Ok::<(), manip_dyn::DynError>(())
+    /// ```
+    pub fn recursive(model: &ChainModel) -> ChainData {
         Self::with_links(model.n_links())
     }
 
@@ -57,31 +95,46 @@ impl ChainData {
     }
 
     fn with_links(n: usize) -> ChainData {
-        let stack = StackReq::or(
-            llt::factor::cholesky_in_place_scratch::<f64>(n, Par::Seq, Default::default()),
-            llt::solve::solve_in_place_scratch::<f64>(n, 1, Par::Seq),
-        );
-        let mut data = ChainData {
+        ChainData {
             frames: vec![LinkFrame::default(); n],
             accelerations: vec![LinkAcceleration::default(); n],
             subtrees: vec![Subtree::default(); n],
             subtree_motions: vec![SubtreeMotion::default(); n],
             articulated: vec![ArticulatedLink::default(); n],
             mass_row: vec![0.0; n],
+            factorisation: None,
+        }
+    }
+
+    /// Allocates (and warms up) the `n x n` part.
+    fn allocate_factorisation(&mut self) {
+        self.factorisation = Some(Factorisation::new(self.n_links()));
+    }
+}
+
+impl Factorisation {
+    /// The factor and scratch for a chain of `n` links (at most [`MAX_DENSE_LINKS`], checked by
+    /// the caller), warmed up.
+    pub(crate) fn new(n: usize) -> Self {
+        let stack = StackReq::or(
+            llt::factor::cholesky_in_place_scratch::<f64>(n, Par::Seq, Default::default()),
+            llt::solve::solve_in_place_scratch::<f64>(n, 1, Par::Seq),
+        );
+        let mut factorisation = Self {
             mass_factor: Mat::zeros(n, n),
             stack: MemBuffer::new(stack),
         };
-        data.warm_up_factorisation();
-        data
+        factorisation.warm_up(n);
+        factorisation
     }
 
     /// faer's blocked Cholesky (from about 100 x 100) multiplies with a kernel that allocates a
     /// packing buffer per thread on first use. Factoring an identity of up to `WARM_UP` rows here
     /// takes that one-time allocation out of the first call of
     /// [`forward_dynamics`](crate::forward_dynamics()) on this thread, for about 0.5 ms.
-    fn warm_up_factorisation(&mut self) {
+    fn warm_up(&mut self, n: usize) {
         const WARM_UP: usize = 256;
-        let size = self.n_links().min(WARM_UP);
+        let size = n.min(WARM_UP);
         let mut block = self.mass_factor.as_mut().submatrix_mut(0, 0, size, size);
         block.rb_mut().fill(0.0);
         block.rb_mut().diagonal_mut().fill(1.0);
@@ -97,9 +150,14 @@ impl ChainData {
 }
 
 impl Clone for ChainData {
-    /// A fresh workspace of the same size (the contents are scratch, so nothing else is copied).
+    /// A fresh workspace of the same size, with the `n x n` factor if this one has it (the
+    /// contents are scratch, so nothing else is copied).
     fn clone(&self) -> Self {
-        Self::with_links(self.n_links())
+        let mut data = Self::with_links(self.n_links());
+        if self.factorisation.is_some() {
+            data.allocate_factorisation();
+        }
+        data
     }
 }
 

@@ -6,12 +6,13 @@
 
 use faer::MatRef;
 
-use crate::model::ChainModel;
+use crate::model::{ChainModel, MAX_DENSE_LINKS};
 
 /// Results and scratch of [`rnea_derivatives`](crate::rnea_derivatives()) and
 /// [`aba_derivatives`](crate::aba_derivatives()) for one [`ChainModel`]: build it once with
 /// [`DerivativeData::new`] (three `n x n` matrices, `24 n^2` bytes), then every call fills it
-/// without allocating.
+/// without allocating. For a chain of more than [`MAX_DENSE_LINKS`] links, which both
+/// derivative functions refuse, it holds nothing: its value is empty and its matrices `0 x 0`.
 ///
 /// After a call it holds the value of the differentiated function ([`value`](Self::value)) and
 /// its three Jacobians, entry `(i, j) = d out_i / d in_j`:
@@ -66,12 +67,14 @@ impl DerivativeData {
     /// ```
     pub fn new(model: &ChainModel) -> DerivativeData {
         let n = model.n_links();
-        let vector = || vec![0.0; n + 1];
+        // Beyond the dense limit every derivative call refuses the chain: allocate nothing.
+        let sized = if n <= MAX_DENSE_LINKS { n } else { 0 };
+        let vector = || vec![0.0; sized + 1];
         let pair = || [vector(), vector()];
         DerivativeData {
             n,
-            value: vec![0.0; n],
-            blocks: vec![0.0; 3 * n * n],
+            value: vec![0.0; sized],
+            blocks: vec![0.0; 3 * sized * sized],
             links: LinkTerms {
                 moment: vector(),
                 rate: vector(),
@@ -83,7 +86,11 @@ impl DerivativeData {
                 row_sum: pair(),
                 base: pair(),
             },
-            sweep: [vec![0.0; 3 * n], vec![0.0; 3 * n], vec![0.0; 3 * n]],
+            sweep: [
+                vec![0.0; 3 * sized],
+                vec![0.0; 3 * sized],
+                vec![0.0; 3 * sized],
+            ],
         }
     }
 
@@ -115,7 +122,7 @@ impl DerivativeData {
     }
 
     fn block(&self, index: usize) -> MatRef<'_, f64> {
-        let n = self.n;
+        let n = self.value.len();
         MatRef::from_row_major_slice_with_stride(&self.blocks[index * n..], n, n, 3 * n)
     }
 }

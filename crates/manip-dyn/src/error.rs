@@ -12,9 +12,12 @@ pub enum DynError {
     /// A chain was asked for with zero links.
     #[error("a chain needs at least one link")]
     NoLinks,
-    /// A chain was asked for with more than [`MAX_LINKS`](crate::model::MAX_LINKS) links.
-    #[error("a chain may have at most {max} links, got {got}")]
+    /// A chain was asked for with more than [`MAX_LINKS`](crate::model::MAX_LINKS) links, or an
+    /// `n x n` algorithm with more than [`MAX_DENSE_LINKS`](crate::model::MAX_DENSE_LINKS).
+    #[error("{what} may have at most {max} links, got {got}")]
     TooManyLinks {
+        /// `"a chain"`, or which `n x n` algorithm refused.
+        what: &'static str,
         /// The number of links asked for.
         got: usize,
         /// The limit.

@@ -7,7 +7,7 @@ use faer::{MatMut, Par};
 
 use crate::check;
 use crate::crba;
-use crate::data::ChainData;
+use crate::data::{ChainData, Factorisation};
 use crate::error::DynError;
 use crate::model::ChainModel;
 use crate::rnea::newton_euler;
@@ -31,6 +31,8 @@ use crate::rnea::newton_euler;
 /// ```
 ///
 /// # Errors
+/// [`DynError::TooManyLinks`] for a chain of more than [`MAX_DENSE_LINKS`](crate::MAX_DENSE_LINKS)
+/// links;
 /// [`DynError::Dimension`] if a slice does not have `n` entries or `data` was built for another
 /// chain, [`DynError::NonFinite`] for a NaN or infinite input,
 /// [`DynError::NotPositiveDefinite`] if a Cholesky pivot is not positive beyond rounding (link
@@ -43,6 +45,7 @@ pub fn forward_dynamics(
     tau: &[f64],
     qdd: &mut [f64],
 ) -> Result<(), DynError> {
+    check::dense("Cholesky forward dynamics", model)?;
     let n = check::inputs(model, data, &[("q", q), ("v", v), ("tau", tau)])?;
     check::output("qdd", qdd, n)?;
 
@@ -53,17 +56,21 @@ pub fn forward_dynamics(
     }
 
     // The Newton-Euler pass left the link directions of `q` in `data.frames`.
-    crba::assemble(
-        model,
-        &data.frames,
-        &mut data.subtrees,
-        &mut data.mass_row,
-        data.mass_factor.as_mut(),
-    );
-    check::finite_matrix("mass matrix", &data.mass_factor.as_mut())?;
-    let stack = MemStack::new(&mut data.stack);
+    let ChainData {
+        frames,
+        subtrees,
+        mass_row,
+        factorisation,
+        ..
+    } = data;
+    let n_links = frames.len();
+    let Factorisation { mass_factor, stack } =
+        factorisation.get_or_insert_with(|| Factorisation::new(n_links));
+    crba::assemble(model, frames, subtrees, mass_row, mass_factor.as_mut());
+    check::finite_matrix("mass matrix", &mass_factor.as_mut())?;
+    let stack = MemStack::new(stack);
     llt::factor::cholesky_in_place(
-        data.mass_factor.as_mut(),
+        mass_factor.as_mut(),
         Default::default(),
         Par::Seq,
         stack,
@@ -71,11 +78,11 @@ pub fn forward_dynamics(
     )
     .map_err(|_| DynError::NotPositiveDefinite)?;
     // The assembly left M_ii in the composite bodies; the pivots are L_ii^2.
-    for (i, subtree) in data.subtrees.iter().enumerate() {
-        check::pivot(data.mass_factor[(i, i)].powi(2), subtree.second_moment)?;
+    for (i, subtree) in subtrees.iter().enumerate() {
+        check::pivot(mass_factor[(i, i)].powi(2), subtree.second_moment)?;
     }
     llt::solve::solve_in_place(
-        data.mass_factor.as_ref(),
+        mass_factor.as_ref(),
         MatMut::from_column_major_slice_mut(qdd, n, 1),
         Par::Seq,
         stack,

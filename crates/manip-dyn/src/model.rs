@@ -70,11 +70,21 @@ impl Link {
     }
 }
 
-/// The most links a chain may have: the workspace's one limit, `backbone_kin::MAX_LINKS`. A
-/// [`ChainData`](crate::ChainData) holds an `n x n` mass matrix, 128 MiB at this limit; a larger
-/// `n` is refused with [`DynError::TooManyLinks`] rather than risk aborting the process on a
-/// failed allocation.
+/// The most links a chain may have: the workspace's one limit, `backbone_kin::MAX_LINKS`
+/// (10^6). A chain, a [`ChainData`](crate::ChainData) and the `O(n)` algorithms (RNEA, ABA, the
+/// bias terms, the energies) need `O(n)` memory; a larger `n` is refused with
+/// [`DynError::TooManyLinks`] rather than risk aborting the process on a failed allocation.
 pub use backbone_kin::MAX_LINKS;
+
+/// The most links of the `n x n` algorithms: [`mass_matrix`](crate::mass_matrix()),
+/// [`coriolis_matrix`](crate::coriolis_matrix()), the Cholesky
+/// [`forward_dynamics`](crate::forward_dynamics()), [`rnea_derivatives`](crate::rnea_derivatives())
+/// and [`aba_derivatives`](crate::aba_derivatives()). Their matrices take `8 n^2` bytes each
+/// (128 MiB at this limit, a [`DerivativeData`](crate::DerivativeData) three times that) and their
+/// time grows as `n^2` or `n^3`; beyond it they refuse the chain with
+/// [`DynError::TooManyLinks`], and [`ChainData::new`](crate::ChainData::new) and
+/// [`DerivativeData::new`](crate::DerivativeData::new) allocate none of their `n x n` memory.
+pub const MAX_DENSE_LINKS: usize = 4096;
 
 /// A planar serial chain of revolute joints under gravity along `-y`.
 ///
@@ -144,6 +154,7 @@ fn check_link_count(n: usize) -> Result<(), DynError> {
     match n {
         0 => Err(DynError::NoLinks),
         n if n > MAX_LINKS => Err(DynError::TooManyLinks {
+            what: "a chain",
             got: n,
             max: MAX_LINKS,
         }),

@@ -75,6 +75,8 @@ use crate::rnea::newton_euler;
 /// ```
 ///
 /// # Errors
+/// [`DynError::TooManyLinks`] for a chain of more than [`MAX_DENSE_LINKS`](crate::MAX_DENSE_LINKS)
+/// links;
 /// [`DynError::Dimension`] if a slice does not have `n` entries or `data` or `derivatives` was
 /// built for another chain, [`DynError::NonFinite`] for a NaN or infinite input,
 /// [`DynError::NonFiniteResult`] if a result overflows.
@@ -86,6 +88,7 @@ pub fn rnea_derivatives(
     v: &[f64],
     qdd: &[f64],
 ) -> Result<(), DynError> {
+    check::dense("the RNEA derivatives", model)?;
     let n = check::inputs(model, data, &[("q", q), ("v", v), ("qdd", qdd)])?;
     check::derivative_workspace(derivatives, n)?;
     newton_euler(

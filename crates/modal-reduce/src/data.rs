@@ -13,9 +13,12 @@ use crate::terms::Pair;
 /// After [`reduced_terms`](crate::reduced_terms), [`reduced_terms_by_projection`](crate::reduced_terms_by_projection)
 /// or a forward-dynamics call it holds `M*`, `C*` and `G*` at the state passed in, readable with
 /// [`mass_matrix`](Self::mass_matrix), [`coriolis`](Self::coriolis) and
-/// [`gravity`](Self::gravity). Its memory is `O(n^2)` because the projection path
-/// ([`reduced_terms_by_projection`](crate::reduced_terms_by_projection)) and the full chain's workspace hold
-/// `n x n` matrices; the default path touches only an `O(m^2)` part of it.
+/// [`gravity`](Self::gravity). Its memory is `O(n + m^2)`: per-link buffers of the default path
+/// and the full chain's recursive workspace
+/// ([`ChainData::recursive`](manip_dyn::ChainData::recursive)), a few hundred bytes a link. The
+/// projection path ([`reduced_terms_by_projection`](crate::reduced_terms_by_projection)) needs an `n x n` mass matrix and
+/// `M J` (`n x m`) besides: its first call allocates them, and it refuses chains of more than
+/// [`manip_dyn::MAX_DENSE_LINKS`] links.
 #[derive(Debug, Clone)]
 pub struct ReducedData {
     pub(crate) n_links: usize,
@@ -41,29 +44,44 @@ pub struct ReducedData {
     pub(crate) theta_dot: Vec<f64>,
     pub(crate) theta_ddot: Vec<f64>,
     pub(crate) joint_torque: Vec<f64>,
-    /// The full mass matrix `M` (`n x n`) and `M J` (`n x m`), for the projection path.
-    pub(crate) joint_mass: Mat<f64>,
-    pub(crate) mass_times_jacobian: Mat<f64>,
-    /// The full chain's own workspace.
+    /// The projection path's matrices, allocated by its first call.
+    pub(crate) projection: Option<Projection>,
+    /// The full chain's own workspace, recursive algorithms only.
     pub(crate) chain: ChainData,
 }
 
-/// Per link (length `n` each): absolute angle, its sine and cosine, squared angular rate, and the
-/// Coriolis/centrifugal force `c_l` in absolute angles (see [`crate::terms`]).
+/// The matrices of the projection path ([`reduced_terms_by_projection`](crate::reduced_terms_by_projection)).
+#[derive(Debug, Clone)]
+pub(crate) struct Projection {
+    /// The full mass matrix `M` (`n x n`).
+    pub(crate) joint_mass: Mat<f64>,
+    /// `M J` (`n x m`).
+    pub(crate) mass_times_jacobian: Mat<f64>,
+}
+
+impl Projection {
+    /// Zero matrices for `n` links and `m` coordinates.
+    pub(crate) fn new(n: usize, m: usize) -> Self {
+        Self {
+            joint_mass: Mat::zeros(n, n),
+            mass_times_jacobian: Mat::zeros(n, m),
+        }
+    }
+}
+
+/// Per link (length `n` each): absolute angle and its sine and cosine (see [`crate::terms`]).
 #[derive(Debug, Clone)]
 pub(crate) struct LinkBuffers {
     pub(crate) angle: Vec<f64>,
     pub(crate) sin: Vec<f64>,
     pub(crate) cos: Vec<f64>,
-    pub(crate) rate_squared: Vec<f64>,
-    pub(crate) force: Vec<f64>,
 }
 
 /// Scratch of the default path for sizes without a specialised version (see [`crate::terms`]).
 #[derive(Debug, Clone)]
 pub(crate) struct TermScratch {
     /// `m`: the columns of the prefix sum `P_l`.
-    pub(crate) joint: Vec<Pair>,
+    pub(crate) joint: Vec<Pair<f64>>,
     /// `m`: `S_l v_l`.
     pub(crate) cos_moment: Vec<f64>,
 }
@@ -85,8 +103,6 @@ impl ReducedData {
                 angle: vec![0.0; n],
                 sin: vec![0.0; n],
                 cos: vec![0.0; n],
-                rate_squared: vec![0.0; n],
-                force: vec![0.0; n],
             },
             scratch: TermScratch {
                 joint: vec![[0.0; 2]; m],
@@ -96,9 +112,8 @@ impl ReducedData {
             theta_dot: vec![0.0; n],
             theta_ddot: vec![0.0; n],
             joint_torque: vec![0.0; n],
-            joint_mass: Mat::zeros(n, n),
-            mass_times_jacobian: Mat::zeros(n, m),
-            chain: ChainData::new(model.chain()),
+            projection: None,
+            chain: ChainData::recursive(model.chain()),
         }
     }
 

@@ -162,7 +162,7 @@ pub fn reduced_derivatives(
     let m = model.n_coords();
     let d = &mut *derivatives;
     d.factor.copy_from_slice(&data.mass);
-    if !ldlt_in_place(&mut d.factor, m) {
+    if !ldlt_in_place((), &mut d.factor, m) {
         return Err(ReduceError::NotPositiveDefinite);
     }
     // Column k of each block: -M*^-1 D_a e_k, -M*^-1 D_v e_k, M*^-1 e_k.

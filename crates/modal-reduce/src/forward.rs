@@ -107,7 +107,7 @@ fn solve_on_stack<const M: usize>(mass: &[f64], x: &mut [f64]) -> bool {
 /// is not numerically positive definite.
 #[inline(always)]
 fn factor_and_solve(factor: &mut [f64], x: &mut [f64], m: usize) -> bool {
-    if !ldlt_in_place(factor, m) {
+    if !ldlt_in_place((), factor, m) {
         return false;
     }
     ldlt_solve_in_place(factor, m, x);

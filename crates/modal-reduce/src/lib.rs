@@ -1,11 +1,13 @@
 #![doc = include_str!("../README.md")]
 
+mod batch;
 mod data;
 mod derivatives;
 mod energy;
 mod error;
 mod forward;
 pub mod jacobi;
+mod lanes;
 mod model;
 mod projection;
 mod small_linalg;
@@ -13,6 +15,7 @@ pub mod terms;
 mod torques;
 mod trig;
 
+pub use batch::{BatchError, MAX_BATCH_COORDS, ReducedBatchData, forward_dynamics_batch};
 pub use data::ReducedData;
 pub use derivatives::{ReducedDerivatives, reduced_derivatives};
 pub use energy::{kinetic_energy, potential_energy};

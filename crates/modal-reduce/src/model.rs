@@ -2,7 +2,6 @@
 //! split).
 
 use backbone_kin::{BaseAngle, ModalMap};
-use faer::Mat;
 use manip_dyn::ChainModel;
 
 use crate::error::ReduceError;
@@ -14,7 +13,9 @@ use crate::small_linalg::symmetric_eigen_extremes;
 const RANK_TOLERANCE: f64 = 1e-10;
 
 /// Largest relative difference between a map's and a chain's link fractions `L_i / l` that counts
-/// as the same geometry: rounding of the two sums, far below any real difference in design.
+/// as the same geometry, for up to `GEOMETRY_TOLERANCE / (2 eps)` (4503) links: rounding of the
+/// two sums, far below any real difference in design. Each sum of `n` lengths is within
+/// `(n - 1) eps / 2` of exact (relative), so longer chains get `2 n eps` (4.4e-10 at 10^6 links).
 const GEOMETRY_TOLERANCE: f64 = 1e-12;
 
 /// The per-link constants of the default path (see [`crate::terms`]).
@@ -49,8 +50,6 @@ pub(crate) struct LinkConstants {
 pub struct ReducedModel {
     chain: ChainModel,
     map: ModalMap,
-    /// `J` as a faer matrix (`n x m`), for the projection path.
-    jacobian: Mat<f64>,
     /// Row `l` is `Phi_l = J_0 + ... + J_l`, the gradient of link `l`'s absolute angle with
     /// respect to `a` (row-major, `n x m`).
     angle_rows: Vec<f64>,
@@ -89,7 +88,8 @@ impl ReducedModel {
     /// Builds the reduced model of `chain` under `map`.
     ///
     /// Fails if the map's joint count differs from the chain's link count, if the map was built
-    /// for links of other relative lengths (`L_i / l` differing by more than `1e-12` relative:
+    /// for links of other relative lengths (`L_i / l` differing by more than `1e-12` relative, or
+    /// `2 n eps` for chains of more than 4503 links, the rounding of the sums:
     /// for example [`ModalMap::paper`] with a chain of unequal links, whose `J` would be
     /// silently wrong), or if `J` is column-rank-deficient (for example three coordinates on
     /// fewer than three links, or more harmonics than the links can resolve), since
@@ -105,7 +105,6 @@ impl ReducedModel {
         }
         check_geometry(&chain, &map)?;
         check_column_rank(&map)?;
-        let jacobian = Mat::from_fn(n, m, |i, j| map.entry(i, j));
         // mu_l, the mass beyond link l (see the module `terms` for this and S_l, h_ll and K).
         let chain_links = chain.links();
         let mut beyond = vec![0.0; n];
@@ -145,7 +144,6 @@ impl ReducedModel {
         Ok(Self {
             chain,
             map,
-            jacobian,
             angle_rows,
             links,
             constant_mass,
@@ -172,9 +170,9 @@ impl ReducedModel {
         self.map.n_coords()
     }
 
-    /// `J` as a faer matrix.
+    /// `J` as a faer matrix (a view of the map's row-major entries).
     pub(crate) fn jacobian(&self) -> faer::MatRef<'_, f64> {
-        self.jacobian.as_ref()
+        faer::MatRef::from_row_major_slice(self.map.jacobian(), self.n_links(), self.n_coords())
     }
 
     /// Row-major `n x m` gradients of the absolute link angles, `Phi_i`.
@@ -197,6 +195,7 @@ impl ReducedModel {
 fn check_geometry(chain: &ChainModel, map: &ModalMap) -> Result<(), ReduceError> {
     let map_total: f64 = map.link_lengths().iter().sum();
     let chain_total = chain.total_length();
+    let tolerance = GEOMETRY_TOLERANCE.max(2.0 * chain.n_links() as f64 * f64::EPSILON);
     for (link, (&map_length, chain_length)) in map
         .link_lengths()
         .iter()
@@ -204,7 +203,7 @@ fn check_geometry(chain: &ChainModel, map: &ModalMap) -> Result<(), ReduceError>
         .enumerate()
     {
         let (map_fraction, chain_fraction) = (map_length / map_total, chain_length / chain_total);
-        if (map_fraction - chain_fraction).abs() > GEOMETRY_TOLERANCE * chain_fraction {
+        if (map_fraction - chain_fraction).abs() > tolerance * chain_fraction {
             return Err(ReduceError::GeometryMismatch {
                 link,
                 map_fraction,

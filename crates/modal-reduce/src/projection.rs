@@ -4,15 +4,18 @@
 
 use faer::linalg::matmul::matmul;
 use faer::{Accum, MatMut, Par};
+use manip_dyn::{DynError, MAX_DENSE_LINKS};
 
-use crate::data::ReducedData;
+use crate::data::{Projection, ReducedData};
 use crate::error::{ReduceError, check_input};
 use crate::model::ReducedModel;
 use crate::torques::project;
 
 /// Computes `M* = J^T M J`, `C* = J^T C(theta, J a_dot)` and `G* = J^T G(theta)` at
 /// `theta = J a + theta_0` (eq 14) into `data`, by forming the full `n x n` mass matrix with
-/// `manip_dyn::mass_matrix` and multiplying with faer (sequential, no allocation).
+/// `manip_dyn::mass_matrix` and multiplying with faer (sequential). The first call on a `data`
+/// allocates the `n x n` and `n x m` matrices; later calls allocate nothing. Refuses chains of
+/// more than [`MAX_DENSE_LINKS`] links with [`DynError::TooManyLinks`].
 ///
 /// Gives the same terms as [`reduced_terms`](crate::reduced_terms) up to rounding, at
 /// `O(n^2 m)` instead of `O(n m^2)` cost.
@@ -27,19 +30,26 @@ pub fn reduced_terms_by_projection(
     check_input("a", a, m)?;
     check_input("a_dot", a_dot, m)?;
     let (chain, map) = (model.chain(), model.map());
+    let n = model.n_links();
+    if n > MAX_DENSE_LINKS {
+        return Err(ReduceError::Dyn(DynError::TooManyLinks {
+            what: "the projection J^T M J",
+            got: n,
+            max: MAX_DENSE_LINKS,
+        }));
+    }
     map.joint_angles(a, &mut data.theta)?;
     map.joint_rates(a_dot, &mut data.theta_dot)?;
+    let Projection {
+        joint_mass,
+        mass_times_jacobian,
+    } = data.projection.get_or_insert_with(|| Projection::new(n, m));
 
-    manip_dyn::mass_matrix(
-        chain,
-        &mut data.chain,
-        &data.theta,
-        data.joint_mass.as_mut(),
-    )?;
+    manip_dyn::mass_matrix(chain, &mut data.chain, &data.theta, joint_mass.as_mut())?;
     matmul(
-        data.mass_times_jacobian.as_mut(),
+        mass_times_jacobian.as_mut(),
         Accum::Replace,
-        data.joint_mass.as_ref(),
+        joint_mass.as_ref(),
         model.jacobian(),
         1.0,
         Par::Seq,
@@ -48,7 +58,7 @@ pub fn reduced_terms_by_projection(
         MatMut::from_row_major_slice_mut(&mut data.mass, m, m),
         Accum::Replace,
         model.jacobian().transpose(),
-        data.mass_times_jacobian.as_ref(),
+        mass_times_jacobian.as_ref(),
         1.0,
         Par::Seq,
     );

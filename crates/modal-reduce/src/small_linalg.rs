@@ -5,32 +5,35 @@
 //! per-call overhead of faer's Cholesky exceeds the whole `3 x 3` solve), and they are short
 //! enough to check by eye.
 
+use crate::lanes::Lane;
+
 /// Factorises the symmetric positive-definite `m x m` matrix `a` (row-major) in place as
 /// `a = L D L^T`, `L` unit lower triangular and `D` diagonal: `L` below the diagonal, `1 / D` on
-/// it, scratch (`L^T D`) above it; only the lower triangle of the input is read.
+/// it, scratch (`L^T D`) above it; only the lower triangle of the input is read. Each entry holds
+/// `L::WIDTH` independent matrices (see [`Lane`]).
 ///
 /// Square-root free and with one division per column, which is most of the cost at this size;
 /// the solve then only multiplies.
 /// Returns `false` if a pivot `D_j` is not positive and finite (the matrix is not numerically
-/// positive definite); `a` then holds a partial factorisation.
+/// positive definite; in any lane); `a` then holds a partial factorisation.
 #[inline(always)]
-pub(crate) fn ldlt_in_place(a: &mut [f64], m: usize) -> bool {
+pub(crate) fn ldlt_in_place<L: Lane>(context: L::Context, a: &mut [L], m: usize) -> bool {
     let a = &mut a[..m * m];
     for j in 0..m {
         // a[k][j] (k < j) holds L_jk D_k.
         let mut pivot = a[j * m + j];
         for k in 0..j {
-            pivot -= a[j * m + k] * a[k * m + j];
+            pivot = pivot - a[j * m + k] * a[k * m + j];
         }
-        if !(pivot > 0.0 && pivot.is_finite()) {
+        if !pivot.all_positive_finite() {
             return false;
         }
-        let inverse = 1.0 / pivot;
+        let inverse = L::splat(context, 1.0) / pivot;
         a[j * m + j] = inverse;
         for i in j + 1..m {
             let mut value = a[i * m + j];
             for k in 0..j {
-                value -= a[i * m + k] * a[k * m + j];
+                value = value - a[i * m + k] * a[k * m + j];
             }
             // value = L_ij D_j.
             a[j * m + i] = value;
@@ -43,19 +46,19 @@ pub(crate) fn ldlt_in_place(a: &mut [f64], m: usize) -> bool {
 /// Solves `L D L^T x = b` in place (`x` holds `b` on entry), with the factors left by
 /// [`ldlt_in_place`].
 #[inline(always)]
-pub(crate) fn ldlt_solve_in_place(factor: &[f64], m: usize, x: &mut [f64]) {
+pub(crate) fn ldlt_solve_in_place<L: Lane>(factor: &[L], m: usize, x: &mut [L]) {
     let (f, x) = (&factor[..m * m], &mut x[..m]);
     for i in 0..m {
         for k in 0..i {
-            x[i] -= f[i * m + k] * x[k];
+            x[i] = x[i] - f[i * m + k] * x[k];
         }
     }
     for i in 0..m {
-        x[i] *= f[i * m + i];
+        x[i] = x[i] * f[i * m + i];
     }
     for i in (0..m).rev() {
         for k in i + 1..m {
-            x[i] -= f[k * m + i] * x[k];
+            x[i] = x[i] - f[k * m + i] * x[k];
         }
     }
 }
@@ -145,7 +148,7 @@ mod tests {
         ) {
             let a = spd(&entries, m);
             let mut factor = a.clone();
-            prop_assert!(ldlt_in_place(&mut factor, m));
+            prop_assert!(ldlt_in_place((), &mut factor, m));
             let mut x = rhs.clone();
             ldlt_solve_in_place(&factor, m, &mut x);
             for i in 0..m {
@@ -178,9 +181,9 @@ mod tests {
     #[test]
     fn ldlt_refuses_indefinite_and_nan() {
         let mut indefinite = [1.0, 2.0, 2.0, 1.0];
-        assert!(!ldlt_in_place(&mut indefinite, 2));
+        assert!(!ldlt_in_place((), &mut indefinite, 2));
         let mut nan = [f64::NAN, 0.0, 0.0, 1.0];
-        assert!(!ldlt_in_place(&mut nan, 2));
+        assert!(!ldlt_in_place((), &mut nan, 2));
     }
 
     #[test]

@@ -29,38 +29,49 @@
 //! `C* = Phi^T c(phi, Phi a_dot)` and `G* = Phi^T dV/dphi`; these are the projections
 //! `J^T M J`, `J^T C`, `J^T G` of eq 14, written in absolute rather than relative angles.
 //!
-//! *Prefix and suffix sums.* With `P_l = sum_{j<l} L_j w_j Phi_j` (`2 x m`),
-//! `q_l = -sum_{j<l} L_j phi_dot_j^2 u_j` (the acceleration of joint `l` when `a_ddot = 0`) and
-//! `R_l = sum_{j>l} S_j phi_dot_j^2 u_j`:
+//! *Prefix sums.* With `P_l = sum_{j<l} L_j w_j Phi_j` (`2 x m`) and
+//! `q_l = -sum_{j<l} L_j phi_dot_j^2 u_j` (the acceleration of joint `l` when `a_ddot = 0`):
 //!
 //! ```text
 //! v_l = P_l^T w_l = sum_{j<l} L_j cos(phi_j - phi_l) Phi_j^T
 //! w_l . q_l       = sum_{j<l} L_j phi_dot_j^2 sin(phi_l - phi_j)
-//! w_l . R_l       = sum_{j>l} S_j phi_dot_j^2 sin(phi_j - phi_l)
 //! ```
 //!
 //! and splitting each double sum into `j < l`, `j = l` and `j > l`:
 //!
 //! ```text
 //! M* = K + sum_l S_l (Phi_l^T v_l^T + v_l Phi_l),   K = sum_l h_ll Phi_l^T Phi_l  (constant),
-//! c_l = S_l (w_l . q_l) - L_l (w_l . R_l),          C* = sum_l c_l Phi_l^T,
-//! G* = g sum_l S_l cos(phi_l) Phi_l^T,
-//! P_{l+1} = P_l + L_l w_l Phi_l,   q_{l+1} = q_l - L_l phi_dot_l^2 u_l,   R_{l-1} = R_l + S_l phi_dot_l^2 u_l.
+//! c_l = S_l (w_l . q_l) - L_l sum_{j>l} S_j phi_dot_j^2 sin(phi_j - phi_l).
 //! ```
 //!
-//! So a pass from the base builds `P_l`, `M*` and the first part of `c_l`, and a pass from the
-//! tip finishes `c_l` and projects `C*` and `G*`. Per link this is one sine-cosine pair (computed
-//! for all links at once, see `trig`), `O(1)` work for `c_l`, `O(m)` for `v_l`, `P_l` and the
-//! projections, and `O(m^2)` for the symmetric update of `M*` (its upper triangle; mirrored at
-//! the end).
+//! The second part of `c_l` is a suffix sum, but its projection is a prefix sum again: exchanging
+//! the order of summation, `sum_l L_l sum_{j>l} S_j phi_dot_j^2 sin(phi_j - phi_l) Phi_l^T =
+//! sum_j S_j phi_dot_j^2 P_j^T u_j`, so
+//!
+//! ```text
+//! C* = sum_l (S_l (w_l . q_l) Phi_l^T - S_l phi_dot_l^2 P_l^T u_l),
+//! G* = g sum_l S_l cos(phi_l) Phi_l^T,
+//! P_{l+1} = P_l + L_l w_l Phi_l,   q_{l+1} = q_l - L_l phi_dot_l^2 u_l.
+//! ```
+//!
+//! So one pass from the base builds `P_l` and `q_l` and accumulates `M*`, `C*` and `G*`. Per link
+//! this is one sine-cosine pair (computed for all links at once, see `trig`), `O(m)` work for
+//! `v_l`, `P_l^T u_l`, `P_l` and the projections, and `O(m^2)` for the symmetric update of `M*`
+//! (its upper triangle; mirrored at the end).
+//!
+//! The kernel is written once, generic over its number type: `f64` for one state, and a SIMD
+//! register of several states side by side for [`forward_dynamics_batch`].
+//!
+//! [`forward_dynamics_batch`]: crate::forward_dynamics_batch
 
 use crate::data::{LinkBuffers, ReducedData};
 use crate::error::{ReduceError, check_finite_result, check_input};
+use crate::lanes::Lane;
 use crate::model::ReducedModel;
 use crate::trig::sin_cos;
 
-/// Computes `M*(a)`, `C*(a, a_dot)` and `G*(a)` (eq 14) into `data` in `O(n m^2)`, by prefix and
-/// suffix sums along the chain (the default path; see the [module documentation](self) for the
+/// Computes `M*(a)`, `C*(a, a_dot)` and `G*(a)` (eq 14) into `data` in `O(n m^2)`, by prefix
+/// sums along the chain (the default path; see the [module documentation](self) for the
 /// derivation).
 ///
 /// Read the results with [`ReducedData::mass_matrix`], [`ReducedData::coriolis`] and
@@ -94,50 +105,67 @@ pub fn reduced_terms(
         2 => accumulate_on_stack::<2>(model, data, a, a_dot),
         3 => accumulate_on_stack::<3>(model, data, a, a_dot),
         _ => {
-            let data = &mut *data;
-            let scratch = &mut data.scratch;
-            accumulate(
-                model,
-                a,
-                a_dot,
-                m,
-                Workspace {
-                    links: &mut data.links,
-                    mass: &mut data.mass,
-                    coriolis: &mut data.coriolis,
-                    gravity: &mut data.gravity,
-                    joint: &mut scratch.joint,
-                    cos_moment: &mut scratch.cos_moment,
-                },
-            );
+            let ReducedData {
+                links,
+                mass,
+                coriolis,
+                gravity,
+                scratch,
+                ..
+            } = data;
+            let terms = Terms {
+                mass,
+                coriolis,
+                gravity,
+                joint: &mut scratch.joint,
+                cos_moment: &mut scratch.cos_moment,
+            };
+            accumulate((), model, a, a_dot, m, links.trig(), terms);
         }
     }
-    finish(model, m, data);
     check_finite_result("reduced mass matrix M*", &data.mass)?;
     check_finite_result("reduced Coriolis vector C*", &data.coriolis)?;
     check_finite_result("reduced gravity vector G*", &data.gravity)
 }
 
 /// An `(x, y)` pair: a column of the `2 x m` prefix sum `P_l`.
-pub(crate) type Pair = [f64; 2];
+pub(crate) type Pair<L> = [L; 2];
 
-/// The accumulators and scratch of the sums.
-struct Workspace<'a> {
-    /// Per link (`n` each): absolute angle, its sine and cosine, squared angular rate, force.
-    links: &'a mut LinkBuffers,
-    /// `sum_l S_l (Phi_l^T v_l^T + v_l Phi_l)`, row-major `m x m`, upper triangle.
-    mass: &'a mut [f64],
-    /// `C*`, length `m`.
-    coriolis: &'a mut [f64],
-    /// `G* / g`, length `m`.
-    gravity: &'a mut [f64],
-    /// Columns of `P_l`, length `m`.
-    joint: &'a mut [Pair],
-    /// `S_l v_l`, length `m`.
-    cos_moment: &'a mut [f64],
+/// The per-link buffers of the kernel, `n` values of `L::WIDTH` lanes each (`[link][lane]`).
+pub(crate) struct LinkTrig<'a> {
+    /// Absolute angle `phi_l`.
+    pub(crate) angle: &'a mut [f64],
+    /// Its sine and cosine.
+    pub(crate) sin: &'a mut [f64],
+    pub(crate) cos: &'a mut [f64],
 }
 
-/// [`accumulate`] for a compile-time `M`, on local arrays, copied into `data`.
+impl LinkBuffers {
+    /// The buffers as the kernel takes them.
+    pub(crate) fn trig(&mut self) -> LinkTrig<'_> {
+        LinkTrig {
+            angle: &mut self.angle,
+            sin: &mut self.sin,
+            cos: &mut self.cos,
+        }
+    }
+}
+
+/// The results and scratch of the kernel, `m` or `m x m` values.
+pub(crate) struct Terms<'a, L> {
+    /// `M*`, row-major `m x m`.
+    pub(crate) mass: &'a mut [L],
+    /// `C*`, length `m`.
+    pub(crate) coriolis: &'a mut [L],
+    /// `G*`, length `m`.
+    pub(crate) gravity: &'a mut [L],
+    /// Columns of `P_l`, length `m`.
+    pub(crate) joint: &'a mut [Pair<L>],
+    /// `S_l v_l`, length `m`.
+    pub(crate) cos_moment: &'a mut [L],
+}
+
+/// [`accumulate`] for a compile-time `M` on one state, on local arrays, copied into `data`.
 #[inline(always)]
 fn accumulate_on_stack<const M: usize>(
     model: &ReducedModel,
@@ -149,130 +177,115 @@ fn accumulate_on_stack<const M: usize>(
     let (mut coriolis, mut gravity) = ([0.0; M], [0.0; M]);
     let mut joint = [[0.0; 2]; M];
     let mut cos_moment = [0.0; M];
-    accumulate(
-        model,
-        a,
-        a_dot,
-        M,
-        Workspace {
-            links: &mut data.links,
-            mass: mass.as_flattened_mut(),
-            coriolis: &mut coriolis,
-            gravity: &mut gravity,
-            joint: &mut joint,
-            cos_moment: &mut cos_moment,
-        },
-    );
+    let terms = Terms {
+        mass: mass.as_flattened_mut(),
+        coriolis: &mut coriolis,
+        gravity: &mut gravity,
+        joint: &mut joint,
+        cos_moment: &mut cos_moment,
+    };
+    accumulate((), model, a, a_dot, M, data.links.trig(), terms);
     data.mass.copy_from_slice(mass.as_flattened());
     data.coriolis.copy_from_slice(&coriolis);
     data.gravity.copy_from_slice(&gravity);
 }
 
-/// The sums of the module documentation, for `m` coordinates, into `work`.
+/// The sums of the module documentation, for `m` coordinates of `L::WIDTH` states each, into
+/// `terms`: `M*` (both triangles), `C*` and `G*`.
 #[inline(always)]
-fn accumulate(model: &ReducedModel, a: &[f64], a_dot: &[f64], m: usize, work: Workspace<'_>) {
+pub(crate) fn accumulate<L: Lane>(
+    context: L::Context,
+    model: &ReducedModel,
+    a: &[L],
+    a_dot: &[L],
+    m: usize,
+    links: LinkTrig<'_>,
+    terms: Terms<'_, L>,
+) {
+    let width = L::WIDTH;
+    let zero = L::splat(context, 0.0);
     let (a, a_dot) = (&a[..m], &a_dot[..m]);
-    let mass = &mut work.mass[..m * m];
-    let coriolis = &mut work.coriolis[..m];
-    let gravity = &mut work.gravity[..m];
-    let joint = &mut work.joint[..m];
-    let cos_moment = &mut work.cos_moment[..m];
-    mass.fill(0.0);
-    coriolis.fill(0.0);
-    gravity.fill(0.0);
-    joint.fill([0.0; 2]);
-    // First pass: absolute angles, their sines and cosines, squared rates.
-    let LinkBuffers {
-        angle,
-        sin,
-        cos,
-        rate_squared,
-        force,
-    } = work.links;
-    for (((angle, rate_squared), phi), link) in angle
-        .iter_mut()
-        .zip(rate_squared.iter_mut())
-        .zip(model.angle_rows().chunks_exact(m))
-        .zip(model.link_constants())
+    let mass = &mut terms.mass[..m * m];
+    let coriolis = &mut terms.coriolis[..m];
+    let gravity = &mut terms.gravity[..m];
+    let joint = &mut terms.joint[..m];
+    let cos_moment = &mut terms.cos_moment[..m];
+    mass.fill(zero);
+    coriolis.fill(zero);
+    gravity.fill(zero);
+    joint.fill([zero; 2]);
+    let constants = model.link_constants();
+    let rows = model.angle_rows();
+    let size = constants.len() * width;
+    let (angle, sin, cos) = (
+        &mut links.angle[..size],
+        &mut links.sin[..size],
+        &mut links.cos[..size],
+    );
+    // Absolute angles, then their sines and cosines, all links at once.
+    for ((angle, phi), link) in angle
+        .chunks_exact_mut(width)
+        .zip(rows.chunks_exact(m))
+        .zip(constants)
     {
         let phi = &phi[..m];
-        let mut phi_l = link.angle_offset;
-        let mut rate = 0.0;
+        let mut phi_l = L::splat(context, link.angle_offset);
         for k in 0..m {
-            phi_l += phi[k] * a[k];
-            rate += phi[k] * a_dot[k];
+            phi_l = phi_l + a[k] * phi[k];
         }
-        *angle = phi_l;
-        *rate_squared = rate * rate;
+        phi_l.store(angle);
     }
     sin_cos(angle, sin, cos);
-    // Second pass, from the base: P_l and M*; q_l and the first part of c_l.
-    let mut q = [0.0; 2];
-    for (((((link, phi), &sin), &cos), &rate2), force) in model
-        .link_constants()
+    // One pass from the base: P_l, q_l, and the sums of M*, C* and G*.
+    let mut q = [zero; 2];
+    for (((link, phi), sin), cos) in constants
         .iter()
-        .zip(model.angle_rows().chunks_exact(m))
-        .zip(sin.iter())
-        .zip(cos.iter())
-        .zip(rate_squared.iter())
-        .zip(force.iter_mut())
+        .zip(rows.chunks_exact(m))
+        .zip(sin.chunks_exact(width))
+        .zip(cos.chunks_exact(width))
     {
         let phi = &phi[..m];
+        let (sin, cos) = (L::load(context, sin), L::load(context, cos));
+        let mut rate = zero;
+        for k in 0..m {
+            rate = rate + a_dot[k] * phi[k];
+        }
+        let rate2 = rate * rate;
         let moment = link.first_moment;
+        // S_l (w_l . q_l), S_l phi_dot_l^2 and S_l cos(phi_l).
+        let force = (cos * q[1] - sin * q[0]) * moment;
+        let moment_rate2 = rate2 * moment;
+        let gravity_force = cos * moment;
         for k in 0..m {
             let [px, py] = joint[k];
-            cos_moment[k] = moment * (cos * py - sin * px);
+            cos_moment[k] = (cos * py - sin * px) * moment;
+            let along = cos * px + sin * py;
+            coriolis[k] = coriolis[k] + force * phi[k] - moment_rate2 * along;
+            gravity[k] = gravity[k] + gravity_force * phi[k];
         }
         for j in 0..m {
             for k in j..m {
-                mass[j * m + k] += phi[j] * cos_moment[k] + cos_moment[j] * phi[k];
+                mass[j * m + k] =
+                    mass[j * m + k] + (cos_moment[k] * phi[j] + cos_moment[j] * phi[k]);
             }
         }
-        *force = moment * (cos * q[1] - sin * q[0]);
-        let (l_sin, l_cos) = (link.length * sin, link.length * cos);
+        let (l_sin, l_cos) = (sin * link.length, cos * link.length);
         for k in 0..m {
-            joint[k][0] -= l_sin * phi[k];
-            joint[k][1] += l_cos * phi[k];
+            joint[k][0] = joint[k][0] - l_sin * phi[k];
+            joint[k][1] = joint[k][1] + l_cos * phi[k];
         }
-        q[0] -= l_cos * rate2;
-        q[1] -= l_sin * rate2;
+        q[0] = q[0] - l_cos * rate2;
+        q[1] = q[1] - l_sin * rate2;
     }
-    // Third pass, from the tip: R_l, the rest of c_l, and C* = Phi^T c, G* / g = Phi^T (S cos).
-    let mut r = [0.0; 2];
-    for (((((link, phi), &sin), &cos), &rate2), &force) in model
-        .link_constants()
-        .iter()
-        .zip(model.angle_rows().chunks_exact(m))
-        .zip(sin.iter())
-        .zip(cos.iter())
-        .zip(rate_squared.iter())
-        .zip(force.iter())
-        .rev()
-    {
-        let phi = &phi[..m];
-        let coriolis_force = force - link.length * (cos * r[1] - sin * r[0]);
-        let gravity_force = link.first_moment * cos;
-        for k in 0..m {
-            coriolis[k] += coriolis_force * phi[k];
-            gravity[k] += gravity_force * phi[k];
-        }
-        let moment_rate2 = link.first_moment * rate2;
-        r[0] += moment_rate2 * cos;
-        r[1] += moment_rate2 * sin;
-    }
-}
-
-/// Adds the constant part `K` to `M*` and mirrors its upper triangle; scales `G*` by `g`.
-#[inline(always)]
-fn finish(model: &ReducedModel, m: usize, data: &mut ReducedData) {
+    // The constant part K of M*, the lower triangle, and G* = g (...).
     let constant = model.constant_mass();
     let g = model.chain().gravity();
     for j in 0..m {
         for k in j..m {
-            let entry = data.mass[j * m + k] + constant[j * m + k];
-            data.mass[j * m + k] = entry;
-            data.mass[k * m + j] = entry;
+            let entry = mass[j * m + k] + L::splat(context, constant[j * m + k]);
+            mass[j * m + k] = entry;
+            mass[k * m + j] = entry;
         }
-        data.gravity[j] *= g;
+        gravity[j] = gravity[j] * g;
     }
 }

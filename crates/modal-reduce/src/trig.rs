@@ -49,7 +49,9 @@ const COS: [f64; 7] = [
     1.0 / 20922789888000.0,
 ];
 
-/// `sin[i] = sin(angles[i])` and `cos[i] = cos(angles[i])` (slices of equal length).
+/// `sin[i] = sin(angles[i])` and `cos[i] = cos(angles[i])` (slices of equal length). Inlined,
+/// so that inside a batch it vectorises with the batch's instruction set.
+#[inline(always)]
 pub(crate) fn sin_cos(angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
     let (sin, cos) = (&mut sin[..angles.len()], &mut cos[..angles.len()]);
     let mut any_large = false;

@@ -111,7 +111,7 @@ fn rows() -> Vec<Row<KinError>> {
             "huge_link_count",
             ModalMap::new(&vec![0.1; MAX_LINKS + 1], 1, BaseAngle::Free).unwrap_err(),
             |e| matches!(e, KinError::TooMany { what: "links", .. }),
-            "at most 4096 links are supported, got 4097",
+            "at most 1000000 links are supported, got 1000001",
         ),
         words(
             "huge_harmonic_count",

@@ -108,14 +108,14 @@ fn model_rows() -> Vec<Row<DynError>> {
     for n in [MAX_LINKS + 1, 1_000_000_000, usize::MAX] {
         let error = ChainModel::uniform(n, 0.1, 0.1, 9.81).unwrap_err();
         assert!(
-            matches!(error, DynError::TooManyLinks { got, max: MAX_LINKS } if got == n),
+            matches!(error, DynError::TooManyLinks { got, max: MAX_LINKS, .. } if got == n),
             "{error:?}"
         );
         rows.push(words(
             "huge_link_count",
             error,
             |e| matches!(e, DynError::TooManyLinks { .. }),
-            &["at most 4096 links"],
+            &["a chain may have at most 1000000 links"],
         ));
     }
     for length in [0.0, -0.1, f64::NAN, f64::INFINITY] {

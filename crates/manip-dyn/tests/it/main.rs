@@ -1,7 +1,8 @@
 //! The integration tests of manip-dyn, one binary: `closed_form` (one- and two-link arms by
 //! hand), `properties` (each algorithm against an independent one over random arms),
-//! `derivatives` (the analytic derivatives against finite differences), `bad_input` for every
-//! refusal, `allocation` for the allocation-free algorithms and `common` for shared helpers.
+//! `derivatives` (the analytic derivatives against finite differences), `dense_limit` (the `n x n`
+//! algorithms refuse chains beyond `MAX_DENSE_LINKS`, no workspace holds `n x n` memory for them),
+//! `bad_input` for every refusal, `allocation` for the allocation-free algorithms and `common` for shared helpers.
 
 // Counts each thread's allocations; the allocation tests measure their own thread only, so the
 // other tests of this binary may run in parallel.
@@ -12,5 +13,6 @@ mod allocation;
 mod bad_input;
 mod closed_form;
 mod common;
+mod dense_limit;
 mod derivatives;
 mod properties;

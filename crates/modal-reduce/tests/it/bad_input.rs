@@ -82,7 +82,7 @@ fn model_rows() -> Vec<Row<ReduceError>> {
             "huge_link_count_is_refused_upstream",
             ModalMap::paper(usize::MAX).unwrap_err().into(),
             |e| matches!(e, ReduceError::Kin(KinError::TooMany { what: "links", .. })),
-            "modal map: at most 4096 links",
+            "modal map: at most 1000000 links",
         ),
     ];
     for n in [1, 2] {

@@ -326,7 +326,7 @@ mod regressions {
     fn a_huge_link_count_is_refused_before_allocating() {
         assert_eq!(
             build_error("arm = { links = 1000000000000 }"),
-            "arm.links must be at most 4096, got 1000000000000"
+            "arm.links must be at most 1000000, got 1000000000000"
         );
     }
 

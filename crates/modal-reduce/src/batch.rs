@@ -1,0 +1,256 @@
+//! Reduced forward dynamics (eq 15) of many independent states at once, SIMD across states.
+//!
+//! The states of a batch are taken `W` at a time, `W` the number of `f64` lanes of the widest
+//! instruction set the processor has (8 with AVX-512, 4 with AVX2; chosen at run time by
+//! [`pulp::Arch`], so one binary runs everywhere), and each group runs through the same kernel as
+//! one state ([`crate::terms`], [`crate::small_linalg`]), written once over
+//! [`Lane`](crate::lanes::Lane): lane `i` of every register holds state `i` of the group
+//! (structure of arrays). The operations, and their order, are those of the one-state path, so
+//! each state's result is the same.
+//!
+//! A group whose inputs are not all finite, or one of whose states fails (a non-positive pivot,
+//! an overflow), is redone one state at a time by [`forward_dynamics`], which names the failure;
+//! so are the states left over after the last whole group, and every state of a model with more
+//! than [`MAX_BATCH_COORDS`] coordinates.
+
+use pulp::{Arch, Simd, WithSimd};
+
+use crate::data::ReducedData;
+use crate::error::{ReduceError, check_len};
+use crate::forward::forward_dynamics;
+use crate::lanes::{Lane, Pack};
+use crate::model::ReducedModel;
+use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
+use crate::terms::{LinkTrig, Terms, accumulate};
+
+/// The most `f64` lanes of a SIMD register (AVX-512).
+const MAX_WIDTH: usize = 8;
+
+/// The most modal coordinates evaluated SIMD across states (`K = 2` harmonics with `alpha0`
+/// free); larger models run their batches one state at a time.
+pub const MAX_BATCH_COORDS: usize = 5;
+
+/// Why a batch was refused: its slices do not hold whole states, or one state failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum BatchError {
+    /// The slices do not hold the same whole number of states of `m` values each.
+    #[error(transparent)]
+    Shape(ReduceError),
+    /// The state at this index (0-based; the lowest one that failed) was refused.
+    #[error("state {state}: {error}")]
+    State {
+        /// 0-based index of the state in the batch.
+        state: usize,
+        /// Why [`forward_dynamics`] refused it.
+        error: ReduceError,
+    },
+}
+
+/// Workspace of [`forward_dynamics_batch`] for one [`ReducedModel`]: create it once, reuse it for
+/// every batch. Its memory is `O(n)` like a [`ReducedData`]'s (which it holds, for the states
+/// evaluated one at a time) plus three buffers of `n` values per lane (`192 n` bytes).
+#[derive(Debug, Clone)]
+pub struct ReducedBatchData {
+    /// Per link and lane (`[link][lane]`, `MAX_WIDTH` lanes): absolute angle, sine, cosine.
+    angle: Vec<f64>,
+    sin: Vec<f64>,
+    cos: Vec<f64>,
+    /// The one-state workspace.
+    single: ReducedData,
+    /// The instruction set found at construction.
+    arch: Arch,
+}
+
+impl ReducedBatchData {
+    /// A workspace sized for `model`, for the instruction set of this processor.
+    pub fn new(model: &ReducedModel) -> Self {
+        let size = model.n_links() * MAX_WIDTH;
+        Self {
+            angle: vec![0.0; size],
+            sin: vec![0.0; size],
+            cos: vec![0.0; size],
+            single: ReducedData::new(model),
+            arch: Arch::new(),
+        }
+    }
+}
+
+/// [`forward_dynamics`] of a batch of states: `a`, `a_dot`, `tau_star` and `a_ddot` hold `N`
+/// states of `m` values each, state after state (row-major `N x m`), and state `i` of `a_ddot`
+/// gets what `forward_dynamics` gives for state `i` of the inputs.
+///
+/// SIMD across states (see the [module documentation](self)); allocation-free. On an error
+/// `a_ddot` is unspecified.
+///
+/// ```
+/// use backbone_kin::ModalMap;
+/// use manip_dyn::ChainModel;
+/// use modal_reduce::{ReducedBatchData, ReducedData, ReducedModel, forward_dynamics, forward_dynamics_batch};
+///
+/// let model = ReducedModel::new(ChainModel::uniform(10, 0.1, 0.1, 9.81)?, ModalMap::paper(10)?)?;
+/// let states = 11;
+/// let a: Vec<f64> = (0..3 * states).map(|i| 0.1 * (i as f64).sin()).collect();
+/// let a_dot: Vec<f64> = (0..3 * states).map(|i| 0.2 * (i as f64).cos()).collect();
+/// let tau_star = vec![0.05; 3 * states];
+/// let mut a_ddot = vec![0.0; 3 * states];
+/// forward_dynamics_batch(&model, &mut ReducedBatchData::new(&model), &a, &a_dot, &tau_star, &mut a_ddot)?;
+/// let (mut data, mut one) = (ReducedData::new(&model), [0.0; 3]);
+/// forward_dynamics(&model, &mut data, &a[30..], &a_dot[30..], &tau_star[30..], &mut one)?;
+/// assert_eq!(&a_ddot[30..], one.as_slice());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn forward_dynamics_batch(
+    model: &ReducedModel,
+    data: &mut ReducedBatchData,
+    a: &[f64],
+    a_dot: &[f64],
+    tau_star: &[f64],
+    a_ddot: &mut [f64],
+) -> Result<(), BatchError> {
+    data.single.check_model(model).map_err(BatchError::Shape)?;
+    let m = model.n_coords();
+    let values = a.len() - a.len() % m;
+    let shape = |name, found| check_len(name, found, values).map_err(BatchError::Shape);
+    shape("a (whole states of m values)", a.len())?;
+    shape("a_dot (as many values as a)", a_dot.len())?;
+    shape("tau_star (as many values as a)", tau_star.len())?;
+    shape("a_ddot (as many values as a)", a_ddot.len())?;
+    let arch = data.arch;
+    arch.dispatch(Batch {
+        model,
+        data,
+        inputs: [a, a_dot, tau_star],
+        a_ddot,
+    })
+}
+
+/// One batch, run by [`pulp::Arch::dispatch`] with the processor's instruction set.
+struct Batch<'a> {
+    model: &'a ReducedModel,
+    data: &'a mut ReducedBatchData,
+    /// `a`, `a_dot`, `tau_star`.
+    inputs: [&'a [f64]; 3],
+    a_ddot: &'a mut [f64],
+}
+
+impl WithSimd for Batch<'_> {
+    type Output = Result<(), BatchError>;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(mut self, simd: S) -> Self::Output {
+        match self.model.n_coords() {
+            2 => self.run::<S, 2>(simd),
+            3 => self.run::<S, 3>(simd),
+            4 => self.run::<S, 4>(simd),
+            5 => self.run::<S, 5>(simd),
+            _ => self.one_at_a_time(0),
+        }
+    }
+}
+
+impl Batch<'_> {
+    /// Whole groups of `S::F64_LANES` states in SIMD, the rest one at a time.
+    #[inline(always)]
+    fn run<S: Simd, const M: usize>(mut self, simd: S) -> Result<(), BatchError> {
+        let width = S::F64_LANES;
+        if width > MAX_WIDTH {
+            return self.one_at_a_time(0);
+        }
+        let states = self.a_ddot.len() / M;
+        let grouped = states - states % width;
+        for first in (0..grouped).step_by(width) {
+            let range = first * M..(first + width) * M;
+            let inputs = self.inputs.map(|x| &x[range.clone()]);
+            let links = LinkTrig {
+                angle: &mut self.data.angle,
+                sin: &mut self.data.sin,
+                cos: &mut self.data.cos,
+            };
+            let out = &mut self.a_ddot[range];
+            if !group::<S, M>(simd, self.model, links, inputs, out) {
+                self.states(first, first + width)?;
+            }
+        }
+        self.one_at_a_time(grouped)
+    }
+
+    /// States `first..` one at a time.
+    fn one_at_a_time(&mut self, first: usize) -> Result<(), BatchError> {
+        let states = self.a_ddot.len() / self.model.n_coords();
+        self.states(first, states)
+    }
+
+    /// States `first..last` one at a time, by [`forward_dynamics`].
+    fn states(&mut self, first: usize, last: usize) -> Result<(), BatchError> {
+        let m = self.model.n_coords();
+        for state in first..last {
+            let range = state * m..(state + 1) * m;
+            let [a, a_dot, tau_star] = self.inputs.map(|x| &x[range.clone()]);
+            forward_dynamics(
+                self.model,
+                &mut self.data.single,
+                a,
+                a_dot,
+                tau_star,
+                &mut self.a_ddot[range],
+            )
+            .map_err(|error| BatchError::State { state, error })?;
+        }
+        Ok(())
+    }
+}
+
+/// One group of `S::F64_LANES` states (`inputs` and `out` hold exactly those): gathers the
+/// inputs into lanes, runs the kernel and scatters the accelerations. `false` if an input is not
+/// finite or any state failed (`out` is then unspecified).
+#[inline(always)]
+fn group<S: Simd, const M: usize>(
+    simd: S,
+    model: &ReducedModel,
+    links: LinkTrig<'_>,
+    inputs: [&[f64]; 3],
+    out: &mut [f64],
+) -> bool {
+    let width = S::F64_LANES;
+    if !inputs.iter().all(|x| x.iter().all(|v| v.is_finite())) {
+        return false;
+    }
+    let mut buffer = [0.0; MAX_WIDTH];
+    let mut gather = |values: &[f64], k: usize| {
+        for (lane, slot) in buffer[..width].iter_mut().enumerate() {
+            *slot = values[lane * M + k];
+        }
+        Pack::<S>::load(simd, &buffer)
+    };
+    let a: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[0], k));
+    let a_dot: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[1], k));
+    let tau_star: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[2], k));
+    let zero = Pack::splat(simd, 0.0);
+    let mut mass = [[zero; M]; M];
+    let (mut coriolis, mut gravity, mut cos_moment) = ([zero; M], [zero; M], [zero; M]);
+    let mut joint = [[zero; 2]; M];
+    let terms = Terms {
+        mass: mass.as_flattened_mut(),
+        coriolis: &mut coriolis,
+        gravity: &mut gravity,
+        joint: &mut joint,
+        cos_moment: &mut cos_moment,
+    };
+    accumulate(simd, model, &a, &a_dot, M, links, terms);
+    // The right-hand side tau* - C* - G* and the solve, as in `forward_dynamics`.
+    let mut x: [Pack<S>; M] = std::array::from_fn(|k| tau_star[k] - coriolis[k] - gravity[k]);
+    if !ldlt_in_place(simd, mass.as_flattened_mut(), M) {
+        return false;
+    }
+    ldlt_solve_in_place(mass.as_flattened(), M, &mut x);
+    let mut finite = true;
+    for (k, value) in x.iter().enumerate() {
+        value.store(&mut buffer);
+        for (lane, &v) in buffer[..width].iter().enumerate() {
+            finite &= v.is_finite();
+            out[lane * M + k] = v;
+        }
+    }
+    finite
+}

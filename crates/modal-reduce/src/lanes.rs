@@ -1,0 +1,159 @@
+//! The number type the default path is written in: one state (`f64`) or several states side by
+//! side in a SIMD register ([`Pack`]), so that one kernel serves [`forward_dynamics`] and
+//! [`forward_dynamics_batch`].
+//!
+//! Both implementations do exactly the same operations in the same order (no fused multiply-add),
+//! so a state gives the same bits whether it is computed alone or in a batch.
+//!
+//! [`forward_dynamics`]: crate::forward_dynamics
+//! [`forward_dynamics_batch`]: crate::forward_dynamics_batch
+
+use std::ops::{Add, Div, Mul, Sub};
+
+use pulp::Simd;
+
+/// A real number of `WIDTH` independent states: the arithmetic of the kernels, plus loads and
+/// stores from `[f64]` slices holding the `WIDTH` values side by side.
+pub(crate) trait Lane:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Mul<f64, Output = Self>
+{
+    /// How many states one value holds.
+    const WIDTH: usize;
+    /// What building a value needs (the SIMD token for [`Pack`], nothing for `f64`).
+    type Context: Copy;
+    /// `x` in every lane.
+    fn splat(context: Self::Context, x: f64) -> Self;
+    /// The value whose lanes are `slice[..WIDTH]`.
+    fn load(context: Self::Context, slice: &[f64]) -> Self;
+    /// Writes the lanes into `slice[..WIDTH]`.
+    fn store(self, slice: &mut [f64]);
+    /// Whether every lane is positive and finite (a usable pivot).
+    fn all_positive_finite(self) -> bool;
+}
+
+impl Lane for f64 {
+    const WIDTH: usize = 1;
+    type Context = ();
+
+    #[inline(always)]
+    fn splat((): (), x: f64) -> Self {
+        x
+    }
+
+    #[inline(always)]
+    fn load((): (), slice: &[f64]) -> Self {
+        slice[0]
+    }
+
+    #[inline(always)]
+    fn store(self, slice: &mut [f64]) {
+        slice[0] = self;
+    }
+
+    #[inline(always)]
+    fn all_positive_finite(self) -> bool {
+        self > 0.0 && self.is_finite()
+    }
+}
+
+/// `S::F64_LANES` states in one SIMD register of the instruction set `S` (8 with AVX-512, 4 with
+/// AVX2, 1 without either), chosen at run time by [`pulp::Arch`].
+#[derive(Clone, Copy)]
+pub(crate) struct Pack<S: Simd> {
+    simd: S,
+    value: S::f64s,
+}
+
+impl<S: Simd> Add for Pack<S> {
+    type Output = Self;
+
+    #[inline(always)]
+    fn add(self, other: Self) -> Self {
+        Self {
+            simd: self.simd,
+            value: self.simd.add_f64s(self.value, other.value),
+        }
+    }
+}
+
+impl<S: Simd> Sub for Pack<S> {
+    type Output = Self;
+
+    #[inline(always)]
+    fn sub(self, other: Self) -> Self {
+        Self {
+            simd: self.simd,
+            value: self.simd.sub_f64s(self.value, other.value),
+        }
+    }
+}
+
+impl<S: Simd> Mul for Pack<S> {
+    type Output = Self;
+
+    #[inline(always)]
+    fn mul(self, other: Self) -> Self {
+        Self {
+            simd: self.simd,
+            value: self.simd.mul_f64s(self.value, other.value),
+        }
+    }
+}
+
+impl<S: Simd> Div for Pack<S> {
+    type Output = Self;
+
+    #[inline(always)]
+    fn div(self, other: Self) -> Self {
+        Self {
+            simd: self.simd,
+            value: self.simd.div_f64s(self.value, other.value),
+        }
+    }
+}
+
+impl<S: Simd> Mul<f64> for Pack<S> {
+    type Output = Self;
+
+    #[inline(always)]
+    fn mul(self, other: f64) -> Self {
+        self * Self::splat(self.simd, other)
+    }
+}
+
+impl<S: Simd> Lane for Pack<S> {
+    const WIDTH: usize = S::F64_LANES;
+    type Context = S;
+
+    #[inline(always)]
+    fn splat(simd: S, x: f64) -> Self {
+        Self {
+            simd,
+            value: simd.splat_f64s(x),
+        }
+    }
+
+    #[inline(always)]
+    fn load(simd: S, slice: &[f64]) -> Self {
+        Self {
+            simd,
+            value: S::as_simd_f64s(&slice[..Self::WIDTH]).0[0],
+        }
+    }
+
+    #[inline(always)]
+    fn store(self, slice: &mut [f64]) {
+        S::as_mut_simd_f64s(&mut slice[..Self::WIDTH]).0[0] = self.value;
+    }
+
+    #[inline(always)]
+    fn all_positive_finite(self) -> bool {
+        let lanes: &[f64] = pulp::bytemuck::cast_slice(std::slice::from_ref(&self.value));
+        lanes.iter().all(|&x| x > 0.0 && x.is_finite())
+    }
+}
