@@ -168,7 +168,9 @@ pub fn test_references(text: &str) -> Vec<TestReference> {
             continue;
         }
         let item = item.trim();
-        let names = match item.strip_prefix('{').and_then(|i| i.strip_suffix('}')) {
+        // `path::{a, b}`: the names in the braces (after any module path such as `tests::`).
+        let braces = item.find('{').map_or(item, |at| &item[at..]);
+        let names = match braces.strip_prefix('{').and_then(|i| i.strip_suffix('}')) {
             Some(list) => list.split(',').map(str::trim).collect(),
             None => vec![item],
         };
@@ -428,7 +430,8 @@ mod tests {
     fn test_references_are_parsed_in_every_form() {
         let doc = "| a | b | `manip-dyn/tests/bad_input.rs::non_finite_gravity` |\n\
                    | c | `fuzzy-sugeno/src/learn/genfis.rs::tests::bad_requests` |\n\
-                   `hrm-cli/tests/eval_stream.rs::{one, two_three}` and `<crate>/tests/<file>.rs::<test>` \
+                   `hrm-cli/tests/eval_stream.rs::{one, two_three}` and \
+                   `sim-core/src/a.rs::tests::{four, five}` and `<crate>/tests/<file>.rs::<test>` \
                    and `Scenario::build` and `docs/sweep.md`";
         assert_eq!(
             test_references(doc),
@@ -444,6 +447,10 @@ mod tests {
                 TestReference {
                     file: "hrm-cli/tests/eval_stream.rs".into(),
                     names: vec!["one".into(), "two_three".into()],
+                },
+                TestReference {
+                    file: "sim-core/src/a.rs".into(),
+                    names: vec!["four".into(), "five".into()],
                 },
             ]
         );

@@ -80,8 +80,8 @@ impl ReducedBatchData {
 /// states of `m` values each, state after state (row-major `N x m`), and state `i` of `a_ddot`
 /// gets what `forward_dynamics` gives for state `i` of the inputs.
 ///
-/// SIMD across states (see the [module documentation](self)); allocation-free. On an error
-/// `a_ddot` is unspecified.
+/// SIMD across states (structure of arrays, the instruction set chosen at run time);
+/// allocation-free. On an error `a_ddot` is unspecified.
 ///
 /// ```
 /// use backbone_kin::ModalMap;

@@ -76,7 +76,7 @@ pub fn execute(config: &SweepConfig, id: &RunId) -> RunResult {
     RunResult::new(id, outcome)
 }
 
-/// Runs the runs of `shard` in parallel (rayon), in batches of [`BATCH_RUNS`], calling
+/// Runs the runs of `shard` in parallel (rayon), in batches of `BATCH_RUNS` (1024), calling
 /// `progress` after each run and `sink` with each result in index order; stops at the first
 /// error of `sink`. Only one batch of results is held at a time.
 pub fn for_each_run(
