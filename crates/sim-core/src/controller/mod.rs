@@ -1,7 +1,8 @@
 //! Controllers of the `m` modal coordinates, behind one trait: the paper's fuzzy controller
 //! (eqs 19-24, Figure 8) applied per coordinate pair or any `.fis` system with `2m` inputs and
 //! `m` outputs, its linearisation at the origin (PD), computed torque with the exact reduced
-//! model, and the fuzzy controller plus gravity compensation `G*`.
+//! model, the fuzzy controller plus gravity compensation `G*`, and model-predictive control
+//! under `tau*` limits ([`MpcController`]).
 //!
 //! The closed loop samples a controller at its own period and holds its output in between
 //! (zero-order hold). At each sample it hands the controller a [`ControlContext`] that borrows
@@ -33,10 +34,12 @@
 
 mod computed_torque;
 mod fuzzy;
+mod mpc;
 mod pd;
 
 pub use computed_torque::ComputedTorque;
 pub use fuzzy::FuzzyController;
+pub use mpc::MpcController;
 pub use pd::PdController;
 
 use crate::error::SimError;
