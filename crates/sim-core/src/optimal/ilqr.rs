@@ -477,9 +477,9 @@ impl Ilqr {
                 Err(other) => return Err(other),
             };
             iterations += 1;
-            if mu <= settings.min_regularisation
-                && (self.feedforward_size() < settings.gradient_tolerance
-                    || -(expected[0] + expected[1]) <= settings.tolerance * cost.abs())
+            if (mu <= settings.min_regularisation
+                && self.feedforward_size() < settings.gradient_tolerance)
+                || -(expected[0] + expected[1]) <= settings.tolerance * cost.abs()
             {
                 converged = true;
                 break;
