@@ -40,7 +40,7 @@ enum Command {
         /// Scenario name or path.
         #[arg(long)]
         scenario: String,
-        /// Override the scenario's controller: fuzzy, pd, computed-torque, fuzzy-gc or mpc.
+        /// Override the scenario's controller: fuzzy, pd, computed-torque or fuzzy-gc.
         #[arg(long)]
         controller: Option<String>,
         /// Output folder.

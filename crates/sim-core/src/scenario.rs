@@ -27,7 +27,7 @@
 //! target = [0.2, -0.2]
 //! time = 0.1
 //!
-//! [controller]            # kind = "fuzzy" | "pd" | "computed-torque" | "fuzzy-gc" | "mpc"
+//! [controller]            # kind = "fuzzy" | "pd" | "computed-torque" | "fuzzy-gc"
 //! kind = "fuzzy"
 //! period = 0.0001         # s, default: the RK4 step
 //! # kp = [2500.0, 2500.0]   computed torque (1/s^2), kd = [100.0, 100.0] (1/s)
@@ -47,12 +47,9 @@
 //! joint_torque_nm = 5.0   # or one limit per joint
 //! ```
 
-use crate::controller::{
-    ComputedTorque, Controller, FuzzyController, ModalState, MpcController, PdController,
-};
+use crate::controller::{ComputedTorque, Controller, FuzzyController, ModalState, PdController};
 use crate::error::SimError;
 use crate::ode::Tolerances;
-use crate::optimal::MpcSettings;
 use crate::reference::{CartesianPath, PathShape, Reference, Sinusoid, Step};
 use crate::simulation::{Integrator, LoopSettings, Simulation};
 use backbone_kin::{BaseAngle, Branch, ModalMap};
@@ -381,10 +378,6 @@ pub enum ControllerKind {
     ComputedTorque,
     /// The fuzzy controller plus gravity compensation `G*`.
     FuzzyGc,
-    /// Model-predictive control: control-limited iLQR over a receding horizon
-    /// ([`MpcController`], [`MpcSettings::uniform`]); not in [`ALL`](Self::ALL), the paper's
-    /// comparison.
-    Mpc,
 }
 
 impl ControllerKind {
@@ -403,7 +396,6 @@ impl ControllerKind {
             ControllerKind::Pd => "pd",
             ControllerKind::ComputedTorque => "computed-torque",
             ControllerKind::FuzzyGc => "fuzzy-gc",
-            ControllerKind::Mpc => "mpc",
         }
     }
 }
@@ -417,16 +409,15 @@ impl fmt::Display for ControllerKind {
 impl FromStr for ControllerKind {
     type Err = SimError;
 
-    /// Parses `fuzzy`, `pd`, `computed-torque`, `fuzzy-gc` or `mpc`.
+    /// Parses `fuzzy`, `pd`, `computed-torque` or `fuzzy-gc`.
     fn from_str(s: &str) -> Result<Self, SimError> {
         Self::ALL
             .into_iter()
-            .chain([ControllerKind::Mpc])
             .find(|k| k.name() == s)
             .ok_or_else(|| {
                 SimError::setting(
                     "controller",
-                    format!("must be one of fuzzy, pd, computed-torque, fuzzy-gc, mpc, got '{s}'"),
+                    format!("must be one of fuzzy, pd, computed-torque, fuzzy-gc, got '{s}'"),
                 )
             })
     }
@@ -708,16 +699,13 @@ impl Scenario {
     pub fn build(&self) -> Result<Simulation, SimError> {
         let model = self.model()?;
         let m = model.n_coords();
-        let build_reference = || {
-            self.reference.build(
-                model.chain().total_length(),
-                self.modal.harmonics,
-                self.alpha0,
-                m,
-            )
-        };
-        let reference = build_reference()?;
-        let controller = self.controller.build(&model, &build_reference)?;
+        let reference = self.reference.build(
+            model.chain().total_length(),
+            self.modal.harmonics,
+            self.alpha0,
+            m,
+        )?;
+        let controller = self.controller.build(&model)?;
         let period = match (self.controller.period, self.integrator) {
             (Some(period), _) => period,
             (None, IntegratorSpec::Rk4 { dt }) => dt,
@@ -934,12 +922,7 @@ impl ControllerSpec {
     }
 
     /// The controller for `model`'s `m` coordinates; every gain array must have `m` entries.
-    /// `reference` builds a copy of the loop's reference, for the controllers that preview it.
-    fn build(
-        &self,
-        model: &ReducedModel,
-        reference: &dyn Fn() -> Result<Box<dyn Reference>, SimError>,
-    ) -> Result<Box<dyn Controller>, SimError> {
+    fn build(&self, model: &ReducedModel) -> Result<Box<dyn Controller>, SimError> {
         let m = model.n_coords();
         let gains = |name: &str, values: &Option<Vec<f64>>, default: f64| {
             per_coordinate(name, values.as_deref(), m)
@@ -961,11 +944,6 @@ impl ControllerSpec {
             ControllerKind::FuzzyGc => Box::new(
                 FuzzyController::new(self.fuzzy_system()?, m)?.with_gravity_compensation(model)?,
             ),
-            ControllerKind::Mpc => Box::new(MpcController::new(
-                model,
-                &MpcSettings::uniform(m),
-                reference()?,
-            )?),
         })
     }
 }

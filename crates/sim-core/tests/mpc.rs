@@ -17,7 +17,7 @@ use sim_core::optimal::{
     ReducedEuler, TrackingCost,
 };
 use sim_core::reference::{Reference, ReferencePreview, ReferenceSample, Sinusoid, Step};
-use sim_core::{ControllerKind, Integrator, LoopSettings, Scenario, Simulation};
+use sim_core::{Integrator, LoopSettings, Simulation};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
@@ -884,24 +884,5 @@ fn mpc_control_calls_allocate_nothing() {
         for t in [0.0, 0.001, 0.01, 0.015, 0.02, 0.05, 0.0505, 0.0] {
             assert_eq!(count(t, &mut controller), 0, "m = {m}, t = {t}");
         }
-    }
-}
-
-#[test]
-fn scenarios_run_mpc_by_name() {
-    let kind: ControllerKind = "mpc".parse().unwrap();
-    assert_eq!(kind.name(), "mpc");
-    let err = "mcp".parse::<ControllerKind>().unwrap_err();
-    assert!(err.to_string().contains("mpc"), "{err}");
-    for name in ["paper-tracking", "free-base-tracking"] {
-        let mut scenario = Scenario::builtin(name).unwrap();
-        scenario.controller.kind = kind;
-        scenario.duration = 0.2;
-        let run = scenario.build().unwrap().run().unwrap();
-        assert!(
-            run.summary.tip_error_rms_m < 5e-3,
-            "{name}: tip RMS {} m",
-            run.summary.tip_error_rms_m
-        );
     }
 }
