@@ -444,46 +444,7 @@ fn sort_dedup(points: &mut Vec<f64>, width: f64) {
 
 /// Where a set's membership changes character: centres, feet, shoulders, half-power points.
 fn set_landmarks(mf: &MembershipFn) -> Vec<f64> {
-    match *mf {
-        MembershipFn::Bell { width, center, .. } => vec![center - width, center, center + width],
-        MembershipFn::Gaussian { sigma, center } => vec![center - sigma, center, center + sigma],
-        MembershipFn::Gaussian2 {
-            sigma1,
-            center1,
-            sigma2,
-            center2,
-        } => {
-            vec![center1 - sigma1, center1, center2, center2 + sigma2]
-        }
-        MembershipFn::Triangle { left, peak, right } => vec![left, peak, right],
-        MembershipFn::Trapezoid {
-            left_foot,
-            left_shoulder,
-            right_shoulder,
-            right_foot,
-        } => {
-            vec![left_foot, left_shoulder, right_shoulder, right_foot]
-        }
-        MembershipFn::Sigmoid { center, .. } => vec![center],
-        MembershipFn::SigmoidDifference {
-            center1, center2, ..
-        }
-        | MembershipFn::SigmoidProduct {
-            center1, center2, ..
-        } => {
-            vec![center1, center2]
-        }
-        MembershipFn::SShape { start, end } | MembershipFn::ZShape { start, end } => {
-            vec![start, 0.5 * (start + end), end]
-        }
-        MembershipFn::PiShape {
-            left_foot,
-            left_shoulder,
-            right_shoulder,
-            right_foot,
-        } => vec![left_foot, left_shoulder, right_shoulder, right_foot],
-        MembershipFn::Constant { .. } => Vec::new(),
-    }
+    (mf.kind().landmarks)(&mf.param_array().0)
 }
 
 /// Each set's position along its axis: the centroid of its membership over the range (1001

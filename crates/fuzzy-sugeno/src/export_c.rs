@@ -18,8 +18,7 @@
 //! On a non-zero return `out` is left untouched, as the evaluator leaves its buffer.
 
 use crate::error::FuzzyError;
-use crate::eval::{EvalOptions, NoRuleFired, OutOfRange};
-use crate::membership::CompiledMf;
+use crate::eval::{CompiledMf, EvalOptions, NoRuleFired, OutOfRange};
 use crate::system::{AndMethod, Defuzzification, FuzzySystem, OrMethod};
 use std::fmt::Write as _;
 

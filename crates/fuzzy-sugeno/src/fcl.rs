@@ -11,7 +11,7 @@
 //! shortest exact form, so writing then reading gives back the identical system.
 
 use crate::error::FuzzyError;
-use crate::membership::MembershipFn;
+use crate::membership::{KINDS, Kind, MembershipFn};
 use crate::system::{
     AndMethod, Antecedent, Connective, Defuzzification, FuzzySet, FuzzySystem, InputVariable,
     Methods, OrMethod, OutputFn, OutputTerm, OutputVariable, Rule,
@@ -183,52 +183,23 @@ impl FuzzySystem {
 /// A term's FCL value: IEC point lists for triangles and trapezoids, fuzzylite's class names
 /// and parameter order otherwise.
 fn term(mf: &MembershipFn) -> String {
+    let (p, _) = mf.param_array();
     match *mf {
-        MembershipFn::Triangle { left, peak, right } => {
-            format!("({left:?}, 0.0) ({peak:?}, 1.0) ({right:?}, 0.0)")
+        MembershipFn::Triangle { .. } => {
+            format!("({:?}, 0.0) ({:?}, 1.0) ({:?}, 0.0)", p[0], p[1], p[2])
         }
-        MembershipFn::Trapezoid {
-            left_foot,
-            left_shoulder,
-            right_shoulder,
-            right_foot,
-        } => format!(
-            "({left_foot:?}, 0.0) ({left_shoulder:?}, 1.0) ({right_shoulder:?}, 1.0) ({right_foot:?}, 0.0)"
+        MembershipFn::Trapezoid { .. } => format!(
+            "({:?}, 0.0) ({:?}, 1.0) ({:?}, 1.0) ({:?}, 0.0)",
+            p[0], p[1], p[2], p[3]
         ),
-        MembershipFn::Bell {
-            width,
-            slope,
-            center,
-        } => format!("Bell {center:?} {width:?} {slope:?}"),
-        MembershipFn::Gaussian { sigma, center } => format!("Gaussian {center:?} {sigma:?}"),
-        MembershipFn::Gaussian2 {
-            sigma1,
-            center1,
-            sigma2,
-            center2,
-        } => format!("GaussianProduct {center1:?} {sigma1:?} {center2:?} {sigma2:?}"),
-        MembershipFn::Sigmoid { slope, center } => format!("Sigmoid {center:?} {slope:?}"),
-        MembershipFn::SigmoidDifference {
-            slope1,
-            center1,
-            slope2,
-            center2,
-        } => format!("SigmoidDifference {center1:?} {slope1:?} {slope2:?} {center2:?}"),
-        MembershipFn::SigmoidProduct {
-            slope1,
-            center1,
-            slope2,
-            center2,
-        } => format!("SigmoidProduct {center1:?} {slope1:?} {slope2:?} {center2:?}"),
-        MembershipFn::SShape { start, end } => format!("SShape {start:?} {end:?}"),
-        MembershipFn::ZShape { start, end } => format!("ZShape {start:?} {end:?}"),
-        MembershipFn::PiShape {
-            left_foot,
-            left_shoulder,
-            right_shoulder,
-            right_foot,
-        } => format!("PiShape {left_foot:?} {left_shoulder:?} {right_shoulder:?} {right_foot:?}"),
-        MembershipFn::Constant { value } => format!("Constant {value:?}"),
+        _ => {
+            let kind = mf.kind();
+            let mut text = kind.fcl.to_string();
+            for &i in kind.fcl_order {
+                let _ = write!(text, " {:?}", p[i]);
+            }
+            text
+        }
     }
 }
 
@@ -761,69 +732,27 @@ fn input_term(line: usize, value: &str) -> Result<MembershipFn, FuzzyError> {
         points(line, value)?
     } else {
         let (class, p) = class_parameters(line, value)?;
-        let expected = match class {
-            "Triangle" | "Bell" => 3,
-            "Gaussian" | "Sigmoid" | "SShape" | "ZShape" => 2,
-            "Trapezoid" | "GaussianProduct" | "SigmoidDifference" | "SigmoidProduct"
-            | "PiShape" => 4,
-            "Constant" => 1,
-            _ if class.parse::<f64>().is_ok() => {
+        let Some(kind) = Kind::by_fcl_class(class) else {
+            if class.parse::<f64>().is_ok() {
                 return Err(error(line, "singleton input terms are not supported"));
             }
-            _ => {
-                return Err(error(
-                    line,
-                    format!(
-                        "input term class '{class}' is not supported; expected a point list or one \
-                         of Triangle, Trapezoid, Bell, Gaussian, GaussianProduct, Sigmoid, \
-                         SigmoidDifference, SigmoidProduct, SShape, ZShape, PiShape, Constant"
-                    ),
-                ));
-            }
+            let classes: Vec<&str> = KINDS.iter().map(|kind| kind.fcl).collect();
+            return Err(error(
+                line,
+                format!(
+                    "input term class '{class}' is not supported; expected a point list or one \
+                     of {}",
+                    classes.join(", ")
+                ),
+            ));
         };
-        arity(line, class, &p, expected)?;
-        match class {
-            "Triangle" => MembershipFn::triangle(p[0], p[1], p[2]),
-            "Trapezoid" => MembershipFn::trapezoid(p[0], p[1], p[2], p[3]),
-            "Bell" => MembershipFn::bell(p[1], p[2], p[0]),
-            "Gaussian" => MembershipFn::gaussian(p[1], p[0]),
-            "GaussianProduct" => MembershipFn::Gaussian2 {
-                sigma1: p[1],
-                center1: p[0],
-                sigma2: p[3],
-                center2: p[2],
-            },
-            "Sigmoid" => MembershipFn::sigmoid(p[1], p[0]),
-            "SigmoidDifference" => MembershipFn::SigmoidDifference {
-                slope1: p[1],
-                center1: p[0],
-                slope2: p[2],
-                center2: p[3],
-            },
-            "SigmoidProduct" => MembershipFn::SigmoidProduct {
-                slope1: p[1],
-                center1: p[0],
-                slope2: p[2],
-                center2: p[3],
-            },
-            // fuzzylite's SShape(start, end), ZShape(start, end) and
-            // PiShape(bottomLeft, topLeft, topRight, bottomRight): MATLAB's order.
-            "SShape" => MembershipFn::SShape {
-                start: p[0],
-                end: p[1],
-            },
-            "ZShape" => MembershipFn::ZShape {
-                start: p[0],
-                end: p[1],
-            },
-            "PiShape" => MembershipFn::PiShape {
-                left_foot: p[0],
-                left_shoulder: p[1],
-                right_shoulder: p[2],
-                right_foot: p[3],
-            },
-            _ => MembershipFn::Constant { value: p[0] },
+        arity(line, class, &p, kind.parameters)?;
+        // fuzzylite's order to MATLAB's.
+        let mut params = [0.0; 4];
+        for (&i, &value) in kind.fcl_order.iter().zip(&p) {
+            params[i] = value;
         }
+        (kind.build)(&params[..kind.parameters])
     };
     mf.validate().map_err(|e| error(line, e.to_string()))?;
     Ok(mf)

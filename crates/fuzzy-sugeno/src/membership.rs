@@ -1,11 +1,15 @@
 //! Membership functions of the input fuzzy sets, with MATLAB's names, parameter order and
 //! formulas (`gbellmf`, `gaussmf`, ...).
 //!
-//! [`MembershipFn`] is the description a user writes; a system compiles each one once, when it is
-//! built, into an evaluation form that picks the cheapest exact formula (for example repeated
-//! squaring instead of `powf` for the integer bell slopes the paper uses).
+//! [`MembershipFn`] is the description a user writes. What the crate knows about each kind
+//! (names in `.fis` and FCL, parameter count and order, constructor, landmarks) is one entry of
+//! `KINDS`, so readers and writers share it instead of matching on the variants. A system
+//! compiles each function once, when it is built, into the evaluation form of `eval.rs`
+//! (`CompiledMf`), which picks the cheapest exact formula (for example repeated squaring instead
+//! of `powf` for the integer bell slopes the paper uses).
 
 use crate::error::FuzzyError;
+use crate::eval::CompiledMf;
 
 /// A membership function `mu(x) in [0, 1]` of one input fuzzy set.
 ///
@@ -170,20 +174,67 @@ impl MembershipFn {
 
     /// MATLAB's name of this type (`"gbellmf"`, `"gaussmf"`, ...).
     pub fn matlab_name(&self) -> &'static str {
-        match self {
-            Self::Bell { .. } => "gbellmf",
-            Self::Gaussian { .. } => "gaussmf",
-            Self::Gaussian2 { .. } => "gauss2mf",
-            Self::Triangle { .. } => "trimf",
-            Self::Trapezoid { .. } => "trapmf",
-            Self::Sigmoid { .. } => "sigmf",
-            Self::SigmoidDifference { .. } => "dsigmf",
-            Self::SigmoidProduct { .. } => "psigmf",
-            Self::SShape { .. } => "smf",
-            Self::ZShape { .. } => "zmf",
-            Self::PiShape { .. } => "pimf",
-            Self::Constant { .. } => "constant",
-        }
+        self.kind().matlab
+    }
+
+    /// This function's kind: its entry in [`KINDS`].
+    pub(crate) fn kind(&self) -> &'static Kind {
+        self.described().0
+    }
+
+    /// The function's kind and its parameters in MATLAB's order (unused slots 0): the one place
+    /// that takes a variant apart, as [`Kind::build`] is the one that puts it together.
+    fn described(&self) -> (&'static Kind, [f64; 4]) {
+        let (index, params) = match *self {
+            Self::Triangle { left, peak, right } => (0, [left, peak, right, 0.0]),
+            Self::Trapezoid {
+                left_foot,
+                left_shoulder,
+                right_shoulder,
+                right_foot,
+            } => (1, [left_foot, left_shoulder, right_shoulder, right_foot]),
+            Self::Bell {
+                width,
+                slope,
+                center,
+            } => (2, [width, slope, center, 0.0]),
+            Self::Gaussian { sigma, center } => (3, [sigma, center, 0.0, 0.0]),
+            Self::Gaussian2 {
+                sigma1,
+                center1,
+                sigma2,
+                center2,
+            } => (4, [sigma1, center1, sigma2, center2]),
+            Self::Sigmoid { slope, center } => (5, [slope, center, 0.0, 0.0]),
+            Self::SigmoidDifference {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            } => (6, [slope1, center1, slope2, center2]),
+            Self::SigmoidProduct {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            } => (7, [slope1, center1, slope2, center2]),
+            Self::SShape { start, end } => (8, [start, end, 0.0, 0.0]),
+            Self::ZShape { start, end } => (9, [start, end, 0.0, 0.0]),
+            Self::PiShape {
+                left_foot,
+                left_shoulder,
+                right_shoulder,
+                right_foot,
+            } => (10, [left_foot, left_shoulder, right_shoulder, right_foot]),
+            Self::Constant { value } => (11, [value, 0.0, 0.0, 0.0]),
+        };
+        (&KINDS[index], params)
+    }
+
+    /// The function of the same kind with parameters `p` (MATLAB's order, this kind's count),
+    /// not validated.
+    pub(crate) fn with_params(&self, p: &[f64]) -> Self {
+        (self.kind().build)(p)
     }
 
     /// The parameters in MATLAB's order (the `[...]` of a `.fis` line).
@@ -195,50 +246,8 @@ impl MembershipFn {
     /// The parameters in MATLAB's order in a fixed array, and how many there are (at most 4):
     /// [`params`](Self::params) without allocating.
     pub(crate) fn param_array(&self) -> ([f64; 4], usize) {
-        match *self {
-            Self::Bell {
-                width,
-                slope,
-                center,
-            } => ([width, slope, center, 0.0], 3),
-            Self::Gaussian { sigma, center } => ([sigma, center, 0.0, 0.0], 2),
-            Self::Gaussian2 {
-                sigma1,
-                center1,
-                sigma2,
-                center2,
-            } => ([sigma1, center1, sigma2, center2], 4),
-            Self::Triangle { left, peak, right } => ([left, peak, right, 0.0], 3),
-            Self::Trapezoid {
-                left_foot,
-                left_shoulder,
-                right_shoulder,
-                right_foot,
-            } => ([left_foot, left_shoulder, right_shoulder, right_foot], 4),
-            Self::Sigmoid { slope, center } => ([slope, center, 0.0, 0.0], 2),
-            Self::SigmoidDifference {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            }
-            | Self::SigmoidProduct {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            } => ([slope1, center1, slope2, center2], 4),
-            Self::SShape { start, end } | Self::ZShape { start, end } => {
-                ([start, end, 0.0, 0.0], 2)
-            }
-            Self::PiShape {
-                left_foot,
-                left_shoulder,
-                right_shoulder,
-                right_foot,
-            } => ([left_foot, left_shoulder, right_shoulder, right_foot], 4),
-            Self::Constant { value } => ([value, 0.0, 0.0, 0.0], 1),
-        }
+        let (kind, params) = self.described();
+        (params, kind.parameters)
     }
 
     /// How many parameters MATLAB's type `name` takes (`None` for an unknown type). A `.fis`
@@ -252,13 +261,7 @@ impl MembershipFn {
     /// assert_eq!(MembershipFn::matlab_parameter_count("rampmf"), None);
     /// ```
     pub fn matlab_parameter_count(name: &str) -> Option<usize> {
-        match name {
-            "gbellmf" | "trimf" => Some(3),
-            "gaussmf" | "sigmf" | "smf" | "zmf" => Some(2),
-            "gauss2mf" | "trapmf" | "dsigmf" | "psigmf" | "pimf" => Some(4),
-            "constant" => Some(1),
-            _ => None,
-        }
+        Kind::by_matlab_name(name).map(|kind| kind.parameters)
     }
 
     /// Builds a function from MATLAB's type name and parameter list, and validates it.
@@ -271,69 +274,29 @@ impl MembershipFn {
     /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
     /// ```
     pub fn from_matlab(name: &str, params: &[f64]) -> Result<Self, FuzzyError> {
-        let Some(expected) = Self::matlab_parameter_count(name) else {
+        let Some(kind) = Kind::by_matlab_name(name) else {
+            let names: Vec<&str> = KINDS.iter().map(|kind| kind.matlab).collect();
             return Err(FuzzyError::InvalidMembership {
                 function: name.to_string(),
-                reason:
-                    "unknown membership function type; expected one of trimf, trapmf, gaussmf, \
-                         gauss2mf, gbellmf, sigmf, dsigmf, psigmf, smf, zmf, pimf, constant"
-                        .to_string(),
+                reason: format!(
+                    "unknown membership function type; expected one of {}",
+                    names.join(", ")
+                ),
             });
         };
-        if params.len() != expected {
+        if params.len() != kind.parameters {
             return Err(FuzzyError::InvalidMembership {
                 function: name.to_string(),
-                reason: format!("expected {expected} parameters, got {}", params.len()),
+                reason: format!(
+                    "expected {} parameters, got {}",
+                    kind.parameters,
+                    params.len()
+                ),
             });
         }
-        let mf = Self::from_matlab_unchecked(name, params);
+        let mf = (kind.build)(params);
         mf.validate()?;
         Ok(mf)
-    }
-
-    /// The function of MATLAB type `name` (one of the names [`from_matlab`](Self::from_matlab)
-    /// accepts) with parameters `p` of that type's length, not validated.
-    pub(crate) fn from_matlab_unchecked(name: &str, p: &[f64]) -> Self {
-        match name {
-            "gbellmf" => Self::bell(p[0], p[1], p[2]),
-            "trimf" => Self::triangle(p[0], p[1], p[2]),
-            "gaussmf" => Self::gaussian(p[0], p[1]),
-            "sigmf" => Self::sigmoid(p[0], p[1]),
-            "gauss2mf" => Self::Gaussian2 {
-                sigma1: p[0],
-                center1: p[1],
-                sigma2: p[2],
-                center2: p[3],
-            },
-            "trapmf" => Self::trapezoid(p[0], p[1], p[2], p[3]),
-            "dsigmf" => Self::SigmoidDifference {
-                slope1: p[0],
-                center1: p[1],
-                slope2: p[2],
-                center2: p[3],
-            },
-            "psigmf" => Self::SigmoidProduct {
-                slope1: p[0],
-                center1: p[1],
-                slope2: p[2],
-                center2: p[3],
-            },
-            "smf" => Self::SShape {
-                start: p[0],
-                end: p[1],
-            },
-            "zmf" => Self::ZShape {
-                start: p[0],
-                end: p[1],
-            },
-            "pimf" => Self::PiShape {
-                left_foot: p[0],
-                left_shoulder: p[1],
-                right_shoulder: p[2],
-                right_foot: p[3],
-            },
-            _ => Self::Constant { value: p[0] },
-        }
     }
 
     /// Checks the parameters: all finite, widths and sigmas positive, bell slope positive, the
@@ -431,333 +394,182 @@ impl MembershipFn {
     }
 }
 
+/// One membership-function kind, described once: its names in the formats the crate reads and
+/// writes (MATLAB's `.fis`, fuzzylite's FCL), its parameters, their order in FCL, how to build
+/// the function from them, and where its degree changes character. The formulas themselves are
+/// the compiled form's (`eval::CompiledMf`); the gradients are ANFIS's (`learn::premise`).
+#[derive(Debug)]
+pub(crate) struct Kind {
+    /// MATLAB's type name (`.fis`).
+    pub(crate) matlab: &'static str,
+    /// fuzzylite's term class (FCL); triangles and trapezoids are written as IEC point lists.
+    pub(crate) fcl: &'static str,
+    /// How many parameters the kind takes.
+    pub(crate) parameters: usize,
+    /// fuzzylite's parameter order: FCL position `i` holds MATLAB's parameter `fcl_order[i]`.
+    pub(crate) fcl_order: &'static [usize],
+    /// The function with these parameters (MATLAB's order, [`Kind::parameters`] of them), not
+    /// validated.
+    pub(crate) build: fn(&[f64]) -> MembershipFn,
+    /// Where the degree changes character (centres, feet, shoulders, half-power points), from
+    /// the parameters in MATLAB's order: the sample points of the rule-base analysis.
+    pub(crate) landmarks: fn(&[f64; 4]) -> Vec<f64>,
+}
+
+impl Kind {
+    /// The kind of MATLAB type `name`.
+    pub(crate) fn by_matlab_name(name: &str) -> Option<&'static Kind> {
+        KINDS.iter().find(|kind| kind.matlab == name)
+    }
+
+    /// The kind of fuzzylite term class `class`.
+    pub(crate) fn by_fcl_class(class: &str) -> Option<&'static Kind> {
+        KINDS.iter().find(|kind| kind.fcl == class)
+    }
+}
+
+/// Every kind, in the order error messages list them.
+pub(crate) static KINDS: [Kind; 12] = [
+    Kind {
+        matlab: "trimf",
+        fcl: "Triangle",
+        parameters: 3,
+        fcl_order: &[0, 1, 2],
+        build: |p| MembershipFn::triangle(p[0], p[1], p[2]),
+        landmarks: |p| vec![p[0], p[1], p[2]],
+    },
+    Kind {
+        matlab: "trapmf",
+        fcl: "Trapezoid",
+        parameters: 4,
+        fcl_order: &[0, 1, 2, 3],
+        build: |p| MembershipFn::trapezoid(p[0], p[1], p[2], p[3]),
+        landmarks: |p| p.to_vec(),
+    },
+    Kind {
+        matlab: "gbellmf",
+        fcl: "Bell",
+        parameters: 3,
+        // fuzzylite's Bell(center, width, slope).
+        fcl_order: &[2, 0, 1],
+        build: |p| MembershipFn::bell(p[0], p[1], p[2]),
+        // The centre and the half-power points c ± a.
+        landmarks: |&[width, _, center, _]| vec![center - width, center, center + width],
+    },
+    Kind {
+        matlab: "gaussmf",
+        fcl: "Gaussian",
+        parameters: 2,
+        // fuzzylite's Gaussian(mean, standardDeviation).
+        fcl_order: &[1, 0],
+        build: |p| MembershipFn::gaussian(p[0], p[1]),
+        landmarks: |&[sigma, center, _, _]| vec![center - sigma, center, center + sigma],
+    },
+    Kind {
+        matlab: "gauss2mf",
+        fcl: "GaussianProduct",
+        parameters: 4,
+        // fuzzylite's GaussianProduct(meanA, standardDeviationA, meanB, standardDeviationB).
+        fcl_order: &[1, 0, 3, 2],
+        build: |p| MembershipFn::Gaussian2 {
+            sigma1: p[0],
+            center1: p[1],
+            sigma2: p[2],
+            center2: p[3],
+        },
+        landmarks: |&[sigma1, center1, sigma2, center2]| {
+            vec![center1 - sigma1, center1, center2, center2 + sigma2]
+        },
+    },
+    Kind {
+        matlab: "sigmf",
+        fcl: "Sigmoid",
+        parameters: 2,
+        // fuzzylite's Sigmoid(inflection, slope).
+        fcl_order: &[1, 0],
+        build: |p| MembershipFn::sigmoid(p[0], p[1]),
+        landmarks: |&[_, center, _, _]| vec![center],
+    },
+    Kind {
+        matlab: "dsigmf",
+        fcl: "SigmoidDifference",
+        parameters: 4,
+        // fuzzylite's SigmoidDifference(left, rising, falling, right).
+        fcl_order: &[1, 0, 2, 3],
+        build: |p| MembershipFn::SigmoidDifference {
+            slope1: p[0],
+            center1: p[1],
+            slope2: p[2],
+            center2: p[3],
+        },
+        landmarks: |&[_, center1, _, center2]| vec![center1, center2],
+    },
+    Kind {
+        matlab: "psigmf",
+        fcl: "SigmoidProduct",
+        parameters: 4,
+        // fuzzylite's SigmoidProduct(left, rising, falling, right).
+        fcl_order: &[1, 0, 2, 3],
+        build: |p| MembershipFn::SigmoidProduct {
+            slope1: p[0],
+            center1: p[1],
+            slope2: p[2],
+            center2: p[3],
+        },
+        landmarks: |&[_, center1, _, center2]| vec![center1, center2],
+    },
+    Kind {
+        matlab: "smf",
+        fcl: "SShape",
+        parameters: 2,
+        // fuzzylite's SShape(start, end): MATLAB's order.
+        fcl_order: &[0, 1],
+        build: |p| MembershipFn::SShape {
+            start: p[0],
+            end: p[1],
+        },
+        landmarks: |&[start, end, _, _]| vec![start, 0.5 * (start + end), end],
+    },
+    Kind {
+        matlab: "zmf",
+        fcl: "ZShape",
+        parameters: 2,
+        // fuzzylite's ZShape(start, end): MATLAB's order.
+        fcl_order: &[0, 1],
+        build: |p| MembershipFn::ZShape {
+            start: p[0],
+            end: p[1],
+        },
+        landmarks: |&[start, end, _, _]| vec![start, 0.5 * (start + end), end],
+    },
+    Kind {
+        matlab: "pimf",
+        fcl: "PiShape",
+        parameters: 4,
+        // fuzzylite's PiShape(bottomLeft, topLeft, topRight, bottomRight): MATLAB's order.
+        fcl_order: &[0, 1, 2, 3],
+        build: |p| MembershipFn::PiShape {
+            left_foot: p[0],
+            left_shoulder: p[1],
+            right_shoulder: p[2],
+            right_foot: p[3],
+        },
+        landmarks: |p| p.to_vec(),
+    },
+    Kind {
+        matlab: "constant",
+        fcl: "Constant",
+        parameters: 1,
+        fcl_order: &[0],
+        build: |p| MembershipFn::Constant { value: p[0] },
+        landmarks: |_| Vec::new(),
+    },
+];
+
 /// Formats parameters the way a `.fis` file shows them: `[0.3 2 -0.3]`.
 pub(crate) fn format_params(params: &[f64]) -> String {
     let inner: Vec<String> = params.iter().map(|v| v.to_string()).collect();
     format!("[{}]", inner.join(" "))
-}
-
-/// The largest exponent `2 b` evaluated by repeated squaring; larger or non-integer ones use `powf`.
-const MAX_INTEGER_BELL_EXPONENT: f64 = 64.0;
-
-/// A validated membership function in evaluation form.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum CompiledMf {
-    /// Bell with `b = 1`: `1 / (1 + u^2)`, `u = (x - c) / a`.
-    BellSquare { center: f64, width: f64 },
-    /// Bell with `b = 2` (the paper's): `1 / (1 + (u^2)^2)`.
-    BellQuartic { center: f64, width: f64 },
-    /// Bell with an integer exponent `2 b <= 64`: `|u|^(2b)` by repeated squaring.
-    BellInteger {
-        center: f64,
-        width: f64,
-        exponent: u32,
-    },
-    /// Any other bell: `|u|^(2b)` by `powf`.
-    BellReal {
-        center: f64,
-        width: f64,
-        exponent: f64,
-    },
-    /// `exp(-(x - c)^2 * k)` with `k = 1 / (2 sigma^2)`.
-    Gaussian { center: f64, k: f64 },
-    /// Two-sided Gaussian (MATLAB's `gauss2mf`).
-    Gaussian2 {
-        center1: f64,
-        k1: f64,
-        center2: f64,
-        k2: f64,
-    },
-    /// `trimf`.
-    Triangle { left: f64, peak: f64, right: f64 },
-    /// `trapmf`.
-    Trapezoid { a: f64, b: f64, c: f64, d: f64 },
-    /// `sigmf`.
-    Sigmoid { slope: f64, center: f64 },
-    /// `dsigmf`.
-    SigmoidDifference {
-        slope1: f64,
-        center1: f64,
-        slope2: f64,
-        center2: f64,
-    },
-    /// `psigmf`.
-    SigmoidProduct {
-        slope1: f64,
-        center1: f64,
-        slope2: f64,
-        center2: f64,
-    },
-    /// `smf`, or its step when `a >= b`.
-    SShape { start: f64, end: f64 },
-    /// `zmf`, or its step when `a >= b`.
-    ZShape { start: f64, end: f64 },
-    /// `pimf`: `smf(x, [a b]) * zmf(x, [c d])`.
-    PiShape { a: f64, b: f64, c: f64, d: f64 },
-    /// `constant`.
-    Constant(f64),
-}
-
-impl CompiledMf {
-    /// Validates `mf` and picks its evaluation form.
-    pub(crate) fn new(mf: &MembershipFn) -> Result<Self, FuzzyError> {
-        mf.validate()?;
-        let gauss_k = |sigma: f64| 1.0 / (2.0 * sigma * sigma);
-        Ok(match *mf {
-            MembershipFn::Bell {
-                width,
-                slope,
-                center,
-            } => {
-                let exponent = 2.0 * slope;
-                if exponent == 2.0 {
-                    Self::BellSquare { center, width }
-                } else if exponent == 4.0 {
-                    Self::BellQuartic { center, width }
-                } else if exponent.fract() == 0.0 && exponent <= MAX_INTEGER_BELL_EXPONENT {
-                    Self::BellInteger {
-                        center,
-                        width,
-                        exponent: exponent as u32,
-                    }
-                } else {
-                    Self::BellReal {
-                        center,
-                        width,
-                        exponent,
-                    }
-                }
-            }
-            MembershipFn::Gaussian { sigma, center } => Self::Gaussian {
-                center,
-                k: gauss_k(sigma),
-            },
-            MembershipFn::Gaussian2 {
-                sigma1,
-                center1,
-                sigma2,
-                center2,
-            } => Self::Gaussian2 {
-                center1,
-                k1: gauss_k(sigma1),
-                center2,
-                k2: gauss_k(sigma2),
-            },
-            MembershipFn::Triangle { left, peak, right } => Self::Triangle { left, peak, right },
-            MembershipFn::Trapezoid {
-                left_foot,
-                left_shoulder,
-                right_shoulder,
-                right_foot,
-            } => Self::Trapezoid {
-                a: left_foot,
-                b: left_shoulder,
-                c: right_shoulder,
-                d: right_foot,
-            },
-            MembershipFn::Sigmoid { slope, center } => Self::Sigmoid { slope, center },
-            MembershipFn::SigmoidDifference {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            } => Self::SigmoidDifference {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            },
-            MembershipFn::SigmoidProduct {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            } => Self::SigmoidProduct {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            },
-            MembershipFn::SShape { start, end } => Self::SShape { start, end },
-            MembershipFn::ZShape { start, end } => Self::ZShape { start, end },
-            MembershipFn::PiShape {
-                left_foot,
-                left_shoulder,
-                right_shoulder,
-                right_foot,
-            } => Self::PiShape {
-                a: left_foot,
-                b: left_shoulder,
-                c: right_shoulder,
-                d: right_foot,
-            },
-            MembershipFn::Constant { value } => Self::Constant(value),
-        })
-    }
-
-    /// The degree of membership of `x` (finite `x`; never NaN for finite `x`).
-    #[inline]
-    pub(crate) fn eval(&self, x: f64) -> f64 {
-        match *self {
-            Self::BellSquare { center, width } => {
-                let u = (x - center) / width;
-                1.0 / (1.0 + u * u)
-            }
-            Self::BellQuartic { center, width } => {
-                let u = (x - center) / width;
-                let u2 = u * u;
-                1.0 / (1.0 + u2 * u2)
-            }
-            Self::BellInteger {
-                center,
-                width,
-                exponent,
-            } => 1.0 / (1.0 + integer_power(((x - center) / width).abs(), exponent)),
-            Self::BellReal {
-                center,
-                width,
-                exponent,
-            } => 1.0 / (1.0 + ((x - center) / width).abs().powf(exponent)),
-            Self::Gaussian { center, k } => gaussian(x, center, k),
-            Self::Gaussian2 {
-                center1,
-                k1,
-                center2,
-                k2,
-            } => {
-                let left = if x <= center1 {
-                    gaussian(x, center1, k1)
-                } else {
-                    1.0
-                };
-                let right = if x >= center2 {
-                    gaussian(x, center2, k2)
-                } else {
-                    1.0
-                };
-                left * right
-            }
-            Self::Triangle { left, peak, right } => {
-                if x == peak {
-                    1.0
-                } else if x <= left || x >= right {
-                    0.0
-                } else if x < peak {
-                    (x - left) / (peak - left)
-                } else {
-                    (right - x) / (right - peak)
-                }
-            }
-            Self::Trapezoid { a, b, c, d } => {
-                let (rising, falling) = trapezoid_sides(x, a, b, c, d);
-                rising.min(falling)
-            }
-            Self::Sigmoid { slope, center } => sigmoid(x, slope, center),
-            Self::SigmoidDifference {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            } => (sigmoid(x, slope1, center1) - sigmoid(x, slope2, center2)).abs(),
-            Self::SigmoidProduct {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            } => sigmoid(x, slope1, center1) * sigmoid(x, slope2, center2),
-            Self::SShape { start, end } => s_shape(x, start, end),
-            Self::ZShape { start, end } => z_shape(x, start, end),
-            Self::PiShape { a, b, c, d } => s_shape(x, a, b) * z_shape(x, c, d),
-            Self::Constant(value) => value,
-        }
-    }
-}
-
-/// The rising and falling sides of `trapmf [a b c d]` at `x`: the degree is their minimum.
-#[inline]
-pub(crate) fn trapezoid_sides(x: f64, a: f64, b: f64, c: f64, d: f64) -> (f64, f64) {
-    let rising = if x >= b {
-        1.0
-    } else if x < a {
-        0.0
-    } else {
-        (x - a) / (b - a)
-    };
-    let falling = if x <= c {
-        1.0
-    } else if x > d {
-        0.0
-    } else {
-        (d - x) / (d - c)
-    };
-    (rising, falling)
-}
-
-/// MATLAB's `smf(x, [a b])`: the quadratic spline from 0 at `a` to 1 at `b` (value 1/2 at the
-/// midpoint), or the step `x >= (a + b) / 2` when `a >= b`.
-#[inline]
-pub(crate) fn s_shape(x: f64, a: f64, b: f64) -> f64 {
-    let middle = 0.5 * (a + b);
-    if a >= b {
-        return if x >= middle { 1.0 } else { 0.0 };
-    }
-    if x <= a {
-        0.0
-    } else if x <= middle {
-        let t = (x - a) / (b - a);
-        2.0 * t * t
-    } else if x <= b {
-        let t = (b - x) / (b - a);
-        1.0 - 2.0 * t * t
-    } else {
-        1.0
-    }
-}
-
-/// MATLAB's `zmf(x, [a b])`: the quadratic spline from 1 at `a` to 0 at `b`, or the step
-/// `x <= (a + b) / 2` when `a >= b`.
-#[inline]
-pub(crate) fn z_shape(x: f64, a: f64, b: f64) -> f64 {
-    let middle = 0.5 * (a + b);
-    if a >= b {
-        return if x <= middle { 1.0 } else { 0.0 };
-    }
-    if x <= a {
-        1.0
-    } else if x <= middle {
-        let t = (x - a) / (b - a);
-        1.0 - 2.0 * t * t
-    } else if x <= b {
-        let t = (b - x) / (b - a);
-        2.0 * t * t
-    } else {
-        0.0
-    }
-}
-
-#[inline]
-fn gaussian(x: f64, center: f64, k: f64) -> f64 {
-    let d = x - center;
-    (-(d * d) * k).exp()
-}
-
-#[inline]
-fn sigmoid(x: f64, slope: f64, center: f64) -> f64 {
-    1.0 / (1.0 + (-slope * (x - center)).exp())
-}
-
-/// `base^exponent` by repeated squaring (exponentiation by squaring), no `powf`.
-#[inline]
-fn integer_power(mut base: f64, mut exponent: u32) -> f64 {
-    let mut result = 1.0;
-    while exponent > 0 {
-        if exponent & 1 == 1 {
-            result *= base;
-        }
-        base *= base;
-        exponent >>= 1;
-    }
-    result
 }
 
 #[cfg(test)]
@@ -788,24 +600,29 @@ mod tests {
     }
 
     #[test]
-    fn integer_slopes_are_compiled_without_powf() {
-        let compile = |b: f64| CompiledMf::new(&MembershipFn::bell(1.0, b, 0.0)).unwrap();
-        assert!(matches!(compile(1.0), CompiledMf::BellSquare { .. }));
-        assert!(matches!(compile(2.0), CompiledMf::BellQuartic { .. }));
-        assert!(matches!(
-            compile(1.5),
-            CompiledMf::BellInteger { exponent: 3, .. }
-        ));
-        assert!(matches!(
-            compile(32.0),
-            CompiledMf::BellInteger { exponent: 64, .. }
-        ));
-        assert!(matches!(compile(32.5), CompiledMf::BellReal { .. }));
-        assert!(matches!(compile(0.3), CompiledMf::BellReal { .. }));
-        // Exponentiation by squaring is exact for powers of two and small integers.
-        assert_eq!(integer_power(1.5, 0), 1.0);
-        assert_eq!(integer_power(1.5, 5), 7.59375);
-        assert_eq!(integer_power(2.0, 64), 2f64.powi(64));
+    fn every_kind_is_described_once_and_consistently() {
+        let params = [0.1, 0.2, 0.3, 0.4];
+        for kind in &KINDS {
+            let mf = (kind.build)(&params[..kind.parameters]);
+            // The variant's kind is this entry, and its parameters come back in MATLAB's order.
+            assert!(std::ptr::eq(mf.kind(), kind), "{}", kind.matlab);
+            assert_eq!(mf.params(), &params[..kind.parameters], "{}", kind.matlab);
+            assert_eq!(mf.with_params(&params[..kind.parameters]), mf);
+            assert_eq!(
+                MembershipFn::matlab_parameter_count(kind.matlab),
+                Some(kind.parameters)
+            );
+            assert!(std::ptr::eq(Kind::by_fcl_class(kind.fcl).unwrap(), kind));
+            // fuzzylite's order is a permutation of MATLAB's.
+            let mut order = kind.fcl_order.to_vec();
+            order.sort_unstable();
+            assert_eq!(
+                order,
+                (0..kind.parameters).collect::<Vec<_>>(),
+                "{}",
+                kind.fcl
+            );
+        }
     }
 
     #[test]

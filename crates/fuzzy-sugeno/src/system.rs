@@ -2,7 +2,8 @@
 //! (section 4 of the paper, eqs 19-21).
 
 use crate::error::FuzzyError;
-use crate::membership::{CompiledMf, MembershipFn};
+use crate::eval::CompiledMf;
+use crate::membership::MembershipFn;
 
 /// An input variable: a name, the range it was designed for, and its fuzzy sets.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,6 +1,30 @@
 //! Numbers from the command line checked against their bounds before they reach an allocation
 //! or a loop. Counts are parsed as wide signed integers (with negative numbers allowed), so that
-//! `--seeds -1` gets the option's own message rather than a parse error.
+//! `--seeds -1` gets the option's own message rather than a parse error. Controller names come
+//! from the one controller table, `sim_core::CONTROLLERS`.
+
+use sim_core::{CONTROLLERS, ControllerKind};
+use std::sync::LazyLock;
+
+/// Every controller's name, comma-separated: the default of list options.
+pub static ALL_CONTROLLERS: LazyLock<String> = LazyLock::new(|| ControllerKind::names(","));
+
+/// The help of `simulate --controller`: every controller's name.
+pub static CONTROLLER_HELP: LazyLock<String> = LazyLock::new(|| {
+    format!(
+        "Override the scenario's controller: {}",
+        ControllerKind::names(", ")
+    )
+});
+
+/// The long help (`--help`) of `simulate --controller`: every controller with its description.
+pub static CONTROLLER_LONG_HELP: LazyLock<String> = LazyLock::new(|| {
+    let mut help = String::from("Override the scenario's controller, one of:");
+    for entry in CONTROLLERS {
+        help += &format!("\n- {}: {}", entry.name, entry.description);
+    }
+    help
+});
 
 /// `value` of option `option` as a count from `min` to `max`, or the one-line message
 /// "`option` must be at least `min` and at most `max`, got `value`".

@@ -4,6 +4,7 @@
 use crate::output_dir::OutputDir;
 use crate::{console, figures, progress, report};
 use serde_json::json;
+use sim_core::imitation::{self, ImitationOptions};
 use sim_core::study::{self, ComparisonRun as Outcome, Stopped, run_one};
 use sim_core::{ControllerKind, ReferenceSpec, Run, Scenario};
 use std::fmt::Write as _;
@@ -51,9 +52,19 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
     });
     bar.finish_and_clear();
     let outcomes = outcomes?;
-    let summaries: Vec<_> = outcomes.iter().map(outcome_json).collect();
+    let learned = learned_runs(dir, scenarios)?;
+    let mut summaries: Vec<_> = outcomes.iter().map(outcome_json).collect();
+    summaries.extend(learned.iter().map(|o| {
+        let mut summary = outcome_json(o);
+        summary["controller"] = json!(LEARNED);
+        summary
+    }));
     write(&dir.join("summary.json"), &pretty(&json!(summaries))?)?;
-    let rows = table_rows(&outcomes);
+    let mut rows = table_rows(&outcomes);
+    rows.extend(table_rows(&learned).into_iter().map(|mut row| {
+        row.cells[1] = LEARNED.to_owned();
+        row
+    }));
     let text = table(&rows);
     write(&dir.join("comparison.txt"), &text)?;
     let sections = figures(dir, scenarios, &outcomes)?;
@@ -62,7 +73,7 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
         rows,
     };
     let intro = format!(
-        "Every scenario ({}) run with every controller ({}): the comparison table, then figures in the spirit of the paper's section 5. Per-run time series and metrics are in <scenario>/<controller>/timeseries.csv and summary.json next to this page.",
+        "Every scenario ({}) run with every controller ({}): the comparison table, then figures in the spirit of the paper's section 5. The {LEARNED} row of {LEARNED_ON} is a fuzzy controller learned by imitation of computed torque on the step and sine responses about a grid of operating points, never on the path ({LEARNED}.fis next to this page). Per-run time series and metrics are in <scenario>/<controller>/timeseries.csv and summary.json next to this page.",
         scenarios
             .iter()
             .map(|s| s.name.as_str())
@@ -80,10 +91,42 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
     staging.commit()?;
     console::print(&text)?;
     console::print(&format!(
-        "wrote {} (summary.json, comparison.txt, figures/, one folder per run)\nreport: {}\n",
+        "wrote {} (summary.json, comparison.txt, figures/, learned.fis, one folder per run)\nreport: {}\n",
         out.display(),
         out.join("report.html").display()
     ))
+}
+
+/// The name of the learned controller's rows, folders and file (`learned.fis`).
+const LEARNED: &str = "learned";
+/// The scenario the learned controller is compared on; it is trained on
+/// [`PAPER_TRAINING_SCENARIOS`](imitation::PAPER_TRAINING_SCENARIOS), never on it.
+const LEARNED_ON: &str = "paper-tracking";
+
+/// The learned controller's runs: if `scenarios` holds [`LEARNED_ON`], a fuzzy controller learned
+/// by imitation of computed torque on the shipped step and sine responses about a grid of
+/// operating points ([`paper_demonstrations`](imitation::paper_demonstrations), default
+/// [`ImitationOptions`]) is written to `out/learned.fis` and run on it; its files go to
+/// `out/<scenario>/learned`.
+fn learned_runs(out: &Path, scenarios: &[Scenario]) -> Result<Vec<Outcome>, String> {
+    let targets: Vec<&Scenario> = scenarios.iter().filter(|s| s.name == LEARNED_ON).collect();
+    if targets.is_empty() {
+        return Ok(Vec::new());
+    }
+    let learned = imitation::paper_demonstrations()
+        .and_then(|training| imitation::imitate(&training, &ImitationOptions::default(), |_, _| {}))
+        .map_err(|e| format!("learning the {LEARNED} controller: {e}"))?;
+    let file = out.join(format!("{LEARNED}.fis"));
+    write(&file, &learned.system.to_fis())?;
+    let mut runs = Vec::with_capacity(targets.len());
+    for target in targets {
+        let mut scenario = target.clone();
+        scenario.controller.fis = Some(file.clone());
+        let outcome = run_one(&scenario, ControllerKind::Fuzzy);
+        write_outcome(&outcome, &out.join(&scenario.name).join(LEARNED))?;
+        runs.push(outcome);
+    }
+    Ok(runs)
 }
 
 /// Interval between the drawn arm configurations of Figure 10 (s).
@@ -216,26 +259,10 @@ fn outcome_json(outcome: &Outcome) -> serde_json::Value {
 /// and the time it `stopped_at_s`.
 fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    let (run, summary) = match &outcome.result {
-        Ok(run) => (
-            Some(run),
-            serde_json::to_value(&run.summary).map_err(|e| e.to_string())?,
-        ),
-        Err(Stopped {
-            error,
-            partial: None,
-        }) => (None, json!({ "error": error })),
-        Err(Stopped {
-            error,
-            partial: Some(run),
-        }) => {
-            let mut summary = serde_json::to_value(&run.summary).map_err(|e| e.to_string())?;
-            if let Some(fields) = summary.as_object_mut() {
-                fields.insert("error".into(), json!(error));
-                fields.insert("stopped_at_s".into(), json!(run.summary.simulated_s));
-            }
-            (Some(run), summary)
-        }
+    let summary = sim_core::summary_json::run(&outcome.result);
+    let run = match &outcome.result {
+        Ok(run) => Some(run),
+        Err(stopped) => stopped.partial.as_ref(),
     };
     write(&dir.join("summary.json"), &pretty(&summary)?)?;
     if let Some(run) = run {
@@ -356,6 +383,7 @@ fn write(path: &Path, text: &str) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use fuzzy_sugeno::FuzzySystem;
 
     #[test]
     fn simulate_writes_the_summary_keys_and_a_time_series() {
@@ -403,8 +431,14 @@ mod tests {
         scenarios[1].limits.max_modal_error = 1e-6;
         experiments(&dir, &scenarios).unwrap();
         let page = std::fs::read_to_string(dir.join("report.html")).unwrap();
-        let runs = scenarios.len() * ControllerKind::ALL.len();
+        // Every scenario with every controller, and the learned controller on paper-tracking.
+        let runs = scenarios.len() * ControllerKind::ALL.len() + 1;
         assert_eq!(page.matches("<tr>").count(), 1 + runs);
+        assert!(page.contains("<td>paper-tracking</td><td>learned</td><td class=\"num\">"));
+        let learned =
+            FuzzySystem::from_fis(&std::fs::read_to_string(dir.join("learned.fis")).unwrap());
+        assert_eq!(learned.unwrap().inputs().len(), 8);
+        assert!(dir.join("paper-tracking/learned/timeseries.csv").is_file());
         assert_eq!(page.matches("<td class=\"error\"").count(), 4, "{page}");
         let mut images = 0;
         for piece in page.split("<img src=\"").skip(1) {
@@ -432,9 +466,6 @@ mod tests {
         let dir = std::env::temp_dir();
         assert!(simulate("no-such-scenario", None, &dir).is_err());
         let err = simulate("paper-responses-step", Some("bang-bang"), &dir).unwrap_err();
-        assert!(
-            err.contains("fuzzy, pd, computed-torque, fuzzy-gc"),
-            "{err}"
-        );
+        assert!(err.contains(&ControllerKind::names(", ")), "{err}");
     }
 }

@@ -7,7 +7,8 @@
 //! - `hrm fis surface FILE --out DIR`: SVGs of every input's membership functions and of every
 //!   output over every pair of inputs (others at a reference value), like MATLAB's `plotmf` and
 //!   `gensurf`.
-//! - `hrm fis train ...` and `hrm fis export ...`: see `fis_train` and `fis_export`.
+//! - `hrm fis train ...`, `hrm fis export ...` and `hrm fis imitate ...`: see `fis_train`,
+//!   `fis_export` and `fis_imitate`.
 //!
 //! A FILE whose name ends in `.fcl` is read as IEC 61131-7 FCL, any other as MATLAB `.fis`.
 
@@ -59,6 +60,8 @@ enum FisCommand {
     Train(crate::fis_train::TrainArgs),
     /// Write the system as C99 source and header, or as IEC 61131-7 FCL.
     Export(crate::fis_export::ExportArgs),
+    /// Learn a fuzzy controller from a teacher controller run on training scenarios (ANFIS) and write it as a .fis file.
+    Imitate(crate::fis_imitate::ImitateArgs),
     /// Write SVG plots of the membership functions and control surfaces.
     Surface {
         /// The `.fis` file.
@@ -126,6 +129,7 @@ pub fn run(args: FisArgs) -> Result<(), String> {
         }
         FisCommand::Train(args) => crate::fis_train::run(args),
         FisCommand::Export(args) => crate::fis_export::run(args),
+        FisCommand::Imitate(args) => crate::fis_imitate::run(args),
         FisCommand::Surface {
             file,
             out,

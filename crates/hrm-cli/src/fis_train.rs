@@ -5,7 +5,7 @@
 //! with an optional header line of column names (taken as the variables' names). Every size is
 //! bounded before it is used: the file, its rows and columns, the epochs and the rule count.
 
-use crate::progress;
+use crate::{output_dir, progress};
 use clap::Args;
 use fuzzy_sugeno::learn::{
     Anfis, AnfisOptions, ConsequentOrder, GridPartition, MAX_INPUTS, MAX_ROWS, SetShape,
@@ -144,8 +144,7 @@ pub fn run(args: TrainArgs) -> Result<(), String> {
         );
         trainer.best_system().map_err(|e| e.to_string())?
     };
-    std::fs::write(&args.out, system.to_fis())
-        .map_err(|e| format!("{}: {e}", args.out.display()))?;
+    output_dir::write_file(&args.out, &system.to_fis(), "fis train")?;
     println!("wrote {}", args.out.display());
     Ok(())
 }

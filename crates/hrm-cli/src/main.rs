@@ -8,6 +8,7 @@ mod experiment;
 mod figures;
 mod fis_cmd;
 mod fis_export;
+mod fis_imitate;
 mod fis_train;
 mod output_dir;
 mod plot;
@@ -40,8 +41,11 @@ enum Command {
         /// Scenario name or path.
         #[arg(long)]
         scenario: String,
-        /// Override the scenario's controller: fuzzy, pd, computed-torque or fuzzy-gc.
-        #[arg(long)]
+        #[arg(
+            long,
+            help = args::CONTROLLER_HELP.as_str(),
+            long_help = args::CONTROLLER_LONG_HELP.as_str()
+        )]
         controller: Option<String>,
         /// Output folder.
         #[arg(long, default_value = "hrm-output/simulate")]

@@ -90,6 +90,11 @@ impl<'py> States<'py> {
         }
     }
 
+    /// Whether the argument is a batch `(N, width)` rather than one state.
+    pub(crate) fn is_batch(&self) -> bool {
+        self.batch.is_some()
+    }
+
     /// A description of the shape for messages: `(n,)` or `(N, n)`.
     fn shape_text(&self) -> String {
         match *self.array.shape() {

@@ -9,7 +9,10 @@
 //!   driver (GIL released, rayon);
 //! - [`arm`]: `hrm.Arm` (`manip-dyn`);
 //! - [`reduced`]: `hrm.ReducedModel` (`backbone-kin`, `modal-reduce`);
-//! - [`fuzzy`]: `hrm.fuzzy.System`, `hrm.fuzzy.paper_controller` (`fuzzy-sugeno`).
+//! - [`fuzzy`]: `hrm.fuzzy.System`, `hrm.fuzzy.paper_controller` (`fuzzy-sugeno`);
+//! - [`scenario`]: `hrm.Scenario`, `hrm.Settings`, `hrm.ReferenceSample`, `hrm.Run`: closed-loop
+//!   runs with built-in or Python controllers (`sim-core`);
+//! - [`sweep`]: `hrm.Sweep`: Monte Carlo sweeps, whole or shard by shard (`sim_core::study`).
 //!
 //! The tests are Python (`tests/`, run by `cargo xtask test`); `docs/python.md` is the guide.
 #![deny(missing_docs)]
@@ -19,6 +22,8 @@ mod array;
 mod errors;
 mod fuzzy;
 mod reduced;
+mod scenario;
+mod sweep;
 
 use pyo3::prelude::*;
 
@@ -28,6 +33,11 @@ fn _hrm(module: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = module.py();
     module.add_class::<arm::Arm>()?;
     module.add_class::<reduced::ReducedModel>()?;
+    module.add_class::<scenario::Scenario>()?;
+    module.add_class::<scenario::Settings>()?;
+    module.add_class::<scenario::ReferenceSample>()?;
+    module.add_class::<scenario::Run>()?;
+    module.add_class::<sweep::Sweep>()?;
     module.add("InvalidInput", py.get_type::<errors::InvalidInput>())?;
     module.add("Unreachable", py.get_type::<errors::Unreachable>())?;
     module.add("NumericalError", py.get_type::<errors::NumericalError>())?;

@@ -11,7 +11,8 @@
 //!
 //! Experiments are [`Scenario`]s, TOML files; the paper's are shipped with the crate
 //! ([`Scenario::builtin_names`]): `paper-tracking` (Figures 10-11) and the
-//! `paper-responses-{step,sine,noise}` responses (Figure 9).
+//! `paper-responses-{step,sine,noise}` responses (Figure 9). [`imitation`] learns a fuzzy
+//! controller from a better teacher (computed torque) on such scenarios.
 //!
 //! ```
 //! use sim_core::{ControllerKind, Scenario};
@@ -34,6 +35,7 @@ pub struct ReadmeDoctests;
 
 pub mod controller;
 mod error;
+pub mod imitation;
 mod input_file;
 mod noise;
 pub mod ode;
@@ -43,6 +45,7 @@ pub mod reference;
 mod scenario;
 mod simulation;
 pub mod study;
+pub mod summary_json;
 
 /// The most modal coordinates a loop may have: `2K + 1` for the most harmonics a modal map may
 /// have ([`backbone_kin::MAX_HARMONICS`]).
@@ -52,9 +55,9 @@ pub use error::{ControllerFailure, SimError};
 pub use input_file::{MAX_INPUT_FILE_BYTES, read_text_file};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use scenario::{
-    Alpha0, ArmSpec, BranchSpec, ControllerKind, ControllerSpec, InitialSpec, IntegratorSpec,
-    LimitsSpec, ModalSpec, NoiseSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec,
-    TorqueLimit,
+    Alpha0, ArmSpec, BranchSpec, CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup,
+    ControllerSpec, InitialSpec, IntegratorSpec, LimitsSpec, ModalSpec, NoiseSpec, ReferenceSpec,
+    Scenario, ScenarioError, SineSpec, TorqueLimit,
 };
 pub use simulation::{
     ControlSample, Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES,

@@ -17,7 +17,8 @@ use super::learning;
 use super::least_squares::{LeastSquares, LeastSquaresError};
 use super::premise::{gradient, repair};
 use crate::FuzzyError;
-use crate::membership::{CompiledMf, MembershipFn};
+use crate::eval::CompiledMf;
+use crate::membership::MembershipFn;
 use crate::system::{
     AndMethod, Antecedent, Connective, Defuzzification, FuzzySystem, OutputFn, affine,
 };
@@ -552,7 +553,7 @@ impl Anfis {
                 *p -= eta * g;
             }
             let before = *mf;
-            *mf = MembershipFn::from_matlab_unchecked(mf.matlab_name(), &params[..count]);
+            *mf = mf.with_params(&params[..count]);
             repair(mf, &before, self.mf_span[m]);
             self.net.compiled[m] = CompiledMf::new(mf)?;
         }
@@ -830,7 +831,7 @@ mod tests {
                 let mut at = |delta: f64| {
                     let mut p = params;
                     p[k] += delta;
-                    let mf = Mf::from_matlab_unchecked(trainer.mfs[m].matlab_name(), &p[..count]);
+                    let mf = trainer.mfs[m].with_params(&p[..count]);
                     trainer.net.compiled[m] = CompiledMf::new(&mf).unwrap();
                     let e = sse(&mut trainer);
                     trainer.net.compiled[m] = CompiledMf::new(&trainer.mfs[m]).unwrap();

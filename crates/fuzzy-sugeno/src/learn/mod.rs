@@ -42,7 +42,7 @@ pub use anfis::{Anfis, AnfisOptions, EpochReport, Trained, anfis};
 pub use data::{MAX_INPUTS, MAX_ROWS, TrainingData};
 pub use genfis::{
     ConsequentOrder, GridPartition, MAX_CLUSTER_ROWS, MAX_RULES, SetShape, SubtractiveClustering,
-    genfis_cluster, genfis_grid,
+    genfis_cluster, genfis_grid, genfis_grid_over,
 };
 pub use merge::merge_outputs;
 

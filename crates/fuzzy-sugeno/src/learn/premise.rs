@@ -2,7 +2,8 @@
 //! parameters (layer 1 of Jang 1993, the `d O / d alpha` of eq 12), and the repair that keeps a
 //! function valid after a gradient step.
 
-use crate::membership::{MembershipFn, s_shape, trapezoid_sides, z_shape};
+use crate::eval::{s_shape, sigmoid, trapezoid_sides, z_shape};
+use crate::membership::MembershipFn;
 
 /// Writes `d mu / d p` at `x` into `grad`, for the parameters `p` in MATLAB's order; `mu` is the
 /// degree at `x`. Where a function has a kink (triangle corners, the shoulders of `gauss2mf`),
@@ -155,10 +156,6 @@ fn s_shape_gradient(x: f64, a: f64, b: f64) -> (f64, f64) {
         let s = (b - x) / w;
         (-4.0 * s * (b - x) / (w * w), -4.0 * s * (x - a) / (w * w))
     }
-}
-
-fn sigmoid(x: f64, slope: f64, center: f64) -> f64 {
-    1.0 / (1.0 + (-slope * (x - center)).exp())
 }
 
 /// `(d s / d a, d s / d c)` of `s = 1 / (1 + exp(-a (x - c)))`.
@@ -332,7 +329,7 @@ mod tests {
                 let degree_at = |delta: f64| {
                     let mut p = params;
                     p[k] += delta;
-                    let moved = MembershipFn::from_matlab_unchecked(mf.matlab_name(), &p[..count]);
+                    let moved = mf.with_params(&p[..count]);
                     moved.degree(x)
                 };
                 let (Ok(up), Ok(down)) = (degree_at(h), degree_at(-h)) else { continue };
@@ -366,7 +363,7 @@ mod tests {
             for (p, s) in params.iter_mut().zip(step) {
                 *p += s;
             }
-            let mut moved = MembershipFn::from_matlab_unchecked(mf.matlab_name(), &params[..count]);
+            let mut moved = mf.with_params(&params[..count]);
             repair(&mut moved, &mf, 2.0);
             prop_assert!(moved.validate().is_ok(), "{moved:?}");
             // A spline of smf, zmf or pimf stays a spline.

@@ -52,7 +52,7 @@ struct SweepArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "fuzzy,pd,computed-torque,fuzzy-gc"
+        default_value = crate::args::ALL_CONTROLLERS.as_str()
     )]
     controllers: Vec<ControllerKind>,
     /// Noise levels L, comma-separated: the sensor noise std on every modal coordinate in rad.
@@ -248,7 +248,7 @@ fn merge_files(inputs: &[PathBuf], out: &Path, target: &Path) -> Result<String, 
 /// table.
 fn write_report(whole: &ShardFile, out: &Path) -> Result<String, String> {
     let cells = study::cells(&whole.config, &whole.runs);
-    let summary = report::summary_json(&whole.config, &cells);
+    let summary = sim_core::summary_json::sweep(&whole.config, &cells);
     let summary = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())? + "\n";
     write(&out.join("summary.json"), &summary)?;
     let mut table = report::table(&whole.config, &cells);

@@ -1,8 +1,7 @@
-//! The report of a whole sweep: a text table, `summary.json` and an SVG plot of the tip error
-//! against the noise level.
+//! The report of a whole sweep: a text table and an SVG plot of the tip error against the noise
+//! level (its `summary.json` is `sim_core::summary_json::sweep`'s).
 
 use crate::plot::{Labels, Series, line_chart};
-use serde_json::json;
 use sim_core::study::{Cell, Stats, SweepConfig};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -125,11 +124,6 @@ pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
         }
     }
     s
-}
-
-/// `summary.json`: the configuration and the cells.
-pub fn summary_json(config: &SweepConfig, cells: &[Cell]) -> serde_json::Value {
-    json!({ "config": config, "cells": cells })
 }
 
 /// The plot: mean tip error RMS against the noise level per controller, with the band

@@ -1,10 +1,13 @@
 """hrm: hyper-redundant manipulators from Python.
 
 Planar chain dynamics (``Arm``), the modal reduction of the paper's backbone-curve method
-(``ReducedModel``) and Takagi-Sugeno fuzzy systems (``hrm.fuzzy``), computed by the Rust crates
-of https://github.com/hrm-toolkit/hrm. Every method takes one state, shape ``(n,)``, or a batch,
-shape ``(N, n)``, as numpy arrays (or anything ``numpy.asarray`` turns into real numbers) and
-answers with the same leading dimension; batches release the GIL and run on all cores.
+(``ReducedModel``), Takagi-Sugeno fuzzy systems (``hrm.fuzzy``), closed-loop experiments
+(``Scenario``, run with a built-in or a Python controller into a ``Run``) and Monte Carlo
+sweeps (``Sweep``, whole or shard by shard), computed by the Rust crates of
+https://github.com/hrm-toolkit/hrm. Every model method takes one state, shape ``(n,)``, or a
+batch, shape ``(N, n)``, as numpy arrays (or anything ``numpy.asarray`` turns into real
+numbers) and answers with the same leading dimension; batches, runs and sweeps release the GIL
+and run on all cores.
 
 Errors are ``InvalidInput`` (a ``ValueError``), ``Unreachable`` (a ``ValueError``) and
 ``NumericalError`` (an ``ArithmeticError``), with the messages the ``hrm`` command prints.
@@ -17,6 +20,11 @@ from ._hrm import (
     InvalidInput,
     NumericalError,
     ReducedModel,
+    ReferenceSample,
+    Run,
+    Scenario,
+    Settings,
+    Sweep,
     Unreachable,
     __version__,
 )
@@ -26,6 +34,11 @@ __all__ = [
     "InvalidInput",
     "NumericalError",
     "ReducedModel",
+    "ReferenceSample",
+    "Run",
+    "Scenario",
+    "Settings",
+    "Sweep",
     "Unreachable",
     "__version__",
     "fuzzy",

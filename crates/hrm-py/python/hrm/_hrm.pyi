@@ -1,6 +1,7 @@
 """Type stubs of the extension module hrm._hrm (re-exported by hrm and hrm.fuzzy)."""
 
-from typing import Literal, Optional, Sequence, Union
+from os import PathLike
+from typing import Any, Callable, Dict, Iterable, List, Literal, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -108,3 +109,148 @@ class ReducedModel:
         """a_ddot = M*^-1 (tau* - C* - G*), shape (m,) or (N, m)."""
     def joint_torques(self, a: ArrayLike, a_dot: ArrayLike, a_ddot: ArrayLike) -> Array:
         """tau = M J a_ddot + C + G, shape (n,) or (N, n)."""
+
+class Settings:
+    """A table of a scenario (scenario.arm, scenario.reference.sine); its keys are attributes
+    that read and write the scenario itself."""
+
+    def __getattr__(self, name: str) -> Any: ...
+    def __setattr__(self, name: str, value: Any) -> None: ...
+    def __delattr__(self, name: str) -> None: ...
+    def to_dict(self) -> Dict[str, Any]:
+        """The table as a dict (a copy)."""
+
+class ReferenceSample:
+    """The reference a Python controller receives at a sample (reference noise included)."""
+
+    @property
+    def a(self) -> Array:
+        """Desired modal coordinates (rad), shape (m,)."""
+    @property
+    def a_dot(self) -> Array:
+        """Desired rates (rad/s), shape (m,)."""
+    @property
+    def a_ddot(self) -> Array:
+        """Desired accelerations (rad/s^2), shape (m,)."""
+
+ControllerFunction = Callable[[float, Array, Array, ReferenceSample], ArrayLike]
+
+class Run:
+    """The result of Scenario.run: time series (one row per recorded sample) and summary."""
+
+    @property
+    def t(self) -> Array:
+        """Sample times (s), shape (K,)."""
+    @property
+    def a(self) -> Array:
+        """Modal coordinates (rad), shape (K, m)."""
+    @property
+    def a_dot(self) -> Array:
+        """Modal rates (rad/s), shape (K, m)."""
+    @property
+    def a_ref(self) -> Array:
+        """The noise-free reference (rad), shape (K, m)."""
+    @property
+    def tau_star(self) -> Array:
+        """Modal torques tau* held from each sample (N m), shape (K, m)."""
+    @property
+    def joint_torques(self) -> Array:
+        """Joint torques tau = M J a_ddot + C + G (N m), shape (K, n)."""
+    @property
+    def tip(self) -> Array:
+        """The chain's tip (m), shape (K, 2)."""
+    @property
+    def tip_ref(self) -> Array:
+        """The reference tip (m), shape (K, 2)."""
+    @property
+    def summary(self) -> Dict[str, Any]:
+        """The summary metrics, with the keys of `hrm simulate`'s summary.json."""
+    @property
+    def failure(self) -> Optional[str]:
+        """Why and when the run stopped early, or None."""
+    @property
+    def controller(self) -> str:
+        """The controller's name, or "python" for a callable."""
+    @property
+    def coordinates(self) -> List[str]:
+        """The names of the modal coordinates."""
+
+class Scenario:
+    """A closed-loop experiment; every key of its TOML file is an attribute."""
+
+    name: str
+    description: str
+    duration: float
+    alpha0: Union[float, str]
+    seed: int
+    record_period: Optional[float]
+    modal: Settings
+    arm: Settings
+    initial: Optional[Settings]
+    reference: Settings
+    controller: Settings
+    integrator: Settings
+    noise: Settings
+    limits: Settings
+
+    @staticmethod
+    def builtin(name: str) -> "Scenario":
+        """A scenario shipped with hrm, by name."""
+    @staticmethod
+    def builtin_names() -> List[str]:
+        """The names of the shipped scenarios."""
+    @staticmethod
+    def from_toml(path_or_text: Union[str, "PathLike[str]"]) -> "Scenario":
+        """Reads a scenario from a TOML file or from its text."""
+    def to_toml(self) -> str:
+        """The scenario as TOML text."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The whole scenario as a dict (a copy)."""
+    def copy(self) -> "Scenario":
+        """An independent copy."""
+    @property
+    def n_coords(self) -> int:
+        """Number of modal coordinates m."""
+    @property
+    def coordinate_names(self) -> List[str]:
+        """a1, ..., a2K, then alpha0 when it is free."""
+    def run(self, controller: Union[None, str, ControllerFunction] = None) -> Run:
+        """Runs the closed loop with the scenario's controller, a built-in one by name, or a
+        Python callable f(t, a, a_dot, ref) -> tau_star."""
+
+class Sweep:
+    """A Monte Carlo sweep over noise levels and seeds (hrm sweep), whole or by shards."""
+
+    def __init__(
+        self,
+        scenario: Union[Scenario, str, "PathLike[str]"],
+        noise_levels: Sequence[float],
+        seeds: int,
+        controllers: Optional[Sequence[str]] = None,
+        base_seed: int = 1,
+        rate_noise_ratio: float = 10.0,
+        reference_noise_ratio: float = 0.0,
+    ) -> None: ...
+    @property
+    def n_runs(self) -> int:
+        """Noise levels x controllers x seeds."""
+    @property
+    def config(self) -> Dict[str, Any]:
+        """The configuration as a dict."""
+    @property
+    def scenario(self) -> Scenario:
+        """The scenario swept (a copy)."""
+    def shard_runs(self, index: int, count: int) -> List[int]:
+        """The run indices of shard index of count."""
+    def run_shard(self, index: int = 1, count: int = 1) -> str:
+        """Runs one shard (GIL released) and returns the shard file's JSON text."""
+    def run(self) -> Dict[str, Any]:
+        """Runs the whole sweep and returns its summary.json as a dict."""
+    @staticmethod
+    def merge(shards: Iterable[Union[str, "PathLike[str]"]]) -> Dict[str, Any]:
+        """Combines shard files (texts, paths or directories) into the whole sweep's summary."""
+    def to_json(self) -> str:
+        """The configuration as JSON."""
+    @staticmethod
+    def from_json(text: str) -> "Sweep":
+        """A sweep from its configuration's JSON."""

@@ -1,8 +1,11 @@
 //! The paper's fuzzy controller (Figure 8), for any number of modal coordinates, optionally with
-//! gravity compensation.
+//! gravity compensation; and the input layout of controllers learned by imitation.
 
-use super::{ControlContext, Controller, ControllerError, check_context, check_coordinate_count};
+use super::{
+    ControlContext, Controller, ControllerError, ModalState, check_context, check_coordinate_count,
+};
 use crate::error::SimError;
+use crate::reference::ReferenceSample;
 use fuzzy_sugeno::{Evaluator, FuzzySystem};
 use modal_reduce::{ReducedData, ReducedModel};
 
@@ -16,6 +19,36 @@ pub(super) enum Layout {
     /// `(a_1, a_2), (a_3, a_4), ...`; with `m` odd the last coordinate takes the first slot of a
     /// pair whose second slot is zero.
     Pairs,
+    /// One system over all coordinates with the [`scheduled_inputs`] (`4m` inputs), outputs
+    /// `[tau_1*, ..., tau_m*]`: the layout of controllers learned by imitation.
+    Scheduled,
+}
+
+/// The number of inputs per coordinate of the [`Layout::Scheduled`] layout.
+pub(crate) const SCHEDULED_INPUTS_PER_COORDINATE: usize = 4;
+
+/// Writes the `4m` inputs of a scheduled fuzzy controller into `out`: per coordinate the error
+/// `a_i - a_i_ref`, the error rate `a_i_dot - a_i_ref_dot`, the coordinate `a_i` and the reference
+/// acceleration `a_i_ref_ddot`, in four blocks of `m`:
+/// `[da_1..da_m, da_1_dot..da_m_dot, a_1..a_m, a_1_ref_ddot..a_m_ref_ddot]`.
+///
+/// They are the quantities computed torque (eq 15 solved for `tau*`) is made of: its torque
+/// `M*(a) (a_ref_ddot - kp da - kd da_dot) + C*(a, a_dot) + G*(a)` is linear in the errors and
+/// the reference acceleration with coefficients that depend on the configuration `a`, so a
+/// first-order Sugeno system whose rules partition `a` and whose linear consequents take all four
+/// blocks can reproduce it (gain scheduling).
+pub(crate) fn scheduled_inputs(
+    measured: &ModalState,
+    reference: &ReferenceSample,
+    out: &mut [f64],
+) {
+    let m = measured.a.len();
+    for i in 0..m {
+        out[i] = measured.a[i] - reference.a[i];
+        out[m + i] = measured.a_dot[i] - reference.a_dot[i];
+        out[2 * m + i] = measured.a[i];
+        out[3 * m + i] = reference.a_ddot[i];
+    }
 }
 
 impl Layout {
@@ -27,46 +60,61 @@ impl Layout {
             Ok(Layout::Whole)
         } else if (inputs, outputs) == (4, 2) {
             Ok(Layout::Pairs)
+        } else if (inputs, outputs) == (SCHEDULED_INPUTS_PER_COORDINATE * m, m) {
+            Ok(Layout::Scheduled)
         } else {
             Err(SimError::setting(
                 "controller.fis",
                 format!(
                     "must have {} inputs [da_1..da_{m}, a_1_dot..a_{m}_dot] and {m} outputs \
                      [tau_1..tau_{m}] for {m} modal coordinates (or 4 inputs and 2 outputs, \
-                     applied per coordinate pair), '{}' has {inputs} inputs and {outputs} outputs",
+                     applied per coordinate pair, or {} inputs [da, da_dot, a, a_ref_ddot] of a \
+                     learned controller), '{}' has {inputs} inputs and {outputs} outputs",
                     2 * m,
+                    SCHEDULED_INPUTS_PER_COORDINATE * m,
                     system.name()
                 ),
             ))
         }
     }
 
-    /// The system input that receives the error (`rate = false`) or the rate of coordinate `i`
-    /// of `m`.
+    /// The system input that receives the error (`rate = false`) or the rate (the error rate
+    /// for [`Layout::Scheduled`]) of coordinate `i` of `m`.
     pub(super) fn input_index(self, i: usize, m: usize, rate: bool) -> usize {
         match self {
-            Layout::Whole => i + if rate { m } else { 0 },
+            Layout::Whole | Layout::Scheduled => i + if rate { m } else { 0 },
             Layout::Pairs => i % 2 + if rate { 2 } else { 0 },
         }
     }
 
-    /// Evaluates `evaluator` on the error `da = a - a_ref` and rate `a_dot` of every coordinate
-    /// (the inputs measured minus desired, the sign that makes Table 1 stabilising), using
-    /// `inputs` as scratch (`2m` entries, or 4 for pairs).
+    /// The number of system inputs for `m` coordinates (the size of [`eval`](Self::eval)'s
+    /// scratch).
+    pub(super) fn n_inputs(self, m: usize) -> usize {
+        match self {
+            Layout::Whole => 2 * m,
+            Layout::Pairs => 4,
+            Layout::Scheduled => SCHEDULED_INPUTS_PER_COORDINATE * m,
+        }
+    }
+
+    /// Evaluates `evaluator` on the `measured` state and the `reference` (the inputs measured
+    /// minus desired, the sign that makes Table 1 stabilising), using `inputs` as scratch
+    /// ([`n_inputs`](Self::n_inputs) entries).
     pub(super) fn eval(
         self,
         evaluator: &mut Evaluator,
-        da: impl Fn(usize) -> f64,
-        a_dot: impl Fn(usize) -> f64,
+        measured: &ModalState,
+        reference: &ReferenceSample,
         inputs: &mut [f64],
         tau: &mut [f64],
     ) -> Result<(), fuzzy_sugeno::FuzzyError> {
         let m = tau.len();
+        let da = |i: usize| measured.a[i] - reference.a[i];
         match self {
             Layout::Whole => {
                 for i in 0..m {
                     inputs[i] = da(i);
-                    inputs[m + i] = a_dot(i);
+                    inputs[m + i] = measured.a_dot[i];
                 }
                 evaluator.eval(&inputs[..2 * m], tau)
             }
@@ -75,11 +123,17 @@ impl Layout {
                     let (i, j) = (2 * p, 2 * p + 1);
                     let mut out = [0.0; 2];
                     let second = |f: &dyn Fn(usize) -> f64| if j < m { f(j) } else { 0.0 };
+                    let a_dot = |i: usize| measured.a_dot[i];
                     let x = [da(i), second(&da), a_dot(i), second(&a_dot)];
                     evaluator.eval(&x, &mut out)?;
                     pair.copy_from_slice(&out[..pair.len()]);
                 }
                 Ok(())
+            }
+            Layout::Scheduled => {
+                let inputs = &mut inputs[..SCHEDULED_INPUTS_PER_COORDINATE * m];
+                scheduled_inputs(measured, reference, inputs);
+                evaluator.eval(inputs, tau)
             }
         }
     }
@@ -98,6 +152,11 @@ impl Layout {
 /// cosine-type `a_{2k}` as on `a2`; a free `alpha0` (the last of an odd `m`) is treated like `a1`.
 /// For `m = 2` the two readings coincide: the paper's controller.
 ///
+/// A system with `4m` inputs and `m` outputs, such as one learned by imitation
+/// ([`crate::imitation`]), is evaluated once per sample on the errors, error rates, coordinates
+/// and reference accelerations (`[da_1..da_m, da_1_dot..da_m_dot, a_1..a_m,
+/// a_1_ref_ddot..a_m_ref_ddot]`).
+///
 /// With gravity compensation ("fuzzy-gc") the reduced gravity vector `G*(a)` of the measured
 /// configuration is added to the fuzzy output.
 #[derive(Debug, Clone)]
@@ -111,7 +170,8 @@ pub struct FuzzyController {
 
 impl FuzzyController {
     /// The fuzzy controller `system` for `m` coordinates; fails unless it has `2m` inputs and
-    /// `m` outputs, or 4 inputs and 2 outputs (applied per pair).
+    /// `m` outputs, 4 inputs and 2 outputs (applied per pair), or `4m` inputs and `m` outputs
+    /// (scheduled).
     ///
     /// ```
     /// use backbone_kin::ModalMap;
@@ -134,15 +194,11 @@ impl FuzzyController {
     /// ```
     pub fn new(system: FuzzySystem, m: usize) -> Result<Self, SimError> {
         let layout = Layout::of(&system, m)?;
-        let inputs = match layout {
-            Layout::Whole => 2 * m,
-            Layout::Pairs => 4,
-        };
         Ok(Self {
             evaluator: Evaluator::new(system),
             layout,
             m,
-            inputs: vec![0.0; inputs],
+            inputs: vec![0.0; layout.n_inputs(m)],
             gravity: None,
         })
     }
@@ -181,8 +237,8 @@ impl Controller for FuzzyController {
         self.layout
             .eval(
                 &mut self.evaluator,
-                |i| measured.a[i] - reference.a[i],
-                |i| measured.a_dot[i],
+                measured,
+                reference,
                 &mut self.inputs,
                 tau_star,
             )

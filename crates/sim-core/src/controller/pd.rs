@@ -1,8 +1,11 @@
 //! A linear controller with the fuzzy controller's inputs: its linearisation at the origin.
 
 use super::fuzzy::Layout;
-use super::{ControlContext, Controller, ControllerError, check_context, check_coordinate_count};
+use super::{
+    ControlContext, Controller, ControllerError, ModalState, check_context, check_coordinate_count,
+};
 use crate::error::{SimError, check_finite};
+use crate::reference::ReferenceSample;
 use fuzzy_sugeno::{Evaluator, FuzzySystem};
 
 /// Relative step of the central differences that linearise a fuzzy system, as a fraction of
@@ -63,6 +66,8 @@ impl PdController {
     /// [`FuzzyController`](super::FuzzyController) for the shapes it accepts) at the origin:
     /// each coordinate's offset and its own error and rate slopes (the diagonal of the
     /// Jacobian), by central differences with steps of `1e-6` of each input's range width.
+    /// The state is perturbed with the reference at rest at zero, so for a scheduled (learned)
+    /// system the error slope includes the slope in the coordinate input `a_i`.
     ///
     /// ```
     /// use sim_core::controller::PdController;
@@ -74,13 +79,15 @@ impl PdController {
     pub fn from_fuzzy_slope(system: &FuzzySystem, m: usize) -> Result<Self, SimError> {
         let layout = Layout::of(system, m)?;
         let mut evaluator = Evaluator::new(system.clone());
-        let mut scratch = vec![0.0; system.inputs().len()];
+        let mut scratch = vec![0.0; layout.n_inputs(m)];
         let mut tau = vec![0.0; m];
-        let mut eval = |evaluator: &mut Evaluator, da: &[f64], rate: &[f64], tau: &mut [f64]| {
-            layout.eval(evaluator, |i| da[i], |i| rate[i], &mut scratch, tau)
+        // At the origin: the reference at rest at zero, the state perturbed.
+        let reference = ReferenceSample::zeros(m);
+        let mut state = ModalState::zeros(m);
+        let mut eval = |evaluator: &mut Evaluator, state: &ModalState, tau: &mut [f64]| {
+            layout.eval(evaluator, state, &reference, &mut scratch, tau)
         };
-        let zero = vec![0.0; m];
-        eval(&mut evaluator, &zero, &zero, &mut tau)?;
+        eval(&mut evaluator, &state, &mut tau)?;
         let offset = tau.clone();
         let (mut plus, mut minus) = (vec![0.0; m], vec![0.0; m]);
         let mut slopes = [vec![0.0; m], vec![0.0; m]];
@@ -89,13 +96,18 @@ impl PdController {
             for i in 0..m {
                 let range = system.inputs()[layout.input_index(i, m, rate)].range;
                 let h = SLOPE_STEP * (range[1] - range[0]);
-                let mut x = vec![0.0; m];
-                x[i] = h;
-                let (da, v) = if rate { (&zero, &x) } else { (&x, &zero) };
-                eval(&mut evaluator, da, v, &mut plus)?;
-                x[i] = -h;
-                let (da, v) = if rate { (&zero, &x) } else { (&x, &zero) };
-                eval(&mut evaluator, da, v, &mut minus)?;
+                let set = |state: &mut ModalState, v: f64| {
+                    if rate {
+                        state.a_dot[i] = v;
+                    } else {
+                        state.a[i] = v;
+                    }
+                };
+                set(&mut state, h);
+                eval(&mut evaluator, &state, &mut plus)?;
+                set(&mut state, -h);
+                eval(&mut evaluator, &state, &mut minus)?;
+                set(&mut state, 0.0);
                 slope[i] = -(plus[i] - minus[i]) / (2.0 * h);
             }
         }

@@ -1,0 +1,485 @@
+//! The `hrm` command line on bad input (the "Command line" rows of `docs/bad-input.md`): a
+//! non-zero exit status, exactly one readable line on stderr starting with `hrm:`, and never a
+//! panic. Clap's own usage errors are the one exception: they are several lines, starting with
+//! `error:`, and exit with status 2.
+
+use crate::common::{hrm, scratch};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A regular file `blocker` in `dir`: `blocker/out` can never be created as a folder, even by
+/// root (permission bits would not stop the tests, which run as root).
+fn blocked_folder(dir: &Path) -> PathBuf {
+    let blocker = dir.join("blocker");
+    std::fs::write(&blocker, "a file, not a folder").unwrap();
+    blocker.join("out")
+}
+
+/// A short scenario file (a 0.01 s step response), so that a run costs nothing.
+fn short_scenario(dir: &Path) -> PathBuf {
+    let path = dir.join("short.toml");
+    std::fs::write(
+        &path,
+        r#"name = "short"
+duration = 0.01
+alpha0 = 1.5707963267948966
+record_period = 0.001
+
+[reference]
+kind = "step"
+initial = [0.0, 0.0]
+target = [0.2, -0.2]
+time = 0.0
+
+[controller]
+kind = "fuzzy"
+period = 0.001
+
+[integrator]
+method = "rk4"
+dt = 0.0001
+"#,
+    )
+    .unwrap();
+    path
+}
+
+/// Fails unless `output` is a clean refusal: non-zero status, one `hrm: ` line on stderr, no
+/// panic. Returns that line.
+fn refused(output: &Output) -> String {
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "exit status {:?}", output.status);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "stderr is not one line: {stderr:?}");
+    assert!(lines[0].starts_with("hrm: "), "{stderr:?}");
+    lines[0].to_string()
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn simulate_out_folder_under_a_regular_file() {
+    let dir = scratch("errors-simulate-out");
+    let (scenario, out) = (short_scenario(&dir), blocked_folder(&dir));
+    let line = refused(&hrm(&[
+        "simulate",
+        "--scenario",
+        path(&scenario),
+        "--out",
+        path(&out),
+    ]));
+    assert!(line.contains("blocker"), "{line}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn fis_surface_out_folder_under_a_regular_file() {
+    let dir = scratch("errors-surface-out");
+    let out = blocked_folder(&dir);
+    let fis = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../fuzzy-sugeno/data/paper.fis"
+    );
+    let line = refused(&hrm(&[
+        "fis",
+        "surface",
+        fis,
+        "--out",
+        path(&out),
+        "--resolution",
+        "3",
+    ]));
+    assert!(line.contains("blocker"), "{line}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn simulate_unknown_scenario() {
+    let line = refused(&hrm(&["simulate", "--scenario", "no-such-scenario"]));
+    assert!(line.contains("no-such-scenario"), "{line}");
+}
+
+#[test]
+fn simulate_unknown_controller() {
+    let dir = scratch("errors-controller");
+    let scenario = short_scenario(&dir);
+    let line = refused(&hrm(&[
+        "simulate",
+        "--scenario",
+        path(&scenario),
+        "--controller",
+        "banana",
+        "--out",
+        path(&dir.join("out")),
+    ]));
+    assert!(line.contains("banana"), "{line}");
+    assert!(
+        !dir.join("out").exists(),
+        "nothing is written for a refused run"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn fis_check_missing_file() {
+    let dir = scratch("errors-fis-missing");
+    let missing = dir.join("missing.fis");
+    let line = refused(&hrm(&["fis", "check", path(&missing)]));
+    assert!(line.contains("missing.fis"), "{line}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn fis_check_garbage_file() {
+    let dir = scratch("errors-fis-garbage");
+    let garbage = dir.join("garbage.fis");
+    std::fs::write(&garbage, b"\x00\xffnot a [fis] file\n=== ===\n").unwrap();
+    refused(&hrm(&["fis", "check", path(&garbage)]));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn unknown_subcommand() {
+    // Clap's usage error: several lines (the error, a usage line, a hint), status 2.
+    let output = hrm(&["frobnicate"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(
+        stderr.starts_with("error: unrecognized subcommand 'frobnicate'"),
+        "{stderr}"
+    );
+}
+
+fn stdout(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+/// Every file under `dir` with its contents, sorted by path.
+fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut files = Vec::new();
+    let mut pending = vec![dir.to_path_buf()];
+    while let Some(d) = pending.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                pending.push(path);
+            } else {
+                files.push((path.clone(), std::fs::read(&path).unwrap()));
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+#[test]
+fn a_failing_simulate_leaves_the_earlier_output_and_a_success_replaces_it() {
+    let dir = scratch("errors-simulate-replace");
+    let (scenario, out) = (short_scenario(&dir), dir.join("out"));
+    let run = |scenario: &Path| {
+        hrm(&[
+            "simulate",
+            "--scenario",
+            path(scenario),
+            "--out",
+            path(&out),
+        ])
+    };
+    let first = run(&scenario);
+    assert!(first.status.success(), "{first:?}");
+    assert!(stdout(&first).contains("wrote"));
+    std::fs::write(out.join("stale.txt"), "from an earlier run").unwrap();
+    let before = snapshot(&out);
+    // A scenario that fails validation (not a whole number of periods): refused, nothing
+    // touched, no "wrote".
+    let bad = dir.join("bad.toml");
+    let text = std::fs::read_to_string(&scenario).unwrap();
+    std::fs::write(&bad, text.replace("duration = 0.01", "duration = 0.0105")).unwrap();
+    let output = run(&bad);
+    let line = refused(&output);
+    assert!(line.contains("duration must be a whole number"), "{line}");
+    assert!(!stdout(&output).contains("wrote"), "{output:?}");
+    assert_eq!(snapshot(&out), before, "the earlier output changed");
+    // A success replaces the folder whole: the stale file is gone.
+    assert!(run(&scenario).status.success());
+    assert!(!out.join("stale.txt").exists());
+    assert!(out.join("timeseries.csv").is_file() && out.join(".hrm-output").is_file());
+    // A folder that hrm did not write is never replaced.
+    let mine = dir.join("mine");
+    std::fs::create_dir_all(&mine).unwrap();
+    std::fs::write(mine.join("notes.txt"), "mine").unwrap();
+    let line = refused(&hrm(&[
+        "simulate",
+        "--scenario",
+        path(&scenario),
+        "--out",
+        path(&mine),
+    ]));
+    assert!(line.contains("hrm did not write"), "{line}");
+    assert!(mine.join("notes.txt").is_file());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_diverging_simulate_writes_its_data_up_to_the_stop() {
+    let dir = scratch("errors-simulate-diverge");
+    let scenario = dir.join("runaway.toml");
+    // The step comes at 5 ms; a 0.05 rad runaway bound stops the run right after it.
+    let text = std::fs::read_to_string(short_scenario(&dir)).unwrap();
+    let text = text.replace("time = 0.0", "time = 0.005") + "\n[limits]\nmax_modal_error = 0.05\n";
+    std::fs::write(&scenario, text).unwrap();
+    let out = dir.join("out");
+    let output = hrm(&[
+        "simulate",
+        "--scenario",
+        path(&scenario),
+        "--out",
+        path(&out),
+    ]);
+    let line = refused(&output);
+    assert!(line.contains("runaway tracking error"), "{line}");
+    assert!(stdout(&output).contains("wrote"), "{output:?}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let stopped = summary["stopped_at_s"].as_f64().unwrap();
+    assert!((0.005..0.01).contains(&stopped), "{summary}");
+    assert!(summary["error"].as_str().unwrap().contains("runaway"));
+    assert!(summary["tip_error_rms_m"].as_f64().unwrap().is_finite());
+    let csv = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
+    let last_t: f64 = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        csv.lines().count() > 5 && (last_t - stopped).abs() < 1e-12,
+        "{csv}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn counts_are_bounded_before_use_with_the_option_named() {
+    let fis = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../fuzzy-sugeno/data/paper.fis"
+    );
+    let dir = scratch("errors-counts");
+    let out = dir.join("out");
+    let noise: Vec<String> = (0..1001).map(|k| format!("{}", k as f64 * 1e-4)).collect();
+    let noise = noise.join(",");
+    for (args, expected) in [
+        (
+            vec!["fis", "check", "--samples", "1000000000000", fis],
+            "--samples must be at least 2 and at most 1000000, got 1000000000000",
+        ),
+        (
+            vec!["fis", "check", "--samples", "-1", fis],
+            "--samples must be at least 2",
+        ),
+        (
+            vec![
+                "fis",
+                "surface",
+                fis,
+                "--out",
+                path(&out),
+                "--resolution",
+                "100000",
+            ],
+            "--resolution must be at least 2 and at most 600",
+        ),
+        (
+            vec![
+                "fis",
+                "surface",
+                fis,
+                "--out",
+                path(&out),
+                "--resolution",
+                "-5",
+            ],
+            "got -5",
+        ),
+        (
+            vec!["sweep", "--seeds", "-1", "--out", path(&out)],
+            "--seeds must be at least 1 and at most 1000000, got -1",
+        ),
+        (
+            vec![
+                "sweep",
+                "--seeds",
+                "100000000000000000",
+                "--shard",
+                "1/2",
+                "--out",
+                path(&out),
+            ],
+            "--seeds must be at least 1",
+        ),
+        (
+            vec!["sweep", "--noise", &noise, "--out", path(&out)],
+            "--noise lists 1001 levels",
+        ),
+        (
+            vec!["sweep", "--controllers", "pd,fuzzy,pd", "--out", path(&out)],
+            "--controllers lists pd twice",
+        ),
+        (
+            vec!["sweep", "--seeds", "1000000", "--out", path(&out)],
+            "24000000 runs",
+        ),
+    ] {
+        let line = refused(&hrm(&args));
+        assert!(line.contains(expected), "{args:?}: {line}");
+    }
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn input_files_are_read_with_a_size_limit() {
+    let dir = scratch("errors-file-size");
+    // Sparse files: refused by their size before a byte is read.
+    let huge = |name: &str, len: u64| {
+        let path = dir.join(name);
+        std::fs::File::create(&path).unwrap().set_len(len).unwrap();
+        path
+    };
+    let fis = huge("huge.fis", (16 << 20) + 1);
+    let line = refused(&hrm(&["fis", "check", path(&fis)]));
+    assert!(
+        line.contains("16777217 bytes, more than the 16777216 allowed"),
+        "{line}"
+    );
+    let toml = huge("huge.toml", 1 << 40);
+    let line = refused(&hrm(&[
+        "simulate",
+        "--scenario",
+        path(&toml),
+        "--out",
+        path(&dir.join("o")),
+    ]));
+    assert!(
+        line.contains("huge.toml") && line.contains("more than the 16777216"),
+        "{line}"
+    );
+    let shard = huge("shard-1-of-1.json", (1 << 30) + 1);
+    let line = refused(&hrm(&[
+        "sweep",
+        "merge",
+        "--out",
+        path(&dir.join("o")),
+        path(&shard),
+    ]));
+    assert!(line.contains("more than the 1073741824 allowed"), "{line}");
+    // An endless stream stops at the limit.
+    if Path::new("/dev/zero").exists() {
+        let line = refused(&hrm(&["fis", "eval", "/dev/zero", "0"]));
+        assert!(
+            line.contains("more than the 16777216 bytes allowed"),
+            "{line}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn control_bytes_from_a_file_are_escaped_in_the_message() {
+    let dir = scratch("errors-control-bytes");
+    let paper = include_str!("../../../fuzzy-sugeno/data/paper.fis");
+    let fis = dir.join("evil.fis");
+    std::fs::write(
+        &fis,
+        paper.replacen("NumMFs=2", "NumMFs=\u{1b}[2J\u{7}\r", 1),
+    )
+    .unwrap();
+    let output = hrm(&["fis", "check", path(&fis)]);
+    let line = refused(&output);
+    assert!(
+        !output.stderr.iter().any(|&b| b < 0x20 && b != b'\n'),
+        "{line:?}"
+    );
+    assert!(line.contains("\\u{1b}[2J\\u{7}"), "{line}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Runs `hrm args` with `stdin` as input and its standard output closed as soon as it starts,
+/// as `hrm ... | head -0` would.
+fn with_reader_gone(args: &[&str], stdin: &[u8]) -> Output {
+    use std::io::Write;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hrm"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let mut input = child.stdin.take().unwrap();
+    // The write fails once hrm has stopped reading; that is fine.
+    let _ = input.write_all(stdin);
+    drop(input);
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+fn output_ends_quietly_when_the_reader_goes_away() {
+    let fis = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../fuzzy-sugeno/data/paper.fis"
+    );
+    let requests = "{\"op\":\"fk\",\"a\":[0.3,-0.2],\"alpha0\":1.2}\n".repeat(2000);
+    for (args, stdin) in [
+        (vec!["eval"], requests.as_bytes()),
+        (vec!["fis", "eval", fis, "0.1", "0", "0", "0"], &b""[..]),
+        (vec!["fis", "check", fis], &b""[..]),
+    ] {
+        let output = with_reader_gone(&args, stdin);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(0), "{args:?}: {stderr}");
+        assert!(stderr.is_empty(), "{args:?}: {stderr}");
+    }
+}
+
+#[test]
+fn a_merge_into_the_folder_of_its_shards_is_refused() {
+    let dir = scratch("errors-merge-into-shards");
+    let (scenario, shards) = (short_scenario(&dir), dir.join("shards"));
+    let output = hrm(&[
+        "sweep",
+        "--scenario",
+        path(&scenario),
+        "--noise",
+        "0",
+        "--seeds",
+        "1",
+        "--controllers",
+        "pd",
+        "--shard",
+        "1/1",
+        "--out",
+        path(&shards),
+    ]);
+    assert!(output.status.success(), "{output:?}");
+    let before = snapshot(&shards);
+    let line = refused(&hrm(&[
+        "sweep",
+        "merge",
+        "--out",
+        path(&shards),
+        path(&shards),
+    ]));
+    assert!(line.contains("holds the shard file"), "{line}");
+    assert_eq!(snapshot(&shards), before);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,86 @@
+//! `hrm fis export` and FCL files in `hrm fis eval`: the paper's controller through FCL gives
+//! the same outputs, the C files are written, bad options are one-line errors.
+
+use crate::common::{hrm, scratch};
+use std::process::Output;
+
+const PAPER_FIS: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../fuzzy-sugeno/data/paper.fis"
+);
+const FUZZYLITE_FCL: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../fuzzy-sugeno/data/paper.fuzzylite.fcl"
+);
+
+fn stdout(output: &Output) -> String {
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8(output.stdout.clone()).unwrap()
+}
+
+#[test]
+fn fcl_export_evaluates_like_the_fis_file() {
+    let dir = scratch("fis-export-fcl");
+    let out = dir.to_str().unwrap();
+    let written = stdout(&hrm(&[
+        "fis", "export", "--format", "fcl", PAPER_FIS, "--out", out,
+    ]));
+    let fcl = written.trim();
+    assert!(fcl.ends_with("paper.fcl"));
+    let x = ["0.15", "-0.1", "-0.5", "0.2"];
+    let eval = |file: &str| stdout(&hrm(&[&["fis", "eval", file][..], &x[..]].concat()));
+    let expected = eval(PAPER_FIS);
+    assert!(expected.starts_with("tau1 = -56.14035087719"), "{expected}");
+    assert_eq!(eval(fcl), expected);
+    assert_eq!(eval(FUZZYLITE_FCL), expected);
+}
+
+#[test]
+fn c_export_writes_the_header_and_source() {
+    let dir = scratch("fis-export-c");
+    let out = dir.to_str().unwrap();
+    let written = stdout(&hrm(&[
+        "fis",
+        "export",
+        "--format",
+        "c",
+        PAPER_FIS,
+        "--out",
+        out,
+        "--prefix",
+        "ctl",
+        "--no-rule-fired",
+        "error",
+    ]));
+    assert_eq!(written.lines().count(), 2);
+    let header = std::fs::read_to_string(dir.join("ctl.h")).unwrap();
+    assert!(header.contains("int ctl_eval(const double *in, double *out);"));
+    assert!(header.contains("an output on which no rule fires is an error"));
+    assert!(
+        std::fs::read_to_string(dir.join("ctl.c"))
+            .unwrap()
+            .contains("#include <math.h>")
+    );
+    let refused = hrm(&[
+        "fis", "export", "--format", "c", PAPER_FIS, "--out", out, "--prefix", "a-b",
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(stderr.lines().count(), 1);
+    assert!(stderr.starts_with("hrm: export: the prefix must be a C identifier"));
+}
+
+/// `hrm fis check` reads an FCL file: the same analysis as for the `.fis` file, without the
+/// `.fis` reader's line of ignored items (the FCL reader keeps no such notes).
+#[test]
+fn check_reads_fcl_without_the_notes_line() {
+    let from_fis = stdout(&hrm(&["fis", "check", PAPER_FIS]));
+    let from_fcl = stdout(&hrm(&["fis", "check", FUZZYLITE_FCL]));
+    let (notes, analysis) = from_fis.split_once('\n').unwrap();
+    assert!(notes.ends_with("paper.fis: nothing ignored"), "{notes}");
+    assert_eq!(from_fcl, analysis);
+}

@@ -1,0 +1,108 @@
+//! `hrm fis train` end to end: a CSV in, a `.fis` out that `hrm fis eval` loads and that
+//! reproduces the data; bad files are one-line errors.
+
+use crate::common::{hrm, scratch};
+use std::path::PathBuf;
+
+fn target(x1: f64, x2: f64) -> f64 {
+    (2.0 * x1).sin() + 0.5 * x2 * x2
+}
+
+fn write_csv(path: &PathBuf, rows: usize, seed: usize, header: bool) {
+    let mut text = if header {
+        "e,de,u\n".to_string()
+    } else {
+        String::new()
+    };
+    for k in 0..rows {
+        let x1 = -1.0 + 2.0 * ((k * 37 + seed) % 101) as f64 / 100.0;
+        let x2 = -1.0 + 2.0 * ((k * 13 + seed) % 17) as f64 / 16.0;
+        text.push_str(&format!("{x1},{x2},{}\n", target(x1, x2)));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn trains_writes_and_evaluates() {
+    let dir = scratch("fis-train-round-trip");
+    let (train, check, out) = (
+        dir.join("train.csv"),
+        dir.join("check.csv"),
+        dir.join("learned.fis"),
+    );
+    write_csv(&train, 200, 0, true);
+    write_csv(&check, 60, 5, false);
+    let run = hrm(&[
+        "fis",
+        "train",
+        "--data",
+        train.to_str().unwrap(),
+        "--check",
+        check.to_str().unwrap(),
+        "--mfs",
+        "3",
+        "--epochs",
+        "30",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(
+        stdout.starts_with("2 inputs, 9 rules, 200 training samples, 60 check samples\n"),
+        "{stdout}"
+    );
+    assert_eq!(stdout.matches(", check RMSE ").count(), 30);
+    assert!(stdout.contains("kept the system of epoch "));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.contains("Name='de'") && text.contains("NumRules=9"));
+    let eval = hrm(&["fis", "eval", out.to_str().unwrap(), "0.3", "-0.5"]);
+    let line = String::from_utf8_lossy(&eval.stdout);
+    let value: f64 = line.trim().strip_prefix("u = ").unwrap().parse().unwrap();
+    assert!((value - target(0.3, -0.5)).abs() < 0.01, "{line}");
+}
+
+#[test]
+fn bad_input_is_one_line() {
+    let dir = scratch("fis-train-bad");
+    let (csv, out) = (dir.join("bad.csv"), dir.join("x.fis"));
+    let refused = |args: &[&str]| {
+        let output = hrm(args);
+        assert_eq!(output.status.code(), Some(1));
+        let stderr = String::from_utf8_lossy(&output.stderr).to_string();
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        stderr
+    };
+    std::fs::write(&csv, "1,2\n3,oops\n").unwrap();
+    let args = [
+        "fis",
+        "train",
+        "--data",
+        csv.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    assert!(
+        refused(&args).ends_with("bad.csv: line 2 column 2: expected a number, found 'oops'\n")
+    );
+    std::fs::write(&csv, "1,2\n1,3\n").unwrap();
+    assert!(
+        refused(&args)
+            .ends_with("input 1 is constant (1) over the data; a fuzzy partition needs a range\n")
+    );
+    write_csv(&csv, 20, 0, false);
+    let mut many = args.to_vec();
+    many.extend(["--mfs", "100"]);
+    assert_eq!(
+        refused(&many),
+        "hrm: learning: sets per input must lie in 1..=64, got 100\n"
+    );
+    let mut order = args.to_vec();
+    order.extend(["--order", "2"]);
+    assert_eq!(refused(&order), "hrm: --order must be 0 or 1, got 2\n");
+    assert!(!out.exists());
+}

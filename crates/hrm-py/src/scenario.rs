@@ -1,0 +1,830 @@
+//! `hrm.Scenario`, `hrm.Settings` and `hrm.Run`: the closed-loop experiments of `sim-core`
+//! (section 5 of the paper) from Python, closed by a built-in controller or a Python callable.
+//!
+//! A scenario's settings are its TOML keys (`sim_core::Scenario`), read and written as
+//! attributes: `scenario.duration`, `scenario.arm.links`, `scenario.reference.sine.amplitude`.
+//! A write is converted to a TOML value and the whole scenario is deserialised again, so a
+//! wrong type or an unknown key is refused at once with the library's message; domains
+//! (positive periods, array lengths, reachable paths) are checked when the scenario is run,
+//! by `Scenario::build`, with the messages `hrm simulate` prints.
+
+use crate::array::States;
+use crate::errors::{Error, InvalidInput, NumericalError};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1};
+use pyo3::exceptions::{PyAttributeError, PyFileNotFoundError, PyOSError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use sim_core::controller::{ControlContext, Controller, ControllerError};
+use sim_core::study::Stopped;
+use sim_core::{ControllerKind, ScenarioError};
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+/// A closed-loop experiment: arm, modal family, reference, controller, integrator, noise and
+/// limits, as in a scenario file (docs/python.md, "Scenarios").
+///
+/// Build one with Scenario.builtin(name) or Scenario.from_toml(path_or_text). Every key of the
+/// TOML file is an attribute: scenario.duration, scenario.seed, scenario.arm.links,
+/// scenario.reference.sine.amplitude; a table is a Settings view that writes through. A write
+/// with a wrong type or an unknown key raises InvalidInput at once; values outside their domain
+/// are refused by run(), with the messages `hrm simulate` prints. None removes an optional key.
+#[pyclass(module = "hrm", frozen)]
+pub struct Scenario {
+    inner: Mutex<sim_core::Scenario>,
+}
+
+impl Scenario {
+    /// A Python scenario holding `scenario`.
+    pub(crate) fn wrap(scenario: sim_core::Scenario) -> Self {
+        Self {
+            inner: Mutex::new(scenario),
+        }
+    }
+
+    fn lock(&self) -> MutexGuard<'_, sim_core::Scenario> {
+        self.inner
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// A copy of the library's scenario.
+    pub(crate) fn get(&self) -> sim_core::Scenario {
+        self.lock().clone()
+    }
+}
+
+/// A `ScenarioError` as a Python exception: an unreadable file is an `OSError`
+/// (`FileNotFoundError` when it does not exist), anything else [`InvalidInput`].
+fn scenario_error(error: ScenarioError) -> PyErr {
+    match &error {
+        ScenarioError::Io { path, .. } if !path.exists() => {
+            PyFileNotFoundError::new_err(error.to_string())
+        }
+        ScenarioError::Io { .. } => PyOSError::new_err(error.to_string()),
+        _ => InvalidInput::new_err(error.to_string()),
+    }
+}
+
+/// The scenario as a TOML table (every key it would write to a file).
+fn table(scenario: &sim_core::Scenario) -> PyResult<toml::Table> {
+    match toml::Value::try_from(scenario) {
+        Ok(toml::Value::Table(table)) => Ok(table),
+        Ok(_) => unreachable!("a scenario serialises to a table"),
+        Err(e) => Err(Error::input(format!("the scenario cannot be written as TOML: {e}")).into()),
+    }
+}
+
+/// The value at `path` (keys from the top) of `table`.
+fn lookup<'a>(table: &'a toml::Table, path: &[String]) -> Option<&'a toml::Value> {
+    let (first, rest) = path.split_first()?;
+    rest.iter()
+        .try_fold(table.get(first)?, |value, key| value.as_table()?.get(key))
+}
+
+/// The table at `path` of `table`, for writing.
+fn lookup_mut<'a>(table: &'a mut toml::Table, path: &[String]) -> Option<&'a mut toml::Table> {
+    path.iter()
+        .try_fold(table, |table, key| table.get_mut(key)?.as_table_mut())
+}
+
+/// `table` with `value` at `path` + `key` (or the key removed for `None`), deserialised as a
+/// scenario: the library's message, after the dotted key, when it does not fit.
+fn with_setting(
+    mut table: toml::Table,
+    path: &[String],
+    key: &str,
+    value: Option<toml::Value>,
+) -> Result<sim_core::Scenario, Error> {
+    let dotted = dotted(path, key);
+    let parent = lookup_mut(&mut table, path)
+        .ok_or_else(|| Error::input(format!("{dotted}: the scenario has no such table")))?;
+    match value {
+        Some(value) => parent.insert(key.to_string(), value),
+        None => parent.remove(key),
+    };
+    toml::Value::Table(table)
+        .try_into::<sim_core::Scenario>()
+        .map_err(|e| Error::input(format!("{dotted}: {}", e.message().trim_end())))
+}
+
+/// `path.key` as a scenario file spells it.
+fn dotted(path: &[String], key: &str) -> String {
+    path.iter()
+        .map(String::as_str)
+        .chain([key])
+        .collect::<Vec<_>>()
+        .join(".")
+}
+
+/// Reads setting `key` of the table at `path`: a table is a [`Settings`] view, a value its
+/// Python equivalent, an optional key that is not set `None`; a key the scenario does not have
+/// is an `AttributeError`.
+fn read_setting(
+    py: Python<'_>,
+    scenario: &Py<Scenario>,
+    path: &[String],
+    key: &str,
+) -> PyResult<Py<PyAny>> {
+    let current = table(&scenario.get().lock())?;
+    let mut full = path.to_vec();
+    full.push(key.to_string());
+    match lookup(&current, &full) {
+        Some(toml::Value::Table(_)) => Ok(Py::new(
+            py,
+            Settings {
+                scenario: scenario.clone_ref(py),
+                path: full,
+            },
+        )?
+        .into_any()),
+        Some(value) => toml_to_py(py, value),
+        None => {
+            // A key the scenario may hold but does not: probing it with a value of a type no
+            // setting has (an empty array of tables) fails with "unknown field" only if no such
+            // setting exists.
+            let probe = toml::Value::Array(vec![toml::Value::Table(toml::Table::new())]);
+            match with_setting(current, path, key, Some(probe)) {
+                Err(e) if e.message.contains("unknown field") => Err(PyAttributeError::new_err(
+                    format!("the scenario has no setting {}", dotted(path, key)),
+                )),
+                _ => Ok(py.None()),
+            }
+        }
+    }
+}
+
+/// Writes setting `key` of the table at `path` (`None` removes it).
+fn write_setting(
+    scenario: &Scenario,
+    path: &[String],
+    key: &str,
+    value: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let name = dotted(path, key);
+    let value = if value.is_none() {
+        None
+    } else {
+        Some(py_to_toml(value, &name)?)
+    };
+    let mut inner = scenario.lock();
+    let updated = with_setting(table(&inner)?, path, key, value)?;
+    *inner = updated;
+    Ok(())
+}
+
+/// A TOML value as a Python object: tables as dicts, arrays as lists.
+fn toml_to_py(py: Python<'_>, value: &toml::Value) -> PyResult<Py<PyAny>> {
+    Ok(match value {
+        toml::Value::String(s) => s.into_pyobject(py)?.into_any().unbind(),
+        toml::Value::Integer(i) => i.into_pyobject(py)?.into_any().unbind(),
+        toml::Value::Float(f) => f.into_pyobject(py)?.into_any().unbind(),
+        toml::Value::Boolean(b) => PyBool::new(py, *b).to_owned().into_any().unbind(),
+        toml::Value::Datetime(d) => d.to_string().into_pyobject(py)?.into_any().unbind(),
+        toml::Value::Array(items) => {
+            let list = PyList::empty(py);
+            for item in items {
+                list.append(toml_to_py(py, item)?)?;
+            }
+            list.into_any().unbind()
+        }
+        toml::Value::Table(table) => {
+            let dict = PyDict::new(py);
+            for (key, item) in table {
+                dict.set_item(key, toml_to_py(py, item)?)?;
+            }
+            dict.into_any().unbind()
+        }
+    })
+}
+
+/// The deepest nesting of lists and dicts a setting may have (a scenario's deepest, a polyline
+/// in a table of the reference, is 3): deeper values are refused before the recursion goes on.
+const MAX_SETTING_DEPTH: usize = 16;
+
+/// The most items a list (or array) of a setting may have, checked before it is converted.
+const MAX_SETTING_ITEMS: usize = 1 << 20;
+
+/// A Python value as a TOML value for setting `name`: bools, integers (beyond 64 bits signed
+/// as a decimal string, as TOML writes large seeds), floats, strings, paths, dicts, and lists,
+/// tuples and numpy arrays of those, nested at most [`MAX_SETTING_DEPTH`] deep with at most
+/// [`MAX_SETTING_ITEMS`] items per list.
+fn py_to_toml(value: &Bound<'_, PyAny>, name: &str) -> PyResult<toml::Value> {
+    to_toml_at(value, name, 0)
+}
+
+/// [`py_to_toml`] at nesting `depth`.
+fn to_toml_at(value: &Bound<'_, PyAny>, name: &str, depth: usize) -> PyResult<toml::Value> {
+    if depth > MAX_SETTING_DEPTH {
+        return Err(Error::input(format!(
+            "{name} is nested more than {MAX_SETTING_DEPTH} levels deep"
+        ))
+        .into());
+    }
+    let too_many = |items: usize| {
+        Error::input(format!(
+            "{name} has {items} items, more than the {MAX_SETTING_ITEMS} a setting may have"
+        ))
+    };
+    if let Ok(b) = value.cast::<PyBool>() {
+        return Ok(toml::Value::Boolean(b.is_true()));
+    }
+    if value.cast::<PyString>().is_ok() {
+        return Ok(toml::Value::String(value.extract()?));
+    }
+    if value.cast::<PyInt>().is_ok() {
+        if let Ok(i) = value.extract::<i64>() {
+            return Ok(toml::Value::Integer(i));
+        }
+        return match value.extract::<u64>() {
+            Ok(u) => Ok(toml::Value::String(u.to_string())),
+            Err(_) => Err(Error::input(format!(
+                "{name}: the integer {value} does not fit 64 bits"
+            ))
+            .into()),
+        };
+    }
+    if let Ok(f) = value.cast::<PyFloat>() {
+        return Ok(toml::Value::Float(f.value()));
+    }
+    if let Ok(dict) = value.cast::<PyDict>() {
+        let mut table = toml::Table::new();
+        for (key, item) in dict.iter() {
+            let key: String = key
+                .extract()
+                .map_err(|_| Error::input(format!("{name}: table keys must be strings")))?;
+            let item = to_toml_at(&item, &format!("{name}.{key}"), depth + 1)?;
+            table.insert(key, item);
+        }
+        return Ok(toml::Value::Table(table));
+    }
+    if value.cast::<PyList>().is_ok() || value.cast::<PyTuple>().is_ok() {
+        let items = value.len()?;
+        if items > MAX_SETTING_ITEMS {
+            return Err(too_many(items).into());
+        }
+        let items = value
+            .try_iter()?
+            .map(|item| to_toml_at(&item?, name, depth + 1))
+            .collect::<PyResult<Vec<_>>>()?;
+        return Ok(toml::Value::Array(items));
+    }
+    if value.hasattr("__fspath__")? {
+        let os = value.py().import("os")?;
+        return to_toml_at(&os.call_method1("fspath", (value,))?, name, depth);
+    }
+    // numpy arrays and scalars (float32, int64, ...) become Python lists and numbers.
+    if value.hasattr("tolist")? {
+        if let Ok(size) = value.getattr("size").and_then(|s| s.extract::<usize>())
+            && size > MAX_SETTING_ITEMS
+        {
+            return Err(too_many(size).into());
+        }
+        let plain = value.call_method0("tolist")?;
+        if plain.cast::<PyList>().is_ok()
+            || plain.cast::<PyFloat>().is_ok()
+            || plain.cast::<PyInt>().is_ok()
+        {
+            return to_toml_at(&plain, name, depth);
+        }
+    }
+    Err(Error::input(format!(
+        "{name} cannot be set to a {}",
+        value.get_type().name()?
+    ))
+    .into())
+}
+
+/// A table of a scenario (`scenario.arm`, `scenario.reference.sine`): its keys are attributes
+/// that read and write the scenario itself.
+///
+/// A table the scenario does not hold yet (e.g. `initial`) is set whole, as a dict:
+/// `scenario.initial = {"a": [0.1, 0.0]}`.
+#[pyclass(module = "hrm", frozen)]
+pub struct Settings {
+    scenario: Py<Scenario>,
+    path: Vec<String>,
+}
+
+#[pymethods]
+impl Settings {
+    fn __getattr__(&self, py: Python<'_>, name: &str) -> PyResult<Py<PyAny>> {
+        if name.starts_with("__") {
+            return Err(PyAttributeError::new_err(name.to_string()));
+        }
+        read_setting(py, &self.scenario, &self.path, name)
+    }
+
+    fn __setattr__(&self, name: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        write_setting(self.scenario.get(), &self.path, name, value)
+    }
+
+    fn __delattr__(&self, py: Python<'_>, name: &str) -> PyResult<()> {
+        write_setting(
+            self.scenario.get(),
+            &self.path,
+            name,
+            &py.None().into_bound(py),
+        )
+    }
+
+    /// The table as a dict (a copy: writing to it does not change the scenario).
+    fn to_dict(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let current = table(&self.scenario.get().lock())?;
+        let value = lookup(&current, &self.path)
+            .cloned()
+            .unwrap_or(toml::Value::Table(toml::Table::new()));
+        toml_to_py(py, &value)
+    }
+
+    /// The table's keys that are set.
+    fn __dir__(&self) -> PyResult<Vec<String>> {
+        let current = table(&self.scenario.get().lock())?;
+        Ok(match lookup(&current, &self.path) {
+            Some(toml::Value::Table(t)) => t.keys().cloned().collect(),
+            _ => Vec::new(),
+        })
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let dict = self.to_dict(py)?;
+        Ok(format!(
+            "Settings({}: {})",
+            self.path.join("."),
+            dict.bind(py).repr()?
+        ))
+    }
+}
+
+/// A controller for `Scenario.run`: a built-in one by name, or a Python callable.
+enum Choice {
+    BuiltIn(ControllerKind),
+    Python(Py<PyAny>),
+}
+
+impl Choice {
+    fn read(controller: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Self>> {
+        let Some(controller) = controller.filter(|c| !c.is_none()) else {
+            return Ok(None);
+        };
+        if let Ok(name) = controller.extract::<String>() {
+            let kind: ControllerKind = name.parse().map_err(Error::from)?;
+            return Ok(Some(Choice::BuiltIn(kind)));
+        }
+        if controller.is_callable() {
+            return Ok(Some(Choice::Python(controller.clone().unbind())));
+        }
+        Err(Error::input(format!(
+            "controller must be a built-in controller's name ({}) or a callable f(t, a, a_dot, \
+             ref) -> tau_star, got a {}",
+            ControllerKind::ALL.map(ControllerKind::name).join(", "),
+            controller.get_type().name()?
+        ))
+        .into())
+    }
+}
+
+/// The reference a Python controller receives at a sample (reference noise included in `a`).
+#[pyclass(module = "hrm", frozen)]
+pub struct ReferenceSample {
+    a: Py<PyArray1<f64>>,
+    a_dot: Py<PyArray1<f64>>,
+    a_ddot: Py<PyArray1<f64>>,
+}
+
+#[pymethods]
+impl ReferenceSample {
+    /// Desired modal coordinates (rad), shape (m,).
+    #[getter]
+    fn a(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.a.clone_ref(py)
+    }
+
+    /// Desired rates (rad/s), shape (m,).
+    #[getter]
+    fn a_dot(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.a_dot.clone_ref(py)
+    }
+
+    /// Desired accelerations (rad/s^2), shape (m,).
+    #[getter]
+    fn a_ddot(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.a_ddot.clone_ref(py)
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!(
+            "ReferenceSample(a={}, a_dot={}, a_ddot={})",
+            self.a.bind(py).repr()?,
+            self.a_dot.bind(py).repr()?,
+            self.a_ddot.bind(py).repr()?
+        ))
+    }
+}
+
+/// A Python callable `f(t, a, a_dot, ref) -> tau_star` as a `sim-core` controller. An exception
+/// it raises, or a return value that is not `m` finite numbers, is kept in `raised` and ends
+/// the run (the run reports a controller failure); `Scenario.run` then raises it as it is, with
+/// its traceback.
+struct PythonController {
+    function: Py<PyAny>,
+    m: usize,
+    raised: Arc<Mutex<Option<PyErr>>>,
+}
+
+/// The error the run reports when the Python controller raised (the exception itself is kept).
+#[derive(Debug)]
+struct Raised;
+
+impl std::fmt::Display for Raised {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("the Python controller raised an exception")
+    }
+}
+
+impl std::error::Error for Raised {}
+
+impl PythonController {
+    fn call(&self, py: Python<'_>, ctx: &ControlContext<'_>, tau_star: &mut [f64]) -> PyResult<()> {
+        let reference = ReferenceSample {
+            a: PyArray1::from_slice(py, &ctx.reference.a).unbind(),
+            a_dot: PyArray1::from_slice(py, &ctx.reference.a_dot).unbind(),
+            a_ddot: PyArray1::from_slice(py, &ctx.reference.a_ddot).unbind(),
+        };
+        let out = self.function.bind(py).call1((
+            ctx.t,
+            PyArray1::from_slice(py, &ctx.measured.a),
+            PyArray1::from_slice(py, &ctx.measured.a_dot),
+            reference,
+        ))?;
+        let t = ctx.t;
+        let context = |message: String| {
+            Error::input(format!(
+                "the controller's return value at t = {t} s: {message}"
+            ))
+        };
+        let values = States::read(&out, "tau_star", self.m).map_err(|e| {
+            let message = e.value(py).str().map(|s| s.to_string()).unwrap_or_default();
+            PyErr::from(context(message))
+        })?;
+        if values.is_batch() {
+            return Err(context(format!(
+                "tau_star must have shape ({},), got a batch",
+                self.m
+            ))
+            .into());
+        }
+        let values = values.values();
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(NumericalError::new_err(format!(
+                "the controller returned a non-finite tau_star {values:?} at t = {t} s"
+            )));
+        }
+        tau_star.copy_from_slice(values);
+        Ok(())
+    }
+}
+
+impl Controller for PythonController {
+    fn control(
+        &mut self,
+        ctx: &ControlContext<'_>,
+        tau_star: &mut [f64],
+    ) -> Result<(), ControllerError> {
+        Python::attach(|py| self.call(py, ctx, tau_star)).map_err(|error| {
+            *self
+                .raised
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner()) = Some(error);
+            Box::new(Raised) as ControllerError
+        })
+    }
+
+    fn n_coords(&self) -> Option<usize> {
+        Some(self.m)
+    }
+}
+
+#[pymethods]
+impl Scenario {
+    /// A scenario shipped with hrm, by name (Scenario.builtin_names()): "paper-tracking"
+    /// (Figures 10-11), "paper-responses-step", "-sine", "-noise" (Figure 9), and
+    /// "harmonic-tracking", "free-base-tracking".
+    #[staticmethod]
+    fn builtin(name: &str) -> PyResult<Self> {
+        Ok(Self::wrap(
+            sim_core::Scenario::builtin(name).map_err(scenario_error)?,
+        ))
+    }
+
+    /// The names of the shipped scenarios.
+    #[staticmethod]
+    fn builtin_names() -> Vec<&'static str> {
+        sim_core::Scenario::builtin_names().collect()
+    }
+
+    /// Reads a scenario: `path_or_text` is a path (str or os.PathLike; a relative controller.fis
+    /// is taken relative to the file) or the TOML text itself (a str with a line break). Raises
+    /// InvalidInput for malformed TOML (the message names the line and column), FileNotFoundError
+    /// or OSError when the file cannot be read.
+    #[staticmethod]
+    fn from_toml(path_or_text: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let scenario = match path_or_text.extract::<String>() {
+            Ok(text) if text.contains('\n') => sim_core::Scenario::from_toml(&text),
+            _ => sim_core::Scenario::load(&path_or_text.extract::<PathBuf>()?),
+        };
+        Ok(Self::wrap(scenario.map_err(scenario_error)?))
+    }
+
+    /// The scenario as TOML text (Scenario.from_toml reads it back; `hrm simulate --scenario`
+    /// runs it).
+    fn to_toml(&self) -> String {
+        self.lock().to_toml()
+    }
+
+    /// The whole scenario as a dict of its settings (a copy).
+    fn to_dict(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        toml_to_py(py, &toml::Value::Table(table(&self.lock())?))
+    }
+
+    /// An independent copy.
+    fn copy(&self) -> Self {
+        Self::wrap(self.get())
+    }
+
+    /// The number of modal coordinates m: 2K with alpha0 fixed, 2K + 1 with it free.
+    #[getter]
+    fn n_coords(&self) -> usize {
+        self.lock().n_coords()
+    }
+
+    /// The names of the modal coordinates: a1, ..., a2K, then alpha0 when it is free.
+    #[getter]
+    fn coordinate_names(&self) -> Vec<String> {
+        self.lock().coordinate_names()
+    }
+
+    fn __getattr__(slf: &Bound<'_, Self>, name: &str) -> PyResult<Py<PyAny>> {
+        if name.starts_with("__") {
+            return Err(PyAttributeError::new_err(name.to_string()));
+        }
+        read_setting(slf.py(), &slf.clone().unbind(), &[], name)
+    }
+
+    fn __setattr__(&self, name: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        write_setting(self, &[], name, value)
+    }
+
+    fn __delattr__(&self, py: Python<'_>, name: &str) -> PyResult<()> {
+        write_setting(self, &[], name, &py.None().into_bound(py))
+    }
+
+    /// The settings that are set, and the methods.
+    fn __dir__(slf: &Bound<'_, Self>) -> PyResult<Vec<String>> {
+        let mut names: Vec<String> = table(&slf.get().lock())?.keys().cloned().collect();
+        for name in slf.get_type().dir()? {
+            names.push(name.extract()?);
+        }
+        names.sort();
+        names.dedup();
+        Ok(names)
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        Ok((slf.get_type().getattr("from_toml")?, (slf.get().to_toml(),)))
+    }
+
+    fn __repr__(&self) -> String {
+        let s = self.lock();
+        format!(
+            "Scenario(name={:?}, controller={}, duration={}, coordinates={:?})",
+            s.name,
+            s.controller.kind,
+            s.duration,
+            s.coordinate_names()
+        )
+    }
+
+    /// Runs the closed loop and returns a Run (time series and summary).
+    ///
+    /// `controller`: None for the scenario's own (`scenario.controller.kind`), a built-in name
+    /// ("fuzzy", "pd", "computed-torque", "fuzzy-gc"), or a callable f(t, a, a_dot, ref) ->
+    /// tau_star called at every controller sample with the time (s), the measured modal state
+    /// (numpy arrays of shape (m,), sensor noise included) and the reference (a ReferenceSample
+    /// with a, a_dot, a_ddot), returning m modal torques (N m); scenario.controller.period sets
+    /// its sampling. An exception raised by the callable stops the run and propagates as it is;
+    /// a return value of the wrong shape or dtype raises InvalidInput, a non-finite one
+    /// NumericalError.
+    ///
+    /// A scenario whose settings are out of their domain raises InvalidInput before anything
+    /// runs. A run that diverges (runaway tracking error, integrator failure) returns a Run
+    /// whose `failure` says when and why, with the data up to the stop.
+    ///
+    /// Built-in controllers run with the GIL released; a Python controller holds it.
+    #[pyo3(signature = (controller=None))]
+    fn run(&self, py: Python<'_>, controller: Option<&Bound<'_, PyAny>>) -> PyResult<Run> {
+        let mut scenario = self.get();
+        let choice = Choice::read(controller)?;
+        let (result, label) = match choice {
+            Some(Choice::Python(function)) => {
+                let raised = Arc::new(Mutex::new(None));
+                let controller = PythonController {
+                    function,
+                    m: scenario.n_coords(),
+                    raised: Arc::clone(&raised),
+                };
+                let mut simulation = scenario
+                    .build_with_controller(Box::new(controller))
+                    .map_err(Error::from)?;
+                let result = simulation.run();
+                if let Some(error) = raised
+                    .lock()
+                    .unwrap_or_else(|poisoned| poisoned.into_inner())
+                    .take()
+                {
+                    return Err(error);
+                }
+                (result, "python")
+            }
+            builtin => {
+                if let Some(Choice::BuiltIn(kind)) = builtin {
+                    scenario.controller.kind = kind;
+                }
+                let mut simulation = scenario.build().map_err(Error::from)?;
+                (
+                    py.detach(|| simulation.run()),
+                    scenario.controller.kind.name(),
+                )
+            }
+        };
+        let result = result.map_err(|failure| Stopped {
+            error: failure.error.to_string(),
+            partial: Some(sim_core::Run {
+                record: failure.record,
+                summary: failure.summary,
+            }),
+        });
+        Run::new(py, &scenario, label, result)
+    }
+}
+
+/// The result of Scenario.run: the time series at the recording period (one row per recorded
+/// controller sample) and the summary metrics.
+///
+/// A run that stopped early (runaway tracking error, integrator failure) has `failure` set to
+/// the reason and holds the data up to the stop, the failing sample included; its summary has
+/// the extra keys "error" and "stopped_at_s", as the summary.json of `hrm simulate` does.
+#[pyclass(module = "hrm", frozen)]
+pub struct Run {
+    arrays: [Py<PyAny>; 8],
+    summary: Py<PyDict>,
+    failure: Option<String>,
+    controller: String,
+    coordinates: Vec<String>,
+}
+
+/// `values` (`rows x width`, row-major) as a numpy array of shape `(rows, width)`.
+fn matrix(py: Python<'_>, values: Vec<f64>, width: usize) -> Py<PyAny> {
+    let rows = values.len().checked_div(width).unwrap_or(0);
+    Array2::from_shape_vec((rows, width), values)
+        .expect("a record holds whole rows")
+        .into_pyarray(py)
+        .into_any()
+        .unbind()
+}
+
+impl Run {
+    fn new(
+        py: Python<'_>,
+        scenario: &sim_core::Scenario,
+        controller: &str,
+        result: Result<sim_core::Run, Stopped>,
+    ) -> PyResult<Self> {
+        let json = sim_core::summary_json::run(&result).to_string();
+        let summary = py
+            .import("json")?
+            .call_method1("loads", (json,))?
+            .cast_into::<PyDict>()?
+            .unbind();
+        let (run, failure) = match result {
+            Ok(run) => (run, None),
+            Err(Stopped {
+                error,
+                partial: Some(run),
+            }) => (run, Some(error)),
+            Err(Stopped {
+                error,
+                partial: None,
+            }) => return Err(Error::input(error).into()),
+        };
+        let r = run.record;
+        let (m, n) = (r.n_coords, r.n_joints);
+        let tips = |tips: Vec<[f64; 2]>| matrix(py, tips.into_iter().flatten().collect(), 2);
+        Ok(Self {
+            arrays: [
+                r.t.into_pyarray(py).into_any().unbind(),
+                matrix(py, r.a, m),
+                matrix(py, r.a_dot, m),
+                matrix(py, r.a_ref, m),
+                matrix(py, r.tau_star, m),
+                matrix(py, r.joint_torques, n),
+                tips(r.tip),
+                tips(r.tip_ref),
+            ],
+            summary,
+            failure,
+            controller: controller.to_string(),
+            coordinates: scenario.coordinate_names(),
+        })
+    }
+}
+
+#[pymethods]
+impl Run {
+    /// Sample times (s), shape (K,).
+    #[getter]
+    fn t(&self, py: Python<'_>) -> Py<PyAny> {
+        self.arrays[0].clone_ref(py)
+    }
+
+    /// Modal coordinates (rad), shape (K, m).
+    #[getter]
+    fn a(&self, py: Python<'_>) -> Py<PyAny> {
+        self.arrays[1].clone_ref(py)
+    }
+
+    /// Modal rates (rad/s), shape (K, m).
+    #[getter]
+    fn a_dot(&self, py: Python<'_>) -> Py<PyAny> {
+        self.arrays[2].clone_ref(py)
+    }
+
+    /// The reference without reference noise (rad), shape (K, m).
+    #[getter]
+    fn a_ref(&self, py: Python<'_>) -> Py<PyAny> {
+        self.arrays[3].clone_ref(py)
+    }
+
+    /// Modal torques tau* held from each sample to the next (N m), shape (K, m).
+    #[getter]
+    fn tau_star(&self, py: Python<'_>) -> Py<PyAny> {
+        self.arrays[4].clone_ref(py)
+    }
+
+    /// Joint torques tau = M J a_ddot + C + G (eq 13) at each sample (N m), shape (K, n).
+    #[getter]
+    fn joint_torques(&self, py: Python<'_>) -> Py<PyAny> {
+        self.arrays[5].clone_ref(py)
+    }
+
+    /// The discrete chain's tip (m), shape (K, 2).
+    #[getter]
+    fn tip(&self, py: Python<'_>) -> Py<PyAny> {
+        self.arrays[6].clone_ref(py)
+    }
+
+    /// The reference tip: the backbone curve's end at a_ref, the path point for a path (m),
+    /// shape (K, 2).
+    #[getter]
+    fn tip_ref(&self, py: Python<'_>) -> Py<PyAny> {
+        self.arrays[7].clone_ref(py)
+    }
+
+    /// The summary metrics: a dict with the keys of `hrm simulate`'s summary.json.
+    #[getter]
+    fn summary(&self, py: Python<'_>) -> Py<PyDict> {
+        self.summary.clone_ref(py)
+    }
+
+    /// Why and when the run stopped early, or None for a run that completed.
+    #[getter]
+    fn failure(&self) -> Option<&str> {
+        self.failure.as_deref()
+    }
+
+    /// The controller: a built-in name, or "python" for a callable.
+    #[getter]
+    fn controller(&self) -> &str {
+        &self.controller
+    }
+
+    /// The names of the modal coordinates (the columns of a, a_dot, a_ref, tau_star).
+    #[getter]
+    fn coordinates(&self) -> Vec<String> {
+        self.coordinates.clone()
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let samples = self.arrays[0].bind(py).len().unwrap_or(0);
+        match &self.failure {
+            None => format!(
+                "Run(controller={:?}, samples={samples}, completed)",
+                self.controller
+            ),
+            Some(e) => format!(
+                "Run(controller={:?}, samples={samples}, stopped: {e})",
+                self.controller
+            ),
+        }
+    }
+}

@@ -1,0 +1,214 @@
+//! `hrm.Sweep`: the Monte Carlo sweeps of `hrm sweep` (`sim_core::study`) from Python, whole or
+//! shard by shard, so that Slurm, Dask, Ray or `concurrent.futures` can schedule the shards
+//! (docs/sweep.md). Runs release the GIL and use all cores (rayon).
+
+use crate::errors::Error;
+use crate::scenario::Scenario;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use sim_core::ControllerKind;
+use sim_core::study::{self, Shard, ShardFile, SweepConfig};
+use std::path::{Path, PathBuf};
+
+/// A sweep: one scenario run with several controllers at several sensor-noise levels, `seeds`
+/// noise realisations each (the `hrm sweep` study, docs/sweep.md).
+///
+/// Sweep(scenario, noise_levels, seeds, controllers=None, base_seed=1, rate_noise_ratio=10.0,
+/// reference_noise_ratio=0.0): `scenario` is a Scenario (its duration applies; its noise and
+/// seed are replaced per run) or a built-in name or TOML path; `controllers` defaults to all
+/// four; noise levels (rad) must be distinct and ascending. Every controller's simulation is
+/// built once here, so a bad setting raises InvalidInput at once.
+///
+/// sweep.run() runs everything and returns the summary; sweep.run_shard(k, n) runs shard k of n
+/// and returns the shard file's text, and Sweep.merge(shards) combines shard files into the
+/// same summary, bit for bit.
+#[pyclass(module = "hrm", frozen)]
+pub struct Sweep {
+    config: SweepConfig,
+}
+
+/// A library message as [`InvalidInput`](crate::errors::InvalidInput).
+fn input(message: String) -> PyErr {
+    Error::input(message).into()
+}
+
+/// `text` (a summary or shard file) as Python objects, through the `json` module.
+fn json_to_py<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+/// The `summary.json` of a whole sweep (`hrm sweep`'s), as a dict.
+fn summary<'py>(py: Python<'py>, whole: &ShardFile) -> PyResult<Bound<'py, PyDict>> {
+    let cells = study::cells(&whole.config, &whole.runs);
+    let text = sim_core::summary_json::sweep(&whole.config, &cells).to_string();
+    Ok(json_to_py(py, &text)?.cast_into::<PyDict>()?)
+}
+
+/// A shard `index` of `count`, checked as `hrm sweep --shard K/N` checks it.
+fn shard(index: usize, count: usize) -> PyResult<Shard> {
+    format!("{index}/{count}").parse().map_err(input)
+}
+
+impl Sweep {
+    fn checked(config: SweepConfig) -> PyResult<Self> {
+        config.validate().map_err(input)?;
+        config.check_builds().map_err(input)?;
+        Ok(Self { config })
+    }
+}
+
+#[pymethods]
+impl Sweep {
+    #[new]
+    #[pyo3(signature = (
+        scenario, noise_levels, seeds, controllers=None, base_seed=1, rate_noise_ratio=10.0,
+        reference_noise_ratio=0.0
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        scenario: &Bound<'_, PyAny>,
+        noise_levels: Vec<f64>,
+        seeds: &Bound<'_, PyAny>,
+        controllers: Option<Vec<String>>,
+        base_seed: u64,
+        rate_noise_ratio: f64,
+        reference_noise_ratio: f64,
+    ) -> PyResult<Self> {
+        let mut scenario = match scenario.cast::<Scenario>() {
+            Ok(s) => s.get().get(),
+            Err(_) => {
+                let name: PathBuf = scenario.extract()?;
+                sim_core::Scenario::resolve(&name.to_string_lossy())
+                    .map_err(|e| input(e.to_string()))?
+            }
+        };
+        scenario.noise = Default::default();
+        scenario.seed = 0;
+        let controllers = match controllers {
+            None => ControllerKind::ALL.to_vec(),
+            Some(names) => names
+                .iter()
+                .map(|n| n.parse().map_err(Error::from))
+                .collect::<Result<_, _>>()?,
+        };
+        Self::checked(SweepConfig {
+            hrm_version: study::VERSION.to_string(),
+            scenario,
+            controllers,
+            noise_levels,
+            rate_noise_ratio,
+            reference_noise_ratio,
+            seeds: crate::errors::count(seeds, "seeds", 1)?,
+            base_seed,
+        })
+    }
+
+    /// The number of runs: noise levels x controllers x seeds.
+    #[getter]
+    fn n_runs(&self) -> usize {
+        self.config.runs().unwrap_or(0)
+    }
+
+    /// The indices of the runs shard `index` of `count` takes (1 <= index <= count): the runs i
+    /// with i % count == index - 1, as `hrm sweep --shard index/count`.
+    fn shard_runs(&self, index: usize, count: usize) -> PyResult<Vec<usize>> {
+        Ok(shard(index, count)?.indices(self.n_runs()).collect())
+    }
+
+    /// Runs shard `index` of `count` (the whole sweep by default) on all cores, with the GIL
+    /// released, and returns the shard file's JSON text: what `hrm sweep --shard index/count`
+    /// writes to shard-index-of-count.json. Runs that diverge are recorded as failed, not raised.
+    #[pyo3(signature = (index=1, count=1))]
+    fn run_shard(&self, py: Python<'_>, index: usize, count: usize) -> PyResult<String> {
+        let shard = shard(index, count)?;
+        let file = py.detach(|| study::run_shard(&self.config, shard, || {}));
+        file.to_json().map_err(input)
+    }
+
+    /// Runs the whole sweep and returns its summary: the dict `hrm sweep` writes to
+    /// summary.json ({"config": ..., "cells": [...]}, one cell per noise level and controller).
+    fn run<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let text = self.run_shard(py, 1, 1)?;
+        // As `hrm sweep` does: the report from the runs as read back, like a merge's.
+        let whole = ShardFile::parse(&text, Path::new("runs.json")).map_err(input)?;
+        summary(py, &whole)
+    }
+
+    /// Combines shard files into the summary of the whole sweep (the summary.json of `hrm sweep
+    /// merge`, equal to an unsharded run's). Each item of `shards` is a shard file's text (as
+    /// run_shard returns it), a path to one, or a directory whose shard-*.json files are all
+    /// taken. Shards of different sweeps or splits, a shard given twice or missing, and runs out
+    /// of place raise InvalidInput naming the files concerned.
+    #[staticmethod]
+    fn merge<'py>(py: Python<'py>, shards: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+        let mut files = Vec::new();
+        let mut paths = Vec::new();
+        for (k, item) in shards.try_iter()?.enumerate() {
+            let item = item?;
+            match item.extract::<String>() {
+                Ok(text) if text.trim_start().starts_with('{') => {
+                    let origin = PathBuf::from(format!("shards[{k}]"));
+                    files.push((
+                        origin.clone(),
+                        ShardFile::parse(&text, &origin).map_err(input)?,
+                    ));
+                }
+                _ => paths.push(item.extract::<PathBuf>()?),
+            }
+        }
+        for path in study::shard_paths(&paths).map_err(input)? {
+            let file = ShardFile::read(&path).map_err(input)?;
+            files.push((path, file));
+        }
+        let whole = py.detach(|| study::merge(files)).map_err(input)?;
+        summary(py, &whole)
+    }
+
+    /// The sweep's configuration as JSON (the "config" of its shard files and summary);
+    /// Sweep.from_json reads it back.
+    fn to_json(&self) -> PyResult<String> {
+        serde_json::to_string(&self.config).map_err(|e| input(e.to_string()))
+    }
+
+    /// A sweep from its configuration's JSON (Sweep.to_json, or the "config" of a shard file),
+    /// checked as the constructor checks it.
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<Self> {
+        let config: SweepConfig = serde_json::from_str(text)
+            .map_err(|e| input(format!("malformed sweep configuration: {e}")))?;
+        Self::checked(config)
+    }
+
+    /// The configuration as a dict.
+    #[getter]
+    fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.to_json()?)
+    }
+
+    /// The scenario swept (a copy).
+    #[getter]
+    fn scenario(&self, py: Python<'_>) -> PyResult<Py<Scenario>> {
+        Py::new(py, Scenario::wrap(self.config.scenario.clone()))
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        Ok((
+            slf.get_type().getattr("from_json")?,
+            (slf.get().to_json()?,),
+        ))
+    }
+
+    fn __repr__(&self) -> String {
+        let c = &self.config;
+        format!(
+            "Sweep(scenario={:?}, controllers={:?}, noise_levels={:?}, seeds={}, base_seed={}, \
+             runs={})",
+            c.scenario.name,
+            c.controllers.iter().map(|k| k.name()).collect::<Vec<_>>(),
+            c.noise_levels,
+            c.seeds,
+            c.base_seed,
+            self.n_runs()
+        )
+    }
+}

@@ -1,0 +1,95 @@
+"""Sweeps from Python: plan, shards scheduled by concurrent.futures, merge equal to the
+unsharded sweep and to `hrm sweep`'s summary.json, and the merge's refusals."""
+
+import concurrent.futures
+import json
+import pickle
+import subprocess
+
+import pytest
+
+import hrm
+from test_scenario import hrm_binary
+
+
+def small_sweep():
+    scenario = hrm.Scenario.builtin("paper-responses-step")
+    scenario.duration = 0.1
+    return hrm.Sweep(scenario, noise_levels=[0.0, 0.01], seeds=3, controllers=["pd", "fuzzy"], base_seed=5)
+
+
+def test_plan():
+    sweep = small_sweep()
+    assert sweep.n_runs == 2 * 2 * 3
+    shards = [sweep.shard_runs(k, 5) for k in range(1, 6)]
+    assert sorted(i for shard in shards for i in shard) == list(range(sweep.n_runs))
+    assert shards[1] == [1, 6, 11]
+    with pytest.raises(hrm.InvalidInput, match="K/N"):
+        sweep.shard_runs(6, 5)
+    assert sweep.config["noise_levels"] == [0.0, 0.01] and sweep.scenario.duration == 0.1
+    with pytest.raises(hrm.InvalidInput, match="ascending"):
+        hrm.Sweep("paper-responses-step", noise_levels=[0.01, 0.0], seeds=1)
+    with pytest.raises(hrm.InvalidInput, match="seeds must be at least 1"):
+        hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=-1)
+    with pytest.raises(hrm.InvalidInput, match="must be one of"):
+        hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, controllers=["lqr?"])
+
+
+def test_shards_scheduled_by_concurrent_futures_merge_to_the_unsharded_sweep(tmp_path):
+    """The pattern of docs/sweep.md's Dask example, with a thread pool: each task runs one shard
+    (the GIL is released while it runs), and the merge equals the unsharded sweep bit for bit."""
+    sweep = small_sweep()
+    count = 3
+    with concurrent.futures.ThreadPoolExecutor(max_workers=count) as pool:
+        texts = list(pool.map(lambda k: sweep.run_shard(k, count), range(1, count + 1)))
+    whole = sweep.run()
+    assert hrm.Sweep.merge(texts) == whole
+    # As files, in any order, or as the directory holding them.
+    for k, text in enumerate(texts, start=1):
+        (tmp_path / f"shard-{k}-of-{count}.json").write_text(text)
+    assert hrm.Sweep.merge(reversed(sorted(tmp_path.iterdir()))) == whole
+    assert hrm.Sweep.merge([tmp_path]) == whole
+    cells = whole["cells"]
+    assert [(c["noise_level"], c["controller"]) for c in cells] == [
+        (0.0, "pd"), (0.0, "fuzzy"), (0.01, "pd"), (0.01, "fuzzy")]
+    assert all(c["runs"] == 3 and c["failed"] == 0 for c in cells)
+    # Without noise every seed gives the same run; with noise they differ.
+    assert cells[0]["tip_error_rms_mm"]["std"] == 0.0 < cells[2]["tip_error_rms_mm"]["std"]
+
+
+def test_the_merge_refuses_incomplete_or_foreign_shards():
+    sweep = small_sweep()
+    texts = [sweep.run_shard(k, 2) for k in (1, 2)]
+    with pytest.raises(hrm.InvalidInput, match="shard 2/2 is missing"):
+        hrm.Sweep.merge(texts[:1])
+    with pytest.raises(hrm.InvalidInput, match="given twice"):
+        hrm.Sweep.merge([texts[0], texts[0], texts[1]])
+    other = hrm.Sweep(sweep.scenario, noise_levels=[0.0, 0.01], seeds=3, controllers=["pd", "fuzzy"], base_seed=6)
+    with pytest.raises(hrm.InvalidInput, match="differ in base_seed"):
+        hrm.Sweep.merge([texts[0], other.run_shard(2, 2)])
+    with pytest.raises(hrm.InvalidInput, match="nothing to merge"):
+        hrm.Sweep.merge([])
+
+
+def test_sweeps_pickle_for_process_pools_and_clusters():
+    sweep = small_sweep()
+    clone = pickle.loads(pickle.dumps(sweep))
+    assert clone.config == sweep.config
+    assert hrm.Sweep.from_json(sweep.to_json()).config == sweep.config
+
+
+def test_merge_equals_the_clis_summary_json(tmp_path):
+    binary = hrm_binary()
+    sweep = small_sweep()
+    args = [binary, "sweep", "--scenario", "paper-responses-step", "--duration", "0.1", "--noise", "0,0.01",
+            "--seeds", "3", "--controllers", "pd,fuzzy", "--base-seed", "5"]
+    for k in (1, 2):
+        subprocess.run(args + ["--shard", f"{k}/2", "--out", tmp_path / "shards"], check=True, capture_output=True)
+    subprocess.run([binary, "sweep", "merge", "--out", tmp_path / "merged", tmp_path / "shards"], check=True,
+                   capture_output=True)
+    cli = json.loads((tmp_path / "merged" / "summary.json").read_text())
+    # The command's shard files merge in Python to the command's summary, key for key.
+    assert hrm.Sweep.merge([tmp_path / "shards"]) == cli
+    python = sweep.run()
+    assert python.keys() == cli.keys() and python["config"] == cli["config"]
+    assert [c.keys() for c in python["cells"]] == [c.keys() for c in cli["cells"]]

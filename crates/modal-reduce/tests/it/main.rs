@@ -1,0 +1,17 @@
+//! The integration tests of modal-reduce, one binary: `closed_form` (the two-link arm by hand),
+//! `properties` (the fast path against `J^T M J` and brute-force energies over random models),
+//! `derivatives`, `jacobi` (the eq-18 iteration), `bad_input` for every refusal, `allocation`
+//! for the allocation-free per-step functions and `common` for random models and references.
+
+// Counts each thread's allocations; the allocation tests measure their own thread only, so the
+// other tests of this binary may run in parallel.
+#[global_allocator]
+static ALLOCATOR: test_support::alloc::CountingAllocator = test_support::alloc::CountingAllocator;
+
+mod allocation;
+mod bad_input;
+mod closed_form;
+mod common;
+mod derivatives;
+mod jacobi;
+mod properties;

@@ -1,0 +1,61 @@
+//! Scenarios: a closed-loop experiment described in a TOML file (arm, `alpha0`, reference,
+//! controller, integrator, step sizes, duration, noise, seed), and the paper's experiments
+//! shipped with the crate.
+//!
+//! Required keys: `name`, `duration`, `alpha0`, `reference` (with its `kind` and that kind's
+//! required keys) and `integrator` (with its `method`); everything else has a default. Every
+//! per-coordinate array (`initial`, `reference`, `noise`, the controller gains) has exactly `m`
+//! entries, the number of modal coordinates: `2K` with `alpha0` fixed, `2K + 1` with `alpha0`
+//! free (its last entry is then `alpha0`'s).
+//!
+//! ```toml
+//! name = "step"
+//! duration = 2.0          # s
+//! alpha0 = 1.5707963267948966   # rad, or "free": alpha0 is the last modal coordinate
+//! seed = 1
+//! record_period = 0.001   # s, default: the controller period
+//!
+//! [modal]                 # the modal family, default: the paper's K = 1
+//! harmonics = 1
+//!
+//! [arm]                   # defaults: the paper's 10 links of 0.1 m and 0.1 kg, g = 9.81
+//! links = 10
+//!
+//! [reference]             # kind = "constant" | "step" | "sinusoid" | "path"
+//! kind = "step"
+//! initial = [0.0, 0.0]
+//! target = [0.2, -0.2]
+//! time = 0.1
+//!
+//! [controller]            # kind = "fuzzy" | "pd" | "computed-torque" | "fuzzy-gc"
+//! kind = "fuzzy"
+//! period = 0.0001         # s, default: the RK4 step
+//! # kp = [2500.0, 2500.0]   computed torque (1/s^2), kd = [100.0, 100.0] (1/s)
+//! # pd_kp = [600.0, 300.0]  PD (N m/rad), pd_kd = [20.0, 10.0] (N m s/rad); default: fuzzy slope
+//!
+//! [integrator]            # method = "rk4" (dt) | "dopri5" (rtol, atol, h_max, max_steps)
+//! method = "rk4"
+//! dt = 0.0001
+//!
+//! [noise]                 # standard deviations, default 0
+//! reference_std = [0.0, 0.0]
+//! sensor_a_std = [0.0, 0.0]
+//! sensor_a_dot_std = [0.0, 0.0]
+//!
+//! [limits]
+//! max_modal_error = 3.14  # rad, runaway bound
+//! joint_torque_nm = 5.0   # or one limit per joint
+//! ```
+
+mod builtin;
+mod controllers;
+mod factory;
+mod file;
+mod schema;
+
+pub use controllers::{CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup};
+pub use file::ScenarioError;
+pub use schema::{
+    Alpha0, ArmSpec, BranchSpec, ControllerSpec, InitialSpec, IntegratorSpec, LimitsSpec,
+    ModalSpec, NoiseSpec, ReferenceSpec, Scenario, SineSpec, TorqueLimit,
+};
