@@ -439,7 +439,11 @@ mod tests {
             FuzzySystem::from_fis(&std::fs::read_to_string(dir.join("learned.fis")).unwrap());
         assert_eq!(learned.unwrap().inputs().len(), 8);
         assert!(dir.join("paper-tracking/learned/timeseries.csv").is_file());
-        assert_eq!(page.matches("<td class=\"error\"").count(), 4, "{page}");
+        assert_eq!(
+            page.matches("<td class=\"error\"").count(),
+            ControllerKind::ALL.len(),
+            "{page}"
+        );
         let mut images = 0;
         for piece in page.split("<img src=\"").skip(1) {
             let file = &piece[..piece.find('"').unwrap()];
@@ -448,7 +452,7 @@ mod tests {
         }
         // Figures 10 (one per controller) and 11, four membership plots and two surfaces; no
         // Figure 9 as every step run failed.
-        assert_eq!(images, 4 + 1 + 4 + 2);
+        assert_eq!(images, ControllerKind::ALL.len() + 1 + 4 + 2);
         for name in ["summary.json", "comparison.txt"] {
             assert!(dir.join(name).is_file());
         }

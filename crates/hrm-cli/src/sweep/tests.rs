@@ -36,7 +36,7 @@ fn read(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
-/// A small sweep: 2 noise levels x 4 controllers x 3 seeds of 0.15 s (the step is at 0.1 s).
+/// A small sweep: 2 noise levels x every controller x 3 seeds of 0.15 s (the step is at 0.1 s).
 const SMALL: &[&str] = &[
     "--scenario",
     "paper-responses-step",
@@ -130,11 +130,14 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
         assert_eq!(read(&whole.join(file)), read(&merged.join(file)), "{file}");
     }
     let whole_runs = ShardFile::read(&whole.join("runs.json")).unwrap();
-    assert_eq!(whole_runs.runs.len(), 24);
+    assert_eq!(whole_runs.runs.len(), 2 * 3 * ControllerKind::ALL.len());
     let merged_runs = ShardFile::read(&merged.join("runs.json")).unwrap();
     assert_eq!(whole_runs.config, merged_runs.config);
     let indices = |f: &ShardFile| f.runs.iter().map(|r| r.index).collect::<Vec<_>>();
-    assert_eq!(indices(&merged_runs), (0..24).collect::<Vec<_>>());
+    assert_eq!(
+        indices(&merged_runs),
+        (0..2 * 3 * ControllerKind::ALL.len()).collect::<Vec<_>>()
+    );
     assert_eq!(indices(&whole_runs), indices(&merged_runs));
     let svg = read(&merged.join("tip_error_rms.svg"));
     assert!(svg.contains("computed-torque: mean ± std"));
@@ -170,7 +173,11 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
     let cut_path = root.join("cut").join("shard-2-of-3.json");
     write(&cut_path, &cut.to_json().unwrap()).unwrap();
     let err = merge(&[shard(1), cut_path.clone(), shard(3)]);
-    assert!(err.contains("1 of 24 runs are missing"), "{err}");
+    let missing = format!(
+        "1 of {} runs are missing",
+        2 * 3 * ControllerKind::ALL.len()
+    );
+    assert!(err.contains(&missing), "{err}");
     // A run moved to a shard it does not belong to.
     let mut moved = ShardFile::read(&shard(2)).unwrap();
     moved.runs[0].index = 0;
@@ -251,8 +258,9 @@ fn noise_spreads_the_errors_and_no_noise_does_not() {
     let config = small_config(&[0.0, 0.01], 4);
     let whole = run_shard(&config, Shard::WHOLE);
     let cells = study::cells(&config, &whole.runs);
-    assert_eq!(cells.len(), 8);
-    for (quiet, noisy) in cells[..4].iter().zip(&cells[4..]) {
+    let kinds = ControllerKind::ALL.len();
+    assert_eq!(cells.len(), 2 * kinds);
+    for (quiet, noisy) in cells[..kinds].iter().zip(&cells[kinds..]) {
         assert_eq!(quiet.controller, noisy.controller);
         assert_eq!((quiet.failed, noisy.failed), (0, 0));
         // Without noise every seed gives the same run.
@@ -322,12 +330,12 @@ fn a_thousand_short_runs_complete_without_nan() {
     ])
     .unwrap();
     let config = configure(&args.sweep).unwrap();
-    assert_eq!(config.runs(), Some(1000));
+    assert_eq!(config.runs(), Some(5 * 50 * ControllerKind::ALL.len()));
     let whole = run_shard(&config, Shard::WHOLE);
     let text = whole.to_json().unwrap();
     let parsed = ShardFile::parse(&text, Path::new("memory")).unwrap();
     let cells = study::cells(&parsed.config, &parsed.runs);
-    assert_eq!(cells.len(), 20);
+    assert_eq!(cells.len(), 5 * ControllerKind::ALL.len());
     for cell in &cells {
         assert_eq!((cell.runs, cell.failed), (50, 0), "{cell:?}");
         assert_eq!(cell.modal_error_rms.len(), 2);

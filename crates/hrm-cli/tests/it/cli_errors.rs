@@ -335,7 +335,7 @@ fn counts_are_bounded_before_use_with_the_option_named() {
         ),
         (
             vec!["sweep", "--seeds", "1000000", "--out", path(&out)],
-            "24000000 runs",
+            "30000000 runs",
         ),
     ] {
         let line = refused(&hrm(&args));

@@ -68,7 +68,7 @@ pub fn run_one(scenario: &Scenario, kind: ControllerKind) -> ComparisonRun {
 /// scenarios.retain(|s| s.name == "paper-responses-step");
 /// scenarios[0].duration = 0.2;
 /// let runs = compare(&scenarios, |_| Ok(()))?;
-/// assert_eq!(runs.len(), 4);
+/// assert_eq!(runs.len(), sim_core::ControllerKind::ALL.len());
 /// assert!(runs.iter().all(|r| r.result.is_ok()));
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
