@@ -608,7 +608,7 @@ impl Scenario {
     /// Runs the closed loop and returns a Run (time series and summary).
     ///
     /// `controller`: None for the scenario's own (`scenario.controller.kind`), a built-in name
-    /// ("fuzzy", "pd", "computed-torque", "fuzzy-gc"), or a callable f(t, a, a_dot, ref) ->
+    /// ("fuzzy", "pd", "computed-torque", "fuzzy-gc", "mpc"), or a callable f(t, a, a_dot, ref) ->
     /// tau_star called at every controller sample with the time (s), the measured modal state
     /// (numpy arrays of shape (m,), sensor noise included) and the reference (a ReferenceSample
     /// with a, a_dot, a_ddot), returning m modal torques (N m); scenario.controller.period sets

@@ -114,7 +114,7 @@ fn bad_options_are_one_line_errors_and_leave_the_old_file() {
     for (args, message) in [
         (
             vec!["--teacher", "bang-bang"],
-            "hrm: --teacher: controller must be one of fuzzy, pd, computed-torque, fuzzy-gc, got 'bang-bang'",
+            "hrm: --teacher: controller must be one of fuzzy, pd, computed-torque, fuzzy-gc, mpc, got 'bang-bang'",
         ),
         (
             vec!["--stride", "0"],

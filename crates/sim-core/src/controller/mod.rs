@@ -1,8 +1,9 @@
 //! Controllers of the `m` modal coordinates, behind one trait: the paper's fuzzy controller
 //! (eqs 19-24, Figure 8) applied per coordinate pair or any `.fis` system with `2m` inputs and
 //! `m` outputs, its linearisation at the origin (PD), computed torque with the exact reduced
-//! model, the fuzzy controller plus gravity compensation `G*`, and the LQR about the reference,
-//! re-linearised along it ([`LqrController`]).
+//! model, the fuzzy controller plus gravity compensation `G*`, the LQR about the reference,
+//! re-linearised along it ([`LqrController`]), and model-predictive control under `tau*` limits
+//! ([`MpcController`]).
 //!
 //! The closed loop samples a controller at its own period and holds its output in between
 //! (zero-order hold). At each sample it hands the controller a [`ControlContext`] that borrows
@@ -35,12 +36,14 @@
 mod computed_torque;
 mod fuzzy;
 mod lqr;
+mod mpc;
 mod pd;
 
 pub use computed_torque::ComputedTorque;
 pub use fuzzy::FuzzyController;
 pub(crate) use fuzzy::{SCHEDULED_INPUTS_PER_COORDINATE, scheduled_inputs};
 pub use lqr::LqrController;
+pub use mpc::MpcController;
 pub use pd::PdController;
 
 use crate::error::SimError;

@@ -7,16 +7,30 @@
 //!   exponential).
 //! - [`Lqr`]: the discrete infinite-horizon LQR gain by the Riccati recursion, for regulating
 //!   about a reference (`u = u_ref - K (x - x_ref)`).
+//! - [`Ilqr`]: control-limited iterative LQR (Tassa, Mansard and Todorov 2014) over a finite
+//!   horizon of any [`DiscreteDynamics`], with the box limits on the controls handled in the
+//!   solver by a [`BoxQp`] per step; [`ReducedEuler`] is the reduced model discretised by
+//!   semi-implicit Euler with its exact Jacobians.
+//! - [`Mpc`]: receding-horizon model-predictive control on [`Ilqr`], tracking a reference under
+//!   `tau*` limits, warm-started from its previous plan.
 //!
-//! These depend only on `modal-reduce`; wrapping them as controllers of the closed loop is a
-//! separate step. Every type is built once for a model and then allocates nothing.
+//! These depend only on `modal-reduce`; the closed loop wraps them as controllers
+//! ([`crate::controller`]). Every type is built once for a model and then allocates nothing.
 
+mod box_qp;
 mod dense;
+mod discrete;
+mod ilqr;
 mod linearise;
 mod lqr;
+mod mpc;
 
+pub use box_qp::{BoxQp, BoxQpReport, BoxQpSettings};
+pub use discrete::{DiscreteDynamics, ReducedEuler};
+pub use ilqr::{Ilqr, IlqrReport, IlqrSettings, MAX_HORIZON, MAX_WORKSPACE, TrackingCost};
 pub use linearise::Linearisation;
 pub use lqr::{Lqr, LqrSettings};
+pub use mpc::{MAX_MPC_HORIZON, Mpc, MpcSettings};
 
 use modal_reduce::ReduceError;
 

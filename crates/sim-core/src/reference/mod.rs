@@ -4,12 +4,15 @@
 //!
 //! A reference supplies the desired `a`, `a_dot` and `a_ddot` at any time; the controllers that
 //! need rates or accelerations (computed torque) get them from the reference, not by
-//! differencing the samples.
+//! differencing the samples. A [`ReferencePreview`] samples a reference ahead over a horizon,
+//! for the controllers that plan (model-predictive control).
 
 pub(crate) mod continuation;
 mod path;
+mod preview;
 
 pub use path::{CartesianPath, FREE_BASE_START, PathShape};
+pub use preview::{MAX_PREVIEW_SAMPLES, ReferencePreview};
 
 use crate::error::{SimError, check_finite, check_non_negative};
 

@@ -1,10 +1,14 @@
 //! The controllers a scenario may name: one table ([`CONTROLLERS`]) of names, descriptions and
 //! constructors from the scenario's `[controller]` settings.
 
+use super::Scenario;
 use super::factory::per_coordinate;
 use super::schema::ControllerSpec;
-use crate::controller::{ComputedTorque, Controller, FuzzyController, LqrController, PdController};
+use crate::controller::{
+    ComputedTorque, Controller, FuzzyController, LqrController, MpcController, PdController,
+};
 use crate::error::SimError;
+use crate::optimal::MpcSettings;
 use fuzzy_sugeno::FuzzySystem;
 use modal_reduce::ReducedModel;
 use serde::{Deserialize, Serialize};
@@ -27,6 +31,9 @@ pub enum ControllerKind {
     FuzzyGc,
     /// LQR about the reference, re-linearised along it ([`LqrController`]).
     Lqr,
+    /// Model-predictive control: control-limited iLQR over a receding horizon, previewing the
+    /// scenario's reference ([`MpcController`], [`MpcSettings::uniform`]).
+    Mpc,
 }
 
 /// What a controller's constructor is given: the scenario's `[controller]` settings, with every
@@ -36,6 +43,9 @@ pub enum ControllerKind {
 pub struct ControllerSetup<'a> {
     /// The scenario's `[controller]` table.
     pub spec: &'a ControllerSpec,
+    /// The whole scenario, for controllers that need more than `[controller]` (MPC previews its
+    /// reference).
+    pub scenario: &'a Scenario,
     /// The reduced model the controller will be sampled on (`m` coordinates).
     pub model: &'a ReducedModel,
     /// The controller's sampling period (s).
@@ -137,6 +147,16 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
                     .lqr_relinearise
                     .unwrap_or(LqrController::DEFAULT_RELINEARISE_PERIOD),
             )?))
+        },
+    },
+    ControllerEntry {
+        kind: ControllerKind::Mpc,
+        name: "mpc",
+        description: "model-predictive control: control-limited iLQR over a 0.3 s receding horizon",
+        build: |s| {
+            let settings = MpcSettings::uniform(m(s));
+            let reference = s.scenario.build_reference(s.model)?;
+            Ok(Box::new(MpcController::new(s.model, &settings, reference)?))
         },
     },
 ];

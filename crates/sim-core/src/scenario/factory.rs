@@ -54,6 +54,7 @@ impl Scenario {
         self.assemble(|model, period| {
             ControllerSetup {
                 spec: &self.controller,
+                scenario: self,
                 model,
                 period,
             }
@@ -71,6 +72,20 @@ impl Scenario {
         self.assemble(|_, _| Ok(controller))
     }
 
+    /// The scenario's reference for `model`'s coordinates (the loop's; the MPC controller
+    /// previews a copy of it).
+    pub(crate) fn build_reference(
+        &self,
+        model: &ReducedModel,
+    ) -> Result<Box<dyn Reference>, SimError> {
+        self.reference.build(
+            model.chain().total_length(),
+            self.modal.harmonics,
+            self.alpha0,
+            model.n_coords(),
+        )
+    }
+
     /// The simulation closed by the controller `controller(model, period)` makes.
     fn assemble(
         &self,
@@ -78,12 +93,7 @@ impl Scenario {
     ) -> Result<Simulation, SimError> {
         let model = self.model()?;
         let m = model.n_coords();
-        let reference = self.reference.build(
-            model.chain().total_length(),
-            self.modal.harmonics,
-            self.alpha0,
-            m,
-        )?;
+        let reference = self.build_reference(&model)?;
         let period = match (self.controller.period, self.integrator) {
             (Some(period), _) => period,
             (None, IntegratorSpec::Rk4 { dt }) => dt,

@@ -1,5 +1,5 @@
 //! The integration tests of sim-core, one binary: a module per `src` module it tests (`ode`,
-//! `reference`, `controller`, `optimal`), the closed loop (`closed_loop`, `energy`, `replay` on
+//! `reference`, `controller`, `optimal`, `mpc` for control-limited iLQR and MPC), the closed loop (`closed_loop`, `energy`, `replay` on
 //! the full chain, `imitation` for the controller learned from computed torque, `long_runs`,
 //! `paper_pinned` for the paper's figures), `scenario_fuzz` for scenario files,
 //! `scenario_controller` for a scenario closed by an outside controller, `bad_input` for every
@@ -17,6 +17,7 @@ mod controller;
 mod energy;
 mod imitation;
 mod long_runs;
+mod mpc;
 mod ode;
 mod optimal;
 mod paper_pinned;

@@ -1,0 +1,65 @@
+//! Model-predictive control (issue 13): `mpc/solve_10` is one warm-started MPC solve for the
+//! paper's 10-link arm (`alpha0 = pi/2` fixed, m = 2) over the default horizon (60 steps of 5 ms), with
+//! `tau*` limits that bind: the previous plan shifted by one step, the references of the new
+//! horizon set, and control-limited iLQR run from a state slightly off the previous plan's
+//! prediction (at most the default 5 iterations). Preparing the warm start (a clone of the
+//! planned workspace) is not timed.
+
+use backbone_kin::ModalMap;
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
+use manip_dyn::ChainModel;
+use modal_reduce::ReducedModel;
+use sim_core::optimal::{Mpc, MpcSettings};
+use sim_core::reference::{Reference, ReferenceSample, Sinusoid};
+use std::hint::black_box;
+
+/// Sets the references of the horizon starting at `t`.
+fn set_references(mpc: &mut Mpc, model: &ReducedModel, reference: &mut Sinusoid, t: f64) {
+    let mut sample = ReferenceSample::zeros(2);
+    for k in 0..=mpc.horizon() {
+        reference
+            .sample(t + k as f64 * mpc.step(), &mut sample)
+            .unwrap();
+        mpc.set_reference(model, k, &sample.a, &sample.a_dot, &sample.a_ddot)
+            .unwrap();
+    }
+}
+
+fn solve(c: &mut Criterion) {
+    let alpha0 = std::f64::consts::FRAC_PI_2;
+    let model = ReducedModel::new(
+        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
+        ModalMap::paper_fixed_alpha0(10, alpha0).unwrap(),
+    )
+    .unwrap();
+    // A brisk motion about the paper's start (a1 ~ 1, a2 ~ 0): 0.3 rad and 0.1 rad at 1 Hz.
+    let mut reference = Sinusoid::new(&[1.0, 0.0], &[0.3, 0.1], &[1.0, 1.0], &[0.0, 0.5]).unwrap();
+    let mut settings = MpcSettings::uniform(2);
+    settings.tau_star_limits = Some(vec![1.5, 0.6]);
+    let mut mpc = Mpc::new(&model, &settings).unwrap();
+    // The plan at t = 0 from rest at the reference, converged, then the warm start at t = h.
+    set_references(&mut mpc, &model, &mut reference, 0.0);
+    let mut start = ReferenceSample::zeros(2);
+    reference.sample(0.0, &mut start).unwrap();
+    for _ in 0..5 {
+        mpc.solve(&model, &start.a, &[0.0; 2]).unwrap();
+    }
+    let predicted = mpc.ilqr().states()[4..8].to_vec();
+    let a = [predicted[0] + 2e-3, predicted[1] - 1e-3];
+    let a_dot = [predicted[2] + 1e-2, predicted[3]];
+    mpc.shift(1);
+    let h = mpc.step();
+    set_references(&mut mpc, &model, &mut reference, h);
+    let mut group = c.benchmark_group("mpc");
+    group.bench_function("solve_10", |b| {
+        b.iter_batched_ref(
+            || mpc.clone(),
+            |mpc| mpc.solve(&model, black_box(&a), black_box(&a_dot)).unwrap(),
+            BatchSize::SmallInput,
+        )
+    });
+    group.finish();
+}
+
+criterion_group!(benches, solve);
+criterion_main!(benches);

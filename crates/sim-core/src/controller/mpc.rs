@@ -1,0 +1,146 @@
+//! Model-predictive control in the loop: [`Mpc`] re-planned every model step from the measured
+//! state over a preview of the reference, with the plan's feedback in between.
+
+use super::{ControlContext, Controller, ControllerError, check_context};
+use crate::error::SimError;
+use crate::optimal::{Mpc, MpcSettings};
+use crate::reference::{Reference, ReferencePreview};
+use modal_reduce::ReducedModel;
+
+/// Receding-horizon MPC ([`Mpc`]): at the first sample, and then at the first sample at least one
+/// model step `h` after the last plan, it previews the reference over the horizon
+/// (`t, t + h, ..., t + N h`; node 0 is the reference the loop hands it), shifts the previous
+/// plan by the steps elapsed as the warm start, and re-plans from the measured state by
+/// control-limited iLQR. At every sample it applies the plan's first torque with its locally
+/// optimal feedback about the planned state ([`Mpc::control`]), clamped to the `tau*` limits.
+///
+/// It previews its own copy of the loop's reference (a [`Reference`] is sampled by time alone,
+/// so both agree); reference noise reaches it through node 0. A run that restarts at an earlier
+/// time (a new run of the same [`Simulation`](crate::Simulation)) starts planning afresh.
+/// The loop's actuator limits ([`ControlContext::tau_star_limits`], a scenario's
+/// `[limits] tau_star`), when set, replace the settings' limits at every plan, so the solver
+/// plans within the torques the loop will let through. Nothing allocates per sample.
+#[derive(Debug)]
+pub struct MpcController {
+    mpc: Mpc,
+    preview: ReferencePreview,
+    /// The time of the last plan.
+    plan_time: f64,
+}
+
+/// Slack on "at least one step after the last plan" (relative to the step).
+const PLAN_SLACK: f64 = 1e-9;
+
+impl MpcController {
+    /// MPC of `model`'s coordinates with `settings`, previewing `reference` (the loop's
+    /// reference, or a copy of it).
+    ///
+    /// ```
+    /// use backbone_kin::ModalMap;
+    /// use manip_dyn::ChainModel;
+    /// use modal_reduce::ReducedModel;
+    /// use sim_core::controller::{ControlContext, Controller, ModalState, MpcController};
+    /// use sim_core::optimal::MpcSettings;
+    /// use sim_core::reference::{ReferenceSample, Step};
+    ///
+    /// let model = ReducedModel::new(ChainModel::uniform(10, 0.1, 0.1, 9.81)?, ModalMap::paper(10)?)?;
+    /// let mut settings = MpcSettings::uniform(3);
+    /// settings.tau_star_limits = Some(vec![5.0; 3]);
+    /// let reference = Step::constant(&[0.5, 0.1, 1.5])?;
+    /// let mut mpc = MpcController::new(&model, &settings, Box::new(reference))?;
+    /// let measured = ModalState::new(&[0.4, 0.0, 1.5], &[0.0; 3])?;
+    /// let mut target = ReferenceSample::zeros(3);
+    /// target.a.copy_from_slice(&[0.5, 0.1, 1.5]);
+    /// let ctx = ControlContext { t: 0.0, measured: &measured, reference: &target, model: &model };
+    /// let mut tau = [0.0; 3];
+    /// mpc.control(&ctx, &mut tau)?;
+    /// assert!(tau.iter().all(|t| t.abs() <= 5.0));
+    /// # Ok::<(), Box<dyn std::error::Error + Send + Sync>>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`SimError::InvalidSetting`] for settings out of their domain (named `controller.mpc`) or
+    /// a reference with another number of coordinates.
+    pub fn new(
+        model: &ReducedModel,
+        settings: &MpcSettings,
+        reference: Box<dyn Reference>,
+    ) -> Result<Self, SimError> {
+        let m = model.n_coords();
+        super::check_coordinate_count("controller.mpc", m)?;
+        if reference.n_coords() != m {
+            return Err(SimError::setting(
+                "controller.mpc",
+                format!(
+                    "previews a reference of {} coordinates, the model has {m}",
+                    reference.n_coords()
+                ),
+            ));
+        }
+        let mpc = Mpc::new(model, settings)
+            .map_err(|error| SimError::setting("controller.mpc", error.to_string()))?;
+        let preview = ReferencePreview::new(reference, settings.horizon + 1, settings.step)?;
+        Ok(Self {
+            mpc,
+            preview,
+            plan_time: 0.0,
+        })
+    }
+
+    /// The MPC workspace: the last plan.
+    pub fn mpc(&self) -> &Mpc {
+        &self.mpc
+    }
+
+    /// Re-plans at `ctx.t` from the measured state.
+    fn plan(&mut self, ctx: &ControlContext<'_>) -> Result<(), ControllerError> {
+        let t = ctx.t;
+        let h = self.mpc.step();
+        if self.mpc.planned() {
+            if t < self.plan_time {
+                self.mpc.reset();
+            } else {
+                let steps = ((t - self.plan_time) / h).round().max(1.0);
+                self.mpc.shift(steps.min(usize::MAX as f64) as usize);
+            }
+        }
+        let samples = self.preview.advance(t)?;
+        for (k, sample) in samples.iter().enumerate() {
+            let sample = if k == 0 { ctx.reference } else { sample };
+            self.mpc
+                .set_reference(ctx.model, k, &sample.a, &sample.a_dot, &sample.a_ddot)?;
+        }
+        if let Some(limits) = ctx.tau_star_limits {
+            self.mpc.set_limits(Some(limits))?;
+        }
+        self.mpc
+            .solve(ctx.model, &ctx.measured.a, &ctx.measured.a_dot)?;
+        self.plan_time = t;
+        Ok(())
+    }
+}
+
+impl Controller for MpcController {
+    fn control(
+        &mut self,
+        ctx: &ControlContext<'_>,
+        tau_star: &mut [f64],
+    ) -> Result<(), ControllerError> {
+        check_context(ctx, self.mpc.n_coords(), tau_star)?;
+        let due = self.plan_time + self.mpc.step() * (1.0 - PLAN_SLACK);
+        if !self.mpc.planned() || ctx.t >= due || ctx.t < self.plan_time {
+            self.plan(ctx)?;
+        }
+        self.mpc.control(
+            ctx.t - self.plan_time,
+            &ctx.measured.a,
+            &ctx.measured.a_dot,
+            tau_star,
+        )?;
+        Ok(())
+    }
+
+    fn n_coords(&self) -> Option<usize> {
+        Some(self.mpc.n_coords())
+    }
+}

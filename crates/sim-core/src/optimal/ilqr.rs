@@ -1,0 +1,844 @@
+//! Control-limited iterative LQR (DDP without second-order dynamics terms, Tassa, Mansard and
+//! Todorov 2014) over a finite horizon, for any [`DiscreteDynamics`].
+
+use super::OptimalError;
+use super::box_qp::{BoxQp, BoxQpSettings};
+use super::dense::{multiply, multiply_transposed};
+use super::discrete::DiscreteDynamics;
+
+/// The most steps a horizon may have.
+pub const MAX_HORIZON: usize = 100_000;
+/// The most numbers an [`Ilqr`] workspace may hold (256 MiB of `f64`): a guard on
+/// `horizon * (n_x^2 + 2 n_x n_u)`, the size of the Jacobians and gains.
+pub const MAX_WORKSPACE: usize = 1 << 25;
+
+/// The diagonal quadratic tracking cost of [`Ilqr`]:
+///
+/// ```text
+/// J = sum_{k<N} 1/2 [ (x_k - r_k)^T Q (x_k - r_k) + (u_k - w_k)^T R (u_k - w_k) ]
+///     + 1/2 (x_N - r_N)^T Q_f (x_N - r_N)
+/// ```
+///
+/// with `Q = diag(state)`, `R = diag(control)`, `Q_f = diag(terminal)`, the state references
+/// `r_k` and the control references `w_k` (a feedforward, e.g. the inverse dynamics along the
+/// reference, so that `R` weighs the effort of *correcting*).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackingCost {
+    /// `Q`'s diagonal (`n_x` entries, non-negative).
+    pub state: Vec<f64>,
+    /// `R`'s diagonal (`n_u` entries, positive).
+    pub control: Vec<f64>,
+    /// `Q_f`'s diagonal (`n_x` entries, non-negative).
+    pub terminal: Vec<f64>,
+}
+
+/// Stopping rules and regularisation schedule of [`Ilqr::solve`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IlqrSettings {
+    /// The most iterations (backward pass and line search), at most 1e4.
+    pub max_iterations: usize,
+    /// Converged when an accepted iteration lowers the cost by less than this fraction of it.
+    pub tolerance: f64,
+    /// Converged when the feed-forward steps are this small: the mean over the horizon of
+    /// `max_i |k_i| / (|u_i| + 1)` (Tassa et al.'s gradient test).
+    pub gradient_tolerance: f64,
+    /// The regularisation `mu` of the first iteration (`Q_uu + mu I`); non-negative.
+    pub regularisation: f64,
+    /// Below this a decreasing `mu` becomes 0; above [`max_regularisation`](Self::max_regularisation)
+    /// the solve stops unconverged.
+    pub min_regularisation: f64,
+    /// See [`min_regularisation`](Self::min_regularisation).
+    pub max_regularisation: f64,
+    /// Step lengths tried by the line search: `1, 1/2, ..., 2^-(steps-1)` (1 to 60).
+    pub line_search_steps: usize,
+    /// The per-step box QP.
+    pub box_qp: BoxQpSettings,
+}
+
+impl Default for IlqrSettings {
+    fn default() -> Self {
+        Self {
+            max_iterations: 100,
+            tolerance: 1e-9,
+            gradient_tolerance: 1e-7,
+            regularisation: 0.0,
+            min_regularisation: 1e-8,
+            max_regularisation: 1e10,
+            line_search_steps: 10,
+            box_qp: BoxQpSettings::default(),
+        }
+    }
+}
+
+impl IlqrSettings {
+    /// Checks every setting against its domain (the box QP's included).
+    ///
+    /// # Errors
+    /// [`OptimalError::InvalidSetting`] naming the first setting out of its domain.
+    pub fn validate(&self) -> Result<(), OptimalError> {
+        if self.max_iterations > 10_000 {
+            return Err(OptimalError::InvalidSetting {
+                name: "max_iterations",
+                requirement: "at most 1e4",
+                value: self.max_iterations as f64,
+            });
+        }
+        if !(1..=60).contains(&self.line_search_steps) {
+            return Err(OptimalError::InvalidSetting {
+                name: "line_search_steps",
+                requirement: "between 1 and 60",
+                value: self.line_search_steps as f64,
+            });
+        }
+        for (name, value) in [
+            ("tolerance", self.tolerance),
+            ("gradient_tolerance", self.gradient_tolerance),
+            ("regularisation", self.regularisation),
+            ("min_regularisation", self.min_regularisation),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(OptimalError::InvalidSetting {
+                    name,
+                    requirement: "non-negative and finite",
+                    value,
+                });
+            }
+        }
+        let max = self.max_regularisation;
+        if !(max.is_finite() && max > self.min_regularisation && max >= self.regularisation) {
+            return Err(OptimalError::InvalidSetting {
+                name: "max_regularisation",
+                requirement: "finite and above min_regularisation and regularisation",
+                value: max,
+            });
+        }
+        self.box_qp.validate()
+    }
+}
+
+/// Growth factor of the regularisation schedule (Tassa, Erez and Todorov 2012, section V).
+const REGULARISATION_FACTOR: f64 = 1.6;
+/// A line-search step is accepted when it realises this fraction of the predicted decrease.
+const ACCEPTANCE: f64 = 1e-4;
+
+/// What an [`Ilqr::solve`] did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IlqrReport {
+    /// Iterations taken (backward passes that reached a line search).
+    pub iterations: usize,
+    /// The cost of the warm start's rollout.
+    pub initial_cost: f64,
+    /// The cost of the solution.
+    pub cost: f64,
+    /// Whether a convergence test (not the iteration limit or the regularisation limit) ended it.
+    pub converged: bool,
+    /// The regularisation at the end.
+    pub regularisation: f64,
+}
+
+/// The workspace of control-limited iLQR for `n_x` states, `n_u` controls and a horizon of `N`
+/// steps: the trajectory, references, bounds, Jacobians, gains and the per-step QP, all
+/// allocated by [`new`](Self::new); [`solve`](Self::solve) allocates nothing.
+///
+/// Each iteration (Tassa, Mansard and Todorov 2014, Algorithm 2):
+///
+/// 1. Linearise `x_{k+1} = F(x_k, u_k)` along the current trajectory (`A_k`, `B_k`).
+/// 2. Backward pass from `V_x = Q_f (x_N - r_N)`, `V_xx = Q_f`:
+///    `Q_x = l_x + A^T V_x'`, `Q_u = l_u + B^T V_x'`, `Q_xx = Q + A^T V_xx' A`,
+///    `Q_uu = R + B^T V_xx' B`, `Q_ux = B^T V_xx' A`; the feed-forward `k` solves the box QP
+///    `min 1/2 d^T (Q_uu + mu I) d + Q_u^T d` over `lower - u_k <= d <= upper - u_k`
+///    ([`BoxQp`], warm-started from the previous `k`); the gain is
+///    `K_f = -(Q_uu + mu I)_ff^-1 Q_ux,f` on the free controls and `K_c = 0` on the clamped ones,
+///    so feedback never pushes a saturated control further; then
+///    `V_x = Q_x + K^T Q_uu k + K^T Q_u + Q_ux^T k`,
+///    `V_xx = Q_xx + K^T Q_uu K + K^T Q_ux + Q_ux^T K`.
+/// 3. Forward pass with a backtracking line search on `alpha`:
+///    `u'_k = clamp(u_k + alpha k_k + K_k (x'_k - x_k))`, `x'_{k+1} = F(x'_k, u'_k)`, accepted
+///    when the cost falls by at least `1e-4` of the predicted
+///    `-(alpha sum k^T Q_u + alpha^2 / 2 sum k^T Q_uu k)`.
+///
+/// `mu` follows the schedule of Tassa, Erez and Todorov 2012: it grows (by a factor that itself
+/// grows from 1.6) when `Q_uu + mu I` is not positive definite or no step is accepted, and
+/// shrinks after an accepted step. Controls stay in the box throughout: the warm start is
+/// projected onto it and every forward pass clamps. The cost is a [`TrackingCost`].
+#[derive(Debug, Clone)]
+pub struct Ilqr {
+    nx: usize,
+    nu: usize,
+    horizon: usize,
+    cost: TrackingCost,
+    /// The current trajectory `x_0..x_N`, `u_0..u_{N-1}` and the line search's candidate.
+    x: Vec<f64>,
+    u: Vec<f64>,
+    x_try: Vec<f64>,
+    u_try: Vec<f64>,
+    /// References `r_0..r_N` and `w_0..w_{N-1}`.
+    x_ref: Vec<f64>,
+    u_ref: Vec<f64>,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    /// Per step: `A_k` (`n_x x n_x`), `B_k` (`n_x x n_u`), `K_k` (`n_u x n_x`), `k_k` (`n_u`).
+    a: Vec<f64>,
+    b: Vec<f64>,
+    gain: Vec<f64>,
+    feedforward: Vec<f64>,
+    /// Backward-pass terms.
+    v_x: Vec<f64>,
+    v_xx: Vec<f64>,
+    q_x: Vec<f64>,
+    q_u: Vec<f64>,
+    q_xx: Vec<f64>,
+    q_uu: Vec<f64>,
+    q_ux: Vec<f64>,
+    /// `V_xx' A` (`n_x x n_x`), `V_xx' B` (`n_x x n_u`), `Q_uu K` (`n_u x n_x`), `Q_uu k` (`n_u`),
+    /// the regularised Hessian (`n_u x n_u`) and the step bounds (`n_u` each).
+    va: Vec<f64>,
+    vb: Vec<f64>,
+    quu_gain: Vec<f64>,
+    quu_ff: Vec<f64>,
+    hessian: Vec<f64>,
+    step_lower: Vec<f64>,
+    step_upper: Vec<f64>,
+    /// The adjoint of [`gradient`](Self::gradient) and its next value.
+    adjoint: Vec<f64>,
+    adjoint_next: Vec<f64>,
+    qp: BoxQp,
+}
+
+impl Ilqr {
+    /// A workspace for `n_x` states, `n_u` controls, `horizon` steps and `cost`. The bounds start
+    /// unbounded, the references and the warm start at zero.
+    ///
+    /// # Errors
+    /// [`OptimalError::InvalidSetting`] for a dimension or horizon of zero, a horizon above
+    /// [`MAX_HORIZON`], a workspace above [`MAX_WORKSPACE`] numbers, or weights that are
+    /// negative or not finite (control weights must be positive);
+    /// [`OptimalError::Dimension`] for weights of the wrong length.
+    pub fn new(
+        nx: usize,
+        nu: usize,
+        horizon: usize,
+        cost: &TrackingCost,
+    ) -> Result<Self, OptimalError> {
+        for (name, value) in [("n_x", nx), ("n_u", nu), ("horizon", horizon)] {
+            if value == 0 {
+                return Err(OptimalError::InvalidSetting {
+                    name,
+                    requirement: "at least 1",
+                    value: 0.0,
+                });
+            }
+        }
+        if horizon > MAX_HORIZON {
+            return Err(OptimalError::InvalidSetting {
+                name: "horizon",
+                requirement: "at most 100000 steps",
+                value: horizon as f64,
+            });
+        }
+        let per_step = nx
+            .saturating_mul(nx)
+            .saturating_add(nx.saturating_mul(nu).saturating_mul(2));
+        if horizon.saturating_mul(per_step) > MAX_WORKSPACE {
+            return Err(OptimalError::InvalidSetting {
+                name: "horizon",
+                requirement: "small enough for horizon * (n_x^2 + 2 n_x n_u) <= 2^25",
+                value: horizon as f64,
+            });
+        }
+        for (name, weights, len, positive) in [
+            ("state weight", &cost.state, nx, false),
+            ("control weight", &cost.control, nu, true),
+            ("terminal weight", &cost.terminal, nx, false),
+        ] {
+            if weights.len() != len {
+                return Err(OptimalError::Dimension {
+                    name,
+                    expected: len,
+                    found: weights.len(),
+                });
+            }
+            for &w in weights {
+                let ok = w.is_finite() && if positive { w > 0.0 } else { w >= 0.0 };
+                if !ok {
+                    return Err(OptimalError::InvalidSetting {
+                        name,
+                        requirement: if positive {
+                            "positive and finite"
+                        } else {
+                            "non-negative and finite"
+                        },
+                        value: w,
+                    });
+                }
+            }
+        }
+        let n = horizon;
+        Ok(Self {
+            nx,
+            nu,
+            horizon,
+            cost: cost.clone(),
+            x: vec![0.0; (n + 1) * nx],
+            u: vec![0.0; n * nu],
+            x_try: vec![0.0; (n + 1) * nx],
+            u_try: vec![0.0; n * nu],
+            x_ref: vec![0.0; (n + 1) * nx],
+            u_ref: vec![0.0; n * nu],
+            lower: vec![f64::NEG_INFINITY; nu],
+            upper: vec![f64::INFINITY; nu],
+            a: vec![0.0; n * nx * nx],
+            b: vec![0.0; n * nx * nu],
+            gain: vec![0.0; n * nu * nx],
+            feedforward: vec![0.0; n * nu],
+            v_x: vec![0.0; nx],
+            v_xx: vec![0.0; nx * nx],
+            q_x: vec![0.0; nx],
+            q_u: vec![0.0; nu],
+            q_xx: vec![0.0; nx * nx],
+            q_uu: vec![0.0; nu * nu],
+            q_ux: vec![0.0; nu * nx],
+            va: vec![0.0; nx * nx],
+            vb: vec![0.0; nx * nu],
+            quu_gain: vec![0.0; nu * nx],
+            quu_ff: vec![0.0; nu],
+            hessian: vec![0.0; nu * nu],
+            step_lower: vec![0.0; nu],
+            step_upper: vec![0.0; nu],
+            adjoint: vec![0.0; nx],
+            adjoint_next: vec![0.0; nx],
+            qp: BoxQp::new(nu),
+        })
+    }
+
+    /// The number of states `n_x`.
+    pub fn state_dim(&self) -> usize {
+        self.nx
+    }
+
+    /// The number of controls `n_u`.
+    pub fn control_dim(&self) -> usize {
+        self.nu
+    }
+
+    /// The number of steps `N`.
+    pub fn horizon(&self) -> usize {
+        self.horizon
+    }
+
+    /// Sets the box `lower <= u_k <= upper` on every control (`n_u` entries each; infinite
+    /// entries for unbounded controls).
+    ///
+    /// # Errors
+    /// [`OptimalError::Dimension`] for wrong lengths, [`OptimalError::InvalidSetting`] for a NaN
+    /// or `lower > upper`.
+    pub fn set_bounds(&mut self, lower: &[f64], upper: &[f64]) -> Result<(), OptimalError> {
+        for (name, values) in [("lower bound", lower), ("upper bound", upper)] {
+            if values.len() != self.nu {
+                return Err(OptimalError::Dimension {
+                    name,
+                    expected: self.nu,
+                    found: values.len(),
+                });
+            }
+        }
+        for (&l, &u) in lower.iter().zip(upper) {
+            if l.is_nan() || u.is_nan() || l > u || l == f64::INFINITY || u == f64::NEG_INFINITY {
+                return Err(OptimalError::InvalidSetting {
+                    name: "control bounds",
+                    requirement: "ordered (lower <= upper), not NaN, with a finite interior",
+                    value: l - u,
+                });
+            }
+        }
+        self.lower.copy_from_slice(lower);
+        self.upper.copy_from_slice(upper);
+        Ok(())
+    }
+
+    /// The state references `r_0..r_N`, `(N + 1) x n_x` row-major, to fill before a solve.
+    pub fn state_references_mut(&mut self) -> &mut [f64] {
+        &mut self.x_ref
+    }
+
+    /// The control references `w_0..w_{N-1}`, `N x n_u` row-major, to fill before a solve.
+    pub fn control_references_mut(&mut self) -> &mut [f64] {
+        &mut self.u_ref
+    }
+
+    /// The controls `u_0..u_{N-1}` (`N x n_u` row-major): the warm start before a solve, the
+    /// solution after it.
+    pub fn controls_mut(&mut self) -> &mut [f64] {
+        &mut self.u
+    }
+
+    /// The controls of the last solve (`N x n_u` row-major).
+    pub fn controls(&self) -> &[f64] {
+        &self.u
+    }
+
+    /// The states `x_0..x_N` of the last solve (`(N + 1) x n_x` row-major).
+    pub fn states(&self) -> &[f64] {
+        &self.x
+    }
+
+    /// The feedback gains `K_0..K_{N-1}` of the last solve's last backward pass
+    /// (`N x n_u x n_x`), zero rows for clamped controls.
+    pub fn gains(&self) -> &[f64] {
+        &self.gain
+    }
+
+    /// The control bounds `(lower, upper)`.
+    pub fn bounds(&self) -> (&[f64], &[f64]) {
+        (&self.lower, &self.upper)
+    }
+
+    /// Sets the warm start to the control references `w_k`.
+    pub fn warm_start_from_control_references(&mut self) {
+        self.u.copy_from_slice(&self.u_ref);
+    }
+
+    /// Shifts the controls (and the QP warm starts) `steps` steps earlier, repeating the last
+    /// control at the end: the warm start of a receding horizon that moved on by `steps`.
+    pub fn shift(&mut self, steps: usize) {
+        let (n, nu) = (self.horizon, self.nu);
+        let s = steps.min(n - 1);
+        if s == 0 {
+            return;
+        }
+        for buffer in [&mut self.u, &mut self.feedforward] {
+            buffer.copy_within(s * nu.., 0);
+            let (head, tail) = buffer.split_at_mut((n - s) * nu);
+            let last = &head[(n - s - 1) * nu..];
+            for chunk in tail.chunks_exact_mut(nu) {
+                chunk.copy_from_slice(last);
+            }
+        }
+    }
+
+    /// `clamp(u_k + K_k dx)` into `out` (`n_u` entries): the locally optimal feedback of the last
+    /// solve at step `k` for a state `dx` away from the planned `x_k`.
+    ///
+    /// # Panics
+    /// If `k >= N` or the slices are shorter than `n_x` and `n_u`.
+    pub fn feedback(&self, k: usize, dx: &[f64], out: &mut [f64]) {
+        let (nx, nu) = (self.nx, self.nu);
+        for (i, out) in out.iter_mut().enumerate().take(nu) {
+            let row = &self.gain[(k * nu + i) * nx..(k * nu + i + 1) * nx];
+            let correction: f64 = row.iter().zip(dx).map(|(g, d)| g * d).sum();
+            *out = (self.u[k * nu + i] + correction).clamp(self.lower[i], self.upper[i]);
+        }
+    }
+
+    /// Minimises the [`TrackingCost`] from `x0` (`n_x` entries) over the horizon, starting from
+    /// the controls in [`controls_mut`](Self::controls_mut) (projected onto the box). The
+    /// solution is then in [`controls`](Self::controls), [`states`](Self::states) and
+    /// [`gains`](Self::gains).
+    ///
+    /// # Errors
+    /// [`OptimalError::Dimension`] if `dynamics` or `x0` does not match the workspace,
+    /// [`OptimalError::InvalidSetting`] for bad settings, a non-finite `x0` or reference, or a
+    /// warm start whose rollout the dynamics refuse ([`OptimalError::Dynamics`]).
+    pub fn solve<D: DiscreteDynamics + ?Sized>(
+        &mut self,
+        dynamics: &mut D,
+        x0: &[f64],
+        settings: &IlqrSettings,
+    ) -> Result<IlqrReport, OptimalError> {
+        self.check(dynamics, x0, settings)?;
+        let steps = settings.line_search_steps;
+        // The warm start, projected onto the box.
+        for chunk in self.u.chunks_exact_mut(self.nu) {
+            for ((u, l), h) in chunk.iter_mut().zip(&self.lower).zip(&self.upper) {
+                *u = if u.is_finite() { *u } else { 0.0 }.clamp(*l, *h);
+            }
+        }
+        self.x[..self.nx].copy_from_slice(x0);
+        let initial_cost = self.rollout(dynamics)?;
+        let mut cost = initial_cost;
+        let mut mu = settings.regularisation;
+        let mut delta = 1.0;
+        let mut converged = false;
+        let mut iterations = 0;
+        let mut linearised = false;
+        while iterations < settings.max_iterations {
+            if !linearised {
+                self.linearise(dynamics)?;
+                linearised = true;
+            }
+            let expected = match self.backward(mu, &settings.box_qp) {
+                Ok(expected) => expected,
+                Err(OptimalError::NotPositiveDefinite(_)) => {
+                    if !increase(&mut mu, &mut delta, settings) {
+                        break;
+                    }
+                    continue;
+                }
+                Err(other) => return Err(other),
+            };
+            iterations += 1;
+            if (mu <= settings.min_regularisation
+                && self.feedforward_size() < settings.gradient_tolerance)
+                || -(expected[0] + expected[1]) <= settings.tolerance * cost.abs()
+            {
+                converged = true;
+                break;
+            }
+            let mut accepted = None;
+            let mut alpha = 1.0;
+            for _ in 0..steps {
+                let candidate = self.forward(dynamics, alpha);
+                let predicted = -(alpha * expected[0] + alpha * alpha * expected[1]);
+                if candidate < cost && (cost - candidate) >= ACCEPTANCE * predicted {
+                    accepted = Some(candidate);
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            match accepted {
+                Some(candidate) => {
+                    std::mem::swap(&mut self.x, &mut self.x_try);
+                    std::mem::swap(&mut self.u, &mut self.u_try);
+                    linearised = false;
+                    let improvement = cost - candidate;
+                    cost = candidate;
+                    decrease(&mut mu, &mut delta, settings);
+                    if improvement <= settings.tolerance * cost.abs() {
+                        converged = true;
+                        break;
+                    }
+                }
+                None => {
+                    if !increase(&mut mu, &mut delta, settings) {
+                        break;
+                    }
+                }
+            }
+        }
+        Ok(IlqrReport {
+            iterations,
+            initial_cost,
+            cost,
+            converged,
+            regularisation: mu,
+        })
+    }
+
+    /// The cost of the current trajectory and its gradient with respect to the controls,
+    /// `dJ / du_k` into `out` (`N x n_u`), by the adjoint recursion
+    /// `lambda_N = Q_f (x_N - r_N)`, `dJ/du_k = l_u + B_k^T lambda_{k+1}`,
+    /// `lambda_k = l_x + A_k^T lambda_{k+1}` (first-order optimality: at a solution the gradient
+    /// vanishes on the free controls and points into the box on the clamped ones). Re-linearises
+    /// along the trajectory.
+    ///
+    /// # Errors
+    /// [`OptimalError::Dimension`] for a wrong `out` or dynamics; the dynamics' errors.
+    pub fn gradient<D: DiscreteDynamics + ?Sized>(
+        &mut self,
+        dynamics: &mut D,
+        out: &mut [f64],
+    ) -> Result<f64, OptimalError> {
+        self.check_dynamics(dynamics)?;
+        if out.len() != self.horizon * self.nu {
+            return Err(OptimalError::Dimension {
+                name: "gradient",
+                expected: self.horizon * self.nu,
+                found: out.len(),
+            });
+        }
+        self.linearise(dynamics)?;
+        let (nx, nu, n) = (self.nx, self.nu, self.horizon);
+        for i in 0..nx {
+            self.adjoint[i] = self.cost.terminal[i] * (self.x[n * nx + i] - self.x_ref[n * nx + i]);
+        }
+        for k in (0..n).rev() {
+            let a = &self.a[k * nx * nx..(k + 1) * nx * nx];
+            let b = &self.b[k * nx * nu..(k + 1) * nx * nu];
+            multiply_transposed(b, &self.adjoint, &mut out[k * nu..(k + 1) * nu], nu, nx, 1);
+            for j in 0..nu {
+                out[k * nu + j] +=
+                    self.cost.control[j] * (self.u[k * nu + j] - self.u_ref[k * nu + j]);
+            }
+            multiply_transposed(a, &self.adjoint, &mut self.adjoint_next, nx, nx, 1);
+            for i in 0..nx {
+                self.adjoint[i] = self.adjoint_next[i]
+                    + self.cost.state[i] * (self.x[k * nx + i] - self.x_ref[k * nx + i]);
+            }
+        }
+        Ok(self.trajectory_cost(&self.x, &self.u))
+    }
+
+    /// Checks the arguments of a solve.
+    fn check<D: DiscreteDynamics + ?Sized>(
+        &self,
+        dynamics: &D,
+        x0: &[f64],
+        settings: &IlqrSettings,
+    ) -> Result<(), OptimalError> {
+        self.check_dynamics(dynamics)?;
+        if x0.len() != self.nx {
+            return Err(OptimalError::Dimension {
+                name: "x0",
+                expected: self.nx,
+                found: x0.len(),
+            });
+        }
+        let finite = |name, values: &[f64]| match values.iter().find(|v| !v.is_finite()) {
+            None => Ok(()),
+            Some(&value) => Err(OptimalError::InvalidSetting {
+                name,
+                requirement: "finite",
+                value,
+            }),
+        };
+        finite("x0", x0)?;
+        finite("state reference", &self.x_ref)?;
+        finite("control reference", &self.u_ref)?;
+        settings.validate()
+    }
+
+    fn check_dynamics<D: DiscreteDynamics + ?Sized>(
+        &self,
+        dynamics: &D,
+    ) -> Result<(), OptimalError> {
+        for (name, got, expected) in [
+            ("dynamics states", dynamics.state_dim(), self.nx),
+            ("dynamics controls", dynamics.control_dim(), self.nu),
+        ] {
+            if got != expected {
+                return Err(OptimalError::Dimension {
+                    name,
+                    expected,
+                    found: got,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// `x_{k+1} = F(x_k, u_k)` from `x_0` with the current controls; the cost.
+    fn rollout<D: DiscreteDynamics + ?Sized>(
+        &mut self,
+        dynamics: &mut D,
+    ) -> Result<f64, OptimalError> {
+        let (nx, nu) = (self.nx, self.nu);
+        for k in 0..self.horizon {
+            let (past, future) = self.x.split_at_mut((k + 1) * nx);
+            dynamics.step(
+                &past[k * nx..],
+                &self.u[k * nu..(k + 1) * nu],
+                &mut future[..nx],
+            )?;
+        }
+        let cost = self.trajectory_cost(&self.x, &self.u);
+        if cost.is_finite() {
+            Ok(cost)
+        } else {
+            Err(OptimalError::InvalidSetting {
+                name: "warm start",
+                requirement: "a rollout of finite cost",
+                value: cost,
+            })
+        }
+    }
+
+    /// The Jacobians along the current trajectory.
+    fn linearise<D: DiscreteDynamics + ?Sized>(
+        &mut self,
+        dynamics: &mut D,
+    ) -> Result<(), OptimalError> {
+        let (nx, nu) = (self.nx, self.nu);
+        for k in 0..self.horizon {
+            dynamics.linearise(
+                &self.x[k * nx..(k + 1) * nx],
+                &self.u[k * nu..(k + 1) * nu],
+                &mut self.x_try[..nx],
+                &mut self.a[k * nx * nx..(k + 1) * nx * nx],
+                &mut self.b[k * nx * nu..(k + 1) * nx * nu],
+            )?;
+        }
+        Ok(())
+    }
+
+    /// The backward pass with regularisation `mu`: gains, feed-forward steps and the expected
+    /// decrease terms `[sum k^T Q_u, 1/2 sum k^T Q_uu k]`.
+    fn backward(&mut self, mu: f64, qp: &BoxQpSettings) -> Result<[f64; 2], OptimalError> {
+        let (nx, nu, n) = (self.nx, self.nu, self.horizon);
+        let cost = &self.cost;
+        let mut expected = [0.0; 2];
+        for i in 0..nx {
+            self.v_x[i] = cost.terminal[i] * (self.x[n * nx + i] - self.x_ref[n * nx + i]);
+        }
+        self.v_xx.fill(0.0);
+        for i in 0..nx {
+            self.v_xx[i * nx + i] = cost.terminal[i];
+        }
+        for k in (0..n).rev() {
+            let a = &self.a[k * nx * nx..(k + 1) * nx * nx];
+            let b = &self.b[k * nx * nu..(k + 1) * nx * nu];
+            let u = &self.u[k * nu..(k + 1) * nu];
+            // Q_x, Q_u.
+            multiply_transposed(a, &self.v_x, &mut self.q_x, nx, nx, 1);
+            multiply_transposed(b, &self.v_x, &mut self.q_u, nu, nx, 1);
+            for i in 0..nx {
+                self.q_x[i] += cost.state[i] * (self.x[k * nx + i] - self.x_ref[k * nx + i]);
+            }
+            for (j, q) in self.q_u.iter_mut().enumerate() {
+                *q += cost.control[j] * (u[j] - self.u_ref[k * nu + j]);
+            }
+            // Q_xx, Q_uu, Q_ux.
+            multiply(&self.v_xx, a, &mut self.va, nx, nx, nx);
+            multiply(&self.v_xx, b, &mut self.vb, nx, nx, nu);
+            multiply_transposed(a, &self.va, &mut self.q_xx, nx, nx, nx);
+            multiply_transposed(b, &self.vb, &mut self.q_uu, nu, nx, nu);
+            multiply_transposed(b, &self.va, &mut self.q_ux, nu, nx, nx);
+            for i in 0..nx {
+                self.q_xx[i * nx + i] += cost.state[i];
+            }
+            for j in 0..nu {
+                self.q_uu[j * nu + j] += cost.control[j];
+            }
+            // The feed-forward step: the box QP on (Q_uu + mu I, Q_u).
+            self.hessian.copy_from_slice(&self.q_uu);
+            for (j, &uj) in u.iter().enumerate() {
+                self.hessian[j * nu + j] += mu;
+                self.step_lower[j] = self.lower[j] - uj;
+                self.step_upper[j] = self.upper[j] - uj;
+            }
+            let ff = &mut self.feedforward[k * nu..(k + 1) * nu];
+            self.qp.solve(
+                &self.hessian,
+                &self.q_u,
+                &self.step_lower,
+                &self.step_upper,
+                ff,
+                qp,
+            )?;
+            // The gain on the free controls, zero on the clamped ones.
+            let gain = &mut self.gain[k * nu * nx..(k + 1) * nu * nx];
+            gain.copy_from_slice(&self.q_ux);
+            self.qp.solve_free(gain, nx);
+            for g in gain.iter_mut() {
+                *g = -*g;
+            }
+            // The value function.
+            multiply(&self.q_uu, gain, &mut self.quu_gain, nu, nu, nx);
+            multiply(&self.q_uu, ff, &mut self.quu_ff, nu, nu, 1);
+            for (j, f) in ff.iter().enumerate() {
+                expected[0] += f * self.q_u[j];
+                expected[1] += 0.5 * f * self.quu_ff[j];
+            }
+            for i in 0..nx {
+                let mut s = self.q_x[i];
+                for j in 0..nu {
+                    s += gain[j * nx + i] * (self.quu_ff[j] + self.q_u[j])
+                        + self.q_ux[j * nx + i] * ff[j];
+                }
+                self.v_x[i] = s;
+            }
+            for i in 0..nx {
+                for l in 0..nx {
+                    let mut s = self.q_xx[i * nx + l];
+                    for j in 0..nu {
+                        s += gain[j * nx + i] * (self.quu_gain[j * nx + l] + self.q_ux[j * nx + l])
+                            + self.q_ux[j * nx + i] * gain[j * nx + l];
+                    }
+                    self.v_xx[i * nx + l] = s;
+                }
+            }
+            for i in 0..nx {
+                for l in i + 1..nx {
+                    let mean = 0.5 * (self.v_xx[i * nx + l] + self.v_xx[l * nx + i]);
+                    self.v_xx[i * nx + l] = mean;
+                    self.v_xx[l * nx + i] = mean;
+                }
+            }
+        }
+        Ok(expected)
+    }
+
+    /// The forward pass at step length `alpha` into `x_try`, `u_try`; its cost (infinite if the
+    /// dynamics refuse a state on the way).
+    fn forward<D: DiscreteDynamics + ?Sized>(&mut self, dynamics: &mut D, alpha: f64) -> f64 {
+        let (nx, nu) = (self.nx, self.nu);
+        self.x_try[..nx].copy_from_slice(&self.x[..nx]);
+        for k in 0..self.horizon {
+            for j in 0..nu {
+                let row = &self.gain[(k * nu + j) * nx..(k * nu + j + 1) * nx];
+                let mut u = self.u[k * nu + j] + alpha * self.feedforward[k * nu + j];
+                for (i, g) in row.iter().enumerate() {
+                    u += g * (self.x_try[k * nx + i] - self.x[k * nx + i]);
+                }
+                self.u_try[k * nu + j] = u.clamp(self.lower[j], self.upper[j]);
+            }
+            let (past, future) = self.x_try.split_at_mut((k + 1) * nx);
+            if dynamics
+                .step(
+                    &past[k * nx..],
+                    &self.u_try[k * nu..(k + 1) * nu],
+                    &mut future[..nx],
+                )
+                .is_err()
+            {
+                return f64::INFINITY;
+            }
+        }
+        let cost = self.trajectory_cost(&self.x_try, &self.u_try);
+        if cost.is_nan() { f64::INFINITY } else { cost }
+    }
+
+    /// The tracking cost of a trajectory.
+    fn trajectory_cost(&self, x: &[f64], u: &[f64]) -> f64 {
+        let (nx, nu, n) = (self.nx, self.nu, self.horizon);
+        let c = &self.cost;
+        let mut total = 0.0;
+        for k in 0..=n {
+            let weights = if k == n { &c.terminal } else { &c.state };
+            for i in 0..nx {
+                let e = x[k * nx + i] - self.x_ref[k * nx + i];
+                total += 0.5 * weights[i] * e * e;
+            }
+            if k < n {
+                for j in 0..nu {
+                    let e = u[k * nu + j] - self.u_ref[k * nu + j];
+                    total += 0.5 * c.control[j] * e * e;
+                }
+            }
+        }
+        total
+    }
+
+    /// Tassa et al.'s gradient measure: the mean over the horizon of
+    /// `max_i |k_i| / (|u_i| + 1)`.
+    fn feedforward_size(&self) -> f64 {
+        let nu = self.nu;
+        let total: f64 = self
+            .feedforward
+            .chunks_exact(nu)
+            .zip(self.u.chunks_exact(nu))
+            .map(|(k, u)| {
+                k.iter()
+                    .zip(u)
+                    .map(|(k, u)| k.abs() / (u.abs() + 1.0))
+                    .fold(0.0, f64::max)
+            })
+            .sum();
+        total / self.horizon as f64
+    }
+}
+
+/// Grows the regularisation; `false` once it passes its maximum.
+fn increase(mu: &mut f64, delta: &mut f64, settings: &IlqrSettings) -> bool {
+    *delta = (*delta * REGULARISATION_FACTOR).max(REGULARISATION_FACTOR);
+    *mu = (*mu * *delta).max(settings.min_regularisation.max(f64::MIN_POSITIVE));
+    *mu <= settings.max_regularisation
+}
+
+/// Shrinks the regularisation, to zero below its minimum.
+fn decrease(mu: &mut f64, delta: &mut f64, settings: &IlqrSettings) {
+    *delta = (*delta / REGULARISATION_FACTOR).min(1.0 / REGULARISATION_FACTOR);
+    *mu *= *delta;
+    if *mu < settings.min_regularisation {
+        *mu = 0.0;
+    }
+}
