@@ -33,14 +33,14 @@ pub struct MpcSettings {
 
 impl MpcSettings {
     /// Settings for `m` coordinates: 60 steps of 5 ms (a 0.3 s horizon), position weight
-    /// `1e4`, rate weight `10`, effort weight `1e-3`, a terminal weight of 0.1 s, no limits, at
+    /// `1e4`, rate weight `1`, effort weight `1e-3`, a terminal weight of 0.1 s, no limits, at
     /// most 5 iterations per solve starting from the regularisation `1e-2`.
     pub fn uniform(m: usize) -> Self {
         Self {
             horizon: 60,
             step: 0.005,
             position_weight: vec![1e4; m],
-            rate_weight: vec![10.0; m],
+            rate_weight: vec![1.0; m],
             effort_weight: vec![1e-3; m],
             terminal_seconds: 0.1,
             tau_star_limits: None,
