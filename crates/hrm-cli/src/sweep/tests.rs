@@ -170,14 +170,16 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
     assert!(err.contains("same split"), "{err}");
     // A shard file cut short.
     let mut cut = ShardFile::read(&shard(2)).unwrap();
+    let in_shard = cut.runs.len();
     cut.runs.pop();
     let cut_path = root.join("cut").join("shard-2-of-3.json");
     write(&cut_path, &cut.to_json().unwrap()).unwrap();
     let err = merge(&[shard(1), cut_path.clone(), shard(3)]);
-    assert!(
-        err.contains("is cut short: it holds 7 of the 8 runs of shard 2/3"),
-        "{err}"
+    let cut_short = format!(
+        "is cut short: it holds {} of the {in_shard} runs of shard 2/3",
+        in_shard - 1
     );
+    assert!(err.contains(&cut_short), "{err}");
     // A run moved to a shard it does not belong to.
     let mut moved = ShardFile::read(&shard(2)).unwrap();
     moved.runs[0].index = 0;
