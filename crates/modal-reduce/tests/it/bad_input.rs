@@ -519,7 +519,10 @@ fn every_refusal_is_in_exactly_one_class() {
     for Row { name, error, .. } in model_rows().into_iter().chain(call_rows()) {
         let numerical = matches!(
             error,
-            ReduceError::NonFiniteResult { .. } | ReduceError::JacobiDiverged { .. }
+            ReduceError::NonFiniteResult { .. }
+                | ReduceError::JacobiDiverged { .. }
+                | ReduceError::JacobiNotConverged { .. }
+                | ReduceError::NotPositiveDefinite
         ) || matches!(error, ReduceError::Dyn(ref e) if e.is_numerical());
         let unreachable = error.is_unreachable();
         assert_eq!(error.is_numerical(), numerical, "{name}: {error}");

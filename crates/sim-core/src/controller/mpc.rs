@@ -51,7 +51,13 @@ impl MpcController {
     /// let measured = ModalState::new(&[0.4, 0.0, 1.5], &[0.0; 3])?;
     /// let mut target = ReferenceSample::zeros(3);
     /// target.a.copy_from_slice(&[0.5, 0.1, 1.5]);
-    /// let ctx = ControlContext { t: 0.0, measured: &measured, reference: &target, model: &model };
+    /// let ctx = ControlContext {
+    ///     t: 0.0,
+    ///     measured: &measured,
+    ///     reference: &target,
+    ///     model: &model,
+    ///     tau_star_limits: None,
+    /// };
     /// let mut tau = [0.0; 3];
     /// mpc.control(&ctx, &mut tau)?;
     /// assert!(tau.iter().all(|t| t.abs() <= 5.0));
