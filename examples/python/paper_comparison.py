@@ -30,7 +30,7 @@ for name in SCENARIOS:
         s = run.summary
         modal = ", ".join(f"{v:.2e}" for v in s["modal_error_rms_rad"])
         row = f"{name:<22} {controller:<16} {s['tip_error_rms_m'] * 1e3:>10.4f} {s['tip_error_max_m'] * 1e3:>10.4f} " \
-              f"{modal:>20} {s['peak_joint_torque_nm']:>12.3f} {s['control_effort']:>11.4e}"
+              f"{modal:>20} {s['peak_joint_torque_nm']:>12.3f} {s['control_effort_n2m2s']:>11.4e}"
         print(row if run.failure is None else f"{row}  stopped: {run.failure}")
 
 # The paper's headline figures (fuzzy control of the tracking task), pinned by the test suite.
