@@ -33,11 +33,12 @@ fn jacobian(model: &ReducedModel) -> Mat<f64> {
 }
 
 /// Asserts `analytic == expected` entrywise to `tolerance` times the larger matrix's largest
-/// entry (plus a floor for matrices that vanish).
+/// entry plus `floor` (for matrices that vanish, or the error estimate of finite differences).
 fn assert_close(
     analytic: MatRef<'_, f64>,
     expected: MatRef<'_, f64>,
     tolerance: f64,
+    floor: f64,
     name: &str,
 ) -> Result<(), TestCaseError> {
     let scale = max_abs(&to_vec(expected)).max(max_abs(&to_vec(analytic)));
@@ -45,7 +46,7 @@ fn assert_close(
         for j in 0..expected.ncols() {
             let error = (analytic[(i, j)] - expected[(i, j)]).abs();
             prop_assert!(
-                error <= tolerance * scale + 1e-12,
+                error <= tolerance * scale + floor,
                 "{name}[{i}][{j}]: {} vs {} (scale {scale})",
                 analytic[(i, j)],
                 expected[(i, j)]
@@ -85,9 +86,9 @@ proptest! {
         // Both sides solve with M*, whose conditioning grows with the harmonics.
         let cond = max_abs(&to_vec(m_star.as_ref())) * max_abs(&to_vec(inverse.as_ref()));
         let tolerance = 1e-13 * cond.max(1.0);
-        assert_close(derivatives.d_a(), d_a.as_ref(), tolerance, "d a_ddot / d a")?;
-        assert_close(derivatives.d_a_dot(), d_a_dot.as_ref(), tolerance, "d a_ddot / d a_dot")?;
-        assert_close(derivatives.d_tau_star(), inverse.as_ref(), tolerance, "d a_ddot / d tau*")?;
+        assert_close(derivatives.d_a(), d_a.as_ref(), tolerance, 1e-12, "d a_ddot / d a")?;
+        assert_close(derivatives.d_a_dot(), d_a_dot.as_ref(), tolerance, 1e-12, "d a_ddot / d a_dot")?;
+        assert_close(derivatives.d_tau_star(), inverse.as_ref(), tolerance, 1e-12, "d a_ddot / d tau*")?;
     }
 
     #[test]
@@ -102,9 +103,13 @@ proptest! {
         let analytic = [derivatives.d_a(), derivatives.d_a_dot(), derivatives.d_tau_star()];
         for (which, analytic) in analytic.into_iter().enumerate() {
             let mut fd = Mat::<f64>::zeros(m, m);
+            // Ridders' own error estimate: where the dynamics bend sharply (a nearly singular
+            // M*, accelerations of thousands of rad/s^2) the extrapolation is less accurate than
+            // 1e-6 of the scale, and it says so.
+            let mut fd_error = 0.0f64;
             for k in 0..m {
                 let mut moved = inputs.clone();
-                let (column, _error) = ridders(
+                let (column, error) = ridders(
                     |x| {
                         moved[which][k] = x;
                         let mut out = vec![0.0; m];
@@ -115,11 +120,18 @@ proptest! {
                     inputs[which][k],
                     0.1,
                 );
+                fd_error = fd_error.max(error);
                 for i in 0..m {
                     fd[(i, k)] = column[i];
                 }
             }
-            assert_close(analytic, fd.as_ref(), 1e-6, ["d_a", "d_a_dot", "d_tau_star"][which])?;
+            assert_close(
+                analytic,
+                fd.as_ref(),
+                1e-6,
+                1e-12 + 10.0 * fd_error,
+                ["d_a", "d_a_dot", "d_tau_star"][which],
+            )?;
         }
     }
 }
