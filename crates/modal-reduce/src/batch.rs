@@ -4,7 +4,7 @@
 //! instruction set the processor has (8 with AVX-512, 4 with AVX2; chosen at run time by
 //! [`pulp::Arch`], so one binary runs everywhere), and each group runs through the same kernel as
 //! one state ([`crate::terms`], [`crate::small_linalg`]), written once over
-//! [`Lane`](crate::lanes::Lane): lane `i` of every register holds state `i` of the group
+//! [`Lane`](lane_math::Lane): lane `i` of every register holds state `i` of the group
 //! (structure of arrays). The operations, and their order, are those of the one-state path, so
 //! each state's result is the same.
 //!
@@ -18,10 +18,10 @@ use pulp::{Arch, Simd, WithSimd};
 use crate::data::ReducedData;
 use crate::error::{ReduceError, check_len};
 use crate::forward::forward_dynamics;
-use crate::lanes::{Lane, Pack};
 use crate::model::ReducedModel;
 use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
 use crate::terms::{LinkTrig, Terms, accumulate};
+use lane_math::{Lane, Pack};
 
 /// The most `f64` lanes of a SIMD register (AVX-512).
 const MAX_WIDTH: usize = 8;

@@ -7,13 +7,11 @@ mod energy;
 mod error;
 mod forward;
 pub mod jacobi;
-mod lanes;
 mod model;
 mod projection;
 mod small_linalg;
 pub mod terms;
 mod torques;
-mod trig;
 
 pub use batch::{BatchError, MAX_BATCH_COORDS, ReducedBatchData, forward_dynamics_batch};
 pub use data::ReducedData;

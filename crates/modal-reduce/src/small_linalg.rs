@@ -5,7 +5,7 @@
 //! per-call overhead of faer's Cholesky exceeds the whole `3 x 3` solve), and they are short
 //! enough to check by eye.
 
-use crate::lanes::Lane;
+use lane_math::Lane;
 
 /// Factorises the symmetric positive-definite `m x m` matrix `a` (row-major) in place as
 /// `a = L D L^T`, `L` unit lower triangular and `D` diagonal: `L` below the diagonal, `1 / D` on

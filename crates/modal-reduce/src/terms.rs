@@ -66,9 +66,9 @@
 
 use crate::data::{LinkBuffers, ReducedData};
 use crate::error::{ReduceError, check_finite_result, check_input};
-use crate::lanes::Lane;
 use crate::model::ReducedModel;
-use crate::trig::sin_cos;
+use lane_math::Lane;
+use lane_math::sin_cos;
 
 /// Computes `M*(a)`, `C*(a, a_dot)` and `G*(a)` (eq 14) into `data` in `O(n m^2)`, by prefix
 /// sums along the chain (the default path; see the [module documentation](self) for the

@@ -52,7 +52,7 @@ const COS: [f64; 7] = [
 /// `sin[i] = sin(angles[i])` and `cos[i] = cos(angles[i])` (slices of equal length). Inlined,
 /// so that inside a batch it vectorises with the batch's instruction set.
 #[inline(always)]
-pub(crate) fn sin_cos(angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
+pub fn sin_cos(angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
     let (sin, cos) = (&mut sin[..angles.len()], &mut cos[..angles.len()]);
     let mut any_large = false;
     for ((&x, s), c) in angles.iter().zip(sin.iter_mut()).zip(cos.iter_mut()) {

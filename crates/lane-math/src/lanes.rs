@@ -1,12 +1,9 @@
-//! The number type the default path is written in: one state (`f64`) or several states side by
-//! side in a SIMD register ([`Pack`]), so that one kernel serves [`forward_dynamics`] and
-//! [`forward_dynamics_batch`].
+//! The number type the kernels are written in: one state (`f64`) or several states side by side
+//! in a SIMD register ([`Pack`]), so that one kernel serves a single state and a batch (in
+//! `modal-reduce`, `forward_dynamics` and `forward_dynamics_batch`).
 //!
 //! Both implementations do exactly the same operations in the same order (no fused multiply-add),
 //! so a state gives the same bits whether it is computed alone or in a batch.
-//!
-//! [`forward_dynamics`]: crate::forward_dynamics
-//! [`forward_dynamics_batch`]: crate::forward_dynamics_batch
 
 use std::ops::{Add, Div, Mul, Sub};
 
@@ -14,7 +11,7 @@ use pulp::Simd;
 
 /// A real number of `WIDTH` independent states: the arithmetic of the kernels, plus loads and
 /// stores from `[f64]` slices holding the `WIDTH` values side by side.
-pub(crate) trait Lane:
+pub trait Lane:
     Copy
     + Add<Output = Self>
     + Sub<Output = Self>
@@ -64,7 +61,7 @@ impl Lane for f64 {
 /// `S::F64_LANES` states in one SIMD register of the instruction set `S` (8 with AVX-512, 4 with
 /// AVX2, 1 without either), chosen at run time by [`pulp::Arch`].
 #[derive(Clone, Copy)]
-pub(crate) struct Pack<S: Simd> {
+pub struct Pack<S: Simd> {
     simd: S,
     value: S::f64s,
 }
