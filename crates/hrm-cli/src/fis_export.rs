@@ -3,6 +3,7 @@
 //! format carries).
 
 use crate::fis_cmd::{RangePolicy, read_system};
+use crate::output_dir;
 use clap::{Args, ValueEnum};
 use fuzzy_sugeno::{EvalOptions, NoRuleFired, OutOfRange};
 use std::path::{Path, PathBuf};
@@ -77,10 +78,13 @@ pub fn run(args: ExportArgs) -> Result<(), String> {
             vec![(format!("{stem}.fcl"), text)]
         }
     };
-    std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
-    for (name, text) in files {
-        let path: PathBuf = Path::new(&args.out).join(name);
-        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    // All files whole or none: a failure leaves the folder's existing files as they were.
+    let files: Vec<(PathBuf, String)> = files
+        .into_iter()
+        .map(|(name, text)| (Path::new(&args.out).join(name), text))
+        .collect();
+    output_dir::write_files(&files, "fis export")?;
+    for (path, _) in &files {
         crate::console::print(&format!("{}\n", path.display()))?;
     }
     Ok(())

@@ -77,7 +77,7 @@ impl OutputDir {
             }
             Ok(_) => {}
         }
-        remove_abandoned_staging(&target);
+        remove_abandoned(&target, "staging");
         let staging = sibling(&target, "staging");
         if staging.exists() {
             std::fs::remove_dir_all(&staging).map_err(|e| fail("cannot clear staging for", e))?;
@@ -167,6 +167,47 @@ pub fn write_file_with(
     command: &str,
     write: impl FnOnce(&mut dyn Write) -> Result<(), String>,
 ) -> Result<(), String> {
+    let temporary = stage_file(path, command, write)?;
+    put_in_place(&temporary, path)
+}
+
+/// Writes several files whole, all or none: each `(path, text)` goes to a temporary sibling
+/// first, and only when every one is written are they renamed over their paths. A failure
+/// before the renames leaves every existing file as it was. Folders are created as by
+/// [`write_file_with`].
+pub fn write_files(files: &[(PathBuf, String)], command: &str) -> Result<(), String> {
+    let mut staged = Vec::with_capacity(files.len());
+    for (path, text) in files {
+        match stage_file(path, command, |out| {
+            out.write_all(text.as_bytes()).map_err(|e| e.to_string())
+        }) {
+            Ok(temporary) => staged.push(temporary),
+            Err(e) => {
+                for temporary in &staged {
+                    let _ = std::fs::remove_file(temporary);
+                }
+                return Err(e);
+            }
+        }
+    }
+    let mut result = Ok(());
+    for ((path, _), temporary) in files.iter().zip(&staged) {
+        if result.is_ok() {
+            result = put_in_place(temporary, path);
+        } else {
+            let _ = std::fs::remove_file(temporary);
+        }
+    }
+    result
+}
+
+/// Writes `path`'s contents with `write` into its temporary sibling (after removing the
+/// temporaries of killed commands) and returns the sibling's path; on failure nothing is left.
+fn stage_file(
+    path: &Path,
+    command: &str,
+    write: impl FnOnce(&mut dyn Write) -> Result<(), String>,
+) -> Result<PathBuf, String> {
     let fail = |what: &str, e: &dyn std::fmt::Display| format!("{what} {}: {e}", path.display());
     let Some(name) = path.file_name() else {
         return Err(format!("{}: not a file name", path.display()));
@@ -177,19 +218,34 @@ pub fn write_file_with(
         std::fs::write(dir.join(MARKER), format!("written by `hrm {command}`\n"))
             .map_err(|e| fail("cannot create the folder of", &e))?;
     }
-    let temporary = sibling(&dir.join(name), "partial");
+    let path = dir.join(name);
+    if path.is_dir() {
+        return Err(format!("cannot write {}: it is a folder", path.display()));
+    }
+    remove_abandoned(&path, "partial");
+    let temporary = sibling(&path, "partial");
     let written = std::fs::File::create(&temporary)
         .map_err(|e| fail("cannot write", &e))
         .and_then(|file| {
             let mut out = std::io::BufWriter::new(file);
             write(&mut out)?;
             out.flush().map_err(|e| fail("cannot write", &e))
-        })
-        .and_then(|()| std::fs::rename(&temporary, path).map_err(|e| fail("cannot write", &e)));
-    if written.is_err() {
-        let _ = std::fs::remove_file(&temporary);
+        });
+    match written {
+        Ok(()) => Ok(temporary),
+        Err(e) => {
+            let _ = std::fs::remove_file(&temporary);
+            Err(e)
+        }
     }
-    written
+}
+
+/// Renames the staged `temporary` over `path`; on failure the temporary is removed.
+fn put_in_place(temporary: &Path, path: &Path) -> Result<(), String> {
+    std::fs::rename(temporary, path).map_err(|e| {
+        let _ = std::fs::remove_file(temporary);
+        format!("cannot write {}: {e}", path.display())
+    })
 }
 
 /// `.<name>.hrm-<what>-<pid>` beside `path`.
@@ -200,17 +256,23 @@ fn sibling(path: &Path, what: &str) -> PathBuf {
     path.with_file_name(name)
 }
 
-/// Removes the staging folders of `target` left by commands that were killed (their process
-/// is gone), where the system lists its processes in `/proc`. Moved-aside old copies are kept:
-/// after a crash between the two renames of a commit, one may be the only copy of an output.
-fn remove_abandoned_staging(target: &Path) {
+/// Removes the siblings `.<name>.hrm-<what>-<pid>` of `target` (staging folders, partial
+/// files) left by commands that were killed (their process is gone), where the system lists its
+/// processes in `/proc`. Moved-aside old copies are kept: after a crash between the two renames
+/// of a commit, one may be the only copy of an output.
+fn remove_abandoned(target: &Path, what: &str) {
     let (Some(dir), Some(name)) = (target.parent(), target.file_name()) else {
         return;
     };
-    let prefix = format!(".{}.hrm-staging-", name.to_string_lossy());
+    let prefix = format!(".{}.hrm-{what}-", name.to_string_lossy());
     if !Path::new("/proc/self").is_dir() {
         return;
     }
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
     };
@@ -224,7 +286,12 @@ fn remove_abandoned_staging(target: &Path) {
             continue;
         };
         if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
-            let _ = std::fs::remove_dir_all(entry.path());
+            let path = entry.path();
+            let _ = if path.is_dir() {
+                std::fs::remove_dir_all(&path)
+            } else {
+                std::fs::remove_file(&path)
+            };
         }
     }
 }
@@ -368,6 +435,45 @@ mod tests {
         assert_eq!(err, "the runs stopped");
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "{\"a\":1}");
         assert_eq!(names(&root.join("shards")), [MARKER, "shard-1-of-2.json"]);
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn several_files_are_written_all_or_none() {
+        let root = scratch("files");
+        let (header, source) = (root.join("out/a.h"), root.join("out/a.c"));
+        let files = |h: &str, c: &str| {
+            vec![
+                (header.clone(), h.to_string()),
+                (source.clone(), c.to_string()),
+            ]
+        };
+        write_files(&files("h1", "c1"), "fis export").unwrap();
+        assert_eq!(names(&root.join("out")), [MARKER, "a.c", "a.h"]);
+        // The second file cannot be written (its path is a folder): neither file changes.
+        std::fs::remove_file(&source).unwrap();
+        std::fs::create_dir(&source).unwrap();
+        let err = write_files(&files("h2", "c2"), "fis export").unwrap_err();
+        assert!(err.contains("it is a folder"), "{err}");
+        assert_eq!(std::fs::read_to_string(&header).unwrap(), "h1");
+        assert_eq!(names(&root.join("out")), [MARKER, "a.c", "a.h"]);
+        std::fs::remove_dir(&source).unwrap();
+        write_files(&files("h3", "c3"), "fis export").unwrap();
+        assert_eq!(std::fs::read_to_string(&header).unwrap(), "h3");
+        assert_eq!(std::fs::read_to_string(&source).unwrap(), "c3");
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn partial_files_of_killed_commands_are_removed() {
+        let root = scratch("abandoned");
+        std::fs::create_dir_all(&root).unwrap();
+        let path = root.join("shard-1-of-2.json");
+        // No process has the largest pid; this command's own partial file is left alone.
+        let dead = root.join(format!(".shard-1-of-2.json.hrm-partial-{}", u32::MAX));
+        std::fs::write(&dead, "half a shard").unwrap();
+        write_file(&path, "{}", "sweep").unwrap();
+        assert_eq!(names(&root), ["shard-1-of-2.json"]);
         std::fs::remove_dir_all(&root).unwrap();
     }
 }
