@@ -1,5 +1,5 @@
 #!/bin/sh
-# Builds aba_derivatives.cpp against the Pinocchio of the `pin` wheel and runs it.
+# Builds chain.cpp against the Pinocchio of the `pin` wheel and runs it.
 #
 #   python3 -m venv /tmp/pin && /tmp/pin/bin/pip install pin cmeel-eigen
 #   PYTHON=/tmp/pin/bin/python benches/pinocchio/run.sh
@@ -15,7 +15,7 @@ PREFIX=$("$PYTHON" -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])
 OUT=${OUT:-/tmp/hrm-pinocchio-bench}
 c++ -O3 -DNDEBUG -std=c++17 -DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS \
     -DBOOST_MPL_LIMIT_LIST_SIZE=30 -DBOOST_MPL_LIMIT_VECTOR_SIZE=30 -DBOOST_FUSION_INVOKE_MAX_ARITY=12 \
-    -DPINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION "$HERE/aba_derivatives.cpp" -o "$OUT" \
+    -DPINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION "$HERE/chain.cpp" -o "$OUT" \
     -I"$PREFIX/include" -I"$PREFIX/include/eigen3" \
     -L"$PREFIX/lib" -Wl,-rpath,"$PREFIX/lib" -lpinocchio_default
 "$OUT"

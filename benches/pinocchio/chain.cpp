@@ -1,12 +1,22 @@
-// Times Pinocchio's computeABADerivatives (and computeRNEADerivatives) on the planar chain of
-// hrm's `aba_derivatives` bench: n revolute-z joints, uniform links of 0.1 m and 0.1 kg (centre
-// of mass at the midpoint, inertia m L^2 / 12 about it), gravity 9.81 m/s^2 along -y, at the
-// same curled, moving state (benches/benches/derivatives.rs). Prints one line per size: the
-// median over batches of the time per call, in nanoseconds.
+// Times Pinocchio on the planar chain of hrm's benches: n revolute-z joints, uniform links of
+// 0.1 m and 0.1 kg (centre of mass at the midpoint, inertia m L^2 / 12 about it), gravity
+// 9.81 m/s^2 along -y, at a curled, moving state (benches/benches/derivatives.rs). For each size:
+//   - aba: forward dynamics (beside hrm's `full_fd/n`);
+//   - crba + nonLinearEffects + projection + LLT: reduced forward dynamics of m = 3 modal
+//     coordinates the way a Pinocchio user would get it, M* = J^T M J, C* + G* = J^T nle, then
+//     M*^-1 (tau* - C* - G*) (beside hrm's `reduced_fd/n`; the timing does not depend on J's
+//     values, so J is a fixed dense n x 3 matrix);
+//   - computeABADerivatives and computeRNEADerivatives (beside hrm's `aba_derivatives/n` and
+//     `rnea_derivatives/n`).
+// Prints one line per algorithm and size: the median over batches of the time per call, in
+// nanoseconds.
 //
 // Build and run with ./run.sh (it compiles against the headers and library of the `pin` wheel).
 
 #include <pinocchio/algorithm/aba-derivatives.hpp>
+#include <pinocchio/algorithm/aba.hpp>
+#include <pinocchio/algorithm/crba.hpp>
+#include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/algorithm/rnea-derivatives.hpp>
 #include <pinocchio/multibody.hpp>
 
@@ -62,6 +72,23 @@ int main() {
       tau[i] = 0.01 * std::sin(2.0 * x);
     }
     int calls = n <= 10 ? 20000 : 500;
+    double fd_ns = median_ns([&] { aba(model, data, q, v, tau); }, calls, 51);
+    Eigen::MatrixXd jacobian(n, 3);
+    for (int i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k) jacobian(i, k) = std::cos(0.7 * (k + 1) * (i + 1) / n);
+    Eigen::Vector3d tau_star(1.0, -0.5, 0.2), a_ddot;
+    double reduced_ns = median_ns(
+        [&] {
+          crba(model, data, q);
+          data.M.triangularView<Eigen::StrictlyLower>() = data.M.transpose().triangularView<Eigen::StrictlyLower>();
+          nonLinearEffects(model, data, q, v);
+          Eigen::Matrix3d reduced_mass = jacobian.transpose() * data.M * jacobian;
+          Eigen::Vector3d bias = jacobian.transpose() * data.nle;
+          a_ddot = reduced_mass.llt().solve(tau_star - bias);
+        },
+        calls, 51);
+    std::printf("pinocchio aba/%d %.1f ns\n", n, fd_ns);
+    std::printf("pinocchio crba+nle+projection+llt/%d %.1f ns\n", n, reduced_ns);
     double aba_ns = median_ns([&] { computeABADerivatives(model, data, q, v, tau); }, calls, 51);
     // The qdd that ABA finds, for RNEA's derivatives at the same state.
     Eigen::VectorXd a = data.ddq;
