@@ -12,7 +12,7 @@ use crate::terms::{StackTerms, accumulate_in_data, all_finite, check_state, chec
 
 /// The modal accelerations `a_ddot` under generalised forces `tau*` (eq 15), written into
 /// `a_ddot` (length `m`), with `M*`, `C*` and `G*` from the default `O(n m^2)` path
-/// ([`reduced_terms`]). `data` holds those terms afterwards. Allocation-free.
+/// ([`reduced_terms`](crate::reduced_terms)). `data` holds those terms afterwards. Allocation-free.
 ///
 /// ```
 /// use backbone_kin::ModalMap;
