@@ -31,6 +31,12 @@ pub trait Lane:
     fn store(self, slice: &mut [f64]);
     /// Whether every lane is positive and finite (a usable pivot).
     fn all_positive_finite(self) -> bool;
+    /// Lane by lane, the bitwise exclusive or of the two values' representations: with `-0.0`
+    /// in a lane of `other`, flips the sign of that lane of `self`.
+    fn xor_bits(self, other: Self) -> Self;
+    /// Lane by lane, `if_set` where the representation of `self` has any of the bits of `mask`
+    /// set, `if_clear` where it has none.
+    fn select_by_bits(self, mask: u64, if_set: Self, if_clear: Self) -> Self;
 }
 
 impl Lane for f64 {
@@ -55,6 +61,20 @@ impl Lane for f64 {
     #[inline(always)]
     fn all_positive_finite(self) -> bool {
         self > 0.0 && self.is_finite()
+    }
+
+    #[inline(always)]
+    fn xor_bits(self, other: Self) -> Self {
+        f64::from_bits(self.to_bits() ^ other.to_bits())
+    }
+
+    #[inline(always)]
+    fn select_by_bits(self, mask: u64, if_set: Self, if_clear: Self) -> Self {
+        if self.to_bits() & mask != 0 {
+            if_set
+        } else {
+            if_clear
+        }
     }
 }
 
@@ -152,5 +172,24 @@ impl<S: Simd> Lane for Pack<S> {
     fn all_positive_finite(self) -> bool {
         let lanes: &[f64] = pulp::bytemuck::cast_slice(std::slice::from_ref(&self.value));
         lanes.iter().all(|&x| x > 0.0 && x.is_finite())
+    }
+
+    #[inline(always)]
+    fn xor_bits(self, other: Self) -> Self {
+        Self {
+            simd: self.simd,
+            value: self.simd.xor_f64s(self.value, other.value),
+        }
+    }
+
+    #[inline(always)]
+    fn select_by_bits(self, mask: u64, if_set: Self, if_clear: Self) -> Self {
+        let simd = self.simd;
+        let bits = simd.and_u64s(simd.transmute_u64s_f64s(self.value), simd.splat_u64s(mask));
+        let clear = simd.equal_u64s(bits, simd.splat_u64s(0));
+        Self {
+            simd,
+            value: simd.select_f64s(clear, if_clear.value, if_set.value),
+        }
     }
 }

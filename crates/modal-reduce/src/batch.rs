@@ -237,7 +237,7 @@ fn group<S: Simd, const M: usize>(
         joint: &mut joint,
         cos_moment: &mut cos_moment,
     };
-    accumulate(simd, model, &a, &a_dot, M, links, terms);
+    accumulate(simd, simd, model, &a, &a_dot, M, links, terms);
     // The right-hand side tau* - C* - G* and the solve, as in `forward_dynamics`.
     let mut x: [Pack<S>; M] = std::array::from_fn(|k| tau_star[k] - coriolis[k] - gravity[k]);
     if !ldlt_in_place(simd, mass.as_flattened_mut(), M) {

@@ -3,10 +3,15 @@
 
 use faer::{Mat, MatRef};
 use manip_dyn::ChainData;
+use pulp::Arch;
 
 use crate::error::{ReduceError, check_len};
 use crate::model::ReducedModel;
 use crate::terms::Pair;
+
+/// The most `f64` lanes of a SIMD register (AVX-512): the per-link buffers of one state are
+/// padded to a multiple of it.
+pub(crate) const LINK_PADDING: usize = 8;
 
 /// Workspace for one [`ReducedModel`]: create it once, reuse it for every call.
 ///
@@ -48,6 +53,9 @@ pub struct ReducedData {
     pub(crate) projection: Option<Projection>,
     /// The full chain's own workspace, recursive algorithms only.
     pub(crate) chain: ChainData,
+    /// The processor's instruction set, found at construction: the default path runs with it
+    /// (see [`crate::terms`]).
+    pub(crate) arch: Arch,
 }
 
 /// The matrices of the projection path ([`reduced_terms_by_projection`](crate::reduced_terms_by_projection)).
@@ -69,7 +77,9 @@ impl Projection {
     }
 }
 
-/// Per link (length `n` each): absolute angle and its sine and cosine (see [`crate::terms`]).
+/// Per link: absolute angle and its sine and cosine (see [`crate::terms`]). Length `n` rounded
+/// up to a whole number of the widest SIMD registers ([`LINK_PADDING`]), so that the sines and
+/// cosines of one state are computed in whole registers; the padding holds zeros.
 #[derive(Debug, Clone)]
 pub(crate) struct LinkBuffers {
     pub(crate) angle: Vec<f64>,
@@ -100,9 +110,9 @@ impl ReducedData {
             rhs: vec![0.0; m],
             iterate: vec![0.0; m],
             links: LinkBuffers {
-                angle: vec![0.0; n],
-                sin: vec![0.0; n],
-                cos: vec![0.0; n],
+                angle: vec![0.0; n.next_multiple_of(LINK_PADDING)],
+                sin: vec![0.0; n.next_multiple_of(LINK_PADDING)],
+                cos: vec![0.0; n.next_multiple_of(LINK_PADDING)],
             },
             scratch: TermScratch {
                 joint: vec![[0.0; 2]; m],
@@ -114,6 +124,7 @@ impl ReducedData {
             joint_torque: vec![0.0; n],
             projection: None,
             chain: ChainData::recursive(model.chain()),
+            arch: Arch::new(),
         }
     }
 

@@ -68,7 +68,8 @@ use crate::data::{LinkBuffers, ReducedData};
 use crate::error::{ReduceError, check_finite_result, check_input};
 use crate::model::ReducedModel;
 use lane_math::Lane;
-use lane_math::sin_cos;
+use lane_math::sin_cos_simd;
+use pulp::{Simd, WithSimd};
 
 /// Computes `M*(a)`, `C*(a, a_dot)` and `G*(a)` (eq 14) into `data` in `O(n m^2)`, by prefix
 /// sums along the chain (the default path; see the [module documentation](self) for the
@@ -96,42 +97,173 @@ pub fn reduced_terms(
     a: &[f64],
     a_dot: &[f64],
 ) -> Result<(), ReduceError> {
+    check_state(model, data, a, a_dot)?;
+    let arch = data.arch;
+    arch.dispatch(TermsOfOneState {
+        model,
+        data: &mut *data,
+        a,
+        a_dot,
+    });
+    check_terms(data)
+}
+
+/// Checks that `data` was made for `model` and that `a` and `a_dot` are `m` finite values each.
+pub(crate) fn check_state(
+    model: &ReducedModel,
+    data: &ReducedData,
+    a: &[f64],
+    a_dot: &[f64],
+) -> Result<(), ReduceError> {
     data.check_model(model)?;
     let m = model.n_coords();
     check_input("a", a, m)?;
-    check_input("a_dot", a_dot, m)?;
-    // The paper's sizes run on stack arrays that the optimiser keeps in registers.
-    match m {
-        2 => accumulate_on_stack::<2>(model, data, a, a_dot),
-        3 => accumulate_on_stack::<3>(model, data, a, a_dot),
-        _ => {
-            let ReducedData {
-                links,
-                mass,
-                coriolis,
-                gravity,
-                scratch,
-                ..
-            } = data;
-            let terms = Terms {
-                mass,
-                coriolis,
-                gravity,
-                joint: &mut scratch.joint,
-                cos_moment: &mut scratch.cos_moment,
-            };
-            accumulate((), model, a, a_dot, m, links.trig(), terms);
-        }
-    }
+    check_input("a_dot", a_dot, m)
+}
+
+/// Checks that the terms in `data` are finite, naming the first that is not.
+pub(crate) fn check_terms(data: &ReducedData) -> Result<(), ReduceError> {
     check_finite_result("reduced mass matrix M*", &data.mass)?;
     check_finite_result("reduced Coriolis vector C*", &data.coriolis)?;
     check_finite_result("reduced gravity vector G*", &data.gravity)
 }
 
+/// Whether every value is finite: one test of all of them, without the early exit that keeps a
+/// search from vectorising.
+#[inline(always)]
+pub(crate) fn all_finite(values: &[f64]) -> bool {
+    values.iter().fold(true, |finite, v| finite & v.is_finite())
+}
+
+/// The terms of [`reduced_terms`] (inputs already checked), run by [`pulp::Arch::dispatch`] so
+/// that the kernel is compiled for the processor's instruction set (AVX-512's 32 registers hold
+/// the pass's running sums; the sines and cosines vectorise across links).
+struct TermsOfOneState<'a> {
+    model: &'a ReducedModel,
+    data: &'a mut ReducedData,
+    a: &'a [f64],
+    a_dot: &'a [f64],
+}
+
+impl WithSimd for TermsOfOneState<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let Self {
+            model,
+            data,
+            a,
+            a_dot,
+        } = self;
+        // The sizes evaluated SIMD across states in a batch run on stack arrays here too.
+        match model.n_coords() {
+            2 => StackTerms::<2>::compute(simd, model, data, a, a_dot).store(data),
+            3 => StackTerms::<3>::compute(simd, model, data, a, a_dot).store(data),
+            4 => StackTerms::<4>::compute(simd, model, data, a, a_dot).store(data),
+            5 => StackTerms::<5>::compute(simd, model, data, a, a_dot).store(data),
+            _ => accumulate_in_data(simd, model, data, a, a_dot),
+        }
+    }
+}
+
+/// [`accumulate`] for any `m`, into the slices of `data`.
+#[inline(always)]
+pub(crate) fn accumulate_in_data<S: Simd>(
+    simd: S,
+    model: &ReducedModel,
+    data: &mut ReducedData,
+    a: &[f64],
+    a_dot: &[f64],
+) {
+    let ReducedData {
+        links,
+        mass,
+        coriolis,
+        gravity,
+        scratch,
+        ..
+    } = data;
+    let terms = Terms {
+        mass,
+        coriolis,
+        gravity,
+        joint: &mut scratch.joint,
+        cos_moment: &mut scratch.cos_moment,
+    };
+    accumulate(
+        (),
+        simd,
+        model,
+        a,
+        a_dot,
+        model.n_coords(),
+        links.trig(),
+        terms,
+    );
+}
+
+/// `M*`, `C*` and `G*` of one state for a compile-time `M`, on the stack (the optimiser keeps
+/// them in registers).
+pub(crate) struct StackTerms<const M: usize> {
+    /// `M*`.
+    pub(crate) mass: [[f64; M]; M],
+    /// `C*`.
+    pub(crate) coriolis: [f64; M],
+    /// `G*`.
+    pub(crate) gravity: [f64; M],
+}
+
+impl<const M: usize> StackTerms<M> {
+    /// [`accumulate`] for one state, with `data`'s per-link buffers.
+    #[inline(always)]
+    pub(crate) fn compute<S: Simd>(
+        simd: S,
+        model: &ReducedModel,
+        data: &mut ReducedData,
+        a: &[f64],
+        a_dot: &[f64],
+    ) -> Self {
+        let mut terms = Self {
+            mass: [[0.0; M]; M],
+            coriolis: [0.0; M],
+            gravity: [0.0; M],
+        };
+        let mut joint = [[0.0; 2]; M];
+        let mut cos_moment = [0.0; M];
+        let slices = Terms {
+            mass: terms.mass.as_flattened_mut(),
+            coriolis: &mut terms.coriolis,
+            gravity: &mut terms.gravity,
+            joint: &mut joint,
+            cos_moment: &mut cos_moment,
+        };
+        accumulate((), simd, model, a, a_dot, M, data.links.trig(), slices);
+        terms
+    }
+
+    /// Copies the terms into `data`, where [`ReducedData::mass_matrix`] and the others read them.
+    #[inline(always)]
+    pub(crate) fn store(&self, data: &mut ReducedData) {
+        data.mass.copy_from_slice(self.mass.as_flattened());
+        data.coriolis.copy_from_slice(&self.coriolis);
+        data.gravity.copy_from_slice(&self.gravity);
+    }
+
+    /// Whether every term is finite.
+    #[inline(always)]
+    pub(crate) fn all_finite(&self) -> bool {
+        all_finite(self.mass.as_flattened())
+            & all_finite(&self.coriolis)
+            & all_finite(&self.gravity)
+    }
+}
+
 /// An `(x, y)` pair: a column of the `2 x m` prefix sum `P_l`.
 pub(crate) type Pair<L> = [L; 2];
 
-/// The per-link buffers of the kernel, `n` values of `L::WIDTH` lanes each (`[link][lane]`).
+/// The per-link buffers of the kernel, at least `n` values of `L::WIDTH` lanes each
+/// (`[link][lane]`); entries beyond those are padding.
 pub(crate) struct LinkTrig<'a> {
     /// Absolute angle `phi_l`.
     pub(crate) angle: &'a mut [f64],
@@ -165,36 +297,13 @@ pub(crate) struct Terms<'a, L> {
     pub(crate) cos_moment: &'a mut [L],
 }
 
-/// [`accumulate`] for a compile-time `M` on one state, on local arrays, copied into `data`.
-#[inline(always)]
-fn accumulate_on_stack<const M: usize>(
-    model: &ReducedModel,
-    data: &mut ReducedData,
-    a: &[f64],
-    a_dot: &[f64],
-) {
-    let mut mass = [[0.0; M]; M];
-    let (mut coriolis, mut gravity) = ([0.0; M], [0.0; M]);
-    let mut joint = [[0.0; 2]; M];
-    let mut cos_moment = [0.0; M];
-    let terms = Terms {
-        mass: mass.as_flattened_mut(),
-        coriolis: &mut coriolis,
-        gravity: &mut gravity,
-        joint: &mut joint,
-        cos_moment: &mut cos_moment,
-    };
-    accumulate((), model, a, a_dot, M, data.links.trig(), terms);
-    data.mass.copy_from_slice(mass.as_flattened());
-    data.coriolis.copy_from_slice(&coriolis);
-    data.gravity.copy_from_slice(&gravity);
-}
-
 /// The sums of the module documentation, for `m` coordinates of `L::WIDTH` states each, into
-/// `terms`: `M*` (both triangles), `C*` and `G*`.
+/// `terms`: `M*` (both triangles), `C*` and `G*`; the sines and cosines in registers of `simd`.
 #[inline(always)]
-pub(crate) fn accumulate<L: Lane>(
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn accumulate<L: Lane, S: Simd>(
     context: L::Context,
+    simd: S,
     model: &ReducedModel,
     a: &[L],
     a_dot: &[L],
@@ -217,13 +326,10 @@ pub(crate) fn accumulate<L: Lane>(
     let constants = model.link_constants();
     let rows = model.angle_rows();
     let size = constants.len() * width;
-    let (angle, sin, cos) = (
-        &mut links.angle[..size],
-        &mut links.sin[..size],
-        &mut links.cos[..size],
-    );
-    // Absolute angles, then their sines and cosines, all links at once.
-    for ((angle, phi), link) in angle
+    // Absolute angles, then their sines and cosines, all links at once, in whole SIMD registers
+    // when the buffers are padded for it (one state's are: see `ReducedData`).
+    let padded = size.next_multiple_of(S::F64_LANES).min(links.angle.len());
+    for ((angle, phi), link) in links.angle[..size]
         .chunks_exact_mut(width)
         .zip(rows.chunks_exact(m))
         .zip(constants)
@@ -235,7 +341,13 @@ pub(crate) fn accumulate<L: Lane>(
         }
         phi_l.store(angle);
     }
-    sin_cos(angle, sin, cos);
+    sin_cos_simd(
+        simd,
+        &links.angle[..padded],
+        &mut links.sin[..padded],
+        &mut links.cos[..padded],
+    );
+    let (sin, cos) = (&links.sin[..size], &links.cos[..size]);
     // One pass from the base: P_l, q_l, and the sums of M*, C* and G*.
     let mut q = [zero; 2];
     for (((link, phi), sin), cos) in constants
