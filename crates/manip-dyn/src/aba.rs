@@ -62,7 +62,7 @@ pub(crate) trait AbaLane: Lane {
     /// `PIVOT_FLOOR * scale` in every lane. One state gets the exact error; a batch gets
     /// `NotPositiveDefinite` for any failing lane (its states are then redone one at a time),
     /// and never passes what the exact test refuses.
-    fn check_pivot(pivot: Self, scale: Self) -> Result<(), DynError>;
+    fn check_pivot(context: Self::Context, pivot: Self, scale: Self) -> Result<(), DynError>;
 }
 
 /// The most `f64` lanes of a SIMD register (AVX-512).
@@ -92,7 +92,7 @@ impl AbaLane for f64 {
     }
 
     #[inline(always)]
-    fn check_pivot(pivot: f64, scale: f64) -> Result<(), DynError> {
+    fn check_pivot((): (), pivot: f64, scale: f64) -> Result<(), DynError> {
         check::pivot(pivot, scale)
     }
 }
@@ -129,10 +129,12 @@ impl<S: Simd> AbaLane for Pack<S> {
     }
 
     #[inline(always)]
-    fn check_pivot(pivot: Self, scale: Self) -> Result<(), DynError> {
-        // A positive, finite margin implies that both are finite and pivot > PIVOT_FLOOR * scale
-        // (a difference of finite doubles has the exact sign).
-        if (pivot - scale * check::PIVOT_FLOOR).all_positive_finite() {
+    fn check_pivot(simd: S, pivot: Self, scale: Self) -> Result<(), DynError> {
+        // pivot > PIVOT_FLOOR * scale by the sign of their difference (exact for finite
+        // doubles), and pivot below infinity: two vector compares. A NaN fails both.
+        let margin = pivot - scale * check::PIVOT_FLOOR;
+        let finite = Self::splat(simd, f64::INFINITY).all_greater(pivot);
+        if finite && margin.all_greater(Self::splat(simd, 0.0)) {
             Ok(())
         } else {
             Err(DynError::NotPositiveDefinite)
@@ -312,7 +314,7 @@ fn backward_sweep<L: AbaLane>(
         let bias_force = [force[0] - c * centripetal, force[1] - s * centripetal];
         // The scale of D_i's rounding: its terms' magnitudes, |r|^2 tr K bounding r^T K r.
         let scale = about_joint + (kxx + kyy) * (link.length * link.length);
-        L::check_pivot(d_axis, scale)?;
+        L::check_pivot(context, d_axis, scale)?;
         let tau_i = L::gather(context, tau, n, i);
         let residual = tau_i - bias_moment;
         let joint = &mut articulated[i];

@@ -237,7 +237,13 @@ fn group<S: Simd>(
     inputs: [&[f64]; 3],
     out: &mut [f64],
 ) -> bool {
-    inputs.iter().all(|x| x.iter().all(|v| v.is_finite()))
+    inputs.iter().all(|x| all_finite(x))
         && kernel::<Pack<S>>(simd, model, links, inputs, out).is_ok()
-        && out.iter().all(|v| v.is_finite())
+        && all_finite(out)
+}
+
+/// Whether every value is finite, without an early exit, so that the loop vectorises.
+#[inline(always)]
+fn all_finite(values: &[f64]) -> bool {
+    values.iter().fold(true, |all, v| all & v.is_finite())
 }
