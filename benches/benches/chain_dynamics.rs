@@ -1,13 +1,17 @@
 //! Full planar-chain dynamics (`manip-dyn`) per step: forward dynamics by the articulated-body
-//! algorithm (`full_fd`, O(n)) and through a Cholesky solve of `M` (`fd_cholesky`, O(n^3)), the
+//! algorithm (`full_fd`, O(n); `full_fd_batch/10`, a batch of 1024 states of the 10-link arm,
+//! SIMD across states, with Criterion's throughput in states so that `cargo xtask bench`
+//! records nanoseconds per state) and through a Cholesky solve of `M` (`fd_cholesky`, O(n^3)), the
 //! mass matrix by CRBA (`crba`, O(n^2)), and inverse dynamics by RNEA (`rnea`, O(n)).
 //!
 //! Chains of `n` uniform links of 0.1 m and 0.1 kg (the paper's links) at a curled, moving
 //! state; every call reuses one `ChainData`, as a simulation step does.
 
-use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use manip_dyn::faer::Mat;
-use manip_dyn::{ChainData, ChainModel, aba, forward_dynamics, mass_matrix, rnea};
+use manip_dyn::{
+    AbaBatchData, ChainData, ChainModel, aba, aba_batch, forward_dynamics, mass_matrix, rnea,
+};
 use std::hint::black_box;
 
 /// An arm of `n` links at a smooth, curled pose, moving, with small torques.
@@ -48,6 +52,33 @@ fn full_fd(c: &mut Criterion) {
             })
         });
     }
+    group.finish();
+}
+
+/// States in `full_fd_batch/10`.
+const BATCH: usize = 1024;
+
+/// A batch of [`BATCH`] different states of the 10-link arm (the state of `full_fd/10` scaled
+/// differently in each), per state.
+fn full_fd_batch(c: &mut Criterion) {
+    let case = Case::new(10);
+    let mut data = AbaBatchData::new(&case.arm);
+    let batch = |base: &[f64]| {
+        (0..BATCH)
+            .flat_map(|i| base.iter().map(move |x| x * (1.0 + 0.1 * (i as f64).sin())))
+            .collect::<Vec<f64>>()
+    };
+    let (q, v, tau) = (batch(&case.q), batch(&case.v), batch(&case.tau));
+    let mut qdd = vec![0.0; q.len()];
+    let mut group = c.benchmark_group("full_fd_batch");
+    group.throughput(Throughput::Elements(BATCH as u64));
+    group.bench_function("10", |b| {
+        b.iter(|| {
+            let (q, v, tau) = (black_box(&q), black_box(&v), black_box(&tau));
+            aba_batch(&case.arm, &mut data, q, v, tau, &mut qdd).unwrap();
+            black_box(&qdd);
+        })
+    });
     group.finish();
 }
 
@@ -97,5 +128,12 @@ fn rnea_bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, full_fd, fd_cholesky, crba, rnea_bench);
+criterion_group!(
+    benches,
+    full_fd,
+    full_fd_batch,
+    fd_cholesky,
+    crba,
+    rnea_bench
+);
 criterion_main!(benches);

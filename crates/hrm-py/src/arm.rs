@@ -1,9 +1,9 @@
 //! `hrm.Arm`: the planar chain and its dynamics (eq 12), from `manip-dyn`.
 
-use crate::array::{Output, States, evaluate};
+use crate::array::{Output, States, evaluate, evaluate_chunks};
 use crate::errors::{Error, check_finite, count};
 use manip_dyn::faer::MatMut;
-use manip_dyn::{ChainData, ChainModel, DynError, MAX_DENSE_LINKS};
+use manip_dyn::{AbaBatchData, BatchError, ChainData, ChainModel, DynError, MAX_DENSE_LINKS};
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
 use sim_core::ArmSpec;
@@ -28,6 +28,8 @@ use std::sync::Mutex;
 pub struct Arm {
     chain: ChainModel,
     workspace: Mutex<ChainData>,
+    /// The workspace of `aba` (one state and batches), built by its first call.
+    aba_workspace: Mutex<Option<AbaBatchData>>,
 }
 
 impl Arm {
@@ -76,6 +78,7 @@ impl Arm {
         let chain = spec.to_chain().map_err(Error::from)?;
         Ok(Self {
             workspace: Mutex::new(ChainData::recursive(&chain)),
+            aba_workspace: Mutex::new(None),
             chain,
         })
     }
@@ -242,8 +245,9 @@ impl Arm {
     }
 
     /// Forward dynamics (ABA, O(n)): the joint accelerations theta_ddot under the torques tau,
-    /// shape (n,) or (N, n). Raises NumericalError if the mass matrix is not numerically positive
-    /// definite.
+    /// shape (n,) or (N, n). A batch runs through `manip_dyn::aba_batch`, several states at once
+    /// in the processor's SIMD registers, with the results of one state at a time. Raises
+    /// NumericalError if the mass matrix is not numerically positive definite.
     fn aba<'py>(
         &self,
         py: Python<'py>,
@@ -258,15 +262,19 @@ impl Arm {
             States::read(tau, "tau", n)?,
         ];
         let [q, v, t] = &inputs;
-        let out = evaluate(
+        let out = evaluate_chunks(
             py,
             [q, v, t],
             n,
-            &self.workspace,
-            || self.fresh(),
-            |data, [q, v, t], out| {
-                manip_dyn::aba(&self.chain, data, q, v, t, out)?;
-                check_finite("theta_ddot", out)
+            &self.aba_workspace,
+            || None,
+            |workspace, [q, v, t], out| {
+                let data = workspace.get_or_insert_with(|| AbaBatchData::new(&self.chain));
+                manip_dyn::aba_batch(&self.chain, data, q, v, t, out).map_err(|error| match error {
+                    BatchError::State { state, error } => (state, Error::from(error)),
+                    // The driver passes whole states: a shape error cannot happen.
+                    other => (0, Error::input(other.to_string())),
+                })
             },
         )?;
         Ok(out.into_py(py, &[n]))

@@ -37,6 +37,9 @@ pub trait Lane:
     /// Lane by lane, `if_set` where the representation of `self` has any of the bits of `mask`
     /// set, `if_clear` where it has none.
     fn select_by_bits(self, mask: u64, if_set: Self, if_clear: Self) -> Self;
+    /// Whether every lane is greater than the same lane of `other` (false where either is NaN):
+    /// one vector compare, for tests inside a kernel's loop.
+    fn all_greater(self, other: Self) -> bool;
 }
 
 impl Lane for f64 {
@@ -75,6 +78,11 @@ impl Lane for f64 {
         } else {
             if_clear
         }
+    }
+
+    #[inline(always)]
+    fn all_greater(self, other: Self) -> bool {
+        self > other
     }
 }
 
@@ -191,5 +199,67 @@ impl<S: Simd> Lane for Pack<S> {
             simd,
             value: simd.select_f64s(clear, if_clear.value, if_set.value),
         }
+    }
+
+    #[inline(always)]
+    fn all_greater(self, other: Self) -> bool {
+        let simd = self.simd;
+        let greater = simd.greater_than_f64s(self.value, other.value);
+        let zero = simd.splat_f64s(0.0);
+        let every = simd.greater_than_or_equal_f64s(zero, zero);
+        // The lanes where `self > other` fails; none when the first of them is past the end.
+        simd.first_true_m64s(simd.xor_m64s(greater, every)) == Self::WIDTH
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pulp::{Arch, WithSimd};
+
+    /// `all_greater` of every pair of lanes drawn from `values`, against `f64`'s `>` lane by lane,
+    /// with the instruction set of this processor.
+    struct AllGreater<'a>(&'a [f64]);
+
+    impl WithSimd for AllGreater<'_> {
+        type Output = ();
+
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, simd: S) {
+            let width = Pack::<S>::WIDTH;
+            let values = self.0;
+            // Every lane but one holds a passing pair; the other lane holds each case in turn.
+            for &a in values {
+                for &b in values {
+                    for lane in 0..width {
+                        let mut left = vec![2.0; width];
+                        let mut right = vec![1.0; width];
+                        left[lane] = a;
+                        right[lane] = b;
+                        let got = Pack::load(simd, &left).all_greater(Pack::load(simd, &right));
+                        assert_eq!(got, a.all_greater(b), "{a} > {b} in lane {lane} of {width}");
+                        assert_eq!(got, a > b);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn all_greater_matches_f64_in_every_lane() {
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            5e-324,
+            f64::MAX,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+        ];
+        Arch::new().dispatch(AllGreater(&values));
+        // And with the narrowest registers, whatever this processor has.
+        AllGreater(&values).with_simd(pulp::Scalar::new());
     }
 }

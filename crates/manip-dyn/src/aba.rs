@@ -14,23 +14,132 @@
 //! `beta_i = (0, -L omega^2 u)`, and `tau_i = S^T f_i`. Gravity is an upward acceleration of the
 //! base. The backward sweep condenses the chain tip-first into articulated inertias
 //! `f_i = IA_i A_i + pA_i`; the forward sweep then solves each joint's acceleration.
+//!
+//! The algorithm is written once, as [`kernel`], over the number type [`AbaLane`]: `f64` for one
+//! state ([`aba`]) and a SIMD register of several states side by side for a batch
+//! ([`aba_batch`](crate::aba_batch())), with the same operations in the same order, so a state
+//! gives the same bits alone or in a batch. Three passes: the absolute angles and rates from the
+//! base, then the sines and cosines of all angles at once (`lane_math::sin_cos`); the backward
+//! sweep; the forward sweep. Both sweeps are written so that the chain of dependent operations
+//! from one link to the next is short (one division, and a few multiply-adds), since at `n = 10`
+//! their latency, not the operation count, bounds the time.
+
+use lane_math::{Lane, Pack, sin_cos};
+use pulp::Simd;
 
 use crate::check;
-use crate::crba::{Subtree, accumulate_subtrees};
 use crate::data::ChainData;
 use crate::error::DynError;
-use crate::kinematics::{LinkFrame, dot, update_frames};
+use crate::kinematics::LinkFrame;
 use crate::model::ChainModel;
 
-/// What the forward sweep needs of joint `i`.
+/// What the forward sweep (and `aba_derivatives`) needs of joint `i`, for one state (`T = f64`)
+/// or the lanes of a batch.
 #[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct ArticulatedLink {
+pub(crate) struct ArticulatedLink<T = f64> {
     /// The translational part of `U_i = IA_i S` (its rotational part is `D_i`).
-    pub(crate) u_lin: [f64; 2],
+    pub(crate) u_lin: [T; 2],
     /// `D_i = S^T IA_i S`: the articulated inertia about the joint axis.
-    pub(crate) d: f64,
+    pub(crate) d: T,
     /// `tau_i - S^T pA_i`: the joint torque left after the articulated bias force.
-    residual: f64,
+    residual: T,
+}
+
+/// The number type of [`kernel`]: a [`Lane`] with a storage form for the values kept per link
+/// between the passes, loads of a link's inputs from row-major states, and the pivot test.
+pub(crate) trait AbaLane: Lane {
+    /// One value per link in the workspace: `f64`, or [`MAX_WIDTH`] lanes.
+    type Slot: Copy + Default + std::fmt::Debug;
+    /// The value held in `slot`.
+    fn get(context: Self::Context, slot: &Self::Slot) -> Self;
+    /// Stores `self` into `slot`.
+    fn set(self, slot: &mut Self::Slot);
+    /// Entry `i` of each of the `WIDTH` states of `rows` (row-major, `n` values a state).
+    fn gather(context: Self::Context, rows: &[f64], n: usize, i: usize) -> Self;
+    /// Writes the lanes into entry `i` of each state of `rows`.
+    fn scatter(self, rows: &mut [f64], n: usize, i: usize);
+    /// The pivot test of [`check::pivot`]: `Ok` if `pivot` is finite and above
+    /// `PIVOT_FLOOR * scale` in every lane. One state gets the exact error; a batch gets
+    /// `NotPositiveDefinite` for any failing lane (its states are then redone one at a time),
+    /// and never passes what the exact test refuses.
+    fn check_pivot(context: Self::Context, pivot: Self, scale: Self) -> Result<(), DynError>;
+}
+
+/// The most `f64` lanes of a SIMD register (AVX-512).
+pub(crate) const MAX_WIDTH: usize = 8;
+
+impl AbaLane for f64 {
+    type Slot = f64;
+
+    #[inline(always)]
+    fn get((): (), slot: &f64) -> f64 {
+        *slot
+    }
+
+    #[inline(always)]
+    fn set(self, slot: &mut f64) {
+        *slot = self;
+    }
+
+    #[inline(always)]
+    fn gather((): (), rows: &[f64], _n: usize, i: usize) -> f64 {
+        rows[i]
+    }
+
+    #[inline(always)]
+    fn scatter(self, rows: &mut [f64], _n: usize, i: usize) {
+        rows[i] = self;
+    }
+
+    #[inline(always)]
+    fn check_pivot((): (), pivot: f64, scale: f64) -> Result<(), DynError> {
+        check::pivot(pivot, scale)
+    }
+}
+
+impl<S: Simd> AbaLane for Pack<S> {
+    type Slot = [f64; MAX_WIDTH];
+
+    #[inline(always)]
+    fn get(simd: S, slot: &[f64; MAX_WIDTH]) -> Self {
+        Self::load(simd, slot)
+    }
+
+    #[inline(always)]
+    fn set(self, slot: &mut [f64; MAX_WIDTH]) {
+        self.store(slot);
+    }
+
+    #[inline(always)]
+    fn gather(simd: S, rows: &[f64], n: usize, i: usize) -> Self {
+        let mut lanes = [0.0; MAX_WIDTH];
+        for (lane, slot) in lanes[..Self::WIDTH].iter_mut().enumerate() {
+            *slot = rows[lane * n + i];
+        }
+        Self::load(simd, &lanes)
+    }
+
+    #[inline(always)]
+    fn scatter(self, rows: &mut [f64], n: usize, i: usize) {
+        let mut lanes = [0.0; MAX_WIDTH];
+        self.store(&mut lanes);
+        for (lane, &value) in lanes[..Self::WIDTH].iter().enumerate() {
+            rows[lane * n + i] = value;
+        }
+    }
+
+    #[inline(always)]
+    fn check_pivot(simd: S, pivot: Self, scale: Self) -> Result<(), DynError> {
+        // pivot > PIVOT_FLOOR * scale by the sign of their difference (exact for finite
+        // doubles), and pivot below infinity: two vector compares. A NaN fails both.
+        let margin = pivot - scale * check::PIVOT_FLOOR;
+        let finite = Self::splat(simd, f64::INFINITY).all_greater(pivot);
+        if finite && margin.all_greater(Self::splat(simd, 0.0)) {
+            Ok(())
+        } else {
+            Err(DynError::NotPositiveDefinite)
+        }
+    }
 }
 
 /// Forward dynamics by the articulated-body algorithm: the joint accelerations `qdd` that the
@@ -77,117 +186,195 @@ pub(crate) fn articulated_body(
     tau: &[f64],
     qdd: &mut [f64],
 ) -> Result<(), DynError> {
-    update_frames(&mut data.frames, q, Some(v));
-    // The composite inertias about each joint (the diagonal of M) are the scale of the pivots.
-    accumulate_subtrees(model, &data.frames, &mut data.subtrees);
-    backward_sweep(
-        model,
-        &data.frames,
-        &data.subtrees,
-        tau,
-        &mut data.articulated,
-    )?;
-    forward_sweep(model, &data.frames, &data.articulated, qdd);
+    let links = LinkBuffers {
+        angle: &mut data.angle,
+        sin: &mut data.sin,
+        cos: &mut data.cos,
+        frames: &mut data.frames,
+        articulated: &mut data.articulated,
+    };
+    kernel::<f64>((), model, links, [q, v, tau], qdd)
+}
+
+/// The per-link workspace of [`kernel`] for `L::WIDTH` states: `angle`, `sin` and `cos` hold
+/// `n` values of `WIDTH` lanes each (`[link][lane]`), the others one slot a link.
+pub(crate) struct LinkBuffers<'a, T> {
+    /// Absolute angle `phi_i`, then its sine and cosine.
+    pub(crate) angle: &'a mut [f64],
+    pub(crate) sin: &'a mut [f64],
+    pub(crate) cos: &'a mut [f64],
+    /// Direction and angular velocity of each link.
+    pub(crate) frames: &'a mut [LinkFrame<T>],
+    /// Articulated-body quantities of each joint.
+    pub(crate) articulated: &'a mut [ArticulatedLink<T>],
+}
+
+/// The articulated-body algorithm for `L::WIDTH` states: `inputs` are `q`, `v` and `tau`, each
+/// `WIDTH` states of `n` values one after another (row-major), and `qdd` gets the accelerations
+/// in the same layout. Inputs finite, sizes checked by the caller.
+#[inline(always)]
+pub(crate) fn kernel<L: AbaLane>(
+    context: L::Context,
+    model: &ChainModel,
+    links: LinkBuffers<'_, L::Slot>,
+    inputs: [&[f64]; 3],
+    qdd: &mut [f64],
+) -> Result<(), DynError> {
+    let n = model.n_links();
+    let width = L::WIDTH;
+    let [q, v, tau] = inputs;
+    let LinkBuffers {
+        angle,
+        sin,
+        cos,
+        frames,
+        articulated,
+    } = links;
+    let (angle, sin, cos) = (
+        &mut angle[..n * width],
+        &mut sin[..n * width],
+        &mut cos[..n * width],
+    );
+    let (frames, articulated) = (&mut frames[..n], &mut articulated[..n]);
+    let zero = L::splat(context, 0.0);
+    // The absolute angles and rates, base first.
+    let (mut phi, mut omega) = (zero, zero);
+    for (i, (angle, frame)) in angle
+        .chunks_exact_mut(width)
+        .zip(frames.iter_mut())
+        .enumerate()
+    {
+        phi = phi + L::gather(context, q, n, i);
+        omega = omega + L::gather(context, v, n, i);
+        phi.store(angle);
+        omega.set(&mut frame.omega);
+    }
+    sin_cos(angle, sin, cos);
+    backward_sweep::<L>(context, model, sin, cos, tau, frames, articulated)?;
+    forward_sweep::<L>(context, model, frames, articulated, qdd);
     Ok(())
 }
 
-/// What link `i` sees of the links beyond it once their joint accelerations are solved out,
-/// referred to joint `i + 1`: `f = IA' A + pA'` with `IA' = [[0, 0], [0, K]]` and
-/// `pA' = (tau_{i+1}, force)`. The rotational row of `IA'` vanishes and the moment of `pA'` is
-/// the joint torque because a revolute joint transmits no other moment.
-#[derive(Debug, Clone, Copy, Default)]
-struct Condensed {
-    /// `K`, the symmetric 2 x 2 resistance to translating the joint, as `[k_xx, k_xy, k_yy]`.
-    inertia: [f64; 3],
-    /// The bias force at the joint.
-    force: [f64; 2],
-    /// The joint torque.
-    torque: f64,
-}
-
-/// Condenses the chain from the tip: the articulated inertia and bias force of each joint.
-fn backward_sweep(
+/// Condenses the chain from the tip: the articulated inertia and bias force of each joint, and
+/// each link's direction into `frames`.
+///
+/// What link `i` sees of the links beyond it, once their joint accelerations are solved out, is
+/// `f = IA' A + pA'` at joint `i + 1` with `IA' = [[0, 0], [0, K]]` and `pA' = (tau_{i+1},
+/// force)`: `K`, the symmetric 2 x 2 resistance to translating the joint, is `[k_xx, k_xy,
+/// k_yy]`. The rotational row of `IA'` vanishes and the moment of `pA'` is the joint torque
+/// because a revolute joint transmits no other moment.
+#[inline(always)]
+fn backward_sweep<L: AbaLane>(
+    context: L::Context,
     model: &ChainModel,
-    frames: &[LinkFrame],
-    subtrees: &[Subtree],
+    sin: &[f64],
+    cos: &[f64],
     tau: &[f64],
-    articulated: &mut [ArticulatedLink],
+    frames: &mut [LinkFrame<L::Slot>],
+    articulated: &mut [ArticulatedLink<L::Slot>],
 ) -> Result<(), DynError> {
-    let mut child = Condensed::default();
-    for i in (0..model.n_links()).rev() {
+    let n = model.n_links();
+    let width = L::WIDTH;
+    let zero = L::splat(context, 0.0);
+    let (mut kxx, mut kxy, mut kyy) = (zero, zero, zero);
+    let (mut fx, mut fy, mut torque) = (zero, zero, zero);
+    for i in (0..n).rev() {
         let link = &model.links()[i];
-        let frame = &frames[i];
-        let u = frame.axis;
-        let w = frame.normal();
-        let w2 = frame.omega * frame.omega;
-        // Joint i + 1 is at d = L u; X(d) moves the child's quantities to joint i, where the
-        // child's acceleration gains the centripetal bias beta = (0, -omega^2 d).
-        let d = [link.length * u[0], link.length * u[1]];
-        let r = [-d[1], d[0]];
-        let [kxx, kxy, kyy] = child.inertia;
-        let k_mul = |x: [f64; 2]| [kxx * x[0] + kxy * x[1], kxy * x[0] + kyy * x[1]];
-        let k_beta = k_mul([-w2 * d[0], -w2 * d[1]]);
-        let force = [child.force[0] + k_beta[0], child.force[1] + k_beta[1]];
-        let k_r = k_mul(r);
-
-        // IA_i = H_i + X^T IA' X and pA_i = b_i + X^T (pA' + IA' beta), with the link's inertia
-        // about its joint H_i = [[I + m c^2, m c w^T], [m c w, m 1]] and centripetal bias
-        // b_i = (0, -m c omega^2 u).
+        let (s, c) = (
+            L::load(context, &sin[i * width..]),
+            L::load(context, &cos[i * width..]),
+        );
+        let frame = &mut frames[i];
+        c.set(&mut frame.axis[0]);
+        s.set(&mut frame.axis[1]);
+        let omega = L::get(context, &frame.omega);
+        let w2 = omega * omega;
+        // Joint i + 1 is at d = L u; r = e_z x d = L w; X(d) moves the child's quantities to
+        // joint i, where the child's acceleration gains the centripetal bias beta = -omega^2 d.
+        let (dx, dy) = (c * link.length, s * link.length);
         let mc = link.mass * link.com;
-        let d_axis = link.inertia + mc * link.com + dot(r, k_r);
-        let u_lin = [mc * w[0] + k_r[0], mc * w[1] + k_r[1]];
-        let bias_moment = child.torque + dot(r, force);
-        let bias_force = [force[0] - mc * w2 * u[0], force[1] - mc * w2 * u[1]];
-        check::pivot(d_axis, subtrees[i].second_moment)?;
-        let residual = tau[i] - bias_moment;
-        articulated[i] = ArticulatedLink {
-            u_lin,
-            d: d_axis,
-            residual,
-        };
+        // D_i = S^T IA_i S = I + m c^2 + r^T K r, with the products of r formed before K is
+        // known, so that the chain from K to D is one multiply and two adds.
+        let about_joint = L::splat(context, link.inertia + mc * link.com);
+        let mass = L::splat(context, link.mass);
+        let (rr_xx, rr_xy, rr_yy) = (dy * dy, dx * dy * 2.0, dx * dx);
+        let d_axis = (kxx * rr_xx + about_joint) + (kyy * rr_yy - kxy * rr_xy);
+        // U_i = m c w + K r; its rotational part is D_i.
+        let u_lin = [
+            (kxy * dx - kxx * dy) - s * mc,
+            (kyy * dx - kxy * dy) + c * mc,
+        ];
+        // pA_i = b_i + X^T (pA' + K beta), b_i = (0, -m c omega^2 u).
+        let force = [
+            fx - (kxx * dx + kxy * dy) * w2,
+            fy - (kxy * dx + kyy * dy) * w2,
+        ];
+        let bias_moment = torque + (dx * force[1] - dy * force[0]);
+        let centripetal = w2 * mc;
+        let bias_force = [force[0] - c * centripetal, force[1] - s * centripetal];
+        // The scale of D_i's rounding: its terms' magnitudes, |r|^2 tr K bounding r^T K r.
+        let scale = about_joint + (kxx + kyy) * (link.length * link.length);
+        L::check_pivot(context, d_axis, scale)?;
+        let tau_i = L::gather(context, tau, n, i);
+        let residual = tau_i - bias_moment;
+        let joint = &mut articulated[i];
+        u_lin[0].set(&mut joint.u_lin[0]);
+        u_lin[1].set(&mut joint.u_lin[1]);
+        d_axis.set(&mut joint.d);
+        residual.set(&mut joint.residual);
         // Solve the joint acceleration out: IA - U U^T / D and pA + U residual / D.
-        let gain = [u_lin[0] / d_axis, u_lin[1] / d_axis];
-        child = Condensed {
-            inertia: [
-                link.mass + kxx - gain[0] * u_lin[0],
-                kxy - gain[0] * u_lin[1],
-                link.mass + kyy - gain[1] * u_lin[1],
-            ],
-            force: [
-                bias_force[0] + gain[0] * residual,
-                bias_force[1] + gain[1] * residual,
-            ],
-            torque: tau[i],
-        };
+        let inverse = L::splat(context, 1.0) / d_axis;
+        let along = residual * inverse;
+        kxx = (kxx + mass) - u_lin[0] * u_lin[0] * inverse;
+        kxy = kxy - u_lin[0] * u_lin[1] * inverse;
+        kyy = (kyy + mass) - u_lin[1] * u_lin[1] * inverse;
+        fx = bias_force[0] + u_lin[0] * along;
+        fy = bias_force[1] + u_lin[1] * along;
+        torque = tau_i;
     }
     Ok(())
 }
 
-/// Solves the joint accelerations from the base out.
-fn forward_sweep(
+/// Solves the joint accelerations from the base out, into `qdd` (row-major, `n` a state).
+#[inline(always)]
+fn forward_sweep<L: AbaLane>(
+    context: L::Context,
     model: &ChainModel,
-    frames: &[LinkFrame],
-    articulated: &[ArticulatedLink],
+    frames: &[LinkFrame<L::Slot>],
+    articulated: &[ArticulatedLink<L::Slot>],
     qdd: &mut [f64],
 ) {
-    // Acceleration of link i's parent, moved to joint i (gravity as an upward base acceleration).
-    let mut parent = [0.0, 0.0, model.gravity()];
+    let n = model.n_links();
+    // The parent's acceleration moved to joint i: angular, x, y (gravity as an upward base
+    // acceleration).
+    let (mut angular, mut ax, mut ay) = (
+        L::splat(context, 0.0),
+        L::splat(context, 0.0),
+        L::splat(context, model.gravity()),
+    );
     for (i, (link, (frame, joint))) in model
         .links()
         .iter()
         .zip(frames.iter().zip(articulated))
         .enumerate()
     {
-        // qdd_i = (tau_i - S^T pA_i - U_i^T A_i^-) / D_i.
-        let acc = (joint.residual - dot([parent[1], parent[2]], joint.u_lin)) / joint.d - parent[0];
-        qdd[i] = acc;
-        let own = [parent[0] + acc, parent[1], parent[2]];
-        let w2 = frame.omega * frame.omega;
-        let d = [link.length * frame.axis[0], link.length * frame.axis[1]];
-        parent = [
-            own[0],
-            own[1] - d[1] * own[0] - w2 * d[0],
-            own[2] + d[0] * own[0] - w2 * d[1],
+        let get = |slot| L::get(context, slot);
+        let inverse = L::splat(context, 1.0) / get(&joint.d);
+        let gain = [
+            get(&joint.u_lin[0]) * inverse,
+            get(&joint.u_lin[1]) * inverse,
         ];
+        // The link's angular acceleration: qdd_i + parent's = (tau_i - S^T pA_i - U_i^T A^-) / D_i.
+        let own = get(&joint.residual) * inverse - (ax * gain[0] + ay * gain[1]);
+        (own - angular).scatter(qdd, n, i);
+        let omega = get(&frame.omega);
+        let w2 = omega * omega;
+        let (dx, dy) = (
+            get(&frame.axis[0]) * link.length,
+            get(&frame.axis[1]) * link.length,
+        );
+        ax = (ax - dx * w2) - dy * own;
+        ay = (ay - dy * w2) + dx * own;
+        angular = own;
     }
 }

@@ -97,14 +97,16 @@ pub(crate) fn finite_matrix(name: &'static str, m: &MatMut<'_, f64>) -> Result<(
     }
 }
 
-/// Smallest admissible ratio of a factorisation pivot of `M` to the diagonal entry of `M` it
-/// comes from. Rounding perturbs a pivot by a few machine epsilons of that entry, so below about
-/// 1e3 epsilons (2e-13) the pivot, and every acceleration computed from it, has no reliable
-/// digits. Physical chains are far from it: a straight uniform chain of 1000 links reaches 2e-9.
-const PIVOT_FLOOR: f64 = 1e3 * f64::EPSILON;
+/// Smallest admissible ratio of a factorisation pivot of `M` to the scale of its rounding (for a
+/// Cholesky pivot, the diagonal entry of `M` it comes from; for an articulated inertia, the
+/// magnitude of the terms it is summed from). Rounding perturbs a pivot by a few machine
+/// epsilons of that scale, so below about 1e3 epsilons (2e-13) the pivot, and every acceleration
+/// computed from it, has no reliable digits.
+pub(crate) const PIVOT_FLOOR: f64 = 1e3 * f64::EPSILON;
 
 /// A pivot of a factorisation of `M` (a Cholesky pivot `L_ii^2`, or an articulated inertia
-/// about a joint axis) must be finite and positive beyond rounding relative to `M_ii`.
+/// about a joint axis) must be finite and positive beyond rounding relative to `diagonal`, the
+/// scale of its rounding ([`PIVOT_FLOOR`]).
 pub(crate) fn pivot(pivot: f64, diagonal: f64) -> Result<(), DynError> {
     if !(pivot.is_finite() && diagonal.is_finite()) {
         Err(DynError::NonFiniteResult {

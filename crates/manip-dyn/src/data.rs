@@ -27,6 +27,10 @@ use crate::rnea::LinkAcceleration;
 pub struct ChainData {
     /// Direction and angular velocity of each link.
     pub(crate) frames: Vec<LinkFrame>,
+    /// Absolute angle of each link, then its sine and cosine (the ABA's vectorised trigonometry).
+    pub(crate) angle: Vec<f64>,
+    pub(crate) sin: Vec<f64>,
+    pub(crate) cos: Vec<f64>,
     /// Link accelerations of the Newton-Euler recursion.
     pub(crate) accelerations: Vec<LinkAcceleration>,
     /// Composite bodies `i..n` of the composite-rigid-body algorithm.
@@ -97,6 +101,9 @@ impl ChainData {
     fn with_links(n: usize) -> ChainData {
         ChainData {
             frames: vec![LinkFrame::default(); n],
+            angle: vec![0.0; n],
+            sin: vec![0.0; n],
+            cos: vec![0.0; n],
             accelerations: vec![LinkAcceleration::default(); n],
             subtrees: vec![Subtree::default(); n],
             subtree_motions: vec![SubtreeMotion::default(); n],

@@ -1,13 +1,14 @@
 //! The forward pass every algorithm starts with: each link's direction and angular velocity.
 
-/// Where link `i` points and how fast it turns, in the base frame.
+/// Where link `i` points and how fast it turns, in the base frame: `T = f64` for one state, or
+/// the lanes of several states side by side (the ABA batch, see `crate::aba::AbaLane`).
 #[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct LinkFrame {
+pub(crate) struct LinkFrame<T = f64> {
     /// Unit vector `u_i = (cos phi_i, sin phi_i)` from joint `i` to joint `i + 1`, where
     /// `phi_i = theta_1 + ... + theta_i` is the absolute angle.
-    pub axis: [f64; 2],
+    pub axis: [T; 2],
     /// Absolute angular velocity `omega_i = theta_dot_1 + ... + theta_dot_i` (0 without `v`).
-    pub omega: f64,
+    pub omega: T,
 }
 
 impl LinkFrame {

@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 mod aba;
+mod aba_batch;
 mod aba_derivatives;
 mod bias;
 mod check;
@@ -20,6 +21,7 @@ mod rnea_derivatives;
 pub use faer;
 
 pub use aba::aba;
+pub use aba_batch::{AbaBatchData, BatchError, MAX_BATCH_LINKS, aba_batch};
 pub use aba_derivatives::aba_derivatives;
 pub use bias::{coriolis, gravity, nonlinear_effects};
 pub use coriolis_matrix::coriolis_matrix;

@@ -62,7 +62,7 @@ class Arm:
     def rnea(self, theta: ArrayLike, theta_dot: ArrayLike, theta_ddot: ArrayLike) -> Array:
         """Inverse dynamics: tau = M theta_ddot + C + G, shape (n,) or (N, n)."""
     def aba(self, theta: ArrayLike, theta_dot: ArrayLike, tau: ArrayLike) -> Array:
-        """Forward dynamics: theta_ddot, shape (n,) or (N, n)."""
+        """Forward dynamics (ABA): theta_ddot, shape (n,) or (N, n); a batch runs SIMD across states."""
     def energy(self, theta: ArrayLike, theta_dot: ArrayLike) -> Union[float, Array]:
         """Kinetic plus potential energy (J): a float, or shape (N,) for a batch."""
 
