@@ -6,12 +6,19 @@
 //! A sweep in a few lines, whole or as shards merged back (bit for bit the same numbers):
 //!
 //! ```
-//! use sim_core::study::{Shard, SweepConfig, cells, merge, run_shard};
+//! use sim_core::study::{Shard, SweepConfig, SweepSettings, cells, merge, run_shard};
 //! use sim_core::{ControllerKind, Scenario};
 //!
 //! let mut scenario = Scenario::builtin("paper-responses-step")?;
 //! scenario.duration = 0.15;
-//! let config = SweepConfig::new(scenario, vec![ControllerKind::Pd], vec![0.0, 0.01], 2, 7)?;
+//! let settings = SweepSettings {
+//!     controllers: vec![ControllerKind::Pd],
+//!     noise_levels: vec![0.0, 0.01],
+//!     seeds: 2,
+//!     base_seed: 7,
+//!     ..SweepSettings::default()
+//! };
+//! let config = SweepConfig::new(scenario, settings)?;
 //! let whole = run_shard(&config, Shard::WHOLE, || {});
 //! let halves = (1..=2).map(|index| {
 //!     let shard = Shard { index, count: 2 };
@@ -35,7 +42,9 @@ pub use comparison::{ComparisonRun, Stopped, builtin_scenarios, compare, run_one
 pub use inputs::{
     InputDigest, SCENARIO_INPUT, check_digests, check_json_safe, first_changed, input_digests,
 };
-pub use plan::{MAX_RUNS, MAX_SHARDS, RunId, Shard, SweepConfig, run_seed};
+pub use plan::{
+    MAX_RUNS, MAX_SHARDS, RunId, SettingError, Shard, SweepConfig, SweepSettings, run_seed,
+};
 pub use shard_file::{
     FORMAT, MAX_SHARD_LINE_BYTES, Outcome, RunMetrics, RunResult, ShardFile, ShardHeader,
     ShardInput, ShardReader, ShardSource, merge, merge_readers, shard_paths, write_json_line,

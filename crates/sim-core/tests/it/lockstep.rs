@@ -12,8 +12,8 @@ use proptest::prelude::*;
 use sim_core::controller::{ControlContext, Controller, ControllerError, PdController};
 use sim_core::ode::Tolerances;
 use sim_core::reference::Sinusoid;
-use sim_core::study::{self, Shard, SweepConfig};
-use sim_core::{ControllerKind, Integrator, Lockstep, LoopSettings, Scenario, Simulation};
+use sim_core::study::{self, Shard, SweepConfig, SweepSettings};
+use sim_core::{Integrator, Lockstep, LoopSettings, Scenario, Simulation};
 use std::f64::consts::FRAC_PI_2;
 use test_support::config::check_scaled;
 
@@ -321,14 +321,13 @@ fn a_sweep_in_lock_step_gives_every_run_as_run_alone() {
     scenario.duration = 0.2;
     scenario.limits.max_modal_error = 0.25;
     let lanes = batch_lanes(&scenario.model().unwrap());
-    let config = SweepConfig::new(
-        scenario,
-        ControllerKind::ALL.to_vec(),
-        vec![0.0, 0.02, 2.0],
-        lanes + 3,
-        5,
-    )
-    .unwrap();
+    let settings = SweepSettings {
+        noise_levels: vec![0.0, 0.02, 2.0],
+        seeds: lanes + 3,
+        base_seed: 5,
+        ..SweepSettings::default()
+    };
+    let config = SweepConfig::new(scenario, settings).unwrap();
     assert_eq!(study::lockstep_size(&config), lanes);
     for shard in [Shard::WHOLE, Shard { index: 2, count: 3 }] {
         let whole = study::run_shard(&config, shard, || {});
