@@ -8,9 +8,15 @@
 //!
 //! `scenario/harmonic_tracking`: the same task with the two-harmonic family (`m = 4`), whose
 //! reference comes from the numerical inverse kinematics at every controller sample.
+//!
+//! `scenario_group/alone` and `scenario_group/lockstep`: one SIMD group's worth of
+//! `paper-tracking` runs (8 with AVX-512), each with its own seed of sensor noise
+//! (`L = 0.01` rad, as a sweep runs them), run one after the other and as one `Lockstep` group
+//! whose RK4 stages are evaluated together; Criterion's throughput is in runs, so both read as
+//! time per run.
 
-use criterion::{Criterion, criterion_group, criterion_main};
-use sim_core::{ControllerKind, Scenario};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use sim_core::{ControllerKind, Lockstep, NoiseSpec, Scenario, Simulation};
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -38,5 +44,46 @@ fn paper_tracking(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, paper_tracking);
+fn paper_tracking_group(c: &mut Criterion) {
+    let mut scenario = Scenario::builtin("paper-tracking").expect("the shipped scenario parses");
+    let model = scenario.model().expect("the shipped scenario builds");
+    let lanes = modal_reduce::batch_lanes(&model);
+    scenario.noise = NoiseSpec::uniform(scenario.n_coords(), 0.01, 0.1, 0.0);
+    let mut runs = || -> Vec<Simulation> {
+        (1..=lanes as u64)
+            .map(|seed| {
+                scenario.seed = seed;
+                scenario.build().expect("the shipped scenario builds")
+            })
+            .collect()
+    };
+    let mut alone = runs();
+    let mut together = Lockstep::new(runs()).expect("runs of one scenario make a group");
+    let mut group = c.benchmark_group("scenario_group");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(10));
+    group.throughput(Throughput::Elements(lanes as u64));
+    group.bench_function("alone", |b| {
+        b.iter(|| {
+            for simulation in &mut alone {
+                let run = simulation.run().expect("the paper's scenario runs");
+                black_box(run.summary.tip_error_rms_m);
+            }
+        })
+    });
+    group.bench_function("lockstep", |b| {
+        b.iter(|| {
+            for run in together.run() {
+                black_box(
+                    run.expect("the paper's scenario runs")
+                        .summary
+                        .tip_error_rms_m,
+                );
+            }
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, paper_tracking, paper_tracking_group);
 criterion_main!(benches);

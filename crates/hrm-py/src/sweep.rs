@@ -7,7 +7,7 @@ use crate::scenario::Scenario;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sim_core::ControllerKind;
-use sim_core::study::{self, Shard, ShardFile, SweepConfig};
+use sim_core::study::{self, Shard, ShardFile, SweepConfig, SweepSettings};
 use std::path::{Path, PathBuf};
 
 /// A sweep: one scenario run with several controllers at several sensor-noise levels, `seeds`
@@ -15,9 +15,10 @@ use std::path::{Path, PathBuf};
 ///
 /// Sweep(scenario, noise_levels, seeds, controllers=None, base_seed=1, rate_noise_ratio=10.0,
 /// reference_noise_ratio=0.0): `scenario` is a Scenario (its duration applies; its noise and
-/// seed are replaced per run) or a built-in name or TOML path; `controllers` defaults to all
-/// four; noise levels (rad) must be distinct and ascending. Every controller's simulation is
-/// built once here, so a bad setting raises InvalidInput at once.
+/// seed are replaced per run) or a built-in name or TOML path; `controllers` defaults to every
+/// controller, and names each at most once; noise levels (rad) must be distinct and ascending.
+/// Every controller's simulation is built once here, so a bad setting raises InvalidInput at
+/// once, naming the keyword ("seeds must be at least 1").
 ///
 /// sweep.run() runs everything and returns the summary; sweep.run_shard(k, n) runs shard k of n
 /// and returns the shard file's text, and Sweep.merge(shards) combines shard files into the
@@ -50,6 +51,8 @@ fn shard(index: usize, count: usize) -> PyResult<Shard> {
 }
 
 impl Sweep {
+    /// A sweep read back from its configuration's JSON, checked as [`SweepConfig::new`] checks
+    /// a new one.
     fn checked(config: SweepConfig) -> PyResult<Self> {
         config.validate().map_err(input)?;
         config.check_builds().map_err(input)?;
@@ -74,7 +77,7 @@ impl Sweep {
         rate_noise_ratio: f64,
         reference_noise_ratio: f64,
     ) -> PyResult<Self> {
-        let mut scenario = match scenario.cast::<Scenario>() {
+        let scenario = match scenario.cast::<Scenario>() {
             Ok(s) => s.get().get(),
             Err(_) => {
                 let name: PathBuf = scenario.extract()?;
@@ -82,8 +85,6 @@ impl Sweep {
                     .map_err(|e| input(e.to_string()))?
             }
         };
-        scenario.noise = Default::default();
-        scenario.seed = 0;
         let controllers = match controllers {
             None => ControllerKind::ALL.to_vec(),
             Some(names) => names
@@ -91,17 +92,16 @@ impl Sweep {
                 .map(|n| n.parse().map_err(Error::from))
                 .collect::<Result<_, _>>()?,
         };
-        Self::checked(SweepConfig {
-            hrm_version: study::VERSION.to_string(),
-            inputs: study::input_digests(&scenario).map_err(input)?,
-            scenario,
+        let settings = SweepSettings {
             controllers,
             noise_levels,
             rate_noise_ratio,
             reference_noise_ratio,
             seeds: crate::errors::count(seeds, "seeds", 1)?,
             base_seed,
-        })
+        };
+        let config = SweepConfig::new(scenario, settings).map_err(input)?;
+        Ok(Self { config })
     }
 
     /// The number of runs: noise levels x controllers x seeds.

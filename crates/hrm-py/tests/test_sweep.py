@@ -33,6 +33,10 @@ def test_plan():
         hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=-1)
     with pytest.raises(hrm.InvalidInput, match="must be one of"):
         hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, controllers=["lqr?"])
+    with pytest.raises(hrm.InvalidInput, match="^controllers lists pd twice$"):
+        hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, controllers=["pd", "fuzzy", "pd"])
+    with pytest.raises(hrm.InvalidInput, match="^rate_noise_ratio must be finite and non-negative, got -1$"):
+        hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, rate_noise_ratio=-1.0)
 
 
 def test_shards_scheduled_by_concurrent_futures_merge_to_the_unsharded_sweep(tmp_path):

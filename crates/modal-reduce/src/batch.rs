@@ -24,7 +24,7 @@ use crate::terms::{LinkTrig, Terms, accumulate};
 use lane_math::{Lane, Pack};
 
 /// The most `f64` lanes of a SIMD register (AVX-512).
-const MAX_WIDTH: usize = 8;
+pub(crate) const MAX_WIDTH: usize = 8;
 
 /// The most modal coordinates evaluated SIMD across states (`K = 2` harmonics with `alpha0`
 /// free); larger models run their batches one state at a time.

@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 mod batch;
+mod batch_group;
 mod data;
 mod derivatives;
 mod energy;
@@ -14,6 +15,7 @@ pub mod terms;
 mod torques;
 
 pub use batch::{BatchError, MAX_BATCH_COORDS, ReducedBatchData, forward_dynamics_batch};
+pub use batch_group::batch_lanes;
 pub use data::ReducedData;
 pub use derivatives::{ReducedDerivatives, reduced_derivatives};
 pub use energy::{kinetic_energy, potential_energy};

@@ -5,12 +5,16 @@
 use crate::controller::{ControlContext, Controller, ModalState};
 use crate::error::{Readable, SimError, check_finite, check_non_negative, check_positive};
 use crate::noise::GaussianNoise;
-use crate::ode::{DormandPrince, OdeSystem, Rk4, Tolerances};
+use crate::ode::{DormandPrince, OdeSystem, Rk4, Stats, Tolerances};
 use crate::record::{Metrics, Record, Sample, Summary};
 use crate::reference::continuation::Family;
 use crate::reference::{Reference, ReferenceSample};
 use backbone_kin::BaseAngle;
 use modal_reduce::{ReduceError, ReducedData, ReducedModel};
+
+mod lockstep;
+
+pub use lockstep::Lockstep;
 
 /// ChaCha streams of the two noise sources, so that each has its own sequence.
 const REFERENCE_NOISE_STREAM: u64 = 1;
@@ -100,6 +104,38 @@ pub struct RunFailure {
     pub record: Record,
     /// The metrics up to the last good sample.
     pub summary: Summary,
+}
+
+/// A run in progress: what [`Simulation::run`] accumulates sample by sample.
+struct Progress {
+    record: Record,
+    metrics: Metrics,
+    /// Accepted and rejected integrator steps so far.
+    steps: usize,
+    rejected: usize,
+    /// The controller samples of the run after the first, and how many make one recording
+    /// period.
+    samples: usize,
+    record_every: usize,
+}
+
+impl Progress {
+    /// The run stopped by `error`, with what was recorded so far.
+    fn fail(self, error: SimError) -> Box<RunFailure> {
+        Box::new(RunFailure {
+            error,
+            summary: self.metrics.summary(self.steps, self.rejected),
+            record: self.record,
+        })
+    }
+
+    /// The completed run.
+    fn finish(self) -> Run {
+        Run {
+            summary: self.metrics.summary(self.steps, self.rejected),
+            record: self.record,
+        }
+    }
 }
 
 /// The reduced dynamics with a held modal torque: `y = [a, a_dot]` (`2m` entries).
@@ -462,85 +498,93 @@ impl Simulation {
     /// [`RunFailure`] that says when and why and keeps the data recorded so far (the runaway
     /// sample included).
     pub fn run(&mut self) -> Result<Run, Box<RunFailure>> {
-        self.reset();
-        let s = &self.settings;
-        let m = self.n_coords();
-        let period = s.controller_period;
-        let max_error = s.max_modal_error;
-        let (samples, record_every) = sample_counts(s);
-        let n = self.plant.model.n_links();
-        let mut record = Record::with_capacity(m, n, recorded_samples(s));
-        let mut metrics = Metrics::new(m, n, s.joint_torque_limits.clone());
-        let (mut steps, mut rejected) = (0, 0);
-        let fail = |error, record, metrics: &Metrics, steps, rejected| {
-            Box::new(RunFailure {
-                error,
-                record,
-                summary: metrics.summary(steps, rejected),
-            })
-        };
-        for k in 0..=samples {
-            let last = k == samples;
-            let taken = self.take_sample().and_then(|()| {
-                if last {
-                    self.acceleration()
-                } else {
-                    self.integrate()
-                }
-            });
-            if let Err(error) = taken {
-                return Err(fail(error, record, &metrics, steps, rejected));
-            }
-            let sample = &self.sample;
-            let t = sample.t;
-            steps += sample.steps.0;
-            rejected += sample.steps.1;
-            metrics.add_control(
-                t,
-                &sample.tau_star,
-                &sample.clamped,
-                if last { 0.0 } else { period },
-            );
-            let runaway = (0..m)
-                .map(|i| (i, (sample.state.a[i] - sample.reference.a[i]).abs()))
-                .find(|&(_, e)| e > max_error || e.is_nan());
-            if k % record_every == 0 || last || runaway.is_some() {
-                match self.observe() {
-                    Ok(observation) => {
-                        let (tip, tip_ref) = (observation.tip, observation.tip_ref);
-                        let sample = &self.sample;
-                        let row = Sample {
-                            t,
-                            a: &sample.state.a,
-                            a_dot: &sample.state.a_dot,
-                            a_ref: &sample.reference.a,
-                            a_ref_dot: &sample.reference.a_dot,
-                            a_cmd: &sample.command.a,
-                            tau_star: &sample.tau_star,
-                            clamped: &sample.clamped,
-                            tip,
-                            tip_ref,
-                        };
-                        metrics.add(&row, &self.joint_torques);
-                        record.push(&row, &self.joint_torques);
+        let mut progress = self.start_run();
+        for k in 0..=progress.samples {
+            let last = k == progress.samples;
+            let taken = self
+                .take_sample()
+                .and_then(|()| {
+                    if last {
+                        self.acceleration()
+                    } else {
+                        self.integrate()
                     }
-                    Err(error) => return Err(fail(error, record, &metrics, steps, rejected)),
-                }
-            }
-            if let Some((i, error)) = runaway {
-                let error = SimError::RunawayError {
-                    t,
-                    coordinate: i + 1,
-                    error,
-                    bound: max_error,
-                };
-                return Err(fail(error, record, &metrics, steps, rejected));
+                })
+                .and_then(|()| self.conclude_sample(&mut progress, k));
+            if let Err(error) = taken {
+                return Err(progress.fail(error));
             }
         }
-        Ok(Run {
-            record,
-            summary: metrics.summary(steps, rejected),
-        })
+        Ok(progress.finish())
+    }
+
+    /// Resets the loop and sizes what a [`run`](Self::run) accumulates.
+    fn start_run(&mut self) -> Progress {
+        self.reset();
+        let s = &self.settings;
+        let (samples, record_every) = sample_counts(s);
+        let (m, n) = (self.n_coords(), self.plant.model.n_links());
+        Progress {
+            record: Record::with_capacity(m, n, recorded_samples(s)),
+            metrics: Metrics::new(m, n, s.joint_torque_limits.clone()),
+            steps: 0,
+            rejected: 0,
+            samples,
+            record_every,
+        }
+    }
+
+    /// Adds sample `k` of a run, taken and then integrated (or, the last, given its
+    /// acceleration), to `progress`: its control to the metrics, the sample to the record every
+    /// recording period (and the last and a runaway one, [`observe`](Self::observe)), then the
+    /// runaway check.
+    fn conclude_sample(&mut self, progress: &mut Progress, k: usize) -> Result<(), SimError> {
+        let last = k == progress.samples;
+        let m = self.n_coords();
+        let max_error = self.settings.max_modal_error;
+        let sample = &self.sample;
+        let t = sample.t;
+        progress.steps += sample.steps.0;
+        progress.rejected += sample.steps.1;
+        let held = if last {
+            0.0
+        } else {
+            self.settings.controller_period
+        };
+        progress
+            .metrics
+            .add_control(t, &sample.tau_star, &sample.clamped, held);
+        let runaway = (0..m)
+            .map(|i| (i, (sample.state.a[i] - sample.reference.a[i]).abs()))
+            .find(|&(_, e)| e > max_error || e.is_nan());
+        if k.is_multiple_of(progress.record_every) || last || runaway.is_some() {
+            let observation = self.observe()?;
+            let (tip, tip_ref) = (observation.tip, observation.tip_ref);
+            let sample = &self.sample;
+            let row = Sample {
+                t,
+                a: &sample.state.a,
+                a_dot: &sample.state.a_dot,
+                a_ref: &sample.reference.a,
+                a_ref_dot: &sample.reference.a_dot,
+                a_cmd: &sample.command.a,
+                tau_star: &sample.tau_star,
+                clamped: &sample.clamped,
+                tip,
+                tip_ref,
+            };
+            progress.metrics.add(&row, &self.joint_torques);
+            progress.record.push(&row, &self.joint_torques);
+        }
+        match runaway {
+            Some((i, error)) => Err(SimError::RunawayError {
+                t,
+                coordinate: i + 1,
+                error,
+                bound: max_error,
+            }),
+            None => Ok(()),
+        }
     }
 
     /// The controller sample at the current time: state, reference, noise, `tau*` (into
@@ -601,27 +645,30 @@ impl Simulation {
     /// Integrates from the sample just taken to the next one under its held `tau*`; the
     /// integrator's first stage is the acceleration at the sample.
     fn integrate(&mut self) -> Result<(), SimError> {
-        let m = self.n_coords();
         let t = self.sample.t;
-        let period = self.settings.controller_period;
+        let t1 = t + self.settings.controller_period;
         let plant = &mut self.plant;
-        let (stats, start) = match &mut self.stepper {
-            Stepper::Rk4(rk4, dt) => {
-                let stats = rk4.integrate(plant, t, t + period, &mut self.y, *dt);
-                (stats, rk4.start_derivative())
-            }
-            Stepper::DormandPrince(dp) => {
-                let stats = dp.integrate(plant, t, t + period, &mut self.y);
-                (stats, dp.start_derivative())
-            }
+        let stats = match &mut self.stepper {
+            Stepper::Rk4(rk4, dt) => rk4.integrate(plant, t, t1, &mut self.y, *dt),
+            Stepper::DormandPrince(dp) => dp.integrate(plant, t, t1, &mut self.y),
         };
-        let stats = stats.map_err(SimError::Integration)?;
+        self.advance(stats.map_err(SimError::Integration)?);
+        Ok(())
+    }
+
+    /// Moves the loop to the next sample once the integrator has brought `y` there with `stats`:
+    /// the sample gets its acceleration (the integrator's first stage) and step counts.
+    fn advance(&mut self, stats: Stats) {
+        let m = self.n_coords();
+        let start = match &self.stepper {
+            Stepper::Rk4(rk4, _) => rk4.start_derivative(),
+            Stepper::DormandPrince(dp) => dp.start_derivative(),
+        };
         self.sample.a_ddot.copy_from_slice(&start[m..]);
         self.sample.steps = (stats.accepted, stats.rejected);
         self.taken += 1;
         self.current.a.copy_from_slice(&self.y[..m]);
         self.current.a_dot.copy_from_slice(&self.y[m..]);
-        Ok(())
     }
 
     /// The acceleration at the sample just taken under its `tau*`, without integrating.

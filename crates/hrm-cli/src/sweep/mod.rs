@@ -14,7 +14,9 @@ mod report;
 use crate::console;
 use crate::output_dir::{self, OutputDir};
 use clap::{Args, Subcommand};
-use sim_core::study::{self, Cell, CellBuilder, Shard, ShardHeader, ShardReader, SweepConfig};
+use sim_core::study::{
+    self, Cell, CellBuilder, Shard, ShardHeader, ShardReader, SweepConfig, SweepSettings,
+};
 use sim_core::{ControllerKind, Scenario};
 use std::path::{Path, PathBuf};
 
@@ -137,8 +139,7 @@ const MAX_NOISE_LEVELS: usize = 1000;
 const MAX_SEEDS: usize = 1_000_000;
 
 /// The command line's counts checked before anything is built: `--seeds` and `--base-seed` in
-/// range, at most [`MAX_NOISE_LEVELS`] noise levels, no controller twice, at most
-/// [`study::MAX_RUNS`] runs.
+/// range, at most [`MAX_NOISE_LEVELS`] noise levels, at most [`study::MAX_RUNS`] runs.
 fn check_counts(args: &SweepArgs) -> Result<(usize, u64), String> {
     let seeds = crate::args::count("--seeds", args.seeds, 1, MAX_SEEDS)?;
     let base_seed = crate::args::count("--base-seed", args.base_seed, 0, usize::MAX)? as u64;
@@ -147,11 +148,6 @@ fn check_counts(args: &SweepArgs) -> Result<(usize, u64), String> {
             "--noise lists {} levels, more than the {MAX_NOISE_LEVELS} a sweep takes",
             args.noise.len()
         ));
-    }
-    for (k, c) in args.controllers.iter().enumerate() {
-        if args.controllers[..k].contains(c) {
-            return Err(format!("--controllers lists {c} twice"));
-        }
     }
     let runs = args.noise.len() * args.controllers.len() * seeds;
     if runs > study::MAX_RUNS {
@@ -166,22 +162,25 @@ fn check_counts(args: &SweepArgs) -> Result<(usize, u64), String> {
     Ok((seeds, base_seed))
 }
 
-/// The sweep's configuration: the scenario resolved, the duration applied, everything
-/// checked, and every controller's simulation built once so that a bad setting fails here
-/// rather than in every run.
+/// The option of `hrm sweep` that sets a [`SweepSettings`] field.
+fn option(setting: &str) -> &str {
+    match setting {
+        "controllers" => "--controllers",
+        "noise_levels" => "--noise",
+        "rate_noise_ratio" => "--rate-noise-ratio",
+        "reference_noise_ratio" => "--reference-noise-ratio",
+        "seeds" => "--seeds",
+        "base_seed" => "--base-seed",
+        other => other,
+    }
+}
+
+/// The sweep's configuration ([`SweepConfig::new`]): the scenario resolved, the duration
+/// applied, everything checked (a refused setting named by its option), and every controller's
+/// simulation built once so that a bad setting fails here rather than in every run.
 fn configure(args: &SweepArgs) -> Result<SweepConfig, String> {
     let (seeds, base_seed) = check_counts(args)?;
-    let mut scenario = Scenario::resolve(&args.scenario).map_err(|e| e.to_string())?;
-    if let Some(duration) = args.duration {
-        scenario.duration = duration;
-    }
-    scenario.noise = Default::default();
-    scenario.seed = 0;
-    study::check_json_safe(&scenario)?;
-    let config = SweepConfig {
-        hrm_version: study::VERSION.to_string(),
-        inputs: study::input_digests(&scenario)?,
-        scenario,
+    let settings = SweepSettings {
         controllers: args.controllers.clone(),
         noise_levels: args.noise.clone(),
         rate_noise_ratio: args.rate_noise_ratio,
@@ -189,9 +188,14 @@ fn configure(args: &SweepArgs) -> Result<SweepConfig, String> {
         seeds,
         base_seed,
     };
-    config.validate()?;
-    config.check_builds()?;
-    Ok(config)
+    settings
+        .check()
+        .map_err(|e| format!("{} {}", option(e.setting), e.problem))?;
+    let mut scenario = Scenario::resolve(&args.scenario).map_err(|e| e.to_string())?;
+    if let Some(duration) = args.duration {
+        scenario.duration = duration;
+    }
+    SweepConfig::new(scenario, settings)
 }
 
 /// Runs the runs of `shard` with a progress bar, writing its shard file to `out` as they finish

@@ -82,6 +82,16 @@ fn the_command_line_parses_with_defaults_and_merge() {
     assert_eq!(a.controllers, ControllerKind::ALL);
     assert_eq!(a.noise, [0.0, 0.005, 0.01, 0.02, 0.05, 0.1]);
     assert_eq!((a.seeds, a.base_seed, a.shard), (10, 1, None));
+    // The library's defaults are the command's.
+    let defaults = SweepSettings::default();
+    assert_eq!(a.controllers, defaults.controllers);
+    assert_eq!(a.noise, defaults.noise_levels);
+    assert_eq!(a.rate_noise_ratio, defaults.rate_noise_ratio);
+    assert_eq!(a.reference_noise_ratio, defaults.reference_noise_ratio);
+    assert_eq!(
+        (a.seeds, a.base_seed),
+        (defaults.seeds as i128, defaults.base_seed as i128)
+    );
     let cli = parse(&["--controllers", "pd,fuzzy-gc", "--shard", "2/5"]).unwrap();
     assert_eq!(
         cli.sweep.controllers,
@@ -110,6 +120,23 @@ fn bad_settings_are_refused_before_running() {
     // 0.00015 s is not a whole number of the 1e-4 s controller periods.
     let err = hrm_sweep(&with(SMALL, &["--duration", "0.00015", "--out", out])).unwrap_err();
     assert!(err.contains("duration"), "{err}");
+    // The library's refusals, named by the option.
+    let err = hrm_sweep(&with(SMALL, &["--noise", "0.01,0", "--out", out])).unwrap_err();
+    assert!(
+        err.starts_with("--noise must be distinct and ascending"),
+        "{err}"
+    );
+    let err = hrm_sweep(&with(SMALL, &["--rate-noise-ratio", "-1", "--out", out])).unwrap_err();
+    assert_eq!(
+        err,
+        "--rate-noise-ratio must be finite and non-negative, got -1"
+    );
+    let err = hrm_sweep(&with(
+        SMALL,
+        &["--controllers", "pd,fuzzy,pd", "--out", out],
+    ))
+    .unwrap_err();
+    assert_eq!(err, "--controllers lists pd twice");
 }
 
 /// The acceptance test of sharding: three shards merged give exactly the unsharded report.
@@ -195,7 +222,7 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
     write(&cut_path, &empty.to_json().unwrap()).unwrap();
     let err = merge(&[shard(1), cut_path.clone(), shard(3)]);
     assert!(
-        err.contains("invalid sweep configuration: --seeds"),
+        err.contains("invalid sweep configuration: seeds must be at least 1"),
         "{err}"
     );
     // Counts no sweep could have are refused before anything is sized by them.

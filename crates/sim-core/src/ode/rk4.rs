@@ -2,6 +2,10 @@
 
 use super::{OdeError, OdeSystem, Stats, check_call, combine, eval};
 
+/// The nodes `c_s` of the classical tableau: stage `s` is evaluated at `t + c_s h` and
+/// `y + h c_s k_{s-1}` (the first at `(t, y)` itself).
+const NODES: [f64; Rk4::STAGES] = [0.0, 0.5, 0.5, 1.0];
+
 /// Classical RK4 with preallocated stages: four right-hand side evaluations per step, global
 /// error `O(h^4)`.
 ///
@@ -28,6 +32,9 @@ pub struct Rk4 {
 }
 
 impl Rk4 {
+    /// The stages of one step (right-hand side evaluations).
+    pub(crate) const STAGES: usize = 4;
+
     /// An integrator for states of `dim` numbers.
     pub fn new(dim: usize) -> Self {
         Self {
@@ -58,16 +65,46 @@ impl Rk4 {
         y: &mut [f64],
         max_step: f64,
     ) -> Result<Stats, OdeError<S::Error>> {
+        let mut stats = Stats::default();
+        let Some((steps, h)) = self.begin(t0, t1, y, max_step)? else {
+            return Ok(stats);
+        };
+        for i in 0..steps {
+            let t = Self::step_time(t0, i, h);
+            for s in 0..Self::STAGES {
+                let (t_s, y_s, k_s) = self.stage(s, t, y, h);
+                eval(system, t_s, y_s, k_s, &mut stats)?;
+            }
+            stats.accepted += 1;
+            self.finish_step(i, t, y, h)?;
+        }
+        Ok(stats)
+    }
+
+    /// Checks an integration of `y` from `t0` to `t1` in steps no longer than `max_step`, and
+    /// plans it: the number of equal steps and their size, `None` for an empty interval.
+    ///
+    /// [`integrate`](Self::integrate) is `begin`, then for each step `i` the [`STAGES`](Self::STAGES)
+    /// [`stage`](Self::stage)s from [`step_time`](Self::step_time)`(t0, i, h)` with their
+    /// derivatives evaluated, then [`finish_step`](Self::finish_step); a lock-step group of
+    /// runs (`crate::Lockstep`) drives the same calls for each of its runs, evaluating a stage
+    /// of all of them at once.
+    pub(crate) fn begin<E>(
+        &self,
+        t0: f64,
+        t1: f64,
+        y: &[f64],
+        max_step: f64,
+    ) -> Result<Option<(usize, f64)>, OdeError<E>> {
         check_call(self.dim(), y, t0, t1)?;
         if !(max_step.is_finite() && max_step > 0.0) {
             return Err(OdeError::InvalidSetting(
                 "the RK4 step must be positive and finite",
             ));
         }
-        let mut stats = Stats::default();
         let span = t1 - t0;
         if span == 0.0 {
-            return Ok(stats);
+            return Ok(None);
         }
         // A relative slack keeps `span / max_step = 1 + 1e-12` (the rounding of `t1 - t0` far from
         // the origin) from costing a second step; a step that much longer is harmless.
@@ -78,42 +115,61 @@ impl Rk4 {
             ));
         }
         let steps = steps as usize;
-        let h = span / steps as f64;
-        for i in 0..steps {
-            let t = if i == 0 { t0 } else { t0 + i as f64 * h };
-            self.step(system, t, y, h, &mut stats)?;
-            if i == 0 {
-                self.start.copy_from_slice(&self.k[0]);
-            }
-        }
-        Ok(stats)
+        Ok(Some((steps, span / steps as f64)))
     }
 
-    /// One RK4 step of size `h` from `(t, y)`.
-    fn step<S: OdeSystem>(
+    /// The start of step `i` of size `h` of an integration from `t0`.
+    pub(crate) fn step_time(t0: f64, i: usize, h: f64) -> f64 {
+        if i == 0 { t0 } else { t0 + i as f64 * h }
+    }
+
+    /// Stage `s` (`0..STAGES`) of the step of size `h` from `(t, y)`, the stages before it
+    /// evaluated: its time `t + c_s h`, its state (`y` itself for the first stage, else
+    /// `y + h c_s k_{s-1}`, in the stage buffer) and the buffer its derivative `k_s` goes into.
+    pub(crate) fn stage<'a>(
+        &'a mut self,
+        s: usize,
+        t: f64,
+        y: &'a [f64],
+        h: f64,
+    ) -> (f64, &'a [f64], &'a mut [f64]) {
+        let (done, next) = self.k.split_at_mut(s);
+        match done.last() {
+            None => (t, y, &mut next[0]),
+            Some(previous) => {
+                combine(&mut self.stage, y, h, &[NODES[s]], &[previous]);
+                (t + NODES[s] * h, &self.stage, &mut next[0])
+            }
+        }
+    }
+
+    /// The derivative buffer `k_s` of stage `s`, for a caller that evaluates it after
+    /// [`stage`](Self::stage) has returned.
+    pub(crate) fn derivative_mut(&mut self, s: usize) -> &mut [f64] {
+        &mut self.k[s]
+    }
+
+    /// Completes step `i` of size `h` from `(t, y)` once its [`STAGES`](Self::STAGES) derivatives are in:
+    /// `y += h/6 (k1 + 2 (k2 + k3) + k4)`, and after the first step of an integration its first
+    /// derivative becomes the [`start_derivative`](Self::start_derivative). Fails if the new
+    /// state is not finite.
+    pub(crate) fn finish_step<E>(
         &mut self,
-        system: &mut S,
+        i: usize,
         t: f64,
         y: &mut [f64],
         h: f64,
-        stats: &mut Stats,
-    ) -> Result<(), OdeError<S::Error>> {
-        let [k1, k2, k3, k4] = &mut self.k;
-        let stage = &mut self.stage;
-        eval(system, t, y, k1, stats)?;
-        combine(stage, y, h, &[0.5], &[k1]);
-        eval(system, t + 0.5 * h, stage, k2, stats)?;
-        combine(stage, y, h, &[0.5], &[k2]);
-        eval(system, t + 0.5 * h, stage, k3, stats)?;
-        combine(stage, y, h, &[1.0], &[k3]);
-        eval(system, t + h, stage, k4, stats)?;
+    ) -> Result<(), OdeError<E>> {
+        let [k1, k2, k3, k4] = &self.k;
         let sixth = h / 6.0;
         for (j, yj) in y.iter_mut().enumerate() {
             *yj += sixth * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);
         }
-        stats.accepted += 1;
         if y.iter().any(|v| !v.is_finite()) {
             return Err(OdeError::NonFinite { t });
+        }
+        if i == 0 {
+            self.start.copy_from_slice(k1);
         }
         Ok(())
     }

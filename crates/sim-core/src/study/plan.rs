@@ -58,36 +58,185 @@ pub struct RunId {
     pub seed: u64,
 }
 
+/// What a sweep varies and how many noise realisations it draws: the options of `hrm sweep` and
+/// the keywords of `hrm.Sweep`, which [`SweepConfig::new`] checks and turns into a sweep. The
+/// [`Default`] is `hrm sweep`'s.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepSettings {
+    /// The controllers compared, in table order, each once.
+    pub controllers: Vec<ControllerKind>,
+    /// The noise levels `L`, distinct and ascending: the sensor noise standard deviation on every
+    /// modal coordinate (rad).
+    pub noise_levels: Vec<f64>,
+    /// Sensor noise on every modal rate per unit of noise level (rad/s per rad, i.e. 1/s).
+    pub rate_noise_ratio: f64,
+    /// Noise on every coordinate of the reference per unit of noise level.
+    pub reference_noise_ratio: f64,
+    /// Noise realisations per (noise level, controller) cell, at least 1.
+    pub seeds: usize,
+    /// The seed every run's seed derives from ([`run_seed`]).
+    pub base_seed: u64,
+}
+
+impl Default for SweepSettings {
+    /// `hrm sweep`'s defaults: every controller, noise levels 0, 0.005, 0.01, 0.02, 0.05 and
+    /// 0.1 rad, rate noise ratio 10, no reference noise, 10 seeds from base seed 1.
+    fn default() -> Self {
+        Self {
+            controllers: ControllerKind::ALL.to_vec(),
+            noise_levels: vec![0.0, 0.005, 0.01, 0.02, 0.05, 0.1],
+            rate_noise_ratio: 10.0,
+            reference_noise_ratio: 0.0,
+            seeds: 10,
+            base_seed: 1,
+        }
+    }
+}
+
+/// A sweep setting out of its domain: the setting (a field of [`SweepSettings`]) and what is
+/// wrong with it, written `"{setting} {problem}"` (e.g. "seeds must be at least 1"); a front end
+/// may name it its own way (`hrm sweep` writes its option, "--seeds must be at least 1").
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{setting} {problem}")]
+pub struct SettingError {
+    /// The setting's name, as in [`SweepSettings`].
+    pub setting: &'static str,
+    /// What is wrong, a phrase that follows the name.
+    pub problem: String,
+}
+
+impl SettingError {
+    fn new(setting: &'static str, problem: impl Into<String>) -> Self {
+        Self {
+            setting,
+            problem: problem.into(),
+        }
+    }
+}
+
+impl SweepSettings {
+    /// Checks the settings: at least one controller and none twice, at least one noise level,
+    /// all finite, non-negative, distinct and ascending, finite non-negative ratios, at least one
+    /// seed, and at most [`MAX_RUNS`] runs.
+    pub fn check(&self) -> Result<(), SettingError> {
+        if self.controllers.is_empty() {
+            return Err(SettingError::new(
+                "controllers",
+                "must name at least one controller",
+            ));
+        }
+        for (k, c) in self.controllers.iter().enumerate().skip(1) {
+            if self.controllers[..k].contains(c) {
+                return Err(SettingError::new("controllers", format!("lists {c} twice")));
+            }
+        }
+        if self.noise_levels.is_empty() {
+            return Err(SettingError::new(
+                "noise_levels",
+                "must hold at least one noise level",
+            ));
+        }
+        if let Some(bad) = self
+            .noise_levels
+            .iter()
+            .find(|l| !(l.is_finite() && **l >= 0.0))
+        {
+            return Err(SettingError::new(
+                "noise_levels",
+                format!("must be finite and non-negative, got {bad}"),
+            ));
+        }
+        if self.noise_levels.windows(2).any(|w| w[0] >= w[1]) {
+            return Err(SettingError::new(
+                "noise_levels",
+                format!(
+                    "must be distinct and ascending, got {:?}",
+                    self.noise_levels
+                ),
+            ));
+        }
+        for (name, ratio) in [
+            ("rate_noise_ratio", self.rate_noise_ratio),
+            ("reference_noise_ratio", self.reference_noise_ratio),
+        ] {
+            if !(ratio.is_finite() && ratio >= 0.0) {
+                return Err(SettingError::new(
+                    name,
+                    format!("must be finite and non-negative, got {ratio}"),
+                ));
+            }
+        }
+        if self.seeds == 0 {
+            return Err(SettingError::new("seeds", "must be at least 1"));
+        }
+        let runs = self
+            .noise_levels
+            .len()
+            .checked_mul(self.controllers.len())
+            .and_then(|cells| cells.checked_mul(self.seeds));
+        match runs {
+            Some(runs) if runs <= MAX_RUNS => Ok(()),
+            _ => Err(SettingError::new(
+                "seeds",
+                format!(
+                    "= {} with {} noise levels x {} controllers makes more than the {MAX_RUNS} \
+                     runs allowed",
+                    self.seeds,
+                    self.noise_levels.len(),
+                    self.controllers.len()
+                ),
+            )),
+        }
+    }
+}
+
 impl SweepConfig {
-    /// A sweep of `scenario` (its noise and seed are replaced per run) over `controllers`,
-    /// sensor noise levels `noise_levels` (rad; rate noise 10 L rad/s, no reference noise, as
-    /// `hrm sweep`'s defaults) and `seeds` realisations from `base_seed`, with the digests of its
-    /// inputs; checked by [`validate`](Self::validate) and [`check_builds`](Self::check_builds).
-    pub fn new(
-        scenario: Scenario,
-        controllers: Vec<ControllerKind>,
-        noise_levels: Vec<f64>,
-        seeds: usize,
-        base_seed: u64,
-    ) -> Result<Self, String> {
+    /// The sweep of `scenario` (its duration applies; its noise and seed are cleared, then set
+    /// per run) under `settings`, with the SHA-256 of its inputs: `settings` are checked
+    /// ([`SweepSettings::check`]), then the scenario ([`validate`](Self::validate): every setting
+    /// JSON can hold), and every controller's simulation is built once
+    /// ([`check_builds`](Self::check_builds)), so a bad setting fails here rather than in every
+    /// run. The one constructor of a checked sweep: `hrm sweep` and `hrm.Sweep` call it.
+    pub fn new(scenario: Scenario, settings: SweepSettings) -> Result<Self, String> {
+        settings.check().map_err(|e| e.to_string())?;
         let mut scenario = scenario;
         scenario.noise = NoiseSpec::default();
         scenario.seed = 0;
         inputs::check_json_safe(&scenario)?;
+        let SweepSettings {
+            controllers,
+            noise_levels,
+            rate_noise_ratio,
+            reference_noise_ratio,
+            seeds,
+            base_seed,
+        } = settings;
         let config = SweepConfig {
             hrm_version: super::VERSION.to_string(),
             inputs: inputs::input_digests(&scenario)?,
             scenario,
             controllers,
             noise_levels,
-            rate_noise_ratio: 10.0,
-            reference_noise_ratio: 0.0,
+            rate_noise_ratio,
+            reference_noise_ratio,
             seeds,
             base_seed,
         };
         config.validate()?;
         config.check_builds()?;
         Ok(config)
+    }
+
+    /// The settings of the sweep.
+    pub fn settings(&self) -> SweepSettings {
+        SweepSettings {
+            controllers: self.controllers.clone(),
+            noise_levels: self.noise_levels.clone(),
+            rate_noise_ratio: self.rate_noise_ratio,
+            reference_noise_ratio: self.reference_noise_ratio,
+            seeds: self.seeds,
+            base_seed: self.base_seed,
+        }
     }
 
     /// Builds the simulation of the first run of each controller at the largest noise level, so
@@ -106,57 +255,15 @@ impl SweepConfig {
         Ok(())
     }
 
-    /// Checks the numbers that the scenario itself does not check, that every scenario setting
-    /// survives JSON ([`check_json_safe`](super::check_json_safe)) and that
-    /// [`inputs`](Self::inputs) lists the scenario, with the digest of its content, and the
-    /// files it references ([`check_digests`](super::check_digests)).
+    /// Checks that every scenario setting survives JSON
+    /// ([`check_json_safe`](super::check_json_safe)), that [`inputs`](Self::inputs) lists the
+    /// scenario, with the digest of its content, and the files it references
+    /// ([`check_digests`](super::check_digests)), and the [`settings`](Self::settings)
+    /// ([`SweepSettings::check`]): for a configuration read back from a shard file or JSON.
     pub fn validate(&self) -> Result<(), String> {
         inputs::check_json_safe(&self.scenario)?;
         inputs::check_digests(&self.scenario, &self.inputs)?;
-        if self.controllers.is_empty() {
-            return Err("--controllers: at least one controller is needed".into());
-        }
-        if self.noise_levels.is_empty() {
-            return Err("--noise: at least one noise level is needed".into());
-        }
-        if let Some(bad) = self
-            .noise_levels
-            .iter()
-            .find(|l| !(l.is_finite() && **l >= 0.0))
-        {
-            return Err(format!(
-                "--noise: noise levels must be finite and non-negative, got {bad}"
-            ));
-        }
-        if self.noise_levels.windows(2).any(|w| w[0] >= w[1]) {
-            return Err(format!(
-                "--noise: noise levels must be distinct and ascending, got {:?}",
-                self.noise_levels
-            ));
-        }
-        for (name, ratio) in [
-            ("--rate-noise-ratio", self.rate_noise_ratio),
-            ("--reference-noise-ratio", self.reference_noise_ratio),
-        ] {
-            if !(ratio.is_finite() && ratio >= 0.0) {
-                return Err(format!(
-                    "{name} must be finite and non-negative, got {ratio}"
-                ));
-            }
-        }
-        if self.seeds == 0 {
-            return Err("--seeds must be at least 1".into());
-        }
-        match self.runs() {
-            Some(runs) if runs <= MAX_RUNS => Ok(()),
-            _ => Err(format!(
-                "the sweep has {} noise levels x {} controllers x {} seeds, more than the \
-                 {MAX_RUNS} runs allowed",
-                self.noise_levels.len(),
-                self.controllers.len(),
-                self.seeds
-            )),
-        }
+        self.settings().check().map_err(|e| e.to_string())
     }
 
     /// Number of runs: noise levels x controllers x seeds (`None` on overflow).
@@ -353,27 +460,83 @@ mod tests {
     }
 
     #[test]
-    fn invalid_configurations_are_refused() {
+    fn invalid_configurations_are_refused_naming_the_setting() {
         let mut c = config(2, 2, 2);
         assert!(c.validate().is_ok());
         c.noise_levels[1] = -1.0;
-        assert!(c.validate().unwrap_err().contains("non-negative, got -1"));
+        let err = c.validate().unwrap_err();
+        assert_eq!(err, "noise_levels must be finite and non-negative, got -1");
         c.noise_levels[1] = f64::NAN;
         assert!(c.validate().unwrap_err().contains("got NaN"));
         c.noise_levels = vec![0.01, 0.0];
-        assert!(c.validate().unwrap_err().contains("ascending"));
+        let err = c.validate().unwrap_err();
+        assert!(err.starts_with("noise_levels must be distinct and ascending"));
         let mut c = config(2, 2, 0);
-        assert!(c.validate().unwrap_err().contains("--seeds"));
+        assert_eq!(c.validate().unwrap_err(), "seeds must be at least 1");
         c.seeds = 1;
         c.rate_noise_ratio = f64::INFINITY;
-        assert!(c.validate().unwrap_err().contains("--rate-noise-ratio"));
-        assert!(config(0, 2, 1).validate().unwrap_err().contains("--noise"));
-        assert!(
-            config(1, 0, 1)
-                .validate()
-                .unwrap_err()
-                .contains("--controllers")
+        let err = c.validate().unwrap_err();
+        assert_eq!(
+            err,
+            "rate_noise_ratio must be finite and non-negative, got inf"
         );
+        let err = config(0, 2, 1).validate().unwrap_err();
+        assert_eq!(err, "noise_levels must hold at least one noise level");
+        let err = config(1, 0, 1).validate().unwrap_err();
+        assert_eq!(err, "controllers must name at least one controller");
+        let mut twice = config(1, 3, 1);
+        twice.controllers[2] = twice.controllers[0];
+        let err = twice.validate().unwrap_err();
+        assert_eq!(
+            err,
+            format!("controllers lists {} twice", twice.controllers[0])
+        );
+        let err = config(2, 2, MAX_RUNS).validate().unwrap_err();
+        assert!(err.starts_with("seeds = 10000000 with 2 noise levels x 2 controllers makes more than the 10000000 runs"), "{err}");
+        // The error says which setting, for a front end to name it its own way.
+        let settings = SweepSettings {
+            seeds: 0,
+            ..SweepSettings::default()
+        };
+        let err = settings.check().unwrap_err();
+        assert_eq!(
+            (err.setting, err.problem.as_str()),
+            ("seeds", "must be at least 1")
+        );
+    }
+
+    #[test]
+    fn the_constructor_checks_the_settings_then_the_scenario_and_clears_its_noise() {
+        let mut scenario = Scenario::builtin("paper-responses-step").unwrap();
+        scenario.seed = 77;
+        scenario.noise = NoiseSpec::uniform(2, 0.1, 0.0, 0.0);
+        let settings = SweepSettings {
+            controllers: vec![ControllerKind::Pd, ControllerKind::Fuzzy],
+            noise_levels: vec![0.0, 0.01],
+            seeds: 3,
+            base_seed: 5,
+            reference_noise_ratio: 0.5,
+            ..SweepSettings::default()
+        };
+        let config = SweepConfig::new(scenario.clone(), settings.clone()).unwrap();
+        assert_eq!(config.settings(), settings);
+        assert_eq!(
+            (config.scenario.seed, &config.scenario.noise),
+            (0, &NoiseSpec::default())
+        );
+        assert_eq!(
+            config.inputs,
+            inputs::input_digests(&config.scenario).unwrap()
+        );
+        let twice = SweepSettings {
+            controllers: vec![ControllerKind::Pd, ControllerKind::Pd],
+            ..settings.clone()
+        };
+        let err = SweepConfig::new(scenario.clone(), twice).unwrap_err();
+        assert_eq!(err, "controllers lists pd twice");
+        scenario.duration = 0.00015;
+        let err = SweepConfig::new(scenario, settings).unwrap_err();
+        assert!(err.contains("duration"), "{err}");
     }
 
     #[test]

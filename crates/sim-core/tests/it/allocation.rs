@@ -78,3 +78,35 @@ fn allocations_do_not_grow_with_the_number_of_steps() {
         }
     }
 }
+
+/// A lock-step group allocates per run, never per step: stepping it by hand allocates nothing,
+/// and a whole run of the group as much for 0.05 s as for 0.5 s.
+#[test]
+fn lock_step_groups_allocate_nothing_per_step() {
+    assert!(is_counting());
+    let group = |duration: f64| {
+        let runs = (0..11)
+            .map(|seed| {
+                let mut scenario = Scenario::builtin("paper-tracking").unwrap();
+                scenario.duration = duration;
+                scenario.seed = seed;
+                scenario.noise.sensor_a_std = Some(vec![1e-3, 1e-3]);
+                scenario.build().unwrap()
+            })
+            .collect();
+        sim_core::Lockstep::new(runs).unwrap()
+    };
+    let mut stepped = group(0.5);
+    stepped.step();
+    let count = allocations_during(|| {
+        for _ in 0..100 {
+            assert_eq!(stepped.step(), 11);
+        }
+    });
+    assert_eq!(count, 0);
+    let (mut short, mut long) = (group(0.05), group(0.5));
+    let runs = |g: &mut sim_core::Lockstep| {
+        allocations_during(|| assert!(g.run().iter().all(Result::is_ok)))
+    };
+    assert_eq!(runs(&mut short), runs(&mut long));
+}

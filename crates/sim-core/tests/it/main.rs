@@ -2,7 +2,8 @@
 //! `reference`, `controller`, `optimal`, `mpc` for control-limited iLQR and MPC), the closed loop (`closed_loop`, `energy`, `replay` on
 //! the full chain, `imitation` for the controller learned from computed torque, `long_runs`,
 //! `paper_pinned` for the paper's figures), `scenario_fuzz` for scenario files,
-//! `scenario_controller` for a scenario closed by an outside controller, `bad_input` for every
+//! `scenario_controller` for a scenario closed by an outside controller, `lockstep` for
+//! groups of runs stepped together against the runs alone, `bad_input` for every
 //! refusal and `allocation` for the allocation-free loop.
 
 // Counts each thread's allocations; the allocation tests measure their own thread only, so the
@@ -16,6 +17,7 @@ mod closed_loop;
 mod controller;
 mod energy;
 mod imitation;
+mod lockstep;
 mod long_runs;
 mod mpc;
 mod ode;
