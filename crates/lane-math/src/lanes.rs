@@ -253,12 +253,17 @@ mod tests {
             let width = Pack::<S>::WIDTH;
             for start in 0..VALUES.len() {
                 let a: Vec<f64> = (0..width).map(|i| VALUES[(start + i) % 12]).collect();
-                let b: Vec<f64> = (0..width).map(|i| VALUES[(start + 5 * i + 1) % 12]).collect();
+                let b: Vec<f64> = (0..width)
+                    .map(|i| VALUES[(start + 5 * i + 1) % 12])
+                    .collect();
                 let (pa, pb) = (Pack::load(simd, &a), Pack::load(simd, &b));
                 let mut out = vec![0.0; width];
                 let square = |x: f64| x * x - 1.0;
                 for (op, expect) in [
-                    (pa.abs(), &(|x: f64, _: f64| Lane::abs(x)) as &dyn Fn(f64, f64) -> f64),
+                    (
+                        pa.abs(),
+                        &(|x: f64, _: f64| Lane::abs(x)) as &dyn Fn(f64, f64) -> f64,
+                    ),
                     (pa.min(pb), &|x: f64, y: f64| Lane::min(x, y)),
                     (pa.max(pb), &|x: f64, y: f64| Lane::max(x, y)),
                     (pa.map(square), &|x: f64, _: f64| Lane::map(x, square)),
