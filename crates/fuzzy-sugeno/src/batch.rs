@@ -29,7 +29,7 @@ const MAX_WIDTH: usize = 8;
 /// construction.
 #[derive(Debug, Clone)]
 pub(crate) struct BatchWorkspace {
-    work: Workspace,
+    work: Workspace<MAX_WIDTH>,
     arch: Arch,
 }
 
@@ -37,7 +37,7 @@ impl BatchWorkspace {
     /// Buffers for a group of points of `system`.
     pub(crate) fn new(system: &FuzzySystem) -> Self {
         Self {
-            work: Workspace::new(system, MAX_WIDTH),
+            work: Workspace::new(system),
             arch: Arch::new(),
         }
     }
@@ -69,7 +69,7 @@ impl BatchWorkspace {
 struct Batch<'a, F> {
     system: &'a FuzzySystem,
     options: &'a EvalOptions,
-    work: &'a mut Workspace,
+    work: &'a mut Workspace<MAX_WIDTH>,
     inputs: &'a [f64],
     outputs: &'a mut [f64],
     point: F,
@@ -107,27 +107,32 @@ impl<F: FnMut(&[f64], &mut [f64]) -> Result<(), FuzzyError>> Batch<'_, F> {
         for (lane, row) in rows.chunks_exact(n_in).enumerate() {
             for (i, &value) in row.iter().enumerate() {
                 match load_input(self.system, self.options, i, value) {
-                    Ok(x) => self.work.x[i * MAX_WIDTH + lane] = x,
+                    Ok(x) => self.work.x[i][lane] = x,
                     Err(_) => return false,
                 }
             }
         }
         let (c, methods) = (self.system.compiled(), self.system.methods());
         let mut slots = self.work.slots();
-        kernel::fire::<Pack<S>>(simd, c, methods.and, methods.or, &mut slots);
-        kernel::sums::<Pack<S>>(simd, c, &mut slots);
-        let (sums, y) = (&self.work.sums, &mut self.work.y);
-        for lane in 0..width {
-            for o in 0..n_out {
-                let weighted = sums[2 * o * MAX_WIDTH + lane];
-                let total = sums[(2 * o + 1) * MAX_WIDTH + lane];
-                match output_value(self.system, self.options, o, weighted, total) {
-                    Ok(value) => y[lane * n_out + o] = value,
+        kernel::fire::<Pack<S>, MAX_WIDTH>(simd, c, methods.and, methods.or, &mut slots);
+        kernel::sums::<Pack<S>, MAX_WIDTH>(simd, c, &mut slots);
+        // Every output of the group is checked before the first is written; each replaces its
+        // weighted sum.
+        for (o, pair) in self.work.sums.chunks_exact_mut(2).enumerate() {
+            let (weighted, total) = pair.split_at_mut(1);
+            for (value, &total) in weighted[0][..width].iter_mut().zip(&total[0][..width]) {
+                match output_value(self.system, self.options, o, *value, total) {
+                    Ok(output) => *value = output,
                     Err(_) => return false,
                 }
             }
         }
-        self.outputs[first * n_out..(first + width) * n_out].copy_from_slice(&y[..width * n_out]);
+        let rows = &mut self.outputs[first * n_out..(first + width) * n_out];
+        for (lane, row) in rows.chunks_exact_mut(n_out).enumerate() {
+            for (out, pair) in row.iter_mut().zip(self.work.sums.chunks_exact(2)) {
+                *out = pair[0][lane];
+            }
+        }
         true
     }
 

@@ -89,7 +89,7 @@ pub struct Evaluator {
     system: FuzzySystem,
     options: EvalOptions,
     /// The kernel's buffers for one point.
-    one: Workspace,
+    one: Workspace<1>,
     /// The kernel's buffers for a group of points, and the instruction set.
     batch: BatchWorkspace,
 }
@@ -98,7 +98,7 @@ impl Evaluator {
     /// An evaluator with the default [`EvalOptions`] (clamp inputs, middle of range when no
     /// rule fires).
     pub fn new(system: FuzzySystem) -> Self {
-        let one = Workspace::new(&system, 1);
+        let one = Workspace::new(&system);
         let batch = BatchWorkspace::new(&system);
         Self {
             system,
@@ -186,7 +186,7 @@ impl Evaluator {
     /// (zeros before the first).
     pub fn firing_strengths(&self) -> &[f64] {
         let c = self.system.compiled();
-        &self.one.values[c.strength_base..c.slot_count]
+        self.one.values[c.strength_base..c.slot_count].as_flattened()
     }
 }
 
@@ -195,7 +195,7 @@ impl Evaluator {
 fn fire_point(
     system: &FuzzySystem,
     options: &EvalOptions,
-    work: &mut Workspace,
+    work: &mut Workspace<1>,
     inputs: &[f64],
 ) -> Result<(), FuzzyError> {
     let variables = system.inputs();
@@ -206,10 +206,10 @@ fn fire_point(
         });
     }
     for (index, (slot, &value)) in work.x.iter_mut().zip(inputs).enumerate() {
-        *slot = load_input(system, options, index, value)?;
+        slot[0] = load_input(system, options, index, value)?;
     }
     let methods = system.methods();
-    kernel::fire::<f64>(
+    kernel::fire::<f64, 1>(
         (),
         system.compiled(),
         methods.and,
@@ -224,7 +224,7 @@ fn fire_point(
 fn eval_point(
     system: &FuzzySystem,
     options: &EvalOptions,
-    work: &mut Workspace,
+    work: &mut Workspace<1>,
     inputs: &[f64],
     outputs: &mut [f64],
 ) -> Result<(), FuzzyError> {
@@ -236,12 +236,13 @@ fn eval_point(
         });
     }
     fire_point(system, options, work, inputs)?;
-    kernel::sums::<f64>((), system.compiled(), &mut work.slots());
-    for (o, pair) in work.sums.chunks_exact(2).enumerate() {
-        work.y[o] = output_value(system, options, o, pair[0], pair[1])?;
+    kernel::sums::<f64, 1>((), system.compiled(), &mut work.slots());
+    // Every output is checked before the first is written; each replaces its weighted sum.
+    for (o, pair) in work.sums.chunks_exact_mut(2).enumerate() {
+        pair[0][0] = output_value(system, options, o, pair[0][0], pair[1][0])?;
     }
-    for (out, &y) in outputs.iter_mut().zip(&work.y) {
-        *out = y;
+    for (out, pair) in outputs.iter_mut().zip(work.sums.chunks_exact(2)) {
+        *out = pair[0][0];
     }
     Ok(())
 }

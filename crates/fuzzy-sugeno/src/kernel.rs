@@ -2,8 +2,9 @@
 //! side by side in a SIMD register ([`lane_math::Pack`]), with the same operations in the same
 //! order, so a point gives the same bits alone or in a batch.
 //!
-//! Every quantity lives in a *slot* of a flat buffer: slot `s` holds the `stride` values
-//! `buffer[s * stride..][..W]`, one per point (`stride = 1` for one point). The value slots are,
+//! Every quantity lives in a *slot*, an array of `N` values (`N = 1` for one point, the widest
+//! register's lane count for a batch), of which the first `W` hold one point each. The value
+//! slots are,
 //! in order (see [`Compiled`]): the membership degrees, their complements if any rule negates,
 //! the constants 1 and 0, the AND nodes, the OR nodes, and each rule's firing strength.
 //!
@@ -21,100 +22,86 @@ use lane_math::Lane;
 
 use crate::system::{AndMethod, Compiled, FuzzySystem, OrMethod};
 
-/// The buffers of one evaluation, in slots of `stride` values (see the module docs).
-pub(crate) struct Slots<'a> {
-    /// Values per slot: 1 for one point, the batch width for a batch.
-    pub stride: usize,
+/// The buffers of one evaluation, in slots of `N` values (see the module docs).
+pub(crate) struct Slots<'a, const N: usize> {
     /// One slot per input, after the range policy.
-    pub x: &'a [f64],
+    pub x: &'a [[f64; N]],
     /// The value slots ([`Compiled::slot_count`]); the constants 1 and 0 are filled in once.
-    pub values: &'a mut [f64],
+    pub values: &'a mut [[f64; N]],
     /// One slot per output term ([`Compiled::term_values`]); constant terms are filled in once.
-    pub terms: &'a mut [f64],
+    pub terms: &'a mut [[f64; N]],
     /// Two slots per output: the weighted sum of the rule outputs and the total strength.
-    pub sums: &'a mut [f64],
+    pub sums: &'a mut [[f64; N]],
 }
 
-impl Slots<'_> {
-    #[inline(always)]
-    fn get<L: Lane>(cx: L::Context, buffer: &[f64], stride: usize, slot: usize) -> L {
-        L::load(cx, &buffer[slot * stride..])
-    }
+/// The value of slot `slot` of `buffer`.
+#[inline(always)]
+fn get<L: Lane, const N: usize>(cx: L::Context, buffer: &[[f64; N]], slot: usize) -> L {
+    L::load(cx, &buffer[slot])
+}
 
-    #[inline(always)]
-    fn set<L: Lane>(buffer: &mut [f64], stride: usize, slot: usize, value: L) {
-        value.store(&mut buffer[slot * stride..]);
-    }
+/// Writes `value` into slot `slot` of `buffer`.
+#[inline(always)]
+fn set<L: Lane, const N: usize>(buffer: &mut [[f64; N]], slot: usize, value: L) {
+    value.store(&mut buffer[slot]);
 }
 
 /// Layers 1-3: the membership degrees at `slots.x`, their complements, the AND and OR nodes and
 /// every rule's strength (its combined antecedents times its weight).
 #[inline(always)]
-pub(crate) fn fire<L: Lane>(
+pub(crate) fn fire<L: Lane, const N: usize>(
     cx: L::Context,
     c: &Compiled,
     and: AndMethod,
     or: OrMethod,
-    slots: &mut Slots<'_>,
+    slots: &mut Slots<'_, N>,
 ) {
-    let stride = slots.stride;
     let values = &mut *slots.values;
     for (k, (mf, &i)) in c.mfs.iter().zip(&c.mf_inputs).enumerate() {
-        let x = Slots::get::<L>(cx, slots.x, stride, i);
-        Slots::set(values, stride, k, mf.eval_lane(cx, x));
+        let x = get::<L, N>(cx, slots.x, i);
+        set(values, k, mf.eval_lane(cx, x));
     }
     if c.has_complements {
         let n_mf = c.mfs.len();
         let one = L::splat(cx, 1.0);
         for k in 0..n_mf {
-            let degree: L = Slots::get(cx, values, stride, k);
-            Slots::set(values, stride, n_mf + k, one - degree);
+            let degree: L = get(cx, values, k);
+            set(values, n_mf + k, one - degree);
         }
     }
     // One monomorphised loop per pair of methods.
     let probor = |s: L, d: L| s + d - s * d;
     let product = |s: L, d: L| s * d;
     match (and, or) {
-        (AndMethod::Product, OrMethod::ProbabilisticSum) => {
-            nodes(cx, c, values, stride, product, probor)
-        }
-        (AndMethod::Product, OrMethod::Maximum) => nodes(cx, c, values, stride, product, L::max),
-        (AndMethod::Minimum, OrMethod::ProbabilisticSum) => {
-            nodes(cx, c, values, stride, L::min, probor)
-        }
-        (AndMethod::Minimum, OrMethod::Maximum) => nodes(cx, c, values, stride, L::min, L::max),
+        (AndMethod::Product, OrMethod::ProbabilisticSum) => nodes(cx, c, values, product, probor),
+        (AndMethod::Product, OrMethod::Maximum) => nodes(cx, c, values, product, L::max),
+        (AndMethod::Minimum, OrMethod::ProbabilisticSum) => nodes(cx, c, values, L::min, probor),
+        (AndMethod::Minimum, OrMethod::Maximum) => nodes(cx, c, values, L::min, L::max),
     }
     for (r, (&slot, &weight)) in c.rule_slots.iter().zip(&c.weights).enumerate() {
-        let combined: L = Slots::get(cx, values, stride, slot as usize);
-        Slots::set(values, stride, c.strength_base + r, combined * weight);
+        let combined: L = get(cx, values, slot as usize);
+        set(values, c.strength_base + r, combined * weight);
     }
 }
 
 /// The AND nodes, then the OR nodes, each from two earlier slots.
 #[inline(always)]
-fn nodes<L: Lane>(
+fn nodes<L: Lane, const N: usize>(
     cx: L::Context,
     c: &Compiled,
-    values: &mut [f64],
-    stride: usize,
+    values: &mut [[f64; N]],
     and: impl Fn(L, L) -> L,
     or: impl Fn(L, L) -> L,
 ) {
     let mut slot = c.node_base;
     for &[a, b] in &c.and_nodes {
-        let (a, b): (L, L) = (
-            Slots::get(cx, values, stride, a as usize),
-            Slots::get(cx, values, stride, b as usize),
-        );
-        Slots::set(values, stride, slot, and(a, b));
+        let (a, b): (L, L) = (get(cx, values, a as usize), get(cx, values, b as usize));
+        set(values, slot, and(a, b));
         slot += 1;
     }
     for &[a, b] in &c.or_nodes {
-        let (a, b): (L, L) = (
-            Slots::get(cx, values, stride, a as usize),
-            Slots::get(cx, values, stride, b as usize),
-        );
-        Slots::set(values, stride, slot, or(a, b));
+        let (a, b): (L, L) = (get(cx, values, a as usize), get(cx, values, b as usize));
+        set(values, slot, or(a, b));
         slot += 1;
     }
 }
@@ -123,76 +110,67 @@ fn nodes<L: Lane>(
 /// weighted sum `sum_r w_r z_r` and the total `sum_r w_r` over the rules that conclude on it, in
 /// rule order (the numerator and denominator of eq 21).
 #[inline(always)]
-pub(crate) fn sums<L: Lane>(cx: L::Context, c: &Compiled, slots: &mut Slots<'_>) {
-    let stride = slots.stride;
+pub(crate) fn sums<L: Lane, const N: usize>(
+    cx: L::Context,
+    c: &Compiled,
+    slots: &mut Slots<'_, N>,
+) {
     let n_in = c.n_inputs;
     for &(term, offset) in &c.linear_terms {
         let p = &c.coefficients[offset..offset + n_in + 1];
         let mut acc = L::splat(cx, p[n_in]);
         for (i, &p_i) in p[..n_in].iter().enumerate() {
-            acc = acc + Slots::get::<L>(cx, slots.x, stride, i) * p_i;
+            acc = acc + get::<L, N>(cx, slots.x, i) * p_i;
         }
-        Slots::set(slots.terms, stride, term, acc);
+        set(slots.terms, term, acc);
     }
     let zero = L::splat(cx, 0.0);
     for (o, bounds) in c.conclusion_offsets.windows(2).enumerate() {
         let (mut weighted, mut total) = (zero, zero);
         for &[rule, term] in &c.conclusions[bounds[0]..bounds[1]] {
-            let w: L = Slots::get(cx, slots.values, stride, c.strength_base + rule as usize);
-            let z: L = Slots::get(cx, slots.terms, stride, term as usize);
+            let w: L = get(cx, slots.values, c.strength_base + rule as usize);
+            let z: L = get(cx, slots.terms, term as usize);
             weighted = weighted + w * z;
             total = total + w;
         }
-        Slots::set(slots.sums, stride, 2 * o, weighted);
-        Slots::set(slots.sums, stride, 2 * o + 1, total);
+        set(slots.sums, 2 * o, weighted);
+        set(slots.sums, 2 * o + 1, total);
     }
 }
 
-/// The kernel's buffers for `stride` points, sized for one system at construction.
+/// The kernel's buffers for `N` points, sized for one system at construction.
 #[derive(Debug, Clone)]
-pub(crate) struct Workspace {
-    /// Values per slot.
-    pub stride: usize,
+pub(crate) struct Workspace<const N: usize> {
     /// One slot per input.
-    pub x: Vec<f64>,
+    pub x: Vec<[f64; N]>,
     /// The value slots, the constants 1 and 0 filled in.
-    pub values: Vec<f64>,
+    pub values: Vec<[f64; N]>,
     /// One slot per output term, the constant terms filled in.
-    pub terms: Vec<f64>,
+    pub terms: Vec<[f64; N]>,
     /// Two slots per output.
-    pub sums: Vec<f64>,
-    /// The outputs of `stride` points, point after point, kept until all of them are valid.
-    pub y: Vec<f64>,
+    pub sums: Vec<[f64; N]>,
 }
 
-impl Workspace {
-    /// Buffers for `stride` points of `system`.
-    pub(crate) fn new(system: &FuzzySystem, stride: usize) -> Self {
+impl<const N: usize> Workspace<N> {
+    /// Buffers for `N` points of `system`.
+    pub(crate) fn new(system: &FuzzySystem) -> Self {
         let c = system.compiled();
-        let n_out = system.outputs().len();
-        let mut values = vec![0.0; c.slot_count * stride];
-        // The neutral elements of AND and OR, which "don't care" antecedents point at.
-        values[(c.degree_count - 2) * stride..(c.degree_count - 1) * stride].fill(1.0);
-        let terms = c
-            .term_values
-            .iter()
-            .flat_map(|&t| std::iter::repeat_n(t, stride))
-            .collect();
+        let mut values = vec![[0.0; N]; c.slot_count];
+        // The neutral element of AND, which "don't care" antecedents point at (0, that of OR,
+        // is already there).
+        values[c.degree_count - 2] = [1.0; N];
         Self {
-            stride,
-            x: vec![0.0; c.n_inputs * stride],
+            x: vec![[0.0; N]; c.n_inputs],
             values,
-            terms,
-            sums: vec![0.0; 2 * n_out * stride],
-            y: vec![0.0; n_out * stride],
+            terms: c.term_values.iter().map(|&t| [t; N]).collect(),
+            sums: vec![[0.0; N]; 2 * system.outputs().len()],
         }
     }
 
     /// The buffers as the kernel takes them.
     #[inline(always)]
-    pub(crate) fn slots(&mut self) -> Slots<'_> {
+    pub(crate) fn slots(&mut self) -> Slots<'_, N> {
         Slots {
-            stride: self.stride,
             x: &self.x,
             values: &mut self.values,
             terms: &mut self.terms,
