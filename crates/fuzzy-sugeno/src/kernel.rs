@@ -78,9 +78,11 @@ pub(crate) fn fire<L: Lane, const N: usize>(
         (AndMethod::Minimum, OrMethod::ProbabilisticSum) => nodes(cx, c, values, L::min, probor),
         (AndMethod::Minimum, OrMethod::Maximum) => nodes(cx, c, values, L::min, L::max),
     }
-    for (r, (&slot, &weight)) in c.rule_slots.iter().zip(&c.weights).enumerate() {
-        let combined: L = get(cx, values, slot as usize);
-        set(values, c.strength_base + r, combined * weight);
+    if !c.weights_folded {
+        for (r, (&slot, &weight)) in c.rule_slots.iter().zip(&c.weights).enumerate() {
+            let combined: L = get(cx, values, slot as usize);
+            set(values, c.strength_base + r, combined * weight);
+        }
     }
 }
 
@@ -125,6 +127,9 @@ pub(crate) fn sums<L: Lane, const N: usize>(
         set(slots.terms, term, acc);
     }
     let zero = L::splat(cx, 0.0);
+    if let Some(dense) = &c.dense_terms {
+        return dense_sums::<L, N>(cx, c, dense, slots);
+    }
     for (o, bounds) in c.conclusion_offsets.windows(2).enumerate() {
         let (mut weighted, mut total) = (zero, zero);
         for &[rule, term] in &c.conclusions[bounds[0]..bounds[1]] {
@@ -135,6 +140,44 @@ pub(crate) fn sums<L: Lane, const N: usize>(
         }
         set(slots.sums, 2 * o, weighted);
         set(slots.sums, 2 * o + 1, total);
+    }
+}
+
+/// [`sums`] when every rule concludes on every output: the outputs two at a time, side by side
+/// (each still summed in rule order), and the total strength, the same for all, summed once.
+#[inline(always)]
+fn dense_sums<L: Lane, const N: usize>(
+    cx: L::Context,
+    c: &Compiled,
+    dense: &[u32],
+    slots: &mut Slots<'_, N>,
+) {
+    let n_out = c.conclusion_offsets.len() - 1;
+    let zero = L::splat(cx, 0.0);
+    let strengths = &slots.values[c.strength_base..c.strength_base + c.weights.len()];
+    let mut total = zero;
+    for o in (0..n_out).step_by(2) {
+        let pair = o + 1 < n_out;
+        let (mut first, mut second, mut sum) = (zero, zero, zero);
+        for (strength, terms) in strengths.iter().zip(dense.chunks_exact(n_out)) {
+            let w = L::load(cx, strength);
+            first = first + w * get::<L, N>(cx, slots.terms, terms[o] as usize);
+            if pair {
+                second = second + w * get::<L, N>(cx, slots.terms, terms[o + 1] as usize);
+            }
+            if o == 0 {
+                sum = sum + w;
+            }
+        }
+        if o == 0 {
+            total = sum;
+        }
+        set(slots.sums, 2 * o, first);
+        set(slots.sums, 2 * o + 1, total);
+        if pair {
+            set(slots.sums, 2 * o + 2, second);
+            set(slots.sums, 2 * o + 3, total);
+        }
     }
 }
 

@@ -478,8 +478,15 @@ pub(crate) struct Compiled {
     pub or_nodes: Vec<[u32; 2]>,
     /// The slot holding each rule's combined antecedents (a degree for a rule of one antecedent).
     pub rule_slots: Vec<u32>,
-    /// The first of the rules' strength slots, one per rule, after the nodes.
+    /// The first of the rules' strength slots, one per rule in rule order: after the nodes, or,
+    /// when every weight is 1 and the rules' combined antecedents already sit in consecutive
+    /// slots in rule order (`weights_folded`), those slots themselves.
     pub strength_base: usize,
+    /// Whether the strengths are the combined antecedents in place (no weight to apply).
+    pub weights_folded: bool,
+    /// When every rule concludes on every output: the term of each rule for each output, rule
+    /// after rule (`n_outputs` entries each), so that the outputs are summed side by side.
+    pub dense_terms: Option<Vec<u32>>,
     /// The number of value slots: degrees, complements, 1 and 0, nodes, strengths.
     pub slot_count: usize,
     /// `[rule, term]` for every rule that concludes on an output, output after output and in
@@ -562,7 +569,7 @@ impl Compiled {
                 });
             }
         }
-        let every_rule_concludes = (0..outputs.len())
+        let every_rule_concludes: Vec<bool> = (0..outputs.len())
             .map(|o| rules.iter().all(|r| r.consequents[o].is_some()))
             .collect();
         let mut conclusions = Vec::new();
@@ -615,7 +622,23 @@ impl Compiled {
                 rule_slots[r] = slot;
             }
         }
-        let strength_base = node_base + and_nodes.len() + or_nodes.len();
+        let node_end = node_base + and_nodes.len() + or_nodes.len();
+        let weights_folded = rules.iter().all(|r| r.weight == 1.0)
+            && rule_slots
+                .iter()
+                .enumerate()
+                .all(|(r, &slot)| slot as usize == rule_slots[0] as usize + r);
+        let strength_base = if weights_folded {
+            rule_slots[0] as usize
+        } else {
+            node_end
+        };
+        let dense_terms = every_rule_concludes.iter().all(|&every| every).then(|| {
+            (0..rules.len())
+                .flat_map(|r| (0..outputs.len()).map(move |o| (r, o)))
+                .map(|(r, o)| consequents[o * rules.len() + r])
+                .collect()
+        });
         Ok(Self {
             mfs,
             mf_inputs,
@@ -639,7 +662,13 @@ impl Compiled {
             or_nodes,
             rule_slots,
             strength_base,
-            slot_count: strength_base + rules.len(),
+            weights_folded,
+            dense_terms,
+            slot_count: if weights_folded {
+                node_end
+            } else {
+                node_end + rules.len()
+            },
             conclusions,
             conclusion_offsets,
         })
