@@ -1,7 +1,9 @@
 //! Fuzzy inference: one evaluation of the paper's controller (4 inputs, 8 bell sets, 16 rules,
-//! 2 outputs), and of a first-order system with 2 inputs, 7 bell sets each and 49 rules.
+//! 2 outputs), and of a first-order system with 2 inputs, 7 bell sets each and 49 rules; and
+//! the same systems evaluated at 1024 points by one `eval_batch` (SIMD across points), timed per
+//! point (Criterion's throughput).
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use fuzzy_sugeno::{
     Antecedent, Connective, Evaluator, FuzzySystem, MembershipFn, OutputFn, Rule, paper_controller,
 };
@@ -72,5 +74,40 @@ fn fuzzy(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, fuzzy);
+/// Points of a batch.
+const BATCH_POINTS: usize = 1024;
+
+/// `BATCH_POINTS` points spread over `[-1.2, 1.2]` times each input's half-range `scale`
+/// (some outside the ranges, so clamped).
+fn points(scale: &[f64]) -> Vec<f64> {
+    (0..BATCH_POINTS * scale.len())
+        .map(|k| 1.2 * scale[k % scale.len()] * (0.37 * k as f64).sin())
+        .collect()
+}
+
+fn fuzzy_batch(c: &mut Criterion) {
+    let mut group = c.benchmark_group("fuzzy_batch");
+    group.throughput(Throughput::Elements(BATCH_POINTS as u64));
+    let mut paper = Evaluator::new(paper_controller());
+    let x = points(&[0.3, 0.3, 1.0, 1.0]);
+    let mut tau = vec![0.0; 2 * BATCH_POINTS];
+    group.bench_function("paper", |b| {
+        b.iter(|| {
+            paper.eval_batch(black_box(&x), &mut tau).expect("in range");
+            black_box(tau[0])
+        })
+    });
+    let mut grid = Evaluator::new(forty_nine_rules());
+    let xy = points(&[1.0, 1.0]);
+    let mut z = vec![0.0; BATCH_POINTS];
+    group.bench_function("49rules", |b| {
+        b.iter(|| {
+            grid.eval_batch(black_box(&xy), &mut z).expect("in range");
+            black_box(z[0])
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, fuzzy, fuzzy_batch);
 criterion_main!(benches);

@@ -1,12 +1,14 @@
 #![doc = include_str!("../README.md")]
 
 pub mod analysis;
+mod batch;
 mod builder;
 mod error;
 mod eval;
 mod export_c;
 mod fcl;
 mod fis;
+mod kernel;
 pub mod learn;
 mod membership;
 mod paper;

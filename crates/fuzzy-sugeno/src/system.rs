@@ -465,6 +465,35 @@ pub(crate) struct Compiled {
     pub every_rule_concludes: Vec<bool>,
     /// One row per output, one entry per rule: 1 if the rule concludes on the output, else 0.
     pub concludes: Vec<f64>,
+    /// The number of input variables.
+    pub n_inputs: usize,
+    /// The first node slot of the value slots of `kernel.rs` (the degree table comes first:
+    /// `node_base = degree_count`).
+    pub node_base: usize,
+    /// The AND nodes, in slots `node_base..`: each combines two earlier slots (a degree or an
+    /// AND node, then a degree), so that a rule's antecedents are combined left to right and
+    /// rules with the same leading antecedents share their partial results.
+    pub and_nodes: Vec<[u32; 2]>,
+    /// The OR nodes, in the slots after the AND nodes, built the same way.
+    pub or_nodes: Vec<[u32; 2]>,
+    /// The slot holding each rule's combined antecedents (a degree for a rule of one antecedent).
+    pub rule_slots: Vec<u32>,
+    /// The first of the rules' strength slots, one per rule in rule order: after the nodes, or,
+    /// when every weight is 1 and the rules' combined antecedents already sit in consecutive
+    /// slots in rule order (`weights_folded`), those slots themselves.
+    pub strength_base: usize,
+    /// Whether the strengths are the combined antecedents in place (no weight to apply).
+    pub weights_folded: bool,
+    /// When every rule concludes on every output: the term of each rule for each output, rule
+    /// after rule (`n_outputs` entries each), so that the outputs are summed side by side.
+    pub dense_terms: Option<Vec<u32>>,
+    /// The number of value slots: degrees, complements, 1 and 0, nodes, strengths.
+    pub slot_count: usize,
+    /// `[rule, term]` for every rule that concludes on an output, output after output and in
+    /// rule order within one output; `term` indexes `term_values`.
+    pub conclusions: Vec<[u32; 2]>,
+    /// Output `o`'s conclusions are `conclusions[conclusion_offsets[o]..conclusion_offsets[o + 1]]`.
+    pub conclusion_offsets: Vec<usize>,
 }
 
 impl Compiled {
@@ -540,9 +569,76 @@ impl Compiled {
                 });
             }
         }
-        let every_rule_concludes = (0..outputs.len())
+        let every_rule_concludes: Vec<bool> = (0..outputs.len())
             .map(|o| rules.iter().all(|r| r.consequents[o].is_some()))
             .collect();
+        let mut conclusions = Vec::new();
+        let mut conclusion_offsets = vec![0];
+        for (o, &first_term) in term_offsets.iter().enumerate() {
+            for (r, rule) in rules.iter().enumerate() {
+                if let Some(k) = rule.consequents[o] {
+                    conclusions.push([index(r)?, index(first_term + k)?]);
+                }
+            }
+            conclusion_offsets.push(conclusions.len());
+        }
+        // The nodes: AND rules first, so that every AND node precedes every OR node.
+        let node_base = degree_count;
+        let mut rule_slots = vec![0; rules.len()];
+        let mut and_nodes = Vec::new();
+        let mut or_nodes = Vec::new();
+        for connective in [Connective::And, Connective::Or] {
+            let (nodes, first) = match connective {
+                Connective::And => (&mut and_nodes, node_base),
+                Connective::Or => (&mut or_nodes, node_base + and_nodes.len()),
+            };
+            let mut known: std::collections::HashMap<[u32; 2], u32> = Default::default();
+            for (r, rule) in rules.iter().enumerate() {
+                if rule.connective != connective {
+                    continue;
+                }
+                let row = &antecedents[r * inputs.len()..(r + 1) * inputs.len()];
+                let mut cared = row
+                    .iter()
+                    .zip(&rule.antecedents)
+                    .filter(|(_, a)| **a != Antecedent::Any)
+                    .map(|(&slot, _)| slot);
+                // `check_rule` refuses a rule whose antecedents are all "don't care".
+                let mut slot = cared.next().ok_or_else(|| {
+                    invalid(&format!("rule {}", r + 1), SystemProblem::NoAntecedent)
+                })?;
+                for next in cared {
+                    let pair = [slot, next];
+                    slot = match known.get(&pair) {
+                        Some(&node) => node,
+                        None => {
+                            let node = index(first + nodes.len())?;
+                            nodes.push(pair);
+                            known.insert(pair, node);
+                            node
+                        }
+                    };
+                }
+                rule_slots[r] = slot;
+            }
+        }
+        let node_end = node_base + and_nodes.len() + or_nodes.len();
+        let weights_folded = rules.iter().all(|r| r.weight == 1.0)
+            && rule_slots
+                .iter()
+                .enumerate()
+                .all(|(r, &slot)| slot as usize == rule_slots[0] as usize + r);
+        let strength_base = if weights_folded {
+            rule_slots[0] as usize
+        } else {
+            node_end
+        };
+        let dense_terms = every_rule_concludes.iter().all(|&every| every).then(|| {
+            (0..rules.len())
+                .flat_map(|r| (0..outputs.len()).map(move |o| (r, o)))
+                .map(|(r, o)| consequents[o * rules.len() + r])
+                .collect()
+        });
         Ok(Self {
             mfs,
             mf_inputs,
@@ -560,6 +656,21 @@ impl Compiled {
             consequents,
             every_rule_concludes,
             concludes,
+            n_inputs: inputs.len(),
+            node_base,
+            and_nodes,
+            or_nodes,
+            rule_slots,
+            strength_base,
+            weights_folded,
+            dense_terms,
+            slot_count: if weights_folded {
+                node_end
+            } else {
+                node_end + rules.len()
+            },
+            conclusions,
+            conclusion_offsets,
         })
     }
 }

@@ -1,8 +1,8 @@
 //! `hrm.fuzzy`: Takagi-Sugeno systems (eqs 19-24), from `fuzzy-sugeno`.
 
-use crate::array::{States, evaluate};
-use crate::errors::{Error, check_finite, count};
-use fuzzy_sugeno::{AnalysisOptions, AnalysisReport, Evaluator, FuzzySystem};
+use crate::array::{States, evaluate_chunks};
+use crate::errors::{Error, count};
+use fuzzy_sugeno::{AnalysisOptions, AnalysisReport, Evaluator, FuzzyError, FuzzySystem};
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyPermissionError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -102,20 +102,26 @@ impl System {
     }
 
     /// The outputs at input vector(s) `x`: shape (n_inputs,) gives (n_outputs,), (N, n_inputs)
-    /// gives (N, n_outputs) (singleton fuzzification, rule firing, eq 21's defuzzifier).
+    /// gives (N, n_outputs) (singleton fuzzification, rule firing, eq 21's defuzzifier). A batch
+    /// runs through the evaluator's SIMD batch (several points per instruction), each row's
+    /// outputs equal to those of evaluating it alone.
     fn eval<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let (n_in, n_out) = (self.system.inputs().len(), self.system.outputs().len());
         let x = States::read(x, "x", n_in)?;
         let fresh = || Evaluator::new(self.system.clone());
-        let out = evaluate(
+        // The evaluator's batch (SIMD across points); it refuses non-finite outputs itself.
+        let out = evaluate_chunks(
             py,
             [&x],
             n_out,
             &self.evaluator,
             fresh,
             |evaluator, [x], out| {
-                evaluator.eval(x, out)?;
-                check_finite("outputs", out)
+                evaluator.eval_batch(x, out).map_err(|error| match error {
+                    FuzzyError::Batch { row, source } => (row, Error::from(*source)),
+                    // The driver passes whole rows: a shape error cannot happen.
+                    other => (0, Error::from(other)),
+                })
             },
         )?;
         Ok(out.into_py(py, &[n_out]))

@@ -40,6 +40,18 @@ pub trait Lane:
     /// Whether every lane is greater than the same lane of `other` (false where either is NaN):
     /// one vector compare, for tests inside a kernel's loop.
     fn all_greater(self, other: Self) -> bool;
+    /// `|x|` in every lane.
+    fn abs(self) -> Self;
+    /// The smaller of the two values in every lane: `self` where `self < other`, else `other`
+    /// (the x86 `minpd` rule, so both implementations agree; it equals `f64::min` unless a lane
+    /// holds a NaN or both are zeros).
+    fn min(self, other: Self) -> Self;
+    /// The larger of the two values in every lane: `self` where `self > other`, else `other`
+    /// (the x86 `maxpd` rule; it equals `f64::max` unless a lane holds a NaN or both are zeros).
+    fn max(self, other: Self) -> Self;
+    /// `f` applied to every lane, one lane at a time: the scalar fallback for what has no SIMD
+    /// form (`exp`, `powf`, branchy formulas). Each lane gets exactly `f` of its value.
+    fn map(self, f: impl Fn(f64) -> f64) -> Self;
 }
 
 impl Lane for f64 {
@@ -83,6 +95,26 @@ impl Lane for f64 {
     #[inline(always)]
     fn all_greater(self, other: Self) -> bool {
         self > other
+    }
+
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        if self < other { self } else { other }
+    }
+
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        if self > other { self } else { other }
+    }
+
+    #[inline(always)]
+    fn map(self, f: impl Fn(f64) -> f64) -> Self {
+        f(self)
     }
 }
 
@@ -210,6 +242,40 @@ impl<S: Simd> Lane for Pack<S> {
         // The lanes where `self > other` fails; none when the first of them is past the end.
         simd.first_true_m64s(simd.xor_m64s(greater, every)) == Self::WIDTH
     }
+
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Self {
+            simd: self.simd,
+            value: self.simd.abs_f64s(self.value),
+        }
+    }
+
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        Self {
+            simd: self.simd,
+            value: self.simd.min_f64s(self.value, other.value),
+        }
+    }
+
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        Self {
+            simd: self.simd,
+            value: self.simd.max_f64s(self.value, other.value),
+        }
+    }
+
+    #[inline(always)]
+    fn map(mut self, f: impl Fn(f64) -> f64) -> Self {
+        let lanes: &mut [f64] =
+            pulp::bytemuck::cast_slice_mut(std::slice::from_mut(&mut self.value));
+        for x in lanes {
+            *x = f(*x);
+        }
+        self
+    }
 }
 
 #[cfg(test)]
@@ -261,5 +327,79 @@ mod tests {
         Arch::new().dispatch(AllGreater(&values));
         // And with the narrowest registers, whatever this processor has.
         AllGreater(&values).with_simd(pulp::Scalar::new());
+    }
+
+    /// Values with both signs, zeros, subnormals, infinities and ties.
+    const VALUES: [f64; 12] = [
+        -3.5,
+        2.25,
+        0.0,
+        1e-310,
+        -1e-310,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        7.0,
+        7.0,
+        -0.125,
+        1e300,
+        -2.0,
+    ];
+
+    /// Every new operation of a [`Pack`] of the processor's widest instruction set against the
+    /// `f64` implementation, lane by lane, bit for bit, and the `f64` one against `f64`'s own.
+    struct Check;
+
+    impl WithSimd for Check {
+        type Output = ();
+
+        fn with_simd<S: Simd>(self, simd: S) {
+            let width = Pack::<S>::WIDTH;
+            for start in 0..VALUES.len() {
+                let a: Vec<f64> = (0..width).map(|i| VALUES[(start + i) % 12]).collect();
+                let b: Vec<f64> = (0..width)
+                    .map(|i| VALUES[(start + 5 * i + 1) % 12])
+                    .collect();
+                let (pa, pb) = (Pack::load(simd, &a), Pack::load(simd, &b));
+                let mut out = vec![0.0; width];
+                let square = |x: f64| x * x - 1.0;
+                for (op, expect) in [
+                    (
+                        pa.abs(),
+                        &(|x: f64, _: f64| Lane::abs(x)) as &dyn Fn(f64, f64) -> f64,
+                    ),
+                    (pa.min(pb), &|x: f64, y: f64| Lane::min(x, y)),
+                    (pa.max(pb), &|x: f64, y: f64| Lane::max(x, y)),
+                    (pa.map(square), &|x: f64, _: f64| Lane::map(x, square)),
+                ] {
+                    op.store(&mut out);
+                    for i in 0..width {
+                        assert_eq!(out[i].to_bits(), expect(a[i], b[i]).to_bits());
+                    }
+                }
+                for i in 0..width {
+                    let (x, y) = (a[i], b[i]);
+                    assert_eq!(Lane::abs(x).to_bits(), x.abs().to_bits());
+                    assert_eq!(Lane::map(x, square).to_bits(), square(x).to_bits());
+                    if !(x == 0.0 && y == 0.0) {
+                        assert_eq!(Lane::min(x, y).to_bits(), x.min(y).to_bits());
+                        assert_eq!(Lane::max(x, y).to_bits(), x.max(y).to_bits());
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn abs_min_max_map_agree_with_f64_in_every_lane() {
+        Arch::new().dispatch(Check);
+        // The instruction-set-free fallback too.
+        Check.with_simd(pulp::Scalar::new());
+    }
+
+    #[test]
+    fn min_and_max_follow_the_x86_rule_on_zeros() {
+        assert_eq!(Lane::min(0.0, -0.0).to_bits(), (-0.0f64).to_bits());
+        assert_eq!(Lane::min(-0.0, 0.0).to_bits(), 0.0f64.to_bits());
+        assert_eq!(Lane::max(0.0, -0.0).to_bits(), (-0.0f64).to_bits());
     }
 }

@@ -64,22 +64,6 @@ proptest! {
             }
         }
     }
-
-    #[test]
-    fn a_batch_equals_row_by_row_evaluation(seed in any::<u64>()) {
-        let system = random_system(seed, false);
-        let (n_in, n_out) = (system.inputs().len(), system.outputs().len());
-        let mut rng = Rng::new(seed.rotate_left(7));
-        let inputs: Vec<f64> = (0..5).flat_map(|_| random_point(&system, &mut rng)).collect();
-        let mut batch = vec![0.0; 5 * n_out];
-        let mut evaluator = Evaluator::new(system);
-        evaluator.eval_batch(&inputs, &mut batch).unwrap();
-        let mut row = vec![0.0; n_out];
-        for (x, y) in inputs.chunks(n_in).zip(batch.chunks(n_out)) {
-            evaluator.eval(x, &mut row).unwrap();
-            prop_assert_eq!(&row[..], y);
-        }
-    }
 }
 
 /// One input on [0, 1] with two triangles that leave (0.4, 0.6) uncovered, one output on [0, 10].

@@ -1,6 +1,6 @@
 //! The integration tests of fuzzy-sugeno, one binary: a module per `src` module it tests
 //! (`evaluator`, `fcl`, `export_c`, `anfis`; `fis_files`, `fis_fuzz` and `fis_interop` for the
-//! `.fis` reader and writer), `bad_input` for every refusal, `allocation` for the allocation-free
+//! `.fis` reader and writer), `batch` for the SIMD batch against one point at a time, `bad_input` for every refusal, `allocation` for the allocation-free
 //! evaluation and training, and `common` for random systems and the independent reference
 //! evaluator.
 
@@ -12,6 +12,7 @@ static ALLOCATOR: test_support::alloc::CountingAllocator = test_support::alloc::
 mod allocation;
 mod anfis;
 mod bad_input;
+mod batch;
 mod common;
 mod evaluator;
 mod export_c;

@@ -1,0 +1,223 @@
+//! The inference of eqs 19-21 written once over [`Lane`]: one input point (`f64`) or `W` points
+//! side by side in a SIMD register ([`lane_math::Pack`]), with the same operations in the same
+//! order, so a point gives the same bits alone or in a batch.
+//!
+//! Every quantity lives in a *slot*, an array of `N` values (`N = 1` for one point, the widest
+//! register's lane count for a batch), of which the first `W` hold one point each. The value
+//! slots are,
+//! in order (see [`Compiled`]): the membership degrees, their complements if any rule negates,
+//! the constants 1 and 0, the AND nodes, the OR nodes, and each rule's firing strength.
+//!
+//! A rule's antecedents are combined left to right, as `((mu_1 AND mu_2) AND mu_3) ...`, each
+//! partial result a *node* shared by every rule with the same leading antecedents (the paper's 16
+//! rules over 4 inputs need 4 + 8 + 16 = 28 products instead of 48). "Don't care" antecedents are
+//! left out: combining with the neutral element (1 for AND, 0 for OR) is exact for degrees in
+//! `[0, 1]`, so the strengths are those of the textbook fold.
+//!
+//! What is not arithmetic on all points at once, checking and clamping the inputs and the
+//! policies of the last step (no rule fired, a non-finite output), is done per point by the
+//! callers in `eval.rs`.
+
+use lane_math::Lane;
+
+use crate::system::{AndMethod, Compiled, FuzzySystem, OrMethod};
+
+/// The buffers of one evaluation, in slots of `N` values (see the module docs).
+pub(crate) struct Slots<'a, const N: usize> {
+    /// One slot per input, after the range policy.
+    pub x: &'a [[f64; N]],
+    /// The value slots ([`Compiled::slot_count`]); the constants 1 and 0 are filled in once.
+    pub values: &'a mut [[f64; N]],
+    /// One slot per output term ([`Compiled::term_values`]); constant terms are filled in once.
+    pub terms: &'a mut [[f64; N]],
+    /// Two slots per output: the weighted sum of the rule outputs and the total strength.
+    pub sums: &'a mut [[f64; N]],
+}
+
+/// The value of slot `slot` of `buffer`.
+#[inline(always)]
+fn get<L: Lane, const N: usize>(cx: L::Context, buffer: &[[f64; N]], slot: usize) -> L {
+    L::load(cx, &buffer[slot])
+}
+
+/// Writes `value` into slot `slot` of `buffer`.
+#[inline(always)]
+fn set<L: Lane, const N: usize>(buffer: &mut [[f64; N]], slot: usize, value: L) {
+    value.store(&mut buffer[slot]);
+}
+
+/// Layers 1-3: the membership degrees at `slots.x`, their complements, the AND and OR nodes and
+/// every rule's strength (its combined antecedents times its weight).
+#[inline(always)]
+pub(crate) fn fire<L: Lane, const N: usize>(
+    cx: L::Context,
+    c: &Compiled,
+    and: AndMethod,
+    or: OrMethod,
+    slots: &mut Slots<'_, N>,
+) {
+    let values = &mut *slots.values;
+    for (k, (mf, &i)) in c.mfs.iter().zip(&c.mf_inputs).enumerate() {
+        let x = get::<L, N>(cx, slots.x, i);
+        set(values, k, mf.eval_lane(cx, x));
+    }
+    if c.has_complements {
+        let n_mf = c.mfs.len();
+        let one = L::splat(cx, 1.0);
+        for k in 0..n_mf {
+            let degree: L = get(cx, values, k);
+            set(values, n_mf + k, one - degree);
+        }
+    }
+    // One monomorphised loop per pair of methods.
+    let probor = |s: L, d: L| s + d - s * d;
+    let product = |s: L, d: L| s * d;
+    match (and, or) {
+        (AndMethod::Product, OrMethod::ProbabilisticSum) => nodes(cx, c, values, product, probor),
+        (AndMethod::Product, OrMethod::Maximum) => nodes(cx, c, values, product, L::max),
+        (AndMethod::Minimum, OrMethod::ProbabilisticSum) => nodes(cx, c, values, L::min, probor),
+        (AndMethod::Minimum, OrMethod::Maximum) => nodes(cx, c, values, L::min, L::max),
+    }
+    if !c.weights_folded {
+        for (r, (&slot, &weight)) in c.rule_slots.iter().zip(&c.weights).enumerate() {
+            let combined: L = get(cx, values, slot as usize);
+            set(values, c.strength_base + r, combined * weight);
+        }
+    }
+}
+
+/// The AND nodes, then the OR nodes, each from two earlier slots.
+#[inline(always)]
+fn nodes<L: Lane, const N: usize>(
+    cx: L::Context,
+    c: &Compiled,
+    values: &mut [[f64; N]],
+    and: impl Fn(L, L) -> L,
+    or: impl Fn(L, L) -> L,
+) {
+    let mut slot = c.node_base;
+    for &[a, b] in &c.and_nodes {
+        let (a, b): (L, L) = (get(cx, values, a as usize), get(cx, values, b as usize));
+        set(values, slot, and(a, b));
+        slot += 1;
+    }
+    for &[a, b] in &c.or_nodes {
+        let (a, b): (L, L) = (get(cx, values, a as usize), get(cx, values, b as usize));
+        set(values, slot, or(a, b));
+        slot += 1;
+    }
+}
+
+/// Layer 4, after [`fire`]: the first-order terms at `slots.x`, then for every output the
+/// weighted sum `sum_r w_r z_r` and the total `sum_r w_r` over the rules that conclude on it, in
+/// rule order (the numerator and denominator of eq 21).
+#[inline(always)]
+pub(crate) fn sums<L: Lane, const N: usize>(
+    cx: L::Context,
+    c: &Compiled,
+    slots: &mut Slots<'_, N>,
+) {
+    let n_in = c.n_inputs;
+    for &(term, offset) in &c.linear_terms {
+        let p = &c.coefficients[offset..offset + n_in + 1];
+        let mut acc = L::splat(cx, p[n_in]);
+        for (i, &p_i) in p[..n_in].iter().enumerate() {
+            acc = acc + get::<L, N>(cx, slots.x, i) * p_i;
+        }
+        set(slots.terms, term, acc);
+    }
+    let zero = L::splat(cx, 0.0);
+    if let Some(dense) = &c.dense_terms {
+        return dense_sums::<L, N>(cx, c, dense, slots);
+    }
+    for (o, bounds) in c.conclusion_offsets.windows(2).enumerate() {
+        let (mut weighted, mut total) = (zero, zero);
+        for &[rule, term] in &c.conclusions[bounds[0]..bounds[1]] {
+            let w: L = get(cx, slots.values, c.strength_base + rule as usize);
+            let z: L = get(cx, slots.terms, term as usize);
+            weighted = weighted + w * z;
+            total = total + w;
+        }
+        set(slots.sums, 2 * o, weighted);
+        set(slots.sums, 2 * o + 1, total);
+    }
+}
+
+/// [`sums`] when every rule concludes on every output: the outputs two at a time, side by side
+/// (each still summed in rule order), and the total strength, the same for all, summed once.
+#[inline(always)]
+fn dense_sums<L: Lane, const N: usize>(
+    cx: L::Context,
+    c: &Compiled,
+    dense: &[u32],
+    slots: &mut Slots<'_, N>,
+) {
+    let n_out = c.conclusion_offsets.len() - 1;
+    let zero = L::splat(cx, 0.0);
+    let strengths = &slots.values[c.strength_base..c.strength_base + c.weights.len()];
+    let mut total = zero;
+    for o in (0..n_out).step_by(2) {
+        let pair = o + 1 < n_out;
+        let (mut first, mut second, mut sum) = (zero, zero, zero);
+        for (strength, terms) in strengths.iter().zip(dense.chunks_exact(n_out)) {
+            let w = L::load(cx, strength);
+            first = first + w * get::<L, N>(cx, slots.terms, terms[o] as usize);
+            if pair {
+                second = second + w * get::<L, N>(cx, slots.terms, terms[o + 1] as usize);
+            }
+            if o == 0 {
+                sum = sum + w;
+            }
+        }
+        if o == 0 {
+            total = sum;
+        }
+        set(slots.sums, 2 * o, first);
+        set(slots.sums, 2 * o + 1, total);
+        if pair {
+            set(slots.sums, 2 * o + 2, second);
+            set(slots.sums, 2 * o + 3, total);
+        }
+    }
+}
+
+/// The kernel's buffers for `N` points, sized for one system at construction.
+#[derive(Debug, Clone)]
+pub(crate) struct Workspace<const N: usize> {
+    /// One slot per input.
+    pub x: Vec<[f64; N]>,
+    /// The value slots, the constants 1 and 0 filled in.
+    pub values: Vec<[f64; N]>,
+    /// One slot per output term, the constant terms filled in.
+    pub terms: Vec<[f64; N]>,
+    /// Two slots per output.
+    pub sums: Vec<[f64; N]>,
+}
+
+impl<const N: usize> Workspace<N> {
+    /// Buffers for `N` points of `system`.
+    pub(crate) fn new(system: &FuzzySystem) -> Self {
+        let c = system.compiled();
+        let mut values = vec![[0.0; N]; c.slot_count];
+        // The neutral element of AND, which "don't care" antecedents point at (0, that of OR,
+        // is already there).
+        values[c.degree_count - 2] = [1.0; N];
+        Self {
+            x: vec![[0.0; N]; c.n_inputs],
+            values,
+            terms: c.term_values.iter().map(|&t| [t; N]).collect(),
+            sums: vec![[0.0; N]; 2 * system.outputs().len()],
+        }
+    }
+
+    /// The buffers as the kernel takes them.
+    #[inline(always)]
+    pub(crate) fn slots(&mut self) -> Slots<'_, N> {
+        Slots {
+            x: &self.x,
+            values: &mut self.values,
+            terms: &mut self.terms,
+            sums: &mut self.sums,
+        }
+    }
+}
