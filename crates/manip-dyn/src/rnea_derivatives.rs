@@ -102,6 +102,7 @@ pub fn rnea_derivatives(
     );
     check::finite_result("tau", &derivatives.value)?;
     // The Newton-Euler pass left the link directions and rates of (q, v) in `data.frames`.
+    let stride = derivatives.stride;
     fill_partials(
         model,
         &data.frames,
@@ -109,19 +110,23 @@ pub fn rnea_derivatives(
         1.0,
         &mut derivatives.links,
         &mut derivatives.blocks,
+        stride,
     );
     crba::assemble(
         model,
         &data.frames,
         &mut data.subtrees,
         &mut data.mass_row,
-        MatMut::from_row_major_slice_with_stride_mut(&mut derivatives.blocks[2 * n..], n, n, 3 * n),
+        MatMut::from_row_major_slice_with_stride_mut(&mut derivatives.blocks[2 * n..], n, n, stride),
     );
     check::finite_result("tau derivatives", &derivatives.blocks)
 }
 
 /// Writes `sign * d tau / d q` and `sign * d tau / d v` at the accelerations `qdd` into the first
-/// two `n`-column blocks of the row-major `n x 3n` `blocks`, from `frames` already updated at `(q, v)` (inputs validated).
+/// two `n`-column blocks of the row-major `n x stride` `blocks`, from `frames` already updated at
+/// `(q, v)` (inputs validated). Inlined, so that inside `aba_derivatives`' SIMD dispatch the
+/// loops vectorise with its instruction set.
+#[inline(always)]
 pub(crate) fn fill_partials(
     model: &ChainModel,
     frames: &[LinkFrame],
@@ -129,12 +134,13 @@ pub(crate) fn fill_partials(
     sign: f64,
     terms: &mut LinkTerms,
     blocks: &mut [f64],
+    stride: usize,
 ) {
     let n = model.n_links();
     link_terms(model, frames, qdd, sign, terms);
     let [lambda_x, lambda_y] = &terms.lambda;
     let [sigma_x, sigma_y] = &terms.sigma;
-    for (i, row) in blocks.chunks_exact_mut(3 * n).enumerate() {
+    for (i, row) in blocks.chunks_exact_mut(stride).enumerate() {
         let (d_q, rest) = row.split_at_mut(n);
         let d_v = &mut rest[..n];
         for (which, out) in [d_q, d_v].into_iter().enumerate() {
