@@ -12,7 +12,7 @@ use crate::model::{ChainModel, MAX_DENSE_LINKS};
 /// The row stride of the three Jacobians is a multiple of this many entries (the widest SIMD
 /// register's `f64` lanes, AVX-512), so that the many-right-hand-side sweeps of
 /// `aba_derivatives` run on whole registers; the padding columns stay zero.
-const ROW_ALIGNMENT: usize = 8;
+pub(crate) const ROW_ALIGNMENT: usize = 8;
 
 /// Results and scratch of [`rnea_derivatives`](crate::rnea_derivatives()) and
 /// [`aba_derivatives`](crate::aba_derivatives()) for one [`ChainModel`]: build it once with
@@ -62,9 +62,8 @@ pub(crate) struct SweepLink {
 /// [`rnea_derivatives`](crate::rnea_derivatives()): one set for `d/dq` and one for `d/dv`.
 #[derive(Debug, Clone)]
 pub(crate) struct LinkTerms {
-    /// `S_j`, absolute angular rate `w_j` and acceleration `alpha_j` of each link.
+    /// `S_j` and absolute angular acceleration `alpha_j` of each link.
     pub moment: Vec<f64>,
-    pub rate: Vec<f64>,
     pub accel: Vec<f64>,
     /// Joint positions `lambda_k = sum_{j<k} L_j u_j` and subtree moments
     /// `sigma_i = sum_{j>=i} S_j u_j`, by component.
@@ -102,7 +101,6 @@ impl DerivativeData {
             stride,
             links: LinkTerms {
                 moment: vector(),
-                rate: vector(),
                 accel: vector(),
                 lambda: pair(),
                 sigma: pair(),
