@@ -81,10 +81,13 @@ pub(crate) fn right_hand_side(
 fn solve(data: &mut ReducedData, tau_star: &[f64], a_ddot: &mut [f64]) -> Result<(), ReduceError> {
     right_hand_side(tau_star, &data.coriolis, &data.gravity, a_ddot);
     let m = data.n_coords;
-    // The paper's sizes factorise a copy on the stack, with fully unrolled loops.
+    // The paper's sizes and two harmonics (m = 2 to 5) factorise a copy on the stack, with
+    // fully unrolled loops.
     let positive_definite = match m {
         2 => solve_on_stack::<2>(&data.mass, a_ddot),
         3 => solve_on_stack::<3>(&data.mass, a_ddot),
+        4 => solve_on_stack::<4>(&data.mass, a_ddot),
+        5 => solve_on_stack::<5>(&data.mass, a_ddot),
         _ => {
             data.factor.copy_from_slice(&data.mass);
             factor_and_solve(&mut data.factor, a_ddot, m)

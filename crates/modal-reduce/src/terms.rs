@@ -100,10 +100,13 @@ pub fn reduced_terms(
     let m = model.n_coords();
     check_input("a", a, m)?;
     check_input("a_dot", a_dot, m)?;
-    // The paper's sizes run on stack arrays that the optimiser keeps in registers.
+    // The paper's sizes and two harmonics (m = 2 to 5) run on stack arrays that the optimiser
+    // keeps in registers.
     match m {
         2 => accumulate_on_stack::<2>(model, data, a, a_dot),
         3 => accumulate_on_stack::<3>(model, data, a, a_dot),
+        4 => accumulate_on_stack::<4>(model, data, a, a_dot),
+        5 => accumulate_on_stack::<5>(model, data, a, a_dot),
         _ => {
             let ReducedData {
                 links,
