@@ -5,12 +5,18 @@
 //! [`aba_derivatives`]: crate::aba_derivatives()
 
 use faer::MatRef;
+use pulp::Arch;
 
 use crate::model::{ChainModel, MAX_DENSE_LINKS};
 
+/// The row stride of the three Jacobians is a multiple of this many entries (the widest SIMD
+/// register's `f64` lanes, AVX-512), so that the many-right-hand-side sweeps of
+/// `aba_derivatives` run on whole registers; the padding columns stay zero.
+pub(crate) const ROW_ALIGNMENT: usize = 8;
+
 /// Results and scratch of [`rnea_derivatives`](crate::rnea_derivatives()) and
 /// [`aba_derivatives`](crate::aba_derivatives()) for one [`ChainModel`]: build it once with
-/// [`DerivativeData::new`] (three `n x n` matrices, `24 n^2` bytes), then every call fills it
+/// [`DerivativeData::new`] (three `n x n` matrices side by side, about `24 n^2` bytes), then every call fills it
 /// without allocating. For a chain of more than [`MAX_DENSE_LINKS`] links, which both
 /// derivative functions refuse, it holds nothing: its value is empty and its matrices `0 x 0`.
 ///
@@ -26,22 +32,38 @@ pub struct DerivativeData {
     pub(crate) n: usize,
     /// `tau` or `qdd`.
     pub(crate) value: Vec<f64>,
-    /// Row-major `n x 3n`: row `i` is `[d_q row i | d_v row i | d_input row i]`, so that the
-    /// many-right-hand-side solve of `aba_derivatives` runs along contiguous rows.
+    /// Row-major `n x stride`: row `i` is `[d_q row i | d_v row i | d_input row i | padding]`,
+    /// so that the many-right-hand-side solve of `aba_derivatives` runs along contiguous rows.
     pub(crate) blocks: Vec<f64>,
+    /// The row stride of `blocks`: `3n` rounded up to a multiple of [`ROW_ALIGNMENT`].
+    pub(crate) stride: usize,
     /// Per-link terms of the derivative formulas (see `rnea_derivatives`).
     pub(crate) links: LinkTerms,
-    /// Per-column state of the many-right-hand-side sweeps, `3n` each.
-    pub(crate) sweep: [Vec<f64>; 3],
+    /// Per-link constants of the many-right-hand-side sweeps (see `aba_derivatives`).
+    pub(crate) solve: Vec<SweepLink>,
+    /// The instruction set found at construction, for the sweeps.
+    pub(crate) arch: Arch,
+}
+
+/// What the sweeps of `aba_derivatives` that apply `M^-1` need of joint `i`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct SweepLink {
+    /// `L_i u_i`, joint `i + 1` relative to joint `i`.
+    pub offset: [f64; 2],
+    /// The translational part `U_i` of the articulated inertia times the joint axis.
+    pub coupling: [f64; 2],
+    /// `U_i / D_i`.
+    pub gain: [f64; 2],
+    /// `1 / D_i`.
+    pub inverse: f64,
 }
 
 /// Per-link vectors (length `n + 1`, the last entry the empty sum) of the closed forms in
 /// [`rnea_derivatives`](crate::rnea_derivatives()): one set for `d/dq` and one for `d/dv`.
 #[derive(Debug, Clone)]
 pub(crate) struct LinkTerms {
-    /// `S_j`, absolute angular rate `w_j` and acceleration `alpha_j` of each link.
+    /// `S_j` and absolute angular acceleration `alpha_j` of each link.
     pub moment: Vec<f64>,
-    pub rate: Vec<f64>,
     pub accel: Vec<f64>,
     /// Joint positions `lambda_k = sum_{j<k} L_j u_j` and subtree moments
     /// `sigma_i = sum_{j>=i} S_j u_j`, by component.
@@ -71,13 +93,14 @@ impl DerivativeData {
         let sized = if n <= MAX_DENSE_LINKS { n } else { 0 };
         let vector = || vec![0.0; sized + 1];
         let pair = || [vector(), vector()];
+        let stride = (3 * sized).next_multiple_of(ROW_ALIGNMENT);
         DerivativeData {
             n,
             value: vec![0.0; sized],
-            blocks: vec![0.0; 3 * sized * sized],
+            blocks: vec![0.0; stride * sized],
+            stride,
             links: LinkTerms {
                 moment: vector(),
-                rate: vector(),
                 accel: vector(),
                 lambda: pair(),
                 sigma: pair(),
@@ -86,11 +109,8 @@ impl DerivativeData {
                 row_sum: pair(),
                 base: pair(),
             },
-            sweep: [
-                vec![0.0; 3 * sized],
-                vec![0.0; 3 * sized],
-                vec![0.0; 3 * sized],
-            ],
+            solve: vec![SweepLink::default(); sized],
+            arch: Arch::new(),
         }
     }
 
@@ -123,6 +143,6 @@ impl DerivativeData {
 
     fn block(&self, index: usize) -> MatRef<'_, f64> {
         let n = self.value.len();
-        MatRef::from_row_major_slice_with_stride(&self.blocks[index * n..], n, n, 3 * n)
+        MatRef::from_row_major_slice_with_stride(&self.blocks[index * n..], n, n, self.stride)
     }
 }

@@ -43,6 +43,7 @@
 //! triangle: `O(n)` work for the sums, then two multiply-adds per entry.
 
 use faer::MatMut;
+use pulp::{Simd, WithSimd};
 
 use crate::check;
 use crate::crba;
@@ -102,26 +103,64 @@ pub fn rnea_derivatives(
     );
     check::finite_result("tau", &derivatives.value)?;
     // The Newton-Euler pass left the link directions and rates of (q, v) in `data.frames`.
-    fill_partials(
+    let stride = derivatives.stride;
+    let arch = derivatives.arch;
+    arch.dispatch(Partials {
         model,
-        &data.frames,
+        frames: &data.frames,
         qdd,
-        1.0,
-        &mut derivatives.links,
-        &mut derivatives.blocks,
-    );
+        terms: &mut derivatives.links,
+        blocks: &mut derivatives.blocks,
+        stride,
+    });
     crba::assemble(
         model,
         &data.frames,
         &mut data.subtrees,
         &mut data.mass_row,
-        MatMut::from_row_major_slice_with_stride_mut(&mut derivatives.blocks[2 * n..], n, n, 3 * n),
+        MatMut::from_row_major_slice_with_stride_mut(
+            &mut derivatives.blocks[2 * n..],
+            n,
+            n,
+            stride,
+        ),
     );
     check::finite_result("tau derivatives", &derivatives.blocks)
 }
 
+/// [`fill_partials`] with `sign = 1`, by [`pulp::Arch::dispatch`] so that its loops vectorise
+/// with the processor's instruction set.
+struct Partials<'a> {
+    model: &'a ChainModel,
+    frames: &'a [LinkFrame],
+    qdd: &'a [f64],
+    terms: &'a mut LinkTerms,
+    blocks: &'a mut [f64],
+    stride: usize,
+}
+
+impl WithSimd for Partials<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) {
+        let Self {
+            model,
+            frames,
+            qdd,
+            terms,
+            blocks,
+            stride,
+        } = self;
+        fill_partials(model, frames, qdd, 1.0, terms, blocks, stride);
+    }
+}
+
 /// Writes `sign * d tau / d q` and `sign * d tau / d v` at the accelerations `qdd` into the first
-/// two `n`-column blocks of the row-major `n x 3n` `blocks`, from `frames` already updated at `(q, v)` (inputs validated).
+/// two `n`-column blocks of the row-major `n x stride` `blocks`, from `frames` already updated at
+/// `(q, v)` (inputs validated). Inlined, so that inside a SIMD dispatch the loops vectorise with
+/// its instruction set.
+#[inline(always)]
 pub(crate) fn fill_partials(
     model: &ChainModel,
     frames: &[LinkFrame],
@@ -129,12 +168,13 @@ pub(crate) fn fill_partials(
     sign: f64,
     terms: &mut LinkTerms,
     blocks: &mut [f64],
+    stride: usize,
 ) {
     let n = model.n_links();
     link_terms(model, frames, qdd, sign, terms);
     let [lambda_x, lambda_y] = &terms.lambda;
     let [sigma_x, sigma_y] = &terms.sigma;
-    for (i, row) in blocks.chunks_exact_mut(3 * n).enumerate() {
+    for (i, row) in blocks.chunks_exact_mut(stride).enumerate() {
         let (d_q, rest) = row.split_at_mut(n);
         let d_v = &mut rest[..n];
         for (which, out) in [d_q, d_v].into_iter().enumerate() {
@@ -169,88 +209,85 @@ fn link_terms(
     terms: &mut LinkTerms,
 ) {
     let n = model.n_links();
-    let links = model.links();
+    let (links, frames, qdd) = (model.links(), &frames[..n], &qdd[..n]);
     let g = model.gravity();
-    // From the tip: S_j, sigma_i, A_k (both sets).
-    let mut beyond = 0.0;
-    let mut sigma = [0.0; 2];
-    let mut suffix = [[0.0; 2]; 2];
-    for which in 0..2 {
-        terms.suffix[which][0][n] = 0.0;
-        terms.suffix[which][1][n] = 0.0;
-    }
+    // Every vector cut to its length here, so that the loops below index without checks.
+    let LinkTerms {
+        moment,
+        accel,
+        lambda: [lambda_x, lambda_y],
+        sigma: [sigma_x, sigma_y],
+        suffix: [[aq_x, aq_y], [av_x, av_y]],
+        prefix: [[bq_x, bq_y], [bv_x, bv_y]],
+        row_sum: [kq, kv],
+        base: [base_q, base_v],
+    } = terms;
+    let (moment, accel) = (&mut moment[..n], &mut accel[..n]);
+    let (lambda_x, lambda_y) = (&mut lambda_x[..n], &mut lambda_y[..n]);
+    let (sigma_x, sigma_y) = (&mut sigma_x[..n], &mut sigma_y[..n]);
+    let (aq_x, aq_y) = (&mut aq_x[..=n], &mut aq_y[..=n]);
+    let (av_x, av_y) = (&mut av_x[..=n], &mut av_y[..=n]);
+    let (bq_x, bq_y) = (&mut bq_x[..n], &mut bq_y[..n]);
+    let (bv_x, bv_y) = (&mut bv_x[..n], &mut bv_y[..n]);
+    let (kq, kv) = (&mut kq[..n], &mut kv[..n]);
+    let (base_q, base_v) = (&mut base_q[..n], &mut base_v[..n]);
     // From the base: absolute accelerations (needed by E before the sweep from the tip).
     let mut alpha = 0.0;
-    for (accel, &qdd_i) in terms.accel.iter_mut().zip(qdd) {
+    for (accel, &qdd_i) in accel.iter_mut().zip(qdd) {
         alpha += qdd_i;
         *accel = alpha;
     }
+    // From the tip: S_j, sigma_i, A_k (both sets).
+    let mut beyond = 0.0;
+    let mut sigma = [0.0; 2];
+    let (mut a_q, mut a_v) = ([0.0; 2], [0.0; 2]);
+    (aq_x[n], aq_y[n], av_x[n], av_y[n]) = (0.0, 0.0, 0.0, 0.0);
     for j in (0..n).rev() {
-        let link = &links[j];
-        let frame = &frames[j];
+        let (link, frame) = (&links[j], &frames[j]);
         let [c, s] = frame.axis;
-        let moment = link.mass * link.com + link.length * beyond;
+        let moment_j = link.mass * link.com + link.length * beyond;
         beyond += link.mass;
-        let (w, alpha) = (frame.omega, terms.accel[j]);
-        terms.moment[j] = moment;
-        terms.rate[j] = w;
-        sigma = [sigma[0] + moment * c, sigma[1] + moment * s];
-        terms.sigma[0][j] = sigma[0];
-        terms.sigma[1][j] = sigma[1];
-        for (which, [ex, ey]) in [motion_e(c, s, w, alpha), motion_f(c, s, w)]
-            .into_iter()
-            .enumerate()
-        {
-            let sum = &mut suffix[which];
-            *sum = [sum[0] + sign * moment * ex, sum[1] + sign * moment * ey];
-            terms.suffix[which][0][j] = sum[0];
-            terms.suffix[which][1][j] = sum[1];
-        }
+        moment[j] = moment_j;
+        sigma = [sigma[0] + moment_j * c, sigma[1] + moment_j * s];
+        (sigma_x[j], sigma_y[j]) = (sigma[0], sigma[1]);
+        let [ex, ey] = motion_e(c, s, frame.omega, accel[j]);
+        let [fx, fy] = motion_f(c, s, frame.omega);
+        a_q = [a_q[0] + sign * moment_j * ex, a_q[1] + sign * moment_j * ey];
+        a_v = [a_v[0] + sign * moment_j * fx, a_v[1] + sign * moment_j * fy];
+        (aq_x[j], aq_y[j], av_x[j], av_y[j]) = (a_q[0], a_q[1], a_v[0], a_v[1]);
     }
-    // From the base: lambda_k, B_k, the row sums kappa_j.
+    // From the base: lambda_k, B_k, the row sums kappa_j (from B_j, before adding link j, and
+    // A_{j+1}).
     let mut lambda = [0.0; 2];
-    let mut prefix = [[0.0; 2]; 2];
+    let (mut b_q, mut b_v) = ([0.0; 2], [0.0; 2]);
     for j in 0..n {
-        let link = &links[j];
-        let [c, s] = frames[j].axis;
-        let (moment, w, alpha) = (terms.moment[j], terms.rate[j], terms.accel[j]);
-        terms.lambda[0][j] = lambda[0];
-        terms.lambda[1][j] = lambda[1];
-        lambda = [lambda[0] + link.length * c, lambda[1] + link.length * s];
-        for (which, [ex, ey]) in [motion_e(c, s, w, alpha), motion_f(c, s, w)]
-            .into_iter()
-            .enumerate()
-        {
-            let sum = &mut prefix[which];
-            terms.prefix[which][0][j] = sum[0];
-            terms.prefix[which][1][j] = sum[1];
-            // kappa_j from B_j (before adding link j) and A_{j+1}.
-            terms.row_sum[which][j] = if which == 0 {
-                -sign * g * moment * s
-            } else {
-                let (ax, ay) = (terms.suffix[1][0][j + 1], terms.suffix[1][1][j + 1]);
-                moment * (s * sum[0] - c * sum[1]) + link.length * (s * ax - c * ay)
-            };
-            *sum = [
-                sum[0] + sign * link.length * ex,
-                sum[1] + sign * link.length * ey,
-            ];
-        }
+        let (link, frame) = (&links[j], &frames[j]);
+        let [c, s] = frame.axis;
+        let (moment_j, length) = (moment[j], link.length);
+        (lambda_x[j], lambda_y[j]) = (lambda[0], lambda[1]);
+        lambda = [lambda[0] + length * c, lambda[1] + length * s];
+        let [ex, ey] = motion_e(c, s, frame.omega, accel[j]);
+        let [fx, fy] = motion_f(c, s, frame.omega);
+        (bq_x[j], bq_y[j], bv_x[j], bv_y[j]) = (b_q[0], b_q[1], b_v[0], b_v[1]);
+        kq[j] = -sign * g * moment_j * s;
+        kv[j] = moment_j * (s * b_v[0] - c * b_v[1]) + length * (s * av_x[j + 1] - c * av_y[j + 1]);
+        b_q = [b_q[0] + sign * length * ex, b_q[1] + sign * length * ey];
+        b_v = [b_v[0] + sign * length * fx, b_v[1] + sign * length * fy];
     }
     // From the tip: K_i = sum_{j>=i} kappa_j, then base_k.
-    for which in 0..2 {
+    let sets = [
+        (kq, base_q, [&*aq_x, &*aq_y], [&*bq_x, &*bq_y]),
+        (kv, base_v, [&*av_x, &*av_y], [&*bv_x, &*bv_y]),
+    ];
+    for (row_sum, base, [a_x, a_y], [b_x, b_y]) in sets {
         let mut total = 0.0;
         for k in (0..n).rev() {
-            total += terms.row_sum[which][k];
-            terms.row_sum[which][k] = total;
+            total += row_sum[k];
+            row_sum[k] = total;
         }
         for k in 0..n {
-            let (ax, ay) = (terms.suffix[which][0][k], terms.suffix[which][1][k]);
-            let (bx, by) = (terms.prefix[which][0][k], terms.prefix[which][1][k]);
-            terms.base[which][k] = terms.row_sum[which][k] - bx * terms.sigma[1][k]
-                + by * terms.sigma[0][k]
-                + ax * terms.lambda[1][k]
-                - ay * terms.lambda[0][k];
+            base[k] = row_sum[k] - b_x[k] * sigma_y[k] + b_y[k] * sigma_x[k] + a_x[k] * lambda_y[k]
+                - a_y[k] * lambda_x[k];
         }
     }
 }

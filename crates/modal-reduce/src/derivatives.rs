@@ -27,7 +27,11 @@
 //! `X_jj = -L_j (s_j A_{j+1}^x - c_j A_{j+1}^y) - S_j (s_j B_j^x - c_j B_j^y) - g S_j s_j` from the
 //! scalar sums `A_k = sum_{l>=k} S_l E_l` and `B_j = sum_{l<j} L_l E_l`. `D_v` is the same with
 //! `F` for `E` and no diagonal. One pass from the tip (`A`) and one from the base (the rest),
-//! `O(m^2)` per link; then an `L D L^T` factorisation of `M*` and `3m` small solves.
+//! `O(m^2)` per link (`O(m)` for the vectors of the link, then a rank-2 update of each partial);
+//! then an `L D L^T` factorisation of `M*` and one substitution sweep over the rows of the
+//! `m x 3m` right-hand side `[-D_a | -D_v | 1]`, which gives the three Jacobians at once. The
+//! paper's sizes (`m = 2` to `5`) run on stack arrays of compile-time size, which the compiler
+//! unrolls; other sizes on the workspace's vectors.
 
 use faer::MatRef;
 
@@ -35,7 +39,7 @@ use crate::data::ReducedData;
 use crate::error::{ReduceError, check_finite_result, check_len};
 use crate::forward::forward_dynamics;
 use crate::model::ReducedModel;
-use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
+use crate::small_linalg::{ldlt_in_place, ldlt_solve_rows_in_place};
 
 /// Results and scratch of [`reduced_derivatives`] for one [`ReducedModel`]: `O(n + m^2)` memory,
 /// built once; every call then fills it without allocating.
@@ -55,19 +59,26 @@ pub struct ReducedDerivatives {
     rate: Vec<f64>,
     accel: Vec<f64>,
     diagonal: Vec<f64>,
-    /// `m` each: `P^s`, `P^c`, `Q^x`, `Q^y` and the `F` counterparts of `Q`.
-    prefix: [Vec<f64>; 6],
-    /// `m x m` each, column-major (row `k` is column `k`): `D_a`, `D_v`; then the factor of `M*`.
-    partial: [Vec<f64>; 2],
+    /// Scratch of the sizes without a stack version: [`VECTORS`] vectors of `m` and the
+    /// factor of `M*` (`m x m`).
+    vectors: [Vec<f64>; VECTORS],
     factor: Vec<f64>,
-    /// `m`: one right-hand side of the solves.
-    column: Vec<f64>,
 }
+
+/// The `m`-vectors of the pass from the base: `P^s`, `P^c`, `Q^x`, `Q^y`, the `F` counterparts
+/// of `Q`, and the link's four update vectors (above and below the diagonal, for `D_a` and
+/// `D_v`).
+const VECTORS: usize = 10;
+
+/// The most coordinates on stack arrays (`K = 2` harmonics with `alpha0` free).
+const MAX_STACK_COORDS: usize = 5;
 
 impl ReducedDerivatives {
     /// A workspace sized for `model`.
     pub fn new(model: &ReducedModel) -> Self {
         let (n, m) = (model.n_links(), model.n_coords());
+        // The stack sizes need no heap scratch.
+        let heap = m > MAX_STACK_COORDS;
         Self {
             n_links: n,
             n_coords: m,
@@ -76,10 +87,8 @@ impl ReducedDerivatives {
             rate: vec![0.0; n],
             accel: vec![0.0; n],
             diagonal: vec![0.0; n],
-            prefix: std::array::from_fn(|_| vec![0.0; m]),
-            partial: [vec![0.0; m * m], vec![0.0; m * m]],
-            factor: vec![0.0; m * m],
-            column: vec![0.0; m],
+            vectors: std::array::from_fn(|_| vec![0.0; if heap { m } else { 0 }]),
+            factor: vec![0.0; if heap { m * m } else { 0 }],
         }
     }
 
@@ -157,73 +166,128 @@ pub fn reduced_derivatives(
         model.n_coords(),
     )?;
     forward_dynamics(model, data, a, a_dot, tau_star, &mut derivatives.a_ddot)?;
-    // `forward_dynamics` left each link's sine and cosine in `data.links`.
-    partials(model, data, derivatives, a_dot);
-    let m = model.n_coords();
-    let d = &mut *derivatives;
-    d.factor.copy_from_slice(&data.mass);
-    if !ldlt_in_place((), &mut d.factor, m) {
+    // `forward_dynamics` left each link's sine and cosine in `data.links`, and M* in `data`.
+    let positive_definite = match model.n_coords() {
+        2 => on_stack::<2>(model, data, derivatives, a_dot),
+        3 => on_stack::<3>(model, data, derivatives, a_dot),
+        4 => on_stack::<4>(model, data, derivatives, a_dot),
+        5 => on_stack::<5>(model, data, derivatives, a_dot),
+        m => {
+            let ReducedDerivatives {
+                a_ddot,
+                jacobians,
+                rate,
+                accel,
+                diagonal,
+                vectors,
+                factor,
+                ..
+            } = derivatives;
+            let links = LinkScratch {
+                rate,
+                accel,
+                diagonal,
+            };
+            let vectors = vectors.each_mut().map(Vec::as_mut_slice);
+            differentiate(
+                model, data, m, a_dot, a_ddot, links, vectors, factor, jacobians,
+            )
+        }
+    };
+    if !positive_definite {
         return Err(ReduceError::NotPositiveDefinite);
     }
-    // Column k of each block: -M*^-1 D_a e_k, -M*^-1 D_v e_k, M*^-1 e_k.
-    for k in 0..m {
-        for block in 0..3 {
-            let column = &mut d.column;
-            match block {
-                2 => {
-                    column.fill(0.0);
-                    column[k] = 1.0;
-                }
-                _ => {
-                    for (entry, &value) in column.iter_mut().zip(&d.partial[block][k * m..]) {
-                        *entry = -value;
-                    }
-                }
-            }
-            ldlt_solve_in_place(&d.factor, m, column);
-            for (i, &value) in column.iter().enumerate() {
-                d.jacobians[i * 3 * m + block * m + k] = value;
-            }
-        }
-    }
-    check_finite_result("reduced dynamics derivatives", &d.jacobians)
+    check_finite_result("reduced dynamics derivatives", &derivatives.jacobians)
 }
 
-/// `D_a` and `D_v` (column-major) at the state of `data` (sines and cosines of the link angles)
-/// and the accelerations in `derivatives`.
-fn partials(
+/// Per-link scratch of [`differentiate`] (`n` each): `w_l`, `alpha_l` and `X_ll`.
+struct LinkScratch<'a> {
+    rate: &'a mut [f64],
+    accel: &'a mut [f64],
+    diagonal: &'a mut [f64],
+}
+
+/// [`differentiate`] for a compile-time `M`, on local arrays; the Jacobians are copied into
+/// `derivatives`.
+#[inline(always)]
+fn on_stack<const M: usize>(
     model: &ReducedModel,
     data: &ReducedData,
     derivatives: &mut ReducedDerivatives,
     a_dot: &[f64],
-) {
-    let m = model.n_coords();
-    let g = model.chain().gravity();
-    let (sin, cos) = (&data.links.sin, &data.links.cos);
-    let rows = model.angle_rows();
-    let links = model.link_constants();
+) -> bool {
+    let mut vectors = [[0.0; M]; VECTORS];
+    let mut factor = [[0.0; M]; M];
+    let mut jacobians = [[[0.0; M]; 3]; M];
     let ReducedDerivatives {
         a_ddot,
         rate,
         accel,
         diagonal,
-        prefix,
-        partial,
         ..
     } = derivatives;
+    let links = LinkScratch {
+        rate,
+        accel,
+        diagonal,
+    };
+    let positive_definite = differentiate(
+        model,
+        data,
+        M,
+        a_dot,
+        a_ddot,
+        links,
+        vectors.each_mut().map(|vector| vector.as_mut_slice()),
+        factor.as_flattened_mut(),
+        jacobians.as_flattened_mut().as_flattened_mut(),
+    );
+    derivatives
+        .jacobians
+        .copy_from_slice(jacobians.as_flattened().as_flattened());
+    positive_definite
+}
+
+/// The three Jacobians (row-major `m x 3m`, into `jacobians`) at the state of `data` (the sines
+/// and cosines of the link angles, `M*`) and the accelerations `a_ddot`; `vectors` are
+/// [`VECTORS`] `m`-vectors of scratch and `factor` `m x m`. `false` if `M*` is not numerically
+/// positive definite.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn differentiate(
+    model: &ReducedModel,
+    data: &ReducedData,
+    m: usize,
+    a_dot: &[f64],
+    a_ddot: &[f64],
+    links: LinkScratch<'_>,
+    vectors: [&mut [f64]; VECTORS],
+    factor: &mut [f64],
+    jacobians: &mut [f64],
+) -> bool {
+    let n = model.n_links();
+    let g = model.chain().gravity();
+    let (a_dot, a_ddot) = (&a_dot[..m], &a_ddot[..m]);
+    let (sin, cos) = (&data.links.sin[..n], &data.links.cos[..n]);
+    let rows = &model.angle_rows()[..n * m];
+    let constants = &model.link_constants()[..n];
+    let (rate, accel, diagonal) = (
+        &mut links.rate[..n],
+        &mut links.accel[..n],
+        &mut links.diagonal[..n],
+    );
     // From the tip: w_l, alpha_l, and the part of X_ll from A_{l+1} and gravity.
     let mut suffix = [0.0; 2];
-    for l in (0..links.len()).rev() {
+    for l in (0..n).rev() {
         let phi = &rows[l * m..(l + 1) * m];
-        let (w, alpha) = phi
-            .iter()
-            .zip(a_dot.iter().zip(a_ddot.iter()))
-            .fold((0.0, 0.0), |(w, alpha), (p, (v, acc))| {
-                (w + p * v, alpha + p * acc)
-            });
+        let (mut w, mut alpha) = (0.0, 0.0);
+        for k in 0..m {
+            w += phi[k] * a_dot[k];
+            alpha += phi[k] * a_ddot[k];
+        }
         rate[l] = w;
         accel[l] = alpha;
-        let (s, c, link) = (sin[l], cos[l], &links[l]);
+        let (s, c, link) = (sin[l], cos[l], &constants[l]);
         diagonal[l] = -link.length * (s * suffix[0] - c * suffix[1]) - g * link.first_moment * s;
         let e = motion_e(c, s, w, alpha);
         suffix = [
@@ -231,31 +295,52 @@ fn partials(
             suffix[1] + link.first_moment * e[1],
         ];
     }
-    // From the base: the prefix sums and the projections.
-    for p in prefix.iter_mut() {
-        p.fill(0.0);
+    // From the base: the prefix sums, and the rank-2 update of each partial, accumulated with
+    // the opposite sign as the right-hand sides -D_a and -D_v.
+    let [
+        p_sin,
+        p_cos,
+        q_x,
+        q_y,
+        qf_x,
+        qf_y,
+        above_a,
+        above_v,
+        below_a,
+        below_v,
+    ] = vectors.map(|vector| &mut vector[..m]);
+    for prefix in [
+        &mut *p_sin,
+        &mut *p_cos,
+        &mut *q_x,
+        &mut *q_y,
+        &mut *qf_x,
+        &mut *qf_y,
+    ] {
+        prefix.fill(0.0);
     }
-    for q in partial.iter_mut() {
-        q.fill(0.0);
-    }
-    let [p_sin, p_cos, q_x, q_y, qf_x, qf_y] = prefix;
-    let [d_a, d_v] = partial;
+    let width = 3 * m;
+    let jacobians = &mut jacobians[..m * width];
+    jacobians.fill(0.0);
     let mut before = [0.0; 2];
-    for (l, (link, phi)) in links.iter().zip(rows.chunks_exact(m)).enumerate() {
+    for (l, (link, phi)) in constants.iter().zip(rows.chunks_exact(m)).enumerate() {
         let (s, c, w, alpha) = (sin[l], cos[l], rate[l], accel[l]);
         let moment = link.first_moment;
         let e = motion_e(c, s, w, alpha);
         let f = [2.0 * w * c, 2.0 * w * s];
         let weight = diagonal[l] - moment * (s * before[0] - c * before[1]);
-        // D += above ⊗ Phi + Phi ⊗ below (stored column-major: d[k * m + i] = D_ik).
-        for k in 0..m {
-            let below_a = moment * (s * q_x[k] - c * q_y[k]);
-            let below_v = moment * (s * qf_x[k] - c * qf_y[k]);
-            for i in 0..m {
-                let above_a = moment * (e[0] * p_sin[i] - e[1] * p_cos[i]) + weight * phi[i];
-                let above_v = moment * (f[0] * p_sin[i] - f[1] * p_cos[i]);
-                d_a[k * m + i] += above_a * phi[k] + phi[i] * below_a;
-                d_v[k * m + i] += above_v * phi[k] + phi[i] * below_v;
+        // D += above ⊗ Phi + Phi ⊗ below.
+        for i in 0..m {
+            above_a[i] = -(moment * (e[0] * p_sin[i] - e[1] * p_cos[i]) + weight * phi[i]);
+            above_v[i] = -(moment * (f[0] * p_sin[i] - f[1] * p_cos[i]));
+            below_a[i] = -(moment * (s * q_x[i] - c * q_y[i]));
+            below_v[i] = -(moment * (s * qf_x[i] - c * qf_y[i]));
+        }
+        for (i, row) in jacobians.chunks_exact_mut(width).enumerate() {
+            let (d_a, d_v) = row[..2 * m].split_at_mut(m);
+            for k in 0..m {
+                d_a[k] += above_a[i] * phi[k] + phi[i] * below_a[k];
+                d_v[k] += above_v[i] * phi[k] + phi[i] * below_v[k];
             }
         }
         let length = link.length;
@@ -270,6 +355,17 @@ fn partials(
         }
         before = [before[0] + length * e[0], before[1] + length * e[1]];
     }
+    // The right-hand side of M*^-1 itself, then all 3m columns solved at once.
+    for (i, row) in jacobians.chunks_exact_mut(width).enumerate() {
+        row[2 * m + i] = 1.0;
+    }
+    let factor = &mut factor[..m * m];
+    factor.copy_from_slice(&data.mass[..m * m]);
+    if !ldlt_in_place((), factor, m) {
+        return false;
+    }
+    ldlt_solve_rows_in_place(factor, m, jacobians, width);
+    true
 }
 
 /// `E_l = (c alpha - s w^2, s alpha + c w^2)`.

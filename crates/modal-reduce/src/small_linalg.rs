@@ -63,6 +63,40 @@ pub(crate) fn ldlt_solve_in_place<L: Lane>(factor: &[L], m: usize, x: &mut [L]) 
     }
 }
 
+/// Solves `L D L^T X = B` in place for the row-major `m x columns` matrix `x` (holding `B` on
+/// entry), with the factors left by [`ldlt_in_place`]: the substitutions of
+/// [`ldlt_solve_in_place`] on whole rows, so each column gets the same operations in the same
+/// order (the same bits) as solved alone, and the inner loops run along contiguous rows.
+#[inline(always)]
+pub(crate) fn ldlt_solve_rows_in_place(factor: &[f64], m: usize, x: &mut [f64], columns: usize) {
+    let (f, x) = (&factor[..m * m], &mut x[..m * columns]);
+    for i in 0..m {
+        let (solved, rest) = x.split_at_mut(i * columns);
+        let row = &mut rest[..columns];
+        for (k, other) in solved.chunks_exact(columns).enumerate() {
+            let l = f[i * m + k];
+            for (entry, &value) in row.iter_mut().zip(other) {
+                *entry -= l * value;
+            }
+        }
+    }
+    for (i, row) in x.chunks_exact_mut(columns).enumerate() {
+        let inverse = f[i * m + i];
+        for entry in row {
+            *entry *= inverse;
+        }
+    }
+    for i in (0..m).rev() {
+        let (row, solved) = x[i * columns..].split_at_mut(columns);
+        for (k, other) in solved.chunks_exact(columns).enumerate() {
+            let l = f[(i + 1 + k) * m + i];
+            for (entry, &value) in row.iter_mut().zip(other) {
+                *entry -= l * value;
+            }
+        }
+    }
+}
+
 /// The smallest and largest eigenvalues of the symmetric `m x m` matrix `a` (row-major), by
 /// cyclic Jacobi rotations; `a` is overwritten (its diagonal ends up holding the eigenvalues).
 ///
@@ -154,6 +188,28 @@ mod tests {
             for i in 0..m {
                 let ax: f64 = (0..m).map(|j| a[i * m + j] * x[j]).sum();
                 prop_assert!((ax - rhs[i]).abs() <= 1e-9 * (1.0 + rhs[i].abs()), "row {i}");
+            }
+        }
+
+        #[test]
+        fn row_solves_equal_column_solves_bit_for_bit(
+            (m, columns, entries, rhs) in (1usize..8, 1usize..10).prop_flat_map(|(m, columns)| (
+                Just(m),
+                Just(columns),
+                prop::collection::vec(-2.0..2.0f64, m * m),
+                prop::collection::vec(-5.0..5.0f64, m * columns),
+            ))
+        ) {
+            let mut factor = spd(&entries, m);
+            prop_assert!(ldlt_in_place((), &mut factor, m));
+            let mut rows = rhs.clone();
+            ldlt_solve_rows_in_place(&factor, m, &mut rows, columns);
+            for j in 0..columns {
+                let mut column: Vec<f64> = (0..m).map(|i| rhs[i * columns + j]).collect();
+                ldlt_solve_in_place(&factor, m, &mut column);
+                for i in 0..m {
+                    prop_assert_eq!(rows[i * columns + j].to_bits(), column[i].to_bits(), "[{}][{}]", i, j);
+                }
             }
         }
 
