@@ -15,24 +15,23 @@ use test_support::config::scaled;
 const AGREEMENT: f64 = 1e-6;
 
 /// Column `k` of the Jacobian of `f` with respect to input `which` (0, 1, 2) at `inputs`, by
-/// Ridders' central differences; panics if the error estimate is not far below the tolerance.
+/// Ridders' central differences, with Ridders' own estimate of its error.
 fn fd_column(
     f: &mut impl FnMut(&[f64], &[f64], &[f64]) -> Vec<f64>,
     inputs: [&[f64]; 3],
     which: usize,
     k: usize,
-) -> Vec<f64> {
+) -> (Vec<f64>, f64) {
     let mut moved: [Vec<f64>; 3] = inputs.map(<[f64]>::to_vec);
     let x = inputs[which][k];
-    let (column, _error) = ridders(
+    ridders(
         |value| {
             moved[which][k] = value;
             f(&moved[0], &moved[1], &moved[2])
         },
         x,
         0.1,
-    );
-    column
+    )
 }
 
 /// Asserts `analytic` (n x n) equals the finite-difference Jacobian of `f` with respect to input
@@ -46,8 +45,13 @@ fn assert_matches_fd(
 ) -> Result<(), TestCaseError> {
     let n = analytic.nrows();
     let mut fd = Mat::<f64>::zeros(n, n);
+    // Ridders' own error estimate: where the dynamics bend sharply (a nearly singular M,
+    // accelerations of thousands of rad/s^2) the extrapolation is less accurate than AGREEMENT
+    // of the scale, and it says so (found at 2048 cases: 2.7e-5 relative).
+    let mut fd_error = 0.0f64;
     for k in 0..n {
-        let column = fd_column(&mut f, inputs, which, k);
+        let (column, error) = fd_column(&mut f, inputs, which, k);
+        fd_error = fd_error.max(error);
         for i in 0..n {
             fd[(i, k)] = column[i];
         }
@@ -59,8 +63,9 @@ fn assert_matches_fd(
             // The floor covers Jacobians that vanish (no gravity, no motion): differences of
             // rounding noise.
             prop_assert!(
-                error <= AGREEMENT * scale + 1e-12,
-                "{name}[{i}][{k}]: analytic {} vs finite differences {} (scale {scale})",
+                error <= AGREEMENT * scale + 1e-12 + 10.0 * fd_error,
+                "{name}[{i}][{k}]: analytic {} vs finite differences {} (scale {scale}, \
+                 Ridders' error estimate {fd_error})",
                 analytic[(i, k)],
                 fd[(i, k)]
             );
