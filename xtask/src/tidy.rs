@@ -79,26 +79,22 @@ pub fn run(root: &Path, doc: impl FnOnce() -> Result<(), String>) -> Vec<String>
                         dir.display()
                     ));
                 }
-                let forbidden: &[&str] = match krate.as_str() {
-                    "lane-math" => &[
-                        "backbone-kin",
-                        "manip-dyn",
-                        "modal-reduce",
-                        "fuzzy-sugeno",
-                        "sim-core",
-                        "hrm",
-                        "hrm-cli",
-                    ],
-                    "fuzzy-sugeno" => &[
-                        "backbone-kin",
-                        "manip-dyn",
-                        "modal-reduce",
-                        "sim-core",
-                        "hrm",
-                        "hrm-cli",
-                    ],
-                    k if LIBRARIES.contains(&k) => &["hrm-cli"],
-                    _ => &[],
+                // The bottom crates may use only the listed crates of ours; every library is
+                // kept off the command line.
+                let allowed: Option<&[&str]> = match krate.as_str() {
+                    "lane-math" => Some(&[]),
+                    "fuzzy-sugeno" => Some(&["lane-math"]),
+                    _ => None,
+                };
+                let forbidden: Vec<&str> = match allowed {
+                    Some(allowed) => LIBRARIES
+                        .iter()
+                        .chain(&["hrm-cli"])
+                        .copied()
+                        .filter(|other| *other != krate.as_str() && !allowed.contains(other))
+                        .collect(),
+                    None if LIBRARIES.contains(&krate.as_str()) => vec!["hrm-cli"],
+                    None => Vec::new(),
                 };
                 for dependency in dependencies(&manifest) {
                     if forbidden.contains(&dependency.as_str()) {
