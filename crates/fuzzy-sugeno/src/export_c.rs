@@ -233,9 +233,9 @@ fn source(system: &FuzzySystem, prefix: &str, options: &EvalOptions) -> String {
     // First-order terms by their index in the term table, and whether any rule uses one.
     let linear: std::collections::HashMap<usize, usize> = c.linear_terms.iter().copied().collect();
     let uses_linear = c
-        .consequents
+        .conclusions
         .iter()
-        .any(|&t| linear.contains_key(&(t as usize)));
+        .any(|&[_, t]| linear.contains_key(&(t as usize)));
     if c.is_or.iter().any(|&o| o) && methods.or == OrMethod::ProbabilisticSum {
         let _ = writeln!(
             s,
@@ -318,9 +318,10 @@ fn source(system: &FuzzySystem, prefix: &str, options: &EvalOptions) -> String {
     // Outputs (Evaluator::defuzzify).
     let _ = writeln!(s, "    /* layers 3-5: outputs */");
     for (o, output) in system.outputs().iter().enumerate() {
-        let row = &c.consequents[o * n_rules..(o + 1) * n_rules];
-        let _ = writeln!(s, "    weighted = 0.0;");
-        for (r, &term) in row.iter().enumerate() {
+        // The rules that conclude on the output, in rule order (kernel::sums).
+        let bounds = c.conclusion_offsets[o]..c.conclusion_offsets[o + 1];
+        let _ = writeln!(s, "    weighted = 0.0;\n    total = 0.0;");
+        for &[rule, term] in &c.conclusions[bounds] {
             let term = term as usize;
             match linear.get(&term) {
                 Some(&offset) => {
@@ -329,28 +330,17 @@ fn source(system: &FuzzySystem, prefix: &str, options: &EvalOptions) -> String {
                     for (i, coefficient) in p[..n_in].iter().enumerate() {
                         let _ = writeln!(s, "    t = t + {} * x[{i}];", lit(*coefficient));
                     }
-                    let _ = writeln!(s, "    weighted = weighted + w[{r}] * t;");
+                    let _ = writeln!(s, "    weighted = weighted + w[{rule}] * t;");
                 }
                 None => {
                     let _ = writeln!(
                         s,
-                        "    weighted = weighted + w[{r}] * {};",
+                        "    weighted = weighted + w[{rule}] * {};",
                         lit(c.term_values[term])
                     );
                 }
             }
-        }
-        let _ = writeln!(s, "    total = 0.0;");
-        for r in 0..n_rules {
-            if c.every_rule_concludes[o] {
-                let _ = writeln!(s, "    total = total + w[{r}];");
-            } else {
-                let _ = writeln!(
-                    s,
-                    "    total = total + w[{r}] * {};",
-                    lit(c.concludes[o * n_rules + r])
-                );
-            }
+            let _ = writeln!(s, "    total = total + w[{rule}];");
         }
         let value = match methods.defuzzification {
             Defuzzification::WeightedAverage => "weighted / total",

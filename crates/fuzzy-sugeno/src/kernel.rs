@@ -144,37 +144,30 @@ pub(crate) fn sums<L: Lane, const N: usize>(
 }
 
 /// [`sums`] when every rule concludes on every output: the outputs two at a time, side by side
-/// (each still summed in rule order), and the total strength, the same for all, summed once.
+/// (each summed in rule order), with the total strength, the same for all, summed alongside.
 #[inline(always)]
 fn dense_sums<L: Lane, const N: usize>(
     cx: L::Context,
     c: &Compiled,
-    dense: &[u32],
+    dense: &[[u32; 2]],
     slots: &mut Slots<'_, N>,
 ) {
     let n_out = c.conclusion_offsets.len() - 1;
+    let n_rules = c.weights.len();
     let zero = L::splat(cx, 0.0);
-    let strengths = &slots.values[c.strength_base..c.strength_base + c.weights.len()];
-    let mut total = zero;
-    for o in (0..n_out).step_by(2) {
-        let pair = o + 1 < n_out;
-        let (mut first, mut second, mut sum) = (zero, zero, zero);
-        for (strength, terms) in strengths.iter().zip(dense.chunks_exact(n_out)) {
+    let strengths = &slots.values[c.strength_base..c.strength_base + n_rules];
+    for (pair, terms) in dense.chunks_exact(n_rules).enumerate() {
+        let (mut first, mut second, mut total) = (zero, zero, zero);
+        for (strength, &[a, b]) in strengths.iter().zip(terms) {
             let w = L::load(cx, strength);
-            first = first + w * get::<L, N>(cx, slots.terms, terms[o] as usize);
-            if pair {
-                second = second + w * get::<L, N>(cx, slots.terms, terms[o + 1] as usize);
-            }
-            if o == 0 {
-                sum = sum + w;
-            }
+            first = first + w * get::<L, N>(cx, slots.terms, a as usize);
+            second = second + w * get::<L, N>(cx, slots.terms, b as usize);
+            total = total + w;
         }
-        if o == 0 {
-            total = sum;
-        }
+        let o = 2 * pair;
         set(slots.sums, 2 * o, first);
         set(slots.sums, 2 * o + 1, total);
-        if pair {
+        if o + 1 < n_out {
             set(slots.sums, 2 * o + 2, second);
             set(slots.sums, 2 * o + 3, total);
         }

@@ -458,13 +458,6 @@ pub(crate) struct Compiled {
     pub linear_terms: Vec<(usize, usize)>,
     /// The coefficients of the first-order terms, `n_inputs + 1` each.
     pub coefficients: Vec<f64>,
-    /// One row per output, one entry per rule: the index in `term_values` of the rule's
-    /// consequent, or of the trailing 0 of `term_values` when the rule says nothing about it.
-    pub consequents: Vec<u32>,
-    /// Whether every rule concludes on each output (then its total strength is the sum of all).
-    pub every_rule_concludes: Vec<bool>,
-    /// One row per output, one entry per rule: 1 if the rule concludes on the output, else 0.
-    pub concludes: Vec<f64>,
     /// The number of input variables.
     pub n_inputs: usize,
     /// The first node slot of the value slots of `kernel.rs` (the degree table comes first:
@@ -484,9 +477,10 @@ pub(crate) struct Compiled {
     pub strength_base: usize,
     /// Whether the strengths are the combined antecedents in place (no weight to apply).
     pub weights_folded: bool,
-    /// When every rule concludes on every output: the term of each rule for each output, rule
-    /// after rule (`n_outputs` entries each), so that the outputs are summed side by side.
-    pub dense_terms: Option<Vec<u32>>,
+    /// When every rule concludes on every output: the outputs in pairs `(2p, 2p + 1)`, and for
+    /// each pair, rule after rule, the rule's terms for both (the second repeating the first
+    /// when the last pair has one output), so that two outputs are summed side by side.
+    pub dense_terms: Option<Vec<[u32; 2]>>,
     /// The number of value slots: degrees, complements, 1 and 0, nodes, strengths.
     pub slot_count: usize,
     /// `[rule, term]` for every rule that concludes on an output, output after output and in
@@ -554,24 +548,6 @@ impl Compiled {
                 })?);
             }
         }
-        let no_conclusion = term_values.len();
-        term_values.push(0.0);
-        let mut consequents = Vec::with_capacity(outputs.len() * rules.len());
-        let mut concludes = Vec::with_capacity(outputs.len() * rules.len());
-        for (o, &first_term) in term_offsets.iter().enumerate() {
-            for rule in rules {
-                let term = rule.consequents[o].map_or(no_conclusion, |k| first_term + k);
-                consequents.push(index(term)?);
-                concludes.push(if rule.consequents[o].is_some() {
-                    1.0
-                } else {
-                    0.0
-                });
-            }
-        }
-        let every_rule_concludes: Vec<bool> = (0..outputs.len())
-            .map(|o| rules.iter().all(|r| r.consequents[o].is_some()))
-            .collect();
         let mut conclusions = Vec::new();
         let mut conclusion_offsets = vec![0];
         for (o, &first_term) in term_offsets.iter().enumerate() {
@@ -582,7 +558,11 @@ impl Compiled {
             }
             conclusion_offsets.push(conclusions.len());
         }
-        // The nodes: AND rules first, so that every AND node precedes every OR node.
+        // The nodes: AND rules first, so that every AND node precedes every OR node. Within one
+        // connective they are built level by level (every rule's first pair, then every rule's
+        // second, ...), so that when the rules all combine the same number of antecedents their
+        // last nodes are consecutive and in rule order: the strengths are then read in place
+        // (`weights_folded`) instead of being copied out.
         let node_base = degree_count;
         let mut rule_slots = vec![0; rules.len()];
         let mut and_nodes = Vec::new();
@@ -592,24 +572,34 @@ impl Compiled {
                 Connective::And => (&mut and_nodes, node_base),
                 Connective::Or => (&mut or_nodes, node_base + and_nodes.len()),
             };
-            let mut known: std::collections::HashMap<[u32; 2], u32> = Default::default();
+            // Each rule's antecedents that are not "don't care", in input order.
+            let mut chains = Vec::new();
             for (r, rule) in rules.iter().enumerate() {
                 if rule.connective != connective {
                     continue;
                 }
                 let row = &antecedents[r * inputs.len()..(r + 1) * inputs.len()];
-                let mut cared = row
+                let cared: Vec<u32> = row
                     .iter()
                     .zip(&rule.antecedents)
                     .filter(|(_, a)| **a != Antecedent::Any)
-                    .map(|(&slot, _)| slot);
+                    .map(|(&slot, _)| slot)
+                    .collect();
                 // `check_rule` refuses a rule whose antecedents are all "don't care".
-                let mut slot = cared.next().ok_or_else(|| {
+                rule_slots[r] = *cared.first().ok_or_else(|| {
                     invalid(&format!("rule {}", r + 1), SystemProblem::NoAntecedent)
                 })?;
-                for next in cared {
-                    let pair = [slot, next];
-                    slot = match known.get(&pair) {
+                chains.push((r, cared));
+            }
+            let mut known: std::collections::HashMap<[u32; 2], u32> = Default::default();
+            let depth = chains.iter().map(|(_, cared)| cared.len()).max();
+            for level in 1..depth.unwrap_or(0) {
+                for (r, cared) in &chains {
+                    let Some(&next) = cared.get(level) else {
+                        continue;
+                    };
+                    let pair = [rule_slots[*r], next];
+                    rule_slots[*r] = match known.get(&pair) {
                         Some(&node) => node,
                         None => {
                             let node = index(first + nodes.len())?;
@@ -619,7 +609,6 @@ impl Compiled {
                         }
                     };
                 }
-                rule_slots[r] = slot;
             }
         }
         let node_end = node_base + and_nodes.len() + or_nodes.len();
@@ -633,12 +622,28 @@ impl Compiled {
         } else {
             node_end
         };
-        let dense_terms = every_rule_concludes.iter().all(|&every| every).then(|| {
-            (0..rules.len())
-                .flat_map(|r| (0..outputs.len()).map(move |o| (r, o)))
-                .map(|(r, o)| consequents[o * rules.len() + r])
-                .collect()
-        });
+        // When every rule concludes on every output: each rule's terms, output pair by pair.
+        let every_rule_concludes = rules
+            .iter()
+            .all(|r| r.consequents.iter().all(Option::is_some));
+        let dense_terms = if every_rule_concludes {
+            let term = |r: &Rule, o: usize| index(term_offsets[o] + r.consequents[o].unwrap_or(0));
+            let mut pairs = Vec::with_capacity(outputs.len().div_ceil(2) * rules.len());
+            for o in (0..outputs.len()).step_by(2) {
+                for rule in rules {
+                    let first = term(rule, o)?;
+                    let second = if o + 1 < outputs.len() {
+                        term(rule, o + 1)?
+                    } else {
+                        first
+                    };
+                    pairs.push([first, second]);
+                }
+            }
+            Some(pairs)
+        } else {
+            None
+        };
         Ok(Self {
             mfs,
             mf_inputs,
@@ -653,9 +658,6 @@ impl Compiled {
             term_values,
             linear_terms,
             coefficients,
-            consequents,
-            every_rule_concludes,
-            concludes,
             n_inputs: inputs.len(),
             node_base,
             and_nodes,
@@ -672,5 +674,31 @@ impl Compiled {
             conclusions,
             conclusion_offsets,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::paper_controller;
+
+    #[test]
+    fn a_full_grid_of_rules_shares_its_prefixes_and_reads_its_strengths_in_place() {
+        let system = paper_controller();
+        let c = system.compiled();
+        // 16 rules over 4 inputs: 4 + 8 + 16 products, the last 16 in rule order.
+        assert_eq!(c.and_nodes.len(), 28);
+        assert!(c.weights_folded);
+        assert_eq!(c.strength_base, c.node_base + 12);
+        let expected: Vec<u32> = (0..16).map(|r| (c.node_base + 12 + r) as u32).collect();
+        assert_eq!(c.rule_slots, expected);
+        // Level by level: every node reads slots of the levels before it.
+        for (k, &[a, b]) in c.and_nodes.iter().enumerate() {
+            let level_start = match k {
+                0..4 => c.node_base,
+                4..12 => c.node_base + 4,
+                _ => c.node_base + 12,
+            };
+            assert!((a as usize) < level_start && (b as usize) < c.node_base);
+        }
     }
 }
