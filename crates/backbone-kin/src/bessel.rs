@@ -5,6 +5,8 @@
 //! `A = sqrt(a1^2 + a2^2)` of a curve whose end point lies at distance `r = l y` from the base
 //! (eqs 3-4).
 
+use std::sync::OnceLock;
+
 use crate::error::KinError;
 use crate::validate::check_finite;
 
@@ -14,8 +16,15 @@ pub const J0_FIRST_ZERO: f64 = 2.404_825_557_695_773;
 /// Below this distance `d = 1 - y` from the top, the inverse comes from its power series alone.
 const SERIES_ONLY_BELOW: f64 = 1e-2;
 
-/// Most Newton-bisection steps; the iteration needs about four from the series start.
+/// Most Newton-bisection steps; the iteration needs two from the tabulated start.
 const MAX_STEPS: usize = 64;
+
+/// Pieces of `s = sqrt(1 - value)` over `[sqrt(SERIES_ONLY_BELOW), 1]`, equal in length, on each
+/// of which the start of Newton's method is a Chebyshev interpolant of the inverse.
+const START_PIECES: usize = 16;
+
+/// Chebyshev coefficients of each piece's interpolant (its degree plus one).
+const START_TERMS: usize = 10;
 
 /// The restricted inverse of `J0`: the unique `A in [0, J0_FIRST_ZERO]` with `J0(A) = value`.
 ///
@@ -29,8 +38,11 @@ const MAX_STEPS: usize = 64;
 /// `u = d + d^2/4 + 7 d^3/72 + 13 d^4/288 + 997 d^5/43200 + 13001 d^6/1036800 + O(d^7)`,
 /// which is used alone when `d < 1e-2` (its truncation error in `u` is then at most `7e-15`
 /// relative, at `d = 1e-2`, which moves `J0(A)` by under `1e-16`: below the rounding of `libm::j0`)
-/// and otherwise as the start of Newton's method with `J0' = -J1`, safeguarded by bisection on a
-/// bracket that always contains the root.
+/// and otherwise Newton's method with `J0' = -J1`, safeguarded by bisection on a bracket that
+/// always contains the root, from a start tabulated once in `sqrt(d)` (piecewise Chebyshev
+/// interpolants built from the series-started iteration) so close to the root that the
+/// iteration ends after its second step: five Bessel evaluations, where the series start takes
+/// seven to eleven beyond `d = 0.1`.
 ///
 /// ```
 /// use backbone_kin::{inverse_j0, J0_FIRST_ZERO};
@@ -51,16 +63,64 @@ pub fn inverse_j0(value: f64) -> Result<f64, KinError> {
     }
     // Exact for value >= 1/2 (Sterbenz), which covers the series region.
     let d = 1.0 - value;
+    if d < SERIES_ONLY_BELOW {
+        return Ok(series_start(d));
+    }
+    Ok(newton_bisection(value, tabulated_start(d)))
+}
+
+/// The series inversion of `J0` at `d = 1 - value` (see [`inverse_j0`]).
+fn series_start(d: f64) -> f64 {
     let u = d
         * (1.0
             + d * (1.0 / 4.0
                 + d * (7.0 / 72.0
                     + d * (13.0 / 288.0 + d * (997.0 / 43200.0 + d * (13001.0 / 1036800.0))))));
-    let start = (2.0 * u.sqrt()).min(J0_FIRST_ZERO);
-    if d < SERIES_ONLY_BELOW {
-        return Ok(start);
+    (2.0 * u.sqrt()).min(J0_FIRST_ZERO)
+}
+
+/// The inverse beyond the series region as a function of `s = sqrt(d)`, `d = 1 - value`, which
+/// is analytic there (`A = 2 s (1 + s^2 / 8 + ...)` near the top; the nearest singularity, where
+/// `J1(A) = 0`, lies at `s = 1.18`): on each of [`START_PIECES`] pieces the interpolant of degree
+/// `START_TERMS - 1` at the piece's Chebyshev points, within `1e-11` of the inverse (a test
+/// checks it), so that the first Newton step reaches the root to rounding and the second
+/// confirms it. The table is built on first use from [`newton_bisection`] started from the
+/// series.
+fn tabulated_start(d: f64) -> f64 {
+    static TABLE: OnceLock<[[f64; START_TERMS]; START_PIECES]> = OnceLock::new();
+    let s_min = SERIES_ONLY_BELOW.sqrt();
+    let half = 0.5 * (1.0 - s_min) / START_PIECES as f64;
+    let centre = |piece: usize| s_min + (2 * piece + 1) as f64 * half;
+    let table = TABLE.get_or_init(|| {
+        let node = |j: usize| (std::f64::consts::PI * (j as f64 + 0.5) / START_TERMS as f64).cos();
+        std::array::from_fn(|piece| {
+            let inverse: [f64; START_TERMS] = std::array::from_fn(|j| {
+                let s = centre(piece) + half * node(j);
+                let d = s * s;
+                newton_bisection(1.0 - d, series_start(d))
+            });
+            std::array::from_fn(|k| {
+                let sum: f64 = (0..START_TERMS)
+                    .map(|j| {
+                        let angle = std::f64::consts::PI * k as f64 * (j as f64 + 0.5);
+                        inverse[j] * (angle / START_TERMS as f64).cos()
+                    })
+                    .sum();
+                let scale = if k == 0 { 1.0 } else { 2.0 };
+                scale * sum / START_TERMS as f64
+            })
+        })
+    });
+    let s = d.sqrt();
+    let piece = (((s - s_min) / (2.0 * half)) as usize).min(START_PIECES - 1);
+    let t = (s - centre(piece)) / half;
+    // Clenshaw's recurrence for sum_k c_k T_k(t).
+    let c = &table[piece];
+    let (mut b1, mut b2) = (0.0, 0.0);
+    for &c_k in c[1..].iter().rev() {
+        (b1, b2) = (2.0 * t * b1 - b2 + c_k, b1);
     }
-    Ok(newton_bisection(value, start))
+    (t * b1 - b2 + c[0]).clamp(0.0, J0_FIRST_ZERO)
 }
 
 /// Solves `J0(A) = value` on `[0, J0_FIRST_ZERO]` from `start`, keeping a bracket `[lo, hi]`
@@ -126,6 +186,56 @@ mod tests {
             assert!(
                 (newton - series).abs() < 1e-14,
                 "{value}: {newton} vs {series}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_tabulated_start_is_one_short_newton_step_from_the_root() {
+        // Dense in s = sqrt(1 - value), the variable of the table, over the whole region.
+        let s_min = SERIES_ONLY_BELOW.sqrt();
+        let mut worst: f64 = 0.0;
+        for i in 0..=20_000 {
+            let s = s_min + (1.0 - s_min) * f64::from(i) / 20_000.0;
+            let d = s * s;
+            let start = tabulated_start(d);
+            let root = slow_newton(1.0 - d);
+            worst = worst.max((start - root).abs());
+        }
+        assert!(worst < 1e-11, "largest start error {worst:e}");
+    }
+
+    /// The root by Newton's method from the series start, stopped only when the step reaches
+    /// rounding: a second algorithm for the tabulated start and the polished result.
+    fn slow_newton(value: f64) -> f64 {
+        let mut amplitude = series_start(1.0 - value);
+        for _ in 0..100 {
+            let step = (libm::j0(amplitude) - value) / libm::j1(amplitude);
+            amplitude += step;
+            if step.abs() <= 4.0 * f64::EPSILON * amplitude {
+                break;
+            }
+        }
+        amplitude
+    }
+
+    #[test]
+    fn the_polished_root_is_the_slowly_converged_root() {
+        for i in 1..2_000 {
+            let value = f64::from(i) / 2_000.0;
+            let root = slow_newton(value);
+            let polished = inverse_j0(value).unwrap();
+            // As close as the rounding of J0 (a few 1e-16) lets two roots be, dy / J1(A) ...
+            let conditioning = 4.0 * f64::EPSILON / libm::j1(root);
+            assert!(
+                (polished - root).abs() <= conditioning,
+                "{value}: {polished} vs {root}"
+            );
+            // ... and as good a root: J0 there is the value to its rounding.
+            assert!(
+                (libm::j0(polished) - value).abs() <= 3e-16,
+                "{value}: residual {:e}",
+                libm::j0(polished) - value
             );
         }
     }
