@@ -20,7 +20,7 @@
 
 use lane_math::Lane;
 
-use crate::system::{AndMethod, Compiled, FuzzySystem, OrMethod};
+use crate::system::{AndMethod, Compiled, DenseTerms, FuzzySystem, OrMethod};
 
 /// The buffers of one evaluation, in slots of `N` values (see the module docs).
 pub(crate) struct Slots<'a, const N: usize> {
@@ -127,8 +127,18 @@ pub(crate) fn sums<L: Lane, const N: usize>(
         set(slots.terms, term, acc);
     }
     let zero = L::splat(cx, 0.0);
-    if let Some(dense) = &c.dense_terms {
-        return dense_sums::<L, N>(cx, c, dense, slots);
+    match &c.dense_terms {
+        Some(DenseTerms::Constants(values)) => {
+            let terms = |_: &[[f64; N]], &[a, b]: &[f64; 2]| [L::splat(cx, a), L::splat(cx, b)];
+            return dense_sums::<L, N, _>(cx, c, values, slots, terms);
+        }
+        Some(DenseTerms::Slots(indices)) => {
+            let terms = |values: &[[f64; N]], &[a, b]: &[u32; 2]| {
+                [get(cx, values, a as usize), get(cx, values, b as usize)]
+            };
+            return dense_sums::<L, N, _>(cx, c, indices, slots, terms);
+        }
+        None => {}
     }
     for (o, bounds) in c.conclusion_offsets.windows(2).enumerate() {
         let (mut weighted, mut total) = (zero, zero);
@@ -144,24 +154,27 @@ pub(crate) fn sums<L: Lane, const N: usize>(
 }
 
 /// [`sums`] when every rule concludes on every output: the outputs two at a time, side by side
-/// (each summed in rule order), with the total strength, the same for all, summed alongside.
+/// (each summed in rule order), with the total strength, the same for all, summed alongside;
+/// `terms` gives a rule's two terms from an entry of `dense` and the term slots.
 #[inline(always)]
-fn dense_sums<L: Lane, const N: usize>(
+fn dense_sums<L: Lane, const N: usize, T>(
     cx: L::Context,
     c: &Compiled,
-    dense: &[[u32; 2]],
+    dense: &[T],
     slots: &mut Slots<'_, N>,
+    terms: impl Fn(&[[f64; N]], &T) -> [L; 2],
 ) {
     let n_out = c.conclusion_offsets.len() - 1;
     let n_rules = c.weights.len();
     let zero = L::splat(cx, 0.0);
     let strengths = &slots.values[c.strength_base..c.strength_base + n_rules];
-    for (pair, terms) in dense.chunks_exact(n_rules).enumerate() {
+    for (pair, rules) in dense.chunks_exact(n_rules).enumerate() {
         let (mut first, mut second, mut total) = (zero, zero, zero);
-        for (strength, &[a, b]) in strengths.iter().zip(terms) {
+        for (strength, rule) in strengths.iter().zip(rules) {
             let w = L::load(cx, strength);
-            first = first + w * get::<L, N>(cx, slots.terms, a as usize);
-            second = second + w * get::<L, N>(cx, slots.terms, b as usize);
+            let [a, b] = terms(slots.terms, rule);
+            first = first + w * a;
+            second = second + w * b;
             total = total + w;
         }
         let o = 2 * pair;

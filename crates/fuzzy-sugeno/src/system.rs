@@ -480,7 +480,7 @@ pub(crate) struct Compiled {
     /// When every rule concludes on every output: the outputs in pairs `(2p, 2p + 1)`, and for
     /// each pair, rule after rule, the rule's terms for both (the second repeating the first
     /// when the last pair has one output), so that two outputs are summed side by side.
-    pub dense_terms: Option<Vec<[u32; 2]>>,
+    pub dense_terms: Option<DenseTerms>,
     /// The number of value slots: degrees, complements, 1 and 0, nodes, strengths.
     pub slot_count: usize,
     /// `[rule, term]` for every rule that concludes on an output, output after output and in
@@ -488,6 +488,15 @@ pub(crate) struct Compiled {
     pub conclusions: Vec<[u32; 2]>,
     /// Output `o`'s conclusions are `conclusions[conclusion_offsets[o]..conclusion_offsets[o + 1]]`.
     pub conclusion_offsets: Vec<usize>,
+}
+
+/// The terms of [`Compiled::dense_terms`], one pair per rule and pair of outputs.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum DenseTerms {
+    /// Every term is a constant (a zero-order system): their values.
+    Constants(Vec<[f64; 2]>),
+    /// Some term is first order, computed at each point: their indices in the term slots.
+    Slots(Vec<[u32; 2]>),
 }
 
 impl Compiled {
@@ -627,20 +636,25 @@ impl Compiled {
             .iter()
             .all(|r| r.consequents.iter().all(Option::is_some));
         let dense_terms = if every_rule_concludes {
-            let term = |r: &Rule, o: usize| index(term_offsets[o] + r.consequents[o].unwrap_or(0));
+            let term = |r: &Rule, o: usize| term_offsets[o] + r.consequents[o].unwrap_or(0);
             let mut pairs = Vec::with_capacity(outputs.len().div_ceil(2) * rules.len());
             for o in (0..outputs.len()).step_by(2) {
                 for rule in rules {
-                    let first = term(rule, o)?;
+                    let first = term(rule, o);
                     let second = if o + 1 < outputs.len() {
-                        term(rule, o + 1)?
+                        term(rule, o + 1)
                     } else {
                         first
                     };
                     pairs.push([first, second]);
                 }
             }
-            Some(pairs)
+            Some(if linear_terms.is_empty() {
+                DenseTerms::Constants(pairs.iter().map(|p| p.map(|t| term_values[t])).collect())
+            } else {
+                let indices = pairs.iter().map(|&[a, b]| Ok([index(a)?, index(b)?]));
+                DenseTerms::Slots(indices.collect::<Result<_, FuzzyError>>()?)
+            })
         } else {
             None
         };
