@@ -98,13 +98,16 @@ pub fn inverse_kinematics(
     }
     let a2 = wrap_angle(target[1].atan2(target[0]) - alpha0);
     let amplitude = inverse_j0((r / length).min(1.0))?;
-    let slack = (RATIO_UNCERTAINTY / libm::j1(amplitude)).min(2.0 * RATIO_UNCERTAINTY.sqrt());
-    if a2.abs() > amplitude + slack {
-        return Err(KinError::A2ExceedsAmplitude {
-            a2_abs: a2.abs(),
-            amplitude,
-            alpha0,
-        });
+    // The slack (never negative) is only needed, and its J1 only evaluated, past the amplitude.
+    if a2.abs() > amplitude {
+        let slack = (RATIO_UNCERTAINTY / libm::j1(amplitude)).min(2.0 * RATIO_UNCERTAINTY.sqrt());
+        if a2.abs() > amplitude + slack {
+            return Err(KinError::A2ExceedsAmplitude {
+                a2_abs: a2.abs(),
+                amplitude,
+                alpha0,
+            });
+        }
     }
     // (A - a2)(A + a2) keeps relative accuracy when |a2| is close to A.
     let a1 = ((amplitude - a2.abs()).max(0.0) * (amplitude + a2.abs())).sqrt();

@@ -88,8 +88,16 @@ impl Family {
 
     /// The end point at `a` (by quadrature for `K > 1`, in closed form for `K = 1`).
     pub(crate) fn end_point(&mut self, a: &[f64]) -> Result<[f64; 2], KinError> {
-        self.curve.set_modes(&a[..self.modes])?;
-        let p = self.curve.end_point();
+        let p = match a[..self.modes] {
+            // One harmonic: the closed form, with no quadrature to set up for the curve.
+            [a1, a2] => {
+                backbone_kin::end_point(self.curve.length(), [a1, a2], self.curve.alpha0())?
+            }
+            _ => {
+                self.curve.set_modes(&a[..self.modes])?;
+                self.curve.end_point()
+            }
+        };
         Ok(if self.free {
             rotate(p, a[self.modes])
         } else {
