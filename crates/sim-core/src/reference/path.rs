@@ -293,9 +293,9 @@ impl Reference for CartesianPath {
         let psi_dot = (x * v[1] - y * v[0]) / (r * r);
         let r_ddot = (v[0] * v[0] + v[1] * v[1] + x * acc[0] + y * acc[1] - r_dot * r_dot) / r;
         let psi_ddot = (x * acc[1] - y * acc[0]) / (r * r) - 2.0 * r_dot * psi_dot / r;
-        // J0(A) = r / l, with J0' = -J1 and J1' = J0 - J1 / A.
+        // J0(A) = r / l (to the rounding of the inverse), with J0' = -J1 and J1' = J0 - J1 / A.
         let amp_dot = -r_dot / (self.length * j1);
-        let j1_prime = libm::j0(amplitude) - j1 / amplitude;
+        let j1_prime = (r / self.length).min(1.0) - j1 / amplitude;
         let amp_ddot = -(r_ddot / self.length + j1_prime * amp_dot * amp_dot) / j1;
         // a1 a1' = A A' - a2 a2', differentiated once more.
         let (a2_dot, a2_ddot) = (psi_dot, psi_ddot);
