@@ -155,7 +155,9 @@ fn lqr_solves_the_riccati_equation_and_stabilises_the_loop() {
         lin.linearise(&model, &a, &vec![0.0; m], &u, 0.01).unwrap();
         let (q, r) = weights(m, 1e-2);
         let mut lqr = Lqr::new(m, &q, &r).unwrap();
-        lqr.solve(&lin, &LqrSettings::default()).unwrap();
+        let steps = lqr.solve(&lin, &LqrSettings::default()).unwrap();
+        // Doubling: a few tens of steps stand for 2^steps steps of the recursion.
+        assert!(steps <= 30, "m = {m}: {steps} doubling steps");
         let (ad, bd) = (row_major(lin.discrete_a()), row_major(lin.discrete_b()));
         let p = row_major(lqr.cost_to_go());
         let k = row_major(lqr.gain());
