@@ -4,4 +4,4 @@ mod lanes;
 mod trig;
 
 pub use lanes::{Lane, Pack};
-pub use trig::{sin_cos, sin_cos_lane, sin_cos_simd};
+pub use trig::{sin_cos, sin_cos_simd};

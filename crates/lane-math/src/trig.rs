@@ -103,35 +103,6 @@ pub fn sin_cos_simd<S: Simd>(simd: S, angles: &[f64], sin: &mut [f64], cos: &mut
     redo_large(angles, sin, cos);
 }
 
-/// `(sin x, cos x)` of every lane of one register, kept in registers: the values of
-/// [`sin_cos`] bit for bit (the same operations; lanes beyond `2^19 pi` by `libm`), for a
-/// kernel that computes its angles in registers and uses their sines and cosines there, without
-/// storing and reloading them.
-#[inline(always)]
-pub fn sin_cos_lane<L: Lane>(context: L::Context, x: L) -> (L, L) {
-    let (sin, cos) = sin_cos_reduced(context, x);
-    // |x| <= REDUCTION_LIMIT in every lane, in one vector compare (false on a NaN, which the
-    // slow path keeps as the polynomial's NaN).
-    if L::splat(context, REDUCTION_LIMIT.next_up()).all_greater(x.abs()) {
-        (sin, cos)
-    } else {
-        sin_cos_lanes_with_large(x)
-    }
-}
-
-/// [`sin_cos_lane`] when a lane is beyond [`REDUCTION_LIMIT`] or not a number: lane by lane.
-#[cold]
-fn sin_cos_lanes_with_large<L: Lane>(x: L) -> (L, L) {
-    let one = |x: f64| {
-        if x.abs() > REDUCTION_LIMIT {
-            libm::sincos(x)
-        } else {
-            sin_cos_reduced((), x)
-        }
-    };
-    (x.map(|x| one(x).0), x.map(|x| one(x).1))
-}
-
 /// Redoes the angles beyond [`REDUCTION_LIMIT`], if any, with `libm`.
 #[inline(always)]
 fn redo_large(angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
@@ -216,33 +187,7 @@ mod tests {
         }
     }
 
-    /// [`sin_cos_lane`] of `angles`, a whole register at a time (the last one padded with
-    /// zeros), with the processor's instruction set.
-    struct InRegisters<'a> {
-        angles: &'a [f64],
-        sin: &'a mut [f64],
-        cos: &'a mut [f64],
-    }
-
-    impl pulp::WithSimd for InRegisters<'_> {
-        type Output = ();
-
-        fn with_simd<S: pulp::Simd>(self, simd: S) {
-            let width = Pack::<S>::WIDTH;
-            for (i, chunk) in self.angles.chunks(width).enumerate() {
-                let mut x = vec![0.0; width];
-                x[..chunk.len()].copy_from_slice(chunk);
-                let (s, c) = sin_cos_lane(simd, Pack::<S>::load(simd, &x));
-                for (lane, _) in chunk.iter().enumerate() {
-                    self.sin[i * width + lane] = s.lane(lane);
-                    self.cos[i * width + lane] = c.lane(lane);
-                }
-            }
-        }
-    }
-
-    /// The bits of `(sin, cos)` of `angles` by [`sin_cos`], [`sin_cos_simd`] and
-    /// [`sin_cos_lane`] (which must agree).
+    /// The bits of `(sin, cos)` of `angles` by [`sin_cos`] and by [`sin_cos_simd`].
     fn both(angles: &[f64]) -> [Vec<u64>; 2] {
         let n = angles.len();
         let (mut sin, mut cos) = (vec![0.0; n], vec![0.0; n]);
@@ -256,21 +201,6 @@ mod tests {
         let bits = |v: Vec<f64>| v.into_iter().map(f64::to_bits).collect::<Vec<_>>();
         assert_eq!(bits(simd_sin), bits(sin.clone()));
         assert_eq!(bits(simd_cos), bits(cos.clone()));
-        let (mut lane_sin, mut lane_cos) = (vec![0.0; n], vec![0.0; n]);
-        pulp::Arch::new().dispatch(InRegisters {
-            angles,
-            sin: &mut lane_sin,
-            cos: &mut lane_cos,
-        });
-        assert_eq!(bits(lane_sin), bits(sin.clone()));
-        assert_eq!(bits(lane_cos), bits(cos.clone()));
-        for (i, &x) in angles.iter().enumerate() {
-            let (s, c) = sin_cos_lane((), x);
-            assert_eq!(
-                (s.to_bits(), c.to_bits()),
-                (sin[i].to_bits(), cos[i].to_bits())
-            );
-        }
         [bits(sin), bits(cos)]
     }
 
@@ -356,9 +286,5 @@ mod tests {
         let (mut s, mut c) = ([0.0; 2], [0.0; 2]);
         sin_cos(&[f64::NAN, f64::INFINITY], &mut s, &mut c);
         assert!(s.iter().chain(&c).all(|v| v.is_nan()));
-        for x in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-            let (s, c) = sin_cos_lane((), x);
-            assert!(s.is_nan() && c.is_nan(), "{x}");
-        }
     }
 }

@@ -49,11 +49,12 @@ pub enum BatchError {
 
 /// Workspace of [`forward_dynamics_batch`] for one [`ReducedModel`]: create it once, reuse it for
 /// every batch. Its memory is `O(n)` like a [`ReducedData`]'s (which it holds, for the states
-/// evaluated one at a time) plus three buffers of `n` values per lane (`192 n` bytes).
+/// evaluated one at a time) plus four buffers of `n` values per lane (`256 n` bytes).
 #[derive(Debug, Clone)]
 pub struct ReducedBatchData {
-    /// Per link and lane (`[link][lane]`, `MAX_WIDTH` lanes): sine and cosine of the absolute
-    /// angle.
+    /// Per link and lane (`[link][lane]`, `MAX_WIDTH` lanes): the absolute angle, its sine and
+    /// cosine.
+    angle: Vec<f64>,
     sin: Vec<f64>,
     cos: Vec<f64>,
     /// Per link and lane: the rate `phi_dot_l` (see [`crate::terms`]; the pass computes the
@@ -70,6 +71,7 @@ impl ReducedBatchData {
     pub fn new(model: &ReducedModel) -> Self {
         let size = model.n_links() * MAX_WIDTH;
         Self {
+            angle: vec![0.0; size],
             sin: vec![0.0; size],
             cos: vec![0.0; size],
             products: vec![0.0; size],
@@ -166,6 +168,7 @@ impl Batch<'_> {
             let range = first * M..(first + width) * M;
             let inputs = self.inputs.map(|x| &x[range.clone()]);
             let links = LinkBuffers {
+                angle: &mut self.data.angle,
                 sin: &mut self.data.sin,
                 cos: &mut self.data.cos,
                 products: &mut self.data.products,

@@ -77,12 +77,13 @@ impl Projection {
     }
 }
 
-/// The per-link buffers of the default path (see [`crate::terms`]): the sine and cosine of every
-/// link's absolute angle (read again by [`crate::derivatives`]) and the per-link products, `n`
+/// The per-link buffers of the default path (see [`crate::terms`]): every link's absolute angle,
+/// its sine and cosine (read again by [`crate::derivatives`]) and the per-link products, `n`
 /// rounded up to a whole number of the widest SIMD registers ([`LINK_PADDING`]) each, so that
 /// they are computed in whole registers.
 #[derive(Debug, Clone)]
 pub(crate) struct OneStateLinks {
+    pub(crate) angle: Vec<f64>,
     pub(crate) sin: Vec<f64>,
     pub(crate) cos: Vec<f64>,
     /// `[product][link]`.
@@ -116,6 +117,7 @@ impl ReducedData {
             rhs: vec![0.0; m],
             iterate: vec![0.0; m],
             links: OneStateLinks {
+                angle: vec![0.0; n.next_multiple_of(LINK_PADDING)],
                 sin: vec![0.0; n.next_multiple_of(LINK_PADDING)],
                 cos: vec![0.0; n.next_multiple_of(LINK_PADDING)],
                 products: vec![0.0; PRODUCTS * n.next_multiple_of(LINK_PADDING)],

@@ -83,7 +83,7 @@
 use crate::data::{LINK_PADDING, ReducedData};
 use crate::error::{ReduceError, check_finite_result, check_input};
 use crate::model::ReducedModel;
-use lane_math::{Lane, Pack, sin_cos_lane};
+use lane_math::{Lane, Pack, sin_cos_simd};
 use pulp::{Simd, WithSimd};
 
 /// Per-link products the pre-pass leaves for the pass besides the sine and cosine, in this order
@@ -213,6 +213,7 @@ pub(crate) fn accumulate_in_data<S: Simd>(
     };
     let m = model.n_coords();
     let link_buffers = LinkBuffers {
+        angle: &mut links.angle,
         sin: &mut links.sin,
         cos: &mut links.cos,
         products: &mut links.products,
@@ -267,6 +268,7 @@ impl<const M: usize> StackTerms<M> {
         let mut joint = [[zero; 2]; M];
         let links = &mut data.links;
         let link_buffers = LinkBuffers {
+            angle: &mut links.angle,
             sin: &mut links.sin,
             cos: &mut links.cos,
             products: &mut links.products,
@@ -347,7 +349,7 @@ pub(crate) trait Layout: Copy {
     /// [`link_products`]).
     fn link(
         self,
-        values: &BlockValues<'_>,
+        values: &LinkValues<'_>,
         i: usize,
         moment: f64,
         length: f64,
@@ -393,7 +395,7 @@ impl<S: Simd> Layout for CoordinateLanes<S> {
     const PRE_PASS_PRODUCTS: usize = PRODUCTS;
 
     #[inline(always)]
-    fn link(self, values: &BlockValues<'_>, i: usize, _: f64, _: f64) -> [f64; 2 + PRODUCTS] {
+    fn link(self, values: &LinkValues<'_>, i: usize, _: f64, _: f64) -> [f64; 2 + PRODUCTS] {
         values.load((), i)
     }
 
@@ -449,7 +451,7 @@ impl<S: Simd> Layout for OneStateScalar<S> {
     const PRE_PASS_PRODUCTS: usize = PRODUCTS;
 
     #[inline(always)]
-    fn link(self, values: &BlockValues<'_>, i: usize, _: f64, _: f64) -> [f64; 2 + PRODUCTS] {
+    fn link(self, values: &LinkValues<'_>, i: usize, _: f64, _: f64) -> [f64; 2 + PRODUCTS] {
         values.load((), i)
     }
 
@@ -505,13 +507,13 @@ impl<S: Simd> Layout for StateLanes<S> {
     #[inline(always)]
     fn link(
         self,
-        values: &BlockValues<'_>,
+        values: &LinkValues<'_>,
         i: usize,
         moment: f64,
         length: f64,
     ) -> [Pack<S>; 2 + PRODUCTS] {
         let simd = self.0;
-        let angles = values.load_angles(simd, i);
+        let angles = values.load_trig_rate(simd, i);
         let [sin, cos, _] = angles;
         let moment = Pack::splat(simd, moment);
         let [p0, p1, p2, p3, p4, p5] = link_products(angles, moment, Pack::splat(simd, length));
@@ -572,16 +574,14 @@ impl<S: Simd> Layout for StateLanes<S> {
             let angle_rate = link_angle_rate(simd, Pack::splat(simd, offset), &inputs);
             links.store_angle_rate(l, width, angle_rate);
         }
-        for l in 0..n {
-            links.sin_cos::<Pack<S>>(simd, l, width);
-        }
+        links.sin_cos(simd, n * width);
     }
 }
 
 /// The pre-pass of one state: [`link_angle_rate`], the sines and cosines, then
 /// [`link_products`], each a loop over registers of consecutive links (the last one padded with
 /// the zeros of the padded constants). Separate loops, so that the sines and cosines (long
-/// chains of dependent operations) stay short enough for the processor to overlap them.
+/// chains of dependent operations) run alone, short enough for the processor to overlap them.
 #[inline(always)]
 fn link_values_across_links<S: Simd>(
     simd: S,
@@ -592,16 +592,17 @@ fn link_values_across_links<S: Simd>(
 ) {
     if S::F64_LANES > LINK_PADDING {
         // Wider registers than the padding: one link at a time.
-        across_links::<f64>((), model, a, a_dot, links);
+        across_links::<f64, S>((), simd, model, a, a_dot, links);
     } else {
-        across_links::<Pack<S>>(simd, model, a, a_dot, links);
+        across_links::<Pack<S>, S>(simd, simd, model, a, a_dot, links);
     }
 }
 
 /// [`link_values_across_links`] in registers of `L` (`L::WIDTH` at most [`LINK_PADDING`]).
 #[inline(always)]
-fn across_links<L: Lane>(
+fn across_links<L: Lane, S: Simd>(
     context: L::Context,
+    simd: S,
     model: &ReducedModel,
     a: &[f64],
     a_dot: &[f64],
@@ -620,9 +621,7 @@ fn across_links<L: Lane>(
         let offset = L::load(context, &constants.angle_offset[l..]);
         links.store_angle_rate(l, 1, link_angle_rate(context, offset, &inputs));
     }
-    for l in (0..n).step_by(L::WIDTH) {
-        links.sin_cos::<L>(context, l, 1);
-    }
+    links.sin_cos(simd, n.next_multiple_of(L::WIDTH));
     for l in (0..n).step_by(L::WIDTH) {
         let angles = links.load_trig_rate(context, l, 1);
         let moment = L::load(context, &constants.first_moment[l..]);
@@ -724,11 +723,13 @@ fn link_products<L: Lane>([sin, cos, rate]: [L; 3], moment: L, length: L) -> [L;
     ]
 }
 
-/// The per-link buffers of the kernel: the sine and cosine of every link's angle and the
+/// The per-link buffers of the kernel: every link's angle, its sine and cosine, and the
 /// [`PRODUCTS`], each entry `W` values side by side (`W` the lanes of the layout's
 /// [`Value`](Layout::Value): one state's links have one, a batch's the states of a group).
 pub(crate) struct LinkBuffers<'a> {
-    /// `sin phi_l`, `[link][lane]`.
+    /// `phi_l`, `[link][lane]`.
+    pub(crate) angle: &'a mut [f64],
+    /// `sin phi_l`, as `angle`.
     pub(crate) sin: &'a mut [f64],
     /// `cos phi_l`, as `sin`.
     pub(crate) cos: &'a mut [f64],
@@ -739,26 +740,27 @@ pub(crate) struct LinkBuffers<'a> {
 }
 
 impl LinkBuffers<'_> {
-    /// Stores `[phi_l, phi_dot_l]` of link `l` (the angle where its sine goes, until
-    /// [`sin_cos`](Self::sin_cos); the rate where the first product goes, until
+    /// Stores `[phi_l, phi_dot_l]` of link `l` (the rate where the first product goes, until
     /// [`store_products`](Self::store_products)), entries of `width` lanes: of the links
     /// `l..l + L::WIDTH` for a register across links (`width` 1), of link `l` for a register of
     /// states (`width` `L::WIDTH`).
     #[inline(always)]
     fn store_angle_rate<L: Lane>(&mut self, l: usize, width: usize, [angle, rate]: [L; 2]) {
         let entry = l * width;
-        angle.store(&mut self.sin[entry..]);
+        angle.store(&mut self.angle[entry..]);
         rate.store(&mut self.products[entry..]);
     }
 
-    /// Replaces the angle of link `l` (entries as in
-    /// [`store_angle_rate`](Self::store_angle_rate)) by its sine and cosine.
+    /// The sines and cosines of the first `entries` angles, in registers of `S`.
     #[inline(always)]
-    fn sin_cos<L: Lane>(&mut self, context: L::Context, l: usize, width: usize) {
-        let entry = l * width;
-        let (sin, cos) = sin_cos_lane(context, L::load(context, &self.sin[entry..]));
-        sin.store(&mut self.sin[entry..]);
-        cos.store(&mut self.cos[entry..]);
+    fn sin_cos<S: Simd>(&mut self, simd: S, entries: usize) {
+        let angle = &self.angle[..entries];
+        sin_cos_simd(
+            simd,
+            angle,
+            &mut self.sin[..entries],
+            &mut self.cos[..entries],
+        );
     }
 
     /// `[sin phi_l, cos phi_l, phi_dot_l]` of link `l` after [`sin_cos`](Self::sin_cos).
@@ -772,7 +774,8 @@ impl LinkBuffers<'_> {
         ]
     }
 
-    /// Stores the [`PRODUCTS`] of link `l` (entries as in [`store_angles`](Self::store_angles)).
+    /// Stores the [`PRODUCTS`] of link `l` (entries as in
+    /// [`store_angle_rate`](Self::store_angle_rate)).
     #[inline(always)]
     fn store_products<L: Lane>(&mut self, l: usize, width: usize, products: [L; PRODUCTS]) {
         for (p, value) in products.iter().enumerate() {
@@ -780,9 +783,10 @@ impl LinkBuffers<'_> {
         }
     }
 
-    /// The values of the first `n` links, entries of `width` lanes, for the pass.
+    /// The values of the first `n` links, entries of `width` lanes, for the pass (the first
+    /// `products` of the [`PRODUCTS`]).
     #[inline(always)]
-    fn block(&self, n: usize, width: usize, products: usize) -> BlockValues<'_> {
+    fn values(&self, n: usize, width: usize, products: usize) -> LinkValues<'_> {
         let size = n * width;
         let product = |p: usize| {
             if p < products {
@@ -791,7 +795,7 @@ impl LinkBuffers<'_> {
                 &[]
             }
         };
-        BlockValues {
+        LinkValues {
             sin: &self.sin[..size],
             cos: &self.cos[..size],
             products: [
@@ -809,16 +813,16 @@ impl LinkBuffers<'_> {
 /// The values the pre-pass left for the links (see [`LinkBuffers`]), each slice exactly the
 /// links' entries, so that the pass reads them without bounds checks (the products the
 /// pre-pass did not compute empty).
-pub(crate) struct BlockValues<'a> {
+pub(crate) struct LinkValues<'a> {
     sin: &'a [f64],
     cos: &'a [f64],
     products: [&'a [f64]; PRODUCTS],
 }
 
-impl BlockValues<'_> {
+impl LinkValues<'_> {
     /// The sine and cosine of link `i` and its rate `phi_dot_l` (where the first product goes).
     #[inline(always)]
-    fn load_angles<L: Lane>(&self, context: L::Context, i: usize) -> [L; 3] {
+    fn load_trig_rate<L: Lane>(&self, context: L::Context, i: usize) -> [L; 3] {
         let entry = i * L::WIDTH;
         [
             L::load(context, &self.sin[entry..]),
@@ -891,7 +895,7 @@ pub(crate) fn accumulate<Y: Layout>(
     let mut q = [Y::Value::splat(vc, 0.0); 2];
     layout.link_values(model, a, a_dot, &mut links);
     // The pass: P_l, q_l, and the sums of M*, C* and G*.
-    let values = links.block(n, Y::Value::WIDTH, Y::PRE_PASS_PRODUCTS);
+    let values = links.values(n, Y::Value::WIDTH, Y::PRE_PASS_PRODUCTS);
     let moments = &moments[..n];
     let lengths = &model.link_constants().length[..n];
     let rows = &rows[..n * m + LINK_PADDING];
