@@ -354,6 +354,9 @@ pub(crate) trait Layout: Copy {
         moment: f64,
         length: f64,
     ) -> [Self::Value; 2 + PRODUCTS];
+    /// `S_l cos phi_l` of link `i` (the second of the [`PRODUCTS`]), as [`link`](Self::link)
+    /// gives it.
+    fn gravity_force(self, values: &LinkValues<'_>, i: usize, moment: f64) -> Self::Value;
     /// The per-link values of all links into `links` (the pre-pass).
     fn link_values(
         self,
@@ -397,6 +400,11 @@ impl<S: Simd> Layout for CoordinateLanes<S> {
     #[inline(always)]
     fn link(self, values: &LinkValues<'_>, i: usize, _: f64, _: f64) -> [f64; 2 + PRODUCTS] {
         values.load((), i)
+    }
+
+    #[inline(always)]
+    fn gravity_force(self, values: &LinkValues<'_>, i: usize, _: f64) -> f64 {
+        values.products[1][i]
     }
 
     #[inline(always)]
@@ -453,6 +461,11 @@ impl<S: Simd> Layout for OneStateScalar<S> {
     #[inline(always)]
     fn link(self, values: &LinkValues<'_>, i: usize, _: f64, _: f64) -> [f64; 2 + PRODUCTS] {
         values.load((), i)
+    }
+
+    #[inline(always)]
+    fn gravity_force(self, values: &LinkValues<'_>, i: usize, _: f64) -> f64 {
+        values.products[1][i]
     }
 
     #[inline(always)]
@@ -518,6 +531,12 @@ impl<S: Simd> Layout for StateLanes<S> {
         let moment = Pack::splat(simd, moment);
         let [p0, p1, p2, p3, p4, p5] = link_products(angles, moment, Pack::splat(simd, length));
         [sin, cos, p0, p1, p2, p3, p4, p5]
+    }
+
+    #[inline(always)]
+    fn gravity_force(self, values: &LinkValues<'_>, i: usize, moment: f64) -> Pack<S> {
+        let [_, cos, _] = values.load_trig_rate::<Pack<S>>(self.0, i);
+        cos * moment
     }
 
     #[inline(always)]
@@ -894,7 +913,7 @@ pub(crate) fn accumulate<Y: Layout>(
     let rows = model.angle_rows();
     let mut q = [Y::Value::splat(vc, 0.0); 2];
     layout.link_values(model, a, a_dot, &mut links);
-    // The pass: P_l, q_l, and the sums of M*, C* and G*.
+    // The pass: P_l, q_l, and the sums of M* and C*.
     let values = links.values(n, Y::Value::WIDTH, Y::PRE_PASS_PRODUCTS);
     let moments = &moments[..n];
     let lengths = &model.link_constants().length[..n];
@@ -902,23 +921,14 @@ pub(crate) fn accumulate<Y: Layout>(
     {
         for (i, &moment) in moments.iter().enumerate() {
             let row = &rows[i * m..];
-            let [
-                sin,
-                cos,
-                moment_rate2,
-                gravity_force,
-                l_sin,
-                l_cos,
-                drop_x,
-                drop_y,
-            ] = layout.link(&values, i, moment, lengths[i]);
+            let [sin, cos, moment_rate2, _, l_sin, l_cos, drop_x, drop_y] =
+                layout.link(&values, i, moment, lengths[i]);
             // S_l (w_l . q_l).
             // (No closures or array maps here: their bodies would be compiled without the
             // instruction set of the dispatch, and its intrinsics called, not inlined.)
             let force = layout.spread((cos * q[1] - sin * q[0]) * moment);
             let (sin, cos) = (layout.spread(sin), layout.spread(cos));
             let moment_rate2 = layout.spread(moment_rate2);
-            let gravity_force = layout.spread(gravity_force);
             let (l_sin, l_cos) = (layout.spread(l_sin), layout.spread(l_cos));
             for c in 0..chunks {
                 let phi = layout.constant_row(row, c);
@@ -926,7 +936,6 @@ pub(crate) fn accumulate<Y: Layout>(
                 cos_moment[c] = (cos * py - sin * px) * moment;
                 let along = cos * px + sin * py;
                 coriolis[c] = coriolis[c] + force * phi - moment_rate2 * along;
-                gravity[c] = gravity[c] + gravity_force * phi;
             }
             // A += Phi_l^T (S_l v_l)^T, row by row.
             for (j, &phi_j) in row[..m].iter().enumerate() {
@@ -943,7 +952,15 @@ pub(crate) fn accumulate<Y: Layout>(
             q = [q[0] - drop_x, q[1] - drop_y];
         }
     }
-    // G* = g (...).
+    // G* = g sum_l S_l cos(phi_l) Phi_l^T, a loop of its own: it needs no prefix sum, and its
+    // running sums would crowd the pass's registers.
+    for (i, &moment) in moments.iter().enumerate() {
+        let row = &rows[i * m..];
+        let gravity_force = layout.spread(layout.gravity_force(&values, i, moment));
+        for (c, value) in gravity.iter_mut().enumerate() {
+            *value = *value + gravity_force * layout.constant_row(row, c);
+        }
+    }
     let g = model.chain().gravity();
     for value in gravity {
         *value = *value * g;
