@@ -69,12 +69,12 @@
 //! batch, whose registers hold states either way, computes the products in the pass). Then the
 //! pass runs over the links with what is left, the prefix sums.
 //!
-//! The kernel is written once, generic over a [`Layout`]: how its numbers sit in SIMD registers.
-//! One state either has its coordinates side by side in one register ([`CoordinateLanes`]: each
+//! The kernel is written once, generic over a `Layout`: how its numbers sit in SIMD registers.
+//! One state either has its coordinates side by side in one register (`CoordinateLanes`: each
 //! per-coordinate loop of the pass is one vector operation, and the pre-pass runs across links,
-//! a register of consecutive links at a time), or one coordinate a number ([`OneStateScalar`],
+//! a register of consecutive links at a time), or one coordinate a number (`OneStateScalar`,
 //! when `m` exceeds the register); a batch ([`forward_dynamics_batch`]) has one coordinate of
-//! several states in a register ([`StateLanes`]). Every state gets the same operations in the
+//! several states in a register (`StateLanes`). Every state gets the same operations in the
 //! same order in each, lane by lane, without fused multiply-adds, so a state gives the same bits
 //! alone or in a batch.
 //!
