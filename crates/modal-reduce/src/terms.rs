@@ -354,6 +354,9 @@ pub(crate) trait Layout: Copy {
         moment: f64,
         length: f64,
     ) -> [Self::Value; 2 + PRODUCTS];
+    /// Whether `G*` is summed in a loop of its own after the pass rather than in it (a batch,
+    /// whose pass has no register to spare).
+    const GRAVITY_APART: bool;
     /// `S_l cos phi_l` of link `i` (the second of the [`PRODUCTS`]), as [`link`](Self::link)
     /// gives it.
     fn gravity_force(self, values: &LinkValues<'_>, i: usize, moment: f64) -> Self::Value;
@@ -396,6 +399,7 @@ impl<S: Simd> Layout for CoordinateLanes<S> {
     type Value = f64;
 
     const PRE_PASS_PRODUCTS: usize = PRODUCTS;
+    const GRAVITY_APART: bool = false;
 
     #[inline(always)]
     fn link(self, values: &LinkValues<'_>, i: usize, _: f64, _: f64) -> [f64; 2 + PRODUCTS] {
@@ -457,6 +461,7 @@ impl<S: Simd> Layout for OneStateScalar<S> {
     type Value = f64;
 
     const PRE_PASS_PRODUCTS: usize = PRODUCTS;
+    const GRAVITY_APART: bool = false;
 
     #[inline(always)]
     fn link(self, values: &LinkValues<'_>, i: usize, _: f64, _: f64) -> [f64; 2 + PRODUCTS] {
@@ -516,6 +521,7 @@ impl<S: Simd> Layout for StateLanes<S> {
     type Value = Pack<S>;
 
     const PRE_PASS_PRODUCTS: usize = 1;
+    const GRAVITY_APART: bool = true;
 
     #[inline(always)]
     fn link(
@@ -921,14 +927,25 @@ pub(crate) fn accumulate<Y: Layout>(
     {
         for (i, &moment) in moments.iter().enumerate() {
             let row = &rows[i * m..];
-            let [sin, cos, moment_rate2, _, l_sin, l_cos, drop_x, drop_y] =
-                layout.link(&values, i, moment, lengths[i]);
+            let [
+                sin,
+                cos,
+                moment_rate2,
+                gravity_force,
+                l_sin,
+                l_cos,
+                drop_x,
+                drop_y,
+            ] = layout.link(&values, i, moment, lengths[i]);
             // S_l (w_l . q_l).
             // (No closures or array maps here: their bodies would be compiled without the
             // instruction set of the dispatch, and its intrinsics called, not inlined.)
             let force = layout.spread((cos * q[1] - sin * q[0]) * moment);
             let (sin, cos) = (layout.spread(sin), layout.spread(cos));
             let moment_rate2 = layout.spread(moment_rate2);
+            if !Y::GRAVITY_APART {
+                add_gravity(layout, gravity, layout.spread(gravity_force), row);
+            }
             let (l_sin, l_cos) = (layout.spread(l_sin), layout.spread(l_cos));
             for c in 0..chunks {
                 let phi = layout.constant_row(row, c);
@@ -952,18 +969,32 @@ pub(crate) fn accumulate<Y: Layout>(
             q = [q[0] - drop_x, q[1] - drop_y];
         }
     }
-    // G* = g sum_l S_l cos(phi_l) Phi_l^T, a loop of its own: it needs no prefix sum, and its
-    // running sums would crowd the pass's registers.
-    for (i, &moment) in moments.iter().enumerate() {
-        let row = &rows[i * m..];
-        let gravity_force = layout.spread(layout.gravity_force(&values, i, moment));
-        for (c, value) in gravity.iter_mut().enumerate() {
-            *value = *value + gravity_force * layout.constant_row(row, c);
+    // G* = g sum_l S_l cos(phi_l) Phi_l^T: it needs no prefix sum, so where its running sums
+    // would crowd the pass's registers it is summed in a loop of its own (the same operations in
+    // the same order either way).
+    if Y::GRAVITY_APART {
+        for (i, &moment) in moments.iter().enumerate() {
+            let gravity_force = layout.spread(layout.gravity_force(&values, i, moment));
+            add_gravity(layout, gravity, gravity_force, &rows[i * m..]);
         }
     }
     let g = model.chain().gravity();
     for value in gravity {
         *value = *value * g;
+    }
+}
+
+/// `gravity += S_l cos(phi_l) Phi_l^T` for link `row` (`Phi_l`, followed by the padding of
+/// [`Layout::constant_row`]).
+#[inline(always)]
+fn add_gravity<Y: Layout>(
+    layout: Y,
+    gravity: &mut [Y::Register],
+    gravity_force: Y::Register,
+    row: &[f64],
+) {
+    for (c, value) in gravity.iter_mut().enumerate() {
+        *value = *value + gravity_force * layout.constant_row(row, c);
     }
 }
 
