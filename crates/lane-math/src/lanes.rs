@@ -52,6 +52,12 @@ pub trait Lane:
     /// `f` applied to every lane, one lane at a time: the scalar fallback for what has no SIMD
     /// form (`exp`, `powf`, branchy formulas). Each lane gets exactly `f` of its value.
     fn map(self, f: impl Fn(f64) -> f64) -> Self;
+    /// Lane by lane, the bitwise and of the two values' representations: with all bits set in a
+    /// lane of `other`, that lane of `self`; with none, `+0.0` (masks lanes out).
+    fn and_bits(self, other: Self) -> Self;
+    /// The value of lane `index` (`index < WIDTH`), for reading one state's result, or one
+    /// coordinate of a register of coordinates.
+    fn lane(self, index: usize) -> f64;
 }
 
 impl Lane for f64 {
@@ -115,6 +121,17 @@ impl Lane for f64 {
     #[inline(always)]
     fn map(self, f: impl Fn(f64) -> f64) -> Self {
         f(self)
+    }
+
+    #[inline(always)]
+    fn and_bits(self, other: Self) -> Self {
+        f64::from_bits(self.to_bits() & other.to_bits())
+    }
+
+    #[inline(always)]
+    fn lane(self, index: usize) -> f64 {
+        debug_assert_eq!(index, 0, "an f64 has one lane");
+        self
     }
 }
 
@@ -276,6 +293,20 @@ impl<S: Simd> Lane for Pack<S> {
         }
         self
     }
+
+    #[inline(always)]
+    fn and_bits(self, other: Self) -> Self {
+        Self {
+            simd: self.simd,
+            value: self.simd.and_f64s(self.value, other.value),
+        }
+    }
+
+    #[inline(always)]
+    fn lane(self, index: usize) -> f64 {
+        let lanes: &[f64] = pulp::bytemuck::cast_slice(std::slice::from_ref(&self.value));
+        lanes[index]
+    }
 }
 
 #[cfg(test)]
@@ -376,6 +407,18 @@ mod tests {
                         assert_eq!(out[i].to_bits(), expect(a[i], b[i]).to_bits());
                     }
                 }
+                let mask: Vec<f64> = (0..width)
+                    .map(|i| f64::from_bits(if (start + i) % 3 == 0 { !0 } else { 0 }))
+                    .collect();
+                pa.and_bits(Pack::load(simd, &mask)).store(&mut out);
+                for i in 0..width {
+                    let expect = Lane::and_bits(a[i], mask[i]);
+                    assert_eq!(out[i].to_bits(), expect.to_bits());
+                    let kept = if (start + i) % 3 == 0 { a[i] } else { 0.0 };
+                    assert_eq!(expect.to_bits(), kept.to_bits());
+                    assert_eq!(pa.lane(i).to_bits(), a[i].to_bits());
+                    assert_eq!(Lane::lane(a[i], 0).to_bits(), a[i].to_bits());
+                }
                 for i in 0..width {
                     let (x, y) = (a[i], b[i]);
                     assert_eq!(Lane::abs(x).to_bits(), x.abs().to_bits());
@@ -390,7 +433,7 @@ mod tests {
     }
 
     #[test]
-    fn abs_min_max_map_agree_with_f64_in_every_lane() {
+    fn abs_min_max_map_and_bits_lane_agree_with_f64_in_every_lane() {
         Arch::new().dispatch(Check);
         // The instruction-set-free fallback too.
         Check.with_simd(pulp::Scalar::new());

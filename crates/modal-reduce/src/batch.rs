@@ -20,7 +20,7 @@ use crate::error::{ReduceError, check_len};
 use crate::forward::forward_dynamics;
 use crate::model::ReducedModel;
 use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
-use crate::terms::{LinkTrig, Terms, accumulate};
+use crate::terms::{LinkBuffers, StateLanes, Terms, accumulate, all_finite, extract};
 use lane_math::{Lane, Pack};
 
 /// The most `f64` lanes of a SIMD register (AVX-512).
@@ -49,13 +49,17 @@ pub enum BatchError {
 
 /// Workspace of [`forward_dynamics_batch`] for one [`ReducedModel`]: create it once, reuse it for
 /// every batch. Its memory is `O(n)` like a [`ReducedData`]'s (which it holds, for the states
-/// evaluated one at a time) plus three buffers of `n` values per lane (`192 n` bytes).
+/// evaluated one at a time) plus four buffers of `n` values per lane (`256 n` bytes).
 #[derive(Debug, Clone)]
 pub struct ReducedBatchData {
-    /// Per link and lane (`[link][lane]`, `MAX_WIDTH` lanes): absolute angle, sine, cosine.
+    /// Per link and lane (`[link][lane]`, `MAX_WIDTH` lanes): the absolute angle, its sine and
+    /// cosine.
     angle: Vec<f64>,
     sin: Vec<f64>,
     cos: Vec<f64>,
+    /// Per link and lane: the rate `phi_dot_l` (see [`crate::terms`]; the pass computes the
+    /// other products of a batch itself).
+    products: Vec<f64>,
     /// The one-state workspace.
     single: ReducedData,
     /// The instruction set found at construction.
@@ -70,6 +74,7 @@ impl ReducedBatchData {
             angle: vec![0.0; size],
             sin: vec![0.0; size],
             cos: vec![0.0; size],
+            products: vec![0.0; size],
             single: ReducedData::new(model),
             arch: Arch::new(),
         }
@@ -162,10 +167,12 @@ impl Batch<'_> {
         for first in (0..grouped).step_by(width) {
             let range = first * M..(first + width) * M;
             let inputs = self.inputs.map(|x| &x[range.clone()]);
-            let links = LinkTrig {
+            let links = LinkBuffers {
                 angle: &mut self.data.angle,
                 sin: &mut self.data.sin,
                 cos: &mut self.data.cos,
+                products: &mut self.data.products,
+                links: self.model.n_links(),
             };
             let out = &mut self.a_ddot[range];
             if !group::<S, M>(simd, self.model, links, inputs, out) {
@@ -208,12 +215,12 @@ impl Batch<'_> {
 fn group<S: Simd, const M: usize>(
     simd: S,
     model: &ReducedModel,
-    links: LinkTrig<'_>,
+    links: LinkBuffers<'_>,
     inputs: [&[f64]; 3],
     out: &mut [f64],
 ) -> bool {
     let width = S::F64_LANES;
-    if !inputs.iter().all(|x| x.iter().all(|v| v.is_finite())) {
+    if !(all_finite(inputs[0]) & all_finite(inputs[1]) & all_finite(inputs[2])) {
         return false;
     }
     let mut buffer = [0.0; MAX_WIDTH];
@@ -227,17 +234,28 @@ fn group<S: Simd, const M: usize>(
     let a_dot: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[1], k));
     let tau_star: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[2], k));
     let zero = Pack::splat(simd, 0.0);
-    let mut mass = [[zero; M]; M];
+    let (mut sums, mut mass) = ([[zero; M]; M], [[zero; M]; M]);
+    let (mut coriolis_sums, mut gravity_sums) = ([zero; M], [zero; M]);
     let (mut coriolis, mut gravity, mut cos_moment) = ([zero; M], [zero; M], [zero; M]);
     let mut joint = [[zero; 2]; M];
-    let terms = Terms {
-        mass: mass.as_flattened_mut(),
-        coriolis: &mut coriolis,
-        gravity: &mut gravity,
+    let mut terms = Terms {
+        mass: sums.as_flattened_mut(),
+        coriolis: &mut coriolis_sums,
+        gravity: &mut gravity_sums,
         joint: &mut joint,
         cos_moment: &mut cos_moment,
     };
-    accumulate(simd, simd, model, &a, &a_dot, M, links, terms);
+    let layout = StateLanes(simd);
+    accumulate(layout, model, &a, &a_dot, M, links, &mut terms);
+    extract(
+        layout,
+        model,
+        M,
+        &terms,
+        mass.as_flattened_mut(),
+        &mut coriolis,
+        &mut gravity,
+    );
     // The right-hand side tau* - C* - G* and the solve, as in `forward_dynamics`.
     let mut x: [Pack<S>; M] = std::array::from_fn(|k| tau_star[k] - coriolis[k] - gravity[k]);
     if !ldlt_in_place(simd, mass.as_flattened_mut(), M) {

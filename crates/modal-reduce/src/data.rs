@@ -7,7 +7,7 @@ use pulp::Arch;
 
 use crate::error::{ReduceError, check_len};
 use crate::model::ReducedModel;
-use crate::terms::Pair;
+use crate::terms::{PRODUCTS, Pair};
 
 /// The most `f64` lanes of a SIMD register (AVX-512): the per-link buffers of one state are
 /// padded to a multiple of it.
@@ -41,7 +41,7 @@ pub struct ReducedData {
     pub(crate) rhs: Vec<f64>,
     pub(crate) iterate: Vec<f64>,
     /// Per-link buffers of the default path.
-    pub(crate) links: LinkBuffers,
+    pub(crate) links: OneStateLinks,
     /// Scratch of the default path for sizes without a specialised version.
     pub(crate) scratch: TermScratch,
     /// Joint-space state and torque buffers, length `n`.
@@ -77,19 +77,26 @@ impl Projection {
     }
 }
 
-/// Per link: absolute angle and its sine and cosine (see [`crate::terms`]). Length `n` rounded
-/// up to a whole number of the widest SIMD registers ([`LINK_PADDING`]), so that the sines and
-/// cosines of one state are computed in whole registers; the padding holds zeros.
+/// The per-link buffers of the default path (see [`crate::terms`]): every link's absolute angle,
+/// its sine and cosine (read again by [`crate::derivatives`]) and the per-link products, `n`
+/// rounded up to a whole number of the widest SIMD registers ([`LINK_PADDING`]) each, so that
+/// they are computed in whole registers.
 #[derive(Debug, Clone)]
-pub(crate) struct LinkBuffers {
+pub(crate) struct OneStateLinks {
     pub(crate) angle: Vec<f64>,
     pub(crate) sin: Vec<f64>,
     pub(crate) cos: Vec<f64>,
+    /// `[product][link]`.
+    pub(crate) products: Vec<f64>,
 }
 
 /// Scratch of the default path for sizes without a specialised version (see [`crate::terms`]).
 #[derive(Debug, Clone)]
 pub(crate) struct TermScratch {
+    /// `m x m`, `m`, `m`: `M*` (upper triangle), `C*` and `G*` as the kernel leaves them.
+    pub(crate) mass: Vec<f64>,
+    pub(crate) coriolis: Vec<f64>,
+    pub(crate) gravity: Vec<f64>,
     /// `m`: the columns of the prefix sum `P_l`.
     pub(crate) joint: Vec<Pair<f64>>,
     /// `m`: `S_l v_l`.
@@ -109,12 +116,16 @@ impl ReducedData {
             factor: vec![0.0; m * m],
             rhs: vec![0.0; m],
             iterate: vec![0.0; m],
-            links: LinkBuffers {
+            links: OneStateLinks {
                 angle: vec![0.0; n.next_multiple_of(LINK_PADDING)],
                 sin: vec![0.0; n.next_multiple_of(LINK_PADDING)],
                 cos: vec![0.0; n.next_multiple_of(LINK_PADDING)],
+                products: vec![0.0; PRODUCTS * n.next_multiple_of(LINK_PADDING)],
             },
             scratch: TermScratch {
+                mass: vec![0.0; m * m],
+                coriolis: vec![0.0; m],
+                gravity: vec![0.0; m],
                 joint: vec![[0.0; 2]; m],
                 cos_moment: vec![0.0; m],
             },

@@ -270,7 +270,8 @@ fn differentiate(
     let (a_dot, a_ddot) = (&a_dot[..m], &a_ddot[..m]);
     let (sin, cos) = (&data.links.sin[..n], &data.links.cos[..n]);
     let rows = &model.angle_rows()[..n * m];
-    let constants = &model.link_constants()[..n];
+    let constants = model.link_constants();
+    let (lengths, moments) = (&constants.length[..n], &constants.first_moment[..n]);
     let (rate, accel, diagonal) = (
         &mut links.rate[..n],
         &mut links.accel[..n],
@@ -287,13 +288,10 @@ fn differentiate(
         }
         rate[l] = w;
         accel[l] = alpha;
-        let (s, c, link) = (sin[l], cos[l], &constants[l]);
-        diagonal[l] = -link.length * (s * suffix[0] - c * suffix[1]) - g * link.first_moment * s;
+        let (s, c, moment) = (sin[l], cos[l], moments[l]);
+        diagonal[l] = -lengths[l] * (s * suffix[0] - c * suffix[1]) - g * moment * s;
         let e = motion_e(c, s, w, alpha);
-        suffix = [
-            suffix[0] + link.first_moment * e[0],
-            suffix[1] + link.first_moment * e[1],
-        ];
+        suffix = [suffix[0] + moment * e[0], suffix[1] + moment * e[1]];
     }
     // From the base: the prefix sums, and the rank-2 update of each partial, accumulated with
     // the opposite sign as the right-hand sides -D_a and -D_v.
@@ -323,9 +321,9 @@ fn differentiate(
     let jacobians = &mut jacobians[..m * width];
     jacobians.fill(0.0);
     let mut before = [0.0; 2];
-    for (l, (link, phi)) in constants.iter().zip(rows.chunks_exact(m)).enumerate() {
+    for (l, phi) in rows.chunks_exact(m).enumerate() {
         let (s, c, w, alpha) = (sin[l], cos[l], rate[l], accel[l]);
-        let moment = link.first_moment;
+        let moment = moments[l];
         let e = motion_e(c, s, w, alpha);
         let f = [2.0 * w * c, 2.0 * w * s];
         let weight = diagonal[l] - moment * (s * before[0] - c * before[1]);
@@ -343,7 +341,7 @@ fn differentiate(
                 d_v[k] += above_v[i] * phi[k] + phi[i] * below_v[k];
             }
         }
-        let length = link.length;
+        let length = lengths[l];
         for k in 0..m {
             let lp = length * phi[k];
             p_sin[k] += s * lp;

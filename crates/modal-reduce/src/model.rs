@@ -4,6 +4,7 @@
 use backbone_kin::{BaseAngle, ModalMap};
 use manip_dyn::ChainModel;
 
+use crate::data::LINK_PADDING;
 use crate::error::ReduceError;
 use crate::small_linalg::symmetric_eigen_extremes;
 
@@ -18,16 +19,30 @@ const RANK_TOLERANCE: f64 = 1e-10;
 /// `(n - 1) eps / 2` of exact (relative), so longer chains get `2 n eps` (4.4e-10 at 10^6 links).
 const GEOMETRY_TOLERANCE: f64 = 1e-12;
 
-/// The per-link constants of the default path (see [`crate::terms`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The per-link constants of the default path (see [`crate::terms`]), one array per quantity
+/// (structure of arrays), each `n` values followed by zeros up to a multiple of [`LINK_PADDING`]
+/// links, so that whole registers of consecutive links load from them.
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct LinkConstants {
     /// Link length `L_l`.
-    pub length: f64,
+    pub length: Vec<f64>,
     /// `S_l = m_l r_l + L_l mu_l`: the first moment of mass about joint `l` of the link and,
     /// lumped at its far joint, all the mass `mu_l` beyond it.
-    pub first_moment: f64,
+    pub first_moment: Vec<f64>,
     /// Absolute angle of the link at `a = 0`: `phi0_l = theta0_0 + ... + theta0_l`.
-    pub angle_offset: f64,
+    pub angle_offset: Vec<f64>,
+    /// The columns of `Phi` (entry `k` of every `Phi_l`), column `k` at `k` times the padded
+    /// length.
+    pub angle_columns: Vec<f64>,
+    /// The padded length of each array and column.
+    pub padded: usize,
+}
+
+impl LinkConstants {
+    /// Column `k` of `Phi`, padded.
+    pub(crate) fn angle_column(&self, k: usize) -> &[f64] {
+        &self.angle_columns[k * self.padded..(k + 1) * self.padded]
+    }
 }
 
 /// A planar chain constrained to a constant modal map `theta = J a + theta_0` (eqs 8-11), with
@@ -51,10 +66,12 @@ pub struct ReducedModel {
     chain: ChainModel,
     map: ModalMap,
     /// Row `l` is `Phi_l = J_0 + ... + J_l`, the gradient of link `l`'s absolute angle with
-    /// respect to `a` (row-major, `n x m`).
+    /// respect to `a` (row-major, `n x m`), followed by [`LINK_PADDING`] zeros so that a whole
+    /// register loads from the start of any row.
     angle_rows: Vec<f64>,
-    links: Vec<LinkConstants>,
-    /// `K = sum_l h_ll Phi_l^T Phi_l` (row-major `m x m`): the constant part of `M*`.
+    links: LinkConstants,
+    /// `K = sum_l h_ll Phi_l^T Phi_l` (row-major `m x m`): the constant part of `M*`, followed
+    /// by [`LINK_PADDING`] zeros like `angle_rows`.
     constant_mass: Vec<f64>,
 }
 
@@ -111,9 +128,16 @@ impl ReducedModel {
         for l in (0..n - 1).rev() {
             beyond[l] = beyond[l + 1] + chain_links[l + 1].mass;
         }
-        let mut angle_rows = vec![0.0; n * m];
-        let mut links = Vec::with_capacity(n);
-        let mut constant_mass = vec![0.0; m * m];
+        let mut angle_rows = vec![0.0; n * m + LINK_PADDING];
+        let padded = n.next_multiple_of(LINK_PADDING);
+        let mut links = LinkConstants {
+            length: vec![0.0; padded],
+            first_moment: vec![0.0; padded],
+            angle_offset: vec![0.0; padded],
+            angle_columns: vec![0.0; m * padded],
+            padded,
+        };
+        let mut constant_mass = vec![0.0; m * m + LINK_PADDING];
         let mut running = vec![0.0; m];
         let mut angle_offset = 0.0;
         for (l, (link, phi)) in chain_links
@@ -126,12 +150,13 @@ impl ReducedModel {
                 *sum += entry;
             }
             phi.copy_from_slice(&running);
+            for (k, &entry) in running.iter().enumerate() {
+                links.angle_columns[k * padded + l] = entry;
+            }
             angle_offset += map.offset()[l];
-            links.push(LinkConstants {
-                length: link.length,
-                first_moment: link.mass * link.com + link.length * beyond[l],
-                angle_offset,
-            });
+            links.length[l] = link.length;
+            links.first_moment[l] = link.mass * link.com + link.length * beyond[l];
+            links.angle_offset[l] = angle_offset;
             let diagonal = link.inertia
                 + link.mass * link.com * link.com
                 + link.length * link.length * beyond[l];
@@ -162,7 +187,7 @@ impl ReducedModel {
 
     /// Number of links (and joints) `n`.
     pub fn n_links(&self) -> usize {
-        self.links.len()
+        self.map.n_joints()
     }
 
     /// Number of modal coordinates `m`.
@@ -175,18 +200,19 @@ impl ReducedModel {
         faer::MatRef::from_row_major_slice(self.map.jacobian(), self.n_links(), self.n_coords())
     }
 
-    /// Row-major `n x m` gradients of the absolute link angles, `Phi_i`.
+    /// Row-major `n x m` gradients of the absolute link angles, `Phi_i`, followed by
+    /// [`LINK_PADDING`] zeros.
     pub(crate) fn angle_rows(&self) -> &[f64] {
         &self.angle_rows
     }
 
-    /// The constant part `K` of `M*`, row-major `m x m`.
+    /// The constant part `K` of `M*`, row-major `m x m`, followed by [`LINK_PADDING`] zeros.
     pub(crate) fn constant_mass(&self) -> &[f64] {
         &self.constant_mass
     }
 
     /// Per-link constants, base first.
-    pub(crate) fn link_constants(&self) -> &[LinkConstants] {
+    pub(crate) fn link_constants(&self) -> &LinkConstants {
         &self.links
     }
 }

@@ -25,7 +25,9 @@ pub(crate) fn ldlt_in_place<L: Lane>(context: L::Context, a: &mut [L], m: usize)
         for k in 0..j {
             pivot = pivot - a[j * m + k] * a[k * m + j];
         }
-        if !pivot.all_positive_finite() {
+        // Positive and finite in every lane, in two vector compares (false on a NaN).
+        let positive = pivot.all_greater(L::splat(context, 0.0));
+        if !(positive & L::splat(context, f64::INFINITY).all_greater(pivot)) {
             return false;
         }
         let inverse = L::splat(context, 1.0) / pivot;

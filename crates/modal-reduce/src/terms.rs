@@ -40,7 +40,7 @@
 //! and splitting each double sum into `j < l`, `j = l` and `j > l`:
 //!
 //! ```text
-//! M* = K + sum_l S_l (Phi_l^T v_l^T + v_l Phi_l),   K = sum_l h_ll Phi_l^T Phi_l  (constant),
+//! M* = K + A + A^T,   A = sum_l Phi_l^T (S_l v_l)^T,   K = sum_l h_ll Phi_l^T Phi_l  (constant),
 //! c_l = S_l (w_l . q_l) - L_l sum_{j>l} S_j phi_dot_j^2 sin(phi_j - phi_l).
 //! ```
 //!
@@ -55,21 +55,41 @@
 //! ```
 //!
 //! So one pass from the base builds `P_l` and `q_l` and accumulates `M*`, `C*` and `G*`. Per link
-//! this is one sine-cosine pair (computed for all links at once, see `trig`), `O(m)` work for
-//! `v_l`, `P_l^T u_l`, `P_l` and the projections, and `O(m^2)` for the symmetric update of `M*`
-//! (its upper triangle; mirrored at the end).
+//! this is one sine-cosine pair, `O(m)` work for `v_l`, `P_l^T u_l`, `P_l` and the projections,
+//! and `O(m^2)` for the update of `A` (one multiply-add an entry; `M*` is symmetrised from it at
+//! the end).
 //!
-//! The kernel is written once, generic over its number type: `f64` for one state, and a SIMD
-//! register of several states side by side for [`forward_dynamics_batch`].
+//! # Evaluation
+//!
+//! A pre-pass computes, for all links at once, what depends on one link only: `phi_l`,
+//! `phi_dot_l`, `sin phi_l`, `cos phi_l` and, for one state, the products `S_l phi_dot_l^2`,
+//! `S_l cos phi_l`, `L_l sin phi_l`, `L_l cos phi_l`, `L_l cos(phi_l) phi_dot_l^2` and
+//! `L_l sin(phi_l) phi_dot_l^2` (the steps of `q_l`): for one state it runs across links, a
+//! register of consecutive links at a time, where the pass could only use one lane for them (a
+//! batch, whose registers hold states either way, computes the products in the pass). Then the
+//! pass runs over the links with what is left, the prefix sums.
+//!
+//! The kernel is written once, generic over a `Layout`: how its numbers sit in SIMD registers.
+//! One state either has its coordinates side by side in one register (`CoordinateLanes`: each
+//! per-coordinate loop of the pass is one vector operation, and the pre-pass runs across links,
+//! a register of consecutive links at a time), or one coordinate a number (`OneStateScalar`,
+//! when `m` exceeds the register); a batch ([`forward_dynamics_batch`]) has one coordinate of
+//! several states in a register (`StateLanes`). Every state gets the same operations in the
+//! same order in each, lane by lane, without fused multiply-adds, so a state gives the same bits
+//! alone or in a batch.
 //!
 //! [`forward_dynamics_batch`]: crate::forward_dynamics_batch
 
-use crate::data::{LinkBuffers, ReducedData};
+use crate::data::{LINK_PADDING, ReducedData};
 use crate::error::{ReduceError, check_finite_result, check_input};
 use crate::model::ReducedModel;
-use lane_math::Lane;
-use lane_math::sin_cos_simd;
+use lane_math::{Lane, Pack, sin_cos_simd};
 use pulp::{Simd, WithSimd};
+
+/// Per-link products the pre-pass leaves for the pass besides the sine and cosine, in this order
+/// in the buffer: `S_l phi_dot_l^2`, `S_l cos phi_l`, `L_l sin phi_l`, `L_l cos phi_l`,
+/// `L_l cos(phi_l) phi_dot_l^2`, `L_l sin(phi_l) phi_dot_l^2`.
+pub(crate) const PRODUCTS: usize = 6;
 
 /// Computes `M*(a)`, `C*(a, a_dot)` and `G*(a)` (eq 14) into `data` in `O(n m^2)`, by prefix
 /// sums along the chain (the default path; see the [module documentation](self) for the
@@ -136,8 +156,7 @@ pub(crate) fn all_finite(values: &[f64]) -> bool {
 }
 
 /// The terms of [`reduced_terms`] (inputs already checked), run by [`pulp::Arch::dispatch`] so
-/// that the kernel is compiled for the processor's instruction set (AVX-512's 32 registers hold
-/// the pass's running sums; the sines and cosines vectorise across links).
+/// that the kernel is compiled for the processor's instruction set.
 struct TermsOfOneState<'a> {
     model: &'a ReducedModel,
     data: &'a mut ReducedData,
@@ -167,7 +186,7 @@ impl WithSimd for TermsOfOneState<'_> {
     }
 }
 
-/// [`accumulate`] for any `m`, into the slices of `data`.
+/// [`accumulate`] for any `m`, one coordinate a number, into the slices of `data`.
 #[inline(always)]
 pub(crate) fn accumulate_in_data<S: Simd>(
     simd: S,
@@ -184,23 +203,24 @@ pub(crate) fn accumulate_in_data<S: Simd>(
         scratch,
         ..
     } = data;
-    let terms = Terms {
-        mass,
-        coriolis,
-        gravity,
+    let layout = OneStateScalar(simd);
+    let mut terms = Terms {
+        mass: &mut scratch.mass,
+        coriolis: &mut scratch.coriolis,
+        gravity: &mut scratch.gravity,
         joint: &mut scratch.joint,
         cos_moment: &mut scratch.cos_moment,
     };
-    accumulate(
-        (),
-        simd,
-        model,
-        a,
-        a_dot,
-        model.n_coords(),
-        links.trig(),
-        terms,
-    );
+    let m = model.n_coords();
+    let link_buffers = LinkBuffers {
+        angle: &mut links.angle,
+        sin: &mut links.sin,
+        cos: &mut links.cos,
+        products: &mut links.products,
+        links: model.link_constants().padded,
+    };
+    accumulate(layout, model, a, a_dot, m, link_buffers, &mut terms);
+    extract(layout, model, m, &terms, mass, coriolis, gravity);
 }
 
 /// `M*`, `C*` and `G*` of one state for a compile-time `M`, on the stack (the optimiser keeps
@@ -215,7 +235,8 @@ pub(crate) struct StackTerms<const M: usize> {
 }
 
 impl<const M: usize> StackTerms<M> {
-    /// [`accumulate`] for one state, with `data`'s per-link buffers.
+    /// [`accumulate`] for one state, with `data`'s per-link buffers: the coordinates in one
+    /// register when they fit ([`CoordinateLanes`]), else one a number ([`OneStateScalar`]).
     #[inline(always)]
     pub(crate) fn compute<S: Simd>(
         simd: S,
@@ -224,22 +245,58 @@ impl<const M: usize> StackTerms<M> {
         a: &[f64],
         a_dot: &[f64],
     ) -> Self {
-        let mut terms = Self {
+        if M <= S::F64_LANES && S::F64_LANES <= LINK_PADDING {
+            Self::compute_in(CoordinateLanes::new(simd, M), model, data, a, a_dot)
+        } else {
+            Self::compute_in(OneStateScalar(simd), model, data, a, a_dot)
+        }
+    }
+
+    /// [`compute`](Self::compute) in the layout `layout`.
+    #[inline(always)]
+    fn compute_in<Y: Layout<Value = f64>>(
+        layout: Y,
+        model: &ReducedModel,
+        data: &mut ReducedData,
+        a: &[f64],
+        a_dot: &[f64],
+    ) -> Self {
+        let zero = Y::Register::splat(layout.register_context(), 0.0);
+        // At most M registers a row (one coordinate a register).
+        let mut mass = [[zero; M]; M];
+        let (mut coriolis, mut gravity, mut cos_moment) = ([zero; M], [zero; M], [zero; M]);
+        let mut joint = [[zero; 2]; M];
+        let links = &mut data.links;
+        let link_buffers = LinkBuffers {
+            angle: &mut links.angle,
+            sin: &mut links.sin,
+            cos: &mut links.cos,
+            products: &mut links.products,
+            links: model.link_constants().padded,
+        };
+        let mut terms = Terms {
+            mass: mass.as_flattened_mut(),
+            coriolis: &mut coriolis,
+            gravity: &mut gravity,
+            joint: &mut joint,
+            cos_moment: &mut cos_moment,
+        };
+        accumulate(layout, model, a, a_dot, M, link_buffers, &mut terms);
+        let mut out = Self {
             mass: [[0.0; M]; M],
             coriolis: [0.0; M],
             gravity: [0.0; M],
         };
-        let mut joint = [[0.0; 2]; M];
-        let mut cos_moment = [0.0; M];
-        let slices = Terms {
-            mass: terms.mass.as_flattened_mut(),
-            coriolis: &mut terms.coriolis,
-            gravity: &mut terms.gravity,
-            joint: &mut joint,
-            cos_moment: &mut cos_moment,
-        };
-        accumulate((), simd, model, a, a_dot, M, data.links.trig(), slices);
-        terms
+        extract(
+            layout,
+            model,
+            M,
+            &terms,
+            out.mass.as_flattened_mut(),
+            &mut out.coriolis,
+            &mut out.gravity,
+        );
+        out
     }
 
     /// Copies the terms into `data`, where [`ReducedData::mass_matrix`] and the others read them.
@@ -262,142 +319,710 @@ impl<const M: usize> StackTerms<M> {
 /// An `(x, y)` pair: a column of the `2 x m` prefix sum `P_l`.
 pub(crate) type Pair<L> = [L; 2];
 
-/// The per-link buffers of the kernel, at least `n` values of `L::WIDTH` lanes each
-/// (`[link][lane]`); entries beyond those are padding.
-pub(crate) struct LinkTrig<'a> {
-    /// Absolute angle `phi_l`.
-    pub(crate) angle: &'a mut [f64],
-    /// Its sine and cosine.
-    pub(crate) sin: &'a mut [f64],
-    pub(crate) cos: &'a mut [f64],
+/// How the kernel's numbers sit in registers (see the [module documentation](self)).
+pub(crate) trait Layout: Copy {
+    /// A register of the pass: several coordinates of one state, or one coordinate (of one state
+    /// or of several side by side).
+    type Register: Lane;
+    /// One number of each state: `f64` for one state, a register of states for a batch.
+    type Value: Lane;
+    /// What building a register needs.
+    fn register_context(self) -> <Self::Register as Lane>::Context;
+    /// What building a value needs.
+    fn value_context(self) -> <Self::Value as Lane>::Context;
+    /// How many registers a row of `m` coordinates takes.
+    fn chunks(self, m: usize) -> usize;
+    /// `value` in every coordinate of a register.
+    fn spread(self, value: Self::Value) -> Self::Register;
+    /// Register `chunk` of a constant row of the layout's `m` coordinates starting at `row[0]`;
+    /// `row` continues for at least [`LINK_PADDING`] values (the lanes past the `m` coordinates
+    /// are zero).
+    fn constant_row(self, row: &[f64], chunk: usize) -> Self::Register;
+    /// Coordinate `k` of the row held in the registers `row`.
+    fn coordinate(self, row: &[Self::Register], k: usize) -> Self::Value;
+    /// How many of the [`PRODUCTS`] the pre-pass stores: all, or only the rate `phi_dot_l` (in
+    /// the first one's place) when the pass computes them (a batch, whose pre-pass is not
+    /// vectorised across links any more than its pass).
+    const PRE_PASS_PRODUCTS: usize;
+    /// The sine, cosine and [`PRODUCTS`] of link `i` for the pass, from `values` and, if the
+    /// pre-pass left them to the pass, the link's first moment and length (see
+    /// [`link_products`]).
+    fn link(
+        self,
+        values: &LinkValues<'_>,
+        i: usize,
+        moment: f64,
+        length: f64,
+    ) -> [Self::Value; 2 + PRODUCTS];
+    /// Whether `G*` is summed in a loop of its own after the pass rather than in it (a batch,
+    /// whose pass has no register to spare).
+    const GRAVITY_APART: bool;
+    /// `S_l cos phi_l` of link `i` (the second of the [`PRODUCTS`]), as [`link`](Self::link)
+    /// gives it.
+    fn gravity_force(self, values: &LinkValues<'_>, i: usize, moment: f64) -> Self::Value;
+    /// The per-link values of all links into `links` (the pre-pass).
+    fn link_values(
+        self,
+        model: &ReducedModel,
+        a: &[Self::Value],
+        a_dot: &[Self::Value],
+        links: &mut LinkBuffers<'_>,
+    );
 }
 
-impl LinkBuffers {
-    /// The buffers as the kernel takes them.
-    pub(crate) fn trig(&mut self) -> LinkTrig<'_> {
-        LinkTrig {
-            angle: &mut self.angle,
-            sin: &mut self.sin,
-            cos: &mut self.cos,
+/// One state, its coordinates side by side in one register of the instruction set `S` (`m` at
+/// most its lanes, which are at most [`LINK_PADDING`]); the pre-pass runs across links.
+#[derive(Clone, Copy)]
+pub(crate) struct CoordinateLanes<S: Simd> {
+    simd: S,
+    /// All bits set in the lanes of the `m` coordinates, none past them.
+    mask: Pack<S>,
+}
+
+impl<S: Simd> CoordinateLanes<S> {
+    /// The layout for `m` coordinates.
+    #[inline(always)]
+    pub(crate) fn new(simd: S, m: usize) -> Self {
+        let mut mask = [0.0; LINK_PADDING];
+        for lane in &mut mask[..m] {
+            *lane = f64::from_bits(!0);
+        }
+        Self {
+            simd,
+            mask: Pack::load(simd, &mask),
         }
     }
 }
 
-/// The results and scratch of the kernel, `m` or `m x m` values.
-pub(crate) struct Terms<'a, L> {
-    /// `M*`, row-major `m x m`.
-    pub(crate) mass: &'a mut [L],
-    /// `C*`, length `m`.
-    pub(crate) coriolis: &'a mut [L],
-    /// `G*`, length `m`.
-    pub(crate) gravity: &'a mut [L],
-    /// Columns of `P_l`, length `m`.
-    pub(crate) joint: &'a mut [Pair<L>],
-    /// `S_l v_l`, length `m`.
-    pub(crate) cos_moment: &'a mut [L],
+impl<S: Simd> Layout for CoordinateLanes<S> {
+    type Register = Pack<S>;
+    type Value = f64;
+
+    const PRE_PASS_PRODUCTS: usize = PRODUCTS;
+    const GRAVITY_APART: bool = false;
+
+    #[inline(always)]
+    fn link(self, values: &LinkValues<'_>, i: usize, _: f64, _: f64) -> [f64; 2 + PRODUCTS] {
+        values.load((), i)
+    }
+
+    #[inline(always)]
+    fn gravity_force(self, values: &LinkValues<'_>, i: usize, _: f64) -> f64 {
+        values.products[1][i]
+    }
+
+    #[inline(always)]
+    fn register_context(self) -> S {
+        self.simd
+    }
+
+    #[inline(always)]
+    fn value_context(self) {}
+
+    #[inline(always)]
+    fn chunks(self, _: usize) -> usize {
+        1
+    }
+
+    #[inline(always)]
+    fn spread(self, value: f64) -> Pack<S> {
+        Pack::splat(self.simd, value)
+    }
+
+    #[inline(always)]
+    fn constant_row(self, row: &[f64], _: usize) -> Pack<S> {
+        Pack::load(self.simd, row).and_bits(self.mask)
+    }
+
+    #[inline(always)]
+    fn coordinate(self, row: &[Pack<S>], k: usize) -> f64 {
+        row[0].lane(k)
+    }
+
+    #[inline(always)]
+    fn link_values(
+        self,
+        model: &ReducedModel,
+        a: &[f64],
+        a_dot: &[f64],
+        links: &mut LinkBuffers<'_>,
+    ) {
+        link_values_across_links(self.simd, model, a, a_dot, links);
+    }
 }
 
-/// The sums of the module documentation, for `m` coordinates of `L::WIDTH` states each, into
-/// `terms`: `M*` (both triangles), `C*` and `G*`; the sines and cosines in registers of `simd`.
+/// One state, one coordinate a number (for more coordinates than a register holds); the
+/// pre-pass runs across links in registers of `S`.
+#[derive(Clone, Copy)]
+pub(crate) struct OneStateScalar<S>(pub(crate) S);
+
+impl<S: Simd> Layout for OneStateScalar<S> {
+    type Register = f64;
+    type Value = f64;
+
+    const PRE_PASS_PRODUCTS: usize = PRODUCTS;
+    const GRAVITY_APART: bool = false;
+
+    #[inline(always)]
+    fn link(self, values: &LinkValues<'_>, i: usize, _: f64, _: f64) -> [f64; 2 + PRODUCTS] {
+        values.load((), i)
+    }
+
+    #[inline(always)]
+    fn gravity_force(self, values: &LinkValues<'_>, i: usize, _: f64) -> f64 {
+        values.products[1][i]
+    }
+
+    #[inline(always)]
+    fn register_context(self) {}
+
+    #[inline(always)]
+    fn value_context(self) {}
+
+    #[inline(always)]
+    fn chunks(self, m: usize) -> usize {
+        m
+    }
+
+    #[inline(always)]
+    fn spread(self, value: f64) -> f64 {
+        value
+    }
+
+    #[inline(always)]
+    fn constant_row(self, row: &[f64], chunk: usize) -> f64 {
+        row[chunk]
+    }
+
+    #[inline(always)]
+    fn coordinate(self, row: &[f64], k: usize) -> f64 {
+        row[k]
+    }
+
+    #[inline(always)]
+    fn link_values(
+        self,
+        model: &ReducedModel,
+        a: &[f64],
+        a_dot: &[f64],
+        links: &mut LinkBuffers<'_>,
+    ) {
+        link_values_across_links(self.0, model, a, a_dot, links);
+    }
+}
+
+/// Several states side by side, lane `i` of every register holding state `i`; one coordinate a
+/// register.
+#[derive(Clone, Copy)]
+pub(crate) struct StateLanes<S: Simd>(pub(crate) S);
+
+impl<S: Simd> Layout for StateLanes<S> {
+    type Register = Pack<S>;
+    type Value = Pack<S>;
+
+    const PRE_PASS_PRODUCTS: usize = 1;
+    const GRAVITY_APART: bool = true;
+
+    #[inline(always)]
+    fn link(
+        self,
+        values: &LinkValues<'_>,
+        i: usize,
+        moment: f64,
+        length: f64,
+    ) -> [Pack<S>; 2 + PRODUCTS] {
+        let simd = self.0;
+        let angles = values.load_trig_rate(simd, i);
+        let [sin, cos, _] = angles;
+        let moment = Pack::splat(simd, moment);
+        let [p0, p1, p2, p3, p4, p5] = link_products(angles, moment, Pack::splat(simd, length));
+        [sin, cos, p0, p1, p2, p3, p4, p5]
+    }
+
+    #[inline(always)]
+    fn gravity_force(self, values: &LinkValues<'_>, i: usize, moment: f64) -> Pack<S> {
+        let [_, cos, _] = values.load_trig_rate::<Pack<S>>(self.0, i);
+        cos * moment
+    }
+
+    #[inline(always)]
+    fn register_context(self) -> S {
+        self.0
+    }
+
+    #[inline(always)]
+    fn value_context(self) -> S {
+        self.0
+    }
+
+    #[inline(always)]
+    fn chunks(self, m: usize) -> usize {
+        m
+    }
+
+    #[inline(always)]
+    fn spread(self, value: Pack<S>) -> Pack<S> {
+        value
+    }
+
+    #[inline(always)]
+    fn constant_row(self, row: &[f64], chunk: usize) -> Pack<S> {
+        Pack::splat(self.0, row[chunk])
+    }
+
+    #[inline(always)]
+    fn coordinate(self, row: &[Pack<S>], k: usize) -> Pack<S> {
+        row[k]
+    }
+
+    #[inline(always)]
+    fn link_values(
+        self,
+        model: &ReducedModel,
+        a: &[Pack<S>],
+        a_dot: &[Pack<S>],
+        links: &mut LinkBuffers<'_>,
+    ) {
+        let simd = self.0;
+        let width = S::F64_LANES;
+        let constants = model.link_constants();
+        let m = a.len();
+        let n = model.n_links();
+        let rows = model.angle_rows()[..n * m].chunks_exact(m);
+        for (l, (phi, &offset)) in rows.zip(&constants.angle_offset[..n]).enumerate() {
+            let inputs = AcrossStates {
+                simd,
+                a,
+                a_dot,
+                phi,
+            };
+            let angle_rate = link_angle_rate(simd, Pack::splat(simd, offset), &inputs);
+            links.store_angle_rate(l, width, angle_rate);
+        }
+        links.sin_cos(simd, n * width);
+    }
+}
+
+/// The pre-pass of one state: [`link_angle_rate`], the sines and cosines, then
+/// [`link_products`], each a loop over registers of consecutive links (the last one padded with
+/// the zeros of the padded constants). Separate loops, so that the sines and cosines (long
+/// chains of dependent operations) run alone, short enough for the processor to overlap them.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn accumulate<L: Lane, S: Simd>(
+fn link_values_across_links<S: Simd>(
+    simd: S,
+    model: &ReducedModel,
+    a: &[f64],
+    a_dot: &[f64],
+    links: &mut LinkBuffers<'_>,
+) {
+    if S::F64_LANES > LINK_PADDING {
+        // Wider registers than the padding: one link at a time.
+        across_links::<f64, S>((), simd, model, a, a_dot, links);
+    } else {
+        across_links::<Pack<S>, S>(simd, simd, model, a, a_dot, links);
+    }
+}
+
+/// [`link_values_across_links`] in registers of `L` (`L::WIDTH` at most [`LINK_PADDING`]).
+#[inline(always)]
+fn across_links<L: Lane, S: Simd>(
     context: L::Context,
     simd: S,
     model: &ReducedModel,
-    a: &[L],
-    a_dot: &[L],
-    m: usize,
-    links: LinkTrig<'_>,
-    terms: Terms<'_, L>,
+    a: &[f64],
+    a_dot: &[f64],
+    links: &mut LinkBuffers<'_>,
 ) {
-    let width = L::WIDTH;
-    let zero = L::splat(context, 0.0);
+    let constants = model.link_constants();
+    let n = model.n_links();
+    for l in (0..n).step_by(L::WIDTH) {
+        let inputs = AcrossLinks::<L> {
+            context,
+            model,
+            a,
+            a_dot,
+            l,
+        };
+        let offset = L::load(context, &constants.angle_offset[l..]);
+        links.store_angle_rate(l, 1, link_angle_rate(context, offset, &inputs));
+    }
+    links.sin_cos(simd, n.next_multiple_of(L::WIDTH));
+    for l in (0..n).step_by(L::WIDTH) {
+        let angles = links.load_trig_rate(context, l, 1);
+        let moment = L::load(context, &constants.first_moment[l..]);
+        let length = L::load(context, &constants.length[l..]);
+        links.store_products(l, 1, link_products(angles, moment, length));
+    }
+}
+
+/// The inputs of [`link_angle_rate`] for the consecutive links `l..l + L::WIDTH` of one state (its
+/// coordinates spread across the lanes).
+struct AcrossLinks<'a, L: Lane> {
+    context: L::Context,
+    model: &'a ReducedModel,
+    a: &'a [f64],
+    a_dot: &'a [f64],
+    l: usize,
+}
+
+impl<L: Lane> LinkInputs<L> for AcrossLinks<'_, L> {
+    #[inline(always)]
+    fn coords(&self) -> usize {
+        self.a.len()
+    }
+
+    #[inline(always)]
+    fn term(&self, k: usize) -> (L, L, L) {
+        let column = self.model.link_constants().angle_column(k);
+        (
+            L::splat(self.context, self.a[k]),
+            L::splat(self.context, self.a_dot[k]),
+            L::load(self.context, &column[self.l..]),
+        )
+    }
+}
+
+/// The inputs of [`link_angle_rate`] for link `phi` (its row `Phi_l`) of several states side by side.
+struct AcrossStates<'a, S: Simd> {
+    simd: S,
+    a: &'a [Pack<S>],
+    a_dot: &'a [Pack<S>],
+    phi: &'a [f64],
+}
+
+impl<S: Simd> LinkInputs<Pack<S>> for AcrossStates<'_, S> {
+    #[inline(always)]
+    fn coords(&self) -> usize {
+        self.a.len()
+    }
+
+    #[inline(always)]
+    fn term(&self, k: usize) -> (Pack<S>, Pack<S>, Pack<S>) {
+        (
+            self.a[k],
+            self.a_dot[k],
+            Pack::splat(self.simd, self.phi[k]),
+        )
+    }
+}
+
+/// The state-dependent inputs of [`link_angle_rate`].
+trait LinkInputs<L> {
+    /// The number of coordinates `m`.
+    fn coords(&self) -> usize;
+    /// `(a_k, a_dot_k, (Phi_l)_k)`.
+    fn term(&self, k: usize) -> (L, L, L);
+}
+
+/// `[phi_l, phi_dot_l]` of one link (or one lane's link each), from its angle offset `phi0_l`
+/// and the state: `phi_l = phi0_l + Phi_l . a`, `phi_dot_l = Phi_l . a_dot`.
+#[inline(always)]
+fn link_angle_rate<L: Lane>(
+    context: L::Context,
+    angle_offset: L,
+    inputs: &impl LinkInputs<L>,
+) -> [L; 2] {
+    let mut angle = angle_offset;
+    let mut rate = L::splat(context, 0.0);
+    for k in 0..inputs.coords() {
+        let (a, a_dot, phi) = inputs.term(k);
+        angle = angle + a * phi;
+        rate = rate + a_dot * phi;
+    }
+    [angle, rate]
+}
+
+/// The [`PRODUCTS`] of one link (or one lane's link each) from `[sin phi_l, cos phi_l, phi_dot_l]`, its first moment
+/// `S_l` and its length `L_l`.
+#[inline(always)]
+fn link_products<L: Lane>([sin, cos, rate]: [L; 3], moment: L, length: L) -> [L; PRODUCTS] {
+    let rate2 = rate * rate;
+    let (l_sin, l_cos) = (sin * length, cos * length);
+    [
+        rate2 * moment,
+        cos * moment,
+        l_sin,
+        l_cos,
+        l_cos * rate2,
+        l_sin * rate2,
+    ]
+}
+
+/// The per-link buffers of the kernel: every link's angle, its sine and cosine, and the
+/// [`PRODUCTS`], each entry `W` values side by side (`W` the lanes of the layout's
+/// [`Value`](Layout::Value): one state's links have one, a batch's the states of a group).
+pub(crate) struct LinkBuffers<'a> {
+    /// `phi_l`, `[link][lane]`.
+    pub(crate) angle: &'a mut [f64],
+    /// `sin phi_l`, as `angle`.
+    pub(crate) sin: &'a mut [f64],
+    /// `cos phi_l`, as `sin`.
+    pub(crate) cos: &'a mut [f64],
+    /// The products, `[product][link][lane]`.
+    pub(crate) products: &'a mut [f64],
+    /// The links of each product's buffer: `n`, or more for padding.
+    pub(crate) links: usize,
+}
+
+impl LinkBuffers<'_> {
+    /// Stores `[phi_l, phi_dot_l]` of link `l` (the rate where the first product goes, until
+    /// [`store_products`](Self::store_products)), entries of `width` lanes: of the links
+    /// `l..l + L::WIDTH` for a register across links (`width` 1), of link `l` for a register of
+    /// states (`width` `L::WIDTH`).
+    #[inline(always)]
+    fn store_angle_rate<L: Lane>(&mut self, l: usize, width: usize, [angle, rate]: [L; 2]) {
+        let entry = l * width;
+        angle.store(&mut self.angle[entry..]);
+        rate.store(&mut self.products[entry..]);
+    }
+
+    /// The sines and cosines of the first `entries` angles, in registers of `S`.
+    #[inline(always)]
+    fn sin_cos<S: Simd>(&mut self, simd: S, entries: usize) {
+        let angle = &self.angle[..entries];
+        sin_cos_simd(
+            simd,
+            angle,
+            &mut self.sin[..entries],
+            &mut self.cos[..entries],
+        );
+    }
+
+    /// `[sin phi_l, cos phi_l, phi_dot_l]` of link `l` after [`sin_cos`](Self::sin_cos).
+    #[inline(always)]
+    fn load_trig_rate<L: Lane>(&self, context: L::Context, l: usize, width: usize) -> [L; 3] {
+        let entry = l * width;
+        [
+            L::load(context, &self.sin[entry..]),
+            L::load(context, &self.cos[entry..]),
+            L::load(context, &self.products[entry..]),
+        ]
+    }
+
+    /// Stores the [`PRODUCTS`] of link `l` (entries as in
+    /// [`store_angle_rate`](Self::store_angle_rate)).
+    #[inline(always)]
+    fn store_products<L: Lane>(&mut self, l: usize, width: usize, products: [L; PRODUCTS]) {
+        for (p, value) in products.iter().enumerate() {
+            value.store(&mut self.products[(p * self.links + l) * width..]);
+        }
+    }
+
+    /// The values of the first `n` links, entries of `width` lanes, for the pass (the first
+    /// `products` of the [`PRODUCTS`]).
+    #[inline(always)]
+    fn values(&self, n: usize, width: usize, products: usize) -> LinkValues<'_> {
+        let size = n * width;
+        let product = |p: usize| {
+            if p < products {
+                &self.products[p * self.links * width..][..size]
+            } else {
+                &[]
+            }
+        };
+        LinkValues {
+            sin: &self.sin[..size],
+            cos: &self.cos[..size],
+            products: [
+                product(0),
+                product(1),
+                product(2),
+                product(3),
+                product(4),
+                product(5),
+            ],
+        }
+    }
+}
+
+/// The values the pre-pass left for the links (see [`LinkBuffers`]), each slice exactly the
+/// links' entries, so that the pass reads them without bounds checks (the products the
+/// pre-pass did not compute empty).
+pub(crate) struct LinkValues<'a> {
+    sin: &'a [f64],
+    cos: &'a [f64],
+    products: [&'a [f64]; PRODUCTS],
+}
+
+impl LinkValues<'_> {
+    /// The sine and cosine of link `i` and its rate `phi_dot_l` (where the first product goes).
+    #[inline(always)]
+    fn load_trig_rate<L: Lane>(&self, context: L::Context, i: usize) -> [L; 3] {
+        let entry = i * L::WIDTH;
+        [
+            L::load(context, &self.sin[entry..]),
+            L::load(context, &self.cos[entry..]),
+            L::load(context, &self.products[0][entry..]),
+        ]
+    }
+
+    /// The sine, cosine and products of link `i`.
+    #[inline(always)]
+    fn load<L: Lane>(&self, context: L::Context, i: usize) -> [L; 2 + PRODUCTS] {
+        let entry = i * L::WIDTH;
+        let [p0, p1, p2, p3, p4, p5] = self.products;
+        [
+            L::load(context, &self.sin[entry..]),
+            L::load(context, &self.cos[entry..]),
+            L::load(context, &p0[entry..]),
+            L::load(context, &p1[entry..]),
+            L::load(context, &p2[entry..]),
+            L::load(context, &p3[entry..]),
+            L::load(context, &p4[entry..]),
+            L::load(context, &p5[entry..]),
+        ]
+    }
+}
+
+/// The results and scratch of the kernel, in registers of a [`Layout`]: `m` rows of
+/// [`chunks`](Layout::chunks) registers, or one row.
+pub(crate) struct Terms<'a, R> {
+    /// `A` (see [`accumulate`]), row after row.
+    pub(crate) mass: &'a mut [R],
+    /// `C*`.
+    pub(crate) coriolis: &'a mut [R],
+    /// `G*`.
+    pub(crate) gravity: &'a mut [R],
+    /// Columns of `P_l`.
+    pub(crate) joint: &'a mut [Pair<R>],
+    /// `S_l v_l`.
+    pub(crate) cos_moment: &'a mut [R],
+}
+
+/// The sums of the module documentation, for `m` coordinates, into `terms` in the registers of
+/// `layout`: `A` (all of it; `M* = K + A + A^T`, see [`extract`]), `C*` and `G*`.
+#[inline(always)]
+pub(crate) fn accumulate<Y: Layout>(
+    layout: Y,
+    model: &ReducedModel,
+    a: &[Y::Value],
+    a_dot: &[Y::Value],
+    m: usize,
+    mut links: LinkBuffers<'_>,
+    terms: &mut Terms<'_, Y::Register>,
+) {
+    let (rc, vc) = (layout.register_context(), layout.value_context());
+    let chunks = layout.chunks(m);
+    let zero = Y::Register::splat(rc, 0.0);
     let (a, a_dot) = (&a[..m], &a_dot[..m]);
-    let mass = &mut terms.mass[..m * m];
-    let coriolis = &mut terms.coriolis[..m];
-    let gravity = &mut terms.gravity[..m];
-    let joint = &mut terms.joint[..m];
-    let cos_moment = &mut terms.cos_moment[..m];
+    let mass = &mut terms.mass[..m * chunks];
+    let coriolis = &mut terms.coriolis[..chunks];
+    let gravity = &mut terms.gravity[..chunks];
+    let joint = &mut terms.joint[..chunks];
+    let cos_moment = &mut terms.cos_moment[..chunks];
     mass.fill(zero);
     coriolis.fill(zero);
     gravity.fill(zero);
     joint.fill([zero; 2]);
-    let constants = model.link_constants();
+    let n = model.n_links();
+    let moments = &model.link_constants().first_moment;
     let rows = model.angle_rows();
-    let size = constants.len() * width;
-    // Absolute angles, then their sines and cosines, all links at once, in whole SIMD registers
-    // when the buffers are padded for it (one state's are: see `ReducedData`).
-    let padded = size.next_multiple_of(S::F64_LANES).min(links.angle.len());
-    for ((angle, phi), link) in links.angle[..size]
-        .chunks_exact_mut(width)
-        .zip(rows.chunks_exact(m))
-        .zip(constants)
+    let mut q = [Y::Value::splat(vc, 0.0); 2];
+    layout.link_values(model, a, a_dot, &mut links);
+    // The pass: P_l, q_l, and the sums of M* and C*.
+    let values = links.values(n, Y::Value::WIDTH, Y::PRE_PASS_PRODUCTS);
+    let moments = &moments[..n];
+    let lengths = &model.link_constants().length[..n];
+    let rows = &rows[..n * m + LINK_PADDING];
     {
-        let phi = &phi[..m];
-        let mut phi_l = L::splat(context, link.angle_offset);
-        for k in 0..m {
-            phi_l = phi_l + a[k] * phi[k];
-        }
-        phi_l.store(angle);
-    }
-    sin_cos_simd(
-        simd,
-        &links.angle[..padded],
-        &mut links.sin[..padded],
-        &mut links.cos[..padded],
-    );
-    let (sin, cos) = (&links.sin[..size], &links.cos[..size]);
-    // One pass from the base: P_l, q_l, and the sums of M*, C* and G*.
-    let mut q = [zero; 2];
-    for (((link, phi), sin), cos) in constants
-        .iter()
-        .zip(rows.chunks_exact(m))
-        .zip(sin.chunks_exact(width))
-        .zip(cos.chunks_exact(width))
-    {
-        let phi = &phi[..m];
-        let (sin, cos) = (L::load(context, sin), L::load(context, cos));
-        let mut rate = zero;
-        for k in 0..m {
-            rate = rate + a_dot[k] * phi[k];
-        }
-        let rate2 = rate * rate;
-        let moment = link.first_moment;
-        // S_l (w_l . q_l), S_l phi_dot_l^2 and S_l cos(phi_l).
-        let force = (cos * q[1] - sin * q[0]) * moment;
-        let moment_rate2 = rate2 * moment;
-        let gravity_force = cos * moment;
-        for k in 0..m {
-            let [px, py] = joint[k];
-            cos_moment[k] = (cos * py - sin * px) * moment;
-            let along = cos * px + sin * py;
-            coriolis[k] = coriolis[k] + force * phi[k] - moment_rate2 * along;
-            gravity[k] = gravity[k] + gravity_force * phi[k];
-        }
-        for j in 0..m {
-            for k in j..m {
-                mass[j * m + k] =
-                    mass[j * m + k] + (cos_moment[k] * phi[j] + cos_moment[j] * phi[k]);
+        for (i, &moment) in moments.iter().enumerate() {
+            let row = &rows[i * m..];
+            let [
+                sin,
+                cos,
+                moment_rate2,
+                gravity_force,
+                l_sin,
+                l_cos,
+                drop_x,
+                drop_y,
+            ] = layout.link(&values, i, moment, lengths[i]);
+            // S_l (w_l . q_l).
+            // (No closures or array maps here: their bodies would be compiled without the
+            // instruction set of the dispatch, and its intrinsics called, not inlined.)
+            let force = layout.spread((cos * q[1] - sin * q[0]) * moment);
+            let (sin, cos) = (layout.spread(sin), layout.spread(cos));
+            let moment_rate2 = layout.spread(moment_rate2);
+            if !Y::GRAVITY_APART {
+                add_gravity(layout, gravity, layout.spread(gravity_force), row);
             }
+            let (l_sin, l_cos) = (layout.spread(l_sin), layout.spread(l_cos));
+            for c in 0..chunks {
+                let phi = layout.constant_row(row, c);
+                let [px, py] = joint[c];
+                cos_moment[c] = (cos * py - sin * px) * moment;
+                let along = cos * px + sin * py;
+                coriolis[c] = coriolis[c] + force * phi - moment_rate2 * along;
+            }
+            // A += Phi_l^T (S_l v_l)^T, row by row.
+            for (j, &phi_j) in row[..m].iter().enumerate() {
+                for c in 0..chunks {
+                    let entry = &mut mass[j * chunks + c];
+                    *entry = *entry + cos_moment[c] * phi_j;
+                }
+            }
+            for (c, pair) in joint.iter_mut().enumerate() {
+                let phi = layout.constant_row(row, c);
+                let [px, py] = *pair;
+                *pair = [px - l_sin * phi, py + l_cos * phi];
+            }
+            q = [q[0] - drop_x, q[1] - drop_y];
         }
-        let (l_sin, l_cos) = (sin * link.length, cos * link.length);
-        for k in 0..m {
-            joint[k][0] = joint[k][0] - l_sin * phi[k];
-            joint[k][1] = joint[k][1] + l_cos * phi[k];
-        }
-        q[0] = q[0] - l_cos * rate2;
-        q[1] = q[1] - l_sin * rate2;
     }
-    // The constant part K of M*, the lower triangle, and G* = g (...).
-    let constant = model.constant_mass();
+    // G* = g sum_l S_l cos(phi_l) Phi_l^T: it needs no prefix sum, so where its running sums
+    // would crowd the pass's registers it is summed in a loop of its own (the same operations in
+    // the same order either way).
+    if Y::GRAVITY_APART {
+        for (i, &moment) in moments.iter().enumerate() {
+            let gravity_force = layout.spread(layout.gravity_force(&values, i, moment));
+            add_gravity(layout, gravity, gravity_force, &rows[i * m..]);
+        }
+    }
     let g = model.chain().gravity();
+    for value in gravity {
+        *value = *value * g;
+    }
+}
+
+/// `gravity += S_l cos(phi_l) Phi_l^T` for link `row` (`Phi_l`, followed by the padding of
+/// [`Layout::constant_row`]).
+#[inline(always)]
+fn add_gravity<Y: Layout>(
+    layout: Y,
+    gravity: &mut [Y::Register],
+    gravity_force: Y::Register,
+    row: &[f64],
+) {
+    for (c, value) in gravity.iter_mut().enumerate() {
+        *value = *value + gravity_force * layout.constant_row(row, c);
+    }
+}
+
+/// The terms left by [`accumulate`] in the registers of `layout`, as numbers of each state:
+/// `M* = K + (A + A^T)` (its upper triangle, mirrored), `C*` and `G*`.
+#[inline(always)]
+pub(crate) fn extract<Y: Layout>(
+    layout: Y,
+    model: &ReducedModel,
+    m: usize,
+    terms: &Terms<'_, Y::Register>,
+    mass: &mut [Y::Value],
+    coriolis: &mut [Y::Value],
+    gravity: &mut [Y::Value],
+) {
+    let chunks = layout.chunks(m);
+    let constant = model.constant_mass();
+    let vc = layout.value_context();
     for j in 0..m {
+        let row = &terms.mass[j * chunks..(j + 1) * chunks];
         for k in j..m {
-            let entry = mass[j * m + k] + L::splat(context, constant[j * m + k]);
+            let other = &terms.mass[k * chunks..(k + 1) * chunks];
+            let sum = layout.coordinate(row, k) + layout.coordinate(other, j);
+            let entry = sum + Y::Value::splat(vc, constant[j * m + k]);
             mass[j * m + k] = entry;
             mass[k * m + j] = entry;
         }
-        gravity[j] = gravity[j] * g;
+        coriolis[j] = layout.coordinate(terms.coriolis, j);
+        gravity[j] = layout.coordinate(terms.gravity, j);
     }
 }
