@@ -91,7 +91,9 @@ fn series_start(d: f64) -> f64 {
 /// `START_TERMS - 1` at the piece's Chebyshev points, within `1e-11` of the inverse (a test
 /// checks it), so that the first Newton step reaches the root to rounding and the second
 /// confirms it. The table is built on first use from [`newton_bisection`] started from the
-/// series.
+/// series: the Chebyshev coefficients of each piece, turned into powers of the piece's local
+/// variable `t` so that the start is a short Estrin evaluation (a chain of four multiply-adds,
+/// where Clenshaw's recurrence is a chain of nine).
 fn tabulated_start(d: f64) -> f64 {
     static TABLE: OnceLock<[[f64; START_TERMS]; START_PIECES]> = OnceLock::new();
     let s_min = SERIES_ONLY_BELOW.sqrt();
@@ -105,7 +107,7 @@ fn tabulated_start(d: f64) -> f64 {
                 let d = s * s;
                 newton_bisection(1.0 - d, series_start(d))
             });
-            std::array::from_fn(|k| {
+            let chebyshev: [f64; START_TERMS] = std::array::from_fn(|k| {
                 let sum: f64 = (0..START_TERMS)
                     .map(|j| {
                         let angle = std::f64::consts::PI * k as f64 * (j as f64 + 0.5);
@@ -114,19 +116,42 @@ fn tabulated_start(d: f64) -> f64 {
                     .sum();
                 let scale = if k == 0 { 1.0 } else { 2.0 };
                 scale * sum / START_TERMS as f64
-            })
+            });
+            monomial(&chebyshev)
         })
     });
     let s = d.sqrt();
     let piece = (((s - s_min) / (2.0 * half)) as usize).min(START_PIECES - 1);
     let t = (s - centre(piece)) / half;
-    // Clenshaw's recurrence for sum_k c_k T_k(t).
-    let c = &table[piece];
-    let (mut b1, mut b2) = (0.0, 0.0);
-    for &c_k in c[1..].iter().rev() {
-        (b1, b2) = (2.0 * t * b1 - b2 + c_k, b1);
+    let [a0, a1, a2, a3, a4, a5, a6, a7, a8, a9] = table[piece];
+    let (t2, t4) = (t * t, t * t * (t * t));
+    let low = (a0 + a1 * t) + (a2 + a3 * t) * t2;
+    let high = (a4 + a5 * t) + (a6 + a7 * t) * t2;
+    (low + high * t4 + (a8 + a9 * t) * (t4 * t4)).clamp(0.0, J0_FIRST_ZERO)
+}
+
+/// The power-series coefficients of `sum_k c_k T_k(t)`, `T_k` the Chebyshev polynomials (their
+/// integer coefficients, by `T_{k+1} = 2 t T_k - T_{k-1}`, are exact in `f64`).
+fn monomial(chebyshev: &[f64; START_TERMS]) -> [f64; START_TERMS] {
+    let mut powers = [0.0; START_TERMS];
+    let (mut previous, mut current) = ([0.0; START_TERMS], [0.0; START_TERMS]);
+    previous[0] = 1.0;
+    current[1] = 1.0;
+    for (k, &c) in chebyshev.iter().enumerate() {
+        let t_k = if k == 0 { previous } else { current };
+        for (p, t) in powers.iter_mut().zip(t_k) {
+            *p += c * t;
+        }
+        if k >= 1 {
+            let mut next = [0.0; START_TERMS];
+            for j in 0..START_TERMS {
+                let shifted = if j > 0 { 2.0 * current[j - 1] } else { 0.0 };
+                next[j] = shifted - previous[j];
+            }
+            (previous, current) = (current, next);
+        }
     }
-    (t * b1 - b2 + c[0]).clamp(0.0, J0_FIRST_ZERO)
+    powers
 }
 
 /// Solves `J0(A) = value` on `[0, J0_FIRST_ZERO]` from `start`, keeping a bracket `[lo, hi]`
