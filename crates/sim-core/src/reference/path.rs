@@ -278,7 +278,8 @@ impl Reference for CartesianPath {
         let [x, y] = p;
         let [a1, a2] = inverse_kinematics(self.length, p, alpha0, branch)
             .map_err(|source| SimError::Unreachable { t, x, y, source })?;
-        let amplitude = a1.hypot(a2);
+        // Both at most J0's first zero (2.4): no overflow for `hypot` to guard against.
+        let amplitude = (a1 * a1 + a2 * a2).sqrt();
         let j1 = libm::j1(amplitude);
         let singular = |what| SimError::SingularPoint { what, t, x, y };
         if j1 <= SINGULAR_TOLERANCE {
