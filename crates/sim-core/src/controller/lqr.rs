@@ -3,6 +3,7 @@
 
 use super::{ControlContext, Controller, ControllerError, check_context, check_coordinate_count};
 use crate::error::{Readable, SimError, check_positive};
+use crate::optimal::dense::symmetrise;
 use crate::optimal::{Linearisation, Lqr, LqrSettings};
 use modal_reduce::{ReducedData, ReducedModel};
 
@@ -125,13 +126,7 @@ impl LqrController {
                 q[i * n + j] = w4 * square;
             }
         }
-        for i in 0..m {
-            for j in i + 1..m {
-                let mean = 0.5 * (q[i * n + j] + q[j * n + i]);
-                q[i * n + j] = mean;
-                q[j * n + i] = mean;
-            }
-        }
+        symmetrise(&mut q, n);
         let mut r = vec![0.0; m * m];
         for i in 0..m {
             r[i * m + i] = 1.0;

@@ -59,6 +59,18 @@ pub(crate) fn multiply_by_transposed(
     }
 }
 
+/// Replaces the `n x n` matrix `a` with its symmetric part `(a + a^T) / 2` (against the rounding
+/// drift of products that are symmetric in exact arithmetic).
+pub(crate) fn symmetrise(a: &mut [f64], n: usize) {
+    for i in 0..n {
+        for j in i + 1..n {
+            let mean = 0.5 * (a[i * n + j] + a[j * n + i]);
+            a[i * n + j] = mean;
+            a[j * n + i] = mean;
+        }
+    }
+}
+
 /// Cholesky factorisation in place of the symmetric `m x m` matrix `a` (lower triangle);
 /// `false` if it is not numerically positive definite.
 pub(crate) fn cholesky(a: &mut [f64], m: usize) -> bool {

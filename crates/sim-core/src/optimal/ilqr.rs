@@ -3,7 +3,7 @@
 
 use super::OptimalError;
 use super::box_qp::{BoxQp, BoxQpSettings};
-use super::dense::{multiply, multiply_transposed};
+use super::dense::{multiply, multiply_transposed, symmetrise};
 use super::discrete::DiscreteDynamics;
 
 /// The most steps a horizon may have.
@@ -746,13 +746,7 @@ impl Ilqr {
                     self.v_xx[i * nx + l] = s;
                 }
             }
-            for i in 0..nx {
-                for l in i + 1..nx {
-                    let mean = 0.5 * (self.v_xx[i * nx + l] + self.v_xx[l * nx + i]);
-                    self.v_xx[i * nx + l] = mean;
-                    self.v_xx[l * nx + i] = mean;
-                }
-            }
+            symmetrise(&mut self.v_xx, nx);
         }
         Ok(expected)
     }

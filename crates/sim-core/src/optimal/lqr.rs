@@ -6,6 +6,7 @@ use manip_dyn::faer::MatRef;
 use super::OptimalError;
 use super::dense::{
     cholesky, cholesky_solve, lu_solve, multiply, multiply_by_transposed, multiply_transposed,
+    symmetrise,
 };
 use super::linearise::Linearisation;
 
@@ -311,16 +312,5 @@ impl Lqr {
             *out = u_ref[i] - feedback;
         }
         Ok(())
-    }
-}
-
-/// Replaces the `n x n` matrix `a` with its symmetric part.
-fn symmetrise(a: &mut [f64], n: usize) {
-    for i in 0..n {
-        for j in i + 1..n {
-            let mean = 0.5 * (a[i * n + j] + a[j * n + i]);
-            a[i * n + j] = mean;
-            a[j * n + i] = mean;
-        }
     }
 }

@@ -18,7 +18,7 @@
 //! ([`crate::controller`]). Every type is built once for a model and then allocates nothing.
 
 mod box_qp;
-mod dense;
+pub(crate) mod dense;
 mod discrete;
 mod ilqr;
 mod linearise;
