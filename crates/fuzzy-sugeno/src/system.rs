@@ -631,33 +631,31 @@ impl Compiled {
         } else {
             node_end
         };
-        // When every rule concludes on every output: each rule's terms, output pair by pair.
-        let every_rule_concludes = rules
-            .iter()
-            .all(|r| r.consequents.iter().all(Option::is_some));
-        let dense_terms = if every_rule_concludes {
-            let term = |r: &Rule, o: usize| term_offsets[o] + r.consequents[o].unwrap_or(0);
-            let mut pairs = Vec::with_capacity(outputs.len().div_ceil(2) * rules.len());
-            for o in (0..outputs.len()).step_by(2) {
-                for rule in rules {
-                    let first = term(rule, o);
-                    let second = if o + 1 < outputs.len() {
-                        term(rule, o + 1)
-                    } else {
-                        first
-                    };
-                    pairs.push([first, second]);
-                }
-            }
-            Some(if linear_terms.is_empty() {
-                DenseTerms::Constants(pairs.iter().map(|p| p.map(|t| term_values[t])).collect())
+        // When every rule concludes on every output, its conclusions are one per rule in rule
+        // order: each rule's terms, output pair by pair.
+        let every_rule_concludes = conclusion_offsets
+            .windows(2)
+            .all(|bounds| bounds[1] - bounds[0] == rules.len());
+        let dense_terms = every_rule_concludes.then(|| {
+            let term = |o: usize, r: usize| conclusions[conclusion_offsets[o] + r][1];
+            let n_out = outputs.len();
+            let pairs: Vec<[u32; 2]> = (0..n_out)
+                .step_by(2)
+                .flat_map(|o| {
+                    (0..rules.len()).map(move |r| [term(o, r), term((o + 1).min(n_out - 1), r)])
+                })
+                .collect();
+            if linear_terms.is_empty() {
+                DenseTerms::Constants(
+                    pairs
+                        .iter()
+                        .map(|p| p.map(|t| term_values[t as usize]))
+                        .collect(),
+                )
             } else {
-                let indices = pairs.iter().map(|&[a, b]| Ok([index(a)?, index(b)?]));
-                DenseTerms::Slots(indices.collect::<Result<_, FuzzyError>>()?)
-            })
-        } else {
-            None
-        };
+                DenseTerms::Slots(pairs)
+            }
+        });
         Ok(Self {
             mfs,
             mf_inputs,
