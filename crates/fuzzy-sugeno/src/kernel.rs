@@ -34,16 +34,43 @@ pub(crate) struct Slots<'a, const N: usize> {
     pub sums: &'a mut [[f64; N]],
 }
 
-/// The value of slot `slot` of `buffer`.
-#[inline(always)]
-fn get<L: Lane, const N: usize>(cx: L::Context, buffer: &[[f64; N]], slot: usize) -> L {
-    L::load(cx, &buffer[slot])
+impl<const N: usize> Slots<'_, N> {
+    /// Panics unless the buffers have the sizes that `c` gives them. With
+    /// [`Compiled::slots_in_bounds`] (asserted when the tables are built), this makes every slot
+    /// that the kernel reads from `c` an index within its buffer: the condition under which
+    /// [`get`] and [`set`] skip the bounds checks.
+    #[inline(always)]
+    fn check_sizes(&self, c: &Compiled) {
+        assert!(
+            self.x.len() == c.n_inputs
+                && self.values.len() == c.slot_count
+                && self.terms.len() == c.term_values.len()
+                && self.sums.len() == 2 * (c.conclusion_offsets.len() - 1),
+            "fuzzy-sugeno: kernel buffers sized for another system"
+        );
+    }
 }
 
-/// Writes `value` into slot `slot` of `buffer`.
+/// The value of slot `slot` of `buffer`, which must be in bounds (see [`Slots::check_sizes`]).
+///
+/// The kernel's slots are table-driven (a rule base is data), so the compiler cannot see that
+/// they are in bounds; the checks it would add are about a fifth of the instructions of the
+/// paper's controller. The tables are checked once instead, when they are built.
+#[inline(always)]
+fn get<L: Lane, const N: usize>(cx: L::Context, buffer: &[[f64; N]], slot: usize) -> L {
+    debug_assert!(slot < buffer.len());
+    // SAFETY: every slot passed here comes from the compiled tables or is below a count of
+    // them, all within the buffer sizes that `Slots::check_sizes` asserted at the kernel's
+    // entry (`Compiled::slots_in_bounds`).
+    L::load(cx, unsafe { buffer.get_unchecked(slot) })
+}
+
+/// Writes `value` into slot `slot` of `buffer`, which must be in bounds (see [`get`]).
 #[inline(always)]
 fn set<L: Lane, const N: usize>(buffer: &mut [[f64; N]], slot: usize, value: L) {
-    value.store(&mut buffer[slot]);
+    debug_assert!(slot < buffer.len());
+    // SAFETY: as in `get`.
+    value.store(unsafe { buffer.get_unchecked_mut(slot) });
 }
 
 /// Layers 1-3: the membership degrees at `slots.x`, their complements, the AND and OR nodes and
@@ -56,6 +83,7 @@ pub(crate) fn fire<L: Lane, const N: usize>(
     or: OrMethod,
     slots: &mut Slots<'_, N>,
 ) {
+    slots.check_sizes(c);
     let values = &mut *slots.values;
     for (k, (mf, &i)) in c.mfs.iter().zip(&c.mf_inputs).enumerate() {
         let x = get::<L, N>(cx, slots.x, i);
@@ -117,6 +145,7 @@ pub(crate) fn sums<L: Lane, const N: usize>(
     c: &Compiled,
     slots: &mut Slots<'_, N>,
 ) {
+    slots.check_sizes(c);
     let n_in = c.n_inputs;
     for &(term, offset) in &c.linear_terms {
         let p = &c.coefficients[offset..offset + n_in + 1];
@@ -225,5 +254,22 @@ impl<const N: usize> Workspace<N> {
             terms: &mut self.terms,
             sums: &mut self.sums,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{AndMethod, OrMethod, paper_controller};
+
+    /// Buffers of other sizes than the tables give are refused, before any unchecked access.
+    #[test]
+    #[should_panic(expected = "kernel buffers sized for another system")]
+    fn buffers_of_other_sizes_are_refused() {
+        let paper = paper_controller();
+        let mut work = Workspace::<1>::new(&paper);
+        work.values.pop();
+        let (and, or) = (AndMethod::Product, OrMethod::ProbabilisticSum);
+        fire::<f64, 1>((), paper.compiled(), and, or, &mut work.slots());
     }
 }

@@ -656,7 +656,7 @@ impl Compiled {
                 DenseTerms::Slots(pairs)
             }
         });
-        Ok(Self {
+        let compiled = Self {
             mfs,
             mf_inputs,
             has_complements,
@@ -685,13 +685,74 @@ impl Compiled {
             },
             conclusions,
             conclusion_offsets,
-        })
+        };
+        // The kernel indexes its buffers without bounds checks on this (`kernel::get`).
+        assert!(
+            compiled.slots_in_bounds(),
+            "fuzzy-sugeno: compiled tables out of bounds"
+        );
+        Ok(compiled)
+    }
+
+    /// Whether every slot that the kernel reads from these tables is within the buffer sizes
+    /// that the tables give (`n_inputs` inputs, `slot_count` values, the terms, two sums per
+    /// output): each node reads slots before its own, and the rules' strengths, conclusions
+    /// and dense terms stay within their counts.
+    pub(crate) fn slots_in_bounds(&self) -> bool {
+        let (n_terms, n_rules) = (self.term_values.len(), self.weights.len());
+        let n_out = self.conclusion_offsets.len() - 1;
+        let n_nodes = self.and_nodes.len() + self.or_nodes.len();
+        let degrees = self.mfs.len() * if self.has_complements { 2 } else { 1 };
+        let nodes_in_bounds = self
+            .and_nodes
+            .iter()
+            .chain(&self.or_nodes)
+            .zip(self.node_base..)
+            .all(|(&[a, b], slot)| (a as usize) < slot && (b as usize) < slot);
+        let dense_in_bounds = match &self.dense_terms {
+            None => true,
+            Some(DenseTerms::Constants(pairs)) => pairs.len() == n_out.div_ceil(2) * n_rules,
+            Some(DenseTerms::Slots(pairs)) => {
+                pairs.len() == n_out.div_ceil(2) * n_rules
+                    && pairs.iter().flatten().all(|&t| (t as usize) < n_terms)
+            }
+        };
+        self.mfs.len() == self.mf_inputs.len()
+            && self.mf_inputs.iter().all(|&i| i < self.n_inputs)
+            && degrees + 2 == self.degree_count
+            && self.node_base == self.degree_count
+            && nodes_in_bounds
+            && self.node_base + n_nodes <= self.slot_count
+            && self.rule_slots.len() == n_rules
+            && self
+                .rule_slots
+                .iter()
+                .all(|&s| (s as usize) < self.slot_count)
+            && self.strength_base + n_rules <= self.slot_count
+            && self.linear_terms.iter().all(|&(term, _)| term < n_terms)
+            && self
+                .conclusions
+                .iter()
+                .all(|&[rule, term]| (rule as usize) < n_rules && (term as usize) < n_terms)
+            && dense_in_bounds
     }
 }
 
 #[cfg(test)]
 mod tests {
     use crate::paper_controller;
+
+    /// The check the kernel's unchecked indexing rests on catches a table out of bounds.
+    #[test]
+    fn slots_in_bounds_catches_a_node_reading_a_later_slot() {
+        let mut c = paper_controller().compiled().clone();
+        assert!(c.slots_in_bounds());
+        c.and_nodes[0] = [0, c.node_base as u32];
+        assert!(!c.slots_in_bounds());
+        let mut c = paper_controller().compiled().clone();
+        c.conclusions[3][1] = c.term_values.len() as u32;
+        assert!(!c.slots_in_bounds());
+    }
 
     #[test]
     fn a_full_grid_of_rules_shares_its_prefixes_and_reads_its_strengths_in_place() {
