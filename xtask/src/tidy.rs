@@ -13,7 +13,9 @@
 //!   its crate, and no README names an absolute path.
 //! - Invariants of `docs/architecture.md`: every crate takes its lints from `[workspace.lints]`;
 //!   every public error enum of a library crate is `#[non_exhaustive]`; `lane-math` depends on
-//!   none of the other crates, `fuzzy-sugeno` on none but `lane-math`, and no library crate depends on the command line.
+//!   none of the other crates, `fuzzy-sugeno` on none but `lane-math`, and no library crate depends on the command line;
+//!   `unsafe` code appears only in the library files [`UNSAFE_FILES`] lists, each block under a
+//!   `// SAFETY:` comment.
 //! - `cargo doc --workspace --no-deps` with `RUSTDOCFLAGS=-D warnings`.
 //!
 //! Each check is a function of file contents (the file system is read in [`run`] only), with a
@@ -23,6 +25,10 @@ use std::path::{Component, Path, PathBuf};
 
 /// The repository's address; links into it must name files that exist.
 const REPOSITORY: &str = "https://github.com/hrm-toolkit/hrm";
+
+/// The only library source files allowed `unsafe` code (docs/architecture.md, "Unsafe code"),
+/// each block under a `// SAFETY:` comment.
+const UNSAFE_FILES: [&str; 1] = ["crates/fuzzy-sugeno/src/kernel.rs"];
 
 /// The workspace's library crates (published, usable alone).
 const LIBRARIES: [&str; 7] = [
@@ -111,11 +117,16 @@ pub fn run(root: &Path, doc: impl FnOnce() -> Result<(), String>) -> Vec<String>
         if LIBRARIES.contains(&krate.as_str()) {
             for file in rust_files(&root.join(&dir).join("src")) {
                 let source = std::fs::read_to_string(&file).unwrap_or_default();
+                let relative = file.strip_prefix(root).unwrap_or(&file);
                 for name in exhaustive_error_enums(&source) {
                     problems.push(format!(
                         "{}: the public error enum {name} is not #[non_exhaustive]",
-                        file.strip_prefix(root).unwrap_or(&file).display()
+                        relative.display()
                     ));
+                }
+                let allowed = UNSAFE_FILES.iter().any(|f| Path::new(f) == relative);
+                for (line, problem) in unsafe_problems(&source, allowed) {
+                    problems.push(format!("{}:{line}: {problem}", relative.display()));
                 }
             }
         }
@@ -276,6 +287,41 @@ pub fn exhaustive_error_enums(source: &str) -> Vec<String> {
             .take_while(|l| l.starts_with("#[") || l.starts_with("///") || l.starts_with(')'));
         if !attributes.into_iter().any(|l| l == "#[non_exhaustive]") {
             found.push(name);
+        }
+    }
+    found
+}
+
+/// The lines (1-based) of `source` with `unsafe` code that break the rule: any, unless the
+/// file is `allowed`; then each needs a `// SAFETY:` line in the comment right above it.
+pub fn unsafe_problems(source: &str, allowed: bool) -> Vec<(usize, &'static str)> {
+    let lines: Vec<&str> = source.lines().collect();
+    let mut found = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let code = line.split("//").next().unwrap_or_default();
+        let is_unsafe = ["unsafe {", "unsafe fn", "unsafe impl", "unsafe extern"]
+            .iter()
+            .any(|pattern| code.contains(pattern));
+        if !is_unsafe {
+            continue;
+        }
+        if !allowed {
+            found.push((
+                i + 1,
+                "unsafe code outside the files docs/architecture.md allows",
+            ));
+            continue;
+        }
+        let mut comment = lines[..i]
+            .iter()
+            .rev()
+            .map(|l| l.trim())
+            .take_while(|l| l.starts_with("//"));
+        if !comment.any(|l| l.starts_with("// SAFETY:")) {
+            found.push((
+                i + 1,
+                "an unsafe block without a `// SAFETY:` comment above it",
+            ));
         }
     }
     found
@@ -512,6 +558,22 @@ mod tests {
                       /// Doc.\n#[derive(Debug)]\npub enum BadError {\n}\n\
                       pub enum Kind {}\npub(crate) enum PrivateError {}\n";
         assert_eq!(exhaustive_error_enums(source), ["BadError"]);
+    }
+
+    #[test]
+    fn unsafe_code_is_found_outside_its_files_and_without_its_comment() {
+        let source = "fn f(v: &[f64]) -> f64 {\n    // SAFETY: in bounds.\n    \
+                      unsafe { *v.get_unchecked(0) }\n}\n// unsafe { in a comment }\n\
+                      fn g(v: &[f64]) -> f64 {\n    unsafe { *v.get_unchecked(0) }\n}\n";
+        assert_eq!(unsafe_problems(source, true).len(), 1);
+        assert_eq!(unsafe_problems(source, true)[0].0, 7);
+        assert_eq!(
+            unsafe_problems(source, false)
+                .iter()
+                .map(|p| p.0)
+                .collect::<Vec<_>>(),
+            [3, 7]
+        );
     }
 
     #[test]
