@@ -205,10 +205,14 @@ impl Sweep {
             "Sweep(scenario={:?}, controllers={:?}, noise_levels={:?}, seeds={}, base_seed={}, \
              runs={})",
             c.scenario.name,
-            c.controllers.iter().map(|k| k.name()).collect::<Vec<_>>(),
-            c.noise_levels,
-            c.seeds,
-            c.base_seed,
+            c.settings
+                .controllers
+                .iter()
+                .map(|k| k.name())
+                .collect::<Vec<_>>(),
+            c.settings.noise_levels,
+            c.settings.seeds,
+            c.settings.base_seed,
             self.n_runs()
         )
     }

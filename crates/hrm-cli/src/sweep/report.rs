@@ -16,11 +16,11 @@ pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
         s,
         "sweep of {}: {} noise levels x {} controllers x {} seeds = {} runs, base seed {}, {} s each",
         config.scenario.name,
-        config.noise_levels.len(),
-        config.controllers.len(),
-        config.seeds,
+        config.settings.noise_levels.len(),
+        config.settings.controllers.len(),
+        config.settings.seeds,
         cells.iter().map(|c| c.runs).sum::<usize>(),
-        config.base_seed,
+        config.settings.base_seed,
         config.scenario.duration,
     );
     let names = config.scenario.coordinate_names();
@@ -29,9 +29,9 @@ pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
         s,
         "noise level L: sensor noise std L rad on ({}), {} L rad/s on ({}), {} L rad on the reference",
         names.join(", "),
-        config.rate_noise_ratio,
+        config.settings.rate_noise_ratio,
         rates.join(", "),
-        config.reference_noise_ratio
+        config.settings.reference_noise_ratio
     );
     let _ = write!(
         s,
@@ -134,7 +134,7 @@ pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
 pub fn plot(path: &Path, config: &SweepConfig, cells: &[Cell]) -> Result<bool, String> {
     let mut means = Vec::new();
     let mut bands = Vec::new();
-    for &controller in &config.controllers {
+    for &controller in &config.settings.controllers {
         let stats: Vec<(f64, Stats)> = cells
             .iter()
             .filter(|c| c.controller == controller)
@@ -162,7 +162,7 @@ pub fn plot(path: &Path, config: &SweepConfig, cells: &[Cell]) -> Result<bool, S
     means.extend(bands);
     let title = format!(
         "{}: tip error RMS vs noise level ({} seeds)",
-        config.scenario.name, config.seeds
+        config.scenario.name, config.settings.seeds
     );
     let labels = Labels {
         title: &title,

@@ -218,7 +218,7 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
     );
     // A hand-edited configuration that makes no sweep.
     let mut empty = ShardFile::read(&shard(2)).unwrap();
-    empty.config.seeds = 0;
+    empty.config.settings.seeds = 0;
     write(&cut_path, &empty.to_json().unwrap()).unwrap();
     let err = merge(&[shard(1), cut_path.clone(), shard(3)]);
     assert!(
@@ -227,7 +227,7 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
     );
     // Counts no sweep could have are refused before anything is sized by them.
     let mut huge = ShardFile::read(&shard(2)).unwrap();
-    huge.config.seeds = 1 << 50;
+    huge.config.settings.seeds = 1 << 50;
     write(&cut_path, &huge.to_json().unwrap()).unwrap();
     let err = merge(std::slice::from_ref(&cut_path));
     assert!(err.contains("runs allowed"), "{err}");
@@ -260,7 +260,7 @@ fn small_config(levels: &[f64], seeds: usize) -> SweepConfig {
     let seeds = seeds.to_string();
     let args = parse(&with(SMALL, &["--seeds", &seeds])).unwrap();
     let mut config = configure(&args.sweep).unwrap();
-    config.noise_levels = levels.to_vec();
+    config.settings.noise_levels = levels.to_vec();
     config
 }
 
@@ -575,7 +575,14 @@ fn shard_files_are_streamed_and_checked_line_by_line() {
     let older = "{\n  \"format\": \"hrm-sweep-shard/2\",\n  \"runs\": []\n}\n";
     let err = check(older);
     assert!(
-        err.contains("(format \"hrm-sweep-shard/2\", expected \"hrm-sweep-shard/3\")")
+        err.contains("(format \"hrm-sweep-shard/2\", expected \"hrm-sweep-shard/4\")")
+            && err.contains("older versions cannot be merged"),
+        "{err}"
+    );
+    // Format 3: JSON lines, the sweep's settings beside the scenario rather than nested.
+    let err = check(&runs.replacen("hrm-sweep-shard/4", "hrm-sweep-shard/3", 1));
+    assert!(
+        err.contains("(format \"hrm-sweep-shard/3\", expected \"hrm-sweep-shard/4\")")
             && err.contains("older versions cannot be merged"),
         "{err}"
     );

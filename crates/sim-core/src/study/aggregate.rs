@@ -185,7 +185,7 @@ impl CellBuilder {
     /// A builder for the cells of `config`.
     pub fn new(config: &SweepConfig) -> Self {
         CellBuilder {
-            seeds: config.seeds.max(1),
+            seeds: config.settings.seeds.max(1),
             n_coords: config.scenario.n_coords(),
             done: Vec::new(),
             current: None,

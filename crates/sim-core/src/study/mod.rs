@@ -147,8 +147,8 @@ pub fn lockstep_size(config: &SweepConfig) -> usize {
 /// controller, each group in index order.
 fn lockstep_groups(config: &SweepConfig, indices: &[usize], size: usize) -> Vec<Vec<RunId>> {
     let mut groups = Vec::new();
-    for (c, controller) in config.controllers.iter().enumerate() {
-        if config.controllers[..c].contains(controller) {
+    for (c, controller) in config.settings.controllers.iter().enumerate() {
+        if config.settings.controllers[..c].contains(controller) {
             continue;
         }
         let ids: Vec<RunId> = indices

@@ -24,18 +24,8 @@ pub struct SweepConfig {
     pub hrm_version: String,
     /// The scenario, duration override applied; its `noise` and `seed` are replaced per run.
     pub scenario: Scenario,
-    /// The controllers compared, in table order.
-    pub controllers: Vec<ControllerKind>,
-    /// The noise levels: the sensor noise standard deviation on `(a1, a2)` (rad).
-    pub noise_levels: Vec<f64>,
-    /// Sensor noise on `(a1_dot, a2_dot)` per unit of noise level (rad/s per rad, i.e. 1/s).
-    pub rate_noise_ratio: f64,
-    /// Noise on the reference `(a1_ref, a2_ref)` per unit of noise level.
-    pub reference_noise_ratio: f64,
-    /// Noise realisations per (noise level, controller) cell.
-    pub seeds: usize,
-    /// The seed every run's seed derives from ([`run_seed`]).
-    pub base_seed: u64,
+    /// What the sweep varies: controllers, noise levels and ratios, seeds.
+    pub settings: SweepSettings,
     /// The SHA-256 of the scenario and of every file it references
     /// ([`input_digests`](super::input_digests) of `scenario`).
     pub inputs: Vec<InputDigest>,
@@ -61,7 +51,8 @@ pub struct RunId {
 /// What a sweep varies and how many noise realisations it draws: the options of `hrm sweep` and
 /// the keywords of `hrm.Sweep`, which [`SweepConfig::new`] checks and turns into a sweep. The
 /// [`Default`] is `hrm sweep`'s.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SweepSettings {
     /// The controllers compared, in table order, each once.
     pub controllers: Vec<ControllerKind>,
@@ -115,6 +106,14 @@ impl SettingError {
 }
 
 impl SweepSettings {
+    /// Number of runs: noise levels x controllers x seeds (`None` on overflow).
+    pub fn runs(&self) -> Option<usize> {
+        self.noise_levels
+            .len()
+            .checked_mul(self.controllers.len())?
+            .checked_mul(self.seeds)
+    }
+
     /// Checks the settings: at least one controller and none twice, at least one noise level,
     /// all finite, non-negative, distinct and ascending, finite non-negative ratios, at least one
     /// seed, and at most [`MAX_RUNS`] runs.
@@ -169,12 +168,7 @@ impl SweepSettings {
         if self.seeds == 0 {
             return Err(SettingError::new("seeds", "must be at least 1"));
         }
-        let runs = self
-            .noise_levels
-            .len()
-            .checked_mul(self.controllers.len())
-            .and_then(|cells| cells.checked_mul(self.seeds));
-        match runs {
+        match self.runs() {
             Some(runs) if runs <= MAX_RUNS => Ok(()),
             _ => Err(SettingError::new(
                 "seeds",
@@ -203,48 +197,24 @@ impl SweepConfig {
         scenario.noise = NoiseSpec::default();
         scenario.seed = 0;
         inputs::check_json_safe(&scenario)?;
-        let SweepSettings {
-            controllers,
-            noise_levels,
-            rate_noise_ratio,
-            reference_noise_ratio,
-            seeds,
-            base_seed,
-        } = settings;
         let config = SweepConfig {
             hrm_version: super::VERSION.to_string(),
             inputs: inputs::input_digests(&scenario)?,
             scenario,
-            controllers,
-            noise_levels,
-            rate_noise_ratio,
-            reference_noise_ratio,
-            seeds,
-            base_seed,
+            settings,
         };
         config.validate()?;
         config.check_builds()?;
         Ok(config)
     }
 
-    /// The settings of the sweep.
-    pub fn settings(&self) -> SweepSettings {
-        SweepSettings {
-            controllers: self.controllers.clone(),
-            noise_levels: self.noise_levels.clone(),
-            rate_noise_ratio: self.rate_noise_ratio,
-            reference_noise_ratio: self.reference_noise_ratio,
-            seeds: self.seeds,
-            base_seed: self.base_seed,
-        }
-    }
-
     /// Builds the simulation of the first run of each controller at the largest noise level, so
     /// that a bad setting fails once here rather than in every run.
     pub fn check_builds(&self) -> Result<(), String> {
-        let cells = self.noise_levels.len() * self.controllers.len();
-        for c in 0..self.controllers.len() {
-            let id = self.run_at((cells - self.controllers.len() + c) * self.seeds);
+        let cells = self.settings.noise_levels.len() * self.settings.controllers.len();
+        for c in 0..self.settings.controllers.len() {
+            let id =
+                self.run_at((cells - self.settings.controllers.len() + c) * self.settings.seeds);
             self.scenario_for(&id).build().map_err(|e| {
                 format!(
                     "scenario {} with {}: {e}",
@@ -263,31 +233,28 @@ impl SweepConfig {
     pub fn validate(&self) -> Result<(), String> {
         inputs::check_json_safe(&self.scenario)?;
         inputs::check_digests(&self.scenario, &self.inputs)?;
-        self.settings().check().map_err(|e| e.to_string())
+        self.settings.check().map_err(|e| e.to_string())
     }
 
     /// Number of runs: noise levels x controllers x seeds (`None` on overflow).
     pub fn runs(&self) -> Option<usize> {
-        self.noise_levels
-            .len()
-            .checked_mul(self.controllers.len())?
-            .checked_mul(self.seeds)
+        self.settings.runs()
     }
 
     /// Run `index` of the enumeration `index = (level_index * controllers + controller_index)
     /// * seeds + seed_index`: noise level slowest, seed fastest.
     pub fn run_at(&self, index: usize) -> RunId {
-        let seed_index = index % self.seeds;
-        let cell = index / self.seeds;
-        let n_controllers = self.controllers.len();
+        let seed_index = index % self.settings.seeds;
+        let cell = index / self.settings.seeds;
+        let n_controllers = self.settings.controllers.len();
         let level_index = cell / n_controllers;
         RunId {
             index,
             level_index,
-            noise_level: self.noise_levels[level_index],
-            controller: self.controllers[cell % n_controllers],
+            noise_level: self.settings.noise_levels[level_index],
+            controller: self.settings.controllers[cell % n_controllers],
             seed_index,
-            seed: run_seed(self.base_seed, seed_index),
+            seed: run_seed(self.settings.base_seed, seed_index),
         }
     }
 
@@ -300,29 +267,27 @@ impl SweepConfig {
         scenario.noise = NoiseSpec::uniform(
             scenario.n_coords(),
             level,
-            self.rate_noise_ratio * level,
-            self.reference_noise_ratio * level,
+            self.settings.rate_noise_ratio * level,
+            self.settings.reference_noise_ratio * level,
         );
         scenario
     }
 
     /// The name of the first field in which `other` differs, if any.
     pub fn first_difference(&self, other: &Self) -> Option<&'static str> {
+        let (a, b) = (&self.settings, &other.settings);
         [
             ("hrm_version", self.hrm_version == other.hrm_version),
             ("scenario", self.scenario == other.scenario),
-            ("controllers", self.controllers == other.controllers),
-            ("noise_levels", self.noise_levels == other.noise_levels),
-            (
-                "rate_noise_ratio",
-                self.rate_noise_ratio == other.rate_noise_ratio,
-            ),
+            ("controllers", a.controllers == b.controllers),
+            ("noise_levels", a.noise_levels == b.noise_levels),
+            ("rate_noise_ratio", a.rate_noise_ratio == b.rate_noise_ratio),
             (
                 "reference_noise_ratio",
-                self.reference_noise_ratio == other.reference_noise_ratio,
+                a.reference_noise_ratio == b.reference_noise_ratio,
             ),
-            ("seeds", self.seeds == other.seeds),
-            ("base_seed", self.base_seed == other.base_seed),
+            ("seeds", a.seeds == b.seeds),
+            ("base_seed", a.base_seed == b.base_seed),
             ("inputs", self.inputs == other.inputs),
         ]
         .into_iter()
@@ -414,12 +379,14 @@ mod tests {
             inputs: inputs::input_digests(&scenario).unwrap(),
             hrm_version: "test".into(),
             scenario,
-            controllers: ControllerKind::ALL[..controllers].to_vec(),
-            noise_levels: (0..levels).map(|l| l as f64 * 1e-3).collect(),
-            rate_noise_ratio: 10.0,
-            reference_noise_ratio: 0.5,
-            seeds,
-            base_seed: 9,
+            settings: SweepSettings {
+                controllers: ControllerKind::ALL[..controllers].to_vec(),
+                noise_levels: (0..levels).map(|l| l as f64 * 1e-3).collect(),
+                rate_noise_ratio: 10.0,
+                reference_noise_ratio: 0.5,
+                seeds,
+                base_seed: 9,
+            },
         }
     }
 
@@ -463,18 +430,18 @@ mod tests {
     fn invalid_configurations_are_refused_naming_the_setting() {
         let mut c = config(2, 2, 2);
         assert!(c.validate().is_ok());
-        c.noise_levels[1] = -1.0;
+        c.settings.noise_levels[1] = -1.0;
         let err = c.validate().unwrap_err();
         assert_eq!(err, "noise_levels must be finite and non-negative, got -1");
-        c.noise_levels[1] = f64::NAN;
+        c.settings.noise_levels[1] = f64::NAN;
         assert!(c.validate().unwrap_err().contains("got NaN"));
-        c.noise_levels = vec![0.01, 0.0];
+        c.settings.noise_levels = vec![0.01, 0.0];
         let err = c.validate().unwrap_err();
         assert!(err.starts_with("noise_levels must be distinct and ascending"));
         let mut c = config(2, 2, 0);
         assert_eq!(c.validate().unwrap_err(), "seeds must be at least 1");
-        c.seeds = 1;
-        c.rate_noise_ratio = f64::INFINITY;
+        c.settings.seeds = 1;
+        c.settings.rate_noise_ratio = f64::INFINITY;
         let err = c.validate().unwrap_err();
         assert_eq!(
             err,
@@ -485,11 +452,11 @@ mod tests {
         let err = config(1, 0, 1).validate().unwrap_err();
         assert_eq!(err, "controllers must name at least one controller");
         let mut twice = config(1, 3, 1);
-        twice.controllers[2] = twice.controllers[0];
+        twice.settings.controllers[2] = twice.settings.controllers[0];
         let err = twice.validate().unwrap_err();
         assert_eq!(
             err,
-            format!("controllers lists {} twice", twice.controllers[0])
+            format!("controllers lists {} twice", twice.settings.controllers[0])
         );
         let err = config(2, 2, MAX_RUNS).validate().unwrap_err();
         assert!(err.starts_with("seeds = 10000000 with 2 noise levels x 2 controllers makes more than the 10000000 runs"), "{err}");
@@ -519,7 +486,7 @@ mod tests {
             ..SweepSettings::default()
         };
         let config = SweepConfig::new(scenario.clone(), settings.clone()).unwrap();
-        assert_eq!(config.settings(), settings);
+        assert_eq!(config.settings, settings);
         assert_eq!(
             (config.scenario.seed, &config.scenario.noise),
             (0, &NoiseSpec::default())
@@ -544,7 +511,7 @@ mod tests {
         let a = config(2, 2, 2);
         assert_eq!(a.first_difference(&a.clone()), None);
         let mut b = a.clone();
-        b.base_seed = 10;
+        b.settings.base_seed = 10;
         assert_eq!(a.first_difference(&b), Some("base_seed"));
         b.scenario.duration = 0.5;
         assert_eq!(a.first_difference(&b), Some("scenario"));

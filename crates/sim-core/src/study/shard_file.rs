@@ -15,7 +15,7 @@ use std::io::{BufRead, BufReader, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 /// The `format` tag of a shard file.
-pub const FORMAT: &str = "hrm-sweep-shard/3";
+pub const FORMAT: &str = "hrm-sweep-shard/4";
 
 /// Longest line of a shard file read (64 MiB: the header holds the scenario, whose file has at
 /// most 16 MiB; a run's line has a few hundred bytes).
