@@ -245,8 +245,14 @@ fn source(system: &FuzzySystem, prefix: &str, options: &EvalOptions) -> String {
     let _ = writeln!(
         s,
         "int {prefix}_eval(const double *in, double *out)\n{{\n    double x[{n_in}];\n    \
-         double mu[{}];\n    double w[{n_rules}];\n    double y[{n_out}];\n    double {}weighted, total;\n    int i;\n",
+         double mu[{}];\n{}    double y[{n_out}];\n    double {}weighted, total;\n    int i;\n",
         c.degree_count,
+        // A system without rules has no strengths (and C no arrays of length 0).
+        if n_rules > 0 {
+            format!("    double w[{n_rules}];\n")
+        } else {
+            String::new()
+        },
         if uses_linear { "t, " } else { "" }
     );
     // Inputs and the range policy (Evaluator::load_inputs).
@@ -314,6 +320,9 @@ fn source(system: &FuzzySystem, prefix: &str, options: &EvalOptions) -> String {
             };
         }
         let _ = writeln!(s, "    w[{r}] = {} * ({expr});", lit(c.weights[r]));
+    }
+    if n_rules == 0 {
+        let _ = writeln!(s, "    (void)mu; /* no rule reads the degrees */");
     }
     // Outputs (Evaluator::defuzzify).
     let _ = writeln!(s, "    /* layers 3-5: outputs */");

@@ -621,21 +621,19 @@ impl Compiled {
             }
         }
         let node_end = node_base + and_nodes.len() + or_nodes.len();
-        let weights_folded = rules.iter().all(|r| r.weight == 1.0)
-            && rule_slots
-                .iter()
-                .enumerate()
-                .all(|(r, &slot)| slot as usize == rule_slots[0] as usize + r);
-        let strength_base = if weights_folded {
-            rule_slots[0] as usize
-        } else {
-            node_end
-        };
+        // A system without rules (a `.fis` file may have none) has no strengths to read in place.
+        let folded_base = rule_slots.first().filter(|&&first| {
+            rules.iter().all(|r| r.weight == 1.0)
+                && (0..).zip(&rule_slots).all(|(r, &slot)| slot == first + r)
+        });
+        let weights_folded = folded_base.is_some();
+        let strength_base = folded_base.map_or(node_end, |&first| first as usize);
         // When every rule concludes on every output, its conclusions are one per rule in rule
         // order: each rule's terms, output pair by pair.
-        let every_rule_concludes = conclusion_offsets
-            .windows(2)
-            .all(|bounds| bounds[1] - bounds[0] == rules.len());
+        let every_rule_concludes = !rules.is_empty()
+            && conclusion_offsets
+                .windows(2)
+                .all(|bounds| bounds[1] - bounds[0] == rules.len());
         let dense_terms = every_rule_concludes.then(|| {
             let term = |o: usize, r: usize| conclusions[conclusion_offsets[o] + r][1];
             let n_out = outputs.len();

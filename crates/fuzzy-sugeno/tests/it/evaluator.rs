@@ -129,6 +129,36 @@ fn the_no_rule_fired_policy_is_applied() {
     assert!(matches!(nan, FuzzyError::NonFiniteFallback { value } if value.is_nan()));
 }
 
+/// A system without rules (a `.fis` file may declare `NumRules=0`) builds, and no rule fires:
+/// one point and a batch both give the no-rule-fired policy's value.
+#[test]
+fn a_system_without_rules_fires_none() {
+    let empty = FuzzySystem::builder("empty")
+        .input(
+            "x",
+            [0.0, 1.0],
+            [("lo", MembershipFn::triangle(0.0, 0.0, 0.5))],
+        )
+        .output("y", [2.0, 8.0], [("a", OutputFn::Constant(2.0))])
+        .build()
+        .unwrap();
+    let mut evaluator = Evaluator::new(empty.clone());
+    let mut out = [0.0];
+    evaluator.eval(&[0.2], &mut out).unwrap();
+    assert_eq!(out, [5.0]);
+    assert!(evaluator.firing_strengths().is_empty());
+    let mut outs = [0.0; 11];
+    let points: Vec<f64> = (0..11).map(|k| k as f64 / 10.0).collect();
+    evaluator.eval_batch(&points, &mut outs).unwrap();
+    assert_eq!(outs, [5.0; 11]);
+    let options = EvalOptions {
+        no_rule_fired: NoRuleFired::Error,
+        ..EvalOptions::default()
+    };
+    let error = eval_with(empty, options, &[0.2]).unwrap_err();
+    assert_eq!(error.to_string(), "no rule fired for output 0 ('y')");
+}
+
 #[test]
 fn the_out_of_range_policy_is_applied() {
     let options = |out_of_range| EvalOptions {
