@@ -1,8 +1,7 @@
 //! Samples to learn from: rows of input values followed by output values.
 
-use super::learning;
-use crate::FuzzyError;
 use crate::system::check_name;
+use crate::{FuzzyError, LearningProblem};
 
 /// The most rows a data set may hold.
 pub const MAX_ROWS: usize = 1_000_000;
@@ -27,35 +26,44 @@ impl TrainingData {
     /// than [`MAX_INPUTS`] inputs.
     pub fn new(n_inputs: usize, n_outputs: usize, values: Vec<f64>) -> Result<Self, FuzzyError> {
         if n_inputs == 0 || n_inputs > MAX_INPUTS {
-            return Err(learning(format!(
-                "the number of inputs must lie in 1..={MAX_INPUTS}, got {n_inputs}"
-            )));
+            return Err(LearningProblem::CountOutOfRange {
+                name: "the number of inputs",
+                count: n_inputs,
+                max: MAX_INPUTS,
+            }
+            .into());
         }
         if n_outputs == 0 || n_outputs > MAX_OUTPUTS {
-            return Err(learning(format!(
-                "the number of outputs must lie in 1..={MAX_OUTPUTS}, got {n_outputs}"
-            )));
+            return Err(LearningProblem::CountOutOfRange {
+                name: "the number of outputs",
+                count: n_outputs,
+                max: MAX_OUTPUTS,
+            }
+            .into());
         }
         let width = n_inputs + n_outputs;
         if values.is_empty() || !values.len().is_multiple_of(width) {
-            return Err(learning(format!(
-                "{} values are not a whole, non-zero number of rows of {width}",
-                values.len()
-            )));
+            return Err(LearningProblem::RowLength {
+                values: values.len(),
+                width,
+            }
+            .into());
         }
         let rows = values.len() / width;
         if rows > MAX_ROWS {
-            return Err(learning(format!(
-                "{rows} rows exceed the limit of {MAX_ROWS}"
-            )));
+            return Err(LearningProblem::TooManyRows {
+                rows,
+                limit: MAX_ROWS,
+            }
+            .into());
         }
         if let Some(k) = values.iter().position(|v| !v.is_finite()) {
-            return Err(learning(format!(
-                "row {} column {} is not finite ({})",
-                k / width + 1,
-                k % width + 1,
-                values[k]
-            )));
+            return Err(LearningProblem::NonFiniteValue {
+                row: k / width,
+                column: k % width,
+                value: values[k],
+            }
+            .into());
         }
         Ok(Self {
             n_inputs,
@@ -71,19 +79,21 @@ impl TrainingData {
     pub fn with_names(mut self, names: Vec<String>) -> Result<Self, FuzzyError> {
         let width = self.n_inputs + self.n_outputs;
         if names.len() != width {
-            return Err(learning(format!(
-                "{} column names for {width} columns",
-                names.len()
-            )));
+            return Err(LearningProblem::ColumnNameCount {
+                names: names.len(),
+                columns: width,
+            }
+            .into());
         }
         for (k, name) in names.iter().enumerate() {
             check_name("variable", name)
-                .map_err(|problem| learning(format!("column {}: {problem}", k + 1)))?;
+                .map_err(|problem| LearningProblem::ColumnName { column: k, problem })?;
             if names[..k].contains(name) {
-                return Err(learning(format!(
-                    "column {}: another column is also named '{name}'",
-                    k + 1
-                )));
+                return Err(LearningProblem::DuplicateColumnName {
+                    column: k,
+                    name: name.clone(),
+                }
+                .into());
             }
         }
         self.names = Some(names);
@@ -142,11 +152,11 @@ impl TrainingData {
     /// Refuses an output index this data set does not have.
     pub(crate) fn check_output(&self, output: usize) -> Result<(), FuzzyError> {
         if output >= self.n_outputs {
-            return Err(learning(format!(
-                "output {} asked of data with {} outputs",
-                output + 1,
-                self.n_outputs
-            )));
+            return Err(LearningProblem::NoSuchOutput {
+                output,
+                outputs: self.n_outputs,
+            }
+            .into());
         }
         Ok(())
     }

@@ -4,13 +4,12 @@
 
 use super::anfis::{Anfis, AnfisOptions};
 use super::data::TrainingData;
-use super::learning;
-use crate::FuzzyError;
 use crate::membership::MembershipFn;
 use crate::system::{
     Antecedent, Connective, FuzzySet, FuzzySystem, InputVariable, Methods, OutputFn, OutputTerm,
     OutputVariable, Rule,
 };
+use crate::{FuzzyError, LearningProblem};
 
 /// The most rules `genfis` builds (sets per input to the power of the inputs, or clusters).
 pub const MAX_RULES: usize = 4096;
@@ -69,10 +68,10 @@ impl SetShape {
             "psigmf" => Self::SigmoidProduct,
             "pimf" => Self::PiShape,
             _ => {
-                return Err(learning(format!(
-                    "unknown set type '{name}' for a grid partition; expected one of gbellmf, \
-                     gaussmf, gauss2mf, trimf, trapmf, sigmf, dsigmf, psigmf, pimf"
-                )));
+                return Err(LearningProblem::UnknownSetShape {
+                    name: name.to_string(),
+                }
+                .into());
             }
         })
     }
@@ -236,30 +235,32 @@ pub fn genfis_grid_over(
         || partitioned.windows(2).any(|w| w[0] >= w[1])
         || partitioned.last().is_some_and(|&i| i >= n)
     {
-        return Err(learning(format!(
-            "the partitioned inputs must be a non-empty increasing list of indices below {n}, \
-             got {partitioned:?}"
-        )));
+        return Err(LearningProblem::PartitionedInputs {
+            partitioned: partitioned.to_vec(),
+            inputs: n,
+        }
+        .into());
     }
     if !(1..=MAX_SETS_PER_INPUT).contains(&k) {
-        return Err(learning(format!(
-            "sets per input must lie in 1..={MAX_SETS_PER_INPUT}, got {k}"
-        )));
+        return Err(LearningProblem::CountOutOfRange {
+            name: "sets per input",
+            count: k,
+            max: MAX_SETS_PER_INPUT,
+        }
+        .into());
     }
     if grid.shape == SetShape::Sigmoid && k != 2 {
-        return Err(learning(format!(
-            "sigmf partitions have exactly 2 sets per input (one open to each side), got {k}"
-        )));
+        return Err(LearningProblem::SigmoidSets { sets: k }.into());
     }
     let p = partitioned.len();
     let rules = u32::try_from(p)
         .ok()
         .and_then(|p| k.checked_pow(p))
         .filter(|&r| r <= MAX_RULES)
-        .ok_or_else(|| {
-            learning(format!(
-                "{k} sets on each of {p} inputs make more than {MAX_RULES} rules"
-            ))
+        .ok_or(LearningProblem::TooManyRules {
+            sets: k,
+            inputs: p,
+            limit: MAX_RULES,
         })?;
     let mut inputs = Vec::with_capacity(n);
     for i in 0..n {
@@ -304,15 +305,19 @@ pub fn genfis_cluster(
     data.check_output(output)?;
     let ra = clustering.radius;
     if !(ra > 0.0 && ra <= 1.0) {
-        return Err(learning(format!(
-            "the cluster radius must lie in (0, 1], got {ra}"
-        )));
+        return Err(LearningProblem::OutsideUnitInterval {
+            name: "the cluster radius",
+            value: ra,
+        }
+        .into());
     }
     let rows = data.rows();
     if rows > MAX_CLUSTER_ROWS {
-        return Err(learning(format!(
-            "subtractive clustering takes at most {MAX_CLUSTER_ROWS} rows, got {rows}"
-        )));
+        return Err(LearningProblem::TooManyClusterRows {
+            rows,
+            limit: MAX_CLUSTER_ROWS,
+        }
+        .into());
     }
     let n = data.n_inputs();
     let ranges = (0..n)
@@ -397,9 +402,11 @@ fn subtractive_clustering(points: &[f64], dim: usize, ra: f64) -> Result<Vec<usi
             }
         }
         if centres.len() == MAX_RULES {
-            return Err(learning(format!(
-                "a cluster radius of {ra} finds more than {MAX_RULES} clusters; use a larger radius"
-            )));
+            return Err(LearningProblem::TooManyClusters {
+                radius: ra,
+                limit: MAX_RULES,
+            }
+            .into());
         }
         centres.push(best);
         for (i, q) in potential.iter_mut().enumerate() {
@@ -415,10 +422,11 @@ fn input_range(data: &TrainingData, i: usize) -> Result<[f64; 2], FuzzyError> {
     if lo < hi {
         Ok([lo, hi])
     } else {
-        Err(learning(format!(
-            "input {} is constant ({lo}) over the data; a fuzzy partition needs a range",
-            i + 1
-        )))
+        Err(LearningProblem::ConstantInput {
+            input: i,
+            value: lo,
+        }
+        .into())
     }
 }
 
@@ -434,10 +442,7 @@ fn assemble(
     let n = inputs.len();
     let [lo, hi] = data.column_range(n + output);
     if lo >= hi {
-        return Err(learning(format!(
-            "output {} is constant ({lo}) over the data; there is nothing to learn",
-            output + 1
-        )));
+        return Err(LearningProblem::ConstantOutput { output, value: lo }.into());
     }
     let terms = (0..antecedents.len())
         .map(|r| OutputTerm {
