@@ -709,3 +709,43 @@ impl std::fmt::Display for ConsequentParameter {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The messages of the learning problems that no test reaches cheaply (a system the
+    /// builder refuses, 2^32 sets, more than 4096 clusters) are the texts written before the
+    /// problems were typed; every other problem's message is checked where it is raised.
+    #[test]
+    fn unreached_learning_problems_keep_their_messages() {
+        let cases = [
+            (
+                LearningProblem::TooManySets,
+                "too many sets to index with 32 bits",
+            ),
+            (
+                LearningProblem::TooManyClusters {
+                    radius: 0.01,
+                    limit: 4096,
+                },
+                "a cluster radius of 0.01 finds more than 4096 clusters; use a larger radius",
+            ),
+            (LearningProblem::NoRules, "the system has no rules"),
+            (
+                LearningProblem::NoConsequent { rule: 2 },
+                "rule 3 has no consequent",
+            ),
+            (
+                LearningProblem::NotSingleOutput { outputs: 2 },
+                "ANFIS trains single-output systems; this one has 2 outputs (train one system \
+                 per output)",
+            ),
+        ];
+        for (problem, message) in cases {
+            let error = FuzzyError::from(problem);
+            assert_eq!(error.to_string(), format!("learning: {message}"));
+            assert!(error.is_invalid_input() && !error.is_numerical());
+        }
+    }
+}

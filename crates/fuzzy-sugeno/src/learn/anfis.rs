@@ -894,12 +894,17 @@ mod tests {
 
     #[test]
     fn systems_anfis_cannot_train_are_refused_by_reason() {
-        let message = |system: FuzzySystem| {
-            Anfis::new(system, &data(), None, 0, AnfisOptions::default())
-                .unwrap_err()
-                .to_string()
+        let refuse = |system: FuzzySystem| {
+            let error = Anfis::new(system, &data(), None, 0, AnfisOptions::default()).unwrap_err();
+            assert!(error.is_invalid_input() && !error.is_numerical(), "{error}");
+            match error {
+                FuzzyError::Learning(problem) => problem,
+                other => panic!("not a learning error: {other}"),
+            }
         };
-        let two_outputs = crate::paper_controller();
+        let message = |problem: LearningProblem| FuzzyError::from(problem).to_string();
+        let two_outputs = refuse(crate::paper_controller());
+        assert_eq!(two_outputs, LearningProblem::NotSingleOutput { outputs: 2 });
         assert!(message(two_outputs).contains("single-output systems; this one has 2 outputs"));
         let sets = [
             ("lo", Mf::gaussian(0.5, -1.0)),
@@ -911,38 +916,127 @@ mod tests {
                 .input("y", [0.0, 2.0], sets)
                 .output("z", [0.0, 1.0], [("c", OutputFn::Constant(0.5))])
         };
+        let minimum = refuse(
+            base()
+                .and_method(AndMethod::Minimum)
+                .rule(["lo", "lo"], ["c"])
+                .build()
+                .unwrap(),
+        );
+        assert_eq!(minimum, LearningProblem::NotProductAnd);
         assert_eq!(
-            message(
-                base()
-                    .and_method(AndMethod::Minimum)
-                    .rule(["lo", "lo"], ["c"])
-                    .build()
-                    .unwrap()
-            ),
+            message(minimum),
             "learning: ANFIS needs the product AND (AndMethod='prod')"
         );
-        assert_eq!(
-            message(base().rule(["not lo", "lo"], ["c"]).build().unwrap()),
-            "learning: rule 1 negates an antecedent; ANFIS needs plain sets"
+        let sum = refuse(
+            base()
+                .defuzzification(Defuzzification::WeightedSum)
+                .rule(["lo", "lo"], ["c"])
+                .build()
+                .unwrap(),
         );
+        assert_eq!(sum, LearningProblem::NotWeightedAverage);
         assert_eq!(
-            message(
-                base()
-                    .weighted_rule(["lo", "hi"], ["c"], 1.0, Connective::Or)
-                    .build()
-                    .unwrap()
-            ),
+            message(sum),
+            "learning: ANFIS needs the weighted-average defuzzifier (DefuzzMethod='wtaver')"
+        );
+        let negated = refuse(
+            base()
+                .rule(["lo", "hi"], ["c"])
+                .rule(["not lo", "lo"], ["c"])
+                .build()
+                .unwrap(),
+        );
+        assert_eq!(negated, LearningProblem::NegatedAntecedent { rule: 1 });
+        assert_eq!(
+            message(negated),
+            "learning: rule 2 negates an antecedent; ANFIS needs plain sets"
+        );
+        let or = refuse(
+            base()
+                .weighted_rule(["lo", "hi"], ["c"], 1.0, Connective::Or)
+                .build()
+                .unwrap(),
+        );
+        assert_eq!(or, LearningProblem::OrRule { rule: 0 });
+        assert_eq!(
+            message(or),
             "learning: rule 1 is an OR rule; ANFIS needs AND rules"
         );
-        let bad = AnfisOptions {
-            epochs: 0,
-            ..AnfisOptions::default()
+    }
+
+    #[test]
+    fn bad_options_and_data_are_refused_by_name() {
+        let refuse = |options: AnfisOptions, check: Option<&TrainingData>| {
+            Anfis::new(mixed_system(), &data(), check, 0, options).unwrap_err()
         };
+        let with = |f: fn(&mut AnfisOptions)| {
+            let mut options = AnfisOptions::default();
+            f(&mut options);
+            refuse(options, None)
+        };
+        let epochs = with(|o| o.epochs = 0);
         assert_eq!(
-            Anfis::new(mixed_system(), &data(), None, 0, bad)
-                .unwrap_err()
-                .to_string(),
+            epochs,
+            FuzzyError::Learning(LearningProblem::CountOutOfRange {
+                name: "epochs",
+                count: 0,
+                max: MAX_EPOCHS
+            })
+        );
+        assert_eq!(
+            epochs.to_string(),
             "learning: epochs must lie in 1..=1000000, got 0"
         );
+        let ridge = with(|o| o.ridge = -1.0);
+        assert_eq!(
+            ridge,
+            FuzzyError::Learning(LearningProblem::BelowMinimum {
+                name: "the ridge",
+                min: 0.0,
+                value: -1.0
+            })
+        );
+        assert_eq!(
+            ridge.to_string(),
+            "learning: the ridge must be finite and at least 0, got -1"
+        );
+        assert!(matches!(
+            with(|o| o.step_increase = f64::NAN),
+            FuzzyError::Learning(LearningProblem::BelowMinimum {
+                name: "the step increase",
+                min: 1.0,
+                value,
+            }) if value.is_nan()
+        ));
+        let decrease = with(|o| o.step_decrease = 1.5);
+        assert_eq!(
+            decrease,
+            FuzzyError::Learning(LearningProblem::OutsideUnitInterval {
+                name: "the step decrease",
+                value: 1.5
+            })
+        );
+        assert_eq!(
+            decrease.to_string(),
+            "learning: the step decrease must lie in (0, 1], got 1.5"
+        );
+        let narrow = TrainingData::new(1, 1, vec![0.0, 1.0]).unwrap();
+        let inputs = refuse(AnfisOptions::default(), Some(&narrow));
+        assert_eq!(
+            inputs,
+            FuzzyError::Learning(LearningProblem::DataInputs {
+                data: "check",
+                expected: 2,
+                found: 1
+            })
+        );
+        assert_eq!(
+            inputs.to_string(),
+            "learning: the check data have 1 inputs, the system 2"
+        );
+        for error in [epochs, ridge, decrease, inputs] {
+            assert!(error.is_invalid_input() && !error.is_numerical(), "{error}");
+        }
     }
 }
