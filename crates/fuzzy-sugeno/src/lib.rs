@@ -16,7 +16,7 @@ mod system;
 
 pub use analysis::{AnalysisOptions, AnalysisReport};
 pub use builder::SystemBuilder;
-pub use error::{FuzzyError, SystemProblem};
+pub use error::{ConsequentParameter, FuzzyError, LearningProblem, SystemProblem};
 pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange};
 pub use export_c::CSource;
 pub use fis::FisNote;

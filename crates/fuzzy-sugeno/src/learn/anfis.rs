@@ -13,15 +13,14 @@
 //! Everything is sized in [`Anfis::new`]; an epoch ([`Anfis::epoch`]) allocates nothing.
 
 use super::data::TrainingData;
-use super::learning;
 use super::least_squares::{LeastSquares, LeastSquaresError};
 use super::premise::{gradient, repair};
-use crate::FuzzyError;
 use crate::eval::CompiledMf;
 use crate::membership::MembershipFn;
 use crate::system::{
     AndMethod, Antecedent, Connective, Defuzzification, FuzzySystem, OutputFn, affine,
 };
+use crate::{ConsequentParameter, FuzzyError, LearningProblem};
 
 /// The most epochs one training may run.
 const MAX_EPOCHS: usize = 1_000_000;
@@ -67,18 +66,18 @@ impl Default for AnfisOptions {
 impl AnfisOptions {
     fn validate(&self) -> Result<(), FuzzyError> {
         if !(1..=MAX_EPOCHS).contains(&self.epochs) {
-            return Err(learning(format!(
-                "epochs must lie in 1..={MAX_EPOCHS}, got {}",
-                self.epochs
-            )));
+            return Err(LearningProblem::CountOutOfRange {
+                name: "epochs",
+                count: self.epochs,
+                max: MAX_EPOCHS,
+            }
+            .into());
         }
-        let finite_at_least = |name: &str, value: f64, min: f64| {
+        let finite_at_least = |name: &'static str, value: f64, min: f64| {
             if value.is_finite() && value >= min {
                 Ok(())
             } else {
-                Err(learning(format!(
-                    "{name} must be finite and at least {min}, got {value}"
-                )))
+                Err(LearningProblem::BelowMinimum { name, min, value })
             }
         };
         finite_at_least("the initial step", self.initial_step, 0.0)?;
@@ -86,10 +85,11 @@ impl AnfisOptions {
         finite_at_least("the ridge", self.ridge, 0.0)?;
         finite_at_least("the target RMSE", self.target_rmse, 0.0)?;
         if !(self.step_decrease > 0.0 && self.step_decrease <= 1.0) {
-            return Err(learning(format!(
-                "the step decrease must lie in (0, 1], got {}",
-                self.step_decrease
-            )));
+            return Err(LearningProblem::OutsideUnitInterval {
+                name: "the step decrease",
+                value: self.step_decrease,
+            }
+            .into());
         }
         Ok(())
     }
@@ -220,10 +220,12 @@ impl Anfis {
         for (what, data) in [("training", Some(train)), ("check", check)] {
             let Some(data) = data else { continue };
             if data.n_inputs() != n_inputs {
-                return Err(learning(format!(
-                    "the {what} data have {} inputs, the system {n_inputs}",
-                    data.n_inputs()
-                )));
+                return Err(LearningProblem::DataInputs {
+                    data: what,
+                    expected: n_inputs,
+                    found: data.n_inputs(),
+                }
+                .into());
             }
             data.check_output(output)?;
         }
@@ -273,8 +275,9 @@ impl Anfis {
         for rule in rules {
             for (i, antecedent) in rule.antecedents.iter().enumerate() {
                 antecedents.push(match *antecedent {
-                    Antecedent::Is(k) => u32::try_from(set_start[i] + k)
-                        .map_err(|_| learning("too many sets to index with 32 bits"))?,
+                    Antecedent::Is(k) => {
+                        u32::try_from(set_start[i] + k).map_err(|_| LearningProblem::TooManySets)?
+                    }
                     _ => ANY,
                 });
             }
@@ -285,10 +288,12 @@ impl Anfis {
         let rows = train.rows();
         let unknowns = theta.len();
         if rows.saturating_mul(unknowns) > MAX_LEAST_SQUARES_ENTRIES {
-            return Err(learning(format!(
-                "{rows} samples times {unknowns} consequent parameters exceed the least-squares \
-                 limit of {MAX_LEAST_SQUARES_ENTRIES} entries"
-            )));
+            return Err(LearningProblem::LeastSquaresTooLarge {
+                samples: rows,
+                unknowns,
+                limit: MAX_LEAST_SQUARES_ENTRIES,
+            }
+            .into());
         }
         let clamped = |data: &TrainingData| {
             let mut x = Vec::with_capacity(data.rows() * n_inputs);
@@ -435,15 +440,15 @@ impl Anfis {
                 self.net.theta.copy_from_slice(solution);
                 Ok(())
             }
-            Err(LeastSquaresError::RankDeficient { column }) => Err(self.rank_deficiency(column)),
-            Err(LeastSquaresError::NonFinite) => Err(learning(
-                "the least-squares problem for the consequents holds a non-finite value",
-            )),
+            Err(LeastSquaresError::RankDeficient { column }) => {
+                Err(self.rank_deficiency(column).into())
+            }
+            Err(LeastSquaresError::NonFinite) => Err(LearningProblem::NonFiniteLeastSquares.into()),
         }
     }
 
     /// Names the consequent parameter that the data do not determine.
-    fn rank_deficiency(&self, column: usize) -> FuzzyError {
+    fn rank_deficiency(&self, column: usize) -> LearningProblem {
         let term = self
             .terms
             .iter()
@@ -452,17 +457,17 @@ impl Anfis {
         let (offset, linear) = self.terms[term];
         let n = self.net.n_inputs;
         let parameter = match column - offset {
-            k if !linear || k == n => "the constant".to_string(),
-            k => format!(
-                "the coefficient of input '{}'",
-                self.template.inputs()[k].name
-            ),
+            k if !linear || k == n => ConsequentParameter::Constant,
+            k => ConsequentParameter::Coefficient {
+                input: k,
+                name: self.template.inputs()[k].name.clone(),
+            },
         };
-        learning(format!(
-            "the data do not determine {parameter} of output term '{}' (least squares is rank \
-             deficient: too few samples where its rules fire, or collinear inputs); use a ridge > 0",
-            self.template.outputs()[0].terms[term].name
-        ))
+        LearningProblem::RankDeficient {
+            term,
+            name: self.template.outputs()[0].terms[term].name.clone(),
+            parameter,
+        }
     }
 
     /// The backward pass: returns the training SSE and accumulates `dE / d alpha` into `grad`.
@@ -540,10 +545,7 @@ impl Anfis {
             return Ok(());
         }
         if !norm.is_finite() {
-            return Err(learning(format!(
-                "the premise gradient is not finite at epoch {}",
-                self.epoch
-            )));
+            return Err(LearningProblem::NonFiniteGradient { epoch: self.epoch }.into());
         }
         let eta = self.step / norm;
         for (m, mf) in self.mfs.iter_mut().enumerate() {
@@ -667,42 +669,34 @@ impl Network {
 /// Refuses a system ANFIS cannot train, saying why.
 fn check_structure(system: &FuzzySystem) -> Result<(), FuzzyError> {
     if system.outputs().len() != 1 {
-        return Err(learning(format!(
-            "ANFIS trains single-output systems; this one has {} outputs (train one system per output)",
-            system.outputs().len()
-        )));
+        return Err(LearningProblem::NotSingleOutput {
+            outputs: system.outputs().len(),
+        }
+        .into());
     }
     let methods = system.methods();
     if methods.and != AndMethod::Product {
-        return Err(learning("ANFIS needs the product AND (AndMethod='prod')"));
+        return Err(LearningProblem::NotProductAnd.into());
     }
     if methods.defuzzification != Defuzzification::WeightedAverage {
-        return Err(learning(
-            "ANFIS needs the weighted-average defuzzifier (DefuzzMethod='wtaver')",
-        ));
+        return Err(LearningProblem::NotWeightedAverage.into());
     }
     if system.rules().is_empty() {
-        return Err(learning("the system has no rules"));
+        return Err(LearningProblem::NoRules.into());
     }
     for (r, rule) in system.rules().iter().enumerate() {
         if rule.connective != Connective::And {
-            return Err(learning(format!(
-                "rule {} is an OR rule; ANFIS needs AND rules",
-                r + 1
-            )));
+            return Err(LearningProblem::OrRule { rule: r }.into());
         }
         if rule
             .antecedents
             .iter()
             .any(|a| matches!(a, Antecedent::IsNot(_)))
         {
-            return Err(learning(format!(
-                "rule {} negates an antecedent; ANFIS needs plain sets",
-                r + 1
-            )));
+            return Err(LearningProblem::NegatedAntecedent { rule: r }.into());
         }
         if rule.consequents[0].is_none() {
-            return Err(learning(format!("rule {} has no consequent", r + 1)));
+            return Err(LearningProblem::NoConsequent { rule: r }.into());
         }
     }
     Ok(())
@@ -900,12 +894,17 @@ mod tests {
 
     #[test]
     fn systems_anfis_cannot_train_are_refused_by_reason() {
-        let message = |system: FuzzySystem| {
-            Anfis::new(system, &data(), None, 0, AnfisOptions::default())
-                .unwrap_err()
-                .to_string()
+        let refuse = |system: FuzzySystem| {
+            let error = Anfis::new(system, &data(), None, 0, AnfisOptions::default()).unwrap_err();
+            assert!(error.is_invalid_input() && !error.is_numerical(), "{error}");
+            match error {
+                FuzzyError::Learning(problem) => problem,
+                other => panic!("not a learning error: {other}"),
+            }
         };
-        let two_outputs = crate::paper_controller();
+        let message = |problem: LearningProblem| FuzzyError::from(problem).to_string();
+        let two_outputs = refuse(crate::paper_controller());
+        assert_eq!(two_outputs, LearningProblem::NotSingleOutput { outputs: 2 });
         assert!(message(two_outputs).contains("single-output systems; this one has 2 outputs"));
         let sets = [
             ("lo", Mf::gaussian(0.5, -1.0)),
@@ -917,38 +916,127 @@ mod tests {
                 .input("y", [0.0, 2.0], sets)
                 .output("z", [0.0, 1.0], [("c", OutputFn::Constant(0.5))])
         };
+        let minimum = refuse(
+            base()
+                .and_method(AndMethod::Minimum)
+                .rule(["lo", "lo"], ["c"])
+                .build()
+                .unwrap(),
+        );
+        assert_eq!(minimum, LearningProblem::NotProductAnd);
         assert_eq!(
-            message(
-                base()
-                    .and_method(AndMethod::Minimum)
-                    .rule(["lo", "lo"], ["c"])
-                    .build()
-                    .unwrap()
-            ),
+            message(minimum),
             "learning: ANFIS needs the product AND (AndMethod='prod')"
         );
-        assert_eq!(
-            message(base().rule(["not lo", "lo"], ["c"]).build().unwrap()),
-            "learning: rule 1 negates an antecedent; ANFIS needs plain sets"
+        let sum = refuse(
+            base()
+                .defuzzification(Defuzzification::WeightedSum)
+                .rule(["lo", "lo"], ["c"])
+                .build()
+                .unwrap(),
         );
+        assert_eq!(sum, LearningProblem::NotWeightedAverage);
         assert_eq!(
-            message(
-                base()
-                    .weighted_rule(["lo", "hi"], ["c"], 1.0, Connective::Or)
-                    .build()
-                    .unwrap()
-            ),
+            message(sum),
+            "learning: ANFIS needs the weighted-average defuzzifier (DefuzzMethod='wtaver')"
+        );
+        let negated = refuse(
+            base()
+                .rule(["lo", "hi"], ["c"])
+                .rule(["not lo", "lo"], ["c"])
+                .build()
+                .unwrap(),
+        );
+        assert_eq!(negated, LearningProblem::NegatedAntecedent { rule: 1 });
+        assert_eq!(
+            message(negated),
+            "learning: rule 2 negates an antecedent; ANFIS needs plain sets"
+        );
+        let or = refuse(
+            base()
+                .weighted_rule(["lo", "hi"], ["c"], 1.0, Connective::Or)
+                .build()
+                .unwrap(),
+        );
+        assert_eq!(or, LearningProblem::OrRule { rule: 0 });
+        assert_eq!(
+            message(or),
             "learning: rule 1 is an OR rule; ANFIS needs AND rules"
         );
-        let bad = AnfisOptions {
-            epochs: 0,
-            ..AnfisOptions::default()
+    }
+
+    #[test]
+    fn bad_options_and_data_are_refused_by_name() {
+        let refuse = |options: AnfisOptions, check: Option<&TrainingData>| {
+            Anfis::new(mixed_system(), &data(), check, 0, options).unwrap_err()
         };
+        let with = |f: fn(&mut AnfisOptions)| {
+            let mut options = AnfisOptions::default();
+            f(&mut options);
+            refuse(options, None)
+        };
+        let epochs = with(|o| o.epochs = 0);
         assert_eq!(
-            Anfis::new(mixed_system(), &data(), None, 0, bad)
-                .unwrap_err()
-                .to_string(),
+            epochs,
+            FuzzyError::Learning(LearningProblem::CountOutOfRange {
+                name: "epochs",
+                count: 0,
+                max: MAX_EPOCHS
+            })
+        );
+        assert_eq!(
+            epochs.to_string(),
             "learning: epochs must lie in 1..=1000000, got 0"
         );
+        let ridge = with(|o| o.ridge = -1.0);
+        assert_eq!(
+            ridge,
+            FuzzyError::Learning(LearningProblem::BelowMinimum {
+                name: "the ridge",
+                min: 0.0,
+                value: -1.0
+            })
+        );
+        assert_eq!(
+            ridge.to_string(),
+            "learning: the ridge must be finite and at least 0, got -1"
+        );
+        assert!(matches!(
+            with(|o| o.step_increase = f64::NAN),
+            FuzzyError::Learning(LearningProblem::BelowMinimum {
+                name: "the step increase",
+                min: 1.0,
+                value,
+            }) if value.is_nan()
+        ));
+        let decrease = with(|o| o.step_decrease = 1.5);
+        assert_eq!(
+            decrease,
+            FuzzyError::Learning(LearningProblem::OutsideUnitInterval {
+                name: "the step decrease",
+                value: 1.5
+            })
+        );
+        assert_eq!(
+            decrease.to_string(),
+            "learning: the step decrease must lie in (0, 1], got 1.5"
+        );
+        let narrow = TrainingData::new(1, 1, vec![0.0, 1.0]).unwrap();
+        let inputs = refuse(AnfisOptions::default(), Some(&narrow));
+        assert_eq!(
+            inputs,
+            FuzzyError::Learning(LearningProblem::DataInputs {
+                data: "check",
+                expected: 2,
+                found: 1
+            })
+        );
+        assert_eq!(
+            inputs.to_string(),
+            "learning: the check data have 1 inputs, the system 2"
+        );
+        for error in [epochs, ridge, decrease, inputs] {
+            assert!(error.is_invalid_input() && !error.is_numerical(), "{error}");
+        }
     }
 }

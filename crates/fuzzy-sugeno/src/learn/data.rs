@@ -1,8 +1,7 @@
 //! Samples to learn from: rows of input values followed by output values.
 
-use super::learning;
-use crate::FuzzyError;
 use crate::system::check_name;
+use crate::{FuzzyError, LearningProblem};
 
 /// The most rows a data set may hold.
 pub const MAX_ROWS: usize = 1_000_000;
@@ -27,35 +26,44 @@ impl TrainingData {
     /// than [`MAX_INPUTS`] inputs.
     pub fn new(n_inputs: usize, n_outputs: usize, values: Vec<f64>) -> Result<Self, FuzzyError> {
         if n_inputs == 0 || n_inputs > MAX_INPUTS {
-            return Err(learning(format!(
-                "the number of inputs must lie in 1..={MAX_INPUTS}, got {n_inputs}"
-            )));
+            return Err(LearningProblem::CountOutOfRange {
+                name: "the number of inputs",
+                count: n_inputs,
+                max: MAX_INPUTS,
+            }
+            .into());
         }
         if n_outputs == 0 || n_outputs > MAX_OUTPUTS {
-            return Err(learning(format!(
-                "the number of outputs must lie in 1..={MAX_OUTPUTS}, got {n_outputs}"
-            )));
+            return Err(LearningProblem::CountOutOfRange {
+                name: "the number of outputs",
+                count: n_outputs,
+                max: MAX_OUTPUTS,
+            }
+            .into());
         }
         let width = n_inputs + n_outputs;
         if values.is_empty() || !values.len().is_multiple_of(width) {
-            return Err(learning(format!(
-                "{} values are not a whole, non-zero number of rows of {width}",
-                values.len()
-            )));
+            return Err(LearningProblem::RowLength {
+                values: values.len(),
+                width,
+            }
+            .into());
         }
         let rows = values.len() / width;
         if rows > MAX_ROWS {
-            return Err(learning(format!(
-                "{rows} rows exceed the limit of {MAX_ROWS}"
-            )));
+            return Err(LearningProblem::TooManyRows {
+                rows,
+                limit: MAX_ROWS,
+            }
+            .into());
         }
         if let Some(k) = values.iter().position(|v| !v.is_finite()) {
-            return Err(learning(format!(
-                "row {} column {} is not finite ({})",
-                k / width + 1,
-                k % width + 1,
-                values[k]
-            )));
+            return Err(LearningProblem::NonFiniteValue {
+                row: k / width,
+                column: k % width,
+                value: values[k],
+            }
+            .into());
         }
         Ok(Self {
             n_inputs,
@@ -71,19 +79,21 @@ impl TrainingData {
     pub fn with_names(mut self, names: Vec<String>) -> Result<Self, FuzzyError> {
         let width = self.n_inputs + self.n_outputs;
         if names.len() != width {
-            return Err(learning(format!(
-                "{} column names for {width} columns",
-                names.len()
-            )));
+            return Err(LearningProblem::ColumnNameCount {
+                names: names.len(),
+                columns: width,
+            }
+            .into());
         }
         for (k, name) in names.iter().enumerate() {
             check_name("variable", name)
-                .map_err(|problem| learning(format!("column {}: {problem}", k + 1)))?;
+                .map_err(|problem| LearningProblem::ColumnName { column: k, problem })?;
             if names[..k].contains(name) {
-                return Err(learning(format!(
-                    "column {}: another column is also named '{name}'",
-                    k + 1
-                )));
+                return Err(LearningProblem::DuplicateColumnName {
+                    column: k,
+                    name: name.clone(),
+                }
+                .into());
             }
         }
         self.names = Some(names);
@@ -142,11 +152,11 @@ impl TrainingData {
     /// Refuses an output index this data set does not have.
     pub(crate) fn check_output(&self, output: usize) -> Result<(), FuzzyError> {
         if output >= self.n_outputs {
-            return Err(learning(format!(
-                "output {} asked of data with {} outputs",
-                output + 1,
-                self.n_outputs
-            )));
+            return Err(LearningProblem::NoSuchOutput {
+                output,
+                outputs: self.n_outputs,
+            }
+            .into());
         }
         Ok(())
     }
@@ -155,6 +165,7 @@ impl TrainingData {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::SystemProblem;
 
     #[test]
     fn rows_and_columns() {
@@ -167,18 +178,122 @@ mod tests {
 
     #[test]
     fn bad_data_is_refused_with_its_place() {
-        let message = |n, m, v: Vec<f64>| TrainingData::new(n, m, v).unwrap_err().to_string();
+        let refuse = |n, m, v: Vec<f64>| match TrainingData::new(n, m, v).unwrap_err() {
+            FuzzyError::Learning(problem) => problem,
+            other => panic!("not a learning error: {other}"),
+        };
+        let problem = refuse(2, 1, vec![1.0, 2.0, 3.0, 4.0, f64::NAN, 6.0]);
+        assert!(matches!(
+            problem,
+            LearningProblem::NonFiniteValue { row: 1, column: 1, value } if value.is_nan()
+        ));
         assert_eq!(
-            message(2, 1, vec![1.0, 2.0, 3.0, 4.0, f64::NAN, 6.0]),
+            FuzzyError::from(problem).to_string(),
             "learning: row 2 column 2 is not finite (NaN)"
         );
+        let problem = refuse(2, 1, vec![1.0; 4]);
         assert_eq!(
-            message(2, 1, vec![1.0; 4]),
-            "learning: 4 values are not a whole, non-zero number of rows of 3"
+            problem,
+            LearningProblem::RowLength {
+                values: 4,
+                width: 3
+            }
         );
         assert_eq!(
-            message(0, 1, vec![1.0]),
+            problem.to_string(),
+            "4 values are not a whole, non-zero number of rows of 3"
+        );
+        assert_eq!(
+            refuse(2, 1, Vec::new()),
+            LearningProblem::RowLength {
+                values: 0,
+                width: 3
+            }
+        );
+        let problem = refuse(0, 1, vec![1.0]);
+        assert_eq!(
+            problem,
+            LearningProblem::CountOutOfRange {
+                name: "the number of inputs",
+                count: 0,
+                max: MAX_INPUTS
+            }
+        );
+        assert_eq!(
+            FuzzyError::from(problem).to_string(),
             "learning: the number of inputs must lie in 1..=64, got 0"
         );
+        assert_eq!(
+            refuse(1, 65, vec![1.0; 66]),
+            LearningProblem::CountOutOfRange {
+                name: "the number of outputs",
+                count: 65,
+                max: MAX_OUTPUTS
+            }
+        );
+        let problem = refuse(1, 1, vec![0.0; 2 * (MAX_ROWS + 1)]);
+        assert_eq!(
+            problem,
+            LearningProblem::TooManyRows {
+                rows: MAX_ROWS + 1,
+                limit: MAX_ROWS
+            }
+        );
+        assert_eq!(
+            problem.to_string(),
+            "1000001 rows exceed the limit of 1000000"
+        );
+        // Malformed data are the caller's input, not a numerical failure.
+        let error = TrainingData::new(2, 1, vec![f64::INFINITY; 3]).unwrap_err();
+        assert!(error.is_invalid_input() && !error.is_numerical());
+    }
+
+    #[test]
+    fn bad_column_names_are_refused_with_their_column() {
+        let data = || TrainingData::new(1, 1, vec![1.0, 2.0]).unwrap();
+        let names = |names: &[&str]| {
+            let names = names.iter().map(|n| n.to_string()).collect();
+            match data().with_names(names).unwrap_err() {
+                FuzzyError::Learning(problem) => problem,
+                other => panic!("not a learning error: {other}"),
+            }
+        };
+        let problem = names(&["x"]);
+        assert_eq!(
+            problem,
+            LearningProblem::ColumnNameCount {
+                names: 1,
+                columns: 2
+            }
+        );
+        assert_eq!(problem.to_string(), "1 column names for 2 columns");
+        let problem = names(&["x", "x"]);
+        assert_eq!(
+            problem,
+            LearningProblem::DuplicateColumnName {
+                column: 1,
+                name: "x".to_string()
+            }
+        );
+        assert_eq!(
+            problem.to_string(),
+            "column 2: another column is also named 'x'"
+        );
+        let problem = names(&["x", ""]);
+        assert_eq!(
+            problem,
+            LearningProblem::ColumnName {
+                column: 1,
+                problem: SystemProblem::EmptyName { kind: "variable" }
+            }
+        );
+        assert_eq!(problem.to_string(), "column 2: the variable name is empty");
+        assert!(matches!(
+            names(&["it's", "y"]),
+            LearningProblem::ColumnName {
+                column: 0,
+                problem: SystemProblem::UnwritableName { .. }
+            }
+        ));
     }
 }

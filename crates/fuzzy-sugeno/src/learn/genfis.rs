@@ -4,13 +4,12 @@
 
 use super::anfis::{Anfis, AnfisOptions};
 use super::data::TrainingData;
-use super::learning;
-use crate::FuzzyError;
 use crate::membership::MembershipFn;
 use crate::system::{
     Antecedent, Connective, FuzzySet, FuzzySystem, InputVariable, Methods, OutputFn, OutputTerm,
     OutputVariable, Rule,
 };
+use crate::{FuzzyError, LearningProblem};
 
 /// The most rules `genfis` builds (sets per input to the power of the inputs, or clusters).
 pub const MAX_RULES: usize = 4096;
@@ -69,10 +68,10 @@ impl SetShape {
             "psigmf" => Self::SigmoidProduct,
             "pimf" => Self::PiShape,
             _ => {
-                return Err(learning(format!(
-                    "unknown set type '{name}' for a grid partition; expected one of gbellmf, \
-                     gaussmf, gauss2mf, trimf, trapmf, sigmf, dsigmf, psigmf, pimf"
-                )));
+                return Err(LearningProblem::UnknownSetShape {
+                    name: name.to_string(),
+                }
+                .into());
             }
         })
     }
@@ -236,30 +235,32 @@ pub fn genfis_grid_over(
         || partitioned.windows(2).any(|w| w[0] >= w[1])
         || partitioned.last().is_some_and(|&i| i >= n)
     {
-        return Err(learning(format!(
-            "the partitioned inputs must be a non-empty increasing list of indices below {n}, \
-             got {partitioned:?}"
-        )));
+        return Err(LearningProblem::PartitionedInputs {
+            partitioned: partitioned.to_vec(),
+            inputs: n,
+        }
+        .into());
     }
     if !(1..=MAX_SETS_PER_INPUT).contains(&k) {
-        return Err(learning(format!(
-            "sets per input must lie in 1..={MAX_SETS_PER_INPUT}, got {k}"
-        )));
+        return Err(LearningProblem::CountOutOfRange {
+            name: "sets per input",
+            count: k,
+            max: MAX_SETS_PER_INPUT,
+        }
+        .into());
     }
     if grid.shape == SetShape::Sigmoid && k != 2 {
-        return Err(learning(format!(
-            "sigmf partitions have exactly 2 sets per input (one open to each side), got {k}"
-        )));
+        return Err(LearningProblem::SigmoidSets { sets: k }.into());
     }
     let p = partitioned.len();
     let rules = u32::try_from(p)
         .ok()
         .and_then(|p| k.checked_pow(p))
         .filter(|&r| r <= MAX_RULES)
-        .ok_or_else(|| {
-            learning(format!(
-                "{k} sets on each of {p} inputs make more than {MAX_RULES} rules"
-            ))
+        .ok_or(LearningProblem::TooManyRules {
+            sets: k,
+            inputs: p,
+            limit: MAX_RULES,
         })?;
     let mut inputs = Vec::with_capacity(n);
     for i in 0..n {
@@ -304,15 +305,19 @@ pub fn genfis_cluster(
     data.check_output(output)?;
     let ra = clustering.radius;
     if !(ra > 0.0 && ra <= 1.0) {
-        return Err(learning(format!(
-            "the cluster radius must lie in (0, 1], got {ra}"
-        )));
+        return Err(LearningProblem::OutsideUnitInterval {
+            name: "the cluster radius",
+            value: ra,
+        }
+        .into());
     }
     let rows = data.rows();
     if rows > MAX_CLUSTER_ROWS {
-        return Err(learning(format!(
-            "subtractive clustering takes at most {MAX_CLUSTER_ROWS} rows, got {rows}"
-        )));
+        return Err(LearningProblem::TooManyClusterRows {
+            rows,
+            limit: MAX_CLUSTER_ROWS,
+        }
+        .into());
     }
     let n = data.n_inputs();
     let ranges = (0..n)
@@ -397,9 +402,11 @@ fn subtractive_clustering(points: &[f64], dim: usize, ra: f64) -> Result<Vec<usi
             }
         }
         if centres.len() == MAX_RULES {
-            return Err(learning(format!(
-                "a cluster radius of {ra} finds more than {MAX_RULES} clusters; use a larger radius"
-            )));
+            return Err(LearningProblem::TooManyClusters {
+                radius: ra,
+                limit: MAX_RULES,
+            }
+            .into());
         }
         centres.push(best);
         for (i, q) in potential.iter_mut().enumerate() {
@@ -415,10 +422,11 @@ fn input_range(data: &TrainingData, i: usize) -> Result<[f64; 2], FuzzyError> {
     if lo < hi {
         Ok([lo, hi])
     } else {
-        Err(learning(format!(
-            "input {} is constant ({lo}) over the data; a fuzzy partition needs a range",
-            i + 1
-        )))
+        Err(LearningProblem::ConstantInput {
+            input: i,
+            value: lo,
+        }
+        .into())
     }
 }
 
@@ -434,10 +442,7 @@ fn assemble(
     let n = inputs.len();
     let [lo, hi] = data.column_range(n + output);
     if lo >= hi {
-        return Err(learning(format!(
-            "output {} is constant ({lo}) over the data; there is nothing to learn",
-            output + 1
-        )));
+        return Err(LearningProblem::ConstantOutput { output, value: lo }.into());
     }
     let terms = (0..antecedents.len())
         .map(|r| OutputTerm {
@@ -483,6 +488,7 @@ fn assemble(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::learn::MAX_ROWS;
     use proptest::prelude::*;
 
     fn plane(rows: usize) -> TrainingData {
@@ -598,14 +604,20 @@ mod tests {
             genfis_grid(&data, 0, &grid).unwrap()
         );
         for bad in [&[][..], &[1, 0], &[0, 0], &[2]] {
+            let error = genfis_grid_over(&data, 0, &grid, bad).unwrap_err();
             assert_eq!(
-                genfis_grid_over(&data, 0, &grid, bad)
-                    .unwrap_err()
-                    .to_string(),
+                error.to_string(),
                 format!(
                     "learning: the partitioned inputs must be a non-empty increasing list of \
                      indices below 2, got {bad:?}"
                 )
+            );
+            assert_eq!(
+                error,
+                FuzzyError::Learning(LearningProblem::PartitionedInputs {
+                    partitioned: bad.to_vec(),
+                    inputs: 2
+                })
             );
         }
     }
@@ -648,59 +660,128 @@ mod tests {
 
     #[test]
     fn bad_requests_are_refused_with_a_reason() {
+        // Each refusal: its problem, with the numbers and names as fields, and its message.
+        fn check<T: std::fmt::Debug>(
+            result: Result<T, FuzzyError>,
+            expected: LearningProblem,
+            message: &str,
+        ) {
+            let error = result.unwrap_err();
+            assert_eq!(error, FuzzyError::Learning(expected));
+            assert_eq!(error.to_string(), message);
+            assert!(error.is_invalid_input() && !error.is_numerical(), "{error}");
+        }
         let data = plane(49);
         let grid = |k, shape| GridPartition {
             sets_per_input: k,
             shape,
             order: ConsequentOrder::First,
         };
-        let message = |g: GridPartition| genfis_grid(&data, 0, &g).unwrap_err().to_string();
-        assert_eq!(
-            message(grid(3, SetShape::Sigmoid)),
-            "learning: sigmf partitions have exactly 2 sets per input (one open to each side), got 3"
+        check(
+            genfis_grid(&data, 0, &grid(3, SetShape::Sigmoid)),
+            LearningProblem::SigmoidSets { sets: 3 },
+            "learning: sigmf partitions have exactly 2 sets per input (one open to each side), got 3",
         );
-        assert_eq!(
-            message(grid(0, SetShape::Bell)),
-            "learning: sets per input must lie in 1..=64, got 0"
+        check(
+            genfis_grid(&data, 0, &grid(0, SetShape::Bell)),
+            LearningProblem::CountOutOfRange {
+                name: "sets per input",
+                count: 0,
+                max: MAX_SETS_PER_INPUT,
+            },
+            "learning: sets per input must lie in 1..=64, got 0",
         );
-        assert_eq!(
-            SetShape::from_matlab_name("constant")
-                .unwrap_err()
-                .to_string(),
-            "learning: unknown set type 'constant' for a grid partition; expected one of gbellmf, gaussmf, gauss2mf, trimf, trapmf, sigmf, dsigmf, psigmf, pimf"
+        check(
+            genfis_grid(&data, 0, &grid(65, SetShape::Bell)),
+            LearningProblem::CountOutOfRange {
+                name: "sets per input",
+                count: 65,
+                max: MAX_SETS_PER_INPUT,
+            },
+            "learning: sets per input must lie in 1..=64, got 65",
+        );
+        check(
+            SetShape::from_matlab_name("constant"),
+            LearningProblem::UnknownSetShape {
+                name: "constant".to_string(),
+            },
+            "learning: unknown set type 'constant' for a grid partition; expected one of gbellmf, gaussmf, gauss2mf, trimf, trapmf, sigmf, dsigmf, psigmf, pimf",
         );
         let wide = TrainingData::new(13, 1, (0..14 * 3).map(|v| (v % 5) as f64).collect()).unwrap();
-        assert_eq!(
-            genfis_grid(&wide, 0, &GridPartition::default())
-                .unwrap_err()
-                .to_string(),
-            "learning: 2 sets on each of 13 inputs make more than 4096 rules"
+        check(
+            genfis_grid(&wide, 0, &GridPartition::default()),
+            LearningProblem::TooManyRules {
+                sets: 2,
+                inputs: 13,
+                limit: MAX_RULES,
+            },
+            "learning: 2 sets on each of 13 inputs make more than 4096 rules",
         );
         let constant = TrainingData::new(1, 1, vec![1.0, 0.0, 1.0, 1.0]).unwrap();
-        assert_eq!(
-            genfis_grid(&constant, 0, &GridPartition::default())
-                .unwrap_err()
-                .to_string(),
-            "learning: input 1 is constant (1) over the data; a fuzzy partition needs a range"
+        check(
+            genfis_grid(&constant, 0, &GridPartition::default()),
+            LearningProblem::ConstantInput {
+                input: 0,
+                value: 1.0,
+            },
+            "learning: input 1 is constant (1) over the data; a fuzzy partition needs a range",
         );
-        assert_eq!(
+        let flat = TrainingData::new(1, 2, vec![0.0, 5.0, 2.5, 1.0, 6.0, 2.5]).unwrap();
+        check(
+            genfis_cluster(&flat, 1, &SubtractiveClustering::default()),
+            LearningProblem::ConstantOutput {
+                output: 1,
+                value: 2.5,
+            },
+            "learning: output 2 is constant (2.5) over the data; there is nothing to learn",
+        );
+        check(
             genfis_cluster(
                 &data,
                 0,
                 &SubtractiveClustering {
                     radius: 0.0,
-                    order: ConsequentOrder::First
-                }
-            )
-            .unwrap_err()
-            .to_string(),
-            "learning: the cluster radius must lie in (0, 1], got 0"
+                    order: ConsequentOrder::First,
+                },
+            ),
+            LearningProblem::OutsideUnitInterval {
+                name: "the cluster radius",
+                value: 0.0,
+            },
+            "learning: the cluster radius must lie in (0, 1], got 0",
         );
-        assert_eq!(
-            genfis_grid(&data, 1, &GridPartition::default())
-                .unwrap_err()
-                .to_string(),
-            "learning: output 2 asked of data with 1 outputs"
+        let many = TrainingData::new(
+            1,
+            1,
+            (0..2 * (MAX_CLUSTER_ROWS + 1)).map(|v| v as f64).collect(),
+        )
+        .unwrap();
+        check(
+            genfis_cluster(&many, 0, &SubtractiveClustering::default()),
+            LearningProblem::TooManyClusterRows {
+                rows: MAX_CLUSTER_ROWS + 1,
+                limit: MAX_CLUSTER_ROWS,
+            },
+            "learning: subtractive clustering takes at most 10000 rows, got 10001",
+        );
+        let long = TrainingData::new(1, 1, (0..2 * MAX_ROWS).map(|v| v as f64).collect()).unwrap();
+        check(
+            genfis_grid(&long, 0, &grid(13, SetShape::Bell)),
+            LearningProblem::LeastSquaresTooLarge {
+                samples: MAX_ROWS,
+                unknowns: 13 * 2,
+                limit: 25_000_000,
+            },
+            "learning: 1000000 samples times 26 consequent parameters exceed the least-squares \
+             limit of 25000000 entries",
+        );
+        check(
+            genfis_grid(&data, 1, &GridPartition::default()),
+            LearningProblem::NoSuchOutput {
+                output: 1,
+                outputs: 1,
+            },
+            "learning: output 2 asked of data with 1 outputs",
         );
     }
 }

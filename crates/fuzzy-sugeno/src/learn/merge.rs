@@ -2,9 +2,8 @@
 //! several outputs, learned one system per output, becomes one `.fis` (for example a controller
 //! with two torques).
 
-use super::learning;
-use crate::FuzzyError;
 use crate::system::{FuzzySet, FuzzySystem, InputVariable, Rule};
+use crate::{FuzzyError, LearningProblem};
 
 /// Merges single-output systems over the same inputs (same names and ranges, same inference
 /// methods) into one system named `name` with their outputs in order. Each input gets the sets
@@ -29,21 +28,25 @@ use crate::system::{FuzzySet, FuzzySystem, InputVariable, Rule};
 /// ```
 pub fn merge_outputs(name: &str, systems: &[FuzzySystem]) -> Result<FuzzySystem, FuzzyError> {
     let Some(first) = systems.first() else {
-        return Err(learning("no systems to merge"));
+        return Err(LearningProblem::NothingToMerge.into());
     };
     let n_inputs = first.inputs().len();
     for (k, system) in systems.iter().enumerate() {
-        let which = format!("system {} ('{}')", k + 1, system.name());
+        let name = || system.name().to_string();
         if system.outputs().len() != 1 {
-            return Err(learning(format!(
-                "{which} has {} outputs; merge single-output systems",
-                system.outputs().len()
-            )));
+            return Err(LearningProblem::MergeOutputs {
+                system: k,
+                name: name(),
+                outputs: system.outputs().len(),
+            }
+            .into());
         }
         if system.methods() != first.methods() {
-            return Err(learning(format!(
-                "{which} uses other inference methods than system 1"
-            )));
+            return Err(LearningProblem::MergeMethods {
+                system: k,
+                name: name(),
+            }
+            .into());
         }
         let same_inputs = system.inputs().len() == n_inputs
             && system
@@ -52,9 +55,11 @@ pub fn merge_outputs(name: &str, systems: &[FuzzySystem]) -> Result<FuzzySystem,
                 .zip(first.inputs())
                 .all(|(a, b)| a.name == b.name && a.range == b.range);
         if !same_inputs {
-            return Err(learning(format!(
-                "{which} does not have system 1's inputs (names and ranges)"
-            )));
+            return Err(LearningProblem::MergeInputs {
+                system: k,
+                name: name(),
+            }
+            .into());
         }
     }
     let mut inputs: Vec<InputVariable> = first

@@ -45,9 +45,3 @@ pub use genfis::{
     SubtractiveClustering, genfis_cluster, genfis_grid, genfis_grid_over,
 };
 pub use merge::merge_outputs;
-
-use crate::FuzzyError;
-
-fn learning(message: impl Into<String>) -> FuzzyError {
-    FuzzyError::Learning(message.into())
-}

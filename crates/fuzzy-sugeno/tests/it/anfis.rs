@@ -5,8 +5,12 @@ use crate::common;
 
 use fuzzy_sugeno::learn::{
     AnfisOptions, ConsequentOrder, GridPartition, SetShape, TrainingData, anfis, genfis_grid,
+    merge_outputs,
 };
-use fuzzy_sugeno::{Evaluator, FuzzySystem};
+use fuzzy_sugeno::{
+    AndMethod, ConsequentParameter, Evaluator, FuzzyError, FuzzySystem, LearningProblem,
+    MembershipFn, OutputFn,
+};
 use std::time::Instant;
 
 /// The Mackey-Glass delay equation `dx/dt = 0.2 x(t - tau) / (1 + x(t - tau)^10) - 0.1 x(t)`
@@ -222,6 +226,31 @@ fn undetermined_consequents_are_an_error_without_ridge_and_finite_with_it() {
             && message.ends_with("use a ridge > 0"),
         "{message}"
     );
+    // The term named (one term per rule) is that of a rule no sample fires.
+    let FuzzyError::Learning(LearningProblem::RankDeficient {
+        term,
+        name,
+        parameter,
+    }) = &error
+    else {
+        panic!("not a rank deficiency: {error:?}");
+    };
+    assert_eq!(parameter, &ConsequentParameter::Constant);
+    assert_eq!(name, &initial.outputs()[0].terms[*term].name);
+    for r in 0..data.rows() {
+        let strength: f64 = initial.rules()[*term]
+            .antecedents
+            .iter()
+            .zip(initial.inputs())
+            .zip(data.inputs(r))
+            .map(|((antecedent, input), &x)| match *antecedent {
+                fuzzy_sugeno::Antecedent::Is(set) => input.sets[set].membership.degree(x).unwrap(),
+                _ => 1.0,
+            })
+            .product();
+        assert_eq!(strength, 0.0, "term {term} ('{name}'), sample {r}");
+    }
+    assert!(error.is_numerical() && !error.is_invalid_input());
     let trained = anfis(
         initial,
         &data,
@@ -264,7 +293,7 @@ fn systems_learned_per_output_merge_into_one_that_evaluates_the_same() {
             anfis(initial, &data, None, o, &options).unwrap().system
         })
         .collect();
-    let merged = fuzzy_sugeno::learn::merge_outputs("both", &systems).unwrap();
+    let merged = merge_outputs("both", &systems).unwrap();
     assert_eq!(merged.rules().len(), 4 + 9);
     assert_eq!(FuzzySystem::from_fis(&merged.to_fis()).unwrap(), merged);
     let mut both = Evaluator::new(merged);
@@ -277,11 +306,154 @@ fn systems_learned_per_output_merge_into_one_that_evaluates_the_same() {
             assert_eq!(y2[o], y1[0], "row {r} output {o}");
         }
     }
-    let refused = fuzzy_sugeno::learn::merge_outputs("x", &[both.system().clone()]).unwrap_err();
+    let refused = merge_outputs("x", &[both.system().clone()]).unwrap_err();
     assert_eq!(
         refused.to_string(),
         "learning: system 1 ('both') has 2 outputs; merge single-output systems"
     );
+    assert_eq!(
+        refused,
+        FuzzyError::Learning(LearningProblem::MergeOutputs {
+            system: 0,
+            name: "both".to_string(),
+            outputs: 2
+        })
+    );
+}
+
+#[test]
+fn systems_that_do_not_share_inputs_and_methods_are_not_merged() {
+    let system = |name: &str, input: &str, and: AndMethod| {
+        FuzzySystem::builder(name)
+            .and_method(and)
+            .input(
+                input,
+                [0.0, 1.0],
+                [("a", MembershipFn::triangle(-1.0, 0.0, 1.0))],
+            )
+            .output("y", [0.0, 1.0], [("c", OutputFn::Constant(0.5))])
+            .rule(["a"], ["c"])
+            .build()
+            .unwrap()
+    };
+    let first = system("first", "x", AndMethod::Product);
+    let refuse = |others: &[FuzzySystem]| merge_outputs("m", others).unwrap_err();
+    let error = refuse(&[]);
+    assert_eq!(error, FuzzyError::Learning(LearningProblem::NothingToMerge));
+    assert_eq!(error.to_string(), "learning: no systems to merge");
+    let error = refuse(&[first.clone(), system("min", "x", AndMethod::Minimum)]);
+    assert_eq!(
+        error,
+        FuzzyError::Learning(LearningProblem::MergeMethods {
+            system: 1,
+            name: "min".to_string()
+        })
+    );
+    assert_eq!(
+        error.to_string(),
+        "learning: system 2 ('min') uses other inference methods than system 1"
+    );
+    let error = refuse(&[
+        first.clone(),
+        first.clone(),
+        system("z", "z", AndMethod::Product),
+    ]);
+    assert_eq!(
+        error,
+        FuzzyError::Learning(LearningProblem::MergeInputs {
+            system: 2,
+            name: "z".to_string()
+        })
+    );
+    assert_eq!(
+        error.to_string(),
+        "learning: system 3 ('z') does not have system 1's inputs (names and ranges)"
+    );
+    assert!(error.is_invalid_input() && !error.is_numerical());
+}
+
+#[test]
+fn collinear_inputs_leave_a_coefficient_undetermined_without_ridge() {
+    // in2 = 2 in1 on every sample: one rule's linear consequent cannot tell their coefficients
+    // apart, so plain least squares names in2's.
+    let values = (0..20)
+        .flat_map(|k| {
+            let x = k as f64 / 19.0;
+            [x, 2.0 * x, (3.0 * x).sin()]
+        })
+        .collect();
+    let data = TrainingData::new(2, 1, values).unwrap();
+    let one_rule = GridPartition {
+        sets_per_input: 1,
+        ..GridPartition::default()
+    };
+    let initial = genfis_grid(&data, 0, &one_rule).unwrap();
+    let plain = AnfisOptions {
+        epochs: 1,
+        ridge: 0.0,
+        ..AnfisOptions::default()
+    };
+    let error = anfis(initial, &data, None, 0, &plain).unwrap_err();
+    assert_eq!(
+        error,
+        FuzzyError::Learning(LearningProblem::RankDeficient {
+            term: 0,
+            name: "out1mf1".to_string(),
+            parameter: ConsequentParameter::Coefficient {
+                input: 1,
+                name: "in2".to_string()
+            }
+        })
+    );
+    assert_eq!(
+        error.to_string(),
+        "learning: the data do not determine the coefficient of input 'in2' of output term \
+         'out1mf1' (least squares is rank deficient: too few samples where its rules fire, or \
+         collinear inputs); use a ridge > 0"
+    );
+    assert!(error.is_numerical());
+}
+
+#[test]
+fn overflowing_data_are_a_numerical_error_not_a_nan_system() {
+    // Finite inputs near 1e200: the first-order least-squares matrix holds their squares, inf.
+    let values = (0..10).flat_map(|k| [k as f64 * 1e200, k as f64]).collect();
+    let huge_inputs = TrainingData::new(1, 1, values).unwrap();
+    let error = genfis_grid(&huge_inputs, 0, &GridPartition::default()).unwrap_err();
+    assert_eq!(
+        error,
+        FuzzyError::Learning(LearningProblem::NonFiniteLeastSquares)
+    );
+    assert_eq!(
+        error.to_string(),
+        "learning: the least-squares problem for the consequents holds a non-finite value"
+    );
+    assert!(error.is_numerical() && !error.is_invalid_input());
+    // Finite targets of +-1e300 that no system fits: the squared error and its gradient
+    // overflow, and the first premise step refuses them.
+    let values = (0..10)
+        .flat_map(|k| [k as f64, if k % 2 == 0 { 1e300 } else { -1e300 }])
+        .collect();
+    let huge_targets = TrainingData::new(1, 1, values).unwrap();
+    let zero_order = GridPartition {
+        order: ConsequentOrder::Zero,
+        ..GridPartition::default()
+    };
+    let initial = genfis_grid(&huge_targets, 0, &zero_order).unwrap();
+    let options = AnfisOptions {
+        epochs: 2,
+        ..AnfisOptions::default()
+    };
+    let error = anfis(initial, &huge_targets, None, 0, &options).unwrap_err();
+    assert_eq!(
+        error,
+        FuzzyError::Learning(LearningProblem::NonFiniteGradient { epoch: 1 })
+    );
+    assert_eq!(
+        error.to_string(),
+        "learning: the premise gradient is not finite at epoch 1"
+    );
+    assert!(error.is_numerical());
 }
 
 /// ANFIS trains a system with an input that has no sets and a point output range (both allowed
