@@ -476,3 +476,17 @@ pub fn relaxed_system() -> FuzzySystem {
         .build()
         .expect("validation accepts empty inputs and point output ranges")
 }
+
+/// A system without rules (a `.fis` file may declare `NumRules=0`): one input with one set, one
+/// output on `[2, 8]` (so "no rule fired" falls back to 5).
+pub fn without_rules() -> FuzzySystem {
+    FuzzySystem::builder("empty")
+        .input(
+            "x",
+            [0.0, 1.0],
+            [("lo", MembershipFn::triangle(0.0, 0.0, 0.5))],
+        )
+        .output("y", [2.0, 8.0], [("a", OutputFn::Constant(2.0))])
+        .build()
+        .unwrap()
+}

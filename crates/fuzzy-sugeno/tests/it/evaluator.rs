@@ -1,7 +1,7 @@
 //! The evaluator against an independent reference, by-hand values, the hull property and every
 //! error path and policy.
 
-use crate::common::{Rng, random_point, random_system, reference_eval};
+use crate::common::{self, Rng, random_point, random_system, reference_eval};
 use fuzzy_sugeno::{
     AndMethod, Connective, Defuzzification, EvalOptions, Evaluator, FuzzyError, FuzzySystem,
     MembershipFn, NoRuleFired, OrMethod, OutOfRange, OutputFn,
@@ -133,15 +133,7 @@ fn the_no_rule_fired_policy_is_applied() {
 /// one point and a batch both give the no-rule-fired policy's value.
 #[test]
 fn a_system_without_rules_fires_none() {
-    let empty = FuzzySystem::builder("empty")
-        .input(
-            "x",
-            [0.0, 1.0],
-            [("lo", MembershipFn::triangle(0.0, 0.0, 0.5))],
-        )
-        .output("y", [2.0, 8.0], [("a", OutputFn::Constant(2.0))])
-        .build()
-        .unwrap();
+    let empty = common::without_rules();
     let mut evaluator = Evaluator::new(empty.clone());
     let mut out = [0.0];
     evaluator.eval(&[0.2], &mut out).unwrap();

@@ -7,8 +7,7 @@ use crate::common;
 
 use crate::common::{Rng, random_point, random_system};
 use fuzzy_sugeno::{
-    EvalOptions, Evaluator, FuzzyError, FuzzySystem, MembershipFn, NoRuleFired, OutOfRange,
-    OutputFn, paper_controller,
+    EvalOptions, Evaluator, FuzzyError, FuzzySystem, NoRuleFired, OutOfRange, paper_controller,
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -281,15 +280,7 @@ fn empty_inputs_and_point_output_ranges_in_c_match_rust() {
 /// A system without rules exports, and in C as in Rust no rule fires: the fallback everywhere.
 #[test]
 fn a_system_without_rules_in_c_matches_rust() {
-    let system = FuzzySystem::builder("empty")
-        .input(
-            "x",
-            [0.0, 1.0],
-            [("lo", MembershipFn::triangle(0.0, 0.0, 0.5))],
-        )
-        .output("y", [2.0, 8.0], [("a", OutputFn::Constant(2.0))])
-        .build()
-        .unwrap();
+    let system = common::without_rules();
     let points = (0..=10).map(|k| (0, vec![k as f64 / 10.0])).collect();
     let strict = EvalOptions {
         no_rule_fired: NoRuleFired::Error,
