@@ -180,7 +180,8 @@ impl Sweep {
         Self::checked(config)
     }
 
-    /// The configuration as a dict.
+    /// The configuration as a dict: `hrm_version`, `scenario`, `settings` (the keywords),
+    /// `inputs` (the SHA-256 of the scenario and its files).
     #[getter]
     fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         json_to_py(py, &self.to_json()?)

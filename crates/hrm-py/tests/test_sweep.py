@@ -26,7 +26,8 @@ def test_plan():
     assert shards[1] == [1, 6, 11]
     with pytest.raises(hrm.InvalidInput, match="K/N"):
         sweep.shard_runs(6, 5)
-    assert sweep.config["noise_levels"] == [0.0, 0.01] and sweep.scenario.duration == 0.1
+    assert sweep.config["settings"]["noise_levels"] == [0.0, 0.01] and sweep.scenario.duration == 0.1
+    assert sweep.config["settings"]["controllers"] == ["pd", "fuzzy"] and sweep.config["settings"]["base_seed"] == 5
     with pytest.raises(hrm.InvalidInput, match="ascending"):
         hrm.Sweep("paper-responses-step", noise_levels=[0.01, 0.0], seeds=1)
     with pytest.raises(hrm.InvalidInput, match="seeds must be at least 1"):

@@ -236,7 +236,7 @@ class Sweep:
         """Noise levels x controllers x seeds."""
     @property
     def config(self) -> Dict[str, Any]:
-        """The configuration as a dict."""
+        """The configuration as a dict: hrm_version, scenario, settings (the keywords), inputs."""
     @property
     def scenario(self) -> Scenario:
         """The scenario swept (a copy)."""
