@@ -36,7 +36,7 @@ pub struct SweepConfig {
 pub struct RunId {
     /// The run's index in the fixed enumeration.
     pub index: usize,
-    /// Position of its noise level in [`SweepConfig::noise_levels`].
+    /// Position of its noise level in [`SweepSettings::noise_levels`].
     pub level_index: usize,
     /// Its noise level (rad).
     pub noise_level: f64,
