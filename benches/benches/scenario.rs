@@ -12,8 +12,8 @@
 //! `scenario_group/alone` and `scenario_group/lockstep`: one SIMD group's worth of
 //! `paper-tracking` runs (8 with AVX-512), each with its own seed of sensor noise
 //! (`L = 0.01` rad, as a sweep runs them), run one after the other and as one `Lockstep` group
-//! whose RK4 stages are evaluated together; Criterion's throughput is in runs, so both read as
-//! time per run.
+//! whose RK4 stages are evaluated together and whose reference is sampled once for all runs;
+//! Criterion's throughput is in runs, so both read as time per run.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use sim_core::{ControllerKind, Lockstep, NoiseSpec, Scenario, Simulation};

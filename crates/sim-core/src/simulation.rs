@@ -289,6 +289,11 @@ pub struct Simulation {
     /// Scratch for the measured `[a, a_dot]`.
     measured: Vec<f64>,
     sample: ControlSample,
+    /// What the reference is as a function of time, when known: runs with equal keys sample the
+    /// same values, so a lock-step group samples it once for all of them. Set by
+    /// [`Scenario::build`](crate::Scenario::build) (the reference's settings and the arm's
+    /// length and modal family); `None` for a reference handed to [`new`](Self::new).
+    reference_key: Option<String>,
 }
 
 impl Simulation {
@@ -364,6 +369,7 @@ impl Simulation {
         let data = ReducedData::new(&model);
         let stepper = Stepper::new(settings.integrator, 2 * m);
         let mut simulation = Self {
+            reference_key: None,
             plant: Plant {
                 model,
                 data,
@@ -393,6 +399,13 @@ impl Simulation {
     /// The reduced model being simulated.
     pub fn model(&self) -> &ReducedModel {
         &self.plant.model
+    }
+
+    /// The simulation with its reference known as `key` (see the field's docs): runs of a
+    /// lock-step group with equal keys share their reference samples.
+    pub(crate) fn with_reference_key(mut self, key: String) -> Self {
+        self.reference_key = Some(key);
+        self
     }
 
     /// The settings of the loop.
@@ -591,6 +604,13 @@ impl Simulation {
     /// `self.sample`; its acceleration and steps are set by [`integrate`](Self::integrate) or
     /// [`acceleration`](Self::acceleration)).
     fn take_sample(&mut self) -> Result<(), SimError> {
+        self.take_sample_with(None)
+    }
+
+    /// [`take_sample`](Self::take_sample) with the reference at the current time already
+    /// sampled (`shared`, by another run of a lock-step group with the same
+    /// [`reference_key`](Self::reference_key)), or sampled here (`None`).
+    fn take_sample_with(&mut self, shared: Option<&ReferenceSample>) -> Result<(), SimError> {
         let m = self.n_coords();
         let t = self.time();
         let sample = &mut self.sample;
@@ -598,17 +618,11 @@ impl Simulation {
         sample.steps = (0, 0);
         sample.state.a.copy_from_slice(&self.y[..m]);
         sample.state.a_dot.copy_from_slice(&self.y[m..]);
-        self.reference.sample(t, &mut sample.reference)?;
-        // Field by field: a derived `clone_from` would allocate.
-        sample.command.a.copy_from_slice(&sample.reference.a);
-        sample
-            .command
-            .a_dot
-            .copy_from_slice(&sample.reference.a_dot);
-        sample
-            .command
-            .a_ddot
-            .copy_from_slice(&sample.reference.a_ddot);
+        match shared {
+            Some(reference) => sample.reference.copy_from(reference),
+            None => self.reference.sample(t, &mut sample.reference)?,
+        }
+        sample.command.copy_from(&sample.reference);
         if let Some(noise) = &mut self.reference_noise {
             noise.perturb(&mut sample.command.a);
         }

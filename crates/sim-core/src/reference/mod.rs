@@ -41,6 +41,13 @@ impl ReferenceSample {
     pub fn n_coords(&self) -> usize {
         self.a.len()
     }
+
+    /// Copies `other` (of the same size) into this sample without allocating.
+    pub fn copy_from(&mut self, other: &Self) {
+        self.a.copy_from_slice(&other.a);
+        self.a_dot.copy_from_slice(&other.a_dot);
+        self.a_ddot.copy_from_slice(&other.a_ddot);
+    }
 }
 
 /// A desired motion of the `m` modal coordinates over time.

@@ -138,7 +138,19 @@ impl Scenario {
                 Some(ModalState { a, a_dot })
             }
         };
-        Simulation::new(model, reference, controller, settings, initial)
+        // The reference as a function of time is what `build_reference` builds it from.
+        let reference_key = serde_json::to_string(&(
+            &self.reference,
+            model.chain().total_length(),
+            self.modal.harmonics,
+            self.alpha0,
+            m,
+        ))
+        .map_err(|e| SimError::setting("reference", e.to_string()))?;
+        Ok(
+            Simulation::new(model, reference, controller, settings, initial)?
+                .with_reference_key(reference_key),
+        )
     }
 }
 

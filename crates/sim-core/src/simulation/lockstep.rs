@@ -3,12 +3,17 @@
 //! [`forward_dynamics_batch`], SIMD across the runs.
 //!
 //! Each run keeps everything of its own: controller, noise streams, reference, integrator
-//! workspace, record. Only the right-hand side of the RK4 stages is shared: at stage `s` of a
+//! workspace, record. What is shared is the right-hand side of the RK4 stages: at stage `s` of a
 //! step, every run's stage state is gathered into the batch's arrays, the batch evaluates them
 //! (each state's result the same bits as one [`forward_dynamics`] call), and each run gets its
 //! derivative back. The stages themselves are [`Rk4`]'s own code ([`Rk4::stage`],
 //! [`Rk4::finish_step`]), the code of a run integrated alone, so a run gives the same bits in a
 //! group as alone.
+//!
+//! Runs built from scenarios with the same reference (a sweep's runs, which differ in noise and
+//! seed) also share their reference samples: the reference is a function of time, so the first
+//! run sampled at a controller sample hands its sample to the others instead of each computing
+//! it again (for a path followed by inverse kinematics, about a quarter of a run alone).
 //!
 //! Adaptive Dormand-Prince runs choose their own step sizes, so their stages do not line up:
 //! a group of them integrates each run alone (the group still steps them together). So does a
@@ -18,6 +23,7 @@
 use super::{Progress, Run, RunFailure, Simulation, Stepper};
 use crate::error::SimError;
 use crate::ode::{OdeError, Rk4, Stats};
+use crate::reference::ReferenceSample;
 use crate::simulation::{Integrator, Observation};
 use modal_reduce::{
     ReducedBatchData, ReducedData, ReducedModel, batch_lanes, forward_dynamics,
@@ -70,6 +76,11 @@ pub struct Lockstep {
     together: Option<f64>,
     /// States per SIMD group of the batch ([`batch_lanes`]).
     lanes: usize,
+    /// Whether every run's reference is the same function of time (equal reference keys of
+    /// [`Scenario::build`](crate::Scenario::build)), sampled once a controller sample.
+    shares_reference: bool,
+    /// The shared reference sample of the current controller sample.
+    reference: ReferenceSample,
     /// The runs evaluated at the current stage, slot by slot.
     slots: Vec<usize>,
     /// Per slot, `m` values each (the slots padded to whole SIMD groups): the stage's
@@ -126,6 +137,8 @@ impl Lockstep {
             _ => None,
         };
         let values = runs.len().div_ceil(lanes) * lanes * model.n_coords();
+        let shares_reference = first.reference_key.is_some()
+            && runs.iter().all(|r| r.reference_key == first.reference_key);
         for run in &mut runs {
             run.reset();
         }
@@ -138,10 +151,12 @@ impl Lockstep {
             a_dot: vec![0.0; values],
             tau_star: vec![0.0; values],
             a_ddot: vec![0.0; values],
+            reference: ReferenceSample::zeros(model.n_coords()),
             runs,
             model,
             together,
             lanes,
+            shares_reference,
         })
     }
 
@@ -247,12 +262,27 @@ impl Lockstep {
             .collect()
     }
 
-    /// The controller sample of every running run ([`Simulation::take_sample`]).
+    /// Whether the runs share their reference samples (see the type's docs): they were built by
+    /// [`Scenario::build`](crate::Scenario::build) from scenarios with the same reference, arm
+    /// length and modal family.
+    pub fn shares_reference(&self) -> bool {
+        self.shares_reference
+    }
+
+    /// The controller sample of every running run ([`Simulation::take_sample`]); when the runs
+    /// share their reference, the first run whose sample succeeds samples it for the others.
     fn take_samples(&mut self) {
+        let mut shared = false;
         for (run, stopped) in self.runs.iter_mut().zip(&mut self.stopped) {
-            if stopped.is_none() {
-                *stopped = run.take_sample().err();
+            if stopped.is_some() {
+                continue;
             }
+            let result = run.take_sample_with(shared.then_some(&self.reference));
+            if result.is_ok() && self.shares_reference && !shared {
+                self.reference.copy_from(&run.sample.reference);
+                shared = true;
+            }
+            *stopped = result.err();
         }
     }
 

@@ -3,7 +3,8 @@
 //! group's size (smaller than a SIMD group, a whole number of them, with a remainder), however
 //! its runs differ (seed, noise level, controller) and wherever some of them stop (a controller
 //! error, a non-finite torque, dynamics that overflow inside an RK4 stage, a runaway error);
-//! the same for the loop stepped by hand, for Dormand-Prince groups and for a sweep's groups.
+//! the same for the loop stepped by hand, for Dormand-Prince groups and for a sweep's groups,
+//! whose runs share their reference samples.
 
 use backbone_kin::ModalMap;
 use manip_dyn::ChainModel;
@@ -13,7 +14,7 @@ use sim_core::controller::{ControlContext, Controller, ControllerError, PdContro
 use sim_core::ode::Tolerances;
 use sim_core::reference::Sinusoid;
 use sim_core::study::{self, Shard, SweepConfig, SweepSettings};
-use sim_core::{Integrator, Lockstep, LoopSettings, Scenario, Simulation};
+use sim_core::{Integrator, Lockstep, LoopSettings, NoiseSpec, Scenario, Simulation};
 use std::f64::consts::FRAC_PI_2;
 use test_support::config::check_scaled;
 
@@ -341,4 +342,44 @@ fn a_sweep_in_lock_step_gives_every_run_as_run_alone() {
         }
         assert!(failed > 0, "some runs must stop mid-way");
     }
+}
+
+/// Runs of scenarios that differ in noise and seed share their reference samples (here a path
+/// followed by inverse kinematics, with reference noise too) and still give each run alone; a
+/// run whose reference differs, or a reference handed to `Simulation::new`, shares nothing.
+#[test]
+fn runs_of_one_reference_share_its_samples_and_give_each_run_alone() {
+    let mut scenario = Scenario::builtin("paper-tracking").unwrap();
+    scenario.duration = 0.05;
+    let m = scenario.n_coords();
+    let scenarios: Vec<Scenario> = (0..5)
+        .map(|k| {
+            let mut run = scenario.clone();
+            run.seed = k + 1;
+            run.noise = NoiseSpec::uniform(m, 1e-3 * k as f64, 1e-2, 0.5);
+            run
+        })
+        .collect();
+    let build = |scenarios: &[Scenario]| -> Vec<Simulation> {
+        scenarios.iter().map(|s| s.build().unwrap()).collect()
+    };
+    let check = |scenarios: &[Scenario], shares: bool| {
+        let mut group = Lockstep::new(build(scenarios)).unwrap();
+        assert_eq!(group.shares_reference(), shares);
+        for (k, (together, scenario)) in group.run().iter().zip(scenarios).enumerate() {
+            let alone = scenario.build().unwrap().run();
+            assert_eq!(exact(together), exact(&alone), "run {k}");
+        }
+    };
+    check(&scenarios, true);
+    let mut other = scenarios.clone();
+    other[3].reference = Scenario::builtin("paper-responses-step").unwrap().reference;
+    check(&other, false);
+    let spec = Spec {
+        seed: 1,
+        noise: 0.0,
+        stop: Stop::Never,
+    };
+    let handed = (0..3).map(|_| simulation(spec, RK4)).collect();
+    assert!(!Lockstep::new(handed).unwrap().shares_reference());
 }
