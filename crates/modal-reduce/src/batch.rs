@@ -236,14 +236,14 @@ fn group<S: Simd, const M: usize>(
     let zero = Pack::splat(simd, 0.0);
     let (mut sums, mut mass) = ([[zero; M]; M], [[zero; M]; M]);
     let (mut coriolis_sums, mut gravity_sums) = ([zero; M], [zero; M]);
-    let (mut coriolis, mut gravity, mut cos_moment) = ([zero; M], [zero; M], [zero; M]);
+    let (mut coriolis, mut gravity, mut v) = ([zero; M], [zero; M], [zero; M]);
     let mut joint = [[zero; 2]; M];
     let mut terms = Terms {
         mass: sums.as_flattened_mut(),
         coriolis: &mut coriolis_sums,
         gravity: &mut gravity_sums,
         joint: &mut joint,
-        cos_moment: &mut cos_moment,
+        v: &mut v,
     };
     let layout = StateLanes(simd);
     accumulate(layout, model, &a, &a_dot, M, links, &mut terms);

@@ -69,6 +69,8 @@ pub struct ReducedModel {
     /// respect to `a` (row-major, `n x m`), followed by [`LINK_PADDING`] zeros so that a whole
     /// register loads from the start of any row.
     angle_rows: Vec<f64>,
+    /// Row `l` is `S_l Phi_l` (see [`LinkConstants::first_moment`]), laid out like `angle_rows`.
+    moment_rows: Vec<f64>,
     links: LinkConstants,
     /// `K = sum_l h_ll Phi_l^T Phi_l` (row-major `m x m`): the constant part of `M*`, followed
     /// by [`LINK_PADDING`] zeros like `angle_rows`.
@@ -129,6 +131,7 @@ impl ReducedModel {
             beyond[l] = beyond[l + 1] + chain_links[l + 1].mass;
         }
         let mut angle_rows = vec![0.0; n * m + LINK_PADDING];
+        let mut moment_rows = vec![0.0; n * m + LINK_PADDING];
         let padded = n.next_multiple_of(LINK_PADDING);
         let mut links = LinkConstants {
             length: vec![0.0; padded],
@@ -156,6 +159,9 @@ impl ReducedModel {
             angle_offset += map.offset()[l];
             links.length[l] = link.length;
             links.first_moment[l] = link.mass * link.com + link.length * beyond[l];
+            for (k, &entry) in running.iter().enumerate() {
+                moment_rows[l * m + k] = links.first_moment[l] * entry;
+            }
             links.angle_offset[l] = angle_offset;
             let diagonal = link.inertia
                 + link.mass * link.com * link.com
@@ -170,6 +176,7 @@ impl ReducedModel {
             chain,
             map,
             angle_rows,
+            moment_rows,
             links,
             constant_mass,
         })
@@ -204,6 +211,11 @@ impl ReducedModel {
     /// [`LINK_PADDING`] zeros.
     pub(crate) fn angle_rows(&self) -> &[f64] {
         &self.angle_rows
+    }
+
+    /// Row-major `n x m` rows `S_l Phi_l`, followed by [`LINK_PADDING`] zeros.
+    pub(crate) fn moment_rows(&self) -> &[f64] {
+        &self.moment_rows
     }
 
     /// The constant part `K` of `M*`, row-major `m x m`, followed by [`LINK_PADDING`] zeros.
