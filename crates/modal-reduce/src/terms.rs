@@ -74,6 +74,11 @@
 //! `sum_l (w_l . q_l) (S_l Phi_l)^T` and `G*` as `g sum_l cos(phi_l) (S_l Phi_l)^T`, one
 //! multiplication by `S_l` fewer per coordinate and link than with `Phi_l`.
 //!
+//! A free base angle `alpha0` adds to every absolute angle: its column of `Phi` is all ones
+//! ([`ReducedModel::unit_column`]). A batch whose last coordinate is such a column skips the
+//! multiplications by it (in `phi_l`, `phi_dot_l` and the update of `P_l`), which gives the same
+//! bits, since `x * 1 = x` exactly: four vector operations fewer a link.
+//!
 //! The kernel is written once, generic over a `Layout`: how its numbers sit in SIMD registers.
 //! One state either has its coordinates side by side in one register (`CoordinateLanes`: each
 //! per-coordinate loop of the pass is one vector operation, and the pre-pass runs across links,
@@ -345,6 +350,12 @@ pub(crate) trait Layout: Copy {
     fn constant_row(self, row: &[f64], chunk: usize) -> Self::Register;
     /// Coordinate `k` of the row held in the registers `row`.
     fn coordinate(self, row: &[Self::Register], k: usize) -> Self::Value;
+    /// `x` times register `chunk` of the constant row `row` of `Phi` (see
+    /// [`constant_row`](Self::constant_row)).
+    #[inline(always)]
+    fn times_phi(self, x: Self::Register, row: &[f64], chunk: usize) -> Self::Register {
+        x * self.constant_row(row, chunk)
+    }
     /// How many of the [`PRODUCTS`] the pre-pass stores: all, or only the rate `phi_dot_l` (in
     /// the first one's place) when the pass computes them (a batch, whose pre-pass is not
     /// vectorised across links any more than its pass).
@@ -518,7 +529,22 @@ impl<S: Simd> Layout for OneStateScalar<S> {
 /// Several states side by side, lane `i` of every register holding state `i`; one coordinate a
 /// register.
 #[derive(Clone, Copy)]
-pub(crate) struct StateLanes<S: Simd>(pub(crate) S);
+pub(crate) struct StateLanes<S: Simd> {
+    simd: S,
+    /// A coordinate whose column of `Phi` is all ones ([`ReducedModel::unit_column`]), or
+    /// `usize::MAX`: the multiplications by that column are skipped, which gives the same bits
+    /// (`x * 1 = x` exactly) with fewer operations.
+    unit: usize,
+}
+
+impl<S: Simd> StateLanes<S> {
+    /// The layout of `S`, skipping the multiplications by the column `unit` of `Phi` (all ones;
+    /// `usize::MAX` for none).
+    #[inline(always)]
+    pub(crate) fn new(simd: S, unit: usize) -> Self {
+        Self { simd, unit }
+    }
+}
 
 impl<S: Simd> Layout for StateLanes<S> {
     type Register = Pack<S>;
@@ -535,7 +561,7 @@ impl<S: Simd> Layout for StateLanes<S> {
         moment: f64,
         length: f64,
     ) -> [Pack<S>; 2 + PRODUCTS] {
-        let simd = self.0;
+        let simd = self.simd;
         let angles = values.load_trig_rate(simd, i);
         let [sin, cos, _] = angles;
         let moment = Pack::splat(simd, moment);
@@ -545,18 +571,18 @@ impl<S: Simd> Layout for StateLanes<S> {
 
     #[inline(always)]
     fn cos(self, values: &LinkValues<'_>, i: usize) -> Pack<S> {
-        let [_, cos, _] = values.load_trig_rate::<Pack<S>>(self.0, i);
+        let [_, cos, _] = values.load_trig_rate::<Pack<S>>(self.simd, i);
         cos
     }
 
     #[inline(always)]
     fn register_context(self) -> S {
-        self.0
+        self.simd
     }
 
     #[inline(always)]
     fn value_context(self) -> S {
-        self.0
+        self.simd
     }
 
     #[inline(always)]
@@ -571,12 +597,21 @@ impl<S: Simd> Layout for StateLanes<S> {
 
     #[inline(always)]
     fn constant_row(self, row: &[f64], chunk: usize) -> Pack<S> {
-        Pack::splat(self.0, row[chunk])
+        Pack::splat(self.simd, row[chunk])
     }
 
     #[inline(always)]
     fn coordinate(self, row: &[Pack<S>], k: usize) -> Pack<S> {
         row[k]
+    }
+
+    #[inline(always)]
+    fn times_phi(self, x: Pack<S>, row: &[f64], chunk: usize) -> Pack<S> {
+        if chunk == self.unit {
+            x
+        } else {
+            x * self.constant_row(row, chunk)
+        }
     }
 
     #[inline(always)]
@@ -587,7 +622,7 @@ impl<S: Simd> Layout for StateLanes<S> {
         a_dot: &[Pack<S>],
         links: &mut LinkBuffers<'_>,
     ) {
-        let simd = self.0;
+        let simd = self.simd;
         let width = S::F64_LANES;
         let constants = model.link_constants();
         let m = a.len();
@@ -599,6 +634,7 @@ impl<S: Simd> Layout for StateLanes<S> {
                 a,
                 a_dot,
                 phi,
+                unit: self.unit,
             };
             let angle_rate = link_angle_rate(simd, Pack::splat(simd, offset), &inputs);
             links.store_angle_rate(l, width, angle_rate);
@@ -676,12 +712,12 @@ impl<L: Lane> LinkInputs<L> for AcrossLinks<'_, L> {
     }
 
     #[inline(always)]
-    fn term(&self, k: usize) -> (L, L, L) {
+    fn terms(&self, k: usize) -> (L, L) {
         let column = self.model.link_constants().angle_column(k);
+        let phi = L::load(self.context, &column[self.l..]);
         (
-            L::splat(self.context, self.a[k]),
-            L::splat(self.context, self.a_dot[k]),
-            L::load(self.context, &column[self.l..]),
+            L::splat(self.context, self.a[k]) * phi,
+            L::splat(self.context, self.a_dot[k]) * phi,
         )
     }
 }
@@ -692,6 +728,8 @@ struct AcrossStates<'a, S: Simd> {
     a: &'a [Pack<S>],
     a_dot: &'a [Pack<S>],
     phi: &'a [f64],
+    /// The column of ones of `Phi`, or `usize::MAX` (see [`StateLanes`]).
+    unit: usize,
 }
 
 impl<S: Simd> LinkInputs<Pack<S>> for AcrossStates<'_, S> {
@@ -701,12 +739,12 @@ impl<S: Simd> LinkInputs<Pack<S>> for AcrossStates<'_, S> {
     }
 
     #[inline(always)]
-    fn term(&self, k: usize) -> (Pack<S>, Pack<S>, Pack<S>) {
-        (
-            self.a[k],
-            self.a_dot[k],
-            Pack::splat(self.simd, self.phi[k]),
-        )
+    fn terms(&self, k: usize) -> (Pack<S>, Pack<S>) {
+        if k == self.unit {
+            return (self.a[k], self.a_dot[k]);
+        }
+        let phi = Pack::splat(self.simd, self.phi[k]);
+        (self.a[k] * phi, self.a_dot[k] * phi)
     }
 }
 
@@ -714,8 +752,8 @@ impl<S: Simd> LinkInputs<Pack<S>> for AcrossStates<'_, S> {
 trait LinkInputs<L> {
     /// The number of coordinates `m`.
     fn coords(&self) -> usize;
-    /// `(a_k, a_dot_k, (Phi_l)_k)`.
-    fn term(&self, k: usize) -> (L, L, L);
+    /// `(a_k (Phi_l)_k, a_dot_k (Phi_l)_k)`.
+    fn terms(&self, k: usize) -> (L, L);
 }
 
 /// `[phi_l, phi_dot_l]` of one link (or one lane's link each), from its angle offset `phi0_l`
@@ -729,9 +767,9 @@ fn link_angle_rate<L: Lane>(
     let mut angle = angle_offset;
     let mut rate = L::splat(context, 0.0);
     for k in 0..inputs.coords() {
-        let (a, a_dot, phi) = inputs.term(k);
-        angle = angle + a * phi;
-        rate = rate + a_dot * phi;
+        let (angle_term, rate_term) = inputs.terms(k);
+        angle = angle + angle_term;
+        rate = rate + rate_term;
     }
     [angle, rate]
 }
@@ -944,9 +982,12 @@ pub(crate) fn accumulate<Y: Layout>(
                 }
             }
             for (c, pair) in joint.iter_mut().enumerate() {
-                let phi = layout.constant_row(row, c);
                 let [px, py] = *pair;
-                *pair = [px - l_sin * phi, py + l_cos * phi];
+                let (l_sin_phi, l_cos_phi) = (
+                    layout.times_phi(l_sin, row, c),
+                    layout.times_phi(l_cos, row, c),
+                );
+                *pair = [px - l_sin_phi, py + l_cos_phi];
             }
             q = [q[0] - drop_x, q[1] - drop_y];
         }
