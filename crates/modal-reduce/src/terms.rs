@@ -75,7 +75,7 @@
 //! multiplication by `S_l` fewer per coordinate and link than with `Phi_l`.
 //!
 //! A free base angle `alpha0` adds to every absolute angle: its column of `Phi` is all ones
-//! ([`ReducedModel::unit_column`]). A batch whose last coordinate is such a column skips the
+//! (`ReducedModel::unit_column`). A batch whose last coordinate is such a column skips the
 //! multiplications by it (in `phi_l`, `phi_dot_l` and the update of `P_l`), which gives the same
 //! bits, since `x * 1 = x` exactly: four vector operations fewer a link.
 //!
