@@ -144,20 +144,31 @@ impl WithSimd for Batch<'_> {
 
     #[inline(always)]
     fn with_simd<S: Simd>(mut self, simd: S) -> Self::Output {
-        match self.model.n_coords() {
-            2 => self.run::<S, 2>(simd),
-            3 => self.run::<S, 3>(simd),
-            4 => self.run::<S, 4>(simd),
-            5 => self.run::<S, 5>(simd),
+        // With the last coordinate's column of Phi all ones (alpha0 free), a kernel that skips
+        // the multiplications by it.
+        let m = self.model.n_coords();
+        match (m, self.model.unit_column() == Some(m - 1)) {
+            (2, false) => self.run::<S, 2, false>(simd),
+            (2, true) => self.run::<S, 2, true>(simd),
+            (3, false) => self.run::<S, 3, false>(simd),
+            (3, true) => self.run::<S, 3, true>(simd),
+            (4, false) => self.run::<S, 4, false>(simd),
+            (4, true) => self.run::<S, 4, true>(simd),
+            (5, false) => self.run::<S, 5, false>(simd),
+            (5, true) => self.run::<S, 5, true>(simd),
             _ => self.one_at_a_time(0),
         }
     }
 }
 
 impl Batch<'_> {
-    /// Whole groups of `S::F64_LANES` states in SIMD, the rest one at a time.
+    /// Whole groups of `S::F64_LANES` states in SIMD, the rest one at a time; `UNIT_LAST`: the
+    /// last coordinate's column of `Phi` is all ones.
     #[inline(always)]
-    fn run<S: Simd, const M: usize>(mut self, simd: S) -> Result<(), BatchError> {
+    fn run<S: Simd, const M: usize, const UNIT_LAST: bool>(
+        mut self,
+        simd: S,
+    ) -> Result<(), BatchError> {
         let width = S::F64_LANES;
         if width > MAX_WIDTH {
             return self.one_at_a_time(0);
@@ -175,7 +186,7 @@ impl Batch<'_> {
                 links: self.model.n_links(),
             };
             let out = &mut self.a_ddot[range];
-            if !group::<S, M>(simd, self.model, links, inputs, out) {
+            if !group::<S, M, UNIT_LAST>(simd, self.model, links, inputs, out) {
                 self.states(first, first + width)?;
             }
         }
@@ -212,7 +223,7 @@ impl Batch<'_> {
 /// inputs into lanes, runs the kernel and scatters the accelerations. `false` if an input is not
 /// finite or any state failed (`out` is then unspecified).
 #[inline(always)]
-fn group<S: Simd, const M: usize>(
+fn group<S: Simd, const M: usize, const UNIT_LAST: bool>(
     simd: S,
     model: &ReducedModel,
     links: LinkBuffers<'_>,
@@ -236,16 +247,16 @@ fn group<S: Simd, const M: usize>(
     let zero = Pack::splat(simd, 0.0);
     let (mut sums, mut mass) = ([[zero; M]; M], [[zero; M]; M]);
     let (mut coriolis_sums, mut gravity_sums) = ([zero; M], [zero; M]);
-    let (mut coriolis, mut gravity, mut cos_moment) = ([zero; M], [zero; M], [zero; M]);
+    let (mut coriolis, mut gravity, mut v) = ([zero; M], [zero; M], [zero; M]);
     let mut joint = [[zero; 2]; M];
     let mut terms = Terms {
         mass: sums.as_flattened_mut(),
         coriolis: &mut coriolis_sums,
         gravity: &mut gravity_sums,
         joint: &mut joint,
-        cos_moment: &mut cos_moment,
+        v: &mut v,
     };
-    let layout = StateLanes(simd);
+    let layout = StateLanes::new(simd, if UNIT_LAST { M - 1 } else { usize::MAX });
     accumulate(layout, model, &a, &a_dot, M, links, &mut terms);
     extract(
         layout,

@@ -99,8 +99,8 @@ pub(crate) struct TermScratch {
     pub(crate) gravity: Vec<f64>,
     /// `m`: the columns of the prefix sum `P_l`.
     pub(crate) joint: Vec<Pair<f64>>,
-    /// `m`: `S_l v_l`.
-    pub(crate) cos_moment: Vec<f64>,
+    /// `m`: `v_l`.
+    pub(crate) v: Vec<f64>,
 }
 
 impl ReducedData {
@@ -127,7 +127,7 @@ impl ReducedData {
                 coriolis: vec![0.0; m],
                 gravity: vec![0.0; m],
                 joint: vec![[0.0; 2]; m],
-                cos_moment: vec![0.0; m],
+                v: vec![0.0; m],
             },
             theta: vec![0.0; n],
             theta_dot: vec![0.0; n],

@@ -69,6 +69,10 @@ pub struct ReducedModel {
     /// respect to `a` (row-major, `n x m`), followed by [`LINK_PADDING`] zeros so that a whole
     /// register loads from the start of any row.
     angle_rows: Vec<f64>,
+    /// Row `l` is `S_l Phi_l` (see [`LinkConstants::first_moment`]), laid out like `angle_rows`.
+    moment_rows: Vec<f64>,
+    /// The first coordinate whose column of `Phi` is all ones (a free base angle `alpha0`).
+    unit_column: Option<usize>,
     links: LinkConstants,
     /// `K = sum_l h_ll Phi_l^T Phi_l` (row-major `m x m`): the constant part of `M*`, followed
     /// by [`LINK_PADDING`] zeros like `angle_rows`.
@@ -129,6 +133,7 @@ impl ReducedModel {
             beyond[l] = beyond[l + 1] + chain_links[l + 1].mass;
         }
         let mut angle_rows = vec![0.0; n * m + LINK_PADDING];
+        let mut moment_rows = vec![0.0; n * m + LINK_PADDING];
         let padded = n.next_multiple_of(LINK_PADDING);
         let mut links = LinkConstants {
             length: vec![0.0; padded],
@@ -156,6 +161,9 @@ impl ReducedModel {
             angle_offset += map.offset()[l];
             links.length[l] = link.length;
             links.first_moment[l] = link.mass * link.com + link.length * beyond[l];
+            for (k, &entry) in running.iter().enumerate() {
+                moment_rows[l * m + k] = links.first_moment[l] * entry;
+            }
             links.angle_offset[l] = angle_offset;
             let diagonal = link.inertia
                 + link.mass * link.com * link.com
@@ -166,10 +174,14 @@ impl ReducedModel {
                 }
             }
         }
+        let unit_column =
+            (0..m).find(|&k| angle_rows[..n * m].chunks_exact(m).all(|row| row[k] == 1.0));
         Ok(Self {
             chain,
             map,
             angle_rows,
+            moment_rows,
+            unit_column,
             links,
             constant_mass,
         })
@@ -204,6 +216,18 @@ impl ReducedModel {
     /// [`LINK_PADDING`] zeros.
     pub(crate) fn angle_rows(&self) -> &[f64] {
         &self.angle_rows
+    }
+
+    /// The first coordinate whose column of `Phi` is exactly one for every link, if any: a free
+    /// base angle `alpha0`, which adds to every absolute angle. A batch skips the
+    /// multiplications by it (the same bits).
+    pub(crate) fn unit_column(&self) -> Option<usize> {
+        self.unit_column
+    }
+
+    /// Row-major `n x m` rows `S_l Phi_l`, followed by [`LINK_PADDING`] zeros.
+    pub(crate) fn moment_rows(&self) -> &[f64] {
+        &self.moment_rows
     }
 
     /// The constant part `K` of `M*`, row-major `m x m`, followed by [`LINK_PADDING`] zeros.
@@ -271,4 +295,20 @@ fn check_column_rank(map: &ModalMap) -> Result<(), ReduceError> {
         return Err(deficient(min_eigenvalue));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_free_base_angle_is_the_unit_column_and_a_fixed_one_leaves_none() {
+        let chain = ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap();
+        let paper = ReducedModel::new(chain.clone(), ModalMap::paper(10).unwrap()).unwrap();
+        // (a1, a2, alpha0): alpha0 adds to every absolute angle.
+        assert_eq!(paper.unit_column(), Some(2));
+        let fixed = ModalMap::uniform(10, 2, BaseAngle::Fixed(0.3)).unwrap();
+        let fixed = ReducedModel::new(chain, fixed).unwrap();
+        assert_eq!(fixed.unit_column(), None);
+    }
 }

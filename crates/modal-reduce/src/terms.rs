@@ -63,11 +63,21 @@
 //!
 //! A pre-pass computes, for all links at once, what depends on one link only: `phi_l`,
 //! `phi_dot_l`, `sin phi_l`, `cos phi_l` and, for one state, the products `S_l phi_dot_l^2`,
-//! `S_l cos phi_l`, `L_l sin phi_l`, `L_l cos phi_l`, `L_l cos(phi_l) phi_dot_l^2` and
+//! `L_l sin phi_l`, `L_l cos phi_l`, `L_l cos(phi_l) phi_dot_l^2` and
 //! `L_l sin(phi_l) phi_dot_l^2` (the steps of `q_l`): for one state it runs across links, a
 //! register of consecutive links at a time, where the pass could only use one lane for them (a
 //! batch, whose registers hold states either way, computes the products in the pass). Then the
 //! pass runs over the links with what is left, the prefix sums.
+//!
+//! The model holds the rows `S_l Phi_l` besides `Phi_l`, so that `S_l` multiplies no
+//! state-dependent value: `A` is summed as `sum_l (S_l Phi_l)^T v_l^T`, `C*`'s first part as
+//! `sum_l (w_l . q_l) (S_l Phi_l)^T` and `G*` as `g sum_l cos(phi_l) (S_l Phi_l)^T`, one
+//! multiplication by `S_l` fewer per coordinate and link than with `Phi_l`.
+//!
+//! A free base angle `alpha0` adds to every absolute angle: its column of `Phi` is all ones
+//! (`ReducedModel::unit_column`). A batch whose last coordinate is such a column skips the
+//! multiplications by it (in `phi_l`, `phi_dot_l` and the update of `P_l`), which gives the same
+//! bits, since `x * 1 = x` exactly: four vector operations fewer a link.
 //!
 //! The kernel is written once, generic over a `Layout`: how its numbers sit in SIMD registers.
 //! One state either has its coordinates side by side in one register (`CoordinateLanes`: each
@@ -87,9 +97,9 @@ use lane_math::{Lane, Pack, sin_cos_simd};
 use pulp::{Simd, WithSimd};
 
 /// Per-link products the pre-pass leaves for the pass besides the sine and cosine, in this order
-/// in the buffer: `S_l phi_dot_l^2`, `S_l cos phi_l`, `L_l sin phi_l`, `L_l cos phi_l`,
+/// in the buffer: `S_l phi_dot_l^2`, `L_l sin phi_l`, `L_l cos phi_l`,
 /// `L_l cos(phi_l) phi_dot_l^2`, `L_l sin(phi_l) phi_dot_l^2`.
-pub(crate) const PRODUCTS: usize = 6;
+pub(crate) const PRODUCTS: usize = 5;
 
 /// Computes `M*(a)`, `C*(a, a_dot)` and `G*(a)` (eq 14) into `data` in `O(n m^2)`, by prefix
 /// sums along the chain (the default path; see the [module documentation](self) for the
@@ -209,7 +219,7 @@ pub(crate) fn accumulate_in_data<S: Simd>(
         coriolis: &mut scratch.coriolis,
         gravity: &mut scratch.gravity,
         joint: &mut scratch.joint,
-        cos_moment: &mut scratch.cos_moment,
+        v: &mut scratch.v,
     };
     let m = model.n_coords();
     let link_buffers = LinkBuffers {
@@ -264,7 +274,7 @@ impl<const M: usize> StackTerms<M> {
         let zero = Y::Register::splat(layout.register_context(), 0.0);
         // At most M registers a row (one coordinate a register).
         let mut mass = [[zero; M]; M];
-        let (mut coriolis, mut gravity, mut cos_moment) = ([zero; M], [zero; M], [zero; M]);
+        let (mut coriolis, mut gravity, mut v) = ([zero; M], [zero; M], [zero; M]);
         let mut joint = [[zero; 2]; M];
         let links = &mut data.links;
         let link_buffers = LinkBuffers {
@@ -279,7 +289,7 @@ impl<const M: usize> StackTerms<M> {
             coriolis: &mut coriolis,
             gravity: &mut gravity,
             joint: &mut joint,
-            cos_moment: &mut cos_moment,
+            v: &mut v,
         };
         accumulate(layout, model, a, a_dot, M, link_buffers, &mut terms);
         let mut out = Self {
@@ -340,6 +350,12 @@ pub(crate) trait Layout: Copy {
     fn constant_row(self, row: &[f64], chunk: usize) -> Self::Register;
     /// Coordinate `k` of the row held in the registers `row`.
     fn coordinate(self, row: &[Self::Register], k: usize) -> Self::Value;
+    /// `x` times register `chunk` of the constant row `row` of `Phi` (see
+    /// [`constant_row`](Self::constant_row)).
+    #[inline(always)]
+    fn times_phi(self, x: Self::Register, row: &[f64], chunk: usize) -> Self::Register {
+        x * self.constant_row(row, chunk)
+    }
     /// How many of the [`PRODUCTS`] the pre-pass stores: all, or only the rate `phi_dot_l` (in
     /// the first one's place) when the pass computes them (a batch, whose pre-pass is not
     /// vectorised across links any more than its pass).
@@ -357,9 +373,8 @@ pub(crate) trait Layout: Copy {
     /// Whether `G*` is summed in a loop of its own after the pass rather than in it (a batch,
     /// whose pass has no register to spare).
     const GRAVITY_APART: bool;
-    /// `S_l cos phi_l` of link `i` (the second of the [`PRODUCTS`]), as [`link`](Self::link)
-    /// gives it.
-    fn gravity_force(self, values: &LinkValues<'_>, i: usize, moment: f64) -> Self::Value;
+    /// `cos phi_l` of link `i`, as [`link`](Self::link) gives it.
+    fn cos(self, values: &LinkValues<'_>, i: usize) -> Self::Value;
     /// The per-link values of all links into `links` (the pre-pass).
     fn link_values(
         self,
@@ -407,8 +422,8 @@ impl<S: Simd> Layout for CoordinateLanes<S> {
     }
 
     #[inline(always)]
-    fn gravity_force(self, values: &LinkValues<'_>, i: usize, _: f64) -> f64 {
-        values.products[1][i]
+    fn cos(self, values: &LinkValues<'_>, i: usize) -> f64 {
+        values.cos[i]
     }
 
     #[inline(always)]
@@ -469,8 +484,8 @@ impl<S: Simd> Layout for OneStateScalar<S> {
     }
 
     #[inline(always)]
-    fn gravity_force(self, values: &LinkValues<'_>, i: usize, _: f64) -> f64 {
-        values.products[1][i]
+    fn cos(self, values: &LinkValues<'_>, i: usize) -> f64 {
+        values.cos[i]
     }
 
     #[inline(always)]
@@ -514,7 +529,22 @@ impl<S: Simd> Layout for OneStateScalar<S> {
 /// Several states side by side, lane `i` of every register holding state `i`; one coordinate a
 /// register.
 #[derive(Clone, Copy)]
-pub(crate) struct StateLanes<S: Simd>(pub(crate) S);
+pub(crate) struct StateLanes<S: Simd> {
+    simd: S,
+    /// A coordinate whose column of `Phi` is all ones ([`ReducedModel::unit_column`]), or
+    /// `usize::MAX`: the multiplications by that column are skipped, which gives the same bits
+    /// (`x * 1 = x` exactly) with fewer operations.
+    unit: usize,
+}
+
+impl<S: Simd> StateLanes<S> {
+    /// The layout of `S`, skipping the multiplications by the column `unit` of `Phi` (all ones;
+    /// `usize::MAX` for none).
+    #[inline(always)]
+    pub(crate) fn new(simd: S, unit: usize) -> Self {
+        Self { simd, unit }
+    }
+}
 
 impl<S: Simd> Layout for StateLanes<S> {
     type Register = Pack<S>;
@@ -531,28 +561,28 @@ impl<S: Simd> Layout for StateLanes<S> {
         moment: f64,
         length: f64,
     ) -> [Pack<S>; 2 + PRODUCTS] {
-        let simd = self.0;
+        let simd = self.simd;
         let angles = values.load_trig_rate(simd, i);
         let [sin, cos, _] = angles;
         let moment = Pack::splat(simd, moment);
-        let [p0, p1, p2, p3, p4, p5] = link_products(angles, moment, Pack::splat(simd, length));
-        [sin, cos, p0, p1, p2, p3, p4, p5]
+        let [p0, p1, p2, p3, p4] = link_products(angles, moment, Pack::splat(simd, length));
+        [sin, cos, p0, p1, p2, p3, p4]
     }
 
     #[inline(always)]
-    fn gravity_force(self, values: &LinkValues<'_>, i: usize, moment: f64) -> Pack<S> {
-        let [_, cos, _] = values.load_trig_rate::<Pack<S>>(self.0, i);
-        cos * moment
+    fn cos(self, values: &LinkValues<'_>, i: usize) -> Pack<S> {
+        let [_, cos, _] = values.load_trig_rate::<Pack<S>>(self.simd, i);
+        cos
     }
 
     #[inline(always)]
     fn register_context(self) -> S {
-        self.0
+        self.simd
     }
 
     #[inline(always)]
     fn value_context(self) -> S {
-        self.0
+        self.simd
     }
 
     #[inline(always)]
@@ -567,12 +597,21 @@ impl<S: Simd> Layout for StateLanes<S> {
 
     #[inline(always)]
     fn constant_row(self, row: &[f64], chunk: usize) -> Pack<S> {
-        Pack::splat(self.0, row[chunk])
+        Pack::splat(self.simd, row[chunk])
     }
 
     #[inline(always)]
     fn coordinate(self, row: &[Pack<S>], k: usize) -> Pack<S> {
         row[k]
+    }
+
+    #[inline(always)]
+    fn times_phi(self, x: Pack<S>, row: &[f64], chunk: usize) -> Pack<S> {
+        if chunk == self.unit {
+            x
+        } else {
+            x * self.constant_row(row, chunk)
+        }
     }
 
     #[inline(always)]
@@ -583,7 +622,7 @@ impl<S: Simd> Layout for StateLanes<S> {
         a_dot: &[Pack<S>],
         links: &mut LinkBuffers<'_>,
     ) {
-        let simd = self.0;
+        let simd = self.simd;
         let width = S::F64_LANES;
         let constants = model.link_constants();
         let m = a.len();
@@ -595,6 +634,7 @@ impl<S: Simd> Layout for StateLanes<S> {
                 a,
                 a_dot,
                 phi,
+                unit: self.unit,
             };
             let angle_rate = link_angle_rate(simd, Pack::splat(simd, offset), &inputs);
             links.store_angle_rate(l, width, angle_rate);
@@ -672,12 +712,12 @@ impl<L: Lane> LinkInputs<L> for AcrossLinks<'_, L> {
     }
 
     #[inline(always)]
-    fn term(&self, k: usize) -> (L, L, L) {
+    fn terms(&self, k: usize) -> (L, L) {
         let column = self.model.link_constants().angle_column(k);
+        let phi = L::load(self.context, &column[self.l..]);
         (
-            L::splat(self.context, self.a[k]),
-            L::splat(self.context, self.a_dot[k]),
-            L::load(self.context, &column[self.l..]),
+            L::splat(self.context, self.a[k]) * phi,
+            L::splat(self.context, self.a_dot[k]) * phi,
         )
     }
 }
@@ -688,6 +728,8 @@ struct AcrossStates<'a, S: Simd> {
     a: &'a [Pack<S>],
     a_dot: &'a [Pack<S>],
     phi: &'a [f64],
+    /// The column of ones of `Phi`, or `usize::MAX` (see [`StateLanes`]).
+    unit: usize,
 }
 
 impl<S: Simd> LinkInputs<Pack<S>> for AcrossStates<'_, S> {
@@ -697,12 +739,12 @@ impl<S: Simd> LinkInputs<Pack<S>> for AcrossStates<'_, S> {
     }
 
     #[inline(always)]
-    fn term(&self, k: usize) -> (Pack<S>, Pack<S>, Pack<S>) {
-        (
-            self.a[k],
-            self.a_dot[k],
-            Pack::splat(self.simd, self.phi[k]),
-        )
+    fn terms(&self, k: usize) -> (Pack<S>, Pack<S>) {
+        if k == self.unit {
+            return (self.a[k], self.a_dot[k]);
+        }
+        let phi = Pack::splat(self.simd, self.phi[k]);
+        (self.a[k] * phi, self.a_dot[k] * phi)
     }
 }
 
@@ -710,8 +752,8 @@ impl<S: Simd> LinkInputs<Pack<S>> for AcrossStates<'_, S> {
 trait LinkInputs<L> {
     /// The number of coordinates `m`.
     fn coords(&self) -> usize;
-    /// `(a_k, a_dot_k, (Phi_l)_k)`.
-    fn term(&self, k: usize) -> (L, L, L);
+    /// `(a_k (Phi_l)_k, a_dot_k (Phi_l)_k)`.
+    fn terms(&self, k: usize) -> (L, L);
 }
 
 /// `[phi_l, phi_dot_l]` of one link (or one lane's link each), from its angle offset `phi0_l`
@@ -725,9 +767,9 @@ fn link_angle_rate<L: Lane>(
     let mut angle = angle_offset;
     let mut rate = L::splat(context, 0.0);
     for k in 0..inputs.coords() {
-        let (a, a_dot, phi) = inputs.term(k);
-        angle = angle + a * phi;
-        rate = rate + a_dot * phi;
+        let (angle_term, rate_term) = inputs.terms(k);
+        angle = angle + angle_term;
+        rate = rate + rate_term;
     }
     [angle, rate]
 }
@@ -738,14 +780,7 @@ fn link_angle_rate<L: Lane>(
 fn link_products<L: Lane>([sin, cos, rate]: [L; 3], moment: L, length: L) -> [L; PRODUCTS] {
     let rate2 = rate * rate;
     let (l_sin, l_cos) = (sin * length, cos * length);
-    [
-        rate2 * moment,
-        cos * moment,
-        l_sin,
-        l_cos,
-        l_cos * rate2,
-        l_sin * rate2,
-    ]
+    [rate2 * moment, l_sin, l_cos, l_cos * rate2, l_sin * rate2]
 }
 
 /// The per-link buffers of the kernel: every link's angle, its sine and cosine, and the
@@ -823,14 +858,7 @@ impl LinkBuffers<'_> {
         LinkValues {
             sin: &self.sin[..size],
             cos: &self.cos[..size],
-            products: [
-                product(0),
-                product(1),
-                product(2),
-                product(3),
-                product(4),
-                product(5),
-            ],
+            products: [product(0), product(1), product(2), product(3), product(4)],
         }
     }
 }
@@ -860,7 +888,7 @@ impl LinkValues<'_> {
     #[inline(always)]
     fn load<L: Lane>(&self, context: L::Context, i: usize) -> [L; 2 + PRODUCTS] {
         let entry = i * L::WIDTH;
-        let [p0, p1, p2, p3, p4, p5] = self.products;
+        let [p0, p1, p2, p3, p4] = self.products;
         [
             L::load(context, &self.sin[entry..]),
             L::load(context, &self.cos[entry..]),
@@ -869,7 +897,6 @@ impl LinkValues<'_> {
             L::load(context, &p2[entry..]),
             L::load(context, &p3[entry..]),
             L::load(context, &p4[entry..]),
-            L::load(context, &p5[entry..]),
         ]
     }
 }
@@ -885,8 +912,8 @@ pub(crate) struct Terms<'a, R> {
     pub(crate) gravity: &'a mut [R],
     /// Columns of `P_l`.
     pub(crate) joint: &'a mut [Pair<R>],
-    /// `S_l v_l`.
-    pub(crate) cos_moment: &'a mut [R],
+    /// `v_l`.
+    pub(crate) v: &'a mut [R],
 }
 
 /// The sums of the module documentation, for `m` coordinates, into `terms` in the registers of
@@ -909,7 +936,7 @@ pub(crate) fn accumulate<Y: Layout>(
     let coriolis = &mut terms.coriolis[..chunks];
     let gravity = &mut terms.gravity[..chunks];
     let joint = &mut terms.joint[..chunks];
-    let cos_moment = &mut terms.cos_moment[..chunks];
+    let v = &mut terms.v[..chunks];
     mass.fill(zero);
     coriolis.fill(zero);
     gravity.fill(zero);
@@ -924,58 +951,54 @@ pub(crate) fn accumulate<Y: Layout>(
     let moments = &moments[..n];
     let lengths = &model.link_constants().length[..n];
     let rows = &rows[..n * m + LINK_PADDING];
+    let moment_rows = &model.moment_rows()[..n * m + LINK_PADDING];
     {
         for (i, &moment) in moments.iter().enumerate() {
-            let row = &rows[i * m..];
-            let [
-                sin,
-                cos,
-                moment_rate2,
-                gravity_force,
-                l_sin,
-                l_cos,
-                drop_x,
-                drop_y,
-            ] = layout.link(&values, i, moment, lengths[i]);
-            // S_l (w_l . q_l).
+            let (row, moment_row) = (&rows[i * m..], &moment_rows[i * m..]);
+            let [sin, cos, moment_rate2, l_sin, l_cos, drop_x, drop_y] =
+                layout.link(&values, i, moment, lengths[i]);
+            // w_l . q_l, which S_l Phi_l multiplies.
             // (No closures or array maps here: their bodies would be compiled without the
             // instruction set of the dispatch, and its intrinsics called, not inlined.)
-            let force = layout.spread((cos * q[1] - sin * q[0]) * moment);
+            let force = layout.spread(cos * q[1] - sin * q[0]);
             let (sin, cos) = (layout.spread(sin), layout.spread(cos));
             let moment_rate2 = layout.spread(moment_rate2);
             if !Y::GRAVITY_APART {
-                add_gravity(layout, gravity, layout.spread(gravity_force), row);
+                add_gravity(layout, gravity, cos, moment_row);
             }
             let (l_sin, l_cos) = (layout.spread(l_sin), layout.spread(l_cos));
             for c in 0..chunks {
-                let phi = layout.constant_row(row, c);
+                let moment_phi = layout.constant_row(moment_row, c);
                 let [px, py] = joint[c];
-                cos_moment[c] = (cos * py - sin * px) * moment;
+                v[c] = cos * py - sin * px;
                 let along = cos * px + sin * py;
-                coriolis[c] = coriolis[c] + force * phi - moment_rate2 * along;
+                coriolis[c] = coriolis[c] + force * moment_phi - moment_rate2 * along;
             }
-            // A += Phi_l^T (S_l v_l)^T, row by row.
-            for (j, &phi_j) in row[..m].iter().enumerate() {
+            // A += (S_l Phi_l)^T v_l^T, row by row.
+            for (j, &moment_phi_j) in moment_row[..m].iter().enumerate() {
                 for c in 0..chunks {
                     let entry = &mut mass[j * chunks + c];
-                    *entry = *entry + cos_moment[c] * phi_j;
+                    *entry = *entry + v[c] * moment_phi_j;
                 }
             }
             for (c, pair) in joint.iter_mut().enumerate() {
-                let phi = layout.constant_row(row, c);
                 let [px, py] = *pair;
-                *pair = [px - l_sin * phi, py + l_cos * phi];
+                let (l_sin_phi, l_cos_phi) = (
+                    layout.times_phi(l_sin, row, c),
+                    layout.times_phi(l_cos, row, c),
+                );
+                *pair = [px - l_sin_phi, py + l_cos_phi];
             }
             q = [q[0] - drop_x, q[1] - drop_y];
         }
     }
-    // G* = g sum_l S_l cos(phi_l) Phi_l^T: it needs no prefix sum, so where its running sums
+    // G* = g sum_l cos(phi_l) S_l Phi_l^T: it needs no prefix sum, so where its running sums
     // would crowd the pass's registers it is summed in a loop of its own (the same operations in
     // the same order either way).
     if Y::GRAVITY_APART {
-        for (i, &moment) in moments.iter().enumerate() {
-            let gravity_force = layout.spread(layout.gravity_force(&values, i, moment));
-            add_gravity(layout, gravity, gravity_force, &rows[i * m..]);
+        for i in 0..n {
+            let cos = layout.spread(layout.cos(&values, i));
+            add_gravity(layout, gravity, cos, &moment_rows[i * m..]);
         }
     }
     let g = model.chain().gravity();
@@ -984,17 +1007,17 @@ pub(crate) fn accumulate<Y: Layout>(
     }
 }
 
-/// `gravity += S_l cos(phi_l) Phi_l^T` for link `row` (`Phi_l`, followed by the padding of
-/// [`Layout::constant_row`]).
+/// `gravity += cos(phi_l) S_l Phi_l^T` for link `moment_row` (`S_l Phi_l`, followed by the
+/// padding of [`Layout::constant_row`]).
 #[inline(always)]
 fn add_gravity<Y: Layout>(
     layout: Y,
     gravity: &mut [Y::Register],
-    gravity_force: Y::Register,
-    row: &[f64],
+    cos: Y::Register,
+    moment_row: &[f64],
 ) {
     for (c, value) in gravity.iter_mut().enumerate() {
-        *value = *value + gravity_force * layout.constant_row(row, c);
+        *value = *value + cos * layout.constant_row(moment_row, c);
     }
 }
 
