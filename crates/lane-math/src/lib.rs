@@ -4,4 +4,4 @@ mod lanes;
 mod trig;
 
 pub use lanes::{Lane, Pack};
-pub use trig::{sin_cos, sin_cos_simd};
+pub use trig::{REDUCTION_LIMIT, sin_cos, sin_cos_in_range, sin_cos_lanes};

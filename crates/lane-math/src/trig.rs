@@ -20,17 +20,16 @@
 
 use std::f64::consts::FRAC_2_PI;
 
-use pulp::Simd;
-
-use crate::lanes::{Lane, Pack};
+use crate::lanes::Lane;
 
 /// The two parts of `pi/2`: `HI` has 33 significant bits, `LO` is the double nearest
 /// `pi/2 - HI`.
 const PIO2_HI: f64 = 1.5707963267341256;
 const PIO2_LO: f64 = 6.077100506506192e-11;
 
-/// Largest `|x|` reduced here: `|k| < 2^20` keeps `k HI` exact.
-const REDUCTION_LIMIT: f64 = 524288.0 * std::f64::consts::PI;
+/// The largest `|x|` reduced here, `2^19 pi`: `|k| < 2^20` keeps `k HI` exact. Beyond it,
+/// [`sin_cos`] and [`sin_cos_lanes`] call `libm`, and [`sin_cos_in_range`] is wrong.
+pub const REDUCTION_LIMIT: f64 = 524288.0 * std::f64::consts::PI;
 
 /// `1.5 2^52`: adding it rounds to an integer, which then sits in the low mantissa bits.
 const ROUNDING_SHIFT: f64 = 6755399441055744.0;
@@ -61,7 +60,7 @@ const COS: [f64; 6] = [
     -1.1358536515252448e-11,
 ];
 
-/// The most `f64` lanes of a SIMD register (AVX-512).
+/// The most `f64` lanes of a SIMD register (AVX-512, the widest `pulp` dispatches to).
 const MAX_LANES: usize = 8;
 
 /// `sin[i] = sin(angles[i])` and `cos[i] = cos(angles[i])` (slices of equal length). Inlined,
@@ -70,45 +69,29 @@ const MAX_LANES: usize = 8;
 pub fn sin_cos(angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
     let (sin, cos) = (&mut sin[..angles.len()], &mut cos[..angles.len()]);
     for ((&x, s), c) in angles.iter().zip(sin.iter_mut()).zip(cos.iter_mut()) {
-        (*s, *c) = sin_cos_reduced((), x);
+        (*s, *c) = sin_cos_in_range((), x);
     }
     redo_large(angles, sin, cos);
 }
 
-/// [`sin_cos`] in explicit SIMD registers of the instruction set `S` (inside
-/// [`pulp::Arch::dispatch`]): `S::F64_LANES` angles at a time, the last few padded to a whole
-/// register, so that a short slice (the ten links of an arm) takes two AVX-512 steps rather than
-/// ten scalar ones. The same operations as [`sin_cos`], so the same bits.
+/// `(sin x, cos x)` in every lane of `x`, as [`sin_cos`] gives them (the same operations, so the
+/// same bits): the form for a kernel that already holds its angles in registers (`Pack` inside
+/// [`pulp::Arch::dispatch`], or `f64`), so they are not stored and read back. Branch-free but for
+/// one test of the register: lanes beyond `2^19 pi` go to `libm`.
 #[inline(always)]
-pub fn sin_cos_simd<S: Simd>(simd: S, angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
-    let width = S::F64_LANES;
-    if width > MAX_LANES {
-        return sin_cos(angles, sin, cos);
+pub fn sin_cos_lanes<L: Lane>(context: L::Context, x: L) -> (L, L) {
+    let (sin, cos) = sin_cos_in_range(context, x);
+    // Every lane within the limit (a NaN is not, and is left as it is below).
+    if L::splat(context, REDUCTION_LIMIT.next_up()).all_greater(x.abs()) {
+        return (sin, cos);
     }
-    let n = angles.len();
-    let (sin, cos) = (&mut sin[..n], &mut cos[..n]);
-    let whole = n - n % width;
-    for ((x, s), c) in angles[..whole]
-        .chunks_exact(width)
-        .zip(sin.chunks_exact_mut(width))
-        .zip(cos.chunks_exact_mut(width))
-    {
-        let (sin_x, cos_x) = sin_cos_reduced(simd, Pack::<S>::load(simd, x));
-        sin_x.store(s);
-        cos_x.store(c);
-    }
-    if whole < n {
-        let rest = n - whole;
-        let mut x = [0.0; MAX_LANES];
-        x[..rest].copy_from_slice(&angles[whole..]);
-        let (sin_x, cos_x) = sin_cos_reduced(simd, Pack::<S>::load(simd, &x));
-        let (mut s, mut c) = ([0.0; MAX_LANES], [0.0; MAX_LANES]);
-        sin_x.store(&mut s);
-        cos_x.store(&mut c);
-        sin[whole..].copy_from_slice(&s[..rest]);
-        cos[whole..].copy_from_slice(&c[..rest]);
-    }
-    redo_large(angles, sin, cos);
+    let [mut angles, mut sin_out, mut cos_out] = [[0.0; MAX_LANES]; 3];
+    x.store(&mut angles);
+    sin.store(&mut sin_out);
+    cos.store(&mut cos_out);
+    let lanes = ..L::WIDTH;
+    sin_cos_large(&angles[lanes], &mut sin_out[lanes], &mut cos_out[lanes]);
+    (L::load(context, &sin_out), L::load(context, &cos_out))
 }
 
 /// Redoes the angles beyond [`REDUCTION_LIMIT`], if any, with `libm`.
@@ -133,23 +116,20 @@ fn sin_cos_large(angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
     }
 }
 
-/// `(sin x, cos x)` in every lane with `|x| <= REDUCTION_LIMIT`, branch-free (steps 1-3 of the
-/// module documentation).
+/// `(sin x, cos x)` in every lane, for lanes with `|x| <= REDUCTION_LIMIT` only (the caller's
+/// guarantee: beyond it the result is wrong, though never unsafe), branch-free (steps 1-3 of the
+/// module documentation): [`sin_cos_lanes`] without its test of the register, for a kernel
+/// that bounds its angles beforehand. Within the limit, the same bits as the others.
 #[inline(always)]
-fn sin_cos_reduced<L: Lane>(context: L::Context, x: L) -> (L, L) {
+pub fn sin_cos_in_range<L: Lane>(context: L::Context, x: L) -> (L, L) {
     let splat = |c| L::splat(context, c);
     let shifted = x * FRAC_2_PI + splat(ROUNDING_SHIFT);
     let k = shifted - splat(ROUNDING_SHIFT);
     let r = (x - k * PIO2_HI) - k * PIO2_LO;
     let r2 = r * r;
-    let mut sin_tail = splat(SIN[5]);
-    for &coefficient in SIN[..5].iter().rev() {
-        sin_tail = sin_tail * r2 + splat(coefficient);
-    }
-    let mut cos_tail = splat(COS[5]);
-    for &coefficient in COS[..5].iter().rev() {
-        cos_tail = cos_tail * r2 + splat(coefficient);
-    }
+    let r4 = r2 * r2;
+    let sin_tail = estrin(splat, &SIN, r2, r4);
+    let mut cos_tail = estrin(splat, &COS, r2, r4);
     // cos r = 1 + r^2 (-1/2 + r^2 Q(r^2)): one operation fewer than 1 - r^2/2 + r^4 Q(r^2), and
     // as accurate (one rounding of a value of at most 0.31 before the last addition).
     cos_tail = cos_tail * r2 + splat(-0.5);
@@ -166,9 +146,20 @@ fn sin_cos_reduced<L: Lane>(context: L::Context, x: L) -> (L, L) {
     (sin_x.xor_bits(sin_sign), cos_x.xor_bits(cos_sign))
 }
 
+/// `c[0] + c[1] t + ... + c[5] t^5` with `t2 = t^2`, by Estrin's scheme: three independent
+/// pairs, then two steps in `t2`, so that its chain of dependent operations is half Horner's.
+#[inline(always)]
+fn estrin<L: Lane>(splat: impl Fn(f64) -> L, c: &[f64; 6], t: L, t2: L) -> L {
+    let low = splat(c[0]) + t * splat(c[1]);
+    let middle = splat(c[2]) + t * splat(c[3]);
+    let high = splat(c[4]) + t * splat(c[5]);
+    low + t2 * (middle + t2 * high)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lanes::Pack;
     use proptest::prelude::*;
 
     /// Both results of both routines (the same bits) against `libm` (within 1 ulp of the exact values) to 3e-16 absolute.
@@ -183,7 +174,8 @@ mod tests {
         Ok(())
     }
 
-    /// [`sin_cos_simd`] of `angles` with the processor's instruction set.
+    /// [`sin_cos_lanes`] of `angles`, a register of the processor's instruction set at a time
+    /// (the last padded with zeros).
     struct Simd<'a> {
         angles: &'a [f64],
         sin: &'a mut [f64],
@@ -194,11 +186,23 @@ mod tests {
         type Output = ();
 
         fn with_simd<S: pulp::Simd>(self, simd: S) {
-            sin_cos_simd(simd, self.angles, self.sin, self.cos);
+            let width = Pack::<S>::WIDTH;
+            for (first, angles) in self.angles.chunks(width).enumerate() {
+                let mut padded = [0.0; MAX_LANES];
+                padded[..angles.len()].copy_from_slice(angles);
+                let (sin, cos) = sin_cos_lanes(simd, Pack::<S>::load(simd, &padded));
+                let (mut sin_out, mut cos_out) = ([0.0; MAX_LANES], [0.0; MAX_LANES]);
+                sin.store(&mut sin_out);
+                cos.store(&mut cos_out);
+                let range = first * width..first * width + angles.len();
+                self.sin[range.clone()].copy_from_slice(&sin_out[..angles.len()]);
+                self.cos[range].copy_from_slice(&cos_out[..angles.len()]);
+            }
         }
     }
 
-    /// The bits of `(sin, cos)` of `angles` by [`sin_cos`] and by [`sin_cos_simd`].
+    /// The bits of `(sin, cos)` of `angles` by [`sin_cos`] and by [`sin_cos_lanes`] (which must
+    /// agree).
     fn both(angles: &[f64]) -> [Vec<u64>; 2] {
         let n = angles.len();
         let (mut sin, mut cos) = (vec![0.0; n], vec![0.0; n]);
@@ -326,5 +330,23 @@ mod tests {
         let (mut s, mut c) = ([0.0; 2], [0.0; 2]);
         sin_cos(&[f64::NAN, f64::INFINITY], &mut s, &mut c);
         assert!(s.iter().chain(&c).all(|v| v.is_nan()));
+        // A register with a NaN, infinities and an angle beyond the reduction among ordinary
+        // ones: the same bits both ways (`both` asserts it), and NaN where there is no value.
+        let mixed = [
+            0.5,
+            f64::NAN,
+            f64::INFINITY,
+            -3e6,
+            -f64::INFINITY,
+            1.0,
+            2.0,
+            3.0,
+            4.0,
+        ];
+        let [sin, cos] = both(&mixed);
+        for (i, &x) in mixed.iter().enumerate() {
+            let (s, c) = (f64::from_bits(sin[i]), f64::from_bits(cos[i]));
+            assert_eq!(s.is_nan() && c.is_nan(), !x.is_finite(), "{x}: {s}, {c}");
+        }
     }
 }

@@ -20,7 +20,9 @@ use crate::error::{ReduceError, check_len};
 use crate::forward::forward_dynamics;
 use crate::model::ReducedModel;
 use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
-use crate::terms::{LinkBuffers, StateLanes, Terms, accumulate, all_finite, extract};
+use crate::terms::{
+    LinkBuffers, PRODUCTS, StateLanes, Terms, accumulate, all_finite, angles_in_range, extract,
+};
 use lane_math::{Lane, Pack};
 
 /// The most `f64` lanes of a SIMD register (AVX-512).
@@ -49,7 +51,7 @@ pub enum BatchError {
 
 /// Workspace of [`forward_dynamics_batch`] for one [`ReducedModel`]: create it once, reuse it for
 /// every batch. Its memory is `O(n)` like a [`ReducedData`]'s (which it holds, for the states
-/// evaluated one at a time) plus four buffers of `n` values per lane (`256 n` bytes).
+/// evaluated one at a time) plus seven buffers of `n` values per lane (`448 n` bytes).
 #[derive(Debug, Clone)]
 pub struct ReducedBatchData {
     /// Per link and lane (`[link][lane]`, `MAX_WIDTH` lanes): the absolute angle, its sine and
@@ -57,8 +59,7 @@ pub struct ReducedBatchData {
     angle: Vec<f64>,
     sin: Vec<f64>,
     cos: Vec<f64>,
-    /// Per link and lane: the rate `phi_dot_l` (see [`crate::terms`]; the pass computes the
-    /// other products of a batch itself).
+    /// Per product, link and lane: the products of [`crate::terms`].
     products: Vec<f64>,
     /// The one-state workspace.
     single: ReducedData,
@@ -74,7 +75,7 @@ impl ReducedBatchData {
             angle: vec![0.0; size],
             sin: vec![0.0; size],
             cos: vec![0.0; size],
-            products: vec![0.0; size],
+            products: vec![0.0; PRODUCTS * size],
             single: ReducedData::new(model),
             arch: Arch::new(),
         }
@@ -244,6 +245,9 @@ fn group<S: Simd, const M: usize, const UNIT_LAST: bool>(
     let a: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[0], k));
     let a_dot: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[1], k));
     let tau_star: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[2], k));
+    if !angles_in_range(simd, model, &a) {
+        return false;
+    }
     let zero = Pack::splat(simd, 0.0);
     let (mut sums, mut mass) = ([[zero; M]; M], [[zero; M]; M]);
     let (mut coriolis_sums, mut gravity_sums) = ([zero; M], [zero; M]);

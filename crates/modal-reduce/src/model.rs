@@ -77,6 +77,9 @@ pub struct ReducedModel {
     /// `K = sum_l h_ll Phi_l^T Phi_l` (row-major `m x m`): the constant part of `M*`, followed
     /// by [`LINK_PADDING`] zeros like `angle_rows`.
     constant_mass: Vec<f64>,
+    /// `[max_l |phi0_l|, max_l |(Phi_l)_0|, ..., max_l |(Phi_l)_{m-1}|]`: every absolute angle
+    /// is at most `angle_bound[0] + sum_k angle_bound[k + 1] |a_k|` in size.
+    angle_bound: Vec<f64>,
 }
 
 impl ReducedModel {
@@ -176,6 +179,16 @@ impl ReducedModel {
         }
         let unit_column =
             (0..m).find(|&k| angle_rows[..n * m].chunks_exact(m).all(|row| row[k] == 1.0));
+        let mut angle_bound = vec![0.0; m + 1];
+        for (offset, row) in links.angle_offset[..n]
+            .iter()
+            .zip(angle_rows.chunks_exact(m))
+        {
+            angle_bound[0] = f64::max(angle_bound[0], offset.abs());
+            for (bound, entry) in angle_bound[1..].iter_mut().zip(row) {
+                *bound = f64::max(*bound, entry.abs());
+            }
+        }
         Ok(Self {
             chain,
             map,
@@ -184,6 +197,7 @@ impl ReducedModel {
             unit_column,
             links,
             constant_mass,
+            angle_bound,
         })
     }
 
@@ -228,6 +242,11 @@ impl ReducedModel {
     /// Row-major `n x m` rows `S_l Phi_l`, followed by [`LINK_PADDING`] zeros.
     pub(crate) fn moment_rows(&self) -> &[f64] {
         &self.moment_rows
+    }
+
+    /// A bound on the absolute angles: see the field `angle_bound`.
+    pub(crate) fn angle_bound(&self) -> &[f64] {
+        &self.angle_bound
     }
 
     /// The constant part `K` of `M*`, row-major `m x m`, followed by [`LINK_PADDING`] zeros.

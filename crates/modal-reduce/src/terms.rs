@@ -93,7 +93,7 @@
 use crate::data::{LINK_PADDING, ReducedData};
 use crate::error::{ReduceError, check_finite_result, check_input};
 use crate::model::ReducedModel;
-use lane_math::{Lane, Pack, sin_cos_simd};
+use lane_math::{Lane, Pack, REDUCTION_LIMIT, sin_cos_in_range, sin_cos_lanes};
 use pulp::{Simd, WithSimd};
 
 /// Per-link products the pre-pass leaves for the pass besides the sine and cosine, in this order
@@ -356,25 +356,9 @@ pub(crate) trait Layout: Copy {
     fn times_phi(self, x: Self::Register, row: &[f64], chunk: usize) -> Self::Register {
         x * self.constant_row(row, chunk)
     }
-    /// How many of the [`PRODUCTS`] the pre-pass stores: all, or only the rate `phi_dot_l` (in
-    /// the first one's place) when the pass computes them (a batch, whose pre-pass is not
-    /// vectorised across links any more than its pass).
-    const PRE_PASS_PRODUCTS: usize;
-    /// The sine, cosine and [`PRODUCTS`] of link `i` for the pass, from `values` and, if the
-    /// pre-pass left them to the pass, the link's first moment and length (see
-    /// [`link_products`]).
-    fn link(
-        self,
-        values: &LinkValues<'_>,
-        i: usize,
-        moment: f64,
-        length: f64,
-    ) -> [Self::Value; 2 + PRODUCTS];
     /// Whether `G*` is summed in a loop of its own after the pass rather than in it (a batch,
     /// whose pass has no register to spare).
     const GRAVITY_APART: bool;
-    /// `cos phi_l` of link `i`, as [`link`](Self::link) gives it.
-    fn cos(self, values: &LinkValues<'_>, i: usize) -> Self::Value;
     /// The per-link values of all links into `links` (the pre-pass).
     fn link_values(
         self,
@@ -413,18 +397,7 @@ impl<S: Simd> Layout for CoordinateLanes<S> {
     type Register = Pack<S>;
     type Value = f64;
 
-    const PRE_PASS_PRODUCTS: usize = PRODUCTS;
     const GRAVITY_APART: bool = false;
-
-    #[inline(always)]
-    fn link(self, values: &LinkValues<'_>, i: usize, _: f64, _: f64) -> [f64; 2 + PRODUCTS] {
-        values.load((), i)
-    }
-
-    #[inline(always)]
-    fn cos(self, values: &LinkValues<'_>, i: usize) -> f64 {
-        values.cos[i]
-    }
 
     #[inline(always)]
     fn register_context(self) -> S {
@@ -475,18 +448,7 @@ impl<S: Simd> Layout for OneStateScalar<S> {
     type Register = f64;
     type Value = f64;
 
-    const PRE_PASS_PRODUCTS: usize = PRODUCTS;
     const GRAVITY_APART: bool = false;
-
-    #[inline(always)]
-    fn link(self, values: &LinkValues<'_>, i: usize, _: f64, _: f64) -> [f64; 2 + PRODUCTS] {
-        values.load((), i)
-    }
-
-    #[inline(always)]
-    fn cos(self, values: &LinkValues<'_>, i: usize) -> f64 {
-        values.cos[i]
-    }
 
     #[inline(always)]
     fn register_context(self) {}
@@ -527,7 +489,8 @@ impl<S: Simd> Layout for OneStateScalar<S> {
 }
 
 /// Several states side by side, lane `i` of every register holding state `i`; one coordinate a
-/// register.
+/// register. Only for states that pass [`angles_in_range`]: its sines and cosines skip the test
+/// for angles beyond the reduction's range (four vector operations a link).
 #[derive(Clone, Copy)]
 pub(crate) struct StateLanes<S: Simd> {
     simd: S,
@@ -550,30 +513,7 @@ impl<S: Simd> Layout for StateLanes<S> {
     type Register = Pack<S>;
     type Value = Pack<S>;
 
-    const PRE_PASS_PRODUCTS: usize = 1;
     const GRAVITY_APART: bool = true;
-
-    #[inline(always)]
-    fn link(
-        self,
-        values: &LinkValues<'_>,
-        i: usize,
-        moment: f64,
-        length: f64,
-    ) -> [Pack<S>; 2 + PRODUCTS] {
-        let simd = self.simd;
-        let angles = values.load_trig_rate(simd, i);
-        let [sin, cos, _] = angles;
-        let moment = Pack::splat(simd, moment);
-        let [p0, p1, p2, p3, p4] = link_products(angles, moment, Pack::splat(simd, length));
-        [sin, cos, p0, p1, p2, p3, p4]
-    }
-
-    #[inline(always)]
-    fn cos(self, values: &LinkValues<'_>, i: usize) -> Pack<S> {
-        let [_, cos, _] = values.load_trig_rate::<Pack<S>>(self.simd, i);
-        cos
-    }
 
     #[inline(always)]
     fn register_context(self) -> S {
@@ -628,7 +568,14 @@ impl<S: Simd> Layout for StateLanes<S> {
         let m = a.len();
         let n = model.n_links();
         let rows = model.angle_rows()[..n * m].chunks_exact(m);
-        for (l, (phi, &offset)) in rows.zip(&constants.angle_offset[..n]).enumerate() {
+        let offsets = &constants.angle_offset[..n];
+        let LinkBuffers {
+            angle, products, ..
+        } = links;
+        let angles = angle[..n * width].chunks_exact_mut(width);
+        // The rates where the first product goes, until the products replace them.
+        let rates = products[..n * width].chunks_exact_mut(width);
+        for (((phi, &offset), angle), rate) in rows.zip(offsets).zip(angles).zip(rates) {
             let inputs = AcrossStates {
                 simd,
                 a,
@@ -636,11 +583,38 @@ impl<S: Simd> Layout for StateLanes<S> {
                 phi,
                 unit: self.unit,
             };
-            let angle_rate = link_angle_rate(simd, Pack::splat(simd, offset), &inputs);
-            links.store_angle_rate(l, width, angle_rate);
+            let [angle_l, rate_l] = link_angle_rate(simd, Pack::splat(simd, offset), &inputs);
+            angle_l.store(angle);
+            rate_l.store(rate);
         }
-        links.sin_cos(simd, n * width);
+        let (moments, lengths) = (&constants.first_moment[..n], &constants.length[..n]);
+        let (angle, mut registers) = links.angles_and_registers(n, width);
+        let per_link = angle.chunks_exact(width).zip(moments).zip(lengths);
+        for ((angle, &moment), &length) in per_link {
+            let Some(out) = registers.next() else { break };
+            let rate = Pack::load(simd, &*out[2]);
+            // Within the reduction's range: `angles_in_range` held (see `StateLanes`).
+            let (sin, cos) = sin_cos_in_range(simd, Pack::load(simd, angle));
+            let (moment, length) = (Pack::splat(simd, moment), Pack::splat(simd, length));
+            let [p0, p1, p2, p3, p4] = link_products([sin, cos, rate], moment, length);
+            store_link(out, [sin, cos, p0, p1, p2, p3, p4]);
+        }
     }
+}
+
+/// Whether every link's absolute angle is within [`REDUCTION_LIMIT`] in every state of `a` (of
+/// [`StateLanes`]), by the model's bound `|phi_l| <= max |phi0| + sum_k max_l |(Phi_l)_k| |a_k|`
+/// kept under half the limit, a margin far beyond the rounding of the sums. One test for a
+/// group of states instead of one a link; a group that fails is left to the one-state path,
+/// which tests each angle (far beyond any arm's range: a quarter of a million turns).
+#[inline(always)]
+pub(crate) fn angles_in_range<S: Simd>(simd: S, model: &ReducedModel, a: &[Pack<S>]) -> bool {
+    let (offset, columns) = model.angle_bound().split_first().unwrap_or((&0.0, &[]));
+    let mut bound = Pack::splat(simd, *offset);
+    for (a_k, &column) in a.iter().zip(columns) {
+        bound = bound + a_k.abs() * Pack::splat(simd, column);
+    }
+    Pack::splat(simd, 0.5 * REDUCTION_LIMIT).all_greater(bound)
 }
 
 /// The pre-pass of one state: [`link_angle_rate`], the sines and cosines, then
@@ -657,17 +631,16 @@ fn link_values_across_links<S: Simd>(
 ) {
     if S::F64_LANES > LINK_PADDING {
         // Wider registers than the padding: one link at a time.
-        across_links::<f64, S>((), simd, model, a, a_dot, links);
+        across_links::<f64>((), model, a, a_dot, links);
     } else {
-        across_links::<Pack<S>, S>(simd, simd, model, a, a_dot, links);
+        across_links::<Pack<S>>(simd, model, a, a_dot, links);
     }
 }
 
 /// [`link_values_across_links`] in registers of `L` (`L::WIDTH` at most [`LINK_PADDING`]).
 #[inline(always)]
-fn across_links<L: Lane, S: Simd>(
+fn across_links<L: Lane>(
     context: L::Context,
-    simd: S,
     model: &ReducedModel,
     a: &[f64],
     a_dot: &[f64],
@@ -686,7 +659,7 @@ fn across_links<L: Lane, S: Simd>(
         let offset = L::load(context, &constants.angle_offset[l..]);
         links.store_angle_rate(l, 1, link_angle_rate(context, offset, &inputs));
     }
-    links.sin_cos(simd, n.next_multiple_of(L::WIDTH));
+    links.sin_cos::<L>(context, n.next_multiple_of(L::WIDTH));
     for l in (0..n).step_by(L::WIDTH) {
         let angles = links.load_trig_rate(context, l, 1);
         let moment = L::load(context, &constants.first_moment[l..]);
@@ -787,7 +760,8 @@ fn link_products<L: Lane>([sin, cos, rate]: [L; 3], moment: L, length: L) -> [L;
 /// [`PRODUCTS`], each entry `W` values side by side (`W` the lanes of the layout's
 /// [`Value`](Layout::Value): one state's links have one, a batch's the states of a group).
 pub(crate) struct LinkBuffers<'a> {
-    /// `phi_l`, `[link][lane]`.
+    /// `phi_l`, `[link][lane]`: the one-state pre-pass's (a batch keeps its angles in
+    /// registers, and leaves it empty).
     pub(crate) angle: &'a mut [f64],
     /// `sin phi_l`, as `angle`.
     pub(crate) sin: &'a mut [f64],
@@ -811,16 +785,46 @@ impl LinkBuffers<'_> {
         rate.store(&mut self.products[entry..]);
     }
 
-    /// The sines and cosines of the first `entries` angles, in registers of `S`.
+    /// The sines and cosines of the first `entries` angles (a whole number of registers of
+    /// `L`), a register at a time.
     #[inline(always)]
-    fn sin_cos<S: Simd>(&mut self, simd: S, entries: usize) {
-        let angle = &self.angle[..entries];
-        sin_cos_simd(
-            simd,
-            angle,
-            &mut self.sin[..entries],
-            &mut self.cos[..entries],
-        );
+    fn sin_cos<L: Lane>(&mut self, context: L::Context, entries: usize) {
+        let width = L::WIDTH;
+        let angle = self.angle[..entries].chunks_exact(width);
+        let sin = self.sin[..entries].chunks_exact_mut(width);
+        let cos = self.cos[..entries].chunks_exact_mut(width);
+        for ((angle, sin), cos) in angle.zip(sin).zip(cos) {
+            let (sin_x, cos_x) = sin_cos_lanes(context, L::load(context, angle));
+            sin_x.store(sin);
+            cos_x.store(cos);
+        }
+    }
+
+    /// The entries of the first `registers` registers of `width` lanes, in the order of
+    /// [`LinkValues::registers`], to be written by [`store_link`].
+    #[inline(always)]
+    fn angles_and_registers(
+        &mut self,
+        registers: usize,
+        width: usize,
+    ) -> (&[f64], impl Iterator<Item = [&mut [f64]; 2 + PRODUCTS]>) {
+        let size = registers * width;
+        let mut rest = &mut *self.products;
+        let [p0, p1, p2, p3, p4] = std::array::from_fn(|_| {
+            let (product, tail) = std::mem::take(&mut rest).split_at_mut(self.links * width);
+            rest = tail;
+            product[..size].chunks_exact_mut(width)
+        });
+        let sin = self.sin[..size].chunks_exact_mut(width);
+        let registers = sin
+            .zip(self.cos[..size].chunks_exact_mut(width))
+            .zip(p0)
+            .zip(p1)
+            .zip(p2)
+            .zip(p3)
+            .zip(p4)
+            .map(|((((((sin, cos), p0), p1), p2), p3), p4)| [sin, cos, p0, p1, p2, p3, p4]);
+        (&self.angle[..size], registers)
     }
 
     /// `[sin phi_l, cos phi_l, phi_dot_l]` of link `l` after [`sin_cos`](Self::sin_cos).
@@ -843,62 +847,53 @@ impl LinkBuffers<'_> {
         }
     }
 
-    /// The values of the first `n` links, entries of `width` lanes, for the pass (the first
-    /// `products` of the [`PRODUCTS`]).
+    /// The entries the pre-pass left for the first `registers` registers of `width` lanes, for
+    /// the pass: `[sin phi_l, cos phi_l]` and the [`PRODUCTS`], each a slice of `width`
+    /// values (read by [`load_link`]), zipped so that the pass reads them without bounds
+    /// checks.
     #[inline(always)]
-    fn values(&self, n: usize, width: usize, products: usize) -> LinkValues<'_> {
-        let size = n * width;
-        let product = |p: usize| {
-            if p < products {
-                &self.products[p * self.links * width..][..size]
-            } else {
-                &[]
-            }
-        };
-        LinkValues {
-            sin: &self.sin[..size],
-            cos: &self.cos[..size],
-            products: [product(0), product(1), product(2), product(3), product(4)],
-        }
+    fn values(
+        &self,
+        registers: usize,
+        width: usize,
+    ) -> impl Iterator<Item = [&[f64]; 2 + PRODUCTS]> {
+        let size = registers * width;
+        let stride = self.links * width;
+        let [p0, p1, p2, p3, p4] =
+            std::array::from_fn(|p| self.products[p * stride..][..size].chunks_exact(width));
+        let sin = self.sin[..size].chunks_exact(width);
+        sin.zip(self.cos[..size].chunks_exact(width))
+            .zip(p0)
+            .zip(p1)
+            .zip(p2)
+            .zip(p3)
+            .zip(p4)
+            .map(|((((((sin, cos), p0), p1), p2), p3), p4)| [sin, cos, p0, p1, p2, p3, p4])
     }
 }
 
-/// The values the pre-pass left for the links (see [`LinkBuffers`]), each slice exactly the
-/// links' entries, so that the pass reads them without bounds checks (the products the
-/// pre-pass did not compute empty).
-pub(crate) struct LinkValues<'a> {
-    sin: &'a [f64],
-    cos: &'a [f64],
-    products: [&'a [f64]; PRODUCTS],
+/// Writes a register of [`LinkBuffers::registers`].
+#[inline(always)]
+fn store_link<L: Lane>(out: [&mut [f64]; 2 + PRODUCTS], values: [L; 2 + PRODUCTS]) {
+    for (value, out) in values.into_iter().zip(out) {
+        value.store(out);
+    }
 }
 
-impl LinkValues<'_> {
-    /// The sine and cosine of link `i` and its rate `phi_dot_l` (where the first product goes).
-    #[inline(always)]
-    fn load_trig_rate<L: Lane>(&self, context: L::Context, i: usize) -> [L; 3] {
-        let entry = i * L::WIDTH;
-        [
-            L::load(context, &self.sin[entry..]),
-            L::load(context, &self.cos[entry..]),
-            L::load(context, &self.products[0][entry..]),
-        ]
-    }
-
-    /// The sine, cosine and products of link `i`.
-    #[inline(always)]
-    fn load<L: Lane>(&self, context: L::Context, i: usize) -> [L; 2 + PRODUCTS] {
-        let entry = i * L::WIDTH;
-        let [p0, p1, p2, p3, p4] = self.products;
-        [
-            L::load(context, &self.sin[entry..]),
-            L::load(context, &self.cos[entry..]),
-            L::load(context, &p0[entry..]),
-            L::load(context, &p1[entry..]),
-            L::load(context, &p2[entry..]),
-            L::load(context, &p3[entry..]),
-            L::load(context, &p4[entry..]),
-        ]
-    }
+/// Reads a register of [`LinkBuffers::values`].
+#[inline(always)]
+fn load_link<L: Lane>(context: L::Context, entries: [&[f64]; 2 + PRODUCTS]) -> [L; 2 + PRODUCTS] {
+    // (No closure: its body would be compiled without the dispatch's instruction set.)
+    let [sin, cos, p0, p1, p2, p3, p4] = entries;
+    [
+        L::load(context, sin),
+        L::load(context, cos),
+        L::load(context, p0),
+        L::load(context, p1),
+        L::load(context, p2),
+        L::load(context, p3),
+        L::load(context, p4),
+    ]
 }
 
 /// The results and scratch of the kernel, in registers of a [`Layout`]: `m` rows of
@@ -942,21 +937,17 @@ pub(crate) fn accumulate<Y: Layout>(
     gravity.fill(zero);
     joint.fill([zero; 2]);
     let n = model.n_links();
-    let moments = &model.link_constants().first_moment;
     let rows = model.angle_rows();
     let mut q = [Y::Value::splat(vc, 0.0); 2];
     layout.link_values(model, a, a_dot, &mut links);
     // The pass: P_l, q_l, and the sums of M* and C*.
-    let values = links.values(n, Y::Value::WIDTH, Y::PRE_PASS_PRODUCTS);
-    let moments = &moments[..n];
-    let lengths = &model.link_constants().length[..n];
-    let rows = &rows[..n * m + LINK_PADDING];
-    let moment_rows = &model.moment_rows()[..n * m + LINK_PADDING];
-    {
-        for (i, &moment) in moments.iter().enumerate() {
-            let (row, moment_row) = (&rows[i * m..], &moment_rows[i * m..]);
-            let [sin, cos, moment_rate2, l_sin, l_cos, drop_x, drop_y] =
-                layout.link(&values, i, moment, lengths[i]);
+    // Each link's rows zipped with its values, so that nothing is bounds-checked.
+    let moment_rows = model.moment_rows();
+    let width = Y::Value::WIDTH;
+    let links_rows = padded_rows(rows, n, m).zip(padded_rows(moment_rows, n, m));
+    for ((row, moment_row), entries) in links_rows.zip(links.values(n, width)) {
+        {
+            let [sin, cos, moment_rate2, l_sin, l_cos, drop_x, drop_y] = load_link(vc, entries);
             // w_l . q_l, which S_l Phi_l multiplies.
             // (No closures or array maps here: their bodies would be compiled without the
             // instruction set of the dispatch, and its intrinsics called, not inlined.)
@@ -996,15 +987,25 @@ pub(crate) fn accumulate<Y: Layout>(
     // would crowd the pass's registers it is summed in a loop of its own (the same operations in
     // the same order either way).
     if Y::GRAVITY_APART {
-        for i in 0..n {
-            let cos = layout.spread(layout.cos(&values, i));
-            add_gravity(layout, gravity, cos, &moment_rows[i * m..]);
+        for (moment_row, [_, cos, ..]) in padded_rows(moment_rows, n, m).zip(links.values(n, width))
+        {
+            let cos = layout.spread(Y::Value::load(vc, cos));
+            add_gravity(layout, gravity, cos, moment_row);
         }
     }
     let g = model.chain().gravity();
     for value in gravity {
         *value = *value * g;
     }
+}
+
+/// The `n` rows of `m` values of `rows` (`Phi` or the rows `S_l Phi_l`), each with the
+/// [`LINK_PADDING`] values after it that [`Layout::constant_row`] may read.
+#[inline(always)]
+fn padded_rows(rows: &[f64], n: usize, m: usize) -> impl Iterator<Item = &[f64]> {
+    rows[..n * m + LINK_PADDING]
+        .windows(m + LINK_PADDING)
+        .step_by(m)
 }
 
 /// `gravity += cos(phi_l) S_l Phi_l^T` for link `moment_row` (`S_l Phi_l`, followed by the
