@@ -12,7 +12,8 @@
 //!    `cos r = 1 + r^2 (-1/2 + r^2 Q(r^2))`, `P` and `Q` of degree 5, whose coefficients minimise the
 //!    largest relative error of `sin` (`3.6e-18`) and the largest error of `cos` (`5.6e-20`);
 //!    rounding (about one ulp) dominates. They take two and one fewer multiply-adds than the
-//!    Taylor polynomials of the same accuracy (to `r^17` and `r^16`).
+//!    Taylor polynomials of the same accuracy (to `r^17` and `r^16`), and are evaluated by
+//!    Estrin's scheme, whose chain of dependent operations is half Horner's.
 //! 3. The quadrant `k mod 4` swaps and negates the pair.
 //!
 //! Angles beyond `2^19 pi` (where the exact products run out of bits) go to `libm::sincos`.

@@ -62,12 +62,14 @@
 //! # Evaluation
 //!
 //! A pre-pass computes, for all links at once, what depends on one link only: `phi_l`,
-//! `phi_dot_l`, `sin phi_l`, `cos phi_l` and, for one state, the products `S_l phi_dot_l^2`,
+//! `phi_dot_l`, `sin phi_l`, `cos phi_l` and the products `S_l phi_dot_l^2`,
 //! `L_l sin phi_l`, `L_l cos phi_l`, `L_l cos(phi_l) phi_dot_l^2` and
 //! `L_l sin(phi_l) phi_dot_l^2` (the steps of `q_l`): for one state it runs across links, a
-//! register of consecutive links at a time, where the pass could only use one lane for them (a
-//! batch, whose registers hold states either way, computes the products in the pass). Then the
-//! pass runs over the links with what is left, the prefix sums.
+//! register of consecutive links at a time, where the pass could only use one lane for them; a
+//! batch, whose registers hold states either way, runs it link by link, the angles and rates in
+//! one loop and the rest in a second, in registers. Then the pass runs over the links with what
+//! is left, the prefix sums, reading each link's values through zipped iterators (no bounds
+//! checks).
 //!
 //! The model holds the rows `S_l Phi_l` besides `Phi_l`, so that `S_l` multiplies no
 //! state-dependent value: `A` is summed as `sum_l (S_l Phi_l)^T v_l^T`, `C*`'s first part as

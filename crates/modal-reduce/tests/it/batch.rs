@@ -96,6 +96,52 @@ proptest! {
     }
 }
 
+/// Absolute angles near and beyond the sine and cosine's reduction (`2^19 pi`, about 1.6e6 rad):
+/// a group whose angles might pass half of it runs one state at a time, and every state still
+/// gets its own bits, whether its angles are reduced or go to `libm`.
+#[test]
+fn huge_angles_give_each_state_its_own_bits() {
+    let model = ReducedModel::new(
+        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
+        ModalMap::paper(10).unwrap(),
+    )
+    .unwrap();
+    // Four groups of 8 (or eight of 4): ordinary; one lane at 6e5 (within the group bound);
+    // one at 1e6 (beyond the bound, within the reduction); one at 3e6 (beyond both).
+    let base_angle = |state: usize| match state {
+        13 => 6e5,
+        18 => -1e6,
+        29 => 3e6,
+        _ => 0.1 * state as f64,
+    };
+    let states = 32;
+    let a: Vec<f64> = (0..states)
+        .flat_map(|s| [0.3 - 0.01 * s as f64, -0.2, base_angle(s)])
+        .collect();
+    let a_dot: Vec<f64> = (0..states)
+        .flat_map(|s| [0.5, -0.1 * s as f64, 0.2])
+        .collect();
+    let tau_star = vec![0.4; 3 * states];
+    let expected = one_at_a_time(&model, &a, &a_dot, &tau_star).unwrap();
+    let got = batch(&model, &a, &a_dot, &tau_star).unwrap();
+    for (i, (x, y)) in got.iter().zip(&expected).enumerate() {
+        assert_eq!(x.to_bits(), y.to_bits(), "value {i}: {x} vs {y}");
+    }
+    // The huge base angle only turns the arm: the same accelerations as at its remainder mod
+    // 2 pi, to the rounding of the angles (1e6 rad carries about 1e-10 rad of it).
+    let mut near = a.clone();
+    for s in [13, 18, 29] {
+        near[3 * s + 2] = base_angle(s).rem_euclid(std::f64::consts::TAU);
+    }
+    let reference = one_at_a_time(&model, &near, &a_dot, &tau_star).unwrap();
+    for (i, (x, y)) in got.iter().zip(&reference).enumerate() {
+        assert!(
+            (x - y).abs() <= 1e-6 * (1.0 + y.abs()),
+            "value {i}: {x} vs {y}"
+        );
+    }
+}
+
 #[test]
 fn partial_states_are_refused() {
     let model = ReducedModel::new(
