@@ -30,7 +30,8 @@ const MAX_WIDTH: usize = 8;
 #[derive(Debug, Clone)]
 pub(crate) struct BatchWorkspace {
     work: Workspace<MAX_WIDTH>,
-    arch: Arch,
+    /// The instruction set of the dispatch.
+    pub(crate) arch: Arch,
 }
 
 impl BatchWorkspace {

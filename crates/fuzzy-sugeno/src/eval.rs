@@ -687,4 +687,28 @@ mod tests {
         assert_eq!(integer_power((), 1.5, 5), 7.59375);
         assert_eq!(integer_power((), 2.0, 64), 2f64.powi(64));
     }
+
+    /// Every instruction set gives every point the same bits, in a batch and alone (see
+    /// [`lane_math::instruction_sets`]), inputs inside and outside their ranges.
+    #[test]
+    fn every_instruction_set_gives_the_same_bits() {
+        let mut evaluator = Evaluator::new(crate::paper_controller());
+        let n_in = evaluator.system.inputs().len();
+        let n_out = evaluator.system.outputs().len();
+        let points = 29;
+        let inputs: Vec<f64> = (0..n_in * points)
+            .map(|i| 3.0 * ((i as f64) * 0.37).sin())
+            .collect();
+        let mut alone = vec![0.0; n_out * points];
+        for (x, y) in inputs.chunks_exact(n_in).zip(alone.chunks_exact_mut(n_out)) {
+            evaluator.eval(x, y).unwrap();
+        }
+        let bits = |x: &[f64]| x.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for arch in lane_math::instruction_sets() {
+            evaluator.batch.arch = arch;
+            let mut batch = vec![0.0; n_out * points];
+            evaluator.eval_batch(&inputs, &mut batch).unwrap();
+            assert_eq!(bits(&batch), bits(&alone), "{arch:?}");
+        }
+    }
 }

@@ -1,7 +1,9 @@
 #![doc = include_str!("../README.md")]
 
+mod instruction_sets;
 mod lanes;
 mod trig;
 
+pub use instruction_sets::instruction_sets;
 pub use lanes::{Lane, Pack};
 pub use trig::{REDUCTION_LIMIT, sin_cos, sin_cos_in_range, sin_cos_lanes};

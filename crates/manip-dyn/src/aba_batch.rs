@@ -247,3 +247,47 @@ fn group<S: Simd>(
 fn all_finite(values: &[f64]) -> bool {
     values.iter().fold(true, |all, v| all & v.is_finite())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{ChainData, Link, aba};
+
+    /// Every instruction set gives every state the same bits, in a batch and alone (see
+    /// [`lane_math::instruction_sets`]).
+    #[test]
+    fn every_instruction_set_gives_the_same_bits() {
+        let links: Vec<Link> = (0..13)
+            .map(|i| Link::uniform_beam(0.05 + 0.01 * (i % 5) as f64, 0.1 + 0.03 * i as f64))
+            .collect::<Result<_, _>>()
+            .unwrap();
+        let model = ChainModel::new(links, 9.81).unwrap();
+        let (n, states) = (model.n_links(), 19);
+        let value = |i: usize, scale: f64| scale * ((i as f64) * 0.7).sin();
+        let q: Vec<f64> = (0..n * states).map(|i| value(i, 1.3)).collect();
+        let v: Vec<f64> = (0..n * states).map(|i| value(i + 5, 2.0)).collect();
+        let tau: Vec<f64> = (0..n * states).map(|i| value(i + 9, 0.5)).collect();
+        let bits = |x: &[f64]| x.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let mut alone = vec![0.0; n * states];
+        let mut single = ChainData::new(&model);
+        for (s, out) in alone.chunks_exact_mut(n).enumerate() {
+            let state = s * n..(s + 1) * n;
+            aba(
+                &model,
+                &mut single,
+                &q[state.clone()],
+                &v[state.clone()],
+                &tau[state],
+                out,
+            )
+            .unwrap();
+        }
+        for arch in lane_math::instruction_sets() {
+            let mut data = AbaBatchData::new(&model);
+            data.arch = arch;
+            let mut batch = vec![0.0; n * states];
+            aba_batch(&model, &mut data, &q, &v, &tau, &mut batch).unwrap();
+            assert_eq!(bits(&batch), bits(&alone), "{arch:?}");
+        }
+    }
+}

@@ -287,3 +287,70 @@ fn group<S: Simd, const M: usize, const UNIT_LAST: bool>(
     }
     finite
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use backbone_kin::BaseAngle;
+    use manip_dyn::{ChainModel, Link};
+
+    /// Unequal links, and each modal family the batch has kernels for, and one beyond them.
+    fn models() -> Vec<ReducedModel> {
+        let links: Vec<Link> = (0..11)
+            .map(|i| Link::uniform_beam(0.05 + 0.01 * (i % 4) as f64, 0.1 + 0.02 * i as f64))
+            .collect::<Result<_, _>>()
+            .unwrap();
+        let chain = ChainModel::new(links, 9.81).unwrap();
+        [
+            (1, BaseAngle::Fixed(0.3)),
+            (1, BaseAngle::Free),
+            (2, BaseAngle::Fixed(-0.2)),
+            (2, BaseAngle::Free),
+            (3, BaseAngle::Free),
+        ]
+        .into_iter()
+        .map(|(harmonics, base)| ReducedModel::from_chain(chain.clone(), harmonics, base).unwrap())
+        .collect()
+    }
+
+    /// Every instruction set gives every state the same bits, in a batch and alone: the kernels
+    /// do the same operations in the same order, without fused multiply-adds, whatever the
+    /// width of the registers (8 lanes, 4 or 1), so results do not depend on the machine.
+    #[test]
+    fn every_instruction_set_gives_the_same_bits() {
+        for model in models() {
+            let m = model.n_coords();
+            let states = 19;
+            let value = |i: usize, scale: f64| scale * ((i as f64) * 0.7).sin();
+            let a: Vec<f64> = (0..m * states).map(|i| value(i, 1.1)).collect();
+            let a_dot: Vec<f64> = (0..m * states).map(|i| value(i + 5, 2.0)).collect();
+            let tau_star: Vec<f64> = (0..m * states).map(|i| value(i + 9, 3.0)).collect();
+            let mut reference: Option<Vec<u64>> = None;
+            for arch in lane_math::instruction_sets() {
+                let mut batch_data = ReducedBatchData::new(&model);
+                batch_data.arch = arch;
+                let mut batch = vec![0.0; m * states];
+                forward_dynamics_batch(&model, &mut batch_data, &a, &a_dot, &tau_star, &mut batch)
+                    .unwrap();
+                let mut data = ReducedData::new(&model);
+                data.arch = arch;
+                let mut alone = vec![0.0; m * states];
+                for (s, out) in alone.chunks_exact_mut(m).enumerate() {
+                    let state = s * m..(s + 1) * m;
+                    let (a, a_dot) = (&a[state.clone()], &a_dot[state.clone()]);
+                    forward_dynamics(&model, &mut data, a, a_dot, &tau_star[state], out).unwrap();
+                }
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(
+                    bits(&batch),
+                    bits(&alone),
+                    "m = {m}, {arch:?}: batch and alone"
+                );
+                match &reference {
+                    None => reference = Some(bits(&alone)),
+                    Some(expected) => assert_eq!(&bits(&alone), expected, "m = {m}, {arch:?}"),
+                }
+            }
+        }
+    }
+}
