@@ -51,7 +51,7 @@ pub enum BatchError {
 
 /// Workspace of [`forward_dynamics_batch`] for one [`ReducedModel`]: create it once, reuse it for
 /// every batch. Its memory is `O(n)` like a [`ReducedData`]'s (which it holds, for the states
-/// evaluated one at a time) plus seven buffers of `n` values per lane (`448 n` bytes).
+/// evaluated one at a time) plus eight buffers of `n` values per lane (`512 n` bytes).
 #[derive(Debug, Clone)]
 pub struct ReducedBatchData {
     /// Per link and lane (`[link][lane]`, `MAX_WIDTH` lanes): the absolute angle, its sine and

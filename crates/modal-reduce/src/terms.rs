@@ -762,8 +762,7 @@ fn link_products<L: Lane>([sin, cos, rate]: [L; 3], moment: L, length: L) -> [L;
 /// [`PRODUCTS`], each entry `W` values side by side (`W` the lanes of the layout's
 /// [`Value`](Layout::Value): one state's links have one, a batch's the states of a group).
 pub(crate) struct LinkBuffers<'a> {
-    /// `phi_l`, `[link][lane]`: the one-state pre-pass's (a batch keeps its angles in
-    /// registers, and leaves it empty).
+    /// `phi_l`, `[link][lane]`.
     pub(crate) angle: &'a mut [f64],
     /// `sin phi_l`, as `angle`.
     pub(crate) sin: &'a mut [f64],
@@ -803,7 +802,7 @@ impl LinkBuffers<'_> {
     }
 
     /// The entries of the first `registers` registers of `width` lanes, in the order of
-    /// [`LinkValues::registers`], to be written by [`store_link`].
+    /// [`values`](Self::values), to be written by [`store_link`]; and the angles.
     #[inline(always)]
     fn angles_and_registers(
         &mut self,
@@ -874,7 +873,7 @@ impl LinkBuffers<'_> {
     }
 }
 
-/// Writes a register of [`LinkBuffers::registers`].
+/// Writes a register of [`LinkBuffers::angles_and_registers`].
 #[inline(always)]
 fn store_link<L: Lane>(out: [&mut [f64]; 2 + PRODUCTS], values: [L; 2 + PRODUCTS]) {
     for (value, out) in values.into_iter().zip(out) {
