@@ -3,8 +3,6 @@
 //! and no allocation.
 
 use crate::common::*;
-use backbone_kin::ModalMap;
-use manip_dyn::ChainModel;
 use modal_reduce::{
     BatchError, ReduceError, ReducedBatchData, ReducedData, ReducedModel, forward_dynamics,
     forward_dynamics_batch,
@@ -101,11 +99,7 @@ proptest! {
 /// gets its own bits, whether its angles are reduced or go to `libm`.
 #[test]
 fn huge_angles_give_each_state_its_own_bits() {
-    let model = ReducedModel::new(
-        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
-        ModalMap::paper(10).unwrap(),
-    )
-    .unwrap();
+    let model = paper_arm();
     // Four groups of 8 (or eight of 4): ordinary; one lane at 6e5 (within the group bound);
     // one at 1e6 (beyond the bound, within the reduction); one at 3e6 (beyond both).
     let base_angle = |state: usize| match state {
@@ -144,11 +138,7 @@ fn huge_angles_give_each_state_its_own_bits() {
 
 #[test]
 fn partial_states_are_refused() {
-    let model = ReducedModel::new(
-        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
-        ModalMap::paper(10).unwrap(),
-    )
-    .unwrap();
+    let model = paper_arm();
     let mut data = ReducedBatchData::new(&model);
     let mut out = vec![0.0; 6];
     let err = forward_dynamics_batch(
@@ -178,11 +168,7 @@ fn partial_states_are_refused() {
 
 #[test]
 fn a_batch_allocates_nothing() {
-    let model = ReducedModel::new(
-        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
-        ModalMap::paper(10).unwrap(),
-    )
-    .unwrap();
+    let model = paper_arm();
     let states = 37;
     let a: Vec<f64> = (0..3 * states).map(|i| 0.1 * (i as f64).sin()).collect();
     let a_dot: Vec<f64> = (0..3 * states).map(|i| (i as f64).cos()).collect();

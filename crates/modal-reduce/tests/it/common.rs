@@ -122,3 +122,13 @@ pub fn to_vec(mat: faer::MatRef<'_, f64>) -> Vec<f64> {
     }
     out
 }
+
+/// The paper's arm: 10 equal links of 0.1 m and 0.1 kg, `g = 9.81`, the paper's map
+/// `(a1, a2, alpha0)`.
+pub fn paper_arm() -> ReducedModel {
+    ReducedModel::new(
+        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
+        ModalMap::paper(10).unwrap(),
+    )
+    .unwrap()
+}

@@ -140,11 +140,7 @@ proptest! {
 fn workspaces_and_inputs_are_checked() {
     use backbone_kin::ModalMap;
     use manip_dyn::ChainModel;
-    let model = ReducedModel::new(
-        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
-        ModalMap::paper(10).unwrap(),
-    )
-    .unwrap();
+    let model = paper_arm();
     let other = ReducedModel::new(
         ChainModel::uniform(8, 0.1, 0.1, 9.81).unwrap(),
         ModalMap::paper(8).unwrap(),

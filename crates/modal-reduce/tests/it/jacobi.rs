@@ -126,11 +126,7 @@ proptest! {
 /// so eq 18 diverges: reported, not returned.
 #[test]
 fn paper_arm_with_three_coordinates_diverges() {
-    let model = ReducedModel::new(
-        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
-        ModalMap::paper(10).unwrap(),
-    )
-    .unwrap();
+    let model = paper_arm();
     let mut data = ReducedData::new(&model);
     let mut a_ddot = [f64::NAN; 3];
     let poses = [
