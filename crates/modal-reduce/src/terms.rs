@@ -590,10 +590,9 @@ impl<S: Simd> Layout for StateLanes<S> {
             rate_l.store(rate);
         }
         let (moments, lengths) = (&constants.first_moment[..n], &constants.length[..n]);
-        let (angle, mut registers) = links.angles_and_registers(n, width);
+        let (angle, registers) = links.angles_and_registers(n, width);
         let per_link = angle.chunks_exact(width).zip(moments).zip(lengths);
-        for ((angle, &moment), &length) in per_link {
-            let Some(out) = registers.next() else { break };
+        for (((angle, &moment), &length), out) in per_link.zip(registers) {
             let rate = Pack::load(simd, &*out[2]);
             // Within the reduction's range: `angles_in_range` held (see `StateLanes`).
             let (sin, cos) = sin_cos_in_range(simd, Pack::load(simd, angle));
