@@ -6,8 +6,9 @@ use pulp::Arch;
 /// Every instruction set this processor can run, as [`pulp::Arch`] values to dispatch with: the
 /// widest ([`Arch::new`]), none ([`Arch::Scalar`], one lane), and on x86-64 AVX2 where present
 /// (4 lanes). A kernel written over [`Lane`](crate::Lane) does the same operations in the same
-/// order under each (no fused multiply-add), so it gives the same bits under each; the kernels'
-/// tests check it by running under every one of them.
+/// order under each, its fused multiply-adds rounded once by each ([`Lane::mul_add`](crate::Lane::mul_add)), so it
+/// gives the same bits under each; the kernels' tests check it by running under every one of
+/// them.
 ///
 /// ```
 /// let sets = lane_math::instruction_sets();

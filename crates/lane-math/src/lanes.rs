@@ -2,8 +2,10 @@
 //! in a SIMD register ([`Pack`]), so that one kernel serves a single state and a batch (in
 //! `modal-reduce`, `forward_dynamics` and `forward_dynamics_batch`).
 //!
-//! Both implementations do exactly the same operations in the same order (no fused multiply-add),
-//! so a state gives the same bits whether it is computed alone or in a batch.
+//! Both implementations do exactly the same operations in the same order, so a state gives the
+//! same bits whether it is computed alone or in a batch. That includes the fused multiply-adds
+//! ([`Lane::mul_add`]): one instruction with AVX2 and AVX-512, the correctly rounded software
+//! `fma` without them, rounded once either way.
 
 use std::ops::{Add, Div, Mul, Sub};
 
@@ -40,6 +42,12 @@ pub trait Lane:
     /// Whether every lane is greater than the same lane of `other` (false where either is NaN):
     /// one vector compare, for tests inside a kernel's loop.
     fn all_greater(self, other: Self) -> bool;
+    /// `self * factor + addend` in every lane, rounded once (a fused multiply-add: one
+    /// instruction with AVX2 and AVX-512, the correctly rounded software `fma` without them), so
+    /// every instruction set gives the same bits.
+    fn mul_add(self, factor: Self, addend: Self) -> Self;
+    /// `addend - self * factor` in every lane, rounded once (as [`mul_add`](Self::mul_add)).
+    fn neg_mul_add(self, factor: Self, addend: Self) -> Self;
     /// `|x|` in every lane.
     fn abs(self) -> Self;
     /// The smaller of the two values in every lane: `self` where `self < other`, else `other`
@@ -101,6 +109,16 @@ impl Lane for f64 {
     #[inline(always)]
     fn all_greater(self, other: Self) -> bool {
         self > other
+    }
+
+    #[inline(always)]
+    fn mul_add(self, factor: Self, addend: Self) -> Self {
+        f64::mul_add(self, factor, addend)
+    }
+
+    #[inline(always)]
+    fn neg_mul_add(self, factor: Self, addend: Self) -> Self {
+        f64::mul_add(-self, factor, addend)
     }
 
     #[inline(always)]
@@ -258,6 +276,26 @@ impl<S: Simd> Lane for Pack<S> {
         let every = simd.greater_than_or_equal_f64s(zero, zero);
         // The lanes where `self > other` fails; none when the first of them is past the end.
         simd.first_true_m64s(simd.xor_m64s(greater, every)) == Self::WIDTH
+    }
+
+    #[inline(always)]
+    fn mul_add(self, factor: Self, addend: Self) -> Self {
+        Self {
+            simd: self.simd,
+            value: self
+                .simd
+                .mul_add_f64s(self.value, factor.value, addend.value),
+        }
+    }
+
+    #[inline(always)]
+    fn neg_mul_add(self, factor: Self, addend: Self) -> Self {
+        Self {
+            simd: self.simd,
+            value: self
+                .simd
+                .negate_mul_add_f64s(self.value, factor.value, addend.value),
+        }
     }
 
     #[inline(always)]

@@ -6,14 +6,15 @@
 //! 1. Argument reduction (Cody-Waite): `x = k pi/2 + r` with `k` the integer nearest `x 2/pi`
 //!    and `|r| <= pi/4`, subtracting `k pi/2` in two parts (`pi/2 = HI + LO`, `HI` with 33
 //!    significant bits, so `k HI` and `x - k HI` are exact for `|k| < 2^20`, and `LO` the double
-//!    nearest `pi/2 - HI`: `k LO` rounds by at most `1e-20`, and `pi/2 - HI - LO` is below
-//!    `4e-27`, so `r` is within an ulp of `x - k pi/2`).
+//!    nearest `pi/2 - HI`; `pi/2 - HI - LO` is below `4e-27`), each subtraction one fused
+//!    multiply-add ([`Lane::mul_add`], rounded once), so `r` is within an ulp of `x - k pi/2`.
 //! 2. Minimax polynomials on `|r| <= pi/4`: `sin r = r + r^3 P(r^2)` and
 //!    `cos r = 1 + r^2 (-1/2 + r^2 Q(r^2))`, `P` and `Q` of degree 5, whose coefficients minimise the
 //!    largest relative error of `sin` (`3.6e-18`) and the largest error of `cos` (`5.6e-20`);
 //!    rounding (about one ulp) dominates. They take two and one fewer multiply-adds than the
 //!    Taylor polynomials of the same accuracy (to `r^17` and `r^16`), and are evaluated by
-//!    Estrin's scheme, whose chain of dependent operations is half Horner's.
+//!    Estrin's scheme, whose chain of dependent operations is half Horner's, in fused
+//!    multiply-adds (one operation, and one rounding, where a multiply and an add took two).
 //! 3. The quadrant `k mod 4` swaps and negates the pair.
 //!
 //! Angles beyond `2^19 pi` (where the exact products run out of bits) go to `libm::sincos`.
@@ -124,18 +125,18 @@ fn sin_cos_large(angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
 #[inline(always)]
 pub fn sin_cos_in_range<L: Lane>(context: L::Context, x: L) -> (L, L) {
     let splat = |c| L::splat(context, c);
-    let shifted = x * FRAC_2_PI + splat(ROUNDING_SHIFT);
+    let shifted = x.mul_add(splat(FRAC_2_PI), splat(ROUNDING_SHIFT));
     let k = shifted - splat(ROUNDING_SHIFT);
-    let r = (x - k * PIO2_HI) - k * PIO2_LO;
+    let r = k.neg_mul_add(splat(PIO2_LO), k.neg_mul_add(splat(PIO2_HI), x));
     let r2 = r * r;
     let r4 = r2 * r2;
     let sin_tail = estrin(splat, &SIN, r2, r4);
-    let mut cos_tail = estrin(splat, &COS, r2, r4);
+    let cos_tail = estrin(splat, &COS, r2, r4);
     // cos r = 1 + r^2 (-1/2 + r^2 Q(r^2)): one operation fewer than 1 - r^2/2 + r^4 Q(r^2), and
     // as accurate (one rounding of a value of at most 0.31 before the last addition).
-    cos_tail = cos_tail * r2 + splat(-0.5);
-    let sin_r = r + r * r2 * sin_tail;
-    let cos_r = splat(1.0) + r2 * cos_tail;
+    let cos_tail = cos_tail.mul_add(r2, splat(-0.5));
+    let sin_r = (r * r2).mul_add(sin_tail, r);
+    let cos_r = r2.mul_add(cos_tail, splat(1.0));
     // The low mantissa bits of `shifted` hold k in two's complement, so its bit 0 is k mod 2
     // and its bit 1 that of k div 2: k mod 4 = 0: (s, c); 1: (c, -s); 2: (-s, -c); 3: (-c, s).
     // Selections by bits rather than branches, so that the loops over angles vectorise.
@@ -151,10 +152,10 @@ pub fn sin_cos_in_range<L: Lane>(context: L::Context, x: L) -> (L, L) {
 /// pairs, then two steps in `t2`, so that its chain of dependent operations is half Horner's.
 #[inline(always)]
 fn estrin<L: Lane>(splat: impl Fn(f64) -> L, c: &[f64; 6], t: L, t2: L) -> L {
-    let low = splat(c[0]) + t * splat(c[1]);
-    let middle = splat(c[2]) + t * splat(c[3]);
-    let high = splat(c[4]) + t * splat(c[5]);
-    low + t2 * (middle + t2 * high)
+    let low = t.mul_add(splat(c[1]), splat(c[0]));
+    let middle = t.mul_add(splat(c[3]), splat(c[2]));
+    let high = t.mul_add(splat(c[5]), splat(c[4]));
+    t2.mul_add(t2.mul_add(high, middle), low)
 }
 
 #[cfg(test)]

@@ -196,6 +196,7 @@ impl WithSimd for Batch<'_> {
                 cos: &mut self.data.cos,
                 frames: &mut self.data.frames,
                 articulated: &mut self.data.articulated,
+                arch: self.data.arch,
             };
             let out = &mut self.qdd[range];
             if !group::<S>(simd, self.model, links, inputs, out) {

@@ -4,6 +4,7 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt;
 use faer::reborrow::ReborrowMut;
 use faer::{Mat, Par};
+use pulp::Arch;
 
 use crate::aba::ArticulatedLink;
 use crate::coriolis_matrix::SubtreeMotion;
@@ -43,6 +44,8 @@ pub struct ChainData {
     pub(crate) mass_row: Vec<f64>,
     /// The Cholesky forward dynamics' `n x n` matrix and scratch, once allocated.
     pub(crate) factorisation: Option<Factorisation>,
+    /// The instruction set found at construction, for the kernels compiled for it (the ABA).
+    pub(crate) arch: Arch,
 }
 
 /// The `n x n` part of a [`ChainData`], used by the Cholesky forward dynamics only.
@@ -110,6 +113,7 @@ impl ChainData {
             articulated: vec![ArticulatedLink::default(); n],
             mass_row: vec![0.0; n],
             factorisation: None,
+            arch: Arch::new(),
         }
     }
 

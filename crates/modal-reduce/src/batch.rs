@@ -15,6 +15,7 @@
 
 use pulp::{Arch, Simd, WithSimd};
 
+use crate::cache_aligned::CacheAligned;
 use crate::data::ReducedData;
 use crate::error::{ReduceError, check_len};
 use crate::forward::forward_dynamics;
@@ -56,11 +57,11 @@ pub enum BatchError {
 pub struct ReducedBatchData {
     /// Per link and lane (`[link][lane]`, `MAX_WIDTH` lanes): the absolute angle, its sine and
     /// cosine.
-    angle: Vec<f64>,
-    sin: Vec<f64>,
-    cos: Vec<f64>,
+    angle: CacheAligned,
+    sin: CacheAligned,
+    cos: CacheAligned,
     /// Per product, link and lane: the products of [`crate::terms`].
-    products: Vec<f64>,
+    products: CacheAligned,
     /// The one-state workspace.
     single: ReducedData,
     /// The instruction set found at construction.
@@ -72,10 +73,10 @@ impl ReducedBatchData {
     pub fn new(model: &ReducedModel) -> Self {
         let size = model.n_links() * MAX_WIDTH;
         Self {
-            angle: vec![0.0; size],
-            sin: vec![0.0; size],
-            cos: vec![0.0; size],
-            products: vec![0.0; PRODUCTS * size],
+            angle: CacheAligned::zeros(size),
+            sin: CacheAligned::zeros(size),
+            cos: CacheAligned::zeros(size),
+            products: CacheAligned::zeros(PRODUCTS * size),
             single: ReducedData::new(model),
             arch: Arch::new(),
         }
@@ -180,10 +181,10 @@ impl Batch<'_> {
             let range = first * M..(first + width) * M;
             let inputs = self.inputs.map(|x| &x[range.clone()]);
             let links = LinkBuffers {
-                angle: &mut self.data.angle,
-                sin: &mut self.data.sin,
-                cos: &mut self.data.cos,
-                products: &mut self.data.products,
+                angle: self.data.angle.get_mut(),
+                sin: self.data.sin.get_mut(),
+                cos: self.data.cos.get_mut(),
+                products: self.data.products.get_mut(),
                 links: self.model.n_links(),
             };
             let out = &mut self.a_ddot[range];
@@ -314,8 +315,9 @@ mod tests {
     }
 
     /// Every instruction set gives every state the same bits, in a batch and alone: the kernels
-    /// do the same operations in the same order, without fused multiply-adds, whatever the
-    /// width of the registers (8 lanes, 4 or 1), so results do not depend on the machine.
+    /// do the same operations in the same order, whatever the width of the registers (8 lanes,
+    /// 4 or 1), and every instruction set rounds a fused multiply-add once (in software without
+    /// AVX2), so results do not depend on the machine.
     #[test]
     fn every_instruction_set_gives_the_same_bits() {
         for model in models() {

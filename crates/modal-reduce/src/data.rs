@@ -5,6 +5,7 @@ use faer::{Mat, MatRef};
 use manip_dyn::ChainData;
 use pulp::Arch;
 
+use crate::cache_aligned::CacheAligned;
 use crate::error::{ReduceError, check_len};
 use crate::model::ReducedModel;
 use crate::terms::{PRODUCTS, Pair};
@@ -83,11 +84,11 @@ impl Projection {
 /// they are computed in whole registers.
 #[derive(Debug, Clone)]
 pub(crate) struct OneStateLinks {
-    pub(crate) angle: Vec<f64>,
-    pub(crate) sin: Vec<f64>,
-    pub(crate) cos: Vec<f64>,
+    pub(crate) angle: CacheAligned,
+    pub(crate) sin: CacheAligned,
+    pub(crate) cos: CacheAligned,
     /// `[product][link]`.
-    pub(crate) products: Vec<f64>,
+    pub(crate) products: CacheAligned,
 }
 
 /// Scratch of the default path for sizes without a specialised version (see [`crate::terms`]).
@@ -117,10 +118,10 @@ impl ReducedData {
             rhs: vec![0.0; m],
             iterate: vec![0.0; m],
             links: OneStateLinks {
-                angle: vec![0.0; n.next_multiple_of(LINK_PADDING)],
-                sin: vec![0.0; n.next_multiple_of(LINK_PADDING)],
-                cos: vec![0.0; n.next_multiple_of(LINK_PADDING)],
-                products: vec![0.0; PRODUCTS * n.next_multiple_of(LINK_PADDING)],
+                angle: CacheAligned::zeros(n.next_multiple_of(LINK_PADDING)),
+                sin: CacheAligned::zeros(n.next_multiple_of(LINK_PADDING)),
+                cos: CacheAligned::zeros(n.next_multiple_of(LINK_PADDING)),
+                products: CacheAligned::zeros(PRODUCTS * n.next_multiple_of(LINK_PADDING)),
             },
             scratch: TermScratch {
                 mass: vec![0.0; m * m],

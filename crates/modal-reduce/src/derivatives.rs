@@ -268,7 +268,7 @@ fn differentiate(
     let n = model.n_links();
     let g = model.chain().gravity();
     let (a_dot, a_ddot) = (&a_dot[..m], &a_ddot[..m]);
-    let (sin, cos) = (&data.links.sin[..n], &data.links.cos[..n]);
+    let (sin, cos) = (&data.links.sin.get()[..n], &data.links.cos.get()[..n]);
     let rows = &model.angle_rows()[..n * m];
     let constants = model.link_constants();
     let (lengths, moments) = (&constants.length[..n], &constants.first_moment[..n]);

@@ -2,6 +2,7 @@
 
 mod batch;
 mod batch_group;
+mod cache_aligned;
 mod data;
 mod derivatives;
 mod energy;

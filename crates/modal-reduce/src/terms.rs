@@ -87,8 +87,9 @@
 //! a register of consecutive links at a time), or one coordinate a number (`OneStateScalar`,
 //! when `m` exceeds the register); a batch ([`forward_dynamics_batch`]) has one coordinate of
 //! several states in a register (`StateLanes`). Every state gets the same operations in the
-//! same order in each, lane by lane, without fused multiply-adds, so a state gives the same bits
-//! alone or in a batch.
+//! same order in each, lane by lane, so a state gives the same bits alone or in a batch. Its
+//! fused multiply-adds ([`Lane::mul_add`], rounded once by every instruction set) take one
+//! operation where a multiply and an add took two, and half the latency.
 //!
 //! [`forward_dynamics_batch`]: crate::forward_dynamics_batch
 
@@ -225,10 +226,10 @@ pub(crate) fn accumulate_in_data<S: Simd>(
     };
     let m = model.n_coords();
     let link_buffers = LinkBuffers {
-        angle: &mut links.angle,
-        sin: &mut links.sin,
-        cos: &mut links.cos,
-        products: &mut links.products,
+        angle: links.angle.get_mut(),
+        sin: links.sin.get_mut(),
+        cos: links.cos.get_mut(),
+        products: links.products.get_mut(),
         links: model.link_constants().padded,
     };
     accumulate(layout, model, a, a_dot, m, link_buffers, &mut terms);
@@ -280,10 +281,10 @@ impl<const M: usize> StackTerms<M> {
         let mut joint = [[zero; 2]; M];
         let links = &mut data.links;
         let link_buffers = LinkBuffers {
-            angle: &mut links.angle,
-            sin: &mut links.sin,
-            cos: &mut links.cos,
-            products: &mut links.products,
+            angle: links.angle.get_mut(),
+            sin: links.sin.get_mut(),
+            cos: links.cos.get_mut(),
+            products: links.products.get_mut(),
             links: model.link_constants().padded,
         };
         let mut terms = Terms {
@@ -352,15 +353,20 @@ pub(crate) trait Layout: Copy {
     fn constant_row(self, row: &[f64], chunk: usize) -> Self::Register;
     /// Coordinate `k` of the row held in the registers `row`.
     fn coordinate(self, row: &[Self::Register], k: usize) -> Self::Value;
-    /// `x` times register `chunk` of the constant row `row` of `Phi` (see
+    /// The step `P_{l+1} = P_l + L_l w_l Phi_l` of register `chunk` of the columns `pair` of
+    /// `P_l`, from `L_l sin phi_l`, `L_l cos phi_l` and the constant row `row` of `Phi` (see
     /// [`constant_row`](Self::constant_row)).
     #[inline(always)]
-    fn times_phi(self, x: Self::Register, row: &[f64], chunk: usize) -> Self::Register {
-        x * self.constant_row(row, chunk)
+    fn joint_step(
+        self,
+        [px, py]: Pair<Self::Register>,
+        [l_sin, l_cos]: Pair<Self::Register>,
+        row: &[f64],
+        chunk: usize,
+    ) -> Pair<Self::Register> {
+        let phi = self.constant_row(row, chunk);
+        [l_sin.neg_mul_add(phi, px), l_cos.mul_add(phi, py)]
     }
-    /// Whether `G*` is summed in a loop of its own after the pass rather than in it (a batch,
-    /// whose pass has no register to spare).
-    const GRAVITY_APART: bool;
     /// The per-link values of all links into `links` (the pre-pass).
     fn link_values(
         self,
@@ -398,8 +404,6 @@ impl<S: Simd> CoordinateLanes<S> {
 impl<S: Simd> Layout for CoordinateLanes<S> {
     type Register = Pack<S>;
     type Value = f64;
-
-    const GRAVITY_APART: bool = false;
 
     #[inline(always)]
     fn register_context(self) -> S {
@@ -449,8 +453,6 @@ pub(crate) struct OneStateScalar<S>(pub(crate) S);
 impl<S: Simd> Layout for OneStateScalar<S> {
     type Register = f64;
     type Value = f64;
-
-    const GRAVITY_APART: bool = false;
 
     #[inline(always)]
     fn register_context(self) {}
@@ -515,8 +517,6 @@ impl<S: Simd> Layout for StateLanes<S> {
     type Register = Pack<S>;
     type Value = Pack<S>;
 
-    const GRAVITY_APART: bool = true;
-
     #[inline(always)]
     fn register_context(self) -> S {
         self.simd
@@ -548,11 +548,19 @@ impl<S: Simd> Layout for StateLanes<S> {
     }
 
     #[inline(always)]
-    fn times_phi(self, x: Pack<S>, row: &[f64], chunk: usize) -> Pack<S> {
+    fn joint_step(
+        self,
+        [px, py]: Pair<Pack<S>>,
+        [l_sin, l_cos]: Pair<Pack<S>>,
+        row: &[f64],
+        chunk: usize,
+    ) -> Pair<Pack<S>> {
         if chunk == self.unit {
-            x
+            // `x * 1 + y` rounds as `x + y`.
+            [px - l_sin, py + l_cos]
         } else {
-            x * self.constant_row(row, chunk)
+            let phi = self.constant_row(row, chunk);
+            [l_sin.neg_mul_add(phi, px), l_cos.mul_add(phi, py)]
         }
     }
 
@@ -686,12 +694,12 @@ impl<L: Lane> LinkInputs<L> for AcrossLinks<'_, L> {
     }
 
     #[inline(always)]
-    fn terms(&self, k: usize) -> (L, L) {
+    fn add_terms(&self, k: usize, angle: L, rate: L) -> (L, L) {
         let column = self.model.link_constants().angle_column(k);
         let phi = L::load(self.context, &column[self.l..]);
         (
-            L::splat(self.context, self.a[k]) * phi,
-            L::splat(self.context, self.a_dot[k]) * phi,
+            L::splat(self.context, self.a[k]).mul_add(phi, angle),
+            L::splat(self.context, self.a_dot[k]).mul_add(phi, rate),
         )
     }
 }
@@ -713,12 +721,16 @@ impl<S: Simd> LinkInputs<Pack<S>> for AcrossStates<'_, S> {
     }
 
     #[inline(always)]
-    fn terms(&self, k: usize) -> (Pack<S>, Pack<S>) {
+    fn add_terms(&self, k: usize, angle: Pack<S>, rate: Pack<S>) -> (Pack<S>, Pack<S>) {
         if k == self.unit {
-            return (self.a[k], self.a_dot[k]);
+            // `x * 1 + y` rounds as `x + y`.
+            return (angle + self.a[k], rate + self.a_dot[k]);
         }
         let phi = Pack::splat(self.simd, self.phi[k]);
-        (self.a[k] * phi, self.a_dot[k] * phi)
+        (
+            self.a[k].mul_add(phi, angle),
+            self.a_dot[k].mul_add(phi, rate),
+        )
     }
 }
 
@@ -726,8 +738,8 @@ impl<S: Simd> LinkInputs<Pack<S>> for AcrossStates<'_, S> {
 trait LinkInputs<L> {
     /// The number of coordinates `m`.
     fn coords(&self) -> usize;
-    /// `(a_k (Phi_l)_k, a_dot_k (Phi_l)_k)`.
-    fn terms(&self, k: usize) -> (L, L);
+    /// `(angle + a_k (Phi_l)_k, rate + a_dot_k (Phi_l)_k)`, each rounded once.
+    fn add_terms(&self, k: usize, angle: L, rate: L) -> (L, L);
 }
 
 /// `[phi_l, phi_dot_l]` of one link (or one lane's link each), from its angle offset `phi0_l`
@@ -741,9 +753,7 @@ fn link_angle_rate<L: Lane>(
     let mut angle = angle_offset;
     let mut rate = L::splat(context, 0.0);
     for k in 0..inputs.coords() {
-        let (angle_term, rate_term) = inputs.terms(k);
-        angle = angle + angle_term;
-        rate = rate + rate_term;
+        (angle, rate) = inputs.add_terms(k, angle, rate);
     }
     [angle, rate]
 }
@@ -947,50 +957,36 @@ pub(crate) fn accumulate<Y: Layout>(
     let links_rows = padded_rows(rows, n, m).zip(padded_rows(moment_rows, n, m));
     for ((row, moment_row), entries) in links_rows.zip(links.values(n, width)) {
         {
-            let [sin, cos, moment_rate2, l_sin, l_cos, drop_x, drop_y] = load_link(vc, entries);
+            let [sin, cos, moment_rate2, l_sin, l_cos, drop_x, drop_y]: [Y::Value; 2 + PRODUCTS] =
+                load_link(vc, entries);
             // w_l . q_l, which S_l Phi_l multiplies.
             // (No closures or array maps here: their bodies would be compiled without the
             // instruction set of the dispatch, and its intrinsics called, not inlined.)
-            let force = layout.spread(cos * q[1] - sin * q[0]);
+            let force = layout.spread(sin.neg_mul_add(q[0], cos * q[1]));
             let (sin, cos) = (layout.spread(sin), layout.spread(cos));
             let moment_rate2 = layout.spread(moment_rate2);
-            if !Y::GRAVITY_APART {
-                add_gravity(layout, gravity, cos, moment_row);
-            }
+            add_gravity(layout, gravity, cos, moment_row);
             let (l_sin, l_cos) = (layout.spread(l_sin), layout.spread(l_cos));
             for c in 0..chunks {
                 let moment_phi = layout.constant_row(moment_row, c);
                 let [px, py] = joint[c];
-                v[c] = cos * py - sin * px;
-                let along = cos * px + sin * py;
-                coriolis[c] = coriolis[c] + force * moment_phi - moment_rate2 * along;
+                v[c] = sin.neg_mul_add(px, cos * py);
+                let along = sin.mul_add(py, cos * px);
+                coriolis[c] =
+                    moment_rate2.neg_mul_add(along, force.mul_add(moment_phi, coriolis[c]));
             }
             // A += (S_l Phi_l)^T v_l^T, row by row.
             for (j, &moment_phi_j) in moment_row[..m].iter().enumerate() {
+                let moment_phi_j = Y::Register::splat(rc, moment_phi_j);
                 for c in 0..chunks {
                     let entry = &mut mass[j * chunks + c];
-                    *entry = *entry + v[c] * moment_phi_j;
+                    *entry = v[c].mul_add(moment_phi_j, *entry);
                 }
             }
             for (c, pair) in joint.iter_mut().enumerate() {
-                let [px, py] = *pair;
-                let (l_sin_phi, l_cos_phi) = (
-                    layout.times_phi(l_sin, row, c),
-                    layout.times_phi(l_cos, row, c),
-                );
-                *pair = [px - l_sin_phi, py + l_cos_phi];
+                *pair = layout.joint_step(*pair, [l_sin, l_cos], row, c);
             }
             q = [q[0] - drop_x, q[1] - drop_y];
-        }
-    }
-    // G* = g sum_l cos(phi_l) S_l Phi_l^T: it needs no prefix sum, so where its running sums
-    // would crowd the pass's registers it is summed in a loop of its own (the same operations in
-    // the same order either way).
-    if Y::GRAVITY_APART {
-        for (moment_row, [_, cos, ..]) in padded_rows(moment_rows, n, m).zip(links.values(n, width))
-        {
-            let cos = layout.spread(Y::Value::load(vc, cos));
-            add_gravity(layout, gravity, cos, moment_row);
         }
     }
     let g = model.chain().gravity();
@@ -1018,7 +1014,7 @@ fn add_gravity<Y: Layout>(
     moment_row: &[f64],
 ) {
     for (c, value) in gravity.iter_mut().enumerate() {
-        *value = *value + cos * layout.constant_row(moment_row, c);
+        *value = cos.mul_add(layout.constant_row(moment_row, c), *value);
     }
 }
 
