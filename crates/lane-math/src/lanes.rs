@@ -457,6 +457,41 @@ mod tests {
                     assert_eq!(pa.lane(i).to_bits(), a[i].to_bits());
                     assert_eq!(Lane::lane(a[i], 0).to_bits(), a[i].to_bits());
                 }
+                // A third operand for the fused multiply-adds.
+                let c: Vec<f64> = (0..width)
+                    .map(|i| VALUES[(start + 7 * i + 3) % 12])
+                    .collect();
+                let pc = Pack::load(simd, &c);
+                for (op, expect) in [
+                    (pa.mul_add(pb, pc), f64::mul_add as fn(f64, f64, f64) -> f64),
+                    (pa.neg_mul_add(pb, pc), |x: f64, y: f64, z: f64| {
+                        (-x).mul_add(y, z)
+                    }),
+                ] {
+                    op.store(&mut out);
+                    for i in 0..width {
+                        assert_eq!(out[i].to_bits(), expect(a[i], b[i], c[i]).to_bits());
+                    }
+                }
+                // Rounded once: (1 + 2^-30)(1 - 2^-30) - 1 is -2^-60 exactly, where a multiply
+                // and an add would give 0.
+                let (x, y) = (1.0 + 2f64.powi(-30), 1.0 - 2f64.powi(-30));
+                let fused =
+                    Pack::splat(simd, x).mul_add(Pack::splat(simd, y), Pack::splat(simd, -1.0));
+                let negated = Pack::splat(simd, -x)
+                    .neg_mul_add(Pack::splat(simd, y), Pack::splat(simd, -1.0));
+                for i in 0..width {
+                    assert_eq!(fused.lane(i), -(2f64.powi(-60)));
+                    assert_eq!(negated.lane(i), -(2f64.powi(-60)));
+                }
+                for i in 0..width {
+                    let (x, y, z) = (a[i], b[i], c[i]);
+                    assert_eq!(Lane::mul_add(x, y, z).to_bits(), x.mul_add(y, z).to_bits());
+                    assert_eq!(
+                        Lane::neg_mul_add(x, y, z).to_bits(),
+                        (-x).mul_add(y, z).to_bits()
+                    );
+                }
                 for i in 0..width {
                     let (x, y) = (a[i], b[i]);
                     assert_eq!(Lane::abs(x).to_bits(), x.abs().to_bits());
@@ -471,7 +506,7 @@ mod tests {
     }
 
     #[test]
-    fn abs_min_max_map_and_bits_lane_agree_with_f64_in_every_lane() {
+    fn pack_operations_agree_with_f64_in_every_lane() {
         Arch::new().dispatch(Check);
         // The instruction-set-free fallback too.
         Check.with_simd(pulp::Scalar::new());

@@ -364,9 +364,9 @@ pub(crate) trait Layout: Copy {
         row: &[f64],
         chunk: usize,
     ) -> Pair<Self::Register> {
-        let phi = self.constant_row(row, chunk);
-        [l_sin.neg_mul_add(phi, px), l_cos.mul_add(phi, py)]
+        joint_step_by([px, py], [l_sin, l_cos], self.constant_row(row, chunk))
     }
+
     /// The per-link values of all links into `links` (the pre-pass).
     fn link_values(
         self,
@@ -559,8 +559,7 @@ impl<S: Simd> Layout for StateLanes<S> {
             // `x * 1 + y` rounds as `x + y`.
             [px - l_sin, py + l_cos]
         } else {
-            let phi = self.constant_row(row, chunk);
-            [l_sin.neg_mul_add(phi, px), l_cos.mul_add(phi, py)]
+            joint_step_by([px, py], [l_sin, l_cos], self.constant_row(row, chunk))
         }
     }
 
@@ -609,6 +608,13 @@ impl<S: Simd> Layout for StateLanes<S> {
             store_link(out, [sin, cos, p0, p1, p2, p3, p4]);
         }
     }
+}
+
+/// `[px - l_sin phi, py + l_cos phi]`, each rounded once: the step of a column pair of `P_l`
+/// (see [`Layout::joint_step`]).
+#[inline(always)]
+fn joint_step_by<R: Lane>([px, py]: Pair<R>, [l_sin, l_cos]: Pair<R>, phi: R) -> Pair<R> {
+    [l_sin.neg_mul_add(phi, px), l_cos.mul_add(phi, py)]
 }
 
 /// Whether every link's absolute angle is within [`REDUCTION_LIMIT`] in every state of `a` (of
