@@ -44,7 +44,8 @@ pub struct ChainData {
     pub(crate) mass_row: Vec<f64>,
     /// The Cholesky forward dynamics' `n x n` matrix and scratch, once allocated.
     pub(crate) factorisation: Option<Factorisation>,
-    /// The instruction set found at construction, for the kernels compiled for it (the ABA).
+    /// The instruction set found at construction, for one state's sines and cosines in the ABA
+    /// (compiled for it, see `aba.rs`).
     pub(crate) arch: Arch,
 }
 
