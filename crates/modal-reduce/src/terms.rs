@@ -962,38 +962,35 @@ pub(crate) fn accumulate<Y: Layout>(
     let width = Y::Value::WIDTH;
     let links_rows = padded_rows(rows, n, m).zip(padded_rows(moment_rows, n, m));
     for ((row, moment_row), entries) in links_rows.zip(links.values(n, width)) {
-        {
-            let [sin, cos, moment_rate2, l_sin, l_cos, drop_x, drop_y]: [Y::Value; 2 + PRODUCTS] =
-                load_link(vc, entries);
-            // w_l . q_l, which S_l Phi_l multiplies.
-            // (No closures or array maps here: their bodies would be compiled without the
-            // instruction set of the dispatch, and its intrinsics called, not inlined.)
-            let force = layout.spread(sin.neg_mul_add(q[0], cos * q[1]));
-            let (sin, cos) = (layout.spread(sin), layout.spread(cos));
-            let moment_rate2 = layout.spread(moment_rate2);
-            add_gravity(layout, gravity, cos, moment_row);
-            let (l_sin, l_cos) = (layout.spread(l_sin), layout.spread(l_cos));
-            for c in 0..chunks {
-                let moment_phi = layout.constant_row(moment_row, c);
-                let [px, py] = joint[c];
-                v[c] = sin.neg_mul_add(px, cos * py);
-                let along = sin.mul_add(py, cos * px);
-                coriolis[c] =
-                    moment_rate2.neg_mul_add(along, force.mul_add(moment_phi, coriolis[c]));
-            }
-            // A += (S_l Phi_l)^T v_l^T, row by row.
-            for (j, &moment_phi_j) in moment_row[..m].iter().enumerate() {
-                let moment_phi_j = Y::Register::splat(rc, moment_phi_j);
-                for c in 0..chunks {
-                    let entry = &mut mass[j * chunks + c];
-                    *entry = v[c].mul_add(moment_phi_j, *entry);
-                }
-            }
-            for (c, pair) in joint.iter_mut().enumerate() {
-                *pair = layout.joint_step(*pair, [l_sin, l_cos], row, c);
-            }
-            q = [q[0] - drop_x, q[1] - drop_y];
+        let [sin, cos, moment_rate2, l_sin, l_cos, drop_x, drop_y]: [Y::Value; 2 + PRODUCTS] =
+            load_link(vc, entries);
+        // w_l . q_l, which S_l Phi_l multiplies.
+        // (No closures or array maps here: their bodies would be compiled without the
+        // instruction set of the dispatch, and its intrinsics called, not inlined.)
+        let force = layout.spread(sin.neg_mul_add(q[0], cos * q[1]));
+        let (sin, cos) = (layout.spread(sin), layout.spread(cos));
+        let moment_rate2 = layout.spread(moment_rate2);
+        add_gravity(layout, gravity, cos, moment_row);
+        let (l_sin, l_cos) = (layout.spread(l_sin), layout.spread(l_cos));
+        for c in 0..chunks {
+            let moment_phi = layout.constant_row(moment_row, c);
+            let [px, py] = joint[c];
+            v[c] = sin.neg_mul_add(px, cos * py);
+            let along = sin.mul_add(py, cos * px);
+            coriolis[c] = moment_rate2.neg_mul_add(along, force.mul_add(moment_phi, coriolis[c]));
         }
+        // A += (S_l Phi_l)^T v_l^T, row by row.
+        for (j, &moment_phi_j) in moment_row[..m].iter().enumerate() {
+            let moment_phi_j = Y::Register::splat(rc, moment_phi_j);
+            for c in 0..chunks {
+                let entry = &mut mass[j * chunks + c];
+                *entry = v[c].mul_add(moment_phi_j, *entry);
+            }
+        }
+        for (c, pair) in joint.iter_mut().enumerate() {
+            *pair = layout.joint_step(*pair, [l_sin, l_cos], row, c);
+        }
+        q = [q[0] - drop_x, q[1] - drop_y];
     }
     let g = model.chain().gravity();
     for value in gravity {
