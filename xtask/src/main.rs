@@ -110,9 +110,15 @@ fn test() -> Result<(), String> {
         "--quiet",
         "--disable-pip-version-check",
     ];
+    // The packages the Python tests need, one a line in crates/hrm-py/tests/requirements.txt.
+    let requirements = root
+        .join("crates")
+        .join("hrm-py")
+        .join("tests")
+        .join("requirements.txt");
     run(
         &python,
-        &[&pip[..], &["numpy", "pytest", "pin", "maturin"]].concat(),
+        &[&pip[..], &["-r", &requirements.to_string_lossy()]].concat(),
     )?;
     // The same command a user runs; maturin builds the extension in release mode, once.
     let package = root.join("crates").join("hrm-py");
