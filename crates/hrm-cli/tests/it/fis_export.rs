@@ -39,6 +39,36 @@ fn fcl_export_evaluates_like_the_fis_file() {
     assert_eq!(eval(FUZZYLITE_FCL), expected);
 }
 
+/// A name FCL cannot carry (a variable named `END_VAR`) is a one-line error naming it, exit 1,
+/// and nothing is written.
+#[test]
+fn fcl_export_refuses_a_keyword_name_and_writes_nothing() {
+    let dir = scratch("fis-export-fcl-keyword");
+    let fis = dir.join("keyword.fis");
+    let text = std::fs::read_to_string(PAPER_FIS)
+        .unwrap()
+        .replace("Name='da1'", "Name='END_VAR'");
+    std::fs::write(&fis, text).unwrap();
+    let out = dir.join("out");
+    let refused = hrm(&[
+        "fis",
+        "export",
+        "--format",
+        "fcl",
+        fis.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.starts_with("hrm: export: the input name 'END_VAR' cannot be written in FCL"),
+        "{stderr}"
+    );
+    assert!(!out.join("keyword.fcl").exists());
+}
+
 #[test]
 fn c_export_writes_the_header_and_source() {
     let dir = scratch("fis-export-c");
