@@ -119,7 +119,7 @@ pub(crate) fn warn_outside_range(evaluator: &Evaluator) {
             input.range[0],
             input.range[1]
         );
-        eprintln!("{}", crate::console::error_line(&line));
+        eprintln!("{}", console::error_line(&line));
     }
 }
 
