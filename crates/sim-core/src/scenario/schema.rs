@@ -376,7 +376,7 @@ impl NoiseSpec {
     }
 }
 
-/// The runaway bound, optional joint torque limits (reported) and optional actuator limits on
+/// The runaway bound, optional joint torque limits (reported) and optional limits (modal forces, not joint torques) on
 /// `tau*` (enforced).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -387,9 +387,11 @@ pub struct LimitsSpec {
     /// Joint torque limits (N m): one for all joints or one per joint; exceeding is reported.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joint_torque_nm: Option<TorqueLimit>,
-    /// Actuator saturation on the modal torques (N m): one limit for every coordinate or one per
-    /// coordinate (`m` entries), each finite and positive. The loop clamps every controller's
-    /// output to `[-limit_i, limit_i]` before applying it and records when it did.
+    /// Saturation of the modal forces `tau* = J^T tau` (N m): one limit for every coordinate or
+    /// one per coordinate (`m` entries), each finite and positive. They bound the modal
+    /// coordinates' generalised forces, not any joint torque (see `joint_torque_nm`). The loop
+    /// clamps every controller's output to `[-limit_i, limit_i]` before applying it and records
+    /// when it did.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tau_star: Option<ModalTorqueLimit>,
 }
