@@ -114,3 +114,26 @@ fn check_reads_fcl_without_the_notes_line() {
     assert!(notes.ends_with("paper.fis: nothing ignored"), "{notes}");
     assert_eq!(from_fcl, analysis);
 }
+
+/// `hrm fis eval` evaluates an input outside its range as given, as MATLAB's evalfis does, with
+/// one warning line on standard error; `--out-of-range clamp` evaluates it at the range's end.
+#[test]
+fn eval_takes_inputs_outside_their_ranges_as_given_with_a_warning() {
+    let x = ["-0.414", "-0.263", "0.904", "0.246"];
+    let as_given = hrm(&[&["fis", "eval", PAPER_FIS][..], &x[..]].concat());
+    assert!(stdout(&as_given).starts_with("tau1 = 75.933"));
+    let warning = String::from_utf8_lossy(&as_given.stderr);
+    assert_eq!(warning.lines().count(), 1, "{warning}");
+    assert!(
+        warning
+            .starts_with("hrm: warning: input 1 ('da1') = -0.414 is outside its range [-0.3, 0.3]"),
+        "{warning}"
+    );
+    let clamped = hrm(&[
+        &["fis", "eval", PAPER_FIS, "--out-of-range", "clamp"][..],
+        &x[..],
+    ]
+    .concat());
+    assert!(stdout(&clamped).starts_with("tau1 = 71.320"));
+    assert!(clamped.stderr.is_empty());
+}
