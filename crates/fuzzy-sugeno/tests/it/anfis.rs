@@ -13,15 +13,7 @@ use fuzzy_sugeno::{
 };
 use std::time::Instant;
 
-/// The Mackey-Glass delay equation `dx/dt = 0.2 x(t - tau) / (1 + x(t - tau)^10) - 0.1 x(t)`
-/// with `tau = 17`, `x(0) = 1.2`, `x(t) = 0` for `t < 0`, integrated by fourth-order Runge-Kutta
-/// with `per_unit` steps per time unit (a divisor of the delay's 17 units), the delayed value at
-/// half steps by cubic Hermite interpolation of the stored solution and its derivative, so the
-/// scheme keeps fourth order. Returns `x` at `t = 0, 1, ..., t_end`.
-///
-/// Jang integrates with step 0.1; on a chaotic attractor any integration error grows into a
-/// different trajectory within the benchmark's 1100 time units, so the benchmark uses a step at
-/// which halving it no longer moves the samples (tested below).
+/// How the delayed value `x(t - tau)` is taken at RK4's half steps.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Delay {
     /// Cubic Hermite interpolation of the stored solution at the half steps.
@@ -32,10 +24,20 @@ enum Delay {
     Held,
 }
 
+/// The Mackey-Glass delay equation `dx/dt = 0.2 x(t - tau) / (1 + x(t - tau)^10) - 0.1 x(t)`
+/// with `tau = 17`, `x(0) = 1.2`, `x(t) = 0` for `t < 0`, integrated by fourth-order Runge-Kutta
+/// with `per_unit` steps per time unit (a divisor of the delay's 17 units), the delayed value at
+/// half steps by cubic Hermite interpolation of the stored solution and its derivative, so the
+/// scheme keeps fourth order. Returns `x` at `t = 0, 1, ..., t_end`.
+///
+/// Jang integrates with step 0.1; on a chaotic attractor any integration error grows into a
+/// different trajectory within the benchmark's 1100 time units, so the benchmark is run on Jang's
+/// step and on a step at which halving it no longer moves the samples (tested below).
 fn mackey_glass(t_end: usize, per_unit: usize) -> Vec<f64> {
     mackey_glass_with(t_end, per_unit, Delay::Hermite)
 }
 
+/// [`mackey_glass`] with the delayed value at the half steps taken by `delay_rule`.
 fn mackey_glass_with(t_end: usize, per_unit: usize, delay_rule: Delay) -> Vec<f64> {
     const TAU: usize = 17;
     let h = 1.0 / per_unit as f64;
@@ -71,12 +73,9 @@ fn mackey_glass_with(t_end: usize, per_unit: usize, delay_rule: Delay) -> Vec<f6
     x.into_iter().step_by(per_unit).collect()
 }
 
-/// Jang's 1000 pairs `[x(t-18), x(t-12), x(t-6), x(t); x(t+6)]` for `t = 118 ... 1117`, split
-/// into the first 500 (training) and the last 500 (check).
-fn mackey_glass_data() -> (TrainingData, TrainingData) {
-    mackey_glass_pairs(&mackey_glass(1123, STEPS_PER_UNIT))
-}
-
+/// Jang's 1000 pairs `[x(t-18), x(t-12), x(t-6), x(t); x(t+6)]` for `t = 118 ... 1117` of the
+/// series `x` (sampled at `t = 0, 1, ...`), split into the first 500 (training) and the last 500
+/// (check).
 fn mackey_glass_pairs(x: &[f64]) -> (TrainingData, TrainingData) {
     let rows = |ts: std::ops::Range<usize>| {
         let values = ts
