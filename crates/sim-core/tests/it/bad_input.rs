@@ -575,3 +575,50 @@ fn limits_and_peaks_checked_between_recorded_samples() {
     assert_ne!(sparse.tip_error_rms_m, every.tip_error_rms_m);
     assert_ne!(sparse.tip_error_max_m, every.tip_error_max_m);
 }
+
+#[test]
+fn an_infinite_runaway_bound_is_refused_by_simulate_as_by_sweep() {
+    let mut scenario = sim_core::Scenario::builtin("paper-responses-step").unwrap();
+    scenario.limits.max_modal_error = f64::INFINITY;
+    let message = scenario.build().err().expect("refused").to_string();
+    assert!(
+        message.contains("limits.max_modal_error") && message.contains("must be finite, got inf"),
+        "{message}"
+    );
+    // The library loop itself still takes an infinite bound (no runaway check).
+    let mut s = settings();
+    s.max_modal_error = f64::INFINITY;
+    assert!(build(s).is_ok());
+}
+
+#[test]
+fn non_regular_input_files_are_refused_not_waited_on() {
+    let dir = std::env::temp_dir().join(format!("sim-core-fifo-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("controller.fis");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    if made {
+        // A FIFO as a scenario file and as a scenario's `controller.fis`: refused at once.
+        let message = sim_core::Scenario::resolve(fifo.to_str().unwrap())
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(message.contains("not a regular file"), "{message}");
+        let text = format!(
+            "{}\n",
+            sim_core::Scenario::builtin_text("paper-responses-step")
+                .unwrap()
+                .replace(
+                    "kind = \"fuzzy\"",
+                    &format!("kind = \"fuzzy\"\nfis = {:?}", fifo.to_str().unwrap())
+                )
+        );
+        let scenario = sim_core::Scenario::from_toml(&text).unwrap();
+        let message = scenario.build().err().expect("refused").to_string();
+        assert!(message.contains("not a regular file"), "{message}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
