@@ -39,32 +39,32 @@
 //! algorithms are derived in `docs/theory.md` ("Spatial chains").
 
 mod aba;
-//TMP mod aba_batch;
-//TMP mod aba_derivatives;
+mod aba_batch;
+mod aba_derivatives;
 mod algebra;
 mod bias;
 mod crba;
 mod data;
-//TMP mod derivative_data;
+mod derivative_data;
 mod energy;
 mod kinematics;
 mod model;
 mod rnea;
-//TMP mod rnea_derivatives;
+mod rnea_derivatives;
 
 pub use aba::aba;
-//TMP pub use aba_batch::{SpatialBatchData, aba_batch};
-//TMP pub use aba_derivatives::aba_derivatives;
+pub use aba_batch::{SpatialBatchData, aba_batch};
+pub use aba_derivatives::aba_derivatives;
 pub use algebra::{Force, Mat3, Motion, Transform, Vec3};
 pub use bias::{coriolis, gravity, nonlinear_effects};
 pub use crba::mass_matrix;
 pub use data::SpatialData;
-//TMP pub use derivative_data::SpatialDerivativeData;
+pub use derivative_data::SpatialDerivativeData;
 pub use energy::{kinetic_energy, potential_energy};
 pub use kinematics::{forward_kinematics, jacobian};
 pub use model::{JointKind, SpatialJoint, SpatialLink, SpatialModel};
 pub use rnea::rnea;
-//TMP pub use rnea_derivatives::rnea_derivatives;
+pub use rnea_derivatives::rnea_derivatives;
 
 use crate::check;
 use crate::error::DynError;

@@ -3,3 +3,5 @@
 //! random spatial chains), and `sample` for the random chains.
 
 mod planar;
+mod properties;
+pub mod sample;
