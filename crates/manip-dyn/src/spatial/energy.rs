@@ -34,10 +34,10 @@ pub fn kinetic_energy(
     update_placements(model, data, q);
     let mut velocity = Motion::default();
     let mut twice = 0.0;
-    for i in 0..model.n_links() {
-        velocity = data.placements[i]
+    for (i, (placement, rate)) in data.placements.iter().zip(v).enumerate() {
+        velocity = placement
             .inv_act_motion(&velocity)
-            .plus(&model.axes[i].times(v[i]));
+            .plus(&model.axes[i].times(*rate));
         twice += velocity.dot(&model.inertias[i].apply((), &velocity));
     }
     check::finite_scalar("kinetic energy", 0.5 * twice)
