@@ -21,7 +21,7 @@ mod system;
 pub use analysis::{AnalysisOptions, AnalysisReport};
 pub use builder::SystemBuilder;
 pub use error::{ConsequentParameter, FuzzyError, LearningProblem, SystemProblem};
-pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange};
+pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange, OutsideRange};
 #[cfg(feature = "formats")]
 pub use export_c::CSource;
 #[cfg(feature = "formats")]

@@ -9,6 +9,6 @@ pub mod summary_json;
 pub use input_file::{MAX_INPUT_FILE_BYTES, read_text_file};
 pub use scenario::{
     Alpha0, ArmSpec, BranchSpec, CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup,
-    ControllerSpec, InitialSpec, IntegratorSpec, LimitsSpec, ModalSpec, ModalTorqueLimit,
-    NoiseSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec, TorqueLimit,
+    ControllerSpec, FuzzyInputRange, InitialSpec, IntegratorSpec, LimitsSpec, ModalSpec,
+    ModalTorqueLimit, NoiseSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec, TorqueLimit,
 };
