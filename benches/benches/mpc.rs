@@ -9,7 +9,7 @@ use backbone_kin::ModalMap;
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use manip_dyn::ChainModel;
 use modal_reduce::ReducedModel;
-use sim_core::optimal::{Mpc, MpcSettings};
+use optimal_ctl::{Mpc, MpcSettings};
 use sim_core::reference::{Reference, ReferenceSample, Sinusoid};
 use std::hint::black_box;
 

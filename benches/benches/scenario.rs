@@ -16,7 +16,8 @@
 //! Criterion's throughput is in runs, so both read as time per run.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use sim_core::{ControllerKind, Lockstep, NoiseSpec, Scenario, Simulation};
+use sim_core::{Lockstep, Simulation};
+use sim_study::{ControllerKind, NoiseSpec, Scenario};
 use std::hint::black_box;
 use std::time::Duration;
 

@@ -2,7 +2,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use sim_core::Scenario;
+use sim_study::Scenario;
 
 fuzz_target!(|text: &str| {
     if let Ok(scenario) = Scenario::from_toml(text) {

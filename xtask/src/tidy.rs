@@ -31,13 +31,15 @@ const REPOSITORY: &str = "https://github.com/hrm-toolkit/hrm";
 const UNSAFE_FILES: [&str; 1] = ["crates/fuzzy-sugeno/src/kernel.rs"];
 
 /// The workspace's library crates (published, usable alone).
-const LIBRARIES: [&str; 7] = [
+const LIBRARIES: [&str; 9] = [
     "lane-math",
     "backbone-kin",
     "manip-dyn",
     "modal-reduce",
     "fuzzy-sugeno",
+    "optimal-ctl",
     "sim-core",
+    "sim-study",
     "hrm",
 ];
 

@@ -5,10 +5,14 @@ mod batch;
 mod builder;
 mod error;
 mod eval;
+#[cfg(feature = "formats")]
 mod export_c;
+#[cfg(feature = "formats")]
 mod fcl;
+#[cfg(feature = "formats")]
 mod fis;
 mod kernel;
+#[cfg(feature = "learn")]
 pub mod learn;
 mod membership;
 mod paper;
@@ -18,7 +22,9 @@ pub use analysis::{AnalysisOptions, AnalysisReport, COVERAGE_ROUNDING};
 pub use builder::SystemBuilder;
 pub use error::{ConsequentParameter, FuzzyError, LearningProblem, SystemProblem};
 pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange, OutsideRange};
+#[cfg(feature = "formats")]
 pub use export_c::CSource;
+#[cfg(feature = "formats")]
 pub use fis::FisNote;
 pub use membership::MembershipFn;
 pub use paper::{PaperController, paper_controller};

@@ -233,6 +233,10 @@ impl MembershipFn {
 
     /// The function of the same kind with parameters `p` (MATLAB's order, this kind's count),
     /// not validated.
+    #[cfg_attr(
+        not(feature = "learn"),
+        allow(dead_code, reason = "only learning moves parameters")
+    )]
     pub(crate) fn with_params(&self, p: &[f64]) -> Self {
         (self.kind().build)(p)
     }
@@ -403,10 +407,18 @@ pub(crate) struct Kind {
     /// MATLAB's type name (`.fis`).
     pub(crate) matlab: &'static str,
     /// fuzzylite's term class (FCL); triangles and trapezoids are written as IEC point lists.
+    #[cfg_attr(
+        not(feature = "formats"),
+        allow(dead_code, reason = "read by the FCL format")
+    )]
     pub(crate) fcl: &'static str,
     /// How many parameters the kind takes.
     pub(crate) parameters: usize,
     /// fuzzylite's parameter order: FCL position `i` holds MATLAB's parameter `fcl_order[i]`.
+    #[cfg_attr(
+        not(feature = "formats"),
+        allow(dead_code, reason = "read by the FCL format")
+    )]
     pub(crate) fcl_order: &'static [usize],
     /// The function with these parameters (MATLAB's order, [`Kind::parameters`] of them), not
     /// validated.
@@ -423,6 +435,10 @@ impl Kind {
     }
 
     /// The kind of fuzzylite term class `class`.
+    #[cfg_attr(
+        not(feature = "formats"),
+        allow(dead_code, reason = "read by the FCL format")
+    )]
     pub(crate) fn by_fcl_class(class: &str) -> Option<&'static Kind> {
         KINDS.iter().find(|kind| kind.fcl == class)
     }

@@ -1,9 +1,9 @@
 //! Numbers from the command line checked against their bounds before they reach an allocation
 //! or a loop. Counts are parsed as wide signed integers (with negative numbers allowed), so that
 //! `--seeds -1` gets the option's own message rather than a parse error. Controller names come
-//! from the one controller table, `sim_core::CONTROLLERS`.
+//! from the one controller table, `sim_study::CONTROLLERS`.
 
-use sim_core::{CONTROLLERS, ControllerKind};
+use sim_study::{CONTROLLERS, ControllerKind};
 use std::sync::LazyLock;
 
 /// Every controller's name, comma-separated: the default of list options.

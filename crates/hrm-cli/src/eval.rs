@@ -17,7 +17,8 @@ use modal_reduce::{ReduceError, ReducedData, ReducedModel};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer};
 use serde_json::{Map, Value, json};
-use sim_core::{ArmSpec, SimError};
+use sim_core::SimError;
+use sim_study::ArmSpec;
 use std::io::{BufRead, Write};
 
 mod derivatives;

@@ -4,9 +4,10 @@
 use crate::output_dir::OutputDir;
 use crate::{console, figures, progress, report};
 use serde_json::json;
-use sim_core::imitation::{self, ImitationOptions};
-use sim_core::study::{self, ComparisonRun as Outcome, run_one};
-use sim_core::{ControllerKind, ReferenceSpec, Run, Scenario};
+use sim_core::Run;
+use sim_study::imitation::{self, ImitationOptions};
+use sim_study::study::{self, ComparisonRun as Outcome, run_one};
+use sim_study::{ControllerKind, ReferenceSpec, Scenario};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -266,7 +267,7 @@ fn outcome_json(outcome: &Outcome) -> serde_json::Value {
 /// and the time it `stopped_at_s`.
 fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    let summary = sim_core::summary_json::run(&outcome.result);
+    let summary = sim_study::summary_json::run(&outcome.result);
     let run = match &outcome.result {
         Ok(run) => Some(run),
         Err(stopped) => stopped.partial.as_ref(),

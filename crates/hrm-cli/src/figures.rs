@@ -4,7 +4,8 @@
 
 use crate::fis_cmd;
 use crate::plot::{self, Labels, Panel, Series, Style};
-use sim_core::{ControllerKind, Record, Run, Scenario};
+use sim_core::{Record, Run};
+use sim_study::{ControllerKind, Scenario};
 use std::path::{Path, PathBuf};
 
 /// At most this many points per curve: enough for a smooth line, small enough for a light SVG.

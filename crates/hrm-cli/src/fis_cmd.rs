@@ -191,9 +191,9 @@ fn load_system(text: &str) -> Result<FuzzySystem, String> {
     FuzzySystem::from_fis(text).map_err(|e| e.to_string())
 }
 
-/// The text of `path`, read up to [`sim_core::MAX_INPUT_FILE_BYTES`].
+/// The text of `path`, read up to [`sim_study::MAX_INPUT_FILE_BYTES`].
 fn read_text(path: &Path) -> Result<String, String> {
-    sim_core::read_text_file(path, sim_core::MAX_INPUT_FILE_BYTES)
+    sim_study::read_text_file(path, sim_study::MAX_INPUT_FILE_BYTES)
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 

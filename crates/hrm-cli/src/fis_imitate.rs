@@ -1,11 +1,11 @@
 //! `hrm fis imitate`: a fuzzy controller learned from a teacher controller on training scenarios
-//! (`sim_core::imitation`), written as a MATLAB `.fis` file that any scenario with the same
+//! (`sim_study::imitation`), written as a MATLAB `.fis` file that any scenario with the same
 //! modal coordinates takes as its `controller.fis`.
 
 use crate::{args, output_dir, progress};
 use clap::Args;
-use sim_core::imitation::{self, ImitationOptions, MAX_EPOCHS, MAX_SETS, MAX_STRIDE};
-use sim_core::{ControllerKind, Scenario};
+use sim_study::imitation::{self, ImitationOptions, MAX_EPOCHS, MAX_SETS, MAX_STRIDE};
+use sim_study::{ControllerKind, Scenario};
 use std::path::PathBuf;
 
 /// From this many epochs in all, a progress bar shows on a terminal.

@@ -155,7 +155,7 @@ fn path(p: Option<&Path>) -> String {
 fn read_csv(file: &Path) -> Result<TrainingData, String> {
     let fail = |message: String| format!("{}: {message}", file.display());
     // Read with the limit, not by the size alone: `/dev/zero` or a pipe reports size 0.
-    let text = sim_core::read_text_file(file, MAX_CSV_BYTES).map_err(|e| fail(e.to_string()))?;
+    let text = sim_study::read_text_file(file, MAX_CSV_BYTES).map_err(|e| fail(e.to_string()))?;
     parse_csv(&text).map_err(fail)
 }
 

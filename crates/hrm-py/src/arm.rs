@@ -6,7 +6,7 @@ use manip_dyn::faer::MatMut;
 use manip_dyn::{AbaBatchData, BatchError, ChainData, ChainModel, DynError, MAX_DENSE_LINKS};
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
-use sim_core::ArmSpec;
+use sim_study::ArmSpec;
 use std::sync::Mutex;
 
 /// A planar serial chain of revolute joints under gravity along -y (the paper's eq 12:

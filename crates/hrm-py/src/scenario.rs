@@ -1,7 +1,7 @@
 //! `hrm.Scenario`, `hrm.Settings` and `hrm.Run`: the closed-loop experiments of `sim-core`
 //! (section 5 of the paper) from Python, closed by a built-in controller or a Python callable.
 //!
-//! A scenario's settings are its TOML keys (`sim_core::Scenario`), read and written as
+//! A scenario's settings are its TOML keys (`sim_study::Scenario`), read and written as
 //! attributes: `scenario.duration`, `scenario.arm.links`, `scenario.reference.sine.amplitude`.
 //! A write is converted to a TOML value and the whole scenario is deserialised again, so a
 //! wrong type or an unknown key is refused at once with the library's message; domains
@@ -16,8 +16,8 @@ use pyo3::exceptions::{PyAttributeError, PyFileNotFoundError, PyOSError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use sim_core::controller::{ControlContext, Controller, ControllerError};
-use sim_core::study::Stopped;
-use sim_core::{ControllerKind, ScenarioError};
+use sim_study::study::Stopped;
+use sim_study::{ControllerKind, ScenarioError};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, MutexGuard};
 
@@ -31,25 +31,25 @@ use std::sync::{Arc, Mutex, MutexGuard};
 /// are refused by run(), with the messages `hrm simulate` prints. None removes an optional key.
 #[pyclass(module = "hrm", frozen)]
 pub struct Scenario {
-    inner: Mutex<sim_core::Scenario>,
+    inner: Mutex<sim_study::Scenario>,
 }
 
 impl Scenario {
     /// A Python scenario holding `scenario`.
-    pub(crate) fn wrap(scenario: sim_core::Scenario) -> Self {
+    pub(crate) fn wrap(scenario: sim_study::Scenario) -> Self {
         Self {
             inner: Mutex::new(scenario),
         }
     }
 
-    fn lock(&self) -> MutexGuard<'_, sim_core::Scenario> {
+    fn lock(&self) -> MutexGuard<'_, sim_study::Scenario> {
         self.inner
             .lock()
             .unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 
     /// A copy of the library's scenario.
-    pub(crate) fn get(&self) -> sim_core::Scenario {
+    pub(crate) fn get(&self) -> sim_study::Scenario {
         self.lock().clone()
     }
 }
@@ -67,7 +67,7 @@ fn scenario_error(error: ScenarioError) -> PyErr {
 }
 
 /// The scenario as a TOML table (every key it would write to a file).
-fn table(scenario: &sim_core::Scenario) -> PyResult<toml::Table> {
+fn table(scenario: &sim_study::Scenario) -> PyResult<toml::Table> {
     match toml::Value::try_from(scenario) {
         Ok(toml::Value::Table(table)) => Ok(table),
         Ok(_) => unreachable!("a scenario serialises to a table"),
@@ -95,7 +95,7 @@ fn with_setting(
     path: &[String],
     key: &str,
     value: Option<toml::Value>,
-) -> Result<sim_core::Scenario, Error> {
+) -> Result<sim_study::Scenario, Error> {
     let dotted = dotted(path, key);
     let parent = lookup_mut(&mut table, path)
         .ok_or_else(|| Error::input(format!("{dotted}: the scenario has no such table")))?;
@@ -104,7 +104,7 @@ fn with_setting(
         None => parent.remove(key),
     };
     toml::Value::Table(table)
-        .try_into::<sim_core::Scenario>()
+        .try_into::<sim_study::Scenario>()
         .map_err(|e| Error::input(format!("{dotted}: {}", e.message().trim_end())))
 }
 
@@ -513,14 +513,14 @@ impl Scenario {
     #[staticmethod]
     fn builtin(name: &str) -> PyResult<Self> {
         Ok(Self::wrap(
-            sim_core::Scenario::builtin(name).map_err(scenario_error)?,
+            sim_study::Scenario::builtin(name).map_err(scenario_error)?,
         ))
     }
 
     /// The names of the shipped scenarios.
     #[staticmethod]
     fn builtin_names() -> Vec<&'static str> {
-        sim_core::Scenario::builtin_names().collect()
+        sim_study::Scenario::builtin_names().collect()
     }
 
     /// Reads a scenario: `path_or_text` is a path (str or os.PathLike; a relative controller.fis
@@ -530,8 +530,8 @@ impl Scenario {
     #[staticmethod]
     fn from_toml(path_or_text: &Bound<'_, PyAny>) -> PyResult<Self> {
         let scenario = match path_or_text.extract::<String>() {
-            Ok(text) if text.contains('\n') => sim_core::Scenario::from_toml(&text),
-            _ => sim_core::Scenario::load(&path_or_text.extract::<PathBuf>()?),
+            Ok(text) if text.contains('\n') => sim_study::Scenario::from_toml(&text),
+            _ => sim_study::Scenario::load(&path_or_text.extract::<PathBuf>()?),
         };
         Ok(Self::wrap(scenario.map_err(scenario_error)?))
     }
@@ -696,11 +696,11 @@ fn matrix(py: Python<'_>, values: Vec<f64>, width: usize) -> Py<PyAny> {
 impl Run {
     fn new(
         py: Python<'_>,
-        scenario: &sim_core::Scenario,
+        scenario: &sim_study::Scenario,
         controller: &str,
         result: Result<sim_core::Run, Stopped>,
     ) -> PyResult<Self> {
-        let json = sim_core::summary_json::run(&result).to_string();
+        let json = sim_study::summary_json::run(&result).to_string();
         let summary = py
             .import("json")?
             .call_method1("loads", (json,))?

@@ -1,4 +1,4 @@
-//! `hrm.Sweep`: the Monte Carlo sweeps of `hrm sweep` (`sim_core::study`) from Python, whole or
+//! `hrm.Sweep`: the Monte Carlo sweeps of `hrm sweep` (`sim_study::study`) from Python, whole or
 //! shard by shard, so that Slurm, Dask, Ray or `concurrent.futures` can schedule the shards
 //! (docs/sweep.md). Runs release the GIL and use all cores (rayon).
 
@@ -6,8 +6,8 @@ use crate::errors::Error;
 use crate::scenario::Scenario;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use sim_core::ControllerKind;
-use sim_core::study::{self, Shard, ShardFile, SweepConfig, SweepSettings};
+use sim_study::ControllerKind;
+use sim_study::study::{self, Shard, ShardFile, SweepConfig, SweepSettings};
 use std::path::{Path, PathBuf};
 
 /// A sweep: one scenario run with several controllers at several sensor-noise levels, `seeds`
@@ -41,7 +41,7 @@ fn json_to_py<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
 /// The `summary.json` of a whole sweep (`hrm sweep`'s), as a dict.
 fn summary<'py>(py: Python<'py>, whole: &ShardFile) -> PyResult<Bound<'py, PyDict>> {
     let cells = study::cells(&whole.config, &whole.runs);
-    let text = sim_core::summary_json::sweep(&whole.config, &cells).to_string();
+    let text = sim_study::summary_json::sweep(&whole.config, &cells).to_string();
     Ok(json_to_py(py, &text)?.cast_into::<PyDict>()?)
 }
 
@@ -81,7 +81,7 @@ impl Sweep {
             Ok(s) => s.get().get(),
             Err(_) => {
                 let name: PathBuf = scenario.extract()?;
-                sim_core::Scenario::resolve(&name.to_string_lossy())
+                sim_study::Scenario::resolve(&name.to_string_lossy())
                     .map_err(|e| input(e.to_string()))?
             }
         };

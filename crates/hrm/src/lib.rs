@@ -4,7 +4,9 @@ pub use backbone_kin;
 pub use fuzzy_sugeno;
 pub use manip_dyn;
 pub use modal_reduce;
+pub use optimal_ctl;
 pub use sim_core;
+pub use sim_study;
 
 /// What a first program needs, in one `use hrm::prelude::*;`.
 pub mod prelude {
@@ -21,7 +23,6 @@ pub mod prelude {
     pub use sim_core::reference::{
         CartesianPath, PathShape, Reference, ReferenceSample, Sinusoid, Step,
     };
-    pub use sim_core::{
-        ControllerKind, Integrator, LoopSettings, Run, Scenario, SimError, Simulation,
-    };
+    pub use sim_core::{Integrator, LoopSettings, Run, SimError, Simulation};
+    pub use sim_study::{ControllerKind, Scenario};
 }

@@ -178,7 +178,7 @@ impl SimError {
     }
 
     /// An [`InvalidSetting`](Self::InvalidSetting) error.
-    pub(crate) fn setting(name: impl Into<String>, requirement: impl Into<String>) -> Self {
+    pub fn setting(name: impl Into<String>, requirement: impl Into<String>) -> Self {
         Self::InvalidSetting {
             name: name.into(),
             requirement: requirement.into(),
@@ -210,8 +210,9 @@ pub(crate) fn check_non_negative(name: &str, value: f64) -> Result<(), SimError>
     }
 }
 
-/// Checks that every entry of `values` is finite.
-pub(crate) fn check_finite(name: &str, values: &[f64]) -> Result<(), SimError> {
+/// Checks that every entry of `values` is finite: an [`InvalidSetting`](SimError::InvalidSetting)
+/// error naming `name` and the first non-finite entry otherwise.
+pub fn check_finite(name: &str, values: &[f64]) -> Result<(), SimError> {
     match values.iter().find(|v| !v.is_finite()) {
         None => Ok(()),
         Some(v) => Err(SimError::setting(name, format!("must be finite, got {v}"))),

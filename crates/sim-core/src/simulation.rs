@@ -292,7 +292,7 @@ pub struct Simulation {
     sample: ControlSample,
     /// What the reference is as a function of time, when known: runs with equal keys sample the
     /// same values, so a lock-step group samples it once for all of them. Set by
-    /// [`Scenario::build`](crate::Scenario::build) (the reference's settings and the arm's
+    /// `sim_study::Scenario::build` (the reference's settings and the arm's
     /// length and modal family); `None` for a reference handed to [`new`](Self::new).
     reference_key: Option<String>,
 }
@@ -404,7 +404,7 @@ impl Simulation {
 
     /// The simulation with its reference known as `key` (see the field's docs): runs of a
     /// lock-step group with equal keys share their reference samples.
-    pub(crate) fn with_reference_key(mut self, key: String) -> Self {
+    pub fn with_reference_key(mut self, key: String) -> Self {
         self.reference_key = Some(key);
         self
     }

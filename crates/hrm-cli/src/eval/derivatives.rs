@@ -7,7 +7,7 @@ use manip_dyn::{ChainData, ChainModel, DerivativeData};
 use modal_reduce::{ReducedData, ReducedDerivatives, ReducedModel};
 use serde::Deserialize;
 use serde_json::{Value, json};
-use sim_core::ArmSpec;
+use sim_study::ArmSpec;
 
 use super::{EvalError, EvalResult, finite, json_fields, modal_map};
 

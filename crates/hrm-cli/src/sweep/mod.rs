@@ -14,10 +14,10 @@ mod report;
 use crate::console;
 use crate::output_dir::{self, OutputDir};
 use clap::{Args, Subcommand};
-use sim_core::study::{
+use sim_study::study::{
     self, Cell, CellBuilder, Shard, ShardHeader, ShardReader, SweepConfig, SweepSettings,
 };
-use sim_core::{ControllerKind, Scenario};
+use sim_study::{ControllerKind, Scenario};
 use std::path::{Path, PathBuf};
 
 /// The arguments of `hrm sweep`.
@@ -285,7 +285,7 @@ fn create(path: &Path) -> Result<std::io::BufWriter<std::fs::File>, String> {
 /// Writes `summary.json`, `table.txt` and `tip_error_rms.svg` of a whole sweep from its cells;
 /// returns the table.
 fn write_report(config: &SweepConfig, cells: &[Cell], out: &Path) -> Result<String, String> {
-    let summary = sim_core::summary_json::sweep(config, cells);
+    let summary = sim_study::summary_json::sweep(config, cells);
     let summary = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())? + "\n";
     write(&out.join("summary.json"), &summary)?;
     let mut table = report::table(config, cells);

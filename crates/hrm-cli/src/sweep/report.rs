@@ -1,8 +1,8 @@
 //! The report of a whole sweep: a text table and an SVG plot of the tip error against the noise
-//! level (its `summary.json` is `sim_core::summary_json::sweep`'s).
+//! level (its `summary.json` is `sim_study::summary_json::sweep`'s).
 
 use crate::plot::{Labels, Series, line_chart};
-use sim_core::study::{Cell, Stats, SweepConfig};
+use sim_study::study::{Cell, Stats, SweepConfig};
 use std::fmt::Write as _;
 use std::path::Path;
 

@@ -1,6 +1,6 @@
 use super::*;
 use clap::Parser;
-use sim_core::study::{Outcome, RunMetrics, ShardFile};
+use sim_study::study::{Outcome, RunMetrics, ShardFile};
 
 /// `hrm` reduced to its `sweep` subcommand.
 #[derive(Parser)]

@@ -2,8 +2,8 @@
 //! back as a scenario's fuzzy controller, and bad options are one-line errors that leave an
 //! earlier file alone.
 
-use sim_core::Scenario;
-use sim_core::imitation::{self, ImitationOptions};
+use sim_study::Scenario;
+use sim_study::imitation::{self, ImitationOptions};
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -113,7 +113,7 @@ fn bad_options_are_one_line_errors_and_leave_the_old_file() {
     let out = out.to_str().unwrap();
     let unknown_teacher = format!(
         "hrm: --teacher: controller must be one of {}, got 'bang-bang'",
-        sim_core::ControllerKind::names(", ")
+        sim_study::ControllerKind::names(", ")
     );
     for (args, message) in [
         (vec!["--teacher", "bang-bang"], unknown_teacher.as_str()),

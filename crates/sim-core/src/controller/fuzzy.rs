@@ -25,7 +25,7 @@ pub(super) enum Layout {
 }
 
 /// The number of inputs per coordinate of the [`Layout::Scheduled`] layout.
-pub(crate) const SCHEDULED_INPUTS_PER_COORDINATE: usize = 4;
+pub const SCHEDULED_INPUTS_PER_COORDINATE: usize = 4;
 
 /// Writes the `4m` inputs of a scheduled fuzzy controller into `out`: per coordinate the error
 /// `a_i - a_i_ref`, the error rate `a_i_dot - a_i_ref_dot`, the coordinate `a_i` and the reference
@@ -37,11 +37,7 @@ pub(crate) const SCHEDULED_INPUTS_PER_COORDINATE: usize = 4;
 /// the reference acceleration with coefficients that depend on the configuration `a`, so a
 /// first-order Sugeno system whose rules partition `a` and whose linear consequents take all four
 /// blocks can reproduce it (gain scheduling).
-pub(crate) fn scheduled_inputs(
-    measured: &ModalState,
-    reference: &ReferenceSample,
-    out: &mut [f64],
-) {
+pub fn scheduled_inputs(measured: &ModalState, reference: &ReferenceSample, out: &mut [f64]) {
     let m = measured.a.len();
     for i in 0..m {
         out[i] = measured.a[i] - reference.a[i];
@@ -153,7 +149,7 @@ impl Layout {
 /// For `m = 2` the two readings coincide: the paper's controller.
 ///
 /// A system with `4m` inputs and `m` outputs, such as one learned by imitation
-/// ([`crate::imitation`]), is evaluated once per sample on the errors, error rates, coordinates
+/// (`sim_study::imitation`), is evaluated once per sample on the errors, error rates, coordinates
 /// and reference accelerations (`[da_1..da_m, da_1_dot..da_m_dot, a_1..a_m,
 /// a_1_ref_ddot..a_m_ref_ddot]`).
 ///

@@ -3,9 +3,9 @@
 
 use super::{ControlContext, Controller, ControllerError, check_context, check_coordinate_count};
 use crate::error::{Readable, SimError, check_positive};
-use crate::optimal::dense::symmetrise;
-use crate::optimal::{Linearisation, Lqr, LqrSettings};
 use modal_reduce::{ReducedData, ReducedModel};
+use optimal_ctl::dense::symmetrise;
+use optimal_ctl::{Linearisation, Lqr, LqrSettings};
 
 /// The largest design frequency `omega` (rad/s): `omega^4` scales the state weight.
 const MAX_FREQUENCY: f64 = 1e4;

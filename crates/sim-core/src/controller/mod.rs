@@ -41,7 +41,7 @@ mod pd;
 
 pub use computed_torque::ComputedTorque;
 pub use fuzzy::FuzzyController;
-pub(crate) use fuzzy::{SCHEDULED_INPUTS_PER_COORDINATE, scheduled_inputs};
+pub use fuzzy::{SCHEDULED_INPUTS_PER_COORDINATE, scheduled_inputs};
 pub use lqr::LqrController;
 pub use mpc::MpcController;
 pub use pd::PdController;

@@ -3,9 +3,9 @@
 
 use super::{ControlContext, Controller, ControllerError, check_context};
 use crate::error::SimError;
-use crate::optimal::{Mpc, MpcSettings};
 use crate::reference::{Reference, ReferencePreview};
 use modal_reduce::ReducedModel;
+use optimal_ctl::{Mpc, MpcSettings};
 
 /// Receding-horizon MPC ([`Mpc`]): at the first sample, and then at the first sample at least one
 /// model step `h` after the last plan, it previews the reference over the horizon
@@ -40,7 +40,7 @@ impl MpcController {
     /// use manip_dyn::ChainModel;
     /// use modal_reduce::ReducedModel;
     /// use sim_core::controller::{ControlContext, Controller, ModalState, MpcController};
-    /// use sim_core::optimal::MpcSettings;
+    /// use optimal_ctl::MpcSettings;
     /// use sim_core::reference::{ReferenceSample, Step};
     ///
     /// let model = ReducedModel::new(ChainModel::uniform(10, 0.1, 0.1, 9.81)?, ModalMap::paper(10)?)?;

@@ -32,7 +32,7 @@ use modal_reduce::{
 
 /// Closed-loop runs of one reduced model with the same integrator, controller period and
 /// duration, stepped together: the runs of a Monte Carlo sweep that differ in seed or noise
-/// level (`sim_core::study` runs its sweeps this way), or any set of runs a caller wants
+/// level (`sim_study::study` runs its sweeps this way), or any set of runs a caller wants
 /// advanced side by side. Each run is a [`Simulation`] with its own controller, reference,
 /// noise and record; with RK4, the reduced dynamics of all of them are evaluated at once at
 /// every integrator stage, SIMD across the runs ([`forward_dynamics_batch`]), and each run's
@@ -45,21 +45,29 @@ use modal_reduce::{
 /// from the start, as [`Simulation::run`] runs one. Stepping allocates nothing.
 ///
 /// ```
-/// use sim_core::{Lockstep, Scenario};
+/// use backbone_kin::ModalMap;
+/// use manip_dyn::ChainModel;
+/// use modal_reduce::ReducedModel;
+/// use sim_core::controller::FuzzyController;
+/// use sim_core::reference::Step;
+/// use sim_core::{Integrator, Lockstep, LoopSettings, Simulation};
 ///
-/// let mut scenario = Scenario::builtin("paper-responses-noise")?;
-/// scenario.duration = 0.05;
-/// let runs: Vec<_> = (1..=5)
-///     .map(|seed| {
-///         scenario.seed = seed;
-///         scenario.build()
-///     })
-///     .collect::<Result<_, _>>()?;
+/// let build = |seed: u64| -> Result<Simulation, Box<dyn std::error::Error>> {
+///     let arm = ChainModel::uniform(10, 0.1, 0.1, 9.81)?;
+///     let map = ModalMap::paper_fixed_alpha0(10, std::f64::consts::FRAC_PI_2)?;
+///     let reference = Step::new(&[0.0, 0.0], &[0.2, -0.1], 0.0)?;
+///     let controller = FuzzyController::new(fuzzy_sugeno::paper_controller(), 2)?;
+///     let mut settings = LoopSettings::new(Integrator::Rk4 { dt: 1e-4 }, 1e-4, 0.05);
+///     settings.seed = seed;
+///     settings.sensor_noise_std = vec![0.01; 4];
+///     let model = ReducedModel::new(arm, map)?;
+///     Ok(Simulation::new(model, Box::new(reference), Box::new(controller), settings, None)?)
+/// };
+/// let runs = (1..=5).map(build).collect::<Result<Vec<_>, _>>()?;
 /// let mut group = Lockstep::new(runs)?;
 /// let results = group.run();
 /// // The same runs, one at a time: the same numbers.
-/// scenario.seed = 3;
-/// let alone = scenario.build()?.run()?;
+/// let alone = build(3)?.run()?;
 /// assert_eq!(results[2].as_ref().map(|run| &run.summary), Ok(&alone.summary));
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
@@ -77,7 +85,7 @@ pub struct Lockstep {
     /// States per SIMD group of the batch ([`batch_lanes`]).
     lanes: usize,
     /// Whether every run's reference is the same function of time (equal reference keys of
-    /// [`Scenario::build`](crate::Scenario::build)), sampled once a controller sample.
+    /// `sim_study::Scenario::build`), sampled once a controller sample.
     shares_reference: bool,
     /// The shared reference sample of the current controller sample.
     reference: ReferenceSample,
@@ -263,7 +271,7 @@ impl Lockstep {
     }
 
     /// Whether the runs share their reference samples (see the type's docs): they were built by
-    /// [`Scenario::build`](crate::Scenario::build) from scenarios with the same reference, arm
+    /// `sim_study::Scenario::build` from scenarios with the same reference, arm
     /// length and modal family.
     pub fn shares_reference(&self) -> bool {
         self.shares_reference

@@ -6,13 +6,13 @@ use backbone_kin::{BaseAngle, ModalMap};
 use fuzzy_sugeno::{Evaluator, paper_controller};
 use manip_dyn::ChainModel;
 use modal_reduce::{ReducedData, ReducedModel, forward_dynamics};
+use optimal_ctl::Linearisation;
 use proptest::prelude::*;
 use sim_core::SimError;
 use sim_core::controller::{
     ComputedTorque, ControlContext, Controller, FuzzyController, LqrController, ModalState,
     PdController,
 };
-use sim_core::optimal::Linearisation;
 use sim_core::reference::{ReferenceSample, Step};
 use sim_core::{Integrator, LoopSettings, Simulation};
 

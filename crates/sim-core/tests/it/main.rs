@@ -1,29 +1,8 @@
 //! The integration tests of sim-core, one binary: a module per `src` module it tests (`ode`,
-//! `reference`, `controller`, `optimal`, `mpc` for control-limited iLQR and MPC), the closed loop (`closed_loop`, `energy`, `replay` on
-//! the full chain, `imitation` for the controller learned from computed torque, `long_runs`,
-//! `paper_pinned` for the paper's figures), `scenario_fuzz` for scenario files,
-//! `scenario_controller` for a scenario closed by an outside controller, `lockstep` for
-//! groups of runs stepped together against the runs alone, `bad_input` for every
-//! refusal and `allocation` for the allocation-free loop.
+//! `reference`, `controller`) and `energy` for the closed loop's conservation of energy. The
+//! closed loop built from scenarios is tested in `sim-study`.
 
-// Counts each thread's allocations; the allocation tests measure their own thread only, so the
-// other tests of this binary may run in parallel.
-#[global_allocator]
-static ALLOCATOR: test_support::alloc::CountingAllocator = test_support::alloc::CountingAllocator;
-
-mod allocation;
-mod bad_input;
-mod closed_loop;
 mod controller;
 mod energy;
-mod imitation;
-mod lockstep;
-mod long_runs;
-mod mpc;
 mod ode;
-mod optimal;
-mod paper_pinned;
 mod reference;
-mod replay;
-mod scenario_controller;
-mod scenario_fuzz;

@@ -1,0 +1,83 @@
+#![doc = include_str!("../README.md")]
+
+mod box_qp;
+pub mod dense;
+mod discrete;
+mod ilqr;
+mod linearise;
+mod lqr;
+mod mpc;
+
+pub use box_qp::{BoxQp, BoxQpReport, BoxQpSettings};
+pub use discrete::{DiscreteDynamics, ReducedEuler};
+pub use ilqr::{Ilqr, IlqrReport, IlqrSettings, MAX_HORIZON, MAX_WORKSPACE, TrackingCost};
+pub use linearise::Linearisation;
+pub use lqr::{Lqr, LqrSettings};
+pub use mpc::{MAX_MPC_HORIZON, Mpc, MpcSettings};
+
+use modal_reduce::ReduceError;
+
+/// Why an optimal-control computation was refused or failed.
+///
+/// [`OptimalError::is_numerical`] and [`OptimalError::is_invalid_input`] sort the variants into
+/// the two classes a caller acts on; exactly one holds for every error.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum OptimalError {
+    /// The reduced dynamics refused the state (sizes, non-finite values, or a singular `M*`).
+    #[error("reduced dynamics: {0}")]
+    Dynamics(#[from] ReduceError),
+    /// A setting was out of its domain.
+    #[error("{name} must be {requirement}, got {value}")]
+    InvalidSetting {
+        /// Which setting.
+        name: &'static str,
+        /// What it must be.
+        requirement: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// A matrix had the wrong size.
+    #[error("{name} has {found} entries, expected {expected}")]
+    Dimension {
+        /// Which matrix.
+        name: &'static str,
+        /// The size expected.
+        expected: usize,
+        /// The size given.
+        found: usize,
+    },
+    /// The Riccati recursion did not converge within its iteration limit (the pair `(A, B)` is
+    /// not stabilisable, or the weights make it too slow).
+    #[error(
+        "the Riccati recursion did not converge in {iterations} iterations (last change {change:e})"
+    )]
+    NoConvergence {
+        /// Iterations run.
+        iterations: usize,
+        /// The relative change of `P` in the last iteration.
+        change: f64,
+    },
+    /// A matrix that must be positive definite (`R + B^T P B`) was not, numerically.
+    #[error("{0} is not numerically positive definite")]
+    NotPositiveDefinite(&'static str),
+}
+
+impl OptimalError {
+    /// Whether a computation on valid input failed numerically: the reduced dynamics' numerical
+    /// failures ([`ReduceError::is_numerical`]), a Riccati recursion that did not converge, or a
+    /// matrix that is not numerically positive definite.
+    pub fn is_numerical(&self) -> bool {
+        match self {
+            Self::Dynamics(e) => e.is_numerical(),
+            Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) => true,
+            _ => false,
+        }
+    }
+
+    /// Whether the input was malformed or outside its domain (every error that is not
+    /// [`is_numerical`](Self::is_numerical)).
+    pub fn is_invalid_input(&self) -> bool {
+        !self.is_numerical()
+    }
+}

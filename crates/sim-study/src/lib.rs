@@ -1,0 +1,14 @@
+#![doc = include_str!("../README.md")]
+
+pub mod imitation;
+mod input_file;
+mod scenario;
+pub mod study;
+pub mod summary_json;
+
+pub use input_file::{MAX_INPUT_FILE_BYTES, open_regular_file, read_text_file};
+pub use scenario::{
+    Alpha0, ArmSpec, BranchSpec, CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup,
+    ControllerSpec, FuzzyInputRange, InitialSpec, IntegratorSpec, LimitsSpec, ModalSpec,
+    ModalTorqueLimit, NoiseSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec, TorqueLimit,
+};

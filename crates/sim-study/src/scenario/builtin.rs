@@ -1,0 +1,79 @@
+//! The scenarios shipped with the crate, compiled in.
+
+use super::file::{ScenarioError, parse};
+use super::schema::Scenario;
+
+/// The scenarios shipped with the crate, by name: the paper's experiments (section 5) with the
+/// tracking task also five times faster under limits on the modal forces `tau*`, then the paper's tracking task
+/// with two harmonics and with `alpha0` free.
+const BUILTIN: &[(&str, &str)] = &[
+    (
+        "paper-tracking",
+        include_str!("../../scenarios/paper-tracking.toml"),
+    ),
+    (
+        "paper-tracking-fast",
+        include_str!("../../scenarios/paper-tracking-fast.toml"),
+    ),
+    (
+        "paper-responses-step",
+        include_str!("../../scenarios/paper-responses-step.toml"),
+    ),
+    (
+        "paper-responses-sine",
+        include_str!("../../scenarios/paper-responses-sine.toml"),
+    ),
+    (
+        "paper-responses-noise",
+        include_str!("../../scenarios/paper-responses-noise.toml"),
+    ),
+    (
+        "harmonic-tracking",
+        include_str!("../../scenarios/harmonic-tracking.toml"),
+    ),
+    (
+        "free-base-tracking",
+        include_str!("../../scenarios/free-base-tracking.toml"),
+    ),
+];
+
+impl Scenario {
+    /// A scenario shipped with the crate, by name (see [`Scenario::builtin_names`]).
+    ///
+    /// ```
+    /// let scenario = sim_study::Scenario::builtin("paper-tracking")?;
+    /// assert_eq!(scenario.duration, 5.5);
+    /// # Ok::<(), sim_study::ScenarioError>(())
+    /// ```
+    pub fn builtin(name: &str) -> Result<Self, ScenarioError> {
+        match BUILTIN.iter().find(|(n, _)| *n == name) {
+            Some((name, text)) => parse(text, name),
+            None => Err(unknown(name)),
+        }
+    }
+
+    /// The names of the shipped scenarios: `paper-tracking` (Figures 10-11),
+    /// `paper-tracking-fast` (the same path in 1 s under `tau*` limits), the
+    /// `paper-responses-*` step, sine and noise responses (Figure 9), and the tracking task for
+    /// other modal families: `harmonic-tracking` (`K = 2`, `m = 4`) and `free-base-tracking`
+    /// (`alpha0` free, `m = 3`).
+    pub fn builtin_names() -> impl Iterator<Item = &'static str> {
+        BUILTIN.iter().map(|(name, _)| *name)
+    }
+
+    /// The TOML text of a shipped scenario.
+    pub fn builtin_text(name: &str) -> Option<&'static str> {
+        BUILTIN.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+    }
+}
+
+pub(super) fn unknown(name: &str) -> ScenarioError {
+    ScenarioError::Unknown {
+        name: name.to_string(),
+        available: BUILTIN
+            .iter()
+            .map(|(n, _)| *n)
+            .collect::<Vec<_>>()
+            .join(", "),
+    }
+}

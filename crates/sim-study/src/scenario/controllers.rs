@@ -1,0 +1,287 @@
+//! The controllers a scenario may name: one table ([`CONTROLLERS`]) of names, descriptions and
+//! constructors from the scenario's `[controller]` settings.
+
+use super::Scenario;
+use super::factory::per_coordinate;
+use super::schema::ControllerSpec;
+use fuzzy_sugeno::FuzzySystem;
+use modal_reduce::ReducedModel;
+use optimal_ctl::MpcSettings;
+use serde::{Deserialize, Serialize};
+use sim_core::SimError;
+use sim_core::controller::{
+    ComputedTorque, Controller, FuzzyController, LqrController, MpcController, PdController,
+};
+use std::fmt;
+use std::str::FromStr;
+
+/// Which controller closes the loop: the key of a row of [`CONTROLLERS`], where its name,
+/// description and constructor are. Written in scenario files and on the command line by its
+/// [`name`](Self::name).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub enum ControllerKind {
+    /// The paper's fuzzy controller, or the `.fis` system given.
+    #[default]
+    Fuzzy,
+    /// The fuzzy controller's linearisation at the origin ([`PdController::from_fuzzy_slope`]).
+    Pd,
+    /// Computed torque with the exact reduced model ([`ComputedTorque`]).
+    ComputedTorque,
+    /// The fuzzy controller plus gravity compensation `G*`.
+    FuzzyGc,
+    /// LQR about the reference, re-linearised along it ([`LqrController`]).
+    Lqr,
+    /// Model-predictive control: control-limited iLQR over a receding horizon, previewing the
+    /// scenario's reference ([`MpcController`], [`MpcSettings::uniform`]).
+    Mpc,
+}
+
+/// What a controller's constructor is given: the scenario's `[controller]` settings, with every
+/// per-coordinate gain array already checked to have `m` entries, and the model and sampling
+/// period of the loop.
+#[derive(Debug, Clone, Copy)]
+pub struct ControllerSetup<'a> {
+    /// The scenario's `[controller]` table.
+    pub spec: &'a ControllerSpec,
+    /// The whole scenario, for controllers that need more than `[controller]` (MPC previews its
+    /// reference).
+    pub scenario: &'a Scenario,
+    /// The reduced model the controller will be sampled on (`m` coordinates).
+    pub model: &'a ReducedModel,
+    /// The controller's sampling period (s).
+    pub period: f64,
+}
+
+/// A row of the controller table: a controller's name, what it is, and how a scenario builds it.
+#[derive(Debug, Clone, Copy)]
+pub struct ControllerEntry {
+    /// Its key.
+    pub kind: ControllerKind,
+    /// Its name in scenario files, on the command line and in outputs.
+    pub name: &'static str,
+    /// One line on what it is (the command line's help).
+    pub description: &'static str,
+    build: fn(&ControllerSetup<'_>) -> Result<Box<dyn Controller>, SimError>,
+}
+
+impl ControllerSetup<'_> {
+    /// The controller of `spec.kind` for the model: checks every per-coordinate gain array of
+    /// `spec` (whichever controller uses it) to have `m` entries, then calls the kind's
+    /// constructor in [`CONTROLLERS`].
+    pub fn build(&self) -> Result<Box<dyn Controller>, SimError> {
+        let m = m(self);
+        self.spec.computed_torque_gains(m)?;
+        per_coordinate("controller.pd_kp", self.spec.pd_kp.as_deref(), m)?;
+        per_coordinate("controller.pd_kd", self.spec.pd_kd.as_deref(), m)?;
+        self.spec.kind.entry().build(self)
+    }
+}
+
+impl ControllerEntry {
+    /// Builds the controller for `setup`'s model.
+    pub fn build(&self, setup: &ControllerSetup<'_>) -> Result<Box<dyn Controller>, SimError> {
+        (self.build)(setup)
+    }
+}
+
+/// The controller table, in the order of the paper's comparison (the order of the main job's
+/// table): row `i` is the entry of the [`ControllerKind`] whose discriminant is `i`, checked when
+/// the crate compiles.
+pub const CONTROLLERS: &[ControllerEntry] = &[
+    ControllerEntry {
+        kind: ControllerKind::Fuzzy,
+        name: "fuzzy",
+        description: "the paper's fuzzy controller (eqs 19-24), or the .fis system given",
+        build: |s| {
+            Ok(Box::new(
+                FuzzyController::new(s.spec.fuzzy_system()?, m(s))?
+                    .with_out_of_range(s.spec.out_of_range.unwrap_or_default().into())?,
+            ))
+        },
+    },
+    ControllerEntry {
+        kind: ControllerKind::Pd,
+        name: "pd",
+        description: "PD: the fuzzy controller's slope at the origin, or the pd_kp, pd_kd gains",
+        build: |s| {
+            let m = m(s);
+            let slope = PdController::from_fuzzy_slope(&s.spec.fuzzy_system()?, m)?;
+            let kp = per_coordinate("controller.pd_kp", s.spec.pd_kp.as_deref(), m)?
+                .unwrap_or_else(|| slope.kp().to_vec());
+            let kd = per_coordinate("controller.pd_kd", s.spec.pd_kd.as_deref(), m)?
+                .unwrap_or_else(|| slope.kd().to_vec());
+            Ok(Box::new(PdController::new(slope.offset(), &kp, &kd)?))
+        },
+    },
+    ControllerEntry {
+        kind: ControllerKind::ComputedTorque,
+        name: "computed-torque",
+        description: "computed torque with the exact reduced model, gains kp, kd",
+        build: |s| {
+            let (kp, kd) = s.spec.computed_torque_gains(m(s))?;
+            Ok(Box::new(ComputedTorque::new(s.model, &kp, &kd)?))
+        },
+    },
+    ControllerEntry {
+        kind: ControllerKind::FuzzyGc,
+        name: "fuzzy-gc",
+        description: "the fuzzy controller plus gravity compensation G*",
+        build: |s| {
+            let fuzzy = FuzzyController::new(s.spec.fuzzy_system()?, m(s))?
+                .with_out_of_range(s.spec.out_of_range.unwrap_or_default().into())?;
+            Ok(Box::new(fuzzy.with_gravity_compensation(s.model)?))
+        },
+    },
+    ControllerEntry {
+        kind: ControllerKind::Lqr,
+        name: "lqr",
+        description: "LQR about the reference (feedforward M* a_ref_dd + C* + G*), re-linearised \
+                      along it every lqr_relinearise s, design frequency lqr_frequency",
+        build: |s| {
+            Ok(Box::new(LqrController::new(
+                s.model,
+                s.period,
+                s.spec
+                    .lqr_frequency
+                    .unwrap_or(LqrController::DEFAULT_FREQUENCY),
+                s.spec
+                    .lqr_relinearise
+                    .unwrap_or(LqrController::DEFAULT_RELINEARISE_PERIOD),
+            )?))
+        },
+    },
+    ControllerEntry {
+        kind: ControllerKind::Mpc,
+        name: "mpc",
+        description: "model-predictive control: control-limited iLQR over a 0.3 s receding horizon",
+        build: |s| {
+            let settings = MpcSettings::uniform(m(s));
+            let reference = s.scenario.build_reference(s.model)?;
+            Ok(Box::new(MpcController::new(s.model, &settings, reference)?))
+        },
+    },
+];
+
+// Row `i` of the table is the kind with discriminant `i`, so `kind.entry()` is an index.
+const _: () = {
+    let mut i = 0;
+    while i < CONTROLLERS.len() {
+        assert!(CONTROLLERS[i].kind as usize == i);
+        i += 1;
+    }
+};
+
+/// The number of modal coordinates of a setup's model.
+fn m(setup: &ControllerSetup<'_>) -> usize {
+    setup.model.n_coords()
+}
+
+impl ControllerKind {
+    /// Every controller, in the table's order.
+    pub const ALL: [ControllerKind; CONTROLLERS.len()] = {
+        let mut all = [ControllerKind::Fuzzy; CONTROLLERS.len()];
+        let mut i = 0;
+        while i < all.len() {
+            all[i] = CONTROLLERS[i].kind;
+            i += 1;
+        }
+        all
+    };
+
+    /// Its row of [`CONTROLLERS`].
+    pub fn entry(self) -> &'static ControllerEntry {
+        &CONTROLLERS[self as usize]
+    }
+
+    /// The name used in scenario files and on the command line.
+    pub fn name(self) -> &'static str {
+        self.entry().name
+    }
+
+    /// Every controller's name, joined by `separator`.
+    pub fn names(separator: &str) -> String {
+        CONTROLLERS
+            .iter()
+            .map(|e| e.name)
+            .collect::<Vec<_>>()
+            .join(separator)
+    }
+}
+
+impl fmt::Display for ControllerKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for ControllerKind {
+    type Err = SimError;
+
+    /// Parses a name of the table ([`CONTROLLERS`]).
+    fn from_str(s: &str) -> Result<Self, SimError> {
+        CONTROLLERS
+            .iter()
+            .find(|e| e.name == s)
+            .map(|e| e.kind)
+            .ok_or_else(|| {
+                SimError::setting(
+                    "controller",
+                    format!("must be one of {}, got '{s}'", Self::names(", ")),
+                )
+            })
+    }
+}
+
+impl Serialize for ControllerKind {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for ControllerKind {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(deserializer)?;
+        name.parse().map_err(|_| {
+            serde::de::Error::custom(format!(
+                "unknown controller `{name}`, expected one of {}",
+                Self::names(", ")
+            ))
+        })
+    }
+}
+
+/// The default computed-torque stiffness (1/s^2): 50 rad/s.
+const DEFAULT_KP: f64 = 2500.0;
+/// The default computed-torque damping (1/s): critically damped with [`DEFAULT_KP`].
+const DEFAULT_KD: f64 = 100.0;
+
+impl ControllerSpec {
+    /// The fuzzy system: the `.fis` file if given, else the paper's.
+    fn fuzzy_system(&self) -> Result<FuzzySystem, SimError> {
+        match &self.fis {
+            None => Ok(fuzzy_sugeno::paper_controller()),
+            Some(path) => {
+                let text =
+                    crate::read_text_file(path, crate::MAX_INPUT_FILE_BYTES).map_err(|e| {
+                        SimError::setting(
+                            "controller.fis",
+                            format!("cannot be read from {}: {e}", path.display()),
+                        )
+                    })?;
+                Ok(FuzzySystem::from_fis(&text)?)
+            }
+        }
+    }
+
+    /// The computed-torque gains `kp`, `kd` for `m` coordinates (defaults where not given).
+    fn computed_torque_gains(&self, m: usize) -> Result<(Vec<f64>, Vec<f64>), SimError> {
+        let gains = |name: &str, values: &Option<Vec<f64>>, default: f64| {
+            per_coordinate(name, values.as_deref(), m)
+                .map(|v| v.unwrap_or_else(|| vec![default; m]))
+        };
+        Ok((
+            gains("controller.kp", &self.kp, DEFAULT_KP)?,
+            gains("controller.kd", &self.kd, DEFAULT_KD)?,
+        ))
+    }
+}

@@ -1,0 +1,344 @@
+//! From a scenario to a [`Simulation`]: the arm, the reduced model, the reference, the
+//! controller and the loop's settings, every setting checked and named when it fails.
+
+use super::controllers::ControllerSetup;
+use super::schema::{
+    Alpha0, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, ReferenceSpec, Scenario,
+    TorqueLimit,
+};
+use backbone_kin::{Branch, ModalMap};
+use manip_dyn::{ChainModel, Link};
+use modal_reduce::ReducedModel;
+use sim_core::SimError;
+use sim_core::controller::{Controller, ModalState};
+use sim_core::ode::Tolerances;
+use sim_core::reference::{CartesianPath, PathShape, Reference, Sinusoid, Step};
+use sim_core::{Integrator, LoopSettings, Simulation};
+
+impl Scenario {
+    /// The reduced model of the arm with the scenario's modal family. Refuses a family with no
+    /// harmonic or more coordinates than the arm has links (its reduced mass matrix would be
+    /// singular).
+    pub fn model(&self) -> Result<ReducedModel, SimError> {
+        let chain = self.arm.to_chain()?;
+        let k = self.modal.harmonics;
+        if k == 0 {
+            return Err(SimError::setting("modal.harmonics", "must be at least 1"));
+        }
+        let n = chain.n_links();
+        if k > n {
+            return Err(SimError::setting(
+                "modal.harmonics",
+                format!("must be at most the arm's {n} links, got {k}"),
+            ));
+        }
+        let m = self.n_coords();
+        if m > n {
+            return Err(SimError::setting(
+                "modal.harmonics",
+                format!(
+                    "= {k} gives {m} modal coordinates, more than the arm's {n} links: the \
+                     reduced mass matrix would be singular"
+                ),
+            ));
+        }
+        let lengths: Vec<f64> = chain.link_lengths().collect();
+        let map = ModalMap::new(&lengths, k, self.alpha0.base_angle())?;
+        ReducedModel::new(chain, map).map_err(SimError::Model)
+    }
+
+    /// Builds the simulation: checks every setting and the whole reference path, loads the
+    /// `.fis` file if any. Errors name the setting that failed; the loop's own limits are
+    /// [`Simulation::new`]'s.
+    pub fn build(&self) -> Result<Simulation, SimError> {
+        self.assemble(|model, period| {
+            ControllerSetup {
+                spec: &self.controller,
+                scenario: self,
+                model,
+                period,
+            }
+            .build()
+        })
+    }
+
+    /// Builds the simulation as [`build`](Self::build) does, but closed by `controller` (a
+    /// controller written elsewhere, e.g. in Python) instead of the one `controller.kind` names;
+    /// `controller.period` still sets its sampling, and the other `[controller]` keys are unused.
+    pub fn build_with_controller(
+        &self,
+        controller: Box<dyn Controller>,
+    ) -> Result<Simulation, SimError> {
+        self.assemble(|_, _| Ok(controller))
+    }
+
+    /// The scenario's reference for `model`'s coordinates (the loop's; the MPC controller
+    /// previews a copy of it).
+    pub(crate) fn build_reference(
+        &self,
+        model: &ReducedModel,
+    ) -> Result<Box<dyn Reference>, SimError> {
+        self.reference.build(
+            model.chain().total_length(),
+            self.modal.harmonics,
+            self.alpha0,
+            model.n_coords(),
+        )
+    }
+
+    /// The simulation closed by the controller `controller(model, period)` makes.
+    fn assemble(
+        &self,
+        controller: impl FnOnce(&ReducedModel, f64) -> Result<Box<dyn Controller>, SimError>,
+    ) -> Result<Simulation, SimError> {
+        let model = self.model()?;
+        let m = model.n_coords();
+        let reference = self.build_reference(&model)?;
+        let period = match (self.controller.period, self.integrator) {
+            (Some(period), _) => period,
+            (None, IntegratorSpec::Rk4 { dt }) => dt,
+            (None, IntegratorSpec::Dopri5 { .. }) => {
+                return Err(SimError::setting(
+                    "controller.period",
+                    "is required with the dopri5 integrator",
+                ));
+            }
+        };
+        let controller = controller(&model, period)?;
+        let mut settings = LoopSettings::new(self.integrator.build(), period, self.duration);
+        settings.record_period = self.record_period.unwrap_or(period);
+        settings.seed = self.seed;
+        let noise = |name: &str, values: &Option<Vec<f64>>| {
+            per_coordinate(name, values.as_deref(), m).map(|v| v.unwrap_or_else(|| vec![0.0; m]))
+        };
+        settings.reference_noise_std = noise("noise.reference_std", &self.noise.reference_std)?;
+        settings.sensor_noise_std = noise("noise.sensor_a_std", &self.noise.sensor_a_std)?;
+        settings.sensor_noise_std.extend(noise(
+            "noise.sensor_a_dot_std",
+            &self.noise.sensor_a_dot_std,
+        )?);
+        // One rule for `simulate` and `sweep`: a scenario's bound is finite, so that every
+        // scenario that runs can also be written to a shard file (JSON has no infinity).
+        if self.limits.max_modal_error == f64::INFINITY {
+            return Err(SimError::setting(
+                "limits.max_modal_error",
+                "must be finite, got inf (a shard file cannot hold it): give a large bound such \
+                 as 1e6 rad for no practical runaway check",
+            ));
+        }
+        settings.max_modal_error = self.limits.max_modal_error;
+        settings.joint_torque_limits = self.limits.joint_torque_nm.as_ref().map(|l| match l {
+            TorqueLimit::All(limit) => vec![*limit; model.n_links()],
+            TorqueLimit::PerJoint(limits) => limits.clone(),
+        });
+        settings.tau_star_limits = match &self.limits.tau_star {
+            None => None,
+            Some(ModalTorqueLimit::All(limit)) => Some(vec![*limit; m]),
+            Some(ModalTorqueLimit::PerCoordinate(limits)) => {
+                per_coordinate("limits.tau_star", Some(limits), m)?
+            }
+        };
+        let initial = match &self.initial {
+            None => None,
+            Some(i) => {
+                let a = per_coordinate("initial.a", Some(&i.a), m)?.unwrap_or_default();
+                let a_dot = per_coordinate("initial.a_dot", i.a_dot.as_deref(), m)?
+                    .unwrap_or_else(|| vec![0.0; m]);
+                Some(ModalState { a, a_dot })
+            }
+        };
+        // The reference as a function of time is what `build_reference` builds it from.
+        let reference_key = serde_json::to_string(&(
+            &self.reference,
+            model.chain().total_length(),
+            self.modal.harmonics,
+            self.alpha0,
+            m,
+        ))
+        .map_err(|e| SimError::setting("reference", e.to_string()))?;
+        Ok(
+            Simulation::new(model, reference, controller, settings, initial)?
+                .with_reference_key(reference_key),
+        )
+    }
+}
+
+impl ArmSpec {
+    /// The chain: `links` uniform beams of `link_length` and `link_mass` (the paper's by
+    /// default), with per-link `lengths`, `masses` and `inertias` overriding; all given sizes must
+    /// agree, and the arm has between 1 and [`manip_dyn::MAX_LINKS`] links, checked before any
+    /// per-link array is allocated.
+    pub fn to_chain(&self) -> Result<ChainModel, SimError> {
+        let mut n = self.links;
+        for (name, array) in [
+            ("arm.lengths", &self.lengths),
+            ("arm.masses", &self.masses),
+            ("arm.inertias", &self.inertias),
+        ] {
+            if let Some(values) = array {
+                match n {
+                    Some(k) if k != values.len() => {
+                        return Err(SimError::setting(
+                            name,
+                            format!("has {} entries but the arm has {k} links", values.len()),
+                        ));
+                    }
+                    _ => n = Some(values.len()),
+                }
+            }
+        }
+        let n = n.unwrap_or(10);
+        if n == 0 {
+            return Err(SimError::setting("arm.links", "must be at least 1"));
+        }
+        if n > manip_dyn::MAX_LINKS {
+            return Err(SimError::setting(
+                "arm.links",
+                format!("must be at most {}, got {n}", manip_dyn::MAX_LINKS),
+            ));
+        }
+        let per_link = |array: &Option<Vec<f64>>, scalar: f64| match array {
+            Some(values) => values.clone(),
+            None => vec![scalar; n],
+        };
+        let lengths = per_link(&self.lengths, self.link_length.unwrap_or(0.1));
+        let masses = per_link(&self.masses, self.link_mass.unwrap_or(0.1));
+        // A lone link has no index: name the link's real one.
+        let arm_error = |i: usize, e: manip_dyn::DynError| {
+            SimError::setting("arm", format!("is invalid: {}", e.at_link(i)))
+        };
+        let mut links = Vec::with_capacity(n);
+        for i in 0..n {
+            let beam = Link::uniform_beam(lengths[i], masses[i]).map_err(|e| arm_error(i, e))?;
+            let link = match &self.inertias {
+                Some(inertias) => Link::new(beam.length, beam.mass, beam.com, inertias[i])
+                    .map_err(|e| arm_error(i, e))?,
+                None => beam,
+            };
+            links.push(link);
+        }
+        ChainModel::new(links, self.gravity.unwrap_or(9.81))
+            .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))
+    }
+}
+
+/// `values` if given, checked to have exactly `m` entries (one per modal coordinate); the
+/// error names the field.
+pub(super) fn per_coordinate(
+    name: &str,
+    values: Option<&[f64]>,
+    m: usize,
+) -> Result<Option<Vec<f64>>, SimError> {
+    match values {
+        None => Ok(None),
+        Some(values) if values.len() == m => Ok(Some(values.to_vec())),
+        Some(values) => Err(SimError::setting(
+            name,
+            format!(
+                "has {} entries, the modal family has {m} coordinates (one entry each)",
+                values.len()
+            ),
+        )),
+    }
+}
+
+impl ReferenceSpec {
+    /// The reference of `m` coordinates for a curve of length `length` with `harmonics`
+    /// harmonics and base angle `alpha0`.
+    fn build(
+        &self,
+        length: f64,
+        harmonics: usize,
+        alpha0: Alpha0,
+        m: usize,
+    ) -> Result<Box<dyn Reference>, SimError> {
+        let given = |name: &str, values: &[f64]| {
+            per_coordinate(name, Some(values), m).map(Option::unwrap_or_default)
+        };
+        let or_zero = |name: &str, values: &Option<Vec<f64>>| {
+            per_coordinate(name, values.as_deref(), m).map(|v| v.unwrap_or_else(|| vec![0.0; m]))
+        };
+        Ok(match self {
+            ReferenceSpec::Constant { a } => Box::new(Step::constant(&given("reference.a", a)?)?),
+            ReferenceSpec::Step {
+                initial,
+                target,
+                time,
+            } => Box::new(Step::new(
+                &or_zero("reference.initial", initial)?,
+                &given("reference.target", target)?,
+                *time,
+            )?),
+            ReferenceSpec::Sinusoid {
+                offset,
+                amplitude,
+                frequency_hz,
+                phase,
+            } => Box::new(Sinusoid::new(
+                &or_zero("reference.offset", offset)?,
+                &given("reference.amplitude", amplitude)?,
+                &given("reference.frequency_hz", frequency_hz)?,
+                &or_zero("reference.phase", phase)?,
+            )?),
+            ReferenceSpec::Path {
+                travel_time,
+                branch,
+                sine,
+                points,
+            } => {
+                let shape = match (sine, points) {
+                    (Some(s), None) => PathShape::Sine {
+                        amplitude: s.amplitude,
+                        wavenumber: s.wavenumber,
+                        phase: s.phase,
+                        offset: s.offset,
+                        x_start: s.x_start,
+                        x_end: s.x_end,
+                    },
+                    (None, Some(points)) => PathShape::Polyline(points.clone()),
+                    _ => {
+                        return Err(SimError::setting(
+                            "reference",
+                            "of kind \"path\" needs exactly one of `sine` or `points`",
+                        ));
+                    }
+                };
+                let branch = match branch {
+                    BranchSpec::Positive => Branch::Positive,
+                    BranchSpec::Negative => Branch::Negative,
+                };
+                Box::new(CartesianPath::new(
+                    shape,
+                    *travel_time,
+                    length,
+                    harmonics,
+                    alpha0.base_angle(),
+                    branch,
+                )?)
+            }
+        })
+    }
+}
+
+impl IntegratorSpec {
+    fn build(self) -> Integrator {
+        match self {
+            IntegratorSpec::Rk4 { dt } => Integrator::Rk4 { dt },
+            IntegratorSpec::Dopri5 {
+                rtol,
+                atol,
+                h_max,
+                max_steps,
+            } => {
+                let defaults = Tolerances::default();
+                Integrator::DormandPrince(Tolerances {
+                    rtol,
+                    atol,
+                    h_max: h_max.unwrap_or(defaults.h_max),
+                    max_steps: max_steps.unwrap_or(defaults.max_steps),
+                    ..defaults
+                })
+            }
+        }
+    }
+}

@@ -1,0 +1,123 @@
+//! Reading scenarios: TOML text and files, with one-line errors.
+
+use super::builtin::unknown;
+use super::schema::Scenario;
+use std::path::{Path, PathBuf};
+
+/// Why a scenario could not be read.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ScenarioError {
+    /// The file could not be read.
+    #[error("cannot read scenario file {path}: {message}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The system's reason.
+        message: String,
+    },
+    /// The text is not a valid scenario; the message gives the line, column and problem.
+    #[error("scenario {origin} is malformed: {message}")]
+    Parse {
+        /// The file or built-in name.
+        origin: String,
+        /// What is wrong, and where.
+        message: String,
+    },
+    /// Neither a built-in scenario nor an existing file.
+    #[error("'{name}' is neither a built-in scenario ({available}) nor a scenario file")]
+    Unknown {
+        /// The name asked for.
+        name: String,
+        /// The built-in names.
+        available: String,
+    },
+}
+
+impl Scenario {
+    /// Parses a scenario from TOML text.
+    ///
+    /// ```
+    /// let scenario = sim_study::Scenario::from_toml(r#"
+    ///     name = "hold"
+    ///     duration = 0.1
+    ///     alpha0 = 1.0
+    ///     reference = { kind = "constant", a = [0.3, -0.2] }
+    ///     integrator = { method = "rk4", dt = 1e-3 }
+    /// "#)?;
+    /// let run = scenario.build()?.run()?;
+    /// assert_eq!(run.summary.controller_samples, 101);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn from_toml(text: &str) -> Result<Self, ScenarioError> {
+        parse(text, "text")
+    }
+
+    /// Reads a scenario file; a relative `controller.fis` path is taken relative to the file.
+    pub fn load(path: &Path) -> Result<Self, ScenarioError> {
+        let text = crate::read_text_file(path, crate::MAX_INPUT_FILE_BYTES).map_err(|e| {
+            ScenarioError::Io {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            }
+        })?;
+        let mut scenario = parse(&text, &path.display().to_string())?;
+        if let (Some(fis), Some(dir)) = (&scenario.controller.fis, path.parent())
+            && fis.is_relative()
+        {
+            scenario.controller.fis = Some(dir.join(fis));
+        }
+        Ok(scenario)
+    }
+
+    /// A built-in scenario by name, or else a scenario file at that path.
+    pub fn resolve(name_or_path: &str) -> Result<Self, ScenarioError> {
+        if Self::builtin_text(name_or_path).is_some() {
+            return Self::builtin(name_or_path);
+        }
+        let path = Path::new(name_or_path);
+        if path.exists() {
+            Self::load(path)
+        } else {
+            Err(unknown(name_or_path))
+        }
+    }
+
+    /// The scenario as TOML (it parses back to an equal scenario).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).expect("a scenario serialises to TOML")
+    }
+}
+
+/// Parses scenario text; a refusal is one line: `line L, column C (`<that line>`): <what is
+/// wrong>` (toml's own message spans several lines around the quoted text).
+pub(super) fn parse(text: &str, origin: &str) -> Result<Scenario, ScenarioError> {
+    toml::from_str(text).map_err(|e| {
+        let what = e.message().trim_end().replace('\n', "; ");
+        let message = match e.span() {
+            Some(span) => {
+                let mut end = span.start.min(text.len());
+                while !text.is_char_boundary(end) {
+                    end -= 1;
+                }
+                let before = &text[..end];
+                let line = before.matches('\n').count() + 1;
+                let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+                let quoted: String = text
+                    .lines()
+                    .nth(line - 1)
+                    .unwrap_or_default()
+                    .trim()
+                    .chars()
+                    .take(80)
+                    .collect();
+                format!("line {line}, column {column} (`{quoted}`): {what}")
+            }
+            None => what,
+        };
+        ScenarioError::Parse {
+            origin: origin.to_string(),
+            message,
+        }
+    })
+}

@@ -1,0 +1,510 @@
+//! The scenario schema: what a scenario file may say, with its defaults.
+
+use super::controllers::ControllerKind;
+use backbone_kin::BaseAngle;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::path::PathBuf;
+
+/// A closed-loop experiment. Build it with [`Scenario::build`]; every field is public so that a
+/// caller can adjust a loaded scenario (another controller, noise level or seed) before building.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Short name.
+    pub name: String,
+    /// What the scenario shows.
+    #[serde(default)]
+    pub description: String,
+    /// Simulated time (s).
+    pub duration: f64,
+    /// The base inclination `alpha0`: fixed (rad) or free (the last modal coordinate).
+    pub alpha0: Alpha0,
+    /// Seed of the noise sources. TOML integers stop at `2^63 - 1`: larger seeds are written
+    /// (and may be given) as a decimal string, `seed = "18446744073709551615"`.
+    #[serde(default, with = "seed_text")]
+    pub seed: u64,
+    /// Recording period (s); default: the controller period.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub record_period: Option<f64>,
+    /// The modal family (default: the paper's `K = 1`).
+    #[serde(default)]
+    pub modal: ModalSpec,
+    /// The arm.
+    #[serde(default)]
+    pub arm: ArmSpec,
+    /// The initial state; default: at rest at the reference's value at `t = 0`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial: Option<InitialSpec>,
+    /// The reference for the modal coordinates.
+    pub reference: ReferenceSpec,
+    /// The controller.
+    #[serde(default)]
+    pub controller: ControllerSpec,
+    /// The integrator.
+    pub integrator: IntegratorSpec,
+    /// Noise levels.
+    #[serde(default)]
+    pub noise: NoiseSpec,
+    /// Runaway bound and torque limits.
+    #[serde(default)]
+    pub limits: LimitsSpec,
+}
+
+/// The base inclination `alpha0` of a scenario: a number (fixed, in rad) or `"free"`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Alpha0 {
+    /// Held at this angle (rad); not a coordinate.
+    Fixed(f64),
+    /// A modal coordinate, the last one.
+    Free,
+}
+
+impl Alpha0 {
+    /// As a [`BaseAngle`] of the modal map.
+    pub fn base_angle(self) -> BaseAngle {
+        match self {
+            Alpha0::Fixed(alpha0) => BaseAngle::Fixed(alpha0),
+            Alpha0::Free => BaseAngle::Free,
+        }
+    }
+}
+
+impl Serialize for Alpha0 {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Alpha0::Fixed(alpha0) => serializer.serialize_f64(*alpha0),
+            Alpha0::Free => serializer.serialize_str("free"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Alpha0 {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = Alpha0;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("alpha0: a number (rad) or \"free\"")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Alpha0, E> {
+                Ok(Alpha0::Fixed(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Alpha0, E> {
+                Ok(Alpha0::Fixed(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Alpha0, E> {
+                Ok(Alpha0::Fixed(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Alpha0, E> {
+                if v == "free" {
+                    Ok(Alpha0::Free)
+                } else {
+                    Err(E::custom(format!(
+                        "alpha0 must be a number (rad) or \"free\", got \"{v}\""
+                    )))
+                }
+            }
+        }
+        deserializer.deserialize_any(Visitor)
+    }
+}
+
+/// The modal family: `K` harmonics (`m = 2K` coordinates with `alpha0` fixed, `2K + 1` free).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModalSpec {
+    /// The number of harmonics `K` (default 1, the paper's).
+    #[serde(default = "default_harmonics")]
+    pub harmonics: usize,
+}
+
+fn default_harmonics() -> usize {
+    1
+}
+
+impl Default for ModalSpec {
+    fn default() -> Self {
+        Self {
+            harmonics: default_harmonics(),
+        }
+    }
+}
+
+/// The arm: the paper's by default; per-link arrays override the scalars.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArmSpec {
+    /// Number of links (default 10).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub links: Option<usize>,
+    /// Length of every link (m, default 0.1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub link_length: Option<f64>,
+    /// Mass of every link (kg, default 0.1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub link_mass: Option<f64>,
+    /// Gravitational acceleration along `-y` (m/s^2, default 9.81).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<f64>,
+    /// Per-link lengths (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lengths: Option<Vec<f64>>,
+    /// Per-link masses (kg).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub masses: Option<Vec<f64>>,
+    /// Per-link inertias about the centre of mass (kg m^2; default: uniform beams).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inertias: Option<Vec<f64>>,
+}
+
+/// The initial modal state (`m` entries each).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// The coordinates (rad).
+    pub a: Vec<f64>,
+    /// Their rates (rad/s), default zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub a_dot: Option<Vec<f64>>,
+}
+
+/// The reference for the `m` modal coordinates, tagged by `kind`; every array has `m` entries.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum ReferenceSpec {
+    /// A constant `a` (rad).
+    Constant {
+        /// The value.
+        a: Vec<f64>,
+    },
+    /// `initial` until `time` (s), then `target` (rad).
+    Step {
+        /// Before the step (default zero).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        initial: Option<Vec<f64>>,
+        /// After the step.
+        target: Vec<f64>,
+        /// When (s, default 0).
+        #[serde(default)]
+        time: f64,
+    },
+    /// `offset + amplitude sin(2 pi frequency_hz t + phase)` per coordinate.
+    Sinusoid {
+        /// Offsets (rad, default zero).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        offset: Option<Vec<f64>>,
+        /// Amplitudes (rad).
+        amplitude: Vec<f64>,
+        /// Frequencies (Hz).
+        frequency_hz: Vec<f64>,
+        /// Phases (rad, default zero).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        phase: Option<Vec<f64>>,
+    },
+    /// A tip path followed through the inverse kinematics of the modal family (closed form for
+    /// `K = 1` with `alpha0` fixed, numerical continuation otherwise, see
+    /// [`CartesianPath`](sim_core::reference::CartesianPath)): exactly one of `sine` or `points`.
+    Path {
+        /// Time along the path (s); the end point is held afterwards.
+        travel_time: f64,
+        /// Sign branch of `a1` (default positive, the paper's).
+        #[serde(default)]
+        branch: BranchSpec,
+        /// `y = amplitude sin(wavenumber x + phase) + offset`, at constant speed in `x`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        sine: Option<SineSpec>,
+        /// A polyline `[[x, y], ...]` (m), at constant speed along it.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        points: Option<Vec<[f64; 2]>>,
+    },
+}
+
+/// The sign branch of `a1` in the inverse kinematics (eq 6).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BranchSpec {
+    /// `a1 >= 0`.
+    #[default]
+    Positive,
+    /// `a1 <= 0`.
+    Negative,
+}
+
+/// A sine tip path `y = amplitude sin(wavenumber x + phase) + offset`, `x` from `x_start` to
+/// `x_end`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SineSpec {
+    /// Amplitude (m).
+    pub amplitude: f64,
+    /// Wavenumber (rad/m).
+    pub wavenumber: f64,
+    /// Phase (rad, default 0).
+    #[serde(default)]
+    pub phase: f64,
+    /// Offset (m, default 0).
+    #[serde(default)]
+    pub offset: f64,
+    /// First `x` (m).
+    pub x_start: f64,
+    /// Last `x` (m).
+    pub x_end: f64,
+}
+
+/// The controller and its sampling.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControllerSpec {
+    /// Which controller (default fuzzy).
+    #[serde(default)]
+    pub kind: ControllerKind,
+    /// Sampling period (s); default: the RK4 step (required with `dopri5`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub period: Option<f64>,
+    /// A `.fis` file replacing the paper's fuzzy system (for fuzzy, pd and fuzzy-gc); a relative
+    /// path is relative to the scenario file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fis: Option<PathBuf>,
+    /// What the fuzzy controllers (fuzzy, fuzzy-gc) do with an input outside its variable's
+    /// range: `"as-given"` (the default, as MATLAB's `evalfis` and Simulink's Fuzzy Logic
+    /// Controller block evaluate it; bells fade far out) or `"clamp"` (evaluated at the nearest
+    /// end of the range: the action saturates).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub out_of_range: Option<FuzzyInputRange>,
+    /// Computed-torque stiffness per coordinate (1/s^2, default 2500 each: 50 rad/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kp: Option<Vec<f64>>,
+    /// Computed-torque damping per coordinate (1/s, default 100 each: critically damped).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kd: Option<Vec<f64>>,
+    /// PD stiffness per coordinate (N m/rad); default: the fuzzy system's slope at the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pd_kp: Option<Vec<f64>>,
+    /// PD damping per coordinate (N m s/rad); default: the fuzzy system's slope at the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pd_kd: Option<Vec<f64>>,
+    /// LQR design frequency `omega` (rad/s, default 50): the weights place the poles of the
+    /// straight arm without gravity at a Butterworth pair of radius `omega`
+    /// ([`LqrController`](sim_core::controller::LqrController)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lqr_frequency: Option<f64>,
+    /// LQR re-linearisation period (s, default 0.01; at least the controller period).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lqr_relinearise: Option<f64>,
+}
+
+/// What a fuzzy controller does with an input outside its variable's range
+/// ([`fuzzy_sugeno::OutOfRange`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FuzzyInputRange {
+    /// Evaluated as given (MATLAB's `evalfis`, Simulink's Fuzzy Logic Controller block).
+    #[default]
+    AsGiven,
+    /// Evaluated at the nearest end of the range.
+    Clamp,
+}
+
+impl From<FuzzyInputRange> for fuzzy_sugeno::OutOfRange {
+    fn from(policy: FuzzyInputRange) -> Self {
+        match policy {
+            FuzzyInputRange::AsGiven => Self::AsGiven,
+            FuzzyInputRange::Clamp => Self::Clamp,
+        }
+    }
+}
+
+/// The integrator between controller samples, tagged by `method`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "method", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum IntegratorSpec {
+    /// Fixed-step RK4.
+    Rk4 {
+        /// The step (s).
+        dt: f64,
+    },
+    /// Adaptive Dormand-Prince 5(4).
+    Dopri5 {
+        /// Relative tolerance (default 1e-9).
+        #[serde(default = "default_rtol")]
+        rtol: f64,
+        /// Absolute tolerance (default 1e-12).
+        #[serde(default = "default_atol")]
+        atol: f64,
+        /// Largest step (s, default unbounded).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        h_max: Option<f64>,
+        /// Most steps per controller period (default 1,000,000).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        max_steps: Option<usize>,
+    },
+}
+
+fn default_rtol() -> f64 {
+    1e-9
+}
+
+fn default_atol() -> f64 {
+    1e-12
+}
+
+/// Standard deviations of the seeded Gaussian noise, `m` entries each (all default to zero).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoiseSpec {
+    /// On the reference `a_ref` the controller receives (rad).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_std: Option<Vec<f64>>,
+    /// On the measured coordinates `a` (rad).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor_a_std: Option<Vec<f64>>,
+    /// On the measured rates `a_dot` (rad/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor_a_dot_std: Option<Vec<f64>>,
+}
+
+impl NoiseSpec {
+    /// The same noise level on every one of `m` coordinates: `sensor` rad on `a`, `rate` rad/s
+    /// on `a_dot`, `reference` rad on `a_ref`.
+    pub fn uniform(m: usize, sensor: f64, rate: f64, reference: f64) -> Self {
+        Self {
+            reference_std: Some(vec![reference; m]),
+            sensor_a_std: Some(vec![sensor; m]),
+            sensor_a_dot_std: Some(vec![rate; m]),
+        }
+    }
+}
+
+/// The runaway bound, optional joint torque limits (reported) and optional limits (modal forces, not joint torques) on
+/// `tau*` (enforced).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LimitsSpec {
+    /// The run stops when `|a_i - a_i_ref|` exceeds this (rad, default pi).
+    #[serde(default = "default_max_modal_error")]
+    pub max_modal_error: f64,
+    /// Joint torque limits (N m): one for all joints or one per joint; exceeding is reported.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint_torque_nm: Option<TorqueLimit>,
+    /// Saturation of the modal forces `tau* = J^T tau` (N m): one limit for every coordinate or
+    /// one per coordinate (`m` entries), each finite and positive. They bound the modal
+    /// coordinates' generalised forces, not any joint torque (see `joint_torque_nm`). The loop
+    /// clamps every controller's output to `[-limit_i, limit_i]` before applying it and records
+    /// when it did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tau_star: Option<ModalTorqueLimit>,
+}
+
+fn default_max_modal_error() -> f64 {
+    std::f64::consts::PI
+}
+
+impl Default for LimitsSpec {
+    fn default() -> Self {
+        Self {
+            max_modal_error: default_max_modal_error(),
+            joint_torque_nm: None,
+            tau_star: None,
+        }
+    }
+}
+
+/// A limit on the modal torques `tau*`: the same for every coordinate, or one per coordinate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ModalTorqueLimit {
+    /// The same limit for every coordinate (N m).
+    All(f64),
+    /// One limit per coordinate, in coordinate order (N m).
+    PerCoordinate(Vec<f64>),
+}
+
+/// A torque limit for every joint, or one per joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum TorqueLimit {
+    /// The same limit for every joint (N m).
+    All(f64),
+    /// One limit per joint, base first (N m).
+    PerJoint(Vec<f64>),
+}
+
+impl Scenario {
+    /// The number of modal coordinates `m`: `2K` with `alpha0` fixed, `2K + 1` with it free
+    /// (saturating, for a scenario read from a file whose `harmonics` is not yet validated).
+    pub fn n_coords(&self) -> usize {
+        self.modal
+            .harmonics
+            .saturating_mul(2)
+            .saturating_add(usize::from(self.alpha0 == Alpha0::Free))
+    }
+
+    /// The names of the modal coordinates, in order: `a1, ..., a{2K}`, then `alpha0` when it is
+    /// free (the column names of the outputs).
+    ///
+    /// ```
+    /// let mut scenario = sim_study::Scenario::builtin("paper-tracking")?;
+    /// assert_eq!(scenario.coordinate_names(), ["a1", "a2"]);
+    /// scenario.alpha0 = sim_study::Alpha0::Free;
+    /// assert_eq!(scenario.coordinate_names(), ["a1", "a2", "alpha0"]);
+    /// # Ok::<(), sim_study::ScenarioError>(())
+    /// ```
+    pub fn coordinate_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = (1..=2 * self.modal.harmonics)
+            .map(|i| format!("a{i}"))
+            .collect();
+        if self.alpha0 == Alpha0::Free {
+            names.push("alpha0".into());
+        }
+        names
+    }
+}
+
+/// A `u64` seed as a TOML integer when it fits one (`i64`), else as a decimal string.
+mod seed_text {
+    use serde::de::{Error, Visitor};
+    use serde::{Deserializer, Serializer};
+    use std::fmt;
+
+    pub fn serialize<S: Serializer>(seed: &u64, serializer: S) -> Result<S::Ok, S::Error> {
+        match i64::try_from(*seed) {
+            Ok(seed) => serializer.serialize_i64(seed),
+            Err(_) => serializer.serialize_str(&seed.to_string()),
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<u64, D::Error> {
+        deserializer.deserialize_any(SeedVisitor)
+    }
+
+    struct SeedVisitor;
+
+    impl Visitor<'_> for SeedVisitor {
+        type Value = u64;
+
+        fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            f.write_str(
+                "a seed: an integer from 0 to 18446744073709551615 (as a string above 2^63 - 1)",
+            )
+        }
+
+        fn visit_u64<E: Error>(self, seed: u64) -> Result<u64, E> {
+            Ok(seed)
+        }
+
+        fn visit_i64<E: Error>(self, seed: i64) -> Result<u64, E> {
+            u64::try_from(seed)
+                .map_err(|_| E::custom(format!("seed must not be negative, got {seed}")))
+        }
+
+        fn visit_str<E: Error>(self, seed: &str) -> Result<u64, E> {
+            seed.parse().map_err(|_| {
+                E::custom(format!(
+                    "seed must be an integer from 0 to {}, got \"{seed}\"",
+                    u64::MAX
+                ))
+            })
+        }
+    }
+}

@@ -1,0 +1,241 @@
+//! Studies as a library: the main job's comparison of every shipped scenario with every
+//! controller, and Monte Carlo sweeps over noise levels and seeds with their plan, seeds,
+//! sharding, parallel running (rayon), aggregation and merge (`docs/sweep.md`). The `hrm`
+//! command is a thin layer of arguments and printing over these functions.
+//!
+//! A sweep in a few lines, whole or as shards merged back (bit for bit the same numbers):
+//!
+//! ```
+//! use sim_study::study::{Shard, SweepConfig, SweepSettings, cells, merge, run_shard};
+//! use sim_study::{ControllerKind, Scenario};
+//!
+//! let mut scenario = Scenario::builtin("paper-responses-step")?;
+//! scenario.duration = 0.15;
+//! let settings = SweepSettings {
+//!     controllers: vec![ControllerKind::Pd],
+//!     noise_levels: vec![0.0, 0.01],
+//!     seeds: 2,
+//!     base_seed: 7,
+//!     ..SweepSettings::default()
+//! };
+//! let config = SweepConfig::new(scenario, settings)?;
+//! let whole = run_shard(&config, Shard::WHOLE, || {});
+//! let halves = (1..=2).map(|index| {
+//!     let shard = Shard { index, count: 2 };
+//!     (std::path::PathBuf::from(format!("shard-{index}")), run_shard(&config, shard, || {}))
+//! });
+//! let merged = merge(halves.collect())?;
+//! assert_eq!(merged, whole);
+//! let table = cells(&config, &whole.runs);
+//! assert_eq!(table.len(), 2); // one cell per noise level and controller
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod aggregate;
+mod comparison;
+mod inputs;
+mod plan;
+mod shard_file;
+
+pub use aggregate::{Cell, CellBuilder, FailedRun, MAX_LISTED_FAILURES, Stats, cells};
+pub use comparison::{ComparisonRun, Stopped, builtin_scenarios, compare, run_one};
+pub use inputs::{
+    InputDigest, SCENARIO_INPUT, check_digests, check_json_safe, first_changed, input_digests,
+};
+pub use plan::{
+    MAX_RUNS, MAX_SHARDS, RunId, SettingError, Shard, SweepConfig, SweepSettings, run_seed,
+};
+pub use shard_file::{
+    FORMAT, MAX_SHARD_LINE_BYTES, Outcome, RunMetrics, RunResult, ShardFile, ShardHeader,
+    ShardInput, ShardReader, ShardSource, merge, merge_readers, shard_paths, write_json_line,
+};
+
+use crate::IntegratorSpec;
+use rayon::prelude::*;
+use sim_core::{Lockstep, Run, RunFailure};
+use std::io::Write;
+
+/// Runs run in parallel before their results are passed on in index order: enough to keep
+/// every core busy, few enough that the batch's results take little memory (a few hundred
+/// kilobytes).
+const BATCH_RUNS: usize = 1024;
+
+/// The toolkit version recorded in a sweep's configuration: shards merge only when theirs agree.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// Runs run `id` of `config` alone and keeps its summary metrics (the time series are dropped at
+/// once).
+pub fn execute(config: &SweepConfig, id: &RunId) -> RunResult {
+    let outcome = match config.scenario_for(id).build() {
+        Err(e) => build_failure(&e),
+        Ok(mut simulation) => outcome(simulation.run()),
+    };
+    RunResult::new(id, outcome)
+}
+
+/// Runs the runs `ids` of `config` side by side in a [`Lockstep`] group, their dynamics
+/// evaluated together (SIMD across runs) at every integrator stage, and keeps their summary
+/// metrics: the results in the order of `ids`, each the same, bit for bit, as [`execute`]'s.
+/// The runs must share the controller (they may differ in noise level and seed); a run that
+/// cannot be built or that stops leaves the others running.
+pub fn execute_group(config: &SweepConfig, ids: &[RunId]) -> Vec<RunResult> {
+    // Each run's outcome; those of the runs built are set when the group has run.
+    let mut outcomes = Vec::with_capacity(ids.len());
+    let (mut built, mut positions) = (Vec::new(), Vec::new());
+    for (position, id) in ids.iter().enumerate() {
+        outcomes.push(match config.scenario_for(id).build() {
+            Ok(simulation) => {
+                built.push(simulation);
+                positions.push(position);
+                build_failure(&"not run")
+            }
+            Err(e) => build_failure(&e),
+        });
+    }
+    if !built.is_empty() {
+        match Lockstep::new(built) {
+            Ok(mut group) => {
+                for (position, run) in positions.into_iter().zip(group.run()) {
+                    outcomes[position] = outcome(run);
+                }
+            }
+            // Runs a group refuses (they cannot differ but in noise and seed) are run alone.
+            Err(_) => return ids.iter().map(|id| execute(config, id)).collect(),
+        }
+    }
+    ids.iter()
+        .zip(outcomes)
+        .map(|(id, outcome)| RunResult::new(id, outcome))
+        .collect()
+}
+
+/// The outcome of a run that could not be built.
+fn build_failure(error: &dyn std::fmt::Display) -> Outcome {
+    Outcome::Failed {
+        error: error.to_string(),
+        simulated_s: 0.0,
+    }
+}
+
+/// The summary metrics of a run that completed, or why and when it stopped.
+fn outcome(run: Result<Run, Box<RunFailure>>) -> Outcome {
+    match run {
+        Ok(run) => match RunMetrics::from_summary(&run.summary) {
+            Ok(metrics) => Outcome::Completed(metrics),
+            Err(error) => Outcome::Failed {
+                error,
+                simulated_s: run.summary.simulated_s,
+            },
+        },
+        Err(failure) => Outcome::Failed {
+            error: failure.error.to_string(),
+            simulated_s: failure.summary.simulated_s,
+        },
+    }
+}
+
+/// How many runs of a sweep go into one lock-step group: the states the reduced dynamics'
+/// batch evaluates in one SIMD group ([`modal_reduce::batch_lanes`]) for an RK4 scenario, one
+/// (each run alone) for an adaptive integrator, whose runs choose their own steps.
+pub fn lockstep_size(config: &SweepConfig) -> usize {
+    match (&config.scenario.integrator, config.scenario.model()) {
+        (IntegratorSpec::Rk4 { .. }, Ok(model)) => modal_reduce::batch_lanes(&model),
+        _ => 1,
+    }
+}
+
+/// The runs `indices` (ascending) of `config` in lock-step groups of at most `size` runs of one
+/// controller, each group in index order.
+fn lockstep_groups(config: &SweepConfig, indices: &[usize], size: usize) -> Vec<Vec<RunId>> {
+    let mut groups = Vec::new();
+    for (c, controller) in config.settings.controllers.iter().enumerate() {
+        if config.settings.controllers[..c].contains(controller) {
+            continue;
+        }
+        let ids: Vec<RunId> = indices
+            .iter()
+            .map(|&i| config.run_at(i))
+            .filter(|id| id.controller == *controller)
+            .collect();
+        groups.extend(ids.chunks(size.max(1)).map(<[RunId]>::to_vec));
+    }
+    groups
+}
+
+/// Runs the runs of `shard` in lock-step groups ([`execute_group`], [`lockstep_size`] runs of
+/// one controller each), the groups in parallel (rayon), in batches of `BATCH_RUNS` (1024)
+/// runs, calling `progress` after each run and `sink` with each result in index order; stops at
+/// the first error of `sink`. Only one batch of results is held at a time.
+pub fn for_each_run(
+    config: &SweepConfig,
+    shard: Shard,
+    progress: impl Fn() + Sync,
+    mut sink: impl FnMut(RunResult) -> Result<(), String>,
+) -> Result<(), String> {
+    let mut indices = shard.indices(config.runs().unwrap_or(0));
+    let size = lockstep_size(config);
+    loop {
+        let batch: Vec<usize> = indices.by_ref().take(BATCH_RUNS).collect();
+        if batch.is_empty() {
+            return Ok(());
+        }
+        let groups = lockstep_groups(config, &batch, size);
+        let mut results: Vec<RunResult> = groups
+            .par_iter()
+            .flat_map_iter(|ids| {
+                let results = execute_group(config, ids);
+                results.iter().for_each(|_| progress());
+                results
+            })
+            .collect();
+        results.sort_unstable_by_key(|run| run.index);
+        results.into_iter().try_for_each(&mut sink)?;
+    }
+}
+
+/// Runs the runs of `shard` and keeps them in memory (see [`write_shard`] to stream them to a
+/// file); the results are in index order. [`Shard::WHOLE`] runs the whole sweep.
+pub fn run_shard(config: &SweepConfig, shard: Shard, progress: impl Fn() + Sync) -> ShardFile {
+    let mut runs = Vec::with_capacity(shard.run_count(config.runs().unwrap_or(0)));
+    let pushed: Result<(), String> = for_each_run(config, shard, progress, |run| {
+        runs.push(run);
+        Ok(())
+    });
+    debug_assert!(pushed.is_ok(), "pushing to a vector cannot fail");
+    ShardFile {
+        format: FORMAT.into(),
+        config: config.clone(),
+        shard,
+        runs,
+    }
+}
+
+/// Runs the runs of `shard` and writes its shard file to `out` as they finish (the header, then
+/// one line per run, in index order), so that memory does not grow with the number of runs.
+/// Afterwards the files the scenario references are read again: if one changed while the
+/// sweep ran (its runs could mix two contents), the shard is refused. Returns the number of
+/// runs and of those that stopped.
+pub fn write_shard<W: Write + ?Sized>(
+    config: &SweepConfig,
+    shard: Shard,
+    out: &mut W,
+    progress: impl Fn() + Sync,
+) -> Result<(usize, usize), String> {
+    write_json_line(out, &ShardHeader::new(config, shard))?;
+    let (mut runs, mut stopped) = (0, 0);
+    for_each_run(config, shard, progress, |run| {
+        runs += 1;
+        stopped += usize::from(matches!(run.outcome, Outcome::Failed { .. }));
+        write_json_line(out, &run)
+    })?;
+    let now = input_digests(&config.scenario)?;
+    if let Some((input, _)) = first_changed(&config.inputs, &now) {
+        return Err(format!(
+            "{} changed while the sweep ran, so its runs may mix two contents: run the sweep \
+             again",
+            input.describe()
+        ));
+    }
+    out.flush().map_err(|e| e.to_string())?;
+    Ok((runs, stopped))
+}

@@ -1,0 +1,635 @@
+//! The outcome of each run, the shard file that stores a slice of a sweep's runs, and merging
+//! shard files back into the whole sweep.
+//!
+//! A shard file (format 3) is JSON lines: a [`ShardHeader`] (format, configuration with the
+//! digests of its inputs, shard), then one [`RunResult`] per line in index order. It is written
+//! and read one run at a time ([`write_json_line`], [`ShardReader`]), so neither a sweep nor a
+//! merge holds its runs in memory.
+
+use super::inputs;
+use super::plan::{MAX_SHARDS, RunId, Shard, SweepConfig};
+use crate::ControllerKind;
+use serde::{Deserialize, Serialize};
+use sim_core::Summary;
+use std::fs::File;
+use std::io::{BufRead, BufReader, Read, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+
+/// The `format` tag of a shard file.
+pub const FORMAT: &str = "hrm-sweep-shard/4";
+
+/// Longest line of a shard file read (64 MiB: the header holds the scenario, whose file has at
+/// most 16 MiB; a run's line has a few hundred bytes).
+pub const MAX_SHARD_LINE_BYTES: usize = 64 << 20;
+
+/// Most shard files a merge keeps open; beyond, each is opened for each run read from it.
+const MAX_OPEN_SHARD_FILES: usize = 64;
+
+/// Missing shards named in a message; the rest are counted.
+const LISTED_MISSING_SHARDS: usize = 5;
+
+/// A slice of a sweep held in memory: its configuration, which shard, and the runs of that
+/// shard in index order. The whole sweep is shard 1/1. On disk it is a shard file of JSON lines
+/// ([`ShardFile::to_json`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShardFile {
+    /// [`FORMAT`].
+    pub format: String,
+    /// The sweep.
+    pub config: SweepConfig,
+    /// Which slice.
+    pub shard: Shard,
+    /// One entry per run of the slice, ascending index.
+    pub runs: Vec<RunResult>,
+}
+
+/// One run: where it sits in the sweep and how it ended.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunResult {
+    /// Index in the sweep's enumeration.
+    pub index: usize,
+    /// Noise level (rad).
+    pub noise_level: f64,
+    /// Controller.
+    pub controller: ControllerKind,
+    /// Which noise realisation of the cell (0-based).
+    pub seed_index: usize,
+    /// Seed of the run's noise sources.
+    pub seed: u64,
+    /// Its metrics, or why it stopped.
+    pub outcome: Outcome,
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Outcome {
+    /// It ran to the end.
+    Completed(RunMetrics),
+    /// It stopped (divergence, runaway error) or could not be built.
+    Failed {
+        /// Why, and when.
+        error: String,
+        /// Simulated time reached (s).
+        simulated_s: f64,
+    },
+}
+
+/// The summary metrics a sweep keeps of a run (see [`Summary`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunMetrics {
+    /// Tip error RMS (m).
+    pub tip_error_rms_m: f64,
+    /// Largest tip error (m).
+    pub tip_error_max_m: f64,
+    /// Modal error RMS per coordinate (rad).
+    pub modal_error_rms_rad: Vec<f64>,
+    /// Largest joint torque (N m).
+    pub peak_joint_torque_nm: f64,
+    /// Control effort (N^2 m^2 s).
+    pub control_effort_n2m2s: f64,
+}
+
+impl RunMetrics {
+    /// The kept metrics of `summary`, or an error if one is not finite.
+    pub fn from_summary(s: &Summary) -> Result<Self, String> {
+        let m = RunMetrics {
+            tip_error_rms_m: s.tip_error_rms_m,
+            tip_error_max_m: s.tip_error_max_m,
+            modal_error_rms_rad: s.modal_error_rms_rad.clone(),
+            peak_joint_torque_nm: s.peak_joint_torque_nm,
+            control_effort_n2m2s: s.control_effort_n2m2s,
+        };
+        let values = [
+            m.tip_error_rms_m,
+            m.tip_error_max_m,
+            m.peak_joint_torque_nm,
+            m.control_effort_n2m2s,
+        ];
+        if values
+            .iter()
+            .chain(&m.modal_error_rms_rad)
+            .all(|v| v.is_finite())
+        {
+            Ok(m)
+        } else {
+            Err(format!("the run's summary metrics are not finite: {m:?}"))
+        }
+    }
+}
+
+impl RunResult {
+    /// A run's entry.
+    pub fn new(id: &RunId, outcome: Outcome) -> Self {
+        RunResult {
+            index: id.index,
+            noise_level: id.noise_level,
+            controller: id.controller,
+            seed_index: id.seed_index,
+            seed: id.seed,
+            outcome,
+        }
+    }
+
+    /// Whether the entry's position fields agree with run `id`.
+    fn matches(&self, id: &RunId) -> bool {
+        self.index == id.index
+            && self.noise_level == id.noise_level
+            && self.controller == id.controller
+            && self.seed_index == id.seed_index
+            && self.seed == id.seed
+    }
+}
+
+impl ShardFile {
+    /// Parses a shard file's text; `origin` names it in errors.
+    pub fn parse(text: &str, origin: &Path) -> Result<Self, String> {
+        Self::collect(ShardReader::new(text.as_bytes(), origin)?)
+    }
+
+    /// Reads a shard file.
+    pub fn read(path: &Path) -> Result<Self, String> {
+        Self::collect(ShardReader::open(path)?)
+    }
+
+    /// Every run of `reader`.
+    fn collect<R: ShardSource>(mut reader: ShardReader<R>) -> Result<Self, String> {
+        let mut runs = Vec::new();
+        while let Some(run) = reader.next_run()? {
+            runs.push(run);
+        }
+        let ShardHeader {
+            format,
+            config,
+            shard,
+        } = reader.header;
+        Ok(ShardFile {
+            format,
+            config,
+            shard,
+            runs,
+        })
+    }
+
+    /// The file's text: the header line, then one line per run (what `hrm sweep` writes).
+    pub fn to_json(&self) -> Result<String, String> {
+        let mut out = Vec::new();
+        let header = ShardHeader {
+            format: self.format.clone(),
+            config: self.config.clone(),
+            shard: self.shard,
+        };
+        write_json_line(&mut out, &header)?;
+        for run in &self.runs {
+            write_json_line(&mut out, run)?;
+        }
+        String::from_utf8(out).map_err(|e| e.to_string())
+    }
+}
+
+/// The first line of a shard file: what the runs on the following lines are of.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShardHeader {
+    /// [`FORMAT`].
+    pub format: String,
+    /// The sweep, with the digests of its inputs.
+    pub config: SweepConfig,
+    /// Which slice.
+    pub shard: Shard,
+}
+
+impl ShardHeader {
+    /// The header of `shard` of the sweep `config`.
+    pub fn new(config: &SweepConfig, shard: Shard) -> Self {
+        ShardHeader {
+            format: FORMAT.into(),
+            config: config.clone(),
+            shard,
+        }
+    }
+
+    /// The number of runs the shard holds.
+    pub fn run_count(&self) -> usize {
+        self.shard.run_count(self.config.runs().unwrap_or(0))
+    }
+
+    /// Checks the configuration and that the shard is one of a split the sweep can have.
+    fn check(&self, origin: &Path) -> Result<(), String> {
+        self.config.validate().map_err(|e| {
+            format!(
+                "{} holds an invalid sweep configuration: {e}",
+                origin.display()
+            )
+        })?;
+        let Shard { index, count } = self.shard;
+        if !(1..=MAX_SHARDS).contains(&count) || !(1..=count).contains(&index) {
+            return Err(format!(
+                "{} is shard {index} of a split into {count} shards; a split has 1 to \
+                 {MAX_SHARDS} shards, numbered from 1",
+                origin.display()
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Writes `value` as one line of compact JSON.
+pub fn write_json_line<W: Write + ?Sized>(
+    out: &mut W,
+    value: &impl Serialize,
+) -> Result<(), String> {
+    serde_json::to_writer(&mut *out, value)
+        .map_err(|e| e.to_string())
+        .and_then(|()| out.write_all(b"\n").map_err(|e| e.to_string()))
+}
+
+/// What a shard file is read from: a buffered reader that may be closed between runs
+/// ([`release`](Self::release)) and reopened where it stopped.
+pub trait ShardSource: BufRead {
+    /// Closes the underlying file until the next read, if there is one.
+    fn release(&mut self) {}
+}
+
+impl ShardSource for &[u8] {}
+
+/// A shard file on disk, read from where its reading stopped; reopened after a
+/// [`release`](ShardSource::release).
+#[derive(Debug)]
+pub struct ShardInput {
+    path: PathBuf,
+    offset: u64,
+    file: Option<BufReader<File>>,
+}
+
+impl ShardInput {
+    /// The open file, reopened at the offset reached if it was released.
+    fn file(&mut self) -> std::io::Result<&mut BufReader<File>> {
+        let file = match self.file.take() {
+            Some(file) => file,
+            None => {
+                let mut file = crate::open_regular_file(&self.path)?;
+                file.seek(SeekFrom::Start(self.offset))?;
+                BufReader::new(file)
+            }
+        };
+        Ok(self.file.insert(file))
+    }
+}
+
+impl Read for ShardInput {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.file()?.read(buf)?;
+        self.offset += n as u64;
+        Ok(n)
+    }
+}
+
+impl BufRead for ShardInput {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        self.file()?.fill_buf()
+    }
+
+    fn consume(&mut self, amount: usize) {
+        if let Some(file) = &mut self.file {
+            file.consume(amount);
+            self.offset += amount as u64;
+        }
+    }
+}
+
+impl ShardSource for ShardInput {
+    fn release(&mut self) {
+        self.file = None;
+    }
+}
+
+/// Reads a shard file one run at a time: the header is read and checked when the reader is
+/// made, then [`next_run`](Self::next_run) gives the shard's runs in order, each checked to
+/// be the next run of the shard, and refuses a file cut short or holding more lines.
+#[derive(Debug)]
+pub struct ShardReader<R> {
+    input: R,
+    origin: PathBuf,
+    header: ShardHeader,
+    runs_read: usize,
+    line: Vec<u8>,
+}
+
+impl ShardReader<ShardInput> {
+    /// Opens the shard file `path` and reads its header; the file is closed until the first
+    /// run is read.
+    pub fn open(path: &Path) -> Result<Self, String> {
+        let file = crate::open_regular_file(path)
+            .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let mut reader = Self::new(
+            ShardInput {
+                path: path.to_path_buf(),
+                offset: 0,
+                file: Some(BufReader::new(file)),
+            },
+            path,
+        )?;
+        reader.input.release();
+        Ok(reader)
+    }
+}
+
+impl<R: ShardSource> ShardReader<R> {
+    /// Reads and checks the header from `input`; `origin` names the file in errors.
+    pub fn new(mut input: R, origin: &Path) -> Result<Self, String> {
+        let mut line = Vec::new();
+        if read_line(&mut input, &mut line, origin, 1)? == 0 {
+            return Err(format!(
+                "{} is empty, not an hrm sweep shard file",
+                origin.display()
+            ));
+        }
+        let value: serde_json::Value = match serde_json::from_slice(&line) {
+            Ok(value) => value,
+            Err(e) => {
+                // An older shard file is one pretty-printed object: `{`, then its format.
+                let ahead = input.fill_buf().unwrap_or_default();
+                let start = [&line[..], &ahead[..ahead.len().min(4096)]].concat();
+                return Err(match declared_format(&start) {
+                    Some(format) => not_a_shard(origin, Some(&format)),
+                    None => format!(
+                        "{} is not an hrm sweep shard file: its first line is not JSON ({e})",
+                        origin.display()
+                    ),
+                });
+            }
+        };
+        match value.get("format").and_then(|f| f.as_str()) {
+            Some(FORMAT) => {}
+            other => return Err(not_a_shard(origin, other)),
+        }
+        let header: ShardHeader = serde_json::from_value(value)
+            .map_err(|e| format!("{} has a malformed header: {e}", origin.display()))?;
+        header.check(origin)?;
+        Ok(ShardReader {
+            input,
+            origin: origin.to_path_buf(),
+            header,
+            runs_read: 0,
+            line,
+        })
+    }
+
+    /// The header: the sweep and the shard.
+    pub fn header(&self) -> &ShardHeader {
+        &self.header
+    }
+
+    /// The shard's next run, `None` after its last. Refuses a malformed line, a run that is not
+    /// the shard's next, a completed run with a modal error count other than the scenario's,
+    /// a file cut short and lines after the last run.
+    pub fn next_run(&mut self) -> Result<Option<RunResult>, String> {
+        let number = self.runs_read + 2;
+        let origin = self.origin.display();
+        let Shard { index, count } = self.header.shard;
+        let expected = self.header.run_count();
+        if read_line(&mut self.input, &mut self.line, &self.origin, number)? == 0 {
+            if self.runs_read < expected {
+                return Err(format!(
+                    "{origin} is cut short: it holds {} of the {expected} runs of shard \
+                     {index}/{count}",
+                    self.runs_read
+                ));
+            }
+            return Ok(None);
+        }
+        if self.runs_read == expected {
+            return Err(format!(
+                "{origin}: line {number}: more lines than the {expected} runs of shard \
+                 {index}/{count}"
+            ));
+        }
+        let run: RunResult = serde_json::from_slice(&self.line)
+            .map_err(|e| format!("{origin}: line {number} is not a run: {e}"))?;
+        let i = index - 1 + self.runs_read * count;
+        if !run.matches(&self.header.config.run_at(i)) {
+            return Err(format!(
+                "{origin}: line {number} holds run {}, which is not run {i} of this sweep, the \
+                 next of its shard {index}/{count}",
+                run.index
+            ));
+        }
+        let m = self.header.config.scenario.n_coords();
+        if let Outcome::Completed(metrics) = &run.outcome
+            && metrics.modal_error_rms_rad.len() != m
+        {
+            return Err(format!(
+                "{origin}: run {} has {} modal errors, but its scenario has {m} modal coordinates",
+                run.index,
+                metrics.modal_error_rms_rad.len()
+            ));
+        }
+        self.runs_read += 1;
+        Ok(Some(run))
+    }
+}
+
+/// Reads one line (its newline kept) of at most [`MAX_SHARD_LINE_BYTES`] into `line`; returns
+/// its length, 0 at the end of the file.
+fn read_line(
+    input: &mut impl BufRead,
+    line: &mut Vec<u8>,
+    origin: &Path,
+    number: usize,
+) -> Result<usize, String> {
+    line.clear();
+    let n = input
+        .take(MAX_SHARD_LINE_BYTES as u64 + 1)
+        .read_until(b'\n', line)
+        .map_err(|e| format!("cannot read {}: {e}", origin.display()))?;
+    if n > MAX_SHARD_LINE_BYTES {
+        return Err(format!(
+            "{}: line {number} is longer than the {MAX_SHARD_LINE_BYTES} bytes a shard file's \
+             line may have",
+            origin.display()
+        ));
+    }
+    Ok(n)
+}
+
+/// The refusal of a file that declares another format (or none).
+fn not_a_shard(origin: &Path, format: Option<&str>) -> String {
+    let found = match format {
+        Some(f) => format!("format \"{}\"", f.escape_debug()),
+        None => "no format".into(),
+    };
+    let older = match format {
+        Some(f) if f.starts_with("hrm-sweep-shard/") => {
+            ": shard files of older versions cannot be merged, run the shard again"
+        }
+        _ => "",
+    };
+    format!(
+        "{} is not an hrm sweep shard file ({found}, expected \"{FORMAT}\"){older}",
+        origin.display()
+    )
+}
+
+/// The value of the first `"format": "..."` in `text` (an older, pretty-printed shard file).
+fn declared_format(text: &[u8]) -> Option<String> {
+    let text = String::from_utf8_lossy(text);
+    let after = text.split_once("\"format\"")?.1.trim_start();
+    let value = after.strip_prefix(':')?.trim_start().strip_prefix('"')?;
+    Some(value.split_once('"')?.0.to_string())
+}
+
+/// The shard files named by `inputs`: files as given, and every `shard-*.json` in a directory.
+pub fn shard_paths(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
+    let mut paths = Vec::new();
+    for input in inputs {
+        if input.is_dir() {
+            let entries = std::fs::read_dir(input)
+                .map_err(|e| format!("cannot list {}: {e}", input.display()))?;
+            let mut found: Vec<PathBuf> = entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| {
+                    p.file_name().and_then(|n| n.to_str()).is_some_and(|n| {
+                        n.starts_with("shard-") && n.ends_with(".json") && p.is_file()
+                    })
+                })
+                .collect();
+            if found.is_empty() {
+                return Err(format!("no shard-*.json files in {}", input.display()));
+            }
+            found.sort();
+            paths.extend(found);
+        } else {
+            paths.push(input.clone());
+        }
+    }
+    Ok(paths)
+}
+
+/// Combines shards held in memory into the whole sweep (shard 1/1, runs in index order), as
+/// [`merge_readers`] does with files; `PathBuf`s name the shards in errors.
+pub fn merge(shards: Vec<(PathBuf, ShardFile)>) -> Result<ShardFile, String> {
+    let texts = shards
+        .into_iter()
+        .map(|(path, file)| file.to_json().map(|text| (path, text)))
+        .collect::<Result<Vec<_>, _>>()?;
+    let readers = texts
+        .iter()
+        .map(|(path, text)| ShardReader::new(text.as_bytes(), path))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut runs = Vec::new();
+    let header = merge_readers(readers, |run| {
+        runs.push(run);
+        Ok(())
+    })?;
+    Ok(ShardFile {
+        format: header.format,
+        config: header.config,
+        shard: header.shard,
+        runs,
+    })
+}
+
+/// Combines shards into the whole sweep: refuses shards of different sweeps (naming the first
+/// setting that differs, or the referenced file whose content differs), of different splits, a
+/// shard given twice and missing shards, then passes every run to `sink` in index order, read
+/// from the files as it comes (a file cut short or with a run out of place is refused by its
+/// reader). Returns the header of the whole sweep (shard 1/1).
+pub fn merge_readers<R: ShardSource>(
+    mut shards: Vec<ShardReader<R>>,
+    mut sink: impl FnMut(RunResult) -> Result<(), String>,
+) -> Result<ShardHeader, String> {
+    let Some(first) = shards.first() else {
+        return Err("nothing to merge: no shard files given".into());
+    };
+    let (first_path, config) = (first.origin.clone(), first.header.config.clone());
+    let (first_shard, count) = (first.header.shard, first.header.shard.count);
+    for other in &shards {
+        let path = other.origin.display();
+        match config.first_difference(&other.header.config) {
+            None => {}
+            Some("inputs") => {
+                let (input, there) =
+                    inputs::first_changed(&config.inputs, &other.header.config.inputs)
+                        .ok_or("the shards' input lists differ")?;
+                return Err(format!(
+                    "{} and {path} were run with different contents of {}: SHA-256 {}... \
+                     against {}...; merge only the shards of one sweep",
+                    first_path.display(),
+                    input.describe(),
+                    &input.sha256[..12],
+                    &there[..12]
+                ));
+            }
+            Some(field) => {
+                return Err(format!(
+                    "{} and {path} come from different sweeps (their configurations differ in \
+                     {field})",
+                    first_path.display()
+                ));
+            }
+        }
+        if other.header.shard.count != count {
+            return Err(format!(
+                "{path} is shard {} but {} is shard {first_shard}: every shard must come from the \
+                 same split",
+                other.header.shard,
+                first_path.display()
+            ));
+        }
+    }
+    shards.sort_by_key(|s| s.header.shard.index);
+    if let Some(pair) = shards
+        .windows(2)
+        .find(|w| w[0].header.shard == w[1].header.shard)
+    {
+        return Err(format!(
+            "shard {} is given twice: {} and {}",
+            pair[0].header.shard,
+            pair[0].origin.display(),
+            pair[1].origin.display()
+        ));
+    }
+    if shards.len() < count {
+        let mut given = shards.iter().map(|s| s.header.shard.index).peekable();
+        let absent: Vec<String> = (1..=count)
+            .filter(|&k| given.next_if_eq(&k).is_none())
+            .take(LISTED_MISSING_SHARDS)
+            .map(|k| format!("{k}/{count}"))
+            .collect();
+        let more = count - shards.len() - absent.len();
+        let (noun, verb) = if absent.len() + more > 1 {
+            ("shards", "are")
+        } else {
+            ("shard", "is")
+        };
+        let more = if more > 0 {
+            format!(" and {more} more")
+        } else {
+            String::new()
+        };
+        return Err(format!(
+            "cannot merge: {noun} {}{more} {verb} missing",
+            absent.join(", ")
+        ));
+    }
+    let keep_open = count <= MAX_OPEN_SHARD_FILES;
+    for i in 0..config.runs().unwrap_or(0) {
+        let reader = &mut shards[i % count];
+        let run = reader
+            .next_run()?
+            .ok_or_else(|| format!("{} ends before run {i}", reader.origin.display()))?;
+        if !keep_open {
+            reader.input.release();
+        }
+        sink(run)?;
+    }
+    for reader in &mut shards {
+        reader.next_run()?;
+        reader.input.release();
+    }
+    Ok(ShardHeader::new(&config, Shard::WHOLE))
+}

@@ -1,0 +1,624 @@
+//! One test per sim-core row of `docs/bad-input.md` (the scenario loader has its own fuzz tests):
+//! each bad setting is refused with the named [`SimError`] or [`OdeError`] variant when the
+//! simulation is built, never half-way through a run, and a failing run keeps its data.
+
+use backbone_kin::{BaseAngle, Branch, ModalMap};
+use manip_dyn::ChainModel;
+use modal_reduce::ReducedModel;
+use sim_core::controller::{ComputedTorque, FuzzyController, PdController};
+use sim_core::ode::{DormandPrince, OdeError, OdeSystem, Rk4, Tolerances};
+use sim_core::reference::{CartesianPath, PathShape, Sinusoid, Step};
+use sim_core::{
+    Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS, SimError,
+    Simulation,
+};
+use std::f64::consts::FRAC_PI_2;
+
+fn paper_model() -> ReducedModel {
+    ReducedModel::new(
+        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
+        ModalMap::paper_fixed_alpha0(10, FRAC_PI_2).unwrap(),
+    )
+    .unwrap()
+}
+
+fn settings() -> LoopSettings {
+    LoopSettings::new(Integrator::Rk4 { dt: 1e-3 }, 1e-3, 0.1)
+}
+
+/// Builds the paper's arm under `settings` with a PD law tracking a step.
+fn build(settings: LoopSettings) -> Result<Simulation, SimError> {
+    let reference = Step::new(&[0.0, 0.0], &[0.2, -0.1], 0.0).unwrap();
+    let controller = PdController::new(&[0.0; 2], &[5.0, 5.0], &[1.0, 1.0]).unwrap();
+    Simulation::new(
+        paper_model(),
+        Box::new(reference),
+        Box::new(controller),
+        settings,
+        None,
+    )
+}
+
+/// The setting an `InvalidSetting` error names, and its message.
+fn invalid(result: Result<Simulation, SimError>) -> (String, String) {
+    match result {
+        Err(e @ SimError::InvalidSetting { .. }) => {
+            let message = e.to_string();
+            let SimError::InvalidSetting { name, .. } = e else {
+                unreachable!()
+            };
+            (name, message)
+        }
+        Err(other) => panic!("expected InvalidSetting, got {other:?}"),
+        Ok(_) => panic!("expected InvalidSetting, got a simulation"),
+    }
+}
+
+#[test]
+fn reference_and_controller_of_another_size_than_the_model() {
+    let free = ReducedModel::new(
+        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
+        ModalMap::paper(10).unwrap(),
+    )
+    .unwrap();
+    let result = Simulation::new(
+        free,
+        Box::new(Step::constant(&[0.0; 2]).unwrap()),
+        Box::new(PdController::new(&[0.0; 2], &[0.0; 2], &[0.0; 2]).unwrap()),
+        settings(),
+        None,
+    );
+    // The model with alpha0 free has 3 coordinates: the 2-coordinate reference is refused first.
+    let (name, message) = invalid(result);
+    assert_eq!(name, "reference");
+    assert!(
+        message.contains("sets 2 coordinates, the model has 3"),
+        "{message}"
+    );
+}
+
+#[test]
+fn controller_period_not_positive() {
+    for period in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
+        let s = LoopSettings {
+            controller_period: period,
+            ..settings()
+        };
+        let (name, message) = invalid(build(s));
+        assert_eq!(name, "controller.period", "{period}");
+        assert!(message.contains("must be positive and finite"), "{message}");
+    }
+}
+
+#[test]
+fn duration_not_positive() {
+    for duration in [0.0, -1.0, f64::NAN] {
+        let s = LoopSettings {
+            duration,
+            ..settings()
+        };
+        assert_eq!(invalid(build(s)).0, "duration");
+    }
+}
+
+#[test]
+fn duration_not_a_whole_number_of_periods() {
+    let s = LoopSettings {
+        duration: 0.1005,
+        ..settings()
+    };
+    let (name, message) = invalid(build(s));
+    assert_eq!(name, "duration");
+    assert!(message.contains("whole number of controller periods"));
+}
+
+#[test]
+fn record_period_not_a_whole_number_of_periods() {
+    for record_period in [0.0015, 0.0, -1.0] {
+        let s = LoopSettings {
+            record_period,
+            ..settings()
+        };
+        assert_eq!(invalid(build(s)).0, "record_period", "{record_period}");
+    }
+}
+
+#[test]
+fn rk4_step_not_positive_or_not_dividing_the_period() {
+    for dt in [0.0, -1e-4, f64::NAN] {
+        let s = LoopSettings {
+            integrator: Integrator::Rk4 { dt },
+            ..settings()
+        };
+        assert_eq!(invalid(build(s)).0, "integrator.dt", "{dt}");
+    }
+    let s = LoopSettings {
+        integrator: Integrator::Rk4 { dt: 3e-4 },
+        ..settings()
+    };
+    let (name, message) = invalid(build(s));
+    assert_eq!(name, "controller.period");
+    assert!(message.contains("whole number of RK4 steps"));
+}
+
+#[test]
+fn dormand_prince_tolerances_out_of_domain() {
+    let base = Tolerances::default();
+    let bad = [
+        Tolerances { rtol: 0.0, ..base },
+        Tolerances {
+            atol: f64::NAN,
+            ..base
+        },
+        Tolerances { h_max: 0.0, ..base },
+        Tolerances {
+            h_min: -1.0,
+            ..base
+        },
+        Tolerances {
+            h_init: Some(-1e-3),
+            ..base
+        },
+        Tolerances {
+            max_steps: 0,
+            ..base
+        },
+    ];
+    for tolerances in bad {
+        // Refused when the simulation is built, not at the first step of a run...
+        let s = LoopSettings {
+            integrator: Integrator::DormandPrince(tolerances),
+            ..settings()
+        };
+        let (name, message) = invalid(build(s));
+        assert_eq!(name, "integrator", "{tolerances:?}");
+        assert!(message.starts_with("integrator setting: "), "{message}");
+        // ...and by the integrator itself.
+        let mut y = [1.0];
+        let err = DormandPrince::new(1, tolerances)
+            .integrate(&mut Decay, 0.0, 1.0, &mut y)
+            .unwrap_err();
+        assert!(matches!(err, OdeError::InvalidSetting(_)), "{err:?}");
+        assert_eq!(y, [1.0]);
+    }
+}
+
+#[test]
+fn noise_negative_or_non_finite() {
+    let s = LoopSettings {
+        reference_noise_std: vec![0.0, -0.1],
+        ..settings()
+    };
+    assert_eq!(invalid(build(s)).0, "noise.reference_std");
+    let s = LoopSettings {
+        sensor_noise_std: vec![0.0, 0.0, f64::INFINITY, 0.0],
+        ..settings()
+    };
+    assert_eq!(invalid(build(s)).0, "noise.sensor_std");
+}
+
+#[test]
+fn runaway_bound_not_positive() {
+    for bound in [0.0, -1.0, f64::NAN] {
+        let s = LoopSettings {
+            max_modal_error: bound,
+            ..settings()
+        };
+        assert_eq!(invalid(build(s)).0, "limits.max_modal_error", "{bound}");
+    }
+}
+
+#[test]
+fn torque_limits_wrong_length_or_not_positive() {
+    let s = LoopSettings {
+        joint_torque_limits: Some(vec![1.0; 9]),
+        ..settings()
+    };
+    let (name, message) = invalid(build(s));
+    assert_eq!(name, "limits.joint_torque_nm");
+    assert!(message.contains("has 9 entries, the arm has 10 joints"));
+    for bad in [0.0, -1.0, f64::NAN] {
+        let mut limits = vec![1.0; 10];
+        limits[3] = bad;
+        let s = LoopSettings {
+            joint_torque_limits: Some(limits),
+            ..settings()
+        };
+        assert_eq!(invalid(build(s)).0, "limits.joint_torque_nm", "{bad}");
+    }
+}
+
+#[test]
+fn actuator_limits_wrong_length_or_not_positive() {
+    let s = LoopSettings {
+        tau_star_limits: Some(vec![1.0; 3]),
+        ..settings()
+    };
+    let (name, message) = invalid(build(s));
+    assert_eq!(name, "limits.tau_star");
+    assert!(
+        message.contains("has 3 entries, the modal family has 2 coordinates"),
+        "{message}"
+    );
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let s = LoopSettings {
+            tau_star_limits: Some(vec![1.0, bad]),
+            ..settings()
+        };
+        let (name, message) = invalid(build(s));
+        assert_eq!(name, "limits.tau_star", "{bad}");
+        assert!(message.contains("must be positive and finite"), "{message}");
+    }
+    // From a scenario file: one number for all, or one per coordinate, checked the same way.
+    let mut scenario = sim_study::Scenario::builtin("paper-responses-step").unwrap();
+    scenario.limits.tau_star = Some(sim_study::ModalTorqueLimit::PerCoordinate(vec![1.0; 3]));
+    assert_eq!(invalid(scenario.build()).0, "limits.tau_star");
+    scenario.limits.tau_star = Some(sim_study::ModalTorqueLimit::All(-2.0));
+    assert_eq!(invalid(scenario.build()).0, "limits.tau_star");
+}
+
+#[test]
+fn run_that_would_never_end() {
+    // Recording only at the end keeps the record small, so only the sample count refuses it.
+    let s = LoopSettings {
+        duration: 1e300,
+        record_period: 1e300,
+        ..settings()
+    };
+    let (name, message) = invalid(build(s));
+    assert_eq!(name, "duration");
+    assert_eq!(
+        message,
+        format!(
+            "duration must be at most {MAX_CONTROLLER_SAMPLES:e} controller periods (0.001 s), \
+             got 1e300 s"
+        )
+    );
+}
+
+#[test]
+fn run_of_astronomically_many_rk4_steps() {
+    // 0.1 s in steps of 1e-12 s: 1e11 steps, days of computing, refused up front with the count.
+    let s = LoopSettings::new(Integrator::Rk4 { dt: 1e-12 }, 1e-3, 0.1);
+    let (name, message) = invalid(build(s));
+    assert_eq!(name, "integrator.dt");
+    assert!(
+        message.contains("1.000e11 RK4 steps over 0.1 s")
+            && message.contains(&format!("more than the {MAX_RK4_STEPS:e}")),
+        "{message}"
+    );
+    // A step of 1e-300 s is refused the same way, its numbers readable (no 300-digit decimal).
+    let s = LoopSettings::new(Integrator::Rk4 { dt: 1e-300 }, 1e-3, 0.1);
+    let (_, message) = invalid(build(s));
+    assert!(message.contains("1.000e299 RK4 steps"), "{message}");
+    // A duration of 1e-300 s is not a whole number of periods; the message shows it as 1e-300.
+    let s = LoopSettings {
+        duration: 1e-300,
+        ..settings()
+    };
+    let (_, message) = invalid(build(s));
+    assert!(message.ends_with("got 1e-300 s"), "{message}");
+}
+
+#[test]
+fn run_too_long_to_record() {
+    // 1e8 samples would be recorded: refused up front instead of failing to allocate.
+    let s = LoopSettings {
+        duration: 1e5,
+        ..settings()
+    };
+    let (name, message) = invalid(build(s));
+    assert_eq!(name, "record_period");
+    assert!(
+        message.contains(&format!("more than the {MAX_RECORDED_VALUES}")),
+        "{message}"
+    );
+    // Recording rarely makes the same duration acceptable.
+    let s = LoopSettings {
+        duration: 1e3,
+        record_period: 1.0,
+        ..settings()
+    };
+    assert!(build(s).is_ok());
+}
+
+#[test]
+fn non_finite_initial_state() {
+    let result = Simulation::new(
+        paper_model(),
+        Box::new(Step::constant(&[0.0; 2]).unwrap()),
+        Box::new(PdController::new(&[0.0; 2], &[0.0; 2], &[0.0; 2]).unwrap()),
+        settings(),
+        Some(sim_core::controller::ModalState {
+            a: vec![0.0, f64::NAN],
+            a_dot: vec![0.0; 2],
+        }),
+    );
+    assert_eq!(invalid(result).0, "initial.a");
+}
+
+#[test]
+fn step_reference_non_finite_or_negative_time() {
+    assert!(matches!(
+        Step::new(&[f64::NAN, 0.0], &[0.0; 2], 0.0),
+        Err(SimError::InvalidSetting { ref name, .. }) if name == "reference.initial"
+    ));
+    assert!(matches!(
+        Step::new(&[0.0; 2], &[0.0; 2], -1.0),
+        Err(SimError::InvalidSetting { ref name, .. }) if name == "reference.time"
+    ));
+}
+
+#[test]
+fn sinusoid_negative_frequency() {
+    assert!(matches!(
+        Sinusoid::new(&[0.0; 2], &[0.1; 2], &[-1.0, 1.0], &[0.0; 2]),
+        Err(SimError::InvalidSetting { ref name, .. }) if name == "reference.frequency_hz"
+    ));
+}
+
+#[test]
+fn path_point_out_of_reach() {
+    let shape = PathShape::Polyline(vec![[0.3, 0.5], [1.5, 0.5]]);
+    let err = CartesianPath::new(
+        shape,
+        5.0,
+        1.0,
+        1,
+        BaseAngle::Fixed(FRAC_PI_2),
+        Branch::Positive,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, SimError::Unreachable { ref source, .. } if source.is_unreachable()),
+        "{err:?}"
+    );
+    assert!(err.to_string().contains("is unreachable: "), "{err}");
+}
+
+#[test]
+fn path_degenerate() {
+    let cases = [
+        (PathShape::Polyline(vec![[0.3, 0.5]]), "reference.points"),
+        (
+            PathShape::Polyline(vec![[0.3, 0.5], [0.3, 0.5]]),
+            "reference.points",
+        ),
+        (
+            PathShape::Polyline(vec![[0.3, 0.5], [f64::NAN, 0.5]]),
+            "reference.points",
+        ),
+        (
+            PathShape::Sine {
+                amplitude: 0.1,
+                wavenumber: 5.0,
+                phase: 0.0,
+                offset: 0.2,
+                x_start: 0.2,
+                x_end: 0.2,
+            },
+            "reference.x_end",
+        ),
+    ];
+    for (shape, setting) in cases {
+        let err = CartesianPath::new(
+            shape,
+            5.0,
+            1.0,
+            1,
+            BaseAngle::Fixed(FRAC_PI_2),
+            Branch::Positive,
+        )
+        .unwrap_err();
+        assert!(
+            matches!(err, SimError::InvalidSetting { ref name, .. } if name == setting),
+            "{err:?}"
+        );
+    }
+    let shape = PathShape::Polyline(vec![[0.3, 0.5], [0.4, 0.5]]);
+    for travel_time in [0.0, -1.0, f64::INFINITY] {
+        assert!(matches!(
+            CartesianPath::new(shape.clone(), travel_time, 1.0, 1, BaseAngle::Fixed(FRAC_PI_2), Branch::Positive),
+            Err(SimError::InvalidSetting { ref name, .. }) if name == "reference.travel_time"
+        ));
+    }
+}
+
+#[test]
+fn controller_gains_out_of_domain() {
+    assert!(matches!(
+        PdController::new(&[0.0, f64::NAN], &[0.0; 2], &[0.0; 2]),
+        Err(SimError::InvalidSetting { ref name, .. }) if name == "controller offset"
+    ));
+    assert!(matches!(
+        ComputedTorque::new(&paper_model(), &[-1.0, 1.0], &[1.0, 1.0]),
+        Err(SimError::InvalidSetting { ref name, .. }) if name == "controller.kp"
+    ));
+}
+
+#[test]
+fn fuzzy_controller_of_the_wrong_shape() {
+    let system = fuzzy_sugeno::FuzzySystem::builder("one input")
+        .input(
+            "x",
+            [-1.0, 1.0],
+            [("z", fuzzy_sugeno::MembershipFn::gaussian(0.3, 0.0))],
+        )
+        .output(
+            "y",
+            [-1.0, 1.0],
+            [("zero", fuzzy_sugeno::OutputFn::Constant(0.0))],
+        )
+        .rule(["z"], ["zero"])
+        .build()
+        .unwrap();
+    let err = FuzzyController::new(system, 2).unwrap_err();
+    assert!(matches!(err, SimError::InvalidSetting { ref name, .. } if name == "controller.fis"));
+    assert!(err.to_string().contains("has 1 inputs and 1 outputs"));
+}
+
+/// `y' = -y`.
+struct Decay;
+
+impl OdeSystem for Decay {
+    type Error = std::convert::Infallible;
+    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), Self::Error> {
+        dy[0] = -y[0];
+        Ok(())
+    }
+}
+
+#[test]
+fn ode_state_of_wrong_dimension() {
+    let mut y = [1.0, 2.0];
+    let err = Rk4::new(1)
+        .integrate(&mut Decay, 0.0, 1.0, &mut y, 0.1)
+        .unwrap_err();
+    assert!(matches!(
+        err,
+        OdeError::Dimension {
+            expected: 1,
+            found: 2
+        }
+    ));
+    assert_eq!(y, [1.0, 2.0]);
+}
+
+#[test]
+fn ode_interval_or_step_out_of_domain() {
+    let mut rk4 = Rk4::new(1);
+    let mut y = [1.0];
+    for (t0, t1, step) in [
+        (0.0, f64::NAN, 0.1),
+        (1.0, 0.0, 0.1),
+        (0.0, 1.0, 0.0),
+        (0.0, 1.0, -0.1),
+        (0.0, 1.0, f64::NAN),
+        (0.0, 1.0, 1e-300),
+    ] {
+        let err = rk4.integrate(&mut Decay, t0, t1, &mut y, step).unwrap_err();
+        assert!(
+            matches!(err, OdeError::InvalidSetting(_)),
+            "{t0} {t1} {step}: {err:?}"
+        );
+        assert_eq!(y, [1.0]);
+    }
+}
+
+#[test]
+fn ode_non_finite_state() {
+    let mut y = [f64::NAN];
+    let err = Rk4::new(1)
+        .integrate(&mut Decay, 0.0, 1.0, &mut y, 0.1)
+        .unwrap_err();
+    assert!(matches!(err, OdeError::NonFinite { t: 0.0 }));
+}
+
+#[test]
+fn runaway_run_keeps_its_data() {
+    let s = LoopSettings {
+        max_modal_error: 1e-3,
+        ..settings()
+    };
+    let failure = build(s).unwrap().run().unwrap_err();
+    assert!(
+        matches!(failure.error, SimError::RunawayError { .. }),
+        "{:?}",
+        failure.error
+    );
+    assert!(!failure.record.is_empty());
+    assert!(failure.record.t.iter().all(|t| t.is_finite()));
+    assert!(failure.to_string().contains("data kept up to t ="));
+}
+
+/// The issue's `step.toml`: a 0.05 s step response of the paper's arm, fuzzy at 1e-4 s, with a
+/// joint torque limit of 50 N m and the recording period given.
+fn step_response(record_period: f64) -> sim_core::Scenario {
+    let text = format!(
+        "name = \"step\"\nduration = 0.05\nalpha0 = 1.5707963267948966\nrecord_period = {record_period}\n\
+         [reference]\nkind = \"step\"\ninitial = [0.0, 0.0]\ntarget = [0.2, -0.2]\ntime = 0.01\n\
+         [controller]\nkind = \"fuzzy\"\nperiod = 0.0001\n\
+         [integrator]\nmethod = \"rk4\"\ndt = 0.0001\n\
+         [limits]\njoint_torque_nm = 50.0\n"
+    );
+    sim_core::Scenario::from_toml(&text).unwrap()
+}
+
+#[test]
+fn limits_and_peaks_checked_between_recorded_samples() {
+    // The torque spike after the step lasts less than a recording period of 0.05 s: the peaks,
+    // limit checks and clamped fractions must see it all the same, whatever is recorded.
+    let every = step_response(0.0001)
+        .build()
+        .unwrap()
+        .run()
+        .unwrap()
+        .summary;
+    let sparse = step_response(0.05).build().unwrap().run().unwrap().summary;
+    assert!(
+        every.peak_joint_torque_nm > 50.0,
+        "{}",
+        every.peak_joint_torque_nm
+    );
+    assert_eq!(sparse.recorded_samples, 2);
+    assert_eq!(every.recorded_samples, every.controller_samples);
+    assert_eq!(sparse.peak_joint_torque_nm, every.peak_joint_torque_nm);
+    assert_eq!(sparse.peak_joint_torques_nm, every.peak_joint_torques_nm);
+    assert_eq!(sparse.peak_modal_torques_nm, every.peak_modal_torques_nm);
+    assert_eq!(sparse.torque_limit_exceeded, every.torque_limit_exceeded);
+    assert!(!sparse.torque_limit_exceeded.is_empty());
+    assert_eq!(
+        sparse.tau_star_clamped_fraction,
+        every.tau_star_clamped_fraction
+    );
+    // The tracking errors are those of the recorded time series.
+    assert_ne!(sparse.tip_error_rms_m, every.tip_error_rms_m);
+    assert_ne!(sparse.tip_error_max_m, every.tip_error_max_m);
+}
+
+#[test]
+fn an_infinite_runaway_bound_is_refused_by_simulate_as_by_sweep() {
+    let mut scenario = sim_core::Scenario::builtin("paper-responses-step").unwrap();
+    scenario.limits.max_modal_error = f64::INFINITY;
+    let message = scenario.build().err().expect("refused").to_string();
+    assert!(
+        message.contains("limits.max_modal_error") && message.contains("must be finite, got inf"),
+        "{message}"
+    );
+    // The library loop itself still takes an infinite bound (no runaway check).
+    let mut s = settings();
+    s.max_modal_error = f64::INFINITY;
+    assert!(build(s).is_ok());
+}
+
+#[test]
+fn non_regular_input_files_are_refused_not_waited_on() {
+    let dir = std::env::temp_dir().join(format!("sim-core-fifo-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("controller.fis");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    if made {
+        // A FIFO as a scenario file and as a scenario's `controller.fis`: refused at once.
+        let message = sim_core::Scenario::resolve(fifo.to_str().unwrap())
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(message.contains("not a regular file"), "{message}");
+        let text = format!(
+            "{}\n",
+            sim_core::Scenario::builtin_text("paper-responses-step")
+                .unwrap()
+                .replace(
+                    "kind = \"fuzzy\"",
+                    &format!("kind = \"fuzzy\"\nfis = {:?}", fifo.to_str().unwrap())
+                )
+        );
+        let scenario = sim_core::Scenario::from_toml(&text).unwrap();
+        let message = scenario.build().err().expect("refused").to_string();
+        assert!(message.contains("not a regular file"), "{message}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
