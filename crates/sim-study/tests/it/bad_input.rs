@@ -533,7 +533,7 @@ fn runaway_run_keeps_its_data() {
 
 /// The issue's `step.toml`: a 0.05 s step response of the paper's arm, fuzzy at 1e-4 s, with a
 /// joint torque limit of 50 N m and the recording period given.
-fn step_response(record_period: f64) -> sim_core::Scenario {
+fn step_response(record_period: f64) -> sim_study::Scenario {
     let text = format!(
         "name = \"step\"\nduration = 0.05\nalpha0 = 1.5707963267948966\nrecord_period = {record_period}\n\
          [reference]\nkind = \"step\"\ninitial = [0.0, 0.0]\ntarget = [0.2, -0.2]\ntime = 0.01\n\
@@ -541,7 +541,7 @@ fn step_response(record_period: f64) -> sim_core::Scenario {
          [integrator]\nmethod = \"rk4\"\ndt = 0.0001\n\
          [limits]\njoint_torque_nm = 50.0\n"
     );
-    sim_core::Scenario::from_toml(&text).unwrap()
+    sim_study::Scenario::from_toml(&text).unwrap()
 }
 
 #[test]
@@ -578,7 +578,7 @@ fn limits_and_peaks_checked_between_recorded_samples() {
 
 #[test]
 fn an_infinite_runaway_bound_is_refused_by_simulate_as_by_sweep() {
-    let mut scenario = sim_core::Scenario::builtin("paper-responses-step").unwrap();
+    let mut scenario = sim_study::Scenario::builtin("paper-responses-step").unwrap();
     scenario.limits.max_modal_error = f64::INFINITY;
     let message = scenario.build().err().expect("refused").to_string();
     assert!(
@@ -602,21 +602,21 @@ fn non_regular_input_files_are_refused_not_waited_on() {
         .is_ok_and(|s| s.success());
     if made {
         // A FIFO as a scenario file and as a scenario's `controller.fis`: refused at once.
-        let message = sim_core::Scenario::resolve(fifo.to_str().unwrap())
+        let message = sim_study::Scenario::resolve(fifo.to_str().unwrap())
             .err()
             .expect("refused")
             .to_string();
         assert!(message.contains("not a regular file"), "{message}");
         let text = format!(
             "{}\n",
-            sim_core::Scenario::builtin_text("paper-responses-step")
+            sim_study::Scenario::builtin_text("paper-responses-step")
                 .unwrap()
                 .replace(
                     "kind = \"fuzzy\"",
                     &format!("kind = \"fuzzy\"\nfis = {:?}", fifo.to_str().unwrap())
                 )
         );
-        let scenario = sim_core::Scenario::from_toml(&text).unwrap();
+        let scenario = sim_study::Scenario::from_toml(&text).unwrap();
         let message = scenario.build().err().expect("refused").to_string();
         assert!(message.contains("not a regular file"), "{message}");
     }
