@@ -441,9 +441,33 @@ fn modal_map(
             )));
         }
     };
+    let (n, m) = (chain.n_links(), a.len());
+    let entries = n.saturating_mul(m);
+    if entries > MAX_MAP_ANSWER {
+        return Err(EvalError::input(format!(
+            "arm.links times the modal coordinates must be at most {MAX_MAP_ANSWER} (the n x m \
+             modal Jacobian a request may build and answer), got {n} x {m} = {entries}"
+        )));
+    }
+    let work = entries.saturating_mul(m);
+    if work > MAX_MAP_WORK {
+        return Err(EvalError::input(format!(
+            "arm.links times the square of the modal coordinates must be at most \
+             {MAX_MAP_WORK} (the work of M* = J^T M J), got {n} x {m}^2 = {work}"
+        )));
+    }
     let lengths: Vec<f64> = chain.link_lengths().collect();
     ModalMap::new(&lengths, k, base).map_err(EvalError::from)
 }
+
+/// Most entries `n m` of the modal Jacobian a request may build (`joints` answers all of them,
+/// about 100 MB of JSON at the limit): every one-link-per-coordinate arm up to
+/// [`backbone_kin::MAX_LINKS`] with 4 coordinates fits.
+const MAX_MAP_ANSWER: usize = 1 << 22;
+
+/// Most work `n m^2` of a modal request (`M* = J^T M J` of `reduced` and its derivatives), about
+/// a tenth of a second.
+const MAX_MAP_WORK: usize = 1 << 25;
 
 /// Refuses to answer with a non-finite number (JSON has none).
 fn finite(name: &str, values: &[f64]) -> Result<(), EvalError> {
@@ -903,6 +927,37 @@ mod tests {
             "arm is invalid: link 1: mass must be positive and finite, got -1"
         );
         assert_eq!(answers[0]["id"], "x");
+    }
+
+    #[test]
+    fn modal_requests_are_bounded_in_answer_size_and_work() {
+        // 130 bytes that used to answer 767 MB (joints) or work seconds (reduced): refused.
+        let a = vec![0.0; 128];
+        let answer = request(json!({"op": "joints", "arm": {"links": 260_000}, "a": a,
+            "alpha0": 1, "harmonics": 64}));
+        assert_eq!(answer["error"]["kind"], "invalid_input", "{answer}");
+        assert!(
+            answer["error"]["message"]
+                .as_str()
+                .unwrap()
+                .contains("at most 4194304 (the n x m modal Jacobian"),
+            "{answer}"
+        );
+        let a = vec![0.0; 32];
+        let answer = request(json!({"op": "reduced", "arm": {"links": 100_000}, "a": a,
+            "a_dot": a, "tau_star": a, "alpha0": 1, "harmonics": 16}));
+        assert!(
+            answer["error"]["message"]
+                .as_str()
+                .unwrap()
+                .contains("100000 x 32^2 = 102400000"),
+            "{answer}"
+        );
+        let answer = request(
+            json!({"op": "reduced_derivatives", "arm": {"links": 100_000},
+            "a": a, "a_dot": a, "tau_star": a, "alpha0": 1, "harmonics": 16}),
+        );
+        assert_eq!(answer["error"]["kind"], "invalid_input", "{answer}");
     }
 
     #[test]
