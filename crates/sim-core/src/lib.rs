@@ -27,6 +27,6 @@ pub use scenario::{
     NoiseSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec, TorqueLimit,
 };
 pub use simulation::{
-    ControlSample, Integrator, Lockstep, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES,
-    MAX_RK4_STEPS, Observation, Run, RunFailure, Simulation,
+    ControlSample, Integrator, Lockstep, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_LOOP_WORK,
+    MAX_RECORDED_VALUES, MAX_RK4_STEPS, Observation, Run, RunFailure, Simulation,
 };

@@ -622,3 +622,18 @@ fn non_regular_input_files_are_refused_not_waited_on() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn run_of_too_much_work_per_step() {
+    // 512 links with K = 256 (26 s a step): refused before the run, with the estimate.
+    let mut scenario = sim_core::Scenario::builtin("paper-responses-step").unwrap();
+    scenario.arm.links = Some(512);
+    scenario.modal.harmonics = 256;
+    let message = scenario.build().err().expect("refused").to_string();
+    assert!(
+        message.contains("512 links with 512 modal coordinates take an estimated 1.342e8"),
+        "{message}"
+    );
+    // The paper's arm is far inside.
+    assert!(10.0 * 4.0 < sim_core::MAX_LOOP_WORK);
+}
