@@ -603,8 +603,7 @@ fn non_regular_input_files_are_refused_not_waited_on() {
     if made {
         // A FIFO as a scenario file and as a scenario's `controller.fis`: refused at once.
         let message = sim_core::Scenario::resolve(fifo.to_str().unwrap())
-            .err()
-            .expect("refused")
+            .expect_err("refused")
             .to_string();
         assert!(message.contains("not a regular file"), "{message}");
         let text = format!(
@@ -634,6 +633,4 @@ fn run_of_too_much_work_per_step() {
         message.contains("512 links with 512 modal coordinates take an estimated 1.342e8"),
         "{message}"
     );
-    // The paper's arm is far inside.
-    assert!(10.0 * 4.0 < sim_core::MAX_LOOP_WORK);
 }
