@@ -20,19 +20,35 @@ pub fn print(text: &str) -> Result<(), String> {
     }
 }
 
-/// `text` with every control character except those in `keep` written as a Rust escape
-/// (`\n`, `\u{1b}`), so that a message quoting a file cannot move the cursor, recolour the
-/// terminal or break into several lines.
+/// `text` with every control character except those in `keep`, and every bidirectional
+/// formatting character (U+202E reverses the text after it), written as a Rust escape (`\n`,
+/// `\u{1b}`, `\u{202e}`), so that a message quoting a file cannot move the cursor, recolour
+/// the terminal, break into several lines or read backwards.
 pub fn escape_controls(text: &str, keep: &[char]) -> String {
     let mut escaped = String::with_capacity(text.len());
     for c in text.chars() {
-        if c.is_control() && !keep.contains(&c) {
+        if (c.is_control() || is_bidi_control(c)) && !keep.contains(&c) {
             escaped.extend(c.escape_default());
         } else {
             escaped.push(c);
         }
     }
     escaped
+}
+
+/// Whether `c` is a bidirectional formatting character of Unicode (UAX #9): the marks, the
+/// embeddings and overrides, the isolates.
+fn is_bidi_control(c: char) -> bool {
+    matches!(
+        c,
+        '\u{061c}' | '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}'
+    )
+}
+
+/// Escapes the characters of a user's text (a scenario name, a CSV header) that would break a
+/// table row or reorder it: newline and tab too, besides what [`escape_controls`] escapes.
+pub fn escape_field(text: &str) -> String {
+    escape_controls(text, &[])
 }
 
 /// The one line `hrm` writes to standard error for a failure: control characters escaped and
@@ -89,6 +105,15 @@ mod tests {
             escape_controls("a\tb\nc\u{7}", &['\n', '\t']),
             "a\tb\nc\\u{7}"
         );
+    }
+
+    #[test]
+    fn bidirectional_overrides_are_escaped() {
+        assert_eq!(
+            error_line("scenario \u{202e}gnirts\u{2066}x\u{200f}"),
+            "hrm: scenario \\u{202e}gnirts\\u{2066}x\\u{200f}"
+        );
+        assert_eq!(escape_field("name\nwith\tbreaks"), "name\\nwith\\tbreaks");
     }
 
     #[test]

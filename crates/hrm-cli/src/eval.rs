@@ -199,6 +199,77 @@ fn error_answer(id: Value, error: &EvalError) -> Value {
     json!({"id": id, "ok": false, "error": {"kind": error.kind.as_str(), "message": error.message}})
 }
 
+/// A JSON value read with every object's keys distinct: `{"op": "fk", "op": "ik"}` is refused
+/// ("duplicate key"), as TOML refuses it, rather than the last one silently winning.
+struct UniqueKeys(Value);
+
+impl<'de> Deserialize<'de> for UniqueKeys {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer
+            .deserialize_any(UniqueKeysVisitor)
+            .map(UniqueKeys)
+    }
+}
+
+/// Builds a [`UniqueKeys`] value.
+struct UniqueKeysVisitor;
+
+impl<'de> serde::de::Visitor<'de> for UniqueKeysVisitor {
+    type Value = Value;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a JSON value")
+    }
+    fn visit_bool<E>(self, v: bool) -> Result<Value, E> {
+        Ok(Value::Bool(v))
+    }
+    fn visit_i64<E>(self, v: i64) -> Result<Value, E> {
+        Ok(Value::from(v))
+    }
+    fn visit_u64<E>(self, v: u64) -> Result<Value, E> {
+        Ok(Value::from(v))
+    }
+    fn visit_f64<E>(self, v: f64) -> Result<Value, E> {
+        Ok(Value::from(v))
+    }
+    fn visit_str<E>(self, v: &str) -> Result<Value, E> {
+        Ok(Value::String(v.to_string()))
+    }
+    fn visit_string<E>(self, v: String) -> Result<Value, E> {
+        Ok(Value::String(v))
+    }
+    fn visit_unit<E>(self) -> Result<Value, E> {
+        Ok(Value::Null)
+    }
+    fn visit_none<E>(self) -> Result<Value, E> {
+        Ok(Value::Null)
+    }
+    fn visit_some<D: Deserializer<'de>>(self, d: D) -> Result<Value, D::Error> {
+        UniqueKeys::deserialize(d).map(|v| v.0)
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Value, A::Error> {
+        let mut items = Vec::new();
+        while let Some(UniqueKeys(item)) = seq.next_element()? {
+            items.push(item);
+        }
+        Ok(Value::Array(items))
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Value, A::Error> {
+        let mut object = Map::new();
+        while let Some(key) = map.next_key::<String>()? {
+            if object.contains_key(&key) {
+                return Err(serde::de::Error::custom(format!(
+                    "duplicate key {}",
+                    Value::String(key)
+                )));
+            }
+            let UniqueKeys(value) = map.next_value()?;
+            object.insert(key, value);
+        }
+        Ok(Value::Object(object))
+    }
+}
+
 /// Answers one request line.
 fn answer(line: &[u8]) -> Value {
     let text = match std::str::from_utf8(line) {
@@ -210,8 +281,8 @@ fn answer(line: &[u8]) -> Value {
             );
         }
     };
-    let mut request = match serde_json::from_str::<Value>(text) {
-        Ok(Value::Object(map)) => map,
+    let mut request = match serde_json::from_str::<UniqueKeys>(text) {
+        Ok(UniqueKeys(Value::Object(map))) => map,
         Ok(_) => {
             return error_answer(
                 Value::Null,
@@ -371,9 +442,33 @@ fn modal_map(
             )));
         }
     };
+    let (n, m) = (chain.n_links(), a.len());
+    let entries = n.saturating_mul(m);
+    if entries > MAX_MAP_ANSWER {
+        return Err(EvalError::input(format!(
+            "arm.links times the modal coordinates must be at most {MAX_MAP_ANSWER} (the n x m \
+             modal Jacobian a request may build and answer), got {n} x {m} = {entries}"
+        )));
+    }
+    let work = entries.saturating_mul(m);
+    if work > MAX_MAP_WORK {
+        return Err(EvalError::input(format!(
+            "arm.links times the square of the modal coordinates must be at most \
+             {MAX_MAP_WORK} (the work of M* = J^T M J), got {n} x {m}^2 = {work}"
+        )));
+    }
     let lengths: Vec<f64> = chain.link_lengths().collect();
     ModalMap::new(&lengths, k, base).map_err(EvalError::from)
 }
+
+/// Most entries `n m` of the modal Jacobian a request may build (`joints` answers all of them,
+/// about 100 MB of JSON at the limit): every one-link-per-coordinate arm up to
+/// [`backbone_kin::MAX_LINKS`] with 4 coordinates fits.
+const MAX_MAP_ANSWER: usize = 1 << 22;
+
+/// Most work `n m^2` of a modal request (`M* = J^T M J` of `reduced` and its derivatives), about
+/// a tenth of a second.
+const MAX_MAP_WORK: usize = 1 << 25;
 
 /// Refuses to answer with a non-finite number (JSON has none).
 fn finite(name: &str, values: &[f64]) -> Result<(), EvalError> {
@@ -870,6 +965,58 @@ mod tests {
             "arm is invalid: link 1: mass must be positive and finite, got -1"
         );
         assert_eq!(answers[0]["id"], "x");
+    }
+
+    #[test]
+    fn modal_requests_are_bounded_in_answer_size_and_work() {
+        // 130 bytes that used to answer 767 MB (joints) or work seconds (reduced): refused.
+        let a = vec![0.0; 128];
+        let answer = request(json!({"op": "joints", "arm": {"links": 260_000}, "a": a,
+            "alpha0": 1, "harmonics": 64}));
+        assert_eq!(answer["error"]["kind"], "invalid_input", "{answer}");
+        assert!(
+            answer["error"]["message"]
+                .as_str()
+                .unwrap()
+                .contains("at most 4194304 (the n x m modal Jacobian"),
+            "{answer}"
+        );
+        let a = vec![0.0; 32];
+        let answer = request(json!({"op": "reduced", "arm": {"links": 100_000}, "a": a,
+            "a_dot": a, "tau_star": a, "alpha0": 1, "harmonics": 16}));
+        assert!(
+            answer["error"]["message"]
+                .as_str()
+                .unwrap()
+                .contains("100000 x 32^2 = 102400000"),
+            "{answer}"
+        );
+        let answer = request(
+            json!({"op": "reduced_derivatives", "arm": {"links": 100_000},
+            "a": a, "a_dot": a, "tau_star": a, "alpha0": 1, "harmonics": 16}),
+        );
+        assert_eq!(answer["error"]["kind"], "invalid_input", "{answer}");
+    }
+
+    #[test]
+    fn duplicate_keys_are_refused_at_any_depth() {
+        let answers = run(
+            b"{\"op\": \"fk\", \"op\": \"ik\", \"a\": [0, 0], \"alpha0\": 1}\n\
+            {\"op\": \"fk\", \"arm\": {\"links\": 3, \"links\": 4}, \"a\": [0, 0], \"alpha0\": 1}\n\
+            {\"op\": \"fk\", \"arm\": {\"links\": 3}, \"a\": [0, 0], \"alpha0\": 1}\n",
+        );
+        for answer in &answers[..2] {
+            assert_eq!(answer["error"]["kind"], "parse", "{answer}");
+            let message = answer["error"]["message"].as_str().unwrap();
+            assert!(message.contains("duplicate key"), "{message}");
+        }
+        assert!(
+            answers[0]["error"]["message"]
+                .as_str()
+                .unwrap()
+                .contains("\"op\"")
+        );
+        assert!(answers[2].get("error").is_none(), "{}", answers[2]);
     }
 
     fn request(line: Value) -> Value {

@@ -324,7 +324,12 @@ fn table_rows(outcomes: &[Outcome], scenarios: &[Scenario]) -> Vec<report::Row> 
             let limited = scenarios
                 .iter()
                 .any(|s| s.name == o.scenario && s.limits.tau_star.is_some());
-            let mut cells = vec![o.scenario.clone(), o.controller.name().to_owned()];
+            // The scenario's name is the user's text: a newline or U+202E in it must not break
+            // or reverse the table.
+            let mut cells = vec![
+                console::escape_field(&o.scenario),
+                o.controller.name().to_owned(),
+            ];
             match &o.result {
                 Ok(run) => {
                     let m = &run.summary;
@@ -435,7 +440,16 @@ mod tests {
             csv.lines().count(),
             outcome.result.as_ref().unwrap().record.len() + 1
         );
-        assert!(table(&table_rows(&[outcome], &[scenario])).contains("computed-torque"));
+        let mut outcome = outcome;
+        assert!(
+            table(&table_rows(std::slice::from_ref(&outcome), &[scenario]))
+                .contains("computed-torque")
+        );
+        // A scenario name with a newline and a right-to-left override stays on its row, escaped.
+        outcome.scenario = "step\nlimit \u{202e}".into();
+        let text = table(&table_rows(&[outcome], &[]));
+        assert_eq!(text.lines().count(), 2, "{text}");
+        assert!(text.contains("step\\nlimit \\u{202e}"), "{text}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -13,6 +13,7 @@ mod output_dir;
 mod plot;
 mod progress;
 mod report;
+mod signals;
 mod sweep;
 
 use clap::{Parser, Subcommand};
@@ -59,6 +60,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    signals::install();
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Run { out }) => experiment::main_job(&out),

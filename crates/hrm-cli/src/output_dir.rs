@@ -98,6 +98,7 @@ impl OutputDir {
             std::fs::remove_dir_all(&staging).map_err(|e| fail("cannot clear staging for", e))?;
         }
         std::fs::create_dir(&staging).map_err(|e| fail("cannot create staging for", e))?;
+        crate::signals::register(&staging);
         let dir = OutputDir {
             shown: shown.clone(),
             target,
@@ -137,6 +138,9 @@ impl OutputDir {
     /// the nested outputs of other commands are carried over, the new one takes its name and
     /// the old one is deleted. On failure the old folder is put back.
     pub fn commit(mut self) -> Result<(), String> {
+        // From here an interruption leaves the staging folder to the next command's cleanup
+        // rather than removing it between the two renames.
+        crate::signals::unregister(&self.staging);
         let old = sibling(&self.target, "old");
         let had_old = self.target.exists();
         let fail = |what: &str, e: std::io::Error| format!("{what} {}: {e}", self.shown.display());
@@ -188,6 +192,7 @@ impl Drop for OutputDir {
     fn drop(&mut self) {
         if !self.committed {
             let _ = std::fs::remove_dir_all(&self.staging);
+            crate::signals::unregister(&self.staging);
         }
     }
 }
@@ -272,6 +277,7 @@ pub fn write_files(files: &[(PathBuf, String)], command: &str) -> Result<(), Str
             Err(e) => {
                 for temporary in &staged {
                     let _ = std::fs::remove_file(temporary);
+                    crate::signals::unregister(temporary);
                 }
                 return Err(e);
             }
@@ -283,6 +289,7 @@ pub fn write_files(files: &[(PathBuf, String)], command: &str) -> Result<(), Str
             result = put_in_place(temporary, path);
         } else {
             let _ = std::fs::remove_file(temporary);
+            crate::signals::unregister(temporary);
         }
     }
     result
@@ -312,6 +319,7 @@ fn stage_file(
     }
     remove_abandoned(&path, "partial");
     let temporary = sibling(&path, "partial");
+    crate::signals::register(&temporary);
     let written = std::fs::File::create(&temporary)
         .map_err(|e| fail("cannot write", &e))
         .and_then(|file| {
@@ -323,6 +331,7 @@ fn stage_file(
         Ok(()) => Ok(temporary),
         Err(e) => {
             let _ = std::fs::remove_file(&temporary);
+            crate::signals::unregister(&temporary);
             Err(e)
         }
     }
@@ -330,10 +339,12 @@ fn stage_file(
 
 /// Renames the staged `temporary` over `path`; on failure the temporary is removed.
 fn put_in_place(temporary: &Path, path: &Path) -> Result<(), String> {
-    std::fs::rename(temporary, path).map_err(|e| {
+    let renamed = std::fs::rename(temporary, path).map_err(|e| {
         let _ = std::fs::remove_file(temporary);
         format!("cannot write {}: {e}", path.display())
-    })
+    });
+    crate::signals::unregister(temporary);
+    renamed
 }
 
 /// The longest file name most file systems take (`NAME_MAX`, bytes).

@@ -15,6 +15,6 @@ pub const MAX_COORDINATES: usize = 2 * backbone_kin::MAX_HARMONICS + 1;
 pub use error::{ControllerFailure, SimError, check_finite};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use simulation::{
-    ControlSample, Integrator, Lockstep, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES,
-    MAX_RK4_STEPS, Observation, Run, RunFailure, Simulation,
+    ControlSample, Integrator, Lockstep, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_LOOP_WORK,
+    MAX_RECORDED_VALUES, MAX_RK4_STEPS, Observation, Run, RunFailure, Simulation,
 };

@@ -746,6 +746,30 @@ fn whole_ratio(numerator: f64, denominator: f64) -> Option<usize> {
 /// [`MAX_RK4_STEPS`] bounds an RK4 run.
 pub const MAX_CONTROLLER_SAMPLES: f64 = 1e9;
 
+/// The most work `n m^2` one evaluation of the reduced dynamics may take in a closed-loop run
+/// (`n` links, `m` modal coordinates: building `M* = J^T M J` is `n m^2` multiply-adds, and every
+/// integrator stage does it): `2^24`, about a hundredth of a second, so 4096 links take at most
+/// 64 coordinates (`K = 32` with `alpha0` fixed). Beyond it one RK4 step takes seconds to
+/// minutes (512 links with `K = 256`: 26 s a step), and a run is refused before it starts.
+pub const MAX_LOOP_WORK: f64 = 16_777_216.0;
+
+/// Refuses a run whose reduced dynamics would take more than [`MAX_LOOP_WORK`] per evaluation.
+pub(crate) fn check_loop_work(n_links: usize, m: usize) -> Result<(), SimError> {
+    let work = n_links as f64 * (m as f64).powi(2);
+    if work > MAX_LOOP_WORK {
+        return Err(SimError::setting(
+            "modal.harmonics",
+            format!(
+                "{n_links} links with {m} modal coordinates take an estimated {work:.3e} \
+                 multiply-adds per evaluation of the reduced dynamics (n m^2), more than the \
+                 {MAX_LOOP_WORK:e} a closed-loop run may take (seconds to minutes a step): use \
+                 fewer harmonics or fewer links"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The most fixed steps an RK4 run may take (`duration / integrator.dt`): about half an hour of
 /// computing for a 10-link arm, so a step typed `1e-12` for `1e-4` is refused up front rather
 /// than running for days.
@@ -872,6 +896,7 @@ fn validate(s: &LoopSettings, m: usize, n_links: usize) -> Result<(), SimError> 
             ));
         }
     }
+    check_loop_work(n_links, m)?;
     if let Some(limits) = &s.joint_torque_limits {
         if limits.len() != n_links {
             return Err(SimError::setting(

@@ -590,5 +590,35 @@ fn shard_files_are_streamed_and_checked_line_by_line() {
     let edited = runs.replacen("\"duration\":0.02", "\"duration\":0.03", 1);
     let err = check(&edited);
     assert!(err.contains("SHA-256 does not match its content"), "{err}");
+    // Issue 32: a hand-edited metric is checked like any input, by field, before it is averaged.
+    let metric = |key: &str, value: &str| {
+        let line = lines[3];
+        let start = line.find(&format!("\"{key}\":")).unwrap() + key.len() + 3;
+        let end = start + line[start..].find([',', '}', ']']).unwrap();
+        let line = format!("{}{value}{}", &line[..start], &line[end..]);
+        let mut edited: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+        edited[3] = line;
+        check(&(edited.join("\n") + "\n"))
+    };
+    let err = metric("tip_error_rms_m", "-1.586");
+    assert!(
+        err.contains("f.json: line 4: run 2: tip_error_rms_m = -1.586e0"),
+        "{err}"
+    );
+    let err = metric("peak_joint_torque_nm", "1e308");
+    assert!(
+        err.contains("peak_joint_torque_nm = 1e308 is not a metric"),
+        "{err}"
+    );
+    let err = metric("tip_error_max_m", "0");
+    assert!(
+        err.contains("tip_error_max_m = 0e0 is below tip_error_rms_m"),
+        "{err}"
+    );
+    let err = metric("modal_error_rms_rad", "[4");
+    assert!(
+        err.contains("exceeds the scenario's runaway bound"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&root).unwrap();
 }

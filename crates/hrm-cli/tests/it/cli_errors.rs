@@ -396,15 +396,21 @@ fn input_files_are_read_with_a_size_limit() {
         line.contains("line 1 is longer than the 67108864 bytes a shard file's line may have"),
         "{line}"
     );
-    // An endless stream stops at the limit.
+    // A device, like a FIFO, is refused before it is opened (issue 32).
     if Path::new("/dev/zero").exists() {
         let line = refused(&hrm(&["fis", "eval", "/dev/zero", "0"]));
-        assert!(
-            line.contains("more than the 16777216 bytes allowed"),
-            "{line}"
-        );
+        assert!(line.contains("is not a regular file"), "{line}");
         let line = merge("/dev/zero");
-        assert!(line.contains("line 1 is longer than"), "{line}");
+        assert!(line.contains("is not a regular file"), "{line}");
+    }
+    let fifo = dir.join("controller.fis");
+    if Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        let line = refused(&hrm(&["fis", "check", path(&fifo)]));
+        assert!(line.contains("is not a regular file"), "{line}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -534,7 +540,61 @@ fn a_merge_into_the_folder_of_its_shards_is_refused() {
         path(&shards),
         path(&shards),
     ]));
-    assert!(line.contains("holds the shard file"), "{line}");
+    // Refused as a folder of another kind (issue 32), before the merge's own check.
+    assert!(
+        line.contains("holds the output of `hrm sweep --shard`"),
+        "{line}"
+    );
     assert_eq!(snapshot(&shards), before);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Issue 32: SIGINT or SIGTERM mid-run removes the staging folder at once and leaves the earlier
+/// output as it was; the exit status is the signal's.
+#[test]
+fn an_interrupted_command_removes_its_staging_folder() {
+    let dir = scratch("errors-signals");
+    let out = dir.join("out");
+    let scenario = short_scenario(&dir);
+    let first = hrm(&[
+        "simulate",
+        "--scenario",
+        path(&scenario),
+        "--out",
+        path(&out),
+    ]);
+    assert!(first.status.success(), "{first:?}");
+    let before = snapshot(&out);
+    for signal in ["INT", "TERM"] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_hrm"))
+            .args([
+                "simulate",
+                "--scenario",
+                "paper-tracking",
+                "--out",
+                path(&out),
+            ])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        // Wait for the staging folder, then interrupt the run.
+        let staging = dir.join(format!(".out.hrm-staging-{}", child.id()));
+        let start = std::time::Instant::now();
+        while !staging.exists() && start.elapsed() < std::time::Duration::from_secs(30) {
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        assert!(staging.exists(), "no staging folder appeared");
+        let sent = Command::new("kill")
+            .args([format!("-{signal}"), child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(sent.success());
+        let status = child.wait().unwrap();
+        let expected = if signal == "INT" { 130 } else { 143 };
+        assert_eq!(status.code(), Some(expected), "{signal}: {status:?}");
+        assert!(!staging.exists(), "{signal}: the staging folder is left");
+        assert_eq!(snapshot(&out), before, "{signal}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -1,6 +1,7 @@
 //! Process-level fuzzing of every `hrm` subcommand: random and hostile option values, mutated
 //! `.fis`, scenario, CSV and shard files (their counts, indices and seeds too), random bytes on
-//! standard input, stray arguments.
+//! standard input, stray arguments; and output folders in every state (files of other kinds,
+//! FIFOs, read-only outputs, symbolic links) written by commands interrupted by signals.
 //!
 //! Properties of every invocation: it ends within [`DEADLINE`]; its exit status is 0, 1 or 2
 //! (success, a refusal, a usage error); nothing it prints contains `panicked`; a refusal is
@@ -800,4 +801,228 @@ fn fixture_is_sound() {
     );
     assert!(output.status.success(), "{output:?}");
     assert!(Path::new(&fixture().dir).is_dir());
+}
+
+/// What `--out` is before a command writes it.
+#[derive(Debug, Clone, Copy)]
+enum OutState {
+    Missing,
+    RegularFile,
+    Fifo,
+    UserFolder,
+    SymlinkToUserFolder,
+    ShardFolder,
+    ReadOnlyOutput,
+    SymlinkToOutput,
+    DanglingSymlink,
+}
+
+const OUT_STATES: [OutState; 9] = [
+    OutState::Missing,
+    OutState::RegularFile,
+    OutState::Fifo,
+    OutState::UserFolder,
+    OutState::SymlinkToUserFolder,
+    OutState::ShardFolder,
+    OutState::ReadOnlyOutput,
+    OutState::SymlinkToOutput,
+    OutState::DanglingSymlink,
+];
+
+/// Puts `out` (in its own parent folder) in `state`; returns the user's paths whose contents
+/// no command may change.
+fn prepare_out(out: &Path, state: OutState) -> Vec<PathBuf> {
+    use std::os::unix::fs::{PermissionsExt, symlink};
+    let parent = out.parent().unwrap();
+    std::fs::create_dir_all(parent).unwrap();
+    let user = parent.join("user");
+    let user_folder = || {
+        std::fs::create_dir_all(&user).unwrap();
+        std::fs::write(user.join("thesis.tex"), "mine").unwrap();
+        vec![user.join("thesis.tex")]
+    };
+    let marked = |dir: &Path, command: &str| {
+        std::fs::create_dir_all(dir).unwrap();
+        std::fs::write(
+            dir.join(".hrm-output"),
+            format!("written by `hrm {command}`\n"),
+        )
+        .unwrap();
+    };
+    match state {
+        OutState::Missing => Vec::new(),
+        OutState::RegularFile => {
+            std::fs::write(out, "notes").unwrap();
+            vec![out.to_path_buf()]
+        }
+        OutState::Fifo => {
+            let made = Command::new("mkfifo").arg(out).status();
+            assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+            Vec::new()
+        }
+        OutState::UserFolder => {
+            std::fs::create_dir_all(out).unwrap();
+            std::fs::write(out.join("thesis.tex"), "mine").unwrap();
+            vec![out.join("thesis.tex")]
+        }
+        OutState::SymlinkToUserFolder => {
+            let kept = user_folder();
+            symlink(&user, out).unwrap();
+            kept
+        }
+        OutState::ShardFolder => {
+            marked(out, "sweep --shard");
+            let shard = out.join("shard-1-of-2.json");
+            std::fs::write(&shard, &fixture().shards[1]).unwrap();
+            vec![shard]
+        }
+        OutState::ReadOnlyOutput => {
+            marked(out, "simulate");
+            std::fs::create_dir_all(out.join("data")).unwrap();
+            for dir in [out.join("data"), out.to_path_buf()] {
+                std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o555)).unwrap();
+            }
+            Vec::new()
+        }
+        OutState::SymlinkToOutput => {
+            let target = parent.join("real-output");
+            marked(&target, "simulate");
+            symlink(&target, out).unwrap();
+            Vec::new()
+        }
+        OutState::DanglingSymlink => {
+            symlink(parent.join("nowhere"), out).unwrap();
+            Vec::new()
+        }
+    }
+}
+
+/// The contents of `paths` (a FIFO or folder as a marker), to compare before and after.
+fn contents(paths: &[PathBuf]) -> Vec<Option<Vec<u8>>> {
+    paths.iter().map(|p| std::fs::read(p).ok()).collect()
+}
+
+/// Runs `hrm args`, sending `signal` (`INT` or `TERM`) after `delay` if it is still running.
+fn hrm_signalled(args: &[&str], signal: Option<(&str, Duration)>) -> Output {
+    let child = Command::new(env!("CARGO_BIN_EXE_hrm"))
+        .args(args)
+        .env("RUST_BACKTRACE", "0")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("hrm starts");
+    if let Some((name, delay)) = signal {
+        std::thread::sleep(delay);
+        let _ = Command::new("kill")
+            .args([format!("-{name}"), child.id().to_string()])
+            .status();
+    }
+    let pid = child.id();
+    let waiter = std::thread::spawn(move || child.wait_with_output().unwrap());
+    let start = Instant::now();
+    while !waiter.is_finished() {
+        if start.elapsed() > DEADLINE {
+            let _ = Command::new("kill")
+                .args(["-KILL", &pid.to_string()])
+                .status();
+            panic!("hrm {args:?} ran for more than {DEADLINE:?}");
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    waiter.join().unwrap()
+}
+
+/// Output folders in every state a user or an earlier command leaves them (files of other
+/// kinds, FIFOs, read-only outputs, symbolic links), written by `simulate` and `sweep`,
+/// sometimes interrupted by SIGINT or SIGTERM mid-run: the user's files never change, no
+/// staging folder or temporary file is left, and the command succeeds, refuses in one line or
+/// ends with the signal's status.
+#[test]
+fn output_folders_of_every_kind_and_signals_lose_nothing() {
+    // A folder of its own: the other fuzz test removes the fixture's folder when it ends.
+    let root = std::env::temp_dir().join(format!("hrm-cli-out-states-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(&root).unwrap();
+    let scenario_path = root.join("signals.toml");
+    std::fs::write(&scenario_path, &fixture().scenario).unwrap();
+    let scenario = scenario_path.to_str().unwrap().to_string();
+    let counter = AtomicUsize::new(0);
+    let strategy = (
+        0..OUT_STATES.len(),
+        0..2usize,
+        prop::option::of((prop::bool::ANY, 0..150u64)),
+    );
+    let mut runner = TestRunner::new(Config {
+        cases: 48,
+        ..Config::default()
+    });
+    let result = runner.run(&strategy, |(state, command, signal)| {
+        let state = OUT_STATES[state];
+        let parent = root.join(counter.fetch_add(1, Ordering::Relaxed).to_string());
+        let out = parent.join("out");
+        let kept = prepare_out(&out, state);
+        let before = contents(&kept);
+        let out_arg = out.to_str().unwrap();
+        let args: Vec<&str> = match command {
+            0 => vec!["simulate", "--scenario", &scenario, "--out", out_arg],
+            _ => vec![
+                "sweep",
+                "--scenario",
+                &scenario,
+                "--noise",
+                "0,0.01",
+                "--seeds",
+                "2",
+                "--controllers",
+                "pd",
+                "--out",
+                out_arg,
+            ],
+        };
+        let signal =
+            signal.map(|(int, ms)| (if int { "INT" } else { "TERM" }, Duration::from_millis(ms)));
+        let output = hrm_signalled(&args, signal);
+        let code = output.status.code();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        let expected: &[i32] = if signal.is_some() {
+            &[0, 1, 130, 143]
+        } else {
+            &[0, 1]
+        };
+        prop_assert!(
+            code.is_some_and(|c| expected.contains(&c)),
+            "{state:?} {args:?} {signal:?}: exit {:?}: {stderr}",
+            output.status
+        );
+        prop_assert!(!stderr.contains("panicked"), "{stderr}");
+        if code == Some(1) {
+            prop_assert!(
+                stderr.lines().count() == 1 && stderr.starts_with("hrm: "),
+                "{state:?} {args:?}: {stderr:?}"
+            );
+        }
+        prop_assert_eq!(
+            contents(&kept),
+            before,
+            "{:?} {:?}: user files changed",
+            state,
+            args
+        );
+        let leftovers: Vec<String> = std::fs::read_dir(&parent)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.contains(".hrm-staging-") || n.contains(".hrm-partial-"))
+            .collect();
+        prop_assert!(
+            leftovers.is_empty(),
+            "{state:?} {args:?} {signal:?}: left {leftovers:?}"
+        );
+        Ok(())
+    });
+    match result {
+        // The folders of a failing case are kept for a look.
+        Ok(()) => std::fs::remove_dir_all(&root).unwrap(),
+        Err(e) => panic!("{e}"),
+    }
 }

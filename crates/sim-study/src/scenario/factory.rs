@@ -18,7 +18,8 @@ use sim_core::{Integrator, LoopSettings, Simulation};
 impl Scenario {
     /// The reduced model of the arm with the scenario's modal family. Refuses a family with no
     /// harmonic or more coordinates than the arm has links (its reduced mass matrix would be
-    /// singular).
+    /// singular), or one whose dynamics take more than [`MAX_LOOP_WORK`](crate::MAX_LOOP_WORK)
+    /// per evaluation.
     pub fn model(&self) -> Result<ReducedModel, SimError> {
         let chain = self.arm.to_chain()?;
         let k = self.modal.harmonics;
@@ -42,6 +43,7 @@ impl Scenario {
                 ),
             ));
         }
+        crate::simulation::check_loop_work(n, m)?;
         let lengths: Vec<f64> = chain.link_lengths().collect();
         let map = ModalMap::new(&lengths, k, self.alpha0.base_angle())?;
         ReducedModel::new(chain, map).map_err(SimError::Model)

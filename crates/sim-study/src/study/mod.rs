@@ -46,8 +46,9 @@ pub use plan::{
     MAX_RUNS, MAX_SHARDS, RunId, SettingError, Shard, SweepConfig, SweepSettings, run_seed,
 };
 pub use shard_file::{
-    FORMAT, MAX_SHARD_LINE_BYTES, Outcome, RunMetrics, RunResult, ShardFile, ShardHeader,
-    ShardInput, ShardReader, ShardSource, merge, merge_readers, shard_paths, write_json_line,
+    FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, Outcome, RunMetrics, RunResult, ShardFile,
+    ShardHeader, ShardInput, ShardReader, ShardSource, merge, merge_readers, shard_paths,
+    write_json_line,
 };
 
 use crate::IntegratorSpec;

@@ -121,6 +121,50 @@ impl RunMetrics {
     }
 }
 
+/// Largest metric a shard file may hold: ten million runs of it still sum to a finite mean.
+pub const MAX_SHARD_METRIC: f64 = 1e300;
+
+impl RunMetrics {
+    /// Checks metrics read from a shard file as any input is checked: each finite, non-negative
+    /// and at most [`MAX_SHARD_METRIC`]; the largest tip error at least its RMS (both are taken
+    /// over the same samples); each modal RMS within the runaway bound `max_modal_error` that
+    /// every sample of a completed run kept to. The error names the field and the value.
+    pub fn check(&self, max_modal_error: f64) -> Result<(), String> {
+        let named = [
+            ("tip_error_rms_m", self.tip_error_rms_m),
+            ("tip_error_max_m", self.tip_error_max_m),
+            ("peak_joint_torque_nm", self.peak_joint_torque_nm),
+            ("control_effort_n2m2s", self.control_effort_n2m2s),
+        ];
+        let modal = self
+            .modal_error_rms_rad
+            .iter()
+            .map(|&v| ("modal_error_rms_rad", v));
+        for (name, value) in named.into_iter().chain(modal) {
+            if !(0.0..=MAX_SHARD_METRIC).contains(&value) {
+                return Err(format!(
+                    "{name} = {value:e} is not a metric a run gives: it must lie in [0, \
+                     {MAX_SHARD_METRIC:e}]"
+                ));
+            }
+            if name == "modal_error_rms_rad" && value > max_modal_error {
+                return Err(format!(
+                    "{name} = {value:e} exceeds the scenario's runaway bound \
+                     limits.max_modal_error = {max_modal_error:e}, which a completed run keeps to"
+                ));
+            }
+        }
+        if self.tip_error_max_m < self.tip_error_rms_m * (1.0 - 1e-12) {
+            return Err(format!(
+                "tip_error_max_m = {:e} is below tip_error_rms_m = {:e}: a maximum is at least \
+                 the RMS of the same samples",
+                self.tip_error_max_m, self.tip_error_rms_m
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl RunResult {
     /// A run's entry.
     pub fn new(id: &RunId, outcome: Outcome) -> Self {
@@ -419,13 +463,26 @@ impl<R: ShardSource> ShardReader<R> {
             ));
         }
         let m = self.header.config.scenario.n_coords();
-        if let Outcome::Completed(metrics) = &run.outcome
-            && metrics.modal_error_rms_rad.len() != m
+        if let Outcome::Completed(metrics) = &run.outcome {
+            if metrics.modal_error_rms_rad.len() != m {
+                return Err(format!(
+                    "{origin}: run {} has {} modal errors, but its scenario has {m} modal \
+                     coordinates",
+                    run.index,
+                    metrics.modal_error_rms_rad.len()
+                ));
+            }
+            metrics
+                .check(self.header.config.scenario.limits.max_modal_error)
+                .map_err(|e| format!("{origin}: line {number}: run {}: {e}", run.index))?;
+        }
+        if let Outcome::Failed { simulated_s, .. } = &run.outcome
+            && !(simulated_s.is_finite() && *simulated_s >= 0.0)
         {
             return Err(format!(
-                "{origin}: run {} has {} modal errors, but its scenario has {m} modal coordinates",
-                run.index,
-                metrics.modal_error_rms_rad.len()
+                "{origin}: line {number}: run {}: simulated_s = {simulated_s:e} must be finite \
+                 and non-negative",
+                run.index
             ));
         }
         self.runs_read += 1;

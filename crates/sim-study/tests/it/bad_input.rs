@@ -603,8 +603,7 @@ fn non_regular_input_files_are_refused_not_waited_on() {
     if made {
         // A FIFO as a scenario file and as a scenario's `controller.fis`: refused at once.
         let message = sim_study::Scenario::resolve(fifo.to_str().unwrap())
-            .err()
-            .expect("refused")
+            .expect_err("refused")
             .to_string();
         assert!(message.contains("not a regular file"), "{message}");
         let text = format!(
@@ -621,4 +620,17 @@ fn non_regular_input_files_are_refused_not_waited_on() {
         assert!(message.contains("not a regular file"), "{message}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn run_of_too_much_work_per_step() {
+    // 512 links with K = 256 (26 s a step): refused before the run, with the estimate.
+    let mut scenario = sim_study::Scenario::builtin("paper-responses-step").unwrap();
+    scenario.arm.links = Some(512);
+    scenario.modal.harmonics = 256;
+    let message = scenario.build().err().expect("refused").to_string();
+    assert!(
+        message.contains("512 links with 512 modal coordinates take an estimated 1.342e8"),
+        "{message}"
+    );
 }
