@@ -80,9 +80,10 @@ pub struct ImitationOptions {
     /// ANFIS's initial premise step `kappa` (default 0.01); 0 fits the consequents only.
     pub step: f64,
     /// How far the learned system's input ranges reach beyond the data, as a fraction of each
-    /// input's range in the data on either side (default 1: three times the width). The
-    /// controller clamps its inputs to these ranges; beyond the data the outermost rules' linear
-    /// models extrapolate. 0 to [`MAX_MARGIN`].
+    /// input's range in the data on either side (default 1: three times the width). Beyond the
+    /// data the outermost rules' linear models extrapolate; an input beyond these ranges is
+    /// evaluated as given by default (a scenario's `out_of_range = "clamp"` clamps it to them).
+    /// 0 to [`MAX_MARGIN`].
     pub margin: f64,
 }
 
