@@ -254,15 +254,16 @@ fn write_joint(out: &mut String, indent: &str, joint: &Joint, anchor: &[f64; 3],
     out.push_str("/>\n");
 }
 
+/// MuJoCo takes `fullinertia` in the body frame only (not with `quat`): the tensor is rotated
+/// from the `<inertial>` frame into the link frame, `R I R^T`.
 fn write_inertial(out: &mut String, indent: &str, inertial: &Inertial) {
-    let [ixx, ixy, ixz, iyy, iyz, izz] = inertial.inertia;
+    let (com, i) = inertial.in_link_frame();
     let _ = writeln!(
         out,
-        "{indent}<inertial pos=\"{}\" quat=\"{}\" mass=\"{:?}\" fullinertia=\"{}\"/>",
-        numbers(&inertial.origin.xyz),
-        numbers(&matrix_quaternion(&inertial.origin.rotation())),
+        "{indent}<inertial pos=\"{}\" mass=\"{:?}\" fullinertia=\"{}\"/>",
+        numbers(&com),
         inertial.mass,
-        numbers(&[ixx, iyy, izz, ixy, ixz, iyz])
+        numbers(&[i[0][0], i[1][1], i[2][2], i[0][1], i[0][2], i[1][2]])
     );
 }
 
