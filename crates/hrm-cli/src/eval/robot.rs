@@ -30,14 +30,25 @@ fn robot(urdf: &str) -> Result<Robot, EvalError> {
     Ok(robot)
 }
 
+/// `"gravity"`: three finite numbers, or `default` when absent.
+fn gravity(requested: Option<Vec<f64>>, default: [f64; 3]) -> Result<[f64; 3], EvalError> {
+    match requested.as_deref() {
+        None => Ok(default),
+        Some(&[x, y, z]) if [x, y, z].iter().all(|g| g.is_finite()) => Ok([x, y, z]),
+        Some(values) => Err(EvalError::input(format!(
+            "gravity must be three finite numbers [gx, gy, gz], got {values:?}"
+        ))),
+    }
+}
+
 /// The dynamics model of a URDF chain under `gravity` (default [`DEFAULT_GRAVITY`]).
-fn model(urdf: &str, gravity: Option<[f64; 3]>) -> Result<SpatialModel, EvalError> {
+fn model(urdf: &str, requested: Option<Vec<f64>>) -> Result<SpatialModel, EvalError> {
+    let gravity = gravity(requested, DEFAULT_GRAVITY)?;
     let robot = robot(urdf)?;
     if robot.n_joints() == 0 {
         return Err(EvalError::input("urdf: the chain has no movable joint"));
     }
-    robot_desc::to_spatial(&robot, gravity.unwrap_or(DEFAULT_GRAVITY))
-        .map_err(|e| EvalError::input(format!("urdf: {e}")))
+    robot_desc::to_spatial(&robot, gravity).map_err(|e| EvalError::input(format!("urdf: {e}")))
 }
 
 /// Each vector has one entry per movable joint.
@@ -58,7 +69,7 @@ fn joint_vectors(n: usize, vectors: &[(&str, &[f64])]) -> Result<(), EvalError> 
 #[serde(deny_unknown_fields)]
 pub(super) struct DynamicsRequest {
     urdf: String,
-    gravity: Option<[f64; 3]>,
+    gravity: Option<Vec<f64>>,
     theta: Vec<f64>,
     theta_dot: Vec<f64>,
 }
@@ -97,7 +108,7 @@ pub(super) fn dynamics(request: DynamicsRequest) -> EvalResult {
 #[serde(deny_unknown_fields)]
 pub(super) struct RneaDerivativesRequest {
     urdf: String,
-    gravity: Option<[f64; 3]>,
+    gravity: Option<Vec<f64>>,
     theta: Vec<f64>,
     theta_dot: Vec<f64>,
     theta_ddot: Vec<f64>,
@@ -136,7 +147,7 @@ pub(super) fn rnea_derivatives(request: RneaDerivativesRequest) -> EvalResult {
 #[serde(deny_unknown_fields)]
 pub(super) struct AbaDerivativesRequest {
     urdf: String,
-    gravity: Option<[f64; 3]>,
+    gravity: Option<Vec<f64>>,
     theta: Vec<f64>,
     theta_dot: Vec<f64>,
     tau: Vec<f64>,
@@ -209,7 +220,7 @@ pub(super) struct ExportRequest {
     #[serde(default, deserialize_with = "super::optional_arm_object")]
     arm: Option<ArmSpec>,
     format: String,
-    gravity: Option<[f64; 3]>,
+    gravity: Option<Vec<f64>>,
 }
 
 /// `export`: a URDF chain or a planar arm as one URDF or MJCF document.
@@ -232,10 +243,7 @@ pub(super) fn export(request: ExportRequest) -> EvalResult {
             ));
         }
     };
-    let gravity = request.gravity.unwrap_or(default_gravity);
-    if let Some(g) = gravity.iter().find(|g| !g.is_finite()) {
-        return Err(EvalError::input(format!("gravity must be finite, got {g}")));
-    }
+    let gravity = gravity(request.gravity, default_gravity)?;
     let text = match request.format.as_str() {
         "urdf" => robot_desc::write_urdf(&robot),
         "mjcf" => {
