@@ -41,7 +41,7 @@ fn snake() -> SpatialModel {
 
 /// Seven joints of pseudo-random axes and origins (one prismatic), cuboid links.
 fn random7() -> SpatialModel {
-    let r = |k: usize| ((k as f64 * 12.9898).sin() * 43758.5453).fract();
+    let r = |k: usize| ((k as f64 * 12.9898).sin() * 43758.5453).fract().abs();
     let (mut joints, mut links) = (Vec::new(), Vec::new());
     for i in 0..7 {
         let axis = [r(6 * i) - 0.5, r(6 * i + 1) - 0.5, r(6 * i + 2) + 0.1];

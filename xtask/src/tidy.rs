@@ -31,10 +31,11 @@ const REPOSITORY: &str = "https://github.com/hrm-toolkit/hrm";
 const UNSAFE_FILES: [&str; 1] = ["crates/fuzzy-sugeno/src/kernel.rs"];
 
 /// The workspace's library crates (published, usable alone).
-const LIBRARIES: [&str; 9] = [
+const LIBRARIES: [&str; 10] = [
     "lane-math",
     "backbone-kin",
     "manip-dyn",
+    "robot-desc",
     "modal-reduce",
     "fuzzy-sugeno",
     "optimal-ctl",

@@ -22,6 +22,7 @@ use sim_study::ArmSpec;
 use std::io::{BufRead, Write};
 
 mod derivatives;
+mod robot;
 
 /// Longest request line accepted (bytes); longer lines are skipped with a `line_too_long` error.
 pub const MAX_LINE_BYTES: usize = 16 << 20;
@@ -315,10 +316,17 @@ fn answer(line: &[u8]) -> Value {
     }
 }
 
-const OPS: &str = "fk, ik, joints, dynamics, reduced, fuzzy, rnea_derivatives, aba_derivatives, reduced_derivatives";
+const OPS: &str = "fk, ik, joints, dynamics, reduced, fuzzy, rnea_derivatives, aba_derivatives, reduced_derivatives, frames, export";
 
 fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
+    // `"urdf"` in place of `"arm"`: the spatial chain of a robot description.
+    let urdf = request.contains_key("urdf");
     match op {
+        "dynamics" if urdf => robot::dynamics(parse(request)?),
+        "rnea_derivatives" if urdf => robot::rnea_derivatives(parse(request)?),
+        "aba_derivatives" if urdf => robot::aba_derivatives(parse(request)?),
+        "frames" => robot::frames(parse(request)?),
+        "export" => robot::export(parse(request)?),
         "fk" => fk(parse(request)?),
         "ik" => ik(parse(request)?),
         "joints" => joints(parse(request)?),
@@ -353,6 +361,13 @@ fn arm_object<'de, D: Deserializer<'de>>(deserializer: D) -> Result<ArmSpec, D::
             json_type(&other)
         ))),
     }
+}
+
+/// An optional `"arm"` object, read as [`arm_object`] reads one.
+fn optional_arm_object<'de, D: Deserializer<'de>>(
+    deserializer: D,
+) -> Result<Option<ArmSpec>, D::Error> {
+    arm_object(deserializer).map(Some)
 }
 
 /// The JSON type of a value, for messages.

@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 mod args;
+mod arm_cmd;
 mod console;
 mod eval;
 mod experiment;
@@ -55,6 +56,8 @@ enum Command {
     Eval,
     /// Check, evaluate, plot, train and export Takagi-Sugeno systems (MATLAB .fis or FCL files).
     Fis(fis_cmd::FisArgs),
+    /// Robot descriptions: check a URDF chain, export one (or a scenario's planar arm) as URDF or MJCF.
+    Arm(arm_cmd::ArmArgs),
     /// Monte Carlo over noise levels and seeds: mean and spread of the errors per controller (docs/sweep.md).
     Sweep(sweep::SweepCli),
 }
@@ -72,6 +75,7 @@ fn main() -> ExitCode {
         Some(Command::Eval) => eval::run_stdio(),
         Some(Command::Fis(args)) => fis_cmd::run(args),
         Some(Command::Sweep(args)) => sweep::run(args),
+        Some(Command::Arm(args)) => arm_cmd::run(args),
         None => experiment::main_job(std::path::Path::new("hrm-output")),
     };
     match result {

@@ -159,7 +159,7 @@ fn joint_vectors<const N: usize>(
 }
 
 /// A matrix as JSON rows, refused if an entry is not finite.
-fn rows(name: &str, m: MatRef<'_, f64>) -> Result<Value, EvalError> {
+pub(super) fn rows(name: &str, m: MatRef<'_, f64>) -> Result<Value, EvalError> {
     let rows: Vec<Vec<f64>> = (0..m.nrows())
         .map(|i| (0..m.ncols()).map(|j| m[(i, j)]).collect())
         .collect();

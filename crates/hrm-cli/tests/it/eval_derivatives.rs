@@ -7,7 +7,7 @@ use std::io::Write;
 use std::process::{Command, Stdio};
 
 /// Sends `requests` to one `hrm eval` and returns the answers, in order.
-fn eval(requests: &[Value]) -> Vec<Value> {
+pub(crate) fn eval(requests: &[Value]) -> Vec<Value> {
     let mut child = Command::new(env!("CARGO_BIN_EXE_hrm"))
         .arg("eval")
         .stdin(Stdio::piped())

@@ -179,6 +179,26 @@ impl Transform {
             translation,
         }
     }
+
+    /// The roll, pitch and yaw of [`from_rpy`](Self::from_rpy) that give this rotation, pitch in
+    /// `[-pi/2, pi/2]` (at `|pitch| = pi/2` the roll is taken as zero).
+    ///
+    /// ```
+    /// use manip_dyn::spatial::Transform;
+    /// let rpy = [0.3, -1.1, 2.5];
+    /// let back = Transform::from_rpy(rpy, [0.0; 3]).to_rpy();
+    /// assert!(rpy.iter().zip(back).all(|(a, b)| (a - b).abs() < 1e-12));
+    /// ```
+    pub fn to_rpy(&self) -> Vec3 {
+        let r = &self.rotation;
+        let cos_pitch = r[2][1].hypot(r[2][2]);
+        let pitch = (-r[2][0]).atan2(cos_pitch);
+        if cos_pitch > 1e-12 {
+            [r[2][1].atan2(r[2][2]), pitch, r[1][0].atan2(r[0][0])]
+        } else {
+            [0.0, pitch, (-r[0][1]).atan2(r[1][1])]
+        }
+    }
 }
 
 impl<T: Lane> Transform<T> {

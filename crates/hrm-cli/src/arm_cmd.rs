@@ -1,0 +1,237 @@
+//! `hrm arm`: robot descriptions. `check` reads a URDF chain and says what was read, merged and
+//! ignored; `export` writes a URDF chain, or the planar arm of a scenario, as URDF or MJCF into
+//! an output folder written whole (`output_dir`), never over files hrm did not write.
+
+use crate::console;
+use crate::output_dir::OutputDir;
+use clap::{Args, Subcommand, ValueEnum};
+use robot_desc::{Robot, read_urdf, write_mjcf_files, write_urdf};
+use sim_core::{ArmSpec, Scenario};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The arguments of `hrm arm`.
+#[derive(Debug, Args)]
+pub struct ArmArgs {
+    #[command(subcommand)]
+    command: ArmCommand,
+}
+
+#[derive(Debug, Subcommand)]
+enum ArmCommand {
+    /// Read a URDF serial chain and list its joints, the links merged through fixed joints and the elements ignored.
+    Check {
+        /// The `.urdf` file.
+        file: PathBuf,
+    },
+    /// Write a URDF chain, or a scenario's planar arm (shipped name or TOML file), as URDF or MJCF.
+    Export {
+        /// A `.urdf` file, or a scenario (its `[arm]` is exported in the base's x-y plane).
+        file: String,
+        /// What to write.
+        #[arg(long, value_enum)]
+        format: Format,
+        /// The folder to write into (replaced whole; refused if it holds files hrm did not write).
+        #[arg(long)]
+        out: PathBuf,
+        /// MJCF gravity "gx gy gz" (m/s^2); default "0 0 -9.81" for a URDF, "0 -g 0" for a planar arm.
+        #[arg(long, allow_hyphen_values = true)]
+        gravity: Option<String>,
+    },
+}
+
+/// The export formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// URDF (no gravity: set it in the simulator).
+    Urdf,
+    /// MJCF for MuJoCo (gravity in `<option>`).
+    Mjcf,
+}
+
+/// ROS's gravity, the default of a URDF chain.
+pub const DEFAULT_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
+
+/// Runs `hrm arm`.
+pub fn run(args: ArmArgs) -> Result<(), String> {
+    match args.command {
+        ArmCommand::Check { file } => check(&file),
+        ArmCommand::Export {
+            file,
+            format,
+            out,
+            gravity,
+        } => export(&file, format, &out, gravity.as_deref()),
+    }
+}
+
+/// The text of a URDF file, read up to [`robot_desc::MAX_URDF_BYTES`].
+fn read_urdf_file(path: &Path) -> Result<String, String> {
+    sim_core::read_text_file(path, robot_desc::MAX_URDF_BYTES as u64)
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
+fn check(path: &Path) -> Result<(), String> {
+    let text = read_urdf_file(path)?;
+    let reading = read_urdf(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let (robot, report) = (&reading.robot, &reading.report);
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "robot '{}': {} links and {} joints read; a serial chain of {} movable joints on base '{}'",
+        robot.name,
+        report.links,
+        report.joints,
+        robot.n_joints(),
+        robot.base.name
+    );
+    for (i, joint) in robot.joints.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "  {:>3} {} '{}' axis {:?} -> link '{}' (mass {} kg){}",
+            i + 1,
+            joint.kind.urdf_name(),
+            joint.name,
+            joint.axis,
+            joint.child.name,
+            joint.child.inertial.mass,
+            if joint.child.inertial.is_massless() {
+                ", massless"
+            } else {
+                ""
+            }
+        );
+    }
+    if report.merged.is_empty() {
+        out.push_str("merged: none\n");
+    }
+    for merged in &report.merged {
+        let _ = writeln!(
+            out,
+            "merged: link '{}' into '{}' (fixed joint '{}')",
+            merged.link, merged.into, merged.joint
+        );
+    }
+    if report.ignored.is_empty() {
+        out.push_str("ignored: none\n");
+    }
+    for (path, count) in &report.ignored {
+        let _ = writeln!(out, "ignored: <{path}> x{count}");
+    }
+    console::print(&out)
+}
+
+/// The robot of a `.urdf` file (default gravity [`DEFAULT_GRAVITY`]) or of a scenario's arm.
+fn robot_of(source: &str) -> Result<(Robot, [f64; 3]), String> {
+    let path = Path::new(source);
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+    {
+        let text = read_urdf_file(path)?;
+        let robot = read_urdf(&text)
+            .map_err(|e| format!("{source}: {e}"))?
+            .robot;
+        return Ok((robot, DEFAULT_GRAVITY));
+    }
+    let scenario = Scenario::resolve(source).map_err(|e| e.to_string())?;
+    planar_robot(&scenario.arm, "hrm_planar_arm")
+}
+
+/// A scenario's planar arm as a spatial chain in the base's x-y plane, and its gravity along
+/// `-y`.
+pub fn planar_robot(arm: &ArmSpec, name: &str) -> Result<(Robot, [f64; 3]), String> {
+    let chain = arm.to_chain().map_err(|e| e.to_string())?;
+    let gravity = [0.0, -chain.gravity(), 0.0];
+    Ok((robot_desc::from_planar(&chain, name), gravity))
+}
+
+/// `"gx gy gz"` (spaces or commas), finite.
+fn parse_gravity(text: &str) -> Result<[f64; 3], String> {
+    let values: Vec<f64> = text
+        .split(|c: char| c == ',' || c.is_ascii_whitespace())
+        .filter(|t| !t.is_empty())
+        .map(|t| {
+            t.parse::<f64>()
+                .map_err(|_| format!("--gravity: {t:?} is not a number"))
+        })
+        .collect::<Result<_, _>>()?;
+    match values[..] {
+        [x, y, z] if values.iter().all(|v| v.is_finite()) => Ok([x, y, z]),
+        _ => Err(format!(
+            "--gravity must be three finite numbers \"gx gy gz\", got {text:?}"
+        )),
+    }
+}
+
+/// The files of an export: `(name, text)`, the main file first.
+pub fn export_files(
+    robot: &Robot,
+    format: Format,
+    gravity: [f64; 3],
+) -> Result<Vec<(String, String)>, String> {
+    let stem = file_stem(&robot.name);
+    match format {
+        Format::Urdf => Ok(vec![(format!("{stem}.urdf"), write_urdf(robot))]),
+        Format::Mjcf => write_mjcf_files(robot, gravity, &stem).map_err(|e| e.to_string()),
+    }
+}
+
+/// The robot's name if it makes a plain file name, else `robot`.
+fn file_stem(name: &str) -> String {
+    let plain = !name.is_empty()
+        && name.len() <= 64
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+    if plain {
+        name.to_string()
+    } else {
+        "robot".to_string()
+    }
+}
+
+fn export(source: &str, format: Format, out: &Path, gravity: Option<&str>) -> Result<(), String> {
+    let (robot, default_gravity) = robot_of(source)?;
+    let gravity = gravity
+        .map(parse_gravity)
+        .transpose()?
+        .unwrap_or(default_gravity);
+    let files = export_files(&robot, format, gravity)?;
+    let staging = OutputDir::create(out, "arm export")?;
+    for (name, text) in &files {
+        std::fs::write(staging.path().join(name), text)
+            .map_err(|e| format!("cannot write {}: {e}", out.join(name).display()))?;
+    }
+    staging.commit()?;
+    let mut message = String::new();
+    for (name, _) in &files {
+        let _ = writeln!(message, "wrote {}", out.join(name).display());
+    }
+    console::print(&message)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gravity_takes_three_finite_numbers() {
+        assert_eq!(parse_gravity("0 -9.81 0"), Ok([0.0, -9.81, 0.0]));
+        assert_eq!(parse_gravity("1,2,3"), Ok([1.0, 2.0, 3.0]));
+        assert!(
+            parse_gravity("0 0")
+                .unwrap_err()
+                .contains("three finite numbers")
+        );
+        assert!(parse_gravity("0 0 NaN").is_err());
+        assert!(parse_gravity("0 0 x").unwrap_err().contains("\"x\""));
+    }
+
+    #[test]
+    fn file_names_come_from_plain_robot_names_only() {
+        assert_eq!(file_stem("snake_10"), "snake_10");
+        assert_eq!(file_stem("../../etc/passwd"), "robot");
+        assert_eq!(file_stem(""), "robot");
+    }
+}

@@ -1,0 +1,44 @@
+//! A description as `manip-dyn`'s spatial chain.
+
+use crate::error::DescError;
+use crate::model::Robot;
+use manip_dyn::spatial::{SpatialJoint, SpatialLink, SpatialModel, Transform};
+
+/// The chain's dynamics model under gravity `[gx, gy, gz]` (m/s^2, base frame; URDF carries
+/// none, ROS's convention is `[0, 0, -9.81]`): joint origins as `Transform::from_rpy`, each
+/// body's inertia rotated from its `<inertial>` frame into the link frame (`R I R^T`), the
+/// base's mass ignored (it does not move). `manip-dyn` needs a positive mass on every moving
+/// link: a massless link (the middle of a universal joint written as two revolute joints) is
+/// refused, naming it.
+pub fn to_spatial(robot: &Robot, gravity: [f64; 3]) -> Result<SpatialModel, DescError> {
+    let mut joints = Vec::with_capacity(robot.n_joints());
+    let mut links = Vec::with_capacity(robot.n_joints());
+    for joint in &robot.joints {
+        let origin = Transform::from_rpy(joint.origin.rpy, joint.origin.xyz);
+        joints.push(if joint.kind.is_rotation() {
+            SpatialJoint::revolute(joint.axis, origin)
+        } else {
+            SpatialJoint::prismatic(joint.axis, origin)
+        });
+        let (com, inertia) = joint.child.inertial.in_link_frame();
+        links.push(SpatialLink {
+            mass: joint.child.inertial.mass,
+            com,
+            inertia,
+        });
+    }
+    SpatialModel::new(joints, links, gravity).map_err(|e| {
+        let element = match &e {
+            manip_dyn::DynError::InvalidLink { index, .. }
+            | manip_dyn::DynError::InvalidJoint { index, .. } => robot
+                .joints
+                .get(*index)
+                .map(|j| format!("joint '{}' and link '{}'", j.name, j.child.name)),
+            _ => None,
+        };
+        DescError::invalid(
+            element.unwrap_or_else(|| format!("robot '{}'", robot.name)),
+            format!("not a dynamics model: {e}"),
+        )
+    })
+}

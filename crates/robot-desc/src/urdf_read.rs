@@ -1,0 +1,783 @@
+//! Reading URDF serial chains, with every size bounded before it reaches an allocation.
+
+use crate::error::DescError;
+use crate::model::{
+    Body, Geometry, Inertial, Joint, JointDynamics, JointKind, Limits, Robot, Shape,
+};
+use crate::pose::Pose;
+use roxmltree::{Document, Node, ParsingOptions};
+use std::collections::{BTreeMap, HashMap};
+
+/// Longest URDF text read (bytes). A chain of 1000 links with geometry takes about 1 MB.
+pub const MAX_URDF_BYTES: usize = 8 << 20;
+
+/// Deepest element nesting read. URDF needs five levels (`robot > link > visual > geometry >
+/// box`); a document nesting deeper is refused before anything is built from it.
+pub const MAX_XML_DEPTH: usize = 32;
+
+/// Most XML nodes (elements, text, comments) a document may have.
+pub const MAX_XML_NODES: u32 = 1_000_000;
+
+/// Longest attribute value (bytes): a mesh file name is the longest legitimate one.
+pub const MAX_ATTRIBUTE_BYTES: usize = 4096;
+
+/// Largest magnitude of any number read (lengths in m, masses in kg, inertias in kg m^2,
+/// limits): far beyond any robot, small enough that products of a few never overflow.
+pub const MAX_MAGNITUDE: f64 = 1e9;
+
+/// A link merged into another by a fixed joint.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Merged {
+    /// The fixed joint.
+    pub joint: String,
+    /// The link merged away.
+    pub link: String,
+    /// The body it joined.
+    pub into: String,
+}
+
+/// What [`read_urdf`] read, merged and ignored (for `hrm arm check`).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ReadReport {
+    /// `<link>` elements read.
+    pub links: usize,
+    /// `<joint>` elements read (fixed ones included).
+    pub joints: usize,
+    /// Links merged into their parent through fixed joints, in chain order.
+    pub merged: Vec<Merged>,
+    /// Elements skipped because they do not change the chain's kinematics or dynamics
+    /// (`transmission`, `gazebo`, `material`, a joint's `mimic` or `safety_controller`...), by
+    /// path, with how many times each occurred.
+    pub ignored: BTreeMap<String, usize>,
+}
+
+/// A description read from URDF and the report of how.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reading {
+    /// The chain.
+    pub robot: Robot,
+    /// What was read, merged and ignored.
+    pub report: ReadReport,
+}
+
+/// Reads a URDF serial chain.
+///
+/// Bounds first: at most [`MAX_URDF_BYTES`], no DTD (so no entity is ever expanded), at most
+/// [`MAX_XML_NODES`] nodes nested at most [`MAX_XML_DEPTH`] deep, attribute values of at most
+/// [`MAX_ATTRIBUTE_BYTES`]. Then the chain: `revolute`, `continuous` and `prismatic` joints are
+/// its degrees of freedom; links behind `fixed` joints are merged into their parent body (mass
+/// properties by the parallel-axis theorem, geometry moved into the parent's frame, the next
+/// joint's origin composed). Axes are normalised. Trees, closed loops, `floating` and `planar`
+/// joints, links without a path to the root and duplicated names are refused, naming the element.
+pub fn read_urdf(text: &str) -> Result<Reading, DescError> {
+    if text.len() > MAX_URDF_BYTES {
+        return Err(DescError::TooLarge {
+            got: text.len(),
+            max: MAX_URDF_BYTES,
+        });
+    }
+    let options = ParsingOptions {
+        allow_dtd: false,
+        nodes_limit: MAX_XML_NODES,
+        ..ParsingOptions::default()
+    };
+    let doc =
+        Document::parse_with_options(text, options).map_err(|e| DescError::Xml(e.to_string()))?;
+    check_shape(&doc)?;
+    let root = doc.root_element();
+    if root.tag_name().name() != "robot" {
+        return Err(DescError::invalid(
+            format!("<{}>", root.tag_name().name()),
+            "the document's element must be <robot>",
+        ));
+    }
+    let name = required(root, "name", || "<robot>".to_string())?.to_string();
+    let mut report = ReadReport::default();
+    let mut links: Vec<UrdfLink> = Vec::new();
+    let mut joints: Vec<UrdfJoint> = Vec::new();
+    for child in root.children().filter(Node::is_element) {
+        match child.tag_name().name() {
+            "link" => links.push(read_link(child, &mut report)?),
+            "joint" => joints.push(read_joint(child, &mut report)?),
+            other => ignore(&mut report, other),
+        }
+    }
+    report.links = links.len();
+    report.joints = joints.len();
+    let robot = assemble(name, links, joints, &mut report)?;
+    Ok(Reading { robot, report })
+}
+
+/// Depth and attribute lengths, checked on the parsed document in one pass in document order
+/// (a node's depth is its parent's plus one; no recursion, no walk up the ancestors).
+fn check_shape(doc: &Document<'_>) -> Result<(), DescError> {
+    let mut depths: Vec<u32> = Vec::new();
+    for node in doc.descendants() {
+        let depth = node.parent().map_or(0, |p| depths[p.id().get_usize()] + 1);
+        let index = node.id().get_usize();
+        if depths.len() <= index {
+            depths.resize(index + 1, 0);
+        }
+        depths[index] = depth;
+        if !node.is_element() {
+            continue;
+        }
+        if depth as usize > MAX_XML_DEPTH {
+            return Err(DescError::TooDeep {
+                max: MAX_XML_DEPTH,
+                line: line_of(node),
+            });
+        }
+        for attribute in node.attributes() {
+            if attribute.value().len() > MAX_ATTRIBUTE_BYTES {
+                return Err(DescError::AttributeTooLong {
+                    element: node.tag_name().name().to_string(),
+                    attribute: attribute.name().to_string(),
+                    line: line_of(node),
+                    got: attribute.value().len(),
+                    max: MAX_ATTRIBUTE_BYTES,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+fn line_of(node: Node<'_, '_>) -> u32 {
+    node.document().text_pos_at(node.range().start).row
+}
+
+fn ignore(report: &mut ReadReport, path: &str) {
+    *report.ignored.entry(path.to_string()).or_insert(0) += 1;
+}
+
+/// A `<link>` as written.
+struct UrdfLink {
+    name: String,
+    body: Body,
+}
+
+/// A `<joint>` as written.
+struct UrdfJoint {
+    name: String,
+    /// `None` for `fixed`.
+    kind: Option<JointKind>,
+    parent: String,
+    child: String,
+    origin: Pose,
+    axis: [f64; 3],
+    limits: Option<Limits>,
+    dynamics: Option<JointDynamics>,
+}
+
+fn required<'a>(
+    node: Node<'a, '_>,
+    attribute: &str,
+    element: impl FnOnce() -> String,
+) -> Result<&'a str, DescError> {
+    node.attribute(attribute)
+        .ok_or_else(|| DescError::invalid(element(), format!("missing attribute {attribute:?}")))
+}
+
+/// One number, finite and at most [`MAX_MAGNITUDE`] in magnitude.
+fn number(text: &str, what: &str, element: &dyn Fn() -> String) -> Result<f64, DescError> {
+    let value: f64 = text.trim().parse().map_err(|_| {
+        DescError::invalid(element(), format!("{what} must be a number, got {text:?}"))
+    })?;
+    if !value.is_finite() || value.abs() > MAX_MAGNITUDE {
+        return Err(DescError::invalid(
+            element(),
+            format!(
+                "{what} must be finite and at most {MAX_MAGNITUDE:e} in magnitude, got {value}"
+            ),
+        ));
+    }
+    Ok(value)
+}
+
+/// Exactly three numbers separated by white space.
+fn triple(text: &str, what: &str, element: &dyn Fn() -> String) -> Result<[f64; 3], DescError> {
+    let mut values = [0.0; 3];
+    let mut tokens = text.split_ascii_whitespace();
+    for value in &mut values {
+        let token = tokens.next().ok_or_else(|| {
+            DescError::invalid(
+                element(),
+                format!("{what} must have 3 numbers, got {text:?}"),
+            )
+        })?;
+        *value = number(token, what, element)?;
+    }
+    if tokens.next().is_some() {
+        return Err(DescError::invalid(
+            element(),
+            format!("{what} must have 3 numbers, got more"),
+        ));
+    }
+    Ok(values)
+}
+
+/// An optional numeric attribute.
+fn optional_number(
+    node: Node<'_, '_>,
+    attribute: &str,
+    element: &dyn Fn() -> String,
+) -> Result<Option<f64>, DescError> {
+    node.attribute(attribute)
+        .map(|text| number(text, attribute, element))
+        .transpose()
+}
+
+/// A required numeric attribute.
+fn required_number(
+    node: Node<'_, '_>,
+    attribute: &str,
+    element: &dyn Fn() -> String,
+) -> Result<f64, DescError> {
+    number(required(node, attribute, element)?, attribute, element)
+}
+
+/// The `<origin>` child, identity when absent.
+fn origin(node: Node<'_, '_>, element: &dyn Fn() -> String) -> Result<Pose, DescError> {
+    let mut origins = node.children().filter(|c| c.has_tag_name("origin"));
+    let Some(origin) = origins.next() else {
+        return Ok(Pose::IDENTITY);
+    };
+    if origins.next().is_some() {
+        return Err(DescError::invalid(element(), "more than one <origin>"));
+    }
+    let element = || format!("<origin> of {}", element());
+    Ok(Pose {
+        xyz: origin
+            .attribute("xyz")
+            .map(|t| triple(t, "xyz", &element))
+            .transpose()?
+            .unwrap_or_default(),
+        rpy: origin
+            .attribute("rpy")
+            .map(|t| triple(t, "rpy", &element))
+            .transpose()?
+            .unwrap_or_default(),
+    })
+}
+
+/// A single child element, or `None`; two are refused.
+fn single<'a, 'i>(
+    node: Node<'a, 'i>,
+    tag: &str,
+    element: &dyn Fn() -> String,
+) -> Result<Option<Node<'a, 'i>>, DescError> {
+    let mut found = node.children().filter(|c| c.has_tag_name(tag));
+    let first = found.next();
+    if first.is_some() && found.next().is_some() {
+        return Err(DescError::invalid(
+            element(),
+            format!("more than one <{tag}>"),
+        ));
+    }
+    Ok(first)
+}
+
+fn read_link(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfLink, DescError> {
+    let name = required(node, "name", || format!("<link> at line {}", line_of(node)))?.to_string();
+    let element = || format!("link '{name}'");
+    let mut body = Body {
+        name: name.clone(),
+        ..Body::default()
+    };
+    if let Some(inertial) = single(node, "inertial", &element)? {
+        body.inertial = read_inertial(inertial, &name)?;
+    }
+    for child in node.children().filter(Node::is_element) {
+        match child.tag_name().name() {
+            "inertial" => {}
+            "visual" => body
+                .visuals
+                .push(read_geometry(child, &name, "visual", report)?),
+            "collision" => body
+                .collisions
+                .push(read_geometry(child, &name, "collision", report)?),
+            other => ignore(report, &format!("link/{other}")),
+        }
+    }
+    Ok(UrdfLink { name, body })
+}
+
+fn read_inertial(node: Node<'_, '_>, link: &str) -> Result<Inertial, DescError> {
+    let element = || format!("<inertial> of link '{link}'");
+    let origin = origin(node, &element)?;
+    let mass = match single(node, "mass", &element)? {
+        Some(mass) => required_number(mass, "value", &|| format!("<mass> of link '{link}'"))?,
+        None => 0.0,
+    };
+    if mass < 0.0 {
+        return Err(DescError::invalid(
+            element(),
+            format!("mass must be non-negative, got {mass}"),
+        ));
+    }
+    let mut inertia = [0.0; 6];
+    if let Some(tensor) = single(node, "inertia", &element)? {
+        let element = || format!("<inertia> of link '{link}'");
+        for (value, attribute) in inertia
+            .iter_mut()
+            .zip(["ixx", "ixy", "ixz", "iyy", "iyz", "izz"])
+        {
+            *value = optional_number(tensor, attribute, &element)?.unwrap_or(0.0);
+        }
+    }
+    let inertial = Inertial {
+        origin,
+        mass,
+        inertia,
+    };
+    check_inertia(&inertial).map_err(|problem| DescError::invalid(element(), problem))?;
+    Ok(inertial)
+}
+
+/// Relative tolerance of the inertia checks, against the tensor's trace: rounding of the
+/// eigenvalues is about `1e-16` of it, CAD exports printed to 9 digits about `1e-9`.
+const INERTIA_TOLERANCE: f64 = 1e-9;
+
+/// A physical inertia tensor: principal moments non-negative and satisfying the triangle
+/// inequalities `I_a <= I_b + I_c` (each moment is an integral of squared distances from two of
+/// the axes, whose sum exceeds the distance from the third).
+pub(crate) fn check_inertia(inertial: &Inertial) -> Result<(), String> {
+    let moments = principal_moments(&inertial.inertia);
+    let trace: f64 = moments.iter().sum();
+    let tolerance = INERTIA_TOLERANCE * trace.abs();
+    if moments[0] < -tolerance {
+        return Err(format!(
+            "inertia must be positive semi-definite, its principal moments are {moments:?}"
+        ));
+    }
+    if moments[2] > moments[0] + moments[1] + tolerance {
+        return Err(format!(
+            "inertia breaks the triangle inequality: principal moments {moments:?}, the largest \
+             exceeds the sum of the other two"
+        ));
+    }
+    Ok(())
+}
+
+/// Eigenvalues of the symmetric tensor `[ixx, ixy, ixz, iyy, iyz, izz]`, ascending (the
+/// trigonometric closed form of the characteristic cubic).
+pub(crate) fn principal_moments(&[xx, xy, xz, yy, yz, zz]: &[f64; 6]) -> [f64; 3] {
+    let off = xy * xy + xz * xz + yz * yz;
+    let mean = (xx + yy + zz) / 3.0;
+    if off == 0.0 {
+        let mut d = [xx, yy, zz];
+        d.sort_by(f64::total_cmp);
+        return d;
+    }
+    let (a, b, c) = (xx - mean, yy - mean, zz - mean);
+    let p = ((a * a + b * b + c * c + 2.0 * off) / 6.0).sqrt();
+    // det((I - mean E) / p) / 2, clamped to [-1, 1] against rounding.
+    let det = a * (b * c - yz * yz) - xy * (xy * c - yz * xz) + xz * (xy * yz - b * xz);
+    let r = (det / (2.0 * p * p * p)).clamp(-1.0, 1.0);
+    let phi = r.acos() / 3.0;
+    let largest = mean + 2.0 * p * phi.cos();
+    let smallest = mean + 2.0 * p * (phi + 2.0 * std::f64::consts::FRAC_PI_3).cos();
+    [smallest, 3.0 * mean - largest - smallest, largest]
+}
+
+fn read_geometry(
+    node: Node<'_, '_>,
+    link: &str,
+    kind: &str,
+    report: &mut ReadReport,
+) -> Result<Geometry, DescError> {
+    let element = || format!("<{kind}> of link '{link}'");
+    let origin = origin(node, &element)?;
+    let geometry = single(node, "geometry", &element)?
+        .ok_or_else(|| DescError::invalid(element(), "missing <geometry>"))?;
+    let mut shapes = geometry.children().filter(Node::is_element);
+    let shape_node = shapes
+        .next()
+        .ok_or_else(|| DescError::invalid(element(), "<geometry> has no shape"))?;
+    if shapes.next().is_some() {
+        return Err(DescError::invalid(
+            element(),
+            "<geometry> has more than one shape",
+        ));
+    }
+    let shape_element = || format!("<{}> of {}", shape_node.tag_name().name(), element());
+    let positive = |value: f64, what: &str| {
+        if value > 0.0 {
+            Ok(value)
+        } else {
+            Err(DescError::invalid(
+                shape_element(),
+                format!("{what} must be positive, got {value}"),
+            ))
+        }
+    };
+    let shape = match shape_node.tag_name().name() {
+        "box" => {
+            let size = triple(
+                required(shape_node, "size", shape_element)?,
+                "size",
+                &shape_element,
+            )?;
+            for side in size {
+                positive(side, "size")?;
+            }
+            Shape::Box(size)
+        }
+        "cylinder" => Shape::Cylinder {
+            radius: positive(
+                required_number(shape_node, "radius", &shape_element)?,
+                "radius",
+            )?,
+            length: positive(
+                required_number(shape_node, "length", &shape_element)?,
+                "length",
+            )?,
+        },
+        "sphere" => Shape::Sphere(positive(
+            required_number(shape_node, "radius", &shape_element)?,
+            "radius",
+        )?),
+        "mesh" => Shape::Mesh {
+            filename: required(shape_node, "filename", shape_element)?.to_string(),
+            scale: shape_node
+                .attribute("scale")
+                .map(|t| triple(t, "scale", &shape_element))
+                .transpose()?,
+        },
+        other => {
+            return Err(DescError::invalid(
+                element(),
+                format!("unknown shape <{other}> (box, cylinder, sphere and mesh are read)"),
+            ));
+        }
+    };
+    for child in node.children().filter(Node::is_element) {
+        let tag = child.tag_name().name();
+        if !matches!(tag, "origin" | "geometry") {
+            ignore(report, &format!("link/{kind}/{tag}"));
+        }
+    }
+    Ok(Geometry {
+        name: node.attribute("name").map(str::to_string),
+        origin,
+        shape,
+    })
+}
+
+fn read_joint(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfJoint, DescError> {
+    let name = required(node, "name", || {
+        format!("<joint> at line {}", line_of(node))
+    })?
+    .to_string();
+    let element = || format!("joint '{name}'");
+    let kind = match required(node, "type", element)? {
+        "revolute" => Some(JointKind::Revolute),
+        "continuous" => Some(JointKind::Continuous),
+        "prismatic" => Some(JointKind::Prismatic),
+        "fixed" => None,
+        kind @ ("floating" | "planar") => {
+            return Err(DescError::not_a_chain(
+                element(),
+                format!("{kind} joints are not read (a fixed base, one degree of freedom a joint)"),
+            ));
+        }
+        other => {
+            return Err(DescError::invalid(
+                element(),
+                format!("unknown joint type {other:?}"),
+            ));
+        }
+    };
+    let link_of = |tag: &str| -> Result<String, DescError> {
+        let child = single(node, tag, &element)?
+            .ok_or_else(|| DescError::invalid(element(), format!("missing <{tag}>")))?;
+        Ok(required(child, "link", || format!("<{tag}> of joint '{name}'"))?.to_string())
+    };
+    let (parent, child) = (link_of("parent")?, link_of("child")?);
+    let origin = origin(node, &element)?;
+    let axis = match single(node, "axis", &element)? {
+        Some(axis) => {
+            let element = || format!("<axis> of joint '{name}'");
+            normalised(triple(required(axis, "xyz", element)?, "xyz", &element)?)
+                .ok_or_else(|| DescError::invalid(element(), "the axis must not be zero"))?
+        }
+        None => [1.0, 0.0, 0.0],
+    };
+    let limits = single(node, "limit", &element)?
+        .map(|limit| {
+            let element = || format!("<limit> of joint '{name}'");
+            let limits = Limits {
+                lower: optional_number(limit, "lower", &element)?,
+                upper: optional_number(limit, "upper", &element)?,
+                effort: optional_number(limit, "effort", &element)?,
+                velocity: optional_number(limit, "velocity", &element)?,
+            };
+            check_limits(&limits).map_err(|problem| DescError::invalid(element(), problem))?;
+            Ok::<_, DescError>(limits)
+        })
+        .transpose()?;
+    let dynamics = single(node, "dynamics", &element)?
+        .map(|dynamics| {
+            let element = || format!("<dynamics> of joint '{name}'");
+            let values = JointDynamics {
+                damping: optional_number(dynamics, "damping", &element)?,
+                friction: optional_number(dynamics, "friction", &element)?,
+            };
+            for (what, value) in [("damping", values.damping), ("friction", values.friction)] {
+                if let Some(value) = value.filter(|v| *v < 0.0) {
+                    return Err(DescError::invalid(
+                        element(),
+                        format!("{what} must be non-negative, got {value}"),
+                    ));
+                }
+            }
+            Ok(values)
+        })
+        .transpose()?;
+    for child in node.children().filter(Node::is_element) {
+        let tag = child.tag_name().name();
+        if !matches!(
+            tag,
+            "parent" | "child" | "origin" | "axis" | "limit" | "dynamics"
+        ) {
+            ignore(report, &format!("joint/{tag}"));
+        }
+    }
+    Ok(UrdfJoint {
+        name,
+        kind,
+        parent,
+        child,
+        origin,
+        axis,
+        limits,
+        dynamics,
+    })
+}
+
+fn check_limits(limits: &Limits) -> Result<(), String> {
+    if let (Some(lower), Some(upper)) = (limits.lower, limits.upper)
+        && lower > upper
+    {
+        return Err(format!("lower ({lower}) must not exceed upper ({upper})"));
+    }
+    for (what, value) in [("effort", limits.effort), ("velocity", limits.velocity)] {
+        if let Some(value) = value.filter(|v| *v < 0.0) {
+            return Err(format!("{what} must be non-negative, got {value}"));
+        }
+    }
+    Ok(())
+}
+
+/// `v / |v|`, or `None` for a zero vector. A vector already of unit length within four units
+/// in the last place is kept as it is, so that normalising is idempotent and a written model
+/// reads back bit for bit.
+pub(crate) fn normalised(v: [f64; 3]) -> Option<[f64; 3]> {
+    // Scale first so that tiny and huge axes neither underflow nor overflow the norm.
+    let scale = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if scale == 0.0 {
+        return None;
+    }
+    let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if (norm - 1.0).abs() <= 4.0 * f64::EPSILON {
+        return Some(v);
+    }
+    let s = v.map(|x| x / scale);
+    let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+    Some(s.map(|x| x / n))
+}
+
+/// Builds the chain from the links and joints as written.
+fn assemble(
+    name: String,
+    links: Vec<UrdfLink>,
+    joints: Vec<UrdfJoint>,
+    report: &mut ReadReport,
+) -> Result<Robot, DescError> {
+    if links.is_empty() {
+        return Err(DescError::invalid(
+            format!("robot '{name}'"),
+            "has no <link>",
+        ));
+    }
+    let mut link_index: HashMap<&str, usize> = HashMap::with_capacity(links.len());
+    for (i, link) in links.iter().enumerate() {
+        if link_index.insert(&link.name, i).is_some() {
+            return Err(DescError::invalid(
+                format!("link '{}'", link.name),
+                "the name is used twice",
+            ));
+        }
+    }
+    let mut joint_names: HashMap<&str, ()> = HashMap::with_capacity(joints.len());
+    // The joint of which each link is the child, and the joints leaving each link.
+    let mut parent_joint: Vec<Option<usize>> = vec![None; links.len()];
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); links.len()];
+    let mut child_of = Vec::with_capacity(joints.len());
+    for (j, joint) in joints.iter().enumerate() {
+        let element = || format!("joint '{}'", joint.name);
+        if joint_names.insert(&joint.name, ()).is_some() {
+            return Err(DescError::invalid(element(), "the name is used twice"));
+        }
+        let find = |link: &str, role: &str| {
+            link_index.get(link).copied().ok_or_else(|| {
+                DescError::invalid(
+                    element(),
+                    format!("its {role} link '{link}' does not exist"),
+                )
+            })
+        };
+        let (parent, child) = (find(&joint.parent, "parent")?, find(&joint.child, "child")?);
+        if parent == child {
+            return Err(DescError::not_a_chain(
+                element(),
+                "joins link to itself (a closed loop)",
+            ));
+        }
+        if let Some(other) = parent_joint[child] {
+            return Err(DescError::not_a_chain(
+                format!("link '{}'", joint.child),
+                format!(
+                    "is the child of two joints, '{}' and '{}' (a closed loop)",
+                    joints[other].name, joint.name
+                ),
+            ));
+        }
+        parent_joint[child] = Some(j);
+        children[parent].push(j);
+        child_of.push(child);
+    }
+    let mut roots = (0..links.len()).filter(|&i| parent_joint[i].is_none());
+    let root = roots.next().ok_or_else(|| {
+        DescError::not_a_chain(
+            format!("robot '{name}'"),
+            "every link is the child of a joint, there is no root (a closed loop)",
+        )
+    })?;
+    if let Some(other) = roots.next() {
+        return Err(DescError::not_a_chain(
+            format!("link '{}'", links[other].name),
+            format!(
+                "has no path to the root link '{}' (both are children of no joint)",
+                links[root].name
+            ),
+        ));
+    }
+    let mut visited = vec![false; links.len()];
+    let mut chain = Chain {
+        links: links.into_iter().map(Some).collect(),
+        joints: joints.into_iter().map(Some).collect(),
+        children,
+        child_of,
+    };
+    let (base, mut next) = weld(root, &mut chain, &mut visited, report)?;
+    let mut movable = Vec::new();
+    while let Some((j, placement)) = next {
+        let joint = chain.joints[j].take().expect("a joint has one parent link");
+        let (body, after) = weld(chain.child_of[j], &mut chain, &mut visited, report)?;
+        movable.push(Joint {
+            name: joint.name,
+            kind: joint.kind.expect("weld hands on movable joints only"),
+            origin: placement.compose(&joint.origin),
+            axis: joint.axis,
+            limits: joint.limits,
+            dynamics: joint.dynamics,
+            child: body,
+        });
+        next = after;
+    }
+    if let Some(lost) = visited.iter().position(|v| !v) {
+        let lost_name = &chain.links[lost]
+            .as_ref()
+            .expect("unvisited links are there")
+            .name;
+        return Err(DescError::not_a_chain(
+            format!("link '{lost_name}'"),
+            format!(
+                "has no path to the root link '{}' (a closed loop)",
+                base.name
+            ),
+        ));
+    }
+    Ok(Robot {
+        name,
+        base,
+        joints: movable,
+    })
+}
+
+/// The body of link `first` and every link welded to it by fixed joints, and the one movable
+/// joint leaving it (with the placement of its parent link in the body frame), if any.
+fn weld(
+    first: usize,
+    chain: &mut Chain,
+    visited: &mut [bool],
+    report: &mut ReadReport,
+) -> Result<(Body, Option<(usize, Pose)>), DescError> {
+    visited[first] = true;
+    let mut body = chain.links[first]
+        .take()
+        .expect("each link is visited once")
+        .body;
+    let mut movable: Option<(usize, Pose)> = None;
+    // Links of the body still to expand, with their placement in the body frame.
+    let mut stack = vec![(first, Pose::IDENTITY, body.name.clone())];
+    while let Some((link, placement, link_name)) = stack.pop() {
+        for &j in &chain.children[link] {
+            let joint = chain.joints[j]
+                .as_ref()
+                .expect("joints below an unvisited link are there");
+            if joint.kind.is_some() {
+                if let Some((other, _)) = movable {
+                    let other = chain.joints[other].as_ref().expect("still there");
+                    return Err(DescError::not_a_chain(
+                        format!("link '{link_name}'"),
+                        format!(
+                            "has two movable joints below it, '{}' and '{}' (a tree)",
+                            other.name, joint.name
+                        ),
+                    ));
+                }
+                movable = Some((j, placement));
+                continue;
+            }
+            let joint = chain.joints[j].take().expect("checked above");
+            let child = chain.child_of[j];
+            visited[child] = true;
+            let welded = chain.links[child]
+                .take()
+                .expect("a link has one parent joint");
+            let at = placement.compose(&joint.origin);
+            if !welded.body.inertial.is_massless() {
+                body.inertial = body.inertial.merged(&welded.body.inertial, &at);
+            }
+            for (from, to) in [
+                (welded.body.visuals, &mut body.visuals),
+                (welded.body.collisions, &mut body.collisions),
+            ] {
+                to.extend(from.into_iter().map(|g| Geometry {
+                    origin: at.compose(&g.origin),
+                    ..g
+                }));
+            }
+            report.merged.push(Merged {
+                joint: joint.name,
+                link: welded.name.clone(),
+                into: body.name.clone(),
+            });
+            stack.push((child, at, welded.name));
+        }
+    }
+    Ok((body, movable))
+}
+
+/// The links and joints not yet taken into bodies, and the chain's connectivity.
+struct Chain {
+    links: Vec<Option<UrdfLink>>,
+    joints: Vec<Option<UrdfJoint>>,
+    /// The joints leaving each link.
+    children: Vec<Vec<usize>>,
+    /// Each joint's child link.
+    child_of: Vec<usize>,
+}

@@ -1,0 +1,166 @@
+//! Writing a chain as URDF, numbers in Rust's shortest round-trip form so that reading the text
+//! back gives the same model bit for bit.
+
+use crate::model::{Body, Geometry, Inertial, Robot, Shape};
+use crate::pose::Pose;
+use std::fmt::Write;
+
+/// The chain as a URDF document: the base link, then each movable joint and its child link.
+/// Fixed links were merged when the model was read, so none is written; reading the result
+/// gives back `robot` exactly (every `f64` is printed in its shortest form that parses back to
+/// the same bits).
+pub fn write_urdf(robot: &Robot) -> String {
+    let mut out = String::new();
+    out.push_str("<?xml version=\"1.0\"?>\n");
+    let _ = writeln!(out, "<robot name=\"{}\">", escape(&robot.name));
+    write_link(&mut out, &robot.base);
+    let mut parent = &robot.base.name;
+    for joint in &robot.joints {
+        let _ = writeln!(
+            out,
+            "  <joint name=\"{}\" type=\"{}\">",
+            escape(&joint.name),
+            joint.kind.urdf_name()
+        );
+        let _ = writeln!(out, "    <parent link=\"{}\"/>", escape(parent));
+        let _ = writeln!(out, "    <child link=\"{}\"/>", escape(&joint.child.name));
+        write_origin(&mut out, "    ", &joint.origin);
+        let _ = writeln!(out, "    <axis xyz=\"{}\"/>", numbers(&joint.axis));
+        if let Some(limits) = &joint.limits {
+            out.push_str("    <limit");
+            for (name, value) in [
+                ("lower", limits.lower),
+                ("upper", limits.upper),
+                ("effort", limits.effort),
+                ("velocity", limits.velocity),
+            ] {
+                if let Some(value) = value {
+                    let _ = write!(out, " {name}=\"{value:?}\"");
+                }
+            }
+            out.push_str("/>\n");
+        }
+        if let Some(dynamics) = &joint.dynamics {
+            out.push_str("    <dynamics");
+            for (name, value) in [
+                ("damping", dynamics.damping),
+                ("friction", dynamics.friction),
+            ] {
+                if let Some(value) = value {
+                    let _ = write!(out, " {name}=\"{value:?}\"");
+                }
+            }
+            out.push_str("/>\n");
+        }
+        out.push_str("  </joint>\n");
+        write_link(&mut out, &joint.child);
+        parent = &joint.child.name;
+    }
+    out.push_str("</robot>\n");
+    out
+}
+
+fn write_link(out: &mut String, body: &Body) {
+    let _ = writeln!(out, "  <link name=\"{}\">", escape(&body.name));
+    if !all_zero_bits(&body.inertial) {
+        let Inertial {
+            origin,
+            mass,
+            inertia: [ixx, ixy, ixz, iyy, iyz, izz],
+        } = &body.inertial;
+        out.push_str("    <inertial>\n");
+        write_origin(out, "      ", origin);
+        let _ = writeln!(out, "      <mass value=\"{mass:?}\"/>");
+        let _ = writeln!(
+            out,
+            "      <inertia ixx=\"{ixx:?}\" ixy=\"{ixy:?}\" ixz=\"{ixz:?}\" iyy=\"{iyy:?}\" \
+             iyz=\"{iyz:?}\" izz=\"{izz:?}\"/>"
+        );
+        out.push_str("    </inertial>\n");
+    }
+    for (tag, geometries) in [("visual", &body.visuals), ("collision", &body.collisions)] {
+        for geometry in geometries {
+            write_geometry(out, tag, geometry);
+        }
+    }
+    out.push_str("  </link>\n");
+}
+
+/// True when every number of the inertial is `+0.0`, as for a link read without `<inertial>`.
+fn all_zero_bits(inertial: &Inertial) -> bool {
+    let o = &inertial.origin;
+    o.xyz
+        .iter()
+        .chain(&o.rpy)
+        .chain(std::iter::once(&inertial.mass))
+        .chain(&inertial.inertia)
+        .all(|v| v.to_bits() == 0)
+}
+
+fn write_geometry(out: &mut String, tag: &str, geometry: &Geometry) {
+    match &geometry.name {
+        Some(name) => {
+            let _ = writeln!(out, "    <{tag} name=\"{}\">", escape(name));
+        }
+        None => {
+            let _ = writeln!(out, "    <{tag}>");
+        }
+    }
+    write_origin(out, "      ", &geometry.origin);
+    out.push_str("      <geometry>\n");
+    let _ = match &geometry.shape {
+        Shape::Box(size) => writeln!(out, "        <box size=\"{}\"/>", numbers(size)),
+        Shape::Cylinder { radius, length } => writeln!(
+            out,
+            "        <cylinder radius=\"{radius:?}\" length=\"{length:?}\"/>"
+        ),
+        Shape::Sphere(radius) => writeln!(out, "        <sphere radius=\"{radius:?}\"/>"),
+        Shape::Mesh { filename, scale } => {
+            let _ = write!(out, "        <mesh filename=\"{}\"", escape(filename));
+            if let Some(scale) = scale {
+                let _ = write!(out, " scale=\"{}\"", numbers(scale));
+            }
+            writeln!(out, "/>")
+        }
+    };
+    out.push_str("      </geometry>\n");
+    let _ = writeln!(out, "    </{tag}>");
+}
+
+fn write_origin(out: &mut String, indent: &str, pose: &Pose) {
+    let _ = writeln!(
+        out,
+        "{indent}<origin xyz=\"{}\" rpy=\"{}\"/>",
+        numbers(&pose.xyz),
+        numbers(&pose.rpy)
+    );
+}
+
+/// Numbers separated by spaces, each in Rust's shortest round-trip form (`{:?}`, which uses
+/// an exponent for very small and very large magnitudes).
+pub(crate) fn numbers(values: &[f64]) -> String {
+    let mut text = String::new();
+    for (i, value) in values.iter().enumerate() {
+        if i > 0 {
+            text.push(' ');
+        }
+        let _ = write!(text, "{value:?}");
+    }
+    text
+}
+
+/// Text safe inside a double-quoted XML attribute.
+pub(crate) fn escape(text: &str) -> String {
+    let mut escaped = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => escaped.push_str("&amp;"),
+            '<' => escaped.push_str("&lt;"),
+            '>' => escaped.push_str("&gt;"),
+            '"' => escaped.push_str("&quot;"),
+            '\'' => escaped.push_str("&apos;"),
+            c => escaped.push(c),
+        }
+    }
+    escaped
+}

@@ -1,0 +1,410 @@
+//! Reading and writing URDF: what is kept, merged and refused, and the bit-for-bit round trip.
+
+use robot_desc::{DescError, JointKind, Robot, Shape, read_urdf, write_urdf};
+use std::time::{Duration, Instant};
+
+/// A 3-joint chain: a prismatic base axis, a revolute with limits, a continuous joint, a fixed
+/// tool link, a visual box, collision cylinder and sphere, a mesh, and elements to ignore.
+const ARM: &str = r#"<?xml version="1.0"?>
+<robot name="arm">
+  <material name="blue"><color rgba="0 0 1 1"/></material>
+  <link name="base"><visual><geometry><box size="0.2 0.2 0.1"/></geometry></visual></link>
+  <joint name="slide" type="prismatic">
+    <parent link="base"/><child link="carriage"/>
+    <axis xyz="0 0 2"/>
+    <limit lower="0" upper="0.5" effort="100" velocity="0.2"/>
+  </joint>
+  <link name="carriage">
+    <inertial><origin xyz="0 0 0.05" rpy="0.1 0.2 0.3"/><mass value="2"/>
+      <inertia ixx="0.02" ixy="0.001" ixz="0" iyy="0.03" iyz="0" izz="0.04"/></inertial>
+    <collision><origin xyz="0 0 0.05"/><geometry><cylinder radius="0.05" length="0.1"/></geometry></collision>
+  </link>
+  <joint name="shoulder" type="revolute">
+    <parent link="carriage"/><child link="upper"/>
+    <origin xyz="0 0 0.1" rpy="0 0.5 0"/><axis xyz="0 1 0"/>
+    <limit lower="-1.5" upper="1.5" effort="10" velocity="3"/>
+    <dynamics damping="0.1"/>
+    <safety_controller k_velocity="1"/>
+  </joint>
+  <link name="upper">
+    <inertial><origin xyz="0.2 0 0"/><mass value="1.5"/>
+      <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/></inertial>
+    <visual name="tube"><origin xyz="0.2 0 0" rpy="0 1.5707963267948966 0"/>
+      <geometry><mesh filename="package://arm/upper.stl" scale="1 1 1"/></geometry>
+      <material name="blue"/></visual>
+  </link>
+  <joint name="elbow" type="continuous">
+    <parent link="upper"/><child link="fore"/>
+    <origin xyz="0.4 0 0"/><axis xyz="0 0 1"/>
+  </joint>
+  <link name="fore">
+    <inertial><origin xyz="0.15 0 0"/><mass value="1"/>
+      <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+  </link>
+  <joint name="tool_mount" type="fixed">
+    <parent link="fore"/><child link="tool"/>
+    <origin xyz="0.3 0 0" rpy="0 0 0.5"/>
+  </joint>
+  <link name="tool">
+    <inertial><mass value="0.5"/><inertia ixx="0.0001" iyy="0.0001" izz="0.0001"/></inertial>
+    <collision><geometry><sphere radius="0.03"/></geometry></collision>
+  </link>
+  <transmission name="t1"><type>x</type></transmission>
+  <gazebo reference="tool"/>
+</robot>
+"#;
+
+#[test]
+fn reads_joints_bodies_limits_geometry_and_reports_what_it_merged_and_ignored() {
+    let reading = read_urdf(ARM).unwrap();
+    let robot = &reading.robot;
+    assert_eq!(robot.name, "arm");
+    assert_eq!(robot.base.name, "base");
+    let kinds: Vec<JointKind> = robot.joints.iter().map(|j| j.kind).collect();
+    assert_eq!(
+        kinds,
+        [
+            JointKind::Prismatic,
+            JointKind::Revolute,
+            JointKind::Continuous
+        ]
+    );
+    // The axis is normalised, the default origin is the identity.
+    assert_eq!(robot.joints[0].axis, [0.0, 0.0, 1.0]);
+    let limits = robot.joints[0].limits.unwrap();
+    assert_eq!(
+        (limits.lower, limits.upper, limits.effort, limits.velocity),
+        (Some(0.0), Some(0.5), Some(100.0), Some(0.2))
+    );
+    assert_eq!(robot.joints[1].dynamics.unwrap().damping, Some(0.1));
+    assert_eq!(robot.joints[1].origin.rpy, [0.0, 0.5, 0.0]);
+    assert_eq!(robot.joints[0].child.inertial.origin.rpy, [0.1, 0.2, 0.3]);
+    assert!(matches!(robot.base.visuals[0].shape, Shape::Box(_)));
+    assert!(matches!(
+        &robot.joints[1].child.visuals[0].shape,
+        Shape::Mesh { filename, .. } if filename == "package://arm/upper.stl"
+    ));
+    // The tool is merged into the forearm, its sphere moved into the forearm's frame.
+    let fore = &robot.joints[2].child;
+    assert_eq!(fore.name, "fore");
+    assert_eq!(fore.inertial.mass, 1.5);
+    assert_eq!(fore.collisions.len(), 1);
+    assert_eq!(fore.collisions[0].origin.xyz, [0.3, 0.0, 0.0]);
+    assert_eq!(reading.report.merged.len(), 1);
+    assert_eq!(reading.report.merged[0].link, "tool");
+    assert_eq!(reading.report.merged[0].into, "fore");
+    assert_eq!((reading.report.links, reading.report.joints), (5, 4));
+    for ignored in [
+        "material",
+        "transmission",
+        "gazebo",
+        "joint/safety_controller",
+    ] {
+        assert!(reading.report.ignored.contains_key(ignored), "{ignored}");
+    }
+}
+
+/// The forearm (1 kg, centre at x = 0.15) and tool (0.5 kg at x = 0.3): centre of mass and
+/// inertia by hand, from the parallel-axis theorem.
+#[test]
+fn a_fixed_link_merges_by_the_parallel_axis_theorem() {
+    let fore = &read_urdf(ARM).unwrap().robot.joints[2].child.inertial;
+    let com = (1.0 * 0.15 + 0.5 * 0.3) / 1.5;
+    assert!((fore.origin.xyz[0] - com).abs() < 1e-15);
+    let (d1, d2) = (0.15 - com, 0.3 - com);
+    let iyy = 0.01 + 1.0 * d1 * d1 + 0.0001 + 0.5 * d2 * d2;
+    let ixx = 0.001 + 0.0001;
+    // The tool's yaw of 0.5 rad leaves its isotropic inertia unchanged.
+    let [xx, xy, xz, yy, yz, zz] = fore.inertia;
+    assert!((xx - ixx).abs() < 1e-15 && (yy - iyy).abs() < 1e-15 && (zz - iyy).abs() < 1e-15);
+    assert!(xy.abs() < 1e-18 && xz.abs() < 1e-18 && yz.abs() < 1e-18);
+}
+
+/// Two cubes of side `s` and mass `m` side by side weigh and turn as one `2s x s x s` box.
+#[test]
+fn two_welded_cubes_are_one_box() {
+    let (s, m) = (0.1, 2.0);
+    let cube = m * s * s / 6.0;
+    let text = format!(
+        r#"<robot name="boxes">
+  <link name="base"/>
+  <joint name="j" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/></joint>
+  <link name="a"><inertial><origin xyz="{h} 0 0" rpy="0.3 0.2 0.1"/><mass value="{m}"/>
+    <inertia ixx="{cube}" iyy="{cube}" izz="{cube}"/></inertial></link>
+  <joint name="weld" type="fixed"><parent link="a"/><child link="b"/><origin xyz="{s} 0 0" rpy="1 2 3"/></joint>
+  <link name="b"><inertial><origin xyz="0 0 0"/><mass value="{m}"/>
+    <inertia ixx="{cube}" iyy="{cube}" izz="{cube}"/></inertial></link>
+</robot>"#,
+        h = s / 2.0,
+    );
+    let body = &read_urdf(&text).unwrap().robot.joints[0].child.inertial;
+    let (mass, long, short) = (2.0 * m, 2.0 * s, s);
+    assert_eq!(body.mass, mass);
+    assert!((body.origin.xyz[0] - 0.75 * s).abs() < 1e-15);
+    // The union of a cube centred at s/2 and one centred at s is not a box: check the
+    // parallel-axis sum directly, d = +-s/4.
+    let d = s / 4.0;
+    let iyy = 2.0 * (cube + m * d * d);
+    assert!((body.inertia[0] - 2.0 * cube).abs() < 1e-15);
+    assert!((body.inertia[3] - iyy).abs() < 1e-15 && (body.inertia[5] - iyy).abs() < 1e-15);
+    // Centred at s/2 and 3s/2 instead, they are the 2s x s x s box.
+    let text = text
+        .replace(
+            &format!("<origin xyz=\"{s} 0 0\" rpy=\"1 2 3\"/>"),
+            &format!("<origin xyz=\"{} 0 0\"/>", s),
+        )
+        .replace(
+            "<origin xyz=\"0 0 0\"/>",
+            &format!("<origin xyz=\"{h} 0 0\"/>", h = s / 2.0),
+        );
+    let body = &read_urdf(&text).unwrap().robot.joints[0].child.inertial;
+    let box_ixx = mass * (short * short + short * short) / 12.0;
+    let box_iyy = mass * (long * long + short * short) / 12.0;
+    assert!((body.inertia[0] - box_ixx).abs() < 1e-15, "{body:?}");
+    assert!((body.inertia[3] - box_iyy).abs() < 1e-15, "{body:?}");
+}
+
+/// Bit-for-bit identity of two models (`PartialEq` would take `-0.0` for `0.0`).
+fn same_bits(a: &Robot, b: &Robot) -> bool {
+    format!("{a:?}") == format!("{b:?}") && a == b
+}
+
+/// A pseudo-random chain as URDF text: random axes, origins, inertias (from random principal
+/// moments satisfying the triangle inequality, rotated), some prismatic joints, massless
+/// universal-joint middles, and a fixed tool link.
+fn random_urdf(seed: u64, n: usize) -> String {
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut text = String::from("<robot name=\"random\">\n<link name=\"l0\"/>\n");
+    for i in 1..=n {
+        let kind = match (next() * 4.0) as u32 {
+            0 => "prismatic",
+            1 => "continuous",
+            _ => "revolute",
+        };
+        let v = |next: &mut dyn FnMut() -> f64| next() * 2.0 - 1.0;
+        text += &format!(
+            "<joint name=\"j{i}\" type=\"{kind}\"><parent link=\"l{}\"/><child link=\"l{i}\"/>\
+             <origin xyz=\"{} {} {}\" rpy=\"{} {} {}\"/><axis xyz=\"{} {} {}\"/>\
+             <limit lower=\"-1\" upper=\"1\" effort=\"5\" velocity=\"2\"/></joint>\n",
+            i - 1,
+            v(&mut next) * 0.3,
+            v(&mut next) * 0.3,
+            v(&mut next) * 0.3,
+            v(&mut next) * 3.0,
+            v(&mut next) * 1.5,
+            v(&mut next) * 3.0,
+            v(&mut next),
+            v(&mut next),
+            v(&mut next) + 0.01,
+        );
+        if next() < 0.2 {
+            text += &format!("<link name=\"l{i}\"/>\n");
+            continue;
+        }
+        let (a, b) = (0.01 + next() * 0.1, 0.01 + next() * 0.1);
+        let c = a.max(b) - a.min(b) + next() * (a + b - (a.max(b) - a.min(b)));
+        text += &format!(
+            "<link name=\"l{i}\"><inertial><origin xyz=\"{} {} {}\" rpy=\"{} {} {}\"/>\
+             <mass value=\"{}\"/><inertia ixx=\"{a}\" ixy=\"0\" ixz=\"0\" iyy=\"{b}\" iyz=\"0\" izz=\"{c}\"/>\
+             </inertial></link>\n",
+            v(&mut next) * 0.2,
+            v(&mut next) * 0.2,
+            v(&mut next) * 0.2,
+            v(&mut next),
+            v(&mut next),
+            v(&mut next),
+            0.1 + next() * 2.0,
+        );
+    }
+    text += &format!(
+        "<joint name=\"tool_mount\" type=\"fixed\"><parent link=\"l{n}\"/><child link=\"tool\"/>\
+         <origin xyz=\"0.1 0.02 0\" rpy=\"0.3 0 0.2\"/></joint>\n\
+         <link name=\"tool\"><inertial><origin xyz=\"0.01 0 0\"/><mass value=\"0.3\"/>\
+         <inertia ixx=\"0.001\" iyy=\"0.002\" izz=\"0.002\" ixy=\"0.0001\"/></inertial></link>\n</robot>\n"
+    );
+    text
+}
+
+#[test]
+fn read_write_read_is_the_same_model_bit_for_bit() {
+    for seed in 0..40 {
+        let n = 1 + (seed as usize * 7) % 30;
+        let first = read_urdf(&random_urdf(seed, n)).unwrap().robot;
+        assert_eq!(first.n_joints(), n);
+        let written = write_urdf(&first);
+        let second = read_urdf(&written).unwrap().robot;
+        assert!(same_bits(&first, &second), "seed {seed}");
+        assert_eq!(write_urdf(&second), written, "seed {seed}");
+    }
+    let arm = read_urdf(ARM).unwrap().robot;
+    assert!(same_bits(
+        &arm,
+        &read_urdf(&write_urdf(&arm)).unwrap().robot
+    ));
+}
+
+/// Refused, with a message containing every one of `needles`, in well under a second.
+fn refused(text: &str, needles: &[&str]) -> DescError {
+    let start = Instant::now();
+    let error = read_urdf(text).expect_err("must be refused");
+    let elapsed = start.elapsed();
+    let message = error.to_string();
+    assert!(!message.contains('\n'), "{message}");
+    for needle in needles {
+        assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+    }
+    assert!(
+        elapsed < Duration::from_millis(500),
+        "{message}: took {elapsed:?}"
+    );
+    error
+}
+
+fn chain_with(joint_extra: &str, link_extra: &str) -> String {
+    format!(
+        r#"<robot name="r"><link name="a"/>
+  <joint name="j" type="revolute"><parent link="a"/><child link="b"/>{joint_extra}</joint>
+  <link name="b">{link_extra}</link></robot>"#
+    )
+}
+
+#[test]
+fn hostile_files_are_refused_in_milliseconds() {
+    // Entity expansion ("billion laughs"): no DTD is read.
+    let mut laughs =
+        String::from("<?xml version=\"1.0\"?>\n<!DOCTYPE robot [\n<!ENTITY l0 \"lol\">\n");
+    for i in 1..10 {
+        let prev = format!("&l{};", i - 1);
+        laughs += &format!("<!ENTITY l{i} \"{}\">\n", prev.repeat(10));
+    }
+    laughs += "]>\n<robot name=\"&l9;\"><link name=\"a\"/></robot>";
+    refused(&laughs, &["XML", "DTD"]);
+    // 100,000 nested elements.
+    let deep = format!(
+        "<robot name=\"r\">{}{}</robot>",
+        "<link>".repeat(100_000),
+        "</link>".repeat(100_000)
+    );
+    refused(&deep, &["nest deeper than 32"]);
+    // A 3 MB attribute.
+    let long = format!(
+        "<robot name=\"r\"><link name=\"{}\"/></robot>",
+        "x".repeat(3 << 20)
+    );
+    refused(&long, &["attribute \"name\" of <link>", "3145728 bytes"]);
+    // More than the size limit.
+    let huge = " ".repeat(robot_desc::MAX_URDF_BYTES + 1);
+    refused(&huge, &["at most 8388608 bytes"]);
+    let mass = |m: &str| chain_with("", &format!("<inertial><mass value=\"{m}\"/></inertial>"));
+    refused(&mass("NaN"), &["<mass> of link 'b'", "finite"]);
+    refused(&mass("inf"), &["<mass> of link 'b'", "finite"]);
+    refused(&mass("-1"), &["<inertial> of link 'b'", "non-negative"]);
+    refused(&mass("1e300"), &["<mass> of link 'b'", "at most"]);
+    refused(&mass("heavy"), &["<mass> of link 'b'", "must be a number"]);
+    let inertia = |i: &str| {
+        chain_with(
+            "",
+            &format!("<inertial><mass value=\"1\"/><inertia {i}/></inertial>"),
+        )
+    };
+    refused(
+        &inertia("ixx=\"1\" iyy=\"1\" izz=\"3\""),
+        &["<inertial> of link 'b'", "triangle inequality"],
+    );
+    refused(
+        &inertia("ixx=\"-1\" iyy=\"1\" izz=\"1\""),
+        &["<inertial> of link 'b'", "positive semi-definite"],
+    );
+    // Off-diagonal terms that break positivity with a positive diagonal.
+    refused(
+        &inertia("ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"2\""),
+        &["<inertial> of link 'b'", "positive semi-definite"],
+    );
+}
+
+#[test]
+fn what_is_not_a_serial_chain_is_refused_naming_the_element() {
+    refused(
+        &chain_with("<axis xyz=\"0 0 0\"/>", ""),
+        &["<axis> of joint 'j'", "must not be zero"],
+    );
+    refused(
+        &chain_with("<axis xyz=\"0 1\"/>", ""),
+        &["<axis> of joint 'j'", "3 numbers"],
+    );
+    for kind in ["floating", "planar"] {
+        let text = chain_with("", "").replace("revolute", kind);
+        refused(&text, &["joint 'j'", kind, "serial chains"]);
+    }
+    refused(
+        &chain_with("", "").replace("revolute", "screw"),
+        &["joint 'j'", "unknown joint type \"screw\""],
+    );
+    let tree = r#"<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+      <joint name="j1" type="revolute"><parent link="a"/><child link="b"/></joint>
+      <joint name="j2" type="revolute"><parent link="a"/><child link="c"/></joint></robot>"#;
+    refused(
+        tree,
+        &["link 'a'", "two movable joints", "'j1'", "'j2'", "tree"],
+    );
+    let diamond = r#"<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+      <joint name="j1" type="revolute"><parent link="a"/><child link="b"/></joint>
+      <joint name="j2" type="revolute"><parent link="b"/><child link="c"/></joint>
+      <joint name="j3" type="revolute"><parent link="a"/><child link="c"/></joint></robot>"#;
+    refused(diamond, &["link 'c'", "child of two joints", "closed loop"]);
+    let ring = r#"<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+      <joint name="j1" type="revolute"><parent link="a"/><child link="b"/></joint>
+      <joint name="j2" type="revolute"><parent link="c"/><child link="c2"/></joint>
+      <link name="c2"/>
+      <joint name="j3" type="revolute"><parent link="c2"/><child link="c"/></joint></robot>"#;
+    refused(ring, &["link 'c'", "no path to the root link 'a'"]);
+    let orphan = r#"<robot name="r"><link name="a"/><link name="b"/><link name="lost"/>
+      <joint name="j1" type="revolute"><parent link="a"/><child link="b"/></joint></robot>"#;
+    refused(orphan, &["link 'lost'", "no path to the root link 'a'"]);
+    let twice = r#"<robot name="r"><link name="a"/><link name="a"/></robot>"#;
+    refused(twice, &["link 'a'", "used twice"]);
+    let joints_twice = r#"<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+      <joint name="j" type="revolute"><parent link="a"/><child link="b"/></joint>
+      <joint name="j" type="revolute"><parent link="b"/><child link="c"/></joint></robot>"#;
+    refused(joints_twice, &["joint 'j'", "used twice"]);
+    refused(
+        &chain_with("", "").replace("<child link=\"b\"/>", "<child link=\"z\"/>"),
+        &["joint 'j'", "child link 'z' does not exist"],
+    );
+    refused(
+        &chain_with("<limit lower=\"1\" upper=\"-1\"/>", ""),
+        &["<limit> of joint 'j'", "must not exceed"],
+    );
+    refused(
+        "<robot><link name=\"a\"/></robot>",
+        &["<robot>", "missing attribute \"name\""],
+    );
+    refused("<model name=\"x\"/>", &["<model>", "must be <robot>"]);
+    refused(
+        "<robot name=\"x\"><link name=\"a\">",
+        &["not a readable XML document"],
+    );
+}
+
+#[test]
+fn a_long_chain_reads_in_linear_time() {
+    // 5000 joints (about 2 MB with inertias) read well inside the time of a few milliseconds
+    // a joint would take if anything were quadratic.
+    let text = random_urdf(7, 5000);
+    let start = Instant::now();
+    let robot = read_urdf(&text).unwrap().robot;
+    assert_eq!(robot.n_joints(), 5000);
+    assert!(
+        start.elapsed() < Duration::from_secs(2),
+        "{:?}",
+        start.elapsed()
+    );
+}
