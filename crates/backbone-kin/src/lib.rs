@@ -14,6 +14,7 @@ pub mod spatial_curve;
 pub mod spatial_ik;
 pub mod spatial_map;
 mod validate;
+pub mod vec3;
 
 pub use bessel::{J0_FIRST_ZERO, inverse_j0};
 pub use chain::{joint_positions, tip_position};
@@ -26,8 +27,9 @@ pub use modal_map::{
     BaseAngle, MAX_HARMONICS, MAX_LINKS, MAX_MAP_ENTRIES, ModalMap, harmonic_basis,
 };
 pub use spatial_chain::{
-    BasePose, Rotation, spatial_joint_positions, spatial_tip_jacobian, spatial_tip_position,
+    BasePose, spatial_joint_positions, spatial_tip_jacobian, spatial_tip_position,
 };
 pub use spatial_curve::{CurveTip, MAX_CURVE_STEPS, SPATIAL_CURVE_TOLERANCE, SpatialCurve};
 pub use spatial_ik::SpatialIk;
 pub use spatial_map::SpatialModalMap;
+pub use vec3::Rotation;

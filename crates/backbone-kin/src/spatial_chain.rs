@@ -10,9 +10,7 @@
 
 use crate::error::KinError;
 use crate::validate::{check_finite, check_len, check_link_lengths, check_output_len};
-
-/// A 3 x 3 rotation matrix, `r[row][column]`.
-pub type Rotation = [[f64; 3]; 3];
+use crate::vec3::{Rotation, column, cross, mat_mul, rot_x, rot_y, rot_z, sub};
 
 /// The pose of the arm's base: its position and its orientation as roll, pitch and yaw about the
 /// fixed `x`, `y` and `z` axes (URDF's convention: `R = Rz(yaw) Ry(pitch) Rx(roll)`). The
@@ -39,7 +37,7 @@ impl BasePose {
     /// The base rotation `Rz(yaw) Ry(pitch) Rx(roll)`.
     pub fn rotation(&self) -> Rotation {
         let [roll, pitch, yaw] = self.rpy;
-        mul(mul(rot_z(yaw), rot_y(pitch)), rot_x(roll))
+        mat_mul(mat_mul(rot_z(yaw), rot_y(pitch)), rot_x(roll))
     }
 }
 
@@ -126,9 +124,9 @@ fn walk(
     let mut point = base.xyz;
     for (i, (&length, angles)) in link_lengths.iter().zip(theta.chunks_exact(2)).enumerate() {
         let z_axis = column(&rotation, 2);
-        let after_z = mul(rotation, rot_z(angles[0]));
+        let after_z = mat_mul(rotation, rot_z(angles[0]));
         let y_axis = column(&after_z, 1);
-        rotation = mul(after_z, rot_y(angles[1]));
+        rotation = mat_mul(after_z, rot_y(angles[1]));
         let start = point;
         let x_axis = column(&rotation, 0);
         point = std::array::from_fn(|d| start[d] + length * x_axis[d]);
@@ -148,43 +146,4 @@ fn check_chain(link_lengths: &[f64], base: &BasePose, theta: &[f64]) -> Result<(
     check_link_lengths(link_lengths)?;
     base.validate()?;
     check_len("joint angles", theta, 2 * link_lengths.len())
-}
-
-/// The rotation by `angle` about `x`.
-pub fn rot_x(angle: f64) -> Rotation {
-    let (s, c) = angle.sin_cos();
-    [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]
-}
-
-/// The rotation by `angle` about `y`.
-pub fn rot_y(angle: f64) -> Rotation {
-    let (s, c) = angle.sin_cos();
-    [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]
-}
-
-/// The rotation by `angle` about `z`.
-pub fn rot_z(angle: f64) -> Rotation {
-    let (s, c) = angle.sin_cos();
-    [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
-}
-
-/// The product `a b` of two 3 x 3 matrices.
-pub fn mul(a: Rotation, b: Rotation) -> Rotation {
-    std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
-}
-
-fn column(r: &Rotation, j: usize) -> [f64; 3] {
-    [r[0][j], r[1][j], r[2][j]]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    std::array::from_fn(|d| a[d] - b[d])
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }

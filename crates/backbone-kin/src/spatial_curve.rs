@@ -19,8 +19,9 @@
 
 use crate::error::KinError;
 use crate::modal_map::check_harmonics;
-use crate::spatial_chain::{BasePose, Rotation, mul};
+use crate::spatial_chain::BasePose;
 use crate::validate::{check_len, check_length};
+use crate::vec3::{Rotation, column, distance, mat_mul};
 
 /// The most Runge-Kutta steps [`SpatialCurve::tip`] takes over the curve (2^22).
 pub const MAX_CURVE_STEPS: usize = 1 << 22;
@@ -114,7 +115,7 @@ impl SpatialCurve {
     fn integrate(&self, steps: usize) -> ([f64; 3], Rotation) {
         let h = self.length / steps as f64;
         let (mut p, mut r) = (self.base.xyz, self.base.rotation());
-        let derivative = |r: &Rotation, s: f64| (mul(*r, skew(self.rate(s))), column_x(r));
+        let derivative = |r: &Rotation, s: f64| (mat_mul(*r, skew(self.rate(s))), column(r, 0));
         for step in 0..steps {
             let s = step as f64 * h;
             let (k1r, k1p) = derivative(&r, s);
@@ -155,15 +156,6 @@ fn skew(w: [f64; 3]) -> Rotation {
     [[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]]
 }
 
-fn column_x(r: &Rotation) -> [f64; 3] {
-    [r[0][0], r[1][0], r[2][0]]
-}
-
 fn axpy(r: &Rotation, h: f64, k: &Rotation) -> Rotation {
     std::array::from_fn(|i| std::array::from_fn(|j| r[i][j] + h * k[i][j]))
-}
-
-fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
-    let d: [f64; 3] = std::array::from_fn(|i| a[i] - b[i]);
-    d.iter().map(|x| x * x).sum::<f64>().sqrt()
 }

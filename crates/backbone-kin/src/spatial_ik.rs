@@ -15,6 +15,7 @@ use crate::harmonic_ik::{IkOptions, IkReport, Workspace, least_squares};
 use crate::spatial_chain::{BasePose, spatial_tip_jacobian};
 use crate::spatial_map::SpatialModalMap;
 use crate::validate::{check_finite, check_len};
+use crate::vec3::distance;
 
 /// Reusable inverse kinematics of a universal-joint chain on the spatial modal family. Created
 /// once; [`solve`](Self::solve) allocates nothing.
@@ -105,8 +106,7 @@ impl SpatialIk {
             check_finite(name, value)?;
         }
         check_len("initial guess", a, self.trial.len())?;
-        let offset: [f64; 3] = std::array::from_fn(|d| target[d] - self.base.xyz[d]);
-        let r = offset.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let r = distance(target, self.base.xyz);
         if r > self.length {
             return Err(KinError::OutOfReach {
                 r,
