@@ -21,6 +21,7 @@ use sim_core::{ArmSpec, SimError};
 use std::io::{BufRead, Write};
 
 mod derivatives;
+mod spatial;
 
 /// Longest request line accepted (bytes); longer lines are skipped with a `line_too_long` error.
 pub const MAX_LINE_BYTES: usize = 16 << 20;
@@ -246,6 +247,9 @@ fn answer(line: &[u8]) -> Value {
 const OPS: &str = "fk, ik, joints, dynamics, reduced, fuzzy, rnea_derivatives, aba_derivatives, reduced_derivatives";
 
 fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
+    if spatial::is_spatial(&request) {
+        return spatial::dispatch(op, request);
+    }
     match op {
         "fk" => fk(parse(request)?),
         "ik" => ik(parse(request)?),
