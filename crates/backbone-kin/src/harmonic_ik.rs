@@ -172,23 +172,24 @@ impl HarmonicIk {
     }
 }
 
-/// The buffers of [`least_squares`]: a trial point (`m` entries) and two `2 x m` Jacobians.
+/// The buffers of [`least_squares`]: a trial point (`m` entries) and two `D x m` Jacobians.
 pub(crate) struct Workspace<'w> {
     pub(crate) trial: &'w mut [f64],
     pub(crate) jacobian: &'w mut Vec<f64>,
     pub(crate) trial_jacobian: &'w mut Vec<f64>,
 }
 
-/// The damped least-squares iteration of the module docs on any end-point map:
-/// `point_and_jacobian(a, J)` returns `p(a)` and writes `J = d p / d a` (`2 x m`, row-major).
-/// `a` holds the guess on entry and the solution (or the best iterate) on return.
-pub(crate) fn least_squares(
-    target: [f64; 2],
+/// The damped least-squares iteration of the module docs on any end-point map into `D = 2` or
+/// `3` dimensions: `point_and_jacobian(a, J)` returns `p(a)` and writes `J = d p / d a`
+/// (`D x m`, row-major). `a` holds the guess on entry and the solution (or the best iterate) on
+/// return.
+pub(crate) fn least_squares<const D: usize>(
+    target: [f64; D],
     a: &mut [f64],
     tolerance: f64,
     max_iterations: usize,
     work: Workspace<'_>,
-    mut point_and_jacobian: impl FnMut(&[f64], &mut [f64]) -> Result<[f64; 2], KinError>,
+    mut point_and_jacobian: impl FnMut(&[f64], &mut [f64]) -> Result<[f64; D], KinError>,
 ) -> Result<IkReport, KinError> {
     let Workspace {
         trial,
@@ -200,7 +201,7 @@ pub(crate) fn least_squares(
     let mut damping = DAMPING_MIN;
     let mut iterations = 0;
     while residual > tolerance {
-        let error = [point[0] - target[0], point[1] - target[1]];
+        let error: [f64; D] = std::array::from_fn(|d| point[d] - target[d]);
         if iterations == max_iterations
             || damping > DAMPING_MAX
             || !damped_step(jacobian, error, damping, a, trial)
@@ -230,42 +231,78 @@ pub(crate) fn least_squares(
 }
 
 /// `trial = a - J^T (J J^T + mu I)^{-1} error` with `mu = damping * trace(J J^T)`, `J` the
-/// `2 x m` row-major end-point Jacobian, the step shortened to at most [`MAX_STEP`]. Returns
-/// false when the step is undefined (`J = 0`).
-fn damped_step(
+/// `D x m` row-major end-point Jacobian, the step shortened to at most [`MAX_STEP`]. Returns
+/// false when the step is undefined (`J J^T + mu I` singular, e.g. `J = 0`).
+fn damped_step<const D: usize>(
     jacobian: &[f64],
-    error: [f64; 2],
+    error: [f64; D],
     damping: f64,
     a: &[f64],
     trial: &mut [f64],
 ) -> bool {
-    let (jx, jy) = jacobian.split_at(a.len());
+    let m = a.len();
+    let row = |d: usize| &jacobian[d * m..(d + 1) * m];
     let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(p, q)| p * q).sum::<f64>();
-    let (gxx, gxy, gyy) = (dot(jx, jx), dot(jx, jy), dot(jy, jy));
-    let mu = damping * (gxx + gyy);
-    let (g00, g11) = (gxx + mu, gyy + mu);
-    let det = g00 * g11 - gxy * gxy;
-    if !(det > 0.0 && det.is_finite()) {
-        return false;
+    let mut gram: [[f64; D]; D] =
+        std::array::from_fn(|i| std::array::from_fn(|j| dot(row(i), row(j))));
+    let mu = damping * (0..D).map(|d| gram[d][d]).sum::<f64>();
+    for (d, g) in gram.iter_mut().enumerate() {
+        g[d] += mu;
     }
-    let y = [
-        (g11 * error[0] - gxy * error[1]) / det,
-        (g00 * error[1] - gxy * error[0]) / det,
-    ];
-    let step = |dx: f64, dy: f64| dx * y[0] + dy * y[1];
-    let norm = jx
-        .iter()
-        .zip(jy)
-        .map(|(&dx, &dy)| step(dx, dy).powi(2))
-        .sum::<f64>()
-        .sqrt();
+    let Some(y) = solve_symmetric(&gram, error) else {
+        return false;
+    };
+    let step = |j: usize| (0..D).map(|d| row(d)[j] * y[d]).sum::<f64>();
+    let norm = (0..m).map(|j| step(j).powi(2)).sum::<f64>().sqrt();
     let scale = (MAX_STEP / norm).min(1.0);
-    for (((t, &aj), &dx), &dy) in trial.iter_mut().zip(a).zip(jx).zip(jy) {
-        *t = aj - scale * step(dx, dy);
+    for (j, (t, &aj)) in trial.iter_mut().zip(a).enumerate() {
+        *t = aj - scale * step(j);
     }
     true
 }
 
-fn distance(p: [f64; 2], q: [f64; 2]) -> f64 {
-    (p[0] - q[0]).hypot(p[1] - q[1])
+/// `G^{-1} e` for a symmetric `2 x 2` or `3 x 3` matrix `G` by its adjugate (Cramer's rule), or
+/// `None` where the determinant is not positive and finite.
+fn solve_symmetric<const D: usize>(g: &[[f64; D]; D], e: [f64; D]) -> Option<[f64; D]> {
+    let mut y = [0.0; D];
+    let det = match D {
+        2 => {
+            let det = g[0][0] * g[1][1] - g[0][1] * g[0][1];
+            y[0] = g[1][1] * e[0] - g[0][1] * e[1];
+            y[1] = g[0][0] * e[1] - g[0][1] * e[0];
+            det
+        }
+        3 => {
+            let c = |i: usize, j: usize, k: usize, l: usize| g[i][k] * g[j][l] - g[i][l] * g[j][k];
+            let adj = [
+                [c(1, 2, 1, 2), -c(0, 2, 1, 2), c(0, 1, 1, 2)],
+                [-c(1, 2, 0, 2), c(0, 2, 0, 2), -c(0, 1, 0, 2)],
+                [c(1, 2, 0, 1), -c(0, 2, 0, 1), c(0, 1, 0, 1)],
+            ];
+            for (yi, a) in y.iter_mut().zip(adj) {
+                *yi = a[0] * e[0] + a[1] * e[1] + a[2] * e[2];
+            }
+            g[0][0] * adj[0][0] + g[0][1] * adj[1][0] + g[0][2] * adj[2][0]
+        }
+        _ => return None,
+    };
+    if !(det > 0.0 && det.is_finite()) {
+        return None;
+    }
+    for yi in &mut y {
+        *yi /= det;
+    }
+    Some(y)
+}
+
+fn distance<const D: usize>(p: [f64; D], q: [f64; D]) -> f64 {
+    match D {
+        2 => (p[0] - q[0]).hypot(p[1] - q[1]),
+        _ => p
+            .iter()
+            .zip(&q)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            .sqrt(),
+    }
 }

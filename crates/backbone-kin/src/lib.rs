@@ -9,7 +9,12 @@ pub mod error;
 pub mod harmonic_ik;
 pub mod modal_map;
 mod quadrature;
+pub mod spatial_chain;
+pub mod spatial_curve;
+pub mod spatial_ik;
+pub mod spatial_map;
 mod validate;
+pub mod vec3;
 
 pub use bessel::{J0_FIRST_ZERO, inverse_j0};
 pub use chain::{joint_positions, tip_position};
@@ -21,3 +26,10 @@ pub use harmonic_ik::{HarmonicIk, IkOptions, IkReport};
 pub use modal_map::{
     BaseAngle, MAX_HARMONICS, MAX_LINKS, MAX_MAP_ENTRIES, ModalMap, harmonic_basis,
 };
+pub use spatial_chain::{
+    BasePose, spatial_joint_positions, spatial_tip_jacobian, spatial_tip_position,
+};
+pub use spatial_curve::{CurveTip, MAX_CURVE_STEPS, SPATIAL_CURVE_TOLERANCE, SpatialCurve};
+pub use spatial_ik::SpatialIk;
+pub use spatial_map::SpatialModalMap;
+pub use vec3::Rotation;

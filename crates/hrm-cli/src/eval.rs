@@ -23,6 +23,7 @@ use std::io::{BufRead, Write};
 
 mod derivatives;
 mod robot;
+mod spatial;
 
 /// Longest request line accepted (bytes); longer lines are skipped with a `line_too_long` error.
 pub const MAX_LINE_BYTES: usize = 16 << 20;
@@ -321,6 +322,9 @@ const OPS: &str = "fk, ik, joints, dynamics, reduced, fuzzy, rnea_derivatives, a
 fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
     // `"urdf"` in place of `"arm"`: the spatial chain of a robot description.
     let urdf = request.contains_key("urdf");
+    if spatial::is_spatial(&request) {
+        return spatial::dispatch(op, request);
+    }
     match op {
         "dynamics" if urdf => robot::dynamics(parse(request)?),
         "rnea_derivatives" if urdf => robot::rnea_derivatives(parse(request)?),

@@ -6,6 +6,7 @@ mod errors;
 mod fuzzy;
 mod reduced;
 mod scenario;
+mod spatial;
 mod sweep;
 
 use pyo3::prelude::*;
@@ -16,6 +17,7 @@ fn _hrm(module: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = module.py();
     module.add_class::<arm::Arm>()?;
     module.add_class::<reduced::ReducedModel>()?;
+    module.add_class::<spatial::SpatialArm>()?;
     module.add_class::<scenario::Scenario>()?;
     module.add_class::<scenario::Settings>()?;
     module.add_class::<scenario::ReferenceSample>()?;

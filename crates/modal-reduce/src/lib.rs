@@ -12,6 +12,7 @@ pub mod jacobi;
 mod model;
 mod projection;
 mod small_linalg;
+pub mod spatial;
 pub mod terms;
 mod torques;
 

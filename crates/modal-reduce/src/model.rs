@@ -284,7 +284,7 @@ fn check_geometry(chain: &ChainModel, map: &ModalMap) -> Result<(), ReduceError>
 }
 
 /// Refuses a map whose `J` has (numerically) dependent columns.
-fn check_column_rank(map: &ModalMap) -> Result<(), ReduceError> {
+pub(crate) fn check_column_rank(map: &ModalMap) -> Result<(), ReduceError> {
     let (n, m) = (map.n_joints(), map.n_coords());
     let mut gram = vec![0.0; m * m];
     for i in 0..n {

@@ -15,3 +15,4 @@ mod curve;
 mod inverse;
 mod map_limits;
 mod modal_map;
+mod spatial;

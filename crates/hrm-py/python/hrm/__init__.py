@@ -1,7 +1,8 @@
 """hrm: hyper-redundant manipulators from Python.
 
 Planar chain dynamics (``Arm``), the modal reduction of the paper's backbone-curve method
-(``ReducedModel``), Takagi-Sugeno fuzzy systems (``hrm.fuzzy``), closed-loop experiments
+(``ReducedModel``), spatial arms of universal joints on a modal backbone curve
+(``SpatialArm``), Takagi-Sugeno fuzzy systems (``hrm.fuzzy``), closed-loop experiments
 (``Scenario``, run with a built-in or a Python controller into a ``Run``) and Monte Carlo
 sweeps (``Sweep``, whole or shard by shard), computed by the Rust crates of
 https://github.com/hrm-toolkit/hrm. Every model method takes one state, shape ``(n,)``, or a
@@ -24,6 +25,7 @@ from ._hrm import (
     Run,
     Scenario,
     Settings,
+    SpatialArm,
     Sweep,
     Unreachable,
     __version__,
@@ -38,6 +40,7 @@ __all__ = [
     "Run",
     "Scenario",
     "Settings",
+    "SpatialArm",
     "Sweep",
     "Unreachable",
     "__version__",

@@ -1,7 +1,7 @@
 """Type stubs of the extension module hrm._hrm (re-exported by hrm and hrm.fuzzy)."""
 
 from os import PathLike
-from typing import Any, Callable, Dict, Iterable, List, Literal, Optional, Sequence, Union
+from typing import Any, Callable, Dict, Iterable, List, Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -174,6 +174,60 @@ class Run:
     @property
     def coordinates(self) -> List[str]:
         """The names of the modal coordinates."""
+
+class SpatialArm:
+    """Universal-joint arm on a spatial modal backbone curve: theta = J a (2n x 4K)."""
+
+    def __init__(
+        self,
+        links: Optional[int] = None,
+        link_length: float = 0.1,
+        link_mass: float = 0.1,
+        gravity: Sequence[float] = (0.0, 0.0, -9.81),
+        lengths: Optional[Sequence[float]] = None,
+        masses: Optional[Sequence[float]] = None,
+        inertias: Optional[Sequence[Sequence[float]]] = None,
+        base_xyz: Sequence[float] = (0.0, 0.0, 0.0),
+        base_rpy: Sequence[float] = (0.0, 0.0, 0.0),
+        harmonics: int = 1,
+    ) -> None: ...
+    @property
+    def n_links(self) -> int:
+        """Number of links n (2n joint angles)."""
+    @property
+    def n_coords(self) -> int:
+        """Number of modal coordinates m = 4K."""
+    @property
+    def harmonics(self) -> int:
+        """Number of harmonics K per plane."""
+    @property
+    def lengths(self) -> Array:
+        """Link lengths (m), shape (n,)."""
+    @property
+    def masses(self) -> Array:
+        """Link masses (kg), shape (n,)."""
+    @property
+    def inertias(self) -> Array:
+        """Principal moments [Ixx, Iyy, Izz] (kg m^2), shape (n, 3)."""
+    @property
+    def gravity(self) -> Tuple[float, float, float]:
+        """Gravity vector (m/s^2)."""
+    @property
+    def base_xyz(self) -> Tuple[float, float, float]:
+        """Base position (m)."""
+    @property
+    def base_rpy(self) -> Tuple[float, float, float]:
+        """Base roll, pitch, yaw (rad)."""
+    def joints(self, a: ArrayLike) -> Tuple[Array, Array]:
+        """(theta (2n,) or (N, 2n), the constant Jacobian J (2n, m))."""
+    def fk(self, a: ArrayLike) -> Tuple[Array, Array]:
+        """(backbone curve's tip, chain's tip), each (3,) or (N, 3)."""
+    def ik(self, target: ArrayLike, guess: Optional[ArrayLike] = None) -> Array:
+        """Modal coordinates whose chain's tip is on target, shape (m,) or (N, m)."""
+    def reduced(self, a: ArrayLike, a_dot: ArrayLike, tau_star: ArrayLike) -> Dict[str, Array]:
+        """mass_matrix, coriolis, gravity, a_ddot and joint_torques at (a, a_dot) under tau*."""
+    def forward_dynamics(self, a: ArrayLike, a_dot: ArrayLike, tau_star: ArrayLike) -> Array:
+        """a_ddot = M*^-1 (tau* - C* - G*), shape (m,) or (N, m)."""
 
 class Scenario:
     """A closed-loop experiment; every key of its TOML file is an attribute."""

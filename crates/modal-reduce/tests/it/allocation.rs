@@ -59,3 +59,23 @@ fn per_step_functions_do_not_allocate() {
         assert_eq!(allocations, 0, "n = {n}, m = {m}");
     }
 }
+
+#[test]
+fn spatial_per_step_functions_do_not_allocate() {
+    use modal_reduce::spatial::{
+        SpatialReducedData, SpatialReducedModel, spatial_forward_dynamics, spatial_joint_torques,
+        spatial_reduced_terms,
+    };
+    assert!(is_counting());
+    let model = SpatialReducedModel::uniform_rods(50, 2, 0.02, 0.02, [0.0, 0.0, -9.81]).unwrap();
+    let m = model.n_coords();
+    let mut data = SpatialReducedData::new(&model);
+    let (a, a_dot, tau_star) = (vec![0.3; m], vec![-0.2; m], vec![0.5; m]);
+    let (mut a_ddot, mut tau) = (vec![0.0; m], vec![0.0; 100]);
+    let count = allocations_during(|| {
+        spatial_reduced_terms(&model, &mut data, &a, &a_dot).unwrap();
+        spatial_forward_dynamics(&model, &mut data, &a, &a_dot, &tau_star, &mut a_ddot).unwrap();
+        spatial_joint_torques(&model, &mut data, &a, &a_dot, &a_ddot, &mut tau).unwrap();
+    });
+    assert_eq!(count, 0);
+}

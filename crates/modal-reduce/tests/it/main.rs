@@ -20,3 +20,4 @@ mod derivatives;
 mod jacobi;
 mod large_chains;
 mod properties;
+mod spatial;

@@ -1,0 +1,153 @@
+//! Inverse kinematics of the tip of the spatial modal family's universal-joint chain
+//! ([`SpatialModalMap`], [`spatial_chain`](crate::spatial_chain)), for any `K`.
+//!
+//! [`SpatialIk`] solves `tip_chain(a) = target` (3 equations, `4K` unknowns) with the damped
+//! least-squares iteration of [`HarmonicIk`](crate::HarmonicIk) in three dimensions:
+//! `delta = -J^T (J J^T + mu I)^{-1} (tip(a) - target)` with the analytic Jacobian
+//! `d tip / d a = (d tip / d theta) J_modal`, `d tip / d theta_j = u_j x (tip - o_j)`
+//! ([`spatial_tip_jacobian`]), steps of at most 0.5 rad in modal space. The problem is
+//! underdetermined, so near a solution each step is the minimum-norm Gauss-Newton step and the
+//! solver returns a solution near the guess. The method is local: the straight arm (`a = 0`) is
+//! a singular start for targets on its axis, so give a bent guess for those.
+
+use crate::error::KinError;
+use crate::harmonic_ik::{IkOptions, IkReport, Workspace, least_squares};
+use crate::spatial_chain::{BasePose, spatial_tip_jacobian};
+use crate::spatial_map::SpatialModalMap;
+use crate::validate::{check_finite, check_len};
+use crate::vec3::distance;
+
+/// Reusable inverse kinematics of a universal-joint chain on the spatial modal family. Created
+/// once; [`solve`](Self::solve) allocates nothing.
+///
+/// The default tolerance is `max(1e-14, 8 (2n) eps)` relative to the chain's length, as for the
+/// planar [`ChainIk`](crate::ChainIk).
+///
+/// ```
+/// use backbone_kin::{BasePose, SpatialIk, SpatialModalMap, spatial_tip_position};
+/// let map = SpatialModalMap::new(&[0.1; 10], 1)?; // 10 links of 0.1 m
+/// let base = BasePose::default();
+/// let tip_of = |a: &[f64]| {
+///     let mut theta = [0.0; 20];
+///     map.joint_angles(a, &mut theta)?;
+///     spatial_tip_position(map.link_lengths(), &base, &theta)
+/// };
+/// let target = tip_of(&[0.8, -0.3, -0.5, 0.2])?; // a point the family reaches
+/// let mut ik = SpatialIk::new(map.clone(), base)?;
+/// let mut a = [0.5, 0.0, -0.3, 0.0]; // guess on entry, solution on return
+/// ik.solve(target, &mut a)?;
+/// let tip = tip_of(&a)?;
+/// assert!((0..3).all(|d| (tip[d] - target[d]).abs() < 1e-13));
+/// # Ok::<(), backbone_kin::KinError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct SpatialIk {
+    map: SpatialModalMap,
+    base: BasePose,
+    length: f64,
+    options: IkOptions,
+    theta: Vec<f64>,
+    joint_jacobian: Vec<f64>,
+    trial: Vec<f64>,
+    jacobian: Vec<f64>,
+    trial_jacobian: Vec<f64>,
+}
+
+impl SpatialIk {
+    /// A solver for the chain of `map`'s links leaving the base pose `base`.
+    pub fn new(map: SpatialModalMap, base: BasePose) -> Result<Self, KinError> {
+        base.validate()?;
+        let (n2, m) = (map.n_joints(), map.n_coords());
+        let length = map.link_lengths().iter().sum();
+        let rounding = 8.0 * n2 as f64 * f64::EPSILON;
+        Ok(Self {
+            map,
+            base,
+            length,
+            options: IkOptions {
+                tolerance: IkOptions::default().tolerance.max(rounding),
+                ..IkOptions::default()
+            },
+            theta: vec![0.0; n2],
+            joint_jacobian: vec![0.0; 3 * n2],
+            trial: vec![0.0; m],
+            jacobian: vec![0.0; 3 * m],
+            trial_jacobian: vec![0.0; 3 * m],
+        })
+    }
+
+    /// Replaces the stopping rules; `tolerance` (relative to the chain's length) must be positive
+    /// and finite.
+    pub fn with_options(mut self, options: IkOptions) -> Result<Self, KinError> {
+        options.validate()?;
+        self.options = options;
+        Ok(self)
+    }
+
+    /// The stopping rules in use.
+    pub fn options(&self) -> IkOptions {
+        self.options
+    }
+
+    /// The modal map the solver inverts.
+    pub fn map(&self) -> &SpatialModalMap {
+        &self.map
+    }
+
+    /// Solves `tip_chain(a) = target` for the modal coordinates `a` (`4K` entries), which hold
+    /// the initial guess on entry and the solution on success (the best iterate after
+    /// [`KinError::NotConverged`]).
+    ///
+    /// Errors: [`KinError::OutOfReach`] if the target is farther from the base than the chain is
+    /// long; [`KinError::NotConverged`] if the iteration stalls or runs out of steps; input
+    /// errors for a non-finite target or guess, or a guess of the wrong size.
+    pub fn solve(&mut self, target: [f64; 3], a: &mut [f64]) -> Result<IkReport, KinError> {
+        for (name, value) in ["target x", "target y", "target z"].into_iter().zip(target) {
+            check_finite(name, value)?;
+        }
+        check_len("initial guess", a, self.trial.len())?;
+        let r = distance(target, self.base.xyz);
+        if r > self.length {
+            return Err(KinError::OutOfReach {
+                r,
+                length: self.length,
+            });
+        }
+        let Self {
+            map,
+            base,
+            theta,
+            joint_jacobian,
+            ..
+        } = self;
+        let (n2, m) = (map.n_joints(), map.n_coords());
+        least_squares(
+            target,
+            a,
+            self.options.tolerance * self.length,
+            self.options.max_iterations,
+            Workspace {
+                trial: &mut self.trial,
+                jacobian: &mut self.jacobian,
+                trial_jacobian: &mut self.trial_jacobian,
+            },
+            |modes, jacobian| {
+                map.joint_angles(modes, theta)?;
+                let tip = spatial_tip_jacobian(map.link_lengths(), base, theta, joint_jacobian)?;
+                // d tip / d a = (d tip / d theta) J, row by row.
+                for (out, row) in jacobian
+                    .chunks_exact_mut(m)
+                    .zip(joint_jacobian.chunks_exact(n2))
+                {
+                    out.fill(0.0);
+                    for (j, &d_theta) in row.iter().enumerate() {
+                        for (o, &entry) in out.iter_mut().zip(map.row(j)) {
+                            *o += d_theta * entry;
+                        }
+                    }
+                }
+                Ok(tip)
+            },
+        )
+    }
+}

@@ -1,0 +1,420 @@
+//! The ops of `hrm eval` on spatial modal arms (`"arm": {"kind": "spatial", ...}`):
+//! `joints`, `fk`, `ik` and `reduced` (`docs/eval-protocol.md`, "Spatial arms").
+
+use super::{EvalError, EvalResult, finite, json_fields};
+use backbone_kin::{
+    BasePose, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, SpatialModalMap,
+    spatial_tip_position,
+};
+use modal_reduce::spatial::{
+    SpatialLinkInertia, SpatialReducedData, SpatialReducedModel, spatial_forward_dynamics,
+    spatial_joint_torques,
+};
+use serde::Deserialize;
+use serde_json::{Map, Value, json};
+
+/// Most links of a spatial arm in a request (`2n` joints).
+const MAX_SPATIAL_LINKS: usize = 100_000;
+
+/// Most harmonics per plane in a request (`m = 4K` coordinates).
+const MAX_SPATIAL_HARMONICS: usize = 16;
+
+/// Most entries of an answer's Jacobian or of the work of `reduced` (`2n x 4K`, and `n m^2`):
+/// about 0.1 s of work and 64 MB of JSON at most.
+const MAX_SPATIAL_WORK: usize = 1 << 22;
+
+/// Whether a request's `"arm"` is a spatial arm (`"kind": "spatial"`).
+pub(super) fn is_spatial(request: &Map<String, Value>) -> bool {
+    request
+        .get("arm")
+        .and_then(|arm| arm.get("kind"))
+        .is_some_and(|kind| kind == "spatial")
+}
+
+/// Answers `op` on a spatial arm.
+pub(super) fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
+    match op {
+        "joints" => joints(super::parse(request)?),
+        "fk" => fk(super::parse(request)?),
+        "ik" => ik(super::parse(request)?),
+        "reduced" => reduced(super::parse(request)?),
+        other => Err(EvalError::input(format!(
+            "op {other:?} does not take a spatial arm; spatial arms take joints, fk, ik and reduced"
+        ))),
+    }
+}
+
+/// `"base"` of a spatial arm.
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct BaseSpec {
+    #[serde(default)]
+    xyz: [f64; 3],
+    #[serde(default)]
+    rpy: [f64; 3],
+}
+
+/// A spatial arm as requests give it.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpatialArmSpec {
+    #[allow(dead_code, reason = "checked by is_spatial: always \"spatial\" here")]
+    kind: String,
+    joints: Option<String>,
+    links: Option<usize>,
+    link_length: Option<f64>,
+    lengths: Option<Vec<f64>>,
+    link_mass: Option<f64>,
+    masses: Option<Vec<f64>>,
+    inertias: Option<Vec<[f64; 3]>>,
+    gravity: Option<[f64; 3]>,
+    #[serde(default)]
+    base: BaseSpec,
+}
+
+impl SpatialArmSpec {
+    /// The arm's reduced model with `harmonics` harmonics per plane; the defaults are the
+    /// paper's link size (10 links of 0.1 m and 0.1 kg, slender rods) under gravity along `-z`.
+    fn model(&self, harmonics: usize) -> Result<SpatialReducedModel, EvalError> {
+        if let Some(joints) = self.joints.as_deref().filter(|j| *j != "universal") {
+            return Err(EvalError::input(format!(
+                "arm.joints must be \"universal\", got {joints:?}"
+            )));
+        }
+        let n = match (&self.lengths, &self.masses, &self.inertias) {
+            (Some(v), _, _) => v.len(),
+            (_, Some(v), _) => v.len(),
+            (_, _, Some(v)) => v.len(),
+            _ => self.links.unwrap_or(10),
+        };
+        if n == 0 || n > MAX_SPATIAL_LINKS {
+            return Err(EvalError::input(format!(
+                "arm.links must be from 1 to {MAX_SPATIAL_LINKS}, got {n}"
+            )));
+        }
+        if self.links.is_some_and(|links| links != n) {
+            return Err(EvalError::input(format!(
+                "arm.links is {} but the per-link lists have {n} entries",
+                self.links.unwrap_or(0)
+            )));
+        }
+        let per_link =
+            |name: &str, list: &Option<Vec<f64>>, one: Option<f64>, default: f64| match (list, one)
+            {
+                (Some(_), Some(_)) => Err(EvalError::input(format!(
+                    "give arm.{name}s or arm.link_{name}, not both"
+                ))),
+                (Some(list), None) if list.len() != n => Err(EvalError::input(format!(
+                    "arm.{name}s has {} entries, expected {n}",
+                    list.len()
+                ))),
+                (Some(list), None) => Ok(list.clone()),
+                (None, one) => Ok(vec![one.unwrap_or(default); n]),
+            };
+        let lengths = per_link("length", &self.lengths, self.link_length, 0.1)?;
+        let masses = per_link("masse", &self.masses, self.link_mass, 0.1)?;
+        let work = (2 * n)
+            .saturating_mul(4 * harmonics)
+            .saturating_mul(4 * harmonics);
+        if work > MAX_SPATIAL_WORK {
+            return Err(EvalError::input(format!(
+                "arm.links x (4 harmonics)^2 must be at most {}, got {n} links and {harmonics} \
+                 harmonics",
+                MAX_SPATIAL_WORK / 2
+            )));
+        }
+        let map = SpatialModalMap::new(&lengths, harmonics)?;
+        let links = match &self.inertias {
+            Some(inertias) if inertias.len() != n => {
+                return Err(EvalError::input(format!(
+                    "arm.inertias has {} entries, expected {n}",
+                    inertias.len()
+                )));
+            }
+            Some(inertias) => masses
+                .iter()
+                .zip(inertias)
+                .map(|(&mass, &principal)| SpatialLinkInertia { mass, principal })
+                .collect(),
+            None => masses
+                .iter()
+                .zip(&lengths)
+                .map(|(&mass, &length)| SpatialLinkInertia::rod(mass, length))
+                .collect(),
+        };
+        let base = BasePose {
+            xyz: self.base.xyz,
+            rpy: self.base.rpy,
+        };
+        let gravity = self.gravity.unwrap_or([0.0, 0.0, -9.81]);
+        Ok(SpatialReducedModel::new(map, base, links, gravity)?)
+    }
+}
+
+/// `"harmonics"` of a spatial request: `1` to [`MAX_SPATIAL_HARMONICS`], default 1.
+fn harmonics(requested: Option<usize>) -> Result<usize, EvalError> {
+    super::harmonics(requested, MAX_SPATIAL_HARMONICS)
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StateRequest {
+    arm: SpatialArmSpec,
+    a: Vec<f64>,
+    harmonics: Option<usize>,
+}
+
+/// `joints`: `theta` (`2n`, `[z_1, y_1, ...]`) and the constant `2n x 4K` modal Jacobian.
+fn joints(request: StateRequest) -> EvalResult {
+    let model = request.arm.model(harmonics(request.harmonics)?)?;
+    let map = model.map();
+    let mut theta = vec![0.0; map.n_joints()];
+    map.joint_angles(&request.a, &mut theta)?;
+    finite("theta", &theta)?;
+    let jacobian: Vec<&[f64]> = (0..map.n_joints()).map(|i| map.row(i)).collect();
+    Ok(json_fields([
+        ("theta", json!(theta)),
+        ("jacobian", json!(jacobian)),
+    ]))
+}
+
+/// `fk`: the tip of the backbone curve (`tip`, integrated to `1e-12` of the arm's length) and of
+/// the universal-joint chain (`tip_chain`), both `[x, y, z]`.
+fn fk(request: StateRequest) -> EvalResult {
+    let model = request.arm.model(harmonics(request.harmonics)?)?;
+    let map = model.map();
+    let mut theta = vec![0.0; map.n_joints()];
+    map.joint_angles(&request.a, &mut theta)?;
+    let tip_chain = spatial_tip_position(map.link_lengths(), model.base(), &theta)?;
+    let length: f64 = map.link_lengths().iter().sum();
+    let curve = SpatialCurve::new(length, map.harmonics(), &request.a, *model.base())?;
+    let tip = curve.tip(SPATIAL_CURVE_TOLERANCE * length)?.position;
+    finite("tip", &[tip, tip_chain].concat())?;
+    Ok(json_fields([
+        ("tip", json!(tip)),
+        ("tip_chain", json!(tip_chain)),
+    ]))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct IkRequest {
+    arm: SpatialArmSpec,
+    target: [f64; 3],
+    harmonics: Option<usize>,
+    guess: Option<Vec<f64>>,
+}
+
+/// `ik`: modal coordinates `a` (`4K`) whose chain's tip is on the target, by damped least squares
+/// from `"guess"` (default: a quarter bend in each plane, away from the straight arm's
+/// singularity).
+fn ik(request: IkRequest) -> EvalResult {
+    let model = request.arm.model(harmonics(request.harmonics)?)?;
+    let m = model.n_coords();
+    let mut a = match request.guess {
+        Some(guess) => guess,
+        None => (0..m)
+            .map(|j| if j % 2 == 0 { 0.25 } else { 0.0 })
+            .collect(),
+    };
+    if let Some(bad) = a.iter().find(|v| v.abs() > super::MAX_GUESS) {
+        return Err(EvalError::input(format!(
+            "guess entries must be at most {} in magnitude, got {bad}",
+            super::MAX_GUESS
+        )));
+    }
+    let mut solver = SpatialIk::new(model.map().clone(), *model.base())?;
+    let report = solver.solve(request.target, &mut a)?;
+    finite("a", &a)?;
+    Ok(json_fields([
+        ("a", json!(a)),
+        ("iterations", json!(report.iterations)),
+        ("residual", json!(report.residual)),
+    ]))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ReducedRequest {
+    arm: SpatialArmSpec,
+    a: Vec<f64>,
+    a_dot: Vec<f64>,
+    tau_star: Vec<f64>,
+    harmonics: Option<usize>,
+}
+
+/// `reduced`: `M*`, `C*`, `G*`, the modal accelerations under `tau*` and the `2n` joint torques
+/// that realise them.
+fn reduced(request: ReducedRequest) -> EvalResult {
+    let model = request.arm.model(harmonics(request.harmonics)?)?;
+    let (n, m) = (model.n_links(), model.n_coords());
+    let mut data = SpatialReducedData::new(&model);
+    let (mut a_ddot, mut torques) = (vec![0.0; m], vec![0.0; 2 * n]);
+    spatial_forward_dynamics(
+        &model,
+        &mut data,
+        &request.a,
+        &request.a_dot,
+        &request.tau_star,
+        &mut a_ddot,
+    )?;
+    let mass: Vec<&[f64]> = data.mass_matrix().chunks_exact(m).collect();
+    let mass = json!(mass);
+    let (coriolis, gravity) = (data.coriolis().to_vec(), data.gravity().to_vec());
+    spatial_joint_torques(
+        &model,
+        &mut data,
+        &request.a,
+        &request.a_dot,
+        &a_ddot,
+        &mut torques,
+    )?;
+    for (name, values) in [("a_ddot", &a_ddot), ("joint_torques", &torques)] {
+        finite(name, values)?;
+    }
+    Ok(json_fields([
+        ("mass_matrix", mass),
+        ("coriolis", json!(coriolis)),
+        ("gravity", json!(gravity)),
+        ("a_ddot", json!(a_ddot)),
+        ("joint_torques", json!(torques)),
+    ]))
+}
+
+#[cfg(test)]
+mod tests {
+    use serde_json::{Value, json};
+
+    fn request(line: Value) -> Value {
+        super::super::answer(line.to_string().as_bytes())
+    }
+
+    fn vector(value: &Value) -> Vec<f64> {
+        value
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    }
+
+    #[test]
+    fn ik_fk_and_reduced_agree_through_the_protocol() {
+        let arm = json!({"kind": "spatial", "joints": "universal", "links": 10,
+                         "link_length": 0.1, "link_mass": 0.1,
+                         "base": {"xyz": [0.0, 0.0, 0.5], "rpy": [0.0, 0.2, 0.0]}});
+        let target = [0.5, 0.3, 0.2];
+        let solved = request(json!({"op": "ik", "arm": arm, "target": target}));
+        assert_eq!(solved["ok"], true, "{solved}");
+        let a = vector(&solved["a"]);
+        let fk = request(json!({"op": "fk", "arm": arm, "a": a}));
+        let tip_chain = vector(&fk["tip_chain"]);
+        assert!(
+            (0..3).all(|d| (tip_chain[d] - target[d]).abs() < 1e-13),
+            "{fk}"
+        );
+        // The joint torques that realise the modal motion project back onto tau*.
+        let tau_star = [0.3, -0.2, 0.1, 0.05];
+        let reduced = request(json!({"op": "reduced", "arm": arm, "a": a,
+                                     "a_dot": [0.5, -1.0, 0.2, 0.7], "tau_star": tau_star}));
+        let joints = request(json!({"op": "joints", "arm": arm, "a": a}));
+        let torques = vector(&reduced["joint_torques"]);
+        let jacobian: Vec<Vec<f64>> = joints["jacobian"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(vector)
+            .collect();
+        assert_eq!(
+            (torques.len(), jacobian.len(), jacobian[0].len()),
+            (20, 20, 4)
+        );
+        for (c, &tau) in tau_star.iter().enumerate() {
+            let projected: f64 = (0..20).map(|j| jacobian[j][c] * torques[j]).sum();
+            assert!((projected - tau).abs() < 1e-12, "{projected} vs {tau}");
+        }
+    }
+
+    #[test]
+    fn in_the_plane_a_spatial_arm_answers_as_the_planar_one() {
+        let spatial = json!({"kind": "spatial", "gravity": [0.0, -9.81, 0.0]});
+        let (a, a_dot) = ([0.8, -0.3], [0.4, 0.9]);
+        let planar = request(
+            json!({"op": "reduced", "a": a, "alpha0": 0.0, "a_dot": a_dot,
+                                    "tau_star": [0.0, 0.0]}),
+        );
+        let answer = request(
+            json!({"op": "reduced", "arm": spatial, "a": [a[0], a[1], 0.0, 0.0],
+                                    "a_dot": [a_dot[0], a_dot[1], 0.0, 0.0],
+                                    "tau_star": [0.0, 0.0, 0.0, 0.0]}),
+        );
+        for r in 0..2 {
+            let (p, s) = (
+                vector(&planar["mass_matrix"][r]),
+                vector(&answer["mass_matrix"][r]),
+            );
+            assert!((0..2).all(|c| (p[c] - s[c]).abs() < 1e-12), "{p:?} {s:?}");
+        }
+        for key in ["coriolis", "gravity"] {
+            let (p, s) = (vector(&planar[key]), vector(&answer[key]));
+            assert!(
+                (0..2).all(|c| (p[c] - s[c]).abs() < 1e-12),
+                "{key}: {p:?} {s:?}"
+            );
+        }
+        let joints = request(json!({"op": "joints", "a": a, "alpha0": 0.0}));
+        let spatial_joints =
+            request(json!({"op": "joints", "arm": spatial, "a": [a[0], a[1], 0.0, 0.0]}));
+        let (p, s) = (vector(&joints["theta"]), vector(&spatial_joints["theta"]));
+        assert!((0..10).all(|i| p[i] == s[2 * i] && s[2 * i + 1] == 0.0));
+    }
+
+    #[test]
+    fn spatial_requests_are_bounded_and_checked() {
+        let cases = [
+            (
+                json!({"op": "dynamics", "arm": {"kind": "spatial"}, "theta": [], "theta_dot": []}),
+                "does not take a spatial arm",
+            ),
+            (
+                json!({"op": "joints", "arm": {"kind": "spatial", "joints": "alternating"}, "a": [0, 0, 0, 0]}),
+                "arm.joints must be \"universal\"",
+            ),
+            (
+                json!({"op": "joints", "arm": {"kind": "spatial", "links": 100_000}, "a": [], "harmonics": 16}),
+                "must be at most",
+            ),
+            (
+                json!({"op": "joints", "arm": {"kind": "spatial", "links": 0}, "a": [0, 0, 0, 0]}),
+                "arm.links must be from 1",
+            ),
+            (
+                json!({"op": "joints", "arm": {"kind": "spatial", "lengths": [0.1, 0.2], "masses": [0.1]},
+                    "a": [0, 0, 0, 0]}),
+                "arm.masses has 1 entries, expected 2",
+            ),
+            (
+                json!({"op": "joints", "arm": {"kind": "spatial", "inertias": [[1.0, 0.1, 0.1]]}, "a": [0, 0, 0, 0]}),
+                "triangle",
+            ),
+            (
+                json!({"op": "fk", "arm": {"kind": "spatial"}, "a": [0, 0, 0]}),
+                "expected 4",
+            ),
+            (
+                json!({"op": "ik", "arm": {"kind": "spatial"}, "target": [5.0, 0.0, 0.0]}),
+                "out of reach",
+            ),
+            (
+                json!({"op": "joints", "arm": {"kind": "spatial", "colour": 1}, "a": [0, 0, 0, 0]}),
+                "unknown field",
+            ),
+        ];
+        for (line, expected) in cases {
+            let answer = request(line.clone());
+            assert_eq!(answer["ok"], false, "{line}");
+            let message = answer["error"]["message"].as_str().unwrap();
+            assert!(message.contains(expected), "{line}: {message}");
+        }
+    }
+}

@@ -1,0 +1,87 @@
+//! The workspace of a [`SpatialReducedModel`]'s algorithms (the "Data"): created once, reused by
+//! every call, so that no call allocates.
+
+use super::model::SpatialReducedModel;
+use super::motion::LinkMotion;
+use crate::error::{ReduceError, check_len};
+
+/// Buffers for [`spatial_reduced_terms`](super::spatial_reduced_terms),
+/// [`spatial_forward_dynamics`](super::spatial_forward_dynamics) and
+/// [`spatial_joint_torques`](super::spatial_joint_torques), sized for one model: `O(n + m^2)`.
+#[derive(Debug, Clone)]
+pub struct SpatialReducedData {
+    pub(crate) n_links: usize,
+    pub(crate) n_coords: usize,
+    /// Joint angles, rates and accelerations (`2n` each).
+    pub(crate) theta: Vec<f64>,
+    pub(crate) theta_dot: Vec<f64>,
+    pub(crate) theta_ddot: Vec<f64>,
+    /// The angular-velocity Jacobian `Jw` and the velocity Jacobian of the world origin moving
+    /// with the link, `Jo` (`3 x m` each, row-major), accumulated joint by joint; the
+    /// centre of mass's velocity Jacobian `Jv` and `I Jw` of one link.
+    pub(crate) omega_jacobian: Vec<f64>,
+    pub(crate) origin_jacobian: Vec<f64>,
+    pub(crate) com_jacobian: Vec<f64>,
+    pub(crate) inertia_times_omega_jacobian: Vec<f64>,
+    pub(crate) mass_matrix: Vec<f64>,
+    pub(crate) coriolis: Vec<f64>,
+    pub(crate) gravity: Vec<f64>,
+    /// `L D L^T` of `M*` and the right-hand side of a solve.
+    pub(crate) factor: Vec<f64>,
+    /// Every link's motion, for the backward pass of the joint torques.
+    pub(crate) links: Vec<LinkMotion>,
+}
+
+impl SpatialReducedData {
+    /// A workspace for `model`.
+    pub fn new(model: &SpatialReducedModel) -> Self {
+        let (n, m) = (model.n_links(), model.n_coords());
+        let zero_motion = LinkMotion {
+            u_z: [0.0; 3],
+            u_y: [0.0; 3],
+            joint: [0.0; 3],
+            rotation: [[0.0; 3]; 3],
+            omega: [0.0; 3],
+            omega_dot: [0.0; 3],
+            com: [0.0; 3],
+            com_accel: [0.0; 3],
+        };
+        Self {
+            n_links: n,
+            n_coords: m,
+            theta: vec![0.0; 2 * n],
+            theta_dot: vec![0.0; 2 * n],
+            theta_ddot: vec![0.0; 2 * n],
+            omega_jacobian: vec![0.0; 3 * m],
+            origin_jacobian: vec![0.0; 3 * m],
+            com_jacobian: vec![0.0; 3 * m],
+            inertia_times_omega_jacobian: vec![0.0; 3 * m],
+            mass_matrix: vec![0.0; m * m],
+            coriolis: vec![0.0; m],
+            gravity: vec![0.0; m],
+            factor: vec![0.0; m * m],
+            links: vec![zero_motion; n],
+        }
+    }
+
+    /// The reduced mass matrix `M* = J^T M J` (`m x m`, row-major) of the last computation.
+    pub fn mass_matrix(&self) -> &[f64] {
+        &self.mass_matrix
+    }
+
+    /// The reduced Coriolis and centrifugal vector `C* = J^T C` (`m`) of the last computation.
+    pub fn coriolis(&self) -> &[f64] {
+        &self.coriolis
+    }
+
+    /// The reduced gravity vector `G* = J^T G` (`m`) of the last computation.
+    pub fn gravity(&self) -> &[f64] {
+        &self.gravity
+    }
+
+    /// Checks that this workspace was made for `model`.
+    pub(crate) fn check_model(&self, model: &SpatialReducedModel) -> Result<(), ReduceError> {
+        check_len("workspace links", self.n_links, model.n_links())?;
+        check_len("workspace coordinates", self.n_coords, model.n_coords())
+    }
+}

@@ -1,0 +1,25 @@
+//! Reduced dynamics of spatial modal arms: the universal-joint chain of
+//! [`SpatialModalMap`](backbone_kin::SpatialModalMap) projected onto its `m = 4K` modal
+//! coordinates, `M* a_dd + C* + G* = tau*` with `M* = J^T M J`, `C* = J^T C`, `G* = J^T G`
+//! (eqs 13-14 for the spatial chain; `docs/theory.md`, section 8).
+//!
+//! - [`model`]: [`SpatialReducedModel`], the arm (links, base pose, gravity) and its map;
+//!   [`data`]: [`SpatialReducedData`], the workspace.
+//! - [`motion`]: one link's step of the forward recursion (frames, joint axes, angular velocity
+//!   and acceleration, the acceleration of its centre of mass), which both algorithms share.
+//! - [`terms`]: `M*`, `C*`, `G*` in `O(n m^2)` without the `2n x 2n` mass matrix.
+//! - [`torques`]: the joint torques that realise a modal motion (Newton-Euler, `O(n)`).
+//! - [`forward`]: reduced forward dynamics.
+
+pub mod data;
+pub mod forward;
+pub mod model;
+pub mod motion;
+pub mod terms;
+pub mod torques;
+
+pub use data::SpatialReducedData;
+pub use forward::spatial_forward_dynamics;
+pub use model::{SpatialLinkInertia, SpatialReducedModel};
+pub use terms::spatial_reduced_terms;
+pub use torques::spatial_joint_torques;

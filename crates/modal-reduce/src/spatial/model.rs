@@ -1,0 +1,161 @@
+//! The spatial modal arm: its links, base pose, gravity and modal map (the "Model").
+
+use backbone_kin::{BasePose, SpatialModalMap};
+use manip_dyn::DynError;
+
+use crate::error::ReduceError;
+use crate::model::check_column_rank;
+
+/// A link's mass and principal moments of inertia about its centre of mass, in the link frame
+/// (`x` along the link), the centre of mass at the link's midpoint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpatialLinkInertia {
+    /// Mass (kg), positive and finite.
+    pub mass: f64,
+    /// `[Ixx, Iyy, Izz]` (kg m^2): non-negative, finite, and each at most the sum of the other two
+    /// (the triangle inequalities of a rigid body's principal moments).
+    pub principal: [f64; 3],
+}
+
+impl SpatialLinkInertia {
+    /// A slender uniform rod of length `length` along `x`: `Ixx = 0`, `Iyy = Izz = m L^2 / 12`
+    /// (the paper's planar links seen in 3-D).
+    pub fn rod(mass: f64, length: f64) -> Self {
+        let bending = mass * length * length / 12.0;
+        Self {
+            mass,
+            principal: [0.0, bending, bending],
+        }
+    }
+
+    fn validate(&self, index: usize) -> Result<(), ReduceError> {
+        let invalid = |quantity, requirement, value| {
+            ReduceError::Dyn(DynError::InvalidLink {
+                index,
+                quantity,
+                requirement,
+                value,
+            })
+        };
+        if !(self.mass.is_finite() && self.mass > 0.0) {
+            return Err(invalid("mass", "positive and finite", self.mass));
+        }
+        let [a, b, c] = self.principal;
+        for value in [a, b, c] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(invalid(
+                    "principal inertia",
+                    "non-negative and finite",
+                    value,
+                ));
+            }
+        }
+        for (value, others) in [(a, b + c), (b, a + c), (c, a + b)] {
+            if value > others * (1.0 + 4.0 * f64::EPSILON) {
+                return Err(invalid(
+                    "principal inertia",
+                    "at most the sum of the other two (triangle inequality)",
+                    value,
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A spatial modal arm (module docs of [`spatial`](crate::spatial)): immutable once built.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpatialReducedModel {
+    map: SpatialModalMap,
+    base: BasePose,
+    links: Vec<SpatialLinkInertia>,
+    gravity: [f64; 3],
+}
+
+impl SpatialReducedModel {
+    /// The arm of `map`'s links with these inertias (one per link), leaving `base`, under
+    /// `gravity` (m/s^2, world frame).
+    ///
+    /// Errors: a number of inertias other than the map's links, a map of dependent columns
+    /// ([`ReduceError::RankDeficient`]: fewer than `2K` links), an invalid inertia (naming the link),
+    /// a non-finite base pose or gravity.
+    pub fn new(
+        map: SpatialModalMap,
+        base: BasePose,
+        links: Vec<SpatialLinkInertia>,
+        gravity: [f64; 3],
+    ) -> Result<Self, ReduceError> {
+        if links.len() != map.n_links() {
+            return Err(ReduceError::Dimension {
+                name: "link inertias",
+                expected: map.n_links(),
+                found: links.len(),
+            });
+        }
+        for (index, link) in links.iter().enumerate() {
+            link.validate(index)?;
+        }
+        // J is two copies of the planar map, one per plane: full column rank with it.
+        check_column_rank(map.planar())?;
+        base.validate()?;
+        for (index, &value) in gravity.iter().enumerate() {
+            if !value.is_finite() {
+                return Err(ReduceError::NonFinite {
+                    name: "gravity",
+                    index,
+                    value,
+                });
+            }
+        }
+        Ok(Self {
+            map,
+            base,
+            links,
+            gravity,
+        })
+    }
+
+    /// `n` equal rods of `length` and `mass` ([`SpatialLinkInertia::rod`]) with `harmonics`
+    /// harmonics per plane, from the identity base pose, under `gravity`.
+    pub fn uniform_rods(
+        n: usize,
+        harmonics: usize,
+        length: f64,
+        mass: f64,
+        gravity: [f64; 3],
+    ) -> Result<Self, ReduceError> {
+        let map = SpatialModalMap::new(&vec![length; n.min(backbone_kin::MAX_LINKS)], harmonics)?;
+        let links = vec![SpatialLinkInertia::rod(mass, length); map.n_links()];
+        Self::new(map, BasePose::default(), links, gravity)
+    }
+
+    /// The modal map `theta = J a`.
+    pub fn map(&self) -> &SpatialModalMap {
+        &self.map
+    }
+
+    /// The base pose.
+    pub fn base(&self) -> &BasePose {
+        &self.base
+    }
+
+    /// The links' inertias, base first.
+    pub fn links(&self) -> &[SpatialLinkInertia] {
+        &self.links
+    }
+
+    /// Gravity in the world frame (m/s^2).
+    pub fn gravity(&self) -> [f64; 3] {
+        self.gravity
+    }
+
+    /// Number of links `n` (`2n` joints).
+    pub fn n_links(&self) -> usize {
+        self.links.len()
+    }
+
+    /// Number of modal coordinates `m = 4K`.
+    pub fn n_coords(&self) -> usize {
+        self.map.n_coords()
+    }
+}
