@@ -14,6 +14,7 @@ mod plot;
 mod progress;
 mod report;
 mod sweep;
+mod view_cmd;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -34,6 +35,10 @@ enum Command {
         /// Output folder.
         #[arg(long, default_value = "hrm-output")]
         out: PathBuf,
+        /// Run each scenario for at most this many seconds: a quick look at the report (the
+        /// paper's numbers need the full durations).
+        #[arg(long)]
+        duration: Option<f64>,
     },
     /// Run one scenario (a shipped name such as `paper-tracking`, or a TOML file).
     Simulate {
@@ -56,12 +61,15 @@ enum Command {
     Fis(fis_cmd::FisArgs),
     /// Monte Carlo over noise levels and seeds: mean and spread of the errors per controller (docs/sweep.md).
     Sweep(sweep::SweepCli),
+    /// The interactive page of a run (an `hrm simulate` or `hrm run` output folder), and with
+    /// --gif an animated GIF of it.
+    View(view_cmd::ViewArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Some(Command::Run { out }) => experiment::main_job(&out),
+        Some(Command::Run { out, duration }) => experiment::main_job(&out, duration),
         Some(Command::Simulate {
             scenario,
             controller,
@@ -70,7 +78,8 @@ fn main() -> ExitCode {
         Some(Command::Eval) => eval::run_stdio(),
         Some(Command::Fis(args)) => fis_cmd::run(args),
         Some(Command::Sweep(args)) => sweep::run(args),
-        None => experiment::main_job(std::path::Path::new("hrm-output")),
+        Some(Command::View(args)) => view_cmd::run(args),
+        None => experiment::main_job(std::path::Path::new("hrm-output"), None),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -175,11 +175,11 @@ pub fn write_file_with(
 /// first, and only when every one is written are they renamed over their paths. A failure
 /// before the renames leaves every existing file as it was. Folders are created as by
 /// [`write_file_with`].
-pub fn write_files(files: &[(PathBuf, String)], command: &str) -> Result<(), String> {
+pub fn write_files(files: &[(PathBuf, impl AsRef<[u8]>)], command: &str) -> Result<(), String> {
     let mut staged = Vec::with_capacity(files.len());
-    for (path, text) in files {
+    for (path, contents) in files {
         match stage_file(path, command, |out| {
-            out.write_all(text.as_bytes()).map_err(|e| e.to_string())
+            out.write_all(contents.as_ref()).map_err(|e| e.to_string())
         }) {
             Ok(temporary) => staged.push(temporary),
             Err(e) => {

@@ -319,14 +319,33 @@
     ctx.restore();
   }
 
+  /**
+   * A tube of `width` pixels through world points `pts` in the current stroke colour: a round
+   * line, or a disc when it is seen end-on (a zero-length line draws nothing).
+   */
+  function tube(ctx, camera, b, pts, width) {
+    const s = pts.map((p) => project(camera, p, b));
+    const long = s.some((q) => Math.hypot(q[0] - s[0][0], q[1] - s[0][1]) > 0.5);
+    ctx.lineWidth = Math.max(1, width);
+    ctx.lineCap = "round";
+    ctx.lineJoin = "round";
+    if (long) {
+      polyline(ctx, camera, b, pts);
+    } else {
+      ctx.save();
+      ctx.fillStyle = ctx.strokeStyle;
+      ctx.beginPath();
+      ctx.arc(s[0][0], s[0][1], Math.max(0.5, width / 2), 0, 2 * Math.PI);
+      ctx.fill();
+      ctx.restore();
+    }
+  }
+
   function drawObstacles(ctx, camera, b, run) {
     ctx.save();
     for (const c of run.channels || []) {
       ctx.strokeStyle = "rgba(120,170,220,0.35)";
-      ctx.lineWidth = Math.max(1, c.width * camera.scale);
-      ctx.lineCap = "round";
-      ctx.lineJoin = "round";
-      polyline(ctx, camera, b, c.points.map((p) => points(p, run.dims)[0]));
+      tube(ctx, camera, b, c.points.map((p) => points(p, run.dims)[0]), c.width * camera.scale);
     }
     ctx.fillStyle = "rgba(110,110,110,0.45)";
     ctx.strokeStyle = "rgba(60,60,60,0.8)";
@@ -341,9 +360,7 @@
       } else if (o.kind === "capsule") {
         ctx.save();
         ctx.strokeStyle = "rgba(110,110,110,0.45)";
-        ctx.lineCap = "round";
-        ctx.lineWidth = 2 * o.radius * camera.scale;
-        polyline(ctx, camera, b, [points(o.a, run.dims)[0], points(o.b, run.dims)[0]]);
+        tube(ctx, camera, b, [points(o.a, run.dims)[0], points(o.b, run.dims)[0]], 2 * o.radius * camera.scale);
         ctx.restore();
       } else if (o.kind === "box") {
         const c = points(o.centre, run.dims)[0];
@@ -835,12 +852,31 @@
     });
   }
 
+  /**
+   * The run with a "joint torques" panel added to its series, made from the torques that
+   * colour its links (the page carries them once), with the run's other panels first.
+   */
+  function withTorquePanel(run) {
+    const series = (run.series || []).slice();
+    if (run.joint_torque && run.joint_torque.length && !series.some((s) => s.title === "joint torques")) {
+      const n = run.joint_torque[0].length;
+      series.push({
+        title: "joint torques",
+        unit: "N m",
+        names: Array.from({ length: n }, (_, i) => "tau_" + (i + 1)),
+        values: Array.from({ length: n }, (_, i) => run.joint_torque.map((row) => row[i])),
+      });
+    }
+    return Object.assign({}, run, { series });
+  }
+
   /** Mounts every .hrm-view of `doc`; a scene whose data cannot be read says so in place. */
   function mountAll(doc) {
     for (const root of doc.querySelectorAll(".hrm-view")) {
       const holder = root.querySelector('script[type="application/json"]');
       try {
-        mount(root, JSON.parse(holder.textContent));
+        const scene = JSON.parse(holder.textContent);
+        mount(root, Object.assign({}, scene, { runs: scene.runs.map(withTorquePanel) }));
       } catch (e) {
         root.appendChild(element(doc, "p", { class: "hrm-status", text: "cannot show this run: " + e.message }));
         throw e;
@@ -864,6 +900,7 @@
     fitCamera,
     worldPoints,
     yRange,
+    withTorquePanel,
     VIEWS,
     mount,
     mountAll,

@@ -142,3 +142,14 @@ test("the world points of a run cover its arm, obstacles and channels", () => {
   close(v.yRange([[1, 3]])[0], 0.9);
   assert.deepEqual(v.yRange([]), [-1, 1]);
 });
+
+test("the joint torques get a panel of their own, once", () => {
+  const run = { t: [0, 1], joint_torque: [[1, 2], [3, 4]], series: [{ title: "tip error", unit: "mm", names: ["e"], values: [[0, 1]] }] };
+  const shown = v.withTorquePanel(run);
+  assert.deepEqual(shown.series.map((s) => s.title), ["tip error", "joint torques"]);
+  assert.deepEqual(shown.series[1].names, ["tau_1", "tau_2"]);
+  assert.deepEqual(shown.series[1].values, [[1, 3], [2, 4]]);
+  assert.equal(run.series.length, 1, "the data is left as it was");
+  assert.equal(v.withTorquePanel(shown).series.length, 2);
+  assert.deepEqual(v.withTorquePanel({ t: [0], joint_torque: [] }).series, []);
+});

@@ -43,8 +43,8 @@ fn exponent_for(values: impl Iterator<Item = f64>, digits: i32) -> i32 {
     }
 }
 
-/// Decimal places of the arm's coordinates: 0.01 mm.
-const POSITION_EXPONENT: i32 = -5;
+/// Decimal places of the arm's coordinates: 0.1 mm.
+const POSITION_EXPONENT: i32 = -4;
 /// Significant digits of a time series (relative to its curve's peak) and of a joint torque
 /// (relative to the run's peak torque).
 const SERIES_DIGITS: i32 = 4;

@@ -8,8 +8,8 @@ use sim_core::{Record, Scenario, TorqueLimit};
 /// The run `record` of `scenario` under the controller named `label`: every sample's joint
 /// positions (`theta = J a + theta_0`, eq 8, then the chain from the base at the origin), the
 /// reference tip, the joint torques (eq 13) against the scenario's joint torque limits, and the
-/// series tip error (mm), modal coordinates with their references (rad), `tau*` (N m) and the
-/// joint torques (N m). `stopped` is why a run stopped early.
+/// series tip error (mm), modal coordinates with their references (rad) and `tau*` (N m) (the
+/// viewer adds the panel of the joint torques itself, from the torques that colour the links). `stopped` is why a run stopped early.
 pub fn from_record(
     scenario: &Scenario,
     label: &str,
@@ -64,7 +64,7 @@ pub fn from_record(
     let joint_torque: Vec<Vec<f64>> = (0..samples)
         .map(|k| record.joint_torques_at(k).to_vec())
         .collect();
-    let mut series = vec![
+    let series = vec![
         Series {
             title: "tip error".into(),
             unit: "mm".into(),
@@ -79,16 +79,6 @@ pub fn from_record(
             values: (0..m).map(|i| modal(Record::tau_star_at, i)).collect(),
         },
     ];
-    if record.joint_torques.len() == samples * n {
-        series.push(Series {
-            title: "joint torques".into(),
-            unit: "N m".into(),
-            names: (1..=n).map(|i| format!("tau_{i}")).collect(),
-            values: (0..n)
-                .map(|i| joint_torque.iter().map(|row| row[i]).collect())
-                .collect(),
-        });
-    }
     let torque_limit = match &scenario.limits.joint_torque_nm {
         Some(TorqueLimit::All(limit)) => vec![*limit; n],
         Some(TorqueLimit::PerJoint(limits)) => limits.clone(),

@@ -454,6 +454,9 @@ pub fn write_gif(run: &RunView, options: &GifOptions, out: impl Write) -> Result
     encoder
         .set_repeat(gif::Repeat::Infinite)
         .map_err(|e| format!("gif: {e}"))?;
+    encoder
+        .write_raw_extension(gif::AnyExtension(0xFE), &[crate::SIGNATURE.as_bytes()])
+        .map_err(|e| format!("gif: {e}"))?;
     let delay = (100 / options.fps) as u16;
     let mut previous: Option<Vec<u8>> = None;
     for f in 0..frames {

@@ -7,9 +7,12 @@ use crate::view::Scene;
 pub const SCRIPT: &str = include_str!("../assets/viewer.js");
 /// The viewer's style sheet.
 pub const STYLE: &str = include_str!("../assets/viewer.css");
-/// Samples a run keeps in a page by default ([`RunView::decimated`](crate::RunView::decimated)):
+/// Samples a run keeps in a page of one run ([`RunView::decimated`](crate::RunView::decimated)):
 /// about 55 a second of a 5.5 s run, smooth to play and light to embed.
 pub const PAGE_SAMPLES: usize = 300;
+/// Samples a run keeps in a page of many runs (the main job's report, 43 runs): about 36 a
+/// second of a 5.5 s run; the viewer interpolates between them.
+pub const REPORT_SAMPLES: usize = 200;
 
 /// `text` with the characters that mean something in HTML (`& < > " '`) replaced by entities,
 /// safe inside elements and quoted attributes.
@@ -52,10 +55,25 @@ pub fn scene_html(scene: &Scene, samples: usize) -> Result<String, String> {
     ))
 }
 
-/// The style sheet and script every page with scenes carries once: put [`head`] in the
-/// `<head>` and [`tail`] at the end of the `<body>`.
+/// What every page and GIF hrm writes carries (a `generator` meta element, a GIF comment), so
+/// that hrm replaces only files it wrote ([`written_by_hrm`]).
+pub const SIGNATURE: &str = "written by hrm";
+
+/// Whether a file beginning with `start` (its first [`SIGNATURE_WITHIN`] bytes or fewer) is a
+/// page or GIF hrm wrote.
+pub fn written_by_hrm(start: &[u8]) -> bool {
+    let needle = SIGNATURE.as_bytes();
+    start.windows(needle.len()).any(|w| w == needle)
+}
+
+/// How far into a page or GIF its [`SIGNATURE`] is: within the first 2 KiB.
+pub const SIGNATURE_WITHIN: usize = 2048;
+
+/// The signature, style sheet and script every page with scenes carries once: put [`head`]
+/// in the `<head>` (it opens it, right after the charset) and [`tail`] at the end of the
+/// `<body>`.
 pub fn head() -> String {
-    format!("<style>{STYLE}</style>\n")
+    format!("<meta name=\"generator\" content=\"{SIGNATURE}\">\n<style>{STYLE}</style>\n")
 }
 
 /// The viewer's script, to close the `<body>` of a page with scenes.
@@ -71,7 +89,7 @@ pub fn page(title: &str, intro: &str, scenes: &[Scene], samples: usize) -> Resul
         body.push_str(&scene_html(scene, samples)?);
     }
     Ok(format!(
-        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{0}</title>\n<style>body{{font-family:sans-serif;margin:1.5em;max-width:1500px;color:#222}}</style>\n{1}</head>\n<body>\n<h1>{0}</h1>\n<p>{2}</p>\n{body}{3}</body>\n</html>\n",
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n{1}<title>{0}</title>\n<style>body{{font-family:sans-serif;margin:1.5em;max-width:1500px;color:#222}}</style>\n</head>\n<body>\n<h1>{0}</h1>\n<p>{2}</p>\n{body}{3}</body>\n</html>\n",
         escape(title),
         head(),
         escape(intro),

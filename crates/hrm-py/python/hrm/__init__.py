@@ -27,6 +27,7 @@ from ._hrm import (
     Sweep,
     Unreachable,
     __version__,
+    view_html,
 )
 
 __all__ = [
@@ -42,4 +43,5 @@ __all__ = [
     "Unreachable",
     "__version__",
     "fuzzy",
+    "view_html",
 ]
