@@ -148,7 +148,15 @@ fn table_html(s: &mut String, table: &Table, names: usize) {
         .collect();
     s.push_str("<table>\n<tr>");
     for header in &table.headers {
-        let _ = write!(s, "<th>{}</th>", escape(header));
+        // The unit on a line of its own: `tip error RMS` over `(mm)`.
+        match header.strip_suffix(')').and_then(|h| h.rsplit_once(" (")) {
+            Some((name, unit)) => {
+                let _ = write!(s, "<th>{}<br>({})</th>", escape(name), escape(unit));
+            }
+            None => {
+                let _ = write!(s, "<th>{}</th>", escape(header));
+            }
+        }
     }
     s.push_str("</tr>\n");
     for row in &table.rows {
@@ -267,6 +275,7 @@ mod tests {
         assert_eq!(page.matches("<table>").count(), 2);
         assert_eq!(page.matches("<tr>").count(), 2 + 3 + 1);
         assert!(page.contains("<h3 id=\"s &amp; t\">s &amp; t</h3>\n<p>x &lt; y</p>"));
+        assert!(page.contains("<th>controller</th><th>tip RMS<br>(mm)</th>"));
         // The lowest tip error is marked, a tie marks both, a lone row marks nothing.
         assert!(page.contains(
             "<td>fuzzy</td><td class=\"num best\">0.9</td><td class=\"num best\">20</td>"

@@ -288,7 +288,7 @@
         ctx.moveTo(s, 0);
         ctx.lineTo(s, camera.height);
         ctx.stroke();
-        ctx.fillText(formatTick(x, gx.step), s + 2, camera.height - 4);
+        if (s > 2 && s < camera.width - 30) ctx.fillText(formatTick(x, gx.step), s + 2, camera.height - 4);
       }
       for (const y of gy.ticks) {
         const s = project(camera, [0, y, 0], b)[1];
@@ -296,7 +296,7 @@
         ctx.moveTo(0, s);
         ctx.lineTo(camera.width, s);
         ctx.stroke();
-        ctx.fillText(formatTick(y, gy.step), 3, s - 3);
+        if (s > 24 && s < camera.height - 16) ctx.fillText(formatTick(y, gy.step), 3, s - 3);
       }
       ctx.fillText("x, y (m)", camera.width - 52, 12);
     } else {
@@ -464,7 +464,7 @@
   // ---- Time series ------------------------------------------------------------------------
 
   /** Margins of a series panel (pixels): room for the tick labels outside the plotted area. */
-  const MARGIN = { left: 58, right: 10, top: 8, bottom: 22 };
+  const MARGIN = { left: 58, right: 24, top: 8, bottom: 22 };
 
   /** The y range of some curves: their extent widened by 5 %, or +-1 about a constant. */
   function yRange(curves) {
@@ -650,7 +650,7 @@
       panels.textContent = "";
       const list = shown();
       const split = list.length > 1 && state.layout === "side";
-      const total = Math.max(280, arms.clientWidth || root.clientWidth / 2 || 480);
+      const total = Math.max(280, (arms.clientWidth || root.clientWidth / 2 || 482) - 4);
       const width = split ? Math.floor((total - 8) / 2) : total;
       const height = Math.round(Math.min(460, Math.max(240, (split ? 1.1 : 0.75) * width)));
       armCanvases = (split ? list : [list]).map((which) => {
@@ -677,7 +677,7 @@
       }
       if (list.length > 1) legend.appendChild(element(doc, "span", { class: "hrm-key", text: "series: " + list[0].label + " solid, " + list[1].label + " dashed" }));
       const groups = list[0].series.length;
-      const panelWidth = Math.max(280, panels.clientWidth || 480);
+      const panelWidth = Math.max(280, (panels.clientWidth || 482) - 2);
       seriesCanvases = [];
       for (let g = 0; g < groups; g++) {
         const s = list[0].series[g];
