@@ -19,18 +19,12 @@ import numpy as np
 import pytest
 
 import hrm
+from engines import require
 
-REQUIRED = os.environ.get("HRM_REQUIRE_ENGINES") == "1"
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 REFERENCES = pathlib.Path(__file__).resolve().parent / "browser-references"
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 VIEWPORT = {"width": 1280, "height": 1000}
-
-
-def missing(what):
-    if REQUIRED:
-        pytest.fail(f"{what} (required: HRM_REQUIRE_ENGINES=1)")
-    pytest.skip(what)
 
 
 def hrm_binary():
@@ -41,7 +35,7 @@ def hrm_binary():
     for profile in ("debug", "release"):
         if (target / profile / "hrm").is_file():
             return target / profile / "hrm"
-    missing(f"no hrm binary in {target}/debug or release (cargo build -p hrm-cli)")
+    require(False, f"the hrm binary (cargo build -p hrm-cli) in {target}/debug or release")
 
 
 @pytest.fixture(scope="module")
@@ -49,9 +43,8 @@ def browser():
     try:
         from playwright.sync_api import sync_playwright
     except ImportError:
-        missing("playwright is not installed (pip install playwright)")
-    if not os.path.exists(CHROMIUM):
-        missing("chromium is not installed (apt-get install chromium)")
+        require(False, "Playwright (pip install playwright)")
+    require(os.path.exists(CHROMIUM), "Chromium (apt-get install chromium)")
     with sync_playwright() as p:
         # No sandbox: CI runs as root, where Chromium's sandbox refuses to start.
         b = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])

@@ -412,27 +412,23 @@ fn torque_colours_match_the_viewer() {
 /// `HRM_REQUIRE_ENGINES=1` (CI), where a missing node fails.
 #[test]
 fn viewer_script_tests_pass_under_node() {
+    let Some(node) = test_support::engine::program("node", "nodejs") else {
+        return;
+    };
     let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
-    let output = std::process::Command::new("node")
+    let out = std::process::Command::new(node)
         .arg("--test")
         .arg(assets.join("viewer.test.js"))
-        .output();
-    match output {
-        Err(e) if std::env::var("HRM_REQUIRE_ENGINES").as_deref() == Ok("1") => {
-            panic!("node is required (HRM_REQUIRE_ENGINES=1) but cannot run: {e}")
-        }
-        Err(e) => eprintln!("skipped: node cannot run ({e})"),
-        Ok(out) => {
-            let text = String::from_utf8_lossy(&out.stdout);
-            assert!(
-                out.status.success(),
-                "{text}\n{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-            assert!(
-                text.contains("# fail 0") && !text.contains("# pass 0"),
-                "{text}"
-            );
-        }
-    }
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("# fail 0") && !text.contains("# pass 0"),
+        "{text}"
+    );
 }
