@@ -695,7 +695,7 @@ mod tests {
         assert!(err.contains("did not create"), "{err}");
         // A folder `fis export` created may be written again.
         let ours = root.join("ours/hrm_fis.c");
-        write_files(&[(ours.clone(), "v1".into())], "fis export").unwrap();
+        write_files(&[(ours.clone(), String::from("v1"))], "fis export").unwrap();
         refuse_foreign_files(std::slice::from_ref(&ours), "fis export").unwrap();
         refuse_foreign_files(&[root.join("mine/new.c")], "fis export").unwrap();
         // The same file by another path is an input.
