@@ -6,7 +6,7 @@ use crate::console;
 use crate::output_dir::OutputDir;
 use clap::{Args, Subcommand, ValueEnum};
 use robot_desc::{Robot, read_urdf, write_mjcf_files, write_urdf};
-use sim_core::{ArmSpec, Scenario};
+use sim_study::{ArmSpec, Scenario};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -67,7 +67,7 @@ pub fn run(args: ArmArgs) -> Result<(), String> {
 
 /// The text of a URDF file, read up to [`robot_desc::MAX_URDF_BYTES`].
 fn read_urdf_file(path: &Path) -> Result<String, String> {
-    sim_core::read_text_file(path, robot_desc::MAX_URDF_BYTES as u64)
+    sim_study::read_text_file(path, robot_desc::MAX_URDF_BYTES as u64)
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 

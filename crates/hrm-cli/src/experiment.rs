@@ -24,7 +24,7 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
     scenario.build().map_err(|e| e.to_string())?;
     let staging = OutputDir::create(out, "simulate")?;
     let outcome = run_one(&scenario, scenario.controller.kind);
-    write_outcome(&outcome, staging.path())?;
+    write_outcome(&outcome, &scenario, staging.path())?;
     staging.commit()?;
     console::print(&table(&table_rows(
         std::slice::from_ref(&outcome),
@@ -34,9 +34,20 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
     outcome.result.map(|_| ()).map_err(|stopped| stopped.error)
 }
 
-/// The main job: every shipped scenario with every controller (see [`experiments`]).
-pub fn main_job(out: &Path) -> Result<(), String> {
-    let scenarios = study::builtin_scenarios().map_err(|e| e.to_string())?;
+/// The main job: every shipped scenario with every controller (see [`experiments`]), each cut
+/// at `duration` seconds when given (finite, positive).
+pub fn main_job(out: &Path, duration: Option<f64>) -> Result<(), String> {
+    let mut scenarios = study::builtin_scenarios().map_err(|e| e.to_string())?;
+    if let Some(cut) = duration {
+        if !(cut.is_finite() && cut > 0.0) {
+            return Err(format!(
+                "--duration: {cut}, expected a finite positive number of seconds"
+            ));
+        }
+        for scenario in &mut scenarios {
+            scenario.duration = scenario.duration.min(cut);
+        }
+    }
     experiments(out, &scenarios)
 }
 
@@ -53,7 +64,12 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
     let bar = progress::bar(runs as u64, "runs");
     let outcomes = study::compare(scenarios, |outcome| {
         let kind = outcome.controller;
-        write_outcome(outcome, &dir.join(&outcome.scenario).join(kind.name()))?;
+        let scenario = scenario_of(scenarios, outcome)?;
+        write_outcome(
+            outcome,
+            scenario,
+            &dir.join(&outcome.scenario).join(kind.name()),
+        )?;
         bar.set_message(format!("{} with {kind}", outcome.scenario));
         bar.inc(1);
         Ok(())
@@ -76,12 +92,9 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
     let text = table(&rows);
     write(&dir.join("comparison.txt"), &text)?;
     let sections = figures(dir, scenarios, &outcomes)?;
-    let html_table = report::Table {
-        headers: HEADERS.map(String::from).to_vec(),
-        rows,
-    };
+    let groups = groups(scenarios, &outcomes, &learned, &rows)?;
     let intro = format!(
-        "Every scenario ({}) run with every controller ({}): the comparison table, then figures in the spirit of the paper's section 5. The {LEARNED} row of {LEARNED_ON} is a fuzzy controller learned by imitation of computed torque on the step and sine responses about a grid of operating points, never on the path ({LEARNED}.fis next to this page). Per-run time series and metrics are in <scenario>/<controller>/timeseries.csv and summary.json next to this page.",
+        "Every scenario ({}) run with every controller ({}): a table and an animation per scenario, then figures in the spirit of the paper's section 5. The {LEARNED} row of {LEARNED_ON} is a fuzzy controller learned by imitation of computed torque on the step and sine responses about a grid of operating points, never on the path ({LEARNED}.fis next to this page). Per-run time series and metrics are in <scenario>/<controller>/timeseries.csv and summary.json next to this page.",
         scenarios
             .iter()
             .map(|s| s.name.as_str())
@@ -93,8 +106,9 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
         &dir.join("report.html"),
         "hrm: the paper's experiments",
         &intro,
-        &html_table,
+        &groups,
         &sections,
+        run_view::REPORT_SAMPLES,
     )?;
     staging.commit()?;
     console::print(&text)?;
@@ -131,10 +145,89 @@ fn learned_runs(out: &Path, scenarios: &[Scenario]) -> Result<Vec<Outcome>, Stri
         let mut scenario = target.clone();
         scenario.controller.fis = Some(file.clone());
         let outcome = run_one(&scenario, ControllerKind::Fuzzy);
-        write_outcome(&outcome, &out.join(&scenario.name).join(LEARNED))?;
+        // The run's scenario.toml names the learned system relative to itself.
+        let mut written = scenario.clone();
+        written.controller.fis = Some(Path::new("../..").join(format!("{LEARNED}.fis")));
+        write_outcome(&outcome, &written, &out.join(&scenario.name).join(LEARNED))?;
         runs.push(outcome);
     }
     Ok(runs)
+}
+
+/// The scenario `outcome` ran.
+fn scenario_of<'a>(scenarios: &'a [Scenario], outcome: &Outcome) -> Result<&'a Scenario, String> {
+    scenarios
+        .iter()
+        .find(|s| s.name == outcome.scenario)
+        .ok_or_else(|| format!("no scenario named {}", outcome.scenario))
+}
+
+/// The run `outcome` of `scenario` as the viewer draws it (up to the stop for a run that
+/// stopped), named `label`; `None` for a run that recorded nothing.
+pub fn run_view_of(
+    scenario: &Scenario,
+    label: &str,
+    outcome: &Outcome,
+) -> Result<Option<run_view::RunView>, String> {
+    let (run, stopped) = match &outcome.result {
+        Ok(run) => (Some(run), None),
+        Err(stopped) => (stopped.partial.as_ref(), Some(stopped.error.as_str())),
+    };
+    match run {
+        Some(run) if !run.record.is_empty() => {
+            run_view::from_record(scenario, label, &run.record, stopped).map(Some)
+        }
+        _ => Ok(None),
+    }
+}
+
+/// The report's groups: per scenario, its rows of the comparison (without the scenario
+/// column) and the animation of its runs, the learned controller's included.
+fn groups(
+    scenarios: &[Scenario],
+    outcomes: &[Outcome],
+    learned: &[Outcome],
+    rows: &[report::Row],
+) -> Result<Vec<report::Group>, String> {
+    scenarios
+        .iter()
+        .map(|scenario| {
+            let mut runs = Vec::new();
+            for outcome in outcomes.iter().chain(learned) {
+                if outcome.scenario != scenario.name {
+                    continue;
+                }
+                let label = if learned.iter().any(|l| std::ptr::eq(l, outcome)) {
+                    LEARNED
+                } else {
+                    outcome.controller.name()
+                };
+                runs.extend(run_view_of(scenario, label, outcome)?);
+            }
+            let rows = rows
+                .iter()
+                .filter(|r| r.cells[0] == scenario.name)
+                .map(|r| report::Row {
+                    cells: r.cells[1..].to_vec(),
+                    error: r.error.clone(),
+                })
+                .collect();
+            Ok(report::Group {
+                title: scenario.name.clone(),
+                text: scenario.description.clone(),
+                table: report::Table {
+                    headers: HEADERS[1..].iter().map(|h| h.to_string()).collect(),
+                    rows,
+                },
+                names: 1,
+                scene: (!runs.is_empty()).then(|| run_view::Scene {
+                    title: format!("{}: every controller, animated", scenario.name),
+                    caption: "The arm link by link (links coloured by joint torque), the reference (red) and the tip's trace (green), in sync with the time series; pick a second controller to compare side by side or overlaid.".into(),
+                    runs,
+                }),
+            })
+        })
+        .collect()
 }
 
 /// Interval between the drawn arm configurations of Figure 10 (s).
@@ -176,7 +269,7 @@ fn figures(
             figures::modal_responses(&dir.join(&file), name, &names, &runs)?;
             responses.push(figure(
                 file,
-                format!("{name}: {}(t) of every controller against the reference (paper Figure 9). Scenario: {}", names.join("(t), "), scenario.description),
+                format!("{name}: {}(t) of every controller against the reference; look at overshoot and settling (paper Figure 9).", names.join("(t), ")),
             ));
             continue;
         }
@@ -191,14 +284,14 @@ fn figures(
             )?;
             backbones.push(figure(
                 file,
-                format!("{name} with {kind}: the arm's backbone every {CONFIGURATION_INTERVAL_S} s (light to dark), base at the origin, over the reference path and the tip's path, equal scales (paper Figure 10)."),
+                format!("{name} with {kind}: the arm every {CONFIGURATION_INTERVAL_S} s, light to dark; the tip (green) should stay on the red path (paper Figure 10)."),
             ));
         }
         let file = format!("fig11_{name}.svg");
         figures::tracking_residual(&dir.join(&file), name, &runs)?;
         residuals.push(figure(
             file,
-            format!("{name}: distance from the tip to the reference point on the path, in mm, for every controller (paper Figure 11)."),
+            format!("{name}: distance from the tip to its reference (mm) for every controller; lower is better (paper Figure 11)."),
         ));
     }
     let fuzzy = figures::fuzzy_controller(&dir.join("fuzzy"), SURFACE_RESOLUTION)?
@@ -262,11 +355,14 @@ fn outcome_json(outcome: &Outcome) -> serde_json::Value {
     }
 }
 
-/// Writes `summary.json` and `timeseries.csv` of one run into `dir`. A run that stopped has
-/// its time series up to the stop, and a summary of the metrics up to it with the `error`
-/// and the time it `stopped_at_s`.
-fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
+/// Writes `summary.json`, `timeseries.csv` and `scenario.toml` (what `hrm view` draws the arm
+/// from) of one run of `scenario` into `dir`. A run that stopped has its time series up to the
+/// stop, and a summary of the metrics up to it with the `error` and the time it `stopped_at_s`.
+fn write_outcome(outcome: &Outcome, scenario: &Scenario, dir: &Path) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let mut ran = scenario.clone();
+    ran.controller.kind = outcome.controller;
+    write(&dir.join("scenario.toml"), &ran.to_toml())?;
     let summary = sim_study::summary_json::run(&outcome.result);
     let run = match &outcome.result {
         Ok(run) => Some(run),
@@ -283,6 +379,7 @@ fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
         header.extend((1..=names.len()).map(|i| format!("tau{i}")));
         header.extend(["tip_x", "tip_y", "tip_ref_x", "tip_ref_y"].map(String::from));
         header.extend((1..=names.len()).map(|i| format!("clamped{i}")));
+        header.extend((1..=r.n_joints).map(|j| format!("joint_tau{j}")));
         let mut csv = header.join(",") + "\n";
         for k in 0..r.len() {
             let row = std::iter::once(r.t[k])
@@ -292,7 +389,8 @@ fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
                 .chain(r.tau_star_at(k).iter().copied())
                 .chain(r.tip[k])
                 .chain(r.tip_ref[k])
-                .chain(r.clamped_at(k).iter().map(|&c| f64::from(u8::from(c))));
+                .chain(r.clamped_at(k).iter().map(|&c| f64::from(u8::from(c))))
+                .chain(r.joint_torques_at(k).iter().copied());
             let line: Vec<String> = row.map(|v| v.to_string()).collect();
             let _ = writeln!(csv, "{}", line.join(","));
         }
@@ -305,17 +403,17 @@ fn write_outcome(outcome: &Outcome, dir: &Path) -> Result<(), String> {
 const HEADERS: [&str; 9] = [
     "scenario",
     "controller",
-    "tip rms mm",
-    "tip max mm",
-    "modal rms (rad)",
-    "peak tau* (N m)",
-    "peak tau N m",
-    "effort",
-    "clamped %",
+    "tip error RMS (mm)",
+    "tip error max (mm)",
+    "modal error RMS (mrad)",
+    "peak |tau*| (N m)",
+    "peak |joint torque| (N m)",
+    "effort (N^2 m^2 s)",
+    "tau* clamped (%)",
 ];
 
-/// The comparison table's rows: tip error RMS and maximum (mm), modal error RMS, peak torques,
-/// effort, and the percentage of controller samples whose `tau_i*` the actuator limits clamped
+/// The comparison table's rows in plain notation ([`report::plain`]): tip error RMS and
+/// maximum (mm), modal error RMS (mrad), peak torques (N m), effort, and the percentage of controller samples whose `tau_i*` the actuator limits clamped
 /// (`-` for a scenario without limits); a failed run has only its scenario and controller, and its error.
 fn table_rows(outcomes: &[Outcome], scenarios: &[Scenario]) -> Vec<report::Row> {
     outcomes
@@ -334,12 +432,12 @@ fn table_rows(outcomes: &[Outcome], scenarios: &[Scenario]) -> Vec<report::Row> 
                 Ok(run) => {
                     let m = &run.summary;
                     cells.extend([
-                        format!("{:.4}", m.tip_error_rms_m * 1e3),
-                        format!("{:.4}", m.tip_error_max_m * 1e3),
-                        list(&m.modal_error_rms_rad, |v| format!("{v:.2e}")),
-                        list(&m.peak_modal_torques_nm, |v| format!("{v:.2}")),
-                        format!("{:.3}", m.peak_joint_torque_nm),
-                        format!("{:.4e}", m.control_effort_n2m2s),
+                        report::plain(m.tip_error_rms_m * 1e3, 3),
+                        report::plain(m.tip_error_max_m * 1e3, 3),
+                        list(&m.modal_error_rms_rad, |v| report::plain(v * 1e3, 3)),
+                        list(&m.peak_modal_torques_nm, |v| report::plain(v, 3)),
+                        report::plain(m.peak_joint_torque_nm, 3),
+                        report::plain(m.control_effort_n2m2s, 4),
                         if limited {
                             list(&m.tau_star_clamped_fraction, |v| {
                                 format!("{:.1}", 100.0 * v)
@@ -418,7 +516,7 @@ mod tests {
         let mut scenario = Scenario::builtin("paper-responses-step").unwrap();
         scenario.duration = 0.2;
         let outcome = run_one(&scenario, ControllerKind::ComputedTorque);
-        write_outcome(&outcome, &dir).unwrap();
+        write_outcome(&outcome, &scenario, &dir).unwrap();
         let summary: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap())
                 .unwrap();
@@ -469,8 +567,23 @@ mod tests {
         let page = std::fs::read_to_string(dir.join("report.html")).unwrap();
         // Every scenario with every controller, and the learned controller on paper-tracking.
         let runs = scenarios.len() * ControllerKind::ALL.len() + 1;
-        assert_eq!(page.matches("<tr>").count(), 1 + runs);
-        assert!(page.contains("<td>paper-tracking</td><td>learned</td><td class=\"num\">"));
+        // One table per scenario, and its animation.
+        assert_eq!(page.matches("<table>").count(), scenarios.len());
+        assert_eq!(page.matches("<tr>").count(), scenarios.len() + runs);
+        assert!(page.contains("<td>learned</td><td class=\"num"));
+        assert!(page.matches("class=\"hrm-view\"").count() >= 1);
+        assert!(!page.contains("http://") && !page.contains("https://"));
+        // Numbers in plain notation: no exponent in any cell.
+        for cell in page.split("<td class=\"num").skip(1) {
+            let text = &cell[cell.find('>').unwrap() + 1..cell.find("</td>").unwrap()];
+            assert!(!text.contains('e'), "{text}");
+        }
+        // Each run's folder holds the scenario it ran, the learned one naming its system.
+        let ran = Scenario::load(&dir.join("paper-tracking/learned/scenario.toml")).unwrap();
+        assert_eq!(
+            ran.controller.fis.unwrap(),
+            dir.join("paper-tracking/learned/../../learned.fis")
+        );
         let learned =
             FuzzySystem::from_fis(&std::fs::read_to_string(dir.join("learned.fis")).unwrap());
         assert_eq!(learned.unwrap().inputs().len(), 8);

@@ -16,6 +16,7 @@ mod progress;
 mod report;
 mod signals;
 mod sweep;
+mod view_cmd;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -36,6 +37,10 @@ enum Command {
         /// Output folder.
         #[arg(long, default_value = "hrm-output")]
         out: PathBuf,
+        /// Run each scenario for at most this many seconds: a quick look at the report (the
+        /// paper's numbers need the full durations).
+        #[arg(long)]
+        duration: Option<f64>,
     },
     /// Run one scenario (a shipped name such as `paper-tracking`, or a TOML file).
     Simulate {
@@ -60,13 +65,16 @@ enum Command {
     Arm(arm_cmd::ArmArgs),
     /// Monte Carlo over noise levels and seeds: mean and spread of the errors per controller (docs/sweep.md).
     Sweep(sweep::SweepCli),
+    /// The interactive page of a run (an `hrm simulate` or `hrm run` output folder), and with
+    /// --gif an animated GIF of it.
+    View(view_cmd::ViewArgs),
 }
 
 fn main() -> ExitCode {
     signals::install();
     let cli = Cli::parse();
     let result = match cli.command {
-        Some(Command::Run { out }) => experiment::main_job(&out),
+        Some(Command::Run { out, duration }) => experiment::main_job(&out, duration),
         Some(Command::Simulate {
             scenario,
             controller,
@@ -76,7 +84,8 @@ fn main() -> ExitCode {
         Some(Command::Fis(args)) => fis_cmd::run(args),
         Some(Command::Sweep(args)) => sweep::run(args),
         Some(Command::Arm(args)) => arm_cmd::run(args),
-        None => experiment::main_job(std::path::Path::new("hrm-output")),
+        Some(Command::View(args)) => view_cmd::run(args),
+        None => experiment::main_job(std::path::Path::new("hrm-output"), None),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

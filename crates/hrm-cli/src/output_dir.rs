@@ -267,11 +267,11 @@ pub fn write_file_with(
 /// first, and only when every one is written are they renamed over their paths. A failure
 /// before the renames leaves every existing file as it was. Folders are created as by
 /// [`write_file_with`].
-pub fn write_files(files: &[(PathBuf, String)], command: &str) -> Result<(), String> {
+pub fn write_files(files: &[(PathBuf, impl AsRef<[u8]>)], command: &str) -> Result<(), String> {
     let mut staged = Vec::with_capacity(files.len());
-    for (path, text) in files {
+    for (path, contents) in files {
         match stage_file(path, command, |out| {
-            out.write_all(text.as_bytes()).map_err(|e| e.to_string())
+            out.write_all(contents.as_ref()).map_err(|e| e.to_string())
         }) {
             Ok(temporary) => staged.push(temporary),
             Err(e) => {
@@ -706,7 +706,7 @@ mod tests {
         assert!(err.contains("did not create"), "{err}");
         // A folder `fis export` created may be written again.
         let ours = root.join("ours/hrm_fis.c");
-        write_files(&[(ours.clone(), "v1".into())], "fis export").unwrap();
+        write_files(&[(ours.clone(), String::from("v1"))], "fis export").unwrap();
         refuse_foreign_files(std::slice::from_ref(&ours), "fis export").unwrap();
         refuse_foreign_files(&[root.join("mine/new.c")], "fis export").unwrap();
         // The same file by another path is an input.

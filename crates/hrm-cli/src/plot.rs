@@ -134,7 +134,10 @@ fn panel_ranges(path: &Path, panels: &[Panel<'_>]) -> Result<Vec<[Range<f64>; 2]
         .collect()
 }
 
-/// Draws one line chart with a legend into `area`.
+/// Width of the legend column right of a chart (pixels): legends never cover the curves.
+const LEGEND_WIDTH: u32 = 170;
+
+/// Draws one line chart into `area`, its legend in a column to the right of the plotted area.
 fn draw_panel(
     area: &DrawingArea<SVGBackend<'_>, Shift>,
     x_label: &str,
@@ -142,7 +145,9 @@ fn draw_panel(
     [x_range, y_range]: &[Range<f64>; 2],
 ) -> Result<(), Box<dyn std::error::Error>> {
     let (x_ticks, y_ticks) = (tick_format(x_range), tick_format(y_range));
-    let mut chart = ChartBuilder::on(area)
+    let width = area.dim_in_pixel().0;
+    let (plot_area, legend_area) = area.split_horizontally(width.saturating_sub(LEGEND_WIDTH));
+    let mut chart = ChartBuilder::on(&plot_area)
         .margin(15)
         .x_label_area_size(50)
         .y_label_area_size(75)
@@ -156,24 +161,33 @@ fn draw_panel(
         .x_label_formatter(&x_ticks)
         .y_label_formatter(&y_ticks)
         .draw()?;
+    let mut entries = Vec::with_capacity(panel.series.len());
     for (k, s) in panel.series.iter().enumerate() {
         let colour = Palette99::pick(k).to_rgba();
-        chart
-            .draw_series(LineSeries::new(
-                s.points.iter().copied(),
-                colour.stroke_width(2),
-            ))?
-            .label(s.label.as_str())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
+        chart.draw_series(LineSeries::new(
+            s.points.iter().copied(),
+            colour.stroke_width(2),
+        ))?;
+        entries.push((s.label.as_str(), colour.stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .label_font(TICK_FONT)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()?;
+    legend(&legend_area, &entries)?;
+    Ok(())
+}
+
+/// Draws legend `entries` (label, line style) one a line from the top of `area`.
+fn legend(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    entries: &[(&str, ShapeStyle)],
+) -> Result<(), Box<dyn std::error::Error>> {
+    for (k, (label, style)) in entries.iter().filter(|(l, _)| !l.is_empty()).enumerate() {
+        let y = 40 + 24 * k as i32;
+        area.draw(&PathElement::new(vec![(4, y), (28, y)], *style))?;
+        area.draw(&Text::new(
+            label.to_string(),
+            (34, y - 8),
+            TICK_FONT.into_font().color(&BLACK),
+        ))?;
+    }
     Ok(())
 }
 
@@ -207,7 +221,9 @@ pub fn xy_chart(
     let root = SVGBackend::new(path, SIZE).into_drawing_area();
     let draw = || -> Result<(), Box<dyn std::error::Error>> {
         root.fill(&WHITE)?;
-        let area = root.titled(labels.title, TITLE_FONT)?;
+        let titled = root.titled(labels.title, TITLE_FONT)?;
+        let (area, legend_area) =
+            titled.split_horizontally(titled.dim_in_pixel().0.saturating_sub(LEGEND_WIDTH));
         let (w, h) = area.dim_in_pixel();
         let pixels = (
             w.saturating_sub(2 * MARGIN + Y_LABELS).max(1),
@@ -229,37 +245,22 @@ pub fn xy_chart(
             .x_label_formatter(&x_ticks)
             .y_label_formatter(&y_ticks)
             .draw()?;
+        let mut entries = Vec::new();
         for (series, style) in curves {
             let (r, g, b) = style.colour;
-            let colour = RGBColor(r, g, b);
-            let width = style.width;
-            let drawn = chart.draw_series(LineSeries::new(
-                series.points.iter().copied(),
-                colour.stroke_width(width),
-            ))?;
-            if !series.label.is_empty() {
-                drawn.label(series.label.as_str()).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(width))
-                });
-            }
+            let colour = RGBColor(r, g, b).stroke_width(style.width);
+            chart.draw_series(LineSeries::new(series.points.iter().copied(), colour))?;
+            entries.push((series.label.as_str(), colour));
             if style.dots {
                 chart.draw_series(
                     series
                         .points
                         .iter()
-                        .map(|&p| Circle::new(p, width + 1, colour.filled())),
+                        .map(|&p| Circle::new(p, style.width + 1, colour.color.filled())),
                 )?;
             }
         }
-        if curves.iter().any(|(s, _)| !s.label.is_empty()) {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::LowerRight)
-                .label_font(TICK_FONT)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()?;
-        }
+        legend(&legend_area, &entries)?;
         root.present()?;
         Ok(())
     };

@@ -23,6 +23,7 @@ fn _hrm(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<scenario::ReferenceSample>()?;
     module.add_class::<scenario::Run>()?;
     module.add_class::<sweep::Sweep>()?;
+    module.add_function(wrap_pyfunction!(scenario::view_html, module)?)?;
     module.add("InvalidInput", py.get_type::<errors::InvalidInput>())?;
     module.add("Unreachable", py.get_type::<errors::Unreachable>())?;
     module.add("NumericalError", py.get_type::<errors::NumericalError>())?;

@@ -668,6 +668,26 @@ impl Scenario {
     }
 }
 
+/// The height of a run's viewer in a notebook (pixels).
+const VIEW_HEIGHT: u32 = 720;
+
+/// A scene given as JSON text (docs/run-view.md: `{"title", "caption", "runs": [...]}`, each
+/// run planar or spatial, with optional obstacles, channels, joint torques and series) as a
+/// self-contained HTML page; any run, also one computed elsewhere. Refused with InvalidInput
+/// naming the field when the data does not fit the format.
+#[pyfunction]
+pub fn view_html(scene: &str) -> PyResult<String> {
+    let scene: run_view::Scene =
+        serde_json::from_str(scene).map_err(|e| Error::input(format!("scene: {e}")))?;
+    run_view::page(
+        &scene.title,
+        &scene.caption,
+        std::slice::from_ref(&scene),
+        run_view::PAGE_SAMPLES,
+    )
+    .map_err(|e| Error::input(e).into())
+}
+
 /// The result of Scenario.run: the time series at the recording period (one row per recorded
 /// controller sample) and the summary metrics.
 ///
@@ -681,6 +701,8 @@ pub struct Run {
     failure: Option<String>,
     controller: String,
     coordinates: Vec<String>,
+    /// The run as the viewer draws it (`run-view`), with the scenario's name.
+    view: run_view::Scene,
 }
 
 /// `values` (`rows x width`, row-major) as a numpy array of shape `(rows, width)`.
@@ -717,6 +739,14 @@ impl Run {
                 partial: None,
             }) => return Err(Error::input(error).into()),
         };
+        let view = run_view::Scene {
+            title: format!("{} with {controller}", scenario.name),
+            caption: scenario.description.clone(),
+            runs: vec![
+                run_view::from_record(scenario, controller, &run.record, failure.as_deref())
+                    .map_err(Error::input)?,
+            ],
+        };
         let r = run.record;
         let (m, n) = (r.n_coords, r.n_joints);
         let tips = |tips: Vec<[f64; 2]>| matrix(py, tips.into_iter().flatten().collect(), 2);
@@ -735,6 +765,7 @@ impl Run {
             failure,
             controller: controller.to_string(),
             coordinates: scenario.coordinate_names(),
+            view,
         })
     }
 }
@@ -812,6 +843,25 @@ impl Run {
     #[getter]
     fn coordinates(&self) -> Vec<String> {
         self.coordinates.clone()
+    }
+
+    /// The run as a self-contained HTML page (no network): the arm link by link, coloured by
+    /// joint torque, the reference path and the tip's trace, played in sync with the tip error,
+    /// modal coordinates, tau* and joint torques (what `hrm view` writes). Save it to a file
+    /// and open it in a browser.
+    fn view_html(&self) -> PyResult<String> {
+        run_view::page(
+            &self.view.title,
+            "",
+            std::slice::from_ref(&self.view),
+            run_view::PAGE_SAMPLES,
+        )
+        .map_err(|e| Error::input(e).into())
+    }
+
+    /// The page of `view_html` in an iframe: what Jupyter shows for a Run.
+    fn _repr_html_(&self) -> PyResult<String> {
+        Ok(run_view::iframe(&self.view_html()?, VIEW_HEIGHT))
     }
 
     fn __repr__(&self, py: Python<'_>) -> String {

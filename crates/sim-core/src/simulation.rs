@@ -754,7 +754,7 @@ pub const MAX_CONTROLLER_SAMPLES: f64 = 1e9;
 pub const MAX_LOOP_WORK: f64 = 16_777_216.0;
 
 /// Refuses a run whose reduced dynamics would take more than [`MAX_LOOP_WORK`] per evaluation.
-pub(crate) fn check_loop_work(n_links: usize, m: usize) -> Result<(), SimError> {
+pub fn check_loop_work(n_links: usize, m: usize) -> Result<(), SimError> {
     let work = n_links as f64 * (m as f64).powi(2);
     if work > MAX_LOOP_WORK {
         return Err(SimError::setting(

@@ -7,7 +7,7 @@ use manip_dyn::spatial::{self, SpatialData, SpatialDerivativeData, SpatialModel}
 use robot_desc::{Robot, read_urdf};
 use serde::Deserialize;
 use serde_json::json;
-use sim_core::ArmSpec;
+use sim_study::ArmSpec;
 
 use super::derivatives::{MAX_DERIVATIVE_LINKS, rows};
 use super::{EvalError, EvalResult, finite, json_fields};

@@ -598,3 +598,90 @@ fn an_interrupted_command_removes_its_staging_folder() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn hrm_view_writes_a_page_and_a_gif_and_replaces_only_its_own_files() {
+    let dir = scratch("errors-view");
+    let run = dir.join("run");
+    assert!(
+        hrm(&[
+            "simulate",
+            "--scenario",
+            path(&short_scenario(&dir)),
+            "--out",
+            path(&run)
+        ])
+        .status
+        .success()
+    );
+    let gif = dir.join("run.gif");
+    let output = hrm(&[
+        "view",
+        path(&run),
+        "--gif",
+        path(&gif),
+        "--width",
+        "120",
+        "--height",
+        "90",
+    ]);
+    assert!(output.status.success(), "{output:?}");
+    let page = std::fs::read_to_string(run.join("view.html")).unwrap();
+    assert!(page.contains("class=\"hrm-view\"") && page.contains("\"label\":\"fuzzy\""));
+    assert_eq!(&std::fs::read(&gif).unwrap()[..6], b"GIF89a");
+    // Again: hrm's own files are replaced.
+    assert!(
+        hrm(&["view", path(&run), "--gif", path(&gif)])
+            .status
+            .success()
+    );
+    // A file hrm did not write is never replaced, and then nothing is written.
+    let mine = dir.join("mine.html");
+    std::fs::write(&mine, "<p>my notes</p>").unwrap();
+    std::fs::remove_file(&gif).unwrap();
+    let line = refused(&hrm(&[
+        "view",
+        path(&run),
+        "--out",
+        path(&mine),
+        "--gif",
+        path(&gif),
+    ]));
+    assert!(
+        line.contains("mine.html: exists and hrm did not write it"),
+        "{line}"
+    );
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "<p>my notes</p>");
+    assert!(!gif.exists());
+    // Not a run; a broken time series; bad GIF options.
+    let line = refused(&hrm(&["view", path(&dir)]));
+    assert!(line.contains("neither an `hrm simulate` output"), "{line}");
+    let csv = run.join("timeseries.csv");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    std::fs::write(&csv, text.replacen("\n0,", "\nzero,", 1)).unwrap();
+    let line = refused(&hrm(&["view", path(&run)]));
+    assert!(
+        line.contains("timeseries.csv: line 2: column t: \"zero\" is not a number"),
+        "{line}"
+    );
+    std::fs::write(&csv, text).unwrap();
+    let line = refused(&hrm(&[
+        "view",
+        path(&run),
+        "--gif",
+        path(&gif),
+        "--fps",
+        "0",
+    ]));
+    assert!(line.contains("gif fps: 0"), "{line}");
+    let line = refused(&hrm(&[
+        "view",
+        path(&run),
+        "--gif",
+        path(&gif),
+        "--speed",
+        "nan",
+    ]));
+    assert!(line.contains("gif speed: NaN"), "{line}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

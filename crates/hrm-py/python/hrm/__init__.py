@@ -29,6 +29,7 @@ from ._hrm import (
     Sweep,
     Unreachable,
     __version__,
+    view_html,
 )
 
 __all__ = [
@@ -45,4 +46,5 @@ __all__ = [
     "Unreachable",
     "__version__",
     "fuzzy",
+    "view_html",
 ]

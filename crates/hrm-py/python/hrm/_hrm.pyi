@@ -174,6 +174,13 @@ class Run:
     @property
     def coordinates(self) -> List[str]:
         """The names of the modal coordinates."""
+    def view_html(self) -> str:
+        """The run as a self-contained HTML page: the arm animated beside its time series."""
+    def _repr_html_(self) -> str:
+        """The page of view_html in an iframe (what Jupyter shows)."""
+
+def view_html(scene: str) -> str:
+    """A scene as JSON text (docs/run-view.md) as a self-contained HTML page."""
 
 class SpatialArm:
     """Universal-joint arm on a spatial modal backbone curve: theta = J a (2n x 4K)."""

@@ -43,7 +43,7 @@ impl Scenario {
                 ),
             ));
         }
-        crate::simulation::check_loop_work(n, m)?;
+        sim_core::check_loop_work(n, m)?;
         let lengths: Vec<f64> = chain.link_lengths().collect();
         let map = ModalMap::new(&lengths, k, self.alpha0.base_angle())?;
         ReducedModel::new(chain, map).map_err(SimError::Model)

@@ -1,0 +1,298 @@
+//! `hrm view DIR`: the viewer page (`run-view`) of an `hrm simulate` output folder, or of a
+//! main job's output folder (one animation per scenario, every controller), and with
+//! `--gif FILE` an animated GIF of one run. The files are written whole or not at all, and a
+//! file hrm did not write is never replaced.
+
+use crate::output_dir;
+use run_view::{GifOptions, RunView, Scene};
+use sim_core::Record;
+use sim_study::{ControllerKind, MAX_INPUT_FILE_BYTES, Scenario, read_text_file};
+use std::path::{Path, PathBuf};
+
+/// Largest `timeseries.csv` read (256 MiB: a 10-link run of an hour at the recording rate of
+/// the shipped scenarios is about a tenth of it).
+const MAX_TIMESERIES_BYTES: u64 = 256 << 20;
+
+/// The command line of `hrm view`.
+#[derive(clap::Args)]
+pub struct ViewArgs {
+    /// An `hrm simulate` output folder, or the main job's (`hrm run`) output folder.
+    dir: PathBuf,
+    /// The page to write (default: DIR/view.html).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Also write an animated GIF of the run (of a main job's folder: of `--run`).
+    #[arg(long)]
+    gif: Option<PathBuf>,
+    /// The run of a main job's folder the GIF shows, as SCENARIO/CONTROLLER.
+    #[arg(long, default_value = "paper-tracking/fuzzy")]
+    run: String,
+    /// GIF width (pixels).
+    #[arg(long, default_value_t = 480)]
+    width: u32,
+    /// GIF height (pixels).
+    #[arg(long, default_value_t = 360)]
+    height: u32,
+    /// GIF frames a second.
+    #[arg(long, default_value_t = 20)]
+    fps: u32,
+    /// Seconds of the run a second of the GIF shows (1 is real time).
+    #[arg(long, default_value_t = 1.0)]
+    speed: f64,
+}
+
+/// Runs `hrm view`.
+pub fn run(args: ViewArgs) -> Result<(), String> {
+    let options = GifOptions {
+        width: args.width,
+        height: args.height,
+        fps: args.fps,
+        speed: args.speed,
+    };
+    if args.gif.is_some() {
+        options.check()?;
+    }
+    let dir = &args.dir;
+    if !dir.is_dir() {
+        return Err(format!("{}: not a folder", dir.display()));
+    }
+    let (title, scenes, gif_run) = if dir.join("timeseries.csv").is_file() {
+        let (scenario, run) = load_run(dir, None)?;
+        let title = format!("{} with {}", scenario.name, run.label);
+        let scene = Scene {
+            title: title.clone(),
+            caption: scenario.description.clone(),
+            runs: vec![run.clone()],
+        };
+        (title, vec![scene], run)
+    } else {
+        let scenes = load_main_job(dir)?;
+        let (name, controller) = args
+            .run
+            .split_once('/')
+            .ok_or_else(|| format!("--run {}: expected SCENARIO/CONTROLLER", args.run))?;
+        let gif_run = scenes
+            .iter()
+            .filter(|s| s.title == name)
+            .flat_map(|s| &s.runs)
+            .find(|r| r.label == controller)
+            .cloned();
+        let gif_run = match (gif_run, &args.gif) {
+            (Some(run), _) => run,
+            (None, None) => scenes[0].runs[0].clone(),
+            (None, Some(_)) => {
+                return Err(format!(
+                    "--run {}: no such run in {} (its folders are SCENARIO/CONTROLLER)",
+                    args.run,
+                    dir.display()
+                ));
+            }
+        };
+        ("hrm: every run of the main job".to_owned(), scenes, gif_run)
+    };
+    let out = args.out.clone().unwrap_or_else(|| dir.join("view.html"));
+    let page = run_view::page(
+        &title,
+        "The arm link by link (links coloured by joint torque), the reference path and the tip's trace, in sync with the time series. Space plays and pauses, the arrows step, drag pans (or orbits a spatial arm), the wheel zooms.",
+        &scenes,
+        if scenes.len() > 1 {
+            run_view::REPORT_SAMPLES
+        } else {
+            run_view::PAGE_SAMPLES
+        },
+    )?;
+    refuse_foreign(&out)?;
+    let mut files = vec![(out.clone(), page.into_bytes())];
+    if let Some(gif) = &args.gif {
+        refuse_foreign(gif)?;
+        let mut bytes = Vec::new();
+        run_view::write_gif(&gif_run, &options, &mut bytes)?;
+        files.push((gif.clone(), bytes));
+    }
+    // The page and the GIF: both or neither.
+    output_dir::write_files(&files, "view")?;
+    crate::console::print(&format!("wrote {}\n", out.display()))?;
+    if let Some(gif) = &args.gif {
+        crate::console::print(&format!("wrote {}\n", gif.display()))?;
+    }
+    Ok(())
+}
+
+/// Refuses to replace an existing `path` that hrm did not write (no [`run_view::SIGNATURE`]).
+fn refuse_foreign(path: &Path) -> Result<(), String> {
+    use std::io::Read;
+    let Ok(file) = std::fs::File::open(path) else {
+        return Ok(());
+    };
+    if path.is_dir() {
+        return Err(format!("{}: is a folder", path.display()));
+    }
+    let mut start = Vec::with_capacity(run_view::SIGNATURE_WITHIN);
+    file.take(run_view::SIGNATURE_WITHIN as u64)
+        .read_to_end(&mut start)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    if run_view::written_by_hrm(&start) {
+        Ok(())
+    } else {
+        Err(format!(
+            "{}: exists and hrm did not write it; choose another file or remove this one",
+            path.display()
+        ))
+    }
+}
+
+/// The runs of a main job's output folder: one scene per scenario folder, its controllers in
+/// the order of the comparison (the learned controller last).
+fn load_main_job(dir: &Path) -> Result<Vec<Scene>, String> {
+    let folders = |path: &Path| -> Result<Vec<PathBuf>, String> {
+        let mut list: Vec<PathBuf> = std::fs::read_dir(path)
+            .map_err(|e| format!("{}: {e}", path.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.is_dir())
+            .collect();
+        list.sort();
+        Ok(list)
+    };
+    let rank = |path: &Path| {
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
+        ControllerKind::ALL
+            .iter()
+            .position(|k| Some(k.name()) == name.as_deref())
+            .unwrap_or(ControllerKind::ALL.len())
+    };
+    let mut scenes = Vec::new();
+    for scenario_dir in folders(dir)? {
+        let mut runs: Vec<PathBuf> = folders(&scenario_dir)?
+            .into_iter()
+            .filter(|p| p.join("timeseries.csv").is_file())
+            .collect();
+        runs.sort_by_key(|p| rank(p));
+        let mut views = Vec::with_capacity(runs.len());
+        let mut description = String::new();
+        for run in &runs {
+            let label = run.file_name().map(|n| n.to_string_lossy().into_owned());
+            let (scenario, view) = load_run(run, label.as_deref())?;
+            description = scenario.description;
+            views.push(view);
+        }
+        if let (false, Some(name)) = (views.is_empty(), scenario_dir.file_name()) {
+            scenes.push(Scene {
+                title: name.to_string_lossy().into_owned(),
+                caption: description,
+                runs: views,
+            });
+        }
+    }
+    if scenes.is_empty() {
+        return Err(format!(
+            "{}: neither an `hrm simulate` output (no timeseries.csv) nor a main job's (no SCENARIO/CONTROLLER/timeseries.csv)",
+            dir.display()
+        ));
+    }
+    Ok(scenes)
+}
+
+/// One run folder (`scenario.toml`, `timeseries.csv`, `summary.json`) as a [`RunView`] named
+/// `label` (default: its controller).
+fn load_run(dir: &Path, label: Option<&str>) -> Result<(Scenario, RunView), String> {
+    let toml = dir.join("scenario.toml");
+    if !toml.is_file() {
+        return Err(format!(
+            "{}: no scenario.toml (written by hrm simulate and hrm run since `hrm view` exists); run it again",
+            dir.display()
+        ));
+    }
+    let scenario = Scenario::load(&toml).map_err(|e| format!("{}: {e}", toml.display()))?;
+    let summary = dir.join("summary.json");
+    let stopped = match read_text_file(&summary, MAX_INPUT_FILE_BYTES) {
+        Ok(text) => serde_json::from_str::<serde_json::Value>(&text)
+            .map_err(|e| format!("{}: {e}", summary.display()))?
+            .get("error")
+            .and_then(|e| e.as_str().map(str::to_owned)),
+        Err(_) => None,
+    };
+    let csv = dir.join("timeseries.csv");
+    let text = read_text_file(&csv, MAX_TIMESERIES_BYTES)
+        .map_err(|e| format!("{}: {e}", csv.display()))?;
+    let record =
+        parse_timeseries(&text, &scenario).map_err(|e| format!("{}: {e}", csv.display()))?;
+    let label = label.unwrap_or(scenario.controller.kind.name());
+    let view = run_view::from_record(&scenario, label, &record, stopped.as_deref())
+        .map_err(|e| format!("{}: {e}", dir.display()))?;
+    Ok((scenario, view))
+}
+
+/// The columns of `timeseries.csv` the viewer needs, back into a [`Record`]: `t`, the
+/// coordinates and their `_ref`, `tau1..m`, the tips, and `joint_tau1..n` when present.
+fn parse_timeseries(text: &str, scenario: &Scenario) -> Result<Record, String> {
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().ok_or("empty file")?.split(',').collect();
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| format!("no column {name}"))
+    };
+    let names = scenario.coordinate_names();
+    let m = names.len();
+    let a: Vec<usize> = names.iter().map(|n| column(n)).collect::<Result<_, _>>()?;
+    let a_ref: Vec<usize> = names
+        .iter()
+        .map(|n| column(&format!("{n}_ref")))
+        .collect::<Result<_, _>>()?;
+    let tau: Vec<usize> = (1..=m)
+        .map(|i| column(&format!("tau{i}")))
+        .collect::<Result<_, _>>()?;
+    let [t, tip_x, tip_y, ref_x, ref_y] =
+        ["t", "tip_x", "tip_y", "tip_ref_x", "tip_ref_y"].map(column);
+    let (t, tip_x, tip_y, ref_x, ref_y) = (t?, tip_x?, tip_y?, ref_x?, ref_y?);
+    let links = scenario
+        .model()
+        .map_err(|e| e.to_string())?
+        .chain()
+        .link_lengths()
+        .count();
+    let joint: Vec<usize> = (1..=links)
+        .map_while(|j| column(&format!("joint_tau{j}")).ok())
+        .collect();
+    let mut record = Record {
+        n_joints: links,
+        n_coords: m,
+        ..Record::default()
+    };
+    let mut row = Vec::with_capacity(header.len());
+    for (line, text) in lines.enumerate() {
+        row.clear();
+        for (k, cell) in text.split(',').enumerate() {
+            let value: f64 = cell.parse().map_err(|_| {
+                format!(
+                    "line {}: column {}: {cell:?} is not a number",
+                    line + 2,
+                    header.get(k).unwrap_or(&"?")
+                )
+            })?;
+            row.push(value);
+        }
+        if row.len() != header.len() {
+            return Err(format!(
+                "line {}: {} values for {} columns",
+                line + 2,
+                row.len(),
+                header.len()
+            ));
+        }
+        record.t.push(row[t]);
+        record.a.extend(a.iter().map(|&c| row[c]));
+        record.a_ref.extend(a_ref.iter().map(|&c| row[c]));
+        record.tau_star.extend(tau.iter().map(|&c| row[c]));
+        record.tip.push([row[tip_x], row[tip_y]]);
+        record.tip_ref.push([row[ref_x], row[ref_y]]);
+        if joint.len() == links {
+            record.joint_torques.extend(joint.iter().map(|&c| row[c]));
+        }
+    }
+    if record.is_empty() {
+        return Err("no samples".into());
+    }
+    Ok(record)
+}

@@ -1,0 +1,321 @@
+//! What the page, the viewer and the GIF draw: a run as plain data ([`RunView`]), the same
+//! scenario under one or more controllers ([`Scene`]), checked before anything is drawn.
+//!
+//! This is also the page's data format (JSON, `docs/run-view.md`): every point has 2
+//! coordinates (a planar arm, in its plane) or 3 (a spatial arm); obstacles, channels, joint
+//! torques with their limits and extra series (such as clearance) are optional.
+
+use serde::{Deserialize, Serialize};
+
+/// The most samples a run may hold (the page's data is decimated well below this).
+pub const MAX_SAMPLES: usize = 100_000;
+/// The most points (joints and base) an arm may have.
+pub const MAX_POINTS: usize = 1_001;
+/// The most obstacles, channels or series groups of a run.
+pub const MAX_ITEMS: usize = 1_000;
+/// The most runs a scene may compare.
+pub const MAX_RUNS: usize = 64;
+
+/// A run as drawn: the arm's points, the reference and the time series, sample by sample.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunView {
+    /// The run's name in the page (e.g. the controller).
+    pub label: String,
+    /// 2 for a planar arm drawn in its plane (x, y), 3 for a spatial arm (x, y, z).
+    pub dims: usize,
+    /// Sample times (s), increasing.
+    pub t: Vec<f64>,
+    /// Per sample, the arm's points base first, tip last, flattened (`dims` numbers a point, m).
+    pub joints: Vec<Vec<f64>>,
+    /// Per sample, the reference tip (`dims` numbers, m); empty when there is none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub tip_ref: Vec<Vec<f64>>,
+    /// Per sample, the torque of each joint (N m; joint `i` drives link `i`); empty when unknown.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joint_torque: Vec<Vec<f64>>,
+    /// The joints' torque limits (N m, one a joint); empty when the arm has none, and then the
+    /// links are coloured against the run's peak torque.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub torque_limit: Vec<f64>,
+    /// Time series drawn beside the arm, one panel each.
+    #[serde(default)]
+    pub series: Vec<Series>,
+    /// Obstacles in the workspace.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacles: Vec<Obstacle>,
+    /// Channels the arm moves through.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub channels: Vec<Channel>,
+    /// Set when the run stopped early: why.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<String>,
+}
+
+/// A panel of time series sharing a unit (e.g. the modal coordinates and their references).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Series {
+    /// What the panel shows, e.g. `tip error`.
+    pub title: String,
+    /// The unit of its values, e.g. `mm`.
+    pub unit: String,
+    /// One name a curve.
+    pub names: Vec<String>,
+    /// One curve a name, one value a sample of [`RunView::t`].
+    pub values: Vec<Vec<f64>>,
+}
+
+/// An obstacle: a disc in the plane, a sphere, a capsule (a segment with a radius) or an
+/// axis-aligned box; points have the run's [`dims`](RunView::dims) coordinates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum Obstacle {
+    /// A disc (planar) of `radius` about `centre`.
+    Circle {
+        /// Centre (m).
+        centre: Vec<f64>,
+        /// Radius (m).
+        radius: f64,
+    },
+    /// A ball (spatial) of `radius` about `centre`.
+    Sphere {
+        /// Centre (m).
+        centre: Vec<f64>,
+        /// Radius (m).
+        radius: f64,
+    },
+    /// The points within `radius` of the segment from `a` to `b`.
+    Capsule {
+        /// One end of the axis (m).
+        a: Vec<f64>,
+        /// The other end (m).
+        b: Vec<f64>,
+        /// Radius (m).
+        radius: f64,
+    },
+    /// An axis-aligned box.
+    Box {
+        /// Centre (m).
+        centre: Vec<f64>,
+        /// Half the side along each axis (m).
+        half: Vec<f64>,
+    },
+}
+
+/// A channel: a tube (or strip, planar) of `width` about a polyline.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Channel {
+    /// The centre line (m).
+    pub points: Vec<Vec<f64>>,
+    /// The channel's full width (m).
+    pub width: f64,
+}
+
+/// One animation of a page: the same scenario under one or more controllers, compared side by
+/// side or overlaid.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// The heading, e.g. the scenario's name.
+    pub title: String,
+    /// One line that says what to look at.
+    pub caption: String,
+    /// The runs (at least one).
+    pub runs: Vec<RunView>,
+}
+
+impl Scene {
+    /// Checks every run ([`RunView::check`]); the error names the run and the field.
+    pub fn check(&self) -> Result<(), String> {
+        if self.runs.is_empty() || self.runs.len() > MAX_RUNS {
+            return Err(format!(
+                "scene {:?}: runs: {} runs, expected 1 to {MAX_RUNS}",
+                self.title,
+                self.runs.len()
+            ));
+        }
+        for run in &self.runs {
+            run.check()
+                .map_err(|e| format!("scene {:?}, run {:?}: {e}", self.title, run.label))?;
+        }
+        Ok(())
+    }
+}
+
+impl RunView {
+    /// The number of samples.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    /// Whether the run has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+
+    /// The number of points of the arm (base and joints, the tip last).
+    pub fn points(&self) -> usize {
+        self.joints
+            .first()
+            .map_or(0, |j| j.len() / self.dims.max(1))
+    }
+
+    /// Checks the sizes and values: `dims` 2 or 3, at least one sample, increasing finite
+    /// times, one row of the right length a sample in every per-sample field, finite
+    /// coordinates, positive finite radii, widths and limits, and the sizes within
+    /// [`MAX_SAMPLES`], [`MAX_POINTS`] and [`MAX_ITEMS`]. The error names the field.
+    pub fn check(&self) -> Result<(), String> {
+        let d = self.dims;
+        if d != 2 && d != 3 {
+            return Err(format!("dims: {d}, expected 2 (planar) or 3 (spatial)"));
+        }
+        let n = self.len();
+        if n == 0 || n > MAX_SAMPLES {
+            return Err(format!("t: {n} samples, expected 1 to {MAX_SAMPLES}"));
+        }
+        finite("t", &self.t)?;
+        if let Some(k) = self.t.windows(2).position(|w| w[1] <= w[0]) {
+            return Err(format!("t: not increasing at sample {}", k + 1));
+        }
+        let width = self.joints.first().map_or(0, Vec::len);
+        if width < 2 * d || !width.is_multiple_of(d) || width / d > MAX_POINTS {
+            return Err(format!(
+                "joints: {width} numbers a sample, expected {d} a point for 2 to {MAX_POINTS} points"
+            ));
+        }
+        rows("joints", &self.joints, n, width)?;
+        if !self.tip_ref.is_empty() {
+            rows("tip_ref", &self.tip_ref, n, d)?;
+        }
+        let links = width / d - 1;
+        if !self.joint_torque.is_empty() {
+            rows("joint_torque", &self.joint_torque, n, links)?;
+        }
+        if !self.torque_limit.is_empty() {
+            if self.torque_limit.len() != links {
+                return Err(format!(
+                    "torque_limit: {} limits, expected one a joint ({links})",
+                    self.torque_limit.len()
+                ));
+            }
+            positive("torque_limit", &self.torque_limit)?;
+        }
+        for (what, count) in [
+            ("series", self.series.len()),
+            ("obstacles", self.obstacles.len()),
+            ("channels", self.channels.len()),
+        ] {
+            if count > MAX_ITEMS {
+                return Err(format!("{what}: {count}, more than {MAX_ITEMS}"));
+            }
+        }
+        for (i, s) in self.series.iter().enumerate() {
+            let field = format!("series[{i}] ({:?})", s.title);
+            if s.names.len() != s.values.len() || s.names.is_empty() || s.names.len() > MAX_ITEMS {
+                return Err(format!(
+                    "{field}: {} names for {} curves, expected one name a curve (1 to {MAX_ITEMS})",
+                    s.names.len(),
+                    s.values.len()
+                ));
+            }
+            for (curve, values) in s.values.iter().enumerate() {
+                if values.len() != n {
+                    return Err(format!(
+                        "{field}.values[{curve}]: {} values, expected one a sample ({n})",
+                        values.len()
+                    ));
+                }
+                finite(&field, values)?;
+            }
+        }
+        for (i, o) in self.obstacles.iter().enumerate() {
+            let field = format!("obstacles[{i}]");
+            let (points, lengths): (Vec<&Vec<f64>>, Vec<f64>) = match o {
+                Obstacle::Circle { centre, radius } if d == 2 => (vec![centre], vec![*radius]),
+                Obstacle::Sphere { centre, radius } if d == 3 => (vec![centre], vec![*radius]),
+                Obstacle::Circle { .. } | Obstacle::Sphere { .. } => {
+                    return Err(format!(
+                        "{field}: a circle is planar and a sphere spatial; this run has dims {d}"
+                    ));
+                }
+                Obstacle::Capsule { a, b, radius } => (vec![a, b], vec![*radius]),
+                Obstacle::Box { centre, half } => (vec![centre], half.clone()),
+            };
+            if let Obstacle::Box { half, .. } = o
+                && half.len() != d
+            {
+                return Err(format!(
+                    "{field}.half: {} numbers, expected {d}",
+                    half.len()
+                ));
+            }
+            for p in points {
+                point(&field, p, d)?;
+            }
+            positive(&field, &lengths)?;
+        }
+        for (i, c) in self.channels.iter().enumerate() {
+            let field = format!("channels[{i}]");
+            if c.points.len() < 2 || c.points.len() > MAX_SAMPLES {
+                return Err(format!(
+                    "{field}.points: {} points, expected 2 to {MAX_SAMPLES}",
+                    c.points.len()
+                ));
+            }
+            for p in &c.points {
+                point(&field, p, d)?;
+            }
+            positive(&format!("{field}.width"), &[c.width])?;
+        }
+        Ok(())
+    }
+}
+
+/// Every value of `values` finite.
+fn finite(field: &str, values: &[f64]) -> Result<(), String> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(k) => Err(format!("{field}: value {k} is {}, not finite", values[k])),
+        None => Ok(()),
+    }
+}
+
+/// Every value of `values` finite and positive.
+fn positive(field: &str, values: &[f64]) -> Result<(), String> {
+    match values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
+        Some(v) => Err(format!("{field}: {v}, expected a finite positive number")),
+        None => Ok(()),
+    }
+}
+
+/// A point of `d` finite coordinates.
+fn point(field: &str, p: &[f64], d: usize) -> Result<(), String> {
+    if p.len() != d {
+        return Err(format!(
+            "{field}: a point of {} coordinates, expected {d}",
+            p.len()
+        ));
+    }
+    finite(field, p)
+}
+
+/// `n` rows of `width` finite numbers.
+fn rows(field: &str, rows: &[Vec<f64>], n: usize, width: usize) -> Result<(), String> {
+    if rows.len() != n {
+        return Err(format!(
+            "{field}: {} rows, expected one a sample ({n})",
+            rows.len()
+        ));
+    }
+    for (k, row) in rows.iter().enumerate() {
+        if row.len() != width {
+            return Err(format!(
+                "{field}[{k}]: {} numbers, expected {width}",
+                row.len()
+            ));
+        }
+        finite(&format!("{field}[{k}]"), row)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,434 @@
+//! The run-view crate: the data checks, a planar run of the closed loop, the page, the GIF,
+//! and the viewer script's own tests (node).
+
+use run_view::{
+    Camera, Channel, GifOptions, Obstacle, PAGE_SAMPLES, RunView, Scene, Series, from_record, page,
+    scene_html, write_gif,
+};
+use sim_study::{ControllerKind, Scenario};
+
+/// A synthetic spatial arm: `links` links of 0.1 m whose bending plane turns about the vertical
+/// as time goes on (a helix that unwinds), with a sphere, a capsule, a box and a channel.
+fn spatial(samples: usize, links: usize) -> RunView {
+    let t: Vec<f64> = (0..samples)
+        .map(|k| 2.0 * k as f64 / (samples - 1) as f64)
+        .collect();
+    let arm = |t: f64| -> Vec<f64> {
+        let mut p = [0.0f64; 3];
+        let mut out = p.to_vec();
+        for i in 0..links {
+            let bend = 0.15 * (i as f64 + 1.0) * (1.0 - 0.3 * t);
+            let turn = 0.6 * t + 0.4 * i as f64;
+            let dir = [bend.sin() * turn.cos(), bend.sin() * turn.sin(), bend.cos()];
+            p = [0, 1, 2].map(|j| p[j] + 0.1 * dir[j]);
+            out.extend(p);
+        }
+        out
+    };
+    let joints: Vec<Vec<f64>> = t.iter().map(|&t| arm(t)).collect();
+    let tip_ref = joints
+        .iter()
+        .map(|row| row[row.len() - 3..].to_vec())
+        .collect();
+    let joint_torque: Vec<Vec<f64>> = t
+        .iter()
+        .map(|&t| {
+            (0..links)
+                .map(|i| (links - i) as f64 * (1.0 + t).sin())
+                .collect()
+        })
+        .collect();
+    let clearance = t.iter().map(|&t| 50.0 - 10.0 * t).collect();
+    RunView {
+        label: "synthetic spatial".into(),
+        dims: 3,
+        t: t.clone(),
+        joints,
+        tip_ref,
+        joint_torque,
+        torque_limit: vec![links as f64; links],
+        series: vec![Series {
+            title: "clearance".into(),
+            unit: "mm".into(),
+            names: vec!["nearest obstacle".into()],
+            values: vec![clearance],
+        }],
+        obstacles: vec![
+            Obstacle::Sphere {
+                centre: vec![0.3, 0.2, 0.5],
+                radius: 0.08,
+            },
+            Obstacle::Capsule {
+                a: vec![-0.3, 0.0, 0.2],
+                b: vec![-0.3, 0.0, 0.7],
+                radius: 0.04,
+            },
+            Obstacle::Box {
+                centre: vec![0.0, -0.35, 0.3],
+                half: vec![0.1, 0.05, 0.2],
+            },
+        ],
+        channels: vec![Channel {
+            points: vec![vec![0.0, 0.0, 0.0], vec![0.0, 0.0, 0.9]],
+            width: 0.3,
+        }],
+        stopped: None,
+    }
+}
+
+fn planar(duration: f64, kind: ControllerKind) -> (Scenario, RunView) {
+    let mut scenario = Scenario::builtin("paper-tracking").unwrap();
+    scenario.duration = duration;
+    scenario.controller.kind = kind;
+    let run = scenario.build().unwrap().run().unwrap();
+    let view = from_record(&scenario, kind.name(), &run.record, None).unwrap();
+    (scenario, view)
+}
+
+#[test]
+fn a_planar_run_is_drawn_from_its_modal_coordinates() {
+    let mut scenario = Scenario::builtin("paper-tracking").unwrap();
+    scenario.duration = 0.3;
+    let run = scenario.build().unwrap().run().unwrap();
+    let view = from_record(&scenario, "fuzzy", &run.record, None).unwrap();
+    assert_eq!(
+        (view.dims, view.points(), view.len()),
+        (2, 11, run.record.len())
+    );
+    for (k, row) in view.joints.iter().enumerate() {
+        // Base at the origin, every link 0.1 m long, the last point the recorded tip.
+        assert_eq!(&row[..2], &[0.0, 0.0]);
+        for link in row.chunks_exact(2).collect::<Vec<_>>().windows(2) {
+            let length = (link[1][0] - link[0][0]).hypot(link[1][1] - link[0][1]);
+            assert!((length - 0.1).abs() < 1e-12, "{length}");
+        }
+        let tip = &row[20..];
+        assert!((tip[0] - run.record.tip[k][0]).abs() < 1e-12);
+        assert!((tip[1] - run.record.tip[k][1]).abs() < 1e-12);
+    }
+    let titles: Vec<&str> = view.series.iter().map(|s| s.title.as_str()).collect();
+    assert_eq!(
+        titles,
+        ["tip error", "modal coordinates", "modal torques tau*"]
+    );
+    // The tip error series is the distance from the tip to the reference, in mm.
+    let k = view.len() - 1;
+    let (tip, reference) = (run.record.tip[k], run.record.tip_ref[k]);
+    let expected = 1e3 * (tip[0] - reference[0]).hypot(tip[1] - reference[1]);
+    assert!((view.series[0].values[0][k] - expected).abs() < 1e-12);
+    assert_eq!(view.joint_torque[k], run.record.joint_torques_at(k));
+    // A record of another scenario is refused.
+    let mut other = Scenario::builtin("paper-tracking").unwrap();
+    other.arm.links = Some(12);
+    assert!(from_record(&other, "x", &run.record, None).is_err());
+}
+
+#[test]
+fn bad_data_is_refused_naming_the_field() {
+    let good = spatial(5, 4);
+    good.check().unwrap();
+    type Spoil = Box<dyn Fn(&mut RunView)>;
+    let cases: Vec<(&str, Spoil)> = vec![
+        ("dims", Box::new(|r| r.dims = 4)),
+        ("t: 0 samples", Box::new(|r| r.t.clear())),
+        ("t: not increasing", Box::new(|r| r.t[2] = r.t[1])),
+        ("t: value 3 is NaN", Box::new(|r| r.t[3] = f64::NAN)),
+        (
+            "joints: 4 rows",
+            Box::new(|r| {
+                r.joints.pop();
+            }),
+        ),
+        (
+            "joints[1]: 14 numbers",
+            Box::new(|r| {
+                r.joints[1].pop();
+            }),
+        ),
+        (
+            "joints[2]: value 0 is inf",
+            Box::new(|r| r.joints[2][0] = f64::INFINITY),
+        ),
+        (
+            "tip_ref[0]: 2 numbers",
+            Box::new(|r| {
+                r.tip_ref[0].pop();
+            }),
+        ),
+        (
+            "joint_torque: 4 rows",
+            Box::new(|r| {
+                r.joint_torque.pop();
+            }),
+        ),
+        (
+            "torque_limit: 3 limits",
+            Box::new(|r| {
+                r.torque_limit.pop();
+            }),
+        ),
+        ("torque_limit: -1", Box::new(|r| r.torque_limit[0] = -1.0)),
+        (
+            "series[0] (\"clearance\").values[0]: 4 values",
+            Box::new(|r| {
+                r.series[0].values[0].pop();
+            }),
+        ),
+        (
+            "series[0] (\"clearance\"): 2 names for 1 curves",
+            Box::new(|r| {
+                r.series[0].names.push("x".into());
+            }),
+        ),
+        (
+            "obstacles[0]: a circle is planar",
+            Box::new(|r| {
+                r.obstacles[0] = Obstacle::Circle {
+                    centre: vec![0.0, 0.0],
+                    radius: 1.0,
+                };
+            }),
+        ),
+        (
+            "obstacles[1]: 0, expected a finite positive",
+            Box::new(|r| {
+                if let Obstacle::Capsule { radius, .. } = &mut r.obstacles[1] {
+                    *radius = 0.0;
+                }
+            }),
+        ),
+        (
+            "obstacles[2].half: 2 numbers",
+            Box::new(|r| {
+                if let Obstacle::Box { half, .. } = &mut r.obstacles[2] {
+                    half.pop();
+                }
+            }),
+        ),
+        (
+            "channels[0].points: 1 points",
+            Box::new(|r| {
+                r.channels[0].points.pop();
+            }),
+        ),
+        (
+            "channels[0].width: NaN",
+            Box::new(|r| r.channels[0].width = f64::NAN),
+        ),
+    ];
+    for (expected, spoil) in cases {
+        let mut run = good.clone();
+        spoil(&mut run);
+        let err = run.check().unwrap_err();
+        assert!(err.starts_with(expected), "{expected}: {err}");
+    }
+    let empty = Scene {
+        title: "s".into(),
+        caption: String::new(),
+        runs: Vec::new(),
+    };
+    assert!(empty.check().unwrap_err().contains("runs: 0 runs"));
+    // JSON from elsewhere (Python, a file) goes through the same checks after parsing.
+    let text = serde_json::to_string(&good).unwrap();
+    let back: RunView = serde_json::from_str(&text).unwrap();
+    assert_eq!(back, good);
+    let unknown = text.replacen("\"dims\"", "\"dimz\"", 1);
+    assert!(serde_json::from_str::<RunView>(&unknown).is_err());
+}
+
+#[test]
+fn decimation_bounds_the_page_and_keeps_the_run_ends() {
+    let run = spatial(2001, 6);
+    let small = run.decimated(100);
+    small.check().unwrap();
+    assert!(small.len() <= 101);
+    assert_eq!(small.t[0], run.t[0]);
+    assert_eq!(*small.t.last().unwrap(), *run.t.last().unwrap());
+    // Coordinates to 0.1 mm, series to 4 significant digits of their peak.
+    for (a, b) in small
+        .joints
+        .last()
+        .unwrap()
+        .iter()
+        .zip(run.joints.last().unwrap())
+    {
+        assert!((a - b).abs() <= 0.5e-4 + 1e-15, "{a} {b}");
+    }
+    let peak = 50.0;
+    for (&a, k) in small.series[0].values[0]
+        .iter()
+        .zip(run_view::strided(2001, 100))
+    {
+        assert!((a - run.series[0].values[0][k]).abs() <= 0.5e-3 * peak / 10.0 + 1e-12);
+    }
+    let scene = Scene {
+        title: "spatial".into(),
+        caption: "c".into(),
+        runs: vec![run],
+    };
+    let full = scene_html(&scene, 100_000).unwrap().len();
+    let cut = scene_html(&scene, 100).unwrap().len();
+    assert!(cut * 10 < full, "{cut} vs {full}");
+}
+
+#[test]
+fn the_page_is_self_contained_and_its_data_cannot_end_the_script() {
+    let (_, fuzzy) = planar(0.2, ControllerKind::Fuzzy);
+    let mut pd = planar(0.2, ControllerKind::Pd).1;
+    pd.label = "pd </script><script>alert(1)</script>".into();
+    pd.stopped = Some("|a| > pi & \"quoted\"".into());
+    let scene = Scene {
+        title: "paper-tracking <short>".into(),
+        caption: "two controllers".into(),
+        runs: vec![fuzzy, pd],
+    };
+    let html = page("T & U", "intro", &[scene], PAGE_SAMPLES).unwrap();
+    assert!(html.starts_with("<!DOCTYPE html>") && html.ends_with("</html>\n"));
+    assert!(!html.contains("http://") && !html.contains("https://") && !html.contains("src="));
+    assert_eq!(
+        html.matches("</script>").count(),
+        2,
+        "only the data's and the viewer's"
+    );
+    assert!(html.contains("<h3>paper-tracking &lt;short&gt;</h3>"));
+    assert!(!run_view::SCRIPT.contains("</script"));
+    // The data parses back to the decimated runs.
+    let start = html.find("application/json\">").unwrap() + "application/json\">".len();
+    let end = start + html[start..].find("</script>").unwrap();
+    let scene: Scene = serde_json::from_str(&html[start..end]).unwrap();
+    assert_eq!(scene.runs[1].label, "pd </script><script>alert(1)</script>");
+    scene.check().unwrap();
+    let frame = run_view::iframe(&html, 600);
+    assert!(frame.starts_with("<iframe srcdoc=\"&lt;!DOCTYPE html&gt;"));
+    assert!(!frame[8..].contains('"') || frame.matches('"').count() == 6);
+}
+
+#[test]
+fn the_gif_shows_the_arm_moving_over_its_path() {
+    let (_, run) = planar(0.5, ControllerKind::Fuzzy);
+    let options = GifOptions {
+        width: 200,
+        height: 150,
+        fps: 20,
+        speed: 0.5,
+    };
+    let mut bytes = Vec::new();
+    write_gif(&run, &options, &mut bytes).unwrap();
+    let mut decoder = gif::DecodeOptions::new();
+    decoder.set_color_output(gif::ColorOutput::RGBA);
+    let mut decoder = decoder.read_info(&bytes[..]).unwrap();
+    assert_eq!((decoder.width(), decoder.height()), (200, 150));
+    let mut frames = 0;
+    let mut changed = 0;
+    while let Some(frame) = decoder.read_next_frame().unwrap() {
+        frames += 1;
+        if frames > 1 && frame.buffer.chunks_exact(4).any(|p| p[3] != 0) {
+            changed += 1;
+        }
+    }
+    // 0.5 s of run at half speed and 20 frames a second: 21 frames, the arm moving in each.
+    assert_eq!(frames, 21);
+    assert!(changed >= 15, "{changed}");
+    // The first frame: the arm's base and tip where the camera puts them, the tip on the path.
+    let camera = Camera::fit(
+        &run.joints
+            .iter()
+            .flat_map(|r| r.chunks_exact(2).map(|p| [p[0], p[1], 0.0]))
+            .chain(run.tip_ref.iter().map(|p| [p[0], p[1], 0.0]))
+            .collect::<Vec<_>>(),
+        2,
+        200.0,
+        150.0,
+    );
+    let mut pixmap = tiny_skia_pixmap(200, 150);
+    run_view::draw_frame(&mut pixmap, &run, &camera, 0.0);
+    let pixel = |p: [f64; 3]| {
+        let i = 4 * (p[1].round() as usize * 200 + p[0].round() as usize);
+        pixmap.data()[i..i + 3].to_vec()
+    };
+    assert_eq!(
+        pixel(camera.project([0.0, 0.0, 0.0])),
+        [34, 34, 34],
+        "the base"
+    );
+    let middle = &run.joints[0][10..14];
+    let link = camera.project([
+        0.5 * (middle[0] + middle[2]),
+        0.5 * (middle[1] + middle[3]),
+        0.0,
+    ]);
+    let colour = pixel(link);
+    assert!(colour != [255, 255, 255], "a link at {link:?}");
+    // Refusals: options and an overlong animation.
+    let slow = GifOptions {
+        speed: 1e-4,
+        ..options
+    };
+    assert!(
+        write_gif(&run, &slow, Vec::new())
+            .unwrap_err()
+            .contains("frames")
+    );
+    let wide = GifOptions {
+        width: 0,
+        ..options
+    };
+    assert!(
+        write_gif(&run, &wide, Vec::new())
+            .unwrap_err()
+            .contains("gif width: 0")
+    );
+    let mut spatial_gif = Vec::new();
+    write_gif(&spatial(40, 8), &options, &mut spatial_gif).unwrap();
+    assert_eq!(&spatial_gif[..6], b"GIF89a");
+}
+
+fn tiny_skia_pixmap(w: u32, h: u32) -> tiny_skia::Pixmap {
+    tiny_skia::Pixmap::new(w, h).unwrap()
+}
+
+#[test]
+fn torque_colours_match_the_viewer() {
+    // The stops of viewer.js's torqueColour.
+    assert_eq!(run_view::torque_colour(0.0), [49, 99, 170]);
+    assert_eq!(run_view::torque_colour(0.4), [44, 160, 44]);
+    assert_eq!(run_view::torque_colour(-0.7), [240, 170, 20]);
+    assert_eq!(run_view::torque_colour(1.0), [214, 39, 40]);
+    assert_eq!(run_view::torque_colour(1.01), [120, 0, 20]);
+    assert_eq!(run_view::torque_colour(0.2), [47, 130, 107]);
+    // The camera from above: x to the right, y up the picture.
+    let camera = Camera {
+        yaw: 0.0,
+        pitch: 90.0,
+        target: [0.0; 3],
+        scale: 100.0,
+        size: [200.0, 100.0],
+    };
+    let p = camera.project([1.0, 0.5, 0.0]);
+    assert!((p[0] - 200.0).abs() < 1e-9 && (p[1] - 0.0).abs() < 1e-9);
+}
+
+/// The viewer script's own tests (`node --test`): skipped when node is missing, unless
+/// `HRM_REQUIRE_ENGINES=1` (CI), where a missing node fails.
+#[test]
+fn viewer_script_tests_pass_under_node() {
+    let Some(node) = test_support::engine::program("node", "nodejs") else {
+        return;
+    };
+    let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
+    let out = std::process::Command::new(node)
+        .arg("--test")
+        .arg(assets.join("viewer.test.js"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("# fail 0") && !text.contains("# pass 0"),
+        "{text}"
+    );
+}
