@@ -169,14 +169,38 @@ pub enum FuzzyError {
     },
     /// A name of the system cannot be written in FCL.
     #[error(
-        "export: the {kind} name '{name}' is not an FCL identifier (letters, digits and _, \
-         not starting with a digit, not a keyword)"
+        "export: the {kind} name '{name}' cannot be written in FCL: a name must be ASCII \
+         letters, digits and _, not start with a digit, and not be a keyword of FCL or of \
+         fuzzylite's rules (END_VAR, RANGE, then, any, very, ...); rename it"
     )]
     FclName {
         /// `"system"`, `"input"`, `"output"`, `"set"` or `"term"`.
         kind: &'static str,
         /// The name.
         name: String,
+    },
+    /// Two sets of an input, or two terms of an output, share a name (a `.fis` file allows it;
+    /// FCL rules name terms, so the second could not be told from the first).
+    #[error("export: {variable} has two terms named '{name}'; FCL rules name terms, so rename one")]
+    FclDuplicateTerm {
+        /// `input 'x'` or `output 'y'`.
+        variable: String,
+        /// The shared name.
+        name: String,
+    },
+    /// A set is one of MATLAB's steps (`smf`, `zmf` or `pimf` with a foot at or past its
+    /// shoulder), which fuzzylite's `SShape`, `ZShape` and `PiShape` evaluate otherwise.
+    #[error(
+        "export: the set '{set}' of input '{input}' is MATLAB's step ({shape} with its foot at or \
+         past its shoulder), which fuzzylite evaluates otherwise; FCL cannot carry it"
+    )]
+    FclStep {
+        /// The input's name.
+        input: String,
+        /// The set's name.
+        set: String,
+        /// `"smf"`, `"zmf"` or `"pimf"`.
+        shape: &'static str,
     },
 }
 

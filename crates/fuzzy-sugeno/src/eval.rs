@@ -13,13 +13,17 @@ use crate::system::{Defuzzification, FuzzySystem};
 /// What to do with an input outside its variable's range.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum OutOfRange {
-    /// Evaluate at the nearest end of the range (the default). For a controller this is the
-    /// safe choice: bell and Gaussian sets decay on both sides, so evaluated as given a very
-    /// large error would *weaken* the action of the rule base instead of saturating it.
-    #[default]
+    /// Evaluate at the nearest end of the range. For a controller this saturates the action:
+    /// bell and Gaussian sets decay on both sides, so evaluated as given a very large error
+    /// *weakens* the action of the rule base (the paper's controller at
+    /// `[-0.414, -0.263, 0.904, 0.246]`: 71.32 clamped, 75.94 as given; far enough out, every
+    /// output tends to the average of the rules' conclusions).
     Clamp,
-    /// Evaluate the membership functions at the value as given (MATLAB's `evalfis` does this,
-    /// with a warning).
+    /// Evaluate the membership functions at the value as given (the default): what MATLAB's
+    /// `evalfis` and Simulink's Fuzzy Logic Controller block do, with a warning.
+    /// [`Evaluator::first_outside_range`] tells the caller when this happened, so that it can
+    /// warn as MATLAB does.
+    #[default]
     AsGiven,
     /// Refuse with [`FuzzyError::InputOutOfRange`].
     Error,
@@ -92,11 +96,22 @@ pub struct Evaluator {
     one: Workspace<1>,
     /// The kernel's buffers for a group of points, and the instruction set.
     batch: BatchWorkspace,
+    /// The first input evaluated outside its range under [`OutOfRange::AsGiven`].
+    outside: Option<OutsideRange>,
+}
+
+/// An input evaluated outside its variable's range, as given ([`OutOfRange::AsGiven`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OutsideRange {
+    /// The input's index.
+    pub index: usize,
+    /// The value evaluated.
+    pub value: f64,
 }
 
 impl Evaluator {
-    /// An evaluator with the default [`EvalOptions`] (clamp inputs, middle of range when no
-    /// rule fires).
+    /// An evaluator with the default [`EvalOptions`] (inputs as given, as MATLAB's `evalfis`
+    /// evaluates them; middle of range when no rule fires).
     pub fn new(system: FuzzySystem) -> Self {
         let one = Workspace::new(&system);
         let batch = BatchWorkspace::new(&system);
@@ -105,6 +120,7 @@ impl Evaluator {
             options: EvalOptions::default(),
             one,
             batch,
+            outside: None,
         }
     }
 
@@ -130,7 +146,49 @@ impl Evaluator {
     /// Evaluates the system: `inputs` has one value per input variable, `outputs` one slot per
     /// output variable. On error `outputs` is left untouched.
     pub fn eval(&mut self, inputs: &[f64], outputs: &mut [f64]) -> Result<(), FuzzyError> {
-        eval_point(&self.system, &self.options, &mut self.one, inputs, outputs)
+        eval_point(&self.system, &self.options, &mut self.one, inputs, outputs)?;
+        self.note_outside(inputs);
+        Ok(())
+    }
+
+    /// The first input this evaluator evaluated outside its range under
+    /// [`OutOfRange::AsGiven`] (by [`eval`](Self::eval), [`eval_batch`](Self::eval_batch) or
+    /// [`fire`](Self::fire)), if any: where MATLAB's `evalfis` warns that an input left its
+    /// range. `None` under the other policies.
+    ///
+    /// ```
+    /// use fuzzy_sugeno::{paper_controller, Evaluator, OutsideRange};
+    ///
+    /// let mut controller = Evaluator::new(paper_controller());
+    /// let mut torques = [0.0; 2];
+    /// controller.eval(&[0.1, 0.0, 0.0, 0.0], &mut torques)?;
+    /// assert_eq!(controller.first_outside_range(), None);
+    /// // da1 = -0.414 is outside [-0.3, 0.3]: evaluated as given, as MATLAB does.
+    /// controller.eval(&[-0.414, -0.263, 0.904, 0.246], &mut torques)?;
+    /// assert_eq!(controller.first_outside_range(), Some(OutsideRange { index: 0, value: -0.414 }));
+    /// assert!((torques[0] - 75.93).abs() < 0.01);
+    /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
+    /// ```
+    pub fn first_outside_range(&self) -> Option<OutsideRange> {
+        self.outside
+    }
+
+    /// Records the first input of `rows` (rows of one value per input) outside its range, under
+    /// [`OutOfRange::AsGiven`], until one is found.
+    fn note_outside(&mut self, rows: &[f64]) {
+        if self.outside.is_some() || self.options.out_of_range != OutOfRange::AsGiven {
+            return;
+        }
+        let variables = self.system.inputs();
+        self.outside = rows
+            .iter()
+            .zip(variables.iter().cycle())
+            .enumerate()
+            .find(|(_, (v, var))| **v < var.range[0] || **v > var.range[1])
+            .map(|(k, (&value, _))| OutsideRange {
+                index: k % variables.len(),
+                value,
+            });
     }
 
     /// Evaluates many input vectors: `inputs` holds rows of one value per input variable,
@@ -172,13 +230,22 @@ impl Evaluator {
         }
         let (system, options, one) = (&self.system, &self.options, &mut self.one);
         let point = |x: &[f64], y: &mut [f64]| eval_point(system, options, one, x, y);
-        self.batch.run(system, options, inputs, outputs, point)
+        let result = self.batch.run(system, options, inputs, outputs, point);
+        // The rows evaluated: all of them, or those before the failing one.
+        let done = match &result {
+            Ok(()) => rows,
+            Err(FuzzyError::Batch { row, .. }) => *row,
+            Err(_) => 0,
+        };
+        self.note_outside(&inputs[..done * n_in]);
+        result
     }
 
     /// Computes and returns every rule's firing strength at `inputs` (antecedents combined by
     /// the rule's AND/OR, times the rule's weight), in rule order.
     pub fn fire(&mut self, inputs: &[f64]) -> Result<&[f64], FuzzyError> {
         fire_point(&self.system, &self.options, &mut self.one, inputs)?;
+        self.note_outside(inputs);
         Ok(self.firing_strengths())
     }
 

@@ -1,14 +1,28 @@
 //! IEC 61131-7 Fuzzy Control Language (FCL) for Sugeno systems, read and written, including
 //! the files fuzzylite's FCL exporter writes.
 //!
-//! Written files use the standard's blocks (`FUNCTION_BLOCK`, `VAR_INPUT`, `FUZZIFY`,
-//! `DEFUZZIFY` with singleton terms and `METHOD : COGS`, `RULEBLOCK` with `IF ... THEN ...
-//! WITH w;` rules) and its point lists for triangles and trapezoids. The standard has no bell,
-//! Gaussian, sigmoid or linear terms; those are written as fuzzylite writes them (`TERM N :=
-//! Bell -0.3 0.3 2;`, `TERM z := Linear 1 2 0.5;`), and a `RANGE` is written in every `FUZZIFY`
-//! block as fuzzylite does. Reading accepts both forms, `(* *)` and `//` comments, any case of
-//! the keywords, and rules with or without the final `;`. Numbers are written in their
-//! shortest exact form, so writing then reading gives back the identical system.
+//! Written files are read by fuzzylite 6 (tested against the program in CI) and follow the
+//! standard's blocks: `FUNCTION_BLOCK`, `VAR_INPUT`, `FUZZIFY`, `DEFUZZIFY` with singleton
+//! terms, `METHOD : COGS` and fuzzylite's `ACCU : UnboundedSum`, `RULEBLOCK` with `ACT : PROD`
+//! and rules `if x is a and y is not b then z is c and w is d with 0.5;`, and the standard's
+//! point lists for triangles and trapezoids. Where the two differ the file is written as
+//! fuzzylite reads it: rule keywords in lower case (the standard's keywords are
+//! case-insensitive, fuzzylite's rule parser knows only the lower-case ones), conclusions joined
+//! by `and` (the standard's grammar also has `,`, which fuzzylite does not understand), no
+//! comment (fuzzylite stops at `(*`, the standard has no `//`). The standard has no bell,
+//! Gaussian, sigmoid or linear terms; those are written as fuzzylite writes them
+//! (`TERM N := Bell -0.3 0.3 2.0;`, `TERM z := Linear 1.0 2.0 0.5;`), and a `RANGE` is written
+//! in every `FUZZIFY` block as fuzzylite does. MATLAB's steps (`smf`, `zmf`, `pimf` with a foot
+//! at or past its shoulder) are refused: fuzzylite's shapes with those parameters evaluate
+//! otherwise. Two terms of a variable sharing a name (which a `.fis` file allows) are refused too.
+//! Names must be identifiers that are no keyword of
+//! either (`END_VAR`, `RANGE`, `then`, fuzzylite's hedges `any`, `very`, ...): writing refuses
+//! any other name rather than write a file that reads as something else.
+//!
+//! Reading accepts both forms, `(* *)` and `//` comments, any case of the keywords, `,` or
+//! `and` between conclusions, and rules with or without the final `;`. Numbers are written in
+//! their shortest exact form (always with a decimal point), so writing then reading gives back
+//! the identical system.
 
 use crate::error::FuzzyError;
 use crate::membership::{KINDS, Kind, MembershipFn};
@@ -26,21 +40,66 @@ const KEYWORDS: [&str; 9] = [
     "IF", "THEN", "IS", "NOT", "AND", "OR", "WITH", "RULE", "TERM",
 ];
 
+/// Further words a written name cannot be (compared ignoring case): the rest of IEC 61131-7's
+/// keywords, and the words fuzzylite's rule parser takes for hedges.
+const RESERVED: [&str; 39] = [
+    "ACCU",
+    "ACT",
+    "ASUM",
+    "BDIF",
+    "BSUM",
+    "COA",
+    "COG",
+    "COGS",
+    "COGSS",
+    "DEFAULT",
+    "DEFUZZIFY",
+    "END_DEFUZZIFY",
+    "END_FUNCTION_BLOCK",
+    "END_FUZZIFY",
+    "END_OPTIONS",
+    "END_RULEBLOCK",
+    "END_VAR",
+    "FUNCTION_BLOCK",
+    "FUZZIFY",
+    "LM",
+    "MAX",
+    "METHOD",
+    "MIN",
+    "MM",
+    "NC",
+    "NSUM",
+    "OPTIONS",
+    "PROD",
+    "RANGE",
+    "REAL",
+    "RM",
+    "RULEBLOCK",
+    "VAR_INPUT",
+    "VAR_OUTPUT",
+    "ANY",
+    "VERY",
+    "SOMEWHAT",
+    "SELDOM",
+    "EXTREMELY",
+];
+
 impl FuzzySystem {
-    /// Writes the system as IEC 61131-7 FCL (see the module documentation). Fails if a name
-    /// is not an FCL identifier (letters, digits and `_`, not starting with a digit, not a
-    /// keyword).
+    /// Writes the system as FCL that fuzzylite 6 and IEC 61131-7 read (see the module
+    /// documentation). Fails if a name is not an FCL identifier (ASCII letters, digits and `_`,
+    /// not starting with a digit) or is a keyword of the standard or of fuzzylite's rules.
     ///
     /// ```
     /// use fuzzy_sugeno::{paper_controller, FuzzySystem};
     /// let fcl = paper_controller().to_fcl()?;
     /// assert!(fcl.contains("TERM N := Bell -0.3 0.3 2.0;"));
+    /// assert!(fcl.contains("then tau1 is VP and tau2 is VP;"));
     /// assert_eq!(FuzzySystem::from_fcl(&fcl)?, paper_controller());
     /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
     /// ```
     pub fn to_fcl(&self) -> Result<String, FuzzyError> {
         let identifier = |kind: &'static str, name: &str| {
-            if is_identifier(name) {
+            if is_identifier(name) && !RESERVED.iter().any(|k| k.eq_ignore_ascii_case(name)) {
                 Ok(())
             } else {
                 Err(FuzzyError::FclName {
@@ -50,13 +109,7 @@ impl FuzzySystem {
             }
         };
         identifier("system", self.name())?;
-        let mut out = format!(
-            "(* Sugeno system '{}', written by hrm (fuzzy-sugeno) as IEC 61131-7 FCL; bell, \
-             Gaussian, sigmoid and linear terms use fuzzylite's names. *)\n\
-             FUNCTION_BLOCK {}\n\nVAR_INPUT\n",
-            self.name(),
-            self.name()
-        );
+        let mut out = format!("FUNCTION_BLOCK {}\n\nVAR_INPUT\n", self.name());
         for input in self.inputs() {
             identifier("input", &input.name)?;
             let _ = writeln!(out, "    {} : REAL;", input.name);
@@ -70,11 +123,25 @@ impl FuzzySystem {
         for input in self.inputs() {
             let _ = write!(
                 out,
-                "\nFUZZIFY {}\n    RANGE := ({:?} .. {:?});\n",
-                input.name, input.range[0], input.range[1]
+                "\nFUZZIFY {}\n    RANGE := ({} .. {});\n",
+                input.name,
+                real(input.range[0]),
+                real(input.range[1])
             );
+            unique(
+                "input",
+                &input.name,
+                input.sets.iter().map(|set| set.name.as_str()),
+            )?;
             for set in &input.sets {
                 identifier("set", &set.name)?;
+                if let Some(shape) = matlab_step(&set.membership) {
+                    return Err(FuzzyError::FclStep {
+                        input: input.name.clone(),
+                        set: set.name.clone(),
+                        shape,
+                    });
+                }
                 let _ = writeln!(out, "    TERM {} := {};", set.name, term(&set.membership));
             }
             out.push_str("END_FUZZIFY\n");
@@ -83,20 +150,27 @@ impl FuzzySystem {
         for output in self.outputs() {
             let _ = write!(
                 out,
-                "\nDEFUZZIFY {}\n    RANGE := ({:?} .. {:?});\n",
-                output.name, output.range[0], output.range[1]
+                "\nDEFUZZIFY {}\n    RANGE := ({} .. {});\n",
+                output.name,
+                real(output.range[0]),
+                real(output.range[1])
             );
+            unique(
+                "output",
+                &output.name,
+                output.terms.iter().map(|t| t.name.as_str()),
+            )?;
             for t in &output.terms {
                 identifier("term", &t.name)?;
                 let value = match &t.function {
-                    OutputFn::Constant(c) => format!("{c:?}"),
+                    OutputFn::Constant(c) => real(*c),
                     OutputFn::Linear {
                         coefficients,
                         constant,
                     } => {
                         let mut s = "Linear".to_string();
                         for p in coefficients.iter().chain([constant]) {
-                            let _ = write!(s, " {p:?}");
+                            let _ = write!(s, " {}", real(*p));
                         }
                         s
                     }
@@ -109,8 +183,9 @@ impl FuzzySystem {
             };
             let _ = writeln!(
                 out,
-                "    METHOD : {method};\n    DEFAULT := {:?};\nEND_DEFUZZIFY",
-                0.5 * (output.range[0] + output.range[1])
+                "    METHOD : {method};\n    ACCU : UnboundedSum;\n    DEFAULT := {};\n\
+                 END_DEFUZZIFY",
+                real(0.5 * (output.range[0] + output.range[1]))
             );
         }
         let and = match methods.and {
@@ -121,11 +196,14 @@ impl FuzzySystem {
             OrMethod::ProbabilisticSum => "ASUM",
             OrMethod::Maximum => "MAX",
         };
-        let _ = writeln!(out, "\nRULEBLOCK rules\n    AND : {and};\n    OR : {or};");
+        let _ = writeln!(
+            out,
+            "\nRULEBLOCK rules\n    AND : {and};\n    OR : {or};\n    ACT : PROD;"
+        );
         for (r, rule) in self.rules().iter().enumerate() {
             let connective = match rule.connective {
-                Connective::And => " AND ",
-                Connective::Or => " OR ",
+                Connective::And => " and ",
+                Connective::Or => " or ",
             };
             let premises: Vec<String> = rule
                 .antecedents
@@ -133,9 +211,9 @@ impl FuzzySystem {
                 .zip(self.inputs())
                 .filter_map(|(a, input)| match *a {
                     Antecedent::Any => None,
-                    Antecedent::Is(k) => Some(format!("{} IS {}", input.name, input.sets[k].name)),
+                    Antecedent::Is(k) => Some(format!("{} is {}", input.name, input.sets[k].name)),
                     Antecedent::IsNot(k) => {
-                        Some(format!("{} IS NOT {}", input.name, input.sets[k].name))
+                        Some(format!("{} is not {}", input.name, input.sets[k].name))
                     }
                 })
                 .collect();
@@ -144,20 +222,20 @@ impl FuzzySystem {
                 .iter()
                 .zip(self.outputs())
                 .filter_map(|(c, output)| {
-                    c.map(|k| format!("{} IS {}", output.name, output.terms[k].name))
+                    c.map(|k| format!("{} is {}", output.name, output.terms[k].name))
                 })
                 .collect();
             let weight = if rule.weight == 1.0 {
                 String::new()
             } else {
-                format!(" WITH {:?}", rule.weight)
+                format!(" with {}", real(rule.weight))
             };
             let _ = writeln!(
                 out,
-                "    RULE {} : IF {} THEN {}{weight};",
+                "    RULE {} : if {} then {}{weight};",
                 r + 1,
                 premises.join(connective),
-                conclusions.join(", ")
+                conclusions.join(" and ")
             );
         }
         out.push_str("END_RULEBLOCK\n\nEND_FUNCTION_BLOCK\n");
@@ -186,20 +264,72 @@ fn term(mf: &MembershipFn) -> String {
     let (p, _) = mf.param_array();
     match *mf {
         MembershipFn::Triangle { .. } => {
-            format!("({:?}, 0.0) ({:?}, 1.0) ({:?}, 0.0)", p[0], p[1], p[2])
+            format!(
+                "({}, 0.0) ({}, 1.0) ({}, 0.0)",
+                real(p[0]),
+                real(p[1]),
+                real(p[2])
+            )
         }
         MembershipFn::Trapezoid { .. } => format!(
-            "({:?}, 0.0) ({:?}, 1.0) ({:?}, 1.0) ({:?}, 0.0)",
-            p[0], p[1], p[2], p[3]
+            "({}, 0.0) ({}, 1.0) ({}, 1.0) ({}, 0.0)",
+            real(p[0]),
+            real(p[1]),
+            real(p[2]),
+            real(p[3])
         ),
         _ => {
             let kind = mf.kind();
             let mut text = kind.fcl.to_string();
             for &i in kind.fcl_order {
-                let _ = write!(text, " {:?}", p[i]);
+                let _ = write!(text, " {}", real(p[i]));
             }
             text
         }
+    }
+}
+
+/// Refuses a variable two of whose terms share a name.
+fn unique<'a>(
+    kind: &str,
+    variable: &str,
+    mut names: impl Iterator<Item = &'a str> + Clone,
+) -> Result<(), FuzzyError> {
+    while let Some(name) = names.next() {
+        if names.clone().any(|other| other == name) {
+            return Err(FuzzyError::FclDuplicateTerm {
+                variable: format!("{kind} '{variable}'"),
+                name: name.to_string(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The MATLAB name of a set that is one of MATLAB's steps (`smf`/`zmf` with `a >= b`, `pimf`
+/// with `a >= b` or `c >= d`): fuzzylite's `SShape`, `ZShape` and `PiShape` with those
+/// parameters are 0 where MATLAB's steps are 1.
+fn matlab_step(mf: &MembershipFn) -> Option<&'static str> {
+    match *mf {
+        MembershipFn::SShape { start, end } if start >= end => Some("smf"),
+        MembershipFn::ZShape { start, end } if start >= end => Some("zmf"),
+        MembershipFn::PiShape {
+            left_foot,
+            left_shoulder,
+            right_shoulder,
+            right_foot,
+        } if left_foot >= left_shoulder || right_shoulder >= right_foot => Some("pimf"),
+        _ => None,
+    }
+}
+
+/// A finite number in its shortest exact form, with the decimal point an IEC 61131 REAL
+/// literal needs (`1.0e-7`, not Rust's `1e-7`).
+fn real(x: f64) -> String {
+    let text = format!("{x:?}");
+    match text.find('e') {
+        Some(e) if !text.contains('.') => format!("{}.0{}", &text[..e], &text[e..]),
+        _ => text,
     }
 }
 

@@ -17,7 +17,7 @@ mod system;
 pub use analysis::{AnalysisOptions, AnalysisReport};
 pub use builder::SystemBuilder;
 pub use error::{ConsequentParameter, FuzzyError, LearningProblem, SystemProblem};
-pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange};
+pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange, OutsideRange};
 pub use export_c::CSource;
 pub use fis::FisNote;
 pub use membership::MembershipFn;

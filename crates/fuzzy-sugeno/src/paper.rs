@@ -196,19 +196,42 @@ mod tests {
         assert!(tau1 > 80.0 && tau2 > 40.0);
     }
 
+    /// The direct formula of eq 21 for one output pair: bells of half-width `r` (error) and
+    /// `rv` (rate), slope 2, centred at the range ends; `z` the constants of (N,N), (N,P),
+    /// (P,N), (P,P).
+    fn by_formula(e: f64, v: f64, r: f64, rv: f64, z: [f64; 4]) -> f64 {
+        let bell = |x: f64, c: f64, a: f64| 1.0 / (1.0 + ((x - c) / a).powi(4));
+        let (n, p) = (bell(e, -r, r), bell(e, r, r));
+        let (vn, vp) = (bell(v, -rv, rv), bell(v, rv, rv));
+        (n * vn * z[0] + n * vp * z[1] + p * vn * z[2] + p * vp * z[3]) / ((n + p) * (vn + vp))
+    }
+
     #[test]
-    fn out_of_range_inputs_saturate_by_default() {
-        // Clamped, a far error acts like the edge of the range.
-        assert_eq!(eval([5.0, 0.0, 0.0, 0.0]), eval([0.3, 0.0, 0.0, 0.0]));
-        // As given, the bells decay on both sides and the action fades towards zero.
+    fn out_of_range_inputs_are_evaluated_as_given_by_default_as_matlab_does() {
+        // MATLAB's evalfis (and Simulink's Fuzzy Logic Controller block) evaluate an input
+        // outside its range as given, with a warning: here da1 = -0.414, outside [-0.3, 0.3].
+        let x = [-0.414, -0.263, 0.904, 0.246];
+        let tau1 = by_formula(x[0], x[2], 0.3, 1.0, [100.0, 80.0, -80.0, -100.0]);
+        let tau2 = by_formula(x[1], x[3], 0.3, 1.0, [50.0, 40.0, -40.0, -50.0]);
+        let got = eval(x);
+        assert!(close(got[0], tau1) && close(got[1], tau2), "{got:?}");
+        assert!((tau1 - 75.933).abs() < 1e-3, "{tau1}");
+        // Clamped (the explicit choice), da1 acts like the edge of its range.
         let options = crate::EvalOptions {
-            out_of_range: OutOfRange::AsGiven,
+            out_of_range: OutOfRange::Clamp,
             ..Default::default()
         };
-        let mut as_given = Evaluator::with_options(paper_controller(), options).unwrap();
+        let mut clamped = Evaluator::with_options(paper_controller(), options).unwrap();
         let mut out = [0.0; 2];
-        as_given.eval(&[5.0, 0.0, 0.0, 0.0], &mut out).unwrap();
-        assert!(out[0] > -80.0 && out[0] < 0.0, "{}", out[0]);
+        clamped.eval(&x, &mut out).unwrap();
+        let tau1 = by_formula(-0.3, x[2], 0.3, 1.0, [100.0, 80.0, -80.0, -100.0]);
+        assert!(close(out[0], tau1), "{}", out[0]);
+        assert!((tau1 - 71.321).abs() < 1e-3, "{tau1}");
+        // Far out, clamping saturates the action while the bells evaluated as given fade.
+        clamped.eval(&[5.0, 0.0, 0.0, 0.0], &mut out).unwrap();
+        assert_eq!(out, eval([0.3, 0.0, 0.0, 0.0]));
+        let [far, _] = eval([5.0, 0.0, 0.0, 0.0]);
+        assert!(far > -80.0 && far < 0.0, "{far}");
     }
 
     #[test]

@@ -616,6 +616,9 @@ struct FuzzyRequest {
     controller: Option<String>,
     fis: Option<String>,
     inputs: Vec<f64>,
+    /// `"as-given"` (the default, MATLAB's evalfis), `"clamp"` or `"error"`.
+    #[serde(default)]
+    out_of_range: Option<String>,
 }
 
 /// `fuzzy`: the outputs of the paper's controller (eqs 19-24), or of a system given as `.fis` text.
@@ -635,8 +638,24 @@ fn fuzzy(request: FuzzyRequest) -> EvalResult {
             ));
         }
     };
-    let mut outputs = vec![0.0; system.outputs().len()];
-    fuzzy_sugeno::Evaluator::new(system).eval(&request.inputs, &mut outputs)?;
+    let out_of_range = match request.out_of_range.as_deref() {
+        None | Some("as-given") => fuzzy_sugeno::OutOfRange::AsGiven,
+        Some("clamp") => fuzzy_sugeno::OutOfRange::Clamp,
+        Some("error") => fuzzy_sugeno::OutOfRange::Error,
+        Some(other) => {
+            return Err(EvalError::input(format!(
+                "out_of_range {other:?}: expected \"as-given\", \"clamp\" or \"error\""
+            )));
+        }
+    };
+    let options = fuzzy_sugeno::EvalOptions {
+        out_of_range,
+        ..fuzzy_sugeno::EvalOptions::default()
+    };
+    let mut evaluator = fuzzy_sugeno::Evaluator::with_options(system, options)?;
+    let mut outputs = vec![0.0; evaluator.system().outputs().len()];
+    evaluator.eval(&request.inputs, &mut outputs)?;
+    crate::fis_cmd::warn_outside_range(&evaluator);
     finite("outputs", &outputs)?;
     Ok(json_fields([("outputs", json!(outputs))]))
 }
@@ -783,6 +802,24 @@ mod tests {
         let answers = run(two);
         assert_eq!(vector(&answers[0]["a_ddot"]).len(), 2);
         assert_eq!(answers[1]["error"]["kind"], "invalid_input");
+    }
+
+    /// An input outside its range is evaluated as given by default (MATLAB's evalfis: 75.93
+    /// for tau1 at the paper's point, by the formula of eq 21), clamped on request (71.32).
+    #[test]
+    fn fuzzy_inputs_outside_their_ranges_as_given_unless_clamped() {
+        let point = "[-0.414,-0.263,0.904,0.246]";
+        let input = format!(
+            "{{\"op\":\"fuzzy\",\"controller\":\"paper\",\"inputs\":{point}}}\n\
+            {{\"op\":\"fuzzy\",\"controller\":\"paper\",\"inputs\":{point},\"out_of_range\":\"clamp\"}}\n\
+            {{\"op\":\"fuzzy\",\"controller\":\"paper\",\"inputs\":{point},\"out_of_range\":\"error\"}}\n\
+            {{\"op\":\"fuzzy\",\"controller\":\"paper\",\"inputs\":{point},\"out_of_range\":\"wrap\"}}\n"
+        );
+        let answers = run(input.as_bytes());
+        approx::assert_abs_diff_eq!(vector(&answers[0]["outputs"])[0], 75.933, epsilon = 1e-3);
+        approx::assert_abs_diff_eq!(vector(&answers[1]["outputs"])[0], 71.321, epsilon = 1e-3);
+        assert_eq!(answers[2]["error"]["kind"], "invalid_input");
+        assert_eq!(answers[3]["error"]["kind"], "invalid_input");
     }
 
     #[test]

@@ -52,8 +52,9 @@ enum FisCommand {
         /// One value per input, in the file's order.
         #[arg(required = true, allow_negative_numbers = true)]
         inputs: Vec<f64>,
-        /// What to do with an input outside its range.
-        #[arg(long, value_enum, default_value_t = RangePolicy::Clamp)]
+        /// What to do with an input outside its range (as-given: MATLAB's evalfis, with a
+        /// warning on standard error).
+        #[arg(long, value_enum, default_value_t = RangePolicy::AsGiven)]
         out_of_range: RangePolicy,
     },
     /// Learn a system from a CSV of samples (genfis, then ANFIS) and write it as a .fis file.
@@ -81,12 +82,45 @@ enum FisCommand {
 /// The out-of-range policies, as command-line values.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub(crate) enum RangePolicy {
-    /// Evaluate at the nearest end of the range.
+    /// Evaluate at the nearest end of the range (saturates the action).
     Clamp,
-    /// Evaluate the membership functions at the value as given.
+    /// Evaluate the membership functions at the value as given (MATLAB's evalfis and
+    /// Simulink's Fuzzy Logic Controller; bells fade far out).
     AsGiven,
     /// Refuse.
     Error,
+}
+
+impl RangePolicy {
+    /// The library's policy.
+    pub(crate) fn policy(self) -> OutOfRange {
+        match self {
+            RangePolicy::Clamp => OutOfRange::Clamp,
+            RangePolicy::AsGiven => OutOfRange::AsGiven,
+            RangePolicy::Error => OutOfRange::Error,
+        }
+    }
+}
+
+/// Warns on standard error, as MATLAB's `evalfis` does, when `evaluator` has evaluated an input
+/// outside its range as given: once per process (a `hrm eval` session answers many requests).
+pub(crate) fn warn_outside_range(evaluator: &Evaluator) {
+    static WARNED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+    if let Some(outside) = evaluator.first_outside_range()
+        && !WARNED.swap(true, std::sync::atomic::Ordering::Relaxed)
+    {
+        let input = &evaluator.system().inputs()[outside.index];
+        let line = format!(
+            "warning: input {} ('{}') = {} is outside its range [{}, {}]; evaluated as given, as \
+             MATLAB's evalfis does (--out-of-range clamp evaluates at the nearest end)",
+            outside.index + 1,
+            input.name,
+            outside.value,
+            input.range[0],
+            input.range[1]
+        );
+        eprintln!("{}", console::error_line(&line));
+    }
 }
 
 /// Runs `hrm fis ...`.
@@ -222,8 +256,18 @@ fn check(system: &FuzzySystem, options: &AnalysisOptions) -> Result<(String, boo
             options.samples_per_input, options.max_grid_points
         ));
     }
+    text.push_str(OUT_OF_RANGE_NOTE);
     Ok((text, report.passed()))
 }
+
+/// What `hrm fis check` says about the two ways of evaluating an input outside its range.
+const OUT_OF_RANGE_NOTE: &str = "inputs outside their ranges: `hrm fis eval`, `hrm eval` and a \
+scenario's fuzzy controller evaluate them as given by default, as MATLAB's evalfis and \
+Simulink's Fuzzy Logic Controller block do (with a warning on standard error): sets that decay on \
+both sides (bells, Gaussians) then fade, so a large error weakens the controller's action, and \
+far out every output tends to a mean of the rules' conclusions; `--out-of-range clamp` (a \
+scenario's `[controller] out_of_range = \"clamp\"`) evaluates them at the nearest end of the \
+range instead, so a large error acts like the edge of the range and the action saturates\n";
 
 /// Each output's name and value at `inputs`.
 fn eval(
@@ -231,13 +275,8 @@ fn eval(
     inputs: &[f64],
     policy: RangePolicy,
 ) -> Result<Vec<(String, f64)>, String> {
-    let out_of_range = match policy {
-        RangePolicy::Clamp => OutOfRange::Clamp,
-        RangePolicy::AsGiven => OutOfRange::AsGiven,
-        RangePolicy::Error => OutOfRange::Error,
-    };
     let options = EvalOptions {
-        out_of_range,
+        out_of_range: policy.policy(),
         ..EvalOptions::default()
     };
     let mut evaluator = Evaluator::with_options(system, options).map_err(|e| e.to_string())?;
@@ -245,6 +284,7 @@ fn eval(
     evaluator
         .eval(inputs, &mut outputs)
         .map_err(|e| e.to_string())?;
+    warn_outside_range(&evaluator);
     let names = evaluator.system().outputs().iter().map(|o| o.name.clone());
     Ok(names.zip(outputs).collect())
 }
@@ -611,6 +651,7 @@ mod tests {
         let (report, passed) = check(&paper_controller(), &AnalysisOptions::default()).unwrap();
         assert!(passed, "{report}");
         assert!(report.contains("completeness: pass") && report.contains("continuity: pass"));
+        assert!(report.ends_with(OUT_OF_RANGE_NOTE), "{report}");
         let narrow = PaperController {
             width_fraction: 0.5,
             ..PaperController::default()

@@ -5,7 +5,7 @@
 use crate::fis_cmd::{RangePolicy, read_system};
 use crate::output_dir;
 use clap::{Args, ValueEnum};
-use fuzzy_sugeno::{EvalOptions, NoRuleFired, OutOfRange};
+use fuzzy_sugeno::{EvalOptions, NoRuleFired};
 use std::path::{Path, PathBuf};
 
 /// The arguments of `hrm fis export`.
@@ -22,8 +22,9 @@ pub struct ExportArgs {
     /// C: the prefix of the file names and of the function, `<prefix>_eval`.
     #[arg(long, default_value = "hrm_fis")]
     prefix: String,
-    /// C: what the function does with an input outside its range.
-    #[arg(long, value_enum, default_value_t = RangePolicy::Clamp)]
+    /// C: what the function does with an input outside its range (as-given: MATLAB's
+    /// evalfis, the default of `hrm fis eval`).
+    #[arg(long, value_enum, default_value_t = RangePolicy::AsGiven)]
     out_of_range: RangePolicy,
     /// C: what the function does when no rule fires for an output.
     #[arg(long, value_enum, default_value_t = NoRulePolicy::Middle)]
@@ -54,11 +55,7 @@ pub fn run(args: ExportArgs) -> Result<(), String> {
     let files: Vec<(String, String)> = match args.format {
         Format::C => {
             let options = EvalOptions {
-                out_of_range: match args.out_of_range {
-                    RangePolicy::Clamp => OutOfRange::Clamp,
-                    RangePolicy::AsGiven => OutOfRange::AsGiven,
-                    RangePolicy::Error => OutOfRange::Error,
-                },
+                out_of_range: args.out_of_range.policy(),
                 no_rule_fired: match args.no_rule_fired {
                     NoRulePolicy::Middle => NoRuleFired::MiddleOfRange,
                     NoRulePolicy::Error => NoRuleFired::Error,

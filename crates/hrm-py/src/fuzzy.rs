@@ -12,8 +12,8 @@ use std::sync::Mutex;
 /// A zero- or first-order Takagi-Sugeno fuzzy system (eqs 19-21), with MATLAB .fis interop.
 ///
 /// Build one with System.from_fis(path_or_text) or hrm.fuzzy.paper_controller(). Inputs outside
-/// a variable's range are evaluated at the nearest end of the range (the `hrm fis eval`
-/// default).
+/// a variable's range are evaluated as given, as MATLAB's evalfis does (the `hrm fis eval`
+/// default), without a warning.
 #[pyclass(module = "hrm.fuzzy", frozen)]
 pub struct System {
     system: FuzzySystem,

@@ -23,8 +23,8 @@ pub use input_file::{MAX_INPUT_FILE_BYTES, read_text_file};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use scenario::{
     Alpha0, ArmSpec, BranchSpec, CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup,
-    ControllerSpec, InitialSpec, IntegratorSpec, LimitsSpec, ModalSpec, ModalTorqueLimit,
-    NoiseSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec, TorqueLimit,
+    ControllerSpec, FuzzyInputRange, InitialSpec, IntegratorSpec, LimitsSpec, ModalSpec,
+    ModalTorqueLimit, NoiseSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec, TorqueLimit,
 };
 pub use simulation::{
     ControlSample, Integrator, Lockstep, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES,

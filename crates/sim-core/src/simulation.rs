@@ -59,7 +59,7 @@ pub struct LoopSettings {
     pub max_modal_error: f64,
     /// Optional per-joint torque limits (N m): exceeding one is reported in the summary.
     pub joint_torque_limits: Option<Vec<f64>>,
-    /// Optional actuator limits on the modal torques (N m, `m` entries, finite and positive):
+    /// Optional limits on the modal forces `tau*` (N m, `m` entries, finite and positive; not joint torques):
     /// every controller's output is clamped to `[-limit_i, limit_i]` before it is applied
     /// (the clamped torque is what is held, recorded and summed into the effort), and each
     /// sample records which coordinates were clamped. Controllers see them in

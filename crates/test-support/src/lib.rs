@@ -3,6 +3,7 @@
 
 pub mod alloc;
 pub mod config;
+pub mod engine;
 pub mod numeric;
 pub mod refusal;
 pub mod sample;

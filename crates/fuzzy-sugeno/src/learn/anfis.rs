@@ -152,8 +152,9 @@ pub fn anfis(
 /// The system must have one output, product AND, the weighted-average defuzzifier and AND
 /// rules whose antecedents are sets or "don't care" (no negation), each rule concluding on a
 /// constant or linear term (terms may be shared by rules); every membership type trains (a
-/// `constant` degree stays fixed). Inputs are clamped to their ranges, as the default
-/// [`Evaluator`](crate::Evaluator) does, so the errors reported are the evaluator's; a sample on
+/// `constant` degree stays fixed). Inputs are taken as given, even outside their ranges, as
+/// MATLAB's `anfis` and the default [`Evaluator`](crate::Evaluator) take them, so the errors
+/// reported are the evaluator's; a sample on
 /// which no rule fires is predicted as the middle of the output range and does not move any
 /// parameter.
 ///
@@ -295,22 +296,17 @@ impl Anfis {
             }
             .into());
         }
-        let clamped = |data: &TrainingData| {
+        let columns = |data: &TrainingData| {
             let mut x = Vec::with_capacity(data.rows() * n_inputs);
             let mut y = Vec::with_capacity(data.rows());
             for r in 0..data.rows() {
-                x.extend(
-                    data.inputs(r)
-                        .iter()
-                        .zip(system.inputs())
-                        .map(|(v, input)| v.clamp(input.range[0], input.range[1])),
-                );
+                x.extend_from_slice(data.inputs(r));
                 y.push(data.target(r, output));
             }
             (x, y)
         };
-        let (train_x, train_y) = clamped(train);
-        let (check_x, check_y) = check.map(clamped).unwrap_or_default();
+        let (train_x, train_y) = columns(train);
+        let (check_x, check_y) = check.map(columns).unwrap_or_default();
         let [lo, hi] = output_variable.range;
         let (n_mf, n_rules) = (mfs.len(), rules.len());
         let net = Network {

@@ -339,13 +339,9 @@ fn reference_z(x: f64, a: f64, b: f64) -> f64 {
     }
 }
 
-/// Rule strengths and outputs (`None` where no rule fired) at `x`, inputs clamped to range.
+/// Rule strengths and outputs (`None` where no rule fired) at `x`, inputs as given (the
+/// evaluator's default, MATLAB's `evalfis`), even outside their ranges.
 pub fn reference_eval(system: &FuzzySystem, x: &[f64]) -> (Vec<f64>, Vec<Option<f64>>) {
-    let x: Vec<f64> = x
-        .iter()
-        .zip(system.inputs())
-        .map(|(v, var)| v.clamp(var.range[0], var.range[1]))
-        .collect();
     let methods = system.methods();
     let strengths: Vec<f64> = system
         .rules()
@@ -397,9 +393,7 @@ pub fn reference_eval(system: &FuzzySystem, x: &[f64]) -> (Vec<f64>, Vec<Option<
                         OutputFn::Linear {
                             coefficients,
                             constant,
-                        } => {
-                            constant + coefficients.iter().zip(&x).map(|(p, v)| p * v).sum::<f64>()
-                        }
+                        } => constant + coefficients.iter().zip(x).map(|(p, v)| p * v).sum::<f64>(),
                     };
                     weighted += w * z;
                     total += w;

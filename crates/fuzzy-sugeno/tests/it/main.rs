@@ -1,5 +1,5 @@
 //! The integration tests of fuzzy-sugeno, one binary: a module per `src` module it tests
-//! (`evaluator`, `fcl`, `export_c`, `anfis`; `fis_files`, `fis_fuzz` and `fis_interop` for the
+//! (`evaluator`, `fcl` (and `fuzzylite`, against the real program), `export_c`, `anfis`; `fis_files`, `fis_fuzz` and `fis_interop` for the
 //! `.fis` reader and writer), `batch` for the SIMD batch against one point at a time, `bad_input` for every refusal, `allocation` for the allocation-free
 //! evaluation and training, and `common` for random systems and the independent reference
 //! evaluator.
@@ -20,3 +20,4 @@ mod fcl;
 mod fis_files;
 mod fis_fuzz;
 mod fis_interop;
+mod fuzzylite;

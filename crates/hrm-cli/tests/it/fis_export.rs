@@ -39,6 +39,36 @@ fn fcl_export_evaluates_like_the_fis_file() {
     assert_eq!(eval(FUZZYLITE_FCL), expected);
 }
 
+/// A name FCL cannot carry (a variable named `END_VAR`) is a one-line error naming it, exit 1,
+/// and nothing is written.
+#[test]
+fn fcl_export_refuses_a_keyword_name_and_writes_nothing() {
+    let dir = scratch("fis-export-fcl-keyword");
+    let fis = dir.join("keyword.fis");
+    let text = std::fs::read_to_string(PAPER_FIS)
+        .unwrap()
+        .replace("Name='da1'", "Name='END_VAR'");
+    std::fs::write(&fis, text).unwrap();
+    let out = dir.join("out");
+    let refused = hrm(&[
+        "fis",
+        "export",
+        "--format",
+        "fcl",
+        fis.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.starts_with("hrm: export: the input name 'END_VAR' cannot be written in FCL"),
+        "{stderr}"
+    );
+    assert!(!out.join("keyword.fcl").exists());
+}
+
 #[test]
 fn c_export_writes_the_header_and_source() {
     let dir = scratch("fis-export-c");
@@ -83,4 +113,27 @@ fn check_reads_fcl_without_the_notes_line() {
     let (notes, analysis) = from_fis.split_once('\n').unwrap();
     assert!(notes.ends_with("paper.fis: nothing ignored"), "{notes}");
     assert_eq!(from_fcl, analysis);
+}
+
+/// `hrm fis eval` evaluates an input outside its range as given, as MATLAB's evalfis does, with
+/// one warning line on standard error; `--out-of-range clamp` evaluates it at the range's end.
+#[test]
+fn eval_takes_inputs_outside_their_ranges_as_given_with_a_warning() {
+    let x = ["-0.414", "-0.263", "0.904", "0.246"];
+    let as_given = hrm(&[&["fis", "eval", PAPER_FIS][..], &x[..]].concat());
+    assert!(stdout(&as_given).starts_with("tau1 = 75.933"));
+    let warning = String::from_utf8_lossy(&as_given.stderr);
+    assert_eq!(warning.lines().count(), 1, "{warning}");
+    assert!(
+        warning
+            .starts_with("hrm: warning: input 1 ('da1') = -0.414 is outside its range [-0.3, 0.3]"),
+        "{warning}"
+    );
+    let clamped = hrm(&[
+        &["fis", "eval", PAPER_FIS, "--out-of-range", "clamp"][..],
+        &x[..],
+    ]
+    .concat());
+    assert!(stdout(&clamped).starts_with("tau1 = 71.320"));
+    assert!(clamped.stderr.is_empty());
 }

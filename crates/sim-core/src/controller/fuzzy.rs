@@ -6,7 +6,7 @@ use super::{
 };
 use crate::error::SimError;
 use crate::reference::ReferenceSample;
-use fuzzy_sugeno::{Evaluator, FuzzySystem};
+use fuzzy_sugeno::{EvalOptions, Evaluator, FuzzySystem, OutOfRange, OutsideRange};
 use modal_reduce::{ReducedData, ReducedModel};
 
 /// How a fuzzy system's inputs and outputs sit on the `m` coordinates.
@@ -224,6 +224,22 @@ impl FuzzyController {
         }
         self.gravity = Some(ReducedData::new(model));
         Ok(self)
+    }
+
+    /// The same controller evaluating inputs outside their ranges by `policy`; the default is
+    /// MATLAB's [`OutOfRange::AsGiven`] (`evalfis`, Simulink's Fuzzy Logic Controller block).
+    pub fn with_out_of_range(mut self, policy: OutOfRange) -> Result<Self, SimError> {
+        let options = EvalOptions {
+            out_of_range: policy,
+            ..self.evaluator.options().clone()
+        };
+        self.evaluator = Evaluator::with_options(self.evaluator.system().clone(), options)?;
+        Ok(self)
+    }
+
+    /// The first input evaluated outside its range, as given, if any (where MATLAB warns).
+    pub fn first_outside_range(&self) -> Option<OutsideRange> {
+        self.evaluator.first_outside_range()
     }
 
     /// The fuzzy system.

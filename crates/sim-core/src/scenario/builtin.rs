@@ -4,7 +4,7 @@ use super::file::{ScenarioError, parse};
 use super::schema::Scenario;
 
 /// The scenarios shipped with the crate, by name: the paper's experiments (section 5) with the
-/// tracking task also five times faster under actuator limits, then the paper's tracking task
+/// tracking task also five times faster under limits on the modal forces `tau*`, then the paper's tracking task
 /// with two harmonics and with `alpha0` free.
 const BUILTIN: &[(&str, &str)] = &[
     (
@@ -53,7 +53,7 @@ impl Scenario {
     }
 
     /// The names of the shipped scenarios: `paper-tracking` (Figures 10-11),
-    /// `paper-tracking-fast` (the same path in 1 s under actuator limits), the
+    /// `paper-tracking-fast` (the same path in 1 s under `tau*` limits), the
     /// `paper-responses-*` step, sine and noise responses (Figure 9), and the tracking task for
     /// other modal families: `harmonic-tracking` (`K = 2`, `m = 4`) and `free-base-tracking`
     /// (`alpha0` free, `m = 3`).

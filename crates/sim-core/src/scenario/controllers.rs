@@ -93,10 +93,10 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         name: "fuzzy",
         description: "the paper's fuzzy controller (eqs 19-24), or the .fis system given",
         build: |s| {
-            Ok(Box::new(FuzzyController::new(
-                s.spec.fuzzy_system()?,
-                m(s),
-            )?))
+            Ok(Box::new(
+                FuzzyController::new(s.spec.fuzzy_system()?, m(s))?
+                    .with_out_of_range(s.spec.out_of_range.unwrap_or_default().into())?,
+            ))
         },
     },
     ControllerEntry {
@@ -127,7 +127,8 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         name: "fuzzy-gc",
         description: "the fuzzy controller plus gravity compensation G*",
         build: |s| {
-            let fuzzy = FuzzyController::new(s.spec.fuzzy_system()?, m(s))?;
+            let fuzzy = FuzzyController::new(s.spec.fuzzy_system()?, m(s))?
+                .with_out_of_range(s.spec.out_of_range.unwrap_or_default().into())?;
             Ok(Box::new(fuzzy.with_gravity_compensation(s.model)?))
         },
     },

@@ -266,6 +266,12 @@ pub struct ControllerSpec {
     /// path is relative to the scenario file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fis: Option<PathBuf>,
+    /// What the fuzzy controllers (fuzzy, fuzzy-gc) do with an input outside its variable's
+    /// range: `"as-given"` (the default, as MATLAB's `evalfis` and Simulink's Fuzzy Logic
+    /// Controller block evaluate it; bells fade far out) or `"clamp"` (evaluated at the nearest
+    /// end of the range: the action saturates).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub out_of_range: Option<FuzzyInputRange>,
     /// Computed-torque stiffness per coordinate (1/s^2, default 2500 each: 50 rad/s).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kp: Option<Vec<f64>>,
@@ -286,6 +292,27 @@ pub struct ControllerSpec {
     /// LQR re-linearisation period (s, default 0.01; at least the controller period).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lqr_relinearise: Option<f64>,
+}
+
+/// What a fuzzy controller does with an input outside its variable's range
+/// ([`fuzzy_sugeno::OutOfRange`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FuzzyInputRange {
+    /// Evaluated as given (MATLAB's `evalfis`, Simulink's Fuzzy Logic Controller block).
+    #[default]
+    AsGiven,
+    /// Evaluated at the nearest end of the range.
+    Clamp,
+}
+
+impl From<FuzzyInputRange> for fuzzy_sugeno::OutOfRange {
+    fn from(policy: FuzzyInputRange) -> Self {
+        match policy {
+            FuzzyInputRange::AsGiven => Self::AsGiven,
+            FuzzyInputRange::Clamp => Self::Clamp,
+        }
+    }
 }
 
 /// The integrator between controller samples, tagged by `method`.
@@ -349,7 +376,7 @@ impl NoiseSpec {
     }
 }
 
-/// The runaway bound, optional joint torque limits (reported) and optional actuator limits on
+/// The runaway bound, optional joint torque limits (reported) and optional limits (modal forces, not joint torques) on
 /// `tau*` (enforced).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -360,9 +387,11 @@ pub struct LimitsSpec {
     /// Joint torque limits (N m): one for all joints or one per joint; exceeding is reported.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joint_torque_nm: Option<TorqueLimit>,
-    /// Actuator saturation on the modal torques (N m): one limit for every coordinate or one per
-    /// coordinate (`m` entries), each finite and positive. The loop clamps every controller's
-    /// output to `[-limit_i, limit_i]` before applying it and records when it did.
+    /// Saturation of the modal forces `tau* = J^T tau` (N m): one limit for every coordinate or
+    /// one per coordinate (`m` entries), each finite and positive. They bound the modal
+    /// coordinates' generalised forces, not any joint torque (see `joint_torque_nm`). The loop
+    /// clamps every controller's output to `[-limit_i, limit_i]` before applying it and records
+    /// when it did.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tau_star: Option<ModalTorqueLimit>,
 }
