@@ -24,6 +24,11 @@ use crate::membership::MembershipFn;
 use crate::system::{AndMethod, Antecedent, FuzzySystem, InputVariable};
 use std::fmt;
 
+/// The relative rounding allowance of the completeness check: a weakest strength within
+/// `threshold * COVERAGE_ROUNDING` below the threshold passes (a set evaluated at its own
+/// half-power point gives `0.49999999999999994`, not `0.5`), and the report says so.
+pub const COVERAGE_ROUNDING: f64 = 1e-12;
+
 /// The thresholds and resolution of [`FuzzySystem::analyze`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct AnalysisOptions {
@@ -134,12 +139,17 @@ struct Names {
 }
 
 impl Completeness {
-    /// Whether every output reaches the threshold everywhere on the grid (up to a relative
-    /// rounding allowance of 1e-12).
+    /// Whether every output reaches the threshold everywhere on the grid (up to the relative
+    /// rounding allowance [`COVERAGE_ROUNDING`]).
     pub fn passed(&self) -> bool {
         self.outputs
             .iter()
-            .all(|c| c.weakest_strength >= self.threshold * (1.0 - 1e-12))
+            .all(|c| self.covered(c.weakest_strength))
+    }
+
+    /// Whether `strength` reaches the threshold up to the rounding allowance.
+    fn covered(&self, strength: f64) -> bool {
+        strength >= self.threshold * (1.0 - COVERAGE_ROUNDING)
     }
 }
 
@@ -528,6 +538,15 @@ impl fmt::Display for AnalysisReport {
                 coverage.weakest_strength,
                 at.join(", ")
             )?;
+            if coverage.weakest_strength < c.threshold && c.covered(coverage.weakest_strength) {
+                write!(
+                    f,
+                    " (below the threshold {} by {:.1e}, within the relative rounding allowance \
+                     {COVERAGE_ROUNDING:e})",
+                    c.threshold,
+                    c.threshold - coverage.weakest_strength
+                )?;
+            }
             if coverage.strongest_rules.is_empty() {
                 writeln!(f, ", where no rule fires")?;
             } else {
@@ -616,6 +635,30 @@ mod tests {
         assert_eq!((tau2.jump, tau2.relative, tau2.input), (90.0, 0.9, 1));
         let text = report.to_string();
         assert!(text.contains("tau1: largest jump 180 (0.9 of range [-100, 100]) between rules 1 and 9 (da1: N -> P)"), "{text}");
+    }
+
+    #[test]
+    fn a_pass_within_the_rounding_allowance_says_so() {
+        // A weakest strength a few ulps under the threshold passes, but is not printed as if it
+        // reached it: the report names the shortfall and the allowance.
+        let mut report = report(&paper_controller());
+        report.completeness.threshold = 0.25;
+        for coverage in &mut report.completeness.outputs {
+            coverage.weakest_strength = 0.249_999_999_999_999_1;
+        }
+        assert!(report.completeness.passed());
+        let text = report.to_string();
+        assert!(
+            text.contains(
+                "weakest strength 0.2499999999999991 at (da1 = 0, da2 = 0, a1_dot = 0, a2_dot = 0) \
+                 (below the threshold 0.25 by 8.9e-16, within the relative rounding allowance 1e-12)"
+            ),
+            "{text}"
+        );
+        // Beyond the allowance it fails.
+        report.completeness.outputs[0].weakest_strength = 0.25 * (1.0 - 2e-12);
+        assert!(!report.completeness.passed());
+        assert!(report.to_string().starts_with("completeness: FAIL"));
     }
 
     #[test]

@@ -14,7 +14,7 @@ mod membership;
 mod paper;
 mod system;
 
-pub use analysis::{AnalysisOptions, AnalysisReport};
+pub use analysis::{AnalysisOptions, AnalysisReport, COVERAGE_ROUNDING};
 pub use builder::SystemBuilder;
 pub use error::{ConsequentParameter, FuzzyError, LearningProblem, SystemProblem};
 pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange, OutsideRange};

@@ -43,6 +43,10 @@ pub fn main_job(out: &Path) -> Result<(), String> {
 /// the per-run files, the comparison table, the figures and `report.html` into `out`.
 fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
     let staging = OutputDir::create(out, "run")?;
+    staging.claim("figures")?;
+    for scenario in scenarios {
+        staging.claim(&scenario.name)?;
+    }
     let dir = staging.path();
     let runs = scenarios.len() * ControllerKind::ALL.len();
     let bar = progress::bar(runs as u64, "runs");

@@ -80,6 +80,8 @@ pub fn run(args: ExportArgs) -> Result<(), String> {
         .into_iter()
         .map(|(name, text)| (Path::new(&args.out).join(name), text))
         .collect();
+    let paths: Vec<PathBuf> = files.iter().map(|(path, _)| path.clone()).collect();
+    output_dir::refuse_foreign_files(&paths, "fis export")?;
     output_dir::write_files(&files, "fis export")?;
     for (path, _) in &files {
         crate::console::print(&format!("{}\n", path.display()))?;

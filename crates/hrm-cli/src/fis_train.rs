@@ -64,6 +64,9 @@ pub fn run(args: TrainArgs) -> Result<(), String> {
         1 => ConsequentOrder::First,
         other => return Err(format!("--order must be 0 or 1, got {other}")),
     };
+    let mut inputs = vec![("--data", args.data.as_path())];
+    inputs.extend(args.check.as_deref().map(|check| ("--check", check)));
+    output_dir::refuse_input_as_output(&args.out, &inputs)?;
     let train = read_csv(&args.data)?;
     let check = args.check.as_deref().map(read_csv).transpose()?;
     if let Some(check) = &check

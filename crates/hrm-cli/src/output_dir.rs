@@ -55,6 +55,7 @@ impl OutputDir {
                 file.display()
             ));
         }
+        check_name_length(&shown, name.len(), "staging")?;
         std::fs::create_dir_all(parent).map_err(|e| fail("cannot create the parent of", e))?;
         // `..` and symbolic links are resolved, so that the staging folder is a true sibling.
         let parent = std::fs::canonicalize(parent).map_err(|e| fail("output folder", e))?;
@@ -75,9 +76,23 @@ impl OutputDir {
                     shown.display()
                 ));
             }
-            Ok(_) => {}
+            Ok(_) => {
+                if let Some(other) = marker_command(&target)
+                    && kind(&other) != kind(command)
+                {
+                    return Err(format!(
+                        "output folder {}: holds the output of `hrm {other}`, which `hrm \
+                         {command}` would replace; choose another folder (or remove this one)",
+                        shown.display()
+                    ));
+                }
+            }
         }
         remove_abandoned(&target, "staging");
+        if target.is_dir() {
+            // With the output in place, the old copies of killed commands are not its only copy.
+            remove_abandoned(&target, "old");
+        }
         let staging = sibling(&target, "staging");
         if staging.exists() {
             std::fs::remove_dir_all(&staging).map_err(|e| fail("cannot clear staging for", e))?;
@@ -95,6 +110,22 @@ impl OutputDir {
         )
         .map_err(|e| fail("cannot write the marker of", e))?;
         Ok(dir)
+    }
+
+    /// Checks that the entry `name` of the new output will not replace the output of another
+    /// command nested in the old one (`hrm simulate --out hrm-output/paper-tracking` before the
+    /// main job writes `hrm-output/paper-tracking`): call it for the entries a command is about
+    /// to write, before the work, so that the refusal comes first.
+    pub fn claim(&self, name: &str) -> Result<(), String> {
+        let nested = self.target.join(name);
+        match marker_command(&nested) {
+            Some(other) if self.target.is_dir() && !is_output_of_parent(&nested) => Err(format!(
+                "output folder {}: holds the output of `hrm {other}`, which this command \
+                     would replace; move it or choose another --out",
+                self.shown.join(name).display()
+            )),
+            _ => Ok(()),
+        }
     }
 
     /// The folder to write into (the staging folder until [`OutputDir::commit`]).
@@ -118,7 +149,7 @@ impl OutputDir {
                 .map_err(|e| fail("cannot move aside the previous", e))?;
         }
         let carried = if had_old {
-            carry_nested(&old, &self.staging)
+            carry_nested(&old, &self.staging, &self.shown)
         } else {
             Ok(Vec::new())
         };
@@ -136,9 +167,18 @@ impl OutputDir {
             return Err(fail("cannot put in place the output folder", e));
         }
         self.committed = true;
-        if had_old {
-            // The new output is in place; a leftover old copy is only untidy.
-            let _ = std::fs::remove_dir_all(&old);
+        if had_old && let Err(e) = remove_tree(&old) {
+            // The new output is in place; the old copy (read-only, say) is only in the way: say
+            // where it is rather than leave it unnoticed.
+            eprintln!(
+                "{}",
+                crate::console::error_line(&format!(
+                    "warning: wrote {}, but its previous copy, moved to {}, cannot be removed \
+                     ({e}); remove it by hand",
+                    self.shown.display(),
+                    old.display()
+                ))
+            );
         }
         Ok(())
     }
@@ -150,6 +190,53 @@ impl Drop for OutputDir {
             let _ = std::fs::remove_dir_all(&self.staging);
         }
     }
+}
+
+/// Refuses, before any work, an output file that is one of the command's inputs (`fis train
+/// --out data.csv --data data.csv` would overwrite the training data): `out` names the same
+/// file as an input (the same device and inode, whatever the path).
+pub fn refuse_input_as_output(out: &Path, inputs: &[(&str, &Path)]) -> Result<(), String> {
+    use std::os::unix::fs::MetadataExt;
+    let Ok(target) = std::fs::metadata(out) else {
+        return Ok(());
+    };
+    for (option, input) in inputs {
+        if let Ok(meta) = std::fs::metadata(input)
+            && (meta.dev(), meta.ino()) == (target.dev(), target.ino())
+        {
+            return Err(format!(
+                "--out {} is the {option} file {}: writing it would overwrite an input; choose \
+                 another --out",
+                out.display(),
+                input.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses, before any work, to replace existing files in a folder `hrm {command}` did not
+/// create (one without its [`MARKER`]): `fis export --out DIR` into a folder of the user's never
+/// overwrites the user's own `hrm_fis.c`.
+pub fn refuse_foreign_files(paths: &[PathBuf], command: &str) -> Result<(), String> {
+    for path in paths {
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let dir = if dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            dir
+        };
+        if std::fs::symlink_metadata(path).is_ok()
+            && marker_command(dir).is_none_or(|other| other != command)
+        {
+            return Err(format!(
+                "{} exists in a folder that `hrm {command}` did not create (no {MARKER} marker \
+                 naming it): remove the file or choose another --out",
+                path.display()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Writes the file `path` whole with the contents `text`, as [`write_file_with`] does.
@@ -218,6 +305,7 @@ fn stage_file(
         std::fs::write(dir.join(MARKER), format!("written by `hrm {command}`\n"))
             .map_err(|e| fail("cannot create the folder of", &e))?;
     }
+    check_name_length(path, name.len(), "partial")?;
     let path = dir.join(name);
     if path.is_dir() {
         return Err(format!("cannot write {}: it is a folder", path.display()));
@@ -248,6 +336,47 @@ fn put_in_place(temporary: &Path, path: &Path) -> Result<(), String> {
     })
 }
 
+/// The longest file name most file systems take (`NAME_MAX`, bytes).
+const NAME_MAX: usize = 255;
+
+/// Checks, before any work, that the sibling `.<name>.hrm-<what>-<pid>` of an output of
+/// `name_bytes` bytes fits in [`NAME_MAX`] (the moved-aside `old` copy is shorter).
+fn check_name_length(shown: &Path, name_bytes: usize, what: &str) -> Result<(), String> {
+    let suffix = format!(".hrm-{what}-{}", u32::MAX).len() + 1;
+    if name_bytes + suffix > NAME_MAX {
+        return Err(format!(
+            "output {}: its name is {name_bytes} bytes long, at most {} are allowed (the \
+             temporary sibling it is written through adds {suffix} to the {NAME_MAX} a name may \
+             have)",
+            shown.display(),
+            NAME_MAX - suffix
+        ));
+    }
+    Ok(())
+}
+
+/// The command named by the [`MARKER`] of `dir` (`simulate`, `sweep --shard`), if it has one.
+fn marker_command(dir: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(dir.join(MARKER)).ok()?;
+    let command = text.split('`').nth(1)?.strip_prefix("hrm ")?;
+    Some(command.to_string())
+}
+
+/// The kind of output a command writes: `sweep` and `sweep merge` write the same.
+fn kind(command: &str) -> &str {
+    match command {
+        "sweep merge" => "sweep",
+        other => other,
+    }
+}
+
+/// Whether the marked folder `nested` belongs to its parent's output (the parent is an
+/// output of the same command), rather than being another command's output nested in it.
+fn is_output_of_parent(nested: &Path) -> bool {
+    let parent = nested.parent().and_then(marker_command);
+    parent.is_some() && parent == marker_command(nested)
+}
+
 /// `.<name>.hrm-<what>-<pid>` beside `path`.
 fn sibling(path: &Path, what: &str) -> PathBuf {
     let mut name = OsString::from(".");
@@ -258,8 +387,9 @@ fn sibling(path: &Path, what: &str) -> PathBuf {
 
 /// Removes the siblings `.<name>.hrm-<what>-<pid>` of `target` (staging folders, partial
 /// files) left by commands that were killed (their process is gone), where the system lists its
-/// processes in `/proc`. Moved-aside old copies are kept: after a crash between the two renames
-/// of a commit, one may be the only copy of an output.
+/// processes in `/proc`. Moved-aside old copies (`what = "old"`) are removed only while the
+/// output itself is in place: after a crash between the two renames of a commit, one may be the
+/// only copy of an output.
 fn remove_abandoned(target: &Path, what: &str) {
     let (Some(dir), Some(name)) = (target.parent(), target.file_name()) else {
         return;
@@ -288,10 +418,40 @@ fn remove_abandoned(target: &Path, what: &str) {
         if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
             let path = entry.path();
             let _ = if path.is_dir() {
-                std::fs::remove_dir_all(&path)
+                remove_tree(&path)
             } else {
                 std::fs::remove_file(&path)
             };
+        }
+    }
+}
+
+/// Removes the folder `path` and its contents, making its read-only folders writable first if
+/// a plain removal fails (an output the user made read-only, moved aside by a commit).
+fn remove_tree(path: &Path) -> std::io::Result<()> {
+    if std::fs::remove_dir_all(path).is_ok() {
+        return Ok(());
+    }
+    make_writable(path);
+    std::fs::remove_dir_all(path)
+}
+
+/// Gives the owner write permission on the folder `dir` and the folders under it (symbolic
+/// links are not followed).
+fn make_writable(dir: &Path) {
+    use std::os::unix::fs::PermissionsExt;
+    let Ok(meta) = std::fs::symlink_metadata(dir) else {
+        return;
+    };
+    if !meta.is_dir() {
+        return;
+    }
+    let mut permissions = meta.permissions();
+    permissions.set_mode(permissions.mode() | 0o700);
+    let _ = std::fs::set_permissions(dir, permissions);
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for entry in entries.flatten() {
+            make_writable(&entry.path());
         }
     }
 }
@@ -315,15 +475,28 @@ fn replaceable(dir: &Path) -> bool {
         .all(|entry| entry.is_ok_and(|e| e.path().is_dir() && is_output(&e.path())))
 }
 
-/// Moves the output folders nested in `old` into `new`, except where `new` has an entry of the
-/// same name; returns the names moved. On failure, what was moved goes back.
-fn carry_nested(old: &Path, new: &Path) -> std::io::Result<Vec<OsString>> {
+/// Moves the output folders nested in `old` into `new`; returns the names moved. Where `new`
+/// has an entry of the same name, the nested output is refused (it would be lost), as
+/// [`OutputDir::claim`] refuses it before the work. On failure, what was moved goes back.
+fn carry_nested(old: &Path, new: &Path, shown: &Path) -> std::io::Result<Vec<OsString>> {
     let mut moved = Vec::new();
     for entry in std::fs::read_dir(old)? {
         let entry = entry?;
         let (path, name) = (entry.path(), entry.file_name());
-        if !path.is_dir() || !is_output(&path) || new.join(&name).exists() {
+        if !path.is_dir() || !is_output(&path) {
             continue;
+        }
+        if new.join(&name).exists() {
+            if is_output_of_parent(&path) {
+                continue;
+            }
+            for name in &moved {
+                let _ = std::fs::rename(new.join(name), old.join(name));
+            }
+            return Err(std::io::Error::other(format!(
+                "{} holds the output of another command, which this one would replace",
+                shown.join(&name).display()
+            )));
         }
         if let Err(e) = std::fs::rename(&path, new.join(&name)) {
             for name in &moved {
@@ -413,6 +586,126 @@ mod tests {
         let err = OutputDir::create(Path::new("/"), "run").unwrap_err();
         assert!(err.contains("ends in its own name"), "{err}");
         assert_eq!(names(&root), ["file", "mine", "out"]);
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn only_an_output_of_the_same_kind_is_replaced() {
+        let root = scratch("kinds");
+        let shards = root.join("shards");
+        write_file(&shards.join("shard-1-of-3.json"), "{}", "sweep --shard").unwrap();
+        for command in ["sweep", "simulate", "run", "sweep merge"] {
+            let err = OutputDir::create(&shards, command).unwrap_err();
+            assert!(
+                err.contains("holds the output of `hrm sweep --shard`"),
+                "{err}"
+            );
+        }
+        assert_eq!(names(&shards), [MARKER, "shard-1-of-3.json"]);
+        // `sweep` and `sweep merge` write the same kind of folder.
+        let merged = root.join("merged");
+        OutputDir::create(&merged, "sweep merge")
+            .unwrap()
+            .commit()
+            .unwrap();
+        OutputDir::create(&merged, "sweep")
+            .unwrap()
+            .commit()
+            .unwrap();
+        // The main job refuses, before its work, to write over `hrm simulate`'s output nested
+        // under one of its own entries; the commit refuses it too.
+        let (outer, inner) = (root.join("out"), root.join("out/paper-tracking"));
+        OutputDir::create(&inner, "simulate")
+            .unwrap()
+            .commit()
+            .unwrap();
+        OutputDir::create(&outer, "run").unwrap().commit().unwrap();
+        let dir = OutputDir::create(&outer, "run").unwrap();
+        let err = dir.claim("paper-tracking").unwrap_err();
+        assert!(err.contains("holds the output of `hrm simulate`"), "{err}");
+        dir.claim("paper-responses-step").unwrap();
+        std::fs::create_dir(dir.path().join("paper-tracking")).unwrap();
+        let err = dir.commit().unwrap_err();
+        assert!(err.contains("holds the output of another command"), "{err}");
+        assert_eq!(names(&outer), [MARKER, "paper-tracking"]);
+        assert_eq!(names(&inner), [MARKER]);
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn an_output_name_too_long_is_refused_before_anything_is_written() {
+        let root = scratch("long");
+        let out = root.join("x".repeat(250));
+        let err = OutputDir::create(&out, "simulate").unwrap_err();
+        assert!(
+            err.contains("its name is 250 bytes long, at most 231"),
+            "{err}"
+        );
+        let err = write_file(&out, "x", "fis train").unwrap_err();
+        assert!(
+            err.contains("its name is 250 bytes long, at most 231"),
+            "{err}"
+        );
+        assert!(names(&root).is_empty());
+        // The longest name allowed goes through.
+        OutputDir::create(&root.join("x".repeat(231)), "simulate")
+            .unwrap()
+            .commit()
+            .unwrap();
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn a_read_only_old_output_is_removed_all_the_same() {
+        use std::os::unix::fs::PermissionsExt;
+        let root = scratch("read-only");
+        let out = root.join("out");
+        let dir = OutputDir::create(&out, "simulate").unwrap();
+        std::fs::create_dir(dir.path().join("data")).unwrap();
+        std::fs::write(dir.path().join("data/big.csv"), "t").unwrap();
+        dir.commit().unwrap();
+        for folder in [out.join("data"), out.clone()] {
+            std::fs::set_permissions(&folder, std::fs::Permissions::from_mode(0o555)).unwrap();
+        }
+        OutputDir::create(&out, "simulate")
+            .unwrap()
+            .commit()
+            .unwrap();
+        assert_eq!(names(&root), ["out"], "no old copy left behind");
+        assert_eq!(names(&out), [MARKER]);
+        // An old copy a killed command left is removed by the next command.
+        let dead = root.join(format!(".out.hrm-old-{}", u32::MAX));
+        std::fs::create_dir_all(dead.join("sub")).unwrap();
+        std::fs::set_permissions(dead.join("sub"), std::fs::Permissions::from_mode(0o555)).unwrap();
+        OutputDir::create(&out, "simulate")
+            .unwrap()
+            .commit()
+            .unwrap();
+        assert_eq!(names(&root), ["out"]);
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn user_files_and_inputs_are_not_overwritten() {
+        let root = scratch("user-files");
+        let mine = root.join("mine/hrm_fis.c");
+        std::fs::create_dir_all(root.join("mine")).unwrap();
+        std::fs::write(&mine, "my code").unwrap();
+        let err = refuse_foreign_files(std::slice::from_ref(&mine), "fis export").unwrap_err();
+        assert!(err.contains("did not create"), "{err}");
+        // A folder `fis export` created may be written again.
+        let ours = root.join("ours/hrm_fis.c");
+        write_files(&[(ours.clone(), "v1".into())], "fis export").unwrap();
+        refuse_foreign_files(std::slice::from_ref(&ours), "fis export").unwrap();
+        refuse_foreign_files(&[root.join("mine/new.c")], "fis export").unwrap();
+        // The same file by another path is an input.
+        let data = root.join("mine/data.csv");
+        std::fs::write(&data, "1,2\n").unwrap();
+        let other_path = root.join("mine/../mine/data.csv");
+        let err = refuse_input_as_output(&other_path, &[("--data", &data)]).unwrap_err();
+        assert!(err.contains("is the --data file"), "{err}");
+        refuse_input_as_output(&root.join("mine/out.fis"), &[("--data", &data)]).unwrap();
+        assert_eq!(std::fs::read_to_string(&mine).unwrap(), "my code");
         std::fs::remove_dir_all(&root).unwrap();
     }
 

@@ -245,7 +245,7 @@ fn group<S: Simd>(
 
 /// Whether every value is finite, without an early exit, so that the loop vectorises.
 #[inline(always)]
-fn all_finite(values: &[f64]) -> bool {
+pub(crate) fn all_finite(values: &[f64]) -> bool {
     values.iter().fold(true, |all, v| all & v.is_finite())
 }
 

@@ -34,10 +34,16 @@ pub(crate) fn inputs(
 ) -> Result<usize, DynError> {
     let n = model.n_links();
     workspace(model, data)?;
+    vectors(n, inputs)?;
+    Ok(n)
+}
+
+/// Each named input has `n` finite entries.
+pub(crate) fn vectors(n: usize, inputs: &[(&'static str, &[f64])]) -> Result<(), DynError> {
     for &(name, x) in inputs {
         input(name, x, n)?;
     }
-    Ok(n)
+    Ok(())
 }
 
 /// An input vector of `n` finite entries.
@@ -60,7 +66,11 @@ pub(crate) fn output(name: &'static str, x: &[f64], n: usize) -> Result<(), DynE
 
 /// An `n x n` algorithm (named by `what`) accepts at most [`MAX_DENSE_LINKS`] links.
 pub(crate) fn dense(what: &'static str, model: &ChainModel) -> Result<(), DynError> {
-    let got = model.n_links();
+    dense_count(what, model.n_links())
+}
+
+/// An `n x n` algorithm (named by `what`) accepts at most [`MAX_DENSE_LINKS`] links: `got`.
+pub(crate) fn dense_count(what: &'static str, got: usize) -> Result<(), DynError> {
     if got <= MAX_DENSE_LINKS {
         Ok(())
     } else {
@@ -128,7 +138,8 @@ pub(crate) fn finite_scalar(name: &'static str, x: f64) -> Result<f64, DynError>
     }
 }
 
-fn length(name: &'static str, found: usize, expected: usize) -> Result<(), DynError> {
+/// `found` entries where `expected` are needed.
+pub(crate) fn length(name: &'static str, found: usize, expected: usize) -> Result<(), DynError> {
     if found == expected {
         Ok(())
     } else {

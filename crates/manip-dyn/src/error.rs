@@ -36,6 +36,26 @@ pub enum DynError {
         /// The offending value.
         value: f64,
     },
+    /// A joint parameter of a spatial chain was out of its domain.
+    #[error("joint {index}: {quantity} must be {requirement}, got {value}")]
+    InvalidJoint {
+        /// 0-based joint index.
+        index: usize,
+        /// Which parameter (`"axis"`, `"axis (its norm)"`, `"origin"`, ...).
+        quantity: &'static str,
+        /// What it must be.
+        requirement: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// A link index named no link of the chain.
+    #[error("link index {index} is out of range: the chain has {n_links} links")]
+    NoSuchLink {
+        /// The index asked for.
+        index: usize,
+        /// The chain's number of links.
+        n_links: usize,
+    },
     /// A parameter of a lone link (from [`Link::new`](crate::Link::new) or
     /// [`Link::uniform_beam`](crate::Link::uniform_beam), which know no index) was out of its
     /// domain; [`DynError::at_link`] names the link once the caller knows where it goes.
@@ -48,7 +68,7 @@ pub enum DynError {
         /// The offending value.
         value: f64,
     },
-    /// The gravitational acceleration was not finite.
+    /// The gravitational acceleration (or a component of it) was not finite.
     #[error("gravity must be finite, got {0}")]
     InvalidGravity(f64),
     /// A slice or matrix had the wrong size.

@@ -16,6 +16,7 @@ mod kinematics;
 pub mod model;
 mod rnea;
 mod rnea_derivatives;
+pub mod spatial;
 
 /// The faer version whose matrices [`mass_matrix`] and [`coriolis_matrix`] fill.
 pub use faer;

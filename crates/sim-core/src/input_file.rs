@@ -1,6 +1,7 @@
 //! Reading the text files a user points the toolkit at (scenario TOML, MATLAB `.fis`) with a
-//! size limit, so that a huge file or an endless stream (`/dev/zero`, a pipe) is a clear error
-//! rather than memory exhaustion. (Sweep shard files are read a line at a time, each line with
+//! size limit, so that a huge file is a clear error rather than memory exhaustion, and only if it
+//! is a regular file, so that a FIFO, `/dev/zero` or a socket is a clear error rather than a
+//! hang. (Sweep shard files are read a line at a time, each line with
 //! its own limit: `study::ShardReader`.)
 
 use std::io::{Error, ErrorKind, Read};
@@ -10,8 +11,9 @@ use std::path::Path;
 /// thousand times the largest real file.
 pub const MAX_INPUT_FILE_BYTES: u64 = 16 << 20;
 
-/// Reads the UTF-8 text file at `path`, refusing one of more than `max_bytes` bytes: a regular
-/// file by its size before anything is read, a stream after `max_bytes + 1` bytes. The
+/// Reads the UTF-8 regular file at `path` ([`open_regular_file`]), refusing one of more than
+/// `max_bytes` bytes: by its size before anything is read, and after `max_bytes + 1` bytes if
+/// it grows while being read. The
 /// errors' kinds are `FileTooLarge` and `InvalidData` (not UTF-8); their messages leave naming
 /// the file to the caller.
 ///
@@ -25,14 +27,8 @@ pub const MAX_INPUT_FILE_BYTES: u64 = 16 << 20;
 /// # Ok::<(), std::io::Error>(())
 /// ```
 pub fn read_text_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
-    let file = std::fs::File::open(path)?;
+    let file = open_regular_file(path)?;
     let metadata = file.metadata()?;
-    if metadata.is_dir() {
-        return Err(Error::new(
-            ErrorKind::IsADirectory,
-            "is a directory, not a file",
-        ));
-    }
     if metadata.is_file() && metadata.len() > max_bytes {
         return Err(too_large(format!(
             "the file has {} bytes, more than the {max_bytes} allowed",
@@ -56,6 +52,26 @@ pub fn read_text_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
             ),
         )
     })
+}
+
+/// Opens the file at `path` for reading if it is a regular file (symbolic links followed),
+/// checked before it is opened: opening a FIFO would wait for a writer forever, and a device
+/// or socket is no input file. The error kinds are `IsADirectory` and `InvalidInput`.
+pub fn open_regular_file(path: &Path) -> std::io::Result<std::fs::File> {
+    let metadata = std::fs::metadata(path)?;
+    if metadata.is_dir() {
+        return Err(Error::new(
+            ErrorKind::IsADirectory,
+            "is a directory, not a file",
+        ));
+    }
+    if !metadata.is_file() {
+        return Err(Error::new(
+            ErrorKind::InvalidInput,
+            "is not a regular file (a FIFO, socket or device): only regular files are read",
+        ));
+    }
+    std::fs::File::open(path)
 }
 
 fn too_large(message: String) -> Error {
@@ -83,14 +99,20 @@ mod tests {
             read_text_file(&dir, 10).unwrap_err().kind(),
             ErrorKind::IsADirectory
         );
-        // An endless stream stops at the limit.
+        // A device or a FIFO is refused before it is opened (a FIFO would block the open).
         if Path::new("/dev/zero").exists() {
             let err = read_text_file(Path::new("/dev/zero"), 1 << 16).unwrap_err();
-            assert_eq!(err.kind(), ErrorKind::FileTooLarge);
-            assert!(
-                err.to_string().contains("more than the 65536 bytes"),
-                "{err}"
-            );
+            assert_eq!(err.kind(), ErrorKind::InvalidInput);
+            assert!(err.to_string().contains("not a regular file"), "{err}");
+        }
+        let fifo = dir.join("fifo.fis");
+        if std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .is_ok_and(|s| s.success())
+        {
+            let err = read_text_file(&fifo, 10).unwrap_err();
+            assert_eq!(err.kind(), ErrorKind::InvalidInput);
         }
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -19,7 +19,7 @@ pub mod summary_json;
 pub const MAX_COORDINATES: usize = 2 * backbone_kin::MAX_HARMONICS + 1;
 
 pub use error::{ControllerFailure, SimError};
-pub use input_file::{MAX_INPUT_FILE_BYTES, read_text_file};
+pub use input_file::{MAX_INPUT_FILE_BYTES, open_regular_file, read_text_file};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use scenario::{
     Alpha0, ArmSpec, BranchSpec, CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup,

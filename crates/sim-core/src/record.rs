@@ -163,26 +163,31 @@ pub struct TorqueLimitExceeded {
     pub joint: usize,
     /// The limit (N m).
     pub limit_nm: f64,
-    /// First recorded sample time at which `|tau| > limit` (s).
+    /// First controller sample time at which `|tau| > limit` (s).
     pub first_time_s: f64,
     /// Largest `|tau|` over the run (N m).
     pub peak_nm: f64,
-    /// Number of recorded samples over the limit.
+    /// Number of controller samples (recorded or not) over the limit.
     pub samples_over: usize,
 }
 
 /// Summary metrics of a run.
 ///
-/// Errors and peaks are taken over the recorded samples, so they agree with the time series of
-/// the [`Record`] (record every controller sample to take them over all); the control effort
-/// integrates the held torques over every controller period. Serialises to the fields of
+/// The torque peaks, the torque limit checks and the clamped fractions cover every controller
+/// sample, recorded or not, so a torque spike between two recorded samples is never missed. The
+/// tracking errors (`tip_error_rms_m`, `tip_error_max_m`, `modal_error_rms_rad`,
+/// `modal_error_max_rad`) are the statistics of the [`Record`]'s time series, taken over the
+/// recorded samples (every `record_period`, plus the last and a runaway sample): record every
+/// controller sample to take them over all (the runaway check itself sees every sample). The
+/// control effort integrates the held torques over every controller period. Serialises to the
+/// fields of
 /// `summary.json`; the key of every physical quantity ends in its unit (`_m`, `_rad`, `_nm`, `_s`,
 /// `_n2m2s`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
     /// Controller samples taken (including the one at the final time).
     pub controller_samples: usize,
-    /// Recorded samples (the ones the errors and peaks are taken over).
+    /// Recorded samples (the ones the tracking errors are taken over).
     pub recorded_samples: usize,
     /// Accepted integrator steps.
     pub steps: usize,
@@ -190,19 +195,21 @@ pub struct Summary {
     pub rejected_steps: usize,
     /// Simulated time (s): the final sample time, or the last good one of a failed run.
     pub simulated_s: f64,
-    /// Root mean square of the distance between the chain's tip and the reference tip (m).
+    /// Root mean square of the distance between the chain's tip and the reference tip over the
+    /// recorded samples (m).
     pub tip_error_rms_m: f64,
-    /// Largest such distance (m).
+    /// Largest such distance over the recorded samples (m).
     pub tip_error_max_m: f64,
-    /// Root mean square of `a_i - a_i_ref` per coordinate (rad), against the noise-free reference.
+    /// Root mean square of `a_i - a_i_ref` per coordinate over the recorded samples (rad),
+    /// against the noise-free reference.
     pub modal_error_rms_rad: Vec<f64>,
-    /// Largest `|a_i - a_i_ref|` per coordinate (rad).
+    /// Largest `|a_i - a_i_ref|` per coordinate over the recorded samples (rad).
     pub modal_error_max_rad: Vec<f64>,
-    /// Largest `|tau_i*|` per coordinate (N m).
+    /// Largest `|tau_i*|` per coordinate over every controller sample (N m).
     pub peak_modal_torques_nm: Vec<f64>,
-    /// Largest `|tau_j|` over all joints (N m).
+    /// Largest `|tau_j|` over all joints and every controller sample (N m).
     pub peak_joint_torque_nm: f64,
-    /// Largest `|tau_j|` of each joint (N m).
+    /// Largest `|tau_j|` of each joint over every controller sample (N m).
     pub peak_joint_torques_nm: Vec<f64>,
     /// Control effort `integral of |tau*|^2 dt` under the zero-order hold (N^2 m^2 s).
     pub control_effort_n2m2s: f64,
@@ -250,9 +257,17 @@ impl Metrics {
         }
     }
 
-    /// Counts a controller sample at `t` whose torque `tau_star` (with its clamping flags) is
-    /// held for `hold` seconds.
-    pub(crate) fn add_control(&mut self, t: f64, tau_star: &[f64], clamped: &[bool], hold: f64) {
+    /// Counts the controller sample at `t` whose torque `tau_star` (with its clamping flags and
+    /// the joint torques at the sample) is held for `hold` seconds: its clamping, effort, torque peaks and limit checks, which therefore
+    /// cover every controller sample whether it is recorded or not.
+    pub(crate) fn add_control(
+        &mut self,
+        t: f64,
+        tau_star: &[f64],
+        clamped: &[bool],
+        joint_torques: &[f64],
+        hold: f64,
+    ) {
         self.controller_samples += 1;
         for (count, &c) in self.clamped.iter_mut().zip(clamped) {
             *count += usize::from(c);
@@ -263,19 +278,8 @@ impl Metrics {
             square += tau * tau;
         }
         self.effort += square * hold;
-    }
-
-    /// Adds recorded sample `s` with its joint torques.
-    pub(crate) fn add(&mut self, s: &Sample<'_>, joint_torques: &[f64]) {
-        self.samples += 1;
-        let tip_error = (s.tip[0] - s.tip_ref[0]).hypot(s.tip[1] - s.tip_ref[1]);
-        self.tip_sq += tip_error * tip_error;
-        self.tip_max = self.tip_max.max(tip_error);
-        for i in 0..self.modal_sq.len() {
-            let e = s.a[i] - s.a_ref[i];
-            self.modal_sq[i] += e * e;
-            self.modal_max[i] = self.modal_max[i].max(e.abs());
-            self.peak_tau_star[i] = self.peak_tau_star[i].max(s.tau_star[i].abs());
+        for (peak, tau) in self.peak_tau_star.iter_mut().zip(tau_star) {
+            *peak = peak.max(tau.abs());
         }
         for (j, &tau) in joint_torques.iter().enumerate() {
             self.peak_joint[j] = self.peak_joint[j].max(tau.abs());
@@ -285,12 +289,26 @@ impl Metrics {
                 let entry = self.exceeded[j].get_or_insert(TorqueLimitExceeded {
                     joint: j,
                     limit_nm: limits[j],
-                    first_time_s: s.t,
+                    first_time_s: t,
                     peak_nm: 0.0,
                     samples_over: 0,
                 });
                 entry.samples_over += 1;
             }
+        }
+    }
+
+    /// Adds recorded sample `s` (already counted by [`add_control`](Self::add_control)) to the
+    /// tracking errors, which are taken over the recorded samples.
+    pub(crate) fn add_recorded(&mut self, s: &Sample<'_>) {
+        self.samples += 1;
+        let tip_error = (s.tip[0] - s.tip_ref[0]).hypot(s.tip[1] - s.tip_ref[1]);
+        self.tip_sq += tip_error * tip_error;
+        self.tip_max = self.tip_max.max(tip_error);
+        for i in 0..self.modal_sq.len() {
+            let e = s.a[i] - s.a_ref[i];
+            self.modal_sq[i] += e * e;
+            self.modal_max[i] = self.modal_max[i].max(e.abs());
         }
     }
 

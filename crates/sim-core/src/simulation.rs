@@ -44,8 +44,9 @@ pub struct LoopSettings {
     pub controller_period: f64,
     /// Simulated time (s): a whole number of controller periods.
     pub duration: f64,
-    /// Recording period (s): a whole number of controller periods. The summary's errors and
-    /// peaks are taken over the recorded samples, the runaway check over every sample.
+    /// Recording period (s): a whole number of controller periods. The summary's tracking errors
+    /// (RMS and maxima) are taken over the recorded samples; its torque peaks, limit checks and
+    /// clamped fractions, and the runaway check, over every controller sample.
     pub record_period: f64,
     /// Seed of the noise sources.
     pub seed: u64,
@@ -476,6 +477,17 @@ impl Simulation {
     /// The joint torques `tau = M J a_dd + C + G` (eq 13), the chain's tip and the reference tip
     /// of the last sample. Allocation-free.
     pub fn observe(&mut self) -> Result<Observation<'_>, SimError> {
+        self.sample_joint_torques()?;
+        let (tip, tip_ref) = self.sample_tips()?;
+        Ok(Observation {
+            joint_torques: &self.joint_torques,
+            tip,
+            tip_ref,
+        })
+    }
+
+    /// The joint torques of the last sample (eq 13) into `self.joint_torques`.
+    fn sample_joint_torques(&mut self) -> Result<(), SimError> {
         let t = self.sample.t;
         let plant = &mut self.plant;
         let state = &self.sample.state;
@@ -487,15 +499,19 @@ impl Simulation {
             &self.sample.a_ddot,
             &mut self.joint_torques,
         )
-        .map_err(|source| SimError::Dynamics { t, source })?;
-        plant.model.map().joint_angles(&state.a, &mut self.theta)?;
+        .map_err(|source| SimError::Dynamics { t, source })
+    }
+
+    /// The chain's tip and the reference tip of the last sample.
+    fn sample_tips(&mut self) -> Result<([f64; 2], [f64; 2]), SimError> {
+        let state = &self.sample.state;
+        self.plant
+            .model
+            .map()
+            .joint_angles(&state.a, &mut self.theta)?;
         let tip = backbone_kin::tip_position(&self.link_lengths, &self.theta)?;
         let tip_ref = self.family.end_point(&self.sample.reference.a)?;
-        Ok(Observation {
-            joint_torques: &self.joint_torques,
-            tip,
-            tip_ref,
-        })
+        Ok((tip, tip_ref))
     }
 
     /// Runs the loop from the initial state for the whole duration (it [`reset`](Self::reset)s
@@ -548,9 +564,9 @@ impl Simulation {
     }
 
     /// Adds sample `k` of a run, taken and then integrated (or, the last, given its
-    /// acceleration), to `progress`: its control to the metrics, the sample to the record every
-    /// recording period (and the last and a runaway one, [`observe`](Self::observe)), then the
-    /// runaway check.
+    /// acceleration), to `progress`: the sample, [`observe`](Self::observe)d, to the metrics
+    /// (torques, every sample), to the record and its tracking errors every recording period
+    /// (and the last and a runaway one), then the runaway check.
     fn conclude_sample(&mut self, progress: &mut Progress, k: usize) -> Result<(), SimError> {
         let last = k == progress.samples;
         let m = self.n_coords();
@@ -564,15 +580,20 @@ impl Simulation {
         } else {
             self.settings.controller_period
         };
-        progress
-            .metrics
-            .add_control(t, &sample.tau_star, &sample.clamped, held);
         let runaway = (0..m)
             .map(|i| (i, (sample.state.a[i] - sample.reference.a[i]).abs()))
             .find(|&(_, e)| e > max_error || e.is_nan());
+        self.sample_joint_torques()?;
+        let sample = &self.sample;
+        progress.metrics.add_control(
+            t,
+            &sample.tau_star,
+            &sample.clamped,
+            &self.joint_torques,
+            held,
+        );
         if k.is_multiple_of(progress.record_every) || last || runaway.is_some() {
-            let observation = self.observe()?;
-            let (tip, tip_ref) = (observation.tip, observation.tip_ref);
+            let (tip, tip_ref) = self.sample_tips()?;
             let sample = &self.sample;
             let row = Sample {
                 t,
@@ -586,7 +607,7 @@ impl Simulation {
                 tip,
                 tip_ref,
             };
-            progress.metrics.add(&row, &self.joint_torques);
+            progress.metrics.add_recorded(&row);
             progress.record.push(&row, &self.joint_torques);
         }
         match runaway {

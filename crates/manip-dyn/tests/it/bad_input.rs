@@ -736,3 +736,322 @@ fn messages_say_what_failed() {
     let message = DynError::NonFiniteResult { name: "tau" }.to_string();
     assert!(message.contains("tau") && message.contains("too large"));
 }
+
+/// Every refusal of a bad spatial model, joint or link, and of a bad spatial call.
+fn spatial_rows() -> Vec<Row<DynError>> {
+    use manip_dyn::spatial::{
+        SpatialData, SpatialDerivativeData, SpatialJoint, SpatialLink, SpatialModel, Transform,
+        aba_derivatives, jacobian,
+    };
+    let link = SpatialLink::cuboid(0.1, [0.1, 0.01, 0.01], [0.05, 0.0, 0.0]);
+    let joint = SpatialJoint::revolute([0.0, 0.0, 1.0], Transform::IDENTITY);
+    let model = |joints: Vec<SpatialJoint>, links: Vec<SpatialLink>, g: [f64; 3]| {
+        SpatialModel::new(joints, links, g).unwrap_err()
+    };
+    let one = |joint: SpatialJoint, link: SpatialLink| model(vec![joint], vec![link], [0.0; 3]);
+    let good = SpatialModel::new(vec![joint; 2], vec![link; 2], [0.0, 0.0, -9.81]).unwrap();
+    let mut data = SpatialData::new(&good);
+    let mut j = Mat::<f64>::zeros(6, 2);
+    vec![
+        exactly(
+            "spatial_zero_joints",
+            model(vec![], vec![], [0.0; 3]),
+            |e| *e == DynError::NoLinks,
+            "a chain needs at least one link",
+        ),
+        words(
+            "spatial_link_count_differs",
+            model(vec![joint; 2], vec![link], [0.0; 3]),
+            |e| matches!(e, DynError::Dimension { .. }),
+            &["links (one per joint) has 1 entries, expected 2"],
+        ),
+        words(
+            "spatial_zero_axis",
+            one(
+                SpatialJoint {
+                    axis: [0.0; 3],
+                    ..joint
+                },
+                link,
+            ),
+            |e| matches!(e, DynError::InvalidJoint { index: 0, .. }),
+            &["joint 0: axis (its norm) must be 1", "got 0"],
+        ),
+        words(
+            "spatial_non_finite_axis",
+            one(
+                SpatialJoint {
+                    axis: [f64::NAN, 0.0, 1.0],
+                    ..joint
+                },
+                link,
+            ),
+            |e| {
+                matches!(
+                    e,
+                    DynError::InvalidJoint {
+                        quantity: "axis",
+                        ..
+                    }
+                )
+            },
+            &["joint 0: axis must be finite, got NaN"],
+        ),
+        words(
+            "spatial_non_rigid_origin",
+            one(
+                SpatialJoint {
+                    origin: Transform {
+                        rotation: [[2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                        translation: [0.0; 3],
+                    },
+                    ..joint
+                },
+                link,
+            ),
+            |e| matches!(e, DynError::InvalidJoint { .. }),
+            &["origin rotation", "a rotation matrix"],
+        ),
+        words(
+            "spatial_reflected_origin",
+            one(
+                SpatialJoint {
+                    origin: Transform {
+                        rotation: [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                        translation: [0.0; 3],
+                    },
+                    ..joint
+                },
+                link,
+            ),
+            |e| matches!(e, DynError::InvalidJoint { .. }),
+            &["not a reflection"],
+        ),
+        words(
+            "spatial_non_finite_origin",
+            one(
+                SpatialJoint {
+                    origin: Transform::translation([0.0, f64::INFINITY, 0.0]),
+                    ..joint
+                },
+                link,
+            ),
+            |e| {
+                matches!(
+                    e,
+                    DynError::InvalidJoint {
+                        quantity: "origin",
+                        ..
+                    }
+                )
+            },
+            &["joint 0: origin must be finite, got inf"],
+        ),
+        words(
+            "spatial_negative_mass",
+            one(joint, SpatialLink { mass: -1.0, ..link }),
+            |e| {
+                matches!(
+                    e,
+                    DynError::InvalidLink {
+                        index: 0,
+                        quantity: "mass",
+                        ..
+                    }
+                )
+            },
+            &["link 0: mass must be positive and finite, got -1"],
+        ),
+        words(
+            "spatial_nan_mass",
+            one(
+                joint,
+                SpatialLink {
+                    mass: f64::NAN,
+                    ..link
+                },
+            ),
+            |e| {
+                matches!(
+                    e,
+                    DynError::InvalidLink {
+                        quantity: "mass",
+                        ..
+                    }
+                )
+            },
+            &["got NaN"],
+        ),
+        words(
+            "spatial_non_finite_inertia",
+            one(
+                joint,
+                SpatialLink {
+                    com: [0.0, f64::NAN, 0.0],
+                    ..link
+                },
+            ),
+            |e| {
+                matches!(
+                    e,
+                    DynError::InvalidLink {
+                        quantity: "centre of mass",
+                        ..
+                    }
+                )
+            },
+            &["centre of mass must be finite"],
+        ),
+        words(
+            "spatial_asymmetric_inertia",
+            one(
+                joint,
+                SpatialLink {
+                    inertia: [[1e-3, 1e-4, 0.0], [0.0, 1e-3, 0.0], [0.0, 0.0, 1e-3]],
+                    ..link
+                },
+            ),
+            |e| matches!(e, DynError::InvalidLink { .. }),
+            &["symmetric"],
+        ),
+        words(
+            "spatial_triangle_inequality",
+            one(
+                joint,
+                SpatialLink {
+                    inertia: [[1e-3, 0.0, 0.0], [0.0, 1e-3, 0.0], [0.0, 0.0, 3e-3]],
+                    ..link
+                },
+            ),
+            |e| matches!(e, DynError::InvalidLink { .. }),
+            &["triangle inequalities", "got -0.0005"],
+        ),
+        words(
+            "spatial_negative_inertia",
+            one(
+                joint,
+                SpatialLink {
+                    inertia: [[-1e-3, 0.0, 0.0], [0.0, 1e-3, 0.0], [0.0, 0.0, 1e-3]],
+                    ..link
+                },
+            ),
+            |e| matches!(e, DynError::InvalidLink { .. }),
+            &["triangle inequalities"],
+        ),
+        words(
+            "spatial_non_finite_gravity",
+            model(vec![joint], vec![link], [0.0, f64::NAN, 0.0]),
+            |e| matches!(e, DynError::InvalidGravity(_)),
+            &["gravity must be finite, got NaN"],
+        ),
+        words(
+            "spatial_no_such_link",
+            jacobian(&good, &mut data, &[0.0; 2], 2, [0.0; 3], j.as_mut()).unwrap_err(),
+            |e| {
+                matches!(
+                    e,
+                    DynError::NoSuchLink {
+                        index: 2,
+                        n_links: 2
+                    }
+                )
+            },
+            &["link index 2 is out of range: the chain has 2 links"],
+        ),
+        words(
+            "spatial_non_finite_point",
+            jacobian(
+                &good,
+                &mut data,
+                &[0.0; 2],
+                1,
+                [0.0, f64::NAN, 0.0],
+                j.as_mut(),
+            )
+            .unwrap_err(),
+            |e| matches!(e, DynError::NonFinite { name: "point", .. }),
+            &["point[1] must be finite, got NaN"],
+        ),
+        words(
+            "spatial_jacobian_of_wrong_shape",
+            jacobian(
+                &good,
+                &mut data,
+                &[0.0; 2],
+                1,
+                [0.0; 3],
+                Mat::<f64>::zeros(3, 2).as_mut(),
+            )
+            .unwrap_err(),
+            |e| matches!(e, DynError::Dimension { .. }),
+            &["out (rows) has 3 entries, expected 6"],
+        ),
+        words(
+            "spatial_workspace_of_another_chain",
+            aba_derivatives(
+                &good,
+                &mut SpatialData::new(
+                    &SpatialModel::new(vec![joint], vec![link], [0.0; 3]).unwrap(),
+                ),
+                &mut SpatialDerivativeData::new(&good),
+                &[0.0; 2],
+                &[0.0; 2],
+                &[0.0; 2],
+            )
+            .unwrap_err(),
+            |e| matches!(e, DynError::Dimension { .. }),
+            &["data (a SpatialData built for another model) has 1 entries, expected 2"],
+        ),
+        words(
+            "spatial_non_finite_input",
+            manip_dyn::spatial::aba(
+                &good,
+                &mut data,
+                &[0.0; 2],
+                &[0.0, f64::INFINITY],
+                &[0.0; 2],
+                &mut [0.0; 2],
+            )
+            .unwrap_err(),
+            |e| {
+                matches!(
+                    e,
+                    DynError::NonFinite {
+                        name: "v",
+                        index: 1,
+                        ..
+                    }
+                )
+            },
+            &["v[1] must be finite, got inf"],
+        ),
+        // A point mass on the joint's axis at the tip: nothing resists that joint.
+        words(
+            "spatial_massless_joint",
+            {
+                let point = SpatialLink {
+                    mass: 1.0,
+                    com: [0.0; 3],
+                    inertia: [[0.0; 3]; 3],
+                };
+                let arm = SpatialModel::new(vec![joint; 2], vec![link, point], [0.0; 3]).unwrap();
+                manip_dyn::spatial::aba(
+                    &arm,
+                    &mut SpatialData::new(&arm),
+                    &[0.0; 2],
+                    &[0.0; 2],
+                    &[0.0; 2],
+                    &mut [0.0; 2],
+                )
+                .unwrap_err()
+            },
+            |e| *e == DynError::NotPositiveDefinite,
+            &["not numerically positive definite"],
+        ),
+    ]
+}
+
+#[test]
+fn bad_spatial_models_and_calls_are_refused() {
+    check(&spatial_rows());
+}

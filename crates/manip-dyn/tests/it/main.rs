@@ -19,3 +19,4 @@ mod dense_limit;
 mod derivatives;
 mod long_chains;
 mod properties;
+mod spatial;

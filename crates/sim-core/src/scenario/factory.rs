@@ -117,6 +117,15 @@ impl Scenario {
             "noise.sensor_a_dot_std",
             &self.noise.sensor_a_dot_std,
         )?);
+        // One rule for `simulate` and `sweep`: a scenario's bound is finite, so that every
+        // scenario that runs can also be written to a shard file (JSON has no infinity).
+        if self.limits.max_modal_error == f64::INFINITY {
+            return Err(SimError::setting(
+                "limits.max_modal_error",
+                "must be finite, got inf (a shard file cannot hold it): give a large bound such \
+                 as 1e6 rad for no practical runaway check",
+            ));
+        }
         settings.max_modal_error = self.limits.max_modal_error;
         settings.joint_torque_limits = self.limits.joint_torque_nm.as_ref().map(|l| match l {
             TorqueLimit::All(limit) => vec![*limit; model.n_links()],

@@ -76,7 +76,7 @@ impl Scenario {
             return Self::builtin(name_or_path);
         }
         let path = Path::new(name_or_path);
-        if path.is_file() {
+        if path.exists() {
             Self::load(path)
         } else {
             Err(unknown(name_or_path))

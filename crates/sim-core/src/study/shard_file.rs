@@ -270,7 +270,7 @@ impl ShardInput {
         let file = match self.file.take() {
             Some(file) => file,
             None => {
-                let mut file = File::open(&self.path)?;
+                let mut file = crate::open_regular_file(&self.path)?;
                 file.seek(SeekFrom::Start(self.offset))?;
                 BufReader::new(file)
             }
@@ -322,7 +322,8 @@ impl ShardReader<ShardInput> {
     /// Opens the shard file `path` and reads its header; the file is closed until the first
     /// run is read.
     pub fn open(path: &Path) -> Result<Self, String> {
-        let file = File::open(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let file = crate::open_regular_file(path)
+            .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
         let mut reader = Self::new(
             ShardInput {
                 path: path.to_path_buf(),

@@ -530,3 +530,95 @@ fn runaway_run_keeps_its_data() {
     assert!(failure.record.t.iter().all(|t| t.is_finite()));
     assert!(failure.to_string().contains("data kept up to t ="));
 }
+
+/// The issue's `step.toml`: a 0.05 s step response of the paper's arm, fuzzy at 1e-4 s, with a
+/// joint torque limit of 50 N m and the recording period given.
+fn step_response(record_period: f64) -> sim_core::Scenario {
+    let text = format!(
+        "name = \"step\"\nduration = 0.05\nalpha0 = 1.5707963267948966\nrecord_period = {record_period}\n\
+         [reference]\nkind = \"step\"\ninitial = [0.0, 0.0]\ntarget = [0.2, -0.2]\ntime = 0.01\n\
+         [controller]\nkind = \"fuzzy\"\nperiod = 0.0001\n\
+         [integrator]\nmethod = \"rk4\"\ndt = 0.0001\n\
+         [limits]\njoint_torque_nm = 50.0\n"
+    );
+    sim_core::Scenario::from_toml(&text).unwrap()
+}
+
+#[test]
+fn limits_and_peaks_checked_between_recorded_samples() {
+    // The torque spike after the step lasts less than a recording period of 0.05 s: the peaks,
+    // limit checks and clamped fractions must see it all the same, whatever is recorded.
+    let every = step_response(0.0001)
+        .build()
+        .unwrap()
+        .run()
+        .unwrap()
+        .summary;
+    let sparse = step_response(0.05).build().unwrap().run().unwrap().summary;
+    assert!(
+        every.peak_joint_torque_nm > 50.0,
+        "{}",
+        every.peak_joint_torque_nm
+    );
+    assert_eq!(sparse.recorded_samples, 2);
+    assert_eq!(every.recorded_samples, every.controller_samples);
+    assert_eq!(sparse.peak_joint_torque_nm, every.peak_joint_torque_nm);
+    assert_eq!(sparse.peak_joint_torques_nm, every.peak_joint_torques_nm);
+    assert_eq!(sparse.peak_modal_torques_nm, every.peak_modal_torques_nm);
+    assert_eq!(sparse.torque_limit_exceeded, every.torque_limit_exceeded);
+    assert!(!sparse.torque_limit_exceeded.is_empty());
+    assert_eq!(
+        sparse.tau_star_clamped_fraction,
+        every.tau_star_clamped_fraction
+    );
+    // The tracking errors are those of the recorded time series.
+    assert_ne!(sparse.tip_error_rms_m, every.tip_error_rms_m);
+    assert_ne!(sparse.tip_error_max_m, every.tip_error_max_m);
+}
+
+#[test]
+fn an_infinite_runaway_bound_is_refused_by_simulate_as_by_sweep() {
+    let mut scenario = sim_core::Scenario::builtin("paper-responses-step").unwrap();
+    scenario.limits.max_modal_error = f64::INFINITY;
+    let message = scenario.build().err().expect("refused").to_string();
+    assert!(
+        message.contains("limits.max_modal_error") && message.contains("must be finite, got inf"),
+        "{message}"
+    );
+    // The library loop itself still takes an infinite bound (no runaway check).
+    let mut s = settings();
+    s.max_modal_error = f64::INFINITY;
+    assert!(build(s).is_ok());
+}
+
+#[test]
+fn non_regular_input_files_are_refused_not_waited_on() {
+    let dir = std::env::temp_dir().join(format!("sim-core-fifo-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("controller.fis");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    if made {
+        // A FIFO as a scenario file and as a scenario's `controller.fis`: refused at once.
+        let message = sim_core::Scenario::resolve(fifo.to_str().unwrap())
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(message.contains("not a regular file"), "{message}");
+        let text = format!(
+            "{}\n",
+            sim_core::Scenario::builtin_text("paper-responses-step")
+                .unwrap()
+                .replace(
+                    "kind = \"fuzzy\"",
+                    &format!("kind = \"fuzzy\"\nfis = {:?}", fifo.to_str().unwrap())
+                )
+        );
+        let scenario = sim_core::Scenario::from_toml(&text).unwrap();
+        let message = scenario.build().err().expect("refused").to_string();
+        assert!(message.contains("not a regular file"), "{message}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

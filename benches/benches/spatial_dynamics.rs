@@ -1,0 +1,159 @@
+//! Spatial-chain dynamics (`manip_dyn::spatial`) per call: forward dynamics by the
+//! articulated-body algorithm one state at a time (`spatial_aba`) and in a batch of 1024 states
+//! (`spatial_aba_batch`, SIMD across states, throughput in states so that the figure is per
+//! state), and the analytic ABA derivatives (`spatial_aba_derivatives`: `qdd`, `d qdd / d q`,
+//! `d qdd / d v`, `M^-1`).
+//!
+//! Two chains, those of the comparison with Pinocchio in `docs/performance.md`: the 10-link
+//! universal-joint snake (`snake20`: 20 revolute joints alternating `z` and `y`, links of 0.1 m
+//! and 0.1 kg, each link's rod split between its two bodies) and a 7-joint chain of fixed
+//! pseudo-random axes, origins and inertias (`random7`), at a moving state.
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use manip_dyn::spatial::{
+    SpatialBatchData, SpatialData, SpatialDerivativeData, SpatialJoint, SpatialLink, SpatialModel,
+    Transform, aba, aba_batch, aba_derivatives,
+};
+use std::hint::black_box;
+
+/// The universal-joint snake.
+fn snake() -> SpatialModel {
+    let (mut joints, mut links) = (Vec::new(), Vec::new());
+    for i in 0..20 {
+        let reach = if i > 0 && i % 2 == 0 { 0.1 } else { 0.0 };
+        let axis = if i % 2 == 0 {
+            [0.0, 0.0, 1.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        joints.push(SpatialJoint::revolute(
+            axis,
+            Transform::translation([reach, 0.0, 0.0]),
+        ));
+        links.push(SpatialLink::cuboid(
+            0.05,
+            [0.1, 0.01, 0.01],
+            [0.05, 0.0, 0.0],
+        ));
+    }
+    SpatialModel::new(joints, links, [0.0, 0.0, -9.81]).unwrap()
+}
+
+/// Seven joints of pseudo-random axes and origins (one prismatic), cuboid links.
+fn random7() -> SpatialModel {
+    let r = |k: usize| ((k as f64 * 12.9898).sin() * 43758.5453).fract();
+    let (mut joints, mut links) = (Vec::new(), Vec::new());
+    for i in 0..7 {
+        let axis = [r(6 * i) - 0.5, r(6 * i + 1) - 0.5, r(6 * i + 2) + 0.1];
+        let norm = axis.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let origin = Transform::from_rpy(
+            [r(6 * i + 3) * 3.0, r(6 * i + 4) * 3.0, r(6 * i + 5) * 3.0],
+            [
+                0.1 + 0.1 * r(7 * i),
+                0.05 * r(7 * i + 1),
+                0.05 * r(7 * i + 2),
+            ],
+        );
+        let axis = axis.map(|x| x / norm);
+        joints.push(if i == 3 {
+            SpatialJoint::prismatic(axis, origin)
+        } else {
+            SpatialJoint::revolute(axis, origin)
+        });
+        links.push(SpatialLink::cuboid(
+            0.5 + r(9 * i),
+            [0.1 + 0.1 * r(9 * i + 1), 0.05, 0.04],
+            [0.05, 0.02 * r(9 * i + 2), 0.0],
+        ));
+    }
+    SpatialModel::new(joints, links, [0.0, 0.0, -9.81]).unwrap()
+}
+
+/// A chain at a moving state, with small efforts.
+struct Case {
+    name: &'static str,
+    model: SpatialModel,
+    q: Vec<f64>,
+    v: Vec<f64>,
+    tau: Vec<f64>,
+}
+
+fn cases() -> [Case; 2] {
+    [("snake20", snake()), ("random7", random7())].map(|(name, model)| {
+        let n = model.n_links();
+        let s = |i: usize, k: f64| (k * i as f64 / n as f64 + 0.3).sin();
+        Case {
+            name,
+            q: (0..n).map(|i| 0.3 * s(i, 6.0)).collect(),
+            v: (0..n).map(|i| 0.5 * s(i, 3.0)).collect(),
+            tau: (0..n).map(|i| 0.01 * s(i, 2.0)).collect(),
+            model,
+        }
+    })
+}
+
+fn spatial_aba(c: &mut Criterion) {
+    let mut group = c.benchmark_group("spatial_aba");
+    for case in cases() {
+        let mut data = SpatialData::new(&case.model);
+        let mut out = vec![0.0; case.model.n_links()];
+        group.bench_function(BenchmarkId::from_parameter(case.name), |b| {
+            b.iter(|| {
+                let (q, v, tau) = (black_box(&case.q), black_box(&case.v), black_box(&case.tau));
+                aba(&case.model, &mut data, q, v, tau, &mut out).unwrap();
+                black_box(out[0])
+            })
+        });
+    }
+    group.finish();
+}
+
+/// States in `spatial_aba_batch`.
+const BATCH: usize = 1024;
+
+fn spatial_aba_batch(c: &mut Criterion) {
+    let mut group = c.benchmark_group("spatial_aba_batch");
+    group.throughput(Throughput::Elements(BATCH as u64));
+    for case in cases() {
+        let n = case.model.n_links();
+        let mut data = SpatialBatchData::new(&case.model);
+        let spread = |x: &[f64]| -> Vec<f64> {
+            (0..BATCH)
+                .flat_map(|s| x.iter().map(move |x| x * (1.0 + 1e-3 * s as f64)))
+                .collect()
+        };
+        let (q, v, tau) = (spread(&case.q), spread(&case.v), spread(&case.tau));
+        let mut out = vec![0.0; n * BATCH];
+        group.bench_function(BenchmarkId::from_parameter(case.name), |b| {
+            b.iter(|| {
+                aba_batch(&case.model, &mut data, black_box(&q), &v, &tau, &mut out).unwrap();
+                black_box(out[0])
+            })
+        });
+    }
+    group.finish();
+}
+
+fn spatial_aba_derivatives(c: &mut Criterion) {
+    let mut group = c.benchmark_group("spatial_aba_derivatives");
+    for case in cases() {
+        let mut data = SpatialData::new(&case.model);
+        let mut derivatives = SpatialDerivativeData::new(&case.model);
+        group.bench_function(BenchmarkId::from_parameter(case.name), |b| {
+            b.iter(|| {
+                let (q, v, tau) = (black_box(&case.q), black_box(&case.v), black_box(&case.tau));
+                aba_derivatives(&case.model, &mut data, &mut derivatives, q, v, tau).unwrap();
+                black_box(derivatives.value()[0])
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    spatial_aba,
+    spatial_aba_batch,
+    spatial_aba_derivatives
+);
+criterion_main!(benches);

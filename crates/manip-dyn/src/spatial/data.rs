@@ -1,0 +1,84 @@
+//! The reusable workspace of the spatial algorithms (the "Data" of the Model/Data split).
+
+use pulp::Arch;
+
+use super::aba::AbaLink;
+use super::algebra::{Force, Motion, Symmetric6, Transform};
+use super::model::SpatialModel;
+
+/// Scratch space for one [`SpatialModel`]: build it once with [`SpatialData::new`], then pass it
+/// to every algorithm of [`spatial`](crate::spatial); after construction none of them allocates.
+/// Its memory is `O(n)` (under a kilobyte a link).
+///
+/// After [`forward_kinematics`](super::forward_kinematics()) (and every algorithm that runs it:
+/// all but the articulated-body ones) it holds each link's pose, read with
+/// [`link_pose`](Self::link_pose); its other contents between calls are unspecified.
+#[derive(Clone)]
+pub struct SpatialData {
+    /// `q`, then `sin q_i`, `cos q_i` (revolute joints; unused for prismatic ones).
+    pub(crate) angle: Vec<f64>,
+    pub(crate) sin: Vec<f64>,
+    pub(crate) cos: Vec<f64>,
+    /// Link `i`'s frame in link `i - 1`'s frame at `q`.
+    pub(crate) placements: Vec<Transform>,
+    /// Link `i`'s frame in the base frame at `q`.
+    pub(crate) poses: Vec<Transform>,
+    /// Spatial velocity and acceleration of each link, in its own frame.
+    pub(crate) velocities: Vec<Motion>,
+    pub(crate) accelerations: Vec<Motion>,
+    /// The force each link receives from its parent, in its own frame.
+    pub(crate) forces: Vec<Force>,
+    /// Composite inertia of links `i..n` in link `i`'s frame (CRBA).
+    pub(crate) composites: Vec<Symmetric6>,
+    /// The articulated-body quantities of each joint (ABA).
+    pub(crate) articulated: Vec<AbaLink<f64>>,
+    /// The instruction set found at construction, for the sines and cosines.
+    pub(crate) arch: Arch,
+}
+
+impl SpatialData {
+    /// Allocates the workspace for `model`.
+    ///
+    /// ```
+    /// use manip_dyn::ChainModel;
+    /// use manip_dyn::spatial::{SpatialData, SpatialModel};
+    /// let arm = SpatialModel::from_planar(&ChainModel::uniform(10, 0.1, 0.1, 9.81)?);
+    /// assert_eq!(SpatialData::new(&arm).n_links(), 10);
+    /// # Ok::<(), manip_dyn::DynError>(())
+    /// ```
+    pub fn new(model: &SpatialModel) -> SpatialData {
+        let n = model.n_links();
+        SpatialData {
+            angle: vec![0.0; n],
+            sin: vec![0.0; n],
+            cos: vec![0.0; n],
+            placements: vec![Transform::IDENTITY; n],
+            poses: vec![Transform::IDENTITY; n],
+            velocities: vec![Motion::default(); n],
+            accelerations: vec![Motion::default(); n],
+            forces: vec![Force::default(); n],
+            composites: vec![Symmetric6::default(); n],
+            articulated: vec![AbaLink::default(); n],
+            arch: Arch::new(),
+        }
+    }
+
+    /// Number of links of the chain this workspace was built for.
+    pub fn n_links(&self) -> usize {
+        self.poses.len()
+    }
+
+    /// Link `index`'s frame in the base frame as of the last forward kinematics, or `None` for
+    /// an index past the chain.
+    pub fn link_pose(&self, index: usize) -> Option<&Transform> {
+        self.poses.get(index)
+    }
+}
+
+impl std::fmt::Debug for SpatialData {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SpatialData")
+            .field("n_links", &self.n_links())
+            .finish_non_exhaustive()
+    }
+}

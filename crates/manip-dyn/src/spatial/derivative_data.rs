@@ -1,0 +1,167 @@
+//! The workspace and results of the spatial analytic derivatives
+//! ([`rnea_derivatives`](super::rnea_derivatives()) and
+//! [`aba_derivatives`](super::aba_derivatives())).
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::llt;
+use faer::{Mat, MatRef, Par};
+
+use super::algebra::Symmetric6;
+use super::model::SpatialModel;
+use crate::model::MAX_DENSE_LINKS;
+
+/// A spatial 6-vector as plain numbers (linear part first), for the world-frame sums of the
+/// derivatives.
+pub(crate) type Six = [f64; 6];
+
+/// Results and scratch of [`rnea_derivatives`](super::rnea_derivatives()) and
+/// [`aba_derivatives`](super::aba_derivatives()) for one [`SpatialModel`]: build it once with
+/// [`SpatialDerivativeData::new`] (about `32 n^2` bytes), then every call fills it without
+/// allocating. For a chain of more than [`MAX_DENSE_LINKS`] links, which both refuse, it holds
+/// nothing.
+///
+/// After a call it holds the differentiated function's value and its three Jacobians, entry
+/// `(i, j) = d out_i / d in_j`:
+///
+/// | after | [`value`](Self::value) | [`d_q`](Self::d_q) | [`d_v`](Self::d_v) | [`d_input`](Self::d_input) |
+/// |---|---|---|---|---|
+/// | `rnea_derivatives` | `tau` | `d tau / d q` | `d tau / d v` | `d tau / d qdd = M` |
+/// | `aba_derivatives` | `qdd` | `d qdd / d q` | `d qdd / d v` | `d qdd / d tau = M^-1` |
+pub struct SpatialDerivativeData {
+    pub(crate) n: usize,
+    /// `tau` or `qdd`.
+    pub(crate) value: Vec<f64>,
+    /// The ABA's accelerations while the RNEA derivatives run (`aba_derivatives`).
+    pub(crate) accelerations: Vec<f64>,
+    /// `n x 3n`: `[d_q | d_v | d_input]`.
+    pub(crate) blocks: Mat<f64>,
+    /// Per link, in the base frame: joint axis `J_i`, `P_i = Ic_i J_i`, `Q_i = Bc_i^T J_i`,
+    /// `w_i`, `beta_i`, and the column constants `G_i`, `H_i` (theory.md, "Spatial
+    /// derivatives").
+    pub(crate) axis: Vec<Six>,
+    pub(crate) p: Vec<Six>,
+    pub(crate) q: Vec<Six>,
+    pub(crate) w: Vec<Six>,
+    pub(crate) beta: Vec<Six>,
+    pub(crate) g: Vec<Six>,
+    pub(crate) h: Vec<Six>,
+    /// Composite inertia `Ic_i` and Coriolis operator `Bc_i` of links `i..n`, base frame.
+    pub(crate) composite: Vec<Symmetric6>,
+    pub(crate) coriolis: Vec<[Six; 6]>,
+    /// `M`, then its Cholesky factor (`aba_derivatives`), and the factorisation's scratch.
+    pub(crate) factor: Mat<f64>,
+    pub(crate) stack: MemBuffer,
+}
+
+impl SpatialDerivativeData {
+    /// Allocates the results and scratch for `model`.
+    ///
+    /// ```
+    /// use manip_dyn::ChainModel;
+    /// use manip_dyn::spatial::{SpatialDerivativeData, SpatialModel};
+    /// let arm = SpatialModel::from_planar(&ChainModel::uniform(10, 0.1, 0.1, 9.81)?);
+    /// assert_eq!(SpatialDerivativeData::new(&arm).d_q().nrows(), 10);
+    /// # Ok::<(), manip_dyn::DynError>(())
+    /// ```
+    pub fn new(model: &SpatialModel) -> SpatialDerivativeData {
+        Self::sized(model.n_links())
+    }
+
+    /// The workspace of a chain of `n` links.
+    fn sized(n: usize) -> SpatialDerivativeData {
+        let sized = if n <= MAX_DENSE_LINKS { n } else { 0 };
+        let six = || vec![[0.0; 6]; sized];
+        let stack = StackReq::or(
+            llt::factor::cholesky_in_place_scratch::<f64>(sized, Par::Seq, Default::default()),
+            llt::solve::solve_in_place_scratch::<f64>(sized, 3 * sized, Par::Seq),
+        );
+        let mut derivatives = SpatialDerivativeData {
+            n,
+            value: vec![0.0; sized],
+            accelerations: vec![0.0; sized],
+            blocks: Mat::zeros(sized, 3 * sized),
+            axis: six(),
+            p: six(),
+            q: six(),
+            w: six(),
+            beta: six(),
+            g: six(),
+            h: six(),
+            composite: vec![Symmetric6::default(); sized],
+            coriolis: vec![[[0.0; 6]; 6]; sized],
+            factor: Mat::zeros(sized, sized),
+            stack: MemBuffer::new(stack),
+        };
+        derivatives.warm_up();
+        derivatives
+    }
+
+    /// faer's blocked factorisation and many-right-hand-side solve (from about 64 rows)
+    /// multiply with a kernel that allocates a packing buffer per thread on first use: one
+    /// factorisation of the identity and solve here take that allocation out of the first
+    /// [`aba_derivatives`](super::aba_derivatives()) on this thread.
+    fn warm_up(&mut self) {
+        self.factor.fill(0.0);
+        self.factor.diagonal_mut().fill(1.0);
+        let stack = MemStack::new(&mut self.stack);
+        let factored = llt::factor::cholesky_in_place(
+            self.factor.as_mut(),
+            Default::default(),
+            Par::Seq,
+            stack,
+            Default::default(),
+        );
+        debug_assert!(factored.is_ok(), "the identity is positive definite");
+        llt::solve::solve_in_place(self.factor.as_ref(), self.blocks.as_mut(), Par::Seq, stack);
+    }
+
+    /// Number of links of the chain this workspace was built for.
+    pub fn n_links(&self) -> usize {
+        self.n
+    }
+
+    /// The differentiated function's value: `tau` after `rnea_derivatives`, `qdd` after
+    /// `aba_derivatives`.
+    pub fn value(&self) -> &[f64] {
+        &self.value
+    }
+
+    /// The Jacobian with respect to the joint values `q` (`n x n`).
+    pub fn d_q(&self) -> MatRef<'_, f64> {
+        self.block(0)
+    }
+
+    /// The Jacobian with respect to the joint rates `v` (`n x n`).
+    pub fn d_v(&self) -> MatRef<'_, f64> {
+        self.block(1)
+    }
+
+    /// The Jacobian with respect to the third input: `M` after `rnea_derivatives`, `M^-1` after
+    /// `aba_derivatives`.
+    pub fn d_input(&self) -> MatRef<'_, f64> {
+        self.block(2)
+    }
+
+    fn block(&self, index: usize) -> MatRef<'_, f64> {
+        let n = self.value.len();
+        self.blocks.as_ref().subcols(index * n, n)
+    }
+}
+
+impl Clone for SpatialDerivativeData {
+    /// A workspace of the same size, with the same results (the scratch is not copied).
+    fn clone(&self) -> Self {
+        let mut copy = Self::sized(self.n);
+        copy.value.copy_from_slice(&self.value);
+        copy.blocks.copy_from(&self.blocks);
+        copy
+    }
+}
+
+impl std::fmt::Debug for SpatialDerivativeData {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SpatialDerivativeData")
+            .field("n_links", &self.n)
+            .finish_non_exhaustive()
+    }
+}
