@@ -3,7 +3,8 @@
 //! `tau*` limits that bind: the previous plan shifted by one step, the references of the new
 //! horizon set, and control-limited iLQR run from a state slightly off the previous plan's
 //! prediction (at most the default 5 iterations). Preparing the warm start (a clone of the
-//! planned workspace) is not timed.
+//! planned workspace) is not timed. `mpc/solve_30` is the same arm (1 m, 1 kg) split into 30
+//! links, beside Crocoddyl's solve of the full joint space (benches/crocoddyl/mpc.py, issue 34).
 
 use backbone_kin::ModalMap;
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
@@ -26,10 +27,20 @@ fn set_references(mpc: &mut Mpc, model: &ReducedModel, reference: &mut Sinusoid,
 }
 
 fn solve(c: &mut Criterion) {
+    let mut group = c.benchmark_group("mpc");
+    for n in [10, 30] {
+        solve_n(&mut group, n);
+    }
+    group.finish();
+}
+
+/// `mpc/solve_<n>`: the arm of 1 m and 1 kg in `n` equal links.
+fn solve_n(group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>, n: usize) {
     let alpha0 = std::f64::consts::FRAC_PI_2;
+    let size = 1.0 / n as f64;
     let model = ReducedModel::new(
-        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
-        ModalMap::paper_fixed_alpha0(10, alpha0).unwrap(),
+        ChainModel::uniform(n, size, size, 9.81).unwrap(),
+        ModalMap::paper_fixed_alpha0(n, alpha0).unwrap(),
     )
     .unwrap();
     // A brisk motion about the paper's start (a1 ~ 1, a2 ~ 0): 0.3 rad and 0.1 rad at 1 Hz.
@@ -50,15 +61,13 @@ fn solve(c: &mut Criterion) {
     mpc.shift(1);
     let h = mpc.step();
     set_references(&mut mpc, &model, &mut reference, h);
-    let mut group = c.benchmark_group("mpc");
-    group.bench_function("solve_10", |b| {
+    group.bench_function(format!("solve_{n}"), |b| {
         b.iter_batched_ref(
             || mpc.clone(),
             |mpc| mpc.solve(&model, black_box(&a), black_box(&a_dot)).unwrap(),
             BatchSize::SmallInput,
         )
     });
-    group.finish();
 }
 
 criterion_group!(benches, solve);

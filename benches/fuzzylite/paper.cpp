@@ -1,7 +1,8 @@
 // Times fuzzylite 6 (Debian's libfuzzylite-dev) on the paper's controller, read from the same
 // `.fis` file hrm ships (crates/fuzzy-sugeno/data/paper.fis: 4 inputs, 8 bell sets, 16 rules,
 // 2 outputs), at the input of hrm's `fuzzy/paper` bench (benches/benches/fuzzy.rs). Prints the
-// median over batches of the time per evaluation in nanoseconds, and the two outputs, which must
+// median over batches of the time per evaluation, `fuzzylite/paper <ns> ns` (the figure
+// `cargo xtask bench --check` reads), and the two outputs, which must
 // equal hrm's at the same input (a check that both evaluate the same system).
 //
 // Build and run with ./run.sh.
@@ -39,7 +40,7 @@ int main(int argc, char** argv) {
     times.push_back(std::chrono::duration<double, std::nano>(stop - start).count() / calls);
   }
   std::sort(times.begin(), times.end());
-  std::printf("fuzzylite paper %.1f ns\n", times[times.size() / 2]);
+  std::printf("fuzzylite/paper %.1f ns\n", times[times.size() / 2]);
   std::printf("  check: outputs %.15g %.15g\n", engine->getOutputVariable(0)->getValue(),
               engine->getOutputVariable(1)->getValue());
   return 0;

@@ -8,8 +8,9 @@
 //     values, so J is a fixed dense n x 3 matrix);
 //   - computeABADerivatives and computeRNEADerivatives (beside hrm's `aba_derivatives/n` and
 //     `rnea_derivatives/n`).
-// Prints one line per algorithm and size: the median over batches of the time per call, in
-// nanoseconds.
+// Prints one line per algorithm and size, `pinocchio/<algorithm>/<n> <median> ns`: the median
+// over batches of the time per call (the figures `cargo xtask bench --check` reads; the ids name
+// the hrm bench each one stands beside).
 //
 // Build and run with ./run.sh (it compiles against the headers and library of the `pin` wheel).
 
@@ -87,14 +88,15 @@ int main() {
           a_ddot = reduced_mass.llt().solve(tau_star - bias);
         },
         calls, 51);
-    std::printf("pinocchio aba/%d %.1f ns\n", n, fd_ns);
-    std::printf("pinocchio crba+nle+projection+llt/%d %.1f ns\n", n, reduced_ns);
+    std::printf("pinocchio/aba/%d %.1f ns\n", n, fd_ns);
+    // crba + nonLinearEffects + J^T M J, J^T nle + 3x3 LLT
+    std::printf("pinocchio/reduced_fd/%d %.1f ns\n", n, reduced_ns);
     double aba_ns = median_ns([&] { computeABADerivatives(model, data, q, v, tau); }, calls, 51);
     // The qdd that ABA finds, for RNEA's derivatives at the same state.
     Eigen::VectorXd a = data.ddq;
     double rnea_ns = median_ns([&] { computeRNEADerivatives(model, data, q, v, a); }, calls, 51);
-    std::printf("pinocchio computeABADerivatives/%d %.1f ns\n", n, aba_ns);
-    std::printf("pinocchio computeRNEADerivatives/%d %.1f ns\n", n, rnea_ns);
+    std::printf("pinocchio/aba_derivatives/%d %.1f ns\n", n, aba_ns);
+    std::printf("pinocchio/rnea_derivatives/%d %.1f ns\n", n, rnea_ns);
     // A check that the harness times the same chain: the acceleration of the last joint.
     std::printf("  check: qdd[n-1] = %.12g, dqdd/dtau[0][0] = %.12g\n", data.ddq[n - 1],
                 data.Minv(0, 0));

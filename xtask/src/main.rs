@@ -15,10 +15,13 @@
 //! - `bench [FILTER]`: the Criterion benches, then `target/bench-summary.json` (bench id -> median
 //!   nanoseconds per iteration, or per element for a bench with Criterion's throughput set, such
 //!   as the states of a batch) printed as a table.
-//! - `bench --check`: compares `target/bench-summary.json` with the targets of
-//!   `benches/targets.toml` and prints what falls short (fails if anything does). Not part of CI:
-//!   timings on a shared machine are noisy.
+//! - `bench --check [--rounds N] [--measurement-time SECONDS] [--only TEXT]`: the targets of
+//!   `benches/targets.toml`, measured in this invocation: the anchors' harnesses (Pinocchio,
+//!   fuzzylite, Crocoddyl) and hrm's benches interleaved over rounds, ratios checked on the
+//!   medians ([`mod@bench_check`]); fails if a target falls short. Not part of CI (CI compiles the
+//!   benches, never runs them).
 
+mod bench_check;
 mod tidy;
 
 use std::path::{Path, PathBuf};
@@ -31,7 +34,7 @@ fn main() -> ExitCode {
         Some("test") => test(),
         Some("tidy") => tidy(),
         Some("props") => props(&args[1..]),
-        Some("bench") if args.get(1).is_some_and(|a| a == "--check") => check_targets(),
+        Some("bench") if args.get(1).is_some_and(|a| a == "--check") => check(&args[2..]),
         Some("bench") => bench(&args[1..]),
         _ => Err(USAGE.to_string()),
     };
@@ -44,8 +47,8 @@ fn main() -> ExitCode {
     }
 }
 
-const USAGE: &str =
-    "usage: cargo xtask ci | test | tidy | props [--cases N] | bench [FILTER] | bench --check";
+const USAGE: &str = "usage: cargo xtask ci | test | tidy | props [--cases N] | bench [FILTER] \
+     | bench --check [--rounds N] [--measurement-time SECONDS] [--only TEXT]";
 
 fn ci() -> Result<(), String> {
     cargo(&["fmt", "--all", "--", "--check"], &[])?;
@@ -182,6 +185,47 @@ fn run(program: &Path, args: &[&str]) -> Result<(), String> {
     }
 }
 
+/// `bench --check [--rounds N] [--measurement-time SECONDS] [--only TEXT]` ([`mod@bench_check`]).
+fn check(args: &[String]) -> Result<(), String> {
+    let mut options = bench_check::Options {
+        rounds: 3,
+        measurement_seconds: 2.0,
+        only: None,
+    };
+    let mut rest = args.iter();
+    while let Some(flag) = rest.next() {
+        let value = rest
+            .next()
+            .ok_or_else(|| format!("{flag} needs a value; {USAGE}"))?;
+        match flag.as_str() {
+            "--rounds" => {
+                options.rounds = value
+                    .parse()
+                    .ok()
+                    .filter(|n| (1..=bench_check::MAX_ROUNDS).contains(n))
+                    .ok_or_else(|| {
+                        format!(
+                            "--rounds must be 1 to {}, not {value}",
+                            bench_check::MAX_ROUNDS
+                        )
+                    })?;
+            }
+            "--measurement-time" => {
+                options.measurement_seconds = value
+                    .parse()
+                    .ok()
+                    .filter(|s: &f64| (0.1..=600.0).contains(s))
+                    .ok_or_else(|| {
+                        format!("--measurement-time must be 0.1 to 600 seconds, not {value}")
+                    })?;
+            }
+            "--only" => options.only = Some(value.clone()),
+            _ => return Err(USAGE.to_string()),
+        }
+    }
+    bench_check::run(&workspace_root(), &target_dir(), &options)
+}
+
 fn props(args: &[String]) -> Result<(), String> {
     let cases = match args {
         [] => "2048".to_string(),
@@ -201,7 +245,7 @@ fn bench(args: &[String]) -> Result<(), String> {
     cargo(&cmd, &[])?;
     let criterion = target_dir().join("criterion");
     let mut rows = Vec::new();
-    collect_medians(&criterion, &mut rows)?;
+    collect_medians(&criterion, &mut rows, None)?;
     if rows.is_empty() {
         return Err(format!(
             "no Criterion results under {}",
@@ -226,8 +270,13 @@ fn bench(args: &[String]) -> Result<(), String> {
 }
 
 /// Walks Criterion's output folder and collects `(full id, median ns)` from every
-/// `new/benchmark.json` + `new/estimates.json` pair.
-fn collect_medians(dir: &Path, rows: &mut Vec<(String, f64)>) -> Result<(), String> {
+/// `new/benchmark.json` + `new/estimates.json` pair (only those written at or after `since`, if
+/// given).
+fn collect_medians(
+    dir: &Path,
+    rows: &mut Vec<(String, f64)>,
+    since: Option<std::time::SystemTime>,
+) -> Result<(), String> {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Ok(());
     };
@@ -237,6 +286,14 @@ fn collect_medians(dir: &Path, rows: &mut Vec<(String, f64)>) -> Result<(), Stri
             continue;
         }
         if path.file_name().is_some_and(|n| n == "new") {
+            let fresh = since.is_none_or(|since| {
+                std::fs::metadata(path.join("estimates.json"))
+                    .and_then(|m| m.modified())
+                    .is_ok_and(|modified| modified >= since)
+            });
+            if !fresh {
+                continue;
+            }
             if let (Some(id), Some(median)) = (
                 read_json(&path.join("benchmark.json"), &["full_id"])
                     .and_then(|v| v.as_str().map(str::to_owned)),
@@ -251,114 +308,10 @@ fn collect_medians(dir: &Path, rows: &mut Vec<(String, f64)>) -> Result<(), Stri
                 rows.push((id, median / elements));
             }
         } else {
-            collect_medians(&path, rows)?;
+            collect_medians(&path, rows, since)?;
         }
     }
     Ok(())
-}
-
-/// `bench --check`: every target of `benches/targets.toml` against `target/bench-summary.json`.
-/// A `[[max]]` target bounds a bench's median (`id`, `ns`); a `[[speedup]]` target asks bench `id`
-/// to be at least `at_least` times faster than bench `over`, both from the same summary.
-fn check_targets() -> Result<(), String> {
-    let targets_path = workspace_root().join("benches").join("targets.toml");
-    let text = std::fs::read_to_string(&targets_path)
-        .map_err(|e| format!("{}: {e}", targets_path.display()))?;
-    let targets: toml::Table =
-        toml::from_str(&text).map_err(|e| format!("{}: {e}", targets_path.display()))?;
-    let summary_path = target_dir().join("bench-summary.json");
-    let summary: serde_json::Map<String, serde_json::Value> =
-        std::fs::read_to_string(&summary_path)
-            .ok()
-            .and_then(|text| serde_json::from_str(&text).ok())
-            .ok_or_else(|| {
-                format!(
-                    "cannot read {}: run `cargo xtask bench` first",
-                    summary_path.display()
-                )
-            })?;
-    let median = |id: &str| summary.get(id).and_then(serde_json::Value::as_f64);
-    let entries = |kind: &str| -> Result<Vec<toml::Table>, String> {
-        match targets.get(kind) {
-            None => Ok(Vec::new()),
-            Some(toml::Value::Array(items)) => items
-                .iter()
-                .map(|item| {
-                    item.as_table()
-                        .cloned()
-                        .ok_or_else(|| format!("[[{kind}]] entries must be tables"))
-                })
-                .collect(),
-            Some(_) => Err(format!("`{kind}` must be an array of tables ([[{kind}]])")),
-        }
-    };
-    let field = |table: &toml::Table, kind: &str, key: &str| -> Result<toml::Value, String> {
-        table
-            .get(key)
-            .cloned()
-            .ok_or_else(|| format!("a [[{kind}]] entry lacks `{key}`: {table}"))
-    };
-    let number = |value: toml::Value| match value {
-        toml::Value::Float(x) => Some(x),
-        toml::Value::Integer(x) => Some(x as f64),
-        _ => None,
-    };
-    let (mut short, mut unmeasured) = (0, 0);
-    println!(
-        "{:<28}  {:>12}  {:>16}  result",
-        "bench", "measured", "target"
-    );
-    for target in entries("max")? {
-        let id = field(&target, "max", "id")?;
-        let id = id.as_str().ok_or("`id` must be a string")?;
-        let limit = number(field(&target, "max", "ns")?).ok_or("`ns` must be a number")?;
-        let wanted = format!("<= {}", human_time(limit));
-        match median(id) {
-            None => {
-                unmeasured += 1;
-                println!("{id:<28}  {:>12}  {wanted:>16}  not measured", "-");
-            }
-            Some(ns) => {
-                let ok = ns <= limit;
-                short += usize::from(!ok);
-                let verdict = if ok { "ok" } else { "SHORT" };
-                println!("{id:<28}  {:>12}  {wanted:>16}  {verdict}", human_time(ns));
-            }
-        }
-    }
-    for target in entries("speedup")? {
-        let id = field(&target, "speedup", "id")?;
-        let over = field(&target, "speedup", "over")?;
-        let (id, over) = (
-            id.as_str().ok_or("`id` must be a string")?,
-            over.as_str().ok_or("`over` must be a string")?,
-        );
-        let factor =
-            number(field(&target, "speedup", "at_least")?).ok_or("`at_least` must be a number")?;
-        let wanted = format!(">= {factor}x {over}");
-        match (median(id), median(over)) {
-            (Some(fast), Some(slow)) => {
-                let ratio = slow / fast;
-                let ok = ratio >= factor;
-                short += usize::from(!ok);
-                let verdict = if ok { "ok" } else { "SHORT" };
-                println!("{id:<28}  {:>11.2}x  {wanted:>16}  {verdict}", ratio);
-            }
-            _ => {
-                unmeasured += 1;
-                println!("{id:<28}  {:>12}  {wanted:>16}  not measured", "-");
-            }
-        }
-    }
-    println!(
-        "\n{short} target(s) short, {unmeasured} not measured (from {})",
-        summary_path.display()
-    );
-    if short == 0 {
-        Ok(())
-    } else {
-        Err(format!("{short} bench target(s) fall short"))
-    }
 }
 
 fn read_json(path: &Path, keys: &[&str]) -> Option<serde_json::Value> {
