@@ -31,11 +31,12 @@ const REPOSITORY: &str = "https://github.com/hrm-toolkit/hrm";
 const UNSAFE_FILES: [&str; 1] = ["crates/fuzzy-sugeno/src/kernel.rs"];
 
 /// The workspace's library crates (published, usable alone).
-const LIBRARIES: [&str; 10] = [
+const LIBRARIES: [&str; 11] = [
     "lane-math",
     "backbone-kin",
     "manip-dyn",
     "robot-desc",
+    "clearance",
     "modal-reduce",
     "fuzzy-sugeno",
     "optimal-ctl",

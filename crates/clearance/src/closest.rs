@@ -1,0 +1,251 @@
+//! Closest points between a segment (a link's axis) and a point, a segment or a box.
+//!
+//! Each returns the parameter `t` of the closest point `c = a + t (b - a)` on the link's axis, the
+//! distance between the cores (signed for a box: negative when `c` is inside) and the unit normal
+//! `n`, the gradient of that distance with respect to `c`. By the envelope theorem the distance's
+//! gradient with respect to the segment's ends is `(1 - t) n` and `t n`. Where two cores meet
+//! (a link's axis through a sphere's centre, two crossing axes) the distance of the cores is
+//! zero and stays zero under small motions of crossing axes: the normal is then zero, a
+//! subgradient, and the clearance saturates at minus the radii.
+
+use crate::obstacle::{box_signed_distance, unit_or};
+use crate::vector::{V3, dot, lerp, sub, to_local, to_world};
+
+/// The closest point of the link's axis `a`-`b` to a core and the signed distance between them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Closest {
+    /// The parameter of the closest point on the link's axis, in `[0, 1]`.
+    pub t: f64,
+    /// The closest point on the link's axis.
+    pub point: V3,
+    /// The closest point on the other core (a point of the box's surface for a box).
+    pub other: V3,
+    /// The distance between the cores, negative when the link's axis enters a box.
+    pub distance: f64,
+    /// The unit gradient of `distance` with respect to `point`.
+    pub normal: V3,
+}
+
+/// The unit vector along `v` and its length; below the rounding of coordinates of size `scale`
+/// the cores meet, the direction is noise, and the normal is zero.
+#[inline]
+fn direction(v: V3, scale: f64) -> (V3, f64) {
+    let (normal, length) = unit_or(v, [0.0; 3]);
+    if length <= 1e-12 * scale {
+        ([0.0; 3], length)
+    } else {
+        (normal, length)
+    }
+}
+
+/// The closest point of the segment `a`-`b` to the point `o`.
+#[inline]
+pub fn segment_point(a: V3, b: V3, o: V3) -> Closest {
+    let axis = sub(b, a);
+    let length2 = dot(axis, axis);
+    let t = if length2 > 0.0 {
+        (dot(sub(o, a), axis) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let point = lerp(a, b, t);
+    let (normal, distance) = direction(sub(point, o), length2.sqrt());
+    Closest {
+        t,
+        point,
+        other: o,
+        distance,
+        normal,
+    }
+}
+
+/// The closest points of the segments `a`-`b` and `c`-`d` (Ericson, *Real-Time Collision
+/// Detection*, 5.1.9, with the degenerate and parallel cases resolved).
+#[inline]
+pub fn segment_segment(a: V3, b: V3, c: V3, d: V3) -> Closest {
+    let d1 = sub(b, a);
+    let d2 = sub(d, c);
+    let r = sub(a, c);
+    let (aa, ee, f) = (dot(d1, d1), dot(d2, d2), dot(d2, r));
+    let (t, s) = if aa <= 0.0 && ee <= 0.0 {
+        (0.0, 0.0)
+    } else if aa <= 0.0 {
+        (0.0, (f / ee).clamp(0.0, 1.0))
+    } else {
+        let cc = dot(d1, r);
+        if ee <= 0.0 {
+            ((-cc / aa).clamp(0.0, 1.0), 0.0)
+        } else {
+            let bb = dot(d1, d2);
+            let denom = aa * ee - bb * bb;
+            let mut t = if denom > 0.0 {
+                ((bb * f - cc * ee) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let mut s = (bb * t + f) / ee;
+            if s < 0.0 {
+                s = 0.0;
+                t = (-cc / aa).clamp(0.0, 1.0);
+            } else if s > 1.0 {
+                s = 1.0;
+                t = ((bb - cc) / aa).clamp(0.0, 1.0);
+            }
+            (t, s)
+        }
+    };
+    let point = lerp(a, b, t);
+    let other = lerp(c, d, s);
+    let (normal, distance) = direction(sub(point, other), aa.sqrt() + ee.sqrt());
+    Closest {
+        t,
+        point,
+        other,
+        distance,
+        normal,
+    }
+}
+
+/// The point of the segment `a`-`b` deepest in (or closest to) the box of `center`, `half`
+/// and `axes` (the columns of its rotation), and its signed distance.
+///
+/// The box's signed distance along the segment, `f(t)`, is convex (the signed distance of a
+/// convex set is convex) and smooth between the breakpoints where a local coordinate crosses
+/// `0` or `+-h_k` or two faces' depths `|q_j| - h_j`, `|q_k| - h_k` tie: outside the box `f` is
+/// the root of a quadratic, inside the largest of linear functions. Its minimum is therefore
+/// one of the breakpoints or the stationary point of an outside piece; all are evaluated.
+pub fn segment_box(a: V3, b: V3, center: V3, half: V3, axes: &[V3; 3]) -> Closest {
+    let q0 = to_local(axes, sub(a, center));
+    let dq = to_local(axes, sub(b, a));
+    let at = |t: f64| [q0[0] + t * dq[0], q0[1] + t * dq[1], q0[2] + t * dq[2]];
+    let mut breaks = [0.0_f64; 26];
+    let mut count = 0;
+    let mut push = |t: f64| {
+        if t > 0.0 && t < 1.0 {
+            breaks[count] = t;
+            count += 1;
+        }
+    };
+    for k in 0..3 {
+        if dq[k] != 0.0 {
+            push(-q0[k] / dq[k]);
+            if half[k].is_finite() {
+                push((half[k] - q0[k]) / dq[k]);
+                push((-half[k] - q0[k]) / dq[k]);
+            }
+        }
+    }
+    for (j, k) in [(0, 1), (0, 2), (1, 2)] {
+        if !(half[j].is_finite() && half[k].is_finite()) {
+            continue;
+        }
+        for (sj, sk) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+            let slope = sj * dq[j] - sk * dq[k];
+            if slope != 0.0 {
+                push((half[j] - half[k] - sj * q0[j] + sk * q0[k]) / slope);
+            }
+        }
+    }
+    breaks[count] = 0.0;
+    breaks[count + 1] = 1.0;
+    let breaks = &mut breaks[..count + 2];
+    breaks.sort_unstable_by(f64::total_cmp);
+    let mut best = (0.0, f64::INFINITY);
+    let mut consider = |t: f64| {
+        let value = box_signed_distance(at(t), half);
+        if value < best.1 {
+            best = (t, value);
+        }
+    };
+    for window in breaks.windows(2) {
+        let (lo, hi) = (window[0], window[1]);
+        consider(lo);
+        // The stationary point of the squared outside distance of this piece.
+        let mid = at(0.5 * (lo + hi));
+        let (mut num, mut den) = (0.0, 0.0);
+        for k in 0..3 {
+            let bound = if mid[k] > half[k] {
+                half[k]
+            } else if mid[k] < -half[k] {
+                -half[k]
+            } else {
+                continue;
+            };
+            num -= (q0[k] - bound) * dq[k];
+            den += dq[k] * dq[k];
+        }
+        if den > 0.0 {
+            consider((num / den).clamp(lo, hi));
+        }
+    }
+    consider(1.0);
+    let (t, distance) = best;
+    let q = at(t);
+    // The gradient of the box's signed distance at q: outward from the nearest surface point.
+    let mut outside = [0.0; 3];
+    let (mut deepest, mut face) = (f64::NEG_INFINITY, 0);
+    for k in 0..3 {
+        outside[k] = q[k] - q[k].clamp(-half[k], half[k]);
+        let gap = q[k].abs() - half[k];
+        if gap > deepest {
+            (deepest, face) = (gap, k);
+        }
+    }
+    let (mut local_normal, gap) = unit_or(outside, {
+        let mut n = [0.0; 3];
+        n[face] = if q[face] < 0.0 { -1.0 } else { 1.0 };
+        n
+    });
+    if gap == 0.0 && t > 0.0 && t < 1.0 {
+        local_normal = inside_kink_normal(q, dq, half, deepest).unwrap_or(local_normal);
+    }
+    let mut surface = q;
+    if gap > 0.0 {
+        for k in 0..3 {
+            surface[k] = q[k].clamp(-half[k], half[k]);
+        }
+    } else {
+        surface[face] = half[face].copysign(q[face]);
+    }
+    let normal = to_world(axes, local_normal);
+    Closest {
+        t,
+        point: lerp(a, b, t),
+        other: crate::vector::add(center, to_world(axes, surface)),
+        distance,
+        normal,
+    }
+}
+
+/// Inside the box the depth along the segment is the largest of the affine pieces
+/// `sigma q_k(t) - h_k`; at a minimum where two of them tie with slopes of opposite sign, the
+/// minimum's gradient is their normals' combination `lambda n_- + (1 - lambda) n_+` that makes
+/// the slope zero, `lambda s_- + (1 - lambda) s_+ = 0`. `None` when one piece is active.
+fn inside_kink_normal(q: V3, dq: V3, half: V3, deepest: f64) -> Option<V3> {
+    let tolerance = 1e-9 * (1.0 + deepest.abs());
+    // (slope, normal) of the active pieces with the smallest and the largest slope.
+    let mut falling: Option<(f64, V3)> = None;
+    let mut rising: Option<(f64, V3)> = None;
+    for k in 0..3 {
+        for sign in [-1.0, 1.0] {
+            if (sign * q[k] - half[k] - deepest).abs() > tolerance {
+                continue;
+            }
+            let slope = sign * dq[k];
+            let mut normal = [0.0; 3];
+            normal[k] = sign;
+            if falling.is_none_or(|(s, _)| slope < s) {
+                falling = Some((slope, normal));
+            }
+            if rising.is_none_or(|(s, _)| slope > s) {
+                rising = Some((slope, normal));
+            }
+        }
+    }
+    let ((down, n_down), (up, n_up)) = (falling?, rising?);
+    if !(down < 0.0 && up > 0.0) {
+        return None;
+    }
+    let lambda = up / (up - down);
+    Some([0, 1, 2].map(|k| lambda * n_down[k] + (1.0 - lambda) * n_up[k]))
+}

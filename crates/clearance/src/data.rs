@@ -1,0 +1,113 @@
+//! What the clearance algorithms write: the chain's placement, distances, closest points and
+//! modal gradients, sized once from a model.
+
+use crate::closest::Closest;
+use crate::error::ClearanceError;
+use crate::model::ClearanceModel;
+use crate::vector::V3;
+
+/// The most modal gradient entries (pairs times coordinates) a [`ClearanceData`] holds: `2^25`.
+pub const MAX_GRADIENT_ENTRIES: usize = 1 << 25;
+
+/// The working memory of [`ClearanceModel`]'s algorithms for a chain with `m` modal coordinates
+/// (`m` may be zero when only joint gradients are wanted). Holds no algorithm.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClearanceData {
+    /// `n + 1` joint points, base to tip: link `i` runs from `points[i]` to `points[i + 1]`.
+    pub(crate) points: Vec<V3>,
+    /// `n` unit joint axes in world coordinates (`z` for a planar chain).
+    pub(crate) axes: Vec<V3>,
+    /// The planar chain's points, from `backbone_kin::joint_positions`.
+    pub(crate) planar: Vec<[f64; 2]>,
+    /// Per pair: the signed clearance (distance between the surfaces, negative in contact).
+    pub(crate) distances: Vec<f64>,
+    /// Per pair: the closest points and the normal.
+    pub(crate) closest: Vec<Closest>,
+    /// The number of modal coordinates `m`.
+    pub(crate) n_coords: usize,
+    /// `pairs x m` modal gradients, row-major.
+    pub(crate) modal_gradient: Vec<f64>,
+    /// Prefix sums `W_il = sum_{j <= i} J_jl w_j` (`n x m`).
+    pub(crate) prefix_axes: Vec<V3>,
+    /// Prefix sums `U_il = sum_{j <= i} J_jl (w_j x p_j)` (`n x m`).
+    pub(crate) prefix_moments: Vec<V3>,
+}
+
+impl ClearanceData {
+    /// Data for `model` and modal maps of `n_coords` coordinates; refused when the modal
+    /// gradients (pairs times coordinates) would exceed [`MAX_GRADIENT_ENTRIES`].
+    pub fn new(model: &ClearanceModel, n_coords: usize) -> Result<Self, ClearanceError> {
+        let n = model.n_links();
+        let pairs = model.pairs().len();
+        let entries = pairs.max(n).saturating_mul(n_coords);
+        if entries > MAX_GRADIENT_ENTRIES {
+            return Err(ClearanceError::TooMany {
+                what: "modal gradient entries (pairs x coordinates)",
+                got: entries,
+                max: MAX_GRADIENT_ENTRIES,
+            });
+        }
+        let empty = Closest {
+            t: 0.0,
+            point: [0.0; 3],
+            other: [0.0; 3],
+            distance: 0.0,
+            normal: [0.0; 3],
+        };
+        Ok(Self {
+            points: vec![[0.0; 3]; n + 1],
+            axes: vec![[0.0, 0.0, 1.0]; n],
+            planar: vec![[0.0; 2]; n + 1],
+            distances: vec![f64::INFINITY; pairs],
+            closest: vec![empty; pairs],
+            n_coords,
+            modal_gradient: vec![0.0; pairs * n_coords],
+            prefix_axes: vec![[0.0; 3]; n * n_coords],
+            prefix_moments: vec![[0.0; 3]; n * n_coords],
+        })
+    }
+
+    /// The joint points, base to tip.
+    pub fn points(&self) -> &[V3] {
+        &self.points
+    }
+
+    /// The joint axes in world coordinates.
+    pub fn axes(&self) -> &[V3] {
+        &self.axes
+    }
+
+    /// Each pair's clearance (distance between the capsules' surfaces; negative in contact), in
+    /// the order of [`ClearanceModel::pairs`].
+    pub fn distances(&self) -> &[f64] {
+        &self.distances
+    }
+
+    /// Each pair's closest points and normal (`normal` is the clearance's gradient with respect
+    /// to the link's point; for a self pair the link is the proximal one).
+    pub fn closest(&self) -> &[Closest] {
+        &self.closest
+    }
+
+    /// The gradient of pair `pair`'s clearance with respect to the modal coordinates.
+    ///
+    /// # Panics
+    /// If `pair` is out of range, like slice indexing.
+    pub fn modal_gradient(&self, pair: usize) -> &[f64] {
+        &self.modal_gradient[pair * self.n_coords..(pair + 1) * self.n_coords]
+    }
+
+    /// The smallest clearance to an obstacle (`+inf` with no obstacle).
+    pub fn min_obstacle_clearance(&self, model: &ClearanceModel) -> f64 {
+        min(&self.distances[..model.n_obstacle_pairs()])
+    }
+
+    /// The smallest clearance between links that share no joint (`+inf` below three links).
+    pub fn min_self_clearance(&self, model: &ClearanceModel) -> f64 {
+        min(&self.distances[model.n_obstacle_pairs()..])
+    }
+}
+
+fn min(values: &[f64]) -> f64 {
+    values.iter().copied().fold(f64::INFINITY, f64::min)
+}

@@ -1,0 +1,54 @@
+//! Placing the chain: its joint points and axes in world coordinates.
+
+use crate::data::ClearanceData;
+use crate::error::{ClearanceError, check_finite, check_len};
+use crate::model::ClearanceModel;
+use crate::vector::{V3, dot};
+
+/// Places a planar chain (base at the origin, every axis along `z`) with joint angles `theta`
+/// through `backbone_kin::joint_positions`. Allocation-free.
+pub fn place_planar(
+    model: &ClearanceModel,
+    data: &mut ClearanceData,
+    link_lengths: &[f64],
+    theta: &[f64],
+) -> Result<(), ClearanceError> {
+    check_len("link lengths", link_lengths.len(), model.n_links())?;
+    backbone_kin::joint_positions(link_lengths, theta, &mut data.planar)?;
+    for (point, planar) in data.points.iter_mut().zip(&data.planar) {
+        *point = [planar[0], planar[1], 0.0];
+    }
+    data.axes.fill([0.0, 0.0, 1.0]);
+    Ok(())
+}
+
+/// Places any serial chain of revolute joints: `points` the `n + 1` joint points from the base
+/// to the tip (joint `i` at `points[i]`, link `i` to `points[i + 1]`) and `axes` the `n` unit
+/// joint axes in world coordinates. Allocation-free.
+pub fn place(
+    model: &ClearanceModel,
+    data: &mut ClearanceData,
+    points: &[V3],
+    axes: &[V3],
+) -> Result<(), ClearanceError> {
+    check_len("joint points", points.len(), model.n_links() + 1)?;
+    check_len("joint axes", axes.len(), model.n_links())?;
+    for point in points {
+        point
+            .iter()
+            .try_for_each(|&x| check_finite("joint point", x))?;
+    }
+    for axis in axes {
+        let length = dot(*axis, *axis).sqrt();
+        if (length - 1.0).abs() > 1e-9 || length.is_nan() {
+            return Err(ClearanceError::OutOfRange {
+                name: "joint axis length",
+                bound: "1 (a unit vector)",
+                value: length,
+            });
+        }
+    }
+    data.points.copy_from_slice(points);
+    data.axes.copy_from_slice(axes);
+    Ok(())
+}

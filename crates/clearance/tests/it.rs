@@ -1,0 +1,462 @@
+//! Distances against brute force, gradients against finite differences.
+
+use backbone_kin::{BaseAngle, ModalMap};
+use clearance::{
+    ClearanceData, ClearanceError, ClearanceModel, Obstacle, Pair, distances, joint_gradient,
+    modal_gradients, place, place_planar, segment_box, segment_point, segment_segment,
+};
+use proptest::prelude::*;
+
+type V = [f64; 3];
+
+fn sub(a: V, b: V) -> V {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn norm(a: V) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+fn lerp(a: V, b: V, t: f64) -> V {
+    [
+        a[0] + t * (b[0] - a[0]),
+        a[1] + t * (b[1] - a[1]),
+        a[2] + t * (b[2] - a[2]),
+    ]
+}
+fn matmul(a: [[f64; 3]; 3], b: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let mut c = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            c[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
+        }
+    }
+    c
+}
+/// `Rz(yaw) Ry(pitch) Rx(roll)` as a row-major matrix, built from the three elementary turns.
+fn rotation(rpy: V) -> [[f64; 3]; 3] {
+    let (sr, cr) = rpy[0].sin_cos();
+    let (sp, cp) = rpy[1].sin_cos();
+    let (sy, cy) = rpy[2].sin_cos();
+    let rx = [[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]];
+    let ry = [[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]];
+    let rz = [[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]];
+    matmul(rz, matmul(ry, rx))
+}
+/// The distance from `x` to the segment `a`-`b`, by its own projection.
+fn point_segment(x: V, a: V, b: V) -> f64 {
+    let d = sub(b, a);
+    let len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    let t = if len2 > 0.0 {
+        ((x[0] - a[0]) * d[0] + (x[1] - a[1]) * d[1] + (x[2] - a[2]) * d[2]) / len2
+    } else {
+        0.0
+    };
+    norm(sub(x, lerp(a, b, t.clamp(0.0, 1.0))))
+}
+
+/// A box given by its own row-major rotation, for the brute-force reference.
+struct TestBox {
+    center: V,
+    half: V,
+    rot: [[f64; 3]; 3],
+}
+impl TestBox {
+    fn local(&self, x: V) -> V {
+        let d = sub(x, self.center);
+        let r = self.rot;
+        [
+            r[0][0] * d[0] + r[1][0] * d[1] + r[2][0] * d[2],
+            r[0][1] * d[0] + r[1][1] * d[1] + r[2][1] * d[2],
+            r[0][2] * d[0] + r[1][2] * d[1] + r[2][2] * d[2],
+        ]
+    }
+    fn world(&self, q: V) -> V {
+        let r = self.rot;
+        let mut x = self.center;
+        for i in 0..3 {
+            for k in 0..3 {
+                x[i] += r[i][k] * q[k];
+            }
+        }
+        x
+    }
+    /// Signed distance: outside, the distance to the clamped point; inside, minus the distance
+    /// to the nearest face.
+    fn sdf(&self, x: V) -> f64 {
+        let q = self.local(x);
+        let inside = (0..3).all(|k| q[k].abs() <= self.half[k]);
+        if inside {
+            -(0..3)
+                .map(|k| self.half[k] - q[k].abs())
+                .fold(f64::INFINITY, f64::min)
+        } else {
+            let c: Vec<f64> = (0..3)
+                .map(|k| q[k] - q[k].clamp(-self.half[k], self.half[k]))
+                .collect();
+            (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
+        }
+    }
+    /// A grid of points on the surface, `per_side` a face side.
+    fn surface(&self, per_side: usize) -> Vec<V> {
+        let mut points = Vec::new();
+        for face in 0..3 {
+            let (u, v) = ((face + 1) % 3, (face + 2) % 3);
+            for sign in [-1.0, 1.0] {
+                for i in 0..=per_side {
+                    for j in 0..=per_side {
+                        let mut q = [0.0; 3];
+                        q[face] = sign * self.half[face];
+                        q[u] = self.half[u] * (2.0 * i as f64 / per_side as f64 - 1.0);
+                        q[v] = self.half[v] * (2.0 * j as f64 / per_side as f64 - 1.0);
+                        points.push(self.world(q));
+                    }
+                }
+            }
+        }
+        points
+    }
+}
+
+/// The smallest of a convex function on `[0, 1]`: dense samples, then golden section.
+fn convex_min(f: impl Fn(f64) -> f64) -> f64 {
+    let n = 4000;
+    let best = (0..=n)
+        .map(|i| i as f64 / n as f64)
+        .min_by(|a, b| f(*a).total_cmp(&f(*b)))
+        .unwrap();
+    let (mut lo, mut hi) = (
+        (best - 1.0 / n as f64).max(0.0),
+        (best + 1.0 / n as f64).min(1.0),
+    );
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..80 {
+        let (x1, x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+        if f(x1) < f(x2) {
+            hi = x2;
+        } else {
+            lo = x1;
+        }
+    }
+    f(0.5 * (lo + hi)).min(f(best))
+}
+
+fn v3() -> impl Strategy<Value = V> {
+    prop::array::uniform3(-1.0..1.0f64)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn segment_point_matches_sampling(a in v3(), b in v3(), o in v3()) {
+        let found = segment_point(a, b, o);
+        let reference = convex_min(|t| norm(sub(lerp(a, b, t), o)));
+        prop_assert!((found.distance - reference).abs() < 1e-9);
+        prop_assert!((norm(sub(found.point, o)) - found.distance).abs() < 1e-12);
+    }
+
+    #[test]
+    fn segment_segment_matches_sampling(a in v3(), b in v3(), c in v3(), d in v3()) {
+        let found = segment_segment(a, b, c, d);
+        let reference = convex_min(|t| point_segment(lerp(a, b, t), c, d));
+        prop_assert!((found.distance - reference).abs() < 1e-9, "{} vs {}", found.distance, reference);
+        prop_assert!((norm(sub(found.point, found.other)) - found.distance).abs() < 1e-12);
+    }
+
+    #[test]
+    fn segment_box_matches_sampling(
+        a in v3(), b in v3(), center in prop::array::uniform3(-0.5..0.5f64),
+        half in prop::array::uniform3(0.05..0.6f64), rpy in prop::array::uniform3(-3.0..3.0f64),
+    ) {
+        let reference_box = TestBox { center, half, rot: rotation(rpy) };
+        let Obstacle::Box { center, half_extents, axes } = Obstacle::cuboid(center, half, rpy).unwrap()
+            else { unreachable!() };
+        let found = segment_box(a, b, center, half_extents, &axes);
+        let reference = convex_min(|t| reference_box.sdf(lerp(a, b, t)));
+        prop_assert!((found.distance - reference).abs() < 1e-8, "{} vs {}", found.distance, reference);
+        prop_assert!((reference_box.sdf(found.point) - found.distance).abs() < 1e-12);
+        prop_assert!(reference_box.sdf(found.other).abs() < 1e-12);
+    }
+
+    /// The distance from the segment to the sampled surface of a box it does not touch: the
+    /// samples lie on the surface, so they bound the distance from above within their spacing.
+    #[test]
+    fn segment_box_matches_surface_samples(
+        a in v3(), b in v3(), half in prop::array::uniform3(0.05..0.3f64),
+        rpy in prop::array::uniform3(-3.0..3.0f64),
+    ) {
+        let center = [1.5, 0.2, -0.1];
+        let reference_box = TestBox { center, half, rot: rotation(rpy) };
+        let Obstacle::Box { center, half_extents, axes } = Obstacle::cuboid(center, half, rpy).unwrap()
+            else { unreachable!() };
+        let found = segment_box(a, b, center, half_extents, &axes);
+        let per_side = 60;
+        let sampled = reference_box.surface(per_side).into_iter()
+            .map(|y| point_segment(y, a, b)).fold(f64::INFINITY, f64::min);
+        let spacing = 2.0 * half.iter().copied().fold(0.0, f64::max) / per_side as f64;
+        prop_assert!(found.distance > 0.0);
+        prop_assert!(sampled >= found.distance - 1e-12);
+        prop_assert!(sampled - found.distance <= spacing, "{} vs {}", sampled, found.distance);
+    }
+}
+
+#[test]
+fn planar_rectangle_is_a_box_of_infinite_height() {
+    let rectangle =
+        Obstacle::cuboid([0.4, 0.1, 0.0], [0.1, 0.2, f64::INFINITY], [0.0, 0.0, 0.3]).unwrap();
+    let Obstacle::Box {
+        center,
+        half_extents,
+        axes,
+    } = rectangle
+    else {
+        unreachable!()
+    };
+    let tall = TestBox {
+        center,
+        half: [0.1, 0.2, 1e6],
+        rot: rotation([0.0, 0.0, 0.3]),
+    };
+    for (a, b) in [
+        ([0.0, 0.0, 0.0], [1.0, 0.5, 0.0]),
+        ([0.0, -0.5, 0.0], [0.0, 0.5, 0.0]),
+        ([0.38, 0.1, 0.0], [0.42, 0.12, 0.0]),
+    ] {
+        let found = segment_box(a, b, center, half_extents, &axes);
+        let reference = convex_min(|t| tall.sdf(lerp(a, b, t)));
+        assert!((found.distance - reference).abs() < 1e-8);
+    }
+}
+
+/// Pairs over every kind of obstacle around a planar 8-link chain.
+fn planar_model() -> (ClearanceModel, Vec<f64>) {
+    let obstacles = vec![
+        Obstacle::circle([0.35, 0.25], 0.05).unwrap(),
+        Obstacle::capsule([0.1, -0.3, 0.0], [0.5, -0.2, 0.0], 0.03).unwrap(),
+        Obstacle::cuboid(
+            [0.6, 0.1, 0.0],
+            [0.05, 0.08, f64::INFINITY],
+            [0.0, 0.0, 0.4],
+        )
+        .unwrap(),
+        Obstacle::cuboid([0.2, 0.4, 0.05], [0.05, 0.1, 0.1], [0.2, -0.1, 0.7]).unwrap(),
+    ];
+    (
+        ClearanceModel::new(8, 0.012, obstacles).unwrap(),
+        vec![0.1, 0.12, 0.09, 0.1, 0.11, 0.1, 0.08, 0.1],
+    )
+}
+
+fn planar_distances(model: &ClearanceModel, lengths: &[f64], theta: &[f64]) -> Vec<f64> {
+    let mut data = ClearanceData::new(model, 0).unwrap();
+    place_planar(model, &mut data, lengths, theta).unwrap();
+    distances(model, &mut data);
+    data.distances().to_vec()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn joint_gradients_match_finite_differences(theta in prop::collection::vec(-1.2..1.2f64, 8)) {
+        let (model, lengths) = planar_model();
+        let mut data = ClearanceData::new(&model, 0).unwrap();
+        place_planar(&model, &mut data, &lengths, &theta).unwrap();
+        distances(&model, &mut data);
+        let mut gradient = vec![0.0; 8];
+        let h = 1e-6;
+        let mut checked = 0;
+        for pair in 0..model.pairs().len() {
+            joint_gradient(&model, &data, pair, &mut gradient).unwrap();
+            for j in 0..8 {
+                let (mut plus, mut minus) = (theta.clone(), theta.clone());
+                plus[j] += h;
+                minus[j] -= h;
+                let up = planar_distances(&model, &lengths, &plus)[pair];
+                let down = planar_distances(&model, &lengths, &minus)[pair];
+                let fd = (up - down) / (2.0 * h);
+                // A closest point at a kink of the distance (a box's edge, a deep link through a
+                // sphere's centre) has one-sided derivatives: check where both sides agree.
+                let one_sided = (up - data.distances()[pair]) / h;
+                if (one_sided - fd).abs() < 1e-4 {
+                    prop_assert!((gradient[j] - fd).abs() < 1e-5,
+                        "pair {:?} joint {}: {} vs {}", model.pairs()[pair], j, gradient[j], fd);
+                    checked += 1;
+                }
+            }
+        }
+        prop_assert!(checked > 8 * model.pairs().len() * 9 / 10);
+    }
+
+    #[test]
+    fn modal_gradients_match_finite_differences(a in prop::collection::vec(-1.5..1.5f64, 5)) {
+        let (model, lengths) = planar_model();
+        let map = ModalMap::new(&lengths, 2, BaseAngle::Free).unwrap();
+        let mut data = ClearanceData::new(&model, 5).unwrap();
+        let mut theta = vec![0.0; 8];
+        map.joint_angles(&a, &mut theta).unwrap();
+        place_planar(&model, &mut data, &lengths, &theta).unwrap();
+        distances(&model, &mut data);
+        modal_gradients(&model, &mut data, &map).unwrap();
+        let at = |a: &[f64]| {
+            let mut theta = vec![0.0; 8];
+            map.joint_angles(a, &mut theta).unwrap();
+            planar_distances(&model, &lengths, &theta)
+        };
+        let h = 1e-6;
+        let mut joint = vec![0.0; 8];
+        for pair in 0..model.pairs().len() {
+            // J^T of the joint gradient, the chain rule done the long way.
+            joint_gradient(&model, &data, pair, &mut joint).unwrap();
+            for l in 0..5 {
+                let chain: f64 = (0..8).map(|j| map.entry(j, l) * joint[j]).sum();
+                prop_assert!((data.modal_gradient(pair)[l] - chain).abs() < 1e-12);
+                let (mut plus, mut minus) = (a.clone(), a.clone());
+                plus[l] += h;
+                minus[l] -= h;
+                let (up, down) = (at(&plus)[pair], at(&minus)[pair]);
+                let fd = (up - down) / (2.0 * h);
+                if ((up - data.distances()[pair]) / h - fd).abs() < 1e-4 {
+                    prop_assert!((data.modal_gradient(pair)[l] - fd).abs() < 1e-5);
+                }
+            }
+        }
+    }
+}
+
+/// Rodrigues' rotation of `v` about the unit `axis` by `angle`.
+fn rotate(axis: V, angle: f64, v: V) -> V {
+    let (s, c) = angle.sin_cos();
+    let d = axis[0] * v[0] + axis[1] * v[1] + axis[2] * v[2];
+    let x = [
+        axis[1] * v[2] - axis[2] * v[1],
+        axis[2] * v[0] - axis[0] * v[2],
+        axis[0] * v[1] - axis[1] * v[0],
+    ];
+    [0, 1, 2].map(|i| v[i] * c + x[i] * s + axis[i] * d * (1.0 - c))
+}
+
+/// A spatial chain: joint `i` turns about its local axis, links along the local `x`.
+fn spatial_chain(theta: &[f64], local_axes: &[V]) -> (Vec<V>, Vec<V>) {
+    let mut frame = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let (mut points, mut axes) = (vec![[0.0; 3]], Vec::new());
+    for (angle, local) in theta.iter().zip(local_axes) {
+        let axis = [0, 1, 2].map(|k| (0..3).map(|c| frame[c][k] * local[c]).sum::<f64>());
+        axes.push(axis);
+        frame = frame.map(|column| rotate(axis, *angle, column));
+        let last = *points.last().unwrap();
+        points.push([0, 1, 2].map(|k| last[k] + 0.1 * frame[0][k]));
+    }
+    (points, axes)
+}
+
+#[test]
+fn spatial_joint_gradients_match_finite_differences() {
+    let locals: Vec<V> = (0..6)
+        .map(|i| {
+            if i % 2 == 0 {
+                [0.0, 0.0, 1.0]
+            } else {
+                [0.0, 1.0, 0.0]
+            }
+        })
+        .collect();
+    let model = ClearanceModel::new(
+        6,
+        0.01,
+        vec![
+            Obstacle::sphere([0.3, 0.1, 0.1], 0.05).unwrap(),
+            Obstacle::capsule([0.2, -0.2, -0.1], [0.3, 0.2, -0.15], 0.02).unwrap(),
+            Obstacle::cuboid([0.45, 0.0, 0.05], [0.03, 0.1, 0.05], [0.3, 0.2, 0.1]).unwrap(),
+        ],
+    )
+    .unwrap();
+    let theta = [0.3, -0.4, 0.7, 0.5, -0.9, 1.1];
+    let evaluate = |theta: &[f64]| {
+        let (points, axes) = spatial_chain(theta, &locals);
+        let mut data = ClearanceData::new(&model, 0).unwrap();
+        place(&model, &mut data, &points, &axes).unwrap();
+        distances(&model, &mut data);
+        data
+    };
+    let data = evaluate(&theta);
+    let mut gradient = [0.0; 6];
+    let h = 1e-6;
+    for pair in 0..model.pairs().len() {
+        joint_gradient(&model, &data, pair, &mut gradient).unwrap();
+        for j in 0..6 {
+            let (mut plus, mut minus) = (theta, theta);
+            plus[j] += h;
+            minus[j] -= h;
+            let fd = (evaluate(&plus).distances()[pair] - evaluate(&minus).distances()[pair])
+                / (2.0 * h);
+            assert!(
+                (gradient[j] - fd).abs() < 1e-6,
+                "pair {pair} joint {j}: {} vs {fd}",
+                gradient[j]
+            );
+        }
+    }
+}
+
+#[test]
+fn folded_chain_collides_with_itself_and_adjacent_links_are_not_pairs() {
+    let model = ClearanceModel::new(4, 0.01, Vec::new()).unwrap();
+    assert_eq!(
+        model.pairs(),
+        &[
+            Pair::Links { link: 0, other: 2 },
+            Pair::Links { link: 0, other: 3 },
+            Pair::Links { link: 1, other: 3 }
+        ]
+    );
+    let mut data = ClearanceData::new(&model, 0).unwrap();
+    // A hairpin: links 0 and 2 run antiparallel 0.015 apart, less than the 0.02 of two radii.
+    let pi = std::f64::consts::PI;
+    let lengths = [0.1, 0.015, 0.1, 0.1];
+    place_planar(&model, &mut data, &lengths, &[0.0, pi / 2.0, pi / 2.0, 0.0]).unwrap();
+    let (near_obstacle, near_self) = distances(&model, &mut data);
+    assert_eq!(near_obstacle, f64::INFINITY);
+    assert!((data.distances()[0] - (0.015 - 0.02)).abs() < 1e-12);
+    assert!((near_self - (0.015 - 0.02)).abs() < 1e-12);
+    assert_eq!(data.min_self_clearance(&model), near_self);
+}
+
+#[test]
+fn circle_clearance_is_the_textbook_distance() {
+    // A straight chain along x, a circle above its middle.
+    let model =
+        ClearanceModel::new(5, 0.01, vec![Obstacle::circle([0.25, 0.2], 0.05).unwrap()]).unwrap();
+    let mut data = ClearanceData::new(&model, 0).unwrap();
+    place_planar(&model, &mut data, &[0.1; 5], &[0.0; 5]).unwrap();
+    let (near, _) = distances(&model, &mut data);
+    assert!((near - (0.2 - 0.05 - 0.01)).abs() < 1e-15);
+    let mut gradient = [0.0; 5];
+    joint_gradient(&model, &data, 2, &mut gradient).unwrap();
+    // Turning the base by dtheta lifts x = 0.25 by 0.25 dtheta, towards the circle.
+    assert!((gradient[0] + 0.25).abs() < 1e-15 && (gradient[2] + 0.05).abs() < 1e-15);
+    assert_eq!(gradient[3], 0.0);
+}
+
+#[test]
+fn bad_input_is_refused_with_the_field_named() {
+    let refusal = |r: Result<Obstacle, ClearanceError>| r.unwrap_err().to_string();
+    assert!(refusal(Obstacle::circle([f64::NAN, 0.0], 1.0)).contains("sphere center"));
+    assert!(refusal(Obstacle::circle([0.0, 0.0], -1.0)).contains("obstacle radius"));
+    assert!(
+        refusal(Obstacle::cuboid([0.0; 3], [1.0, 0.0, 1.0], [0.0; 3])).contains("half_extents")
+    );
+    assert!(
+        refusal(Obstacle::cuboid([0.0; 3], [1.0, f64::NAN, 1.0], [0.0; 3]))
+            .contains("half_extents")
+    );
+    let model = ClearanceModel::new(3, f64::INFINITY, Vec::new()).unwrap_err();
+    assert!(model.to_string().contains("link radius"));
+    let too_many = ClearanceModel::new(100_000, 0.01, Vec::new()).unwrap_err();
+    assert!(matches!(too_many, ClearanceError::TooMany { .. }));
+    let model = ClearanceModel::new(3, 0.01, Vec::new()).unwrap();
+    let mut data = ClearanceData::new(&model, 0).unwrap();
+    assert!(place_planar(&model, &mut data, &[0.1; 3], &[0.0; 2]).is_err());
+    assert!(place(&model, &mut data, &[[0.0; 3]; 4], &[[0.0, 0.0, 2.0]; 3]).is_err());
+    let mut gradient = [0.0; 3];
+    assert!(joint_gradient(&model, &data, 1, &mut gradient).is_err());
+}
