@@ -16,6 +16,5 @@ pub use error::{ControllerFailure, SimError, check_finite};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use simulation::{
     ControlSample, Integrator, Lockstep, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_LOOP_WORK,
-    check_loop_work,
-    MAX_RECORDED_VALUES, MAX_RK4_STEPS, Observation, Run, RunFailure, Simulation,
+    MAX_RECORDED_VALUES, MAX_RK4_STEPS, Observation, Run, RunFailure, Simulation, check_loop_work,
 };
