@@ -15,8 +15,8 @@
 use backbone_kin::{ModalMap, tip_position};
 use manip_dyn::ChainModel;
 use modal_reduce::{ReducedData, ReducedModel, forward_dynamics, reduced_terms};
-use sim_core::ode::{OdeSystem, Rk4};
 use optimal_ctl::{Mpc, MpcSettings};
+use sim_core::ode::{OdeSystem, Rk4};
 use sim_core::reference::{Reference, ReferenceSample, Sinusoid};
 
 const LOOP_SECONDS: f64 = 1.0;
