@@ -24,7 +24,8 @@ pub(super) enum Layout {
     Scheduled,
 }
 
-/// The number of inputs per coordinate of the [`Layout::Scheduled`] layout.
+/// The number of inputs per modal coordinate of a scheduled `.fis`, the `4m`-input layout of a
+/// learned controller.
 pub const SCHEDULED_INPUTS_PER_COORDINATE: usize = 4;
 
 /// Writes the `4m` inputs of a scheduled fuzzy controller into `out`: per coordinate the error

@@ -18,7 +18,7 @@ use sim_core::{Integrator, LoopSettings, Simulation};
 impl Scenario {
     /// The reduced model of the arm with the scenario's modal family. Refuses a family with no
     /// harmonic or more coordinates than the arm has links (its reduced mass matrix would be
-    /// singular), or one whose dynamics take more than [`MAX_LOOP_WORK`](crate::MAX_LOOP_WORK)
+    /// singular), or one whose dynamics take more than [`MAX_LOOP_WORK`](sim_core::MAX_LOOP_WORK)
     /// per evaluation.
     pub fn model(&self) -> Result<ReducedModel, SimError> {
         let chain = self.arm.to_chain()?;
