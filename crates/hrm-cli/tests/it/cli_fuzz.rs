@@ -990,8 +990,14 @@ fn output_folders_of_every_kind_and_signals_lose_nothing() {
         } else {
             &[0, 1]
         };
+        // A signal that arrives before hrm installs its handler (at once, before anything is
+        // written) ends the process by the signal itself.
+        let killed_before_handler = {
+            use std::os::unix::process::ExitStatusExt;
+            signal.is_some() && matches!(output.status.signal(), Some(2 | 15))
+        };
         prop_assert!(
-            code.is_some_and(|c| expected.contains(&c)),
+            killed_before_handler || code.is_some_and(|c| expected.contains(&c)),
             "{state:?} {args:?} {signal:?}: exit {:?}: {stderr}",
             output.status
         );
