@@ -19,6 +19,7 @@ mod continuum;
 mod derivatives;
 mod jacobi;
 mod large_chains;
+mod plant;
 mod properties;
 mod spatial;
 mod spatial_derivatives;
