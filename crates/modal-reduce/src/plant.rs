@@ -16,6 +16,44 @@ use crate::{
     reduced_derivatives, reduced_terms,
 };
 
+/// A modal arm owned (what a simulation holds), planar or spatial; [`PlantModel::plant`] lends it
+/// as a [`Plant`].
+#[derive(Debug, Clone)]
+pub enum PlantModel {
+    /// A planar modal arm.
+    Planar(ReducedModel),
+    /// A spatial modal arm.
+    Spatial(SpatialReducedModel),
+}
+
+impl PlantModel {
+    /// The arm, borrowed.
+    pub fn plant(&self) -> Plant<'_> {
+        match self {
+            PlantModel::Planar(model) => Plant::Planar(model),
+            PlantModel::Spatial(model) => Plant::Spatial(model),
+        }
+    }
+}
+
+impl From<ReducedModel> for PlantModel {
+    fn from(model: ReducedModel) -> Self {
+        PlantModel::Planar(model)
+    }
+}
+
+impl From<SpatialReducedModel> for PlantModel {
+    fn from(model: SpatialReducedModel) -> Self {
+        PlantModel::Spatial(model)
+    }
+}
+
+impl<'a> From<&'a PlantModel> for Plant<'a> {
+    fn from(model: &'a PlantModel) -> Self {
+        model.plant()
+    }
+}
+
 /// A modal arm as the loop sees it, borrowed: the planar arm of the paper (eqs 7-18) or a
 /// spatial universal-joint arm (`docs/theory.md`, section 8).
 #[derive(Debug, Clone, Copy)]

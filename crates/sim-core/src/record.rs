@@ -30,11 +30,16 @@ pub struct Record {
     /// Whether the actuator limit clamped the controller's `tau_i*` at this sample, per
     /// coordinate (row-major like the modal series; all `false` without limits).
     pub clamped: Vec<bool>,
-    /// Tip of the discrete chain (m).
+    /// Tip of the discrete chain, `x` and `y` (m).
     pub tip: Vec<[f64; 2]>,
-    /// The reference tip: the backbone curve's end point at `a_ref` (eqs 3-4), which for a
-    /// Cartesian path reference is the path point (m).
+    /// The reference tip, `x` and `y`: the backbone curve's end point at `a_ref` (eqs 3-4) for a
+    /// planar arm, the chain's tip at `a_ref` for a spatial one; for a Cartesian path reference
+    /// it is the path point (m).
     pub tip_ref: Vec<[f64; 2]>,
+    /// The `z` of [`tip`](Self::tip) (zero for a planar arm) (m).
+    pub tip_z: Vec<f64>,
+    /// The `z` of [`tip_ref`](Self::tip_ref) (m).
+    pub tip_ref_z: Vec<f64>,
     /// Joint torques `tau = M J a_dd + C + G` (eq 13) at the sample, `n_joints` per sample,
     /// row-major (N m).
     pub joint_torques: Vec<f64>,
@@ -111,15 +116,15 @@ pub(crate) struct Sample<'a> {
     pub a_cmd: &'a [f64],
     pub tau_star: &'a [f64],
     pub clamped: &'a [bool],
-    pub tip: [f64; 2],
-    pub tip_ref: [f64; 2],
+    pub tip: [f64; 3],
+    pub tip_ref: [f64; 3],
 }
 
 impl Record {
     /// The values one recorded sample holds: `t`, seven modal series of `n_coords` (the
-    /// clamping flags counted as one value each), two tips, and a torque per joint.
+    /// clamping flags counted as one value each), two tips of three coordinates, and a torque per joint.
     pub(crate) fn values_per_sample(n_coords: usize, n_joints: usize) -> usize {
-        5 + 7 * n_coords + n_joints
+        7 + 7 * n_coords + n_joints
     }
 
     pub(crate) fn with_capacity(n_coords: usize, n_joints: usize, samples: usize) -> Self {
@@ -137,6 +142,8 @@ impl Record {
             clamped: Vec::with_capacity(samples * n_coords),
             tip: Vec::with_capacity(samples),
             tip_ref: Vec::with_capacity(samples),
+            tip_z: Vec::with_capacity(samples),
+            tip_ref_z: Vec::with_capacity(samples),
             joint_torques: Vec::with_capacity(samples * n_joints),
         }
     }
@@ -150,8 +157,10 @@ impl Record {
         self.a_cmd.extend_from_slice(s.a_cmd);
         self.tau_star.extend_from_slice(s.tau_star);
         self.clamped.extend_from_slice(s.clamped);
-        self.tip.push(s.tip);
-        self.tip_ref.push(s.tip_ref);
+        self.tip.push([s.tip[0], s.tip[1]]);
+        self.tip_ref.push([s.tip_ref[0], s.tip_ref[1]]);
+        self.tip_z.push(s.tip[2]);
+        self.tip_ref_z.push(s.tip_ref[2]);
         self.joint_torques.extend_from_slice(joint_torques);
     }
 }
@@ -302,7 +311,10 @@ impl Metrics {
     /// tracking errors, which are taken over the recorded samples.
     pub(crate) fn add_recorded(&mut self, s: &Sample<'_>) {
         self.samples += 1;
-        let tip_error = (s.tip[0] - s.tip_ref[0]).hypot(s.tip[1] - s.tip_ref[1]);
+        // In the plane `z` is zero and `hypot(d, 0) = |d|` exactly: the planar distance's bits.
+        let tip_error = (s.tip[0] - s.tip_ref[0])
+            .hypot(s.tip[1] - s.tip_ref[1])
+            .hypot(s.tip[2] - s.tip_ref[2]);
         self.tip_sq += tip_error * tip_error;
         self.tip_max = self.tip_max.max(tip_error);
         for i in 0..self.modal_sq.len() {

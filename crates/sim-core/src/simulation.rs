@@ -10,7 +10,7 @@ use crate::record::{Metrics, Record, Sample, Summary};
 use crate::reference::continuation::Family;
 use crate::reference::{Reference, ReferenceSample};
 use backbone_kin::BaseAngle;
-use modal_reduce::{ReduceError, ReducedData, ReducedModel};
+use modal_reduce::{Plant, PlantData, PlantModel, ReduceError};
 
 mod lockstep;
 
@@ -139,26 +139,101 @@ impl Progress {
     }
 }
 
-/// The reduced dynamics with a held modal torque: `y = [a, a_dot]` (`2m` entries).
-struct Plant {
-    model: ReducedModel,
-    data: ReducedData,
+/// The reduced dynamics (planar or spatial) with a held modal torque: `y = [a, a_dot]` (`2m`
+/// entries).
+struct Dynamics {
+    model: PlantModel,
+    data: PlantData,
     tau_star: Vec<f64>,
 }
 
-impl OdeSystem for Plant {
+impl OdeSystem for Dynamics {
     type Error = ReduceError;
     fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), ReduceError> {
         let m = self.tau_star.len();
         dy[..m].copy_from_slice(&y[m..]);
-        modal_reduce::forward_dynamics(
-            &self.model,
+        self.model.plant().forward_dynamics(
             &mut self.data,
             &y[..m],
             &y[m..],
             &self.tau_star,
             &mut dy[m..],
         )
+    }
+}
+
+/// Where the tips come from: for a planar arm the chain's tip and the backbone curve's end at
+/// the reference (eqs 3-4); for a spatial arm the chain's tip at the state and at the reference
+/// (the spatial curve has no closed form, and the continuation tracks the chain's tip).
+enum Tips {
+    Planar {
+        family: Family,
+        link_lengths: Vec<f64>,
+        theta: Vec<f64>,
+    },
+    Spatial {
+        theta: Vec<f64>,
+    },
+}
+
+impl Tips {
+    fn new(model: &PlantModel) -> Result<Self, SimError> {
+        Ok(match model {
+            PlantModel::Planar(model) => {
+                let link_lengths: Vec<f64> = model.chain().link_lengths().collect();
+                let curve_length = link_lengths.iter().sum();
+                let map = model.map();
+                let fixed = match map.base_angle() {
+                    BaseAngle::Fixed(alpha0) => Some(alpha0),
+                    BaseAngle::Free => None,
+                };
+                Tips::Planar {
+                    family: Family::new(curve_length, map.harmonics(), fixed)?,
+                    link_lengths,
+                    theta: vec![0.0; model.n_links()],
+                }
+            }
+            PlantModel::Spatial(model) => Tips::Spatial {
+                theta: vec![0.0; 2 * model.n_links()],
+            },
+        })
+    }
+
+    /// The tip at `a` and the reference tip at `a_ref`, `[x, y, z]` (`z = 0` in the plane).
+    fn at(
+        &mut self,
+        model: &PlantModel,
+        a: &[f64],
+        a_ref: &[f64],
+    ) -> Result<([f64; 3], [f64; 3]), SimError> {
+        match (self, model) {
+            (
+                Tips::Planar {
+                    family,
+                    link_lengths,
+                    theta,
+                },
+                PlantModel::Planar(model),
+            ) => {
+                model.map().joint_angles(a, theta)?;
+                let [x, y] = backbone_kin::tip_position(link_lengths, theta)?;
+                let [x_ref, y_ref] = family.end_point(a_ref)?;
+                Ok(([x, y, 0.0], [x_ref, y_ref, 0.0]))
+            }
+            (Tips::Spatial { theta }, PlantModel::Spatial(model)) => {
+                let map = model.map();
+                let mut chain_tip = |a: &[f64]| -> Result<[f64; 3], SimError> {
+                    map.joint_angles(a, theta)?;
+                    Ok(backbone_kin::spatial_tip_position(
+                        map.link_lengths(),
+                        model.base(),
+                        theta,
+                    )?)
+                };
+                Ok((chain_tip(a)?, chain_tip(a_ref)?))
+            }
+            _ => unreachable!("the tips are built for the simulation's own model"),
+        }
     }
 }
 
@@ -225,10 +300,11 @@ impl ControlSample {
 pub struct Observation<'a> {
     /// Joint torques `tau = M J a_dd + C + G` (eq 13) at the sample (N m).
     pub joint_torques: &'a [f64],
-    /// The tip of the discrete chain (m).
-    pub tip: [f64; 2],
-    /// The reference tip: the backbone curve's end point at the noise-free reference (m).
-    pub tip_ref: [f64; 2],
+    /// The tip of the discrete chain, `[x, y, z]` (m; `z = 0` for a planar arm).
+    pub tip: [f64; 3],
+    /// The reference tip at the noise-free reference (m): the backbone curve's end point for a
+    /// planar arm, the chain's tip for a spatial one.
+    pub tip_ref: [f64; 3],
 }
 
 /// A closed-loop simulation of `m` modal coordinates, built once and run any number of times
@@ -268,15 +344,13 @@ pub struct Observation<'a> {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub struct Simulation {
-    plant: Plant,
+    plant: Dynamics,
     reference: Box<dyn Reference>,
     controller: Box<dyn Controller>,
     settings: LoopSettings,
     initial: ModalState,
-    /// The end point of the backbone curve, for the reference tip.
-    family: Family,
-    link_lengths: Vec<f64>,
-    theta: Vec<f64>,
+    /// The tips' geometry.
+    tips: Tips,
     joint_torques: Vec<f64>,
     /// Controller samples taken since the last reset.
     taken: usize,
@@ -310,13 +384,15 @@ impl Simulation {
     /// steps, a record of more than [`MAX_RECORDED_VALUES`] numbers, negative or non-finite noise, a non-positive error
     /// bound, or torque limits of the wrong sign.
     pub fn new(
-        model: ReducedModel,
+        model: impl Into<PlantModel>,
         mut reference: Box<dyn Reference>,
         controller: Box<dyn Controller>,
         settings: LoopSettings,
         initial: Option<ModalState>,
     ) -> Result<Self, SimError> {
-        let m = model.n_coords();
+        let model = model.into();
+        let plant = model.plant();
+        let m = plant.n_coords();
         if reference.n_coords() != m {
             return Err(SimError::setting(
                 "reference",
@@ -334,7 +410,7 @@ impl Simulation {
                 format!("is built for {c} coordinates, the model has {m}"),
             ));
         }
-        validate(&settings, m, model.n_links())?;
+        validate(&settings, m, plant.n_joints())?;
         let initial = match initial {
             Some(state) => state,
             None => {
@@ -358,20 +434,13 @@ impl Simulation {
             }
             check_finite(name, values)?;
         }
-        let n = model.n_links();
-        let link_lengths: Vec<f64> = model.chain().link_lengths().collect();
-        let curve_length = link_lengths.iter().sum();
-        let map = model.map();
-        let fixed = match map.base_angle() {
-            BaseAngle::Fixed(alpha0) => Some(alpha0),
-            BaseAngle::Free => None,
-        };
-        let family = Family::new(curve_length, map.harmonics(), fixed)?;
-        let data = ReducedData::new(&model);
+        let n = plant.n_joints();
+        let tips = Tips::new(&model)?;
+        let data = PlantData::new(plant);
         let stepper = Stepper::new(settings.integrator, 2 * m);
         let mut simulation = Self {
             reference_key: None,
-            plant: Plant {
+            plant: Dynamics {
                 model,
                 data,
                 tau_star: vec![0.0; m],
@@ -380,9 +449,7 @@ impl Simulation {
             controller,
             settings,
             initial,
-            family,
-            link_lengths,
-            theta: vec![0.0; n],
+            tips,
             joint_torques: vec![0.0; n],
             taken: 0,
             y: vec![0.0; 2 * m],
@@ -397,9 +464,9 @@ impl Simulation {
         Ok(simulation)
     }
 
-    /// The reduced model being simulated.
-    pub fn model(&self) -> &ReducedModel {
-        &self.plant.model
+    /// The reduced model being simulated, planar or spatial.
+    pub fn model(&self) -> Plant<'_> {
+        self.plant.model.plant()
     }
 
     /// The simulation with its reference known as `key` (see the field's docs): runs of a
@@ -491,27 +558,26 @@ impl Simulation {
         let t = self.sample.t;
         let plant = &mut self.plant;
         let state = &self.sample.state;
-        modal_reduce::joint_torques(
-            &plant.model,
-            &mut plant.data,
-            &state.a,
-            &state.a_dot,
-            &self.sample.a_ddot,
-            &mut self.joint_torques,
-        )
-        .map_err(|source| SimError::Dynamics { t, source })
+        plant
+            .model
+            .plant()
+            .joint_torques(
+                &mut plant.data,
+                &state.a,
+                &state.a_dot,
+                &self.sample.a_ddot,
+                &mut self.joint_torques,
+            )
+            .map_err(|source| SimError::Dynamics { t, source })
     }
 
     /// The chain's tip and the reference tip of the last sample.
-    fn sample_tips(&mut self) -> Result<([f64; 2], [f64; 2]), SimError> {
-        let state = &self.sample.state;
-        self.plant
-            .model
-            .map()
-            .joint_angles(&state.a, &mut self.theta)?;
-        let tip = backbone_kin::tip_position(&self.link_lengths, &self.theta)?;
-        let tip_ref = self.family.end_point(&self.sample.reference.a)?;
-        Ok((tip, tip_ref))
+    fn sample_tips(&mut self) -> Result<([f64; 3], [f64; 3]), SimError> {
+        self.tips.at(
+            &self.plant.model,
+            &self.sample.state.a,
+            &self.sample.reference.a,
+        )
     }
 
     /// Runs the loop from the initial state for the whole duration (it [`reset`](Self::reset)s
@@ -552,7 +618,7 @@ impl Simulation {
         self.reset();
         let s = &self.settings;
         let (samples, record_every) = sample_counts(s);
-        let (m, n) = (self.n_coords(), self.plant.model.n_links());
+        let (m, n) = (self.n_coords(), self.plant.model.plant().n_joints());
         Progress {
             record: Record::with_capacity(m, n, recorded_samples(s)),
             metrics: Metrics::new(m, n, s.joint_torque_limits.clone()),
@@ -657,7 +723,7 @@ impl Simulation {
             t,
             measured: &sample.measured,
             reference: &sample.command,
-            model: (&self.plant.model).into(),
+            model: self.plant.model.plant(),
             tau_star_limits: self.settings.tau_star_limits.as_deref(),
         };
         self.controller
@@ -711,15 +777,17 @@ impl Simulation {
         let t = self.sample.t;
         let plant = &mut self.plant;
         let state = &self.sample.state;
-        modal_reduce::forward_dynamics(
-            &plant.model,
-            &mut plant.data,
-            &state.a,
-            &state.a_dot,
-            &plant.tau_star,
-            &mut self.sample.a_ddot,
-        )
-        .map_err(|source| SimError::Dynamics { t, source })
+        plant
+            .model
+            .plant()
+            .forward_dynamics(
+                &mut plant.data,
+                &state.a,
+                &state.a_dot,
+                &plant.tau_star,
+                &mut self.sample.a_ddot,
+            )
+            .map_err(|source| SimError::Dynamics { t, source })
     }
 }
 
@@ -795,8 +863,9 @@ fn sample_counts(s: &LoopSettings) -> (usize, usize) {
     (samples, record_every)
 }
 
-/// Checks the settings of a loop of `m` coordinates for a chain of `n_links`.
-fn validate(s: &LoopSettings, m: usize, n_links: usize) -> Result<(), SimError> {
+/// Checks the settings of a loop of `m` coordinates for a chain of `n_joints` (`n` planar, `2n`
+/// spatial: the joint torques recorded, and the work of one evaluation, [`check_loop_work`]).
+fn validate(s: &LoopSettings, m: usize, n_joints: usize) -> Result<(), SimError> {
     check_positive("controller.period", s.controller_period)?;
     check_positive("duration", s.duration)?;
     check_positive("record_period", s.record_period)?;
@@ -871,7 +940,7 @@ fn validate(s: &LoopSettings, m: usize, n_links: usize) -> Result<(), SimError> 
             format!("must be positive, got {}", s.max_modal_error),
         ));
     }
-    let recorded = recorded_samples(s).saturating_mul(Record::values_per_sample(m, n_links));
+    let recorded = recorded_samples(s).saturating_mul(Record::values_per_sample(m, n_joints));
     if recorded > MAX_RECORDED_VALUES {
         return Err(SimError::setting(
             "record_period",
@@ -896,12 +965,15 @@ fn validate(s: &LoopSettings, m: usize, n_links: usize) -> Result<(), SimError> 
             ));
         }
     }
-    check_loop_work(n_links, m)?;
+    check_loop_work(n_joints, m)?;
     if let Some(limits) = &s.joint_torque_limits {
-        if limits.len() != n_links {
+        if limits.len() != n_joints {
             return Err(SimError::setting(
                 "limits.joint_torque_nm",
-                format!("has {} entries, the arm has {n_links} joints", limits.len()),
+                format!(
+                    "has {} entries, the arm has {n_joints} joints",
+                    limits.len()
+                ),
             ));
         }
         for &l in limits {

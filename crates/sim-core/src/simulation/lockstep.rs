@@ -113,7 +113,13 @@ impl Lockstep {
                 "a lock-step group needs at least one simulation",
             ));
         };
-        let model = first.model().clone();
+        let Some(model) = first.model().planar().cloned() else {
+            return Err(SimError::setting(
+                "runs",
+                "a lock-step group takes planar arms (its SIMD batch is the planar reduced \
+                 dynamics); run a spatial arm alone",
+            ));
+        };
         let settings = first.settings().clone();
         for (i, run) in runs.iter().enumerate().skip(1) {
             let differs = |name: &str| {
@@ -126,7 +132,11 @@ impl Lockstep {
                 )
             };
             let s = run.settings();
-            if run.model().chain() != model.chain() || run.model().map() != model.map() {
+            let same = run
+                .model()
+                .planar()
+                .is_some_and(|other| other.chain() == model.chain() && other.map() == model.map());
+            if !same {
                 return Err(differs("model"));
             }
             if s.integrator != settings.integrator {

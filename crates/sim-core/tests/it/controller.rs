@@ -31,18 +31,19 @@ fn model(m: usize) -> ReducedModel {
 }
 
 /// `controller`'s torque for `model` at `measured` and `reference`.
-fn control(
+fn control<'a>(
     controller: &mut dyn Controller,
-    model: &ReducedModel,
+    model: impl Into<modal_reduce::Plant<'a>>,
     measured: &ModalState,
     reference: &ReferenceSample,
 ) -> Result<Vec<f64>, SimError> {
+    let model = model.into();
     let mut tau = vec![0.0; model.n_coords()];
     let ctx = ControlContext {
         t: 0.0,
         measured,
         reference,
-        model: model.into(),
+        model,
         tau_star_limits: None,
     };
     controller
