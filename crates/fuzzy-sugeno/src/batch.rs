@@ -18,8 +18,8 @@ use lane_math::Pack;
 use pulp::{Arch, Simd, WithSimd};
 
 use crate::error::FuzzyError;
-use crate::eval::{EvalOptions, load_input, output_value};
 use crate::kernel::{self, Workspace};
+use crate::options::{EvalOptions, load_input, output_value};
 use crate::system::FuzzySystem;
 
 /// The most `f64` lanes of a SIMD register (AVX-512): the stride of the batch's buffers.

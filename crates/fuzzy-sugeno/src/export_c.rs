@@ -17,8 +17,9 @@
 //!
 //! On a non-zero return `out` is left untouched, as the evaluator leaves its buffer.
 
+use crate::compiled_mf::CompiledMf;
 use crate::error::FuzzyError;
-use crate::eval::{CompiledMf, EvalOptions, NoRuleFired, OutOfRange};
+use crate::options::{EvalOptions, NoRuleFired, OutOfRange};
 use crate::system::{AndMethod, Defuzzification, FuzzySystem, OrMethod};
 use std::fmt::Write as _;
 

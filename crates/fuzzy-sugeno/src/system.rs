@@ -1,8 +1,8 @@
 //! A validated Takagi-Sugeno fuzzy system: variables, fuzzy sets, rules and inference methods
 //! (section 4 of the paper, eqs 19-21).
 
+use crate::compiled_mf::CompiledMf;
 use crate::error::{FuzzyError, SystemProblem};
-use crate::eval::CompiledMf;
 use crate::membership::MembershipFn;
 
 /// An input variable: a name, the range it was designed for, and its fuzzy sets.
@@ -190,11 +190,6 @@ pub struct FuzzySystem {
 }
 
 impl FuzzySystem {
-    /// Starts a [`SystemBuilder`](crate::SystemBuilder).
-    pub fn builder(name: impl Into<String>) -> crate::SystemBuilder {
-        crate::SystemBuilder::new(name)
-    }
-
     /// Validates every part and compiles the evaluation tables.
     pub(crate) fn new(
         name: String,
@@ -511,7 +506,7 @@ impl Compiled {
         for (i, input) in inputs.iter().enumerate() {
             set_offsets.push(mfs.len());
             for set in &input.sets {
-                mfs.push(CompiledMf::new(&set.membership)?);
+                mfs.push(set.membership.compile()?);
                 mf_inputs.push(i);
             }
         }
