@@ -83,6 +83,15 @@ pub enum SimError {
         /// The torque it produced, one entry per coordinate.
         tau_star: Vec<f64>,
     },
+    /// A disturbance hook ([`LoopHooks`](crate::LoopHooks)) produced a NaN or infinite joint
+    /// torque.
+    #[error("the disturbance hook produced a non-finite joint torque {tau:?} at t = {t} s")]
+    NonFiniteDisturbance {
+        /// When (s).
+        t: f64,
+        /// The joint torques it produced, one entry per joint.
+        tau: Vec<f64>,
+    },
     /// A controller failed with an error of its own (one that is not a [`SimError`]).
     #[error("the controller failed at t = {t} s: {source}")]
     Controller {
@@ -144,7 +153,7 @@ impl SimError {
     }
 
     /// Whether a computation or a run on valid input failed numerically: a wrapped library error
-    /// of that class, an integration that diverged, a non-finite control, a runaway tracking
+    /// of that class, an integration that diverged, a non-finite control or disturbance, a runaway tracking
     /// error, or a controller's own failure during the run.
     pub fn is_numerical(&self) -> bool {
         match self {
@@ -153,6 +162,7 @@ impl SimError {
             Self::Fuzzy(e) => e.is_numerical(),
             Self::Integration(_)
             | Self::NonFiniteControl { .. }
+            | Self::NonFiniteDisturbance { .. }
             | Self::Controller { .. }
             | Self::RunawayError { .. } => true,
             _ => false,

@@ -15,6 +15,8 @@ pub const MAX_COORDINATES: usize = 2 * backbone_kin::MAX_HARMONICS + 1;
 pub use error::{ControllerFailure, SimError, check_finite};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use simulation::{
-    ControlSample, Integrator, Lockstep, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_LOOP_WORK,
-    MAX_RECORDED_VALUES, MAX_RK4_STEPS, Observation, Run, RunFailure, Simulation, check_loop_work,
+    ControlSample, ControllerFactory, Integrator, Lockstep, LoopHooks, LoopSettings,
+    MAX_CONTROLLER_SAMPLES, MAX_LOOP_WORK, MAX_RECORDED_VALUES, MAX_RK4_STEPS, NoHooks,
+    Observation, Prepared, ReferenceFactory, Run, RunFailure, RunNoise, Simulation,
+    check_loop_work,
 };
