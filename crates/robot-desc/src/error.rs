@@ -1,5 +1,7 @@
 //! The error type of this crate.
 
+use lane_math::{Classify, ErrorClass};
+
 /// Why a robot description was refused or could not be exported. Every message is one line
 /// naming the element (`joint 'elbow'`, `link 'tool'`, `<inertial>` of a link) and the problem.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -70,6 +72,14 @@ pub enum DescError {
         /// Why.
         problem: String,
     },
+}
+
+impl Classify for DescError {
+    /// Always [`InvalidInput`](ErrorClass::InvalidInput): a description is read, checked and
+    /// written, never computed with.
+    fn class(&self) -> ErrorClass {
+        ErrorClass::InvalidInput
+    }
 }
 
 impl DescError {

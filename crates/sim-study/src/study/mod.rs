@@ -34,26 +34,28 @@
 mod aggregate;
 mod comparison;
 mod inputs;
+mod outcome;
 mod plan;
 mod shard_file;
 
 pub use aggregate::{Cell, CellBuilder, FailedRun, MAX_LISTED_FAILURES, Stats, cells};
-pub use comparison::{ComparisonRun, Stopped, builtin_scenarios, compare, run_one};
+pub use comparison::{ComparisonRun, builtin_scenarios, compare, run_one};
 pub use inputs::{
     InputDigest, SCENARIO_INPUT, check_digests, check_json_safe, first_changed, input_digests,
 };
+pub use outcome::{RunError, RunOutcome, Stopped, run_scenario};
 pub use plan::{
     MAX_RUNS, MAX_SHARDS, RunId, SettingError, Shard, SweepConfig, SweepSettings, run_seed,
 };
 pub use shard_file::{
-    FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, Outcome, RunMetrics, RunResult, ShardFile,
-    ShardHeader, ShardInput, ShardReader, ShardSource, merge, merge_readers, shard_paths,
+    FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, RunMetrics, RunResult, ShardFile, ShardHeader,
+    ShardInput, ShardReader, ShardSource, StoredOutcome, merge, merge_readers, shard_paths,
     write_json_line,
 };
 
 use crate::IntegratorSpec;
 use rayon::prelude::*;
-use sim_core::{Lockstep, Run, RunFailure};
+use sim_core::Lockstep;
 use std::io::Write;
 
 /// Runs run in parallel before their results are passed on in index order: enough to keep
@@ -67,11 +69,10 @@ pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 /// Runs run `id` of `config` alone and keeps its summary metrics (the time series are dropped at
 /// once).
 pub fn execute(config: &SweepConfig, id: &RunId) -> RunResult {
-    let outcome = match config.scenario_for(id).build() {
-        Err(e) => build_failure(&e),
-        Ok(mut simulation) => outcome(simulation.run()),
-    };
-    RunResult::new(id, outcome)
+    RunResult::new(
+        id,
+        StoredOutcome::of(run_scenario(&config.scenario_for(id))),
+    )
 }
 
 /// Runs the runs `ids` of `config` side by side in a [`Lockstep`] group, their dynamics
@@ -88,16 +89,16 @@ pub fn execute_group(config: &SweepConfig, ids: &[RunId]) -> Vec<RunResult> {
             Ok(simulation) => {
                 built.push(simulation);
                 positions.push(position);
-                build_failure(&"not run")
+                None
             }
-            Err(e) => build_failure(&e),
+            Err(e) => Some(StoredOutcome::of(Err(Stopped::not_built(e)))),
         });
     }
     if !built.is_empty() {
         match Lockstep::new(built) {
             Ok(mut group) => {
                 for (position, run) in positions.into_iter().zip(group.run()) {
-                    outcomes[position] = outcome(run);
+                    outcomes[position] = Some(StoredOutcome::of(run.map_err(Stopped::from)));
                 }
             }
             // Runs a group refuses (they cannot differ but in noise and seed) are run alone.
@@ -106,33 +107,8 @@ pub fn execute_group(config: &SweepConfig, ids: &[RunId]) -> Vec<RunResult> {
     }
     ids.iter()
         .zip(outcomes)
-        .map(|(id, outcome)| RunResult::new(id, outcome))
+        .map(|(id, outcome)| RunResult::new(id, outcome.expect("every run of the group has run")))
         .collect()
-}
-
-/// The outcome of a run that could not be built.
-fn build_failure(error: &dyn std::fmt::Display) -> Outcome {
-    Outcome::Failed {
-        error: error.to_string(),
-        simulated_s: 0.0,
-    }
-}
-
-/// The summary metrics of a run that completed, or why and when it stopped.
-fn outcome(run: Result<Run, Box<RunFailure>>) -> Outcome {
-    match run {
-        Ok(run) => match RunMetrics::from_summary(&run.summary) {
-            Ok(metrics) => Outcome::Completed(metrics),
-            Err(error) => Outcome::Failed {
-                error,
-                simulated_s: run.summary.simulated_s,
-            },
-        },
-        Err(failure) => Outcome::Failed {
-            error: failure.error.to_string(),
-            simulated_s: failure.summary.simulated_s,
-        },
-    }
 }
 
 /// How many runs of a sweep go into one lock-step group: the states the reduced dynamics'
@@ -226,7 +202,7 @@ pub fn write_shard<W: Write + ?Sized>(
     let (mut runs, mut stopped) = (0, 0);
     for_each_run(config, shard, progress, |run| {
         runs += 1;
-        stopped += usize::from(matches!(run.outcome, Outcome::Failed { .. }));
+        stopped += usize::from(matches!(run.outcome, StoredOutcome::Failed { .. }));
         write_json_line(out, &run)
     })?;
     let now = input_digests(&config.scenario)?;
