@@ -18,7 +18,7 @@ pub enum DescError {
     /// The text is not well-formed XML, or uses a DTD (refused: no entity is ever expanded),
     /// or has more than [`MAX_XML_NODES`](crate::MAX_XML_NODES) nodes.
     #[error("not a readable XML document: {0}")]
-    Xml(String),
+    Xml(roxmltree::Error),
     /// Elements nest deeper than [`MAX_XML_DEPTH`](crate::MAX_XML_DEPTH).
     #[error("elements nest deeper than {max} levels (at line {line}); URDF needs 5")]
     TooDeep {
