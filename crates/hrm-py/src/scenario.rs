@@ -16,7 +16,7 @@ use pyo3::exceptions::{PyAttributeError, PyFileNotFoundError, PyOSError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use sim_core::controller::{ControlContext, Controller, ControllerError};
-use sim_study::study::Stopped;
+use sim_study::study::{RunOutcome, Stopped};
 use sim_study::{ControllerKind, ScenarioError};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -657,13 +657,7 @@ impl Scenario {
                 )
             }
         };
-        let result = result.map_err(|failure| Stopped {
-            error: failure.error.to_string(),
-            partial: Some(sim_core::Run {
-                record: failure.record,
-                summary: failure.summary,
-            }),
-        });
+        let result = result.map_err(Stopped::from);
         Run::new(py, &scenario, label, result)
     }
 }
@@ -720,7 +714,7 @@ impl Run {
         py: Python<'_>,
         scenario: &sim_study::Scenario,
         controller: &str,
-        result: Result<sim_core::Run, Stopped>,
+        result: RunOutcome,
     ) -> PyResult<Self> {
         let json = sim_study::summary_json::run(&result).to_string();
         let summary = py
@@ -733,11 +727,11 @@ impl Run {
             Err(Stopped {
                 error,
                 partial: Some(run),
-            }) => (run, Some(error)),
+            }) => (run, Some(error.to_string())),
             Err(Stopped {
                 error,
                 partial: None,
-            }) => return Err(Error::input(error).into()),
+            }) => return Err(Error::from(error).into()),
         };
         let view = run_view::Scene {
             title: format!("{} with {controller}", scenario.name),

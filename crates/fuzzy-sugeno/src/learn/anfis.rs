@@ -702,6 +702,7 @@ fn check_structure(system: &FuzzySystem) -> Result<(), FuzzyError> {
 mod tests {
     use super::*;
     use crate::MembershipFn as Mf;
+    use lane_math::Classify;
 
     /// Two inputs with sets of several types (pimf and zmf among them), a shared term, a
     /// don't-care and a rule weight.

@@ -34,26 +34,28 @@
 mod aggregate;
 mod comparison;
 mod inputs;
+mod outcome;
 mod plan;
 mod shard_file;
 
 pub use aggregate::{Cell, CellBuilder, FailedRun, MAX_LISTED_FAILURES, Stats, cells};
-pub use comparison::{ComparisonRun, Stopped, builtin_scenarios, compare, run_one};
+pub use comparison::{ComparisonRun, builtin_scenarios, compare, run_one};
 pub use inputs::{
     InputDigest, SCENARIO_INPUT, check_digests, check_json_safe, first_changed, input_digests,
 };
+pub use outcome::{RunError, RunOutcome, Stopped, run_scenario};
 pub use plan::{
     MAX_RUNS, MAX_SHARDS, RunId, SettingError, Shard, SweepConfig, SweepSettings, run_seed,
 };
 pub use shard_file::{
-    FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, Outcome, RunMetrics, RunResult, ShardFile,
-    ShardHeader, ShardInput, ShardReader, ShardSource, merge, merge_readers, shard_paths,
+    FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, RunMetrics, RunResult, ShardFile, ShardHeader,
+    ShardInput, ShardReader, ShardSource, StoredOutcome, merge, merge_readers, shard_paths,
     write_json_line,
 };
 
 use crate::{ControllerKind, IntegratorSpec};
 use rayon::prelude::*;
-use sim_core::{Prepared, Run, RunFailure, SimError};
+use sim_core::{Prepared, SimError};
 use std::io::Write;
 
 /// Runs run in parallel before their results are passed on in index order: enough to keep
@@ -68,20 +70,20 @@ pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 /// once).
 pub fn execute(config: &SweepConfig, id: &RunId) -> RunResult {
     let outcome = match config.prepare(id.controller) {
-        Err(e) => build_failure(&e),
+        Err(e) => StoredOutcome::of(Err(Stopped::not_built(e))),
         Ok(prepared) => run_alone(config, &prepared, id),
     };
     RunResult::new(id, outcome)
 }
 
 /// Runs run `id` of `config` alone from its controller's prepared simulation.
-fn run_alone(config: &SweepConfig, prepared: &Prepared, id: &RunId) -> Outcome {
+fn run_alone(config: &SweepConfig, prepared: &Prepared, id: &RunId) -> StoredOutcome {
     match config
         .run_noise(id)
         .and_then(|noise| prepared.simulation(&noise))
     {
-        Err(e) => build_failure(&e),
-        Ok(mut simulation) => outcome(simulation.run()),
+        Err(e) => StoredOutcome::of(Err(Stopped::not_built(e))),
+        Ok(mut simulation) => StoredOutcome::of(simulation.run().map_err(Stopped::from)),
     }
 }
 
@@ -108,7 +110,7 @@ fn execute_prepared(
         Err(e) => {
             return ids
                 .iter()
-                .map(|id| RunResult::new(id, build_failure(e)))
+                .map(|id| RunResult::new(id, StoredOutcome::of(Err(Stopped::not_built(e.clone())))))
                 .collect();
         }
     };
@@ -121,38 +123,13 @@ fn execute_prepared(
         Ok(mut group) => ids
             .iter()
             .zip(group.run())
-            .map(|(id, run)| RunResult::new(id, outcome(run)))
+            .map(|(id, run)| RunResult::new(id, StoredOutcome::of(run.map_err(Stopped::from))))
             .collect(),
         // A run that cannot be built fails alone.
         Err(_) => ids
             .iter()
             .map(|id| RunResult::new(id, run_alone(config, prepared, id)))
             .collect(),
-    }
-}
-
-/// The outcome of a run that could not be built.
-fn build_failure(error: &dyn std::fmt::Display) -> Outcome {
-    Outcome::Failed {
-        error: error.to_string(),
-        simulated_s: 0.0,
-    }
-}
-
-/// The summary metrics of a run that completed, or why and when it stopped.
-fn outcome(run: Result<Run, Box<RunFailure>>) -> Outcome {
-    match run {
-        Ok(run) => match RunMetrics::from_summary(&run.summary) {
-            Ok(metrics) => Outcome::Completed(metrics),
-            Err(error) => Outcome::Failed {
-                error,
-                simulated_s: run.summary.simulated_s,
-            },
-        },
-        Err(failure) => Outcome::Failed {
-            error: failure.error.to_string(),
-            simulated_s: failure.summary.simulated_s,
-        },
     }
 }
 
@@ -259,7 +236,7 @@ pub fn write_shard<W: Write + ?Sized>(
     let (mut runs, mut stopped) = (0, 0);
     for_each_run(config, shard, progress, |run| {
         runs += 1;
-        stopped += usize::from(matches!(run.outcome, Outcome::Failed { .. }));
+        stopped += usize::from(matches!(run.outcome, StoredOutcome::Failed { .. }));
         write_json_line(out, &run)
     })?;
     let now = input_digests(&config.scenario)?;
