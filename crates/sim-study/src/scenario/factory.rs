@@ -171,6 +171,13 @@ impl ArmSpec {
     /// agree, and the arm has between 1 and [`manip_dyn::MAX_LINKS`] links, checked before any
     /// per-link array is allocated.
     pub fn to_chain(&self) -> Result<ChainModel, SimError> {
+        if self.urdf.is_some() {
+            return Err(SimError::setting(
+                "arm.urdf",
+                "names a spatial chain, which runs only in the joint-space loop \
+                 (Scenario::run_chain, as `hrm simulate` runs it), not as a planar arm",
+            ));
+        }
         let mut n = self.links;
         for (name, array) in [
             ("arm.lengths", &self.lengths),
@@ -247,7 +254,7 @@ pub(super) fn per_coordinate(
 impl ReferenceSpec {
     /// The reference of `m` coordinates for a curve of length `length` with `harmonics`
     /// harmonics and base angle `alpha0`.
-    fn build(
+    pub(super) fn build(
         &self,
         length: f64,
         harmonics: usize,

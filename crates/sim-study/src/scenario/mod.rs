@@ -51,6 +51,7 @@
 //! ```
 
 mod builtin;
+mod chain;
 mod controllers;
 mod factory;
 mod file;
