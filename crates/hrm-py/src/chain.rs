@@ -26,7 +26,7 @@ const DEFAULT_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
 fn urdf_text(source: &Bound<'_, PyAny>) -> PyResult<String> {
     let path = if let Ok(text) = source.cast::<PyString>() {
         let text: String = text.extract()?;
-        if !(text.ends_with(".urdf") && !text.contains('<')) {
+        if !text.ends_with(".urdf") || text.contains('<') {
             return Ok(text);
         }
         PathBuf::from(text)

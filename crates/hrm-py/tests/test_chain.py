@@ -160,7 +160,7 @@ def test_pickle_and_urdf_round_trip():
     assert again.to_urdf() == chain.to_urdf()
     theta, v, tau = states(5, 1)[:3]
     assert np.array_equal(again.aba(theta, v, tau), chain.aba(theta, v, tau))
-    assert "<mujoco" in chain.to_mjcf() and 'gravity="0 -9.81 0"' in chain.to_mjcf()
+    assert "<mujoco" in chain.to_mjcf() and 'gravity="0.0 -9.81 0.0"' in chain.to_mjcf()
 
 
 def test_a_planar_arm_exported_as_urdf_has_the_planar_dynamics():
