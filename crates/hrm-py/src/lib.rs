@@ -2,6 +2,7 @@
 
 mod arm;
 mod array;
+mod chain;
 mod errors;
 mod fuzzy;
 mod reduced;
@@ -16,6 +17,7 @@ use pyo3::prelude::*;
 fn _hrm(module: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = module.py();
     module.add_class::<arm::Arm>()?;
+    module.add_class::<chain::Chain>()?;
     module.add_class::<reduced::ReducedModel>()?;
     module.add_class::<spatial::SpatialArm>()?;
     module.add_class::<scenario::Scenario>()?;

@@ -160,7 +160,7 @@ fn build(
 
 /// `array[..., first:last]` reshaped to `shape` after the batch dimension (when `batch`), as a
 /// contiguous copy: one field of a result computed as one flat row per state.
-fn field<'py>(
+pub(crate) fn field<'py>(
     array: &Bound<'py, PyAny>,
     batch: bool,
     first: usize,

@@ -76,6 +76,19 @@ pub enum SimError {
     /// The integrator stopped: the dynamics failed or the state blew up between two samples.
     #[error("integration diverged: {0}")]
     Integration(OdeError<ReduceError>),
+    /// The spatial chain's dynamics refused a computation at a controller sample (the joint-space
+    /// loop of a URDF arm, [`run_chain_loop`](crate::run_chain_loop)).
+    #[error("chain dynamics at t = {t} s: {source}")]
+    ChainDynamics {
+        /// When (s).
+        t: f64,
+        /// The refusal.
+        source: manip_dyn::DynError,
+    },
+    /// The joint-space loop's integrator stopped: the chain's dynamics failed or the state blew
+    /// up between two controller samples.
+    #[error("integration diverged: {0}")]
+    ChainIntegration(OdeError<manip_dyn::DynError>),
     /// The controller produced a NaN or infinite torque.
     #[error("the controller produced a non-finite modal torque {tau_star:?} at t = {t} s")]
     NonFiniteControl {
@@ -153,7 +166,9 @@ impl Classify for SimError {
             Self::Kinematics(e) => e.class(),
             Self::Dynamics { source, .. } | Self::Model(source) => source.class(),
             Self::Fuzzy(e) => e.class(),
+            Self::ChainDynamics { source, .. } => source.class(),
             Self::Integration(_)
+            | Self::ChainIntegration(_)
             | Self::NonFiniteControl { .. }
             | Self::NonFiniteDisturbance { .. }
             | Self::Controller { .. }

@@ -189,6 +189,13 @@ impl ArmSpec {
     /// agree, and the arm has between 1 and [`manip_dyn::MAX_LINKS`] links, checked before any
     /// per-link array is allocated.
     pub fn to_chain(&self) -> Result<ChainModel, SimError> {
+        if self.urdf.is_some() {
+            return Err(SimError::setting(
+                "arm.urdf",
+                "names a spatial chain, which runs only in the joint-space loop \
+                 (Scenario::run_chain, as `hrm simulate` runs it), not as a planar arm",
+            ));
+        }
         let mut n = self.links;
         for (name, array) in [
             ("arm.lengths", &self.lengths),
@@ -266,7 +273,7 @@ impl ReferenceSpec {
     /// The reference of `m` coordinates for a curve of length `length` with `harmonics`
     /// harmonics and base angle `alpha0`, built once (a path's inverse kinematics solved
     /// once), and cloned for each run.
-    fn build(
+    pub(super) fn build(
         &self,
         length: f64,
         harmonics: usize,
