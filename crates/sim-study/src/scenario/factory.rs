@@ -53,6 +53,16 @@ impl Scenario {
     /// `.fis` file if any. Errors name the setting that failed; the loop's own limits are
     /// [`Simulation::new`]'s.
     pub fn build(&self) -> Result<Simulation, SimError> {
+        self.build_wrapping(|controller| controller)
+    }
+
+    /// Builds the simulation as [`build`](Self::build) does, with the controller `controller.kind`
+    /// names passed through `wrap` (e.g. a wrapper that stops the run when a Python user presses
+    /// Ctrl-C).
+    pub fn build_wrapping(
+        &self,
+        wrap: impl FnOnce(Box<dyn Controller>) -> Box<dyn Controller>,
+    ) -> Result<Simulation, SimError> {
         self.assemble(|model, period| {
             ControllerSetup {
                 spec: &self.controller,
@@ -61,6 +71,7 @@ impl Scenario {
                 period,
             }
             .build()
+            .map(wrap)
         })
     }
 
