@@ -1,9 +1,11 @@
 #![doc = include_str!("../README.md")]
 
+mod args;
 mod arm;
 mod array;
 mod errors;
 mod fuzzy;
+mod pool;
 mod reduced;
 mod scenario;
 mod spatial;

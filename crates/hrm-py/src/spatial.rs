@@ -85,6 +85,14 @@ impl SpatialArm {
         self.model.n_coords()
     }
 
+    /// The work of one state of the O(n m^2) terms, for the driver's GIL threshold.
+    fn work(&self) -> usize {
+        self.model
+            .n_links()
+            .saturating_mul(self.m())
+            .saturating_mul(self.m())
+    }
+
     fn joints_count(&self) -> usize {
         self.model.map().n_joints()
     }
@@ -343,6 +351,7 @@ impl SpatialArm {
             py,
             [&a],
             joints,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |_, [a], out| {
@@ -371,6 +380,7 @@ impl SpatialArm {
             py,
             [&a],
             6,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a], out| {
@@ -438,6 +448,7 @@ impl SpatialArm {
                 py,
                 [&target],
                 m,
+                self.work(),
                 &self.workspace,
                 || self.fresh(),
                 |ws, [target], out| solve(ws, target, None, out),
@@ -448,6 +459,7 @@ impl SpatialArm {
                     py,
                     [&target, &guess],
                     m,
+                    self.work(),
                     &self.workspace,
                     || self.fresh(),
                     |ws, [target, guess], out| solve(ws, target, Some(guess), out),
@@ -482,6 +494,7 @@ impl SpatialArm {
             py,
             [a, a_dot, tau],
             per_state,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a, a_dot, tau], out| {
@@ -537,6 +550,7 @@ impl SpatialArm {
             py,
             [a, a_dot, tau],
             m,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a, a_dot, tau], out| {
