@@ -251,7 +251,9 @@ impl ReducedModel {
     ///
     /// For K = 1 the closed form of eqs 5-6 (through the restricted inverse of J0) on `branch`
     /// ("positive": a1 >= 0, the paper's; or "negative"); for K > 1 Levenberg-Marquardt from that
-    /// solution, the higher harmonics starting at zero. The base angle is the model's fixed
+    /// solution, the higher harmonics starting at zero, and where the K = 1 family does not
+    /// reach the target or the iteration does not converge from there, from the other branch's
+    /// closed form and a fixed list of moderate curves (`backbone_kin::HarmonicIk::solve_unguided`). The base angle is the model's fixed
     /// alpha0; for a model whose alpha0 is a coordinate, pass `alpha0` (it becomes the last
     /// coordinate of the result, reduced to [-pi, pi] when it is outside, as the model's fixed
     /// alpha0 is). Raises Unreachable for a target the curve cannot reach and
@@ -308,11 +310,15 @@ impl ReducedModel {
             || solver.clone(),
             |solver, [target], out| {
                 let target = [target[0], target[1]];
-                let a = backbone_kin::inverse_kinematics(length, target, alpha0, branch)?;
                 out.fill(0.0);
-                out[..2].copy_from_slice(&a);
-                if let Some(solver) = solver {
-                    solver.solve(target, &mut out[..2 * harmonics])?;
+                match solver {
+                    None => {
+                        let a = backbone_kin::inverse_kinematics(length, target, alpha0, branch)?;
+                        out[..2].copy_from_slice(&a);
+                    }
+                    Some(solver) => {
+                        solver.solve_unguided(target, branch, &mut out[..2 * harmonics])?;
+                    }
                 }
                 if free {
                     out[2 * harmonics] = alpha0;

@@ -294,6 +294,18 @@ def test_ik_reduces_a_huge_base_angle(alpha0):
     assert np.linalg.norm(fixed.fk(fixed.ik(target)) - target) < 5e-3
 
 
+@pytest.mark.parametrize("harmonics, alpha0", [(2, 0.0), (2, 0.4), (3, -0.3)])
+def test_k_harmonic_ik_solves_what_the_family_reaches(harmonics, alpha0):
+    # 200 seeded targets m.fk(a), a in [-0.5, 0.5]^{2K}: some need |a2| beyond the K = 1
+    # family's amplitude, where the closed-form start used to give Unreachable.
+    model = hrm.ReducedModel(hrm.Arm(links=20, link_length=0.05), harmonics=harmonics, alpha0=alpha0)
+    rng = np.random.default_rng(32)
+    targets = model.fk(rng.uniform(-0.5, 0.5, (200, 2 * harmonics)))
+    a = model.ik(targets)
+    assert np.abs(model.fk(a) - targets).max() < 1e-5  # the chain's tip within its discretisation
+    np.testing.assert_array_equal(a[17], model.ik(targets[17]))
+
+
 def test_run_results_are_not_shared_mutable_objects():
     run = short_step(0.01).run("pd")
     for name in ["t", "a", "a_dot", "a_ref", "tau_star", "joint_torques", "tip", "tip_ref"]:
