@@ -12,8 +12,9 @@ use modal_reduce::ReducedModel;
 use sim_core::controller::{Controller, ModalState};
 use sim_core::ode::Tolerances;
 use sim_core::reference::{CartesianPath, PathShape, Sinusoid, Step};
-use sim_core::{Integrator, LoopSettings, Prepared, ReferenceFactory, SimError};
+use sim_core::{ControllerFactory, Integrator, LoopSettings, Prepared, ReferenceFactory, SimError};
 use sim_core::{RunNoise, Simulation};
+use std::sync::Arc;
 
 impl Scenario {
     /// The reduced model of the arm with the scenario's modal family. Refuses a family with no
@@ -64,6 +65,20 @@ impl Scenario {
     /// for one run.
     pub fn build(&self) -> Result<Simulation, SimError> {
         let prepared = self.prepare()?;
+        prepared.simulation(&prepared.settings().noise())
+    }
+
+    /// Builds the simulation as [`build`](Self::build) does, with every controller the
+    /// prepared simulation makes passed through `wrap` (e.g. a wrapper that stops the run when a
+    /// Python user presses Ctrl-C).
+    pub fn build_wrapping(
+        &self,
+        wrap: impl Fn(Box<dyn Controller>) -> Box<dyn Controller> + Send + Sync + 'static,
+    ) -> Result<Simulation, SimError> {
+        let (model, reference, controller, settings, initial) =
+            self.assemble(|setup| setup.prepare())?;
+        let controller: ControllerFactory = Arc::new(move || controller().map(&wrap));
+        let prepared = Prepared::new(model, reference, controller, settings, initial)?;
         prepared.simulation(&prepared.settings().noise())
     }
 

@@ -170,6 +170,18 @@ pub fn for_each_run(
     config: &SweepConfig,
     shard: Shard,
     progress: impl Fn() + Sync,
+    sink: impl FnMut(RunResult) -> Result<(), String>,
+) -> Result<(), String> {
+    for_each_run_until(config, shard, progress, || false, sink)
+}
+
+/// [`for_each_run`], checking `stop` before each lock-step group: once it returns true, no
+/// further group starts and the call fails with [`STOPPED`] (a Python caller's Ctrl-C).
+pub fn for_each_run_until(
+    config: &SweepConfig,
+    shard: Shard,
+    progress: impl Fn() + Sync,
+    stop: impl Fn() -> bool + Sync,
     mut sink: impl FnMut(RunResult) -> Result<(), String>,
 ) -> Result<(), String> {
     let mut indices = shard.indices(config.runs().unwrap_or(0));
@@ -190,6 +202,9 @@ pub fn for_each_run(
         let mut results: Vec<RunResult> = groups
             .par_iter()
             .flat_map_iter(|ids| {
+                if stop() {
+                    return Vec::new();
+                }
                 let (_, prepared) = prepared
                     .iter()
                     .find(|(kind, _)| *kind == ids[0].controller)
@@ -199,26 +214,44 @@ pub fn for_each_run(
                 results
             })
             .collect();
+        if stop() {
+            return Err(STOPPED.to_string());
+        }
         results.sort_unstable_by_key(|run| run.index);
         results.into_iter().try_for_each(&mut sink)?;
     }
 }
 
+/// The error of [`for_each_run_until`] and [`run_shard_until`] when `stop` ended the runs.
+pub const STOPPED: &str = "the sweep was stopped before all its runs were done";
+
 /// Runs the runs of `shard` and keeps them in memory (see [`write_shard`] to stream them to a
 /// file); the results are in index order. [`Shard::WHOLE`] runs the whole sweep.
 pub fn run_shard(config: &SweepConfig, shard: Shard, progress: impl Fn() + Sync) -> ShardFile {
+    run_shard_until(config, shard, progress, || false)
+        .expect("pushing to a vector cannot fail and nothing stops the runs")
+}
+
+/// [`run_shard`], checking `stop` before each lock-step group ([`for_each_run_until`]): `None`
+/// once it returned true.
+pub fn run_shard_until(
+    config: &SweepConfig,
+    shard: Shard,
+    progress: impl Fn() + Sync,
+    stop: impl Fn() -> bool + Sync,
+) -> Option<ShardFile> {
     let mut runs = Vec::with_capacity(shard.run_count(config.runs().unwrap_or(0)));
-    let pushed: Result<(), String> = for_each_run(config, shard, progress, |run| {
+    for_each_run_until(config, shard, progress, stop, |run| {
         runs.push(run);
         Ok(())
-    });
-    debug_assert!(pushed.is_ok(), "pushing to a vector cannot fail");
-    ShardFile {
+    })
+    .ok()?;
+    Some(ShardFile {
         format: FORMAT.into(),
         config: config.clone(),
         shard,
         runs,
-    }
+    })
 }
 
 /// Runs the runs of `shard` and writes its shard file to `out` as they finish (the header, then
