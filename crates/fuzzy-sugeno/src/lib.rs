@@ -16,6 +16,7 @@ mod kernel;
 pub mod learn;
 mod membership;
 mod paper;
+mod separable;
 mod system;
 
 pub use analysis::{AnalysisOptions, AnalysisReport, COVERAGE_ROUNDING};
