@@ -240,7 +240,7 @@ fn bell<L: Lane>(cx: L::Context, x: L, center: f64, width: f64, power: impl Fn(L
 
 /// `base^exponent` by repeated squaring (exponentiation by squaring), no `powf`.
 #[inline(always)]
-fn integer_power<L: Lane>(cx: L::Context, mut base: L, mut exponent: u32) -> L {
+pub(crate) fn integer_power<L: Lane>(cx: L::Context, mut base: L, mut exponent: u32) -> L {
     let mut result = L::splat(cx, 1.0);
     while exponent > 0 {
         if exponent & 1 == 1 {

@@ -186,8 +186,10 @@ impl Evaluator {
         Ok(self.firing_strengths())
     }
 
-    /// The firing strengths computed by the last [`eval`](Self::eval) or [`fire`](Self::fire)
-    /// (zeros before the first).
+    /// The firing strengths computed by the last [`fire`](Self::fire) (zeros before the first).
+    /// [`eval`](Self::eval) computes them too, except for a system whose rules are a complete
+    /// grid with a separable form (such as the paper's controller), which it evaluates without
+    /// them: call `fire` to read the strengths at a point.
     pub fn firing_strengths(&self) -> &[f64] {
         let c = self.system.compiled();
         self.one.values[c.strength_base..c.slot_count].as_flattened()
@@ -197,6 +199,26 @@ impl Evaluator {
 /// Checks one point's inputs, applies the range policy into `work.x` and fires the rules.
 #[inline]
 fn fire_point(
+    system: &FuzzySystem,
+    options: &EvalOptions,
+    work: &mut Workspace<1>,
+    inputs: &[f64],
+) -> Result<(), FuzzyError> {
+    load_inputs(system, options, work, inputs)?;
+    let methods = system.methods();
+    kernel::fire::<f64, 1>(
+        (),
+        system.compiled(),
+        methods.and,
+        methods.or,
+        &mut work.slots(),
+    );
+    Ok(())
+}
+
+/// Checks one point's inputs and applies the range policy into `work.x`.
+#[inline(always)]
+fn load_inputs(
     system: &FuzzySystem,
     options: &EvalOptions,
     work: &mut Workspace<1>,
@@ -212,14 +234,6 @@ fn fire_point(
     for (index, (slot, &value)) in work.x.iter_mut().zip(inputs).enumerate() {
         slot[0] = load_input(system, options, index, value)?;
     }
-    let methods = system.methods();
-    kernel::fire::<f64, 1>(
-        (),
-        system.compiled(),
-        methods.and,
-        methods.or,
-        &mut work.slots(),
-    );
     Ok(())
 }
 
@@ -239,8 +253,13 @@ fn eval_point(
             found: outputs.len(),
         });
     }
-    fire_point(system, options, work, inputs)?;
-    kernel::sums::<f64, 1>((), system.compiled(), &mut work.slots());
+    load_inputs(system, options, work, inputs)?;
+    let c = system.compiled();
+    if !kernel::separable_sums::<f64, 1>((), c, &mut work.slots()) {
+        let methods = system.methods();
+        kernel::fire::<f64, 1>((), c, methods.and, methods.or, &mut work.slots());
+        kernel::sums::<f64, 1>((), c, &mut work.slots());
+    }
     // Every output is checked before the first is written; each replaces its weighted sum.
     for (o, pair) in work.sums.chunks_exact_mut(2).enumerate() {
         pair[0][0] = output_value(system, options, o, pair[0][0], pair[1][0])?;

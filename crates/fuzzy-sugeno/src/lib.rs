@@ -18,6 +18,7 @@ pub mod learn;
 mod membership;
 mod options;
 mod paper;
+mod separable;
 mod system;
 
 pub use analysis::{AnalysisOptions, AnalysisReport, COVERAGE_ROUNDING};

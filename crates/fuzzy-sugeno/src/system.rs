@@ -4,6 +4,7 @@
 use crate::compiled_mf::CompiledMf;
 use crate::error::{FuzzyError, SystemProblem};
 use crate::membership::MembershipFn;
+use crate::separable::Separable;
 
 /// An input variable: a name, the range it was designed for, and its fuzzy sets.
 #[derive(Debug, Clone, PartialEq)]
@@ -242,7 +243,7 @@ impl FuzzySystem {
             check_rule(rule, &inputs, &outputs)
                 .map_err(|problem| invalid(&format!("rule {}", r + 1), problem))?;
         }
-        let compiled = Compiled::new(&inputs, &outputs, &rules)?;
+        let compiled = Compiled::new(&inputs, &outputs, &rules, methods)?;
         Ok(Self {
             name,
             inputs,
@@ -280,6 +281,13 @@ impl FuzzySystem {
 
     pub(crate) fn compiled(&self) -> &Compiled {
         &self.compiled
+    }
+
+    /// The system without its separable form, evaluated by the general kernel (for tests).
+    #[cfg(test)]
+    pub(crate) fn without_separable_form(mut self) -> Self {
+        self.compiled.separable = None;
+        self
     }
 }
 
@@ -483,6 +491,9 @@ pub(crate) struct Compiled {
     pub conclusions: Vec<[u32; 2]>,
     /// Output `o`'s conclusions are `conclusions[conclusion_offsets[o]..conclusion_offsets[o + 1]]`.
     pub conclusion_offsets: Vec<usize>,
+    /// The separable form of a complete grid of product rules, when the system has one
+    /// (`separable.rs`): what [`Evaluator::eval`](crate::Evaluator::eval) takes.
+    pub separable: Option<Separable>,
 }
 
 /// The terms of [`Compiled::dense_terms`], one pair per rule and pair of outputs.
@@ -499,6 +510,7 @@ impl Compiled {
         inputs: &[InputVariable],
         outputs: &[OutputVariable],
         rules: &[Rule],
+        methods: Methods,
     ) -> Result<Self, FuzzyError> {
         let mut mfs = Vec::new();
         let mut mf_inputs = Vec::new();
@@ -649,7 +661,20 @@ impl Compiled {
                 DenseTerms::Slots(pairs)
             }
         });
+        let constant_terms: Vec<Vec<Option<f64>>> = outputs
+            .iter()
+            .map(|output| {
+                (output.terms.iter())
+                    .map(|term| match term.function {
+                        OutputFn::Constant(c) => Some(c),
+                        OutputFn::Linear { .. } => None,
+                    })
+                    .collect()
+            })
+            .collect();
+        let separable = Separable::new(&mfs, &mf_inputs, &constant_terms, rules, methods);
         let compiled = Self {
+            separable,
             mfs,
             mf_inputs,
             has_complements,
@@ -728,6 +753,11 @@ impl Compiled {
                 .iter()
                 .all(|&[rule, term]| (rule as usize) < n_rules && (term as usize) < n_terms)
             && dense_in_bounds
+            && self.separable.as_ref().is_none_or(|s| {
+                s.slots_in_bounds()
+                    && s.sets.len() == self.mfs.len()
+                    && s.set_offsets.len() == self.n_inputs + 1
+            })
     }
 }
 

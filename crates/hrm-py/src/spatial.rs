@@ -604,6 +604,7 @@ impl SpatialArm {
             py,
             [a, a_dot, tau],
             per_state,
+            self.work() * m,
             &self.workspace,
             || self.fresh(),
             |ws, [a, a_dot, tau], out| {
