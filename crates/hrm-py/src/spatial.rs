@@ -102,6 +102,14 @@ impl SpatialArm {
         self.model.n_coords()
     }
 
+    /// The work of one state of the O(n m^2) terms, for the driver's GIL threshold.
+    fn work(&self) -> usize {
+        self.model
+            .n_links()
+            .saturating_mul(self.m())
+            .saturating_mul(self.m())
+    }
+
     fn joints_count(&self) -> usize {
         self.model.map().n_joints()
     }
@@ -177,7 +185,7 @@ fn build(
 
 /// `array[..., first:last]` reshaped to `shape` after the batch dimension (when `batch`), as a
 /// contiguous copy: one field of a result computed as one flat row per state.
-fn field<'py>(
+pub(crate) fn field<'py>(
     array: &Bound<'py, PyAny>,
     batch: bool,
     first: usize,
@@ -360,6 +368,7 @@ impl SpatialArm {
             py,
             [&a],
             joints,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |_, [a], out| {
@@ -388,6 +397,7 @@ impl SpatialArm {
             py,
             [&a],
             6,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a], out| {
@@ -455,6 +465,7 @@ impl SpatialArm {
                 py,
                 [&target],
                 m,
+                self.work(),
                 &self.workspace,
                 || self.fresh(),
                 |ws, [target], out| solve(ws, target, None, out),
@@ -465,6 +476,7 @@ impl SpatialArm {
                     py,
                     [&target, &guess],
                     m,
+                    self.work(),
                     &self.workspace,
                     || self.fresh(),
                     |ws, [target, guess], out| solve(ws, target, Some(guess), out),
@@ -499,6 +511,7 @@ impl SpatialArm {
             py,
             [a, a_dot, tau],
             per_state,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a, a_dot, tau], out| {
@@ -554,6 +567,7 @@ impl SpatialArm {
             py,
             [a, a_dot, tau],
             m,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a, a_dot, tau], out| {
@@ -590,6 +604,7 @@ impl SpatialArm {
             py,
             [a, a_dot, tau],
             per_state,
+            self.work() * m,
             &self.workspace,
             || self.fresh(),
             |ws, [a, a_dot, tau], out| {

@@ -9,11 +9,12 @@ use faer::MatRef;
 
 use crate::spatial::{
     SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel, spatial_forward_dynamics,
-    spatial_joint_torques, spatial_reduced_derivatives, spatial_reduced_terms,
+    spatial_joint_torques, spatial_project_torques, spatial_reduced_derivatives,
+    spatial_reduced_terms,
 };
 use crate::{
     ReduceError, ReducedData, ReducedDerivatives, ReducedModel, forward_dynamics, joint_torques,
-    reduced_derivatives, reduced_terms,
+    project_torques, reduced_derivatives, reduced_terms,
 };
 
 /// A modal arm owned (what a simulation holds), planar or spatial; [`PlantModel::plant`] lends it
@@ -174,6 +175,17 @@ impl<'a> Plant<'a> {
                 spatial_joint_torques(model, data, a, a_dot, a_ddot, tau)
             }
             _ => Err(other_family(self)),
+        }
+    }
+
+    /// The modal forces of joint torques, `tau_star = J^T tau` ([`project_torques`] or
+    /// [`spatial_project_torques`]).
+    ///
+    /// Errors: as those.
+    pub fn project_torques(self, tau: &[f64], tau_star: &mut [f64]) -> Result<(), ReduceError> {
+        match self {
+            Plant::Planar(model) => project_torques(model, tau, tau_star),
+            Plant::Spatial(model) => spatial_project_torques(model, tau, tau_star),
         }
     }
 

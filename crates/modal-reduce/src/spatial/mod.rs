@@ -27,4 +27,4 @@ pub use derivatives::{SpatialReducedDerivatives, spatial_reduced_derivatives};
 pub use forward::spatial_forward_dynamics;
 pub use model::{SpatialLinkInertia, SpatialReducedModel};
 pub use terms::spatial_reduced_terms;
-pub use torques::spatial_joint_torques;
+pub use torques::{spatial_joint_torques, spatial_project_torques};

@@ -80,3 +80,24 @@ pub fn spatial_joint_torques(
     }
     check_finite_result("joint torques", tau)
 }
+
+/// The modal forces of joint torques: `tau_star = J^T tau` (`2n` joint torques, `z` and `y`
+/// joint of each link in turn, to `m`). Allocation-free.
+///
+/// Errors: `tau` not `2n` finite values, `tau_star` not of length `m`.
+pub fn spatial_project_torques(
+    model: &SpatialReducedModel,
+    tau: &[f64],
+    tau_star: &mut [f64],
+) -> Result<(), ReduceError> {
+    let map = model.map();
+    check_input("tau", tau, map.n_joints())?;
+    check_len("tau_star", tau_star.len(), model.n_coords())?;
+    tau_star.fill(0.0);
+    for (j, &value) in tau.iter().enumerate() {
+        for (out, &entry) in tau_star.iter_mut().zip(map.row(j)) {
+            *out += entry * value;
+        }
+    }
+    Ok(())
+}

@@ -2,6 +2,7 @@
 //! and a workspace of the other family is refused.
 
 use backbone_kin::ModalMap;
+use lane_math::Classify;
 use manip_dyn::ChainModel;
 use modal_reduce::spatial::{
     SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel, spatial_reduced_derivatives,
