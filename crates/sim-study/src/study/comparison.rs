@@ -2,7 +2,7 @@
 
 use crate::{ControllerKind, Scenario, ScenarioError};
 use rayon::prelude::*;
-use sim_core::Run;
+use sim_core::{Prepared, Run, SimError};
 
 /// One finished (or stopped) run of a comparison: its scenario, controller, the names of its
 /// modal coordinates and its outcome (the run, or why it could not be built or had to stop).
@@ -37,7 +37,17 @@ pub fn builtin_scenarios() -> Result<Vec<Scenario>, ScenarioError> {
 pub fn run_one(scenario: &Scenario, kind: ControllerKind) -> ComparisonRun {
     let mut scenario = scenario.clone();
     scenario.controller.kind = kind;
-    let result = match scenario.build() {
+    let prepared = scenario.prepare();
+    run_prepared(&scenario, prepared)
+}
+
+/// Runs `scenario` (with its own controller, seed and noise) from `prepared`, its simulation
+/// prepared by [`Scenario::prepare`] or [`Scenario::prepare_with_system`], or the error that
+/// refused it.
+pub fn run_prepared(scenario: &Scenario, prepared: Result<Prepared, SimError>) -> ComparisonRun {
+    let simulation =
+        prepared.and_then(|prepared| prepared.simulation(&prepared.settings().noise()));
+    let result = match simulation {
         Err(e) => Err(Stopped {
             error: e.to_string(),
             partial: None,
@@ -52,7 +62,7 @@ pub fn run_one(scenario: &Scenario, kind: ControllerKind) -> ComparisonRun {
     };
     ComparisonRun {
         scenario: scenario.name.clone(),
-        controller: kind,
+        controller: scenario.controller.kind,
         coordinates: scenario.coordinate_names(),
         result,
     }
