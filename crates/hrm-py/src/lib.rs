@@ -8,6 +8,7 @@ mod reduced;
 mod scenario;
 mod spatial;
 mod sweep;
+mod value;
 
 use pyo3::prelude::*;
 
