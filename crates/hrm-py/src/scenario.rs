@@ -15,7 +15,8 @@ use numpy::{IntoPyArray, PyArray1};
 use pyo3::exceptions::{PyAttributeError, PyFileNotFoundError, PyOSError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
-use sim_core::controller::{ControlContext, Controller, ControllerError};
+use sim_core::LoopHooks;
+use sim_core::controller::{ControlContext, Controller, ControllerError, ModalState};
 use sim_study::study::Stopped;
 use sim_study::{ControllerKind, ScenarioError};
 use std::path::PathBuf;
@@ -505,6 +506,63 @@ impl Controller for PythonController {
     }
 }
 
+/// A Python callable `f(t, a, a_dot) -> tau_d` as the loop's disturbance hook: the external
+/// joint torques (N m, one per joint) acting from the controller sample at `t` to the next, or
+/// `None` for none. An exception it raises, or a return value that is not `n` finite numbers,
+/// is kept in `raised` and ends the run (its torque is made non-finite, which stops the loop);
+/// `Scenario.run` then raises it as it is.
+struct PythonDisturbance {
+    function: Py<PyAny>,
+    n: usize,
+    raised: Option<PyErr>,
+}
+
+impl PythonDisturbance {
+    fn call(&self, py: Python<'_>, t: f64, state: &ModalState, tau: &mut [f64]) -> PyResult<bool> {
+        let out = self.function.bind(py).call1((
+            t,
+            PyArray1::from_slice(py, &state.a),
+            PyArray1::from_slice(py, &state.a_dot),
+        ))?;
+        if out.is_none() {
+            return Ok(false);
+        }
+        let context = |message: String| {
+            Error::input(format!(
+                "the disturbance's return value at t = {t} s: {message}"
+            ))
+        };
+        let values = States::read(&out, "tau", self.n).map_err(|e| {
+            let message = e.value(py).str().map(|s| s.to_string()).unwrap_or_default();
+            PyErr::from(context(message))
+        })?;
+        if values.is_batch() {
+            return Err(context(format!("tau must have shape ({},), got a batch", self.n)).into());
+        }
+        let values = values.values();
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(NumericalError::new_err(format!(
+                "the disturbance returned a non-finite joint torque {values:?} at t = {t} s"
+            )));
+        }
+        tau.copy_from_slice(values);
+        Ok(true)
+    }
+}
+
+impl LoopHooks for PythonDisturbance {
+    fn disturbance(&mut self, t: f64, state: &ModalState, tau: &mut [f64]) -> bool {
+        match Python::attach(|py| self.call(py, t, state, tau)) {
+            Ok(applied) => applied,
+            Err(error) => {
+                self.raised = Some(error);
+                tau.fill(f64::NAN);
+                true
+            }
+        }
+    }
+}
+
 #[pymethods]
 impl Scenario {
     /// A scenario shipped with hrm, by name (Scenario.builtin_names()): "paper-tracking"
@@ -620,11 +678,47 @@ impl Scenario {
     /// runs. A run that diverges (runaway tracking error, integrator failure) returns a Run
     /// whose `failure` says when and why, with the data up to the stop.
     ///
-    /// Built-in controllers run with the GIL released; a Python controller holds it.
-    #[pyo3(signature = (controller=None))]
-    fn run(&self, py: Python<'_>, controller: Option<&Bound<'_, PyAny>>) -> PyResult<Run> {
+    /// `disturbance`: None, or a callable f(t, a, a_dot) -> tau_d called at every controller
+    /// sample with the time (s) and the true modal state (numpy arrays of shape (m,)), returning
+    /// the external joint torques (N m, shape (n,), one per joint: a push on the arm) that act
+    /// until the next sample, or None for none. The loop adds their modal force J^T tau_d to the
+    /// controller's tau_star; the recorded tau_star stays the controller's and the recorded
+    /// joint torques are the actuators' (the push subtracted). Its exceptions and bad return
+    /// values are raised as a controller's are.
+    ///
+    /// Built-in controllers run with the GIL released; a Python controller or disturbance holds
+    /// it when it is called.
+    #[pyo3(signature = (controller=None, disturbance=None))]
+    fn run(
+        &self,
+        py: Python<'_>,
+        controller: Option<&Bound<'_, PyAny>>,
+        disturbance: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Run> {
         let mut scenario = self.get();
         let choice = Choice::read(controller)?;
+        let mut hooks = match disturbance {
+            None => None,
+            Some(f) if f.is_none() => None,
+            Some(f) if f.is_callable() => Some(PythonDisturbance {
+                function: f.clone().unbind(),
+                n: scenario.model().map_err(Error::from)?.n_links(),
+                raised: None,
+            }),
+            Some(f) => {
+                return Err(Error::input(format!(
+                    "disturbance must be None or a callable f(t, a, a_dot) -> tau, got {}",
+                    f.get_type().name()?
+                ))
+                .into());
+            }
+        };
+        let run = |simulation: &mut sim_core::Simulation, hooks: &mut Option<PythonDisturbance>| {
+            match hooks {
+                Some(hooks) => simulation.run_with(hooks),
+                None => simulation.run(),
+            }
+        };
         let (result, label) = match choice {
             Some(Choice::Python(function)) => {
                 let raised = Arc::new(Mutex::new(None));
@@ -636,7 +730,7 @@ impl Scenario {
                 let mut simulation = scenario
                     .build_with_controller(Box::new(controller))
                     .map_err(Error::from)?;
-                let result = simulation.run();
+                let result = run(&mut simulation, &mut hooks);
                 if let Some(error) = raised
                     .lock()
                     .unwrap_or_else(|poisoned| poisoned.into_inner())
@@ -652,11 +746,14 @@ impl Scenario {
                 }
                 let mut simulation = scenario.build().map_err(Error::from)?;
                 (
-                    py.detach(|| simulation.run()),
+                    py.detach(|| run(&mut simulation, &mut hooks)),
                     scenario.controller.kind.name(),
                 )
             }
         };
+        if let Some(error) = hooks.and_then(|hooks| hooks.raised) {
+            return Err(error);
+        }
         let result = result.map_err(|failure| Stopped {
             error: failure.error.to_string(),
             partial: Some(sim_core::Run {
@@ -722,10 +819,7 @@ impl Run {
         controller: &str,
         result: Result<sim_core::Run, Stopped>,
     ) -> PyResult<Self> {
-        let json = sim_study::summary_json::run(&result).to_string();
-        let summary = py
-            .import("json")?
-            .call_method1("loads", (json,))?
+        let summary = crate::value::to_py(py, &sim_study::summary_json::run(&result))?
             .cast_into::<PyDict>()?
             .unbind();
         let (run, failure) = match result {
