@@ -1,5 +1,6 @@
 #![doc = include_str!("../README.md")]
 
+mod chain_loop;
 pub mod controller;
 mod error;
 mod noise;
@@ -12,6 +13,7 @@ mod simulation;
 /// have ([`backbone_kin::MAX_HARMONICS`]).
 pub const MAX_COORDINATES: usize = 2 * backbone_kin::MAX_HARMONICS + 1;
 
+pub use chain_loop::{ChainLoopSettings, ChainRecord, ChainRun, ChainSummary, run_chain_loop};
 pub use error::{ControllerFailure, SimError, check_finite};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use simulation::{

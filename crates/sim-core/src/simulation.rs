@@ -665,7 +665,7 @@ impl Simulation {
             t,
             measured: &sample.measured,
             reference: &sample.command,
-            model: &self.plant.model,
+            model: (&*self.plant.model).into(),
             tau_star_limits: self.settings.tau_star_limits.as_deref(),
         };
         self.controller

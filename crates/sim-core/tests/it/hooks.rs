@@ -5,6 +5,7 @@
 //! lock-step group with hooks gives each run with its hooks alone.
 
 use backbone_kin::ModalMap;
+use lane_math::Classify;
 use manip_dyn::ChainModel;
 use modal_reduce::{ReducedData, ReducedModel};
 use sim_core::controller::{ControlContext, Controller, ControllerError, ModalState, PdController};

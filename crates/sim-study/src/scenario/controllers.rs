@@ -302,7 +302,7 @@ impl ControllerSpec {
     }
 
     /// The computed-torque gains `kp`, `kd` for `m` coordinates (defaults where not given).
-    fn computed_torque_gains(&self, m: usize) -> Result<(Vec<f64>, Vec<f64>), SimError> {
+    pub(super) fn computed_torque_gains(&self, m: usize) -> Result<(Vec<f64>, Vec<f64>), SimError> {
         let gains = |name: &str, values: &Option<Vec<f64>>, default: f64| {
             per_coordinate(name, values.as_deref(), m)
                 .map(|v| v.unwrap_or_else(|| vec![default; m]))

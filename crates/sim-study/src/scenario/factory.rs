@@ -13,8 +13,9 @@ use modal_reduce::ReducedModel;
 use sim_core::controller::{Controller, ModalState};
 use sim_core::ode::Tolerances;
 use sim_core::reference::{CartesianPath, PathShape, Sinusoid, Step};
-use sim_core::{Integrator, LoopSettings, Prepared, ReferenceFactory, SimError};
+use sim_core::{ControllerFactory, Integrator, LoopSettings, Prepared, ReferenceFactory, SimError};
 use sim_core::{RunNoise, Simulation};
+use std::sync::Arc;
 
 impl Scenario {
     /// The reduced model of the arm with the scenario's modal family. Refuses a family with no
@@ -75,6 +76,20 @@ impl Scenario {
     /// for one run.
     pub fn build(&self) -> Result<Simulation, SimError> {
         let prepared = self.prepare()?;
+        prepared.simulation(&prepared.settings().noise())
+    }
+
+    /// Builds the simulation as [`build`](Self::build) does, with every controller the
+    /// prepared simulation makes passed through `wrap` (e.g. a wrapper that stops the run when a
+    /// Python user presses Ctrl-C).
+    pub fn build_wrapping(
+        &self,
+        wrap: impl Fn(Box<dyn Controller>) -> Box<dyn Controller> + Send + Sync + 'static,
+    ) -> Result<Simulation, SimError> {
+        let (model, reference, controller, settings, initial) =
+            self.assemble(None, |setup| setup.prepare())?;
+        let controller: ControllerFactory = Arc::new(move || controller().map(&wrap));
+        let prepared = Prepared::new(model, reference, controller, settings, initial)?;
         prepared.simulation(&prepared.settings().noise())
     }
 
@@ -203,6 +218,13 @@ impl ArmSpec {
     /// agree, and the arm has between 1 and [`manip_dyn::MAX_LINKS`] links, checked before any
     /// per-link array is allocated.
     pub fn to_chain(&self) -> Result<ChainModel, SimError> {
+        if self.urdf.is_some() {
+            return Err(SimError::setting(
+                "arm.urdf",
+                "names a spatial chain, which runs only in the joint-space loop \
+                 (Scenario::run_chain, as `hrm simulate` runs it), not as a planar arm",
+            ));
+        }
         let mut n = self.links;
         for (name, array) in [
             ("arm.lengths", &self.lengths),
@@ -280,7 +302,7 @@ impl ReferenceSpec {
     /// The reference of `m` coordinates for a curve of length `length` with `harmonics`
     /// harmonics and base angle `alpha0`, built once (a path's inverse kinematics solved
     /// once), and cloned for each run.
-    fn build(
+    pub(super) fn build(
         &self,
         length: f64,
         harmonics: usize,

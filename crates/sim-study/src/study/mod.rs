@@ -34,26 +34,28 @@
 mod aggregate;
 mod comparison;
 mod inputs;
+mod outcome;
 mod plan;
 mod shard_file;
 
 pub use aggregate::{Cell, CellBuilder, FailedRun, MAX_LISTED_FAILURES, Stats, cells};
-pub use comparison::{ComparisonRun, Stopped, builtin_scenarios, compare, run_one, run_prepared};
+pub use comparison::{ComparisonRun, builtin_scenarios, compare, run_one, run_prepared};
 pub use inputs::{
     InputDigest, SCENARIO_INPUT, check_digests, check_json_safe, first_changed, input_digests,
 };
+pub use outcome::{RunError, RunOutcome, Stopped, run_scenario};
 pub use plan::{
     MAX_RUNS, MAX_SHARDS, RunId, SettingError, Shard, SweepConfig, SweepSettings, run_seed,
 };
 pub use shard_file::{
-    FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, Outcome, RunMetrics, RunResult, ShardFile,
-    ShardHeader, ShardInput, ShardReader, ShardSource, merge, merge_readers, shard_paths,
+    FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, RunMetrics, RunResult, ShardFile, ShardHeader,
+    ShardInput, ShardReader, ShardSource, StoredOutcome, merge, merge_readers, shard_paths,
     write_json_line,
 };
 
 use crate::{ControllerKind, IntegratorSpec};
 use rayon::prelude::*;
-use sim_core::{Prepared, Run, RunFailure, SimError};
+use sim_core::{Prepared, SimError};
 use std::io::Write;
 
 /// Runs run in parallel before their results are passed on in index order: enough to keep
@@ -68,20 +70,20 @@ pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 /// once).
 pub fn execute(config: &SweepConfig, id: &RunId) -> RunResult {
     let outcome = match config.prepare(id.controller) {
-        Err(e) => build_failure(&e),
+        Err(e) => StoredOutcome::of(Err(Stopped::not_built(e))),
         Ok(prepared) => run_alone(config, &prepared, id),
     };
     RunResult::new(id, outcome)
 }
 
 /// Runs run `id` of `config` alone from its controller's prepared simulation.
-fn run_alone(config: &SweepConfig, prepared: &Prepared, id: &RunId) -> Outcome {
+fn run_alone(config: &SweepConfig, prepared: &Prepared, id: &RunId) -> StoredOutcome {
     match config
         .run_noise(id)
         .and_then(|noise| prepared.simulation(&noise))
     {
-        Err(e) => build_failure(&e),
-        Ok(mut simulation) => outcome(simulation.run()),
+        Err(e) => StoredOutcome::of(Err(Stopped::not_built(e))),
+        Ok(mut simulation) => StoredOutcome::of(simulation.run().map_err(Stopped::from)),
     }
 }
 
@@ -108,7 +110,7 @@ fn execute_prepared(
         Err(e) => {
             return ids
                 .iter()
-                .map(|id| RunResult::new(id, build_failure(e)))
+                .map(|id| RunResult::new(id, StoredOutcome::of(Err(Stopped::not_built(e.clone())))))
                 .collect();
         }
     };
@@ -121,38 +123,13 @@ fn execute_prepared(
         Ok(mut group) => ids
             .iter()
             .zip(group.run())
-            .map(|(id, run)| RunResult::new(id, outcome(run)))
+            .map(|(id, run)| RunResult::new(id, StoredOutcome::of(run.map_err(Stopped::from))))
             .collect(),
         // A run that cannot be built fails alone.
         Err(_) => ids
             .iter()
             .map(|id| RunResult::new(id, run_alone(config, prepared, id)))
             .collect(),
-    }
-}
-
-/// The outcome of a run that could not be built.
-fn build_failure(error: &dyn std::fmt::Display) -> Outcome {
-    Outcome::Failed {
-        error: error.to_string(),
-        simulated_s: 0.0,
-    }
-}
-
-/// The summary metrics of a run that completed, or why and when it stopped.
-fn outcome(run: Result<Run, Box<RunFailure>>) -> Outcome {
-    match run {
-        Ok(run) => match RunMetrics::from_summary(&run.summary) {
-            Ok(metrics) => Outcome::Completed(metrics),
-            Err(error) => Outcome::Failed {
-                error,
-                simulated_s: run.summary.simulated_s,
-            },
-        },
-        Err(failure) => Outcome::Failed {
-            error: failure.error.to_string(),
-            simulated_s: failure.summary.simulated_s,
-        },
     }
 }
 
@@ -193,6 +170,18 @@ pub fn for_each_run(
     config: &SweepConfig,
     shard: Shard,
     progress: impl Fn() + Sync,
+    sink: impl FnMut(RunResult) -> Result<(), String>,
+) -> Result<(), String> {
+    for_each_run_until(config, shard, progress, || false, sink)
+}
+
+/// [`for_each_run`], checking `stop` before each lock-step group: once it returns true, no
+/// further group starts and the call fails with [`STOPPED`] (a Python caller's Ctrl-C).
+pub fn for_each_run_until(
+    config: &SweepConfig,
+    shard: Shard,
+    progress: impl Fn() + Sync,
+    stop: impl Fn() -> bool + Sync,
     mut sink: impl FnMut(RunResult) -> Result<(), String>,
 ) -> Result<(), String> {
     let mut indices = shard.indices(config.runs().unwrap_or(0));
@@ -213,6 +202,9 @@ pub fn for_each_run(
         let mut results: Vec<RunResult> = groups
             .par_iter()
             .flat_map_iter(|ids| {
+                if stop() {
+                    return Vec::new();
+                }
                 let (_, prepared) = prepared
                     .iter()
                     .find(|(kind, _)| *kind == ids[0].controller)
@@ -222,26 +214,44 @@ pub fn for_each_run(
                 results
             })
             .collect();
+        if stop() {
+            return Err(STOPPED.to_string());
+        }
         results.sort_unstable_by_key(|run| run.index);
         results.into_iter().try_for_each(&mut sink)?;
     }
 }
 
+/// The error of [`for_each_run_until`] and [`run_shard_until`] when `stop` ended the runs.
+pub const STOPPED: &str = "the sweep was stopped before all its runs were done";
+
 /// Runs the runs of `shard` and keeps them in memory (see [`write_shard`] to stream them to a
 /// file); the results are in index order. [`Shard::WHOLE`] runs the whole sweep.
 pub fn run_shard(config: &SweepConfig, shard: Shard, progress: impl Fn() + Sync) -> ShardFile {
+    run_shard_until(config, shard, progress, || false)
+        .expect("pushing to a vector cannot fail and nothing stops the runs")
+}
+
+/// [`run_shard`], checking `stop` before each lock-step group ([`for_each_run_until`]): `None`
+/// once it returned true.
+pub fn run_shard_until(
+    config: &SweepConfig,
+    shard: Shard,
+    progress: impl Fn() + Sync,
+    stop: impl Fn() -> bool + Sync,
+) -> Option<ShardFile> {
     let mut runs = Vec::with_capacity(shard.run_count(config.runs().unwrap_or(0)));
-    let pushed: Result<(), String> = for_each_run(config, shard, progress, |run| {
+    for_each_run_until(config, shard, progress, stop, |run| {
         runs.push(run);
         Ok(())
-    });
-    debug_assert!(pushed.is_ok(), "pushing to a vector cannot fail");
-    ShardFile {
+    })
+    .ok()?;
+    Some(ShardFile {
         format: FORMAT.into(),
         config: config.clone(),
         shard,
         runs,
-    }
+    })
 }
 
 /// Runs the runs of `shard` and writes its shard file to `out` as they finish (the header, then
@@ -259,7 +269,7 @@ pub fn write_shard<W: Write + ?Sized>(
     let (mut runs, mut stopped) = (0, 0);
     for_each_run(config, shard, progress, |run| {
         runs += 1;
-        stopped += usize::from(matches!(run.outcome, Outcome::Failed { .. }));
+        stopped += usize::from(matches!(run.outcome, StoredOutcome::Failed { .. }));
         write_json_line(out, &run)
     })?;
     let now = input_digests(&config.scenario)?;

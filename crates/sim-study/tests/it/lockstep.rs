@@ -371,7 +371,7 @@ fn a_sweep_in_lock_step_gives_every_run_as_run_alone() {
         for (run, i) in whole.runs.iter().zip(indices) {
             let alone = study::execute(&config, &config.run_at(i));
             assert_eq!(exact(run), exact(&alone), "run {i}");
-            failed += usize::from(matches!(run.outcome, study::Outcome::Failed { .. }));
+            failed += usize::from(matches!(run.outcome, study::StoredOutcome::Failed { .. }));
         }
         assert!(failed > 0, "some runs must stop mid-way");
     }
