@@ -36,10 +36,11 @@ pub fn run_one(scenario: &Scenario, kind: ControllerKind) -> ComparisonRun {
 /// prepared by [`Scenario::prepare`] or [`Scenario::prepare_with_system`], or the error that
 /// refused it.
 pub fn run_prepared(scenario: &Scenario, prepared: Result<Prepared, SimError>) -> ComparisonRun {
-    let result = prepared
-        .and_then(|prepared| prepared.simulation(&prepared.settings().noise()))
-        .map_err(Stopped::not_built)
-        .and_then(|mut simulation| Ok(simulation.run()?));
+    let result =
+        match prepared.and_then(|prepared| prepared.simulation(&prepared.settings().noise())) {
+            Err(error) => Err(Stopped::not_built(error)),
+            Ok(mut simulation) => simulation.run().map_err(Stopped::from),
+        };
     ComparisonRun {
         scenario: scenario.name.clone(),
         controller: scenario.controller.kind,
