@@ -6,7 +6,7 @@ use crate::{console, figures, progress, report};
 use serde_json::json;
 use sim_core::Run;
 use sim_study::imitation::{self, ImitationOptions};
-use sim_study::study::{self, ComparisonRun, run_one};
+use sim_study::study::{self, ComparisonRun, run_one, run_prepared};
 use sim_study::{ControllerKind, ReferenceSpec, Scenario};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -134,8 +134,8 @@ const LEARNED_ON: &str = "paper-tracking";
 /// The learned controller's runs: if `scenarios` holds [`LEARNED_ON`], a fuzzy controller learned
 /// by imitation of computed torque on the shipped step and sine responses about a grid of
 /// operating points ([`paper_demonstrations`](imitation::paper_demonstrations), default
-/// [`ImitationOptions`]) is written to `out/learned.fis` and run on it; its files go to
-/// `out/<scenario>/learned`.
+/// [`ImitationOptions`]) is written to `out/learned.fis` and run, from memory, on it; its files
+/// go to `out/<scenario>/learned`.
 fn learned_runs(out: &Path, scenarios: &[Scenario]) -> Result<Vec<ComparisonRun>, String> {
     let targets: Vec<&Scenario> = scenarios.iter().filter(|s| s.name == LEARNED_ON).collect();
     if targets.is_empty() {
@@ -149,8 +149,11 @@ fn learned_runs(out: &Path, scenarios: &[Scenario]) -> Result<Vec<ComparisonRun>
     let mut runs = Vec::with_capacity(targets.len());
     for target in targets {
         let mut scenario = target.clone();
+        scenario.controller.kind = ControllerKind::Fuzzy;
         scenario.controller.fis = Some(file.clone());
-        let outcome = run_one(&scenario, ControllerKind::Fuzzy);
+        // The learned system as learned, not read back from its file (the same numbers: a
+        // `.fis` file holds every number in its shortest exact form).
+        let outcome = run_prepared(&scenario, scenario.prepare_with_system(&learned.system));
         // The run's scenario.toml names the learned system relative to itself.
         let mut written = scenario.clone();
         written.controller.fis = Some(Path::new("../..").join(format!("{LEARNED}.fis")));

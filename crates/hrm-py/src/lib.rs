@@ -11,6 +11,7 @@ mod reduced;
 mod scenario;
 mod spatial;
 mod sweep;
+mod value;
 
 use pyo3::prelude::*;
 

@@ -16,7 +16,8 @@ use numpy::{IntoPyArray, PyArray1};
 use pyo3::exceptions::{PyAttributeError, PyFileNotFoundError, PyOSError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
-use sim_core::controller::{ControlContext, Controller, ControllerError};
+use sim_core::LoopHooks;
+use sim_core::controller::{ControlContext, Controller, ControllerError, ModalState};
 use sim_study::study::{RunOutcome, Stopped};
 use sim_study::{ControllerKind, ScenarioError};
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -620,6 +621,63 @@ impl Controller for PythonController {
     }
 }
 
+/// A Python callable `f(t, a, a_dot) -> tau_d` as the loop's disturbance hook: the external
+/// joint torques (N m, one per joint) acting from the controller sample at `t` to the next, or
+/// `None` for none. An exception it raises, or a return value that is not `n` finite numbers,
+/// is kept in `raised` and ends the run (its torque is made non-finite, which stops the loop);
+/// `Scenario.run` then raises it as it is.
+struct PythonDisturbance {
+    function: Py<PyAny>,
+    n: usize,
+    raised: Option<PyErr>,
+}
+
+impl PythonDisturbance {
+    fn call(&self, py: Python<'_>, t: f64, state: &ModalState, tau: &mut [f64]) -> PyResult<bool> {
+        let out = self.function.bind(py).call1((
+            t,
+            PyArray1::from_slice(py, &state.a),
+            PyArray1::from_slice(py, &state.a_dot),
+        ))?;
+        if out.is_none() {
+            return Ok(false);
+        }
+        let context = |message: String| {
+            Error::input(format!(
+                "the disturbance's return value at t = {t} s: {message}"
+            ))
+        };
+        let values = States::read(&out, "tau", self.n).map_err(|e| {
+            let message = e.value(py).str().map(|s| s.to_string()).unwrap_or_default();
+            PyErr::from(context(message))
+        })?;
+        if values.is_batch() {
+            return Err(context(format!("tau must have shape ({},), got a batch", self.n)).into());
+        }
+        let values = values.values();
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(NumericalError::new_err(format!(
+                "the disturbance returned a non-finite joint torque {values:?} at t = {t} s"
+            )));
+        }
+        tau.copy_from_slice(values);
+        Ok(true)
+    }
+}
+
+impl LoopHooks for PythonDisturbance {
+    fn disturbance(&mut self, t: f64, state: &ModalState, tau: &mut [f64]) -> bool {
+        match Python::attach(|py| self.call(py, t, state, tau)) {
+            Ok(applied) => applied,
+            Err(error) => {
+                self.raised = Some(error);
+                tau.fill(f64::NAN);
+                true
+            }
+        }
+    }
+}
+
 #[pymethods]
 impl Scenario {
     /// A scenario shipped with hrm, by name (Scenario.builtin_names()): "paper-tracking"
@@ -735,13 +793,48 @@ impl Scenario {
     /// runs. A run that diverges (runaway tracking error, integrator failure) returns a Run
     /// whose `failure` says when and why, with the data up to the stop.
     ///
+    /// `disturbance`: None, or a callable f(t, a, a_dot) -> tau_d called at every controller
+    /// sample with the time (s) and the true modal state (numpy arrays of shape (m,)), returning
+    /// the external joint torques (N m, shape (n,), one per joint: a push on the arm) that act
+    /// until the next sample, or None for none. The loop adds their modal force J^T tau_d to the
+    /// controller's tau_star; the recorded tau_star stays the controller's and the recorded
+    /// joint torques are the actuators' (the push subtracted). Its exceptions and bad return
+    /// values are raised as a controller's are.
+    ///
     /// Built-in controllers run with the GIL released, and Ctrl-C stops them within 0.05 s
     /// (KeyboardInterrupt); a Python controller holds the GIL, and Ctrl-C interrupts it as any
-    /// Python code.
-    #[pyo3(signature = (controller=None))]
-    fn run(&self, py: Python<'_>, controller: Option<&Bound<'_, PyAny>>) -> PyResult<Run> {
+    /// Python code. A Python disturbance takes the GIL when it is called.
+    #[pyo3(signature = (controller=None, disturbance=None))]
+    fn run(
+        &self,
+        py: Python<'_>,
+        controller: Option<&Bound<'_, PyAny>>,
+        disturbance: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Run> {
         let mut scenario = self.get();
         let choice = Choice::read(controller)?;
+        let mut hooks = match disturbance {
+            None => None,
+            Some(f) if f.is_none() => None,
+            Some(f) if f.is_callable() => Some(PythonDisturbance {
+                function: f.clone().unbind(),
+                n: scenario.model().map_err(Error::from)?.n_links(),
+                raised: None,
+            }),
+            Some(f) => {
+                return Err(Error::input(format!(
+                    "disturbance must be None or a callable f(t, a, a_dot) -> tau, got {}",
+                    f.get_type().name()?
+                ))
+                .into());
+            }
+        };
+        let run = |simulation: &mut sim_core::Simulation, hooks: &mut Option<PythonDisturbance>| {
+            match hooks {
+                Some(hooks) => simulation.run_with(hooks),
+                None => simulation.run(),
+            }
+        };
         let (result, label) = match choice {
             Some(Choice::Python(function)) => {
                 let raised = Arc::new(Mutex::new(None));
@@ -753,7 +846,7 @@ impl Scenario {
                 let mut simulation = scenario
                     .build_with_controller(Box::new(controller))
                     .map_err(Error::from)?;
-                let result = simulation.run();
+                let result = run(&mut simulation, &mut hooks);
                 if let Some(error) = raised
                     .lock()
                     .unwrap_or_else(|poisoned| poisoned.into_inner())
@@ -778,11 +871,14 @@ impl Scenario {
                     })
                     .map_err(Error::from)?;
                 (
-                    pool::run(py, &cancel, || simulation.run())?,
+                    pool::run(py, &cancel, || run(&mut simulation, &mut hooks))?,
                     scenario.controller.kind.name(),
                 )
             }
         };
+        if let Some(error) = hooks.and_then(|hooks| hooks.raised) {
+            return Err(error);
+        }
         let result = result.map_err(Stopped::from);
         Run::new(py, &scenario, label, result)
     }
@@ -818,8 +914,9 @@ pub fn view_html(scene: &str) -> PyResult<String> {
 pub struct Run {
     /// The time series, read-only numpy arrays.
     arrays: [Py<PyAny>; 8],
-    /// The summary as JSON text: each read of `summary` parses a fresh dict.
-    summary: String,
+    /// The summary (`sim_study::summary_json::run`): each read of `summary` builds a fresh dict
+    /// from it.
+    summary: serde_json::Value,
     failure: Option<String>,
     controller: String,
     coordinates: Vec<String>,
@@ -844,7 +941,7 @@ impl Run {
         controller: &str,
         result: RunOutcome,
     ) -> PyResult<Self> {
-        let summary = sim_study::summary_json::run(&result).to_string();
+        let summary = sim_study::summary_json::run(&result);
         let (run, failure) = match result {
             Ok(run) => (run, None),
             Err(Stopped {
@@ -892,7 +989,7 @@ impl Run {
     fn assemble(
         py: Python<'_>,
         arrays: [Py<PyAny>; 8],
-        summary: String,
+        summary: serde_json::Value,
         failure: Option<String>,
         controller: String,
         coordinates: Vec<String>,
@@ -970,10 +1067,7 @@ impl Run {
     /// copy at each read).
     #[getter]
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        Ok(py
-            .import("json")?
-            .call_method1("loads", (&self.summary,))?
-            .cast_into::<PyDict>()?)
+        Ok(crate::value::to_py(py, &self.summary)?.cast_into::<PyDict>()?)
     }
 
     /// `pickle` and `copy.deepcopy` support: the run rebuilt from its arrays, summary, failure,
@@ -998,11 +1092,12 @@ impl Run {
         let py = slf.py();
         let run = slf.get();
         let view = serde_json::to_string(&run.view).map_err(|e| Error::input(e.to_string()))?;
+        let summary = run.summary.to_string();
         Ok((
             slf.get_type().getattr("_restore")?,
             (
                 run.arrays.iter().map(|a| a.clone_ref(py)).collect(),
-                run.summary.clone(),
+                summary,
                 run.failure.clone(),
                 run.controller.clone(),
                 run.coordinates.clone(),
@@ -1032,6 +1127,8 @@ impl Run {
             .try_into()
             .map_err(|_| Error::input("a run has 8 arrays"))?;
         let view = serde_json::from_str(view).map_err(|e| Error::input(format!("view: {e}")))?;
+        let summary =
+            serde_json::from_str(&summary).map_err(|e| Error::input(format!("summary: {e}")))?;
         Self::assemble(py, arrays, summary, failure, controller, coordinates, view)
     }
 

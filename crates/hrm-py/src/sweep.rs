@@ -34,16 +34,17 @@ fn input(message: String) -> PyErr {
     Error::input(message).into()
 }
 
-/// `text` (a summary or shard file) as Python objects, through the `json` module.
+/// `text` (a sweep's configuration as JSON) as Python objects, through the `json` module (which
+/// keeps the order of its keys).
 fn json_to_py<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
     py.import("json")?.call_method1("loads", (text,))
 }
 
-/// The `summary.json` of a whole sweep (`hrm sweep`'s), as a dict.
+/// The `summary.json` of a whole sweep (`hrm sweep`'s), as a dict built directly.
 fn summary<'py>(py: Python<'py>, whole: &ShardFile) -> PyResult<Bound<'py, PyDict>> {
     let cells = study::cells(&whole.config, &whole.runs);
-    let text = sim_study::summary_json::sweep(&whole.config, &cells).to_string();
-    Ok(json_to_py(py, &text)?.cast_into::<PyDict>()?)
+    let value = sim_study::summary_json::sweep(&whole.config, &cells);
+    Ok(crate::value::to_py(py, &value)?.cast_into::<PyDict>()?)
 }
 
 /// A shard `index` of `count`, checked as `hrm sweep --shard K/N` checks it.

@@ -218,6 +218,66 @@ def test_a_controller_may_return_lists_and_float32():
     assert np.array_equal(a.a, b.a) and np.all(a.tau_star == [0.5, -0.25])
 
 
+def paper_jacobian():
+    """J of the paper's arm (10 links of 0.1 m and 0.1 kg, K = 1, alpha0 = pi/2), shape (10, 2)."""
+    arm = hrm.Arm(links=10, link_length=0.1, link_mass=0.1)
+    return hrm.ReducedModel(arm, harmonics=1, alpha0=np.pi / 2).jacobian
+
+
+def test_a_disturbance_is_its_modal_force_added_to_the_controllers():
+    scenario = short_step(0.1)
+    tau_d = 0.02 * (np.arange(10) - 3.5)
+    force = paper_jacobian().T @ tau_d
+
+    def pd(t, a, a_dot, ref):
+        return -400.0 * (a - ref.a) - 20.0 * a_dot
+
+    seen = []
+
+    def push(t, a, a_dot):
+        seen.append((t, a.copy()))
+        return tau_d if t >= 0.05 else None
+
+    pushed = scenario.run(pd, disturbance=push)
+    added = scenario.run(lambda t, a, a_dot, ref: pd(t, a, a_dot, ref) + (force if t >= 0.05 else 0.0))
+    plain = scenario.run(pd)
+    np.testing.assert_allclose(pushed.a, added.a, rtol=1e-12, atol=1e-15)
+    after = pushed.t > 0.05 + 1e-9
+    assert np.array_equal(pushed.a[~after], plain.a[~after]) and not np.allclose(pushed.a[after], plain.a[after])
+    # The recorded joint torques are the actuators': the push subtracted.
+    pushing = (pushed.t >= 0.05 - 1e-12)[:, None]
+    np.testing.assert_allclose(pushed.joint_torques + pushing * tau_d, added.joint_torques, rtol=1e-9, atol=1e-12)
+    # Called once per controller sample, in order, with the true state.
+    assert len(seen) == pushed.summary["controller_samples"]
+    assert np.all(np.diff([t for t, _ in seen]) > 0)
+    recorded = {round(t, 9): i for i, t in enumerate(pushed.t)}
+    for t, a in seen:
+        if round(t, 9) in recorded:
+            assert np.array_equal(a, pushed.a[recorded[round(t, 9)]])
+    # With a built-in controller too, and a disturbance of None changes nothing.
+    assert scenario.run("pd", disturbance=lambda t, a, a_dot: None).summary == scenario.run("pd").summary
+    assert scenario.run("pd", disturbance=push).summary != scenario.run("pd").summary
+
+
+def test_a_disturbance_raising_or_returning_nonsense_is_a_clear_error():
+    class Slipped(RuntimeError):
+        pass
+
+    def slipping(t, a, a_dot):
+        if t >= 0.01:
+            raise Slipped("slipped")
+        return None
+
+    with pytest.raises(Slipped, match="slipped"):
+        short_step(0.05).run("pd", disturbance=slipping)
+    with pytest.raises(hrm.InvalidInput, match=r"disturbance's return value at t = 0 s: tau has 2 entries, expected 10"):
+        short_step(0.05).run(disturbance=lambda t, a, a_dot: np.zeros(2))
+    with pytest.raises(hrm.NumericalError, match="non-finite joint torque"):
+        short_step(0.05).run(disturbance=lambda t, a, a_dot: np.full(10, np.inf))
+    with pytest.raises(hrm.InvalidInput, match="disturbance must be None or a callable"):
+        short_step(0.05).run(disturbance=3.0)
+
+
 def test_a_run_that_diverges_keeps_its_data_up_to_the_stop():
     scenario = short_step(0.5)
     scenario.limits.max_modal_error = 0.05

@@ -201,6 +201,7 @@ class ReferenceSample:
         """Desired accelerations (rad/s^2), shape (m,)."""
 
 ControllerFunction = Callable[[float, Array, Array, ReferenceSample], ArrayLike]
+DisturbanceFunction = Callable[[float, Array, Array], Optional[ArrayLike]]
 
 class Run:
     """The result of Scenario.run: time series (one row per recorded sample) and summary."""
@@ -342,9 +343,14 @@ class Scenario:
     @property
     def coordinate_names(self) -> List[str]:
         """a1, ..., a2K, then alpha0 when it is free."""
-    def run(self, controller: Union[None, str, ControllerFunction] = None) -> Run:
+    def run(
+        self,
+        controller: Union[None, str, ControllerFunction] = None,
+        disturbance: Optional[DisturbanceFunction] = None,
+    ) -> Run:
         """Runs the closed loop with the scenario's controller, a built-in one by name, or a
-        Python callable f(t, a, a_dot, ref) -> tau_star."""
+        Python callable f(t, a, a_dot, ref) -> tau_star; `disturbance` f(t, a, a_dot) -> tau_d
+        (joint torques, shape (n,), or None) pushes the arm between controller samples."""
 
 class Sweep:
     """A Monte Carlo sweep over noise levels and seeds (hrm sweep), whole or by shards."""

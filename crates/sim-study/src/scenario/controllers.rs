@@ -49,6 +49,9 @@ pub struct ControllerSetup<'a> {
     pub period: f64,
     /// The loop's reference (MPC previews a copy of it).
     pub reference: &'a ReferenceFactory,
+    /// A fuzzy system given in memory (e.g. one just learned), used instead of the `.fis` file
+    /// `spec.fis` names or the paper's; `None` for those.
+    pub system: Option<&'a FuzzySystem>,
 }
 
 /// A row of the controller table: a controller's name, what it is, and how a scenario builds it.
@@ -64,6 +67,15 @@ pub struct ControllerEntry {
 }
 
 impl ControllerSetup<'_> {
+    /// The fuzzy system: the one given in memory, else the `.fis` file if given, else the
+    /// paper's.
+    fn fuzzy_system(&self) -> Result<FuzzySystem, SimError> {
+        match self.system {
+            Some(system) => Ok(system.clone()),
+            None => self.spec.fuzzy_system(),
+        }
+    }
+
     /// The controller of `spec.kind` for the model, prepared for any number of runs: checks
     /// every per-coordinate gain array of `spec` (whichever controller uses it) to have `m`
     /// entries, then calls the kind's constructor in [`CONTROLLERS`].
@@ -94,7 +106,7 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         description: "the paper's fuzzy controller (eqs 19-24), or the .fis system given",
         prepare: |s| {
             Ok(Prepared::controller_clones(
-                FuzzyController::new(s.spec.fuzzy_system()?, m(s))?
+                FuzzyController::new(s.fuzzy_system()?, m(s))?
                     .with_out_of_range(s.spec.out_of_range.unwrap_or_default().into())?,
             ))
         },
@@ -105,7 +117,7 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         description: "PD: the fuzzy controller's slope at the origin, or the pd_kp, pd_kd gains",
         prepare: |s| {
             let m = m(s);
-            let slope = PdController::from_fuzzy_slope(&s.spec.fuzzy_system()?, m)?;
+            let slope = PdController::from_fuzzy_slope(&s.fuzzy_system()?, m)?;
             let kp = per_coordinate("controller.pd_kp", s.spec.pd_kp.as_deref(), m)?
                 .unwrap_or_else(|| slope.kp().to_vec());
             let kd = per_coordinate("controller.pd_kd", s.spec.pd_kd.as_deref(), m)?
@@ -133,7 +145,7 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         name: "fuzzy-gc",
         description: "the fuzzy controller plus gravity compensation G*",
         prepare: |s| {
-            let fuzzy = FuzzyController::new(s.spec.fuzzy_system()?, m(s))?
+            let fuzzy = FuzzyController::new(s.fuzzy_system()?, m(s))?
                 .with_out_of_range(s.spec.out_of_range.unwrap_or_default().into())?;
             Ok(Prepared::controller_clones(
                 fuzzy.with_gravity_compensation(s.model)?,

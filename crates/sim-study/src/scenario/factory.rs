@@ -7,6 +7,7 @@ use super::schema::{
     Scenario, TorqueLimit,
 };
 use backbone_kin::{Branch, ModalMap};
+use fuzzy_sugeno::FuzzySystem;
 use manip_dyn::{ChainModel, Link};
 use modal_reduce::ReducedModel;
 use sim_core::controller::{Controller, ModalState};
@@ -57,7 +58,17 @@ impl Scenario {
     /// are the prepared settings' ([`run_noise`](Self::run_noise) gives them).
     pub fn prepare(&self) -> Result<Prepared, SimError> {
         let (model, reference, controller, settings, initial) =
-            self.assemble(|setup| setup.prepare())?;
+            self.assemble(None, |setup| setup.prepare())?;
+        Prepared::new(model, reference, controller, settings, initial)
+    }
+
+    /// Prepares the simulation as [`prepare`](Self::prepare) does, with the fuzzy system
+    /// `system` (e.g. one just learned, kept in memory) in place of the `.fis` file
+    /// `controller.fis` names or the paper's: the controllers built on a fuzzy system (`fuzzy`,
+    /// `pd`, `fuzzy-gc`) use it, the others ignore it.
+    pub fn prepare_with_system(&self, system: &FuzzySystem) -> Result<Prepared, SimError> {
+        let (model, reference, controller, settings, initial) =
+            self.assemble(Some(system), |setup| setup.prepare())?;
         Prepared::new(model, reference, controller, settings, initial)
     }
 
@@ -76,7 +87,7 @@ impl Scenario {
         wrap: impl Fn(Box<dyn Controller>) -> Box<dyn Controller> + Send + Sync + 'static,
     ) -> Result<Simulation, SimError> {
         let (model, reference, controller, settings, initial) =
-            self.assemble(|setup| setup.prepare())?;
+            self.assemble(None, |setup| setup.prepare())?;
         let controller: ControllerFactory = Arc::new(move || controller().map(&wrap));
         let prepared = Prepared::new(model, reference, controller, settings, initial)?;
         prepared.simulation(&prepared.settings().noise())
@@ -90,7 +101,7 @@ impl Scenario {
         controller: Box<dyn Controller>,
     ) -> Result<Simulation, SimError> {
         let (model, reference, controller, settings, initial) =
-            self.assemble(|_| Ok(controller))?;
+            self.assemble(None, |_| Ok(controller))?;
         Simulation::new(model, reference()?, controller, settings, initial)
     }
 
@@ -100,10 +111,12 @@ impl Scenario {
     }
 
     /// The scenario's parts: the model, a factory of its reference (built once), the
-    /// controller `controller` makes from the setup, the loop's settings and the initial state.
+    /// controller `controller` makes from the setup (with the fuzzy system `system` if given),
+    /// the loop's settings and the initial state.
     #[allow(clippy::type_complexity)]
     fn assemble<C>(
         &self,
+        system: Option<&FuzzySystem>,
         controller: impl FnOnce(&ControllerSetup<'_>) -> Result<C, SimError>,
     ) -> Result<
         (
@@ -138,6 +151,7 @@ impl Scenario {
             model: &model,
             period,
             reference: &reference,
+            system,
         })?;
         let mut settings = LoopSettings::new(self.integrator.build(), period, self.duration);
         settings.record_period = self.record_period.unwrap_or(period);

@@ -1,8 +1,9 @@
 //! The main job's experiment set: every shipped scenario with every controller, in parallel.
 
-use super::outcome::{RunOutcome, run_scenario};
+use super::outcome::{RunOutcome, Stopped};
 use crate::{ControllerKind, Scenario, ScenarioError};
 use rayon::prelude::*;
+use sim_core::{Prepared, SimError};
 
 /// One finished (or stopped) run of a comparison: its scenario, controller, the names of its
 /// modal coordinates and its outcome (the run, or why it could not be built or had to stop).
@@ -27,10 +28,22 @@ pub fn builtin_scenarios() -> Result<Vec<Scenario>, ScenarioError> {
 pub fn run_one(scenario: &Scenario, kind: ControllerKind) -> ComparisonRun {
     let mut scenario = scenario.clone();
     scenario.controller.kind = kind;
-    let result = run_scenario(&scenario);
+    let prepared = scenario.prepare();
+    run_prepared(&scenario, prepared)
+}
+
+/// Runs `scenario` (with its own controller, seed and noise) from `prepared`, its simulation
+/// prepared by [`Scenario::prepare`] or [`Scenario::prepare_with_system`], or the error that
+/// refused it.
+pub fn run_prepared(scenario: &Scenario, prepared: Result<Prepared, SimError>) -> ComparisonRun {
+    let result =
+        match prepared.and_then(|prepared| prepared.simulation(&prepared.settings().noise())) {
+            Err(error) => Err(Stopped::not_built(error)),
+            Ok(mut simulation) => simulation.run().map_err(Stopped::from),
+        };
     ComparisonRun {
         scenario: scenario.name.clone(),
-        controller: kind,
+        controller: scenario.controller.kind,
         coordinates: scenario.coordinate_names(),
         result,
     }

@@ -39,7 +39,7 @@ mod plan;
 mod shard_file;
 
 pub use aggregate::{Cell, CellBuilder, FailedRun, MAX_LISTED_FAILURES, Stats, cells};
-pub use comparison::{ComparisonRun, builtin_scenarios, compare, run_one};
+pub use comparison::{ComparisonRun, builtin_scenarios, compare, run_one, run_prepared};
 pub use inputs::{
     InputDigest, SCENARIO_INPUT, check_digests, check_json_safe, first_changed, input_digests,
 };

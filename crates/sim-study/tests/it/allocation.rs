@@ -79,6 +79,46 @@ fn allocations_do_not_grow_with_the_number_of_steps() {
     }
 }
 
+/// A constant push on the last joint and a running sum of `a1`: hooks that allocate nothing.
+struct PushAndSum {
+    sum: f64,
+}
+
+impl sim_core::LoopHooks for PushAndSum {
+    fn disturbance(
+        &mut self,
+        _t: f64,
+        _state: &sim_core::controller::ModalState,
+        tau: &mut [f64],
+    ) -> bool {
+        tau.fill(0.0);
+        tau[tau.len() - 1] = 0.01;
+        true
+    }
+
+    fn observe(&mut self, sample: &sim_core::ControlSample) {
+        self.sum += sample.state.a[0];
+    }
+}
+
+/// The loop with hooks allocates per run, never per step, as without.
+#[test]
+fn hooks_allocate_nothing_per_step() {
+    assert!(is_counting());
+    let count = |duration: f64| {
+        let mut scenario = Scenario::builtin("paper-tracking").unwrap();
+        scenario.duration = duration;
+        let mut simulation = scenario.build().unwrap();
+        let mut hooks = PushAndSum { sum: 0.0 };
+        let count = allocations_during(|| {
+            simulation.run_with(&mut hooks).unwrap();
+        });
+        assert!(hooks.sum != 0.0);
+        count
+    };
+    assert_eq!(count(0.05), count(0.5));
+}
+
 /// A lock-step group allocates per run, never per step: stepping it by hand allocates nothing,
 /// and a whole run of the group as much for 0.05 s as for 0.5 s.
 #[test]

@@ -186,7 +186,18 @@ fn the_learned_fis_reloads_equal_and_is_a_scenario_controller() {
     let mut scenario = Scenario::builtin("paper-responses-step").unwrap();
     scenario.controller.fis = Some(file.clone());
     scenario.duration = 0.05;
-    assert!(scenario.build().unwrap().run().is_ok());
+    let from_file = scenario.build().unwrap().run().unwrap();
+    // The system kept in memory (the main job's learned row) runs as read from its file, bit for
+    // bit, and needs no file.
+    let in_memory = |scenario: &Scenario| {
+        let prepared = scenario.prepare_with_system(&learned.system).unwrap();
+        let noise = prepared.settings().noise();
+        prepared.simulation(&noise).unwrap().run().unwrap()
+    };
+    assert_eq!(in_memory(&scenario), from_file);
+    let mut no_file = scenario.clone();
+    no_file.controller.fis = Some(file.with_extension("missing"));
+    assert_eq!(in_memory(&no_file), from_file);
     scenario.alpha0 = Alpha0::Free;
     scenario.reference = sim_study::ReferenceSpec::Constant {
         a: vec![0.0, 0.0, 1.5],
