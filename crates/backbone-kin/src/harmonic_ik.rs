@@ -27,6 +27,7 @@ use crate::curve::BackboneCurve;
 use crate::error::KinError;
 use crate::modal_map::check_harmonics;
 use crate::validate::{check_finite, check_len};
+use lane_math::Classify;
 
 /// Stopping rules of [`HarmonicIk::solve`].
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -103,6 +103,7 @@ impl Arm {
             lengths,
             masses,
             inertias,
+            urdf: None,
         };
         let chain = spec.to_chain().map_err(Error::from)?;
         Ok(Self::from_chain(chain))
@@ -142,6 +143,27 @@ impl Arm {
     #[getter]
     fn coms<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.column(|l| l.com).into_pyarray(py)
+    }
+
+    /// A spatial chain read from URDF: `hrm.Chain.from_urdf(urdf, gravity)` (an `hrm.Chain`, the
+    /// class of URDF chains, not a planar `Arm`).
+    #[staticmethod]
+    #[pyo3(signature = (urdf, gravity=[0.0, 0.0, -9.81]))]
+    fn from_urdf(urdf: &Bound<'_, PyAny>, gravity: [f64; 3]) -> PyResult<crate::chain::Chain> {
+        crate::chain::Chain::from_urdf(urdf, gravity)
+    }
+
+    /// The arm as URDF text: joints about z in the base's x-y plane, links along x. URDF has no
+    /// gravity: set it along -y (the arm's) in the engine that reads it.
+    fn to_urdf(&self) -> String {
+        robot_desc::write_urdf(&crate::chain::planar_robot(&self.chain).0)
+    }
+
+    /// The arm as one MJCF document for MuJoCo (as `to_urdf`), its gravity along -y in
+    /// `<option>`.
+    fn to_mjcf(&self) -> PyResult<String> {
+        let (robot, gravity) = crate::chain::planar_robot(&self.chain);
+        crate::chain::mjcf(&robot, gravity)
     }
 
     /// `pickle` and `copy.deepcopy` support: the arm rebuilt from its gravity and per-link

@@ -17,7 +17,7 @@ use pyo3::exceptions::{PyAttributeError, PyFileNotFoundError, PyOSError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use sim_core::controller::{ControlContext, Controller, ControllerError};
-use sim_study::study::Stopped;
+use sim_study::study::{RunOutcome, Stopped};
 use sim_study::{ControllerKind, ScenarioError};
 use std::sync::{Arc, Mutex, MutexGuard};
 
@@ -770,10 +770,10 @@ impl Scenario {
                 let cancel = Cancel::new();
                 let flag = cancel.clone();
                 let mut simulation = scenario
-                    .build_wrapping(|inner| {
+                    .build_wrapping(move |inner| {
                         Box::new(Interruptible {
                             inner,
-                            cancel: flag,
+                            cancel: flag.clone(),
                         })
                     })
                     .map_err(Error::from)?;
@@ -783,13 +783,7 @@ impl Scenario {
                 )
             }
         };
-        let result = result.map_err(|failure| Stopped {
-            error: failure.error.to_string(),
-            partial: Some(sim_core::Run {
-                record: failure.record,
-                summary: failure.summary,
-            }),
-        });
+        let result = result.map_err(Stopped::from);
         Run::new(py, &scenario, label, result)
     }
 }
@@ -848,7 +842,7 @@ impl Run {
         py: Python<'_>,
         scenario: &sim_study::Scenario,
         controller: &str,
-        result: Result<sim_core::Run, Stopped>,
+        result: RunOutcome,
     ) -> PyResult<Self> {
         let summary = sim_study::summary_json::run(&result).to_string();
         let (run, failure) = match result {
@@ -856,11 +850,11 @@ impl Run {
             Err(Stopped {
                 error,
                 partial: Some(run),
-            }) => (run, Some(error)),
+            }) => (run, Some(error.to_string())),
             Err(Stopped {
                 error,
                 partial: None,
-            }) => return Err(Error::input(error).into()),
+            }) => return Err(Error::from(error).into()),
         };
         let view = run_view::Scene {
             title: format!("{} with {controller}", scenario.name),
