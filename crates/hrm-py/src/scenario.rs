@@ -850,7 +850,7 @@ impl Run {
             Err(Stopped {
                 error,
                 partial: Some(run),
-            }) => (run, Some(error.to_string())),
+            }) => (*run, Some(error.to_string())),
             Err(Stopped {
                 error,
                 partial: None,

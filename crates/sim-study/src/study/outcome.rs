@@ -44,7 +44,7 @@ pub struct Stopped {
     pub error: RunError,
     /// The record and the summary up to the stop (what [`RunFailure`] keeps); `None` if the
     /// scenario could not be built.
-    pub partial: Option<Run>,
+    pub partial: Option<Box<Run>>,
 }
 
 impl Stopped {
@@ -73,7 +73,7 @@ impl From<Box<RunFailure>> for Stopped {
         } = *failure;
         Self {
             error: error.into(),
-            partial: Some(Run { record, summary }),
+            partial: Some(Box::new(Run { record, summary })),
         }
     }
 }

@@ -106,7 +106,7 @@ impl StoredOutcome {
                 Ok(metrics) => return StoredOutcome::Completed(metrics),
                 Err(error) => Stopped {
                     error,
-                    partial: Some(run),
+                    partial: Some(Box::new(run)),
                 },
             },
             Err(stopped) => stopped,
