@@ -1,5 +1,6 @@
 #![doc = include_str!("../README.md")]
 
+pub mod angle;
 pub mod bessel;
 pub mod chain;
 pub mod chain_ik;
@@ -16,6 +17,7 @@ pub mod spatial_map;
 mod validate;
 pub mod vec3;
 
+pub use angle::reduce_angle;
 pub use bessel::{J0_FIRST_ZERO, inverse_j0};
 pub use chain::{joint_positions, tip_position};
 pub use chain_ik::{ChainIk, chain_inverse_kinematics};

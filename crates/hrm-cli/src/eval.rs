@@ -8,7 +8,7 @@
 
 use backbone_kin::{
     BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, ModalMap, end_point, inverse_kinematics,
-    tip_position,
+    reduce_angle, tip_position,
 };
 use fuzzy_sugeno::FuzzySystem;
 use lane_math::{Classify, ErrorClass};
@@ -343,22 +343,6 @@ fn json_type(value: &Value) -> &'static str {
         Value::String(_) => "a string",
         Value::Array(_) => "an array",
         Value::Object(_) => "an object",
-    }
-}
-
-/// An angle in `(-pi, pi]` equal to `alpha0` modulo `2 pi`. Values already there are kept bit for
-/// bit; larger ones are reduced through their sine and cosine, whose argument reduction is exact
-/// (reducing by the double nearest `2 pi` would be off by `alpha0 / 2 pi` times its rounding
-/// error, thousands of radians at `alpha0 = 1e20`). Only `alpha0` is reduced: it enters every
-/// answer only through the link angles' sines and cosines, but `theta_1 = alpha0 + ...` would
-/// otherwise lose the modal part in rounding.
-fn reduce_angle(alpha0: f64) -> f64 {
-    use std::f64::consts::PI;
-    if alpha0 > -PI && alpha0 <= PI {
-        alpha0
-    } else {
-        let (sin, cos) = alpha0.sin_cos();
-        sin.atan2(cos)
     }
 }
 

@@ -4,6 +4,7 @@
 
 use crate::array::passes_through;
 use crate::errors::Error;
+use numpy::{PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyString};
@@ -64,4 +65,37 @@ pub(crate) fn path(value: &Bound<'_, PyAny>, name: &str) -> PyResult<std::path::
             wrong_type(name, "a str or an os.PathLike", value)
         }
     })
+}
+
+/// A 3-vector for argument `name` (a gravity vector, a position, roll-pitch-yaw angles).
+pub(crate) fn vec3(value: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; 3]> {
+    let values = reals(value, name)?;
+    values.as_slice().try_into().map_err(|_| {
+        Error::input(format!(
+            "{name} must have 3 entries (x, y, z), got {}",
+            values.len()
+        ))
+        .into()
+    })
+}
+
+/// Rows of three real numbers for argument `name` (per-link principal inertias): an `(n, 3)`
+/// array or a list of triples.
+pub(crate) fn rows3(value: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f64; 3]>> {
+    if value.is_instance_of::<PyString>() || value.is_instance_of::<PyBytes>() {
+        return Err(wrong_type(name, "rows of three real numbers", value));
+    }
+    let array = crate::array::float64_array(value, name)?;
+    let shape = array.shape().to_vec();
+    if shape.len() != 2 || shape[1] != 3 {
+        return Err(Error::input(format!(
+            "{name} must be rows of three numbers, shape (n, 3), got an array of shape {shape:?}"
+        ))
+        .into());
+    }
+    let flat: Vec<f64> = crate::array::vector(&array.reshape([shape[0] * 3])?.into_any(), name)?;
+    Ok(flat
+        .chunks_exact(3)
+        .map(|row| [row[0], row[1], row[2]])
+        .collect())
 }

@@ -148,8 +148,11 @@ impl Arm {
     /// A spatial chain read from URDF: `hrm.Chain.from_urdf(urdf, gravity)` (an `hrm.Chain`, the
     /// class of URDF chains, not a planar `Arm`).
     #[staticmethod]
-    #[pyo3(signature = (urdf, gravity=[0.0, 0.0, -9.81]))]
-    fn from_urdf(urdf: &Bound<'_, PyAny>, gravity: [f64; 3]) -> PyResult<crate::chain::Chain> {
+    #[pyo3(signature = (urdf, gravity=None), text_signature = "(urdf, gravity=(0, 0, -9.81))")]
+    fn from_urdf(
+        urdf: &Bound<'_, PyAny>,
+        gravity: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<crate::chain::Chain> {
         crate::chain::Chain::from_urdf(urdf, gravity)
     }
 

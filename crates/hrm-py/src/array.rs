@@ -146,7 +146,7 @@ fn aligned(array: &Bound<'_, PyArrayDyn<f64>>) -> bool {
 /// numpy masked array with masked entries is refused (its mask cannot be honoured), one
 /// without is read as its data. A `KeyboardInterrupt` or `MemoryError` raised while the object
 /// is converted propagates as it is.
-fn float64_array<'py>(
+pub(crate) fn float64_array<'py>(
     object: &Bound<'py, PyAny>,
     name: &str,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {

@@ -189,8 +189,12 @@ impl Chain {
     /// The chain of a URDF description (text, a path-like object, or a string ending in `.urdf`
     /// naming a file) under the gravity vector `gravity` (m/s^2, base frame).
     #[staticmethod]
-    #[pyo3(signature = (urdf, gravity=DEFAULT_GRAVITY))]
-    pub(crate) fn from_urdf(urdf: &Bound<'_, PyAny>, gravity: [f64; 3]) -> PyResult<Self> {
+    #[pyo3(signature = (urdf, gravity=None), text_signature = "(urdf, gravity=(0, 0, -9.81))")]
+    pub(crate) fn from_urdf(
+        urdf: &Bound<'_, PyAny>,
+        gravity: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let gravity = gravity.map_or(Ok(DEFAULT_GRAVITY), |g| crate::args::vec3(g, "gravity"))?;
         let text = urdf_text(urdf)?;
         Ok(Self::read(&text, gravity)?)
     }

@@ -4,7 +4,7 @@
 use crate::arm::Arm;
 use crate::array::{States, evaluate, evaluate_chunks};
 use crate::errors::{Error, check_finite, count};
-use backbone_kin::{BaseAngle, Branch, HarmonicIk, ModalMap};
+use backbone_kin::{BaseAngle, Branch, HarmonicIk, ModalMap, reduce_angle};
 use modal_reduce::{BatchError, ReducedBatchData, ReducedData};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
@@ -29,7 +29,7 @@ struct Workspace {
 /// `harmonics` K gives the coordinates (a_1, ..., a_2K) of the curvature's K harmonics (K = 1 is
 /// the paper's (a1, a2)). `alpha0=None` makes the base angle the last coordinate, so m = 2K + 1
 /// (the paper's (a1, a2, alpha0)); a number holds it fixed (m = 2K, theta_0 = alpha0 e_1, the
-/// paper's experiments; an alpha0 outside [-pi, pi] is reduced into it, exactly). Raises
+/// paper's experiments; an alpha0 outside (-pi, pi] is reduced into it, exactly). Raises
 /// InvalidInput if J is column-rank-deficient (fewer than m links). The construction, O(n m^2),
 /// runs with the GIL released.
 ///
@@ -84,18 +84,6 @@ impl ReducedModel {
         let a_dot = a_dot.unwrap_or(&workspace.zeros);
         modal_reduce::reduced_terms(&self.model, &mut workspace.data, a, a_dot)?;
         Ok(())
-    }
-}
-
-/// `angle` (rad) reduced to [-pi, pi] when it is outside: a base angle such as 1e15 would
-/// otherwise swamp the joint angles added to it (theta_1 = alpha0 + ..., eq 8) and move the tip.
-/// `sin` and `cos` reduce their argument exactly, so `atan2` of them is the exact remainder
-/// (to the last bit); a non-finite angle is left for the library to refuse.
-fn reduce_angle(angle: f64) -> f64 {
-    if angle.abs() <= std::f64::consts::PI || !angle.is_finite() {
-        angle
-    } else {
-        angle.sin().atan2(angle.cos())
     }
 }
 
@@ -255,7 +243,7 @@ impl ReducedModel {
     /// reach the target or the iteration does not converge from there, from the other branch's
     /// closed form and a fixed list of moderate curves (`backbone_kin::HarmonicIk::solve_unguided`). The base angle is the model's fixed
     /// alpha0; for a model whose alpha0 is a coordinate, pass `alpha0` (it becomes the last
-    /// coordinate of the result, reduced to [-pi, pi] when it is outside, as the model's fixed
+    /// coordinate of the result, reduced to (-pi, pi] when it is outside, as the model's fixed
     /// alpha0 is). Raises Unreachable for a target the curve cannot reach and
     /// NumericalError if the iteration does not converge.
     #[pyo3(signature = (target, alpha0=None, branch="positive"))]

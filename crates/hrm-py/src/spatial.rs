@@ -2,6 +2,7 @@
 //! coordinates (the paper's eqs 7-18 in two bending planes), from `backbone-kin` and
 //! `modal-reduce::spatial`.
 
+use crate::args;
 use crate::array::{Output, States, evaluate};
 use crate::errors::{Error, check_finite, count};
 use backbone_kin::{
@@ -213,7 +214,7 @@ fn flat<'py>(py: Python<'py>, out: Output, per_state: usize) -> Bound<'py, PyAny
 #[pymethods]
 impl SpatialArm {
     #[new]
-    #[pyo3(signature = (links=None, link_length=0.1, link_mass=0.1, gravity=[0.0, 0.0, -9.81], lengths=None, masses=None, inertias=None, base_xyz=[0.0; 3], base_rpy=[0.0; 3], harmonics=None),
+    #[pyo3(signature = (links=None, link_length=None, link_mass=None, gravity=None, lengths=None, masses=None, inertias=None, base_xyz=None, base_rpy=None, harmonics=None),
            text_signature = "(links=None, link_length=0.1, link_mass=0.1, gravity=(0, 0, -9.81), lengths=None, masses=None, inertias=None, base_xyz=(0, 0, 0), base_rpy=(0, 0, 0), harmonics=1)")]
     #[allow(
         clippy::too_many_arguments,
@@ -221,17 +222,37 @@ impl SpatialArm {
     )]
     fn new(
         links: Option<&Bound<'_, PyAny>>,
-        link_length: f64,
-        link_mass: f64,
-        gravity: [f64; 3],
-        lengths: Option<Vec<f64>>,
-        masses: Option<Vec<f64>>,
-        inertias: Option<Vec<[f64; 3]>>,
-        base_xyz: [f64; 3],
-        base_rpy: [f64; 3],
+        link_length: Option<&Bound<'_, PyAny>>,
+        link_mass: Option<&Bound<'_, PyAny>>,
+        gravity: Option<&Bound<'_, PyAny>>,
+        lengths: Option<&Bound<'_, PyAny>>,
+        masses: Option<&Bound<'_, PyAny>>,
+        inertias: Option<&Bound<'_, PyAny>>,
+        base_xyz: Option<&Bound<'_, PyAny>>,
+        base_rpy: Option<&Bound<'_, PyAny>>,
         harmonics: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let links = links.map(|n| count(n, "arm.links", 1)).transpose()?;
+        let real = |value: Option<&Bound<'_, PyAny>>, name, default| {
+            value.map_or(Ok(default), |v| args::real(v, name))
+        };
+        let (link_length, link_mass) = (
+            real(link_length, "link_length", 0.1)?,
+            real(link_mass, "link_mass", 0.1)?,
+        );
+        let vec3 = |value: Option<&Bound<'_, PyAny>>, name, default| {
+            value.map_or(Ok(default), |v| args::vec3(v, name))
+        };
+        let gravity = vec3(gravity, "gravity", [0.0, 0.0, -9.81])?;
+        let (base_xyz, base_rpy) = (
+            vec3(base_xyz, "base_xyz", [0.0; 3])?,
+            vec3(base_rpy, "base_rpy", [0.0; 3])?,
+        );
+        let per_link = |value: Option<&Bound<'_, PyAny>>, name| {
+            value.map(|v| args::reals(v, name)).transpose()
+        };
+        let (lengths, masses) = (per_link(lengths, "lengths")?, per_link(masses, "masses")?);
+        let inertias = inertias.map(|v| args::rows3(v, "inertias")).transpose()?;
         let harmonics = harmonics.map_or(Ok(1), |k| count(k, "harmonics", 1))?;
         let base = BasePose {
             xyz: base_xyz,

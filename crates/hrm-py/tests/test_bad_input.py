@@ -416,3 +416,33 @@ def test_every_controller_is_listed_in_the_docs():
     for name in names:
         assert f'"{name}"' in hrm.Scenario.run.__doc__, name
         assert f"`{name}`" in python_md or f'"{name}"' in python_md, name
+
+
+# --- the spatial and URDF classes ------------------------------------------------------------------
+
+
+def test_spatial_and_urdf_classes_follow_the_same_rules():
+    from test_robot_engines import random_chain
+
+    with pytest.raises(TypeError, match="^link_length must be a real number, got a str$"):
+        hrm.SpatialArm(link_length="x")
+    with pytest.raises(TypeError, match="^gravity must be a sequence of real numbers, got a str$"):
+        hrm.SpatialArm(gravity="x")
+    with pytest.raises(hrm.InvalidInput, match=r"^gravity must have 3 entries \(x, y, z\), got 1$"):
+        hrm.SpatialArm(gravity=[1.0])
+    with pytest.raises(hrm.InvalidInput, match=r"^inertias must be rows of three numbers, shape \(n, 3\)"):
+        hrm.SpatialArm(inertias=[[1.0, 2.0]])
+    with pytest.raises(hrm.InvalidInput, match="^lengths is a masked array"):
+        hrm.SpatialArm(lengths=np.ma.masked_array([0.1, 0.1], mask=[True, False]))
+    urdf = random_chain(3, 4)
+    with pytest.raises(hrm.InvalidInput, match=r"^gravity must have 3 entries \(x, y, z\), got 2$"):
+        hrm.Chain.from_urdf(urdf, gravity=(0.0, -9.81))
+    chain = hrm.Chain.from_urdf(urdf, gravity=np.array([0.0, -9.81, 0.0]))
+    q = packed(3, chain.n_joints)["x"]
+    np.testing.assert_array_equal(chain.gravity(q), chain.gravity(np.array(q)))
+    for clone in round_trips(chain):
+        np.testing.assert_array_equal(clone.mass_matrix(np.array(q)), chain.mass_matrix(np.array(q)))
+    arm = hrm.SpatialArm(links=4, inertias=np.full((4, 3), 1e-3), base_rpy=[0.1, 0.2, 0.3])
+    a = packed(2, arm.n_coords)["x"]
+    for clone in round_trips(arm):
+        np.testing.assert_array_equal(clone.fk(a), arm.fk(np.array(a)))
