@@ -97,6 +97,12 @@ pub(crate) fn cholesky(a: &mut [f64], m: usize) -> bool {
 
 /// Overwrites the `m x c` right-hand sides `x` with `(L L^T)^-1 x`, `L` from [`cholesky`].
 pub(crate) fn cholesky_solve(l: &[f64], m: usize, x: &mut [f64], c: usize) {
+    forward_substitute(l, m, x, c);
+    back_substitute(l, m, x, c);
+}
+
+/// Overwrites the `m x c` right-hand sides `x` with `L^-1 x`, `L` from [`cholesky`].
+pub(crate) fn forward_substitute(l: &[f64], m: usize, x: &mut [f64], c: usize) {
     for col in 0..c {
         for i in 0..m {
             let mut s = x[i * c + col];
@@ -105,6 +111,12 @@ pub(crate) fn cholesky_solve(l: &[f64], m: usize, x: &mut [f64], c: usize) {
             }
             x[i * c + col] = s / l[i * m + i];
         }
+    }
+}
+
+/// Overwrites the `m x c` right-hand sides `x` with `L^-T x`, `L` from [`cholesky`].
+pub(crate) fn back_substitute(l: &[f64], m: usize, x: &mut [f64], c: usize) {
+    for col in 0..c {
         for i in (0..m).rev() {
             let mut s = x[i * c + col];
             for k in i + 1..m {

@@ -4,16 +4,20 @@ mod box_qp;
 pub mod dense;
 mod discrete;
 mod ilqr;
+mod linear_qp;
 mod linearise;
 mod lqr;
 mod mpc;
+mod polytope;
 
 pub use box_qp::{BoxQp, BoxQpReport, BoxQpSettings};
 pub use discrete::{DiscreteDynamics, ReducedEuler};
 pub use ilqr::{Ilqr, IlqrReport, IlqrSettings, MAX_HORIZON, MAX_WORKSPACE, TrackingCost};
+pub use linear_qp::{LinearQp, LinearQpFailure};
 pub use linearise::Linearisation;
 pub use lqr::{Lqr, LqrSettings};
 pub use mpc::{MAX_MPC_HORIZON, Mpc, MpcSettings};
+pub use polytope::{PolytopeProjection, ProjectionFailure};
 
 use lane_math::{Classify, ErrorClass};
 use modal_reduce::ReduceError;

@@ -1,0 +1,274 @@
+//! The closest point of a polytope `{x : G x <= g}` of `R^m`: least-distance programming solved
+//! by non-negative least squares (Lawson and Hanson, *Solving Least Squares Problems*, 1974,
+//! chapters 23 and 24).
+//!
+//! With `y = x - x0` the problem is `min |y|` subject to `-G y >= G x0 - g`, an LDP of `m`
+//! unknowns. Its dual is the NNLS problem `min |E u - f|`, `u >= 0`, with
+//! `E = [-G^T; (G x0 - g)^T]` (`m + 1` rows, one column per constraint) and `f = e_{m+1}`: the
+//! residual `r = E u - f` gives `y = -r_{1..m} / r_{m+1}`, and a zero residual proves the polytope
+//! empty. NNLS is the finite active-set method: a constraint enters the passive set while its
+//! dual gradient is positive, and a step that would make a passive variable negative stops at
+//! zero and returns it.
+
+/// Why no point was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProjectionFailure {
+    /// The constraints admit no point.
+    Empty,
+    /// The active-set iterations did not settle within their bound (rounding near a degenerate
+    /// vertex).
+    NoConvergence,
+    /// The sizes disagree: `G` is not `g.len() x m`, `x0` or `x` not `m` long, or more rows than
+    /// the working memory was made for.
+    Dimension,
+}
+
+impl std::fmt::Display for ProjectionFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Empty => "the constraints admit no point",
+            Self::NoConvergence => "the active-set iterations did not converge",
+            Self::Dimension => "the constraint matrix, bounds and points disagree in size",
+        })
+    }
+}
+
+impl std::error::Error for ProjectionFailure {}
+
+/// Working memory of the projection for `m` unknowns and up to `rows` constraints.
+/// [`project`](Self::project) allocates nothing.
+#[derive(Debug, Clone)]
+pub struct PolytopeProjection {
+    m: usize,
+    rows: usize,
+    /// `E`, column-major, `(m + 1) x rows`.
+    e: Vec<f64>,
+    u: Vec<f64>,
+    z: Vec<f64>,
+    w: Vec<f64>,
+    passive: Vec<bool>,
+    /// The passive columns, in order.
+    order: Vec<usize>,
+    /// The least-squares subproblem: matrix `(m + 1) x k`, right-hand side, solution.
+    qr: Vec<f64>,
+    rhs: Vec<f64>,
+    residual: Vec<f64>,
+}
+
+impl PolytopeProjection {
+    /// The number of unknowns `m`.
+    pub fn n_unknowns(&self) -> usize {
+        self.m
+    }
+
+    /// The most constraints [`project`](Self::project) accepts.
+    pub fn max_rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Working memory for `m` unknowns and at most `rows` constraints.
+    pub fn new(m: usize, rows: usize) -> Self {
+        let height = m + 1;
+        Self {
+            m,
+            rows,
+            e: vec![0.0; height * rows],
+            u: vec![0.0; rows],
+            z: vec![0.0; rows],
+            w: vec![0.0; rows],
+            passive: vec![false; rows],
+            order: Vec::with_capacity(rows),
+            qr: vec![0.0; height * height],
+            rhs: vec![0.0; height],
+            residual: vec![0.0; height],
+        }
+    }
+
+    /// Writes into `x` the point of `{x : G x <= g}` closest to `x0`; `G` is row-major with `m`
+    /// columns and `g.len()` rows (at most the `rows` of [`new`](Self::new)). Returns whether
+    /// `x0` had to move. Allocation-free.
+    ///
+    /// # Errors
+    /// [`ProjectionFailure::Empty`] when no point satisfies the constraints,
+    /// [`ProjectionFailure::NoConvergence`] when the iterations do not settle,
+    /// [`ProjectionFailure::Dimension`] when the sizes disagree.
+    pub fn project(
+        &mut self,
+        constraints: &[f64],
+        g: &[f64],
+        x0: &[f64],
+        x: &mut [f64],
+    ) -> Result<bool, ProjectionFailure> {
+        let (m, p) = (self.m, g.len());
+        if p > self.rows || constraints.len() != p * m || x0.len() != m || x.len() != m {
+            return Err(ProjectionFailure::Dimension);
+        }
+        let height = m + 1;
+        let mut violated = false;
+        for i in 0..p {
+            let row = &constraints[i * m..(i + 1) * m];
+            let column = &mut self.e[i * height..(i + 1) * height];
+            let mut gx = 0.0;
+            for k in 0..m {
+                column[k] = -row[k];
+                gx += row[k] * x0[k];
+            }
+            column[m] = gx - g[i];
+            violated |= gx > g[i];
+        }
+        x.copy_from_slice(x0);
+        if !violated {
+            return Ok(false);
+        }
+        self.nnls(p)?;
+        // r = E u - f.
+        self.residual.fill(0.0);
+        self.residual[m] = -1.0;
+        for i in 0..p {
+            if self.u[i] != 0.0 {
+                let column = &self.e[i * height..(i + 1) * height];
+                for (r, c) in self.residual.iter_mut().zip(column) {
+                    *r += c * self.u[i];
+                }
+            }
+        }
+        let norm = self.residual.iter().map(|r| r * r).sum::<f64>().sqrt();
+        if norm <= 1e-12 {
+            return Err(ProjectionFailure::Empty);
+        }
+        let last = self.residual[m];
+        for k in 0..m {
+            x[k] = x0[k] - self.residual[k] / last;
+        }
+        Ok(true)
+    }
+
+    /// Lawson and Hanson's NNLS on the first `p` columns of `E`, `f = e_{m+1}`, into `u`.
+    fn nnls(&mut self, p: usize) -> Result<(), ProjectionFailure> {
+        let height = self.m + 1;
+        let scale = (0..p * height).map(|i| self.e[i].abs()).fold(1.0, f64::max);
+        let tolerance = 1e-12 * scale;
+        self.u[..p].fill(0.0);
+        self.passive[..p].fill(false);
+        self.order.clear();
+        for _ in 0..3 * p + 10 {
+            // w = E^T (f - E u).
+            self.residual.fill(0.0);
+            self.residual[height - 1] = 1.0;
+            for &j in &self.order {
+                let column = &self.e[j * height..(j + 1) * height];
+                for (r, c) in self.residual.iter_mut().zip(column) {
+                    *r -= c * self.u[j];
+                }
+            }
+            let mut best = None;
+            for j in 0..p {
+                let column = &self.e[j * height..(j + 1) * height];
+                self.w[j] = column.iter().zip(&self.residual).map(|(c, r)| c * r).sum();
+                if !self.passive[j]
+                    && self.w[j] > tolerance
+                    && best.is_none_or(|b: usize| self.w[j] > self.w[b])
+                    && self.order.len() < height
+                {
+                    best = Some(j);
+                }
+            }
+            let Some(entering) = best else {
+                return Ok(());
+            };
+            self.passive[entering] = true;
+            self.order.push(entering);
+            loop {
+                if !self.solve_passive() {
+                    // Dependent columns: the entering one adds nothing.
+                    self.passive[entering] = false;
+                    self.order.retain(|&j| j != entering);
+                    return Ok(());
+                }
+                if self.order.iter().all(|&j| self.z[j] > 0.0) {
+                    for &j in &self.order {
+                        self.u[j] = self.z[j];
+                    }
+                    break;
+                }
+                let mut alpha = f64::INFINITY;
+                for &j in &self.order {
+                    if self.z[j] <= 0.0 {
+                        alpha = alpha.min(self.u[j] / (self.u[j] - self.z[j]));
+                    }
+                }
+                for &j in &self.order {
+                    self.u[j] += alpha * (self.z[j] - self.u[j]);
+                }
+                let (u, passive) = (&mut self.u, &mut self.passive);
+                self.order.retain(|&j| {
+                    let keep = u[j] > tolerance;
+                    if !keep {
+                        u[j] = 0.0;
+                        passive[j] = false;
+                    }
+                    keep
+                });
+                if self.order.is_empty() {
+                    break;
+                }
+            }
+        }
+        Err(ProjectionFailure::NoConvergence)
+    }
+
+    /// The least-squares solution `z` of `E_P z = f` over the passive columns by Householder QR;
+    /// `false` when the columns are numerically dependent.
+    fn solve_passive(&mut self) -> bool {
+        let height = self.m + 1;
+        let k = self.order.len();
+        for (c, &j) in self.order.iter().enumerate() {
+            self.qr[c * height..(c + 1) * height]
+                .copy_from_slice(&self.e[j * height..(j + 1) * height]);
+        }
+        self.rhs.fill(0.0);
+        self.rhs[height - 1] = 1.0;
+        for c in 0..k {
+            let column = c * height;
+            let norm = (c..height)
+                .map(|r| self.qr[column + r] * self.qr[column + r])
+                .sum::<f64>()
+                .sqrt();
+            if norm <= 1e-13 {
+                return false;
+            }
+            let alpha = if self.qr[column + c] > 0.0 {
+                -norm
+            } else {
+                norm
+            };
+            self.qr[column + c] -= alpha;
+            let vv: f64 = (c..height).map(|r| self.qr[column + r].powi(2)).sum();
+            // Apply I - 2 v v^T / v^T v to the later columns and the right-hand side.
+            for other in c + 1..k {
+                let o = other * height;
+                let dot: f64 = (c..height)
+                    .map(|r| self.qr[column + r] * self.qr[o + r])
+                    .sum();
+                let factor = 2.0 * dot / vv;
+                for r in c..height {
+                    self.qr[o + r] -= factor * self.qr[column + r];
+                }
+            }
+            let dot: f64 = (c..height).map(|r| self.qr[column + r] * self.rhs[r]).sum();
+            let factor = 2.0 * dot / vv;
+            for r in c..height {
+                self.rhs[r] -= factor * self.qr[column + r];
+            }
+            self.qr[column + c] = alpha;
+        }
+        for c in (0..k).rev() {
+            let mut value = self.rhs[c];
+            for other in c + 1..k {
+                value -= self.qr[other * height + c] * self.z[self.order[other]];
+            }
+            self.z[self.order[c]] = value / self.qr[c * height + c];
+        }
+        true
+    }
+}
