@@ -12,7 +12,10 @@
 //!   crates.io and docs.rs show without the rest of the repository) has no relative link leaving
 //!   its crate, and no README names an absolute path.
 //! - Invariants of `docs/architecture.md`: every crate takes its lints from `[workspace.lints]`;
-//!   every public error enum of a library crate is `#[non_exhaustive]`; `lane-math` depends on
+//!   every public error enum of a library crate is `#[non_exhaustive]`; no library code (every
+//!   crate but [`FRONT_ENDS`], tests aside) names `Result<_, String>`, and no error enum has a
+//!   message-only variant (its one field a `String`, unnamed or named `message`, `reason` or
+//!   `error`), but in the files [`STRING_ERROR_FILES`] lists, each of which must still have one; `lane-math` depends on
 //!   none of the other crates, `fuzzy-sugeno` on none but `lane-math`, and no library crate depends on the command line;
 //!   `unsafe` code appears only in the library files [`UNSAFE_FILES`] lists, each block under a
 //!   `// SAFETY:` comment.
@@ -29,6 +32,25 @@ const REPOSITORY: &str = "https://github.com/hrm-toolkit/hrm";
 /// The only library source files allowed `unsafe` code (docs/architecture.md, "Unsafe code"),
 /// each block under a `// SAFETY:` comment.
 const UNSAFE_FILES: [&str; 1] = ["crates/fuzzy-sugeno/src/kernel.rs"];
+
+/// The library files that still return `Result<_, String>` or hold a message-only error variant:
+/// the string rules skip them, and each must still break one (so the list only shrinks). Every
+/// other file of a crate under `crates/` but the front ends is held to the rules.
+const STRING_ERROR_FILES: [&str; 10] = [
+    "crates/fuzzy-sugeno/src/fis.rs",
+    "crates/sim-study/src/study/inputs.rs",
+    "crates/sim-study/src/study/mod.rs",
+    "crates/sim-study/src/study/plan.rs",
+    "crates/sim-study/src/study/shard_file.rs",
+    "crates/run-view/src/view.rs",
+    "crates/run-view/src/page.rs",
+    "crates/run-view/src/gif.rs",
+    "crates/run-view/src/from_record.rs",
+    "crates/robot-desc/src/urdf_read.rs",
+];
+
+/// The crates under `crates/` that are front ends, not libraries: the string rules do not apply.
+const FRONT_ENDS: [&str; 3] = ["hrm-cli", "hrm-py", "test-support"];
 
 /// The workspace's library crates (published, usable alone).
 const LIBRARIES: [&str; 11] = [
@@ -133,6 +155,27 @@ pub fn run(root: &Path, doc: impl FnOnce() -> Result<(), String>) -> Vec<String>
                     problems.push(format!("{}:{line}: {problem}", relative.display()));
                 }
             }
+        }
+    }
+
+    for krate in crates.iter().filter(|k| !FRONT_ENDS.contains(&k.as_str())) {
+        let dir = Path::new("crates").join(krate);
+        for file in rust_files(&root.join(&dir).join("src")) {
+            let source = std::fs::read_to_string(&file).unwrap_or_default();
+            let relative = file.strip_prefix(root).unwrap_or(&file);
+            let listed = STRING_ERROR_FILES.iter().any(|f| Path::new(f) == relative);
+            problems.extend(string_problems(
+                &relative.display().to_string(),
+                &source,
+                listed,
+            ));
+        }
+    }
+    for listed in STRING_ERROR_FILES {
+        if read(Path::new(listed)).is_err() {
+            problems.push(format!(
+                "{listed} is listed in STRING_ERROR_FILES but does not exist: remove it"
+            ));
         }
     }
 
@@ -292,6 +335,165 @@ pub fn exhaustive_error_enums(source: &str) -> Vec<String> {
         if !attributes.into_iter().any(|l| l == "#[non_exhaustive]") {
             found.push(name);
         }
+    }
+    found
+}
+
+/// The string-error problems of the library file `path`: each `Result<_, String>` and
+/// message-only error variant, or, for a file `listed` in [`STRING_ERROR_FILES`], that it has
+/// none left (then it must leave the list).
+pub fn string_problems(path: &str, source: &str, listed: bool) -> Vec<String> {
+    let results = string_results(source);
+    let variants = message_only_variants(source);
+    if listed {
+        return if results.is_empty() && variants.is_empty() {
+            vec![format!(
+                "{path} has no string errors left: remove it from STRING_ERROR_FILES"
+            )]
+        } else {
+            Vec::new()
+        };
+    }
+    let policy = "(docs/architecture.md, \"One error policy\")";
+    let results = results.into_iter().map(|line| {
+        format!(
+            "{path}:{line}: `Result<_, String>` in a library crate: return a typed error {policy}"
+        )
+    });
+    let variants = variants.into_iter().map(|(line, variant)| {
+        format!(
+            "{path}:{line}: the error variant {variant} carries only a message: give it the \
+             structured facts {policy}"
+        )
+    });
+    results.chain(variants).collect()
+}
+
+/// `source` without its unit tests: everything from a `#[cfg(test)]` line followed by a `mod`
+/// line on (a file's test module comes last), and with line comments blanked, so that the
+/// rules below read code only. Lines keep their numbers.
+fn library_code(source: &str) -> Vec<&str> {
+    let lines: Vec<&str> = source.lines().collect();
+    let end = (0..lines.len())
+        .find(|&i| {
+            lines[i].trim() == "#[cfg(test)]"
+                && lines
+                    .get(i + 1)
+                    .is_some_and(|next| next.trim_start().starts_with("mod "))
+        })
+        .unwrap_or(lines.len());
+    lines[..end]
+        .iter()
+        .map(|line| match line.find("//") {
+            Some(at) => &line[..at],
+            None => line,
+        })
+        .collect()
+}
+
+/// The lines (1-based) of `source`'s library code that name a `Result` whose error type is
+/// `String` (`Result<T, String>`, also spread over several lines); unit tests are exempt.
+pub fn string_results(source: &str) -> Vec<usize> {
+    let lines = library_code(source);
+    let text = lines.join("\n");
+    let mut found = Vec::new();
+    for (start, _) in text.match_indices("Result<") {
+        let preceded = text[..start]
+            .chars()
+            .next_back()
+            .is_some_and(|c| c.is_alphanumeric() || c == '_');
+        if preceded {
+            continue;
+        }
+        // The generic arguments, up to the matching `>`; the last one at depth 1 is the error.
+        let (mut depth, mut last) = (0usize, start + "Result<".len());
+        for (i, c) in text[start..].char_indices().map(|(i, c)| (start + i, c)) {
+            match c {
+                '<' | '(' | '[' => depth += 1,
+                '>' | ')' | ']' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        let error = text[last..i].trim();
+                        let two_arguments = last > start + "Result<".len();
+                        if two_arguments && (error == "String" || error == "std::string::String") {
+                            found.push(text[..start].matches('\n').count() + 1);
+                        }
+                        break;
+                    }
+                }
+                ',' if depth == 1 => last = i + 1,
+                _ => {}
+            }
+        }
+    }
+    found
+}
+
+/// The variants of `source`'s error enums (public or not, named `...Error`) that carry only a
+/// message: one field, a `String`, unnamed (`Xml(String)`) or named `message`, `reason` or
+/// `error`; with their lines (1-based).
+pub fn message_only_variants(source: &str) -> Vec<(usize, String)> {
+    let lines = library_code(source);
+    let mut found = Vec::new();
+    let mut in_error_enum = false;
+    let mut i = 0;
+    while i < lines.len() {
+        let line = lines[i].trim();
+        if let Some(rest) = line
+            .strip_prefix("pub enum ")
+            .or_else(|| line.strip_prefix("pub(crate) enum "))
+            .or_else(|| line.strip_prefix("enum "))
+        {
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            in_error_enum = name.ends_with("Error");
+        } else if line == "}" {
+            in_error_enum = false;
+        } else if in_error_enum {
+            let variant: String = line
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            let starts_variant = variant.starts_with(|c: char| c.is_ascii_uppercase());
+            if starts_variant && line[variant.len()..].trim_start().starts_with("(String)") {
+                found.push((i + 1, variant));
+            } else if starts_variant && line.contains('{') {
+                // The fields up to the closing brace, doc comments and attributes aside.
+                let mut fields = Vec::new();
+                let mut j = i;
+                let mut body = line.split_once('{').map_or("", |(_, body)| body);
+                loop {
+                    let (inside, closed) = match body.split_once('}') {
+                        Some((inside, _)) => (inside, true),
+                        None => (body, false),
+                    };
+                    fields.extend(
+                        inside
+                            .split(',')
+                            .map(str::trim)
+                            .filter(|f| !(f.is_empty() || f.starts_with('#'))),
+                    );
+                    if closed || j + 1 >= lines.len() {
+                        break;
+                    }
+                    j += 1;
+                    body = lines[j].trim();
+                }
+                let message_only = matches!(
+                    fields.as_slice(),
+                    [field] if ["message", "reason", "error"]
+                        .iter()
+                        .any(|name| field.replace(' ', "") == format!("{name}:String"))
+                );
+                if message_only {
+                    found.push((i + 1, variant));
+                }
+                i = j;
+            }
+        }
+        i += 1;
     }
     found
 }
@@ -614,6 +816,62 @@ mod tests {
         assert_eq!(
             citation_problems(Path::new("README.md"), "[t](docs/theory.md)", false, exists),
             Vec::<String>::new()
+        );
+    }
+
+    #[test]
+    fn string_errors_in_library_code_are_found() {
+        let source = "/// Never `Result<(), String>` in a doc comment.\n\
+                      pub fn a() -> Result<(), String> {}\n\
+                      fn b(f: impl Fn() -> Result<Vec<(u8, u8)>,\n    String>) {}\n\
+                      fn c() -> Result<String, Error> {}\n\
+                      fn d() -> io::Result<String> {}\n\
+                      fn e() -> MyResult<(), String> {}\n\
+                      // fn f() -> Result<(), String>\n\
+                      type G = std::result::Result<u8, std::string::String>;\n\
+                      #[cfg(test)]\n\
+                      mod tests {\n    fn h() -> Result<(), String> {}\n}\n";
+        assert_eq!(string_results(source), [2, 3, 9]);
+    }
+
+    #[test]
+    fn message_only_error_variants_are_found() {
+        let source = "pub enum ParseError {\n\
+                      \x20   /// Only a message.\n\
+                      \x20   Fis {\n\
+                      \x20       /// The text.\n\
+                      \x20       message: String,\n\
+                      \x20   },\n\
+                      \x20   Line {\n        line: usize,\n        message: String,\n    },\n\
+                      \x20   #[error(\"{0}\")]\n    Xml(String),\n\
+                      \x20   Io(std::io::Error),\n\
+                      \x20   Named { name: String },\n\
+                      \x20   Short { error: String },\n\
+                      \x20   Why {\n        reason: String,\n    },\n\
+                      }\n\
+                      pub enum Shape {\n    Text { message: String },\n}\n";
+        assert_eq!(
+            message_only_variants(source),
+            [
+                (3, "Fis".to_string()),
+                (12, "Xml".into()),
+                (15, "Short".into()),
+                (16, "Why".into())
+            ]
+        );
+    }
+
+    #[test]
+    fn listed_string_error_files_only_shrink() {
+        let stringly = "pub fn a() -> Result<(), String> {}\n";
+        let typed = "pub fn a() -> Result<(), Error> {}\n";
+        assert_eq!(string_problems("a.rs", stringly, false).len(), 1);
+        assert!(string_problems("a.rs", stringly, true).is_empty());
+        assert!(string_problems("a.rs", typed, false).is_empty());
+        let stale = string_problems("a.rs", typed, true);
+        assert!(
+            stale[0].contains("remove it from STRING_ERROR_FILES"),
+            "{stale:?}"
         );
     }
 }

@@ -9,6 +9,7 @@
 use backbone_kin::{
     BackboneCurve, Branch, HarmonicIk, KinError, ModalMap, inverse_kinematics, tip_position,
 };
+use lane_math::Classify;
 use std::f64::consts::FRAC_PI_2;
 
 const LINKS: usize = 10;

@@ -1,12 +1,14 @@
 //! The error type of this crate.
 
+use lane_math::{Classify, ErrorClass};
+
 /// Why a kinematics computation was refused.
 ///
 /// Every variant names the condition that failed, so a caller (or the `hrm` command line) can
-/// print it as one readable line. Three predicates sort the variants into the classes a caller
-/// acts on, exactly one of which holds for every error: [`KinError::is_unreachable`] ("the
-/// backbone curve cannot reach this target"), [`KinError::is_numerical`] (a numerical method
-/// failed on valid input) and [`KinError::is_invalid_input`] (everything else: the input is
+/// print it as one readable line. [`Classify::class`] sorts the variants into the classes a caller
+/// acts on: [`ErrorClass::Unreachable`] ("the
+/// backbone curve cannot reach this target"), [`ErrorClass::Numerical`] (a numerical method
+/// failed on valid input) and [`ErrorClass::InvalidInput`] (everything else: the input is
 /// malformed or outside the model's domain).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -144,32 +146,25 @@ pub enum KinError {
     },
 }
 
-impl KinError {
-    /// Whether the error means the closed form cannot reach the target ([`OutOfReach`]: no curve
-    /// of this length can; [`AtBase`]: its direction is undefined; [`A2ExceedsAmplitude`]: not on
-    /// the first branch of `J0` with this `alpha0`), as opposed to malformed input or a numerical
-    /// failure.
+impl Classify for KinError {
+    /// [`Unreachable`](ErrorClass::Unreachable) when the closed form cannot reach the target
+    /// ([`OutOfReach`]: no curve of this length can; [`AtBase`]: its direction is undefined;
+    /// [`A2ExceedsAmplitude`]: not on the first branch of `J0` with this `alpha0`);
+    /// [`Numerical`](ErrorClass::Numerical) when a numerical inverse kinematics did not reach its
+    /// tolerance ([`NotConverged`](KinError::NotConverged)); otherwise the input was malformed or
+    /// outside the model's domain.
     ///
     /// [`OutOfReach`]: KinError::OutOfReach
     /// [`AtBase`]: KinError::AtBase
     /// [`A2ExceedsAmplitude`]: KinError::A2ExceedsAmplitude
-    pub fn is_unreachable(&self) -> bool {
-        matches!(
-            self,
-            Self::OutOfReach { .. } | Self::AtBase { .. } | Self::A2ExceedsAmplitude { .. }
-        )
-    }
-
-    /// Whether a numerical method failed on valid input: a numerical inverse kinematics that did
-    /// not reach its tolerance ([`NotConverged`](KinError::NotConverged)).
-    pub fn is_numerical(&self) -> bool {
-        matches!(self, Self::NotConverged { .. })
-    }
-
-    /// Whether the input was malformed or outside the model's domain: neither
-    /// [`is_unreachable`](Self::is_unreachable) nor [`is_numerical`](Self::is_numerical).
-    pub fn is_invalid_input(&self) -> bool {
-        !(self.is_unreachable() || self.is_numerical())
+    fn class(&self) -> ErrorClass {
+        match self {
+            Self::OutOfReach { .. } | Self::AtBase { .. } | Self::A2ExceedsAmplitude { .. } => {
+                ErrorClass::Unreachable
+            }
+            Self::NotConverged { .. } => ErrorClass::Numerical,
+            _ => ErrorClass::InvalidInput,
+        }
     }
 }
 

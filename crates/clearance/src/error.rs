@@ -1,5 +1,7 @@
 //! The error type of this crate.
 
+use lane_math::{Classify, ErrorClass};
+
 /// Why a clearance model or computation was refused; every variant names the condition.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -45,6 +47,16 @@ pub enum ClearanceError {
     /// The chain's kinematics refused the input.
     #[error(transparent)]
     Kinematics(#[from] backbone_kin::KinError),
+}
+
+impl Classify for ClearanceError {
+    /// A refused kinematics computation keeps its class; every other error is invalid input.
+    fn class(&self) -> ErrorClass {
+        match self {
+            Self::Kinematics(error) => error.class(),
+            _ => ErrorClass::InvalidInput,
+        }
+    }
 }
 
 pub(crate) fn check_finite(name: &'static str, value: f64) -> Result<(), ClearanceError> {

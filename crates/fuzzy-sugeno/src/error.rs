@@ -1,10 +1,12 @@
 //! The crate's error type.
 
+use lane_math::{Classify, ErrorClass};
+
 /// Everything that can go wrong when building, evaluating, reading or analysing a fuzzy system.
 /// Every message says which condition failed and where.
 ///
-/// [`FuzzyError::is_numerical`] and [`FuzzyError::is_invalid_input`] sort the variants into the
-/// two classes a caller acts on; exactly one holds for every error.
+/// [`ErrorClass::Numerical`] and [`ErrorClass::InvalidInput`] are the two classes
+/// ([`Classify::class`]) its variants fall into.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum FuzzyError {
@@ -204,24 +206,20 @@ pub enum FuzzyError {
     },
 }
 
-impl FuzzyError {
-    /// Whether a computation on valid input failed numerically: an output that came out
-    /// non-finite ([`NonFiniteOutput`](FuzzyError::NonFiniteOutput)), also inside a batch, or a
-    /// training whose least-squares problem or premise gradient failed
-    /// ([`LearningProblem::is_numerical`]).
-    pub fn is_numerical(&self) -> bool {
+impl Classify for FuzzyError {
+    /// [`Numerical`](ErrorClass::Numerical) when a computation on valid input failed: an output
+    /// that came out non-finite ([`NonFiniteOutput`](FuzzyError::NonFiniteOutput)), also inside a
+    /// batch, or a training whose least-squares problem or premise gradient failed
+    /// ([`LearningProblem`]'s class); otherwise the input (a system, a file, options or values to
+    /// evaluate) was malformed or outside its domain. No fuzzy error is
+    /// [`Unreachable`](ErrorClass::Unreachable).
+    fn class(&self) -> ErrorClass {
         match self {
-            Self::NonFiniteOutput { .. } => true,
-            Self::Learning(problem) => problem.is_numerical(),
-            Self::Batch { source, .. } => source.is_numerical(),
-            _ => false,
+            Self::NonFiniteOutput { .. } => ErrorClass::Numerical,
+            Self::Learning(problem) => problem.class(),
+            Self::Batch { source, .. } => source.class(),
+            _ => ErrorClass::InvalidInput,
         }
-    }
-
-    /// Whether the input (a system, a file, options or values to evaluate) was malformed or
-    /// outside its domain: every error that is not [`is_numerical`](Self::is_numerical).
-    pub fn is_invalid_input(&self) -> bool {
-        !self.is_numerical()
     }
 }
 
@@ -386,7 +384,7 @@ pub enum SystemProblem {
 ///
 /// Indices (rows, columns, inputs, outputs, rules, systems, terms) are 0-based, as the API takes
 /// them; the messages count from 1, as a spreadsheet or a `.fis` file does.
-/// [`is_numerical`](Self::is_numerical) tells the problems of a computation on valid input
+/// Its class ([`ErrorClass::Numerical`] or not) tells the problems of a computation on valid input
 /// (least squares the data do not determine, a gradient that overflows) from bad data, options
 /// or systems.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -689,17 +687,17 @@ pub enum LearningProblem {
     },
 }
 
-impl LearningProblem {
-    /// Whether a computation on valid data and options failed numerically: a least-squares
-    /// problem that is non-finite or that the data do not determine, or a non-finite premise
-    /// gradient. Every other problem is bad data, options or systems.
-    pub fn is_numerical(&self) -> bool {
-        matches!(
-            self,
+impl Classify for LearningProblem {
+    /// [`Numerical`](ErrorClass::Numerical) when a computation on valid data and options failed:
+    /// a least-squares problem that is non-finite or that the data do not determine, or a
+    /// non-finite premise gradient. Every other problem is bad data, options or systems.
+    fn class(&self) -> ErrorClass {
+        match self {
             Self::NonFiniteLeastSquares
-                | Self::RankDeficient { .. }
-                | Self::NonFiniteGradient { .. }
-        )
+            | Self::RankDeficient { .. }
+            | Self::NonFiniteGradient { .. } => ErrorClass::Numerical,
+            _ => ErrorClass::InvalidInput,
+        }
     }
 }
 

@@ -7,17 +7,17 @@
 //! is documented in `docs/eval-protocol.md`.
 
 use backbone_kin::{
-    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, KinError, ModalMap, end_point,
-    inverse_kinematics, tip_position,
+    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, ModalMap, end_point, inverse_kinematics,
+    tip_position,
 };
-use fuzzy_sugeno::{FuzzyError, FuzzySystem};
+use fuzzy_sugeno::FuzzySystem;
+use lane_math::{Classify, ErrorClass};
 use manip_dyn::faer::Mat;
-use manip_dyn::{ChainData, ChainModel, DynError};
-use modal_reduce::{ReduceError, ReducedData, ReducedModel};
+use manip_dyn::{ChainData, ChainModel};
+use modal_reduce::{ReducedData, ReducedModel};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer};
 use serde_json::{Map, Value, json};
-use sim_core::SimError;
 use sim_study::ArmSpec;
 use std::io::{BufRead, Write};
 
@@ -108,12 +108,10 @@ enum Kind {
     InvalidRequest,
     /// An `op` this version does not know.
     UnknownOp,
-    /// Well-formed, but outside the model's domain (non-finite, wrong size, non-positive mass).
-    InvalidInput,
-    /// An inverse-kinematics target the backbone curve cannot reach.
-    Unreachable,
-    /// A computation that failed numerically.
-    Numerical,
+    /// A library's refusal, in the library's own class (`docs/eval-protocol.md`: well-formed but
+    /// outside the model's domain, a target the curve cannot reach, a computation that failed
+    /// numerically).
+    Library(ErrorClass),
 }
 
 impl Kind {
@@ -124,9 +122,7 @@ impl Kind {
             Kind::LineTooLong => "line_too_long",
             Kind::InvalidRequest => "invalid_request",
             Kind::UnknownOp => "unknown_op",
-            Kind::InvalidInput => "invalid_input",
-            Kind::Unreachable => "unreachable",
-            Kind::Numerical => "numerical",
+            Kind::Library(class) => class.name(),
         }
     }
 }
@@ -147,51 +143,15 @@ impl EvalError {
     }
 
     fn input(message: impl ToString) -> Self {
-        Self::new(Kind::InvalidInput, message.to_string())
-    }
-
-    /// A library error as an answer: its kind read off the error's own predicates
-    /// (`is_unreachable`, `is_numerical`; everything else is invalid input), its message the
-    /// error's text.
-    fn library(unreachable: bool, numerical: bool, error: impl ToString) -> Self {
-        let kind = if unreachable {
-            Kind::Unreachable
-        } else if numerical {
-            Kind::Numerical
-        } else {
-            Kind::InvalidInput
-        };
-        Self::new(kind, error.to_string())
+        Self::new(Kind::Library(ErrorClass::InvalidInput), message.to_string())
     }
 }
 
-impl From<KinError> for EvalError {
-    fn from(error: KinError) -> Self {
-        Self::library(error.is_unreachable(), error.is_numerical(), error)
-    }
-}
-
-impl From<DynError> for EvalError {
-    fn from(error: DynError) -> Self {
-        Self::library(false, error.is_numerical(), error)
-    }
-}
-
-impl From<ReduceError> for EvalError {
-    fn from(error: ReduceError) -> Self {
-        Self::library(error.is_unreachable(), error.is_numerical(), error)
-    }
-}
-
-impl From<FuzzyError> for EvalError {
-    fn from(error: FuzzyError) -> Self {
-        Self::library(false, error.is_numerical(), error)
-    }
-}
-
-impl From<SimError> for EvalError {
-    fn from(error: SimError) -> Self {
-        Self::library(error.is_unreachable(), error.is_numerical(), error)
+/// A library error as an answer: its kind the error's [`ErrorClass`], its message the error's
+/// text.
+impl<E: Classify + std::fmt::Display> From<E> for EvalError {
+    fn from(error: E) -> Self {
+        Self::new(Kind::Library(error.class()), error.to_string())
     }
 }
 
@@ -493,7 +453,7 @@ const MAX_MAP_WORK: usize = 1 << 25;
 fn finite(name: &str, values: &[f64]) -> Result<(), EvalError> {
     match values.iter().find(|v| !v.is_finite()) {
         Some(v) => Err(EvalError::new(
-            Kind::Numerical,
+            Kind::Library(ErrorClass::Numerical),
             format!("{name} came out non-finite ({v})"),
         )),
         None => Ok(()),

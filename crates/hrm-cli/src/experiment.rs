@@ -6,7 +6,7 @@ use crate::{console, figures, progress, report};
 use serde_json::json;
 use sim_core::Run;
 use sim_study::imitation::{self, ImitationOptions};
-use sim_study::study::{self, ComparisonRun as Outcome, run_one};
+use sim_study::study::{self, ComparisonRun, run_one};
 use sim_study::{ControllerKind, ReferenceSpec, Scenario};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -34,7 +34,10 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
         std::slice::from_ref(&scenario),
     )))?;
     console::print(&format!("wrote {}\n", out.display()))?;
-    outcome.result.map(|_| ()).map_err(|stopped| stopped.error)
+    outcome
+        .result
+        .map(|_| ())
+        .map_err(|stopped| stopped.error.to_string())
 }
 
 /// The main job: every shipped scenario with every controller (see [`experiments`]), each cut
@@ -75,7 +78,7 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
         )?;
         bar.set_message(format!("{} with {kind}", outcome.scenario));
         bar.inc(1);
-        Ok(())
+        Ok::<(), String>(())
     });
     bar.finish_and_clear();
     let outcomes = outcomes?;
@@ -133,7 +136,7 @@ const LEARNED_ON: &str = "paper-tracking";
 /// operating points ([`paper_demonstrations`](imitation::paper_demonstrations), default
 /// [`ImitationOptions`]) is written to `out/learned.fis` and run on it; its files go to
 /// `out/<scenario>/learned`.
-fn learned_runs(out: &Path, scenarios: &[Scenario]) -> Result<Vec<Outcome>, String> {
+fn learned_runs(out: &Path, scenarios: &[Scenario]) -> Result<Vec<ComparisonRun>, String> {
     let targets: Vec<&Scenario> = scenarios.iter().filter(|s| s.name == LEARNED_ON).collect();
     if targets.is_empty() {
         return Ok(Vec::new());
@@ -158,7 +161,10 @@ fn learned_runs(out: &Path, scenarios: &[Scenario]) -> Result<Vec<Outcome>, Stri
 }
 
 /// The scenario `outcome` ran.
-fn scenario_of<'a>(scenarios: &'a [Scenario], outcome: &Outcome) -> Result<&'a Scenario, String> {
+fn scenario_of<'a>(
+    scenarios: &'a [Scenario],
+    outcome: &ComparisonRun,
+) -> Result<&'a Scenario, String> {
     scenarios
         .iter()
         .find(|s| s.name == outcome.scenario)
@@ -170,15 +176,15 @@ fn scenario_of<'a>(scenarios: &'a [Scenario], outcome: &Outcome) -> Result<&'a S
 pub fn run_view_of(
     scenario: &Scenario,
     label: &str,
-    outcome: &Outcome,
+    outcome: &ComparisonRun,
 ) -> Result<Option<run_view::RunView>, String> {
     let (run, stopped) = match &outcome.result {
         Ok(run) => (Some(run), None),
-        Err(stopped) => (stopped.partial.as_ref(), Some(stopped.error.as_str())),
+        Err(stopped) => (stopped.partial.as_deref(), Some(stopped.error.to_string())),
     };
     match run {
         Some(run) if !run.record.is_empty() => {
-            run_view::from_record(scenario, label, &run.record, stopped).map(Some)
+            run_view::from_record(scenario, label, &run.record, stopped.as_deref()).map(Some)
         }
         _ => Ok(None),
     }
@@ -188,8 +194,8 @@ pub fn run_view_of(
 /// column) and the animation of its runs, the learned controller's included.
 fn groups(
     scenarios: &[Scenario],
-    outcomes: &[Outcome],
-    learned: &[Outcome],
+    outcomes: &[ComparisonRun],
+    learned: &[ComparisonRun],
     rows: &[report::Row],
 ) -> Result<Vec<report::Group>, String> {
     scenarios
@@ -244,7 +250,7 @@ const SURFACE_RESOLUTION: usize = 61;
 fn figures(
     out: &Path,
     scenarios: &[Scenario],
-    outcomes: &[Outcome],
+    outcomes: &[ComparisonRun],
 ) -> Result<Vec<report::Section>, String> {
     let dir = out.join("figures");
     std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
@@ -347,13 +353,13 @@ fn figures(
     ])
 }
 
-fn outcome_json(outcome: &Outcome) -> serde_json::Value {
+fn outcome_json(outcome: &ComparisonRun) -> serde_json::Value {
     match &outcome.result {
         Ok(run) => {
             json!({"scenario": outcome.scenario, "controller": outcome.controller.name(), "summary": run.summary})
         }
         Err(e) => {
-            json!({"scenario": outcome.scenario, "controller": outcome.controller.name(), "error": e.error})
+            json!({"scenario": outcome.scenario, "controller": outcome.controller.name(), "error": e.error.to_string()})
         }
     }
 }
@@ -361,7 +367,7 @@ fn outcome_json(outcome: &Outcome) -> serde_json::Value {
 /// Writes `summary.json`, `timeseries.csv` and `scenario.toml` (what `hrm view` draws the arm
 /// from) of one run of `scenario` into `dir`. A run that stopped has its time series up to the
 /// stop, and a summary of the metrics up to it with the `error` and the time it `stopped_at_s`.
-fn write_outcome(outcome: &Outcome, scenario: &Scenario, dir: &Path) -> Result<(), String> {
+fn write_outcome(outcome: &ComparisonRun, scenario: &Scenario, dir: &Path) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     let mut ran = scenario.clone();
     ran.controller.kind = outcome.controller;
@@ -369,7 +375,7 @@ fn write_outcome(outcome: &Outcome, scenario: &Scenario, dir: &Path) -> Result<(
     let summary = sim_study::summary_json::run(&outcome.result);
     let run = match &outcome.result {
         Ok(run) => Some(run),
-        Err(stopped) => stopped.partial.as_ref(),
+        Err(stopped) => stopped.partial.as_deref(),
     };
     write(&dir.join("summary.json"), &pretty(&summary)?)?;
     if let Some(run) = run {
@@ -418,7 +424,7 @@ const HEADERS: [&str; 9] = [
 /// The comparison table's rows in plain notation ([`report::plain`]): tip error RMS and
 /// maximum (mm), modal error RMS (mrad), peak torques (N m), effort, and the percentage of controller samples whose `tau_i*` the actuator limits clamped
 /// (`-` for a scenario without limits); a failed run has only its scenario and controller, and its error.
-fn table_rows(outcomes: &[Outcome], scenarios: &[Scenario]) -> Vec<report::Row> {
+fn table_rows(outcomes: &[ComparisonRun], scenarios: &[Scenario]) -> Vec<report::Row> {
     outcomes
         .iter()
         .map(|o| {
@@ -453,7 +459,7 @@ fn table_rows(outcomes: &[Outcome], scenarios: &[Scenario]) -> Vec<report::Row> 
                 }
                 Err(e) => report::Row {
                     cells,
-                    error: Some(e.error.clone()),
+                    error: Some(e.error.to_string()),
                 },
             }
         })

@@ -157,6 +157,7 @@ impl Chain {
             py,
             [a, b, c],
             per_state,
+            100 * n * n + 200 * n,
             &self.workspace,
             || self.fresh(),
             |ws, [a, b, c], out| {
@@ -291,6 +292,7 @@ impl Chain {
             py,
             [&theta],
             n * n,
+            50 * n * n + 100 * n,
             &self.workspace,
             || self.fresh(),
             |ws, [q], out| {
@@ -322,6 +324,7 @@ impl Chain {
             py,
             [&theta, &theta_dot],
             n,
+            300 * n,
             &self.workspace,
             || self.fresh(),
             |ws, [q, v], out| {
@@ -344,6 +347,7 @@ impl Chain {
             py,
             [&theta],
             n,
+            300 * n,
             &self.workspace,
             || self.fresh(),
             |ws, [q], out| {
@@ -374,6 +378,7 @@ impl Chain {
             py,
             [q, v, a],
             n,
+            300 * n,
             &self.workspace,
             || self.fresh(),
             |ws, [q, v, a], out| {
@@ -405,6 +410,7 @@ impl Chain {
             py,
             [q, v, t],
             n,
+            300 * n,
             &self.workspace,
             || self.fresh(),
             |ws, [q, v, t], out| {
@@ -475,6 +481,7 @@ impl Chain {
             py,
             [&theta],
             per_state,
+            100 * n * n + 200 * n,
             &self.workspace,
             || self.fresh(),
             |ws, [q], out| {
@@ -517,6 +524,7 @@ impl Chain {
             py,
             [&theta, &theta_dot],
             1,
+            300 * n,
             &self.workspace,
             || self.fresh(),
             |ws, [q, v], out| {

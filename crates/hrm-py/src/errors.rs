@@ -1,21 +1,17 @@
 //! The three exceptions of the package and the mapping of every library error onto them.
 //!
-//! The classification is the one `hrm eval` uses for its error `kind` (`docs/eval-protocol.md`),
-//! read off each library error's predicates (`is_unreachable`, `is_numerical`,
-//! `is_invalid_input`), and the messages are the libraries' own `Display` text, so Python sees
-//! what the CLI prints:
+//! The classification is the library's one ([`ErrorClass`], which every library error reports
+//! through [`Classify`]), the one `hrm eval` reports as its error `kind`
+//! (`docs/eval-protocol.md`), and the messages are the libraries' own `Display` text, so Python
+//! sees what the CLI prints:
 //! malformed or out-of-domain input is [`InvalidInput`] (a `ValueError`), a target the backbone
 //! curve cannot reach is [`Unreachable`], and a computation that failed in double precision
 //! (a mass matrix that is not numerically positive definite, a non-finite result) is
 //! [`NumericalError`].
 
-use backbone_kin::KinError;
-use fuzzy_sugeno::FuzzyError;
-use manip_dyn::DynError;
-use modal_reduce::ReduceError;
+use lane_math::{Classify, ErrorClass};
 use pyo3::exceptions::{PyArithmeticError, PyValueError};
 use pyo3::{PyErr, create_exception};
-use sim_core::SimError;
 
 create_exception!(
     hrm,
@@ -40,23 +36,12 @@ create_exception!(
      positive definite, an iteration that did not converge, or a result that came out non-finite."
 );
 
-/// Which exception an [`Error`] becomes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Kind {
-    /// [`InvalidInput`].
-    InvalidInput,
-    /// [`Unreachable`].
-    Unreachable,
-    /// [`NumericalError`].
-    Numerical,
-}
-
 /// A refused computation: which exception, and its one-line message. Unlike a `PyErr` it can be
 /// built and carried without the GIL, inside a batch running on other threads.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Error {
-    /// Which exception.
-    pub kind: Kind,
+    /// Which exception: one per [`ErrorClass`].
+    pub kind: ErrorClass,
     /// The message, as the CLI prints it.
     pub message: String,
 }
@@ -68,7 +53,7 @@ impl Error {
     /// An [`InvalidInput`] with this message.
     pub fn input(message: impl Into<String>) -> Self {
         Self {
-            kind: Kind::InvalidInput,
+            kind: ErrorClass::InvalidInput,
             message: message.into(),
         }
     }
@@ -76,7 +61,7 @@ impl Error {
     /// A [`NumericalError`] with this message.
     pub fn numerical(message: impl Into<String>) -> Self {
         Self {
-            kind: Kind::Numerical,
+            kind: ErrorClass::Numerical,
             message: message.into(),
         }
     }
@@ -94,67 +79,18 @@ impl Error {
 impl From<Error> for PyErr {
     fn from(error: Error) -> PyErr {
         match error.kind {
-            Kind::InvalidInput => InvalidInput::new_err(error.message),
-            Kind::Unreachable => Unreachable::new_err(error.message),
-            Kind::Numerical => NumericalError::new_err(error.message),
+            ErrorClass::Unreachable => Unreachable::new_err(error.message),
+            ErrorClass::Numerical => NumericalError::new_err(error.message),
+            _ => InvalidInput::new_err(error.message),
         }
     }
 }
 
-impl Kind {
-    /// The class of a library error, from its predicates (`is_unreachable`, `is_numerical`;
-    /// everything else is invalid input).
-    fn of(unreachable: bool, numerical: bool) -> Self {
-        if unreachable {
-            Kind::Unreachable
-        } else if numerical {
-            Kind::Numerical
-        } else {
-            Kind::InvalidInput
-        }
-    }
-}
-
-impl From<KinError> for Error {
-    fn from(error: KinError) -> Self {
+/// A library error as the exception of its [`ErrorClass`], with the library's own message.
+impl<E: Classify + std::fmt::Display> From<E> for Error {
+    fn from(error: E) -> Self {
         Self {
-            kind: Kind::of(error.is_unreachable(), error.is_numerical()),
-            message: error.to_string(),
-        }
-    }
-}
-
-impl From<DynError> for Error {
-    fn from(error: DynError) -> Self {
-        Self {
-            kind: Kind::of(false, error.is_numerical()),
-            message: error.to_string(),
-        }
-    }
-}
-
-impl From<ReduceError> for Error {
-    fn from(error: ReduceError) -> Self {
-        Self {
-            kind: Kind::of(error.is_unreachable(), error.is_numerical()),
-            message: error.to_string(),
-        }
-    }
-}
-
-impl From<FuzzyError> for Error {
-    fn from(error: FuzzyError) -> Self {
-        Self {
-            kind: Kind::of(false, error.is_numerical()),
-            message: error.to_string(),
-        }
-    }
-}
-
-impl From<SimError> for Error {
-    fn from(error: SimError) -> Self {
-        Self {
-            kind: Kind::of(error.is_unreachable(), error.is_numerical()),
+            kind: error.class(),
             message: error.to_string(),
         }
     }
@@ -177,7 +113,8 @@ pub(crate) fn count(
             Err(Error::input(format!("{name} must be at least {minimum}, got {n}")).into())
         }
         _ => Err(Error::input(format!(
-            "{name} must be a whole number of at most 64 bits, got {value}"
+            "{name} must be a whole number of at most 64 bits, got {}",
+            value.repr()?
         ))
         .into()),
     }

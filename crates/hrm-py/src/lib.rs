@@ -1,10 +1,12 @@
 #![doc = include_str!("../README.md")]
 
+mod args;
 mod arm;
 mod array;
 mod chain;
 mod errors;
 mod fuzzy;
+mod pool;
 mod reduced;
 mod scenario;
 mod spatial;

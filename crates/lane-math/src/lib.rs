@@ -1,9 +1,11 @@
 #![doc = include_str!("../README.md")]
 
+mod error_class;
 mod instruction_sets;
 mod lanes;
 mod trig;
 
+pub use error_class::{Classify, ErrorClass};
 pub use instruction_sets::instruction_sets;
 pub use lanes::{Lane, Pack};
 pub use trig::{REDUCTION_LIMIT, sin_cos, sin_cos_in_range, sin_cos_lanes};

@@ -14,12 +14,12 @@
 //! of more than [`MAX_BATCH_LINKS`] links.
 
 use lane_math::Pack;
+use lane_math::{Classify, ErrorClass};
 use pulp::{Arch, Simd, WithSimd};
 
-use crate::aba::{ArticulatedLink, LinkBuffers, MAX_WIDTH, aba, kernel};
-use crate::data::ChainData;
+use crate::aba::{LinkBuffers, MAX_WIDTH, aba, kernel};
+use crate::data::{ArticulatedLink, ChainData, LinkFrame};
 use crate::error::DynError;
-use crate::kinematics::LinkFrame;
 use crate::model::ChainModel;
 
 /// The most links evaluated SIMD across states: an [`AbaBatchData`] holds 640 bytes a link for
@@ -43,6 +43,15 @@ pub enum BatchError {
         /// Why [`aba`] refused it.
         error: DynError,
     },
+}
+
+impl Classify for BatchError {
+    /// The class of the [`DynError`] inside.
+    fn class(&self) -> ErrorClass {
+        match self {
+            Self::Shape(error) | Self::State { error, .. } => error.class(),
+        }
+    }
 }
 
 /// Workspace of [`aba_batch`] for one [`ChainModel`]: create it once, reuse it for every batch.

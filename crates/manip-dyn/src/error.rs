@@ -1,11 +1,13 @@
 //! The error type of this crate.
 
+use lane_math::{Classify, ErrorClass};
+
 /// Why a dynamics computation was refused.
 ///
-/// Every variant names the condition that failed. Two predicates sort the variants into the
-/// classes a caller acts on, exactly one of which holds for every error:
-/// [`DynError::is_numerical`] (a computation on valid input failed in double precision) and
-/// [`DynError::is_invalid_input`] (the input is malformed or outside the model's domain).
+/// Every variant names the condition that failed. [`Classify::class`] sorts the variants into
+/// the classes a caller acts on:
+/// [`ErrorClass::Numerical`] (a computation on valid input failed in double precision) and
+/// [`ErrorClass::InvalidInput`] (the input is malformed or outside the model's domain).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum DynError {
@@ -106,24 +108,21 @@ pub enum DynError {
     NotPositiveDefinite,
 }
 
+impl Classify for DynError {
+    /// [`Numerical`](ErrorClass::Numerical) when a computation on valid input failed in double
+    /// precision: a mass matrix that is not numerically positive definite, or a result that
+    /// overflowed ([`NotPositiveDefinite`](DynError::NotPositiveDefinite),
+    /// [`NonFiniteResult`](DynError::NonFiniteResult)); otherwise the input was malformed or
+    /// outside the model's domain.
+    fn class(&self) -> ErrorClass {
+        match self {
+            Self::NotPositiveDefinite | Self::NonFiniteResult { .. } => ErrorClass::Numerical,
+            _ => ErrorClass::InvalidInput,
+        }
+    }
+}
+
 impl DynError {
-    /// Whether a computation on valid input failed in double precision: a mass matrix that is
-    /// not numerically positive definite, or a result that overflowed
-    /// ([`NotPositiveDefinite`](DynError::NotPositiveDefinite),
-    /// [`NonFiniteResult`](DynError::NonFiniteResult)).
-    pub fn is_numerical(&self) -> bool {
-        matches!(
-            self,
-            Self::NotPositiveDefinite | Self::NonFiniteResult { .. }
-        )
-    }
-
-    /// Whether the input was malformed or outside the model's domain (every error that is not
-    /// [`is_numerical`](Self::is_numerical)).
-    pub fn is_invalid_input(&self) -> bool {
-        !self.is_numerical()
-    }
-
     /// Names the link of a [`DynError::InvalidLinkParameter`]: it becomes
     /// [`DynError::InvalidLink`] with this 0-based `index`. Every other error is returned as is.
     ///

@@ -13,6 +13,7 @@
 //! so are the states left over after the last whole group, and every state of a model with more
 //! than [`MAX_BATCH_COORDS`] coordinates.
 
+use lane_math::{Classify, ErrorClass};
 use pulp::{Arch, Simd, WithSimd};
 
 use crate::cache_aligned::CacheAligned;
@@ -48,6 +49,15 @@ pub enum BatchError {
         /// Why [`forward_dynamics`] refused it.
         error: ReduceError,
     },
+}
+
+impl Classify for BatchError {
+    /// The class of the [`ReduceError`] inside.
+    fn class(&self) -> ErrorClass {
+        match self {
+            Self::Shape(error) | Self::State { error, .. } => error.class(),
+        }
+    }
 }
 
 /// Workspace of [`forward_dynamics_batch`] for one [`ReducedModel`]: create it once, reuse it for

@@ -1,16 +1,18 @@
 //! The error type of this crate, and the input checks that produce it.
 
+use lane_math::{Classify, ErrorClass};
+
 use backbone_kin::KinError;
 use manip_dyn::DynError;
 
 /// Why a reduced-dynamics computation was refused.
 ///
 /// Every variant names the condition that failed, so a caller (or the `hrm` command line) can
-/// print it as one readable line. Three predicates sort the variants into the classes a caller
-/// acts on, exactly one of which holds for every error: [`ReduceError::is_numerical`] (a
-/// computation on valid input failed in double precision), [`ReduceError::is_unreachable`] (a
+/// print it as one readable line. [`Classify::class`] sorts the variants into the classes a caller
+/// acts on: [`ErrorClass::Numerical`] (a
+/// computation on valid input failed in double precision), [`ErrorClass::Unreachable`] (a
 /// kinematic target the curve cannot reach, from [`KinError`]) and
-/// [`ReduceError::is_invalid_input`] (the input is malformed or outside the model's domain). A
+/// [`ErrorClass::InvalidInput`] (the input is malformed or outside the model's domain). A
 /// wrapped [`DynError`] or [`KinError`] keeps its own class.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -121,33 +123,31 @@ pub enum ReduceError {
         /// The offending value.
         value: f64,
     },
+    /// A workspace built for a planar arm given with a spatial one, or the reverse.
+    #[error("a workspace built for a {built} arm was given a {given} arm")]
+    WrongFamily {
+        /// The family the workspace was built for (`"planar"` or `"spatial"`).
+        built: &'static str,
+        /// The family of the arm given.
+        given: &'static str,
+    },
 }
 
-impl ReduceError {
-    /// Whether a computation on valid input failed in double precision: `M*` not numerically
-    /// positive definite, a result that overflowed, the eq-18 iteration diverging or not
-    /// converging, or a wrapped [`DynError`] or [`KinError`] of that class.
-    pub fn is_numerical(&self) -> bool {
+impl Classify for ReduceError {
+    /// [`Numerical`](ErrorClass::Numerical) when a computation on valid input failed in double
+    /// precision: `M*` not numerically positive definite, a result that overflowed, the eq-18
+    /// iteration diverging or not converging; a wrapped [`DynError`] or [`KinError`] keeps its
+    /// own class; otherwise the input was malformed or outside the model's domain.
+    fn class(&self) -> ErrorClass {
         match self {
-            Self::Dyn(e) => e.is_numerical(),
-            Self::Kin(e) => e.is_numerical(),
+            Self::Dyn(e) => e.class(),
+            Self::Kin(e) => e.class(),
             Self::NotPositiveDefinite
             | Self::NonFiniteResult { .. }
             | Self::JacobiDiverged { .. }
-            | Self::JacobiNotConverged { .. } => true,
-            _ => false,
+            | Self::JacobiNotConverged { .. } => ErrorClass::Numerical,
+            _ => ErrorClass::InvalidInput,
         }
-    }
-
-    /// Whether a wrapped [`KinError`] says the curve cannot reach a target.
-    pub fn is_unreachable(&self) -> bool {
-        matches!(self, Self::Kin(e) if e.is_unreachable())
-    }
-
-    /// Whether the input was malformed or outside the model's domain: neither
-    /// [`is_numerical`](Self::is_numerical) nor [`is_unreachable`](Self::is_unreachable).
-    pub fn is_invalid_input(&self) -> bool {
-        !(self.is_numerical() || self.is_unreachable())
     }
 }
 

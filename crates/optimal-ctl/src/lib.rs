@@ -15,12 +15,13 @@ pub use linearise::Linearisation;
 pub use lqr::{Lqr, LqrSettings};
 pub use mpc::{MAX_MPC_HORIZON, Mpc, MpcSettings};
 
+use lane_math::{Classify, ErrorClass};
 use modal_reduce::ReduceError;
 
 /// Why an optimal-control computation was refused or failed.
 ///
-/// [`OptimalError::is_numerical`] and [`OptimalError::is_invalid_input`] sort the variants into
-/// the two classes a caller acts on; exactly one holds for every error.
+/// [`ErrorClass::Numerical`] and [`ErrorClass::InvalidInput`] are the two classes
+/// ([`Classify::class`]) its variants fall into.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum OptimalError {
@@ -63,21 +64,16 @@ pub enum OptimalError {
     NotPositiveDefinite(&'static str),
 }
 
-impl OptimalError {
-    /// Whether a computation on valid input failed numerically: the reduced dynamics' numerical
-    /// failures ([`ReduceError::is_numerical`]), a Riccati recursion that did not converge, or a
-    /// matrix that is not numerically positive definite.
-    pub fn is_numerical(&self) -> bool {
+impl Classify for OptimalError {
+    /// [`Numerical`](ErrorClass::Numerical) when a computation on valid input failed: a Riccati
+    /// recursion that did not converge, or a matrix that is not numerically positive definite; a
+    /// wrapped [`ReduceError`] keeps its own class; otherwise the input was malformed or outside
+    /// its domain.
+    fn class(&self) -> ErrorClass {
         match self {
-            Self::Dynamics(e) => e.is_numerical(),
-            Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) => true,
-            _ => false,
+            Self::Dynamics(e) => e.class(),
+            Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) => ErrorClass::Numerical,
+            _ => ErrorClass::InvalidInput,
         }
-    }
-
-    /// Whether the input was malformed or outside its domain (every error that is not
-    /// [`is_numerical`](Self::is_numerical)).
-    pub fn is_invalid_input(&self) -> bool {
-        !self.is_numerical()
     }
 }

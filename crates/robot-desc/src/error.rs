@@ -1,5 +1,7 @@
 //! The error type of this crate.
 
+use lane_math::{Classify, ErrorClass};
+
 /// Why a robot description was refused or could not be exported. Every message is one line
 /// naming the element (`joint 'elbow'`, `link 'tool'`, `<inertial>` of a link) and the problem.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -16,7 +18,7 @@ pub enum DescError {
     /// The text is not well-formed XML, or uses a DTD (refused: no entity is ever expanded),
     /// or has more than [`MAX_XML_NODES`](crate::MAX_XML_NODES) nodes.
     #[error("not a readable XML document: {0}")]
-    Xml(String),
+    Xml(roxmltree::Error),
     /// Elements nest deeper than [`MAX_XML_DEPTH`](crate::MAX_XML_DEPTH).
     #[error("elements nest deeper than {max} levels (at line {line}); URDF needs 5")]
     TooDeep {
@@ -70,6 +72,14 @@ pub enum DescError {
         /// Why.
         problem: String,
     },
+}
+
+impl Classify for DescError {
+    /// Always [`InvalidInput`](ErrorClass::InvalidInput): a description is read, checked and
+    /// written, never computed with.
+    fn class(&self) -> ErrorClass {
+        ErrorClass::InvalidInput
+    }
 }
 
 impl DescError {

@@ -81,8 +81,7 @@ pub fn read_urdf(text: &str) -> Result<Reading, DescError> {
         nodes_limit: MAX_XML_NODES,
         ..ParsingOptions::default()
     };
-    let doc =
-        Document::parse_with_options(text, options).map_err(|e| DescError::Xml(e.to_string()))?;
+    let doc = Document::parse_with_options(text, options).map_err(DescError::Xml)?;
     check_shape(&doc)?;
     let root = doc.root_element();
     if root.tag_name().name() != "robot" {

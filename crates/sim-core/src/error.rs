@@ -1,5 +1,7 @@
 //! The error types of this crate.
 
+use lane_math::{Classify, ErrorClass};
+
 use crate::ode::OdeError;
 use backbone_kin::KinError;
 use modal_reduce::ReduceError;
@@ -8,11 +10,10 @@ use std::sync::Arc;
 
 /// Why a simulation could not be built or had to stop.
 ///
-/// Every variant names the condition that failed; the ones raised during a run say when. Three
-/// predicates sort the variants into the classes a caller acts on, exactly one of which holds
-/// for every error: [`SimError::is_unreachable`] (a reference the curve cannot reach),
-/// [`SimError::is_numerical`] (a computation or a run on valid input failed numerically) and
-/// [`SimError::is_invalid_input`] (a setting, file or model outside its domain). A wrapped
+/// Every variant names the condition that failed; the ones raised during a run say when. [`Classify::class`]
+/// sorts the variants into the classes a caller acts on: [`ErrorClass::Unreachable`] (a reference the curve cannot reach),
+/// [`ErrorClass::Numerical`] (a computation or a run on valid input failed numerically) and
+/// [`ErrorClass::InvalidInput`] (a setting, file or model outside its domain). A wrapped
 /// library error keeps its own class.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -96,6 +97,15 @@ pub enum SimError {
         /// The torque it produced, one entry per coordinate.
         tau_star: Vec<f64>,
     },
+    /// A disturbance hook ([`LoopHooks`](crate::LoopHooks)) produced a NaN or infinite joint
+    /// torque.
+    #[error("the disturbance hook produced a non-finite joint torque {tau:?} at t = {t} s")]
+    NonFiniteDisturbance {
+        /// When (s).
+        t: f64,
+        /// The joint torques it produced, one entry per joint.
+        tau: Vec<f64>,
+    },
     /// A controller failed with an error of its own (one that is not a [`SimError`]).
     #[error("the controller failed at t = {t} s: {source}")]
     Controller {
@@ -144,42 +154,31 @@ impl PartialEq for ControllerFailure {
     }
 }
 
-impl SimError {
-    /// Whether a reference point cannot be reached by the backbone curve
-    /// ([`Unreachable`](SimError::Unreachable), or a wrapped [`KinError`] of that class).
-    pub fn is_unreachable(&self) -> bool {
+impl Classify for SimError {
+    /// [`Unreachable`](ErrorClass::Unreachable) for a reference point the backbone curve cannot
+    /// reach ([`Unreachable`](SimError::Unreachable)); [`Numerical`](ErrorClass::Numerical) for a
+    /// run on valid input that failed: an integration that diverged, a non-finite control, a
+    /// runaway tracking error, or a controller's own failure; a wrapped library error keeps its
+    /// own class; otherwise a setting, file or model was outside its domain.
+    fn class(&self) -> ErrorClass {
         match self {
-            Self::Unreachable { .. } => true,
-            Self::Kinematics(e) => e.is_unreachable(),
-            Self::Dynamics { source, .. } | Self::Model(source) => source.is_unreachable(),
-            _ => false,
-        }
-    }
-
-    /// Whether a computation or a run on valid input failed numerically: a wrapped library error
-    /// of that class, an integration that diverged, a non-finite control, a runaway tracking
-    /// error, or a controller's own failure during the run.
-    pub fn is_numerical(&self) -> bool {
-        match self {
-            Self::Kinematics(e) => e.is_numerical(),
-            Self::Dynamics { source, .. } | Self::Model(source) => source.is_numerical(),
-            Self::Fuzzy(e) => e.is_numerical(),
-            Self::ChainDynamics { source, .. } => source.is_numerical(),
+            Self::Unreachable { .. } => ErrorClass::Unreachable,
+            Self::Kinematics(e) => e.class(),
+            Self::Dynamics { source, .. } | Self::Model(source) => source.class(),
+            Self::Fuzzy(e) => e.class(),
+            Self::ChainDynamics { source, .. } => source.class(),
             Self::Integration(_)
             | Self::ChainIntegration(_)
             | Self::NonFiniteControl { .. }
+            | Self::NonFiniteDisturbance { .. }
             | Self::Controller { .. }
-            | Self::RunawayError { .. } => true,
-            _ => false,
+            | Self::RunawayError { .. } => ErrorClass::Numerical,
+            _ => ErrorClass::InvalidInput,
         }
     }
+}
 
-    /// Whether a setting, file or model was outside its domain: neither
-    /// [`is_unreachable`](Self::is_unreachable) nor [`is_numerical`](Self::is_numerical).
-    pub fn is_invalid_input(&self) -> bool {
-        !(self.is_unreachable() || self.is_numerical())
-    }
-
+impl SimError {
     /// The run's error for a controller failure at `t`: a [`SimError`] (the built-in
     /// controllers') as it is, any other error as [`SimError::Controller`].
     pub fn from_controller(t: f64, error: crate::controller::ControllerError) -> Self {

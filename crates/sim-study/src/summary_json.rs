@@ -7,9 +7,8 @@
 //! - [`sweep`]: a whole sweep (`hrm sweep`, `hrm sweep merge`): `{"config": ..., "cells": [...]}`
 //!   (`docs/sweep.md`).
 
-use crate::study::{Cell, Stopped, SweepConfig};
+use crate::study::{Cell, RunOutcome, Stopped, SweepConfig};
 use serde_json::{Value, json};
-use sim_core::Run;
 
 /// The `summary.json` of one run: its [`Summary`](sim_core::Summary)'s fields; for a run that
 /// stopped, those of the data up to the stop plus `error` (why and when) and `stopped_at_s`;
@@ -30,20 +29,20 @@ use sim_core::Run;
 /// assert_eq!(summary["stopped_at_s"], summary["simulated_s"]);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-pub fn run(result: &Result<Run, Stopped>) -> Value {
+pub fn run(result: &RunOutcome) -> Value {
     match result {
         Ok(run) => json!(run.summary),
         Err(Stopped {
             error,
             partial: None,
-        }) => json!({ "error": error }),
+        }) => json!({ "error": error.to_string() }),
         Err(Stopped {
             error,
             partial: Some(run),
         }) => {
             let mut summary = json!(run.summary);
             if let Some(fields) = summary.as_object_mut() {
-                fields.insert("error".into(), json!(error));
+                fields.insert("error".into(), json!(error.to_string()));
                 fields.insert("stopped_at_s".into(), json!(run.summary.simulated_s));
             }
             summary

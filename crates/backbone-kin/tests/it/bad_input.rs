@@ -8,6 +8,7 @@ use backbone_kin::{
     BackboneCurve, BaseAngle, Branch, HarmonicIk, IkOptions, KinError, MAX_HARMONICS, MAX_LINKS,
     ModalMap, end_point, inverse_j0, inverse_kinematics, joint_positions, tip_position,
 };
+use lane_math::Classify;
 use std::collections::BTreeSet;
 use std::f64::consts::FRAC_PI_2;
 use test_support::refusal::{Row, SENTINEL, check, exactly, row, starts, untouched, words};

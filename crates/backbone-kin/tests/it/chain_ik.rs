@@ -6,6 +6,7 @@ use backbone_kin::{
     BackboneCurve, BaseAngle, Branch, ChainIk, IkOptions, KinError, ModalMap,
     chain_inverse_kinematics, end_point, inverse_kinematics, tip_position,
 };
+use lane_math::Classify;
 use proptest::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
 

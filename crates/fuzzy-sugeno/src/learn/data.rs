@@ -166,6 +166,7 @@ impl TrainingData {
 mod tests {
     use super::*;
     use crate::SystemProblem;
+    use lane_math::Classify;
 
     #[test]
     fn rows_and_columns() {

@@ -489,6 +489,7 @@ fn assemble(
 mod tests {
     use super::*;
     use crate::learn::MAX_ROWS;
+    use lane_math::Classify;
     use proptest::prelude::*;
 
     fn plane(rows: usize) -> TrainingData {

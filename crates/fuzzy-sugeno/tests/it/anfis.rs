@@ -2,6 +2,7 @@
 //! series generated here; and the trained system evaluated by the crate's own evaluator.
 
 use crate::common;
+use lane_math::Classify;
 
 use fuzzy_sugeno::learn::{
     AnfisOptions, ConsequentOrder, GridPartition, SetShape, TrainingData, anfis, genfis_grid,

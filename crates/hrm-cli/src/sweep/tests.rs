@@ -1,6 +1,6 @@
 use super::*;
 use clap::Parser;
-use sim_study::study::{Outcome, RunMetrics, ShardFile};
+use sim_study::study::{RunMetrics, ShardFile, StoredOutcome};
 
 /// `hrm` reduced to its `sweep` subcommand.
 #[derive(Parser)]
@@ -238,7 +238,7 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
     assert!(err.contains("a split has 1 to 10000000"), "{err}");
     assert!(parse(&["--shard", "1/10000001"]).is_err());
     let mut short = ShardFile::read(&shard(2)).unwrap();
-    if let Outcome::Completed(metrics) = &mut short.runs[0].outcome {
+    if let StoredOutcome::Completed(metrics) = &mut short.runs[0].outcome {
         metrics.modal_error_rms_rad.pop();
     }
     write(&cut_path, &short.to_json().unwrap()).unwrap();
@@ -278,7 +278,7 @@ fn a_run_in_a_sweep_is_the_scenario_run_alone_with_its_seed() {
         let alone = scenario.build().unwrap().run().unwrap();
         assert_eq!(
             run.outcome,
-            Outcome::Completed(RunMetrics::from_summary(&alone.summary).unwrap()),
+            StoredOutcome::Completed(RunMetrics::from_summary(&alone.summary).unwrap()),
             "run {}",
             run.index
         );

@@ -5,6 +5,7 @@
 //! tests here. Refused calls leave their outputs untouched and the workspace usable.
 
 use faer::Mat;
+use lane_math::Classify;
 use manip_dyn::{
     ChainData, ChainModel, DynError, Link, MAX_LINKS, aba, coriolis, coriolis_matrix,
     forward_dynamics, gravity, kinetic_energy, mass_matrix, nonlinear_effects, potential_energy,

@@ -5,6 +5,7 @@
 //! untouched, and a workspace that saw an error stays usable.
 
 use backbone_kin::{BaseAngle, KinError, ModalMap};
+use lane_math::Classify;
 use manip_dyn::{ChainModel, DynError};
 use modal_reduce::{
     JacobiSettings, ReduceError, ReducedData, ReducedModel, forward_dynamics,

@@ -17,6 +17,8 @@ mod rk4;
 pub use dopri5::{DormandPrince, Tolerances};
 pub use rk4::Rk4;
 
+use lane_math::{Classify, ErrorClass};
+
 /// The right-hand side `f(t, y)` of a first-order system `y' = f(t, y)`.
 pub trait OdeSystem {
     /// Why an evaluation of the right-hand side failed.
@@ -88,6 +90,22 @@ pub enum OdeError<E> {
     /// The interval, step size or tolerances were not usable.
     #[error("invalid integration setting: {0}")]
     InvalidSetting(&'static str),
+}
+
+impl<E: Classify> Classify for OdeError<E> {
+    /// The right-hand side's error keeps its class; a state that blew up, a step that fell too
+    /// small and a step budget spent are [`Numerical`](ErrorClass::Numerical); a state of the
+    /// wrong dimension or an unusable interval, step or tolerance is
+    /// [`InvalidInput`](ErrorClass::InvalidInput).
+    fn class(&self) -> ErrorClass {
+        match self {
+            Self::Rhs { source, .. } => source.class(),
+            Self::NonFinite { .. } | Self::StepTooSmall { .. } | Self::MaxSteps { .. } => {
+                ErrorClass::Numerical
+            }
+            Self::Dimension { .. } | Self::InvalidSetting(_) => ErrorClass::InvalidInput,
+        }
+    }
 }
 
 /// Checks `y` against the dimension and the interval `[t0, t1]`.

@@ -117,7 +117,7 @@ impl Scenario {
         }
         let mut reference = self
             .reference
-            .build(0.0, self.modal.harmonics, self.alpha0, n)?;
+            .build(0.0, self.modal.harmonics, self.alpha0, n)?()?;
         let q0 = match &self.initial {
             Some(initial) => {
                 if initial.a_dot.is_some() {

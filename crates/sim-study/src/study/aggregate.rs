@@ -4,7 +4,7 @@
 //! only the current cell's values.
 
 use super::plan::SweepConfig;
-use super::shard_file::{Outcome, RunMetrics, RunResult};
+use super::shard_file::{RunMetrics, RunResult, StoredOutcome};
 use crate::ControllerKind;
 use serde::Serialize;
 
@@ -213,8 +213,8 @@ impl CellBuilder {
         });
         values.runs += 1;
         match &run.outcome {
-            Outcome::Completed(metrics) => values.push(metrics),
-            Outcome::Failed { error, .. } => {
+            StoredOutcome::Completed(metrics) => values.push(metrics),
+            StoredOutcome::Failed { error, .. } => {
                 values.failed += 1;
                 if values.failures.len() < MAX_LISTED_FAILURES {
                     values.failures.push(FailedRun {

@@ -1,8 +1,8 @@
 //! The main job's experiment set: every shipped scenario with every controller, in parallel.
 
+use super::outcome::{RunOutcome, run_scenario};
 use crate::{ControllerKind, Scenario, ScenarioError};
 use rayon::prelude::*;
-use sim_core::Run;
 
 /// One finished (or stopped) run of a comparison: its scenario, controller, the names of its
 /// modal coordinates and its outcome (the run, or why it could not be built or had to stop).
@@ -15,17 +15,7 @@ pub struct ComparisonRun {
     /// The names of the modal coordinates ([`Scenario::coordinate_names`]).
     pub coordinates: Vec<String>,
     /// The run, or why it stopped and what it recorded until then.
-    pub result: Result<Run, Stopped>,
-}
-
-/// Why a run of a comparison stopped, and what it recorded until then.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Stopped {
-    /// The error that stopped the run, or refused to build it.
-    pub error: String,
-    /// The record and the summary up to the stop (what [`sim_core::RunFailure`] keeps); `None` if
-    /// the scenario could not be built.
-    pub partial: Option<Run>,
+    pub result: RunOutcome,
 }
 
 /// Every shipped scenario ([`Scenario::builtin_names`]), in order.
@@ -37,19 +27,7 @@ pub fn builtin_scenarios() -> Result<Vec<Scenario>, ScenarioError> {
 pub fn run_one(scenario: &Scenario, kind: ControllerKind) -> ComparisonRun {
     let mut scenario = scenario.clone();
     scenario.controller.kind = kind;
-    let result = match scenario.build() {
-        Err(e) => Err(Stopped {
-            error: e.to_string(),
-            partial: None,
-        }),
-        Ok(mut simulation) => simulation.run().map_err(|failure| Stopped {
-            error: failure.error.to_string(),
-            partial: Some(Run {
-                record: failure.record,
-                summary: failure.summary,
-            }),
-        }),
-    };
+    let result = run_scenario(&scenario);
     ComparisonRun {
         scenario: scenario.name.clone(),
         controller: kind,
@@ -61,22 +39,22 @@ pub fn run_one(scenario: &Scenario, kind: ControllerKind) -> ComparisonRun {
 /// Runs every scenario with every controller ([`ControllerKind::ALL`]) in parallel (rayon), calling
 /// `each` on every run as it finishes (e.g. to write its files), and returns the runs in a fixed
 /// order: scenario by scenario, controllers in [`ControllerKind::ALL`] order. The first error of
-/// `each` stops the comparison.
+/// `each` (of the caller's own type `E`) stops the comparison.
 ///
 /// ```
 /// use sim_study::study::{builtin_scenarios, compare};
 /// let mut scenarios = builtin_scenarios()?;
 /// scenarios.retain(|s| s.name == "paper-responses-step");
 /// scenarios[0].duration = 0.2;
-/// let runs = compare(&scenarios, |_| Ok(()))?;
+/// let runs = compare(&scenarios, |_| Ok::<(), std::convert::Infallible>(()))?;
 /// assert_eq!(runs.len(), sim_study::ControllerKind::ALL.len());
 /// assert!(runs.iter().all(|r| r.result.is_ok()));
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-pub fn compare(
+pub fn compare<E: Send>(
     scenarios: &[Scenario],
-    each: impl Fn(&ComparisonRun) -> Result<(), String> + Sync,
-) -> Result<Vec<ComparisonRun>, String> {
+    each: impl Fn(&ComparisonRun) -> Result<(), E> + Sync,
+) -> Result<Vec<ComparisonRun>, E> {
     let jobs: Vec<(&Scenario, ControllerKind)> = scenarios
         .iter()
         .flat_map(|scenario| ControllerKind::ALL.map(|kind| (scenario, kind)))

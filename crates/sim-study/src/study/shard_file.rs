@@ -7,6 +7,7 @@
 //! merge holds its runs in memory.
 
 use super::inputs;
+use super::outcome::{RunError, RunOutcome, Stopped};
 use super::plan::{MAX_SHARDS, RunId, Shard, SweepConfig};
 use crate::ControllerKind;
 use serde::{Deserialize, Serialize};
@@ -59,18 +60,21 @@ pub struct RunResult {
     /// Seed of the run's noise sources.
     pub seed: u64,
     /// Its metrics, or why it stopped.
-    pub outcome: Outcome,
+    pub outcome: StoredOutcome,
 }
 
-/// How a run ended.
+/// A run's [`RunOutcome`] as a shard file keeps it: the summary metrics of a run that completed,
+/// or the message of its [`RunError`] and the time it reached. The typed error does not survive
+/// the file (a merge reads it back as the text the sweep wrote), so this is the record of an
+/// outcome, not an error type.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
-pub enum Outcome {
+pub enum StoredOutcome {
     /// It ran to the end.
     Completed(RunMetrics),
     /// It stopped (divergence, runaway error) or could not be built.
     Failed {
-        /// Why, and when.
+        /// Why, and when: the [`RunError`]'s message.
         error: String,
         /// Simulated time reached (s).
         simulated_s: f64,
@@ -93,9 +97,30 @@ pub struct RunMetrics {
     pub control_effort_n2m2s: f64,
 }
 
+impl StoredOutcome {
+    /// What a sweep keeps of `outcome`: the metrics of a run that completed with finite ones,
+    /// otherwise the error's message and the simulated time reached.
+    pub fn of(outcome: RunOutcome) -> Self {
+        let stopped = match outcome {
+            Ok(run) => match RunMetrics::from_summary(&run.summary) {
+                Ok(metrics) => return StoredOutcome::Completed(metrics),
+                Err(error) => Stopped {
+                    error,
+                    partial: Some(Box::new(run)),
+                },
+            },
+            Err(stopped) => stopped,
+        };
+        StoredOutcome::Failed {
+            error: stopped.error.to_string(),
+            simulated_s: stopped.simulated_s(),
+        }
+    }
+}
+
 impl RunMetrics {
-    /// The kept metrics of `summary`, or an error if one is not finite.
-    pub fn from_summary(s: &Summary) -> Result<Self, String> {
+    /// The kept metrics of `summary`, or [`RunError::NonFiniteMetrics`] if one is not finite.
+    pub fn from_summary(s: &Summary) -> Result<Self, RunError> {
         let m = RunMetrics {
             tip_error_rms_m: s.tip_error_rms_m,
             tip_error_max_m: s.tip_error_max_m,
@@ -116,7 +141,7 @@ impl RunMetrics {
         {
             Ok(m)
         } else {
-            Err(format!("the run's summary metrics are not finite: {m:?}"))
+            Err(RunError::NonFiniteMetrics(m))
         }
     }
 }
@@ -167,7 +192,7 @@ impl RunMetrics {
 
 impl RunResult {
     /// A run's entry.
-    pub fn new(id: &RunId, outcome: Outcome) -> Self {
+    pub fn new(id: &RunId, outcome: StoredOutcome) -> Self {
         RunResult {
             index: id.index,
             noise_level: id.noise_level,
@@ -463,7 +488,7 @@ impl<R: ShardSource> ShardReader<R> {
             ));
         }
         let m = self.header.config.scenario.n_coords();
-        if let Outcome::Completed(metrics) = &run.outcome {
+        if let StoredOutcome::Completed(metrics) = &run.outcome {
             if metrics.modal_error_rms_rad.len() != m {
                 return Err(format!(
                     "{origin}: run {} has {} modal errors, but its scenario has {m} modal \
@@ -476,7 +501,7 @@ impl<R: ShardSource> ShardReader<R> {
                 .check(self.header.config.scenario.limits.max_modal_error)
                 .map_err(|e| format!("{origin}: line {number}: run {}: {e}", run.index))?;
         }
-        if let Outcome::Failed { simulated_s, .. } = &run.outcome
+        if let StoredOutcome::Failed { simulated_s, .. } = &run.outcome
             && !(simulated_s.is_finite() && *simulated_s >= 0.0)
         {
             return Err(format!(

@@ -3,6 +3,7 @@
 //! simulation is built, never half-way through a run, and a failing run keeps its data.
 
 use backbone_kin::{BaseAngle, Branch, ModalMap};
+use lane_math::Classify;
 use manip_dyn::ChainModel;
 use modal_reduce::ReducedModel;
 use sim_core::controller::{ComputedTorque, FuzzyController, PdController};
