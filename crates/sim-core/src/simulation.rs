@@ -172,7 +172,7 @@ impl OdeSystem for Dynamics {
 /// (the spatial curve has no closed form, and the continuation tracks the chain's tip).
 enum Tips {
     Planar {
-        family: Family,
+        family: Box<Family>,
         link_lengths: Vec<f64>,
         theta: Vec<f64>,
     },
@@ -193,7 +193,7 @@ impl Tips {
                     BaseAngle::Free => None,
                 };
                 Tips::Planar {
-                    family: Family::new(curve_length, map.harmonics(), fixed)?,
+                    family: Box::new(Family::new(curve_length, map.harmonics(), fixed)?),
                     link_lengths,
                     theta: vec![0.0; model.n_links()],
                 }
