@@ -17,14 +17,12 @@ use lane_math::{Classify, ErrorClass};
 use pulp::{Arch, Simd, WithSimd};
 
 use crate::cache_aligned::CacheAligned;
-use crate::data::ReducedData;
-use crate::error::{ReduceError, check_len};
+use crate::data::{PRODUCTS, ReducedData};
+use crate::error::{ReduceError, all_finite, check_len};
 use crate::forward::forward_dynamics;
 use crate::model::ReducedModel;
 use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
-use crate::terms::{
-    LinkBuffers, PRODUCTS, StateLanes, Terms, accumulate, all_finite, angles_in_range, extract,
-};
+use crate::terms::{LinkBuffers, StateLanes, Terms, accumulate, angles_in_range, extract};
 use lane_math::{Lane, Pack};
 
 /// The most `f64` lanes of a SIMD register (AVX-512).

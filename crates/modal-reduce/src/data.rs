@@ -7,12 +7,15 @@ use pulp::Arch;
 
 use crate::cache_aligned::CacheAligned;
 use crate::error::{ReduceError, check_len};
-use crate::model::ReducedModel;
-use crate::terms::{PRODUCTS, Pair};
+use crate::model::{LINK_PADDING, ReducedModel};
 
-/// The most `f64` lanes of a SIMD register (AVX-512): the per-link buffers of one state are
-/// padded to a multiple of it.
-pub(crate) const LINK_PADDING: usize = 8;
+/// Per-link products the pre-pass leaves for the pass besides the sine and cosine, in this order
+/// in the buffer: `S_l phi_dot_l^2`, `L_l sin phi_l`, `L_l cos phi_l`,
+/// `L_l cos(phi_l) phi_dot_l^2`, `L_l sin(phi_l) phi_dot_l^2`.
+pub(crate) const PRODUCTS: usize = 5;
+
+/// An `(x, y)` pair: a column of the `2 x m` prefix sum `P_l`.
+pub(crate) type Pair<L> = [L; 2];
 
 /// Workspace for one [`ReducedModel`]: create it once, reuse it for every call.
 ///

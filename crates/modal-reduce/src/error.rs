@@ -193,3 +193,10 @@ pub(crate) fn check_finite_result(name: &'static str, values: &[f64]) -> Result<
         Err(ReduceError::NonFiniteResult { name })
     }
 }
+
+/// Whether every value is finite: one test of all of them, without the early exit that keeps a
+/// search from vectorising.
+#[inline(always)]
+pub(crate) fn all_finite(values: &[f64]) -> bool {
+    values.iter().fold(true, |finite, v| finite & v.is_finite())
+}

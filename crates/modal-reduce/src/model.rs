@@ -4,9 +4,12 @@
 use backbone_kin::{BaseAngle, ModalMap};
 use manip_dyn::ChainModel;
 
-use crate::data::LINK_PADDING;
 use crate::error::ReduceError;
 use crate::small_linalg::symmetric_eigen_extremes;
+
+/// The most `f64` lanes of a SIMD register (AVX-512): the per-link buffers of one state are
+/// padded to a multiple of it.
+pub(crate) const LINK_PADDING: usize = 8;
 
 /// Below this smallest eigenvalue of the column-normalised Gram matrix of `J` (the square of the
 /// smallest singular value of `J` with unit columns) the map is treated as rank-deficient: `M*`

@@ -8,6 +8,11 @@ use modal_reduce::ReduceError;
 use std::fmt;
 use std::sync::Arc;
 
+/// The error a controller may fail with: any error type, boxed. The built-in controllers fail
+/// with a boxed [`SimError`], which the run reports as it is; any other error is reported as
+/// [`SimError::Controller`] carrying it as its source.
+pub type ControllerError = Box<dyn std::error::Error + Send + Sync + 'static>;
+
 /// Why a simulation could not be built or had to stop.
 ///
 /// Every variant names the condition that failed; the ones raised during a run say when. [`Classify::class`]
@@ -181,7 +186,7 @@ impl Classify for SimError {
 impl SimError {
     /// The run's error for a controller failure at `t`: a [`SimError`] (the built-in
     /// controllers') as it is, any other error as [`SimError::Controller`].
-    pub fn from_controller(t: f64, error: crate::controller::ControllerError) -> Self {
+    pub fn from_controller(t: f64, error: ControllerError) -> Self {
         match error.downcast::<SimError>() {
             Ok(error) => *error,
             Err(source) => SimError::Controller {

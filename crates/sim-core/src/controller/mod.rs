@@ -46,14 +46,10 @@ pub use lqr::LqrController;
 pub use mpc::MpcController;
 pub use pd::PdController;
 
+pub use crate::error::ControllerError;
 use crate::error::SimError;
 use crate::reference::ReferenceSample;
 use modal_reduce::Plant;
-
-/// The error a controller may fail with: any error type, boxed. The built-in controllers fail
-/// with a boxed [`SimError`], which the run reports as it is; any other error is reported as
-/// [`SimError::Controller`] carrying it as its source.
-pub type ControllerError = Box<dyn std::error::Error + Send + Sync + 'static>;
 
 /// A modal state: the coordinates `a` and their rates `a_dot`, `m` entries each.
 #[derive(Debug, Clone, PartialEq, Default)]
