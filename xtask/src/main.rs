@@ -22,6 +22,7 @@
 //!   benches, never runs them).
 
 mod bench_check;
+mod imports;
 mod tidy;
 
 use std::path::{Path, PathBuf};

@@ -2,6 +2,7 @@
 
 use super::file::{ScenarioError, parse};
 use super::schema::Scenario;
+use std::path::Path;
 
 /// The scenarios shipped with the crate, by name: the paper's experiments (section 5) with the
 /// tracking task also five times faster under limits on the modal forces `tau*`, then the paper's tracking task
@@ -49,6 +50,19 @@ impl Scenario {
         match BUILTIN.iter().find(|(n, _)| *n == name) {
             Some((name, text)) => parse(text, name),
             None => Err(unknown(name)),
+        }
+    }
+
+    /// A built-in scenario by name, or else a scenario file at that path.
+    pub fn resolve(name_or_path: &str) -> Result<Self, ScenarioError> {
+        if Self::builtin_text(name_or_path).is_some() {
+            return Self::builtin(name_or_path);
+        }
+        let path = Path::new(name_or_path);
+        if path.exists() {
+            Self::load(path)
+        } else {
+            Err(unknown(name_or_path))
         }
     }
 

@@ -1,7 +1,6 @@
 //! The controllers a scenario may name: one table ([`CONTROLLERS`]) of names, descriptions and
 //! constructors from the scenario's `[controller]` settings.
 
-use super::factory::per_coordinate;
 use super::schema::ControllerSpec;
 use fuzzy_sugeno::FuzzySystem;
 use modal_reduce::ReducedModel;
@@ -311,5 +310,25 @@ impl ControllerSpec {
             gains("controller.kp", &self.kp, DEFAULT_KP)?,
             gains("controller.kd", &self.kd, DEFAULT_KD)?,
         ))
+    }
+}
+
+/// `values` if given, checked to have exactly `m` entries (one per modal coordinate); the
+/// error names the field.
+pub(super) fn per_coordinate(
+    name: &str,
+    values: Option<&[f64]>,
+    m: usize,
+) -> Result<Option<Vec<f64>>, SimError> {
+    match values {
+        None => Ok(None),
+        Some(values) if values.len() == m => Ok(Some(values.to_vec())),
+        Some(values) => Err(SimError::setting(
+            name,
+            format!(
+                "has {} entries, the modal family has {m} coordinates (one entry each)",
+                values.len()
+            ),
+        )),
     }
 }

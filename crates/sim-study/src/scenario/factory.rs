@@ -1,7 +1,7 @@
 //! From a scenario to a [`Simulation`]: the arm, the reduced model, the reference, the
 //! controller and the loop's settings, every setting checked and named when it fails.
 
-use super::controllers::ControllerSetup;
+use super::controllers::{ControllerSetup, per_coordinate};
 use super::schema::{
     Alpha0, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, NoiseSpec, ReferenceSpec,
     Scenario, TorqueLimit,
@@ -275,26 +275,6 @@ impl ArmSpec {
         }
         ChainModel::new(links, self.gravity.unwrap_or(9.81))
             .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))
-    }
-}
-
-/// `values` if given, checked to have exactly `m` entries (one per modal coordinate); the
-/// error names the field.
-pub(super) fn per_coordinate(
-    name: &str,
-    values: Option<&[f64]>,
-    m: usize,
-) -> Result<Option<Vec<f64>>, SimError> {
-    match values {
-        None => Ok(None),
-        Some(values) if values.len() == m => Ok(Some(values.to_vec())),
-        Some(values) => Err(SimError::setting(
-            name,
-            format!(
-                "has {} entries, the modal family has {m} coordinates (one entry each)",
-                values.len()
-            ),
-        )),
     }
 }
 

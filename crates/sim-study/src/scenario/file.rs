@@ -1,6 +1,5 @@
 //! Reading scenarios: TOML text and files, with one-line errors.
 
-use super::builtin::unknown;
 use super::schema::Scenario;
 use std::path::{Path, PathBuf};
 
@@ -74,19 +73,6 @@ impl Scenario {
             }
         }
         Ok(scenario)
-    }
-
-    /// A built-in scenario by name, or else a scenario file at that path.
-    pub fn resolve(name_or_path: &str) -> Result<Self, ScenarioError> {
-        if Self::builtin_text(name_or_path).is_some() {
-            return Self::builtin(name_or_path);
-        }
-        let path = Path::new(name_or_path);
-        if path.exists() {
-            Self::load(path)
-        } else {
-            Err(unknown(name_or_path))
-        }
     }
 
     /// The scenario as TOML (it parses back to an equal scenario).
