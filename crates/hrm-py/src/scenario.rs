@@ -657,7 +657,7 @@ impl Scenario {
                 )
             }
         };
-        let result = result.map_err(Stopped::from);
+        let result = result.map_err(Box::<Stopped>::from);
         Run::new(py, &scenario, label, result)
     }
 }
@@ -679,7 +679,7 @@ pub fn view_html(scene: &str) -> PyResult<String> {
         std::slice::from_ref(&scene),
         run_view::PAGE_SAMPLES,
     )
-    .map_err(|e| Error::input(e).into())
+    .map_err(|e| Error::input(e.to_string()).into())
 }
 
 /// The result of Scenario.run: the time series at the recording period (one row per recorded
@@ -724,21 +724,17 @@ impl Run {
             .unbind();
         let (run, failure) = match result {
             Ok(run) => (run, None),
-            Err(Stopped {
-                error,
-                partial: Some(run),
-            }) => (run, Some(error.to_string())),
-            Err(Stopped {
-                error,
-                partial: None,
-            }) => return Err(Error::from(error).into()),
+            Err(stopped) => match stopped.partial {
+                Some(run) => (run, Some(stopped.error.to_string())),
+                None => return Err(Error::from(stopped.error).into()),
+            },
         };
         let view = run_view::Scene {
             title: format!("{} with {controller}", scenario.name),
             caption: scenario.description.clone(),
             runs: vec![
                 run_view::from_record(scenario, controller, &run.record, failure.as_deref())
-                    .map_err(Error::input)?,
+                    .map_err(|e| Error::input(e.to_string()))?,
             ],
         };
         let r = run.record;
@@ -850,7 +846,7 @@ impl Run {
             std::slice::from_ref(&self.view),
             run_view::PAGE_SAMPLES,
         )
-        .map_err(|e| Error::input(e).into())
+        .map_err(|e| Error::input(e.to_string()).into())
     }
 
     /// The page of `view_html` in an iframe: what Jupyter shows for a Run.

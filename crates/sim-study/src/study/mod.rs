@@ -98,7 +98,7 @@ pub fn execute_group(config: &SweepConfig, ids: &[RunId]) -> Vec<RunResult> {
         match Lockstep::new(built) {
             Ok(mut group) => {
                 for (position, run) in positions.into_iter().zip(group.run()) {
-                    outcomes[position] = Some(StoredOutcome::of(run.map_err(Stopped::from)));
+                    outcomes[position] = Some(StoredOutcome::of(run.map_err(Into::into)));
                 }
             }
             // Runs a group refuses (they cannot differ but in noise and seed) are run alone.

@@ -7,9 +7,10 @@ use lane_math::{Classify, ErrorClass};
 use sim_core::{Run, RunFailure, SimError};
 
 /// How a run ended: the [`Run`] (record and summary) if it ran to the end, or [`Stopped`]: why it
-/// did not, with what it recorded until then. A sweep keeps of it the metrics
+/// did not, with what it recorded until then (boxed, as [`RunFailure`] is, to keep the `Ok` path
+/// small). A sweep keeps of it the metrics
 /// ([`StoredOutcome::of`](super::StoredOutcome::of)).
-pub type RunOutcome = Result<Run, Stopped>;
+pub type RunOutcome = Result<Run, Box<Stopped>>;
 
 /// Why a run of a study did not complete.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -49,11 +50,11 @@ pub struct Stopped {
 
 impl Stopped {
     /// A run that could not be built: `error`, and nothing recorded.
-    pub fn not_built(error: impl Into<RunError>) -> Self {
-        Self {
+    pub fn not_built(error: impl Into<RunError>) -> Box<Self> {
+        Box::new(Self {
             error: error.into(),
             partial: None,
-        }
+        })
     }
 
     /// Simulated time reached (s): the partial run's, 0 for a run that was not built.
@@ -64,17 +65,17 @@ impl Stopped {
     }
 }
 
-impl From<Box<RunFailure>> for Stopped {
+impl From<Box<RunFailure>> for Box<Stopped> {
     fn from(failure: Box<RunFailure>) -> Self {
         let RunFailure {
             error,
             record,
             summary,
         } = *failure;
-        Self {
+        Box::new(Stopped {
             error: error.into(),
             partial: Some(Run { record, summary }),
-        }
+        })
     }
 }
 

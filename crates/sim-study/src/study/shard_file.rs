@@ -109,7 +109,7 @@ impl StoredOutcome {
                     partial: Some(run),
                 },
             },
-            Err(stopped) => stopped,
+            Err(stopped) => *stopped,
         };
         StoredOutcome::Failed {
             error: stopped.error.to_string(),
