@@ -16,7 +16,7 @@
 //! Criterion's throughput is in runs, so both read as time per run.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use sim_core::{Lockstep, Simulation};
+use sim_core::{RunNoise, Simulation};
 use sim_study::{ControllerKind, NoiseSpec, Scenario};
 use std::hint::black_box;
 use std::time::Duration;
@@ -50,16 +50,25 @@ fn paper_tracking_group(c: &mut Criterion) {
     let model = scenario.model().expect("the shipped scenario builds");
     let lanes = modal_reduce::batch_lanes(&model);
     scenario.noise = NoiseSpec::uniform(scenario.n_coords(), 0.01, 0.1, 0.0);
-    let mut runs = || -> Vec<Simulation> {
-        (1..=lanes as u64)
-            .map(|seed| {
-                scenario.seed = seed;
-                scenario.build().expect("the shipped scenario builds")
-            })
-            .collect()
-    };
-    let mut alone = runs();
-    let mut together = Lockstep::new(runs()).expect("runs of one scenario make a group");
+    let prepared = scenario.prepare().expect("the shipped scenario builds");
+    let noise = scenario.run_noise().expect("the shipped scenario builds");
+    let noises: Vec<RunNoise> = (1..=lanes as u64)
+        .map(|seed| RunNoise {
+            seed,
+            ..noise.clone()
+        })
+        .collect();
+    let mut alone: Vec<Simulation> = noises
+        .iter()
+        .map(|noise| {
+            prepared
+                .simulation(noise)
+                .expect("the shipped scenario builds")
+        })
+        .collect();
+    let mut together = prepared
+        .lockstep(&noises)
+        .expect("runs of one scenario make a group");
     let mut group = c.benchmark_group("scenario_group");
     group.sample_size(10);
     group.measurement_time(Duration::from_secs(10));

@@ -22,8 +22,11 @@ Prints, for n = 10 and 30 (the figures `cargo xtask bench --check` reads):
   measured state, the first planned torque held in between), against the reference's tip, the
   loop benches/examples/mpc_loop.rs runs for hrm.
 
-The torque limits are 1.2 times the largest inverse-dynamics torque of each joint along the
-reference (binding in the transients), as in hrm's loop for each modal coordinate.
+The torque limits are 3 times the largest inverse-dynamics torque of each joint along the
+reference (binding in the first transient, from rest onto the moving reference), as in hrm's
+loop for each modal coordinate. At 1.2 and 2 times, the full arm's loop falls over: its
+warm-started 5-iteration solves saturate in the transient and open gaps they do not close
+(the reduced arm has no other modes to hold); at 3 times it tracks.
 
 Run with ./run.sh (PYTHON must have `crocoddyl` and `pin` from PyPI).
 """
@@ -49,7 +52,7 @@ OFFSET, AMPLITUDE, FREQUENCY, PHASE = (
     np.array([0.0, 0.5]),
 )
 LOOP_SECONDS, PLANT_STEP, SUBSTEPS = 1.0, 0.001, 5
-LIMIT_FACTOR = 1.2
+LIMIT_FACTOR = 3.0
 
 
 def planar_arm(n):
@@ -105,7 +108,7 @@ class Arm:
         scale = (self.jacobian**2).sum() / self.jacobian.shape[1]
         self.weights = np.concatenate([np.full(n, 1e4 / scale), np.full(n, 1.0 / scale)])
         self.effort = 1e-3 * scale
-        # Box limits: 1.2 times each joint's peak inverse-dynamics torque along the loop.
+        # Box limits: LIMIT_FACTOR times each joint's peak inverse-dynamics torque along the loop.
         peak = np.zeros(n)
         for t in np.arange(0.0, LOOP_SECONDS + HORIZON * STEP, STEP):
             peak = np.maximum(peak, np.abs(self.reference(t)[1]))

@@ -17,12 +17,17 @@
 //! iterations on average), in `[-1, 1]` in 98%, in `[-2, 2]` in 99% (8-10 iterations); the test
 //! `numeric_ik_convergence_rates` keeps these rates. Failures are stationary points of the
 //! end-point error (where the tip cannot move radially) and are reported as
-//! [`KinError::NotConverged`].
+//! [`KinError::NotConverged`]. Without a caller's guess, [`HarmonicIk::solve_unguided`] starts
+//! from the closed form of eqs 5-6 and, where that has no answer or does not converge, from a
+//! fixed list of other starts: it reaches every end point of 200 random `K = 2` and `K = 3`
+//! curves with coordinates in `[-0.5, 0.5]` (test `unguided_ik_reaches_what_the_family_reaches`).
 
+use crate::closed_form::{Branch, inverse_kinematics};
 use crate::curve::BackboneCurve;
 use crate::error::KinError;
 use crate::modal_map::check_harmonics;
 use crate::validate::{check_finite, check_len};
+use lane_math::Classify;
 
 /// Stopping rules of [`HarmonicIk::solve`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -169,6 +174,89 @@ impl HarmonicIk {
                 curve.end_point_jacobian(jacobian)
             },
         )
+    }
+}
+
+/// The first two modal coordinates of the starts [`HarmonicIk::solve_unguided`] tries after the
+/// closed form (the higher harmonics start at zero), for `branch = Positive`; `Negative` flips
+/// the sign of `a1`. Curves of moderate curvature on both sides of the base direction.
+const FALLBACK_STARTS: [[f64; 2]; 12] = [
+    [0.5, 0.5],
+    [0.5, -0.5],
+    [1.0, 1.0],
+    [1.0, -1.0],
+    [1.5, 0.0],
+    [-0.5, 0.5],
+    [-0.5, -0.5],
+    [2.0, 1.0],
+    [2.0, -1.0],
+    [-1.0, 1.0],
+    [-1.0, -1.0],
+    [0.0, 1.5],
+];
+
+impl HarmonicIk {
+    /// Solves `p(a) = target` without a caller's guess (the `2K` entries of `a` are
+    /// overwritten): first from the closed form of eqs 5-6 on `branch` (higher harmonics zero),
+    /// then, if the closed form has no answer (a target the `K = 1` family does not reach,
+    /// `|a2| > A`) or the iteration does not converge from it, from the closed form on the
+    /// other branch and from [`FALLBACK_STARTS`] in turn. A solution found from the closed form
+    /// is the one [`solve`](Self::solve) finds from it; otherwise the first start that converges
+    /// gives the answer, so the result is deterministic.
+    ///
+    /// Errors: those of [`solve`](Self::solve) for bad input or an out-of-reach target; if no
+    /// start converges, the closed form's own error when it had none to offer (e.g.
+    /// [`KinError::A2ExceedsAmplitude`]), else [`KinError::NotConverged`] from it.
+    pub fn solve_unguided(
+        &mut self,
+        target: [f64; 2],
+        branch: Branch,
+        a: &mut [f64],
+    ) -> Result<IkReport, KinError> {
+        check_len("modal coordinates", a, self.trial.len())?;
+        let (length, alpha0) = (self.curve.length(), self.curve.alpha0());
+        let other = match branch {
+            Branch::Positive => Branch::Negative,
+            Branch::Negative => Branch::Positive,
+        };
+        let sign = match branch {
+            Branch::Positive => 1.0,
+            Branch::Negative => -1.0,
+        };
+        let mut first_error = None;
+        for start in 0..2 + FALLBACK_STARTS.len() {
+            a.fill(0.0);
+            match start {
+                0 | 1 => {
+                    let side = if start == 0 { branch } else { other };
+                    match inverse_kinematics(length, target, alpha0, side) {
+                        Ok(closed) => a[..2].copy_from_slice(&closed),
+                        Err(error) => {
+                            if error.is_unreachable()
+                                && !matches!(error, KinError::OutOfReach { .. })
+                            {
+                                first_error.get_or_insert(error);
+                                continue;
+                            }
+                            return Err(error);
+                        }
+                    }
+                }
+                k => {
+                    let [a1, a2] = FALLBACK_STARTS[k - 2];
+                    a[0] = sign * a1;
+                    a[1] = a2;
+                }
+            }
+            match self.solve(target, a) {
+                Ok(report) => return Ok(report),
+                Err(error @ KinError::NotConverged { .. }) => {
+                    first_error.get_or_insert(error);
+                }
+                Err(error) => return Err(error),
+            }
+        }
+        Err(first_error.expect("at least one start was tried"))
     }
 }
 

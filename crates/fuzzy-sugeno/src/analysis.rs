@@ -19,8 +19,9 @@
 //!   neighbouring cells.
 
 use crate::error::FuzzyError;
-use crate::eval::{EvalOptions, Evaluator, OutOfRange};
+use crate::eval::Evaluator;
 use crate::membership::MembershipFn;
+use crate::options::{EvalOptions, OutOfRange};
 use crate::system::{AndMethod, Antecedent, FuzzySystem, InputVariable};
 use std::fmt;
 

@@ -18,8 +18,8 @@ use lane_math::Pack;
 use pulp::{Arch, Simd, WithSimd};
 
 use crate::error::FuzzyError;
-use crate::eval::{EvalOptions, load_input, output_value};
 use crate::kernel::{self, Workspace};
+use crate::options::{EvalOptions, load_input, output_value};
 use crate::system::FuzzySystem;
 
 /// The most `f64` lanes of a SIMD register (AVX-512): the stride of the batch's buffers.
@@ -115,8 +115,17 @@ impl<F: FnMut(&[f64], &mut [f64]) -> Result<(), FuzzyError>> Batch<'_, F> {
         }
         let (c, methods) = (self.system.compiled(), self.system.methods());
         let mut slots = self.work.slots();
-        kernel::fire::<Pack<S>, MAX_WIDTH>(simd, c, methods.and, methods.or, &mut slots);
-        kernel::sums::<Pack<S>, MAX_WIDTH>(simd, c, &mut slots);
+        if c.separable.is_some() {
+            // A row beyond the separable form's limits is evaluated as `eval` evaluates it, by
+            // the general kernel: the group's rows then go one at a time, each taking its own
+            // path, so that a row's bits never depend on the rows beside it.
+            if !kernel::separable_sums::<Pack<S>, MAX_WIDTH>(simd, c, &mut slots) {
+                return false;
+            }
+        } else {
+            kernel::fire::<Pack<S>, MAX_WIDTH>(simd, c, methods.and, methods.or, &mut slots);
+            kernel::sums::<Pack<S>, MAX_WIDTH>(simd, c, &mut slots);
+        }
         // Every output of the group is checked before the first is written; each replaces its
         // weighted sum.
         for (o, pair) in self.work.sums.chunks_exact_mut(2).enumerate() {

@@ -50,6 +50,13 @@ enum PendingRule {
     Indexed(Rule),
 }
 
+impl FuzzySystem {
+    /// Starts a [`SystemBuilder`].
+    pub fn builder(name: impl Into<String>) -> SystemBuilder {
+        SystemBuilder::new(name)
+    }
+}
+
 impl SystemBuilder {
     /// An empty system with product AND, probabilistic-sum OR and the centre-average
     /// defuzzifier (the paper's methods).

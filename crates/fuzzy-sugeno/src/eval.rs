@@ -2,74 +2,11 @@
 //! or minimum AND, probabilistic sum or maximum OR, rule weights) and the centre-average
 //! defuzzifier of eq 21.
 
-use lane_math::Lane;
-
 use crate::batch::BatchWorkspace;
 use crate::error::FuzzyError;
 use crate::kernel::{self, Workspace};
-use crate::membership::MembershipFn;
-use crate::system::{Defuzzification, FuzzySystem};
-
-/// What to do with an input outside its variable's range.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum OutOfRange {
-    /// Evaluate at the nearest end of the range. For a controller this saturates the action:
-    /// bell and Gaussian sets decay on both sides, so evaluated as given a very large error
-    /// *weakens* the action of the rule base (the paper's controller at
-    /// `[-0.414, -0.263, 0.904, 0.246]`: 71.32 clamped, 75.94 as given; far enough out, every
-    /// output tends to the average of the rules' conclusions).
-    Clamp,
-    /// Evaluate the membership functions at the value as given (the default): what MATLAB's
-    /// `evalfis` and Simulink's Fuzzy Logic Controller block do, with a warning.
-    /// [`Evaluator::first_outside_range`] tells the caller when this happened, so that it can
-    /// warn as MATLAB does.
-    #[default]
-    AsGiven,
-    /// Refuse with [`FuzzyError::InputOutOfRange`].
-    Error,
-}
-
-/// What an output is when none of the rules that conclude on it fires (total strength 0).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub enum NoRuleFired {
-    /// The middle of the output's range (the default). MATLAB's `evalfis` does the same: "No
-    /// rules fired for Output 1. Defuzzified output value set to its mean range value", a
-    /// warning by default (`evalfisOptions`' `NoRuleFiredMessage`).
-    #[default]
-    MiddleOfRange,
-    /// One fixed value per output.
-    Values(Vec<f64>),
-    /// Refuse with [`FuzzyError::NoRuleFired`].
-    Error,
-}
-
-/// The evaluation policies of an [`Evaluator`].
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct EvalOptions {
-    /// Inputs outside their range.
-    pub out_of_range: OutOfRange,
-    /// Outputs on which no rule fires.
-    pub no_rule_fired: NoRuleFired,
-}
-
-impl EvalOptions {
-    /// Checks the options for a system of `n_outputs` outputs: [`NoRuleFired::Values`] must hold
-    /// one finite value per output.
-    pub(crate) fn check(&self, n_outputs: usize) -> Result<(), FuzzyError> {
-        if let NoRuleFired::Values(values) = &self.no_rule_fired {
-            if values.len() != n_outputs {
-                return Err(FuzzyError::FallbackCount {
-                    expected: n_outputs,
-                    found: values.len(),
-                });
-            }
-            if let Some(&value) = values.iter().find(|v| !v.is_finite()) {
-                return Err(FuzzyError::NonFiniteFallback { value });
-            }
-        }
-        Ok(())
-    }
-}
+use crate::options::{EvalOptions, OutOfRange, load_input, output_value};
+use crate::system::FuzzySystem;
 
 /// Evaluates a [`FuzzySystem`] with its own scratch space: after [`Evaluator::new`], evaluating
 /// allocates nothing. Clone it to evaluate on several threads.
@@ -249,8 +186,10 @@ impl Evaluator {
         Ok(self.firing_strengths())
     }
 
-    /// The firing strengths computed by the last [`eval`](Self::eval) or [`fire`](Self::fire)
-    /// (zeros before the first).
+    /// The firing strengths computed by the last [`fire`](Self::fire) (zeros before the first).
+    /// [`eval`](Self::eval) computes them too, except for a system whose rules are a complete
+    /// grid with a separable form (such as the paper's controller), which it evaluates without
+    /// them: call `fire` to read the strengths at a point.
     pub fn firing_strengths(&self) -> &[f64] {
         let c = self.system.compiled();
         self.one.values[c.strength_base..c.slot_count].as_flattened()
@@ -260,6 +199,26 @@ impl Evaluator {
 /// Checks one point's inputs, applies the range policy into `work.x` and fires the rules.
 #[inline]
 fn fire_point(
+    system: &FuzzySystem,
+    options: &EvalOptions,
+    work: &mut Workspace<1>,
+    inputs: &[f64],
+) -> Result<(), FuzzyError> {
+    load_inputs(system, options, work, inputs)?;
+    let methods = system.methods();
+    kernel::fire::<f64, 1>(
+        (),
+        system.compiled(),
+        methods.and,
+        methods.or,
+        &mut work.slots(),
+    );
+    Ok(())
+}
+
+/// Checks one point's inputs and applies the range policy into `work.x`.
+#[inline(always)]
+fn load_inputs(
     system: &FuzzySystem,
     options: &EvalOptions,
     work: &mut Workspace<1>,
@@ -275,14 +234,6 @@ fn fire_point(
     for (index, (slot, &value)) in work.x.iter_mut().zip(inputs).enumerate() {
         slot[0] = load_input(system, options, index, value)?;
     }
-    let methods = system.methods();
-    kernel::fire::<f64, 1>(
-        (),
-        system.compiled(),
-        methods.and,
-        methods.or,
-        &mut work.slots(),
-    );
     Ok(())
 }
 
@@ -302,8 +253,13 @@ fn eval_point(
             found: outputs.len(),
         });
     }
-    fire_point(system, options, work, inputs)?;
-    kernel::sums::<f64, 1>((), system.compiled(), &mut work.slots());
+    load_inputs(system, options, work, inputs)?;
+    let c = system.compiled();
+    if !kernel::separable_sums::<f64, 1>((), c, &mut work.slots()) {
+        let methods = system.methods();
+        kernel::fire::<f64, 1>((), c, methods.and, methods.or, &mut work.slots());
+        kernel::sums::<f64, 1>((), c, &mut work.slots());
+    }
     // Every output is checked before the first is written; each replaces its weighted sum.
     for (o, pair) in work.sums.chunks_exact_mut(2).enumerate() {
         pair[0][0] = output_value(system, options, o, pair[0][0], pair[1][0])?;
@@ -314,446 +270,9 @@ fn eval_point(
     Ok(())
 }
 
-/// Input `index` after the range policy; refuses a non-finite value, and one out of range under
-/// [`OutOfRange::Error`].
-#[inline(always)]
-pub(crate) fn load_input(
-    system: &FuzzySystem,
-    options: &EvalOptions,
-    index: usize,
-    value: f64,
-) -> Result<f64, FuzzyError> {
-    let variable = &system.inputs()[index];
-    if !value.is_finite() {
-        return Err(FuzzyError::NonFiniteInput {
-            index,
-            name: variable.name.clone(),
-            value,
-        });
-    }
-    let [min, max] = variable.range;
-    Ok(match options.out_of_range {
-        OutOfRange::Clamp => value.clamp(min, max),
-        OutOfRange::AsGiven => value,
-        OutOfRange::Error if value < min || value > max => {
-            return Err(FuzzyError::InputOutOfRange {
-                index,
-                name: variable.name.clone(),
-                value,
-                min,
-                max,
-            });
-        }
-        OutOfRange::Error => value,
-    })
-}
-
-/// Output `o` from the weighted sum and the total strength of the rules that conclude on it
-/// (eq 21, or the weighted sum), with the policy when no rule fires; refuses a non-finite value.
-#[inline(always)]
-pub(crate) fn output_value(
-    system: &FuzzySystem,
-    options: &EvalOptions,
-    o: usize,
-    weighted: f64,
-    total: f64,
-) -> Result<f64, FuzzyError> {
-    let value = if total > 0.0 {
-        match system.methods().defuzzification {
-            Defuzzification::WeightedAverage => weighted / total,
-            Defuzzification::WeightedSum => weighted,
-        }
-    } else {
-        let variable = &system.outputs()[o];
-        match &options.no_rule_fired {
-            NoRuleFired::MiddleOfRange => 0.5 * (variable.range[0] + variable.range[1]),
-            NoRuleFired::Values(values) => values[o],
-            NoRuleFired::Error => {
-                return Err(FuzzyError::NoRuleFired {
-                    index: o,
-                    name: variable.name.clone(),
-                });
-            }
-        }
-    };
-    if !value.is_finite() {
-        return Err(FuzzyError::NonFiniteOutput {
-            index: o,
-            name: system.outputs()[o].name.clone(),
-            value,
-        });
-    }
-    Ok(value)
-}
-
-/// The largest exponent `2 b` evaluated by repeated squaring; larger or non-integer ones use `powf`.
-const MAX_INTEGER_BELL_EXPONENT: f64 = 64.0;
-
-/// A validated membership function in evaluation form.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum CompiledMf {
-    /// Bell with `b = 1`: `1 / (1 + u^2)`, `u = (x - c) / a`.
-    BellSquare { center: f64, width: f64 },
-    /// Bell with `b = 2` (the paper's): `1 / (1 + (u^2)^2)`.
-    BellQuartic { center: f64, width: f64 },
-    /// Bell with an integer exponent `2 b <= 64`: `|u|^(2b)` by repeated squaring.
-    BellInteger {
-        center: f64,
-        width: f64,
-        exponent: u32,
-    },
-    /// Any other bell: `|u|^(2b)` by `powf`.
-    BellReal {
-        center: f64,
-        width: f64,
-        exponent: f64,
-    },
-    /// `exp(-(x - c)^2 * k)` with `k = 1 / (2 sigma^2)`.
-    Gaussian { center: f64, k: f64 },
-    /// Two-sided Gaussian (MATLAB's `gauss2mf`).
-    Gaussian2 {
-        center1: f64,
-        k1: f64,
-        center2: f64,
-        k2: f64,
-    },
-    /// `trimf`.
-    Triangle { left: f64, peak: f64, right: f64 },
-    /// `trapmf`.
-    Trapezoid { a: f64, b: f64, c: f64, d: f64 },
-    /// `sigmf`.
-    Sigmoid { slope: f64, center: f64 },
-    /// `dsigmf`.
-    SigmoidDifference {
-        slope1: f64,
-        center1: f64,
-        slope2: f64,
-        center2: f64,
-    },
-    /// `psigmf`.
-    SigmoidProduct {
-        slope1: f64,
-        center1: f64,
-        slope2: f64,
-        center2: f64,
-    },
-    /// `smf`, or its step when `a >= b`.
-    SShape { start: f64, end: f64 },
-    /// `zmf`, or its step when `a >= b`.
-    ZShape { start: f64, end: f64 },
-    /// `pimf`: `smf(x, [a b]) * zmf(x, [c d])`.
-    PiShape { a: f64, b: f64, c: f64, d: f64 },
-    /// `constant`.
-    Constant(f64),
-}
-
-impl CompiledMf {
-    /// Validates `mf` and picks its evaluation form.
-    pub(crate) fn new(mf: &MembershipFn) -> Result<Self, FuzzyError> {
-        mf.validate()?;
-        let gauss_k = |sigma: f64| 1.0 / (2.0 * sigma * sigma);
-        Ok(match *mf {
-            MembershipFn::Bell {
-                width,
-                slope,
-                center,
-            } => {
-                let exponent = 2.0 * slope;
-                if exponent == 2.0 {
-                    Self::BellSquare { center, width }
-                } else if exponent == 4.0 {
-                    Self::BellQuartic { center, width }
-                } else if exponent.fract() == 0.0 && exponent <= MAX_INTEGER_BELL_EXPONENT {
-                    Self::BellInteger {
-                        center,
-                        width,
-                        exponent: exponent as u32,
-                    }
-                } else {
-                    Self::BellReal {
-                        center,
-                        width,
-                        exponent,
-                    }
-                }
-            }
-            MembershipFn::Gaussian { sigma, center } => Self::Gaussian {
-                center,
-                k: gauss_k(sigma),
-            },
-            MembershipFn::Gaussian2 {
-                sigma1,
-                center1,
-                sigma2,
-                center2,
-            } => Self::Gaussian2 {
-                center1,
-                k1: gauss_k(sigma1),
-                center2,
-                k2: gauss_k(sigma2),
-            },
-            MembershipFn::Triangle { left, peak, right } => Self::Triangle { left, peak, right },
-            MembershipFn::Trapezoid {
-                left_foot,
-                left_shoulder,
-                right_shoulder,
-                right_foot,
-            } => Self::Trapezoid {
-                a: left_foot,
-                b: left_shoulder,
-                c: right_shoulder,
-                d: right_foot,
-            },
-            MembershipFn::Sigmoid { slope, center } => Self::Sigmoid { slope, center },
-            MembershipFn::SigmoidDifference {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            } => Self::SigmoidDifference {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            },
-            MembershipFn::SigmoidProduct {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            } => Self::SigmoidProduct {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            },
-            MembershipFn::SShape { start, end } => Self::SShape { start, end },
-            MembershipFn::ZShape { start, end } => Self::ZShape { start, end },
-            MembershipFn::PiShape {
-                left_foot,
-                left_shoulder,
-                right_shoulder,
-                right_foot,
-            } => Self::PiShape {
-                a: left_foot,
-                b: left_shoulder,
-                c: right_shoulder,
-                d: right_foot,
-            },
-            MembershipFn::Constant { value } => Self::Constant(value),
-        })
-    }
-
-    /// The degrees of membership of the points of `x` (one or a SIMD register of them): the
-    /// integer bells branch-free on all lanes at once, the other kinds by [`eval`](Self::eval)
-    /// lane by lane. Either way each lane gets exactly what `eval` gives for it.
-    #[inline(always)]
-    pub(crate) fn eval_lane<L: Lane>(&self, cx: L::Context, x: L) -> L {
-        match *self {
-            Self::BellSquare { center, width } => bell(cx, x, center, width, |u| u * u),
-            Self::BellQuartic { center, width } => bell(cx, x, center, width, |u| {
-                let u2 = u * u;
-                u2 * u2
-            }),
-            Self::BellInteger {
-                center,
-                width,
-                exponent,
-            } => bell(cx, x, center, width, |u| {
-                integer_power(cx, u.abs(), exponent)
-            }),
-            _ => x.map(|x| self.eval(x)),
-        }
-    }
-
-    /// The degree of membership of `x` (finite `x`; never NaN for finite `x`).
-    #[inline]
-    pub(crate) fn eval(&self, x: f64) -> f64 {
-        match *self {
-            Self::BellSquare { .. } | Self::BellQuartic { .. } | Self::BellInteger { .. } => {
-                self.eval_lane((), x)
-            }
-            Self::BellReal {
-                center,
-                width,
-                exponent,
-            } => 1.0 / (1.0 + ((x - center) / width).abs().powf(exponent)),
-            Self::Gaussian { center, k } => gaussian(x, center, k),
-            Self::Gaussian2 {
-                center1,
-                k1,
-                center2,
-                k2,
-            } => {
-                let left = if x <= center1 {
-                    gaussian(x, center1, k1)
-                } else {
-                    1.0
-                };
-                let right = if x >= center2 {
-                    gaussian(x, center2, k2)
-                } else {
-                    1.0
-                };
-                left * right
-            }
-            Self::Triangle { left, peak, right } => {
-                if x == peak {
-                    1.0
-                } else if x <= left || x >= right {
-                    0.0
-                } else if x < peak {
-                    (x - left) / (peak - left)
-                } else {
-                    (right - x) / (right - peak)
-                }
-            }
-            Self::Trapezoid { a, b, c, d } => {
-                let (rising, falling) = trapezoid_sides(x, a, b, c, d);
-                rising.min(falling)
-            }
-            Self::Sigmoid { slope, center } => sigmoid(x, slope, center),
-            Self::SigmoidDifference {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            } => (sigmoid(x, slope1, center1) - sigmoid(x, slope2, center2)).abs(),
-            Self::SigmoidProduct {
-                slope1,
-                center1,
-                slope2,
-                center2,
-            } => sigmoid(x, slope1, center1) * sigmoid(x, slope2, center2),
-            Self::SShape { start, end } => s_shape(x, start, end),
-            Self::ZShape { start, end } => z_shape(x, start, end),
-            Self::PiShape { a, b, c, d } => s_shape(x, a, b) * z_shape(x, c, d),
-            Self::Constant(value) => value,
-        }
-    }
-}
-
-/// The rising and falling sides of `trapmf [a b c d]` at `x`: the degree is their minimum.
-#[inline]
-pub(crate) fn trapezoid_sides(x: f64, a: f64, b: f64, c: f64, d: f64) -> (f64, f64) {
-    let rising = if x >= b {
-        1.0
-    } else if x < a {
-        0.0
-    } else {
-        (x - a) / (b - a)
-    };
-    let falling = if x <= c {
-        1.0
-    } else if x > d {
-        0.0
-    } else {
-        (d - x) / (d - c)
-    };
-    (rising, falling)
-}
-
-/// MATLAB's `smf(x, [a b])`: the quadratic spline from 0 at `a` to 1 at `b` (value 1/2 at the
-/// midpoint), or the step `x >= (a + b) / 2` when `a >= b`.
-#[inline]
-pub(crate) fn s_shape(x: f64, a: f64, b: f64) -> f64 {
-    let middle = 0.5 * (a + b);
-    if a >= b {
-        return if x >= middle { 1.0 } else { 0.0 };
-    }
-    if x <= a {
-        0.0
-    } else if x <= middle {
-        let t = (x - a) / (b - a);
-        2.0 * t * t
-    } else if x <= b {
-        let t = (b - x) / (b - a);
-        1.0 - 2.0 * t * t
-    } else {
-        1.0
-    }
-}
-
-/// MATLAB's `zmf(x, [a b])`: the quadratic spline from 1 at `a` to 0 at `b`, or the step
-/// `x <= (a + b) / 2` when `a >= b`.
-#[inline]
-pub(crate) fn z_shape(x: f64, a: f64, b: f64) -> f64 {
-    let middle = 0.5 * (a + b);
-    if a >= b {
-        return if x <= middle { 1.0 } else { 0.0 };
-    }
-    if x <= a {
-        1.0
-    } else if x <= middle {
-        let t = (x - a) / (b - a);
-        1.0 - 2.0 * t * t
-    } else if x <= b {
-        let t = (b - x) / (b - a);
-        2.0 * t * t
-    } else {
-        0.0
-    }
-}
-
-#[inline]
-fn gaussian(x: f64, center: f64, k: f64) -> f64 {
-    let d = x - center;
-    (-(d * d) * k).exp()
-}
-
-/// MATLAB's `sigmf(x, [a c])`: `1 / (1 + exp(-a (x - c)))`.
-#[inline]
-pub(crate) fn sigmoid(x: f64, slope: f64, center: f64) -> f64 {
-    1.0 / (1.0 + (-slope * (x - center)).exp())
-}
-
-/// The generalized bell `1 / (1 + power(u))`, `u = (x - center) / width`, `power(u)` standing
-/// for `|u|^(2b)`.
-#[inline(always)]
-fn bell<L: Lane>(cx: L::Context, x: L, center: f64, width: f64, power: impl Fn(L) -> L) -> L {
-    let u = (x - L::splat(cx, center)) / L::splat(cx, width);
-    let one = L::splat(cx, 1.0);
-    one / (one + power(u))
-}
-
-/// `base^exponent` by repeated squaring (exponentiation by squaring), no `powf`.
-#[inline(always)]
-fn integer_power<L: Lane>(cx: L::Context, mut base: L, mut exponent: u32) -> L {
-    let mut result = L::splat(cx, 1.0);
-    while exponent > 0 {
-        if exponent & 1 == 1 {
-            result = result * base;
-        }
-        base = base * base;
-        exponent >>= 1;
-    }
-    result
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn integer_slopes_are_compiled_without_powf() {
-        let compile = |b: f64| CompiledMf::new(&MembershipFn::bell(1.0, b, 0.0)).unwrap();
-        assert!(matches!(compile(1.0), CompiledMf::BellSquare { .. }));
-        assert!(matches!(compile(2.0), CompiledMf::BellQuartic { .. }));
-        assert!(matches!(
-            compile(1.5),
-            CompiledMf::BellInteger { exponent: 3, .. }
-        ));
-        assert!(matches!(
-            compile(32.0),
-            CompiledMf::BellInteger { exponent: 64, .. }
-        ));
-        assert!(matches!(compile(32.5), CompiledMf::BellReal { .. }));
-        assert!(matches!(compile(0.3), CompiledMf::BellReal { .. }));
-        // Exponentiation by squaring is exact for powers of two and small integers.
-        assert_eq!(integer_power((), 1.5, 0), 1.0);
-        assert_eq!(integer_power((), 1.5, 5), 7.59375);
-        assert_eq!(integer_power((), 2.0, 64), 2f64.powi(64));
-    }
 
     /// Every instruction set gives every point the same bits, in a batch and alone (see
     /// [`lane_math::instruction_sets`]), inputs inside and outside their ranges.

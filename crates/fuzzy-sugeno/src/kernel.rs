@@ -20,6 +20,8 @@
 
 use lane_math::Lane;
 
+use crate::compiled_mf::integer_power;
+use crate::separable::{MAX_SEPARABLE_SETS, Separable};
 use crate::system::{AndMethod, Compiled, DenseTerms, FuzzySystem, OrMethod};
 
 /// The buffers of one evaluation, in slots of `N` values (see the module docs).
@@ -32,6 +34,8 @@ pub(crate) struct Slots<'a, const N: usize> {
     pub terms: &'a mut [[f64; N]],
     /// Two slots per output: the weighted sum of the rule outputs and the total strength.
     pub sums: &'a mut [[f64; N]],
+    /// The grades of the separable form ([`Separable::grade_count`]; empty without one).
+    pub grades: &'a mut [[f64; N]],
 }
 
 impl<const N: usize> Slots<'_, N> {
@@ -45,7 +49,8 @@ impl<const N: usize> Slots<'_, N> {
             self.x.len() == c.n_inputs
                 && self.values.len() == c.slot_count
                 && self.terms.len() == c.term_values.len()
-                && self.sums.len() == 2 * (c.conclusion_offsets.len() - 1),
+                && self.sums.len() == 2 * (c.conclusion_offsets.len() - 1)
+                && self.grades.len() == c.separable.as_ref().map_or(0, Separable::grade_count),
             "fuzzy-sugeno: kernel buffers sized for another system"
         );
     }
@@ -216,6 +221,88 @@ fn dense_sums<L: Lane, const N: usize, T>(
     }
 }
 
+/// The separable form of `c` (`separable.rs`) at `slots.x`, into `slots.sums` as [`sums`]
+/// writes them (the numerator and denominator of eq 21, each multiplied by the same positive
+/// product of the grades); `false`, with the sums untouched, when `c` has no separable form or
+/// a point of `slots.x` lies where an `A_{ik}` exceeds its limit (then [`fire`] and [`sums`]
+/// evaluate it).
+#[inline(always)]
+pub(crate) fn separable_sums<L: Lane, const N: usize>(
+    cx: L::Context,
+    c: &Compiled,
+    slots: &mut Slots<'_, N>,
+) -> bool {
+    slots.check_sizes(c);
+    let Some(s) = &c.separable else {
+        return false;
+    };
+    // One monomorphised body per common exponent: the paper's `2 b = 4`, the square, any other.
+    match s.exponent {
+        2 => separable_grid(cx, s, slots, |u: L| u * u),
+        4 => separable_grid(cx, s, slots, |u: L| {
+            let u2 = u * u;
+            u2 * u2
+        }),
+        e => separable_grid(cx, s, slots, |u: L| integer_power(cx, u.abs(), e)),
+    }
+}
+
+/// [`separable_sums`] with `power(u) = |u|^(2 b)`.
+#[inline(always)]
+fn separable_grid<L: Lane, const N: usize>(
+    cx: L::Context,
+    s: &Separable,
+    slots: &mut Slots<'_, N>,
+    power: impl Fn(L) -> L,
+) -> bool {
+    let one = L::splat(cx, 1.0);
+    let n_sets = s.sets.len();
+    let mut largest = one;
+    for (i, bounds) in s.set_offsets.windows(2).enumerate() {
+        let x: L = get(cx, slots.x, i);
+        // `A_k = 1 + |u_k|^(2b)`, then the grades `P_k = prod_{j != k} A_j` and their sum.
+        let mut a = [one; MAX_SEPARABLE_SETS];
+        for (a, &[center, inverse_width]) in a.iter_mut().zip(&s.sets[bounds[0]..bounds[1]]) {
+            *a = one + power((x - L::splat(cx, center)) * inverse_width);
+            largest = largest.max(*a);
+        }
+        let count = bounds[1] - bounds[0];
+        let mut sum = L::splat(cx, 0.0);
+        for k in 0..count {
+            let mut grade = one;
+            for (j, &a_j) in a[..count].iter().enumerate() {
+                if j != k {
+                    grade = grade * a_j;
+                }
+            }
+            set(slots.grades, bounds[0] + k, grade);
+            sum = sum + grade;
+        }
+        set(slots.grades, n_sets + i, sum);
+    }
+    if !L::splat(cx, s.limit).all_greater(largest) {
+        return false;
+    }
+    for (o, grid) in s.outputs.iter().enumerate() {
+        let d = grid.inputs.len();
+        let mut weighted = L::splat(cx, 0.0);
+        for (k, &z) in grid.terms.iter().enumerate() {
+            let mut term = L::splat(cx, z);
+            for &slot in &grid.factors[k * d..(k + 1) * d] {
+                term = term * get::<L, N>(cx, slots.grades, slot as usize);
+            }
+            weighted = weighted + term;
+        }
+        let mut total = one;
+        for &i in &grid.inputs {
+            total = total * get::<L, N>(cx, slots.grades, n_sets + i);
+        }
+        set(slots.sums, 2 * o, weighted);
+        set(slots.sums, 2 * o + 1, total);
+    }
+    true
+}
+
 /// The kernel's buffers for `N` points, sized for one system at construction.
 #[derive(Debug, Clone)]
 pub(crate) struct Workspace<const N: usize> {
@@ -227,6 +314,8 @@ pub(crate) struct Workspace<const N: usize> {
     pub terms: Vec<[f64; N]>,
     /// Two slots per output.
     pub sums: Vec<[f64; N]>,
+    /// The grades of the separable form, if the system has one.
+    pub grades: Vec<[f64; N]>,
 }
 
 impl<const N: usize> Workspace<N> {
@@ -242,6 +331,7 @@ impl<const N: usize> Workspace<N> {
             values,
             terms: c.term_values.iter().map(|&t| [t; N]).collect(),
             sums: vec![[0.0; N]; 2 * system.outputs().len()],
+            grades: vec![[0.0; N]; c.separable.as_ref().map_or(0, Separable::grade_count)],
         }
     }
 
@@ -253,6 +343,7 @@ impl<const N: usize> Workspace<N> {
             values: &mut self.values,
             terms: &mut self.terms,
             sums: &mut self.sums,
+            grades: &mut self.grades,
         }
     }
 }

@@ -3,6 +3,7 @@
 pub mod analysis;
 mod batch;
 mod builder;
+mod compiled_mf;
 mod error;
 mod eval;
 #[cfg(feature = "formats")]
@@ -15,18 +16,21 @@ mod kernel;
 #[cfg(feature = "learn")]
 pub mod learn;
 mod membership;
+mod options;
 mod paper;
+mod separable;
 mod system;
 
 pub use analysis::{AnalysisOptions, AnalysisReport, COVERAGE_ROUNDING};
 pub use builder::SystemBuilder;
 pub use error::{ConsequentParameter, FuzzyError, LearningProblem, SystemProblem};
-pub use eval::{EvalOptions, Evaluator, NoRuleFired, OutOfRange, OutsideRange};
+pub use eval::{Evaluator, OutsideRange};
 #[cfg(feature = "formats")]
 pub use export_c::CSource;
 #[cfg(feature = "formats")]
 pub use fis::FisNote;
 pub use membership::MembershipFn;
+pub use options::{EvalOptions, NoRuleFired, OutOfRange};
 pub use paper::{PaperController, paper_controller};
 pub use system::{
     AndMethod, Antecedent, Connective, Defuzzification, FuzzySet, FuzzySystem, InputVariable,

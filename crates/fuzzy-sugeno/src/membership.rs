@@ -8,8 +8,8 @@
 //! (`CompiledMf`), which picks the cheapest exact formula (for example repeated squaring instead
 //! of `powf` for the integer bell slopes the paper uses).
 
+use crate::compiled_mf::{CompiledMf, MAX_INTEGER_BELL_EXPONENT};
 use crate::error::FuzzyError;
-use crate::eval::CompiledMf;
 
 /// A membership function `mu(x) in [0, 1]` of one input fuzzy set.
 ///
@@ -394,14 +394,112 @@ impl MembershipFn {
     /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
     /// ```
     pub fn degree(&self, x: f64) -> Result<f64, FuzzyError> {
-        Ok(CompiledMf::new(self)?.eval(x))
+        Ok(self.compile()?.eval(x))
+    }
+
+    /// Validates the function and picks its evaluation form ([`CompiledMf`]).
+    pub(crate) fn compile(&self) -> Result<CompiledMf, FuzzyError> {
+        self.validate()?;
+        let gauss_k = |sigma: f64| 1.0 / (2.0 * sigma * sigma);
+        Ok(match *self {
+            MembershipFn::Bell {
+                width,
+                slope,
+                center,
+            } => {
+                let exponent = 2.0 * slope;
+                if exponent == 2.0 {
+                    CompiledMf::BellSquare { center, width }
+                } else if exponent == 4.0 {
+                    CompiledMf::BellQuartic { center, width }
+                } else if exponent.fract() == 0.0 && exponent <= MAX_INTEGER_BELL_EXPONENT {
+                    CompiledMf::BellInteger {
+                        center,
+                        width,
+                        exponent: exponent as u32,
+                    }
+                } else {
+                    CompiledMf::BellReal {
+                        center,
+                        width,
+                        exponent,
+                    }
+                }
+            }
+            MembershipFn::Gaussian { sigma, center } => CompiledMf::Gaussian {
+                center,
+                k: gauss_k(sigma),
+            },
+            MembershipFn::Gaussian2 {
+                sigma1,
+                center1,
+                sigma2,
+                center2,
+            } => CompiledMf::Gaussian2 {
+                center1,
+                k1: gauss_k(sigma1),
+                center2,
+                k2: gauss_k(sigma2),
+            },
+            MembershipFn::Triangle { left, peak, right } => {
+                CompiledMf::Triangle { left, peak, right }
+            }
+            MembershipFn::Trapezoid {
+                left_foot,
+                left_shoulder,
+                right_shoulder,
+                right_foot,
+            } => CompiledMf::Trapezoid {
+                a: left_foot,
+                b: left_shoulder,
+                c: right_shoulder,
+                d: right_foot,
+            },
+            MembershipFn::Sigmoid { slope, center } => CompiledMf::Sigmoid { slope, center },
+            MembershipFn::SigmoidDifference {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            } => CompiledMf::SigmoidDifference {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            },
+            MembershipFn::SigmoidProduct {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            } => CompiledMf::SigmoidProduct {
+                slope1,
+                center1,
+                slope2,
+                center2,
+            },
+            MembershipFn::SShape { start, end } => CompiledMf::SShape { start, end },
+            MembershipFn::ZShape { start, end } => CompiledMf::ZShape { start, end },
+            MembershipFn::PiShape {
+                left_foot,
+                left_shoulder,
+                right_shoulder,
+                right_foot,
+            } => CompiledMf::PiShape {
+                a: left_foot,
+                b: left_shoulder,
+                c: right_shoulder,
+                d: right_foot,
+            },
+            MembershipFn::Constant { value } => CompiledMf::Constant(value),
+        })
     }
 }
 
 /// One membership-function kind, described once: its names in the formats the crate reads and
 /// writes (MATLAB's `.fis`, fuzzylite's FCL), its parameters, their order in FCL, how to build
 /// the function from them, and where its degree changes character. The formulas themselves are
-/// the compiled form's (`eval::CompiledMf`); the gradients are ANFIS's (`learn::premise`).
+/// the compiled form's (`compiled_mf::CompiledMf`); the gradients are ANFIS's (`learn::premise`).
 #[derive(Debug)]
 pub(crate) struct Kind {
     /// MATLAB's type name (`.fis`).

@@ -1,9 +1,10 @@
 //! A validated Takagi-Sugeno fuzzy system: variables, fuzzy sets, rules and inference methods
 //! (section 4 of the paper, eqs 19-21).
 
+use crate::compiled_mf::CompiledMf;
 use crate::error::{FuzzyError, SystemProblem};
-use crate::eval::CompiledMf;
 use crate::membership::MembershipFn;
+use crate::separable::Separable;
 
 /// An input variable: a name, the range it was designed for, and its fuzzy sets.
 #[derive(Debug, Clone, PartialEq)]
@@ -190,11 +191,6 @@ pub struct FuzzySystem {
 }
 
 impl FuzzySystem {
-    /// Starts a [`SystemBuilder`](crate::SystemBuilder).
-    pub fn builder(name: impl Into<String>) -> crate::SystemBuilder {
-        crate::SystemBuilder::new(name)
-    }
-
     /// Validates every part and compiles the evaluation tables.
     pub(crate) fn new(
         name: String,
@@ -247,7 +243,7 @@ impl FuzzySystem {
             check_rule(rule, &inputs, &outputs)
                 .map_err(|problem| invalid(&format!("rule {}", r + 1), problem))?;
         }
-        let compiled = Compiled::new(&inputs, &outputs, &rules)?;
+        let compiled = Compiled::new(&inputs, &outputs, &rules, methods)?;
         Ok(Self {
             name,
             inputs,
@@ -285,6 +281,13 @@ impl FuzzySystem {
 
     pub(crate) fn compiled(&self) -> &Compiled {
         &self.compiled
+    }
+
+    /// The system without its separable form, evaluated by the general kernel (for tests).
+    #[cfg(test)]
+    pub(crate) fn without_separable_form(mut self) -> Self {
+        self.compiled.separable = None;
+        self
     }
 }
 
@@ -488,6 +491,9 @@ pub(crate) struct Compiled {
     pub conclusions: Vec<[u32; 2]>,
     /// Output `o`'s conclusions are `conclusions[conclusion_offsets[o]..conclusion_offsets[o + 1]]`.
     pub conclusion_offsets: Vec<usize>,
+    /// The separable form of a complete grid of product rules, when the system has one
+    /// (`separable.rs`): what [`Evaluator::eval`](crate::Evaluator::eval) takes.
+    pub separable: Option<Separable>,
 }
 
 /// The terms of [`Compiled::dense_terms`], one pair per rule and pair of outputs.
@@ -504,6 +510,7 @@ impl Compiled {
         inputs: &[InputVariable],
         outputs: &[OutputVariable],
         rules: &[Rule],
+        methods: Methods,
     ) -> Result<Self, FuzzyError> {
         let mut mfs = Vec::new();
         let mut mf_inputs = Vec::new();
@@ -511,7 +518,7 @@ impl Compiled {
         for (i, input) in inputs.iter().enumerate() {
             set_offsets.push(mfs.len());
             for set in &input.sets {
-                mfs.push(CompiledMf::new(&set.membership)?);
+                mfs.push(set.membership.compile()?);
                 mf_inputs.push(i);
             }
         }
@@ -654,7 +661,20 @@ impl Compiled {
                 DenseTerms::Slots(pairs)
             }
         });
+        let constant_terms: Vec<Vec<Option<f64>>> = outputs
+            .iter()
+            .map(|output| {
+                (output.terms.iter())
+                    .map(|term| match term.function {
+                        OutputFn::Constant(c) => Some(c),
+                        OutputFn::Linear { .. } => None,
+                    })
+                    .collect()
+            })
+            .collect();
+        let separable = Separable::new(&mfs, &mf_inputs, &constant_terms, rules, methods);
         let compiled = Self {
+            separable,
             mfs,
             mf_inputs,
             has_complements,
@@ -733,6 +753,11 @@ impl Compiled {
                 .iter()
                 .all(|&[rule, term]| (rule as usize) < n_rules && (term as usize) < n_terms)
             && dense_in_bounds
+            && self.separable.as_ref().is_none_or(|s| {
+                s.slots_in_bounds()
+                    && s.sets.len() == self.mfs.len()
+                    && s.set_offsets.len() == self.n_inputs + 1
+            })
     }
 }
 

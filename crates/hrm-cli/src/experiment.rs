@@ -21,6 +21,9 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
             .parse()
             .map_err(|e: sim_core::SimError| e.to_string())?;
     }
+    if scenario.arm.urdf.is_some() {
+        return crate::chain_simulate::simulate(&scenario, out);
+    }
     scenario.build().map_err(|e| e.to_string())?;
     let staging = OutputDir::create(out, "simulate")?;
     let outcome = run_one(&scenario, scenario.controller.kind);

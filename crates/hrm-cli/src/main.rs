@@ -2,6 +2,7 @@
 
 mod args;
 mod arm_cmd;
+mod chain_simulate;
 mod console;
 mod eval;
 mod experiment;

@@ -1,5 +1,6 @@
 //! `hrm.Arm`: the planar chain and its dynamics (eq 12), from `manip-dyn`.
 
+use crate::args;
 use crate::array::{Output, States, evaluate, evaluate_chunks};
 use crate::errors::{Error, check_finite, count};
 use manip_dyn::faer::MatMut;
@@ -33,6 +34,15 @@ pub struct Arm {
 }
 
 impl Arm {
+    /// The Python arm of `chain`.
+    pub(crate) fn from_chain(chain: ChainModel) -> Self {
+        Self {
+            workspace: Mutex::new(ChainData::recursive(&chain)),
+            aba_workspace: Mutex::new(None),
+            chain,
+        }
+    }
+
     /// The chain.
     pub(crate) fn chain(&self) -> &ChainModel {
         &self.chain
@@ -55,17 +65,36 @@ impl Arm {
 #[pymethods]
 impl Arm {
     #[new]
-    #[pyo3(signature = (links=None, link_length=0.1, link_mass=0.1, gravity=9.81, lengths=None, masses=None, inertias=None))]
+    #[pyo3(
+        signature = (links=None, link_length=None, link_mass=None, gravity=None, lengths=None, masses=None, inertias=None),
+        text_signature = "(links=None, link_length=0.1, link_mass=0.1, gravity=9.81, lengths=None, masses=None, inertias=None)"
+    )]
     fn new(
         links: Option<&Bound<'_, PyAny>>,
-        link_length: f64,
-        link_mass: f64,
-        gravity: f64,
-        lengths: Option<Vec<f64>>,
-        masses: Option<Vec<f64>>,
-        inertias: Option<Vec<f64>>,
+        link_length: Option<&Bound<'_, PyAny>>,
+        link_mass: Option<&Bound<'_, PyAny>>,
+        gravity: Option<&Bound<'_, PyAny>>,
+        lengths: Option<&Bound<'_, PyAny>>,
+        masses: Option<&Bound<'_, PyAny>>,
+        inertias: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let links = links.map(|n| count(n, "arm.links", 1)).transpose()?;
+        let real = |value: Option<&Bound<'_, PyAny>>, name, default| {
+            value.map_or(Ok(default), |v| args::real(v, name))
+        };
+        let (link_length, link_mass, gravity) = (
+            real(link_length, "link_length", 0.1)?,
+            real(link_mass, "link_mass", 0.1)?,
+            real(gravity, "gravity", 9.81)?,
+        );
+        let per_link = |value: Option<&Bound<'_, PyAny>>, name| {
+            value.map(|v| args::reals(v, name)).transpose()
+        };
+        let (lengths, masses, inertias) = (
+            per_link(lengths, "lengths")?,
+            per_link(masses, "masses")?,
+            per_link(inertias, "inertias")?,
+        );
         let spec = ArmSpec {
             links,
             link_length: Some(link_length),
@@ -74,13 +103,10 @@ impl Arm {
             lengths,
             masses,
             inertias,
+            urdf: None,
         };
         let chain = spec.to_chain().map_err(Error::from)?;
-        Ok(Self {
-            workspace: Mutex::new(ChainData::recursive(&chain)),
-            aba_workspace: Mutex::new(None),
-            chain,
-        })
+        Ok(Self::from_chain(chain))
     }
 
     /// Number of links (and joints) n.
@@ -119,6 +145,54 @@ impl Arm {
         self.column(|l| l.com).into_pyarray(py)
     }
 
+    /// A spatial chain read from URDF: `hrm.Chain.from_urdf(urdf, gravity)` (an `hrm.Chain`, the
+    /// class of URDF chains, not a planar `Arm`).
+    #[staticmethod]
+    #[pyo3(signature = (urdf, gravity=[0.0, 0.0, -9.81]))]
+    fn from_urdf(urdf: &Bound<'_, PyAny>, gravity: [f64; 3]) -> PyResult<crate::chain::Chain> {
+        crate::chain::Chain::from_urdf(urdf, gravity)
+    }
+
+    /// The arm as URDF text: joints about z in the base's x-y plane, links along x. URDF has no
+    /// gravity: set it along -y (the arm's) in the engine that reads it.
+    fn to_urdf(&self) -> String {
+        robot_desc::write_urdf(&crate::chain::planar_robot(&self.chain).0)
+    }
+
+    /// The arm as one MJCF document for MuJoCo (as `to_urdf`), its gravity along -y in
+    /// `<option>`.
+    fn to_mjcf(&self) -> PyResult<String> {
+        let (robot, gravity) = crate::chain::planar_robot(&self.chain);
+        crate::chain::mjcf(&robot, gravity)
+    }
+
+    /// `pickle` and `copy.deepcopy` support: the arm rebuilt from its gravity and per-link
+    /// lengths, masses and inertias (its defining parameters).
+    #[allow(
+        clippy::type_complexity,
+        reason = "pickle's (callable, arguments) pair"
+    )]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (Option<usize>, f64, f64, f64, Vec<f64>, Vec<f64>, Vec<f64>),
+    )> {
+        let arm = slf.get();
+        Ok((
+            slf.get_type().into_any(),
+            (
+                None,
+                0.1,
+                0.1,
+                arm.chain.gravity(),
+                arm.column(|l| l.length),
+                arm.column(|l| l.mass),
+                arm.column(|l| l.inertia),
+            ),
+        ))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Arm(links={}, total_length={}, total_mass={}, gravity={})",
@@ -150,6 +224,7 @@ impl Arm {
         let out = evaluate(
             py,
             [&theta],
+            n * n,
             n * n,
             &self.workspace,
             || self.fresh(),
@@ -183,6 +258,7 @@ impl Arm {
             py,
             [&theta, &theta_dot],
             n,
+            20 * n,
             &self.workspace,
             || self.fresh(),
             |data, [q, v], out| {
@@ -205,6 +281,7 @@ impl Arm {
             py,
             [&theta],
             n,
+            20 * n,
             &self.workspace,
             || self.fresh(),
             |data, [q], out| {
@@ -234,6 +311,7 @@ impl Arm {
             py,
             [q, v, qdd],
             n,
+            30 * n,
             &self.workspace,
             || self.fresh(),
             |data, [q, v, qdd], out| {
@@ -266,6 +344,7 @@ impl Arm {
             py,
             [q, v, t],
             n,
+            40 * n,
             &self.aba_workspace,
             || None,
             |workspace, [q, v, t], out| {
@@ -297,6 +376,7 @@ impl Arm {
             py,
             [&theta, &theta_dot],
             1,
+            20 * n,
             &self.workspace,
             || self.fresh(),
             |data, [q, v], out| {

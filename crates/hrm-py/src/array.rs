@@ -10,8 +10,13 @@
 //! error message.
 
 use crate::errors::{Error, Result};
+use crate::pool::{self, Cancel};
 use numpy::ndarray::{ArrayD, IxDyn};
-use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{
+    IntoPyArray, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{PyException, PyMemoryError};
 use pyo3::prelude::*;
 use pyo3::types::PyFloat;
 use rayon::prelude::*;
@@ -20,8 +25,12 @@ use std::sync::Mutex;
 /// Batches of at least this many states are spread over rayon's threads.
 pub(crate) const PARALLEL_MIN_STATES: usize = 512;
 
-/// States per rayon task (each task builds one workspace).
+/// The most states per chunk of a batch (rayon task; each task builds one workspace).
 const CHUNK_STATES: usize = 512;
+
+/// The work (floating-point operations, as the methods estimate it) of one chunk of a batch,
+/// when that is fewer than [`CHUNK_STATES`] states: a few milliseconds, the delay of Ctrl-C.
+const WORK_PER_CHUNK: usize = 1 << 22;
 
 /// The most values one result may hold (2 GiB of float64); a larger batch is refused before
 /// anything is allocated.
@@ -70,7 +79,16 @@ impl<'py> States<'py> {
                 .into());
             }
         };
-        let copy = (!array.is_c_contiguous()).then(|| array.as_array().iter().copied().collect());
+        let copy = if array.is_c_contiguous() && array.as_slice().is_ok() {
+            None
+        } else {
+            let view = array.as_array();
+            let mut copy = zeros(0, name)?;
+            copy.try_reserve_exact(view.len())
+                .map_err(|_| PyMemoryError::new_err(format!("{name}: cannot copy the array")))?;
+            copy.extend(view.iter().copied());
+            Some(copy)
+        };
         Ok(Self {
             name,
             array,
@@ -86,7 +104,7 @@ impl<'py> States<'py> {
             None => self
                 .array
                 .as_slice()
-                .expect("a C-contiguous array is a slice"),
+                .expect("checked in States::read: the array is a slice"),
         }
     }
 
@@ -105,20 +123,66 @@ impl<'py> States<'py> {
     }
 }
 
-/// `object` as a float64 numpy array: itself when it is one, otherwise converted by
-/// `numpy.asarray` if it holds booleans, integers or floats.
+/// Whether `error` must reach the caller as it is rather than inside an
+/// [`InvalidInput`](crate::errors::InvalidInput): a `KeyboardInterrupt` (or any other
+/// `BaseException` that is not an `Exception`, such as `SystemExit`) and a `MemoryError`.
+pub(crate) fn passes_through(py: Python<'_>, error: &PyErr) -> bool {
+    !error.is_instance_of::<PyException>(py) || error.is_instance_of::<PyMemoryError>(py)
+}
+
+/// Whether numpy `array` can be read in place: its data and strides are multiples of 8 bytes
+/// (a field of a packed structured array is not, and has to be copied first).
+fn aligned(array: &Bound<'_, PyArrayDyn<f64>>) -> bool {
+    let align = align_of::<f64>();
+    (array.data() as usize).is_multiple_of(align)
+        && array
+            .strides()
+            .iter()
+            .all(|&stride| stride.unsigned_abs().is_multiple_of(align))
+}
+
+/// `object` as an aligned float64 numpy array: itself when it is one, otherwise converted by
+/// `numpy.asarray` if it holds booleans, integers or floats (an unaligned view is copied). A
+/// numpy masked array with masked entries is refused (its mask cannot be honoured), one
+/// without is read as its data. A `KeyboardInterrupt` or `MemoryError` raised while the object
+/// is converted propagates as it is.
 fn float64_array<'py>(
     object: &Bound<'py, PyAny>,
     name: &str,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    if let Ok(array) = object.cast::<PyArrayDyn<f64>>() {
+    let py = object.py();
+    let exact = object.is_exact_instance_of::<PyUntypedArray>();
+    if exact
+        && let Ok(array) = object.cast::<PyArrayDyn<f64>>()
+        && aligned(array)
+    {
         return Ok(array.clone());
     }
-    let py = object.py();
     let numpy = py.import("numpy")?;
-    let array = numpy
-        .call_method1("asarray", (object,))
-        .map_err(|e| Error::input(format!("{name} is not an array of numbers: {e}")))?;
+    let wrap = |e: PyErr| {
+        if passes_through(py, &e) {
+            e
+        } else {
+            Error::input(format!("{name} is not an array of numbers: {e}")).into()
+        }
+    };
+    let mut object = object.clone();
+    if !exact && object.hasattr("mask").map_err(wrap)? {
+        let masked = numpy.getattr("ma")?;
+        if masked
+            .call_method1("is_masked", (&object,))
+            .map_err(wrap)?
+            .is_truthy()?
+        {
+            return Err(Error::input(format!(
+                "{name} is a masked array with masked entries, which hrm cannot skip: fill \
+                 them (x.filled(value)) or leave those states out"
+            ))
+            .into());
+        }
+        object = masked.call_method1("getdata", (&object,)).map_err(wrap)?;
+    }
+    let array = numpy.call_method1("asarray", (&object,)).map_err(wrap)?;
     let dtype = array.getattr("dtype")?;
     let kind: String = dtype.getattr("kind")?.extract()?;
     if !matches!(kind.as_str(), "b" | "i" | "u" | "f") {
@@ -128,8 +192,40 @@ fn float64_array<'py>(
         ))
         .into());
     }
+    // `astype` copies into a fresh, aligned array (also when the dtype already is float64).
     let converted = array.call_method1("astype", ("float64",))?;
     Ok(converted.cast_into::<PyArrayDyn<f64>>()?)
+}
+
+/// A zeroed buffer of `len` float64 values, or a `MemoryError` naming `what` when the system
+/// refuses the memory (instead of aborting the interpreter).
+pub(crate) fn zeros(len: usize, what: &str) -> PyResult<Vec<f64>> {
+    let mut values = Vec::new();
+    values.try_reserve_exact(len).map_err(|_| {
+        PyMemoryError::new_err(format!(
+            "{what}: cannot allocate {len} float64 values ({} MiB)",
+            len.saturating_mul(8) >> 20
+        ))
+    })?;
+    values.resize(len, 0.0);
+    Ok(values)
+}
+
+/// `object` as a vector of float64 values (a 1-D array, list or tuple of real numbers, read as
+/// [`States`] are); `name` is the argument's name in messages.
+pub(crate) fn vector(object: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<f64>> {
+    let array = float64_array(object, name)?;
+    let array = array
+        .try_readonly()
+        .map_err(|e| Error::input(format!("{name}: {e}")))?;
+    if array.ndim() != 1 {
+        return Err(Error::input(format!(
+            "{name} must be a 1-D sequence of numbers, got an array of shape {:?}",
+            array.shape()
+        ))
+        .into());
+    }
+    Ok(array.as_array().iter().copied().collect())
 }
 
 /// Checks that the inputs agree on being one state or batches of the same length, and returns
@@ -176,14 +272,25 @@ impl Output {
     }
 }
 
+/// Work (about the floating-point operations of one state) from which one state is computed
+/// with the GIL released, as batches are, so that other Python threads run meanwhile.
+pub(crate) const DETACH_MIN_WORK: usize = 1 << 16;
+
+/// Total work of a batch from which it runs on the package's pool with Ctrl-C checked between
+/// chunks ([`pool::run`]) even below [`PARALLEL_MIN_STATES`] states.
+const INTERRUPTIBLE_MIN_WORK: usize = 1 << 24;
+
 /// Runs `compute(workspace, [row of each input], out)` for every state of `inputs`, writing
-/// `per_state` values per state. One state runs at once on `shared`, the object's own workspace;
-/// a batch runs with the GIL released, sequentially on `shared` or, from
-/// [`PARALLEL_MIN_STATES`] states on, in parallel with a `fresh()` workspace per task.
+/// `per_state` values per state; `work` estimates one state's floating-point operations. One
+/// state runs at once on `shared`, the object's own workspace (with the GIL released from
+/// [`DETACH_MIN_WORK`] on); a batch runs with the GIL released, sequentially on `shared` or,
+/// from [`PARALLEL_MIN_STATES`] states on, in parallel on the package's pool with a `fresh()`
+/// workspace per task, Ctrl-C checked between chunks.
 pub(crate) fn evaluate<const K: usize, W: Send>(
     py: Python<'_>,
     inputs: [&States<'_>; K],
     per_state: usize,
+    work: usize,
     shared: &Mutex<W>,
     fresh: impl Fn() -> W + Sync,
     compute: impl Fn(&mut W, [&[f64]; K], &mut [f64]) -> Result<()> + Sync,
@@ -192,6 +299,7 @@ pub(crate) fn evaluate<const K: usize, W: Send>(
         py,
         inputs,
         per_state,
+        work,
         shared,
         fresh,
         |workspace, chunk, out| {
@@ -215,6 +323,7 @@ pub(crate) fn evaluate_chunks<const K: usize, W: Send>(
     py: Python<'_>,
     inputs: [&States<'_>; K],
     per_state: usize,
+    work: usize,
     shared: &Mutex<W>,
     fresh: impl Fn() -> W + Sync,
     compute_chunk: impl Fn(&mut W, [&[f64]; K], &mut [f64]) -> std::result::Result<(), (usize, Error)>
@@ -235,8 +344,13 @@ pub(crate) fn evaluate_chunks<const K: usize, W: Send>(
             .unwrap_or_else(|poisoned| poisoned.into_inner())
     };
     let Some(n_states) = batch else {
-        let mut out = vec![0.0; per_state];
-        compute_chunk(&mut lock(), rows(0, 1), &mut out).map_err(|(_, e)| e)?;
+        let mut out = zeros(per_state, "the result")?;
+        let mut one = || compute_chunk(&mut lock(), rows(0, 1), &mut out).map_err(|(_, e)| e);
+        if work >= DETACH_MIN_WORK {
+            py.detach(one)?;
+        } else {
+            one()?;
+        }
         return Ok(Output { batch, values: out });
     };
     let total = n_states
@@ -248,28 +362,56 @@ pub(crate) fn evaluate_chunks<const K: usize, W: Send>(
                  more than the limit of {MAX_OUTPUT_VALUES}: split the batch"
             ))
         })?;
-    let mut out = vec![0.0; total];
+    let mut out = zeros(total, "the result of the batch")?;
     let run_chunk = |workspace: &mut W, first: usize, chunk: &mut [f64]| {
         let count = chunk.len() / per_state;
         compute_chunk(workspace, rows(first, count), chunk).map_err(|(state, e)| (first + state, e))
     };
-    let result: std::result::Result<(), (usize, Error)> = py.detach(|| {
-        if n_states < PARALLEL_MIN_STATES {
-            return run_chunk(&mut lock(), 0, &mut out);
+    // A chunk the user interrupted: never reported, the KeyboardInterrupt is.
+    let stopped = || (0, Error::input("interrupted"));
+    // Chunks of about WORK_PER_CHUNK (a few milliseconds), at most CHUNK_STATES states: Ctrl-C
+    // is checked between them.
+    let chunk_states = (WORK_PER_CHUNK / work.max(1)).clamp(1, CHUNK_STATES);
+    let chunk_values = chunk_states * per_state.max(1);
+    let serial = |cancel: &Cancel, out: &mut [f64]| {
+        let mut workspace = lock();
+        for (c, chunk) in out.chunks_mut(chunk_values).enumerate() {
+            if cancel.is_set() {
+                return Err(stopped());
+            }
+            run_chunk(&mut workspace, c * chunk_states, chunk)?;
         }
-        let failures: Vec<(usize, Error)> = out
-            .par_chunks_mut(CHUNK_STATES * per_state)
-            .enumerate()
-            .map_init(&fresh, |workspace, (c, chunk)| {
-                run_chunk(workspace, c * CHUNK_STATES, chunk)
-            })
-            .filter_map(std::result::Result::err)
-            .collect();
-        match failures.into_iter().min_by_key(|(state, _)| *state) {
-            Some(failure) => Err(failure),
-            None => Ok(()),
+        Ok(())
+    };
+    let result: std::result::Result<(), (usize, Error)> = if n_states < PARALLEL_MIN_STATES {
+        if n_states.saturating_mul(work) < INTERRUPTIBLE_MIN_WORK {
+            py.detach(|| serial(&Cancel::new(), &mut out))
+        } else {
+            {
+                let cancel = Cancel::new();
+                pool::run(py, &cancel, || serial(&cancel, &mut out))?
+            }
         }
-    });
+    } else {
+        let cancel = Cancel::new();
+        pool::run(py, &cancel, || {
+            let failures: Vec<(usize, Error)> = out
+                .par_chunks_mut(chunk_values)
+                .enumerate()
+                .map_init(&fresh, |workspace, (c, chunk)| {
+                    if cancel.is_set() {
+                        return Err(stopped());
+                    }
+                    run_chunk(workspace, c * chunk_states, chunk)
+                })
+                .filter_map(std::result::Result::err)
+                .collect();
+            match failures.into_iter().min_by_key(|(state, _)| *state) {
+                Some(failure) => Err(failure),
+                None => Ok(()),
+            }
+        })?
+    };
     result.map_err(|(state, error)| error.context(format!("state {state}")))?;
     Ok(Output { batch, values: out })
 }

@@ -113,7 +113,8 @@ pub(crate) fn count(
             Err(Error::input(format!("{name} must be at least {minimum}, got {n}")).into())
         }
         _ => Err(Error::input(format!(
-            "{name} must be a whole number of at most 64 bits, got {value}"
+            "{name} must be a whole number of at most 64 bits, got {}",
+            value.repr()?
         ))
         .into()),
     }

@@ -55,7 +55,7 @@ impl System {
             Ok(text) if text.contains('\n') || text.trim_start().starts_with('[') => {
                 FuzzySystem::from_fis(&text).map_err(Error::from)?
             }
-            _ => read_fis(&path_or_text.extract::<PathBuf>()?)?,
+            _ => read_fis(&crate::args::path(path_or_text, "path_or_text")?)?,
         };
         Ok(Self::wrap(system))
     }
@@ -63,6 +63,11 @@ impl System {
     /// The system as the text of a MATLAB .fis file (System.from_fis reads it back).
     fn to_fis(&self) -> String {
         self.system.to_fis()
+    }
+
+    /// `pickle` and `copy.deepcopy` support: the system rebuilt from its .fis text.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        Ok((slf.get_type().getattr("from_fis")?, (slf.get().to_fis(),)))
     }
 
     /// The system's name.
@@ -114,6 +119,7 @@ impl System {
             py,
             [&x],
             n_out,
+            self.system.rules().len() * n_in.max(1) * 4,
             &self.evaluator,
             fresh,
             |evaluator, [x], out| {

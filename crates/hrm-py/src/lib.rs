@@ -1,9 +1,12 @@
 #![doc = include_str!("../README.md")]
 
+mod args;
 mod arm;
 mod array;
+mod chain;
 mod errors;
 mod fuzzy;
+mod pool;
 mod reduced;
 mod scenario;
 mod spatial;
@@ -16,6 +19,7 @@ use pyo3::prelude::*;
 fn _hrm(module: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = module.py();
     module.add_class::<arm::Arm>()?;
+    module.add_class::<chain::Chain>()?;
     module.add_class::<reduced::ReducedModel>()?;
     module.add_class::<spatial::SpatialArm>()?;
     module.add_class::<scenario::Scenario>()?;

@@ -29,7 +29,9 @@ struct Workspace {
 /// `harmonics` K gives the coordinates (a_1, ..., a_2K) of the curvature's K harmonics (K = 1 is
 /// the paper's (a1, a2)). `alpha0=None` makes the base angle the last coordinate, so m = 2K + 1
 /// (the paper's (a1, a2, alpha0)); a number holds it fixed (m = 2K, theta_0 = alpha0 e_1, the
-/// paper's experiments). Raises InvalidInput if J is column-rank-deficient (fewer than m links).
+/// paper's experiments; an alpha0 outside [-pi, pi] is reduced into it, exactly). Raises
+/// InvalidInput if J is column-rank-deficient (fewer than m links). The construction, O(n m^2),
+/// runs with the GIL released.
 ///
 /// Every method takes one state (shape (m,)) or a batch (shape (N, m)) and answers with the same
 /// leading dimension.
@@ -60,6 +62,14 @@ impl ReducedModel {
         self.model.n_coords()
     }
 
+    /// The work of one state of the O(n m^2) terms, for the driver's GIL threshold.
+    fn work(&self) -> usize {
+        self.model
+            .n_links()
+            .saturating_mul(self.m())
+            .saturating_mul(self.m())
+    }
+
     fn n(&self) -> usize {
         self.model.n_links()
     }
@@ -77,22 +87,59 @@ impl ReducedModel {
     }
 }
 
+/// `angle` (rad) reduced to [-pi, pi] when it is outside: a base angle such as 1e15 would
+/// otherwise swamp the joint angles added to it (theta_1 = alpha0 + ..., eq 8) and move the tip.
+/// `sin` and `cos` reduce their argument exactly, so `atan2` of them is the exact remainder
+/// (to the last bit); a non-finite angle is left for the library to refuse.
+fn reduce_angle(angle: f64) -> f64 {
+    if angle.abs() <= std::f64::consts::PI || !angle.is_finite() {
+        angle
+    } else {
+        angle.sin().atan2(angle.cos())
+    }
+}
+
 #[pymethods]
 impl ReducedModel {
     #[new]
     #[pyo3(signature = (arm, harmonics=None, alpha0=None), text_signature = "(arm, harmonics=1, alpha0=None)")]
-    fn new(arm: &Arm, harmonics: Option<&Bound<'_, PyAny>>, alpha0: Option<f64>) -> PyResult<Self> {
+    fn new(
+        py: Python<'_>,
+        arm: &Arm,
+        harmonics: Option<&Bound<'_, PyAny>>,
+        alpha0: Option<f64>,
+    ) -> PyResult<Self> {
         let harmonics = harmonics.map_or(Ok(1), |k| count(k, "harmonics", 1))?;
         let chain = arm.chain().clone();
-        let lengths: Vec<f64> = chain.link_lengths().collect();
-        let base = alpha0.map_or(BaseAngle::Free, BaseAngle::Fixed);
-        let map = ModalMap::new(&lengths, harmonics, base).map_err(Error::from)?;
-        let model = modal_reduce::ReducedModel::new(chain, map).map_err(Error::from)?;
-        Ok(Self {
-            workspace: Mutex::new(Workspace::new(&model)),
-            model,
-            lengths,
+        let base = alpha0.map_or(BaseAngle::Free, |a| BaseAngle::Fixed(reduce_angle(a)));
+        // O(n m^2) and more: other Python threads run meanwhile.
+        py.detach(|| {
+            let lengths: Vec<f64> = chain.link_lengths().collect();
+            let map = ModalMap::new(&lengths, harmonics, base).map_err(Error::from)?;
+            let model = modal_reduce::ReducedModel::new(chain, map).map_err(Error::from)?;
+            Ok(Self {
+                workspace: Mutex::new(Workspace::new(&model)),
+                model,
+                lengths,
+            })
         })
+    }
+
+    /// `pickle` and `copy.deepcopy` support: the model rebuilt from its arm, harmonics and
+    /// alpha0 (its defining parameters).
+    #[allow(
+        clippy::type_complexity,
+        reason = "pickle's (callable, arguments) pair"
+    )]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Py<Arm>, usize, Option<f64>))> {
+        let model = slf.get();
+        let arm = Py::new(slf.py(), Arm::from_chain(model.model.chain().clone()))?;
+        Ok((
+            slf.get_type().into_any(),
+            (arm, model.harmonics(), model.alpha0()),
+        ))
     }
 
     /// Number of modal coordinates m (2 K, plus 1 when alpha0 is a coordinate).
@@ -162,6 +209,7 @@ impl ReducedModel {
             py,
             [&a],
             self.n(),
+            self.n() * self.m(),
             &self.workspace,
             || self.fresh(),
             |_, [a], out| {
@@ -181,6 +229,7 @@ impl ReducedModel {
             py,
             [&a],
             2,
+            self.n() * self.m(),
             &self.workspace,
             || self.fresh(),
             |ws, [a], out| {
@@ -202,9 +251,12 @@ impl ReducedModel {
     ///
     /// For K = 1 the closed form of eqs 5-6 (through the restricted inverse of J0) on `branch`
     /// ("positive": a1 >= 0, the paper's; or "negative"); for K > 1 Levenberg-Marquardt from that
-    /// solution, the higher harmonics starting at zero. The base angle is the model's fixed
+    /// solution, the higher harmonics starting at zero, and where the K = 1 family does not
+    /// reach the target or the iteration does not converge from there, from the other branch's
+    /// closed form and a fixed list of moderate curves (`backbone_kin::HarmonicIk::solve_unguided`). The base angle is the model's fixed
     /// alpha0; for a model whose alpha0 is a coordinate, pass `alpha0` (it becomes the last
-    /// coordinate of the result). Raises Unreachable for a target the curve cannot reach and
+    /// coordinate of the result, reduced to [-pi, pi] when it is outside, as the model's fixed
+    /// alpha0 is). Raises Unreachable for a target the curve cannot reach and
     /// NumericalError if the iteration does not converge.
     #[pyo3(signature = (target, alpha0=None, branch="positive"))]
     fn ik<'py>(
@@ -226,7 +278,7 @@ impl ReducedModel {
         };
         let (alpha0, free) = match (self.model.map().base_angle(), alpha0) {
             (BaseAngle::Fixed(fixed), None) => (fixed, false),
-            (BaseAngle::Free, Some(given)) => (given, true),
+            (BaseAngle::Free, Some(given)) => (reduce_angle(given), true),
             (BaseAngle::Fixed(fixed), Some(_)) => {
                 return Err(Error::input(format!(
                     "this model holds alpha0 fixed at {fixed}: ik takes alpha0 only for a model \
@@ -253,15 +305,20 @@ impl ReducedModel {
             py,
             [&target],
             self.m(),
+            1000 * self.m() * self.m(),
             &shared,
             || solver.clone(),
             |solver, [target], out| {
                 let target = [target[0], target[1]];
-                let a = backbone_kin::inverse_kinematics(length, target, alpha0, branch)?;
                 out.fill(0.0);
-                out[..2].copy_from_slice(&a);
-                if let Some(solver) = solver {
-                    solver.solve(target, &mut out[..2 * harmonics])?;
+                match solver {
+                    None => {
+                        let a = backbone_kin::inverse_kinematics(length, target, alpha0, branch)?;
+                        out[..2].copy_from_slice(&a);
+                    }
+                    Some(solver) => {
+                        solver.solve_unguided(target, branch, &mut out[..2 * harmonics])?;
+                    }
                 }
                 if free {
                     out[2 * harmonics] = alpha0;
@@ -284,6 +341,7 @@ impl ReducedModel {
             py,
             [&a],
             m * m,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a], out| {
@@ -312,6 +370,7 @@ impl ReducedModel {
             py,
             [&a, &a_dot],
             m,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a, a_dot], out| {
@@ -331,6 +390,7 @@ impl ReducedModel {
             py,
             [&a],
             m,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a], out| {
@@ -363,6 +423,7 @@ impl ReducedModel {
             py,
             [a, a_dot, tau_star],
             m,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a, a_dot, tau], out| {
@@ -397,6 +458,7 @@ impl ReducedModel {
             py,
             [a, a_dot, a_ddot],
             self.n(),
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a, a_dot, a_ddot], out| {

@@ -10,6 +10,7 @@
 
 use crate::array::States;
 use crate::errors::{Error, InvalidInput, NumericalError};
+use crate::pool::{self, Cancel};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::exceptions::{PyAttributeError, PyFileNotFoundError, PyOSError};
@@ -18,7 +19,6 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use sim_core::controller::{ControlContext, Controller, ControllerError};
 use sim_study::study::{RunOutcome, Stopped};
 use sim_study::{ControllerKind, ScenarioError};
-use std::path::PathBuf;
 use std::sync::{Arc, Mutex, MutexGuard};
 
 /// A closed-loop experiment: arm, modal family, reference, controller, integrator, noise and
@@ -328,6 +328,29 @@ impl Settings {
         )
     }
 
+    /// `pickle` and `copy.deepcopy` support: the view rebuilt as `functools.reduce(getattr,
+    /// path, scenario)`, on a copy of its scenario.
+    #[allow(
+        clippy::type_complexity,
+        reason = "pickle's (callable, arguments) pair"
+    )]
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (Bound<'py, PyAny>, Vec<String>, Py<Scenario>),
+    )> {
+        Ok((
+            py.import("functools")?.getattr("reduce")?,
+            (
+                py.import("builtins")?.getattr("getattr")?,
+                self.path.clone(),
+                self.scenario.clone_ref(py),
+            ),
+        ))
+    }
+
     /// The table as a dict (a copy: writing to it does not change the scenario).
     fn to_dict(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         let current = table(&self.scenario.get().lock())?;
@@ -394,6 +417,59 @@ pub struct ReferenceSample {
 
 #[pymethods]
 impl ReferenceSample {
+    /// A reference sample of `a`, `a_dot` and `a_ddot` (each m numbers; copied), e.g. to test a
+    /// controller outside a run.
+    #[new]
+    fn new(
+        py: Python<'_>,
+        a: &Bound<'_, PyAny>,
+        a_dot: &Bound<'_, PyAny>,
+        a_ddot: &Bound<'_, PyAny>,
+    ) -> PyResult<Self> {
+        let (a, a_dot, a_ddot) = (
+            crate::args::reals(a, "a")?,
+            crate::args::reals(a_dot, "a_dot")?,
+            crate::args::reals(a_ddot, "a_ddot")?,
+        );
+        if a_dot.len() != a.len() || a_ddot.len() != a.len() {
+            return Err(Error::input(format!(
+                "a, a_dot and a_ddot must have the same length, got {}, {} and {}",
+                a.len(),
+                a_dot.len(),
+                a_ddot.len()
+            ))
+            .into());
+        }
+        Ok(Self {
+            a: PyArray1::from_vec(py, a).unbind(),
+            a_dot: PyArray1::from_vec(py, a_dot).unbind(),
+            a_ddot: PyArray1::from_vec(py, a_ddot).unbind(),
+        })
+    }
+
+    /// `pickle` and `copy.deepcopy` support: the sample rebuilt from its three arrays.
+    #[allow(
+        clippy::type_complexity,
+        reason = "pickle's (callable, arguments) pair"
+    )]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> (
+        Bound<'py, PyAny>,
+        (Py<PyArray1<f64>>, Py<PyArray1<f64>>, Py<PyArray1<f64>>),
+    ) {
+        let py = slf.py();
+        let sample = slf.get();
+        (
+            slf.get_type().into_any(),
+            (
+                sample.a.clone_ref(py),
+                sample.a_dot.clone_ref(py),
+                sample.a_ddot.clone_ref(py),
+            ),
+        )
+    }
+
     /// Desired modal coordinates (rad), shape (m,).
     #[getter]
     fn a(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
@@ -464,6 +540,9 @@ impl PythonController {
             ))
         };
         let values = States::read(&out, "tau_star", self.m).map_err(|e| {
+            if crate::array::passes_through(py, &e) {
+                return e;
+            }
             let message = e.value(py).str().map(|s| s.to_string()).unwrap_or_default();
             PyErr::from(context(message))
         })?;
@@ -482,6 +561,42 @@ impl PythonController {
         }
         tau_star.copy_from_slice(values);
         Ok(())
+    }
+}
+
+/// A built-in controller that fails at its next sample once the user pressed Ctrl-C, so that an
+/// interrupted run stops (the interrupt is raised in place of the run's result).
+struct Interruptible {
+    inner: Box<dyn Controller>,
+    cancel: Cancel,
+}
+
+/// The error of an [`Interruptible`] controller that was interrupted.
+#[derive(Debug)]
+struct Interrupted;
+
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("interrupted by the user")
+    }
+}
+
+impl std::error::Error for Interrupted {}
+
+impl Controller for Interruptible {
+    fn control(
+        &mut self,
+        ctx: &ControlContext<'_>,
+        tau_star: &mut [f64],
+    ) -> Result<(), ControllerError> {
+        if self.cancel.is_set() {
+            return Err(Box::new(Interrupted));
+        }
+        self.inner.control(ctx, tau_star)
+    }
+
+    fn n_coords(&self) -> Option<usize> {
+        self.inner.n_coords()
     }
 }
 
@@ -531,7 +646,7 @@ impl Scenario {
     fn from_toml(path_or_text: &Bound<'_, PyAny>) -> PyResult<Self> {
         let scenario = match path_or_text.extract::<String>() {
             Ok(text) if text.contains('\n') => sim_study::Scenario::from_toml(&text),
-            _ => sim_study::Scenario::load(&path_or_text.extract::<PathBuf>()?),
+            _ => sim_study::Scenario::load(&crate::args::path(path_or_text, "path_or_text")?),
         };
         Ok(Self::wrap(scenario.map_err(scenario_error)?))
     }
@@ -608,7 +723,7 @@ impl Scenario {
     /// Runs the closed loop and returns a Run (time series and summary).
     ///
     /// `controller`: None for the scenario's own (`scenario.controller.kind`), a built-in name
-    /// ("fuzzy", "pd", "computed-torque", "fuzzy-gc", "mpc"), or a callable f(t, a, a_dot, ref) ->
+    /// ("fuzzy", "pd", "computed-torque", "fuzzy-gc", "lqr", "mpc"), or a callable f(t, a, a_dot, ref) ->
     /// tau_star called at every controller sample with the time (s), the measured modal state
     /// (numpy arrays of shape (m,), sensor noise included) and the reference (a ReferenceSample
     /// with a, a_dot, a_ddot), returning m modal torques (N m); scenario.controller.period sets
@@ -620,7 +735,9 @@ impl Scenario {
     /// runs. A run that diverges (runaway tracking error, integrator failure) returns a Run
     /// whose `failure` says when and why, with the data up to the stop.
     ///
-    /// Built-in controllers run with the GIL released; a Python controller holds it.
+    /// Built-in controllers run with the GIL released, and Ctrl-C stops them within 0.05 s
+    /// (KeyboardInterrupt); a Python controller holds the GIL, and Ctrl-C interrupts it as any
+    /// Python code.
     #[pyo3(signature = (controller=None))]
     fn run(&self, py: Python<'_>, controller: Option<&Bound<'_, PyAny>>) -> PyResult<Run> {
         let mut scenario = self.get();
@@ -650,9 +767,18 @@ impl Scenario {
                 if let Some(Choice::BuiltIn(kind)) = builtin {
                     scenario.controller.kind = kind;
                 }
-                let mut simulation = scenario.build().map_err(Error::from)?;
+                let cancel = Cancel::new();
+                let flag = cancel.clone();
+                let mut simulation = scenario
+                    .build_wrapping(move |inner| {
+                        Box::new(Interruptible {
+                            inner,
+                            cancel: flag.clone(),
+                        })
+                    })
+                    .map_err(Error::from)?;
                 (
-                    py.detach(|| simulation.run()),
+                    pool::run(py, &cancel, || simulation.run())?,
                     scenario.controller.kind.name(),
                 )
             }
@@ -690,8 +816,10 @@ pub fn view_html(scene: &str) -> PyResult<String> {
 /// the extra keys "error" and "stopped_at_s", as the summary.json of `hrm simulate` does.
 #[pyclass(module = "hrm", frozen)]
 pub struct Run {
+    /// The time series, read-only numpy arrays.
     arrays: [Py<PyAny>; 8],
-    summary: Py<PyDict>,
+    /// The summary as JSON text: each read of `summary` parses a fresh dict.
+    summary: String,
     failure: Option<String>,
     controller: String,
     coordinates: Vec<String>,
@@ -716,12 +844,7 @@ impl Run {
         controller: &str,
         result: RunOutcome,
     ) -> PyResult<Self> {
-        let json = sim_study::summary_json::run(&result).to_string();
-        let summary = py
-            .import("json")?
-            .call_method1("loads", (json,))?
-            .cast_into::<PyDict>()?
-            .unbind();
+        let summary = sim_study::summary_json::run(&result).to_string();
         let (run, failure) = match result {
             Ok(run) => (run, None),
             Err(stopped) => match stopped.partial {
@@ -740,21 +863,49 @@ impl Run {
         let r = run.record;
         let (m, n) = (r.n_coords, r.n_joints);
         let tips = |tips: Vec<[f64; 2]>| matrix(py, tips.into_iter().flatten().collect(), 2);
-        Ok(Self {
-            arrays: [
-                r.t.into_pyarray(py).into_any().unbind(),
-                matrix(py, r.a, m),
-                matrix(py, r.a_dot, m),
-                matrix(py, r.a_ref, m),
-                matrix(py, r.tau_star, m),
-                matrix(py, r.joint_torques, n),
-                tips(r.tip),
-                tips(r.tip_ref),
-            ],
+        let arrays = [
+            r.t.into_pyarray(py).into_any().unbind(),
+            matrix(py, r.a, m),
+            matrix(py, r.a_dot, m),
+            matrix(py, r.a_ref, m),
+            matrix(py, r.tau_star, m),
+            matrix(py, r.joint_torques, n),
+            tips(r.tip),
+            tips(r.tip_ref),
+        ];
+        Self::assemble(
+            py,
+            arrays,
             summary,
             failure,
-            controller: controller.to_string(),
-            coordinates: scenario.coordinate_names(),
+            controller.to_string(),
+            scenario.coordinate_names(),
+            view,
+        )
+    }
+
+    /// A run of these parts, its arrays made read-only.
+    fn assemble(
+        py: Python<'_>,
+        arrays: [Py<PyAny>; 8],
+        summary: String,
+        failure: Option<String>,
+        controller: String,
+        coordinates: Vec<String>,
+        view: run_view::Scene,
+    ) -> PyResult<Self> {
+        for array in &arrays {
+            array
+                .bind(py)
+                .getattr("flags")?
+                .setattr("writeable", false)?;
+        }
+        Ok(Self {
+            arrays,
+            summary,
+            failure,
+            controller,
+            coordinates,
             view,
         })
     }
@@ -811,10 +962,73 @@ impl Run {
         self.arrays[7].clone_ref(py)
     }
 
-    /// The summary metrics: a dict with the keys of `hrm simulate`'s summary.json.
+    /// The summary metrics: a dict with the keys of `hrm simulate`'s summary.json (a fresh
+    /// copy at each read).
     #[getter]
-    fn summary(&self, py: Python<'_>) -> Py<PyDict> {
-        self.summary.clone_ref(py)
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        Ok(py
+            .import("json")?
+            .call_method1("loads", (&self.summary,))?
+            .cast_into::<PyDict>()?)
+    }
+
+    /// `pickle` and `copy.deepcopy` support: the run rebuilt from its arrays, summary, failure,
+    /// controller, coordinate names and viewer scene.
+    #[allow(
+        clippy::type_complexity,
+        reason = "pickle's (callable, arguments) pair"
+    )]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (
+            Vec<Py<PyAny>>,
+            String,
+            Option<String>,
+            String,
+            Vec<String>,
+            String,
+        ),
+    )> {
+        let py = slf.py();
+        let run = slf.get();
+        let view = serde_json::to_string(&run.view).map_err(|e| Error::input(e.to_string()))?;
+        Ok((
+            slf.get_type().getattr("_restore")?,
+            (
+                run.arrays.iter().map(|a| a.clone_ref(py)).collect(),
+                run.summary.clone(),
+                run.failure.clone(),
+                run.controller.clone(),
+                run.coordinates.clone(),
+                view,
+            ),
+        ))
+    }
+
+    /// The run `__reduce__` took apart (pickle's constructor; not for direct use).
+    #[staticmethod]
+    fn _restore(
+        py: Python<'_>,
+        arrays: Vec<Bound<'_, PyAny>>,
+        summary: String,
+        failure: Option<String>,
+        controller: String,
+        coordinates: Vec<String>,
+        view: &str,
+    ) -> PyResult<Self> {
+        let arrays: [Py<PyAny>; 8] = arrays
+            .into_iter()
+            .map(|a| -> PyResult<Py<PyAny>> {
+                // A copy: the pickled run's arrays stay its own.
+                Ok(a.call_method0("copy")?.unbind())
+            })
+            .collect::<PyResult<Vec<_>>>()?
+            .try_into()
+            .map_err(|_| Error::input("a run has 8 arrays"))?;
+        let view = serde_json::from_str(view).map_err(|e| Error::input(format!("view: {e}")))?;
+        Self::assemble(py, arrays, summary, failure, controller, coordinates, view)
     }
 
     /// Why and when the run stopped early, or None for a run that completed.

@@ -9,8 +9,8 @@ use backbone_kin::{
     spatial_tip_position,
 };
 use modal_reduce::spatial::{
-    SpatialLinkInertia, SpatialReducedData, SpatialReducedModel, spatial_forward_dynamics,
-    spatial_joint_torques,
+    SpatialLinkInertia, SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel,
+    spatial_forward_dynamics, spatial_joint_torques, spatial_reduced_derivatives,
 };
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
@@ -27,10 +27,15 @@ const MAX_HARMONICS: usize = 16;
 /// takes bounded steps, so this bounds the amplitudes it visits.
 const MAX_GUESS: f64 = 10.0;
 
-/// The workspace of one thread: the reduced model's data, the joint angles of one state, the
-/// modal accelerations of `reduced` and the inverse-kinematics solver.
+/// Most links `to_urdf` and `to_mjcf` write, as `hrm eval`'s `export` (about 1.4 MB of URDF per
+/// 1,000 links).
+const MAX_EXPORT_LINKS: usize = 10_000;
+
+/// The workspace of one thread: the reduced model's data and derivatives, the joint angles of
+/// one state, the modal accelerations of `reduced` and the inverse-kinematics solver.
 struct Workspace {
     data: SpatialReducedData,
+    derivatives: SpatialReducedDerivatives,
     theta: Vec<f64>,
     a_ddot: Vec<f64>,
     ik: SpatialIk,
@@ -40,6 +45,7 @@ impl Workspace {
     fn new(model: &SpatialReducedModel) -> crate::errors::Result<Self> {
         Ok(Self {
             data: SpatialReducedData::new(model),
+            derivatives: SpatialReducedDerivatives::new(model),
             theta: vec![0.0; model.map().n_joints()],
             a_ddot: vec![0.0; model.n_coords()],
             ik: SpatialIk::new(model.map().clone(), *model.base()).map_err(Error::from)?,
@@ -81,8 +87,27 @@ impl SpatialArm {
         Workspace::new(&self.model).expect("the model's own map and base built a solver before")
     }
 
+    /// The arm's chain as a description, refused past [`MAX_EXPORT_LINKS`].
+    fn robot(&self) -> crate::errors::Result<robot_desc::Robot> {
+        let n = self.model.n_links();
+        if n > MAX_EXPORT_LINKS {
+            return Err(Error::input(format!(
+                "an arm of {n} links; to_urdf and to_mjcf write at most {MAX_EXPORT_LINKS}"
+            )));
+        }
+        Ok(robot_desc::from_spatial_arm(&self.model, "hrm_spatial_arm"))
+    }
+
     fn m(&self) -> usize {
         self.model.n_coords()
+    }
+
+    /// The work of one state of the O(n m^2) terms, for the driver's GIL threshold.
+    fn work(&self) -> usize {
+        self.model
+            .n_links()
+            .saturating_mul(self.m())
+            .saturating_mul(self.m())
     }
 
     fn joints_count(&self) -> usize {
@@ -160,7 +185,7 @@ fn build(
 
 /// `array[..., first:last]` reshaped to `shape` after the batch dimension (when `batch`), as a
 /// contiguous copy: one field of a result computed as one flat row per state.
-fn field<'py>(
+pub(crate) fn field<'py>(
     array: &Bound<'py, PyAny>,
     batch: bool,
     first: usize,
@@ -343,6 +368,7 @@ impl SpatialArm {
             py,
             [&a],
             joints,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |_, [a], out| {
@@ -371,6 +397,7 @@ impl SpatialArm {
             py,
             [&a],
             6,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a], out| {
@@ -438,6 +465,7 @@ impl SpatialArm {
                 py,
                 [&target],
                 m,
+                self.work(),
                 &self.workspace,
                 || self.fresh(),
                 |ws, [target], out| solve(ws, target, None, out),
@@ -448,6 +476,7 @@ impl SpatialArm {
                     py,
                     [&target, &guess],
                     m,
+                    self.work(),
                     &self.workspace,
                     || self.fresh(),
                     |ws, [target, guess], out| solve(ws, target, Some(guess), out),
@@ -482,6 +511,7 @@ impl SpatialArm {
             py,
             [a, a_dot, tau],
             per_state,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a, a_dot, tau], out| {
@@ -537,6 +567,7 @@ impl SpatialArm {
             py,
             [a, a_dot, tau],
             m,
+            self.work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a, a_dot, tau], out| {
@@ -546,5 +577,92 @@ impl SpatialArm {
             },
         )?;
         Ok(out.into_py(py, &[m]))
+    }
+
+    /// The reduced forward dynamics and its analytic derivatives at (a, a_dot, tau_star): a dict
+    /// of a_ddot (m,), d_a = d a_ddot / d a, d_a_dot = d a_ddot / d a_dot and
+    /// d_tau_star = M*^-1 (m, m each, entry (i, j) = d a_ddot_i / d in_j), each with a leading N
+    /// for a batch; O(n m^2) from the tangent of the Newton-Euler recursion. Raises
+    /// NumericalError if M* is not numerically positive definite.
+    fn reduced_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        a: &Bound<'py, PyAny>,
+        a_dot: &Bound<'py, PyAny>,
+        tau_star: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let m = self.m();
+        let inputs = [
+            States::read(a, "a", m)?,
+            States::read(a_dot, "a_dot", m)?,
+            States::read(tau_star, "tau_star", m)?,
+        ];
+        let batch = inputs[0].is_batch();
+        let [a, a_dot, tau] = &inputs;
+        let per_state = m + 3 * m * m;
+        let out = evaluate(
+            py,
+            [a, a_dot, tau],
+            per_state,
+            self.work() * m,
+            &self.workspace,
+            || self.fresh(),
+            |ws, [a, a_dot, tau], out| {
+                spatial_reduced_derivatives(
+                    &self.model,
+                    &mut ws.data,
+                    &mut ws.derivatives,
+                    a,
+                    a_dot,
+                    tau,
+                )
+                .map_err(Error::from)?;
+                let (a_ddot, rest) = out.split_at_mut(m);
+                a_ddot.copy_from_slice(ws.derivatives.a_ddot());
+                let derivatives = &ws.derivatives;
+                for (block, matrix) in rest.chunks_exact_mut(m * m).zip([
+                    derivatives.d_a(),
+                    derivatives.d_a_dot(),
+                    derivatives.d_tau_star(),
+                ]) {
+                    for (i, row) in block.chunks_exact_mut(m).enumerate() {
+                        for (j, entry) in row.iter_mut().enumerate() {
+                            *entry = matrix[(i, j)];
+                        }
+                    }
+                }
+                check_finite("reduced dynamics derivatives", out)
+            },
+        )?;
+        let all = flat(py, out, per_state);
+        let dict = PyDict::new(py);
+        let mut first = 0;
+        for (name, shape) in [
+            ("a_ddot", &[m][..]),
+            ("d_a", &[m, m][..]),
+            ("d_a_dot", &[m, m][..]),
+            ("d_tau_star", &[m, m][..]),
+        ] {
+            let last = first + shape.iter().product::<usize>();
+            dict.set_item(name, field(&all, batch, first, last, shape)?)?;
+            first = last;
+        }
+        Ok(dict)
+    }
+
+    /// The arm's chain as URDF text (hrm eval's `export`): per link `joint_i_z` about the
+    /// parent's z axis (moving the massless `link_i_z`) and `joint_i_y` about its y axis (moving
+    /// `link_i`), the movable joints in the order of theta, the first pair at the base pose. URDF
+    /// carries no gravity: set the arm's `gravity` in the engine. At most 10,000 links.
+    fn to_urdf(&self) -> PyResult<String> {
+        Ok(robot_desc::write_urdf(&self.robot()?))
+    }
+
+    /// The arm's chain as MJCF text for MuJoCo, its gravity in `<option>` (the two hinges of a
+    /// universal joint in one body). MuJoCo refuses singular inertias, so slender rods (the
+    /// default inertias, Ixx = 0) raise InvalidInput; give `inertias`. At most 495 links (MuJoCo's XML nesting).
+    fn to_mjcf(&self) -> PyResult<String> {
+        robot_desc::write_mjcf(&self.robot()?, self.model.gravity())
+            .map_err(|e| Error::input(e.to_string()).into())
     }
 }

@@ -3,6 +3,7 @@
 //! (docs/sweep.md). Runs release the GIL and use all cores (rayon).
 
 use crate::errors::Error;
+use crate::pool::{self, Cancel};
 use crate::scenario::Scenario;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -64,23 +65,24 @@ impl Sweep {
 impl Sweep {
     #[new]
     #[pyo3(signature = (
-        scenario, noise_levels, seeds, controllers=None, base_seed=1, rate_noise_ratio=10.0,
+        scenario, noise_levels, seeds, controllers=None, base_seed=None, rate_noise_ratio=10.0,
         reference_noise_ratio=0.0
-    ))]
+    ), text_signature = "(scenario, noise_levels, seeds, controllers=None, base_seed=1, \
+        rate_noise_ratio=10.0, reference_noise_ratio=0.0)")]
     #[allow(clippy::too_many_arguments)]
     fn new(
         scenario: &Bound<'_, PyAny>,
-        noise_levels: Vec<f64>,
+        noise_levels: &Bound<'_, PyAny>,
         seeds: &Bound<'_, PyAny>,
         controllers: Option<Vec<String>>,
-        base_seed: u64,
+        base_seed: Option<&Bound<'_, PyAny>>,
         rate_noise_ratio: f64,
         reference_noise_ratio: f64,
     ) -> PyResult<Self> {
         let scenario = match scenario.cast::<Scenario>() {
             Ok(s) => s.get().get(),
             Err(_) => {
-                let name: PathBuf = scenario.extract()?;
+                let name = crate::args::path(scenario, "scenario")?;
                 sim_study::Scenario::resolve(&name.to_string_lossy())
                     .map_err(|e| input(e.to_string()))?
             }
@@ -94,11 +96,11 @@ impl Sweep {
         };
         let settings = SweepSettings {
             controllers,
-            noise_levels,
+            noise_levels: crate::args::reals(noise_levels, "noise_levels")?,
             rate_noise_ratio,
             reference_noise_ratio,
             seeds: crate::errors::count(seeds, "seeds", 1)?,
-            base_seed,
+            base_seed: base_seed.map_or(Ok(1), |s| crate::args::seed(s, "base_seed"))?,
         };
         let config = SweepConfig::new(scenario, settings).map_err(input)?;
         Ok(Self { config })
@@ -119,10 +121,16 @@ impl Sweep {
     /// Runs shard `index` of `count` (the whole sweep by default) on all cores, with the GIL
     /// released, and returns the shard file's JSON text: what `hrm sweep --shard index/count`
     /// writes to shard-index-of-count.json. Runs that diverge are recorded as failed, not raised.
+    /// Ctrl-C raises KeyboardInterrupt within 0.05 s; the runs under way finish in the background
+    /// first (no new lock-step group starts).
     #[pyo3(signature = (index=1, count=1))]
     fn run_shard(&self, py: Python<'_>, index: usize, count: usize) -> PyResult<String> {
         let shard = shard(index, count)?;
-        let file = py.detach(|| study::run_shard(&self.config, shard, || {}));
+        let cancel = Cancel::new();
+        let file = pool::run(py, &cancel, || {
+            study::run_shard_until(&self.config, shard, || {}, || cancel.is_set())
+        })?
+        .ok_or_else(|| input(study::STOPPED.to_string()))?;
         file.to_json().map_err(input)
     }
 
@@ -142,6 +150,12 @@ impl Sweep {
     /// of place raise InvalidInput naming the files concerned.
     #[staticmethod]
     fn merge<'py>(py: Python<'py>, shards: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+        if shards.is_instance_of::<pyo3::types::PyString>() {
+            return Err(pyo3::exceptions::PyTypeError::new_err(
+                "shards must be a list of shard files' texts, paths or directories, got a str: \
+                 give [text] for one shard",
+            ));
+        }
         let mut files = Vec::new();
         let mut paths = Vec::new();
         for (k, item) in shards.try_iter()?.enumerate() {

@@ -5,9 +5,10 @@
 use hrm::prelude::*;
 
 /// Computed torque written by hand: `tau* = M* (a_ref_dd - kp e - kd e_dot) + C* + G*`, with the
-/// reduced model the loop lends at every sample and a workspace sized once.
+/// reduced model the loop lends at every sample (planar or spatial: a `Plant`) and a workspace
+/// sized once.
 struct MyComputedTorque {
-    data: ReducedData,
+    data: PlantData,
     desired: Vec<f64>,
 }
 
@@ -19,7 +20,7 @@ impl Controller for MyComputedTorque {
     ) -> Result<(), ControllerError> {
         let (kp, kd) = (900.0, 60.0);
         let (state, reference) = (ctx.measured, ctx.reference);
-        reduced_terms(ctx.model, &mut self.data, &state.a, &state.a_dot)?;
+        ctx.model.terms(&mut self.data, &state.a, &state.a_dot)?;
         for (i, d) in self.desired.iter_mut().enumerate() {
             *d = reference.a_ddot[i]
                 - kp * (state.a[i] - reference.a[i])
@@ -57,7 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
         t: 0.0,
         measured: &measured,
         reference: &reference,
-        model: &model,
+        model: (&model).into(),
         tau_star_limits: None,
     };
     let mut tau = [0.0; 2];
@@ -67,7 +68,7 @@ fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
 
     // A closed loop with the controller above: a step of the modal reference.
     let controller = MyComputedTorque {
-        data: ReducedData::new(&model),
+        data: PlantData::new((&model).into()),
         desired: vec![0.0; 2],
     };
     let step = Step::new(&[0.0, 0.0], &[0.3, -0.2], 0.1)?;

@@ -14,7 +14,7 @@ pub mod prelude {
     pub use fuzzy_sugeno::{Evaluator, FuzzySystem, PaperController, paper_controller};
     pub use manip_dyn::{ChainModel, Link};
     pub use modal_reduce::{
-        ReducedData, ReducedModel, forward_dynamics, joint_torques, reduced_terms,
+        Plant, PlantData, ReducedData, ReducedModel, forward_dynamics, joint_torques, reduced_terms,
     };
     pub use sim_core::controller::{
         ComputedTorque, ControlContext, Controller, ControllerError, FuzzyController, ModalState,

@@ -28,22 +28,9 @@ use lane_math::{Lane, Pack, sin_cos};
 use pulp::{Arch, Simd, WithSimd};
 
 use crate::check;
-use crate::data::ChainData;
+use crate::data::{ArticulatedLink, ChainData, LinkFrame};
 use crate::error::DynError;
-use crate::kinematics::LinkFrame;
 use crate::model::ChainModel;
-
-/// What the forward sweep (and `aba_derivatives`) needs of joint `i`, for one state (`T = f64`)
-/// or the lanes of a batch.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct ArticulatedLink<T = f64> {
-    /// The translational part of `U_i = IA_i S` (its rotational part is `D_i`).
-    pub(crate) u_lin: [T; 2],
-    /// `D_i = S^T IA_i S`: the articulated inertia about the joint axis.
-    pub(crate) d: T,
-    /// `tau_i - S^T pA_i`: the joint torque left after the articulated bias force.
-    residual: T,
-}
 
 /// The number type of [`kernel`]: a [`Lane`] with a storage form for the values kept per link
 /// between the passes, loads of a link's inputs from row-major states, and the pivot test.

@@ -17,10 +17,9 @@ use lane_math::Pack;
 use lane_math::{Classify, ErrorClass};
 use pulp::{Arch, Simd, WithSimd};
 
-use crate::aba::{ArticulatedLink, LinkBuffers, MAX_WIDTH, aba, kernel};
-use crate::data::ChainData;
+use crate::aba::{LinkBuffers, MAX_WIDTH, aba, kernel};
+use crate::data::{ArticulatedLink, ChainData, LinkFrame};
 use crate::error::DynError;
-use crate::kinematics::LinkFrame;
 use crate::model::ChainModel;
 
 /// The most links evaluated SIMD across states: an [`AbaBatchData`] holds 640 bytes a link for

@@ -19,12 +19,11 @@
 use lane_math::{Lane, Pack};
 use pulp::{Simd, WithSimd};
 
-use crate::aba::{ArticulatedLink, articulated_body};
+use crate::aba::articulated_body;
 use crate::check;
-use crate::data::ChainData;
+use crate::data::{ArticulatedLink, ChainData, LinkFrame};
 use crate::derivative_data::{DerivativeData, ROW_ALIGNMENT, SweepLink};
 use crate::error::DynError;
-use crate::kinematics::LinkFrame;
 use crate::model::ChainModel;
 use crate::rnea_derivatives::fill_partials;
 

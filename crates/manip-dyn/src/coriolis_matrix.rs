@@ -18,20 +18,11 @@
 use faer::MatMut;
 
 use crate::check;
-use crate::crba::{Subtree, accumulate_subtrees};
-use crate::data::ChainData;
+use crate::crba::accumulate_subtrees;
+use crate::data::{ChainData, LinkFrame, Subtree, SubtreeMotion};
 use crate::error::DynError;
-use crate::kinematics::{LinkFrame, dot, update_frames};
+use crate::kinematics::{dot, update_frames};
 use crate::model::ChainModel;
-
-/// Velocity moments of the composite body of links `i..n`, about joint `i`.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct SubtreeMotion {
-    /// Momentum relative to joint `i`: `sum_b m_b (r_b_dot - p_i_dot)`.
-    momentum: [f64; 2],
-    /// `sum_b m_b (r_b - p_i) . (r_b_dot - p_i_dot)`: the diagonal entry `c_ii`.
-    diagonal: f64,
-}
 
 /// The Coriolis matrix `C(q, v)` built from the Christoffel symbols of `M` (see the module
 /// documentation), written in full into `out`. `C(q, v) v` is the vector

@@ -5,21 +5,10 @@ use faer::MatMut;
 use faer::reborrow::{Reborrow, ReborrowMut};
 
 use crate::check;
-use crate::data::ChainData;
+use crate::data::{ChainData, LinkFrame, Subtree};
 use crate::error::DynError;
-use crate::kinematics::{LinkFrame, dot, update_frames};
+use crate::kinematics::{dot, update_frames};
 use crate::model::ChainModel;
-
-/// Links `i..n` welded into one rigid body, described about joint `i`.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Subtree {
-    /// Total mass.
-    pub mass: f64,
-    /// First moment of mass about joint `i`: `sum_b m_b (r_b - p_i)`.
-    pub first_moment: [f64; 2],
-    /// Polar moment of inertia about joint `i`: `sum_b I_b + m_b |r_b - p_i|^2`.
-    pub second_moment: f64,
-}
 
 /// The mass matrix `M(q)` (eq 12), symmetric positive definite, written in full into `out`.
 ///

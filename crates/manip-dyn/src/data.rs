@@ -6,12 +6,7 @@ use faer::reborrow::ReborrowMut;
 use faer::{Mat, Par};
 use pulp::Arch;
 
-use crate::aba::ArticulatedLink;
-use crate::coriolis_matrix::SubtreeMotion;
-use crate::crba::Subtree;
-use crate::kinematics::LinkFrame;
 use crate::model::{ChainModel, MAX_DENSE_LINKS};
-use crate::rnea::LinkAcceleration;
 
 /// Scratch space for one [`ChainModel`]: build it once with [`ChainData::new`], then pass it to
 /// every algorithm. After construction, no algorithm of this crate allocates (on another thread
@@ -178,5 +173,67 @@ impl std::fmt::Debug for ChainData {
         f.debug_struct("ChainData")
             .field("n_links", &self.n_links())
             .finish_non_exhaustive()
+    }
+}
+
+/// What the forward sweep (and `aba_derivatives`) needs of joint `i`, for one state (`T = f64`)
+/// or the lanes of a batch.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct ArticulatedLink<T = f64> {
+    /// The translational part of `U_i = IA_i S` (its rotational part is `D_i`).
+    pub(crate) u_lin: [T; 2],
+    /// `D_i = S^T IA_i S`: the articulated inertia about the joint axis.
+    pub(crate) d: T,
+    /// `tau_i - S^T pA_i`: the joint torque left after the articulated bias force.
+    pub(crate) residual: T,
+}
+
+/// Links `i..n` welded into one rigid body, described about joint `i`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Subtree {
+    /// Total mass.
+    pub mass: f64,
+    /// First moment of mass about joint `i`: `sum_b m_b (r_b - p_i)`.
+    pub first_moment: [f64; 2],
+    /// Polar moment of inertia about joint `i`: `sum_b I_b + m_b |r_b - p_i|^2`.
+    pub second_moment: f64,
+}
+
+/// Velocity moments of the composite body of links `i..n`, about joint `i`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct SubtreeMotion {
+    /// Momentum relative to joint `i`: `sum_b m_b (r_b_dot - p_i_dot)`.
+    pub(crate) momentum: [f64; 2],
+    /// `sum_b m_b (r_b - p_i) . (r_b_dot - p_i_dot)`: the diagonal entry `c_ii`.
+    pub(crate) diagonal: f64,
+}
+
+/// Accelerations of one link, from the forward sweep of the recursion.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct LinkAcceleration {
+    /// Absolute angular acceleration `alpha_i = a_1 + ... + a_i`.
+    pub(crate) alpha: f64,
+    /// Acceleration of the centre of mass, plus `g` along `+y` (gravity enters as an upward
+    /// acceleration of the base).
+    pub(crate) com: [f64; 2],
+}
+
+/// Where link `i` points and how fast it turns, in the base frame: `T = f64` for one state, or
+/// the lanes of several states side by side (the ABA batch, see `crate::aba::AbaLane`); filled by
+/// `crate::kinematics::update_frames`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct LinkFrame<T = f64> {
+    /// Unit vector `u_i = (cos phi_i, sin phi_i)` from joint `i` to joint `i + 1`, where
+    /// `phi_i = theta_1 + ... + theta_i` is the absolute angle.
+    pub axis: [T; 2],
+    /// Absolute angular velocity `omega_i = theta_dot_1 + ... + theta_dot_i` (0 without `v`).
+    pub omega: T,
+}
+
+impl LinkFrame {
+    /// `e_z x u_i = (-sin phi_i, cos phi_i)`: the direction a point of the link moves when the
+    /// link turns about one of its points behind it.
+    pub fn normal(&self) -> [f64; 2] {
+        [-self.axis[1], self.axis[0]]
     }
 }

@@ -2,20 +2,10 @@
 //! eq 12, `tau = M(q) qdd + C(q, v) + G(q)`.
 
 use crate::check;
-use crate::data::ChainData;
+use crate::data::{ChainData, LinkAcceleration, LinkFrame};
 use crate::error::DynError;
-use crate::kinematics::{LinkFrame, cross, update_frames};
+use crate::kinematics::{cross, update_frames};
 use crate::model::ChainModel;
-
-/// Accelerations of one link, from the forward sweep of the recursion.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct LinkAcceleration {
-    /// Absolute angular acceleration `alpha_i = a_1 + ... + a_i`.
-    alpha: f64,
-    /// Acceleration of the centre of mass, plus `g` along `+y` (gravity enters as an upward
-    /// acceleration of the base).
-    com: [f64; 2],
-}
 
 /// Inverse dynamics: the joint torques `tau` that give the joint accelerations `qdd` at the state
 /// `(q, v)` (eq 12).

@@ -47,10 +47,9 @@ use pulp::{Simd, WithSimd};
 
 use crate::check;
 use crate::crba;
-use crate::data::ChainData;
+use crate::data::{ChainData, LinkFrame};
 use crate::derivative_data::{DerivativeData, LinkTerms};
 use crate::error::DynError;
-use crate::kinematics::LinkFrame;
 use crate::model::ChainModel;
 use crate::rnea::newton_euler;
 

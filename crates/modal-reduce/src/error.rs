@@ -123,6 +123,14 @@ pub enum ReduceError {
         /// The offending value.
         value: f64,
     },
+    /// A workspace built for a planar arm given with a spatial one, or the reverse.
+    #[error("a workspace built for a {built} arm was given a {given} arm")]
+    WrongFamily {
+        /// The family the workspace was built for (`"planar"` or `"spatial"`).
+        built: &'static str,
+        /// The family of the arm given.
+        given: &'static str,
+    },
 }
 
 impl Classify for ReduceError {

@@ -2,7 +2,7 @@
 //! [`Ilqr`](super::Ilqr), and the reduced model (eq 15) discretised by semi-implicit Euler with
 //! its exact Jacobians from the analytic derivatives.
 
-use modal_reduce::{ReducedData, ReducedDerivatives, ReducedModel, reduced_derivatives};
+use modal_reduce::{Plant, PlantData, PlantDerivatives};
 
 use super::OptimalError;
 
@@ -44,7 +44,7 @@ pub trait DiscreteDynamics {
 /// ```
 ///
 /// `x = (a, a_dot)` (`2m` entries), `u = tau*` (`m`), `f` the forward dynamics. Its Jacobians are
-/// exact for this map, from `modal_reduce::reduced_derivatives` (`F_a = d a_ddot / d a`,
+/// exact for this map, from the plant's analytic derivatives (`modal_reduce::Plant::derivatives`) (`F_a = d a_ddot / d a`,
 /// `F_v = d a_ddot / d a_dot`, `F_u = M*^-1`):
 ///
 /// ```text
@@ -54,12 +54,12 @@ pub trait DiscreteDynamics {
 /// One dynamics evaluation per step (RK4 would take four, each with its own derivatives);
 /// symplectic Euler keeps the energy of the unforced arm bounded instead of letting it drift,
 /// and its local error `O(h^2)` is corrected at every re-plan of a receding horizon. It borrows
-/// the model and a workspace (`ReducedData`, `ReducedDerivatives`) for one solve.
+/// the model (planar or spatial) and a workspace (`PlantData`, `PlantDerivatives`) for one solve.
 #[derive(Debug)]
 pub struct ReducedEuler<'a> {
-    model: &'a ReducedModel,
-    data: &'a mut ReducedData,
-    derivatives: &'a mut ReducedDerivatives,
+    model: Plant<'a>,
+    data: &'a mut PlantData,
+    derivatives: &'a mut PlantDerivatives,
     step: f64,
 }
 
@@ -70,14 +70,14 @@ impl<'a> ReducedEuler<'a> {
     /// # Errors
     /// [`OptimalError::InvalidSetting`] unless `step` is positive and finite (at most 10 s).
     pub fn new(
-        model: &'a ReducedModel,
-        data: &'a mut ReducedData,
-        derivatives: &'a mut ReducedDerivatives,
+        model: impl Into<Plant<'a>>,
+        data: &'a mut PlantData,
+        derivatives: &'a mut PlantDerivatives,
         step: f64,
     ) -> Result<Self, OptimalError> {
         check_step(step)?;
         Ok(Self {
-            model,
+            model: model.into(),
             data,
             derivatives,
             step,
@@ -111,7 +111,7 @@ impl DiscreteDynamics for ReducedEuler<'_> {
         let (m, h) = (self.model.n_coords(), self.step);
         let (a, v) = x.split_at(m);
         let (a_next, v_next) = next.split_at_mut(m);
-        modal_reduce::forward_dynamics(self.model, self.data, a, v, u, v_next)?;
+        self.model.forward_dynamics(self.data, a, v, u, v_next)?;
         for i in 0..m {
             v_next[i] = v[i] + h * v_next[i];
             a_next[i] = a[i] + h * v_next[i];
@@ -130,7 +130,8 @@ impl DiscreteDynamics for ReducedEuler<'_> {
         let (m, h) = (self.model.n_coords(), self.step);
         let n = 2 * m;
         let (a, v) = x.split_at(m);
-        reduced_derivatives(self.model, self.data, self.derivatives, a, v, u)?;
+        self.model
+            .derivatives(self.data, self.derivatives, a, v, u)?;
         let d = &*self.derivatives;
         let (f_a, f_v, f_u) = (d.d_a(), d.d_a_dot(), d.d_tau_star());
         for i in 0..m {

@@ -1,7 +1,7 @@
 //! The reduced model linearised about a state: continuous and zero-order-hold discrete `(A, B)`.
 
 use faer::MatRef;
-use modal_reduce::{ReducedData, ReducedDerivatives, ReducedModel, reduced_derivatives};
+use modal_reduce::{Plant, PlantData, PlantDerivatives};
 
 use super::OptimalError;
 use super::dense::exponential;
@@ -14,15 +14,15 @@ use super::dense::exponential;
 /// A_d = exp(A h),   B_d = int_0^h exp(A s) ds B                            (zero-order hold)
 /// ```
 ///
-/// with the analytic derivatives of `modal_reduce::reduced_derivatives`; the discrete pair is
-/// the exact transition of the linear system over a period `h` with `u` held, computed as one
-/// matrix exponential, `exp([[A, B], [0, 0]] h) = [[A_d, B_d], [0, I]]`. Build it once per model;
+/// with the analytic derivatives of the planar or spatial plant
+/// (`modal_reduce::Plant::derivatives`); the discrete pair is the exact transition of the linear
+/// system over a period `h` with `u` held, computed as one matrix exponential, `exp([[A, B], [0, 0]] h) = [[A_d, B_d], [0, I]]`. Build it once per model;
 /// [`linearise`](Self::linearise) allocates nothing.
 #[derive(Debug, Clone)]
 pub struct Linearisation {
     m: usize,
-    data: ReducedData,
-    derivatives: ReducedDerivatives,
+    data: PlantData,
+    derivatives: PlantDerivatives,
     /// `(3m) x (3m)` row-major: the augmented `[[A, B], [0, 0]] h`, then its exponential.
     augmented: Vec<f64>,
     exponential: Vec<f64>,
@@ -37,14 +37,15 @@ pub struct Linearisation {
 }
 
 impl Linearisation {
-    /// The workspace for `model`.
-    pub fn new(model: &ReducedModel) -> Self {
+    /// The workspace for `model` (a planar or spatial arm).
+    pub fn new<'p>(model: impl Into<Plant<'p>>) -> Self {
+        let model = model.into();
         let m = model.n_coords();
         let s = 3 * m;
         Self {
             m,
-            data: ReducedData::new(model),
-            derivatives: ReducedDerivatives::new(model),
+            data: PlantData::new(model),
+            derivatives: PlantDerivatives::new(model),
             augmented: vec![0.0; s * s],
             exponential: vec![0.0; s * s],
             work: vec![0.0; 2 * s * s],
@@ -62,9 +63,9 @@ impl Linearisation {
     /// # Errors
     /// [`OptimalError::InvalidSetting`] unless `period` is positive and finite (at most 1e3 s);
     /// [`OptimalError::Dynamics`] if the reduced dynamics refuses the state.
-    pub fn linearise(
+    pub fn linearise<'p>(
         &mut self,
-        model: &ReducedModel,
+        model: impl Into<Plant<'p>>,
         a: &[f64],
         a_dot: &[f64],
         tau_star: &[f64],
@@ -77,14 +78,9 @@ impl Linearisation {
                 value: period,
             });
         }
-        reduced_derivatives(
-            model,
-            &mut self.data,
-            &mut self.derivatives,
-            a,
-            a_dot,
-            tau_star,
-        )?;
+        model
+            .into()
+            .derivatives(&mut self.data, &mut self.derivatives, a, a_dot, tau_star)?;
         let m = self.m;
         let n = 2 * m;
         let d = &self.derivatives;

@@ -2,7 +2,7 @@
 //! horizon of the semi-implicit Euler discretisation, re-planned from the measured state and
 //! warm-started from the previous plan shifted by the time elapsed.
 
-use modal_reduce::{ReducedData, ReducedDerivatives, ReducedModel};
+use modal_reduce::{Plant, PlantData, PlantDerivatives};
 
 use super::OptimalError;
 use super::discrete::{ReducedEuler, check_step};
@@ -83,8 +83,8 @@ pub struct Mpc {
     step: f64,
     solver: IlqrSettings,
     ilqr: Ilqr,
-    data: ReducedData,
-    derivatives: ReducedDerivatives,
+    data: PlantData,
+    derivatives: PlantDerivatives,
     /// `2m`: the state and its deviation from the plan.
     state: Vec<f64>,
     deviation: Vec<f64>,
@@ -100,7 +100,11 @@ impl Mpc {
     /// [`OptimalError::InvalidSetting`] or [`OptimalError::Dimension`] for settings out of their
     /// domain or of the wrong length (horizon above [`MAX_MPC_HORIZON`], a weight or limit that
     /// is negative, zero where it must be positive, or not finite).
-    pub fn new(model: &ReducedModel, settings: &MpcSettings) -> Result<Self, OptimalError> {
+    pub fn new<'p>(
+        model: impl Into<Plant<'p>>,
+        settings: &MpcSettings,
+    ) -> Result<Self, OptimalError> {
+        let model = model.into();
         let m = model.n_coords();
         check_step(settings.step)?;
         if settings.horizon == 0 || settings.horizon > MAX_MPC_HORIZON {
@@ -162,8 +166,8 @@ impl Mpc {
             step: h,
             solver: settings.solver,
             ilqr,
-            data: ReducedData::new(model),
-            derivatives: ReducedDerivatives::new(model),
+            data: PlantData::new(model),
+            derivatives: PlantDerivatives::new(model),
             state: vec![0.0; 2 * m],
             deviation: vec![0.0; 2 * m],
             lower: vec![0.0; m],
@@ -235,9 +239,9 @@ impl Mpc {
     /// # Errors
     /// [`OptimalError::Dimension`] for `k > N` or wrong lengths, [`OptimalError::Dynamics`] if
     /// the model refuses the reference state.
-    pub fn set_reference(
+    pub fn set_reference<'p>(
         &mut self,
-        model: &ReducedModel,
+        model: impl Into<Plant<'p>>,
         k: usize,
         a: &[f64],
         a_dot: &[f64],
@@ -264,7 +268,7 @@ impl Mpc {
         x_ref[..m].copy_from_slice(a);
         x_ref[m..].copy_from_slice(a_dot);
         if k < n {
-            modal_reduce::reduced_terms(model, &mut self.data, a, a_dot)?;
+            model.into().terms(&mut self.data, a, a_dot)?;
             let (mass, c, g) = (
                 self.data.mass_matrix(),
                 self.data.coriolis(),
@@ -294,13 +298,13 @@ impl Mpc {
     /// # Errors
     /// [`OptimalError::Dimension`] for wrong lengths or a model of another size; the solver's and
     /// the dynamics' errors.
-    pub fn solve(
+    pub fn solve<'p>(
         &mut self,
-        model: &ReducedModel,
+        model: impl Into<Plant<'p>>,
         a: &[f64],
         a_dot: &[f64],
     ) -> Result<IlqrReport, OptimalError> {
-        let m = self.m;
+        let (m, model) = (self.m, model.into());
         if model.n_coords() != m {
             return Err(OptimalError::Dimension {
                 name: "model coordinates",

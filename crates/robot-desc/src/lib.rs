@@ -6,6 +6,7 @@ pub mod model;
 mod planar;
 pub mod pose;
 mod spatial;
+mod universal;
 mod urdf_read;
 mod urdf_write;
 
@@ -17,6 +18,7 @@ pub use mjcf::{
 pub use model::{Body, Geometry, Inertial, Joint, JointDynamics, JointKind, Limits, Robot, Shape};
 pub use planar::from_planar;
 pub use spatial::to_spatial;
+pub use universal::from_spatial_arm;
 pub use urdf_read::{
     MAX_ATTRIBUTE_BYTES, MAX_MAGNITUDE, MAX_URDF_BYTES, MAX_XML_DEPTH, MAX_XML_NODES, Merged,
     ReadReport, Reading, read_urdf,

@@ -76,6 +76,19 @@ pub enum SimError {
     /// The integrator stopped: the dynamics failed or the state blew up between two samples.
     #[error("integration diverged: {0}")]
     Integration(OdeError<ReduceError>),
+    /// The spatial chain's dynamics refused a computation at a controller sample (the joint-space
+    /// loop of a URDF arm, [`run_chain_loop`](crate::run_chain_loop)).
+    #[error("chain dynamics at t = {t} s: {source}")]
+    ChainDynamics {
+        /// When (s).
+        t: f64,
+        /// The refusal.
+        source: manip_dyn::DynError,
+    },
+    /// The joint-space loop's integrator stopped: the chain's dynamics failed or the state blew
+    /// up between two controller samples.
+    #[error("integration diverged: {0}")]
+    ChainIntegration(OdeError<manip_dyn::DynError>),
     /// The controller produced a NaN or infinite torque.
     #[error("the controller produced a non-finite modal torque {tau_star:?} at t = {t} s")]
     NonFiniteControl {
@@ -83,6 +96,15 @@ pub enum SimError {
         t: f64,
         /// The torque it produced, one entry per coordinate.
         tau_star: Vec<f64>,
+    },
+    /// A disturbance hook ([`LoopHooks`](crate::LoopHooks)) produced a NaN or infinite joint
+    /// torque.
+    #[error("the disturbance hook produced a non-finite joint torque {tau:?} at t = {t} s")]
+    NonFiniteDisturbance {
+        /// When (s).
+        t: f64,
+        /// The joint torques it produced, one entry per joint.
+        tau: Vec<f64>,
     },
     /// A controller failed with an error of its own (one that is not a [`SimError`]).
     #[error("the controller failed at t = {t} s: {source}")]
@@ -144,8 +166,11 @@ impl Classify for SimError {
             Self::Kinematics(e) => e.class(),
             Self::Dynamics { source, .. } | Self::Model(source) => source.class(),
             Self::Fuzzy(e) => e.class(),
+            Self::ChainDynamics { source, .. } => source.class(),
             Self::Integration(_)
+            | Self::ChainIntegration(_)
             | Self::NonFiniteControl { .. }
+            | Self::NonFiniteDisturbance { .. }
             | Self::Controller { .. }
             | Self::RunawayError { .. } => ErrorClass::Numerical,
             _ => ErrorClass::InvalidInput,

@@ -1,5 +1,6 @@
 #![doc = include_str!("../README.md")]
 
+mod chain_loop;
 pub mod controller;
 mod error;
 mod noise;
@@ -12,9 +13,12 @@ mod simulation;
 /// have ([`backbone_kin::MAX_HARMONICS`]).
 pub const MAX_COORDINATES: usize = 2 * backbone_kin::MAX_HARMONICS + 1;
 
+pub use chain_loop::{ChainLoopSettings, ChainRecord, ChainRun, ChainSummary, run_chain_loop};
 pub use error::{ControllerFailure, SimError, check_finite};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use simulation::{
-    ControlSample, Integrator, Lockstep, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_LOOP_WORK,
-    MAX_RECORDED_VALUES, MAX_RK4_STEPS, Observation, Run, RunFailure, Simulation, check_loop_work,
+    ControlSample, ControllerFactory, Integrator, Lockstep, LoopHooks, LoopSettings,
+    MAX_CONTROLLER_SAMPLES, MAX_LOOP_WORK, MAX_RECORDED_VALUES, MAX_RK4_STEPS, NoHooks,
+    Observation, Prepared, ReferenceFactory, Run, RunFailure, RunNoise, Simulation,
+    check_loop_work,
 };

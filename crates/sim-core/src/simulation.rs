@@ -11,10 +11,15 @@ use crate::reference::continuation::Family;
 use crate::reference::{Reference, ReferenceSample};
 use backbone_kin::BaseAngle;
 use modal_reduce::{ReduceError, ReducedData, ReducedModel};
+use std::sync::Arc;
 
+mod hooks;
 mod lockstep;
+mod prepared;
 
+pub use hooks::{LoopHooks, NoHooks};
 pub use lockstep::Lockstep;
+pub use prepared::{ControllerFactory, Prepared, ReferenceFactory, RunNoise};
 
 /// ChaCha streams of the two noise sources, so that each has its own sequence.
 const REFERENCE_NOISE_STREAM: u64 = 1;
@@ -141,7 +146,7 @@ impl Progress {
 
 /// The reduced dynamics with a held modal torque: `y = [a, a_dot]` (`2m` entries).
 struct Plant {
-    model: ReducedModel,
+    model: Arc<ReducedModel>,
     data: ReducedData,
     tau_star: Vec<f64>,
 }
@@ -194,6 +199,10 @@ pub struct ControlSample {
     /// The modal torques `tau*` held from `t` to the next sample (N m): the controller's
     /// output, clamped to the actuator limits if there are any.
     pub tau_star: Vec<f64>,
+    /// The modal force `f = J^T tau_d` (N m, eqs 14-15) of the external joint torques `tau_d` a
+    /// [`LoopHooks::disturbance`] applies from `t` to the next sample, on top of `tau*`; zeros
+    /// without one.
+    pub disturbance: Vec<f64>,
     /// Per coordinate, whether the actuator limit clamped the controller's output (all `false`
     /// without limits).
     pub clamped: Vec<bool>,
@@ -213,6 +222,7 @@ impl ControlSample {
             command: ReferenceSample::zeros(m),
             measured: ModalState::zeros(m),
             tau_star: vec![0.0; m],
+            disturbance: vec![0.0; m],
             clamped: vec![false; m],
             a_ddot: vec![0.0; m],
             steps: (0, 0),
@@ -290,11 +300,10 @@ pub struct Simulation {
     /// Scratch for the measured `[a, a_dot]`.
     measured: Vec<f64>,
     sample: ControlSample,
-    /// What the reference is as a function of time, when known: runs with equal keys sample the
-    /// same values, so a lock-step group samples it once for all of them. Set by
-    /// `sim_study::Scenario::build` (the reference's settings and the arm's
-    /// length and modal family); `None` for a reference handed to [`new`](Self::new).
-    reference_key: Option<String>,
+    /// The external joint torques `tau_d` of the last [`LoopHooks::disturbance`] (`n` entries),
+    /// and whether they act on the current sample.
+    tau_disturbance: Vec<f64>,
+    disturbed: bool,
 }
 
 impl Simulation {
@@ -317,47 +326,22 @@ impl Simulation {
         initial: Option<ModalState>,
     ) -> Result<Self, SimError> {
         let m = model.n_coords();
-        if reference.n_coords() != m {
-            return Err(SimError::setting(
-                "reference",
-                format!(
-                    "sets {} coordinates, the model has {m}",
-                    reference.n_coords()
-                ),
-            ));
-        }
-        if let Some(c) = controller.n_coords()
-            && c != m
-        {
-            return Err(SimError::setting(
-                "controller",
-                format!("is built for {c} coordinates, the model has {m}"),
-            ));
-        }
+        check_parts(reference.as_ref(), controller.as_ref(), m)?;
         validate(&settings, m, model.n_links())?;
-        let initial = match initial {
-            Some(state) => state,
-            None => {
-                let mut sample = ReferenceSample::zeros(m);
-                reference.sample(0.0, &mut sample)?;
-                ModalState {
-                    a: sample.a,
-                    a_dot: vec![0.0; m],
-                }
-            }
-        };
-        for (name, values) in [("initial.a", &initial.a), ("initial.a_dot", &initial.a_dot)] {
-            if values.len() != m {
-                return Err(SimError::setting(
-                    name,
-                    format!(
-                        "has {} entries, the model has {m} coordinates",
-                        values.len()
-                    ),
-                ));
-            }
-            check_finite(name, values)?;
-        }
+        let initial = initial_state(reference.as_mut(), initial, m)?;
+        Self::assemble(Arc::new(model), reference, controller, settings, initial)
+    }
+
+    /// The simulation of checked parts: `settings` validated for `model`, `initial` of its size.
+    /// Sizes the per-run buffers (the run's Data).
+    fn assemble(
+        model: Arc<ReducedModel>,
+        reference: Box<dyn Reference>,
+        controller: Box<dyn Controller>,
+        settings: LoopSettings,
+        initial: ModalState,
+    ) -> Result<Self, SimError> {
+        let m = model.n_coords();
         let n = model.n_links();
         let link_lengths: Vec<f64> = model.chain().link_lengths().collect();
         let curve_length = link_lengths.iter().sum();
@@ -370,7 +354,6 @@ impl Simulation {
         let data = ReducedData::new(&model);
         let stepper = Stepper::new(settings.integrator, 2 * m);
         let mut simulation = Self {
-            reference_key: None,
             plant: Plant {
                 model,
                 data,
@@ -392,6 +375,8 @@ impl Simulation {
             sensor_noise: None,
             measured: vec![0.0; 2 * m],
             sample: ControlSample::zeros(m),
+            tau_disturbance: vec![0.0; n],
+            disturbed: false,
         };
         simulation.reset();
         Ok(simulation)
@@ -400,13 +385,6 @@ impl Simulation {
     /// The reduced model being simulated.
     pub fn model(&self) -> &ReducedModel {
         &self.plant.model
-    }
-
-    /// The simulation with its reference known as `key` (see the field's docs): runs of a
-    /// lock-step group with equal keys share their reference samples.
-    pub fn with_reference_key(mut self, key: String) -> Self {
-        self.reference_key = Some(key);
-        self
     }
 
     /// The settings of the loop.
@@ -460,6 +438,8 @@ impl Simulation {
             GaussianNoise::new(s.seed, REFERENCE_NOISE_STREAM, &s.reference_noise_std);
         self.sensor_noise = GaussianNoise::new(s.seed, SENSOR_NOISE_STREAM, &s.sensor_noise_std);
         self.sample = ControlSample::zeros(m);
+        self.tau_disturbance.fill(0.0);
+        self.disturbed = false;
     }
 
     /// Advances one controller period: takes the controller sample at the current time `t_k`
@@ -469,8 +449,18 @@ impl Simulation {
     /// Fails if the reference, the controller or the integration fails, or the controller's
     /// torque is not finite; the simulation then stays at `t_k`.
     pub fn step(&mut self) -> Result<&ControlSample, SimError> {
-        self.take_sample()?;
+        self.step_with(&mut NoHooks)
+    }
+
+    /// [`step`](Self::step) with `hooks`: their disturbance acts from `t_k` to `t_{k+1}` and
+    /// their observer sees the sample once it is integrated.
+    pub fn step_with<H: LoopHooks + ?Sized>(
+        &mut self,
+        hooks: &mut H,
+    ) -> Result<&ControlSample, SimError> {
+        self.take_sample(None, hooks)?;
         self.integrate()?;
+        hooks.observe(&self.sample);
         Ok(&self.sample)
     }
 
@@ -499,7 +489,14 @@ impl Simulation {
             &self.sample.a_ddot,
             &mut self.joint_torques,
         )
-        .map_err(|source| SimError::Dynamics { t, source })
+        .map_err(|source| SimError::Dynamics { t, source })?;
+        // The actuators deliver eq 13's torques less the push.
+        if self.disturbed {
+            for (tau, d) in self.joint_torques.iter_mut().zip(&self.tau_disturbance) {
+                *tau -= d;
+            }
+        }
+        Ok(())
     }
 
     /// The chain's tip and the reference tip of the last sample.
@@ -527,11 +524,20 @@ impl Simulation {
     /// [`RunFailure`] that says when and why and keeps the data recorded so far (the runaway
     /// sample included).
     pub fn run(&mut self) -> Result<Run, Box<RunFailure>> {
+        self.run_with(&mut NoHooks)
+    }
+
+    /// [`run`](Self::run) with `hooks`: their disturbance acts on the arm and their observer
+    /// sees every controller sample, in order ([`LoopHooks`]).
+    pub fn run_with<H: LoopHooks + ?Sized>(
+        &mut self,
+        hooks: &mut H,
+    ) -> Result<Run, Box<RunFailure>> {
         let mut progress = self.start_run();
         for k in 0..=progress.samples {
             let last = k == progress.samples;
             let taken = self
-                .take_sample()
+                .take_sample(None, hooks)
                 .and_then(|()| {
                     if last {
                         self.acceleration()
@@ -539,7 +545,10 @@ impl Simulation {
                         self.integrate()
                     }
                 })
-                .and_then(|()| self.conclude_sample(&mut progress, k));
+                .and_then(|()| {
+                    hooks.observe(&self.sample);
+                    self.conclude_sample(&mut progress, k)
+                });
             if let Err(error) = taken {
                 return Err(progress.fail(error));
             }
@@ -621,17 +630,16 @@ impl Simulation {
         }
     }
 
-    /// The controller sample at the current time: state, reference, noise, `tau*` (into
-    /// `self.sample`; its acceleration and steps are set by [`integrate`](Self::integrate) or
-    /// [`acceleration`](Self::acceleration)).
-    fn take_sample(&mut self) -> Result<(), SimError> {
-        self.take_sample_with(None)
-    }
-
-    /// [`take_sample`](Self::take_sample) with the reference at the current time already
-    /// sampled (`shared`, by another run of a lock-step group with the same
-    /// [`reference_key`](Self::reference_key)), or sampled here (`None`).
-    fn take_sample_with(&mut self, shared: Option<&ReferenceSample>) -> Result<(), SimError> {
+    /// The controller sample at the current time: state, reference, noise, `tau*` and the
+    /// disturbance of `hooks` (into `self.sample`; its acceleration and steps are set by
+    /// [`integrate`](Self::integrate) or [`acceleration`](Self::acceleration)). The reference
+    /// at the current time is `shared` when another run of a lock-step group (of the same
+    /// [`Prepared`] simulation, so the same reference) has sampled it, or sampled here (`None`).
+    fn take_sample<H: LoopHooks + ?Sized>(
+        &mut self,
+        shared: Option<&ReferenceSample>,
+        hooks: &mut H,
+    ) -> Result<(), SimError> {
         let m = self.n_coords();
         let t = self.time();
         let sample = &mut self.sample;
@@ -657,7 +665,7 @@ impl Simulation {
             t,
             measured: &sample.measured,
             reference: &sample.command,
-            model: &self.plant.model,
+            model: (&*self.plant.model).into(),
             tau_star_limits: self.settings.tau_star_limits.as_deref(),
         };
         self.controller
@@ -674,6 +682,28 @@ impl Simulation {
             None => sample.clamped.fill(false),
         }
         self.plant.tau_star.copy_from_slice(&sample.tau_star);
+        if hooks.disturbance(t, &sample.state, &mut self.tau_disturbance) {
+            if !self.tau_disturbance.iter().all(|v| v.is_finite()) {
+                return Err(SimError::NonFiniteDisturbance {
+                    t,
+                    tau: self.tau_disturbance.clone(),
+                });
+            }
+            // eqs 14-15: the modal force of the joint torques, f = J^T tau_d.
+            modal_reduce::project_torques(
+                &self.plant.model,
+                &self.tau_disturbance,
+                &mut sample.disturbance,
+            )
+            .map_err(|source| SimError::Dynamics { t, source })?;
+            for (tau, f) in self.plant.tau_star.iter_mut().zip(&sample.disturbance) {
+                *tau += f;
+            }
+            self.disturbed = true;
+        } else if self.disturbed {
+            sample.disturbance.fill(0.0);
+            self.disturbed = false;
+        }
         Ok(())
     }
 
@@ -795,6 +825,94 @@ fn sample_counts(s: &LoopSettings) -> (usize, usize) {
     (samples, record_every)
 }
 
+/// Checks the noise of the settings of a loop of `m` coordinates: `m` reference and `2m` sensor
+/// standard deviations (or none), non-negative and finite.
+fn validate_noise(s: &LoopSettings, m: usize) -> Result<(), SimError> {
+    for (name, values, len) in [
+        ("noise.reference_std", &s.reference_noise_std, m),
+        ("noise.sensor_std", &s.sensor_noise_std, 2 * m),
+    ] {
+        if !values.is_empty() && values.len() != len {
+            return Err(SimError::setting(
+                name,
+                format!(
+                    "has {} entries, the loop needs {len} (or none)",
+                    values.len()
+                ),
+            ));
+        }
+        for &v in values {
+            check_non_negative(name, v)?;
+        }
+    }
+    Ok(())
+}
+
+/// Checks that `reference` and `controller` are built for the `m` coordinates of the model.
+fn check_parts(
+    reference: &dyn Reference,
+    controller: &dyn Controller,
+    m: usize,
+) -> Result<(), SimError> {
+    if reference.n_coords() != m {
+        return Err(SimError::setting(
+            "reference",
+            format!(
+                "sets {} coordinates, the model has {m}",
+                reference.n_coords()
+            ),
+        ));
+    }
+    if let Some(c) = controller.n_coords()
+        && c != m
+    {
+        return Err(SimError::setting(
+            "controller",
+            format!("is built for {c} coordinates, the model has {m}"),
+        ));
+    }
+    Ok(())
+}
+
+/// The initial state of a loop of `m` coordinates: `initial`, checked to have `m` finite
+/// entries per field ([`check_initial`]), or rest at the reference's value at `t = 0`.
+fn initial_state(
+    reference: &mut dyn Reference,
+    initial: Option<ModalState>,
+    m: usize,
+) -> Result<ModalState, SimError> {
+    let initial = match initial {
+        Some(state) => state,
+        None => {
+            let mut sample = ReferenceSample::zeros(m);
+            reference.sample(0.0, &mut sample)?;
+            ModalState {
+                a: sample.a,
+                a_dot: vec![0.0; m],
+            }
+        }
+    };
+    check_initial(&initial, m)?;
+    Ok(initial)
+}
+
+/// Checks that an initial state has `m` finite entries per field.
+fn check_initial(initial: &ModalState, m: usize) -> Result<(), SimError> {
+    for (name, values) in [("initial.a", &initial.a), ("initial.a_dot", &initial.a_dot)] {
+        if values.len() != m {
+            return Err(SimError::setting(
+                name,
+                format!(
+                    "has {} entries, the model has {m} coordinates",
+                    values.len()
+                ),
+            ));
+        }
+        check_finite(name, values)?;
+    }
+    Ok(())
+}
+
 /// Checks the settings of a loop of `m` coordinates for a chain of `n_links`.
 fn validate(s: &LoopSettings, m: usize, n_links: usize) -> Result<(), SimError> {
     check_positive("controller.period", s.controller_period)?;
@@ -848,23 +966,7 @@ fn validate(s: &LoopSettings, m: usize, n_links: usize) -> Result<(), SimError> 
             .check()
             .map_err(|reason| SimError::setting("integrator", format!("setting: {reason}")))?,
     }
-    for (name, values, len) in [
-        ("noise.reference_std", &s.reference_noise_std, m),
-        ("noise.sensor_std", &s.sensor_noise_std, 2 * m),
-    ] {
-        if !values.is_empty() && values.len() != len {
-            return Err(SimError::setting(
-                name,
-                format!(
-                    "has {} entries, the loop needs {len} (or none)",
-                    values.len()
-                ),
-            ));
-        }
-        for &v in values {
-            check_non_negative(name, v)?;
-        }
-    }
+    validate_noise(s, m)?;
     if s.max_modal_error.is_nan() || s.max_modal_error <= 0.0 {
         return Err(SimError::setting(
             "limits.max_modal_error",

@@ -254,3 +254,47 @@ fn targets_beyond_the_first_branch_are_named_as_such_and_solvable_from_a_guess()
     assert!((reached[0] - target[0]).abs() < 1e-13 && (reached[1] - target[1]).abs() < 1e-13);
     assert!(guess[0].hypot(guess[1]) > J0_FIRST_ZERO);
 }
+
+/// `solve_unguided` reaches every end point of the `K = 2, 3` families with coordinates in
+/// `[-0.5, 0.5]^{2K}`, including those the `K = 1` closed form cannot start from (`|a2| > A`,
+/// 32 of the 200 `K = 2` targets here), and keeps the closed form's start where it works.
+#[test]
+fn unguided_ik_reaches_what_the_family_reaches() {
+    let mut state = 2024u64;
+    let mut uniform = |half_width: f64| {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * half_width
+    };
+    for harmonics in [2, 3] {
+        let mut beyond_closed_form = 0;
+        for _ in 0..200 {
+            let alpha0 = uniform(0.5);
+            let truth: Vec<f64> = (0..2 * harmonics).map(|_| uniform(0.5)).collect();
+            let target = BackboneCurve::new(1.0, &truth, alpha0).unwrap().end_point();
+            let mut ik = HarmonicIk::new(1.0, harmonics, alpha0).unwrap();
+            let mut a = vec![0.0; 2 * harmonics];
+            let report = ik.solve_unguided(target, Branch::Positive, &mut a).unwrap();
+            let reached = BackboneCurve::new(1.0, &a, alpha0).unwrap().end_point();
+            assert!(
+                (reached[0] - target[0]).hypot(reached[1] - target[1]) <= 1e-14,
+                "K = {harmonics}, {truth:?}: {report:?}"
+            );
+            match inverse_kinematics(1.0, target, alpha0, Branch::Positive) {
+                Ok(closed) => {
+                    let mut from_closed = vec![0.0; 2 * harmonics];
+                    from_closed[..2].copy_from_slice(&closed);
+                    if ik.solve(target, &mut from_closed).is_ok() {
+                        assert_eq!(a, from_closed);
+                    }
+                }
+                Err(_) => beyond_closed_form += 1,
+            }
+        }
+        assert!(
+            beyond_closed_form > 0,
+            "K = {harmonics}: no target beyond the closed form"
+        );
+    }
+}

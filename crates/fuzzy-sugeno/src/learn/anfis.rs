@@ -15,7 +15,7 @@
 use super::data::TrainingData;
 use super::least_squares::{LeastSquares, LeastSquaresError};
 use super::premise::{gradient, repair};
-use crate::eval::CompiledMf;
+use crate::compiled_mf::CompiledMf;
 use crate::membership::MembershipFn;
 use crate::system::{
     AndMethod, Antecedent, Connective, Defuzzification, FuzzySystem, OutputFn, affine,
@@ -248,7 +248,7 @@ impl Anfis {
         }
         let compiled = mfs
             .iter()
-            .map(CompiledMf::new)
+            .map(MembershipFn::compile)
             .collect::<Result<Vec<_>, _>>()?;
         let output_variable = &system.outputs()[0];
         let mut terms = Vec::with_capacity(output_variable.terms.len());
@@ -553,7 +553,7 @@ impl Anfis {
             let before = *mf;
             *mf = mf.with_params(&params[..count]);
             repair(mf, &before, self.mf_span[m]);
-            self.net.compiled[m] = CompiledMf::new(mf)?;
+            self.net.compiled[m] = mf.compile()?;
         }
         Ok(())
     }
@@ -823,9 +823,9 @@ mod tests {
                     let mut p = params;
                     p[k] += delta;
                     let mf = trainer.mfs[m].with_params(&p[..count]);
-                    trainer.net.compiled[m] = CompiledMf::new(&mf).unwrap();
+                    trainer.net.compiled[m] = mf.compile().unwrap();
                     let e = sse(&mut trainer);
-                    trainer.net.compiled[m] = CompiledMf::new(&trainer.mfs[m]).unwrap();
+                    trainer.net.compiled[m] = trainer.mfs[m].compile().unwrap();
                     e
                 };
                 let numeric = (at(h) - at(-h)) / (2.0 * h);

@@ -2,7 +2,7 @@
 //! parameters (layer 1 of Jang 1993, the `d O / d alpha` of eq 12), and the repair that keeps a
 //! function valid after a gradient step.
 
-use crate::eval::{s_shape, sigmoid, trapezoid_sides, z_shape};
+use crate::compiled_mf::{s_shape, sigmoid, trapezoid_sides, z_shape};
 use crate::membership::MembershipFn;
 
 /// Writes `d mu / d p` at `x` into `grad`, for the parameters `p` in MATLAB's order; `mu` is the

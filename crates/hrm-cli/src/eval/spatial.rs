@@ -1,5 +1,6 @@
 //! The ops of `hrm eval` on spatial modal arms (`"arm": {"kind": "spatial", ...}`):
-//! `joints`, `fk`, `ik` and `reduced` (`docs/eval-protocol.md`, "Spatial arms").
+//! `joints`, `fk`, `ik`, `reduced`, `reduced_derivatives` and `export`
+//! (`docs/eval-protocol.md`, "Spatial arms").
 
 use super::{EvalError, EvalResult, finite, json_fields};
 use backbone_kin::{
@@ -7,8 +8,8 @@ use backbone_kin::{
     spatial_tip_position,
 };
 use modal_reduce::spatial::{
-    SpatialLinkInertia, SpatialReducedData, SpatialReducedModel, spatial_forward_dynamics,
-    spatial_joint_torques,
+    SpatialLinkInertia, SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel,
+    spatial_forward_dynamics, spatial_joint_torques, spatial_reduced_derivatives,
 };
 use serde::Deserialize;
 use serde_json::{Map, Value, json};
@@ -22,6 +23,9 @@ const MAX_SPATIAL_HARMONICS: usize = 16;
 /// Most entries of an answer's Jacobian or of the work of `reduced` (`2n x 4K`, and `n m^2`):
 /// about 0.1 s of work and 64 MB of JSON at most.
 const MAX_SPATIAL_WORK: usize = 1 << 22;
+
+/// Most links of a spatial arm `export` writes (about 1.4 MB of URDF per 1,000 links).
+const MAX_SPATIAL_EXPORT_LINKS: usize = 10_000;
 
 /// Whether a request's `"arm"` is a spatial arm (`"kind": "spatial"`).
 pub(super) fn is_spatial(request: &Map<String, Value>) -> bool {
@@ -38,8 +42,11 @@ pub(super) fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
         "fk" => fk(super::parse(request)?),
         "ik" => ik(super::parse(request)?),
         "reduced" => reduced(super::parse(request)?),
+        "reduced_derivatives" => reduced_derivatives(super::parse(request)?),
+        "export" => export(super::parse(request)?),
         other => Err(EvalError::input(format!(
-            "op {other:?} does not take a spatial arm; spatial arms take joints, fk, ik and reduced"
+            "op {other:?} does not take a spatial arm; spatial arms take joints, fk, ik, reduced, \
+             reduced_derivatives and export"
         ))),
     }
 }
@@ -281,6 +288,66 @@ fn reduced(request: ReducedRequest) -> EvalResult {
     ]))
 }
 
+/// `reduced_derivatives`: `a_ddot` and its analytic Jacobians `d_a`, `d_a_dot` and
+/// `d_tau_star = M*^-1` (`m x m` each), as for planar arms.
+fn reduced_derivatives(request: ReducedRequest) -> EvalResult {
+    let model = request.arm.model(harmonics(request.harmonics)?)?;
+    let mut derivatives = SpatialReducedDerivatives::new(&model);
+    spatial_reduced_derivatives(
+        &model,
+        &mut SpatialReducedData::new(&model),
+        &mut derivatives,
+        &request.a,
+        &request.a_dot,
+        &request.tau_star,
+    )?;
+    finite("a_ddot", derivatives.a_ddot())?;
+    Ok(json_fields([
+        ("a_ddot", json!(derivatives.a_ddot())),
+        ("d_a", super::derivatives::rows("d_a", derivatives.d_a())?),
+        (
+            "d_a_dot",
+            super::derivatives::rows("d_a_dot", derivatives.d_a_dot())?,
+        ),
+        (
+            "d_tau_star",
+            super::derivatives::rows("d_tau_star", derivatives.d_tau_star())?,
+        ),
+    ]))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExportRequest {
+    arm: SpatialArmSpec,
+    format: String,
+    harmonics: Option<usize>,
+}
+
+/// `export`: the arm as URDF or MJCF ([`robot_desc::from_spatial_arm`]: its movable joints in the
+/// order of `theta`; the MJCF carries the arm's gravity, a URDF none).
+fn export(request: ExportRequest) -> EvalResult {
+    let model = request.arm.model(harmonics(request.harmonics)?)?;
+    if model.n_links() > MAX_SPATIAL_EXPORT_LINKS {
+        return Err(EvalError::input(format!(
+            "arm.links must be at most {MAX_SPATIAL_EXPORT_LINKS} for export, got {}",
+            model.n_links()
+        )));
+    }
+    let robot = robot_desc::from_spatial_arm(&model, "hrm_spatial_arm");
+    let text = match request.format.as_str() {
+        "urdf" => robot_desc::write_urdf(&robot),
+        "mjcf" => robot_desc::write_mjcf(&robot, model.gravity())
+            .map_err(|e| EvalError::input(e.to_string()))?,
+        other => {
+            return Err(EvalError::input(format!(
+                "format must be \"urdf\" or \"mjcf\", got {other:?}"
+            )));
+        }
+    };
+    Ok(json_fields([("text", json!(text))]))
+}
+
 #[cfg(test)]
 mod tests {
     use serde_json::{Value, json};
@@ -369,6 +436,86 @@ mod tests {
         assert!((0..10).all(|i| p[i] == s[2 * i] && s[2 * i + 1] == 0.0));
     }
 
+    /// The exported URDF read back: `2n` joints in the order of `theta`, whose frames composed
+    /// joint by joint (`origin * Rot(axis, q)`) put the last link's end on the chain's tip;
+    /// the inertias as given.
+    #[test]
+    fn the_exported_urdf_is_the_arm() {
+        use robot_desc::pose::{mat_mul, mat_vec};
+        let arm = json!({"kind": "spatial", "lengths": [0.1, 0.2, 0.15, 0.1],
+                         "inertias": [[0.002, 0.001, 0.0015], [0.002, 0.001, 0.0015], [0.002, 0.001, 0.0015], [0.002, 0.001, 0.0015]],
+                         "base": {"xyz": [0.1, 0.0, 0.3], "rpy": [0.3, -0.2, 0.5]}});
+        let exported = request(json!({"op": "export", "arm": arm, "format": "urdf"}));
+        let robot = robot_desc::read_urdf(exported["text"].as_str().unwrap())
+            .unwrap()
+            .robot;
+        let a = [0.4, -0.3, 0.2, 0.6];
+        let theta = vector(&request(json!({"op": "joints", "arm": arm, "a": a}))["theta"]);
+        let tip = vector(&request(json!({"op": "fk", "arm": arm, "a": a}))["tip_chain"]);
+        assert_eq!(robot.n_joints(), 8);
+        let (mut rotation, mut position) = (
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            [0.0; 3],
+        );
+        for (joint, &q) in robot.joints.iter().zip(&theta) {
+            let offset = mat_vec(&rotation, joint.origin.xyz);
+            position = [0, 1, 2].map(|d| position[d] + offset[d]);
+            rotation = mat_mul(&rotation, &joint.origin.rotation());
+            let turn = if joint.axis == [0.0, 0.0, 1.0] {
+                robot_desc::pose::rpy_matrix([0.0, 0.0, q])
+            } else {
+                assert_eq!(joint.axis, [0.0, 1.0, 0.0]);
+                robot_desc::pose::rpy_matrix([0.0, q, 0.0])
+            };
+            rotation = mat_mul(&rotation, &turn);
+        }
+        let end = mat_vec(&rotation, [0.1, 0.0, 0.0]);
+        for d in 0..3 {
+            assert!(
+                (position[d] + end[d] - tip[d]).abs() < 1e-14,
+                "{position:?} {tip:?}"
+            );
+        }
+        let last = &robot.joints[7].child.inertial;
+        assert_eq!(
+            (last.mass, last.inertia),
+            (0.1, [0.002, 0.0, 0.0, 0.001, 0.0, 0.0015])
+        );
+        assert_eq!(last.origin.xyz, [0.05, 0.0, 0.0]);
+    }
+
+    /// `reduced_derivatives` answers what the library computes (tested there against finite
+    /// differences): `d_tau_star` inverts `mass_matrix`.
+    #[test]
+    fn reduced_derivatives_answer_through_the_protocol() {
+        let arm = json!({"kind": "spatial", "links": 6});
+        let state = json!({"a": [0.4, -0.3, 0.2, 0.6], "a_dot": [0.5, -1.0, 0.2, 0.7],
+                           "tau_star": [0.1, 0.0, -0.1, 0.2]});
+        let mut line = json!({"op": "reduced_derivatives", "arm": arm});
+        let mut reduced_line = json!({"op": "reduced", "arm": arm});
+        for key in ["a", "a_dot", "tau_star"] {
+            line[key] = state[key].clone();
+            reduced_line[key] = state[key].clone();
+        }
+        let answer = request(line);
+        let reduced = request(reduced_line);
+        assert_eq!(answer["a_ddot"], reduced["a_ddot"]);
+        for i in 0..4 {
+            for j in 0..4 {
+                let product: f64 = (0..4)
+                    .map(|l| {
+                        answer["d_tau_star"][i][l].as_f64().unwrap()
+                            * reduced["mass_matrix"][l][j].as_f64().unwrap()
+                    })
+                    .sum();
+                assert!((product - f64::from(u8::from(i == j))).abs() < 1e-10);
+            }
+        }
+        for key in ["d_a", "d_a_dot"] {
+            assert_eq!(answer[key].as_array().unwrap().len(), 4);
+        }
+    }
+
     #[test]
     fn spatial_requests_are_bounded_and_checked() {
         let cases = [
@@ -400,6 +547,14 @@ mod tests {
             (
                 json!({"op": "fk", "arm": {"kind": "spatial"}, "a": [0, 0, 0]}),
                 "expected 4",
+            ),
+            (
+                json!({"op": "export", "arm": {"kind": "spatial", "links": 20_000}, "format": "urdf"}),
+                "at most 10000 for export",
+            ),
+            (
+                json!({"op": "export", "arm": {"kind": "spatial"}, "format": "sdf"}),
+                "format must be",
             ),
             (
                 json!({"op": "ik", "arm": {"kind": "spatial"}, "target": [5.0, 0.0, 0.0]}),

@@ -1,6 +1,6 @@
 """hrm: hyper-redundant manipulators from Python.
 
-Planar chain dynamics (``Arm``), the modal reduction of the paper's backbone-curve method
+Planar chain dynamics (``Arm``), spatial chains read from URDF (``Chain``), the modal reduction of the paper's backbone-curve method
 (``ReducedModel``), spatial arms of universal joints on a modal backbone curve
 (``SpatialArm``), Takagi-Sugeno fuzzy systems (``hrm.fuzzy``), closed-loop experiments
 (``Scenario``, run with a built-in or a Python controller into a ``Run``) and Monte Carlo
@@ -18,6 +18,7 @@ See docs/python.md.
 from . import fuzzy
 from ._hrm import (
     Arm,
+    Chain,
     InvalidInput,
     NumericalError,
     ReducedModel,
@@ -34,6 +35,7 @@ from ._hrm import (
 
 __all__ = [
     "Arm",
+    "Chain",
     "InvalidInput",
     "NumericalError",
     "ReducedModel",

@@ -65,6 +65,73 @@ class Arm:
         """Forward dynamics (ABA): theta_ddot, shape (n,) or (N, n); a batch runs SIMD across states."""
     def energy(self, theta: ArrayLike, theta_dot: ArrayLike) -> Union[float, Array]:
         """Kinetic plus potential energy (J): a float, or shape (N,) for a batch."""
+    @staticmethod
+    def from_urdf(
+        urdf: Union[str, "PathLike[str]"], gravity: Sequence[float] = (0.0, 0.0, -9.81)
+    ) -> Chain:
+        """A spatial chain read from URDF: Chain.from_urdf(urdf, gravity)."""
+    def to_urdf(self) -> str:
+        """The arm as URDF text (joints about z, links along x; gravity along -y not in it)."""
+    def to_mjcf(self) -> str:
+        """The arm as one MJCF document, gravity along -y in <option>."""
+
+class Chain:
+    """A spatial serial chain with a fixed base read from URDF: tau = M(q) q_ddot + C(q, q_dot)
+    q_dot + G(q), one entry per movable joint in chain order."""
+
+    @staticmethod
+    def from_urdf(
+        urdf: Union[str, "PathLike[str]"], gravity: Sequence[float] = (0.0, 0.0, -9.81)
+    ) -> "Chain":
+        """The chain of URDF text, a path-like object, or a string ending in .urdf naming a
+        regular file (at most 8 MiB), under the world gravity vector (m/s^2)."""
+    @property
+    def n_joints(self) -> int:
+        """Number of movable joints n."""
+    @property
+    def name(self) -> str:
+        """The URDF robot name."""
+    @property
+    def joint_names(self) -> List[str]:
+        """The movable joints' names, in chain order."""
+    @property
+    def link_names(self) -> List[str]:
+        """The moving links' names (fixed links merged into them)."""
+    @property
+    def joint_kinds(self) -> List[str]:
+        """"revolute", "continuous" or "prismatic" per joint."""
+    @property
+    def limits(self) -> Array:
+        """Lower and upper joint limits, shape (n, 2) (infinite where none)."""
+    @property
+    def gravity_vector(self) -> Tuple[float, float, float]:
+        """The gravitational acceleration in the base frame (m/s^2)."""
+    def to_urdf(self) -> str:
+        """The chain as URDF text."""
+    def to_mjcf(self) -> str:
+        """The chain as one MJCF document, gravity in <option>."""
+    def mass_matrix(self, theta: ArrayLike) -> Array:
+        """M(q) (CRBA), shape (n, n) or (N, n, n)."""
+    def coriolis(self, theta: ArrayLike, theta_dot: ArrayLike) -> Array:
+        """C(q, q_dot) q_dot, shape (n,) or (N, n)."""
+    def gravity(self, theta: ArrayLike) -> Array:
+        """G(q), shape (n,) or (N, n)."""
+    def rnea(self, theta: ArrayLike, theta_dot: ArrayLike, theta_ddot: ArrayLike) -> Array:
+        """Inverse dynamics tau, shape (n,) or (N, n)."""
+    def aba(self, theta: ArrayLike, theta_dot: ArrayLike, tau: ArrayLike) -> Array:
+        """Forward dynamics q_ddot (ABA; a batch SIMD across states), shape (n,) or (N, n)."""
+    def rnea_derivatives(
+        self, theta: ArrayLike, theta_dot: ArrayLike, theta_ddot: ArrayLike
+    ) -> Tuple[Array, Array, Array]:
+        """(tau, d tau / d q, d tau / d q_dot)."""
+    def aba_derivatives(
+        self, theta: ArrayLike, theta_dot: ArrayLike, tau: ArrayLike
+    ) -> Tuple[Array, Array, Array, Array]:
+        """(q_ddot, d q_ddot / d q, d q_ddot / d q_dot, M^-1)."""
+    def frames(self, theta: ArrayLike) -> Tuple[Array, Array]:
+        """(positions (n, 3), rotations (n, 3, 3)) of each moving link in the base frame."""
+    def energy(self, theta: ArrayLike, theta_dot: ArrayLike) -> Union[float, Array]:
+        """Kinetic plus potential energy (J)."""
 
 class ReducedModel:
     """The arm's dynamics in the modal coordinates of its backbone curve (eqs 7-18)."""

@@ -18,32 +18,13 @@
 
 use lane_math::Lane;
 
-use super::algebra::{Force, Mat3, Motion, Symmetric6, Transform, Vec3, splat3};
-use super::data::SpatialData;
+use super::algebra::{Force, Motion, Symmetric6, Transform, Vec3, splat3};
+use super::data::{AbaLink, SpatialData};
 use super::kinematics::joint_placement;
 use super::model::SpatialModel;
 use crate::aba::AbaLane;
 use crate::check;
 use crate::error::DynError;
-
-/// What the later sweeps need of joint `i`, for one state (`T = f64`) or the lanes of a batch
-/// (`T` a slot of lanes).
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct AbaLink<T> {
-    /// `X_i`: link `i`'s frame in its parent's.
-    rotation: Mat3<T>,
-    translation: Vec3<T>,
-    /// `c_i` (linear, angular).
-    bias: [Vec3<T>; 2],
-    /// `p_i`, the rigid bias force (linear, angular).
-    force: [Vec3<T>; 2],
-    /// `U_i` (linear, angular).
-    coupling: [Vec3<T>; 2],
-    /// `1 / D_i`.
-    inverse: T,
-    /// `u_i`.
-    residual: T,
-}
 
 /// Forward dynamics by the articulated-body algorithm: the joint accelerations `qdd` that the
 /// torques (or forces, for prismatic joints) `tau` produce at the state `(q, v)`, in `O(n)`.

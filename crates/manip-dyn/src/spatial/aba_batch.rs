@@ -5,8 +5,8 @@
 use lane_math::Pack;
 use pulp::{Arch, Simd, WithSimd};
 
-use super::aba::{AbaBuffers, AbaLink, aba, kernel};
-use super::data::SpatialData;
+use super::aba::{AbaBuffers, aba, kernel};
+use super::data::{AbaLink, SpatialData};
 use super::model::SpatialModel;
 use crate::aba::MAX_WIDTH;
 use crate::aba_batch::{BatchError, MAX_BATCH_LINKS, all_finite};

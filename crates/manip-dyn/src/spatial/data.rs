@@ -2,8 +2,7 @@
 
 use pulp::Arch;
 
-use super::aba::AbaLink;
-use super::algebra::{Force, Motion, Symmetric6, Transform};
+use super::algebra::{Force, Mat3, Motion, Symmetric6, Transform, Vec3};
 use super::model::SpatialModel;
 
 /// Scratch space for one [`SpatialModel`]: build it once with [`SpatialData::new`], then pass it
@@ -81,4 +80,23 @@ impl std::fmt::Debug for SpatialData {
             .field("n_links", &self.n_links())
             .finish_non_exhaustive()
     }
+}
+
+/// What the later sweeps need of joint `i`, for one state (`T = f64`) or the lanes of a batch
+/// (`T` a slot of lanes).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct AbaLink<T> {
+    /// `X_i`: link `i`'s frame in its parent's.
+    pub(crate) rotation: Mat3<T>,
+    pub(crate) translation: Vec3<T>,
+    /// `c_i` (linear, angular).
+    pub(crate) bias: [Vec3<T>; 2],
+    /// `p_i`, the rigid bias force (linear, angular).
+    pub(crate) force: [Vec3<T>; 2],
+    /// `U_i` (linear, angular).
+    pub(crate) coupling: [Vec3<T>; 2],
+    /// `1 / D_i`.
+    pub(crate) inverse: T,
+    /// `u_i`.
+    pub(crate) residual: T,
 }

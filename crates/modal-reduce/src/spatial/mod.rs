@@ -10,15 +10,20 @@
 //! - [`terms`]: `M*`, `C*`, `G*` in `O(n m^2)` without the `2n x 2n` mass matrix.
 //! - [`torques`]: the joint torques that realise a modal motion (Newton-Euler, `O(n)`).
 //! - [`forward`]: reduced forward dynamics.
+//! - [`tangent`]: the tangent of the Newton-Euler recursion along one direction;
+//!   [`derivatives`]: the analytic derivatives of the reduced forward dynamics, `O(n m^2)`.
 
 pub mod data;
+pub mod derivatives;
 pub mod forward;
 pub mod model;
 pub mod motion;
+pub mod tangent;
 pub mod terms;
 pub mod torques;
 
 pub use data::SpatialReducedData;
+pub use derivatives::{SpatialReducedDerivatives, spatial_reduced_derivatives};
 pub use forward::spatial_forward_dynamics;
 pub use model::{SpatialLinkInertia, SpatialReducedModel};
 pub use terms::spatial_reduced_terms;

@@ -16,7 +16,9 @@
 //! With zero joint accelerations the accelerations are the bias terms of `C*` (velocity
 //! products only).
 
-use backbone_kin::vec3::{Rotation, add, column, cross, mat_mul, rot_y, rot_z, scale};
+use backbone_kin::vec3::{
+    Rotation, add, column, cross, mat_mul, mat_vec, rot_y, rot_z, scale, sub,
+};
 
 /// The state the recursion carries from link to link.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -131,4 +133,30 @@ pub fn world_inertia(rotation: &Rotation, principal: [f64; 3]) -> Rotation {
                 .sum()
         })
     })
+}
+
+/// Link `i`'s step of the backward pass: from the force `F_{i+1}` and the moment `N_{i+1}` about
+/// `next_joint = p_i` that the links beyond it need, the force `F_i = m_i (a_i - g) + F_{i+1}` and
+/// the moment about `p_{i-1}`, `N_i = I_i w_dot_i + w_i x I_i w_i + (c_i - p_{i-1}) x m_i (a_i - g)
+/// + (p_i - p_{i-1}) x F_{i+1} + N_{i+1}` (`world` the link's inertia `I_i`, `mass` `m_i`).
+pub fn link_wrench(
+    motion: &LinkMotion,
+    world: &Rotation,
+    mass: f64,
+    gravity: [f64; 3],
+    force: [f64; 3],
+    moment: [f64; 3],
+    next_joint: [f64; 3],
+) -> ([f64; 3], [f64; 3]) {
+    let own = scale(sub(motion.com_accel, gravity), mass);
+    let spin = cross(motion.omega, mat_vec(world, motion.omega));
+    let own_moment = add(
+        add(mat_vec(world, motion.omega_dot), spin),
+        cross(sub(motion.com, motion.joint), own),
+    );
+    let moment = add(
+        add(moment, cross(sub(next_joint, motion.joint), force)),
+        own_moment,
+    );
+    (add(force, own), moment)
 }

@@ -10,10 +10,10 @@
 
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
-use super::motion::{Carried, link_step, world_inertia};
+use super::motion::{Carried, link_step, link_wrench, world_inertia};
 use super::terms::check_state;
 use crate::error::{ReduceError, check_finite_result, check_input, check_len};
-use backbone_kin::vec3::{add, cross, dot, mat_vec, scale, sub};
+use backbone_kin::vec3::dot;
 
 /// The joint torques `tau` (`2n`) of the modal motion `(a, a_dot, a_ddot)`. Allocation-free.
 ///
@@ -65,17 +65,15 @@ pub fn spatial_joint_torques(
         .rev()
     {
         let world = world_inertia(&motion.rotation, inertia.principal);
-        let own = scale(sub(motion.com_accel, gravity), inertia.mass);
-        let spin = cross(motion.omega, mat_vec(&world, motion.omega));
-        let own_moment = add(
-            add(mat_vec(&world, motion.omega_dot), spin),
-            cross(sub(motion.com, motion.joint), own),
+        (force, moment) = link_wrench(
+            motion,
+            &world,
+            inertia.mass,
+            gravity,
+            force,
+            moment,
+            next_joint,
         );
-        moment = add(
-            add(moment, cross(sub(next_joint, motion.joint), force)),
-            own_moment,
-        );
-        force = add(force, own);
         next_joint = motion.joint;
         pair[0] = dot(motion.u_z, moment);
         pair[1] = dot(motion.u_y, moment);

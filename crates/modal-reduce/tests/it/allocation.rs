@@ -63,7 +63,8 @@ fn per_step_functions_do_not_allocate() {
 #[test]
 fn spatial_per_step_functions_do_not_allocate() {
     use modal_reduce::spatial::{
-        SpatialReducedData, SpatialReducedModel, spatial_forward_dynamics, spatial_joint_torques,
+        SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel,
+        spatial_forward_dynamics, spatial_joint_torques, spatial_reduced_derivatives,
         spatial_reduced_terms,
     };
     assert!(is_counting());
@@ -72,7 +73,10 @@ fn spatial_per_step_functions_do_not_allocate() {
     let mut data = SpatialReducedData::new(&model);
     let (a, a_dot, tau_star) = (vec![0.3; m], vec![-0.2; m], vec![0.5; m]);
     let (mut a_ddot, mut tau) = (vec![0.0; m], vec![0.0; 100]);
+    let mut derivatives = SpatialReducedDerivatives::new(&model);
     let count = allocations_during(|| {
+        spatial_reduced_derivatives(&model, &mut data, &mut derivatives, &a, &a_dot, &tau_star)
+            .unwrap();
         spatial_reduced_terms(&model, &mut data, &a, &a_dot).unwrap();
         spatial_forward_dynamics(&model, &mut data, &a, &a_dot, &tau_star, &mut a_ddot).unwrap();
         spatial_joint_torques(&model, &mut data, &a, &a_dot, &a_ddot, &mut tau).unwrap();

@@ -15,7 +15,7 @@ use proptest::prelude::*;
 
 /// A random arm: `n` links of random lengths and inertias, `K` harmonics, a random base pose
 /// and gravity.
-fn arm(n: usize, k: usize, seed: u64) -> SpatialReducedModel {
+pub(crate) fn arm(n: usize, k: usize, seed: u64) -> SpatialReducedModel {
     let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
     let mut next = move || {
         state ^= state << 13;
@@ -49,7 +49,7 @@ fn arm(n: usize, k: usize, seed: u64) -> SpatialReducedModel {
     .unwrap()
 }
 
-fn state(m: usize, seed: u64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+pub(crate) fn state(m: usize, seed: u64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let f = |j: usize, s: f64| ((seed as f64 + 1.0) * (j as f64 + 0.37) * s).sin();
     (
         (0..m).map(|j| 0.8 * f(j, 1.3)).collect(),

@@ -1,11 +1,12 @@
-//! The optimal-control building blocks on the paper's arm: the linearisation against the
-//! nonlinear flow (finite differences of an RK4 integration about an equilibrium), the LQR's
+//! The optimal-control building blocks on the paper's arm: the linearisation (of planar and
+//! spatial arms) against the nonlinear flow (finite differences of an RK4 integration about an equilibrium), the LQR's
 //! Riccati residual and closed-loop stability, and the regulator driving the nonlinear model
 //! back to its reference.
 
 use backbone_kin::{BaseAngle, ModalMap};
 use manip_dyn::ChainModel;
-use modal_reduce::{ReducedData, ReducedModel, forward_dynamics};
+use modal_reduce::spatial::SpatialReducedModel;
+use modal_reduce::{Plant, PlantData, ReducedModel};
 use optimal_ctl::{Linearisation, Lqr, LqrSettings, OptimalError};
 
 fn model(harmonics: usize, base: BaseAngle) -> ReducedModel {
@@ -14,21 +15,25 @@ fn model(harmonics: usize, base: BaseAngle) -> ReducedModel {
 }
 
 /// The generalised forces holding `a` at rest: `G*(a)`.
-fn holding(model: &ReducedModel, a: &[f64]) -> Vec<f64> {
+fn holding(model: Plant<'_>, a: &[f64]) -> Vec<f64> {
     let m = model.n_coords();
-    let mut data = ReducedData::new(model);
+    let mut data = PlantData::new(model);
     let mut out = vec![0.0; m];
-    forward_dynamics(model, &mut data, a, &vec![0.0; m], &vec![0.0; m], &mut out).unwrap();
+    model
+        .forward_dynamics(&mut data, a, &vec![0.0; m], &vec![0.0; m], &mut out)
+        .unwrap();
     data.gravity().to_vec()
 }
 
 /// The nonlinear state after `period` s with `u` held, by RK4 with `steps` steps.
-fn flow(model: &ReducedModel, x: &[f64], u: &[f64], period: f64, steps: usize) -> Vec<f64> {
+fn flow(model: Plant<'_>, x: &[f64], u: &[f64], period: f64, steps: usize) -> Vec<f64> {
     let m = model.n_coords();
-    let mut data = ReducedData::new(model);
+    let mut data = PlantData::new(model);
     let mut rhs = |x: &[f64]| -> Vec<f64> {
         let mut a_ddot = vec![0.0; m];
-        forward_dynamics(model, &mut data, &x[..m], &x[m..], u, &mut a_ddot).unwrap();
+        model
+            .forward_dynamics(&mut data, &x[..m], &x[m..], u, &mut a_ddot)
+            .unwrap();
         [&x[m..], &a_ddot[..]].concat()
     };
     let h = period / steps as f64;
@@ -50,19 +55,30 @@ fn flow(model: &ReducedModel, x: &[f64], u: &[f64], period: f64, steps: usize) -
 
 #[test]
 fn discrete_linearisation_is_the_jacobian_of_the_flow_at_an_equilibrium() {
-    for (harmonics, base) in [
+    let planar: Vec<ReducedModel> = [
         (1, BaseAngle::Fixed(1.4)),
         (1, BaseAngle::Free),
         (2, BaseAngle::Fixed(1.4)),
-    ] {
-        let model = model(harmonics, base);
+    ]
+    .into_iter()
+    .map(|(harmonics, base)| model(harmonics, base))
+    .collect();
+    // A spatial arm, a cantilever under gravity along -z (m = 4 and 8).
+    let spatial: Vec<SpatialReducedModel> = [1, 2]
+        .into_iter()
+        .map(|k| SpatialReducedModel::uniform_rods(10, k, 0.1, 0.1, [0.0, 0.0, -9.81]).unwrap())
+        .collect();
+    let plants = planar
+        .iter()
+        .map(Plant::from)
+        .chain(spatial.iter().map(Plant::from));
+    for model in plants {
         let m = model.n_coords();
-        let a: Vec<f64> = [0.4, -0.3, 0.2, 0.1, 1.2][..m].to_vec();
-        let u = holding(&model, &a);
+        let a: Vec<f64> = [0.4, -0.3, 0.2, 0.1, 1.2, -0.2, 0.3, 0.1][..m].to_vec();
+        let u = holding(model, &a);
         let period = 0.01;
-        let mut lin = Linearisation::new(&model);
-        lin.linearise(&model, &a, &vec![0.0; m], &u, period)
-            .unwrap();
+        let mut lin = Linearisation::new(model);
+        lin.linearise(model, &a, &vec![0.0; m], &u, period).unwrap();
         assert!(
             lin.drift().iter().all(|x| x.abs() < 1e-12),
             "not an equilibrium"
@@ -78,8 +94,8 @@ fn discrete_linearisation_is_the_jacobian_of_the_flow_at_an_equilibrium() {
                 up[k - 2 * m] += eps;
                 um[k - 2 * m] -= eps;
             }
-            let plus = flow(&model, &xp, &up, period, 50);
-            let minus = flow(&model, &xm, &um, period, 50);
+            let plus = flow(model, &xp, &up, period, 50);
+            let minus = flow(model, &xm, &um, period, 50);
             for i in 0..2 * m {
                 let fd = (plus[i] - minus[i]) / (2.0 * eps);
                 let analytic = if k < 2 * m {
@@ -150,7 +166,7 @@ fn lqr_solves_the_riccati_equation_and_stabilises_the_loop() {
         let model = model(harmonics, base);
         let (m, n) = (model.n_coords(), 2 * model.n_coords());
         let a: Vec<f64> = [0.4, -0.3, 0.2, 0.1, 1.2][..m].to_vec();
-        let u = holding(&model, &a);
+        let u = holding((&model).into(), &a);
         let mut lin = Linearisation::new(&model);
         lin.linearise(&model, &a, &vec![0.0; m], &u, 0.01).unwrap();
         let (q, r) = weights(m, 1e-2);
@@ -206,7 +222,7 @@ fn lqr_brings_the_nonlinear_arm_back_to_its_reference() {
     let model = model(1, BaseAngle::Fixed(1.4));
     let m = model.n_coords();
     let a_ref = vec![0.4, -0.3];
-    let u_ref = holding(&model, &a_ref);
+    let u_ref = holding((&model).into(), &a_ref);
     let period = 0.01;
     let mut lin = Linearisation::new(&model);
     lin.linearise(&model, &a_ref, &[0.0, 0.0], &u_ref, period)
@@ -219,7 +235,7 @@ fn lqr_brings_the_nonlinear_arm_back_to_its_reference() {
     let mut u = vec![0.0; m];
     for _ in 0..300 {
         lqr.control(&u_ref, &x, &x_ref, &mut u).unwrap();
-        x = flow(&model, &x, &u, period, 10);
+        x = flow((&model).into(), &x, &u, period, 10);
     }
     for (xi, ri) in x.iter().zip(&x_ref) {
         assert!((xi - ri).abs() < 1e-4, "{x:?} vs {x_ref:?}");

@@ -2,7 +2,7 @@
 
 use super::{ControlContext, Controller, ControllerError, check_context};
 use crate::error::{SimError, check_non_negative};
-use modal_reduce::{ReducedData, ReducedModel};
+use modal_reduce::{Plant, PlantData};
 
 /// `tau* = M*(a) (a_ref_dd - kp (a - a_ref) - kd (a_dot - a_ref_dot)) + C*(a, a_dot) + G*(a)`
 /// (eq 15 solved for the torque), with the reduced model of the loop
@@ -10,7 +10,7 @@ use modal_reduce::{ReducedData, ReducedModel};
 /// `e'' + kd e' + kp e = 0` in each coordinate.
 #[derive(Debug, Clone)]
 pub struct ComputedTorque {
-    data: ReducedData,
+    data: PlantData,
     kp: Vec<f64>,
     kd: Vec<f64>,
     desired: Vec<f64>,
@@ -37,7 +37,7 @@ impl ComputedTorque {
     ///     t: 0.0,
     ///     measured: &measured,
     ///     reference: &reference,
-    ///     model: &model,
+    ///     model: (&model).into(),
     ///     tau_star_limits: None,
     /// };
     /// let mut tau = [0.0; 5];
@@ -46,7 +46,8 @@ impl ComputedTorque {
     /// assert!(tau[4].abs() > 1.0);
     /// # Ok::<(), sim_core::controller::ControllerError>(())
     /// ```
-    pub fn new(model: &ReducedModel, kp: &[f64], kd: &[f64]) -> Result<Self, SimError> {
+    pub fn new<'p>(model: impl Into<Plant<'p>>, kp: &[f64], kd: &[f64]) -> Result<Self, SimError> {
+        let model = model.into();
         let m = model.n_coords();
         for (name, gains) in [("controller.kp", kp), ("controller.kd", kd)] {
             if gains.len() != m {
@@ -60,7 +61,7 @@ impl ComputedTorque {
             }
         }
         Ok(Self {
-            data: ReducedData::new(model),
+            data: PlantData::new(model),
             kp: kp.to_vec(),
             kd: kd.to_vec(),
             desired: vec![0.0; m],
@@ -77,7 +78,8 @@ impl Controller for ComputedTorque {
         let m = self.kp.len();
         check_context(ctx, m, tau_star)?;
         let (measured, reference) = (ctx.measured, ctx.reference);
-        modal_reduce::reduced_terms(ctx.model, &mut self.data, &measured.a, &measured.a_dot)
+        ctx.model
+            .terms(&mut self.data, &measured.a, &measured.a_dot)
             .map_err(|source| SimError::Dynamics { t: ctx.t, source })?;
         for i in 0..m {
             self.desired[i] = reference.a_ddot[i]

@@ -7,7 +7,7 @@ use super::{
 use crate::error::SimError;
 use crate::reference::ReferenceSample;
 use fuzzy_sugeno::{EvalOptions, Evaluator, FuzzySystem, OutOfRange, OutsideRange};
-use modal_reduce::{ReducedData, ReducedModel};
+use modal_reduce::{Plant, PlantData};
 
 /// How a fuzzy system's inputs and outputs sit on the `m` coordinates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -162,7 +162,7 @@ pub struct FuzzyController {
     layout: Layout,
     m: usize,
     inputs: Vec<f64>,
-    gravity: Option<ReducedData>,
+    gravity: Option<PlantData>,
 }
 
 impl FuzzyController {
@@ -187,7 +187,7 @@ impl FuzzyController {
     ///     t: 0.0,
     ///     measured: &measured,
     ///     reference: &reference,
-    ///     model: &model,
+    ///     model: (&model).into(),
     ///     tau_star_limits: None,
     /// };
     /// let mut tau = [0.0; 2];
@@ -208,8 +208,11 @@ impl FuzzyController {
 
     /// The same controller plus the gravity compensation `G*(a)` of the loop's model; `model`
     /// (with the controller's `m` coordinates) sizes the workspace.
-    pub fn with_gravity_compensation(mut self, model: &ReducedModel) -> Result<Self, SimError> {
-        let m = self.m;
+    pub fn with_gravity_compensation<'p>(
+        mut self,
+        model: impl Into<Plant<'p>>,
+    ) -> Result<Self, SimError> {
+        let (m, model) = (self.m, model.into());
         if model.n_coords() != m {
             return Err(SimError::setting(
                 "model",
@@ -219,7 +222,7 @@ impl FuzzyController {
                 ),
             ));
         }
-        self.gravity = Some(ReducedData::new(model));
+        self.gravity = Some(PlantData::new(model));
         Ok(self)
     }
 
@@ -263,7 +266,8 @@ impl Controller for FuzzyController {
             )
             .map_err(SimError::from)?;
         if let Some(data) = &mut self.gravity {
-            modal_reduce::reduced_terms(ctx.model, data, &measured.a, &measured.a_dot)
+            ctx.model
+                .terms(data, &measured.a, &measured.a_dot)
                 .map_err(|source| SimError::Dynamics { t: ctx.t, source })?;
             for (tau, g) in tau_star.iter_mut().zip(data.gravity()) {
                 *tau += g;

@@ -3,7 +3,7 @@
 
 use super::{ControlContext, Controller, ControllerError, check_context, check_coordinate_count};
 use crate::error::{Readable, SimError, check_positive};
-use modal_reduce::{ReducedData, ReducedModel};
+use modal_reduce::{Plant, PlantData};
 use optimal_ctl::dense::symmetrise;
 use optimal_ctl::{Linearisation, Lqr, LqrSettings};
 
@@ -39,7 +39,7 @@ pub struct LqrController {
     m: usize,
     period: f64,
     relinearise_period: f64,
-    data: ReducedData,
+    data: PlantData,
     linearisation: Linearisation,
     lqr: Lqr,
     settings: LqrSettings,
@@ -75,7 +75,7 @@ impl LqrController {
     ///     t: 0.0,
     ///     measured: &measured,
     ///     reference: &reference,
-    ///     model: &model,
+    ///     model: (&model).into(),
     ///     tau_star_limits: None,
     /// };
     /// let mut tau = [0.0; 2];
@@ -84,12 +84,13 @@ impl LqrController {
     /// assert!(tau.iter().any(|t| t.abs() > 1e-3));
     /// # Ok::<(), sim_core::controller::ControllerError>(())
     /// ```
-    pub fn new(
-        model: &ReducedModel,
+    pub fn new<'p>(
+        model: impl Into<Plant<'p>>,
         period: f64,
         frequency: f64,
         relinearise_period: f64,
     ) -> Result<Self, SimError> {
+        let model = model.into();
         let m = model.n_coords();
         check_coordinate_count("controller", m)?;
         check_positive("controller.period", period)?;
@@ -114,8 +115,9 @@ impl LqrController {
                 ),
             ));
         }
-        let mut data = ReducedData::new(model);
-        modal_reduce::reduced_terms(model, &mut data, &vec![0.0; m], &vec![0.0; m])
+        let mut data = PlantData::new(model);
+        model
+            .terms(&mut data, &vec![0.0; m], &vec![0.0; m])
             .map_err(|source| SimError::Dynamics { t: 0.0, source })?;
         let (n, w4) = (2 * m, frequency.powi(4));
         let mass = data.mass_matrix();
@@ -168,7 +170,8 @@ impl Controller for LqrController {
         let (measured, reference) = (ctx.measured, ctx.reference);
         let t = ctx.t;
         // The feedforward: eq 15 along the reference.
-        modal_reduce::reduced_terms(ctx.model, &mut self.data, &reference.a, &reference.a_dot)
+        ctx.model
+            .terms(&mut self.data, &reference.a, &reference.a_dot)
             .map_err(|source| SimError::Dynamics { t, source })?;
         let mass = self.data.mass_matrix();
         let (c, g) = (self.data.coriolis(), self.data.gravity());

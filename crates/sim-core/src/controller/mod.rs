@@ -7,8 +7,8 @@
 //!
 //! The closed loop samples a controller at its own period and holds its output in between
 //! (zero-order hold). At each sample it hands the controller a [`ControlContext`] that borrows
-//! the time, the measured state, the reference sample and the [`ReducedModel`] being simulated,
-//! so no controller needs its own copy of the model.
+//! the time, the measured state, the reference sample and the [`Plant`] being simulated (a planar
+//! or a spatial modal arm), so no controller needs its own copy of the model.
 //!
 //! A controller written elsewhere implements [`Controller`] and may fail with an error of its
 //! own; the run reports it as [`SimError::Controller`] with the error
@@ -48,7 +48,7 @@ pub use pd::PdController;
 
 use crate::error::SimError;
 use crate::reference::ReferenceSample;
-use modal_reduce::ReducedModel;
+use modal_reduce::Plant;
 
 /// The error a controller may fail with: any error type, boxed. The built-in controllers fail
 /// with a boxed [`SimError`], which the run reports as it is; any other error is reported as
@@ -108,8 +108,8 @@ pub struct ControlContext<'a> {
     pub measured: &'a ModalState,
     /// The reference as the controller receives it (reference noise included in `a`).
     pub reference: &'a ReferenceSample,
-    /// The reduced model being simulated.
-    pub model: &'a ReducedModel,
+    /// The reduced model being simulated, planar or spatial.
+    pub model: Plant<'a>,
     /// The actuator limits on `tau*` (N m, `m` entries) if the loop has any: the loop clamps
     /// whatever the controller asks for to `[-limit_i, limit_i]`, so a controller that plans
     /// (e.g. model-predictive control) can respect them itself. `None` without limits.

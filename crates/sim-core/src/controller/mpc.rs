@@ -4,7 +4,7 @@
 use super::{ControlContext, Controller, ControllerError, check_context};
 use crate::error::SimError;
 use crate::reference::{Reference, ReferencePreview};
-use modal_reduce::ReducedModel;
+use modal_reduce::Plant;
 use optimal_ctl::{Mpc, MpcSettings};
 
 /// Receding-horizon MPC ([`Mpc`]): at the first sample, and then at the first sample at least one
@@ -55,7 +55,7 @@ impl MpcController {
     ///     t: 0.0,
     ///     measured: &measured,
     ///     reference: &target,
-    ///     model: &model,
+    ///     model: (&model).into(),
     ///     tau_star_limits: None,
     /// };
     /// let mut tau = [0.0; 3];
@@ -67,11 +67,12 @@ impl MpcController {
     /// # Errors
     /// [`SimError::InvalidSetting`] for settings out of their domain (named `controller.mpc`) or
     /// a reference with another number of coordinates.
-    pub fn new(
-        model: &ReducedModel,
+    pub fn new<'p>(
+        model: impl Into<Plant<'p>>,
         settings: &MpcSettings,
         reference: Box<dyn Reference>,
     ) -> Result<Self, SimError> {
+        let model = model.into();
         let m = model.n_coords();
         super::check_coordinate_count("controller.mpc", m)?;
         if reference.n_coords() != m {

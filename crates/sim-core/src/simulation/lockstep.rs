@@ -10,17 +10,18 @@
 //! [`Rk4::finish_step`]), the code of a run integrated alone, so a run gives the same bits in a
 //! group as alone.
 //!
-//! Runs built from scenarios with the same reference (a sweep's runs, which differ in noise and
-//! seed) also share their reference samples: the reference is a function of time, so the first
-//! run sampled at a controller sample hands its sample to the others instead of each computing
-//! it again (for a path followed by inverse kinematics, about a quarter of a run alone).
+//! The runs of a group come from one [`Prepared`](crate::Prepared) simulation and differ only in noise and seed,
+//! so they also share their reference samples: the reference is a function of time, so the
+//! first run sampled at a controller sample hands its sample to the others instead of each
+//! computing it again (for a path followed by inverse kinematics, about a quarter of a run
+//! alone).
 //!
 //! Adaptive Dormand-Prince runs choose their own step sizes, so their stages do not line up:
 //! a group of them integrates each run alone (the group still steps them together). So does a
 //! group on a processor without SIMD or of a model whose batches run one state at a time
 //! ([`batch_lanes`] is 1), where lock-step would gain nothing.
 
-use super::{Progress, Run, RunFailure, Simulation, Stepper};
+use super::{LoopHooks, NoHooks, Progress, Run, RunFailure, Simulation, Stepper};
 use crate::error::SimError;
 use crate::ode::{OdeError, Rk4, Stats};
 use crate::reference::ReferenceSample;
@@ -29,20 +30,23 @@ use modal_reduce::{
     ReducedBatchData, ReducedData, ReducedModel, batch_lanes, forward_dynamics,
     forward_dynamics_batch,
 };
+use std::sync::Arc;
 
-/// Closed-loop runs of one reduced model with the same integrator, controller period and
-/// duration, stepped together: the runs of a Monte Carlo sweep that differ in seed or noise
-/// level (`sim_study::study` runs its sweeps this way), or any set of runs a caller wants
-/// advanced side by side. Each run is a [`Simulation`] with its own controller, reference,
-/// noise and record; with RK4, the reduced dynamics of all of them are evaluated at once at
-/// every integrator stage, SIMD across the runs ([`forward_dynamics_batch`]), and each run's
-/// results are bit for bit those of the run alone.
+/// Closed-loop runs of one [`Prepared`](crate::Prepared) simulation that differ in seed or noise level (the
+/// runs of a Monte Carlo sweep: `sim_study::study` runs its sweeps this way), stepped together
+/// ([`Prepared::lockstep`](crate::Prepared::lockstep) forms a group). Each run is a [`Simulation`] with its own
+/// controller, noise and record; the runs share the model and the reference's samples, and
+/// with RK4 the reduced dynamics of all of them are evaluated at once at every integrator
+/// stage, SIMD across the runs ([`forward_dynamics_batch`]). Each run's results are bit for bit
+/// those of the run alone.
 ///
 /// As with one [`Simulation`], a caller may own the loop: [`step`](Self::step) advances every
 /// running run by one controller period, [`simulation`](Self::simulation) and
 /// [`observe`](Self::observe) show where each is, and [`stopped`](Self::stopped) why a run
 /// stopped (a run that fails stops alone; the others go on). [`run`](Self::run) runs them all
-/// from the start, as [`Simulation::run`] runs one. Stepping allocates nothing.
+/// from the start, as [`Simulation::run`] runs one; [`run_with`](Self::run_with) and
+/// [`step_with`](Self::step_with) take one set of [`LoopHooks`] per run. Stepping allocates
+/// nothing.
 ///
 /// ```
 /// use backbone_kin::ModalMap;
@@ -50,24 +54,25 @@ use modal_reduce::{
 /// use modal_reduce::ReducedModel;
 /// use sim_core::controller::FuzzyController;
 /// use sim_core::reference::Step;
-/// use sim_core::{Integrator, Lockstep, LoopSettings, Simulation};
+/// use sim_core::{Integrator, LoopSettings, Prepared, RunNoise};
 ///
-/// let build = |seed: u64| -> Result<Simulation, Box<dyn std::error::Error>> {
-///     let arm = ChainModel::uniform(10, 0.1, 0.1, 9.81)?;
-///     let map = ModalMap::paper_fixed_alpha0(10, std::f64::consts::FRAC_PI_2)?;
-///     let reference = Step::new(&[0.0, 0.0], &[0.2, -0.1], 0.0)?;
-///     let controller = FuzzyController::new(fuzzy_sugeno::paper_controller(), 2)?;
-///     let mut settings = LoopSettings::new(Integrator::Rk4 { dt: 1e-4 }, 1e-4, 0.05);
-///     settings.seed = seed;
-///     settings.sensor_noise_std = vec![0.01; 4];
-///     let model = ReducedModel::new(arm, map)?;
-///     Ok(Simulation::new(model, Box::new(reference), Box::new(controller), settings, None)?)
-/// };
-/// let runs = (1..=5).map(build).collect::<Result<Vec<_>, _>>()?;
-/// let mut group = Lockstep::new(runs)?;
-/// let results = group.run();
+/// let arm = ChainModel::uniform(10, 0.1, 0.1, 9.81)?;
+/// let model = ReducedModel::new(arm, ModalMap::paper_fixed_alpha0(10, std::f64::consts::FRAC_PI_2)?)?;
+/// let step = Step::new(&[0.0, 0.0], &[0.2, -0.1], 0.0)?;
+/// let fuzzy = FuzzyController::new(fuzzy_sugeno::paper_controller(), 2)?;
+/// let settings = LoopSettings::new(Integrator::Rk4 { dt: 1e-4 }, 1e-4, 0.05);
+/// let prepared = Prepared::new(
+///     model,
+///     Prepared::reference_clones(step),
+///     Prepared::controller_clones(fuzzy),
+///     settings,
+///     None,
+/// )?;
+/// let noise = |seed| RunNoise { seed, reference_std: vec![], sensor_std: vec![0.01; 4] };
+/// let noises: Vec<RunNoise> = (1..=5).map(noise).collect();
+/// let results = prepared.lockstep(&noises)?.run();
 /// // The same runs, one at a time: the same numbers.
-/// let alone = build(3)?.run()?;
+/// let alone = prepared.simulation(&noise(3))?.run()?;
 /// assert_eq!(results[2].as_ref().map(|run| &run.summary), Ok(&alone.summary));
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
@@ -76,7 +81,7 @@ pub struct Lockstep {
     /// Why each run stopped; `None` while it runs.
     stopped: Vec<Option<SimError>>,
     /// The model every run simulates, and the batch's workspaces for it.
-    model: ReducedModel,
+    model: Arc<ReducedModel>,
     batch: ReducedBatchData,
     single: ReducedData,
     /// The RK4 step when the runs' stages are evaluated together; `None` when each run is
@@ -84,10 +89,7 @@ pub struct Lockstep {
     together: Option<f64>,
     /// States per SIMD group of the batch ([`batch_lanes`]).
     lanes: usize,
-    /// Whether every run's reference is the same function of time (equal reference keys of
-    /// `sim_study::Scenario::build`), sampled once a controller sample.
-    shares_reference: bool,
-    /// The shared reference sample of the current controller sample.
+    /// The reference sample of the current controller sample, shared by the runs.
     reference: ReferenceSample,
     /// The runs evaluated at the current stage, slot by slot.
     slots: Vec<usize>,
@@ -100,53 +102,26 @@ pub struct Lockstep {
 }
 
 impl Lockstep {
-    /// A group of `runs`: simulations of the same arm and modal family with the same
-    /// integrator, controller period and duration (their controllers, references, noise,
-    /// recording and limits may differ). Each is [`reset`](Simulation::reset) to its start.
-    ///
-    /// Fails with [`SimError::InvalidSetting`] for no run, or a run whose model, integrator,
-    /// controller period or duration differs from the first run's.
-    pub fn new(mut runs: Vec<Simulation>) -> Result<Self, SimError> {
+    /// A group of `runs` of `model`, each [`reset`](Simulation::reset) to its start: the
+    /// simulations of one [`Prepared`](crate::Prepared) simulation ([`Prepared::lockstep`](crate::Prepared::lockstep)), so the same model,
+    /// reference, controller, integrator and periods. Fails with [`SimError::InvalidSetting`]
+    /// for no run.
+    pub(super) fn new(
+        model: Arc<ReducedModel>,
+        mut runs: Vec<Simulation>,
+    ) -> Result<Self, SimError> {
         let Some(first) = runs.first() else {
             return Err(SimError::setting(
                 "runs",
                 "a lock-step group needs at least one simulation",
             ));
         };
-        let model = first.model().clone();
-        let settings = first.settings().clone();
-        for (i, run) in runs.iter().enumerate().skip(1) {
-            let differs = |name: &str| {
-                SimError::setting(
-                    name,
-                    format!(
-                        "of run {i} differs from run 0's: the runs of a lock-step group share \
-                         it"
-                    ),
-                )
-            };
-            let s = run.settings();
-            if run.model().chain() != model.chain() || run.model().map() != model.map() {
-                return Err(differs("model"));
-            }
-            if s.integrator != settings.integrator {
-                return Err(differs("integrator"));
-            }
-            if s.controller_period != settings.controller_period {
-                return Err(differs("controller.period"));
-            }
-            if s.duration != settings.duration {
-                return Err(differs("duration"));
-            }
-        }
         let lanes = batch_lanes(&model);
-        let together = match settings.integrator {
+        let together = match first.settings().integrator {
             Integrator::Rk4 { dt } if lanes > 1 => Some(dt),
             _ => None,
         };
         let values = runs.len().div_ceil(lanes) * lanes * model.n_coords();
-        let shares_reference = first.reference_key.is_some()
-            && runs.iter().all(|r| r.reference_key == first.reference_key);
         for run in &mut runs {
             run.reset();
         }
@@ -164,7 +139,6 @@ impl Lockstep {
             model,
             together,
             lanes,
-            shares_reference,
         })
     }
 
@@ -173,7 +147,8 @@ impl Lockstep {
         self.runs.len()
     }
 
-    /// Whether the group has no run (never: [`new`](Self::new) refuses that).
+    /// Whether the group has no run (never: [`Prepared::lockstep`](crate::Prepared::lockstep)
+    /// refuses that).
     pub fn is_empty(&self) -> bool {
         self.runs.is_empty()
     }
@@ -226,8 +201,19 @@ impl Lockstep {
     /// says why; it stays at its last sample) and the others go on. Returns the number of runs
     /// still running. Allocation-free (but for the error of a run that stops).
     pub fn step(&mut self) -> usize {
-        self.take_samples();
+        self.step_with::<NoHooks>(&mut [])
+    }
+
+    /// [`step`](Self::step) with the hooks of each run (`hooks[i]` for run `i`; empty for none):
+    /// their disturbances act on their runs and their observers see their runs' samples.
+    ///
+    /// # Panics
+    /// If `hooks` is neither empty nor one per run.
+    pub fn step_with<H: LoopHooks>(&mut self, hooks: &mut [H]) -> usize {
+        self.check_hooks(hooks);
+        self.take_samples(hooks);
         self.integrate();
+        self.observe_samples(hooks);
         self.running()
     }
 
@@ -235,11 +221,21 @@ impl Lockstep {
     /// (it [`reset`](Self::reset)s first): the results in run order, each the same as the run
     /// alone would give.
     pub fn run(&mut self) -> Vec<Result<Run, Box<RunFailure>>> {
+        self.run_with::<NoHooks>(&mut [])
+    }
+
+    /// [`run`](Self::run) with the hooks of each run, as [`step_with`](Self::step_with) takes
+    /// them: each run's results are those of [`Simulation::run_with`] with its hooks.
+    ///
+    /// # Panics
+    /// If `hooks` is neither empty nor one per run.
+    pub fn run_with<H: LoopHooks>(&mut self, hooks: &mut [H]) -> Vec<Result<Run, Box<RunFailure>>> {
+        self.check_hooks(hooks);
         self.reset();
         let mut progress: Vec<Progress> = self.runs.iter_mut().map(|r| r.start_run()).collect();
         let samples = progress[0].samples;
         for k in 0..=samples {
-            self.take_samples();
+            self.take_samples(hooks);
             if k == samples {
                 for (run, stopped) in self.runs.iter_mut().zip(&mut self.stopped) {
                     if stopped.is_none() {
@@ -249,6 +245,7 @@ impl Lockstep {
             } else {
                 self.integrate();
             }
+            self.observe_samples(hooks);
             for ((run, stopped), progress) in self
                 .runs
                 .iter_mut()
@@ -270,27 +267,43 @@ impl Lockstep {
             .collect()
     }
 
-    /// Whether the runs share their reference samples (see the type's docs): they were built by
-    /// `sim_study::Scenario::build` from scenarios with the same reference, arm
-    /// length and modal family.
-    pub fn shares_reference(&self) -> bool {
-        self.shares_reference
+    /// Refuses hooks that are neither none nor one per run.
+    fn check_hooks<H>(&self, hooks: &[H]) {
+        assert!(
+            hooks.is_empty() || hooks.len() == self.runs.len(),
+            "a lock-step group of {} runs takes no hooks or one per run, got {}",
+            self.runs.len(),
+            hooks.len()
+        );
     }
 
-    /// The controller sample of every running run ([`Simulation::take_sample`]); when the runs
-    /// share their reference, the first run whose sample succeeds samples it for the others.
-    fn take_samples(&mut self) {
+    /// The controller sample of every running run ([`Simulation::take_sample`], with its hooks
+    /// if any); the first run whose sample succeeds samples the reference for the others.
+    fn take_samples<H: LoopHooks>(&mut self, hooks: &mut [H]) {
         let mut shared = false;
-        for (run, stopped) in self.runs.iter_mut().zip(&mut self.stopped) {
+        for (r, (run, stopped)) in self.runs.iter_mut().zip(&mut self.stopped).enumerate() {
             if stopped.is_some() {
                 continue;
             }
-            let result = run.take_sample_with(shared.then_some(&self.reference));
-            if result.is_ok() && self.shares_reference && !shared {
+            let reference = shared.then_some(&self.reference);
+            let result = match hooks.get_mut(r) {
+                Some(hooks) => run.take_sample(reference, hooks),
+                None => run.take_sample(reference, &mut NoHooks),
+            };
+            if result.is_ok() && !shared {
                 self.reference.copy_from(&run.sample.reference);
                 shared = true;
             }
             *stopped = result.err();
+        }
+    }
+
+    /// Shows each running run's sample, complete, to its observer.
+    fn observe_samples<H: LoopHooks>(&mut self, hooks: &mut [H]) {
+        for ((run, stopped), hooks) in self.runs.iter().zip(&self.stopped).zip(hooks) {
+            if stopped.is_none() {
+                hooks.observe(&run.sample);
+            }
         }
     }
 
@@ -442,8 +455,8 @@ impl Lockstep {
 }
 
 /// The RK4 integrator of a run of a group whose runs are integrated together (all of them
-/// RK4: [`Lockstep::new`] checks that the runs share the integrator, and a simulation's stepper
-/// is the one its settings name).
+/// RK4: the runs of one [`Prepared`](crate::Prepared) simulation share the integrator, and a simulation's
+/// stepper is the one its settings name).
 fn rk4(stepper: &mut Stepper) -> &mut Rk4 {
     match stepper {
         Stepper::Rk4(rk4, _) => rk4,

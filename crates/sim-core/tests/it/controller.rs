@@ -42,7 +42,7 @@ fn control(
         t: 0.0,
         measured,
         reference,
-        model,
+        model: model.into(),
         tau_star_limits: None,
     };
     controller
@@ -357,4 +357,88 @@ fn lqr_loop_is_its_linearisation_near_an_equilibrium() {
         let last = run.record.len() - 1;
         assert!(run.record.a_at(last).iter().all(|a| a.abs() < 0.2 * eps));
     }
+}
+
+/// Every model-based controller on a spatial arm (`m = 4`, a cantilever under gravity along
+/// `-z`): computed torque realises its desired acceleration through the spatial forward
+/// dynamics, the fuzzy controller plus `G*` adds the spatial `G*`, the LQR at rest on a resting
+/// reference gives the holding torque `G*`, and MPC plans finite torques within its limits.
+#[test]
+fn model_based_controllers_run_on_a_spatial_arm() {
+    use modal_reduce::spatial::SpatialReducedModel;
+    use modal_reduce::{Plant, PlantData};
+    use sim_core::controller::MpcController;
+    let spatial = SpatialReducedModel::uniform_rods(10, 1, 0.1, 0.1, [0.0, 0.0, -9.81]).unwrap();
+    let plant = Plant::from(&spatial);
+    let measured = ModalState::new(&[0.2, -0.1, 0.15, 0.05], &[0.3, 0.0, -0.2, 0.1]).unwrap();
+    let mut reference = ReferenceSample::zeros(4);
+    reference.a.copy_from_slice(&[0.25, -0.05, 0.1, 0.0]);
+    reference.a_ddot.copy_from_slice(&[0.5, -0.2, 0.1, 0.3]);
+    let context = |measured, reference| ControlContext {
+        t: 0.0,
+        measured,
+        reference,
+        model: plant,
+        tau_star_limits: None,
+    };
+    let (kp, kd) = ([400.0; 4], [40.0; 4]);
+    let mut ct = ComputedTorque::new(&spatial, &kp, &kd).unwrap();
+    let mut tau = [0.0; 4];
+    ct.control(&context(&measured, &reference), &mut tau)
+        .unwrap();
+    let mut data = PlantData::new(plant);
+    let mut a_ddot = [0.0; 4];
+    plant
+        .forward_dynamics(&mut data, &measured.a, &measured.a_dot, &tau, &mut a_ddot)
+        .unwrap();
+    for i in 0..4 {
+        let desired = reference.a_ddot[i]
+            - kp[i] * (measured.a[i] - reference.a[i])
+            - kd[i] * (measured.a_dot[i] - reference.a_dot[i]);
+        assert!(
+            (a_ddot[i] - desired).abs() < 1e-9,
+            "{i}: {} vs {desired}",
+            a_ddot[i]
+        );
+    }
+    let gravity = data.gravity().to_vec();
+    assert!(gravity.iter().any(|g| g.abs() > 0.1), "{gravity:?}");
+    let (mut fuzzy, mut fuzzy_gc) = (
+        FuzzyController::new(paper_controller(), 4).unwrap(),
+        FuzzyController::new(paper_controller(), 4)
+            .unwrap()
+            .with_gravity_compensation(&spatial)
+            .unwrap(),
+    );
+    let (mut plain, mut compensated) = ([0.0; 4], [0.0; 4]);
+    fuzzy
+        .control(&context(&measured, &reference), &mut plain)
+        .unwrap();
+    fuzzy_gc
+        .control(&context(&measured, &reference), &mut compensated)
+        .unwrap();
+    for i in 0..4 {
+        assert!((compensated[i] - plain[i] - gravity[i]).abs() < 1e-12);
+    }
+    // At rest on a resting reference the LQR's feedback vanishes: the feedforward G* holds.
+    let mut lqr = LqrController::new(&spatial, 1e-3, 20.0, 0.05).unwrap();
+    let rest = ModalState::new(&reference.a, &[0.0; 4]).unwrap();
+    let mut resting = reference.clone();
+    resting.a_ddot.fill(0.0);
+    lqr.control(&context(&rest, &resting), &mut tau).unwrap();
+    plant.terms(&mut data, &rest.a, &rest.a_dot).unwrap();
+    for (t, g) in tau.iter().zip(data.gravity()) {
+        assert!((t - g).abs() < 1e-9 * (1.0 + t.abs()), "{t} vs {g}");
+    }
+    let mut settings = optimal_ctl::MpcSettings::uniform(4);
+    settings.horizon = 10;
+    settings.tau_star_limits = Some(vec![5.0; 4]);
+    let step = Step::new(&reference.a, &reference.a, 0.0).unwrap();
+    let mut mpc = MpcController::new(&spatial, &settings, Box::new(step)).unwrap();
+    mpc.control(&context(&measured, &reference), &mut tau)
+        .unwrap();
+    assert!(
+        tau.iter().all(|t| t.is_finite() && t.abs() <= 5.0),
+        "{tau:?}"
+    );
 }

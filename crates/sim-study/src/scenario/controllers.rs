@@ -1,19 +1,19 @@
 //! The controllers a scenario may name: one table ([`CONTROLLERS`]) of names, descriptions and
 //! constructors from the scenario's `[controller]` settings.
 
-use super::Scenario;
 use super::factory::per_coordinate;
 use super::schema::ControllerSpec;
 use fuzzy_sugeno::FuzzySystem;
 use modal_reduce::ReducedModel;
 use optimal_ctl::MpcSettings;
 use serde::{Deserialize, Serialize};
-use sim_core::SimError;
 use sim_core::controller::{
-    ComputedTorque, Controller, FuzzyController, LqrController, MpcController, PdController,
+    ComputedTorque, FuzzyController, LqrController, MpcController, PdController,
 };
+use sim_core::{ControllerFactory, Prepared, ReferenceFactory, SimError};
 use std::fmt;
 use std::str::FromStr;
+use std::sync::Arc;
 
 /// Which controller closes the loop: the key of a row of [`CONTROLLERS`], where its name,
 /// description and constructor are. Written in scenario files and on the command line by its
@@ -37,19 +37,18 @@ pub enum ControllerKind {
 }
 
 /// What a controller's constructor is given: the scenario's `[controller]` settings, with every
-/// per-coordinate gain array already checked to have `m` entries, and the model and sampling
-/// period of the loop.
-#[derive(Debug, Clone, Copy)]
+/// per-coordinate gain array already checked to have `m` entries, the model and sampling period
+/// of the loop, and its reference.
+#[derive(Clone, Copy)]
 pub struct ControllerSetup<'a> {
     /// The scenario's `[controller]` table.
     pub spec: &'a ControllerSpec,
-    /// The whole scenario, for controllers that need more than `[controller]` (MPC previews its
-    /// reference).
-    pub scenario: &'a Scenario,
     /// The reduced model the controller will be sampled on (`m` coordinates).
     pub model: &'a ReducedModel,
     /// The controller's sampling period (s).
     pub period: f64,
+    /// The loop's reference (MPC previews a copy of it).
+    pub reference: &'a ReferenceFactory,
 }
 
 /// A row of the controller table: a controller's name, what it is, and how a scenario builds it.
@@ -61,26 +60,27 @@ pub struct ControllerEntry {
     pub name: &'static str,
     /// One line on what it is (the command line's help).
     pub description: &'static str,
-    build: fn(&ControllerSetup<'_>) -> Result<Box<dyn Controller>, SimError>,
+    prepare: fn(&ControllerSetup<'_>) -> Result<ControllerFactory, SimError>,
 }
 
 impl ControllerSetup<'_> {
-    /// The controller of `spec.kind` for the model: checks every per-coordinate gain array of
-    /// `spec` (whichever controller uses it) to have `m` entries, then calls the kind's
-    /// constructor in [`CONTROLLERS`].
-    pub fn build(&self) -> Result<Box<dyn Controller>, SimError> {
+    /// The controller of `spec.kind` for the model, prepared for any number of runs: checks
+    /// every per-coordinate gain array of `spec` (whichever controller uses it) to have `m`
+    /// entries, then calls the kind's constructor in [`CONTROLLERS`].
+    pub fn prepare(&self) -> Result<ControllerFactory, SimError> {
         let m = m(self);
         self.spec.computed_torque_gains(m)?;
         per_coordinate("controller.pd_kp", self.spec.pd_kp.as_deref(), m)?;
         per_coordinate("controller.pd_kd", self.spec.pd_kd.as_deref(), m)?;
-        self.spec.kind.entry().build(self)
+        self.spec.kind.entry().prepare(self)
     }
 }
 
 impl ControllerEntry {
-    /// Builds the controller for `setup`'s model.
-    pub fn build(&self, setup: &ControllerSetup<'_>) -> Result<Box<dyn Controller>, SimError> {
-        (self.build)(setup)
+    /// The controller for `setup`'s model, built once (a `.fis` file read and parsed once),
+    /// as a factory of fresh copies for the runs.
+    pub fn prepare(&self, setup: &ControllerSetup<'_>) -> Result<ControllerFactory, SimError> {
+        (self.prepare)(setup)
     }
 }
 
@@ -92,8 +92,8 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         kind: ControllerKind::Fuzzy,
         name: "fuzzy",
         description: "the paper's fuzzy controller (eqs 19-24), or the .fis system given",
-        build: |s| {
-            Ok(Box::new(
+        prepare: |s| {
+            Ok(Prepared::controller_clones(
                 FuzzyController::new(s.spec.fuzzy_system()?, m(s))?
                     .with_out_of_range(s.spec.out_of_range.unwrap_or_default().into())?,
             ))
@@ -103,33 +103,41 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         kind: ControllerKind::Pd,
         name: "pd",
         description: "PD: the fuzzy controller's slope at the origin, or the pd_kp, pd_kd gains",
-        build: |s| {
+        prepare: |s| {
             let m = m(s);
             let slope = PdController::from_fuzzy_slope(&s.spec.fuzzy_system()?, m)?;
             let kp = per_coordinate("controller.pd_kp", s.spec.pd_kp.as_deref(), m)?
                 .unwrap_or_else(|| slope.kp().to_vec());
             let kd = per_coordinate("controller.pd_kd", s.spec.pd_kd.as_deref(), m)?
                 .unwrap_or_else(|| slope.kd().to_vec());
-            Ok(Box::new(PdController::new(slope.offset(), &kp, &kd)?))
+            Ok(Prepared::controller_clones(PdController::new(
+                slope.offset(),
+                &kp,
+                &kd,
+            )?))
         },
     },
     ControllerEntry {
         kind: ControllerKind::ComputedTorque,
         name: "computed-torque",
         description: "computed torque with the exact reduced model, gains kp, kd",
-        build: |s| {
+        prepare: |s| {
             let (kp, kd) = s.spec.computed_torque_gains(m(s))?;
-            Ok(Box::new(ComputedTorque::new(s.model, &kp, &kd)?))
+            Ok(Prepared::controller_clones(ComputedTorque::new(
+                s.model, &kp, &kd,
+            )?))
         },
     },
     ControllerEntry {
         kind: ControllerKind::FuzzyGc,
         name: "fuzzy-gc",
         description: "the fuzzy controller plus gravity compensation G*",
-        build: |s| {
+        prepare: |s| {
             let fuzzy = FuzzyController::new(s.spec.fuzzy_system()?, m(s))?
                 .with_out_of_range(s.spec.out_of_range.unwrap_or_default().into())?;
-            Ok(Box::new(fuzzy.with_gravity_compensation(s.model)?))
+            Ok(Prepared::controller_clones(
+                fuzzy.with_gravity_compensation(s.model)?,
+            ))
         },
     },
     ControllerEntry {
@@ -137,8 +145,8 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         name: "lqr",
         description: "LQR about the reference (feedforward M* a_ref_dd + C* + G*), re-linearised \
                       along it every lqr_relinearise s, design frequency lqr_frequency",
-        build: |s| {
-            Ok(Box::new(LqrController::new(
+        prepare: |s| {
+            Ok(Prepared::controller_clones(LqrController::new(
                 s.model,
                 s.period,
                 s.spec
@@ -154,10 +162,18 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         kind: ControllerKind::Mpc,
         name: "mpc",
         description: "model-predictive control: control-limited iLQR over a 0.3 s receding horizon",
-        build: |s| {
+        prepare: |s| {
             let settings = MpcSettings::uniform(m(s));
-            let reference = s.scenario.build_reference(s.model)?;
-            Ok(Box::new(MpcController::new(s.model, &settings, reference)?))
+            let (model, reference) = (s.model.clone(), Arc::clone(s.reference));
+            // Checked once here; each run builds its own (its plan is its state).
+            MpcController::new(&model, &settings, reference()?)?;
+            Ok(Arc::new(move || {
+                Ok(Box::new(MpcController::new(
+                    &model,
+                    &settings,
+                    reference()?,
+                )?))
+            }))
         },
     },
 ];
@@ -274,7 +290,7 @@ impl ControllerSpec {
     }
 
     /// The computed-torque gains `kp`, `kd` for `m` coordinates (defaults where not given).
-    fn computed_torque_gains(&self, m: usize) -> Result<(Vec<f64>, Vec<f64>), SimError> {
+    pub(super) fn computed_torque_gains(&self, m: usize) -> Result<(Vec<f64>, Vec<f64>), SimError> {
         let gains = |name: &str, values: &Option<Vec<f64>>, default: f64| {
             per_coordinate(name, values.as_deref(), m)
                 .map(|v| v.unwrap_or_else(|| vec![default; m]))

@@ -3,17 +3,18 @@
 
 use super::controllers::ControllerSetup;
 use super::schema::{
-    Alpha0, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, ReferenceSpec, Scenario,
-    TorqueLimit,
+    Alpha0, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, NoiseSpec, ReferenceSpec,
+    Scenario, TorqueLimit,
 };
 use backbone_kin::{Branch, ModalMap};
 use manip_dyn::{ChainModel, Link};
 use modal_reduce::ReducedModel;
-use sim_core::SimError;
 use sim_core::controller::{Controller, ModalState};
 use sim_core::ode::Tolerances;
-use sim_core::reference::{CartesianPath, PathShape, Reference, Sinusoid, Step};
-use sim_core::{Integrator, LoopSettings, Simulation};
+use sim_core::reference::{CartesianPath, PathShape, Sinusoid, Step};
+use sim_core::{ControllerFactory, Integrator, LoopSettings, Prepared, ReferenceFactory, SimError};
+use sim_core::{RunNoise, Simulation};
+use std::sync::Arc;
 
 impl Scenario {
     /// The reduced model of the arm with the scenario's modal family. Refuses a family with no
@@ -49,19 +50,36 @@ impl Scenario {
         ReducedModel::new(chain, map).map_err(SimError::Model)
     }
 
-    /// Builds the simulation: checks every setting and the whole reference path, loads the
-    /// `.fis` file if any. Errors name the setting that failed; the loop's own limits are
-    /// [`Simulation::new`]'s.
+    /// Prepares the simulation once for any number of runs that differ in seed and noise
+    /// ([`Prepared`]): checks every setting and the whole reference path, loads the `.fis` file
+    /// if any, builds the reference and the controller once. Errors name the setting that
+    /// failed; the loop's own limits are [`Prepared::new`]'s. The scenario's own seed and noise
+    /// are the prepared settings' ([`run_noise`](Self::run_noise) gives them).
+    pub fn prepare(&self) -> Result<Prepared, SimError> {
+        let (model, reference, controller, settings, initial) =
+            self.assemble(|setup| setup.prepare())?;
+        Prepared::new(model, reference, controller, settings, initial)
+    }
+
+    /// Builds the simulation with the scenario's own seed and noise: [`prepare`](Self::prepare)
+    /// for one run.
     pub fn build(&self) -> Result<Simulation, SimError> {
-        self.assemble(|model, period| {
-            ControllerSetup {
-                spec: &self.controller,
-                scenario: self,
-                model,
-                period,
-            }
-            .build()
-        })
+        let prepared = self.prepare()?;
+        prepared.simulation(&prepared.settings().noise())
+    }
+
+    /// Builds the simulation as [`build`](Self::build) does, with every controller the
+    /// prepared simulation makes passed through `wrap` (e.g. a wrapper that stops the run when a
+    /// Python user presses Ctrl-C).
+    pub fn build_wrapping(
+        &self,
+        wrap: impl Fn(Box<dyn Controller>) -> Box<dyn Controller> + Send + Sync + 'static,
+    ) -> Result<Simulation, SimError> {
+        let (model, reference, controller, settings, initial) =
+            self.assemble(|setup| setup.prepare())?;
+        let controller: ControllerFactory = Arc::new(move || controller().map(&wrap));
+        let prepared = Prepared::new(model, reference, controller, settings, initial)?;
+        prepared.simulation(&prepared.settings().noise())
     }
 
     /// Builds the simulation as [`build`](Self::build) does, but closed by `controller` (a
@@ -71,31 +89,40 @@ impl Scenario {
         &self,
         controller: Box<dyn Controller>,
     ) -> Result<Simulation, SimError> {
-        self.assemble(|_, _| Ok(controller))
+        let (model, reference, controller, settings, initial) =
+            self.assemble(|_| Ok(controller))?;
+        Simulation::new(model, reference()?, controller, settings, initial)
     }
 
-    /// The scenario's reference for `model`'s coordinates (the loop's; the MPC controller
-    /// previews a copy of it).
-    pub(crate) fn build_reference(
+    /// The scenario's seed and noise ([`NoiseSpec::run_noise`]).
+    pub fn run_noise(&self) -> Result<RunNoise, SimError> {
+        self.noise.run_noise(self.seed, self.n_coords())
+    }
+
+    /// The scenario's parts: the model, a factory of its reference (built once), the
+    /// controller `controller` makes from the setup, the loop's settings and the initial state.
+    #[allow(clippy::type_complexity)]
+    fn assemble<C>(
         &self,
-        model: &ReducedModel,
-    ) -> Result<Box<dyn Reference>, SimError> {
-        self.reference.build(
+        controller: impl FnOnce(&ControllerSetup<'_>) -> Result<C, SimError>,
+    ) -> Result<
+        (
+            ReducedModel,
+            ReferenceFactory,
+            C,
+            LoopSettings,
+            Option<ModalState>,
+        ),
+        SimError,
+    > {
+        let model = self.model()?;
+        let m = model.n_coords();
+        let reference = self.reference.build(
             model.chain().total_length(),
             self.modal.harmonics,
             self.alpha0,
-            model.n_coords(),
-        )
-    }
-
-    /// The simulation closed by the controller `controller(model, period)` makes.
-    fn assemble(
-        &self,
-        controller: impl FnOnce(&ReducedModel, f64) -> Result<Box<dyn Controller>, SimError>,
-    ) -> Result<Simulation, SimError> {
-        let model = self.model()?;
-        let m = model.n_coords();
-        let reference = self.build_reference(&model)?;
+            m,
+        )?;
         let period = match (self.controller.period, self.integrator) {
             (Some(period), _) => period,
             (None, IntegratorSpec::Rk4 { dt }) => dt,
@@ -106,19 +133,18 @@ impl Scenario {
                 ));
             }
         };
-        let controller = controller(&model, period)?;
+        let controller = controller(&ControllerSetup {
+            spec: &self.controller,
+            model: &model,
+            period,
+            reference: &reference,
+        })?;
         let mut settings = LoopSettings::new(self.integrator.build(), period, self.duration);
         settings.record_period = self.record_period.unwrap_or(period);
-        settings.seed = self.seed;
-        let noise = |name: &str, values: &Option<Vec<f64>>| {
-            per_coordinate(name, values.as_deref(), m).map(|v| v.unwrap_or_else(|| vec![0.0; m]))
-        };
-        settings.reference_noise_std = noise("noise.reference_std", &self.noise.reference_std)?;
-        settings.sensor_noise_std = noise("noise.sensor_a_std", &self.noise.sensor_a_std)?;
-        settings.sensor_noise_std.extend(noise(
-            "noise.sensor_a_dot_std",
-            &self.noise.sensor_a_dot_std,
-        )?);
+        let noise = self.run_noise()?;
+        settings.seed = noise.seed;
+        settings.reference_noise_std = noise.reference_std;
+        settings.sensor_noise_std = noise.sensor_std;
         // One rule for `simulate` and `sweep`: a scenario's bound is finite, so that every
         // scenario that runs can also be written to a shard file (JSON has no infinity).
         if self.limits.max_modal_error == f64::INFINITY {
@@ -149,19 +175,26 @@ impl Scenario {
                 Some(ModalState { a, a_dot })
             }
         };
-        // The reference as a function of time is what `build_reference` builds it from.
-        let reference_key = serde_json::to_string(&(
-            &self.reference,
-            model.chain().total_length(),
-            self.modal.harmonics,
-            self.alpha0,
-            m,
-        ))
-        .map_err(|e| SimError::setting("reference", e.to_string()))?;
-        Ok(
-            Simulation::new(model, reference, controller, settings, initial)?
-                .with_reference_key(reference_key),
-        )
+        Ok((model, reference, controller, settings, initial))
+    }
+}
+
+impl NoiseSpec {
+    /// The noise with `seed` for `m` coordinates, one standard deviation per coordinate (`m` on
+    /// the reference, `2m` on the sensors: the coordinates, then the rates; zeros where not
+    /// given). The error names the noise field whose length is not `m`.
+    pub fn run_noise(&self, seed: u64, m: usize) -> Result<RunNoise, SimError> {
+        let noise = |name: &str, values: &Option<Vec<f64>>| {
+            per_coordinate(name, values.as_deref(), m).map(|v| v.unwrap_or_else(|| vec![0.0; m]))
+        };
+        let reference_std = noise("noise.reference_std", &self.reference_std)?;
+        let mut sensor_std = noise("noise.sensor_a_std", &self.sensor_a_std)?;
+        sensor_std.extend(noise("noise.sensor_a_dot_std", &self.sensor_a_dot_std)?);
+        Ok(RunNoise {
+            seed,
+            reference_std,
+            sensor_std,
+        })
     }
 }
 
@@ -171,6 +204,13 @@ impl ArmSpec {
     /// agree, and the arm has between 1 and [`manip_dyn::MAX_LINKS`] links, checked before any
     /// per-link array is allocated.
     pub fn to_chain(&self) -> Result<ChainModel, SimError> {
+        if self.urdf.is_some() {
+            return Err(SimError::setting(
+                "arm.urdf",
+                "names a spatial chain, which runs only in the joint-space loop \
+                 (Scenario::run_chain, as `hrm simulate` runs it), not as a planar arm",
+            ));
+        }
         let mut n = self.links;
         for (name, array) in [
             ("arm.lengths", &self.lengths),
@@ -246,14 +286,15 @@ pub(super) fn per_coordinate(
 
 impl ReferenceSpec {
     /// The reference of `m` coordinates for a curve of length `length` with `harmonics`
-    /// harmonics and base angle `alpha0`.
-    fn build(
+    /// harmonics and base angle `alpha0`, built once (a path's inverse kinematics solved
+    /// once), and cloned for each run.
+    pub(super) fn build(
         &self,
         length: f64,
         harmonics: usize,
         alpha0: Alpha0,
         m: usize,
-    ) -> Result<Box<dyn Reference>, SimError> {
+    ) -> Result<ReferenceFactory, SimError> {
         let given = |name: &str, values: &[f64]| {
             per_coordinate(name, Some(values), m).map(Option::unwrap_or_default)
         };
@@ -261,12 +302,14 @@ impl ReferenceSpec {
             per_coordinate(name, values.as_deref(), m).map(|v| v.unwrap_or_else(|| vec![0.0; m]))
         };
         Ok(match self {
-            ReferenceSpec::Constant { a } => Box::new(Step::constant(&given("reference.a", a)?)?),
+            ReferenceSpec::Constant { a } => {
+                Prepared::reference_clones(Step::constant(&given("reference.a", a)?)?)
+            }
             ReferenceSpec::Step {
                 initial,
                 target,
                 time,
-            } => Box::new(Step::new(
+            } => Prepared::reference_clones(Step::new(
                 &or_zero("reference.initial", initial)?,
                 &given("reference.target", target)?,
                 *time,
@@ -276,7 +319,7 @@ impl ReferenceSpec {
                 amplitude,
                 frequency_hz,
                 phase,
-            } => Box::new(Sinusoid::new(
+            } => Prepared::reference_clones(Sinusoid::new(
                 &or_zero("reference.offset", offset)?,
                 &given("reference.amplitude", amplitude)?,
                 &given("reference.frequency_hz", frequency_hz)?,
@@ -309,7 +352,7 @@ impl ReferenceSpec {
                     BranchSpec::Positive => Branch::Positive,
                     BranchSpec::Negative => Branch::Negative,
                 };
-                Box::new(CartesianPath::new(
+                Prepared::reference_clones(CartesianPath::new(
                     shape,
                     *travel_time,
                     length,

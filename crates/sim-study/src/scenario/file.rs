@@ -53,7 +53,8 @@ impl Scenario {
         parse(text, "text")
     }
 
-    /// Reads a scenario file; a relative `controller.fis` path is taken relative to the file.
+    /// Reads a scenario file; a relative `controller.fis` or `arm.urdf` path is taken relative to
+    /// the file.
     pub fn load(path: &Path) -> Result<Self, ScenarioError> {
         let text = crate::read_text_file(path, crate::MAX_INPUT_FILE_BYTES).map_err(|e| {
             ScenarioError::Io {
@@ -62,10 +63,15 @@ impl Scenario {
             }
         })?;
         let mut scenario = parse(&text, &path.display().to_string())?;
-        if let (Some(fis), Some(dir)) = (&scenario.controller.fis, path.parent())
-            && fis.is_relative()
-        {
-            scenario.controller.fis = Some(dir.join(fis));
+        if let Some(dir) = path.parent() {
+            for file in [&mut scenario.controller.fis, &mut scenario.arm.urdf]
+                .into_iter()
+                .flatten()
+            {
+                if file.is_relative() {
+                    *file = dir.join(&*file);
+                }
+            }
         }
         Ok(scenario)
     }

@@ -20,6 +20,8 @@
 //!
 //! [arm]                   # defaults: the paper's 10 links of 0.1 m and 0.1 kg, g = 9.81
 //! links = 10
+//! # urdf = "arm.urdf"     a URDF chain instead (relative to the file), run in joint space by
+//! #                       Scenario::run_chain: computed torque only, one entry per joint
 //!
 //! [reference]             # kind = "constant" | "step" | "sinusoid" | "path"
 //! kind = "step"
@@ -51,6 +53,7 @@
 //! ```
 
 mod builtin;
+mod chain;
 mod controllers;
 mod factory;
 mod file;

@@ -156,6 +156,10 @@ pub struct ArmSpec {
     /// Per-link inertias about the centre of mass (kg m^2; default: uniform beams).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inertias: Option<Vec<f64>>,
+    /// A URDF serial chain (a path, relative to the scenario file) in place of the planar arm:
+    /// run in joint space by [`Scenario::run_chain`], with only `gravity` of the other keys.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub urdf: Option<PathBuf>,
 }
 
 /// The initial modal state (`m` entries each).

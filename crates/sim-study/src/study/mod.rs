@@ -53,9 +53,9 @@ pub use shard_file::{
     write_json_line,
 };
 
-use crate::IntegratorSpec;
+use crate::{ControllerKind, IntegratorSpec};
 use rayon::prelude::*;
-use sim_core::Lockstep;
+use sim_core::{Prepared, SimError};
 use std::io::Write;
 
 /// Runs run in parallel before their results are passed on in index order: enough to keep
@@ -69,46 +69,68 @@ pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 /// Runs run `id` of `config` alone and keeps its summary metrics (the time series are dropped at
 /// once).
 pub fn execute(config: &SweepConfig, id: &RunId) -> RunResult {
-    RunResult::new(
-        id,
-        StoredOutcome::of(run_scenario(&config.scenario_for(id))),
-    )
+    let outcome = match config.prepare(id.controller) {
+        Err(e) => StoredOutcome::of(Err(Stopped::not_built(e))),
+        Ok(prepared) => run_alone(config, &prepared, id),
+    };
+    RunResult::new(id, outcome)
 }
 
-/// Runs the runs `ids` of `config` side by side in a [`Lockstep`] group, their dynamics
+/// Runs run `id` of `config` alone from its controller's prepared simulation.
+fn run_alone(config: &SweepConfig, prepared: &Prepared, id: &RunId) -> StoredOutcome {
+    match config
+        .run_noise(id)
+        .and_then(|noise| prepared.simulation(&noise))
+    {
+        Err(e) => StoredOutcome::of(Err(Stopped::not_built(e))),
+        Ok(mut simulation) => StoredOutcome::of(simulation.run().map_err(Into::into)),
+    }
+}
+
+/// Runs the runs `ids` of `config` side by side in a [`Lockstep`](sim_core::Lockstep) group, their dynamics
 /// evaluated together (SIMD across runs) at every integrator stage, and keeps their summary
 /// metrics: the results in the order of `ids`, each the same, bit for bit, as [`execute`]'s.
 /// The runs must share the controller (they may differ in noise level and seed); a run that
-/// cannot be built or that stops leaves the others running.
+/// stops leaves the others running.
 pub fn execute_group(config: &SweepConfig, ids: &[RunId]) -> Vec<RunResult> {
-    // Each run's outcome; those of the runs built are set when the group has run.
-    let mut outcomes = Vec::with_capacity(ids.len());
-    let (mut built, mut positions) = (Vec::new(), Vec::new());
-    for (position, id) in ids.iter().enumerate() {
-        outcomes.push(match config.scenario_for(id).build() {
-            Ok(simulation) => {
-                built.push(simulation);
-                positions.push(position);
-                None
-            }
-            Err(e) => Some(StoredOutcome::of(Err(Stopped::not_built(e)))),
-        });
+    match ids.first() {
+        None => Vec::new(),
+        Some(first) => execute_prepared(config, &config.prepare(first.controller), ids),
     }
-    if !built.is_empty() {
-        match Lockstep::new(built) {
-            Ok(mut group) => {
-                for (position, run) in positions.into_iter().zip(group.run()) {
-                    outcomes[position] = Some(StoredOutcome::of(run.map_err(Into::into)));
-                }
-            }
-            // Runs a group refuses (they cannot differ but in noise and seed) are run alone.
-            Err(_) => return ids.iter().map(|id| execute(config, id)).collect(),
+}
+
+/// [`execute_group`] of runs whose controller's simulation is `prepared` (or could not be).
+fn execute_prepared(
+    config: &SweepConfig,
+    prepared: &Result<Prepared, SimError>,
+    ids: &[RunId],
+) -> Vec<RunResult> {
+    let prepared = match prepared {
+        Ok(prepared) => prepared,
+        Err(e) => {
+            return ids
+                .iter()
+                .map(|id| RunResult::new(id, StoredOutcome::of(Err(Stopped::not_built(e.clone())))))
+                .collect();
         }
+    };
+    let group = ids
+        .iter()
+        .map(|id| config.run_noise(id))
+        .collect::<Result<Vec<_>, _>>()
+        .and_then(|noises| prepared.lockstep(&noises));
+    match group {
+        Ok(mut group) => ids
+            .iter()
+            .zip(group.run())
+            .map(|(id, run)| RunResult::new(id, StoredOutcome::of(run.map_err(Into::into))))
+            .collect(),
+        // A run that cannot be built fails alone.
+        Err(_) => ids
+            .iter()
+            .map(|id| RunResult::new(id, run_alone(config, prepared, id)))
+            .collect(),
     }
-    ids.iter()
-        .zip(outcomes)
-        .map(|(id, outcome)| RunResult::new(id, outcome.expect("every run of the group has run")))
-        .collect()
 }
 
 /// How many runs of a sweep go into one lock-step group: the states the reduced dynamics'
@@ -140,17 +162,37 @@ fn lockstep_groups(config: &SweepConfig, indices: &[usize], size: usize) -> Vec<
 }
 
 /// Runs the runs of `shard` in lock-step groups ([`execute_group`], [`lockstep_size`] runs of
-/// one controller each), the groups in parallel (rayon), in batches of `BATCH_RUNS` (1024)
-/// runs, calling `progress` after each run and `sink` with each result in index order; stops at
-/// the first error of `sink`. Only one batch of results is held at a time.
+/// one controller each, whose simulation is prepared once for the shard), the groups in
+/// parallel (rayon), in batches of `BATCH_RUNS` (1024) runs, calling `progress` after each run
+/// and `sink` with each result in index order; stops at the first error of `sink`. Only one
+/// batch of results is held at a time.
 pub fn for_each_run(
     config: &SweepConfig,
     shard: Shard,
     progress: impl Fn() + Sync,
+    sink: impl FnMut(RunResult) -> Result<(), String>,
+) -> Result<(), String> {
+    for_each_run_until(config, shard, progress, || false, sink)
+}
+
+/// [`for_each_run`], checking `stop` before each lock-step group: once it returns true, no
+/// further group starts and the call fails with [`STOPPED`] (a Python caller's Ctrl-C).
+pub fn for_each_run_until(
+    config: &SweepConfig,
+    shard: Shard,
+    progress: impl Fn() + Sync,
+    stop: impl Fn() -> bool + Sync,
     mut sink: impl FnMut(RunResult) -> Result<(), String>,
 ) -> Result<(), String> {
     let mut indices = shard.indices(config.runs().unwrap_or(0));
     let size = lockstep_size(config);
+    // Each controller's simulation, prepared once for all of its runs.
+    let mut prepared: Vec<(ControllerKind, Result<Prepared, SimError>)> = Vec::new();
+    for &kind in &config.settings.controllers {
+        if prepared.iter().all(|(k, _)| *k != kind) {
+            prepared.push((kind, config.prepare(kind)));
+        }
+    }
     loop {
         let batch: Vec<usize> = indices.by_ref().take(BATCH_RUNS).collect();
         if batch.is_empty() {
@@ -160,31 +202,56 @@ pub fn for_each_run(
         let mut results: Vec<RunResult> = groups
             .par_iter()
             .flat_map_iter(|ids| {
-                let results = execute_group(config, ids);
+                if stop() {
+                    return Vec::new();
+                }
+                let (_, prepared) = prepared
+                    .iter()
+                    .find(|(kind, _)| *kind == ids[0].controller)
+                    .expect("every controller of the sweep is prepared");
+                let results = execute_prepared(config, prepared, ids);
                 results.iter().for_each(|_| progress());
                 results
             })
             .collect();
+        if stop() {
+            return Err(STOPPED.to_string());
+        }
         results.sort_unstable_by_key(|run| run.index);
         results.into_iter().try_for_each(&mut sink)?;
     }
 }
 
+/// The error of [`for_each_run_until`] and [`run_shard_until`] when `stop` ended the runs.
+pub const STOPPED: &str = "the sweep was stopped before all its runs were done";
+
 /// Runs the runs of `shard` and keeps them in memory (see [`write_shard`] to stream them to a
 /// file); the results are in index order. [`Shard::WHOLE`] runs the whole sweep.
 pub fn run_shard(config: &SweepConfig, shard: Shard, progress: impl Fn() + Sync) -> ShardFile {
+    run_shard_until(config, shard, progress, || false)
+        .expect("pushing to a vector cannot fail and nothing stops the runs")
+}
+
+/// [`run_shard`], checking `stop` before each lock-step group ([`for_each_run_until`]): `None`
+/// once it returned true.
+pub fn run_shard_until(
+    config: &SweepConfig,
+    shard: Shard,
+    progress: impl Fn() + Sync,
+    stop: impl Fn() -> bool + Sync,
+) -> Option<ShardFile> {
     let mut runs = Vec::with_capacity(shard.run_count(config.runs().unwrap_or(0)));
-    let pushed: Result<(), String> = for_each_run(config, shard, progress, |run| {
+    for_each_run_until(config, shard, progress, stop, |run| {
         runs.push(run);
         Ok(())
-    });
-    debug_assert!(pushed.is_ok(), "pushing to a vector cannot fail");
-    ShardFile {
+    })
+    .ok()?;
+    Some(ShardFile {
         format: FORMAT.into(),
         config: config.clone(),
         shard,
         runs,
-    }
+    })
 }
 
 /// Runs the runs of `shard` and writes its shard file to `out` as they finish (the header, then

@@ -4,6 +4,7 @@
 use super::inputs::{self, InputDigest};
 use crate::{ControllerKind, NoiseSpec, Scenario};
 use serde::{Deserialize, Serialize};
+use sim_core::{Prepared, RunNoise, SimError};
 use std::fmt;
 use std::str::FromStr;
 
@@ -261,16 +262,36 @@ impl SweepConfig {
     /// The scenario of run `id`: its controller, seed and noise.
     pub fn scenario_for(&self, id: &RunId) -> Scenario {
         let mut scenario = self.scenario.clone();
-        let level = id.noise_level;
         scenario.controller.kind = id.controller;
         scenario.seed = id.seed;
-        scenario.noise = NoiseSpec::uniform(
-            scenario.n_coords(),
+        scenario.noise = self.noise_spec(id);
+        scenario
+    }
+
+    /// The scenario with `controller`, prepared once for all of its runs
+    /// ([`Scenario::prepare`]); each run then takes its [`run_noise`](Self::run_noise).
+    pub fn prepare(&self, controller: ControllerKind) -> Result<Prepared, SimError> {
+        let mut scenario = self.scenario.clone();
+        scenario.controller.kind = controller;
+        scenario.prepare()
+    }
+
+    /// Run `id`'s seed and noise: what its [`scenario_for`](Self::scenario_for) sets.
+    pub fn run_noise(&self, id: &RunId) -> Result<RunNoise, SimError> {
+        self.noise_spec(id)
+            .run_noise(id.seed, self.scenario.n_coords())
+    }
+
+    /// Run `id`'s noise level on every coordinate, scaled by the settings' ratios on the rates
+    /// and the reference.
+    fn noise_spec(&self, id: &RunId) -> NoiseSpec {
+        let level = id.noise_level;
+        NoiseSpec::uniform(
+            self.scenario.n_coords(),
             level,
             self.settings.rate_noise_ratio * level,
             self.settings.reference_noise_ratio * level,
-        );
-        scenario
+        )
     }
 
     /// The name of the first field in which `other` differs, if any.

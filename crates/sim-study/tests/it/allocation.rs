@@ -85,16 +85,17 @@ fn allocations_do_not_grow_with_the_number_of_steps() {
 fn lock_step_groups_allocate_nothing_per_step() {
     assert!(is_counting());
     let group = |duration: f64| {
-        let runs = (0..11)
-            .map(|seed| {
-                let mut scenario = Scenario::builtin("paper-tracking").unwrap();
-                scenario.duration = duration;
-                scenario.seed = seed;
-                scenario.noise.sensor_a_std = Some(vec![1e-3, 1e-3]);
-                scenario.build().unwrap()
+        let mut scenario = Scenario::builtin("paper-tracking").unwrap();
+        scenario.duration = duration;
+        scenario.noise.sensor_a_std = Some(vec![1e-3, 1e-3]);
+        let noise = scenario.run_noise().unwrap();
+        let noises: Vec<_> = (0..11)
+            .map(|seed| sim_core::RunNoise {
+                seed,
+                ..noise.clone()
             })
             .collect();
-        sim_core::Lockstep::new(runs).unwrap()
+        scenario.prepare().unwrap().lockstep(&noises).unwrap()
     };
     let mut stepped = group(0.5);
     stepped.step();

@@ -725,8 +725,9 @@ impl Controller for Tired {
             return Err(Box::new(TiredError(ctx.t)));
         }
         // Hold the arm against gravity with the model the loop lends.
-        let mut data = modal_reduce::ReducedData::new(ctx.model);
-        modal_reduce::reduced_terms(ctx.model, &mut data, &ctx.measured.a, &ctx.measured.a_dot)?;
+        let mut data = modal_reduce::PlantData::new(ctx.model);
+        ctx.model
+            .terms(&mut data, &ctx.measured.a, &ctx.measured.a_dot)?;
         tau_star.copy_from_slice(data.gravity());
         Ok(())
     }

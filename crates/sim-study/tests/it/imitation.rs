@@ -112,7 +112,7 @@ fn the_scheduled_layout_feeds_the_documented_quantities() {
             t: 0.0,
             measured: &measured,
             reference: &reference,
-            model: &model,
+            model: (&model).into(),
             tau_star_limits: None,
         };
         let mut tau = [0.0; 2];

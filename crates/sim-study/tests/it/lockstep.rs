@@ -1,7 +1,8 @@
-//! Lock-step groups (`Lockstep`) against the same runs one at a time: every run of a group,
-//! completed or stopped, gives the same record, summary and error, bit for bit, whatever the
-//! group's size (smaller than a SIMD group, a whole number of them, with a remainder), however
-//! its runs differ (seed, noise level, controller) and wherever some of them stop (a controller
+//! Lock-step groups (`Lockstep`, formed by `Prepared::lockstep`) against the same runs one at a
+//! time, each built alone by `Simulation::new`: every run of a group, completed or stopped,
+//! gives the same record, summary and error, bit for bit, whatever the group's size (smaller
+//! than a SIMD group, a whole number of them, with a remainder), however its runs differ (seed,
+//! noise level, the state of their controllers) and wherever some of them stop (a controller
 //! error, a non-finite torque, dynamics that overflow inside an RK4 stage, a runaway error);
 //! the same for the loop stepped by hand, for Dormand-Prince groups and for a sweep's groups,
 //! whose runs share their reference samples.
@@ -13,10 +14,14 @@ use proptest::prelude::*;
 use sim_core::controller::{ControlContext, Controller, ControllerError, PdController};
 use sim_core::ode::Tolerances;
 use sim_core::reference::Sinusoid;
-use sim_core::{Integrator, Lockstep, LoopSettings, Simulation};
+use sim_core::{
+    ControllerFactory, Integrator, Lockstep, LoopSettings, Prepared, RunNoise, Simulation,
+};
 use sim_study::study::{self, Shard, SweepConfig, SweepSettings};
 use sim_study::{NoiseSpec, Scenario};
 use std::f64::consts::FRAC_PI_2;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use test_support::config::check_scaled;
 
 /// How a scripted run stops.
@@ -33,6 +38,7 @@ enum Stop {
 }
 
 /// A PD law that stops as told.
+#[derive(Clone)]
 struct Scripted {
     pd: PdController,
     stop: Stop,
@@ -71,28 +77,66 @@ fn paper_model() -> ReducedModel {
     .unwrap()
 }
 
-/// The paper's arm tracking a sinusoid for 0.3 s under a PD law, two RK4 steps per controller
-/// period, recording every other sample, a runaway bound of 0.5 rad.
-fn simulation(spec: Spec, integrator: Integrator) -> Simulation {
-    let reference = Sinusoid::new(&[0.3, -0.2], &[0.1, 0.05], &[2.0, 3.0], &[0.0, 1.0]).unwrap();
+fn sinusoid() -> Sinusoid {
+    Sinusoid::new(&[0.3, -0.2], &[0.1, 0.05], &[2.0, 3.0], &[0.0, 1.0]).unwrap()
+}
+
+fn scripted(stop: Stop) -> Scripted {
     let pd = PdController::new(&[0.0; 2], &[8.0, 6.0], &[1.0, 0.8]).unwrap();
+    Scripted { pd, stop }
+}
+
+/// Two RK4 steps per controller period over 0.3 s, recording every other sample, a runaway
+/// bound of 0.5 rad, no noise.
+fn settings(integrator: Integrator) -> LoopSettings {
     let mut settings = LoopSettings::new(integrator, 2e-3, 0.3);
     settings.record_period = 4e-3;
-    settings.seed = spec.seed;
-    settings.sensor_noise_std = vec![spec.noise, spec.noise, 10.0 * spec.noise, 10.0 * spec.noise];
     settings.max_modal_error = 0.5;
-    let controller = Scripted {
-        pd,
-        stop: spec.stop,
-    };
+    settings
+}
+
+/// A run's seed and sensor noise.
+fn noise(spec: Spec) -> RunNoise {
+    let n = spec.noise;
+    RunNoise {
+        seed: spec.seed,
+        reference_std: Vec::new(),
+        sensor_std: vec![n, n, 10.0 * n, 10.0 * n],
+    }
+}
+
+/// The paper's arm tracking a sinusoid for 0.3 s under a PD law that stops as `spec` says,
+/// built alone.
+fn simulation(spec: Spec, integrator: Integrator) -> Simulation {
     Simulation::new(
         paper_model(),
-        Box::new(reference),
-        Box::new(controller),
-        settings,
+        Box::new(sinusoid()),
+        Box::new(scripted(spec.stop)),
+        settings(integrator).with_noise(&noise(spec)),
         None,
     )
     .unwrap()
+}
+
+/// The runs of `specs` as one group of a prepared simulation whose controller factory hands
+/// run `k` the PD law that stops as `specs[k]` says.
+fn group(specs: &[Spec], integrator: Integrator) -> Lockstep {
+    let stops: Vec<Stop> = specs.iter().map(|s| s.stop).collect();
+    let next = AtomicUsize::new(0);
+    let controllers: ControllerFactory = Arc::new(move || {
+        let k = next.fetch_add(1, Ordering::Relaxed);
+        Ok(Box::new(scripted(stops[k])))
+    });
+    let prepared = Prepared::new(
+        paper_model(),
+        Prepared::reference_clones(sinusoid()),
+        controllers,
+        settings(integrator),
+        None,
+    )
+    .unwrap();
+    let noises: Vec<RunNoise> = specs.iter().map(|&s| noise(s)).collect();
+    prepared.lockstep(&noises).unwrap()
 }
 
 const RK4: Integrator = Integrator::Rk4 { dt: 1e-3 };
@@ -106,8 +150,7 @@ fn exact<T: std::fmt::Debug>(value: &T) -> String {
 /// Runs `specs` as one group and one at a time and checks that every result is the same.
 /// Returns the errors of the runs that stopped.
 fn check_group(specs: &[Spec], integrator: Integrator) -> Vec<String> {
-    let runs = specs.iter().map(|&s| simulation(s, integrator)).collect();
-    let mut group = Lockstep::new(runs).unwrap();
+    let mut group = group(specs, integrator);
     assert_eq!(
         group.is_lockstep(),
         matches!(integrator, Integrator::Rk4 { .. }) && batch_lanes(&paper_model()) > 1
@@ -211,7 +254,7 @@ fn a_group_stepped_by_hand_is_each_run_stepped_alone() {
             },
         })
         .collect();
-    let mut group = Lockstep::new(specs.iter().map(|&s| simulation(s, RK4)).collect()).unwrap();
+    let mut group = group(&specs, RK4);
     let mut alone: Vec<Simulation> = specs.iter().map(|&s| simulation(s, RK4)).collect();
     let mut errors: Vec<Option<String>> = vec![None; specs.len()];
     for _ in 0..50 {
@@ -270,48 +313,37 @@ fn dormand_prince_groups_integrate_each_run_alone() {
 }
 
 #[test]
-fn groups_of_other_models_or_loops_are_refused() {
-    let spec = Spec {
-        seed: 1,
-        noise: 0.0,
-        stop: Stop::Never,
-    };
-    let refused = |runs: Vec<Simulation>| match Lockstep::new(runs) {
+fn a_group_of_no_run_or_of_bad_noise_is_refused() {
+    let prepared = Prepared::new(
+        paper_model(),
+        Prepared::reference_clones(sinusoid()),
+        Prepared::controller_clones(scripted(Stop::Never)),
+        settings(RK4),
+        None,
+    )
+    .unwrap();
+    let refused = |noises: &[RunNoise]| match prepared.lockstep(noises) {
         Err(e) => e.to_string(),
         Ok(_) => panic!("a group was built"),
     };
-    let err = refused(Vec::new());
+    let err = refused(&[]);
     assert!(err.contains("at least one simulation"), "{err}");
-    let other_step = Integrator::Rk4 { dt: 5e-4 };
-    let err = refused(vec![simulation(spec, RK4), simulation(spec, other_step)]);
+    let spec = Spec {
+        seed: 1,
+        noise: 0.01,
+        stop: Stop::Never,
+    };
+    let mut short = noise(spec);
+    short.sensor_std.pop();
+    let err = refused(&[noise(spec), short]);
     assert!(
-        err.contains("integrator") && err.contains("of run 1 differs from run 0's"),
+        err.contains("noise.sensor_std") && err.contains("has 3 entries"),
         "{err}"
     );
-    let mut longer = simulation(spec, RK4).settings().clone();
-    longer.duration = 0.4;
-    let reference = Sinusoid::new(&[0.3, -0.2], &[0.1, 0.05], &[2.0, 3.0], &[0.0, 1.0]).unwrap();
-    let pd = PdController::new(&[0.0; 2], &[8.0, 6.0], &[1.0, 0.8]).unwrap();
-    let build = |model, settings| {
-        Simulation::new(
-            model,
-            Box::new(reference.clone()),
-            Box::new(pd.clone()),
-            settings,
-            None,
-        )
-        .unwrap()
-    };
-    let err = refused(vec![simulation(spec, RK4), build(paper_model(), longer)]);
-    assert!(err.contains("duration"), "{err}");
-    let heavier = ReducedModel::new(
-        ChainModel::uniform(10, 0.1, 0.2, 9.81).unwrap(),
-        ModalMap::paper_fixed_alpha0(10, FRAC_PI_2).unwrap(),
-    )
-    .unwrap();
-    let same = simulation(spec, RK4).settings().clone();
-    let err = refused(vec![simulation(spec, RK4), build(heavier, same)]);
-    assert!(err.contains("model"), "{err}");
+    let mut negative = noise(spec);
+    negative.reference_std = vec![-1.0, 0.0];
+    let err = refused(&[negative]);
+    assert!(err.contains("noise.reference_std"), "{err}");
 }
 
 /// A sweep's lock-step groups (`study::for_each_run`) give every run as `study::execute` runs
@@ -345,9 +377,9 @@ fn a_sweep_in_lock_step_gives_every_run_as_run_alone() {
     }
 }
 
-/// Runs of scenarios that differ in noise and seed share their reference samples (here a path
-/// followed by inverse kinematics, with reference noise too) and still give each run alone; a
-/// run whose reference differs, or a reference handed to `Simulation::new`, shares nothing.
+/// The runs of one prepared scenario that differ in noise and seed share their reference
+/// samples (here a path followed by inverse kinematics, with reference noise too) and still give
+/// each run alone, built from its own scenario.
 #[test]
 fn runs_of_one_reference_share_its_samples_and_give_each_run_alone() {
     let mut scenario = Scenario::builtin("paper-tracking").unwrap();
@@ -361,26 +393,10 @@ fn runs_of_one_reference_share_its_samples_and_give_each_run_alone() {
             run
         })
         .collect();
-    let build = |scenarios: &[Scenario]| -> Vec<Simulation> {
-        scenarios.iter().map(|s| s.build().unwrap()).collect()
-    };
-    let check = |scenarios: &[Scenario], shares: bool| {
-        let mut group = Lockstep::new(build(scenarios)).unwrap();
-        assert_eq!(group.shares_reference(), shares);
-        for (k, (together, scenario)) in group.run().iter().zip(scenarios).enumerate() {
-            let alone = scenario.build().unwrap().run();
-            assert_eq!(exact(together), exact(&alone), "run {k}");
-        }
-    };
-    check(&scenarios, true);
-    let mut other = scenarios.clone();
-    other[3].reference = Scenario::builtin("paper-responses-step").unwrap().reference;
-    check(&other, false);
-    let spec = Spec {
-        seed: 1,
-        noise: 0.0,
-        stop: Stop::Never,
-    };
-    let handed = (0..3).map(|_| simulation(spec, RK4)).collect();
-    assert!(!Lockstep::new(handed).unwrap().shares_reference());
+    let noises: Vec<RunNoise> = scenarios.iter().map(|s| s.run_noise().unwrap()).collect();
+    let mut group = scenario.prepare().unwrap().lockstep(&noises).unwrap();
+    for (k, (together, scenario)) in group.run().iter().zip(&scenarios).enumerate() {
+        let alone = scenario.build().unwrap().run();
+        assert_eq!(exact(together), exact(&alone), "run {k}");
+    }
 }

@@ -6,7 +6,7 @@
 
 use backbone_kin::{BaseAngle, ModalMap};
 use manip_dyn::{ChainModel, Link};
-use modal_reduce::{ReducedData, ReducedDerivatives, ReducedModel};
+use modal_reduce::{PlantData, PlantDerivatives, ReducedData, ReducedModel};
 use optimal_ctl::{
     BoxQp, BoxQpSettings, DiscreteDynamics, Ilqr, IlqrSettings, MpcSettings, OptimalError,
     ReducedEuler, TrackingCost,
@@ -449,8 +449,10 @@ fn limits_hold_and_the_cost_decreases_monotonically_for_every_family() {
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     for model in families() {
         let m = model.n_coords();
-        let (mut data, mut derivatives) =
-            (ReducedData::new(&model), ReducedDerivatives::new(&model));
+        let (mut data, mut derivatives) = (
+            PlantData::new((&model).into()),
+            PlantDerivatives::new((&model).into()),
+        );
         for _ in 0..3 {
             let (ilqr, x0) = reduced_problem(&model, 30, &mut rng, 0.7);
             let mut previous = f64::INFINITY;
@@ -492,8 +494,10 @@ fn cost_gradient_matches_central_finite_differences() {
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     for model in families() {
         let m = model.n_coords();
-        let (mut data, mut derivatives) =
-            (ReducedData::new(&model), ReducedDerivatives::new(&model));
+        let (mut data, mut derivatives) = (
+            PlantData::new((&model).into()),
+            PlantDerivatives::new((&model).into()),
+        );
         let horizon = 12;
         let (mut ilqr, x0) = reduced_problem(&model, horizon, &mut rng, 1e6);
         let g_ref = ilqr.control_references_mut().to_vec();
@@ -502,8 +506,8 @@ fn cost_gradient_matches_central_finite_differences() {
             .map(|g| g + rng.random_range(-0.3..0.3))
             .collect();
         let cost_of = |ilqr: &mut Ilqr,
-                       data: &mut ReducedData,
-                       derivatives: &mut ReducedDerivatives,
+                       data: &mut PlantData,
+                       derivatives: &mut PlantDerivatives,
                        u: &[f64]| {
             ilqr.controls_mut().copy_from_slice(u);
             let mut dynamics = ReducedEuler::new(&model, data, derivatives, 0.02).unwrap();
@@ -522,16 +526,15 @@ fn cost_gradient_matches_central_finite_differences() {
         for index in 0..horizon * m {
             // Step-size control: the central difference at two steps must agree before it is
             // trusted.
-            let fd = |eps: f64,
-                      ilqr: &mut Ilqr,
-                      data: &mut ReducedData,
-                      der: &mut ReducedDerivatives| {
-                let mut plus = controls.clone();
-                plus[index] += eps;
-                let mut minus = controls.clone();
-                minus[index] -= eps;
-                (cost_of(ilqr, data, der, &plus) - cost_of(ilqr, data, der, &minus)) / (2.0 * eps)
-            };
+            let fd =
+                |eps: f64, ilqr: &mut Ilqr, data: &mut PlantData, der: &mut PlantDerivatives| {
+                    let mut plus = controls.clone();
+                    plus[index] += eps;
+                    let mut minus = controls.clone();
+                    minus[index] -= eps;
+                    (cost_of(ilqr, data, der, &plus) - cost_of(ilqr, data, der, &minus))
+                        / (2.0 * eps)
+                };
             let coarse = fd(1e-4, &mut ilqr, &mut data, &mut derivatives);
             let fine = fd(5e-5, &mut ilqr, &mut data, &mut derivatives);
             assert!(
@@ -552,8 +555,10 @@ fn the_solution_satisfies_the_kkt_conditions_of_the_box() {
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     for model in families() {
         let m = model.n_coords();
-        let (mut data, mut derivatives) =
-            (ReducedData::new(&model), ReducedDerivatives::new(&model));
+        let (mut data, mut derivatives) = (
+            PlantData::new((&model).into()),
+            PlantDerivatives::new((&model).into()),
+        );
         for _ in 0..2 {
             let horizon = 25;
             let (mut ilqr, x0) = reduced_problem(&model, horizon, &mut rng, 0.8);
@@ -681,7 +686,7 @@ fn bad_mpc_settings_are_refused_with_the_field_named() {
                     t: 0.0,
                     measured: &measured,
                     reference: &target,
-                    model: &model,
+                    model: (&model).into(),
                     tau_star_limits: None,
                 };
                 controller
@@ -845,7 +850,7 @@ fn mpc_control_calls_allocate_nothing() {
                 t,
                 measured: &measured,
                 reference: &target,
-                model: &model,
+                model: (&model).into(),
                 tau_star_limits: Some(&loop_limits),
             };
             let before = allocations();
@@ -898,7 +903,7 @@ fn mpc_plans_within_the_loop_s_limits() {
             t: 0.0,
             measured: &measured,
             reference: &target,
-            model: &model,
+            model: (&model).into(),
             tau_star_limits: Some(&limits),
         };
         let mut tau = vec![0.0; m];

@@ -1,0 +1,67 @@
+//! Keyword arguments read with their names in every message: a wrong type is a `TypeError`
+//! naming the argument and the type given, a value out of range an
+//! [`InvalidInput`](crate::errors::InvalidInput) naming it.
+
+use crate::array::passes_through;
+use crate::errors::Error;
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyString};
+
+/// The `TypeError` for argument `name` given a `value` of the wrong type.
+fn wrong_type(name: &str, expected: &str, value: &Bound<'_, PyAny>) -> PyErr {
+    let given = value
+        .get_type()
+        .name()
+        .map_or_else(|_| "object".to_string(), |n| n.to_string());
+    PyTypeError::new_err(format!("{name} must be {expected}, got a {given}"))
+}
+
+/// A real number for argument `name` (a Python or numpy int or float).
+pub(crate) fn real(value: &Bound<'_, PyAny>, name: &str) -> PyResult<f64> {
+    if value.is_instance_of::<PyString>() || value.is_instance_of::<PyBytes>() {
+        return Err(wrong_type(name, "a real number", value));
+    }
+    value.extract::<f64>().map_err(|e| {
+        if passes_through(value.py(), &e) {
+            e
+        } else {
+            wrong_type(name, "a real number", value)
+        }
+    })
+}
+
+/// A 1-D sequence of real numbers for argument `name` (a list, tuple or numpy array; not a
+/// string): a wrong type is a `TypeError`, another number of dimensions an `InvalidInput`.
+pub(crate) fn reals(value: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<f64>> {
+    if value.is_instance_of::<PyString>() || value.is_instance_of::<PyBytes>() {
+        return Err(wrong_type(name, "a sequence of real numbers", value));
+    }
+    crate::array::vector(value, name)
+}
+
+/// A seed for argument `name`: a whole number from 0 to 2^64 - 1.
+pub(crate) fn seed(value: &Bound<'_, PyAny>, name: &str) -> PyResult<u64> {
+    if let Ok(seed) = value.extract::<u64>() {
+        return Ok(seed);
+    }
+    match value.extract::<i128>() {
+        Ok(n) => Err(Error::input(format!(
+            "{name} must be a whole number from 0 to 2^64 - 1, got {n}"
+        ))
+        .into()),
+        Err(e) if passes_through(value.py(), &e) => Err(e),
+        Err(_) => Err(wrong_type(name, "a whole number", value)),
+    }
+}
+
+/// A path for argument `name`: a `str` or an `os.PathLike`.
+pub(crate) fn path(value: &Bound<'_, PyAny>, name: &str) -> PyResult<std::path::PathBuf> {
+    value.extract().map_err(|e| {
+        if passes_through(value.py(), &e) {
+            e
+        } else {
+            wrong_type(name, "a str or an os.PathLike", value)
+        }
+    })
+}

@@ -1,0 +1,418 @@
+"""What a hostile or careless user does to `import hrm` (issue 32, docs/bad-input.md, "Python"):
+fork after a parallel batch, unaligned and masked arrays, RAYON_NUM_THREADS, allocation
+failures, Ctrl-C, the GIL during long work, huge base angles, shared results, pickling and
+the messages of wrong arguments. Whatever could hang or kill the interpreter runs in a
+subprocess with a timeout."""
+
+import copy
+import os
+import pickle
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import hrm
+
+DOCS = Path(__file__).resolve().parents[3] / "docs"
+
+
+def run_python(code, timeout=120, env=None):
+    """Runs `code` in a fresh interpreter; returns the completed process (stdout, stderr)."""
+    full_env = dict(os.environ)
+    full_env.update(env or {})
+    return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True,
+                          timeout=timeout, env=full_env)
+
+
+def short_step(duration=0.05):
+    scenario = hrm.Scenario.builtin("paper-responses-step")
+    scenario.duration = duration
+    return scenario
+
+
+# --- fork after a parallel batch -----------------------------------------------------------------
+
+
+def test_a_forked_child_runs_parallel_batches_after_the_parent_did(tmp_path):
+    script = tmp_path / "fork.py"
+    script.write_text(textwrap.dedent("""
+        import multiprocessing, warnings
+        import numpy as np
+        import hrm
+
+        warnings.simplefilter("ignore", DeprecationWarning)  # fork of a multi-threaded process
+
+        def sweep():
+            scenario = hrm.Scenario.builtin("paper-responses-step")
+            scenario.duration = 0.02
+            return hrm.Sweep(scenario, noise_levels=[0.0, 0.01], seeds=2, controllers=["pd"])
+
+        def work(k):
+            states = np.full((1024, 10), 0.01 * k)
+            arm = hrm.Arm()
+            model = hrm.ReducedModel(arm, alpha0=0.3)
+            return (arm.gravity(states).sum(), model.gravity(np.full((1024, 2), 0.01 * k)).sum(),
+                    hrm.fuzzy.paper_controller().eval(np.full((1024, 4), 0.01 * k)).sum(),
+                    len(sweep().run_shard(1, 2)))
+
+        if __name__ == "__main__":
+            expected = [work(k) for k in range(4)]  # the parent's pool is running now
+            with multiprocessing.get_context("fork").Pool(2) as pool:
+                got = pool.map(work, range(4))
+            assert got == expected, (got, expected)
+            print("ok")
+    """))
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "ok"
+
+
+# --- layouts: unaligned views, masked arrays ------------------------------------------------------
+
+
+def packed(rows, width):
+    """A packed structured array whose float64 field is unaligned (offset 1 byte)."""
+    dtype = np.dtype([("flag", "u1"), ("x", "f8", (width,))], align=False)
+    record = np.zeros(rows, dtype=dtype)
+    record["x"] = np.linspace(0.0, 0.3, rows * width).reshape(rows, width)
+    return record
+
+
+def test_unaligned_views_are_read_as_copies():
+    arm = hrm.Arm()
+    record = packed(3, 10)
+    one, batch = record[1]["x"], record["x"]
+    assert one.flags.c_contiguous and not one.flags.aligned and not batch.flags.aligned
+    np.testing.assert_array_equal(arm.gravity(one), arm.gravity(np.array(one)))
+    np.testing.assert_array_equal(arm.rnea(batch, batch, batch), arm.rnea(*(np.array(batch),) * 3))
+    np.testing.assert_array_equal(arm.aba(one, one, one), arm.aba(*(np.array(one),) * 3))
+    model = hrm.ReducedModel(arm, alpha0=0.2)
+    a = packed(2, 2)["x"]
+    np.testing.assert_array_equal(model.fk(a), model.fk(np.array(a)))
+    np.testing.assert_array_equal(model.forward_dynamics(a, a, a), model.forward_dynamics(*(np.array(a),) * 3))
+    fis = hrm.fuzzy.paper_controller()
+    x = packed(4, 4)["x"]
+    np.testing.assert_array_equal(fis.eval(x), fis.eval(np.array(x)))
+    lengths = packed(1, 3)[0]["x"] + 0.1
+    np.testing.assert_array_equal(hrm.Arm(lengths=lengths).lengths, np.array(lengths))
+
+
+def test_a_controller_may_return_an_unaligned_view():
+    scenario = short_step(0.01)
+    m = scenario.n_coords
+    record = packed(1, m)
+
+    def controller(t, a, a_dot, ref):
+        record[0]["x"] = -2.0 * (a - ref.a) - 0.5 * a_dot
+        return record[0]["x"]
+
+    run = scenario.run(controller)
+    assert run.failure is None and np.isfinite(run.tau_star).all()
+
+
+def test_masked_arrays_are_refused_when_masked_and_read_when_not():
+    arm = hrm.Arm()
+    theta = np.ma.masked_array(np.full(10, 0.1), mask=[False] * 9 + [True])
+    with pytest.raises(hrm.InvalidInput, match="theta is a masked array with masked entries"):
+        arm.gravity(theta)
+    with pytest.raises(hrm.InvalidInput, match="x is a masked array"):
+        hrm.fuzzy.paper_controller().eval(np.ma.masked_invalid([0.0, np.nan, 0.0, 0.0]))
+    with pytest.raises(hrm.InvalidInput, match="lengths is a masked array"):
+        hrm.Arm(lengths=np.ma.masked_array([0.1, 0.1], mask=[True, False]))
+    clear = np.ma.masked_array(np.full((3, 10), 0.1), mask=False)
+    np.testing.assert_array_equal(arm.gravity(clear), arm.gravity(np.full((3, 10), 0.1)))
+
+
+# --- threads, memory, signals ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("value", ["5000", "-1", "abc", "1e3"])
+def test_a_bad_rayon_num_threads_is_a_clear_error_and_leaves_nothing_broken(value):
+    done = run_python("""
+        import os
+        import numpy as np
+        import hrm
+        states = np.zeros((2000, 10))
+        try:
+            hrm.Arm().gravity(states)
+        except hrm.InvalidInput as e:
+            assert "RAYON_NUM_THREADS" in str(e), e
+            print("refused:", e)
+        os.environ["RAYON_NUM_THREADS"] = "2"
+        assert (hrm.Arm().gravity(states) == hrm.Arm().gravity(states[:1])).all()
+        print("ok")
+    """, env={"RAYON_NUM_THREADS": value})
+    assert done.returncode == 0, done.stderr
+    assert "refused: RAYON_NUM_THREADS must be a number of threads from 0" in done.stdout
+    assert done.stdout.strip().endswith("ok")
+
+
+@pytest.mark.parametrize("value", ["0", "", "3"])
+def test_a_valid_rayon_num_threads_works(value):
+    done = run_python("""
+        import numpy as np
+        import hrm
+        assert hrm.Arm().gravity(np.zeros((2000, 10))).shape == (2000, 10)
+        print("ok")
+    """, env={"RAYON_NUM_THREADS": value})
+    assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+def test_an_allocation_the_system_refuses_is_a_memory_error():
+    # 8 mass matrices of 4096 links: 1 GiB, within the documented limits, beyond the address
+    # space left to the process.
+    done = run_python("""
+        import resource
+        import numpy as np
+        import hrm
+        arm = hrm.Arm(links=4096)
+        arm.gravity(np.zeros((600, 4096)))  # the pool's threads exist before the limit
+        size = int(open("/proc/self/statm").read().split()[0]) * resource.getpagesize()
+        resource.setrlimit(resource.RLIMIT_AS, (size + (256 << 20), resource.RLIM_INFINITY))
+        try:
+            arm.mass_matrix(np.zeros((8, 4096)))
+        except MemoryError as e:
+            print("MemoryError:", e)
+        print(arm.gravity(np.zeros(4096)).shape)
+    """)
+    assert done.returncode == 0, done.stderr
+    assert "MemoryError: the result of the batch: cannot allocate 134217728 float64 values" in done.stdout
+    assert done.stdout.strip().endswith("(4096,)")
+
+
+INTERRUPT = textwrap.dedent("""
+    import signal, threading, time, os
+    import numpy as np
+    import hrm
+
+    def interrupted_after(call):
+        timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+        start = time.monotonic()
+        timer.start()
+        try:
+            call()
+        except KeyboardInterrupt:
+            print("interrupted after %.2f s" % (time.monotonic() - start))
+        else:
+            print("finished after %.2f s" % (time.monotonic() - start))
+        timer.join()
+""")
+
+
+@pytest.mark.parametrize("setup, call", [
+    ("model = hrm.ReducedModel(hrm.Arm(links=2000), harmonics=10); a = np.zeros((60000, 21))",
+     "model.mass_matrix(a)"),
+    ("model = hrm.ReducedModel(hrm.Arm(links=3000), harmonics=30); a = np.zeros((500, 61))",
+     "model.mass_matrix(a)"),
+    ("s = hrm.Scenario.builtin('paper-tracking'); s.duration = 200.0", "s.run()"),
+    ("s = hrm.Scenario.builtin('paper-responses-step'); s.duration = 2.0; "
+     "sweep = hrm.Sweep(s, noise_levels=[0.0, 0.01], seeds=200, controllers=['fuzzy', 'pd'])", "sweep.run()"),
+], ids=["parallel-batch", "serial-batch", "scenario-run", "sweep-run"])
+def test_ctrl_c_interrupts_long_calls_promptly(setup, call):
+    code = INTERRUPT + f"\n{setup}\ndef call():\n    {call}\ninterrupted_after(call)\n"
+    done = run_python(code, timeout=300)
+    assert done.returncode == 0, done.stderr
+    words = done.stdout.split()
+    assert words[0] == "interrupted", done.stdout
+    assert float(words[2]) < 1.0, done.stdout
+
+
+def test_ctrl_c_while_an_argument_is_converted_is_a_keyboard_interrupt():
+    class Interrupting:
+        def __array__(self, dtype=None, copy=None):
+            raise KeyboardInterrupt
+
+        def __float__(self):
+            raise KeyboardInterrupt
+
+    arm = hrm.Arm()
+    with pytest.raises(KeyboardInterrupt):
+        arm.gravity(Interrupting())
+    with pytest.raises(KeyboardInterrupt):
+        hrm.Arm(link_length=Interrupting())
+    with pytest.raises(KeyboardInterrupt):
+        hrm.Arm(lengths=Interrupting())
+
+    def controller(t, a, a_dot, ref):
+        return Interrupting()
+
+    with pytest.raises(KeyboardInterrupt):
+        short_step(0.01).run(controller)
+
+
+def progress_share(call):
+    """The share of its free-running speed another Python thread keeps while `call` runs (about 1
+    when `call` releases the GIL, near 0 when it holds it), and how long `call` took."""
+
+    def counted_during(action):
+        count, stop = [0], threading.Event()
+
+        def counter():
+            while not stop.is_set():
+                count[0] += 1
+
+        thread = threading.Thread(target=counter)
+        thread.start()
+        time.sleep(0.05)
+        start, before = time.monotonic(), count[0]
+        action()
+        after, elapsed = count[0], time.monotonic() - start
+        stop.set()
+        thread.join()
+        return (after - before) / elapsed, elapsed
+
+    free, _ = counted_during(lambda: time.sleep(0.2))
+    rate, elapsed = counted_during(call)
+    return rate / free, elapsed
+
+
+def test_long_one_object_calls_let_other_threads_run():
+    arm = hrm.Arm(links=3000)
+    models = []
+    share, elapsed = progress_share(lambda: models.append(hrm.ReducedModel(arm, harmonics=150)))
+    assert elapsed > 0.1 and share > 0.25, (share, elapsed)  # 0.03 with the GIL held
+    model = models[0]
+    share, elapsed = progress_share(lambda: model.mass_matrix(np.zeros(model.n_coords)))
+    assert elapsed > 0.05 and share > 0.25, (share, elapsed)
+
+
+# --- wrong answers without an error --------------------------------------------------------------
+
+
+@pytest.mark.parametrize("alpha0", [1e15, 1e17, 1e300, -7.0])
+def test_ik_reduces_a_huge_base_angle(alpha0):
+    model = hrm.ReducedModel(hrm.Arm(links=20, link_length=0.05))
+    reduced = np.arctan2(np.sin(alpha0), np.cos(alpha0))
+    target = model.fk([0.3, 0.2, reduced])
+    a = model.ik(target, alpha0=alpha0)
+    np.testing.assert_array_equal(a, model.ik(target, alpha0=reduced))
+    assert abs(a[-1]) <= np.pi
+    # The tip of the 20-link chain is within its discretisation error of the curve's end.
+    assert np.linalg.norm(model.fk(a) - target) < 5e-3
+    fixed = hrm.ReducedModel(hrm.Arm(links=20, link_length=0.05), alpha0=alpha0)
+    assert fixed.alpha0 == reduced
+    assert np.linalg.norm(fixed.fk(fixed.ik(target)) - target) < 5e-3
+
+
+@pytest.mark.parametrize("harmonics, alpha0", [(2, 0.0), (2, 0.4), (3, -0.3)])
+def test_k_harmonic_ik_solves_what_the_family_reaches(harmonics, alpha0):
+    # 200 seeded targets m.fk(a), a in [-0.5, 0.5]^{2K}: some need |a2| beyond the K = 1
+    # family's amplitude, where the closed-form start used to give Unreachable.
+    model = hrm.ReducedModel(hrm.Arm(links=20, link_length=0.05), harmonics=harmonics, alpha0=alpha0)
+    rng = np.random.default_rng(32)
+    targets = model.fk(rng.uniform(-0.5, 0.5, (200, 2 * harmonics)))
+    a = model.ik(targets)
+    assert np.abs(model.fk(a) - targets).max() < 1e-5  # the chain's tip within its discretisation
+    np.testing.assert_array_equal(a[17], model.ik(targets[17]))
+
+
+def test_run_results_are_not_shared_mutable_objects():
+    run = short_step(0.01).run("pd")
+    for name in ["t", "a", "a_dot", "a_ref", "tau_star", "joint_torques", "tip", "tip_ref"]:
+        array = getattr(run, name)
+        assert not array.flags.writeable
+        with pytest.raises(ValueError, match="read-only"):
+            array[0] = 42
+    first = run.t[0]
+    summary = run.summary
+    summary["rms_tip_error_mm"] = -1.0
+    summary.clear()
+    assert run.summary and run.summary != summary and run.t[0] == first
+
+
+# --- pickling -------------------------------------------------------------------------------------
+
+
+def round_trips(value):
+    return [pickle.loads(pickle.dumps(value)), copy.deepcopy(value)]
+
+
+def test_models_pickle_by_their_parameters():
+    arm = hrm.Arm(lengths=[0.1, 0.2, 0.15], masses=[1.0, 0.5, 0.25], inertias=[1e-3, 2e-3, 3e-3], gravity=3.7)
+    theta = np.array([0.1, -0.4, 0.3])
+    for clone in round_trips(arm):
+        np.testing.assert_array_equal(clone.mass_matrix(theta), arm.mass_matrix(theta))
+        np.testing.assert_array_equal(clone.gravity(theta), arm.gravity(theta))
+        assert repr(clone) == repr(arm)
+    for model in [hrm.ReducedModel(arm, harmonics=1), hrm.ReducedModel(hrm.Arm(), harmonics=2, alpha0=0.4)]:
+        a = np.linspace(0.1, 0.2, model.n_coords)
+        for clone in round_trips(model):
+            assert repr(clone) == repr(model)
+            np.testing.assert_array_equal(clone.mass_matrix(a), model.mass_matrix(a))
+            np.testing.assert_array_equal(clone.fk(a), model.fk(a))
+    fis = hrm.fuzzy.paper_controller()
+    x = np.random.default_rng(3).uniform(-1, 1, (50, 4))
+    for clone in round_trips(fis):
+        np.testing.assert_array_equal(clone.eval(x), fis.eval(x))
+        assert clone.to_fis() == fis.to_fis()
+
+
+def test_runs_settings_and_reference_samples_pickle():
+    scenario = short_step(0.01)
+    run = scenario.run("fuzzy")
+    for clone in round_trips(run):
+        for name in ["t", "a", "tau_star", "joint_torques", "tip"]:
+            np.testing.assert_array_equal(getattr(clone, name), getattr(run, name))
+        assert clone.summary == run.summary and clone.failure == run.failure
+        assert clone.controller == run.controller and clone.coordinates == run.coordinates
+        assert clone.view_html() == run.view_html()
+    sine = hrm.Scenario.builtin("paper-responses-sine").reference
+    for clone in round_trips(sine):
+        assert clone.to_dict() == sine.to_dict()
+        clone.amplitude = [0.2, 0.2]  # a view on a copy of the scenario
+        assert sine.amplitude == [0.3, 0.15] and clone.amplitude == [0.2, 0.2]
+    sample = hrm.ReferenceSample([0.1, 0.2], [0.0, 1.0], [2.0, 3.0])
+    for clone in round_trips(sample):
+        for name in ["a", "a_dot", "a_ddot"]:
+            np.testing.assert_array_equal(getattr(clone, name), getattr(sample, name))
+    with pytest.raises(hrm.InvalidInput, match="same length"):
+        hrm.ReferenceSample([0.1], [0.0, 1.0], [2.0])
+
+
+# --- messages -------------------------------------------------------------------------------------
+
+
+def test_wrong_argument_types_name_the_argument():
+    with pytest.raises(TypeError, match="^link_length must be a real number, got a str$"):
+        hrm.Arm(link_length="x")
+    with pytest.raises(TypeError, match="^gravity must be a real number"):
+        hrm.Arm(gravity=[1.0])
+    with pytest.raises(hrm.InvalidInput, match=r"^lengths must be a 1-D sequence of numbers, got an array of shape \[2, 2\]"):
+        hrm.Arm(lengths=np.ones((2, 2)))
+    with pytest.raises(TypeError, match="^noise_levels must be a sequence of real numbers, got a str$"):
+        hrm.Sweep("paper-responses-step", noise_levels="abc", seeds=1)
+    with pytest.raises(TypeError, match="^path_or_text must be a str or an os.PathLike, got a int$"):
+        hrm.Scenario.from_toml(5)
+    with pytest.raises(TypeError, match="^path_or_text must be a str or an os.PathLike"):
+        hrm.fuzzy.System.from_fis(5)
+    with pytest.raises(hrm.InvalidInput, match="^base_seed must be a whole number from 0 to 2\\^64 - 1, got -1$"):
+        hrm.Sweep(short_step(), noise_levels=[0.0], seeds=1, base_seed=-1)
+    with pytest.raises(TypeError, match="^base_seed must be a whole number, got a float$"):
+        hrm.Sweep(short_step(), noise_levels=[0.0], seeds=1, base_seed=1.5)
+    with pytest.raises(hrm.InvalidInput, match="^arm.links must be a whole number of at most 64 bits, got '3'$"):
+        hrm.Arm(links="3")
+    with pytest.raises(hrm.InvalidInput, match="^arm.links must be a whole number of at most 64 bits, got 3.0$"):
+        hrm.Arm(links=3.0)
+
+
+def test_merge_refuses_a_string():
+    text = hrm.Sweep(short_step(0.01), noise_levels=[0.0], seeds=1, controllers=["pd"]).run_shard()
+    with pytest.raises(TypeError, match=r"^shards must be a list .* got a str: give \[text\] for one shard$"):
+        hrm.Sweep.merge(text)
+    assert hrm.Sweep.merge([text])["cells"]
+
+
+def test_every_controller_is_listed_in_the_docs():
+    names = hrm.Sweep(short_step(0.01), noise_levels=[0.0], seeds=1).config["settings"]["controllers"]
+    assert len(names) == 6
+    python_md = (DOCS / "python.md").read_text()
+    for name in names:
+        assert f'"{name}"' in hrm.Scenario.run.__doc__, name
+        assert f"`{name}`" in python_md or f'"{name}"' in python_md, name

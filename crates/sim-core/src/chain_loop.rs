@@ -1,0 +1,381 @@
+//! The closed loop on a full spatial chain in joint space (a URDF arm): computed torque on the
+//! chain's own dynamics, tracking a joint-space [`Reference`], the plant integrated by RK4 with
+//! the articulated-body algorithm.
+//!
+//! At each controller sample `t_k` (every `period` s) the controller reads the state `(q, v)` and
+//! the reference `(q_r, v_r, a_r)` and commands, by one RNEA (`manip_dyn::spatial::rnea`),
+//!
+//! ```text
+//! tau = M(q) (a_r + K_d (v_r - v) + K_p (q_r - q)) + C(q, v) v + G(q),
+//! ```
+//!
+//! held until the next sample while RK4 integrates `q_dd = M^-1 (tau - C v - G)` by the ABA in
+//! steps of at most `dt`. With the exact model the joint error obeys
+//! `e_dd + K_d e_d + K_p e = 0` between samples: it converges for positive gains.
+//!
+//! This loop is separate from the modal loop ([`Simulation`](crate::Simulation)): its state is
+//! the joint vector, not modal coordinates, and its only controller is computed torque.
+
+use crate::error::{SimError, check_finite, check_positive};
+use crate::ode::{OdeSystem, Rk4};
+use crate::reference::{Reference, ReferenceSample};
+use crate::simulation::{MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS};
+use manip_dyn::DynError;
+use manip_dyn::spatial::{SpatialData, SpatialModel, aba, rnea};
+
+/// The settings of a [`run_chain_loop`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainLoopSettings {
+    /// Simulated time (s), positive.
+    pub duration: f64,
+    /// Controller period (s): the torque is held between samples.
+    pub period: f64,
+    /// Longest RK4 step (s), at most `period`.
+    pub dt: f64,
+    /// Recording period (s): every controller sample whose index is a multiple of
+    /// `round(record_period / period)` (at least 1) is recorded, and the last.
+    pub record_period: f64,
+    /// Stiffness per joint (1/s^2), positive.
+    pub kp: Vec<f64>,
+    /// Damping per joint (1/s), positive.
+    pub kd: Vec<f64>,
+    /// Runaway bound on `|q_i - q_r,i|` (rad or m): the run stops past it.
+    pub max_joint_error: f64,
+}
+
+/// The recorded time series of a chain run, `n` values per sample in each joint series.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ChainRecord {
+    /// Sample times (s).
+    pub t: Vec<f64>,
+    /// Joint values, sample after sample.
+    pub q: Vec<f64>,
+    /// Reference joint values.
+    pub q_ref: Vec<f64>,
+    /// Commanded joint efforts (N m or N).
+    pub tau: Vec<f64>,
+}
+
+/// The metrics of a chain run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainSummary {
+    /// Controller samples taken (including the one at the final time).
+    pub controller_samples: usize,
+    /// Accepted RK4 steps.
+    pub steps: usize,
+    /// Root mean square of `q_i - q_r,i` per joint over the recorded samples.
+    pub joint_error_rms: Vec<f64>,
+    /// Largest `|q_i - q_r,i|` per joint over the recorded samples.
+    pub joint_error_max: Vec<f64>,
+    /// `|q - q_r|` (Euclidean, over the joints) at the final time.
+    pub final_error: f64,
+    /// Largest `|tau_i|` per joint over the controller samples.
+    pub peak_joint_efforts: Vec<f64>,
+}
+
+/// A finished chain run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainRun {
+    /// The metrics.
+    pub summary: ChainSummary,
+    /// The time series.
+    pub record: ChainRecord,
+}
+
+/// The plant between two controller samples: `(q, v)' = (v, ABA(q, v, tau))`.
+struct Plant<'a> {
+    model: &'a SpatialModel,
+    data: &'a mut SpatialData,
+    tau: &'a [f64],
+}
+
+impl OdeSystem for Plant<'_> {
+    type Error = DynError;
+
+    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), DynError> {
+        let n = self.model.n_links();
+        let (q, v) = y.split_at(n);
+        let (q_dot, v_dot) = dy.split_at_mut(n);
+        q_dot.copy_from_slice(v);
+        aba(self.model, self.data, q, v, self.tau, v_dot)
+    }
+}
+
+/// Checks the settings against a chain of `n` joints; returns the number of controller periods.
+fn check(settings: &ChainLoopSettings, n: usize) -> Result<usize, SimError> {
+    check_positive("duration", settings.duration)?;
+    check_positive("controller.period", settings.period)?;
+    check_positive("integrator.dt", settings.dt)?;
+    check_positive("record_period", settings.record_period)?;
+    check_positive("limits.max_modal_error", settings.max_joint_error)?;
+    if settings.dt > settings.period {
+        return Err(SimError::setting(
+            "integrator.dt",
+            format!(
+                "must be at most the controller period {} s, got {}",
+                settings.period, settings.dt
+            ),
+        ));
+    }
+    for (name, gains) in [
+        ("controller.kp", &settings.kp),
+        ("controller.kd", &settings.kd),
+    ] {
+        if gains.len() != n {
+            return Err(SimError::setting(
+                name,
+                format!("has {} entries, expected one per joint ({n})", gains.len()),
+            ));
+        }
+        for &g in gains.iter() {
+            check_positive(name, g)?;
+        }
+    }
+    let periods = (settings.duration / settings.period).ceil();
+    let steps = periods * (settings.period / settings.dt).ceil();
+    let recorded = (periods / (settings.record_period / settings.period).round().max(1.0) + 2.0)
+        * (3 * n) as f64;
+    if periods >= MAX_CONTROLLER_SAMPLES
+        || steps > MAX_RK4_STEPS
+        || recorded > MAX_RECORDED_VALUES as f64
+    {
+        return Err(SimError::setting(
+            "duration",
+            format!(
+                "= {} s takes {periods} controller samples and {steps} RK4 steps recording \
+                 {recorded} values, past the loop's limits ({MAX_CONTROLLER_SAMPLES}, \
+                 {MAX_RK4_STEPS}, {MAX_RECORDED_VALUES})",
+                settings.duration
+            ),
+        ));
+    }
+    Ok(periods as usize)
+}
+
+/// Runs computed torque on `model` from rest at `q0` (one value per joint), tracking
+/// `reference` (one coordinate per joint).
+///
+/// # Errors
+/// [`SimError::InvalidSetting`] for a setting out of its domain (named as in a scenario file) or
+/// a reference or `q0` of the wrong length; [`SimError::ChainDynamics`] if the dynamics fail at
+/// a controller sample, [`SimError::ChainIntegration`] if they fail or blow up between two,
+/// [`SimError::RunawayError`] past `max_joint_error` (its `coordinate` is the 1-based joint).
+pub fn run_chain_loop(
+    model: &SpatialModel,
+    reference: &mut dyn Reference,
+    q0: &[f64],
+    settings: &ChainLoopSettings,
+) -> Result<ChainRun, SimError> {
+    let n = model.n_links();
+    let periods = check(settings, n)?;
+    if reference.n_coords() != n {
+        return Err(SimError::setting(
+            "reference",
+            format!(
+                "sets {} coordinates, expected one per joint of the URDF arm ({n})",
+                reference.n_coords()
+            ),
+        ));
+    }
+    if q0.len() != n {
+        return Err(SimError::setting(
+            "initial.a",
+            format!("has {} entries, expected one per joint ({n})", q0.len()),
+        ));
+    }
+    check_finite("initial.a", q0)?;
+    let mut data = SpatialData::new(model);
+    let mut rk4 = Rk4::new(2 * n);
+    let mut state = vec![0.0; 2 * n];
+    state[..n].copy_from_slice(q0);
+    let mut sample = ReferenceSample::zeros(n);
+    let (mut command, mut tau) = (vec![0.0; n], vec![0.0; n]);
+    let mut record = ChainRecord::default();
+    let mut squares = vec![0.0; n];
+    let mut summary = ChainSummary {
+        controller_samples: 0,
+        steps: 0,
+        joint_error_rms: vec![0.0; n],
+        joint_error_max: vec![0.0; n],
+        final_error: 0.0,
+        peak_joint_efforts: vec![0.0; n],
+    };
+    let every = ((settings.record_period / settings.period).round() as usize).max(1);
+    for k in 0..=periods {
+        let t = (k as f64 * settings.period).min(settings.duration);
+        reference.sample(t, &mut sample)?;
+        let (q, v) = state.split_at(n);
+        for i in 0..n {
+            let error = sample.a[i] - q[i];
+            if error.abs() > settings.max_joint_error || !error.is_finite() {
+                return Err(SimError::RunawayError {
+                    t,
+                    coordinate: i + 1,
+                    error: error.abs(),
+                    bound: settings.max_joint_error,
+                });
+            }
+            command[i] = sample.a_ddot[i]
+                + settings.kd[i] * (sample.a_dot[i] - v[i])
+                + settings.kp[i] * error;
+        }
+        rnea(model, &mut data, q, v, &command, &mut tau)
+            .map_err(|source| SimError::ChainDynamics { t, source })?;
+        summary.controller_samples += 1;
+        for (peak, effort) in summary.peak_joint_efforts.iter_mut().zip(&tau) {
+            *peak = peak.max(effort.abs());
+        }
+        if k % every == 0 || k == periods {
+            record.t.push(t);
+            record.q.extend_from_slice(q);
+            record.q_ref.extend_from_slice(&sample.a);
+            record.tau.extend_from_slice(&tau);
+            for i in 0..n {
+                let error = (q[i] - sample.a[i]).abs();
+                squares[i] += error * error;
+                summary.joint_error_max[i] = summary.joint_error_max[i].max(error);
+            }
+        }
+        if k == periods {
+            summary.final_error = q
+                .iter()
+                .zip(&sample.a)
+                .map(|(x, r)| (x - r).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            break;
+        }
+        let t1 = ((k + 1) as f64 * settings.period).min(settings.duration);
+        let mut plant = Plant {
+            model,
+            data: &mut data,
+            tau: &tau,
+        };
+        let stats = rk4
+            .integrate(&mut plant, t, t1, &mut state, settings.dt)
+            .map_err(SimError::ChainIntegration)?;
+        summary.steps += stats.accepted;
+    }
+    let samples = record.t.len() as f64;
+    for (rms, square) in summary.joint_error_rms.iter_mut().zip(&squares) {
+        *rms = (square / samples).sqrt();
+    }
+    Ok(ChainRun { summary, record })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reference::{Sinusoid, Step};
+    use manip_dyn::spatial::{SpatialJoint, SpatialLink, Transform};
+
+    /// Seven joints alternating yaw, pitch and roll, 0.15 m apart, under ROS gravity.
+    fn arm() -> SpatialModel {
+        let axes = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]];
+        let joints = (0..7)
+            .map(|i| {
+                let offset = if i == 0 { 0.0 } else { 0.15 };
+                SpatialJoint::revolute(axes[i % 3], Transform::translation([offset, 0.0, 0.0]))
+            })
+            .collect();
+        let links = (0..7)
+            .map(|i| {
+                SpatialLink::cuboid(1.0 - 0.1 * i as f64, [0.15, 0.04, 0.04], [0.075, 0.0, 0.0])
+            })
+            .collect();
+        SpatialModel::new(joints, links, [0.0, 0.0, -9.81]).unwrap()
+    }
+
+    fn settings(n: usize) -> ChainLoopSettings {
+        ChainLoopSettings {
+            duration: 1.0,
+            period: 1e-4,
+            dt: 1e-4,
+            record_period: 1e-4,
+            kp: vec![400.0; n],
+            kd: vec![40.0; n],
+            max_joint_error: 3.0,
+        }
+    }
+
+    #[test]
+    fn a_step_converges_at_the_closed_loop_rate() {
+        let model = arm();
+        let target = [0.3, -0.2, 0.1, 0.4, -0.3, 0.2, 0.1];
+        let mut step = Step::new(&[0.0; 7], &target, 0.0).unwrap();
+        let run = run_chain_loop(&model, &mut step, &[0.0; 7], &settings(7)).unwrap();
+        // e'' + 40 e' + 400 e = 0 from e(0) = target: e(t) = e0 (1 + 20 t) exp(-20 t), 2e-8 of
+        // it at t = 1 s; the zero-order hold of the torque over 0.1 ms adds O(1e-3) relative.
+        let e0 = target.iter().map(|x| x * x).sum::<f64>().sqrt();
+        assert!(
+            run.summary.final_error < 1e-6 * e0,
+            "{}",
+            run.summary.final_error
+        );
+        let at = |t: f64| {
+            let k = (t / 1e-4).round() as usize;
+            (0..7)
+                .map(|i| (run.record.q[7 * k + i] - target[i]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        let exact = |t: f64| e0 * (1.0 + 20.0 * t) * (-20.0 * t).exp();
+        for t in [0.05, 0.1, 0.2] {
+            assert!(
+                (at(t) - exact(t)).abs() < 1e-2 * exact(t),
+                "t = {t}: {} vs {}",
+                at(t),
+                exact(t)
+            );
+        }
+        assert_eq!(run.summary.controller_samples, 10001);
+        assert_eq!(run.summary.steps, 10000);
+        assert_eq!(run.record.t.len(), 10001);
+    }
+
+    #[test]
+    fn a_sine_is_tracked() {
+        let model = arm();
+        let mut sine = Sinusoid::new(&[0.0; 7], &[0.2; 7], &[1.0; 7], &[0.0; 7]).unwrap();
+        let run = run_chain_loop(&model, &mut sine, &[0.0; 7], &settings(7)).unwrap();
+        // Starting at rest on the reference as it moves at v0 = 0.4 pi rad/s: the error
+        // e = -v0 t exp(-20 t) peaks at v0 / (20 e) at t = 50 ms, then only the zero-order hold's
+        // O(period) lag remains.
+        let peak = 0.4 * std::f64::consts::PI / (20.0 * std::f64::consts::E);
+        for e in &run.summary.joint_error_max {
+            assert!((e - peak).abs() < 0.02 * peak, "{:?}", run.summary);
+        }
+        assert!(
+            run.summary.final_error < 3e-3,
+            "{}",
+            run.summary.final_error
+        );
+    }
+
+    #[test]
+    fn bad_settings_are_named() {
+        let model = arm();
+        let mut step = Step::constant(&[0.0; 7]).unwrap();
+        let mut s = settings(7);
+        s.kp.pop();
+        let e = run_chain_loop(&model, &mut step, &[0.0; 7], &s).unwrap_err();
+        assert!(
+            e.to_string().starts_with("controller.kp has 6 entries"),
+            "{e}"
+        );
+        let mut s = settings(7);
+        s.dt = 1e-2;
+        let e = run_chain_loop(&model, &mut step, &[0.0; 7], &s).unwrap_err();
+        assert!(
+            e.to_string().starts_with("integrator.dt must be at most"),
+            "{e}"
+        );
+        let mut short = Step::constant(&[0.0; 3]).unwrap();
+        let e = run_chain_loop(&model, &mut short, &[0.0; 7], &settings(7)).unwrap_err();
+        assert!(e.to_string().contains("one per joint"), "{e}");
+        let mut s = settings(7);
+        s.duration = 1e12;
+        let e = run_chain_loop(&model, &mut step, &[0.0; 7], &s).unwrap_err();
+        assert!(e.to_string().contains("past the loop's limits"), "{e}");
+    }
+}

@@ -1,0 +1,226 @@
+//! Scenarios on a URDF arm (`[arm] urdf = "FILE.urdf"`): the full spatial chain in the
+//! joint-space loop of [`sim_core::run_chain_loop`], computed torque tracking a joint-space
+//! reference.
+
+use super::controllers::ControllerKind;
+use super::schema::{ArmSpec, IntegratorSpec, NoiseSpec, ReferenceSpec, Scenario};
+use manip_dyn::spatial::SpatialModel;
+use sim_core::{ChainLoopSettings, ChainRun, SimError, run_chain_loop};
+
+/// The refusal of a scenario key a URDF arm does not use.
+fn unused(name: &str, why: &str) -> SimError {
+    SimError::setting(
+        name,
+        format!("is not used with a URDF arm ([arm] urdf): {why}"),
+    )
+}
+
+impl Scenario {
+    /// The dynamics model of the scenario's URDF arm (`arm.urdf`, a regular file of at most
+    /// [`robot_desc::MAX_URDF_BYTES`]) under gravity `(0, 0, -arm.gravity)` (ROS's convention,
+    /// 9.81 m/s^2 by default), or `None` for a planar arm.
+    ///
+    /// # Errors
+    /// [`SimError::InvalidSetting`] naming `arm.urdf` for a file that cannot be read or is not
+    /// a URDF serial chain with at least one movable joint, and naming a planar arm key given
+    /// with it.
+    pub fn urdf_model(&self) -> Result<Option<SpatialModel>, SimError> {
+        let ArmSpec {
+            urdf: Some(path),
+            links,
+            link_length,
+            link_mass,
+            gravity,
+            lengths,
+            masses,
+            inertias,
+        } = &self.arm
+        else {
+            return Ok(None);
+        };
+        let planar = [
+            ("arm.links", links.is_some()),
+            ("arm.link_length", link_length.is_some()),
+            ("arm.link_mass", link_mass.is_some()),
+            ("arm.lengths", lengths.is_some()),
+            ("arm.masses", masses.is_some()),
+            ("arm.inertias", inertias.is_some()),
+        ];
+        if let Some((name, _)) = planar.iter().find(|(_, given)| *given) {
+            return Err(unused(name, "the URDF describes the links"));
+        }
+        let invalid = |what: String| SimError::setting("arm.urdf", what);
+        let text = crate::read_text_file(path, robot_desc::MAX_URDF_BYTES as u64)
+            .map_err(|e| invalid(format!("cannot be read from {}: {e}", path.display())))?;
+        let robot = robot_desc::read_urdf(&text)
+            .map_err(|e| invalid(format!("({}): {e}", path.display())))?
+            .robot;
+        if robot.n_joints() == 0 {
+            return Err(invalid(format!(
+                "({}) has no movable joint (revolute, continuous or prismatic)",
+                path.display()
+            )));
+        }
+        let g = gravity.unwrap_or(9.81);
+        robot_desc::to_spatial(&robot, [0.0, 0.0, -g])
+            .map(Some)
+            .map_err(|e| invalid(format!("({}): {e}", path.display())))
+    }
+
+    /// Runs the scenario on its URDF arm: computed torque (`controller.kp`, `controller.kd`, one
+    /// entry per joint, defaults 2500 and 100) every `controller.period` (default the RK4 step)
+    /// tracking the reference in joint coordinates (`constant`, `step` or `sinusoid`, one entry
+    /// per movable joint in chain order), from rest at `initial.a` (default the reference at
+    /// `t = 0`), the plant integrated by RK4 with the ABA; `limits.max_modal_error` bounds each
+    /// joint's error. `alpha0` and `modal` are not used.
+    ///
+    /// # Errors
+    /// As [`urdf_model`](Self::urdf_model) (and [`SimError::InvalidSetting`] naming `arm.urdf`
+    /// for a planar arm); [`SimError::InvalidSetting`] naming the key for a controller other
+    /// than computed torque, the dopri5 integrator, a path reference, noise, torque limits or
+    /// arrays of the wrong length; the run's errors ([`run_chain_loop`]).
+    pub fn run_chain(&self) -> Result<ChainRun, SimError> {
+        let model = self.urdf_model()?.ok_or_else(|| {
+            SimError::setting("arm.urdf", "is required to run a scenario in joint space")
+        })?;
+        let n = model.n_links();
+        if self.controller.kind != ControllerKind::ComputedTorque {
+            return Err(SimError::setting(
+                "controller.kind",
+                format!(
+                    "must be \"computed-torque\" with a URDF arm ([arm] urdf: computed torque on \
+                     the full chain in joint space is the only controller), got \"{}\"",
+                    self.controller.kind
+                ),
+            ));
+        }
+        let IntegratorSpec::Rk4 { dt } = self.integrator else {
+            return Err(unused(
+                "integrator.method = \"dopri5\"",
+                "the joint-space loop integrates by RK4",
+            ));
+        };
+        if matches!(self.reference, ReferenceSpec::Path { .. }) {
+            return Err(unused(
+                "reference.kind = \"path\"",
+                "a joint-space reference is constant, step or sinusoid",
+            ));
+        }
+        if self.noise != NoiseSpec::default() {
+            return Err(unused("noise", "the joint-space loop is noise-free"));
+        }
+        if self.limits.joint_torque_nm.is_some() || self.limits.tau_star.is_some() {
+            return Err(unused(
+                "limits.joint_torque_nm and limits.tau_star",
+                "only limits.max_modal_error bounds the joint errors",
+            ));
+        }
+        let mut reference = self
+            .reference
+            .build(0.0, self.modal.harmonics, self.alpha0, n)?()?;
+        let q0 = match &self.initial {
+            Some(initial) => {
+                if initial.a_dot.is_some() {
+                    return Err(unused("initial.a_dot", "the chain starts at rest"));
+                }
+                initial.a.clone()
+            }
+            None => {
+                let mut sample = sim_core::reference::ReferenceSample::zeros(n);
+                reference.sample(0.0, &mut sample)?;
+                sample.a
+            }
+        };
+        let (kp, kd) = self.controller.computed_torque_gains(n)?;
+        let period = self.controller.period.unwrap_or(dt);
+        let settings = ChainLoopSettings {
+            duration: self.duration,
+            period,
+            dt,
+            record_period: self.record_period.unwrap_or(period),
+            kp,
+            kd,
+            max_joint_error: self.limits.max_modal_error,
+        };
+        run_chain_loop(&model, reference.as_mut(), &q0, &settings)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::{Path, PathBuf};
+
+    fn example(name: &str) -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../examples/urdf-arm")
+            .join(name)
+    }
+
+    #[test]
+    fn the_example_step_converges_in_joint_space() {
+        let scenario = Scenario::load(&example("step.toml")).unwrap();
+        assert_eq!(scenario.arm.urdf, Some(example("arm7.urdf")));
+        let run = scenario.run_chain().unwrap();
+        let summary = &run.summary;
+        // e'' + 40 e' + 400 e = 0 after the step at 0.1 s: (1 + 20 t) exp(-20 t) of the step's
+        // 1.1 rad norm after 0.9 s is 2e-7 rad; the zero-order hold leaves O(1e-4) of it.
+        assert!(summary.final_error < 1e-5, "{summary:?}");
+        let step = [0.5, 0.4, 0.3, 0.6, 0.2, 0.5, 0.4];
+        for (max, jump) in summary.joint_error_max.iter().zip(step) {
+            assert!((max - jump).abs() < 1e-9, "{max} vs {jump}");
+        }
+        assert!(
+            summary
+                .joint_error_rms
+                .iter()
+                .all(|e| e.is_finite() && *e > 0.0)
+        );
+        let sine = Scenario::load(&example("sine.toml"))
+            .unwrap()
+            .run_chain()
+            .unwrap();
+        assert!(sine.summary.final_error < 5e-3, "{:?}", sine.summary);
+    }
+
+    #[test]
+    fn a_urdf_arm_refuses_what_it_does_not_use() {
+        let mut scenario = Scenario::load(&example("step.toml")).unwrap();
+        let message = |s: &Scenario| s.run_chain().unwrap_err().to_string();
+        scenario.controller.kind = ControllerKind::Fuzzy;
+        assert!(message(&scenario).starts_with("controller.kind must be \"computed-torque\""));
+        assert!(
+            scenario
+                .build()
+                .err()
+                .unwrap()
+                .to_string()
+                .starts_with("arm.urdf names a spatial")
+        );
+        scenario.controller.kind = ControllerKind::ComputedTorque;
+        scenario.arm.links = Some(3);
+        assert!(message(&scenario).starts_with("arm.links is not used with a URDF arm"));
+        scenario.arm.links = None;
+        scenario.controller.kp = Some(vec![1.0; 6]);
+        assert!(
+            message(&scenario).starts_with("controller.kp has 6 entries"),
+            "{}",
+            message(&scenario)
+        );
+        scenario.controller.kp = None;
+        scenario.arm.urdf = Some(example("missing.urdf"));
+        assert!(message(&scenario).starts_with("arm.urdf cannot be read from"));
+        scenario.arm.urdf = Some(example("step.toml"));
+        assert!(
+            message(&scenario).starts_with("arm.urdf ("),
+            "{}",
+            message(&scenario)
+        );
+        scenario.arm.urdf = Some(example(""));
+        assert!(
+            message(&scenario).contains("directory"),
+            "{}",
+            message(&scenario)
+        );
+    }
+}
