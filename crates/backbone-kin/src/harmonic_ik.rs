@@ -200,7 +200,7 @@ impl HarmonicIk {
     /// overwritten): first from the closed form of eqs 5-6 on `branch` (higher harmonics zero),
     /// then, if the closed form has no answer (a target the `K = 1` family does not reach,
     /// `|a2| > A`) or the iteration does not converge from it, from the closed form on the
-    /// other branch and from [`FALLBACK_STARTS`] in turn. A solution found from the closed form
+    /// other branch and from `FALLBACK_STARTS` in turn. A solution found from the closed form
     /// is the one [`solve`](Self::solve) finds from it; otherwise the first start that converges
     /// gives the answer, so the result is deterministic.
     ///

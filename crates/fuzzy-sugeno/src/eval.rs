@@ -61,7 +61,7 @@ impl Evaluator {
         }
     }
 
-    /// An evaluator with the given options; fails if [`NoRuleFired::Values`] does not hold one
+    /// An evaluator with the given options; fails if [`NoRuleFired::Values`](crate::NoRuleFired::Values) does not hold one
     /// finite value per output.
     pub fn with_options(system: FuzzySystem, options: EvalOptions) -> Result<Self, FuzzyError> {
         options.check(system.outputs().len())?;

@@ -15,7 +15,7 @@ pub enum OutOfRange {
     Clamp,
     /// Evaluate the membership functions at the value as given (the default): what MATLAB's
     /// `evalfis` and Simulink's Fuzzy Logic Controller block do, with a warning.
-    /// [`Evaluator::first_outside_range`] tells the caller when this happened, so that it can
+    /// [`Evaluator::first_outside_range`](crate::Evaluator::first_outside_range) tells the caller when this happened, so that it can
     /// warn as MATLAB does.
     #[default]
     AsGiven,
@@ -37,7 +37,7 @@ pub enum NoRuleFired {
     Error,
 }
 
-/// The evaluation policies of an [`Evaluator`].
+/// The evaluation policies of an [`Evaluator`](crate::Evaluator).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct EvalOptions {
     /// Inputs outside their range.

@@ -180,7 +180,7 @@ pub fn run_view_of(
 ) -> Result<Option<run_view::RunView>, String> {
     let (run, stopped) = match &outcome.result {
         Ok(run) => (Some(run), None),
-        Err(stopped) => (stopped.partial.as_ref(), Some(stopped.error.to_string())),
+        Err(stopped) => (stopped.partial.as_deref(), Some(stopped.error.to_string())),
     };
     match run {
         Some(run) if !run.record.is_empty() => {
@@ -377,7 +377,7 @@ fn write_outcome(outcome: &ComparisonRun, scenario: &Scenario, dir: &Path) -> Re
     let summary = sim_study::summary_json::run(&outcome.result);
     let run = match &outcome.result {
         Ok(run) => Some(run),
-        Err(stopped) => stopped.partial.as_ref(),
+        Err(stopped) => stopped.partial.as_deref(),
     };
     write(&dir.join("summary.json"), &pretty(&summary)?)?;
     if let Some(run) = run {

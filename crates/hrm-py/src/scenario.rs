@@ -783,7 +783,7 @@ impl Scenario {
                 )
             }
         };
-        let result = result.map_err(Box::<Stopped>::from);
+        let result = result.map_err(Stopped::from);
         Run::new(py, &scenario, label, result)
     }
 }
@@ -847,10 +847,14 @@ impl Run {
         let summary = sim_study::summary_json::run(&result).to_string();
         let (run, failure) = match result {
             Ok(run) => (run, None),
-            Err(stopped) => match stopped.partial {
-                Some(run) => (run, Some(stopped.error.to_string())),
-                None => return Err(Error::from(stopped.error).into()),
-            },
+            Err(Stopped {
+                error,
+                partial: Some(run),
+            }) => (*run, Some(error.to_string())),
+            Err(Stopped {
+                error,
+                partial: None,
+            }) => return Err(Error::from(error).into()),
         };
         let view = run_view::Scene {
             title: format!("{} with {controller}", scenario.name),

@@ -7,7 +7,7 @@
 //! - [`sweep`]: a whole sweep (`hrm sweep`, `hrm sweep merge`): `{"config": ..., "cells": [...]}`
 //!   (`docs/sweep.md`).
 
-use crate::study::{Cell, RunOutcome, SweepConfig};
+use crate::study::{Cell, RunOutcome, Stopped, SweepConfig};
 use serde_json::{Value, json};
 
 /// The `summary.json` of one run: its [`Summary`](sim_core::Summary)'s fields; for a run that
@@ -30,17 +30,19 @@ use serde_json::{Value, json};
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn run(result: &RunOutcome) -> Value {
-    let stopped = match result {
-        Ok(run) => return json!(run.summary),
-        Err(stopped) => stopped,
-    };
-    let error = stopped.error.to_string();
-    match &stopped.partial {
-        None => json!({ "error": error }),
-        Some(run) => {
+    match result {
+        Ok(run) => json!(run.summary),
+        Err(Stopped {
+            error,
+            partial: None,
+        }) => json!({ "error": error.to_string() }),
+        Err(Stopped {
+            error,
+            partial: Some(run),
+        }) => {
             let mut summary = json!(run.summary);
             if let Some(fields) = summary.as_object_mut() {
-                fields.insert("error".into(), json!(error));
+                fields.insert("error".into(), json!(error.to_string()));
                 fields.insert("stopped_at_s".into(), json!(run.summary.simulated_s));
             }
             summary

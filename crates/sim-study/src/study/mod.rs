@@ -83,7 +83,7 @@ fn run_alone(config: &SweepConfig, prepared: &Prepared, id: &RunId) -> StoredOut
         .and_then(|noise| prepared.simulation(&noise))
     {
         Err(e) => StoredOutcome::of(Err(Stopped::not_built(e))),
-        Ok(mut simulation) => StoredOutcome::of(simulation.run().map_err(Into::into)),
+        Ok(mut simulation) => StoredOutcome::of(simulation.run().map_err(Stopped::from)),
     }
 }
 
@@ -123,7 +123,7 @@ fn execute_prepared(
         Ok(mut group) => ids
             .iter()
             .zip(group.run())
-            .map(|(id, run)| RunResult::new(id, StoredOutcome::of(run.map_err(Into::into))))
+            .map(|(id, run)| RunResult::new(id, StoredOutcome::of(run.map_err(Stopped::from))))
             .collect(),
         // A run that cannot be built fails alone.
         Err(_) => ids

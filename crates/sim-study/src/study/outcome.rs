@@ -7,10 +7,9 @@ use lane_math::{Classify, ErrorClass};
 use sim_core::{Run, RunFailure, SimError};
 
 /// How a run ended: the [`Run`] (record and summary) if it ran to the end, or [`Stopped`]: why it
-/// did not, with what it recorded until then (boxed, as [`RunFailure`] is, to keep the `Ok` path
-/// small). A sweep keeps of it the metrics
+/// did not, with what it recorded until then. A sweep keeps of it the metrics
 /// ([`StoredOutcome::of`](super::StoredOutcome::of)).
-pub type RunOutcome = Result<Run, Box<Stopped>>;
+pub type RunOutcome = Result<Run, Stopped>;
 
 /// Why a run of a study did not complete.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -45,16 +44,16 @@ pub struct Stopped {
     pub error: RunError,
     /// The record and the summary up to the stop (what [`RunFailure`] keeps); `None` if the
     /// scenario could not be built.
-    pub partial: Option<Run>,
+    pub partial: Option<Box<Run>>,
 }
 
 impl Stopped {
     /// A run that could not be built: `error`, and nothing recorded.
-    pub fn not_built(error: impl Into<RunError>) -> Box<Self> {
-        Box::new(Self {
+    pub fn not_built(error: impl Into<RunError>) -> Self {
+        Self {
             error: error.into(),
             partial: None,
-        })
+        }
     }
 
     /// Simulated time reached (s): the partial run's, 0 for a run that was not built.
@@ -65,17 +64,17 @@ impl Stopped {
     }
 }
 
-impl From<Box<RunFailure>> for Box<Stopped> {
+impl From<Box<RunFailure>> for Stopped {
     fn from(failure: Box<RunFailure>) -> Self {
         let RunFailure {
             error,
             record,
             summary,
         } = *failure;
-        Box::new(Stopped {
+        Self {
             error: error.into(),
-            partial: Some(Run { record, summary }),
-        })
+            partial: Some(Box::new(Run { record, summary })),
+        }
     }
 }
 

@@ -106,10 +106,10 @@ impl StoredOutcome {
                 Ok(metrics) => return StoredOutcome::Completed(metrics),
                 Err(error) => Stopped {
                     error,
-                    partial: Some(run),
+                    partial: Some(Box::new(run)),
                 },
             },
-            Err(stopped) => *stopped,
+            Err(stopped) => stopped,
         };
         StoredOutcome::Failed {
             error: stopped.error.to_string(),
