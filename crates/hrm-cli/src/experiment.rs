@@ -187,7 +187,9 @@ pub fn run_view_of(
     };
     match run {
         Some(run) if !run.record.is_empty() => {
-            run_view::from_record(scenario, label, &run.record, stopped.as_deref()).map(Some)
+            run_view::from_record(scenario, label, &run.record, stopped.as_deref())
+                .map(Some)
+                .map_err(|e| e.to_string())
         }
         _ => Ok(None),
     }

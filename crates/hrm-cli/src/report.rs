@@ -108,7 +108,7 @@ fn html(
         );
         table_html(&mut s, &group.table, group.names);
         if let Some(scene) = &group.scene {
-            s.push_str(&run_view::scene_html(scene, samples)?);
+            s.push_str(&run_view::scene_html(scene, samples).map_err(|e| e.to_string())?);
         }
     }
     for section in sections {

@@ -50,7 +50,7 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
         speed: args.speed,
     };
     if args.gif.is_some() {
-        options.check()?;
+        options.check().map_err(|e| e.to_string())?;
     }
     let dir = &args.dir;
     if !dir.is_dir() {
@@ -100,13 +100,14 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
         } else {
             run_view::PAGE_SAMPLES
         },
-    )?;
+    )
+    .map_err(|e| e.to_string())?;
     refuse_foreign(&out)?;
     let mut files = vec![(out.clone(), page.into_bytes())];
     if let Some(gif) = &args.gif {
         refuse_foreign(gif)?;
         let mut bytes = Vec::new();
-        run_view::write_gif(&gif_run, &options, &mut bytes)?;
+        run_view::write_gif(&gif_run, &options, &mut bytes).map_err(|e| e.to_string())?;
         files.push((gif.clone(), bytes));
     }
     // The page and the GIF: both or neither.

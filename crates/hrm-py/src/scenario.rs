@@ -901,7 +901,7 @@ pub fn view_html(scene: &str) -> PyResult<String> {
         std::slice::from_ref(&scene),
         run_view::PAGE_SAMPLES,
     )
-    .map_err(|e| Error::input(e).into())
+    .map_err(|e| Error::input(e.to_string()).into())
 }
 
 /// The result of Scenario.run: the time series at the recording period (one row per recorded
@@ -958,7 +958,7 @@ impl Run {
             caption: scenario.description.clone(),
             runs: vec![
                 run_view::from_record(scenario, controller, &run.record, failure.as_deref())
-                    .map_err(Error::input)?,
+                    .map_err(|e| Error::input(e.to_string()))?,
             ],
         };
         let r = run.record;
@@ -1161,7 +1161,7 @@ impl Run {
             std::slice::from_ref(&self.view),
             run_view::PAGE_SAMPLES,
         )
-        .map_err(|e| Error::input(e).into())
+        .map_err(|e| Error::input(e.to_string()).into())
     }
 
     /// The page of `view_html` in an iframe: what Jupyter shows for a Run.

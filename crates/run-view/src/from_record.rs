@@ -2,6 +2,7 @@
 //! modal coordinates through the scenario's modal map (eq 8) and the chain's forward kinematics,
 //! and the series a reader checks first.
 
+use crate::error::ViewError;
 use crate::view::{RunView, Series};
 use sim_core::Record;
 use sim_study::{Scenario, TorqueLimit};
@@ -16,26 +17,24 @@ pub fn from_record(
     label: &str,
     record: &Record,
     stopped: Option<&str>,
-) -> Result<RunView, String> {
-    let model = scenario.model().map_err(|e| e.to_string())?;
+) -> Result<RunView, ViewError> {
+    let model = scenario.model()?;
     let lengths: Vec<f64> = model.chain().link_lengths().collect();
     let n = lengths.len();
     let (m, samples) = (record.n_coords, record.len());
     if record.n_joints != n || record.a.len() != samples * m || record.tip.len() != samples {
-        return Err(format!(
-            "the record does not match scenario {}: {} joints, {} samples",
-            scenario.name, record.n_joints, samples
-        ));
+        return Err(ViewError::RecordMismatch {
+            scenario: scenario.name.clone(),
+            joints: record.n_joints,
+            samples,
+        });
     }
     let mut theta = vec![0.0; n];
     let mut points = vec![[0.0; 2]; n + 1];
     let mut joints = Vec::with_capacity(samples);
     for k in 0..samples {
-        model
-            .map()
-            .joint_angles(record.a_at(k), &mut theta)
-            .map_err(|e| e.to_string())?;
-        backbone_kin::joint_positions(&lengths, &theta, &mut points).map_err(|e| e.to_string())?;
+        model.map().joint_angles(record.a_at(k), &mut theta)?;
+        backbone_kin::joint_positions(&lengths, &theta, &mut points)?;
         joints.push(points.iter().flatten().copied().collect());
     }
     let names = scenario.coordinate_names();

@@ -2,7 +2,8 @@
 //! coloured by joint torque, the reference path, the tip's trace, obstacles and channels, and a
 //! progress bar (the picture of the page's viewer at its opening view, without text).
 
-use crate::view::{Obstacle, RunView};
+use crate::error::ViewError;
+use crate::view::{Obstacle, RunView, count, positive};
 use std::io::Write;
 use tiny_skia::{
     Color, FillRule, LineCap, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash, Transform,
@@ -40,23 +41,16 @@ impl Default for GifOptions {
 impl GifOptions {
     /// Checks the sizes (1 to [`MAX_SIDE`] pixels), the rate (1 to 50 frames a second: GIF
     /// delays are hundredths of a second) and the speed (finite, positive).
-    pub fn check(&self) -> Result<(), String> {
-        for (what, side) in [("width", self.width), ("height", self.height)] {
+    pub fn check(&self) -> Result<(), ViewError> {
+        for (what, side) in [("gif width", self.width), ("gif height", self.height)] {
             if side == 0 || side > MAX_SIDE {
-                return Err(format!(
-                    "gif {what}: {side} pixels, expected 1 to {MAX_SIDE}"
-                ));
+                return Err(count(what, side as usize, "pixels", 1, MAX_SIDE as usize));
             }
         }
         if !(1..=50).contains(&self.fps) {
-            return Err(format!("gif fps: {}, expected 1 to 50", self.fps));
+            return Err(count("gif fps", self.fps as usize, "", 1, 50));
         }
-        if !(self.speed.is_finite() && self.speed > 0.0) {
-            return Err(format!(
-                "gif speed: {}, expected a finite positive number",
-                self.speed
-            ));
-        }
+        positive("gif speed", &[self.speed])?;
         Ok(())
     }
 }
@@ -433,30 +427,26 @@ fn index(rgba: &[u8]) -> u8 {
 /// run a second, from its first sample to its last, looping. The run and the options are
 /// checked first; at most [`MAX_FRAMES`] frames (an error names the duration, rate and speed
 /// that need more).
-pub fn write_gif(run: &RunView, options: &GifOptions, out: impl Write) -> Result<(), String> {
+pub fn write_gif(run: &RunView, options: &GifOptions, out: impl Write) -> Result<(), ViewError> {
     run.check()?;
     options.check()?;
     let (t0, t1) = (run.t[0], run.t[run.len() - 1]);
     let frames = ((t1 - t0) / options.speed * f64::from(options.fps)).ceil() as usize + 1;
     if frames > MAX_FRAMES {
-        return Err(format!(
-            "gif: {:.3} s of run at {} frames a second and speed {} make {frames} frames, more than {MAX_FRAMES}; raise the speed or lower the rate",
-            t1 - t0,
-            options.fps,
-            options.speed
-        ));
+        return Err(ViewError::TooManyFrames {
+            seconds: t1 - t0,
+            fps: options.fps,
+            speed: options.speed,
+            frames,
+            max: MAX_FRAMES,
+        });
     }
     let (w, h) = (options.width, options.height);
-    let mut pixmap = Pixmap::new(w, h).ok_or("gif: cannot allocate the picture")?;
+    let mut pixmap = Pixmap::new(w, h).ok_or(ViewError::Picture)?;
     let camera = Camera::fit(&world_points(run), run.dims, f64::from(w), f64::from(h));
-    let mut encoder =
-        gif::Encoder::new(out, w as u16, h as u16, &palette()).map_err(|e| format!("gif: {e}"))?;
-    encoder
-        .set_repeat(gif::Repeat::Infinite)
-        .map_err(|e| format!("gif: {e}"))?;
-    encoder
-        .write_raw_extension(gif::AnyExtension(0xFE), &[crate::SIGNATURE.as_bytes()])
-        .map_err(|e| format!("gif: {e}"))?;
+    let mut encoder = gif::Encoder::new(out, w as u16, h as u16, &palette())?;
+    encoder.set_repeat(gif::Repeat::Infinite)?;
+    encoder.write_raw_extension(gif::AnyExtension(0xFE), &[crate::SIGNATURE.as_bytes()])?;
     let delay = (100 / options.fps) as u16;
     let mut previous: Option<Vec<u8>> = None;
     for f in 0..frames {
@@ -473,9 +463,7 @@ pub fn write_gif(run: &RunView, options: &GifOptions, out: impl Write) -> Result
             },
             Some(before) => changed_part(before, &current, w as usize, h as usize, delay),
         };
-        encoder
-            .write_frame(&frame)
-            .map_err(|e| format!("gif: {e}"))?;
+        encoder.write_frame(&frame)?;
         previous = Some(current);
     }
     Ok(())

@@ -1,12 +1,14 @@
 #![doc = include_str!("../README.md")]
 
 mod decimate;
+mod error;
 mod from_record;
 mod gif;
 mod page;
 mod view;
 
 pub use decimate::{round_decimal, strided};
+pub use error::{FieldProblem, ViewError};
 pub use from_record::from_record;
 pub use gif::{Camera, GifOptions, MAX_FRAMES, MAX_SIDE, draw_frame, torque_colour, write_gif};
 pub use page::{

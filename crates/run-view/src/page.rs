@@ -1,6 +1,7 @@
 //! The page: scenes as HTML with their data, the viewer's script and style sheet inline, so
 //! that a page opens from `file://` with no network (no CDN, no fonts from elsewhere).
 
+use crate::error::ViewError;
 use crate::view::Scene;
 
 /// The viewer's script (`assets/viewer.js`, one readable file with its own tests).
@@ -38,13 +39,13 @@ pub fn escape(text: &str) -> String {
 /// One scene as an HTML block: its heading, caption and an element the script turns into the
 /// viewer, holding the scene's runs decimated to `samples` samples as JSON. The scene is
 /// checked first ([`Scene::check`]).
-pub fn scene_html(scene: &Scene, samples: usize) -> Result<String, String> {
+pub fn scene_html(scene: &Scene, samples: usize) -> Result<String, ViewError> {
     scene.check()?;
     let decimated = Scene {
         runs: scene.runs.iter().map(|r| r.decimated(samples)).collect(),
         ..scene.clone()
     };
-    let json = serde_json::to_string(&decimated).map_err(|e| e.to_string())?;
+    let json = serde_json::to_string(&decimated)?;
     // `<` only occurs inside JSON strings, where `\u003c` means the same: no `</script>` or
     // `<!--` can end the data block early.
     let json = json.replace('<', "\\u003c");
@@ -83,7 +84,12 @@ pub fn tail() -> String {
 }
 
 /// A whole page: `title`, an `intro` paragraph, and every scene with its viewer.
-pub fn page(title: &str, intro: &str, scenes: &[Scene], samples: usize) -> Result<String, String> {
+pub fn page(
+    title: &str,
+    intro: &str,
+    scenes: &[Scene],
+    samples: usize,
+) -> Result<String, ViewError> {
     let mut body = String::new();
     for scene in scenes {
         body.push_str(&scene_html(scene, samples)?);

@@ -5,6 +5,7 @@
 //! coordinates (a planar arm, in its plane) or 3 (a spatial arm); obstacles, channels, joint
 //! torques with their limits and extra series (such as clearance) are optional.
 
+use crate::error::{FieldProblem, ViewError};
 use serde::{Deserialize, Serialize};
 
 /// The most samples a run may hold (the page's data is decimated well below this).
@@ -128,17 +129,20 @@ pub struct Scene {
 
 impl Scene {
     /// Checks every run ([`RunView::check`]); the error names the run and the field.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> Result<(), ViewError> {
         if self.runs.is_empty() || self.runs.len() > MAX_RUNS {
-            return Err(format!(
-                "scene {:?}: runs: {} runs, expected 1 to {MAX_RUNS}",
-                self.title,
-                self.runs.len()
-            ));
+            return Err(ViewError::RunCount {
+                title: self.title.clone(),
+                count: self.runs.len(),
+                max: MAX_RUNS,
+            });
         }
         for run in &self.runs {
-            run.check()
-                .map_err(|e| format!("scene {:?}, run {:?}: {e}", self.title, run.label))?;
+            run.check().map_err(|e| ViewError::Run {
+                title: self.title.clone(),
+                label: run.label.clone(),
+                source: Box::new(e),
+            })?;
         }
         Ok(())
     }
@@ -166,23 +170,31 @@ impl RunView {
     /// times, one row of the right length a sample in every per-sample field, finite
     /// coordinates, positive finite radii, widths and limits, and the sizes within
     /// [`MAX_SAMPLES`], [`MAX_POINTS`] and [`MAX_ITEMS`]. The error names the field.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> Result<(), ViewError> {
         let d = self.dims;
         if d != 2 && d != 3 {
-            return Err(format!("dims: {d}, expected 2 (planar) or 3 (spatial)"));
+            return Err(ViewError::field("dims", FieldProblem::Dims { found: d }));
         }
         let n = self.len();
         if n == 0 || n > MAX_SAMPLES {
-            return Err(format!("t: {n} samples, expected 1 to {MAX_SAMPLES}"));
+            return Err(count("t", n, "samples", 1, MAX_SAMPLES));
         }
         finite("t", &self.t)?;
         if let Some(k) = self.t.windows(2).position(|w| w[1] <= w[0]) {
-            return Err(format!("t: not increasing at sample {}", k + 1));
+            return Err(ViewError::field(
+                "t",
+                FieldProblem::NotIncreasing { sample: k + 1 },
+            ));
         }
         let width = self.joints.first().map_or(0, Vec::len);
         if width < 2 * d || !width.is_multiple_of(d) || width / d > MAX_POINTS {
-            return Err(format!(
-                "joints: {width} numbers a sample, expected {d} a point for 2 to {MAX_POINTS} points"
+            return Err(ViewError::field(
+                "joints",
+                FieldProblem::PointsWidth {
+                    found: width,
+                    dims: d,
+                    max_points: MAX_POINTS,
+                },
             ));
         }
         rows("joints", &self.joints, n, width)?;
@@ -195,9 +207,12 @@ impl RunView {
         }
         if !self.torque_limit.is_empty() {
             if self.torque_limit.len() != links {
-                return Err(format!(
-                    "torque_limit: {} limits, expected one a joint ({links})",
-                    self.torque_limit.len()
+                return Err(ViewError::field(
+                    "torque_limit",
+                    FieldProblem::Limits {
+                        found: self.torque_limit.len(),
+                        joints: links,
+                    },
                 ));
             }
             positive("torque_limit", &self.torque_limit)?;
@@ -208,23 +223,36 @@ impl RunView {
             ("channels", self.channels.len()),
         ] {
             if count > MAX_ITEMS {
-                return Err(format!("{what}: {count}, more than {MAX_ITEMS}"));
+                return Err(ViewError::field(
+                    what,
+                    FieldProblem::TooMany {
+                        found: count,
+                        max: MAX_ITEMS,
+                    },
+                ));
             }
         }
         for (i, s) in self.series.iter().enumerate() {
             let field = format!("series[{i}] ({:?})", s.title);
             if s.names.len() != s.values.len() || s.names.is_empty() || s.names.len() > MAX_ITEMS {
-                return Err(format!(
-                    "{field}: {} names for {} curves, expected one name a curve (1 to {MAX_ITEMS})",
-                    s.names.len(),
-                    s.values.len()
+                return Err(ViewError::field(
+                    field,
+                    FieldProblem::SeriesNames {
+                        names: s.names.len(),
+                        curves: s.values.len(),
+                        max: MAX_ITEMS,
+                    },
                 ));
             }
             for (curve, values) in s.values.iter().enumerate() {
                 if values.len() != n {
-                    return Err(format!(
-                        "{field}.values[{curve}]: {} values, expected one a sample ({n})",
-                        values.len()
+                    return Err(ViewError::field(
+                        format!("{field}.values[{curve}]"),
+                        FieldProblem::PerSample {
+                            what: "values",
+                            found: values.len(),
+                            samples: n,
+                        },
                     ));
                 }
                 finite(&field, values)?;
@@ -236,9 +264,7 @@ impl RunView {
                 Obstacle::Circle { centre, radius } if d == 2 => (vec![centre], vec![*radius]),
                 Obstacle::Sphere { centre, radius } if d == 3 => (vec![centre], vec![*radius]),
                 Obstacle::Circle { .. } | Obstacle::Sphere { .. } => {
-                    return Err(format!(
-                        "{field}: a circle is planar and a sphere spatial; this run has dims {d}"
-                    ));
+                    return Err(ViewError::field(field, FieldProblem::Shape { dims: d }));
                 }
                 Obstacle::Capsule { a, b, radius } => (vec![a, b], vec![*radius]),
                 Obstacle::Box { centre, half } => (vec![centre], half.clone()),
@@ -246,9 +272,12 @@ impl RunView {
             if let Obstacle::Box { half, .. } = o
                 && half.len() != d
             {
-                return Err(format!(
-                    "{field}.half: {} numbers, expected {d}",
-                    half.len()
+                return Err(ViewError::field(
+                    format!("{field}.half"),
+                    FieldProblem::Numbers {
+                        found: half.len(),
+                        expected: d,
+                    },
                 ));
             }
             for p in points {
@@ -259,9 +288,12 @@ impl RunView {
         for (i, c) in self.channels.iter().enumerate() {
             let field = format!("channels[{i}]");
             if c.points.len() < 2 || c.points.len() > MAX_SAMPLES {
-                return Err(format!(
-                    "{field}.points: {} points, expected 2 to {MAX_SAMPLES}",
-                    c.points.len()
+                return Err(count(
+                    format!("{field}.points"),
+                    c.points.len(),
+                    "points",
+                    2,
+                    MAX_SAMPLES,
                 ));
             }
             for p in &c.points {
@@ -273,46 +305,81 @@ impl RunView {
     }
 }
 
+/// A count outside `min..=max`.
+pub(crate) fn count(
+    field: impl Into<String>,
+    found: usize,
+    unit: &'static str,
+    min: usize,
+    max: usize,
+) -> ViewError {
+    ViewError::field(
+        field,
+        FieldProblem::Count {
+            found,
+            unit,
+            min,
+            max,
+        },
+    )
+}
+
 /// Every value of `values` finite.
-fn finite(field: &str, values: &[f64]) -> Result<(), String> {
+fn finite(field: &str, values: &[f64]) -> Result<(), ViewError> {
     match values.iter().position(|v| !v.is_finite()) {
-        Some(k) => Err(format!("{field}: value {k} is {}, not finite", values[k])),
+        Some(index) => Err(ViewError::field(
+            field,
+            FieldProblem::NotFinite {
+                index,
+                value: values[index],
+            },
+        )),
         None => Ok(()),
     }
 }
 
 /// Every value of `values` finite and positive.
-fn positive(field: &str, values: &[f64]) -> Result<(), String> {
+pub(crate) fn positive(field: &str, values: &[f64]) -> Result<(), ViewError> {
     match values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
-        Some(v) => Err(format!("{field}: {v}, expected a finite positive number")),
+        Some(&value) => Err(ViewError::field(field, FieldProblem::NotPositive { value })),
         None => Ok(()),
     }
 }
 
 /// A point of `d` finite coordinates.
-fn point(field: &str, p: &[f64], d: usize) -> Result<(), String> {
+fn point(field: &str, p: &[f64], d: usize) -> Result<(), ViewError> {
     if p.len() != d {
-        return Err(format!(
-            "{field}: a point of {} coordinates, expected {d}",
-            p.len()
+        return Err(ViewError::field(
+            field,
+            FieldProblem::Point {
+                found: p.len(),
+                dims: d,
+            },
         ));
     }
     finite(field, p)
 }
 
 /// `n` rows of `width` finite numbers.
-fn rows(field: &str, rows: &[Vec<f64>], n: usize, width: usize) -> Result<(), String> {
+fn rows(field: &str, rows: &[Vec<f64>], n: usize, width: usize) -> Result<(), ViewError> {
     if rows.len() != n {
-        return Err(format!(
-            "{field}: {} rows, expected one a sample ({n})",
-            rows.len()
+        return Err(ViewError::field(
+            field,
+            FieldProblem::PerSample {
+                what: "rows",
+                found: rows.len(),
+                samples: n,
+            },
         ));
     }
     for (k, row) in rows.iter().enumerate() {
         if row.len() != width {
-            return Err(format!(
-                "{field}[{k}]: {} numbers, expected {width}",
-                row.len()
+            return Err(ViewError::field(
+                format!("{field}[{k}]"),
+                FieldProblem::Numbers {
+                    found: row.len(),
+                    expected: width,
+                },
             ));
         }
         finite(&format!("{field}[{k}]"), row)?;

@@ -219,7 +219,7 @@ fn bad_data_is_refused_naming_the_field() {
     for (expected, spoil) in cases {
         let mut run = good.clone();
         spoil(&mut run);
-        let err = run.check().unwrap_err();
+        let err = run.check().unwrap_err().to_string();
         assert!(err.starts_with(expected), "{expected}: {err}");
     }
     let empty = Scene {
@@ -227,7 +227,13 @@ fn bad_data_is_refused_naming_the_field() {
         caption: String::new(),
         runs: Vec::new(),
     };
-    assert!(empty.check().unwrap_err().contains("runs: 0 runs"));
+    assert!(
+        empty
+            .check()
+            .unwrap_err()
+            .to_string()
+            .contains("runs: 0 runs")
+    );
     // JSON from elsewhere (Python, a file) goes through the same checks after parsing.
     let text = serde_json::to_string(&good).unwrap();
     let back: RunView = serde_json::from_str(&text).unwrap();
@@ -367,6 +373,7 @@ fn the_gif_shows_the_arm_moving_over_its_path() {
     assert!(
         write_gif(&run, &slow, Vec::new())
             .unwrap_err()
+            .to_string()
             .contains("frames")
     );
     let wide = GifOptions {
@@ -376,6 +383,7 @@ fn the_gif_shows_the_arm_moving_over_its_path() {
     assert!(
         write_gif(&run, &wide, Vec::new())
             .unwrap_err()
+            .to_string()
             .contains("gif width: 0")
     );
     let mut spatial_gif = Vec::new();

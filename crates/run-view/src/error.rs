@@ -1,0 +1,225 @@
+//! The error type of this crate.
+
+use lane_math::{Classify, ErrorClass};
+
+/// Why a run or scene could not be drawn: a field outside the format (named as in the JSON of
+/// `docs/run-view.md`), a record that does not fit its scenario, or a GIF or page that could not
+/// be written.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ViewError {
+    /// A field of a run, or an option, outside the format.
+    #[error("{field}: {problem}")]
+    Field {
+        /// The field, e.g. `t`, `joints[3]`, `series[0] ("tip error")`, `gif fps`.
+        field: String,
+        /// What is wrong with it.
+        problem: FieldProblem,
+    },
+    /// A scene without runs or with too many.
+    #[error("scene {title:?}: runs: {count} runs, expected 1 to {max}")]
+    RunCount {
+        /// The scene's title.
+        title: String,
+        /// Its number of runs.
+        count: usize,
+        /// The most runs a scene may have.
+        max: usize,
+    },
+    /// A run of a scene was refused.
+    #[error("scene {title:?}, run {label:?}: {source}")]
+    Run {
+        /// The scene's title.
+        title: String,
+        /// The run's label.
+        label: String,
+        /// Why.
+        source: Box<ViewError>,
+    },
+    /// A GIF would need more frames than [`MAX_FRAMES`](crate::MAX_FRAMES).
+    #[error(
+        "gif: {seconds:.3} s of run at {fps} frames a second and speed {speed} make {frames} \
+         frames, more than {max}; raise the speed or lower the rate"
+    )]
+    TooManyFrames {
+        /// The run's duration (s).
+        seconds: f64,
+        /// Frames a second.
+        fps: u32,
+        /// Seconds of run a second of GIF.
+        speed: f64,
+        /// The frames needed.
+        frames: usize,
+        /// The limit.
+        max: usize,
+    },
+    /// The picture of a GIF's frames could not be allocated.
+    #[error("gif: cannot allocate the picture")]
+    Picture,
+    /// The GIF encoder failed (e.g. writing to its output).
+    #[error("gif: {0}")]
+    Gif(#[from] gif::EncodingError),
+    /// A scene could not be written as JSON.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    /// A record does not fit its scenario's arm.
+    #[error("the record does not match scenario {scenario}: {joints} joints, {samples} samples")]
+    RecordMismatch {
+        /// The scenario's name.
+        scenario: String,
+        /// The record's joints.
+        joints: usize,
+        /// The record's samples.
+        samples: usize,
+    },
+    /// The scenario's model could not be built.
+    #[error(transparent)]
+    Model(#[from] sim_core::SimError),
+    /// The arm's kinematics refused a recorded state.
+    #[error(transparent)]
+    Kinematics(#[from] backbone_kin::KinError),
+}
+
+/// What is wrong with a field: the `problem` of [`ViewError::Field`], phrased to follow the
+/// field's name.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FieldProblem {
+    /// `dims` is neither 2 nor 3.
+    #[error("{found}, expected 2 (planar) or 3 (spatial)")]
+    Dims {
+        /// The value given.
+        found: usize,
+    },
+    /// A count outside its range.
+    #[error("{found}{}, expected {min} to {max}", spaced(unit))]
+    Count {
+        /// The count given.
+        found: usize,
+        /// What is counted (`samples`, `points`, `pixels`), or empty.
+        unit: &'static str,
+        /// The least allowed.
+        min: usize,
+        /// The most allowed.
+        max: usize,
+    },
+    /// More items than allowed.
+    #[error("{found}, more than {max}")]
+    TooMany {
+        /// The count given.
+        found: usize,
+        /// The limit.
+        max: usize,
+    },
+    /// A value that is not finite.
+    #[error("value {index} is {value}, not finite")]
+    NotFinite {
+        /// Its index (0-based).
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// A value that must be finite and positive.
+    #[error("{value}, expected a finite positive number")]
+    NotPositive {
+        /// The value.
+        value: f64,
+    },
+    /// Times that do not increase.
+    #[error("not increasing at sample {sample}")]
+    NotIncreasing {
+        /// The sample (0-based) not after the one before it.
+        sample: usize,
+    },
+    /// A sample's row of joint positions of the wrong width.
+    #[error("{found} numbers a sample, expected {dims} a point for 2 to {max_points} points")]
+    PointsWidth {
+        /// The numbers a sample.
+        found: usize,
+        /// The coordinates of a point.
+        dims: usize,
+        /// The most points.
+        max_points: usize,
+    },
+    /// Torque limits not one a joint.
+    #[error("{found} limits, expected one a joint ({joints})")]
+    Limits {
+        /// The limits given.
+        found: usize,
+        /// The joints.
+        joints: usize,
+    },
+    /// A series' names not one a curve.
+    #[error("{names} names for {curves} curves, expected one name a curve (1 to {max})")]
+    SeriesNames {
+        /// The names given.
+        names: usize,
+        /// The curves given.
+        curves: usize,
+        /// The most curves.
+        max: usize,
+    },
+    /// Rows or values not one a sample.
+    #[error("{found} {what}, expected one a sample ({samples})")]
+    PerSample {
+        /// `rows` or `values`.
+        what: &'static str,
+        /// The number given.
+        found: usize,
+        /// The samples.
+        samples: usize,
+    },
+    /// A row or a list of numbers of the wrong length.
+    #[error("{found} numbers, expected {expected}")]
+    Numbers {
+        /// The numbers given.
+        found: usize,
+        /// The numbers expected.
+        expected: usize,
+    },
+    /// A point of the wrong dimension.
+    #[error("a point of {found} coordinates, expected {dims}")]
+    Point {
+        /// The coordinates given.
+        found: usize,
+        /// The run's dimension.
+        dims: usize,
+    },
+    /// A circle in a spatial run or a sphere in a planar one.
+    #[error("a circle is planar and a sphere spatial; this run has dims {dims}")]
+    Shape {
+        /// The run's dimension.
+        dims: usize,
+    },
+}
+
+/// ` unit`, or nothing for no unit.
+fn spaced(unit: &str) -> String {
+    if unit.is_empty() {
+        String::new()
+    } else {
+        format!(" {unit}")
+    }
+}
+
+impl ViewError {
+    /// A [`ViewError::Field`].
+    pub(crate) fn field(field: impl Into<String>, problem: FieldProblem) -> Self {
+        Self::Field {
+            field: field.into(),
+            problem,
+        }
+    }
+}
+
+impl Classify for ViewError {
+    /// A wrapped model or kinematics error keeps its class; every other error is invalid input.
+    fn class(&self) -> ErrorClass {
+        match self {
+            Self::Model(error) => error.class(),
+            Self::Kinematics(error) => error.class(),
+            Self::Run { source, .. } => source.class(),
+            _ => ErrorClass::InvalidInput,
+        }
+    }
+}
