@@ -405,10 +405,10 @@ pub fn import_graph(files: &[(String, String)]) -> Graph {
             .collect();
         paths.extend(inline_paths(&module.code, &children));
         for path in paths {
-            if let Some(target) = resolver.resolve(name, &path, 0) {
-                if &target != name {
-                    targets.insert(target);
-                }
+            if let Some(target) = resolver.resolve(name, &path, 0)
+                && &target != name
+            {
+                targets.insert(target);
             }
         }
         graph.insert(name.clone(), targets);
@@ -495,15 +495,15 @@ impl Resolver<'_> {
                             let glob = &path[..path.len() - 1];
                             let mut through = glob.to_vec();
                             through.push(item.clone());
-                            if let Some(target) = self.resolve(&base, &through, depth + 1) {
-                                if self.modules.get(&target).is_some_and(|m| {
+                            if let Some(target) = self.resolve(&base, &through, depth + 1)
+                                && self.modules.get(&target).is_some_and(|m| {
                                     defines(&m.code, item)
                                         || m.uses
                                             .iter()
                                             .any(|u| u.paths.iter().any(|(_, n)| n == item))
-                                }) {
-                                    return Some(target);
-                                }
+                                })
+                            {
+                                return Some(target);
                             }
                         }
                     }
