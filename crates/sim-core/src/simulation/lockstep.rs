@@ -206,16 +206,20 @@ impl Lockstep {
     /// says why; it stays at its last sample) and the others go on. Returns the number of runs
     /// still running. Allocation-free (but for the error of a run that stops).
     pub fn step(&mut self) -> usize {
-        self.step_with::<NoHooks>(&mut [])
+        self.step_hooked::<NoHooks>(&mut [])
     }
 
     /// [`step`](Self::step) with the hooks of each run (`hooks[i]` for run `i`; empty for none):
     /// their disturbances act on their runs and their observers see their runs' samples.
     ///
-    /// # Panics
-    /// If `hooks` is neither empty nor one per run.
-    pub fn step_with<H: LoopHooks>(&mut self, hooks: &mut [H]) -> usize {
-        self.check_hooks(hooks);
+    /// Fails, and steps no run, if `hooks` is neither empty nor one per run.
+    pub fn step_with<H: LoopHooks>(&mut self, hooks: &mut [H]) -> Result<usize, SimError> {
+        self.check_hooks(hooks)?;
+        Ok(self.step_hooked(hooks))
+    }
+
+    /// [`step_with`](Self::step_with) with hooks already checked.
+    fn step_hooked<H: LoopHooks>(&mut self, hooks: &mut [H]) -> usize {
         self.take_samples(hooks);
         self.integrate();
         self.observe_samples(hooks);
@@ -226,16 +230,23 @@ impl Lockstep {
     /// (it [`reset`](Self::reset)s first): the results in run order, each the same as the run
     /// alone would give.
     pub fn run(&mut self) -> Vec<Result<Run, Box<RunFailure>>> {
-        self.run_with::<NoHooks>(&mut [])
+        self.run_hooked::<NoHooks>(&mut [])
     }
 
     /// [`run`](Self::run) with the hooks of each run, as [`step_with`](Self::step_with) takes
     /// them: each run's results are those of [`Simulation::run_with`] with its hooks.
     ///
-    /// # Panics
-    /// If `hooks` is neither empty nor one per run.
-    pub fn run_with<H: LoopHooks>(&mut self, hooks: &mut [H]) -> Vec<Result<Run, Box<RunFailure>>> {
-        self.check_hooks(hooks);
+    /// Fails, and runs nothing, if `hooks` is neither empty nor one per run.
+    pub fn run_with<H: LoopHooks>(
+        &mut self,
+        hooks: &mut [H],
+    ) -> Result<Vec<Result<Run, Box<RunFailure>>>, SimError> {
+        self.check_hooks(hooks)?;
+        Ok(self.run_hooked(hooks))
+    }
+
+    /// [`run_with`](Self::run_with) with hooks already checked.
+    fn run_hooked<H: LoopHooks>(&mut self, hooks: &mut [H]) -> Vec<Result<Run, Box<RunFailure>>> {
         self.reset();
         let mut progress: Vec<Progress> = self.runs.iter_mut().map(|r| r.start_run()).collect();
         let samples = progress[0].samples;
@@ -273,13 +284,19 @@ impl Lockstep {
     }
 
     /// Refuses hooks that are neither none nor one per run.
-    fn check_hooks<H>(&self, hooks: &[H]) {
-        assert!(
-            hooks.is_empty() || hooks.len() == self.runs.len(),
-            "a lock-step group of {} runs takes no hooks or one per run, got {}",
-            self.runs.len(),
-            hooks.len()
-        );
+    fn check_hooks<H>(&self, hooks: &[H]) -> Result<(), SimError> {
+        if hooks.is_empty() || hooks.len() == self.runs.len() {
+            Ok(())
+        } else {
+            Err(SimError::setting(
+                "hooks",
+                format!(
+                    "must be none or one per run of the lock-step group ({} runs), got {}",
+                    self.runs.len(),
+                    hooks.len()
+                ),
+            ))
+        }
     }
 
     /// The controller sample of every running run ([`Simulation::take_sample`], with its hooks

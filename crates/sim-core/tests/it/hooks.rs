@@ -384,11 +384,45 @@ fn a_group_with_hooks_gives_each_run_with_its_hooks_alone() {
         tape: Tape::default(),
     };
     let mut together: Vec<PushAndTape> = (0..5).map(hooks).collect();
-    let results = prepared.lockstep(&noises).unwrap().run_with(&mut together);
+    let results = prepared
+        .lockstep(&noises)
+        .unwrap()
+        .run_with(&mut together)
+        .unwrap();
     for (k, noise) in noises.iter().enumerate() {
         let mut alone = hooks(k);
         let run = prepared.simulation(noise).unwrap().run_with(&mut alone);
         assert_eq!(results[k], run, "run {k}");
         assert_eq!(together[k].tape.samples, alone.tape.samples, "run {k}");
     }
+}
+
+#[test]
+fn a_group_refuses_hooks_that_are_not_one_per_run() {
+    let reference = Step::new(&[0.1, -0.05], &[0.3, -0.2], 0.05).unwrap();
+    let settings = LoopSettings::new(Integrator::Rk4 { dt: 5e-4 }, 1e-3, 0.05);
+    let prepared = Prepared::new(
+        model(9.81),
+        Prepared::reference_clones(reference),
+        Prepared::controller_clones(pd()),
+        settings,
+        None,
+    )
+    .unwrap();
+    let noises: Vec<RunNoise> = (0..3)
+        .map(|seed| RunNoise {
+            seed,
+            reference_std: vec![],
+            sensor_std: vec![],
+        })
+        .collect();
+    let mut group = prepared.lockstep(&noises).unwrap();
+    let mut two: Vec<Tape> = (0..2).map(|_| Tape::default()).collect();
+    let error = group.run_with(&mut two).unwrap_err();
+    assert!(error.to_string().contains("hooks"), "{error}");
+    assert!(error.to_string().contains("3 runs"), "{error}");
+    let error = group.step_with(&mut two).unwrap_err();
+    assert!(error.to_string().contains("got 2"), "{error}");
+    // A refusal leaves the group as it was: with no hooks it runs.
+    assert!(group.run().iter().all(Result::is_ok));
 }
