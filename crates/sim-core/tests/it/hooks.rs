@@ -357,18 +357,23 @@ fn a_non_finite_disturbance_stops_the_run() {
     assert_eq!(failure.summary.simulated_s, 0.049);
 }
 
-#[test]
-fn a_group_with_hooks_gives_each_run_with_its_hooks_alone() {
+/// The PD controller on a step of the arm under gravity, prepared for runs of `duration`.
+fn prepared_step(duration: f64) -> Prepared {
     let reference = Step::new(&[0.1, -0.05], &[0.3, -0.2], 0.05).unwrap();
-    let settings = LoopSettings::new(Integrator::Rk4 { dt: 5e-4 }, 1e-3, 0.1);
-    let prepared = Prepared::new(
+    let settings = LoopSettings::new(Integrator::Rk4 { dt: 5e-4 }, 1e-3, duration);
+    Prepared::new(
         model(9.81),
         Prepared::reference_clones(reference),
         Prepared::controller_clones(pd()),
         settings,
         None,
     )
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn a_group_with_hooks_gives_each_run_with_its_hooks_alone() {
+    let prepared = prepared_step(0.1);
     let noises: Vec<RunNoise> = (0..5)
         .map(|seed| RunNoise {
             seed,
@@ -399,16 +404,7 @@ fn a_group_with_hooks_gives_each_run_with_its_hooks_alone() {
 
 #[test]
 fn a_group_refuses_hooks_that_are_not_one_per_run() {
-    let reference = Step::new(&[0.1, -0.05], &[0.3, -0.2], 0.05).unwrap();
-    let settings = LoopSettings::new(Integrator::Rk4 { dt: 5e-4 }, 1e-3, 0.05);
-    let prepared = Prepared::new(
-        model(9.81),
-        Prepared::reference_clones(reference),
-        Prepared::controller_clones(pd()),
-        settings,
-        None,
-    )
-    .unwrap();
+    let prepared = prepared_step(0.05);
     let noises: Vec<RunNoise> = (0..3)
         .map(|seed| RunNoise {
             seed,
