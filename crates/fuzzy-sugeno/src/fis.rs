@@ -4,7 +4,7 @@
 //! Writing then reading gives back the identical system (numbers are written in the shortest
 //! form that parses back to the same `f64`). Reading accepts what MATLAB's `readfis` reads,
 //! including the habits of files written by older MATLAB releases, Octave's fuzzy-logic-toolkit
-//! and fuzzylite (`docs/fis-format.md` lists them); what it accepts but does not keep or use is
+//! and fuzzylite (`docs/fuzzy-formats.md` lists them); what it accepts but does not keep or use is
 //! reported as [`FisNote`]s. Every malformed line is an error that gives its line number and
 //! what was expected, and Mamdani systems are refused.
 
