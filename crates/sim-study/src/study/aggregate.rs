@@ -3,8 +3,9 @@
 //! a cell are consecutive in that order, so the cells are built from a stream of runs holding
 //! only the current cell's values.
 
+use super::outcome::RunMetrics;
 use super::plan::SweepConfig;
-use super::shard_file::{RunMetrics, RunResult, StoredOutcome};
+use super::shard_file::{RunResult, StoredOutcome};
 use crate::ControllerKind;
 use serde::Serialize;
 

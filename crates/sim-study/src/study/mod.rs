@@ -43,14 +43,13 @@ pub use comparison::{ComparisonRun, builtin_scenarios, compare, run_one, run_pre
 pub use inputs::{
     InputDigest, SCENARIO_INPUT, check_digests, check_json_safe, first_changed, input_digests,
 };
-pub use outcome::{RunError, RunOutcome, Stopped, run_scenario};
+pub use outcome::{RunError, RunMetrics, RunOutcome, Stopped, run_scenario};
 pub use plan::{
     MAX_RUNS, MAX_SHARDS, RunId, SettingError, Shard, SweepConfig, SweepSettings, run_seed,
 };
 pub use shard_file::{
-    FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, RunMetrics, RunResult, ShardFile, ShardHeader,
-    ShardInput, ShardReader, ShardSource, StoredOutcome, merge, merge_readers, shard_paths,
-    write_json_line,
+    FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, RunResult, ShardFile, ShardHeader, ShardInput,
+    ShardReader, ShardSource, StoredOutcome, merge, merge_readers, shard_paths, write_json_line,
 };
 
 use crate::{ControllerKind, IntegratorSpec};

@@ -1,10 +1,10 @@
 //! How one run of a study ended: [`RunOutcome`], the one outcome the comparison, the sweeps, the
 //! shards, the command line and the Python package share, with its typed error [`RunError`].
 
-use super::shard_file::RunMetrics;
 use crate::Scenario;
 use lane_math::{Classify, ErrorClass};
-use sim_core::{Run, RunFailure, SimError};
+use serde::{Deserialize, Serialize};
+use sim_core::{Run, RunFailure, SimError, Summary};
 
 /// How a run ended: the [`Run`] (record and summary) if it ran to the end, or [`Stopped`]: why it
 /// did not, with what it recorded until then. A sweep keeps of it the metrics
@@ -95,4 +95,48 @@ impl From<Box<RunFailure>> for Stopped {
 pub fn run_scenario(scenario: &Scenario) -> RunOutcome {
     let mut simulation = scenario.build().map_err(Stopped::not_built)?;
     Ok(simulation.run()?)
+}
+
+/// The summary metrics a sweep keeps of a run (see [`Summary`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunMetrics {
+    /// Tip error RMS (m).
+    pub tip_error_rms_m: f64,
+    /// Largest tip error (m).
+    pub tip_error_max_m: f64,
+    /// Modal error RMS per coordinate (rad).
+    pub modal_error_rms_rad: Vec<f64>,
+    /// Largest joint torque (N m).
+    pub peak_joint_torque_nm: f64,
+    /// Control effort (N^2 m^2 s).
+    pub control_effort_n2m2s: f64,
+}
+
+impl RunMetrics {
+    /// The kept metrics of `summary`, or [`RunError::NonFiniteMetrics`] if one is not finite.
+    pub fn from_summary(s: &Summary) -> Result<Self, RunError> {
+        let m = RunMetrics {
+            tip_error_rms_m: s.tip_error_rms_m,
+            tip_error_max_m: s.tip_error_max_m,
+            modal_error_rms_rad: s.modal_error_rms_rad.clone(),
+            peak_joint_torque_nm: s.peak_joint_torque_nm,
+            control_effort_n2m2s: s.control_effort_n2m2s,
+        };
+        let values = [
+            m.tip_error_rms_m,
+            m.tip_error_max_m,
+            m.peak_joint_torque_nm,
+            m.control_effort_n2m2s,
+        ];
+        if values
+            .iter()
+            .chain(&m.modal_error_rms_rad)
+            .all(|v| v.is_finite())
+        {
+            Ok(m)
+        } else {
+            Err(RunError::NonFiniteMetrics(m))
+        }
+    }
 }

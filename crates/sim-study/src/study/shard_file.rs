@@ -7,11 +7,10 @@
 //! merge holds its runs in memory.
 
 use super::inputs;
-use super::outcome::{RunError, RunOutcome, Stopped};
+use super::outcome::{RunMetrics, RunOutcome, Stopped};
 use super::plan::{MAX_SHARDS, RunId, Shard, SweepConfig};
 use crate::ControllerKind;
 use serde::{Deserialize, Serialize};
-use sim_core::Summary;
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
@@ -64,7 +63,7 @@ pub struct RunResult {
 }
 
 /// A run's [`RunOutcome`] as a shard file keeps it: the summary metrics of a run that completed,
-/// or the message of its [`RunError`] and the time it reached. The typed error does not survive
+/// or the message of its [`RunError`](super::RunError) and the time it reached. The typed error does not survive
 /// the file (a merge reads it back as the text the sweep wrote), so this is the record of an
 /// outcome, not an error type.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -74,27 +73,11 @@ pub enum StoredOutcome {
     Completed(RunMetrics),
     /// It stopped (divergence, runaway error) or could not be built.
     Failed {
-        /// Why, and when: the [`RunError`]'s message.
+        /// Why, and when: the [`RunError`](super::RunError)'s message.
         error: String,
         /// Simulated time reached (s).
         simulated_s: f64,
     },
-}
-
-/// The summary metrics a sweep keeps of a run (see [`Summary`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RunMetrics {
-    /// Tip error RMS (m).
-    pub tip_error_rms_m: f64,
-    /// Largest tip error (m).
-    pub tip_error_max_m: f64,
-    /// Modal error RMS per coordinate (rad).
-    pub modal_error_rms_rad: Vec<f64>,
-    /// Largest joint torque (N m).
-    pub peak_joint_torque_nm: f64,
-    /// Control effort (N^2 m^2 s).
-    pub control_effort_n2m2s: f64,
 }
 
 impl StoredOutcome {
@@ -114,34 +97,6 @@ impl StoredOutcome {
         StoredOutcome::Failed {
             error: stopped.error.to_string(),
             simulated_s: stopped.simulated_s(),
-        }
-    }
-}
-
-impl RunMetrics {
-    /// The kept metrics of `summary`, or [`RunError::NonFiniteMetrics`] if one is not finite.
-    pub fn from_summary(s: &Summary) -> Result<Self, RunError> {
-        let m = RunMetrics {
-            tip_error_rms_m: s.tip_error_rms_m,
-            tip_error_max_m: s.tip_error_max_m,
-            modal_error_rms_rad: s.modal_error_rms_rad.clone(),
-            peak_joint_torque_nm: s.peak_joint_torque_nm,
-            control_effort_n2m2s: s.control_effort_n2m2s,
-        };
-        let values = [
-            m.tip_error_rms_m,
-            m.tip_error_max_m,
-            m.peak_joint_torque_nm,
-            m.control_effort_n2m2s,
-        ];
-        if values
-            .iter()
-            .chain(&m.modal_error_rms_rad)
-            .all(|v| v.is_finite())
-        {
-            Ok(m)
-        } else {
-            Err(RunError::NonFiniteMetrics(m))
         }
     }
 }
