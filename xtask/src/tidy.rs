@@ -55,15 +55,13 @@ const FRONT_ENDS: [&str; 3] = ["hrm-cli", "hrm-py", "test-support"];
 /// through, so that the list only shrinks.
 /// - sim-study: `ControllerKind` (a field of the scenario schema) takes its names from the
 ///   controller table, whose constructors read the schema's `[controller]` settings.
-/// - fuzzy-sugeno: the system holds its separable form, which reads the system's rules.
 /// - hrm-cli: the eval ops' children share the request helpers of `eval`; `fis export` reads
 ///   systems with `fis check`'s helpers.
-const KNOWN_CIRCLES: [(&str, &[&str]); 4] = [
+const KNOWN_CIRCLES: [(&str, &[&str]); 3] = [
     (
         "crates/sim-study",
         &["scenario::controllers", "scenario::schema"],
     ),
-    ("crates/fuzzy-sugeno", &["separable", "system"]),
     (
         "crates/hrm-cli",
         &["eval", "eval::derivatives", "eval::robot", "eval::spatial"],

@@ -18,6 +18,7 @@ pub mod learn;
 mod membership;
 mod options;
 mod paper;
+mod rules;
 mod separable;
 mod system;
 

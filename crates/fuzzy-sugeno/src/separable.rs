@@ -25,7 +25,7 @@
 //! outside their ranges) the point is evaluated by the general kernel.
 
 use crate::compiled_mf::CompiledMf;
-use crate::system::{AndMethod, Antecedent, Connective, Defuzzification, Methods, Rule};
+use crate::rules::{AndMethod, Antecedent, Connective, Defuzzification, Methods, Rule};
 
 /// The most sets an input may have for the separable form (its grades are products of the
 /// others' `A`).
