@@ -2,6 +2,7 @@
 //! bad input becomes a [`KinError`] instead of a panic or a silent NaN.
 
 use crate::error::KinError;
+use lane_math::ShapeProblem;
 
 /// Checks that the scalar `value` is finite.
 pub(crate) fn check_finite(name: &'static str, value: f64) -> Result<(), KinError> {
@@ -55,21 +56,18 @@ pub(crate) fn check_len(
     values: &[f64],
     expected: usize,
 ) -> Result<(), KinError> {
-    if values.len() != expected {
-        return Err(KinError::Dimension {
+    lane_math::check_values(values, expected).map_err(|problem| match problem {
+        ShapeProblem::Length { expected, found } => KinError::Dimension {
             name,
             expected,
-            found: values.len(),
-        });
-    }
-    match values.iter().position(|v| !v.is_finite()) {
-        Some(index) => Err(KinError::NonFinite {
+            found,
+        },
+        ShapeProblem::NonFinite { index, value } => KinError::NonFinite {
             name,
             index: Some(index),
-            value: values[index],
-        }),
-        None => Ok(()),
-    }
+            value,
+        },
+    })
 }
 
 /// Checks that an output buffer has room for exactly `expected` entries.

@@ -435,8 +435,8 @@ const MAX_MAP_WORK: usize = 1 << 25;
 
 /// Refuses to answer with a non-finite number (JSON has none).
 fn finite(name: &str, values: &[f64]) -> Result<(), EvalError> {
-    match values.iter().find(|v| !v.is_finite()) {
-        Some(v) => Err(EvalError::new(
+    match lane_math::first_non_finite(values) {
+        Some((_, v)) => Err(EvalError::new(
             Kind::Library(ErrorClass::Numerical),
             format!("{name} came out non-finite ({v})"),
         )),

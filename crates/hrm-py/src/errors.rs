@@ -123,8 +123,8 @@ pub(crate) fn count(
 /// Refuses a computed vector with a non-finite entry, as `hrm eval` does: "{name} came out
 /// non-finite ({value})".
 pub(crate) fn check_finite(name: &str, values: &[f64]) -> Result<()> {
-    match values.iter().find(|v| !v.is_finite()) {
-        Some(v) => Err(Error::numerical(format!(
+    match lane_math::first_non_finite(values) {
+        Some((_, v)) => Err(Error::numerical(format!(
             "{name} came out non-finite ({v})"
         ))),
         None => Ok(()),

@@ -49,12 +49,8 @@ pub(crate) fn vectors(n: usize, inputs: &[(&'static str, &[f64])]) -> Result<(),
 /// An input vector of `n` finite entries.
 fn input(name: &'static str, x: &[f64], n: usize) -> Result<(), DynError> {
     length(name, x.len(), n)?;
-    match x.iter().position(|value| !value.is_finite()) {
-        Some(index) => Err(DynError::NonFinite {
-            name,
-            index,
-            value: x[index],
-        }),
+    match lane_math::first_non_finite(x) {
+        Some((index, value)) => Err(DynError::NonFinite { name, index, value }),
         None => Ok(()),
     }
 }

@@ -158,12 +158,8 @@ pub(crate) fn check_input(
     expected: usize,
 ) -> Result<(), ReduceError> {
     check_len(name, values.len(), expected)?;
-    match values.iter().position(|v| !v.is_finite()) {
-        Some(index) => Err(ReduceError::NonFinite {
-            name,
-            index,
-            value: values[index],
-        }),
+    match lane_math::first_non_finite(values) {
+        Some((index, value)) => Err(ReduceError::NonFinite { name, index, value }),
         None => Ok(()),
     }
 }

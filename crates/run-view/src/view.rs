@@ -326,13 +326,10 @@ pub(crate) fn count(
 
 /// Every value of `values` finite.
 fn finite(field: &str, values: &[f64]) -> Result<(), ViewError> {
-    match values.iter().position(|v| !v.is_finite()) {
-        Some(index) => Err(ViewError::field(
+    match lane_math::first_non_finite(values) {
+        Some((index, value)) => Err(ViewError::field(
             field,
-            FieldProblem::NotFinite {
-                index,
-                value: values[index],
-            },
+            FieldProblem::NotFinite { index, value },
         )),
         None => Ok(()),
     }

@@ -232,9 +232,9 @@ pub(crate) fn check_non_negative(name: &str, value: f64) -> Result<(), SimError>
 /// Checks that every entry of `values` is finite: an [`InvalidSetting`](SimError::InvalidSetting)
 /// error naming `name` and the first non-finite entry otherwise.
 pub fn check_finite(name: &str, values: &[f64]) -> Result<(), SimError> {
-    match values.iter().find(|v| !v.is_finite()) {
+    match lane_math::first_non_finite(values) {
         None => Ok(()),
-        Some(v) => Err(SimError::setting(name, format!("must be finite, got {v}"))),
+        Some((_, v)) => Err(SimError::setting(name, format!("must be finite, got {v}"))),
     }
 }
 
