@@ -315,7 +315,7 @@ impl MembershipFn {
         };
         let (params, count) = self.param_array();
         let params = &params[..count];
-        if let Some(v) = params.iter().find(|v| !v.is_finite()) {
+        if let Some((_, v)) = lane_math::first_non_finite(params) {
             return fail(format!(
                 "parameters must be finite, got {v} in {}",
                 format_params(params)

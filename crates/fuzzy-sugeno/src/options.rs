@@ -57,7 +57,7 @@ impl EvalOptions {
                     found: values.len(),
                 });
             }
-            if let Some(&value) = values.iter().find(|v| !v.is_finite()) {
+            if let Some((_, value)) = lane_math::first_non_finite(values) {
                 return Err(FuzzyError::NonFiniteFallback { value });
             }
         }

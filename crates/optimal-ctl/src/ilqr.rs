@@ -583,9 +583,9 @@ impl Ilqr {
                 found: x0.len(),
             });
         }
-        let finite = |name, values: &[f64]| match values.iter().find(|v| !v.is_finite()) {
+        let finite = |name, values: &[f64]| match lane_math::first_non_finite(values) {
             None => Ok(()),
-            Some(&value) => Err(OptimalError::InvalidSetting {
+            Some((_, value)) => Err(OptimalError::InvalidSetting {
                 name,
                 requirement: "finite",
                 value,

@@ -57,11 +57,11 @@ impl TrainingData {
             }
             .into());
         }
-        if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+        if let Some((k, value)) = lane_math::first_non_finite(&values) {
             return Err(LearningProblem::NonFiniteValue {
                 row: k / width,
                 column: k % width,
-                value: values[k],
+                value,
             }
             .into());
         }
