@@ -243,17 +243,20 @@ const MAX_SVG_BYTES: f64 = (1u64 << 30) as f64;
 const SVG_BYTES_PER_CELL: f64 = 90.0;
 
 /// The analysis report and whether it passed; a note says when the even samples were thinned
-/// to keep the grid within [`AnalysisOptions::max_grid_points`].
+/// to keep the grid within [`AnalysisOptions::max_grid_points`] and
+/// [`AnalysisOptions::max_work`].
 fn check(system: &FuzzySystem, options: &AnalysisOptions) -> Result<(String, bool), String> {
     let report = system.analyze(options).map_err(|e| e.to_string())?;
     let mut text = report.to_string();
     let grid = &report.completeness.grid;
     if grid.iter().any(|&n| n < options.samples_per_input) {
         let asked = (options.samples_per_input as f64).powi(grid.len() as i32);
+        let points: usize = grid.iter().product();
         text.push_str(&format!(
-            "note: --samples {} per input would make a grid of {asked:e} points, more than the {} \
-             the check evaluates: the even samples were thinned to fit\n",
-            options.samples_per_input, options.max_grid_points
+            "note: --samples {} per input would make a grid of {asked:e} points, more than the \
+             check evaluates (at most {} points and {:e} rule evaluations): the even samples were \
+             thinned to a grid of {points} points\n",
+            options.samples_per_input, options.max_grid_points, options.max_work as f64
         ));
     }
     text.push_str(OUT_OF_RANGE_NOTE);
