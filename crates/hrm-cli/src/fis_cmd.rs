@@ -132,6 +132,13 @@ pub fn run(args: FisArgs) -> Result<(), String> {
             samples,
             max_jump,
         } => {
+            // The options by their CLI names (the library names its fields).
+            if !(coverage > 0.0 && coverage <= 1.0) {
+                return Err(format!("--coverage must lie in (0, 1], got {coverage}"));
+            }
+            if max_jump.is_nan() || max_jump <= 0.0 {
+                return Err(format!("--max-jump must be positive, got {max_jump}"));
+            }
             let options = AnalysisOptions {
                 coverage,
                 samples_per_input: args::count("--samples", samples, 2, MAX_SAMPLES)?,
@@ -345,7 +352,16 @@ fn surface(
                 inputs.len()
             ));
         }
-        Some(values) => values.to_vec(),
+        Some(values) => {
+            if let Some((k, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                return Err(format!(
+                    "--reference value {} (input '{}') must be finite, got {v}",
+                    k + 1,
+                    inputs[k].name
+                ));
+            }
+            values.to_vec()
+        }
     };
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let mut written = Vec::new();
@@ -704,6 +720,16 @@ mod tests {
         assert_eq!(
             surface(&paper_controller(), &dir, 9, Some(&[0.0])).unwrap_err(),
             "--reference has 1 values for 4 inputs"
+        );
+        assert_eq!(
+            surface(
+                &paper_controller(),
+                &dir,
+                9,
+                Some(&[f64::NAN, 0.0, 0.0, 0.0])
+            )
+            .unwrap_err(),
+            "--reference value 1 (input 'da1') must be finite, got NaN"
         );
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -189,6 +189,24 @@ fn fis_check_of_40000_rules_is_refused_by_its_work_bound() {
 }
 
 #[test]
+fn fis_check_options_are_named_as_given() {
+    let dir = scratch("errors-fis-options");
+    let file = dir.join("small.fis");
+    std::fs::write(&file, grid_fis(2)).unwrap();
+    let line = refused(&hrm(&["fis", "check", path(&file), "--max-jump", "nan"]));
+    assert!(
+        line.contains("--max-jump") && line.contains("NaN"),
+        "{line}"
+    );
+    let line = refused(&hrm(&["fis", "check", path(&file), "--coverage", "2"]));
+    assert!(
+        line.contains("--coverage") && line.contains("got 2"),
+        "{line}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn unknown_subcommand() {
     // Clap's usage error: several lines (the error, a usage line, a hint), status 2.
     let output = hrm(&["frobnicate"]);
