@@ -43,6 +43,10 @@ pub struct AnalysisOptions {
     /// Continuity fails when neighbouring consequents jump by this fraction of the output range
     /// or more.
     pub max_relative_jump: f64,
+    /// The most work the analysis does: grid points times rules (completeness) plus rule pairs
+    /// (consistency and continuity). The even samples are thinned to fit, and the analysis fails
+    /// with [`FuzzyError::AnalysisWork`] if the pairs and the smallest grid do not.
+    pub max_work: u64,
 }
 
 impl Default for AnalysisOptions {
@@ -52,6 +56,7 @@ impl Default for AnalysisOptions {
             samples_per_input: 21,
             max_grid_points: 1_000_000,
             max_relative_jump: 1.0,
+            max_work: 100_000_000,
         }
     }
 }
@@ -230,11 +235,24 @@ impl FuzzySystem {
             AndMethod::Product => options.coverage.powi(n as i32),
             AndMethod::Minimum => options.coverage,
         };
-        let axes = grid_axes(
-            self.inputs(),
-            options.samples_per_input,
-            options.max_grid_points,
-        )?;
+        // Work left for the grid once the rule pairs are counted (bounds every loop here).
+        let rules = self.rules().len() as u64;
+        let pairs = rules * rules.saturating_sub(1) / 2;
+        let work_points = options.max_work.saturating_sub(pairs) / rules.max(1);
+        let max_points = options
+            .max_grid_points
+            .min(usize::try_from(work_points).unwrap_or(usize::MAX));
+        let axes =
+            grid_axes(self.inputs(), options.samples_per_input, max_points).map_err(|e| {
+                if max_points < options.max_grid_points {
+                    FuzzyError::AnalysisWork {
+                        rules: self.rules().len(),
+                        max_work: options.max_work,
+                    }
+                } else {
+                    e
+                }
+            })?;
         let options_as_given = EvalOptions {
             out_of_range: OutOfRange::AsGiven,
             ..EvalOptions::default()

@@ -145,6 +145,18 @@ pub enum FuzzyError {
         /// The limit in force.
         max_grid_points: usize,
     },
+    /// The rule pairs plus the smallest completeness grid times the rules exceed
+    /// [`AnalysisOptions::max_work`](crate::AnalysisOptions::max_work).
+    #[error(
+        "analysis: {rules} rules need more than the limit of {max_work} rule evaluations \
+         (rule pairs plus grid points times rules, with 2 samples per input)"
+    )]
+    AnalysisWork {
+        /// The system's rule count.
+        rules: usize,
+        /// The limit in force.
+        max_work: u64,
+    },
     /// Learning from data (`genfis`, ANFIS, [`merge_outputs`](crate::learn::merge_outputs))
     /// cannot proceed: bad data or options, a system that ANFIS cannot train or merge, or a
     /// least-squares problem the data do not determine.

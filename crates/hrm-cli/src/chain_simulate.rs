@@ -2,7 +2,7 @@
 //! spatial chain in joint space ([`Scenario::run_chain`]), written as `scenario.toml`,
 //! `summary.json` and `timeseries.csv` (`t`, then `q_i`, `q_ref_i`, `tau_i` per joint).
 
-use crate::console;
+use crate::console::{self, CsvNumber};
 use crate::output_dir::OutputDir;
 use serde_json::json;
 use sim_study::Scenario;
@@ -41,10 +41,10 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
     }
     csv.push('\n');
     for (k, t) in record.t.iter().enumerate() {
-        let _ = write!(csv, "{t}");
+        let _ = write!(csv, "{}", CsvNumber(*t));
         for series in [&record.q, &record.q_ref, &record.tau] {
             for value in &series[k * n..(k + 1) * n] {
-                let _ = write!(csv, ",{value}");
+                let _ = write!(csv, ",{}", CsvNumber(*value));
             }
         }
         csv.push('\n');

@@ -91,9 +91,50 @@ pub fn readable_numbers(text: &str) -> String {
     out
 }
 
+/// A number as written to a CSV field: Rust's shortest round-trip form, in exponent form when
+/// the plain decimal would be longer than [`CsvNumber::MAX_PLAIN`] characters (`1e308`, not 309
+/// digits; `1e-300`, not 302). Both forms read back to the same `f64`.
+#[derive(Debug, Clone, Copy)]
+pub struct CsvNumber(pub f64);
+
+impl CsvNumber {
+    /// The longest plain decimal written as it is.
+    const MAX_PLAIN: usize = 24;
+}
+
+impl std::fmt::Display for CsvNumber {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let plain = self.0.to_string();
+        if plain.len() > Self::MAX_PLAIN {
+            write!(f, "{:e}", self.0)
+        } else {
+            f.write_str(&plain)
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn csv_numbers_near_the_float_limits_are_short_and_round_trip() {
+        for value in [
+            1e308,
+            -1.7976931348623157e308,
+            1e-300,
+            5e-324,
+            0.1,
+            -250.0,
+            0.0,
+        ] {
+            let text = CsvNumber(value).to_string();
+            assert!(text.len() < 40, "{text}");
+            assert_eq!(text.parse::<f64>().unwrap(), value);
+        }
+        assert_eq!(CsvNumber(1e308).to_string(), "1e308");
+        assert_eq!(CsvNumber(0.001).to_string(), "0.001");
+    }
 
     #[test]
     fn control_characters_are_escaped_and_text_kept() {

@@ -925,7 +925,7 @@ mod tests {
         assert_eq!(answers[0]["error"]["kind"], "invalid_input");
         assert_eq!(
             answers[0]["error"]["message"],
-            "arm is invalid: link 1: mass must be positive and finite, got -1"
+            "arm.masses[1] is invalid: link 1: mass must be positive and finite, got -1"
         );
         assert_eq!(answers[0]["id"], "x");
     }

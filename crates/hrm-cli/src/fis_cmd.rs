@@ -132,6 +132,13 @@ pub fn run(args: FisArgs) -> Result<(), String> {
             samples,
             max_jump,
         } => {
+            // The options by their CLI names (the library names its fields).
+            if !(coverage > 0.0 && coverage <= 1.0) {
+                return Err(format!("--coverage must lie in (0, 1], got {coverage}"));
+            }
+            if max_jump.is_nan() || max_jump <= 0.0 {
+                return Err(format!("--max-jump must be positive, got {max_jump}"));
+            }
             let options = AnalysisOptions {
                 coverage,
                 samples_per_input: args::count("--samples", samples, 2, MAX_SAMPLES)?,
@@ -243,17 +250,20 @@ const MAX_SVG_BYTES: f64 = (1u64 << 30) as f64;
 const SVG_BYTES_PER_CELL: f64 = 90.0;
 
 /// The analysis report and whether it passed; a note says when the even samples were thinned
-/// to keep the grid within [`AnalysisOptions::max_grid_points`].
+/// to keep the grid within [`AnalysisOptions::max_grid_points`] and
+/// [`AnalysisOptions::max_work`].
 fn check(system: &FuzzySystem, options: &AnalysisOptions) -> Result<(String, bool), String> {
     let report = system.analyze(options).map_err(|e| e.to_string())?;
     let mut text = report.to_string();
     let grid = &report.completeness.grid;
     if grid.iter().any(|&n| n < options.samples_per_input) {
         let asked = (options.samples_per_input as f64).powi(grid.len() as i32);
+        let points: usize = grid.iter().product();
         text.push_str(&format!(
-            "note: --samples {} per input would make a grid of {asked:e} points, more than the {} \
-             the check evaluates: the even samples were thinned to fit\n",
-            options.samples_per_input, options.max_grid_points
+            "note: --samples {} per input would make a grid of {asked:e} points, more than the \
+             check evaluates (at most {} points and {:e} rule evaluations): the even samples were \
+             thinned to a grid of {points} points\n",
+            options.samples_per_input, options.max_grid_points, options.max_work as f64
         ));
     }
     text.push_str(OUT_OF_RANGE_NOTE);
@@ -342,7 +352,16 @@ fn surface(
                 inputs.len()
             ));
         }
-        Some(values) => values.to_vec(),
+        Some(values) => {
+            if let Some((k, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                return Err(format!(
+                    "--reference value {} (input '{}') must be finite, got {v}",
+                    k + 1,
+                    inputs[k].name
+                ));
+            }
+            values.to_vec()
+        }
     };
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let mut written = Vec::new();
@@ -701,6 +720,16 @@ mod tests {
         assert_eq!(
             surface(&paper_controller(), &dir, 9, Some(&[0.0])).unwrap_err(),
             "--reference has 1 values for 4 inputs"
+        );
+        assert_eq!(
+            surface(
+                &paper_controller(),
+                &dir,
+                9,
+                Some(&[f64::NAN, 0.0, 0.0, 0.0])
+            )
+            .unwrap_err(),
+            "--reference value 1 (input 'da1') must be finite, got NaN"
         );
         std::fs::remove_dir_all(&dir).unwrap();
     }

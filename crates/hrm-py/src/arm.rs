@@ -23,7 +23,7 @@ use std::sync::Mutex;
 ///
 /// Every method takes one state (arrays of shape (n,)) or a batch (shape (N, n)) and answers
 /// with the same leading dimension. Raises InvalidInput for a bad parameter, naming it as the
-/// `hrm` command line does (e.g. "arm is invalid: link 1: mass must be positive and finite, got
+/// `hrm` command line does (e.g. "arm.masses[1] is invalid: link 1: mass must be positive and finite, got
 /// -1").
 #[pyclass(module = "hrm", frozen)]
 pub struct Arm {

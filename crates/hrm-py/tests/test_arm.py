@@ -164,7 +164,7 @@ def test_non_finite_inputs_and_results(arm):
 
 
 def test_arm_parameters_are_checked_as_the_cli_does():
-    with pytest.raises(hrm.InvalidInput, match=r"^arm is invalid: link 1: mass must be positive and finite, got -1$"):
+    with pytest.raises(hrm.InvalidInput, match=r"^arm\.masses\[1\] is invalid: link 1: mass must be positive and finite, got -1$"):
         hrm.Arm(masses=[0.1, -1])
     with pytest.raises(hrm.InvalidInput, match=r"^arm.lengths has 3 entries but the arm has 4 links$"):
         hrm.Arm(links=4, lengths=[0.1, 0.1, 0.1])

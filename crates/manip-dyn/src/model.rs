@@ -20,8 +20,25 @@ pub struct Link {
 
 impl Link {
     /// A uniform beam: centre of mass at the midpoint, inertia `m L^2 / 12` (the paper's links).
+    /// A length or mass whose inertia under- or overflows (`length = 1e-300`) is refused by
+    /// that name, not as the inertia it derives.
     pub fn uniform_beam(length: f64, mass: f64) -> Result<Self, DynError> {
-        Self::new(length, mass, 0.5 * length, mass * length * length / 12.0)
+        let inertia = mass * length * length / 12.0;
+        let squared = length * length;
+        if length > 0.0 && mass > 0.0 && !(inertia.is_finite() && inertia > 0.0) {
+            let (quantity, value) = if squared.is_finite() && squared > 0.0 {
+                ("mass", mass)
+            } else {
+                ("length", length)
+            };
+            return Err(DynError::InvalidLinkParameter {
+                quantity,
+                requirement: "such that the beam's inertia mass * length^2 / 12 is positive and \
+                              finite in double precision",
+                value,
+            });
+        }
+        Self::new(length, mass, 0.5 * length, inertia)
     }
 
     /// A link with explicit centre-of-mass offset and inertia; validated as in [`ChainModel::new`],

@@ -141,6 +141,71 @@ fn fis_check_garbage_file() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A 2-input `.fis` with `sets` triangles per input and a rule for every pair of sets.
+fn grid_fis(sets: usize) -> String {
+    let mut text = format!(
+        "[System]\nName='big'\nType='sugeno'\nNumInputs=2\nNumOutputs=1\nNumRules={}\n\
+         AndMethod='prod'\nOrMethod='max'\nDefuzzMethod='wtaver'\n",
+        sets * sets
+    );
+    for input in 1..=2 {
+        text.push_str(&format!(
+            "\n[Input{input}]\nName='x{input}'\nRange=[0 {sets}]\nNumMFs={sets}\n"
+        ));
+        for k in 0..sets {
+            text.push_str(&format!(
+                "MF{}='s{k}':'trimf',[{} {k} {}]\n",
+                k + 1,
+                k as f64 - 1.0,
+                k + 1
+            ));
+        }
+    }
+    text.push_str("\n[Output1]\nName='y'\nRange=[0 1]\nNumMFs=1\nMF1='c':'constant',[0.5]\n");
+    text.push_str("\n[Rules]\n");
+    for a in 1..=sets {
+        for b in 1..=sets {
+            text.push_str(&format!("{a} {b}, 1 (1) : 1\n"));
+        }
+    }
+    text
+}
+
+#[test]
+fn fis_check_of_40000_rules_is_refused_by_its_work_bound() {
+    // 40,000 rules over a grid of the 2 x 200 sets' landmarks and midpoints: about 10^10 rule
+    // evaluations (minutes) without the bound; refused before the work starts.
+    let dir = scratch("errors-fis-work");
+    let file = dir.join("big.fis");
+    std::fs::write(&file, grid_fis(200)).unwrap();
+    let started = std::time::Instant::now();
+    let line = refused(&hrm(&["fis", "check", path(&file)]));
+    assert!(
+        line.contains("40000 rules") && line.contains("limit of 100000000 rule evaluations"),
+        "{line}"
+    );
+    assert!(started.elapsed().as_secs() < 10, "{:?}", started.elapsed());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn fis_check_options_are_named_as_given() {
+    let dir = scratch("errors-fis-options");
+    let file = dir.join("small.fis");
+    std::fs::write(&file, grid_fis(2)).unwrap();
+    let line = refused(&hrm(&["fis", "check", path(&file), "--max-jump", "nan"]));
+    assert!(
+        line.contains("--max-jump") && line.contains("NaN"),
+        "{line}"
+    );
+    let line = refused(&hrm(&["fis", "check", path(&file), "--coverage", "2"]));
+    assert!(
+        line.contains("--coverage") && line.contains("got 2"),
+        "{line}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn unknown_subcommand() {
     // Clap's usage error: several lines (the error, a usage line, a hint), status 2.

@@ -48,6 +48,49 @@ fn model_rows() -> Vec<Row<DynError>> {
             },
             &["point mass must sit off the joint"],
         ),
+        // The inertia m L^2 / 12 underflows to 0 (or overflows): named as the length or mass.
+        words(
+            "tiny_beam_length",
+            Link::uniform_beam(1e-300, 1.0).unwrap_err(),
+            |e| {
+                matches!(
+                    e,
+                    DynError::InvalidLinkParameter {
+                        quantity: "length",
+                        ..
+                    }
+                )
+            },
+            &["link length must be such that", "got 0.0000"],
+        ),
+        words(
+            "huge_beam_length",
+            Link::uniform_beam(1e300, 1.0).unwrap_err(),
+            |e| {
+                matches!(
+                    e,
+                    DynError::InvalidLinkParameter {
+                        quantity: "length",
+                        ..
+                    }
+                )
+            },
+            &["link length must be such that", "got 1000000"],
+        ),
+        words(
+            "tiny_beam_mass",
+            Link::uniform_beam(0.1, 5e-324).unwrap_err(),
+            |e| {
+                matches!(
+                    e,
+                    DynError::InvalidLinkParameter {
+                        quantity: "mass",
+                        ..
+                    }
+                )
+            },
+            &["link mass must be such that"],
+        ),
         row(
             "non_finite_centre_of_mass",
             ChainModel::new(

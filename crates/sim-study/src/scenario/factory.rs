@@ -259,9 +259,24 @@ impl ArmSpec {
         };
         let lengths = per_link(&self.lengths, self.link_length.unwrap_or(0.1));
         let masses = per_link(&self.masses, self.link_mass.unwrap_or(0.1));
-        // A lone link has no index: name the link's real one.
+        // A lone link has no index: name the link's real one, and the field the value came from.
         let arm_error = |i: usize, e: manip_dyn::DynError| {
-            SimError::setting("arm", format!("is invalid: {}", e.at_link(i)))
+            let field = match e {
+                manip_dyn::DynError::InvalidLinkParameter {
+                    quantity: "length", ..
+                } => match self.lengths {
+                    Some(_) => format!("arm.lengths[{i}]"),
+                    None => "arm.link_length".to_string(),
+                },
+                manip_dyn::DynError::InvalidLinkParameter {
+                    quantity: "mass", ..
+                } => match self.masses {
+                    Some(_) => format!("arm.masses[{i}]"),
+                    None => "arm.link_mass".to_string(),
+                },
+                _ => "arm".to_string(),
+            };
+            SimError::setting(field, format!("is invalid: {}", e.at_link(i)))
         };
         let mut links = Vec::with_capacity(n);
         for i in 0..n {

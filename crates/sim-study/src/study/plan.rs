@@ -116,8 +116,8 @@ impl SweepSettings {
     }
 
     /// Checks the settings: at least one controller and none twice, at least one noise level,
-    /// all finite, non-negative, distinct and ascending, finite non-negative ratios, at least one
-    /// seed, and at most [`MAX_RUNS`] runs.
+    /// all finite, non-negative, distinct and ascending, finite non-negative ratios whose products
+    /// with the largest level are finite, at least one seed, and at most [`MAX_RUNS`] runs.
     pub fn check(&self) -> Result<(), SettingError> {
         if self.controllers.is_empty() {
             return Err(SettingError::new(
@@ -163,6 +163,19 @@ impl SweepSettings {
                 return Err(SettingError::new(
                     name,
                     format!("must be finite and non-negative, got {ratio}"),
+                ));
+            }
+        }
+        // A run's rate and reference noise are a level times a ratio: finite too.
+        let largest = self.noise_levels[self.noise_levels.len() - 1];
+        for (name, ratio) in [
+            ("rate_noise_ratio", self.rate_noise_ratio),
+            ("reference_noise_ratio", self.reference_noise_ratio),
+        ] {
+            if !(largest * ratio).is_finite() {
+                return Err(SettingError::new(
+                    "noise_levels",
+                    format!("{largest:e} times {name} = {ratio} is not finite"),
                 ));
             }
         }
@@ -467,6 +480,12 @@ mod tests {
         assert_eq!(
             err,
             "rate_noise_ratio must be finite and non-negative, got inf"
+        );
+        c.settings.rate_noise_ratio = 10.0;
+        c.settings.noise_levels = vec![0.0, 1e308];
+        assert_eq!(
+            c.validate().unwrap_err(),
+            "noise_levels 1e308 times rate_noise_ratio = 10 is not finite"
         );
         let err = config(0, 2, 1).validate().unwrap_err();
         assert_eq!(err, "noise_levels must hold at least one noise level");

@@ -509,6 +509,20 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
         .contains("arm.masses")
     );
     assert!(invalid(|s| s.arm.link_length = Some(0.0)).contains("length"));
+    // An inertia m L^2 / 12 that underflows is named as the field the length came from.
+    let err = invalid(|s| s.arm.link_length = Some(1e-300));
+    assert!(
+        err.contains("arm.link_length") && !err.contains("inertia about"),
+        "{err}"
+    );
+    let err = invalid(|s| {
+        s.arm.links = Some(3);
+        s.arm.lengths = Some(vec![0.1, 1e300, 0.1]);
+    });
+    assert!(
+        err.contains("arm.lengths[1] is invalid: link 1: length"),
+        "{err}"
+    );
     assert!(
         invalid(|s| s.limits.joint_torque_nm = Some(TorqueLimit::PerJoint(vec![1.0; 3])))
             .contains("joint_torque_nm")
