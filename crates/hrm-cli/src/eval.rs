@@ -576,15 +576,6 @@ fn joints(mut request: JointsRequest) -> EvalResult {
     ]))
 }
 
-/// A matrix as JSON rows.
-fn rows(m: manip_dyn::faer::MatRef<'_, f64>) -> Result<Value, EvalError> {
-    let rows: Vec<Vec<f64>> = (0..m.nrows())
-        .map(|i| (0..m.ncols()).map(|j| m[(i, j)]).collect())
-        .collect();
-    finite("mass_matrix", &rows.concat())?;
-    Ok(json!(rows))
-}
-
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct DynamicsRequest {
@@ -619,7 +610,10 @@ fn dynamics(request: DynamicsRequest) -> EvalResult {
     finite("coriolis", &coriolis)?;
     finite("gravity", &gravity)?;
     Ok(json_fields([
-        ("mass_matrix", rows(mass.as_ref())?),
+        (
+            "mass_matrix",
+            derivatives::rows("mass_matrix", mass.as_ref())?,
+        ),
         ("coriolis", json!(coriolis)),
         ("gravity", json!(gravity)),
     ]))
@@ -654,7 +648,7 @@ fn reduced(mut request: ReducedRequest) -> EvalResult {
         &request.tau_star,
         &mut a_ddot,
     )?;
-    let mass = rows(data.mass_matrix())?;
+    let mass = derivatives::rows("mass_matrix", data.mass_matrix())?;
     let (coriolis, gravity) = (data.coriolis().to_vec(), data.gravity().to_vec());
     modal_reduce::joint_torques(
         &model,

@@ -45,12 +45,7 @@ pub(super) fn rnea_derivatives(request: RneaDerivativesRequest) -> EvalResult {
         &request.theta_dot,
         &request.theta_ddot,
     )?;
-    finite("tau", derivatives.value())?;
-    Ok(json_fields([
-        ("tau", json!(derivatives.value())),
-        ("d_theta", rows("d_theta", derivatives.d_q())?),
-        ("d_theta_dot", rows("d_theta_dot", derivatives.d_v())?),
-    ]))
+    rnea_answer(derivatives.value(), derivatives.d_q(), derivatives.d_v())
 }
 
 #[derive(Deserialize)]
@@ -84,13 +79,12 @@ pub(super) fn aba_derivatives(request: AbaDerivativesRequest) -> EvalResult {
         &request.theta_dot,
         &request.tau,
     )?;
-    finite("theta_ddot", derivatives.value())?;
-    Ok(json_fields([
-        ("theta_ddot", json!(derivatives.value())),
-        ("d_theta", rows("d_theta", derivatives.d_q())?),
-        ("d_theta_dot", rows("d_theta_dot", derivatives.d_v())?),
-        ("d_tau", rows("d_tau", derivatives.d_input())?),
-    ]))
+    aba_answer(
+        derivatives.value(),
+        derivatives.d_q(),
+        derivatives.d_v(),
+        derivatives.d_input(),
+    )
 }
 
 #[derive(Deserialize)]
@@ -156,6 +150,34 @@ fn joint_vectors<const N: usize>(
         }
     }
     Ok(())
+}
+
+/// The answer of `rnea_derivatives` (of an arm or a URDF chain): `tau` and its Jacobians in
+/// `theta` and `theta_dot`, refused if an entry is not finite.
+pub(super) fn rnea_answer(tau: &[f64], d_q: MatRef<'_, f64>, d_v: MatRef<'_, f64>) -> EvalResult {
+    finite("tau", tau)?;
+    Ok(json_fields([
+        ("tau", json!(tau)),
+        ("d_theta", rows("d_theta", d_q)?),
+        ("d_theta_dot", rows("d_theta_dot", d_v)?),
+    ]))
+}
+
+/// The answer of `aba_derivatives` (of an arm or a URDF chain): `theta_ddot` and its Jacobians
+/// in `theta`, `theta_dot` and `tau`, refused if an entry is not finite.
+pub(super) fn aba_answer(
+    theta_ddot: &[f64],
+    d_q: MatRef<'_, f64>,
+    d_v: MatRef<'_, f64>,
+    d_tau: MatRef<'_, f64>,
+) -> EvalResult {
+    finite("theta_ddot", theta_ddot)?;
+    Ok(json_fields([
+        ("theta_ddot", json!(theta_ddot)),
+        ("d_theta", rows("d_theta", d_q)?),
+        ("d_theta_dot", rows("d_theta_dot", d_v)?),
+        ("d_tau", rows("d_tau", d_tau)?),
+    ]))
 }
 
 /// A matrix as JSON rows, refused if an entry is not finite.

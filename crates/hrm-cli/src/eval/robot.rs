@@ -9,7 +9,7 @@ use serde::Deserialize;
 use serde_json::json;
 use sim_study::ArmSpec;
 
-use super::derivatives::{MAX_DERIVATIVE_LINKS, rows};
+use super::derivatives::{MAX_DERIVATIVE_LINKS, aba_answer, rnea_answer, rows};
 use super::{EvalError, EvalResult, finite, json_fields};
 
 /// ROS's gravity, the default of a URDF chain (URDF carries none).
@@ -134,12 +134,7 @@ pub(super) fn rnea_derivatives(request: RneaDerivativesRequest) -> EvalResult {
         &request.theta_dot,
         &request.theta_ddot,
     )?;
-    finite("tau", derivatives.value())?;
-    Ok(json_fields([
-        ("tau", json!(derivatives.value())),
-        ("d_theta", rows("d_theta", derivatives.d_q())?),
-        ("d_theta_dot", rows("d_theta_dot", derivatives.d_v())?),
-    ]))
+    rnea_answer(derivatives.value(), derivatives.d_q(), derivatives.d_v())
 }
 
 /// `aba_derivatives` of a URDF chain.
@@ -174,13 +169,12 @@ pub(super) fn aba_derivatives(request: AbaDerivativesRequest) -> EvalResult {
         &request.theta_dot,
         &request.tau,
     )?;
-    finite("theta_ddot", derivatives.value())?;
-    Ok(json_fields([
-        ("theta_ddot", json!(derivatives.value())),
-        ("d_theta", rows("d_theta", derivatives.d_q())?),
-        ("d_theta_dot", rows("d_theta_dot", derivatives.d_v())?),
-        ("d_tau", rows("d_tau", derivatives.d_input())?),
-    ]))
+    aba_answer(
+        derivatives.value(),
+        derivatives.d_q(),
+        derivatives.d_v(),
+        derivatives.d_input(),
+    )
 }
 
 /// `frames`.
