@@ -2,6 +2,7 @@
 //! controller and the loop's settings, every setting checked and named when it fails.
 
 use super::controllers::{ControllerSetup, per_coordinate};
+use super::obstacles::Workspace;
 use super::schema::{
     Alpha0, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, NoiseSpec, ReferenceSpec,
     Scenario, TorqueLimit,
@@ -130,6 +131,7 @@ impl Scenario {
     > {
         let model = self.model()?;
         let m = model.n_coords();
+        self.clearance_model(model.n_links(), Workspace::Planar)?;
         let reference = self.reference.build(
             model.chain().total_length(),
             self.modal.harmonics,

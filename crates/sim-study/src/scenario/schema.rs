@@ -49,6 +49,53 @@ pub struct Scenario {
     /// Runaway bound and torque limits.
     #[serde(default)]
     pub limits: LimitsSpec,
+    /// Obstacles (`[[obstacles]]` tables): the loop takes the arm's clearance to them, and to
+    /// itself, at every controller sample.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacles: Vec<ObstacleSpec>,
+}
+
+/// An obstacle, tagged by `kind`. A planar arm moves in the plane `z = 0`: its obstacles are
+/// circles, capsules and boxes given by `[x, y]` points; a spatial arm's are spheres, capsules
+/// and boxes given by `[x, y, z]` points ([`Scenario::obstacles`] checks them).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum ObstacleSpec {
+    /// A disc of the arm's plane (planar arms).
+    Circle {
+        /// The centre `[x, y]` (m).
+        center: Vec<f64>,
+        /// The radius (m, non-negative).
+        radius: f64,
+    },
+    /// A ball (spatial arms).
+    Sphere {
+        /// The centre `[x, y, z]` (m).
+        center: Vec<f64>,
+        /// The radius (m, non-negative).
+        radius: f64,
+    },
+    /// The points within `radius` of the segment `from`-`to`.
+    Capsule {
+        /// One end of the axis (m).
+        from: Vec<f64>,
+        /// The other end (m).
+        to: Vec<f64>,
+        /// The radius (m, non-negative).
+        radius: f64,
+    },
+    /// A box, axis-aligned unless turned by `rpy`.
+    Box {
+        /// The centre (m).
+        center: Vec<f64>,
+        /// Half the side lengths along the box's own axes (m, positive): `[hx, hy]` in the
+        /// plane (the box is then a rectangle), `[hx, hy, hz]` in space.
+        half_extents: Vec<f64>,
+        /// Roll, pitch and yaw (rad, URDF's `R = Rz(yaw) Ry(pitch) Rx(roll)`, default zero); a
+        /// planar arm's box turns about `z` only (`[0, 0, yaw]`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        rpy: Option<Vec<f64>>,
+    },
 }
 
 /// The base inclination `alpha0` of a scenario: a number (fixed, in rad) or `"free"`.
@@ -160,6 +207,10 @@ pub struct ArmSpec {
     /// run in joint space by [`Scenario::run_chain`], with only `gravity` of the other keys.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub urdf: Option<PathBuf>,
+    /// The radius of every link's collision capsule around its segment (m, non-negative, default
+    /// 0): the clearance to obstacles and between links is measured from these capsules.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
 }
 
 /// The initial modal state (`m` entries each).
