@@ -120,9 +120,12 @@ impl Scenario {
         if self.noise != NoiseSpec::default() {
             return Err(unused("noise", "the joint-space loop is noise-free"));
         }
-        if self.limits.joint_torque_nm.is_some() || self.limits.tau_star.is_some() {
+        if self.limits.joint_torque_nm.is_some()
+            || self.limits.joint_angle_rad.is_some()
+            || self.limits.tau_star.is_some()
+        {
             return Err(unused(
-                "limits.joint_torque_nm and limits.tau_star",
+                "limits.joint_torque_nm, limits.joint_angle_rad and limits.tau_star",
                 "only limits.max_modal_error bounds the joint errors",
             ));
         }

@@ -4,8 +4,8 @@
 use super::controllers::{ControllerSetup, per_coordinate};
 use super::obstacles::Workspace;
 use super::schema::{
-    Alpha0, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, NoiseSpec, ReferenceSpec,
-    Scenario, TorqueLimit,
+    Alpha0, AngleLimit, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, NoiseSpec,
+    ReferenceSpec, Scenario, TorqueLimit,
 };
 use backbone_kin::{Branch, ModalMap};
 use fuzzy_sugeno::FuzzySystem;
@@ -131,7 +131,6 @@ impl Scenario {
     > {
         let model = self.model()?;
         let m = model.n_coords();
-        self.clearance_model(model.n_links(), Workspace::Planar)?;
         let reference = self.reference.build(
             model.chain().total_length(),
             self.modal.harmonics,
@@ -175,6 +174,11 @@ impl Scenario {
             TorqueLimit::All(limit) => vec![*limit; model.n_links()],
             TorqueLimit::PerJoint(limits) => limits.clone(),
         });
+        settings.joint_angle_limits = self.limits.joint_angle_rad.as_ref().map(|l| match l {
+            AngleLimit::All(limit) => vec![*limit; model.n_links()],
+            AngleLimit::PerJoint(limits) => limits.clone(),
+        });
+        settings.clearance = self.clearance_model(model.n_links(), Workspace::Planar)?;
         settings.tau_star_limits = match &self.limits.tau_star {
             None => None,
             Some(ModalTorqueLimit::All(limit)) => Some(vec![*limit; m]),

@@ -56,7 +56,8 @@
 //!
 //! [limits]
 //! max_modal_error = 3.14  # rad, runaway bound
-//! joint_torque_nm = 5.0   # or one limit per joint; exceeding is reported
+//! joint_torque_nm = 5.0   # or one limit per joint; enforced by projecting tau* each sample
+//! joint_angle_rad = 2.0   # |theta_j| <= 2 rad, or one limit per joint; enforced likewise
 //! tau_star = [2.0, 0.5]   # N m, or one limit for all: the loop clamps tau* to +-limit
 //! ```
 
@@ -72,7 +73,7 @@ pub use controllers::{CONTROLLERS, ControllerEntry, ControllerKind, ControllerSe
 pub use file::ScenarioError;
 pub use obstacles::{MAX_SCENARIO_OBSTACLES, Workspace};
 pub use schema::{
-    Alpha0, ArmSpec, BranchSpec, ControllerSpec, FuzzyInputRange, InitialSpec, IntegratorSpec,
-    LimitsSpec, ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec, ReferenceSpec, Scenario,
-    SineSpec, TorqueLimit,
+    Alpha0, AngleLimit, ArmSpec, BranchSpec, ControllerSpec, FuzzyInputRange, InitialSpec,
+    IntegratorSpec, LimitsSpec, ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec,
+    ReferenceSpec, Scenario, SineSpec, TorqueLimit,
 };

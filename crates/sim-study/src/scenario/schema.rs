@@ -431,17 +431,25 @@ impl NoiseSpec {
     }
 }
 
-/// The runaway bound, optional joint torque limits (reported) and optional limits (modal forces, not joint torques) on
-/// `tau*` (enforced).
+/// The runaway bound, optional joint torque and joint angle limits (enforced) and optional
+/// limits on the modal forces `tau*` (enforced).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LimitsSpec {
     /// The run stops when `|a_i - a_i_ref|` exceeds this (rad, default pi).
     #[serde(default = "default_max_modal_error")]
     pub max_modal_error: f64,
-    /// Joint torque limits (N m): one for all joints or one per joint; exceeding is reported.
+    /// Joint torque limits (N m): one for all joints or one per joint, enforced: at every
+    /// controller sample the loop projects `tau*` onto the modal torques whose joint torques
+    /// at that state are within them, and reports how often it acted
+    /// ([`LoopSettings::joint_torque_limits`](sim_core::LoopSettings::joint_torque_limits)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joint_torque_nm: Option<TorqueLimit>,
+    /// Joint angle limits `|theta_j| <= limit` (rad): one for all joints or one per joint,
+    /// enforced in the same projection by bounding each joint's rate towards its limit
+    /// ([`LoopSettings::joint_angle_limits`](sim_core::LoopSettings::joint_angle_limits)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint_angle_rad: Option<AngleLimit>,
     /// Saturation of the modal forces `tau* = J^T tau` (N m): one limit for every coordinate or
     /// one per coordinate (`m` entries), each finite and positive. They bound the modal
     /// coordinates' generalised forces, not any joint torque (see `joint_torque_nm`). The loop
@@ -460,6 +468,7 @@ impl Default for LimitsSpec {
         Self {
             max_modal_error: default_max_modal_error(),
             joint_torque_nm: None,
+            joint_angle_rad: None,
             tau_star: None,
         }
     }
@@ -473,6 +482,16 @@ pub enum ModalTorqueLimit {
     All(f64),
     /// One limit per coordinate, in coordinate order (N m).
     PerCoordinate(Vec<f64>),
+}
+
+/// An angle limit for every joint, or one per joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum AngleLimit {
+    /// The same limit for every joint (rad).
+    All(f64),
+    /// One limit per joint, base first (rad).
+    PerJoint(Vec<f64>),
 }
 
 /// A torque limit for every joint, or one per joint.
