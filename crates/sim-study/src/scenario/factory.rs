@@ -2,7 +2,6 @@
 //! controller and the loop's settings, every setting checked and named when it fails.
 
 use super::controllers::{ControllerSetup, per_coordinate};
-use super::obstacles::Workspace;
 use super::schema::{
     Alpha0, AngleLimit, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, NoiseSpec,
     ReferenceSpec, Scenario, TorqueLimit,
@@ -178,7 +177,7 @@ impl Scenario {
             AngleLimit::All(limit) => vec![*limit; model.n_links()],
             AngleLimit::PerJoint(limits) => limits.clone(),
         });
-        settings.clearance = self.clearance_model(model.n_links(), Workspace::Planar)?;
+        settings.clearance = self.clearance_model(model.n_links(), self.workspace())?;
         settings.tau_star_limits = match &self.limits.tau_star {
             None => None,
             Some(ModalTorqueLimit::All(limit)) => Some(vec![*limit; m]),

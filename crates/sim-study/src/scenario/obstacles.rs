@@ -36,6 +36,12 @@ impl Workspace {
 }
 
 impl Scenario {
+    /// Where the scenario's modal arm moves: in the plane (the scenario files' arms are planar
+    /// modal arms; a URDF arm runs in joint space without clearance).
+    pub fn workspace(&self) -> Workspace {
+        Workspace::Planar
+    }
+
     /// The scenario's obstacles for an arm in `workspace`, in file order, each checked: points
     /// of the workspace's dimension, finite; radii finite and non-negative; half-extents
     /// positive (finite); `rpy` three finite angles (`[0, 0, yaw]` in the plane); a `circle` in

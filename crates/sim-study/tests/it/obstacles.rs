@@ -179,3 +179,116 @@ fn unknown_kinds_and_keys_and_too_many_obstacles_are_refused() {
         "obstacles holds 1025 obstacles, more than the 1024 a scenario may"
     );
 }
+
+/// The clearance of a segment's capsule of radius `r` to a circle, by this file's own
+/// geometry: the distance from the centre to the closest point of the segment.
+fn segment_circle(p: [f64; 3], q: [f64; 3], center: [f64; 2], radius: f64, r: f64) -> f64 {
+    let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+    let t =
+        (((center[0] - p[0]) * dx + (center[1] - p[1]) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+    let (x, y) = (p[0] + t * dx, p[1] + t * dy);
+    (x - center[0]).hypot(y - center[1]) - radius - r
+}
+
+/// The paper's arm straight up (`a = 0`, `alpha0 = pi/2`), held by computed torque.
+fn straight(extra: &str) -> Scenario {
+    with(&format!(
+        "[controller]\nkind = \"computed-torque\"\n{extra}"
+    ))
+    .with_constant([0.0, 0.0])
+}
+
+trait Constant {
+    fn with_constant(self, a: [f64; 2]) -> Self;
+}
+
+impl Constant for Scenario {
+    fn with_constant(mut self, a: [f64; 2]) -> Self {
+        self.reference = sim_study::ReferenceSpec::Constant { a: a.to_vec() };
+        self.alpha0 = sim_study::Alpha0::Fixed(std::f64::consts::FRAC_PI_2);
+        self
+    }
+}
+
+#[test]
+fn the_clearance_of_a_straight_arm_is_its_closed_form() {
+    // The arm lies on x = 0 from y = 0 to 1: a circle at (0.3, 0.5) of radius 0.05 is 0.25 from
+    // its axis, and two links that share no joint are one link (0.1 m) apart along it.
+    let r = 0.01;
+    let scenario = straight(&format!(
+        "[arm]\nradius = {r}\n[[obstacles]]\nkind = \"circle\"\ncenter = [0.3, 0.5]\nradius = 0.05\n"
+    ));
+    let run = scenario.build().unwrap().run().unwrap();
+    let s = &run.summary;
+    assert!(
+        (s.min_clearance_m.unwrap() - (0.25 - r)).abs() < 1e-12,
+        "{s:?}"
+    );
+    assert!((s.min_self_clearance_m.unwrap() - (0.1 - 2.0 * r)).abs() < 1e-12);
+    assert_eq!(s.torque_projection_share, None);
+    // Without either key the summary has neither field, and the run is the same bit for bit.
+    let plain = straight("").build().unwrap().run().unwrap();
+    assert_eq!(plain.summary.min_clearance_m, None);
+    assert_eq!(plain.summary.min_self_clearance_m, None);
+    assert_eq!(plain.record.a, run.record.a);
+    assert_eq!(plain.record.joint_points, run.record.joint_points);
+    // The recorded points are the chain's: the base at the origin, the tip the recorded tip.
+    let points = run.record.joint_points_at(3);
+    assert_eq!(points.len(), 11);
+    assert_eq!(points[0], [0.0; 3]);
+    assert_eq!([points[10][0], points[10][1]], run.record.tip[3]);
+}
+
+/// Computed torque drives the arm from straight to the shape `a = (0.3, -0.2)`; an obstacle
+/// put where that shape's last link lies is hit: the unconstrained controller collides, which the
+/// clearance shows (negative), and the clearance recomputed from the recorded points with this
+/// file's own geometry is the summary's, the smallest over every sample.
+#[test]
+fn an_unconstrained_controller_collides_and_the_clearance_shows_it() {
+    let target = [0.3, -0.2];
+    let mut probe = straight("").with_constant(target);
+    probe.duration = 0.01;
+    let run = probe.build().unwrap().run().unwrap();
+    let shape = run.record.joint_points_at(0).to_vec();
+    // Start straight, step to the target at 0.05 s: the arm sweeps from x = 0 to the curved shape.
+    let mid = [
+        0.5 * (shape[9][0] + shape[10][0]),
+        0.5 * (shape[9][1] + shape[10][1]),
+    ];
+    assert!(mid[0].abs() > 0.1, "{mid:?}");
+    let (radius, r) = (0.02, 0.005);
+    let mut scenario = with(&format!(
+        "[controller]\nkind = \"computed-torque\"\n[arm]\nradius = {r}\n\
+         [[obstacles]]\nkind = \"circle\"\ncenter = [{}, {}]\nradius = {radius}\n",
+        mid[0], mid[1]
+    ));
+    scenario.alpha0 = sim_study::Alpha0::Fixed(std::f64::consts::FRAC_PI_2);
+    scenario.reference = sim_study::ReferenceSpec::Step {
+        initial: Some(vec![0.0, 0.0]),
+        target: target.to_vec(),
+        time: 0.05,
+    };
+    scenario.duration = 0.5;
+    let run = scenario.build().unwrap().run().unwrap();
+    let least = run.summary.min_clearance_m.unwrap();
+    assert!(
+        least < -radius,
+        "the arm goes through the obstacle: {least}"
+    );
+    // Every controller sample is recorded here, so the recorded minimum is the summary's.
+    assert_eq!(run.summary.recorded_samples, run.summary.controller_samples);
+    let mut recomputed = f64::INFINITY;
+    for k in 0..run.record.len() {
+        let p = run.record.joint_points_at(k);
+        for link in 0..10 {
+            recomputed = recomputed.min(segment_circle(p[link], p[link + 1], mid, radius, r));
+        }
+    }
+    assert!(
+        (recomputed - least).abs() < 1e-12,
+        "{recomputed} vs {least}"
+    );
+    // At the start the straight arm is clear of it.
+    let p = run.record.joint_points_at(0);
+    assert!((0..10).all(|l| segment_circle(p[l], p[l + 1], mid, radius, r) > 0.0));
+}
