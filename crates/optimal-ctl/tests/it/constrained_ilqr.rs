@@ -235,3 +235,105 @@ fn constrained_solves_need_their_rows_reserved_and_report_an_empty_polytope() {
     let refused = ilqr.solve_constrained(&mut sys, &mut empty, &[1.0, 0.0], &settings);
     assert_eq!(refused.unwrap_err(), OptimalError::Infeasible { step: 3 });
 }
+
+/// The paper's arm with `alpha0 = pi/2` fixed.
+fn paper_arm() -> modal_reduce::ReducedModel {
+    modal_reduce::ReducedModel::new(
+        manip_dyn::ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
+        backbone_kin::ModalMap::paper_fixed_alpha0(10, std::f64::consts::FRAC_PI_2).unwrap(),
+    )
+    .unwrap()
+}
+
+/// The joint torques of `tau_star` at `(a, a_dot)` by RNEA on the full chain (eq 12) with the
+/// joint accelerations `J a_ddot` of the reduced forward dynamics (eq 15).
+fn rnea_torques(
+    model: &modal_reduce::ReducedModel,
+    a: &[f64],
+    a_dot: &[f64],
+    u: &[f64],
+) -> Vec<f64> {
+    let mut data = modal_reduce::ReducedData::new(model);
+    let mut a_ddot = [0.0; 2];
+    modal_reduce::forward_dynamics(model, &mut data, a, a_dot, u, &mut a_ddot).unwrap();
+    let (mut q, mut v, mut qdd, mut tau) = ([0.0; 10], [0.0; 10], [0.0; 10], vec![0.0; 10]);
+    let map = model.map();
+    map.joint_angles(a, &mut q).unwrap();
+    map.joint_rates(a_dot, &mut v).unwrap();
+    map.joint_rates(&a_ddot, &mut qdd).unwrap();
+    let mut chain = manip_dyn::ChainData::new(model.chain());
+    manip_dyn::rnea(model.chain(), &mut chain, &q, &v, &qdd, &mut tau).unwrap();
+    tau
+}
+
+#[test]
+fn the_joint_torque_rows_are_the_chain_s_torques() {
+    let model = paper_arm();
+    let mut rows = optimal_ctl::JointTorqueRows::new(&model, &[2.0; 10]).unwrap();
+    let (mut g, mut bounds) = (vec![0.0; 40], vec![0.0; 20]);
+    let x = [0.4, -0.3, 1.5, -0.7];
+    assert_eq!(
+        rows.rows(0, &x, &[0.0; 2], &[], &mut g, &mut bounds)
+            .unwrap(),
+        20
+    );
+    for u in [[0.0, 0.0], [1.3, -0.4], [-2.0, 3.0]] {
+        let tau = rnea_torques(&model, &x[..2], &x[2..], &u);
+        for j in 0..10 {
+            // Row 2j is A_j u <= limit - b_j: A_j u + b_j = tau_j.
+            let affine = g[2 * j * 2] * u[0] + g[2 * j * 2 + 1] * u[1] + (2.0 - bounds[2 * j]);
+            assert!(
+                (affine - tau[j]).abs() < 1e-10,
+                "joint {j}: {affine} vs {}",
+                tau[j]
+            );
+            assert_eq!(g[(2 * j + 1) * 2], -g[2 * j * 2]);
+            assert!((bounds[2 * j + 1] - (2.0 + (2.0 - bounds[2 * j]))).abs() < 1e-12);
+        }
+    }
+}
+
+/// MPC on the paper's arm towards a bent shape: the unconstrained plan asks for joint torques
+/// beyond 3 N m; the plan within the joint-torque polytope keeps every node's joint torques
+/// (by RNEA, at the planned states) within them.
+#[test]
+fn mpc_plans_within_the_joint_torque_limits() {
+    let model = paper_arm();
+    let mut settings = optimal_ctl::MpcSettings::uniform(2);
+    settings.horizon = 30;
+    let limit = 3.0;
+    let target = ([0.6, -0.4], [0.0; 2], [0.0; 2]);
+    let plan = |constrained: bool| {
+        let mut mpc = optimal_ctl::Mpc::new(&model, &settings).unwrap();
+        for k in 0..=mpc.horizon() {
+            mpc.set_reference(&model, k, &target.0, &target.1, &target.2)
+                .unwrap();
+        }
+        let mut rows = optimal_ctl::JointTorqueRows::new(&model, &[limit; 10]).unwrap();
+        for _ in 0..4 {
+            if constrained {
+                mpc.solve_constrained(&model, &[0.0; 2], &[0.0; 2], &mut rows)
+                    .unwrap();
+            } else {
+                mpc.solve(&model, &[0.0; 2], &[0.0; 2]).unwrap();
+            }
+        }
+        let ilqr = mpc.ilqr();
+        let peak = (0..ilqr.horizon())
+            .map(|k| {
+                let x = &ilqr.states()[k * 4..(k + 1) * 4];
+                let u = &ilqr.controls()[k * 2..(k + 1) * 2];
+                rnea_torques(&model, &x[..2], &x[2..], u)
+                    .iter()
+                    .fold(0.0f64, |m, t| m.max(t.abs()))
+            })
+            .fold(0.0f64, f64::max);
+        (peak, ilqr.states()[ilqr.horizon() * 4])
+    };
+    let (free_peak, _) = plan(false);
+    assert!(free_peak > 1.5 * limit, "{free_peak}");
+    let (peak, a1_end) = plan(true);
+    assert!(peak <= limit * (1.0 + 1e-9), "{peak}");
+    // ... and still moves towards the target.
+    assert!(a1_end > 0.1, "{a1_end}");
+}
