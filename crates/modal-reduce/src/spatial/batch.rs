@@ -35,14 +35,14 @@ pub const MAX_SPATIAL_BATCH_COORDS: usize = 8;
 /// once, reuse it for every batch. It holds a [`SpatialReducedData`] for the states evaluated one
 /// at a time; the SIMD groups need nothing more.
 #[derive(Debug, Clone)]
-pub struct SpatialBatchData {
+pub struct SpatialReducedBatchData {
     /// The one-state workspace.
     single: SpatialReducedData,
     /// The instruction set found at construction.
     arch: Arch,
 }
 
-impl SpatialBatchData {
+impl SpatialReducedBatchData {
     /// A workspace sized for `model`, for the instruction set of this processor.
     pub fn new(model: &SpatialReducedModel) -> Self {
         Self {
@@ -72,7 +72,7 @@ pub fn spatial_batch_lanes(model: &SpatialReducedModel) -> usize {
 ///
 /// ```
 /// use modal_reduce::spatial::{
-///     SpatialBatchData, SpatialReducedData, SpatialReducedModel, spatial_forward_dynamics,
+///     SpatialReducedBatchData, SpatialReducedData, SpatialReducedModel, spatial_forward_dynamics,
 ///     spatial_forward_dynamics_batch,
 /// };
 ///
@@ -82,7 +82,7 @@ pub fn spatial_batch_lanes(model: &SpatialReducedModel) -> usize {
 /// let a_dot: Vec<f64> = (0..4 * states).map(|i| 0.2 * (i as f64).cos()).collect();
 /// let tau_star = vec![0.05; 4 * states];
 /// let mut a_ddot = vec![0.0; 4 * states];
-/// let mut batch = SpatialBatchData::new(&model);
+/// let mut batch = SpatialReducedBatchData::new(&model);
 /// spatial_forward_dynamics_batch(&model, &mut batch, &a, &a_dot, &tau_star, &mut a_ddot)?;
 /// let (mut data, mut one) = (SpatialReducedData::new(&model), [0.0; 4]);
 /// spatial_forward_dynamics(&model, &mut data, &a[36..40], &a_dot[36..40], &tau_star[36..40], &mut one)?;
@@ -91,7 +91,7 @@ pub fn spatial_batch_lanes(model: &SpatialReducedModel) -> usize {
 /// ```
 pub fn spatial_forward_dynamics_batch(
     model: &SpatialReducedModel,
-    data: &mut SpatialBatchData,
+    data: &mut SpatialReducedBatchData,
     a: &[f64],
     a_dot: &[f64],
     tau_star: &[f64],
@@ -277,7 +277,7 @@ mod tests {
             let tau_star: Vec<f64> = (0..m * states).map(|i| value(i + 9, 0.3)).collect();
             let mut reference: Option<Vec<u64>> = None;
             for arch in lane_math::instruction_sets() {
-                let mut batch_data = SpatialBatchData::new(&model);
+                let mut batch_data = SpatialReducedBatchData::new(&model);
                 batch_data.arch = arch;
                 batch_data.single.arch = arch;
                 let mut batch = vec![0.0; m * states];

@@ -25,7 +25,8 @@ pub mod terms;
 pub mod torques;
 
 pub use batch::{
-    MAX_SPATIAL_BATCH_COORDS, SpatialBatchData, spatial_batch_lanes, spatial_forward_dynamics_batch,
+    MAX_SPATIAL_BATCH_COORDS, SpatialReducedBatchData, spatial_batch_lanes,
+    spatial_forward_dynamics_batch,
 };
 pub use data::SpatialReducedData;
 pub use derivatives::{SpatialReducedDerivatives, spatial_reduced_derivatives};
