@@ -52,17 +52,20 @@
 //! tau_star = [2.0, 0.5]   # N m, or one limit for all: the loop clamps tau* to +-limit
 //! ```
 
+mod arm;
 mod builtin;
 mod chain;
 mod controllers;
 mod factory;
 mod file;
 mod schema;
+mod spatial;
 
+pub use arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout};
 pub use controllers::{CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup};
 pub use file::ScenarioError;
 pub use schema::{
-    Alpha0, ArmSpec, BranchSpec, ControllerSpec, FuzzyInputRange, InitialSpec, IntegratorSpec,
-    LimitsSpec, ModalSpec, ModalTorqueLimit, NoiseSpec, ReferenceSpec, Scenario, SineSpec,
-    TorqueLimit,
+    Alpha0, ArmSpec, BranchSpec, ControllerSpec, FuzzyInputRange, HelixSpec, InitialSpec,
+    IntegratorSpec, LimitsSpec, ModalSpec, ModalTorqueLimit, NoiseSpec, ReferenceSpec, Scenario,
+    SineSpec, TorqueLimit,
 };
