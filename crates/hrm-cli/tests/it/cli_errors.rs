@@ -750,3 +750,125 @@ fn hrm_view_writes_a_page_and_a_gif_and_replaces_only_its_own_files() {
     assert!(line.contains("gif speed: NaN"), "{line}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn hrm_view_of_a_sweep_runs_the_chosen_runs_again() {
+    let dir = scratch("errors-view-sweep");
+    // The short step response with its own copy of the paper's fuzzy system.
+    let fis = dir.join("mine.fis");
+    std::fs::copy(
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../fuzzy-sugeno/data/paper.fis"
+        ),
+        &fis,
+    )
+    .unwrap();
+    let scenario = short_scenario(&dir);
+    let text = std::fs::read_to_string(&scenario).unwrap();
+    std::fs::write(
+        &scenario,
+        text.replace(
+            "kind = \"fuzzy\"\n",
+            "kind = \"fuzzy\"\nfis = \"mine.fis\"\n",
+        ),
+    )
+    .unwrap();
+    let sweep = dir.join("sweep");
+    let output = hrm(&[
+        "sweep",
+        "--scenario",
+        path(&scenario),
+        "--noise",
+        "0,0.05",
+        "--seeds",
+        "2",
+        "--controllers",
+        "fuzzy,pd",
+        "--out",
+        path(&sweep),
+    ]);
+    assert!(output.status.success(), "{output:?}");
+    // The list: every run, numbered as in runs.json.
+    let output = hrm(&["view", path(&sweep), "--list"]);
+    assert!(output.status.success(), "{output:?}");
+    let list = String::from_utf8(output.stdout).unwrap();
+    let rows: Vec<&str> = list.lines().skip(2).collect();
+    assert_eq!(rows.len(), 8, "{list}");
+    let words: Vec<&str> = rows[6].split_whitespace().collect();
+    assert_eq!(
+        words[..7],
+        ["6", "0.05", "pd", "1", "tip", "error", "RMS"],
+        "{list}"
+    );
+    assert!(!sweep.join("view.html").exists(), "--list writes nothing");
+    // By default the first seed of both controllers at both noise levels, run again: their
+    // metrics are those the sweep stored, bit for bit (no warning).
+    let output = hrm(&["view", path(&sweep)]);
+    assert!(output.status.success(), "{output:?}");
+    assert!(output.stderr.is_empty(), "{output:?}");
+    let page = std::fs::read_to_string(sweep.join("view.html")).unwrap();
+    assert_eq!(page.matches("<section class=\"hrm-scene\"").count(), 2);
+    assert!(page.contains("at noise level L = 0.05 rad, seed 1"));
+    assert!(page.contains("Runs 4 (fuzzy), 6 (pd) of the sweep"));
+    // Chosen runs, one scene per noise level and seed.
+    let page_b = dir.join("b.html");
+    let output = hrm(&[
+        "view",
+        path(&sweep),
+        "--runs",
+        "5,1",
+        "--out",
+        path(&page_b),
+    ]);
+    assert!(output.status.success(), "{output:?}");
+    let page = std::fs::read_to_string(&page_b).unwrap();
+    assert_eq!(page.matches("<section class=\"hrm-scene\"").count(), 2);
+    assert!(page.contains("L = 0 rad, seed 2") && page.contains("L = 0.05 rad, seed 2"));
+    // A stored metric the re-run does not give is reported, and the page still written.
+    let runs = sweep.join("runs.json");
+    let stored = std::fs::read_to_string(&runs).unwrap();
+    let mut lines: Vec<String> = stored.lines().map(String::from).collect();
+    let mut run: serde_json::Value = serde_json::from_str(&lines[1]).unwrap();
+    let rms = &mut run["outcome"]["completed"]["tip_error_rms_m"];
+    *rms = serde_json::json!(rms.as_f64().unwrap() * 0.999);
+    lines[1] = run.to_string();
+    std::fs::write(&runs, lines.join("\n") + "\n").unwrap();
+    let output = hrm(&["view", path(&sweep), "--runs", "0"]);
+    assert!(output.status.success(), "{output:?}");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.starts_with("warning: run 0 (fuzzy) of ")
+            && stderr.contains("did not give the metrics the sweep stored"),
+        "{stderr}"
+    );
+    std::fs::write(&runs, &stored).unwrap();
+    // Bounded, checked selections.
+    let line = refused(&hrm(&["view", path(&sweep), "--runs", "8"]));
+    assert!(
+        line.ends_with(
+            "--runs 8: the sweep has 8 runs, numbered 0 to 7 (`hrm view DIR --list` lists them)"
+        ),
+        "{line}"
+    );
+    let line = refused(&hrm(&["view", path(&sweep), "--runs", "3,3"]));
+    assert!(line.ends_with("--runs lists run 3 twice"), "{line}");
+    let many = (0..13).map(|i| i.to_string()).collect::<Vec<_>>().join(",");
+    let line = refused(&hrm(&["view", path(&sweep), "--runs", &many]));
+    assert!(line.contains("more than the 12"), "{line}");
+    let line = refused(&hrm(&["view", path(&dir), "--list"]));
+    assert!(
+        line.contains("--list and --runs take a sweep's output folder"),
+        "{line}"
+    );
+    // The fuzzy system changed since the sweep ran: its runs cannot be run again.
+    std::fs::write(&fis, std::fs::read_to_string(&fis).unwrap() + "\n").unwrap();
+    let before = std::fs::read(sweep.join("view.html")).unwrap();
+    let line = refused(&hrm(&["view", path(&sweep)]));
+    assert!(
+        line.contains("mine.fis") && line.contains("changed since the sweep ran"),
+        "{line}"
+    );
+    assert_eq!(std::fs::read(sweep.join("view.html")).unwrap(), before);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
