@@ -189,6 +189,46 @@ fn fis_check_of_40000_rules_is_refused_by_its_work_bound() {
 }
 
 #[test]
+fn fis_check_of_a_grid_past_its_limit_says_what_the_system_needs() {
+    // 4 inputs of 20 triangles: their landmarks and the midpoints between them alone make 41^4
+    // (2.8 million) grid points, past a limit the command line does not offer to raise.
+    let dir = scratch("errors-fis-grid");
+    let mut text = String::from(
+        "[System]\nName='wide'\nType='sugeno'\nNumInputs=4\nNumOutputs=1\nNumRules=1\n\
+         AndMethod='prod'\nOrMethod='probor'\nImpMethod='prod'\nAggMethod='sum'\n\
+         DefuzzMethod='wtaver'\n",
+    );
+    for input in 1..=4 {
+        text.push_str(&format!(
+            "\n[Input{input}]\nName='x{input}'\nRange=[0 20]\nNumMFs=20\n"
+        ));
+        for k in 0..20 {
+            text.push_str(&format!(
+                "MF{}='s{k}':'trimf',[{} {k} {}]\n",
+                k + 1,
+                k as f64 - 1.0,
+                k + 1
+            ));
+        }
+    }
+    text.push_str("\n[Output1]\nName='y'\nRange=[0 1]\nNumMFs=1\nMF1='c':'constant',[0.5]\n");
+    text.push_str("\n[Rules]\n1 1 1 1, 1 (1) : 1\n");
+    let file = dir.join("wide.fis");
+    std::fs::write(&file, text).unwrap();
+    let line = refused(&hrm(&["fis", "check", path(&file)]));
+    assert!(
+        line.contains(
+            "the completeness grid of this system needs 2825761 points (41 x 41 x 41 x 41"
+        ) && line.contains(
+            "more than the 1000000 `hrm fis check` evaluates: check a system with fewer \
+                 inputs or sets"
+        ) && !line.contains("raise"),
+        "{line}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn fis_check_options_are_named_as_given() {
     let dir = scratch("errors-fis-options");
     let file = dir.join("small.fis");
