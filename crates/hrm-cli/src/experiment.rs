@@ -1,10 +1,10 @@
 //! The main job (`hrm` with no arguments) and `hrm simulate`: closed-loop runs of the shipped
 //! scenarios (section 5 of the paper), a comparison table, and per-run output files.
 
-use crate::console::CsvNumber;
 use crate::output_dir::OutputDir;
 use crate::spatial_figures::{self, CoordinateSeries};
 use crate::{console, figures, progress, report};
+use lane_math::Compact;
 use serde_json::json;
 use sim_core::Run;
 use sim_study::imitation::{self, ImitationOptions};
@@ -498,7 +498,7 @@ fn write_outcome(outcome: &ComparisonRun, scenario: &Scenario, dir: &Path) -> Re
                 .chain(spatial.then_some(r.tip_ref_z[k]))
                 .chain(r.clamped_at(k).iter().map(|&c| f64::from(u8::from(c))))
                 .chain(r.joint_torques_at(k).iter().copied());
-            let line: Vec<String> = row.map(|v| CsvNumber(v).to_string()).collect();
+            let line: Vec<String> = row.map(|v| Compact(v).to_string()).collect();
             let _ = writeln!(csv, "{}", line.join(","));
         }
         write(&dir.join("timeseries.csv"), &csv)?;
