@@ -1,0 +1,19 @@
+#![doc = include_str!("../README.md")]
+
+mod arm;
+mod data;
+mod error;
+mod motion;
+mod options;
+mod planar;
+mod planner;
+mod shape;
+
+pub use arm::Arm;
+pub use data::PlanData;
+pub use error::PlanError;
+pub use motion::{SegmentCheck, check_segment};
+pub use options::{MAX_CHECKS, MAX_ITERATIONS, MAX_SAMPLES, PlanOptions};
+pub use planar::PlanarArm;
+pub use planner::{Plan, Planner};
+pub use shape::{ShapeOutcome, solve_shape};
