@@ -3,6 +3,7 @@
 mod arm;
 mod data;
 mod error;
+mod generator;
 mod motion;
 mod options;
 mod planar;
@@ -12,6 +13,7 @@ mod shape;
 pub use arm::Arm;
 pub use data::PlanData;
 pub use error::PlanError;
+pub use generator::{MAX_PASSAGE_OBSTACLES, NarrowPassage, PassageSpec, narrow_passage};
 pub use motion::{SegmentCheck, check_segment};
 pub use options::{MAX_CHECKS, MAX_ITERATIONS, MAX_SAMPLES, PlanOptions};
 pub use planar::PlanarArm;
