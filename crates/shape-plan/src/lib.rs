@@ -2,6 +2,7 @@
 
 mod arm;
 mod data;
+mod deploy;
 mod error;
 mod generator;
 mod motion;
@@ -12,6 +13,10 @@ mod shape;
 
 pub use arm::Arm;
 pub use data::PlanData;
+pub use deploy::{
+    Channel, DeployFrame, DeployMetrics, Deployment, MAX_CENTERLINE_POINTS, MAX_DEPLOY_STEPS,
+    MAX_LENGTH_RATIO, follow_the_leader,
+};
 pub use error::PlanError;
 pub use generator::{MAX_PASSAGE_OBSTACLES, NarrowPassage, PassageSpec, narrow_passage};
 pub use motion::{SegmentCheck, check_segment};
