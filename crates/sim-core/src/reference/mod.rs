@@ -10,9 +10,11 @@
 pub(crate) mod continuation;
 mod path;
 mod preview;
+mod waypoints;
 
 pub use path::{CartesianPath, FREE_BASE_START, PathShape};
 pub use preview::{MAX_PREVIEW_SAMPLES, ReferencePreview};
+pub use waypoints::{MAX_WAYPOINTS, Waypoints};
 
 use crate::error::{SimError, check_finite, check_non_negative};
 
