@@ -1,6 +1,6 @@
 //! The planner's working memory, sized once from an arm and its clearance model.
 
-use crate::arm::Arm;
+use crate::arm::{Arm, ArmScratch};
 use crate::error::PlanError;
 use clearance::{ClearanceData, ClearanceModel};
 use optimal_ctl::LinearQp;
@@ -16,8 +16,10 @@ pub struct PlanData {
     pub(crate) current: ClearanceData,
     /// The clearance data of a trial step or a check point (distances only).
     pub(crate) trial: ClearanceData,
-    /// Joint angles of the last placed shape.
-    pub(crate) theta: Vec<f64>,
+    /// Joint angles, points and axes of the last placed shape.
+    pub(crate) scratch: ArmScratch,
+    /// Every pair's modal gradient at the current iterate, `pairs x m`.
+    pub(crate) gradients: Vec<f64>,
     /// `d tip / d a` of the current iterate, `3 x m`.
     pub(crate) tip_jacobian: Vec<f64>,
     /// A trial point or check point in modal coordinates.
@@ -44,7 +46,8 @@ impl PlanData {
         Ok(Self {
             current: data.clone(),
             trial: data,
-            theta: vec![0.0; arm.n_joints()],
+            scratch: ArmScratch::new(arm),
+            gradients: vec![0.0; clearance.pairs().len() * m],
             tip_jacobian: vec![0.0; 3 * m],
             point: vec![0.0; m],
             step: vec![0.0; m],

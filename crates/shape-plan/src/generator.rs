@@ -117,7 +117,7 @@ pub fn narrow_passage(spec: &PassageSpec) -> Result<NarrowPassage, PlanError> {
         for x in &mut witness {
             *x = rng.random_range(-spec.amplitude..=spec.amplitude);
         }
-        arm.place(&model, &mut data.current, &mut data.theta, &witness)?;
+        arm.place(&model, &mut data.current, &mut data.scratch, &witness)?;
         let (_, itself) = distances(&model, &mut data.current);
         best = best.max(itself);
         if itself >= options.needed()
@@ -135,7 +135,7 @@ pub fn narrow_passage(spec: &PassageSpec) -> Result<NarrowPassage, PlanError> {
             starts: 1000,
         });
     }
-    arm.place(&model, &mut data.current, &mut data.theta, &witness)?;
+    arm.place(&model, &mut data.current, &mut data.scratch, &witness)?;
     let points = data.current.points().to_vec();
     let target = [points[n][0], points[n][1]];
     let mut obstacles = Vec::with_capacity(spec.obstacles);

@@ -10,8 +10,9 @@ mod options;
 mod planar;
 mod planner;
 mod shape;
+mod spatial;
 
-pub use arm::Arm;
+pub use arm::{Arm, ArmScratch};
 pub use data::PlanData;
 pub use deploy::{
     Channel, DeployFrame, DeployMetrics, Deployment, MAX_CENTERLINE_POINTS, MAX_DEPLOY_STEPS,
@@ -24,3 +25,4 @@ pub use options::{MAX_CHECKS, MAX_ITERATIONS, MAX_SAMPLES, PlanOptions};
 pub use planar::PlanarArm;
 pub use planner::{Plan, Planner};
 pub use shape::{ShapeOutcome, solve_shape};
+pub use spatial::SpatialArm;

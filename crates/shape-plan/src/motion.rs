@@ -65,7 +65,7 @@ pub fn check_segment<A: Arm>(
         for ((p, x), y) in data.point.iter_mut().zip(from).zip(to) {
             *p = x + s * (y - x);
         }
-        arm.place(clearance, &mut data.trial, &mut data.theta, &data.point)?;
+        arm.place(clearance, &mut data.trial, &mut data.scratch, &data.point)?;
         let (obstacles, itself) = distances(clearance, &mut data.trial);
         checks += 1;
         smallest = smallest.min(obstacles.min(itself));

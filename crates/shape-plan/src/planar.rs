@@ -1,6 +1,6 @@
 //! The planar modal arm: `K` harmonics, `alpha0` fixed or free, base at the origin.
 
-use crate::arm::Arm;
+use crate::arm::{Arm, ArmScratch};
 use crate::error::{PlanError, check_len};
 use backbone_kin::{BaseAngle, Branch, ChainIk, ModalMap};
 use clearance::{ClearanceData, ClearanceModel, modal_gradients, place_planar};
@@ -78,11 +78,11 @@ impl Arm for PlanarArm {
         &self,
         clearance: &ClearanceModel,
         data: &mut ClearanceData,
-        theta: &mut [f64],
+        scratch: &mut ArmScratch,
         a: &[f64],
     ) -> Result<(), PlanError> {
-        self.map.joint_angles(a, theta)?;
-        place_planar(clearance, data, &self.link_lengths, theta)?;
+        self.map.joint_angles(a, &mut scratch.theta)?;
+        place_planar(clearance, data, &self.link_lengths, &scratch.theta)?;
         Ok(())
     }
 
@@ -90,12 +90,21 @@ impl Arm for PlanarArm {
         &self,
         clearance: &ClearanceModel,
         data: &mut ClearanceData,
-        _theta: &[f64],
+        _scratch: &mut ArmScratch,
+        gradients: &mut [f64],
         tip_jacobian: &mut [f64],
     ) -> Result<(), PlanError> {
         let m = self.map.n_coords();
         check_len("tip Jacobian", tip_jacobian.len(), 3 * m)?;
+        check_len(
+            "pair gradients",
+            gradients.len(),
+            clearance.pairs().len() * m,
+        )?;
         modal_gradients(clearance, data, &self.map)?;
+        for (k, row) in gradients.chunks_exact_mut(m.max(1)).enumerate() {
+            row.copy_from_slice(data.modal_gradient(k));
+        }
         // d tip / d theta_j = z x (tip - p_j), then d tip / d a = sum_j (d tip / d theta_j) J_j.
         let points = data.points();
         let tip = points[self.link_lengths.len()];

@@ -76,7 +76,7 @@ impl<A: Arm> Planner<A> {
         check_len("modal coordinates", a.len(), self.arm.n_coords())?;
         let data = &mut self.data;
         self.arm
-            .place(&self.clearance, &mut data.trial, &mut data.theta, a)?;
+            .place(&self.clearance, &mut data.trial, &mut data.scratch, a)?;
         let (obstacles, itself) = distances(&self.clearance, &mut data.trial);
         Ok(obstacles.min(itself))
     }

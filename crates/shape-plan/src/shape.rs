@@ -2,7 +2,7 @@
 //! the modal coordinates with a trust region (`docs/theory.md`, "Shape planning").
 //!
 //! Each iteration linearises the tip `p(a)` (`T = d p / d a`) and every pair's clearance `d_k(a)`
-//! (its modal gradient, `clearance::modal_gradients`) and solves the strictly convex QP
+//! (its modal gradient, [`Arm::gradients`]) and solves the strictly convex QP
 //!
 //! `min_delta 1/2 |e + T delta|^2 + mu/2 |delta|^2`
 //! subject to `d_k + grad d_k . delta >= g_k` for every pair and `|delta|_inf <= Delta`,
@@ -66,12 +66,13 @@ pub fn solve_shape<A: Arm>(
     let rho = arm.length();
     let n_pairs = clearance.pairs().len();
 
-    arm.place(clearance, &mut data.current, &mut data.theta, a)?;
+    arm.place(clearance, &mut data.current, &mut data.scratch, a)?;
     distances(clearance, &mut data.current);
     arm.gradients(
         clearance,
         &mut data.current,
-        &data.theta,
+        &mut data.scratch,
+        &mut data.gradients,
         &mut data.tip_jacobian,
     )?;
     let mut state = Evaluation::of(&data.current, clearance, target, goal, rho, arm.n_links());
@@ -108,7 +109,7 @@ pub fn solve_shape<A: Arm>(
         for relaxed in [false, true] {
             for (k, &d) in data.current.distances().iter().enumerate() {
                 let row = &mut data.rows[k * m..(k + 1) * m];
-                for (r, g) in row.iter_mut().zip(data.current.modal_gradient(k)) {
+                for (r, g) in row.iter_mut().zip(&data.gradients[k * m..(k + 1) * m]) {
                     *r = -g;
                 }
                 let target_clearance = if relaxed { goal.min(d) } else { goal };
@@ -154,9 +155,7 @@ pub fn solve_shape<A: Arm>(
         }
         let mut model_violation = 0.0;
         for (k, &d) in data.current.distances().iter().enumerate() {
-            let slope: f64 = data
-                .current
-                .modal_gradient(k)
+            let slope: f64 = data.gradients[k * m..(k + 1) * m]
                 .iter()
                 .zip(&data.step)
                 .map(|(x, y)| x * y)
@@ -171,7 +170,7 @@ pub fn solve_shape<A: Arm>(
         for ((p, x), s) in data.point.iter_mut().zip(a.iter()).zip(&data.step) {
             *p = x + s;
         }
-        arm.place(clearance, &mut data.trial, &mut data.theta, &data.point)?;
+        arm.place(clearance, &mut data.trial, &mut data.scratch, &data.point)?;
         distances(clearance, &mut data.trial);
         let trial = Evaluation::of(&data.trial, clearance, target, goal, rho, arm.n_links());
         let ratio = (state.merit - trial.merit) / predicted;
@@ -182,7 +181,8 @@ pub fn solve_shape<A: Arm>(
             arm.gradients(
                 clearance,
                 &mut data.current,
-                &data.theta,
+                &mut data.scratch,
+                &mut data.gradients,
                 &mut data.tip_jacobian,
             )?;
             state = trial;

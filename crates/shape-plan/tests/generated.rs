@@ -48,11 +48,11 @@ fn generated_passages_are_solvable_and_solved() {
         )
         .unwrap();
         assert!(check.clear, "seed {seed}");
-        let mut theta = vec![0.0; 10];
+        let mut scratch = shape_plan::ArmScratch::new(&problem.arm);
         let mut cd = clearance::ClearanceData::new(model, 4).unwrap();
         problem
             .arm
-            .place(model, &mut cd, &mut theta, &problem.witness)
+            .place(model, &mut cd, &mut scratch, &problem.witness)
             .unwrap();
         let (near, itself) = distances(model, &mut cd);
         let tip = cd.points()[10];
