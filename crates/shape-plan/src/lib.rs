@@ -19,7 +19,9 @@ pub use deploy::{
     MAX_LENGTH_RATIO, follow_the_leader,
 };
 pub use error::PlanError;
-pub use generator::{MAX_PASSAGE_OBSTACLES, NarrowPassage, PassageSpec, narrow_passage};
+pub use generator::{
+    MAX_PASSAGE_OBSTACLES, NarrowPassage, PassageSpec, narrow_passage, spatial_narrow_passage,
+};
 pub use motion::{SegmentCheck, check_segment};
 pub use options::{MAX_CHECKS, MAX_ITERATIONS, MAX_SAMPLES, PlanOptions};
 pub use planar::PlanarArm;

@@ -76,3 +76,46 @@ fn generated_passages_are_solvable_and_solved() {
     eprintln!("solved {solved} of {problems}");
     assert!(solved >= problems - 1, "{solved}");
 }
+
+#[test]
+fn generated_spatial_passages_are_solved() {
+    let mut solved = 0;
+    let problems = 8;
+    for seed in 0..problems {
+        let problem = shape_plan::spatial_narrow_passage(&PassageSpec {
+            harmonics: 1,
+            ..spec(seed)
+        })
+        .unwrap();
+        let model = &problem.clearance_model;
+        assert!(model.obstacles().len() >= 3, "seed {seed}");
+        assert_eq!(problem.target.len(), 3);
+        let options = PlanOptions {
+            clearance: 0.01,
+            check_slack: 0.002,
+            seed,
+            ..PlanOptions::default()
+        };
+        let mut data = PlanData::new(&problem.arm, model).unwrap();
+        let witness = check_segment(
+            &problem.arm,
+            model,
+            &options,
+            &mut data,
+            &problem.initial,
+            &problem.witness,
+        )
+        .unwrap();
+        assert!(witness.clear, "seed {seed}");
+        let mut planner = Planner::new(problem.arm.clone(), model.clone(), options).unwrap();
+        match planner.plan(&problem.initial, &problem.target) {
+            Ok(plan) => {
+                solved += 1;
+                assert!(plan.goal_clearance >= options.needed());
+            }
+            Err(e) => eprintln!("seed {seed}: {e}"),
+        }
+    }
+    eprintln!("solved {solved} of {problems}");
+    assert!(solved >= problems - 1, "{solved}");
+}
