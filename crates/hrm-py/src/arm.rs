@@ -104,6 +104,7 @@ impl Arm {
             masses,
             inertias,
             urdf: None,
+            radius: None,
         };
         let chain = spec.to_chain().map_err(Error::from)?;
         Ok(Self::from_chain(chain))

@@ -134,6 +134,15 @@ pub enum SimError {
         /// The bound in force (rad).
         bound: f64,
     },
+    /// The enforced joint limits (`limits.joint_torque_nm`, `limits.joint_angle_rad`) could not
+    /// be met at a controller sample: no modal torque keeps them at that state.
+    #[error("joint limits at t = {t} s: {reason}")]
+    JointLimits {
+        /// When (s).
+        t: f64,
+        /// Why.
+        reason: &'static str,
+    },
 }
 
 /// The error of a controller from outside this crate, shared so that a [`SimError`] stays
@@ -177,7 +186,8 @@ impl Classify for SimError {
             | Self::NonFiniteControl { .. }
             | Self::NonFiniteDisturbance { .. }
             | Self::Controller { .. }
-            | Self::RunawayError { .. } => ErrorClass::Numerical,
+            | Self::RunawayError { .. }
+            | Self::JointLimits { .. } => ErrorClass::Numerical,
             _ => ErrorClass::InvalidInput,
         }
     }
