@@ -524,7 +524,7 @@ fn links_csv(r: &sim_core::Record, workspace: Workspace) -> String {
         let points = r.joint_points_at(k).iter();
         let coordinates = points.flat_map(|p| p.iter().take(axes.len()).copied());
         let row = std::iter::once(r.t[k]).chain(coordinates);
-        let line: Vec<String> = row.map(|v| CsvNumber(v).to_string()).collect();
+        let line: Vec<String> = row.map(|v| Compact(v).to_string()).collect();
         let _ = writeln!(csv, "{}", line.join(","));
     }
     csv
