@@ -47,11 +47,16 @@ impl<L: Lane> Carried<L> {
             omega_dot: [zero; 3],
             accel: [zero; 3],
         };
-        for i in 0..3 {
-            for j in 0..3 {
-                carried.rotation[i][j] = L::splat(context, rotation[i][j]);
+        for ((row, given_row), (p, given)) in carried
+            .rotation
+            .iter_mut()
+            .zip(rotation.iter())
+            .zip(carried.point.iter_mut().zip(point))
+        {
+            for (entry, given_entry) in row.iter_mut().zip(given_row) {
+                *entry = L::splat(context, *given_entry);
             }
-            carried.point[i] = L::splat(context, point[i]);
+            *p = L::splat(context, given);
         }
         carried
     }
