@@ -11,15 +11,17 @@
 //! URDF export), one state at a time and in a batch of 1024 states (`reduced_fd_spatial_batch`,
 //! per state).
 //!
-//! Two chains, those of the comparison with Pinocchio in `docs/performance.md`: the 10-link
-//! universal-joint snake (`snake20`: 20 revolute joints alternating `z` and `y`, links of 0.1 m
-//! and 0.1 kg, each link's rod split between its two bodies) and a 7-joint chain of fixed
-//! pseudo-random axes, origins and inertias (`random7`), at a moving state.
+//! Two chains, read from the URDF files Pinocchio's harness reads (`benches/pinocchio/`, the
+//! anchors `pinocchio/spatial_*/<name>` of `docs/performance.md`): the 10-link universal-joint
+//! snake (`snake20`: 20 revolute joints alternating `z` and `y`, each yaw joint moving a massless
+//! cross, each pitch joint a 0.1 m, 0.1 kg link) and a 7-joint chain of fixed pseudo-random axes,
+//! origins and inertias, one joint prismatic (`random7`), under gravity `[0, 0, -9.81]`, at a
+//! moving state.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use manip_dyn::spatial::{
-    SpatialBatchData, SpatialData, SpatialDerivativeData, SpatialJoint, SpatialLink, SpatialModel,
-    Transform, aba, aba_batch, aba_derivatives,
+    SpatialBatchData, SpatialData, SpatialDerivativeData, SpatialModel, aba, aba_batch,
+    aba_derivatives,
 };
 use modal_reduce::spatial::{
     SpatialReducedBatchData, SpatialReducedData, SpatialReducedModel, spatial_forward_dynamics,
@@ -27,57 +29,10 @@ use modal_reduce::spatial::{
 };
 use std::hint::black_box;
 
-/// The universal-joint snake.
-fn snake() -> SpatialModel {
-    let (mut joints, mut links) = (Vec::new(), Vec::new());
-    for i in 0..20 {
-        let reach = if i > 0 && i % 2 == 0 { 0.1 } else { 0.0 };
-        let axis = if i % 2 == 0 {
-            [0.0, 0.0, 1.0]
-        } else {
-            [0.0, 1.0, 0.0]
-        };
-        joints.push(SpatialJoint::revolute(
-            axis,
-            Transform::translation([reach, 0.0, 0.0]),
-        ));
-        links.push(SpatialLink::cuboid(
-            0.05,
-            [0.1, 0.01, 0.01],
-            [0.05, 0.0, 0.0],
-        ));
-    }
-    SpatialModel::new(joints, links, [0.0, 0.0, -9.81]).unwrap()
-}
-
-/// Seven joints of pseudo-random axes and origins (one prismatic), cuboid links.
-fn random7() -> SpatialModel {
-    let r = |k: usize| ((k as f64 * 12.9898).sin() * 43758.5453).fract().abs();
-    let (mut joints, mut links) = (Vec::new(), Vec::new());
-    for i in 0..7 {
-        let axis = [r(6 * i) - 0.5, r(6 * i + 1) - 0.5, r(6 * i + 2) + 0.1];
-        let norm = axis.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let origin = Transform::from_rpy(
-            [r(6 * i + 3) * 3.0, r(6 * i + 4) * 3.0, r(6 * i + 5) * 3.0],
-            [
-                0.1 + 0.1 * r(7 * i),
-                0.05 * r(7 * i + 1),
-                0.05 * r(7 * i + 2),
-            ],
-        );
-        let axis = axis.map(|x| x / norm);
-        joints.push(if i == 3 {
-            SpatialJoint::prismatic(axis, origin)
-        } else {
-            SpatialJoint::revolute(axis, origin)
-        });
-        links.push(SpatialLink::cuboid(
-            0.5 + r(9 * i),
-            [0.1 + 0.1 * r(9 * i + 1), 0.05, 0.04],
-            [0.05, 0.02 * r(9 * i + 2), 0.0],
-        ));
-    }
-    SpatialModel::new(joints, links, [0.0, 0.0, -9.81]).unwrap()
+/// The spatial chain of a URDF file of `benches/pinocchio/`.
+fn from_urdf(text: &str) -> SpatialModel {
+    let robot = robot_desc::read_urdf(text).unwrap().robot;
+    robot_desc::to_spatial(&robot, [0.0, 0.0, -9.81]).unwrap()
 }
 
 /// A chain at a moving state, with small efforts.
@@ -90,7 +45,12 @@ struct Case {
 }
 
 fn cases() -> [Case; 2] {
-    [("snake20", snake()), ("random7", random7())].map(|(name, model)| {
+    [
+        ("snake20", include_str!("../pinocchio/snake20.urdf")),
+        ("random7", include_str!("../pinocchio/random7.urdf")),
+    ]
+    .map(|(name, urdf)| {
+        let model = from_urdf(urdf);
         let n = model.n_links();
         let s = |i: usize, k: f64| (k * i as f64 / n as f64 + 0.3).sin();
         Case {

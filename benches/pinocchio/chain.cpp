@@ -8,6 +8,13 @@
 //     values, so J is a fixed dense n x 3 matrix);
 //   - computeABADerivatives and computeRNEADerivatives (beside hrm's `aba_derivatives/n` and
 //     `rnea_derivatives/n`).
+// And on the spatial chains of hrm's spatial benches, read from the same URDF files
+// (snake20.urdf: the 10-link universal-joint snake, 20 joints, massless crosses; random7.urdf: 7
+// joints of pseudo-random axes and origins, one prismatic), gravity [0, 0, -9.81], at the state of
+// benches/benches/spatial_dynamics.rs (`spatial_anchors`):
+//   - aba one state (beside hrm's `spatial_aba/<name>`), aba over 1024 states one after another
+//     (per state, beside `spatial_aba_batch/<name>`), computeABADerivatives (beside
+//     `spatial_aba_derivatives/<name>`).
 // Prints one line per algorithm and size, `pinocchio/<algorithm>/<n> <median> ns`: the median
 // over batches of the time per call (the figures `cargo xtask bench --check` reads; the ids name
 // the hrm bench each one stands beside).
@@ -20,11 +27,13 @@
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/algorithm/rnea-derivatives.hpp>
 #include <pinocchio/multibody.hpp>
+#include <pinocchio/parsers/urdf.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 using namespace pinocchio;
@@ -61,7 +70,45 @@ static double median_ns(F&& call, int calls_per_batch, int batches) {
   return times[times.size() / 2];
 }
 
-int main() {
+// The spatial anchors: Pinocchio on hrm's spatial bench chains, read from `dir`'s URDF files.
+static void spatial_anchors(const std::string& dir) {
+  const int batch = 1024;
+  for (const char* name : {"snake20", "random7"}) {
+    Model model;
+    pinocchio::urdf::buildModel(dir + "/" + name + ".urdf", model);
+    model.gravity.linear(Eigen::Vector3d(0.0, 0.0, -9.81));
+    Data data(model);
+    const int n = model.nv;
+    Eigen::VectorXd q(n), v(n), tau(n);
+    for (int i = 0; i < n; ++i) {
+      auto s = [&](double k) { return std::sin(k * i / n + 0.3); };
+      q[i] = 0.3 * s(6.0);
+      v[i] = 0.5 * s(3.0);
+      tau[i] = 0.01 * s(2.0);
+    }
+    double one_ns = median_ns([&] { aba(model, data, q, v, tau); }, 20000, 51);
+    // 1024 states spread as in hrm's batch bench: state k is the state above times 1 + 1e-3 k.
+    Eigen::MatrixXd qs(n, batch), vs(n, batch), taus(n, batch), out(n, batch);
+    for (int k = 0; k < batch; ++k) {
+      double factor = 1.0 + 1e-3 * k;
+      qs.col(k) = q * factor;
+      vs.col(k) = v * factor;
+      taus.col(k) = tau * factor;
+    }
+    double batch_ns = median_ns(
+        [&] {
+          for (int k = 0; k < batch; ++k) out.col(k) = aba(model, data, qs.col(k), vs.col(k), taus.col(k));
+        },
+        20, 51) / batch;
+    double derivatives_ns = median_ns([&] { computeABADerivatives(model, data, q, v, tau); }, 5000, 51);
+    std::printf("pinocchio/spatial_aba/%s %.1f ns\n", name, one_ns);
+    std::printf("pinocchio/spatial_aba_batch/%s %.1f ns\n", name, batch_ns);
+    std::printf("pinocchio/spatial_aba_derivatives/%s %.1f ns\n", name, derivatives_ns);
+    std::printf("  check: qdd[n-1] = %.12g, dqdd/dtau[0][0] = %.12g\n", data.ddq[n - 1], data.Minv(0, 0));
+  }
+}
+
+int main(int argc, char** argv) {
   for (int n : {10, 100}) {
     Model model = planar_chain(n, 0.1, 0.1);
     Data data(model);
@@ -101,5 +148,7 @@ int main() {
     std::printf("  check: qdd[n-1] = %.12g, dqdd/dtau[0][0] = %.12g\n", data.ddq[n - 1],
                 data.Minv(0, 0));
   }
+  // The folder of the URDF files (run.sh passes benches/pinocchio).
+  if (argc > 1) spatial_anchors(argv[1]);
   return 0;
 }

@@ -28,8 +28,8 @@ if [ "$MODE" = build ] || [ "$MODE" = all ]; then
   c++ -O3 -DNDEBUG -std=c++17 -DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS \
       -DBOOST_MPL_LIMIT_LIST_SIZE=30 -DBOOST_MPL_LIMIT_VECTOR_SIZE=30 -DBOOST_FUSION_INVOKE_MAX_ARITY=12 \
       -DPINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION "$HERE/chain.cpp" -o "$OUT" \
-      -I"$PREFIX/include" -I"$PREFIX/include/eigen3" \
-      -L"$PREFIX/lib" -Wl,-rpath,"$PREFIX/lib" -lpinocchio_default
+      -I"$PREFIX/include" -I"$PREFIX/include/eigen3" -I"$PREFIX/include/urdfdom_headers" \
+      -L"$PREFIX/lib" -Wl,-rpath,"$PREFIX/lib" -lpinocchio_parsers -lpinocchio_default
   c++ -O3 -DNDEBUG -std=c++17 -DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS \
       -DBOOST_MPL_LIMIT_LIST_SIZE=30 -DBOOST_MPL_LIMIT_VECTOR_SIZE=30 -DBOOST_FUSION_INVOKE_MAX_ARITY=12 \
       -DPINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION "$HERE/spatial.cpp" -o "$OUT-spatial" \
@@ -38,6 +38,6 @@ if [ "$MODE" = build ] || [ "$MODE" = all ]; then
   (cd "$HERE/../.." && cargo run --quiet --package hrm-benches --example spatial_urdf -- "$ARMS" > /dev/null)
 fi
 if [ "$MODE" = run ] || [ "$MODE" = all ]; then
-  "$OUT"
+  "$OUT" "$HERE"
   "$OUT-spatial" "$ARMS"
 fi
