@@ -1,15 +1,15 @@
 //! The main job (`hrm` with no arguments) and `hrm simulate`: closed-loop runs of the shipped
 //! scenarios (section 5 of the paper), a comparison table, and per-run output files.
 
-use crate::console::CsvNumber;
 use crate::output_dir::OutputDir;
 use crate::spatial_figures::{self, CoordinateSeries};
 use crate::{console, figures, progress, report};
+use lane_math::Compact;
 use serde_json::json;
 use sim_core::Run;
 use sim_study::imitation::{self, ImitationOptions};
 use sim_study::study::{self, ComparisonRun, run_one, run_prepared};
-use sim_study::{ArmKind, ControllerKind, ReferenceSpec, Scenario};
+use sim_study::{ArmKind, ControllerKind, ReferenceSpec, Scenario, Workspace};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -445,7 +445,7 @@ fn outcome_json(outcome: &ComparisonRun) -> serde_json::Value {
     }
 }
 
-/// Writes `summary.json`, `timeseries.csv` and `scenario.toml` (what `hrm view` draws the arm
+/// Writes `summary.json`, `timeseries.csv`, `links.csv` and `scenario.toml` (what `hrm view` draws the arm
 /// from) of one run of `scenario` into `dir`. A run that stopped has its time series up to the
 /// stop, and a summary of the metrics up to it with the `error` and the time it `stopped_at_s`.
 fn write_outcome(outcome: &ComparisonRun, scenario: &Scenario, dir: &Path) -> Result<(), String> {
@@ -498,12 +498,36 @@ fn write_outcome(outcome: &ComparisonRun, scenario: &Scenario, dir: &Path) -> Re
                 .chain(spatial.then_some(r.tip_ref_z[k]))
                 .chain(r.clamped_at(k).iter().map(|&c| f64::from(u8::from(c))))
                 .chain(r.joint_torques_at(k).iter().copied());
-            let line: Vec<String> = row.map(|v| CsvNumber(v).to_string()).collect();
+            let line: Vec<String> = row.map(|v| Compact(v).to_string()).collect();
             let _ = writeln!(csv, "{}", line.join(","));
         }
         write(&dir.join("timeseries.csv"), &csv)?;
+        write(&dir.join("links.csv"), &links_csv(r, scenario.workspace()))?;
     }
     Ok(())
+}
+
+/// `links.csv`: the time, then the base point and every link's end point (`t, x0, y0, x1, y1,
+/// ...`, with `z0, z1, ...` interleaved for a spatial arm) at each recorded sample, exactly the
+/// points the loop measured the clearance from.
+fn links_csv(r: &sim_core::Record, workspace: Workspace) -> String {
+    let axes: &[&str] = match workspace {
+        Workspace::Planar => &["x", "y"],
+        Workspace::Spatial => &["x", "y", "z"],
+    };
+    let mut header = vec!["t".to_string()];
+    for j in 0..r.n_points {
+        header.extend(axes.iter().map(|axis| format!("{axis}{j}")));
+    }
+    let mut csv = header.join(",") + "\n";
+    for k in 0..r.len() {
+        let points = r.joint_points_at(k).iter();
+        let coordinates = points.flat_map(|p| p.iter().take(axes.len()).copied());
+        let row = std::iter::once(r.t[k]).chain(coordinates);
+        let line: Vec<String> = row.map(|v| Compact(v).to_string()).collect();
+        let _ = writeln!(csv, "{}", line.join(","));
+    }
+    csv
 }
 
 /// The comparison table's columns.

@@ -38,6 +38,7 @@ impl Scenario {
             lengths,
             masses,
             inertias,
+            radius,
         } = &self.arm
         else {
             return Ok(None);
@@ -55,6 +56,16 @@ impl Scenario {
         ];
         if let Some((name, _)) = planar.iter().find(|(_, given)| *given) {
             return Err(unused(name, "the URDF describes the links"));
+        }
+        if radius.is_some() || !self.obstacles.is_empty() {
+            return Err(unused(
+                if radius.is_some() {
+                    "arm.radius"
+                } else {
+                    "obstacles"
+                },
+                "the joint-space loop measures no clearance",
+            ));
         }
         let invalid = |what: String| SimError::setting("arm.urdf", what);
         let text = crate::read_text_file(path, robot_desc::MAX_URDF_BYTES as u64)
@@ -116,9 +127,12 @@ impl Scenario {
         if self.noise != NoiseSpec::default() {
             return Err(unused("noise", "the joint-space loop is noise-free"));
         }
-        if self.limits.joint_torque_nm.is_some() || self.limits.tau_star.is_some() {
+        if self.limits.joint_torque_nm.is_some()
+            || self.limits.joint_angle_rad.is_some()
+            || self.limits.tau_star.is_some()
+        {
             return Err(unused(
-                "limits.joint_torque_nm and limits.tau_star",
+                "limits.joint_torque_nm, limits.joint_angle_rad and limits.tau_star",
                 "only limits.max_modal_error bounds the joint errors",
             ));
         }

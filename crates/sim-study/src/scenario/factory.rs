@@ -4,8 +4,8 @@
 use super::arm::{ArmKind, Gravity, Inertias};
 use super::controllers::{ControllerSetup, per_coordinate};
 use super::schema::{
-    Alpha0, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, NoiseSpec, ReferenceSpec,
-    Scenario, TorqueLimit,
+    Alpha0, AngleLimit, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, NoiseSpec,
+    ReferenceSpec, Scenario, TorqueLimit,
 };
 use backbone_kin::{Branch, ModalMap};
 use fuzzy_sugeno::FuzzySystem;
@@ -188,6 +188,11 @@ impl Scenario {
             TorqueLimit::All(limit) => vec![*limit; model.plant().n_joints()],
             TorqueLimit::PerJoint(limits) => limits.clone(),
         });
+        settings.joint_angle_limits = self.limits.joint_angle_rad.as_ref().map(|l| match l {
+            AngleLimit::All(limit) => vec![*limit; model.plant().n_joints()],
+            AngleLimit::PerJoint(limits) => limits.clone(),
+        });
+        settings.clearance = self.clearance_model(model.plant().n_links(), self.workspace())?;
         settings.tau_star_limits = match &self.limits.tau_star {
             None => None,
             Some(ModalTorqueLimit::All(limit)) => Some(vec![*limit; m]),

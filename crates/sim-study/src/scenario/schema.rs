@@ -53,6 +53,53 @@ pub struct Scenario {
     /// Runaway bound and torque limits.
     #[serde(default)]
     pub limits: LimitsSpec,
+    /// Obstacles (`[[obstacles]]` tables): the loop takes the arm's clearance to them, and to
+    /// itself, at every controller sample.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacles: Vec<ObstacleSpec>,
+}
+
+/// An obstacle, tagged by `kind`. A planar arm moves in the plane `z = 0`: its obstacles are
+/// circles, capsules and boxes given by `[x, y]` points; a spatial arm's are spheres, capsules
+/// and boxes given by `[x, y, z]` points ([`Scenario::obstacles`] checks them).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum ObstacleSpec {
+    /// A disc of the arm's plane (planar arms).
+    Circle {
+        /// The centre `[x, y]` (m).
+        center: Vec<f64>,
+        /// The radius (m, non-negative).
+        radius: f64,
+    },
+    /// A ball (spatial arms).
+    Sphere {
+        /// The centre `[x, y, z]` (m).
+        center: Vec<f64>,
+        /// The radius (m, non-negative).
+        radius: f64,
+    },
+    /// The points within `radius` of the segment `from`-`to`.
+    Capsule {
+        /// One end of the axis (m).
+        from: Vec<f64>,
+        /// The other end (m).
+        to: Vec<f64>,
+        /// The radius (m, non-negative).
+        radius: f64,
+    },
+    /// A box, axis-aligned unless turned by `rpy`.
+    Box {
+        /// The centre (m).
+        center: Vec<f64>,
+        /// Half the side lengths along the box's own axes (m, positive): `[hx, hy]` in the
+        /// plane (the box is then a rectangle), `[hx, hy, hz]` in space.
+        half_extents: Vec<f64>,
+        /// Roll, pitch and yaw (rad, URDF's `R = Rz(yaw) Ry(pitch) Rx(roll)`, default zero); a
+        /// planar arm's box turns about `z` only (`[0, 0, yaw]`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        rpy: Option<Vec<f64>>,
+    },
 }
 
 /// The base inclination `alpha0` of a scenario: a number (fixed, in rad) or `"free"`.
@@ -175,6 +222,10 @@ pub struct ArmSpec {
     /// run in joint space by [`Scenario::run_chain`], with only `gravity` of the other keys.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub urdf: Option<PathBuf>,
+    /// The radius of every link's collision capsule around its segment (m, non-negative, default
+    /// 0): the clearance to obstacles and between links is measured from these capsules.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
 }
 
 /// The initial modal state (`m` entries each).
@@ -422,17 +473,25 @@ impl NoiseSpec {
     }
 }
 
-/// The runaway bound, optional joint torque limits (reported) and optional limits (modal forces, not joint torques) on
-/// `tau*` (enforced).
+/// The runaway bound, optional joint torque and joint angle limits (enforced) and optional
+/// limits on the modal forces `tau*` (enforced).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LimitsSpec {
     /// The run stops when `|a_i - a_i_ref|` exceeds this (rad, default pi).
     #[serde(default = "default_max_modal_error")]
     pub max_modal_error: f64,
-    /// Joint torque limits (N m): one for all joints or one per joint; exceeding is reported.
+    /// Joint torque limits (N m): one for all joints or one per joint, enforced: at every
+    /// controller sample the loop projects `tau*` onto the modal torques whose joint torques
+    /// at that state are within them, and reports how often it acted
+    /// ([`LoopSettings::joint_torque_limits`](sim_core::LoopSettings::joint_torque_limits)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joint_torque_nm: Option<TorqueLimit>,
+    /// Joint angle limits `|theta_j| <= limit` (rad): one for all joints or one per joint,
+    /// enforced in the same projection by bounding each joint's rate towards its limit
+    /// ([`LoopSettings::joint_angle_limits`](sim_core::LoopSettings::joint_angle_limits)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint_angle_rad: Option<AngleLimit>,
     /// Saturation of the modal forces `tau* = J^T tau` (N m): one limit for every coordinate or
     /// one per coordinate (`m` entries), each finite and positive. They bound the modal
     /// coordinates' generalised forces, not any joint torque (see `joint_torque_nm`). The loop
@@ -451,6 +510,7 @@ impl Default for LimitsSpec {
         Self {
             max_modal_error: default_max_modal_error(),
             joint_torque_nm: None,
+            joint_angle_rad: None,
             tau_star: None,
         }
     }
@@ -464,6 +524,16 @@ pub enum ModalTorqueLimit {
     All(f64),
     /// One limit per coordinate, in coordinate order (N m).
     PerCoordinate(Vec<f64>),
+}
+
+/// An angle limit for every joint, or one per joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum AngleLimit {
+    /// The same limit for every joint (rad).
+    All(f64),
+    /// One limit per joint, base first (rad).
+    PerJoint(Vec<f64>),
 }
 
 /// A torque limit for every joint, or one per joint.

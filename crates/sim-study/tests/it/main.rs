@@ -17,6 +17,7 @@ mod imitation;
 mod lockstep;
 mod long_runs;
 mod mpc;
+mod obstacles;
 mod paper_pinned;
 mod replay;
 mod scenario_controller;
