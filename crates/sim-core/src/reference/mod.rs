@@ -12,10 +12,12 @@ pub(crate) mod continuation;
 mod path;
 mod preview;
 mod spatial_path;
+mod waypoints;
 
 pub use path::{CartesianPath, FREE_BASE_START, PathShape};
 pub use preview::{MAX_PREVIEW_SAMPLES, ReferencePreview};
 pub use spatial_path::{Helix, SpatialPath};
+pub use waypoints::{MAX_WAYPOINTS, Waypoints};
 
 use crate::error::{SimError, check_finite, check_non_negative};
 
