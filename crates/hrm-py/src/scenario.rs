@@ -725,13 +725,15 @@ impl Scenario {
         Self::wrap(self.get())
     }
 
-    /// The number of modal coordinates m: 2K with alpha0 fixed, 2K + 1 with it free.
+    /// The number of modal coordinates m: 2K with alpha0 fixed, 2K + 1 with it free; 4K for a
+    /// spatial arm.
     #[getter]
     fn n_coords(&self) -> usize {
         self.lock().n_coords()
     }
 
-    /// The names of the modal coordinates: a1, ..., a2K, then alpha0 when it is free.
+    /// The names of the modal coordinates: a1, ..., a2K, then alpha0 when it is free; for a
+    /// spatial arm az1, ..., az2K, ay1, ..., ay2K.
     #[getter]
     fn coordinate_names(&self) -> Vec<String> {
         self.lock().coordinate_names()
@@ -818,7 +820,7 @@ impl Scenario {
             Some(f) if f.is_none() => None,
             Some(f) if f.is_callable() => Some(PythonDisturbance {
                 function: f.clone().unbind(),
-                n: scenario.model().map_err(Error::from)?.n_links(),
+                n: scenario.plant().map_err(Error::from)?.plant().n_joints(),
                 raised: None,
             }),
             Some(f) => {
@@ -963,7 +965,16 @@ impl Run {
         };
         let r = run.record;
         let (m, n) = (r.n_coords, r.n_joints);
-        let tips = |tips: Vec<[f64; 2]>| matrix(py, tips.into_iter().flatten().collect(), 2);
+        // A planar arm's tips in its plane, (x, y); a spatial arm's (x, y, z).
+        let spatial = scenario.arm.kind == sim_study::ArmKind::Spatial;
+        let tips = |tips: Vec<[f64; 2]>, z: Vec<f64>| {
+            if spatial {
+                let values = tips.iter().zip(&z).flat_map(|(p, &z)| [p[0], p[1], z]);
+                matrix(py, values.collect(), 3)
+            } else {
+                matrix(py, tips.into_iter().flatten().collect(), 2)
+            }
+        };
         let arrays = [
             r.t.into_pyarray(py).into_any().unbind(),
             matrix(py, r.a, m),
@@ -971,8 +982,8 @@ impl Run {
             matrix(py, r.a_ref, m),
             matrix(py, r.tau_star, m),
             matrix(py, r.joint_torques, n),
-            tips(r.tip),
-            tips(r.tip_ref),
+            tips(r.tip, r.tip_z),
+            tips(r.tip_ref, r.tip_ref_z),
         ];
         Self::assemble(
             py,
@@ -1050,14 +1061,14 @@ impl Run {
         self.arrays[5].clone_ref(py)
     }
 
-    /// The discrete chain's tip (m), shape (K, 2).
+    /// The discrete chain's tip (m), shape (K, 2); (K, 3) for a spatial arm.
     #[getter]
     fn tip(&self, py: Python<'_>) -> Py<PyAny> {
         self.arrays[6].clone_ref(py)
     }
 
     /// The reference tip: the backbone curve's end at a_ref, the path point for a path (m),
-    /// shape (K, 2).
+    /// shape (K, 2); for a spatial arm the chain's tip at a_ref, shape (K, 3).
     #[getter]
     fn tip_ref(&self, py: Python<'_>) -> Py<PyAny> {
         self.arrays[7].clone_ref(py)

@@ -1,6 +1,6 @@
 //! The integration tests of the `hrm` command, one binary, each running the built executable:
 //! `cli_errors` and `cli_fuzz` for bad command lines and files, `eval_stream` and
-//! `eval_derivatives` and `eval_robot` for `hrm eval`, `fis_export`, `fis_imitate` and `fis_train` for `hrm fis`, `simulate_links` for the points `hrm simulate` writes, and `common` for
+//! `eval_derivatives` and `eval_robot` for `hrm eval`, `fis_export`, `fis_imitate` and `fis_train` for `hrm fis`, `simulate_links` for the points `hrm simulate` writes, `simulate_spatial` for `hrm simulate` and `hrm view` on a spatial arm, and `common` for
 //! running `hrm` in a scratch folder.
 
 mod cli_errors;
@@ -13,3 +13,4 @@ mod fis_export;
 mod fis_imitate;
 mod fis_train;
 mod simulate_links;
+mod simulate_spatial;

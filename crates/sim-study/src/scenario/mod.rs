@@ -2,11 +2,12 @@
 //! controller, integrator, step sizes, duration, noise, seed), and the paper's experiments
 //! shipped with the crate.
 //!
-//! Required keys: `name`, `duration`, `alpha0`, `reference` (with its `kind` and that kind's
-//! required keys) and `integrator` (with its `method`); everything else has a default. Every
-//! per-coordinate array (`initial`, `reference`, `noise`, the controller gains) has exactly `m`
-//! entries, the number of modal coordinates: `2K` with `alpha0` fixed, `2K + 1` with `alpha0`
-//! free (its last entry is then `alpha0`'s).
+//! Required keys: `name`, `duration`, `alpha0` (for a planar arm), `reference` (with its `kind`
+//! and that kind's required keys) and `integrator` (with its `method`); everything else has a
+//! default. Every per-coordinate array (`initial`, `reference`, `noise`, the controller gains) has
+//! exactly `m` entries, the number of modal coordinates: `2K` with `alpha0` fixed, `2K + 1` with
+//! `alpha0` free (its last entry is then `alpha0`'s), `4K` on a spatial arm
+//! (`[az1..az2K, ay1..ay2K]`, in-plane then out-of-plane bending).
 //!
 //! ```toml
 //! name = "step"
@@ -24,6 +25,14 @@
 //! # urdf = "arm.urdf"     a URDF chain instead (relative to the file), run in joint space by
 //! #                       Scenario::run_chain: computed torque only, one entry per joint
 //!
+//! # A spatial modal arm instead (docs/theory.md, section 8): universal joints, m = 4K, no alpha0
+//! # kind = "spatial"      # default "planar"
+//! # joints = "universal"  # the one layout: about the parent's z, then the resulting y
+//! # gravity = [0.0, 0.0, -9.81]   # m/s^2, world frame; a number g is [0, 0, -g] (the default)
+//! # inertias = [[0.0, 8.3e-5, 8.3e-5], ...]  # [Ixx, Iyy, Izz] per link (kg m^2) about the
+//! #                       centre of mass in the link frame; default: slender rods
+//! # base = { xyz = [0.0, 0.0, 0.0], rpy = [0.0, 0.0, 0.0] }  # m, rad (URDF's roll-pitch-yaw)
+//!
 //! [[obstacles]]           # kind = "circle" | "capsule" | "box" (spatial arms: "sphere")
 //! kind = "circle"         # planar points are [x, y], spatial ones [x, y, z]
 //! center = [0.3, 0.6]     # m
@@ -36,6 +45,14 @@
 //! initial = [0.0, 0.0]
 //! target = [0.2, -0.2]
 //! time = 0.1
+//!
+//! # a spatial arm's path: a helix (a circle at pitch 0) instead of `sine` or `points`
+//! # [reference.helix]     # from start, about the line through center along axis, right-handed
+//! # center = [0.8, 0.0, 0.0]   # m
+//! # axis = [1.0, 0.0, 0.0]
+//! # start = [0.8, 0.15, 0.0]   # m, off the axis; the radius is its distance from the axis
+//! # pitch = 0.0           # m per turn along the axis (default 0: a circle)
+//! # turns = 1.0           # default 1, at constant speed over travel_time
 //!
 //! [controller]            # kind = "fuzzy" | "pd" | "computed-torque" | "fuzzy-gc" | "lqr"
 //! kind = "fuzzy"
