@@ -3,7 +3,7 @@
 //! output held in between (zero-order hold).
 
 use crate::controller::{ControlContext, Controller, ModalState};
-use crate::error::{Readable, SimError, check_finite, check_non_negative, check_positive};
+use crate::error::{SimError, check_finite, check_non_negative, check_positive};
 use crate::noise::GaussianNoise;
 use crate::ode::{DormandPrince, OdeSystem, Rk4, Stats, Tolerances};
 use crate::record::{Metrics, Record, Sample, Summary};
@@ -11,6 +11,7 @@ use crate::reference::continuation::Family;
 use crate::reference::{Reference, ReferenceSample};
 use backbone_kin::BaseAngle;
 use clearance::{ClearanceData, ClearanceModel};
+use lane_math::Compact;
 use limits::LimitProjection;
 use modal_reduce::{Plant, PlantData, PlantModel, ReduceError};
 use std::sync::Arc;
@@ -119,7 +120,7 @@ pub struct Run {
 
 /// A run that had to stop, with everything recorded before it did.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{error} (data kept up to t = {} s)", summary.simulated_s)]
+#[error("{error} (data kept up to t = {} s)", Compact(summary.simulated_s))]
 pub struct RunFailure {
     /// Why and when the run stopped.
     pub error: SimError,
@@ -1122,7 +1123,7 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
             "duration",
             format!(
                 "must be at most {MAX_CONTROLLER_SAMPLES:e} controller periods ({} s), got {:e} s",
-                Readable(s.controller_period),
+                Compact(s.controller_period),
                 s.duration
             ),
         ));
@@ -1132,8 +1133,8 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
             "duration",
             format!(
                 "must be a whole number of controller periods ({} s), got {} s",
-                Readable(s.controller_period),
-                Readable(s.duration)
+                Compact(s.controller_period),
+                Compact(s.duration)
             ),
         ));
     }
@@ -1142,8 +1143,8 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
             "record_period",
             format!(
                 "must be a whole number of controller periods ({} s), got {} s",
-                Readable(s.controller_period),
-                Readable(s.record_period)
+                Compact(s.controller_period),
+                Compact(s.record_period)
             ),
         ));
     }
@@ -1155,8 +1156,8 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
                     "controller.period",
                     format!(
                         "must be a whole number of RK4 steps ({} s), got {} s",
-                        Readable(dt),
-                        Readable(s.controller_period)
+                        Compact(dt),
+                        Compact(s.controller_period)
                     ),
                 ));
             }
@@ -1169,7 +1170,7 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
     if s.max_modal_error.is_nan() || s.max_modal_error <= 0.0 {
         return Err(SimError::setting(
             "limits.max_modal_error",
-            format!("must be positive, got {}", s.max_modal_error),
+            format!("must be positive, got {}", Compact(s.max_modal_error)),
         ));
     }
     let recorded =
@@ -1180,7 +1181,7 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
             format!(
                 "would record {recorded} numbers over {} s, more than the {MAX_RECORDED_VALUES} \
                  a run may hold: record less often or simulate less",
-                s.duration
+                Compact(s.duration)
             ),
         ));
     }
@@ -1193,7 +1194,7 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
                     "would take {steps:.3e} RK4 steps over {} s, more than the \
                      {MAX_RK4_STEPS:e} a run may take (hours of computing): use a larger step \
                      or simulate less",
-                    Readable(s.duration)
+                    Compact(s.duration)
                 ),
             ));
         }

@@ -61,6 +61,7 @@
 //! tau_star = [2.0, 0.5]   # N m, or one limit for all: the loop clamps tau* to +-limit
 //! ```
 
+mod arm;
 mod builtin;
 mod chain;
 mod controllers;
@@ -68,12 +69,14 @@ mod factory;
 mod file;
 mod obstacles;
 mod schema;
+mod spatial;
 
+pub use arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout};
 pub use controllers::{CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup};
 pub use file::ScenarioError;
 pub use obstacles::{MAX_SCENARIO_OBSTACLES, Workspace};
 pub use schema::{
-    Alpha0, AngleLimit, ArmSpec, BranchSpec, ControllerSpec, FuzzyInputRange, InitialSpec,
-    IntegratorSpec, LimitsSpec, ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec,
+    Alpha0, AngleLimit, ArmSpec, BranchSpec, ControllerSpec, FuzzyInputRange, HelixSpec,
+    InitialSpec, IntegratorSpec, LimitsSpec, ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec,
     ReferenceSpec, Scenario, SineSpec, TorqueLimit,
 };

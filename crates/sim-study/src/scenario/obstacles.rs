@@ -36,10 +36,13 @@ impl Workspace {
 }
 
 impl Scenario {
-    /// Where the scenario's modal arm moves: in the plane (the scenario files' arms are planar
-    /// modal arms; a URDF arm runs in joint space without clearance).
+    /// Where the scenario's modal arm moves: in the plane for `[arm] kind = "planar"`, in space
+    /// for `"spatial"` (a URDF arm runs in joint space without clearance).
     pub fn workspace(&self) -> Workspace {
-        Workspace::Planar
+        match self.arm.kind {
+            crate::ArmKind::Planar => Workspace::Planar,
+            crate::ArmKind::Spatial => Workspace::Spatial,
+        }
     }
 
     /// The scenario's obstacles for an arm in `workspace`, in file order, each checked: points

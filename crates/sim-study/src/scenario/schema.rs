@@ -1,5 +1,6 @@
 //! The scenario schema: what a scenario file may say, with its defaults.
 
+use super::arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout};
 use super::controllers::ControllerKind;
 use backbone_kin::BaseAngle;
 use serde::{Deserialize, Serialize};
@@ -18,8 +19,11 @@ pub struct Scenario {
     pub description: String,
     /// Simulated time (s).
     pub duration: f64,
-    /// The base inclination `alpha0`: fixed (rad) or free (the last modal coordinate).
-    pub alpha0: Alpha0,
+    /// The base inclination `alpha0` of a planar arm: fixed (rad) or free (the last modal
+    /// coordinate). Required for a planar arm, refused for a spatial one (whose base angles are
+    /// `arm.base`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha0: Option<Alpha0>,
     /// Seed of the noise sources. TOML integers stop at `2^63 - 1`: larger seeds are written
     /// (and may be given) as a decimal string, `seed = "18446744073709551615"`.
     #[serde(default, with = "seed_text")]
@@ -182,6 +186,15 @@ impl Default for ModalSpec {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ArmSpec {
+    /// `"planar"` (default, the paper's arm) or `"spatial"` (universal joints, `m = 4K`).
+    #[serde(default, skip_serializing_if = "ArmKind::is_planar")]
+    pub kind: ArmKind,
+    /// The joints of a spatial arm (default and only layout `"universal"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joints: Option<JointLayout>,
+    /// The base pose of a spatial arm (default: at the origin, along `x`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base: Option<BaseSpec>,
     /// Number of links (default 10).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub links: Option<usize>,
@@ -191,18 +204,20 @@ pub struct ArmSpec {
     /// Mass of every link (kg, default 0.1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub link_mass: Option<f64>,
-    /// Gravitational acceleration along `-y` (m/s^2, default 9.81).
+    /// Gravity (m/s^2): a magnitude along `-y` (planar) or `-z` (spatial), default 9.81, or a
+    /// vector `[gx, gy, gz]` (spatial arms).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gravity: Option<f64>,
+    pub gravity: Option<Gravity>,
     /// Per-link lengths (m).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lengths: Option<Vec<f64>>,
     /// Per-link masses (kg).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub masses: Option<Vec<f64>>,
-    /// Per-link inertias about the centre of mass (kg m^2; default: uniform beams).
+    /// Per-link inertias about the centre of mass (kg m^2; default: uniform beams, slender rods
+    /// for a spatial arm): one number per link (planar) or `[Ixx, Iyy, Izz]` per link (spatial).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub inertias: Option<Vec<f64>>,
+    pub inertias: Option<Inertias>,
     /// A URDF serial chain (a path, relative to the scenario file) in place of the planar arm:
     /// run in joint space by [`Scenario::run_chain`], with only `gravity` of the other keys.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -272,7 +287,34 @@ pub enum ReferenceSpec {
         /// A polyline `[[x, y], ...]` (m), at constant speed along it.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         points: Option<Vec<[f64; 2]>>,
+        /// A helix or circle in space (spatial arms), at constant speed along it.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        helix: Option<HelixSpec>,
     },
+}
+
+/// A helix in space for a spatial arm's tip: from `start`, turning right-handedly about the
+/// line through `center` along `axis` for `turns` turns and rising `pitch` metres per turn along
+/// `axis`, at constant speed; `pitch = 0` (the default) is a circle.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HelixSpec {
+    /// A point on the axis (m).
+    pub center: [f64; 3],
+    /// The axis direction (any length but zero).
+    pub axis: [f64; 3],
+    /// The first point (m), off the axis.
+    pub start: [f64; 3],
+    /// Rise per turn along the axis (m, default 0: a circle).
+    #[serde(default)]
+    pub pitch: f64,
+    /// Number of turns (default 1), positive.
+    #[serde(default = "default_turns")]
+    pub turns: f64,
+}
+
+fn default_turns() -> f64 {
+    1.0
 }
 
 /// The sign branch of `a1` in the inverse kinematics (eq 6).
@@ -508,27 +550,39 @@ impl Scenario {
     /// The number of modal coordinates `m`: `2K` with `alpha0` fixed, `2K + 1` with it free
     /// (saturating, for a scenario read from a file whose `harmonics` is not yet validated).
     pub fn n_coords(&self) -> usize {
-        self.modal
-            .harmonics
-            .saturating_mul(2)
-            .saturating_add(usize::from(self.alpha0 == Alpha0::Free))
+        match self.arm.kind {
+            ArmKind::Planar => self
+                .modal
+                .harmonics
+                .saturating_mul(2)
+                .saturating_add(usize::from(self.alpha0 == Some(Alpha0::Free))),
+            ArmKind::Spatial => self.modal.harmonics.saturating_mul(4),
+        }
     }
 
-    /// The names of the modal coordinates, in order: `a1, ..., a{2K}`, then `alpha0` when it is
-    /// free (the column names of the outputs).
+    /// The names of the modal coordinates, in order (the column names of the outputs): for a
+    /// planar arm `a1, ..., a{2K}`, then `alpha0` when it is free; for a spatial arm
+    /// `az1, ..., az{2K}` (in-plane bending), then `ay1, ..., ay{2K}` (out-of-plane).
     ///
     /// ```
     /// let mut scenario = sim_study::Scenario::builtin("paper-tracking")?;
     /// assert_eq!(scenario.coordinate_names(), ["a1", "a2"]);
-    /// scenario.alpha0 = sim_study::Alpha0::Free;
+    /// scenario.alpha0 = Some(sim_study::Alpha0::Free);
     /// assert_eq!(scenario.coordinate_names(), ["a1", "a2", "alpha0"]);
+    /// let spatial = sim_study::Scenario::builtin("spatial-tracking")?;
+    /// assert_eq!(spatial.coordinate_names(), ["az1", "az2", "ay1", "ay2"]);
     /// # Ok::<(), sim_study::ScenarioError>(())
     /// ```
     pub fn coordinate_names(&self) -> Vec<String> {
-        let mut names: Vec<String> = (1..=2 * self.modal.harmonics)
-            .map(|i| format!("a{i}"))
-            .collect();
-        if self.alpha0 == Alpha0::Free {
+        let modes = 2 * self.modal.harmonics;
+        if self.arm.kind == ArmKind::Spatial {
+            return ["az", "ay"]
+                .iter()
+                .flat_map(|plane| (1..=modes).map(move |i| format!("{plane}{i}")))
+                .collect();
+        }
+        let mut names: Vec<String> = (1..=modes).map(|i| format!("a{i}")).collect();
+        if self.alpha0 == Some(Alpha0::Free) {
             names.push("alpha0".into());
         }
         names

@@ -485,7 +485,6 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
         (base.replace("kind = \"step\"", "kind = \"ramp\""), "ramp"),
         (base.replace("dt = 0.0001", "dtt = 0.0001"), "dtt"),
         (base.replace("time = 0.1", "time = 0.1\nspeed = 3"), "speed"),
-        (base.replace("alpha0 = 1.5707963267948966\n", ""), "alpha0"),
         (format!("{base}\n[arm]\nlinks = \"ten\"\n"), "links"),
     ];
     for (text, needle) in cases {
@@ -495,6 +494,20 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
             "expected '{needle}' in: {err}"
         );
     }
+    // A planar arm needs alpha0; a spatial one refuses it (its base angles are arm.base).
+    let planar = Scenario::from_toml(&base.replace("alpha0 = 1.5707963267948966\n", "")).unwrap();
+    let err = planar.build().err().unwrap().to_string();
+    assert!(
+        err.starts_with("alpha0 is required for a planar arm"),
+        "{err}"
+    );
+    let mut spatial = Scenario::builtin("spatial-tracking").unwrap();
+    spatial.alpha0 = Some(Alpha0::Fixed(0.0));
+    let err = spatial.build().err().unwrap().to_string();
+    assert!(
+        err.starts_with("alpha0 is not used with a spatial arm"),
+        "{err}"
+    );
     let invalid = |edit: fn(&mut Scenario)| {
         let mut s = Scenario::builtin("paper-responses-step").unwrap();
         edit(&mut s);
@@ -548,7 +561,8 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
             travel_time: 1.0,
             branch: Default::default(),
             sine: None,
-            points: None
+            points: None,
+            helix: None,
         })
         .contains("exactly one")
     );
@@ -636,7 +650,7 @@ fn family_step(m: usize, kind: ControllerKind, duration: f64) -> Scenario {
         .map(|i| if i % 2 == 0 { 0.1 } else { -0.05 })
         .collect();
     if m % 2 == 1 {
-        s.alpha0 = Alpha0::Free;
+        s.alpha0 = Some(Alpha0::Free);
         initial[m - 1] = FRAC_PI_2;
         target[m - 1] = FRAC_PI_2 + 0.1;
     }

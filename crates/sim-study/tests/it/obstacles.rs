@@ -205,7 +205,7 @@ trait Constant {
 impl Constant for Scenario {
     fn with_constant(mut self, a: [f64; 2]) -> Self {
         self.reference = sim_study::ReferenceSpec::Constant { a: a.to_vec() };
-        self.alpha0 = sim_study::Alpha0::Fixed(std::f64::consts::FRAC_PI_2);
+        self.alpha0 = Some(sim_study::Alpha0::Fixed(std::f64::consts::FRAC_PI_2));
         self
     }
 }
@@ -262,7 +262,7 @@ fn an_unconstrained_controller_collides_and_the_clearance_shows_it() {
          [[obstacles]]\nkind = \"circle\"\ncenter = [{}, {}]\nradius = {radius}\n",
         mid[0], mid[1]
     ));
-    scenario.alpha0 = sim_study::Alpha0::Fixed(std::f64::consts::FRAC_PI_2);
+    scenario.alpha0 = Some(sim_study::Alpha0::Fixed(std::f64::consts::FRAC_PI_2));
     scenario.reference = sim_study::ReferenceSpec::Step {
         initial: Some(vec![0.0, 0.0]),
         target: target.to_vec(),
