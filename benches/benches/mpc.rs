@@ -5,12 +5,16 @@
 //! prediction (at most the default 5 iterations). Preparing the warm start (a clone of the
 //! planned workspace) is not timed. `mpc/solve_30` is the same arm (1 m, 1 kg) split into 30
 //! links, beside Crocoddyl's solve of the full joint space (benches/crocoddyl/mpc.py, issue 34).
+//! `mpc/solve_constrained_10` is the 10-link solve within the joint-torque polytope as well
+//! (issue 30: `JointTorqueRows` at every node, each joint's limit 10% below its peak over the
+//! free plan, `Mpc::solve_constrained`).
 
 use backbone_kin::ModalMap;
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use manip_dyn::ChainModel;
+use modal_reduce::ReducedData;
 use modal_reduce::ReducedModel;
-use optimal_ctl::{Mpc, MpcSettings};
+use optimal_ctl::{JointTorqueRows, Mpc, MpcSettings, StepConstraints};
 use sim_core::reference::{Reference, ReferenceSample, Sinusoid};
 use std::hint::black_box;
 
@@ -68,6 +72,41 @@ fn solve_n(group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::Wal
             BatchSize::SmallInput,
         )
     });
+    if n == 10 {
+        // The same warm start re-planned within joint-torque limits 10% below each joint's peak
+        // over the free plan (binding), the constraint memory sized beforehand.
+        let limits = plan_peaks(&mpc, &model).map(|peak| 0.9 * peak);
+        let rows = JointTorqueRows::new(&model, &limits).unwrap();
+        let mut warm = mpc.clone();
+        warm.reserve_constraints(rows.max_rows()).unwrap();
+        group.bench_function("solve_constrained_10", |b| {
+            b.iter_batched_ref(
+                || (warm.clone(), rows.clone()),
+                |(mpc, rows)| {
+                    mpc.solve_constrained(&model, black_box(&a), black_box(&a_dot), rows)
+                        .unwrap()
+                },
+                BatchSize::SmallInput,
+            )
+        });
+    }
+}
+
+/// Each joint's largest torque over the nodes of `mpc`'s plan (eq 13 at the planned states).
+fn plan_peaks(mpc: &Mpc, model: &ReducedModel) -> [f64; 10] {
+    let ilqr = mpc.ilqr();
+    let mut data = ReducedData::new(model);
+    let (mut a_ddot, mut tau, mut peaks) = ([0.0; 2], [0.0; 10], [0.0f64; 10]);
+    for k in 0..ilqr.horizon() {
+        let x = &ilqr.states()[k * 4..(k + 1) * 4];
+        let u = &ilqr.controls()[k * 2..(k + 1) * 2];
+        modal_reduce::forward_dynamics(model, &mut data, &x[..2], &x[2..], u, &mut a_ddot).unwrap();
+        modal_reduce::joint_torques(model, &mut data, &x[..2], &x[2..], &a_ddot, &mut tau).unwrap();
+        for (p, t) in peaks.iter_mut().zip(tau) {
+            *p = p.max(t.abs());
+        }
+    }
+    peaks
 }
 
 criterion_group!(benches, solve);

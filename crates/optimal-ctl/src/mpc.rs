@@ -370,6 +370,15 @@ impl Mpc {
         Ok(report)
     }
 
+    /// Sizes the solver's memory for [`solve_constrained`](Self::solve_constrained) with at
+    /// most `max_rows` rows a node (allocates; `solve_constrained` does it on its first call).
+    ///
+    /// # Errors
+    /// As [`Ilqr::reserve_constraints`].
+    pub fn reserve_constraints(&mut self, max_rows: usize) -> Result<(), OptimalError> {
+        self.ilqr.reserve_constraints(max_rows)
+    }
+
     /// Forgets the previous plan: the next [`solve`](Self::solve) warm-starts from the
     /// reference torques.
     pub fn reset(&mut self) {
