@@ -16,6 +16,7 @@ mod plot;
 mod progress;
 mod report;
 mod signals;
+mod spatial_figures;
 mod sweep;
 mod view_cmd;
 mod view_sweep;

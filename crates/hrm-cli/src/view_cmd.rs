@@ -272,17 +272,18 @@ fn parse_timeseries(text: &str, scenario: &Scenario) -> Result<Record, String> {
     let [t, tip_x, tip_y, ref_x, ref_y] =
         ["t", "tip_x", "tip_y", "tip_ref_x", "tip_ref_y"].map(column);
     let (t, tip_x, tip_y, ref_x, ref_y) = (t?, tip_x?, tip_y?, ref_x?, ref_y?);
-    let links = scenario
-        .model()
+    // A spatial run's tip has z columns too; a planar run's z is zero.
+    let [tip_z, ref_z] = ["tip_z", "tip_ref_z"].map(|name| column(name).ok());
+    let n_joints = scenario
+        .plant()
         .map_err(|e| e.to_string())?
-        .chain()
-        .link_lengths()
-        .count();
-    let joint: Vec<usize> = (1..=links)
+        .plant()
+        .n_joints();
+    let joint: Vec<usize> = (1..=n_joints)
         .map_while(|j| column(&format!("joint_tau{j}")).ok())
         .collect();
     let mut record = Record {
-        n_joints: links,
+        n_joints,
         n_coords: m,
         ..Record::default()
     };
@@ -313,7 +314,9 @@ fn parse_timeseries(text: &str, scenario: &Scenario) -> Result<Record, String> {
         record.tau_star.extend(tau.iter().map(|&c| row[c]));
         record.tip.push([row[tip_x], row[tip_y]]);
         record.tip_ref.push([row[ref_x], row[ref_y]]);
-        if joint.len() == links {
+        record.tip_z.push(tip_z.map_or(0.0, |c| row[c]));
+        record.tip_ref_z.push(ref_z.map_or(0.0, |c| row[c]));
+        if joint.len() == n_joints {
             record.joint_torques.extend(joint.iter().map(|&c| row[c]));
         }
     }

@@ -106,17 +106,33 @@ pub enum DynError {
     /// precision; the accelerations would have no reliable digits.
     #[error("the mass matrix is not numerically positive definite")]
     NotPositiveDefinite,
+    /// A spatial chain's articulated inertia about joint `index`'s axis was not positive beyond
+    /// rounding (as for [`NotPositiveDefinite`](DynError::NotPositiveDefinite)): the joint moves
+    /// no mass or inertia, so `M` is singular. A massless link is valid as long as the links
+    /// beyond it give its joint something to move; this names the joint where they do not (a
+    /// massless link at the tip, a point mass on the axis of the last revolute joint).
+    #[error(
+        "joint {index}: the articulated inertia about its axis is not positive beyond rounding \
+         (the joint moves no mass or inertia), so the mass matrix is singular"
+    )]
+    SingularJoint {
+        /// 0-based joint index.
+        index: usize,
+    },
 }
 
 impl Classify for DynError {
     /// [`Numerical`](ErrorClass::Numerical) when a computation on valid input failed in double
     /// precision: a mass matrix that is not numerically positive definite, or a result that
     /// overflowed ([`NotPositiveDefinite`](DynError::NotPositiveDefinite),
+    /// [`SingularJoint`](DynError::SingularJoint),
     /// [`NonFiniteResult`](DynError::NonFiniteResult)); otherwise the input was malformed or
     /// outside the model's domain.
     fn class(&self) -> ErrorClass {
         match self {
-            Self::NotPositiveDefinite | Self::NonFiniteResult { .. } => ErrorClass::Numerical,
+            Self::NotPositiveDefinite
+            | Self::SingularJoint { .. }
+            | Self::NonFiniteResult { .. } => ErrorClass::Numerical,
             _ => ErrorClass::InvalidInput,
         }
     }

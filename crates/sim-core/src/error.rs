@@ -64,6 +64,35 @@ pub enum SimError {
         /// The point's `y` (m).
         y: f64,
     },
+    /// A point of a spatial arm's tip path cannot be reached by its chain.
+    #[error(
+        "the reference path point ({:.6}, {:.6}, {:.6}) at t = {t} s is unreachable: {source}",
+        point[0], point[1], point[2]
+    )]
+    UnreachableInSpace {
+        /// Time on the path (s).
+        t: f64,
+        /// The point (m).
+        point: [f64; 3],
+        /// Which reachability condition failed.
+        source: KinError,
+    },
+    /// A spatial arm's tip path passes through a singular point of the chain's inverse
+    /// kinematics (the tip cannot move in some direction), where the modal rate is undefined.
+    #[error(
+        "the reference path passes through a singular point of the inverse kinematics near \
+         t = {t} s at ({:.6}, {:.6}, {:.6}): {what}, where the modal reference rate is undefined; \
+         move the path or the base",
+        point[0], point[1], point[2]
+    )]
+    SingularPointInSpace {
+        /// Which singularity.
+        what: &'static str,
+        /// Time on the path (s).
+        t: f64,
+        /// The point (m).
+        point: [f64; 3],
+    },
     /// The kinematics refused a computation.
     #[error("kinematics: {0}")]
     Kinematics(#[from] KinError),
@@ -146,6 +175,15 @@ pub enum SimError {
         /// The bound in force (rad).
         bound: f64,
     },
+    /// The enforced joint limits (`limits.joint_torque_nm`, `limits.joint_angle_rad`) could not
+    /// be met at a controller sample: no modal torque keeps them at that state.
+    #[error("joint limits at t = {t} s: {reason}")]
+    JointLimits {
+        /// When (s).
+        t: f64,
+        /// Why.
+        reason: &'static str,
+    },
 }
 
 /// The error of a controller from outside this crate, shared so that a [`SimError`] stays
@@ -179,7 +217,7 @@ impl Classify for SimError {
     /// own class; otherwise a setting, file or model was outside its domain.
     fn class(&self) -> ErrorClass {
         match self {
-            Self::Unreachable { .. } => ErrorClass::Unreachable,
+            Self::Unreachable { .. } | Self::UnreachableInSpace { .. } => ErrorClass::Unreachable,
             Self::Kinematics(e) => e.class(),
             Self::Dynamics { source, .. } | Self::Model(source) => source.class(),
             Self::Fuzzy(e) => e.class(),
@@ -189,7 +227,8 @@ impl Classify for SimError {
             | Self::NonFiniteControl { .. }
             | Self::NonFiniteDisturbance { .. }
             | Self::Controller { .. }
-            | Self::RunawayError { .. } => ErrorClass::Numerical,
+            | Self::RunawayError { .. }
+            | Self::JointLimits { .. } => ErrorClass::Numerical,
             _ => ErrorClass::InvalidInput,
         }
     }

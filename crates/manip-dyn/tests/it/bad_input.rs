@@ -905,7 +905,7 @@ fn spatial_rows() -> Vec<Row<DynError>> {
                     }
                 )
             },
-            &["link 0: mass must be positive and finite, got -1"],
+            &["link 0: mass must be non-negative and finite, got -1"],
         ),
         words(
             "spatial_nan_mass",
@@ -1090,8 +1090,48 @@ fn spatial_rows() -> Vec<Row<DynError>> {
                 )
                 .unwrap_err()
             },
-            |e| *e == DynError::NotPositiveDefinite,
-            &["not numerically positive definite"],
+            |e| *e == DynError::SingularJoint { index: 1 },
+            &["joint 1: the articulated inertia about its axis is not positive"],
+        ),
+        // A massless link at the tip: its joint moves nothing, in the batch as alone.
+        words(
+            "spatial_massless_tip",
+            {
+                let massless = SpatialLink {
+                    mass: 0.0,
+                    com: [0.0; 3],
+                    inertia: [[0.0; 3]; 3],
+                };
+                let arm = SpatialModel::new(vec![joint; 3], vec![link, link, massless], [0.0; 3])
+                    .unwrap();
+                let error = manip_dyn::spatial::aba_batch(
+                    &arm,
+                    &mut manip_dyn::spatial::SpatialBatchData::new(&arm),
+                    &[0.1; 24],
+                    &[0.0; 24],
+                    &[0.0; 24],
+                    &mut [0.0; 24],
+                )
+                .unwrap_err();
+                assert_eq!(
+                    error,
+                    manip_dyn::BatchError::State {
+                        state: 0,
+                        error: DynError::SingularJoint { index: 2 }
+                    }
+                );
+                manip_dyn::spatial::aba(
+                    &arm,
+                    &mut SpatialData::new(&arm),
+                    &[0.0; 3],
+                    &[0.0; 3],
+                    &[0.0; 3],
+                    &mut [0.0; 3],
+                )
+                .unwrap_err()
+            },
+            |e| *e == DynError::SingularJoint { index: 2 } && e.is_numerical(),
+            &["joint 2: the articulated inertia about its axis is not positive"],
         ),
     ]
 }
