@@ -76,12 +76,16 @@ impl Error {
     }
 }
 
+/// The exception of the error's class, its message with any number written out in full by a
+/// library (`1e-300` as 302 characters) in exponent form ([`lane_math::compact_numbers`]), as
+/// the CLI prints it.
 impl From<Error> for PyErr {
     fn from(error: Error) -> PyErr {
+        let message = lane_math::compact_numbers(&error.message);
         match error.kind {
-            ErrorClass::Unreachable => Unreachable::new_err(error.message),
-            ErrorClass::Numerical => NumericalError::new_err(error.message),
-            _ => InvalidInput::new_err(error.message),
+            ErrorClass::Unreachable => Unreachable::new_err(message),
+            ErrorClass::Numerical => NumericalError::new_err(message),
+            _ => InvalidInput::new_err(message),
         }
     }
 }

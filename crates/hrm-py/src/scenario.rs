@@ -9,7 +9,7 @@
 //! by `Scenario::build`, with the messages `hrm simulate` prints.
 
 use crate::array::States;
-use crate::errors::{Error, InvalidInput, NumericalError};
+use crate::errors::{Error, NumericalError};
 use crate::pool::{self, Cancel};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1};
@@ -63,7 +63,7 @@ fn scenario_error(error: ScenarioError) -> PyErr {
             PyFileNotFoundError::new_err(error.to_string())
         }
         ScenarioError::Io { .. } => PyOSError::new_err(error.to_string()),
-        _ => InvalidInput::new_err(error.to_string()),
+        _ => Error::input(error.to_string()).into(),
     }
 }
 
@@ -557,7 +557,8 @@ impl PythonController {
         let values = values.values();
         if values.iter().any(|v| !v.is_finite()) {
             return Err(NumericalError::new_err(format!(
-                "the controller returned a non-finite tau_star {values:?} at t = {t} s"
+                "the controller returned a non-finite tau_star {values:?} at t = {} s",
+                lane_math::Compact(t)
             )));
         }
         tau_star.copy_from_slice(values);
@@ -657,7 +658,8 @@ impl PythonDisturbance {
         let values = values.values();
         if values.iter().any(|v| !v.is_finite()) {
             return Err(NumericalError::new_err(format!(
-                "the disturbance returned a non-finite joint torque {values:?} at t = {t} s"
+                "the disturbance returned a non-finite joint torque {values:?} at t = {} s",
+                lane_math::Compact(t)
             )));
         }
         tau.copy_from_slice(values);

@@ -446,3 +446,21 @@ def test_spatial_and_urdf_classes_follow_the_same_rules():
     a = packed(2, arm.n_coords)["x"]
     for clone in round_trips(arm):
         np.testing.assert_array_equal(clone.fk(a), arm.fk(np.array(a)))
+
+
+def test_messages_write_tiny_and_huge_numbers_compactly():
+    # A library writes 1e-300 through lane_math::Compact; any message is compacted once more at
+    # the exception: never a decimal of hundreds of digits.
+    for call, number in [
+        (lambda: hrm.Arm(links=3, link_length=1e-300), "1e-300"),
+        (lambda: hrm.Arm(links=3, link_length=1e300), "1e300"),
+        (lambda: hrm.Arm(links=3, link_mass=5e-324), "5e-324"),
+    ]:
+        with pytest.raises(hrm.InvalidInput) as error:
+            call()
+        message = str(error.value)
+        assert number in message and len(message) < 300, message
+    scenario = short_step()
+    scenario.limits.max_modal_error = 1e-300
+    run = scenario.run("pd")
+    assert run.failure is not None and "1e-300" in run.failure and len(run.failure) < 300, run.failure

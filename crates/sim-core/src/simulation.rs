@@ -1000,7 +1000,8 @@ pub fn check_loop_work(n_links: usize, m: usize) -> Result<(), SimError> {
 
 /// The most fixed steps an RK4 run may take (`duration / integrator.dt`): about half an hour of
 /// computing for a 10-link arm, so a step typed `1e-12` for `1e-4` is refused up front rather
-/// than running for days.
+/// than running for days. A Dormand-Prince run whose `h_max` forces more steps
+/// (`duration / h_max`) is refused the same way.
 pub const MAX_RK4_STEPS: f64 = 1e9;
 
 /// The most numbers a run may record (1 GiB of `f64`): [`Simulation::new`] refuses a duration and
@@ -1184,6 +1185,24 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
                 Compact(s.duration)
             ),
         ));
+    }
+    // Dormand-Prince steps no longer than h_max: a step typed `1e-300` would fall below the
+    // resolution of t at once and read as a stiff problem, one of `1e-12` would run for days.
+    if let Integrator::DormandPrince(tol) = s.integrator {
+        let steps = s.duration / tol.h_max;
+        if steps > MAX_RK4_STEPS {
+            return Err(SimError::setting(
+                "integrator.h_max",
+                format!(
+                    "= {} s would take at least {} steps over {} s, more than the \
+                     {MAX_RK4_STEPS:e} a run may take (hours of computing): use a larger h_max \
+                     or simulate less",
+                    Compact(tol.h_max),
+                    Compact(steps.round()),
+                    Compact(s.duration)
+                ),
+            ));
+        }
     }
     if let Integrator::Rk4 { dt } = s.integrator {
         let steps = s.duration / dt;

@@ -162,17 +162,33 @@ fn check_counts(args: &SweepArgs) -> Result<(usize, u64), String> {
     Ok((seeds, base_seed))
 }
 
+/// Each [`SweepSettings`] field with the option of `hrm sweep` that sets it.
+const OPTIONS: [(&str, &str); 6] = [
+    ("controllers", "--controllers"),
+    ("noise_levels", "--noise"),
+    ("rate_noise_ratio", "--rate-noise-ratio"),
+    ("reference_noise_ratio", "--reference-noise-ratio"),
+    ("seeds", "--seeds"),
+    ("base_seed", "--base-seed"),
+];
+
 /// The option of `hrm sweep` that sets a [`SweepSettings`] field.
 fn option(setting: &str) -> &str {
-    match setting {
-        "controllers" => "--controllers",
-        "noise_levels" => "--noise",
-        "rate_noise_ratio" => "--rate-noise-ratio",
-        "reference_noise_ratio" => "--reference-noise-ratio",
-        "seeds" => "--seeds",
-        "base_seed" => "--base-seed",
-        other => other,
-    }
+    OPTIONS
+        .iter()
+        .find(|(name, _)| *name == setting)
+        .map_or(setting, |(_, option)| option)
+}
+
+/// A refusal of the settings in the options' words: the setting named by its option, and a
+/// setting the problem cites (`rate_noise_ratio = 10`) too (`--rate-noise-ratio 10`).
+fn in_options(e: &study::SettingError) -> String {
+    let problem = OPTIONS
+        .iter()
+        .fold(e.problem.clone(), |text, (name, option)| {
+            text.replace(&format!("{name} = "), &format!("{option} "))
+        });
+    format!("{} {problem}", option(e.setting))
 }
 
 /// The sweep's configuration ([`SweepConfig::new`]): the scenario resolved, the duration
@@ -188,9 +204,7 @@ fn configure(args: &SweepArgs) -> Result<SweepConfig, String> {
         seeds,
         base_seed,
     };
-    settings
-        .check()
-        .map_err(|e| format!("{} {}", option(e.setting), e.problem))?;
+    settings.check().map_err(|e| in_options(&e))?;
     let mut scenario = Scenario::resolve(&args.scenario).map_err(|e| e.to_string())?;
     if let Some(duration) = args.duration {
         scenario.duration = duration;

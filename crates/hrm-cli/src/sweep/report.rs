@@ -15,7 +15,8 @@ pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
     let _ = writeln!(
         s,
         "sweep of {}: {} noise levels x {} controllers x {} seeds = {} runs, base seed {}, {} s each",
-        config.scenario.name,
+        // The user's text: a newline or U+202E in it must not break or reverse the table.
+        crate::console::escape_field(&config.scenario.name),
         config.settings.noise_levels.len(),
         config.settings.controllers.len(),
         config.settings.seeds,

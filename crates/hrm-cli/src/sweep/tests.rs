@@ -126,11 +126,21 @@ fn bad_settings_are_refused_before_running() {
         err.starts_with("--noise must be distinct and ascending"),
         "{err}"
     );
-    // 1e308 times the rate ratio 10 overflows: named as --noise, not as the scenario's noise.
+    // 1e308 times the rate ratio 10 overflows: named as --noise and --rate-noise-ratio, not as
+    // the scenario's noise or the library's field; a huge ratio is written compactly.
+    let err = hrm_sweep(&with(
+        SMALL,
+        &["--noise", "10", "--rate-noise-ratio", "1e308", "--out", out],
+    ))
+    .unwrap_err();
+    assert_eq!(
+        err,
+        "--noise 10 times --rate-noise-ratio 1e308 is not finite"
+    );
     let err = hrm_sweep(&with(SMALL, &["--noise", "1e308", "--out", out])).unwrap_err();
     assert_eq!(
         err,
-        "--noise 1e308 times rate_noise_ratio = 10 is not finite"
+        "--noise 1e308 times --rate-noise-ratio 10 is not finite"
     );
     let err = hrm_sweep(&with(SMALL, &["--rate-noise-ratio", "-1", "--out", out])).unwrap_err();
     assert_eq!(

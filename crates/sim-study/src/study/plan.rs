@@ -3,6 +3,7 @@
 
 use super::inputs::{self, InputDigest};
 use crate::{ControllerKind, NoiseSpec, Scenario};
+use lane_math::Compact;
 use serde::{Deserialize, Serialize};
 use sim_core::{Prepared, RunNoise, SimError};
 use std::fmt;
@@ -143,7 +144,7 @@ impl SweepSettings {
         {
             return Err(SettingError::new(
                 "noise_levels",
-                format!("must be finite and non-negative, got {bad}"),
+                format!("must be finite and non-negative, got {}", Compact(*bad)),
             ));
         }
         if self.noise_levels.windows(2).any(|w| w[0] >= w[1]) {
@@ -162,7 +163,7 @@ impl SweepSettings {
             if !(ratio.is_finite() && ratio >= 0.0) {
                 return Err(SettingError::new(
                     name,
-                    format!("must be finite and non-negative, got {ratio}"),
+                    format!("must be finite and non-negative, got {}", Compact(ratio)),
                 ));
             }
         }
@@ -175,7 +176,11 @@ impl SweepSettings {
             if !(largest * ratio).is_finite() {
                 return Err(SettingError::new(
                     "noise_levels",
-                    format!("{largest:e} times {name} = {ratio} is not finite"),
+                    format!(
+                        "{} times {name} = {} is not finite",
+                        Compact(largest),
+                        Compact(ratio)
+                    ),
                 ));
             }
         }

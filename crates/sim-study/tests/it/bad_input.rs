@@ -302,6 +302,42 @@ fn run_of_astronomically_many_rk4_steps() {
 }
 
 #[test]
+fn run_whose_h_max_forces_astronomically_many_steps() {
+    // h_max = 1e-300 s: below the resolution of t at once; 1e-12 s: 1e11 steps. Both refused up
+    // front naming integrator.h_max, not reported as a stiff problem once the run starts.
+    for (h_max, steps) in [(1e-300, "1e299"), (1e-12, "100000000000")] {
+        let tolerances = Tolerances {
+            h_max,
+            ..Tolerances::default()
+        };
+        let s = LoopSettings::new(Integrator::DormandPrince(tolerances), 1e-3, 0.1);
+        let (name, message) = invalid(build(s));
+        assert_eq!(name, "integrator.h_max");
+        assert_eq!(
+            message,
+            format!(
+                "integrator.h_max = {} s would take at least {steps} steps over 0.1 s, more than \
+                 the 1e9 a run may take (hours of computing): use a larger h_max or simulate less",
+                lane_math::Compact(h_max)
+            )
+        );
+    }
+    // 1e-9 s (1e8 steps) is within the bound.
+    let tolerances = Tolerances {
+        h_max: 1e-9,
+        ..Tolerances::default()
+    };
+    assert!(
+        build(LoopSettings::new(
+            Integrator::DormandPrince(tolerances),
+            1e-3,
+            0.1
+        ))
+        .is_ok()
+    );
+}
+
+#[test]
 fn run_too_long_to_record() {
     // 1e8 samples would be recorded: refused up front instead of failing to allocate.
     let s = LoopSettings {
