@@ -4,6 +4,13 @@
 //! state), and the analytic ABA derivatives (`spatial_aba_derivatives`: `qdd`, `d qdd / d q`,
 //! `d qdd / d v`, `M^-1`).
 //!
+//! And the spatial modal arm of `modal_reduce::spatial` (`reduced_fd_spatial/<n>`: reduced
+//! forward dynamics of `n` universal-joint links of 0.1 m and 0.1 kg as slender rods, `K = 1`
+//! harmonic per plane so `m = 4`, gravity along `-z`, at a moving state; Pinocchio's
+//! `pinocchio/reduced_fd_spatial/<n>` times CRBA + NLE + `J^T M J` + Cholesky on the same arm's
+//! URDF export), one state at a time and in a batch of 1024 states (`reduced_fd_spatial_batch`,
+//! per state).
+//!
 //! Two chains, those of the comparison with Pinocchio in `docs/performance.md`: the 10-link
 //! universal-joint snake (`snake20`: 20 revolute joints alternating `z` and `y`, links of 0.1 m
 //! and 0.1 kg, each link's rod split between its two bodies) and a 7-joint chain of fixed
@@ -13,6 +20,10 @@ use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_m
 use manip_dyn::spatial::{
     SpatialBatchData, SpatialData, SpatialDerivativeData, SpatialJoint, SpatialLink, SpatialModel,
     Transform, aba, aba_batch, aba_derivatives,
+};
+use modal_reduce::spatial::{
+    SpatialReducedBatchData, SpatialReducedData, SpatialReducedModel, spatial_forward_dynamics,
+    spatial_forward_dynamics_batch,
 };
 use std::hint::black_box;
 
@@ -150,8 +161,68 @@ fn spatial_aba_derivatives(c: &mut Criterion) {
     group.finish();
 }
 
+/// The spatial modal arm of `n` links (`m = 4`) and its moving state `(a, a_dot, tau*)`: those
+/// whose URDF export and map `benches/pinocchio/spatial.cpp` times.
+fn spatial_arm_state(n: usize) -> (SpatialReducedModel, [Vec<f64>; 3]) {
+    (hrm_benches::spatial_arm(n), hrm_benches::spatial_state())
+}
+
+fn reduced_fd_spatial(c: &mut Criterion) {
+    let mut group = c.benchmark_group("reduced_fd_spatial");
+    for n in [10, 100] {
+        let (model, [a, a_dot, tau_star]) = spatial_arm_state(n);
+        let mut data = SpatialReducedData::new(&model);
+        let mut a_ddot = [0.0; 4];
+        group.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter(|| {
+                let (a, a_dot) = (black_box(&a), black_box(&a_dot));
+                spatial_forward_dynamics(&model, &mut data, a, a_dot, &tau_star, &mut a_ddot)
+                    .unwrap();
+                black_box(a_ddot[0])
+            })
+        });
+    }
+    group.finish();
+}
+
+fn reduced_fd_spatial_batch(c: &mut Criterion) {
+    let mut group = c.benchmark_group("reduced_fd_spatial_batch");
+    group.throughput(Throughput::Elements(BATCH as u64));
+    for n in [10, 100] {
+        let (model, state) = spatial_arm_state(n);
+        let [a, a_dot, tau_star] = state.map(|x| {
+            (0..BATCH)
+                .flat_map(|s| {
+                    x.iter()
+                        .map(move |x| x * (1.0 + 1e-3 * s as f64))
+                        .collect::<Vec<_>>()
+                })
+                .collect::<Vec<f64>>()
+        });
+        let mut data = SpatialReducedBatchData::new(&model);
+        let mut out = vec![0.0; a.len()];
+        group.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter(|| {
+                spatial_forward_dynamics_batch(
+                    &model,
+                    &mut data,
+                    black_box(&a),
+                    &a_dot,
+                    &tau_star,
+                    &mut out,
+                )
+                .unwrap();
+                black_box(out[0])
+            })
+        });
+    }
+    group.finish();
+}
+
 criterion_group!(
     benches,
+    reduced_fd_spatial,
+    reduced_fd_spatial_batch,
     spatial_aba,
     spatial_aba_batch,
     spatial_aba_derivatives

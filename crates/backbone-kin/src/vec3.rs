@@ -1,32 +1,43 @@
 //! 3-vectors and 3 x 3 matrices as plain arrays: the arithmetic of the spatial modal family's
 //! kinematics ([`spatial_chain`](crate::spatial_chain), [`spatial_curve`](crate::spatial_curve)),
 //! shared with the spatial reduced dynamics of `modal-reduce`.
+//!
+//! The arithmetic is generic over [`Lane`]: an `f64` is one value, a
+//! [`Pack`](lane_math::Pack) a SIMD register of independent values (the spatial reduced
+//! dynamics' batches across states), with the same operations in the same order either way.
 
-/// A 3 x 3 matrix, `r[row][column]` (a rotation, or an inertia).
-pub type Rotation = [[f64; 3]; 3];
+use lane_math::Lane;
+
+/// A 3 x 3 matrix, `r[row][column]` (a rotation, or an inertia), of `f64` or of lanes.
+pub type Rotation<L = f64> = [[L; 3]; 3];
 
 /// `a + b`.
-pub fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+#[inline(always)]
+pub fn add<L: Lane>(a: [L; 3], b: [L; 3]) -> [L; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
 /// `a - b`.
-pub fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+#[inline(always)]
+pub fn sub<L: Lane>(a: [L; 3], b: [L; 3]) -> [L; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// `s a`.
-pub fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+#[inline(always)]
+pub fn scale<L: Lane>(a: [L; 3], s: L) -> [L; 3] {
     [s * a[0], s * a[1], s * a[2]]
 }
 
 /// `a . b`.
-pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+#[inline(always)]
+pub fn dot<L: Lane>(a: [L; 3], b: [L; 3]) -> L {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// `a x b`.
-pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+#[inline(always)]
+pub fn cross<L: Lane>(a: [L; 3], b: [L; 3]) -> [L; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -41,17 +52,28 @@ pub fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 /// `A v`.
-pub fn mat_vec(a: &Rotation, v: [f64; 3]) -> [f64; 3] {
-    std::array::from_fn(|i| a[i][0] * v[0] + a[i][1] * v[1] + a[i][2] * v[2])
+#[inline(always)]
+pub fn mat_vec<L: Lane>(a: &Rotation<L>, v: [L; 3]) -> [L; 3] {
+    [dot(a[0], v), dot(a[1], v), dot(a[2], v)]
 }
 
 /// The product `a b`.
-pub fn mat_mul(a: Rotation, b: Rotation) -> Rotation {
-    std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
+#[inline(always)]
+pub fn mat_mul<L: Lane>(a: Rotation<L>, b: Rotation<L>) -> Rotation<L> {
+    // Loops, not closures: a closure is compiled without the instruction set of a SIMD
+    // dispatch that inlines this function, and would call its intrinsics.
+    let mut product = a;
+    for (row, a_row) in product.iter_mut().zip(a) {
+        for (j, entry) in row.iter_mut().enumerate() {
+            *entry = a_row[0] * b[0][j] + a_row[1] * b[1][j] + a_row[2] * b[2][j];
+        }
+    }
+    product
 }
 
 /// Column `j` of `r`.
-pub fn column(r: &Rotation, j: usize) -> [f64; 3] {
+#[inline(always)]
+pub fn column<L: Lane>(r: &Rotation<L>, j: usize) -> [L; 3] {
     [r[0][j], r[1][j], r[2][j]]
 }
 

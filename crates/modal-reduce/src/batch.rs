@@ -124,13 +124,7 @@ pub fn forward_dynamics_batch(
     a_ddot: &mut [f64],
 ) -> Result<(), BatchError> {
     data.single.check_model(model).map_err(BatchError::Shape)?;
-    let m = model.n_coords();
-    let values = a.len() - a.len() % m;
-    let shape = |name, found| check_len(name, found, values).map_err(BatchError::Shape);
-    shape("a (whole states of m values)", a.len())?;
-    shape("a_dot (as many values as a)", a_dot.len())?;
-    shape("tau_star (as many values as a)", tau_star.len())?;
-    shape("a_ddot (as many values as a)", a_ddot.len())?;
+    check_batch_shape(model.n_coords(), [a, a_dot, tau_star], a_ddot)?;
     let arch = data.arch;
     arch.dispatch(Batch {
         model,
@@ -138,6 +132,22 @@ pub fn forward_dynamics_batch(
         inputs: [a, a_dot, tau_star],
         a_ddot,
     })
+}
+
+/// Checks that `a`, `a_dot`, `tau_star` (`inputs`) and `a_ddot` hold the same whole number of
+/// states of `m` values each.
+pub(crate) fn check_batch_shape(
+    m: usize,
+    inputs: [&[f64]; 3],
+    a_ddot: &[f64],
+) -> Result<(), BatchError> {
+    let [a, a_dot, tau_star] = inputs;
+    let values = a.len() - a.len() % m;
+    let shape = |name, found| check_len(name, found, values).map_err(BatchError::Shape);
+    shape("a (whole states of m values)", a.len())?;
+    shape("a_dot (as many values as a)", a_dot.len())?;
+    shape("tau_star (as many values as a)", tau_star.len())?;
+    shape("a_ddot (as many values as a)", a_ddot.len())
 }
 
 /// One batch, run by [`pulp::Arch::dispatch`] with the processor's instruction set.

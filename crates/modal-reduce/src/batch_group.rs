@@ -27,6 +27,12 @@ pub fn batch_lanes(model: &ReducedModel) -> usize {
     if model.n_coords() > MAX_BATCH_COORDS {
         return 1;
     }
+    simd_lanes()
+}
+
+/// The number of `f64` lanes of the instruction set [`Arch::new`] picks on this processor (1
+/// without SIMD, or with registers wider than the batches' [`MAX_WIDTH`]).
+pub(crate) fn simd_lanes() -> usize {
     Arch::new().dispatch(Lanes)
 }
 

@@ -26,7 +26,7 @@ pub use error::ReduceError;
 pub use forward::{forward_dynamics, forward_dynamics_by_projection};
 pub use jacobi::{JacobiReport, JacobiSettings, jacobi_forward_dynamics};
 pub use model::ReducedModel;
-pub use plant::{Plant, PlantData, PlantDerivatives, PlantModel};
+pub use plant::{Plant, PlantBatchData, PlantData, PlantDerivatives, PlantModel};
 pub use projection::reduced_terms_by_projection;
 pub use terms::reduced_terms;
 pub use torques::{joint_torques, project_torques};

@@ -8,13 +8,15 @@
 use faer::MatRef;
 
 use crate::spatial::{
-    SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel, spatial_forward_dynamics,
+    SpatialReducedBatchData, SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel,
+    spatial_batch_lanes, spatial_forward_dynamics, spatial_forward_dynamics_batch,
     spatial_joint_torques, spatial_project_torques, spatial_reduced_derivatives,
     spatial_reduced_terms,
 };
 use crate::{
-    ReduceError, ReducedData, ReducedDerivatives, ReducedModel, forward_dynamics, joint_torques,
-    project_torques, reduced_derivatives, reduced_terms,
+    BatchError, ReduceError, ReducedBatchData, ReducedData, ReducedDerivatives, ReducedModel,
+    batch_lanes, forward_dynamics, forward_dynamics_batch, joint_torques, project_torques,
+    reduced_derivatives, reduced_terms,
 };
 
 /// A modal arm owned (what a simulation holds), planar or spatial; [`PlantModel::plant`] lends it
@@ -155,6 +157,41 @@ impl<'a> Plant<'a> {
         }
     }
 
+    /// The modal accelerations of a batch of states, SIMD across states, each state's the bits
+    /// of [`forward_dynamics`](Self::forward_dynamics) ([`forward_dynamics_batch`] or
+    /// [`spatial_forward_dynamics_batch`]; the slices hold states of `m` values one after the
+    /// other).
+    ///
+    /// Errors: as those, and a workspace of the other family (as [`BatchError::Shape`]).
+    pub fn forward_dynamics_batch(
+        self,
+        data: &mut PlantBatchData,
+        a: &[f64],
+        a_dot: &[f64],
+        tau_star: &[f64],
+        a_ddot: &mut [f64],
+    ) -> Result<(), BatchError> {
+        match (self, data) {
+            (Plant::Planar(model), PlantBatchData::Planar(data)) => {
+                forward_dynamics_batch(model, data, a, a_dot, tau_star, a_ddot)
+            }
+            (Plant::Spatial(model), PlantBatchData::Spatial(data)) => {
+                spatial_forward_dynamics_batch(model, data, a, a_dot, tau_star, a_ddot)
+            }
+            _ => Err(BatchError::Shape(other_family(self))),
+        }
+    }
+
+    /// The states one SIMD group of [`forward_dynamics_batch`](Self::forward_dynamics_batch)
+    /// evaluates on this processor ([`batch_lanes`] or [`spatial_batch_lanes`]; 1 when the
+    /// states go one at a time).
+    pub fn batch_lanes(self) -> usize {
+        match self {
+            Plant::Planar(model) => batch_lanes(model),
+            Plant::Spatial(model) => spatial_batch_lanes(model),
+        }
+    }
+
     /// The joint torques that realise the modal motion (`n` planar, `2n` spatial:
     /// [`joint_torques`] or [`spatial_joint_torques`]).
     ///
@@ -278,6 +315,29 @@ impl PlantData {
         match self {
             PlantData::Planar(data) => data.gravity(),
             PlantData::Spatial(data) => data.gravity(),
+        }
+    }
+}
+
+/// The workspace of [`Plant::forward_dynamics_batch`], built once for the plant.
+#[derive(Debug, Clone)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "built once per lock-step group and never moved per step"
+)]
+pub enum PlantBatchData {
+    /// For a planar plant.
+    Planar(ReducedBatchData),
+    /// For a spatial plant.
+    Spatial(SpatialReducedBatchData),
+}
+
+impl PlantBatchData {
+    /// A workspace for `plant`.
+    pub fn new(plant: Plant<'_>) -> Self {
+        match plant {
+            Plant::Planar(model) => PlantBatchData::Planar(ReducedBatchData::new(model)),
+            Plant::Spatial(model) => PlantBatchData::Spatial(SpatialReducedBatchData::new(model)),
         }
     }
 }

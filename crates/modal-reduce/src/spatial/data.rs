@@ -4,6 +4,7 @@
 use super::model::SpatialReducedModel;
 use super::motion::LinkMotion;
 use crate::error::{ReduceError, check_len};
+use pulp::Arch;
 
 /// Buffers for [`spatial_reduced_terms`](super::spatial_reduced_terms),
 /// [`spatial_forward_dynamics`](super::spatial_forward_dynamics) and
@@ -30,6 +31,8 @@ pub struct SpatialReducedData {
     pub(crate) factor: Vec<f64>,
     /// Every link's motion, for the backward pass of the joint torques.
     pub(crate) links: Vec<LinkMotion>,
+    /// The instruction set the terms' kernel is dispatched to (found at construction).
+    pub(crate) arch: Arch,
 }
 
 impl SpatialReducedData {
@@ -61,6 +64,7 @@ impl SpatialReducedData {
             gravity: vec![0.0; m],
             factor: vec![0.0; m * m],
             links: vec![zero_motion; n],
+            arch: Arch::new(),
         }
     }
 

@@ -9,10 +9,12 @@
 //!   and acceleration, the acceleration of its centre of mass), which both algorithms share.
 //! - [`terms`]: `M*`, `C*`, `G*` in `O(n m^2)` without the `2n x 2n` mass matrix.
 //! - [`torques`]: the joint torques that realise a modal motion (Newton-Euler, `O(n)`).
-//! - [`forward`]: reduced forward dynamics.
+//! - [`forward`]: reduced forward dynamics; [`batch`]: the same for many states at once, SIMD
+//!   across states, each state's bits those of [`forward`].
 //! - [`tangent`]: the tangent of the Newton-Euler recursion along one direction;
 //!   [`derivatives`]: the analytic derivatives of the reduced forward dynamics, `O(n m^2)`.
 
+pub mod batch;
 pub mod data;
 pub mod derivatives;
 pub mod forward;
@@ -22,6 +24,10 @@ pub mod tangent;
 pub mod terms;
 pub mod torques;
 
+pub use batch::{
+    MAX_SPATIAL_BATCH_COORDS, SpatialReducedBatchData, spatial_batch_lanes,
+    spatial_forward_dynamics_batch,
+};
 pub use data::SpatialReducedData;
 pub use derivatives::{SpatialReducedDerivatives, spatial_reduced_derivatives};
 pub use forward::spatial_forward_dynamics;

@@ -16,73 +16,106 @@
 //! With zero joint accelerations the accelerations are the bias terms of `C*` (velocity
 //! products only).
 
-use backbone_kin::vec3::{
-    Rotation, add, column, cross, mat_mul, mat_vec, rot_y, rot_z, scale, sub,
-};
+use backbone_kin::vec3::{Rotation, add, column, cross, dot, mat_vec, scale, sub};
+use lane_math::{Lane, sin_cos_lanes};
 
-/// The state the recursion carries from link to link.
+/// The state the recursion carries from link to link (of one state, `f64`, or of one state per
+/// lane, [`Lane`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Carried {
+pub struct Carried<L = f64> {
     /// Frame of the previous link (or the base).
-    pub rotation: Rotation,
+    pub rotation: Rotation<L>,
     /// The joint point `p_{i-1}` (world frame).
-    pub point: [f64; 3],
+    pub point: [L; 3],
     /// Angular velocity of the previous link.
-    pub omega: [f64; 3],
+    pub omega: [L; 3],
     /// Angular acceleration of the previous link.
-    pub omega_dot: [f64; 3],
+    pub omega_dot: [L; 3],
     /// Acceleration of the joint point.
-    pub accel: [f64; 3],
+    pub accel: [L; 3],
 }
 
-impl Carried {
-    /// The base: at rest, in its pose.
-    pub fn base(rotation: Rotation, point: [f64; 3]) -> Self {
-        Self {
-            rotation,
-            point,
-            omega: [0.0; 3],
-            omega_dot: [0.0; 3],
-            accel: [0.0; 3],
+impl<L: Lane> Carried<L> {
+    /// The base: at rest, in its pose (in every lane).
+    #[inline(always)]
+    pub fn base(context: L::Context, rotation: Rotation, point: [f64; 3]) -> Self {
+        let zero = L::splat(context, 0.0);
+        let mut carried = Self {
+            rotation: [[zero; 3]; 3],
+            point: [zero; 3],
+            omega: [zero; 3],
+            omega_dot: [zero; 3],
+            accel: [zero; 3],
+        };
+        for i in 0..3 {
+            for j in 0..3 {
+                carried.rotation[i][j] = L::splat(context, rotation[i][j]);
+            }
+            carried.point[i] = L::splat(context, point[i]);
         }
+        carried
     }
 }
 
 /// What one link's step gives: its joints' axes, its frame, its angular velocity and
 /// acceleration, its centre of mass and that point's acceleration.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LinkMotion {
+pub struct LinkMotion<L = f64> {
     /// Axis of the joint about `z` (world frame).
-    pub u_z: [f64; 3],
+    pub u_z: [L; 3],
     /// Axis of the joint about `y` (world frame).
-    pub u_y: [f64; 3],
+    pub u_y: [L; 3],
     /// The joints' point `p_{i-1}`.
-    pub joint: [f64; 3],
+    pub joint: [L; 3],
     /// The link's frame `R_i`.
-    pub rotation: Rotation,
+    pub rotation: Rotation<L>,
     /// Angular velocity `w_i`.
-    pub omega: [f64; 3],
+    pub omega: [L; 3],
     /// Angular acceleration `w_dot_i`.
-    pub omega_dot: [f64; 3],
+    pub omega_dot: [L; 3],
     /// Centre of mass `c_i`.
-    pub com: [f64; 3],
+    pub com: [L; 3],
     /// Acceleration of the centre of mass.
-    pub com_accel: [f64; 3],
+    pub com_accel: [L; 3],
 }
 
 /// Link `i`'s step: `angles = [z_i, y_i]`, `rates`, `accels` likewise, `length` its length.
 /// Returns the link's motion and updates `carried` for the next link.
-pub fn link_step(
-    carried: &mut Carried,
+///
+/// Generic over [`Lane`] (`context` its constructor's argument, `()` for `f64`): the same
+/// operations in the same order for one state and for a register of states, so each lane gets
+/// the bits of its state alone. The turns are applied column by column, `R Rz(z)` mixing the
+/// first two columns of `R` and `Rz(z) Ry(y)` the first and last, with the sine and cosine of
+/// [`sin_cos_lanes`]. (No closures here or below: a closure is compiled without the instruction
+/// set of the SIMD dispatch that inlines this function, and would call its intrinsics.)
+#[inline(always)]
+pub fn link_step<L: Lane>(
+    context: L::Context,
+    carried: &mut Carried<L>,
     length: f64,
-    angles: [f64; 2],
-    rates: [f64; 2],
-    accels: [f64; 2],
-) -> LinkMotion {
-    let u_z = column(&carried.rotation, 2);
-    let after_z = mat_mul(carried.rotation, rot_z(angles[0]));
-    let u_y = column(&after_z, 1);
-    let rotation = mat_mul(after_z, rot_y(angles[1]));
+    angles: [L; 2],
+    rates: [L; 2],
+    accels: [L; 2],
+) -> LinkMotion<L> {
+    let (x, y, z) = (
+        column(&carried.rotation, 0),
+        column(&carried.rotation, 1),
+        column(&carried.rotation, 2),
+    );
+    let (sin_z, cos_z) = sin_cos_lanes(context, angles[0]);
+    let (sin_y, cos_y) = sin_cos_lanes(context, angles[1]);
+    // R Rz(z): x' = x cos + y sin, y' = y cos - x sin; then Ry(y): x'' = x' cos - z sin,
+    // z'' = x' sin + z cos.
+    let x_mid = add(scale(x, cos_z), scale(y, sin_z));
+    let u_y = sub(scale(y, cos_z), scale(x, sin_z));
+    let along = sub(scale(x_mid, cos_y), scale(z, sin_y));
+    let normal = add(scale(x_mid, sin_y), scale(z, cos_y));
+    let u_z = z;
+    let rotation = [
+        [along[0], u_y[0], normal[0]],
+        [along[1], u_y[1], normal[1]],
+        [along[2], u_y[2], normal[2]],
+    ];
     let omega_mid = add(carried.omega, scale(u_z, rates[0]));
     let omega = add(omega_mid, scale(u_y, rates[1]));
     let mut omega_dot = carried.omega_dot;
@@ -94,15 +127,8 @@ pub fn link_step(
     ] {
         omega_dot = add(omega_dot, scale(term, factor));
     }
-    let along = column(&rotation, 0);
-    let accel_at = |r: [f64; 3]| {
-        add(
-            carried.accel,
-            add(cross(omega_dot, r), cross(omega, cross(omega, r))),
-        )
-    };
-    let to_com = scale(along, 0.5 * length);
-    let to_next = scale(along, length);
+    let to_com = scale(along, L::splat(context, 0.5 * length));
+    let to_next = scale(along, L::splat(context, length));
     let joint = carried.point;
     let motion = LinkMotion {
         u_z,
@@ -112,27 +138,50 @@ pub fn link_step(
         omega,
         omega_dot,
         com: add(joint, to_com),
-        com_accel: accel_at(to_com),
+        com_accel: accel_at(carried.accel, omega, omega_dot, to_com),
     };
     *carried = Carried {
         rotation,
         point: add(joint, to_next),
         omega,
         omega_dot,
-        accel: accel_at(to_next),
+        accel: accel_at(carried.accel, omega, omega_dot, to_next),
     };
     motion
 }
 
-/// `R diag(principal) R^T`, a link's inertia about its centre of mass in the world frame.
-pub fn world_inertia(rotation: &Rotation, principal: [f64; 3]) -> Rotation {
-    std::array::from_fn(|i| {
-        std::array::from_fn(|j| {
-            (0..3)
-                .map(|k| rotation[i][k] * principal[k] * rotation[j][k])
-                .sum()
-        })
-    })
+/// The acceleration of the point `r` away from a point of acceleration `accel` on a body turning
+/// at `omega` with `omega_dot`: `accel + omega_dot x r + omega x (omega x r)`.
+#[inline(always)]
+fn accel_at<L: Lane>(accel: [L; 3], omega: [L; 3], omega_dot: [L; 3], r: [L; 3]) -> [L; 3] {
+    add(
+        accel,
+        add(cross(omega_dot, r), cross(omega, cross(omega, r))),
+    )
+}
+
+/// `R diag(principal) R^T`, a link's inertia about its centre of mass in the world frame
+/// (generic over [`Lane`] as [`link_step`]; the six entries of one triangle, mirrored).
+#[inline(always)]
+pub fn world_inertia<L: Lane>(rotation: &Rotation<L>, principal: [f64; 3]) -> Rotation<L> {
+    let r = rotation;
+    let mut scaled = *r;
+    for row in &mut scaled {
+        for (entry, &moment) in row.iter_mut().zip(&principal) {
+            *entry = *entry * moment;
+        }
+    }
+    let (xx, yy, zz) = (
+        dot(scaled[0], r[0]),
+        dot(scaled[1], r[1]),
+        dot(scaled[2], r[2]),
+    );
+    let (xy, xz, yz) = (
+        dot(scaled[1], r[0]),
+        dot(scaled[2], r[0]),
+        dot(scaled[2], r[1]),
+    );
+    [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]
 }
 
 /// Link `i`'s step of the backward pass: from the force `F_{i+1}` and the moment `N_{i+1}` about

@@ -22,7 +22,9 @@ use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
 use super::motion::{Carried, link_step, world_inertia};
 use crate::error::{ReduceError, check_finite_result, check_input};
-use backbone_kin::vec3::{cross, dot, mat_vec};
+use backbone_kin::vec3::{add, cross, dot, mat_vec, scale};
+use lane_math::Lane;
+use pulp::{Simd, WithSimd};
 
 /// Computes `M*`, `C*` and `G*` at the modal state `(a, a_dot)` into `data` (read them with
 /// [`SpatialReducedData::mass_matrix`], [`coriolis`](SpatialReducedData::coriolis) and
@@ -37,94 +39,201 @@ pub fn spatial_reduced_terms(
     a_dot: &[f64],
 ) -> Result<(), ReduceError> {
     check_state(model, data, a, a_dot)?;
-    let m = model.n_coords();
+    let arch = data.arch;
+    arch.dispatch(TermsOfOneState {
+        model,
+        data,
+        a,
+        a_dot,
+    });
+    check_finite_result("reduced mass matrix M*", &data.mass_matrix)?;
+    check_finite_result("reduced Coriolis vector C*", &data.coriolis)?;
+    check_finite_result("reduced gravity vector G*", &data.gravity)
+}
+
+/// [`spatial_reduced_terms`] after its checks, run by [`pulp::Arch::dispatch`] so that the
+/// kernel's fused multiply-adds are compiled for the processor's instruction set.
+struct TermsOfOneState<'a> {
+    model: &'a SpatialReducedModel,
+    data: &'a mut SpatialReducedData,
+    a: &'a [f64],
+    a_dot: &'a [f64],
+}
+
+impl WithSimd for TermsOfOneState<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) {
+        let data = self.data;
+        let work = TermsLanes {
+            omega_jacobian: &mut data.omega_jacobian,
+            origin_jacobian: &mut data.origin_jacobian,
+            com_jacobian: &mut data.com_jacobian,
+            inertia_times_omega_jacobian: &mut data.inertia_times_omega_jacobian,
+            mass_matrix: &mut data.mass_matrix,
+            coriolis: &mut data.coriolis,
+            gravity: &mut data.gravity,
+        };
+        // The sizes a batch runs SIMD across states, with the size known at compile time.
+        match self.model.n_coords() {
+            4 => accumulate::<f64>((), self.model, self.a, self.a_dot, 4, work),
+            8 => accumulate::<f64>((), self.model, self.a, self.a_dot, 8, work),
+            m => accumulate::<f64>((), self.model, self.a, self.a_dot, m, work),
+        }
+    }
+}
+
+/// The buffers of [`accumulate`], each of one state (`f64`) or one state per lane: `3 x m`
+/// row-major Jacobians `Jw`, `Jo`, `Jv` and `I Jw`, `M*` (`m x m`, row-major), `C*`, `G*`.
+pub(crate) struct TermsLanes<'w, L> {
+    pub(crate) omega_jacobian: &'w mut [L],
+    pub(crate) origin_jacobian: &'w mut [L],
+    pub(crate) com_jacobian: &'w mut [L],
+    pub(crate) inertia_times_omega_jacobian: &'w mut [L],
+    pub(crate) mass_matrix: &'w mut [L],
+    pub(crate) coriolis: &'w mut [L],
+    pub(crate) gravity: &'w mut [L],
+}
+
+/// `M*`, `C*` and `G*` (the module's sums) at `(a, a_dot)` into `work`, `m` coordinates: the
+/// kernel of [`spatial_reduced_terms`] (`L = f64`) and of the batch across states
+/// ([`spatial_forward_dynamics_batch`](super::spatial_forward_dynamics_batch), `L` a SIMD
+/// register of states), the same operations in the same order for both.
+///
+/// The joint angles and rates are formed link by link from the rows of the planar map, so
+/// nothing of size `n` is written: row `2i` of `J` is `[P_i, 0]` and row `2i + 1` is
+/// `[0, P_i]` (`P_i` row `i` of the planar map, `2K` entries), so the `z` joint moves only the
+/// first `2K` columns of the Jacobians and the `y` joint the last `2K`.
+#[inline(always)]
+pub(crate) fn accumulate<L: Lane>(
+    context: L::Context,
+    model: &SpatialReducedModel,
+    a: &[L],
+    a_dot: &[L],
+    m: usize,
+    work: TermsLanes<'_, L>,
+) {
+    // No closures: a closure is compiled without the instruction set of the SIMD dispatch that
+    // inlines this function, and would call its intrinsics.
+    let zero = L::splat(context, 0.0);
+    let TermsLanes {
+        omega_jacobian,
+        origin_jacobian,
+        com_jacobian,
+        inertia_times_omega_jacobian,
+        mass_matrix,
+        coriolis,
+        gravity: gravity_terms,
+    } = work;
+    let (omega_jacobian, origin_jacobian) =
+        (&mut omega_jacobian[..3 * m], &mut origin_jacobian[..3 * m]);
+    let (com_jacobian, inertia_times_omega_jacobian) = (
+        &mut com_jacobian[..3 * m],
+        &mut inertia_times_omega_jacobian[..3 * m],
+    );
+    let (mass_matrix, coriolis, gravity_terms) = (
+        &mut mass_matrix[..m * m],
+        &mut coriolis[..m],
+        &mut gravity_terms[..m],
+    );
+    for buffer in [
+        &mut *omega_jacobian,
+        &mut *origin_jacobian,
+        &mut *mass_matrix,
+        &mut *coriolis,
+        &mut *gravity_terms,
+    ] {
+        buffer.fill(zero);
+    }
+    let half = m / 2;
+    let (a_z, a_y) = a[..m].split_at(half);
+    let (rate_z, rate_y) = a_dot[..m].split_at(half);
     let map = model.map();
-    map.joint_angles(a, &mut data.theta)?;
-    map.joint_rates(a_dot, &mut data.theta_dot)?;
-    data.omega_jacobian.fill(0.0);
-    data.origin_jacobian.fill(0.0);
-    data.mass_matrix.fill(0.0);
-    data.coriolis.fill(0.0);
-    data.gravity.fill(0.0);
+    let planar = map.planar();
     let gravity = model.gravity();
     let base = model.base();
-    let mut carried = Carried::base(base.rotation(), base.xyz);
-    for (i, ((&length, inertia), (angles, rates))) in map
-        .link_lengths()
-        .iter()
-        .zip(model.links())
-        .zip(
-            data.theta
-                .chunks_exact(2)
-                .zip(data.theta_dot.chunks_exact(2)),
-        )
-        .enumerate()
-    {
-        let motion = link_step(
-            &mut carried,
-            length,
-            [angles[0], angles[1]],
-            [rates[0], rates[1]],
-            [0.0; 2],
+    let mut carried = Carried::<L>::base(context, base.rotation(), base.xyz);
+    for (i, (&length, inertia)) in map.link_lengths().iter().zip(model.links()).enumerate() {
+        let row = &planar.row(i)[..half];
+        // theta = J a and theta_dot = J a_dot for this link's two joints.
+        let (mut angles, mut rates) = ([zero; 2], [zero; 2]);
+        for (k, &r) in row.iter().enumerate() {
+            let r = L::splat(context, r);
+            angles = [a_z[k].mul_add(r, angles[0]), a_y[k].mul_add(r, angles[1])];
+            rates = [
+                rate_z[k].mul_add(r, rates[0]),
+                rate_y[k].mul_add(r, rates[1]),
+            ];
+        }
+        let motion = link_step(context, &mut carried, length, angles, rates, [zero; 2]);
+        // Jw += u J_row and Jo += (o x u) J_row for both joints.
+        let (moment_z, moment_y) = (
+            cross(motion.joint, motion.u_z),
+            cross(motion.joint, motion.u_y),
         );
-        for (joint, axis) in [(2 * i, motion.u_z), (2 * i + 1, motion.u_y)] {
-            let moment = cross(motion.joint, axis);
-            let row = map.row(joint);
-            for d in 0..3 {
-                let (w, o) = (
-                    &mut data.omega_jacobian[d * m..(d + 1) * m],
-                    &mut data.origin_jacobian[d * m..(d + 1) * m],
-                );
-                for ((w, o), &r) in w.iter_mut().zip(o.iter_mut()).zip(row) {
-                    *w += axis[d] * r;
-                    *o += moment[d] * r;
-                }
+        for d in 0..3 {
+            let (w, o) = (
+                &mut omega_jacobian[d * m..(d + 1) * m],
+                &mut origin_jacobian[d * m..(d + 1) * m],
+            );
+            let (w_z, w_y) = w.split_at_mut(half);
+            let (o_z, o_y) = o.split_at_mut(half);
+            for (k, &r) in row.iter().enumerate() {
+                let r = L::splat(context, r);
+                w_z[k] = motion.u_z[d].mul_add(r, w_z[k]);
+                o_z[k] = moment_z[d].mul_add(r, o_z[k]);
+                w_y[k] = motion.u_y[d].mul_add(r, w_y[k]);
+                o_y[k] = moment_y[d].mul_add(r, o_y[k]);
             }
         }
-        // Jv = Jo + Jw x c, column by column; I Jw.
+        // Jv = Jo + Jw x c and I Jw, column by column.
         let world = world_inertia(&motion.rotation, inertia.principal);
         for k in 0..m {
-            let w = [0, 1, 2].map(|d| data.omega_jacobian[d * m + k]);
-            let o = [0, 1, 2].map(|d| data.origin_jacobian[d * m + k]);
-            let wc = cross(w, motion.com);
+            let (w, o) = (column(omega_jacobian, m, k), column(origin_jacobian, m, k));
+            let v = add(o, cross(w, motion.com));
             let iw = mat_vec(&world, w);
             for d in 0..3 {
-                data.com_jacobian[d * m + k] = o[d] + wc[d];
-                data.inertia_times_omega_jacobian[d * m + k] = iw[d];
+                com_jacobian[d * m + k] = v[d];
+                inertia_times_omega_jacobian[d * m + k] = iw[d];
             }
         }
-        let mass = inertia.mass;
-        let force = motion.com_accel.map(|x| mass * x);
-        let iw = mat_vec(&world, motion.omega);
-        let torque = {
-            let spin = cross(motion.omega, iw);
-            let angular = mat_vec(&world, motion.omega_dot);
-            [0, 1, 2].map(|d| angular[d] + spin[d])
-        };
-        let (jv, jw, ijw) = (
-            &data.com_jacobian,
-            &data.omega_jacobian,
-            &data.inertia_times_omega_jacobian,
+        let mass = L::splat(context, inertia.mass);
+        let force = scale(motion.com_accel, mass);
+        let weight = [
+            L::splat(context, inertia.mass * gravity[0]),
+            L::splat(context, inertia.mass * gravity[1]),
+            L::splat(context, inertia.mass * gravity[2]),
+        ];
+        let torque = add(
+            mat_vec(&world, motion.omega_dot),
+            cross(motion.omega, mat_vec(&world, motion.omega)),
         );
-        let column = |matrix: &[f64], k: usize| [0, 1, 2].map(|d| matrix[d * m + k]);
         for k in 0..m {
-            let (jv_k, jw_k) = (column(jv, k), column(jw, k));
-            data.coriolis[k] += dot(jv_k, force) + dot(jw_k, torque);
-            data.gravity[k] -= mass * dot(jv_k, gravity);
+            let (v_k, w_k) = (column(com_jacobian, m, k), column(omega_jacobian, m, k));
+            coriolis[k] = coriolis[k] + (dot(v_k, force) + dot(w_k, torque));
+            gravity_terms[k] = gravity_terms[k] - dot(v_k, weight);
             for l in 0..=k {
-                let value = mass * dot(jv_k, column(jv, l)) + dot(jw_k, column(ijw, l));
-                data.mass_matrix[k * m + l] += value;
+                let (v_l, iw_l) = (
+                    column(com_jacobian, m, l),
+                    column(inertia_times_omega_jacobian, m, l),
+                );
+                let value = dot(v_k, v_l).mul_add(mass, dot(w_k, iw_l));
+                mass_matrix[k * m + l] = mass_matrix[k * m + l] + value;
             }
         }
     }
     for k in 0..m {
         for l in 0..k {
-            data.mass_matrix[l * m + k] = data.mass_matrix[k * m + l];
+            mass_matrix[l * m + k] = mass_matrix[k * m + l];
         }
     }
-    check_finite_result("reduced mass matrix M*", &data.mass_matrix)?;
-    check_finite_result("reduced Coriolis vector C*", &data.coriolis)?;
-    check_finite_result("reduced gravity vector G*", &data.gravity)
+}
+
+/// Column `k` of a `3 x m` row-major matrix.
+#[inline(always)]
+fn column<L: Lane>(matrix: &[L], m: usize, k: usize) -> [L; 3] {
+    [matrix[k], matrix[m + k], matrix[2 * m + k]]
 }
 
 /// Checks that `data` was made for `model` and that `a` and `a_dot` are `m` finite values each.

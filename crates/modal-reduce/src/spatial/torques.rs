@@ -35,7 +35,7 @@ pub fn spatial_joint_torques(
     map.joint_rates(a_dot, &mut data.theta_dot)?;
     map.joint_rates(a_ddot, &mut data.theta_ddot)?;
     let base = model.base();
-    let mut carried = Carried::base(base.rotation(), base.xyz);
+    let mut carried = Carried::base((), base.rotation(), base.xyz);
     for (((motion, &length), angles), (rates, accels)) in data
         .links
         .iter_mut()
@@ -48,6 +48,7 @@ pub fn spatial_joint_torques(
         )
     {
         *motion = link_step(
+            (),
             &mut carried,
             length,
             [angles[0], angles[1]],

@@ -3,7 +3,7 @@
 //! motion, the potential's gradient, `C*` from `M*`'s derivatives), energy conservation of free
 //! motion, and bad input.
 
-use backbone_kin::vec3::{Rotation, dot, mat_mul, mat_vec, sub};
+use backbone_kin::vec3::{Rotation, dot, mat_mul, mat_vec};
 use backbone_kin::{BaseAngle, BasePose, ModalMap, SpatialModalMap, spatial_joint_positions};
 use manip_dyn::ChainModel;
 use modal_reduce::spatial::{
@@ -262,7 +262,6 @@ fn the_lagrangian_gives_the_same_terms() {
             data.coriolis()[r]
         );
     }
-    let _ = sub;
 }
 
 #[test]

@@ -1,11 +1,14 @@
 //! Several closed-loop runs of one model stepped side by side ("lock-step"), their reduced
 //! forward dynamics (eq 15) evaluated together at every integrator stage by
-//! [`forward_dynamics_batch`], SIMD across the runs.
+//! [`Plant::forward_dynamics_batch`](modal_reduce::Plant::forward_dynamics_batch) (the planar arm's
+//! [`forward_dynamics_batch`](modal_reduce::forward_dynamics_batch) or the spatial arm's
+//! [`spatial_forward_dynamics_batch`](modal_reduce::spatial::spatial_forward_dynamics_batch)),
+//! SIMD across the runs.
 //!
 //! Each run keeps everything of its own: controller, noise streams, reference, integrator
 //! workspace, record. What is shared is the right-hand side of the RK4 stages: at stage `s` of a
 //! step, every run's stage state is gathered into the batch's arrays, the batch evaluates them
-//! (each state's result the same bits as one [`forward_dynamics`] call), and each run gets its
+//! (each state's result the same bits as one [`Plant::forward_dynamics`](modal_reduce::Plant::forward_dynamics) call), and each run gets its
 //! derivative back. The stages themselves are [`Rk4`]'s own code ([`Rk4::stage`],
 //! [`Rk4::finish_step`]), the code of a run integrated alone, so a run gives the same bits in a
 //! group as alone.
@@ -19,17 +22,14 @@
 //! Adaptive Dormand-Prince runs choose their own step sizes, so their stages do not line up:
 //! a group of them integrates each run alone (the group still steps them together). So does a
 //! group on a processor without SIMD or of a model whose batches run one state at a time
-//! ([`batch_lanes`] is 1), where lock-step would gain nothing.
+//! ([`Plant::batch_lanes`](modal_reduce::Plant::batch_lanes) is 1), where lock-step would gain nothing.
 
 use super::{LoopHooks, NoHooks, Progress, Run, RunFailure, Simulation, Stepper};
 use crate::error::SimError;
 use crate::ode::{OdeError, Rk4, Stats};
 use crate::reference::ReferenceSample;
 use crate::simulation::{Integrator, Observation};
-use modal_reduce::{
-    PlantModel, ReducedBatchData, ReducedData, ReducedModel, batch_lanes, forward_dynamics,
-    forward_dynamics_batch,
-};
+use modal_reduce::{PlantBatchData, PlantData, PlantModel};
 use std::sync::Arc;
 
 /// Closed-loop runs of one [`Prepared`](crate::Prepared) simulation that differ in seed or noise level (the
@@ -37,7 +37,8 @@ use std::sync::Arc;
 /// ([`Prepared::lockstep`](crate::Prepared::lockstep) forms a group). Each run is a [`Simulation`] with its own
 /// controller, noise and record; the runs share the model and the reference's samples, and
 /// with RK4 the reduced dynamics of all of them are evaluated at once at every integrator
-/// stage, SIMD across the runs ([`forward_dynamics_batch`]). Each run's results are bit for bit
+/// stage, SIMD across the runs ([`Plant::forward_dynamics_batch`](modal_reduce::Plant::forward_dynamics_batch)), for planar and spatial arms
+/// alike. Each run's results are bit for bit
 /// those of the run alone.
 ///
 /// As with one [`Simulation`], a caller may own the loop: [`step`](Self::step) advances every
@@ -80,15 +81,14 @@ pub struct Lockstep {
     runs: Vec<Simulation>,
     /// Why each run stopped; `None` while it runs.
     stopped: Vec<Option<SimError>>,
-    /// The model every run simulates (planar: [`Lockstep::new`] refuses a spatial one), and the
-    /// batch's workspaces for it.
+    /// The model every run simulates (planar or spatial), and the batch's workspaces for it.
     model: Arc<PlantModel>,
-    batch: ReducedBatchData,
-    single: ReducedData,
+    batch: PlantBatchData,
+    single: PlantData,
     /// The RK4 step when the runs' stages are evaluated together; `None` when each run is
     /// integrated alone.
     together: Option<f64>,
-    /// States per SIMD group of the batch ([`batch_lanes`]).
+    /// States per SIMD group of the batch ([`Plant::batch_lanes`](modal_reduce::Plant::batch_lanes)).
     lanes: usize,
     /// The reference sample of the current controller sample, shared by the runs.
     reference: ReferenceSample,
@@ -114,32 +114,26 @@ impl Lockstep {
                 "a lock-step group needs at least one simulation",
             ));
         };
-        let Some(planar) = model.plant().planar() else {
-            return Err(SimError::setting(
-                "runs",
-                "a lock-step group takes planar arms (its SIMD batch is the planar reduced \
-                 dynamics); run a spatial arm alone",
-            ));
-        };
-        let lanes = batch_lanes(planar);
+        let plant = model.plant();
+        let lanes = plant.batch_lanes();
         let together = match first.settings().integrator {
             Integrator::Rk4 { dt } if lanes > 1 => Some(dt),
             _ => None,
         };
-        let values = runs.len().div_ceil(lanes) * lanes * planar.n_coords();
+        let values = runs.len().div_ceil(lanes) * lanes * plant.n_coords();
         for run in &mut runs {
             run.reset();
         }
         Ok(Self {
             stopped: vec![None; runs.len()],
-            batch: ReducedBatchData::new(planar),
-            single: ReducedData::new(planar),
+            batch: PlantBatchData::new(plant),
+            single: PlantData::new(plant),
             slots: Vec::with_capacity(runs.len()),
             a: vec![0.0; values],
             a_dot: vec![0.0; values],
             tau_star: vec![0.0; values],
             a_ddot: vec![0.0; values],
-            reference: ReferenceSample::zeros(planar.n_coords()),
+            reference: ReferenceSample::zeros(plant.n_coords()),
             runs,
             model,
             together,
@@ -400,7 +394,7 @@ impl Lockstep {
     /// batch's arrays, padded to whole SIMD groups by copies of the first; returns the stage's
     /// time.
     fn gather(&mut self, s: usize, t: f64, h: f64) -> f64 {
-        let m = self.planar().n_coords();
+        let m = self.model.plant().n_coords();
         let mut t_s = t;
         for (j, &r) in self.slots.iter().enumerate() {
             let run = &mut self.runs[r];
@@ -420,14 +414,6 @@ impl Lockstep {
         t_s
     }
 
-    /// The planar model of the group ([`Lockstep::new`] refuses a spatial one).
-    fn planar(&self) -> &ReducedModel {
-        match &*self.model {
-            PlantModel::Planar(model) => model,
-            PlantModel::Spatial(_) => unreachable!("Lockstep::new refuses spatial arms"),
-        }
-    }
-
     /// The slots evaluated: the runs, rounded up to whole SIMD groups when at least two runs
     /// are left over (a group of `lanes` states costs about two states evaluated one at a
     /// time; a single one left over is cheaper alone).
@@ -443,21 +429,18 @@ impl Lockstep {
     /// run its derivative. If the batch fails, each run is evaluated alone, so that each run
     /// that fails stops with its own error (as alone) and the others go on.
     fn evaluate(&mut self, s: usize, t_s: f64) {
-        let m = self.planar().n_coords();
+        let plant = self.model.plant();
+        let m = plant.n_coords();
         let values = self.padded() * m;
-        let model = match &*self.model {
-            PlantModel::Planar(model) => model,
-            PlantModel::Spatial(_) => unreachable!("Lockstep::new refuses spatial arms"),
-        };
-        let together = forward_dynamics_batch(
-            model,
-            &mut self.batch,
-            &self.a[..values],
-            &self.a_dot[..values],
-            &self.tau_star[..values],
-            &mut self.a_ddot[..values],
-        )
-        .is_ok();
+        let together = plant
+            .forward_dynamics_batch(
+                &mut self.batch,
+                &self.a[..values],
+                &self.a_dot[..values],
+                &self.tau_star[..values],
+                &mut self.a_ddot[..values],
+            )
+            .is_ok();
         let (runs, stopped) = (&mut self.runs, &mut self.stopped);
         let single = &mut self.single;
         let (a, a_dot, tau_star, a_ddot) = (&self.a, &self.a_dot, &self.tau_star, &mut self.a_ddot);
@@ -466,8 +449,7 @@ impl Lockstep {
             let slot = j * m..(j + 1) * m;
             j += 1;
             if !together {
-                let evaluated = forward_dynamics(
-                    model,
+                let evaluated = plant.forward_dynamics(
                     single,
                     &a[slot.clone()],
                     &a_dot[slot.clone()],
