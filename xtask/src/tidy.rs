@@ -15,8 +15,7 @@
 //!   every public error enum of a library crate is `#[non_exhaustive]`; no library code (every
 //!   crate but [`FRONT_ENDS`], tests aside) names `Result<_, String>`, and no error enum has a
 //!   message-only variant (its one field a `String`, unnamed or named `message`, `reason` or
-//!   `error`), but in the files [`STRING_ERROR_FILES`] lists, each of which must still have one; `lane-math` depends on
-//!   none of the other crates, `fuzzy-sugeno` on none but `lane-math`, and no library crate depends on the command line;
+//!   `error`); `lane-math` depends on none of the other crates, `fuzzy-sugeno` on none but `lane-math`, and no library crate depends on the command line;
 //!   `unsafe` code appears only in the library files [`UNSAFE_FILES`] lists, each block under a
 //!   `// SAFETY:` comment.
 //! - `sim-core` depends on none of [`LOOP_FORBIDS`].
@@ -35,18 +34,6 @@ const REPOSITORY: &str = "https://github.com/hrm-toolkit/hrm";
 /// The only library source files allowed `unsafe` code (docs/architecture.md, "Unsafe code"),
 /// each block under a `// SAFETY:` comment.
 const UNSAFE_FILES: [&str; 1] = ["crates/fuzzy-sugeno/src/kernel.rs"];
-
-/// The library files that still return `Result<_, String>` or hold a message-only error variant:
-/// the string rules skip them, and each must still break one (so the list only shrinks). Every
-/// other file of a crate under `crates/` but the front ends is held to the rules.
-const STRING_ERROR_FILES: [&str; 6] = [
-    "crates/fuzzy-sugeno/src/fis.rs",
-    "crates/sim-study/src/study/inputs.rs",
-    "crates/sim-study/src/study/mod.rs",
-    "crates/sim-study/src/study/plan.rs",
-    "crates/sim-study/src/study/shard_file.rs",
-    "crates/robot-desc/src/urdf_read.rs",
-];
 
 /// The crates under `crates/` that are front ends, not libraries: the string rules do not apply.
 const FRONT_ENDS: [&str; 3] = ["hrm-cli", "hrm-py", "test-support"];
@@ -192,19 +179,7 @@ pub fn run(root: &Path, doc: impl FnOnce() -> Result<(), String>) -> Vec<String>
         for file in rust_files(&root.join(&dir).join("src")) {
             let source = std::fs::read_to_string(&file).unwrap_or_default();
             let relative = file.strip_prefix(root).unwrap_or(&file);
-            let listed = STRING_ERROR_FILES.iter().any(|f| Path::new(f) == relative);
-            problems.extend(string_problems(
-                &relative.display().to_string(),
-                &source,
-                listed,
-            ));
-        }
-    }
-    for listed in STRING_ERROR_FILES {
-        if read(Path::new(listed)).is_err() {
-            problems.push(format!(
-                "{listed} is listed in STRING_ERROR_FILES but does not exist: remove it"
-            ));
+            problems.extend(string_problems(&relative.display().to_string(), &source));
         }
     }
 
@@ -416,20 +391,10 @@ pub fn exhaustive_error_enums(source: &str) -> Vec<String> {
 }
 
 /// The string-error problems of the library file `path`: each `Result<_, String>` and
-/// message-only error variant, or, for a file `listed` in [`STRING_ERROR_FILES`], that it has
-/// none left (then it must leave the list).
-pub fn string_problems(path: &str, source: &str, listed: bool) -> Vec<String> {
+/// message-only error variant.
+pub fn string_problems(path: &str, source: &str) -> Vec<String> {
     let results = string_results(source);
     let variants = message_only_variants(source);
-    if listed {
-        return if results.is_empty() && variants.is_empty() {
-            vec![format!(
-                "{path} has no string errors left: remove it from STRING_ERROR_FILES"
-            )]
-        } else {
-            Vec::new()
-        };
-    }
     let policy = "(docs/architecture.md, \"One error policy\")";
     let results = results.into_iter().map(|line| {
         format!(
@@ -938,16 +903,15 @@ mod tests {
     }
 
     #[test]
-    fn listed_string_error_files_only_shrink() {
+    fn string_errors_are_refused_by_line() {
         let stringly = "pub fn a() -> Result<(), String> {}\n";
         let typed = "pub fn a() -> Result<(), Error> {}\n";
-        assert_eq!(string_problems("a.rs", stringly, false).len(), 1);
-        assert!(string_problems("a.rs", stringly, true).is_empty());
-        assert!(string_problems("a.rs", typed, false).is_empty());
-        let stale = string_problems("a.rs", typed, true);
+        let problems = string_problems("a.rs", stringly);
+        assert_eq!(problems.len(), 1);
         assert!(
-            stale[0].contains("remove it from STRING_ERROR_FILES"),
-            "{stale:?}"
+            problems[0].starts_with("a.rs:1: `Result<_, String>`"),
+            "{problems:?}"
         );
+        assert!(string_problems("a.rs", typed).is_empty());
     }
 }

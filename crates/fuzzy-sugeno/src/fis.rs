@@ -1050,28 +1050,84 @@ fn parse_rule(
     Ok(rule)
 }
 
+/// Why a `.fis` value (a quoted name, a bracketed list, a membership function) could not be
+/// read; the caller adds the line and the key. Each names the text it found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+enum ValueError {
+    /// No opening quote.
+    #[error("expected a quoted string like 'name', found `{found}`")]
+    NotQuoted {
+        /// The value.
+        found: String,
+    },
+    /// No closing quote.
+    #[error("unterminated quoted string `{found}`")]
+    Unterminated {
+        /// The value.
+        found: String,
+    },
+    /// Not `[...]`.
+    #[error("expected numbers in brackets like [0 1], found `{found}`")]
+    NotBracketed {
+        /// The value.
+        found: String,
+    },
+    /// A list item that is not a [`number`].
+    #[error("expected a number, found `{found}`")]
+    NotANumber {
+        /// The item.
+        found: String,
+    },
+    /// A quoted part of a membership function `'name':'type',[parameters]` is malformed.
+    #[error("{FUNCTION_SHAPE}: {quote}")]
+    FunctionQuote {
+        /// What is wrong with the quoted name or type.
+        quote: Box<ValueError>,
+    },
+    /// A membership function lacks the `separator` (`:` after the name, `,` after the type).
+    #[error("{FUNCTION_SHAPE}, found `{found}` (no `{separator}` after the {after})")]
+    FunctionSeparator {
+        /// The value.
+        found: String,
+        /// The missing separator.
+        separator: char,
+        /// What it should follow: `name` or `type`.
+        after: &'static str,
+    },
+}
+
+/// The form of a membership function's value, named by [`ValueError`].
+const FUNCTION_SHAPE: &str = "expected 'name':'type',[parameters]";
+
 /// Splits `'text'rest` into `text` and `rest`.
-fn quoted(value: &str) -> Result<(&str, &str), String> {
+fn quoted(value: &str) -> Result<(&str, &str), ValueError> {
+    let found = || value.to_string();
     let inner = value
         .strip_prefix('\'')
-        .ok_or_else(|| format!("expected a quoted string like 'name', found `{value}`"))?;
+        .ok_or_else(|| ValueError::NotQuoted { found: found() })?;
     let end = inner
         .find('\'')
-        .ok_or_else(|| format!("unterminated quoted string `{value}`"))?;
+        .ok_or_else(|| ValueError::Unterminated { found: found() })?;
     Ok((&inner[..end], &inner[end + 1..]))
 }
 
 /// Parses `[a b c]` (spaces or commas between the numbers; each a [`number`]).
-fn bracketed(value: &str) -> Result<Vec<f64>, String> {
+fn bracketed(value: &str) -> Result<Vec<f64>, ValueError> {
     let inner = value
         .trim()
         .strip_prefix('[')
         .and_then(|v| v.strip_suffix(']'))
-        .ok_or_else(|| format!("expected numbers in brackets like [0 1], found `{value}`"))?;
+        .ok_or_else(|| ValueError::NotBracketed {
+            found: value.to_string(),
+        })?;
     inner
         .split(|c: char| c.is_whitespace() || c == ',')
         .filter(|t| !t.is_empty())
-        .map(|t| number(t).ok_or_else(|| format!("expected a number, found `{t}`")))
+        .map(|t| {
+            number(t).ok_or_else(|| ValueError::NotANumber {
+                found: t.to_string(),
+            })
+        })
         .collect()
 }
 
@@ -1122,18 +1178,25 @@ fn number(token: &str) -> Option<f64> {
 }
 
 /// Parses `'name':'type',[params]`.
-fn function(value: &str) -> Result<(&str, &str, Vec<f64>), String> {
-    let shape = "expected 'name':'type',[parameters]";
-    let (name, rest) = quoted(value).map_err(|m| format!("{shape}: {m}"))?;
+fn function(value: &str) -> Result<(&str, &str, Vec<f64>), ValueError> {
+    let quote = |quote| ValueError::FunctionQuote {
+        quote: Box::new(quote),
+    };
+    let separator = |separator, after| ValueError::FunctionSeparator {
+        found: value.to_string(),
+        separator,
+        after,
+    };
+    let (name, rest) = quoted(value).map_err(quote)?;
     let rest = rest
         .trim_start()
         .strip_prefix(':')
-        .ok_or_else(|| format!("{shape}, found `{value}` (no `:` after the name)"))?;
-    let (kind, rest) = quoted(rest.trim_start()).map_err(|m| format!("{shape}: {m}"))?;
+        .ok_or_else(|| separator(':', "name"))?;
+    let (kind, rest) = quoted(rest.trim_start()).map_err(quote)?;
     let rest = rest
         .trim_start()
         .strip_prefix(',')
-        .ok_or_else(|| format!("{shape}, found `{value}` (no `,` after the type)"))?;
+        .ok_or_else(|| separator(',', "type"))?;
     Ok((name, kind, bracketed(rest)?))
 }
 

@@ -29,9 +29,9 @@ pub struct Sweep {
     config: SweepConfig,
 }
 
-/// A library message as [`InvalidInput`](crate::errors::InvalidInput).
-fn input(message: String) -> PyErr {
-    Error::input(message).into()
+/// A library error or message as [`InvalidInput`](crate::errors::InvalidInput).
+fn input(error: impl std::fmt::Display) -> PyErr {
+    Error::input(error.to_string()).into()
 }
 
 /// `text` (a sweep's configuration as JSON) as Python objects, through the `json` module (which
@@ -84,8 +84,7 @@ impl Sweep {
             Ok(s) => s.get().get(),
             Err(_) => {
                 let name = crate::args::path(scenario, "scenario")?;
-                sim_study::Scenario::resolve(&name.to_string_lossy())
-                    .map_err(|e| input(e.to_string()))?
+                sim_study::Scenario::resolve(&name.to_string_lossy()).map_err(input)?
             }
         };
         let controllers = match controllers {
@@ -131,7 +130,7 @@ impl Sweep {
         let file = pool::run(py, &cancel, || {
             study::run_shard_until(&self.config, shard, || {}, || cancel.is_set())
         })?
-        .ok_or_else(|| input(study::STOPPED.to_string()))?;
+        .ok_or_else(|| input(study::StudyError::Stopped))?;
         file.to_json().map_err(input)
     }
 
@@ -183,7 +182,7 @@ impl Sweep {
     /// The sweep's configuration as JSON (the "config" of its shard files and summary);
     /// Sweep.from_json reads it back.
     fn to_json(&self) -> PyResult<String> {
-        serde_json::to_string(&self.config).map_err(|e| input(e.to_string()))
+        serde_json::to_string(&self.config).map_err(input)
     }
 
     /// A sweep from its configuration's JSON (Sweep.to_json, or the "config" of a shard file),

@@ -330,7 +330,7 @@ fn read_inertial(node: Node<'_, '_>, link: &str) -> Result<Inertial, DescError> 
         mass,
         inertia,
     };
-    check_inertia(&inertial).map_err(|problem| DescError::invalid(element(), problem))?;
+    check_inertia(&inertial, &element)?;
     Ok(inertial)
 }
 
@@ -340,20 +340,27 @@ const INERTIA_TOLERANCE: f64 = 1e-9;
 
 /// A physical inertia tensor: principal moments non-negative and satisfying the triangle
 /// inequalities `I_a <= I_b + I_c` (each moment is an integral of squared distances from two of
-/// the axes, whose sum exceeds the distance from the third).
-pub(crate) fn check_inertia(inertial: &Inertial) -> Result<(), String> {
+/// the axes, whose sum exceeds the distance from the third). `element` names the `<inertial>`
+/// in the error.
+fn check_inertia(inertial: &Inertial, element: &dyn Fn() -> String) -> Result<(), DescError> {
     let moments = principal_moments(&inertial.inertia);
     let trace: f64 = moments.iter().sum();
     let tolerance = INERTIA_TOLERANCE * trace.abs();
     if moments[0] < -tolerance {
-        return Err(format!(
-            "inertia must be positive semi-definite, its principal moments are {moments:?}"
+        return Err(DescError::invalid(
+            element(),
+            format!(
+                "inertia must be positive semi-definite, its principal moments are {moments:?}"
+            ),
         ));
     }
     if moments[2] > moments[0] + moments[1] + tolerance {
-        return Err(format!(
-            "inertia breaks the triangle inequality: principal moments {moments:?}, the largest \
+        return Err(DescError::invalid(
+            element(),
+            format!(
+                "inertia breaks the triangle inequality: principal moments {moments:?}, the largest \
              exceeds the sum of the other two"
+            ),
         ));
     }
     Ok(())
@@ -512,7 +519,7 @@ fn read_joint(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfJoint, 
                 effort: optional_number(limit, "effort", &element)?,
                 velocity: optional_number(limit, "velocity", &element)?,
             };
-            check_limits(&limits).map_err(|problem| DescError::invalid(element(), problem))?;
+            check_limits(&limits, &element)?;
             Ok::<_, DescError>(limits)
         })
         .transpose()?;
@@ -555,15 +562,22 @@ fn read_joint(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfJoint, 
     })
 }
 
-fn check_limits(limits: &Limits) -> Result<(), String> {
+/// The `<limit>` of a joint ordered and non-negative; `element` names it in the error.
+fn check_limits(limits: &Limits, element: &dyn Fn() -> String) -> Result<(), DescError> {
     if let (Some(lower), Some(upper)) = (limits.lower, limits.upper)
         && lower > upper
     {
-        return Err(format!("lower ({lower}) must not exceed upper ({upper})"));
+        return Err(DescError::invalid(
+            element(),
+            format!("lower ({lower}) must not exceed upper ({upper})"),
+        ));
     }
     for (what, value) in [("effort", limits.effort), ("velocity", limits.velocity)] {
         if let Some(value) = value.filter(|v| *v < 0.0) {
-            return Err(format!("{what} must be non-negative, got {value}"));
+            return Err(DescError::invalid(
+                element(),
+                format!("{what} must be non-negative, got {value}"),
+            ));
         }
     }
     Ok(())

@@ -209,7 +209,7 @@ fn configure(args: &SweepArgs) -> Result<SweepConfig, String> {
     if let Some(duration) = args.duration {
         scenario.duration = duration;
     }
-    SweepConfig::new(scenario, settings)
+    SweepConfig::new(scenario, settings).map_err(|e| e.to_string())
 }
 
 /// Runs the runs of `shard` with a progress bar, writing its shard file to `out` as they finish
@@ -228,7 +228,7 @@ fn write_shard(
     let bar = crate::progress::bar(shard.run_count(total) as u64, &label);
     let counts = study::write_shard(config, shard, out, || bar.inc(1));
     bar.finish_and_clear();
-    counts
+    counts.map_err(|e| e.to_string())
 }
 
 /// Runs the whole sweep into `out` and returns the table. The report is made from `runs.json`
@@ -239,9 +239,9 @@ fn sweep_whole(config: &SweepConfig, out: &Path) -> Result<String, String> {
     write_shard(config, Shard::WHOLE, &mut file)?;
     std::io::Write::flush(&mut file)
         .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    let mut reader = ShardReader::open(&path)?;
+    let mut reader = ShardReader::open(&path).map_err(|e| e.to_string())?;
     let mut cells = CellBuilder::new(&reader.header().config);
-    while let Some(run) = reader.next_run()? {
+    while let Some(run) = reader.next_run().map_err(|e| e.to_string())? {
         cells.add(&run);
     }
     write_report(config, &cells.finish(), out)
@@ -251,7 +251,7 @@ fn sweep_whole(config: &SweepConfig, out: &Path) -> Result<String, String> {
 /// returns the table; the runs are read and written one at a time. Shard files inside `target`
 /// are refused: replacing `target` would delete them.
 fn merge_files(inputs: &[PathBuf], out: &Path, target: &Path) -> Result<String, String> {
-    let paths = study::shard_paths(inputs)?;
+    let paths = study::shard_paths(inputs).map_err(|e| e.to_string())?;
     if let Ok(target_abs) = std::fs::canonicalize(target) {
         for path in &paths {
             if std::fs::canonicalize(path).is_ok_and(|p| p.starts_with(&target_abs)) {
@@ -267,7 +267,8 @@ fn merge_files(inputs: &[PathBuf], out: &Path, target: &Path) -> Result<String, 
     let shards = paths
         .iter()
         .map(|path| ShardReader::open(path))
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
     let Some(first) = shards.first() else {
         return Err("nothing to merge: no shard files given".into());
     };
@@ -275,12 +276,13 @@ fn merge_files(inputs: &[PathBuf], out: &Path, target: &Path) -> Result<String, 
     let path = out.join("runs.json");
     let mut file = create(&path)?;
     let written = |e: std::io::Error| format!("cannot write {}: {e}", path.display());
-    study::write_json_line(&mut file, &whole)?;
+    study::write_json_line(&mut file, &whole).map_err(|e| e.to_string())?;
     let mut cells = CellBuilder::new(&whole.config);
     study::merge_readers(shards, |run| {
         cells.add(&run);
         study::write_json_line(&mut file, &run)
-    })?;
+    })
+    .map_err(|e| e.to_string())?;
     std::io::Write::flush(&mut file).map_err(written)?;
     write_report(&whole.config, &cells.finish(), out)
 }

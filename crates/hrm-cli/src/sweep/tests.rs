@@ -570,7 +570,11 @@ fn shard_files_are_streamed_and_checked_line_by_line() {
     assert_eq!(runs, read(&merged.join("runs.json")));
     assert_eq!(runs.lines().count(), 71);
 
-    let check = |text: &str| ShardFile::parse(text, Path::new("f.json")).unwrap_err();
+    let check = |text: &str| {
+        ShardFile::parse(text, Path::new("f.json"))
+            .unwrap_err()
+            .to_string()
+    };
     let lines: Vec<&str> = runs.lines().collect();
     let err = check(&runs[..runs.len() - 10]);
     assert!(err.contains("f.json: line 71 is not a run"), "{err}");

@@ -3,6 +3,7 @@
 //! controller), so that shards run with different contents are never merged; and the check
 //! that every scenario setting survives the JSON of a shard file.
 
+use super::StudyError;
 use crate::Scenario;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -59,9 +60,8 @@ fn sha256_hex(bytes: &[u8]) -> String {
 
 /// The digest of the scenario's canonical content: its compact JSON, fields in declaration
 /// order (what a shard file stores).
-fn scenario_digest(scenario: &Scenario) -> Result<InputDigest, String> {
-    let json = serde_json::to_string(scenario)
-        .map_err(|e| format!("the scenario cannot be written as JSON: {e}"))?;
+fn scenario_digest(scenario: &Scenario) -> Result<InputDigest, StudyError> {
+    let json = serde_json::to_string(scenario).map_err(not_writable)?;
     Ok(InputDigest {
         input: SCENARIO_INPUT.into(),
         path: None,
@@ -71,11 +71,16 @@ fn scenario_digest(scenario: &Scenario) -> Result<InputDigest, String> {
 
 /// The digests of `scenario` and of every file it references, scenario first. Reads the files
 /// (at most [`MAX_INPUT_FILE_BYTES`](crate::MAX_INPUT_FILE_BYTES) each, as a run does).
-pub fn input_digests(scenario: &Scenario) -> Result<Vec<InputDigest>, String> {
+pub fn input_digests(scenario: &Scenario) -> Result<Vec<InputDigest>, StudyError> {
     let mut digests = vec![scenario_digest(scenario)?];
     for (input, path) in referenced_files(scenario) {
-        let text = crate::read_text_file(path, crate::MAX_INPUT_FILE_BYTES)
-            .map_err(|e| format!("{input} cannot be read from {}: {e}", path.display()))?;
+        let text = crate::read_text_file(path, crate::MAX_INPUT_FILE_BYTES).map_err(|e| {
+            StudyError::InputUnreadable {
+                input,
+                path: path.to_path_buf(),
+                cause: e.to_string(),
+            }
+        })?;
         digests.push(InputDigest {
             input: input.into(),
             path: Some(path.to_path_buf()),
@@ -88,7 +93,7 @@ pub fn input_digests(scenario: &Scenario) -> Result<Vec<InputDigest>, String> {
 /// Checks, without reading any file, that `digests` list the scenario and the files it
 /// references, in that order, and that the scenario's digest is that of its content (a shard
 /// file whose scenario was edited by hand fails here).
-pub fn check_digests(scenario: &Scenario, digests: &[InputDigest]) -> Result<(), String> {
+pub fn check_digests(scenario: &Scenario, digests: &[InputDigest]) -> Result<(), StudyError> {
     let expected = std::iter::once((SCENARIO_INPUT, None)).chain(
         referenced_files(scenario)
             .into_iter()
@@ -98,34 +103,28 @@ pub fn check_digests(scenario: &Scenario, digests: &[InputDigest]) -> Result<(),
         .iter()
         .map(|d| (d.input.as_str(), d.path.as_deref()));
     if !expected.eq(listed) {
-        let names: Vec<String> = digests.iter().map(InputDigest::describe).collect();
-        return Err(format!(
-            "inputs lists [{}], but the scenario and the files it references are [{}]",
-            names.join(", "),
-            std::iter::once(SCENARIO_INPUT.to_string())
+        return Err(StudyError::InputsListed {
+            listed: digests.iter().map(InputDigest::describe).collect(),
+            expected: std::iter::once(SCENARIO_INPUT.to_string())
                 .chain(
                     referenced_files(scenario)
                         .into_iter()
-                        .map(|(i, p)| format!("{i} ({})", p.display()))
+                        .map(|(i, p)| format!("{i} ({})", p.display())),
                 )
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
+                .collect(),
+        });
     }
     if let Some(bad) = digests
         .iter()
         .find(|d| d.sha256.len() != 64 || !d.sha256.bytes().all(|b| b.is_ascii_hexdigit()))
     {
-        return Err(format!(
-            "the SHA-256 of {} must be 64 hexadecimal digits, got '{}'",
-            bad.describe(),
-            bad.sha256.escape_debug()
-        ));
+        return Err(StudyError::DigestMalformed {
+            input: bad.describe(),
+            sha256: bad.sha256.clone(),
+        });
     }
     if scenario_digest(scenario)?.sha256 != digests[0].sha256 {
-        return Err(
-            "the scenario's SHA-256 does not match its content (was the file edited?)".into(),
-        );
+        return Err(StudyError::ScenarioEdited);
     }
     Ok(())
 }
@@ -145,23 +144,25 @@ pub fn first_changed<'a>(
 /// Checks that every setting of `scenario` can be written to JSON and read back unchanged: JSON
 /// has no infinity or NaN (serde writes them as `null`) and no non-UTF-8 path. The error names
 /// the first setting that cannot, e.g. `limits.max_modal_error = inf`.
-pub fn check_json_safe(scenario: &Scenario) -> Result<(), String> {
-    let value = toml::Value::try_from(scenario)
-        .map_err(|e| format!("a scenario setting cannot be written to a shard file: {e}"))?;
-    if let Some((setting, v)) = first_non_finite(&value, String::new()) {
-        return Err(format!(
-            "scenario setting {setting} = {v} cannot be written to a shard file (JSON has no \
-             infinity or NaN): give a finite value"
-        ));
+pub fn check_json_safe(scenario: &Scenario) -> Result<(), StudyError> {
+    let value = toml::Value::try_from(scenario).map_err(not_writable)?;
+    if let Some((setting, value)) = first_non_finite(&value, String::new()) {
+        return Err(StudyError::NotFinite { setting, value });
     }
-    let json = serde_json::to_string(scenario)
-        .map_err(|e| format!("a scenario setting cannot be written to a shard file: {e}"))?;
+    let json = serde_json::to_string(scenario).map_err(not_writable)?;
     match serde_json::from_str::<Scenario>(&json) {
         Ok(back) if back == *scenario => Ok(()),
-        Ok(_) => {
-            Err("the scenario reads back from JSON changed: a setting does not round-trip".into())
-        }
-        Err(e) => Err(format!("the scenario does not read back from JSON: {e}")),
+        Ok(_) => Err(StudyError::NotRoundTrip { cause: None }),
+        Err(e) => Err(StudyError::NotRoundTrip {
+            cause: Some(e.to_string()),
+        }),
+    }
+}
+
+/// The refusal of a scenario the serialiser cannot write.
+fn not_writable(cause: impl ToString) -> StudyError {
+    StudyError::NotWritable {
+        cause: cause.to_string(),
     }
 }
 
@@ -252,7 +253,7 @@ mod tests {
             for bad in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
                 let mut s = base.clone();
                 edit(&mut s, bad);
-                let err = check_json_safe(&s).unwrap_err();
+                let err = check_json_safe(&s).unwrap_err().to_string();
                 assert!(
                     err.contains(&format!("scenario setting {setting} = {bad}")),
                     "{setting}: {err}"
@@ -261,7 +262,7 @@ mod tests {
         }
         let mut per_joint = base.clone();
         per_joint.limits.joint_torque_nm = Some(TorqueLimit::PerJoint(vec![1.0, f64::INFINITY]));
-        let err = check_json_safe(&per_joint).unwrap_err();
+        let err = check_json_safe(&per_joint).unwrap_err().to_string();
         assert!(err.contains("limits.joint_torque_nm[1] = inf"), "{err}");
     }
 
@@ -271,7 +272,7 @@ mod tests {
         let mut s = Scenario::builtin("paper-responses-step").unwrap();
         let name = std::ffi::OsStr::from_bytes(b"/tmp/\xff.fis");
         s.controller.fis = Some(PathBuf::from(name));
-        let err = check_json_safe(&s).unwrap_err();
+        let err = check_json_safe(&s).unwrap_err().to_string();
         assert!(err.contains("cannot be written to a shard file"), "{err}");
     }
 
@@ -295,6 +296,7 @@ mod tests {
         assert!(
             check_digests(&s, &plain)
                 .unwrap_err()
+                .to_string()
                 .contains("controller.fis")
         );
         std::fs::write(&fis, "two").unwrap();
@@ -308,10 +310,9 @@ mod tests {
         assert_eq!(first_changed(&after, &after.clone()), None);
         let mut edited = s.clone();
         edited.duration = 0.5;
-        assert!(
-            check_digests(&edited, &after)
-                .unwrap_err()
-                .contains("does not match")
+        assert_eq!(
+            check_digests(&edited, &after),
+            Err(StudyError::ScenarioEdited)
         );
         std::fs::remove_dir_all(&dir).unwrap();
     }

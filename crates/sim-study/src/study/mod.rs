@@ -33,6 +33,7 @@
 
 mod aggregate;
 mod comparison;
+mod error;
 mod inputs;
 mod outcome;
 mod plan;
@@ -40,12 +41,14 @@ mod shard_file;
 
 pub use aggregate::{Cell, CellBuilder, FailedRun, MAX_LISTED_FAILURES, Stats, cells};
 pub use comparison::{ComparisonRun, builtin_scenarios, compare, run_one, run_prepared};
+pub use error::{MergeProblem, MetricError, ShardProblem, StudyError};
 pub use inputs::{
     InputDigest, SCENARIO_INPUT, check_digests, check_json_safe, first_changed, input_digests,
 };
 pub use outcome::{RunError, RunMetrics, RunOutcome, Stopped, run_scenario};
 pub use plan::{
-    MAX_RUNS, MAX_SHARDS, RunId, SettingError, Shard, SweepConfig, SweepSettings, run_seed,
+    MAX_RUNS, MAX_SHARDS, RunId, SettingError, Shard, ShardParseError, SweepConfig, SweepSettings,
+    run_seed,
 };
 pub use shard_file::{
     FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, RunResult, ShardFile, ShardHeader, ShardInput,
@@ -169,20 +172,21 @@ pub fn for_each_run(
     config: &SweepConfig,
     shard: Shard,
     progress: impl Fn() + Sync,
-    sink: impl FnMut(RunResult) -> Result<(), String>,
-) -> Result<(), String> {
+    sink: impl FnMut(RunResult) -> Result<(), StudyError>,
+) -> Result<(), StudyError> {
     for_each_run_until(config, shard, progress, || false, sink)
 }
 
 /// [`for_each_run`], checking `stop` before each lock-step group: once it returns true, no
-/// further group starts and the call fails with [`STOPPED`] (a Python caller's Ctrl-C).
+/// further group starts and the call fails with [`StudyError::Stopped`] (a Python caller's
+/// Ctrl-C).
 pub fn for_each_run_until(
     config: &SweepConfig,
     shard: Shard,
     progress: impl Fn() + Sync,
     stop: impl Fn() -> bool + Sync,
-    mut sink: impl FnMut(RunResult) -> Result<(), String>,
-) -> Result<(), String> {
+    mut sink: impl FnMut(RunResult) -> Result<(), StudyError>,
+) -> Result<(), StudyError> {
     let mut indices = shard.indices(config.runs().unwrap_or(0));
     let size = lockstep_size(config);
     // Each controller's simulation, prepared once for all of its runs.
@@ -214,15 +218,12 @@ pub fn for_each_run_until(
             })
             .collect();
         if stop() {
-            return Err(STOPPED.to_string());
+            return Err(StudyError::Stopped);
         }
         results.sort_unstable_by_key(|run| run.index);
         results.into_iter().try_for_each(&mut sink)?;
     }
 }
-
-/// The error of [`for_each_run_until`] and [`run_shard_until`] when `stop` ended the runs.
-pub const STOPPED: &str = "the sweep was stopped before all its runs were done";
 
 /// Runs the runs of `shard` and keeps them in memory (see [`write_shard`] to stream them to a
 /// file); the results are in index order. [`Shard::WHOLE`] runs the whole sweep.
@@ -263,7 +264,7 @@ pub fn write_shard<W: Write + ?Sized>(
     shard: Shard,
     out: &mut W,
     progress: impl Fn() + Sync,
-) -> Result<(usize, usize), String> {
+) -> Result<(usize, usize), StudyError> {
     write_json_line(out, &ShardHeader::new(config, shard))?;
     let (mut runs, mut stopped) = (0, 0);
     for_each_run(config, shard, progress, |run| {
@@ -273,12 +274,12 @@ pub fn write_shard<W: Write + ?Sized>(
     })?;
     let now = input_digests(&config.scenario)?;
     if let Some((input, _)) = first_changed(&config.inputs, &now) {
-        return Err(format!(
-            "{} changed while the sweep ran, so its runs may mix two contents: run the sweep \
-             again",
-            input.describe()
-        ));
+        return Err(StudyError::InputChanged {
+            input: input.describe(),
+        });
     }
-    out.flush().map_err(|e| e.to_string())?;
+    out.flush().map_err(|e| StudyError::Write {
+        cause: e.to_string(),
+    })?;
     Ok((runs, stopped))
 }

@@ -1,6 +1,7 @@
 //! What a sweep runs: its configuration, the fixed enumeration of its runs, each run's seed,
 //! and the slice of runs one shard takes.
 
+use super::StudyError;
 use super::inputs::{self, InputDigest};
 use crate::{ControllerKind, NoiseSpec, Scenario};
 use lane_math::Compact;
@@ -210,8 +211,8 @@ impl SweepConfig {
     /// JSON can hold), and every controller's simulation is built once
     /// ([`check_builds`](Self::check_builds)), so a bad setting fails here rather than in every
     /// run. The one constructor of a checked sweep: `hrm sweep` and `hrm.Sweep` call it.
-    pub fn new(scenario: Scenario, settings: SweepSettings) -> Result<Self, String> {
-        settings.check().map_err(|e| e.to_string())?;
+    pub fn new(scenario: Scenario, settings: SweepSettings) -> Result<Self, StudyError> {
+        settings.check()?;
         let mut scenario = scenario;
         scenario.noise = NoiseSpec::default();
         scenario.seed = 0;
@@ -229,17 +230,18 @@ impl SweepConfig {
 
     /// Builds the simulation of the first run of each controller at the largest noise level, so
     /// that a bad setting fails once here rather than in every run.
-    pub fn check_builds(&self) -> Result<(), String> {
+    pub fn check_builds(&self) -> Result<(), StudyError> {
         let cells = self.settings.noise_levels.len() * self.settings.controllers.len();
         for c in 0..self.settings.controllers.len() {
             let id =
                 self.run_at((cells - self.settings.controllers.len() + c) * self.settings.seeds);
-            self.scenario_for(&id).build().map_err(|e| {
-                format!(
-                    "scenario {} with {}: {e}",
-                    self.scenario.name, id.controller
-                )
-            })?;
+            self.scenario_for(&id)
+                .build()
+                .map_err(|source| StudyError::Build {
+                    scenario: self.scenario.name.clone(),
+                    controller: id.controller,
+                    source: Box::new(source),
+                })?;
         }
         Ok(())
     }
@@ -249,10 +251,10 @@ impl SweepConfig {
     /// scenario, with the digest of its content, and the files it references
     /// ([`check_digests`](super::check_digests)), and the [`settings`](Self::settings)
     /// ([`SweepSettings::check`]): for a configuration read back from a shard file or JSON.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), StudyError> {
         inputs::check_json_safe(&self.scenario)?;
         inputs::check_digests(&self.scenario, &self.inputs)?;
-        self.settings.check().map_err(|e| e.to_string())
+        Ok(self.settings.check()?)
     }
 
     /// Number of runs: noise levels x controllers x seeds (`None` on overflow).
@@ -391,12 +393,22 @@ impl fmt::Display for Shard {
     }
 }
 
+/// A shard written otherwise than `K/N` with `1 <= K <= N <= MAX_SHARDS`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("a shard is written K/N with 1 <= K <= N <= {MAX_SHARDS}, got '{text}'")]
+pub struct ShardParseError {
+    /// The text given.
+    pub text: String,
+}
+
 impl FromStr for Shard {
-    type Err = String;
+    type Err = ShardParseError;
 
     /// Parses `K/N` with `1 <= K <= N <= MAX_SHARDS`.
-    fn from_str(s: &str) -> Result<Self, String> {
-        let bad = || format!("a shard is written K/N with 1 <= K <= N <= {MAX_SHARDS}, got '{s}'");
+    fn from_str(s: &str) -> Result<Self, ShardParseError> {
+        let bad = || ShardParseError {
+            text: s.to_string(),
+        };
         let (k, n) = s.split_once('/').ok_or_else(bad)?;
         let index: usize = k.trim().parse().map_err(|_| bad())?;
         let count: usize = n.trim().parse().map_err(|_| bad())?;
@@ -470,18 +482,21 @@ mod tests {
         let mut c = config(2, 2, 2);
         assert!(c.validate().is_ok());
         c.settings.noise_levels[1] = -1.0;
-        let err = c.validate().unwrap_err();
+        let err = c.validate().unwrap_err().to_string();
         assert_eq!(err, "noise_levels must be finite and non-negative, got -1");
         c.settings.noise_levels[1] = f64::NAN;
-        assert!(c.validate().unwrap_err().contains("got NaN"));
+        assert!(c.validate().unwrap_err().to_string().contains("got NaN"));
         c.settings.noise_levels = vec![0.01, 0.0];
-        let err = c.validate().unwrap_err();
+        let err = c.validate().unwrap_err().to_string();
         assert!(err.starts_with("noise_levels must be distinct and ascending"));
         let mut c = config(2, 2, 0);
-        assert_eq!(c.validate().unwrap_err(), "seeds must be at least 1");
+        assert_eq!(
+            c.validate().unwrap_err().to_string(),
+            "seeds must be at least 1"
+        );
         c.settings.seeds = 1;
         c.settings.rate_noise_ratio = f64::INFINITY;
-        let err = c.validate().unwrap_err();
+        let err = c.validate().unwrap_err().to_string();
         assert_eq!(
             err,
             "rate_noise_ratio must be finite and non-negative, got inf"
@@ -489,21 +504,21 @@ mod tests {
         c.settings.rate_noise_ratio = 10.0;
         c.settings.noise_levels = vec![0.0, 1e308];
         assert_eq!(
-            c.validate().unwrap_err(),
+            c.validate().unwrap_err().to_string(),
             "noise_levels 1e308 times rate_noise_ratio = 10 is not finite"
         );
-        let err = config(0, 2, 1).validate().unwrap_err();
+        let err = config(0, 2, 1).validate().unwrap_err().to_string();
         assert_eq!(err, "noise_levels must hold at least one noise level");
-        let err = config(1, 0, 1).validate().unwrap_err();
+        let err = config(1, 0, 1).validate().unwrap_err().to_string();
         assert_eq!(err, "controllers must name at least one controller");
         let mut twice = config(1, 3, 1);
         twice.settings.controllers[2] = twice.settings.controllers[0];
-        let err = twice.validate().unwrap_err();
+        let err = twice.validate().unwrap_err().to_string();
         assert_eq!(
             err,
             format!("controllers lists {} twice", twice.settings.controllers[0])
         );
-        let err = config(2, 2, MAX_RUNS).validate().unwrap_err();
+        let err = config(2, 2, MAX_RUNS).validate().unwrap_err().to_string();
         assert!(err.starts_with("seeds = 10000000 with 2 noise levels x 2 controllers makes more than the 10000000 runs"), "{err}");
         // The error says which setting, for a front end to name it its own way.
         let settings = SweepSettings {
@@ -544,10 +559,14 @@ mod tests {
             controllers: vec![ControllerKind::Pd, ControllerKind::Pd],
             ..settings.clone()
         };
-        let err = SweepConfig::new(scenario.clone(), twice).unwrap_err();
+        let err = SweepConfig::new(scenario.clone(), twice)
+            .unwrap_err()
+            .to_string();
         assert_eq!(err, "controllers lists pd twice");
         scenario.duration = 0.00015;
-        let err = SweepConfig::new(scenario, settings).unwrap_err();
+        let err = SweepConfig::new(scenario, settings)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("duration"), "{err}");
     }
 
@@ -566,7 +585,13 @@ mod tests {
     fn shards_parse_and_refuse_bad_text() {
         assert_eq!("2/3".parse::<Shard>(), Ok(Shard { index: 2, count: 3 }));
         for bad in ["0/3", "4/3", "3", "a/b", "1/0", "-1/2"] {
-            assert!(bad.parse::<Shard>().unwrap_err().contains("K/N"), "{bad}");
+            assert!(
+                bad.parse::<Shard>()
+                    .unwrap_err()
+                    .to_string()
+                    .contains("K/N"),
+                "{bad}"
+            );
         }
         assert_eq!(Shard { index: 2, count: 3 }.to_string(), "2/3");
     }

@@ -6,6 +6,7 @@
 //! and read one run at a time ([`write_json_line`], [`ShardReader`]), so neither a sweep nor a
 //! merge holds its runs in memory.
 
+use super::error::{MergeProblem, MetricError, ShardProblem, StudyError};
 use super::inputs;
 use super::outcome::{RunMetrics, RunOutcome, Stopped};
 use super::plan::{MAX_SHARDS, RunId, Shard, SweepConfig};
@@ -109,7 +110,7 @@ impl RunMetrics {
     /// and at most [`MAX_SHARD_METRIC`]; the largest tip error at least its RMS (both are taken
     /// over the same samples); each modal RMS within the runaway bound `max_modal_error` that
     /// every sample of a completed run kept to. The error names the field and the value.
-    pub fn check(&self, max_modal_error: f64) -> Result<(), String> {
+    pub fn check(&self, max_modal_error: f64) -> Result<(), MetricError> {
         let named = [
             ("tip_error_rms_m", self.tip_error_rms_m),
             ("tip_error_max_m", self.tip_error_max_m),
@@ -122,24 +123,21 @@ impl RunMetrics {
             .map(|&v| ("modal_error_rms_rad", v));
         for (name, value) in named.into_iter().chain(modal) {
             if !(0.0..=MAX_SHARD_METRIC).contains(&value) {
-                return Err(format!(
-                    "{name} = {value:e} is not a metric a run gives: it must lie in [0, \
-                     {MAX_SHARD_METRIC:e}]"
-                ));
+                return Err(MetricError::OutOfRange { name, value });
             }
             if name == "modal_error_rms_rad" && value > max_modal_error {
-                return Err(format!(
-                    "{name} = {value:e} exceeds the scenario's runaway bound \
-                     limits.max_modal_error = {max_modal_error:e}, which a completed run keeps to"
-                ));
+                return Err(MetricError::AboveRunaway {
+                    name,
+                    value,
+                    bound: max_modal_error,
+                });
             }
         }
         if self.tip_error_max_m < self.tip_error_rms_m * (1.0 - 1e-12) {
-            return Err(format!(
-                "tip_error_max_m = {:e} is below tip_error_rms_m = {:e}: a maximum is at least \
-                 the RMS of the same samples",
-                self.tip_error_max_m, self.tip_error_rms_m
-            ));
+            return Err(MetricError::MaxBelowRms {
+                max: self.tip_error_max_m,
+                rms: self.tip_error_rms_m,
+            });
         }
         Ok(())
     }
@@ -170,17 +168,17 @@ impl RunResult {
 
 impl ShardFile {
     /// Parses a shard file's text; `origin` names it in errors.
-    pub fn parse(text: &str, origin: &Path) -> Result<Self, String> {
+    pub fn parse(text: &str, origin: &Path) -> Result<Self, StudyError> {
         Self::collect(ShardReader::new(text.as_bytes(), origin)?)
     }
 
     /// Reads a shard file.
-    pub fn read(path: &Path) -> Result<Self, String> {
+    pub fn read(path: &Path) -> Result<Self, StudyError> {
         Self::collect(ShardReader::open(path)?)
     }
 
     /// Every run of `reader`.
-    fn collect<R: ShardSource>(mut reader: ShardReader<R>) -> Result<Self, String> {
+    fn collect<R: ShardSource>(mut reader: ShardReader<R>) -> Result<Self, StudyError> {
         let mut runs = Vec::new();
         while let Some(run) = reader.next_run()? {
             runs.push(run);
@@ -199,7 +197,7 @@ impl ShardFile {
     }
 
     /// The file's text: the header line, then one line per run (what `hrm sweep` writes).
-    pub fn to_json(&self) -> Result<String, String> {
+    pub fn to_json(&self) -> Result<String, StudyError> {
         let mut out = Vec::new();
         let header = ShardHeader {
             format: self.format.clone(),
@@ -210,7 +208,9 @@ impl ShardFile {
         for run in &self.runs {
             write_json_line(&mut out, run)?;
         }
-        String::from_utf8(out).map_err(|e| e.to_string())
+        String::from_utf8(out).map_err(|e| StudyError::Write {
+            cause: e.to_string(),
+        })
     }
 }
 
@@ -242,19 +242,20 @@ impl ShardHeader {
     }
 
     /// Checks the configuration and that the shard is one of a split the sweep can have.
-    fn check(&self, origin: &Path) -> Result<(), String> {
+    fn check(&self, origin: &Path) -> Result<(), StudyError> {
         self.config.validate().map_err(|e| {
-            format!(
-                "{} holds an invalid sweep configuration: {e}",
-                origin.display()
+            StudyError::shard_file(
+                origin,
+                ShardProblem::InvalidConfig {
+                    source: Box::new(e),
+                },
             )
         })?;
         let Shard { index, count } = self.shard;
         if !(1..=MAX_SHARDS).contains(&count) || !(1..=count).contains(&index) {
-            return Err(format!(
-                "{} is shard {index} of a split into {count} shards; a split has 1 to \
-                 {MAX_SHARDS} shards, numbered from 1",
-                origin.display()
+            return Err(StudyError::shard_file(
+                origin,
+                ShardProblem::OutsideSplit { index, count },
             ));
         }
         Ok(())
@@ -265,10 +266,11 @@ impl ShardHeader {
 pub fn write_json_line<W: Write + ?Sized>(
     out: &mut W,
     value: &impl Serialize,
-) -> Result<(), String> {
+) -> Result<(), StudyError> {
+    let written = |cause: String| StudyError::Write { cause };
     serde_json::to_writer(&mut *out, value)
-        .map_err(|e| e.to_string())
-        .and_then(|()| out.write_all(b"\n").map_err(|e| e.to_string()))
+        .map_err(|e| written(e.to_string()))
+        .and_then(|()| out.write_all(b"\n").map_err(|e| written(e.to_string())))
 }
 
 /// What a shard file is read from: a buffered reader that may be closed between runs
@@ -346,9 +348,8 @@ pub struct ShardReader<R> {
 impl ShardReader<ShardInput> {
     /// Opens the shard file `path` and reads its header; the file is closed until the first
     /// run is read.
-    pub fn open(path: &Path) -> Result<Self, String> {
-        let file = crate::open_regular_file(path)
-            .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    pub fn open(path: &Path) -> Result<Self, StudyError> {
+        let file = crate::open_regular_file(path).map_err(|e| StudyError::io("read", path, e))?;
         let mut reader = Self::new(
             ShardInput {
                 path: path.to_path_buf(),
@@ -364,13 +365,11 @@ impl ShardReader<ShardInput> {
 
 impl<R: ShardSource> ShardReader<R> {
     /// Reads and checks the header from `input`; `origin` names the file in errors.
-    pub fn new(mut input: R, origin: &Path) -> Result<Self, String> {
+    pub fn new(mut input: R, origin: &Path) -> Result<Self, StudyError> {
+        let refuse = |problem| StudyError::shard_file(origin, problem);
         let mut line = Vec::new();
         if read_line(&mut input, &mut line, origin, 1)? == 0 {
-            return Err(format!(
-                "{} is empty, not an hrm sweep shard file",
-                origin.display()
-            ));
+            return Err(refuse(ShardProblem::Empty));
         }
         let value: serde_json::Value = match serde_json::from_slice(&line) {
             Ok(value) => value,
@@ -378,21 +377,29 @@ impl<R: ShardSource> ShardReader<R> {
                 // An older shard file is one pretty-printed object: `{`, then its format.
                 let ahead = input.fill_buf().unwrap_or_default();
                 let start = [&line[..], &ahead[..ahead.len().min(4096)]].concat();
-                return Err(match declared_format(&start) {
-                    Some(format) => not_a_shard(origin, Some(&format)),
-                    None => format!(
-                        "{} is not an hrm sweep shard file: its first line is not JSON ({e})",
-                        origin.display()
-                    ),
-                });
+                return Err(refuse(match declared_format(&start) {
+                    Some(format) => ShardProblem::Format {
+                        format: Some(format),
+                    },
+                    None => ShardProblem::NotJson {
+                        cause: e.to_string(),
+                    },
+                }));
             }
         };
         match value.get("format").and_then(|f| f.as_str()) {
             Some(FORMAT) => {}
-            other => return Err(not_a_shard(origin, other)),
+            other => {
+                return Err(refuse(ShardProblem::Format {
+                    format: other.map(str::to_string),
+                }));
+            }
         }
-        let header: ShardHeader = serde_json::from_value(value)
-            .map_err(|e| format!("{} has a malformed header: {e}", origin.display()))?;
+        let header: ShardHeader = serde_json::from_value(value).map_err(|e| {
+            refuse(ShardProblem::MalformedHeader {
+                cause: e.to_string(),
+            })
+        })?;
         header.check(origin)?;
         Ok(ShardReader {
             input,
@@ -411,59 +418,70 @@ impl<R: ShardSource> ShardReader<R> {
     /// The shard's next run, `None` after its last. Refuses a malformed line, a run that is not
     /// the shard's next, a completed run with a modal error count other than the scenario's,
     /// a file cut short and lines after the last run.
-    pub fn next_run(&mut self) -> Result<Option<RunResult>, String> {
-        let number = self.runs_read + 2;
-        let origin = self.origin.display();
-        let Shard { index, count } = self.header.shard;
+    pub fn next_run(&mut self) -> Result<Option<RunResult>, StudyError> {
+        let line = self.runs_read + 2;
+        let refuse = |problem| StudyError::shard_file(&self.origin, problem);
+        let shard = self.header.shard;
         let expected = self.header.run_count();
-        if read_line(&mut self.input, &mut self.line, &self.origin, number)? == 0 {
+        if read_line(&mut self.input, &mut self.line, &self.origin, line)? == 0 {
             if self.runs_read < expected {
-                return Err(format!(
-                    "{origin} is cut short: it holds {} of the {expected} runs of shard \
-                     {index}/{count}",
-                    self.runs_read
-                ));
+                return Err(refuse(ShardProblem::CutShort {
+                    held: self.runs_read,
+                    expected,
+                    shard,
+                }));
             }
             return Ok(None);
         }
         if self.runs_read == expected {
-            return Err(format!(
-                "{origin}: line {number}: more lines than the {expected} runs of shard \
-                 {index}/{count}"
-            ));
+            return Err(refuse(ShardProblem::ExtraLines {
+                line,
+                expected,
+                shard,
+            }));
         }
-        let run: RunResult = serde_json::from_slice(&self.line)
-            .map_err(|e| format!("{origin}: line {number} is not a run: {e}"))?;
-        let i = index - 1 + self.runs_read * count;
+        let run: RunResult = serde_json::from_slice(&self.line).map_err(|e| {
+            refuse(ShardProblem::NotARun {
+                line,
+                cause: e.to_string(),
+            })
+        })?;
+        let i = shard.index - 1 + self.runs_read * shard.count;
         if !run.matches(&self.header.config.run_at(i)) {
-            return Err(format!(
-                "{origin}: line {number} holds run {}, which is not run {i} of this sweep, the \
-                 next of its shard {index}/{count}",
-                run.index
-            ));
+            return Err(refuse(ShardProblem::RunOutOfPlace {
+                line,
+                run: run.index,
+                expected: i,
+                shard,
+            }));
         }
         let m = self.header.config.scenario.n_coords();
         if let StoredOutcome::Completed(metrics) = &run.outcome {
             if metrics.modal_error_rms_rad.len() != m {
-                return Err(format!(
-                    "{origin}: run {} has {} modal errors, but its scenario has {m} modal \
-                     coordinates",
-                    run.index,
-                    metrics.modal_error_rms_rad.len()
-                ));
+                return Err(refuse(ShardProblem::ModalCount {
+                    run: run.index,
+                    got: metrics.modal_error_rms_rad.len(),
+                    expected: m,
+                }));
             }
             metrics
                 .check(self.header.config.scenario.limits.max_modal_error)
-                .map_err(|e| format!("{origin}: line {number}: run {}: {e}", run.index))?;
+                .map_err(|source| {
+                    refuse(ShardProblem::Metric {
+                        line,
+                        run: run.index,
+                        source,
+                    })
+                })?;
         }
         if let StoredOutcome::Failed { simulated_s, .. } = &run.outcome
             && !(simulated_s.is_finite() && *simulated_s >= 0.0)
         {
-            return Err(format!(
-                "{origin}: line {number}: run {}: simulated_s = {simulated_s:e} must be finite \
-                 and non-negative",
-                run.index
-            ));
+            return Err(refuse(ShardProblem::SimulatedTime {
+                line,
+                run: run.index,
+                value: *simulated_s,
+            }));
         }
         self.runs_read += 1;
         Ok(Some(run))
@@ -477,38 +495,19 @@ fn read_line(
     line: &mut Vec<u8>,
     origin: &Path,
     number: usize,
-) -> Result<usize, String> {
+) -> Result<usize, StudyError> {
     line.clear();
     let n = input
         .take(MAX_SHARD_LINE_BYTES as u64 + 1)
         .read_until(b'\n', line)
-        .map_err(|e| format!("cannot read {}: {e}", origin.display()))?;
+        .map_err(|e| StudyError::io("read", origin, e))?;
     if n > MAX_SHARD_LINE_BYTES {
-        return Err(format!(
-            "{}: line {number} is longer than the {MAX_SHARD_LINE_BYTES} bytes a shard file's \
-             line may have",
-            origin.display()
+        return Err(StudyError::shard_file(
+            origin,
+            ShardProblem::LineTooLong { line: number },
         ));
     }
     Ok(n)
-}
-
-/// The refusal of a file that declares another format (or none).
-fn not_a_shard(origin: &Path, format: Option<&str>) -> String {
-    let found = match format {
-        Some(f) => format!("format \"{}\"", f.escape_debug()),
-        None => "no format".into(),
-    };
-    let older = match format {
-        Some(f) if f.starts_with("hrm-sweep-shard/") => {
-            ": shard files of older versions cannot be merged, run the shard again"
-        }
-        _ => "",
-    };
-    format!(
-        "{} is not an hrm sweep shard file ({found}, expected \"{FORMAT}\"){older}",
-        origin.display()
-    )
 }
 
 /// The value of the first `"format": "..."` in `text` (an older, pretty-printed shard file).
@@ -520,12 +519,11 @@ fn declared_format(text: &[u8]) -> Option<String> {
 }
 
 /// The shard files named by `inputs`: files as given, and every `shard-*.json` in a directory.
-pub fn shard_paths(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
+pub fn shard_paths(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, StudyError> {
     let mut paths = Vec::new();
     for input in inputs {
         if input.is_dir() {
-            let entries = std::fs::read_dir(input)
-                .map_err(|e| format!("cannot list {}: {e}", input.display()))?;
+            let entries = std::fs::read_dir(input).map_err(|e| StudyError::io("list", input, e))?;
             let mut found: Vec<PathBuf> = entries
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| {
@@ -535,7 +533,7 @@ pub fn shard_paths(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
                 })
                 .collect();
             if found.is_empty() {
-                return Err(format!("no shard-*.json files in {}", input.display()));
+                return Err(StudyError::NoShardFiles { dir: input.clone() });
             }
             found.sort();
             paths.extend(found);
@@ -548,7 +546,7 @@ pub fn shard_paths(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
 
 /// Combines shards held in memory into the whole sweep (shard 1/1, runs in index order), as
 /// [`merge_readers`] does with files; `PathBuf`s name the shards in errors.
-pub fn merge(shards: Vec<(PathBuf, ShardFile)>) -> Result<ShardFile, String> {
+pub fn merge(shards: Vec<(PathBuf, ShardFile)>) -> Result<ShardFile, StudyError> {
     let texts = shards
         .into_iter()
         .map(|(path, file)| file.to_json().map(|text| (path, text)))
@@ -577,45 +575,51 @@ pub fn merge(shards: Vec<(PathBuf, ShardFile)>) -> Result<ShardFile, String> {
 /// reader). Returns the header of the whole sweep (shard 1/1).
 pub fn merge_readers<R: ShardSource>(
     mut shards: Vec<ShardReader<R>>,
-    mut sink: impl FnMut(RunResult) -> Result<(), String>,
-) -> Result<ShardHeader, String> {
+    mut sink: impl FnMut(RunResult) -> Result<(), StudyError>,
+) -> Result<ShardHeader, StudyError> {
     let Some(first) = shards.first() else {
-        return Err("nothing to merge: no shard files given".into());
+        return Err(StudyError::Merge(MergeProblem::Nothing));
     };
     let (first_path, config) = (first.origin.clone(), first.header.config.clone());
     let (first_shard, count) = (first.header.shard, first.header.shard.count);
+    let refuse = |problem| Err(StudyError::Merge(problem));
     for other in &shards {
-        let path = other.origin.display();
+        let (first, other_path) = (first_path.clone(), other.origin.clone());
         match config.first_difference(&other.header.config) {
             None => {}
             Some("inputs") => {
-                let (input, there) =
-                    inputs::first_changed(&config.inputs, &other.header.config.inputs)
-                        .ok_or("the shards' input lists differ")?;
-                return Err(format!(
-                    "{} and {path} were run with different contents of {}: SHA-256 {}... \
-                     against {}...; merge only the shards of one sweep",
-                    first_path.display(),
-                    input.describe(),
-                    &input.sha256[..12],
-                    &there[..12]
-                ));
+                let (here, there) = (&config.inputs, &other.header.config.inputs);
+                return refuse(match inputs::first_changed(here, there) {
+                    Some((input, there)) => MergeProblem::DifferentContents {
+                        first,
+                        other: other_path,
+                        input: input.describe(),
+                        here: input.sha256.clone(),
+                        there: there.to_string(),
+                    },
+                    // Lists of different lengths: the settings naming files differ.
+                    None => MergeProblem::DifferentSweeps {
+                        first,
+                        other: other_path,
+                        field: "inputs",
+                    },
+                });
             }
             Some(field) => {
-                return Err(format!(
-                    "{} and {path} come from different sweeps (their configurations differ in \
-                     {field})",
-                    first_path.display()
-                ));
+                return refuse(MergeProblem::DifferentSweeps {
+                    first,
+                    other: other_path,
+                    field,
+                });
             }
         }
         if other.header.shard.count != count {
-            return Err(format!(
-                "{path} is shard {} but {} is shard {first_shard}: every shard must come from the \
-                 same split",
-                other.header.shard,
-                first_path.display()
-            ));
+            return refuse(MergeProblem::DifferentSplits {
+                first,
+                first_shard,
+                other: other_path,
+                shard: other.header.shard,
+            });
         }
     }
     shards.sort_by_key(|s| s.header.shard.index);
@@ -623,42 +627,31 @@ pub fn merge_readers<R: ShardSource>(
         .windows(2)
         .find(|w| w[0].header.shard == w[1].header.shard)
     {
-        return Err(format!(
-            "shard {} is given twice: {} and {}",
-            pair[0].header.shard,
-            pair[0].origin.display(),
-            pair[1].origin.display()
-        ));
+        return refuse(MergeProblem::Twice {
+            shard: pair[0].header.shard,
+            first: pair[0].origin.clone(),
+            second: pair[1].origin.clone(),
+        });
     }
     if shards.len() < count {
         let mut given = shards.iter().map(|s| s.header.shard.index).peekable();
-        let absent: Vec<String> = (1..=count)
+        let absent: Vec<Shard> = (1..=count)
             .filter(|&k| given.next_if_eq(&k).is_none())
             .take(LISTED_MISSING_SHARDS)
-            .map(|k| format!("{k}/{count}"))
+            .map(|index| Shard { index, count })
             .collect();
         let more = count - shards.len() - absent.len();
-        let (noun, verb) = if absent.len() + more > 1 {
-            ("shards", "are")
-        } else {
-            ("shard", "is")
-        };
-        let more = if more > 0 {
-            format!(" and {more} more")
-        } else {
-            String::new()
-        };
-        return Err(format!(
-            "cannot merge: {noun} {}{more} {verb} missing",
-            absent.join(", ")
-        ));
+        return refuse(MergeProblem::Missing { absent, more });
     }
     let keep_open = count <= MAX_OPEN_SHARD_FILES;
     for i in 0..config.runs().unwrap_or(0) {
         let reader = &mut shards[i % count];
-        let run = reader
-            .next_run()?
-            .ok_or_else(|| format!("{} ends before run {i}", reader.origin.display()))?;
+        let run = reader.next_run()?.ok_or_else(|| {
+            StudyError::Merge(MergeProblem::EndsEarly {
+                path: reader.origin.clone(),
+                run: i,
+            })
+        })?;
         if !keep_open {
             reader.input.release();
         }
