@@ -54,15 +54,21 @@ pub fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// `A v`.
 #[inline(always)]
 pub fn mat_vec<L: Lane>(a: &Rotation<L>, v: [L; 3]) -> [L; 3] {
-    std::array::from_fn(|i| a[i][0] * v[0] + a[i][1] * v[1] + a[i][2] * v[2])
+    [dot(a[0], v), dot(a[1], v), dot(a[2], v)]
 }
 
 /// The product `a b`.
 #[inline(always)]
 pub fn mat_mul<L: Lane>(a: Rotation<L>, b: Rotation<L>) -> Rotation<L> {
-    std::array::from_fn(|i| {
-        std::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j])
-    })
+    // Loops, not closures: a closure is compiled without the instruction set of a SIMD
+    // dispatch that inlines this function, and would call its intrinsics.
+    let mut product = a;
+    for (row, a_row) in product.iter_mut().zip(a) {
+        for (j, entry) in row.iter_mut().enumerate() {
+            *entry = a_row[0] * b[0][j] + a_row[1] * b[1][j] + a_row[2] * b[2][j];
+        }
+    }
+    product
 }
 
 /// Column `j` of `r`.

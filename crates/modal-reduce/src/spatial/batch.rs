@@ -191,17 +191,19 @@ fn group<S: Simd, const M: usize>(
     if !(all_finite(inputs[0]) & all_finite(inputs[1]) & all_finite(inputs[2])) {
         return false;
     }
-    let mut buffer = [0.0; MAX_WIDTH];
-    let mut gather = |values: &[f64], k: usize| {
-        for (lane, slot) in buffer[..width].iter_mut().enumerate() {
-            *slot = values[lane * M + k];
-        }
-        Pack::<S>::load(simd, &buffer)
-    };
-    let a: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[0], k));
-    let a_dot: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[1], k));
-    let tau_star: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[2], k));
+    // Loops, not closures: a closure is compiled without the dispatch's instruction set.
     let zero = Pack::splat(simd, 0.0);
+    let mut buffer = [0.0; MAX_WIDTH];
+    let mut lanes = [[zero; M]; 3];
+    for (values, packs) in inputs.iter().zip(&mut lanes) {
+        for (k, pack) in packs.iter_mut().enumerate() {
+            for (lane, slot) in buffer[..width].iter_mut().enumerate() {
+                *slot = values[lane * M + k];
+            }
+            *pack = Pack::load(simd, &buffer);
+        }
+    }
+    let [a, a_dot, tau_star] = lanes;
     const JACOBIAN: usize = 3 * MAX_SPATIAL_BATCH_COORDS;
     let (mut omega_jacobian, mut origin_jacobian) = ([zero; JACOBIAN], [zero; JACOBIAN]);
     let (mut com_jacobian, mut inertia_jacobian) = ([zero; JACOBIAN], [zero; JACOBIAN]);
@@ -218,7 +220,10 @@ fn group<S: Simd, const M: usize>(
     };
     accumulate(simd, model, &a, &a_dot, M, work);
     // The right-hand side tau* - C* - G* and the solve, as in `spatial_forward_dynamics`.
-    let mut x: [Pack<S>; M] = std::array::from_fn(|k| tau_star[k] - coriolis[k] - gravity[k]);
+    let mut x = tau_star;
+    for ((x, &c), &g) in x.iter_mut().zip(&coriolis).zip(&gravity) {
+        *x = *x - c - g;
+    }
     if !ldlt_in_place(simd, mass.as_flattened_mut(), M) {
         return false;
     }

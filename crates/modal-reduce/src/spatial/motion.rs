@@ -16,7 +16,7 @@
 //! With zero joint accelerations the accelerations are the bias terms of `C*` (velocity
 //! products only).
 
-use backbone_kin::vec3::{Rotation, add, column, cross, mat_vec, scale, sub};
+use backbone_kin::vec3::{Rotation, add, column, cross, dot, mat_vec, scale, sub};
 use lane_math::{Lane, sin_cos_lanes};
 
 /// The state the recursion carries from link to link (of one state, `f64`, or of one state per
@@ -39,15 +39,26 @@ impl<L: Lane> Carried<L> {
     /// The base: at rest, in its pose (in every lane).
     #[inline(always)]
     pub fn base(context: L::Context, rotation: Rotation, point: [f64; 3]) -> Self {
-        let splat = |x: f64| L::splat(context, x);
-        let zero = [splat(0.0); 3];
-        Self {
-            rotation: rotation.map(|row| row.map(splat)),
-            point: point.map(splat),
-            omega: zero,
-            omega_dot: zero,
-            accel: zero,
+        let zero = L::splat(context, 0.0);
+        let mut carried = Self {
+            rotation: [[zero; 3]; 3],
+            point: [zero; 3],
+            omega: [zero; 3],
+            omega_dot: [zero; 3],
+            accel: [zero; 3],
+        };
+        for ((row, given), (entry, &x)) in carried
+            .rotation
+            .iter_mut()
+            .zip(rotation)
+            .zip(carried.point.iter_mut().zip(&point))
+        {
+            for (value, r) in row.iter_mut().zip(given) {
+                *value = L::splat(context, r);
+            }
+            *entry = L::splat(context, x);
         }
+        carried
     }
 }
 
@@ -80,7 +91,8 @@ pub struct LinkMotion<L = f64> {
 /// operations in the same order for one state and for a register of states, so each lane gets
 /// the bits of its state alone. The turns are applied column by column, `R Rz(z)` mixing the
 /// first two columns of `R` and `Rz(z) Ry(y)` the first and last, with the sine and cosine of
-/// [`sin_cos_lanes`].
+/// [`sin_cos_lanes`]. (No closures here or below: a closure is compiled without the instruction
+/// set of the SIMD dispatch that inlines this function, and would call its intrinsics.)
 #[inline(always)]
 pub fn link_step<L: Lane>(
     context: L::Context,
@@ -90,7 +102,11 @@ pub fn link_step<L: Lane>(
     rates: [L; 2],
     accels: [L; 2],
 ) -> LinkMotion<L> {
-    let [x, y, z] = [0, 1, 2].map(|j| column(&carried.rotation, j));
+    let (x, y, z) = (
+        column(&carried.rotation, 0),
+        column(&carried.rotation, 1),
+        column(&carried.rotation, 2),
+    );
     let (sin_z, cos_z) = sin_cos_lanes(context, angles[0]);
     let (sin_y, cos_y) = sin_cos_lanes(context, angles[1]);
     // R Rz(z): x' = x cos + y sin, y' = y cos - x sin; then Ry(y): x'' = x' cos - z sin,
@@ -100,7 +116,11 @@ pub fn link_step<L: Lane>(
     let along = sub(scale(x_mid, cos_y), scale(z, sin_y));
     let normal = add(scale(x_mid, sin_y), scale(z, cos_y));
     let u_z = z;
-    let rotation = std::array::from_fn(|i| [along[i], u_y[i], normal[i]]);
+    let rotation = [
+        [along[0], u_y[0], normal[0]],
+        [along[1], u_y[1], normal[1]],
+        [along[2], u_y[2], normal[2]],
+    ];
     let omega_mid = add(carried.omega, scale(u_z, rates[0]));
     let omega = add(omega_mid, scale(u_y, rates[1]));
     let mut omega_dot = carried.omega_dot;
@@ -112,12 +132,6 @@ pub fn link_step<L: Lane>(
     ] {
         omega_dot = add(omega_dot, scale(term, factor));
     }
-    let accel_at = |r: [L; 3]| {
-        add(
-            carried.accel,
-            add(cross(omega_dot, r), cross(omega, cross(omega, r))),
-        )
-    };
     let to_com = scale(along, L::splat(context, 0.5 * length));
     let to_next = scale(along, L::splat(context, length));
     let joint = carried.point;
@@ -129,16 +143,26 @@ pub fn link_step<L: Lane>(
         omega,
         omega_dot,
         com: add(joint, to_com),
-        com_accel: accel_at(to_com),
+        com_accel: accel_at(carried.accel, omega, omega_dot, to_com),
     };
     *carried = Carried {
         rotation,
         point: add(joint, to_next),
         omega,
         omega_dot,
-        accel: accel_at(to_next),
+        accel: accel_at(carried.accel, omega, omega_dot, to_next),
     };
     motion
+}
+
+/// The acceleration of the point `r` away from a point of acceleration `accel` on a body turning
+/// at `omega` with `omega_dot`: `accel + omega_dot x r + omega x (omega x r)`.
+#[inline(always)]
+fn accel_at<L: Lane>(accel: [L; 3], omega: [L; 3], omega_dot: [L; 3], r: [L; 3]) -> [L; 3] {
+    add(
+        accel,
+        add(cross(omega_dot, r), cross(omega, cross(omega, r))),
+    )
 }
 
 /// `R diag(principal) R^T`, a link's inertia about its centre of mass in the world frame
@@ -146,13 +170,22 @@ pub fn link_step<L: Lane>(
 #[inline(always)]
 pub fn world_inertia<L: Lane>(rotation: &Rotation<L>, principal: [f64; 3]) -> Rotation<L> {
     let r = rotation;
-    let scaled: Rotation<L> =
-        std::array::from_fn(|i| std::array::from_fn(|k| r[i][k] * principal[k]));
-    let entry = |i: usize, j: usize| {
-        scaled[i][0] * r[j][0] + scaled[i][1] * r[j][1] + scaled[i][2] * r[j][2]
-    };
-    let (xx, yy, zz) = (entry(0, 0), entry(1, 1), entry(2, 2));
-    let (xy, xz, yz) = (entry(1, 0), entry(2, 0), entry(2, 1));
+    let mut scaled = *r;
+    for row in &mut scaled {
+        for (entry, &moment) in row.iter_mut().zip(&principal) {
+            *entry = *entry * moment;
+        }
+    }
+    let (xx, yy, zz) = (
+        dot(scaled[0], r[0]),
+        dot(scaled[1], r[1]),
+        dot(scaled[2], r[2]),
+    );
+    let (xy, xz, yz) = (
+        dot(scaled[1], r[0]),
+        dot(scaled[2], r[0]),
+        dot(scaled[2], r[1]),
+    );
     [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]
 }
 

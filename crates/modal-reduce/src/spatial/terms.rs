@@ -114,8 +114,9 @@ pub(crate) fn accumulate<L: Lane>(
     m: usize,
     work: TermsLanes<'_, L>,
 ) {
-    let splat = |x: f64| L::splat(context, x);
-    let zero = splat(0.0);
+    // No closures: a closure is compiled without the instruction set of the SIMD dispatch that
+    // inlines this function, and would call its intrinsics.
+    let zero = L::splat(context, 0.0);
     let TermsLanes {
         omega_jacobian,
         origin_jacobian,
@@ -158,7 +159,7 @@ pub(crate) fn accumulate<L: Lane>(
         // theta = J a and theta_dot = J a_dot for this link's two joints.
         let (mut angles, mut rates) = ([zero; 2], [zero; 2]);
         for (k, &r) in row.iter().enumerate() {
-            let r = splat(r);
+            let r = L::splat(context, r);
             angles = [a_z[k].mul_add(r, angles[0]), a_y[k].mul_add(r, angles[1])];
             rates = [
                 rate_z[k].mul_add(r, rates[0]),
@@ -179,7 +180,7 @@ pub(crate) fn accumulate<L: Lane>(
             let (w_z, w_y) = w.split_at_mut(half);
             let (o_z, o_y) = o.split_at_mut(half);
             for (k, &r) in row.iter().enumerate() {
-                let r = splat(r);
+                let r = L::splat(context, r);
                 w_z[k] = motion.u_z[d].mul_add(r, w_z[k]);
                 o_z[k] = moment_z[d].mul_add(r, o_z[k]);
                 w_y[k] = motion.u_y[d].mul_add(r, w_y[k]);
@@ -189,8 +190,7 @@ pub(crate) fn accumulate<L: Lane>(
         // Jv = Jo + Jw x c and I Jw, column by column.
         let world = world_inertia(&motion.rotation, inertia.principal);
         for k in 0..m {
-            let w = [0, 1, 2].map(|d| omega_jacobian[d * m + k]);
-            let o = [0, 1, 2].map(|d| origin_jacobian[d * m + k]);
+            let (w, o) = (column(omega_jacobian, m, k), column(origin_jacobian, m, k));
             let v = add(o, cross(w, motion.com));
             let iw = mat_vec(&world, w);
             for d in 0..3 {
@@ -198,22 +198,25 @@ pub(crate) fn accumulate<L: Lane>(
                 inertia_times_omega_jacobian[d * m + k] = iw[d];
             }
         }
-        let mass = splat(inertia.mass);
+        let mass = L::splat(context, inertia.mass);
         let force = scale(motion.com_accel, mass);
-        let weight = gravity.map(|g| splat(inertia.mass * g));
+        let weight = [
+            L::splat(context, inertia.mass * gravity[0]),
+            L::splat(context, inertia.mass * gravity[1]),
+            L::splat(context, inertia.mass * gravity[2]),
+        ];
         let torque = add(
             mat_vec(&world, motion.omega_dot),
             cross(motion.omega, mat_vec(&world, motion.omega)),
         );
-        let column = |matrix: &[L], k: usize| [0, 1, 2].map(|d| matrix[d * m + k]);
         for k in 0..m {
-            let (v_k, w_k) = (column(com_jacobian, k), column(omega_jacobian, k));
+            let (v_k, w_k) = (column(com_jacobian, m, k), column(omega_jacobian, m, k));
             coriolis[k] = coriolis[k] + (dot(v_k, force) + dot(w_k, torque));
             gravity_terms[k] = gravity_terms[k] - dot(v_k, weight);
             for l in 0..=k {
                 let (v_l, iw_l) = (
-                    column(com_jacobian, l),
-                    column(inertia_times_omega_jacobian, l),
+                    column(com_jacobian, m, l),
+                    column(inertia_times_omega_jacobian, m, l),
                 );
                 let value = dot(v_k, v_l).mul_add(mass, dot(w_k, iw_l));
                 mass_matrix[k * m + l] = mass_matrix[k * m + l] + value;
@@ -225,6 +228,12 @@ pub(crate) fn accumulate<L: Lane>(
             mass_matrix[l * m + k] = mass_matrix[k * m + l];
         }
     }
+}
+
+/// Column `k` of a `3 x m` row-major matrix.
+#[inline(always)]
+fn column<L: Lane>(matrix: &[L], m: usize, k: usize) -> [L; 3] {
+    [matrix[k], matrix[m + k], matrix[2 * m + k]]
 }
 
 /// Checks that `data` was made for `model` and that `a` and `a_dot` are `m` finite values each.
