@@ -14,7 +14,7 @@ use crate::error::KinError;
 use crate::harmonic_ik::{IkOptions, IkReport, Workspace, least_squares};
 use crate::spatial_chain::{BasePose, spatial_tip_jacobian};
 use crate::spatial_map::SpatialModalMap;
-use crate::validate::{check_finite, check_len};
+use crate::validate::{check_finite, check_len, check_output_len};
 use crate::vec3::distance;
 
 /// Reusable inverse kinematics of a universal-joint chain on the spatial modal family. Created
@@ -120,7 +120,6 @@ impl SpatialIk {
             joint_jacobian,
             ..
         } = self;
-        let (n2, m) = (map.n_joints(), map.n_coords());
         least_squares(
             target,
             a,
@@ -131,23 +130,55 @@ impl SpatialIk {
                 jacobian: &mut self.jacobian,
                 trial_jacobian: &mut self.trial_jacobian,
             },
-            |modes, jacobian| {
-                map.joint_angles(modes, theta)?;
-                let tip = spatial_tip_jacobian(map.link_lengths(), base, theta, joint_jacobian)?;
-                // d tip / d a = (d tip / d theta) J, row by row.
-                for (out, row) in jacobian
-                    .chunks_exact_mut(m)
-                    .zip(joint_jacobian.chunks_exact(n2))
-                {
-                    out.fill(0.0);
-                    for (j, &d_theta) in row.iter().enumerate() {
-                        for (o, &entry) in out.iter_mut().zip(map.row(j)) {
-                            *o += d_theta * entry;
-                        }
-                    }
-                }
-                Ok(tip)
-            },
+            |modes, jacobian| modal_tip_jacobian(map, base, modes, theta, joint_jacobian, jacobian),
         )
     }
+
+    /// The chain's tip at the modal coordinates `a` (`4K`) and its Jacobian
+    /// `d tip / d a = (d tip / d theta) J` into `jacobian` (`3 x 4K`, row-major), the one the
+    /// iteration of [`solve`](Self::solve) uses. Allocation-free.
+    ///
+    /// Errors: `a` or `jacobian` of the wrong size, a non-finite `a`.
+    pub fn tip_jacobian(&mut self, a: &[f64], jacobian: &mut [f64]) -> Result<[f64; 3], KinError> {
+        check_len("modal coordinates", a, self.trial.len())?;
+        check_output_len("tip Jacobian", jacobian.len(), self.jacobian.len())?;
+        for &value in a {
+            check_finite("modal coordinate", value)?;
+        }
+        modal_tip_jacobian(
+            &self.map,
+            &self.base,
+            a,
+            &mut self.theta,
+            &mut self.joint_jacobian,
+            jacobian,
+        )
+    }
+}
+
+/// The tip at `a` and `d tip / d a = (d tip / d theta) J` into `jacobian`, row by row, with the
+/// joint angles and their tip Jacobian in the scratch `theta` and `joint_jacobian`.
+fn modal_tip_jacobian(
+    map: &SpatialModalMap,
+    base: &BasePose,
+    a: &[f64],
+    theta: &mut [f64],
+    joint_jacobian: &mut [f64],
+    jacobian: &mut [f64],
+) -> Result<[f64; 3], KinError> {
+    let (n2, m) = (map.n_joints(), map.n_coords());
+    map.joint_angles(a, theta)?;
+    let tip = spatial_tip_jacobian(map.link_lengths(), base, theta, joint_jacobian)?;
+    for (out, row) in jacobian
+        .chunks_exact_mut(m)
+        .zip(joint_jacobian.chunks_exact(n2))
+    {
+        out.fill(0.0);
+        for (j, &d_theta) in row.iter().enumerate() {
+            for (o, &entry) in out.iter_mut().zip(map.row(j)) {
+                *o += d_theta * entry;
+            }
+        }
+    }
+    Ok(tip)
 }

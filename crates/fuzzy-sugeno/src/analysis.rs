@@ -427,9 +427,11 @@ fn grid_axes(
         return Ok(axes);
     }
     let mut low = 2;
-    if !fits(&build(low)) {
+    let smallest = build(low);
+    if !fits(&smallest) {
         return Err(FuzzyError::AnalysisGrid {
             max_grid_points: max_points,
+            axes: smallest.iter().map(Vec::len).collect(),
         });
     }
     // `low` fits and `high` does not.
@@ -836,10 +838,22 @@ mod tests {
             max_grid_points: 7,
             ..AnalysisOptions::default()
         });
-        assert!(matches!(
-            refused,
-            Err(FuzzyError::AnalysisGrid { max_grid_points: 7 })
-        ));
+        let Err(
+            error @ FuzzyError::AnalysisGrid {
+                max_grid_points: 7, ..
+            },
+        ) = refused
+        else {
+            panic!("{refused:?}")
+        };
+        // The message says what the grid needs, per input, and the limit.
+        assert_eq!(
+            error.to_string(),
+            "analysis: the completeness grid needs 27 points (3 x 3 x 3 along its inputs, each \
+             with 2 even samples, its sets' landmarks and the midpoints between them), more \
+             than the 7 the check evaluates (AnalysisOptions::max_grid_points); a system with \
+             fewer inputs or sets can be checked"
+        );
     }
 
     #[test]

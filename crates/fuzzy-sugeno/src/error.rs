@@ -136,14 +136,20 @@ pub enum FuzzyError {
     },
     /// The completeness grid would need more points than
     /// [`AnalysisOptions::max_grid_points`](crate::AnalysisOptions::max_grid_points) allows even
-    /// with 2 samples per input.
+    /// with 2 samples per input: the breakpoints of the inputs' sets alone are too many.
     #[error(
-        "analysis: the completeness grid needs more than max_grid_points = {max_grid_points} \
-         points even with 2 samples per input; raise max_grid_points"
+        "analysis: the completeness grid needs {} points ({} along its inputs, each with 2 \
+         even samples, its sets' landmarks and the midpoints between them), more than the \
+         {max_grid_points} the check evaluates (AnalysisOptions::max_grid_points); a system \
+         with fewer inputs or sets can be checked",
+        crate::error::grid_size(axes),
+        axes.iter().map(usize::to_string).collect::<Vec<_>>().join(" x ")
     )]
     AnalysisGrid {
         /// The limit in force.
         max_grid_points: usize,
+        /// The points of each input's axis with 2 samples (its ends and its sets' breakpoints).
+        axes: Vec<usize>,
     },
     /// The rule pairs plus the smallest completeness grid times the rules exceed
     /// [`AnalysisOptions::max_work`](crate::AnalysisOptions::max_work).
@@ -742,6 +748,17 @@ impl std::fmt::Display for ConsequentParameter {
             Self::Coefficient { name, .. } => write!(f, "the coefficient of input '{name}'"),
         }
     }
+}
+
+/// The number of points of a grid with `axes` points along each axis, compactly (`1.048576e6`
+/// when it exceeds what a `usize` counts).
+fn grid_size(axes: &[usize]) -> String {
+    axes.iter()
+        .try_fold(1usize, |total, &n| total.checked_mul(n))
+        .map_or_else(
+            || lane_math::Compact(axes.iter().map(|&n| n as f64).product()).to_string(),
+            |total| total.to_string(),
+        )
 }
 
 #[cfg(test)]

@@ -24,7 +24,7 @@
 //! their shortest exact form (always with a decimal point), so writing then reading gives back
 //! the identical system.
 
-use crate::error::FuzzyError;
+use crate::error::{FuzzyError, SystemProblem};
 use crate::membership::{KINDS, Kind, MembershipFn};
 use crate::system::{
     AndMethod, Antecedent, Connective, Defuzzification, FuzzySet, FuzzySystem, InputVariable,
@@ -369,7 +369,11 @@ struct Variable {
     name: String,
     line: usize,
     range: Option<[f64; 2]>,
+    /// The line of its `RANGE`.
+    range_line: usize,
     input_sets: Vec<FuzzySet>,
+    /// The line of each `TERM`, in the order of its sets or terms.
+    term_lines: Vec<usize>,
     output_terms: Vec<OutputTerm>,
     defined: bool,
 }
@@ -523,10 +527,12 @@ impl Reader {
                     _ => &mut self.outputs[k],
                 };
                 variable.range = Some(parse_range(line, rest)?);
+                variable.range_line = line;
             }
             (Section::Fuzzify(k), "TERM") => {
                 let (name, value) = term_definition(line, rest)?;
                 let membership = input_term(line, value)?;
+                self.inputs[k].term_lines.push(line);
                 self.inputs[k].input_sets.push(FuzzySet {
                     name: name.to_string(),
                     membership,
@@ -536,6 +542,7 @@ impl Reader {
                 let (name, value) = term_definition(line, rest)?;
                 let n_inputs = self.inputs.len();
                 let function = output_term(line, value, n_inputs)?;
+                self.outputs[k].term_lines.push(line);
                 self.outputs[k].output_terms.push(OutputTerm {
                     name: name.to_string(),
                     function,
@@ -699,8 +706,51 @@ impl Reader {
                 .defuzzification
                 .map_or(Defuzzification::default(), |(m, _)| m),
         };
-        FuzzySystem::new(self.name, inputs, outputs, rules, methods)
-            .map_err(|e| error(1, e.to_string()))
+        FuzzySystem::new(self.name.clone(), inputs, outputs, rules, methods)
+            .map_err(|e| error(self.line_of(&e), e.to_string()))
+    }
+
+    /// The line a refusal of the whole system points at: the `RANGE`, `TERM` or `RULE` it names
+    /// (an invalid range, set, term or rule weight), else the variable's declaration, else 1.
+    fn line_of(&self, e: &FuzzyError) -> usize {
+        let FuzzyError::InvalidSystem { context, problem } = e else {
+            return 1;
+        };
+        if let Some(n) = context.strip_prefix("rule ") {
+            return n
+                .parse::<usize>()
+                .ok()
+                .and_then(|n| self.rules.get(n.wrapping_sub(1)))
+                .map_or(1, |(line, _)| *line);
+        }
+        // `input 'x'`, `input 'x' set 's'`, `output 'y' term 't'`: FCL names carry no quote.
+        let parts: Vec<&str> = context.split('\'').collect();
+        let variables = match parts[0].trim() {
+            "input" => &self.inputs,
+            "output" => &self.outputs,
+            _ => return 1,
+        };
+        let Some(v) = parts
+            .get(1)
+            .and_then(|name| variables.iter().find(|v| v.name == *name))
+        else {
+            return 1;
+        };
+        if let Some(term) = parts.get(3) {
+            let names = v
+                .input_sets
+                .iter()
+                .map(|s| s.name.as_str())
+                .chain(v.output_terms.iter().map(|t| t.name.as_str()));
+            return names
+                .zip(&v.term_lines)
+                .find(|(name, _)| name == term)
+                .map_or(v.line, |(_, line)| *line);
+        }
+        match problem {
+            SystemProblem::Range { .. } => v.range_line,
+            _ => v.line,
+        }
     }
 }
 

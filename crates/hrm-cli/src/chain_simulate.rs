@@ -2,8 +2,9 @@
 //! spatial chain in joint space ([`Scenario::run_chain`]), written as `scenario.toml`,
 //! `summary.json` and `timeseries.csv` (`t`, then `q_i`, `q_ref_i`, `tau_i` per joint).
 
-use crate::console::{self, CsvNumber};
+use crate::console;
 use crate::output_dir::OutputDir;
+use lane_math::Compact;
 use serde_json::json;
 use sim_study::Scenario;
 use std::fmt::Write as _;
@@ -41,10 +42,10 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
     }
     csv.push('\n');
     for (k, t) in record.t.iter().enumerate() {
-        let _ = write!(csv, "{}", CsvNumber(*t));
+        let _ = write!(csv, "{}", Compact(*t));
         for series in [&record.q, &record.q_ref, &record.tau] {
             for value in &series[k * n..(k + 1) * n] {
-                let _ = write!(csv, ",{}", CsvNumber(*value));
+                let _ = write!(csv, ",{}", Compact(*value));
             }
         }
         csv.push('\n');

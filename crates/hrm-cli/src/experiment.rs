@@ -1,14 +1,15 @@
 //! The main job (`hrm` with no arguments) and `hrm simulate`: closed-loop runs of the shipped
 //! scenarios (section 5 of the paper), a comparison table, and per-run output files.
 
-use crate::console::CsvNumber;
 use crate::output_dir::OutputDir;
+use crate::spatial_figures::{self, CoordinateSeries};
 use crate::{console, figures, progress, report};
+use lane_math::Compact;
 use serde_json::json;
 use sim_core::Run;
 use sim_study::imitation::{self, ImitationOptions};
 use sim_study::study::{self, ComparisonRun, run_one, run_prepared};
-use sim_study::{ControllerKind, ReferenceSpec, Scenario};
+use sim_study::{ArmKind, ControllerKind, ReferenceSpec, Scenario, Workspace};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -272,12 +273,23 @@ fn figures(
             .collect()
     };
     let (mut responses, mut backbones, mut residuals) = (Vec::new(), Vec::new(), Vec::new());
+    let mut spatial = Vec::new();
     for scenario in scenarios {
         let runs = finished(&scenario.name);
         if runs.is_empty() {
             continue;
         }
         let name = &scenario.name;
+        if scenario.arm.kind == ArmKind::Spatial {
+            spatial_figures(&dir, scenario, &runs, &mut spatial)?;
+            let file = format!("fig11_{name}.svg");
+            figures::tracking_residual(&dir.join(&file), name, &runs)?;
+            residuals.push(figure(
+                file,
+                format!("{name}: distance in space from the tip to its reference (mm) for every controller; lower is better."),
+            ));
+            continue;
+        }
         if !matches!(scenario.reference, ReferenceSpec::Path { .. }) {
             let file = format!("fig9_{name}.svg");
             let names = scenario.coordinate_names();
@@ -352,11 +364,74 @@ fn figures(
             residuals,
         ),
         section(
+            "Spatial arms",
+            "Universal-joint arms held as horizontal cantilevers under gravity (along -z), two bending planes of K harmonics each (az: in the x-y plane, ay: out of it); the tip follows a circle about the x axis, out of the arm's plane.",
+            spatial,
+        ),
+        section(
             "The fuzzy controller (section 4)",
             "Four inputs (modal errors da1, da2 and rates a1_dot, a2_dot), two bell sets each, 16 rules, constant (zero-order Sugeno) outputs.",
             fuzzy,
         ),
     ])
+}
+
+/// The figures of a spatial scenario's finished `runs` into `dir`, their captions appended to
+/// `figures`: the backbone in space (three views) of each controller, the tip's coordinates
+/// against the reference, and the per-coordinate modal errors and forces.
+fn spatial_figures(
+    dir: &Path,
+    scenario: &Scenario,
+    runs: &[(ControllerKind, &Run)],
+    figures: &mut Vec<report::Figure>,
+) -> Result<(), String> {
+    let name = &scenario.name;
+    let mut add = |file: String, caption: String| {
+        figures.push(report::Figure {
+            file: format!("figures/{file}"),
+            caption,
+        })
+    };
+    for &(kind, run) in runs {
+        let file = format!("backbone3d_{name}_{}.svg", kind.name());
+        spatial_figures::backbone_in_space(
+            &dir.join(&file),
+            scenario,
+            kind,
+            run,
+            CONFIGURATION_INTERVAL_S,
+        )?;
+        add(
+            file,
+            format!(
+                "{name} with {kind}: the arm every {CONFIGURATION_INTERVAL_S} s, light to dark, from above, from the side and obliquely; the tip (green) should stay on the red path."
+            ),
+        );
+    }
+    let file = format!("tip_{name}.svg");
+    spatial_figures::tip_paths(&dir.join(&file), name, runs)?;
+    add(
+        file,
+        format!("{name}: the tip's x, y and z of every controller against the reference."),
+    );
+    let names = scenario.coordinate_names();
+    for (what, tag, caption) in [
+        (
+            CoordinateSeries::Error,
+            "errors",
+            "the error of every modal coordinate (mrad)",
+        ),
+        (
+            CoordinateSeries::Effort,
+            "efforts",
+            "the modal force tau* of every coordinate (N m)",
+        ),
+    ] {
+        let file = format!("{tag}_{name}.svg");
+        spatial_figures::per_coordinate(&dir.join(&file), name, &names, runs, what)?;
+        add(file, format!("{name}: {caption}, every controller."));
+    }
+    Ok(())
 }
 
 fn outcome_json(outcome: &ComparisonRun) -> serde_json::Value {
@@ -370,7 +445,7 @@ fn outcome_json(outcome: &ComparisonRun) -> serde_json::Value {
     }
 }
 
-/// Writes `summary.json`, `timeseries.csv` and `scenario.toml` (what `hrm view` draws the arm
+/// Writes `summary.json`, `timeseries.csv`, `links.csv` and `scenario.toml` (what `hrm view` draws the arm
 /// from) of one run of `scenario` into `dir`. A run that stopped has its time series up to the
 /// stop, and a summary of the metrics up to it with the `error` and the time it `stopped_at_s`.
 fn write_outcome(outcome: &ComparisonRun, scenario: &Scenario, dir: &Path) -> Result<(), String> {
@@ -392,7 +467,22 @@ fn write_outcome(outcome: &ComparisonRun, scenario: &Scenario, dir: &Path) -> Re
         header.extend(names.iter().map(|n| format!("{n}_dot")));
         header.extend(names.iter().map(|n| format!("{n}_ref")));
         header.extend((1..=names.len()).map(|i| format!("tau{i}")));
-        header.extend(["tip_x", "tip_y", "tip_ref_x", "tip_ref_y"].map(String::from));
+        let spatial = scenario.arm.kind == ArmKind::Spatial;
+        if spatial {
+            header.extend(
+                [
+                    "tip_x",
+                    "tip_y",
+                    "tip_z",
+                    "tip_ref_x",
+                    "tip_ref_y",
+                    "tip_ref_z",
+                ]
+                .map(String::from),
+            );
+        } else {
+            header.extend(["tip_x", "tip_y", "tip_ref_x", "tip_ref_y"].map(String::from));
+        }
         header.extend((1..=names.len()).map(|i| format!("clamped{i}")));
         header.extend((1..=r.n_joints).map(|j| format!("joint_tau{j}")));
         let mut csv = header.join(",") + "\n";
@@ -403,15 +493,41 @@ fn write_outcome(outcome: &ComparisonRun, scenario: &Scenario, dir: &Path) -> Re
                 .chain(r.a_ref_at(k).iter().copied())
                 .chain(r.tau_star_at(k).iter().copied())
                 .chain(r.tip[k])
+                .chain(spatial.then_some(r.tip_z[k]))
                 .chain(r.tip_ref[k])
+                .chain(spatial.then_some(r.tip_ref_z[k]))
                 .chain(r.clamped_at(k).iter().map(|&c| f64::from(u8::from(c))))
                 .chain(r.joint_torques_at(k).iter().copied());
-            let line: Vec<String> = row.map(|v| CsvNumber(v).to_string()).collect();
+            let line: Vec<String> = row.map(|v| Compact(v).to_string()).collect();
             let _ = writeln!(csv, "{}", line.join(","));
         }
         write(&dir.join("timeseries.csv"), &csv)?;
+        write(&dir.join("links.csv"), &links_csv(r, scenario.workspace()))?;
     }
     Ok(())
+}
+
+/// `links.csv`: the time, then the base point and every link's end point (`t, x0, y0, x1, y1,
+/// ...`, with `z0, z1, ...` interleaved for a spatial arm) at each recorded sample, exactly the
+/// points the loop measured the clearance from.
+fn links_csv(r: &sim_core::Record, workspace: Workspace) -> String {
+    let axes: &[&str] = match workspace {
+        Workspace::Planar => &["x", "y"],
+        Workspace::Spatial => &["x", "y", "z"],
+    };
+    let mut header = vec!["t".to_string()];
+    for j in 0..r.n_points {
+        header.extend(axes.iter().map(|axis| format!("{axis}{j}")));
+    }
+    let mut csv = header.join(",") + "\n";
+    for k in 0..r.len() {
+        let points = r.joint_points_at(k).iter();
+        let coordinates = points.flat_map(|p| p.iter().take(axes.len()).copied());
+        let row = std::iter::once(r.t[k]).chain(coordinates);
+        let line: Vec<String> = row.map(|v| Compact(v).to_string()).collect();
+        let _ = writeln!(csv, "{}", line.join(","));
+    }
+    csv
 }
 
 /// The comparison table's columns.

@@ -72,22 +72,10 @@ pub fn configurations(
     record: &Record,
     every_s: f64,
 ) -> Result<Vec<Configuration>, String> {
-    if !(every_s.is_finite() && every_s > 0.0) {
-        return Err(format!(
-            "the interval between configurations must be positive, got {every_s}"
-        ));
-    }
+    let picked = snapshot_samples(record, every_s)?;
     let model = scenario.model().map_err(|e| e.to_string())?;
     let lengths: Vec<f64> = model.chain().link_lengths().collect();
     let mut theta = vec![0.0; lengths.len()];
-    let mut picked = Vec::new();
-    let mut next = f64::NEG_INFINITY;
-    for (k, &t) in record.t.iter().enumerate() {
-        if t >= next || k + 1 == record.len() {
-            picked.push(k);
-            next = ((t / every_s + 1e-9).floor() + 1.0) * every_s;
-        }
-    }
     picked
         .into_iter()
         .map(|k| {
@@ -101,6 +89,25 @@ pub fn configurations(
             Ok(Configuration { k, joints })
         })
         .collect()
+}
+
+/// The samples of `record` drawn every `every_s` seconds: the first, then the first at or after
+/// each multiple, and the last.
+pub fn snapshot_samples(record: &Record, every_s: f64) -> Result<Vec<usize>, String> {
+    if !(every_s.is_finite() && every_s > 0.0) {
+        return Err(format!(
+            "the interval between configurations must be positive, got {every_s}"
+        ));
+    }
+    let mut picked = Vec::new();
+    let mut next = f64::NEG_INFINITY;
+    for (k, &t) in record.t.iter().enumerate() {
+        if t >= next || k + 1 == record.len() {
+            picked.push(k);
+            next = ((t / every_s + 1e-9).floor() + 1.0) * every_s;
+        }
+    }
+    Ok(picked)
 }
 
 /// Figure 10: the arm's configurations every `every_s` seconds (light to dark with time, joints
@@ -226,14 +233,17 @@ pub fn fuzzy_controller(dir: &Path, resolution: usize) -> Result<Vec<PathBuf>, S
     Ok(written)
 }
 
-/// The distance from the tip to the reference tip at sample `k` (m).
+/// The distance from the tip to the reference tip at sample `k` (m), in space (`z = 0` in the
+/// plane, where `hypot(d, 0) = |d|`).
 fn tip_error(record: &Record, k: usize) -> f64 {
     let (tip, reference) = (record.tip[k], record.tip_ref[k]);
-    (tip[0] - reference[0]).hypot(tip[1] - reference[1])
+    (tip[0] - reference[0])
+        .hypot(tip[1] - reference[1])
+        .hypot(record.tip_z[k] - record.tip_ref_z[k])
 }
 
 /// `point(record, k)` at no more than [`MAX_POINTS`] evenly strided samples, the last included.
-fn thin(record: &Record, point: impl Fn(&Record, usize) -> (f64, f64)) -> Vec<(f64, f64)> {
+pub fn thin(record: &Record, point: impl Fn(&Record, usize) -> (f64, f64)) -> Vec<(f64, f64)> {
     let n = record.len();
     let stride = n.div_ceil(MAX_POINTS).max(1);
     let mut points: Vec<_> = (0..n).step_by(stride).map(|k| point(record, k)).collect();

@@ -18,7 +18,8 @@ use crate::output_dir::OutputDir;
 use crate::plot::{self, Grid, Labels, Series};
 use clap::{Args, Subcommand, ValueEnum};
 use fuzzy_sugeno::{
-    AnalysisOptions, EvalOptions, Evaluator, FisNote, FuzzySystem, InputVariable, OutOfRange,
+    AnalysisOptions, EvalOptions, Evaluator, FisNote, FuzzyError, FuzzySystem, InputVariable,
+    OutOfRange,
 };
 use std::path::{Path, PathBuf};
 
@@ -253,7 +254,24 @@ const SVG_BYTES_PER_CELL: f64 = 90.0;
 /// to keep the grid within [`AnalysisOptions::max_grid_points`] and
 /// [`AnalysisOptions::max_work`].
 fn check(system: &FuzzySystem, options: &AnalysisOptions) -> Result<(String, bool), String> {
-    let report = system.analyze(options).map_err(|e| e.to_string())?;
+    let report = system.analyze(options).map_err(|e| match e {
+        // The command line has no option for the grid's limit: say what the system needs.
+        FuzzyError::AnalysisGrid {
+            max_grid_points,
+            axes,
+        } => format!(
+            "the completeness grid of this system needs {} points ({} along its inputs, each \
+             with 2 even samples, its sets' landmarks and the midpoints between them), more \
+             than the {max_grid_points} `hrm fis check` evaluates: check a system with fewer \
+             inputs or sets",
+            lane_math::Compact(axes.iter().map(|&n| n as f64).product()),
+            axes.iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join(" x ")
+        ),
+        e => e.to_string(),
+    })?;
     let mut text = report.to_string();
     let grid = &report.completeness.grid;
     if grid.iter().any(|&n| n < options.samples_per_input) {

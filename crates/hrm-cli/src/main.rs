@@ -16,8 +16,10 @@ mod plot;
 mod progress;
 mod report;
 mod signals;
+mod spatial_figures;
 mod sweep;
 mod view_cmd;
+mod view_sweep;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -66,8 +68,8 @@ enum Command {
     Arm(arm_cmd::ArmArgs),
     /// Monte Carlo over noise levels and seeds: mean and spread of the errors per controller (docs/sweep.md).
     Sweep(sweep::SweepCli),
-    /// The interactive page of a run (an `hrm simulate` or `hrm run` output folder), and with
-    /// --gif an animated GIF of it.
+    /// The interactive page of a run (an `hrm simulate`, `hrm run` or `hrm sweep` output
+    /// folder), and with --gif an animated GIF of it.
     View(view_cmd::ViewArgs),
 }
 

@@ -209,55 +209,54 @@ pub fn xy_chart(
     labels: &Labels<'_>,
     curves: &[(Series, Style)],
 ) -> Result<(), String> {
-    const MARGIN: u32 = 15;
-    const X_LABELS: u32 = 50;
-    const Y_LABELS: u32 = 75;
-    let context = |e: String| format!("{}: {e}", path.display());
-    let points = || curves.iter().flat_map(|(s, _)| s.points.iter());
-    let data = [
-        span(points().map(|p| p.0), "x").map_err(context)?,
-        span(points().map(|p| p.1), "y").map_err(context)?,
-    ];
+    let data = xy_span(path, curves)?;
     let root = SVGBackend::new(path, SIZE).into_drawing_area();
     let draw = || -> Result<(), Box<dyn std::error::Error>> {
         root.fill(&WHITE)?;
         let titled = root.titled(labels.title, TITLE_FONT)?;
         let (area, legend_area) =
             titled.split_horizontally(titled.dim_in_pixel().0.saturating_sub(LEGEND_WIDTH));
-        let (w, h) = area.dim_in_pixel();
-        let pixels = (
-            w.saturating_sub(2 * MARGIN + Y_LABELS).max(1),
-            h.saturating_sub(2 * MARGIN + X_LABELS).max(1),
-        );
-        let [x_range, y_range] = equal_aspect(&data, pixels, 0.05);
-        let (x_ticks, y_ticks) = (tick_format(&x_range), tick_format(&y_range));
-        let mut chart = ChartBuilder::on(&area)
-            .margin(MARGIN)
-            .x_label_area_size(X_LABELS)
-            .y_label_area_size(Y_LABELS)
-            .build_cartesian_2d(x_range.clone(), y_range.clone())?;
-        chart
-            .configure_mesh()
-            .x_desc(labels.x)
-            .y_desc(labels.y)
-            .label_style(TICK_FONT)
-            .axis_desc_style(AXIS_FONT)
-            .x_label_formatter(&x_ticks)
-            .y_label_formatter(&y_ticks)
-            .draw()?;
+        let entries = draw_xy(&area, labels, curves, &data)?;
+        legend(&legend_area, &entries)?;
+        root.present()?;
+        Ok(())
+    };
+    draw().map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Writes several views of one scene side by side under one `title` to the SVG file `path`,
+/// each with equal scales on its two axes (as [`xy_chart`]) and its own `Labels::title` above
+/// it; the legend, of the first view's curves, is on the right.
+pub fn xy_views(
+    path: &Path,
+    title: &str,
+    views: &[(Labels<'_>, Vec<(Series, Style)>)],
+) -> Result<(), String> {
+    if views.is_empty() {
+        return Err(format!("{}: no views to draw", path.display()));
+    }
+    let spans = views
+        .iter()
+        .map(|(_, curves)| xy_span(path, curves))
+        .collect::<Result<Vec<_>, _>>()?;
+    let width = (SIZE.0 - LEGEND_WIDTH) * views.len() as u32 / 2 + LEGEND_WIDTH;
+    let root = SVGBackend::new(path, (width, SIZE.1 * 3 / 4)).into_drawing_area();
+    let draw = || -> Result<(), Box<dyn std::error::Error>> {
+        root.fill(&WHITE)?;
+        let titled = root.titled(title, TITLE_FONT)?;
+        let (area, legend_area) =
+            titled.split_horizontally(titled.dim_in_pixel().0.saturating_sub(LEGEND_WIDTH));
         let mut entries = Vec::new();
-        for (series, style) in curves {
-            let (r, g, b) = style.colour;
-            let colour = RGBColor(r, g, b).stroke_width(style.width);
-            chart.draw_series(LineSeries::new(series.points.iter().copied(), colour))?;
-            entries.push((series.label.as_str(), colour));
-            if style.dots {
-                chart.draw_series(
-                    series
-                        .points
-                        .iter()
-                        .map(|&p| Circle::new(p, style.width + 1, colour.color.filled())),
-                )?;
+        for (k, (cell, ((labels, curves), data))) in area
+            .split_evenly((1, views.len()))
+            .iter()
+            .zip(views.iter().zip(&spans))
+            .enumerate()
+        {
+            let cell = cell.titled(labels.title, AXIS_FONT)?;
+            let drawn = draw_xy(&cell, labels, curves, data)?;
+            if k == 0 {
+                entries = drawn;
             }
         }
         legend(&legend_area, &entries)?;
@@ -265,6 +264,66 @@ pub fn xy_chart(
         Ok(())
     };
     draw().map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The horizontal and vertical spans of `curves`' points.
+fn xy_span(path: &Path, curves: &[(Series, Style)]) -> Result<[Range<f64>; 2], String> {
+    let context = |e: String| format!("{}: {e}", path.display());
+    let points = || curves.iter().flat_map(|(s, _)| s.points.iter());
+    Ok([
+        span(points().map(|p| p.0), "x").map_err(context)?,
+        span(points().map(|p| p.1), "y").map_err(context)?,
+    ])
+}
+
+/// Draws `curves` spanning `data` on `area` with equal scales on both axes; returns the legend
+/// entries.
+fn draw_xy<'c>(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    labels: &Labels<'_>,
+    curves: &'c [(Series, Style)],
+    data: &[Range<f64>; 2],
+) -> Result<Vec<(&'c str, ShapeStyle)>, Box<dyn std::error::Error>> {
+    const MARGIN: u32 = 15;
+    const X_LABELS: u32 = 50;
+    const Y_LABELS: u32 = 75;
+    let (w, h) = area.dim_in_pixel();
+    let pixels = (
+        w.saturating_sub(2 * MARGIN + Y_LABELS).max(1),
+        h.saturating_sub(2 * MARGIN + X_LABELS).max(1),
+    );
+    let [x_range, y_range] = equal_aspect(data, pixels, 0.05);
+    let (x_ticks, y_ticks) = (tick_format(&x_range), tick_format(&y_range));
+    let mut chart = ChartBuilder::on(area)
+        .margin(MARGIN)
+        .x_label_area_size(X_LABELS)
+        .y_label_area_size(Y_LABELS)
+        .build_cartesian_2d(x_range.clone(), y_range.clone())?;
+    chart
+        .configure_mesh()
+        .x_desc(labels.x)
+        .y_desc(labels.y)
+        .label_style(TICK_FONT)
+        .axis_desc_style(AXIS_FONT)
+        .x_label_formatter(&x_ticks)
+        .y_label_formatter(&y_ticks)
+        .draw()?;
+    let mut entries = Vec::new();
+    for (series, style) in curves {
+        let (r, g, b) = style.colour;
+        let colour = RGBColor(r, g, b).stroke_width(style.width);
+        chart.draw_series(LineSeries::new(series.points.iter().copied(), colour))?;
+        entries.push((series.label.as_str(), colour));
+        if style.dots {
+            chart.draw_series(
+                series
+                    .points
+                    .iter()
+                    .map(|&p| Circle::new(p, style.width + 1, colour.color.filled())),
+            )?;
+        }
+    }
+    Ok(entries)
 }
 
 /// Ranges around `data` (widened by `margin` of the larger span on every side) whose units per

@@ -1,6 +1,7 @@
-//! `hrm view DIR`: the viewer page (`run-view`) of an `hrm simulate` output folder, or of a
-//! main job's output folder (one animation per scenario, every controller), and with
-//! `--gif FILE` an animated GIF of one run. The files are written whole or not at all, and a
+//! `hrm view DIR`: the viewer page (`run-view`) of an `hrm simulate` output folder, of a
+//! main job's output folder (one animation per scenario, every controller), or of a sweep's
+//! (chosen runs run again, [`crate::view_sweep`]), and with `--gif FILE` an animated GIF of one
+//! run. The files are written whole or not at all, and a
 //! file hrm did not write is never replaced.
 
 use crate::output_dir;
@@ -16,7 +17,8 @@ const MAX_TIMESERIES_BYTES: u64 = 256 << 20;
 /// The command line of `hrm view`.
 #[derive(clap::Args)]
 pub struct ViewArgs {
-    /// An `hrm simulate` output folder, or the main job's (`hrm run`) output folder.
+    /// An `hrm simulate` output folder, the main job's (`hrm run`) output folder, or a sweep's
+    /// (`hrm sweep`, `hrm sweep merge`).
     dir: PathBuf,
     /// The page to write (default: DIR/view.html).
     #[arg(long)]
@@ -27,6 +29,14 @@ pub struct ViewArgs {
     /// The run of a main job's folder the GIF shows, as SCENARIO/CONTROLLER.
     #[arg(long, default_value = "paper-tracking/fuzzy")]
     run: String,
+    /// A sweep's runs to show (their numbers in `--list`), at most 12; they are run again from
+    /// the sweep's configuration. Default: the first seed of every controller at the lowest and
+    /// the highest noise level. The GIF shows the first.
+    #[arg(long, value_delimiter = ',', value_name = "I,J,...")]
+    runs: Option<Vec<usize>>,
+    /// List a sweep's runs (number, noise level, controller, seed, outcome) and write nothing.
+    #[arg(long)]
+    list: bool,
     /// GIF width (pixels).
     #[arg(long, default_value_t = 480)]
     width: u32,
@@ -56,7 +66,22 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     if !dir.is_dir() {
         return Err(format!("{}: not a folder", dir.display()));
     }
-    let (title, scenes, gif_run) = if dir.join("timeseries.csv").is_file() {
+    let is_sweep = crate::view_sweep::is_sweep(dir);
+    if (args.list || args.runs.is_some()) && !is_sweep {
+        return Err(format!(
+            "{}: --list and --runs take a sweep's output folder (with runs.json)",
+            dir.display()
+        ));
+    }
+    if args.list {
+        return crate::view_sweep::list(dir);
+    }
+    let (title, scenes, gif_run) = if is_sweep {
+        let scenes = crate::view_sweep::load(dir, args.runs.as_deref())?;
+        let gif_run = scenes[0].runs[0].clone();
+        let title = format!("hrm: runs of the sweep in {}", dir.display());
+        (title, scenes, gif_run)
+    } else if dir.join("timeseries.csv").is_file() {
         let (scenario, run) = load_run(dir, None)?;
         let title = format!("{} with {}", scenario.name, run.label);
         let scene = Scene {
@@ -247,17 +272,18 @@ fn parse_timeseries(text: &str, scenario: &Scenario) -> Result<Record, String> {
     let [t, tip_x, tip_y, ref_x, ref_y] =
         ["t", "tip_x", "tip_y", "tip_ref_x", "tip_ref_y"].map(column);
     let (t, tip_x, tip_y, ref_x, ref_y) = (t?, tip_x?, tip_y?, ref_x?, ref_y?);
-    let links = scenario
-        .model()
+    // A spatial run's tip has z columns too; a planar run's z is zero.
+    let [tip_z, ref_z] = ["tip_z", "tip_ref_z"].map(|name| column(name).ok());
+    let n_joints = scenario
+        .plant()
         .map_err(|e| e.to_string())?
-        .chain()
-        .link_lengths()
-        .count();
-    let joint: Vec<usize> = (1..=links)
+        .plant()
+        .n_joints();
+    let joint: Vec<usize> = (1..=n_joints)
         .map_while(|j| column(&format!("joint_tau{j}")).ok())
         .collect();
     let mut record = Record {
-        n_joints: links,
+        n_joints,
         n_coords: m,
         ..Record::default()
     };
@@ -288,7 +314,9 @@ fn parse_timeseries(text: &str, scenario: &Scenario) -> Result<Record, String> {
         record.tau_star.extend(tau.iter().map(|&c| row[c]));
         record.tip.push([row[tip_x], row[tip_y]]);
         record.tip_ref.push([row[ref_x], row[ref_y]]);
-        if joint.len() == links {
+        record.tip_z.push(tip_z.map_or(0.0, |c| row[c]));
+        record.tip_ref_z.push(ref_z.map_or(0.0, |c| row[c]));
+        if joint.len() == n_joints {
             record.joint_torques.extend(joint.iter().map(|&c| row[c]));
         }
     }

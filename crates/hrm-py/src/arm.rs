@@ -7,7 +7,7 @@ use manip_dyn::faer::MatMut;
 use manip_dyn::{AbaBatchData, BatchError, ChainData, ChainModel, DynError, MAX_DENSE_LINKS};
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
-use sim_study::ArmSpec;
+use sim_study::{ArmSpec, Gravity, Inertias};
 use std::sync::Mutex;
 
 /// A planar serial chain of revolute joints under gravity along -y (the paper's eq 12:
@@ -99,11 +99,11 @@ impl Arm {
             links,
             link_length: Some(link_length),
             link_mass: Some(link_mass),
-            gravity: Some(gravity),
+            gravity: Some(Gravity::Magnitude(gravity)),
             lengths,
             masses,
-            inertias,
-            urdf: None,
+            inertias: inertias.map(Inertias::PerLink),
+            ..ArmSpec::default()
         };
         let chain = spec.to_chain().map_err(Error::from)?;
         Ok(Self::from_chain(chain))

@@ -194,15 +194,16 @@ def test_a_universal_joint_snake_agrees_with_pinocchio_and_mujoco():
     compare_with_mujoco(urdf, theta, v)
 
 
-def test_massless_crosses_are_two_hinges_in_one_mujoco_body():
-    """hrm refuses massless moving links; Pinocchio and MuJoCo (two hinges in one body) agree."""
-    require(pin is not None and mujoco is not None, "Pinocchio and MuJoCo")
+def test_massless_crosses_agree_with_pinocchio_and_are_two_hinges_in_one_mujoco_body():
+    """Massless crosses (a universal joint as URDF writes it): hrm agrees with Pinocchio on every
+    quantity (ABA and its derivatives through the articulated inertias of massless bodies), and
+    MuJoCo, on hrm's MJCF (two hinges in one body), with both."""
+    require(pin is not None, "Pinocchio (pin)")
     urdf = snake(middle_mass=0.0)
-    theta, v, _, _ = states(20, 7)
-    model, data = pin_model(urdf, GRAVITY)
-    q = pin_q(model, theta)
-    reference = (symmetric(pin.crba(model, data, q)), pin.nonLinearEffects(model, data, q, v))
-    compare_with_mujoco(urdf, theta, v, hrm_answer=reference)
+    theta, v, a, tau = states(20, 7)
+    compare_with_pinocchio(urdf, theta, v, a, tau)
+    require(mujoco is not None, "MuJoCo (mujoco)")
+    compare_with_mujoco(urdf, theta, v)
     (export,) = hrm_eval([{"op": "export", "urdf": urdf, "format": "mjcf"}])
     assert mujoco.MjModel.from_xml_string(export["text"]).nbody == 1 + 1 + 10
 

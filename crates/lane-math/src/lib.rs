@@ -1,12 +1,14 @@
 #![doc = include_str!("../README.md")]
 
 mod checks;
+mod compact;
 mod error_class;
 mod instruction_sets;
 mod lanes;
 mod trig;
 
 pub use checks::{ShapeProblem, check_values, first_non_finite};
+pub use compact::{Compact, compact_numbers};
 pub use error_class::{Classify, ErrorClass};
 pub use instruction_sets::instruction_sets;
 pub use lanes::{Lane, Pack};

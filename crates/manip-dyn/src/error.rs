@@ -1,6 +1,6 @@
 //! The error type of this crate.
 
-use lane_math::{Classify, ErrorClass};
+use lane_math::{Classify, Compact, ErrorClass};
 
 /// Why a dynamics computation was refused.
 ///
@@ -26,7 +26,7 @@ pub enum DynError {
         max: usize,
     },
     /// A link parameter was out of its domain.
-    #[error("link {index}: {quantity} must be {requirement}, got {value}")]
+    #[error("link {index}: {quantity} must be {requirement}, got {}", Compact(*.value))]
     InvalidLink {
         /// 0-based link index.
         index: usize,
@@ -39,7 +39,7 @@ pub enum DynError {
         value: f64,
     },
     /// A joint parameter of a spatial chain was out of its domain.
-    #[error("joint {index}: {quantity} must be {requirement}, got {value}")]
+    #[error("joint {index}: {quantity} must be {requirement}, got {}", Compact(*.value))]
     InvalidJoint {
         /// 0-based joint index.
         index: usize,
@@ -61,7 +61,7 @@ pub enum DynError {
     /// A parameter of a lone link (from [`Link::new`](crate::Link::new) or
     /// [`Link::uniform_beam`](crate::Link::uniform_beam), which know no index) was out of its
     /// domain; [`DynError::at_link`] names the link once the caller knows where it goes.
-    #[error("link {quantity} must be {requirement}, got {value}")]
+    #[error("link {quantity} must be {requirement}, got {}", Compact(*.value))]
     InvalidLinkParameter {
         /// Which parameter, as in [`DynError::InvalidLink`].
         quantity: &'static str,
@@ -71,7 +71,7 @@ pub enum DynError {
         value: f64,
     },
     /// The gravitational acceleration (or a component of it) was not finite.
-    #[error("gravity must be finite, got {0}")]
+    #[error("gravity must be finite, got {}", Compact(*.0))]
     InvalidGravity(f64),
     /// A slice or matrix had the wrong size.
     #[error("{name} has {found} entries, expected {expected}")]
@@ -84,7 +84,7 @@ pub enum DynError {
         found: usize,
     },
     /// An input that must be finite was NaN or infinite.
-    #[error("{name}[{index}] must be finite, got {value}")]
+    #[error("{name}[{index}] must be finite, got {}", Compact(*.value))]
     NonFinite {
         /// Which input.
         name: &'static str,
@@ -106,17 +106,33 @@ pub enum DynError {
     /// precision; the accelerations would have no reliable digits.
     #[error("the mass matrix is not numerically positive definite")]
     NotPositiveDefinite,
+    /// A spatial chain's articulated inertia about joint `index`'s axis was not positive beyond
+    /// rounding (as for [`NotPositiveDefinite`](DynError::NotPositiveDefinite)): the joint moves
+    /// no mass or inertia, so `M` is singular. A massless link is valid as long as the links
+    /// beyond it give its joint something to move; this names the joint where they do not (a
+    /// massless link at the tip, a point mass on the axis of the last revolute joint).
+    #[error(
+        "joint {index}: the articulated inertia about its axis is not positive beyond rounding \
+         (the joint moves no mass or inertia), so the mass matrix is singular"
+    )]
+    SingularJoint {
+        /// 0-based joint index.
+        index: usize,
+    },
 }
 
 impl Classify for DynError {
     /// [`Numerical`](ErrorClass::Numerical) when a computation on valid input failed in double
     /// precision: a mass matrix that is not numerically positive definite, or a result that
     /// overflowed ([`NotPositiveDefinite`](DynError::NotPositiveDefinite),
+    /// [`SingularJoint`](DynError::SingularJoint),
     /// [`NonFiniteResult`](DynError::NonFiniteResult)); otherwise the input was malformed or
     /// outside the model's domain.
     fn class(&self) -> ErrorClass {
         match self {
-            Self::NotPositiveDefinite | Self::NonFiniteResult { .. } => ErrorClass::Numerical,
+            Self::NotPositiveDefinite
+            | Self::SingularJoint { .. }
+            | Self::NonFiniteResult { .. } => ErrorClass::Numerical,
             _ => ErrorClass::InvalidInput,
         }
     }

@@ -5,6 +5,7 @@ use super::OptimalError;
 use super::box_qp::{BoxQp, BoxQpSettings};
 use super::dense::{multiply, multiply_transposed, symmetrise};
 use super::discrete::DiscreteDynamics;
+use super::step_constraints::{ConstrainedWork, StepConstraints};
 
 /// The most steps a horizon may have.
 pub const MAX_HORIZON: usize = 100_000;
@@ -203,6 +204,8 @@ pub struct Ilqr {
     adjoint: Vec<f64>,
     adjoint_next: Vec<f64>,
     qp: BoxQp,
+    /// The working memory of constrained solves, once reserved.
+    constrained: Option<ConstrainedWork>,
 }
 
 impl Ilqr {
@@ -308,7 +311,38 @@ impl Ilqr {
             adjoint: vec![0.0; nx],
             adjoint_next: vec![0.0; nx],
             qp: BoxQp::new(nu),
+            constrained: None,
         })
+    }
+
+    /// Sizes the working memory of [`solve_constrained`](Self::solve_constrained) for at most
+    /// `max_rows` constraint rows a step (allocates; once, before the solves).
+    ///
+    /// # Errors
+    /// [`OptimalError::InvalidSetting`] when `horizon * max_rows * n_u` would exceed
+    /// [`MAX_WORKSPACE`].
+    pub fn reserve_constraints(&mut self, max_rows: usize) -> Result<(), OptimalError> {
+        if self
+            .horizon
+            .saturating_mul(max_rows)
+            .saturating_mul(self.nu + 1)
+            > MAX_WORKSPACE
+        {
+            return Err(OptimalError::InvalidSetting {
+                name: "constraint rows",
+                requirement: "small enough for horizon * rows * (n_u + 1) <= 2^25",
+                value: max_rows as f64,
+            });
+        }
+        if self.constrained.as_ref().map(ConstrainedWork::max_rows) != Some(max_rows) {
+            self.constrained = Some(ConstrainedWork::new(
+                self.nx,
+                self.nu,
+                self.horizon,
+                max_rows,
+            ));
+        }
+        Ok(())
     }
 
     /// The number of states `n_x`.
@@ -445,6 +479,50 @@ impl Ilqr {
         x0: &[f64],
         settings: &IlqrSettings,
     ) -> Result<IlqrReport, OptimalError> {
+        self.solve_with(dynamics, None, x0, settings)
+    }
+
+    /// [`solve`](Self::solve) with the general linear constraints `G u_k <= g` of
+    /// `constraints` on every step besides the box. The backward pass solves each step's QP
+    /// `min 1/2 d^T (Q_uu + mu I) d + Q_u^T d` subject to the step's rows (at the nominal state)
+    /// and the box by [`LinearQp`](crate::LinearQp), with the feedback gain restricted to
+    /// the directions that keep the active rows active; the forward pass moves every control
+    /// to the closest one within the rows at its own state ([`PolytopeProjection`](crate::PolytopeProjection)).
+    /// A step without rows is the box QP's, exactly. Needs
+    /// [`reserve_constraints`](Self::reserve_constraints) for `constraints.max_rows()` first.
+    ///
+    /// # Errors
+    /// As [`solve`](Self::solve); [`OptimalError::InvalidSetting`] without the reserved rows;
+    /// [`OptimalError::Infeasible`] when a step's rows admit no control at the nominal state;
+    /// the constraints' own errors.
+    pub fn solve_constrained<D: DiscreteDynamics + ?Sized>(
+        &mut self,
+        dynamics: &mut D,
+        constraints: &mut dyn StepConstraints,
+        x0: &[f64],
+        settings: &IlqrSettings,
+    ) -> Result<IlqrReport, OptimalError> {
+        let reserved = self
+            .constrained
+            .as_ref()
+            .map_or(0, ConstrainedWork::max_rows);
+        if reserved < constraints.max_rows() {
+            return Err(OptimalError::InvalidSetting {
+                name: "reserved constraint rows",
+                requirement: "at least the constraints' max_rows (Ilqr::reserve_constraints)",
+                value: reserved as f64,
+            });
+        }
+        self.solve_with(dynamics, Some(constraints), x0, settings)
+    }
+
+    fn solve_with<D: DiscreteDynamics + ?Sized>(
+        &mut self,
+        dynamics: &mut D,
+        mut constraints: Option<&mut (dyn StepConstraints + '_)>,
+        x0: &[f64],
+        settings: &IlqrSettings,
+    ) -> Result<IlqrReport, OptimalError> {
         self.check(dynamics, x0, settings)?;
         let steps = settings.line_search_steps;
         // The warm start, projected onto the box.
@@ -464,9 +542,19 @@ impl Ilqr {
         while iterations < settings.max_iterations {
             if !linearised {
                 self.linearise(dynamics)?;
+                if let (Some(c), Some(work)) = (constraints.as_deref_mut(), &mut self.constrained) {
+                    let (nx, nu) = (self.nx, self.nu);
+                    for k in 0..self.horizon {
+                        let x = &self.x[k * nx..(k + 1) * nx];
+                        let u = &self.u[k * nu..(k + 1) * nu];
+                        let b = &self.b[k * nx * nu..(k + 1) * nx * nu];
+                        work.evaluate(c, k, (x, u, b))?;
+                    }
+                }
                 linearised = true;
             }
-            let expected = match self.backward(mu, &settings.box_qp) {
+            let constrained = constraints.is_some();
+            let expected = match self.backward(mu, &settings.box_qp, constrained) {
                 Ok(expected) => expected,
                 Err(OptimalError::NotPositiveDefinite(_)) => {
                     if !increase(&mut mu, &mut delta, settings) {
@@ -487,7 +575,7 @@ impl Ilqr {
             let mut accepted = None;
             let mut alpha = 1.0;
             for _ in 0..steps {
-                let candidate = self.forward(dynamics, alpha);
+                let candidate = self.forward(dynamics, constraints.as_deref_mut(), alpha)?;
                 let predicted = -(alpha * expected[0] + alpha * alpha * expected[1]);
                 if candidate < cost && (cost - candidate) >= ACCEPTANCE * predicted {
                     accepted = Some(candidate);
@@ -662,7 +750,12 @@ impl Ilqr {
 
     /// The backward pass with regularisation `mu`: gains, feed-forward steps and the expected
     /// decrease terms `[sum k^T Q_u, 1/2 sum k^T Q_uu k]`.
-    fn backward(&mut self, mu: f64, qp: &BoxQpSettings) -> Result<[f64; 2], OptimalError> {
+    fn backward(
+        &mut self,
+        mu: f64,
+        qp: &BoxQpSettings,
+        constrained: bool,
+    ) -> Result<[f64; 2], OptimalError> {
         let (nx, nu, n) = (self.nx, self.nu, self.horizon);
         let cost = &self.cost;
         let mut expected = [0.0; 2];
@@ -706,20 +799,36 @@ impl Ilqr {
                 self.step_upper[j] = self.upper[j] - uj;
             }
             let ff = &mut self.feedforward[k * nu..(k + 1) * nu];
-            self.qp.solve(
-                &self.hessian,
-                &self.q_u,
-                &self.step_lower,
-                &self.step_upper,
-                ff,
-                qp,
-            )?;
-            // The gain on the free controls, zero on the clamped ones.
             let gain = &mut self.gain[k * nu * nx..(k + 1) * nu * nx];
-            gain.copy_from_slice(&self.q_ux);
-            self.qp.solve_free(gain, nx);
-            for g in gain.iter_mut() {
-                *g = -*g;
+            match &mut self.constrained {
+                Some(work) if constrained && work.counts[k] > 0 => {
+                    // The step's rows and the box: the general QP and the gain that keeps the
+                    // active rows active.
+                    work.feedforward(
+                        k,
+                        (&self.hessian, &self.q_u, &self.q_ux),
+                        u,
+                        (&self.lower, &self.upper),
+                        ff,
+                        gain,
+                    )?;
+                }
+                _ => {
+                    self.qp.solve(
+                        &self.hessian,
+                        &self.q_u,
+                        &self.step_lower,
+                        &self.step_upper,
+                        ff,
+                        qp,
+                    )?;
+                    // The gain on the free controls, zero on the clamped ones.
+                    gain.copy_from_slice(&self.q_ux);
+                    self.qp.solve_free(gain, nx);
+                    for g in gain.iter_mut() {
+                        *g = -*g;
+                    }
+                }
             }
             // The value function.
             multiply(&self.q_uu, gain, &mut self.quu_gain, nu, nu, nx);
@@ -751,9 +860,15 @@ impl Ilqr {
         Ok(expected)
     }
 
-    /// The forward pass at step length `alpha` into `x_try`, `u_try`; its cost (infinite if the
-    /// dynamics refuse a state on the way).
-    fn forward<D: DiscreteDynamics + ?Sized>(&mut self, dynamics: &mut D, alpha: f64) -> f64 {
+    /// The forward pass at step length `alpha` into `x_try`, `u_try`, every control moved within
+    /// the step's rows at its state when there are `constraints`; its cost (infinite if the
+    /// dynamics refuse a state on the way or a step's rows admit no control).
+    fn forward<D: DiscreteDynamics + ?Sized>(
+        &mut self,
+        dynamics: &mut D,
+        mut constraints: Option<&mut (dyn StepConstraints + '_)>,
+        alpha: f64,
+    ) -> Result<f64, OptimalError> {
         let (nx, nu) = (self.nx, self.nu);
         self.x_try[..nx].copy_from_slice(&self.x[..nx]);
         for k in 0..self.horizon {
@@ -765,6 +880,21 @@ impl Ilqr {
                 }
                 self.u_try[k * nu + j] = u.clamp(self.lower[j], self.upper[j]);
             }
+            if let (Some(c), Some(work)) = (constraints.as_deref_mut(), &mut self.constrained) {
+                let within = work.project(
+                    c,
+                    k,
+                    (
+                        &self.x_try[k * nx..(k + 1) * nx],
+                        &self.b[k * nx * nu..(k + 1) * nx * nu],
+                    ),
+                    (&self.lower, &self.upper),
+                    &mut self.u_try[k * nu..(k + 1) * nu],
+                )?;
+                if !within {
+                    return Ok(f64::INFINITY);
+                }
+            }
             let (past, future) = self.x_try.split_at_mut((k + 1) * nx);
             if dynamics
                 .step(
@@ -774,11 +904,11 @@ impl Ilqr {
                 )
                 .is_err()
             {
-                return f64::INFINITY;
+                return Ok(f64::INFINITY);
             }
         }
         let cost = self.trajectory_cost(&self.x_try, &self.u_try);
-        if cost.is_nan() { f64::INFINITY } else { cost }
+        Ok(if cost.is_nan() { f64::INFINITY } else { cost })
     }
 
     /// The tracking cost of a trajectory.

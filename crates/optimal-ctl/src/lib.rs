@@ -4,20 +4,24 @@ mod box_qp;
 pub mod dense;
 mod discrete;
 mod ilqr;
+mod joint_torque_rows;
 mod linear_qp;
 mod linearise;
 mod lqr;
 mod mpc;
 mod polytope;
+mod step_constraints;
 
 pub use box_qp::{BoxQp, BoxQpReport, BoxQpSettings};
 pub use discrete::{DiscreteDynamics, ReducedEuler};
 pub use ilqr::{Ilqr, IlqrReport, IlqrSettings, MAX_HORIZON, MAX_WORKSPACE, TrackingCost};
+pub use joint_torque_rows::JointTorqueRows;
 pub use linear_qp::{LinearQp, LinearQpFailure};
 pub use linearise::Linearisation;
 pub use lqr::{Lqr, LqrSettings};
 pub use mpc::{MAX_MPC_HORIZON, Mpc, MpcSettings};
 pub use polytope::{PolytopeProjection, ProjectionFailure};
+pub use step_constraints::StepConstraints;
 
 use lane_math::{Classify, ErrorClass};
 use modal_reduce::ReduceError;
@@ -66,6 +70,12 @@ pub enum OptimalError {
     /// A matrix that must be positive definite (`R + B^T P B`) was not, numerically.
     #[error("{0} is not numerically positive definite")]
     NotPositiveDefinite(&'static str),
+    /// The constraints of a step ([`StepConstraints`]) admit no control at its state.
+    #[error("the constraints of step {step} admit no control")]
+    Infeasible {
+        /// The step (0-based).
+        step: usize,
+    },
 }
 
 impl Classify for OptimalError {
@@ -76,7 +86,9 @@ impl Classify for OptimalError {
     fn class(&self) -> ErrorClass {
         match self {
             Self::Dynamics(e) => e.class(),
-            Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) => ErrorClass::Numerical,
+            Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) | Self::Infeasible { .. } => {
+                ErrorClass::Numerical
+            }
             _ => ErrorClass::InvalidInput,
         }
     }

@@ -7,6 +7,7 @@ use modal_reduce::{Plant, PlantData, PlantDerivatives};
 use super::OptimalError;
 use super::discrete::{ReducedEuler, check_step};
 use super::ilqr::{Ilqr, IlqrReport, IlqrSettings, TrackingCost};
+use super::step_constraints::StepConstraints;
 
 /// The settings of [`Mpc`]: horizon, model step, the weights of the tracking cost and the
 /// `tau*` limits.
@@ -304,7 +305,36 @@ impl Mpc {
         a: &[f64],
         a_dot: &[f64],
     ) -> Result<IlqrReport, OptimalError> {
-        let (m, model) = (self.m, model.into());
+        self.plan(model.into(), a, a_dot, None)
+    }
+
+    /// Plans as [`solve`](Self::solve) does within the general linear constraints of
+    /// `constraints` at every node besides the `tau*` box ([`Ilqr::solve_constrained`]): the
+    /// joint-torque polytope ([`JointTorqueRows`](crate::JointTorqueRows)), or joint limits and
+    /// clearances linearised through the step's `B`. The first call sizes the solver's
+    /// constraint memory (allocates); later calls with as many rows do not.
+    ///
+    /// # Errors
+    /// As [`solve`](Self::solve); [`OptimalError::Infeasible`] when a node's rows admit no
+    /// torque at its planned state.
+    pub fn solve_constrained<'p>(
+        &mut self,
+        model: impl Into<Plant<'p>>,
+        a: &[f64],
+        a_dot: &[f64],
+        constraints: &mut dyn StepConstraints,
+    ) -> Result<IlqrReport, OptimalError> {
+        self.plan(model.into(), a, a_dot, Some(constraints))
+    }
+
+    fn plan(
+        &mut self,
+        model: Plant<'_>,
+        a: &[f64],
+        a_dot: &[f64],
+        constraints: Option<&mut (dyn StepConstraints + '_)>,
+    ) -> Result<IlqrReport, OptimalError> {
+        let m = self.m;
         if model.n_coords() != m {
             return Err(OptimalError::Dimension {
                 name: "model coordinates",
@@ -328,7 +358,14 @@ impl Mpc {
         self.state[m..].copy_from_slice(a_dot);
         let mut dynamics =
             ReducedEuler::new(model, &mut self.data, &mut self.derivatives, self.step)?;
-        let report = self.ilqr.solve(&mut dynamics, &self.state, &self.solver)?;
+        let report = match constraints {
+            None => self.ilqr.solve(&mut dynamics, &self.state, &self.solver)?,
+            Some(rows) => {
+                self.ilqr.reserve_constraints(rows.max_rows())?;
+                self.ilqr
+                    .solve_constrained(&mut dynamics, rows, &self.state, &self.solver)?
+            }
+        };
         self.planned = true;
         Ok(report)
     }

@@ -7,9 +7,9 @@ use manip_dyn::spatial::{SpatialJoint, SpatialLink, SpatialModel, Transform};
 /// The chain's dynamics model under gravity `[gx, gy, gz]` (m/s^2, base frame; URDF carries
 /// none, ROS's convention is `[0, 0, -9.81]`): joint origins as `Transform::from_rpy`, each
 /// body's inertia rotated from its `<inertial>` frame into the link frame (`R I R^T`), the
-/// base's mass ignored (it does not move). `manip-dyn` needs a positive mass on every moving
-/// link: a massless link (the middle of a universal joint written as two revolute joints) is
-/// refused, naming it.
+/// base's mass ignored (it does not move). A massless link (the middle of a universal joint
+/// written as two revolute joints) is kept as it is: `manip-dyn`'s forward dynamics refuse, naming
+/// the joint, only a joint that moves nothing with mass (`DynError::SingularJoint`).
 pub fn to_spatial(robot: &Robot, gravity: [f64; 3]) -> Result<SpatialModel, DescError> {
     let mut joints = Vec::with_capacity(robot.n_joints());
     let mut links = Vec::with_capacity(robot.n_joints());

@@ -1,15 +1,18 @@
-//! A planar closed-loop run of `sim-core` as a [`RunView`]: the arm's points from the recorded
-//! modal coordinates through the scenario's modal map (eq 8) and the chain's forward kinematics,
-//! and the series a reader checks first.
+//! A closed-loop run of `sim-core` (a planar or a spatial arm) as a [`RunView`]: the arm's points
+//! from the recorded modal coordinates through the scenario's modal map (eq 8) and the chain's
+//! forward kinematics, and the series a reader checks first.
 
 use crate::error::ViewError;
 use crate::view::{RunView, Series};
+use modal_reduce::PlantModel;
 use sim_core::Record;
 use sim_study::{Scenario, TorqueLimit};
 
 /// The run `record` of `scenario` under the controller named `label`: every sample's joint
-/// positions (`theta = J a + theta_0`, eq 8, then the chain from the base at the origin), the
-/// reference tip, the joint torques (eq 13) against the scenario's joint torque limits, and the
+/// positions (`theta = J a + theta_0`, eq 8, then the chain from the base at the origin; for a
+/// spatial arm the universal-joint chain from its base pose, in 3-D), the reference tip, the
+/// joint torques (eq 13; a spatial link's the magnitude of its universal joint's two) against
+/// the scenario's joint torque limits (a spatial arm's against the run's peak), and the
 /// series tip error (mm), modal coordinates with their references (rad) and `tau*` (N m) (the
 /// viewer adds the panel of the joint torques itself, from the torques that colour the links). `stopped` is why a run stopped early.
 pub fn from_record(
@@ -18,30 +21,59 @@ pub fn from_record(
     record: &Record,
     stopped: Option<&str>,
 ) -> Result<RunView, ViewError> {
-    let model = scenario.model()?;
-    let lengths: Vec<f64> = model.chain().link_lengths().collect();
-    let n = lengths.len();
+    let plant = scenario.plant()?;
+    // Links, joints and the arm's dimensions.
+    let (n, n_joints, dims) = match &plant {
+        PlantModel::Planar(model) => (model.n_links(), model.n_links(), 2),
+        PlantModel::Spatial(model) => (model.n_links(), 2 * model.n_links(), 3),
+    };
     let (m, samples) = (record.n_coords, record.len());
-    if record.n_joints != n || record.a.len() != samples * m || record.tip.len() != samples {
+    if record.n_joints != n_joints
+        || record.a.len() != samples * m
+        || record.tip.len() != samples
+        || record.tip_z.len() != samples
+    {
         return Err(ViewError::RecordMismatch {
             scenario: scenario.name.clone(),
             joints: record.n_joints,
             samples,
         });
     }
-    let mut theta = vec![0.0; n];
-    let mut points = vec![[0.0; 2]; n + 1];
+    let mut theta = vec![0.0; n_joints];
     let mut joints = Vec::with_capacity(samples);
-    for k in 0..samples {
-        model.map().joint_angles(record.a_at(k), &mut theta)?;
-        backbone_kin::joint_positions(&lengths, &theta, &mut points)?;
-        joints.push(points.iter().flatten().copied().collect());
+    match &plant {
+        PlantModel::Planar(model) => {
+            let lengths: Vec<f64> = model.chain().link_lengths().collect();
+            let mut points = vec![[0.0; 2]; n + 1];
+            for k in 0..samples {
+                model.map().joint_angles(record.a_at(k), &mut theta)?;
+                backbone_kin::joint_positions(&lengths, &theta, &mut points)?;
+                joints.push(points.iter().flatten().copied().collect());
+            }
+        }
+        PlantModel::Spatial(model) => {
+            let map = model.map();
+            let mut points = vec![[0.0; 3]; n + 1];
+            for k in 0..samples {
+                map.joint_angles(record.a_at(k), &mut theta)?;
+                backbone_kin::spatial_joint_positions(
+                    map.link_lengths(),
+                    model.base(),
+                    &theta,
+                    &mut points,
+                )?;
+                joints.push(points.iter().flatten().copied().collect());
+            }
+        }
     }
     let names = scenario.coordinate_names();
+    // In the plane z is zero and `hypot(d, 0) = |d|`.
     let tip_error = (0..samples)
         .map(|k| {
             let (tip, reference) = (record.tip[k], record.tip_ref[k]);
-            1e3 * (tip[0] - reference[0]).hypot(tip[1] - reference[1])
+            1e3 * (tip[0] - reference[0])
+                .hypot(tip[1] - reference[1])
+                .hypot(record.tip_z[k] - record.tip_ref_z[k])
         })
         .collect();
     let modal = |series: fn(&Record, usize) -> &[f64], i: usize| -> Vec<f64> {
@@ -61,8 +93,16 @@ pub fn from_record(
             .values
             .extend([modal(Record::a_at, i), modal(Record::a_ref_at, i)]);
     }
+    // A link's torque: its joint's, or the magnitude of its universal joint's two.
     let joint_torque: Vec<Vec<f64>> = (0..samples)
-        .map(|k| record.joint_torques_at(k).to_vec())
+        .map(|k| match dims {
+            2 => record.joint_torques_at(k).to_vec(),
+            _ => record
+                .joint_torques_at(k)
+                .chunks_exact(2)
+                .map(|pair| pair[0].hypot(pair[1]))
+                .collect(),
+        })
         .collect();
     let series = vec![
         Series {
@@ -79,18 +119,30 @@ pub fn from_record(
             values: (0..m).map(|i| modal(Record::tau_star_at, i)).collect(),
         },
     ];
-    let torque_limit = match &scenario.limits.joint_torque_nm {
-        Some(TorqueLimit::All(limit)) => vec![*limit; n],
-        Some(TorqueLimit::PerJoint(limits)) => limits.clone(),
-        None => Vec::new(),
+    // A spatial arm's links are coloured against the run's peak torque.
+    let torque_limit = match (&scenario.limits.joint_torque_nm, dims) {
+        (Some(TorqueLimit::All(limit)), 2) => vec![*limit; n],
+        (Some(TorqueLimit::PerJoint(limits)), 2) => limits.clone(),
+        _ => Vec::new(),
     };
     let view = RunView {
         label: label.to_owned(),
-        dims: 2,
+        dims,
         t: record.t.clone(),
         joints,
-        tip_ref: record.tip_ref.iter().map(|p| p.to_vec()).collect(),
-        joint_torque: if record.joint_torques.len() == samples * n {
+        tip_ref: record
+            .tip_ref
+            .iter()
+            .zip(&record.tip_ref_z)
+            .map(|(p, &z)| {
+                if dims == 2 {
+                    p.to_vec()
+                } else {
+                    vec![p[0], p[1], z]
+                }
+            })
+            .collect(),
+        joint_torque: if record.joint_torques.len() == samples * n_joints {
             joint_torque
         } else {
             Vec::new()

@@ -20,6 +20,7 @@ use crate::error::{SimError, check_finite, check_positive};
 use crate::ode::{OdeSystem, Rk4};
 use crate::reference::{Reference, ReferenceSample};
 use crate::simulation::{MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS};
+use lane_math::Compact;
 use manip_dyn::DynError;
 use manip_dyn::spatial::{SpatialData, SpatialModel, aba, rnea};
 
@@ -113,7 +114,8 @@ fn check(settings: &ChainLoopSettings, n: usize) -> Result<usize, SimError> {
             "integrator.dt",
             format!(
                 "must be at most the controller period {} s, got {}",
-                settings.period, settings.dt
+                Compact(settings.period),
+                Compact(settings.dt)
             ),
         ));
     }
@@ -142,10 +144,13 @@ fn check(settings: &ChainLoopSettings, n: usize) -> Result<usize, SimError> {
         return Err(SimError::setting(
             "duration",
             format!(
-                "= {} s takes {periods} controller samples and {steps} RK4 steps recording \
-                 {recorded} values, past the loop's limits ({MAX_CONTROLLER_SAMPLES}, \
+                "= {} s takes {} controller samples and {} RK4 steps recording {} values, \
+                 past the loop's limits ({MAX_CONTROLLER_SAMPLES}, \
                  {MAX_RK4_STEPS}, {MAX_RECORDED_VALUES})",
-                settings.duration
+                Compact(settings.duration),
+                Compact(periods),
+                Compact(steps),
+                Compact(recorded)
             ),
         ));
     }

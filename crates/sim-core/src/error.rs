@@ -1,6 +1,6 @@
 //! The error types of this crate.
 
-use lane_math::{Classify, ErrorClass};
+use lane_math::{Classify, Compact, ErrorClass};
 
 use crate::ode::OdeError;
 use backbone_kin::KinError;
@@ -32,7 +32,10 @@ pub enum SimError {
         requirement: String,
     },
     /// A point of a Cartesian reference path cannot be reached by the backbone curve.
-    #[error("the reference path point ({x:.6}, {y:.6}) at t = {t} s is unreachable: {source}")]
+    #[error(
+        "the reference path point ({x:.6}, {y:.6}) at t = {} s is unreachable: {source}",
+        Compact(*.t)
+    )]
     Unreachable {
         /// Time on the path (s).
         t: f64,
@@ -61,11 +64,40 @@ pub enum SimError {
         /// The point's `y` (m).
         y: f64,
     },
+    /// A point of a spatial arm's tip path cannot be reached by its chain.
+    #[error(
+        "the reference path point ({:.6}, {:.6}, {:.6}) at t = {t} s is unreachable: {source}",
+        point[0], point[1], point[2]
+    )]
+    UnreachableInSpace {
+        /// Time on the path (s).
+        t: f64,
+        /// The point (m).
+        point: [f64; 3],
+        /// Which reachability condition failed.
+        source: KinError,
+    },
+    /// A spatial arm's tip path passes through a singular point of the chain's inverse
+    /// kinematics (the tip cannot move in some direction), where the modal rate is undefined.
+    #[error(
+        "the reference path passes through a singular point of the inverse kinematics near \
+         t = {t} s at ({:.6}, {:.6}, {:.6}): {what}, where the modal reference rate is undefined; \
+         move the path or the base",
+        point[0], point[1], point[2]
+    )]
+    SingularPointInSpace {
+        /// Which singularity.
+        what: &'static str,
+        /// Time on the path (s).
+        t: f64,
+        /// The point (m).
+        point: [f64; 3],
+    },
     /// The kinematics refused a computation.
     #[error("kinematics: {0}")]
     Kinematics(#[from] KinError),
     /// The reduced dynamics refused a computation (outside of the integrator).
-    #[error("reduced dynamics at t = {t} s: {source}")]
+    #[error("reduced dynamics at t = {} s: {source}", Compact(*.t))]
     Dynamics {
         /// When (s).
         t: f64,
@@ -83,7 +115,7 @@ pub enum SimError {
     Integration(OdeError<ReduceError>),
     /// The spatial chain's dynamics refused a computation at a controller sample (the joint-space
     /// loop of a URDF arm, [`run_chain_loop`](crate::run_chain_loop)).
-    #[error("chain dynamics at t = {t} s: {source}")]
+    #[error("chain dynamics at t = {} s: {source}", Compact(*.t))]
     ChainDynamics {
         /// When (s).
         t: f64,
@@ -95,7 +127,10 @@ pub enum SimError {
     #[error("integration diverged: {0}")]
     ChainIntegration(OdeError<manip_dyn::DynError>),
     /// The controller produced a NaN or infinite torque.
-    #[error("the controller produced a non-finite modal torque {tau_star:?} at t = {t} s")]
+    #[error(
+        "the controller produced a non-finite modal torque {tau_star:?} at t = {} s",
+        Compact(*.t)
+    )]
     NonFiniteControl {
         /// When (s).
         t: f64,
@@ -104,7 +139,10 @@ pub enum SimError {
     },
     /// A disturbance hook ([`LoopHooks`](crate::LoopHooks)) produced a NaN or infinite joint
     /// torque.
-    #[error("the disturbance hook produced a non-finite joint torque {tau:?} at t = {t} s")]
+    #[error(
+        "the disturbance hook produced a non-finite joint torque {tau:?} at t = {} s",
+        Compact(*.t)
+    )]
     NonFiniteDisturbance {
         /// When (s).
         t: f64,
@@ -112,7 +150,7 @@ pub enum SimError {
         tau: Vec<f64>,
     },
     /// A controller failed with an error of its own (one that is not a [`SimError`]).
-    #[error("the controller failed at t = {t} s: {source}")]
+    #[error("the controller failed at t = {} s: {source}", Compact(*.t))]
     Controller {
         /// When (s).
         t: f64,
@@ -121,8 +159,11 @@ pub enum SimError {
     },
     /// A modal tracking error grew beyond the configured bound.
     #[error(
-        "runaway tracking error at t = {t} s: |a{coordinate} - a{coordinate}_ref| = {error:.4} rad \
-         exceeds the bound {bound} rad"
+        "runaway tracking error at t = {} s: |a{coordinate} - a{coordinate}_ref| = {} rad exceeds \
+         the bound {} rad",
+        Compact(*.t),
+        Compact(*.error),
+        Compact(*.bound)
     )]
     RunawayError {
         /// When (s).
@@ -133,6 +174,15 @@ pub enum SimError {
         error: f64,
         /// The bound in force (rad).
         bound: f64,
+    },
+    /// The enforced joint limits (`limits.joint_torque_nm`, `limits.joint_angle_rad`) could not
+    /// be met at a controller sample: no modal torque keeps them at that state.
+    #[error("joint limits at t = {t} s: {reason}")]
+    JointLimits {
+        /// When (s).
+        t: f64,
+        /// Why.
+        reason: &'static str,
     },
 }
 
@@ -167,7 +217,7 @@ impl Classify for SimError {
     /// own class; otherwise a setting, file or model was outside its domain.
     fn class(&self) -> ErrorClass {
         match self {
-            Self::Unreachable { .. } => ErrorClass::Unreachable,
+            Self::Unreachable { .. } | Self::UnreachableInSpace { .. } => ErrorClass::Unreachable,
             Self::Kinematics(e) => e.class(),
             Self::Dynamics { source, .. } | Self::Model(source) => source.class(),
             Self::Fuzzy(e) => e.class(),
@@ -177,7 +227,8 @@ impl Classify for SimError {
             | Self::NonFiniteControl { .. }
             | Self::NonFiniteDisturbance { .. }
             | Self::Controller { .. }
-            | Self::RunawayError { .. } => ErrorClass::Numerical,
+            | Self::RunawayError { .. }
+            | Self::JointLimits { .. } => ErrorClass::Numerical,
             _ => ErrorClass::InvalidInput,
         }
     }
@@ -212,7 +263,7 @@ pub(crate) fn check_positive(name: &str, value: f64) -> Result<(), SimError> {
     } else {
         Err(SimError::setting(
             name,
-            format!("must be positive and finite, got {}", Readable(value)),
+            format!("must be positive and finite, got {}", Compact(value)),
         ))
     }
 }
@@ -224,7 +275,7 @@ pub(crate) fn check_non_negative(name: &str, value: f64) -> Result<(), SimError>
     } else {
         Err(SimError::setting(
             name,
-            format!("must be non-negative and finite, got {}", Readable(value)),
+            format!("must be non-negative and finite, got {}", Compact(value)),
         ))
     }
 }
@@ -234,44 +285,9 @@ pub(crate) fn check_non_negative(name: &str, value: f64) -> Result<(), SimError>
 pub fn check_finite(name: &str, values: &[f64]) -> Result<(), SimError> {
     match lane_math::first_non_finite(values) {
         None => Ok(()),
-        Some((_, v)) => Err(SimError::setting(name, format!("must be finite, got {v}"))),
-    }
-}
-
-/// A number in an error message as a person reads it: plain decimals from `1e-4` up to `1e15`
-/// (`0.001`, `-0.5`, `250`), exponents beyond (`1e-300`, `1e300`), never a 300-digit decimal.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Readable(pub f64);
-
-impl fmt::Display for Readable {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let magnitude = self.0.abs();
-        if self.0 == 0.0 || !self.0.is_finite() || (1e-4..1e15).contains(&magnitude) {
-            write!(f, "{}", self.0)
-        } else {
-            write!(f, "{:e}", self.0)
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::Readable;
-
-    #[test]
-    fn numbers_are_readable() {
-        for (x, text) in [
-            (0.0, "0"),
-            (-0.5, "-0.5"),
-            (0.001, "0.001"),
-            (250.0, "250"),
-            (1e-300, "1e-300"),
-            (-1e300, "-1e300"),
-            (f64::MAX, "1.7976931348623157e308"),
-            (f64::NAN, "NaN"),
-            (f64::INFINITY, "inf"),
-        ] {
-            assert_eq!(Readable(x).to_string(), text);
-        }
+        Some((_, v)) => Err(SimError::setting(
+            name,
+            format!("must be finite, got {}", Compact(v)),
+        )),
     }
 }

@@ -17,8 +17,8 @@ pub use chain_loop::{ChainLoopSettings, ChainRecord, ChainRun, ChainSummary, run
 pub use error::{ControllerFailure, SimError, check_finite};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use simulation::{
-    ControlSample, ControllerFactory, Integrator, Lockstep, LoopHooks, LoopSettings,
-    MAX_CONTROLLER_SAMPLES, MAX_LOOP_WORK, MAX_RECORDED_VALUES, MAX_RK4_STEPS, NoHooks,
-    Observation, Prepared, ReferenceFactory, Run, RunFailure, RunNoise, Simulation,
+    ControlSample, ControllerFactory, Integrator, JOINT_ANGLE_APPROACH_S, Lockstep, LoopHooks,
+    LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_LOOP_WORK, MAX_RECORDED_VALUES, MAX_RK4_STEPS,
+    NoHooks, Observation, Prepared, ReferenceFactory, Run, RunFailure, RunNoise, Simulation,
     check_loop_work,
 };

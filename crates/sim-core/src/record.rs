@@ -43,6 +43,12 @@ pub struct Record {
     /// Joint torques `tau = M J a_dd + C + G` (eq 13) at the sample, `n_joints` per sample,
     /// row-major (N m).
     pub joint_torques: Vec<f64>,
+    /// The chain's points at the sample, [`n_points`](Self::n_points) per sample: the base, then
+    /// the distal end of every link (the last is the tip), `[x, y, z]` with `z = 0` for a planar
+    /// arm (m). The clearance is measured from exactly these points (`links.csv`).
+    pub joint_points: Vec<[f64; 3]>,
+    /// Points per sample in [`joint_points`](Self::joint_points): the links plus one.
+    pub n_points: usize,
 }
 
 impl Record {
@@ -62,6 +68,14 @@ impl Record {
     /// If `k >= len()`, like slice indexing.
     pub fn joint_torques_at(&self, k: usize) -> &[f64] {
         &self.joint_torques[k * self.n_joints..(k + 1) * self.n_joints]
+    }
+
+    /// The chain's points at sample `k`, base to tip (m).
+    ///
+    /// # Panics
+    /// If `k >= len()`, like slice indexing.
+    pub fn joint_points_at(&self, k: usize) -> &[[f64; 3]] {
+        &self.joint_points[k * self.n_points..(k + 1) * self.n_points]
     }
 
     /// Row `k` of a modal series (`m` numbers).
@@ -122,12 +136,18 @@ pub(crate) struct Sample<'a> {
 
 impl Record {
     /// The values one recorded sample holds: `t`, seven modal series of `n_coords` (the
-    /// clamping flags counted as one value each), two tips of three coordinates, and a torque per joint.
-    pub(crate) fn values_per_sample(n_coords: usize, n_joints: usize) -> usize {
-        7 + 7 * n_coords + n_joints
+    /// clamping flags counted as one value each), two tips of three coordinates, a torque per
+    /// joint and three coordinates per chain point.
+    pub(crate) fn values_per_sample(n_coords: usize, n_joints: usize, n_points: usize) -> usize {
+        7 + 7 * n_coords + n_joints + 3 * n_points
     }
 
-    pub(crate) fn with_capacity(n_coords: usize, n_joints: usize, samples: usize) -> Self {
+    pub(crate) fn with_capacity(
+        n_coords: usize,
+        n_joints: usize,
+        n_points: usize,
+        samples: usize,
+    ) -> Self {
         let series = || Vec::with_capacity(samples * n_coords);
         Self {
             n_joints,
@@ -145,10 +165,12 @@ impl Record {
             tip_z: Vec::with_capacity(samples),
             tip_ref_z: Vec::with_capacity(samples),
             joint_torques: Vec::with_capacity(samples * n_joints),
+            joint_points: Vec::with_capacity(samples * n_points),
+            n_points,
         }
     }
 
-    pub(crate) fn push(&mut self, s: &Sample<'_>, joint_torques: &[f64]) {
+    pub(crate) fn push(&mut self, s: &Sample<'_>, joint_torques: &[f64], points: &[[f64; 3]]) {
         self.t.push(s.t);
         self.a.extend_from_slice(s.a);
         self.a_dot.extend_from_slice(s.a_dot);
@@ -162,6 +184,7 @@ impl Record {
         self.tip_z.push(s.tip[2]);
         self.tip_ref_z.push(s.tip_ref[2]);
         self.joint_torques.extend_from_slice(joint_torques);
+        self.joint_points.extend_from_slice(points);
     }
 }
 
@@ -225,8 +248,24 @@ pub struct Summary {
     /// Per coordinate, the fraction of controller samples (from 0 to 1) at which the actuator
     /// limit `limits.tau_star` clamped the controller's output (zeros without limits).
     pub tau_star_clamped_fraction: Vec<f64>,
-    /// Joints whose torque limit was exceeded (empty without limits or violations).
+    /// Joints whose torque limit was exceeded (empty without limits or violations). The limits
+    /// are enforced at every controller sample, so with them an entry means a joint torque the
+    /// projection could not keep within them (rounding), never a controller left unchecked.
     pub torque_limit_exceeded: Vec<TorqueLimitExceeded>,
+    /// The fraction of controller samples (from 0 to 1) at which the enforced joint limits
+    /// (`limits.joint_torque_nm`, `limits.joint_angle_rad`) moved the controller's `tau*`;
+    /// absent without them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub torque_projection_share: Option<f64>,
+    /// The smallest clearance between a link's capsule and an obstacle over every controller
+    /// sample (m; negative in contact); absent without obstacles.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min_clearance_m: Option<f64>,
+    /// The smallest clearance between two links that share no joint over every controller
+    /// sample (m; negative where they cross); absent without `arm.radius` or obstacles, or for
+    /// an arm of fewer than three links.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min_self_clearance_m: Option<f64>,
 }
 
 /// Running sums behind a [`Summary`].
@@ -245,10 +284,21 @@ pub(crate) struct Metrics {
     clamped: Vec<usize>,
     limits: Option<Vec<f64>>,
     exceeded: Vec<Option<TorqueLimitExceeded>>,
+    /// Controller samples at which the joint limits acted, when they are enforced.
+    projected: Option<usize>,
+    min_clearance: Option<f64>,
+    min_self_clearance: Option<f64>,
 }
 
 impl Metrics {
-    pub(crate) fn new(n_coords: usize, n_joints: usize, limits: Option<Vec<f64>>) -> Self {
+    /// Sums for `n_coords` coordinates and `n_joints` joints, checking the joint torques against
+    /// `limits`; `projecting` when the loop enforces joint limits.
+    pub(crate) fn new(
+        n_coords: usize,
+        n_joints: usize,
+        limits: Option<Vec<f64>>,
+        projecting: bool,
+    ) -> Self {
         Self {
             controller_samples: 0,
             samples: 0,
@@ -263,7 +313,29 @@ impl Metrics {
             clamped: vec![0; n_coords],
             limits,
             exceeded: vec![None; n_joints],
+            projected: projecting.then_some(0),
+            min_clearance: None,
+            min_self_clearance: None,
         }
+    }
+
+    /// Counts a controller sample at which the joint limits moved `tau*`.
+    pub(crate) fn add_projection(&mut self, acted: bool) {
+        if let Some(count) = &mut self.projected {
+            *count += usize::from(acted);
+        }
+    }
+
+    /// Counts a controller sample's smallest clearances to the obstacles and to the arm itself
+    /// (`None` for a kind of pair the model does not have).
+    pub(crate) fn add_clearance(&mut self, to_obstacles: Option<f64>, to_itself: Option<f64>) {
+        let lower = |least: &mut Option<f64>, value: Option<f64>| {
+            if let Some(v) = value {
+                *least = Some(least.map_or(v, |l| l.min(v)));
+            }
+        };
+        lower(&mut self.min_clearance, to_obstacles);
+        lower(&mut self.min_self_clearance, to_itself);
     }
 
     /// Counts the controller sample at `t` whose torque `tau_star` (with its clamping flags and
@@ -355,6 +427,11 @@ impl Metrics {
                 .map(|&c| c as f64 / self.controller_samples.max(1) as f64)
                 .collect(),
             torque_limit_exceeded,
+            torque_projection_share: self
+                .projected
+                .map(|count| count as f64 / self.controller_samples.max(1) as f64),
+            min_clearance_m: self.min_clearance,
+            min_self_clearance_m: self.min_self_clearance,
         }
     }
 }

@@ -3,21 +3,26 @@
 //! output held in between (zero-order hold).
 
 use crate::controller::{ControlContext, Controller, ModalState};
-use crate::error::{Readable, SimError, check_finite, check_non_negative, check_positive};
+use crate::error::{SimError, check_finite, check_non_negative, check_positive};
 use crate::noise::GaussianNoise;
 use crate::ode::{DormandPrince, OdeSystem, Rk4, Stats, Tolerances};
 use crate::record::{Metrics, Record, Sample, Summary};
 use crate::reference::continuation::Family;
 use crate::reference::{Reference, ReferenceSample};
 use backbone_kin::BaseAngle;
+use clearance::{ClearanceData, ClearanceModel};
+use lane_math::Compact;
+use limits::LimitProjection;
 use modal_reduce::{Plant, PlantData, PlantModel, ReduceError};
 use std::sync::Arc;
 
 mod hooks;
+mod limits;
 mod lockstep;
 mod prepared;
 
 pub use hooks::{LoopHooks, NoHooks};
+pub use limits::JOINT_ANGLE_APPROACH_S;
 pub use lockstep::Lockstep;
 pub use prepared::{ControllerFactory, Prepared, ReferenceFactory, RunNoise};
 
@@ -63,14 +68,25 @@ pub struct LoopSettings {
     pub sensor_noise_std: Vec<f64>,
     /// A run stops with [`SimError::RunawayError`] when `|a_i - a_i_ref|` exceeds this (rad).
     pub max_modal_error: f64,
-    /// Optional per-joint torque limits (N m): exceeding one is reported in the summary.
+    /// Optional per-joint torque limits (N m), enforced: at every controller sample the
+    /// (saturated) `tau*` is projected onto the modal torques whose joint torques at the
+    /// sample's state are within them (`docs/theory.md`, "Enforced joint limits"); the summary
+    /// reports how often the projection acted and checks the joint torques at every sample.
     pub joint_torque_limits: Option<Vec<f64>>,
+    /// Optional per-joint angle limits (rad, `|theta_j| <= limit_j`, `theta = J a + theta_0`),
+    /// enforced in the same projection: every joint's predicted rate at the next sample is kept
+    /// at most `(limit_j - theta_j) / T` towards its limit ([`JOINT_ANGLE_APPROACH_S`]). The
+    /// initial state must be within them.
+    pub joint_angle_limits: Option<Vec<f64>>,
     /// Optional limits on the modal forces `tau*` (N m, `m` entries, finite and positive; not joint torques):
     /// every controller's output is clamped to `[-limit_i, limit_i]` before it is applied
     /// (the clamped torque is what is held, recorded and summed into the effort), and each
     /// sample records which coordinates were clamped. Controllers see them in
     /// [`ControlContext::tau_star_limits`].
     pub tau_star_limits: Option<Vec<f64>>,
+    /// Optional links and obstacles: the arm's clearance to the obstacles and to itself is
+    /// measured at every controller sample, and its smallest values reported in the summary.
+    pub clearance: Option<ClearanceModel>,
 }
 
 impl LoopSettings {
@@ -86,7 +102,9 @@ impl LoopSettings {
             sensor_noise_std: Vec::new(),
             max_modal_error: std::f64::consts::PI,
             joint_torque_limits: None,
+            joint_angle_limits: None,
             tau_star_limits: None,
+            clearance: None,
         }
     }
 }
@@ -102,7 +120,7 @@ pub struct Run {
 
 /// A run that had to stop, with everything recorded before it did.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{error} (data kept up to t = {} s)", summary.simulated_s)]
+#[error("{error} (data kept up to t = {} s)", Compact(summary.simulated_s))]
 pub struct RunFailure {
     /// Why and when the run stopped.
     pub error: SimError,
@@ -170,11 +188,19 @@ impl OdeSystem for Dynamics {
 /// Where the tips come from: for a planar arm the chain's tip and the backbone curve's end at
 /// the reference (eqs 3-4); for a spatial arm the chain's tip at the state and at the reference
 /// (the spatial curve has no closed form, and the continuation tracks the chain's tip).
-enum Tips {
+/// Either places the chain's `n + 1` points, from which the tip is the last.
+struct Tips {
+    kind: TipKind,
+    /// The chain's points at the state placed last, base to tip (`z = 0` in the plane).
+    points: Vec<[f64; 3]>,
+}
+
+enum TipKind {
     Planar {
         family: Box<Family>,
         link_lengths: Vec<f64>,
         theta: Vec<f64>,
+        planar: Vec<[f64; 2]>,
     },
     Spatial {
         theta: Vec<f64>,
@@ -183,7 +209,7 @@ enum Tips {
 
 impl Tips {
     fn new(model: &PlantModel) -> Result<Self, SimError> {
-        Ok(match model {
+        let kind = match model {
             PlantModel::Planar(model) => {
                 let link_lengths: Vec<f64> = model.chain().link_lengths().collect();
                 let curve_length = link_lengths.iter().sum();
@@ -192,53 +218,80 @@ impl Tips {
                     BaseAngle::Fixed(alpha0) => Some(alpha0),
                     BaseAngle::Free => None,
                 };
-                Tips::Planar {
+                TipKind::Planar {
                     family: Box::new(Family::new(curve_length, map.harmonics(), fixed)?),
                     link_lengths,
                     theta: vec![0.0; model.n_links()],
+                    planar: vec![[0.0; 2]; model.n_links() + 1],
                 }
             }
-            PlantModel::Spatial(model) => Tips::Spatial {
+            PlantModel::Spatial(model) => TipKind::Spatial {
                 theta: vec![0.0; 2 * model.n_links()],
             },
+        };
+        Ok(Self {
+            kind,
+            points: vec![[0.0; 3]; model.plant().n_links() + 1],
         })
     }
 
-    /// The tip at `a` and the reference tip at `a_ref`, `[x, y, z]` (`z = 0` in the plane).
+    /// Places the chain at `a` into [`points`](Self::points): through the same forward
+    /// kinematics as its tip, so that the last point is the tip bit for bit.
+    fn place(&mut self, model: &PlantModel, a: &[f64]) -> Result<(), SimError> {
+        match (&mut self.kind, model) {
+            (
+                TipKind::Planar {
+                    link_lengths,
+                    theta,
+                    planar,
+                    ..
+                },
+                PlantModel::Planar(model),
+            ) => {
+                model.map().joint_angles(a, theta)?;
+                backbone_kin::joint_positions(link_lengths, theta, planar)?;
+                for (point, p) in self.points.iter_mut().zip(planar.iter()) {
+                    *point = [p[0], p[1], 0.0];
+                }
+            }
+            (TipKind::Spatial { theta }, PlantModel::Spatial(model)) => {
+                let map = model.map();
+                map.joint_angles(a, theta)?;
+                backbone_kin::spatial_joint_positions(
+                    map.link_lengths(),
+                    model.base(),
+                    theta,
+                    &mut self.points,
+                )?;
+            }
+            _ => unreachable!("the tips are built for the simulation's own model"),
+        }
+        Ok(())
+    }
+
+    /// The tip at `a` (the chain placed there, [`place`](Self::place)) and the reference tip
+    /// at `a_ref`, `[x, y, z]` (`z = 0` in the plane).
     fn at(
         &mut self,
         model: &PlantModel,
         a: &[f64],
         a_ref: &[f64],
     ) -> Result<([f64; 3], [f64; 3]), SimError> {
-        match (self, model) {
-            (
-                Tips::Planar {
-                    family,
-                    link_lengths,
-                    theta,
-                },
-                PlantModel::Planar(model),
-            ) => {
-                model.map().joint_angles(a, theta)?;
-                let [x, y] = backbone_kin::tip_position(link_lengths, theta)?;
+        self.place(model, a)?;
+        let tip = self.points[self.points.len() - 1];
+        let tip_ref = match (&mut self.kind, model) {
+            (TipKind::Planar { family, .. }, PlantModel::Planar(_)) => {
                 let [x_ref, y_ref] = family.end_point(a_ref)?;
-                Ok(([x, y, 0.0], [x_ref, y_ref, 0.0]))
+                [x_ref, y_ref, 0.0]
             }
-            (Tips::Spatial { theta }, PlantModel::Spatial(model)) => {
+            (TipKind::Spatial { theta }, PlantModel::Spatial(model)) => {
                 let map = model.map();
-                let mut chain_tip = |a: &[f64]| -> Result<[f64; 3], SimError> {
-                    map.joint_angles(a, theta)?;
-                    Ok(backbone_kin::spatial_tip_position(
-                        map.link_lengths(),
-                        model.base(),
-                        theta,
-                    )?)
-                };
-                Ok((chain_tip(a)?, chain_tip(a_ref)?))
+                map.joint_angles(a_ref, theta)?;
+                backbone_kin::spatial_tip_position(map.link_lengths(), model.base(), theta)?
             }
             _ => unreachable!("the tips are built for the simulation's own model"),
-        }
+        };
+        Ok((tip, tip_ref))
     }
 }
 
@@ -286,6 +339,9 @@ pub struct ControlSample {
     pub a_ddot: Vec<f64>,
     /// Accepted and rejected integrator steps from `t` to the next sample.
     pub steps: (usize, usize),
+    /// Whether the enforced joint limits ([`LoopSettings::joint_torque_limits`],
+    /// [`LoopSettings::joint_angle_limits`]) moved the controller's `tau*`.
+    pub projected: bool,
 }
 
 impl ControlSample {
@@ -301,6 +357,7 @@ impl ControlSample {
             clamped: vec![false; m],
             a_ddot: vec![0.0; m],
             steps: (0, 0),
+            projected: false,
         }
     }
 }
@@ -359,8 +416,14 @@ pub struct Simulation {
     controller: Box<dyn Controller>,
     settings: LoopSettings,
     initial: ModalState,
-    /// The tips' geometry.
+    /// The tips' geometry and the chain's points.
     tips: Tips,
+    /// The projection onto the joint limits, with [`LoopSettings::joint_torque_limits`] or
+    /// [`LoopSettings::joint_angle_limits`].
+    limits: Option<LimitProjection>,
+    /// The clearance's working memory, with [`LoopSettings::clearance`], and the joint axes
+    /// it is placed with.
+    clearance: Option<(ClearanceData, Vec<[f64; 3]>)>,
     joint_torques: Vec<f64>,
     /// Controller samples taken since the last reset.
     taken: usize,
@@ -403,7 +466,7 @@ impl Simulation {
         let plant = model.plant();
         let m = plant.n_coords();
         check_parts(reference.as_ref(), controller.as_ref(), m)?;
-        validate(&settings, m, plant.n_joints())?;
+        validate(&settings, plant)?;
         let initial = initial_state(reference.as_mut(), initial, m)?;
         Self::assemble(Arc::new(model), reference, controller, settings, initial)
     }
@@ -420,6 +483,25 @@ impl Simulation {
         let plant = model.plant();
         let (m, n) = (plant.n_coords(), plant.n_joints());
         let tips = Tips::new(&model)?;
+        let mut limits = LimitProjection::new(
+            plant,
+            settings.joint_torque_limits.as_deref(),
+            settings.joint_angle_limits.as_deref(),
+            settings.tau_star_limits.as_deref(),
+            settings.controller_period,
+        )?;
+        if let Some(limits) = &mut limits {
+            limits.check_start(plant, &initial.a)?;
+        }
+        let clearance = match &settings.clearance {
+            None => None,
+            Some(c) => Some((
+                ClearanceData::new(c, 0).map_err(|e| {
+                    SimError::setting("obstacles", format!("cannot be measured: {e}"))
+                })?,
+                vec![[0.0, 0.0, 1.0]; c.n_links()],
+            )),
+        };
         let data = PlantData::new(plant);
         let stepper = Stepper::new(settings.integrator, 2 * m);
         let mut simulation = Self {
@@ -433,6 +515,8 @@ impl Simulation {
             settings,
             initial,
             tips,
+            limits,
+            clearance,
             joint_torques: vec![0.0; n],
             taken: 0,
             y: vec![0.0; 2 * m],
@@ -627,10 +711,11 @@ impl Simulation {
         self.reset();
         let s = &self.settings;
         let (samples, record_every) = sample_counts(s);
-        let (m, n) = (self.n_coords(), self.plant.model.plant().n_joints());
+        let plant = self.plant.model.plant();
+        let (m, n) = (self.n_coords(), plant.n_joints());
         Progress {
-            record: Record::with_capacity(m, n, recorded_samples(s)),
-            metrics: Metrics::new(m, n, s.joint_torque_limits.clone()),
+            record: Record::with_capacity(m, n, plant.n_links() + 1, recorded_samples(s)),
+            metrics: Metrics::new(m, n, s.joint_torque_limits.clone(), self.limits.is_some()),
             steps: 0,
             rejected: 0,
             samples,
@@ -658,6 +743,19 @@ impl Simulation {
         let runaway = (0..m)
             .map(|i| (i, (sample.state.a[i] - sample.reference.a[i]).abs()))
             .find(|&(_, e)| e > max_error || e.is_nan());
+        progress.metrics.add_projection(sample.projected);
+        if runaway.is_none()
+            && let (Some(model), Some((data, axes))) =
+                (&self.settings.clearance, &mut self.clearance)
+        {
+            self.tips.place(&self.plant.model, &self.sample.state.a)?;
+            measure_clearance(
+                model,
+                data,
+                (&self.tips.points, axes),
+                &mut progress.metrics,
+            )?;
+        }
         self.sample_joint_torques()?;
         let sample = &self.sample;
         progress.metrics.add_control(
@@ -683,7 +781,9 @@ impl Simulation {
                 tip_ref,
             };
             progress.metrics.add_recorded(&row);
-            progress.record.push(&row, &self.joint_torques);
+            progress
+                .record
+                .push(&row, &self.joint_torques, &self.tips.points);
         }
         match runaway {
             Some((i, error)) => Err(SimError::RunawayError {
@@ -747,6 +847,16 @@ impl Simulation {
             Some(limits) => saturate(&mut sample.tau_star, limits, &mut sample.clamped),
             None => sample.clamped.fill(false),
         }
+        sample.projected = match &mut self.limits {
+            Some(limits) => limits.apply(
+                self.plant.model.plant(),
+                &mut self.plant.data,
+                t,
+                (&sample.state.a, &sample.state.a_dot),
+                &mut sample.tau_star,
+            )?,
+            None => false,
+        };
         self.plant.tau_star.copy_from_slice(&sample.tau_star);
         if hooks.disturbance(t, &sample.state, &mut self.tau_disturbance) {
             if !self.tau_disturbance.iter().all(|v| v.is_finite()) {
@@ -818,6 +928,27 @@ impl Simulation {
             )
             .map_err(|source| SimError::Dynamics { t, source })
     }
+}
+
+/// The clearance of the chain at `points` (its `n + 1` points) into `metrics`: every pair's
+/// signed distance ([`clearance::distances`]), the smallest to the obstacles and to the arm
+/// itself. Distances do not use the joint `axes` (gradients would): they are `z`, a planar
+/// chain's, for either family.
+fn measure_clearance(
+    model: &ClearanceModel,
+    data: &mut ClearanceData,
+    (points, axes): (&[[f64; 3]], &[[f64; 3]]),
+    metrics: &mut Metrics,
+) -> Result<(), SimError> {
+    clearance::place(model, data, points, axes)
+        .map_err(|e| SimError::setting("obstacles", format!("cannot be measured: {e}")))?;
+    let (to_obstacles, to_itself) = clearance::distances(model, data);
+    let pairs = model.pairs().len();
+    metrics.add_clearance(
+        (model.n_obstacle_pairs() > 0).then_some(to_obstacles),
+        (pairs > model.n_obstacle_pairs()).then_some(to_itself),
+    );
+    Ok(())
 }
 
 /// Actuator saturation: clamps every `tau_i*` to `[-limits_i, limits_i]` (exactly `+-limits_i`
@@ -982,7 +1113,8 @@ fn check_initial(initial: &ModalState, m: usize) -> Result<(), SimError> {
 
 /// Checks the settings of a loop of `m` coordinates for a chain of `n_joints` (`n` planar, `2n`
 /// spatial: the joint torques recorded, and the work of one evaluation, [`check_loop_work`]).
-fn validate(s: &LoopSettings, m: usize, n_joints: usize) -> Result<(), SimError> {
+fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
+    let (m, n_joints, n_links) = (plant.n_coords(), plant.n_joints(), plant.n_links());
     check_positive("controller.period", s.controller_period)?;
     check_positive("duration", s.duration)?;
     check_positive("record_period", s.record_period)?;
@@ -991,7 +1123,7 @@ fn validate(s: &LoopSettings, m: usize, n_joints: usize) -> Result<(), SimError>
             "duration",
             format!(
                 "must be at most {MAX_CONTROLLER_SAMPLES:e} controller periods ({} s), got {:e} s",
-                Readable(s.controller_period),
+                Compact(s.controller_period),
                 s.duration
             ),
         ));
@@ -1001,8 +1133,8 @@ fn validate(s: &LoopSettings, m: usize, n_joints: usize) -> Result<(), SimError>
             "duration",
             format!(
                 "must be a whole number of controller periods ({} s), got {} s",
-                Readable(s.controller_period),
-                Readable(s.duration)
+                Compact(s.controller_period),
+                Compact(s.duration)
             ),
         ));
     }
@@ -1011,8 +1143,8 @@ fn validate(s: &LoopSettings, m: usize, n_joints: usize) -> Result<(), SimError>
             "record_period",
             format!(
                 "must be a whole number of controller periods ({} s), got {} s",
-                Readable(s.controller_period),
-                Readable(s.record_period)
+                Compact(s.controller_period),
+                Compact(s.record_period)
             ),
         ));
     }
@@ -1024,8 +1156,8 @@ fn validate(s: &LoopSettings, m: usize, n_joints: usize) -> Result<(), SimError>
                     "controller.period",
                     format!(
                         "must be a whole number of RK4 steps ({} s), got {} s",
-                        Readable(dt),
-                        Readable(s.controller_period)
+                        Compact(dt),
+                        Compact(s.controller_period)
                     ),
                 ));
             }
@@ -1038,17 +1170,18 @@ fn validate(s: &LoopSettings, m: usize, n_joints: usize) -> Result<(), SimError>
     if s.max_modal_error.is_nan() || s.max_modal_error <= 0.0 {
         return Err(SimError::setting(
             "limits.max_modal_error",
-            format!("must be positive, got {}", s.max_modal_error),
+            format!("must be positive, got {}", Compact(s.max_modal_error)),
         ));
     }
-    let recorded = recorded_samples(s).saturating_mul(Record::values_per_sample(m, n_joints));
+    let recorded =
+        recorded_samples(s).saturating_mul(Record::values_per_sample(m, n_joints, n_links + 1));
     if recorded > MAX_RECORDED_VALUES {
         return Err(SimError::setting(
             "record_period",
             format!(
                 "would record {recorded} numbers over {} s, more than the {MAX_RECORDED_VALUES} \
                  a run may hold: record less often or simulate less",
-                s.duration
+                Compact(s.duration)
             ),
         ));
     }
@@ -1061,7 +1194,7 @@ fn validate(s: &LoopSettings, m: usize, n_joints: usize) -> Result<(), SimError>
                     "would take {steps:.3e} RK4 steps over {} s, more than the \
                      {MAX_RK4_STEPS:e} a run may take (hours of computing): use a larger step \
                      or simulate less",
-                    Readable(s.duration)
+                    Compact(s.duration)
                 ),
             ));
         }
@@ -1080,6 +1213,31 @@ fn validate(s: &LoopSettings, m: usize, n_joints: usize) -> Result<(), SimError>
         for &l in limits {
             check_positive("limits.joint_torque_nm", l)?;
         }
+    }
+    if let Some(limits) = &s.joint_angle_limits {
+        if limits.len() != n_joints {
+            return Err(SimError::setting(
+                "limits.joint_angle_rad",
+                format!(
+                    "has {} entries, the arm has {n_joints} joints",
+                    limits.len()
+                ),
+            ));
+        }
+        for &l in limits {
+            check_positive("limits.joint_angle_rad", l)?;
+        }
+    }
+    if let Some(model) = &s.clearance
+        && model.n_links() != n_links
+    {
+        return Err(SimError::setting(
+            "obstacles",
+            format!(
+                "are measured against {} links, the arm has {n_links}",
+                model.n_links()
+            ),
+        ));
     }
     if let Some(limits) = &s.tau_star_limits {
         if limits.len() != m {

@@ -198,16 +198,17 @@ pub fn record(
     let mut rows = 0usize;
     let coordinates = first.coordinate_names();
     for scenario in scenarios {
-        // The same count means the same harmonics and the same alpha0 freedom: the same names.
-        if scenario.n_coords() != m {
+        // The same names: the same family (planar or spatial), harmonics and alpha0 freedom.
+        if scenario.n_coords() != m || scenario.coordinate_names() != coordinates {
             return Err(SimError::setting(
                 "imitation.scenarios",
                 format!(
-                    "must share their modal coordinates: '{}' has {m} ({}), '{}' has {}",
+                    "must share their modal coordinates: '{}' has {m} ({}), '{}' has {} ({})",
                     first.name,
                     coordinates.join(", "),
                     scenario.name,
-                    scenario.n_coords()
+                    scenario.n_coords(),
+                    scenario.coordinate_names().join(", ")
                 ),
             ));
         }

@@ -8,7 +8,9 @@ pub mod summary_json;
 
 pub use input_file::{MAX_INPUT_FILE_BYTES, open_regular_file, read_text_file};
 pub use scenario::{
-    Alpha0, ArmSpec, BranchSpec, CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup,
-    ControllerSpec, FuzzyInputRange, InitialSpec, IntegratorSpec, LimitsSpec, ModalSpec,
-    ModalTorqueLimit, NoiseSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec, TorqueLimit,
+    Alpha0, AngleLimit, ArmKind, ArmSpec, BaseSpec, BranchSpec, CONTROLLERS, ControllerEntry,
+    ControllerKind, ControllerSetup, ControllerSpec, FuzzyInputRange, Gravity, HelixSpec, Inertias,
+    InitialSpec, IntegratorSpec, JointLayout, LimitsSpec, MAX_SCENARIO_OBSTACLES, ModalSpec,
+    ModalTorqueLimit, NoiseSpec, ObstacleSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec,
+    TorqueLimit, Workspace,
 };

@@ -93,8 +93,21 @@ pub fn untouched<T: Clone + PartialEq + Debug, R: Debug, E: Debug>(
 /// A value no function under test writes: an output still holding it was left untouched.
 pub const SENTINEL: f64 = -12345.0;
 
-/// Checks every row: the error is the one expected, and its message is one line that says what
-/// the row asks. Panics naming the first row that fails.
+/// The most digits a number in a message may have: the 17 significant digits of an `f64` and
+/// the zeros of a plain decimal down to `1e-4` (`lane_math::Compact`); a count or an index has
+/// fewer.
+const MAX_MESSAGE_DIGITS: usize = 24;
+
+/// The length of the longest run of digits and decimal points in `text`.
+fn longest_digit_run(text: &str) -> usize {
+    text.split(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .map(|run| run.bytes().filter(u8::is_ascii_digit).count())
+        .max()
+        .unwrap_or(0)
+}
+
+/// Checks every row: the error is the one expected, and its message is one line, with its
+/// numbers written compactly (no number of more than 24 digits), that says what the row asks. Panics naming the first row that fails.
 pub fn check<E: Debug + Display>(rows: &[Row<E>]) {
     for Row {
         name,
@@ -108,6 +121,10 @@ pub fn check<E: Debug + Display>(rows: &[Row<E>]) {
         assert!(
             !message.contains('\n'),
             "{name}: {message:?} is not one line"
+        );
+        assert!(
+            longest_digit_run(&message) <= MAX_MESSAGE_DIGITS,
+            "{name}: {message:?} writes a number in full (lane_math::Compact writes it compactly)"
         );
         match *says {
             Says::Exactly(line) => assert_eq!(message, line, "{name}"),

@@ -213,6 +213,22 @@ fn malformed_files_name_the_line_and_the_problem() {
         message("FUNCTION_BLOCK x\nVAR_INPUT\n a : REAL;\nEND_VAR\n"),
         "FCL line 4: expected END_FUNCTION_BLOCK before the end of the text"
     );
+    // Refusals of the whole system point at the RANGE, TERM or RULE they name.
+    assert_eq!(
+        swap("RANGE := (-1.000 .. 1.000);", "RANGE := (1.000 .. -1.000);"),
+        "FCL line 30: input 'a1_dot': range must be finite with min < max, got [1, -1]"
+    );
+    assert_eq!(
+        swap("tau2 is P\n", "tau2 is P with 2.0\n"),
+        "FCL line 65: rule 2: weight must lie in [0, 1], got 2"
+    );
+    assert_eq!(
+        swap(
+            "TERM P := Bell 0.300 0.300 2.000;",
+            "TERM P := Bell 0.300 0 2.000;"
+        ),
+        "FCL line 20: gbellmf: width a must be positive, got 0"
+    );
     assert_eq!(message("(* open"), "FCL line 1: unterminated (* comment");
     assert_eq!(
         message("VAR_INPUT\n"),

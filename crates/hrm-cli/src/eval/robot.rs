@@ -10,7 +10,9 @@ use serde_json::json;
 use sim_study::ArmSpec;
 
 use super::derivatives::{MAX_DERIVATIVE_LINKS, aba_answer, rnea_answer, rows};
-use super::{EvalError, EvalResult, finite, json_fields};
+use super::{EvalError, EvalResult, Kind, finite, json_fields};
+use lane_math::Classify;
+use manip_dyn::DynError;
 
 /// ROS's gravity, the default of a URDF chain (URDF carries none).
 const DEFAULT_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
@@ -49,6 +51,24 @@ fn model(urdf: &str, requested: Option<Vec<f64>>) -> Result<SpatialModel, EvalEr
         return Err(EvalError::input("urdf: the chain has no movable joint"));
     }
     robot_desc::to_spatial(&robot, gravity).map_err(|e| EvalError::input(format!("urdf: {e}")))
+}
+
+/// A library error as an answer, a [`DynError::SingularJoint`] with the URDF name of its joint
+/// ("urdf: joint 'yaw3': joint 4: the articulated inertia ...").
+fn joint_named(urdf: &str, error: DynError) -> EvalError {
+    let name = match error {
+        DynError::SingularJoint { index } => robot(urdf)
+            .ok()
+            .and_then(|robot| robot.joints.get(index).map(|joint| joint.name.clone())),
+        _ => None,
+    };
+    match name {
+        Some(name) => EvalError::new(
+            Kind::Library(error.class()),
+            format!("urdf: joint '{name}': {error}"),
+        ),
+        None => error.into(),
+    }
 }
 
 /// Each vector has one entry per movable joint.
@@ -168,7 +188,8 @@ pub(super) fn aba_derivatives(request: AbaDerivativesRequest) -> EvalResult {
         &request.theta,
         &request.theta_dot,
         &request.tau,
-    )?;
+    )
+    .map_err(|error| joint_named(&request.urdf, error))?;
     aba_answer(
         derivatives.value(),
         derivatives.d_q(),

@@ -189,6 +189,46 @@ fn fis_check_of_40000_rules_is_refused_by_its_work_bound() {
 }
 
 #[test]
+fn fis_check_of_a_grid_past_its_limit_says_what_the_system_needs() {
+    // 4 inputs of 20 triangles: their landmarks and the midpoints between them alone make 41^4
+    // (2.8 million) grid points, past a limit the command line does not offer to raise.
+    let dir = scratch("errors-fis-grid");
+    let mut text = String::from(
+        "[System]\nName='wide'\nType='sugeno'\nNumInputs=4\nNumOutputs=1\nNumRules=1\n\
+         AndMethod='prod'\nOrMethod='probor'\nImpMethod='prod'\nAggMethod='sum'\n\
+         DefuzzMethod='wtaver'\n",
+    );
+    for input in 1..=4 {
+        text.push_str(&format!(
+            "\n[Input{input}]\nName='x{input}'\nRange=[0 20]\nNumMFs=20\n"
+        ));
+        for k in 0..20 {
+            text.push_str(&format!(
+                "MF{}='s{k}':'trimf',[{} {k} {}]\n",
+                k + 1,
+                k as f64 - 1.0,
+                k + 1
+            ));
+        }
+    }
+    text.push_str("\n[Output1]\nName='y'\nRange=[0 1]\nNumMFs=1\nMF1='c':'constant',[0.5]\n");
+    text.push_str("\n[Rules]\n1 1 1 1, 1 (1) : 1\n");
+    let file = dir.join("wide.fis");
+    std::fs::write(&file, text).unwrap();
+    let line = refused(&hrm(&["fis", "check", path(&file)]));
+    assert!(
+        line.contains(
+            "the completeness grid of this system needs 2825761 points (41 x 41 x 41 x 41"
+        ) && line.contains(
+            "more than the 1000000 `hrm fis check` evaluates: check a system with fewer \
+                 inputs or sets"
+        ) && !line.contains("raise"),
+        "{line}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn fis_check_options_are_named_as_given() {
     let dir = scratch("errors-fis-options");
     let file = dir.join("small.fis");
@@ -748,5 +788,127 @@ fn hrm_view_writes_a_page_and_a_gif_and_replaces_only_its_own_files() {
         "nan",
     ]));
     assert!(line.contains("gif speed: NaN"), "{line}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn hrm_view_of_a_sweep_runs_the_chosen_runs_again() {
+    let dir = scratch("errors-view-sweep");
+    // The short step response with its own copy of the paper's fuzzy system.
+    let fis = dir.join("mine.fis");
+    std::fs::copy(
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../fuzzy-sugeno/data/paper.fis"
+        ),
+        &fis,
+    )
+    .unwrap();
+    let scenario = short_scenario(&dir);
+    let text = std::fs::read_to_string(&scenario).unwrap();
+    std::fs::write(
+        &scenario,
+        text.replace(
+            "kind = \"fuzzy\"\n",
+            "kind = \"fuzzy\"\nfis = \"mine.fis\"\n",
+        ),
+    )
+    .unwrap();
+    let sweep = dir.join("sweep");
+    let output = hrm(&[
+        "sweep",
+        "--scenario",
+        path(&scenario),
+        "--noise",
+        "0,0.05",
+        "--seeds",
+        "2",
+        "--controllers",
+        "fuzzy,pd",
+        "--out",
+        path(&sweep),
+    ]);
+    assert!(output.status.success(), "{output:?}");
+    // The list: every run, numbered as in runs.json.
+    let output = hrm(&["view", path(&sweep), "--list"]);
+    assert!(output.status.success(), "{output:?}");
+    let list = String::from_utf8(output.stdout).unwrap();
+    let rows: Vec<&str> = list.lines().skip(2).collect();
+    assert_eq!(rows.len(), 8, "{list}");
+    let words: Vec<&str> = rows[6].split_whitespace().collect();
+    assert_eq!(
+        words[..7],
+        ["6", "0.05", "pd", "1", "tip", "error", "RMS"],
+        "{list}"
+    );
+    assert!(!sweep.join("view.html").exists(), "--list writes nothing");
+    // By default the first seed of both controllers at both noise levels, run again: their
+    // metrics are those the sweep stored, bit for bit (no warning).
+    let output = hrm(&["view", path(&sweep)]);
+    assert!(output.status.success(), "{output:?}");
+    assert!(output.stderr.is_empty(), "{output:?}");
+    let page = std::fs::read_to_string(sweep.join("view.html")).unwrap();
+    assert_eq!(page.matches("<section class=\"hrm-scene\"").count(), 2);
+    assert!(page.contains("at noise level L = 0.05 rad, seed 1"));
+    assert!(page.contains("Runs 4 (fuzzy), 6 (pd) of the sweep"));
+    // Chosen runs, one scene per noise level and seed.
+    let page_b = dir.join("b.html");
+    let output = hrm(&[
+        "view",
+        path(&sweep),
+        "--runs",
+        "5,1",
+        "--out",
+        path(&page_b),
+    ]);
+    assert!(output.status.success(), "{output:?}");
+    let page = std::fs::read_to_string(&page_b).unwrap();
+    assert_eq!(page.matches("<section class=\"hrm-scene\"").count(), 2);
+    assert!(page.contains("L = 0 rad, seed 2") && page.contains("L = 0.05 rad, seed 2"));
+    // A stored metric the re-run does not give is reported, and the page still written.
+    let runs = sweep.join("runs.json");
+    let stored = std::fs::read_to_string(&runs).unwrap();
+    let mut lines: Vec<String> = stored.lines().map(String::from).collect();
+    let mut run: serde_json::Value = serde_json::from_str(&lines[1]).unwrap();
+    let rms = &mut run["outcome"]["completed"]["tip_error_rms_m"];
+    *rms = serde_json::json!(rms.as_f64().unwrap() * 0.999);
+    lines[1] = run.to_string();
+    std::fs::write(&runs, lines.join("\n") + "\n").unwrap();
+    let output = hrm(&["view", path(&sweep), "--runs", "0"]);
+    assert!(output.status.success(), "{output:?}");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.starts_with("warning: run 0 (fuzzy) of ")
+            && stderr.contains("did not give the metrics the sweep stored"),
+        "{stderr}"
+    );
+    std::fs::write(&runs, &stored).unwrap();
+    // Bounded, checked selections.
+    let line = refused(&hrm(&["view", path(&sweep), "--runs", "8"]));
+    assert!(
+        line.ends_with(
+            "--runs 8: the sweep has 8 runs, numbered 0 to 7 (`hrm view DIR --list` lists them)"
+        ),
+        "{line}"
+    );
+    let line = refused(&hrm(&["view", path(&sweep), "--runs", "3,3"]));
+    assert!(line.ends_with("--runs lists run 3 twice"), "{line}");
+    let many = (0..13).map(|i| i.to_string()).collect::<Vec<_>>().join(",");
+    let line = refused(&hrm(&["view", path(&sweep), "--runs", &many]));
+    assert!(line.contains("more than the 12"), "{line}");
+    let line = refused(&hrm(&["view", path(&dir), "--list"]));
+    assert!(
+        line.contains("--list and --runs take a sweep's output folder"),
+        "{line}"
+    );
+    // The fuzzy system changed since the sweep ran: its runs cannot be run again.
+    std::fs::write(&fis, std::fs::read_to_string(&fis).unwrap() + "\n").unwrap();
+    let before = std::fs::read(sweep.join("view.html")).unwrap();
+    let line = refused(&hrm(&["view", path(&sweep)]));
+    assert!(
+        line.contains("mine.fis") && line.contains("changed since the sweep ran"),
+        "{line}"
+    );
+    assert_eq!(std::fs::read(sweep.join("view.html")).unwrap(), before);
     std::fs::remove_dir_all(&dir).unwrap();
 }

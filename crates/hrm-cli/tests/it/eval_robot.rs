@@ -111,8 +111,8 @@ fn bad_robot_requests_get_one_clear_error() {
             "theta has 1 entries, expected 6",
         ),
         (
-            json!({"op": "frames", "urdf": massless, "theta": [0.0]}),
-            "joint 'j' and link 'b'",
+            json!({"op": "aba_derivatives", "urdf": massless, "theta": [0.0], "theta_dot": [0.0], "tau": [0.0]}),
+            "urdf: joint 'j': joint 0: the articulated inertia about its axis is not positive",
         ),
         (
             json!({"op": "export", "urdf": urdf, "arm": arm(), "format": "urdf"}),

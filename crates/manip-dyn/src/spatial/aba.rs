@@ -43,9 +43,10 @@ use crate::error::DynError;
 ///
 /// # Errors
 /// [`DynError::Dimension`] if a slice does not have `n` entries or `data` was built for another
-/// chain, [`DynError::NonFinite`] for a NaN or infinite input, [`DynError::NotPositiveDefinite`]
-/// if an articulated inertia about a joint axis is not positive beyond rounding (a massless or
-/// degenerate subtree, or link parameters too disparate for double precision),
+/// chain, [`DynError::NonFinite`] for a NaN or infinite input, [`DynError::SingularJoint`]
+/// naming the first joint (from the tip) whose articulated inertia about its axis is not positive
+/// beyond rounding (a joint that moves no mass or inertia, or link parameters too disparate for
+/// double precision),
 /// [`DynError::NonFiniteResult`] if the accelerations overflow.
 pub fn aba(
     model: &SpatialModel,
@@ -175,7 +176,12 @@ pub(crate) fn kernel<L: AbaLane>(
         let axis = splat_motion::<L>(context, &model.axes[i]);
         let coupling = inertia.apply(&axis);
         let pivot = axis.dot(&coupling);
-        L::check_pivot(context, pivot, L::splat(context, model.pivot_scales[i]))?;
+        L::check_pivot(context, pivot, L::splat(context, model.pivot_scales[i])).map_err(
+            |error| match error {
+                DynError::NotPositiveDefinite => DynError::SingularJoint { index: i },
+                other => other,
+            },
+        )?;
         let inverse = L::splat(context, 1.0) / pivot;
         let residual = L::gather(context, tau, n, i) - axis.dot(&force);
         set3::<L>(coupling.linear, &mut link.coupling[0]);

@@ -2,16 +2,17 @@
 //! `d qdd / d tau = M^-1`. Differentiating `M(q) qdd + b(q, v) = tau` at the ABA's `qdd` gives
 //! `d qdd / d q = -M^-1 d tau / d q` and `d qdd / d v = -M^-1 d tau / d v` with the RNEA
 //! derivatives taken at `(q, v, qdd)` (Carpentier and Mansard 2018, eq. 12; what Pinocchio's
-//! `computeABADerivatives` returns); `M^-1` comes from the Cholesky factor of the `M` those
-//! derivatives give, solved against `[d tau / d q | d tau / d v | E]` at once.
+//! `computeABADerivatives` returns). `M^-1` comes in `O(n^2)` from the articulated-body
+//! factorisation the ABA has just built ([`minv`](super::minv), theory.md eqs. S1-S3), never
+//! from `M`; the two products with it are one dense `n x n` by `n x 2n` matrix product.
 
-use faer::Par;
-use faer::dyn_stack::MemStack;
-use faer::linalg::cholesky::llt;
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Par};
 
 use super::aba::aba;
 use super::data::SpatialData;
 use super::derivative_data::SpatialDerivativeData;
+use super::minv::inverse_mass_matrix;
 use super::model::SpatialModel;
 use super::rnea_derivatives::rnea_derivatives;
 use crate::check;
@@ -19,7 +20,8 @@ use crate::error::DynError;
 
 /// Forward dynamics and its analytic derivatives at `(q, v, tau)`: `qdd` (as
 /// [`aba`](super::aba())), `d qdd / d q`, `d qdd / d v` and `d qdd / d tau = M^-1`, into
-/// `derivatives`. `O(n^3)` for the solve, allocation-free.
+/// `derivatives`. `M^-1` in `O(n^2)` (theory.md eqs. S1-S3), the RNEA derivatives in
+/// `O(n^2)`, then their product with `M^-1`; allocation-free.
 ///
 /// ```
 /// use manip_dyn::ChainModel;
@@ -36,8 +38,8 @@ use crate::error::DynError;
 /// ```
 ///
 /// # Errors
-/// As [`rnea_derivatives`] and [`aba`](super::aba()) ([`DynError::NotPositiveDefinite`] if `M`
-/// is not numerically positive definite).
+/// As [`rnea_derivatives`] and [`aba`](super::aba()) ([`DynError::SingularJoint`] naming the
+/// first joint, from the tip, whose articulated inertia about its axis is not positive).
 pub fn aba_derivatives(
     model: &SpatialModel,
     data: &mut SpatialData,
@@ -61,36 +63,21 @@ pub fn aba_derivatives(
     solved?;
     let SpatialDerivativeData {
         blocks,
-        factor,
-        stack,
-        accelerations: diagonal,
+        rhs,
+        forces,
+        motions,
         ..
     } = derivatives;
-    let (_, mut mass) = blocks.as_mut().split_at_col_mut(2 * n);
-    factor.copy_from(mass.as_ref());
-    for (i, entry) in diagonal.iter_mut().enumerate() {
-        *entry = mass[(i, i)];
-    }
-    mass.fill(0.0);
-    mass.diagonal_mut().fill(1.0);
-    let stack = MemStack::new(stack);
-    llt::factor::cholesky_in_place(
-        factor.as_mut(),
-        Default::default(),
+    let (mut jacobians, mut minv) = blocks.as_mut().split_at_col_mut(2 * n);
+    rhs.copy_from(jacobians.as_ref());
+    inverse_mass_matrix(model, &data.articulated, forces, motions, minv.as_mut());
+    matmul(
+        jacobians.as_mut(),
+        Accum::Replace,
+        minv.as_ref(),
+        rhs.as_ref(),
+        -1.0,
         Par::Seq,
-        stack,
-        Default::default(),
-    )
-    .map_err(|_| DynError::NotPositiveDefinite)?;
-    for (i, entry) in diagonal.iter().enumerate() {
-        // The pivots L_ii^2 against the diagonal entries of M they come from.
-        check::pivot(factor[(i, i)].powi(2), *entry)?;
-    }
-    llt::solve::solve_in_place(factor.as_ref(), blocks.as_mut(), Par::Seq, stack);
-    for j in 0..2 * n {
-        for i in 0..n {
-            blocks[(i, j)] = -blocks[(i, j)];
-        }
-    }
+    );
     check::finite_matrix("the derivatives", &blocks.as_mut())
 }

@@ -2,11 +2,10 @@
 //! ([`rnea_derivatives`](super::rnea_derivatives()) and
 //! [`aba_derivatives`](super::aba_derivatives())).
 
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::cholesky::llt;
-use faer::{Mat, MatRef, Par};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatRef, Par};
 
-use super::algebra::Symmetric6;
+use super::algebra::{Force, Motion, Symmetric6};
 use super::model::SpatialModel;
 use crate::model::MAX_DENSE_LINKS;
 
@@ -16,7 +15,7 @@ pub(crate) type Six = [f64; 6];
 
 /// Results and scratch of [`rnea_derivatives`](super::rnea_derivatives()) and
 /// [`aba_derivatives`](super::aba_derivatives()) for one [`SpatialModel`]: build it once with
-/// [`SpatialDerivativeData::new`] (about `32 n^2` bytes), then every call fills it without
+/// [`SpatialDerivativeData::new`] (about `40 n^2` bytes), then every call fills it without
 /// allocating. For a chain of more than [`MAX_DENSE_LINKS`] links, which both refuse, it holds
 /// nothing.
 ///
@@ -48,9 +47,11 @@ pub struct SpatialDerivativeData {
     /// Composite inertia `Ic_i` and Coriolis operator `Bc_i` of links `i..n`, base frame.
     pub(crate) composite: Vec<Symmetric6>,
     pub(crate) coriolis: Vec<[Six; 6]>,
-    /// `M`, then its Cholesky factor (`aba_derivatives`), and the factorisation's scratch.
-    pub(crate) factor: Mat<f64>,
-    pub(crate) stack: MemBuffer,
+    /// `[d tau / d q | d tau / d v]` while `aba_derivatives` multiplies it by `-M^-1`.
+    pub(crate) rhs: Mat<f64>,
+    /// The force and motion columns of the `O(n^2)` `M^-1` (`aba_derivatives`).
+    pub(crate) forces: Vec<Force>,
+    pub(crate) motions: Vec<Motion>,
 }
 
 impl SpatialDerivativeData {
@@ -71,10 +72,6 @@ impl SpatialDerivativeData {
     fn sized(n: usize) -> SpatialDerivativeData {
         let sized = if n <= MAX_DENSE_LINKS { n } else { 0 };
         let six = || vec![[0.0; 6]; sized];
-        let stack = StackReq::or(
-            llt::factor::cholesky_in_place_scratch::<f64>(sized, Par::Seq, Default::default()),
-            llt::solve::solve_in_place_scratch::<f64>(sized, 3 * sized, Par::Seq),
-        );
         let mut derivatives = SpatialDerivativeData {
             n,
             value: vec![0.0; sized],
@@ -89,30 +86,28 @@ impl SpatialDerivativeData {
             h: six(),
             composite: vec![Symmetric6::default(); sized],
             coriolis: vec![[[0.0; 6]; 6]; sized],
-            factor: Mat::zeros(sized, sized),
-            stack: MemBuffer::new(stack),
+            rhs: Mat::zeros(sized, 2 * sized),
+            forces: vec![Force::default(); sized],
+            motions: vec![Motion::default(); sized],
         };
         derivatives.warm_up();
         derivatives
     }
 
-    /// faer's blocked factorisation and many-right-hand-side solve (from about 64 rows)
-    /// multiply with a kernel that allocates a packing buffer per thread on first use: one
-    /// factorisation of the identity and solve here take that allocation out of the first
-    /// [`aba_derivatives`](super::aba_derivatives()) on this thread.
+    /// faer's matrix product (from about 64 rows) multiplies with a kernel that allocates a
+    /// packing buffer per thread on first use: one product here takes that allocation out of
+    /// the first [`aba_derivatives`](super::aba_derivatives()) on this thread.
     fn warm_up(&mut self) {
-        self.factor.fill(0.0);
-        self.factor.diagonal_mut().fill(1.0);
-        let stack = MemStack::new(&mut self.stack);
-        let factored = llt::factor::cholesky_in_place(
-            self.factor.as_mut(),
-            Default::default(),
+        let n = self.value.len();
+        let (mut jacobians, minv) = self.blocks.as_mut().split_at_col_mut(2 * n);
+        matmul(
+            jacobians.as_mut(),
+            Accum::Replace,
+            minv.as_ref(),
+            self.rhs.as_ref(),
+            -1.0,
             Par::Seq,
-            stack,
-            Default::default(),
         );
-        debug_assert!(factored.is_ok(), "the identity is positive definite");
-        llt::solve::solve_in_place(self.factor.as_ref(), self.blocks.as_mut(), Par::Seq, stack);
     }
 
     /// Number of links of the chain this workspace was built for.

@@ -32,7 +32,7 @@
 //! | [`aba`] | forward dynamics `qdd` by the articulated-body algorithm, `O(n)` |
 //! | [`aba_batch`] | [`aba`] of many states, SIMD across states, the same bits |
 //! | [`rnea_derivatives`] | `tau`, `d tau / d q`, `d tau / d v`, `M` into a [`SpatialDerivativeData`] |
-//! | [`aba_derivatives`] | `qdd`, `d qdd / d q`, `d qdd / d v`, `M^-1` into a [`SpatialDerivativeData`] |
+//! | [`aba_derivatives`] | `qdd`, `d qdd / d q`, `d qdd / d v`, `M^-1` (in `O(n^2)`) into a [`SpatialDerivativeData`] |
 //!
 //! The `n x n` algorithms refuse chains of more than [`MAX_DENSE_LINKS`](crate::MAX_DENSE_LINKS)
 //! links; a model has at most [`MAX_LINKS`](crate::MAX_LINKS). The conventions and the derivative
@@ -48,6 +48,7 @@ mod data;
 mod derivative_data;
 mod energy;
 mod kinematics;
+mod minv;
 mod model;
 mod rnea;
 mod rnea_derivatives;

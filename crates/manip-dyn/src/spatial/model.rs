@@ -66,7 +66,10 @@ impl SpatialJoint {
 /// the link's frame (the frame its joint moves).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpatialLink {
-    /// Mass (kg), positive and finite.
+    /// Mass (kg), non-negative and finite. A massless link (the cross of a universal joint
+    /// written as two revolute joints) is valid; the algorithms that solve for accelerations
+    /// refuse, naming it, a joint whose articulated inertia vanishes
+    /// ([`DynError::SingularJoint`]), such as one moving only a massless tip link.
     pub mass: f64,
     /// Centre of mass in the link frame (m), finite.
     pub com: Vec3,
@@ -98,8 +101,8 @@ impl SpatialLink {
                 value,
             })
         };
-        if !(self.mass.is_finite() && self.mass > 0.0) {
-            return invalid("mass", "positive and finite", self.mass);
+        if !(self.mass.is_finite() && self.mass >= 0.0) {
+            return invalid("mass", "non-negative and finite", self.mass);
         }
         if let Some(&x) = self.com.iter().find(|x| !x.is_finite()) {
             return invalid("centre of mass", "finite", x);

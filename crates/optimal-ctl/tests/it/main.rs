@@ -1,6 +1,8 @@
 //! The integration tests of optimal-ctl, one binary: linearisation and LQR against finite
 //! differences and closed forms (`optimal`); the polytope projection and the linearly
-//! constrained QP against enumeration of active sets (`qp`).
+//! constrained QP against enumeration of active sets (`qp`); iLQR under linear control
+//! constraints against the condensed QP of the whole horizon (`constrained_ilqr`).
 
+mod constrained_ilqr;
 mod optimal;
 mod qp;

@@ -2,7 +2,8 @@
 //! model-based baseline the paper never ran.
 
 use super::{ControlContext, Controller, ControllerError, check_context, check_coordinate_count};
-use crate::error::{Readable, SimError, check_positive};
+use crate::error::{SimError, check_positive};
+use lane_math::Compact;
 use modal_reduce::{Plant, PlantData};
 use optimal_ctl::dense::symmetrise;
 use optimal_ctl::{Linearisation, Lqr, LqrSettings};
@@ -100,7 +101,7 @@ impl LqrController {
                 "controller.lqr_frequency",
                 format!(
                     "must be at most {MAX_FREQUENCY:e} rad/s, got {}",
-                    Readable(frequency)
+                    Compact(frequency)
                 ),
             ));
         }
@@ -110,8 +111,8 @@ impl LqrController {
                 "controller.lqr_relinearise",
                 format!(
                     "must be at least the controller period ({} s), got {} s",
-                    Readable(period),
-                    Readable(relinearise_period)
+                    Compact(period),
+                    Compact(relinearise_period)
                 ),
             ));
         }

@@ -17,7 +17,7 @@ mod rk4;
 pub use dopri5::{DormandPrince, Tolerances};
 pub use rk4::Rk4;
 
-use lane_math::{Classify, ErrorClass};
+use lane_math::{Classify, Compact, ErrorClass};
 
 /// The right-hand side `f(t, y)` of a first-order system `y' = f(t, y)`.
 pub trait OdeSystem {
@@ -52,14 +52,15 @@ pub enum OdeError<E> {
         source: E,
     },
     /// The state or its derivative became NaN or infinite.
-    #[error("the state became non-finite at t = {t}")]
+    #[error("the state became non-finite at t = {}", Compact(*.t))]
     NonFinite {
         /// Start of the step that produced it.
         t: f64,
     },
     /// The adaptive step size fell below the minimum allowed step.
     #[error(
-        "the step size fell to {h:e} at t = {t}, below the minimum {h_min:e} (stiff or singular problem)"
+        "the step size fell to {h:e} at t = {}, below the minimum {h_min:e} (stiff or singular problem)",
+        Compact(*.t)
     )]
     StepTooSmall {
         /// Where it happened.

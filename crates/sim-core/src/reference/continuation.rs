@@ -13,11 +13,16 @@
 //! grid; a free `alpha0` is held at its predicted value while the modes are corrected (the end
 //! point of a curve with base angle `alpha0` is that of `alpha0 = 0` rotated by `alpha0`).
 
+use super::ReferenceSample;
+use crate::error::SimError;
 use backbone_kin::{BackboneCurve, HarmonicIk, KinError};
 
 /// `J J^T` counts as singular below this ratio of its eigenvalues: the tip cannot move in some
 /// direction (e.g. radially, for a straight curve).
 const SINGULAR_RATIO: f64 = 1e-10;
+/// Largest correction (rad, Euclidean) the inverse kinematics may make to the predicted
+/// configuration between two grid nodes; a larger one means the continuation left its branch.
+const MAX_CORRECTION: f64 = 0.05;
 /// Length of the modal step `delta` (rad) of the central difference of the rate field.
 const RATE_FIELD_STEP: f64 = 1e-5;
 
@@ -36,6 +41,102 @@ impl From<KinError> for ResolveError {
     }
 }
 
+/// The scratch of the rate field's central difference (`m` entries each).
+#[derive(Debug, Clone, Default)]
+pub(super) struct RateScratch {
+    shifted: Vec<f64>,
+    plus: Vec<f64>,
+    minus: Vec<f64>,
+}
+
+impl RateScratch {
+    pub(crate) fn new(m: usize) -> Self {
+        Self {
+            shifted: vec![0.0; m],
+            plus: vec![0.0; m],
+            minus: vec![0.0; m],
+        }
+    }
+}
+
+/// A modal family whose tip moves in `D` dimensions (the planar curve's end point, `D = 2`; the
+/// spatial chain's tip, `D = 3`): what the continuation asks of it.
+pub(super) trait TipFamily<const D: usize> {
+    /// The rate field's scratch.
+    fn scratch(&mut self) -> &mut RateScratch;
+
+    /// The error of a point the family cannot reach.
+    fn unreachable(t: f64, p: [f64; D], source: KinError) -> SimError;
+
+    /// The error of a singular point of the path.
+    fn singular(what: &'static str, t: f64, p: [f64; D]) -> SimError;
+
+    /// The tip at `a`, its `D x m` Jacobian kept for [`pseudo_inverse`](Self::pseudo_inverse).
+    fn jacobian_at(&mut self, a: &[f64]) -> Result<[f64; D], KinError>;
+
+    /// `out = J^+ v = J^T (J J^T)^{-1} v` with the Jacobian of the last
+    /// [`jacobian_at`](Self::jacobian_at).
+    fn pseudo_inverse(&self, v: [f64; D], out: &mut [f64]) -> Result<(), ResolveError>;
+
+    /// Solves `p(a) = target` from the guess in `a`.
+    fn solve(&mut self, target: [f64; D], a: &mut [f64]) -> Result<(), KinError>;
+
+    /// The minimum-norm rate `a_dot = J^+ p_dot` at `a` and its time derivative
+    /// `a_ddot = d(J^+)/da[a_dot] p_dot + J^+ p_ddot`, the first term by a central difference
+    /// along `a_dot`.
+    fn rates(
+        &mut self,
+        a: &[f64],
+        p_dot: [f64; D],
+        p_ddot: [f64; D],
+        a_dot: &mut [f64],
+        a_ddot: &mut [f64],
+    ) -> Result<(), ResolveError> {
+        self.jacobian_at(a)?;
+        self.pseudo_inverse(p_dot, a_dot)?;
+        self.pseudo_inverse(p_ddot, a_ddot)?;
+        let speed = a_dot.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if speed == 0.0 {
+            return Ok(());
+        }
+        let delta = RATE_FIELD_STEP / speed;
+        let RateScratch {
+            mut shifted,
+            mut plus,
+            mut minus,
+        } = std::mem::take(self.scratch());
+        let result = (|| {
+            for (sign, out) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                for ((s, &x), &v) in shifted.iter_mut().zip(a).zip(a_dot.iter()) {
+                    *s = x + sign * delta * v;
+                }
+                self.jacobian_at(&shifted)?;
+                self.pseudo_inverse(p_dot, out)?;
+            }
+            Ok::<(), ResolveError>(())
+        })();
+        if result.is_ok() {
+            for ((dd, p), q) in a_ddot.iter_mut().zip(&plus).zip(&minus) {
+                *dd += (p - q) / (2.0 * delta);
+            }
+        }
+        *self.scratch() = RateScratch {
+            shifted,
+            plus,
+            minus,
+        };
+        result
+    }
+}
+
+/// A tip position and its first two time derivatives.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct TipMotion<const D: usize> {
+    pub(super) p: [f64; D],
+    pub(super) v: [f64; D],
+    pub(super) acc: [f64; D],
+}
+
 /// End point, Jacobian and inverse kinematics of a family with `harmonics` harmonics and a fixed
 /// (`Some(alpha0)`) or free (`None`) base angle; all buffers sized at construction.
 #[derive(Debug, Clone)]
@@ -52,10 +153,7 @@ pub(crate) struct Family {
     mode_jacobian: Vec<f64>,
     /// `2 x m` Jacobian of the family, row-major.
     jacobian: Vec<f64>,
-    /// Scratch: `m` entries each.
-    shifted: Vec<f64>,
-    plus: Vec<f64>,
-    minus: Vec<f64>,
+    scratch: RateScratch,
 }
 
 impl Family {
@@ -75,9 +173,7 @@ impl Family {
             ik: HarmonicIk::new(length, harmonics, base)?,
             mode_jacobian: vec![0.0; 2 * modes],
             jacobian: vec![0.0; 2 * m],
-            shifted: vec![0.0; m],
-            plus: vec![0.0; m],
-            minus: vec![0.0; m],
+            scratch: RateScratch::new(m),
         })
     }
 
@@ -103,6 +199,20 @@ impl Family {
         } else {
             p
         })
+    }
+}
+
+impl TipFamily<2> for Family {
+    fn scratch(&mut self) -> &mut RateScratch {
+        &mut self.scratch
+    }
+
+    fn unreachable(t: f64, [x, y]: [f64; 2], source: KinError) -> SimError {
+        SimError::Unreachable { t, x, y, source }
+    }
+
+    fn singular(what: &'static str, t: f64, [x, y]: [f64; 2]) -> SimError {
+        SimError::SingularPoint { what, t, x, y }
     }
 
     /// The end point at `a` and its Jacobian into `self.jacobian`.
@@ -148,7 +258,7 @@ impl Family {
     }
 
     /// Solves `p(a) = target` from the guess in `a` (a free `alpha0` held at its guess).
-    pub(super) fn solve(&mut self, target: [f64; 2], a: &mut [f64]) -> Result<(), KinError> {
+    fn solve(&mut self, target: [f64; 2], a: &mut [f64]) -> Result<(), KinError> {
         let target = if self.free {
             rotate(target, -a[self.modes])
         } else {
@@ -156,49 +266,49 @@ impl Family {
         };
         self.ik.solve(target, &mut a[..self.modes]).map(|_| ())
     }
+}
 
-    /// The minimum-norm rate `a_dot = J^+ p_dot` at `a` and its time derivative
-    /// `a_ddot = d(J^+)/da[a_dot] p_dot + J^+ p_ddot`, the first term by a central difference
-    /// along `a_dot`.
-    pub(super) fn rates(
-        &mut self,
-        a: &[f64],
-        p_dot: [f64; 2],
-        p_ddot: [f64; 2],
-        a_dot: &mut [f64],
-        a_ddot: &mut [f64],
-    ) -> Result<(), ResolveError> {
-        self.jacobian_at(a)?;
-        self.pseudo_inverse(p_dot, a_dot)?;
-        self.pseudo_inverse(p_ddot, a_ddot)?;
-        let speed = a_dot.iter().map(|v| v * v).sum::<f64>().sqrt();
-        if speed == 0.0 {
-            return Ok(());
+/// The reference at `t` (tip motion `motion`) by the continuation: from `previous` (a node and the time from it to
+/// `t`) by a second-order prediction, or from `out.a` itself; then the inverse kinematics
+/// and the minimum-norm rates.
+pub(super) fn resolve<const D: usize, F: TipFamily<D>>(
+    family: &mut F,
+    t: f64,
+    motion: TipMotion<D>,
+    previous: Option<(&ReferenceSample, f64)>,
+    out: &mut ReferenceSample,
+) -> Result<(), SimError> {
+    let TipMotion { p, v, acc } = motion;
+    if let Some((node, dt)) = previous {
+        for i in 0..out.a.len() {
+            out.a[i] = node.a[i] + dt * node.a_dot[i] + 0.5 * dt * dt * node.a_ddot[i];
         }
-        let delta = RATE_FIELD_STEP / speed;
-        let mut shifted = std::mem::take(&mut self.shifted);
-        let (mut plus, mut minus) = (
-            std::mem::take(&mut self.plus),
-            std::mem::take(&mut self.minus),
-        );
-        let result = (|| {
-            for (sign, out) in [(1.0, &mut plus), (-1.0, &mut minus)] {
-                for ((s, &x), &v) in shifted.iter_mut().zip(a).zip(a_dot.iter()) {
-                    *s = x + sign * delta * v;
-                }
-                self.jacobian_at(&shifted)?;
-                self.pseudo_inverse(p_dot, out)?;
-            }
-            Ok::<(), ResolveError>(())
-        })();
-        if result.is_ok() {
-            for ((dd, p), q) in a_ddot.iter_mut().zip(&plus).zip(&minus) {
-                *dd += (p - q) / (2.0 * delta);
-            }
-        }
-        (self.shifted, self.plus, self.minus) = (shifted, plus, minus);
-        result
     }
+    let unreachable = |source| F::unreachable(t, p, source);
+    // Keep the prediction to measure the correction, in the a_dot buffer (rewritten below).
+    out.a_dot.copy_from_slice(&out.a);
+    family.solve(p, &mut out.a).map_err(unreachable)?;
+    let correction = out
+        .a
+        .iter()
+        .zip(&out.a_dot)
+        .map(|(a, b)| (a - b) * (a - b))
+        .sum::<f64>()
+        .sqrt();
+    let singular = |what| F::singular(what, t, p);
+    if previous.is_some() && correction > MAX_CORRECTION {
+        return Err(singular(
+            "the numerical inverse kinematics left its branch between two grid nodes",
+        ));
+    }
+    family
+        .rates(&out.a, v, acc, &mut out.a_dot, &mut out.a_ddot)
+        .map_err(|e| match e {
+            ResolveError::Singular => {
+                singular("the end-point Jacobian is rank deficient (J J^T singular)")
+            }
+            ResolveError::Kinematics(source) => unreachable(source),
+        })
 }
 
 /// `p` rotated by `angle`.

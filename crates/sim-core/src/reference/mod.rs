@@ -1,6 +1,7 @@
 //! Reference motions for the `m` modal coordinates: steps, sinusoids, and Cartesian tip paths
 //! followed through the inverse kinematics of the modal family (the closed form of eqs 5-6 for
-//! the paper's `K = 1` with `alpha0` fixed, a numerical continuation otherwise).
+//! the paper's `K = 1` with `alpha0` fixed, a numerical continuation otherwise), in the plane or,
+//! for a spatial arm, in space ([`SpatialPath`]).
 //!
 //! A reference supplies the desired `a`, `a_dot` and `a_ddot` at any time; the controllers that
 //! need rates or accelerations (computed torque) get them from the reference, not by
@@ -10,9 +11,13 @@
 pub(crate) mod continuation;
 mod path;
 mod preview;
+mod spatial_path;
+mod waypoints;
 
 pub use path::{CartesianPath, FREE_BASE_START, PathShape};
 pub use preview::{MAX_PREVIEW_SAMPLES, ReferencePreview};
+pub use spatial_path::{Helix, SpatialPath};
+pub use waypoints::{MAX_WAYPOINTS, Waypoints};
 
 use crate::error::{SimError, check_finite, check_non_negative};
 

@@ -2,7 +2,7 @@
 //! the closed form (eqs 5-6) with exact modal rates and accelerations for the paper's `K = 1`
 //! with `alpha0` fixed, a numerical continuation with minimum-norm rates otherwise.
 
-use super::continuation::{Family, ResolveError};
+use super::continuation::{Family, TipMotion, resolve};
 use super::{Reference, ReferenceSample};
 use crate::error::{SimError, check_finite, check_positive};
 use backbone_kin::{BaseAngle, Branch, inverse_kinematics};
@@ -14,9 +14,6 @@ const CHECK_SAMPLES: usize = 2000;
 const SINGULAR_TOLERANCE: f64 = 1e-8;
 /// The base angle a free `alpha0` starts the continuation from (rad): the paper's `pi/2`.
 pub const FREE_BASE_START: f64 = std::f64::consts::FRAC_PI_2;
-/// Largest correction (rad, Euclidean) the inverse kinematics may make to the predicted
-/// configuration between two grid nodes; a larger one means the continuation left its branch.
-const MAX_CORRECTION: f64 = 0.05;
 
 /// The geometric shape of a tip path.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,14 +38,6 @@ pub enum PathShape {
     /// The polyline through these points (m), linearly interpolated and traversed at constant
     /// speed along its length.
     Polyline(Vec<[f64; 2]>),
-}
-
-/// The tip position and its first two time derivatives.
-#[derive(Debug, Clone, Copy)]
-struct TipMotion {
-    p: [f64; 2],
-    v: [f64; 2],
-    acc: [f64; 2],
 }
 
 /// A tip path traversed in `travel_time` seconds, then held at its end point; before `t = 0` it
@@ -203,7 +192,7 @@ impl CartesianPath {
     }
 
     /// The tip's position, velocity and acceleration at `t`.
-    fn tip_motion(&self, t: f64) -> TipMotion {
+    fn tip_motion(&self, t: f64) -> TipMotion<2> {
         let moving = (0.0..self.travel_time).contains(&t);
         let progress = (t / self.travel_time).clamp(0.0, 1.0);
         let rate = if moving { 1.0 / self.travel_time } else { 0.0 };
@@ -271,7 +260,7 @@ impl Reference for CartesianPath {
                 let dt = t.clamp(0.0, self.travel_time) - k as f64 * *step;
                 out.a.copy_from_slice(&node.a);
                 let previous = (dt > 0.0).then_some((node, dt));
-                return resolve(family, t, motion, previous, out);
+                return resolve(&mut **family, t, motion, previous, out);
             }
         };
         let TipMotion { p, v, acc } = motion;
@@ -311,50 +300,6 @@ impl Reference for CartesianPath {
         out.a_ddot.copy_from_slice(&[a1_ddot, a2_ddot]);
         Ok(())
     }
-}
-
-/// The reference at `t` (tip motion `motion`) by the continuation: from `previous` (a node and the time from it to
-/// `t`) by a second-order prediction, or from `out.a` itself; then the inverse kinematics
-/// and the minimum-norm rates.
-fn resolve(
-    family: &mut Family,
-    t: f64,
-    motion: TipMotion,
-    previous: Option<(&ReferenceSample, f64)>,
-    out: &mut ReferenceSample,
-) -> Result<(), SimError> {
-    let TipMotion { p, v, acc } = motion;
-    let [x, y] = p;
-    if let Some((node, dt)) = previous {
-        for i in 0..out.a.len() {
-            out.a[i] = node.a[i] + dt * node.a_dot[i] + 0.5 * dt * dt * node.a_ddot[i];
-        }
-    }
-    let unreachable = |source| SimError::Unreachable { t, x, y, source };
-    // Keep the prediction to measure the correction, in the a_dot buffer (rewritten below).
-    out.a_dot.copy_from_slice(&out.a);
-    family.solve(p, &mut out.a).map_err(unreachable)?;
-    let correction = out
-        .a
-        .iter()
-        .zip(&out.a_dot)
-        .map(|(a, b)| (a - b) * (a - b))
-        .sum::<f64>()
-        .sqrt();
-    let singular = |what| SimError::SingularPoint { what, t, x, y };
-    if previous.is_some() && correction > MAX_CORRECTION {
-        return Err(singular(
-            "the numerical inverse kinematics left its branch between two grid nodes",
-        ));
-    }
-    family
-        .rates(&out.a, v, acc, &mut out.a_dot, &mut out.a_ddot)
-        .map_err(|e| match e {
-            ResolveError::Singular => {
-                singular("the end-point Jacobian is rank deficient (J J^T singular)")
-            }
-            ResolveError::Kinematics(source) => unreachable(source),
-        })
 }
 
 /// Checks a shape's numbers; returns the cumulative arc lengths of a polyline.

@@ -1,7 +1,8 @@
 //! A reference sampled ahead on a uniform time grid, for controllers that plan over a horizon.
 
 use super::{Reference, ReferenceSample};
-use crate::error::{Readable, SimError, check_positive};
+use crate::error::{SimError, check_positive};
+use lane_math::Compact;
 
 /// The most samples a preview may hold.
 pub const MAX_PREVIEW_SAMPLES: usize = 100_001;
@@ -62,7 +63,7 @@ impl ReferencePreview {
         if spacing > 1e3 {
             return Err(SimError::setting(
                 "preview spacing",
-                format!("must be at most 1000 s, got {} s", Readable(spacing)),
+                format!("must be at most 1000 s, got {} s", Compact(spacing)),
             ));
         }
         let m = reference.n_coords();
@@ -87,7 +88,7 @@ impl ReferencePreview {
         if !t.is_finite() {
             return Err(SimError::setting(
                 "preview time",
-                format!("must be finite, got {t}"),
+                format!("must be finite, got {}", Compact(t)),
             ));
         }
         let count = self.samples.len();

@@ -117,7 +117,7 @@ impl Prepared {
     ) -> Result<Self, SimError> {
         let model = model.into();
         let m = model.plant().n_coords();
-        validate(&settings, m, model.plant().n_joints())?;
+        validate(&settings, model.plant())?;
         if let Some(initial) = &initial {
             check_initial(initial, m)?;
         }

@@ -5,5 +5,6 @@
 mod controller;
 mod energy;
 mod hooks;
+mod limits;
 mod ode;
 mod reference;

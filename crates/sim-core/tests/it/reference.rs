@@ -308,3 +308,68 @@ proptest! {
         }
     }
 }
+
+/// A waypoint motion: rates and accelerations are the derivatives of the coordinates (central
+/// differences), every shape lies on its segment, and the motion rests at every waypoint.
+#[test]
+fn waypoints_differentiate_and_stay_on_their_segments() {
+    use sim_core::reference::Waypoints;
+    let points = vec![
+        vec![0.0, 0.0, 0.0],
+        vec![0.6, -0.2, 0.1],
+        vec![0.6, 0.4, -0.3],
+    ];
+    let mut motion = Waypoints::new(&points, 3.0).unwrap();
+    let (mut s, mut lo, mut hi) = (
+        ReferenceSample::zeros(3),
+        ReferenceSample::zeros(3),
+        ReferenceSample::zeros(3),
+    );
+    let h = 1e-6;
+    for k in 1..300 {
+        let t = 3.2 * f64::from(k) / 300.0;
+        motion.sample(t, &mut s).unwrap();
+        motion.sample(t - h, &mut lo).unwrap();
+        motion.sample(t + h, &mut hi).unwrap();
+        for i in 0..3 {
+            let rate = (hi.a[i] - lo.a[i]) / (2.0 * h);
+            let accel = (hi.a_dot[i] - lo.a_dot[i]) / (2.0 * h);
+            assert!((rate - s.a_dot[i]).abs() < 1e-6, "t = {t}");
+            assert!((accel - s.a_ddot[i]).abs() < 1e-4, "t = {t}");
+        }
+        // On the segment: a - w_k parallel to w_{k+1} - w_k.
+        let on_segment = points.windows(2).any(|w| {
+            let d: Vec<f64> = (0..3).map(|i| w[1][i] - w[0][i]).collect();
+            let r: Vec<f64> = (0..3).map(|i| s.a[i] - w[0][i]).collect();
+            let along =
+                (0..3).map(|i| r[i] * d[i]).sum::<f64>() / (0..3).map(|i| d[i] * d[i]).sum::<f64>();
+            (-1e-12..=1.0 + 1e-12).contains(&along)
+                && (0..3).all(|i| (r[i] - along * d[i]).abs() < 1e-12)
+        });
+        assert!(on_segment, "t = {t}");
+    }
+    // Segments of 0.41^0.5 and 0.52^0.5 share the 3 s: the first ends at rest on w_1.
+    let first = 3.0 * 0.41_f64.sqrt() / (0.41_f64.sqrt() + 0.52_f64.sqrt());
+    motion.sample(first, &mut s).unwrap();
+    assert!((0..3).all(|i| (s.a[i] - points[1][i]).abs() < 1e-12 && s.a_dot[i].abs() < 1e-12));
+    motion.sample(3.0, &mut s).unwrap();
+    assert_eq!(s.a, points[2]);
+    assert!(s.a_dot.iter().chain(&s.a_ddot).all(|x| *x == 0.0));
+    for (bad, text) in [
+        (Waypoints::new(&[], 1.0).unwrap_err(), "between 1 and"),
+        (
+            Waypoints::new(&[vec![0.0], vec![0.0, 1.0]], 1.0).unwrap_err(),
+            "has 2 entries",
+        ),
+        (
+            Waypoints::new(&[vec![0.0]], 0.0).unwrap_err(),
+            "travel time",
+        ),
+        (
+            Waypoints::new(&[vec![f64::NAN]], 1.0).unwrap_err(),
+            "finite",
+        ),
+    ] {
+        assert!(bad.to_string().contains(text), "{bad}");
+    }
+}

@@ -36,6 +36,14 @@ const BUILTIN: &[(&str, &str)] = &[
         "free-base-tracking",
         include_str!("../../scenarios/free-base-tracking.toml"),
     ),
+    (
+        "spatial-tracking",
+        include_str!("../../scenarios/spatial-tracking.toml"),
+    ),
+    (
+        "spatial-long",
+        include_str!("../../scenarios/spatial-long.toml"),
+    ),
 ];
 
 impl Scenario {

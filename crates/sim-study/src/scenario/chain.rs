@@ -2,8 +2,9 @@
 //! joint-space loop of [`sim_core::run_chain_loop`], computed torque tracking a joint-space
 //! reference.
 
+use super::arm::{ArmKind, Gravity};
 use super::controllers::ControllerKind;
-use super::schema::{ArmSpec, IntegratorSpec, NoiseSpec, ReferenceSpec, Scenario};
+use super::schema::{Alpha0, ArmSpec, IntegratorSpec, NoiseSpec, ReferenceSpec, Scenario};
 use manip_dyn::spatial::SpatialModel;
 use sim_core::{ChainLoopSettings, ChainRun, SimError, run_chain_loop};
 
@@ -18,7 +19,7 @@ fn unused(name: &str, why: &str) -> SimError {
 impl Scenario {
     /// The dynamics model of the scenario's URDF arm (`arm.urdf`, a regular file of at most
     /// [`robot_desc::MAX_URDF_BYTES`]) under gravity `(0, 0, -arm.gravity)` (ROS's convention,
-    /// 9.81 m/s^2 by default), or `None` for a planar arm.
+    /// 9.81 m/s^2 by default; or the vector `arm.gravity`), or `None` for a modal arm.
     ///
     /// # Errors
     /// [`SimError::InvalidSetting`] naming `arm.urdf` for a file that cannot be read or is not
@@ -27,6 +28,9 @@ impl Scenario {
     pub fn urdf_model(&self) -> Result<Option<SpatialModel>, SimError> {
         let ArmSpec {
             urdf: Some(path),
+            kind,
+            joints,
+            base,
             links,
             link_length,
             link_mass,
@@ -34,11 +38,15 @@ impl Scenario {
             lengths,
             masses,
             inertias,
+            radius,
         } = &self.arm
         else {
             return Ok(None);
         };
         let planar = [
+            ("arm.kind", *kind != ArmKind::Planar),
+            ("arm.joints", joints.is_some()),
+            ("arm.base", base.is_some()),
             ("arm.links", links.is_some()),
             ("arm.link_length", link_length.is_some()),
             ("arm.link_mass", link_mass.is_some()),
@@ -48,6 +56,16 @@ impl Scenario {
         ];
         if let Some((name, _)) = planar.iter().find(|(_, given)| *given) {
             return Err(unused(name, "the URDF describes the links"));
+        }
+        if radius.is_some() || !self.obstacles.is_empty() {
+            return Err(unused(
+                if radius.is_some() {
+                    "arm.radius"
+                } else {
+                    "obstacles"
+                },
+                "the joint-space loop measures no clearance",
+            ));
         }
         let invalid = |what: String| SimError::setting("arm.urdf", what);
         let text = crate::read_text_file(path, robot_desc::MAX_URDF_BYTES as u64)
@@ -61,8 +79,8 @@ impl Scenario {
                 path.display()
             )));
         }
-        let g = gravity.unwrap_or(9.81);
-        robot_desc::to_spatial(&robot, [0.0, 0.0, -g])
+        let gravity = gravity.map_or([0.0, 0.0, -9.81], Gravity::spatial);
+        robot_desc::to_spatial(&robot, gravity)
             .map(Some)
             .map_err(|e| invalid(format!("({}): {e}", path.display())))
     }
@@ -109,15 +127,18 @@ impl Scenario {
         if self.noise != NoiseSpec::default() {
             return Err(unused("noise", "the joint-space loop is noise-free"));
         }
-        if self.limits.joint_torque_nm.is_some() || self.limits.tau_star.is_some() {
+        if self.limits.joint_torque_nm.is_some()
+            || self.limits.joint_angle_rad.is_some()
+            || self.limits.tau_star.is_some()
+        {
             return Err(unused(
-                "limits.joint_torque_nm and limits.tau_star",
+                "limits.joint_torque_nm, limits.joint_angle_rad and limits.tau_star",
                 "only limits.max_modal_error bounds the joint errors",
             ));
         }
-        let mut reference = self
-            .reference
-            .build(0.0, self.modal.harmonics, self.alpha0, n)?()?;
+        let mut reference =
+            self.reference
+                .build(0.0, self.modal.harmonics, Alpha0::Fixed(0.0), n)?()?;
         let q0 = match &self.initial {
             Some(initial) => {
                 if initial.a_dot.is_some() {

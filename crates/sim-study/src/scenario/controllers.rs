@@ -3,7 +3,7 @@
 
 use super::schema::ControllerSpec;
 use fuzzy_sugeno::FuzzySystem;
-use modal_reduce::ReducedModel;
+use modal_reduce::PlantModel;
 use optimal_ctl::MpcSettings;
 use serde::{Deserialize, Serialize};
 use sim_core::controller::{
@@ -42,8 +42,9 @@ pub enum ControllerKind {
 pub struct ControllerSetup<'a> {
     /// The scenario's `[controller]` table.
     pub spec: &'a ControllerSpec,
-    /// The reduced model the controller will be sampled on (`m` coordinates).
-    pub model: &'a ReducedModel,
+    /// The reduced model (planar or spatial) the controller will be sampled on (`m`
+    /// coordinates).
+    pub model: &'a PlantModel,
     /// The controller's sampling period (s).
     pub period: f64,
     /// The loop's reference (MPC previews a copy of it).
@@ -135,7 +136,9 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         prepare: |s| {
             let (kp, kd) = s.spec.computed_torque_gains(m(s))?;
             Ok(Prepared::controller_clones(ComputedTorque::new(
-                s.model, &kp, &kd,
+                s.model.plant(),
+                &kp,
+                &kd,
             )?))
         },
     },
@@ -147,7 +150,7 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
             let fuzzy = FuzzyController::new(s.fuzzy_system()?, m(s))?
                 .with_out_of_range(s.spec.out_of_range.unwrap_or_default().into())?;
             Ok(Prepared::controller_clones(
-                fuzzy.with_gravity_compensation(s.model)?,
+                fuzzy.with_gravity_compensation(s.model.plant())?,
             ))
         },
     },
@@ -158,7 +161,7 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
                       along it every lqr_relinearise s, design frequency lqr_frequency",
         prepare: |s| {
             Ok(Prepared::controller_clones(LqrController::new(
-                s.model,
+                s.model.plant(),
                 s.period,
                 s.spec
                     .lqr_frequency
@@ -177,10 +180,10 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
             let settings = MpcSettings::uniform(m(s));
             let (model, reference) = (s.model.clone(), Arc::clone(s.reference));
             // Checked once here; each run builds its own (its plan is its state).
-            MpcController::new(&model, &settings, reference()?)?;
+            MpcController::new(model.plant(), &settings, reference()?)?;
             Ok(Arc::new(move || {
                 Ok(Box::new(MpcController::new(
-                    &model,
+                    model.plant(),
                     &settings,
                     reference()?,
                 )?))
@@ -200,7 +203,7 @@ const _: () = {
 
 /// The number of modal coordinates of a setup's model.
 fn m(setup: &ControllerSetup<'_>) -> usize {
-    setup.model.n_coords()
+    setup.model.plant().n_coords()
 }
 
 impl ControllerKind {

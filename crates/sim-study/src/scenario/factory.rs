@@ -1,15 +1,16 @@
 //! From a scenario to a [`Simulation`]: the arm, the reduced model, the reference, the
 //! controller and the loop's settings, every setting checked and named when it fails.
 
+use super::arm::{ArmKind, Gravity, Inertias};
 use super::controllers::{ControllerSetup, per_coordinate};
 use super::schema::{
-    Alpha0, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, NoiseSpec, ReferenceSpec,
-    Scenario, TorqueLimit,
+    Alpha0, AngleLimit, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, NoiseSpec,
+    ReferenceSpec, Scenario, TorqueLimit,
 };
 use backbone_kin::{Branch, ModalMap};
 use fuzzy_sugeno::FuzzySystem;
 use manip_dyn::{ChainModel, Link};
-use modal_reduce::ReducedModel;
+use modal_reduce::{PlantModel, ReducedModel};
 use sim_core::controller::{Controller, ModalState};
 use sim_core::ode::Tolerances;
 use sim_core::reference::{CartesianPath, PathShape, Sinusoid, Step};
@@ -24,6 +25,7 @@ impl Scenario {
     /// per evaluation.
     pub fn model(&self) -> Result<ReducedModel, SimError> {
         let chain = self.arm.to_chain()?;
+        let alpha0 = self.planar_alpha0()?;
         let k = self.modal.harmonics;
         if k == 0 {
             return Err(SimError::setting("modal.harmonics", "must be at least 1"));
@@ -47,8 +49,18 @@ impl Scenario {
         }
         sim_core::check_loop_work(n, m)?;
         let lengths: Vec<f64> = chain.link_lengths().collect();
-        let map = ModalMap::new(&lengths, k, self.alpha0.base_angle())?;
+        let map = ModalMap::new(&lengths, k, alpha0.base_angle())?;
         ReducedModel::new(chain, map).map_err(SimError::Model)
+    }
+
+    /// The base inclination of a planar arm: `alpha0`, required.
+    pub(super) fn planar_alpha0(&self) -> Result<Alpha0, SimError> {
+        self.alpha0.ok_or_else(|| {
+            SimError::setting(
+                "alpha0",
+                "is required for a planar arm: a base angle (rad) or \"free\"",
+            )
+        })
     }
 
     /// Prepares the simulation once for any number of runs that differ in seed and noise
@@ -120,7 +132,7 @@ impl Scenario {
         controller: impl FnOnce(&ControllerSetup<'_>) -> Result<C, SimError>,
     ) -> Result<
         (
-            ReducedModel,
+            PlantModel,
             ReferenceFactory,
             C,
             LoopSettings,
@@ -128,14 +140,17 @@ impl Scenario {
         ),
         SimError,
     > {
-        let model = self.model()?;
-        let m = model.n_coords();
-        let reference = self.reference.build(
-            model.chain().total_length(),
-            self.modal.harmonics,
-            self.alpha0,
-            m,
-        )?;
+        let model = self.plant()?;
+        let m = model.plant().n_coords();
+        let reference = match &model {
+            PlantModel::Planar(planar) => self.reference.build(
+                planar.chain().total_length(),
+                self.modal.harmonics,
+                self.planar_alpha0()?,
+                m,
+            )?,
+            PlantModel::Spatial(spatial) => self.spatial_reference(spatial)?,
+        };
         let period = match (self.controller.period, self.integrator) {
             (Some(period), _) => period,
             (None, IntegratorSpec::Rk4 { dt }) => dt,
@@ -170,9 +185,14 @@ impl Scenario {
         }
         settings.max_modal_error = self.limits.max_modal_error;
         settings.joint_torque_limits = self.limits.joint_torque_nm.as_ref().map(|l| match l {
-            TorqueLimit::All(limit) => vec![*limit; model.n_links()],
+            TorqueLimit::All(limit) => vec![*limit; model.plant().n_joints()],
             TorqueLimit::PerJoint(limits) => limits.clone(),
         });
+        settings.joint_angle_limits = self.limits.joint_angle_rad.as_ref().map(|l| match l {
+            AngleLimit::All(limit) => vec![*limit; model.plant().n_joints()],
+            AngleLimit::PerJoint(limits) => limits.clone(),
+        });
+        settings.clearance = self.clearance_model(model.plant().n_links(), self.workspace())?;
         settings.tau_star_limits = match &self.limits.tau_star {
             None => None,
             Some(ModalTorqueLimit::All(limit)) => Some(vec![*limit; m]),
@@ -225,34 +245,45 @@ impl ArmSpec {
                  (Scenario::run_chain, as `hrm simulate` runs it), not as a planar arm",
             ));
         }
-        let mut n = self.links;
-        for (name, array) in [
-            ("arm.lengths", &self.lengths),
-            ("arm.masses", &self.masses),
-            ("arm.inertias", &self.inertias),
-        ] {
-            if let Some(values) = array {
-                match n {
-                    Some(k) if k != values.len() => {
-                        return Err(SimError::setting(
-                            name,
-                            format!("has {} entries but the arm has {k} links", values.len()),
-                        ));
-                    }
-                    _ => n = Some(values.len()),
-                }
-            }
-        }
-        let n = n.unwrap_or(10);
-        if n == 0 {
-            return Err(SimError::setting("arm.links", "must be at least 1"));
-        }
-        if n > manip_dyn::MAX_LINKS {
+        if self.kind == ArmKind::Spatial {
             return Err(SimError::setting(
-                "arm.links",
-                format!("must be at most {}, got {n}", manip_dyn::MAX_LINKS),
+                "arm.kind",
+                "is \"spatial\": a spatial arm's model is Scenario::spatial_model",
             ));
         }
+        for (name, given) in [
+            ("arm.joints", self.joints.is_some()),
+            ("arm.base", self.base.is_some()),
+        ] {
+            if given {
+                return Err(SimError::setting(
+                    name,
+                    "is used only by a spatial arm ([arm] kind = \"spatial\")",
+                ));
+            }
+        }
+        let gravity = match self.gravity {
+            None => 9.81,
+            Some(Gravity::Magnitude(g)) => g,
+            Some(Gravity::Vector(_)) => {
+                return Err(SimError::setting(
+                    "arm.gravity",
+                    "of a planar arm is a magnitude along -y (m/s^2), not a vector",
+                ));
+            }
+        };
+        let inertias = match &self.inertias {
+            None => None,
+            Some(Inertias::PerLink(values)) => Some(values),
+            Some(Inertias::Principal(_)) => {
+                return Err(SimError::setting(
+                    "arm.inertias",
+                    "of a planar arm gives one inertia per link (kg m^2, about the joint axis), \
+                     not [Ixx, Iyy, Izz] triples",
+                ));
+            }
+        };
+        let n = self.link_count(inertias.map(Vec::len))?;
         let per_link = |array: &Option<Vec<f64>>, scalar: f64| match array {
             Some(values) => values.clone(),
             None => vec![scalar; n],
@@ -281,15 +312,52 @@ impl ArmSpec {
         let mut links = Vec::with_capacity(n);
         for i in 0..n {
             let beam = Link::uniform_beam(lengths[i], masses[i]).map_err(|e| arm_error(i, e))?;
-            let link = match &self.inertias {
+            let link = match inertias {
                 Some(inertias) => Link::new(beam.length, beam.mass, beam.com, inertias[i])
                     .map_err(|e| arm_error(i, e))?,
                 None => beam,
             };
             links.push(link);
         }
-        ChainModel::new(links, self.gravity.unwrap_or(9.81))
+        ChainModel::new(links, gravity)
             .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))
+    }
+}
+
+impl ArmSpec {
+    /// The number of links: `links`, or the length of the per-link lists given (`lengths`,
+    /// `masses`, and `inertias` of `inertias` entries), which must agree; 10 by default, at least
+    /// 1 and at most [`manip_dyn::MAX_LINKS`]. Checked before any per-link array is allocated.
+    pub(super) fn link_count(&self, inertias: Option<usize>) -> Result<usize, SimError> {
+        let mut n = self.links;
+        for (name, count) in [
+            ("arm.lengths", self.lengths.as_ref().map(Vec::len)),
+            ("arm.masses", self.masses.as_ref().map(Vec::len)),
+            ("arm.inertias", inertias),
+        ] {
+            if let Some(count) = count {
+                match n {
+                    Some(k) if k != count => {
+                        return Err(SimError::setting(
+                            name,
+                            format!("has {count} entries but the arm has {k} links"),
+                        ));
+                    }
+                    _ => n = Some(count),
+                }
+            }
+        }
+        let n = n.unwrap_or(10);
+        if n == 0 {
+            return Err(SimError::setting("arm.links", "must be at least 1"));
+        }
+        if n > manip_dyn::MAX_LINKS {
+            return Err(SimError::setting(
+                "arm.links",
+                format!("must be at most {}, got {n}", manip_dyn::MAX_LINKS),
+            ));
+        }
+        Ok(n)
     }
 }
 
@@ -339,7 +407,15 @@ impl ReferenceSpec {
                 branch,
                 sine,
                 points,
+                helix,
             } => {
+                if helix.is_some() {
+                    return Err(SimError::setting(
+                        "reference.helix",
+                        "is a path in space, for a spatial arm ([arm] kind = \"spatial\"); a \
+                         planar arm's path is a `sine` or `points`",
+                    ));
+                }
                 let shape = match (sine, points) {
                     (Some(s), None) => PathShape::Sine {
                         amplitude: s.amplitude,

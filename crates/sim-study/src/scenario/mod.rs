@@ -20,8 +20,16 @@
 //!
 //! [arm]                   # defaults: the paper's 10 links of 0.1 m and 0.1 kg, g = 9.81
 //! links = 10
+//! radius = 0.01           # m, each link's collision capsule around its segment, default 0
 //! # urdf = "arm.urdf"     a URDF chain instead (relative to the file), run in joint space by
 //! #                       Scenario::run_chain: computed torque only, one entry per joint
+//!
+//! [[obstacles]]           # kind = "circle" | "capsule" | "box" (spatial arms: "sphere")
+//! kind = "circle"         # planar points are [x, y], spatial ones [x, y, z]
+//! center = [0.3, 0.6]     # m
+//! radius = 0.05           # m
+//! # kind = "capsule": from = [x, y], to = [x, y], radius
+//! # kind = "box": center = [x, y], half_extents = [hx, hy], rpy = [0.0, 0.0, yaw]
 //!
 //! [reference]             # kind = "constant" | "step" | "sinusoid" | "path"
 //! kind = "step"
@@ -48,21 +56,27 @@
 //!
 //! [limits]
 //! max_modal_error = 3.14  # rad, runaway bound
-//! joint_torque_nm = 5.0   # or one limit per joint; exceeding is reported
+//! joint_torque_nm = 5.0   # or one limit per joint; enforced by projecting tau* each sample
+//! joint_angle_rad = 2.0   # |theta_j| <= 2 rad, or one limit per joint; enforced likewise
 //! tau_star = [2.0, 0.5]   # N m, or one limit for all: the loop clamps tau* to +-limit
 //! ```
 
+mod arm;
 mod builtin;
 mod chain;
 mod controllers;
 mod factory;
 mod file;
+mod obstacles;
 mod schema;
+mod spatial;
 
+pub use arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout};
 pub use controllers::{CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup};
 pub use file::ScenarioError;
+pub use obstacles::{MAX_SCENARIO_OBSTACLES, Workspace};
 pub use schema::{
-    Alpha0, ArmSpec, BranchSpec, ControllerSpec, FuzzyInputRange, InitialSpec, IntegratorSpec,
-    LimitsSpec, ModalSpec, ModalTorqueLimit, NoiseSpec, ReferenceSpec, Scenario, SineSpec,
-    TorqueLimit,
+    Alpha0, AngleLimit, ArmSpec, BranchSpec, ControllerSpec, FuzzyInputRange, HelixSpec,
+    InitialSpec, IntegratorSpec, LimitsSpec, ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec,
+    ReferenceSpec, Scenario, SineSpec, TorqueLimit,
 };

@@ -1,5 +1,6 @@
 //! The scenario schema: what a scenario file may say, with its defaults.
 
+use super::arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout};
 use super::controllers::ControllerKind;
 use backbone_kin::BaseAngle;
 use serde::{Deserialize, Serialize};
@@ -18,8 +19,11 @@ pub struct Scenario {
     pub description: String,
     /// Simulated time (s).
     pub duration: f64,
-    /// The base inclination `alpha0`: fixed (rad) or free (the last modal coordinate).
-    pub alpha0: Alpha0,
+    /// The base inclination `alpha0` of a planar arm: fixed (rad) or free (the last modal
+    /// coordinate). Required for a planar arm, refused for a spatial one (whose base angles are
+    /// `arm.base`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha0: Option<Alpha0>,
     /// Seed of the noise sources. TOML integers stop at `2^63 - 1`: larger seeds are written
     /// (and may be given) as a decimal string, `seed = "18446744073709551615"`.
     #[serde(default, with = "seed_text")]
@@ -49,6 +53,53 @@ pub struct Scenario {
     /// Runaway bound and torque limits.
     #[serde(default)]
     pub limits: LimitsSpec,
+    /// Obstacles (`[[obstacles]]` tables): the loop takes the arm's clearance to them, and to
+    /// itself, at every controller sample.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacles: Vec<ObstacleSpec>,
+}
+
+/// An obstacle, tagged by `kind`. A planar arm moves in the plane `z = 0`: its obstacles are
+/// circles, capsules and boxes given by `[x, y]` points; a spatial arm's are spheres, capsules
+/// and boxes given by `[x, y, z]` points ([`Scenario::obstacles`] checks them).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum ObstacleSpec {
+    /// A disc of the arm's plane (planar arms).
+    Circle {
+        /// The centre `[x, y]` (m).
+        center: Vec<f64>,
+        /// The radius (m, non-negative).
+        radius: f64,
+    },
+    /// A ball (spatial arms).
+    Sphere {
+        /// The centre `[x, y, z]` (m).
+        center: Vec<f64>,
+        /// The radius (m, non-negative).
+        radius: f64,
+    },
+    /// The points within `radius` of the segment `from`-`to`.
+    Capsule {
+        /// One end of the axis (m).
+        from: Vec<f64>,
+        /// The other end (m).
+        to: Vec<f64>,
+        /// The radius (m, non-negative).
+        radius: f64,
+    },
+    /// A box, axis-aligned unless turned by `rpy`.
+    Box {
+        /// The centre (m).
+        center: Vec<f64>,
+        /// Half the side lengths along the box's own axes (m, positive): `[hx, hy]` in the
+        /// plane (the box is then a rectangle), `[hx, hy, hz]` in space.
+        half_extents: Vec<f64>,
+        /// Roll, pitch and yaw (rad, URDF's `R = Rz(yaw) Ry(pitch) Rx(roll)`, default zero); a
+        /// planar arm's box turns about `z` only (`[0, 0, yaw]`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        rpy: Option<Vec<f64>>,
+    },
 }
 
 /// The base inclination `alpha0` of a scenario: a number (fixed, in rad) or `"free"`.
@@ -135,6 +186,15 @@ impl Default for ModalSpec {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ArmSpec {
+    /// `"planar"` (default, the paper's arm) or `"spatial"` (universal joints, `m = 4K`).
+    #[serde(default, skip_serializing_if = "ArmKind::is_planar")]
+    pub kind: ArmKind,
+    /// The joints of a spatial arm (default and only layout `"universal"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joints: Option<JointLayout>,
+    /// The base pose of a spatial arm (default: at the origin, along `x`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base: Option<BaseSpec>,
     /// Number of links (default 10).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub links: Option<usize>,
@@ -144,22 +204,28 @@ pub struct ArmSpec {
     /// Mass of every link (kg, default 0.1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub link_mass: Option<f64>,
-    /// Gravitational acceleration along `-y` (m/s^2, default 9.81).
+    /// Gravity (m/s^2): a magnitude along `-y` (planar) or `-z` (spatial), default 9.81, or a
+    /// vector `[gx, gy, gz]` (spatial arms).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gravity: Option<f64>,
+    pub gravity: Option<Gravity>,
     /// Per-link lengths (m).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lengths: Option<Vec<f64>>,
     /// Per-link masses (kg).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub masses: Option<Vec<f64>>,
-    /// Per-link inertias about the centre of mass (kg m^2; default: uniform beams).
+    /// Per-link inertias about the centre of mass (kg m^2; default: uniform beams, slender rods
+    /// for a spatial arm): one number per link (planar) or `[Ixx, Iyy, Izz]` per link (spatial).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub inertias: Option<Vec<f64>>,
+    pub inertias: Option<Inertias>,
     /// A URDF serial chain (a path, relative to the scenario file) in place of the planar arm:
     /// run in joint space by [`Scenario::run_chain`], with only `gravity` of the other keys.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub urdf: Option<PathBuf>,
+    /// The radius of every link's collision capsule around its segment (m, non-negative, default
+    /// 0): the clearance to obstacles and between links is measured from these capsules.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
 }
 
 /// The initial modal state (`m` entries each).
@@ -221,7 +287,34 @@ pub enum ReferenceSpec {
         /// A polyline `[[x, y], ...]` (m), at constant speed along it.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         points: Option<Vec<[f64; 2]>>,
+        /// A helix or circle in space (spatial arms), at constant speed along it.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        helix: Option<HelixSpec>,
     },
+}
+
+/// A helix in space for a spatial arm's tip: from `start`, turning right-handedly about the
+/// line through `center` along `axis` for `turns` turns and rising `pitch` metres per turn along
+/// `axis`, at constant speed; `pitch = 0` (the default) is a circle.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HelixSpec {
+    /// A point on the axis (m).
+    pub center: [f64; 3],
+    /// The axis direction (any length but zero).
+    pub axis: [f64; 3],
+    /// The first point (m), off the axis.
+    pub start: [f64; 3],
+    /// Rise per turn along the axis (m, default 0: a circle).
+    #[serde(default)]
+    pub pitch: f64,
+    /// Number of turns (default 1), positive.
+    #[serde(default = "default_turns")]
+    pub turns: f64,
+}
+
+fn default_turns() -> f64 {
+    1.0
 }
 
 /// The sign branch of `a1` in the inverse kinematics (eq 6).
@@ -380,17 +473,25 @@ impl NoiseSpec {
     }
 }
 
-/// The runaway bound, optional joint torque limits (reported) and optional limits (modal forces, not joint torques) on
-/// `tau*` (enforced).
+/// The runaway bound, optional joint torque and joint angle limits (enforced) and optional
+/// limits on the modal forces `tau*` (enforced).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LimitsSpec {
     /// The run stops when `|a_i - a_i_ref|` exceeds this (rad, default pi).
     #[serde(default = "default_max_modal_error")]
     pub max_modal_error: f64,
-    /// Joint torque limits (N m): one for all joints or one per joint; exceeding is reported.
+    /// Joint torque limits (N m): one for all joints or one per joint, enforced: at every
+    /// controller sample the loop projects `tau*` onto the modal torques whose joint torques
+    /// at that state are within them, and reports how often it acted
+    /// ([`LoopSettings::joint_torque_limits`](sim_core::LoopSettings::joint_torque_limits)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joint_torque_nm: Option<TorqueLimit>,
+    /// Joint angle limits `|theta_j| <= limit` (rad): one for all joints or one per joint,
+    /// enforced in the same projection by bounding each joint's rate towards its limit
+    /// ([`LoopSettings::joint_angle_limits`](sim_core::LoopSettings::joint_angle_limits)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint_angle_rad: Option<AngleLimit>,
     /// Saturation of the modal forces `tau* = J^T tau` (N m): one limit for every coordinate or
     /// one per coordinate (`m` entries), each finite and positive. They bound the modal
     /// coordinates' generalised forces, not any joint torque (see `joint_torque_nm`). The loop
@@ -409,6 +510,7 @@ impl Default for LimitsSpec {
         Self {
             max_modal_error: default_max_modal_error(),
             joint_torque_nm: None,
+            joint_angle_rad: None,
             tau_star: None,
         }
     }
@@ -422,6 +524,16 @@ pub enum ModalTorqueLimit {
     All(f64),
     /// One limit per coordinate, in coordinate order (N m).
     PerCoordinate(Vec<f64>),
+}
+
+/// An angle limit for every joint, or one per joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum AngleLimit {
+    /// The same limit for every joint (rad).
+    All(f64),
+    /// One limit per joint, base first (rad).
+    PerJoint(Vec<f64>),
 }
 
 /// A torque limit for every joint, or one per joint.
@@ -438,27 +550,39 @@ impl Scenario {
     /// The number of modal coordinates `m`: `2K` with `alpha0` fixed, `2K + 1` with it free
     /// (saturating, for a scenario read from a file whose `harmonics` is not yet validated).
     pub fn n_coords(&self) -> usize {
-        self.modal
-            .harmonics
-            .saturating_mul(2)
-            .saturating_add(usize::from(self.alpha0 == Alpha0::Free))
+        match self.arm.kind {
+            ArmKind::Planar => self
+                .modal
+                .harmonics
+                .saturating_mul(2)
+                .saturating_add(usize::from(self.alpha0 == Some(Alpha0::Free))),
+            ArmKind::Spatial => self.modal.harmonics.saturating_mul(4),
+        }
     }
 
-    /// The names of the modal coordinates, in order: `a1, ..., a{2K}`, then `alpha0` when it is
-    /// free (the column names of the outputs).
+    /// The names of the modal coordinates, in order (the column names of the outputs): for a
+    /// planar arm `a1, ..., a{2K}`, then `alpha0` when it is free; for a spatial arm
+    /// `az1, ..., az{2K}` (in-plane bending), then `ay1, ..., ay{2K}` (out-of-plane).
     ///
     /// ```
     /// let mut scenario = sim_study::Scenario::builtin("paper-tracking")?;
     /// assert_eq!(scenario.coordinate_names(), ["a1", "a2"]);
-    /// scenario.alpha0 = sim_study::Alpha0::Free;
+    /// scenario.alpha0 = Some(sim_study::Alpha0::Free);
     /// assert_eq!(scenario.coordinate_names(), ["a1", "a2", "alpha0"]);
+    /// let spatial = sim_study::Scenario::builtin("spatial-tracking")?;
+    /// assert_eq!(spatial.coordinate_names(), ["az1", "az2", "ay1", "ay2"]);
     /// # Ok::<(), sim_study::ScenarioError>(())
     /// ```
     pub fn coordinate_names(&self) -> Vec<String> {
-        let mut names: Vec<String> = (1..=2 * self.modal.harmonics)
-            .map(|i| format!("a{i}"))
-            .collect();
-        if self.alpha0 == Alpha0::Free {
+        let modes = 2 * self.modal.harmonics;
+        if self.arm.kind == ArmKind::Spatial {
+            return ["az", "ay"]
+                .iter()
+                .flat_map(|plane| (1..=modes).map(move |i| format!("{plane}{i}")))
+                .collect();
+        }
+        let mut names: Vec<String> = (1..=modes).map(|i| format!("a{i}")).collect();
+        if self.alpha0 == Some(Alpha0::Free) {
             names.push("alpha0".into());
         }
         names

@@ -222,7 +222,9 @@ mod tests {
                     max_steps: None,
                 }
             }),
-            ("arm.gravity", |s, v| s.arm.gravity = Some(v)),
+            ("arm.gravity", |s, v| {
+                s.arm.gravity = Some(crate::Gravity::Magnitude(v))
+            }),
             ("reference.target[1]", |s, v| {
                 s.reference = ReferenceSpec::Step {
                     initial: None,
@@ -236,6 +238,7 @@ mod tests {
                     branch: Default::default(),
                     sine: None,
                     points: Some(vec![[0.2, 0.5], [v, 0.5]]),
+                    helix: None,
                 }
             }),
             ("limits.joint_torque_nm", |s, v| {

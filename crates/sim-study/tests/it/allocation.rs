@@ -63,7 +63,7 @@ fn allocations_do_not_grow_with_the_number_of_steps() {
                 let mut scenario = Scenario::builtin(name).unwrap();
                 scenario.modal.harmonics = m / 2;
                 if m % 2 == 1 {
-                    scenario.alpha0 = Alpha0::Free;
+                    scenario.alpha0 = Some(Alpha0::Free);
                 }
                 scenario.controller.kind = kind;
                 scenario.noise = NoiseSpec::uniform(m, 1e-3, 1e-2, 1e-3);

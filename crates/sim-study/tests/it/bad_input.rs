@@ -547,8 +547,17 @@ fn step_response(record_period: f64) -> sim_study::Scenario {
 
 #[test]
 fn limits_and_peaks_checked_between_recorded_samples() {
-    // The torque spike after the step lasts less than a recording period of 0.05 s: the peaks,
-    // limit checks and clamped fractions must see it all the same, whatever is recorded.
+    // The torque spike after the step lasts less than a recording period of 0.05 s: the
+    // enforced limit, the peaks and the clamped fractions must see it all the same, whatever is
+    // recorded.
+    let mut free = step_response(0.0001);
+    free.limits.joint_torque_nm = None;
+    let free = free.build().unwrap().run().unwrap().summary;
+    assert!(
+        free.peak_joint_torque_nm > 50.0,
+        "{}",
+        free.peak_joint_torque_nm
+    );
     let every = step_response(0.0001)
         .build()
         .unwrap()
@@ -557,17 +566,21 @@ fn limits_and_peaks_checked_between_recorded_samples() {
         .summary;
     let sparse = step_response(0.05).build().unwrap().run().unwrap().summary;
     assert!(
-        every.peak_joint_torque_nm > 50.0,
+        every.peak_joint_torque_nm <= 50.0,
         "{}",
         every.peak_joint_torque_nm
     );
+    assert!(every.torque_projection_share.unwrap() > 0.0);
     assert_eq!(sparse.recorded_samples, 2);
     assert_eq!(every.recorded_samples, every.controller_samples);
     assert_eq!(sparse.peak_joint_torque_nm, every.peak_joint_torque_nm);
     assert_eq!(sparse.peak_joint_torques_nm, every.peak_joint_torques_nm);
     assert_eq!(sparse.peak_modal_torques_nm, every.peak_modal_torques_nm);
-    assert_eq!(sparse.torque_limit_exceeded, every.torque_limit_exceeded);
-    assert!(!sparse.torque_limit_exceeded.is_empty());
+    assert_eq!(
+        sparse.torque_projection_share,
+        every.torque_projection_share
+    );
+    assert!(sparse.torque_limit_exceeded.is_empty() && every.torque_limit_exceeded.is_empty());
     assert_eq!(
         sparse.tau_star_clamped_fraction,
         every.tau_star_clamped_fraction

@@ -300,30 +300,42 @@ fn non_finite_torques_and_blow_ups_stop_the_run() {
 }
 
 #[test]
-fn torque_limits_are_reported_not_enforced() {
+fn torque_limits_are_enforced_at_every_sample() {
     let mut s = scenario("paper-responses-step", ControllerKind::Fuzzy, 0.5);
+    let free = s.build().unwrap().run().unwrap().summary;
+    assert!(
+        free.peak_joint_torque_nm > 10.0,
+        "{}",
+        free.peak_joint_torque_nm
+    );
+    assert_eq!(free.torque_projection_share, None);
     s.limits.joint_torque_nm = Some(TorqueLimit::All(10.0));
     let run = s.build().unwrap().run().unwrap();
-    let exceeded = &run.summary.torque_limit_exceeded;
-    assert!(!exceeded.is_empty());
-    for e in exceeded {
-        assert!(e.peak_nm > 10.0 && e.first_time_s >= 0.1 && e.samples_over > 0);
-        assert_eq!(e.peak_nm, run.summary.peak_joint_torques_nm[e.joint]);
-    }
-    let over: Vec<usize> = (0..10)
-        .filter(|&j| run.summary.peak_joint_torques_nm[j] > 10.0)
-        .collect();
-    assert_eq!(over, exceeded.iter().map(|e| e.joint).collect::<Vec<_>>());
-    s.limits.joint_torque_nm = Some(TorqueLimit::PerJoint(vec![1e3; 10]));
+    let summary = &run.summary;
+    // Every controller sample's joint torques are within the limit: the projection acted where
+    // the fuzzy controller alone would have broken it.
+    assert!(summary.torque_limit_exceeded.is_empty());
     assert!(
-        s.build()
-            .unwrap()
-            .run()
-            .unwrap()
-            .summary
-            .torque_limit_exceeded
-            .is_empty()
+        summary.peak_joint_torque_nm <= 10.0,
+        "{}",
+        summary.peak_joint_torque_nm
     );
+    let share = summary.torque_projection_share.unwrap();
+    assert!(share > 0.0 && share < 1.0, "{share}");
+    for k in 0..run.record.len() {
+        assert!(
+            run.record
+                .joint_torques_at(k)
+                .iter()
+                .all(|tau| tau.abs() <= 10.0)
+        );
+    }
+    // A limit never reached changes nothing, bit for bit.
+    s.limits.joint_torque_nm = Some(TorqueLimit::PerJoint(vec![1e3; 10]));
+    let loose = s.build().unwrap().run().unwrap().summary;
+    assert_eq!(loose.torque_projection_share, Some(0.0));
+    assert_eq!(loose.tip_error_rms_m, free.tip_error_rms_m);
+    assert_eq!(loose.peak_joint_torques_nm, free.peak_joint_torques_nm);
 }
 
 /// Bang-bang towards the reference: `-gain sign(a_i - a_i_ref)` per coordinate.
@@ -473,7 +485,6 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
         (base.replace("kind = \"step\"", "kind = \"ramp\""), "ramp"),
         (base.replace("dt = 0.0001", "dtt = 0.0001"), "dtt"),
         (base.replace("time = 0.1", "time = 0.1\nspeed = 3"), "speed"),
-        (base.replace("alpha0 = 1.5707963267948966\n", ""), "alpha0"),
         (format!("{base}\n[arm]\nlinks = \"ten\"\n"), "links"),
     ];
     for (text, needle) in cases {
@@ -483,6 +494,20 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
             "expected '{needle}' in: {err}"
         );
     }
+    // A planar arm needs alpha0; a spatial one refuses it (its base angles are arm.base).
+    let planar = Scenario::from_toml(&base.replace("alpha0 = 1.5707963267948966\n", "")).unwrap();
+    let err = planar.build().err().unwrap().to_string();
+    assert!(
+        err.starts_with("alpha0 is required for a planar arm"),
+        "{err}"
+    );
+    let mut spatial = Scenario::builtin("spatial-tracking").unwrap();
+    spatial.alpha0 = Some(Alpha0::Fixed(0.0));
+    let err = spatial.build().err().unwrap().to_string();
+    assert!(
+        err.starts_with("alpha0 is not used with a spatial arm"),
+        "{err}"
+    );
     let invalid = |edit: fn(&mut Scenario)| {
         let mut s = Scenario::builtin("paper-responses-step").unwrap();
         edit(&mut s);
@@ -536,7 +561,8 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
             travel_time: 1.0,
             branch: Default::default(),
             sine: None,
-            points: None
+            points: None,
+            helix: None,
         })
         .contains("exactly one")
     );
@@ -624,7 +650,7 @@ fn family_step(m: usize, kind: ControllerKind, duration: f64) -> Scenario {
         .map(|i| if i % 2 == 0 { 0.1 } else { -0.05 })
         .collect();
     if m % 2 == 1 {
-        s.alpha0 = Alpha0::Free;
+        s.alpha0 = Some(Alpha0::Free);
         initial[m - 1] = FRAC_PI_2;
         target[m - 1] = FRAC_PI_2 + 0.1;
     }

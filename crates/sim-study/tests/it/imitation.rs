@@ -198,7 +198,7 @@ fn the_learned_fis_reloads_equal_and_is_a_scenario_controller() {
     let mut no_file = scenario.clone();
     no_file.controller.fis = Some(file.with_extension("missing"));
     assert_eq!(in_memory(&no_file), from_file);
-    scenario.alpha0 = Alpha0::Free;
+    scenario.alpha0 = Some(Alpha0::Free);
     scenario.reference = sim_study::ReferenceSpec::Constant {
         a: vec![0.0, 0.0, 1.5],
     };

@@ -1,5 +1,6 @@
 //! The paper's runs must not move: every figure of the `paper-*` scenario summaries, with every
-//! controller, pinned to 1e-9 relative, stored in `tests/it/data/paper_summaries.json`.
+//! controller, pinned to 1e-9 relative, stored in `tests/it/data/paper_summaries.json`; and the
+//! spatial arms' (`spatial-*`), in `tests/it/data/spatial_summaries.json`.
 //!
 //! The fuzzy controllers evaluate an input outside its range as given, as Simulink's Fuzzy
 //! Logic Controller block (which the paper used) and MATLAB's `evalfis` do. On `paper-tracking`
@@ -75,6 +76,35 @@ fn every_paper_summary_is_unchanged() {
             let summary = serde_json::to_value(&run.summary).unwrap();
             assert_matches(&entry["summary"], &summary, &format!("{name}/{kind}"));
         }
+    }
+}
+
+/// The spatial arms' runs must not move either: `spatial-tracking` and `spatial-long` with every
+/// controller but MPC (minutes in a debug build), pinned to 1e-9 relative in
+/// `tests/it/data/spatial_summaries.json`.
+#[test]
+fn every_spatial_summary_is_unchanged() {
+    let pinned: Value =
+        serde_json::from_str(include_str!("data/spatial_summaries.json")).expect("pinned JSON");
+    let pinned = pinned.as_array().expect("a list of runs");
+    let kinds = [
+        ControllerKind::Fuzzy,
+        ControllerKind::Pd,
+        ControllerKind::ComputedTorque,
+        ControllerKind::FuzzyGc,
+        ControllerKind::Lqr,
+    ];
+    assert_eq!(pinned.len(), 2 * kinds.len());
+    for (k, entry) in pinned.iter().enumerate() {
+        let name = ["spatial-tracking", "spatial-long"][k / kinds.len()];
+        let kind = kinds[k % kinds.len()];
+        assert_eq!(entry["scenario"], name);
+        assert_eq!(entry["controller"], kind.name());
+        let mut scenario = Scenario::builtin(name).unwrap();
+        scenario.controller.kind = kind;
+        let run = scenario.build().unwrap().run().unwrap();
+        let summary = serde_json::to_value(&run.summary).unwrap();
+        assert_matches(&entry["summary"], &summary, &format!("{name}/{kind}"));
     }
 }
 

@@ -1,7 +1,8 @@
 //! The spatial chains (`manip_dyn::spatial`): `planar` (the planar chain as a spatial one gives
-//! the planar algorithms' results), `properties` (each algorithm against a second one over
+//! the planar algorithms' results), `massless` (chains with massless links), `properties` (each algorithm against a second one over
 //! random spatial chains), and `sample` for the random chains.
 
+mod massless;
 mod planar;
 mod properties;
 pub mod sample;

@@ -159,6 +159,41 @@ proptest! {
         }
     }
 
+    /// The `O(n^2)` path (`M^-1` from the articulated-body factorisation, theory.md eqs. S1-S3)
+    /// against the Cholesky one: `M^-1` the inverse of the CRBA's `M`, and
+    /// `d qdd / d (q, v) = -M^-1 d tau / d (q, v)` with the RNEA derivatives at the ABA's `qdd`
+    /// (Carpentier and Mansard 2018, eq. 12), to 1e-10 of the largest entry.
+    #[test]
+    fn aba_derivatives_match_the_cholesky_path(
+        (model, q, v, tau) in chain_and_state(30),
+    ) {
+        let n = model.n_links();
+        let mut data = SpatialData::new(&model);
+        let mut derivatives = SpatialDerivativeData::new(&model);
+        aba_derivatives(&model, &mut data, &mut derivatives, &q, &v, &tau).unwrap();
+        let qdd = derivatives.value().to_vec();
+        let inverse = mass(&model, &mut data, &q).llt(Side::Lower).unwrap().inverse();
+        let mut rnea_side = SpatialDerivativeData::new(&model);
+        rnea_derivatives(&model, &mut data, &mut rnea_side, &q, &v, &qdd).unwrap();
+        let d_q = -(&inverse * rnea_side.d_q());
+        let d_v = -(&inverse * rnea_side.d_v());
+        for (ours, theirs) in [
+            (derivatives.d_input(), inverse.as_ref()),
+            (derivatives.d_q(), d_q.as_ref()),
+            (derivatives.d_v(), d_v.as_ref()),
+        ] {
+            let scale = (0..n).flat_map(|j| (0..n).map(move |i| theirs[(i, j)].abs())).fold(0.0, f64::max);
+            for j in 0..n {
+                for i in 0..n {
+                    prop_assert!(
+                        (ours[(i, j)] - theirs[(i, j)]).abs() <= 1e-10 * scale,
+                        "({i}, {j}): {} vs {}", ours[(i, j)], theirs[(i, j)]
+                    );
+                }
+            }
+        }
+    }
+
     /// `qd^T (M_dot - 2 C) qd = 0` in its power form: `qd^T M_dot qd = 2 qd^T C(q, qd) qd`, with
     /// `M_dot` the derivative of `M` along `qd` by finite differences.
     #[test]

@@ -101,3 +101,49 @@ pub fn snake() -> SpatialModel {
     }
     SpatialModel::new(joints, links, [0.0, 0.0, -9.81]).unwrap()
 }
+
+/// A massless link (the cross of a universal joint written as two revolute joints).
+pub const MASSLESS: SpatialLink = SpatialLink {
+    mass: 0.0,
+    com: [0.0; 3],
+    inertia: [[0.0; 3]; 3],
+};
+
+/// A random chain of 2 to `max` joints whose even-numbered links but the last are massless
+/// (every massless link has a link with mass beyond it), and a state `(q, v, tau)`.
+pub fn massless_chain_and_state(
+    max: usize,
+) -> impl Strategy<Value = (SpatialModel, Vec<f64>, Vec<f64>, Vec<f64>)> {
+    (2..=max).prop_flat_map(|n| {
+        (
+            vec(joint(), n),
+            vec(link(), n),
+            [-10.0..10.0f64, -10.0..10.0f64, -10.0..10.0f64],
+            vec(-3.0..3.0f64, n),
+            vec(-2.0..2.0f64, n),
+            vec(-5.0..5.0f64, n),
+        )
+            .prop_map(move |(joints, mut links, g, q, v, tau)| {
+                for link in links.iter_mut().take(n - 1).step_by(2) {
+                    *link = MASSLESS;
+                }
+                (SpatialModel::new(joints, links, g).unwrap(), q, v, tau)
+            })
+    })
+}
+
+/// The universal-joint snake of [`snake`] as URDF writes it: each yaw joint moves a massless
+/// cross, its pitch joint (at the same point) the whole 0.1 kg, 0.1 m link.
+pub fn massless_snake() -> SpatialModel {
+    let joints = snake().joints().to_vec();
+    let links = (0..20)
+        .map(|i| {
+            if i % 2 == 0 {
+                MASSLESS
+            } else {
+                SpatialLink::cuboid(0.1, [0.1, 0.01, 0.01], [0.05, 0.0, 0.0])
+            }
+        })
+        .collect();
+    SpatialModel::new(joints, links, [0.0, 0.0, -9.81]).unwrap()
+}

@@ -1,0 +1,302 @@
+//! General linear constraints on the control of every step of [`Ilqr`](crate::Ilqr): the box
+//! QP of control-limited iLQR grown into a QP with linear constraints ([`LinearQp`]).
+//!
+//! A step's constraints are rows `G u_k <= g` given at the step's state `x_k` (and the control
+//! `u_k` and the Jacobian `B_k = dF/du` around which they may be linearised): the joint-torque
+//! polytope at `x_k` (exactly affine in `u_k`), or a state constraint on the next state
+//! linearised through `x_{k+1} ~ F(x_k, u_k) + B_k (u - u_k)` (joint limits, clearance).
+
+use crate::OptimalError;
+use crate::dense::{cholesky, cholesky_solve};
+use crate::linear_qp::{LinearQp, LinearQpFailure};
+use crate::polytope::PolytopeProjection;
+
+/// The constraints `G u_k <= g` of every step of a constrained [`Ilqr`](crate::Ilqr) solve.
+pub trait StepConstraints {
+    /// The most rows a step may have.
+    fn max_rows(&self) -> usize;
+
+    /// Writes the rows of step `k` at state `x` (`n_x`), around control `u` (`n_u`) with
+    /// `b = dF/du` there (`n_x x n_u`, row-major): `rows` (`r x n_u`, row-major) and `bounds`
+    /// (`r`), and returns `r <= max_rows()`. Called along the nominal trajectory before every
+    /// backward pass, and at every state of a forward pass (with the nominal `b`).
+    ///
+    /// # Errors
+    /// Whatever the model refuses at `x`.
+    fn rows(
+        &mut self,
+        k: usize,
+        x: &[f64],
+        u: &[f64],
+        b: &[f64],
+        rows: &mut [f64],
+        bounds: &mut [f64],
+    ) -> Result<usize, OptimalError>;
+}
+
+/// Rows this far inside their bound count as active for the feedback gain (relative).
+const ACTIVE: f64 = 1e-9;
+
+/// The per-step working memory of a constrained solve: the rows of every step along the
+/// nominal trajectory, and the QP, projection and gain of one step. Allocation-free per use.
+#[derive(Debug, Clone)]
+pub(crate) struct ConstrainedWork {
+    nx: usize,
+    nu: usize,
+    max_rows: usize,
+    /// Per step: the rows (`max_rows x n_u`), bounds (`max_rows`) and their number.
+    pub(crate) rows: Vec<f64>,
+    pub(crate) bounds: Vec<f64>,
+    pub(crate) counts: Vec<usize>,
+    /// One step's rows with the box appended (`max_rows + 2 n_u`), in the step `d` or in `u`.
+    qp_rows: Vec<f64>,
+    qp_bounds: Vec<f64>,
+    qp: LinearQp,
+    projection: PolytopeProjection,
+    projected: Vec<f64>,
+    /// The rows at a forward pass's state (the nominal ones stay for the next backward pass).
+    forward_rows: Vec<f64>,
+    forward_bounds: Vec<f64>,
+    /// The gain's linear algebra: `H`'s factor, `X = H^-1 Q_ux`, the active rows `A`,
+    /// `Y = H^-1 A^T`, `S = A Y` and `A X`.
+    factor: Vec<f64>,
+    x_mat: Vec<f64>,
+    active: Vec<f64>,
+    y_mat: Vec<f64>,
+    s_mat: Vec<f64>,
+    ax: Vec<f64>,
+}
+
+impl ConstrainedWork {
+    pub(crate) fn new(nx: usize, nu: usize, horizon: usize, max_rows: usize) -> Self {
+        let total = max_rows + 2 * nu;
+        Self {
+            nx,
+            nu,
+            max_rows,
+            rows: vec![0.0; horizon * max_rows * nu],
+            bounds: vec![0.0; horizon * max_rows],
+            counts: vec![0; horizon],
+            qp_rows: vec![0.0; total * nu],
+            qp_bounds: vec![0.0; total],
+            qp: LinearQp::new(nu, total),
+            projection: PolytopeProjection::new(nu, total),
+            projected: vec![0.0; nu],
+            forward_rows: vec![0.0; max_rows * nu],
+            forward_bounds: vec![0.0; max_rows],
+            factor: vec![0.0; nu * nu],
+            x_mat: vec![0.0; nu * nx],
+            active: vec![0.0; nu * nu],
+            y_mat: vec![0.0; nu * nu],
+            s_mat: vec![0.0; nu * nu],
+            ax: vec![0.0; nu * nx],
+        }
+    }
+
+    /// The most rows a step may have.
+    pub(crate) fn max_rows(&self) -> usize {
+        self.max_rows
+    }
+
+    /// Evaluates the rows of step `k` at `(x, u)` with `b` into the step's storage.
+    pub(crate) fn evaluate(
+        &mut self,
+        constraints: &mut dyn StepConstraints,
+        k: usize,
+        (x, u, b): (&[f64], &[f64], &[f64]),
+    ) -> Result<(), OptimalError> {
+        let (nu, max) = (self.nu, self.max_rows);
+        let rows = &mut self.rows[k * max * nu..(k + 1) * max * nu];
+        let bounds = &mut self.bounds[k * max..(k + 1) * max];
+        let count = constraints.rows(k, x, u, b, rows, bounds)?;
+        if count > max {
+            return Err(OptimalError::Dimension {
+                name: "step constraint rows",
+                expected: max,
+                found: count,
+            });
+        }
+        self.counts[k] = count;
+        Ok(())
+    }
+
+    /// Copies step `k`'s rows (or `rows`/`bounds` given) and the box into the QP's rows, shifted
+    /// to the step `d = u' - u` when `u` is given; returns the number of rows.
+    fn assemble(
+        &mut self,
+        (rows, bounds): (&[f64], &[f64]),
+        u: Option<&[f64]>,
+        (lower, upper): (&[f64], &[f64]),
+    ) -> usize {
+        let nu = self.nu;
+        let count = bounds.len();
+        self.qp_rows[..count * nu].copy_from_slice(rows);
+        for r in 0..count {
+            let shift = u.map_or(0.0, |u| {
+                rows[r * nu..(r + 1) * nu]
+                    .iter()
+                    .zip(u)
+                    .map(|(g, u)| g * u)
+                    .sum()
+            });
+            self.qp_bounds[r] = bounds[r] - shift;
+        }
+        let mut n = count;
+        for j in 0..nu {
+            let uj = u.map_or(0.0, |u| u[j]);
+            for (sign, bound) in [(1.0, upper[j] - uj), (-1.0, uj - lower[j])] {
+                if bound.is_finite() {
+                    let row = &mut self.qp_rows[n * nu..(n + 1) * nu];
+                    row.fill(0.0);
+                    row[j] = sign;
+                    self.qp_bounds[n] = bound;
+                    n += 1;
+                }
+            }
+        }
+        n
+    }
+
+    /// The feed-forward step of step `k`: `ff = argmin 1/2 d^T H d + q^T d` subject to
+    /// `G (u + d) <= g` and the box, and the gain `K = -(H^-1 - H^-1 A^T (A H^-1 A^T)^-1 A H^-1)
+    /// Q_ux` that keeps the active rows `A` active to first order (zero when they leave no
+    /// freedom): the box QP's "zero gain on the clamped controls", for any rows.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn feedforward(
+        &mut self,
+        k: usize,
+        (h, q, q_ux): (&[f64], &[f64], &[f64]),
+        u: &[f64],
+        bounds: (&[f64], &[f64]),
+        ff: &mut [f64],
+        gain: &mut [f64],
+    ) -> Result<(), OptimalError> {
+        let (nx, nu, max) = (self.nx, self.nu, self.max_rows);
+        let count = self.counts[k];
+        let rows = std::mem::take(&mut self.rows);
+        let step_bounds = std::mem::take(&mut self.bounds);
+        let n = self.assemble(
+            (
+                &rows[k * max * nu..(k * max + count) * nu],
+                &step_bounds[k * max..k * max + count],
+            ),
+            Some(u),
+            bounds,
+        );
+        self.rows = rows;
+        self.bounds = step_bounds;
+        match self
+            .qp
+            .solve(h, q, &self.qp_rows[..n * nu], &self.qp_bounds[..n], ff)
+        {
+            Ok(_) => {}
+            Err(LinearQpFailure::NotPositiveDefinite) => {
+                return Err(OptimalError::NotPositiveDefinite("Q_uu + mu I"));
+            }
+            Err(LinearQpFailure::Projection(_)) => {
+                return Err(OptimalError::Infeasible { step: k });
+            }
+        }
+        // The active rows.
+        let mut na = 0;
+        for r in 0..n {
+            let row = &self.qp_rows[r * nu..(r + 1) * nu];
+            let gd: f64 = row.iter().zip(ff.iter()).map(|(g, d)| g * d).sum();
+            let bound = self.qp_bounds[r];
+            if gd >= bound - ACTIVE * (1.0 + bound.abs()) {
+                if na == nu {
+                    // More active rows than controls: a vertex, no feedback freedom.
+                    gain.fill(0.0);
+                    return Ok(());
+                }
+                self.active[na * nu..(na + 1) * nu].copy_from_slice(row);
+                na += 1;
+            }
+        }
+        self.factor.copy_from_slice(h);
+        if !cholesky(&mut self.factor, nu) {
+            return Err(OptimalError::NotPositiveDefinite("Q_uu + mu I"));
+        }
+        self.x_mat.copy_from_slice(q_ux);
+        cholesky_solve(&self.factor, nu, &mut self.x_mat, nx);
+        gain.copy_from_slice(&self.x_mat);
+        if na > 0 {
+            // Y = H^-1 A^T (nu x na), S = A Y, A X.
+            for i in 0..nu {
+                for a in 0..na {
+                    self.y_mat[i * na + a] = self.active[a * nu + i];
+                }
+            }
+            cholesky_solve(&self.factor, nu, &mut self.y_mat[..nu * na], na);
+            for a in 0..na {
+                for b in 0..na {
+                    self.s_mat[a * na + b] = (0..nu)
+                        .map(|i| self.active[a * nu + i] * self.y_mat[i * na + b])
+                        .sum();
+                }
+                for c in 0..nx {
+                    self.ax[a * nx + c] = (0..nu)
+                        .map(|i| self.active[a * nu + i] * self.x_mat[i * nx + c])
+                        .sum();
+                }
+            }
+            if !cholesky(&mut self.s_mat[..na * na], na) {
+                // Dependent active rows: keep the controls where the rows hold them.
+                gain.fill(0.0);
+                return Ok(());
+            }
+            cholesky_solve(&self.s_mat[..na * na], na, &mut self.ax[..na * nx], nx);
+            for i in 0..nu {
+                for c in 0..nx {
+                    let correction: f64 = (0..na)
+                        .map(|a| self.y_mat[i * na + a] * self.ax[a * nx + c])
+                        .sum();
+                    gain[i * nx + c] -= correction;
+                }
+            }
+        }
+        for g in gain.iter_mut() {
+            *g = -*g;
+        }
+        Ok(())
+    }
+
+    /// Moves `u` (`n_u`) to the closest control within the rows of step `k` at the forward
+    /// pass's state `x` (with the nominal `b`) and the box; `Ok(false)` when none is.
+    pub(crate) fn project(
+        &mut self,
+        constraints: &mut dyn StepConstraints,
+        k: usize,
+        (x, b): (&[f64], &[f64]),
+        box_bounds: (&[f64], &[f64]),
+        u: &mut [f64],
+    ) -> Result<bool, OptimalError> {
+        let (nu, max) = (self.nu, self.max_rows);
+        let count =
+            constraints.rows(k, x, u, b, &mut self.forward_rows, &mut self.forward_bounds)?;
+        if count > max {
+            return Err(OptimalError::Dimension {
+                name: "step constraint rows",
+                expected: max,
+                found: count,
+            });
+        }
+        let rows = std::mem::take(&mut self.forward_rows);
+        let bounds = std::mem::take(&mut self.forward_bounds);
+        let n = self.assemble((&rows[..count * nu], &bounds[..count]), None, box_bounds);
+        self.forward_rows = rows;
+        self.forward_bounds = bounds;
+        match self.projection.project(
+            &self.qp_rows[..n * nu],
+            &self.qp_bounds[..n],
+            u,
+            &mut self.projected,
+        ) {
+            Ok(_) => {
+                u.copy_from_slice(&self.projected);
+                Ok(true)
+            }
+            Err(_) => Ok(false),
+        }
+    }
+}

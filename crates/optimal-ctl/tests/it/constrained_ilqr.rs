@@ -1,0 +1,339 @@
+//! iLQR under general linear control constraints (`Ilqr::solve_constrained`) against the same
+//! problem written as one QP over all the controls (the dynamics condensed,
+//! `x_k = Phi_k x_0 + Gamma_k U`) and solved by `LinearQp`, itself checked against enumeration
+//! of active sets (`qp`): on random linear systems with random quadratic costs and random
+//! polytopes of controls, the two optima agree.
+
+use optimal_ctl::{
+    DiscreteDynamics, Ilqr, IlqrSettings, LinearQp, OptimalError, StepConstraints, TrackingCost,
+};
+use proptest::prelude::*;
+
+/// `x' = A x + B u`.
+struct Linear {
+    a: Vec<f64>,
+    b: Vec<f64>,
+    nx: usize,
+    nu: usize,
+}
+
+impl DiscreteDynamics for Linear {
+    fn state_dim(&self) -> usize {
+        self.nx
+    }
+
+    fn control_dim(&self) -> usize {
+        self.nu
+    }
+
+    fn step(&mut self, x: &[f64], u: &[f64], next: &mut [f64]) -> Result<(), OptimalError> {
+        for (i, out) in next.iter_mut().enumerate().take(self.nx) {
+            *out = (0..self.nx)
+                .map(|j| self.a[i * self.nx + j] * x[j])
+                .sum::<f64>()
+                + (0..self.nu)
+                    .map(|j| self.b[i * self.nu + j] * u[j])
+                    .sum::<f64>();
+        }
+        Ok(())
+    }
+
+    fn linearise(
+        &mut self,
+        x: &[f64],
+        u: &[f64],
+        next: &mut [f64],
+        a: &mut [f64],
+        b: &mut [f64],
+    ) -> Result<(), OptimalError> {
+        a.copy_from_slice(&self.a);
+        b.copy_from_slice(&self.b);
+        self.step(x, u, next)
+    }
+}
+
+/// The same rows `G u <= g` at every step.
+struct Fixed {
+    rows: Vec<f64>,
+    bounds: Vec<f64>,
+}
+
+impl StepConstraints for Fixed {
+    fn max_rows(&self) -> usize {
+        self.bounds.len()
+    }
+
+    fn rows(
+        &mut self,
+        _k: usize,
+        _x: &[f64],
+        _u: &[f64],
+        _b: &[f64],
+        rows: &mut [f64],
+        bounds: &mut [f64],
+    ) -> Result<usize, OptimalError> {
+        rows[..self.rows.len()].copy_from_slice(&self.rows);
+        bounds[..self.bounds.len()].copy_from_slice(&self.bounds);
+        Ok(self.bounds.len())
+    }
+}
+
+/// The optimal controls of the whole horizon as one QP, `min 1/2 U^T H U + q^T U` subject to
+/// `G u_k <= g` for every `k`.
+#[allow(clippy::too_many_arguments)]
+fn condensed(
+    sys: &Linear,
+    cost: &TrackingCost,
+    horizon: usize,
+    x0: &[f64],
+    x_ref: &[f64],
+    constraints: &Fixed,
+) -> Vec<f64> {
+    let (nx, nu, n) = (sys.nx, sys.nu, horizon);
+    let dim = n * nu;
+    // x_k = phi_k + Gamma_k U, built forward.
+    let mut phi = x0.to_vec();
+    let mut gamma = vec![0.0; nx * dim];
+    let mut h = vec![0.0; dim * dim];
+    let mut q = vec![0.0; dim];
+    for k in 0..=n {
+        let weights = if k == n { &cost.terminal } else { &cost.state };
+        for i in 0..nx {
+            let e = phi[i] - x_ref[k * nx + i];
+            for c in 0..dim {
+                q[c] += weights[i] * e * gamma[i * dim + c];
+                for d in 0..dim {
+                    h[c * dim + d] += weights[i] * gamma[i * dim + c] * gamma[i * dim + d];
+                }
+            }
+        }
+        if k == n {
+            break;
+        }
+        for j in 0..nu {
+            h[(k * nu + j) * dim + k * nu + j] += cost.control[j];
+        }
+        let mut next_phi = vec![0.0; nx];
+        let mut next_gamma = vec![0.0; nx * dim];
+        for i in 0..nx {
+            for l in 0..nx {
+                next_phi[i] += sys.a[i * nx + l] * phi[l];
+                for c in 0..dim {
+                    next_gamma[i * dim + c] += sys.a[i * nx + l] * gamma[l * dim + c];
+                }
+            }
+            for j in 0..nu {
+                next_gamma[i * dim + k * nu + j] += sys.b[i * nu + j];
+            }
+        }
+        phi = next_phi;
+        gamma = next_gamma;
+    }
+    let per = constraints.bounds.len();
+    let mut rows = vec![0.0; n * per * dim];
+    let mut bounds = vec![0.0; n * per];
+    for k in 0..n {
+        for r in 0..per {
+            for j in 0..nu {
+                rows[(k * per + r) * dim + k * nu + j] = constraints.rows[r * nu + j];
+            }
+            bounds[k * per + r] = constraints.bounds[r];
+        }
+    }
+    let mut qp = LinearQp::new(dim, n * per);
+    let mut u = vec![0.0; dim];
+    qp.solve(&h, &q, &rows, &bounds, &mut u).unwrap();
+    u
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn constrained_ilqr_matches_the_condensed_qp(
+        a in prop::collection::vec(-0.6..0.6f64, 4),
+        b in prop::collection::vec(-1.0..1.0f64, 4),
+        weights in prop::collection::vec(0.5..3.0f64, 6),
+        x0 in prop::collection::vec(-2.0..2.0f64, 2),
+        x_ref in prop::collection::vec(-2.0..2.0f64, 14),
+        seed_rows in prop::collection::vec(-1.0..1.0f64, 6),
+        slack in prop::collection::vec(0.05..0.5f64, 3),
+    ) {
+        let (nx, nu, horizon) = (2, 2, 6);
+        // A = I + small, B random: a controllable-ish discrete system.
+        let a = vec![1.0 + a[0], a[1], a[2], 1.0 + a[3]];
+        let mut sys = Linear { a, b, nx, nu };
+        let cost = TrackingCost {
+            state: weights[..2].to_vec(),
+            control: weights[2..4].to_vec(),
+            terminal: weights[4..6].to_vec(),
+        };
+        // Three rows that u = 0 satisfies with some slack: the polytope is never empty.
+        let constraints = Fixed { rows: seed_rows, bounds: slack };
+        let expected = condensed(&sys, &cost, horizon, &x0, &x_ref, &constraints);
+        let mut ilqr = Ilqr::new(nx, nu, horizon, &cost).unwrap();
+        ilqr.reserve_constraints(3).unwrap();
+        ilqr.state_references_mut().copy_from_slice(&x_ref);
+        let settings = IlqrSettings {
+            max_iterations: 200,
+            tolerance: 1e-14,
+            gradient_tolerance: 1e-12,
+            ..IlqrSettings::default()
+        };
+        // Only problems whose free optimum breaks a row: the constraints matter.
+        ilqr.solve(&mut sys, &x0, &settings).unwrap();
+        let breaks = ilqr.controls().chunks_exact(nu).any(|u| {
+            constraints.rows.chunks_exact(nu).zip(&constraints.bounds)
+                .any(|(row, g)| row[0] * u[0] + row[1] * u[1] > g + 1e-6)
+        });
+        prop_assume!(breaks);
+        ilqr.controls_mut().fill(0.0);
+        let mut fixed = Fixed { rows: constraints.rows.clone(), bounds: constraints.bounds.clone() };
+        ilqr.solve_constrained(&mut sys, &mut fixed, &x0, &settings).unwrap();
+        let scale = 1.0 + expected.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (got, want) in ilqr.controls().iter().zip(&expected) {
+            prop_assert!(
+                (got - want).abs() < 1e-5 * scale,
+                "iLQR {:?}\nQP   {:?}", ilqr.controls(), expected
+            );
+        }
+        // Every planned control is within the rows.
+        for u in ilqr.controls().chunks_exact(nu) {
+            for (row, g) in constraints.rows.chunks_exact(nu).zip(&constraints.bounds) {
+                prop_assert!(row[0] * u[0] + row[1] * u[1] <= g + 1e-9);
+            }
+        }
+    }
+}
+
+#[test]
+fn constrained_solves_need_their_rows_reserved_and_report_an_empty_polytope() {
+    let cost = TrackingCost {
+        state: vec![1.0; 2],
+        control: vec![1.0; 2],
+        terminal: vec![1.0; 2],
+    };
+    let mut sys = Linear {
+        a: vec![1.0, 0.1, 0.0, 1.0],
+        b: vec![0.0, 0.0, 0.1, 0.1],
+        nx: 2,
+        nu: 2,
+    };
+    let mut ilqr = Ilqr::new(2, 2, 4, &cost).unwrap();
+    // u_1 <= -1 and -u_1 <= -1: no control.
+    let mut empty = Fixed {
+        rows: vec![1.0, 0.0, -1.0, 0.0],
+        bounds: vec![-1.0, -1.0],
+    };
+    let settings = IlqrSettings::default();
+    let refused = ilqr.solve_constrained(&mut sys, &mut empty, &[1.0, 0.0], &settings);
+    assert!(
+        matches!(refused, Err(OptimalError::InvalidSetting { .. })),
+        "{refused:?}"
+    );
+    ilqr.reserve_constraints(2).unwrap();
+    let refused = ilqr.solve_constrained(&mut sys, &mut empty, &[1.0, 0.0], &settings);
+    assert_eq!(refused.unwrap_err(), OptimalError::Infeasible { step: 3 });
+}
+
+/// The paper's arm with `alpha0 = pi/2` fixed.
+fn paper_arm() -> modal_reduce::ReducedModel {
+    modal_reduce::ReducedModel::new(
+        manip_dyn::ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
+        backbone_kin::ModalMap::paper_fixed_alpha0(10, std::f64::consts::FRAC_PI_2).unwrap(),
+    )
+    .unwrap()
+}
+
+/// The joint torques of `tau_star` at `(a, a_dot)` by RNEA on the full chain (eq 12) with the
+/// joint accelerations `J a_ddot` of the reduced forward dynamics (eq 15).
+fn rnea_torques(
+    model: &modal_reduce::ReducedModel,
+    a: &[f64],
+    a_dot: &[f64],
+    u: &[f64],
+) -> Vec<f64> {
+    let mut data = modal_reduce::ReducedData::new(model);
+    let mut a_ddot = [0.0; 2];
+    modal_reduce::forward_dynamics(model, &mut data, a, a_dot, u, &mut a_ddot).unwrap();
+    let (mut q, mut v, mut qdd, mut tau) = ([0.0; 10], [0.0; 10], [0.0; 10], vec![0.0; 10]);
+    let map = model.map();
+    map.joint_angles(a, &mut q).unwrap();
+    map.joint_rates(a_dot, &mut v).unwrap();
+    map.joint_rates(&a_ddot, &mut qdd).unwrap();
+    let mut chain = manip_dyn::ChainData::new(model.chain());
+    manip_dyn::rnea(model.chain(), &mut chain, &q, &v, &qdd, &mut tau).unwrap();
+    tau
+}
+
+#[test]
+fn the_joint_torque_rows_are_the_chain_s_torques() {
+    let model = paper_arm();
+    let mut rows = optimal_ctl::JointTorqueRows::new(&model, &[2.0; 10]).unwrap();
+    let (mut g, mut bounds) = (vec![0.0; 40], vec![0.0; 20]);
+    let x = [0.4, -0.3, 1.5, -0.7];
+    assert_eq!(
+        rows.rows(0, &x, &[0.0; 2], &[], &mut g, &mut bounds)
+            .unwrap(),
+        20
+    );
+    for u in [[0.0, 0.0], [1.3, -0.4], [-2.0, 3.0]] {
+        let tau = rnea_torques(&model, &x[..2], &x[2..], &u);
+        for j in 0..10 {
+            // Row 2j is A_j u <= limit - b_j: A_j u + b_j = tau_j.
+            let affine = g[2 * j * 2] * u[0] + g[2 * j * 2 + 1] * u[1] + (2.0 - bounds[2 * j]);
+            assert!(
+                (affine - tau[j]).abs() < 1e-10,
+                "joint {j}: {affine} vs {}",
+                tau[j]
+            );
+            assert_eq!(g[(2 * j + 1) * 2], -g[2 * j * 2]);
+            assert!((bounds[2 * j + 1] - (2.0 + (2.0 - bounds[2 * j]))).abs() < 1e-12);
+        }
+    }
+}
+
+/// MPC on the paper's arm towards a bent shape: the unconstrained plan asks for joint torques
+/// beyond 3 N m; the plan within the joint-torque polytope keeps every node's joint torques
+/// (by RNEA, at the planned states) within them.
+#[test]
+fn mpc_plans_within_the_joint_torque_limits() {
+    let model = paper_arm();
+    let mut settings = optimal_ctl::MpcSettings::uniform(2);
+    settings.horizon = 30;
+    let limit = 3.0;
+    let target = ([0.6, -0.4], [0.0; 2], [0.0; 2]);
+    let plan = |constrained: bool| {
+        let mut mpc = optimal_ctl::Mpc::new(&model, &settings).unwrap();
+        for k in 0..=mpc.horizon() {
+            mpc.set_reference(&model, k, &target.0, &target.1, &target.2)
+                .unwrap();
+        }
+        let mut rows = optimal_ctl::JointTorqueRows::new(&model, &[limit; 10]).unwrap();
+        for _ in 0..4 {
+            if constrained {
+                mpc.solve_constrained(&model, &[0.0; 2], &[0.0; 2], &mut rows)
+                    .unwrap();
+            } else {
+                mpc.solve(&model, &[0.0; 2], &[0.0; 2]).unwrap();
+            }
+        }
+        let ilqr = mpc.ilqr();
+        let peak = (0..ilqr.horizon())
+            .map(|k| {
+                let x = &ilqr.states()[k * 4..(k + 1) * 4];
+                let u = &ilqr.controls()[k * 2..(k + 1) * 2];
+                rnea_torques(&model, &x[..2], &x[2..], u)
+                    .iter()
+                    .fold(0.0f64, |m, t| m.max(t.abs()))
+            })
+            .fold(0.0f64, f64::max);
+        (peak, ilqr.states()[ilqr.horizon() * 4])
+    };
+    let (free_peak, _) = plan(false);
+    assert!(free_peak > 1.5 * limit, "{free_peak}");
+    let (peak, a1_end) = plan(true);
+    assert!(peak <= limit * (1.0 + 1e-9), "{peak}");
+    // ... and still moves towards the target.
+    assert!(a1_end > 0.1, "{a1_end}");
+}

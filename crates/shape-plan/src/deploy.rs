@@ -1,0 +1,383 @@
+//! Follow-the-leader deployment of a planar arm with a base insertion axis into a channel
+//! (`docs/theory.md`, "Follow-the-leader deployment").
+//!
+//! The channel is a centreline polyline `P_0, ..., P_M` and a radius; the insertion axis is the
+//! line through the entry `P_0` along the first segment's direction `d`. The tip's path is
+//! `Gamma(sigma)`: `P_0 + sigma d` behind the entry (`sigma <= 0`, the guide the arm comes
+//! from) and the centreline at arc length `sigma` beyond it. At tip progress `tau` the tip is
+//! `Gamma(tau)` and every joint lies on `Gamma` too: from the tip backwards, joint `k` is the first
+//! point of `Gamma` behind joint `k + 1` at the chord distance `L_k`. The base joint lands on the
+//! axis at `sigma_0 <= 0`, which fixes the prismatic insertion `q = sigma_0 + l` (`q = 0`: fully
+//! retracted, tip at the entry). This is the discrete chain's exact follow-the-leader shape:
+//! the body occupies the path its tip traced.
+//!
+//! The revolute joints follow the constant modal map of the whole chain, `theta = J a + theta_0`
+//! (eq 8, `alpha0` the axis's angle, `K` harmonics): the deployed length changes only `q`, and the
+//! modal coordinates at each step are the least-squares fit `a = argmin |J a + theta_0 -
+//! theta_FTL|`, exact when `2K = n`. The metrics are those of the chain the fit realises.
+
+use crate::error::{PlanError, check_finite};
+use backbone_kin::{BaseAngle, ModalMap, joint_positions};
+use optimal_ctl::LinearQp;
+
+/// The most centreline points a [`Channel`] accepts.
+pub const MAX_CENTERLINE_POINTS: usize = 100_000;
+/// The most deployment steps [`follow_the_leader`] accepts.
+pub const MAX_DEPLOY_STEPS: usize = 10_000;
+/// The most the centreline may be longer than the shortest link, as a ratio (bounds the
+/// backward search of each joint).
+pub const MAX_LENGTH_RATIO: f64 = 1e6;
+/// Points per link at which the body's distances to the path and the walls are sampled.
+const SAMPLES_PER_LINK: usize = 32;
+
+/// A planar channel: a centreline polyline (the plane `z = 0`) and its radius.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Channel {
+    points: Vec<[f64; 2]>,
+    /// Arc length at each point.
+    arcs: Vec<f64>,
+    radius: f64,
+}
+
+impl Channel {
+    /// A channel along `centerline` (at least two points, consecutive points distinct) of
+    /// `radius` (positive).
+    pub fn new(centerline: &[[f64; 2]], radius: f64) -> Result<Self, PlanError> {
+        if centerline.len() < 2 {
+            return Err(PlanError::Dimension {
+                name: "deploy centerline (at least 2 points)",
+                expected: 2,
+                found: centerline.len(),
+            });
+        }
+        if centerline.len() > MAX_CENTERLINE_POINTS {
+            return Err(PlanError::TooMany {
+                name: "deploy centerline points",
+                got: centerline.len(),
+                max: MAX_CENTERLINE_POINTS,
+            });
+        }
+        check_finite("deploy radius", radius)?;
+        if radius <= 0.0 {
+            return Err(PlanError::OutOfRange {
+                name: "deploy radius",
+                bound: "positive",
+                value: radius,
+            });
+        }
+        for x in centerline.iter().flatten() {
+            check_finite("deploy centerline coordinate", *x)?;
+        }
+        let mut arcs = vec![0.0];
+        for pair in centerline.windows(2) {
+            let step = dist(pair[0], pair[1]);
+            if step.is_nan() || step <= 0.0 {
+                return Err(PlanError::OutOfRange {
+                    name: "deploy centerline segment length",
+                    bound: "positive (consecutive points distinct)",
+                    value: step,
+                });
+            }
+            arcs.push(arcs.last().copied().unwrap_or(0.0) + step);
+        }
+        Ok(Self {
+            points: centerline.to_vec(),
+            arcs,
+            radius,
+        })
+    }
+
+    /// The centreline's length.
+    pub fn length(&self) -> f64 {
+        self.arcs.last().copied().unwrap_or(0.0)
+    }
+
+    /// The radius.
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// The entry `P_0`.
+    pub fn entry(&self) -> [f64; 2] {
+        self.points[0]
+    }
+
+    /// The insertion axis's direction `d` (unit).
+    pub fn axis(&self) -> [f64; 2] {
+        let (a, b) = (self.points[0], self.points[1]);
+        let length = dist(a, b);
+        [(b[0] - a[0]) / length, (b[1] - a[1]) / length]
+    }
+
+    /// `Gamma(sigma)`: on the axis behind the entry for `sigma <= 0`, on the centreline beyond
+    /// (held at its end past its length).
+    pub fn point_at(&self, sigma: f64) -> [f64; 2] {
+        if sigma <= 0.0 {
+            let (e, d) = (self.entry(), self.axis());
+            return [e[0] + sigma * d[0], e[1] + sigma * d[1]];
+        }
+        let k = self
+            .arcs
+            .partition_point(|&s| s <= sigma)
+            .min(self.points.len() - 1);
+        let (a, b) = (self.points[k - 1], self.points[k]);
+        let t = ((sigma - self.arcs[k - 1]) / (self.arcs[k] - self.arcs[k - 1])).min(1.0);
+        [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
+    }
+
+    /// The distance of `x` from the guide (the axis behind the entry) and the centreline.
+    pub fn distance(&self, x: [f64; 2]) -> f64 {
+        let (e, d) = (self.entry(), self.axis());
+        // The ray E - s d, s >= 0.
+        let along = ((x[0] - e[0]) * d[0] + (x[1] - e[1]) * d[1]).min(0.0);
+        let mut best = dist(x, [e[0] + along * d[0], e[1] + along * d[1]]);
+        for pair in self.points.windows(2) {
+            best = best.min(point_segment(x, pair[0], pair[1]));
+        }
+        best
+    }
+}
+
+/// One step of a deployment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeployFrame {
+    /// The tip's progress `tau` along the centreline, m.
+    pub progress: f64,
+    /// The prismatic insertion `q` (the base joint at `sigma_0 = q - l` on the axis), m.
+    pub insertion: f64,
+    /// The exact follow-the-leader joint angles (`theta_1` from the `x` axis).
+    pub theta: Vec<f64>,
+    /// The modal coordinates fitted to them.
+    pub modal: Vec<f64>,
+    /// The joint points of the chain the modal coordinates realise, base first.
+    pub points: Vec<[f64; 2]>,
+}
+
+/// What a deployment achieved, over all its steps (realised by the modal chain).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DeployMetrics {
+    /// The largest distance of the tip from the centreline, m.
+    pub tip_error: f64,
+    /// The largest distance of the body from the path its tip traced (with the axis behind the
+    /// entry), as a percentage of the deployed length at that step.
+    pub shape_deviation_percent: f64,
+    /// The smallest clearance of the links' capsules to the channel's walls, m (sampled at
+    /// `32` points a link; the sampling can overstate it by at most `L_max / 64`).
+    pub min_wall_clearance: f64,
+    /// The final deployed length (the tip's progress), m.
+    pub deployed_length: f64,
+}
+
+/// A deployment: its steps and metrics.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Deployment {
+    /// The steps, tip progress from `0` to the deployed length.
+    pub frames: Vec<DeployFrame>,
+    /// The metrics over all steps.
+    pub metrics: DeployMetrics,
+}
+
+/// Deploys the planar chain of `link_lengths` (links of radius `link_radius`) into `channel`
+/// by follow-the-leader (module docs) in `steps` equal steps of tip progress up to `depth`
+/// (at most the centreline's length), fitting `harmonics` harmonics at each step.
+///
+/// Errors: input errors for sizes and numbers (including a centreline longer than
+/// [`MAX_LENGTH_RATIO`] shortest links); [`PlanError::OutOfRange`] when `depth` exceeds
+/// the centreline or would pull the base past the entry (the arm is shorter than the depth).
+pub fn follow_the_leader(
+    channel: &Channel,
+    link_lengths: &[f64],
+    link_radius: f64,
+    harmonics: usize,
+    depth: f64,
+    steps: usize,
+) -> Result<Deployment, PlanError> {
+    check_finite("link radius", link_radius)?;
+    check_finite("deploy depth", depth)?;
+    if !(0.0..=channel.length()).contains(&depth) {
+        return Err(PlanError::OutOfRange {
+            name: "deploy depth",
+            bound: "within [0, the centreline's length]",
+            value: depth,
+        });
+    }
+    if steps == 0 || steps > MAX_DEPLOY_STEPS {
+        return Err(PlanError::TooMany {
+            name: "deploy steps (at least 1)",
+            got: steps,
+            max: MAX_DEPLOY_STEPS,
+        });
+    }
+    let shortest = link_lengths.iter().copied().fold(f64::INFINITY, f64::min);
+    if channel.length() + link_lengths.iter().sum::<f64>() > MAX_LENGTH_RATIO * shortest {
+        return Err(PlanError::OutOfRange {
+            name: "deploy centerline length over the shortest link",
+            bound: "at most 1e6",
+            value: channel.length() / shortest,
+        });
+    }
+    let axis = channel.axis();
+    let alpha0 = axis[1].atan2(axis[0]);
+    let map = ModalMap::new(link_lengths, harmonics, BaseAngle::Fixed(alpha0))?;
+    let (n, m) = (link_lengths.len(), map.n_coords());
+    let length: f64 = link_lengths.iter().sum();
+    // The normal equations of the fit, J^T J (constant), through LinearQp without constraints.
+    let mut normal = vec![0.0; m * m];
+    for i in 0..m {
+        for j in 0..m {
+            normal[i * m + j] = (0..n).map(|k| map.entry(k, i) * map.entry(k, j)).sum();
+        }
+    }
+    let mut qp = LinearQp::new(m, 0);
+    let mut linear = vec![0.0; m];
+    let mut frames = Vec::with_capacity(steps + 1);
+    let mut sigma = vec![0.0; n + 1];
+    let mut joints = vec![[0.0; 2]; n + 1];
+    let mut traced: Vec<[f64; 2]> = Vec::with_capacity(steps + 1);
+    let mut metrics = DeployMetrics {
+        tip_error: 0.0,
+        shape_deviation_percent: 0.0,
+        min_wall_clearance: f64::INFINITY,
+        deployed_length: depth,
+    };
+    for step in 0..=steps {
+        let tau = depth * step as f64 / steps as f64;
+        // Joints on Gamma, from the tip back.
+        sigma[n] = tau;
+        joints[n] = channel.point_at(tau);
+        for k in (0..n).rev() {
+            sigma[k] = chord_back(channel, sigma[k + 1], joints[k + 1], link_lengths[k]);
+            joints[k] = channel.point_at(sigma[k]);
+        }
+        let base_sigma = sigma[0];
+        if base_sigma > 1e-12 * length {
+            return Err(PlanError::OutOfRange {
+                name: "deploy depth (the base would pass the entry: the arm is too short)",
+                bound: "reachable with the base behind the entry",
+                value: depth,
+            });
+        }
+        let mut theta = vec![0.0; n];
+        // Absolute link angles, each within half a turn of the previous one (the first of the
+        // axis's angle), and theta_k their differences (theta_1 from the x axis).
+        let (mut previous, mut reference) = (0.0, alpha0);
+        for k in 0..n {
+            let (a, b) = (joints[k], joints[k + 1]);
+            let phi = unwrap(reference, (b[1] - a[1]).atan2(b[0] - a[0]));
+            theta[k] = phi - previous;
+            (previous, reference) = (phi, phi);
+        }
+        // The fit: J^T J a = J^T (theta - theta_0).
+        for (l, q) in linear.iter_mut().enumerate() {
+            *q = -(0..n)
+                .map(|k| map.entry(k, l) * (theta[k] - map.offset()[k]))
+                .sum::<f64>();
+        }
+        let mut modal = vec![0.0; m];
+        qp.solve(&normal, &linear, &[], &[], &mut modal)
+            .map_err(|_| PlanError::OutOfRange {
+                name: "harmonics (the fit needs at least 2K links)",
+                bound: "at most half the links",
+                value: harmonics as f64,
+            })?;
+        let mut fitted = vec![0.0; n];
+        map.joint_angles(&modal, &mut fitted)?;
+        let mut points = vec![[0.0; 2]; n + 1];
+        joint_positions(link_lengths, &fitted, &mut points)?;
+        for p in &mut points {
+            p[0] += joints[0][0];
+            p[1] += joints[0][1];
+        }
+        // Metrics of the realised chain.
+        let tip = points[n];
+        traced.push(tip);
+        metrics.tip_error = metrics.tip_error.max(channel.distance(tip));
+        let deployed = tau.max(f64::EPSILON);
+        let mut deviation: f64 = 0.0;
+        for pair in points.windows(2) {
+            for s in 0..=SAMPLES_PER_LINK {
+                let t = s as f64 / SAMPLES_PER_LINK as f64;
+                let x = [
+                    pair[0][0] + t * (pair[1][0] - pair[0][0]),
+                    pair[0][1] + t * (pair[1][1] - pair[0][1]),
+                ];
+                metrics.min_wall_clearance = metrics
+                    .min_wall_clearance
+                    .min(channel.radius - link_radius - channel.distance(x));
+                deviation = deviation.max(traced_distance(channel, &traced, x));
+            }
+        }
+        if tau > 0.0 {
+            metrics.shape_deviation_percent = metrics
+                .shape_deviation_percent
+                .max(100.0 * deviation / deployed);
+        }
+        frames.push(DeployFrame {
+            progress: tau,
+            insertion: base_sigma + length,
+            theta,
+            modal,
+            points,
+        });
+    }
+    Ok(Deployment { frames, metrics })
+}
+
+/// The largest `sigma < from` (searched backwards in steps of a tenth of the chord, then
+/// bisected) with `|Gamma(sigma) - joint| = chord`: behind the entry `Gamma` is a straight ray,
+/// so such a point exists.
+fn chord_back(channel: &Channel, from: f64, joint: [f64; 2], chord: f64) -> f64 {
+    let step = 0.1 * chord;
+    let (mut hi, mut lo) = (from, from - step);
+    while dist(channel.point_at(lo), joint) < chord {
+        hi = lo;
+        lo -= step;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid == lo || mid == hi {
+            break;
+        }
+        if dist(channel.point_at(mid), joint) < chord {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// `angle` moved by whole turns to within `pi` of `previous`.
+fn unwrap(previous: f64, angle: f64) -> f64 {
+    let turns = ((angle - previous) / std::f64::consts::TAU).round();
+    angle - turns * std::f64::consts::TAU
+}
+
+/// The distance of `x` from the tip's traced polyline joined to the axis behind the entry.
+fn traced_distance(channel: &Channel, traced: &[[f64; 2]], x: [f64; 2]) -> f64 {
+    let (e, d) = (channel.entry(), channel.axis());
+    let along = ((x[0] - e[0]) * d[0] + (x[1] - e[1]) * d[1]).min(0.0);
+    let mut best = dist(x, [e[0] + along * d[0], e[1] + along * d[1]]);
+    if let Some(first) = traced.first() {
+        best = best.min(point_segment(x, e, *first));
+    }
+    for pair in traced.windows(2) {
+        best = best.min(point_segment(x, pair[0], pair[1]));
+    }
+    best
+}
+
+fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+fn point_segment(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let length2 = d[0] * d[0] + d[1] * d[1];
+    let t = if length2 > 0.0 {
+        (((x[0] - a[0]) * d[0] + (x[1] - a[1]) * d[1]) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    dist(x, [a[0] + t * d[0], a[1] + t * d[1]])
+}

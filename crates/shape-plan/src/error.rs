@@ -1,0 +1,137 @@
+//! The error type of this crate.
+
+use lane_math::{Classify, ErrorClass};
+
+/// Why a plan was refused or not found; every variant names the condition.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PlanError {
+    /// No start led to a shape that reaches the target with the clearance: the best shape
+    /// reached is reported (the one with the smallest tip error, ties broken by clearance).
+    #[error(
+        "no collision-free shape found: the best shape reached has clearance {best_clearance} m \
+         (needed {needed} m) with its tip {tip_error} m from the target, after {starts} starts"
+    )]
+    NoCollisionFreeShape {
+        /// The smallest clearance (to obstacles and to itself) of the best shape reached, m.
+        best_clearance: f64,
+        /// The clearance a shape must keep (the task's margin plus the check slack), m.
+        needed: f64,
+        /// The distance of that shape's tip from the target, m.
+        tip_error: f64,
+        /// How many starts were tried.
+        starts: usize,
+    },
+    /// Collision-free shapes reach the target but no checked path leads to any of them.
+    #[error(
+        "no collision-free motion found: {shapes} collision-free shapes reach the target, but \
+         every path tried from the initial shape comes within {best_clearance} m of a collision \
+         (needed {needed} m)"
+    )]
+    NoCollisionFreeMotion {
+        /// How many goal shapes were found.
+        shapes: usize,
+        /// The largest, over the paths tried, of the smallest clearance checked on the path, m.
+        best_clearance: f64,
+        /// The clearance every check point must keep, m.
+        needed: f64,
+    },
+    /// The initial shape is already closer to an obstacle or to itself than the margin.
+    #[error(
+        "the initial shape has clearance {clearance} m, less than the {needed} m the motion \
+         must keep"
+    )]
+    InitialTooClose {
+        /// The initial shape's smallest clearance, m.
+        clearance: f64,
+        /// The clearance every check point must keep, m.
+        needed: f64,
+    },
+    /// The target is farther from the base than the arm is long.
+    #[error("target is {distance} m from the base, beyond the arm's length {length} m")]
+    OutOfReach {
+        /// Distance of the target from the base, m.
+        distance: f64,
+        /// The arm's length, m.
+        length: f64,
+    },
+    /// A number outside its domain.
+    #[error("{name} must be {bound}, got {value}")]
+    OutOfRange {
+        /// Which input.
+        name: &'static str,
+        /// What it must be, as words.
+        bound: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// A count beyond its limit.
+    #[error("{name} must be at most {max}, got {got}")]
+    TooMany {
+        /// Which count.
+        name: &'static str,
+        /// The count asked for.
+        got: usize,
+        /// The limit.
+        max: usize,
+    },
+    /// A slice had the wrong number of entries.
+    #[error("{name} has {found} entries, expected {expected}")]
+    Dimension {
+        /// Which input.
+        name: &'static str,
+        /// The length expected.
+        expected: usize,
+        /// The length found.
+        found: usize,
+    },
+    /// The clearance computation refused its input.
+    #[error(transparent)]
+    Clearance(#[from] clearance::ClearanceError),
+    /// The kinematics refused its input.
+    #[error(transparent)]
+    Kinematics(#[from] backbone_kin::KinError),
+}
+
+impl Classify for PlanError {
+    /// A target without a collision-free shape or motion is unreachable; wrapped errors keep
+    /// their class; every other error is invalid input.
+    fn class(&self) -> ErrorClass {
+        match self {
+            Self::NoCollisionFreeShape { .. }
+            | Self::NoCollisionFreeMotion { .. }
+            | Self::OutOfReach { .. } => ErrorClass::Unreachable,
+            Self::Clearance(error) => error.class(),
+            Self::Kinematics(error) => error.class(),
+            _ => ErrorClass::InvalidInput,
+        }
+    }
+}
+
+pub(crate) fn check_finite(name: &'static str, value: f64) -> Result<(), PlanError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(PlanError::OutOfRange {
+            name,
+            bound: "finite",
+            value,
+        })
+    }
+}
+
+pub(crate) fn check_len(
+    name: &'static str,
+    found: usize,
+    expected: usize,
+) -> Result<(), PlanError> {
+    if found == expected {
+        Ok(())
+    } else {
+        Err(PlanError::Dimension {
+            name,
+            expected,
+            found,
+        })
+    }
+}

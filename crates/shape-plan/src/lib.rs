@@ -1,0 +1,30 @@
+#![doc = include_str!("../README.md")]
+
+mod arm;
+mod data;
+mod deploy;
+mod error;
+mod generator;
+mod motion;
+mod options;
+mod planar;
+mod planner;
+mod shape;
+mod spatial;
+
+pub use arm::{Arm, ArmScratch};
+pub use data::PlanData;
+pub use deploy::{
+    Channel, DeployFrame, DeployMetrics, Deployment, MAX_CENTERLINE_POINTS, MAX_DEPLOY_STEPS,
+    MAX_LENGTH_RATIO, follow_the_leader,
+};
+pub use error::PlanError;
+pub use generator::{
+    MAX_PASSAGE_OBSTACLES, NarrowPassage, PassageSpec, narrow_passage, spatial_narrow_passage,
+};
+pub use motion::{SegmentCheck, check_segment};
+pub use options::{MAX_CHECKS, MAX_ITERATIONS, MAX_SAMPLES, PlanOptions};
+pub use planar::PlanarArm;
+pub use planner::{Plan, Planner};
+pub use shape::{ShapeOutcome, solve_shape};
+pub use spatial::SpatialArm;

@@ -1,0 +1,218 @@
+//! Scenarios on a spatial modal arm (`[arm] kind = "spatial"`): the arm's reduced model, its
+//! tip path in space, and which of the planar keys it refuses.
+
+use super::arm::{ArmKind, Gravity, Inertias};
+use super::schema::{Alpha0, ArmSpec, BranchSpec, HelixSpec, ReferenceSpec, Scenario};
+use backbone_kin::{BasePose, Branch, SpatialModalMap};
+use manip_dyn::DynError;
+use modal_reduce::spatial::{SpatialLinkInertia, SpatialReducedModel};
+use modal_reduce::{PlantModel, ReduceError};
+use sim_core::reference::{Helix, SpatialPath};
+use sim_core::{Prepared, ReferenceFactory, SimError, check_finite};
+
+/// Gravity of a spatial arm without `arm.gravity`: 9.81 m/s^2 along `-z`.
+const DEFAULT_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
+
+impl Scenario {
+    /// The modal arm of the scenario, planar ([`model`](Self::model)) or spatial
+    /// ([`spatial_model`](Self::spatial_model)), as the loop takes it.
+    pub fn plant(&self) -> Result<PlantModel, SimError> {
+        match self.arm.kind {
+            ArmKind::Planar => self.model().map(PlantModel::Planar),
+            ArmKind::Spatial => self.spatial_model().map(PlantModel::Spatial),
+        }
+    }
+
+    /// The reduced model of a spatial arm (`[arm] kind = "spatial"`) with `modal.harmonics = K`
+    /// harmonics per bending plane (`m = 4K`). Refuses a planar arm, `alpha0` (the base pose
+    /// `arm.base` holds a spatial arm's base angles), a family with no harmonic or more than
+    /// `n / 2` (two coordinates per plane and harmonic: more would leave the reduced mass
+    /// matrix singular), or one whose dynamics take more than
+    /// [`MAX_LOOP_WORK`](sim_core::MAX_LOOP_WORK) per evaluation; the arm's own errors are
+    /// [`ArmSpec::to_spatial`]'s.
+    pub fn spatial_model(&self) -> Result<SpatialReducedModel, SimError> {
+        if self.arm.kind != ArmKind::Spatial {
+            return Err(SimError::setting(
+                "arm.kind",
+                "is \"planar\": the planar arm's model is Scenario::model",
+            ));
+        }
+        if self.alpha0.is_some() {
+            return Err(SimError::setting(
+                "alpha0",
+                "is not used with a spatial arm: its base angles are arm.base.rpy",
+            ));
+        }
+        self.arm.to_spatial(self.modal.harmonics)
+    }
+
+    /// The reference of a spatial scenario for `model`: the modal kinds as for a planar arm
+    /// (`m = 4K` entries per array), or a path of kind `path` with a `helix`.
+    pub(super) fn spatial_reference(
+        &self,
+        model: &SpatialReducedModel,
+    ) -> Result<ReferenceFactory, SimError> {
+        let ReferenceSpec::Path {
+            travel_time,
+            branch,
+            sine,
+            points,
+            helix,
+        } = &self.reference
+        else {
+            return self.reference.build(
+                0.0,
+                self.modal.harmonics,
+                Alpha0::Fixed(0.0),
+                model.n_coords(),
+            );
+        };
+        let helix = match (sine, points, helix) {
+            (None, None, Some(helix)) => helix,
+            _ => {
+                return Err(SimError::setting(
+                    "reference",
+                    "of kind \"path\" on a spatial arm needs a `helix` (and no `sine` or \
+                     `points`, which are paths in the plane)",
+                ));
+            }
+        };
+        let branch = match branch {
+            BranchSpec::Positive => Branch::Positive,
+            BranchSpec::Negative => Branch::Negative,
+        };
+        Ok(Prepared::reference_clones(SpatialPath::new(
+            helix.helix(),
+            *travel_time,
+            model.map().clone(),
+            *model.base(),
+            branch,
+        )?))
+    }
+}
+
+impl HelixSpec {
+    /// The helix of `sim-core`.
+    fn helix(&self) -> Helix {
+        Helix {
+            center: self.center,
+            axis: self.axis,
+            start: self.start,
+            pitch: self.pitch,
+            turns: self.turns,
+        }
+    }
+}
+
+impl ArmSpec {
+    /// The spatial arm with `harmonics` harmonics per plane: `links` links of `link_length` and
+    /// `link_mass` (the paper's 10 of 0.1 m and 0.1 kg by default), per-link `lengths` and
+    /// `masses` overriding, slender rods (`Ixx = 0`, `Iyy = Izz = m L^2 / 12`) unless `inertias` gives each
+    /// link's `[Ixx, Iyy, Izz]`, universal joints, leaving `base` under `gravity` (default
+    /// `[0, 0, -9.81]`; a number `g` is `[0, 0, -g]`). The number of links is checked against
+    /// [`backbone_kin::MAX_LINKS`] before any per-link array is allocated.
+    ///
+    /// # Errors
+    /// [`SimError::InvalidSetting`] naming the field: lists of different lengths, no link or too many, a non-positive or non-finite length or
+    /// mass (`arm.lengths[3]`), an inertia that is negative, not finite or breaks the triangle
+    /// inequality (`arm.inertias[3]`), a non-finite base pose or gravity, a URDF, and harmonics
+    /// out of range (`modal.harmonics`).
+    pub fn to_spatial(&self, harmonics: usize) -> Result<SpatialReducedModel, SimError> {
+        if self.urdf.is_some() {
+            return Err(SimError::setting(
+                "arm.urdf",
+                "is not used with a spatial modal arm (a URDF chain runs in the joint-space \
+                 loop)",
+            ));
+        }
+        let inertias = match &self.inertias {
+            None => None,
+            Some(Inertias::Principal(values)) => Some(values),
+            Some(Inertias::PerLink(_)) => {
+                return Err(SimError::setting(
+                    "arm.inertias",
+                    "of a spatial arm gives [Ixx, Iyy, Izz] per link (kg m^2, about the centre \
+                     of mass in the link frame), not one number per link",
+                ));
+            }
+        };
+        let n = self.link_count(inertias.map(Vec::len))?;
+        let k = harmonics;
+        if k == 0 {
+            return Err(SimError::setting("modal.harmonics", "must be at least 1"));
+        }
+        if k > n / 2 {
+            return Err(SimError::setting(
+                "modal.harmonics",
+                format!(
+                    "= {k} gives {} coordinates per bending plane, more than the arm's {n} \
+                     links: the reduced mass matrix would be singular (at most {} harmonics)",
+                    2 * k,
+                    n / 2
+                ),
+            ));
+        }
+        sim_core::check_loop_work(2 * n, 4 * k)?;
+        let lengths = per_link("length", &self.lengths, self.link_length, n)?;
+        let masses = per_link("mass", &self.masses, self.link_mass, n)?;
+        let links: Vec<SpatialLinkInertia> = match inertias {
+            Some(values) => masses
+                .iter()
+                .zip(values)
+                .map(|(&mass, &principal)| SpatialLinkInertia { mass, principal })
+                .collect(),
+            None => masses
+                .iter()
+                .zip(&lengths)
+                .map(|(&mass, &length)| SpatialLinkInertia::rod(mass, length))
+                .collect(),
+        };
+        let base: BasePose = self.base.unwrap_or_default().into();
+        check_finite("arm.base.xyz", &base.xyz)?;
+        check_finite("arm.base.rpy", &base.rpy)?;
+        let gravity = self.gravity.map_or(DEFAULT_GRAVITY, Gravity::spatial);
+        check_finite("arm.gravity", &gravity)?;
+        let map = SpatialModalMap::new(&lengths, k)
+            .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))?;
+        // Lengths and masses are checked above: a link the model refuses has a bad inertia.
+        SpatialReducedModel::new(map, base, links, gravity).map_err(|e| match e {
+            ReduceError::Dyn(DynError::InvalidLink { index, .. }) => {
+                SimError::setting(format!("arm.inertias[{index}]"), format!("is invalid: {e}"))
+            }
+            e => SimError::setting("arm", format!("is invalid: {e}")),
+        })
+    }
+}
+
+/// The per-link `quantity` (`"length"` or `"mass"`): the list `arm.{quantity}s` if given, else
+/// `n` copies of `arm.link_{quantity}` (default 0.1), each positive and finite; the error names
+/// the entry or the scalar.
+fn per_link(
+    quantity: &str,
+    list: &Option<Vec<f64>>,
+    scalar: Option<f64>,
+    n: usize,
+) -> Result<Vec<f64>, SimError> {
+    let plural = if quantity == "mass" {
+        "masses"
+    } else {
+        "lengths"
+    };
+    let values = match list {
+        Some(values) => values.clone(),
+        None => vec![scalar.unwrap_or(0.1); n],
+    };
+    for (i, &value) in values.iter().enumerate() {
+        if !(value.is_finite() && value > 0.0) {
+            let field = match list {
+                Some(_) => format!("arm.{plural}[{i}]"),
+                None => format!("arm.link_{quantity}"),
+            };
+            return Err(SimError::setting(
+                field,
+                format!("must be positive and finite, got {value}"),
+            ));
+        }
+    }
+    Ok(values)
+}
