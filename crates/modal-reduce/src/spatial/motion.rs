@@ -47,16 +47,16 @@ impl<L: Lane> Carried<L> {
             omega_dot: [zero; 3],
             accel: [zero; 3],
         };
-        for ((row, given_row), (p, given)) in carried
+        for ((row, given), (entry, &x)) in carried
             .rotation
             .iter_mut()
-            .zip(rotation.iter())
-            .zip(carried.point.iter_mut().zip(point))
+            .zip(rotation)
+            .zip(carried.point.iter_mut().zip(&point))
         {
-            for (entry, given_entry) in row.iter_mut().zip(given_row) {
-                *entry = L::splat(context, *given_entry);
+            for (value, r) in row.iter_mut().zip(given) {
+                *value = L::splat(context, r);
             }
-            *p = L::splat(context, given);
+            *entry = L::splat(context, x);
         }
         carried
     }
