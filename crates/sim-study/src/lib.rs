@@ -11,5 +11,5 @@ pub use scenario::{
     Alpha0, AngleLimit, ArmSpec, BranchSpec, CONTROLLERS, ControllerEntry, ControllerKind,
     ControllerSetup, ControllerSpec, FuzzyInputRange, InitialSpec, IntegratorSpec, LimitsSpec,
     MAX_SCENARIO_OBSTACLES, ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec, ReferenceSpec,
-    Scenario, ScenarioError, SineSpec, TorqueLimit, Workspace,
+    Scenario, ScenarioError, SineSpec, TaskSpec, TorqueLimit, Workspace,
 };

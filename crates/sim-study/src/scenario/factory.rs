@@ -130,12 +130,15 @@ impl Scenario {
     > {
         let model = self.model()?;
         let m = model.n_coords();
-        let reference = self.reference.build(
-            model.chain().total_length(),
-            self.modal.harmonics,
-            self.alpha0,
-            m,
-        )?;
+        let reference = match self.planned_reference(&model)? {
+            Some(planned) => Prepared::reference_clones(planned),
+            None => self.reference.build(
+                model.chain().total_length(),
+                self.modal.harmonics,
+                self.alpha0,
+                m,
+            )?,
+        };
         let period = match (self.controller.period, self.integrator) {
             (Some(period), _) => period,
             (None, IntegratorSpec::Rk4 { dt }) => dt,
@@ -339,6 +342,12 @@ impl ReferenceSpec {
                 &given("reference.frequency_hz", frequency_hz)?,
                 &or_zero("reference.phase", phase)?,
             )?),
+            ReferenceSpec::Planned { .. } => {
+                return Err(SimError::setting(
+                    "reference",
+                    "of kind \"planned\" is built from the scenario's [task] (Scenario::plan)",
+                ));
+            }
             ReferenceSpec::Path {
                 travel_time,
                 branch,

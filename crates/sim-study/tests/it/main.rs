@@ -22,3 +22,4 @@ mod paper_pinned;
 mod replay;
 mod scenario_controller;
 mod scenario_fuzz;
+mod task;
