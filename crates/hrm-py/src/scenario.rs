@@ -684,7 +684,8 @@ impl LoopHooks for PythonDisturbance {
 impl Scenario {
     /// A scenario shipped with hrm, by name (Scenario.builtin_names()): "paper-tracking"
     /// (Figures 10-11), "paper-responses-step", "-sine", "-noise" (Figure 9), and
-    /// "harmonic-tracking", "free-base-tracking".
+    /// "harmonic-tracking", "free-base-tracking", and "narrow-gap" (a [task] planned between
+    /// obstacles, then tracked).
     #[staticmethod]
     fn builtin(name: &str) -> PyResult<Self> {
         Ok(Self::wrap(

@@ -421,11 +421,12 @@ fn shift(scenario: &Scenario, offset: &[f64]) -> Result<Scenario, SimError> {
         ReferenceSpec::Sinusoid { offset: o, .. } => {
             add("reference.offset", o.get_or_insert_with(zeros))?;
         }
-        ReferenceSpec::Path { .. } => {
+        ReferenceSpec::Path { .. } | ReferenceSpec::Planned { .. } => {
             return Err(SimError::setting(
                 "imitation.offsets",
                 format!(
-                    "cannot shift the path reference of '{}': a tip path fixes its configurations",
+                    "cannot shift the path or planned reference of '{}': a tip path or a plan \
+                     fixes its configurations",
                     scenario.name
                 ),
             ));

@@ -6,7 +6,8 @@ use std::path::Path;
 
 /// The scenarios shipped with the crate, by name: the paper's experiments (section 5) with the
 /// tracking task also five times faster under limits on the modal forces `tau*`, then the paper's tracking task
-/// with two harmonics and with `alpha0` free.
+/// with two harmonics and with `alpha0` free, then the paper's arm reaching between obstacles on
+/// a planned motion (`narrow-gap`).
 const BUILTIN: &[(&str, &str)] = &[
     (
         "paper-tracking",
@@ -44,6 +45,10 @@ const BUILTIN: &[(&str, &str)] = &[
         "spatial-long",
         include_str!("../../scenarios/spatial-long.toml"),
     ),
+    (
+        "narrow-gap",
+        include_str!("../../scenarios/narrow-gap.toml"),
+    ),
 ];
 
 impl Scenario {
@@ -78,7 +83,8 @@ impl Scenario {
     /// `paper-tracking-fast` (the same path in 1 s under `tau*` limits), the
     /// `paper-responses-*` step, sine and noise responses (Figure 9), and the tracking task for
     /// other modal families: `harmonic-tracking` (`K = 2`, `m = 4`) and `free-base-tracking`
-    /// (`alpha0` free, `m = 3`).
+    /// (`alpha0` free, `m = 3`), and `narrow-gap` (a `[task]` planned between obstacles that
+    /// block both closed-form `K = 1` shapes, then tracked).
     pub fn builtin_names() -> impl Iterator<Item = &'static str> {
         BUILTIN.iter().map(|(name, _)| *name)
     }

@@ -143,12 +143,21 @@ impl Scenario {
         let model = self.plant()?;
         let m = model.plant().n_coords();
         let reference = match &model {
-            PlantModel::Planar(planar) => self.reference.build(
-                planar.chain().total_length(),
-                self.modal.harmonics,
-                self.planar_alpha0()?,
-                m,
-            )?,
+            PlantModel::Planar(planar) => match self.planned_reference(planar)? {
+                Some(planned) => Prepared::reference_clones(planned),
+                None => self.reference.build(
+                    planar.chain().total_length(),
+                    self.modal.harmonics,
+                    self.planar_alpha0()?,
+                    m,
+                )?,
+            },
+            PlantModel::Spatial(_) if self.task.is_some() => {
+                return Err(SimError::setting(
+                    "task",
+                    "is planned for planar arms only: remove [task] or set [arm] kind = \"planar\"",
+                ));
+            }
             PlantModel::Spatial(spatial) => self.spatial_reference(spatial)?,
         };
         let period = match (self.controller.period, self.integrator) {
@@ -402,6 +411,12 @@ impl ReferenceSpec {
                 &given("reference.frequency_hz", frequency_hz)?,
                 &or_zero("reference.phase", phase)?,
             )?),
+            ReferenceSpec::Planned { .. } => {
+                return Err(SimError::setting(
+                    "reference",
+                    "of kind \"planned\" is built from the scenario's [task] (Scenario::plan)",
+                ));
+            }
             ReferenceSpec::Path {
                 travel_time,
                 branch,

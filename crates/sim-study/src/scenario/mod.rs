@@ -40,7 +40,14 @@
 //! # kind = "capsule": from = [x, y], to = [x, y], radius
 //! # kind = "box": center = [x, y], half_extents = [hx, hy], rpy = [0.0, 0.0, yaw]
 //!
-//! [reference]             # kind = "constant" | "step" | "sinusoid" | "path"
+//! [task]                  # optional: planned before the controller runs (shape-plan)
+//! kind = "reach"          # the chain's tip on target, every link clearance from obstacles
+//! target = [0.35, 0.55]   # m                                      and from itself
+//! clearance = 0.01        # m, on the goal shape and all along the motion to it
+//! # check_slack = 1e-3    m, samples = 64, max_iterations = 200: the planner's bounds
+//! # with a task, [reference] kind = "planned", travel_time = 3.0 (s): the plan's motion
+//!
+//! [reference]             # kind = "constant" | "step" | "sinusoid" | "path" | "planned"
 //! kind = "step"
 //! initial = [0.0, 0.0]
 //! target = [0.2, -0.2]
@@ -87,6 +94,7 @@ mod file;
 mod obstacles;
 mod schema;
 mod spatial;
+mod task;
 
 pub use arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout};
 pub use controllers::{CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup};
@@ -95,5 +103,5 @@ pub use obstacles::{MAX_SCENARIO_OBSTACLES, Workspace};
 pub use schema::{
     Alpha0, AngleLimit, ArmSpec, BranchSpec, ControllerSpec, FuzzyInputRange, HelixSpec,
     InitialSpec, IntegratorSpec, LimitsSpec, ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec,
-    ReferenceSpec, Scenario, SineSpec, TorqueLimit,
+    ReferenceSpec, Scenario, SineSpec, TaskSpec, TorqueLimit,
 };

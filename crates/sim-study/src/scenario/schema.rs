@@ -57,6 +57,10 @@ pub struct Scenario {
     /// itself, at every controller sample.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub obstacles: Vec<ObstacleSpec>,
+    /// What the arm must achieve, planned before the controller runs (`[task]`, with the
+    /// reference of kind `"planned"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub task: Option<TaskSpec>,
 }
 
 /// An obstacle, tagged by `kind`. A planar arm moves in the plane `z = 0`: its obstacles are
@@ -290,6 +294,39 @@ pub enum ReferenceSpec {
         /// A helix or circle in space (spatial arms), at constant speed along it.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         helix: Option<HelixSpec>,
+    },
+    /// The motion of the `[task]`'s plan from the initial shape, its straight segments in modal
+    /// space timed by the minimum-jerk profile
+    /// ([`Waypoints`](sim_core::reference::Waypoints)); the goal is held afterwards.
+    Planned {
+        /// Time of the motion (s, positive).
+        travel_time: f64,
+    },
+}
+
+/// A task planned before the controller runs, tagged by `kind`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum TaskSpec {
+    /// Reach `target` with the chain's tip, every link at least `clearance` from every obstacle
+    /// and from the other links, on the goal shape and all along the motion to it
+    /// ([`Scenario::plan`]).
+    Reach {
+        /// The target `[x, y]` (m).
+        target: Vec<f64>,
+        /// The margin (m, non-negative).
+        clearance: f64,
+        /// The slack of the motion's checks (m, positive, default 1e-3): check points keep
+        /// `clearance + check_slack`, so every shape in between keeps `clearance`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        check_slack: Option<f64>,
+        /// Random starts and via points after the deterministic starts (default 64, at most
+        /// 100000).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        samples: Option<usize>,
+        /// Iterations of one shape solve (default 200, at most 100000).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        max_iterations: Option<usize>,
     },
 }
 

@@ -23,3 +23,4 @@ mod replay;
 mod scenario_controller;
 mod scenario_fuzz;
 mod spatial;
+mod task;

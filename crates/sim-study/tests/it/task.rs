@@ -1,0 +1,115 @@
+//! `[task]` scenarios: planned first, then tracked. `narrow-gap` ends on its target and holds it
+//! with computed torque and with MPC, keeping the clearance the plan promised up to the
+//! tracking error, while the closed-form `K = 1` shapes a controller would be given without a
+//! plan collide.
+
+use backbone_kin::{BaseAngle, Branch, ModalMap, chain_inverse_kinematics, joint_positions};
+use sim_study::study::run_one;
+use sim_study::{ControllerKind, ReferenceSpec, Scenario, TaskSpec, Workspace};
+
+fn target(scenario: &Scenario) -> [f64; 2] {
+    let Some(TaskSpec::Reach { target, .. }) = &scenario.task else {
+        panic!("narrow-gap has a reach task")
+    };
+    [target[0], target[1]]
+}
+
+#[test]
+fn narrow_gap_is_planned_then_reached_and_held() {
+    let scenario = Scenario::builtin("narrow-gap").unwrap();
+    let target = target(&scenario);
+    let plan = scenario.plan().unwrap().unwrap();
+    assert!(plan.goal_clearance >= 0.01 && plan.tip_error <= 1e-6);
+    for kind in [ControllerKind::ComputedTorque, ControllerKind::Mpc] {
+        let run = run_one(&scenario, kind)
+            .result
+            .unwrap_or_else(|f| panic!("{kind}: {}", f.error));
+        let record = &run.record;
+        let last = record.len() - 1;
+        let miss = |k: usize| (record.tip[k][0] - target[0]).hypot(record.tip[k][1] - target[1]);
+        // On target at the end, and held over the last half second.
+        let hold_from = record
+            .t
+            .iter()
+            .position(|&t| t >= scenario.duration - 0.5)
+            .unwrap();
+        let worst_hold = (hold_from..=last).map(miss).fold(0.0, f64::max);
+        assert!(miss(last) < 3e-3, "{kind}: {} m", miss(last));
+        assert!(worst_hold < 3e-3, "{kind}: {} m while holding", worst_hold);
+        // The loop's own clearance over every controller sample: the margin less what the
+        // tracking error costs, never a collision.
+        let clearance = run.summary.min_clearance_m.unwrap();
+        assert!(clearance > 0.005, "{kind}: {clearance} m");
+    }
+}
+
+#[test]
+fn without_a_plan_the_closed_form_shapes_collide() {
+    let scenario = Scenario::builtin("narrow-gap").unwrap();
+    let target = target(&scenario);
+    let lengths = [0.1; 10];
+    let alpha0 = std::f64::consts::FRAC_PI_2;
+    let obstacles = scenario.obstacles(Workspace::Planar).unwrap();
+    let map = ModalMap::new(&lengths, 1, BaseAngle::Fixed(alpha0)).unwrap();
+    for branch in [Branch::Positive, Branch::Negative] {
+        let a = chain_inverse_kinematics(&lengths, target, alpha0, branch).unwrap();
+        let mut theta = [0.0; 10];
+        map.joint_angles(&a, &mut theta).unwrap();
+        let mut p = [[0.0; 2]; 11];
+        joint_positions(&lengths, &theta, &mut p).unwrap();
+        // Some joint of the shape lies inside an obstacle (signed distance below the radius).
+        let inside = p.iter().any(|q| {
+            obstacles
+                .iter()
+                .any(|o| o.signed_distance([q[0], q[1], 0.0]) < 0.01)
+        });
+        assert!(inside, "{branch:?}");
+    }
+}
+
+#[test]
+fn tasks_and_planned_references_come_together_and_name_their_fields() {
+    let base = Scenario::builtin("narrow-gap").unwrap();
+    let mut no_task = base.clone();
+    no_task.task = None;
+    let e = no_task.build().err().unwrap().to_string();
+    assert!(e.contains("reference") && e.contains("[task]"), "{e}");
+    let mut no_planned = base.clone();
+    no_planned.reference = ReferenceSpec::Constant { a: vec![0.0; 4] };
+    let e = no_planned.build().err().unwrap().to_string();
+    assert!(e.starts_with("task"), "{e}");
+    let with = |f: &dyn Fn(&mut Scenario)| {
+        let mut s = base.clone();
+        f(&mut s);
+        s.build().err().unwrap().to_string()
+    };
+    let set = |s: &mut Scenario, target: Vec<f64>, clearance: f64| {
+        s.task = Some(TaskSpec::Reach {
+            target,
+            clearance,
+            check_slack: None,
+            samples: None,
+            max_iterations: None,
+        });
+    };
+    let e = with(&|s| set(s, vec![0.3], 0.01));
+    assert!(e.starts_with("task.target must be a point [x, y]"), "{e}");
+    let e = with(&|s| set(s, vec![2.0, 0.0], 0.01));
+    assert!(
+        e.starts_with("task.target cannot be met: target is 2 m"),
+        "{e}"
+    );
+    let e = with(&|s| set(s, vec![0.35, 0.55], -0.1));
+    assert!(
+        e.starts_with("task.clearance cannot be met: clearance must be non-negative"),
+        "{e}"
+    );
+    // A target inside an obstacle: no collision-free shape, the best clearance reported.
+    let e = with(&|s| set(s, vec![-0.14, 0.36], 0.01));
+    assert!(
+        e.starts_with("task cannot be met: no collision-free shape found"),
+        "{e}"
+    );
+    let text = base.to_toml();
+    assert_eq!(Scenario::from_toml(&text).unwrap(), base);
+}
