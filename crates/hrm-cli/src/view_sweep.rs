@@ -20,7 +20,7 @@ pub fn is_sweep(dir: &Path) -> bool {
 
 /// The sweep stored in `dir/runs.json` (its header, checked as a merge checks it).
 fn open(dir: &Path) -> Result<ShardReader<study::ShardInput>, String> {
-    ShardReader::open(&dir.join("runs.json"))
+    ShardReader::open(&dir.join("runs.json")).map_err(|e| e.to_string())
 }
 
 /// Prints the runs of the sweep in `dir`, one a line: index, noise level, controller, seed,
@@ -39,7 +39,7 @@ pub fn list(dir: &Path) -> Result<(), String> {
         "controller",
         "seed",
     );
-    while let Some(run) = reader.next_run()? {
+    while let Some(run) = reader.next_run().map_err(|e| e.to_string())? {
         let outcome = match &run.outcome {
             StoredOutcome::Completed(m) => format!(
                 "tip error RMS {} mm",
@@ -130,7 +130,7 @@ pub fn load(dir: &Path, chosen: Option<&[usize]>) -> Result<Vec<Scene>, String> 
     // What the sweep stored of each chosen run, read in one pass.
     let mut stored = Vec::with_capacity(indices.len());
     while stored.len() < indices.len() {
-        match reader.next_run()? {
+        match reader.next_run().map_err(|e| e.to_string())? {
             Some(run) if indices.contains(&run.index) => stored.push(run.outcome),
             Some(_) => {}
             None => return Err(format!("{}: runs.json ends early", dir.display())),
