@@ -64,7 +64,10 @@
 
   // ---- Numbers ----------------------------------------------------------------------------
 
-  /** About `count` round tick values covering [lo, hi], and their step. */
+  /**
+   * About `count` round tick values covering [lo, hi] (never fewer than two, so that every
+   * axis reads as a scale), and their step.
+   */
   function niceTicks(lo, hi, count) {
     if (!(hi > lo)) {
       const pad = Math.abs(lo) > 0 ? Math.abs(lo) * 0.5 : 1;
@@ -77,6 +80,8 @@
     for (let v = Math.ceil(lo / step - 1e-9) * step; v <= hi + step * 1e-9; v += step) {
       ticks.push(Math.abs(v) < step * 1e-9 ? 0 : v);
     }
+    // A range that holds one multiple of the step gets a finer step.
+    if (ticks.length < 2 && count < 64) return niceTicks(lo, hi, 2 * Math.max(1, count));
     return { ticks, step };
   }
 

@@ -33,7 +33,10 @@ test("ticks are round, cover the range and print in plain notation", () => {
   const quarter = v.niceTicks(0, 1, 4);
   assert.equal(quarter.step, 0.25);
   assert.deepEqual(quarter.ticks.map((x) => v.formatTick(x, quarter.step)), ["0.00", "0.25", "0.50", "0.75", "1.00"]);
-  for (const [lo, hi] of [[1e-7, 3e-7], [-5e4, 2e5], [3, 3], [0.1, 0.7]]) {
+  // A range holding one multiple of the first step (here 2) still reads as a scale.
+  const one = v.niceTicks(-1.6, 1.9, 3);
+  assert.deepEqual(one.ticks, [-1, 0, 1]);
+  for (const [lo, hi] of [[1e-7, 3e-7], [-5e4, 2e5], [3, 3], [0.1, 0.7], [-1.6, 1.9], [-0.12, 0.15]]) {
     const r = v.niceTicks(lo, hi, 5);
     assert.ok(r.ticks.length >= 2 && r.ticks.length <= 12, `${lo}..${hi}: ${r.ticks}`);
     for (const x of r.ticks) assert.doesNotMatch(v.formatTick(x, r.step), /e|^-0$/);

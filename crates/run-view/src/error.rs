@@ -78,6 +78,9 @@ pub enum ViewError {
     /// The arm's kinematics refused a recorded state.
     #[error(transparent)]
     Kinematics(#[from] backbone_kin::KinError),
+    /// The arm's clearance to the scenario's obstacles could not be measured.
+    #[error(transparent)]
+    Clearance(#[from] clearance::ClearanceError),
 }
 
 /// What is wrong with a field: the `problem` of [`ViewError::Field`], phrased to follow the

@@ -3,10 +3,11 @@
 //! forward kinematics, and the series a reader checks first.
 
 use crate::error::ViewError;
-use crate::view::{RunView, Series};
+use crate::view::{Obstacle, RunView, Series};
+use clearance::{ClearanceData, ClearanceModel};
 use modal_reduce::PlantModel;
 use sim_core::Record;
-use sim_study::{Scenario, TorqueLimit};
+use sim_study::{Scenario, TorqueLimit, Workspace};
 
 /// The run `record` of `scenario` under the controller named `label`: every sample's joint
 /// positions (`theta = J a + theta_0`, eq 8, then the chain from the base at the origin; for a
@@ -14,7 +15,12 @@ use sim_study::{Scenario, TorqueLimit};
 /// joint torques (eq 13; a spatial link's the magnitude of its universal joint's two) against
 /// the scenario's joint torque limits (a spatial arm's against the run's peak), and the
 /// series tip error (mm), modal coordinates with their references (rad) and `tau*` (N m) (the
-/// viewer adds the panel of the joint torques itself, from the torques that colour the links). `stopped` is why a run stopped early.
+/// viewer adds the panel of the joint torques itself, from the torques that colour the links).
+/// A scenario with obstacles (or an arm radius) also gets its obstacles drawn and the series
+/// clearance (mm): the smallest clearance of the links' capsules to the obstacles and to the arm
+/// itself at every sample, measured by `clearance::distances` from the drawn joint points.
+/// A box turned by `rpy` is not drawn (the page draws axis-aligned boxes); its clearance is
+/// still measured. `stopped` is why a run stopped early.
 pub fn from_record(
     scenario: &Scenario,
     label: &str,
@@ -104,7 +110,7 @@ pub fn from_record(
                 .collect(),
         })
         .collect();
-    let series = vec![
+    let mut series = vec![
         Series {
             title: "tip error".into(),
             unit: "mm".into(),
@@ -119,6 +125,15 @@ pub fn from_record(
             values: (0..m).map(|i| modal(Record::tau_star_at, i)).collect(),
         },
     ];
+    let workspace = if dims == 2 {
+        Workspace::Planar
+    } else {
+        Workspace::Spatial
+    };
+    let model = scenario.clearance_model(n, workspace)?;
+    if let Some(model) = &model {
+        series.push(clearance_series(model, &joints, dims, m)?);
+    }
     // A spatial arm's links are coloured against the run's peak torque.
     let torque_limit = match (&scenario.limits.joint_torque_nm, dims) {
         (Some(TorqueLimit::All(limit)), 2) => vec![*limit; n],
@@ -149,10 +164,87 @@ pub fn from_record(
         },
         torque_limit,
         series,
-        obstacles: Vec::new(),
+        obstacles: model
+            .iter()
+            .flat_map(ClearanceModel::obstacles)
+            .filter_map(|o| drawn(o, dims))
+            .collect(),
         channels: Vec::new(),
         stopped: stopped.map(str::to_owned),
     };
     view.check()?;
     Ok(view)
+}
+
+/// The smallest clearance (mm) of the links to the obstacles and to the arm itself at every
+/// sample (`joints`: a sample's points, `dims` numbers each; a curve each when the model has
+/// such pairs).
+fn clearance_series(
+    model: &ClearanceModel,
+    joints: &[Vec<f64>],
+    dims: usize,
+    n_coords: usize,
+) -> Result<Series, ViewError> {
+    let mut data = ClearanceData::new(model, n_coords)?;
+    // The distances use the joint points only; the axes serve the gradients, unused here.
+    let axes = vec![[0.0, 0.0, 1.0]; model.n_links()];
+    let mut points = vec![[0.0; 3]; model.n_links() + 1];
+    let (mut to_obstacles, mut to_itself) = (Vec::new(), Vec::new());
+    for sample in joints {
+        for (point, coords) in points.iter_mut().zip(sample.chunks_exact(dims)) {
+            point[..dims].copy_from_slice(coords);
+        }
+        clearance::place(model, &mut data, &points, &axes)?;
+        let (obstacle, itself) = clearance::distances(model, &mut data);
+        to_obstacles.push(1e3 * obstacle);
+        to_itself.push(1e3 * itself);
+    }
+    let mut series = Series {
+        title: "clearance".into(),
+        unit: "mm".into(),
+        names: Vec::new(),
+        values: Vec::new(),
+    };
+    for (name, values) in [("to obstacles", to_obstacles), ("to itself", to_itself)] {
+        if values.iter().all(|v| v.is_finite()) {
+            series.names.push(name.into());
+            series.values.push(values);
+        }
+    }
+    Ok(series)
+}
+
+/// A measured obstacle as the page draws it, in the arm's `dims` coordinates; `None` for a
+/// turned box.
+fn drawn(obstacle: &clearance::Obstacle, dims: usize) -> Option<Obstacle> {
+    let point = |p: &[f64; 3]| p[..dims].to_vec();
+    Some(match obstacle {
+        clearance::Obstacle::Sphere { center, radius } if dims == 2 => Obstacle::Circle {
+            centre: point(center),
+            radius: *radius,
+        },
+        clearance::Obstacle::Sphere { center, radius } => Obstacle::Sphere {
+            centre: point(center),
+            radius: *radius,
+        },
+        clearance::Obstacle::Capsule { from, to, radius } => Obstacle::Capsule {
+            a: point(from),
+            b: point(to),
+            radius: *radius,
+        },
+        clearance::Obstacle::Box {
+            center,
+            half_extents,
+            axes,
+        } => {
+            let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+            if *axes != identity {
+                return None;
+            }
+            Obstacle::Box {
+                centre: point(center),
+                half: point(half_extents),
+            }
+        }
+    })
 }

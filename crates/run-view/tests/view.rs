@@ -440,3 +440,64 @@ fn viewer_script_tests_pass_under_node() {
         "{text}"
     );
 }
+
+/// Distance from the point `o` to the segment `a`-`b` of the plane.
+fn segment_point_distance(a: &[f64], b: &[f64], o: &[f64]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let s = (((o[0] - a[0]) * dx + (o[1] - a[1]) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+    (a[0] + s * dx - o[0]).hypot(a[1] + s * dy - o[1])
+}
+
+#[test]
+fn obstacles_are_drawn_and_the_clearance_is_plotted() {
+    let mut scenario = Scenario::builtin("narrow-gap").unwrap();
+    scenario.duration = 0.3;
+    let run = scenario.build().unwrap().run().unwrap();
+    let view = from_record(&scenario, "fuzzy", &run.record, None).unwrap();
+    // The scenario's two circles, as written in its file.
+    let circles: Vec<(Vec<f64>, f64)> = view
+        .obstacles
+        .iter()
+        .map(|o| match o {
+            Obstacle::Circle { centre, radius } => (centre.clone(), *radius),
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(circles.len(), 2);
+    assert_eq!(
+        circles[0],
+        (vec![-0.14180405308082297, 0.3604062199819269], 0.03)
+    );
+    let clearance = view.series.iter().find(|s| s.title == "clearance").unwrap();
+    assert_eq!(clearance.unit, "mm");
+    assert_eq!(clearance.names, ["to obstacles", "to itself"]);
+    // Closed form: the nearest link axis to a circle's centre, less both radii (links 1 cm).
+    for (k, row) in view.joints.iter().enumerate() {
+        let points: Vec<&[f64]> = row.chunks_exact(2).collect();
+        let expected = circles
+            .iter()
+            .flat_map(|(c, r)| {
+                points
+                    .windows(2)
+                    .map(move |l| segment_point_distance(l[0], l[1], c) - 0.01 - r)
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            (clearance.values[0][k] - 1e3 * expected).abs() < 1e-9,
+            "sample {k}: {} mm, expected {} mm",
+            clearance.values[0][k],
+            1e3 * expected
+        );
+    }
+    // The page carries both into the viewer.
+    let html = scene_html(
+        &Scene {
+            title: "narrow-gap".into(),
+            caption: "c".into(),
+            runs: vec![view],
+        },
+        PAGE_SAMPLES,
+    )
+    .unwrap();
+    assert!(html.contains("\"kind\":\"circle\"") && html.contains("\"clearance\""));
+}
