@@ -421,12 +421,21 @@ fn shift(scenario: &Scenario, offset: &[f64]) -> Result<Scenario, SimError> {
         ReferenceSpec::Sinusoid { offset: o, .. } => {
             add("reference.offset", o.get_or_insert_with(zeros))?;
         }
-        ReferenceSpec::Path { .. } | ReferenceSpec::Planned { .. } => {
+        ReferenceSpec::Path { .. } => {
             return Err(SimError::setting(
                 "imitation.offsets",
                 format!(
-                    "cannot shift the path or planned reference of '{}': a tip path or a plan \
-                     fixes its configurations",
+                    "cannot shift the path reference of '{}': a tip path fixes its configurations",
+                    scenario.name
+                ),
+            ));
+        }
+        ReferenceSpec::Planned { .. } => {
+            return Err(SimError::setting(
+                "imitation.offsets",
+                format!(
+                    "cannot shift the planned reference of '{}': the plan fixes its \
+                     configurations",
                     scenario.name
                 ),
             ));

@@ -336,7 +336,7 @@ fn bad_requests_are_refused_by_name() {
     let free = Scenario::builtin("free-base-tracking").unwrap();
     assert_eq!(
         message(&[step.clone(), free], d),
-        "imitation.scenarios must share their modal coordinates: 'paper-responses-step' has 2 (a1, a2), 'free-base-tracking' has 3"
+        "imitation.scenarios must share their modal coordinates: 'paper-responses-step' has 2 (a1, a2), 'free-base-tracking' has 3 (a1, a2, alpha0)"
     );
     for (options, text) in [
         (
