@@ -11,6 +11,6 @@ pub use scenario::{
     Alpha0, AngleLimit, ArmKind, ArmSpec, BaseSpec, BranchSpec, CONTROLLERS, ControllerEntry,
     ControllerKind, ControllerSetup, ControllerSpec, FuzzyInputRange, Gravity, HelixSpec, Inertias,
     InitialSpec, IntegratorSpec, JointLayout, LimitsSpec, MAX_SCENARIO_OBSTACLES, ModalSpec,
-    ModalTorqueLimit, NoiseSpec, ObstacleSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec, TaskSpec,
-    TorqueLimit, Workspace,
+    ModalTorqueLimit, NoiseSpec, ObstacleSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec,
+    TaskSpec, TorqueLimit, Workspace,
 };

@@ -70,8 +70,12 @@ impl Scenario {
         };
         options.validate().map_err(field)?;
         let lengths: Vec<f64> = model.chain().link_lengths().collect();
-        let arm = PlanarArm::new(&lengths, self.modal.harmonics, self.planar_alpha0()?.base_angle())
-            .map_err(field)?;
+        let arm = PlanarArm::new(
+            &lengths,
+            self.modal.harmonics,
+            self.planar_alpha0()?.base_angle(),
+        )
+        .map_err(field)?;
         let clearance_model = match self.clearance_model(lengths.len(), Workspace::Planar)? {
             Some(model) => model,
             None => ClearanceModel::new(lengths.len(), 0.0, Vec::new())
