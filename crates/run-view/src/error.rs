@@ -78,6 +78,9 @@ pub enum ViewError {
     /// The arm's kinematics refused a recorded state.
     #[error(transparent)]
     Kinematics(#[from] backbone_kin::KinError),
+    /// The clearance of a recorded state could not be measured.
+    #[error(transparent)]
+    Clearance(#[from] clearance::ClearanceError),
 }
 
 /// What is wrong with a field: the `problem` of [`ViewError::Field`], phrased to follow the
@@ -218,6 +221,7 @@ impl Classify for ViewError {
         match self {
             Self::Model(error) => error.class(),
             Self::Kinematics(error) => error.class(),
+            Self::Clearance(error) => error.class(),
             Self::Run { source, .. } => source.class(),
             _ => ErrorClass::InvalidInput,
         }

@@ -1,9 +1,10 @@
 //! A closed-loop run of `sim-core` (a planar or a spatial arm) as a [`RunView`]: the arm's points
 //! from the recorded modal coordinates through the scenario's modal map (eq 8) and the chain's
-//! forward kinematics, and the series a reader checks first.
+//! forward kinematics, the scenario's obstacles, and the series a reader checks first.
 
 use crate::error::ViewError;
-use crate::view::{RunView, Series};
+use crate::view::{Obstacle, RunView, Series};
+use clearance::{ClearanceData, ClearanceModel};
 use modal_reduce::PlantModel;
 use sim_core::Record;
 use sim_study::{Scenario, TorqueLimit};
@@ -14,7 +15,12 @@ use sim_study::{Scenario, TorqueLimit};
 /// joint torques (eq 13; a spatial link's the magnitude of its universal joint's two) against
 /// the scenario's joint torque limits (a spatial arm's against the run's peak), and the
 /// series tip error (mm), modal coordinates with their references (rad) and `tau*` (N m) (the
-/// viewer adds the panel of the joint torques itself, from the torques that colour the links). `stopped` is why a run stopped early.
+/// viewer adds the panel of the joint torques itself, from the torques that colour the links).
+/// A scenario with `[[obstacles]]` or `[arm] radius` also gets its obstacles drawn and a
+/// clearance series (mm): at every recorded sample the smallest clearance of a link's capsule
+/// to an obstacle and between links that share no joint, measured by `clearance::distances`
+/// from the drawn joint points (the loop's own minima over every controller sample are in the
+/// run's summary). `stopped` is why a run stopped early.
 pub fn from_record(
     scenario: &Scenario,
     label: &str,
@@ -66,6 +72,13 @@ pub fn from_record(
             }
         }
     }
+    let (obstacles, clearance) = match scenario.clearance_model(n, scenario.workspace())? {
+        Some(model) => (
+            model.obstacles().iter().map(|o| drawn(o, dims)).collect(),
+            clearance_series(&model, &joints, dims, m)?,
+        ),
+        None => (Vec::new(), None),
+    };
     let names = scenario.coordinate_names();
     // In the plane z is zero and `hypot(d, 0) = |d|`.
     let tip_error = (0..samples)
@@ -104,7 +117,7 @@ pub fn from_record(
                 .collect(),
         })
         .collect();
-    let series = vec![
+    let mut series = vec![
         Series {
             title: "tip error".into(),
             unit: "mm".into(),
@@ -119,6 +132,7 @@ pub fn from_record(
             values: (0..m).map(|i| modal(Record::tau_star_at, i)).collect(),
         },
     ];
+    series.extend(clearance);
     // A spatial arm's links are coloured against the run's peak torque.
     let torque_limit = match (&scenario.limits.joint_torque_nm, dims) {
         (Some(TorqueLimit::All(limit)), 2) => vec![*limit; n],
@@ -149,10 +163,91 @@ pub fn from_record(
         },
         torque_limit,
         series,
-        obstacles: Vec::new(),
+        obstacles,
         channels: Vec::new(),
         stopped: stopped.map(str::to_owned),
     };
     view.check()?;
     Ok(view)
+}
+
+/// The clearance series (mm) of the drawn samples `joints` (each `n + 1` points of `dims`
+/// coordinates): the smallest clearance to an obstacle, and between links when the arm has
+/// a pair that shares no joint (`clearance::distances`); `None` when the arm has neither.
+fn clearance_series(
+    model: &ClearanceModel,
+    joints: &[Vec<f64>],
+    dims: usize,
+    n_coords: usize,
+) -> Result<Option<Series>, ViewError> {
+    let mut data = ClearanceData::new(model, n_coords)?;
+    let mut points = vec![[0.0; 3]; model.n_links() + 1];
+    // The distances read the joint points only; the axes are placeholders of unit length.
+    let axes = vec![[0.0, 0.0, 1.0]; model.n_links()];
+    let (mut to_obstacles, mut to_itself) = (Vec::new(), Vec::new());
+    for row in joints {
+        for (point, drawn) in points.iter_mut().zip(row.chunks_exact(dims)) {
+            point[..dims].copy_from_slice(drawn);
+        }
+        clearance::place(model, &mut data, &points, &axes)?;
+        let (near_obstacle, near_self) = clearance::distances(model, &mut data);
+        to_obstacles.push(1e3 * near_obstacle);
+        to_itself.push(1e3 * near_self);
+    }
+    let (mut names, mut values) = (Vec::new(), Vec::new());
+    if model.n_obstacle_pairs() > 0 {
+        names.push("to the obstacles".into());
+        values.push(to_obstacles);
+    }
+    if model.pairs().len() > model.n_obstacle_pairs() {
+        names.push("between links".into());
+        values.push(to_itself);
+    }
+    Ok((!names.is_empty()).then(|| Series {
+        title: "clearance".into(),
+        unit: "mm".into(),
+        names,
+        values,
+    }))
+}
+
+/// How the viewer draws `obstacle` in `dims` coordinates: a sphere of a planar arm as a
+/// circle, a box as the axis-aligned box that bounds it (exactly the box when it is not
+/// turned; an infinite half-extent along `z` of a planar box is dropped with `z`).
+fn drawn(obstacle: &clearance::Obstacle, dims: usize) -> Obstacle {
+    let cut = |p: [f64; 3]| p[..dims].to_vec();
+    match *obstacle {
+        clearance::Obstacle::Sphere { center, radius } if dims == 2 => Obstacle::Circle {
+            centre: cut(center),
+            radius,
+        },
+        clearance::Obstacle::Sphere { center, radius } => Obstacle::Sphere {
+            centre: cut(center),
+            radius,
+        },
+        clearance::Obstacle::Capsule { from, to, radius } => Obstacle::Capsule {
+            a: cut(from),
+            b: cut(to),
+            radius,
+        },
+        clearance::Obstacle::Box {
+            center,
+            half_extents,
+            axes,
+        } => {
+            // Half the extent of the turned box along world axis `i`: sum_k |R_ik| h_k.
+            let half: Vec<f64> = (0..dims)
+                .map(|i| {
+                    (0..3)
+                        .map(|k| axes[k][i].abs() * half_extents[k])
+                        .filter(|h| !h.is_nan())
+                        .sum()
+                })
+                .collect();
+            Obstacle::Box {
+                centre: cut(center),
+                half,
+            }
+        }
+    }
 }
