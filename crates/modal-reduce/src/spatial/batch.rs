@@ -25,7 +25,7 @@ use super::terms::{TermsLanes, accumulate};
 use crate::batch::{BatchError, MAX_WIDTH, check_batch_shape};
 use crate::batch_group::simd_lanes;
 use crate::error::all_finite;
-use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
+use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 
 /// The most modal coordinates evaluated SIMD across states (`K = 2` harmonics per plane);
 /// larger models run their batches one state at a time.
