@@ -2,6 +2,7 @@
 
 mod checks;
 mod compact;
+pub mod dense;
 mod error_class;
 mod instruction_sets;
 mod lanes;

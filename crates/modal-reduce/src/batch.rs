@@ -21,8 +21,8 @@ use crate::data::{PRODUCTS, ReducedData};
 use crate::error::{ReduceError, all_finite, check_len};
 use crate::forward::forward_dynamics;
 use crate::model::ReducedModel;
-use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
 use crate::terms::{LinkBuffers, StateLanes, Terms, accumulate, angles_in_range, extract};
+use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 use lane_math::{Lane, Pack};
 
 /// The most `f64` lanes of a SIMD register (AVX-512).

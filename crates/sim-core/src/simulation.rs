@@ -988,8 +988,8 @@ pub fn check_loop_work(n_links: usize, m: usize) -> Result<(), SimError> {
         return Err(SimError::setting(
             "modal.harmonics",
             format!(
-                "{n_links} links with {m} modal coordinates take an estimated {work:.3e} \
-                 multiply-adds per evaluation of the reduced dynamics (n m^2), more than the \
+                "is too many for {n_links} links: {m} modal coordinates take an estimated \
+                 {work:.3e} multiply-adds per evaluation of the reduced dynamics (n m^2), more than the \
                  {MAX_LOOP_WORK:e} a closed-loop run may take (seconds to minutes a step): use \
                  fewer harmonics or fewer links"
             ),

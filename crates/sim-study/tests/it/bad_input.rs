@@ -680,7 +680,9 @@ fn run_of_too_much_work_per_step() {
     scenario.modal.harmonics = 256;
     let message = scenario.build().err().expect("refused").to_string();
     assert!(
-        message.contains("512 links with 512 modal coordinates take an estimated 1.342e8"),
+        message.contains(
+            "modal.harmonics is too many for 512 links: 512 modal coordinates take an estimated 1.342e8"
+        ),
         "{message}"
     );
 }
