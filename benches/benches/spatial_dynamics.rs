@@ -1,8 +1,9 @@
 //! Spatial-chain dynamics (`manip_dyn::spatial`) per call: forward dynamics by the
 //! articulated-body algorithm one state at a time (`spatial_aba`) and in a batch of 1024 states
 //! (`spatial_aba_batch`, SIMD across states, throughput in states so that the figure is per
-//! state), and the analytic ABA derivatives (`spatial_aba_derivatives`: `qdd`, `d qdd / d q`,
-//! `d qdd / d v`, `M^-1`).
+//! state), the analytic ABA derivatives (`spatial_aba_derivatives`: `qdd`, `d qdd / d q`,
+//! `d qdd / d v`, `M^-1`) and the analytic RNEA derivatives (`spatial_rnea_derivatives`:
+//! `d tau / d q`, `d tau / d v`, `M`, at the state's `tau` taken as `qdd`).
 //!
 //! And the spatial modal arm of `modal_reduce::spatial` (`reduced_fd_spatial/<n>`: reduced
 //! forward dynamics of `n` universal-joint links of 0.1 m and 0.1 kg as slender rods, `K = 1`
@@ -21,7 +22,7 @@
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use manip_dyn::spatial::{
     SpatialBatchData, SpatialData, SpatialDerivativeData, SpatialModel, aba, aba_batch,
-    aba_derivatives,
+    aba_derivatives, rnea_derivatives,
 };
 use modal_reduce::spatial::{
     SpatialReducedBatchData, SpatialReducedData, SpatialReducedModel, spatial_forward_dynamics,
@@ -121,6 +122,22 @@ fn spatial_aba_derivatives(c: &mut Criterion) {
     group.finish();
 }
 
+fn spatial_rnea_derivatives(c: &mut Criterion) {
+    let mut group = c.benchmark_group("spatial_rnea_derivatives");
+    for case in cases() {
+        let mut data = SpatialData::new(&case.model);
+        let mut derivatives = SpatialDerivativeData::new(&case.model);
+        group.bench_function(BenchmarkId::from_parameter(case.name), |b| {
+            b.iter(|| {
+                let (q, v, qdd) = (black_box(&case.q), black_box(&case.v), black_box(&case.tau));
+                rnea_derivatives(&case.model, &mut data, &mut derivatives, q, v, qdd).unwrap();
+                black_box(derivatives.d_q()[(0, 0)])
+            })
+        });
+    }
+    group.finish();
+}
+
 /// The spatial modal arm of `n` links (`m = 4`) and its moving state `(a, a_dot, tau*)`: those
 /// whose URDF export and map `benches/pinocchio/spatial.cpp` times.
 fn spatial_arm_state(n: usize) -> (SpatialReducedModel, [Vec<f64>; 3]) {
@@ -185,6 +202,7 @@ criterion_group!(
     reduced_fd_spatial_batch,
     spatial_aba,
     spatial_aba_batch,
-    spatial_aba_derivatives
+    spatial_aba_derivatives,
+    spatial_rnea_derivatives
 );
 criterion_main!(benches);

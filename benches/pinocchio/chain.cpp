@@ -14,7 +14,8 @@
 // benches/benches/spatial_dynamics.rs (`spatial_anchors`):
 //   - aba one state (beside hrm's `spatial_aba/<name>`), aba over 1024 states one after another
 //     (per state, beside `spatial_aba_batch/<name>`), computeABADerivatives (beside
-//     `spatial_aba_derivatives/<name>`).
+//     `spatial_aba_derivatives/<name>`), computeRNEADerivatives at qdd = the state's tau, as
+//     hrm's bench takes it (beside `spatial_rnea_derivatives/<name>`).
 // Prints one line per algorithm and size, `pinocchio/<algorithm>/<n> <median> ns`: the median
 // over batches of the time per call (the figures `cargo xtask bench --check` reads; the ids name
 // the hrm bench each one stands beside).
@@ -101,10 +102,14 @@ static void spatial_anchors(const std::string& dir) {
         },
         20, 51) / batch;
     double derivatives_ns = median_ns([&] { computeABADerivatives(model, data, q, v, tau); }, 5000, 51);
+    const double minv00 = data.Minv(0, 0);
+    double rnea_ns = median_ns([&] { computeRNEADerivatives(model, data, q, v, tau); }, 5000, 51);
     std::printf("pinocchio/spatial_aba/%s %.1f ns\n", name, one_ns);
     std::printf("pinocchio/spatial_aba_batch/%s %.1f ns\n", name, batch_ns);
     std::printf("pinocchio/spatial_aba_derivatives/%s %.1f ns\n", name, derivatives_ns);
-    std::printf("  check: qdd[n-1] = %.12g, dqdd/dtau[0][0] = %.12g\n", data.ddq[n - 1], data.Minv(0, 0));
+    std::printf("pinocchio/spatial_rnea_derivatives/%s %.1f ns\n", name, rnea_ns);
+    std::printf("  check: qdd[n-1] = %.12g, dqdd/dtau[0][0] = %.12g, dtau/dq[0][0] = %.12g\n", data.ddq[n - 1],
+                minv00, data.dtau_dq(0, 0));
   }
 }
 

@@ -307,19 +307,74 @@ fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
     }
 }
 
-/// Deserialises the request's remaining fields into the op's typed request.
+/// Deserialises the request's remaining fields into the op's typed request; serde's own type
+/// errors name the JSON path of the field they are about (`arm.links: invalid type: ...`).
 fn parse<T: DeserializeOwned>(request: Map<String, Value>) -> Result<T, EvalError> {
-    serde_json::from_value(Value::Object(request))
-        .map_err(|e| EvalError::new(Kind::InvalidRequest, e.to_string()))
+    from_object(request).map_err(|e| EvalError::new(Kind::InvalidRequest, e))
 }
+
+/// Deserialises an object; an error's message gets the path of the field it is about in front
+/// when [`located`] finds one.
+fn from_object<T: DeserializeOwned>(object: Map<String, Value>) -> Result<T, String> {
+    located(object).map_err(|(path, message)| match path {
+        Some(path) => format!("{path}: {message}"),
+        None => message,
+    })
+}
+
+/// Deserialises an object, answering an error as the dotted JSON path of the offending field
+/// (`theta[1]`, `arm.links`) and the message. Serde's own messages ([`SERDE_MESSAGES`]) name no
+/// field and get the path; the project's own messages name their field already and get none. A
+/// nested object's error (see [`arm_object`]) carries its inner path behind [`NESTED_PATH`],
+/// joined here to the outer one.
+fn located<T: DeserializeOwned>(object: Map<String, Value>) -> Result<T, (Option<String>, String)> {
+    serde_path_to_error::deserialize(Value::Object(object)).map_err(|e| {
+        let path = e.path().to_string();
+        let message = e.into_inner().to_string();
+        if let Some((inner, message)) = message
+            .strip_prefix(NESTED_PATH)
+            .and_then(|nested| nested.split_once('\u{1}'))
+        {
+            let separator = if inner.starts_with('[') { "" } else { "." };
+            (
+                Some(format!("{path}{separator}{inner}")),
+                message.to_string(),
+            )
+        } else if path != "." && SERDE_MESSAGES.iter().any(|p| message.starts_with(p)) {
+            (Some(path), message)
+        } else {
+            (None, message)
+        }
+    })
+}
+
+/// How serde's default `de::Error` messages start: the errors that say what is wrong but not where.
+const SERDE_MESSAGES: [&str; 7] = [
+    "invalid type:",
+    "invalid value:",
+    "invalid length ",
+    "unknown variant ",
+    "unknown field ",
+    "missing field ",
+    "duplicate field ",
+];
+
+/// Starts a nested object's error message as `NESTED_PATH path \u{1} message`, so that the
+/// enclosing [`located`] joins the field's path to the inner one (`arm` and `links` give
+/// `arm.links`). Every nested object is read inside an enclosing [`located`], which removes the
+/// mark.
+const NESTED_PATH: &str = "\u{1}nested:";
 
 /// `"arm"`: an object of [`ArmSpec`] fields. Serde would also read a struct from an array of its
 /// fields in order, which no user means; anything but an object is refused.
 fn arm_object<'de, D: Deserializer<'de>>(deserializer: D) -> Result<ArmSpec, D::Error> {
     match Value::deserialize(deserializer)? {
-        Value::Object(fields) => {
-            serde_json::from_value(Value::Object(fields)).map_err(serde::de::Error::custom)
-        }
+        Value::Object(fields) => located(fields).map_err(|(path, message)| {
+            serde::de::Error::custom(match path {
+                Some(path) => format!("{NESTED_PATH}{path}\u{1}{message}"),
+                None => message,
+            })
+        }),
         other => Err(serde::de::Error::custom(format!(
             "\"arm\" must be an object of arm fields, got {}",
             json_type(&other)
@@ -1149,6 +1204,52 @@ mod tests {
                     .contains("\"arm\" must be an object"),
                 "{answer}"
             );
+        }
+    }
+
+    #[test]
+    fn type_errors_name_the_json_path_of_the_field() {
+        for (line, message) in [
+            (
+                json!({"op": "joints", "arm": {"links": -1}, "a": [0, 0, 0]}),
+                "arm.links: invalid value: integer `-1`, expected usize",
+            ),
+            (
+                json!({"op": "fk", "arm": {"link_length": "x"}, "a": [0, 0], "alpha0": 0}),
+                "arm.link_length: invalid type: string \"x\", expected f64",
+            ),
+            (
+                json!({"op": "dynamics", "theta": [1, "a"], "theta_dot": [0, 0]}),
+                "theta[1]: invalid type: string \"a\", expected f64",
+            ),
+            (
+                json!({"op": "fk", "a": ["NaN", 0], "alpha0": 0}),
+                "a[0]: invalid type: string \"NaN\", expected f64",
+            ),
+            (
+                json!({"op": "fk", "arm": {"kind": "spatial", "links": "3"}, "a": [0, 0]}),
+                "arm.links: invalid type: string \"3\", expected usize",
+            ),
+            (
+                json!({"op": "joints", "arm": {"links": 3, "colour": 1}, "a": [0, 0, 0]}),
+                "arm.colour: unknown field `colour`",
+            ),
+            // Messages that name their field already, or are about the request as a whole,
+            // pass unchanged.
+            (
+                json!({"op": "joints", "arm": [10], "a": [0, 0, 0]}),
+                "\"arm\" must be an object of arm fields, got an array",
+            ),
+            (json!({"op": "fk", "alpha0": 0}), "missing field `a`"),
+        ] {
+            let answer = request(line.clone());
+            assert_eq!(
+                answer["error"]["kind"], "invalid_request",
+                "{line} -> {answer}"
+            );
+            let got = answer["error"]["message"].as_str().unwrap();
+            assert!(got.starts_with(message), "{line} -> {got}");
+            assert!(!got.contains('\u{1}'), "{line} -> {got:?}");
         }
     }
 

@@ -35,12 +35,12 @@ pub struct Arm {
 
 impl Arm {
     /// The Python arm of `chain`.
-    pub(crate) fn from_chain(chain: ChainModel) -> Self {
-        Self {
-            workspace: Mutex::new(ChainData::recursive(&chain)),
+    pub(crate) fn from_chain(chain: ChainModel) -> crate::errors::Result<Self> {
+        Ok(Self {
+            workspace: Mutex::new(ChainData::try_recursive(&chain)?),
             aba_workspace: Mutex::new(None),
             chain,
-        }
+        })
     }
 
     /// The chain.
@@ -49,8 +49,8 @@ impl Arm {
     }
 
     /// A workspace of the recursive algorithms: `O(n)`, since no method here factorises `M`.
-    fn fresh(&self) -> ChainData {
-        ChainData::recursive(&self.chain)
+    fn fresh(&self) -> crate::errors::Result<ChainData> {
+        Ok(ChainData::try_recursive(&self.chain)?)
     }
 
     fn n(&self) -> usize {
@@ -106,7 +106,7 @@ impl Arm {
             ..ArmSpec::default()
         };
         let chain = spec.to_chain().map_err(Error::from)?;
-        Ok(Self::from_chain(chain))
+        Ok(Self::from_chain(chain)?)
     }
 
     /// Number of links (and joints) n.
@@ -349,9 +349,14 @@ impl Arm {
             n,
             40 * n,
             &self.aba_workspace,
-            || None,
+            || Ok(None),
             |workspace, [q, v, t], out| {
-                let data = workspace.get_or_insert_with(|| AbaBatchData::new(&self.chain));
+                let data = match workspace {
+                    Some(data) => data,
+                    empty => empty.insert(
+                        AbaBatchData::try_new(&self.chain).map_err(|e| (0, Error::from(e)))?,
+                    ),
+                };
                 manip_dyn::aba_batch(&self.chain, data, q, v, t, out).map_err(|error| match error {
                     BatchError::State { state, error } => (state, Error::from(error)),
                     // The driver passes whole states: a shape error cannot happen.

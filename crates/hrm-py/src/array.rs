@@ -83,9 +83,7 @@ impl<'py> States<'py> {
             None
         } else {
             let view = array.as_array();
-            let mut copy = zeros(0, name)?;
-            copy.try_reserve_exact(view.len())
-                .map_err(|_| PyMemoryError::new_err(format!("{name}: cannot copy the array")))?;
+            let mut copy = lane_math::try_with_capacity(view.len(), name).map_err(Error::from)?;
             copy.extend(view.iter().copied());
             Some(copy)
         };
@@ -199,16 +197,8 @@ pub(crate) fn float64_array<'py>(
 
 /// A zeroed buffer of `len` float64 values, or a `MemoryError` naming `what` when the system
 /// refuses the memory (instead of aborting the interpreter).
-pub(crate) fn zeros(len: usize, what: &str) -> PyResult<Vec<f64>> {
-    let mut values = Vec::new();
-    values.try_reserve_exact(len).map_err(|_| {
-        PyMemoryError::new_err(format!(
-            "{what}: cannot allocate {len} float64 values ({} MiB)",
-            len.saturating_mul(8) >> 20
-        ))
-    })?;
-    values.resize(len, 0.0);
-    Ok(values)
+pub(crate) fn zeros(len: usize, what: &'static str) -> Result<Vec<f64>> {
+    Ok(lane_math::try_filled(len, 0.0, what)?)
 }
 
 /// `object` as a vector of float64 values (a 1-D array, list or tuple of real numbers, read as
@@ -292,7 +282,7 @@ pub(crate) fn evaluate<const K: usize, W: Send>(
     per_state: usize,
     work: usize,
     shared: &Mutex<W>,
-    fresh: impl Fn() -> W + Sync,
+    fresh: impl Fn() -> Result<W> + Sync,
     compute: impl Fn(&mut W, [&[f64]; K], &mut [f64]) -> Result<()> + Sync,
 ) -> PyResult<Output> {
     evaluate_chunks(
@@ -325,7 +315,7 @@ pub(crate) fn evaluate_chunks<const K: usize, W: Send>(
     per_state: usize,
     work: usize,
     shared: &Mutex<W>,
-    fresh: impl Fn() -> W + Sync,
+    fresh: impl Fn() -> Result<W> + Sync,
     compute_chunk: impl Fn(&mut W, [&[f64]; K], &mut [f64]) -> std::result::Result<(), (usize, Error)>
     + Sync,
 ) -> PyResult<Output> {
@@ -402,7 +392,11 @@ pub(crate) fn evaluate_chunks<const K: usize, W: Send>(
                     if cancel.is_set() {
                         return Err(stopped());
                     }
-                    run_chunk(workspace, c * chunk_states, chunk)
+                    let first = c * chunk_states;
+                    match workspace {
+                        Ok(workspace) => run_chunk(workspace, first, chunk),
+                        Err(refused) => Err((first, refused.clone())),
+                    }
                 })
                 .filter_map(std::result::Result::err)
                 .collect();

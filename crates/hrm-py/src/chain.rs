@@ -51,12 +51,12 @@ struct Workspace {
 }
 
 impl Workspace {
-    fn new(model: &SpatialModel) -> Self {
-        Self {
-            data: SpatialData::new(model),
+    fn new(model: &SpatialModel) -> crate::errors::Result<Self> {
+        Ok(Self {
+            data: SpatialData::try_new(model)?,
             derivatives: None,
             batch: None,
-        }
+        })
     }
 }
 
@@ -96,7 +96,7 @@ impl Chain {
         let model = robot_desc::to_spatial(&robot, gravity)
             .map_err(|e| Error::input(format!("urdf: {e}")))?;
         Ok(Self {
-            workspace: Mutex::new(Workspace::new(&model)),
+            workspace: Mutex::new(Workspace::new(&model)?),
             robot,
             model,
         })
@@ -106,7 +106,7 @@ impl Chain {
         self.model.n_links()
     }
 
-    fn fresh(&self) -> Workspace {
+    fn fresh(&self) -> crate::errors::Result<Workspace> {
         Workspace::new(&self.model)
     }
 
@@ -418,9 +418,12 @@ impl Chain {
             &self.workspace,
             || self.fresh(),
             |ws, [q, v, t], out| {
-                let batch = ws
-                    .batch
-                    .get_or_insert_with(|| SpatialBatchData::new(&self.model));
+                let batch = match &mut ws.batch {
+                    Some(batch) => batch,
+                    empty => empty.insert(
+                        SpatialBatchData::try_new(&self.model).map_err(|e| (0, Error::from(e)))?,
+                    ),
+                };
                 spatial::aba_batch(&self.model, batch, q, v, t, out).map_err(|error| match error {
                     BatchError::State { state, error } => (state, Error::from(error)),
                     // The driver passes whole states: a shape error cannot happen.

@@ -1,4 +1,4 @@
-//! The three exceptions of the package and the mapping of every library error onto them.
+//! The three exceptions of the package (and `MemoryError`) and the mapping of every library error onto them.
 //!
 //! The classification is the library's one ([`ErrorClass`], which every library error reports
 //! through [`Classify`]), the one `hrm eval` reports as its error `kind`
@@ -7,10 +7,11 @@
 //! malformed or out-of-domain input is [`InvalidInput`] (a `ValueError`), a target the backbone
 //! curve cannot reach is [`Unreachable`], and a computation that failed in double precision
 //! (a mass matrix that is not numerically positive definite, a non-finite result) is
-//! [`NumericalError`].
+//! [`NumericalError`], and memory the system refused (a model's arrays, a workspace, a result or
+//! a run's record sized by valid input) is Python's own `MemoryError`.
 
 use lane_math::{Classify, ErrorClass};
-use pyo3::exceptions::{PyArithmeticError, PyValueError};
+use pyo3::exceptions::{PyArithmeticError, PyMemoryError, PyValueError};
 use pyo3::{PyErr, create_exception};
 
 create_exception!(
@@ -85,6 +86,7 @@ impl From<Error> for PyErr {
         match error.kind {
             ErrorClass::Unreachable => Unreachable::new_err(message),
             ErrorClass::Numerical => NumericalError::new_err(message),
+            ErrorClass::OutOfMemory => PyMemoryError::new_err(message),
             _ => InvalidInput::new_err(message),
         }
     }

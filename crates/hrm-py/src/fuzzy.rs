@@ -113,7 +113,7 @@ impl System {
     fn eval<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let (n_in, n_out) = (self.system.inputs().len(), self.system.outputs().len());
         let x = States::read(x, "x", n_in)?;
-        let fresh = || Evaluator::new(self.system.clone());
+        let fresh = || Ok(Evaluator::new(self.system.clone()));
         // The evaluator's batch (SIMD across points); it refuses non-finite outputs itself.
         let out = evaluate_chunks(
             py,

@@ -2,7 +2,7 @@
 //! from `backbone-kin` and `modal-reduce`.
 
 use crate::arm::Arm;
-use crate::array::{States, evaluate, evaluate_chunks};
+use crate::array::{States, evaluate, evaluate_chunks, zeros};
 use crate::errors::{Error, check_finite, count};
 use backbone_kin::{BaseAngle, Branch, HarmonicIk, ModalMap, reduce_angle};
 use modal_reduce::{BatchError, ReducedBatchData, ReducedData};
@@ -43,18 +43,18 @@ pub struct ReducedModel {
 }
 
 impl Workspace {
-    fn new(model: &modal_reduce::ReducedModel) -> Self {
-        Self {
-            data: ReducedData::new(model),
-            batch: ReducedBatchData::new(model),
-            theta: vec![0.0; model.n_links()],
+    fn new(model: &modal_reduce::ReducedModel) -> crate::errors::Result<Self> {
+        Ok(Self {
+            data: ReducedData::try_new(model)?,
+            batch: ReducedBatchData::try_new(model)?,
+            theta: zeros(model.n_links(), "the workspace of the reduced model")?,
             zeros: vec![0.0; model.n_coords()],
-        }
+        })
     }
 }
 
 impl ReducedModel {
-    fn fresh(&self) -> Workspace {
+    fn fresh(&self) -> crate::errors::Result<Workspace> {
         Workspace::new(&self.model)
     }
 
@@ -106,7 +106,7 @@ impl ReducedModel {
             let map = ModalMap::new(&lengths, harmonics, base).map_err(Error::from)?;
             let model = modal_reduce::ReducedModel::new(chain, map).map_err(Error::from)?;
             Ok(Self {
-                workspace: Mutex::new(Workspace::new(&model)),
+                workspace: Mutex::new(Workspace::new(&model)?),
                 model,
                 lengths,
             })
@@ -123,7 +123,7 @@ impl ReducedModel {
         slf: &Bound<'py, Self>,
     ) -> PyResult<(Bound<'py, PyAny>, (Py<Arm>, usize, Option<f64>))> {
         let model = slf.get();
-        let arm = Py::new(slf.py(), Arm::from_chain(model.model.chain().clone()))?;
+        let arm = Py::new(slf.py(), Arm::from_chain(model.model.chain().clone())?)?;
         Ok((
             slf.get_type().into_any(),
             (arm, model.harmonics(), model.alpha0()),
@@ -295,7 +295,7 @@ impl ReducedModel {
             self.m(),
             1000 * self.m() * self.m(),
             &shared,
-            || solver.clone(),
+            || Ok(solver.clone()),
             |solver, [target], out| {
                 let target = [target[0], target[1]];
                 out.fill(0.0);

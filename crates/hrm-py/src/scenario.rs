@@ -11,6 +11,7 @@
 use crate::array::States;
 use crate::errors::{Error, NumericalError};
 use crate::pool::{self, Cancel};
+use lane_math::{Classify, ErrorClass};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::exceptions::{PyAttributeError, PyFileNotFoundError, PyOSError};
@@ -949,6 +950,10 @@ impl Run {
         let summary = sim_study::summary_json::run(&result);
         let (run, failure) = match result {
             Ok(run) => (run, None),
+            // Memory the system refused (the run's record) is a `MemoryError`, not a failed run.
+            Err(Stopped { error, .. }) if error.class() == ErrorClass::OutOfMemory => {
+                return Err(Error::from(error).into());
+            }
             Err(Stopped {
                 error,
                 partial: Some(run),

@@ -84,8 +84,8 @@ pub struct SpatialArm {
 }
 
 impl SpatialArm {
-    fn fresh(&self) -> Workspace {
-        Workspace::new(&self.model).expect("the model's own map and base built a solver before")
+    fn fresh(&self) -> crate::errors::Result<Workspace> {
+        Workspace::new(&self.model)
     }
 
     /// The arm's chain as a description, refused past [`MAX_EXPORT_LINKS`].

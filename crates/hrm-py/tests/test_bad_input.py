@@ -183,8 +183,50 @@ def test_an_allocation_the_system_refuses_is_a_memory_error():
         print(arm.gravity(np.zeros(4096)).shape)
     """)
     assert done.returncode == 0, done.stderr
-    assert "MemoryError: the result of the batch: cannot allocate 134217728 float64 values" in done.stdout
+    assert "MemoryError: the result of the batch: the system refused 1073741824 bytes" in done.stdout
     assert done.stdout.strip().endswith("(4096,)")
+
+
+LIMITED = textwrap.dedent("""
+    import resource
+    import numpy as np
+    import hrm
+
+    def limited(headroom, call):
+        # The address space in use now plus `headroom` bytes, for `call` only.
+        size = int(open("/proc/self/statm").read().split()[0]) * resource.getpagesize()
+        resource.setrlimit(resource.RLIMIT_AS, (size + headroom, resource.RLIM_INFINITY))
+        try:
+            call()
+        except MemoryError as e:
+            print("MemoryError:", e)
+        else:
+            print("no error")
+        finally:
+            resource.setrlimit(resource.RLIMIT_AS, (resource.RLIM_INFINITY, resource.RLIM_INFINITY))
+
+    hrm.Arm(links=2).gravity(np.zeros((600, 2)))  # the pool's threads exist before any limit
+""")
+
+
+@pytest.mark.parametrize("setup, headroom, call, refused", [
+    # The per-task workspaces of a parallel batch: 512 states of 500,000 links, the 2 GB result
+    # given, not the workspaces' ~100 MB each.
+    ("arm = hrm.Arm(links=500000); q = np.zeros((512, 500000))", "512 * 500000 * 8 + (40 << 20)",
+     "arm.gravity(q)", "the workspace of the recursive algorithms: the system refused"),
+    # A model's arrays: a million links' parameters and workspace.
+    ("", "8 << 20", "hrm.Arm(links=1000000)", "the system refused"),
+    # A run's record: 1.9 million samples of 71 numbers (below the 2^27 bound), about 1 GB.
+    ("s = hrm.Scenario.builtin('paper-tracking'); s.duration = 1800.0; s.record_period = 0.001",
+     "256 << 20", "s.run('pd')", "the run's record: the system refused"),
+], ids=["batch-workspaces", "model-arrays", "run-record"])
+def test_memory_the_system_refuses_is_a_memory_error_and_the_interpreter_goes_on(
+        setup, headroom, call, refused):
+    code = LIMITED + f"\n{setup}\nlimited({headroom}, lambda: {call})\nprint(hrm.Arm(links=3).gravity(np.zeros(3)).shape)\n"
+    done = run_python(code, timeout=300, env={"RAYON_NUM_THREADS": "2"})
+    assert done.returncode == 0, done.stderr
+    assert "MemoryError:" in done.stdout and refused in done.stdout, done.stdout
+    assert done.stdout.strip().endswith("(3,)")
 
 
 INTERRUPT = textwrap.dedent("""

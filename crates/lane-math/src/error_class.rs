@@ -1,7 +1,7 @@
 //! The one classification of the workspace's errors.
 
 /// The class of an error: what a caller does about it. Every error type of the `hrm` library
-/// crates sorts its variants into these three ([`Classify`]), a wrapped error of another crate
+/// crates sorts its variants into these classes ([`Classify`]), a wrapped error of another crate
 /// keeping its own class; `hrm eval` reports the class as an error's `kind` and the Python
 /// package raises one exception per class.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -16,10 +16,14 @@ pub enum ErrorClass {
     /// numerically positive definite, an iteration that did not converge, a result or a run
     /// that came out non-finite or ran away.
     Numerical,
+    /// The system refused the memory of a buffer sized by valid input (an allocation within
+    /// the documented limits that the machine cannot give).
+    OutOfMemory,
 }
 
 impl ErrorClass {
-    /// The class's name as `hrm eval` reports it: `invalid_input`, `unreachable`, `numerical`.
+    /// The class's name as `hrm eval` reports it: `invalid_input`, `unreachable`, `numerical`,
+    /// `out_of_memory`.
     ///
     /// ```
     /// assert_eq!(lane_math::ErrorClass::InvalidInput.name(), "invalid_input");
@@ -29,6 +33,7 @@ impl ErrorClass {
             Self::InvalidInput => "invalid_input",
             Self::Unreachable => "unreachable",
             Self::Numerical => "numerical",
+            Self::OutOfMemory => "out_of_memory",
         }
     }
 }

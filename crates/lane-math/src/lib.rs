@@ -1,12 +1,15 @@
 #![doc = include_str!("../README.md")]
 
+mod alloc;
 mod checks;
 mod compact;
+pub mod dense;
 mod error_class;
 mod instruction_sets;
 mod lanes;
 mod trig;
 
+pub use alloc::{OutOfMemory, try_filled, try_reserve, try_with_capacity};
 pub use checks::{ShapeProblem, check_values, first_non_finite};
 pub use compact::{Compact, compact_numbers};
 pub use error_class::{Classify, ErrorClass};

@@ -14,7 +14,7 @@
 //! of more than [`MAX_BATCH_LINKS`] links.
 
 use lane_math::Pack;
-use lane_math::{Classify, ErrorClass};
+use lane_math::{Classify, ErrorClass, try_filled};
 use pulp::{Arch, Simd, WithSimd};
 
 use crate::aba::{LinkBuffers, MAX_WIDTH, aba, kernel};
@@ -81,18 +81,27 @@ impl AbaBatchData {
     /// assert_eq!(data.n_links(), 10);
     /// # Ok::<(), manip_dyn::DynError>(())
     /// ```
+    ///
+    /// # Panics
+    /// When the system refuses the memory; [`AbaBatchData::try_new`] returns the error.
     pub fn new(model: &ChainModel) -> Self {
+        Self::try_new(model).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`AbaBatchData::new`], or [`DynError::OutOfMemory`] when the system refuses the memory.
+    pub fn try_new(model: &ChainModel) -> Result<Self, DynError> {
+        const WHAT: &str = "the workspace of the batch ABA";
         let n = model.n_links();
         let lanes = if n <= MAX_BATCH_LINKS { n } else { 0 };
-        Self {
-            angle: vec![0.0; lanes * MAX_WIDTH],
-            sin: vec![0.0; lanes * MAX_WIDTH],
-            cos: vec![0.0; lanes * MAX_WIDTH],
-            frames: vec![LinkFrame::default(); lanes],
-            articulated: vec![ArticulatedLink::default(); lanes],
-            single: ChainData::recursive(model),
+        Ok(Self {
+            angle: try_filled(lanes * MAX_WIDTH, 0.0, WHAT)?,
+            sin: try_filled(lanes * MAX_WIDTH, 0.0, WHAT)?,
+            cos: try_filled(lanes * MAX_WIDTH, 0.0, WHAT)?,
+            frames: try_filled(lanes, LinkFrame::default(), WHAT)?,
+            articulated: try_filled(lanes, ArticulatedLink::default(), WHAT)?,
+            single: ChainData::try_recursive(model)?,
             arch: Arch::new(),
-        }
+        })
     }
 
     /// Number of links of the chain this workspace was built for.

@@ -4,8 +4,10 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt;
 use faer::reborrow::ReborrowMut;
 use faer::{Mat, Par};
+use lane_math::{OutOfMemory, try_filled};
 use pulp::Arch;
 
+use crate::error::DynError;
 use crate::model::{ChainModel, MAX_DENSE_LINKS};
 
 /// Scratch space for one [`ChainModel`]: build it once with [`ChainData::new`], then pass it to
@@ -65,7 +67,7 @@ impl ChainData {
     /// # Ok::<(), manip_dyn::DynError>(())
     /// ```
     pub fn new(model: &ChainModel) -> ChainData {
-        let mut data = Self::with_links(model.n_links());
+        let mut data = Self::with_links(model.n_links()).unwrap_or_else(|e| panic!("{e}"));
         if data.n_links() <= MAX_DENSE_LINKS {
             data.allocate_factorisation();
         }
@@ -88,8 +90,17 @@ impl ChainData {
     /// assert!((g[0] - 9.81 * 1.0 * 0.5).abs() < 1e-9);
     /// # Ok::<(), manip_dyn::DynError>(())
     /// ```
+    ///
+    /// # Panics
+    /// When the system refuses the memory; [`ChainData::try_recursive`] returns the error.
     pub fn recursive(model: &ChainModel) -> ChainData {
-        Self::with_links(model.n_links())
+        Self::try_recursive(model).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`ChainData::recursive`], or [`DynError::OutOfMemory`] when the system refuses the
+    /// memory.
+    pub fn try_recursive(model: &ChainModel) -> Result<ChainData, DynError> {
+        Ok(Self::with_links(model.n_links())?)
     }
 
     /// Number of links of the chain this workspace was built for.
@@ -97,20 +108,21 @@ impl ChainData {
         self.frames.len()
     }
 
-    fn with_links(n: usize) -> ChainData {
-        ChainData {
-            frames: vec![LinkFrame::default(); n],
-            angle: vec![0.0; n],
-            sin: vec![0.0; n],
-            cos: vec![0.0; n],
-            accelerations: vec![LinkAcceleration::default(); n],
-            subtrees: vec![Subtree::default(); n],
-            subtree_motions: vec![SubtreeMotion::default(); n],
-            articulated: vec![ArticulatedLink::default(); n],
-            mass_row: vec![0.0; n],
+    fn with_links(n: usize) -> Result<ChainData, OutOfMemory> {
+        const WHAT: &str = "the workspace of the recursive algorithms";
+        Ok(ChainData {
+            frames: try_filled(n, LinkFrame::default(), WHAT)?,
+            angle: try_filled(n, 0.0, WHAT)?,
+            sin: try_filled(n, 0.0, WHAT)?,
+            cos: try_filled(n, 0.0, WHAT)?,
+            accelerations: try_filled(n, LinkAcceleration::default(), WHAT)?,
+            subtrees: try_filled(n, Subtree::default(), WHAT)?,
+            subtree_motions: try_filled(n, SubtreeMotion::default(), WHAT)?,
+            articulated: try_filled(n, ArticulatedLink::default(), WHAT)?,
+            mass_row: try_filled(n, 0.0, WHAT)?,
             factorisation: None,
             arch: Arch::new(),
-        }
+        })
     }
 
     /// Allocates (and warms up) the `n x n` part.
@@ -160,7 +172,7 @@ impl Clone for ChainData {
     /// A fresh workspace of the same size, with the `n x n` factor if this one has it (the
     /// contents are scratch, so nothing else is copied).
     fn clone(&self) -> Self {
-        let mut data = Self::with_links(self.n_links());
+        let mut data = Self::with_links(self.n_links()).unwrap_or_else(|e| panic!("{e}"));
         if self.factorisation.is_some() {
             data.allocate_factorisation();
         }

@@ -1,6 +1,6 @@
 //! The error type of this crate.
 
-use lane_math::{Classify, Compact, ErrorClass};
+use lane_math::{Classify, Compact, ErrorClass, OutOfMemory};
 
 /// Why a dynamics computation was refused.
 ///
@@ -119,6 +119,9 @@ pub enum DynError {
         /// 0-based joint index.
         index: usize,
     },
+    /// The system refused the memory of a model's or a workspace's arrays.
+    #[error(transparent)]
+    OutOfMemory(#[from] OutOfMemory),
 }
 
 impl Classify for DynError {
@@ -126,13 +129,15 @@ impl Classify for DynError {
     /// precision: a mass matrix that is not numerically positive definite, or a result that
     /// overflowed ([`NotPositiveDefinite`](DynError::NotPositiveDefinite),
     /// [`SingularJoint`](DynError::SingularJoint),
-    /// [`NonFiniteResult`](DynError::NonFiniteResult)); otherwise the input was malformed or
+    /// [`NonFiniteResult`](DynError::NonFiniteResult)); [`OutOfMemory`](ErrorClass::OutOfMemory)
+    /// when the system refused an allocation; otherwise the input was malformed or
     /// outside the model's domain.
     fn class(&self) -> ErrorClass {
         match self {
             Self::NotPositiveDefinite
             | Self::SingularJoint { .. }
             | Self::NonFiniteResult { .. } => ErrorClass::Numerical,
+            Self::OutOfMemory(e) => e.class(),
             _ => ErrorClass::InvalidInput,
         }
     }

@@ -137,7 +137,11 @@ impl ChainModel {
     /// ```
     pub fn uniform(n: usize, length: f64, mass: f64, gravity: f64) -> Result<Self, DynError> {
         check_link_count(n)?;
-        Self::new(vec![Link::uniform_beam(length, mass)?; n], gravity)
+        let beam = Link::uniform_beam(length, mass)?;
+        Self::new(
+            lane_math::try_filled(n, beam, "the chain's links")?,
+            gravity,
+        )
     }
 
     /// Number of links (and joints) `n`.

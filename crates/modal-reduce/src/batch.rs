@@ -21,8 +21,8 @@ use crate::data::{PRODUCTS, ReducedData};
 use crate::error::{ReduceError, all_finite, check_len};
 use crate::forward::forward_dynamics;
 use crate::model::ReducedModel;
-use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
 use crate::terms::{LinkBuffers, StateLanes, Terms, accumulate, angles_in_range, extract};
+use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 use lane_math::{Lane, Pack};
 
 /// The most `f64` lanes of a SIMD register (AVX-512).
@@ -78,16 +78,27 @@ pub struct ReducedBatchData {
 
 impl ReducedBatchData {
     /// A workspace sized for `model`, for the instruction set of this processor.
+    ///
+    /// # Panics
+    /// When the system refuses the memory; [`ReducedBatchData::try_new`] returns the error.
     pub fn new(model: &ReducedModel) -> Self {
+        Self::try_new(model).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`ReducedBatchData::new`], or [`ReduceError::OutOfMemory`] when the system refuses the
+    /// memory.
+    pub fn try_new(model: &ReducedModel) -> Result<Self, ReduceError> {
+        const WHAT: &str = "the workspace of the reduced model's batch";
         let size = model.n_links() * MAX_WIDTH;
-        Self {
-            angle: CacheAligned::zeros(size),
-            sin: CacheAligned::zeros(size),
-            cos: CacheAligned::zeros(size),
-            products: CacheAligned::zeros(PRODUCTS * size),
-            single: ReducedData::new(model),
+        let aligned = |len: usize| CacheAligned::try_zeros(len, WHAT);
+        Ok(Self {
+            angle: aligned(size)?,
+            sin: aligned(size)?,
+            cos: aligned(size)?,
+            products: aligned(PRODUCTS * size)?,
+            single: ReducedData::try_new(model)?,
             arch: Arch::new(),
-        }
+        })
     }
 }
 

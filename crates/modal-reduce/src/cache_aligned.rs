@@ -2,6 +2,8 @@
 //! read and written as one line rather than split across two (which costs a split load or
 //! store each time: about a tenth of a batch's time when they were unaligned).
 
+use lane_math::{OutOfMemory, try_filled};
+
 /// The bytes of a cache line, and of an AVX-512 register.
 const LINE: usize = 64;
 
@@ -15,12 +17,20 @@ pub(crate) struct CacheAligned {
 
 impl CacheAligned {
     /// `len` zeros.
+    ///
+    /// # Panics
+    /// When the system refuses the memory; [`CacheAligned::try_zeros`] returns the error.
     pub(crate) fn zeros(len: usize) -> Self {
+        Self::try_zeros(len, "a per-link buffer").unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// `len` zeros, or [`OutOfMemory`] naming `what` when the system refuses the memory.
+    pub(crate) fn try_zeros(len: usize, what: &'static str) -> Result<Self, OutOfMemory> {
         let room = LINE / size_of::<f64>() - 1;
-        Self {
-            values: vec![0.0; len + room],
+        Ok(Self {
+            values: try_filled(len.saturating_add(room), 0.0, what)?,
             len,
-        }
+        })
     }
 
     /// Where the aligned values start in `values` (recomputed on each access: a clone's

@@ -2,6 +2,7 @@
 //! reduced terms it holds after a computation.
 
 use faer::{Mat, MatRef};
+use lane_math::try_filled;
 use manip_dyn::ChainData;
 use pulp::Arch;
 
@@ -109,38 +110,51 @@ pub(crate) struct TermScratch {
 
 impl ReducedData {
     /// A workspace sized for `model`.
+    ///
+    /// # Panics
+    /// When the system refuses the memory; [`ReducedData::try_new`] returns the error.
     pub fn new(model: &ReducedModel) -> Self {
+        Self::try_new(model).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`ReducedData::new`], or [`ReduceError::OutOfMemory`] when the system refuses the
+    /// memory.
+    pub fn try_new(model: &ReducedModel) -> Result<Self, ReduceError> {
+        const WHAT: &str = "the workspace of the reduced model";
         let (n, m) = (model.n_links(), model.n_coords());
-        Self {
+        let zeros = |len: usize| try_filled(len, 0.0, WHAT);
+        let padded = n.next_multiple_of(LINK_PADDING);
+        let aligned = |len: usize| CacheAligned::try_zeros(len, WHAT);
+        Ok(Self {
             n_links: n,
             n_coords: m,
-            mass: vec![0.0; m * m],
-            coriolis: vec![0.0; m],
-            gravity: vec![0.0; m],
-            factor: vec![0.0; m * m],
-            rhs: vec![0.0; m],
-            iterate: vec![0.0; m],
+            mass: zeros(m * m)?,
+            coriolis: zeros(m)?,
+            gravity: zeros(m)?,
+            factor: zeros(m * m)?,
+            rhs: zeros(m)?,
+            iterate: zeros(m)?,
             links: OneStateLinks {
-                angle: CacheAligned::zeros(n.next_multiple_of(LINK_PADDING)),
-                sin: CacheAligned::zeros(n.next_multiple_of(LINK_PADDING)),
-                cos: CacheAligned::zeros(n.next_multiple_of(LINK_PADDING)),
-                products: CacheAligned::zeros(PRODUCTS * n.next_multiple_of(LINK_PADDING)),
+                angle: aligned(padded)?,
+                sin: aligned(padded)?,
+                cos: aligned(padded)?,
+                products: aligned(PRODUCTS.saturating_mul(padded))?,
             },
             scratch: TermScratch {
-                mass: vec![0.0; m * m],
-                coriolis: vec![0.0; m],
-                gravity: vec![0.0; m],
-                joint: vec![[0.0; 2]; m],
-                v: vec![0.0; m],
+                mass: zeros(m * m)?,
+                coriolis: zeros(m)?,
+                gravity: zeros(m)?,
+                joint: try_filled(m, [0.0; 2], WHAT)?,
+                v: zeros(m)?,
             },
-            theta: vec![0.0; n],
-            theta_dot: vec![0.0; n],
-            theta_ddot: vec![0.0; n],
-            joint_torque: vec![0.0; n],
+            theta: zeros(n)?,
+            theta_dot: zeros(n)?,
+            theta_ddot: zeros(n)?,
+            joint_torque: zeros(n)?,
             projection: None,
-            chain: ChainData::recursive(model.chain()),
+            chain: ChainData::try_recursive(model.chain())?,
             arch: Arch::new(),
-        }
+        })
     }
 
     /// The reduced mass matrix `M* = J^T M J` (`m x m`, eq 14) of the last computation.

@@ -39,7 +39,7 @@ use crate::data::ReducedData;
 use crate::error::{ReduceError, check_finite_result, check_len};
 use crate::forward::forward_dynamics;
 use crate::model::ReducedModel;
-use crate::small_linalg::{ldlt_in_place, ldlt_solve_rows_in_place};
+use lane_math::dense::{ldlt_in_place, ldlt_solve_rows_in_place};
 
 /// Results and scratch of [`reduced_derivatives`] for one [`ReducedModel`]: `O(n + m^2)` memory,
 /// built once; every call then fills it without allocating.

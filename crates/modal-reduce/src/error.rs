@@ -131,17 +131,22 @@ pub enum ReduceError {
         /// The family of the arm given.
         given: &'static str,
     },
+    /// The system refused the memory of a reduced model's or a workspace's arrays.
+    #[error(transparent)]
+    OutOfMemory(#[from] lane_math::OutOfMemory),
 }
 
 impl Classify for ReduceError {
     /// [`Numerical`](ErrorClass::Numerical) when a computation on valid input failed in double
     /// precision: `M*` not numerically positive definite, a result that overflowed, the eq-18
     /// iteration diverging or not converging; a wrapped [`DynError`] or [`KinError`] keeps its
-    /// own class; otherwise the input was malformed or outside the model's domain.
+    /// own class; [`OutOfMemory`](ErrorClass::OutOfMemory) for memory the system refused;
+    /// otherwise the input was malformed or outside the model's domain.
     fn class(&self) -> ErrorClass {
         match self {
             Self::Dyn(e) => e.class(),
             Self::Kin(e) => e.class(),
+            Self::OutOfMemory(e) => e.class(),
             Self::NotPositiveDefinite
             | Self::NonFiniteResult { .. }
             | Self::JacobiDiverged { .. }

@@ -8,8 +8,8 @@ use crate::error::all_finite;
 use crate::error::{ReduceError, check_finite_result, check_input, check_len};
 use crate::model::ReducedModel;
 use crate::projection::reduced_terms_by_projection;
-use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
 use crate::terms::{StackTerms, accumulate_in_data, check_state, check_terms};
+use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 
 /// The modal accelerations `a_ddot` under generalised forces `tau*` (eq 15), written into
 /// `a_ddot` (length `m`), with `M*`, `C*` and `G*` from the default `O(n m^2)` path

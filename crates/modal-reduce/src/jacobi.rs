@@ -17,8 +17,8 @@ use crate::data::ReducedData;
 use crate::error::{ReduceError, check_finite_result};
 use crate::forward::{check_forces, right_hand_side};
 use crate::model::ReducedModel;
-use crate::small_linalg::symmetric_eigen_extremes;
 use crate::terms::reduced_terms;
+use lane_math::dense::symmetric_eigen_extremes;
 
 /// When the eq-18 iteration stops.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -12,7 +12,6 @@ pub mod jacobi;
 mod model;
 mod plant;
 mod projection;
-mod small_linalg;
 pub mod spatial;
 pub mod terms;
 mod torques;

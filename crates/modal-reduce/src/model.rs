@@ -5,7 +5,7 @@ use backbone_kin::{BaseAngle, ModalMap};
 use manip_dyn::ChainModel;
 
 use crate::error::ReduceError;
-use crate::small_linalg::symmetric_eigen_extremes;
+use lane_math::dense::symmetric_eigen_extremes;
 
 /// The most `f64` lanes of a SIMD register (AVX-512): the per-link buffers of one state are
 /// padded to a multiple of it.

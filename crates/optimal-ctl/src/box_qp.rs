@@ -2,7 +2,7 @@
 //! control-limited DDP (Tassa, Mansard and Todorov 2014, section III and Algorithm 3).
 
 use super::OptimalError;
-use super::dense::{cholesky, cholesky_solve};
+use lane_math::dense::{cholesky, cholesky_solve};
 
 /// Stopping rules of [`BoxQp::solve`].
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -3,9 +3,9 @@
 
 use super::OptimalError;
 use super::box_qp::{BoxQp, BoxQpSettings};
-use super::dense::{multiply, multiply_transposed, symmetrise};
 use super::discrete::DiscreteDynamics;
 use super::step_constraints::{ConstrainedWork, StepConstraints};
+use lane_math::dense::{multiply, multiply_transposed, symmetrise};
 
 /// The most steps a horizon may have.
 pub const MAX_HORIZON: usize = 100_000;

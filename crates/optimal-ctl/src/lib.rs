@@ -1,7 +1,6 @@
 #![doc = include_str!("../README.md")]
 
 mod box_qp;
-pub mod dense;
 mod discrete;
 mod ilqr;
 mod joint_torque_rows;

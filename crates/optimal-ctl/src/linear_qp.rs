@@ -9,8 +9,8 @@
 //! `x = x_u + L^-T y`. This is the general form of the box QP of control-limited DDP
 //! ([`BoxQp`](crate::BoxQp)) that the joint-torque polytope and linearised clearances need.
 
-use crate::dense::{back_substitute, cholesky, cholesky_solve, forward_substitute};
 use crate::polytope::{PolytopeProjection, ProjectionFailure};
+use lane_math::dense::{back_substitute, cholesky, cholesky_solve, forward_substitute};
 
 /// Why a [`LinearQp`] has no solution.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -4,7 +4,7 @@ use faer::MatRef;
 use modal_reduce::{Plant, PlantData, PlantDerivatives};
 
 use super::OptimalError;
-use super::dense::exponential;
+use lane_math::dense::exponential;
 
 /// The linearisation of the reduced dynamics `x_dot = f(x, u)`, `x = (a, a_dot)`, `u = tau*`
 /// (eq 15 as a first-order system), about a state and control:

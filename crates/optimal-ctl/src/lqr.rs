@@ -4,11 +4,11 @@
 use faer::MatRef;
 
 use super::OptimalError;
-use super::dense::{
+use super::linearise::Linearisation;
+use lane_math::dense::{
     cholesky, cholesky_solve, lu_solve, multiply, multiply_by_transposed, multiply_transposed,
     symmetrise,
 };
-use super::linearise::Linearisation;
 
 /// Iteration limit and tolerance of [`Lqr::solve`].
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -7,9 +7,9 @@
 //! linearised through `x_{k+1} ~ F(x_k, u_k) + B_k (u - u_k)` (joint limits, clearance).
 
 use crate::OptimalError;
-use crate::dense::{cholesky, cholesky_solve};
 use crate::linear_qp::{LinearQp, LinearQpFailure};
 use crate::polytope::PolytopeProjection;
+use lane_math::dense::{cholesky, cholesky_solve};
 
 /// The constraints `G u_k <= g` of every step of a constrained [`Ilqr`](crate::Ilqr) solve.
 pub trait StepConstraints {

@@ -78,7 +78,7 @@ pub enum ViewError {
     /// The arm's kinematics refused a recorded state.
     #[error(transparent)]
     Kinematics(#[from] backbone_kin::KinError),
-    /// The arm's clearance to the scenario's obstacles could not be measured.
+    /// The clearance of a recorded state could not be measured.
     #[error(transparent)]
     Clearance(#[from] clearance::ClearanceError),
 }
@@ -221,6 +221,7 @@ impl Classify for ViewError {
         match self {
             Self::Model(error) => error.class(),
             Self::Kinematics(error) => error.class(),
+            Self::Clearance(error) => error.class(),
             Self::Run { source, .. } => source.class(),
             _ => ErrorClass::InvalidInput,
         }

@@ -1,13 +1,13 @@
 //! A closed-loop run of `sim-core` (a planar or a spatial arm) as a [`RunView`]: the arm's points
 //! from the recorded modal coordinates through the scenario's modal map (eq 8) and the chain's
-//! forward kinematics, and the series a reader checks first.
+//! forward kinematics, the scenario's obstacles, and the series a reader checks first.
 
 use crate::error::ViewError;
 use crate::view::{Obstacle, RunView, Series};
 use clearance::{ClearanceData, ClearanceModel};
 use modal_reduce::PlantModel;
 use sim_core::Record;
-use sim_study::{Scenario, TorqueLimit, Workspace};
+use sim_study::{Scenario, TorqueLimit};
 
 /// The run `record` of `scenario` under the controller named `label`: every sample's joint
 /// positions (`theta = J a + theta_0`, eq 8, then the chain from the base at the origin; for a
@@ -16,11 +16,11 @@ use sim_study::{Scenario, TorqueLimit, Workspace};
 /// the scenario's joint torque limits (a spatial arm's against the run's peak), and the
 /// series tip error (mm), modal coordinates with their references (rad) and `tau*` (N m) (the
 /// viewer adds the panel of the joint torques itself, from the torques that colour the links).
-/// A scenario with obstacles (or an arm radius) also gets its obstacles drawn and the series
-/// clearance (mm): the smallest clearance of the links' capsules to the obstacles and to the arm
-/// itself at every sample, measured by `clearance::distances` from the drawn joint points.
-/// A box turned by `rpy` is not drawn (the page draws axis-aligned boxes); its clearance is
-/// still measured. `stopped` is why a run stopped early.
+/// A scenario with `[[obstacles]]` or `[arm] radius` also gets its obstacles drawn and a
+/// clearance series (mm): at every recorded sample the smallest clearance of a link's capsule
+/// to an obstacle and between links that share no joint, measured by `clearance::distances`
+/// from the drawn joint points (the loop's own minima over every controller sample are in the
+/// run's summary). `stopped` is why a run stopped early.
 pub fn from_record(
     scenario: &Scenario,
     label: &str,
@@ -72,6 +72,13 @@ pub fn from_record(
             }
         }
     }
+    let (obstacles, clearance) = match scenario.clearance_model(n, scenario.workspace())? {
+        Some(model) => (
+            model.obstacles().iter().map(|o| drawn(o, dims)).collect(),
+            clearance_series(&model, &joints, dims, m)?,
+        ),
+        None => (Vec::new(), None),
+    };
     let names = scenario.coordinate_names();
     // In the plane z is zero and `hypot(d, 0) = |d|`.
     let tip_error = (0..samples)
@@ -125,15 +132,7 @@ pub fn from_record(
             values: (0..m).map(|i| modal(Record::tau_star_at, i)).collect(),
         },
     ];
-    let workspace = if dims == 2 {
-        Workspace::Planar
-    } else {
-        Workspace::Spatial
-    };
-    let model = scenario.clearance_model(n, workspace)?;
-    if let Some(model) = &model {
-        series.push(clearance_series(model, &joints, dims, m)?);
-    }
+    series.extend(clearance);
     // A spatial arm's links are coloured against the run's peak torque.
     let torque_limit = match (&scenario.limits.joint_torque_nm, dims) {
         (Some(TorqueLimit::All(limit)), 2) => vec![*limit; n],
@@ -164,11 +163,7 @@ pub fn from_record(
         },
         torque_limit,
         series,
-        obstacles: model
-            .iter()
-            .flat_map(ClearanceModel::obstacles)
-            .filter_map(|o| drawn(o, dims))
-            .collect(),
+        obstacles,
         channels: Vec::new(),
         stopped: stopped.map(str::to_owned),
     };
@@ -176,75 +171,83 @@ pub fn from_record(
     Ok(view)
 }
 
-/// The smallest clearance (mm) of the links to the obstacles and to the arm itself at every
-/// sample (`joints`: a sample's points, `dims` numbers each; a curve each when the model has
-/// such pairs).
+/// The clearance series (mm) of the drawn samples `joints` (each `n + 1` points of `dims`
+/// coordinates): the smallest clearance to an obstacle, and between links when the arm has
+/// a pair that shares no joint (`clearance::distances`); `None` when the arm has neither.
 fn clearance_series(
     model: &ClearanceModel,
     joints: &[Vec<f64>],
     dims: usize,
     n_coords: usize,
-) -> Result<Series, ViewError> {
+) -> Result<Option<Series>, ViewError> {
     let mut data = ClearanceData::new(model, n_coords)?;
-    // The distances use the joint points only; the axes serve the gradients, unused here.
-    let axes = vec![[0.0, 0.0, 1.0]; model.n_links()];
     let mut points = vec![[0.0; 3]; model.n_links() + 1];
+    // The distances read the joint points only; the axes are placeholders of unit length.
+    let axes = vec![[0.0, 0.0, 1.0]; model.n_links()];
     let (mut to_obstacles, mut to_itself) = (Vec::new(), Vec::new());
-    for sample in joints {
-        for (point, coords) in points.iter_mut().zip(sample.chunks_exact(dims)) {
-            point[..dims].copy_from_slice(coords);
+    for row in joints {
+        for (point, drawn) in points.iter_mut().zip(row.chunks_exact(dims)) {
+            point[..dims].copy_from_slice(drawn);
         }
         clearance::place(model, &mut data, &points, &axes)?;
-        let (obstacle, itself) = clearance::distances(model, &mut data);
-        to_obstacles.push(1e3 * obstacle);
-        to_itself.push(1e3 * itself);
+        let (near_obstacle, near_self) = clearance::distances(model, &mut data);
+        to_obstacles.push(1e3 * near_obstacle);
+        to_itself.push(1e3 * near_self);
     }
-    let mut series = Series {
+    let (mut names, mut values) = (Vec::new(), Vec::new());
+    if model.n_obstacle_pairs() > 0 {
+        names.push("to the obstacles".into());
+        values.push(to_obstacles);
+    }
+    if model.pairs().len() > model.n_obstacle_pairs() {
+        names.push("between links".into());
+        values.push(to_itself);
+    }
+    Ok((!names.is_empty()).then(|| Series {
         title: "clearance".into(),
         unit: "mm".into(),
-        names: Vec::new(),
-        values: Vec::new(),
-    };
-    for (name, values) in [("to obstacles", to_obstacles), ("to itself", to_itself)] {
-        if values.iter().all(|v| v.is_finite()) {
-            series.names.push(name.into());
-            series.values.push(values);
-        }
-    }
-    Ok(series)
+        names,
+        values,
+    }))
 }
 
-/// A measured obstacle as the page draws it, in the arm's `dims` coordinates; `None` for a
-/// turned box.
-fn drawn(obstacle: &clearance::Obstacle, dims: usize) -> Option<Obstacle> {
-    let point = |p: &[f64; 3]| p[..dims].to_vec();
-    Some(match obstacle {
+/// How the viewer draws `obstacle` in `dims` coordinates: a sphere of a planar arm as a
+/// circle, a box as the axis-aligned box that bounds it (exactly the box when it is not
+/// turned; an infinite half-extent along `z` of a planar box is dropped with `z`).
+fn drawn(obstacle: &clearance::Obstacle, dims: usize) -> Obstacle {
+    let cut = |p: [f64; 3]| p[..dims].to_vec();
+    match *obstacle {
         clearance::Obstacle::Sphere { center, radius } if dims == 2 => Obstacle::Circle {
-            centre: point(center),
-            radius: *radius,
+            centre: cut(center),
+            radius,
         },
         clearance::Obstacle::Sphere { center, radius } => Obstacle::Sphere {
-            centre: point(center),
-            radius: *radius,
+            centre: cut(center),
+            radius,
         },
         clearance::Obstacle::Capsule { from, to, radius } => Obstacle::Capsule {
-            a: point(from),
-            b: point(to),
-            radius: *radius,
+            a: cut(from),
+            b: cut(to),
+            radius,
         },
         clearance::Obstacle::Box {
             center,
             half_extents,
             axes,
         } => {
-            let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-            if *axes != identity {
-                return None;
-            }
+            // Half the extent of the turned box along world axis `i`: sum_k |R_ik| h_k.
+            let half: Vec<f64> = (0..dims)
+                .map(|i| {
+                    (0..3)
+                        .map(|k| axes[k][i].abs() * half_extents[k])
+                        .filter(|h| !h.is_nan())
+                        .sum()
+                })
+                .collect();
             Obstacle::Box {
-                centre: point(center),
-                half: point(half_extents),
+                centre: cut(center),
+                half,
             }
         }
-    })
+    }
 }

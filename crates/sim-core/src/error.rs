@@ -184,6 +184,9 @@ pub enum SimError {
         /// Why.
         reason: &'static str,
     },
+    /// The system refused the memory of a run's workspaces or record.
+    #[error(transparent)]
+    OutOfMemory(#[from] lane_math::OutOfMemory),
 }
 
 /// The error of a controller from outside this crate, shared so that a [`SimError`] stays
@@ -214,7 +217,8 @@ impl Classify for SimError {
     /// reach ([`Unreachable`](SimError::Unreachable)); [`Numerical`](ErrorClass::Numerical) for a
     /// run on valid input that failed: an integration that diverged, a non-finite control, a
     /// runaway tracking error, or a controller's own failure; a wrapped library error keeps its
-    /// own class; otherwise a setting, file or model was outside its domain.
+    /// own class; [`OutOfMemory`](ErrorClass::OutOfMemory) for memory the
+    /// system refused; otherwise a setting, file or model was outside its domain.
     fn class(&self) -> ErrorClass {
         match self {
             Self::Unreachable { .. } | Self::UnreachableInSpace { .. } => ErrorClass::Unreachable,
@@ -222,6 +226,7 @@ impl Classify for SimError {
             Self::Dynamics { source, .. } | Self::Model(source) => source.class(),
             Self::Fuzzy(e) => e.class(),
             Self::ChainDynamics { source, .. } => source.class(),
+            Self::OutOfMemory(e) => e.class(),
             Self::Integration(_)
             | Self::ChainIntegration(_)
             | Self::NonFiniteControl { .. }

@@ -1,6 +1,7 @@
 //! What a closed-loop run records: time series at the recording rate, and summary metrics over
 //! every controller sample.
 
+use lane_math::{OutOfMemory, try_reserve};
 use serde::Serialize;
 
 /// Time series of a run, one entry per recorded controller sample (the state at the sample
@@ -142,32 +143,51 @@ impl Record {
         7 + 7 * n_coords + n_joints + 3 * n_points
     }
 
-    pub(crate) fn with_capacity(
-        n_coords: usize,
-        n_joints: usize,
-        n_points: usize,
-        samples: usize,
-    ) -> Self {
-        let series = || Vec::with_capacity(samples * n_coords);
+    /// An empty record of runs with these sizes.
+    pub(crate) fn empty(n_coords: usize, n_joints: usize, n_points: usize) -> Self {
         Self {
             n_joints,
             n_coords,
-            t: Vec::with_capacity(samples),
-            a: series(),
-            a_dot: series(),
-            a_ref: series(),
-            a_ref_dot: series(),
-            a_cmd: series(),
-            tau_star: series(),
-            clamped: Vec::with_capacity(samples * n_coords),
-            tip: Vec::with_capacity(samples),
-            tip_ref: Vec::with_capacity(samples),
-            tip_z: Vec::with_capacity(samples),
-            tip_ref_z: Vec::with_capacity(samples),
-            joint_torques: Vec::with_capacity(samples * n_joints),
-            joint_points: Vec::with_capacity(samples * n_points),
+            t: Vec::new(),
+            a: Vec::new(),
+            a_dot: Vec::new(),
+            a_ref: Vec::new(),
+            a_ref_dot: Vec::new(),
+            a_cmd: Vec::new(),
+            tau_star: Vec::new(),
+            clamped: Vec::new(),
+            tip: Vec::new(),
+            tip_ref: Vec::new(),
+            tip_z: Vec::new(),
+            tip_ref_z: Vec::new(),
+            joint_torques: Vec::new(),
+            joint_points: Vec::new(),
             n_points,
         }
+    }
+
+    /// Room for `samples` more samples, or [`OutOfMemory`] when the system refuses it.
+    pub(crate) fn reserve(&mut self, samples: usize) -> Result<(), OutOfMemory> {
+        const WHAT: &str = "the run's record";
+        let per = |count: usize| samples.saturating_mul(count);
+        for series in [&mut self.t, &mut self.tip_z, &mut self.tip_ref_z] {
+            try_reserve(series, samples, WHAT)?;
+        }
+        for series in [
+            &mut self.a,
+            &mut self.a_dot,
+            &mut self.a_ref,
+            &mut self.a_ref_dot,
+            &mut self.a_cmd,
+            &mut self.tau_star,
+        ] {
+            try_reserve(series, per(self.n_coords), WHAT)?;
+        }
+        try_reserve(&mut self.clamped, per(self.n_coords), WHAT)?;
+        try_reserve(&mut self.tip, samples, WHAT)?;
+        try_reserve(&mut self.tip_ref, samples, WHAT)?;
+        try_reserve(&mut self.joint_torques, per(self.n_joints), WHAT)?;
+        try_reserve(&mut self.joint_points, per(self.n_points), WHAT)
     }
 
     pub(crate) fn push(&mut self, s: &Sample<'_>, joint_torques: &[f64], points: &[[f64; 3]]) {

@@ -683,7 +683,10 @@ impl Simulation {
         &mut self,
         hooks: &mut H,
     ) -> Result<Run, Box<RunFailure>> {
-        let mut progress = self.start_run();
+        let (mut progress, refused) = self.start_run();
+        if let Some(error) = refused {
+            return Err(progress.fail(error));
+        }
         for k in 0..=progress.samples {
             let last = k == progress.samples;
             let taken = self
@@ -706,21 +709,29 @@ impl Simulation {
         Ok(progress.finish())
     }
 
-    /// Resets the loop and sizes what a [`run`](Self::run) accumulates.
-    fn start_run(&mut self) -> Progress {
+    /// Resets the loop and sizes what a [`run`](Self::run) accumulates; the error is a record
+    /// whose memory the system refused ([`SimError::OutOfMemory`]: the run fails before its
+    /// first sample).
+    fn start_run(&mut self) -> (Progress, Option<SimError>) {
         self.reset();
         let s = &self.settings;
         let (samples, record_every) = sample_counts(s);
         let plant = self.plant.model.plant();
         let (m, n) = (self.n_coords(), plant.n_joints());
-        Progress {
-            record: Record::with_capacity(m, n, plant.n_links() + 1, recorded_samples(s)),
+        let mut record = Record::empty(m, n, plant.n_links() + 1);
+        let refused = record
+            .reserve(recorded_samples(s))
+            .err()
+            .map(SimError::from);
+        let progress = Progress {
+            record,
             metrics: Metrics::new(m, n, s.joint_torque_limits.clone(), self.limits.is_some()),
             steps: 0,
             rejected: 0,
             samples,
             record_every,
-        }
+        };
+        (progress, refused)
     }
 
     /// Adds sample `k` of a run, taken and then integrated (or, the last, given its

@@ -13,7 +13,6 @@
 //! Everything is sized in [`Anfis::new`]; an epoch ([`Anfis::epoch`]) allocates nothing.
 
 use super::data::TrainingData;
-use super::least_squares::{LeastSquares, LeastSquaresError};
 use super::premise::{gradient, repair};
 use crate::compiled_mf::CompiledMf;
 use crate::membership::MembershipFn;
@@ -21,6 +20,7 @@ use crate::system::{
     AndMethod, Antecedent, Connective, Defuzzification, FuzzySystem, OutputFn, affine,
 };
 use crate::{ConsequentParameter, FuzzyError, LearningProblem};
+use lane_math::dense::{LeastSquares, LeastSquaresError};
 
 /// The most epochs one training may run.
 const MAX_EPOCHS: usize = 1_000_000;
@@ -439,7 +439,8 @@ impl Anfis {
             Err(LeastSquaresError::RankDeficient { column }) => {
                 Err(self.rank_deficiency(column).into())
             }
-            Err(LeastSquaresError::NonFinite) => Err(LearningProblem::NonFiniteLeastSquares.into()),
+            // `NonFinite`, and any failure a later version adds: the fit came out non-finite.
+            Err(_) => Err(LearningProblem::NonFiniteLeastSquares.into()),
         }
     }
 

@@ -34,7 +34,6 @@
 mod anfis;
 mod data;
 mod genfis;
-mod least_squares;
 mod merge;
 mod premise;
 

@@ -11,7 +11,8 @@ numbers) and answers with the same leading dimension; batches, runs and sweeps r
 and run on all cores.
 
 Errors are ``InvalidInput`` (a ``ValueError``), ``Unreachable`` (a ``ValueError``) and
-``NumericalError`` (an ``ArithmeticError``), with the messages the ``hrm`` command prints.
+``NumericalError`` (an ``ArithmeticError``), with the messages the ``hrm`` command prints;
+memory the system refuses is a ``MemoryError``.
 See docs/python.md.
 """
 

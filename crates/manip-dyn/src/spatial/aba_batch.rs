@@ -2,7 +2,7 @@
 //! [`kernel`](super::aba) over [`Pack`] for each group of states that fills a register, the
 //! same operations in the same order as one state, so every state gets the same bits as alone.
 
-use lane_math::Pack;
+use lane_math::{Pack, try_filled};
 use pulp::{Arch, Simd, WithSimd};
 
 use super::aba::{AbaBuffers, aba, kernel};
@@ -28,17 +28,27 @@ pub struct SpatialBatchData {
 
 impl SpatialBatchData {
     /// A workspace sized for `model`, for the instruction set of this processor.
+    ///
+    /// # Panics
+    /// When the system refuses the memory; [`SpatialBatchData::try_new`] returns the error.
     pub fn new(model: &SpatialModel) -> Self {
+        Self::try_new(model).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`SpatialBatchData::new`], or [`DynError::OutOfMemory`] when the system refuses the
+    /// memory.
+    pub fn try_new(model: &SpatialModel) -> Result<Self, DynError> {
+        const WHAT: &str = "the workspace of the spatial batch ABA";
         let n = model.n_links();
         let lanes = if n <= MAX_BATCH_LINKS { n } else { 0 };
-        Self {
-            angle: vec![0.0; lanes * MAX_WIDTH],
-            sin: vec![0.0; lanes * MAX_WIDTH],
-            cos: vec![0.0; lanes * MAX_WIDTH],
-            links: vec![AbaLink::default(); lanes],
-            single: SpatialData::new(model),
+        Ok(Self {
+            angle: try_filled(lanes * MAX_WIDTH, 0.0, WHAT)?,
+            sin: try_filled(lanes * MAX_WIDTH, 0.0, WHAT)?,
+            cos: try_filled(lanes * MAX_WIDTH, 0.0, WHAT)?,
+            links: try_filled(lanes, AbaLink::default(), WHAT)?,
+            single: SpatialData::try_new(model)?,
             arch: Arch::new(),
-        }
+        })
     }
 
     /// Number of links of the chain this workspace was built for.

@@ -1,9 +1,11 @@
 //! The reusable workspace of the spatial algorithms (the "Data" of the Model/Data split).
 
+use lane_math::try_filled;
 use pulp::Arch;
 
 use super::algebra::{Force, Mat3, Motion, Symmetric6, Transform, Vec3};
 use super::model::SpatialModel;
+use crate::error::DynError;
 
 /// Scratch space for one [`SpatialModel`]: build it once with [`SpatialData::new`], then pass it
 /// to every algorithm of [`spatial`](crate::spatial); after construction none of them allocates.
@@ -45,21 +47,30 @@ impl SpatialData {
     /// assert_eq!(SpatialData::new(&arm).n_links(), 10);
     /// # Ok::<(), manip_dyn::DynError>(())
     /// ```
+    ///
+    /// # Panics
+    /// When the system refuses the memory; [`SpatialData::try_new`] returns the error.
     pub fn new(model: &SpatialModel) -> SpatialData {
+        Self::try_new(model).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`SpatialData::new`], or [`DynError::OutOfMemory`] when the system refuses the memory.
+    pub fn try_new(model: &SpatialModel) -> Result<SpatialData, DynError> {
+        const WHAT: &str = "the workspace of the spatial recursive algorithms";
         let n = model.n_links();
-        SpatialData {
-            angle: vec![0.0; n],
-            sin: vec![0.0; n],
-            cos: vec![0.0; n],
-            placements: vec![Transform::IDENTITY; n],
-            poses: vec![Transform::IDENTITY; n],
-            velocities: vec![Motion::default(); n],
-            accelerations: vec![Motion::default(); n],
-            forces: vec![Force::default(); n],
-            composites: vec![Symmetric6::default(); n],
-            articulated: vec![AbaLink::default(); n],
+        Ok(SpatialData {
+            angle: try_filled(n, 0.0, WHAT)?,
+            sin: try_filled(n, 0.0, WHAT)?,
+            cos: try_filled(n, 0.0, WHAT)?,
+            placements: try_filled(n, Transform::IDENTITY, WHAT)?,
+            poses: try_filled(n, Transform::IDENTITY, WHAT)?,
+            velocities: try_filled(n, Motion::default(), WHAT)?,
+            accelerations: try_filled(n, Motion::default(), WHAT)?,
+            forces: try_filled(n, Force::default(), WHAT)?,
+            composites: try_filled(n, Symmetric6::default(), WHAT)?,
+            articulated: try_filled(n, AbaLink::default(), WHAT)?,
             arch: Arch::new(),
-        }
+        })
     }
 
     /// Number of links of the chain this workspace was built for.

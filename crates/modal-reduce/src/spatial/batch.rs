@@ -25,7 +25,7 @@ use super::terms::{TermsLanes, accumulate};
 use crate::batch::{BatchError, MAX_WIDTH, check_batch_shape};
 use crate::batch_group::simd_lanes;
 use crate::error::all_finite;
-use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
+use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 
 /// The most modal coordinates evaluated SIMD across states (`K = 2` harmonics per plane);
 /// larger models run their batches one state at a time.
@@ -207,12 +207,14 @@ fn group<S: Simd, const M: usize>(
     const JACOBIAN: usize = 3 * MAX_SPATIAL_BATCH_COORDS;
     let (mut omega_jacobian, mut origin_jacobian) = ([zero; JACOBIAN], [zero; JACOBIAN]);
     let (mut com_jacobian, mut inertia_jacobian) = ([zero; JACOBIAN], [zero; JACOBIAN]);
+    let mut momentum_jacobian = [zero; JACOBIAN];
     let mut mass = [[zero; M]; M];
     let (mut coriolis, mut gravity) = ([zero; M], [zero; M]);
     let work = TermsLanes {
         omega_jacobian: &mut omega_jacobian,
         origin_jacobian: &mut origin_jacobian,
         com_jacobian: &mut com_jacobian,
+        momentum_jacobian: &mut momentum_jacobian,
         inertia_times_omega_jacobian: &mut inertia_jacobian,
         mass_matrix: mass.as_flattened_mut(),
         coriolis: &mut coriolis,

@@ -19,10 +19,11 @@ pub struct SpatialReducedData {
     pub(crate) theta_ddot: Vec<f64>,
     /// The angular-velocity Jacobian `Jw` and the velocity Jacobian of the world origin moving
     /// with the link, `Jo` (`3 x m` each, row-major), accumulated joint by joint; the
-    /// centre of mass's velocity Jacobian `Jv` and `I Jw` of one link.
+    /// centre of mass's velocity Jacobian `Jv`, `m Jv` and `I Jw` of one link.
     pub(crate) omega_jacobian: Vec<f64>,
     pub(crate) origin_jacobian: Vec<f64>,
     pub(crate) com_jacobian: Vec<f64>,
+    pub(crate) momentum_jacobian: Vec<f64>,
     pub(crate) inertia_times_omega_jacobian: Vec<f64>,
     pub(crate) mass_matrix: Vec<f64>,
     pub(crate) coriolis: Vec<f64>,
@@ -58,6 +59,7 @@ impl SpatialReducedData {
             omega_jacobian: vec![0.0; 3 * m],
             origin_jacobian: vec![0.0; 3 * m],
             com_jacobian: vec![0.0; 3 * m],
+            momentum_jacobian: vec![0.0; 3 * m],
             inertia_times_omega_jacobian: vec![0.0; 3 * m],
             mass_matrix: vec![0.0; m * m],
             coriolis: vec![0.0; m],

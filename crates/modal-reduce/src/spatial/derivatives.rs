@@ -20,8 +20,8 @@ use super::tangent::{
 };
 use super::torques::spatial_joint_torques;
 use crate::error::{ReduceError, check_finite_result, check_len};
-use crate::small_linalg::ldlt_solve_rows_in_place;
 use faer::MatRef;
+use lane_math::dense::ldlt_solve_rows_in_place;
 
 /// Results and scratch of [`spatial_reduced_derivatives`] for one [`SpatialReducedModel`]:
 /// `O(n + m^2)` memory, built once; every call then fills it without allocating.

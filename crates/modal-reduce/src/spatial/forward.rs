@@ -5,7 +5,7 @@ use super::model::SpatialReducedModel;
 use super::terms::spatial_reduced_terms;
 use crate::error::{ReduceError, check_finite_result, check_input, check_len};
 use crate::forward::right_hand_side;
-use crate::small_linalg::{ldlt_in_place, ldlt_solve_in_place};
+use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 
 /// The modal accelerations `a_ddot` (`m`) under the modal forces `tau_star` at `(a, a_dot)`:
 /// [`spatial_reduced_terms`], then an `L D L^T` solve of `M*`. Allocation-free.

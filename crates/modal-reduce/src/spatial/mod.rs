@@ -8,6 +8,8 @@
 //! - [`motion`]: one link's step of the forward recursion (frames, joint axes, angular velocity
 //!   and acceleration, the acceleration of its centre of mass), which both algorithms share.
 //! - [`terms`]: `M*`, `C*`, `G*` in `O(n m^2)` without the `2n x 2n` mass matrix.
+//! - [`projection`]: the same terms by projecting the chain's CRBA mass matrix and Newton-Euler
+//!   efforts (`J^T M J`, `O(n^2 m)`), the cross-check of [`terms`].
 //! - [`torques`]: the joint torques that realise a modal motion (Newton-Euler, `O(n)`).
 //! - [`forward`]: reduced forward dynamics; [`batch`]: the same for many states at once, SIMD
 //!   across states, each state's bits those of [`forward`].
@@ -20,6 +22,7 @@ pub mod derivatives;
 pub mod forward;
 pub mod model;
 pub mod motion;
+pub mod projection;
 pub mod tangent;
 pub mod terms;
 pub mod torques;
@@ -32,5 +35,6 @@ pub use data::SpatialReducedData;
 pub use derivatives::{SpatialReducedDerivatives, spatial_reduced_derivatives};
 pub use forward::spatial_forward_dynamics;
 pub use model::{SpatialLinkInertia, SpatialReducedModel};
+pub use projection::{SpatialProjection, spatial_chain, spatial_reduced_terms_by_projection};
 pub use terms::spatial_reduced_terms;
 pub use torques::{spatial_joint_torques, spatial_project_torques};

@@ -1,6 +1,6 @@
 //! The spatial modal arm: its links, base pose, gravity and modal map (the "Model").
 
-use backbone_kin::{BasePose, SpatialModalMap};
+use backbone_kin::{BasePose, Rotation, SpatialModalMap};
 use manip_dyn::DynError;
 
 use crate::error::ReduceError;
@@ -68,6 +68,8 @@ impl SpatialLinkInertia {
 pub struct SpatialReducedModel {
     map: SpatialModalMap,
     base: BasePose,
+    /// `base.rotation()`, formed once.
+    base_rotation: Rotation,
     links: Vec<SpatialLinkInertia>,
     gravity: [f64; 3],
 }
@@ -109,6 +111,7 @@ impl SpatialReducedModel {
         }
         Ok(Self {
             map,
+            base_rotation: base.rotation(),
             base,
             links,
             gravity,
@@ -137,6 +140,11 @@ impl SpatialReducedModel {
     /// The base pose.
     pub fn base(&self) -> &BasePose {
         &self.base
+    }
+
+    /// The base's rotation (of [`base`](Self::base)'s roll, pitch and yaw).
+    pub fn base_rotation(&self) -> Rotation {
+        self.base_rotation
     }
 
     /// The links' inertias, base first.

@@ -11,7 +11,8 @@
 //! - `w_dot_i = w_dot + w x u_z z_dot + u_z z_ddot + w' x u_y y_dot + u_y y_ddot` (an axis fixed
 //!   in a frame turning at `w` changes at `w x u`);
 //! - the centre of mass `c = p + (L / 2) R_i e_x` and the next joint `p_i = p + L R_i e_x`, each
-//!   at `a = a_p + w_dot_i x r + w_i x (w_i x r)`.
+//!   at `a = a_p + w_dot_i x r + w_i x (w_i x r)` (affine in `r`: the centre of mass gets half
+//!   the change of the next joint).
 //!
 //! With zero joint accelerations the accelerations are the bias terms of `C*` (velocity
 //! products only).
@@ -134,6 +135,11 @@ pub fn link_step<L: Lane>(
     }
     let to_com = scale(along, L::splat(context, 0.5 * length));
     let to_next = scale(along, L::splat(context, length));
+    // The acceleration is affine in the offset: the centre of mass gets half the change.
+    let change = add(
+        cross(omega_dot, to_next),
+        cross(omega, cross(omega, to_next)),
+    );
     let joint = carried.point;
     let motion = LinkMotion {
         u_z,
@@ -143,26 +149,16 @@ pub fn link_step<L: Lane>(
         omega,
         omega_dot,
         com: add(joint, to_com),
-        com_accel: accel_at(carried.accel, omega, omega_dot, to_com),
+        com_accel: add(carried.accel, scale(change, L::splat(context, 0.5))),
     };
     *carried = Carried {
         rotation,
         point: add(joint, to_next),
         omega,
         omega_dot,
-        accel: accel_at(carried.accel, omega, omega_dot, to_next),
+        accel: add(carried.accel, change),
     };
     motion
-}
-
-/// The acceleration of the point `r` away from a point of acceleration `accel` on a body turning
-/// at `omega` with `omega_dot`: `accel + omega_dot x r + omega x (omega x r)`.
-#[inline(always)]
-fn accel_at<L: Lane>(accel: [L; 3], omega: [L; 3], omega_dot: [L; 3], r: [L; 3]) -> [L; 3] {
-    add(
-        accel,
-        add(cross(omega_dot, r), cross(omega, cross(omega, r))),
-    )
 }
 
 /// `R diag(principal) R^T`, a link's inertia about its centre of mass in the world frame

@@ -22,7 +22,7 @@ use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
 use super::motion::{Carried, link_step, world_inertia};
 use crate::error::{ReduceError, check_finite_result, check_input};
-use backbone_kin::vec3::{add, cross, dot, mat_vec, scale};
+use backbone_kin::vec3::{add, cross, mat_vec};
 use lane_math::Lane;
 use pulp::{Simd, WithSimd};
 
@@ -70,6 +70,7 @@ impl WithSimd for TermsOfOneState<'_> {
             omega_jacobian: &mut data.omega_jacobian,
             origin_jacobian: &mut data.origin_jacobian,
             com_jacobian: &mut data.com_jacobian,
+            momentum_jacobian: &mut data.momentum_jacobian,
             inertia_times_omega_jacobian: &mut data.inertia_times_omega_jacobian,
             mass_matrix: &mut data.mass_matrix,
             coriolis: &mut data.coriolis,
@@ -85,11 +86,12 @@ impl WithSimd for TermsOfOneState<'_> {
 }
 
 /// The buffers of [`accumulate`], each of one state (`f64`) or one state per lane: `3 x m`
-/// row-major Jacobians `Jw`, `Jo`, `Jv` and `I Jw`, `M*` (`m x m`, row-major), `C*`, `G*`.
+/// row-major Jacobians `Jw`, `Jo`, `Jv`, `m Jv` and `I Jw`, `M*` (`m x m`, row-major), `C*`, `G*`.
 pub(crate) struct TermsLanes<'w, L> {
     pub(crate) omega_jacobian: &'w mut [L],
     pub(crate) origin_jacobian: &'w mut [L],
     pub(crate) com_jacobian: &'w mut [L],
+    pub(crate) momentum_jacobian: &'w mut [L],
     pub(crate) inertia_times_omega_jacobian: &'w mut [L],
     pub(crate) mass_matrix: &'w mut [L],
     pub(crate) coriolis: &'w mut [L],
@@ -121,6 +123,7 @@ pub(crate) fn accumulate<L: Lane>(
         omega_jacobian,
         origin_jacobian,
         com_jacobian,
+        momentum_jacobian,
         inertia_times_omega_jacobian,
         mass_matrix,
         coriolis,
@@ -128,8 +131,9 @@ pub(crate) fn accumulate<L: Lane>(
     } = work;
     let (omega_jacobian, origin_jacobian) =
         (&mut omega_jacobian[..3 * m], &mut origin_jacobian[..3 * m]);
-    let (com_jacobian, inertia_times_omega_jacobian) = (
+    let (com_jacobian, momentum_jacobian, inertia_times_omega_jacobian) = (
         &mut com_jacobian[..3 * m],
+        &mut momentum_jacobian[..3 * m],
         &mut inertia_times_omega_jacobian[..3 * m],
     );
     let (mass_matrix, coriolis, gravity_terms) = (
@@ -152,8 +156,7 @@ pub(crate) fn accumulate<L: Lane>(
     let map = model.map();
     let planar = map.planar();
     let gravity = model.gravity();
-    let base = model.base();
-    let mut carried = Carried::<L>::base(context, base.rotation(), base.xyz);
+    let mut carried = Carried::<L>::base(context, model.base_rotation(), model.base().xyz);
     for (i, (&length, inertia)) in map.link_lengths().iter().zip(model.links()).enumerate() {
         let row = &planar.row(i)[..half];
         // theta = J a and theta_dot = J a_dot for this link's two joints.
@@ -187,39 +190,52 @@ pub(crate) fn accumulate<L: Lane>(
                 o_y[k] = moment_y[d].mul_add(r, o_y[k]);
             }
         }
-        // Jv = Jo + Jw x c and I Jw, column by column.
+        // Jv = Jo + Jw x c, the momentum Jacobian m Jv and I Jw, column by column.
         let world = world_inertia(&motion.rotation, inertia.principal);
+        let mass = L::splat(context, inertia.mass);
+        let c = motion.com;
         for k in 0..m {
             let (w, o) = (column(omega_jacobian, m, k), column(origin_jacobian, m, k));
-            let v = add(o, cross(w, motion.com));
-            let iw = mat_vec(&world, w);
+            let v = [
+                w[2].neg_mul_add(c[1], w[1].mul_add(c[2], o[0])),
+                w[0].neg_mul_add(c[2], w[2].mul_add(c[0], o[1])),
+                w[1].neg_mul_add(c[0], w[0].mul_add(c[1], o[2])),
+            ];
+            let iw = [
+                dot_add(world[0], w, zero),
+                dot_add(world[1], w, zero),
+                dot_add(world[2], w, zero),
+            ];
             for d in 0..3 {
                 com_jacobian[d * m + k] = v[d];
+                momentum_jacobian[d * m + k] = v[d] * mass;
                 inertia_times_omega_jacobian[d * m + k] = iw[d];
             }
         }
-        let mass = L::splat(context, inertia.mass);
-        let force = scale(motion.com_accel, mass);
         let weight = [
-            L::splat(context, inertia.mass * gravity[0]),
-            L::splat(context, inertia.mass * gravity[1]),
-            L::splat(context, inertia.mass * gravity[2]),
+            L::splat(context, gravity[0]),
+            L::splat(context, gravity[1]),
+            L::splat(context, gravity[2]),
         ];
         let torque = add(
             mat_vec(&world, motion.omega_dot),
             cross(motion.omega, mat_vec(&world, motion.omega)),
         );
+        // C* += (m Jv)^T a_c + Jw^T torque, G* -= (m Jv)^T g, M* += (m Jv)^T Jv + Jw^T I Jw.
         for k in 0..m {
-            let (v_k, w_k) = (column(com_jacobian, m, k), column(omega_jacobian, m, k));
-            coriolis[k] = coriolis[k] + (dot(v_k, force) + dot(w_k, torque));
-            gravity_terms[k] = gravity_terms[k] - dot(v_k, weight);
+            let (p_k, w_k) = (
+                column(momentum_jacobian, m, k),
+                column(omega_jacobian, m, k),
+            );
+            coriolis[k] = dot_add(w_k, torque, dot_add(p_k, motion.com_accel, coriolis[k]));
+            gravity_terms[k] = gravity_terms[k] - dot_add(p_k, weight, zero);
             for l in 0..=k {
                 let (v_l, iw_l) = (
                     column(com_jacobian, m, l),
                     column(inertia_times_omega_jacobian, m, l),
                 );
-                let value = dot(v_k, v_l).mul_add(mass, dot(w_k, iw_l));
-                mass_matrix[k * m + l] = mass_matrix[k * m + l] + value;
+                let entry = &mut mass_matrix[k * m + l];
+                *entry = dot_add(w_k, iw_l, dot_add(p_k, v_l, *entry));
             }
         }
     }
@@ -228,6 +244,12 @@ pub(crate) fn accumulate<L: Lane>(
             mass_matrix[l * m + k] = mass_matrix[k * m + l];
         }
     }
+}
+
+/// `acc + a . b` in fused multiply-adds, `a[0] b[0]` first.
+#[inline(always)]
+fn dot_add<L: Lane>(a: [L; 3], b: [L; 3], acc: L) -> L {
+    a[2].mul_add(b[2], a[1].mul_add(b[1], a[0].mul_add(b[0], acc)))
 }
 
 /// Column `k` of a `3 x m` row-major matrix.

@@ -4,8 +4,8 @@
 use super::{ControlContext, Controller, ControllerError, check_context, check_coordinate_count};
 use crate::error::{SimError, check_positive};
 use lane_math::Compact;
+use lane_math::dense::symmetrise;
 use modal_reduce::{Plant, PlantData};
-use optimal_ctl::dense::symmetrise;
 use optimal_ctl::{Linearisation, Lqr, LqrSettings};
 
 /// The largest design frequency `omega` (rad/s): `omega^4` scales the state weight.

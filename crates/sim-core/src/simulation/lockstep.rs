@@ -242,7 +242,11 @@ impl Lockstep {
     /// [`run_with`](Self::run_with) with hooks already checked.
     fn run_hooked<H: LoopHooks>(&mut self, hooks: &mut [H]) -> Vec<Result<Run, Box<RunFailure>>> {
         self.reset();
-        let mut progress: Vec<Progress> = self.runs.iter_mut().map(|r| r.start_run()).collect();
+        let (mut progress, refused): (Vec<Progress>, Vec<Option<SimError>>) =
+            self.runs.iter_mut().map(|r| r.start_run()).unzip();
+        for (stopped, refused) in self.stopped.iter_mut().zip(refused) {
+            *stopped = refused;
+        }
         let samples = progress[0].samples;
         for k in 0..=samples {
             self.take_samples(hooks);

@@ -293,12 +293,13 @@ impl ArmSpec {
             }
         };
         let n = self.link_count(inertias.map(Vec::len))?;
+        const WHAT: &str = "the arm's per-link arrays";
         let per_link = |array: &Option<Vec<f64>>, scalar: f64| match array {
-            Some(values) => values.clone(),
-            None => vec![scalar; n],
+            Some(values) => Ok(values.clone()),
+            None => lane_math::try_filled(n, scalar, WHAT),
         };
-        let lengths = per_link(&self.lengths, self.link_length.unwrap_or(0.1));
-        let masses = per_link(&self.masses, self.link_mass.unwrap_or(0.1));
+        let lengths = per_link(&self.lengths, self.link_length.unwrap_or(0.1))?;
+        let masses = per_link(&self.masses, self.link_mass.unwrap_or(0.1))?;
         // A lone link has no index: name the link's real one, and the field the value came from.
         let arm_error = |i: usize, e: manip_dyn::DynError| {
             let field = match e {
@@ -318,7 +319,7 @@ impl ArmSpec {
             };
             SimError::setting(field, format!("is invalid: {}", e.at_link(i)))
         };
-        let mut links = Vec::with_capacity(n);
+        let mut links = lane_math::try_with_capacity(n, WHAT)?;
         for i in 0..n {
             let beam = Link::uniform_beam(lengths[i], masses[i]).map_err(|e| arm_error(i, e))?;
             let link = match inertias {

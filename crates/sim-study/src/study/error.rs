@@ -2,8 +2,7 @@
 //! read or changed while the sweep ran, a shard file that is refused, shards that do not merge.
 //! Every message is one line naming the setting, file, line or run and the problem.
 
-use super::plan::{MAX_SHARDS, SettingError, Shard};
-use super::shard_file::{FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC};
+use super::shard::{FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, MAX_SHARDS, Shard};
 use crate::ControllerKind;
 use lane_math::{Classify, ErrorClass};
 use sim_core::SimError;
@@ -436,6 +435,28 @@ impl StudyError {
             action,
             path: path.to_path_buf(),
             cause: cause.to_string(),
+        }
+    }
+}
+
+/// A sweep setting out of its domain: the setting (a field of [`SweepSettings`](super::SweepSettings)) and what is
+/// wrong with it, written `"{setting} {problem}"` (e.g. "seeds must be at least 1"); a front end
+/// may name it its own way (`hrm sweep` writes its option, "--seeds must be at least 1").
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{setting} {problem}")]
+pub struct SettingError {
+    /// The setting's name, as in [`SweepSettings`](super::SweepSettings).
+    pub setting: &'static str,
+    /// What is wrong, a phrase that follows the name.
+    pub problem: String,
+}
+
+impl SettingError {
+    /// The error of `setting`, with `problem` the phrase that follows its name.
+    pub(super) fn new(setting: &'static str, problem: impl Into<String>) -> Self {
+        Self {
+            setting,
+            problem: problem.into(),
         }
     }
 }

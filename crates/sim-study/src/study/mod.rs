@@ -37,22 +37,24 @@ mod error;
 mod inputs;
 mod outcome;
 mod plan;
+mod shard;
 mod shard_file;
 
 pub use aggregate::{Cell, CellBuilder, FailedRun, MAX_LISTED_FAILURES, Stats, cells};
 pub use comparison::{ComparisonRun, builtin_scenarios, compare, run_one, run_prepared};
+pub use error::SettingError;
 pub use error::{MergeProblem, MetricError, ShardProblem, StudyError};
 pub use inputs::{
     InputDigest, SCENARIO_INPUT, check_digests, check_json_safe, first_changed, input_digests,
 };
 pub use outcome::{RunError, RunMetrics, RunOutcome, Stopped, run_scenario};
-pub use plan::{
-    MAX_RUNS, MAX_SHARDS, RunId, SettingError, Shard, ShardParseError, SweepConfig, SweepSettings,
-    run_seed,
+pub use plan::{MAX_RUNS, RunId, SweepConfig, SweepSettings, run_seed};
+pub use shard::{
+    FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, MAX_SHARDS, Shard, ShardParseError,
 };
 pub use shard_file::{
-    FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, RunResult, ShardFile, ShardHeader, ShardInput,
-    ShardReader, ShardSource, StoredOutcome, merge, merge_readers, shard_paths, write_json_line,
+    RunResult, ShardFile, ShardHeader, ShardInput, ShardReader, ShardSource, StoredOutcome, merge,
+    merge_readers, shard_paths, write_json_line,
 };
 
 use crate::{ControllerKind, IntegratorSpec};

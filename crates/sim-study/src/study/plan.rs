@@ -1,14 +1,13 @@
 //! What a sweep runs: its configuration, the fixed enumeration of its runs, each run's seed,
 //! and the slice of runs one shard takes.
 
-use super::StudyError;
+use super::error::{SettingError, StudyError};
 use super::inputs::{self, InputDigest};
+use super::shard::MAX_SHARDS;
 use crate::{ControllerKind, NoiseSpec, Scenario};
 use lane_math::Compact;
 use serde::{Deserialize, Serialize};
 use sim_core::{Prepared, RunNoise, SimError};
-use std::fmt;
-use std::str::FromStr;
 
 /// The SplitMix64 increment (the golden ratio in 64-bit fixed point).
 const SPLITMIX_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
@@ -16,8 +15,8 @@ const SPLITMIX_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
 /// Most runs in a sweep (noise levels x controllers x seeds), checked by
 /// [`SweepConfig::validate`] before any per-run buffer exists.
 pub const MAX_RUNS: usize = 10_000_000;
-/// Most shards a sweep splits into (one run each at most, so no more than [`MAX_RUNS`]).
-pub const MAX_SHARDS: usize = MAX_RUNS;
+// A shard holds one run at least, so a sweep never splits into more shards than runs.
+const _: () = assert!(MAX_SHARDS <= MAX_RUNS);
 
 /// Everything that defines a sweep's results; shards merge only when theirs are equal.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -83,27 +82,6 @@ impl Default for SweepSettings {
             reference_noise_ratio: 0.0,
             seeds: 10,
             base_seed: 1,
-        }
-    }
-}
-
-/// A sweep setting out of its domain: the setting (a field of [`SweepSettings`]) and what is
-/// wrong with it, written `"{setting} {problem}"` (e.g. "seeds must be at least 1"); a front end
-/// may name it its own way (`hrm sweep` writes its option, "--seeds must be at least 1").
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{setting} {problem}")]
-pub struct SettingError {
-    /// The setting's name, as in [`SweepSettings`].
-    pub setting: &'static str,
-    /// What is wrong, a phrase that follows the name.
-    pub problem: String,
-}
-
-impl SettingError {
-    fn new(setting: &'static str, problem: impl Into<String>) -> Self {
-        Self {
-            setting,
-            problem: problem.into(),
         }
     }
 }
@@ -352,73 +330,6 @@ pub fn run_seed(base_seed: u64, seed_index: usize) -> u64 {
     z ^ (z >> 31)
 }
 
-/// Shard `index` of `count` (1-based, written `K/N`): the runs whose index `i` has
-/// `i % N == K - 1`. Round robin spreads every cell's costly and cheap runs over all shards.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Shard {
-    /// `K`, from 1 to `count`.
-    pub index: usize,
-    /// `N`, the number of shards.
-    pub count: usize,
-}
-
-impl Shard {
-    /// The whole sweep as one shard.
-    pub const WHOLE: Shard = Shard { index: 1, count: 1 };
-
-    /// Whether run `i` belongs to this shard.
-    pub fn contains(self, i: usize) -> bool {
-        i % self.count == self.index - 1
-    }
-
-    /// The number of runs of this shard among `runs`.
-    pub fn run_count(self, runs: usize) -> usize {
-        if runs < self.index {
-            0
-        } else {
-            (runs - self.index) / self.count + 1
-        }
-    }
-
-    /// The run indices of this shard among `runs`, ascending.
-    pub fn indices(self, runs: usize) -> impl Iterator<Item = usize> {
-        (self.index - 1..runs).step_by(self.count)
-    }
-}
-
-impl fmt::Display for Shard {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}/{}", self.index, self.count)
-    }
-}
-
-/// A shard written otherwise than `K/N` with `1 <= K <= N <= MAX_SHARDS`.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("a shard is written K/N with 1 <= K <= N <= {MAX_SHARDS}, got '{text}'")]
-pub struct ShardParseError {
-    /// The text given.
-    pub text: String,
-}
-
-impl FromStr for Shard {
-    type Err = ShardParseError;
-
-    /// Parses `K/N` with `1 <= K <= N <= MAX_SHARDS`.
-    fn from_str(s: &str) -> Result<Self, ShardParseError> {
-        let bad = || ShardParseError {
-            text: s.to_string(),
-        };
-        let (k, n) = s.split_once('/').ok_or_else(bad)?;
-        let index: usize = k.trim().parse().map_err(|_| bad())?;
-        let count: usize = n.trim().parse().map_err(|_| bad())?;
-        if index == 0 || index > count || count > MAX_SHARDS {
-            return Err(bad());
-        }
-        Ok(Shard { index, count })
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -581,36 +492,7 @@ mod tests {
         assert_eq!(a.first_difference(&b), Some("scenario"));
     }
 
-    #[test]
-    fn shards_parse_and_refuse_bad_text() {
-        assert_eq!("2/3".parse::<Shard>(), Ok(Shard { index: 2, count: 3 }));
-        for bad in ["0/3", "4/3", "3", "a/b", "1/0", "-1/2"] {
-            assert!(
-                bad.parse::<Shard>()
-                    .unwrap_err()
-                    .to_string()
-                    .contains("K/N"),
-                "{bad}"
-            );
-        }
-        assert_eq!(Shard { index: 2, count: 3 }.to_string(), "2/3");
-    }
-
     proptest! {
-        #[test]
-        fn shards_partition_the_runs(runs in 0usize..200, count in 1usize..12) {
-            let mut seen = vec![0u32; runs];
-            for index in 1..=count {
-                let shard = Shard { index, count };
-                prop_assert_eq!(shard.run_count(runs), shard.indices(runs).count());
-                for i in shard.indices(runs) {
-                    prop_assert!(shard.contains(i));
-                    seen[i] += 1;
-                }
-            }
-            prop_assert!(seen.iter().all(|&n| n == 1));
-        }
-
         #[test]
         fn every_run_is_enumerated_once(levels in 1usize..4, controllers in 1usize..=4, seeds in 1usize..6) {
             let c = config(levels, controllers, seeds);

@@ -9,19 +9,13 @@
 use super::error::{MergeProblem, MetricError, ShardProblem, StudyError};
 use super::inputs;
 use super::outcome::{RunMetrics, RunOutcome, Stopped};
-use super::plan::{MAX_SHARDS, RunId, Shard, SweepConfig};
+use super::plan::{RunId, SweepConfig};
+use super::shard::{FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, MAX_SHARDS, Shard};
 use crate::ControllerKind;
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
-
-/// The `format` tag of a shard file.
-pub const FORMAT: &str = "hrm-sweep-shard/4";
-
-/// Longest line of a shard file read (64 MiB: the header holds the scenario, whose file has at
-/// most 16 MiB; a run's line has a few hundred bytes).
-pub const MAX_SHARD_LINE_BYTES: usize = 64 << 20;
 
 /// Most shard files a merge keeps open; beyond, each is opened for each run read from it.
 const MAX_OPEN_SHARD_FILES: usize = 64;
@@ -101,9 +95,6 @@ impl StoredOutcome {
         }
     }
 }
-
-/// Largest metric a shard file may hold: ten million runs of it still sum to a finite mean.
-pub const MAX_SHARD_METRIC: f64 = 1e300;
 
 impl RunMetrics {
     /// Checks metrics read from a shard file as any input is checked: each finite, non-negative

@@ -113,3 +113,43 @@ fn tasks_and_planned_references_come_together_and_name_their_fields() {
     let text = base.to_toml();
     assert_eq!(Scenario::from_toml(&text).unwrap(), base);
 }
+
+#[test]
+fn a_controller_given_the_closed_form_goal_collides_where_the_planned_run_keeps_the_margin() {
+    let planned = Scenario::builtin("narrow-gap").unwrap();
+    let target = target(&planned);
+    let lengths = [0.1; 10];
+    let alpha0 = std::f64::consts::FRAC_PI_2;
+    let k1 = ModalMap::new(&lengths, 1, BaseAngle::Fixed(alpha0)).unwrap();
+    let k2 = ModalMap::new(&lengths, 2, BaseAngle::Fixed(alpha0)).unwrap();
+    for branch in [Branch::Positive, Branch::Negative] {
+        // The closed-form K = 1 goal in the scenario's K = 2 coordinates (second harmonic zero),
+        // checked to be the same shape: its tip is on the target.
+        let a = chain_inverse_kinematics(&lengths, target, alpha0, branch).unwrap();
+        let goal = vec![a[0], a[1], 0.0, 0.0];
+        let (mut theta1, mut theta2) = ([0.0; 10], [0.0; 10]);
+        k1.joint_angles(&a, &mut theta1).unwrap();
+        k2.joint_angles(&goal, &mut theta2).unwrap();
+        assert!(
+            theta1
+                .iter()
+                .zip(&theta2)
+                .all(|(x, y)| (x - y).abs() < 1e-12)
+        );
+        // The same arm, obstacles and controller with that goal as a constant reference and
+        // no plan: computed torque drives the arm into an obstacle.
+        let mut unplanned = planned.clone();
+        unplanned.task = None;
+        unplanned.reference = ReferenceSpec::Constant { a: goal };
+        let run = run_one(&unplanned, ControllerKind::ComputedTorque)
+            .result
+            .unwrap_or_else(|f| panic!("{branch:?}: {}", f.error));
+        let clearance = run.summary.min_clearance_m.unwrap();
+        assert!(clearance < 0.0, "{branch:?}: {clearance} m");
+    }
+    // Planned and tracked, the same controller keeps the margin less the tracking error.
+    let run = run_one(&planned, ControllerKind::ComputedTorque)
+        .result
+        .unwrap();
+    assert!(run.summary.min_clearance_m.unwrap() > 0.005);
+}

@@ -1,11 +1,7 @@
-//! Dense linear algebra on the small `m x m` modal matrices (`m = 2K` or `2K + 1`, 2-3 for the
-//! paper), on plain row-major slices owned by a workspace: nothing allocates.
-//!
-//! At this size hand-written loops beat a general dense-matrix library several times over (the
-//! per-call overhead of faer's Cholesky exceeds the whole `3 x 3` solve), and they are short
-//! enough to check by eye.
+//! `L D L^T` factorisation and solves of small symmetric positive-definite matrices, generic
+//! over [`Lane`] so that one call factorises `L::WIDTH` independent matrices.
 
-use lane_math::Lane;
+use crate::Lane;
 
 /// Factorises the symmetric positive-definite `m x m` matrix `a` (row-major) in place as
 /// `a = L D L^T`, `L` unit lower triangular and `D` diagonal: `L` below the diagonal, `1 / D` on
@@ -17,7 +13,7 @@ use lane_math::Lane;
 /// Returns `false` if a pivot `D_j` is not positive and finite (the matrix is not numerically
 /// positive definite; in any lane); `a` then holds a partial factorisation.
 #[inline(always)]
-pub(crate) fn ldlt_in_place<L: Lane>(context: L::Context, a: &mut [L], m: usize) -> bool {
+pub fn ldlt_in_place<L: Lane>(context: L::Context, a: &mut [L], m: usize) -> bool {
     let a = &mut a[..m * m];
     for j in 0..m {
         // a[k][j] (k < j) holds L_jk D_k.
@@ -48,7 +44,7 @@ pub(crate) fn ldlt_in_place<L: Lane>(context: L::Context, a: &mut [L], m: usize)
 /// Solves `L D L^T x = b` in place (`x` holds `b` on entry), with the factors left by
 /// [`ldlt_in_place`].
 #[inline(always)]
-pub(crate) fn ldlt_solve_in_place<L: Lane>(factor: &[L], m: usize, x: &mut [L]) {
+pub fn ldlt_solve_in_place<L: Lane>(factor: &[L], m: usize, x: &mut [L]) {
     let (f, x) = (&factor[..m * m], &mut x[..m]);
     for i in 0..m {
         for k in 0..i {
@@ -70,7 +66,7 @@ pub(crate) fn ldlt_solve_in_place<L: Lane>(factor: &[L], m: usize, x: &mut [L]) 
 /// [`ldlt_solve_in_place`] on whole rows, so each column gets the same operations in the same
 /// order (the same bits) as solved alone, and the inner loops run along contiguous rows.
 #[inline(always)]
-pub(crate) fn ldlt_solve_rows_in_place(factor: &[f64], m: usize, x: &mut [f64], columns: usize) {
+pub fn ldlt_solve_rows_in_place(factor: &[f64], m: usize, x: &mut [f64], columns: usize) {
     let (f, x) = (&factor[..m * m], &mut x[..m * columns]);
     for i in 0..m {
         let (solved, rest) = x.split_at_mut(i * columns);
@@ -96,61 +92,6 @@ pub(crate) fn ldlt_solve_rows_in_place(factor: &[f64], m: usize, x: &mut [f64], 
                 *entry -= l * value;
             }
         }
-    }
-}
-
-/// The smallest and largest eigenvalues of the symmetric `m x m` matrix `a` (row-major), by
-/// cyclic Jacobi rotations; `a` is overwritten (its diagonal ends up holding the eigenvalues).
-///
-/// Each rotation zeroes one off-diagonal pair; sweeps repeat until the off-diagonal part is
-/// negligible against the diagonal (quadratic convergence: a handful of sweeps at this size).
-pub(crate) fn symmetric_eigen_extremes(a: &mut [f64], m: usize) -> (f64, f64) {
-    const MAX_SWEEPS: usize = 64;
-    let a = &mut a[..m * m];
-    for _ in 0..MAX_SWEEPS {
-        let mut off = 0.0;
-        let mut diag = 0.0;
-        for i in 0..m {
-            diag += a[i * m + i] * a[i * m + i];
-            for j in i + 1..m {
-                off += a[i * m + j] * a[i * m + j];
-            }
-        }
-        if off <= (f64::EPSILON * f64::EPSILON) * diag || off == 0.0 {
-            break;
-        }
-        for p in 0..m {
-            for q in p + 1..m {
-                rotate(a, m, p, q);
-            }
-        }
-    }
-    (0..m)
-        .map(|i| a[i * m + i])
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-            (lo.min(x), hi.max(x))
-        })
-}
-
-/// Applies the Jacobi rotation in the `(p, q)` plane that zeroes `a[p][q]` (`a <- R^T a R`).
-fn rotate(a: &mut [f64], m: usize, p: usize, q: usize) {
-    let apq = a[p * m + q];
-    if apq == 0.0 {
-        return;
-    }
-    let theta = (a[q * m + q] - a[p * m + p]) / (2.0 * apq);
-    let t = theta.signum() / (theta.abs() + theta.hypot(1.0));
-    let c = 1.0 / t.hypot(1.0);
-    let s = t * c;
-    for k in 0..m {
-        let (akp, akq) = (a[k * m + p], a[k * m + q]);
-        a[k * m + p] = c * akp - s * akq;
-        a[k * m + q] = s * akp + c * akq;
-    }
-    for k in 0..m {
-        let (apk, aqk) = (a[p * m + k], a[q * m + k]);
-        a[p * m + k] = c * apk - s * aqk;
-        a[q * m + k] = s * apk + c * aqk;
     }
 }
 
@@ -214,26 +155,6 @@ mod tests {
                 }
             }
         }
-
-        #[test]
-        fn eigen_extremes_match_nalgebra(
-            (m, entries) in (1usize..8).prop_flat_map(|m| (
-                Just(m),
-                prop::collection::vec(-3.0..3.0f64, m * m),
-            ))
-        ) {
-            // A symmetric, indefinite in general.
-            let mut a = vec![0.0; m * m];
-            for i in 0..m {
-                for j in 0..m {
-                    a[i * m + j] = entries[i * m + j] + entries[j * m + i];
-                }
-            }
-            let reference = nalgebra::DMatrix::from_row_slice(m, m, &a).symmetric_eigenvalues();
-            let (lo, hi) = symmetric_eigen_extremes(&mut a, m);
-            prop_assert!((lo - reference.min()).abs() <= 1e-12 * (1.0 + reference.amax()));
-            prop_assert!((hi - reference.max()).abs() <= 1e-12 * (1.0 + reference.amax()));
-        }
     }
 
     #[test]
@@ -242,13 +163,5 @@ mod tests {
         assert!(!ldlt_in_place((), &mut indefinite, 2));
         let mut nan = [f64::NAN, 0.0, 0.0, 1.0];
         assert!(!ldlt_in_place((), &mut nan, 2));
-    }
-
-    #[test]
-    fn eigen_of_a_known_matrix() {
-        // [[2, 1], [1, 2]] has eigenvalues 1 and 3.
-        let mut a = [2.0, 1.0, 1.0, 2.0];
-        let (lo, hi) = symmetric_eigen_extremes(&mut a, 2);
-        assert!((lo - 1.0).abs() < 1e-15 && (hi - 3.0).abs() < 1e-15);
     }
 }

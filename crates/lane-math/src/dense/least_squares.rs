@@ -8,7 +8,8 @@
 
 /// Why a solve failed.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum LeastSquaresError {
+#[non_exhaustive]
+pub enum LeastSquaresError {
     /// Column `column` (0-based) is, to working precision, a combination of the ones before it.
     RankDeficient {
         /// The first undetermined column.
@@ -18,9 +19,32 @@ pub(crate) enum LeastSquaresError {
     NonFinite,
 }
 
+impl std::fmt::Display for LeastSquaresError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::RankDeficient { column } => write!(
+                f,
+                "column {column} of the least-squares problem is a combination of the ones \
+                 before it"
+            ),
+            Self::NonFinite => write!(f, "the least-squares problem holds a non-finite value"),
+        }
+    }
+}
+
+impl std::error::Error for LeastSquaresError {}
+
+impl crate::Classify for LeastSquaresError {
+    /// [`Numerical`](crate::ErrorClass::Numerical): the data were valid numbers, the problem
+    /// came out singular or overflowed in double precision.
+    fn class(&self) -> crate::ErrorClass {
+        crate::ErrorClass::Numerical
+    }
+}
+
 /// A least-squares problem with `rows` equations in `cols` unknowns and its workspace.
 #[derive(Debug, Clone)]
-pub(crate) struct LeastSquares {
+pub struct LeastSquares {
     rows: usize,
     cols: usize,
     /// `(rows + cols) x cols`, column-major; the last `cols` rows hold the ridge.
@@ -35,7 +59,7 @@ pub(crate) struct LeastSquares {
 
 impl LeastSquares {
     /// A zero problem of the given size (the caller bounds `rows * cols`).
-    pub(crate) fn new(rows: usize, cols: usize) -> Self {
+    pub fn new(rows: usize, cols: usize) -> Self {
         let m = rows + cols;
         Self {
             rows,
@@ -49,7 +73,7 @@ impl LeastSquares {
 
     /// Sets row `row` of `A` to zero and `b[row]` to `rhs`.
     #[inline]
-    pub(crate) fn clear_row(&mut self, row: usize, rhs: f64) {
+    pub fn clear_row(&mut self, row: usize, rhs: f64) {
         let m = self.rows + self.cols;
         for c in 0..self.cols {
             self.a[c * m + row] = 0.0;
@@ -59,13 +83,13 @@ impl LeastSquares {
 
     /// Adds `value` to `A[row, col]`.
     #[inline]
-    pub(crate) fn add(&mut self, row: usize, col: usize, value: f64) {
+    pub fn add(&mut self, row: usize, col: usize, value: f64) {
         self.a[col * (self.rows + self.cols) + row] += value;
     }
 
     /// Solves with the ridge `lambda = ridge * |A|_F^2 / cols` (`ridge = 0`: plain least
     /// squares), overwriting `A` and `b`; returns the solution.
-    pub(crate) fn solve(&mut self, ridge: f64) -> Result<&[f64], LeastSquaresError> {
+    pub fn solve(&mut self, ridge: f64) -> Result<&[f64], LeastSquaresError> {
         let (n, m) = (self.cols, self.rows + self.cols);
         let frobenius_sq: f64 = (0..n)
             .map(|c| {

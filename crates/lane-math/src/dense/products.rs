@@ -1,0 +1,80 @@
+//! Products of small row-major matrices and the symmetric part of a square one.
+
+/// `out = a b` with `a` `r x k`, `b` `k x c` (row-major; `out` must not alias).
+#[inline]
+pub fn multiply(a: &[f64], b: &[f64], out: &mut [f64], r: usize, k: usize, c: usize) {
+    for i in 0..r {
+        let row = &mut out[i * c..(i + 1) * c];
+        row.fill(0.0);
+        for l in 0..k {
+            let x = a[i * k + l];
+            for (o, &y) in row.iter_mut().zip(&b[l * c..(l + 1) * c]) {
+                *o += x * y;
+            }
+        }
+    }
+}
+
+/// `out = a^T b` with `a` `k x r`, `b` `k x c`.
+#[inline]
+pub fn multiply_transposed(a: &[f64], b: &[f64], out: &mut [f64], r: usize, k: usize, c: usize) {
+    out[..r * c].fill(0.0);
+    for l in 0..k {
+        for i in 0..r {
+            let x = a[l * r + i];
+            for (o, &y) in out[i * c..(i + 1) * c]
+                .iter_mut()
+                .zip(&b[l * c..(l + 1) * c])
+            {
+                *o += x * y;
+            }
+        }
+    }
+}
+
+/// `out = a b^T` with `a` `r x k`, `b` `c x k`.
+#[inline]
+pub fn multiply_by_transposed(a: &[f64], b: &[f64], out: &mut [f64], r: usize, k: usize, c: usize) {
+    for i in 0..r {
+        let row = &a[i * k..(i + 1) * k];
+        for j in 0..c {
+            out[i * c + j] = row
+                .iter()
+                .zip(&b[j * k..(j + 1) * k])
+                .map(|(x, y)| x * y)
+                .sum();
+        }
+    }
+}
+
+/// Replaces the `n x n` matrix `a` with its symmetric part `(a + a^T) / 2` (against the rounding
+/// drift of products that are symmetric in exact arithmetic).
+#[inline]
+pub fn symmetrise(a: &mut [f64], n: usize) {
+    for i in 0..n {
+        for j in i + 1..n {
+            let mean = 0.5 * (a[i * n + j] + a[j * n + i]);
+            a[i * n + j] = mean;
+            a[j * n + i] = mean;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dense::test_matrix as matrix;
+
+    #[test]
+    fn multiply_by_transposed_is_the_product_with_the_transpose() {
+        let (r, k, c) = (3, 4, 5);
+        let (a, b) = (matrix(r, k, 7), matrix(c, k, 9));
+        let bt: Vec<f64> = (0..k * c).map(|x| b[(x % c) * k + x / c]).collect();
+        let (mut got, mut want) = (vec![0.0; r * c], vec![0.0; r * c]);
+        multiply_by_transposed(&a, &b, &mut got, r, k, c);
+        multiply(&a, &bt, &mut want, r, k, c);
+        for (g, w) in got.iter().zip(&want) {
+            assert!((g - w).abs() < 1e-15);
+        }
+    }
+}
