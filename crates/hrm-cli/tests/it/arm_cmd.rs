@@ -1,0 +1,262 @@
+//! `hrm arm check` and `hrm arm export --format urdf|mjcf --out DIR`: the check lists what the
+//! URDF reader read, merged and ignored; an exported URDF reads back to the same chain bit for
+//! bit; the MJCF carries the gravity and every joint, and splits a chain past MuJoCo's nesting
+//! limit into included files; bad command lines and files get one line naming what is wrong.
+
+use crate::common::{hrm, scratch};
+use robot_desc::{MJCF_BODIES_PER_FILE, MJCF_MAX_BODIES_ONE_FILE, Robot, read_urdf};
+use std::path::{Path, PathBuf};
+
+fn example() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/urdf-arm/arm7.urdf")
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The standard output of a run that must succeed.
+fn succeeds(args: &[&str]) -> String {
+    let out = hrm(args);
+    assert!(
+        out.status.success(),
+        "hrm {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// The one-line error of a run that must fail.
+fn fails(args: &[&str]) -> String {
+    let out = hrm(args);
+    assert!(!out.status.success(), "hrm {args:?} succeeded");
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    err
+}
+
+/// The chain a URDF file holds.
+fn robot(file: &Path) -> Robot {
+    read_urdf(&std::fs::read_to_string(file).unwrap())
+        .unwrap()
+        .robot
+}
+
+/// A serial chain of `n` revolute joints alternating about z and y, unit rods along z.
+fn long_chain(n: usize) -> String {
+    let mut text = String::from("<robot name=\"long\"><link name=\"l0\"/>\n");
+    for i in 1..=n {
+        let axis = if i % 2 == 0 { "0 1 0" } else { "0 0 1" };
+        text += &format!(
+            "<joint name=\"j{i}\" type=\"revolute\"><parent link=\"l{}\"/><child link=\"l{i}\"/>\
+             <origin xyz=\"0 0 0.1\"/><axis xyz=\"{axis}\"/></joint>\n<link name=\"l{i}\">\
+             <inertial><origin xyz=\"0 0 0.05\"/><mass value=\"0.1\"/>\
+             <inertia ixx=\"1e-4\" iyy=\"1e-4\" izz=\"1e-5\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>\
+             </inertial></link>\n",
+            i - 1
+        );
+    }
+    text + "</robot>\n"
+}
+
+#[test]
+fn check_lists_the_chain_and_what_was_merged_and_ignored() {
+    let reading = read_urdf(&std::fs::read_to_string(example()).unwrap()).unwrap();
+    let text = succeeds(&["arm", "check", path(&example())]);
+    let first = text.lines().next().unwrap();
+    assert!(
+        first.contains("robot 'arm7'") && first.contains("7 movable joints on base 'base'"),
+        "{first}"
+    );
+    for joint in &reading.robot.joints {
+        let line = text
+            .lines()
+            .find(|l| l.contains(&format!("'{}'", joint.name)))
+            .unwrap_or_else(|| panic!("joint '{}' is not listed:\n{text}", joint.name));
+        assert!(
+            line.contains(&format!("link '{}'", joint.child.name)),
+            "{line}"
+        );
+    }
+    // The fixed tool link is merged into the last link, as the reader reports.
+    assert!(!reading.report.merged.is_empty());
+    for merged in &reading.report.merged {
+        let line = format!(
+            "merged: link '{}' into '{}' (fixed joint '{}')",
+            merged.link, merged.into, merged.joint
+        );
+        assert!(text.contains(&line), "{line:?} missing:\n{text}");
+    }
+}
+
+#[test]
+fn an_exported_urdf_reads_back_to_the_same_chain_bit_for_bit() {
+    let dir = scratch("arm-export-urdf");
+    let out = dir.join("out");
+    let said = succeeds(&[
+        "arm",
+        "export",
+        path(&example()),
+        "--format",
+        "urdf",
+        "--out",
+        path(&out),
+    ]);
+    let file = out.join("arm7.urdf");
+    assert!(said.contains(path(&file)), "{said}");
+    let (read, original) = (robot(&file), robot(&example()));
+    assert_eq!(format!("{read:?}"), format!("{original:?}"));
+    // Exporting the export writes the same text again.
+    let again = dir.join("again");
+    succeeds(&[
+        "arm",
+        "export",
+        path(&file),
+        "--format",
+        "urdf",
+        "--out",
+        path(&again),
+    ]);
+    assert_eq!(
+        std::fs::read_to_string(&file).unwrap(),
+        std::fs::read_to_string(again.join("arm7.urdf")).unwrap()
+    );
+}
+
+#[test]
+fn the_mjcf_export_carries_gravity_and_every_joint() {
+    let dir = scratch("arm-export-mjcf");
+    let out = dir.join("urdf");
+    succeeds(&[
+        "arm",
+        "export",
+        path(&example()),
+        "--format",
+        "mjcf",
+        "--out",
+        path(&out),
+    ]);
+    let mjcf = std::fs::read_to_string(out.join("arm7.xml")).unwrap();
+    assert!(
+        mjcf.contains("<option gravity=\"0.0 0.0 -9.81\"/>"),
+        "{mjcf}"
+    );
+    assert_eq!(mjcf.matches("<joint ").count(), 7, "{mjcf}");
+    // A given gravity replaces ROS's default.
+    let tilted = dir.join("tilted");
+    succeeds(&[
+        "arm",
+        "export",
+        path(&example()),
+        "--format",
+        "mjcf",
+        "--out",
+        path(&tilted),
+        "--gravity",
+        "1,0,-9",
+    ]);
+    let mjcf = std::fs::read_to_string(tilted.join("arm7.xml")).unwrap();
+    assert!(
+        mjcf.contains("<option gravity=\"1.0 0.0 -9.0\"/>"),
+        "{mjcf}"
+    );
+    // The paper's planar arm: in the base's x-y plane, joints about z, gravity along -y.
+    let planar = dir.join("planar");
+    succeeds(&[
+        "arm",
+        "export",
+        "paper-tracking",
+        "--format",
+        "mjcf",
+        "--out",
+        path(&planar),
+    ]);
+    let mjcf = std::fs::read_to_string(planar.join("hrm_planar_arm.xml")).unwrap();
+    assert!(
+        mjcf.contains("<option gravity=\"0.0 -9.81 0.0\"/>"),
+        "{mjcf}"
+    );
+    assert_eq!(mjcf.matches("<joint ").count(), 10, "{mjcf}");
+    assert_eq!(mjcf.matches("axis=\"0.0 0.0 1.0\"").count(), 10, "{mjcf}");
+}
+
+#[test]
+fn a_chain_past_the_nesting_limit_is_split_into_included_files() {
+    let n = MJCF_MAX_BODIES_ONE_FILE + 5;
+    let dir = scratch("arm-export-long");
+    let urdf = dir.join("long.urdf");
+    std::fs::write(&urdf, long_chain(n)).unwrap();
+    let out = dir.join("out");
+    succeeds(&[
+        "arm",
+        "export",
+        path(&urdf),
+        "--format",
+        "mjcf",
+        "--out",
+        path(&out),
+    ]);
+    let main = std::fs::read_to_string(out.join("long.xml")).unwrap();
+    assert!(
+        main.contains("<include file=\"long-part1.xml\"/>"),
+        "{main}"
+    );
+    let mut joints = main.matches("<joint ").count();
+    let mut parts = 0;
+    while let Ok(part) = std::fs::read_to_string(out.join(format!("long-part{}.xml", parts + 1))) {
+        joints += part.matches("<joint ").count();
+        parts += 1;
+    }
+    // No file holds more than its share of the chain.
+    assert!(
+        parts + 1 >= n.div_ceil(MJCF_BODIES_PER_FILE),
+        "{parts} parts"
+    );
+    assert_eq!(joints, n);
+}
+
+#[test]
+fn bad_arm_commands_get_one_line_naming_the_problem() {
+    let dir = scratch("arm-errors");
+    let missing = dir.join("missing.urdf");
+    assert!(fails(&["arm", "check", path(&missing)]).contains("missing.urdf"));
+    let hostile = dir.join("hostile.urdf");
+    std::fs::write(
+        &hostile,
+        "<robot name=\"r\"><link name=\"a\"/><joint name=\"j\" type=\"revolute\">\
+         <parent link=\"a\"/><child link=\"b\"/></joint><link name=\"b\"><inertial>\
+         <mass value=\"NaN\"/></inertial></link></robot>",
+    )
+    .unwrap();
+    let err = fails(&["arm", "check", path(&hostile)]);
+    assert!(
+        err.contains("hostile.urdf") && err.contains("<mass> of link 'b'"),
+        "{err}"
+    );
+    let out = dir.join("out");
+    // The format is checked by the argument parser (its usage message follows).
+    let run = hrm(&[
+        "arm",
+        "export",
+        path(&example()),
+        "--format",
+        "sdf",
+        "--out",
+        path(&out),
+    ]);
+    assert!(!run.status.success());
+    assert!(String::from_utf8_lossy(&run.stderr).contains("'sdf'"));
+    let err = fails(&[
+        "arm",
+        "export",
+        path(&example()),
+        "--format",
+        "mjcf",
+        "--out",
+        path(&out),
+        "--gravity",
+        "0 nan",
+    ]);
+    assert!(err.contains("--gravity"), "{err}");
+    assert!(!out.exists(), "nothing is written on an error");
+}
