@@ -320,7 +320,8 @@ def test_long_one_object_calls_let_other_threads_run():
     models = []
     share, elapsed = progress_share(lambda: models.append(hrm.ReducedModel(arm, harmonics=150)))
     assert elapsed > 0.1 and share > 0.25, (share, elapsed)  # 0.03 with the GIL held
-    model = models[0]
+    # One-state calls on a larger model, long enough (about 0.1 s) to measure the share.
+    model = hrm.ReducedModel(arm, harmonics=220)
     share, elapsed = progress_share(lambda: model.mass_matrix(np.zeros(model.n_coords)))
     assert elapsed > 0.05 and share > 0.25, (share, elapsed)
 
