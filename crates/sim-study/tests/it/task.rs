@@ -110,6 +110,11 @@ fn tasks_and_planned_references_come_together_and_name_their_fields() {
         e.starts_with("task cannot be met: no collision-free shape found"),
         "{e}"
     );
+    // A spatial arm is not planned: its [task] is refused by name, not ignored.
+    let mut spatial = Scenario::builtin("spatial-tracking").unwrap();
+    spatial.task = base.task.clone();
+    let e = spatial.build().err().unwrap().to_string();
+    assert!(e.starts_with("task is planned for planar arms only"), "{e}");
     let text = base.to_toml();
     assert_eq!(Scenario::from_toml(&text).unwrap(), base);
 }
