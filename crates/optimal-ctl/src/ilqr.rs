@@ -749,14 +749,38 @@ impl Ilqr {
     }
 
     /// The backward pass with regularisation `mu`: gains, feed-forward steps and the expected
-    /// decrease terms `[sum k^T Q_u, 1/2 sum k^T Q_uu k]`.
+    /// decrease terms `[sum k^T Q_u, 1/2 sum k^T Q_uu k]`. The sizes of the reduced model's
+    /// `m = 2` and `m = 3` (`n_x = 2m`, `n_u = m`) have their own bodies, in which the small
+    /// matrix products are unrolled for them; the same operations in the same order as for any
+    /// other size.
     fn backward(
         &mut self,
         mu: f64,
         qp: &BoxQpSettings,
         constrained: bool,
     ) -> Result<[f64; 2], OptimalError> {
-        let (nx, nu, n) = (self.nx, self.nu, self.horizon);
+        match (self.nx, self.nu) {
+            (4, 2) => self.backward_sized::<4, 2>(mu, qp, constrained),
+            (6, 3) => self.backward_sized::<6, 3>(mu, qp, constrained),
+            _ => self.backward_sized::<0, 0>(mu, qp, constrained),
+        }
+    }
+
+    /// [`backward`](Self::backward) for `n_x = NX`, `n_u = NU` known at compile time, or any
+    /// sizes when both are 0.
+    #[inline(always)]
+    fn backward_sized<const NX: usize, const NU: usize>(
+        &mut self,
+        mu: f64,
+        qp: &BoxQpSettings,
+        constrained: bool,
+    ) -> Result<[f64; 2], OptimalError> {
+        let (nx, nu) = if NX == 0 {
+            (self.nx, self.nu)
+        } else {
+            (NX, NU)
+        };
+        let n = self.horizon;
         let cost = &self.cost;
         let mut expected = [0.0; 2];
         for i in 0..nx {

@@ -1,7 +1,8 @@
 //! Products of small row-major matrices and the symmetric part of a square one.
 
-/// `out = a b` with `a` `r x k`, `b` `k x c` (row-major; `out` must not alias).
-#[inline]
+/// `out = a b` with `a` `r x k`, `b` `k x c` (row-major; `out` must not alias). Always
+/// inlined, so that sizes known to the caller unroll its loops.
+#[inline(always)]
 pub fn multiply(a: &[f64], b: &[f64], out: &mut [f64], r: usize, k: usize, c: usize) {
     for i in 0..r {
         let row = &mut out[i * c..(i + 1) * c];
@@ -15,8 +16,8 @@ pub fn multiply(a: &[f64], b: &[f64], out: &mut [f64], r: usize, k: usize, c: us
     }
 }
 
-/// `out = a^T b` with `a` `k x r`, `b` `k x c`.
-#[inline]
+/// `out = a^T b` with `a` `k x r`, `b` `k x c`. Always inlined, as [`multiply`].
+#[inline(always)]
 pub fn multiply_transposed(a: &[f64], b: &[f64], out: &mut [f64], r: usize, k: usize, c: usize) {
     out[..r * c].fill(0.0);
     for l in 0..k {
@@ -48,8 +49,8 @@ pub fn multiply_by_transposed(a: &[f64], b: &[f64], out: &mut [f64], r: usize, k
 }
 
 /// Replaces the `n x n` matrix `a` with its symmetric part `(a + a^T) / 2` (against the rounding
-/// drift of products that are symmetric in exact arithmetic).
-#[inline]
+/// drift of products that are symmetric in exact arithmetic). Always inlined, as [`multiply`].
+#[inline(always)]
 pub fn symmetrise(a: &mut [f64], n: usize) {
     for i in 0..n {
         for j in i + 1..n {
