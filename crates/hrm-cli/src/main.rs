@@ -6,6 +6,7 @@ mod chain_simulate;
 mod console;
 mod eval;
 mod experiment;
+mod figure_parts;
 mod figures;
 mod fis_cmd;
 mod fis_export;
