@@ -11,6 +11,7 @@ mod figures;
 mod fis_cmd;
 mod fis_export;
 mod fis_imitate;
+mod fis_input;
 mod fis_train;
 mod output_dir;
 mod plot;
