@@ -17,6 +17,11 @@ pub(crate) type Six = [f64; 6];
 /// part (3).
 pub(crate) const ROWS: usize = 15;
 
+/// `n` rounded up to whole registers of the widest SIMD instruction set (8 `f64` lanes).
+pub(crate) fn padded(n: usize) -> usize {
+    n.next_multiple_of(8)
+}
+
 /// Results and scratch of [`rnea_derivatives`](super::rnea_derivatives()) and
 /// [`aba_derivatives`](super::aba_derivatives()) for one [`SpatialModel`]: build it once with
 /// [`SpatialDerivativeData::new`] (about `40 n^2` bytes), then every call fills it without
@@ -41,8 +46,11 @@ pub struct SpatialDerivativeData {
     /// Per link `i`, in the base frame, by components (`rows[c][i]`, for products down a
     /// column): the joint axis `J_i` (components 0-5), `P_i = Ic_i J_i` (6-11) and the angular
     /// part of `Q_i = Bc_i^T J_i` (12-14; its linear part vanishes) (theory.md, "Spatial
-    /// derivatives").
+    /// derivatives"). Each row is zero-padded to [`padded`] entries, whole SIMD registers.
     pub(crate) rows: [Vec<f64>; ROWS],
+    /// One column of a result, below and above the diagonal, before it is copied into
+    /// `blocks` (`2 padded(n)` entries).
+    pub(crate) column: Vec<f64>,
     /// Per link: `w_i`, `beta_i`, and the column constants `G_i`, `H_i`.
     pub(crate) w: Vec<Six>,
     pub(crate) beta: Vec<Six>,
@@ -84,7 +92,8 @@ impl SpatialDerivativeData {
             value: vec![0.0; sized],
             accelerations: vec![0.0; sized],
             blocks: Mat::zeros(sized, 3 * sized),
-            rows: std::array::from_fn(|_| vec![0.0; sized]),
+            rows: std::array::from_fn(|_| vec![0.0; padded(sized)]),
+            column: vec![0.0; 2 * padded(sized)],
             w: six(),
             beta: six(),
             g: six(),

@@ -31,13 +31,14 @@
 //! momentum `Hc_i` and a 3 x 3 `Dc_i`, and `Q_i = (0, 2 Hc_i x J_i,linear + Dc_i^T J_i,angular)`.
 
 use faer::{Mat, MatMut};
+use lane_math::{Lane, Pack};
 use pulp::{Simd, WithSimd};
 
 use super::algebra::{
     Force, Mat3, Motion, Symmetric6, Vec3, add, cross, dot, mat_add, mat_t_vec, mat_vec, scale,
 };
 use super::data::SpatialData;
-use super::derivative_data::{Six, SpatialDerivativeData};
+use super::derivative_data::{Six, SpatialDerivativeData, padded};
 use super::kinematics::update_poses;
 use super::model::SpatialModel;
 use super::rnea::newton_euler;
@@ -218,19 +219,29 @@ fn differentiate(
         parent_velocity = pose.act_motion(&data.velocities[i]);
         parent_acceleration = pose.act_motion(&data.accelerations[i]);
     }
-    // Moved out and back (no allocation) so that `fill` reads the vectors while writing it.
+    // Moved out and back (no allocation) so that `Fill` reads the vectors while writing them.
     let mut blocks = std::mem::replace(&mut d.blocks, Mat::new());
+    let mut column = std::mem::take(&mut d.column);
     let (d_q, rest) = blocks.as_mut().split_at_col_mut(n);
     let (d_v, mass) = rest.split_at_col_mut(n);
-    data.arch.dispatch(Fill { d, d_q, d_v, mass });
+    data.arch.dispatch(Fill {
+        d,
+        column: &mut column,
+        d_q,
+        d_v,
+        mass,
+    });
     d.blocks = blocks;
+    d.column = column;
 }
 
 /// The entries of the three matrices from the per-link vectors, column by column, each entry
-/// a sum of products down the component rows (under [`pulp::Arch::dispatch`], so the loops
-/// are compiled for this processor's widest registers).
+/// a sum of products down the component rows in whole SIMD registers (under
+/// [`pulp::Arch::dispatch`]): the column's entries above the diagonal and those on and below
+/// it go to the two halves of `column`, then into the matrix.
 struct Fill<'a> {
     d: &'a SpatialDerivativeData,
+    column: &'a mut [f64],
     d_q: MatMut<'a, f64>,
     d_v: MatMut<'a, f64>,
     mass: MatMut<'a, f64>,
@@ -240,31 +251,26 @@ impl WithSimd for Fill<'_> {
     type Output = ();
 
     #[inline(always)]
-    fn with_simd<S: Simd>(self, _: S) {
+    fn with_simd<S: Simd>(self, simd: S) {
         let Fill {
             d,
+            column,
             mut d_q,
             mut d_v,
             mut mass,
         } = self;
         let n = d.value.len();
-        let r = |c: usize| &d.rows[c][..n];
+        let width = Pack::<S>::WIDTH;
+        let end = padded(n);
+        let r = |c: usize| &d.rows[c][..end];
         let axes = [r(0), r(1), r(2), r(3), r(4), r(5)];
         let p = [r(6), r(7), r(8), r(9), r(10), r(11)];
         let pq = [r(6), r(7), r(8), r(9), r(10), r(11), r(12), r(13), r(14)];
+        let (above, below) = column.split_at_mut(end);
         for k in 0..n {
-            let (q_out, v_out, m_out) = (
-                column(&mut d_q, k),
-                column(&mut d_v, k),
-                column(&mut mass, k),
-            );
-            let (axis, p_k) = (axes.map(|row| row[k]), p.map(|row| row[k]));
+            let axis = [0, 1, 2, 3, 4, 5].map(|c| axes[c][k]);
+            let p_k = [0, 1, 2, 3, 4, 5].map(|c| p[c][k]);
             let (w, beta) = (&d.w[k], &d.beta[k]);
-            // i < k: J_i . G_k, J_i . H_k, J_i . P_k.
-            combine(&mut q_out[..k], &axes, &d.g[k]);
-            combine(&mut v_out[..k], &axes, &d.h[k]);
-            combine(&mut m_out[..k], &axes, &p_k);
-            // i >= k: P_i . beta_k + Q_i . w_k, 2 P_i . w_k + Q_i . J_k, P_i . J_k.
             let dq = [
                 beta[0], beta[1], beta[2], beta[3], beta[4], beta[5], w[3], w[4], w[5],
             ];
@@ -279,34 +285,58 @@ impl WithSimd for Fill<'_> {
                 axis[4],
                 axis[5],
             ];
-            let lower = pq.map(|row| &row[k..]);
-            combine(&mut q_out[k..], &lower, &dq);
-            combine(&mut v_out[k..], &lower, &dv);
-            combine(&mut m_out[k..], &p.map(|row| &row[k..]), &axis);
+            // The registers holding rows 0..k (above the diagonal) and k..n.
+            let (upper, lower) = (0..k.next_multiple_of(width), k - k % width..end);
+            // i < k: J_i . G_k; i >= k: P_i . beta_k + Q_i . w_k.
+            combine(simd, above, &axes, &d.g[k], upper.clone());
+            combine(simd, below, &pq, &dq, lower.clone());
+            store_column(&mut d_q, k, above, below);
+            // i < k: J_i . H_k; i >= k: 2 P_i . w_k + Q_i . J_k.
+            combine(simd, above, &axes, &d.h[k], upper.clone());
+            combine(simd, below, &pq, &dv, lower.clone());
+            store_column(&mut d_v, k, above, below);
+            // M: i < k: J_i . P_k; i >= k: P_i . J_k.
+            combine(simd, above, &axes, &p_k, upper);
+            combine(simd, below, &p, &axis, lower);
+            store_column(&mut mass, k, above, below);
         }
     }
 }
 
-/// Column `k` of `m` as a slice (the blocks of a faer `Mat` are column-major).
+/// Column `k` of `m`: `above[..k]`, then `below[k..]` (the blocks of a faer `Mat` are
+/// column-major).
 #[inline(always)]
-fn column<'m>(m: &'m mut MatMut<'_, f64>, k: usize) -> &'m mut [f64] {
-    m.as_mut()
+fn store_column(m: &mut MatMut<'_, f64>, k: usize, above: &[f64], below: &[f64]) {
+    let column = m
+        .as_mut()
         .col_mut(k)
         .try_as_col_major_mut()
         .expect("the blocks of a faer Mat are column-major")
-        .as_slice_mut()
+        .as_slice_mut();
+    let n = column.len();
+    column[..k].copy_from_slice(&above[..k]);
+    column[k..].copy_from_slice(&below[k..n]);
 }
 
-/// `out[j] = sum_c rows[c][j] x[c]`, every row at least `out.len()` long.
+/// `out[i] = sum_c rows[c][i] x[c]` for the rows `i` of `range`, whole registers of `S`.
 #[inline(always)]
-fn combine<const C: usize>(out: &mut [f64], rows: &[&[f64]; C], x: &[f64; C]) {
-    let len = out.len();
-    let rows = rows.map(|row| &row[..len]);
-    for (j, entry) in out.iter_mut().enumerate() {
-        let mut sum = rows[0][j] * x[0];
+fn combine<S: Simd, const C: usize>(
+    simd: S,
+    out: &mut [f64],
+    rows: &[&[f64]; C],
+    x: &[f64; C],
+    range: std::ops::Range<usize>,
+) {
+    let width = Pack::<S>::WIDTH;
+    let mut factors = [Pack::splat(simd, 0.0); C];
+    for (factor, &value) in factors.iter_mut().zip(x) {
+        *factor = Pack::splat(simd, value);
+    }
+    for at in range.step_by(width) {
+        let mut sum = Pack::load(simd, &rows[0][at..]) * factors[0];
         for c in 1..C {
-            sum += rows[c][j] * x[c];
+            sum = Pack::load(simd, &rows[c][at..]).mul_add(factors[c], sum);
         }
-        *entry = sum;
+        sum.store(&mut out[at..]);
     }
 }
