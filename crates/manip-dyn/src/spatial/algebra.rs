@@ -302,6 +302,35 @@ impl<T: Lane> Transform<T> {
     }
 }
 
+impl Transform {
+    /// A rigid body's inertia given in the child frame, as the 6 x 6 matrix in the parent frame
+    /// (what [`act_inertia`](Self::act_inertia) gives of [`RigidInertia::matrix`], from the ten
+    /// parameters): the centre of mass `c = R c_child + p`, `A = m E`, `B = -m [c]x`,
+    /// `C = R I_c R^T + m (|c|^2 E - c c^T)`.
+    pub(crate) fn act_rigid_inertia(&self, body: &RigidInertia) -> Symmetric6 {
+        let m = body.mass;
+        let c = self.apply(body.com);
+        let mc = scale(c, m);
+        let mut rotational = rotate_congruent(&self.rotation, &body.inertia);
+        let c2 = dot(c, c);
+        for (r, row) in rotational.iter_mut().enumerate() {
+            for (k, entry) in row.iter_mut().enumerate() {
+                let delta = if r == k { c2 } else { 0.0 };
+                *entry += m * (delta - c[r] * c[k]);
+            }
+        }
+        Symmetric6 {
+            a: [[m, 0.0, 0.0], [0.0, m, 0.0], [0.0, 0.0, m]],
+            b: [
+                [0.0, mc[2], -mc[1]],
+                [-mc[2], 0.0, mc[0]],
+                [mc[1], -mc[0], 0.0],
+            ],
+            c: rotational,
+        }
+    }
+}
+
 /// `([p]x m)^T`: row `j` is `p x` (column `j` of `m`).
 #[inline(always)]
 fn mat_cross_t<T: Lane>(p: Vec3<T>, m: &Mat3<T>) -> Mat3<T> {

@@ -158,22 +158,28 @@ fn differentiate(
 ) {
     let n = model.n_links();
     let d = derivatives;
-    // Tip to base: composite inertia and Coriolis operator in the base frame.
+    // Tip to base: composite inertia and Coriolis operator in the base frame (a massless link
+    // adds nothing to either).
     for i in (0..n).rev() {
-        let pose = &data.poses[i];
-        let inertia = pose.act_inertia(&model.matrices[i]);
-        let velocity = pose.act_motion(&data.velocities[i]);
-        let momentum = inertia.apply(&velocity);
-        let block = coriolis_block(&inertia, &velocity, &momentum);
-        if i + 1 < n {
-            d.composite[i] = inertia.plus(&d.composite[i + 1]);
-            d.momentum[i] = add(momentum.linear, d.momentum[i + 1]);
-            d.coriolis[i] = mat_add(&block, &d.coriolis[i + 1]);
+        let (composite, momentum, coriolis) = if i + 1 < n {
+            (d.composite[i + 1], d.momentum[i + 1], d.coriolis[i + 1])
         } else {
-            d.composite[i] = inertia;
-            d.momentum[i] = momentum.linear;
-            d.coriolis[i] = block;
+            (Symmetric6::default(), [0.0; 3], [[0.0; 3]; 3])
+        };
+        if model.massless[i] {
+            d.composite[i] = composite;
+            d.momentum[i] = momentum;
+            d.coriolis[i] = coriolis;
+            continue;
         }
+        let pose = &data.poses[i];
+        let inertia = pose.act_rigid_inertia(&model.inertias[i]);
+        let velocity = pose.act_motion(&data.velocities[i]);
+        let own = inertia.apply(&velocity);
+        let block = coriolis_block(&inertia, &velocity, &own);
+        d.composite[i] = inertia.plus(&composite);
+        d.momentum[i] = add(own.linear, momentum);
+        d.coriolis[i] = mat_add(&block, &coriolis);
     }
     // Base to tip: the per-link vectors.
     let g = model.gravity();
