@@ -41,9 +41,11 @@ use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
 use super::motion::{Carried, JointTurns, cross_fused, link_step_turned};
 use crate::error::{ReduceError, check_finite_result, check_input};
+use crate::forward::right_hand_side;
 use crate::model::LINK_PADDING;
 use crate::terms::{CoordinateLanes, Layout, OneStateScalar};
 use backbone_kin::vec3;
+use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 use lane_math::{Lane, sin_cos, sin_cos_lanes};
 use pulp::{Simd, WithSimd};
 
@@ -63,34 +65,45 @@ pub fn spatial_reduced_terms(
     let arch = data.arch;
     arch.dispatch(TermsOfOneState {
         model,
-        data,
+        data: &mut *data,
         a,
         a_dot,
+        solve: None,
     });
+    check_terms(data)
+}
+
+/// Checks that the terms in `data` are finite, naming the first that is not.
+pub(crate) fn check_terms(data: &SpatialReducedData) -> Result<(), ReduceError> {
     check_finite_result("reduced mass matrix M*", &data.mass_matrix)?;
     check_finite_result("reduced Coriolis vector C*", &data.coriolis)?;
     check_finite_result("reduced gravity vector G*", &data.gravity)
 }
 
-/// [`spatial_reduced_terms`] after its checks, run by [`pulp::Arch::dispatch`] so that the
-/// kernel is compiled for the processor's instruction set.
-struct TermsOfOneState<'a> {
-    model: &'a SpatialReducedModel,
-    data: &'a mut SpatialReducedData,
-    a: &'a [f64],
-    a_dot: &'a [f64],
+/// [`spatial_reduced_terms`] after its checks, and with `solve` the forward dynamics' `L D L^T`
+/// solve ([`spatial_forward_dynamics`](super::spatial_forward_dynamics)), run by
+/// [`pulp::Arch::dispatch`] so that the kernel and the solve are compiled for the processor's
+/// instruction set. Gives `false` if the solve found `M*` not numerically positive definite.
+pub(crate) struct TermsOfOneState<'a> {
+    pub(crate) model: &'a SpatialReducedModel,
+    pub(crate) data: &'a mut SpatialReducedData,
+    pub(crate) a: &'a [f64],
+    pub(crate) a_dot: &'a [f64],
+    /// `tau_star` and where `a_ddot` goes (`m` each, checked).
+    pub(crate) solve: Option<(&'a [f64], &'a mut [f64])>,
 }
 
 impl WithSimd for TermsOfOneState<'_> {
-    type Output = ();
+    type Output = bool;
 
     #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) {
+    fn with_simd<S: Simd>(self, simd: S) -> bool {
         let Self {
             model,
             data,
             a,
             a_dot,
+            solve,
         } = self;
         let SpatialReducedData {
             link_angles,
@@ -106,6 +119,7 @@ impl WithSimd for TermsOfOneState<'_> {
             mass_matrix,
             coriolis,
             gravity,
+            factor,
             ..
         } = data;
         link_values(model, a, a_dot, link_angles, link_rates);
@@ -117,15 +131,21 @@ impl WithSimd for TermsOfOneState<'_> {
             rates: link_rates,
         };
         let out = OneStateTerms {
-            mass_matrix,
-            coriolis,
-            gravity,
+            mass_matrix: &mut *mass_matrix,
+            coriolis: &mut *coriolis,
+            gravity: &mut *gravity,
         };
         // The sizes a batch runs SIMD across states, on the stack, the coordinates side by side
-        // in one register where they fit.
-        match model.n_coords() {
-            4 => on_stack::<S, 4>(simd, model, &turns, out),
-            8 => on_stack::<S, 8>(simd, model, &turns, out),
+        // in one register where they fit; `m` a constant of the solve for them.
+        let m = match model.n_coords() {
+            4 => {
+                on_stack::<S, 4>(simd, model, &turns, out);
+                4
+            }
+            8 => {
+                on_stack::<S, 8>(simd, model, &turns, out);
+                8
+            }
             m => {
                 let work = TermsLanes {
                     omega_jacobian,
@@ -140,8 +160,19 @@ impl WithSimd for TermsOfOneState<'_> {
                 };
                 let work = accumulate(OneStateScalar(simd), model, &turns, m, work);
                 mirror_lower(work.mass_matrix, m);
+                m
             }
+        };
+        let Some((tau_star, a_ddot)) = solve else {
+            return true;
+        };
+        factor.copy_from_slice(mass_matrix);
+        if !ldlt_in_place::<f64>((), factor, m) {
+            return false;
         }
+        right_hand_side(tau_star, coriolis, gravity, a_ddot);
+        ldlt_solve_in_place(factor, m, a_ddot);
+        true
     }
 }
 
