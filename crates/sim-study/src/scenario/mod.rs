@@ -97,11 +97,13 @@ mod spatial;
 mod task;
 
 pub use arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout};
-pub use controllers::{CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup};
+pub use controllers::{
+    CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup, ControllerSpec, FuzzyInputRange,
+};
 pub use file::ScenarioError;
 pub use obstacles::{MAX_SCENARIO_OBSTACLES, Workspace};
 pub use schema::{
-    Alpha0, AngleLimit, ArmSpec, BranchSpec, ControllerSpec, FuzzyInputRange, HelixSpec,
-    InitialSpec, IntegratorSpec, LimitsSpec, ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec,
-    ReferenceSpec, Scenario, SineSpec, TaskSpec, TorqueLimit,
+    Alpha0, AngleLimit, ArmSpec, BranchSpec, HelixSpec, InitialSpec, IntegratorSpec, LimitsSpec,
+    ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec, ReferenceSpec, Scenario, SineSpec,
+    TaskSpec, TorqueLimit,
 };
