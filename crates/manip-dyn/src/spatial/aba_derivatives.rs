@@ -62,15 +62,18 @@ pub fn aba_derivatives(
     derivatives.accelerations = qdd;
     solved?;
     let SpatialDerivativeData {
-        blocks,
-        rhs,
-        forces,
-        motions,
-        ..
+        blocks, rhs, sweep, ..
     } = derivatives;
     let (mut jacobians, mut minv) = blocks.as_mut().split_at_col_mut(2 * n);
     rhs.copy_from(jacobians.as_ref());
-    inverse_mass_matrix(model, &data.articulated, forces, motions, minv.as_mut());
+    inverse_mass_matrix(
+        data.arch,
+        model,
+        &data.articulated,
+        &data.poses,
+        sweep,
+        minv.as_mut(),
+    );
     matmul(
         jacobians.as_mut(),
         Accum::Replace,

@@ -5,7 +5,7 @@
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef, Par};
 
-use super::algebra::{Force, Mat3, Motion, Symmetric6, Vec3};
+use super::algebra::{Mat3, Symmetric6, Vec3};
 use super::model::SpatialModel;
 use crate::model::MAX_DENSE_LINKS;
 
@@ -64,9 +64,8 @@ pub struct SpatialDerivativeData {
     pub(crate) coriolis: Vec<Mat3>,
     /// `[d tau / d q | d tau / d v]` while `aba_derivatives` multiplies it by `-M^-1`.
     pub(crate) rhs: Mat<f64>,
-    /// The force and motion columns of the `O(n^2)` `M^-1` (`aba_derivatives`).
-    pub(crate) forces: Vec<Force>,
-    pub(crate) motions: Vec<Motion>,
+    /// The force, then motion, columns of the `O(n^2)` `M^-1` by component (`aba_derivatives`).
+    pub(crate) sweep: [Vec<f64>; 6],
 }
 
 impl SpatialDerivativeData {
@@ -102,8 +101,7 @@ impl SpatialDerivativeData {
             momentum: vec![[0.0; 3]; sized],
             coriolis: vec![[[0.0; 3]; 3]; sized],
             rhs: Mat::zeros(sized, 2 * sized),
-            forces: vec![Force::default(); sized],
-            motions: vec![Motion::default(); sized],
+            sweep: std::array::from_fn(|_| vec![0.0; sized]),
         };
         derivatives.warm_up();
         derivatives
