@@ -83,6 +83,20 @@ pub fn rnea_derivatives(
         derivatives.n_links(),
         n,
     )?;
+    differentiate_at(model, data, derivatives, q, v, qdd)?;
+    check::finite_matrix("the derivatives", &derivatives.blocks.as_mut())
+}
+
+/// [`rnea_derivatives`] on checked inputs, but for the test of the matrices (which
+/// [`aba_derivatives`](super::aba_derivatives()) makes once, on its own results).
+pub(crate) fn differentiate_at(
+    model: &SpatialModel,
+    data: &mut SpatialData,
+    derivatives: &mut SpatialDerivativeData,
+    q: &[f64],
+    v: &[f64],
+    qdd: &[f64],
+) -> Result<(), DynError> {
     update_poses(model, data, q);
     newton_euler(
         model,
@@ -94,7 +108,7 @@ pub fn rnea_derivatives(
     );
     check::finite_result("tau", &derivatives.value)?;
     differentiate(model, data, derivatives);
-    check::finite_matrix("the derivatives", &derivatives.blocks.as_mut())
+    Ok(())
 }
 
 fn six_motion(m: &Motion) -> Six {
