@@ -17,9 +17,10 @@ pub(crate) type Six = [f64; 6];
 /// part (3).
 pub(crate) const ROWS: usize = 15;
 
-/// `n` rounded up to whole registers of the widest SIMD instruction set (8 `f64` lanes).
+/// `n` and room for one register of the widest SIMD instruction set (8 `f64` lanes): a whole
+/// register can be read from any row index below `n`.
 pub(crate) fn padded(n: usize) -> usize {
-    n.next_multiple_of(8)
+    n + 8
 }
 
 /// Results and scratch of [`rnea_derivatives`](super::rnea_derivatives()) and
@@ -46,11 +47,8 @@ pub struct SpatialDerivativeData {
     /// Per link `i`, in the base frame, by components (`rows[c][i]`, for products down a
     /// column): the joint axis `J_i` (components 0-5), `P_i = Ic_i J_i` (6-11) and the angular
     /// part of `Q_i = Bc_i^T J_i` (12-14; its linear part vanishes) (theory.md, "Spatial
-    /// derivatives"). Each row is zero-padded to [`padded`] entries, whole SIMD registers.
+    /// derivatives"). Each row is zero-padded to [`padded`] entries.
     pub(crate) rows: [Vec<f64>; ROWS],
-    /// One column of a result, below and above the diagonal, before it is copied into
-    /// `blocks` (`2 padded(n)` entries).
-    pub(crate) column: Vec<f64>,
     /// Per link: `w_i`, `beta_i`, and the column constants `G_i`, `H_i`.
     pub(crate) w: Vec<Six>,
     pub(crate) beta: Vec<Six>,
@@ -92,7 +90,6 @@ impl SpatialDerivativeData {
             accelerations: vec![0.0; sized],
             blocks: Mat::zeros(sized, 3 * sized),
             rows: std::array::from_fn(|_| vec![0.0; padded(sized)]),
-            column: vec![0.0; 2 * padded(sized)],
             w: six(),
             beta: six(),
             g: six(),
