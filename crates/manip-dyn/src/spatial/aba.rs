@@ -157,8 +157,16 @@ pub(crate) fn kernel<L: AbaLane>(
         let joint_velocity = axis.times(L::gather(context, v, n, i));
         velocity = placement.inv_act_motion(&velocity).plus(&joint_velocity);
         let bias = velocity.cross_motion(&joint_velocity);
-        let momentum = model.inertias[i].apply(context, &velocity);
-        let force = velocity.cross_force(&momentum);
+        // A massless link (the cross of a universal joint) has no bias force.
+        let force = if model.massless[i] {
+            Force {
+                linear: zero3,
+                angular: zero3,
+            }
+        } else {
+            let momentum = model.inertias[i].apply(context, &velocity);
+            velocity.cross_force(&momentum)
+        };
         for (r, row) in placement.rotation.into_iter().enumerate() {
             set3::<L>(row, &mut link.rotation[r]);
         }
@@ -181,12 +189,19 @@ pub(crate) fn kernel<L: AbaLane>(
     };
     for i in (0..n).rev() {
         let link = &mut links[i];
-        let inertia = Symmetric6::splat(context, &model.matrices[i]).plus(&carried_inertia);
-        let force = Force {
-            linear: get3::<L>(context, &link.force[0]),
-            angular: get3::<L>(context, &link.force[1]),
-        }
-        .plus(&carried_force);
+        // A massless link adds no inertia and no bias force to what its children pass.
+        let (inertia, force) = if model.massless[i] {
+            (carried_inertia, carried_force)
+        } else {
+            let own = Force {
+                linear: get3::<L>(context, &link.force[0]),
+                angular: get3::<L>(context, &link.force[1]),
+            };
+            (
+                Symmetric6::splat(context, &model.matrices[i]).plus(&carried_inertia),
+                own.plus(&carried_force),
+            )
+        };
         let axis = splat_motion::<L>(context, &model.axes[i]);
         let coupling = inertia.apply(&axis);
         let pivot = axis.dot(&coupling);

@@ -5,7 +5,7 @@
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef, Par};
 
-use super::algebra::{Force, Mat3, Motion, Symmetric6, Vec3};
+use super::algebra::{Mat3, Symmetric6, Vec3};
 use super::model::SpatialModel;
 use crate::model::MAX_DENSE_LINKS;
 
@@ -17,9 +17,10 @@ pub(crate) type Six = [f64; 6];
 /// part (3).
 pub(crate) const ROWS: usize = 15;
 
-/// `n` rounded up to whole registers of the widest SIMD instruction set (8 `f64` lanes).
+/// `n` and room for one register of the widest SIMD instruction set (8 `f64` lanes): a whole
+/// register can be read from any row index below `n`.
 pub(crate) fn padded(n: usize) -> usize {
-    n.next_multiple_of(8)
+    n + 8
 }
 
 /// Results and scratch of [`rnea_derivatives`](super::rnea_derivatives()) and
@@ -46,11 +47,8 @@ pub struct SpatialDerivativeData {
     /// Per link `i`, in the base frame, by components (`rows[c][i]`, for products down a
     /// column): the joint axis `J_i` (components 0-5), `P_i = Ic_i J_i` (6-11) and the angular
     /// part of `Q_i = Bc_i^T J_i` (12-14; its linear part vanishes) (theory.md, "Spatial
-    /// derivatives"). Each row is zero-padded to [`padded`] entries, whole SIMD registers.
+    /// derivatives"). Each row is zero-padded to [`padded`] entries.
     pub(crate) rows: [Vec<f64>; ROWS],
-    /// One column of a result, below and above the diagonal, before it is copied into
-    /// `blocks` (`2 padded(n)` entries).
-    pub(crate) column: Vec<f64>,
     /// Per link: `w_i`, `beta_i`, and the column constants `G_i`, `H_i`.
     pub(crate) w: Vec<Six>,
     pub(crate) beta: Vec<Six>,
@@ -64,9 +62,8 @@ pub struct SpatialDerivativeData {
     pub(crate) coriolis: Vec<Mat3>,
     /// `[d tau / d q | d tau / d v]` while `aba_derivatives` multiplies it by `-M^-1`.
     pub(crate) rhs: Mat<f64>,
-    /// The force and motion columns of the `O(n^2)` `M^-1` (`aba_derivatives`).
-    pub(crate) forces: Vec<Force>,
-    pub(crate) motions: Vec<Motion>,
+    /// The force, then motion, columns of the `O(n^2)` `M^-1` by component (`aba_derivatives`).
+    pub(crate) sweep: [Vec<f64>; 6],
 }
 
 impl SpatialDerivativeData {
@@ -93,7 +90,6 @@ impl SpatialDerivativeData {
             accelerations: vec![0.0; sized],
             blocks: Mat::zeros(sized, 3 * sized),
             rows: std::array::from_fn(|_| vec![0.0; padded(sized)]),
-            column: vec![0.0; 2 * padded(sized)],
             w: six(),
             beta: six(),
             g: six(),
@@ -102,8 +98,7 @@ impl SpatialDerivativeData {
             momentum: vec![[0.0; 3]; sized],
             coriolis: vec![[[0.0; 3]; 3]; sized],
             rhs: Mat::zeros(sized, 2 * sized),
-            forces: vec![Force::default(); sized],
-            motions: vec![Motion::default(); sized],
+            sweep: std::array::from_fn(|_| vec![0.0; sized]),
         };
         derivatives.warm_up();
         derivatives

@@ -83,6 +83,20 @@ pub fn rnea_derivatives(
         derivatives.n_links(),
         n,
     )?;
+    differentiate_at(model, data, derivatives, q, v, qdd)?;
+    check::finite_matrix("the derivatives", &derivatives.blocks.as_mut())
+}
+
+/// [`rnea_derivatives`] on checked inputs, but for the test of the matrices (which
+/// [`aba_derivatives`](super::aba_derivatives()) makes once, on its own results).
+pub(crate) fn differentiate_at(
+    model: &SpatialModel,
+    data: &mut SpatialData,
+    derivatives: &mut SpatialDerivativeData,
+    q: &[f64],
+    v: &[f64],
+    qdd: &[f64],
+) -> Result<(), DynError> {
     update_poses(model, data, q);
     newton_euler(
         model,
@@ -94,7 +108,7 @@ pub fn rnea_derivatives(
     );
     check::finite_result("tau", &derivatives.value)?;
     differentiate(model, data, derivatives);
-    check::finite_matrix("the derivatives", &derivatives.blocks.as_mut())
+    Ok(())
 }
 
 fn six_motion(m: &Motion) -> Six {
@@ -227,27 +241,17 @@ fn differentiate(
     }
     // Moved out and back (no allocation) so that `Fill` reads the vectors while writing them.
     let mut blocks = std::mem::replace(&mut d.blocks, Mat::new());
-    let mut column = std::mem::take(&mut d.column);
     let (d_q, rest) = blocks.as_mut().split_at_col_mut(n);
     let (d_v, mass) = rest.split_at_col_mut(n);
-    data.arch.dispatch(Fill {
-        d,
-        column: &mut column,
-        d_q,
-        d_v,
-        mass,
-    });
+    data.arch.dispatch(Fill { d, d_q, d_v, mass });
     d.blocks = blocks;
-    d.column = column;
 }
 
 /// The entries of the three matrices from the per-link vectors, column by column, each entry
-/// a sum of products down the component rows in whole SIMD registers (under
-/// [`pulp::Arch::dispatch`]): the column's entries above the diagonal and those on and below
-/// it go to the two halves of `column`, then into the matrix.
+/// a sum of products down the component rows in SIMD registers (under
+/// [`pulp::Arch::dispatch`]), stored straight into the matrices.
 struct Fill<'a> {
     d: &'a SpatialDerivativeData,
-    column: &'a mut [f64],
     d_q: MatMut<'a, f64>,
     d_v: MatMut<'a, f64>,
     mass: MatMut<'a, f64>,
@@ -260,19 +264,15 @@ impl WithSimd for Fill<'_> {
     fn with_simd<S: Simd>(self, simd: S) {
         let Fill {
             d,
-            column,
             mut d_q,
             mut d_v,
             mut mass,
         } = self;
         let n = d.value.len();
-        let width = Pack::<S>::WIDTH;
-        let end = padded(n);
-        let r = |c: usize| &d.rows[c][..end];
+        let r = |c: usize| &d.rows[c][..padded(n)];
         let axes = [r(0), r(1), r(2), r(3), r(4), r(5)];
         let p = [r(6), r(7), r(8), r(9), r(10), r(11)];
         let pq = [r(6), r(7), r(8), r(9), r(10), r(11), r(12), r(13), r(14)];
-        let (above, below) = column.split_at_mut(end);
         for k in 0..n {
             let axis = [0, 1, 2, 3, 4, 5].map(|c| axes[c][k]);
             let p_k = [0, 1, 2, 3, 4, 5].map(|c| p[c][k]);
@@ -291,58 +291,67 @@ impl WithSimd for Fill<'_> {
                 axis[4],
                 axis[5],
             ];
-            // The registers holding rows 0..k (above the diagonal) and k..n.
-            let (upper, lower) = (0..k.next_multiple_of(width), k - k % width..end);
             // i < k: J_i . G_k; i >= k: P_i . beta_k + Q_i . w_k.
-            combine(simd, above, &axes, &d.g[k], upper.clone());
-            combine(simd, below, &pq, &dq, lower.clone());
-            store_column(&mut d_q, k, above, below);
+            let column = column_of(&mut d_q, k);
+            combine(simd, &mut column[..k], &axes, &d.g[k], 0);
+            combine(simd, &mut column[k..], &pq, &dq, k);
             // i < k: J_i . H_k; i >= k: 2 P_i . w_k + Q_i . J_k.
-            combine(simd, above, &axes, &d.h[k], upper.clone());
-            combine(simd, below, &pq, &dv, lower.clone());
-            store_column(&mut d_v, k, above, below);
+            let column = column_of(&mut d_v, k);
+            combine(simd, &mut column[..k], &axes, &d.h[k], 0);
+            combine(simd, &mut column[k..], &pq, &dv, k);
             // M: i < k: J_i . P_k; i >= k: P_i . J_k.
-            combine(simd, above, &axes, &p_k, upper);
-            combine(simd, below, &p, &axis, lower);
-            store_column(&mut mass, k, above, below);
+            let column = column_of(&mut mass, k);
+            combine(simd, &mut column[..k], &axes, &p_k, 0);
+            combine(simd, &mut column[k..], &p, &axis, k);
         }
     }
 }
 
-/// Column `k` of `m`: `above[..k]`, then `below[k..]` (the blocks of a faer `Mat` are
-/// column-major).
+/// Column `k` of `m` as a slice (the blocks of a faer `Mat` are column-major).
 #[inline(always)]
-fn store_column(m: &mut MatMut<'_, f64>, k: usize, above: &[f64], below: &[f64]) {
-    let column = m
-        .as_mut()
+fn column_of<'m>(m: &'m mut MatMut<'_, f64>, k: usize) -> &'m mut [f64] {
+    m.as_mut()
         .col_mut(k)
         .try_as_col_major_mut()
         .expect("the blocks of a faer Mat are column-major")
-        .as_slice_mut();
-    let n = column.len();
-    column[..k].copy_from_slice(&above[..k]);
-    column[k..].copy_from_slice(&below[k..n]);
+        .as_slice_mut()
 }
 
-/// `out[i] = sum_c rows[c][i] x[c]` for the rows `i` of `range`, whole registers of `S`.
+/// `out[j] = sum_c rows[c][first + j] x[c]`, a register of `S` at a time (the rows hold a
+/// whole register past `first + out.len()`; the last, partial register goes through a
+/// buffer).
 #[inline(always)]
 fn combine<S: Simd, const C: usize>(
     simd: S,
     out: &mut [f64],
     rows: &[&[f64]; C],
     x: &[f64; C],
-    range: std::ops::Range<usize>,
+    first: usize,
 ) {
     let width = Pack::<S>::WIDTH;
     let mut factors = [Pack::splat(simd, 0.0); C];
     for (factor, &value) in factors.iter_mut().zip(x) {
         *factor = Pack::splat(simd, value);
     }
-    for at in range.step_by(width) {
-        let mut sum = Pack::load(simd, &rows[0][at..]) * factors[0];
+    let mut at = 0;
+    while at < out.len() {
+        let row = first + at;
+        let mut sum = Pack::load(simd, &rows[0][row..]) * factors[0];
         for c in 1..C {
-            sum = Pack::load(simd, &rows[c][at..]).mul_add(factors[c], sum);
+            sum = Pack::load(simd, &rows[c][row..]).mul_add(factors[c], sum);
         }
-        sum.store(&mut out[at..]);
+        if at + width <= out.len() {
+            sum.store(&mut out[at..]);
+        } else {
+            let mut last = [0.0; MAX_LANES];
+            sum.store(&mut last);
+            for (entry, value) in out[at..].iter_mut().zip(last) {
+                *entry = value;
+            }
+        }
+        at += width;
     }
 }
+
+/// The most `f64` lanes of a register (AVX-512).
+const MAX_LANES: usize = 8;
