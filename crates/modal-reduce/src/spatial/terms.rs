@@ -24,12 +24,13 @@
 //!   transposed, a register of links at a time) and their sines and cosines
 //!   ([`lane_math::sin_cos`]), so that the pass along the chain has no trigonometry left.
 //! - The pass (`accumulate`) is written once over the planar kernel's register layouts
-//!   (`Layout`): one state of `m = 4` or `8` coordinates holds each row of the Jacobians, of
+//!   (`Registers`): one state of `m = 4` or `8` coordinates holds each row of the Jacobians, of
 //!   `M*`, `C*` and `G*` in one register (`CoordinateLanes`), so that a row's update is one
-//!   vector operation; more coordinates go one a number (`OneStateScalar`); a batch holds one
-//!   coordinate of several states a register (`StateLanes`). Each
-//!   entry gets the same operations in the same order in all three, so a state gives the same
-//!   bits alone and in a batch.
+//!   vector operation; `m = 4` in registers of 8 lanes holds each row twice and two rows of `M*`
+//!   a register (`PairedCoordinates`), which halves the work of `M*`; more coordinates go one a
+//!   number (`OneStateScalar`); a batch holds one coordinate of several states a register
+//!   (`StateLanes`). Each entry gets the same operations in the same order in all of them, so a
+//!   state gives the same bits alone and in a batch.
 //! - The rows of `J` per link (`[P_i, 0]`, `[0, P_i]`) are constants of the model, loaded as
 //!   registers.
 //! - The rotational terms are formed in the link's frame, where the inertia is diagonal:
@@ -43,10 +44,10 @@ use super::motion::{Carried, JointTurns, cross_fused, link_step_turned};
 use crate::error::{ReduceError, check_finite_result, check_input};
 use crate::forward::right_hand_side;
 use crate::model::LINK_PADDING;
-use crate::terms::{CoordinateLanes, Layout, OneStateScalar};
+use crate::terms::{CoordinateLanes, OneStateScalar, Registers, StateLanes};
 use backbone_kin::vec3;
 use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
-use lane_math::{Lane, sin_cos, sin_cos_lanes};
+use lane_math::{Lane, Pack, sin_cos, sin_cos_lanes};
 use pulp::{Simd, WithSimd};
 
 /// Computes `M*`, `C*` and `G*` at the modal state `(a, a_dot)` into `data` (read them with
@@ -184,7 +185,8 @@ struct OneStateTerms<'a> {
 }
 
 /// [`accumulate`] of one state of `M` coordinates on stack registers, the coordinates side by
-/// side in one register of `S` where they fit ([`CoordinateLanes`]), else one a number.
+/// side in one register of `S` where they fit ([`CoordinateLanes`]; twice over when they fill
+/// half of it, [`PairedCoordinates`]), else one a number.
 #[inline(always)]
 fn on_stack<S: Simd, const M: usize>(
     simd: S,
@@ -192,7 +194,9 @@ fn on_stack<S: Simd, const M: usize>(
     turns: &TurnsOfLinks<'_>,
     out: OneStateTerms<'_>,
 ) {
-    if M <= S::F64_LANES && S::F64_LANES <= LINK_PADDING {
+    if M == 4 && S::F64_LANES == 2 * M && S::F64_LANES <= LINK_PADDING {
+        in_layout::<_, M, 1>(PairedCoordinates(simd), model, turns, out);
+    } else if M <= S::F64_LANES && S::F64_LANES <= LINK_PADDING {
         in_layout::<_, M, 1>(CoordinateLanes::new(simd, M), model, turns, out);
     } else {
         in_layout::<_, M, M>(OneStateScalar(simd), model, turns, out);
@@ -202,7 +206,7 @@ fn on_stack<S: Simd, const M: usize>(
 /// [`on_stack`] in the layout `layout`, whose rows of `M` coordinates take `C` registers: the
 /// kernel, then the registers' coordinates into `out`.
 #[inline(always)]
-fn in_layout<Y: Layout<Value = f64>, const M: usize, const C: usize>(
+fn in_layout<Y: MassRows<Value = f64>, const M: usize, const C: usize>(
     layout: Y,
     model: &SpatialReducedModel,
     turns: &TurnsOfLinks<'_>,
@@ -227,9 +231,8 @@ fn in_layout<Y: Layout<Value = f64>, const M: usize, const C: usize>(
     };
     let work = accumulate(layout, model, turns, M, work);
     for k in 0..M {
-        let row = &work.mass_matrix[k * C..(k + 1) * C];
         for l in 0..=k {
-            out.mass_matrix[k * M + l] = layout.coordinate(row, l);
+            out.mass_matrix[k * M + l] = layout.mass_entry(work.mass_matrix, M, k, l);
         }
         out.coriolis[k] = layout.coordinate(work.coriolis, k);
         out.gravity[k] = layout.coordinate(work.gravity, k);
@@ -344,8 +347,8 @@ impl<L: Lane> LinkTurns<L> for TurnsFromModes<'_, L> {
 }
 
 /// The buffers of [`accumulate`], in registers of its layout (`c` the layout's
-/// [`chunks`](Layout::chunks) of `m` coordinates): `3 x c` row-major Jacobians `Jw`, `Jo`, `Jv`,
-/// `m Jv` and `I Jw`, `M*` (`m x c`, row `k` coordinate `k`'s), `C*` and `G*` (`c` each).
+/// [`chunks`](Registers::chunks) of `m` coordinates): `3 x c` row-major Jacobians `Jw`, `Jo`, `Jv`,
+/// `m Jv`, `Jb` and `I_b Jb`, `M*` (as [`MassRows`] keeps it), `C*` and `G*` (`c` each).
 pub(crate) struct TermsLanes<'w, R> {
     pub(crate) omega_jacobian: &'w mut [R],
     pub(crate) origin_jacobian: &'w mut [R],
@@ -367,13 +370,13 @@ pub(crate) struct TermsLanes<'w, R> {
 /// entry in all of them. Returns `work`.
 ///
 /// What depends on the link alone (its frame, motion, inertia in the world frame, the torque
-/// and acceleration of `C*`) is one number of each state ([`Layout::Value`]); the rows of the
-/// Jacobians, of `M*`, `C*` and `G*` are registers of coordinates ([`Layout::Register`]). Row
+/// and acceleration of `C*`) is one number of each state ([`Registers::Value`]); the rows of the
+/// Jacobians, of `M*`, `C*` and `G*` are registers of coordinates ([`Registers::Register`]). Row
 /// `2i` of `J` is `[P_i, 0]` and row `2i + 1` is `[0, P_i]` (`P_i` row `i` of the planar map),
 /// both constants of the model ([`SpatialReducedModel::joint_rows`]): the joints add
 /// `u_z [P_i, 0] + u_y [0, P_i]` to every row of `Jw`, a multiply-add a register each.
 #[inline(always)]
-pub(crate) fn accumulate<'w, Y: Layout>(
+pub(crate) fn accumulate<'w, Y: MassRows>(
     layout: Y,
     model: &SpatialReducedModel,
     turns: &impl LinkTurns<Y::Value>,
@@ -406,7 +409,7 @@ pub(crate) fn accumulate<'w, Y: Layout>(
         &mut body_inertia_jacobian[..rows],
     );
     let (mass_matrix, coriolis, gravity_terms) = (
-        &mut mass_matrix[..m * chunks],
+        &mut mass_matrix[..layout.mass_len(m)],
         &mut coriolis[..chunks],
         &mut gravity_terms[..chunks],
     );
@@ -515,19 +518,13 @@ pub(crate) fn accumulate<'w, Y: Layout>(
             coriolis[k] = dot_add(body, torque, dot_add(p, accel, coriolis[k]));
             gravity_terms[k] = gravity_terms[k] - dot_add(p, weight, zero);
         }
-        // M* += (m Jv)^T Jv + Jb^T I_b Jb, row k from coordinate k of m Jv and Jb.
-        for k in 0..m {
-            let p_k = spread(layout, coordinate(layout, momentum_jacobian, chunks, k));
-            let w_k = spread(layout, coordinate(layout, body_jacobian, chunks, k));
-            let row = &mut mass_matrix[k * chunks..(k + 1) * chunks];
-            for (l, entry) in row.iter_mut().enumerate().take(lower_chunks(chunks, k)) {
-                let (v_l, iw_l) = (
-                    column(com_jacobian, chunks, l),
-                    column(body_inertia_jacobian, chunks, l),
-                );
-                *entry = dot_add(w_k, iw_l, dot_add(p_k, v_l, *entry));
-            }
-        }
+        // M* += (m Jv)^T Jv + Jb^T I_b Jb.
+        layout.add_outers(
+            mass_matrix,
+            [momentum_jacobian, body_jacobian],
+            [com_jacobian, body_inertia_jacobian],
+            m,
+        );
     }
     TermsLanes {
         omega_jacobian,
@@ -551,7 +548,7 @@ fn lower_chunks(chunks: usize, k: usize) -> usize {
 
 /// `[x, y, z]` in every coordinate of a register each.
 #[inline(always)]
-fn spread<Y: Layout>(layout: Y, values: [Y::Value; 3]) -> [Y::Register; 3] {
+fn spread<Y: Registers>(layout: Y, values: [Y::Value; 3]) -> [Y::Register; 3] {
     [
         layout.spread(values[0]),
         layout.spread(values[1]),
@@ -561,7 +558,7 @@ fn spread<Y: Layout>(layout: Y, values: [Y::Value; 3]) -> [Y::Register; 3] {
 
 /// Coordinate `k` of the three rows of a `3 x c` matrix of registers.
 #[inline(always)]
-fn coordinate<Y: Layout>(
+fn coordinate<Y: Registers>(
     layout: Y,
     matrix: &[Y::Register],
     chunks: usize,
@@ -572,6 +569,132 @@ fn coordinate<Y: Layout>(
         layout.coordinate(&matrix[chunks..2 * chunks], k),
         layout.coordinate(&matrix[2 * chunks..], k),
     ]
+}
+
+/// How a layout keeps `M*` and adds the link's `(m Jv)^T Jv + Jb^T I_b Jb` to it: by default
+/// row `k` in the layout's registers of `m` coordinates, its lower triangle updated a row at a
+/// time from coordinate `k` of `m Jv` and `Jb` spread over a register.
+pub(crate) trait MassRows: Registers {
+    /// The registers `M*` takes for `m` coordinates.
+    #[inline(always)]
+    fn mass_len(self, m: usize) -> usize {
+        m * self.chunks(m)
+    }
+
+    /// `M* += sum_r a_r b_r^T` on the lower triangle (at least), over the rows `r` of
+    /// `left = [m Jv, Jb]` and `right = [Jv, I_b Jb]` (`3 x c` registers each), `r` in order:
+    /// each entry gets the six multiply-adds in that order in every layout.
+    #[inline(always)]
+    fn add_outers(
+        self,
+        mass: &mut [Self::Register],
+        left: [&[Self::Register]; 2],
+        right: [&[Self::Register]; 2],
+        m: usize,
+    ) {
+        let chunks = self.chunks(m);
+        for k in 0..m {
+            let a = [
+                spread(self, coordinate(self, left[0], chunks, k)),
+                spread(self, coordinate(self, left[1], chunks, k)),
+            ];
+            let row = &mut mass[k * chunks..(k + 1) * chunks];
+            for (l, entry) in row.iter_mut().enumerate().take(lower_chunks(chunks, k)) {
+                for (a, right) in a.iter().zip(right) {
+                    *entry = dot_add(*a, column(right, chunks, l), *entry);
+                }
+            }
+        }
+    }
+
+    /// Entry `(k, l)` of `M*`, `l <= k`.
+    #[inline(always)]
+    fn mass_entry(self, mass: &[Self::Register], m: usize, k: usize, l: usize) -> Self::Value {
+        let chunks = self.chunks(m);
+        self.coordinate(&mass[k * chunks..(k + 1) * chunks], l)
+    }
+}
+
+impl<S: Simd> MassRows for CoordinateLanes<S> {}
+
+impl<S: Simd> MassRows for OneStateScalar<S> {}
+
+impl<S: Simd> MassRows for StateLanes<S> {}
+
+/// One state of 4 coordinates in registers of 8 lanes (AVX-512), each row twice (lanes 0-3 and
+/// 4-7), so that a register holds two rows of `M*`: the outer product `a b^T` adds
+/// `[a_0 a_0 a_0 a_0 a_1 a_1 a_1 a_1] * [b, b]` to rows 0 and 1 and likewise to rows 2 and 3,
+/// two spreads and two multiply-adds where a row a register takes four of each.
+#[derive(Clone, Copy)]
+pub(crate) struct PairedCoordinates<S: Simd>(pub(crate) S);
+
+impl<S: Simd> Registers for PairedCoordinates<S> {
+    type Register = Pack<S>;
+    type Value = f64;
+
+    #[inline(always)]
+    fn register_context(self) -> S {
+        self.0
+    }
+
+    #[inline(always)]
+    fn value_context(self) {}
+
+    #[inline(always)]
+    fn chunks(self, _: usize) -> usize {
+        1
+    }
+
+    #[inline(always)]
+    fn spread(self, value: f64) -> Pack<S> {
+        Pack::splat(self.0, value)
+    }
+
+    #[inline(always)]
+    fn constant_row(self, row: &[f64], _: usize) -> Pack<S> {
+        let mut lanes = [0.0; LINK_PADDING];
+        lanes[..4].copy_from_slice(&row[..4]);
+        lanes[4..].copy_from_slice(&row[..4]);
+        Pack::load(self.0, &lanes)
+    }
+
+    #[inline(always)]
+    fn coordinate(self, row: &[Pack<S>], k: usize) -> f64 {
+        row[0].lane(k)
+    }
+}
+
+impl<S: Simd> MassRows for PairedCoordinates<S> {
+    #[inline(always)]
+    fn mass_len(self, _: usize) -> usize {
+        2
+    }
+
+    #[inline(always)]
+    fn add_outers(
+        self,
+        mass: &mut [Pack<S>],
+        left: [&[Pack<S>]; 2],
+        right: [&[Pack<S>]; 2],
+        _: usize,
+    ) {
+        let mut lanes = [0.0; LINK_PADDING];
+        for (left, right) in left.iter().zip(right) {
+            for (&a, &b) in left[..3].iter().zip(&right[..3]) {
+                a.store(&mut lanes);
+                let [a0, a1, a2, a3, ..] = lanes;
+                let upper = [a0, a0, a0, a0, a1, a1, a1, a1];
+                let lower = [a2, a2, a2, a2, a3, a3, a3, a3];
+                mass[0] = Pack::load(self.0, &upper).mul_add(b, mass[0]);
+                mass[1] = Pack::load(self.0, &lower).mul_add(b, mass[1]);
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn mass_entry(self, mass: &[Pack<S>], _: usize, k: usize, l: usize) -> f64 {
+        mass[k / 2].lane(4 * (k % 2) + l)
+    }
 }
 
 /// `a . b`, a product and two fused multiply-adds, `a[0] b[0]` first.
