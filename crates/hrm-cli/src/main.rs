@@ -4,6 +4,7 @@ mod args;
 mod arm_cmd;
 mod chain_simulate;
 mod console;
+mod deploy_simulate;
 mod eval;
 mod experiment;
 mod figure_parts;

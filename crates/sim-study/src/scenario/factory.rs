@@ -140,6 +140,13 @@ impl Scenario {
         ),
         SimError,
     > {
+        if self.deploy.is_some() {
+            return Err(SimError::setting(
+                "deploy",
+                "runs in joint space with the arm's insertion axis (Scenario::run_deploy, as \
+                 `hrm simulate` runs it), not in the modal loop",
+            ));
+        }
         let model = self.plant()?;
         let m = model.plant().n_coords();
         let reference = match (self.planned_reference(&model)?, &model) {

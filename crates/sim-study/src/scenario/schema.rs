@@ -61,7 +61,31 @@ pub struct Scenario {
     /// reference of kind `"planned"`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub task: Option<TaskSpec>,
+    /// A follow-the-leader deployment into a channel (`[deploy]`, with the reference of kind
+    /// `"planned"`): the arm gets a base insertion axis and runs in joint space
+    /// ([`Scenario::run_deploy`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deploy: Option<DeploySpec>,
 }
+
+/// A channel the arm deploys into by follow-the-leader (`docs/theory.md`, "Follow-the-leader
+/// deployment"): the arm gets a prismatic insertion axis before its first joint, along the
+/// centreline's first segment, and its tip advances to the centreline's end along the
+/// centreline while its body follows the path the tip traced.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeploySpec {
+    /// The centreline `[[x, y], ...]` (m): at least two points, consecutive points distinct, at
+    /// most [`MAX_DEPLOY_CENTERLINE_POINTS`]. The entry is the first point; the arm starts fully
+    /// retracted, its tip at the entry and its body on the guide behind it. Spatial points
+    /// `[x, y, z]` are refused by name (planar channels only).
+    pub centerline: Vec<Vec<f64>>,
+    /// The channel's radius (m, positive): the walls are at this distance from the centreline.
+    pub radius: f64,
+}
+
+/// The most centreline points a scenario's `[deploy]` accepts.
+pub const MAX_DEPLOY_CENTERLINE_POINTS: usize = 10_000;
 
 /// An obstacle, tagged by `kind`. A planar arm moves in the plane `z = 0`: its obstacles are
 /// circles, capsules and boxes given by `[x, y]` points; a spatial arm's are spheres, capsules

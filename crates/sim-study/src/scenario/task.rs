@@ -116,8 +116,8 @@ impl Scenario {
             }
             (ReferenceSpec::Planned { .. }, None) => Err(SimError::setting(
                 "reference",
-                "of kind \"planned\" follows the plan of a [task]: give one ([task] kind = \
-                 \"reach\", target, clearance)",
+                "of kind \"planned\" follows the plan of a [task] or a [deploy]: give one \
+                 ([task] kind = \"reach\", target, clearance)",
             )),
             (_, Some(_)) => Err(SimError::setting(
                 "task",
