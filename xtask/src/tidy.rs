@@ -42,19 +42,10 @@ const FRONT_ENDS: [&str; 3] = ["hrm-cli", "hrm-py", "test-support"];
 /// through, so that the list only shrinks.
 /// - sim-study: `ControllerKind` (a field of the scenario schema) takes its names from the
 ///   controller table, whose constructors read the schema's `[controller]` settings.
-/// - hrm-cli: the eval ops' children share the request helpers of `eval`; `fis export` reads
-///   systems with `fis check`'s helpers.
-const KNOWN_CIRCLES: [(&str, &[&str]); 3] = [
-    (
-        "crates/sim-study",
-        &["scenario::controllers", "scenario::schema"],
-    ),
-    (
-        "crates/hrm-cli",
-        &["eval", "eval::derivatives", "eval::robot", "eval::spatial"],
-    ),
-    ("crates/hrm-cli", &["fis_cmd", "fis_export"]),
-];
+const KNOWN_CIRCLES: [(&str, &[&str]); 1] = [(
+    "crates/sim-study",
+    &["scenario::controllers", "scenario::schema"],
+)];
 
 /// What the closed loop (`sim-core`) must not depend on: files, hashes and threads belong to
 /// the studies above it.

@@ -2,10 +2,10 @@
 //! space at snapshots (two orthogonal projections and an oblique view), the tip's coordinates
 //! against the reference, and per-coordinate modal errors and efforts.
 
-use crate::figures::{snapshot_samples, thin};
+use crate::figure_parts::{self, snapshot_samples, tip, tip_ref};
 use crate::plot::{self, Labels, Panel, Series, Style};
 use clearance::Obstacle;
-use sim_core::{Record, Run};
+use sim_core::Run;
 use sim_study::{ControllerKind, Scenario, Workspace};
 use std::path::Path;
 
@@ -57,20 +57,6 @@ fn oblique(p: [f64; 3]) -> (f64, f64) {
     )
 }
 
-/// The tip at sample `k` of `record`, `[x, y, z]`.
-fn tip(record: &Record, k: usize) -> [f64; 3] {
-    [record.tip[k][0], record.tip[k][1], record.tip_z[k]]
-}
-
-/// The reference tip at sample `k` of `record`, `[x, y, z]`.
-fn tip_ref(record: &Record, k: usize) -> [f64; 3] {
-    [
-        record.tip_ref[k][0],
-        record.tip_ref[k][1],
-        record.tip_ref_z[k],
-    ]
-}
-
 /// The backbone in space every `every_s` seconds of the run (the chain's joints from the
 /// recorded `a(t)` through the modal map and the universal-joint chain's forward kinematics,
 /// light to dark with time), with the reference path, the tip's path and the scenario's
@@ -104,58 +90,13 @@ pub fn backbone_in_space(
             Ok((k, joints))
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let last = arms.len().saturating_sub(1).max(1) as f64;
     let obstacles = scenario
         .obstacles(Workspace::Spatial)
         .map_err(|e| e.to_string())?;
     let views: Vec<(Labels<'_>, Vec<(Series, Style)>)> = VIEWS
         .iter()
         .map(|view| {
-            let mut curves: Vec<(Series, Style)> = arms
-                .iter()
-                .enumerate()
-                .map(|(i, (k, joints))| {
-                    let shade =
-                        |light: f64, dark: f64| (light + (dark - light) * i as f64 / last) as u8;
-                    let label = if i == 0 || i + 1 == arms.len() {
-                        format!("arm at t = {:.1} s", record.t[*k])
-                    } else {
-                        String::new()
-                    };
-                    let series = Series {
-                        label,
-                        points: joints.iter().map(|&p| (view.project)(p)).collect(),
-                    };
-                    let style = Style {
-                        colour: (shade(170.0, 10.0), shade(200.0, 40.0), shade(240.0, 140.0)),
-                        width: 2,
-                        dots: true,
-                    };
-                    (series, style)
-                })
-                .collect();
-            curves.push((
-                Series {
-                    label: "reference path".into(),
-                    points: thin(record, |r, k| (view.project)(tip_ref(r, k))),
-                },
-                Style {
-                    colour: (220, 30, 30),
-                    width: 3,
-                    dots: false,
-                },
-            ));
-            curves.push((
-                Series {
-                    label: "tip".into(),
-                    points: thin(record, |r, k| (view.project)(tip(r, k))),
-                },
-                Style {
-                    colour: (20, 150, 60),
-                    width: 1,
-                    dots: false,
-                },
-            ));
+            let mut curves = figure_parts::backbone_curves(record, &arms, view.project);
             curves.extend(obstacle_outlines(&obstacles, view.project));
             let labels = Labels {
                 title: view.title,
@@ -165,15 +106,8 @@ pub fn backbone_in_space(
             (labels, curves)
         })
         .collect();
-    plot::xy_views(
-        path,
-        &format!(
-            "Backbone every {every_s} s, {} with {}",
-            scenario.name,
-            controller.name()
-        ),
-        &views,
-    )
+    let title = figure_parts::backbone_title(every_s, &scenario.name, controller);
+    plot::xy_views(path, &title, &views)
 }
 
 /// The tip's `x`, `y` and `z` over time for every run against the reference, one panel each.
@@ -182,37 +116,23 @@ pub fn tip_paths(
     scenario: &str,
     runs: &[(ControllerKind, &Run)],
 ) -> Result<(), String> {
-    let first = runs
-        .first()
-        .ok_or_else(|| format!("{}: no runs to plot", path.display()))?;
-    let series: Vec<Vec<Series>> = (0..3)
-        .map(|d| {
-            runs.iter()
-                .map(|(kind, run)| Series {
-                    label: kind.name().into(),
-                    points: thin(&run.record, |r, k| (r.t[k], tip(r, k)[d])),
-                })
-                .chain(std::iter::once(Series {
-                    label: "reference".into(),
-                    points: thin(&first.1.record, |r, k| (r.t[k], tip_ref(r, k)[d])),
-                }))
-                .collect()
+    let rows = ["tip x (m)", "tip y (m)", "tip z (m)"]
+        .into_iter()
+        .enumerate()
+        .map(|(d, y)| {
+            let series = figure_parts::against_reference(
+                path,
+                runs,
+                |r, k| tip(r, k)[d],
+                |r, k| tip_ref(r, k)[d],
+            )?;
+            Ok((y.to_owned(), series))
         })
-        .collect();
-    let panels: Vec<Panel<'_>> = series
-        .iter()
-        .zip(["tip x (m)", "tip y (m)", "tip z (m)"])
-        .map(|(series, y)| Panel {
-            y,
-            series,
-            y_range: None,
-        })
-        .collect();
-    plot::stacked_line_charts(
+        .collect::<Result<Vec<_>, String>>()?;
+    figure_parts::over_time(
         path,
         &format!("Tip against the reference, {scenario}"),
-        "t (s)",
-        &panels,
+        &rows,
     )
 }
 
@@ -233,41 +153,25 @@ pub fn per_coordinate(
     runs: &[(ControllerKind, &Run)],
     what: CoordinateSeries,
 ) -> Result<(), String> {
-    let value = |r: &Record, k: usize, i: usize| match what {
-        CoordinateSeries::Error => 1e3 * (r.a_at(k)[i] - r.a_ref_at(k)[i]),
-        CoordinateSeries::Effort => r.tau_star_at(k)[i],
-    };
-    let series: Vec<Vec<Series>> = (0..names.len())
-        .map(|i| {
-            runs.iter()
-                .map(|(kind, run)| Series {
-                    label: kind.name().into(),
-                    points: thin(&run.record, |r, k| (r.t[k], value(r, k, i))),
-                })
-                .collect()
-        })
-        .collect();
-    let labels: Vec<String> = names
+    let rows: Vec<(String, Vec<Series>)> = names
         .iter()
-        .map(|name| match what {
-            CoordinateSeries::Error => format!("{name} - ref (mrad)"),
-            CoordinateSeries::Effort => format!("tau*_{name} (N m)"),
-        })
-        .collect();
-    let panels: Vec<Panel<'_>> = series
-        .iter()
-        .zip(&labels)
-        .map(|(series, y)| Panel {
-            y,
-            series,
-            y_range: None,
+        .enumerate()
+        .map(|(i, name)| match what {
+            CoordinateSeries::Error => (
+                format!("{name} - ref (mrad)"),
+                figure_parts::run_series(runs, |r, k| 1e3 * (r.a_at(k)[i] - r.a_ref_at(k)[i])),
+            ),
+            CoordinateSeries::Effort => (
+                format!("tau*_{name} (N m)"),
+                figure_parts::run_series(runs, |r, k| r.tau_star_at(k)[i]),
+            ),
         })
         .collect();
     let title = match what {
         CoordinateSeries::Error => format!("Modal errors, {scenario}"),
         CoordinateSeries::Effort => format!("Modal forces tau*, {scenario}"),
     };
-    plot::stacked_line_charts(path, &title, "t (s)", &panels)
+    figure_parts::over_time(path, &title, &rows)
 }
 
 /// Points on each outline circle of [`obstacle_outlines`].

@@ -18,7 +18,7 @@
 
 use lane_math::Lane;
 
-use super::algebra::{Force, Motion, Symmetric6, Transform, Vec3, splat3};
+use super::algebra::{Force, Mat3, Motion, Symmetric6, Transform, Vec3, splat3, sub};
 use super::data::{AbaLink, SpatialData};
 use super::kinematics::joint_placement;
 use super::model::SpatialModel;
@@ -81,14 +81,28 @@ pub(crate) struct AbaBuffers<'a, T> {
 
 #[inline(always)]
 fn get3<L: AbaLane>(context: L::Context, slots: &[L::Slot; 3]) -> Vec3<L> {
-    [0, 1, 2].map(|k| L::get(context, &slots[k]))
+    [
+        L::get(context, &slots[0]),
+        L::get(context, &slots[1]),
+        L::get(context, &slots[2]),
+    ]
+}
+
+#[inline(always)]
+fn get33<L: AbaLane>(context: L::Context, slots: &[[L::Slot; 3]; 3]) -> Mat3<L> {
+    [
+        get3::<L>(context, &slots[0]),
+        get3::<L>(context, &slots[1]),
+        get3::<L>(context, &slots[2]),
+    ]
 }
 
 #[inline(always)]
 fn set3<L: AbaLane>(values: Vec3<L>, slots: &mut [L::Slot; 3]) {
-    for (value, slot) in values.into_iter().zip(slots.iter_mut()) {
-        value.set(slot);
-    }
+    let [x, y, z] = values;
+    x.set(&mut slots[0]);
+    y.set(&mut slots[1]);
+    z.set(&mut slots[2]);
 }
 
 /// The articulated-body algorithm for `L::WIDTH` states: `inputs` are `q`, `v` and `tau`, each
@@ -190,7 +204,7 @@ pub(crate) fn kernel<L: AbaLane>(
         residual.set(&mut link.residual);
         if i > 0 {
             let placement = Transform {
-                rotation: [0, 1, 2].map(|r| get3::<L>(context, &link.rotation[r])),
+                rotation: get33::<L>(context, &link.rotation),
                 translation: get3::<L>(context, &link.translation),
             };
             let bias = Motion {
@@ -208,12 +222,12 @@ pub(crate) fn kernel<L: AbaLane>(
 
     // Base to tip: accelerations.
     let mut acceleration = Motion {
-        linear: splat3(context, model.gravity()).map(|g| zero - g),
+        linear: sub(zero3, splat3(context, model.gravity())),
         angular: zero3,
     };
     for (i, link) in links.iter().enumerate() {
         let placement = Transform {
-            rotation: [0, 1, 2].map(|r| get3::<L>(context, &link.rotation[r])),
+            rotation: get33::<L>(context, &link.rotation),
             translation: get3::<L>(context, &link.translation),
         };
         let bias = Motion {

@@ -10,7 +10,9 @@ use super::links::{
 use crate::data::Pair;
 use crate::model::{LINK_PADDING, ReducedModel};
 
-/// How the kernel's numbers sit in registers (see the [module documentation](super)).
+/// How the kernel's numbers sit in registers (see the [module documentation](super)). The
+/// spatial kernel ([`spatial::terms`](crate::spatial::terms)) shares the layouts, through the
+/// methods up to [`coordinate`](Self::coordinate) only.
 pub(crate) trait Layout: Copy {
     /// A register of the pass: several coordinates of one state, or one coordinate (of one state
     /// or of several side by side).
