@@ -336,7 +336,7 @@ pub enum TaskSpec {
     /// and from the other links, on the goal shape and all along the motion to it
     /// ([`Scenario::plan`]).
     Reach {
-        /// The target `[x, y]` (m).
+        /// The target (m): `[x, y]` in a planar arm's plane, `[x, y, z]` for a spatial arm.
         target: Vec<f64>,
         /// The margin (m, non-negative).
         clearance: f64,
