@@ -63,7 +63,7 @@ pub struct SpatialDerivativeData {
     /// `[d tau / d q | d tau / d v]` while `aba_derivatives` multiplies it by `-M^-1`.
     pub(crate) rhs: Mat<f64>,
     /// The force, then motion, columns of the `O(n^2)` `M^-1` by component (`aba_derivatives`).
-    pub(crate) sweep: [Vec<f64>; 6],
+    pub(crate) sweep: [Vec<f64>; 7],
 }
 
 impl SpatialDerivativeData {
@@ -98,7 +98,7 @@ impl SpatialDerivativeData {
             momentum: vec![[0.0; 3]; sized],
             coriolis: vec![[[0.0; 3]; 3]; sized],
             rhs: Mat::zeros(sized, 2 * sized),
-            sweep: std::array::from_fn(|_| vec![0.0; sized]),
+            sweep: std::array::from_fn(|_| vec![0.0; padded(sized)]),
         };
         derivatives.warm_up();
         derivatives
