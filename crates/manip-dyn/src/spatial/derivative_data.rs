@@ -2,8 +2,7 @@
 //! ([`rnea_derivatives`](super::rnea_derivatives()) and
 //! [`aba_derivatives`](super::aba_derivatives())).
 
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatRef, Par};
+use faer::{Mat, MatRef};
 
 use super::algebra::{Mat3, Symmetric6, Vec3};
 use super::model::SpatialModel;
@@ -63,7 +62,7 @@ pub struct SpatialDerivativeData {
     /// `[d tau / d q | d tau / d v]` while `aba_derivatives` multiplies it by `-M^-1`.
     pub(crate) rhs: Mat<f64>,
     /// The force, then motion, columns of the `O(n^2)` `M^-1` by component (`aba_derivatives`).
-    pub(crate) sweep: [Vec<f64>; 6],
+    pub(crate) sweep: [Vec<f64>; 7],
 }
 
 impl SpatialDerivativeData {
@@ -84,7 +83,7 @@ impl SpatialDerivativeData {
     fn sized(n: usize) -> SpatialDerivativeData {
         let sized = if n <= MAX_DENSE_LINKS { n } else { 0 };
         let six = || vec![[0.0; 6]; sized];
-        let mut derivatives = SpatialDerivativeData {
+        SpatialDerivativeData {
             n,
             value: vec![0.0; sized],
             accelerations: vec![0.0; sized],
@@ -98,26 +97,8 @@ impl SpatialDerivativeData {
             momentum: vec![[0.0; 3]; sized],
             coriolis: vec![[[0.0; 3]; 3]; sized],
             rhs: Mat::zeros(sized, 2 * sized),
-            sweep: std::array::from_fn(|_| vec![0.0; sized]),
-        };
-        derivatives.warm_up();
-        derivatives
-    }
-
-    /// faer's matrix product (from about 64 rows) multiplies with a kernel that allocates a
-    /// packing buffer per thread on first use: one product here takes that allocation out of
-    /// the first [`aba_derivatives`](super::aba_derivatives()) on this thread.
-    fn warm_up(&mut self) {
-        let n = self.value.len();
-        let (mut jacobians, minv) = self.blocks.as_mut().split_at_col_mut(2 * n);
-        matmul(
-            jacobians.as_mut(),
-            Accum::Replace,
-            minv.as_ref(),
-            self.rhs.as_ref(),
-            -1.0,
-            Par::Seq,
-        );
+            sweep: std::array::from_fn(|_| vec![0.0; padded(sized)]),
+        }
     }
 
     /// Number of links of the chain this workspace was built for.

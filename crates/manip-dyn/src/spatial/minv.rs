@@ -21,26 +21,29 @@
 //! with `S_i`, `U_i` carried there by link `i`'s pose (the pairings `S . F` and `U . a` are
 //! frame-free), `F_{i-1}[:, j] = F_i[:, j] + U_i m_ij` and `a_i[:, j] = a_{i-1}[:, j] +
 //! S_i (M^-1)_ij`, so each entry costs two 6-vector dot products and two 6-vector updates,
-//! computed along the row `j = i..n` with the columns of `F` and `a` stored by component.
+//! computed along the row `j = i..n`, a SIMD register of entries at a time, with the columns of
+//! `F` and `a` stored by component.
 
 use faer::MatMut;
 use pulp::{Arch, Simd, WithSimd};
 
 use super::algebra::{Force, Transform};
 use super::data::AbaLink;
-use super::derivative_data::Six;
+use super::derivative_data::{Six, padded};
 use super::model::SpatialModel;
+use lane_math::{Lane, Pack};
 
 /// `M^-1` into `minv` (`n x n`) from `links`, the articulated quantities of an
 /// [`aba`](super::aba()) at the same `q` (whose pivots it checked), and `poses`, the links'
-/// poses in the base frame at that `q`, with `sweep` (6 rows of at least `n`) as scratch.
+/// poses in the base frame at that `q`, with `sweep` (7 rows of
+/// [`padded`]`(n)`) as scratch.
 /// Allocation-free.
 pub(crate) fn inverse_mass_matrix(
     arch: Arch,
     model: &SpatialModel,
     links: &[AbaLink<f64>],
     poses: &[Transform],
-    sweep: &mut [Vec<f64>; 6],
+    sweep: &mut [Vec<f64>; 7],
     minv: MatMut<'_, f64>,
 ) {
     arch.dispatch(Sweeps {
@@ -58,7 +61,7 @@ struct Sweeps<'a> {
     model: &'a SpatialModel,
     links: &'a [AbaLink<f64>],
     poses: &'a [Transform],
-    sweep: &'a mut [Vec<f64>; 6],
+    sweep: &'a mut [Vec<f64>; 7],
     minv: MatMut<'a, f64>,
 }
 
@@ -95,7 +98,7 @@ impl WithSimd for Sweeps<'_> {
     type Output = ();
 
     #[inline(always)]
-    fn with_simd<S: Simd>(self, _: S) {
+    fn with_simd<S: Simd>(self, simd: S) {
         let Sweeps {
             model,
             links,
@@ -104,73 +107,73 @@ impl WithSimd for Sweeps<'_> {
             mut minv,
         } = self;
         let n = model.n_links();
-        let [r0, r1, r2, r3, r4, r5] = sweep;
-        let rows = [
-            &mut r0[..n],
-            &mut r1[..n],
-            &mut r2[..n],
-            &mut r3[..n],
-            &mut r4[..n],
-            &mut r5[..n],
+        let width = Pack::<S>::WIDTH;
+        let end = padded(n);
+        // Rows 0-5: F (then a) by component; row 6: the entries of one row of the triangle.
+        // All start at zero and stay zero past `n`, so whole registers can be read anywhere.
+        for row in sweep.iter_mut() {
+            row[..end].fill(0.0);
+        }
+        let [r0, r1, r2, r3, r4, r5, entries] = sweep;
+        let mut f = [
+            &mut r0[..end],
+            &mut r1[..end],
+            &mut r2[..end],
+            &mut r3[..end],
+            &mut r4[..end],
+            &mut r5[..end],
         ];
-        let [f0, f1, f2, f3, f4, f5] = rows;
+        let entries = &mut entries[..end];
         // Entry (i, j), j >= i, is kept at (j, i): column i of the lower triangle, contiguous.
-        // Tip to base (S1, S2), F by component in f0..f5.
+        // Tip to base (S1, S2).
         for i in (0..n).rev() {
-            let [s, u] = world(model, links, poses, i);
-            let inverse = links[i].inverse;
-            let column = column_of(&mut minv, i);
-            column[i] = inverse;
-            for j in i + 1..n {
-                let dot = s[0] * f0[j]
-                    + s[1] * f1[j]
-                    + s[2] * f2[j]
-                    + s[3] * f3[j]
-                    + s[4] * f4[j]
-                    + s[5] * f5[j];
-                column[j] = -inverse * dot;
+            let [s, u] = registers(simd, world(model, links, poses, i));
+            let inverse = Pack::splat(simd, -links[i].inverse);
+            let mut j = i;
+            while j < n {
+                let mut dot = Pack::load(simd, &f[0][j..]) * s[0];
+                for c in 1..6 {
+                    dot = Pack::load(simd, &f[c][j..]).mul_add(s[c], dot);
+                }
+                (inverse * dot).store(&mut entries[j..]);
+                j += width;
             }
-            f0[i] = 0.0;
-            f1[i] = 0.0;
-            f2[i] = 0.0;
-            f3[i] = 0.0;
-            f4[i] = 0.0;
-            f5[i] = 0.0;
-            for j in i..n {
-                let m = column[j];
-                f0[j] += u[0] * m;
-                f1[j] += u[1] * m;
-                f2[j] += u[2] * m;
-                f3[j] += u[3] * m;
-                f4[j] += u[4] * m;
-                f5[j] += u[5] * m;
+            entries[i] = links[i].inverse;
+            let mut j = i;
+            while j < n {
+                let m = Pack::load(simd, &entries[j..]);
+                for c in 0..6 {
+                    let updated = m.mul_add(u[c], Pack::load(simd, &f[c][j..]));
+                    updated.store(&mut f[c][j..]);
+                }
+                j += width;
             }
+            column_of(&mut minv, i)[i..].copy_from_slice(&entries[i..n]);
         }
         // Base to tip (S3), a by component in the same rows.
-        let [a0, a1, a2, a3, a4, a5] = [f0, f1, f2, f3, f4, f5];
-        for row in [&mut *a0, &mut *a1, &mut *a2, &mut *a3, &mut *a4, &mut *a5] {
+        for row in f.iter_mut() {
             row.fill(0.0);
         }
         for i in 0..n {
-            let [s, u] = world(model, links, poses, i);
-            let inverse = links[i].inverse;
+            let [s, u] = registers(simd, world(model, links, poses, i));
+            let inverse = Pack::splat(simd, links[i].inverse);
             let column = column_of(&mut minv, i);
-            for j in i..n {
-                let dot = u[0] * a0[j]
-                    + u[1] * a1[j]
-                    + u[2] * a2[j]
-                    + u[3] * a3[j]
-                    + u[4] * a4[j]
-                    + u[5] * a5[j];
-                let entry = column[j] - inverse * dot;
-                column[j] = entry;
-                a0[j] += s[0] * entry;
-                a1[j] += s[1] * entry;
-                a2[j] += s[2] * entry;
-                a3[j] += s[3] * entry;
-                a4[j] += s[4] * entry;
-                a5[j] += s[5] * entry;
+            entries[i..n].copy_from_slice(&column[i..]);
+            let mut j = i;
+            while j < n {
+                let mut dot = Pack::load(simd, &f[0][j..]) * u[0];
+                for c in 1..6 {
+                    dot = Pack::load(simd, &f[c][j..]).mul_add(u[c], dot);
+                }
+                let entry = inverse.neg_mul_add(dot, Pack::load(simd, &entries[j..]));
+                entry.store(&mut entries[j..]);
+                for c in 0..6 {
+                    let updated = entry.mul_add(s[c], Pack::load(simd, &f[c][j..]));
+                    updated.store(&mut f[c][j..]);
+                }
+                j += width;
             }
+            column[i..].copy_from_slice(&entries[i..n]);
         }
         for i in 0..n {
             for j in i + 1..n {
@@ -178,6 +181,18 @@ impl WithSimd for Sweeps<'_> {
             }
         }
     }
+}
+
+/// `S_i` and `U_i` of [`world`] in every lane.
+#[inline(always)]
+fn registers<S: Simd>(simd: S, vectors: [Six; 2]) -> [[Pack<S>; 6]; 2] {
+    let mut out = [[Pack::splat(simd, 0.0); 6]; 2];
+    for (lanes, vector) in out.iter_mut().zip(vectors) {
+        for (lane, value) in lanes.iter_mut().zip(vector) {
+            *lane = Pack::splat(simd, value);
+        }
+    }
+    out
 }
 
 /// Column `k` of `m` as a slice (a faer `Mat`'s blocks are column-major).
