@@ -16,6 +16,7 @@
 //! modal coordinates at each step are the least-squares fit `a = argmin |J a + theta_0 -
 //! theta_FTL|`, exact when `2K = n`. The metrics are those of the chain the fit realises.
 
+use crate::deploy_metrics::{DeployMetrics, DeployTracker};
 use crate::error::{PlanError, check_finite};
 use backbone_kin::{BaseAngle, ModalMap, joint_positions};
 use optimal_ctl::LinearQp;
@@ -27,8 +28,6 @@ pub const MAX_DEPLOY_STEPS: usize = 10_000;
 /// The most the centreline may be longer than the shortest link, as a ratio (bounds the
 /// backward search of each joint).
 pub const MAX_LENGTH_RATIO: f64 = 1e6;
-/// Points per link at which the body's distances to the path and the walls are sampled.
-const SAMPLES_PER_LINK: usize = 32;
 
 /// A planar channel: a centreline polyline (the plane `z = 0`) and its radius.
 #[derive(Debug, Clone, PartialEq)]
@@ -153,21 +152,6 @@ pub struct DeployFrame {
     pub points: Vec<[f64; 2]>,
 }
 
-/// What a deployment achieved, over all its steps (realised by the modal chain).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DeployMetrics {
-    /// The largest distance of the tip from the centreline, m.
-    pub tip_error: f64,
-    /// The largest distance of the body from the path its tip traced (with the axis behind the
-    /// entry), as a percentage of the deployed length at that step.
-    pub shape_deviation_percent: f64,
-    /// The smallest clearance of the links' capsules to the channel's walls, m (sampled at
-    /// `32` points a link; the sampling can overstate it by at most `L_max / 64`).
-    pub min_wall_clearance: f64,
-    /// The final deployed length (the tip's progress), m.
-    pub deployed_length: f64,
-}
-
 /// A deployment: its steps and metrics.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Deployment {
@@ -192,7 +176,6 @@ pub fn follow_the_leader(
     depth: f64,
     steps: usize,
 ) -> Result<Deployment, PlanError> {
-    check_finite("link radius", link_radius)?;
     check_finite("deploy depth", depth)?;
     if !(0.0..=channel.length()).contains(&depth) {
         return Err(PlanError::OutOfRange {
@@ -233,13 +216,7 @@ pub fn follow_the_leader(
     let mut frames = Vec::with_capacity(steps + 1);
     let mut sigma = vec![0.0; n + 1];
     let mut joints = vec![[0.0; 2]; n + 1];
-    let mut traced: Vec<[f64; 2]> = Vec::with_capacity(steps + 1);
-    let mut metrics = DeployMetrics {
-        tip_error: 0.0,
-        shape_deviation_percent: 0.0,
-        min_wall_clearance: f64::INFINITY,
-        deployed_length: depth,
-    };
+    let mut tracker = DeployTracker::new(channel, link_lengths, link_radius)?;
     for step in 0..=steps {
         let tau = depth * step as f64 / steps as f64;
         // Joints on Gamma, from the tip back.
@@ -288,30 +265,7 @@ pub fn follow_the_leader(
             p[0] += joints[0][0];
             p[1] += joints[0][1];
         }
-        // Metrics of the realised chain.
-        let tip = points[n];
-        traced.push(tip);
-        metrics.tip_error = metrics.tip_error.max(channel.distance(tip));
-        let deployed = tau.max(f64::EPSILON);
-        let mut deviation: f64 = 0.0;
-        for pair in points.windows(2) {
-            for s in 0..=SAMPLES_PER_LINK {
-                let t = s as f64 / SAMPLES_PER_LINK as f64;
-                let x = [
-                    pair[0][0] + t * (pair[1][0] - pair[0][0]),
-                    pair[0][1] + t * (pair[1][1] - pair[0][1]),
-                ];
-                metrics.min_wall_clearance = metrics
-                    .min_wall_clearance
-                    .min(channel.radius - link_radius - channel.distance(x));
-                deviation = deviation.max(traced_distance(channel, &traced, x));
-            }
-        }
-        if tau > 0.0 {
-            metrics.shape_deviation_percent = metrics
-                .shape_deviation_percent
-                .max(100.0 * deviation / deployed);
-        }
+        tracker.add(&points, tau);
         frames.push(DeployFrame {
             progress: tau,
             insertion: base_sigma + length,
@@ -320,7 +274,10 @@ pub fn follow_the_leader(
             points,
         });
     }
-    Ok(Deployment { frames, metrics })
+    Ok(Deployment {
+        frames,
+        metrics: tracker.metrics(),
+    })
 }
 
 /// The largest `sigma < from` (searched backwards in steps of a tenth of the chord, then
@@ -353,25 +310,11 @@ fn unwrap(previous: f64, angle: f64) -> f64 {
     angle - turns * std::f64::consts::TAU
 }
 
-/// The distance of `x` from the tip's traced polyline joined to the axis behind the entry.
-fn traced_distance(channel: &Channel, traced: &[[f64; 2]], x: [f64; 2]) -> f64 {
-    let (e, d) = (channel.entry(), channel.axis());
-    let along = ((x[0] - e[0]) * d[0] + (x[1] - e[1]) * d[1]).min(0.0);
-    let mut best = dist(x, [e[0] + along * d[0], e[1] + along * d[1]]);
-    if let Some(first) = traced.first() {
-        best = best.min(point_segment(x, e, *first));
-    }
-    for pair in traced.windows(2) {
-        best = best.min(point_segment(x, pair[0], pair[1]));
-    }
-    best
-}
-
-fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+pub(crate) fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
-fn point_segment(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+pub(crate) fn point_segment(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let d = [b[0] - a[0], b[1] - a[1]];
     let length2 = d[0] * d[0] + d[1] * d[1];
     let t = if length2 > 0.0 {

@@ -3,6 +3,7 @@
 mod arm;
 mod data;
 mod deploy;
+mod deploy_metrics;
 mod error;
 mod generator;
 mod motion;
@@ -15,9 +16,10 @@ mod spatial;
 pub use arm::{Arm, ArmScratch};
 pub use data::PlanData;
 pub use deploy::{
-    Channel, DeployFrame, DeployMetrics, Deployment, MAX_CENTERLINE_POINTS, MAX_DEPLOY_STEPS,
-    MAX_LENGTH_RATIO, follow_the_leader,
+    Channel, DeployFrame, Deployment, MAX_CENTERLINE_POINTS, MAX_DEPLOY_STEPS, MAX_LENGTH_RATIO,
+    follow_the_leader,
 };
+pub use deploy_metrics::{DeployMetrics, DeploySample, DeployTracker, SAMPLES_PER_LINK};
 pub use error::PlanError;
 pub use generator::{
     MAX_PASSAGE_OBSTACLES, NarrowPassage, PassageSpec, narrow_passage, spatial_narrow_passage,
