@@ -207,12 +207,12 @@ fn group<S: Simd, const M: usize>(
     }
     let [a, a_dot, tau_star] = lanes;
     let mut jacobians = [[[zero; M]; 3]; 6];
-    let [omega, origin, com, momentum, body, body_inertia] = &mut jacobians;
+    let [omega, point, com, momentum, body, body_inertia] = &mut jacobians;
     let mut mass = [[zero; M]; M];
     let (mut coriolis, mut gravity) = ([zero; M], [zero; M]);
     let work = TermsLanes {
         omega_jacobian: omega.as_flattened_mut(),
-        origin_jacobian: origin.as_flattened_mut(),
+        point_jacobian: point.as_flattened_mut(),
         com_jacobian: com.as_flattened_mut(),
         momentum_jacobian: momentum.as_flattened_mut(),
         body_jacobian: body.as_flattened_mut(),

@@ -2,10 +2,12 @@
 //! (`docs/theory.md`, section 8).
 //!
 //! The modal rates move link `i` with angular velocity `w_i = Jw_i a_dot` and its centre of mass
-//! with velocity `v_i = Jv_i a_dot`, where `Jw_i = sum_j u_j J_j` and `Jv_i = Jo_i - [c_i]x Jw_i`,
-//! `Jo_i = sum_j (o_j x u_j) J_j` (the velocity of the world origin moving with the link), sums
-//! over the joints `j` up to link `i` (`u_j` the joint's axis, `o_j` its point, `J_j` its row of
-//! the modal map): both `3 x m`, updated joint by joint in `O(m)`. Then, from the kinetic energy
+//! with velocity `v_i = Jv_i a_dot`, where `Jw_i = sum_j u_j J_j` (sum over the joints `j` up to
+//! link `i`, `u_j` the joint's axis, `J_j` its row of the modal map) and
+//! `Jv_i = Jp_i + Jw_i x (c_i - p_{i-1})`, `Jp_i` the velocity Jacobian of the joint point
+//! `p_{i-1}` (the link's two joints turn about it, so it moves with link `i - 1`):
+//! `Jp_{i+1} = Jp_i + Jw_i x (p_i - p_{i-1}) = 2 Jv_i - Jp_i` (the centre of mass at the
+//! midpoint), `3 x m` each, updated link by link in `O(m)`. Then, from the kinetic energy
 //! `T = (1/2) sum_i m_i |v_i|^2 + w_i^T I_i w_i` and the potential `V = -sum_i m_i g . c_i`,
 //!
 //! - `M* = sum_i m_i Jv_i^T Jv_i + Jw_i^T I_i Jw_i` (`I_i` the inertia about the centre of mass
@@ -112,7 +114,7 @@ impl WithSimd for TermsOfOneState<'_> {
             link_sin,
             link_cos,
             omega_jacobian,
-            origin_jacobian,
+            point_jacobian,
             com_jacobian,
             momentum_jacobian,
             body_jacobian,
@@ -150,7 +152,7 @@ impl WithSimd for TermsOfOneState<'_> {
             m => {
                 let work = TermsLanes {
                     omega_jacobian,
-                    origin_jacobian,
+                    point_jacobian,
                     com_jacobian,
                     momentum_jacobian,
                     body_jacobian,
@@ -215,12 +217,12 @@ fn in_layout<Y: MassRows<Value = f64>, const M: usize, const C: usize>(
     let zero = Y::Register::splat(layout.register_context(), 0.0);
     debug_assert_eq!(layout.chunks(M), C);
     let mut jacobians = [[[zero; C]; 3]; 6];
-    let [omega, origin, com, momentum, body, body_inertia] = &mut jacobians;
+    let [omega, point, com, momentum, body, body_inertia] = &mut jacobians;
     let mut mass = [[zero; C]; M];
     let (mut coriolis, mut gravity) = ([zero; C], [zero; C]);
     let work = TermsLanes {
         omega_jacobian: omega.as_flattened_mut(),
-        origin_jacobian: origin.as_flattened_mut(),
+        point_jacobian: point.as_flattened_mut(),
         com_jacobian: com.as_flattened_mut(),
         momentum_jacobian: momentum.as_flattened_mut(),
         body_jacobian: body.as_flattened_mut(),
@@ -351,7 +353,7 @@ impl<L: Lane> LinkTurns<L> for TurnsFromModes<'_, L> {
 /// `m Jv`, `Jb` and `I_b Jb`, `M*` (as [`MassRows`] keeps it), `C*` and `G*` (`c` each).
 pub(crate) struct TermsLanes<'w, R> {
     pub(crate) omega_jacobian: &'w mut [R],
-    pub(crate) origin_jacobian: &'w mut [R],
+    pub(crate) point_jacobian: &'w mut [R],
     pub(crate) com_jacobian: &'w mut [R],
     pub(crate) momentum_jacobian: &'w mut [R],
     pub(crate) body_jacobian: &'w mut [R],
@@ -390,7 +392,7 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
     let chunks = layout.chunks(m);
     let TermsLanes {
         omega_jacobian,
-        origin_jacobian,
+        point_jacobian,
         com_jacobian,
         momentum_jacobian,
         body_jacobian,
@@ -400,8 +402,8 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
         gravity: gravity_terms,
     } = work;
     let rows = 3 * chunks;
-    let (omega_jacobian, origin_jacobian) =
-        (&mut omega_jacobian[..rows], &mut origin_jacobian[..rows]);
+    let (omega_jacobian, point_jacobian) =
+        (&mut omega_jacobian[..rows], &mut point_jacobian[..rows]);
     let (com_jacobian, momentum_jacobian) =
         (&mut com_jacobian[..rows], &mut momentum_jacobian[..rows]);
     let (body_jacobian, body_inertia_jacobian) = (
@@ -415,7 +417,7 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
     );
     for buffer in [
         &mut *omega_jacobian,
-        &mut *origin_jacobian,
+        &mut *point_jacobian,
         &mut *mass_matrix,
         &mut *coriolis,
         &mut *gravity_terms,
@@ -435,12 +437,8 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
     let per_link = model.map().link_lengths().iter().zip(model.links());
     for (i, (&length, inertia)) in per_link.enumerate() {
         let motion = link_step_turned(context, &mut carried, length, turns.turns(i), None);
-        // Jw += u_z [P_i, 0] + u_y [0, P_i] and Jo likewise with o x u, row by row.
+        // Jw += u_z [P_i, 0] + u_y [0, P_i], row by row.
         let (u_z, u_y) = (spread(layout, motion.u_z), spread(layout, motion.u_y));
-        let (o_z, o_y) = (
-            spread(layout, cross_fused(motion.joint, motion.u_z)),
-            spread(layout, cross_fused(motion.joint, motion.u_y)),
-        );
         let joint_rows = model.joint_rows(i);
         let (row_z, row_y) = (joint_rows, &joint_rows[m..]);
         for c in 0..chunks {
@@ -448,8 +446,6 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
             for d in 0..3 {
                 let w = &mut omega_jacobian[d * chunks + c];
                 *w = u_y[d].mul_add(p_y, u_z[d].mul_add(p_z, *w));
-                let o = &mut origin_jacobian[d * chunks + c];
-                *o = o_y[d].mul_add(p_y, o_z[d].mul_add(p_z, *o));
             }
         }
         // In the link's frame (axes `e_d`, the columns of `R_i`) the inertia is
@@ -460,6 +456,9 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
             vec3::column(&motion.rotation, 1),
             vec3::column(&motion.rotation, 2),
         ];
+        // The centre of mass from the joint point, (L / 2) R_i e_x.
+        let half = Y::Value::splat(context, 0.5 * length);
+        let to_com = [axes[0][0] * half, axes[0][1] * half, axes[0][2] * half];
         let principal = [
             Y::Value::splat(context, inertia.principal[0]),
             Y::Value::splat(context, inertia.principal[1]),
@@ -489,14 +488,14 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
         ];
         let principal = spread(layout, principal);
         let (torque, accel) = (spread(layout, torque), spread(layout, motion.com_accel));
-        let c = spread(layout, motion.com);
+        let c = spread(layout, to_com); // c - p
         let mass = layout.spread(Y::Value::splat(context, inertia.mass));
-        // Jv = Jo + Jw x c, the momentum Jacobian m Jv, Jb and I_b Jb; C* += (m Jv)^T a_c +
-        // Jb^T torque, G* -= (m Jv)^T g.
+        // Jv = Jp + Jw x (c - p), the momentum Jacobian m Jv, Jb and I_b Jb, the next joint's
+        // Jp = 2 Jv - Jp; C* += (m Jv)^T a_c + Jb^T torque, G* -= (m Jv)^T g.
         for k in 0..chunks {
             let (w, o) = (
                 column(omega_jacobian, chunks, k),
-                column(origin_jacobian, chunks, k),
+                column(point_jacobian, chunks, k),
             );
             let v = [
                 w[2].neg_mul_add(c[1], w[1].mul_add(c[2], o[0])),
@@ -510,6 +509,7 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
                 dot_fused(axes[2], w),
             ];
             for d in 0..3 {
+                point_jacobian[d * chunks + k] = v[d] + v[d] - o[d];
                 com_jacobian[d * chunks + k] = v[d];
                 momentum_jacobian[d * chunks + k] = p[d];
                 body_jacobian[d * chunks + k] = body[d];
@@ -528,7 +528,7 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
     }
     TermsLanes {
         omega_jacobian,
-        origin_jacobian,
+        point_jacobian,
         com_jacobian,
         momentum_jacobian,
         body_jacobian,
