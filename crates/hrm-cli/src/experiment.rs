@@ -419,7 +419,7 @@ fn figures(
         ),
         section(
             "Spatial arms",
-            "Universal-joint arms held as horizontal cantilevers under gravity (along -z), two bending planes of K harmonics each (az: in the x-y plane, ay: out of it); the tip follows a circle about the x axis, out of the arm's plane.",
+            "Universal-joint arms held as horizontal cantilevers under gravity (along -z), two bending planes of K harmonics each (az: in the x-y plane, ay: out of it); the tip follows a circle about the x axis, out of the arm's plane, or (spatial-clutter) reaches a target among obstacles on a planned motion.",
             spatial,
         ),
         section(
@@ -431,8 +431,9 @@ fn figures(
 }
 
 /// The figures of a spatial scenario's finished `runs` into `dir`, their captions appended to
-/// `figures`: the backbone in space (three views) of each controller, the tip's coordinates
-/// against the reference, and the per-coordinate modal errors and forces.
+/// `figures`: the backbone in space (three views, with the obstacles) of each controller, the
+/// clearance over time among obstacles, the tip's coordinates against the reference, and the
+/// per-coordinate modal errors and forces.
 fn spatial_figures(
     dir: &Path,
     scenario: &Scenario,
@@ -458,7 +459,17 @@ fn spatial_figures(
         add(
             file,
             format!(
-                "{name} with {kind}: the arm every {CONFIGURATION_INTERVAL_S} s, light to dark, from above, from the side and obliquely; the tip (green) should stay on the red path."
+                "{name} with {kind}: the arm every {CONFIGURATION_INTERVAL_S} s, light to dark, from above, from the side and obliquely, with the obstacles (grey) if any; the tip (green) should stay on the red path."
+            ),
+        );
+    }
+    if !scenario.obstacles.is_empty() {
+        let file = format!("clearance_{name}.svg");
+        spatial_figures::clearance_over_time(&dir.join(&file), scenario, runs)?;
+        add(
+            file,
+            format!(
+                "{name}: the smallest clearance of the links to the obstacles and between links (mm) of every controller, against the task's margin; above zero is collision-free."
             ),
         );
     }

@@ -14,7 +14,7 @@ use super::data::SpatialData;
 use super::derivative_data::SpatialDerivativeData;
 use super::minv::inverse_mass_matrix;
 use super::model::SpatialModel;
-use super::rnea_derivatives::rnea_derivatives;
+use super::rnea_derivatives::differentiate_at;
 use crate::check;
 use crate::error::DynError;
 
@@ -38,7 +38,7 @@ use crate::error::DynError;
 /// ```
 ///
 /// # Errors
-/// As [`rnea_derivatives`] and [`aba`](super::aba()) ([`DynError::SingularJoint`] naming the
+/// As [`rnea_derivatives`](super::rnea_derivatives()) and [`aba`](super::aba()) ([`DynError::SingularJoint`] naming the
 /// first joint, from the tip, whose articulated inertia about its axis is not positive).
 pub fn aba_derivatives(
     model: &SpatialModel,
@@ -57,20 +57,23 @@ pub fn aba_derivatives(
     )?;
     let mut qdd = std::mem::take(&mut derivatives.accelerations);
     let solved = aba(model, data, q, v, tau, &mut qdd)
-        .and_then(|()| rnea_derivatives(model, data, derivatives, q, v, &qdd));
+        .and_then(|()| differentiate_at(model, data, derivatives, q, v, &qdd));
     derivatives.value.copy_from_slice(&qdd);
     derivatives.accelerations = qdd;
     solved?;
     let SpatialDerivativeData {
-        blocks,
-        rhs,
-        forces,
-        motions,
-        ..
+        blocks, rhs, sweep, ..
     } = derivatives;
     let (mut jacobians, mut minv) = blocks.as_mut().split_at_col_mut(2 * n);
     rhs.copy_from(jacobians.as_ref());
-    inverse_mass_matrix(model, &data.articulated, forces, motions, minv.as_mut());
+    inverse_mass_matrix(
+        data.arch,
+        model,
+        &data.articulated,
+        &data.poses,
+        sweep,
+        minv.as_mut(),
+    );
     matmul(
         jacobians.as_mut(),
         Accum::Replace,

@@ -16,66 +16,176 @@
 //!                        a_i[:, j] = a'_i[:, j] + S_i (M^-1)_ij                         (S3)
 //! ```
 //!
-//! Only the entries `j >= i` are computed (the rows of the subtree below each joint), about
-//! `35 n^2` multiply-adds; the other half is the symmetric mirror.
+//! Only the entries `j >= i` are computed (the rows of the subtree below each joint); the other
+//! half is the symmetric mirror. The sweeps run in the base frame, where `X_i` is the identity:
+//! with `S_i`, `U_i` carried there by link `i`'s pose (the pairings `S . F` and `U . a` are
+//! frame-free), `F_{i-1}[:, j] = F_i[:, j] + U_i m_ij` and `a_i[:, j] = a_{i-1}[:, j] +
+//! S_i (M^-1)_ij`, so each entry costs two 6-vector dot products and two 6-vector updates,
+//! computed along the row `j = i..n` with the columns of `F` and `a` stored by component.
 
 use faer::MatMut;
+use pulp::{Arch, Simd, WithSimd};
 
-use super::algebra::{Force, Motion, Transform};
+use super::algebra::{Force, Transform};
 use super::data::AbaLink;
+use super::derivative_data::Six;
 use super::model::SpatialModel;
 
 /// `M^-1` into `minv` (`n x n`) from `links`, the articulated quantities of an
-/// [`aba`](super::aba()) at the same `q` (whose pivots it checked), with `forces` and `motions`
-/// (`n` each) as scratch. Allocation-free.
+/// [`aba`](super::aba()) at the same `q` (whose pivots it checked), and `poses`, the links'
+/// poses in the base frame at that `q`, with `sweep` (6 rows of at least `n`) as scratch.
+/// Allocation-free.
 pub(crate) fn inverse_mass_matrix(
+    arch: Arch,
     model: &SpatialModel,
     links: &[AbaLink<f64>],
-    forces: &mut [Force],
-    motions: &mut [Motion],
-    mut minv: MatMut<'_, f64>,
+    poses: &[Transform],
+    sweep: &mut [Vec<f64>; 6],
+    minv: MatMut<'_, f64>,
 ) {
-    let n = model.n_links();
-    let placement = |link: &AbaLink<f64>| Transform {
-        rotation: link.rotation,
-        translation: link.translation,
-    };
-    let coupling = |link: &AbaLink<f64>| Force {
-        linear: link.coupling[0],
-        angular: link.coupling[1],
-    };
-    // Entry (i, j), j >= i, is kept at (j, i): column i of the lower triangle, contiguous.
-    // Tip to base (S1, S2).
-    for i in (0..n).rev() {
-        let link = &links[i];
-        let axis = &model.axes[i];
-        forces[i] = Force::default();
-        minv[(i, i)] = link.inverse;
-        for j in i + 1..n {
-            minv[(j, i)] = -link.inverse * axis.dot(&forces[j]);
-        }
-        if i > 0 {
-            let (x, u) = (placement(link), coupling(link));
+    arch.dispatch(Sweeps {
+        model,
+        links,
+        poses,
+        sweep,
+        minv,
+    });
+}
+
+/// The two sweeps under [`Arch::dispatch`] (the loops along a row vectorise with this
+/// processor's widest registers).
+struct Sweeps<'a> {
+    model: &'a SpatialModel,
+    links: &'a [AbaLink<f64>],
+    poses: &'a [Transform],
+    sweep: &'a mut [Vec<f64>; 6],
+    minv: MatMut<'a, f64>,
+}
+
+/// Joint `i`'s axis `S_i` and `U_i` in the base frame, as plain components.
+#[inline(always)]
+fn world(model: &SpatialModel, links: &[AbaLink<f64>], poses: &[Transform], i: usize) -> [Six; 2] {
+    let pose = &poses[i];
+    let s = pose.act_motion(&model.axes[i]);
+    let u = pose.act_force(&Force {
+        linear: links[i].coupling[0],
+        angular: links[i].coupling[1],
+    });
+    [
+        [
+            s.linear[0],
+            s.linear[1],
+            s.linear[2],
+            s.angular[0],
+            s.angular[1],
+            s.angular[2],
+        ],
+        [
+            u.linear[0],
+            u.linear[1],
+            u.linear[2],
+            u.angular[0],
+            u.angular[1],
+            u.angular[2],
+        ],
+    ]
+}
+
+impl WithSimd for Sweeps<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) {
+        let Sweeps {
+            model,
+            links,
+            poses,
+            sweep,
+            mut minv,
+        } = self;
+        let n = model.n_links();
+        let [r0, r1, r2, r3, r4, r5] = sweep;
+        let rows = [
+            &mut r0[..n],
+            &mut r1[..n],
+            &mut r2[..n],
+            &mut r3[..n],
+            &mut r4[..n],
+            &mut r5[..n],
+        ];
+        let [f0, f1, f2, f3, f4, f5] = rows;
+        // Entry (i, j), j >= i, is kept at (j, i): column i of the lower triangle, contiguous.
+        // Tip to base (S1, S2), F by component in f0..f5.
+        for i in (0..n).rev() {
+            let [s, u] = world(model, links, poses, i);
+            let inverse = links[i].inverse;
+            let column = column_of(&mut minv, i);
+            column[i] = inverse;
+            for j in i + 1..n {
+                let dot = s[0] * f0[j]
+                    + s[1] * f1[j]
+                    + s[2] * f2[j]
+                    + s[3] * f3[j]
+                    + s[4] * f4[j]
+                    + s[5] * f5[j];
+                column[j] = -inverse * dot;
+            }
+            f0[i] = 0.0;
+            f1[i] = 0.0;
+            f2[i] = 0.0;
+            f3[i] = 0.0;
+            f4[i] = 0.0;
+            f5[i] = 0.0;
             for j in i..n {
-                forces[j] = x.act_force(&forces[j].plus(&u.times(minv[(j, i)])));
+                let m = column[j];
+                f0[j] += u[0] * m;
+                f1[j] += u[1] * m;
+                f2[j] += u[2] * m;
+                f3[j] += u[3] * m;
+                f4[j] += u[4] * m;
+                f5[j] += u[5] * m;
+            }
+        }
+        // Base to tip (S3), a by component in the same rows.
+        let [a0, a1, a2, a3, a4, a5] = [f0, f1, f2, f3, f4, f5];
+        for row in [&mut *a0, &mut *a1, &mut *a2, &mut *a3, &mut *a4, &mut *a5] {
+            row.fill(0.0);
+        }
+        for i in 0..n {
+            let [s, u] = world(model, links, poses, i);
+            let inverse = links[i].inverse;
+            let column = column_of(&mut minv, i);
+            for j in i..n {
+                let dot = u[0] * a0[j]
+                    + u[1] * a1[j]
+                    + u[2] * a2[j]
+                    + u[3] * a3[j]
+                    + u[4] * a4[j]
+                    + u[5] * a5[j];
+                let entry = column[j] - inverse * dot;
+                column[j] = entry;
+                a0[j] += s[0] * entry;
+                a1[j] += s[1] * entry;
+                a2[j] += s[2] * entry;
+                a3[j] += s[3] * entry;
+                a4[j] += s[4] * entry;
+                a5[j] += s[5] * entry;
+            }
+        }
+        for i in 0..n {
+            for j in i + 1..n {
+                minv[(i, j)] = minv[(j, i)];
             }
         }
     }
-    // Base to tip (S3).
-    motions.fill(Motion::default());
-    for (i, link) in links.iter().enumerate().take(n) {
-        let axis = &model.axes[i];
-        let (x, u) = (placement(link), coupling(link));
-        for j in i..n {
-            let carried = x.inv_act_motion(&motions[j]);
-            let entry = minv[(j, i)] - link.inverse * carried.dot(&u);
-            minv[(j, i)] = entry;
-            motions[j] = carried.plus(&axis.times(entry));
-        }
-    }
-    for i in 0..n {
-        for j in i + 1..n {
-            minv[(i, j)] = minv[(j, i)];
-        }
-    }
+}
+
+/// Column `k` of `m` as a slice (a faer `Mat`'s blocks are column-major).
+#[inline(always)]
+fn column_of<'m>(m: &'m mut MatMut<'_, f64>, k: usize) -> &'m mut [f64] {
+    m.as_mut()
+        .col_mut(k)
+        .try_as_col_major_mut()
+        .expect("the blocks of a faer Mat are column-major")
+        .as_slice_mut()
 }

@@ -7,7 +7,8 @@ use std::path::Path;
 /// The scenarios shipped with the crate, by name: the paper's experiments (section 5) with the
 /// tracking task also five times faster under limits on the modal forces `tau*`, then the paper's tracking task
 /// with two harmonics and with `alpha0` free, then the paper's arm reaching between obstacles on
-/// a planned motion (`narrow-gap`), then the paper's arm deploying into a bent channel by
+/// a planned motion (`narrow-gap`) and a spatial arm reaching a point in space among obstacles
+/// on a planned motion (`spatial-clutter`), then the paper's arm deploying into a bent channel by
 /// follow-the-leader on an insertion axis (`pipe-deploy`, run by [`Scenario::run_deploy`]).
 const BUILTIN: &[(&str, &str)] = &[
     (
@@ -49,6 +50,10 @@ const BUILTIN: &[(&str, &str)] = &[
     (
         "narrow-gap",
         include_str!("../../scenarios/narrow-gap.toml"),
+    ),
+    (
+        "spatial-clutter",
+        include_str!("../../scenarios/spatial-clutter.toml"),
     ),
     (
         "pipe-deploy",

@@ -1,7 +1,7 @@
 //! The scenario schema: what a scenario file may say, with its defaults.
 
 use super::arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout};
-use super::controllers::ControllerKind;
+use super::controllers::ControllerSpec;
 use backbone_kin::BaseAngle;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -408,69 +408,6 @@ pub struct SineSpec {
     pub x_start: f64,
     /// Last `x` (m).
     pub x_end: f64,
-}
-
-/// The controller and its sampling.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ControllerSpec {
-    /// Which controller (default fuzzy).
-    #[serde(default)]
-    pub kind: ControllerKind,
-    /// Sampling period (s); default: the RK4 step (required with `dopri5`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub period: Option<f64>,
-    /// A `.fis` file replacing the paper's fuzzy system (for fuzzy, pd and fuzzy-gc); a relative
-    /// path is relative to the scenario file.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub fis: Option<PathBuf>,
-    /// What the fuzzy controllers (fuzzy, fuzzy-gc) do with an input outside its variable's
-    /// range: `"as-given"` (the default, as MATLAB's `evalfis` and Simulink's Fuzzy Logic
-    /// Controller block evaluate it; bells fade far out) or `"clamp"` (evaluated at the nearest
-    /// end of the range: the action saturates).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub out_of_range: Option<FuzzyInputRange>,
-    /// Computed-torque stiffness per coordinate (1/s^2, default 2500 each: 50 rad/s).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub kp: Option<Vec<f64>>,
-    /// Computed-torque damping per coordinate (1/s, default 100 each: critically damped).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub kd: Option<Vec<f64>>,
-    /// PD stiffness per coordinate (N m/rad); default: the fuzzy system's slope at the origin.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub pd_kp: Option<Vec<f64>>,
-    /// PD damping per coordinate (N m s/rad); default: the fuzzy system's slope at the origin.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub pd_kd: Option<Vec<f64>>,
-    /// LQR design frequency `omega` (rad/s, default 50): the weights place the poles of the
-    /// straight arm without gravity at a Butterworth pair of radius `omega`
-    /// ([`LqrController`](sim_core::controller::LqrController)).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lqr_frequency: Option<f64>,
-    /// LQR re-linearisation period (s, default 0.01; at least the controller period).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lqr_relinearise: Option<f64>,
-}
-
-/// What a fuzzy controller does with an input outside its variable's range
-/// ([`fuzzy_sugeno::OutOfRange`]).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum FuzzyInputRange {
-    /// Evaluated as given (MATLAB's `evalfis`, Simulink's Fuzzy Logic Controller block).
-    #[default]
-    AsGiven,
-    /// Evaluated at the nearest end of the range.
-    Clamp,
-}
-
-impl From<FuzzyInputRange> for fuzzy_sugeno::OutOfRange {
-    fn from(policy: FuzzyInputRange) -> Self {
-        match policy {
-            FuzzyInputRange::AsGiven => Self::AsGiven,
-            FuzzyInputRange::Clamp => Self::Clamp,
-        }
-    }
 }
 
 /// The integrator between controller samples, tagged by `method`.
