@@ -214,7 +214,7 @@ pub fn figures(
     let clearance = format!("deploy_clearance_{name}.svg");
     let series = [
         Series {
-            label: "smallest clearance to the walls".into(),
+            label: "wall clearance".into(),
             points: t
                 .iter()
                 .zip(&run.samples)
@@ -222,7 +222,7 @@ pub fn figures(
                 .collect(),
         },
         Series {
-            label: "tip's distance from the centreline".into(),
+            label: "tip error".into(),
             points: t
                 .iter()
                 .zip(&run.samples)

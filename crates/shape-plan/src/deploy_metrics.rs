@@ -2,7 +2,7 @@
 //! kinematic plan ([`follow_the_leader`](crate::follow_the_leader)) and those of a dynamic run
 //! that tracks it (`docs/theory.md`, "Follow-the-leader deployment").
 
-use crate::deploy::{Channel, dist, point_segment};
+use crate::channel::{Channel, dist, point_segment};
 use crate::error::{PlanError, check_finite};
 
 /// Points per link at which the body's distances to the path and the walls are sampled (both

@@ -177,8 +177,8 @@ mod tests {
             motion.sample(t - step, &mut minus).unwrap();
             let u = minimum_jerk(t / travel, travel).0;
             let exact = f(u);
-            for i in 0..2 {
-                assert!((s.a[i] - exact[i]).abs() < 1e-3, "t {t}: {:?}", s.a);
+            for (i, exact) in exact.iter().enumerate() {
+                assert!((s.a[i] - exact).abs() < 1e-3, "t {t}: {:?}", s.a);
                 let rate = (plus.a[i] - minus.a[i]) / (2.0 * step);
                 assert!((s.a_dot[i] - rate).abs() < 1e-6, "t {t} rate {i}");
                 let acceleration = (plus.a_dot[i] - minus.a_dot[i]) / (2.0 * step);
