@@ -7,7 +7,7 @@
 
 use super::controllers::ControllerKind;
 use super::schema::{
-    DeploySpec, IntegratorSpec, MAX_DEPLOY_CENTERLINE_POINTS, NoiseSpec, ReferenceSpec, Scenario,
+    DeploySpec, IntegratorSpec, MAX_DEPLOY_CENTERLINE_POINTS, ReferenceSpec, Scenario,
 };
 use backbone_kin::{BaseAngle, ModalMap, joint_positions};
 use manip_dyn::spatial::{SpatialJoint, SpatialLink, SpatialModel, Transform};
@@ -313,17 +313,8 @@ impl Scenario {
         if self.task.is_some() {
             return Err(unused("task", "the deployment is the plan"));
         }
-        if self.noise != NoiseSpec::default() {
-            return Err(unused("noise", "the joint-space loop is noise-free"));
-        }
-        if self.limits.joint_torque_nm.is_some()
-            || self.limits.joint_angle_rad.is_some()
-            || self.limits.tau_star.is_some()
-        {
-            return Err(unused(
-                "limits.joint_torque_nm, limits.joint_angle_rad and limits.tau_star",
-                "only limits.max_modal_error bounds the joint errors",
-            ));
+        if let Some((name, why)) = self.unused_by_joint_space_loops() {
+            return Err(unused(name, why));
         }
         if self.controller.kind != ControllerKind::ComputedTorque {
             return Err(SimError::setting(
