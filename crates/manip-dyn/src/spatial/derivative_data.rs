@@ -2,7 +2,7 @@
 //! ([`rnea_derivatives`](super::rnea_derivatives()) and
 //! [`aba_derivatives`](super::aba_derivatives())).
 
-use faer::{Mat, MatRef};
+use faer::{Mat, MatMut, MatRef};
 
 use super::algebra::{Mat3, Symmetric6, Vec3};
 use super::model::SpatialModel;
@@ -20,6 +20,17 @@ pub(crate) const ROWS: usize = 15;
 /// register can be read from any row index below `n`.
 pub(crate) fn padded(n: usize) -> usize {
     n + 8
+}
+
+/// Column `k` of `m` as a slice (a faer `Mat`'s blocks are column-major), for the SIMD loops
+/// that fill the derivative matrices a column at a time.
+#[inline(always)]
+pub(crate) fn column_of<'m>(m: &'m mut MatMut<'_, f64>, k: usize) -> &'m mut [f64] {
+    m.as_mut()
+        .col_mut(k)
+        .try_as_col_major_mut()
+        .expect("the blocks of a faer Mat are column-major")
+        .as_slice_mut()
 }
 
 /// Results and scratch of [`rnea_derivatives`](super::rnea_derivatives()) and

@@ -29,7 +29,7 @@ use pulp::{Arch, Simd, WithSimd};
 
 use super::algebra::{Force, Transform};
 use super::data::AbaLink;
-use super::derivative_data::{Six, padded};
+use super::derivative_data::{Six, column_of, padded};
 use super::model::SpatialModel;
 use lane_math::{Lane, Pack};
 
@@ -193,14 +193,4 @@ fn registers<S: Simd>(simd: S, vectors: [Six; 2]) -> [[Pack<S>; 6]; 2] {
         }
     }
     out
-}
-
-/// Column `k` of `m` as a slice (a faer `Mat`'s blocks are column-major).
-#[inline(always)]
-fn column_of<'m>(m: &'m mut MatMut<'_, f64>, k: usize) -> &'m mut [f64] {
-    m.as_mut()
-        .col_mut(k)
-        .try_as_col_major_mut()
-        .expect("the blocks of a faer Mat are column-major")
-        .as_slice_mut()
 }

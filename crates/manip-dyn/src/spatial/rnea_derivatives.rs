@@ -38,7 +38,7 @@ use super::algebra::{
     Force, Mat3, Motion, Symmetric6, Vec3, add, cross, dot, mat_add, mat_t_vec, mat_vec, scale,
 };
 use super::data::SpatialData;
-use super::derivative_data::{Six, SpatialDerivativeData, padded};
+use super::derivative_data::{Six, SpatialDerivativeData, column_of, padded};
 use super::kinematics::update_poses;
 use super::model::SpatialModel;
 use super::rnea::newton_euler;
@@ -305,16 +305,6 @@ impl WithSimd for Fill<'_> {
             combine(simd, &mut column[k..], &p, &axis, k);
         }
     }
-}
-
-/// Column `k` of `m` as a slice (the blocks of a faer `Mat` are column-major).
-#[inline(always)]
-fn column_of<'m>(m: &'m mut MatMut<'_, f64>, k: usize) -> &'m mut [f64] {
-    m.as_mut()
-        .col_mut(k)
-        .try_as_col_major_mut()
-        .expect("the blocks of a faer Mat are column-major")
-        .as_slice_mut()
 }
 
 /// `out[j] = sum_c rows[c][first + j] x[c]`, a register of `S` at a time (the rows hold a
