@@ -38,7 +38,7 @@ use super::algebra::{
     Force, Mat3, Motion, Symmetric6, Vec3, add, cross, dot, mat_add, mat_t_vec, mat_vec, scale,
 };
 use super::data::SpatialData;
-use super::derivative_data::{Six, SpatialDerivativeData, column_of, padded};
+use super::derivative_data::{MAX_LANES, Six, SpatialDerivativeData, column_of, padded};
 use super::kinematics::update_poses;
 use super::model::SpatialModel;
 use super::rnea::newton_euler;
@@ -342,6 +342,3 @@ fn combine<S: Simd, const C: usize>(
         at += width;
     }
 }
-
-/// The most `f64` lanes of a register (AVX-512).
-const MAX_LANES: usize = 8;
