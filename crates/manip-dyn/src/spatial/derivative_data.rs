@@ -4,7 +4,7 @@
 
 use faer::{Mat, MatMut, MatRef};
 
-use super::algebra::{Mat3, Symmetric6, Vec3};
+use super::algebra::{Mat3, RigidSum, Vec3};
 use super::model::SpatialModel;
 use crate::model::MAX_DENSE_LINKS;
 
@@ -70,7 +70,7 @@ pub struct SpatialDerivativeData {
     /// Of links `i..n`, in the base frame: the composite inertia `Ic_i`, and the two blocks of
     /// the composite Coriolis operator `Bc_i = [[0, -2 [Hc_i]x], [0, Dc_i]]`: the linear
     /// momentum `Hc_i` and the 3 x 3 `Dc_i`.
-    pub(crate) composite: Vec<Symmetric6>,
+    pub(crate) composite: Vec<RigidSum>,
     pub(crate) momentum: Vec<Vec3>,
     pub(crate) coriolis: Vec<Mat3>,
     /// `[d tau / d q | d tau / d v]` while `aba_derivatives` multiplies it by `-M^-1`.
@@ -110,7 +110,7 @@ impl SpatialDerivativeData {
             beta: six(),
             g: six(),
             h: six(),
-            composite: vec![Symmetric6::default(); sized],
+            composite: vec![RigidSum::default(); sized],
             momentum: vec![[0.0; 3]; sized],
             coriolis: vec![[[0.0; 3]; 3]; sized],
             rhs: Mat::zeros(sized, 2 * sized),

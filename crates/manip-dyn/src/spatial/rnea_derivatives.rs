@@ -35,7 +35,7 @@ use lane_math::{Lane, Pack};
 use pulp::{Simd, WithSimd};
 
 use super::algebra::{
-    Force, Mat3, Motion, Symmetric6, Vec3, add, cross, dot, mat_add, mat_t_vec, mat_vec, scale,
+    Force, Mat3, Motion, RigidSum, Vec3, add, cross, dot, mat_add, mat_t_vec, mat_vec, scale,
 };
 use super::data::SpatialData;
 use super::derivative_data::{MAX_LANES, Six, SpatialDerivativeData, column_of, padded};
@@ -131,16 +131,15 @@ fn cross_matrix(a: Vec3) -> Mat3 {
 /// The block `D` of one body's Coriolis operator `B = [[0, -2 [h]x], [0, D]]` (module
 /// documentation), from its base-frame inertia `inertia`, velocity `(v, omega)` and momentum
 /// `(h, h_omega)`: `D = [omega]x C - C [omega]x - [v]x [mc]x - [mc]x [v]x - [h_omega]x`, with
-/// `C` the rotational block of the inertia and `mc` its first moment (`B = -[mc]x`).
-fn coriolis_block(inertia: &Symmetric6, velocity: &Motion, momentum: &Force) -> Mat3 {
-    let b = &inertia.b;
-    let mc = [b[1][2], b[2][0], b[0][1]];
+/// `C` the rotational block of the inertia and `mc` its first moment.
+fn coriolis_block(inertia: &RigidSum, velocity: &Motion, momentum: &Force) -> Mat3 {
+    let mc = inertia.moment;
     let (v, omega) = (velocity.linear, velocity.angular);
     // K = [omega]x C: column k is omega x (column k of C); C [omega]x = -K^T (C symmetric).
     let kt = [
-        cross(omega, inertia.c[0]),
-        cross(omega, inertia.c[1]),
-        cross(omega, inertia.c[2]),
+        cross(omega, inertia.rotational[0]),
+        cross(omega, inertia.rotational[1]),
+        cross(omega, inertia.rotational[2]),
     ];
     // [a]x [b]x = b a^T - (a . b) E.
     let vm = dot(v, mc);
@@ -178,7 +177,7 @@ fn differentiate(
         let (composite, momentum, coriolis) = if i + 1 < n {
             (d.composite[i + 1], d.momentum[i + 1], d.coriolis[i + 1])
         } else {
-            (Symmetric6::default(), [0.0; 3], [[0.0; 3]; 3])
+            (RigidSum::default(), [0.0; 3], [[0.0; 3]; 3])
         };
         if model.massless[i] {
             d.composite[i] = composite;
@@ -205,7 +204,7 @@ fn differentiate(
     for i in 0..n {
         let pose = &data.poses[i];
         let axis = pose.act_motion(&model.axes[i]);
-        let composite: &Symmetric6 = &d.composite[i];
+        let composite = &d.composite[i];
         let (momentum, coriolis) = (d.momentum[i], &d.coriolis[i]);
         let w = parent_velocity.cross_motion(&axis);
         let beta = parent_acceleration
