@@ -12,6 +12,7 @@ use lane_math::{Lane, Pack};
 use pulp::{Simd, WithSimd};
 
 use super::aba::aba;
+use super::algebra::Transform;
 use super::data::SpatialData;
 use super::derivative_data::{MAX_LANES, SpatialDerivativeData, column_of, padded};
 use super::minv::inverse_mass_matrix;
@@ -58,8 +59,10 @@ pub fn aba_derivatives(
         n,
     )?;
     let mut qdd = std::mem::take(&mut derivatives.accelerations);
-    let solved = aba(model, data, q, v, tau, &mut qdd)
-        .and_then(|()| differentiate_at(model, data, derivatives, q, v, &qdd));
+    let solved = aba(model, data, q, v, tau, &mut qdd).and_then(|()| {
+        poses_from_aba(data);
+        differentiate_at(model, data, derivatives, v, &qdd)
+    });
     derivatives.value.copy_from_slice(&qdd);
     derivatives.accelerations = qdd;
     solved?;
@@ -90,6 +93,21 @@ pub fn aba_derivatives(
         rhs: rhs.as_ref(),
     });
     check::finite_matrix("the derivatives", &blocks.as_mut())
+}
+
+/// The links' poses in the base frame, `oM_i = oM_{i-1} * {i-1}M_i`, from the placements the
+/// ABA has just computed (the same as [`update_poses`](super::kinematics::update_poses) at its
+/// `q`, without the sines, cosines and placements again).
+fn poses_from_aba(data: &mut SpatialData) {
+    let mut parent = Transform::IDENTITY;
+    for (pose, link) in data.poses.iter_mut().zip(&data.articulated) {
+        let placement = Transform {
+            rotation: link.rotation,
+            translation: link.translation,
+        };
+        parent = parent.compose(&placement);
+        *pose = parent;
+    }
 }
 
 /// `out = -minv rhs` (`n x n` by `n x 2n`) under [`pulp::Arch::dispatch`]: a SIMD register of

@@ -88,21 +88,21 @@ pub fn rnea_derivatives(
         derivatives.n_links(),
         n,
     )?;
-    differentiate_at(model, data, derivatives, q, v, qdd)?;
+    update_poses(model, data, q);
+    differentiate_at(model, data, derivatives, v, qdd)?;
     check::finite_matrix("the derivatives", &derivatives.blocks.as_mut())
 }
 
-/// [`rnea_derivatives`] on checked inputs, but for the test of the matrices (which
-/// [`aba_derivatives`](super::aba_derivatives()) makes once, on its own results).
+/// [`rnea_derivatives`] on checked inputs with the links' poses at `q` already in `data`, but
+/// for the test of the matrices (which [`aba_derivatives`](super::aba_derivatives()) makes
+/// once, on its own results).
 pub(crate) fn differentiate_at(
     model: &SpatialModel,
     data: &mut SpatialData,
     derivatives: &mut SpatialDerivativeData,
-    q: &[f64],
     v: &[f64],
     qdd: &[f64],
 ) -> Result<(), DynError> {
-    update_poses(model, data, q);
     let d = derivatives;
     newton_euler_base_frame(model, data, d, v, qdd);
     differentiate(model, d);
