@@ -129,6 +129,13 @@ fn six_force(f: &Force) -> Six {
     [a, b, c, d, e, g]
 }
 
+/// Entry `i` of six component rows (written out: an array `map` here is not inlined).
+#[inline(always)]
+fn entries<R: AsRef<[f64]>>(rows: &[R], i: usize) -> Six {
+    let r = |c: usize| rows[c].as_ref()[i];
+    [r(0), r(1), r(2), r(3), r(4), r(5)]
+}
+
 fn motion_of(x: &Six) -> Motion {
     Motion {
         linear: [x[0], x[1], x[2]],
@@ -249,7 +256,7 @@ fn differentiate(model: &SpatialModel, d: &mut SpatialDerivativeData) {
             coriolis = mat_add(&d.coriolis[i], &coriolis);
             force = force_of(&d.g[i]).plus(&force);
         }
-        let axis = motion_of(&[0, 1, 2, 3, 4, 5].map(|c| d.rows[c][i]));
+        let axis = motion_of(&entries(&d.rows[..6], i));
         let (w, beta) = (motion_of(&d.w[i]), motion_of(&d.beta[i]));
         d.value[i] = axis.dot(&force);
         let p = composite.apply(&axis);
@@ -306,8 +313,8 @@ impl WithSimd for Fill<'_> {
         let p = [r(6), r(7), r(8), r(9), r(10), r(11)];
         let pq = [r(6), r(7), r(8), r(9), r(10), r(11), r(12), r(13), r(14)];
         for k in 0..n {
-            let axis = [0, 1, 2, 3, 4, 5].map(|c| axes[c][k]);
-            let p_k = [0, 1, 2, 3, 4, 5].map(|c| p[c][k]);
+            let axis = entries(&axes, k);
+            let p_k = entries(&p, k);
             let (w, beta) = (&d.w[k], &d.beta[k]);
             let dq = [
                 beta[0], beta[1], beta[2], beta[3], beta[4], beta[5], w[3], w[4], w[5],
