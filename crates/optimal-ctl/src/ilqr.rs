@@ -532,7 +532,13 @@ impl Ilqr {
             }
         }
         self.x[..self.nx].copy_from_slice(x0);
-        let initial_cost = self.rollout(dynamics)?;
+        // Within rows, the warm start's rollout moves every control within its step's rows at
+        // the state reached (as every forward pass does), so that the first nominal trajectory
+        // is feasible; its Jacobians stand when no control moved.
+        let (initial_cost, mut jacobians_current) = match constraints.as_deref_mut() {
+            None => (self.rollout(dynamics)?, false),
+            Some(c) => self.constrained_rollout(dynamics, c)?,
+        };
         let mut cost = initial_cost;
         let mut mu = settings.regularisation;
         let mut delta = 1.0;
@@ -541,7 +547,10 @@ impl Ilqr {
         let mut linearised = false;
         while iterations < settings.max_iterations {
             if !linearised {
-                self.linearise(dynamics)?;
+                if !jacobians_current {
+                    self.linearise(dynamics)?;
+                }
+                jacobians_current = false;
                 if let (Some(c), Some(work)) = (constraints.as_deref_mut(), &mut self.constrained) {
                     let (nx, nu) = (self.nx, self.nu);
                     for k in 0..self.horizon {
@@ -730,6 +739,43 @@ impl Ilqr {
         }
     }
 
+    /// The rollout of the current controls from `x_0` with every control moved to the closest
+    /// within its step's rows (and the box) at the state reached, the rows linearised there
+    /// (a control whose rows admit none is kept); the cost, and whether the Jacobians it
+    /// computed are those of the final trajectory (no control moved).
+    fn constrained_rollout<D: DiscreteDynamics + ?Sized>(
+        &mut self,
+        dynamics: &mut D,
+        constraints: &mut dyn StepConstraints,
+    ) -> Result<(f64, bool), OptimalError> {
+        let (nx, nu) = (self.nx, self.nu);
+        let Some(work) = &mut self.constrained else {
+            return Ok((self.rollout(dynamics)?, false));
+        };
+        let mut unmoved = true;
+        for k in 0..self.horizon {
+            let (past, future) = self.x.split_at_mut((k + 1) * nx);
+            let (x, next) = (&past[k * nx..], &mut future[..nx]);
+            let u = &mut self.u[k * nu..(k + 1) * nu];
+            let b = &mut self.b[k * nx * nu..(k + 1) * nx * nu];
+            dynamics.linearise(x, u, next, &mut self.a[k * nx * nx..(k + 1) * nx * nx], b)?;
+            if work.project(constraints, k, (x, b), (&self.lower, &self.upper), u)? == Some(true) {
+                unmoved = false;
+                dynamics.step(x, u, next)?;
+            }
+        }
+        let cost = self.trajectory_cost(&self.x, &self.u);
+        if cost.is_finite() {
+            Ok((cost, unmoved))
+        } else {
+            Err(OptimalError::InvalidSetting {
+                name: "warm start",
+                requirement: "a rollout of finite cost",
+                value: cost,
+            })
+        }
+    }
+
     /// The Jacobians along the current trajectory.
     fn linearise<D: DiscreteDynamics + ?Sized>(
         &mut self,
@@ -891,7 +937,7 @@ impl Ilqr {
                     (&self.lower, &self.upper),
                     &mut self.u_try[k * nu..(k + 1) * nu],
                 )?;
-                if !within {
+                if within.is_none() {
                     return Ok(f64::INFINITY);
                 }
             }

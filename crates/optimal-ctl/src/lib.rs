@@ -14,7 +14,7 @@ mod step_constraints;
 pub use box_qp::{BoxQp, BoxQpReport, BoxQpSettings};
 pub use discrete::{DiscreteDynamics, ReducedEuler};
 pub use ilqr::{Ilqr, IlqrReport, IlqrSettings, MAX_HORIZON, MAX_WORKSPACE, TrackingCost};
-pub use joint_torque_rows::JointTorqueRows;
+pub use joint_torque_rows::{JointTorqueLimits, JointTorqueRows};
 pub use linear_qp::{LinearQp, LinearQpFailure};
 pub use linearise::Linearisation;
 pub use lqr::{Lqr, LqrSettings};

@@ -262,7 +262,8 @@ impl ConstrainedWork {
     }
 
     /// Moves `u` (`n_u`) to the closest control within the rows of step `k` at the forward
-    /// pass's state `x` (with the nominal `b`) and the box; `Ok(false)` when none is.
+    /// pass's state `x` (with the nominal `b`) and the box: whether it moved, or `None` (`u`
+    /// kept) when no control is within.
     pub(crate) fn project(
         &mut self,
         constraints: &mut dyn StepConstraints,
@@ -270,7 +271,7 @@ impl ConstrainedWork {
         (x, b): (&[f64], &[f64]),
         box_bounds: (&[f64], &[f64]),
         u: &mut [f64],
-    ) -> Result<bool, OptimalError> {
+    ) -> Result<Option<bool>, OptimalError> {
         let (nu, max) = (self.nu, self.max_rows);
         let count =
             constraints.rows(k, x, u, b, &mut self.forward_rows, &mut self.forward_bounds)?;
@@ -292,11 +293,11 @@ impl ConstrainedWork {
             u,
             &mut self.projected,
         ) {
-            Ok(_) => {
+            Ok(moved) => {
                 u.copy_from_slice(&self.projected);
-                Ok(true)
+                Ok(Some(moved))
             }
-            Err(_) => Ok(false),
+            Err(_) => Ok(None),
         }
     }
 }

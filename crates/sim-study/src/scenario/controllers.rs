@@ -7,7 +7,8 @@ use modal_reduce::PlantModel;
 use optimal_ctl::MpcSettings;
 use serde::{Deserialize, Serialize};
 use sim_core::controller::{
-    ComputedTorque, FuzzyController, LqrController, MpcController, PdController,
+    ComputedTorque, Controller, FuzzyController, LqrController, MpcController, MpcLimits,
+    PdController,
 };
 use sim_core::{ControllerFactory, Prepared, ReferenceFactory, SimError};
 use std::fmt;
@@ -52,6 +53,9 @@ pub struct ControllerSetup<'a> {
     /// A fuzzy system given in memory (e.g. one just learned), used instead of the `.fis` file
     /// `spec.fis` names or the paper's; `None` for those.
     pub system: Option<&'a FuzzySystem>,
+    /// What MPC plans within besides the `tau*` box: the loop's joint limits, its links and
+    /// obstacles, and the clearance margin (empty without them).
+    pub limits: &'a MpcLimits,
 }
 
 /// A row of the controller table: a controller's name, what it is, and how a scenario builds it.
@@ -175,19 +179,21 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
     ControllerEntry {
         kind: ControllerKind::Mpc,
         name: "mpc",
-        description: "model-predictive control: control-limited iLQR over a 0.3 s receding horizon",
+        description: "model-predictive control: control-limited iLQR over a 0.3 s receding horizon, \
+                      within the joint limits and the clearance margin (clearance_m)",
         prepare: |s| {
             let settings = MpcSettings::uniform(m(s));
             let (model, reference) = (s.model.clone(), Arc::clone(s.reference));
+            let limits = s.limits.clone();
+            let build = move || -> Result<Box<dyn Controller>, SimError> {
+                Ok(Box::new(
+                    MpcController::new(model.plant(), &settings, reference()?)?
+                        .with_limits(model.plant(), &limits)?,
+                ))
+            };
             // Checked once here; each run builds its own (its plan is its state).
-            MpcController::new(model.plant(), &settings, reference()?)?;
-            Ok(Arc::new(move || {
-                Ok(Box::new(MpcController::new(
-                    model.plant(),
-                    &settings,
-                    reference()?,
-                )?))
-            }))
+            build()?;
+            Ok(Arc::new(build))
         },
     },
 ];

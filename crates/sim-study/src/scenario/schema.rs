@@ -426,6 +426,12 @@ pub struct ControllerSpec {
     /// LQR re-linearisation period (s, default 0.01; at least the controller period).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lqr_relinearise: Option<f64>,
+    /// The clearance MPC plans to keep between every link and every obstacle and between links
+    /// that share no joint (m, non-negative, at most 1e3; default the `[task]`'s `clearance`,
+    /// else 0). Only with `[[obstacles]]` or `[arm] radius`
+    /// ([`MpcLimits`](sim_core::controller::MpcLimits)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearance_m: Option<f64>,
 }
 
 /// What a fuzzy controller does with an input outside its variable's range
