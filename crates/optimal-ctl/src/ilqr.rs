@@ -206,6 +206,9 @@ pub struct Ilqr {
     qp: BoxQp,
     /// The working memory of constrained solves, once reserved.
     constrained: Option<ConstrainedWork>,
+    /// Whether `x`, `u` and `gain` are the last solve's plan (shifted or not): a policy the
+    /// warm start may follow when its open-loop rollout diverges.
+    policy: bool,
 }
 
 impl Ilqr {
@@ -312,6 +315,7 @@ impl Ilqr {
             adjoint_next: vec![0.0; nx],
             qp: BoxQp::new(nu),
             constrained: None,
+            policy: false,
         })
     }
 
@@ -401,8 +405,10 @@ impl Ilqr {
     }
 
     /// The controls `u_0..u_{N-1}` (`N x n_u` row-major): the warm start before a solve, the
-    /// solution after it.
+    /// solution after it. Controls set here are rolled out open loop (the last plan's feedback
+    /// no longer applies to them).
     pub fn controls_mut(&mut self) -> &mut [f64] {
+        self.policy = false;
         &mut self.u
     }
 
@@ -429,25 +435,23 @@ impl Ilqr {
 
     /// Sets the warm start to the control references `w_k`.
     pub fn warm_start_from_control_references(&mut self) {
+        self.policy = false;
         self.u.copy_from_slice(&self.u_ref);
     }
 
-    /// Shifts the controls (and the QP warm starts) `steps` steps earlier, repeating the last
-    /// control at the end: the warm start of a receding horizon that moved on by `steps`.
+    /// Shifts the plan `steps` steps earlier (the controls, the QP warm starts, and the states
+    /// and gains the warm start may follow), repeating the last node at the end: the warm start
+    /// of a receding horizon that moved on by `steps`.
     pub fn shift(&mut self, steps: usize) {
-        let (n, nu) = (self.horizon, self.nu);
+        let (n, nu, nx) = (self.horizon, self.nu, self.nx);
         let s = steps.min(n - 1);
         if s == 0 {
             return;
         }
-        for buffer in [&mut self.u, &mut self.feedforward] {
-            buffer.copy_within(s * nu.., 0);
-            let (head, tail) = buffer.split_at_mut((n - s) * nu);
-            let last = &head[(n - s - 1) * nu..];
-            for chunk in tail.chunks_exact_mut(nu) {
-                chunk.copy_from_slice(last);
-            }
-        }
+        shift_nodes(&mut self.u, nu, s);
+        shift_nodes(&mut self.feedforward, nu, s);
+        shift_nodes(&mut self.gain, nu * nx, s);
+        shift_nodes(&mut self.x, nx, s);
     }
 
     /// `clamp(u_k + K_k dx)` into `out` (`n_u` entries): the locally optimal feedback of the last
@@ -467,7 +471,9 @@ impl Ilqr {
     /// Minimises the [`TrackingCost`] from `x0` (`n_x` entries) over the horizon, starting from
     /// the controls in [`controls_mut`](Self::controls_mut) (projected onto the box). The
     /// solution is then in [`controls`](Self::controls), [`states`](Self::states) and
-    /// [`gains`](Self::gains).
+    /// [`gains`](Self::gains). After a solve (and a [`shift`](Self::shift)), a warm start whose
+    /// open-loop rollout diverges (the dynamics refuse a state or the cost is not finite)
+    /// follows the last plan's feedback `u_k + K_k (x_k - x_plan,k)` instead.
     ///
     /// # Errors
     /// [`OptimalError::Dimension`] if `dynamics` or `x0` does not match the workspace,
@@ -531,14 +537,25 @@ impl Ilqr {
                 *u = if u.is_finite() { *u } else { 0.0 }.clamp(*l, *h);
             }
         }
+        // The previous plan, which a warm start that diverges open loop follows instead.
+        let follow = self.policy;
+        self.policy = false;
+        if follow {
+            self.x_try.copy_from_slice(&self.x);
+            self.u_try.copy_from_slice(&self.u);
+        }
         self.x[..self.nx].copy_from_slice(x0);
         // Within rows, the warm start's rollout moves every control within its step's rows at
         // the state reached (as every forward pass does), so that the first nominal trajectory
         // is feasible; its Jacobians stand when no control moved.
-        let (initial_cost, mut jacobians_current) = match constraints.as_deref_mut() {
-            None => (self.rollout(dynamics)?, false),
-            Some(c) => self.constrained_rollout(dynamics, c)?,
-        };
+        let (initial_cost, mut jacobians_current) =
+            match self.warm_rollout(dynamics, constraints.as_deref_mut(), false) {
+                Err(error) if follow && diverged(&error) => {
+                    self.u.copy_from_slice(&self.u_try);
+                    self.warm_rollout(dynamics, constraints.as_deref_mut(), true)?
+                }
+                other => other?,
+            };
         let mut cost = initial_cost;
         let mut mu = settings.regularisation;
         let mut delta = 1.0;
@@ -612,6 +629,7 @@ impl Ilqr {
                 }
             }
         }
+        self.policy = true;
         Ok(IlqrReport {
             iterations,
             initial_cost,
@@ -713,55 +731,49 @@ impl Ilqr {
         Ok(())
     }
 
-    /// `x_{k+1} = F(x_k, u_k)` from `x_0` with the current controls; the cost.
-    fn rollout<D: DiscreteDynamics + ?Sized>(
+    /// The warm start's rollout from `x_0`: `x_{k+1} = F(x_k, u_k)` with the current controls
+    /// or, when `follow`, with the previous plan's feedback `u_k + K_k (x_k - x̄_k)` about its
+    /// states `x̄_k` (kept in `x_try`), clamped to the box. With `constraints`, every control is
+    /// then moved to the closest within its step's rows at the state reached, the rows
+    /// linearised there (a control whose rows admit none is kept). The cost, and whether the
+    /// Jacobians computed on the way are those of the final trajectory (only with constraints,
+    /// when no control moved).
+    fn warm_rollout<D: DiscreteDynamics + ?Sized>(
         &mut self,
         dynamics: &mut D,
-    ) -> Result<f64, OptimalError> {
-        let (nx, nu) = (self.nx, self.nu);
-        for k in 0..self.horizon {
-            let (past, future) = self.x.split_at_mut((k + 1) * nx);
-            dynamics.step(
-                &past[k * nx..],
-                &self.u[k * nu..(k + 1) * nu],
-                &mut future[..nx],
-            )?;
-        }
-        let cost = self.trajectory_cost(&self.x, &self.u);
-        if cost.is_finite() {
-            Ok(cost)
-        } else {
-            Err(OptimalError::InvalidSetting {
-                name: "warm start",
-                requirement: "a rollout of finite cost",
-                value: cost,
-            })
-        }
-    }
-
-    /// The rollout of the current controls from `x_0` with every control moved to the closest
-    /// within its step's rows (and the box) at the state reached, the rows linearised there
-    /// (a control whose rows admit none is kept); the cost, and whether the Jacobians it
-    /// computed are those of the final trajectory (no control moved).
-    fn constrained_rollout<D: DiscreteDynamics + ?Sized>(
-        &mut self,
-        dynamics: &mut D,
-        constraints: &mut dyn StepConstraints,
+        constraints: Option<&mut (dyn StepConstraints + '_)>,
+        follow: bool,
     ) -> Result<(f64, bool), OptimalError> {
         let (nx, nu) = (self.nx, self.nu);
-        let Some(work) = &mut self.constrained else {
-            return Ok((self.rollout(dynamics)?, false));
+        let mut rows = match (constraints, &mut self.constrained) {
+            (Some(c), Some(work)) => Some((c, work)),
+            _ => None,
         };
-        let mut unmoved = true;
+        let mut unmoved = rows.is_some();
         for k in 0..self.horizon {
             let (past, future) = self.x.split_at_mut((k + 1) * nx);
             let (x, next) = (&past[k * nx..], &mut future[..nx]);
             let u = &mut self.u[k * nu..(k + 1) * nu];
-            let b = &mut self.b[k * nx * nu..(k + 1) * nx * nu];
-            dynamics.linearise(x, u, next, &mut self.a[k * nx * nx..(k + 1) * nx * nx], b)?;
-            if work.project(constraints, k, (x, b), (&self.lower, &self.upper), u)? == Some(true) {
-                unmoved = false;
-                dynamics.step(x, u, next)?;
+            if follow {
+                let planned = &self.x_try[k * nx..(k + 1) * nx];
+                for (j, u) in u.iter_mut().enumerate() {
+                    let row = &self.gain[(k * nu + j) * nx..(k * nu + j + 1) * nx];
+                    let correction: f64 = (0..nx).map(|i| row[i] * (x[i] - planned[i])).sum();
+                    *u = (*u + correction).clamp(self.lower[j], self.upper[j]);
+                }
+            }
+            match &mut rows {
+                None => dynamics.step(x, u, next)?,
+                Some((c, work)) => {
+                    let b = &mut self.b[k * nx * nu..(k + 1) * nx * nu];
+                    let a = &mut self.a[k * nx * nx..(k + 1) * nx * nx];
+                    dynamics.linearise(x, u, next, a, b)?;
+                    let within = (&self.lower[..], &self.upper[..]);
+                    if work.project(&mut **c, k, (x, b), within, u)? == Some(true) {
+                        unmoved = false;
+                        dynamics.step(x, u, next)?;
+                    }
+                }
             }
         }
         let cost = self.trajectory_cost(&self.x, &self.u);
@@ -995,6 +1007,30 @@ impl Ilqr {
             .sum();
         total / self.horizon as f64
     }
+}
+
+/// Moves the nodes of `buffer` (`width` numbers each) `s` nodes earlier, repeating the last.
+fn shift_nodes(buffer: &mut [f64], width: usize, s: usize) {
+    let nodes = buffer.len() / width;
+    buffer.copy_within(s * width.., 0);
+    let (head, tail) = buffer.split_at_mut((nodes - s) * width);
+    let last = &head[(nodes - s - 1) * width..];
+    for chunk in tail.chunks_exact_mut(width) {
+        chunk.copy_from_slice(last);
+    }
+}
+
+/// Whether a warm start's rollout failed because its trajectory diverged: the dynamics refused
+/// a state on the way, or its cost is not finite.
+fn diverged(error: &OptimalError) -> bool {
+    matches!(
+        error,
+        OptimalError::Dynamics(_)
+            | OptimalError::InvalidSetting {
+                name: "warm start",
+                ..
+            }
+    )
 }
 
 /// Grows the regularisation; `false` once it passes its maximum.

@@ -337,3 +337,55 @@ fn mpc_plans_within_the_joint_torque_limits() {
     // ... and still moves towards the target.
     assert!(a1_end > 0.1, "{a1_end}");
 }
+
+/// A receding-horizon warm start whose open-loop rollout overflows (`x' = 2 x + u` over 1100
+/// steps from a state off the previous plan) follows the previous plan's feedback instead, and
+/// the solve reaches the optimum of the scalar Riccati recursion; without a plan to follow the
+/// same warm start is refused.
+#[test]
+fn a_warm_start_that_diverges_open_loop_follows_the_previous_plan() {
+    let (a, b, horizon) = (2.0, 1.0, 1100);
+    let cost = TrackingCost {
+        state: vec![1.0],
+        control: vec![1.0],
+        terminal: vec![1.0],
+    };
+    let mut sys = Linear {
+        a: vec![a],
+        b: vec![b],
+        nx: 1,
+        nu: 1,
+    };
+    let settings = IlqrSettings::default();
+    let mut ilqr = Ilqr::new(1, 1, horizon, &cost).unwrap();
+    // The plan at the reference: zero controls with the regulator's gains.
+    ilqr.solve(&mut sys, &[0.0], &settings).unwrap();
+    ilqr.shift(1);
+    // 2^1100 overflows: open loop, the shifted zero controls give an infinite cost.
+    let report = ilqr.solve(&mut sys, &[1.0], &settings).unwrap();
+    // The optimum 1/2 P_0 x_0^2 from P_N = Q_f, P = Q + a^2 P - (a b P)^2 / (R + b^2 P).
+    let mut p = 1.0;
+    for _ in 0..horizon {
+        p = 1.0 + a * a * p - (a * b * p).powi(2) / (1.0 + b * b * p);
+    }
+    let optimum = 0.5 * p;
+    assert!(report.converged, "{report:?}");
+    assert!(
+        (report.cost - optimum).abs() < 1e-9 * optimum,
+        "{} vs {optimum}",
+        report.cost
+    );
+    // Controls set by hand are rolled out open loop: refused as before.
+    ilqr.controls_mut().fill(0.0);
+    let error = ilqr.solve(&mut sys, &[1.0], &settings).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            OptimalError::InvalidSetting {
+                name: "warm start",
+                ..
+            }
+        ),
+        "{error}"
+    );
+}

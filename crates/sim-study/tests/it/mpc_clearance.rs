@@ -6,14 +6,30 @@
 use backbone_kin::{Branch, chain_inverse_kinematics};
 use optimal_ctl::MpcSettings;
 use sim_core::controller::MpcController;
-use sim_core::reference::Step;
+use sim_core::reference::Sinusoid;
 use sim_study::study::run_one;
 use sim_study::{ControllerKind, ReferenceSpec, Scenario, TaskSpec};
 
-/// `narrow-gap` without its plan: a step at 0.05 s from the straight arm to the closed-form
+/// The time of the unplanned motion (s).
+const TRAVEL: f64 = 1.5;
+
+/// The unplanned motion's reference, `a(t) = goal (1 - cos(pi t / T)) / 2`, arriving at `t = T`
+/// (the run ends then): offsets, amplitudes, frequencies and phases of a [`Sinusoid`].
+fn half_cosine(goal: &[f64]) -> [Vec<f64>; 4] {
+    let half: Vec<f64> = goal.iter().map(|g| g / 2.0).collect();
+    let m = goal.len();
+    [
+        half.clone(),
+        half.iter().map(|h| -h).collect(),
+        vec![0.5 / TRAVEL; m],
+        vec![std::f64::consts::FRAC_PI_2; m],
+    ]
+}
+
+/// `narrow-gap` without its plan: a smooth motion from the straight arm to the closed-form
 /// `K = 1` goal (in the scenario's `K = 2` coordinates), a shape with a joint inside an obstacle
-/// (`task.rs`), for 1.5 s.
-fn unplanned_step() -> (Scenario, Vec<f64>) {
+/// (`task.rs`), over 1.5 s.
+fn unplanned_motion() -> (Scenario, Vec<f64>) {
     let mut scenario = Scenario::builtin("narrow-gap").unwrap();
     let Some(TaskSpec::Reach { target, .. }) = &scenario.task else {
         panic!("narrow-gap has a reach task")
@@ -23,12 +39,14 @@ fn unplanned_step() -> (Scenario, Vec<f64>) {
     let a = chain_inverse_kinematics(&[0.1; 10], target, alpha0, Branch::Positive).unwrap();
     let goal = vec![a[0], a[1], 0.0, 0.0];
     scenario.task = None;
-    scenario.reference = ReferenceSpec::Step {
-        initial: None,
-        target: goal.clone(),
-        time: 0.05,
+    let [offset, amplitude, frequency_hz, phase] = half_cosine(&goal);
+    scenario.reference = ReferenceSpec::Sinusoid {
+        offset: Some(offset),
+        amplitude,
+        frequency_hz,
+        phase: Some(phase),
     };
-    scenario.duration = 1.5;
+    scenario.duration = TRAVEL;
     // The arm held off its goal by the obstacle is far from the reference: no runaway stop.
     scenario.limits.max_modal_error = 100.0;
     (scenario, goal)
@@ -36,18 +54,19 @@ fn unplanned_step() -> (Scenario, Vec<f64>) {
 
 #[test]
 fn mpc_within_the_clearance_rows_keeps_the_margin_where_mpc_within_the_box_collides() {
-    let (mut scenario, goal) = unplanned_step();
+    let (mut scenario, goal) = unplanned_motion();
     let margin = 0.01;
     scenario.controller.clearance_m = Some(margin);
     // MPC within the tau* box alone (no limits: the controller built by hand).
     let model = scenario.model().unwrap();
-    let reference = Step::new(&[0.0; 4], &goal, 0.05).unwrap();
+    let [offset, amplitude, frequency_hz, phase] = half_cosine(&goal);
+    let reference = Sinusoid::new(&offset, &amplitude, &frequency_hz, &phase).unwrap();
     let free = MpcController::new(&model, &MpcSettings::uniform(4), Box::new(reference)).unwrap();
     let run = scenario
         .build_with_controller(Box::new(free))
         .unwrap()
         .run()
-        .unwrap();
+        .unwrap_or_else(|f| panic!("{}", f.error));
     let free_clearance = run.summary.min_clearance_m.unwrap();
     assert!(free_clearance < 0.0, "{free_clearance} m");
     // The scenario's MPC plans within the margin.
@@ -55,14 +74,16 @@ fn mpc_within_the_clearance_rows_keeps_the_margin_where_mpc_within_the_box_colli
         .result
         .unwrap_or_else(|f| panic!("{}", f.error));
     let clearance = run.summary.min_clearance_m.unwrap();
-    assert!(clearance > margin - 1e-3, "{clearance} m");
+    // Within 2 mm: the rows are the clearance linearised about each node's predicted
+    // coordinates, and between plans the loop applies the plan's feedback unprojected.
+    assert!(clearance > margin - 2e-3, "{clearance} m");
     // It is pressed against the margin, not kept away by chance.
     assert!(clearance < margin + 2e-3, "{clearance} m");
 }
 
 #[test]
 fn the_mpc_clearance_margin_is_refused_out_of_its_domain_by_name() {
-    let (scenario, _) = unplanned_step();
+    let (scenario, _) = unplanned_motion();
     for (margin, problem) in [
         (-0.01, "must be non-negative and at most 1e3 m, got -0.01"),
         (f64::NAN, "must be non-negative and at most 1e3 m, got NaN"),
