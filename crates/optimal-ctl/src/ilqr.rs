@@ -135,6 +135,9 @@ pub struct IlqrReport {
     pub converged: bool,
     /// The regularisation at the end.
     pub regularisation: f64,
+    /// Nodes of the last backward pass whose rows (of a constrained solve) admitted no control
+    /// within the box at the nominal state, planned within the box alone there.
+    pub relaxed_nodes: usize,
 }
 
 /// The workspace of control-limited iLQR for `n_x` states, `n_u` controls and a horizon of `N`
@@ -209,6 +212,8 @@ pub struct Ilqr {
     /// Whether `x`, `u` and `gain` are the last solve's plan (shifted or not): a policy the
     /// warm start may follow when its open-loop rollout diverges.
     policy: bool,
+    /// The nodes of the last backward pass planned within the box alone.
+    relaxed: usize,
 }
 
 impl Ilqr {
@@ -316,6 +321,7 @@ impl Ilqr {
             qp: BoxQp::new(nu),
             constrained: None,
             policy: false,
+            relaxed: 0,
         })
     }
 
@@ -494,12 +500,14 @@ impl Ilqr {
     /// and the box by [`LinearQp`](crate::LinearQp), with the feedback gain restricted to
     /// the directions that keep the active rows active; the forward pass moves every control
     /// to the closest one within the rows at its own state ([`PolytopeProjection`](crate::PolytopeProjection)).
-    /// A step without rows is the box QP's, exactly. Needs
-    /// [`reserve_constraints`](Self::reserve_constraints) for `constraints.max_rows()` first.
+    /// A step without rows is the box QP's, exactly. A step whose rows admit no control within
+    /// the box (a warm start, or a state the momentum carries past them) is planned within the
+    /// box alone and counted ([`IlqrReport::relaxed_nodes`]); the forward pass keeps a control
+    /// whose rows admit none. Needs [`reserve_constraints`](Self::reserve_constraints) for
+    /// `constraints.max_rows()` first.
     ///
     /// # Errors
     /// As [`solve`](Self::solve); [`OptimalError::InvalidSetting`] without the reserved rows;
-    /// [`OptimalError::Infeasible`] when a step's rows admit no control at the nominal state;
     /// the constraints' own errors.
     pub fn solve_constrained<D: DiscreteDynamics + ?Sized>(
         &mut self,
@@ -636,6 +644,7 @@ impl Ilqr {
             cost,
             converged,
             regularisation: mu,
+            relaxed_nodes: self.relaxed,
         })
     }
 
@@ -817,6 +826,7 @@ impl Ilqr {
         let (nx, nu, n) = (self.nx, self.nu, self.horizon);
         let cost = &self.cost;
         let mut expected = [0.0; 2];
+        self.relaxed = 0;
         for i in 0..nx {
             self.v_x[i] = cost.terminal[i] * (self.x[n * nx + i] - self.x_ref[n * nx + i]);
         }
@@ -858,11 +868,11 @@ impl Ilqr {
             }
             let ff = &mut self.feedforward[k * nu..(k + 1) * nu];
             let gain = &mut self.gain[k * nu * nx..(k + 1) * nu * nx];
-            match &mut self.constrained {
+            // The step's rows and the box: the general QP and the gain that keeps the active
+            // rows active; the box alone without rows, or where they admit no control.
+            let within_rows = match &mut self.constrained {
                 Some(work) if constrained && work.counts[k] > 0 => {
-                    // The step's rows and the box: the general QP and the gain that keeps the
-                    // active rows active.
-                    work.feedforward(
+                    let feasible = work.feedforward(
                         k,
                         (&self.hessian, &self.q_u, &self.q_ux),
                         u,
@@ -870,22 +880,25 @@ impl Ilqr {
                         ff,
                         gain,
                     )?;
+                    self.relaxed += usize::from(!feasible);
+                    feasible
                 }
-                _ => {
-                    self.qp.solve(
-                        &self.hessian,
-                        &self.q_u,
-                        &self.step_lower,
-                        &self.step_upper,
-                        ff,
-                        qp,
-                    )?;
-                    // The gain on the free controls, zero on the clamped ones.
-                    gain.copy_from_slice(&self.q_ux);
-                    self.qp.solve_free(gain, nx);
-                    for g in gain.iter_mut() {
-                        *g = -*g;
-                    }
+                _ => false,
+            };
+            if !within_rows {
+                self.qp.solve(
+                    &self.hessian,
+                    &self.q_u,
+                    &self.step_lower,
+                    &self.step_upper,
+                    ff,
+                    qp,
+                )?;
+                // The gain on the free controls, zero on the clamped ones.
+                gain.copy_from_slice(&self.q_ux);
+                self.qp.solve_free(gain, nx);
+                for g in gain.iter_mut() {
+                    *g = -*g;
                 }
             }
             // The value function.
@@ -919,8 +932,8 @@ impl Ilqr {
     }
 
     /// The forward pass at step length `alpha` into `x_try`, `u_try`, every control moved within
-    /// the step's rows at its state when there are `constraints`; its cost (infinite if the
-    /// dynamics refuse a state on the way or a step's rows admit no control).
+    /// the step's rows at its state when there are `constraints` (kept where they admit none);
+    /// its cost (infinite if the dynamics refuse a state on the way).
     fn forward<D: DiscreteDynamics + ?Sized>(
         &mut self,
         dynamics: &mut D,
@@ -939,7 +952,9 @@ impl Ilqr {
                 self.u_try[k * nu + j] = u.clamp(self.lower[j], self.upper[j]);
             }
             if let (Some(c), Some(work)) = (constraints.as_deref_mut(), &mut self.constrained) {
-                let within = work.project(
+                // A control whose rows admit none is kept, as in the warm start; a state the
+                // rows' model refuses ends the candidate as the dynamics' refusal does.
+                match work.project(
                     c,
                     k,
                     (
@@ -948,9 +963,10 @@ impl Ilqr {
                     ),
                     (&self.lower, &self.upper),
                     &mut self.u_try[k * nu..(k + 1) * nu],
-                )?;
-                if within.is_none() {
-                    return Ok(f64::INFINITY);
+                ) {
+                    Ok(_) => {}
+                    Err(OptimalError::Dynamics(_)) => return Ok(f64::INFINITY),
+                    Err(other) => return Err(other),
                 }
             }
             let (past, future) = self.x_try.split_at_mut((k + 1) * nx);

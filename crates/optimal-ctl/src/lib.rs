@@ -69,12 +69,6 @@ pub enum OptimalError {
     /// A matrix that must be positive definite (`R + B^T P B`) was not, numerically.
     #[error("{0} is not numerically positive definite")]
     NotPositiveDefinite(&'static str),
-    /// The constraints of a step ([`StepConstraints`]) admit no control at its state.
-    #[error("the constraints of step {step} admit no control")]
-    Infeasible {
-        /// The step (0-based).
-        step: usize,
-    },
 }
 
 impl Classify for OptimalError {
@@ -85,9 +79,7 @@ impl Classify for OptimalError {
     fn class(&self) -> ErrorClass {
         match self {
             Self::Dynamics(e) => e.class(),
-            Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) | Self::Infeasible { .. } => {
-                ErrorClass::Numerical
-            }
+            Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) => ErrorClass::Numerical,
             _ => ErrorClass::InvalidInput,
         }
     }

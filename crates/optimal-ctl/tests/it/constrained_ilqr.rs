@@ -206,8 +206,11 @@ proptest! {
     }
 }
 
+/// Without reserved rows a constrained solve is refused; a step whose rows admit no control is
+/// planned within the box alone (here every step: the plan of the unconstrained solve) and
+/// counted.
 #[test]
-fn constrained_solves_need_their_rows_reserved_and_report_an_empty_polytope() {
+fn constrained_solves_need_their_rows_reserved_and_plan_empty_steps_within_the_box() {
     let cost = TrackingCost {
         state: vec![1.0; 2],
         control: vec![1.0; 2],
@@ -232,8 +235,15 @@ fn constrained_solves_need_their_rows_reserved_and_report_an_empty_polytope() {
         "{refused:?}"
     );
     ilqr.reserve_constraints(2).unwrap();
-    let refused = ilqr.solve_constrained(&mut sys, &mut empty, &[1.0, 0.0], &settings);
-    assert_eq!(refused.unwrap_err(), OptimalError::Infeasible { step: 3 });
+    let report = ilqr
+        .solve_constrained(&mut sys, &mut empty, &[1.0, 0.0], &settings)
+        .unwrap();
+    assert_eq!(report.relaxed_nodes, 4);
+    let mut free = Ilqr::new(2, 2, 4, &cost).unwrap();
+    free.solve(&mut sys, &[1.0, 0.0], &settings).unwrap();
+    for (got, want) in ilqr.controls().iter().zip(free.controls()) {
+        assert!((got - want).abs() < 1e-12, "{got} vs {want}");
+    }
 }
 
 /// The paper's arm with `alpha0 = pi/2` fixed.

@@ -46,8 +46,8 @@ pub use fuzzy::{SCHEDULED_INPUTS_PER_COORDINATE, scheduled_inputs};
 pub use lqr::LqrController;
 pub use mpc::MpcController;
 pub use mpc_limits::{
-    ANGLE_ACTIVATION_RAD, BoundConstraints, CLEARANCE_ACTIVATION_M, MAX_CLEARANCE_MARGIN_M,
-    MAX_CLEARANCE_ROWS, MpcConstraints, MpcLimits,
+    ANGLE_ACTIVATION_RAD, BoundConstraints, CLEARANCE_ACTIVATION_M, CLEARANCE_APPROACH_S,
+    MAX_CLEARANCE_MARGIN_M, MAX_CLEARANCE_ROWS, MpcConstraints, MpcLimits,
 };
 pub use pd::PdController;
 

@@ -6,7 +6,7 @@ use super::{ControlContext, Controller, ControllerError, check_context};
 use crate::error::SimError;
 use crate::reference::{Reference, ReferencePreview};
 use modal_reduce::Plant;
-use optimal_ctl::{Mpc, MpcSettings, OptimalError};
+use optimal_ctl::{Mpc, MpcSettings};
 
 /// Receding-horizon MPC ([`Mpc`]): at the first sample, and then at the first sample at least one
 /// model step `h` after the last plan, it previews the reference over the horizon
@@ -23,9 +23,9 @@ use optimal_ctl::{Mpc, MpcSettings, OptimalError};
 /// plans within the torques the loop will let through. With [`MpcLimits`]
 /// ([`with_limits`](Self::with_limits)) every plan is also made within the joint-torque
 /// polytope, the joint angle limits and the clearance margin ([`MpcConstraints`],
-/// [`Mpc::solve_constrained`]); a plan whose rows admit no torque at some node (a state the arm
-/// was pushed into) is made within the box alone and counted
-/// ([`box_fallbacks`](Self::box_fallbacks)). Nothing allocates per sample.
+/// [`Mpc::solve_constrained`]); a node whose rows admit no torque (a state the arm was pushed
+/// into, or its momentum carries it to) is planned within the box alone and counted
+/// ([`relaxed_nodes`](Self::relaxed_nodes)). Nothing allocates per sample.
 #[derive(Debug)]
 pub struct MpcController {
     mpc: Mpc,
@@ -34,8 +34,8 @@ pub struct MpcController {
     plan_time: f64,
     /// The rows every plan keeps besides the box, if any.
     constraints: Option<MpcConstraints>,
-    /// Plans made within the box alone because the rows admitted no torque.
-    fallbacks: usize,
+    /// Nodes planned within the box alone because their rows admitted no torque.
+    relaxed: usize,
 }
 
 /// Slack on "at least one step after the last plan" (relative to the step).
@@ -102,7 +102,7 @@ impl MpcController {
             preview,
             plan_time: 0.0,
             constraints: None,
-            fallbacks: 0,
+            relaxed: 0,
         })
     }
 
@@ -135,10 +135,11 @@ impl MpcController {
         self.constraints.as_ref()
     }
 
-    /// How many plans were made within the `tau*` box alone because the rows of
-    /// [`with_limits`](Self::with_limits) admitted no torque at some node.
-    pub fn box_fallbacks(&self) -> usize {
-        self.fallbacks
+    /// How many nodes, over every plan's last backward pass, were planned within the `tau*`
+    /// box alone because the rows of [`with_limits`](Self::with_limits) admitted no torque
+    /// there.
+    pub fn relaxed_nodes(&self) -> usize {
+        self.relaxed
     }
 
     /// Re-plans at `ctx.t` from the measured state.
@@ -169,14 +170,8 @@ impl MpcController {
             }
             Some(constraints) => {
                 let mut rows = constraints.bind(ctx.model);
-                match self.mpc.solve_constrained(ctx.model, a, a_dot, &mut rows) {
-                    Ok(_) => {}
-                    Err(OptimalError::Infeasible { .. }) => {
-                        self.fallbacks += 1;
-                        self.mpc.solve(ctx.model, a, a_dot)?;
-                    }
-                    Err(other) => return Err(other.into()),
-                }
+                let report = self.mpc.solve_constrained(ctx.model, a, a_dot, &mut rows)?;
+                self.relaxed += report.relaxed_nodes;
             }
         }
         self.plan_time = t;

@@ -12,6 +12,12 @@ use optimal_ctl::{JointTorqueLimits, OptimalError, StepConstraints};
 /// within this distance of the margin (m).
 pub const CLEARANCE_ACTIVATION_M: f64 = 0.02;
 
+/// The shortest time (s) in which a pair may close its gap to the clearance margin: at each
+/// node a pair's clearance over the margin may shrink at most by the factor `exp(-h / T)` in
+/// one step of `h` (a discrete-time control barrier function), so the arm slows down towards
+/// an obstacle instead of arriving at the margin at full speed.
+pub const CLEARANCE_APPROACH_S: f64 = 0.05;
+
 /// At most this many clearance rows a node: the pairs with the least slack (the arm's few
 /// modal coordinates leave no room for more independent ones).
 pub const MAX_CLEARANCE_ROWS: usize = 16;
@@ -70,6 +76,9 @@ struct ClearanceRows {
     model: ClearanceModel,
     data: ClearanceData,
     margin: f64,
+    /// `exp(-h / CLEARANCE_APPROACH_S)`: the most of its gap over the margin a pair keeps in one
+    /// step.
+    retain: f64,
     placement: Placement,
     /// Per pair: the modal gradient of its clearance (`m`, filled for the candidates).
     gradients: Vec<f64>,
@@ -115,13 +124,15 @@ enum Placement {
 ///   `s_j(u) + J_j (B_a + T B_v) (u' - u)`, the rows `+-s_j(u') <= L_j` for every joint within
 ///   [`ANGLE_ACTIVATION_RAD`] of its limit at `a` or in `s_j(u)` (with semi-implicit Euler,
 ///   `s_j <= L_j` at every node keeps `theta_j <= L_j` at every node);
-/// - clearance: `d(a_{k+1}(u')) ~ d(a_{k+1}(u)) + grad_a d . B_a (u' - u) >= min(c, d(a))`, the
-///   first-order expansion about the predicted next coordinates (the modal gradient there:
-///   `clearance::modal_gradients` on a planar arm, the joints' gradient through `J^T` on a
-///   spatial one; `d(a)` to first order back from them), for every pair (link-obstacle and
-///   link-link) within [`CLEARANCE_ACTIVATION_M`] of the margin `c` at `a_{k+1}(u)`, the
-///   [`MAX_CLEARANCE_ROWS`] with the least slack (a pair already inside the margin may not come
-///   closer).
+/// - clearance: `d(a_{k+1}(u')) ~ d(a_{k+1}(u)) + grad_a d . B_a (u' - u) >=
+///   min(d(a), c + rho (d(a) - c))`, `rho = exp(-h / T)` with `T` =
+///   [`CLEARANCE_APPROACH_S`], the first-order expansion about the predicted next coordinates
+///   (the modal gradient there: `clearance::modal_gradients` on a planar arm, the joints'
+///   gradient through `J^T` on a spatial one; `d(a)` to first order back from them), for every
+///   pair (link-obstacle and link-link) within [`CLEARANCE_ACTIVATION_M`] of the margin `c` at
+///   `a_{k+1}(u)`, the [`MAX_CLEARANCE_ROWS`] with the least slack: a pair closes its gap over
+///   the margin at most by the factor `rho` a step, and one already inside the margin may not
+///   come closer.
 #[derive(Debug, Clone)]
 pub struct MpcConstraints {
     m: usize,
@@ -175,7 +186,12 @@ impl MpcConstraints {
         };
         let clearance = match &limits.clearance {
             None => None,
-            Some(model) => Some(clearance_rows(plant, model, limits.clearance_margin_m)?),
+            Some(model) => Some(clearance_rows(
+                plant,
+                model,
+                limits.clearance_margin_m,
+                step,
+            )?),
         };
         Ok(Some(Self {
             m,
@@ -323,8 +339,8 @@ impl ClearanceRows {
                 self.candidates.push((next, p));
             }
         }
-        // Their modal gradients there, and the slack over the floor min(c, d(a)), d(a) to first
-        // order back from the next coordinates.
+        // Their modal gradients there, and the slack over the floor
+        // min(d(a), c + retain (d(a) - c)), d(a) to first order back from the next coordinates.
         if !self.candidates.is_empty() {
             self.prepare_gradients(plant)?;
         }
@@ -333,7 +349,8 @@ impl ClearanceRows {
             self.gradient(plant, p)?;
             let gradient = &self.gradients[p * m..(p + 1) * m];
             let now = next - dot_difference(gradient, next_a, a);
-            self.candidates[c].0 = next - self.margin.min(now);
+            let floor = now.min(self.margin + self.retain * (now - self.margin));
+            self.candidates[c].0 = next - floor;
         }
         if self.candidates.len() > MAX_CLEARANCE_ROWS {
             self.candidates
@@ -511,6 +528,7 @@ fn clearance_rows(
     plant: Plant<'_>,
     model: &ClearanceModel,
     margin: f64,
+    step: f64,
 ) -> Result<ClearanceRows, SimError> {
     if !(margin.is_finite() && (0.0..=MAX_CLEARANCE_MARGIN_M).contains(&margin)) {
         return Err(SimError::setting(
@@ -548,6 +566,7 @@ fn clearance_rows(
         model: model.clone(),
         data,
         margin,
+        retain: (-step / CLEARANCE_APPROACH_S).exp(),
         placement,
         gradients: vec![0.0; model.pairs().len() * m],
         candidates: Vec::with_capacity(model.pairs().len()),
