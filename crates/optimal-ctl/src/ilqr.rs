@@ -477,9 +477,10 @@ impl Ilqr {
     /// Minimises the [`TrackingCost`] from `x0` (`n_x` entries) over the horizon, starting from
     /// the controls in [`controls_mut`](Self::controls_mut) (projected onto the box). The
     /// solution is then in [`controls`](Self::controls), [`states`](Self::states) and
-    /// [`gains`](Self::gains). After a solve (and a [`shift`](Self::shift)), a warm start whose
-    /// open-loop rollout diverges (the dynamics refuse a state or the cost is not finite)
-    /// follows the last plan's feedback `u_k + K_k (x_k - x_plan,k)` instead.
+    /// [`gains`](Self::gains). After a solve (and a [`shift`](Self::shift)), the warm start
+    /// follows the last plan's feedback `u_k + K_k (x_k - x_plan,k)` from `x0`; controls set by
+    /// [`controls_mut`](Self::controls_mut), or the last plan's when following it diverges (the
+    /// dynamics refuse a state or the cost is not finite), are rolled out open loop.
     ///
     /// # Errors
     /// [`OptimalError::Dimension`] if `dynamics` or `x0` does not match the workspace,
@@ -545,7 +546,9 @@ impl Ilqr {
                 *u = if u.is_finite() { *u } else { 0.0 }.clamp(*l, *h);
             }
         }
-        // The previous plan, which a warm start that diverges open loop follows instead.
+        // The previous plan's policy, which the warm start follows when there is one (its open
+        // loop amplifies the measured state's offset on an unstable arm); the shifted controls
+        // open loop otherwise, or when following diverges.
         let follow = self.policy;
         self.policy = false;
         if follow {
@@ -557,10 +560,10 @@ impl Ilqr {
         // the state reached (as every forward pass does), so that the first nominal trajectory
         // is feasible; its Jacobians stand when no control moved.
         let (initial_cost, mut jacobians_current) =
-            match self.warm_rollout(dynamics, constraints.as_deref_mut(), false) {
+            match self.warm_rollout(dynamics, constraints.as_deref_mut(), follow) {
                 Err(error) if follow && diverged(&error) => {
                     self.u.copy_from_slice(&self.u_try);
-                    self.warm_rollout(dynamics, constraints.as_deref_mut(), true)?
+                    self.warm_rollout(dynamics, constraints.as_deref_mut(), false)?
                 }
                 other => other?,
             };

@@ -348,10 +348,11 @@ fn mpc_plans_within_the_joint_torque_limits() {
     assert!(a1_end > 0.1, "{a1_end}");
 }
 
-/// A receding-horizon warm start whose open-loop rollout overflows (`x' = 2 x + u` over 1100
-/// steps from a state off the previous plan) follows the previous plan's feedback instead, and
-/// the solve reaches the optimum of the scalar Riccati recursion; without a plan to follow the
-/// same warm start is refused.
+/// A receding-horizon warm start follows the previous plan's feedback: on `x' = 2 x + u` over
+/// 1100 steps from a state off the previous plan, where the shifted controls open loop overflow,
+/// the warm start costs the optimum of the scalar Riccati recursion (the plan's gains are the
+/// regulator's) and the solve ends there; controls set by hand are rolled out open loop and
+/// refused.
 #[test]
 fn a_warm_start_that_diverges_open_loop_follows_the_previous_plan() {
     let (a, b, horizon) = (2.0, 1.0, 1100);
@@ -380,6 +381,11 @@ fn a_warm_start_that_diverges_open_loop_follows_the_previous_plan() {
     }
     let optimum = 0.5 * p;
     assert!(report.converged, "{report:?}");
+    assert!(
+        (report.initial_cost - optimum).abs() < 1e-9 * optimum,
+        "{} vs {optimum}",
+        report.initial_cost
+    );
     assert!(
         (report.cost - optimum).abs() < 1e-9 * optimum,
         "{} vs {optimum}",
