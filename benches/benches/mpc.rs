@@ -7,14 +7,19 @@
 //! links, beside Crocoddyl's solve of the full joint space (benches/crocoddyl/mpc.py, issue 34).
 //! `mpc/solve_constrained_10` is the 10-link solve within the joint-torque polytope as well
 //! (issue 30: `JointTorqueRows` at every node, each joint's limit 10% below its peak over the
-//! free plan, `Mpc::solve_constrained`).
+//! free plan, `Mpc::solve_constrained`). `mpc/solve_clearance_10` is the 10-link solve within a
+//! clearance margin of 1 cm (links 1 cm thick) to two circles set 5 mm inside that margin of the
+//! free plan's links 6 and 10 at its middle node (`sim_core::controller::MpcConstraints`: the
+//! linearised clearance rows of the pairs near the margin, active at many nodes).
 
 use backbone_kin::ModalMap;
+use clearance::{ClearanceModel, Obstacle};
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use manip_dyn::ChainModel;
 use modal_reduce::ReducedData;
 use modal_reduce::ReducedModel;
 use optimal_ctl::{JointTorqueRows, Mpc, MpcSettings, StepConstraints};
+use sim_core::controller::{MpcConstraints, MpcLimits};
 use sim_core::reference::{Reference, ReferenceSample, Sinusoid};
 use std::hint::black_box;
 
@@ -73,6 +78,7 @@ fn solve_n(group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::Wal
         )
     });
     if n == 10 {
+        solve_clearance_10(group, &mpc, &model, (&a, &a_dot));
         // The same warm start re-planned within joint-torque limits 10% below each joint's peak
         // over the free plan (binding), the constraint memory sized beforehand.
         let limits = plan_peaks(&mpc, &model).map(|peak| 0.9 * peak);
@@ -90,6 +96,60 @@ fn solve_n(group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::Wal
             )
         });
     }
+}
+
+/// `mpc/solve_clearance_10`: the warm start of `mpc/solve_10` re-planned within a clearance
+/// margin that the free plan breaks.
+fn solve_clearance_10(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    mpc: &Mpc,
+    model: &ReducedModel,
+    (a, a_dot): (&[f64; 2], &[f64; 2]),
+) {
+    let (link_radius, margin, radius) = (0.01, 0.01, 0.03);
+    // The free plan's chain at its middle node.
+    let ilqr = mpc.ilqr();
+    let middle = &ilqr.states()[(ilqr.horizon() / 2) * 4..][..2];
+    let mut theta = [0.0; 10];
+    model.map().joint_angles(middle, &mut theta).unwrap();
+    let mut points = [[0.0; 2]; 11];
+    backbone_kin::joint_positions(&[0.1; 10], &theta, &mut points).unwrap();
+    // A circle beside the middle of a link, its clearance 5 mm short of the margin.
+    let beside = |link: usize, side: f64| {
+        let (p, q) = (points[link], points[link + 1]);
+        let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+        let offset = side * (radius + link_radius + margin - 0.005) / dx.hypot(dy);
+        Obstacle::circle(
+            [
+                0.5 * (p[0] + q[0]) - offset * dy,
+                0.5 * (p[1] + q[1]) + offset * dx,
+            ],
+            radius,
+        )
+        .unwrap()
+    };
+    let obstacles = vec![beside(5, 1.0), beside(9, -1.0)];
+    let limits = MpcLimits {
+        clearance: Some(ClearanceModel::new(10, link_radius, obstacles).unwrap()),
+        clearance_margin_m: margin,
+        ..MpcLimits::default()
+    };
+    let constraints = MpcConstraints::new(model, &limits, mpc.step())
+        .unwrap()
+        .unwrap();
+    let mut warm = mpc.clone();
+    warm.reserve_constraints(constraints.max_rows()).unwrap();
+    group.bench_function("solve_clearance_10", |b| {
+        b.iter_batched_ref(
+            || (warm.clone(), constraints.clone()),
+            |(mpc, constraints)| {
+                let mut rows = constraints.bind(model.into());
+                mpc.solve_constrained(model, black_box(a), black_box(a_dot), &mut rows)
+                    .unwrap()
+            },
+            BatchSize::SmallInput,
+        )
+    });
 }
 
 /// Each joint's largest torque over the nodes of `mpc`'s plan (eq 13 at the planned states).

@@ -2,7 +2,7 @@
 
 use crate::closest::{Closest, segment_box, segment_point, segment_segment};
 use crate::data::ClearanceData;
-use crate::model::{ClearanceModel, Pair};
+use crate::model::ClearanceModel;
 use crate::obstacle::Obstacle;
 
 /// Fills every pair's clearance and closest points for the placed chain and returns the smallest
@@ -15,32 +15,38 @@ use crate::obstacle::Obstacle;
 pub fn distances(model: &ClearanceModel, data: &mut ClearanceData) -> (f64, f64) {
     let radius = model.radius();
     let points = &data.points;
-    let (mut near_obstacle, mut near_self) = (f64::INFINITY, f64::INFINITY);
-    for ((pair, distance), closest) in model
-        .pairs()
-        .iter()
-        .zip(data.distances.iter_mut())
-        .zip(data.closest.iter_mut())
-    {
-        match *pair {
-            Pair::Obstacle { link, obstacle } => {
-                let (a, b) = (points[link], points[link + 1]);
-                let (found, other_radius) = closest_to(&model.obstacles()[obstacle], a, b);
+    let obstacles = model.obstacles();
+    // The pairs in the model's order: link-major against every obstacle, then (i, k >= i + 2).
+    let split = model.n_obstacle_pairs();
+    let (obstacle_distances, self_distances) = data.distances.split_at_mut(split);
+    let (obstacle_closest, self_closest) = data.closest.split_at_mut(split);
+    let mut near_obstacle = f64::INFINITY;
+    if !obstacles.is_empty() {
+        for ((link, distances), closest) in points
+            .windows(2)
+            .zip(obstacle_distances.chunks_exact_mut(obstacles.len()))
+            .zip(obstacle_closest.chunks_exact_mut(obstacles.len()))
+        {
+            let (a, b) = (link[0], link[1]);
+            for ((obstacle, distance), closest) in obstacles.iter().zip(distances).zip(closest) {
+                let (found, other_radius) = closest_to(obstacle, a, b);
                 *distance = found.distance - radius - other_radius;
                 *closest = found;
                 near_obstacle = near_obstacle.min(*distance);
             }
-            Pair::Links { link, other } => {
-                let found = segment_segment(
-                    points[link],
-                    points[link + 1],
-                    points[other],
-                    points[other + 1],
-                );
-                *distance = found.distance - 2.0 * radius;
-                *closest = found;
-                near_self = near_self.min(*distance);
-            }
+        }
+    }
+    let mut near_self = f64::INFINITY;
+    let mut pair = 0;
+    for link in 0..points.len().saturating_sub(1) {
+        let (a, b) = (points[link], points[link + 1]);
+        for other in points[link + 2..].windows(2) {
+            let found = segment_segment(a, b, other[0], other[1]);
+            let distance = found.distance - 2.0 * radius;
+            self_distances[pair] = distance;
+            self_closest[pair] = found;
+            near_self = near_self.min(distance);
+            pair += 1;
         }
     }
     (near_obstacle, near_self)

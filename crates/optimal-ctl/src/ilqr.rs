@@ -135,6 +135,9 @@ pub struct IlqrReport {
     pub converged: bool,
     /// The regularisation at the end.
     pub regularisation: f64,
+    /// Nodes of the last backward pass whose rows (of a constrained solve) admitted no control
+    /// within the box at the nominal state, planned within the box alone there.
+    pub relaxed_nodes: usize,
 }
 
 /// The workspace of control-limited iLQR for `n_x` states, `n_u` controls and a horizon of `N`
@@ -206,6 +209,11 @@ pub struct Ilqr {
     qp: BoxQp,
     /// The working memory of constrained solves, once reserved.
     constrained: Option<ConstrainedWork>,
+    /// Whether `x`, `u` and `gain` are the last solve's plan (shifted or not): a policy the
+    /// warm start may follow when its open-loop rollout diverges.
+    policy: bool,
+    /// The nodes of the last backward pass planned within the box alone.
+    relaxed: usize,
 }
 
 impl Ilqr {
@@ -312,6 +320,8 @@ impl Ilqr {
             adjoint_next: vec![0.0; nx],
             qp: BoxQp::new(nu),
             constrained: None,
+            policy: false,
+            relaxed: 0,
         })
     }
 
@@ -401,8 +411,10 @@ impl Ilqr {
     }
 
     /// The controls `u_0..u_{N-1}` (`N x n_u` row-major): the warm start before a solve, the
-    /// solution after it.
+    /// solution after it. Controls set here are rolled out open loop (the last plan's feedback
+    /// no longer applies to them).
     pub fn controls_mut(&mut self) -> &mut [f64] {
+        self.policy = false;
         &mut self.u
     }
 
@@ -429,25 +441,23 @@ impl Ilqr {
 
     /// Sets the warm start to the control references `w_k`.
     pub fn warm_start_from_control_references(&mut self) {
+        self.policy = false;
         self.u.copy_from_slice(&self.u_ref);
     }
 
-    /// Shifts the controls (and the QP warm starts) `steps` steps earlier, repeating the last
-    /// control at the end: the warm start of a receding horizon that moved on by `steps`.
+    /// Shifts the plan `steps` steps earlier (the controls, the QP warm starts, and the states
+    /// and gains the warm start may follow), repeating the last node at the end: the warm start
+    /// of a receding horizon that moved on by `steps`.
     pub fn shift(&mut self, steps: usize) {
-        let (n, nu) = (self.horizon, self.nu);
+        let (n, nu, nx) = (self.horizon, self.nu, self.nx);
         let s = steps.min(n - 1);
         if s == 0 {
             return;
         }
-        for buffer in [&mut self.u, &mut self.feedforward] {
-            buffer.copy_within(s * nu.., 0);
-            let (head, tail) = buffer.split_at_mut((n - s) * nu);
-            let last = &head[(n - s - 1) * nu..];
-            for chunk in tail.chunks_exact_mut(nu) {
-                chunk.copy_from_slice(last);
-            }
-        }
+        shift_nodes(&mut self.u, nu, s);
+        shift_nodes(&mut self.feedforward, nu, s);
+        shift_nodes(&mut self.gain, nu * nx, s);
+        shift_nodes(&mut self.x, nx, s);
     }
 
     /// `clamp(u_k + K_k dx)` into `out` (`n_u` entries): the locally optimal feedback of the last
@@ -467,7 +477,10 @@ impl Ilqr {
     /// Minimises the [`TrackingCost`] from `x0` (`n_x` entries) over the horizon, starting from
     /// the controls in [`controls_mut`](Self::controls_mut) (projected onto the box). The
     /// solution is then in [`controls`](Self::controls), [`states`](Self::states) and
-    /// [`gains`](Self::gains).
+    /// [`gains`](Self::gains). After a solve (and a [`shift`](Self::shift)), the warm start
+    /// follows the last plan's feedback `u_k + K_k (x_k - x_plan,k)` from `x0`; controls set by
+    /// [`controls_mut`](Self::controls_mut), or the last plan's when following it diverges (the
+    /// dynamics refuse a state or the cost is not finite), are rolled out open loop.
     ///
     /// # Errors
     /// [`OptimalError::Dimension`] if `dynamics` or `x0` does not match the workspace,
@@ -488,12 +501,14 @@ impl Ilqr {
     /// and the box by [`LinearQp`](crate::LinearQp), with the feedback gain restricted to
     /// the directions that keep the active rows active; the forward pass moves every control
     /// to the closest one within the rows at its own state ([`PolytopeProjection`](crate::PolytopeProjection)).
-    /// A step without rows is the box QP's, exactly. Needs
-    /// [`reserve_constraints`](Self::reserve_constraints) for `constraints.max_rows()` first.
+    /// A step without rows is the box QP's, exactly. A step whose rows admit no control within
+    /// the box (a warm start, or a state the momentum carries past them) is planned within the
+    /// box alone and counted ([`IlqrReport::relaxed_nodes`]); the forward pass keeps a control
+    /// whose rows admit none. Needs [`reserve_constraints`](Self::reserve_constraints) for
+    /// `constraints.max_rows()` first.
     ///
     /// # Errors
     /// As [`solve`](Self::solve); [`OptimalError::InvalidSetting`] without the reserved rows;
-    /// [`OptimalError::Infeasible`] when a step's rows admit no control at the nominal state;
     /// the constraints' own errors.
     pub fn solve_constrained<D: DiscreteDynamics + ?Sized>(
         &mut self,
@@ -531,8 +546,27 @@ impl Ilqr {
                 *u = if u.is_finite() { *u } else { 0.0 }.clamp(*l, *h);
             }
         }
+        // The previous plan's policy, which the warm start follows when there is one (its open
+        // loop amplifies the measured state's offset on an unstable arm); the shifted controls
+        // open loop otherwise, or when following diverges.
+        let follow = self.policy;
+        self.policy = false;
+        if follow {
+            self.x_try.copy_from_slice(&self.x);
+            self.u_try.copy_from_slice(&self.u);
+        }
         self.x[..self.nx].copy_from_slice(x0);
-        let initial_cost = self.rollout(dynamics)?;
+        // Within rows, the warm start's rollout moves every control within its step's rows at
+        // the state reached (as every forward pass does), so that the first nominal trajectory
+        // is feasible; its Jacobians stand when no control moved.
+        let (initial_cost, mut jacobians_current) =
+            match self.warm_rollout(dynamics, constraints.as_deref_mut(), follow) {
+                Err(error) if follow && diverged(&error) => {
+                    self.u.copy_from_slice(&self.u_try);
+                    self.warm_rollout(dynamics, constraints.as_deref_mut(), false)?
+                }
+                other => other?,
+            };
         let mut cost = initial_cost;
         let mut mu = settings.regularisation;
         let mut delta = 1.0;
@@ -541,7 +575,10 @@ impl Ilqr {
         let mut linearised = false;
         while iterations < settings.max_iterations {
             if !linearised {
-                self.linearise(dynamics)?;
+                if !jacobians_current {
+                    self.linearise(dynamics)?;
+                }
+                jacobians_current = false;
                 if let (Some(c), Some(work)) = (constraints.as_deref_mut(), &mut self.constrained) {
                     let (nx, nu) = (self.nx, self.nu);
                     for k in 0..self.horizon {
@@ -603,12 +640,14 @@ impl Ilqr {
                 }
             }
         }
+        self.policy = true;
         Ok(IlqrReport {
             iterations,
             initial_cost,
             cost,
             converged,
             regularisation: mu,
+            relaxed_nodes: self.relaxed,
         })
     }
 
@@ -704,23 +743,54 @@ impl Ilqr {
         Ok(())
     }
 
-    /// `x_{k+1} = F(x_k, u_k)` from `x_0` with the current controls; the cost.
-    fn rollout<D: DiscreteDynamics + ?Sized>(
+    /// The warm start's rollout from `x_0`: `x_{k+1} = F(x_k, u_k)` with the current controls
+    /// or, when `follow`, with the previous plan's feedback `u_k + K_k (x_k - x̄_k)` about its
+    /// states `x̄_k` (kept in `x_try`), clamped to the box. With `constraints`, every control is
+    /// then moved to the closest within its step's rows at the state reached, the rows
+    /// linearised there (a control whose rows admit none is kept). The cost, and whether the
+    /// Jacobians computed on the way are those of the final trajectory (only with constraints,
+    /// when no control moved).
+    fn warm_rollout<D: DiscreteDynamics + ?Sized>(
         &mut self,
         dynamics: &mut D,
-    ) -> Result<f64, OptimalError> {
+        constraints: Option<&mut (dyn StepConstraints + '_)>,
+        follow: bool,
+    ) -> Result<(f64, bool), OptimalError> {
         let (nx, nu) = (self.nx, self.nu);
+        let mut rows = match (constraints, &mut self.constrained) {
+            (Some(c), Some(work)) => Some((c, work)),
+            _ => None,
+        };
+        let mut unmoved = rows.is_some();
         for k in 0..self.horizon {
             let (past, future) = self.x.split_at_mut((k + 1) * nx);
-            dynamics.step(
-                &past[k * nx..],
-                &self.u[k * nu..(k + 1) * nu],
-                &mut future[..nx],
-            )?;
+            let (x, next) = (&past[k * nx..], &mut future[..nx]);
+            let u = &mut self.u[k * nu..(k + 1) * nu];
+            if follow {
+                let planned = &self.x_try[k * nx..(k + 1) * nx];
+                for (j, u) in u.iter_mut().enumerate() {
+                    let row = &self.gain[(k * nu + j) * nx..(k * nu + j + 1) * nx];
+                    let correction: f64 = (0..nx).map(|i| row[i] * (x[i] - planned[i])).sum();
+                    *u = (*u + correction).clamp(self.lower[j], self.upper[j]);
+                }
+            }
+            match &mut rows {
+                None => dynamics.step(x, u, next)?,
+                Some((c, work)) => {
+                    let b = &mut self.b[k * nx * nu..(k + 1) * nx * nu];
+                    let a = &mut self.a[k * nx * nx..(k + 1) * nx * nx];
+                    dynamics.linearise(x, u, next, a, b)?;
+                    let within = (&self.lower[..], &self.upper[..]);
+                    if work.project(&mut **c, k, (x, b), within, u)? == Some(true) {
+                        unmoved = false;
+                        dynamics.step(x, u, next)?;
+                    }
+                }
+            }
         }
         let cost = self.trajectory_cost(&self.x, &self.u);
         if cost.is_finite() {
-            Ok(cost)
+            Ok((cost, unmoved))
         } else {
             Err(OptimalError::InvalidSetting {
                 name: "warm start",
@@ -783,6 +853,7 @@ impl Ilqr {
         let n = self.horizon;
         let cost = &self.cost;
         let mut expected = [0.0; 2];
+        self.relaxed = 0;
         for i in 0..nx {
             self.v_x[i] = cost.terminal[i] * (self.x[n * nx + i] - self.x_ref[n * nx + i]);
         }
@@ -824,11 +895,11 @@ impl Ilqr {
             }
             let ff = &mut self.feedforward[k * nu..(k + 1) * nu];
             let gain = &mut self.gain[k * nu * nx..(k + 1) * nu * nx];
-            match &mut self.constrained {
+            // The step's rows and the box: the general QP and the gain that keeps the active
+            // rows active; the box alone without rows, or where they admit no control.
+            let within_rows = match &mut self.constrained {
                 Some(work) if constrained && work.counts[k] > 0 => {
-                    // The step's rows and the box: the general QP and the gain that keeps the
-                    // active rows active.
-                    work.feedforward(
+                    let feasible = work.feedforward(
                         k,
                         (&self.hessian, &self.q_u, &self.q_ux),
                         u,
@@ -836,22 +907,25 @@ impl Ilqr {
                         ff,
                         gain,
                     )?;
+                    self.relaxed += usize::from(!feasible);
+                    feasible
                 }
-                _ => {
-                    self.qp.solve(
-                        &self.hessian,
-                        &self.q_u,
-                        &self.step_lower,
-                        &self.step_upper,
-                        ff,
-                        qp,
-                    )?;
-                    // The gain on the free controls, zero on the clamped ones.
-                    gain.copy_from_slice(&self.q_ux);
-                    self.qp.solve_free(gain, nx);
-                    for g in gain.iter_mut() {
-                        *g = -*g;
-                    }
+                _ => false,
+            };
+            if !within_rows {
+                self.qp.solve(
+                    &self.hessian,
+                    &self.q_u,
+                    &self.step_lower,
+                    &self.step_upper,
+                    ff,
+                    qp,
+                )?;
+                // The gain on the free controls, zero on the clamped ones.
+                gain.copy_from_slice(&self.q_ux);
+                self.qp.solve_free(gain, nx);
+                for g in gain.iter_mut() {
+                    *g = -*g;
                 }
             }
             // The value function.
@@ -885,8 +959,8 @@ impl Ilqr {
     }
 
     /// The forward pass at step length `alpha` into `x_try`, `u_try`, every control moved within
-    /// the step's rows at its state when there are `constraints`; its cost (infinite if the
-    /// dynamics refuse a state on the way or a step's rows admit no control).
+    /// the step's rows at its state when there are `constraints` (kept where they admit none);
+    /// its cost (infinite if the dynamics refuse a state on the way).
     fn forward<D: DiscreteDynamics + ?Sized>(
         &mut self,
         dynamics: &mut D,
@@ -905,7 +979,9 @@ impl Ilqr {
                 self.u_try[k * nu + j] = u.clamp(self.lower[j], self.upper[j]);
             }
             if let (Some(c), Some(work)) = (constraints.as_deref_mut(), &mut self.constrained) {
-                let within = work.project(
+                // A control whose rows admit none is kept, as in the warm start; a state the
+                // rows' model refuses ends the candidate as the dynamics' refusal does.
+                match work.project(
                     c,
                     k,
                     (
@@ -914,9 +990,10 @@ impl Ilqr {
                     ),
                     (&self.lower, &self.upper),
                     &mut self.u_try[k * nu..(k + 1) * nu],
-                )?;
-                if !within {
-                    return Ok(f64::INFINITY);
+                ) {
+                    Ok(_) => {}
+                    Err(OptimalError::Dynamics(_)) => return Ok(f64::INFINITY),
+                    Err(other) => return Err(other),
                 }
             }
             let (past, future) = self.x_try.split_at_mut((k + 1) * nx);
@@ -973,6 +1050,30 @@ impl Ilqr {
             .sum();
         total / self.horizon as f64
     }
+}
+
+/// Moves the nodes of `buffer` (`width` numbers each) `s` nodes earlier, repeating the last.
+fn shift_nodes(buffer: &mut [f64], width: usize, s: usize) {
+    let nodes = buffer.len() / width;
+    buffer.copy_within(s * width.., 0);
+    let (head, tail) = buffer.split_at_mut((nodes - s) * width);
+    let last = &head[(nodes - s - 1) * width..];
+    for chunk in tail.chunks_exact_mut(width) {
+        chunk.copy_from_slice(last);
+    }
+}
+
+/// Whether a warm start's rollout failed because its trajectory diverged: the dynamics refused
+/// a state on the way, or its cost is not finite.
+fn diverged(error: &OptimalError) -> bool {
+    matches!(
+        error,
+        OptimalError::Dynamics(_)
+            | OptimalError::InvalidSetting {
+                name: "warm start",
+                ..
+            }
+    )
 }
 
 /// Grows the regularisation; `false` once it passes its maximum.

@@ -14,7 +14,7 @@ mod step_constraints;
 pub use box_qp::{BoxQp, BoxQpReport, BoxQpSettings};
 pub use discrete::{DiscreteDynamics, ReducedEuler};
 pub use ilqr::{Ilqr, IlqrReport, IlqrSettings, MAX_HORIZON, MAX_WORKSPACE, TrackingCost};
-pub use joint_torque_rows::JointTorqueRows;
+pub use joint_torque_rows::{JointTorqueLimits, JointTorqueRows};
 pub use linear_qp::{LinearQp, LinearQpFailure};
 pub use linearise::Linearisation;
 pub use lqr::{Lqr, LqrSettings};
@@ -69,12 +69,6 @@ pub enum OptimalError {
     /// A matrix that must be positive definite (`R + B^T P B`) was not, numerically.
     #[error("{0} is not numerically positive definite")]
     NotPositiveDefinite(&'static str),
-    /// The constraints of a step ([`StepConstraints`]) admit no control at its state.
-    #[error("the constraints of step {step} admit no control")]
-    Infeasible {
-        /// The step (0-based).
-        step: usize,
-    },
 }
 
 impl Classify for OptimalError {
@@ -85,9 +79,7 @@ impl Classify for OptimalError {
     fn class(&self) -> ErrorClass {
         match self {
             Self::Dynamics(e) => e.class(),
-            Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) | Self::Infeasible { .. } => {
-                ErrorClass::Numerical
-            }
+            Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) => ErrorClass::Numerical,
             _ => ErrorClass::InvalidInput,
         }
     }

@@ -312,11 +312,12 @@ impl Mpc {
     /// `constraints` at every node besides the `tau*` box ([`Ilqr::solve_constrained`]): the
     /// joint-torque polytope ([`JointTorqueRows`](crate::JointTorqueRows)), or joint limits and
     /// clearances linearised through the step's `B`. The first call sizes the solver's
-    /// constraint memory (allocates); later calls with as many rows do not.
+    /// constraint memory (allocates); later calls with as many rows do not. A node whose rows
+    /// admit no torque within the box is planned within the box alone
+    /// ([`IlqrReport::relaxed_nodes`]).
     ///
     /// # Errors
-    /// As [`solve`](Self::solve); [`OptimalError::Infeasible`] when a node's rows admit no
-    /// torque at its planned state.
+    /// As [`solve`](Self::solve).
     pub fn solve_constrained<'p>(
         &mut self,
         model: impl Into<Plant<'p>>,

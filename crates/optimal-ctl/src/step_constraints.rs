@@ -160,7 +160,8 @@ impl ConstrainedWork {
     /// The feed-forward step of step `k`: `ff = argmin 1/2 d^T H d + q^T d` subject to
     /// `G (u + d) <= g` and the box, and the gain `K = -(H^-1 - H^-1 A^T (A H^-1 A^T)^-1 A H^-1)
     /// Q_ux` that keeps the active rows `A` active to first order (zero when they leave no
-    /// freedom): the box QP's "zero gain on the clamped controls", for any rows.
+    /// freedom): the box QP's "zero gain on the clamped controls", for any rows. `false` (and
+    /// `ff`, `gain` unset) when the rows and the box admit no control.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn feedforward(
         &mut self,
@@ -170,7 +171,7 @@ impl ConstrainedWork {
         bounds: (&[f64], &[f64]),
         ff: &mut [f64],
         gain: &mut [f64],
-    ) -> Result<(), OptimalError> {
+    ) -> Result<bool, OptimalError> {
         let (nx, nu, max) = (self.nx, self.nu, self.max_rows);
         let count = self.counts[k];
         let rows = std::mem::take(&mut self.rows);
@@ -193,9 +194,7 @@ impl ConstrainedWork {
             Err(LinearQpFailure::NotPositiveDefinite) => {
                 return Err(OptimalError::NotPositiveDefinite("Q_uu + mu I"));
             }
-            Err(LinearQpFailure::Projection(_)) => {
-                return Err(OptimalError::Infeasible { step: k });
-            }
+            Err(LinearQpFailure::Projection(_)) => return Ok(false),
         }
         // The active rows.
         let mut na = 0;
@@ -207,7 +206,7 @@ impl ConstrainedWork {
                 if na == nu {
                     // More active rows than controls: a vertex, no feedback freedom.
                     gain.fill(0.0);
-                    return Ok(());
+                    return Ok(true);
                 }
                 self.active[na * nu..(na + 1) * nu].copy_from_slice(row);
                 na += 1;
@@ -243,7 +242,7 @@ impl ConstrainedWork {
             if !cholesky(&mut self.s_mat[..na * na], na) {
                 // Dependent active rows: keep the controls where the rows hold them.
                 gain.fill(0.0);
-                return Ok(());
+                return Ok(true);
             }
             cholesky_solve(&self.s_mat[..na * na], na, &mut self.ax[..na * nx], nx);
             for i in 0..nu {
@@ -258,11 +257,12 @@ impl ConstrainedWork {
         for g in gain.iter_mut() {
             *g = -*g;
         }
-        Ok(())
+        Ok(true)
     }
 
     /// Moves `u` (`n_u`) to the closest control within the rows of step `k` at the forward
-    /// pass's state `x` (with the nominal `b`) and the box; `Ok(false)` when none is.
+    /// pass's state `x` (with the nominal `b`) and the box: whether it moved, or `None` (`u`
+    /// kept) when no control is within.
     pub(crate) fn project(
         &mut self,
         constraints: &mut dyn StepConstraints,
@@ -270,7 +270,7 @@ impl ConstrainedWork {
         (x, b): (&[f64], &[f64]),
         box_bounds: (&[f64], &[f64]),
         u: &mut [f64],
-    ) -> Result<bool, OptimalError> {
+    ) -> Result<Option<bool>, OptimalError> {
         let (nu, max) = (self.nu, self.max_rows);
         let count =
             constraints.rows(k, x, u, b, &mut self.forward_rows, &mut self.forward_bounds)?;
@@ -292,11 +292,11 @@ impl ConstrainedWork {
             u,
             &mut self.projected,
         ) {
-            Ok(_) => {
+            Ok(moved) => {
                 u.copy_from_slice(&self.projected);
-                Ok(true)
+                Ok(Some(moved))
             }
-            Err(_) => Ok(false),
+            Err(_) => Ok(None),
         }
     }
 }

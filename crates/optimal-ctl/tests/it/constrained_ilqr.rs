@@ -206,8 +206,11 @@ proptest! {
     }
 }
 
+/// Without reserved rows a constrained solve is refused; a step whose rows admit no control is
+/// planned within the box alone (here every step: the plan of the unconstrained solve) and
+/// counted.
 #[test]
-fn constrained_solves_need_their_rows_reserved_and_report_an_empty_polytope() {
+fn constrained_solves_need_their_rows_reserved_and_plan_empty_steps_within_the_box() {
     let cost = TrackingCost {
         state: vec![1.0; 2],
         control: vec![1.0; 2],
@@ -232,8 +235,15 @@ fn constrained_solves_need_their_rows_reserved_and_report_an_empty_polytope() {
         "{refused:?}"
     );
     ilqr.reserve_constraints(2).unwrap();
-    let refused = ilqr.solve_constrained(&mut sys, &mut empty, &[1.0, 0.0], &settings);
-    assert_eq!(refused.unwrap_err(), OptimalError::Infeasible { step: 3 });
+    let report = ilqr
+        .solve_constrained(&mut sys, &mut empty, &[1.0, 0.0], &settings)
+        .unwrap();
+    assert_eq!(report.relaxed_nodes, 4);
+    let mut free = Ilqr::new(2, 2, 4, &cost).unwrap();
+    free.solve(&mut sys, &[1.0, 0.0], &settings).unwrap();
+    for (got, want) in ilqr.controls().iter().zip(free.controls()) {
+        assert!((got - want).abs() < 1e-12, "{got} vs {want}");
+    }
 }
 
 /// The paper's arm with `alpha0 = pi/2` fixed.
@@ -336,4 +346,62 @@ fn mpc_plans_within_the_joint_torque_limits() {
     assert!(peak <= limit * (1.0 + 1e-9), "{peak}");
     // ... and still moves towards the target.
     assert!(a1_end > 0.1, "{a1_end}");
+}
+
+/// A receding-horizon warm start follows the previous plan's feedback: on `x' = 2 x + u` over
+/// 1100 steps from a state off the previous plan, where the shifted controls open loop overflow,
+/// the warm start costs the optimum of the scalar Riccati recursion (the plan's gains are the
+/// regulator's) and the solve ends there; controls set by hand are rolled out open loop and
+/// refused.
+#[test]
+fn a_warm_start_that_diverges_open_loop_follows_the_previous_plan() {
+    let (a, b, horizon) = (2.0, 1.0, 1100);
+    let cost = TrackingCost {
+        state: vec![1.0],
+        control: vec![1.0],
+        terminal: vec![1.0],
+    };
+    let mut sys = Linear {
+        a: vec![a],
+        b: vec![b],
+        nx: 1,
+        nu: 1,
+    };
+    let settings = IlqrSettings::default();
+    let mut ilqr = Ilqr::new(1, 1, horizon, &cost).unwrap();
+    // The plan at the reference: zero controls with the regulator's gains.
+    ilqr.solve(&mut sys, &[0.0], &settings).unwrap();
+    ilqr.shift(1);
+    // 2^1100 overflows: open loop, the shifted zero controls give an infinite cost.
+    let report = ilqr.solve(&mut sys, &[1.0], &settings).unwrap();
+    // The optimum 1/2 P_0 x_0^2 from P_N = Q_f, P = Q + a^2 P - (a b P)^2 / (R + b^2 P).
+    let mut p = 1.0;
+    for _ in 0..horizon {
+        p = 1.0 + a * a * p - (a * b * p).powi(2) / (1.0 + b * b * p);
+    }
+    let optimum = 0.5 * p;
+    assert!(report.converged, "{report:?}");
+    assert!(
+        (report.initial_cost - optimum).abs() < 1e-9 * optimum,
+        "{} vs {optimum}",
+        report.initial_cost
+    );
+    assert!(
+        (report.cost - optimum).abs() < 1e-9 * optimum,
+        "{} vs {optimum}",
+        report.cost
+    );
+    // Controls set by hand are rolled out open loop: refused as before.
+    ilqr.controls_mut().fill(0.0);
+    let error = ilqr.solve(&mut sys, &[1.0], &settings).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            OptimalError::InvalidSetting {
+                name: "warm start",
+                ..
+            }
+        ),
+        "{error}"
+    );
 }

@@ -2,8 +2,8 @@
 //! (eqs 19-24, Figure 8) applied per coordinate pair or any `.fis` system with `2m` inputs and
 //! `m` outputs, its linearisation at the origin (PD), computed torque with the exact reduced
 //! model, the fuzzy controller plus gravity compensation `G*`, the LQR about the reference,
-//! re-linearised along it ([`LqrController`]), and model-predictive control under `tau*` limits
-//! ([`MpcController`]).
+//! re-linearised along it ([`LqrController`]), and model-predictive control under `tau*` limits,
+//! and within joint limits and clearance ([`MpcController`], [`MpcLimits`]).
 //!
 //! The closed loop samples a controller at its own period and holds its output in between
 //! (zero-order hold). At each sample it hands the controller a [`ControlContext`] that borrows
@@ -37,6 +37,7 @@ mod computed_torque;
 mod fuzzy;
 mod lqr;
 mod mpc;
+mod mpc_limits;
 mod pd;
 
 pub use computed_torque::ComputedTorque;
@@ -44,6 +45,10 @@ pub use fuzzy::FuzzyController;
 pub use fuzzy::{SCHEDULED_INPUTS_PER_COORDINATE, scheduled_inputs};
 pub use lqr::LqrController;
 pub use mpc::MpcController;
+pub use mpc_limits::{
+    ANGLE_ACTIVATION_RAD, BoundConstraints, CLEARANCE_ACTIVATION_M, CLEARANCE_APPROACH_S,
+    MAX_CLEARANCE_MARGIN_M, MAX_CLEARANCE_ROWS, MpcConstraints, MpcLimits,
+};
 pub use pd::PdController;
 
 pub use crate::error::ControllerError;

@@ -1,6 +1,7 @@
 //! Model-predictive control in the loop: [`Mpc`] re-planned every model step from the measured
 //! state over a preview of the reference, with the plan's feedback in between.
 
+use super::mpc_limits::{MpcConstraints, MpcLimits};
 use super::{ControlContext, Controller, ControllerError, check_context};
 use crate::error::SimError;
 use crate::reference::{Reference, ReferencePreview};
@@ -19,13 +20,22 @@ use optimal_ctl::{Mpc, MpcSettings};
 /// time (a new run of the same [`Simulation`](crate::Simulation)) starts planning afresh.
 /// The loop's actuator limits ([`ControlContext::tau_star_limits`], a scenario's
 /// `[limits] tau_star`), when set, replace the settings' limits at every plan, so the solver
-/// plans within the torques the loop will let through. Nothing allocates per sample.
+/// plans within the torques the loop will let through. With [`MpcLimits`]
+/// ([`with_limits`](Self::with_limits)) every plan is also made within the joint-torque
+/// polytope, the joint angle limits and the clearance margin ([`MpcConstraints`],
+/// [`Mpc::solve_constrained`]); a node whose rows admit no torque (a state the arm was pushed
+/// into, or its momentum carries it to) is planned within the box alone and counted
+/// ([`relaxed_nodes`](Self::relaxed_nodes)). Nothing allocates per sample.
 #[derive(Debug)]
 pub struct MpcController {
     mpc: Mpc,
     preview: ReferencePreview,
     /// The time of the last plan.
     plan_time: f64,
+    /// The rows every plan keeps besides the box, if any.
+    constraints: Option<MpcConstraints>,
+    /// Nodes planned within the box alone because their rows admitted no torque.
+    relaxed: usize,
 }
 
 /// Slack on "at least one step after the last plan" (relative to the step).
@@ -91,12 +101,45 @@ impl MpcController {
             mpc,
             preview,
             plan_time: 0.0,
+            constraints: None,
+            relaxed: 0,
         })
+    }
+
+    /// The controller planning within `limits` as well (for `model`, the arm it was built
+    /// for); empty limits change nothing. Sizes the rows' memory (allocates, once).
+    ///
+    /// # Errors
+    /// [`SimError::InvalidSetting`] naming the limit out of its domain ([`MpcConstraints::new`]).
+    pub fn with_limits<'p>(
+        mut self,
+        model: impl Into<Plant<'p>>,
+        limits: &MpcLimits,
+    ) -> Result<Self, SimError> {
+        self.constraints = MpcConstraints::new(model, limits, self.mpc.step())?;
+        if let Some(constraints) = &self.constraints {
+            self.mpc
+                .reserve_constraints(constraints.max_rows())
+                .map_err(|e| SimError::setting("controller.mpc", e.to_string()))?;
+        }
+        Ok(self)
     }
 
     /// The MPC workspace: the last plan.
     pub fn mpc(&self) -> &Mpc {
         &self.mpc
+    }
+
+    /// The rows the plans keep besides the box, if any.
+    pub fn constraints(&self) -> Option<&MpcConstraints> {
+        self.constraints.as_ref()
+    }
+
+    /// How many nodes, over every plan's last backward pass, were planned within the `tau*`
+    /// box alone because the rows of [`with_limits`](Self::with_limits) admitted no torque
+    /// there.
+    pub fn relaxed_nodes(&self) -> usize {
+        self.relaxed
     }
 
     /// Re-plans at `ctx.t` from the measured state.
@@ -120,8 +163,17 @@ impl MpcController {
         if let Some(limits) = ctx.tau_star_limits {
             self.mpc.set_limits(Some(limits))?;
         }
-        self.mpc
-            .solve(ctx.model, &ctx.measured.a, &ctx.measured.a_dot)?;
+        let (a, a_dot) = (&ctx.measured.a, &ctx.measured.a_dot);
+        match &mut self.constraints {
+            None => {
+                self.mpc.solve(ctx.model, a, a_dot)?;
+            }
+            Some(constraints) => {
+                let mut rows = constraints.bind(ctx.model);
+                let report = self.mpc.solve_constrained(ctx.model, a, a_dot, &mut rows)?;
+                self.relaxed += report.relaxed_nodes;
+            }
+        }
         self.plan_time = t;
         Ok(())
     }

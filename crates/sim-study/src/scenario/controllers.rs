@@ -7,7 +7,8 @@ use modal_reduce::PlantModel;
 use optimal_ctl::MpcSettings;
 use serde::{Deserialize, Serialize};
 use sim_core::controller::{
-    ComputedTorque, FuzzyController, LqrController, MpcController, PdController,
+    ComputedTorque, Controller, FuzzyController, LqrController, MpcController, MpcLimits,
+    PdController,
 };
 use sim_core::{ControllerFactory, Prepared, ReferenceFactory, SimError};
 use std::fmt;
@@ -76,6 +77,12 @@ pub struct ControllerSpec {
     /// LQR re-linearisation period (s, default 0.01; at least the controller period).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lqr_relinearise: Option<f64>,
+    /// The clearance MPC plans to keep between every link and every obstacle and between links
+    /// that share no joint (m, non-negative, at most 1e3; default the `[task]`'s `clearance`,
+    /// else 0). Only with `[[obstacles]]` or `[arm] radius`
+    /// ([`MpcLimits`](sim_core::controller::MpcLimits)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearance_m: Option<f64>,
 }
 
 /// What a fuzzy controller does with an input outside its variable's range
@@ -116,6 +123,9 @@ pub struct ControllerSetup<'a> {
     /// A fuzzy system given in memory (e.g. one just learned), used instead of the `.fis` file
     /// `spec.fis` names or the paper's; `None` for those.
     pub system: Option<&'a FuzzySystem>,
+    /// What MPC plans within besides the `tau*` box: the loop's joint limits, its links and
+    /// obstacles, and the clearance margin (empty without them).
+    pub limits: &'a MpcLimits,
 }
 
 /// A row of the controller table: a controller's name, what it is, and how a scenario builds it.
@@ -239,19 +249,21 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
     ControllerEntry {
         kind: ControllerKind::Mpc,
         name: "mpc",
-        description: "model-predictive control: control-limited iLQR over a 0.3 s receding horizon",
+        description: "model-predictive control: control-limited iLQR over a 0.3 s receding horizon, \
+                      within the joint limits and the clearance margin (clearance_m)",
         prepare: |s| {
             let settings = MpcSettings::uniform(m(s));
             let (model, reference) = (s.model.clone(), Arc::clone(s.reference));
+            let limits = s.limits.clone();
+            let build = move || -> Result<Box<dyn Controller>, SimError> {
+                Ok(Box::new(
+                    MpcController::new(model.plant(), &settings, reference()?)?
+                        .with_limits(model.plant(), &limits)?,
+                ))
+            };
             // Checked once here; each run builds its own (its plan is its state).
-            MpcController::new(model.plant(), &settings, reference()?)?;
-            Ok(Arc::new(move || {
-                Ok(Box::new(MpcController::new(
-                    model.plant(),
-                    &settings,
-                    reference()?,
-                )?))
-            }))
+            build()?;
+            Ok(Arc::new(build))
         },
     },
 ];

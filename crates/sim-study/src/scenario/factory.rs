@@ -5,13 +5,13 @@ use super::arm::{ArmKind, Gravity, Inertias};
 use super::controllers::{ControllerSetup, per_coordinate};
 use super::schema::{
     Alpha0, AngleLimit, ArmSpec, BranchSpec, IntegratorSpec, ModalTorqueLimit, NoiseSpec,
-    ReferenceSpec, Scenario, TorqueLimit,
+    ReferenceSpec, Scenario, TaskSpec, TorqueLimit,
 };
 use backbone_kin::{Branch, ModalMap};
 use fuzzy_sugeno::FuzzySystem;
 use manip_dyn::{ChainModel, Link};
 use modal_reduce::{PlantModel, ReducedModel};
-use sim_core::controller::{Controller, ModalState};
+use sim_core::controller::{Controller, MAX_CLEARANCE_MARGIN_M, ModalState, MpcLimits};
 use sim_core::ode::Tolerances;
 use sim_core::reference::{CartesianPath, PathShape, Sinusoid, Step};
 use sim_core::{ControllerFactory, Integrator, LoopSettings, Prepared, ReferenceFactory, SimError};
@@ -117,6 +117,33 @@ impl Scenario {
         Simulation::new(model, reference()?, controller, settings, initial)
     }
 
+    /// The clearance MPC plans to keep (m): `controller.clearance_m`, else the `[task]`'s
+    /// `clearance`, else 0; `measured` is whether the scenario has links and obstacles to keep
+    /// it between (`controller.clearance_m` is refused without them).
+    fn clearance_margin(&self, measured: bool) -> Result<f64, SimError> {
+        const FIELD: &str = "controller.clearance_m";
+        let Some(margin) = self.controller.clearance_m else {
+            return Ok(match &self.task {
+                Some(TaskSpec::Reach { clearance, .. }) => *clearance,
+                None => 0.0,
+            });
+        };
+        if !measured {
+            return Err(SimError::setting(
+                FIELD,
+                "is a margin to [[obstacles]] and between links: give obstacles or [arm] radius, \
+                 or remove it",
+            ));
+        }
+        if !(margin.is_finite() && (0.0..=MAX_CLEARANCE_MARGIN_M).contains(&margin)) {
+            return Err(SimError::setting(
+                FIELD,
+                format!("must be non-negative and at most 1e3 m, got {margin}"),
+            ));
+        }
+        Ok(margin)
+    }
+
     /// The scenario's seed and noise ([`NoiseSpec::run_noise`]).
     pub fn run_noise(&self) -> Result<RunNoise, SimError> {
         self.noise.run_noise(self.seed, self.n_coords())
@@ -169,13 +196,6 @@ impl Scenario {
                 ));
             }
         };
-        let controller = controller(&ControllerSetup {
-            spec: &self.controller,
-            model: &model,
-            period,
-            reference: &reference,
-            system,
-        })?;
         let mut settings = LoopSettings::new(self.integrator.build(), period, self.duration);
         settings.record_period = self.record_period.unwrap_or(period);
         let noise = self.run_noise()?;
@@ -208,6 +228,21 @@ impl Scenario {
                 per_coordinate("limits.tau_star", Some(limits), m)?
             }
         };
+        let limits = MpcLimits {
+            joint_torque_limits: settings.joint_torque_limits.clone(),
+            joint_angle_limits: settings.joint_angle_limits.clone(),
+            joint_angle_approach_s: sim_core::JOINT_ANGLE_APPROACH_S.max(period),
+            clearance: settings.clearance.clone(),
+            clearance_margin_m: self.clearance_margin(settings.clearance.is_some())?,
+        };
+        let controller = controller(&ControllerSetup {
+            spec: &self.controller,
+            model: &model,
+            period,
+            reference: &reference,
+            system,
+            limits: &limits,
+        })?;
         let initial = match &self.initial {
             None => None,
             Some(i) => {

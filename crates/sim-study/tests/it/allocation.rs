@@ -151,3 +151,15 @@ fn lock_step_groups_allocate_nothing_per_step() {
     };
     assert_eq!(runs(&mut short), runs(&mut long));
 }
+
+/// MPC planning within joint torque and angle limits and the clearance margin (`narrow-gap`,
+/// its plan made when the scenario is built) allocates per run, never per step.
+#[test]
+fn mpc_within_limits_and_clearance_allocates_nothing_per_step() {
+    assert!(is_counting());
+    let mut scenario = Scenario::builtin("narrow-gap").unwrap();
+    scenario.controller.kind = ControllerKind::Mpc;
+    scenario.limits.joint_torque_nm = Some(sim_study::TorqueLimit::All(10.0));
+    scenario.limits.joint_angle_rad = Some(sim_study::AngleLimit::All(3.0));
+    assert_eq!(allocations(&scenario, 0.05), allocations(&scenario, 0.5));
+}

@@ -1,5 +1,6 @@
 //! The integration tests of sim-study, one binary: the closed loop built from scenarios
 //! (`closed_loop`, `replay` on the full chain, `mpc` for control-limited iLQR and MPC in the loop,
+//! `mpc_clearance` for MPC within the clearance margin,
 //! `imitation` for the controller learned from computed torque, `long_runs`, `paper_pinned` for
 //! the paper's figures), `scenario_fuzz` for scenario files, `scenario_controller` for a scenario
 //! closed by an outside controller, `lockstep` for groups of runs stepped together against the
@@ -18,6 +19,7 @@ mod imitation;
 mod lockstep;
 mod long_runs;
 mod mpc;
+mod mpc_clearance;
 mod obstacles;
 mod paper_pinned;
 mod replay;
