@@ -3,7 +3,7 @@
 //! The states of a batch are taken `W` at a time, `W` the number of `f64` lanes of the widest
 //! instruction set the processor has (8 with AVX-512, 4 with AVX2; chosen at run time by
 //! [`pulp::Arch`], so one binary runs everywhere), and each group runs through the same kernel as
-//! one state ([`crate::terms`], [`crate::small_linalg`]), written once over
+//! one state ([`crate::terms`], [`lane_math::dense`]), written once over
 //! [`Lane`](lane_math::Lane): lane `i` of every register holds state `i` of the group
 //! (structure of arrays). The operations, and their order, are those of the one-state path, so
 //! each state's result is the same.

@@ -5,8 +5,9 @@
 //! are taken `W` at a time (`W` the `f64` lanes of the widest instruction set [`pulp::Arch`]
 //! finds at run time, 8 with AVX-512, 4 with AVX2), lane `i` of every register holding state `i`
 //! of the group, and each group runs through the kernel of one state (`accumulate`, the
-//! recursion of [`motion`](super::motion), the `L D L^T` solve), written once over
-//! [`Lane`], with the same operations in the same order. A group whose inputs
+//! recursion of [`motion`](super::motion), the `L D L^T` solve), written once over the register
+//! layouts of the [`terms`](super::terms) module (one coordinate of the group's states a
+//! register here), with the same operations in the same order. A group whose inputs
 //! are not all finite, or one of whose states fails, is redone one state at a time by
 //! [`spatial_forward_dynamics`], which names the failure; so are the states after the last whole
 //! group, and every state of a model of more than [`MAX_SPATIAL_BATCH_COORDS`] coordinates.
@@ -21,10 +22,11 @@ use pulp::{Arch, Simd, WithSimd};
 use super::data::SpatialReducedData;
 use super::forward::spatial_forward_dynamics;
 use super::model::SpatialReducedModel;
-use super::terms::{TermsLanes, accumulate};
+use super::terms::{TermsLanes, TurnsFromModes, accumulate};
 use crate::batch::{BatchError, MAX_WIDTH, check_batch_shape};
 use crate::batch_group::simd_lanes;
 use crate::error::all_finite;
+use crate::terms::StateLanes;
 use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 
 /// The most modal coordinates evaluated SIMD across states (`K = 2` harmonics per plane);
@@ -204,23 +206,29 @@ fn group<S: Simd, const M: usize>(
         }
     }
     let [a, a_dot, tau_star] = lanes;
-    const JACOBIAN: usize = 3 * MAX_SPATIAL_BATCH_COORDS;
-    let (mut omega_jacobian, mut origin_jacobian) = ([zero; JACOBIAN], [zero; JACOBIAN]);
-    let (mut com_jacobian, mut inertia_jacobian) = ([zero; JACOBIAN], [zero; JACOBIAN]);
-    let mut momentum_jacobian = [zero; JACOBIAN];
+    let mut jacobians = [[[zero; M]; 3]; 6];
+    let [omega, point, com, momentum, body, body_inertia] = &mut jacobians;
     let mut mass = [[zero; M]; M];
     let (mut coriolis, mut gravity) = ([zero; M], [zero; M]);
     let work = TermsLanes {
-        omega_jacobian: &mut omega_jacobian,
-        origin_jacobian: &mut origin_jacobian,
-        com_jacobian: &mut com_jacobian,
-        momentum_jacobian: &mut momentum_jacobian,
-        inertia_times_omega_jacobian: &mut inertia_jacobian,
+        omega_jacobian: omega.as_flattened_mut(),
+        point_jacobian: point.as_flattened_mut(),
+        com_jacobian: com.as_flattened_mut(),
+        momentum_jacobian: momentum.as_flattened_mut(),
+        body_jacobian: body.as_flattened_mut(),
+        body_inertia_jacobian: body_inertia.as_flattened_mut(),
         mass_matrix: mass.as_flattened_mut(),
         coriolis: &mut coriolis,
         gravity: &mut gravity,
     };
-    accumulate(simd, model, &a, &a_dot, M, work);
+    let turns = TurnsFromModes {
+        context: simd,
+        model,
+        a: &a,
+        a_dot: &a_dot,
+    };
+    // M*'s lower triangle, all the solve reads.
+    accumulate(StateLanes::new(simd, usize::MAX), model, &turns, M, work);
     // The right-hand side tau* - C* - G* and the solve, as in `spatial_forward_dynamics`.
     let mut x = tau_star;
     for ((x, &c), &g) in x.iter_mut().zip(&coriolis).zip(&gravity) {
