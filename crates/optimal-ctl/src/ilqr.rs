@@ -10,7 +10,8 @@ use lane_math::dense::{multiply, multiply_transposed, symmetrise};
 /// The most steps a horizon may have.
 pub const MAX_HORIZON: usize = 100_000;
 /// The most numbers an [`Ilqr`] workspace may hold (256 MiB of `f64`): a guard on
-/// `horizon * (n_x^2 + 2 n_x n_u)`, the size of the Jacobians and gains.
+/// `horizon * (2 n_x^2 + 3 n_x n_u)`, the size of the Jacobians (the nominal trajectory's and
+/// the line search's) and gains.
 pub const MAX_WORKSPACE: usize = 1 << 25;
 
 /// The diagonal quadratic tracking cost of [`Ilqr`]:
@@ -143,7 +144,12 @@ pub struct IlqrReport {
 ///
 /// Each iteration (Tassa, Mansard and Todorov 2014, Algorithm 2):
 ///
-/// 1. Linearise `x_{k+1} = F(x_k, u_k)` along the current trajectory (`A_k`, `B_k`).
+/// 1. Linearise `x_{k+1} = F(x_k, u_k)` along the current trajectory (`A_k`, `B_k`). Without
+///    constraints, the rollout that made the trajectory has mostly done it on its way
+///    ([`DiscreteDynamics::linearise`] gives the next state with the Jacobians, so a node's
+///    dynamics are evaluated once): the warm start's rollout and each line search's first
+///    trial (`alpha = 1`) linearise, except the last allowed iteration's; an accepted later
+///    trial is linearised after it.
 /// 2. Backward pass from `V_x = Q_f (x_N - r_N)`, `V_xx = Q_f`:
 ///    `Q_x = l_x + A^T V_x'`, `Q_u = l_u + B^T V_x'`, `Q_xx = Q + A^T V_xx' A`,
 ///    `Q_uu = R + B^T V_xx' B`, `Q_ux = B^T V_xx' A`; the feed-forward `k` solves the box QP
@@ -178,9 +184,12 @@ pub struct Ilqr {
     u_ref: Vec<f64>,
     lower: Vec<f64>,
     upper: Vec<f64>,
-    /// Per step: `A_k` (`n_x x n_x`), `B_k` (`n_x x n_u`), `K_k` (`n_u x n_x`), `k_k` (`n_u`).
+    /// Per step: `A_k` (`n_x x n_x`), `B_k` (`n_x x n_u`), `K_k` (`n_u x n_x`), `k_k` (`n_u`),
+    /// and the Jacobians along the line search's candidate.
     a: Vec<f64>,
     b: Vec<f64>,
+    a_try: Vec<f64>,
+    b_try: Vec<f64>,
     gain: Vec<f64>,
     feedforward: Vec<f64>,
     /// Backward-pass terms.
@@ -241,11 +250,12 @@ impl Ilqr {
         }
         let per_step = nx
             .saturating_mul(nx)
-            .saturating_add(nx.saturating_mul(nu).saturating_mul(2));
+            .saturating_mul(2)
+            .saturating_add(nx.saturating_mul(nu).saturating_mul(3));
         if horizon.saturating_mul(per_step) > MAX_WORKSPACE {
             return Err(OptimalError::InvalidSetting {
                 name: "horizon",
-                requirement: "small enough for horizon * (n_x^2 + 2 n_x n_u) <= 2^25",
+                requirement: "small enough for horizon * (2 n_x^2 + 3 n_x n_u) <= 2^25",
                 value: horizon as f64,
             });
         }
@@ -292,6 +302,8 @@ impl Ilqr {
             upper: vec![f64::INFINITY; nu],
             a: vec![0.0; n * nx * nx],
             b: vec![0.0; n * nx * nu],
+            a_try: vec![0.0; n * nx * nx],
+            b_try: vec![0.0; n * nx * nu],
             gain: vec![0.0; n * nu * nx],
             feedforward: vec![0.0; n * nu],
             v_x: vec![0.0; nx],
@@ -532,13 +544,15 @@ impl Ilqr {
             }
         }
         self.x[..self.nx].copy_from_slice(x0);
-        let initial_cost = self.rollout(dynamics)?;
+        // Without constraints every rollout linearises on its way; `linearised` says whether it
+        // succeeded at every node (the Jacobians stand for the trajectory).
+        let unconstrained = constraints.is_none();
+        let (initial_cost, mut linearised) = self.rollout(dynamics, unconstrained)?;
         let mut cost = initial_cost;
         let mut mu = settings.regularisation;
         let mut delta = 1.0;
         let mut converged = false;
         let mut iterations = 0;
-        let mut linearised = false;
         while iterations < settings.max_iterations {
             if !linearised {
                 self.linearise(dynamics)?;
@@ -572,22 +586,33 @@ impl Ilqr {
                 converged = true;
                 break;
             }
+            // No linearisation follows the last iteration's line search.
+            let linearising = unconstrained && iterations < settings.max_iterations;
             let mut accepted = None;
             let mut alpha = 1.0;
             for _ in 0..steps {
-                let candidate = self.forward(dynamics, constraints.as_deref_mut(), alpha)?;
+                let (candidate, candidate_linearised) = self.forward(
+                    dynamics,
+                    constraints.as_deref_mut(),
+                    alpha,
+                    linearising && alpha == 1.0,
+                )?;
                 let predicted = -(alpha * expected[0] + alpha * alpha * expected[1]);
                 if candidate < cost && (cost - candidate) >= ACCEPTANCE * predicted {
-                    accepted = Some(candidate);
+                    accepted = Some((candidate, candidate_linearised));
                     break;
                 }
                 alpha *= 0.5;
             }
             match accepted {
-                Some(candidate) => {
+                Some((candidate, candidate_linearised)) => {
                     std::mem::swap(&mut self.x, &mut self.x_try);
                     std::mem::swap(&mut self.u, &mut self.u_try);
-                    linearised = false;
+                    if candidate_linearised {
+                        std::mem::swap(&mut self.a, &mut self.a_try);
+                        std::mem::swap(&mut self.b, &mut self.b_try);
+                    }
+                    linearised = candidate_linearised;
                     let improvement = cost - candidate;
                     cost = candidate;
                     decrease(&mut mu, &mut delta, settings);
@@ -704,23 +729,31 @@ impl Ilqr {
         Ok(())
     }
 
-    /// `x_{k+1} = F(x_k, u_k)` from `x_0` with the current controls; the cost.
+    /// `x_{k+1} = F(x_k, u_k)` from `x_0` with the current controls, with the Jacobians `A_k`,
+    /// `B_k` when `linearising`; the cost, and whether the Jacobians were computed at every
+    /// node.
     fn rollout<D: DiscreteDynamics + ?Sized>(
         &mut self,
         dynamics: &mut D,
-    ) -> Result<f64, OptimalError> {
+        mut linearising: bool,
+    ) -> Result<(f64, bool), OptimalError> {
         let (nx, nu) = (self.nx, self.nu);
         for k in 0..self.horizon {
             let (past, future) = self.x.split_at_mut((k + 1) * nx);
-            dynamics.step(
-                &past[k * nx..],
-                &self.u[k * nu..(k + 1) * nu],
+            advance(
+                dynamics,
+                (&past[k * nx..(k + 1) * nx], &self.u[k * nu..(k + 1) * nu]),
                 &mut future[..nx],
+                (
+                    &mut self.a[k * nx * nx..(k + 1) * nx * nx],
+                    &mut self.b[k * nx * nu..(k + 1) * nx * nu],
+                ),
+                &mut linearising,
             )?;
         }
         let cost = self.trajectory_cost(&self.x, &self.u);
         if cost.is_finite() {
-            Ok(cost)
+            Ok((cost, linearising))
         } else {
             Err(OptimalError::InvalidSetting {
                 name: "warm start",
@@ -885,14 +918,17 @@ impl Ilqr {
     }
 
     /// The forward pass at step length `alpha` into `x_try`, `u_try`, every control moved within
-    /// the step's rows at its state when there are `constraints`; its cost (infinite if the
-    /// dynamics refuse a state on the way or a step's rows admit no control).
+    /// the step's rows at its state when there are `constraints`, the Jacobians into `a_try`,
+    /// `b_try` when `linearising`; its cost (infinite if the dynamics refuse a state on the way
+    /// or a step's rows admit no control), and whether the Jacobians were computed at every
+    /// node.
     fn forward<D: DiscreteDynamics + ?Sized>(
         &mut self,
         dynamics: &mut D,
         mut constraints: Option<&mut (dyn StepConstraints + '_)>,
         alpha: f64,
-    ) -> Result<f64, OptimalError> {
+        mut linearising: bool,
+    ) -> Result<(f64, bool), OptimalError> {
         let (nx, nu) = (self.nx, self.nu);
         self.x_try[..nx].copy_from_slice(&self.x[..nx]);
         for k in 0..self.horizon {
@@ -916,23 +952,33 @@ impl Ilqr {
                     &mut self.u_try[k * nu..(k + 1) * nu],
                 )?;
                 if !within {
-                    return Ok(f64::INFINITY);
+                    return Ok((f64::INFINITY, false));
                 }
             }
             let (past, future) = self.x_try.split_at_mut((k + 1) * nx);
-            if dynamics
-                .step(
-                    &past[k * nx..],
+            if advance(
+                dynamics,
+                (
+                    &past[k * nx..(k + 1) * nx],
                     &self.u_try[k * nu..(k + 1) * nu],
-                    &mut future[..nx],
-                )
-                .is_err()
+                ),
+                &mut future[..nx],
+                (
+                    &mut self.a_try[k * nx * nx..(k + 1) * nx * nx],
+                    &mut self.b_try[k * nx * nu..(k + 1) * nx * nu],
+                ),
+                &mut linearising,
+            )
+            .is_err()
             {
-                return Ok(f64::INFINITY);
+                return Ok((f64::INFINITY, false));
             }
         }
         let cost = self.trajectory_cost(&self.x_try, &self.u_try);
-        Ok(if cost.is_nan() { f64::INFINITY } else { cost })
+        Ok((
+            if cost.is_nan() { f64::INFINITY } else { cost },
+            linearising,
+        ))
     }
 
     /// The tracking cost of a trajectory.
@@ -973,6 +1019,26 @@ impl Ilqr {
             .sum();
         total / self.horizon as f64
     }
+}
+
+/// One node of a rollout: `next = F(x, u)`, and the Jacobians `(A, B)` with it while
+/// `linearising`. A node whose linearisation fails is stepped instead and ends `linearising` for
+/// the rest of the rollout (the solve's own linearisation then meets the failure); the step's
+/// error is returned.
+fn advance<D: DiscreteDynamics + ?Sized>(
+    dynamics: &mut D,
+    (x, u): (&[f64], &[f64]),
+    next: &mut [f64],
+    (a, b): (&mut [f64], &mut [f64]),
+    linearising: &mut bool,
+) -> Result<(), OptimalError> {
+    if *linearising {
+        if dynamics.linearise(x, u, next, a, b).is_ok() {
+            return Ok(());
+        }
+        *linearising = false;
+    }
+    dynamics.step(x, u, next)
 }
 
 /// Grows the regularisation; `false` once it passes its maximum.
