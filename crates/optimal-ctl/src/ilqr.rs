@@ -192,23 +192,8 @@ pub struct Ilqr {
     b_try: Vec<f64>,
     gain: Vec<f64>,
     feedforward: Vec<f64>,
-    /// Backward-pass terms.
-    v_x: Vec<f64>,
-    v_xx: Vec<f64>,
-    q_x: Vec<f64>,
-    q_u: Vec<f64>,
-    q_xx: Vec<f64>,
-    q_uu: Vec<f64>,
-    q_ux: Vec<f64>,
-    /// `V_xx' A` (`n_x x n_x`), `V_xx' B` (`n_x x n_u`), `Q_uu K` (`n_u x n_x`), `Q_uu k` (`n_u`),
-    /// the regularised Hessian (`n_u x n_u`) and the step bounds (`n_u` each).
-    va: Vec<f64>,
-    vb: Vec<f64>,
-    quu_gain: Vec<f64>,
-    quu_ff: Vec<f64>,
-    hessian: Vec<f64>,
-    step_lower: Vec<f64>,
-    step_upper: Vec<f64>,
+    /// The backward pass's terms of one step for sizes without their own (stack) body.
+    terms: HeapTerms,
     /// The adjoint of [`gradient`](Self::gradient) and its next value.
     adjoint: Vec<f64>,
     adjoint_next: Vec<f64>,
@@ -306,20 +291,7 @@ impl Ilqr {
             b_try: vec![0.0; n * nx * nu],
             gain: vec![0.0; n * nu * nx],
             feedforward: vec![0.0; n * nu],
-            v_x: vec![0.0; nx],
-            v_xx: vec![0.0; nx * nx],
-            q_x: vec![0.0; nx],
-            q_u: vec![0.0; nu],
-            q_xx: vec![0.0; nx * nx],
-            q_uu: vec![0.0; nu * nu],
-            q_ux: vec![0.0; nu * nx],
-            va: vec![0.0; nx * nx],
-            vb: vec![0.0; nx * nu],
-            quu_gain: vec![0.0; nu * nx],
-            quu_ff: vec![0.0; nu],
-            hessian: vec![0.0; nu * nu],
-            step_lower: vec![0.0; nu],
-            step_upper: vec![0.0; nu],
+            terms: HeapTerms::new(nx, nu),
             adjoint: vec![0.0; nx],
             adjoint_next: vec![0.0; nx],
             qp: BoxQp::new(nu),
@@ -793,17 +765,35 @@ impl Ilqr {
         constrained: bool,
     ) -> Result<[f64; 2], OptimalError> {
         match (self.nx, self.nu) {
-            (4, 2) => self.backward_sized::<4, 2>(mu, qp, constrained),
-            (6, 3) => self.backward_sized::<6, 3>(mu, qp, constrained),
-            _ => self.backward_sized::<0, 0>(mu, qp, constrained),
+            (4, 2) => {
+                let mut terms = StackTerms::<4, 2>::default();
+                self.backward_sized::<4, 2>(terms.slices(), mu, qp, constrained)
+            }
+            (6, 3) => {
+                let mut terms = StackTerms::<6, 3>::default();
+                self.backward_sized::<6, 3>(terms.slices(), mu, qp, constrained)
+            }
+            _ => {
+                // Taken out of the workspace for the pass (no allocation) and put back.
+                let mut terms = std::mem::take(&mut self.terms);
+                let expected = self.backward_sized::<0, 0>(
+                    terms.slices(self.nx, self.nu),
+                    mu,
+                    qp,
+                    constrained,
+                );
+                self.terms = terms;
+                expected
+            }
         }
     }
 
-    /// [`backward`](Self::backward) for `n_x = NX`, `n_u = NU` known at compile time, or any
-    /// sizes when both are 0.
+    /// [`backward`](Self::backward) for `n_x = NX`, `n_u = NU` known at compile time (the
+    /// terms on the stack), or any sizes when both are 0.
     #[inline(always)]
     fn backward_sized<const NX: usize, const NU: usize>(
         &mut self,
+        t: Terms<'_>,
         mu: f64,
         qp: &BoxQpSettings,
         constrained: bool,
@@ -817,43 +807,43 @@ impl Ilqr {
         let cost = &self.cost;
         let mut expected = [0.0; 2];
         for i in 0..nx {
-            self.v_x[i] = cost.terminal[i] * (self.x[n * nx + i] - self.x_ref[n * nx + i]);
+            t.v_x[i] = cost.terminal[i] * (self.x[n * nx + i] - self.x_ref[n * nx + i]);
         }
-        self.v_xx.fill(0.0);
+        t.v_xx.fill(0.0);
         for i in 0..nx {
-            self.v_xx[i * nx + i] = cost.terminal[i];
+            t.v_xx[i * nx + i] = cost.terminal[i];
         }
         for k in (0..n).rev() {
             let a = &self.a[k * nx * nx..(k + 1) * nx * nx];
             let b = &self.b[k * nx * nu..(k + 1) * nx * nu];
             let u = &self.u[k * nu..(k + 1) * nu];
             // Q_x, Q_u.
-            multiply_transposed(a, &self.v_x, &mut self.q_x, nx, nx, 1);
-            multiply_transposed(b, &self.v_x, &mut self.q_u, nu, nx, 1);
+            multiply_transposed(a, t.v_x, t.q_x, nx, nx, 1);
+            multiply_transposed(b, t.v_x, t.q_u, nu, nx, 1);
             for i in 0..nx {
-                self.q_x[i] += cost.state[i] * (self.x[k * nx + i] - self.x_ref[k * nx + i]);
+                t.q_x[i] += cost.state[i] * (self.x[k * nx + i] - self.x_ref[k * nx + i]);
             }
-            for (j, q) in self.q_u.iter_mut().enumerate() {
+            for (j, q) in t.q_u.iter_mut().enumerate() {
                 *q += cost.control[j] * (u[j] - self.u_ref[k * nu + j]);
             }
             // Q_xx, Q_uu, Q_ux.
-            multiply(&self.v_xx, a, &mut self.va, nx, nx, nx);
-            multiply(&self.v_xx, b, &mut self.vb, nx, nx, nu);
-            multiply_transposed(a, &self.va, &mut self.q_xx, nx, nx, nx);
-            multiply_transposed(b, &self.vb, &mut self.q_uu, nu, nx, nu);
-            multiply_transposed(b, &self.va, &mut self.q_ux, nu, nx, nx);
+            multiply(t.v_xx, a, t.va, nx, nx, nx);
+            multiply(t.v_xx, b, t.vb, nx, nx, nu);
+            multiply_transposed(a, t.va, t.q_xx, nx, nx, nx);
+            multiply_transposed(b, t.vb, t.q_uu, nu, nx, nu);
+            multiply_transposed(b, t.va, t.q_ux, nu, nx, nx);
             for i in 0..nx {
-                self.q_xx[i * nx + i] += cost.state[i];
+                t.q_xx[i * nx + i] += cost.state[i];
             }
             for j in 0..nu {
-                self.q_uu[j * nu + j] += cost.control[j];
+                t.q_uu[j * nu + j] += cost.control[j];
             }
             // The feed-forward step: the box QP on (Q_uu + mu I, Q_u).
-            self.hessian.copy_from_slice(&self.q_uu);
+            t.hessian.copy_from_slice(t.q_uu);
             for (j, &uj) in u.iter().enumerate() {
-                self.hessian[j * nu + j] += mu;
-                self.step_lower[j] = self.lower[j] - uj;
-                self.step_upper[j] = self.upper[j] - uj;
+                t.hessian[j * nu + j] += mu;
+                t.step_lower[j] = self.lower[j] - uj;
+                t.step_upper[j] = self.upper[j] - uj;
             }
             let ff = &mut self.feedforward[k * nu..(k + 1) * nu];
             let gain = &mut self.gain[k * nu * nx..(k + 1) * nu * nx];
@@ -863,7 +853,7 @@ impl Ilqr {
                     // active rows active.
                     work.feedforward(
                         k,
-                        (&self.hessian, &self.q_u, &self.q_ux),
+                        (t.hessian, t.q_u, t.q_ux),
                         u,
                         (&self.lower, &self.upper),
                         ff,
@@ -871,16 +861,10 @@ impl Ilqr {
                     )?;
                 }
                 _ => {
-                    self.qp.solve(
-                        &self.hessian,
-                        &self.q_u,
-                        &self.step_lower,
-                        &self.step_upper,
-                        ff,
-                        qp,
-                    )?;
+                    self.qp
+                        .solve(t.hessian, t.q_u, t.step_lower, t.step_upper, ff, qp)?;
                     // The gain on the free controls, zero on the clamped ones.
-                    gain.copy_from_slice(&self.q_ux);
+                    gain.copy_from_slice(t.q_ux);
                     self.qp.solve_free(gain, nx);
                     for g in gain.iter_mut() {
                         *g = -*g;
@@ -888,31 +872,30 @@ impl Ilqr {
                 }
             }
             // The value function.
-            multiply(&self.q_uu, gain, &mut self.quu_gain, nu, nu, nx);
-            multiply(&self.q_uu, ff, &mut self.quu_ff, nu, nu, 1);
+            multiply(t.q_uu, gain, t.quu_gain, nu, nu, nx);
+            multiply(t.q_uu, ff, t.quu_ff, nu, nu, 1);
             for (j, f) in ff.iter().enumerate() {
-                expected[0] += f * self.q_u[j];
-                expected[1] += 0.5 * f * self.quu_ff[j];
+                expected[0] += f * t.q_u[j];
+                expected[1] += 0.5 * f * t.quu_ff[j];
             }
             for i in 0..nx {
-                let mut s = self.q_x[i];
+                let mut s = t.q_x[i];
                 for j in 0..nu {
-                    s += gain[j * nx + i] * (self.quu_ff[j] + self.q_u[j])
-                        + self.q_ux[j * nx + i] * ff[j];
+                    s += gain[j * nx + i] * (t.quu_ff[j] + t.q_u[j]) + t.q_ux[j * nx + i] * ff[j];
                 }
-                self.v_x[i] = s;
+                t.v_x[i] = s;
             }
             for i in 0..nx {
                 for l in 0..nx {
-                    let mut s = self.q_xx[i * nx + l];
+                    let mut s = t.q_xx[i * nx + l];
                     for j in 0..nu {
-                        s += gain[j * nx + i] * (self.quu_gain[j * nx + l] + self.q_ux[j * nx + l])
-                            + self.q_ux[j * nx + i] * gain[j * nx + l];
+                        s += gain[j * nx + i] * (t.quu_gain[j * nx + l] + t.q_ux[j * nx + l])
+                            + t.q_ux[j * nx + i] * gain[j * nx + l];
                     }
-                    self.v_xx[i * nx + l] = s;
+                    t.v_xx[i * nx + l] = s;
                 }
             }
-            symmetrise(&mut self.v_xx, nx);
+            symmetrise(t.v_xx, nx);
         }
         Ok(expected)
     }
@@ -1018,6 +1001,158 @@ impl Ilqr {
             })
             .sum();
         total / self.horizon as f64
+    }
+}
+
+/// The backward pass's terms of one step, row-major: `V_x'` (`n_x`), `V_xx'` (`n_x x n_x`),
+/// `Q_x`, `Q_u`, `Q_xx`, `Q_uu`, `Q_ux`; `V_xx' A` (`n_x x n_x`), `V_xx' B` (`n_x x n_u`),
+/// `Q_uu K` (`n_u x n_x`), `Q_uu k` (`n_u`), the regularised Hessian (`n_u x n_u`) and the step
+/// bounds (`n_u` each).
+struct Terms<'t> {
+    v_x: &'t mut [f64],
+    v_xx: &'t mut [f64],
+    q_x: &'t mut [f64],
+    q_u: &'t mut [f64],
+    q_xx: &'t mut [f64],
+    q_uu: &'t mut [f64],
+    q_ux: &'t mut [f64],
+    va: &'t mut [f64],
+    vb: &'t mut [f64],
+    quu_gain: &'t mut [f64],
+    quu_ff: &'t mut [f64],
+    hessian: &'t mut [f64],
+    step_lower: &'t mut [f64],
+    step_upper: &'t mut [f64],
+}
+
+/// [`Terms`] on the stack for `n_x = NX`, `n_u = NU`: their sizes known where they are used.
+struct StackTerms<const NX: usize, const NU: usize> {
+    v_x: [f64; NX],
+    v_xx: [[f64; NX]; NX],
+    q_x: [f64; NX],
+    q_u: [f64; NU],
+    q_xx: [[f64; NX]; NX],
+    q_uu: [[f64; NU]; NU],
+    q_ux: [[f64; NX]; NU],
+    va: [[f64; NX]; NX],
+    vb: [[f64; NU]; NX],
+    quu_gain: [[f64; NX]; NU],
+    quu_ff: [f64; NU],
+    hessian: [[f64; NU]; NU],
+    step_lower: [f64; NU],
+    step_upper: [f64; NU],
+}
+
+impl<const NX: usize, const NU: usize> Default for StackTerms<NX, NU> {
+    fn default() -> Self {
+        Self {
+            v_x: [0.0; NX],
+            v_xx: [[0.0; NX]; NX],
+            q_x: [0.0; NX],
+            q_u: [0.0; NU],
+            q_xx: [[0.0; NX]; NX],
+            q_uu: [[0.0; NU]; NU],
+            q_ux: [[0.0; NX]; NU],
+            va: [[0.0; NX]; NX],
+            vb: [[0.0; NU]; NX],
+            quu_gain: [[0.0; NX]; NU],
+            quu_ff: [0.0; NU],
+            hessian: [[0.0; NU]; NU],
+            step_lower: [0.0; NU],
+            step_upper: [0.0; NU],
+        }
+    }
+}
+
+impl<const NX: usize, const NU: usize> StackTerms<NX, NU> {
+    #[inline(always)]
+    fn slices(&mut self) -> Terms<'_> {
+        Terms {
+            v_x: &mut self.v_x,
+            v_xx: self.v_xx.as_flattened_mut(),
+            q_x: &mut self.q_x,
+            q_u: &mut self.q_u,
+            q_xx: self.q_xx.as_flattened_mut(),
+            q_uu: self.q_uu.as_flattened_mut(),
+            q_ux: self.q_ux.as_flattened_mut(),
+            va: self.va.as_flattened_mut(),
+            vb: self.vb.as_flattened_mut(),
+            quu_gain: self.quu_gain.as_flattened_mut(),
+            quu_ff: &mut self.quu_ff,
+            hessian: self.hessian.as_flattened_mut(),
+            step_lower: &mut self.step_lower,
+            step_upper: &mut self.step_upper,
+        }
+    }
+}
+
+/// [`Terms`] in the workspace, for any sizes (allocated once by [`Ilqr::new`]).
+#[derive(Debug, Clone, Default)]
+struct HeapTerms(Vec<f64>);
+
+impl HeapTerms {
+    /// The sizes of the terms, in [`Terms`]' order.
+    fn sizes(nx: usize, nu: usize) -> [usize; 14] {
+        [
+            nx,
+            nx * nx,
+            nx,
+            nu,
+            nx * nx,
+            nu * nu,
+            nu * nx,
+            nx * nx,
+            nx * nu,
+            nu * nx,
+            nu,
+            nu * nu,
+            nu,
+            nu,
+        ]
+    }
+
+    fn new(nx: usize, nu: usize) -> Self {
+        Self(vec![0.0; Self::sizes(nx, nu).iter().sum()])
+    }
+
+    fn slices(&mut self, nx: usize, nu: usize) -> Terms<'_> {
+        let mut rest = self.0.as_mut_slice();
+        let [
+            v_x,
+            v_xx,
+            q_x,
+            q_u,
+            q_xx,
+            q_uu,
+            q_ux,
+            va,
+            vb,
+            quu_gain,
+            quu_ff,
+            hessian,
+            step_lower,
+            step_upper,
+        ] = Self::sizes(nx, nu).map(|size| {
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(size);
+            rest = tail;
+            part
+        });
+        Terms {
+            v_x,
+            v_xx,
+            q_x,
+            q_u,
+            q_xx,
+            q_uu,
+            q_ux,
+            va,
+            vb,
+            quu_gain,
+            quu_ff,
+            hessian,
+            step_lower,
+            step_upper,
+        }
     }
 }
 
