@@ -168,13 +168,25 @@ fn a_warm_started_solve_evaluates_each_node_once() {
 
 #[test]
 fn the_euler_map_linearised_steps_to_the_bits_of_its_step() {
+    // m = 2, 3 and 5 (planar), 4 (spatial).
     let spatial = SpatialReducedModel::uniform_rods(10, 1, 0.1, 0.1, [0.0, 0.0, -9.81]).unwrap();
-    let planar = ReducedModel::new(
-        ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
-        ModalMap::new(&[0.1; 10], 2, BaseAngle::Free).unwrap(),
-    )
-    .unwrap();
-    for model in [Plant::from(&planar), Plant::from(&spatial)] {
+    let planar = [
+        (1, BaseAngle::Fixed(0.3)),
+        (1, BaseAngle::Free),
+        (2, BaseAngle::Free),
+    ]
+    .map(|(harmonics, base)| {
+        ReducedModel::new(
+            ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
+            ModalMap::new(&[0.1; 10], harmonics, base).unwrap(),
+        )
+        .unwrap()
+    });
+    let plants = planar
+        .iter()
+        .map(Plant::from)
+        .chain([Plant::from(&spatial)]);
+    for model in plants {
         let m = model.n_coords();
         let mut data = PlantData::new(model);
         let mut derivatives = PlantDerivatives::new(model);
