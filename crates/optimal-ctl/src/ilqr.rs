@@ -966,19 +966,38 @@ impl Ilqr {
 
     /// The tracking cost of a trajectory.
     fn trajectory_cost(&self, x: &[f64], u: &[f64]) -> f64 {
-        let (nx, nu, n) = (self.nx, self.nu, self.horizon);
+        match (self.nx, self.nu) {
+            (4, 2) => self.trajectory_cost_sized::<4, 2>(x, u),
+            (6, 3) => self.trajectory_cost_sized::<6, 3>(x, u),
+            _ => self.trajectory_cost_sized::<0, 0>(x, u),
+        }
+    }
+
+    /// [`trajectory_cost`](Self::trajectory_cost) for `n_x = NX`, `n_u = NU` known at compile
+    /// time, or any sizes when both are 0: the same sum in the same order.
+    #[inline(always)]
+    fn trajectory_cost_sized<const NX: usize, const NU: usize>(&self, x: &[f64], u: &[f64]) -> f64 {
+        let (nx, nu) = if NX == 0 {
+            (self.nx, self.nu)
+        } else {
+            (NX, NU)
+        };
+        let n = self.horizon;
         let c = &self.cost;
+        let (state, terminal, control) = (&c.state[..nx], &c.terminal[..nx], &c.control[..nu]);
         let mut total = 0.0;
         for k in 0..=n {
-            let weights = if k == n { &c.terminal } else { &c.state };
+            let weights = if k == n { terminal } else { state };
+            let (x, x_ref) = (&x[k * nx..(k + 1) * nx], &self.x_ref[k * nx..(k + 1) * nx]);
             for i in 0..nx {
-                let e = x[k * nx + i] - self.x_ref[k * nx + i];
+                let e = x[i] - x_ref[i];
                 total += 0.5 * weights[i] * e * e;
             }
             if k < n {
+                let (u, u_ref) = (&u[k * nu..(k + 1) * nu], &self.u_ref[k * nu..(k + 1) * nu]);
                 for j in 0..nu {
-                    let e = u[k * nu + j] - self.u_ref[k * nu + j];
-                    total += 0.5 * c.control[j] * e * e;
+                    let e = u[j] - u_ref[j];
+                    total += 0.5 * control[j] * e * e;
                 }
             }
         }
