@@ -4,14 +4,17 @@
 //! derivatives taken at `(q, v, qdd)` (Carpentier and Mansard 2018, eq. 12; what Pinocchio's
 //! `computeABADerivatives` returns). `M^-1` comes in `O(n^2)` from the articulated-body
 //! factorisation the ABA has just built ([`minv`](super::minv), theory.md eqs. S1-S3), never
-//! from `M`; the two products with it are one dense `n x n` by `n x 2n` matrix product.
+//! from `M`; the two products with it are one dense `n x n` by `n x 2n` matrix product, in SIMD
+//! registers.
 
 use faer::{MatMut, MatRef};
+use lane_math::{Lane, Pack};
 use pulp::{Simd, WithSimd};
 
 use super::aba::aba;
+use super::algebra::Transform;
 use super::data::SpatialData;
-use super::derivative_data::SpatialDerivativeData;
+use super::derivative_data::{MAX_LANES, SpatialDerivativeData, column_of, padded};
 use super::minv::inverse_mass_matrix;
 use super::model::SpatialModel;
 use super::rnea_derivatives::differentiate_at;
@@ -56,13 +59,19 @@ pub fn aba_derivatives(
         n,
     )?;
     let mut qdd = std::mem::take(&mut derivatives.accelerations);
-    let solved = aba(model, data, q, v, tau, &mut qdd)
-        .and_then(|()| differentiate_at(model, data, derivatives, q, v, &qdd));
+    let solved = aba(model, data, q, v, tau, &mut qdd).and_then(|()| {
+        poses_from_aba(data);
+        differentiate_at(model, data, derivatives, v, &qdd)
+    });
     derivatives.value.copy_from_slice(&qdd);
     derivatives.accelerations = qdd;
     solved?;
     let SpatialDerivativeData {
-        blocks, rhs, sweep, ..
+        blocks,
+        rhs,
+        sweep,
+        minv_columns,
+        ..
     } = derivatives;
     let (jacobians, mut minv) = blocks.as_mut().split_at_col_mut(2 * n);
     rhs.copy_from(jacobians.as_ref());
@@ -74,47 +83,104 @@ pub fn aba_derivatives(
         sweep,
         minv.as_mut(),
     );
-    data.arch.dispatch(NegatedProduct {
+    let stride = padded(n);
+    for k in 0..n {
+        minv_columns[k * stride..k * stride + n].copy_from_slice(column_of(&mut minv, k));
+    }
+    data.arch.dispatch(Product {
         out: jacobians,
-        minv: minv.as_ref(),
+        columns: minv_columns,
         rhs: rhs.as_ref(),
     });
     check::finite_matrix("the derivatives", &blocks.as_mut())
 }
 
-/// `out = -minv rhs` (`n x n` by `n x 2n`), column by column as sums of `minv`'s columns, under
-/// [`pulp::Arch::dispatch`] (the loops vectorise with this processor's widest registers; at
-/// these sizes faster than a general matrix product's packing).
-struct NegatedProduct<'a> {
+/// The links' poses in the base frame, `oM_i = oM_{i-1} * {i-1}M_i`, from the placements the
+/// ABA has just computed (the same as [`update_poses`](super::kinematics::update_poses) at its
+/// `q`, without the sines, cosines and placements again).
+fn poses_from_aba(data: &mut SpatialData) {
+    let mut parent = Transform::IDENTITY;
+    for (pose, link) in data.poses.iter_mut().zip(&data.articulated) {
+        let placement = Transform {
+            rotation: link.rotation,
+            translation: link.translation,
+        };
+        parent = parent.compose(&placement);
+        *pose = parent;
+    }
+}
+
+/// `out = -minv rhs` (`n x n` by `n x 2n`) under [`pulp::Arch::dispatch`]: a SIMD register of
+/// rows of [`GROUP`] output columns at a time, the sums over `k` of `minv`'s column `k` times
+/// `rhs[(k, c)]` kept in registers (at these sizes faster than a general matrix product's
+/// packing). `columns` holds `minv`'s columns, each zero-padded to [`padded`]`(n)` entries, so
+/// that a whole register can be read at any row.
+struct Product<'a> {
     out: MatMut<'a, f64>,
-    minv: MatRef<'a, f64>,
+    columns: &'a [f64],
     rhs: MatRef<'a, f64>,
 }
 
-impl WithSimd for NegatedProduct<'_> {
+/// Output columns computed together (four register accumulators).
+const GROUP: usize = 4;
+
+impl WithSimd for Product<'_> {
     type Output = ();
 
     #[inline(always)]
-    fn with_simd<S: Simd>(self, _: S) {
-        let NegatedProduct { mut out, minv, rhs } = self;
-        let n = minv.nrows();
-        let contiguous = "the blocks of a faer Mat are column-major";
-        for c in 0..rhs.ncols() {
-            let column = out
-                .as_mut()
-                .col_mut(c)
-                .try_as_col_major_mut()
-                .expect(contiguous)
-                .as_slice_mut();
-            let factors = rhs.col(c).try_as_col_major().expect(contiguous).as_slice();
-            column.fill(0.0);
-            for (k, &factor) in factors.iter().enumerate().take(n) {
-                let factor = -factor;
-                let source = minv.col(k).try_as_col_major().expect(contiguous).as_slice();
-                for (entry, &m) in column.iter_mut().zip(source) {
-                    *entry += m * factor;
-                }
+    fn with_simd<S: Simd>(self, simd: S) {
+        let Product {
+            mut out,
+            columns,
+            rhs,
+        } = self;
+        let (n, width) = (out.nrows(), out.ncols());
+        let mut row = 0;
+        while row < n {
+            let mut c = 0;
+            while c + GROUP <= width {
+                columns_block::<S, GROUP>(simd, &mut out, columns, rhs, row, c);
+                c += GROUP;
             }
+            while c < width {
+                columns_block::<S, 1>(simd, &mut out, columns, rhs, row, c);
+                c += 1;
+            }
+            row += Pack::<S>::WIDTH;
         }
     }
 }
+
+/// Rows `row..row + WIDTH` (those below `n`) of the `G` output columns `c..c + G` of
+/// [`Product`], summed in `k` order from zero with fused multiply-adds, then negated.
+#[inline(always)]
+fn columns_block<S: Simd, const G: usize>(
+    simd: S,
+    out: &mut MatMut<'_, f64>,
+    columns: &[f64],
+    rhs: MatRef<'_, f64>,
+    row: usize,
+    c: usize,
+) {
+    let n = out.nrows();
+    let stride = padded(n);
+    let factors: [&[f64]; G] = std::array::from_fn(|j| {
+        let column = rhs.col(c + j).try_as_col_major();
+        &column.expect(CONTIGUOUS).as_slice()[..n]
+    });
+    let mut sums = [Pack::splat(simd, 0.0); G];
+    for k in 0..n {
+        let m = Pack::load(simd, &columns[k * stride + row..]);
+        for (sum, factor) in sums.iter_mut().zip(&factors) {
+            *sum = m.mul_add(Pack::splat(simd, factor[k]), *sum);
+        }
+    }
+    let rows = (n - row).min(Pack::<S>::WIDTH);
+    for (j, sum) in sums.into_iter().enumerate() {
+        let mut lanes = [0.0; MAX_LANES];
+        (sum * Pack::splat(simd, -1.0)).store(&mut lanes);
+        column_of(out, c + j)[row..row + rows].copy_from_slice(&lanes[..rows]);
+    }
+}
+
+const CONTIGUOUS: &str = "the blocks of a faer Mat are column-major";

@@ -303,14 +303,13 @@ impl<T: Lane> Transform<T> {
 }
 
 impl Transform {
-    /// A rigid body's inertia given in the child frame, as the 6 x 6 matrix in the parent frame
-    /// (what [`act_inertia`](Self::act_inertia) gives of [`RigidInertia::matrix`], from the ten
-    /// parameters): the centre of mass `c = R c_child + p`, `A = m E`, `B = -m [c]x`,
+    /// A rigid body's inertia given in the child frame, in the parent frame by its ten
+    /// parameters (what [`act_inertia`](Self::act_inertia) gives of [`RigidInertia::matrix`]):
+    /// the centre of mass `c = R c_child + p`, first moment `m c`,
     /// `C = R I_c R^T + m (|c|^2 E - c c^T)`.
-    pub(crate) fn act_rigid_inertia(&self, body: &RigidInertia) -> Symmetric6 {
+    pub(crate) fn act_rigid_inertia(&self, body: &RigidInertia) -> RigidSum {
         let m = body.mass;
         let c = self.apply(body.com);
-        let mc = scale(c, m);
         let mut rotational = rotate_congruent(&self.rotation, &body.inertia);
         let c2 = dot(c, c);
         for (r, row) in rotational.iter_mut().enumerate() {
@@ -319,14 +318,10 @@ impl Transform {
                 *entry += m * (delta - c[r] * c[k]);
             }
         }
-        Symmetric6 {
-            a: [[m, 0.0, 0.0], [0.0, m, 0.0], [0.0, 0.0, m]],
-            b: [
-                [0.0, mc[2], -mc[1]],
-                [-mc[2], 0.0, mc[0]],
-                [mc[1], -mc[0], 0.0],
-            ],
-            c: rotational,
+        RigidSum {
+            mass: m,
+            moment: scale(c, m),
+            rotational,
         }
     }
 }
@@ -484,6 +479,41 @@ fn minus_scaled_outer<T: Lane>(m: &Mat3<T>, x: Vec3<T>, y: Vec3<T>, s: T) -> Mat
         sub(m[1], scale(y, xs[1])),
         sub(m[2], scale(y, xs[2])),
     ]
+}
+
+/// A rigid body's inertia, or a sum of them (a subtree's composite inertia), in one frame by
+/// its ten parameters: the total mass `m`, first moment `h = m c` and rotational inertia `C`
+/// about the frame's origin; as a matrix `[[m E, -[h]x], [[h]x, C]]` (a [`Symmetric6`] with
+/// `A = m E`, `B = -[h]x`), applied in about a third of the general product's operations.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct RigidSum {
+    pub(crate) mass: f64,
+    pub(crate) moment: Vec3,
+    pub(crate) rotational: Mat3,
+}
+
+impl RigidSum {
+    /// `Y m = (m v + w x h, h x v + C w)` for `m = (v, w)`.
+    #[inline(always)]
+    pub(crate) fn apply(&self, m: &Motion) -> Force {
+        Force {
+            linear: add(scale(m.linear, self.mass), cross(m.angular, self.moment)),
+            angular: add(
+                cross(self.moment, m.linear),
+                mat_vec(&self.rotational, m.angular),
+            ),
+        }
+    }
+
+    /// `self + other`.
+    #[inline(always)]
+    pub(crate) fn plus(&self, other: &RigidSum) -> RigidSum {
+        RigidSum {
+            mass: self.mass + other.mass,
+            moment: add(self.moment, other.moment),
+            rotational: mat_add(&self.rotational, &other.rotational),
+        }
+    }
 }
 
 /// The rigid-body inertia of a link in its own frame: mass, centre of mass and rotational inertia

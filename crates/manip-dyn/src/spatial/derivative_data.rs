@@ -4,7 +4,7 @@
 
 use faer::{Mat, MatMut, MatRef};
 
-use super::algebra::{Mat3, Symmetric6, Vec3};
+use super::algebra::{Mat3, RigidSum, Vec3};
 use super::model::SpatialModel;
 use crate::model::MAX_DENSE_LINKS;
 
@@ -19,8 +19,11 @@ pub(crate) const ROWS: usize = 15;
 /// `n` and room for one register of the widest SIMD instruction set (8 `f64` lanes): a whole
 /// register can be read from any row index below `n`.
 pub(crate) fn padded(n: usize) -> usize {
-    n + 8
+    n + MAX_LANES
 }
+
+/// The most `f64` lanes of a register (AVX-512).
+pub(crate) const MAX_LANES: usize = 8;
 
 /// Column `k` of `m` as a slice (a faer `Mat`'s blocks are column-major), for the SIMD loops
 /// that fill the derivative matrices a column at a time.
@@ -35,7 +38,7 @@ pub(crate) fn column_of<'m>(m: &'m mut MatMut<'_, f64>, k: usize) -> &'m mut [f6
 
 /// Results and scratch of [`rnea_derivatives`](super::rnea_derivatives()) and
 /// [`aba_derivatives`](super::aba_derivatives()) for one [`SpatialModel`]: build it once with
-/// [`SpatialDerivativeData::new`] (about `40 n^2` bytes), then every call fills it without
+/// [`SpatialDerivativeData::new`] (about `48 n^2` bytes), then every call fills it without
 /// allocating. For a chain of more than [`MAX_DENSE_LINKS`] links, which both refuse, it holds
 /// nothing.
 ///
@@ -67,13 +70,16 @@ pub struct SpatialDerivativeData {
     /// Of links `i..n`, in the base frame: the composite inertia `Ic_i`, and the two blocks of
     /// the composite Coriolis operator `Bc_i = [[0, -2 [Hc_i]x], [0, Dc_i]]`: the linear
     /// momentum `Hc_i` and the 3 x 3 `Dc_i`.
-    pub(crate) composite: Vec<Symmetric6>,
+    pub(crate) composite: Vec<RigidSum>,
     pub(crate) momentum: Vec<Vec3>,
     pub(crate) coriolis: Vec<Mat3>,
     /// `[d tau / d q | d tau / d v]` while `aba_derivatives` multiplies it by `-M^-1`.
     pub(crate) rhs: Mat<f64>,
     /// The force, then motion, columns of the `O(n^2)` `M^-1` by component (`aba_derivatives`).
     pub(crate) sweep: [Vec<f64>; 7],
+    /// `M^-1`'s columns, each zero-padded to [`padded`] entries, for its product with the
+    /// RNEA derivatives (`aba_derivatives`).
+    pub(crate) minv_columns: Vec<f64>,
 }
 
 impl SpatialDerivativeData {
@@ -104,11 +110,12 @@ impl SpatialDerivativeData {
             beta: six(),
             g: six(),
             h: six(),
-            composite: vec![Symmetric6::default(); sized],
+            composite: vec![RigidSum::default(); sized],
             momentum: vec![[0.0; 3]; sized],
             coriolis: vec![[[0.0; 3]; 3]; sized],
             rhs: Mat::zeros(sized, 2 * sized),
             sweep: std::array::from_fn(|_| vec![0.0; padded(sized)]),
+            minv_columns: vec![0.0; sized * padded(sized)],
         }
     }
 

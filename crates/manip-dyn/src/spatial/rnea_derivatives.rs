@@ -23,6 +23,12 @@
 //! `Q_i = Bc_i^T J_i`; for `i < k`, `J_i . G_k` and `J_i . H_k` with column constants `G_k`,
 //! `H_k`: six to nine multiply-adds an entry, computed down each column over the links.
 //!
+//! Everything runs in the base frame: one sweep base to tip gives `J_i`, `v_i`, `a_i`, `w_i`,
+//! `beta_i` and each link's own force `f_i = I_i a_i + v_i x* I_i v_i` (the Newton-Euler
+//! recursion with the base-frame axes, `v_i = v_{i-1} + J_i qd_i`,
+//! `a_i = a_{i-1} + J_i qdd_i + v_i x J_i qd_i`, no per-link frame change), one sweep tip to
+//! base sums `Ic_i`, `Bc_i`, `F_i` and gives `tau_i` with the per-link vectors.
+//!
 //! The Coriolis operator is sparse. With a body's inertia `[[m E, -[mc]x], [[mc]x, C]]`, its
 //! velocity `(v, omega)` and momentum `(h, h_omega) = I (v, omega)`,
 //! `B = -I crm(v) + crf(v) I + (w -> w x* h)` has the blocks
@@ -35,13 +41,12 @@ use lane_math::{Lane, Pack};
 use pulp::{Simd, WithSimd};
 
 use super::algebra::{
-    Force, Mat3, Motion, Symmetric6, Vec3, add, cross, dot, mat_add, mat_t_vec, mat_vec, scale,
+    Force, Mat3, Motion, RigidSum, Vec3, add, cross, dot, mat_add, mat_t_vec, mat_vec, scale,
 };
 use super::data::SpatialData;
-use super::derivative_data::{Six, SpatialDerivativeData, column_of, padded};
+use super::derivative_data::{MAX_LANES, Six, SpatialDerivativeData, column_of, padded};
 use super::kinematics::update_poses;
 use super::model::SpatialModel;
-use super::rnea::newton_euler;
 use crate::check;
 use crate::error::DynError;
 
@@ -83,31 +88,32 @@ pub fn rnea_derivatives(
         derivatives.n_links(),
         n,
     )?;
-    differentiate_at(model, data, derivatives, q, v, qdd)?;
+    update_poses(model, data, q);
+    differentiate_at(model, data, derivatives, v, qdd)?;
     check::finite_matrix("the derivatives", &derivatives.blocks.as_mut())
 }
 
-/// [`rnea_derivatives`] on checked inputs, but for the test of the matrices (which
-/// [`aba_derivatives`](super::aba_derivatives()) makes once, on its own results).
+/// [`rnea_derivatives`] on checked inputs with the links' poses at `q` already in `data`, but
+/// for the test of the matrices (which [`aba_derivatives`](super::aba_derivatives()) makes
+/// once, on its own results).
 pub(crate) fn differentiate_at(
     model: &SpatialModel,
     data: &mut SpatialData,
     derivatives: &mut SpatialDerivativeData,
-    q: &[f64],
     v: &[f64],
     qdd: &[f64],
 ) -> Result<(), DynError> {
-    update_poses(model, data, q);
-    newton_euler(
-        model,
-        data,
-        Some(v),
-        Some(qdd),
-        true,
-        &mut derivatives.value,
-    );
-    check::finite_result("tau", &derivatives.value)?;
-    differentiate(model, data, derivatives);
+    let d = derivatives;
+    newton_euler_base_frame(model, data, d, v, qdd);
+    differentiate(model, d);
+    check::finite_result("tau", &d.value)?;
+    let n = model.n_links();
+    // Moved out and back (no allocation) so that `Fill` reads the vectors while writing them.
+    let mut blocks = std::mem::replace(&mut d.blocks, Mat::new());
+    let (d_q, rest) = blocks.as_mut().split_at_col_mut(n);
+    let (d_v, mass) = rest.split_at_col_mut(n);
+    data.arch.dispatch(Fill { d, d_q, d_v, mass });
+    d.blocks = blocks;
     Ok(())
 }
 
@@ -123,6 +129,27 @@ fn six_force(f: &Force) -> Six {
     [a, b, c, d, e, g]
 }
 
+/// Entry `i` of six component rows (written out: an array `map` here is not inlined).
+#[inline(always)]
+fn entries<R: AsRef<[f64]>>(rows: &[R], i: usize) -> Six {
+    let r = |c: usize| rows[c].as_ref()[i];
+    [r(0), r(1), r(2), r(3), r(4), r(5)]
+}
+
+fn motion_of(x: &Six) -> Motion {
+    Motion {
+        linear: [x[0], x[1], x[2]],
+        angular: [x[3], x[4], x[5]],
+    }
+}
+
+fn force_of(x: &Six) -> Force {
+    Force {
+        linear: [x[0], x[1], x[2]],
+        angular: [x[3], x[4], x[5]],
+    }
+}
+
 /// `[a]x`, the cross-product matrix of `a`.
 fn cross_matrix(a: Vec3) -> Mat3 {
     [[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]]
@@ -131,16 +158,15 @@ fn cross_matrix(a: Vec3) -> Mat3 {
 /// The block `D` of one body's Coriolis operator `B = [[0, -2 [h]x], [0, D]]` (module
 /// documentation), from its base-frame inertia `inertia`, velocity `(v, omega)` and momentum
 /// `(h, h_omega)`: `D = [omega]x C - C [omega]x - [v]x [mc]x - [mc]x [v]x - [h_omega]x`, with
-/// `C` the rotational block of the inertia and `mc` its first moment (`B = -[mc]x`).
-fn coriolis_block(inertia: &Symmetric6, velocity: &Motion, momentum: &Force) -> Mat3 {
-    let b = &inertia.b;
-    let mc = [b[1][2], b[2][0], b[0][1]];
+/// `C` the rotational block of the inertia and `mc` its first moment.
+fn coriolis_block(inertia: &RigidSum, velocity: &Motion, momentum: &Force) -> Mat3 {
+    let mc = inertia.moment;
     let (v, omega) = (velocity.linear, velocity.angular);
     // K = [omega]x C: column k is omega x (column k of C); C [omega]x = -K^T (C symmetric).
     let kt = [
-        cross(omega, inertia.c[0]),
-        cross(omega, inertia.c[1]),
-        cross(omega, inertia.c[2]),
+        cross(omega, inertia.rotational[0]),
+        cross(omega, inertia.rotational[1]),
+        cross(omega, inertia.rotational[2]),
     ];
     // [a]x [b]x = b a^T - (a . b) E.
     let vm = dot(v, mc);
@@ -163,88 +189,101 @@ fn apply_coriolis(momentum: Vec3, d: &Mat3, m: &Motion) -> Force {
     }
 }
 
-/// The derivative matrices from the Newton-Euler pass left in `data` (link-frame velocities,
-/// accelerations and transmitted forces, and the poses).
-fn differentiate(
+/// The Newton-Euler forward sweep in the base frame, base to tip, on the poses in `data`:
+/// each joint's axis `J_i` (into the component rows), `w_i` and `beta_i`, and each link's own
+/// inertia `I_i`, momentum `I_i v_i`, Coriolis block and force `f_i = I_i a_i + v_i x* I_i v_i`
+/// (into `g`, until [`differentiate`] replaces it), with `v_i = v_{i-1} + J_i qd_i` and
+/// `a_i = a_{i-1} + J_i qdd_i + v_i x J_i qd_i` (a massless link has none of the four).
+fn newton_euler_base_frame(
     model: &SpatialModel,
     data: &SpatialData,
-    derivatives: &mut SpatialDerivativeData,
+    d: &mut SpatialDerivativeData,
+    v: &[f64],
+    qdd: &[f64],
 ) {
-    let n = model.n_links();
-    let d = derivatives;
-    // Tip to base: composite inertia and Coriolis operator in the base frame (a massless link
-    // adds nothing to either).
-    for i in (0..n).rev() {
-        let (composite, momentum, coriolis) = if i + 1 < n {
-            (d.composite[i + 1], d.momentum[i + 1], d.coriolis[i + 1])
-        } else {
-            (Symmetric6::default(), [0.0; 3], [[0.0; 3]; 3])
-        };
-        if model.massless[i] {
-            d.composite[i] = composite;
-            d.momentum[i] = momentum;
-            d.coriolis[i] = coriolis;
-            continue;
-        }
-        let pose = &data.poses[i];
-        let inertia = pose.act_rigid_inertia(&model.inertias[i]);
-        let velocity = pose.act_motion(&data.velocities[i]);
-        let own = inertia.apply(&velocity);
-        let block = coriolis_block(&inertia, &velocity, &own);
-        d.composite[i] = inertia.plus(&composite);
-        d.momentum[i] = add(own.linear, momentum);
-        d.coriolis[i] = mat_add(&block, &coriolis);
-    }
-    // Base to tip: the per-link vectors.
     let g = model.gravity();
-    let mut parent_velocity = Motion::default();
-    let mut parent_acceleration = Motion {
+    let mut velocity = Motion::default();
+    let mut acceleration = Motion {
         linear: [-g[0], -g[1], -g[2]],
         angular: [0.0; 3],
     };
-    for i in 0..n {
+    for i in 0..model.n_links() {
         let pose = &data.poses[i];
         let axis = pose.act_motion(&model.axes[i]);
-        let composite: &Symmetric6 = &d.composite[i];
-        let (momentum, coriolis) = (d.momentum[i], &d.coriolis[i]);
-        let w = parent_velocity.cross_motion(&axis);
-        let beta = parent_acceleration
+        let w = velocity.cross_motion(&axis);
+        let beta = acceleration
             .cross_motion(&axis)
-            .plus(&w.cross_motion(&parent_velocity).times(-1.0));
-        let force = pose.act_force(&data.forces[i]);
+            .plus(&w.cross_motion(&velocity).times(-1.0));
+        let joint_velocity = axis.times(v[i]);
+        velocity = velocity.plus(&joint_velocity);
+        acceleration = acceleration
+            .plus(&axis.times(qdd[i]))
+            .plus(&velocity.cross_motion(&joint_velocity));
+        for (row, value) in d.rows.iter_mut().zip(six_motion(&axis)) {
+            row[i] = value;
+        }
+        d.w[i] = six_motion(&w);
+        d.beta[i] = six_motion(&beta);
+        if model.massless[i] {
+            continue;
+        }
+        let inertia = pose.act_rigid_inertia(&model.inertias[i]);
+        let own = inertia.apply(&velocity);
+        d.coriolis[i] = coriolis_block(&inertia, &velocity, &own);
+        d.momentum[i] = own.linear;
+        d.g[i] = six_force(
+            &inertia
+                .apply(&acceleration)
+                .plus(&velocity.cross_force(&own)),
+        );
+        d.composite[i] = inertia;
+    }
+}
+
+/// Tip to base, from what [`newton_euler_base_frame`] left: the subtree sums (composite
+/// inertia `Ic_i`, momentum `Hc_i`, Coriolis block `Dc_i` and transmitted force `F_i`),
+/// `tau_i = J_i . F_i`, and the per-link vectors `P_i`, `Q_i`, `G_i`, `H_i` of the entries.
+fn differentiate(model: &SpatialModel, d: &mut SpatialDerivativeData) {
+    let mut composite = RigidSum::default();
+    let mut momentum = [0.0; 3];
+    let mut coriolis = [[0.0; 3]; 3];
+    let mut force = Force::default();
+    for i in (0..model.n_links()).rev() {
+        // A massless link adds nothing to the sums.
+        if !model.massless[i] {
+            composite = d.composite[i].plus(&composite);
+            momentum = add(d.momentum[i], momentum);
+            coriolis = mat_add(&d.coriolis[i], &coriolis);
+            force = force_of(&d.g[i]).plus(&force);
+        }
+        let axis = motion_of(&entries(&d.rows[..6], i));
+        let (w, beta) = (motion_of(&d.w[i]), motion_of(&d.beta[i]));
+        d.value[i] = axis.dot(&force);
         let p = composite.apply(&axis);
         // Q = Bc^T J = (0, 2 Hc x J_linear + Dc^T J_angular).
         let q = add(
             scale(cross(momentum, axis.linear), 2.0),
-            mat_t_vec(coriolis, axis.angular),
+            mat_t_vec(&coriolis, axis.angular),
         );
-        let row = six_motion(&axis).into_iter().chain(six_force(&p)).chain(q);
-        for (column, value) in d.rows.iter_mut().zip(row) {
-            column[i] = value;
+        for (row, value) in d.rows[6..]
+            .iter_mut()
+            .zip(six_force(&p).into_iter().chain(q))
+        {
+            row[i] = value;
         }
-        d.w[i] = six_motion(&w);
-        d.beta[i] = six_motion(&beta);
         d.g[i] = six_force(
             &axis
                 .cross_force(&force)
                 .plus(&composite.apply(&beta))
-                .plus(&apply_coriolis(momentum, coriolis, &w)),
+                .plus(&apply_coriolis(momentum, &coriolis, &w)),
         );
         d.h[i] = six_force(
             &composite
                 .apply(&w)
                 .times(2.0)
-                .plus(&apply_coriolis(momentum, coriolis, &axis)),
+                .plus(&apply_coriolis(momentum, &coriolis, &axis)),
         );
-        parent_velocity = pose.act_motion(&data.velocities[i]);
-        parent_acceleration = pose.act_motion(&data.accelerations[i]);
     }
-    // Moved out and back (no allocation) so that `Fill` reads the vectors while writing them.
-    let mut blocks = std::mem::replace(&mut d.blocks, Mat::new());
-    let (d_q, rest) = blocks.as_mut().split_at_col_mut(n);
-    let (d_v, mass) = rest.split_at_col_mut(n);
-    data.arch.dispatch(Fill { d, d_q, d_v, mass });
-    d.blocks = blocks;
 }
 
 /// The entries of the three matrices from the per-link vectors, column by column, each entry
@@ -274,8 +313,8 @@ impl WithSimd for Fill<'_> {
         let p = [r(6), r(7), r(8), r(9), r(10), r(11)];
         let pq = [r(6), r(7), r(8), r(9), r(10), r(11), r(12), r(13), r(14)];
         for k in 0..n {
-            let axis = [0, 1, 2, 3, 4, 5].map(|c| axes[c][k]);
-            let p_k = [0, 1, 2, 3, 4, 5].map(|c| p[c][k]);
+            let axis = entries(&axes, k);
+            let p_k = entries(&p, k);
             let (w, beta) = (&d.w[k], &d.beta[k]);
             let dq = [
                 beta[0], beta[1], beta[2], beta[3], beta[4], beta[5], w[3], w[4], w[5],
@@ -342,6 +381,3 @@ fn combine<S: Simd, const C: usize>(
         at += width;
     }
 }
-
-/// The most `f64` lanes of a register (AVX-512).
-const MAX_LANES: usize = 8;
