@@ -144,7 +144,26 @@ impl BoxQp {
         x: &mut [f64],
         settings: &BoxQpSettings,
     ) -> Result<BoxQpReport, OptimalError> {
-        let n = self.n;
+        match self.n {
+            2 => self.solve_sized::<2>(h, g, lower, upper, x, settings),
+            3 => self.solve_sized::<3>(h, g, lower, upper, x, settings),
+            _ => self.solve_sized::<0>(h, g, lower, upper, x, settings),
+        }
+    }
+
+    /// [`solve`](Self::solve) for `n = N` known at compile time (iLQR's reduced models have
+    /// `m = 2` or 3 controls), or any `n` when `N` is 0: the same operations in the same order.
+    #[inline(always)]
+    fn solve_sized<const N: usize>(
+        &mut self,
+        h: &[f64],
+        g: &[f64],
+        lower: &[f64],
+        upper: &[f64],
+        x: &mut [f64],
+        settings: &BoxQpSettings,
+    ) -> Result<BoxQpReport, OptimalError> {
+        let n = if N == 0 { self.n } else { N };
         for (name, got, expected) in [
             ("H", h.len(), n * n),
             ("g", g.len(), n),
@@ -161,6 +180,7 @@ impl BoxQp {
             }
         }
         settings.validate()?;
+        let (h, g, lower, upper, x) = (&h[..n * n], &g[..n], &lower[..n], &upper[..n], &mut x[..n]);
         for i in 0..n {
             if lower[i].is_nan() || upper[i].is_nan() || lower[i] > upper[i] {
                 return Err(OptimalError::InvalidSetting {
@@ -185,7 +205,7 @@ impl BoxQp {
             }
             iterations += 1;
             old_value = value;
-            self.clamp_set(h, g, lower, upper, x);
+            self.clamp_set(n, h, g, (lower, upper), x);
             let changed = self.update_free_set();
             if self.n_free == 0 {
                 converged = true;
@@ -216,15 +236,15 @@ impl BoxQp {
                 self.rhs[f] = -s;
             }
             cholesky_solve(&self.factor, self.n_free, &mut self.rhs[..self.n_free], 1);
-            self.direction.fill(0.0);
+            let direction = &mut self.direction[..n];
+            direction.fill(0.0);
             for f in 0..self.n_free {
                 let i = self.free_index[f];
-                self.direction[i] = self.rhs[f] - x[i];
+                direction[i] = self.rhs[f] - x[i];
             }
-            let slope: f64 = self
-                .direction
+            let slope: f64 = direction
                 .iter()
-                .zip(&self.gradient)
+                .zip(&self.gradient[..n])
                 .map(|(d, g)| d * g)
                 .sum();
             if slope >= 0.0 {
@@ -234,13 +254,14 @@ impl BoxQp {
             }
             // Projected Armijo backtracking.
             let mut step = 1.0;
+            let (candidate, direction) = (&mut self.candidate[..n], &self.direction[..n]);
             loop {
                 for i in 0..n {
-                    self.candidate[i] = (x[i] + step * self.direction[i]).clamp(lower[i], upper[i]);
+                    candidate[i] = (x[i] + step * direction[i]).clamp(lower[i], upper[i]);
                 }
-                let candidate_value = objective(h, g, &self.candidate, n);
+                let candidate_value = objective(h, g, candidate, n);
                 if (candidate_value - value) / (step * slope) >= ARMIJO {
-                    x.copy_from_slice(&self.candidate);
+                    x.copy_from_slice(candidate);
                     value = candidate_value;
                     break;
                 }
@@ -255,7 +276,7 @@ impl BoxQp {
             }
         }
         // The factor must match the free set of the returned point.
-        self.clamp_set(h, g, lower, upper, x);
+        self.clamp_set(n, h, g, (lower, upper), x);
         if self.update_free_set() || !factored {
             self.factor_free(h)?;
         }
@@ -266,9 +287,18 @@ impl BoxQp {
         })
     }
 
-    /// The gradient `g + H x` and the free set at `x`, into `gradient` and `next_free`.
-    fn clamp_set(&mut self, h: &[f64], g: &[f64], lower: &[f64], upper: &[f64], x: &[f64]) {
-        let n = self.n;
+    /// The gradient `g + H x` and the free set at `x` (`n` unknowns), into `gradient` and
+    /// `next_free`.
+    #[inline(always)]
+    fn clamp_set(
+        &mut self,
+        n: usize,
+        h: &[f64],
+        g: &[f64],
+        (lower, upper): (&[f64], &[f64]),
+        x: &[f64],
+    ) {
+        let (h, g, lower, upper, x) = (&h[..n * n], &g[..n], &lower[..n], &upper[..n], &x[..n]);
         for i in 0..n {
             let mut s = g[i];
             for j in 0..n {
@@ -339,6 +369,7 @@ impl BoxQp {
 }
 
 /// `1/2 x^T H x + g^T x`.
+#[inline(always)]
 fn objective(h: &[f64], g: &[f64], x: &[f64], n: usize) -> f64 {
     let mut value = 0.0;
     for i in 0..n {

@@ -127,29 +127,49 @@ impl DiscreteDynamics for ReducedEuler<'_> {
         a_mat: &mut [f64],
         b_mat: &mut [f64],
     ) -> Result<(), OptimalError> {
-        let (m, h) = (self.model.n_coords(), self.step);
-        let n = 2 * m;
+        let m = self.model.n_coords();
         let (a, v) = x.split_at(m);
         self.model
             .derivatives(self.data, self.derivatives, a, v, u)?;
         let d = &*self.derivatives;
-        let (f_a, f_v, f_u) = (d.d_a(), d.d_a_dot(), d.d_tau_star());
-        for i in 0..m {
-            let v_next = v[i] + h * d.a_ddot()[i];
-            next[m + i] = v_next;
-            next[i] = a[i] + h * v_next;
-            for j in 0..m {
-                let identity = if i == j { 1.0 } else { 0.0 };
-                // Velocity rows: d v_next = h F d(.) + identity on v.
-                a_mat[(m + i) * n + j] = h * f_a[(i, j)];
-                a_mat[(m + i) * n + m + j] = identity + h * f_v[(i, j)];
-                b_mat[(m + i) * m + j] = h * f_u[(i, j)];
-                // Position rows: d a_next = d a + h d v_next.
-                a_mat[i * n + j] = identity + h * h * f_a[(i, j)];
-                a_mat[i * n + m + j] = h * (identity + h * f_v[(i, j)]);
-                b_mat[i * m + j] = h * h * f_u[(i, j)];
-            }
+        let euler = (self.step, x, next, a_mat, b_mat);
+        match m {
+            2 => assemble::<2>(d, euler),
+            3 => assemble::<3>(d, euler),
+            _ => assemble::<0>(d, euler),
         }
         Ok(())
+    }
+}
+
+/// The Euler map's next state and Jacobians `(A, B)` from the plant's derivatives `d` at `x`
+/// (`(h, x, next, A, B)`), for `m = M` known at compile time, or any `m` when `M` is 0.
+#[inline(always)]
+fn assemble<const M: usize>(
+    d: &PlantDerivatives,
+    (h, x, next, a_mat, b_mat): (f64, &[f64], &mut [f64], &mut [f64], &mut [f64]),
+) {
+    let m = if M == 0 { d.a_ddot().len() } else { M };
+    let n = 2 * m;
+    let (a, v) = (&x[..m], &x[m..n]);
+    let (next, a_mat, b_mat) = (&mut next[..n], &mut a_mat[..n * n], &mut b_mat[..n * m]);
+    let (f_a, f_v, f_u) = (d.d_a(), d.d_a_dot(), d.d_tau_star());
+    let a_ddot = &d.a_ddot()[..m];
+    for i in 0..m {
+        let v_next = v[i] + h * a_ddot[i];
+        next[m + i] = v_next;
+        next[i] = a[i] + h * v_next;
+        for j in 0..m {
+            let identity = if i == j { 1.0 } else { 0.0 };
+            let (f_a, f_v, f_u) = (f_a[(i, j)], f_v[(i, j)], f_u[(i, j)]);
+            // Velocity rows: d v_next = h F d(.) + identity on v.
+            a_mat[(m + i) * n + j] = h * f_a;
+            a_mat[(m + i) * n + m + j] = identity + h * f_v;
+            b_mat[(m + i) * m + j] = h * f_u;
+            // Position rows: d a_next = d a + h d v_next.
+            a_mat[i * n + j] = identity + h * h * f_a;
+            a_mat[i * n + m + j] = h * (identity + h * f_v);
+            b_mat[i * m + j] = h * h * f_u;
+        }
     }
 }

@@ -10,7 +10,8 @@ use lane_math::dense::{multiply, multiply_transposed, symmetrise};
 /// The most steps a horizon may have.
 pub const MAX_HORIZON: usize = 100_000;
 /// The most numbers an [`Ilqr`] workspace may hold (256 MiB of `f64`): a guard on
-/// `horizon * (n_x^2 + 2 n_x n_u)`, the size of the Jacobians and gains.
+/// `horizon * (2 n_x^2 + 3 n_x n_u)`, the size of the Jacobians (the nominal trajectory's and
+/// the line search's) and gains.
 pub const MAX_WORKSPACE: usize = 1 << 25;
 
 /// The diagonal quadratic tracking cost of [`Ilqr`]:
@@ -146,7 +147,12 @@ pub struct IlqrReport {
 ///
 /// Each iteration (Tassa, Mansard and Todorov 2014, Algorithm 2):
 ///
-/// 1. Linearise `x_{k+1} = F(x_k, u_k)` along the current trajectory (`A_k`, `B_k`).
+/// 1. Linearise `x_{k+1} = F(x_k, u_k)` along the current trajectory (`A_k`, `B_k`). Without
+///    constraints, the rollout that made the trajectory has mostly done it on its way
+///    ([`DiscreteDynamics::linearise`] gives the next state with the Jacobians, so a node's
+///    dynamics are evaluated once): the warm start's rollout and each line search's first
+///    trial (`alpha = 1`) linearise, except the last allowed iteration's; an accepted later
+///    trial is linearised after it.
 /// 2. Backward pass from `V_x = Q_f (x_N - r_N)`, `V_xx = Q_f`:
 ///    `Q_x = l_x + A^T V_x'`, `Q_u = l_u + B^T V_x'`, `Q_xx = Q + A^T V_xx' A`,
 ///    `Q_uu = R + B^T V_xx' B`, `Q_ux = B^T V_xx' A`; the feed-forward `k` solves the box QP
@@ -181,28 +187,16 @@ pub struct Ilqr {
     u_ref: Vec<f64>,
     lower: Vec<f64>,
     upper: Vec<f64>,
-    /// Per step: `A_k` (`n_x x n_x`), `B_k` (`n_x x n_u`), `K_k` (`n_u x n_x`), `k_k` (`n_u`).
+    /// Per step: `A_k` (`n_x x n_x`), `B_k` (`n_x x n_u`), `K_k` (`n_u x n_x`), `k_k` (`n_u`),
+    /// and the Jacobians along the line search's candidate.
     a: Vec<f64>,
     b: Vec<f64>,
+    a_try: Vec<f64>,
+    b_try: Vec<f64>,
     gain: Vec<f64>,
     feedforward: Vec<f64>,
-    /// Backward-pass terms.
-    v_x: Vec<f64>,
-    v_xx: Vec<f64>,
-    q_x: Vec<f64>,
-    q_u: Vec<f64>,
-    q_xx: Vec<f64>,
-    q_uu: Vec<f64>,
-    q_ux: Vec<f64>,
-    /// `V_xx' A` (`n_x x n_x`), `V_xx' B` (`n_x x n_u`), `Q_uu K` (`n_u x n_x`), `Q_uu k` (`n_u`),
-    /// the regularised Hessian (`n_u x n_u`) and the step bounds (`n_u` each).
-    va: Vec<f64>,
-    vb: Vec<f64>,
-    quu_gain: Vec<f64>,
-    quu_ff: Vec<f64>,
-    hessian: Vec<f64>,
-    step_lower: Vec<f64>,
-    step_upper: Vec<f64>,
+    /// The backward pass's terms of one step for sizes without their own (stack) body.
+    terms: HeapTerms,
     /// The adjoint of [`gradient`](Self::gradient) and its next value.
     adjoint: Vec<f64>,
     adjoint_next: Vec<f64>,
@@ -249,11 +243,12 @@ impl Ilqr {
         }
         let per_step = nx
             .saturating_mul(nx)
-            .saturating_add(nx.saturating_mul(nu).saturating_mul(2));
+            .saturating_mul(2)
+            .saturating_add(nx.saturating_mul(nu).saturating_mul(3));
         if horizon.saturating_mul(per_step) > MAX_WORKSPACE {
             return Err(OptimalError::InvalidSetting {
                 name: "horizon",
-                requirement: "small enough for horizon * (n_x^2 + 2 n_x n_u) <= 2^25",
+                requirement: "small enough for horizon * (2 n_x^2 + 3 n_x n_u) <= 2^25",
                 value: horizon as f64,
             });
         }
@@ -300,22 +295,11 @@ impl Ilqr {
             upper: vec![f64::INFINITY; nu],
             a: vec![0.0; n * nx * nx],
             b: vec![0.0; n * nx * nu],
+            a_try: vec![0.0; n * nx * nx],
+            b_try: vec![0.0; n * nx * nu],
             gain: vec![0.0; n * nu * nx],
             feedforward: vec![0.0; n * nu],
-            v_x: vec![0.0; nx],
-            v_xx: vec![0.0; nx * nx],
-            q_x: vec![0.0; nx],
-            q_u: vec![0.0; nu],
-            q_xx: vec![0.0; nx * nx],
-            q_uu: vec![0.0; nu * nu],
-            q_ux: vec![0.0; nu * nx],
-            va: vec![0.0; nx * nx],
-            vb: vec![0.0; nx * nu],
-            quu_gain: vec![0.0; nu * nx],
-            quu_ff: vec![0.0; nu],
-            hessian: vec![0.0; nu * nu],
-            step_lower: vec![0.0; nu],
-            step_upper: vec![0.0; nu],
+            terms: HeapTerms::new(nx, nu),
             adjoint: vec![0.0; nx],
             adjoint_next: vec![0.0; nx],
             qp: BoxQp::new(nu),
@@ -558,12 +542,14 @@ impl Ilqr {
         self.x[..self.nx].copy_from_slice(x0);
         // Within rows, the warm start's rollout moves every control within its step's rows at
         // the state reached (as every forward pass does), so that the first nominal trajectory
-        // is feasible; its Jacobians stand when no control moved.
+        // is feasible; without rows it linearises on its way. `jacobians_current`: the Jacobians
+        // computed on the way stand for the trajectory.
+        let unconstrained = constraints.is_none();
         let (initial_cost, mut jacobians_current) =
-            match self.warm_rollout(dynamics, constraints.as_deref_mut(), follow) {
+            match self.warm_rollout(dynamics, constraints.as_deref_mut(), follow, unconstrained) {
                 Err(error) if follow && diverged(&error) => {
                     self.u.copy_from_slice(&self.u_try);
-                    self.warm_rollout(dynamics, constraints.as_deref_mut(), false)?
+                    self.warm_rollout(dynamics, constraints.as_deref_mut(), false, unconstrained)?
                 }
                 other => other?,
             };
@@ -609,21 +595,33 @@ impl Ilqr {
                 converged = true;
                 break;
             }
+            // No linearisation follows the last iteration's line search.
+            let linearising = unconstrained && iterations < settings.max_iterations;
             let mut accepted = None;
             let mut alpha = 1.0;
             for _ in 0..steps {
-                let candidate = self.forward(dynamics, constraints.as_deref_mut(), alpha)?;
+                let (candidate, candidate_linearised) = self.forward(
+                    dynamics,
+                    constraints.as_deref_mut(),
+                    alpha,
+                    linearising && alpha == 1.0,
+                )?;
                 let predicted = -(alpha * expected[0] + alpha * alpha * expected[1]);
                 if candidate < cost && (cost - candidate) >= ACCEPTANCE * predicted {
-                    accepted = Some(candidate);
+                    accepted = Some((candidate, candidate_linearised));
                     break;
                 }
                 alpha *= 0.5;
             }
             match accepted {
-                Some(candidate) => {
+                Some((candidate, candidate_linearised)) => {
                     std::mem::swap(&mut self.x, &mut self.x_try);
                     std::mem::swap(&mut self.u, &mut self.u_try);
+                    if candidate_linearised {
+                        std::mem::swap(&mut self.a, &mut self.a_try);
+                        std::mem::swap(&mut self.b, &mut self.b_try);
+                    }
+                    jacobians_current = candidate_linearised;
                     linearised = false;
                     let improvement = cost - candidate;
                     cost = candidate;
@@ -747,14 +745,15 @@ impl Ilqr {
     /// or, when `follow`, with the previous plan's feedback `u_k + K_k (x_k - x̄_k)` about its
     /// states `x̄_k` (kept in `x_try`), clamped to the box. With `constraints`, every control is
     /// then moved to the closest within its step's rows at the state reached, the rows
-    /// linearised there (a control whose rows admit none is kept). The cost, and whether the
-    /// Jacobians computed on the way are those of the final trajectory (only with constraints,
-    /// when no control moved).
+    /// linearised there (a control whose rows admit none is kept); without, the Jacobians `A_k`,
+    /// `B_k` come with each step while `linearising`. The cost, and whether the Jacobians
+    /// computed on the way are those of the final trajectory.
     fn warm_rollout<D: DiscreteDynamics + ?Sized>(
         &mut self,
         dynamics: &mut D,
         constraints: Option<&mut (dyn StepConstraints + '_)>,
         follow: bool,
+        mut linearising: bool,
     ) -> Result<(f64, bool), OptimalError> {
         let (nx, nu) = (self.nx, self.nu);
         let mut rows = match (constraints, &mut self.constrained) {
@@ -764,7 +763,7 @@ impl Ilqr {
         let mut unmoved = rows.is_some();
         for k in 0..self.horizon {
             let (past, future) = self.x.split_at_mut((k + 1) * nx);
-            let (x, next) = (&past[k * nx..], &mut future[..nx]);
+            let (x, next) = (&past[k * nx..(k + 1) * nx], &mut future[..nx]);
             let u = &mut self.u[k * nu..(k + 1) * nu];
             if follow {
                 let planned = &self.x_try[k * nx..(k + 1) * nx];
@@ -774,11 +773,11 @@ impl Ilqr {
                     *u = (*u + correction).clamp(self.lower[j], self.upper[j]);
                 }
             }
+            let b = &mut self.b[k * nx * nu..(k + 1) * nx * nu];
+            let a = &mut self.a[k * nx * nx..(k + 1) * nx * nx];
             match &mut rows {
-                None => dynamics.step(x, u, next)?,
+                None => advance(dynamics, (x, u), next, (a, b), &mut linearising)?,
                 Some((c, work)) => {
-                    let b = &mut self.b[k * nx * nu..(k + 1) * nx * nu];
-                    let a = &mut self.a[k * nx * nx..(k + 1) * nx * nx];
                     dynamics.linearise(x, u, next, a, b)?;
                     let within = (&self.lower[..], &self.upper[..]);
                     if work.project(&mut **c, k, (x, b), within, u)? == Some(true) {
@@ -788,9 +787,10 @@ impl Ilqr {
                 }
             }
         }
+        let current = if rows.is_some() { unmoved } else { linearising };
         let cost = self.trajectory_cost(&self.x, &self.u);
         if cost.is_finite() {
-            Ok((cost, unmoved))
+            Ok((cost, current))
         } else {
             Err(OptimalError::InvalidSetting {
                 name: "warm start",
@@ -830,17 +830,35 @@ impl Ilqr {
         constrained: bool,
     ) -> Result<[f64; 2], OptimalError> {
         match (self.nx, self.nu) {
-            (4, 2) => self.backward_sized::<4, 2>(mu, qp, constrained),
-            (6, 3) => self.backward_sized::<6, 3>(mu, qp, constrained),
-            _ => self.backward_sized::<0, 0>(mu, qp, constrained),
+            (4, 2) => {
+                let mut terms = StackTerms::<4, 2>::default();
+                self.backward_sized::<4, 2>(terms.slices(), mu, qp, constrained)
+            }
+            (6, 3) => {
+                let mut terms = StackTerms::<6, 3>::default();
+                self.backward_sized::<6, 3>(terms.slices(), mu, qp, constrained)
+            }
+            _ => {
+                // Taken out of the workspace for the pass (no allocation) and put back.
+                let mut terms = std::mem::take(&mut self.terms);
+                let expected = self.backward_sized::<0, 0>(
+                    terms.slices(self.nx, self.nu),
+                    mu,
+                    qp,
+                    constrained,
+                );
+                self.terms = terms;
+                expected
+            }
         }
     }
 
-    /// [`backward`](Self::backward) for `n_x = NX`, `n_u = NU` known at compile time, or any
-    /// sizes when both are 0.
+    /// [`backward`](Self::backward) for `n_x = NX`, `n_u = NU` known at compile time (the
+    /// terms on the stack), or any sizes when both are 0.
     #[inline(always)]
     fn backward_sized<const NX: usize, const NU: usize>(
         &mut self,
+        t: Terms<'_>,
         mu: f64,
         qp: &BoxQpSettings,
         constrained: bool,
@@ -855,43 +873,43 @@ impl Ilqr {
         let mut expected = [0.0; 2];
         self.relaxed = 0;
         for i in 0..nx {
-            self.v_x[i] = cost.terminal[i] * (self.x[n * nx + i] - self.x_ref[n * nx + i]);
+            t.v_x[i] = cost.terminal[i] * (self.x[n * nx + i] - self.x_ref[n * nx + i]);
         }
-        self.v_xx.fill(0.0);
+        t.v_xx.fill(0.0);
         for i in 0..nx {
-            self.v_xx[i * nx + i] = cost.terminal[i];
+            t.v_xx[i * nx + i] = cost.terminal[i];
         }
         for k in (0..n).rev() {
             let a = &self.a[k * nx * nx..(k + 1) * nx * nx];
             let b = &self.b[k * nx * nu..(k + 1) * nx * nu];
             let u = &self.u[k * nu..(k + 1) * nu];
             // Q_x, Q_u.
-            multiply_transposed(a, &self.v_x, &mut self.q_x, nx, nx, 1);
-            multiply_transposed(b, &self.v_x, &mut self.q_u, nu, nx, 1);
+            multiply_transposed(a, t.v_x, t.q_x, nx, nx, 1);
+            multiply_transposed(b, t.v_x, t.q_u, nu, nx, 1);
             for i in 0..nx {
-                self.q_x[i] += cost.state[i] * (self.x[k * nx + i] - self.x_ref[k * nx + i]);
+                t.q_x[i] += cost.state[i] * (self.x[k * nx + i] - self.x_ref[k * nx + i]);
             }
-            for (j, q) in self.q_u.iter_mut().enumerate() {
+            for (j, q) in t.q_u.iter_mut().enumerate() {
                 *q += cost.control[j] * (u[j] - self.u_ref[k * nu + j]);
             }
             // Q_xx, Q_uu, Q_ux.
-            multiply(&self.v_xx, a, &mut self.va, nx, nx, nx);
-            multiply(&self.v_xx, b, &mut self.vb, nx, nx, nu);
-            multiply_transposed(a, &self.va, &mut self.q_xx, nx, nx, nx);
-            multiply_transposed(b, &self.vb, &mut self.q_uu, nu, nx, nu);
-            multiply_transposed(b, &self.va, &mut self.q_ux, nu, nx, nx);
+            multiply(t.v_xx, a, t.va, nx, nx, nx);
+            multiply(t.v_xx, b, t.vb, nx, nx, nu);
+            multiply_transposed(a, t.va, t.q_xx, nx, nx, nx);
+            multiply_transposed(b, t.vb, t.q_uu, nu, nx, nu);
+            multiply_transposed(b, t.va, t.q_ux, nu, nx, nx);
             for i in 0..nx {
-                self.q_xx[i * nx + i] += cost.state[i];
+                t.q_xx[i * nx + i] += cost.state[i];
             }
             for j in 0..nu {
-                self.q_uu[j * nu + j] += cost.control[j];
+                t.q_uu[j * nu + j] += cost.control[j];
             }
             // The feed-forward step: the box QP on (Q_uu + mu I, Q_u).
-            self.hessian.copy_from_slice(&self.q_uu);
+            t.hessian.copy_from_slice(t.q_uu);
             for (j, &uj) in u.iter().enumerate() {
-                self.hessian[j * nu + j] += mu;
-                self.step_lower[j] = self.lower[j] - uj;
-                self.step_upper[j] = self.upper[j] - uj;
+                t.hessian[j * nu + j] += mu;
+                t.step_lower[j] = self.lower[j] - uj;
+                t.step_upper[j] = self.upper[j] - uj;
             }
             let ff = &mut self.feedforward[k * nu..(k + 1) * nu];
             let gain = &mut self.gain[k * nu * nx..(k + 1) * nu * nx];
@@ -901,7 +919,7 @@ impl Ilqr {
                 Some(work) if constrained && work.counts[k] > 0 => {
                     let feasible = work.feedforward(
                         k,
-                        (&self.hessian, &self.q_u, &self.q_ux),
+                        (t.hessian, t.q_u, t.q_ux),
                         u,
                         (&self.lower, &self.upper),
                         ff,
@@ -913,60 +931,55 @@ impl Ilqr {
                 _ => false,
             };
             if !within_rows {
-                self.qp.solve(
-                    &self.hessian,
-                    &self.q_u,
-                    &self.step_lower,
-                    &self.step_upper,
-                    ff,
-                    qp,
-                )?;
+                self.qp
+                    .solve(t.hessian, t.q_u, t.step_lower, t.step_upper, ff, qp)?;
                 // The gain on the free controls, zero on the clamped ones.
-                gain.copy_from_slice(&self.q_ux);
+                gain.copy_from_slice(t.q_ux);
                 self.qp.solve_free(gain, nx);
                 for g in gain.iter_mut() {
                     *g = -*g;
                 }
             }
             // The value function.
-            multiply(&self.q_uu, gain, &mut self.quu_gain, nu, nu, nx);
-            multiply(&self.q_uu, ff, &mut self.quu_ff, nu, nu, 1);
+            multiply(t.q_uu, gain, t.quu_gain, nu, nu, nx);
+            multiply(t.q_uu, ff, t.quu_ff, nu, nu, 1);
             for (j, f) in ff.iter().enumerate() {
-                expected[0] += f * self.q_u[j];
-                expected[1] += 0.5 * f * self.quu_ff[j];
+                expected[0] += f * t.q_u[j];
+                expected[1] += 0.5 * f * t.quu_ff[j];
             }
             for i in 0..nx {
-                let mut s = self.q_x[i];
+                let mut s = t.q_x[i];
                 for j in 0..nu {
-                    s += gain[j * nx + i] * (self.quu_ff[j] + self.q_u[j])
-                        + self.q_ux[j * nx + i] * ff[j];
+                    s += gain[j * nx + i] * (t.quu_ff[j] + t.q_u[j]) + t.q_ux[j * nx + i] * ff[j];
                 }
-                self.v_x[i] = s;
+                t.v_x[i] = s;
             }
             for i in 0..nx {
                 for l in 0..nx {
-                    let mut s = self.q_xx[i * nx + l];
+                    let mut s = t.q_xx[i * nx + l];
                     for j in 0..nu {
-                        s += gain[j * nx + i] * (self.quu_gain[j * nx + l] + self.q_ux[j * nx + l])
-                            + self.q_ux[j * nx + i] * gain[j * nx + l];
+                        s += gain[j * nx + i] * (t.quu_gain[j * nx + l] + t.q_ux[j * nx + l])
+                            + t.q_ux[j * nx + i] * gain[j * nx + l];
                     }
-                    self.v_xx[i * nx + l] = s;
+                    t.v_xx[i * nx + l] = s;
                 }
             }
-            symmetrise(&mut self.v_xx, nx);
+            symmetrise(t.v_xx, nx);
         }
         Ok(expected)
     }
 
     /// The forward pass at step length `alpha` into `x_try`, `u_try`, every control moved within
-    /// the step's rows at its state when there are `constraints` (kept where they admit none);
-    /// its cost (infinite if the dynamics refuse a state on the way).
+    /// the step's rows at its state when there are `constraints` (kept where they admit none),
+    /// the Jacobians into `a_try`, `b_try` when `linearising`; its cost (infinite if the dynamics
+    /// refuse a state on the way), and whether the Jacobians were computed at every node.
     fn forward<D: DiscreteDynamics + ?Sized>(
         &mut self,
         dynamics: &mut D,
         mut constraints: Option<&mut (dyn StepConstraints + '_)>,
         alpha: f64,
-    ) -> Result<f64, OptimalError> {
+        mut linearising: bool,
+    ) -> Result<(f64, bool), OptimalError> {
         let (nx, nu) = (self.nx, self.nu);
         self.x_try[..nx].copy_from_slice(&self.x[..nx]);
         for k in 0..self.horizon {
@@ -992,41 +1005,70 @@ impl Ilqr {
                     &mut self.u_try[k * nu..(k + 1) * nu],
                 ) {
                     Ok(_) => {}
-                    Err(OptimalError::Dynamics(_)) => return Ok(f64::INFINITY),
+                    Err(OptimalError::Dynamics(_)) => return Ok((f64::INFINITY, false)),
                     Err(other) => return Err(other),
                 }
             }
             let (past, future) = self.x_try.split_at_mut((k + 1) * nx);
-            if dynamics
-                .step(
-                    &past[k * nx..],
+            if advance(
+                dynamics,
+                (
+                    &past[k * nx..(k + 1) * nx],
                     &self.u_try[k * nu..(k + 1) * nu],
-                    &mut future[..nx],
-                )
-                .is_err()
+                ),
+                &mut future[..nx],
+                (
+                    &mut self.a_try[k * nx * nx..(k + 1) * nx * nx],
+                    &mut self.b_try[k * nx * nu..(k + 1) * nx * nu],
+                ),
+                &mut linearising,
+            )
+            .is_err()
             {
-                return Ok(f64::INFINITY);
+                return Ok((f64::INFINITY, false));
             }
         }
         let cost = self.trajectory_cost(&self.x_try, &self.u_try);
-        Ok(if cost.is_nan() { f64::INFINITY } else { cost })
+        Ok((
+            if cost.is_nan() { f64::INFINITY } else { cost },
+            linearising,
+        ))
     }
 
     /// The tracking cost of a trajectory.
     fn trajectory_cost(&self, x: &[f64], u: &[f64]) -> f64 {
-        let (nx, nu, n) = (self.nx, self.nu, self.horizon);
+        match (self.nx, self.nu) {
+            (4, 2) => self.trajectory_cost_sized::<4, 2>(x, u),
+            (6, 3) => self.trajectory_cost_sized::<6, 3>(x, u),
+            _ => self.trajectory_cost_sized::<0, 0>(x, u),
+        }
+    }
+
+    /// [`trajectory_cost`](Self::trajectory_cost) for `n_x = NX`, `n_u = NU` known at compile
+    /// time, or any sizes when both are 0: the same sum in the same order.
+    #[inline(always)]
+    fn trajectory_cost_sized<const NX: usize, const NU: usize>(&self, x: &[f64], u: &[f64]) -> f64 {
+        let (nx, nu) = if NX == 0 {
+            (self.nx, self.nu)
+        } else {
+            (NX, NU)
+        };
+        let n = self.horizon;
         let c = &self.cost;
+        let (state, terminal, control) = (&c.state[..nx], &c.terminal[..nx], &c.control[..nu]);
         let mut total = 0.0;
         for k in 0..=n {
-            let weights = if k == n { &c.terminal } else { &c.state };
+            let weights = if k == n { terminal } else { state };
+            let (x, x_ref) = (&x[k * nx..(k + 1) * nx], &self.x_ref[k * nx..(k + 1) * nx]);
             for i in 0..nx {
-                let e = x[k * nx + i] - self.x_ref[k * nx + i];
+                let e = x[i] - x_ref[i];
                 total += 0.5 * weights[i] * e * e;
             }
             if k < n {
+                let (u, u_ref) = (&u[k * nu..(k + 1) * nu], &self.u_ref[k * nu..(k + 1) * nu]);
                 for j in 0..nu {
-                    let e = u[k * nu + j] - self.u_ref[k * nu + j];
-                    total += 0.5 * c.control[j] * e * e;
+                    let e = u[j] - u_ref[j];
+                    total += 0.5 * control[j] * e * e;
                 }
             }
         }
@@ -1074,6 +1116,178 @@ fn diverged(error: &OptimalError) -> bool {
                 ..
             }
     )
+}
+
+/// The backward pass's terms of one step, row-major: `V_x'` (`n_x`), `V_xx'` (`n_x x n_x`),
+/// `Q_x`, `Q_u`, `Q_xx`, `Q_uu`, `Q_ux`; `V_xx' A` (`n_x x n_x`), `V_xx' B` (`n_x x n_u`),
+/// `Q_uu K` (`n_u x n_x`), `Q_uu k` (`n_u`), the regularised Hessian (`n_u x n_u`) and the step
+/// bounds (`n_u` each).
+struct Terms<'t> {
+    v_x: &'t mut [f64],
+    v_xx: &'t mut [f64],
+    q_x: &'t mut [f64],
+    q_u: &'t mut [f64],
+    q_xx: &'t mut [f64],
+    q_uu: &'t mut [f64],
+    q_ux: &'t mut [f64],
+    va: &'t mut [f64],
+    vb: &'t mut [f64],
+    quu_gain: &'t mut [f64],
+    quu_ff: &'t mut [f64],
+    hessian: &'t mut [f64],
+    step_lower: &'t mut [f64],
+    step_upper: &'t mut [f64],
+}
+
+/// [`Terms`] on the stack for `n_x = NX`, `n_u = NU`: their sizes known where they are used.
+struct StackTerms<const NX: usize, const NU: usize> {
+    v_x: [f64; NX],
+    v_xx: [[f64; NX]; NX],
+    q_x: [f64; NX],
+    q_u: [f64; NU],
+    q_xx: [[f64; NX]; NX],
+    q_uu: [[f64; NU]; NU],
+    q_ux: [[f64; NX]; NU],
+    va: [[f64; NX]; NX],
+    vb: [[f64; NU]; NX],
+    quu_gain: [[f64; NX]; NU],
+    quu_ff: [f64; NU],
+    hessian: [[f64; NU]; NU],
+    step_lower: [f64; NU],
+    step_upper: [f64; NU],
+}
+
+impl<const NX: usize, const NU: usize> Default for StackTerms<NX, NU> {
+    fn default() -> Self {
+        Self {
+            v_x: [0.0; NX],
+            v_xx: [[0.0; NX]; NX],
+            q_x: [0.0; NX],
+            q_u: [0.0; NU],
+            q_xx: [[0.0; NX]; NX],
+            q_uu: [[0.0; NU]; NU],
+            q_ux: [[0.0; NX]; NU],
+            va: [[0.0; NX]; NX],
+            vb: [[0.0; NU]; NX],
+            quu_gain: [[0.0; NX]; NU],
+            quu_ff: [0.0; NU],
+            hessian: [[0.0; NU]; NU],
+            step_lower: [0.0; NU],
+            step_upper: [0.0; NU],
+        }
+    }
+}
+
+impl<const NX: usize, const NU: usize> StackTerms<NX, NU> {
+    #[inline(always)]
+    fn slices(&mut self) -> Terms<'_> {
+        Terms {
+            v_x: &mut self.v_x,
+            v_xx: self.v_xx.as_flattened_mut(),
+            q_x: &mut self.q_x,
+            q_u: &mut self.q_u,
+            q_xx: self.q_xx.as_flattened_mut(),
+            q_uu: self.q_uu.as_flattened_mut(),
+            q_ux: self.q_ux.as_flattened_mut(),
+            va: self.va.as_flattened_mut(),
+            vb: self.vb.as_flattened_mut(),
+            quu_gain: self.quu_gain.as_flattened_mut(),
+            quu_ff: &mut self.quu_ff,
+            hessian: self.hessian.as_flattened_mut(),
+            step_lower: &mut self.step_lower,
+            step_upper: &mut self.step_upper,
+        }
+    }
+}
+
+/// [`Terms`] in the workspace, for any sizes (allocated once by [`Ilqr::new`]).
+#[derive(Debug, Clone, Default)]
+struct HeapTerms(Vec<f64>);
+
+impl HeapTerms {
+    /// The sizes of the terms, in [`Terms`]' order.
+    fn sizes(nx: usize, nu: usize) -> [usize; 14] {
+        [
+            nx,
+            nx * nx,
+            nx,
+            nu,
+            nx * nx,
+            nu * nu,
+            nu * nx,
+            nx * nx,
+            nx * nu,
+            nu * nx,
+            nu,
+            nu * nu,
+            nu,
+            nu,
+        ]
+    }
+
+    fn new(nx: usize, nu: usize) -> Self {
+        Self(vec![0.0; Self::sizes(nx, nu).iter().sum()])
+    }
+
+    fn slices(&mut self, nx: usize, nu: usize) -> Terms<'_> {
+        let mut rest = self.0.as_mut_slice();
+        let [
+            v_x,
+            v_xx,
+            q_x,
+            q_u,
+            q_xx,
+            q_uu,
+            q_ux,
+            va,
+            vb,
+            quu_gain,
+            quu_ff,
+            hessian,
+            step_lower,
+            step_upper,
+        ] = Self::sizes(nx, nu).map(|size| {
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(size);
+            rest = tail;
+            part
+        });
+        Terms {
+            v_x,
+            v_xx,
+            q_x,
+            q_u,
+            q_xx,
+            q_uu,
+            q_ux,
+            va,
+            vb,
+            quu_gain,
+            quu_ff,
+            hessian,
+            step_lower,
+            step_upper,
+        }
+    }
+}
+
+/// One node of a rollout: `next = F(x, u)`, and the Jacobians `(A, B)` with it while
+/// `linearising`. A node whose linearisation fails is stepped instead and ends `linearising` for
+/// the rest of the rollout (the solve's own linearisation then meets the failure); the step's
+/// error is returned.
+fn advance<D: DiscreteDynamics + ?Sized>(
+    dynamics: &mut D,
+    (x, u): (&[f64], &[f64]),
+    next: &mut [f64],
+    (a, b): (&mut [f64], &mut [f64]),
+    linearising: &mut bool,
+) -> Result<(), OptimalError> {
+    if *linearising {
+        if dynamics.linearise(x, u, next, a, b).is_ok() {
+            return Ok(());
+        }
+        *linearising = false;
+    }
+    dynamics.step(x, u, next)
 }
 
 /// Grows the regularisation; `false` once it passes its maximum.
