@@ -16,8 +16,9 @@
 //! modal coordinates at each step are the least-squares fit `a = argmin |J a + theta_0 -
 //! theta_FTL|`, exact when `2K = n`. The metrics are those of the chain the fit realises.
 
-use crate::error::{PlanError, check_finite};
+use crate::error::PlanError;
 use backbone_kin::{BaseAngle, ModalMap, joint_positions};
+use lane_math::check_finite;
 use optimal_ctl::LinearQp;
 
 /// The most centreline points a [`Channel`] accepts.

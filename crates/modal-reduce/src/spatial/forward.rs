@@ -3,9 +3,10 @@
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
 use super::terms::spatial_reduced_terms;
-use crate::error::{ReduceError, check_finite_result, check_input, check_len};
+use crate::error::{ReduceError, check_finite_result};
 use crate::forward::right_hand_side;
 use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
+use lane_math::{check_len, check_values};
 
 /// The modal accelerations `a_ddot` (`m`) under the modal forces `tau_star` at `(a, a_dot)`:
 /// [`spatial_reduced_terms`], then an `L D L^T` solve of `M*`. Allocation-free.
@@ -21,7 +22,7 @@ pub fn spatial_forward_dynamics(
     a_ddot: &mut [f64],
 ) -> Result<(), ReduceError> {
     let m = model.n_coords();
-    check_input("tau_star", tau_star, m)?;
+    check_values("tau_star", tau_star, m)?;
     check_len("a_ddot", a_ddot.len(), m)?;
     spatial_reduced_terms(model, data, a, a_dot)?;
     data.factor.copy_from_slice(&data.mass_matrix);

@@ -21,9 +21,10 @@
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
 use super::motion::{Carried, link_step, world_inertia};
-use crate::error::{ReduceError, check_finite_result, check_input};
+use crate::error::{ReduceError, check_terms_finite};
 use backbone_kin::vec3::{add, cross, mat_vec};
 use lane_math::Lane;
+use lane_math::check_values;
 use pulp::{Simd, WithSimd};
 
 /// Computes `M*`, `C*` and `G*` at the modal state `(a, a_dot)` into `data` (read them with
@@ -46,9 +47,7 @@ pub fn spatial_reduced_terms(
         a,
         a_dot,
     });
-    check_finite_result("reduced mass matrix M*", &data.mass_matrix)?;
-    check_finite_result("reduced Coriolis vector C*", &data.coriolis)?;
-    check_finite_result("reduced gravity vector G*", &data.gravity)
+    check_terms_finite(&data.mass_matrix, &data.coriolis, &data.gravity)
 }
 
 /// [`spatial_reduced_terms`] after its checks, run by [`pulp::Arch::dispatch`] so that the
@@ -267,6 +266,7 @@ pub(crate) fn check_state(
 ) -> Result<(), ReduceError> {
     data.check_model(model)?;
     let m = model.n_coords();
-    check_input("a", a, m)?;
-    check_input("a_dot", a_dot, m)
+    check_values("a", a, m)?;
+    check_values("a_dot", a_dot, m)?;
+    Ok(())
 }
