@@ -1,12 +1,12 @@
 //! Reduced forward dynamics of a spatial modal arm for many independent states at once, SIMD
 //! across states: [`spatial_forward_dynamics`] of each state, the same bits.
 //!
-//! The driver is the planar batch's ([`crate::batch_driver`]): the states are taken `W` at a time
+//! The driver is the planar batch's (`batch_driver.rs`): the states are taken `W` at a time
 //! (`W` the `f64` lanes of the widest instruction set [`pulp::Arch`] finds at run time, 8 with
 //! AVX-512, 4 with AVX2), lane `i` of every register holding state `i` of the group, and each
 //! group runs through the kernel of one state (`accumulate`, the recursion of
 //! [`motion`](super::motion)) and the `L D L^T` solve, written once over
-//! [`Lane`](lane_math::Lane), with the same operations in the same order. A group whose inputs
+//! [`Lane`], with the same operations in the same order. A group whose inputs
 //! are not all finite, or one of whose states fails, is redone one state at a time by
 //! [`spatial_forward_dynamics`], which names the failure; so are the states after the last whole
 //! group, and every state of a model of more than [`MAX_SPATIAL_BATCH_COORDS`] coordinates.
