@@ -19,8 +19,7 @@
 //!   `unsafe` code appears only in the library files [`UNSAFE_FILES`] lists, each block under a
 //!   `// SAFETY:` comment.
 //! - `sim-core` depends on none of [`LOOP_FORBIDS`].
-//! - No import circles among the modules of a crate ([`crate::imports`]), but for those
-//!   [`KNOWN_CIRCLES`] lists.
+//! - No import circles among the modules of a crate ([`crate::imports`]).
 //! - `cargo doc --workspace --no-deps` with `RUSTDOCFLAGS=-D warnings`.
 //!
 //! Each check is a function of file contents (the file system is read in [`run`] only), with a
@@ -37,24 +36,6 @@ const UNSAFE_FILES: [&str; 1] = ["crates/fuzzy-sugeno/src/kernel.rs"];
 
 /// The crates under `crates/` that are front ends, not libraries: the string rules do not apply.
 const FRONT_ENDS: [&str; 3] = ["hrm-cli", "hrm-py", "test-support"];
-
-/// Import circles not yet broken, by crate: a circle among the modules of one entry only is let
-/// through, so that the list only shrinks.
-/// - sim-study: `ControllerKind` (a field of the scenario schema) takes its names from the
-///   controller table, whose constructors read the schema's `[controller]` settings.
-/// - hrm-cli: the eval ops' children share the request helpers of `eval`; `fis export` reads
-///   systems with `fis check`'s helpers.
-const KNOWN_CIRCLES: [(&str, &[&str]); 3] = [
-    (
-        "crates/sim-study",
-        &["scenario::controllers", "scenario::schema"],
-    ),
-    (
-        "crates/hrm-cli",
-        &["eval", "eval::derivatives", "eval::robot", "eval::spatial"],
-    ),
-    ("crates/hrm-cli", &["fis_cmd", "fis_export"]),
-];
 
 /// What the closed loop (`sim-core`) must not depend on: files, hashes and threads belong to
 /// the studies above it.
@@ -225,18 +206,8 @@ fn import_circles(root: &Path, dir: &Path) -> Vec<String> {
             Some((relative, std::fs::read_to_string(&file).ok()?))
         })
         .collect();
-    let allowed: Vec<&[&str]> = KNOWN_CIRCLES
-        .iter()
-        .filter(|(krate, _)| Path::new(krate) == dir)
-        .map(|(_, modules)| *modules)
-        .collect();
     crate::imports::circles(&crate::imports::import_graph(&files))
         .into_iter()
-        .filter(|circle| {
-            !allowed
-                .iter()
-                .any(|modules| circle.iter().all(|m| modules.contains(&m.as_str())))
-        })
         .map(|circle| {
             let named: Vec<String> = circle
                 .iter()

@@ -83,8 +83,9 @@ impl Evaluator {
     /// Evaluates the system: `inputs` has one value per input variable, `outputs` one slot per
     /// output variable. On error `outputs` is left untouched.
     pub fn eval(&mut self, inputs: &[f64], outputs: &mut [f64]) -> Result<(), FuzzyError> {
-        eval_point(&self.system, &self.options, &mut self.one, inputs, outputs)?;
-        self.note_outside(inputs);
+        if eval_point(&self.system, &self.options, &mut self.one, inputs, outputs)? {
+            self.note_outside(inputs);
+        }
         Ok(())
     }
 
@@ -166,7 +167,7 @@ impl Evaluator {
             });
         }
         let (system, options, one) = (&self.system, &self.options, &mut self.one);
-        let point = |x: &[f64], y: &mut [f64]| eval_point(system, options, one, x, y);
+        let point = |x: &[f64], y: &mut [f64]| eval_point(system, options, one, x, y).map(|_| ());
         let result = self.batch.run(system, options, inputs, outputs, point);
         // The rows evaluated: all of them, or those before the failing one.
         let done = match &result {
@@ -181,8 +182,9 @@ impl Evaluator {
     /// Computes and returns every rule's firing strength at `inputs` (antecedents combined by
     /// the rule's AND/OR, times the rule's weight), in rule order.
     pub fn fire(&mut self, inputs: &[f64]) -> Result<&[f64], FuzzyError> {
-        fire_point(&self.system, &self.options, &mut self.one, inputs)?;
-        self.note_outside(inputs);
+        if fire_point(&self.system, &self.options, &mut self.one, inputs)? {
+            self.note_outside(inputs);
+        }
         Ok(self.firing_strengths())
     }
 
@@ -196,15 +198,16 @@ impl Evaluator {
     }
 }
 
-/// Checks one point's inputs, applies the range policy into `work.x` and fires the rules.
+/// Checks one point's inputs, applies the range policy into `work.x` and fires the rules;
+/// whether an input lies outside its range.
 #[inline]
 fn fire_point(
     system: &FuzzySystem,
     options: &EvalOptions,
     work: &mut Workspace<1>,
     inputs: &[f64],
-) -> Result<(), FuzzyError> {
-    load_inputs(system, options, work, inputs)?;
+) -> Result<bool, FuzzyError> {
+    let outside = load_inputs(system, options, work, inputs)?;
     let methods = system.methods();
     kernel::fire::<f64, 1>(
         (),
@@ -213,17 +216,18 @@ fn fire_point(
         methods.or,
         &mut work.slots(),
     );
-    Ok(())
+    Ok(outside)
 }
 
-/// Checks one point's inputs and applies the range policy into `work.x`.
+/// Checks one point's inputs and applies the range policy into `work.x`; whether an input lies
+/// outside its range (as given).
 #[inline(always)]
 fn load_inputs(
     system: &FuzzySystem,
     options: &EvalOptions,
     work: &mut Workspace<1>,
     inputs: &[f64],
-) -> Result<(), FuzzyError> {
+) -> Result<bool, FuzzyError> {
     let variables = system.inputs();
     if inputs.len() != variables.len() {
         return Err(FuzzyError::InputCount {
@@ -231,13 +235,18 @@ fn load_inputs(
             found: inputs.len(),
         });
     }
-    for (index, (slot, &value)) in work.x.iter_mut().zip(inputs).enumerate() {
+    let mut outside = false;
+    for (index, ((slot, &value), variable)) in
+        work.x.iter_mut().zip(inputs).zip(variables).enumerate()
+    {
         slot[0] = load_input(system, options, index, value)?;
+        let [min, max] = variable.range;
+        outside |= (value < min) | (value > max);
     }
-    Ok(())
+    Ok(outside)
 }
 
-/// [`Evaluator::eval`] with the evaluator's parts.
+/// [`Evaluator::eval`] with the evaluator's parts; whether an input lies outside its range.
 #[inline]
 fn eval_point(
     system: &FuzzySystem,
@@ -245,7 +254,7 @@ fn eval_point(
     work: &mut Workspace<1>,
     inputs: &[f64],
     outputs: &mut [f64],
-) -> Result<(), FuzzyError> {
+) -> Result<bool, FuzzyError> {
     let n_out = system.outputs().len();
     if outputs.len() != n_out {
         return Err(FuzzyError::OutputCount {
@@ -253,7 +262,7 @@ fn eval_point(
             found: outputs.len(),
         });
     }
-    load_inputs(system, options, work, inputs)?;
+    let outside = load_inputs(system, options, work, inputs)?;
     let c = system.compiled();
     if !kernel::separable_sums::<f64, 1>((), c, &mut work.slots()) {
         let methods = system.methods();
@@ -267,7 +276,7 @@ fn eval_point(
     for (out, pair) in outputs.iter_mut().zip(work.sums.chunks_exact(2)) {
         *out = pair[0][0];
     }
-    Ok(())
+    Ok(outside)
 }
 
 #[cfg(test)]

@@ -21,7 +21,7 @@
 use lane_math::Lane;
 
 use crate::compiled_mf::integer_power;
-use crate::separable::{MAX_SEPARABLE_SETS, Separable};
+use crate::separable::{MAX_SEPARABLE_SETS, OutputGrid, Separable};
 use crate::system::{AndMethod, Compiled, DenseTerms, FuzzySystem, OrMethod};
 
 /// The buffers of one evaluation, in slots of `N` values (see the module docs).
@@ -243,56 +243,49 @@ pub(crate) fn separable_sums<L: Lane, const N: usize>(
             let u2 = u * u;
             u2 * u2
         }),
-        e => separable_grid(cx, s, slots, |u: L| integer_power(cx, u.abs(), e)),
+        e => separable_grid(cx, s, slots, move |u: L| integer_power(cx, u.abs(), e)),
     }
 }
 
-/// [`separable_sums`] with `power(u) = |u|^(2 b)`.
+/// [`separable_sums`] with `power(u) = |u|^(2 b)`. The loops over an input's sets and over the
+/// factors of a grid's terms run for a count known at compile time (one body per count up to
+/// [`MAX_SEPARABLE_SETS`] sets and 4 factors), so that they are unrolled and
+/// read no loop bounds; every count gives the same operations in the same order.
 #[inline(always)]
 fn separable_grid<L: Lane, const N: usize>(
     cx: L::Context,
     s: &Separable,
     slots: &mut Slots<'_, N>,
-    power: impl Fn(L) -> L,
+    power: impl Fn(L) -> L + Copy,
 ) -> bool {
     let one = L::splat(cx, 1.0);
     let n_sets = s.sets.len();
     let mut largest = one;
     for (i, bounds) in s.set_offsets.windows(2).enumerate() {
         let x: L = get(cx, slots.x, i);
-        // `A_k = 1 + |u_k|^(2b)`, then the grades `P_k = prod_{j != k} A_j` and their sum.
-        let mut a = [one; MAX_SEPARABLE_SETS];
-        for (a, &[center, inverse_width]) in a.iter_mut().zip(&s.sets[bounds[0]..bounds[1]]) {
-            *a = one + power((x - L::splat(cx, center)) * inverse_width);
-            largest = largest.max(*a);
-        }
-        let count = bounds[1] - bounds[0];
-        let mut sum = L::splat(cx, 0.0);
-        for k in 0..count {
-            let mut grade = one;
-            for (j, &a_j) in a[..count].iter().enumerate() {
-                if j != k {
-                    grade = grade * a_j;
-                }
-            }
-            set(slots.grades, bounds[0] + k, grade);
-            sum = sum + grade;
-        }
+        let sets = &s.sets[bounds[0]..bounds[1]];
+        let grades = (&mut *slots.grades, bounds[0]);
+        // `Separable::slots_in_bounds`: 1 to `MAX_SEPARABLE_SETS` sets an input.
+        let sum = match sets.len() {
+            1 => input_grades::<L, N, 1>(cx, sets, x, power, &mut largest, grades),
+            2 => input_grades::<L, N, 2>(cx, sets, x, power, &mut largest, grades),
+            3 => input_grades::<L, N, 3>(cx, sets, x, power, &mut largest, grades),
+            _ => input_grades::<L, N, MAX_SEPARABLE_SETS>(cx, sets, x, power, &mut largest, grades),
+        };
         set(slots.grades, n_sets + i, sum);
     }
     if !L::splat(cx, s.limit).all_greater(largest) {
         return false;
     }
     for (o, grid) in s.outputs.iter().enumerate() {
-        let d = grid.inputs.len();
-        let mut weighted = L::splat(cx, 0.0);
-        for (k, &z) in grid.terms.iter().enumerate() {
-            let mut term = L::splat(cx, z);
-            for &slot in &grid.factors[k * d..(k + 1) * d] {
-                term = term * get::<L, N>(cx, slots.grades, slot as usize);
-            }
-            weighted = weighted + term;
-        }
+        let grades = &*slots.grades;
+        let weighted = match grid.inputs.len() {
+            1 => grid_sum::<L, N, 1>(cx, grid, grades),
+            2 => grid_sum::<L, N, 2>(cx, grid, grades),
+            3 => grid_sum::<L, N, 3>(cx, grid, grades),
+            4 => grid_sum::<L, N, 4>(cx, grid, grades),
+            _ => grid_sum_any(cx, grid, grades),
+        };
         let mut total = one;
         for &i in &grid.inputs {
             total = total * get::<L, N>(cx, slots.grades, n_sets + i);
@@ -301,6 +294,89 @@ fn separable_grid<L: Lane, const N: usize>(
         set(slots.sums, 2 * o + 1, total);
     }
     true
+}
+
+/// One input's `C` sets (`sets`, `C` entries) at `x`: `A_k = 1 + |u_k|^(2b)` (the largest so
+/// far into `largest`), the grades `P_k = prod_{j != k} A_j` into the grade slots from
+/// `grades.1`; returns their sum `S_i`, summed in set order.
+#[inline(always)]
+fn input_grades<L: Lane, const N: usize, const C: usize>(
+    cx: L::Context,
+    sets: &[[f64; 2]],
+    x: L,
+    power: impl Fn(L) -> L,
+    largest: &mut L,
+    (grades, first): (&mut [[f64; N]], usize),
+) -> L {
+    let one = L::splat(cx, 1.0);
+    let Some(sets) = sets.first_chunk::<C>() else {
+        unreachable!("the caller matched the count of sets");
+    };
+    let mut a = [one; C];
+    for (a, &[center, inverse_width]) in a.iter_mut().zip(sets) {
+        *a = one + power((x - L::splat(cx, center)) * inverse_width);
+        *largest = largest.max(*a);
+    }
+    let mut sum = L::splat(cx, 0.0);
+    for k in 0..C {
+        let mut grade = one;
+        for (j, &a_j) in a.iter().enumerate() {
+            if j != k {
+                grade = grade * a_j;
+            }
+        }
+        set(grades, first + k, grade);
+        sum = sum + grade;
+    }
+    sum
+}
+
+/// `sum_k z_k prod P` over the terms of `grid`, whose entries have `D` factors each (`grid`
+/// depends on `D` inputs): [`weighted_terms`] with the factors in arrays of `D`.
+#[inline(always)]
+fn grid_sum<L: Lane, const N: usize, const D: usize>(
+    cx: L::Context,
+    grid: &OutputGrid,
+    grades: &[[f64; N]],
+) -> L {
+    let (factors, _) = grid.factors.as_chunks::<D>();
+    weighted_terms(
+        cx,
+        &grid.terms,
+        factors.iter().map(|f| f.as_slice()),
+        grades,
+    )
+}
+
+/// [`grid_sum`] for any number of inputs.
+#[inline(always)]
+fn grid_sum_any<L: Lane, const N: usize>(
+    cx: L::Context,
+    grid: &OutputGrid,
+    grades: &[[f64; N]],
+) -> L {
+    let d = grid.inputs.len();
+    let factors = (0..grid.terms.len()).map(|k| &grid.factors[k * d..(k + 1) * d]);
+    weighted_terms(cx, &grid.terms, factors, grades)
+}
+
+/// `sum_k z_k prod_{slot in factors_k} P_slot`, in term order, each term's factors in order.
+#[inline(always)]
+fn weighted_terms<'a, L: Lane, const N: usize>(
+    cx: L::Context,
+    terms: &[f64],
+    factors: impl Iterator<Item = &'a [u32]>,
+    grades: &[[f64; N]],
+) -> L {
+    let mut weighted = L::splat(cx, 0.0);
+    for (&z, factors) in terms.iter().zip(factors) {
+        let mut term = L::splat(cx, z);
+        for &slot in factors {
+            term = term * get::<L, N>(cx, grades, slot as usize);
+        }
+        weighted = weighted + term;
+    }
+    weighted
 }
 
 /// The kernel's buffers for `N` points, sized for one system at construction.

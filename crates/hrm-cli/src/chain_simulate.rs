@@ -6,6 +6,7 @@ use crate::console;
 use crate::output_dir::OutputDir;
 use lane_math::Compact;
 use serde_json::json;
+use sim_core::ChainRun;
 use sim_study::Scenario;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -15,42 +16,14 @@ use std::path::Path;
 pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
     let run = scenario.run_chain().map_err(|e| e.to_string())?;
     let summary = &run.summary;
-    let record = &run.record;
     let n = summary.joint_error_rms.len();
     let staging = OutputDir::create(out, "simulate")?;
     let dir = staging.path();
-    let json = json!({
-        "scenario": scenario.name,
-        "controller": "computed-torque",
-        "arm": "urdf",
-        "joints": n,
-        "controller_samples": summary.controller_samples,
-        "steps": summary.steps,
-        "joint_error_rms": summary.joint_error_rms,
-        "joint_error_max": summary.joint_error_max,
-        "final_error": summary.final_error,
-        "peak_joint_efforts": summary.peak_joint_efforts,
-    });
+    let json = chain_summary(scenario, "urdf", &run);
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
     write(&dir.join("summary.json"), &text)?;
     write(&dir.join("scenario.toml"), &scenario.to_toml())?;
-    let mut csv = String::from("t");
-    for series in ["q", "q_ref", "tau"] {
-        for i in 1..=n {
-            let _ = write!(csv, ",{series}_{i}");
-        }
-    }
-    csv.push('\n');
-    for (k, t) in record.t.iter().enumerate() {
-        let _ = write!(csv, "{}", Compact(*t));
-        for series in [&record.q, &record.q_ref, &record.tau] {
-            for value in &series[k * n..(k + 1) * n] {
-                let _ = write!(csv, ",{}", Compact(*value));
-            }
-        }
-        csv.push('\n');
-    }
-    write(&dir.join("timeseries.csv"), &csv)?;
+    write(&dir.join("timeseries.csv"), &chain_timeseries(&run))?;
     staging.commit()?;
     let rms = |values: &[f64]| (values.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt();
     console::print(&format!(
@@ -67,7 +40,48 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
     ))
 }
 
-fn write(path: &Path, text: &str) -> Result<(), String> {
+/// The `summary.json` fields of a joint-space run of `scenario` on an arm of kind `arm`
+/// (`"urdf"`, `"deploy"`).
+pub fn chain_summary(scenario: &Scenario, arm: &str, run: &ChainRun) -> serde_json::Value {
+    let summary = &run.summary;
+    json!({
+        "scenario": scenario.name,
+        "controller": "computed-torque",
+        "arm": arm,
+        "joints": summary.joint_error_rms.len(),
+        "controller_samples": summary.controller_samples,
+        "steps": summary.steps,
+        "joint_error_rms": summary.joint_error_rms,
+        "joint_error_max": summary.joint_error_max,
+        "final_error": summary.final_error,
+        "peak_joint_efforts": summary.peak_joint_efforts,
+    })
+}
+
+/// The `timeseries.csv` of a joint-space run: `t`, then `q_i`, `q_ref_i`, `tau_i` per joint.
+pub fn chain_timeseries(run: &ChainRun) -> String {
+    let record = &run.record;
+    let n = run.summary.joint_error_rms.len();
+    let mut csv = String::from("t");
+    for series in ["q", "q_ref", "tau"] {
+        for i in 1..=n {
+            let _ = write!(csv, ",{series}_{i}");
+        }
+    }
+    csv.push('\n');
+    for (k, t) in record.t.iter().enumerate() {
+        let _ = write!(csv, "{}", Compact(*t));
+        for series in [&record.q, &record.q_ref, &record.tau] {
+            for value in &series[k * n..(k + 1) * n] {
+                let _ = write!(csv, ",{}", Compact(*value));
+            }
+        }
+        csv.push('\n');
+    }
+    csv
+}
+
+pub(crate) fn write(path: &Path, text: &str) -> Result<(), String> {
     std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 

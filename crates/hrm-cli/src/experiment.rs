@@ -3,7 +3,7 @@
 
 use crate::output_dir::OutputDir;
 use crate::spatial_figures::{self, CoordinateSeries};
-use crate::{console, figures, progress, report};
+use crate::{console, deploy_simulate, figures, progress, report};
 use lane_math::Compact;
 use serde_json::json;
 use sim_core::Run;
@@ -25,6 +25,9 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
     }
     if scenario.arm.urdf.is_some() {
         return crate::chain_simulate::simulate(&scenario, out);
+    }
+    if scenario.deploy.is_some() {
+        return deploy_simulate::simulate(&scenario, out);
     }
     scenario.build().map_err(|e| e.to_string())?;
     let staging = OutputDir::create(out, "simulate")?;
@@ -60,13 +63,18 @@ pub fn main_job(out: &Path, duration: Option<f64>) -> Result<(), String> {
 }
 
 /// Runs `scenarios` with every controller, in parallel (results in a fixed order), then writes
-/// the per-run files, the comparison table, the figures and `report.html` into `out`.
-fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
+/// the per-run files, the comparison table, the figures and `report.html` into `out`. A
+/// scenario with a `[deploy]` runs computed torque in joint space on its insertion axis
+/// ([`deploy_runs`]).
+fn experiments(out: &Path, all: &[Scenario]) -> Result<(), String> {
     let staging = OutputDir::create(out, "run")?;
     staging.claim("figures")?;
-    for scenario in scenarios {
+    for scenario in all {
         staging.claim(&scenario.name)?;
     }
+    let (deploys, scenarios): (Vec<Scenario>, Vec<Scenario>) =
+        all.iter().cloned().partition(|s| s.deploy.is_some());
+    let scenarios = &scenarios[..];
     let dir = staging.path();
     let runs = scenarios.len() * ControllerKind::ALL.len();
     let bar = progress::bar(runs as u64, "runs");
@@ -85,7 +93,9 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
     bar.finish_and_clear();
     let outcomes = outcomes?;
     let learned = learned_runs(dir, scenarios)?;
+    let (deploy_summaries, deploy_figures) = deploy_runs(dir, &deploys)?;
     let mut summaries: Vec<_> = outcomes.iter().map(outcome_json).collect();
+    summaries.extend(deploy_summaries);
     summaries.extend(learned.iter().map(|o| {
         let mut summary = outcome_json(o);
         summary["controller"] = json!(LEARNED);
@@ -99,12 +109,21 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
     }));
     let text = table(&rows);
     write(&dir.join("comparison.txt"), &text)?;
-    let sections = figures(dir, scenarios, &outcomes)?;
+    let mut sections = figures(dir, scenarios, &outcomes)?;
+    if !deploy_figures.is_empty() {
+        sections.insert(
+            sections.len() - 1,
+            report::Section {
+                title: "Follow-the-leader deployment".into(),
+                text: "The arm on a prismatic insertion axis advances into a channel, its body on the path its tip traced: the kinematic plan (shape-plan's follow_the_leader) tracked by computed torque on the whole chain in joint space (the only controller of a deployment).".into(),
+                figures: deploy_figures,
+            },
+        );
+    }
     let groups = groups(scenarios, &outcomes, &learned, &rows)?;
     let intro = format!(
-        "Every scenario ({}) run with every controller ({}): a table and an animation per scenario, then figures in the spirit of the paper's section 5. The {LEARNED} row of {LEARNED_ON} is a fuzzy controller learned by imitation of computed torque on the step and sine responses about a grid of operating points, never on the path ({LEARNED}.fis next to this page). Per-run time series and metrics are in <scenario>/<controller>/timeseries.csv and summary.json next to this page.",
-        scenarios
-            .iter()
+        "Every scenario ({}) run with every controller ({}; a follow-the-leader deployment with computed torque only): a table and an animation per scenario, then figures in the spirit of the paper's section 5. The {LEARNED} row of {LEARNED_ON} is a fuzzy controller learned by imitation of computed torque on the step and sine responses about a grid of operating points, never on the path ({LEARNED}.fis next to this page). Per-run time series and metrics are in <scenario>/<controller>/timeseries.csv and summary.json next to this page.",
+        all.iter()
             .map(|s| s.name.as_str())
             .collect::<Vec<_>>()
             .join(", "),
@@ -125,6 +144,41 @@ fn experiments(out: &Path, scenarios: &[Scenario]) -> Result<(), String> {
         out.display(),
         out.join("report.html").display()
     ))
+}
+
+/// The deployment scenarios' runs (computed torque in joint space, [`Scenario::run_deploy`]):
+/// each run's files into `out/<scenario>/computed-torque` and its figures into `out/figures`;
+/// returns their entries of the main `summary.json` (a run that fails: its `error`) and the
+/// report's figures.
+fn deploy_runs(
+    out: &Path,
+    scenarios: &[Scenario],
+) -> Result<(Vec<serde_json::Value>, Vec<report::Figure>), String> {
+    let (mut summaries, mut figures) = (Vec::new(), Vec::new());
+    let figures_dir = out.join("figures");
+    std::fs::create_dir_all(&figures_dir)
+        .map_err(|e| format!("cannot create {}: {e}", figures_dir.display()))?;
+    for scenario in scenarios {
+        let controller = ControllerKind::ComputedTorque.name();
+        let dir = out.join(&scenario.name).join(controller);
+        match scenario.run_deploy() {
+            Ok(run) => {
+                deploy_simulate::write_run(&dir, scenario, &run)?;
+                figures.extend(deploy_simulate::figures(&figures_dir, scenario, &run)?);
+                let summary = deploy_simulate::summary(scenario, &run);
+                summaries.push(json!({"scenario": scenario.name, "controller": controller, "summary": summary}));
+            }
+            Err(e) => {
+                std::fs::create_dir_all(&dir)
+                    .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+                write(&dir.join("scenario.toml"), &scenario.to_toml())?;
+                let error = json!({"error": e.to_string()});
+                write(&dir.join("summary.json"), &pretty(&error)?)?;
+                summaries.push(json!({"scenario": scenario.name, "controller": controller, "error": e.to_string()}));
+            }
+        }
+    }
+    Ok((summaries, figures))
 }
 
 /// The name of the learned controller's rows, folders and file (`learned.fis`).
@@ -365,7 +419,7 @@ fn figures(
         ),
         section(
             "Spatial arms",
-            "Universal-joint arms held as horizontal cantilevers under gravity (along -z), two bending planes of K harmonics each (az: in the x-y plane, ay: out of it); the tip follows a circle about the x axis, out of the arm's plane.",
+            "Universal-joint arms held as horizontal cantilevers under gravity (along -z), two bending planes of K harmonics each (az: in the x-y plane, ay: out of it); the tip follows a circle about the x axis, out of the arm's plane, or (spatial-clutter) reaches a target among obstacles on a planned motion.",
             spatial,
         ),
         section(
@@ -377,8 +431,9 @@ fn figures(
 }
 
 /// The figures of a spatial scenario's finished `runs` into `dir`, their captions appended to
-/// `figures`: the backbone in space (three views) of each controller, the tip's coordinates
-/// against the reference, and the per-coordinate modal errors and forces.
+/// `figures`: the backbone in space (three views, with the obstacles) of each controller, the
+/// clearance over time among obstacles, the tip's coordinates against the reference, and the
+/// per-coordinate modal errors and forces.
 fn spatial_figures(
     dir: &Path,
     scenario: &Scenario,
@@ -404,7 +459,17 @@ fn spatial_figures(
         add(
             file,
             format!(
-                "{name} with {kind}: the arm every {CONFIGURATION_INTERVAL_S} s, light to dark, from above, from the side and obliquely; the tip (green) should stay on the red path."
+                "{name} with {kind}: the arm every {CONFIGURATION_INTERVAL_S} s, light to dark, from above, from the side and obliquely, with the obstacles (grey) if any; the tip (green) should stay on the red path."
+            ),
+        );
+    }
+    if !scenario.obstacles.is_empty() {
+        let file = format!("clearance_{name}.svg");
+        spatial_figures::clearance_over_time(&dir.join(&file), scenario, runs)?;
+        add(
+            file,
+            format!(
+                "{name}: the smallest clearance of the links to the obstacles and between links (mm) of every controller, against the task's margin; above zero is collision-free."
             ),
         );
     }

@@ -2,14 +2,12 @@
 //! (Figure 9), backbone configurations over the tracked path (Figure 10), the tracking residual
 //! (Figure 11), and the fuzzy controller's membership functions and control surfaces.
 
+use crate::figure_parts::{self, snapshot_samples};
 use crate::fis_cmd;
-use crate::plot::{self, Labels, Panel, Series, Style};
+use crate::plot::{self, Labels};
 use sim_core::{Record, Run};
 use sim_study::{ControllerKind, Scenario};
 use std::path::{Path, PathBuf};
-
-/// At most this many points per curve: enough for a smooth line, small enough for a light SVG.
-const MAX_POINTS: usize = 1500;
 
 /// Figure 9: every modal coordinate `a_i(t)` (named `names`) of every run against the
 /// reference, one panel each.
@@ -19,40 +17,23 @@ pub fn modal_responses(
     names: &[String],
     runs: &[(ControllerKind, &Run)],
 ) -> Result<(), String> {
-    let first = runs
-        .first()
-        .ok_or_else(|| format!("{}: no runs to plot", path.display()))?;
-    let coordinate = |i: usize| {
-        let reference = Series {
-            label: "reference".into(),
-            points: thin(&first.1.record, |r, k| (r.t[k], r.a_ref_at(k)[i])),
-        };
-        let controllers = runs.iter().map(|(kind, run)| Series {
-            label: kind.name().into(),
-            points: thin(&run.record, |r, k| (r.t[k], r.a_at(k)[i])),
-        });
-        // The reference last, so that it is drawn on top of a controller that tracks it exactly.
-        controllers
-            .chain(std::iter::once(reference))
-            .collect::<Vec<_>>()
-    };
-    let series: Vec<Vec<Series>> = (0..first.1.record.n_coords).map(coordinate).collect();
-    let labels: Vec<String> = names.iter().map(|name| format!("{name} (rad)")).collect();
-    let panels: Vec<Panel> = series
+    // No more panels than the runs have coordinates.
+    let n_coords = runs.first().map_or(0, |(_, run)| run.record.n_coords);
+    let rows = names
         .iter()
-        .zip(&labels)
-        .map(|(series, y)| Panel {
-            y,
-            series,
-            y_range: None,
+        .take(n_coords)
+        .enumerate()
+        .map(|(i, name)| {
+            let series = figure_parts::against_reference(
+                path,
+                runs,
+                |r, k| r.a_at(k)[i],
+                |r, k| r.a_ref_at(k)[i],
+            )?;
+            Ok((format!("{name} (rad)"), series))
         })
-        .collect();
-    plot::stacked_line_charts(
-        path,
-        &format!("Modal coordinates, {scenario}"),
-        "t (s)",
-        &panels,
-    )
+        .collect::<Result<Vec<_>, String>>()?;
+    figure_parts::over_time(path, &format!("Modal coordinates, {scenario}"), &rows)
 }
 
 /// One drawn arm configuration: sample `k` of a record, with every joint position from the base
@@ -91,25 +72,6 @@ pub fn configurations(
         .collect()
 }
 
-/// The samples of `record` drawn every `every_s` seconds: the first, then the first at or after
-/// each multiple, and the last.
-pub fn snapshot_samples(record: &Record, every_s: f64) -> Result<Vec<usize>, String> {
-    if !(every_s.is_finite() && every_s > 0.0) {
-        return Err(format!(
-            "the interval between configurations must be positive, got {every_s}"
-        ));
-    }
-    let mut picked = Vec::new();
-    let mut next = f64::NEG_INFINITY;
-    for (k, &t) in record.t.iter().enumerate() {
-        if t >= next || k + 1 == record.len() {
-            picked.push(k);
-            next = ((t / every_s + 1e-9).floor() + 1.0) * every_s;
-        }
-    }
-    Ok(picked)
-}
-
 /// Figure 10: the arm's configurations every `every_s` seconds (light to dark with time, joints
 /// as dots) over the reference path and the tip's actual path, base at the origin, equal scales.
 pub fn backbone_over_path(
@@ -120,58 +82,12 @@ pub fn backbone_over_path(
     every_s: f64,
 ) -> Result<(), String> {
     let record = &run.record;
-    let configurations = configurations(scenario, record, every_s)?;
-    let last = configurations.len().saturating_sub(1).max(1) as f64;
-    let mut curves: Vec<(Series, Style)> = configurations
-        .iter()
-        .enumerate()
-        .map(|(i, c)| {
-            // From light to dark blue as time goes on.
-            let shade = |light: f64, dark: f64| (light + (dark - light) * i as f64 / last) as u8;
-            let label = if i == 0 || i + 1 == configurations.len() {
-                format!("arm at t = {:.1} s", record.t[c.k])
-            } else {
-                String::new()
-            };
-            let series = Series {
-                label,
-                points: c.joints.iter().map(|p| (p[0], p[1])).collect(),
-            };
-            let style = Style {
-                colour: (shade(170.0, 10.0), shade(200.0, 40.0), shade(240.0, 140.0)),
-                width: 2,
-                dots: true,
-            };
-            (series, style)
-        })
+    let arms: Vec<(usize, Vec<[f64; 3]>)> = configurations(scenario, record, every_s)?
+        .into_iter()
+        .map(|c| (c.k, c.joints.iter().map(|p| [p[0], p[1], 0.0]).collect()))
         .collect();
-    curves.push((
-        Series {
-            label: "reference path".into(),
-            points: thin(record, |r, k| (r.tip_ref[k][0], r.tip_ref[k][1])),
-        },
-        Style {
-            colour: (220, 30, 30),
-            width: 3,
-            dots: false,
-        },
-    ));
-    curves.push((
-        Series {
-            label: "tip".into(),
-            points: thin(record, |r, k| (r.tip[k][0], r.tip[k][1])),
-        },
-        Style {
-            colour: (20, 150, 60),
-            width: 1,
-            dots: false,
-        },
-    ));
-    let title = format!(
-        "Backbone every {every_s} s, {} with {}",
-        scenario.name,
-        controller.name()
-    );
+    let curves = figure_parts::backbone_curves(record, &arms, |p| (p[0], p[1]));
+    let title = figure_parts::backbone_title(every_s, &scenario.name, controller);
     plot::xy_chart(
         path,
         &Labels {
@@ -190,13 +106,7 @@ pub fn tracking_residual(
     scenario: &str,
     runs: &[(ControllerKind, &Run)],
 ) -> Result<(), String> {
-    let series: Vec<Series> = runs
-        .iter()
-        .map(|(kind, run)| Series {
-            label: kind.name().into(),
-            points: thin(&run.record, |r, k| (r.t[k], 1e3 * tip_error(r, k))),
-        })
-        .collect();
+    let series = figure_parts::run_series(runs, |r, k| 1e3 * tip_error(r, k));
     let title = format!("Tracking residual, {scenario}");
     plot::line_chart(
         path,
@@ -236,21 +146,13 @@ pub fn fuzzy_controller(dir: &Path, resolution: usize) -> Result<Vec<PathBuf>, S
 /// The distance from the tip to the reference tip at sample `k` (m), in space (`z = 0` in the
 /// plane, where `hypot(d, 0) = |d|`).
 fn tip_error(record: &Record, k: usize) -> f64 {
-    let (tip, reference) = (record.tip[k], record.tip_ref[k]);
+    let (tip, reference) = (
+        figure_parts::tip(record, k),
+        figure_parts::tip_ref(record, k),
+    );
     (tip[0] - reference[0])
         .hypot(tip[1] - reference[1])
-        .hypot(record.tip_z[k] - record.tip_ref_z[k])
-}
-
-/// `point(record, k)` at no more than [`MAX_POINTS`] evenly strided samples, the last included.
-pub fn thin(record: &Record, point: impl Fn(&Record, usize) -> (f64, f64)) -> Vec<(f64, f64)> {
-    let n = record.len();
-    let stride = n.div_ceil(MAX_POINTS).max(1);
-    let mut points: Vec<_> = (0..n).step_by(stride).map(|k| point(record, k)).collect();
-    if n > 0 && !(n - 1).is_multiple_of(stride) {
-        points.push(point(record, n - 1));
-    }
-    points
+        .hypot(tip[2] - reference[2])
 }
 
 #[cfg(test)]
@@ -413,22 +315,5 @@ mod tests {
         assert!(modal_responses(&fig9, "s", &names, &[]).is_err());
         drop(step_scenario);
         std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn thinning_keeps_the_ends_and_bounds_the_count() {
-        let record = Record {
-            t: (0..4000).map(|k| k as f64).collect(),
-            ..Record::default()
-        };
-        let points = thin(&record, |r, k| (r.t[k], 0.0));
-        assert!(points.len() <= MAX_POINTS + 1);
-        assert_eq!(points[0].0, 0.0);
-        assert_eq!(points.last().unwrap().0, 3999.0);
-        let short = Record {
-            t: vec![0.0, 1.0],
-            ..Record::default()
-        };
-        assert_eq!(thin(&short, |r, k| (r.t[k], 0.0)).len(), 2);
     }
 }

@@ -14,12 +14,12 @@
 
 use crate::args;
 use crate::console;
+use crate::fis_input::{RangePolicy, read_system, read_system_with_notes};
 use crate::output_dir::OutputDir;
 use crate::plot::{self, Grid, Labels, Series};
-use clap::{Args, Subcommand, ValueEnum};
+use clap::{Args, Subcommand};
 use fuzzy_sugeno::{
     AnalysisOptions, EvalOptions, Evaluator, FisNote, FuzzyError, FuzzySystem, InputVariable,
-    OutOfRange,
 };
 use std::path::{Path, PathBuf};
 
@@ -78,29 +78,6 @@ enum FisCommand {
         #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
         reference: Option<Vec<f64>>,
     },
-}
-
-/// The out-of-range policies, as command-line values.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum RangePolicy {
-    /// Evaluate at the nearest end of the range (saturates the action).
-    Clamp,
-    /// Evaluate the membership functions at the value as given (MATLAB's evalfis and
-    /// Simulink's Fuzzy Logic Controller; bells fade far out).
-    AsGiven,
-    /// Refuse.
-    Error,
-}
-
-impl RangePolicy {
-    /// The library's policy.
-    pub(crate) fn policy(self) -> OutOfRange {
-        match self {
-            RangePolicy::Clamp => OutOfRange::Clamp,
-            RangePolicy::AsGiven => OutOfRange::AsGiven,
-            RangePolicy::Error => OutOfRange::Error,
-        }
-    }
 }
 
 /// Warns on standard error, as MATLAB's `evalfis` does, when `evaluator` has evaluated an input
@@ -197,32 +174,6 @@ pub fn run(args: FisArgs) -> Result<(), String> {
 #[cfg(test)]
 fn load_system(text: &str) -> Result<FuzzySystem, String> {
     FuzzySystem::from_fis(text).map_err(|e| e.to_string())
-}
-
-/// The text of `path`, read up to [`sim_study::MAX_INPUT_FILE_BYTES`].
-fn read_text(path: &Path) -> Result<String, String> {
-    sim_study::read_text_file(path, sim_study::MAX_INPUT_FILE_BYTES)
-        .map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// Reads a `.fis` file, or an FCL file if the name ends in `.fcl`.
-pub(crate) fn read_system(path: &Path) -> Result<FuzzySystem, String> {
-    read_system_with_notes(path).map(|(system, _)| system)
-}
-
-/// Reads a system as [`read_system`] does, with the `.fis` reader's notes of what it accepted
-/// but ignored; `None` for an FCL file, whose reader keeps no such notes.
-fn read_system_with_notes(path: &Path) -> Result<(FuzzySystem, Option<Vec<FisNote>>), String> {
-    let text = read_text(path)?;
-    let is_fcl = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("fcl"));
-    let system = if is_fcl {
-        FuzzySystem::from_fcl(&text).map(|system| (system, None))
-    } else {
-        FuzzySystem::from_fis_with_notes(&text).map(|(system, notes)| (system, Some(notes)))
-    };
-    system.map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// The lines of `file` that were accepted but are neither kept nor used, one per line, so that

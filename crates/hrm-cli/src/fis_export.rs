@@ -2,7 +2,7 @@
 //! IEC 61131-7 FCL (`fuzzy_sugeno`'s `to_c` and `to_fcl`; docs/fuzzy-formats.md says what each
 //! format carries).
 
-use crate::fis_cmd::{RangePolicy, read_system};
+use crate::fis_input::{RangePolicy, read_system};
 use crate::output_dir;
 use clap::{Args, ValueEnum};
 use fuzzy_sugeno::{EvalOptions, NoRuleFired};

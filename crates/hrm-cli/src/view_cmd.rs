@@ -190,7 +190,7 @@ fn load_main_job(dir: &Path) -> Result<Vec<Scene>, String> {
     for scenario_dir in folders(dir)? {
         let mut runs: Vec<PathBuf> = folders(&scenario_dir)?
             .into_iter()
-            .filter(|p| p.join("timeseries.csv").is_file())
+            .filter(|p| p.join("timeseries.csv").is_file() && !is_deployment(p))
             .collect();
         runs.sort_by_key(|p| rank(p));
         let mut views = Vec::with_capacity(runs.len());
@@ -216,6 +216,12 @@ fn load_main_job(dir: &Path) -> Result<Vec<Scene>, String> {
         ));
     }
     Ok(scenes)
+}
+
+/// Whether the run folder `dir` holds a deployment (its scenario has a `[deploy]`): a joint-space
+/// run the main job draws as figures, not an animation.
+fn is_deployment(dir: &Path) -> bool {
+    Scenario::load(&dir.join("scenario.toml")).is_ok_and(|s| s.deploy.is_some())
 }
 
 /// One run folder (`scenario.toml`, `timeseries.csv`, `summary.json`) as a [`RunView`] named

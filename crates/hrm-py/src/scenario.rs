@@ -685,8 +685,9 @@ impl LoopHooks for PythonDisturbance {
 impl Scenario {
     /// A scenario shipped with hrm, by name (Scenario.builtin_names()): "paper-tracking"
     /// (Figures 10-11), "paper-responses-step", "-sine", "-noise" (Figure 9), and
-    /// "harmonic-tracking", "free-base-tracking", and "narrow-gap" (a [task] planned between
-    /// obstacles, then tracked).
+    /// "harmonic-tracking", "free-base-tracking", "spatial-tracking" and "spatial-long" (spatial
+    /// arms), and "narrow-gap" and "spatial-clutter" (a [task] planned between obstacles, then
+    /// tracked, by a planar and a spatial arm).
     #[staticmethod]
     fn builtin(name: &str) -> PyResult<Self> {
         Ok(Self::wrap(

@@ -95,3 +95,23 @@ def test_a_sweep_of_a_spatial_scenario():
     cells = result["cells"]
     assert [c["noise_level"] for c in cells] == [0.0, 1e-3]
     assert all(c["runs"] == 2 and c["failed"] == 0 for c in cells)
+
+
+def test_spatial_clutter_by_name_is_planned_and_reaches_its_target_among_the_obstacles():
+    assert "spatial-clutter" in hrm.Scenario.builtin_names()
+    scenario = hrm.Scenario.builtin("spatial-clutter")
+    assert scenario.arm.kind == "spatial" and scenario.n_coords == 4
+    target = np.array(scenario.task.target)
+    assert target.shape == (3,)
+    run = scenario.run("computed-torque")
+    assert run.failure is None
+    # The tip ends on the target and holds it over the last half second.
+    hold = run.t >= scenario.duration - 0.5
+    miss = np.linalg.norm(run.tip[hold] - target, axis=1)
+    assert miss.max() < 3e-3, miss.max()
+    # The loop's smallest clearance over every controller sample keeps most of the 1 cm margin.
+    assert run.summary["min_clearance_m"] > 0.005, run.summary["min_clearance_m"]
+    # A target of the plane is refused by name on this spatial arm.
+    scenario.task.target = [0.5, 0.3]
+    with pytest.raises(hrm.InvalidInput, match=r"^task.target must be a point \[x, y, z\], got 2 numbers"):
+        scenario.run("computed-torque")

@@ -16,128 +16,18 @@
 //! modal coordinates at each step are the least-squares fit `a = argmin |J a + theta_0 -
 //! theta_FTL|`, exact when `2K = n`. The metrics are those of the chain the fit realises.
 
+use crate::channel::{Channel, dist};
+use crate::deploy_metrics::{DeployMetrics, DeployTracker};
 use crate::error::PlanError;
 use backbone_kin::{BaseAngle, ModalMap, joint_positions};
 use lane_math::check_finite;
 use optimal_ctl::LinearQp;
 
-/// The most centreline points a [`Channel`] accepts.
-pub const MAX_CENTERLINE_POINTS: usize = 100_000;
 /// The most deployment steps [`follow_the_leader`] accepts.
 pub const MAX_DEPLOY_STEPS: usize = 10_000;
 /// The most the centreline may be longer than the shortest link, as a ratio (bounds the
 /// backward search of each joint).
 pub const MAX_LENGTH_RATIO: f64 = 1e6;
-/// Points per link at which the body's distances to the path and the walls are sampled.
-const SAMPLES_PER_LINK: usize = 32;
-
-/// A planar channel: a centreline polyline (the plane `z = 0`) and its radius.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Channel {
-    points: Vec<[f64; 2]>,
-    /// Arc length at each point.
-    arcs: Vec<f64>,
-    radius: f64,
-}
-
-impl Channel {
-    /// A channel along `centerline` (at least two points, consecutive points distinct) of
-    /// `radius` (positive).
-    pub fn new(centerline: &[[f64; 2]], radius: f64) -> Result<Self, PlanError> {
-        if centerline.len() < 2 {
-            return Err(PlanError::Dimension {
-                name: "deploy centerline (at least 2 points)",
-                expected: 2,
-                found: centerline.len(),
-            });
-        }
-        if centerline.len() > MAX_CENTERLINE_POINTS {
-            return Err(PlanError::TooMany {
-                name: "deploy centerline points",
-                got: centerline.len(),
-                max: MAX_CENTERLINE_POINTS,
-            });
-        }
-        check_finite("deploy radius", radius)?;
-        if radius <= 0.0 {
-            return Err(PlanError::OutOfRange {
-                name: "deploy radius",
-                bound: "positive",
-                value: radius,
-            });
-        }
-        for x in centerline.iter().flatten() {
-            check_finite("deploy centerline coordinate", *x)?;
-        }
-        let mut arcs = vec![0.0];
-        for pair in centerline.windows(2) {
-            let step = dist(pair[0], pair[1]);
-            if step.is_nan() || step <= 0.0 {
-                return Err(PlanError::OutOfRange {
-                    name: "deploy centerline segment length",
-                    bound: "positive (consecutive points distinct)",
-                    value: step,
-                });
-            }
-            arcs.push(arcs.last().copied().unwrap_or(0.0) + step);
-        }
-        Ok(Self {
-            points: centerline.to_vec(),
-            arcs,
-            radius,
-        })
-    }
-
-    /// The centreline's length.
-    pub fn length(&self) -> f64 {
-        self.arcs.last().copied().unwrap_or(0.0)
-    }
-
-    /// The radius.
-    pub fn radius(&self) -> f64 {
-        self.radius
-    }
-
-    /// The entry `P_0`.
-    pub fn entry(&self) -> [f64; 2] {
-        self.points[0]
-    }
-
-    /// The insertion axis's direction `d` (unit).
-    pub fn axis(&self) -> [f64; 2] {
-        let (a, b) = (self.points[0], self.points[1]);
-        let length = dist(a, b);
-        [(b[0] - a[0]) / length, (b[1] - a[1]) / length]
-    }
-
-    /// `Gamma(sigma)`: on the axis behind the entry for `sigma <= 0`, on the centreline beyond
-    /// (held at its end past its length).
-    pub fn point_at(&self, sigma: f64) -> [f64; 2] {
-        if sigma <= 0.0 {
-            let (e, d) = (self.entry(), self.axis());
-            return [e[0] + sigma * d[0], e[1] + sigma * d[1]];
-        }
-        let k = self
-            .arcs
-            .partition_point(|&s| s <= sigma)
-            .min(self.points.len() - 1);
-        let (a, b) = (self.points[k - 1], self.points[k]);
-        let t = ((sigma - self.arcs[k - 1]) / (self.arcs[k] - self.arcs[k - 1])).min(1.0);
-        [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
-    }
-
-    /// The distance of `x` from the guide (the axis behind the entry) and the centreline.
-    pub fn distance(&self, x: [f64; 2]) -> f64 {
-        let (e, d) = (self.entry(), self.axis());
-        // The ray E - s d, s >= 0.
-        let along = ((x[0] - e[0]) * d[0] + (x[1] - e[1]) * d[1]).min(0.0);
-        let mut best = dist(x, [e[0] + along * d[0], e[1] + along * d[1]]);
-        for pair in self.points.windows(2) {
-            best = best.min(point_segment(x, pair[0], pair[1]));
-        }
-        best
-    }
-}
 
 /// One step of a deployment.
 #[derive(Debug, Clone, PartialEq)]
@@ -152,21 +42,6 @@ pub struct DeployFrame {
     pub modal: Vec<f64>,
     /// The joint points of the chain the modal coordinates realise, base first.
     pub points: Vec<[f64; 2]>,
-}
-
-/// What a deployment achieved, over all its steps (realised by the modal chain).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DeployMetrics {
-    /// The largest distance of the tip from the centreline, m.
-    pub tip_error: f64,
-    /// The largest distance of the body from the path its tip traced (with the axis behind the
-    /// entry), as a percentage of the deployed length at that step.
-    pub shape_deviation_percent: f64,
-    /// The smallest clearance of the links' capsules to the channel's walls, m (sampled at
-    /// `32` points a link; the sampling can overstate it by at most `L_max / 64`).
-    pub min_wall_clearance: f64,
-    /// The final deployed length (the tip's progress), m.
-    pub deployed_length: f64,
 }
 
 /// A deployment: its steps and metrics.
@@ -193,7 +68,6 @@ pub fn follow_the_leader(
     depth: f64,
     steps: usize,
 ) -> Result<Deployment, PlanError> {
-    check_finite("link radius", link_radius)?;
     check_finite("deploy depth", depth)?;
     if !(0.0..=channel.length()).contains(&depth) {
         return Err(PlanError::OutOfRange {
@@ -234,13 +108,7 @@ pub fn follow_the_leader(
     let mut frames = Vec::with_capacity(steps + 1);
     let mut sigma = vec![0.0; n + 1];
     let mut joints = vec![[0.0; 2]; n + 1];
-    let mut traced: Vec<[f64; 2]> = Vec::with_capacity(steps + 1);
-    let mut metrics = DeployMetrics {
-        tip_error: 0.0,
-        shape_deviation_percent: 0.0,
-        min_wall_clearance: f64::INFINITY,
-        deployed_length: depth,
-    };
+    let mut tracker = DeployTracker::new(channel, link_lengths, link_radius)?;
     for step in 0..=steps {
         let tau = depth * step as f64 / steps as f64;
         // Joints on Gamma, from the tip back.
@@ -289,30 +157,7 @@ pub fn follow_the_leader(
             p[0] += joints[0][0];
             p[1] += joints[0][1];
         }
-        // Metrics of the realised chain.
-        let tip = points[n];
-        traced.push(tip);
-        metrics.tip_error = metrics.tip_error.max(channel.distance(tip));
-        let deployed = tau.max(f64::EPSILON);
-        let mut deviation: f64 = 0.0;
-        for pair in points.windows(2) {
-            for s in 0..=SAMPLES_PER_LINK {
-                let t = s as f64 / SAMPLES_PER_LINK as f64;
-                let x = [
-                    pair[0][0] + t * (pair[1][0] - pair[0][0]),
-                    pair[0][1] + t * (pair[1][1] - pair[0][1]),
-                ];
-                metrics.min_wall_clearance = metrics
-                    .min_wall_clearance
-                    .min(channel.radius - link_radius - channel.distance(x));
-                deviation = deviation.max(traced_distance(channel, &traced, x));
-            }
-        }
-        if tau > 0.0 {
-            metrics.shape_deviation_percent = metrics
-                .shape_deviation_percent
-                .max(100.0 * deviation / deployed);
-        }
+        tracker.add(&points, tau);
         frames.push(DeployFrame {
             progress: tau,
             insertion: base_sigma + length,
@@ -321,7 +166,10 @@ pub fn follow_the_leader(
             points,
         });
     }
-    Ok(Deployment { frames, metrics })
+    Ok(Deployment {
+        frames,
+        metrics: tracker.metrics(),
+    })
 }
 
 /// The largest `sigma < from` (searched backwards in steps of a tenth of the chord, then
@@ -352,33 +200,4 @@ fn chord_back(channel: &Channel, from: f64, joint: [f64; 2], chord: f64) -> f64 
 fn unwrap(previous: f64, angle: f64) -> f64 {
     let turns = ((angle - previous) / std::f64::consts::TAU).round();
     angle - turns * std::f64::consts::TAU
-}
-
-/// The distance of `x` from the tip's traced polyline joined to the axis behind the entry.
-fn traced_distance(channel: &Channel, traced: &[[f64; 2]], x: [f64; 2]) -> f64 {
-    let (e, d) = (channel.entry(), channel.axis());
-    let along = ((x[0] - e[0]) * d[0] + (x[1] - e[1]) * d[1]).min(0.0);
-    let mut best = dist(x, [e[0] + along * d[0], e[1] + along * d[1]]);
-    if let Some(first) = traced.first() {
-        best = best.min(point_segment(x, e, *first));
-    }
-    for pair in traced.windows(2) {
-        best = best.min(point_segment(x, pair[0], pair[1]));
-    }
-    best
-}
-
-fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
-}
-
-fn point_segment(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let length2 = d[0] * d[0] + d[1] * d[1];
-    let t = if length2 > 0.0 {
-        (((x[0] - a[0]) * d[0] + (x[1] - a[1]) * d[1]) / length2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    dist(x, [a[0] + t * d[0], a[1] + t * d[1]])
 }

@@ -1,8 +1,10 @@
 #![doc = include_str!("../README.md")]
 
 mod arm;
+mod channel;
 mod data;
 mod deploy;
+mod deploy_metrics;
 mod error;
 mod generator;
 mod motion;
@@ -13,11 +15,10 @@ mod shape;
 mod spatial;
 
 pub use arm::{Arm, ArmScratch};
+pub use channel::{Channel, MAX_CENTERLINE_POINTS};
 pub use data::PlanData;
-pub use deploy::{
-    Channel, DeployFrame, DeployMetrics, Deployment, MAX_CENTERLINE_POINTS, MAX_DEPLOY_STEPS,
-    MAX_LENGTH_RATIO, follow_the_leader,
-};
+pub use deploy::{DeployFrame, Deployment, MAX_DEPLOY_STEPS, MAX_LENGTH_RATIO, follow_the_leader};
+pub use deploy_metrics::{DeployMetrics, DeploySample, DeployTracker, SAMPLES_PER_LINK};
 pub use error::PlanError;
 pub use generator::{
     MAX_PASSAGE_OBSTACLES, NarrowPassage, PassageSpec, narrow_passage, spatial_narrow_passage,

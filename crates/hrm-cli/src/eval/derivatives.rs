@@ -9,7 +9,7 @@ use serde::Deserialize;
 use serde_json::{Value, json};
 use sim_study::ArmSpec;
 
-use super::{EvalError, EvalResult, finite, json_fields, modal_map};
+use super::request::{EvalError, EvalResult, finite, json_fields, modal_map};
 
 /// The most links the joint-space derivative ops accept: their answer holds `2 n^2` or `3 n^2`
 /// numbers (3 million, some 60 MB of JSON, at this limit) and their workspace `24 n^2` bytes.

@@ -10,7 +10,7 @@ use serde_json::json;
 use sim_study::ArmSpec;
 
 use super::derivatives::{MAX_DERIVATIVE_LINKS, aba_answer, rnea_answer, rows};
-use super::{EvalError, EvalResult, Kind, finite, json_fields};
+use super::request::{EvalError, EvalResult, Kind, finite, json_fields};
 use lane_math::Classify;
 use manip_dyn::DynError;
 
@@ -232,7 +232,7 @@ pub(super) fn frames(request: FramesRequest) -> EvalResult {
 #[serde(deny_unknown_fields)]
 pub(super) struct ExportRequest {
     urdf: Option<String>,
-    #[serde(default, deserialize_with = "super::optional_arm_object")]
+    #[serde(default, deserialize_with = "super::request::optional_arm_object")]
     arm: Option<ArmSpec>,
     format: String,
     gravity: Option<Vec<f64>>,

@@ -2,7 +2,7 @@
 //! `joints`, `fk`, `ik`, `reduced`, `reduced_derivatives` and `export`
 //! (`docs/eval-protocol.md`, "Spatial arms").
 
-use super::{EvalError, EvalResult, finite, json_fields};
+use super::request::{EvalError, EvalResult, finite, json_fields};
 use backbone_kin::{
     BasePose, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, SpatialModalMap,
     spatial_tip_position,
@@ -38,12 +38,12 @@ pub(super) fn is_spatial(request: &Map<String, Value>) -> bool {
 /// Answers `op` on a spatial arm.
 pub(super) fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
     match op {
-        "joints" => joints(super::parse(request)?),
-        "fk" => fk(super::parse(request)?),
-        "ik" => ik(super::parse(request)?),
-        "reduced" => reduced(super::parse(request)?),
-        "reduced_derivatives" => reduced_derivatives(super::parse(request)?),
-        "export" => export(super::parse(request)?),
+        "joints" => joints(super::request::parse(request)?),
+        "fk" => fk(super::request::parse(request)?),
+        "ik" => ik(super::request::parse(request)?),
+        "reduced" => reduced(super::request::parse(request)?),
+        "reduced_derivatives" => reduced_derivatives(super::request::parse(request)?),
+        "export" => export(super::request::parse(request)?),
         other => Err(EvalError::input(format!(
             "op {other:?} does not take a spatial arm; spatial arms take joints, fk, ik, reduced, \
              reduced_derivatives and export"
@@ -160,7 +160,7 @@ impl SpatialArmSpec {
 
 /// `"harmonics"` of a spatial request: `1` to [`MAX_SPATIAL_HARMONICS`], default 1.
 fn harmonics(requested: Option<usize>) -> Result<usize, EvalError> {
-    super::harmonics(requested, MAX_SPATIAL_HARMONICS)
+    super::request::harmonics(requested, MAX_SPATIAL_HARMONICS)
 }
 
 #[derive(Deserialize)]
@@ -224,10 +224,10 @@ fn ik(request: IkRequest) -> EvalResult {
             .map(|j| if j % 2 == 0 { 0.25 } else { 0.0 })
             .collect(),
     };
-    if let Some(bad) = a.iter().find(|v| v.abs() > super::MAX_GUESS) {
+    if let Some(bad) = a.iter().find(|v| v.abs() > super::request::MAX_GUESS) {
         return Err(EvalError::input(format!(
             "guess entries must be at most {} in magnitude, got {bad}",
-            super::MAX_GUESS
+            super::request::MAX_GUESS
         )));
     }
     let mut solver = SpatialIk::new(model.map().clone(), *model.base())?;

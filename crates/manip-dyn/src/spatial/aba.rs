@@ -18,7 +18,7 @@
 
 use lane_math::Lane;
 
-use super::algebra::{Force, Motion, Symmetric6, Transform, Vec3, splat3};
+use super::algebra::{Force, Mat3, Motion, Symmetric6, Transform, Vec3, splat3, sub};
 use super::data::{AbaLink, SpatialData};
 use super::kinematics::joint_placement;
 use super::model::SpatialModel;
@@ -81,14 +81,28 @@ pub(crate) struct AbaBuffers<'a, T> {
 
 #[inline(always)]
 fn get3<L: AbaLane>(context: L::Context, slots: &[L::Slot; 3]) -> Vec3<L> {
-    [0, 1, 2].map(|k| L::get(context, &slots[k]))
+    [
+        L::get(context, &slots[0]),
+        L::get(context, &slots[1]),
+        L::get(context, &slots[2]),
+    ]
+}
+
+#[inline(always)]
+fn get33<L: AbaLane>(context: L::Context, slots: &[[L::Slot; 3]; 3]) -> Mat3<L> {
+    [
+        get3::<L>(context, &slots[0]),
+        get3::<L>(context, &slots[1]),
+        get3::<L>(context, &slots[2]),
+    ]
 }
 
 #[inline(always)]
 fn set3<L: AbaLane>(values: Vec3<L>, slots: &mut [L::Slot; 3]) {
-    for (value, slot) in values.into_iter().zip(slots.iter_mut()) {
-        value.set(slot);
-    }
+    let [x, y, z] = values;
+    x.set(&mut slots[0]);
+    y.set(&mut slots[1]);
+    z.set(&mut slots[2]);
 }
 
 /// The articulated-body algorithm for `L::WIDTH` states: `inputs` are `q`, `v` and `tau`, each
@@ -143,8 +157,16 @@ pub(crate) fn kernel<L: AbaLane>(
         let joint_velocity = axis.times(L::gather(context, v, n, i));
         velocity = placement.inv_act_motion(&velocity).plus(&joint_velocity);
         let bias = velocity.cross_motion(&joint_velocity);
-        let momentum = model.inertias[i].apply(context, &velocity);
-        let force = velocity.cross_force(&momentum);
+        // A massless link (the cross of a universal joint) has no bias force.
+        let force = if model.massless[i] {
+            Force {
+                linear: zero3,
+                angular: zero3,
+            }
+        } else {
+            let momentum = model.inertias[i].apply(context, &velocity);
+            velocity.cross_force(&momentum)
+        };
         for (r, row) in placement.rotation.into_iter().enumerate() {
             set3::<L>(row, &mut link.rotation[r]);
         }
@@ -167,12 +189,19 @@ pub(crate) fn kernel<L: AbaLane>(
     };
     for i in (0..n).rev() {
         let link = &mut links[i];
-        let inertia = Symmetric6::splat(context, &model.matrices[i]).plus(&carried_inertia);
-        let force = Force {
-            linear: get3::<L>(context, &link.force[0]),
-            angular: get3::<L>(context, &link.force[1]),
-        }
-        .plus(&carried_force);
+        // A massless link adds no inertia and no bias force to what its children pass.
+        let (inertia, force) = if model.massless[i] {
+            (carried_inertia, carried_force)
+        } else {
+            let own = Force {
+                linear: get3::<L>(context, &link.force[0]),
+                angular: get3::<L>(context, &link.force[1]),
+            };
+            (
+                Symmetric6::splat(context, &model.matrices[i]).plus(&carried_inertia),
+                own.plus(&carried_force),
+            )
+        };
         let axis = splat_motion::<L>(context, &model.axes[i]);
         let coupling = inertia.apply(&axis);
         let pivot = axis.dot(&coupling);
@@ -190,7 +219,7 @@ pub(crate) fn kernel<L: AbaLane>(
         residual.set(&mut link.residual);
         if i > 0 {
             let placement = Transform {
-                rotation: [0, 1, 2].map(|r| get3::<L>(context, &link.rotation[r])),
+                rotation: get33::<L>(context, &link.rotation),
                 translation: get3::<L>(context, &link.translation),
             };
             let bias = Motion {
@@ -208,12 +237,12 @@ pub(crate) fn kernel<L: AbaLane>(
 
     // Base to tip: accelerations.
     let mut acceleration = Motion {
-        linear: splat3(context, model.gravity()).map(|g| zero - g),
+        linear: sub(zero3, splat3(context, model.gravity())),
         angular: zero3,
     };
     for (i, link) in links.iter().enumerate() {
         let placement = Transform {
-            rotation: [0, 1, 2].map(|r| get3::<L>(context, &link.rotation[r])),
+            rotation: get33::<L>(context, &link.rotation),
             translation: get3::<L>(context, &link.translation),
         };
         let bias = Motion {

@@ -5,7 +5,10 @@
 //!
 //! The types are generic over the number type `T` ([`Lane`]): `f64` for one state, a SIMD
 //! register of several states for the batch articulated-body algorithm, with the same operations
-//! in the same order (so the same bits).
+//! in the same order (so the same bits). The lane-generic code is written without closures
+//! (no array `map`): a closure is compiled on its own, outside the instruction set that
+//! [`pulp::Arch::dispatch`] enables for a batch, so every register operation inside it would be
+//! a function call instead of one instruction.
 
 use lane_math::Lane;
 
@@ -82,7 +85,7 @@ pub(crate) fn transpose<T: Lane>(m: &Mat3<T>) -> Mat3<T> {
 #[inline(always)]
 pub(crate) fn mat_mul<T: Lane>(a: &Mat3<T>, b: &Mat3<T>) -> Mat3<T> {
     let bt = transpose(b);
-    a.map(|row| [dot(row, bt[0]), dot(row, bt[1]), dot(row, bt[2])])
+    [mat_vec(&bt, a[0]), mat_vec(&bt, a[1]), mat_vec(&bt, a[2])]
 }
 
 /// `a + b`, entry by entry.
@@ -106,13 +109,21 @@ pub(crate) fn rotate_congruent<T: Lane>(r: &Mat3<T>, m: &Mat3<T>) -> Mat3<T> {
 /// Every entry as the number type `T`.
 #[inline(always)]
 pub(crate) fn splat3<T: Lane>(context: T::Context, v: Vec3) -> Vec3<T> {
-    v.map(|x| T::splat(context, x))
+    [
+        T::splat(context, v[0]),
+        T::splat(context, v[1]),
+        T::splat(context, v[2]),
+    ]
 }
 
 /// Every entry as the number type `T`.
 #[inline(always)]
 pub(crate) fn splat33<T: Lane>(context: T::Context, m: &Mat3) -> Mat3<T> {
-    m.map(|row| splat3(context, row))
+    [
+        splat3(context, m[0]),
+        splat3(context, m[1]),
+        splat3(context, m[2]),
+    ]
 }
 
 /// The rotation by `angle` about the unit `axis` given as `(sin angle, cos angle)` (Rodrigues:
@@ -291,6 +302,35 @@ impl<T: Lane> Transform<T> {
     }
 }
 
+impl Transform {
+    /// A rigid body's inertia given in the child frame, as the 6 x 6 matrix in the parent frame
+    /// (what [`act_inertia`](Self::act_inertia) gives of [`RigidInertia::matrix`], from the ten
+    /// parameters): the centre of mass `c = R c_child + p`, `A = m E`, `B = -m [c]x`,
+    /// `C = R I_c R^T + m (|c|^2 E - c c^T)`.
+    pub(crate) fn act_rigid_inertia(&self, body: &RigidInertia) -> Symmetric6 {
+        let m = body.mass;
+        let c = self.apply(body.com);
+        let mc = scale(c, m);
+        let mut rotational = rotate_congruent(&self.rotation, &body.inertia);
+        let c2 = dot(c, c);
+        for (r, row) in rotational.iter_mut().enumerate() {
+            for (k, entry) in row.iter_mut().enumerate() {
+                let delta = if r == k { c2 } else { 0.0 };
+                *entry += m * (delta - c[r] * c[k]);
+            }
+        }
+        Symmetric6 {
+            a: [[m, 0.0, 0.0], [0.0, m, 0.0], [0.0, 0.0, m]],
+            b: [
+                [0.0, mc[2], -mc[1]],
+                [-mc[2], 0.0, mc[0]],
+                [mc[1], -mc[0], 0.0],
+            ],
+            c: rotational,
+        }
+    }
+}
+
 /// `([p]x m)^T`: row `j` is `p x` (column `j` of `m`).
 #[inline(always)]
 fn mat_cross_t<T: Lane>(p: Vec3<T>, m: &Mat3<T>) -> Mat3<T> {
@@ -427,20 +467,23 @@ impl<T: Lane> Symmetric6<T> {
     /// solved out, `s = 1 / D`).
     #[inline(always)]
     pub(crate) fn minus_outer(&self, u: &Force<T>, s: T) -> Symmetric6<T> {
-        let outer = |x: Vec3<T>, y: Vec3<T>, m: &Mat3<T>| {
-            let xs = scale(x, s);
-            [
-                sub(m[0], scale(y, xs[0])),
-                sub(m[1], scale(y, xs[1])),
-                sub(m[2], scale(y, xs[2])),
-            ]
-        };
         Symmetric6 {
-            a: outer(u.linear, u.linear, &self.a),
-            b: outer(u.linear, u.angular, &self.b),
-            c: outer(u.angular, u.angular, &self.c),
+            a: minus_scaled_outer(&self.a, u.linear, u.linear, s),
+            b: minus_scaled_outer(&self.b, u.linear, u.angular, s),
+            c: minus_scaled_outer(&self.c, u.angular, u.angular, s),
         }
     }
+}
+
+/// `m - (s x) y^T`, row `r` being `m_r - y (s x_r)`.
+#[inline(always)]
+fn minus_scaled_outer<T: Lane>(m: &Mat3<T>, x: Vec3<T>, y: Vec3<T>, s: T) -> Mat3<T> {
+    let xs = scale(x, s);
+    [
+        sub(m[0], scale(y, xs[0])),
+        sub(m[1], scale(y, xs[1])),
+        sub(m[2], scale(y, xs[2])),
+    ]
 }
 
 /// The rigid-body inertia of a link in its own frame: mass, centre of mass and rotational inertia

@@ -2,16 +2,36 @@
 //! ([`rnea_derivatives`](super::rnea_derivatives()) and
 //! [`aba_derivatives`](super::aba_derivatives())).
 
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatRef, Par};
+use faer::{Mat, MatMut, MatRef};
 
-use super::algebra::{Force, Motion, Symmetric6};
+use super::algebra::{Mat3, Symmetric6, Vec3};
 use super::model::SpatialModel;
 use crate::model::MAX_DENSE_LINKS;
 
 /// A spatial 6-vector as plain numbers (linear part first), for the world-frame sums of the
 /// derivatives.
 pub(crate) type Six = [f64; 6];
+
+/// The per-link component rows of [`SpatialDerivativeData`]: `J` (6), `P` (6), `Q`'s angular
+/// part (3).
+pub(crate) const ROWS: usize = 15;
+
+/// `n` and room for one register of the widest SIMD instruction set (8 `f64` lanes): a whole
+/// register can be read from any row index below `n`.
+pub(crate) fn padded(n: usize) -> usize {
+    n + 8
+}
+
+/// Column `k` of `m` as a slice (a faer `Mat`'s blocks are column-major), for the SIMD loops
+/// that fill the derivative matrices a column at a time.
+#[inline(always)]
+pub(crate) fn column_of<'m>(m: &'m mut MatMut<'_, f64>, k: usize) -> &'m mut [f64] {
+    m.as_mut()
+        .col_mut(k)
+        .try_as_col_major_mut()
+        .expect("the blocks of a faer Mat are column-major")
+        .as_slice_mut()
+}
 
 /// Results and scratch of [`rnea_derivatives`](super::rnea_derivatives()) and
 /// [`aba_derivatives`](super::aba_derivatives()) for one [`SpatialModel`]: build it once with
@@ -34,24 +54,26 @@ pub struct SpatialDerivativeData {
     pub(crate) accelerations: Vec<f64>,
     /// `n x 3n`: `[d_q | d_v | d_input]`.
     pub(crate) blocks: Mat<f64>,
-    /// Per link, in the base frame: joint axis `J_i`, `P_i = Ic_i J_i`, `Q_i = Bc_i^T J_i`,
-    /// `w_i`, `beta_i`, and the column constants `G_i`, `H_i` (theory.md, "Spatial
-    /// derivatives").
-    pub(crate) axis: Vec<Six>,
-    pub(crate) p: Vec<Six>,
-    pub(crate) q: Vec<Six>,
+    /// Per link `i`, in the base frame, by components (`rows[c][i]`, for products down a
+    /// column): the joint axis `J_i` (components 0-5), `P_i = Ic_i J_i` (6-11) and the angular
+    /// part of `Q_i = Bc_i^T J_i` (12-14; its linear part vanishes) (theory.md, "Spatial
+    /// derivatives"). Each row is zero-padded to [`padded`] entries.
+    pub(crate) rows: [Vec<f64>; ROWS],
+    /// Per link: `w_i`, `beta_i`, and the column constants `G_i`, `H_i`.
     pub(crate) w: Vec<Six>,
     pub(crate) beta: Vec<Six>,
     pub(crate) g: Vec<Six>,
     pub(crate) h: Vec<Six>,
-    /// Composite inertia `Ic_i` and Coriolis operator `Bc_i` of links `i..n`, base frame.
+    /// Of links `i..n`, in the base frame: the composite inertia `Ic_i`, and the two blocks of
+    /// the composite Coriolis operator `Bc_i = [[0, -2 [Hc_i]x], [0, Dc_i]]`: the linear
+    /// momentum `Hc_i` and the 3 x 3 `Dc_i`.
     pub(crate) composite: Vec<Symmetric6>,
-    pub(crate) coriolis: Vec<[Six; 6]>,
+    pub(crate) momentum: Vec<Vec3>,
+    pub(crate) coriolis: Vec<Mat3>,
     /// `[d tau / d q | d tau / d v]` while `aba_derivatives` multiplies it by `-M^-1`.
     pub(crate) rhs: Mat<f64>,
-    /// The force and motion columns of the `O(n^2)` `M^-1` (`aba_derivatives`).
-    pub(crate) forces: Vec<Force>,
-    pub(crate) motions: Vec<Motion>,
+    /// The force, then motion, columns of the `O(n^2)` `M^-1` by component (`aba_derivatives`).
+    pub(crate) sweep: [Vec<f64>; 7],
 }
 
 impl SpatialDerivativeData {
@@ -72,42 +94,22 @@ impl SpatialDerivativeData {
     fn sized(n: usize) -> SpatialDerivativeData {
         let sized = if n <= MAX_DENSE_LINKS { n } else { 0 };
         let six = || vec![[0.0; 6]; sized];
-        let mut derivatives = SpatialDerivativeData {
+        SpatialDerivativeData {
             n,
             value: vec![0.0; sized],
             accelerations: vec![0.0; sized],
             blocks: Mat::zeros(sized, 3 * sized),
-            axis: six(),
-            p: six(),
-            q: six(),
+            rows: std::array::from_fn(|_| vec![0.0; padded(sized)]),
             w: six(),
             beta: six(),
             g: six(),
             h: six(),
             composite: vec![Symmetric6::default(); sized],
-            coriolis: vec![[[0.0; 6]; 6]; sized],
+            momentum: vec![[0.0; 3]; sized],
+            coriolis: vec![[[0.0; 3]; 3]; sized],
             rhs: Mat::zeros(sized, 2 * sized),
-            forces: vec![Force::default(); sized],
-            motions: vec![Motion::default(); sized],
-        };
-        derivatives.warm_up();
-        derivatives
-    }
-
-    /// faer's matrix product (from about 64 rows) multiplies with a kernel that allocates a
-    /// packing buffer per thread on first use: one product here takes that allocation out of
-    /// the first [`aba_derivatives`](super::aba_derivatives()) on this thread.
-    fn warm_up(&mut self) {
-        let n = self.value.len();
-        let (mut jacobians, minv) = self.blocks.as_mut().split_at_col_mut(2 * n);
-        matmul(
-            jacobians.as_mut(),
-            Accum::Replace,
-            minv.as_ref(),
-            self.rhs.as_ref(),
-            -1.0,
-            Par::Seq,
-        );
+            sweep: std::array::from_fn(|_| vec![0.0; padded(sized)]),
+        }
     }
 
     /// Number of links of the chain this workspace was built for.

@@ -16,66 +16,181 @@
 //!                        a_i[:, j] = a'_i[:, j] + S_i (M^-1)_ij                         (S3)
 //! ```
 //!
-//! Only the entries `j >= i` are computed (the rows of the subtree below each joint), about
-//! `35 n^2` multiply-adds; the other half is the symmetric mirror.
+//! Only the entries `j >= i` are computed (the rows of the subtree below each joint); the other
+//! half is the symmetric mirror. The sweeps run in the base frame, where `X_i` is the identity:
+//! with `S_i`, `U_i` carried there by link `i`'s pose (the pairings `S . F` and `U . a` are
+//! frame-free), `F_{i-1}[:, j] = F_i[:, j] + U_i m_ij` and `a_i[:, j] = a_{i-1}[:, j] +
+//! S_i (M^-1)_ij`, so each entry costs two 6-vector dot products and two 6-vector updates,
+//! computed along the row `j = i..n`, a SIMD register of entries at a time, with the columns of
+//! `F` and `a` stored by component.
 
 use faer::MatMut;
+use pulp::{Arch, Simd, WithSimd};
 
-use super::algebra::{Force, Motion, Transform};
+use super::algebra::{Force, Transform};
 use super::data::AbaLink;
+use super::derivative_data::{Six, column_of, padded};
 use super::model::SpatialModel;
+use lane_math::{Lane, Pack};
 
 /// `M^-1` into `minv` (`n x n`) from `links`, the articulated quantities of an
-/// [`aba`](super::aba()) at the same `q` (whose pivots it checked), with `forces` and `motions`
-/// (`n` each) as scratch. Allocation-free.
+/// [`aba`](super::aba()) at the same `q` (whose pivots it checked), and `poses`, the links'
+/// poses in the base frame at that `q`, with `sweep` (7 rows of
+/// [`padded`]`(n)`) as scratch.
+/// Allocation-free.
 pub(crate) fn inverse_mass_matrix(
+    arch: Arch,
     model: &SpatialModel,
     links: &[AbaLink<f64>],
-    forces: &mut [Force],
-    motions: &mut [Motion],
-    mut minv: MatMut<'_, f64>,
+    poses: &[Transform],
+    sweep: &mut [Vec<f64>; 7],
+    minv: MatMut<'_, f64>,
 ) {
-    let n = model.n_links();
-    let placement = |link: &AbaLink<f64>| Transform {
-        rotation: link.rotation,
-        translation: link.translation,
-    };
-    let coupling = |link: &AbaLink<f64>| Force {
-        linear: link.coupling[0],
-        angular: link.coupling[1],
-    };
-    // Entry (i, j), j >= i, is kept at (j, i): column i of the lower triangle, contiguous.
-    // Tip to base (S1, S2).
-    for i in (0..n).rev() {
-        let link = &links[i];
-        let axis = &model.axes[i];
-        forces[i] = Force::default();
-        minv[(i, i)] = link.inverse;
-        for j in i + 1..n {
-            minv[(j, i)] = -link.inverse * axis.dot(&forces[j]);
+    arch.dispatch(Sweeps {
+        model,
+        links,
+        poses,
+        sweep,
+        minv,
+    });
+}
+
+/// The two sweeps under [`Arch::dispatch`] (the loops along a row vectorise with this
+/// processor's widest registers).
+struct Sweeps<'a> {
+    model: &'a SpatialModel,
+    links: &'a [AbaLink<f64>],
+    poses: &'a [Transform],
+    sweep: &'a mut [Vec<f64>; 7],
+    minv: MatMut<'a, f64>,
+}
+
+/// Joint `i`'s axis `S_i` and `U_i` in the base frame, as plain components.
+#[inline(always)]
+fn world(model: &SpatialModel, links: &[AbaLink<f64>], poses: &[Transform], i: usize) -> [Six; 2] {
+    let pose = &poses[i];
+    let s = pose.act_motion(&model.axes[i]);
+    let u = pose.act_force(&Force {
+        linear: links[i].coupling[0],
+        angular: links[i].coupling[1],
+    });
+    [
+        [
+            s.linear[0],
+            s.linear[1],
+            s.linear[2],
+            s.angular[0],
+            s.angular[1],
+            s.angular[2],
+        ],
+        [
+            u.linear[0],
+            u.linear[1],
+            u.linear[2],
+            u.angular[0],
+            u.angular[1],
+            u.angular[2],
+        ],
+    ]
+}
+
+impl WithSimd for Sweeps<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let Sweeps {
+            model,
+            links,
+            poses,
+            sweep,
+            mut minv,
+        } = self;
+        let n = model.n_links();
+        let width = Pack::<S>::WIDTH;
+        let end = padded(n);
+        // Rows 0-5: F (then a) by component; row 6: the entries of one row of the triangle.
+        // All start at zero and stay zero past `n`, so whole registers can be read anywhere.
+        for row in sweep.iter_mut() {
+            row[..end].fill(0.0);
         }
-        if i > 0 {
-            let (x, u) = (placement(link), coupling(link));
-            for j in i..n {
-                forces[j] = x.act_force(&forces[j].plus(&u.times(minv[(j, i)])));
+        let [r0, r1, r2, r3, r4, r5, entries] = sweep;
+        let mut f = [
+            &mut r0[..end],
+            &mut r1[..end],
+            &mut r2[..end],
+            &mut r3[..end],
+            &mut r4[..end],
+            &mut r5[..end],
+        ];
+        let entries = &mut entries[..end];
+        // Entry (i, j), j >= i, is kept at (j, i): column i of the lower triangle, contiguous.
+        // Tip to base (S1, S2).
+        for i in (0..n).rev() {
+            let [s, u] = registers(simd, world(model, links, poses, i));
+            let inverse = Pack::splat(simd, -links[i].inverse);
+            let mut j = i;
+            while j < n {
+                let mut dot = Pack::load(simd, &f[0][j..]) * s[0];
+                for c in 1..6 {
+                    dot = Pack::load(simd, &f[c][j..]).mul_add(s[c], dot);
+                }
+                (inverse * dot).store(&mut entries[j..]);
+                j += width;
+            }
+            entries[i] = links[i].inverse;
+            let mut j = i;
+            while j < n {
+                let m = Pack::load(simd, &entries[j..]);
+                for c in 0..6 {
+                    let updated = m.mul_add(u[c], Pack::load(simd, &f[c][j..]));
+                    updated.store(&mut f[c][j..]);
+                }
+                j += width;
+            }
+            column_of(&mut minv, i)[i..].copy_from_slice(&entries[i..n]);
+        }
+        // Base to tip (S3), a by component in the same rows.
+        for row in f.iter_mut() {
+            row.fill(0.0);
+        }
+        for i in 0..n {
+            let [s, u] = registers(simd, world(model, links, poses, i));
+            let inverse = Pack::splat(simd, links[i].inverse);
+            let column = column_of(&mut minv, i);
+            entries[i..n].copy_from_slice(&column[i..]);
+            let mut j = i;
+            while j < n {
+                let mut dot = Pack::load(simd, &f[0][j..]) * u[0];
+                for c in 1..6 {
+                    dot = Pack::load(simd, &f[c][j..]).mul_add(u[c], dot);
+                }
+                let entry = inverse.neg_mul_add(dot, Pack::load(simd, &entries[j..]));
+                entry.store(&mut entries[j..]);
+                for c in 0..6 {
+                    let updated = entry.mul_add(s[c], Pack::load(simd, &f[c][j..]));
+                    updated.store(&mut f[c][j..]);
+                }
+                j += width;
+            }
+            column[i..].copy_from_slice(&entries[i..n]);
+        }
+        for i in 0..n {
+            for j in i + 1..n {
+                minv[(i, j)] = minv[(j, i)];
             }
         }
     }
-    // Base to tip (S3).
-    motions.fill(Motion::default());
-    for (i, link) in links.iter().enumerate().take(n) {
-        let axis = &model.axes[i];
-        let (x, u) = (placement(link), coupling(link));
-        for j in i..n {
-            let carried = x.inv_act_motion(&motions[j]);
-            let entry = minv[(j, i)] - link.inverse * carried.dot(&u);
-            minv[(j, i)] = entry;
-            motions[j] = carried.plus(&axis.times(entry));
+}
+
+/// `S_i` and `U_i` of [`world`] in every lane.
+#[inline(always)]
+fn registers<S: Simd>(simd: S, vectors: [Six; 2]) -> [[Pack<S>; 6]; 2] {
+    let mut out = [[Pack::splat(simd, 0.0); 6]; 2];
+    for (lanes, vector) in out.iter_mut().zip(vectors) {
+        for (lane, value) in lanes.iter_mut().zip(vector) {
+            *lane = Pack::splat(simd, value);
         }
     }
-    for i in 0..n {
-        for j in i + 1..n {
-            minv[(i, j)] = minv[(j, i)];
-        }
-    }
+    out
 }

@@ -186,6 +186,9 @@ pub struct SpatialModel {
     /// Per joint, an upper bound of the diagonal entry of `M` over the configurations with the
     /// prismatic joints at zero: the scale of the rounding of its articulated-inertia pivot.
     pub(crate) pivot_scales: Vec<f64>,
+    /// Per link, whether its inertia is exactly zero (the cross of a universal joint): such a
+    /// link adds nothing to a composite inertia, momentum or force.
+    pub(crate) massless: Vec<bool>,
 }
 
 impl SpatialModel {
@@ -283,6 +286,10 @@ impl SpatialModel {
             matrices: inertias.iter().map(RigidInertia::matrix).collect(),
             axes: joints.iter().map(SpatialJoint::motion_axis).collect(),
             pivot_scales: pivot_scales(&joints, &inertias),
+            massless: inertias
+                .iter()
+                .map(|body| body.matrix() == Symmetric6::default())
+                .collect(),
             inertias,
             joints,
             links,

@@ -6,7 +6,7 @@
 //! `f_i = I_i a_i + v_i x* I_i v_i`. Tip to base: `tau_i = S_i^T f_i`,
 //! `f_{i-1} += X_i^-T f_i`.
 
-use super::algebra::Motion;
+use super::algebra::{Force, Motion};
 use super::data::SpatialData;
 use super::kinematics::update_placements;
 use super::model::SpatialModel;
@@ -77,11 +77,16 @@ pub(crate) fn newton_euler(
             .inv_act_motion(&acceleration)
             .plus(&axis.times(qdd.map_or(0.0, |qdd| qdd[i])))
             .plus(&velocity.cross_motion(&joint_velocity));
-        let inertia = &model.inertias[i];
-        let momentum = inertia.apply((), &velocity);
-        data.forces[i] = inertia
-            .apply((), &acceleration)
-            .plus(&velocity.cross_force(&momentum));
+        // A massless link (the cross of a universal joint) needs no force.
+        data.forces[i] = if model.massless[i] {
+            Force::default()
+        } else {
+            let inertia = &model.inertias[i];
+            let momentum = inertia.apply((), &velocity);
+            inertia
+                .apply((), &acceleration)
+                .plus(&velocity.cross_force(&momentum))
+        };
         data.velocities[i] = velocity;
         data.accelerations[i] = acceleration;
     }

@@ -21,13 +21,24 @@
 //!
 //! For `i >= k` the entries are `P_i . beta_k + Q_i . w_k` with `P_i = Ic_i J_i` and
 //! `Q_i = Bc_i^T J_i`; for `i < k`, `J_i . G_k` and `J_i . H_k` with column constants `G_k`,
-//! `H_k`: six or twelve multiply-adds an entry.
+//! `H_k`: six to nine multiply-adds an entry, computed down each column over the links.
+//!
+//! The Coriolis operator is sparse. With a body's inertia `[[m E, -[mc]x], [[mc]x, C]]`, its
+//! velocity `(v, omega)` and momentum `(h, h_omega) = I (v, omega)`,
+//! `B = -I crm(v) + crf(v) I + (w -> w x* h)` has the blocks
+//! `B = [[0, -2 [h]x], [0, D]]`, `D = [omega]x C - C [omega]x - [v]x [mc]x - [mc]x [v]x -
+//! [h_omega]x` (the mass terms cancel in the left column), so `Bc_i` is the subtree's linear
+//! momentum `Hc_i` and a 3 x 3 `Dc_i`, and `Q_i = (0, 2 Hc_i x J_i,linear + Dc_i^T J_i,angular)`.
 
 use faer::{Mat, MatMut};
+use lane_math::{Lane, Pack};
+use pulp::{Simd, WithSimd};
 
-use super::algebra::{Force, Motion, Symmetric6};
+use super::algebra::{
+    Force, Mat3, Motion, Symmetric6, Vec3, add, cross, dot, mat_add, mat_t_vec, mat_vec, scale,
+};
 use super::data::SpatialData;
-use super::derivative_data::{Six, SpatialDerivativeData};
+use super::derivative_data::{Six, SpatialDerivativeData, column_of, padded};
 use super::kinematics::update_poses;
 use super::model::SpatialModel;
 use super::rnea::newton_euler;
@@ -72,6 +83,20 @@ pub fn rnea_derivatives(
         derivatives.n_links(),
         n,
     )?;
+    differentiate_at(model, data, derivatives, q, v, qdd)?;
+    check::finite_matrix("the derivatives", &derivatives.blocks.as_mut())
+}
+
+/// [`rnea_derivatives`] on checked inputs, but for the test of the matrices (which
+/// [`aba_derivatives`](super::aba_derivatives()) makes once, on its own results).
+pub(crate) fn differentiate_at(
+    model: &SpatialModel,
+    data: &mut SpatialData,
+    derivatives: &mut SpatialDerivativeData,
+    q: &[f64],
+    v: &[f64],
+    qdd: &[f64],
+) -> Result<(), DynError> {
     update_poses(model, data, q);
     newton_euler(
         model,
@@ -83,7 +108,7 @@ pub fn rnea_derivatives(
     );
     check::finite_result("tau", &derivatives.value)?;
     differentiate(model, data, derivatives);
-    check::finite_matrix("the derivatives", &derivatives.blocks.as_mut())
+    Ok(())
 }
 
 fn six_motion(m: &Motion) -> Six {
@@ -98,24 +123,44 @@ fn six_force(f: &Force) -> Six {
     [a, b, c, d, e, g]
 }
 
-fn motion(x: &Six) -> Motion {
-    Motion {
-        linear: [x[0], x[1], x[2]],
-        angular: [x[3], x[4], x[5]],
+/// `[a]x`, the cross-product matrix of `a`.
+fn cross_matrix(a: Vec3) -> Mat3 {
+    [[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]]
+}
+
+/// The block `D` of one body's Coriolis operator `B = [[0, -2 [h]x], [0, D]]` (module
+/// documentation), from its base-frame inertia `inertia`, velocity `(v, omega)` and momentum
+/// `(h, h_omega)`: `D = [omega]x C - C [omega]x - [v]x [mc]x - [mc]x [v]x - [h_omega]x`, with
+/// `C` the rotational block of the inertia and `mc` its first moment (`B = -[mc]x`).
+fn coriolis_block(inertia: &Symmetric6, velocity: &Motion, momentum: &Force) -> Mat3 {
+    let b = &inertia.b;
+    let mc = [b[1][2], b[2][0], b[0][1]];
+    let (v, omega) = (velocity.linear, velocity.angular);
+    // K = [omega]x C: column k is omega x (column k of C); C [omega]x = -K^T (C symmetric).
+    let kt = [
+        cross(omega, inertia.c[0]),
+        cross(omega, inertia.c[1]),
+        cross(omega, inertia.c[2]),
+    ];
+    // [a]x [b]x = b a^T - (a . b) E.
+    let vm = dot(v, mc);
+    let hw = cross_matrix(momentum.angular);
+    let mut d = [[0.0; 3]; 3];
+    for (r, row) in d.iter_mut().enumerate() {
+        for (k, entry) in row.iter_mut().enumerate() {
+            let diagonal = if r == k { 2.0 * vm } else { 0.0 };
+            *entry = kt[k][r] + kt[r][k] + diagonal - mc[r] * v[k] - v[r] * mc[k] - hw[r][k];
+        }
     }
+    d
 }
 
-fn dot6(a: &Six, b: &Six) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-fn add6(a: &Six, b: &Six) -> Six {
-    [0, 1, 2, 3, 4, 5].map(|k| a[k] + b[k])
-}
-
-/// `B m` for the 6 x 6 operator stored by columns.
-fn apply_columns(columns: &[Six; 6], m: &Six) -> Six {
-    [0, 1, 2, 3, 4, 5].map(|r| (0..6).map(|c| columns[c][r] * m[c]).sum())
+/// The composite Coriolis operator `[[0, -2 [h]x], [0, d]]` applied to the motion `m`.
+fn apply_coriolis(momentum: Vec3, d: &Mat3, m: &Motion) -> Force {
+    Force {
+        linear: scale(cross(momentum, m.angular), -2.0),
+        angular: mat_vec(d, m.angular),
+    }
 }
 
 /// The derivative matrices from the Newton-Euler pass left in `data` (link-frame velocities,
@@ -127,32 +172,28 @@ fn differentiate(
 ) {
     let n = model.n_links();
     let d = derivatives;
-    // Tip to base: composite inertia and Coriolis operator in the base frame.
+    // Tip to base: composite inertia and Coriolis operator in the base frame (a massless link
+    // adds nothing to either).
     for i in (0..n).rev() {
-        let pose = &data.poses[i];
-        let inertia = pose.act_inertia(&model.matrices[i]);
-        let velocity = pose.act_motion(&data.velocities[i]);
-        let momentum = inertia.apply(&velocity);
-        let mut operator = [[0.0; 6]; 6];
-        for (c, column) in operator.iter_mut().enumerate() {
-            let mut unit = [0.0; 6];
-            unit[c] = 1.0;
-            let e = motion(&unit);
-            let f = inertia
-                .apply(&e.cross_motion(&velocity))
-                .plus(&e.cross_force(&momentum))
-                .plus(&velocity.cross_force(&inertia.apply(&e)));
-            *column = six_force(&f);
-        }
-        if i + 1 < n {
-            d.composite[i] = inertia.plus(&d.composite[i + 1]);
-            for (column, child) in operator.iter_mut().zip(&d.coriolis[i + 1]) {
-                *column = add6(column, child);
-            }
+        let (composite, momentum, coriolis) = if i + 1 < n {
+            (d.composite[i + 1], d.momentum[i + 1], d.coriolis[i + 1])
         } else {
-            d.composite[i] = inertia;
+            (Symmetric6::default(), [0.0; 3], [[0.0; 3]; 3])
+        };
+        if model.massless[i] {
+            d.composite[i] = composite;
+            d.momentum[i] = momentum;
+            d.coriolis[i] = coriolis;
+            continue;
         }
-        d.coriolis[i] = operator;
+        let pose = &data.poses[i];
+        let inertia = pose.act_rigid_inertia(&model.inertias[i]);
+        let velocity = pose.act_motion(&data.velocities[i]);
+        let own = inertia.apply(&velocity);
+        let block = coriolis_block(&inertia, &velocity, &own);
+        d.composite[i] = inertia.plus(&composite);
+        d.momentum[i] = add(own.linear, momentum);
+        d.coriolis[i] = mat_add(&block, &coriolis);
     }
     // Base to tip: the per-link vectors.
     let g = model.gravity();
@@ -165,61 +206,142 @@ fn differentiate(
         let pose = &data.poses[i];
         let axis = pose.act_motion(&model.axes[i]);
         let composite: &Symmetric6 = &d.composite[i];
+        let (momentum, coriolis) = (d.momentum[i], &d.coriolis[i]);
         let w = parent_velocity.cross_motion(&axis);
         let beta = parent_acceleration
             .cross_motion(&axis)
             .plus(&w.cross_motion(&parent_velocity).times(-1.0));
         let force = pose.act_force(&data.forces[i]);
-        let axis6 = six_motion(&axis);
-        let coriolis = &d.coriolis[i];
-        d.axis[i] = axis6;
-        d.p[i] = six_force(&composite.apply(&axis));
-        d.q[i] = [0, 1, 2, 3, 4, 5].map(|c| dot6(&coriolis[c], &axis6));
+        let p = composite.apply(&axis);
+        // Q = Bc^T J = (0, 2 Hc x J_linear + Dc^T J_angular).
+        let q = add(
+            scale(cross(momentum, axis.linear), 2.0),
+            mat_t_vec(coriolis, axis.angular),
+        );
+        let row = six_motion(&axis).into_iter().chain(six_force(&p)).chain(q);
+        for (column, value) in d.rows.iter_mut().zip(row) {
+            column[i] = value;
+        }
         d.w[i] = six_motion(&w);
         d.beta[i] = six_motion(&beta);
-        let bw = apply_columns(coriolis, &d.w[i]);
-        d.g[i] = add6(
-            &add6(
-                &six_force(&axis.cross_force(&force)),
-                &six_force(&composite.apply(&beta)),
-            ),
-            &bw,
+        d.g[i] = six_force(
+            &axis
+                .cross_force(&force)
+                .plus(&composite.apply(&beta))
+                .plus(&apply_coriolis(momentum, coriolis, &w)),
         );
-        d.h[i] = add6(
-            &six_force(&composite.apply(&w).times(2.0)),
-            &apply_columns(coriolis, &axis6),
+        d.h[i] = six_force(
+            &composite
+                .apply(&w)
+                .times(2.0)
+                .plus(&apply_coriolis(momentum, coriolis, &axis)),
         );
         parent_velocity = pose.act_motion(&data.velocities[i]);
         parent_acceleration = pose.act_motion(&data.accelerations[i]);
     }
-    // Moved out and back (no allocation) so that `fill` reads the vectors while writing it.
+    // Moved out and back (no allocation) so that `Fill` reads the vectors while writing them.
     let mut blocks = std::mem::replace(&mut d.blocks, Mat::new());
-    let (mut d_q, rest) = blocks.as_mut().split_at_col_mut(n);
-    let (mut d_v, mut mass) = rest.split_at_col_mut(n);
-    fill(d, &mut d_q, &mut d_v, &mut mass);
+    let (d_q, rest) = blocks.as_mut().split_at_col_mut(n);
+    let (d_v, mass) = rest.split_at_col_mut(n);
+    data.arch.dispatch(Fill { d, d_q, d_v, mass });
     d.blocks = blocks;
 }
 
-/// The entries of the three matrices from the per-link vectors.
-fn fill(
-    d: &SpatialDerivativeData,
-    d_q: &mut MatMut<'_, f64>,
-    d_v: &mut MatMut<'_, f64>,
-    mass: &mut MatMut<'_, f64>,
-) {
-    let n = d.value.len();
-    for k in 0..n {
-        for i in 0..n {
-            if i >= k {
-                d_q[(i, k)] = dot6(&d.p[i], &d.beta[k]) + dot6(&d.q[i], &d.w[k]);
-                d_v[(i, k)] = 2.0 * dot6(&d.p[i], &d.w[k]) + dot6(&d.q[i], &d.axis[k]);
-                let entry = dot6(&d.p[i], &d.axis[k]);
-                mass[(i, k)] = entry;
-                mass[(k, i)] = entry;
-            } else {
-                d_q[(i, k)] = dot6(&d.axis[i], &d.g[k]);
-                d_v[(i, k)] = dot6(&d.axis[i], &d.h[k]);
-            }
+/// The entries of the three matrices from the per-link vectors, column by column, each entry
+/// a sum of products down the component rows in SIMD registers (under
+/// [`pulp::Arch::dispatch`]), stored straight into the matrices.
+struct Fill<'a> {
+    d: &'a SpatialDerivativeData,
+    d_q: MatMut<'a, f64>,
+    d_v: MatMut<'a, f64>,
+    mass: MatMut<'a, f64>,
+}
+
+impl WithSimd for Fill<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let Fill {
+            d,
+            mut d_q,
+            mut d_v,
+            mut mass,
+        } = self;
+        let n = d.value.len();
+        let r = |c: usize| &d.rows[c][..padded(n)];
+        let axes = [r(0), r(1), r(2), r(3), r(4), r(5)];
+        let p = [r(6), r(7), r(8), r(9), r(10), r(11)];
+        let pq = [r(6), r(7), r(8), r(9), r(10), r(11), r(12), r(13), r(14)];
+        for k in 0..n {
+            let axis = [0, 1, 2, 3, 4, 5].map(|c| axes[c][k]);
+            let p_k = [0, 1, 2, 3, 4, 5].map(|c| p[c][k]);
+            let (w, beta) = (&d.w[k], &d.beta[k]);
+            let dq = [
+                beta[0], beta[1], beta[2], beta[3], beta[4], beta[5], w[3], w[4], w[5],
+            ];
+            let dv = [
+                2.0 * w[0],
+                2.0 * w[1],
+                2.0 * w[2],
+                2.0 * w[3],
+                2.0 * w[4],
+                2.0 * w[5],
+                axis[3],
+                axis[4],
+                axis[5],
+            ];
+            // i < k: J_i . G_k; i >= k: P_i . beta_k + Q_i . w_k.
+            let column = column_of(&mut d_q, k);
+            combine(simd, &mut column[..k], &axes, &d.g[k], 0);
+            combine(simd, &mut column[k..], &pq, &dq, k);
+            // i < k: J_i . H_k; i >= k: 2 P_i . w_k + Q_i . J_k.
+            let column = column_of(&mut d_v, k);
+            combine(simd, &mut column[..k], &axes, &d.h[k], 0);
+            combine(simd, &mut column[k..], &pq, &dv, k);
+            // M: i < k: J_i . P_k; i >= k: P_i . J_k.
+            let column = column_of(&mut mass, k);
+            combine(simd, &mut column[..k], &axes, &p_k, 0);
+            combine(simd, &mut column[k..], &p, &axis, k);
         }
     }
 }
+
+/// `out[j] = sum_c rows[c][first + j] x[c]`, a register of `S` at a time (the rows hold a
+/// whole register past `first + out.len()`; the last, partial register goes through a
+/// buffer).
+#[inline(always)]
+fn combine<S: Simd, const C: usize>(
+    simd: S,
+    out: &mut [f64],
+    rows: &[&[f64]; C],
+    x: &[f64; C],
+    first: usize,
+) {
+    let width = Pack::<S>::WIDTH;
+    let mut factors = [Pack::splat(simd, 0.0); C];
+    for (factor, &value) in factors.iter_mut().zip(x) {
+        *factor = Pack::splat(simd, value);
+    }
+    let mut at = 0;
+    while at < out.len() {
+        let row = first + at;
+        let mut sum = Pack::load(simd, &rows[0][row..]) * factors[0];
+        for c in 1..C {
+            sum = Pack::load(simd, &rows[c][row..]).mul_add(factors[c], sum);
+        }
+        if at + width <= out.len() {
+            sum.store(&mut out[at..]);
+        } else {
+            let mut last = [0.0; MAX_LANES];
+            sum.store(&mut last);
+            for (entry, value) in out[at..].iter_mut().zip(last) {
+                *entry = value;
+            }
+        }
+        at += width;
+    }
+}
+
+/// The most `f64` lanes of a register (AVX-512).
+const MAX_LANES: usize = 8;

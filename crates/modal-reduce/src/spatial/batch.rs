@@ -5,15 +5,20 @@
 //! (`W` the `f64` lanes of the widest instruction set [`pulp::Arch`] finds at run time, 8 with
 //! AVX-512, 4 with AVX2), lane `i` of every register holding state `i` of the group, and each
 //! group runs through the kernel of one state (`accumulate`, the recursion of
-//! [`motion`](super::motion)) and the `L D L^T` solve, written once over
-//! [`Lane`], with the same operations in the same order. A group whose inputs
+//! [`motion`](super::motion)) and the `L D L^T` solve, written once over the register layouts of
+//! the [`terms`](super::terms) module (one coordinate of the group's states a register here),
+//! with the same operations in the same order. A group whose inputs
 //! are not all finite, or one of whose states fails, is redone one state at a time by
 //! [`spatial_forward_dynamics`], which names the failure; so are the states after the last whole
 //! group, and every state of a model of more than [`MAX_SPATIAL_BATCH_COORDS`] coordinates.
 //!
 //! Memory: the kernel forms each link's joint angles from the map's rows as it goes and keeps
 //! only the `3 x m` Jacobians, `M*`, `C*` and `G*` of a group, on the stack, so a batch needs
-//! nothing of size `n` beyond the model (`O(n m)`) and the one-state workspace.
+//! nothing of size `n` beyond the model (`O(n m)`) and the one-state workspace. These stack
+//! Jacobians are declared here and in the one-state `in_layout` of [`terms`](super::terms) rather
+//! than by one shared helper, because the two hold different registers (`M` packs of states here,
+//! `C` registers of a coordinate layout there) and a helper taking the kernel as a closure would
+//! be compiled without the dispatch's instruction set.
 
 use lane_math::{Lane, Pack};
 use pulp::{Arch, Simd};
@@ -21,10 +26,11 @@ use pulp::{Arch, Simd};
 use super::data::SpatialReducedData;
 use super::forward::spatial_forward_dynamics;
 use super::model::SpatialReducedModel;
-use super::terms::{TermsLanes, accumulate};
+use super::terms::{TermsLanes, TurnsFromModes, accumulate};
 use crate::batch_driver::{Batch, BatchError, BatchKernel, run_batch};
 use crate::batch_group::simd_lanes;
 use crate::error::ReduceError;
+use crate::terms::StateLanes;
 
 /// The most modal coordinates evaluated SIMD across states (`K = 2` harmonics per plane);
 /// larger models run their batches one state at a time.
@@ -135,22 +141,34 @@ impl BatchKernel for Spatial<'_> {
         coriolis: &mut [Pack<S>; M],
         gravity: &mut [Pack<S>; M],
     ) -> bool {
-        const JACOBIAN: usize = 3 * MAX_SPATIAL_BATCH_COORDS;
         let zero = Pack::splat(simd, 0.0);
-        let (mut omega_jacobian, mut origin_jacobian) = ([zero; JACOBIAN], [zero; JACOBIAN]);
-        let (mut com_jacobian, mut inertia_jacobian) = ([zero; JACOBIAN], [zero; JACOBIAN]);
-        let mut momentum_jacobian = [zero; JACOBIAN];
+        let mut jacobians = [[[zero; M]; 3]; 6];
+        let [omega, point, com, momentum, body, body_inertia] = &mut jacobians;
         let work = TermsLanes {
-            omega_jacobian: &mut omega_jacobian,
-            origin_jacobian: &mut origin_jacobian,
-            com_jacobian: &mut com_jacobian,
-            momentum_jacobian: &mut momentum_jacobian,
-            inertia_times_omega_jacobian: &mut inertia_jacobian,
+            omega_jacobian: omega.as_flattened_mut(),
+            point_jacobian: point.as_flattened_mut(),
+            com_jacobian: com.as_flattened_mut(),
+            momentum_jacobian: momentum.as_flattened_mut(),
+            body_jacobian: body.as_flattened_mut(),
+            body_inertia_jacobian: body_inertia.as_flattened_mut(),
             mass_matrix: mass.as_flattened_mut(),
             coriolis,
             gravity,
         };
-        accumulate(simd, self.model, a, a_dot, M, work);
+        let turns = TurnsFromModes {
+            context: simd,
+            model: self.model,
+            a,
+            a_dot,
+        };
+        // M*'s lower triangle, all the solve reads.
+        accumulate(
+            StateLanes::new(simd, usize::MAX),
+            self.model,
+            &turns,
+            M,
+            work,
+        );
         true
     }
 

@@ -18,14 +18,22 @@ pub struct SpatialReducedData {
     pub(crate) theta: Vec<f64>,
     pub(crate) theta_dot: Vec<f64>,
     pub(crate) theta_ddot: Vec<f64>,
-    /// The angular-velocity Jacobian `Jw` and the velocity Jacobian of the world origin moving
-    /// with the link, `Jo` (`3 x m` each, row-major), accumulated joint by joint; the
-    /// centre of mass's velocity Jacobian `Jv`, `m Jv` and `I Jw` of one link.
+    /// Every link's joint angles (`theta = J a`) and rates, their sines and cosines (`2n` each:
+    /// the `z` joints', then the `y` joints').
+    pub(crate) link_angles: Vec<f64>,
+    pub(crate) link_rates: Vec<f64>,
+    pub(crate) link_sin: Vec<f64>,
+    pub(crate) link_cos: Vec<f64>,
+    /// The angular-velocity Jacobian `Jw` and the velocity Jacobian of the link's joint point,
+    /// `Jp` (`3 x m` each, row-major), accumulated link by link; the
+    /// centre of mass's velocity Jacobian `Jv`, `m Jv`, the angular-velocity Jacobian in the
+    /// link's frame `Jb = R^T Jw` and `I_b Jb` of one link (`I_b` the principal moments).
     pub(crate) omega_jacobian: Vec<f64>,
-    pub(crate) origin_jacobian: Vec<f64>,
+    pub(crate) point_jacobian: Vec<f64>,
     pub(crate) com_jacobian: Vec<f64>,
     pub(crate) momentum_jacobian: Vec<f64>,
-    pub(crate) inertia_times_omega_jacobian: Vec<f64>,
+    pub(crate) body_jacobian: Vec<f64>,
+    pub(crate) body_inertia_jacobian: Vec<f64>,
     pub(crate) mass_matrix: Vec<f64>,
     pub(crate) coriolis: Vec<f64>,
     pub(crate) gravity: Vec<f64>,
@@ -57,11 +65,16 @@ impl SpatialReducedData {
             theta: vec![0.0; 2 * n],
             theta_dot: vec![0.0; 2 * n],
             theta_ddot: vec![0.0; 2 * n],
+            link_angles: vec![0.0; 2 * n],
+            link_rates: vec![0.0; 2 * n],
+            link_sin: vec![0.0; 2 * n],
+            link_cos: vec![0.0; 2 * n],
             omega_jacobian: vec![0.0; 3 * m],
-            origin_jacobian: vec![0.0; 3 * m],
+            point_jacobian: vec![0.0; 3 * m],
             com_jacobian: vec![0.0; 3 * m],
             momentum_jacobian: vec![0.0; 3 * m],
-            inertia_times_omega_jacobian: vec![0.0; 3 * m],
+            body_jacobian: vec![0.0; 3 * m],
+            body_inertia_jacobian: vec![0.0; 3 * m],
             mass_matrix: vec![0.0; m * m],
             coriolis: vec![0.0; m],
             gravity: vec![0.0; m],

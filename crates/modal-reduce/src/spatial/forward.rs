@@ -2,17 +2,17 @@
 
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
-use super::terms::spatial_reduced_terms;
+use super::terms::{TermsOfOneState, check_state, check_terms};
 use crate::error::{ReduceError, check_finite_result};
-use crate::forward::right_hand_side;
-use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 use lane_math::{check_len, check_values};
 
 /// The modal accelerations `a_ddot` (`m`) under the modal forces `tau_star` at `(a, a_dot)`:
-/// [`spatial_reduced_terms`], then an `L D L^T` solve of `M*`. Allocation-free.
+/// [`spatial_reduced_terms`](super::spatial_reduced_terms), then an `L D L^T` solve of `M*`, in
+/// one dispatch to the processor's instruction set. Allocation-free.
 ///
-/// Errors: as [`spatial_reduced_terms`], `tau_star` or `a_ddot` of the wrong length,
-/// [`ReduceError::NotPositiveDefinite`] where `M*` is not numerically positive definite.
+/// Errors: as [`spatial_reduced_terms`](super::spatial_reduced_terms), `tau_star` or `a_ddot` of
+/// the wrong length, [`ReduceError::NotPositiveDefinite`] where `M*` is not numerically positive
+/// definite.
 pub fn spatial_forward_dynamics(
     model: &SpatialReducedModel,
     data: &mut SpatialReducedData,
@@ -24,12 +24,18 @@ pub fn spatial_forward_dynamics(
     let m = model.n_coords();
     check_values("tau_star", tau_star, m)?;
     check_len("a_ddot", a_ddot.len(), m)?;
-    spatial_reduced_terms(model, data, a, a_dot)?;
-    data.factor.copy_from_slice(&data.mass_matrix);
-    if !ldlt_in_place::<f64>((), &mut data.factor, m) {
+    check_state(model, data, a, a_dot)?;
+    let arch = data.arch;
+    let positive_definite = arch.dispatch(TermsOfOneState {
+        model,
+        data: &mut *data,
+        a,
+        a_dot,
+        solve: Some((tau_star, &mut *a_ddot)),
+    });
+    check_terms(data)?;
+    if !positive_definite {
         return Err(ReduceError::NotPositiveDefinite);
     }
-    right_hand_side(tau_star, &data.coriolis, &data.gravity, a_ddot);
-    ldlt_solve_in_place(&data.factor, m, a_ddot);
     check_finite_result("modal acceleration a_ddot", a_ddot)
 }

@@ -4,7 +4,7 @@ use backbone_kin::{BasePose, Rotation, SpatialModalMap};
 use manip_dyn::DynError;
 
 use crate::error::ReduceError;
-use crate::model::check_column_rank;
+use crate::model::{LINK_PADDING, check_column_rank};
 
 /// A link's mass and principal moments of inertia about its centre of mass, in the link frame
 /// (`x` along the link), the centre of mass at the link's midpoint.
@@ -72,6 +72,14 @@ pub struct SpatialReducedModel {
     base_rotation: Rotation,
     links: Vec<SpatialLinkInertia>,
     gravity: [f64; 3],
+    /// The rows of the map `J`, two a link (`[P_i, 0]` for its joint about `z`, `[0, P_i]` for
+    /// its joint about `y`, `P_i` row `i` of the planar map), `m` values each, followed by
+    /// [`LINK_PADDING`] zeros so that a whole register loads from the start of any row.
+    joint_rows: Vec<f64>,
+    /// The planar map transposed, `2K x n` row-major: column `k` of `P`, the weight of `a_k` in
+    /// every link's angle, so that the angles of all links are formed a register of links at a
+    /// time.
+    angle_columns: Vec<f64>,
 }
 
 impl SpatialReducedModel {
@@ -101,12 +109,26 @@ impl SpatialReducedModel {
         check_column_rank(map.planar())?;
         base.validate()?;
         lane_math::check_all_finite("gravity", &gravity)?;
+        let (n, m) = (map.n_links(), map.n_coords());
+        let half = m / 2;
+        let mut joint_rows = vec![0.0; 2 * n * m + LINK_PADDING];
+        let mut angle_columns = vec![0.0; half * n];
+        for (i, rows) in joint_rows.chunks_exact_mut(2 * m).take(n).enumerate() {
+            let row = &map.planar().row(i)[..half];
+            rows[..half].copy_from_slice(row);
+            rows[m + half..].copy_from_slice(row);
+            for (k, &value) in row.iter().enumerate() {
+                angle_columns[k * n + i] = value;
+            }
+        }
         Ok(Self {
             map,
             base_rotation: base.rotation(),
             base,
             links,
             gravity,
+            joint_rows,
+            angle_columns,
         })
     }
 
@@ -157,5 +179,17 @@ impl SpatialReducedModel {
     /// Number of modal coordinates `m = 4K`.
     pub fn n_coords(&self) -> usize {
         self.map.n_coords()
+    }
+
+    /// Link `i`'s two rows of `J` (`[P_i, 0]`, then `[0, P_i]`), continued by at least
+    /// [`LINK_PADDING`] values.
+    pub(crate) fn joint_rows(&self, i: usize) -> &[f64] {
+        &self.joint_rows[2 * i * self.n_coords()..]
+    }
+
+    /// Column `k` of the planar map (`n` values: `P_ik` for every link `i`).
+    pub(crate) fn angle_column(&self, k: usize) -> &[f64] {
+        let n = self.n_links();
+        &self.angle_columns[k * n..(k + 1) * n]
     }
 }

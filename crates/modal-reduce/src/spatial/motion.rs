@@ -103,43 +103,77 @@ pub fn link_step<L: Lane>(
     rates: [L; 2],
     accels: [L; 2],
 ) -> LinkMotion<L> {
+    let (sin_z, cos_z) = sin_cos_lanes(context, angles[0]);
+    let (sin_y, cos_y) = sin_cos_lanes(context, angles[1]);
+    let turns = JointTurns {
+        sin: [sin_z, sin_y],
+        cos: [cos_z, cos_y],
+        rates,
+    };
+    link_step_turned(context, carried, length, turns, Some(accels))
+}
+
+/// A link's two joint angles, by their sines and cosines (`[z_i, y_i]`), and their rates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointTurns<L = f64> {
+    /// `[sin z_i, sin y_i]`.
+    pub sin: [L; 2],
+    /// `[cos z_i, cos y_i]`.
+    pub cos: [L; 2],
+    /// `[z_dot_i, y_dot_i]`.
+    pub rates: [L; 2],
+}
+
+/// [`link_step`] from the sines and cosines of the angles (`turns`), with the joint
+/// accelerations `accels`, or none (`None`: zero, the terms they weigh skipped).
+#[inline(always)]
+pub fn link_step_turned<L: Lane>(
+    context: L::Context,
+    carried: &mut Carried<L>,
+    length: f64,
+    turns: JointTurns<L>,
+    accels: Option<[L; 2]>,
+) -> LinkMotion<L> {
     let (x, y, z) = (
         column(&carried.rotation, 0),
         column(&carried.rotation, 1),
         column(&carried.rotation, 2),
     );
-    let (sin_z, cos_z) = sin_cos_lanes(context, angles[0]);
-    let (sin_y, cos_y) = sin_cos_lanes(context, angles[1]);
+    let JointTurns { sin, cos, rates } = turns;
+    let [sin_z, sin_y] = sin;
+    let [cos_z, cos_y] = cos;
     // R Rz(z): x' = x cos + y sin, y' = y cos - x sin; then Ry(y): x'' = x' cos - z sin,
     // z'' = x' sin + z cos.
-    let x_mid = add(scale(x, cos_z), scale(y, sin_z));
-    let u_y = sub(scale(y, cos_z), scale(x, sin_z));
-    let along = sub(scale(x_mid, cos_y), scale(z, sin_y));
-    let normal = add(scale(x_mid, sin_y), scale(z, cos_y));
+    let (mut x_mid, mut u_y, mut along, mut normal) = (x, y, x, z);
+    for d in 0..3 {
+        x_mid[d] = x[d].mul_add(cos_z, y[d] * sin_z);
+        u_y[d] = x[d].neg_mul_add(sin_z, y[d] * cos_z);
+        along[d] = z[d].neg_mul_add(sin_y, x_mid[d] * cos_y);
+        normal[d] = z[d].mul_add(cos_y, x_mid[d] * sin_y);
+    }
     let u_z = z;
     let rotation = [
         [along[0], u_y[0], normal[0]],
         [along[1], u_y[1], normal[1]],
         [along[2], u_y[2], normal[2]],
     ];
-    let omega_mid = add(carried.omega, scale(u_z, rates[0]));
-    let omega = add(omega_mid, scale(u_y, rates[1]));
-    let mut omega_dot = carried.omega_dot;
-    for (term, factor) in [
-        (cross(carried.omega, u_z), rates[0]),
-        (u_z, accels[0]),
-        (cross(omega_mid, u_y), rates[1]),
-        (u_y, accels[1]),
-    ] {
-        omega_dot = add(omega_dot, scale(term, factor));
+    let omega_mid = mul_add3(u_z, rates[0], carried.omega);
+    let omega = mul_add3(u_y, rates[1], omega_mid);
+    let mut omega_dot = mul_add3(cross_fused(carried.omega, u_z), rates[0], carried.omega_dot);
+    if let Some(accels) = accels {
+        omega_dot = mul_add3(u_z, accels[0], omega_dot);
     }
-    let to_com = scale(along, L::splat(context, 0.5 * length));
-    let to_next = scale(along, L::splat(context, length));
-    // The acceleration is affine in the offset: the centre of mass gets half the change.
+    omega_dot = mul_add3(cross_fused(omega_mid, u_y), rates[1], omega_dot);
+    if let Some(accels) = accels {
+        omega_dot = mul_add3(u_y, accels[1], omega_dot);
+    }
+    // The acceleration is affine in the offset `r L` along the link (`r = 1` at the next joint,
+    // `1/2` at the centre of mass): `a_p + L (w_dot x e + w x (w x e))` (`e` the unit `along`).
     let change = add(
-        cross(omega_dot, to_next),
-        cross(omega, cross(omega, to_next)),
+        cross_fused(omega_dot, along),
+        cross_fused(omega, cross_fused(omega, along)),
     );
+    let (full, half) = (L::splat(context, length), L::splat(context, 0.5 * length));
     let joint = carried.point;
     let motion = LinkMotion {
         u_z,
@@ -148,17 +182,37 @@ pub fn link_step<L: Lane>(
         rotation,
         omega,
         omega_dot,
-        com: add(joint, to_com),
-        com_accel: add(carried.accel, scale(change, L::splat(context, 0.5))),
+        com: mul_add3(along, half, joint),
+        com_accel: mul_add3(change, half, carried.accel),
     };
     *carried = Carried {
         rotation,
-        point: add(joint, to_next),
+        point: mul_add3(along, full, joint),
         omega,
         omega_dot,
-        accel: add(carried.accel, change),
+        accel: mul_add3(change, full, carried.accel),
     };
     motion
+}
+
+/// `a s + b`, each component one fused multiply-add.
+#[inline(always)]
+pub fn mul_add3<L: Lane>(a: [L; 3], s: L, b: [L; 3]) -> [L; 3] {
+    [
+        a[0].mul_add(s, b[0]),
+        a[1].mul_add(s, b[1]),
+        a[2].mul_add(s, b[2]),
+    ]
+}
+
+/// `a x b`, each component a product and a fused multiply-add.
+#[inline(always)]
+pub fn cross_fused<L: Lane>(a: [L; 3], b: [L; 3]) -> [L; 3] {
+    [
+        a[2].neg_mul_add(b[1], a[1] * b[2]),
+        a[0].neg_mul_add(b[2], a[2] * b[0]),
+        a[1].neg_mul_add(b[0], a[0] * b[1]),
+    ]
 }
 
 /// `R diag(principal) R^T`, a link's inertia about its centre of mass in the world frame

@@ -2,10 +2,12 @@
 //! (`docs/theory.md`, section 8).
 //!
 //! The modal rates move link `i` with angular velocity `w_i = Jw_i a_dot` and its centre of mass
-//! with velocity `v_i = Jv_i a_dot`, where `Jw_i = sum_j u_j J_j` and `Jv_i = Jo_i - [c_i]x Jw_i`,
-//! `Jo_i = sum_j (o_j x u_j) J_j` (the velocity of the world origin moving with the link), sums
-//! over the joints `j` up to link `i` (`u_j` the joint's axis, `o_j` its point, `J_j` its row of
-//! the modal map): both `3 x m`, updated joint by joint in `O(m)`. Then, from the kinetic energy
+//! with velocity `v_i = Jv_i a_dot`, where `Jw_i = sum_j u_j J_j` (sum over the joints `j` up to
+//! link `i`, `u_j` the joint's axis, `J_j` its row of the modal map) and
+//! `Jv_i = Jp_i + Jw_i x (c_i - p_{i-1})`, `Jp_i` the velocity Jacobian of the joint point
+//! `p_{i-1}` (the link's two joints turn about it, so it moves with link `i - 1`):
+//! `Jp_{i+1} = Jp_i + Jw_i x (p_i - p_{i-1}) = 2 Jv_i - Jp_i` (the centre of mass at the
+//! midpoint), `3 x m` each, updated link by link in `O(m)`. Then, from the kinetic energy
 //! `T = (1/2) sum_i m_i |v_i|^2 + w_i^T I_i w_i` and the potential `V = -sum_i m_i g . c_i`,
 //!
 //! - `M* = sum_i m_i Jv_i^T Jv_i + Jw_i^T I_i Jw_i` (`I_i` the inertia about the centre of mass
@@ -17,14 +19,37 @@
 //! `O(m^2)` a link for `M*`, `O(m)` for the others. The tests hold them against the joint torques
 //! of the Newton-Euler recursion (`J^T tau`), the Lagrangian's finite differences, the planar
 //! reduced model and Pinocchio through the URDF export.
+//!
+//! # Evaluation
+//!
+//! - A pre-pass forms every link's joint angles and rates (`J a`, `J a_dot`, from the planar map
+//!   transposed, a register of links at a time) and their sines and cosines
+//!   ([`lane_math::sin_cos`]), so that the pass along the chain has no trigonometry left.
+//! - The pass (`accumulate`) is written once over the planar kernel's register layouts
+//!   (`Registers`): one state of `m = 4` or `8` coordinates holds each row of the Jacobians, of
+//!   `M*`, `C*` and `G*` in one register (`CoordinateLanes`), so that a row's update is one
+//!   vector operation; `m = 4` in registers of 8 lanes holds each row twice and two rows of `M*`
+//!   a register (`PairedCoordinates`), which halves the work of `M*`; more coordinates go one a
+//!   number (`OneStateScalar`); a batch holds one coordinate of several states a register
+//!   (`StateLanes`). Each entry gets the same operations in the same order in all of them, so a
+//!   state gives the same bits alone and in a batch.
+//! - The rows of `J` per link (`[P_i, 0]`, `[0, P_i]`) are constants of the model, loaded as
+//!   registers.
+//! - The rotational terms are formed in the link's frame, where the inertia is diagonal:
+//!   `Jw^T I Jw = Jb^T I_b Jb` and `Jw^T (I w_dot + w x I w) = Jb^T (I_b w_dot_b + w_b x I_b w_b)`
+//!   with `Jb = R^T Jw` (`I_b` the principal moments), three multiply-adds a row where the
+//!   world-frame inertia `R I_b R^T` would take more than its nine entries.
 
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
-use super::motion::{Carried, link_step, world_inertia};
+use super::motion::{Carried, JointTurns, cross_fused, link_step_turned};
 use crate::error::{ReduceError, check_terms_finite};
-use backbone_kin::vec3::{add, cross, mat_vec};
-use lane_math::Lane;
-use lane_math::check_values;
+use crate::forward::right_hand_side;
+use crate::model::LINK_PADDING;
+use crate::terms::{CoordinateLanes, OneStateScalar, Registers, StateLanes};
+use backbone_kin::vec3;
+use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
+use lane_math::{Lane, Pack, check_values, sin_cos, sin_cos_lanes};
 use pulp::{Simd, WithSimd};
 
 /// Computes `M*`, `C*` and `G*` at the modal state `(a, a_dot)` into `data` (read them with
@@ -43,206 +68,637 @@ pub fn spatial_reduced_terms(
     let arch = data.arch;
     arch.dispatch(TermsOfOneState {
         model,
-        data,
+        data: &mut *data,
         a,
         a_dot,
+        solve: None,
     });
+    check_terms(data)
+}
+
+/// Checks that the terms in `data` are finite, naming the first that is not.
+pub(crate) fn check_terms(data: &SpatialReducedData) -> Result<(), ReduceError> {
     check_terms_finite(&data.mass_matrix, &data.coriolis, &data.gravity)
 }
 
-/// [`spatial_reduced_terms`] after its checks, run by [`pulp::Arch::dispatch`] so that the
-/// kernel's fused multiply-adds are compiled for the processor's instruction set.
-struct TermsOfOneState<'a> {
-    model: &'a SpatialReducedModel,
-    data: &'a mut SpatialReducedData,
-    a: &'a [f64],
-    a_dot: &'a [f64],
+/// [`spatial_reduced_terms`] after its checks, and with `solve` the forward dynamics' `L D L^T`
+/// solve ([`spatial_forward_dynamics`](super::spatial_forward_dynamics)), run by
+/// [`pulp::Arch::dispatch`] so that the kernel and the solve are compiled for the processor's
+/// instruction set. Gives `false` if the solve found `M*` not numerically positive definite.
+pub(crate) struct TermsOfOneState<'a> {
+    pub(crate) model: &'a SpatialReducedModel,
+    pub(crate) data: &'a mut SpatialReducedData,
+    pub(crate) a: &'a [f64],
+    pub(crate) a_dot: &'a [f64],
+    /// `tau_star` and where `a_ddot` goes (`m` each, checked).
+    pub(crate) solve: Option<(&'a [f64], &'a mut [f64])>,
 }
 
 impl WithSimd for TermsOfOneState<'_> {
-    type Output = ();
+    type Output = bool;
 
     #[inline(always)]
-    fn with_simd<S: Simd>(self, _: S) {
-        let data = self.data;
-        let work = TermsLanes {
-            omega_jacobian: &mut data.omega_jacobian,
-            origin_jacobian: &mut data.origin_jacobian,
-            com_jacobian: &mut data.com_jacobian,
-            momentum_jacobian: &mut data.momentum_jacobian,
-            inertia_times_omega_jacobian: &mut data.inertia_times_omega_jacobian,
-            mass_matrix: &mut data.mass_matrix,
-            coriolis: &mut data.coriolis,
-            gravity: &mut data.gravity,
+    fn with_simd<S: Simd>(self, simd: S) -> bool {
+        let Self {
+            model,
+            data,
+            a,
+            a_dot,
+            solve,
+        } = self;
+        let SpatialReducedData {
+            link_angles,
+            link_rates,
+            link_sin,
+            link_cos,
+            omega_jacobian,
+            point_jacobian,
+            com_jacobian,
+            momentum_jacobian,
+            body_jacobian,
+            body_inertia_jacobian,
+            mass_matrix,
+            coriolis,
+            gravity,
+            factor,
+            ..
+        } = data;
+        link_values(model, a, a_dot, link_angles, link_rates);
+        sin_cos(link_angles, link_sin, link_cos);
+        let turns = TurnsOfLinks {
+            n: model.n_links(),
+            sin: link_sin,
+            cos: link_cos,
+            rates: link_rates,
         };
-        // The sizes a batch runs SIMD across states, with the size known at compile time.
-        match self.model.n_coords() {
-            4 => accumulate::<f64>((), self.model, self.a, self.a_dot, 4, work),
-            8 => accumulate::<f64>((), self.model, self.a, self.a_dot, 8, work),
-            m => accumulate::<f64>((), self.model, self.a, self.a_dot, m, work),
+        let out = OneStateTerms {
+            mass_matrix: &mut *mass_matrix,
+            coriolis: &mut *coriolis,
+            gravity: &mut *gravity,
+        };
+        // The sizes a batch runs SIMD across states, on the stack, the coordinates side by side
+        // in one register where they fit; `m` a constant of the solve for them.
+        let m = match model.n_coords() {
+            4 => {
+                on_stack::<S, 4>(simd, model, &turns, out);
+                4
+            }
+            8 => {
+                on_stack::<S, 8>(simd, model, &turns, out);
+                8
+            }
+            m => {
+                let work = TermsLanes {
+                    omega_jacobian,
+                    point_jacobian,
+                    com_jacobian,
+                    momentum_jacobian,
+                    body_jacobian,
+                    body_inertia_jacobian,
+                    mass_matrix: out.mass_matrix,
+                    coriolis: out.coriolis,
+                    gravity: out.gravity,
+                };
+                let work = accumulate(OneStateScalar(simd), model, &turns, m, work);
+                mirror_lower(work.mass_matrix, m);
+                m
+            }
+        };
+        let Some((tau_star, a_ddot)) = solve else {
+            return true;
+        };
+        factor.copy_from_slice(mass_matrix);
+        if !ldlt_in_place::<f64>((), factor, m) {
+            return false;
+        }
+        right_hand_side(tau_star, coriolis, gravity, a_ddot);
+        ldlt_solve_in_place(factor, m, a_ddot);
+        true
+    }
+}
+
+/// Where one state's terms go: `M*` (`m x m`, row-major), `C*`, `G*`.
+struct OneStateTerms<'a> {
+    mass_matrix: &'a mut [f64],
+    coriolis: &'a mut [f64],
+    gravity: &'a mut [f64],
+}
+
+/// [`accumulate`] of one state of `M` coordinates on stack registers, the coordinates side by
+/// side in one register of `S` where they fit ([`CoordinateLanes`]; twice over when they fill
+/// half of it, [`PairedCoordinates`]), else one a number.
+#[inline(always)]
+fn on_stack<S: Simd, const M: usize>(
+    simd: S,
+    model: &SpatialReducedModel,
+    turns: &TurnsOfLinks<'_>,
+    out: OneStateTerms<'_>,
+) {
+    if M == 4 && S::F64_LANES == 2 * M && S::F64_LANES <= LINK_PADDING {
+        in_layout::<_, M, 1>(PairedCoordinates(simd), model, turns, out);
+    } else if M <= S::F64_LANES && S::F64_LANES <= LINK_PADDING {
+        in_layout::<_, M, 1>(CoordinateLanes::new(simd, M), model, turns, out);
+    } else {
+        in_layout::<_, M, M>(OneStateScalar(simd), model, turns, out);
+    }
+}
+
+/// [`on_stack`] in the layout `layout`, whose rows of `M` coordinates take `C` registers: the
+/// kernel, then the registers' coordinates into `out`.
+#[inline(always)]
+fn in_layout<Y: MassRows<Value = f64>, const M: usize, const C: usize>(
+    layout: Y,
+    model: &SpatialReducedModel,
+    turns: &TurnsOfLinks<'_>,
+    out: OneStateTerms<'_>,
+) {
+    let zero = Y::Register::splat(layout.register_context(), 0.0);
+    debug_assert_eq!(layout.chunks(M), C);
+    let mut jacobians = [[[zero; C]; 3]; 6];
+    let [omega, point, com, momentum, body, body_inertia] = &mut jacobians;
+    let mut mass = [[zero; C]; M];
+    let (mut coriolis, mut gravity) = ([zero; C], [zero; C]);
+    let work = TermsLanes {
+        omega_jacobian: omega.as_flattened_mut(),
+        point_jacobian: point.as_flattened_mut(),
+        com_jacobian: com.as_flattened_mut(),
+        momentum_jacobian: momentum.as_flattened_mut(),
+        body_jacobian: body.as_flattened_mut(),
+        body_inertia_jacobian: body_inertia.as_flattened_mut(),
+        mass_matrix: mass.as_flattened_mut(),
+        coriolis: &mut coriolis,
+        gravity: &mut gravity,
+    };
+    let work = accumulate(layout, model, turns, M, work);
+    for k in 0..M {
+        for l in 0..=k {
+            out.mass_matrix[k * M + l] = layout.mass_entry(work.mass_matrix, M, k, l);
+        }
+        out.coriolis[k] = layout.coordinate(work.coriolis, k);
+        out.gravity[k] = layout.coordinate(work.gravity, k);
+    }
+    mirror_lower(out.mass_matrix, M);
+}
+
+/// Copies the lower triangle of the `m x m` row-major `matrix` onto its upper one.
+#[inline(always)]
+fn mirror_lower<L: Copy>(matrix: &mut [L], m: usize) {
+    for k in 0..m {
+        for l in 0..k {
+            matrix[l * m + k] = matrix[k * m + l];
         }
     }
 }
 
-/// The buffers of [`accumulate`], each of one state (`f64`) or one state per lane: `3 x m`
-/// row-major Jacobians `Jw`, `Jo`, `Jv`, `m Jv` and `I Jw`, `M*` (`m x m`, row-major), `C*`, `G*`.
-pub(crate) struct TermsLanes<'w, L> {
-    pub(crate) omega_jacobian: &'w mut [L],
-    pub(crate) origin_jacobian: &'w mut [L],
-    pub(crate) com_jacobian: &'w mut [L],
-    pub(crate) momentum_jacobian: &'w mut [L],
-    pub(crate) inertia_times_omega_jacobian: &'w mut [L],
-    pub(crate) mass_matrix: &'w mut [L],
-    pub(crate) coriolis: &'w mut [L],
-    pub(crate) gravity: &'w mut [L],
+/// The joint angles (`theta = J a`) and rates (`J a_dot`) of every link, the `z` joints' (`n`)
+/// then the `y` joints': a register of links at a time, each angle the multiply-adds of
+/// [`TurnsFromModes`] in its order (so the same bits).
+#[inline(always)]
+fn link_values(
+    model: &SpatialReducedModel,
+    a: &[f64],
+    a_dot: &[f64],
+    angles: &mut [f64],
+    rates: &mut [f64],
+) {
+    let (n, half) = (model.n_links(), model.n_coords() / 2);
+    angles.fill(0.0);
+    rates.fill(0.0);
+    let (angle_z, angle_y) = angles.split_at_mut(n);
+    let (rate_z, rate_y) = rates.split_at_mut(n);
+    for k in 0..half {
+        let (a_z, a_y) = (a[k], a[half + k]);
+        let (w_z, w_y) = (a_dot[k], a_dot[half + k]);
+        let column = model.angle_column(k);
+        let angles = angle_z.iter_mut().zip(angle_y.iter_mut());
+        let rates = rate_z.iter_mut().zip(rate_y.iter_mut());
+        for ((&p, (t_z, t_y)), (r_z, r_y)) in column.iter().zip(angles).zip(rates) {
+            *t_z = a_z.mul_add(p, *t_z);
+            *t_y = a_y.mul_add(p, *t_y);
+            *r_z = w_z.mul_add(p, *r_z);
+            *r_y = w_y.mul_add(p, *r_y);
+        }
+    }
 }
 
-/// `M*`, `C*` and `G*` (the module's sums) at `(a, a_dot)` into `work`, `m` coordinates: the
-/// kernel of [`spatial_reduced_terms`] (`L = f64`) and of the batch across states
-/// ([`spatial_forward_dynamics_batch`](super::spatial_forward_dynamics_batch), `L` a SIMD
-/// register of states), the same operations in the same order for both.
+/// Each link's [`JointTurns`], for [`accumulate`].
+pub(crate) trait LinkTurns<L> {
+    /// Link `i`'s.
+    fn turns(&self, i: usize) -> JointTurns<L>;
+}
+
+/// The turns of all links of one state, formed beforehand ([`link_values`], then
+/// [`sin_cos`] of all the angles): the `z` joints' `n` values, then the `y` joints'.
+struct TurnsOfLinks<'a> {
+    n: usize,
+    sin: &'a [f64],
+    cos: &'a [f64],
+    rates: &'a [f64],
+}
+
+impl LinkTurns<f64> for TurnsOfLinks<'_> {
+    #[inline(always)]
+    fn turns(&self, i: usize) -> JointTurns<f64> {
+        let (z, y) = (i, self.n + i);
+        JointTurns {
+            sin: [self.sin[z], self.sin[y]],
+            cos: [self.cos[z], self.cos[y]],
+            rates: [self.rates[z], self.rates[y]],
+        }
+    }
+}
+
+/// The turns of a link formed as the kernel reaches it, from the modal state (`a`, `a_dot`, `m`
+/// values each): `theta = J a`, `J a_dot` by multiply-adds over the row of the planar map, then
+/// [`sin_cos_lanes`] (for a batch, whose registers hold states: nothing of size `n` is kept).
+pub(crate) struct TurnsFromModes<'a, L: Lane> {
+    pub(crate) context: L::Context,
+    pub(crate) model: &'a SpatialReducedModel,
+    pub(crate) a: &'a [L],
+    pub(crate) a_dot: &'a [L],
+}
+
+impl<L: Lane> LinkTurns<L> for TurnsFromModes<'_, L> {
+    #[inline(always)]
+    fn turns(&self, i: usize) -> JointTurns<L> {
+        let context = self.context;
+        let half = self.model.n_coords() / 2;
+        let zero = L::splat(context, 0.0);
+        let (mut angles, mut rates) = ([zero; 2], [zero; 2]);
+        for (k, &r) in self.model.map().planar().row(i)[..half].iter().enumerate() {
+            let r = L::splat(context, r);
+            angles = [
+                self.a[k].mul_add(r, angles[0]),
+                self.a[half + k].mul_add(r, angles[1]),
+            ];
+            rates = [
+                self.a_dot[k].mul_add(r, rates[0]),
+                self.a_dot[half + k].mul_add(r, rates[1]),
+            ];
+        }
+        let (sin_z, cos_z) = sin_cos_lanes(context, angles[0]);
+        let (sin_y, cos_y) = sin_cos_lanes(context, angles[1]);
+        JointTurns {
+            sin: [sin_z, sin_y],
+            cos: [cos_z, cos_y],
+            rates,
+        }
+    }
+}
+
+/// The buffers of [`accumulate`], in registers of its layout (`c` the layout's
+/// [`chunks`](Registers::chunks) of `m` coordinates): `3 x c` row-major Jacobians `Jw`, `Jo`, `Jv`,
+/// `m Jv`, `Jb` and `I_b Jb`, `M*` (as [`MassRows`] keeps it), `C*` and `G*` (`c` each).
+pub(crate) struct TermsLanes<'w, R> {
+    pub(crate) omega_jacobian: &'w mut [R],
+    pub(crate) point_jacobian: &'w mut [R],
+    pub(crate) com_jacobian: &'w mut [R],
+    pub(crate) momentum_jacobian: &'w mut [R],
+    pub(crate) body_jacobian: &'w mut [R],
+    pub(crate) body_inertia_jacobian: &'w mut [R],
+    pub(crate) mass_matrix: &'w mut [R],
+    pub(crate) coriolis: &'w mut [R],
+    pub(crate) gravity: &'w mut [R],
+}
+
+/// `M*` (its lower triangle: entry `(k, l)`, `l <= k`, of every row; the rest unspecified), `C*`
+/// and `G*` (the module's sums) of `m` coordinates into `work`, each link's turns from `turns`:
+/// the kernel of [`spatial_reduced_terms`] (one state, `layout` [`CoordinateLanes`] or
+/// [`OneStateScalar`]) and of the batch across states
+/// ([`spatial_forward_dynamics_batch`](super::spatial_forward_dynamics_batch),
+/// [`StateLanes`](crate::terms::StateLanes)), the same operations in the same order for each
+/// entry in all of them. Returns `work`.
 ///
-/// The joint angles and rates are formed link by link from the rows of the planar map, so
-/// nothing of size `n` is written: row `2i` of `J` is `[P_i, 0]` and row `2i + 1` is
-/// `[0, P_i]` (`P_i` row `i` of the planar map, `2K` entries), so the `z` joint moves only the
-/// first `2K` columns of the Jacobians and the `y` joint the last `2K`.
+/// What depends on the link alone (its frame, motion, inertia in the world frame, the torque
+/// and acceleration of `C*`) is one number of each state ([`Registers::Value`]); the rows of the
+/// Jacobians, of `M*`, `C*` and `G*` are registers of coordinates ([`Registers::Register`]). Row
+/// `2i` of `J` is `[P_i, 0]` and row `2i + 1` is `[0, P_i]` (`P_i` row `i` of the planar map),
+/// both constants of the model ([`SpatialReducedModel::joint_rows`]): the joints add
+/// `u_z [P_i, 0] + u_y [0, P_i]` to every row of `Jw`, a multiply-add a register each.
 #[inline(always)]
-pub(crate) fn accumulate<L: Lane>(
-    context: L::Context,
+pub(crate) fn accumulate<'w, Y: MassRows>(
+    layout: Y,
     model: &SpatialReducedModel,
-    a: &[L],
-    a_dot: &[L],
+    turns: &impl LinkTurns<Y::Value>,
     m: usize,
-    work: TermsLanes<'_, L>,
-) {
+    work: TermsLanes<'w, Y::Register>,
+) -> TermsLanes<'w, Y::Register> {
     // No closures: a closure is compiled without the instruction set of the SIMD dispatch that
     // inlines this function, and would call its intrinsics.
-    let zero = L::splat(context, 0.0);
+    let context = layout.value_context();
+    let zero = Y::Register::splat(layout.register_context(), 0.0);
+    let chunks = layout.chunks(m);
     let TermsLanes {
         omega_jacobian,
-        origin_jacobian,
+        point_jacobian,
         com_jacobian,
         momentum_jacobian,
-        inertia_times_omega_jacobian,
+        body_jacobian,
+        body_inertia_jacobian,
         mass_matrix,
         coriolis,
         gravity: gravity_terms,
     } = work;
-    let (omega_jacobian, origin_jacobian) =
-        (&mut omega_jacobian[..3 * m], &mut origin_jacobian[..3 * m]);
-    let (com_jacobian, momentum_jacobian, inertia_times_omega_jacobian) = (
-        &mut com_jacobian[..3 * m],
-        &mut momentum_jacobian[..3 * m],
-        &mut inertia_times_omega_jacobian[..3 * m],
+    let rows = 3 * chunks;
+    let (omega_jacobian, point_jacobian) =
+        (&mut omega_jacobian[..rows], &mut point_jacobian[..rows]);
+    let (com_jacobian, momentum_jacobian) =
+        (&mut com_jacobian[..rows], &mut momentum_jacobian[..rows]);
+    let (body_jacobian, body_inertia_jacobian) = (
+        &mut body_jacobian[..rows],
+        &mut body_inertia_jacobian[..rows],
     );
     let (mass_matrix, coriolis, gravity_terms) = (
-        &mut mass_matrix[..m * m],
-        &mut coriolis[..m],
-        &mut gravity_terms[..m],
+        &mut mass_matrix[..layout.mass_len(m)],
+        &mut coriolis[..chunks],
+        &mut gravity_terms[..chunks],
     );
     for buffer in [
         &mut *omega_jacobian,
-        &mut *origin_jacobian,
+        &mut *point_jacobian,
         &mut *mass_matrix,
         &mut *coriolis,
         &mut *gravity_terms,
     ] {
         buffer.fill(zero);
     }
-    let half = m / 2;
-    let (a_z, a_y) = a[..m].split_at(half);
-    let (rate_z, rate_y) = a_dot[..m].split_at(half);
-    let map = model.map();
-    let planar = map.planar();
     let gravity = model.gravity();
-    let mut carried = Carried::<L>::base(context, model.base_rotation(), model.base().xyz);
-    for (i, (&length, inertia)) in map.link_lengths().iter().zip(model.links()).enumerate() {
-        let row = &planar.row(i)[..half];
-        // theta = J a and theta_dot = J a_dot for this link's two joints.
-        let (mut angles, mut rates) = ([zero; 2], [zero; 2]);
-        for (k, &r) in row.iter().enumerate() {
-            let r = L::splat(context, r);
-            angles = [a_z[k].mul_add(r, angles[0]), a_y[k].mul_add(r, angles[1])];
-            rates = [
-                rate_z[k].mul_add(r, rates[0]),
-                rate_y[k].mul_add(r, rates[1]),
-            ];
-        }
-        let motion = link_step(context, &mut carried, length, angles, rates, [zero; 2]);
-        // Jw += u J_row and Jo += (o x u) J_row for both joints.
-        let (moment_z, moment_y) = (
-            cross(motion.joint, motion.u_z),
-            cross(motion.joint, motion.u_y),
-        );
-        for d in 0..3 {
-            let (w, o) = (
-                &mut omega_jacobian[d * m..(d + 1) * m],
-                &mut origin_jacobian[d * m..(d + 1) * m],
-            );
-            let (w_z, w_y) = w.split_at_mut(half);
-            let (o_z, o_y) = o.split_at_mut(half);
-            for (k, &r) in row.iter().enumerate() {
-                let r = L::splat(context, r);
-                w_z[k] = motion.u_z[d].mul_add(r, w_z[k]);
-                o_z[k] = moment_z[d].mul_add(r, o_z[k]);
-                w_y[k] = motion.u_y[d].mul_add(r, w_y[k]);
-                o_y[k] = moment_y[d].mul_add(r, o_y[k]);
+    let weight = spread(
+        layout,
+        [
+            Y::Value::splat(context, gravity[0]),
+            Y::Value::splat(context, gravity[1]),
+            Y::Value::splat(context, gravity[2]),
+        ],
+    );
+    let mut carried = Carried::<Y::Value>::base(context, model.base_rotation(), model.base().xyz);
+    let per_link = model.map().link_lengths().iter().zip(model.links());
+    for (i, (&length, inertia)) in per_link.enumerate() {
+        let motion = link_step_turned(context, &mut carried, length, turns.turns(i), None);
+        // Jw += u_z [P_i, 0] + u_y [0, P_i], row by row.
+        let (u_z, u_y) = (spread(layout, motion.u_z), spread(layout, motion.u_y));
+        let joint_rows = model.joint_rows(i);
+        let (row_z, row_y) = (joint_rows, &joint_rows[m..]);
+        for c in 0..chunks {
+            let (p_z, p_y) = (layout.constant_row(row_z, c), layout.constant_row(row_y, c));
+            for d in 0..3 {
+                let w = &mut omega_jacobian[d * chunks + c];
+                *w = u_y[d].mul_add(p_y, u_z[d].mul_add(p_z, *w));
             }
         }
-        // Jv = Jo + Jw x c, the momentum Jacobian m Jv and I Jw, column by column.
-        let world = world_inertia(&motion.rotation, inertia.principal);
-        let mass = L::splat(context, inertia.mass);
-        let c = motion.com;
-        for k in 0..m {
-            let (w, o) = (column(omega_jacobian, m, k), column(origin_jacobian, m, k));
+        // In the link's frame (axes `e_d`, the columns of `R_i`) the inertia is
+        // `diag(principal)`: `Jb = R_i^T Jw`, `w_b = R_i^T w`, `w_dot_b = R_i^T w_dot`, and
+        // `Jw^T (I w_dot + w x I w) = Jb^T (I_b w_dot_b + w_b x I_b w_b)`.
+        let axes = [
+            vec3::column(&motion.rotation, 0),
+            vec3::column(&motion.rotation, 1),
+            vec3::column(&motion.rotation, 2),
+        ];
+        // The centre of mass from the joint point, (L / 2) R_i e_x.
+        let half = Y::Value::splat(context, 0.5 * length);
+        let to_com = [axes[0][0] * half, axes[0][1] * half, axes[0][2] * half];
+        let principal = [
+            Y::Value::splat(context, inertia.principal[0]),
+            Y::Value::splat(context, inertia.principal[1]),
+            Y::Value::splat(context, inertia.principal[2]),
+        ];
+        let (mut omega_body, mut omega_dot_body) = (motion.omega, motion.omega_dot);
+        for d in 0..3 {
+            omega_body[d] = dot_fused(axes[d], motion.omega);
+            omega_dot_body[d] = dot_fused(axes[d], motion.omega_dot);
+        }
+        let spin = cross_fused(
+            omega_body,
+            [
+                omega_body[0] * principal[0],
+                omega_body[1] * principal[1],
+                omega_body[2] * principal[2],
+            ],
+        );
+        let mut torque = spin;
+        for d in 0..3 {
+            torque[d] = principal[d].mul_add(omega_dot_body[d], spin[d]);
+        }
+        let axes = [
+            spread(layout, axes[0]),
+            spread(layout, axes[1]),
+            spread(layout, axes[2]),
+        ];
+        let principal = spread(layout, principal);
+        let (torque, accel) = (spread(layout, torque), spread(layout, motion.com_accel));
+        let c = spread(layout, to_com); // c - p
+        let mass = layout.spread(Y::Value::splat(context, inertia.mass));
+        // Jv = Jp + Jw x (c - p), the momentum Jacobian m Jv, Jb and I_b Jb, the next joint's
+        // Jp = 2 Jv - Jp; C* += (m Jv)^T a_c + Jb^T torque, G* -= (m Jv)^T g.
+        for k in 0..chunks {
+            let (w, o) = (
+                column(omega_jacobian, chunks, k),
+                column(point_jacobian, chunks, k),
+            );
             let v = [
                 w[2].neg_mul_add(c[1], w[1].mul_add(c[2], o[0])),
                 w[0].neg_mul_add(c[2], w[2].mul_add(c[0], o[1])),
                 w[1].neg_mul_add(c[0], w[0].mul_add(c[1], o[2])),
             ];
-            let iw = [
-                dot_add(world[0], w, zero),
-                dot_add(world[1], w, zero),
-                dot_add(world[2], w, zero),
+            let p = [v[0] * mass, v[1] * mass, v[2] * mass];
+            let body = [
+                dot_fused(axes[0], w),
+                dot_fused(axes[1], w),
+                dot_fused(axes[2], w),
             ];
             for d in 0..3 {
-                com_jacobian[d * m + k] = v[d];
-                momentum_jacobian[d * m + k] = v[d] * mass;
-                inertia_times_omega_jacobian[d * m + k] = iw[d];
+                point_jacobian[d * chunks + k] = v[d] + v[d] - o[d];
+                com_jacobian[d * chunks + k] = v[d];
+                momentum_jacobian[d * chunks + k] = p[d];
+                body_jacobian[d * chunks + k] = body[d];
+                body_inertia_jacobian[d * chunks + k] = body[d] * principal[d];
             }
+            coriolis[k] = dot_add(body, torque, dot_add(p, accel, coriolis[k]));
+            gravity_terms[k] = gravity_terms[k] - dot_add(p, weight, zero);
         }
-        let weight = [
-            L::splat(context, gravity[0]),
-            L::splat(context, gravity[1]),
-            L::splat(context, gravity[2]),
-        ];
-        let torque = add(
-            mat_vec(&world, motion.omega_dot),
-            cross(motion.omega, mat_vec(&world, motion.omega)),
+        // M* += (m Jv)^T Jv + Jb^T I_b Jb.
+        layout.add_outers(
+            mass_matrix,
+            [momentum_jacobian, body_jacobian],
+            [com_jacobian, body_inertia_jacobian],
+            m,
         );
-        // C* += (m Jv)^T a_c + Jw^T torque, G* -= (m Jv)^T g, M* += (m Jv)^T Jv + Jw^T I Jw.
+    }
+    TermsLanes {
+        omega_jacobian,
+        point_jacobian,
+        com_jacobian,
+        momentum_jacobian,
+        body_jacobian,
+        body_inertia_jacobian,
+        mass_matrix,
+        coriolis,
+        gravity: gravity_terms,
+    }
+}
+
+/// The registers of row `k` of `M*` that hold entries `(k, l)` with `l <= k`: all (one) when a
+/// register holds every coordinate, else `k + 1` (one coordinate a register).
+#[inline(always)]
+fn lower_chunks(chunks: usize, k: usize) -> usize {
+    if chunks == 1 { 1 } else { k + 1 }
+}
+
+/// `[x, y, z]` in every coordinate of a register each.
+#[inline(always)]
+fn spread<Y: Registers>(layout: Y, values: [Y::Value; 3]) -> [Y::Register; 3] {
+    [
+        layout.spread(values[0]),
+        layout.spread(values[1]),
+        layout.spread(values[2]),
+    ]
+}
+
+/// Coordinate `k` of the three rows of a `3 x c` matrix of registers.
+#[inline(always)]
+fn coordinate<Y: Registers>(
+    layout: Y,
+    matrix: &[Y::Register],
+    chunks: usize,
+    k: usize,
+) -> [Y::Value; 3] {
+    [
+        layout.coordinate(&matrix[..chunks], k),
+        layout.coordinate(&matrix[chunks..2 * chunks], k),
+        layout.coordinate(&matrix[2 * chunks..], k),
+    ]
+}
+
+/// How a layout keeps `M*` and adds the link's `(m Jv)^T Jv + Jb^T I_b Jb` to it: by default
+/// row `k` in the layout's registers of `m` coordinates, its lower triangle updated a row at a
+/// time from coordinate `k` of `m Jv` and `Jb` spread over a register.
+pub(crate) trait MassRows: Registers {
+    /// The registers `M*` takes for `m` coordinates.
+    #[inline(always)]
+    fn mass_len(self, m: usize) -> usize {
+        m * self.chunks(m)
+    }
+
+    /// `M* += sum_r a_r b_r^T` on the lower triangle (at least), over the rows `r` of
+    /// `left = [m Jv, Jb]` and `right = [Jv, I_b Jb]` (`3 x c` registers each), `r` in order:
+    /// each entry gets the six multiply-adds in that order in every layout.
+    #[inline(always)]
+    fn add_outers(
+        self,
+        mass: &mut [Self::Register],
+        left: [&[Self::Register]; 2],
+        right: [&[Self::Register]; 2],
+        m: usize,
+    ) {
+        let chunks = self.chunks(m);
         for k in 0..m {
-            let (p_k, w_k) = (
-                column(momentum_jacobian, m, k),
-                column(omega_jacobian, m, k),
-            );
-            coriolis[k] = dot_add(w_k, torque, dot_add(p_k, motion.com_accel, coriolis[k]));
-            gravity_terms[k] = gravity_terms[k] - dot_add(p_k, weight, zero);
-            for l in 0..=k {
-                let (v_l, iw_l) = (
-                    column(com_jacobian, m, l),
-                    column(inertia_times_omega_jacobian, m, l),
-                );
-                let entry = &mut mass_matrix[k * m + l];
-                *entry = dot_add(w_k, iw_l, dot_add(p_k, v_l, *entry));
+            let a = [
+                spread(self, coordinate(self, left[0], chunks, k)),
+                spread(self, coordinate(self, left[1], chunks, k)),
+            ];
+            let row = &mut mass[k * chunks..(k + 1) * chunks];
+            for (l, entry) in row.iter_mut().enumerate().take(lower_chunks(chunks, k)) {
+                for (a, right) in a.iter().zip(right) {
+                    *entry = dot_add(*a, column(right, chunks, l), *entry);
+                }
             }
         }
     }
-    for k in 0..m {
-        for l in 0..k {
-            mass_matrix[l * m + k] = mass_matrix[k * m + l];
+
+    /// Entry `(k, l)` of `M*`, `l <= k`.
+    #[inline(always)]
+    fn mass_entry(self, mass: &[Self::Register], m: usize, k: usize, l: usize) -> Self::Value {
+        let chunks = self.chunks(m);
+        self.coordinate(&mass[k * chunks..(k + 1) * chunks], l)
+    }
+}
+
+impl<S: Simd> MassRows for CoordinateLanes<S> {}
+
+impl<S: Simd> MassRows for OneStateScalar<S> {}
+
+impl<S: Simd> MassRows for StateLanes<S> {}
+
+/// One state of 4 coordinates in registers of 8 lanes (AVX-512), each row twice (lanes 0-3 and
+/// 4-7), so that a register holds two rows of `M*`: the outer product `a b^T` adds
+/// `[a_0 a_0 a_0 a_0 a_1 a_1 a_1 a_1] * [b, b]` to rows 0 and 1 and likewise to rows 2 and 3,
+/// two spreads and two multiply-adds where a row a register takes four of each.
+#[derive(Clone, Copy)]
+pub(crate) struct PairedCoordinates<S: Simd>(pub(crate) S);
+
+impl<S: Simd> Registers for PairedCoordinates<S> {
+    type Register = Pack<S>;
+    type Value = f64;
+
+    #[inline(always)]
+    fn register_context(self) -> S {
+        self.0
+    }
+
+    #[inline(always)]
+    fn value_context(self) {}
+
+    #[inline(always)]
+    fn chunks(self, _: usize) -> usize {
+        1
+    }
+
+    #[inline(always)]
+    fn spread(self, value: f64) -> Pack<S> {
+        Pack::splat(self.0, value)
+    }
+
+    #[inline(always)]
+    fn constant_row(self, row: &[f64], _: usize) -> Pack<S> {
+        let mut lanes = [0.0; LINK_PADDING];
+        lanes[..4].copy_from_slice(&row[..4]);
+        lanes[4..].copy_from_slice(&row[..4]);
+        Pack::load(self.0, &lanes)
+    }
+
+    #[inline(always)]
+    fn coordinate(self, row: &[Pack<S>], k: usize) -> f64 {
+        row[0].lane(k)
+    }
+}
+
+impl<S: Simd> MassRows for PairedCoordinates<S> {
+    #[inline(always)]
+    fn mass_len(self, _: usize) -> usize {
+        2
+    }
+
+    #[inline(always)]
+    fn add_outers(
+        self,
+        mass: &mut [Pack<S>],
+        left: [&[Pack<S>]; 2],
+        right: [&[Pack<S>]; 2],
+        _: usize,
+    ) {
+        let mut lanes = [0.0; LINK_PADDING];
+        for (left, right) in left.iter().zip(right) {
+            for (&a, &b) in left[..3].iter().zip(&right[..3]) {
+                a.store(&mut lanes);
+                let [a0, a1, a2, a3, ..] = lanes;
+                let upper = [a0, a0, a0, a0, a1, a1, a1, a1];
+                let lower = [a2, a2, a2, a2, a3, a3, a3, a3];
+                mass[0] = Pack::load(self.0, &upper).mul_add(b, mass[0]);
+                mass[1] = Pack::load(self.0, &lower).mul_add(b, mass[1]);
+            }
         }
     }
+
+    #[inline(always)]
+    fn mass_entry(self, mass: &[Pack<S>], _: usize, k: usize, l: usize) -> f64 {
+        mass[k / 2].lane(4 * (k % 2) + l)
+    }
+}
+
+/// `a . b`, a product and two fused multiply-adds, `a[0] b[0]` first.
+#[inline(always)]
+fn dot_fused<L: Lane>(a: [L; 3], b: [L; 3]) -> L {
+    a[2].mul_add(b[2], a[1].mul_add(b[1], a[0] * b[0]))
 }
 
 /// `acc + a . b` in fused multiply-adds, `a[0] b[0]` first.
@@ -251,10 +707,10 @@ fn dot_add<L: Lane>(a: [L; 3], b: [L; 3], acc: L) -> L {
     a[2].mul_add(b[2], a[1].mul_add(b[1], a[0].mul_add(b[0], acc)))
 }
 
-/// Column `k` of a `3 x m` row-major matrix.
+/// Register column `k` of a `3 x c` row-major matrix of registers.
 #[inline(always)]
-fn column<L: Lane>(matrix: &[L], m: usize, k: usize) -> [L; 3] {
-    [matrix[k], matrix[m + k], matrix[2 * m + k]]
+fn column<L: Lane>(matrix: &[L], chunks: usize, k: usize) -> [L; 3] {
+    [matrix[k], matrix[chunks + k], matrix[2 * chunks + k]]
 }
 
 /// Checks that `data` was made for `model` and that `a` and `a_dot` are `m` finite values each.

@@ -9,7 +9,7 @@ use crate::data::{PRODUCTS, Pair};
 use crate::model::{LINK_PADDING, ReducedModel};
 
 /// The results and scratch of the kernel, in registers of a [`Layout`]: `m` rows of
-/// [`chunks`](Layout::chunks) registers, or one row.
+/// [`chunks`](super::Registers::chunks) registers, or one row.
 pub(crate) struct Terms<'a, R> {
     /// `A` (see [`accumulate`]), row after row.
     pub(crate) mass: &'a mut [R],
@@ -95,7 +95,7 @@ pub(crate) fn accumulate<Y: Layout>(
 }
 
 /// The `n` rows of `m` values of `rows` (`Phi` or the rows `S_l Phi_l`), each with the
-/// [`LINK_PADDING`] values after it that [`Layout::constant_row`] may read.
+/// [`LINK_PADDING`] values after it that [`Registers::constant_row`](super::Registers::constant_row) may read.
 #[inline(always)]
 pub(super) fn padded_rows(rows: &[f64], n: usize, m: usize) -> impl Iterator<Item = &[f64]> {
     rows[..n * m + LINK_PADDING]
@@ -104,7 +104,7 @@ pub(super) fn padded_rows(rows: &[f64], n: usize, m: usize) -> impl Iterator<Ite
 }
 
 /// `gravity += cos(phi_l) S_l Phi_l^T` for link `moment_row` (`S_l Phi_l`, followed by the
-/// padding of [`Layout::constant_row`]).
+/// padding of [`Registers::constant_row`](super::Registers::constant_row)).
 #[inline(always)]
 pub(super) fn add_gravity<Y: Layout>(
     layout: Y,

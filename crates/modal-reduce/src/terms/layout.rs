@@ -10,8 +10,9 @@ use super::links::{
 use crate::data::Pair;
 use crate::model::{LINK_PADDING, ReducedModel};
 
-/// How the kernel's numbers sit in registers (see the [module documentation](super)).
-pub(crate) trait Layout: Copy {
+/// How a kernel's numbers sit in registers (see the [module documentation](super)): the part
+/// of a [`Layout`] that the spatial kernel ([`spatial::terms`](crate::spatial::terms)) shares.
+pub(crate) trait Registers: Copy {
     /// A register of the pass: several coordinates of one state, or one coordinate (of one state
     /// or of several side by side).
     type Register: Lane;
@@ -31,9 +32,13 @@ pub(crate) trait Layout: Copy {
     fn constant_row(self, row: &[f64], chunk: usize) -> Self::Register;
     /// Coordinate `k` of the row held in the registers `row`.
     fn coordinate(self, row: &[Self::Register], k: usize) -> Self::Value;
+}
+
+/// How the planar kernel's numbers sit in registers (see the [module documentation](super)).
+pub(crate) trait Layout: Registers {
     /// The step `P_{l+1} = P_l + L_l w_l Phi_l` of register `chunk` of the columns `pair` of
     /// `P_l`, from `L_l sin phi_l`, `L_l cos phi_l` and the constant row `row` of `Phi` (see
-    /// [`constant_row`](Self::constant_row)).
+    /// [`constant_row`](Registers::constant_row)).
     #[inline(always)]
     fn joint_step(
         self,
@@ -79,7 +84,7 @@ impl<S: Simd> CoordinateLanes<S> {
     }
 }
 
-impl<S: Simd> Layout for CoordinateLanes<S> {
+impl<S: Simd> Registers for CoordinateLanes<S> {
     type Register = Pack<S>;
     type Value = f64;
 
@@ -110,7 +115,9 @@ impl<S: Simd> Layout for CoordinateLanes<S> {
     fn coordinate(self, row: &[Pack<S>], k: usize) -> f64 {
         row[0].lane(k)
     }
+}
 
+impl<S: Simd> Layout for CoordinateLanes<S> {
     #[inline(always)]
     fn link_values(
         self,
@@ -128,7 +135,7 @@ impl<S: Simd> Layout for CoordinateLanes<S> {
 #[derive(Clone, Copy)]
 pub(crate) struct OneStateScalar<S>(pub(crate) S);
 
-impl<S: Simd> Layout for OneStateScalar<S> {
+impl<S: Simd> Registers for OneStateScalar<S> {
     type Register = f64;
     type Value = f64;
 
@@ -157,7 +164,9 @@ impl<S: Simd> Layout for OneStateScalar<S> {
     fn coordinate(self, row: &[f64], k: usize) -> f64 {
         row[k]
     }
+}
 
+impl<S: Simd> Layout for OneStateScalar<S> {
     #[inline(always)]
     fn link_values(
         self,
@@ -191,7 +200,7 @@ impl<S: Simd> StateLanes<S> {
     }
 }
 
-impl<S: Simd> Layout for StateLanes<S> {
+impl<S: Simd> Registers for StateLanes<S> {
     type Register = Pack<S>;
     type Value = Pack<S>;
 
@@ -224,7 +233,9 @@ impl<S: Simd> Layout for StateLanes<S> {
     fn coordinate(self, row: &[Pack<S>], k: usize) -> Pack<S> {
         row[k]
     }
+}
 
+impl<S: Simd> Layout for StateLanes<S> {
     #[inline(always)]
     fn joint_step(
         self,

@@ -169,7 +169,7 @@ pub(super) fn link_products<L: Lane>(
 
 /// The per-link buffers of the kernel: every link's angle, its sine and cosine, and the
 /// [`PRODUCTS`], each entry `W` values side by side (`W` the lanes of the layout's
-/// [`Value`](Layout::Value): one state's links have one, a batch's the states of a group).
+/// [`Value`](super::Registers::Value): one state's links have one, a batch's the states of a group).
 pub(crate) struct LinkBuffers<'a> {
     /// `phi_l`, `[link][lane]`.
     pub(crate) angle: &'a mut [f64],

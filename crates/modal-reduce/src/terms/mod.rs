@@ -106,7 +106,7 @@ use crate::model::{LINK_PADDING, ReducedModel};
 pub(crate) use kernel::{Terms, accumulate, extract};
 use lane_math::all_finite;
 use lane_math::check_values;
-pub(crate) use layout::{CoordinateLanes, Layout, OneStateScalar, StateLanes};
+pub(crate) use layout::{CoordinateLanes, Layout, OneStateScalar, Registers, StateLanes};
 pub(crate) use links::{LinkBuffers, angles_in_range};
 
 /// Computes `M*(a)`, `C*(a, a_dot)` and `G*(a)` (eq 14) into `data` in `O(n m^2)`, by prefix

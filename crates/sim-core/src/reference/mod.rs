@@ -12,11 +12,13 @@ pub(crate) mod continuation;
 mod path;
 mod preview;
 mod spatial_path;
+mod spline;
 mod waypoints;
 
 pub use path::{CartesianPath, FREE_BASE_START, PathShape};
 pub use preview::{MAX_PREVIEW_SAMPLES, ReferencePreview};
 pub use spatial_path::{Helix, SpatialPath};
+pub use spline::{MAX_SPLINE_SAMPLES, SplineMotion};
 pub use waypoints::{MAX_WAYPOINTS, Waypoints};
 
 use crate::error::{SimError, check_non_negative};
@@ -64,6 +66,19 @@ pub trait Reference: Send {
     /// Writes the desired motion at time `t` (s) into `out` (`m` entries per field). `&mut self`
     /// only for workspaces: the sample is a function of `t` alone.
     fn sample(&mut self, t: f64, out: &mut ReferenceSample) -> Result<(), SimError>;
+}
+
+/// The minimum-jerk profile `s(u) = 10 u^3 - 15 u^4 + 6 u^5` at the elapsed fraction `u`
+/// (clamped to `[0, 1]`) of a motion of `duration` s, with its first and second time
+/// derivatives: `(s, ds/dt, d2s/dt2)`, rates and accelerations zero at both ends.
+pub(crate) fn minimum_jerk(u: f64, duration: f64) -> (f64, f64, f64) {
+    let u = u.clamp(0.0, 1.0);
+    let (u2, u3) = (u * u, u * u * u);
+    (
+        u3 * (10.0 - 15.0 * u + 6.0 * u2),
+        30.0 * u2 * (1.0 - u) * (1.0 - u) / duration,
+        60.0 * u * (1.0 - u) * (1.0 - 2.0 * u) / (duration * duration),
+    )
 }
 
 /// Checks that the per-coordinate arrays `arrays` (named as in a scenario file) are non-empty and

@@ -1,7 +1,7 @@
 //! A motion through waypoints of the modal coordinates along straight segments: what a shape
 //! plan (`shape-plan`) returns, followed in time.
 
-use super::{Reference, ReferenceSample, check_lengths};
+use super::{Reference, ReferenceSample, check_lengths, minimum_jerk};
 use crate::error::{SimError, check_positive};
 
 /// The most waypoints a [`Waypoints`] reference accepts.
@@ -112,11 +112,7 @@ impl Reference for Waypoints {
         let k = self.starts.partition_point(|&s| s <= t) - 1;
         let (t0, t1) = (self.starts[k], self.starts[k + 1]);
         let duration = t1 - t0;
-        let u = ((t - t0) / duration).clamp(0.0, 1.0);
-        let (u2, u3) = (u * u, u * u * u);
-        let s = u3 * (10.0 - 15.0 * u + 6.0 * u2);
-        let s_dot = 30.0 * u2 * (1.0 - u) * (1.0 - u) / duration;
-        let s_ddot = 60.0 * u * (1.0 - u) * (1.0 - 2.0 * u) / (duration * duration);
+        let (s, s_dot, s_ddot) = minimum_jerk((t - t0) / duration, duration);
         let (from, to) = (&self.points[k], &self.points[k + 1]);
         for i in 0..from.len() {
             let delta = to[i] - from[i];

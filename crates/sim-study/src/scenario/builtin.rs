@@ -7,7 +7,9 @@ use std::path::Path;
 /// The scenarios shipped with the crate, by name: the paper's experiments (section 5) with the
 /// tracking task also five times faster under limits on the modal forces `tau*`, then the paper's tracking task
 /// with two harmonics and with `alpha0` free, then the paper's arm reaching between obstacles on
-/// a planned motion (`narrow-gap`).
+/// a planned motion (`narrow-gap`), a spatial arm reaching a point in space among obstacles
+/// on a planned motion (`spatial-clutter`), and the paper's arm deploying into a bent channel by
+/// follow-the-leader on an insertion axis (`pipe-deploy`, run by [`Scenario::run_deploy`]).
 const BUILTIN: &[(&str, &str)] = &[
     (
         "paper-tracking",
@@ -49,6 +51,14 @@ const BUILTIN: &[(&str, &str)] = &[
         "narrow-gap",
         include_str!("../../scenarios/narrow-gap.toml"),
     ),
+    (
+        "spatial-clutter",
+        include_str!("../../scenarios/spatial-clutter.toml"),
+    ),
+    (
+        "pipe-deploy",
+        include_str!("../../scenarios/pipe-deploy.toml"),
+    ),
 ];
 
 impl Scenario {
@@ -84,7 +94,8 @@ impl Scenario {
     /// `paper-responses-*` step, sine and noise responses (Figure 9), and the tracking task for
     /// other modal families: `harmonic-tracking` (`K = 2`, `m = 4`) and `free-base-tracking`
     /// (`alpha0` free, `m = 3`), and `narrow-gap` (a `[task]` planned between obstacles that
-    /// block both closed-form `K = 1` shapes, then tracked).
+    /// block both closed-form `K = 1` shapes, then tracked), and `pipe-deploy` (a `[deploy]`
+    /// into a bent channel, run in joint space by [`Scenario::run_deploy`]).
     pub fn builtin_names() -> impl Iterator<Item = &'static str> {
         BUILTIN.iter().map(|(name, _)| *name)
     }

@@ -17,6 +17,24 @@ fn unused(name: &str, why: &str) -> SimError {
 }
 
 impl Scenario {
+    /// The first setting the joint-space loops (a URDF arm's and a deployment's) do not use,
+    /// as `(name, why)`: sensor noise, and any limit but `limits.max_modal_error`.
+    pub(super) fn unused_by_joint_space_loops(&self) -> Option<(&'static str, &'static str)> {
+        if self.noise != NoiseSpec::default() {
+            return Some(("noise", "the joint-space loop is noise-free"));
+        }
+        if self.limits.joint_torque_nm.is_some()
+            || self.limits.joint_angle_rad.is_some()
+            || self.limits.tau_star.is_some()
+        {
+            return Some((
+                "limits.joint_torque_nm, limits.joint_angle_rad and limits.tau_star",
+                "only limits.max_modal_error bounds the joint errors",
+            ));
+        }
+        None
+    }
+
     /// The dynamics model of the scenario's URDF arm (`arm.urdf`, a regular file of at most
     /// [`robot_desc::MAX_URDF_BYTES`]) under gravity `(0, 0, -arm.gravity)` (ROS's convention,
     /// 9.81 m/s^2 by default; or the vector `arm.gravity`), or `None` for a modal arm.
@@ -124,17 +142,8 @@ impl Scenario {
                 "a joint-space reference is constant, step or sinusoid",
             ));
         }
-        if self.noise != NoiseSpec::default() {
-            return Err(unused("noise", "the joint-space loop is noise-free"));
-        }
-        if self.limits.joint_torque_nm.is_some()
-            || self.limits.joint_angle_rad.is_some()
-            || self.limits.tau_star.is_some()
-        {
-            return Err(unused(
-                "limits.joint_torque_nm, limits.joint_angle_rad and limits.tau_star",
-                "only limits.max_modal_error bounds the joint errors",
-            ));
+        if let Some((name, why)) = self.unused_by_joint_space_loops() {
+            return Err(unused(name, why));
         }
         let mut reference =
             self.reference

@@ -1,7 +1,7 @@
 //! The controllers a scenario may name: one table ([`CONTROLLERS`]) of names, descriptions and
-//! constructors from the scenario's `[controller]` settings.
+//! constructors, and the scenario's `[controller]` settings they are built from
+//! ([`ControllerSpec`]).
 
-use super::schema::ControllerSpec;
 use fuzzy_sugeno::FuzzySystem;
 use modal_reduce::PlantModel;
 use optimal_ctl::MpcSettings;
@@ -11,6 +11,7 @@ use sim_core::controller::{
 };
 use sim_core::{ControllerFactory, Prepared, ReferenceFactory, SimError};
 use std::fmt;
+use std::path::PathBuf;
 use std::str::FromStr;
 use std::sync::Arc;
 
@@ -33,6 +34,69 @@ pub enum ControllerKind {
     /// Model-predictive control: control-limited iLQR over a receding horizon, previewing the
     /// scenario's reference ([`MpcController`], [`MpcSettings::uniform`]).
     Mpc,
+}
+
+/// The controller and its sampling.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControllerSpec {
+    /// Which controller (default fuzzy).
+    #[serde(default)]
+    pub kind: ControllerKind,
+    /// Sampling period (s); default: the RK4 step (required with `dopri5`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub period: Option<f64>,
+    /// A `.fis` file replacing the paper's fuzzy system (for fuzzy, pd and fuzzy-gc); a relative
+    /// path is relative to the scenario file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fis: Option<PathBuf>,
+    /// What the fuzzy controllers (fuzzy, fuzzy-gc) do with an input outside its variable's
+    /// range: `"as-given"` (the default, as MATLAB's `evalfis` and Simulink's Fuzzy Logic
+    /// Controller block evaluate it; bells fade far out) or `"clamp"` (evaluated at the nearest
+    /// end of the range: the action saturates).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub out_of_range: Option<FuzzyInputRange>,
+    /// Computed-torque stiffness per coordinate (1/s^2, default 2500 each: 50 rad/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kp: Option<Vec<f64>>,
+    /// Computed-torque damping per coordinate (1/s, default 100 each: critically damped).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kd: Option<Vec<f64>>,
+    /// PD stiffness per coordinate (N m/rad); default: the fuzzy system's slope at the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pd_kp: Option<Vec<f64>>,
+    /// PD damping per coordinate (N m s/rad); default: the fuzzy system's slope at the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pd_kd: Option<Vec<f64>>,
+    /// LQR design frequency `omega` (rad/s, default 50): the weights place the poles of the
+    /// straight arm without gravity at a Butterworth pair of radius `omega`
+    /// ([`LqrController`](sim_core::controller::LqrController)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lqr_frequency: Option<f64>,
+    /// LQR re-linearisation period (s, default 0.01; at least the controller period).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lqr_relinearise: Option<f64>,
+}
+
+/// What a fuzzy controller does with an input outside its variable's range
+/// ([`fuzzy_sugeno::OutOfRange`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FuzzyInputRange {
+    /// Evaluated as given (MATLAB's `evalfis`, Simulink's Fuzzy Logic Controller block).
+    #[default]
+    AsGiven,
+    /// Evaluated at the nearest end of the range.
+    Clamp,
+}
+
+impl From<FuzzyInputRange> for fuzzy_sugeno::OutOfRange {
+    fn from(policy: FuzzyInputRange) -> Self {
+        match policy {
+            FuzzyInputRange::AsGiven => Self::AsGiven,
+            FuzzyInputRange::Clamp => Self::Clamp,
+        }
+    }
 }
 
 /// What a controller's constructor is given: the scenario's `[controller]` settings, with every

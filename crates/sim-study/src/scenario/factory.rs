@@ -140,25 +140,24 @@ impl Scenario {
         ),
         SimError,
     > {
+        if self.deploy.is_some() {
+            return Err(SimError::setting(
+                "deploy",
+                "runs in joint space with the arm's insertion axis (Scenario::run_deploy, as \
+                 `hrm simulate` runs it), not in the modal loop",
+            ));
+        }
         let model = self.plant()?;
         let m = model.plant().n_coords();
-        let reference = match &model {
-            PlantModel::Planar(planar) => match self.planned_reference(planar)? {
-                Some(planned) => Prepared::reference_clones(planned),
-                None => self.reference.build(
-                    planar.chain().total_length(),
-                    self.modal.harmonics,
-                    self.planar_alpha0()?,
-                    m,
-                )?,
-            },
-            PlantModel::Spatial(_) if self.task.is_some() => {
-                return Err(SimError::setting(
-                    "task",
-                    "is planned for planar arms only: remove [task] or set [arm] kind = \"planar\"",
-                ));
-            }
-            PlantModel::Spatial(spatial) => self.spatial_reference(spatial)?,
+        let reference = match (self.planned_reference(&model)?, &model) {
+            (Some(planned), _) => Prepared::reference_clones(planned),
+            (None, PlantModel::Planar(planar)) => self.reference.build(
+                planar.chain().total_length(),
+                self.modal.harmonics,
+                self.planar_alpha0()?,
+                m,
+            )?,
+            (None, PlantModel::Spatial(spatial)) => self.spatial_reference(spatial)?,
         };
         let period = match (self.controller.period, self.integrator) {
             (Some(period), _) => period,

@@ -89,6 +89,7 @@ mod arm;
 mod builtin;
 mod chain;
 mod controllers;
+mod deploy;
 mod factory;
 mod file;
 mod obstacles;
@@ -97,11 +98,14 @@ mod spatial;
 mod task;
 
 pub use arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout};
-pub use controllers::{CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup};
+pub use controllers::{
+    CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup, ControllerSpec, FuzzyInputRange,
+};
+pub use deploy::{DEPLOY_PLAN_STEPS, DeployRun, MAX_DEPLOY_RECORDED_SAMPLES};
 pub use file::ScenarioError;
 pub use obstacles::{MAX_SCENARIO_OBSTACLES, Workspace};
 pub use schema::{
-    Alpha0, AngleLimit, ArmSpec, BranchSpec, ControllerSpec, FuzzyInputRange, HelixSpec,
-    InitialSpec, IntegratorSpec, LimitsSpec, ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec,
+    Alpha0, AngleLimit, ArmSpec, BranchSpec, DeploySpec, HelixSpec, InitialSpec, IntegratorSpec,
+    LimitsSpec, MAX_DEPLOY_CENTERLINE_POINTS, ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec,
     ReferenceSpec, Scenario, SineSpec, TaskSpec, TorqueLimit,
 };

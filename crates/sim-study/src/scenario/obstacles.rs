@@ -20,14 +20,16 @@ pub enum Workspace {
 }
 
 impl Workspace {
-    fn dims(self) -> usize {
+    /// The coordinates of a point: 2 or 3.
+    pub(super) fn dims(self) -> usize {
         match self {
             Self::Planar => 2,
             Self::Spatial => 3,
         }
     }
 
-    fn point_words(self) -> &'static str {
+    /// How a message names a point of the workspace.
+    pub(super) fn point_words(self) -> &'static str {
         match self {
             Self::Planar => "a point [x, y] of the arm's plane",
             Self::Spatial => "a point [x, y, z]",
@@ -228,6 +230,6 @@ impl ObstacleSpec {
 }
 
 /// "1 number", "3 numbers".
-fn numbers(n: usize) -> String {
+pub(super) fn numbers(n: usize) -> String {
     format!("{n} number{}", if n == 1 { "" } else { "s" })
 }

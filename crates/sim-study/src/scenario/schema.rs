@@ -1,7 +1,7 @@
 //! The scenario schema: what a scenario file may say, with its defaults.
 
 use super::arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout};
-use super::controllers::ControllerKind;
+use super::controllers::ControllerSpec;
 use backbone_kin::BaseAngle;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -61,7 +61,31 @@ pub struct Scenario {
     /// reference of kind `"planned"`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub task: Option<TaskSpec>,
+    /// A follow-the-leader deployment into a channel (`[deploy]`, with the reference of kind
+    /// `"planned"`): the arm gets a base insertion axis and runs in joint space
+    /// ([`Scenario::run_deploy`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deploy: Option<DeploySpec>,
 }
+
+/// A channel the arm deploys into by follow-the-leader (`docs/theory.md`, "Follow-the-leader
+/// deployment"): the arm gets a prismatic insertion axis before its first joint, along the
+/// centreline's first segment, and its tip advances to the centreline's end along the
+/// centreline while its body follows the path the tip traced.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeploySpec {
+    /// The centreline `[[x, y], ...]` (m): at least two points, consecutive points distinct, at
+    /// most [`MAX_DEPLOY_CENTERLINE_POINTS`]. The entry is the first point; the arm starts fully
+    /// retracted, its tip at the entry and its body on the guide behind it. Spatial points
+    /// `[x, y, z]` are refused by name (planar channels only).
+    pub centerline: Vec<Vec<f64>>,
+    /// The channel's radius (m, positive): the walls are at this distance from the centreline.
+    pub radius: f64,
+}
+
+/// The most centreline points a scenario's `[deploy]` accepts.
+pub const MAX_DEPLOY_CENTERLINE_POINTS: usize = 10_000;
 
 /// An obstacle, tagged by `kind`. A planar arm moves in the plane `z = 0`: its obstacles are
 /// circles, capsules and boxes given by `[x, y]` points; a spatial arm's are spheres, capsules
@@ -312,7 +336,7 @@ pub enum TaskSpec {
     /// and from the other links, on the goal shape and all along the motion to it
     /// ([`Scenario::plan`]).
     Reach {
-        /// The target `[x, y]` (m).
+        /// The target (m): `[x, y]` in a planar arm's plane, `[x, y, z]` for a spatial arm.
         target: Vec<f64>,
         /// The margin (m, non-negative).
         clearance: f64,
@@ -384,69 +408,6 @@ pub struct SineSpec {
     pub x_start: f64,
     /// Last `x` (m).
     pub x_end: f64,
-}
-
-/// The controller and its sampling.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ControllerSpec {
-    /// Which controller (default fuzzy).
-    #[serde(default)]
-    pub kind: ControllerKind,
-    /// Sampling period (s); default: the RK4 step (required with `dopri5`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub period: Option<f64>,
-    /// A `.fis` file replacing the paper's fuzzy system (for fuzzy, pd and fuzzy-gc); a relative
-    /// path is relative to the scenario file.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub fis: Option<PathBuf>,
-    /// What the fuzzy controllers (fuzzy, fuzzy-gc) do with an input outside its variable's
-    /// range: `"as-given"` (the default, as MATLAB's `evalfis` and Simulink's Fuzzy Logic
-    /// Controller block evaluate it; bells fade far out) or `"clamp"` (evaluated at the nearest
-    /// end of the range: the action saturates).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub out_of_range: Option<FuzzyInputRange>,
-    /// Computed-torque stiffness per coordinate (1/s^2, default 2500 each: 50 rad/s).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub kp: Option<Vec<f64>>,
-    /// Computed-torque damping per coordinate (1/s, default 100 each: critically damped).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub kd: Option<Vec<f64>>,
-    /// PD stiffness per coordinate (N m/rad); default: the fuzzy system's slope at the origin.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub pd_kp: Option<Vec<f64>>,
-    /// PD damping per coordinate (N m s/rad); default: the fuzzy system's slope at the origin.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub pd_kd: Option<Vec<f64>>,
-    /// LQR design frequency `omega` (rad/s, default 50): the weights place the poles of the
-    /// straight arm without gravity at a Butterworth pair of radius `omega`
-    /// ([`LqrController`](sim_core::controller::LqrController)).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lqr_frequency: Option<f64>,
-    /// LQR re-linearisation period (s, default 0.01; at least the controller period).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lqr_relinearise: Option<f64>,
-}
-
-/// What a fuzzy controller does with an input outside its variable's range
-/// ([`fuzzy_sugeno::OutOfRange`]).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum FuzzyInputRange {
-    /// Evaluated as given (MATLAB's `evalfis`, Simulink's Fuzzy Logic Controller block).
-    #[default]
-    AsGiven,
-    /// Evaluated at the nearest end of the range.
-    Clamp,
-}
-
-impl From<FuzzyInputRange> for fuzzy_sugeno::OutOfRange {
-    fn from(policy: FuzzyInputRange) -> Self {
-        match policy {
-            FuzzyInputRange::AsGiven => Self::AsGiven,
-            FuzzyInputRange::Clamp => Self::Clamp,
-        }
-    }
 }
 
 /// The integrator between controller samples, tagged by `method`.

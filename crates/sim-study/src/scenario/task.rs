@@ -1,28 +1,29 @@
 //! `[task]`: what the arm must achieve, planned before the controller runs (`shape-plan`), and
 //! the reference of kind `"planned"` that follows the plan.
 
-use super::obstacles::Workspace;
 use super::schema::{ReferenceSpec, Scenario, TaskSpec};
 use clearance::ClearanceModel;
-use modal_reduce::ReducedModel;
-use shape_plan::{Plan, PlanOptions, PlanarArm, Planner};
+use modal_reduce::PlantModel;
+use shape_plan::{Arm, Plan, PlanError, PlanOptions, PlanarArm, Planner, SpatialArm};
 use sim_core::SimError;
 use sim_core::reference::Waypoints;
 
 impl Scenario {
     /// The plan of the scenario's `[task]` (`None` without one): for `kind = "reach"` a goal
-    /// shape whose chain tip is on `target` with every link at least `clearance` from every
-    /// obstacle and from the other links, and a motion to it from the initial shape (`initial.a`,
-    /// default the straight arm `a = 0`) that keeps the margin (`shape_plan::Planner::plan`,
-    /// `docs/theory.md` "Shape planning"), seeded by the scenario's seed. Errors name the task's
-    /// field, or say "no collision-free shape found" with the best clearance reached.
+    /// shape whose chain tip is on `target` (`[x, y]` for a planar arm, `[x, y, z]` for a
+    /// spatial one) with every link at least `clearance` from every obstacle and from the other
+    /// links, and a motion to it from the initial shape (`initial.a`, default the straight arm
+    /// `a = 0`) that keeps the margin (`shape_plan::Planner::plan` on the planar or the
+    /// spatial modal arm, warm-started from its free-space inverse kinematics, `docs/theory.md`
+    /// "Shape planning"), seeded by the scenario's seed. Errors name the task's field, or say
+    /// "no collision-free shape found" with the best clearance reached.
     pub fn plan(&self) -> Result<Option<Plan>, SimError> {
-        let model = self.model()?;
+        let model = self.plant()?;
         self.plan_for(&model)
     }
 
-    /// [`plan`](Self::plan) for the scenario's reduced model, already built.
-    pub(super) fn plan_for(&self, model: &ReducedModel) -> Result<Option<Plan>, SimError> {
+    /// [`plan`](Self::plan) for the scenario's modal arm, already built.
+    pub(super) fn plan_for(&self, model: &PlantModel) -> Result<Option<Plan>, SimError> {
         let Some(TaskSpec::Reach {
             target,
             clearance,
@@ -33,12 +34,14 @@ impl Scenario {
         else {
             return Ok(None);
         };
-        if target.len() != 2 {
+        let workspace = self.workspace();
+        if target.len() != workspace.dims() {
             return Err(SimError::setting(
                 "task.target",
                 format!(
-                    "must be a point [x, y] of the arm's plane, got {} numbers",
-                    target.len()
+                    "must be {}, got {}",
+                    workspace.point_words(),
+                    super::obstacles::numbers(target.len())
                 ),
             ));
         }
@@ -51,52 +54,50 @@ impl Scenario {
             seed: self.seed,
             ..defaults
         };
-        let field = |e: shape_plan::PlanError| {
-            let name = match &e {
-                shape_plan::PlanError::OutOfRange { name, .. }
-                | shape_plan::PlanError::TooMany { name, .. } => match *name {
-                    "clearance" => "task.clearance",
-                    "check slack" => "task.check_slack",
-                    "samples" => "task.samples",
-                    "max iterations" => "task.max_iterations",
-                    "target coordinate" => "task.target",
-                    _ => "task",
-                },
-                shape_plan::PlanError::OutOfReach { .. } => "task.target",
-                shape_plan::PlanError::InitialTooClose { .. } => "initial.a",
-                _ => "task",
-            };
-            SimError::setting(name, format!("cannot be met: {e}"))
-        };
-        options.validate().map_err(field)?;
-        let lengths: Vec<f64> = model.chain().link_lengths().collect();
-        let arm = PlanarArm::new(
-            &lengths,
-            self.modal.harmonics,
-            self.planar_alpha0()?.base_angle(),
-        )
-        .map_err(field)?;
-        let clearance_model = match self.clearance_model(lengths.len(), Workspace::Planar)? {
-            Some(model) => model,
-            None => ClearanceModel::new(lengths.len(), 0.0, Vec::new())
-                .map_err(|e| SimError::setting("arm", format!("cannot be measured: {e}")))?,
-        };
+        options.validate().map_err(task_field)?;
+        let m = model.plant().n_coords();
         let initial = match &self.initial {
             Some(initial) => initial.a.clone(),
-            None => vec![0.0; model.n_coords()],
+            None => vec![0.0; m],
         };
-        if initial.len() != model.n_coords() {
+        if initial.len() != m {
             return Err(SimError::setting(
                 "initial.a",
-                format!(
-                    "must have {} entries, got {}",
-                    model.n_coords(),
-                    initial.len()
-                ),
+                format!("must have {m} entries, got {}", initial.len()),
             ));
         }
-        let mut planner = Planner::new(arm, clearance_model, options).map_err(field)?;
-        planner.plan(&initial, target).map(Some).map_err(field)
+        let plan = match model {
+            PlantModel::Planar(planar) => {
+                let lengths: Vec<f64> = planar.chain().link_lengths().collect();
+                let alpha0 = self.planar_alpha0()?.base_angle();
+                let arm = PlanarArm::new(&lengths, self.modal.harmonics, alpha0);
+                self.plan_arm(arm.map_err(task_field)?, options, &initial, target)
+            }
+            PlantModel::Spatial(spatial) => {
+                let map = spatial.map();
+                let arm = SpatialArm::new(map.link_lengths(), map.harmonics(), *spatial.base());
+                self.plan_arm(arm.map_err(task_field)?, options, &initial, target)
+            }
+        };
+        plan.map(Some)
+    }
+
+    /// The plan of `arm` among the scenario's obstacles from `initial` to `target`.
+    fn plan_arm<A: Arm>(
+        &self,
+        arm: A,
+        options: PlanOptions,
+        initial: &[f64],
+        target: &[f64],
+    ) -> Result<Plan, SimError> {
+        let n = arm.n_links();
+        let clearance_model = match self.clearance_model(n, self.workspace())? {
+            Some(model) => model,
+            None => ClearanceModel::new(n, 0.0, Vec::new())
+                .map_err(|e| SimError::setting("arm", format!("cannot be measured: {e}")))?,
+        };
+        let mut planner = Planner::new(arm, clearance_model, options).map_err(task_field)?;
+        planner.plan(initial, target).map_err(task_field)
     }
 
     /// The reference of kind `"planned"`: the plan's waypoints in `travel_time`
@@ -104,7 +105,7 @@ impl Scenario {
     /// reference.
     pub(super) fn planned_reference(
         &self,
-        model: &ReducedModel,
+        model: &PlantModel,
     ) -> Result<Option<Waypoints>, SimError> {
         match (&self.reference, &self.task) {
             (ReferenceSpec::Planned { travel_time }, Some(_)) => {
@@ -115,8 +116,8 @@ impl Scenario {
             }
             (ReferenceSpec::Planned { .. }, None) => Err(SimError::setting(
                 "reference",
-                "of kind \"planned\" follows the plan of a [task]: give one ([task] kind = \
-                 \"reach\", target, clearance)",
+                "of kind \"planned\" follows the plan of a [task] or a [deploy]: give one \
+                 ([task] kind = \"reach\", target, clearance)",
             )),
             (_, Some(_)) => Err(SimError::setting(
                 "task",
@@ -126,4 +127,22 @@ impl Scenario {
             (_, None) => Ok(None),
         }
     }
+}
+
+/// A planner's error as a setting error naming the task's field it comes from.
+fn task_field(e: PlanError) -> SimError {
+    let name = match &e {
+        PlanError::OutOfRange { name, .. } | PlanError::TooMany { name, .. } => match *name {
+            "clearance" => "task.clearance",
+            "check slack" => "task.check_slack",
+            "samples" => "task.samples",
+            "max iterations" => "task.max_iterations",
+            "target coordinate" => "task.target",
+            _ => "task",
+        },
+        PlanError::OutOfReach { .. } => "task.target",
+        PlanError::InitialTooClose { .. } => "initial.a",
+        _ => "task",
+    };
+    SimError::setting(name, format!("cannot be met: {e}"))
 }

@@ -13,6 +13,7 @@ static ALLOCATOR: test_support::alloc::CountingAllocator = test_support::alloc::
 mod allocation;
 mod bad_input;
 mod closed_loop;
+mod deploy;
 mod imitation;
 mod lockstep;
 mod long_runs;

@@ -79,9 +79,9 @@ fn every_paper_summary_is_unchanged() {
     }
 }
 
-/// The spatial arms' runs must not move either: `spatial-tracking` and `spatial-long` with every
-/// controller but MPC (minutes in a debug build), pinned to 1e-9 relative in
-/// `tests/it/data/spatial_summaries.json`.
+/// The spatial arms' runs must not move either: `spatial-tracking`, `spatial-long` and
+/// `spatial-clutter` (planned, then tracked) with every controller but MPC (minutes in a debug
+/// build), pinned to 1e-9 relative in `tests/it/data/spatial_summaries.json`.
 #[test]
 fn every_spatial_summary_is_unchanged() {
     let pinned: Value =
@@ -94,9 +94,10 @@ fn every_spatial_summary_is_unchanged() {
         ControllerKind::FuzzyGc,
         ControllerKind::Lqr,
     ];
-    assert_eq!(pinned.len(), 2 * kinds.len());
+    let names = ["spatial-tracking", "spatial-long", "spatial-clutter"];
+    assert_eq!(pinned.len(), names.len() * kinds.len());
     for (k, entry) in pinned.iter().enumerate() {
-        let name = ["spatial-tracking", "spatial-long"][k / kinds.len()];
+        let name = names[k / kinds.len()];
         let kind = kinds[k % kinds.len()];
         assert_eq!(entry["scenario"], name);
         assert_eq!(entry["controller"], kind.name());

@@ -1,11 +1,15 @@
-//! `[task]` scenarios: planned first, then tracked. `narrow-gap` ends on its target and holds it
-//! with computed torque and with MPC, keeping the clearance the plan promised up to the
-//! tracking error, while the closed-form `K = 1` shapes a controller would be given without a
-//! plan collide.
+//! `[task]` scenarios: planned first, then tracked. `narrow-gap` (planar) and `spatial-clutter`
+//! (spatial) end on their targets and hold them with computed torque and with MPC, keeping the
+//! clearance the plan promised up to the tracking error, while the free-space shapes a
+//! controller would be given without a plan (the closed-form `K = 1` shapes, the spatial
+//! inverse kinematics') collide.
 
-use backbone_kin::{BaseAngle, Branch, ModalMap, chain_inverse_kinematics, joint_positions};
+use backbone_kin::{
+    BaseAngle, Branch, ModalMap, SpatialIk, chain_inverse_kinematics, joint_positions,
+    spatial_joint_positions,
+};
 use sim_study::study::run_one;
-use sim_study::{ControllerKind, ReferenceSpec, Scenario, TaskSpec, Workspace};
+use sim_study::{ControllerKind, ObstacleSpec, ReferenceSpec, Scenario, TaskSpec, Workspace};
 
 fn target(scenario: &Scenario) -> [f64; 2] {
     let Some(TaskSpec::Reach { target, .. }) = &scenario.task else {
@@ -110,11 +114,37 @@ fn tasks_and_planned_references_come_together_and_name_their_fields() {
         e.starts_with("task cannot be met: no collision-free shape found"),
         "{e}"
     );
-    // A spatial arm is not planned: its [task] is refused by name, not ignored.
-    let mut spatial = Scenario::builtin("spatial-tracking").unwrap();
+    // A spatial arm's target is a point in space: the plane's [x, y] is refused by name.
+    let mut spatial = Scenario::builtin("spatial-clutter").unwrap();
     spatial.task = base.task.clone();
     let e = spatial.build().err().unwrap().to_string();
-    assert!(e.starts_with("task is planned for planar arms only"), "{e}");
+    assert!(
+        e.starts_with("task.target must be a point [x, y, z], got 2 numbers"),
+        "{e}"
+    );
+    let e = {
+        let mut s = spatial.clone();
+        set(&mut s, vec![1.5, 0.0, 0.0], 0.01);
+        s.build().err().unwrap().to_string()
+    };
+    assert!(
+        e.starts_with("task.target cannot be met: target is 1.5 m"),
+        "{e}"
+    );
+    // A spatial target inside an obstacle (the first sphere's centre).
+    let centre = match &spatial.obstacles[0] {
+        ObstacleSpec::Sphere { center, .. } => center.clone(),
+        other => panic!("spatial-clutter's first obstacle is a sphere, got {other:?}"),
+    };
+    let e = {
+        let mut s = spatial.clone();
+        set(&mut s, centre, 0.01);
+        s.build().err().unwrap().to_string()
+    };
+    assert!(
+        e.starts_with("task cannot be met: no collision-free shape found"),
+        "{e}"
+    );
     let text = base.to_toml();
     assert_eq!(Scenario::from_toml(&text).unwrap(), base);
 }
@@ -151,6 +181,130 @@ fn a_controller_given_the_closed_form_goal_collides_where_the_planned_run_keeps_
             .unwrap_or_else(|f| panic!("{branch:?}: {}", f.error));
         let clearance = run.summary.min_clearance_m.unwrap();
         assert!(clearance < 0.0, "{branch:?}: {clearance} m");
+    }
+    // Planned and tracked, the same controller keeps the margin less the tracking error.
+    let run = run_one(&planned, ControllerKind::ComputedTorque)
+        .result
+        .unwrap();
+    assert!(run.summary.min_clearance_m.unwrap() > 0.005);
+}
+
+/// The target of `spatial-clutter`, `[x, y, z]`.
+fn spatial_target(scenario: &Scenario) -> [f64; 3] {
+    let Some(TaskSpec::Reach { target, .. }) = &scenario.task else {
+        panic!("spatial-clutter has a reach task")
+    };
+    [target[0], target[1], target[2]]
+}
+
+/// The smallest signed distance between the capsules of radius `radius` around the chain of
+/// joint points `p` and the obstacles, by sampling each link's axis densely (an independent
+/// check of the clearance crate's closed forms: a capsule's distance is its axis' less the
+/// radius).
+fn sampled_clearance(p: &[[f64; 3]], radius: f64, obstacles: &[clearance::Obstacle]) -> f64 {
+    let mut smallest = f64::INFINITY;
+    for link in p.windows(2) {
+        for k in 0..=200 {
+            let t = k as f64 / 200.0;
+            let q: [f64; 3] = std::array::from_fn(|d| link[0][d] + t * (link[1][d] - link[0][d]));
+            for o in obstacles {
+                smallest = smallest.min(o.signed_distance(q) - radius);
+            }
+        }
+    }
+    smallest
+}
+
+#[test]
+fn spatial_clutter_is_planned_then_reached_and_held() {
+    let scenario = Scenario::builtin("spatial-clutter").unwrap();
+    let target = spatial_target(&scenario);
+    let plan = scenario.plan().unwrap().unwrap();
+    assert!(plan.goal_clearance >= 0.01 && plan.tip_error <= 1e-6);
+    // The goal shape's tip and clearance, recomputed from the chain's own kinematics and by
+    // sampling the links against the obstacles' distance functions.
+    let model = scenario.spatial_model().unwrap();
+    let map = model.map();
+    let mut theta = vec![0.0; map.n_joints()];
+    map.joint_angles(&plan.goal, &mut theta).unwrap();
+    let mut p = vec![[0.0; 3]; model.n_links() + 1];
+    spatial_joint_positions(map.link_lengths(), model.base(), &theta, &mut p).unwrap();
+    let tip = p[model.n_links()];
+    assert!((0..3).all(|d| (tip[d] - target[d]).abs() < 1e-6), "{tip:?}");
+    let obstacles = scenario.obstacles(Workspace::Spatial).unwrap();
+    let radius = scenario.arm.radius.unwrap();
+    assert!(sampled_clearance(&p, radius, &obstacles) >= 0.01 - 1e-9);
+    for kind in [ControllerKind::ComputedTorque, ControllerKind::Mpc] {
+        let run = run_one(&scenario, kind)
+            .result
+            .unwrap_or_else(|f| panic!("{kind}: {}", f.error));
+        let record = &run.record;
+        let last = record.len() - 1;
+        let miss = |k: usize| {
+            let d = [
+                record.tip[k][0] - target[0],
+                record.tip[k][1] - target[1],
+                record.tip_z[k] - target[2],
+            ];
+            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+        };
+        let hold_from = record
+            .t
+            .iter()
+            .position(|&t| t >= scenario.duration - 0.5)
+            .unwrap();
+        let worst_hold = (hold_from..=last).map(miss).fold(0.0, f64::max);
+        assert!(miss(last) < 3e-3, "{kind}: {} m", miss(last));
+        assert!(worst_hold < 3e-3, "{kind}: {} m while holding", worst_hold);
+        let clearance = run.summary.min_clearance_m.unwrap();
+        assert!(clearance > 0.005, "{kind}: {clearance} m");
+    }
+}
+
+#[test]
+fn a_controller_given_the_free_space_ik_shape_collides_where_the_planned_spatial_run_keeps_the_margin()
+ {
+    let planned = Scenario::builtin("spatial-clutter").unwrap();
+    let target = spatial_target(&planned);
+    let model = planned.spatial_model().unwrap();
+    let map = model.map();
+    let obstacles = planned.obstacles(Workspace::Spatial).unwrap();
+    let radius = planned.arm.radius.unwrap();
+    let mut ik = SpatialIk::new(map.clone(), *model.base()).unwrap();
+    // The free-space inverse kinematics from the guesses bent in both planes that the planner
+    // starts from (the straight arm is singular for the solver).
+    let mut shapes: Vec<Vec<f64>> = Vec::new();
+    for (z, y) in [(0.5, 0.5), (-0.5, 0.5), (0.5, -0.5), (-0.5, -0.5)] {
+        let mut a = vec![z, 0.0, y, 0.0];
+        let solved = ik.solve(target, &mut a).is_ok();
+        if solved
+            && shapes
+                .iter()
+                .all(|s| s.iter().zip(&a).any(|(x, y)| (x - y).abs() > 1e-6))
+        {
+            shapes.push(a);
+        }
+    }
+    assert!(shapes.len() >= 2, "{shapes:?}");
+    let mut theta = vec![0.0; map.n_joints()];
+    let mut p = vec![[0.0; 3]; model.n_links() + 1];
+    for a in &shapes {
+        // The shape reaches the target but runs a link into an obstacle.
+        map.joint_angles(a, &mut theta).unwrap();
+        spatial_joint_positions(map.link_lengths(), model.base(), &theta, &mut p).unwrap();
+        let tip = p[model.n_links()];
+        assert!((0..3).all(|d| (tip[d] - target[d]).abs() < 1e-6), "{a:?}");
+        assert!(sampled_clearance(&p, radius, &obstacles) < 0.0, "{a:?}");
+        // Given that shape as a constant reference and no plan, computed torque drives the arm
+        // into the obstacle.
+        let mut unplanned = planned.clone();
+        unplanned.task = None;
+        unplanned.reference = ReferenceSpec::Constant { a: a.clone() };
+        let run = run_one(&unplanned, ControllerKind::ComputedTorque)
+            .result
+            .unwrap_or_else(|f| panic!("{a:?}: {}", f.error));
+        let clearance = run.summary.min_clearance_m.unwrap();
+        assert!(clearance < 0.0, "{a:?}: {clearance} m");
     }
     // Planned and tracked, the same controller keeps the margin less the tracking error.
     let run = run_one(&planned, ControllerKind::ComputedTorque)

@@ -1,0 +1,304 @@
+//! Runs of a scenario with a `[deploy]` (follow-the-leader deployment on an insertion axis,
+//! [`Scenario::run_deploy`]): `hrm simulate` and the main job write `scenario.toml`,
+//! `summary.json` (the joint-space run's fields and the deployment metrics), `timeseries.csv`
+//! (`t`, then `q_i`, `q_ref_i`, `tau_i` per joint, the insertion first) and `links.csv`; the main
+//! job also draws the arm in the channel and its clearance to the walls over time.
+
+use crate::chain_simulate::{chain_summary, chain_timeseries, write};
+use crate::output_dir::OutputDir;
+use crate::plot::{self, Labels, Series, Style};
+use crate::{console, report};
+use lane_math::Compact;
+use serde_json::json;
+use sim_study::{DeployRun, Scenario};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Interval between the drawn arm shapes (s).
+const SHAPE_INTERVAL_S: f64 = 0.5;
+
+/// Runs `scenario` (with a `[deploy]`) and writes its files into `out`; a run that fails writes
+/// nothing.
+pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
+    let run = scenario.run_deploy().map_err(|e| e.to_string())?;
+    let staging = OutputDir::create(out, "simulate")?;
+    write_run(staging.path(), scenario, &run)?;
+    staging.commit()?;
+    console::print(&format!(
+        "{}\nwrote {}\n",
+        headline(scenario, &run),
+        out.display()
+    ))
+}
+
+/// One line on the run: the deployment metrics.
+pub fn headline(scenario: &Scenario, run: &DeployRun) -> String {
+    let m = &run.metrics;
+    format!(
+        "{}: computed torque deploying the arm on its insertion axis: tip error {:.3} mm, \
+         shape deviation {:.2}% of the deployed length, smallest wall clearance {:.2} mm, \
+         final |q - q_ref| {:.3e}",
+        scenario.name,
+        1e3 * m.tip_error,
+        m.shape_deviation_percent,
+        1e3 * m.min_wall_clearance,
+        run.run.summary.final_error
+    )
+}
+
+/// The run's `summary.json`: [`chain_summary`]'s fields, then `deploy_tip_error_m`,
+/// `deploy_shape_deviation_pct`, `deploy_min_wall_clearance_m` and `deploy_length_m` of the run
+/// (over every recorded sample, the rows of `links.csv`) and the same of the kinematic plan it
+/// tracked under `plan`.
+pub fn summary(scenario: &Scenario, run: &DeployRun) -> serde_json::Value {
+    let mut summary = chain_summary(scenario, "deploy", &run.run);
+    let metrics = |m: &sim_study::DeployMetrics| {
+        json!({
+            "deploy_tip_error_m": m.tip_error,
+            "deploy_shape_deviation_pct": m.shape_deviation_percent,
+            "deploy_min_wall_clearance_m": m.min_wall_clearance,
+            "deploy_length_m": m.deployed_length,
+        })
+    };
+    if let (Some(fields), serde_json::Value::Object(own)) =
+        (summary.as_object_mut(), metrics(&run.metrics))
+    {
+        fields.extend(own);
+        fields.insert("plan".into(), metrics(&run.plan));
+    }
+    summary
+}
+
+/// Writes `scenario.toml`, `summary.json`, `timeseries.csv` and `links.csv` of `run` into
+/// `dir` (created if needed).
+pub fn write_run(dir: &Path, scenario: &Scenario, run: &DeployRun) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let text = serde_json::to_string_pretty(&summary(scenario, run)).map_err(|e| e.to_string())?;
+    write(&dir.join("summary.json"), &(text + "\n"))?;
+    write(&dir.join("scenario.toml"), &scenario.to_toml())?;
+    write(&dir.join("timeseries.csv"), &chain_timeseries(&run.run))?;
+    write(&dir.join("links.csv"), &links_csv(run))
+}
+
+/// `t, x0, y0, x1, y1, ...`: the base and every link's end at each recorded sample.
+fn links_csv(run: &DeployRun) -> String {
+    let t = &run.run.record.t;
+    let points = run.points.len() / t.len().max(1);
+    let mut csv = String::from("t");
+    for j in 0..points {
+        let _ = write!(csv, ",x{j},y{j}");
+    }
+    csv.push('\n');
+    for (k, time) in t.iter().enumerate() {
+        let _ = write!(csv, "{}", Compact(*time));
+        for p in run.points_at(k) {
+            let _ = write!(csv, ",{},{}", Compact(p[0]), Compact(p[1]));
+        }
+        csv.push('\n');
+    }
+    csv
+}
+
+/// The channel's two walls (the centreline offset by its radius on either side, the guide
+/// behind the entry included, `behind` metres long) as drawable curves.
+fn walls(run: &DeployRun, behind: f64) -> [Vec<(f64, f64)>; 2] {
+    let channel = &run.channel;
+    let length = channel.length();
+    let samples = 400;
+    let mut sides = [Vec::new(), Vec::new()];
+    for k in 0..=samples {
+        let sigma = -behind + (length + behind) * k as f64 / samples as f64;
+        let step = 1e-4 * (length + behind);
+        let (a, b) = (
+            channel.point_at((sigma - step).max(-behind)),
+            channel.point_at((sigma + step).min(length)),
+        );
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let norm = dx.hypot(dy);
+        let normal = [-dy / norm, dx / norm];
+        let p = channel.point_at(sigma);
+        for (side, sign) in sides.iter_mut().zip([1.0, -1.0]) {
+            side.push((
+                p[0] + sign * channel.radius() * normal[0],
+                p[1] + sign * channel.radius() * normal[1],
+            ));
+        }
+    }
+    sides
+}
+
+/// Draws the run into `dir`: `deploy_<name>.svg` (the walls, the arm every
+/// [`SHAPE_INTERVAL_S`] light to dark, the tip's trace) and `deploy_clearance_<name>.svg` (the
+/// smallest wall clearance and the tip's distance from the centreline over time, mm); returns
+/// the report's figures.
+pub fn figures(
+    dir: &Path,
+    scenario: &Scenario,
+    run: &DeployRun,
+) -> Result<Vec<report::Figure>, String> {
+    let name = &scenario.name;
+    let t = &run.run.record.t;
+    let arm_length: f64 = {
+        let shape = run.points_at(0);
+        shape
+            .windows(2)
+            .map(|p| (p[1][0] - p[0][0]).hypot(p[1][1] - p[0][1]))
+            .sum()
+    };
+    let mut curves = Vec::new();
+    for (side, label) in walls(run, arm_length)
+        .into_iter()
+        .zip(["channel walls", ""])
+    {
+        curves.push((
+            Series {
+                label: label.into(),
+                points: side,
+            },
+            Style {
+                colour: (90, 90, 90),
+                width: 2,
+                dots: false,
+            },
+        ));
+    }
+    let every =
+        ((SHAPE_INTERVAL_S / (t[1.min(t.len() - 1)] - t[0]).max(1e-12)).round() as usize).max(1);
+    let shown: Vec<usize> = (0..t.len()).step_by(every).chain([t.len() - 1]).collect();
+    let last = shown.len().saturating_sub(1).max(1) as f64;
+    for (i, &k) in shown.iter().enumerate() {
+        let shade = |light: f64, dark: f64| (light + (dark - light) * i as f64 / last) as u8;
+        curves.push((
+            Series {
+                label: if i == 0 || i + 1 == shown.len() {
+                    format!("arm at t = {:.1} s", t[k])
+                } else {
+                    String::new()
+                },
+                points: run.points_at(k).iter().map(|p| (p[0], p[1])).collect(),
+            },
+            Style {
+                colour: (shade(170.0, 10.0), shade(200.0, 40.0), shade(240.0, 140.0)),
+                width: 2,
+                dots: true,
+            },
+        ));
+    }
+    curves.push((
+        Series {
+            label: "tip".into(),
+            points: (0..t.len())
+                .map(|k| {
+                    let tip = run.points_at(k).last().copied().unwrap_or_default();
+                    (tip[0], tip[1])
+                })
+                .collect(),
+        },
+        Style {
+            colour: (20, 150, 60),
+            width: 1,
+            dots: false,
+        },
+    ));
+    let shapes = format!("deploy_{name}.svg");
+    let title = format!("{name}: the arm every {SHAPE_INTERVAL_S} s in the channel");
+    plot::xy_chart(
+        &dir.join(&shapes),
+        &Labels {
+            title: &title,
+            x: "x (m)",
+            y: "y (m)",
+        },
+        &curves,
+    )?;
+    let clearance = format!("deploy_clearance_{name}.svg");
+    let series = [
+        Series {
+            label: "wall clearance".into(),
+            points: t
+                .iter()
+                .zip(&run.samples)
+                .map(|(t, s)| (*t, 1e3 * s.wall_clearance))
+                .collect(),
+        },
+        Series {
+            label: "tip error".into(),
+            points: t
+                .iter()
+                .zip(&run.samples)
+                .map(|(t, s)| (*t, 1e3 * s.tip_error))
+                .collect(),
+        },
+    ];
+    let title = format!("{name}: wall clearance and tip error (computed torque)");
+    plot::line_chart(
+        &dir.join(&clearance),
+        &Labels {
+            title: &title,
+            x: "t (s)",
+            y: "mm",
+        },
+        &series,
+        None,
+    )?;
+    let m = &run.metrics;
+    Ok(vec![
+        report::Figure {
+            file: format!("figures/{shapes}"),
+            caption: format!(
+                "{name} with computed-torque: the arm every {SHAPE_INTERVAL_S} s, light to dark, advancing on its insertion axis into the channel (grey walls), its body on the path its tip (green) traced; shape deviation {:.2}% of the deployed length at most.",
+                m.shape_deviation_percent
+            ),
+        },
+        report::Figure {
+            file: format!("figures/{clearance}"),
+            caption: format!(
+                "{name} with computed-torque: the body's smallest clearance to the walls (link capsules of the arm's radius; above zero: inside) and the tip's distance from the centreline (mm) over time; at least {:.2} mm and at most {:.3} mm.",
+                1e3 * m.min_wall_clearance,
+                1e3 * m.tip_error
+            ),
+        },
+    ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pipe_deploy_writes_its_metrics_and_links() {
+        let mut scenario = Scenario::builtin("pipe-deploy").unwrap();
+        scenario.duration = 1.0;
+        let dir = std::env::temp_dir().join(format!("hrm-deploy-simulate-{}", std::process::id()));
+        simulate(&scenario, &dir).unwrap();
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["joints"], 11);
+        assert_eq!(summary["arm"], "deploy");
+        for key in [
+            "deploy_tip_error_m",
+            "deploy_shape_deviation_pct",
+            "deploy_min_wall_clearance_m",
+            "deploy_length_m",
+        ] {
+            assert!(
+                summary[key].is_number() && summary["plan"][key].is_number(),
+                "{key}"
+            );
+        }
+        assert!(summary["deploy_min_wall_clearance_m"].as_f64().unwrap() > 0.0);
+        let links = std::fs::read_to_string(dir.join("links.csv")).unwrap();
+        assert_eq!(links.lines().count(), 1 + 101);
+        assert_eq!(links.lines().next().unwrap().split(',').count(), 1 + 22);
+        let csv = std::fs::read_to_string(dir.join("timeseries.csv")).unwrap();
+        assert_eq!(csv.lines().next().unwrap().split(',').count(), 1 + 33);
+        // The main job's figures.
+        let run = scenario.run_deploy().unwrap();
+        let figures = figures(&dir, &scenario, &run).unwrap();
+        assert_eq!(figures.len(), 2);
+        let svg = std::fs::read_to_string(dir.join("deploy_pipe-deploy.svg")).unwrap();
+        assert!(svg.contains("channel walls"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,271 @@
+//! What every op of `hrm eval` shares: the kind and message of a failed request, a request's
+//! fields read with the JSON path of the one at fault, `"arm"` objects, the modal map of a
+//! request's coordinates, and the checks and layout of an answer.
+
+use backbone_kin::{BaseAngle, ModalMap, reduce_angle};
+use lane_math::{Classify, ErrorClass};
+use manip_dyn::ChainModel;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Deserializer};
+use serde_json::{Map, Value};
+use sim_study::ArmSpec;
+
+/// The category of a failed request, the `kind` field of an error answer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Kind {
+    /// Not valid UTF-8.
+    InvalidUtf8,
+    /// Not valid JSON.
+    Parse,
+    /// A line over [`MAX_LINE_BYTES`].
+    LineTooLong,
+    /// Valid JSON, but not a request of the documented shape (missing or mistyped field).
+    InvalidRequest,
+    /// An `op` this version does not know.
+    UnknownOp,
+    /// A library's refusal, in the library's own class (`docs/eval-protocol.md`: well-formed but
+    /// outside the model's domain, a target the curve cannot reach, a computation that failed
+    /// numerically).
+    Library(ErrorClass),
+}
+
+impl Kind {
+    pub(super) fn as_str(self) -> &'static str {
+        match self {
+            Kind::InvalidUtf8 => "invalid_utf8",
+            Kind::Parse => "parse",
+            Kind::LineTooLong => "line_too_long",
+            Kind::InvalidRequest => "invalid_request",
+            Kind::UnknownOp => "unknown_op",
+            Kind::Library(class) => class.name(),
+        }
+    }
+}
+
+/// A failed request: its kind and a readable message.
+#[derive(Debug)]
+pub(super) struct EvalError {
+    pub(super) kind: Kind,
+    pub(super) message: String,
+}
+
+impl EvalError {
+    pub(super) fn new(kind: Kind, message: impl Into<String>) -> Self {
+        Self {
+            kind,
+            message: message.into(),
+        }
+    }
+
+    pub(super) fn input(message: impl ToString) -> Self {
+        Self::new(Kind::Library(ErrorClass::InvalidInput), message.to_string())
+    }
+}
+
+/// A library error as an answer: its kind the error's [`ErrorClass`], its message the error's
+/// text.
+impl<E: Classify + std::fmt::Display> From<E> for EvalError {
+    fn from(error: E) -> Self {
+        Self::new(Kind::Library(error.class()), error.to_string())
+    }
+}
+
+pub(super) type EvalResult = Result<Map<String, Value>, EvalError>;
+
+/// Deserialises the request's remaining fields into the op's typed request; serde's own type
+/// errors name the JSON path of the field they are about (`arm.links: invalid type: ...`).
+pub(super) fn parse<T: DeserializeOwned>(request: Map<String, Value>) -> Result<T, EvalError> {
+    from_object(request).map_err(|e| EvalError::new(Kind::InvalidRequest, e))
+}
+
+/// Deserialises an object; an error's message gets the path of the field it is about in front
+/// when [`located`] finds one.
+pub(super) fn from_object<T: DeserializeOwned>(object: Map<String, Value>) -> Result<T, String> {
+    located(object).map_err(|(path, message)| match path {
+        Some(path) => format!("{path}: {message}"),
+        None => message,
+    })
+}
+
+/// Deserialises an object, answering an error as the dotted JSON path of the offending field
+/// (`theta[1]`, `arm.links`) and the message. Serde's own messages ([`SERDE_MESSAGES`]) name no
+/// field and get the path; the project's own messages name their field already and get none. A
+/// nested object's error (see [`arm_object`]) carries its inner path behind [`NESTED_PATH`],
+/// joined here to the outer one.
+pub(super) fn located<T: DeserializeOwned>(
+    object: Map<String, Value>,
+) -> Result<T, (Option<String>, String)> {
+    serde_path_to_error::deserialize(Value::Object(object)).map_err(|e| {
+        let path = e.path().to_string();
+        let message = e.into_inner().to_string();
+        if let Some((inner, message)) = message
+            .strip_prefix(NESTED_PATH)
+            .and_then(|nested| nested.split_once('\u{1}'))
+        {
+            let separator = if inner.starts_with('[') { "" } else { "." };
+            (
+                Some(format!("{path}{separator}{inner}")),
+                message.to_string(),
+            )
+        } else if path != "." && SERDE_MESSAGES.iter().any(|p| message.starts_with(p)) {
+            (Some(path), message)
+        } else {
+            (None, message)
+        }
+    })
+}
+
+/// How serde's default `de::Error` messages start: the errors that say what is wrong but not where.
+pub(super) const SERDE_MESSAGES: [&str; 7] = [
+    "invalid type:",
+    "invalid value:",
+    "invalid length ",
+    "unknown variant ",
+    "unknown field ",
+    "missing field ",
+    "duplicate field ",
+];
+
+/// Starts a nested object's error message as `NESTED_PATH path \u{1} message`, so that the
+/// enclosing [`located`] joins the field's path to the inner one (`arm` and `links` give
+/// `arm.links`). Every nested object is read inside an enclosing [`located`], which removes the
+/// mark.
+pub(super) const NESTED_PATH: &str = "\u{1}nested:";
+
+/// `"arm"`: an object of [`ArmSpec`] fields. Serde would also read a struct from an array of its
+/// fields in order, which no user means; anything but an object is refused.
+pub(super) fn arm_object<'de, D: Deserializer<'de>>(deserializer: D) -> Result<ArmSpec, D::Error> {
+    match Value::deserialize(deserializer)? {
+        Value::Object(fields) => located(fields).map_err(|(path, message)| {
+            serde::de::Error::custom(match path {
+                Some(path) => format!("{NESTED_PATH}{path}\u{1}{message}"),
+                None => message,
+            })
+        }),
+        other => Err(serde::de::Error::custom(format!(
+            "\"arm\" must be an object of arm fields, got {}",
+            json_type(&other)
+        ))),
+    }
+}
+
+/// An optional `"arm"` object, read as [`arm_object`] reads one.
+pub(super) fn optional_arm_object<'de, D: Deserializer<'de>>(
+    deserializer: D,
+) -> Result<Option<ArmSpec>, D::Error> {
+    arm_object(deserializer).map(Some)
+}
+
+/// The JSON type of a value, for messages.
+pub(super) fn json_type(value: &Value) -> &'static str {
+    match value {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    }
+}
+
+/// Most harmonics a request may ask for. A `K`-harmonic end point by quadrature costs up to
+/// `K` times [`backbone_kin::MAX_QUADRATURE_NODES`] basis evaluations, so this keeps one `fk`
+/// under about a second; the library's own limit ([`backbone_kin::MAX_HARMONICS`]) is far larger.
+pub(super) const MAX_REQUEST_HARMONICS: usize = 64;
+
+/// Largest magnitude of an `ik` guess entry (rad). The solvers are local and take steps of at
+/// most 0.5 rad, so this bounds the amplitudes they visit, and with them the quadrature's cost.
+pub(super) const MAX_GUESS: f64 = 10.0;
+
+/// `"harmonics"`: `K >= 1` (default 1), at most `max`.
+pub(super) fn harmonics(requested: Option<usize>, max: usize) -> Result<usize, EvalError> {
+    match requested.unwrap_or(1) {
+        0 => Err(EvalError::input("harmonics must be at least 1, got 0")),
+        k if k > max => Err(EvalError::input(format!(
+            "harmonics must be at most {max}, got {k}"
+        ))),
+        k => Ok(k),
+    }
+}
+
+/// Modal coordinates as requests give them: with `"alpha0"`, `a` has `2K` entries and `alpha0` is
+/// fixed; without it, `2K + 1` entries with `alpha0` last. Reduces `alpha0` (in `a` or the field)
+/// to `(-pi, pi]` and returns the modal map of the chain's own links.
+pub(super) fn modal_map(
+    chain: &ChainModel,
+    a: &mut [f64],
+    alpha0: Option<f64>,
+    requested: Option<usize>,
+) -> Result<ModalMap, EvalError> {
+    let k = harmonics(requested, MAX_REQUEST_HARMONICS)?;
+    let base = match (a.len(), alpha0) {
+        (len, Some(alpha0)) if len == 2 * k => BaseAngle::Fixed(reduce_angle(alpha0)),
+        (len, None) if len == 2 * k + 1 => {
+            a[2 * k] = reduce_angle(a[2 * k]);
+            BaseAngle::Free
+        }
+        (len, Some(_)) if len == 2 * k + 1 => {
+            return Err(EvalError::input(
+                "give alpha0 either as the last entry of a or as \"alpha0\", not both",
+            ));
+        }
+        (len, None) if len == 2 * k => {
+            return Err(EvalError::input(format!(
+                "with {len} coordinates (2K, K = {k}), \"alpha0\" is required"
+            )));
+        }
+        (len, _) => {
+            return Err(EvalError::input(format!(
+                "a has {len} entries, expected 2K = {} with \"alpha0\" given, or 2K + 1 = {} \
+                 with alpha0 last (K = {k} harmonics)",
+                2 * k,
+                2 * k + 1
+            )));
+        }
+    };
+    let (n, m) = (chain.n_links(), a.len());
+    let entries = n.saturating_mul(m);
+    if entries > MAX_MAP_ANSWER {
+        return Err(EvalError::input(format!(
+            "arm.links times the modal coordinates must be at most {MAX_MAP_ANSWER} (the n x m \
+             modal Jacobian a request may build and answer), got {n} x {m} = {entries}"
+        )));
+    }
+    let work = entries.saturating_mul(m);
+    if work > MAX_MAP_WORK {
+        return Err(EvalError::input(format!(
+            "arm.links times the square of the modal coordinates must be at most \
+             {MAX_MAP_WORK} (the work of M* = J^T M J), got {n} x {m}^2 = {work}"
+        )));
+    }
+    let lengths: Vec<f64> = chain.link_lengths().collect();
+    ModalMap::new(&lengths, k, base).map_err(EvalError::from)
+}
+
+/// Most entries `n m` of the modal Jacobian a request may build (`joints` answers all of them,
+/// about 100 MB of JSON at the limit): every one-link-per-coordinate arm up to
+/// [`backbone_kin::MAX_LINKS`] with 4 coordinates fits.
+pub(super) const MAX_MAP_ANSWER: usize = 1 << 22;
+
+/// Most work `n m^2` of a modal request (`M* = J^T M J` of `reduced` and its derivatives), about
+/// a tenth of a second.
+pub(super) const MAX_MAP_WORK: usize = 1 << 25;
+
+/// Refuses to answer with a non-finite number (JSON has none).
+pub(super) fn finite(name: &str, values: &[f64]) -> Result<(), EvalError> {
+    match lane_math::first_non_finite(values) {
+        Some((_, v)) => Err(EvalError::new(
+            Kind::Library(ErrorClass::Numerical),
+            format!("{name} came out non-finite ({v})"),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// An answer's fields, in order.
+pub(super) fn json_fields<const N: usize>(fields: [(&str, Value); N]) -> Map<String, Value> {
+    fields
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect()
+}

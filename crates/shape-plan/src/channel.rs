@@ -1,0 +1,131 @@
+//! A planar channel for follow-the-leader deployment: its centreline, the guide behind its
+//! entry, and distances to them.
+
+use crate::error::PlanError;
+use lane_math::check_finite;
+
+/// The most centreline points a [`Channel`] accepts.
+pub const MAX_CENTERLINE_POINTS: usize = 100_000;
+
+/// A planar channel: a centreline polyline (the plane `z = 0`) and its radius.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Channel {
+    points: Vec<[f64; 2]>,
+    /// Arc length at each point.
+    arcs: Vec<f64>,
+    radius: f64,
+}
+
+impl Channel {
+    /// A channel along `centerline` (at least two points, consecutive points distinct) of
+    /// `radius` (positive).
+    pub fn new(centerline: &[[f64; 2]], radius: f64) -> Result<Self, PlanError> {
+        if centerline.len() < 2 {
+            return Err(PlanError::Dimension {
+                name: "deploy centerline (at least 2 points)",
+                expected: 2,
+                found: centerline.len(),
+            });
+        }
+        if centerline.len() > MAX_CENTERLINE_POINTS {
+            return Err(PlanError::TooMany {
+                name: "deploy centerline points",
+                got: centerline.len(),
+                max: MAX_CENTERLINE_POINTS,
+            });
+        }
+        check_finite("deploy radius", radius)?;
+        if radius <= 0.0 {
+            return Err(PlanError::OutOfRange {
+                name: "deploy radius",
+                bound: "positive",
+                value: radius,
+            });
+        }
+        for x in centerline.iter().flatten() {
+            check_finite("deploy centerline coordinate", *x)?;
+        }
+        let mut arcs = vec![0.0];
+        for pair in centerline.windows(2) {
+            let step = dist(pair[0], pair[1]);
+            if step.is_nan() || step <= 0.0 {
+                return Err(PlanError::OutOfRange {
+                    name: "deploy centerline segment length",
+                    bound: "positive (consecutive points distinct)",
+                    value: step,
+                });
+            }
+            arcs.push(arcs.last().copied().unwrap_or(0.0) + step);
+        }
+        Ok(Self {
+            points: centerline.to_vec(),
+            arcs,
+            radius,
+        })
+    }
+
+    /// The centreline's length.
+    pub fn length(&self) -> f64 {
+        self.arcs.last().copied().unwrap_or(0.0)
+    }
+
+    /// The radius.
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// The entry `P_0`.
+    pub fn entry(&self) -> [f64; 2] {
+        self.points[0]
+    }
+
+    /// The insertion axis's direction `d` (unit).
+    pub fn axis(&self) -> [f64; 2] {
+        let (a, b) = (self.points[0], self.points[1]);
+        let length = dist(a, b);
+        [(b[0] - a[0]) / length, (b[1] - a[1]) / length]
+    }
+
+    /// `Gamma(sigma)`: on the axis behind the entry for `sigma <= 0`, on the centreline beyond
+    /// (held at its end past its length).
+    pub fn point_at(&self, sigma: f64) -> [f64; 2] {
+        if sigma <= 0.0 {
+            let (e, d) = (self.entry(), self.axis());
+            return [e[0] + sigma * d[0], e[1] + sigma * d[1]];
+        }
+        let k = self
+            .arcs
+            .partition_point(|&s| s <= sigma)
+            .min(self.points.len() - 1);
+        let (a, b) = (self.points[k - 1], self.points[k]);
+        let t = ((sigma - self.arcs[k - 1]) / (self.arcs[k] - self.arcs[k - 1])).min(1.0);
+        [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
+    }
+
+    /// The distance of `x` from the guide (the axis behind the entry) and the centreline.
+    pub fn distance(&self, x: [f64; 2]) -> f64 {
+        let (e, d) = (self.entry(), self.axis());
+        // The ray E - s d, s >= 0.
+        let along = ((x[0] - e[0]) * d[0] + (x[1] - e[1]) * d[1]).min(0.0);
+        let mut best = dist(x, [e[0] + along * d[0], e[1] + along * d[1]]);
+        for pair in self.points.windows(2) {
+            best = best.min(point_segment(x, pair[0], pair[1]));
+        }
+        best
+    }
+}
+
+pub(crate) fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+pub(crate) fn point_segment(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let length2 = d[0] * d[0] + d[1] * d[1];
+    let t = if length2 > 0.0 {
+        (((x[0] - a[0]) * d[0] + (x[1] - a[1]) * d[1]) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    dist(x, [a[0] + t * d[0], a[1] + t * d[1]])
+}

@@ -1,0 +1,159 @@
+//! The metrics of a follow-the-leader deployment, accumulated over its shapes: those of the
+//! kinematic plan ([`follow_the_leader`](crate::follow_the_leader)) and those of a dynamic run
+//! that tracks it (`docs/theory.md`, "Follow-the-leader deployment").
+
+use crate::channel::{Channel, dist, point_segment};
+use crate::error::PlanError;
+use lane_math::check_finite;
+
+/// Points per link at which the body's distances to the path and the walls are sampled (both
+/// ends included).
+pub const SAMPLES_PER_LINK: usize = 32;
+
+/// What a deployment achieved, over all its shapes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DeployMetrics {
+    /// The largest distance of the tip from the centreline (with the guide behind the entry),
+    /// m.
+    pub tip_error: f64,
+    /// The largest distance of the body from the path its tip traced (joined to the entry and
+    /// the guide behind it), as a percentage of the deployed length at that shape (at least the
+    /// shortest link).
+    pub shape_deviation_percent: f64,
+    /// The smallest clearance of the links' capsules to the channel's walls, m (sampled at
+    /// [`SAMPLES_PER_LINK`] points a link; the sampling can overstate it by at most
+    /// `L_max / 64`).
+    pub min_wall_clearance: f64,
+    /// The deployed length of the last shape, m.
+    pub deployed_length: f64,
+}
+
+/// The metrics of one shape of a deployment ([`DeployTracker::add`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DeploySample {
+    /// The tip's distance from the centreline, m.
+    pub tip_error: f64,
+    /// The body's largest distance from the traced path, % of the deployed length.
+    pub shape_deviation_percent: f64,
+    /// The body's smallest clearance to the walls, m.
+    pub wall_clearance: f64,
+}
+
+/// Accumulates [`DeployMetrics`] over the shapes of a deployment, in time order: each shape's
+/// tip joins the traced path the later shapes are measured against.
+///
+/// ```
+/// use shape_plan::{Channel, DeployTracker};
+/// let channel = Channel::new(&[[0.0, 0.0], [1.0, 0.0]], 0.05)?;
+/// let mut tracker = DeployTracker::new(&channel, &[0.5, 0.5], 0.01)?;
+/// tracker.add(&[[-0.7, 0.0], [-0.2, 0.0], [0.3, 0.0]], 0.3);
+/// let metrics = tracker.metrics();
+/// assert!(metrics.tip_error < 1e-15 && metrics.shape_deviation_percent < 1e-12);
+/// assert!((metrics.min_wall_clearance - 0.04).abs() < 1e-15);
+/// # Ok::<(), shape_plan::PlanError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct DeployTracker<'c> {
+    channel: &'c Channel,
+    link_radius: f64,
+    shortest: f64,
+    traced: Vec<[f64; 2]>,
+    metrics: DeployMetrics,
+}
+
+impl<'c> DeployTracker<'c> {
+    /// A tracker of the chain of `link_lengths` (at least one, each positive), its links
+    /// capsules of `link_radius` (non-negative), in `channel`.
+    pub fn new(
+        channel: &'c Channel,
+        link_lengths: &[f64],
+        link_radius: f64,
+    ) -> Result<Self, PlanError> {
+        check_finite("link radius", link_radius)?;
+        if link_radius < 0.0 {
+            return Err(PlanError::OutOfRange {
+                name: "link radius",
+                bound: "non-negative",
+                value: link_radius,
+            });
+        }
+        let shortest = link_lengths.iter().copied().fold(f64::INFINITY, f64::min);
+        if !(shortest.is_finite() && shortest > 0.0) {
+            return Err(PlanError::OutOfRange {
+                name: "deploy link length",
+                bound: "positive and finite, at least one link",
+                value: shortest,
+            });
+        }
+        Ok(Self {
+            channel,
+            link_radius,
+            shortest,
+            traced: Vec::new(),
+            metrics: DeployMetrics {
+                tip_error: 0.0,
+                shape_deviation_percent: 0.0,
+                min_wall_clearance: f64::INFINITY,
+                deployed_length: 0.0,
+            },
+        })
+    }
+
+    /// Adds the shape of joint points `points` (base first, the tip last, at least one) at the
+    /// deployed length `deployed` (m) and returns its own metrics: the tip's distance from the
+    /// centreline, the body's largest distance from the traced path (this tip included) over
+    /// `max(deployed, shortest link)`, and the body's smallest clearance to the walls.
+    pub fn add(&mut self, points: &[[f64; 2]], deployed: f64) -> DeploySample {
+        let tip = points.last().copied().unwrap_or(self.channel.entry());
+        self.traced.push(tip);
+        let channel = self.channel;
+        let mut sample = DeploySample {
+            tip_error: channel.distance(tip),
+            shape_deviation_percent: 0.0,
+            wall_clearance: f64::INFINITY,
+        };
+        let mut deviation: f64 = 0.0;
+        for pair in points.windows(2) {
+            for s in 0..=SAMPLES_PER_LINK {
+                let t = s as f64 / SAMPLES_PER_LINK as f64;
+                let x = [
+                    pair[0][0] + t * (pair[1][0] - pair[0][0]),
+                    pair[0][1] + t * (pair[1][1] - pair[0][1]),
+                ];
+                sample.wall_clearance = sample
+                    .wall_clearance
+                    .min(channel.radius() - self.link_radius - channel.distance(x));
+                deviation = deviation.max(traced_distance(channel, &self.traced, x));
+            }
+        }
+        sample.shape_deviation_percent = 100.0 * deviation / deployed.max(self.shortest);
+        let metrics = &mut self.metrics;
+        metrics.tip_error = metrics.tip_error.max(sample.tip_error);
+        metrics.shape_deviation_percent = metrics
+            .shape_deviation_percent
+            .max(sample.shape_deviation_percent);
+        metrics.min_wall_clearance = metrics.min_wall_clearance.min(sample.wall_clearance);
+        metrics.deployed_length = deployed;
+        sample
+    }
+
+    /// The metrics of the shapes added so far.
+    pub fn metrics(&self) -> DeployMetrics {
+        self.metrics
+    }
+}
+
+/// The distance of `x` from the tip's traced polyline joined to the entry and the guide behind
+/// it.
+fn traced_distance(channel: &Channel, traced: &[[f64; 2]], x: [f64; 2]) -> f64 {
+    let (e, d) = (channel.entry(), channel.axis());
+    let along = ((x[0] - e[0]) * d[0] + (x[1] - e[1]) * d[1]).min(0.0);
+    let mut best = dist(x, [e[0] + along * d[0], e[1] + along * d[1]]);
+    if let Some(first) = traced.first() {
+        best = best.min(point_segment(x, e, *first));
+    }
+    for pair in traced.windows(2) {
+        best = best.min(point_segment(x, pair[0], pair[1]));
+    }
+    best
+}
