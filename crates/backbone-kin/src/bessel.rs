@@ -8,7 +8,7 @@
 use std::sync::OnceLock;
 
 use crate::error::KinError;
-use crate::validate::check_finite;
+use lane_math::check_finite;
 
 /// `j_{0,1}`, the first positive zero of `J0`: the end of the branch [`inverse_j0`] inverts.
 pub const J0_FIRST_ZERO: f64 = 2.404_825_557_695_773;

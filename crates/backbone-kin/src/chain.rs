@@ -7,7 +7,8 @@
 //! is the midpoint rule applied to the end-point integral of eqs 3-4.
 
 use crate::error::KinError;
-use crate::validate::{check_len, check_link_lengths, check_output_len};
+use crate::validate::check_link_lengths;
+use lane_math::{check_len, check_values};
 
 /// Every joint position from the base to the tip: `positions[0]` is the base (the origin),
 /// `positions[i]` the distal end of link `i` (0-based: of `link_lengths[i - 1]`), and
@@ -27,7 +28,7 @@ pub fn joint_positions(
     positions: &mut [[f64; 2]],
 ) -> Result<(), KinError> {
     check_chain(link_lengths, theta)?;
-    check_output_len("joint positions", positions.len(), link_lengths.len() + 1)?;
+    check_len("joint positions", positions.len(), link_lengths.len() + 1)?;
     positions[0] = [0.0; 2];
     let mut i = 0;
     walk(link_lengths, theta, |point| {
@@ -65,5 +66,6 @@ fn walk(link_lengths: &[f64], theta: &[f64], mut visit: impl FnMut([f64; 2])) {
 
 fn check_chain(link_lengths: &[f64], theta: &[f64]) -> Result<(), KinError> {
     check_link_lengths(link_lengths)?;
-    check_len("joint angles", theta, link_lengths.len())
+    check_values("joint angles", theta, link_lengths.len())?;
+    Ok(())
 }

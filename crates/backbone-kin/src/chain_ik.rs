@@ -27,7 +27,8 @@ use crate::closed_form::{Branch, inverse_kinematics};
 use crate::error::KinError;
 use crate::harmonic_ik::{IkOptions, IkReport, Workspace, least_squares};
 use crate::modal_map::{check_harmonics, harmonic_basis};
-use crate::validate::{check_count, check_finite, check_len, check_link_lengths, check_output_len};
+use crate::validate::{check_count, check_link_lengths};
+use lane_math::{check_finite, check_len, check_values};
 
 /// Reusable inverse kinematics of a chain of given link lengths whose joint angles follow the
 /// `K`-harmonic modal map with `alpha0` fixed (eqs 7-8). Created once;
@@ -120,7 +121,7 @@ impl ChainIk {
     pub fn solve(&mut self, target: [f64; 2], a: &mut [f64]) -> Result<IkReport, KinError> {
         check_finite("target x", target[0])?;
         check_finite("target y", target[1])?;
-        check_len("initial guess", a, self.trial.len())?;
+        check_values("initial guess", a, self.trial.len())?;
         let r = target[0].hypot(target[1]);
         if r > self.length {
             return Err(KinError::OutOfReach {
@@ -156,7 +157,7 @@ impl ChainIk {
         branch: Branch,
         a: &mut [f64],
     ) -> Result<IkReport, KinError> {
-        check_output_len("modal coordinates", a.len(), self.trial.len())?;
+        check_len("modal coordinates", a.len(), self.trial.len())?;
         let start = inverse_kinematics(self.length, target, self.alpha0, branch)?;
         a.fill(0.0);
         a[..2].copy_from_slice(&start);

@@ -8,7 +8,8 @@
 
 use crate::bessel::inverse_j0;
 use crate::error::KinError;
-use crate::validate::{check_finite, check_length};
+use crate::validate::check_length;
+use lane_math::check_finite;
 
 /// The sign branch of `a1 = ±sqrt(A^2 - a2^2)` (eq 6): the two mirror-image curves that reach
 /// the same target with the same `alpha0`.

@@ -14,7 +14,8 @@ use crate::closed_form::bessel_end_point;
 use crate::error::KinError;
 use crate::modal_map::harmonic_basis;
 use crate::quadrature::{self, Resolution};
-use crate::validate::{check_finite, check_len, check_length, check_output_len};
+use crate::validate::check_length;
+use lane_math::{check_finite, check_len, check_values};
 use std::f64::consts::TAU;
 
 /// Bound on the quadrature (truncation) error of [`BackboneCurve::point`] and of the `K > 1`
@@ -69,7 +70,7 @@ impl BackboneCurve {
         if modes.len() % 2 == 1 {
             return Err(KinError::UnpairedModes { got: modes.len() });
         }
-        check_len("modal coordinates", modes, modes.len())?;
+        check_values("modal coordinates", modes, modes.len())?;
         check_finite("alpha0", alpha0)?;
         Ok(Self {
             length,
@@ -87,7 +88,7 @@ impl BackboneCurve {
     /// Replaces the modal coordinates, keeping `K`, the length and `alpha0`. Allocation-free;
     /// on error the curve is unchanged.
     pub fn set_modes(&mut self, modes: &[f64]) -> Result<(), KinError> {
-        check_len("modal coordinates", modes, self.modes.len())?;
+        check_values("modal coordinates", modes, self.modes.len())?;
         self.resolution = resolution(self.length, modes, QUADRATURE_TOLERANCE)?;
         self.modes.copy_from_slice(modes);
         Ok(())
@@ -175,7 +176,7 @@ impl BackboneCurve {
     /// more in the strip).
     pub fn end_point_jacobian(&self, jacobian: &mut [f64]) -> Result<[f64; 2], KinError> {
         let m = self.modes.len();
-        check_output_len("end-point jacobian", jacobian.len(), 2 * m)?;
+        check_len("end-point jacobian", jacobian.len(), 2 * m)?;
         jacobian.fill(0.0);
         let (dx, dy) = jacobian.split_at_mut(m);
         let mut point = [0.0; 2];

@@ -1,6 +1,6 @@
 //! The error type of this crate.
 
-use lane_math::{Classify, ErrorClass};
+use lane_math::{Classify, EntryIndex, ErrorClass, ShapeError, ShapeProblem};
 
 /// Why a kinematics computation was refused.
 ///
@@ -14,7 +14,7 @@ use lane_math::{Classify, ErrorClass};
 #[non_exhaustive]
 pub enum KinError {
     /// An input that must be a finite number was NaN or infinite.
-    #[error("{name}{} must be finite, got {value}", Index(*index))]
+    #[error("{name}{} must be finite, got {value}", EntryIndex(*index))]
     NonFinite {
         /// Which input.
         name: &'static str,
@@ -168,14 +168,36 @@ impl Classify for KinError {
     }
 }
 
-/// `[i]` after an input's name when the offending value is entry `i` of a slice.
-struct Index(Option<usize>);
+/// A refused shape or non-finite input as [`KinError::Dimension`] or [`KinError::NonFinite`],
+/// with the same message.
+impl From<ShapeError<'static>> for KinError {
+    fn from(error: ShapeError<'static>) -> Self {
+        let name = error.name;
+        match error.problem {
+            ShapeProblem::Length { expected, found } => Self::Dimension {
+                name,
+                expected,
+                found,
+            },
+            ShapeProblem::NonFinite { index, value } => Self::NonFinite { name, index, value },
+        }
+    }
+}
 
-impl std::fmt::Display for Index {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.0 {
-            Some(index) => write!(f, "[{index}]"),
-            None => Ok(()),
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shape_error_keeps_its_message() {
+        for error in [
+            lane_math::check_len("joint output", 3, 2).unwrap_err(),
+            lane_math::check_finite("alpha0", f64::NAN).unwrap_err(),
+            lane_math::check_values("joint angles", &[0.0, f64::INFINITY], 2).unwrap_err(),
+        ] {
+            let kin = KinError::from(error);
+            assert_eq!(kin.to_string(), error.to_string());
+            assert!(kin.is_invalid_input());
         }
     }
 }

@@ -26,8 +26,8 @@ use crate::closed_form::{Branch, inverse_kinematics};
 use crate::curve::BackboneCurve;
 use crate::error::KinError;
 use crate::modal_map::check_harmonics;
-use crate::validate::{check_finite, check_len};
 use lane_math::Classify;
+use lane_math::{check_finite, check_values};
 
 /// Stopping rules of [`HarmonicIk::solve`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -151,7 +151,7 @@ impl HarmonicIk {
     pub fn solve(&mut self, target: [f64; 2], a: &mut [f64]) -> Result<IkReport, KinError> {
         check_finite("target x", target[0])?;
         check_finite("target y", target[1])?;
-        check_len("initial guess", a, self.trial.len())?;
+        check_values("initial guess", a, self.trial.len())?;
         let length = self.curve.length();
         let r = target[0].hypot(target[1]);
         if r > length {
@@ -213,7 +213,7 @@ impl HarmonicIk {
         branch: Branch,
         a: &mut [f64],
     ) -> Result<IkReport, KinError> {
-        check_len("modal coordinates", a, self.trial.len())?;
+        check_values("modal coordinates", a, self.trial.len())?;
         let (length, alpha0) = (self.curve.length(), self.curve.alpha0());
         let other = match branch {
             Branch::Positive => Branch::Negative,

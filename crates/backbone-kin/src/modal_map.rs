@@ -13,7 +13,8 @@
 //! the map is affine with offset `theta_0 = alpha0 e_1`.
 
 use crate::error::KinError;
-use crate::validate::{check_count, check_finite, check_len, check_link_lengths, check_output_len};
+use crate::validate::{check_count, check_link_lengths};
+use lane_math::{check_finite, check_len, check_values};
 
 /// The most links any crate of the workspace accepts: `manip_dyn::MAX_LINKS` is this constant,
 /// re-exported. Everything a chain or a reduced model holds grows as `O(n)` (a [`ModalMap`]'s `J`
@@ -227,8 +228,8 @@ impl ModalMap {
     }
 
     fn apply(&self, a: &[f64], out: &mut [f64], with_offset: bool) -> Result<(), KinError> {
-        check_len("modal coordinates", a, self.n_coords)?;
-        check_output_len("joint output", out.len(), self.n_joints)?;
+        check_values("modal coordinates", a, self.n_coords)?;
+        check_len("joint output", out.len(), self.n_joints)?;
         for (i, o) in out.iter_mut().enumerate() {
             let dot: f64 = self.row(i).iter().zip(a).map(|(j, x)| j * x).sum();
             *o = if with_offset {

@@ -9,8 +9,9 @@
 //! plane.
 
 use crate::error::KinError;
-use crate::validate::{check_finite, check_len, check_link_lengths, check_output_len};
+use crate::validate::check_link_lengths;
 use crate::vec3::{Rotation, column, cross, mat_mul, rot_x, rot_y, rot_z, sub};
+use lane_math::{check_finite, check_len, check_values};
 
 /// The pose of the arm's base: its position and its orientation as roll, pitch and yaw about the
 /// fixed `x`, `y` and `z` axes (URDF's convention: `R = Rz(yaw) Ry(pitch) Rx(roll)`). The
@@ -61,7 +62,7 @@ pub fn spatial_joint_positions(
     positions: &mut [[f64; 3]],
 ) -> Result<(), KinError> {
     check_chain(link_lengths, base, theta)?;
-    check_output_len("joint positions", positions.len(), link_lengths.len() + 1)?;
+    check_len("joint positions", positions.len(), link_lengths.len() + 1)?;
     positions[0] = base.xyz;
     walk(link_lengths, base, theta, |i, link| {
         positions[i + 1] = link.end
@@ -92,7 +93,7 @@ pub fn spatial_tip_jacobian(
 ) -> Result<[f64; 3], KinError> {
     let tip = spatial_tip_position(link_lengths, base, theta)?;
     let n2 = theta.len();
-    check_output_len("tip Jacobian", jacobian.len(), 3 * n2)?;
+    check_len("tip Jacobian", jacobian.len(), 3 * n2)?;
     walk(link_lengths, base, theta, |i, link| {
         let arm = sub(tip, link.start);
         for (j, axis) in [(2 * i, link.z_axis), (2 * i + 1, link.y_axis)] {
@@ -145,5 +146,6 @@ fn walk(
 fn check_chain(link_lengths: &[f64], base: &BasePose, theta: &[f64]) -> Result<(), KinError> {
     check_link_lengths(link_lengths)?;
     base.validate()?;
-    check_len("joint angles", theta, 2 * link_lengths.len())
+    check_values("joint angles", theta, 2 * link_lengths.len())?;
+    Ok(())
 }

@@ -20,8 +20,9 @@
 use crate::error::KinError;
 use crate::modal_map::check_harmonics;
 use crate::spatial_chain::BasePose;
-use crate::validate::{check_len, check_length};
+use crate::validate::check_length;
 use crate::vec3::{Rotation, column, distance, mat_mul};
+use lane_math::check_values;
 
 /// The most Runge-Kutta steps [`SpatialCurve::tip`] takes over the curve (2^22).
 pub const MAX_CURVE_STEPS: usize = 1 << 22;
@@ -57,7 +58,7 @@ impl SpatialCurve {
     pub fn new(length: f64, harmonics: usize, a: &[f64], base: BasePose) -> Result<Self, KinError> {
         check_length("curve length", length)?;
         check_harmonics(harmonics)?;
-        check_len("modal coordinates", a, 4 * harmonics)?;
+        check_values("modal coordinates", a, 4 * harmonics)?;
         base.validate()?;
         Ok(Self {
             length,

@@ -14,8 +14,8 @@ use crate::error::KinError;
 use crate::harmonic_ik::{IkOptions, IkReport, Workspace, least_squares};
 use crate::spatial_chain::{BasePose, spatial_tip_jacobian};
 use crate::spatial_map::SpatialModalMap;
-use crate::validate::{check_finite, check_len, check_output_len};
 use crate::vec3::distance;
+use lane_math::{check_finite, check_len, check_values};
 
 /// Reusable inverse kinematics of a universal-joint chain on the spatial modal family. Created
 /// once; [`solve`](Self::solve) allocates nothing.
@@ -105,7 +105,7 @@ impl SpatialIk {
         for (name, value) in ["target x", "target y", "target z"].into_iter().zip(target) {
             check_finite(name, value)?;
         }
-        check_len("initial guess", a, self.trial.len())?;
+        check_values("initial guess", a, self.trial.len())?;
         let r = distance(target, self.base.xyz);
         if r > self.length {
             return Err(KinError::OutOfReach {
@@ -140,8 +140,8 @@ impl SpatialIk {
     ///
     /// Errors: `a` or `jacobian` of the wrong size, a non-finite `a`.
     pub fn tip_jacobian(&mut self, a: &[f64], jacobian: &mut [f64]) -> Result<[f64; 3], KinError> {
-        check_len("modal coordinates", a, self.trial.len())?;
-        check_output_len("tip Jacobian", jacobian.len(), self.jacobian.len())?;
+        check_values("modal coordinates", a, self.trial.len())?;
+        check_len("tip Jacobian", jacobian.len(), self.jacobian.len())?;
         for &value in a {
             check_finite("modal coordinate", value)?;
         }

@@ -17,7 +17,8 @@
 
 use crate::error::KinError;
 use crate::modal_map::{BaseAngle, MAX_MAP_ENTRIES, ModalMap};
-use crate::validate::{check_count, check_len, check_output_len};
+use crate::validate::check_count;
+use lane_math::{check_len, check_values};
 
 /// The constant map `theta = J a` of a universal-joint chain (module docs): `2n` joint angles
 /// from `4K` modal coordinates.
@@ -121,8 +122,8 @@ impl SpatialModalMap {
 
     /// Joint angles `theta = J a` (`2n` entries from `4K`). Allocation-free.
     pub fn joint_angles(&self, a: &[f64], theta: &mut [f64]) -> Result<(), KinError> {
-        check_len("modal coordinates", a, self.n_coords())?;
-        check_output_len("joint output", theta.len(), self.n_joints())?;
+        check_values("modal coordinates", a, self.n_coords())?;
+        check_len("joint output", theta.len(), self.n_joints())?;
         let k2 = self.planar.n_coords();
         let (a_z, a_y) = a.split_at(k2);
         let dot = |row: &[f64], x: &[f64]| row.iter().zip(x).map(|(j, v)| j * v).sum::<f64>();

@@ -1,23 +1,12 @@
-//! Input checks shared by the modules: every public entry point validates before computing, so
-//! bad input becomes a [`KinError`] instead of a panic or a silent NaN.
+//! The input checks of this crate's own domain, shared by its modules: every public entry point
+//! validates before computing, so bad input becomes a [`KinError`] instead of a panic or a silent
+//! NaN. Shapes and finiteness are checked by [`lane_math::check_values`] and its siblings, whose
+//! [`ShapeError`](lane_math::ShapeError) becomes a [`KinError`] through `From`.
 
 use crate::error::KinError;
-use lane_math::ShapeProblem;
 
-/// Checks that the scalar `value` is finite.
-pub(crate) fn check_finite(name: &'static str, value: f64) -> Result<(), KinError> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(KinError::NonFinite {
-            name,
-            index: None,
-            value,
-        })
-    }
-}
-
-/// Checks that the length `value` is positive and finite.
+/// Checks that the length `value` is positive and finite. Beyond finiteness a length must be
+/// positive, a rule of this crate's domain with its own message ([`KinError::NonPositiveLength`]).
 pub(crate) fn check_length(name: &'static str, value: f64) -> Result<(), KinError> {
     if value.is_finite() && value > 0.0 {
         Ok(())
@@ -47,42 +36,5 @@ pub(crate) fn check_count(what: &'static str, got: usize, max: usize) -> Result<
         Ok(())
     } else {
         Err(KinError::TooMany { what, got, max })
-    }
-}
-
-/// Checks that `values` has `expected` entries, all finite.
-pub(crate) fn check_len(
-    name: &'static str,
-    values: &[f64],
-    expected: usize,
-) -> Result<(), KinError> {
-    lane_math::check_values(values, expected).map_err(|problem| match problem {
-        ShapeProblem::Length { expected, found } => KinError::Dimension {
-            name,
-            expected,
-            found,
-        },
-        ShapeProblem::NonFinite { index, value } => KinError::NonFinite {
-            name,
-            index: Some(index),
-            value,
-        },
-    })
-}
-
-/// Checks that an output buffer has room for exactly `expected` entries.
-pub(crate) fn check_output_len(
-    name: &'static str,
-    found: usize,
-    expected: usize,
-) -> Result<(), KinError> {
-    if found == expected {
-        Ok(())
-    } else {
-        Err(KinError::Dimension {
-            name,
-            expected,
-            found,
-        })
     }
 }

@@ -1,6 +1,6 @@
 //! The error type of this crate.
 
-use lane_math::{Classify, ErrorClass};
+use lane_math::{Classify, ErrorClass, ShapeError, ShapeProblem};
 
 /// Why a clearance model or computation was refused; every variant names the condition.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -59,26 +59,36 @@ impl Classify for ClearanceError {
     }
 }
 
-pub(crate) fn check_finite(name: &'static str, value: f64) -> Result<(), ClearanceError> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(ClearanceError::NonFinite { name, value })
+/// A refused shape or non-finite number as [`ClearanceError::Dimension`] or
+/// [`ClearanceError::NonFinite`], with the same message. This crate checks single numbers for
+/// finiteness (a point coordinate by coordinate), so its `NonFinite` carries no index.
+impl From<ShapeError<'static>> for ClearanceError {
+    fn from(error: ShapeError<'static>) -> Self {
+        let name = error.name;
+        match error.problem {
+            ShapeProblem::Length { expected, found } => Self::Dimension {
+                name,
+                expected,
+                found,
+            },
+            ShapeProblem::NonFinite { value, .. } => Self::NonFinite { name, value },
+        }
     }
 }
 
-pub(crate) fn check_len(
-    name: &'static str,
-    found: usize,
-    expected: usize,
-) -> Result<(), ClearanceError> {
-    if found == expected {
-        Ok(())
-    } else {
-        Err(ClearanceError::Dimension {
-            name,
-            expected,
-            found,
-        })
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shape_error_keeps_its_message() {
+        for error in [
+            lane_math::check_len("joint axes", 3, 2).unwrap_err(),
+            lane_math::check_finite("link radius", f64::NEG_INFINITY).unwrap_err(),
+        ] {
+            let clearance = ClearanceError::from(error);
+            assert_eq!(clearance.to_string(), error.to_string());
+            assert!(clearance.is_invalid_input());
+        }
     }
 }

@@ -1,9 +1,10 @@
 //! The gradient of one pair's clearance with respect to the joint angles.
 
 use crate::data::ClearanceData;
-use crate::error::{ClearanceError, check_len};
+use crate::error::ClearanceError;
 use crate::model::{ClearanceModel, Pair};
 use crate::vector::{cross, dot, sub};
+use lane_math::check_len;
 
 /// Writes `d d / d theta` of pair `pair` (after [`distances`](crate::distances)) into `gradient`
 /// (`n` entries). Allocation-free.

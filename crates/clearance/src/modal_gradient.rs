@@ -1,10 +1,11 @@
 //! The gradients of every pair's clearance with respect to the modal coordinates.
 
 use crate::data::ClearanceData;
-use crate::error::{ClearanceError, check_len};
+use crate::error::ClearanceError;
 use crate::model::{ClearanceModel, Pair};
 use crate::vector::{add, cross, dot, scale, sub};
 use backbone_kin::ModalMap;
+use lane_math::check_len;
 
 /// Fills every pair's `d d / d a = J^T d d / d theta` (after [`distances`](crate::distances)),
 /// for the constant modal map `theta = J a + theta_0` (eq 8). Allocation-free.

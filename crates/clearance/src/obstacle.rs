@@ -1,8 +1,9 @@
 //! Obstacles: spheres (circles for a planar arm), capsules and boxes, and their signed distance
 //! to a point.
 
-use crate::error::{ClearanceError, check_finite};
+use crate::error::ClearanceError;
 use crate::vector::{V3, dot, lerp, scale, sub, to_local};
+use lane_math::check_finite;
 
 /// One obstacle, in world coordinates (a planar arm moves in the plane `z = 0`).
 #[derive(Debug, Clone, PartialEq)]
@@ -136,7 +137,8 @@ pub(crate) fn unit_or(v: V3, fallback: V3) -> (V3, f64) {
 }
 
 fn check_point(name: &'static str, point: V3) -> Result<(), ClearanceError> {
-    point.iter().try_for_each(|&x| check_finite(name, x))
+    point.iter().try_for_each(|&x| check_finite(name, x))?;
+    Ok(())
 }
 
 fn check_radius(radius: f64) -> Result<(), ClearanceError> {

@@ -1,9 +1,10 @@
 //! Placing the chain: its joint points and axes in world coordinates.
 
 use crate::data::ClearanceData;
-use crate::error::{ClearanceError, check_finite, check_len};
+use crate::error::ClearanceError;
 use crate::model::ClearanceModel;
 use crate::vector::{V3, dot};
+use lane_math::{check_finite, check_len};
 
 /// Places a planar chain (base at the origin, every axis along `z`) with joint angles `theta`
 /// through `backbone_kin::joint_positions`. Allocation-free.

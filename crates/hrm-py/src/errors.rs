@@ -127,7 +127,10 @@ pub(crate) fn count(
 }
 
 /// Refuses a computed vector with a non-finite entry, as `hrm eval` does: "{name} came out
-/// non-finite ({value})".
+/// non-finite ({value})". A check of a result, not of an input: the libraries checked the inputs
+/// ([`lane_math::check_values`], an [`InvalidInput`]), so a non-finite result is an overflow, a
+/// [`NumericalError`], and only the search for the entry ([`lane_math::first_non_finite`]) is
+/// shared.
 pub(crate) fn check_finite(name: &str, values: &[f64]) -> Result<()> {
     match lane_math::first_non_finite(values) {
         Some((_, v)) => Err(Error::numerical(format!(

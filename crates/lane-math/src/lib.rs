@@ -10,7 +10,10 @@ mod lanes;
 mod trig;
 
 pub use alloc::{OutOfMemory, try_filled, try_reserve, try_with_capacity};
-pub use checks::{ShapeProblem, check_values, first_non_finite};
+pub use checks::{
+    EntryIndex, ShapeError, ShapeProblem, all_finite, check_all_finite, check_finite, check_len,
+    check_values, first_non_finite,
+};
 pub use compact::{Compact, compact_numbers};
 pub use error_class::{Classify, ErrorClass};
 pub use instruction_sets::instruction_sets;

@@ -9,20 +9,22 @@ use crate::model::{ChainModel, MAX_DENSE_LINKS};
 
 /// The workspace must have been built for a chain with as many links as `model`.
 fn workspace(model: &ChainModel, data: &ChainData) -> Result<(), DynError> {
-    length(
+    lane_math::check_len(
         "data (a ChainData built for another model)",
         data.n_links(),
         model.n_links(),
-    )
+    )?;
+    Ok(())
 }
 
 /// A derivative workspace built for a chain of `n` links.
 pub(crate) fn derivative_workspace(derivatives: &DerivativeData, n: usize) -> Result<(), DynError> {
-    length(
+    lane_math::check_len(
         "derivatives (a DerivativeData built for another model)",
         derivatives.n_links(),
         n,
-    )
+    )?;
+    Ok(())
 }
 
 /// The preamble of every algorithm: `data` built for `model` and each named input `n` finite
@@ -41,23 +43,14 @@ pub(crate) fn inputs(
 /// Each named input has `n` finite entries.
 pub(crate) fn vectors(n: usize, inputs: &[(&'static str, &[f64])]) -> Result<(), DynError> {
     for &(name, x) in inputs {
-        input(name, x, n)?;
+        lane_math::check_values(name, x, n)?;
     }
     Ok(())
 }
 
-/// An input vector of `n` finite entries.
-fn input(name: &'static str, x: &[f64], n: usize) -> Result<(), DynError> {
-    length(name, x.len(), n)?;
-    match lane_math::first_non_finite(x) {
-        Some((index, value)) => Err(DynError::NonFinite { name, index, value }),
-        None => Ok(()),
-    }
-}
-
 /// An output vector of `n` entries.
 pub(crate) fn output(name: &'static str, x: &[f64], n: usize) -> Result<(), DynError> {
-    length(name, x.len(), n)
+    Ok(lane_math::check_len(name, x.len(), n)?)
 }
 
 /// An `n x n` algorithm (named by `what`) accepts at most [`MAX_DENSE_LINKS`] links.
@@ -80,17 +73,15 @@ pub(crate) fn dense_count(what: &'static str, got: usize) -> Result<(), DynError
 
 /// An `n x n` output matrix (always the parameter `out`).
 pub(crate) fn square_output(m: &MatMut<'_, f64>, n: usize) -> Result<(), DynError> {
-    length("out (rows)", m.nrows(), n)?;
-    length("out (columns)", m.ncols(), n)
+    lane_math::check_len("out (rows)", m.nrows(), n)?;
+    Ok(lane_math::check_len("out (columns)", m.ncols(), n)?)
 }
 
-/// A computed vector must be finite (finite inputs can still overflow).
+/// A computed vector must be finite (finite inputs can still overflow). Unlike an input's, a
+/// result's non-finite value is a [`DynError::NonFiniteResult`] (numerical, not the caller's
+/// fault), not the [`ShapeError`](lane_math::ShapeError) of an input.
 pub(crate) fn finite_result(name: &'static str, x: &[f64]) -> Result<(), DynError> {
-    if x.iter().all(|value| value.is_finite()) {
-        Ok(())
-    } else {
-        Err(DynError::NonFiniteResult { name })
-    }
+    lane_math::check_all_finite(name, x).map_err(|_| DynError::NonFiniteResult { name })
 }
 
 /// A computed matrix must be finite.
@@ -151,18 +142,5 @@ pub(crate) fn finite_scalar(name: &'static str, x: f64) -> Result<f64, DynError>
         Ok(x)
     } else {
         Err(DynError::NonFiniteResult { name })
-    }
-}
-
-/// `found` entries where `expected` are needed.
-pub(crate) fn length(name: &'static str, found: usize, expected: usize) -> Result<(), DynError> {
-    if found == expected {
-        Ok(())
-    } else {
-        Err(DynError::Dimension {
-            name,
-            expected,
-            found,
-        })
     }
 }

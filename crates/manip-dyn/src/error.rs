@@ -1,6 +1,6 @@
 //! The error type of this crate.
 
-use lane_math::{Classify, Compact, ErrorClass, OutOfMemory};
+use lane_math::{Classify, Compact, EntryIndex, ErrorClass, OutOfMemory, ShapeError, ShapeProblem};
 
 /// Why a dynamics computation was refused.
 ///
@@ -84,12 +84,12 @@ pub enum DynError {
         found: usize,
     },
     /// An input that must be finite was NaN or infinite.
-    #[error("{name}[{index}] must be finite, got {}", Compact(*.value))]
+    #[error("{name}{} must be finite, got {}", EntryIndex(*index), Compact(*.value))]
     NonFinite {
         /// Which input.
         name: &'static str,
-        /// 0-based index of the first offending entry.
-        index: usize,
+        /// 0-based index of the first offending entry of a slice; `None` for a scalar input.
+        index: Option<usize>,
         /// The offending value.
         value: f64,
     },
@@ -122,6 +122,22 @@ pub enum DynError {
     /// The system refused the memory of a model's or a workspace's arrays.
     #[error(transparent)]
     OutOfMemory(#[from] OutOfMemory),
+}
+
+/// A refused shape or non-finite input as [`DynError::Dimension`] or [`DynError::NonFinite`],
+/// with the same message.
+impl From<ShapeError<'static>> for DynError {
+    fn from(error: ShapeError<'static>) -> Self {
+        let name = error.name;
+        match error.problem {
+            ShapeProblem::Length { expected, found } => Self::Dimension {
+                name,
+                expected,
+                found,
+            },
+            ShapeProblem::NonFinite { index, value } => Self::NonFinite { name, index, value },
+        }
+    }
 }
 
 impl Classify for DynError {
@@ -165,6 +181,23 @@ impl DynError {
                 value,
             },
             other => other,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shape_error_keeps_its_message() {
+        for error in [
+            lane_math::check_len("qdd", 3, 2).unwrap_err(),
+            lane_math::check_values("v", &[0.0, f64::NAN], 2).unwrap_err(),
+        ] {
+            let dynamics = DynError::from(error);
+            assert_eq!(dynamics.to_string(), error.to_string());
+            assert!(dynamics.is_invalid_input());
         }
     }
 }

@@ -3,6 +3,7 @@
 mod aba;
 mod aba_batch;
 mod aba_derivatives;
+mod batch_driver;
 mod bias;
 mod check;
 mod coriolis_matrix;
@@ -22,8 +23,9 @@ pub mod spatial;
 pub use faer;
 
 pub use aba::aba;
-pub use aba_batch::{AbaBatchData, BatchError, MAX_BATCH_LINKS, aba_batch};
+pub use aba_batch::{AbaBatchData, aba_batch};
 pub use aba_derivatives::aba_derivatives;
+pub use batch_driver::{BatchError, MAX_BATCH_LINKS};
 pub use bias::{coriolis, gravity, nonlinear_effects};
 pub use coriolis_matrix::coriolis_matrix;
 pub use crba::mass_matrix;

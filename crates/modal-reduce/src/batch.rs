@@ -1,62 +1,32 @@
 //! Reduced forward dynamics (eq 15) of many independent states at once, SIMD across states.
 //!
-//! The states of a batch are taken `W` at a time, `W` the number of `f64` lanes of the widest
-//! instruction set the processor has (8 with AVX-512, 4 with AVX2; chosen at run time by
-//! [`pulp::Arch`], so one binary runs everywhere), and each group runs through the same kernel as
-//! one state ([`crate::terms`], [`lane_math::dense`]), written once over
-//! [`Lane`](lane_math::Lane): lane `i` of every register holds state `i` of the group
-//! (structure of arrays). The operations, and their order, are those of the one-state path, so
-//! each state's result is the same.
+//! The driver ([`crate::batch_driver`], shared with the spatial batch) takes the states `W` at a
+//! time, `W` the number of `f64` lanes of the widest instruction set the processor has (8 with
+//! AVX-512, 4 with AVX2; chosen at run time by [`pulp::Arch`], so one binary runs everywhere), and
+//! each group runs through the same kernel as one state ([`crate::terms`]), written once over
+//! [`Lane`](lane_math::Lane): lane `i` of every register holds state `i` of the group (structure
+//! of arrays). The operations, and their order, are those of the one-state path, so each state's
+//! result is the same.
 //!
 //! A group whose inputs are not all finite, or one of whose states fails (a non-positive pivot,
 //! an overflow), is redone one state at a time by [`forward_dynamics`], which names the failure;
 //! so are the states left over after the last whole group, and every state of a model with more
 //! than [`MAX_BATCH_COORDS`] coordinates.
 
-use lane_math::{Classify, ErrorClass};
-use pulp::{Arch, Simd, WithSimd};
+use pulp::{Arch, Simd};
 
+use crate::batch_driver::{Batch, BatchError, BatchKernel, MAX_WIDTH, run_batch};
 use crate::cache_aligned::CacheAligned;
 use crate::data::{PRODUCTS, ReducedData};
-use crate::error::{ReduceError, all_finite, check_len};
+use crate::error::ReduceError;
 use crate::forward::forward_dynamics;
 use crate::model::ReducedModel;
 use crate::terms::{LinkBuffers, StateLanes, Terms, accumulate, angles_in_range, extract};
-use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 use lane_math::{Lane, Pack};
-
-/// The most `f64` lanes of a SIMD register (AVX-512).
-pub(crate) const MAX_WIDTH: usize = 8;
 
 /// The most modal coordinates evaluated SIMD across states (`K = 2` harmonics with `alpha0`
 /// free); larger models run their batches one state at a time.
 pub const MAX_BATCH_COORDS: usize = 5;
-
-/// Why a batch was refused: its slices do not hold whole states, or one state failed.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum BatchError {
-    /// The slices do not hold the same whole number of states of `m` values each.
-    #[error(transparent)]
-    Shape(ReduceError),
-    /// The state at this index (0-based; the lowest one that failed) was refused.
-    #[error("state {state}: {error}")]
-    State {
-        /// 0-based index of the state in the batch.
-        state: usize,
-        /// Why [`forward_dynamics`] refused it.
-        error: ReduceError,
-    },
-}
-
-impl Classify for BatchError {
-    /// The class of the [`ReduceError`] inside.
-    fn class(&self) -> ErrorClass {
-        match self {
-            Self::Shape(error) | Self::State { error, .. } => error.class(),
-        }
-    }
-}
 
 /// Workspace of [`forward_dynamics_batch`] for one [`ReducedModel`]: create it once, reuse it for
 /// every batch. Its memory is `O(n)` like a [`ReducedData`]'s (which it holds, for the states
@@ -135,187 +105,118 @@ pub fn forward_dynamics_batch(
     a_ddot: &mut [f64],
 ) -> Result<(), BatchError> {
     data.single.check_model(model).map_err(BatchError::Shape)?;
-    check_batch_shape(model.n_coords(), [a, a_dot, tau_star], a_ddot)?;
     let arch = data.arch;
-    arch.dispatch(Batch {
-        model,
-        data,
-        inputs: [a, a_dot, tau_star],
-        a_ddot,
-    })
+    let kernel = Planar { model, data };
+    run_batch(kernel, arch, [a, a_dot, tau_star], a_ddot)
 }
 
-/// Checks that `a`, `a_dot`, `tau_star` (`inputs`) and `a_ddot` hold the same whole number of
-/// states of `m` values each.
-pub(crate) fn check_batch_shape(
-    m: usize,
-    inputs: [&[f64]; 3],
-    a_ddot: &[f64],
-) -> Result<(), BatchError> {
-    let [a, a_dot, tau_star] = inputs;
-    let values = a.len() - a.len() % m;
-    let shape = |name, found| check_len(name, found, values).map_err(BatchError::Shape);
-    shape("a (whole states of m values)", a.len())?;
-    shape("a_dot (as many values as a)", a_dot.len())?;
-    shape("tau_star (as many values as a)", tau_star.len())?;
-    shape("a_ddot (as many values as a)", a_ddot.len())
-}
-
-/// One batch, run by [`pulp::Arch::dispatch`] with the processor's instruction set.
-struct Batch<'a> {
+/// The planar family's part of a batch: the kernel of [`crate::terms`] and [`forward_dynamics`].
+struct Planar<'a> {
     model: &'a ReducedModel,
     data: &'a mut ReducedBatchData,
-    /// `a`, `a_dot`, `tau_star`.
-    inputs: [&'a [f64]; 3],
-    a_ddot: &'a mut [f64],
 }
 
-impl WithSimd for Batch<'_> {
-    type Output = Result<(), BatchError>;
+impl BatchKernel for Planar<'_> {
+    fn n_coords(&self) -> usize {
+        self.model.n_coords()
+    }
 
     #[inline(always)]
-    fn with_simd<S: Simd>(mut self, simd: S) -> Self::Output {
-        // With the last coordinate's column of Phi all ones (alpha0 free), a kernel that skips
-        // the multiplications by it.
-        let m = self.model.n_coords();
-        match (m, self.model.unit_column() == Some(m - 1)) {
-            (2, false) => self.run::<S, 2, false>(simd),
-            (2, true) => self.run::<S, 2, true>(simd),
-            (3, false) => self.run::<S, 3, false>(simd),
-            (3, true) => self.run::<S, 3, true>(simd),
-            (4, false) => self.run::<S, 4, false>(simd),
-            (4, true) => self.run::<S, 4, true>(simd),
-            (5, false) => self.run::<S, 5, false>(simd),
-            (5, true) => self.run::<S, 5, true>(simd),
-            _ => self.one_at_a_time(0),
+    fn dispatch<S: Simd>(batch: Batch<'_, Self>, simd: S) -> Result<(), BatchError> {
+        match batch.kernel().model.n_coords() {
+            2 => batch.groups::<S, 2>(simd),
+            3 => batch.groups::<S, 3>(simd),
+            4 => batch.groups::<S, 4>(simd),
+            5 => batch.groups::<S, 5>(simd),
+            _ => batch.one_at_a_time(),
         }
     }
-}
 
-impl Batch<'_> {
-    /// Whole groups of `S::F64_LANES` states in SIMD, the rest one at a time; `UNIT_LAST`: the
-    /// last coordinate's column of `Phi` is all ones.
+    /// With the last coordinate's column of `Phi` all ones (`alpha0` free), a kernel that skips
+    /// the multiplications by it.
     #[inline(always)]
-    fn run<S: Simd, const M: usize, const UNIT_LAST: bool>(
-        mut self,
+    fn terms<S: Simd, const M: usize>(
+        &mut self,
         simd: S,
-    ) -> Result<(), BatchError> {
-        let width = S::F64_LANES;
-        if width > MAX_WIDTH {
-            return self.one_at_a_time(0);
+        a: &[Pack<S>; M],
+        a_dot: &[Pack<S>; M],
+        mass: &mut [[Pack<S>; M]; M],
+        coriolis: &mut [Pack<S>; M],
+        gravity: &mut [Pack<S>; M],
+    ) -> bool {
+        if self.model.unit_column() == Some(M - 1) {
+            self.terms_of::<S, M, true>(simd, a, a_dot, mass, coriolis, gravity)
+        } else {
+            self.terms_of::<S, M, false>(simd, a, a_dot, mass, coriolis, gravity)
         }
-        let states = self.a_ddot.len() / M;
-        let grouped = states - states % width;
-        for first in (0..grouped).step_by(width) {
-            let range = first * M..(first + width) * M;
-            let inputs = self.inputs.map(|x| &x[range.clone()]);
-            let links = LinkBuffers {
-                angle: self.data.angle.get_mut(),
-                sin: self.data.sin.get_mut(),
-                cos: self.data.cos.get_mut(),
-                products: self.data.products.get_mut(),
-                links: self.model.n_links(),
-            };
-            let out = &mut self.a_ddot[range];
-            if !group::<S, M, UNIT_LAST>(simd, self.model, links, inputs, out) {
-                self.states(first, first + width)?;
-            }
-        }
-        self.one_at_a_time(grouped)
     }
 
-    /// States `first..` one at a time.
-    fn one_at_a_time(&mut self, first: usize) -> Result<(), BatchError> {
-        let states = self.a_ddot.len() / self.model.n_coords();
-        self.states(first, states)
-    }
-
-    /// States `first..last` one at a time, by [`forward_dynamics`].
-    fn states(&mut self, first: usize, last: usize) -> Result<(), BatchError> {
-        let m = self.model.n_coords();
-        for state in first..last {
-            let range = state * m..(state + 1) * m;
-            let [a, a_dot, tau_star] = self.inputs.map(|x| &x[range.clone()]);
-            forward_dynamics(
-                self.model,
-                &mut self.data.single,
-                a,
-                a_dot,
-                tau_star,
-                &mut self.a_ddot[range],
-            )
-            .map_err(|error| BatchError::State { state, error })?;
-        }
-        Ok(())
+    fn one_state(
+        &mut self,
+        a: &[f64],
+        a_dot: &[f64],
+        tau_star: &[f64],
+        a_ddot: &mut [f64],
+    ) -> Result<(), ReduceError> {
+        forward_dynamics(
+            self.model,
+            &mut self.data.single,
+            a,
+            a_dot,
+            tau_star,
+            a_ddot,
+        )
     }
 }
 
-/// One group of `S::F64_LANES` states (`inputs` and `out` hold exactly those): gathers the
-/// inputs into lanes, runs the kernel and scatters the accelerations. `false` if an input is not
-/// finite or any state failed (`out` is then unspecified).
-#[inline(always)]
-fn group<S: Simd, const M: usize, const UNIT_LAST: bool>(
-    simd: S,
-    model: &ReducedModel,
-    links: LinkBuffers<'_>,
-    inputs: [&[f64]; 3],
-    out: &mut [f64],
-) -> bool {
-    let width = S::F64_LANES;
-    if !(all_finite(inputs[0]) & all_finite(inputs[1]) & all_finite(inputs[2])) {
-        return false;
-    }
-    let mut buffer = [0.0; MAX_WIDTH];
-    let mut gather = |values: &[f64], k: usize| {
-        for (lane, slot) in buffer[..width].iter_mut().enumerate() {
-            *slot = values[lane * M + k];
+impl Planar<'_> {
+    /// [`BatchKernel::terms`]; `UNIT_LAST`: the last coordinate's column of `Phi` is all ones.
+    /// `false` for angles the kernel's sine and cosine do not take.
+    #[inline(always)]
+    fn terms_of<S: Simd, const M: usize, const UNIT_LAST: bool>(
+        &mut self,
+        simd: S,
+        a: &[Pack<S>; M],
+        a_dot: &[Pack<S>; M],
+        mass: &mut [[Pack<S>; M]; M],
+        coriolis: &mut [Pack<S>; M],
+        gravity: &mut [Pack<S>; M],
+    ) -> bool {
+        if !angles_in_range(simd, self.model, a) {
+            return false;
         }
-        Pack::<S>::load(simd, &buffer)
-    };
-    let a: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[0], k));
-    let a_dot: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[1], k));
-    let tau_star: [Pack<S>; M] = std::array::from_fn(|k| gather(inputs[2], k));
-    if !angles_in_range(simd, model, &a) {
-        return false;
+        let links = LinkBuffers {
+            angle: self.data.angle.get_mut(),
+            sin: self.data.sin.get_mut(),
+            cos: self.data.cos.get_mut(),
+            products: self.data.products.get_mut(),
+            links: self.model.n_links(),
+        };
+        let zero = Pack::splat(simd, 0.0);
+        let mut sums = [[zero; M]; M];
+        let (mut coriolis_sums, mut gravity_sums) = ([zero; M], [zero; M]);
+        let mut v = [zero; M];
+        let mut joint = [[zero; 2]; M];
+        let mut terms = Terms {
+            mass: sums.as_flattened_mut(),
+            coriolis: &mut coriolis_sums,
+            gravity: &mut gravity_sums,
+            joint: &mut joint,
+            v: &mut v,
+        };
+        let layout = StateLanes::new(simd, if UNIT_LAST { M - 1 } else { usize::MAX });
+        accumulate(layout, self.model, a, a_dot, M, links, &mut terms);
+        extract(
+            layout,
+            self.model,
+            M,
+            &terms,
+            mass.as_flattened_mut(),
+            coriolis,
+            gravity,
+        );
+        true
     }
-    let zero = Pack::splat(simd, 0.0);
-    let (mut sums, mut mass) = ([[zero; M]; M], [[zero; M]; M]);
-    let (mut coriolis_sums, mut gravity_sums) = ([zero; M], [zero; M]);
-    let (mut coriolis, mut gravity, mut v) = ([zero; M], [zero; M], [zero; M]);
-    let mut joint = [[zero; 2]; M];
-    let mut terms = Terms {
-        mass: sums.as_flattened_mut(),
-        coriolis: &mut coriolis_sums,
-        gravity: &mut gravity_sums,
-        joint: &mut joint,
-        v: &mut v,
-    };
-    let layout = StateLanes::new(simd, if UNIT_LAST { M - 1 } else { usize::MAX });
-    accumulate(layout, model, &a, &a_dot, M, links, &mut terms);
-    extract(
-        layout,
-        model,
-        M,
-        &terms,
-        mass.as_flattened_mut(),
-        &mut coriolis,
-        &mut gravity,
-    );
-    // The right-hand side tau* - C* - G* and the solve, as in `forward_dynamics`.
-    let mut x: [Pack<S>; M] = std::array::from_fn(|k| tau_star[k] - coriolis[k] - gravity[k]);
-    if !ldlt_in_place(simd, mass.as_flattened_mut(), M) {
-        return false;
-    }
-    ldlt_solve_in_place(mass.as_flattened(), M, &mut x);
-    let mut finite = true;
-    for (k, value) in x.iter().enumerate() {
-        value.store(&mut buffer);
-        for (lane, &v) in buffer[..width].iter().enumerate() {
-            finite &= v.is_finite();
-            out[lane * M + k] = v;
-        }
-    }
-    finite
 }
 
 #[cfg(test)]

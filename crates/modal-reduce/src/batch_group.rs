@@ -5,7 +5,8 @@
 
 use pulp::{Arch, Simd, WithSimd};
 
-use crate::batch::{MAX_BATCH_COORDS, MAX_WIDTH};
+use crate::batch::MAX_BATCH_COORDS;
+use crate::batch_driver::MAX_WIDTH;
 use crate::model::ReducedModel;
 
 /// The number of states [`forward_dynamics_batch`](crate::forward_dynamics_batch) evaluates in

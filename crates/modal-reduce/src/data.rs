@@ -7,8 +7,9 @@ use manip_dyn::ChainData;
 use pulp::Arch;
 
 use crate::cache_aligned::CacheAligned;
-use crate::error::{ReduceError, check_len};
+use crate::error::ReduceError;
 use crate::model::{LINK_PADDING, ReducedModel};
+use lane_math::check_len;
 
 /// Per-link products the pre-pass leaves for the pass besides the sine and cosine, in this order
 /// in the buffer: `S_l phi_dot_l^2`, `L_l sin phi_l`, `L_l cos phi_l`,
@@ -176,6 +177,7 @@ impl ReducedData {
     /// Checks that this workspace was made for `model`.
     pub(crate) fn check_model(&self, model: &ReducedModel) -> Result<(), ReduceError> {
         check_len("workspace links", self.n_links, model.n_links())?;
-        check_len("workspace coordinates", self.n_coords, model.n_coords())
+        check_len("workspace coordinates", self.n_coords, model.n_coords())?;
+        Ok(())
     }
 }

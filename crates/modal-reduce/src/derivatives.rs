@@ -36,9 +36,10 @@
 use faer::MatRef;
 
 use crate::data::ReducedData;
-use crate::error::{ReduceError, check_finite_result, check_len};
+use crate::error::{ReduceError, check_finite_result};
 use crate::forward::forward_dynamics;
 use crate::model::ReducedModel;
+use lane_math::check_len;
 use lane_math::dense::{ldlt_in_place, ldlt_solve_rows_in_place};
 
 /// Results and scratch of [`reduced_derivatives`] for one [`ReducedModel`]: `O(n + m^2)` memory,

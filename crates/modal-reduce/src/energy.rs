@@ -1,8 +1,9 @@
 //! Kinetic and potential energy of the chain at a modal state.
 
 use crate::data::ReducedData;
-use crate::error::{ReduceError, check_input};
+use crate::error::ReduceError;
 use crate::model::ReducedModel;
+use lane_math::check_values;
 
 /// The chain's kinetic energy at `theta = J a + theta_0`, `theta_dot = J a_dot`; it equals
 /// `1/2 a_dot^T M*(a) a_dot`. Allocation-free.
@@ -13,7 +14,7 @@ pub fn kinetic_energy(
     a_dot: &[f64],
 ) -> Result<f64, ReduceError> {
     data.check_model(model)?;
-    check_input("a_dot", a_dot, model.n_coords())?;
+    check_values("a_dot", a_dot, model.n_coords())?;
     model.map().joint_rates(a_dot, &mut data.theta_dot)?;
     joint_angles(model, data, a)?;
     Ok(manip_dyn::kinetic_energy(
@@ -47,7 +48,7 @@ fn joint_angles(
     data: &mut ReducedData,
     a: &[f64],
 ) -> Result<(), ReduceError> {
-    check_input("a", a, model.n_coords())?;
+    check_values("a", a, model.n_coords())?;
     model.map().joint_angles(a, &mut data.theta)?;
     Ok(())
 }

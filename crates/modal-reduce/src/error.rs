@@ -1,6 +1,6 @@
-//! The error type of this crate, and the input checks that produce it.
+//! The error type of this crate, and the checks of computed results that produce it.
 
-use lane_math::{Classify, ErrorClass};
+use lane_math::{Classify, EntryIndex, ErrorClass, ShapeError, ShapeProblem};
 
 use backbone_kin::KinError;
 use manip_dyn::DynError;
@@ -70,12 +70,12 @@ pub enum ReduceError {
         found: usize,
     },
     /// An input that must be finite was NaN or infinite.
-    #[error("{name}[{index}] must be finite, got {value}")]
+    #[error("{name}{} must be finite, got {value}", EntryIndex(*index))]
     NonFinite {
         /// Which input.
         name: &'static str,
-        /// 0-based index of the first offending entry.
-        index: usize,
+        /// 0-based index of the first offending entry of a slice; `None` for a scalar input.
+        index: Option<usize>,
         /// The offending value.
         value: f64,
     },
@@ -156,48 +156,54 @@ impl Classify for ReduceError {
     }
 }
 
-/// Checks that `values` has `expected` entries, all finite.
-pub(crate) fn check_input(
-    name: &'static str,
-    values: &[f64],
-    expected: usize,
-) -> Result<(), ReduceError> {
-    check_len(name, values.len(), expected)?;
-    match lane_math::first_non_finite(values) {
-        Some((index, value)) => Err(ReduceError::NonFinite { name, index, value }),
-        None => Ok(()),
+/// A refused shape or non-finite input as [`ReduceError::Dimension`] or
+/// [`ReduceError::NonFinite`], with the same message.
+impl From<ShapeError<'static>> for ReduceError {
+    fn from(error: ShapeError<'static>) -> Self {
+        let name = error.name;
+        match error.problem {
+            ShapeProblem::Length { expected, found } => Self::Dimension {
+                name,
+                expected,
+                found,
+            },
+            ShapeProblem::NonFinite { index, value } => Self::NonFinite { name, index, value },
+        }
     }
 }
 
-/// Checks that a slice or workspace has `expected` entries.
-pub(crate) fn check_len(
-    name: &'static str,
-    found: usize,
-    expected: usize,
-) -> Result<(), ReduceError> {
-    if found == expected {
-        Ok(())
-    } else {
-        Err(ReduceError::Dimension {
-            name,
-            expected,
-            found,
-        })
-    }
-}
-
-/// Checks that a computed vector is finite.
+/// Checks that a computed vector is finite. Unlike an input's, a result's non-finite value is a
+/// [`ReduceError::NonFiniteResult`] (numerical: finite inputs overflowed), not the caller's
+/// fault, so it is not reported as the [`ShapeError`] of an input.
 pub(crate) fn check_finite_result(name: &'static str, values: &[f64]) -> Result<(), ReduceError> {
-    if values.iter().all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err(ReduceError::NonFiniteResult { name })
-    }
+    lane_math::check_all_finite(name, values).map_err(|_| ReduceError::NonFiniteResult { name })
 }
 
-/// Whether every value is finite: one test of all of them, without the early exit that keeps a
-/// search from vectorising.
-#[inline(always)]
-pub(crate) fn all_finite(values: &[f64]) -> bool {
-    values.iter().fold(true, |finite, v| finite & v.is_finite())
+/// Checks that the computed terms `M*`, `C*` and `G*` (eq 14) are finite, naming the first
+/// that is not.
+pub(crate) fn check_terms_finite(
+    mass: &[f64],
+    coriolis: &[f64],
+    gravity: &[f64],
+) -> Result<(), ReduceError> {
+    check_finite_result("reduced mass matrix M*", mass)?;
+    check_finite_result("reduced Coriolis vector C*", coriolis)?;
+    check_finite_result("reduced gravity vector G*", gravity)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shape_error_keeps_its_message() {
+        for error in [
+            lane_math::check_len("a_ddot", 3, 2).unwrap_err(),
+            lane_math::check_values("tau_star", &[0.0, f64::NAN], 2).unwrap_err(),
+        ] {
+            let reduce = ReduceError::from(error);
+            assert_eq!(reduce.to_string(), error.to_string());
+            assert!(reduce.is_invalid_input());
+        }
+    }
 }

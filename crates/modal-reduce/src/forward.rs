@@ -4,12 +4,13 @@
 use pulp::{Simd, WithSimd};
 
 use crate::data::ReducedData;
-use crate::error::all_finite;
-use crate::error::{ReduceError, check_finite_result, check_input, check_len};
+use crate::error::{ReduceError, check_finite_result};
 use crate::model::ReducedModel;
 use crate::projection::reduced_terms_by_projection;
 use crate::terms::{StackTerms, accumulate_in_data, check_state, check_terms};
+use lane_math::all_finite;
 use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
+use lane_math::{check_len, check_values};
 
 /// The modal accelerations `a_ddot` under generalised forces `tau*` (eq 15), written into
 /// `a_ddot` (length `m`), with `M*`, `C*` and `G*` from the default `O(n m^2)` path
@@ -72,8 +73,9 @@ pub(crate) fn check_forces(
     tau_star: &[f64],
     a_ddot: &[f64],
 ) -> Result<(), ReduceError> {
-    check_input("tau_star", tau_star, model.n_coords())?;
-    check_len("a_ddot", a_ddot.len(), model.n_coords())
+    check_values("tau_star", tau_star, model.n_coords())?;
+    check_len("a_ddot", a_ddot.len(), model.n_coords())?;
+    Ok(())
 }
 
 /// `out = tau* - C* - G*` (sizes already checked).

@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 mod batch;
+mod batch_driver;
 mod batch_group;
 mod cache_aligned;
 mod data;
@@ -16,7 +17,8 @@ pub mod spatial;
 pub mod terms;
 mod torques;
 
-pub use batch::{BatchError, MAX_BATCH_COORDS, ReducedBatchData, forward_dynamics_batch};
+pub use batch::{MAX_BATCH_COORDS, ReducedBatchData, forward_dynamics_batch};
+pub use batch_driver::BatchError;
 pub use batch_group::batch_lanes;
 pub use data::ReducedData;
 pub use derivatives::{ReducedDerivatives, reduced_derivatives};

@@ -7,9 +7,10 @@ use faer::{Accum, MatMut, Par};
 use manip_dyn::{DynError, MAX_DENSE_LINKS};
 
 use crate::data::{Projection, ReducedData};
-use crate::error::{ReduceError, check_input};
+use crate::error::ReduceError;
 use crate::model::ReducedModel;
 use crate::torques::project;
+use lane_math::check_values;
 
 /// Computes `M* = J^T M J`, `C* = J^T C(theta, J a_dot)` and `G* = J^T G(theta)` at
 /// `theta = J a + theta_0` (eq 14) into `data`, by forming the full `n x n` mass matrix with
@@ -27,8 +28,8 @@ pub fn reduced_terms_by_projection(
 ) -> Result<(), ReduceError> {
     data.check_model(model)?;
     let m = model.n_coords();
-    check_input("a", a, m)?;
-    check_input("a_dot", a_dot, m)?;
+    check_values("a", a, m)?;
+    check_values("a_dot", a_dot, m)?;
     let (chain, map) = (model.chain(), model.map());
     let n = model.n_links();
     if n > MAX_DENSE_LINKS {

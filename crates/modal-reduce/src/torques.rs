@@ -3,8 +3,9 @@
 use backbone_kin::ModalMap;
 
 use crate::data::ReducedData;
-use crate::error::{ReduceError, check_input, check_len};
+use crate::error::ReduceError;
 use crate::model::ReducedModel;
+use lane_math::{check_len, check_values};
 
 /// The joint torques `tau = M J a_ddot + C + G` (eq 13) that make the full chain follow the modal
 /// motion `(a, a_dot, a_ddot)`: what the actuators of the real arm must deliver. Written into
@@ -24,9 +25,9 @@ pub fn joint_torques(
 ) -> Result<(), ReduceError> {
     data.check_model(model)?;
     let m = model.n_coords();
-    check_input("a", a, m)?;
-    check_input("a_dot", a_dot, m)?;
-    check_input("a_ddot", a_ddot, m)?;
+    check_values("a", a, m)?;
+    check_values("a_dot", a_dot, m)?;
+    check_values("a_ddot", a_ddot, m)?;
     check_len("tau", tau.len(), model.n_links())?;
     let map = model.map();
     map.joint_angles(a, &mut data.theta)?;
@@ -63,7 +64,7 @@ pub fn project_torques(
     tau: &[f64],
     tau_star: &mut [f64],
 ) -> Result<(), ReduceError> {
-    check_input("tau", tau, model.n_links())?;
+    check_values("tau", tau, model.n_links())?;
     check_len("tau_star", tau_star.len(), model.n_coords())?;
     project(model.map(), tau, tau_star);
     Ok(())

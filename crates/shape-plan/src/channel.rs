@@ -1,7 +1,8 @@
 //! A planar channel for follow-the-leader deployment: its centreline, the guide behind its
 //! entry, and distances to them.
 
-use crate::error::{PlanError, check_finite};
+use crate::error::PlanError;
+use lane_math::check_finite;
 
 /// The most centreline points a [`Channel`] accepts.
 pub const MAX_CENTERLINE_POINTS: usize = 100_000;

@@ -39,7 +39,7 @@ pub struct PlanData {
 impl PlanData {
     /// Working memory for `arm` among the obstacles of `clearance`.
     pub fn new<A: Arm>(arm: &A, clearance: &ClearanceModel) -> Result<Self, PlanError> {
-        crate::error::check_len("clearance model links", clearance.n_links(), arm.n_links())?;
+        lane_math::check_len("clearance model links", clearance.n_links(), arm.n_links())?;
         let m = arm.n_coords();
         let data = ClearanceData::new(clearance, m)?;
         let rows = clearance.pairs().len() + 2 * m;

@@ -18,8 +18,9 @@
 
 use crate::channel::{Channel, dist};
 use crate::deploy_metrics::{DeployMetrics, DeployTracker};
-use crate::error::{PlanError, check_finite};
+use crate::error::PlanError;
 use backbone_kin::{BaseAngle, ModalMap, joint_positions};
+use lane_math::check_finite;
 use optimal_ctl::LinearQp;
 
 /// The most deployment steps [`follow_the_leader`] accepts.

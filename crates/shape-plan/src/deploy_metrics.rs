@@ -3,7 +3,8 @@
 //! that tracks it (`docs/theory.md`, "Follow-the-leader deployment").
 
 use crate::channel::{Channel, dist, point_segment};
-use crate::error::{PlanError, check_finite};
+use crate::error::PlanError;
+use lane_math::check_finite;
 
 /// Points per link at which the body's distances to the path and the walls are sampled (both
 /// ends included).

@@ -1,6 +1,6 @@
 //! The error type of this crate.
 
-use lane_math::{Classify, ErrorClass};
+use lane_math::{Classify, ErrorClass, ShapeError, ShapeProblem};
 
 /// Why a plan was refused or not found; every variant names the condition.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -108,30 +108,40 @@ impl Classify for PlanError {
     }
 }
 
-pub(crate) fn check_finite(name: &'static str, value: f64) -> Result<(), PlanError> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(PlanError::OutOfRange {
-            name,
-            bound: "finite",
-            value,
-        })
+/// A refused shape or non-finite number as [`PlanError::Dimension`] or a
+/// [`PlanError::OutOfRange`] that must be `"finite"`, with the same message. This crate checks
+/// single numbers for finiteness (a vector entry by entry), so the message carries no index.
+impl From<ShapeError<'static>> for PlanError {
+    fn from(error: ShapeError<'static>) -> Self {
+        let name = error.name;
+        match error.problem {
+            ShapeProblem::Length { expected, found } => Self::Dimension {
+                name,
+                expected,
+                found,
+            },
+            ShapeProblem::NonFinite { value, .. } => Self::OutOfRange {
+                name,
+                bound: "finite",
+                value,
+            },
+        }
     }
 }
 
-pub(crate) fn check_len(
-    name: &'static str,
-    found: usize,
-    expected: usize,
-) -> Result<(), PlanError> {
-    if found == expected {
-        Ok(())
-    } else {
-        Err(PlanError::Dimension {
-            name,
-            expected,
-            found,
-        })
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shape_error_keeps_its_message() {
+        for error in [
+            lane_math::check_len("initial shape", 3, 2).unwrap_err(),
+            lane_math::check_finite("deploy radius", f64::NAN).unwrap_err(),
+        ] {
+            let plan = PlanError::from(error);
+            assert_eq!(plan.to_string(), error.to_string());
+            assert!(plan.is_invalid_input());
+        }
     }
 }

@@ -13,13 +13,14 @@
 
 use crate::arm::{Arm, ArmScratch};
 use crate::data::PlanData;
-use crate::error::{PlanError, check_finite};
+use crate::error::PlanError;
 use crate::motion::check_segment;
 use crate::options::PlanOptions;
 use crate::planar::PlanarArm;
 use crate::spatial::SpatialArm;
 use backbone_kin::{BaseAngle, BasePose};
 use clearance::{ClearanceModel, Obstacle, distances};
+use lane_math::check_finite;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -12,9 +12,10 @@
 
 use crate::arm::Arm;
 use crate::data::PlanData;
-use crate::error::{PlanError, check_len};
+use crate::error::PlanError;
 use crate::options::PlanOptions;
 use clearance::{ClearanceModel, distances};
+use lane_math::check_len;
 
 /// What checking a segment found.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,7 +51,7 @@ pub fn check_segment<A: Arm>(
         .map(|(x, y)| (y - x) * (y - x))
         .sum::<f64>()
         .sqrt();
-    crate::error::check_finite("segment length", length)?;
+    lane_math::check_finite("segment length", length)?;
     let (lipschitz, c, needed) = (arm.lipschitz(), options.clearance, options.needed());
     let mut smallest = f64::INFINITY;
     let (mut s, mut checks) = (0.0_f64, 0);

@@ -1,6 +1,7 @@
 //! What a plan must achieve and how much work it may spend.
 
-use crate::error::{PlanError, check_finite};
+use crate::error::PlanError;
+use lane_math::check_finite;
 
 /// The most iterations of one shape solve [`PlanOptions`] accepts.
 pub const MAX_ITERATIONS: usize = 100_000;

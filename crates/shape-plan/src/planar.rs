@@ -1,9 +1,10 @@
 //! The planar modal arm: `K` harmonics, `alpha0` fixed or free, base at the origin.
 
 use crate::arm::{Arm, ArmScratch};
-use crate::error::{PlanError, check_len};
+use crate::error::PlanError;
 use backbone_kin::{BaseAngle, Branch, ChainIk, ModalMap};
 use clearance::{ClearanceData, ClearanceModel, modal_gradients, place_planar};
+use lane_math::check_len;
 
 /// A planar chain of the given links, base at the origin, joint angles
 /// `theta = J a + theta_0` from the `K`-harmonic [`ModalMap`] of these links (eqs 7-11).

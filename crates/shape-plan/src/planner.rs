@@ -3,11 +3,12 @@
 
 use crate::arm::Arm;
 use crate::data::PlanData;
-use crate::error::{PlanError, check_finite, check_len};
+use crate::error::PlanError;
 use crate::motion::check_segment;
 use crate::options::PlanOptions;
 use crate::shape::solve_shape;
 use clearance::{ClearanceModel, distances};
+use lane_math::{check_finite, check_len};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

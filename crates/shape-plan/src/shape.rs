@@ -58,9 +58,9 @@ pub fn solve_shape<A: Arm>(
     a: &mut [f64],
 ) -> Result<ShapeOutcome, PlanError> {
     let m = arm.n_coords();
-    crate::error::check_len("modal coordinates", a.len(), m)?;
+    lane_math::check_len("modal coordinates", a.len(), m)?;
     for &x in a.iter() {
-        crate::error::check_finite("start coordinate", x)?;
+        lane_math::check_finite("start coordinate", x)?;
     }
     let goal = options.needed() + 0.5 * options.check_slack;
     let rho = arm.length();

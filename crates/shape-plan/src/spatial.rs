@@ -2,10 +2,11 @@
 //! 8), placed from its base pose.
 
 use crate::arm::{Arm, ArmScratch};
-use crate::error::{PlanError, check_len};
+use crate::error::PlanError;
 use backbone_kin::vec3::{add, column, cross, dot, mat_mul, rot_y, rot_z, scale, sub};
 use backbone_kin::{BasePose, SpatialIk, SpatialModalMap};
 use clearance::{ClearanceData, ClearanceModel, Pair, place};
+use lane_math::check_len;
 
 /// A universal-joint chain of the given links (joint angles `theta = J a`, interleaved
 /// `[z_1, y_1, z_2, ...]`) leaving `base`.

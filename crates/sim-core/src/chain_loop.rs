@@ -16,11 +16,12 @@
 //! This loop is separate from the modal loop ([`Simulation`](crate::Simulation)): its state is
 //! the joint vector, not modal coordinates, and its only controller is computed torque.
 
-use crate::error::{SimError, check_finite, check_positive};
+use crate::error::{SimError, check_positive};
 use crate::ode::{OdeSystem, Rk4};
 use crate::reference::{Reference, ReferenceSample};
 use crate::simulation::{MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS};
 use lane_math::Compact;
+use lane_math::check_all_finite;
 use manip_dyn::DynError;
 use manip_dyn::spatial::{SpatialData, SpatialModel, aba, rnea};
 
@@ -188,7 +189,7 @@ pub fn run_chain_loop(
             format!("has {} entries, expected one per joint ({n})", q0.len()),
         ));
     }
-    check_finite("initial.a", q0)?;
+    check_all_finite("initial.a", q0)?;
     let mut data = SpatialData::new(model);
     let mut rk4 = Rk4::new(2 * n);
     let mut state = vec![0.0; 2 * n];

@@ -1,6 +1,6 @@
 //! The error types of this crate.
 
-use lane_math::{Classify, Compact, ErrorClass};
+use lane_math::{Classify, Compact, ErrorClass, ShapeError};
 
 use crate::ode::OdeError;
 use backbone_kin::KinError;
@@ -285,14 +285,11 @@ pub(crate) fn check_non_negative(name: &str, value: f64) -> Result<(), SimError>
     }
 }
 
-/// Checks that every entry of `values` is finite: an [`InvalidSetting`](SimError::InvalidSetting)
-/// error naming `name` and the first non-finite entry otherwise.
-pub fn check_finite(name: &str, values: &[f64]) -> Result<(), SimError> {
-    match lane_math::first_non_finite(values) {
-        None => Ok(()),
-        Some((_, v)) => Err(SimError::setting(
-            name,
-            format!("must be finite, got {}", Compact(v)),
-        )),
+/// A refused shape or non-finite setting as [`InvalidSetting`](SimError::InvalidSetting),
+/// named as the scenario file spells it: `"reference.points must be finite, got NaN"` (a
+/// setting's message names the setting, not the entry of its array).
+impl From<ShapeError<'_>> for SimError {
+    fn from(error: ShapeError<'_>) -> Self {
+        Self::setting(error.name, error.problem.to_string())
     }
 }

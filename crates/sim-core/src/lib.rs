@@ -14,7 +14,7 @@ mod simulation;
 pub const MAX_COORDINATES: usize = 2 * backbone_kin::MAX_HARMONICS + 1;
 
 pub use chain_loop::{ChainLoopSettings, ChainRecord, ChainRun, ChainSummary, run_chain_loop};
-pub use error::{ControllerFailure, SimError, check_finite};
+pub use error::{ControllerFailure, SimError};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use simulation::{
     ControlSample, ControllerFactory, Integrator, JOINT_ANGLE_APPROACH_S, Lockstep, LoopHooks,

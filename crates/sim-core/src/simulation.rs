@@ -3,7 +3,7 @@
 //! output held in between (zero-order hold).
 
 use crate::controller::{ControlContext, Controller, ModalState};
-use crate::error::{SimError, check_finite, check_non_negative, check_positive};
+use crate::error::{SimError, check_non_negative, check_positive};
 use crate::noise::GaussianNoise;
 use crate::ode::{DormandPrince, OdeSystem, Rk4, Stats, Tolerances};
 use crate::record::{Metrics, Record, Sample, Summary};
@@ -12,6 +12,7 @@ use crate::reference::{Reference, ReferenceSample};
 use backbone_kin::BaseAngle;
 use clearance::{ClearanceData, ClearanceModel};
 use lane_math::Compact;
+use lane_math::check_all_finite;
 use limits::LimitProjection;
 use modal_reduce::{Plant, PlantData, PlantModel, ReduceError};
 use std::sync::Arc;
@@ -1118,7 +1119,7 @@ fn check_initial(initial: &ModalState, m: usize) -> Result<(), SimError> {
                 ),
             ));
         }
-        check_finite(name, values)?;
+        check_all_finite(name, values)?;
     }
     Ok(())
 }

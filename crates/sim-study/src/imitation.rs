@@ -361,7 +361,7 @@ pub fn shifted_grid(
         ));
     }
     for list in offsets {
-        sim_core::check_finite(name, list)?;
+        lane_math::check_all_finite(name, list)?;
     }
     let m = offsets.len();
     let mut shifted = Vec::with_capacity(total);

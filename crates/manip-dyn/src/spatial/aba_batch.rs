@@ -3,13 +3,13 @@
 //! same operations in the same order as one state, so every state gets the same bits as alone.
 
 use lane_math::{Pack, try_filled};
-use pulp::{Arch, Simd, WithSimd};
+use pulp::{Arch, Simd};
 
 use super::aba::{AbaBuffers, aba, kernel};
 use super::data::{AbaLink, SpatialData};
 use super::model::SpatialModel;
 use crate::aba::MAX_WIDTH;
-use crate::aba_batch::{BatchError, MAX_BATCH_LINKS, all_finite};
+use crate::batch_driver::{AbaKernel, BatchError, MAX_BATCH_LINKS, run_batch};
 use crate::error::DynError;
 
 /// Workspace of [`aba_batch`] for one [`SpatialModel`]: create it once, reuse it for every batch.
@@ -97,97 +97,44 @@ pub fn aba_batch(
     tau: &[f64],
     qdd: &mut [f64],
 ) -> Result<(), BatchError> {
-    let n = model.n_links();
-    let shape = |name, found, expected| {
-        if found == expected {
-            Ok(())
-        } else {
-            Err(BatchError::Shape(DynError::Dimension {
-                name,
-                expected,
-                found,
-            }))
-        }
-    };
-    shape(
+    let workspace = (
         "data (a SpatialBatchData built for another model)",
         data.n_links(),
-        n,
-    )?;
-    let values = q.len() - q.len() % n;
-    shape("q (whole states of n values)", q.len(), values)?;
-    shape("v (as many values as q)", v.len(), values)?;
-    shape("tau (as many values as q)", tau.len(), values)?;
-    shape("qdd (as many values as q)", qdd.len(), values)?;
+    );
     let arch = data.arch;
-    arch.dispatch(Batch {
-        model,
-        data,
-        inputs: [q, v, tau],
-        qdd,
-    })
+    run_batch(Spatial { model, data }, arch, workspace, [q, v, tau], qdd)
 }
 
-/// One batch, run by [`pulp::Arch::dispatch`] with the processor's instruction set.
-struct Batch<'a> {
+/// The spatial chain's part of a batch: the kernel of [`super::aba`] and [`aba`](super::aba()).
+struct Spatial<'a> {
     model: &'a SpatialModel,
     data: &'a mut SpatialBatchData,
-    inputs: [&'a [f64]; 3],
-    qdd: &'a mut [f64],
 }
 
-impl WithSimd for Batch<'_> {
-    type Output = Result<(), BatchError>;
+impl AbaKernel for Spatial<'_> {
+    fn n_links(&self) -> usize {
+        self.model.n_links()
+    }
 
     #[inline(always)]
-    fn with_simd<S: Simd>(mut self, simd: S) -> Self::Output {
-        let n = self.model.n_links();
-        let width = S::F64_LANES;
-        let states = self.qdd.len() / n;
-        if width > MAX_WIDTH || n > MAX_BATCH_LINKS {
-            return self.states(0, states);
-        }
-        let grouped = states - states % width;
-        for first in (0..grouped).step_by(width) {
-            let range = first * n..(first + width) * n;
-            let inputs = self.inputs.map(|x| &x[range.clone()]);
-            let finite = inputs.iter().all(|x| all_finite(x));
-            let buffers = AbaBuffers {
-                angle: &mut self.data.angle,
-                sin: &mut self.data.sin,
-                cos: &mut self.data.cos,
-                links: &mut self.data.links,
-                arch: self.data.arch,
-            };
-            let out = &mut self.qdd[range];
-            let ok = finite
-                && kernel::<Pack<S>>(simd, self.model, buffers, inputs, out).is_ok()
-                && all_finite(out);
-            if !ok {
-                self.states(first, first + width)?;
-            }
-        }
-        self.states(grouped, states)
+    fn group<S: Simd>(
+        &mut self,
+        simd: S,
+        inputs: [&[f64]; 3],
+        qdd: &mut [f64],
+    ) -> Result<(), DynError> {
+        let buffers = AbaBuffers {
+            angle: &mut self.data.angle,
+            sin: &mut self.data.sin,
+            cos: &mut self.data.cos,
+            links: &mut self.data.links,
+            arch: self.data.arch,
+        };
+        kernel::<Pack<S>>(simd, self.model, buffers, inputs, qdd)
     }
-}
 
-impl Batch<'_> {
-    /// States `first..last` one at a time, by [`aba`].
-    fn states(&mut self, first: usize, last: usize) -> Result<(), BatchError> {
-        let n = self.model.n_links();
-        for state in first..last {
-            let range = state * n..(state + 1) * n;
-            let [q, v, tau] = self.inputs.map(|x| &x[range.clone()]);
-            aba(
-                self.model,
-                &mut self.data.single,
-                q,
-                v,
-                tau,
-                &mut self.qdd[range],
-            )
-            .map_err(|error| BatchError::State { state, error })?;
-        }
-        Ok(())
+    fn one_state(&mut self, inputs: [&[f64]; 3], qdd: &mut [f64]) -> Result<(), DynError> {
+        let [q, v, tau] = inputs;
+        aba(self.model, &mut self.data.single, q, v, tau, qdd)
     }
 }

@@ -53,7 +53,7 @@ pub fn aba_derivatives(
 ) -> Result<(), DynError> {
     check::dense_count("the ABA derivatives", model.n_links())?;
     let n = super::check_inputs(model, data, &[("q", q), ("v", v), ("tau", tau)])?;
-    check::length(
+    lane_math::check_len(
         "derivatives (a SpatialDerivativeData built for another model)",
         derivatives.n_links(),
         n,

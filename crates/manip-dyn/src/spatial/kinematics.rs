@@ -156,8 +156,8 @@ pub fn jacobian(
             n_links: n,
         });
     }
-    check::length("out (rows)", out.nrows(), 6)?;
-    check::length("out (columns)", out.ncols(), n)?;
+    lane_math::check_len("out (rows)", out.nrows(), 6)?;
+    lane_math::check_len("out (columns)", out.ncols(), n)?;
     update_poses(model, data, q);
     let target = data.poses[link].apply(point);
     for k in 0..n {

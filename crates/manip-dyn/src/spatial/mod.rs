@@ -78,7 +78,7 @@ fn check_inputs(
     inputs: &[(&'static str, &[f64])],
 ) -> Result<usize, DynError> {
     let n = model.n_links();
-    check::length(
+    lane_math::check_len(
         "data (a SpatialData built for another model)",
         data.n_links(),
         n,

@@ -83,7 +83,7 @@ pub fn rnea_derivatives(
 ) -> Result<(), DynError> {
     check::dense_count("the RNEA derivatives", model.n_links())?;
     let n = super::check_inputs(model, data, &[("q", q), ("v", v), ("qdd", qdd)])?;
-    check::length(
+    lane_math::check_len(
         "derivatives (a SpatialDerivativeData built for another model)",
         derivatives.n_links(),
         n,

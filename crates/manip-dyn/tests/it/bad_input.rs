@@ -315,7 +315,7 @@ fn call_rows() -> Vec<Row<DynError>> {
                     qdd,
                 )
             }),
-            |e| matches!(e, DynError::NonFinite { name: "v", index: 1, value } if value.is_nan()),
+            |e| matches!(e, DynError::NonFinite { name: "v", index: Some(1), value } if value.is_nan()),
             "v[1] must be finite, got NaN",
         ),
         words(
@@ -591,7 +591,7 @@ fn non_finite_inputs_are_refused() {
                 match (algorithm.call)(&arm, &mut data, &mut args) {
                     Err(DynError::NonFinite {
                         name,
-                        index: 2,
+                        index: Some(2),
                         value,
                     }) => {
                         assert_eq!(name, input, "{}", algorithm.name);
@@ -1063,7 +1063,7 @@ fn spatial_rows() -> Vec<Row<DynError>> {
                     e,
                     DynError::NonFinite {
                         name: "v",
-                        index: 1,
+                        index: Some(1),
                         ..
                     }
                 )

@@ -209,7 +209,7 @@ fn workspaces_are_checked() {
             error,
             DynError::NonFinite {
                 name: "q",
-                index: 3,
+                index: Some(3),
                 ..
             }
         ),
@@ -222,7 +222,7 @@ fn workspaces_are_checked() {
             error,
             DynError::NonFinite {
                 name: "qdd",
-                index: 3,
+                index: Some(3),
                 ..
             }
         ),

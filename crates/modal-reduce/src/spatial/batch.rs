@@ -1,33 +1,36 @@
 //! Reduced forward dynamics of a spatial modal arm for many independent states at once, SIMD
 //! across states: [`spatial_forward_dynamics`] of each state, the same bits.
 //!
-//! As the planar batch ([`forward_dynamics_batch`](crate::forward_dynamics_batch)): the states
-//! are taken `W` at a time (`W` the `f64` lanes of the widest instruction set [`pulp::Arch`]
-//! finds at run time, 8 with AVX-512, 4 with AVX2), lane `i` of every register holding state `i`
-//! of the group, and each group runs through the kernel of one state (`accumulate`, the
-//! recursion of [`motion`](super::motion), the `L D L^T` solve), written once over the register
-//! layouts of the [`terms`](super::terms) module (one coordinate of the group's states a
-//! register here), with the same operations in the same order. A group whose inputs
+//! The driver is the planar batch's (`batch_driver.rs`): the states are taken `W` at a time
+//! (`W` the `f64` lanes of the widest instruction set [`pulp::Arch`] finds at run time, 8 with
+//! AVX-512, 4 with AVX2), lane `i` of every register holding state `i` of the group, and each
+//! group runs through the kernel of one state (`accumulate`, the recursion of
+//! [`motion`](super::motion)) and the `L D L^T` solve, written once over the register layouts of
+//! the [`terms`](super::terms) module (one coordinate of the group's states a register here),
+//! with the same operations in the same order. A group whose inputs
 //! are not all finite, or one of whose states fails, is redone one state at a time by
 //! [`spatial_forward_dynamics`], which names the failure; so are the states after the last whole
 //! group, and every state of a model of more than [`MAX_SPATIAL_BATCH_COORDS`] coordinates.
 //!
 //! Memory: the kernel forms each link's joint angles from the map's rows as it goes and keeps
 //! only the `3 x m` Jacobians, `M*`, `C*` and `G*` of a group, on the stack, so a batch needs
-//! nothing of size `n` beyond the model (`O(n m)`) and the one-state workspace.
+//! nothing of size `n` beyond the model (`O(n m)`) and the one-state workspace. These stack
+//! Jacobians are declared here and in the one-state `in_layout` of [`terms`](super::terms) rather
+//! than by one shared helper, because the two hold different registers (`M` packs of states here,
+//! `C` registers of a coordinate layout there) and a helper taking the kernel as a closure would
+//! be compiled without the dispatch's instruction set.
 
 use lane_math::{Lane, Pack};
-use pulp::{Arch, Simd, WithSimd};
+use pulp::{Arch, Simd};
 
 use super::data::SpatialReducedData;
 use super::forward::spatial_forward_dynamics;
 use super::model::SpatialReducedModel;
 use super::terms::{TermsLanes, TurnsFromModes, accumulate};
-use crate::batch::{BatchError, MAX_WIDTH, check_batch_shape};
+use crate::batch_driver::{Batch, BatchError, BatchKernel, run_batch};
 use crate::batch_group::simd_lanes;
-use crate::error::all_finite;
+use crate::error::ReduceError;
 use crate::terms::StateLanes;
-use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 
 /// The most modal coordinates evaluated SIMD across states (`K = 2` harmonics per plane);
 /// larger models run their batches one state at a time.
@@ -100,153 +103,84 @@ pub fn spatial_forward_dynamics_batch(
     a_ddot: &mut [f64],
 ) -> Result<(), BatchError> {
     data.single.check_model(model).map_err(BatchError::Shape)?;
-    check_batch_shape(model.n_coords(), [a, a_dot, tau_star], a_ddot)?;
-    let arch = data.arch;
-    arch.dispatch(Batch {
+    let kernel = Spatial {
         model,
         single: &mut data.single,
-        inputs: [a, a_dot, tau_star],
-        a_ddot,
-    })
+    };
+    run_batch(kernel, data.arch, [a, a_dot, tau_star], a_ddot)
 }
 
-/// One batch, run by [`pulp::Arch::dispatch`] with the processor's instruction set.
-struct Batch<'a> {
+/// The spatial family's part of a batch: the kernel of [`super::terms`] and
+/// [`spatial_forward_dynamics`].
+struct Spatial<'a> {
     model: &'a SpatialReducedModel,
     single: &'a mut SpatialReducedData,
-    /// `a`, `a_dot`, `tau_star`.
-    inputs: [&'a [f64]; 3],
-    a_ddot: &'a mut [f64],
 }
 
-impl WithSimd for Batch<'_> {
-    type Output = Result<(), BatchError>;
+impl BatchKernel for Spatial<'_> {
+    fn n_coords(&self) -> usize {
+        self.model.n_coords()
+    }
 
     #[inline(always)]
-    fn with_simd<S: Simd>(mut self, simd: S) -> Self::Output {
-        match self.model.n_coords() {
-            4 => self.run::<S, 4>(simd),
-            8 => self.run::<S, 8>(simd),
-            _ => self.states(0),
+    fn dispatch<S: Simd>(batch: Batch<'_, Self>, simd: S) -> Result<(), BatchError> {
+        match batch.kernel().model.n_coords() {
+            4 => batch.groups::<S, 4>(simd),
+            8 => batch.groups::<S, 8>(simd),
+            _ => batch.one_at_a_time(),
         }
     }
-}
 
-impl Batch<'_> {
-    /// Whole groups of `S::F64_LANES` states in SIMD, the rest one at a time.
     #[inline(always)]
-    fn run<S: Simd, const M: usize>(mut self, simd: S) -> Result<(), BatchError> {
-        let width = S::F64_LANES;
-        let states = self.a_ddot.len() / M;
-        if width > MAX_WIDTH {
-            return self.states(0);
-        }
-        let grouped = states - states % width;
-        for first in (0..grouped).step_by(width) {
-            let range = first * M..(first + width) * M;
-            let inputs = self.inputs.map(|x| &x[range.clone()]);
-            if !group::<S, M>(simd, self.model, inputs, &mut self.a_ddot[range]) {
-                self.redo(first, first + width)?;
-            }
-        }
-        self.states(grouped)
+    fn terms<S: Simd, const M: usize>(
+        &mut self,
+        simd: S,
+        a: &[Pack<S>; M],
+        a_dot: &[Pack<S>; M],
+        mass: &mut [[Pack<S>; M]; M],
+        coriolis: &mut [Pack<S>; M],
+        gravity: &mut [Pack<S>; M],
+    ) -> bool {
+        let zero = Pack::splat(simd, 0.0);
+        let mut jacobians = [[[zero; M]; 3]; 6];
+        let [omega, point, com, momentum, body, body_inertia] = &mut jacobians;
+        let work = TermsLanes {
+            omega_jacobian: omega.as_flattened_mut(),
+            point_jacobian: point.as_flattened_mut(),
+            com_jacobian: com.as_flattened_mut(),
+            momentum_jacobian: momentum.as_flattened_mut(),
+            body_jacobian: body.as_flattened_mut(),
+            body_inertia_jacobian: body_inertia.as_flattened_mut(),
+            mass_matrix: mass.as_flattened_mut(),
+            coriolis,
+            gravity,
+        };
+        let turns = TurnsFromModes {
+            context: simd,
+            model: self.model,
+            a,
+            a_dot,
+        };
+        // M*'s lower triangle, all the solve reads.
+        accumulate(
+            StateLanes::new(simd, usize::MAX),
+            self.model,
+            &turns,
+            M,
+            work,
+        );
+        true
     }
 
-    /// States `first..` one at a time.
-    fn states(&mut self, first: usize) -> Result<(), BatchError> {
-        let states = self.a_ddot.len() / self.model.n_coords();
-        self.redo(first, states)
+    fn one_state(
+        &mut self,
+        a: &[f64],
+        a_dot: &[f64],
+        tau_star: &[f64],
+        a_ddot: &mut [f64],
+    ) -> Result<(), ReduceError> {
+        spatial_forward_dynamics(self.model, self.single, a, a_dot, tau_star, a_ddot)
     }
-
-    /// States `first..last` one at a time, by [`spatial_forward_dynamics`].
-    fn redo(&mut self, first: usize, last: usize) -> Result<(), BatchError> {
-        let m = self.model.n_coords();
-        for state in first..last {
-            let range = state * m..(state + 1) * m;
-            let [a, a_dot, tau_star] = self.inputs.map(|x| &x[range.clone()]);
-            spatial_forward_dynamics(
-                self.model,
-                self.single,
-                a,
-                a_dot,
-                tau_star,
-                &mut self.a_ddot[range],
-            )
-            .map_err(|error| BatchError::State { state, error })?;
-        }
-        Ok(())
-    }
-}
-
-/// One group of `S::F64_LANES` states of `M` coordinates (`inputs` and `out` hold exactly
-/// those): gathers the inputs into lanes, runs the kernel and the solve, scatters the
-/// accelerations. `false` if an input is not finite or any state failed (`out` is then
-/// unspecified).
-#[inline(always)]
-fn group<S: Simd, const M: usize>(
-    simd: S,
-    model: &SpatialReducedModel,
-    inputs: [&[f64]; 3],
-    out: &mut [f64],
-) -> bool {
-    let width = S::F64_LANES;
-    if !(all_finite(inputs[0]) & all_finite(inputs[1]) & all_finite(inputs[2])) {
-        return false;
-    }
-    // Loops, not closures: a closure is compiled without the dispatch's instruction set.
-    let zero = Pack::splat(simd, 0.0);
-    let mut buffer = [0.0; MAX_WIDTH];
-    let mut lanes = [[zero; M]; 3];
-    for (values, packs) in inputs.iter().zip(&mut lanes) {
-        for (k, pack) in packs.iter_mut().enumerate() {
-            for (lane, slot) in buffer[..width].iter_mut().enumerate() {
-                *slot = values[lane * M + k];
-            }
-            *pack = Pack::load(simd, &buffer);
-        }
-    }
-    let [a, a_dot, tau_star] = lanes;
-    let mut jacobians = [[[zero; M]; 3]; 6];
-    let [omega, point, com, momentum, body, body_inertia] = &mut jacobians;
-    let mut mass = [[zero; M]; M];
-    let (mut coriolis, mut gravity) = ([zero; M], [zero; M]);
-    let work = TermsLanes {
-        omega_jacobian: omega.as_flattened_mut(),
-        point_jacobian: point.as_flattened_mut(),
-        com_jacobian: com.as_flattened_mut(),
-        momentum_jacobian: momentum.as_flattened_mut(),
-        body_jacobian: body.as_flattened_mut(),
-        body_inertia_jacobian: body_inertia.as_flattened_mut(),
-        mass_matrix: mass.as_flattened_mut(),
-        coriolis: &mut coriolis,
-        gravity: &mut gravity,
-    };
-    let turns = TurnsFromModes {
-        context: simd,
-        model,
-        a: &a,
-        a_dot: &a_dot,
-    };
-    // M*'s lower triangle, all the solve reads.
-    accumulate(StateLanes::new(simd, usize::MAX), model, &turns, M, work);
-    // The right-hand side tau* - C* - G* and the solve, as in `spatial_forward_dynamics`.
-    let mut x = tau_star;
-    for ((x, &c), &g) in x.iter_mut().zip(&coriolis).zip(&gravity) {
-        *x = *x - c - g;
-    }
-    if !ldlt_in_place(simd, mass.as_flattened_mut(), M) {
-        return false;
-    }
-    ldlt_solve_in_place(mass.as_flattened(), M, &mut x);
-    let mut finite = true;
-    for (k, value) in x.iter().enumerate() {
-        value.store(&mut buffer);
-        for (lane, &v) in buffer[..width].iter().enumerate() {
-            finite &= v.is_finite();
-            out[lane * M + k] = v;
-        }
-    }
-    finite
 }
 
 #[cfg(test)]

@@ -3,7 +3,8 @@
 
 use super::model::SpatialReducedModel;
 use super::motion::LinkMotion;
-use crate::error::{ReduceError, check_len};
+use crate::error::ReduceError;
+use lane_math::check_len;
 use pulp::Arch;
 
 /// Buffers for [`spatial_reduced_terms`](super::spatial_reduced_terms),
@@ -101,6 +102,7 @@ impl SpatialReducedData {
     /// Checks that this workspace was made for `model`.
     pub(crate) fn check_model(&self, model: &SpatialReducedModel) -> Result<(), ReduceError> {
         check_len("workspace links", self.n_links, model.n_links())?;
-        check_len("workspace coordinates", self.n_coords, model.n_coords())
+        check_len("workspace coordinates", self.n_coords, model.n_coords())?;
+        Ok(())
     }
 }

@@ -19,8 +19,9 @@ use super::tangent::{
     CarriedTangent, JointPair, LinkTangent, WrenchTangent, link_tangent, wrench_tangent,
 };
 use super::torques::spatial_joint_torques;
-use crate::error::{ReduceError, check_finite_result, check_len};
+use crate::error::{ReduceError, check_finite_result};
 use faer::MatRef;
+use lane_math::check_len;
 use lane_math::dense::ldlt_solve_rows_in_place;
 
 /// Results and scratch of [`spatial_reduced_derivatives`] for one [`SpatialReducedModel`]:

@@ -3,7 +3,8 @@
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
 use super::terms::{TermsOfOneState, check_state, check_terms};
-use crate::error::{ReduceError, check_finite_result, check_input, check_len};
+use crate::error::{ReduceError, check_finite_result};
+use lane_math::{check_len, check_values};
 
 /// The modal accelerations `a_ddot` (`m`) under the modal forces `tau_star` at `(a, a_dot)`:
 /// [`spatial_reduced_terms`](super::spatial_reduced_terms), then an `L D L^T` solve of `M*`, in
@@ -21,7 +22,7 @@ pub fn spatial_forward_dynamics(
     a_ddot: &mut [f64],
 ) -> Result<(), ReduceError> {
     let m = model.n_coords();
-    check_input("tau_star", tau_star, m)?;
+    check_values("tau_star", tau_star, m)?;
     check_len("a_ddot", a_ddot.len(), m)?;
     check_state(model, data, a, a_dot)?;
     let arch = data.arch;

@@ -108,15 +108,7 @@ impl SpatialReducedModel {
         // J is two copies of the planar map, one per plane: full column rank with it.
         check_column_rank(map.planar())?;
         base.validate()?;
-        for (index, &value) in gravity.iter().enumerate() {
-            if !value.is_finite() {
-                return Err(ReduceError::NonFinite {
-                    name: "gravity",
-                    index,
-                    value,
-                });
-            }
-        }
+        lane_math::check_all_finite("gravity", &gravity)?;
         let (n, m) = (map.n_links(), map.n_coords());
         let half = m / 2;
         let mut joint_rows = vec![0.0; 2 * n * m + LINK_PADDING];

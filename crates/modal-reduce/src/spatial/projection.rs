@@ -13,7 +13,7 @@ use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
 use super::terms::check_state;
 use super::torques::spatial_project_torques;
-use crate::error::{ReduceError, check_finite_result};
+use crate::error::{ReduceError, check_terms_finite};
 
 /// The chain of the spatial modal arm `model` as a `manip_dyn` spatial chain of `2n` revolute
 /// joints in the order of `theta = [z_1, y_1, z_2, y_2, ...]`: joint `z_i` about the parent
@@ -159,7 +159,5 @@ pub fn spatial_reduced_terms_by_projection(
     spatial_project_torques(model, joint_torque, &mut data.coriolis)?;
     manip_dyn::spatial::gravity(chain, chain_data, &data.theta, joint_torque)?;
     spatial_project_torques(model, joint_torque, &mut data.gravity)?;
-    check_finite_result("reduced mass matrix M*", &data.mass_matrix)?;
-    check_finite_result("reduced Coriolis vector C*", &data.coriolis)?;
-    check_finite_result("reduced gravity vector G*", &data.gravity)
+    check_terms_finite(&data.mass_matrix, &data.coriolis, &data.gravity)
 }

@@ -43,13 +43,13 @@
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
 use super::motion::{Carried, JointTurns, cross_fused, link_step_turned};
-use crate::error::{ReduceError, check_finite_result, check_input};
+use crate::error::{ReduceError, check_terms_finite};
 use crate::forward::right_hand_side;
 use crate::model::LINK_PADDING;
 use crate::terms::{CoordinateLanes, OneStateScalar, Registers, StateLanes};
 use backbone_kin::vec3;
 use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
-use lane_math::{Lane, Pack, sin_cos, sin_cos_lanes};
+use lane_math::{Lane, Pack, check_values, sin_cos, sin_cos_lanes};
 use pulp::{Simd, WithSimd};
 
 /// Computes `M*`, `C*` and `G*` at the modal state `(a, a_dot)` into `data` (read them with
@@ -78,9 +78,7 @@ pub fn spatial_reduced_terms(
 
 /// Checks that the terms in `data` are finite, naming the first that is not.
 pub(crate) fn check_terms(data: &SpatialReducedData) -> Result<(), ReduceError> {
-    check_finite_result("reduced mass matrix M*", &data.mass_matrix)?;
-    check_finite_result("reduced Coriolis vector C*", &data.coriolis)?;
-    check_finite_result("reduced gravity vector G*", &data.gravity)
+    check_terms_finite(&data.mass_matrix, &data.coriolis, &data.gravity)
 }
 
 /// [`spatial_reduced_terms`] after its checks, and with `solve` the forward dynamics' `L D L^T`
@@ -724,6 +722,7 @@ pub(crate) fn check_state(
 ) -> Result<(), ReduceError> {
     data.check_model(model)?;
     let m = model.n_coords();
-    check_input("a", a, m)?;
-    check_input("a_dot", a_dot, m)
+    check_values("a", a, m)?;
+    check_values("a_dot", a_dot, m)?;
+    Ok(())
 }

@@ -12,8 +12,9 @@ use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
 use super::motion::{Carried, link_step, link_wrench, world_inertia};
 use super::terms::check_state;
-use crate::error::{ReduceError, check_finite_result, check_input, check_len};
+use crate::error::{ReduceError, check_finite_result};
 use backbone_kin::vec3::dot;
+use lane_math::{check_len, check_values};
 
 /// The joint torques `tau` (`2n`) of the modal motion `(a, a_dot, a_ddot)`. Allocation-free.
 ///
@@ -28,7 +29,7 @@ pub fn spatial_joint_torques(
     tau: &mut [f64],
 ) -> Result<(), ReduceError> {
     check_state(model, data, a, a_dot)?;
-    check_input("a_ddot", a_ddot, model.n_coords())?;
+    check_values("a_ddot", a_ddot, model.n_coords())?;
     check_len("joint torques", tau.len(), 2 * model.n_links())?;
     let map = model.map();
     map.joint_angles(a, &mut data.theta)?;
@@ -92,7 +93,7 @@ pub fn spatial_project_torques(
     tau_star: &mut [f64],
 ) -> Result<(), ReduceError> {
     let map = model.map();
-    check_input("tau", tau, map.n_joints())?;
+    check_values("tau", tau, map.n_joints())?;
     check_len("tau_star", tau_star.len(), model.n_coords())?;
     tau_star.fill(0.0);
     for (j, &value) in tau.iter().enumerate() {

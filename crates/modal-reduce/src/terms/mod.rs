@@ -101,9 +101,11 @@ use lane_math::Lane;
 use pulp::{Simd, WithSimd};
 
 use crate::data::ReducedData;
-use crate::error::{ReduceError, all_finite, check_finite_result, check_input};
+use crate::error::{ReduceError, check_terms_finite};
 use crate::model::{LINK_PADDING, ReducedModel};
 pub(crate) use kernel::{Terms, accumulate, extract};
+use lane_math::all_finite;
+use lane_math::check_values;
 pub(crate) use layout::{CoordinateLanes, Layout, OneStateScalar, Registers, StateLanes};
 pub(crate) use links::{LinkBuffers, angles_in_range};
 
@@ -153,15 +155,14 @@ pub(crate) fn check_state(
 ) -> Result<(), ReduceError> {
     data.check_model(model)?;
     let m = model.n_coords();
-    check_input("a", a, m)?;
-    check_input("a_dot", a_dot, m)
+    check_values("a", a, m)?;
+    check_values("a_dot", a_dot, m)?;
+    Ok(())
 }
 
 /// Checks that the terms in `data` are finite, naming the first that is not.
 pub(crate) fn check_terms(data: &ReducedData) -> Result<(), ReduceError> {
-    check_finite_result("reduced mass matrix M*", &data.mass)?;
-    check_finite_result("reduced Coriolis vector C*", &data.coriolis)?;
-    check_finite_result("reduced gravity vector G*", &data.gravity)
+    check_terms_finite(&data.mass, &data.coriolis, &data.gravity)
 }
 
 /// The terms of [`reduced_terms`] (inputs already checked), run by [`pulp::Arch::dispatch`] so

@@ -222,7 +222,7 @@ fn call_rows() -> Vec<Row<ReduceError>> {
                     e,
                     ReduceError::NonFinite {
                         name: "a",
-                        index: 1,
+                        index: Some(1),
                         ..
                     }
                 )
@@ -237,7 +237,7 @@ fn call_rows() -> Vec<Row<ReduceError>> {
                     e,
                     ReduceError::NonFinite {
                         name: "a",
-                        index: 1,
+                        index: Some(1),
                         ..
                     }
                 )
@@ -261,7 +261,7 @@ fn call_rows() -> Vec<Row<ReduceError>> {
                     e,
                     ReduceError::NonFinite {
                         name: "a_dot",
-                        index: 2,
+                        index: Some(2),
                         ..
                     }
                 )
@@ -284,7 +284,7 @@ fn call_rows() -> Vec<Row<ReduceError>> {
                     e,
                     ReduceError::NonFinite {
                         name: "tau_star",
-                        index: 0,
+                        index: Some(0),
                         ..
                     }
                 )

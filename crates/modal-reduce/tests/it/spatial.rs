@@ -391,7 +391,7 @@ fn spatial_arms_refuse_bad_input() {
         SpatialReducedModel::new(map.clone(), base, vec![rod; 3], [0.0, f64::NAN, 0.0]),
         Err(ReduceError::NonFinite {
             name: "gravity",
-            index: 1,
+            index: Some(1),
             ..
         })
     ));
@@ -414,7 +414,7 @@ fn spatial_arms_refuse_bad_input() {
         ),
         Err(ReduceError::NonFinite {
             name: "a_dot",
-            index: 1,
+            index: Some(1),
             ..
         })
     ));

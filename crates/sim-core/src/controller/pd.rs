@@ -4,9 +4,10 @@ use super::fuzzy::Layout;
 use super::{
     ControlContext, Controller, ControllerError, ModalState, check_context, check_coordinate_count,
 };
-use crate::error::{SimError, check_finite};
+use crate::error::SimError;
 use crate::reference::ReferenceSample;
 use fuzzy_sugeno::{Evaluator, FuzzySystem};
+use lane_math::check_all_finite;
 
 /// Relative step of the central differences that linearise a fuzzy system, as a fraction of
 /// each input's range width.
@@ -43,7 +44,7 @@ impl PdController {
             ("controller.pd_kp", kp),
             ("controller.pd_kd", kd),
         ] {
-            check_finite(name, values)?;
+            check_all_finite(name, values)?;
             if values.len() != kp.len() {
                 return Err(SimError::setting(
                     name,

@@ -21,7 +21,8 @@ pub use spatial_path::{Helix, SpatialPath};
 pub use spline::{MAX_SPLINE_SAMPLES, SplineMotion};
 pub use waypoints::{MAX_WAYPOINTS, Waypoints};
 
-use crate::error::{SimError, check_finite, check_non_negative};
+use crate::error::{SimError, check_non_negative};
+use lane_math::check_all_finite;
 
 /// The desired modal motion at one instant, `m` entries per field.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -101,9 +102,9 @@ fn check_lengths(arrays: &[(&str, &[f64])]) -> Result<usize, SimError> {
                 format!("has {} entries, {first} has {m}", values.len()),
             ));
         }
-        check_finite(name, values)?;
+        check_all_finite(name, values)?;
     }
-    check_finite(first, values)?;
+    check_all_finite(first, values)?;
     Ok(m)
 }
 

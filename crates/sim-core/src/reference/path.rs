@@ -4,8 +4,9 @@
 
 use super::continuation::{Family, TipMotion, resolve};
 use super::{Reference, ReferenceSample};
-use crate::error::{SimError, check_finite, check_positive};
+use crate::error::{SimError, check_positive};
 use backbone_kin::{BaseAngle, Branch, inverse_kinematics};
+use lane_math::check_all_finite;
 
 /// How finely [`CartesianPath::new`] checks the path for reachability and singular points; also
 /// the number of intervals of the continuation grid.
@@ -111,7 +112,7 @@ impl CartesianPath {
         check_positive("reference.travel_time", travel_time)?;
         check_positive("arm length", length)?;
         if let BaseAngle::Fixed(alpha0) = base {
-            check_finite("alpha0", &[alpha0])?;
+            check_all_finite("alpha0", &[alpha0])?;
         }
         let arc = validate_shape(&shape)?;
         let mut path = Self {
@@ -313,7 +314,7 @@ fn validate_shape(shape: &PathShape) -> Result<Vec<f64>, SimError> {
             x_start,
             x_end,
         } => {
-            check_finite(
+            check_all_finite(
                 "reference path",
                 &[*amplitude, *wavenumber, *phase, *offset, *x_start, *x_end],
             )?;
@@ -335,8 +336,8 @@ fn validate_shape(shape: &PathShape) -> Result<Vec<f64>, SimError> {
             let mut arc = Vec::with_capacity(points.len());
             arc.push(0.0);
             for (k, pair) in points.windows(2).enumerate() {
-                check_finite("reference.points", &pair[1])?;
-                check_finite("reference.points", &pair[0])?;
+                check_all_finite("reference.points", &pair[1])?;
+                check_all_finite("reference.points", &pair[0])?;
                 let seg = (pair[1][0] - pair[0][0]).hypot(pair[1][1] - pair[0][1]);
                 if seg == 0.0 {
                     return Err(SimError::setting(

@@ -4,9 +4,10 @@
 
 use super::continuation::{RateScratch, ResolveError, TipFamily, TipMotion, resolve};
 use super::{Reference, ReferenceSample};
-use crate::error::{SimError, check_finite, check_positive};
+use crate::error::{SimError, check_positive};
 use backbone_kin::vec3::{cross, dot, sub};
 use backbone_kin::{BasePose, Branch, KinError, SpatialIk, SpatialModalMap, inverse_kinematics};
+use lane_math::check_all_finite;
 
 /// Intervals of the continuation's time grid.
 const GRID_INTERVALS: usize = 2000;
@@ -43,10 +44,10 @@ struct HelixFrame {
 
 impl Helix {
     fn frame(&self) -> Result<HelixFrame, SimError> {
-        check_finite("reference.helix.center", &self.center)?;
-        check_finite("reference.helix.axis", &self.axis)?;
-        check_finite("reference.helix.start", &self.start)?;
-        check_finite("reference.helix.pitch", &[self.pitch])?;
+        check_all_finite("reference.helix.center", &self.center)?;
+        check_all_finite("reference.helix.axis", &self.axis)?;
+        check_all_finite("reference.helix.start", &self.start)?;
+        check_all_finite("reference.helix.pitch", &[self.pitch])?;
         check_positive("reference.helix.turns", self.turns)?;
         if self.turns > 1e3 {
             return Err(SimError::setting(

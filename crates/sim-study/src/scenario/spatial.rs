@@ -4,11 +4,12 @@
 use super::arm::{ArmKind, Gravity, Inertias};
 use super::schema::{Alpha0, ArmSpec, BranchSpec, HelixSpec, ReferenceSpec, Scenario};
 use backbone_kin::{BasePose, Branch, SpatialModalMap};
+use lane_math::check_all_finite;
 use manip_dyn::DynError;
 use modal_reduce::spatial::{SpatialLinkInertia, SpatialReducedModel};
 use modal_reduce::{PlantModel, ReduceError};
 use sim_core::reference::{Helix, SpatialPath};
-use sim_core::{Prepared, ReferenceFactory, SimError, check_finite};
+use sim_core::{Prepared, ReferenceFactory, SimError};
 
 /// Gravity of a spatial arm without `arm.gravity`: 9.81 m/s^2 along `-z`.
 const DEFAULT_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
@@ -168,10 +169,10 @@ impl ArmSpec {
                 .collect(),
         };
         let base: BasePose = self.base.unwrap_or_default().into();
-        check_finite("arm.base.xyz", &base.xyz)?;
-        check_finite("arm.base.rpy", &base.rpy)?;
+        check_all_finite("arm.base.xyz", &base.xyz)?;
+        check_all_finite("arm.base.rpy", &base.rpy)?;
         let gravity = self.gravity.map_or(DEFAULT_GRAVITY, Gravity::spatial);
-        check_finite("arm.gravity", &gravity)?;
+        check_all_finite("arm.gravity", &gravity)?;
         let map = SpatialModalMap::new(&lengths, k)
             .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))?;
         // Lengths and masses are checked above: a link the model refuses has a bad inertia.

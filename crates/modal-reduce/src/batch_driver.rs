@@ -1,0 +1,224 @@
+//! The driver of the planar and the spatial batch ([`forward_dynamics_batch`] and
+//! [`spatial_forward_dynamics_batch`]), written once over an arm family's [`BatchKernel`].
+//!
+//! It checks that the slices hold whole states, takes the states `W` at a time (`W` the `f64`
+//! lanes of the widest instruction set [`pulp::Arch`] finds at run time: 8 with AVX-512, 4 with
+//! AVX2), gathers each group's inputs into lanes (lane `i` of every register holds state `i` of
+//! the group), has the kernel form `M*`, `C*` and `G*` of the group, solves
+//! `M* a_ddot = tau* - C* - G*` by `L D L^T` ([`lane_math::dense`]) and scatters the
+//! accelerations: the operations of the one-state path, in its order, so each state's result is
+//! the same bits. A group whose inputs are not all finite, or one of whose states fails (a
+//! non-positive pivot, an overflow, an angle the kernel does not take), is redone one state at a
+//! time by the family's one-state forward dynamics, which names the failure; so are the states
+//! left over after the last whole group, and every state of a model without a SIMD kernel.
+//!
+//! [`forward_dynamics_batch`]: crate::forward_dynamics_batch
+//! [`spatial_forward_dynamics_batch`]: crate::spatial::spatial_forward_dynamics_batch
+
+use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
+use lane_math::{Classify, ErrorClass, Lane, Pack, check_len};
+use pulp::{Arch, Simd, WithSimd};
+
+use crate::error::ReduceError;
+use lane_math::all_finite;
+
+/// The most `f64` lanes of a SIMD register (AVX-512).
+pub(crate) const MAX_WIDTH: usize = 8;
+
+/// Why a batch was refused: its slices do not hold whole states, or one state failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum BatchError {
+    /// The slices do not hold the same whole number of states of `m` values each.
+    #[error(transparent)]
+    Shape(ReduceError),
+    /// The state at this index (0-based; the lowest one that failed) was refused.
+    #[error("state {state}: {error}")]
+    State {
+        /// 0-based index of the state in the batch.
+        state: usize,
+        /// Why the one-state forward dynamics refused it.
+        error: ReduceError,
+    },
+}
+
+impl Classify for BatchError {
+    /// The class of the [`ReduceError`] inside.
+    fn class(&self) -> ErrorClass {
+        match self {
+            Self::Shape(error) | Self::State { error, .. } => error.class(),
+        }
+    }
+}
+
+/// What an arm family brings to the driver: its SIMD kernel of one group and its one-state path.
+pub(crate) trait BatchKernel: Sized {
+    /// The model's number of modal coordinates `m`.
+    fn n_coords(&self) -> usize;
+
+    /// Runs `batch` with the group size `M = m` when the family has a SIMD kernel for it
+    /// ([`Batch::groups`]), one state at a time otherwise ([`Batch::one_at_a_time`]).
+    fn dispatch<S: Simd>(batch: Batch<'_, Self>, simd: S) -> Result<(), BatchError>;
+
+    /// `M*` (row-major `M x M`), `C*` and `G*` of one group of `S::F64_LANES` states, whose
+    /// finite coordinates and rates are `a` and `a_dot`; `false` if the kernel does not take these
+    /// states (the outputs are then unspecified).
+    fn terms<S: Simd, const M: usize>(
+        &mut self,
+        simd: S,
+        a: &[Pack<S>; M],
+        a_dot: &[Pack<S>; M],
+        mass: &mut [[Pack<S>; M]; M],
+        coriolis: &mut [Pack<S>; M],
+        gravity: &mut [Pack<S>; M],
+    ) -> bool;
+
+    /// The one-state forward dynamics of one state, which names a failure.
+    fn one_state(
+        &mut self,
+        a: &[f64],
+        a_dot: &[f64],
+        tau_star: &[f64],
+        a_ddot: &mut [f64],
+    ) -> Result<(), ReduceError>;
+}
+
+/// Checks that `a`, `a_dot`, `tau_star` and `a_ddot` hold the same whole number of states of
+/// `kernel`'s `m` values each, then runs the batch with `arch`'s instruction set.
+pub(crate) fn run_batch<K: BatchKernel>(
+    kernel: K,
+    arch: Arch,
+    inputs: [&[f64]; 3],
+    a_ddot: &mut [f64],
+) -> Result<(), BatchError> {
+    let [a, a_dot, tau_star] = inputs;
+    let m = kernel.n_coords();
+    let values = a.len() - a.len() % m;
+    let shape =
+        |name, found| check_len(name, found, values).map_err(|e| BatchError::Shape(e.into()));
+    shape("a (whole states of m values)", a.len())?;
+    shape("a_dot (as many values as a)", a_dot.len())?;
+    shape("tau_star (as many values as a)", tau_star.len())?;
+    shape("a_ddot (as many values as a)", a_ddot.len())?;
+    arch.dispatch(Batch {
+        kernel,
+        inputs,
+        a_ddot,
+    })
+}
+
+/// One batch, run by [`pulp::Arch::dispatch`] with the processor's instruction set.
+pub(crate) struct Batch<'a, K> {
+    kernel: K,
+    /// `a`, `a_dot`, `tau_star`.
+    inputs: [&'a [f64]; 3],
+    a_ddot: &'a mut [f64],
+}
+
+impl<K: BatchKernel> WithSimd for Batch<'_, K> {
+    type Output = Result<(), BatchError>;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> Self::Output {
+        K::dispatch(self, simd)
+    }
+}
+
+impl<K: BatchKernel> Batch<'_, K> {
+    /// The kernel, for [`BatchKernel::dispatch`] to choose `M`.
+    pub(crate) fn kernel(&self) -> &K {
+        &self.kernel
+    }
+
+    /// Whole groups of `S::F64_LANES` states of `M = m` coordinates in SIMD, the rest one at a
+    /// time.
+    #[inline(always)]
+    pub(crate) fn groups<S: Simd, const M: usize>(mut self, simd: S) -> Result<(), BatchError> {
+        let width = S::F64_LANES;
+        let states = self.a_ddot.len() / M;
+        if width > MAX_WIDTH {
+            return self.states(0, states);
+        }
+        let grouped = states - states % width;
+        for first in (0..grouped).step_by(width) {
+            let range = first * M..(first + width) * M;
+            let inputs = self.inputs.map(|x| &x[range.clone()]);
+            if !group::<S, M, K>(simd, &mut self.kernel, inputs, &mut self.a_ddot[range]) {
+                self.states(first, first + width)?;
+            }
+        }
+        self.states(grouped, states)
+    }
+
+    /// Every state one at a time.
+    pub(crate) fn one_at_a_time(mut self) -> Result<(), BatchError> {
+        let states = self.a_ddot.len() / self.kernel.n_coords();
+        self.states(0, states)
+    }
+
+    /// States `first..last` one at a time, by the kernel's one-state path.
+    fn states(&mut self, first: usize, last: usize) -> Result<(), BatchError> {
+        let m = self.kernel.n_coords();
+        for state in first..last {
+            let range = state * m..(state + 1) * m;
+            let [a, a_dot, tau_star] = self.inputs.map(|x| &x[range.clone()]);
+            self.kernel
+                .one_state(a, a_dot, tau_star, &mut self.a_ddot[range])
+                .map_err(|error| BatchError::State { state, error })?;
+        }
+        Ok(())
+    }
+}
+
+/// One group of `S::F64_LANES` states of `M` coordinates (`inputs` and `out` hold exactly
+/// those): gathers the inputs into lanes, has the kernel form the terms, solves and scatters the
+/// accelerations. `false` if an input is not finite or any state failed (`out` is then
+/// unspecified).
+#[inline(always)]
+fn group<S: Simd, const M: usize, K: BatchKernel>(
+    simd: S,
+    kernel: &mut K,
+    inputs: [&[f64]; 3],
+    out: &mut [f64],
+) -> bool {
+    let width = S::F64_LANES;
+    if !(all_finite(inputs[0]) & all_finite(inputs[1]) & all_finite(inputs[2])) {
+        return false;
+    }
+    // Loops, not closures: a closure is compiled without the dispatch's instruction set.
+    let zero = Pack::splat(simd, 0.0);
+    let mut buffer = [0.0; MAX_WIDTH];
+    let mut lanes = [[zero; M]; 3];
+    for (values, packs) in inputs.iter().zip(&mut lanes) {
+        for (k, pack) in packs.iter_mut().enumerate() {
+            for (lane, slot) in buffer[..width].iter_mut().enumerate() {
+                *slot = values[lane * M + k];
+            }
+            *pack = Pack::load(simd, &buffer);
+        }
+    }
+    let [a, a_dot, tau_star] = lanes;
+    let mut mass = [[zero; M]; M];
+    let (mut coriolis, mut gravity) = ([zero; M], [zero; M]);
+    if !kernel.terms(simd, &a, &a_dot, &mut mass, &mut coriolis, &mut gravity) {
+        return false;
+    }
+    // The right-hand side tau* - C* - G* and the solve, as in the one-state path.
+    let mut x = tau_star;
+    for ((x, &c), &g) in x.iter_mut().zip(&coriolis).zip(&gravity) {
+        *x = *x - c - g;
+    }
+    if !ldlt_in_place(simd, mass.as_flattened_mut(), M) {
+        return false;
+    }
+    ldlt_solve_in_place(mass.as_flattened(), M, &mut x);
+    let mut finite = true;
+    for (k, value) in x.iter().enumerate() {
+        value.store(&mut buffer);
+        for (lane, &v) in buffer[..width].iter().enumerate() {
+            finite &= v.is_finite();
+            out[lane * M + k] = v;
+        }
+    }
+    finite
+}
