@@ -1,4 +1,5 @@
-//! Reduction of a base angle into `(-pi, pi]`.
+//! Reduction of an angle into `(-pi, pi]`, the one the library uses (base angles, the closed-form
+//! inverse, `hrm eval`).
 
 use std::f64::consts::PI;
 
@@ -9,6 +10,9 @@ use std::f64::consts::PI;
 /// chain only through sines and cosines, but `theta_1 = alpha0 + ...` (eq 8) would lose the modal
 /// part in rounding for a large one: callers reduce it first. A non-finite angle is returned as
 /// it is, for the caller's check to name.
+///
+/// The range in doubles is `[-PI, PI]`: `PI` and `-PI` are the doubles nearest `pi` and `-pi`,
+/// both strictly inside `(-pi, pi]` (`PI < pi`), and each is returned as it is.
 ///
 /// ```
 /// use backbone_kin::reduce_angle;
@@ -40,6 +44,27 @@ mod tests {
         }
         assert!((reduce_angle(7.0) - (7.0 - 2.0 * PI)).abs() < 1e-15);
         assert_eq!(reduce_angle(f64::INFINITY), f64::INFINITY);
+        assert_eq!(reduce_angle(f64::NEG_INFINITY), f64::NEG_INFINITY);
         assert!(reduce_angle(f64::NAN).is_nan());
+    }
+
+    #[test]
+    fn the_ends_of_the_range_are_the_doubles_next_to_plus_and_minus_pi() {
+        // `PI` and `-PI` are the doubles nearest pi and -pi, both inside (-pi, pi]: kept.
+        assert_eq!(reduce_angle(PI).to_bits(), PI.to_bits());
+        assert_eq!(reduce_angle(-PI).to_bits(), (-PI).to_bits());
+        // Just past either end, the other end.
+        let above = f64::from_bits(PI.to_bits() + 1);
+        assert!(reduce_angle(above) < -PI + 1e-15 && reduce_angle(above) >= -PI);
+        let below = -above;
+        assert!(reduce_angle(below) > PI - 1e-15 && reduce_angle(below) <= PI);
+        // A difference of two angles in (-pi, pi], as the closed-form inverse forms, turned by a
+        // whole turn and kept to the last bit otherwise.
+        for (x, expected) in [(1.5 * PI, -0.5 * PI), (-1.5 * PI, 0.5 * PI), (-2.0, -2.0)] {
+            let r = reduce_angle(x);
+            assert!((r - expected).abs() < 1e-15, "{x}: {r}");
+        }
+        assert_eq!(reduce_angle(-1e-300), -1e-300);
+        assert_eq!(reduce_angle(-0.0).to_bits(), (-0.0f64).to_bits());
     }
 }

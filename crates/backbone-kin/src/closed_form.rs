@@ -6,6 +6,7 @@
 //! paper puts `l` inside the Bessel argument, wrongly). Inverting: the direction of the target
 //! fixes `a2`, its distance fixes `A`, and `a1 = ±sqrt(A^2 - a2^2)`.
 
+use crate::angle::reduce_angle;
 use crate::bessel::inverse_j0;
 use crate::error::KinError;
 use crate::validate::check_length;
@@ -97,7 +98,7 @@ pub fn inverse_kinematics(
     if r <= length * f64::EPSILON {
         return Err(KinError::AtBase { r, length });
     }
-    let a2 = wrap_angle(target[1].atan2(target[0]) - alpha0);
+    let a2 = reduce_angle(target[1].atan2(target[0]) - alpha0);
     let amplitude = inverse_j0((r / length).min(1.0))?;
     // The slack (never negative) is only needed, and its J1 only evaluated, past the amplitude.
     if a2.abs() > amplitude {
@@ -116,26 +117,4 @@ pub fn inverse_kinematics(
         Branch::Positive => [a1, a2],
         Branch::Negative => [-a1, a2],
     })
-}
-
-/// Wraps an angle to `(-pi, pi]`.
-fn wrap_angle(angle: f64) -> f64 {
-    use std::f64::consts::{PI, TAU};
-    let wrapped = angle.rem_euclid(TAU);
-    if wrapped > PI { wrapped - TAU } else { wrapped }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use std::f64::consts::PI;
-
-    #[test]
-    fn wrap_angle_lands_in_half_open_interval() {
-        assert_eq!(wrap_angle(PI), PI);
-        assert!((wrap_angle(-PI) - PI).abs() < 1e-15);
-        assert!((wrap_angle(3.0 * PI / 2.0) + PI / 2.0).abs() < 1e-15);
-        assert!((wrap_angle(-7.0) - (-7.0 + 2.0 * PI)).abs() < 1e-15);
-        assert_eq!(wrap_angle(0.25), 0.25);
-    }
 }
