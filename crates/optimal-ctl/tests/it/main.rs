@@ -3,6 +3,7 @@
 //! constrained QP against enumeration of active sets (`qp`); iLQR under linear control
 //! constraints against the condensed QP of the whole horizon (`constrained_ilqr`).
 
+mod chain_mpc;
 mod constrained_ilqr;
 mod optimal;
 mod qp;
