@@ -33,12 +33,14 @@
 //! }
 //! ```
 
+mod chain_mpc;
 mod computed_torque;
 mod fuzzy;
 mod lqr;
 mod mpc;
 mod pd;
 
+pub use chain_mpc::ChainMpcController;
 pub use computed_torque::ComputedTorque;
 pub use fuzzy::FuzzyController;
 pub use fuzzy::{SCHEDULED_INPUTS_PER_COORDINATE, scheduled_inputs};
