@@ -247,8 +247,8 @@ fn run(
         let t = (k as f64 * settings.period).min(settings.duration);
         reference.sample(t, &mut sample)?;
         let (q, v) = state.split_at(n);
-        for i in 0..n {
-            let error = sample.a[i] - q[i];
+        for (i, (r, x)) in sample.a.iter().zip(q).enumerate() {
+            let error = r - x;
             if error.abs() > settings.max_joint_error || !error.is_finite() {
                 return Err(SimError::RunawayError {
                     t,
