@@ -203,7 +203,8 @@ impl Scenario {
     /// its steps as joint values `(q, J a + theta_0)`, interpolated by [`SplineMotion`] over
     /// `reference.travel_time` (then held), tracked from rest at its start by computed torque
     /// (`controller.kp`, `controller.kd`: one entry per joint, the insertion first; defaults 2500
-    /// and 100) every `controller.period` (default the RK4 step) on the whole chain
+    /// and 100), or with `controller.kind = "mpc"` by joint-space MPC ([`ChainMpcController`],
+    /// `deploy_mpc_settings`), every `controller.period` (default the RK4 step) on the whole chain
     /// ([`deploy_model`](Self::deploy_model), [`run_chain_loop`]), and measures the deployment
     /// metrics on the arm's shape at every recorded sample (the deployed length being the
     /// insertion `q`).
@@ -212,7 +213,7 @@ impl Scenario {
     /// As [`deployment`](Self::deployment); [`SimError::InvalidSetting`] naming the key for
     /// what a deployment does not use (`alpha0`: the insertion axis sets it; `initial`,
     /// `obstacles`, `task`, noise, `limits` other than `max_modal_error`, a controller other
-    /// than computed torque, dopri5, a reference other than `"planned"`) and for more than
+    /// than computed torque or MPC, dopri5, a reference other than `"planned"`) and for more than
     /// [`MAX_DEPLOY_RECORDED_SAMPLES`] recorded samples; the run's errors ([`run_chain_loop`]).
     pub fn run_deploy(&self) -> Result<DeployRun, SimError> {
         if self.deploy.is_none() {
