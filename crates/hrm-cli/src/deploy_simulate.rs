@@ -10,7 +10,7 @@ use crate::plot::{self, Labels, Series, Style};
 use crate::{console, report};
 use lane_math::Compact;
 use serde_json::json;
-use sim_study::{DeployRun, Scenario};
+use sim_study::{ControllerKind, DeployRun, Scenario};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -35,10 +35,11 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
 pub fn headline(scenario: &Scenario, run: &DeployRun) -> String {
     let m = &run.metrics;
     format!(
-        "{}: computed torque deploying the arm on its insertion axis: tip error {:.3} mm, \
+        "{}: {} deploying the arm on its insertion axis: tip error {:.3} mm, \
          shape deviation {:.2}% of the deployed length, smallest wall clearance {:.2} mm, \
          final |q - q_ref| {:.3e}",
         scenario.name,
+        scenario.controller.kind.name(),
         1e3 * m.tip_error,
         m.shape_deviation_percent,
         1e3 * m.min_wall_clearance,
@@ -137,6 +138,14 @@ pub fn figures(
     run: &DeployRun,
 ) -> Result<Vec<report::Figure>, String> {
     let name = &scenario.name;
+    let kind = scenario.controller.kind;
+    let controller = kind.name();
+    // Computed torque's figures keep the scenario's name alone; another controller's add its.
+    let suffix = if kind == ControllerKind::ComputedTorque {
+        String::new()
+    } else {
+        format!("_{controller}")
+    };
     let t = &run.run.record.t;
     let arm_length: f64 = {
         let shape = run.points_at(0);
@@ -200,8 +209,8 @@ pub fn figures(
             dots: false,
         },
     ));
-    let shapes = format!("deploy_{name}.svg");
-    let title = format!("{name}: the arm every {SHAPE_INTERVAL_S} s in the channel");
+    let shapes = format!("deploy_{name}{suffix}.svg");
+    let title = format!("{name}: the arm every {SHAPE_INTERVAL_S} s in the channel ({controller})");
     plot::xy_chart(
         &dir.join(&shapes),
         &Labels {
@@ -211,7 +220,7 @@ pub fn figures(
         },
         &curves,
     )?;
-    let clearance = format!("deploy_clearance_{name}.svg");
+    let clearance = format!("deploy_clearance_{name}{suffix}.svg");
     let series = [
         Series {
             label: "wall clearance".into(),
@@ -230,7 +239,7 @@ pub fn figures(
                 .collect(),
         },
     ];
-    let title = format!("{name}: wall clearance and tip error (computed torque)");
+    let title = format!("{name}: wall clearance and tip error ({controller})");
     plot::line_chart(
         &dir.join(&clearance),
         &Labels {
@@ -246,14 +255,14 @@ pub fn figures(
         report::Figure {
             file: format!("figures/{shapes}"),
             caption: format!(
-                "{name} with computed-torque: the arm every {SHAPE_INTERVAL_S} s, light to dark, advancing on its insertion axis into the channel (grey walls), its body on the path its tip (green) traced; shape deviation {:.2}% of the deployed length at most.",
+                "{name} with {controller}: the arm every {SHAPE_INTERVAL_S} s, light to dark, advancing on its insertion axis into the channel (grey walls), its body on the path its tip (green) traced; shape deviation {:.2}% of the deployed length at most.",
                 m.shape_deviation_percent
             ),
         },
         report::Figure {
             file: format!("figures/{clearance}"),
             caption: format!(
-                "{name} with computed-torque: the body's smallest clearance to the walls (link capsules of the arm's radius; above zero: inside) and the tip's distance from the centreline (mm) over time; at least {:.2} mm and at most {:.3} mm.",
+                "{name} with {controller}: the body's smallest clearance to the walls (link capsules of the arm's radius; above zero: inside) and the tip's distance from the centreline (mm) over time; at least {:.2} mm and at most {:.3} mm.",
                 1e3 * m.min_wall_clearance,
                 1e3 * m.tip_error
             ),

@@ -115,14 +115,14 @@ fn experiments(out: &Path, all: &[Scenario]) -> Result<(), String> {
             sections.len() - 1,
             report::Section {
                 title: "Follow-the-leader deployment".into(),
-                text: "The arm on a prismatic insertion axis advances into a channel, its body on the path its tip traced: the kinematic plan (shape-plan's follow_the_leader) tracked by computed torque on the whole chain in joint space (the only controller of a deployment).".into(),
+                text: "The arm on a prismatic insertion axis advances into a channel, its body on the path its tip traced: the kinematic plan (shape-plan's follow_the_leader) tracked on the whole chain in joint space by computed torque and by MPC (iLQR over the chain's joint-space dynamics, insertion included, within a box on the joint efforts).".into(),
                 figures: deploy_figures,
             },
         );
     }
     let groups = groups(scenarios, &outcomes, &learned, &rows)?;
     let intro = format!(
-        "Every scenario ({}) run with every controller ({}; a follow-the-leader deployment with computed torque only): a table and an animation per scenario, then figures in the spirit of the paper's section 5. The {LEARNED} row of {LEARNED_ON} is a fuzzy controller learned by imitation of computed torque on the step and sine responses about a grid of operating points, never on the path ({LEARNED}.fis next to this page). Per-run time series and metrics are in <scenario>/<controller>/timeseries.csv and summary.json next to this page.",
+        "Every scenario ({}) run with every controller ({}; a follow-the-leader deployment with computed torque and MPC): a table and an animation per scenario, then figures in the spirit of the paper's section 5. The {LEARNED} row of {LEARNED_ON} is a fuzzy controller learned by imitation of computed torque on the step and sine responses about a grid of operating points, never on the path ({LEARNED}.fis next to this page). Per-run time series and metrics are in <scenario>/<controller>/timeseries.csv and summary.json next to this page.",
         all.iter()
             .map(|s| s.name.as_str())
             .collect::<Vec<_>>()
@@ -146,8 +146,9 @@ fn experiments(out: &Path, all: &[Scenario]) -> Result<(), String> {
     ))
 }
 
-/// The deployment scenarios' runs (computed torque in joint space, [`Scenario::run_deploy`]):
-/// each run's files into `out/<scenario>/computed-torque` and its figures into `out/figures`;
+/// The deployment scenarios' runs (computed torque, then MPC, in joint space,
+/// [`Scenario::run_deploy`]): each run's files into `out/<scenario>/<controller>` and its
+/// figures into `out/figures`;
 /// returns their entries of the main `summary.json` (a run that fails: its `error`) and the
 /// report's figures.
 fn deploy_runs(
@@ -158,8 +159,16 @@ fn deploy_runs(
     let figures_dir = out.join("figures");
     std::fs::create_dir_all(&figures_dir)
         .map_err(|e| format!("cannot create {}: {e}", figures_dir.display()))?;
-    for scenario in scenarios {
-        let controller = ControllerKind::ComputedTorque.name();
+    for (base, kind) in scenarios.iter().flat_map(|s| {
+        [
+            (s, ControllerKind::ComputedTorque),
+            (s, ControllerKind::Mpc),
+        ]
+    }) {
+        let mut scenario = base.clone();
+        scenario.controller.kind = kind;
+        let scenario = &scenario;
+        let controller = kind.name();
         let dir = out.join(&scenario.name).join(controller);
         match scenario.run_deploy() {
             Ok(run) => {

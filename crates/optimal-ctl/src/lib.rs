@@ -1,6 +1,8 @@
 #![doc = include_str!("../README.md")]
 
 mod box_qp;
+mod chain_euler;
+mod chain_mpc;
 mod discrete;
 mod ilqr;
 mod joint_torque_rows;
@@ -12,6 +14,8 @@ mod polytope;
 mod step_constraints;
 
 pub use box_qp::{BoxQp, BoxQpReport, BoxQpSettings};
+pub use chain_euler::ChainEuler;
+pub use chain_mpc::ChainMpc;
 pub use discrete::{DiscreteDynamics, ReducedEuler};
 pub use ilqr::{Ilqr, IlqrReport, IlqrSettings, MAX_HORIZON, MAX_WORKSPACE, TrackingCost};
 pub use joint_torque_rows::{JointTorqueLimits, JointTorqueRows};
@@ -35,6 +39,9 @@ pub enum OptimalError {
     /// The reduced dynamics refused the state (sizes, non-finite values, or a singular `M*`).
     #[error("reduced dynamics: {0}")]
     Dynamics(#[from] ReduceError),
+    /// The joint-space dynamics of a chain ([`ChainEuler`], [`ChainMpc`]) refused the state.
+    #[error("chain dynamics: {0}")]
+    ChainDynamics(#[from] manip_dyn::DynError),
     /// A setting was out of its domain.
     #[error("{name} must be {requirement}, got {value}")]
     InvalidSetting {
@@ -79,6 +86,7 @@ impl Classify for OptimalError {
     fn class(&self) -> ErrorClass {
         match self {
             Self::Dynamics(e) => e.class(),
+            Self::ChainDynamics(e) => e.class(),
             Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) => ErrorClass::Numerical,
             _ => ErrorClass::InvalidInput,
         }

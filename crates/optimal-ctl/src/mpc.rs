@@ -107,60 +107,8 @@ impl Mpc {
     ) -> Result<Self, OptimalError> {
         let model = model.into();
         let m = model.n_coords();
-        check_step(settings.step)?;
-        if settings.horizon == 0 || settings.horizon > MAX_MPC_HORIZON {
-            return Err(OptimalError::InvalidSetting {
-                name: "horizon",
-                requirement: "between 1 and 10000 steps",
-                value: settings.horizon as f64,
-            });
-        }
-        let terminal = settings.terminal_seconds;
-        if !(terminal.is_finite() && (0.0..=1e6).contains(&terminal)) {
-            return Err(OptimalError::InvalidSetting {
-                name: "terminal_seconds",
-                requirement: "non-negative and at most 1e6 s",
-                value: terminal,
-            });
-        }
-        settings.solver.validate()?;
-        for (name, weights, positive) in [
-            ("position_weight", &settings.position_weight, false),
-            ("rate_weight", &settings.rate_weight, false),
-            ("effort_weight", &settings.effort_weight, true),
-        ] {
-            if weights.len() != m {
-                return Err(OptimalError::Dimension {
-                    name,
-                    expected: m,
-                    found: weights.len(),
-                });
-            }
-            let ok = |w: f64| w <= 1e12 && if positive { w > 0.0 } else { w >= 0.0 };
-            if let Some(&w) = weights.iter().find(|w| !ok(**w)) {
-                return Err(OptimalError::InvalidSetting {
-                    name,
-                    requirement: if positive {
-                        "positive and at most 1e12"
-                    } else {
-                        "non-negative and at most 1e12"
-                    },
-                    value: w,
-                });
-            }
-        }
+        let cost = tracking_cost(settings, m)?;
         let h = settings.step;
-        let state: Vec<f64> = settings
-            .position_weight
-            .iter()
-            .chain(&settings.rate_weight)
-            .map(|w| w * h)
-            .collect();
-        let cost = TrackingCost {
-            terminal: state.iter().map(|w| w / h * terminal).collect(),
-            state,
-            control: settings.effort_weight.iter().map(|w| w * h).collect(),
-        };
         let ilqr = Ilqr::new(2 * m, m, settings.horizon, &cost)?;
         let mut mpc = Self {
             m,
@@ -205,33 +153,7 @@ impl Mpc {
     /// [`OptimalError::Dimension`] for a wrong length, [`OptimalError::InvalidSetting`] for a
     /// limit that is not positive (infinity is allowed: no limit on that coordinate).
     pub fn set_limits(&mut self, limits: Option<&[f64]>) -> Result<(), OptimalError> {
-        match limits {
-            None => {
-                self.lower.fill(f64::NEG_INFINITY);
-                self.upper.fill(f64::INFINITY);
-            }
-            Some(limits) => {
-                if limits.len() != self.m {
-                    return Err(OptimalError::Dimension {
-                        name: "tau_star_limits",
-                        expected: self.m,
-                        found: limits.len(),
-                    });
-                }
-                if let Some(&l) = limits.iter().find(|l| l.is_nan() || **l <= 0.0) {
-                    return Err(OptimalError::InvalidSetting {
-                        name: "tau_star_limits",
-                        requirement: "positive",
-                        value: l,
-                    });
-                }
-                for ((lower, upper), &l) in self.lower.iter_mut().zip(&mut self.upper).zip(limits) {
-                    *lower = -l;
-                    *upper = l;
-                }
-            }
-        }
-        self.ilqr.set_bounds(&self.lower, &self.upper)
+        set_box(&mut self.ilqr, limits, &mut self.lower, &mut self.upper)
     }
 
     /// Sets the reference of node `k` (`0..=N`, time `t + k h` of the plan): `a`, `a_dot` and,
@@ -420,25 +342,153 @@ impl Mpc {
                 });
             }
         }
-        if !self.planned {
-            return Err(OptimalError::InvalidSetting {
-                name: "plan",
-                requirement: "made (solve) before the first control",
-                value: 0.0,
+        plan_feedback(
+            &self.ilqr,
+            self.planned,
+            self.step,
+            elapsed,
+            a,
+            a_dot,
+            &mut self.deviation,
+            tau_star,
+        )
+    }
+}
+
+/// The [`TrackingCost`] of `settings` for `m` coordinates (the running weights times the step,
+/// the terminal weight `terminal_seconds` of the running state weight), after checking every
+/// setting against its domain.
+pub(crate) fn tracking_cost(
+    settings: &MpcSettings,
+    m: usize,
+) -> Result<TrackingCost, OptimalError> {
+    check_step(settings.step)?;
+    if settings.horizon == 0 || settings.horizon > MAX_MPC_HORIZON {
+        return Err(OptimalError::InvalidSetting {
+            name: "horizon",
+            requirement: "between 1 and 10000 steps",
+            value: settings.horizon as f64,
+        });
+    }
+    let terminal = settings.terminal_seconds;
+    if !(terminal.is_finite() && (0.0..=1e6).contains(&terminal)) {
+        return Err(OptimalError::InvalidSetting {
+            name: "terminal_seconds",
+            requirement: "non-negative and at most 1e6 s",
+            value: terminal,
+        });
+    }
+    settings.solver.validate()?;
+    for (name, weights, positive) in [
+        ("position_weight", &settings.position_weight, false),
+        ("rate_weight", &settings.rate_weight, false),
+        ("effort_weight", &settings.effort_weight, true),
+    ] {
+        if weights.len() != m {
+            return Err(OptimalError::Dimension {
+                name,
+                expected: m,
+                found: weights.len(),
             });
         }
-        let fraction = if elapsed.is_finite() {
-            (elapsed / self.step).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let x = self.ilqr.states();
-        for i in 0..2 * m {
-            let planned = x[i] + fraction * (x[2 * m + i] - x[i]);
-            let measured = if i < m { a[i] } else { a_dot[i - m] };
-            self.deviation[i] = measured - planned;
+        let ok = |w: f64| w <= 1e12 && if positive { w > 0.0 } else { w >= 0.0 };
+        if let Some(&w) = weights.iter().find(|w| !ok(**w)) {
+            return Err(OptimalError::InvalidSetting {
+                name,
+                requirement: if positive {
+                    "positive and at most 1e12"
+                } else {
+                    "non-negative and at most 1e12"
+                },
+                value: w,
+            });
         }
-        self.ilqr.feedback(0, &self.deviation, tau_star);
-        Ok(())
     }
+    let h = settings.step;
+    let state: Vec<f64> = settings
+        .position_weight
+        .iter()
+        .chain(&settings.rate_weight)
+        .map(|w| w * h)
+        .collect();
+    let cost = TrackingCost {
+        terminal: state.iter().map(|w| w / h * terminal).collect(),
+        state,
+        control: settings.effort_weight.iter().map(|w| w * h).collect(),
+    };
+    Ok(cost)
+}
+
+/// Sets `ilqr`'s box to `|u_i| <= limits_i` (positive, infinity allowed), or none; `lower` and
+/// `upper` are its workspace (`n_u` entries each).
+pub(crate) fn set_box(
+    ilqr: &mut Ilqr,
+    limits: Option<&[f64]>,
+    lower: &mut [f64],
+    upper: &mut [f64],
+) -> Result<(), OptimalError> {
+    match limits {
+        None => {
+            lower.fill(f64::NEG_INFINITY);
+            upper.fill(f64::INFINITY);
+        }
+        Some(limits) => {
+            if limits.len() != lower.len() {
+                return Err(OptimalError::Dimension {
+                    name: "tau_star_limits",
+                    expected: lower.len(),
+                    found: limits.len(),
+                });
+            }
+            if let Some(&l) = limits.iter().find(|l| l.is_nan() || **l <= 0.0) {
+                return Err(OptimalError::InvalidSetting {
+                    name: "tau_star_limits",
+                    requirement: "positive",
+                    value: l,
+                });
+            }
+            for ((lower, upper), &l) in lower.iter_mut().zip(upper.iter_mut()).zip(limits) {
+                *lower = -l;
+                *upper = l;
+            }
+        }
+    }
+    ilqr.set_bounds(lower, upper)
+}
+
+/// The plan's first control with its feedback about the planned state `elapsed` seconds after
+/// the plan (interpolated between nodes 0 and 1, `elapsed` clamped to `[0, step]`), for the
+/// measured `(a, a_dot)`, into `out`; `deviation` is its workspace (`2m` entries).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn plan_feedback(
+    ilqr: &Ilqr,
+    planned: bool,
+    step: f64,
+    elapsed: f64,
+    a: &[f64],
+    a_dot: &[f64],
+    deviation: &mut [f64],
+    out: &mut [f64],
+) -> Result<(), OptimalError> {
+    let m = a.len();
+    if !planned {
+        return Err(OptimalError::InvalidSetting {
+            name: "plan",
+            requirement: "made (solve) before the first control",
+            value: 0.0,
+        });
+    }
+    let fraction = if elapsed.is_finite() {
+        (elapsed / step).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = ilqr.states();
+    for i in 0..2 * m {
+        let planned = x[i] + fraction * (x[2 * m + i] - x[i]);
+        let measured = if i < m { a[i] } else { a_dot[i - m] };
+        deviation[i] = measured - planned;
+    }
+    ilqr.feedback(0, deviation, out);
+    Ok(())
 }

@@ -13,9 +13,12 @@
 //! steps of at most `dt`. With the exact model the joint error obeys
 //! `e_dd + K_d e_d + K_p e = 0` between samples: it converges for positive gains.
 //!
-//! This loop is separate from the modal loop ([`Simulation`](crate::Simulation)): its state is
-//! the joint vector, not modal coordinates, and its only controller is computed torque.
+//! [`run_chain_loop_mpc`] runs the same loop with joint-space model-predictive control
+//! ([`ChainMpcController`]) in place of computed torque. This loop is separate from the modal
+//! loop ([`Simulation`](crate::Simulation)): its state is the joint vector, not modal
+//! coordinates.
 
+use crate::controller::ChainMpcController;
 use crate::error::{SimError, check_positive};
 use crate::ode::{OdeSystem, Rk4};
 use crate::reference::{Reference, ReferenceSample};
@@ -37,9 +40,11 @@ pub struct ChainLoopSettings {
     /// Recording period (s): every controller sample whose index is a multiple of
     /// `round(record_period / period)` (at least 1) is recorded, and the last.
     pub record_period: f64,
-    /// Stiffness per joint (1/s^2), positive.
+    /// Stiffness per joint (1/s^2), positive (computed torque's; not used by
+    /// [`run_chain_loop_mpc`]).
     pub kp: Vec<f64>,
-    /// Damping per joint (1/s), positive.
+    /// Damping per joint (1/s), positive (computed torque's; not used by
+    /// [`run_chain_loop_mpc`]).
     pub kd: Vec<f64>,
     /// Runaway bound on `|q_i - q_r,i|` (rad or m): the run stops past it.
     pub max_joint_error: f64,
@@ -104,7 +109,7 @@ impl OdeSystem for Plant<'_> {
 }
 
 /// Checks the settings against a chain of `n` joints; returns the number of controller periods.
-fn check(settings: &ChainLoopSettings, n: usize) -> Result<usize, SimError> {
+fn check(settings: &ChainLoopSettings, n: usize, gains: bool) -> Result<usize, SimError> {
     check_positive("duration", settings.duration)?;
     check_positive("controller.period", settings.period)?;
     check_positive("integrator.dt", settings.dt)?;
@@ -120,10 +125,15 @@ fn check(settings: &ChainLoopSettings, n: usize) -> Result<usize, SimError> {
             ),
         ));
     }
-    for (name, gains) in [
-        ("controller.kp", &settings.kp),
-        ("controller.kd", &settings.kd),
-    ] {
+    let checked: &[(&str, &Vec<f64>)] = if gains {
+        &[
+            ("controller.kp", &settings.kp),
+            ("controller.kd", &settings.kd),
+        ]
+    } else {
+        &[]
+    };
+    for &(name, gains) in checked {
         if gains.len() != n {
             return Err(SimError::setting(
                 name,
@@ -172,8 +182,35 @@ pub fn run_chain_loop(
     q0: &[f64],
     settings: &ChainLoopSettings,
 ) -> Result<ChainRun, SimError> {
+    run(model, reference, q0, settings, None)
+}
+
+/// Runs [`run_chain_loop`]'s loop with `mpc` in place of computed torque: at each controller
+/// sample the effort is `mpc`'s ([`ChainMpcController::command`]); `settings.kp` and
+/// `settings.kd` are not used.
+///
+/// # Errors
+/// As [`run_chain_loop`]; [`SimError::Controller`] when the MPC fails at a sample.
+pub fn run_chain_loop_mpc(
+    model: &SpatialModel,
+    reference: &mut dyn Reference,
+    q0: &[f64],
+    settings: &ChainLoopSettings,
+    mpc: &mut ChainMpcController,
+) -> Result<ChainRun, SimError> {
+    run(model, reference, q0, settings, Some(mpc))
+}
+
+/// The loop, with computed torque (`mpc` = `None`) or `mpc`.
+fn run(
+    model: &SpatialModel,
+    reference: &mut dyn Reference,
+    q0: &[f64],
+    settings: &ChainLoopSettings,
+    mut mpc: Option<&mut ChainMpcController>,
+) -> Result<ChainRun, SimError> {
     let n = model.n_links();
-    let periods = check(settings, n)?;
+    let periods = check(settings, n, mpc.is_none())?;
     if reference.n_coords() != n {
         return Err(SimError::setting(
             "reference",
@@ -211,8 +248,8 @@ pub fn run_chain_loop(
         let t = (k as f64 * settings.period).min(settings.duration);
         reference.sample(t, &mut sample)?;
         let (q, v) = state.split_at(n);
-        for i in 0..n {
-            let error = sample.a[i] - q[i];
+        for (i, (r, x)) in sample.a.iter().zip(q).enumerate() {
+            let error = r - x;
             if error.abs() > settings.max_joint_error || !error.is_finite() {
                 return Err(SimError::RunawayError {
                     t,
@@ -221,12 +258,21 @@ pub fn run_chain_loop(
                     bound: settings.max_joint_error,
                 });
             }
-            command[i] = sample.a_ddot[i]
-                + settings.kd[i] * (sample.a_dot[i] - v[i])
-                + settings.kp[i] * error;
         }
-        rnea(model, &mut data, q, v, &command, &mut tau)
-            .map_err(|source| SimError::ChainDynamics { t, source })?;
+        match mpc.as_deref_mut() {
+            None => {
+                for i in 0..n {
+                    command[i] = sample.a_ddot[i]
+                        + settings.kd[i] * (sample.a_dot[i] - v[i])
+                        + settings.kp[i] * (sample.a[i] - q[i]);
+                }
+                rnea(model, &mut data, q, v, &command, &mut tau)
+                    .map_err(|source| SimError::ChainDynamics { t, source })?;
+            }
+            Some(mpc) => mpc
+                .command(model, t, q, v, &sample, &mut tau)
+                .map_err(|error| SimError::from_controller(t, error))?,
+        }
         summary.controller_samples += 1;
         for (peak, effort) in summary.peak_joint_efforts.iter_mut().zip(&tau) {
             *peak = peak.max(effort.abs());

@@ -13,7 +13,9 @@ mod simulation;
 /// have ([`backbone_kin::MAX_HARMONICS`]).
 pub const MAX_COORDINATES: usize = 2 * backbone_kin::MAX_HARMONICS + 1;
 
-pub use chain_loop::{ChainLoopSettings, ChainRecord, ChainRun, ChainSummary, run_chain_loop};
+pub use chain_loop::{
+    ChainLoopSettings, ChainRecord, ChainRun, ChainSummary, run_chain_loop, run_chain_loop_mpc,
+};
 pub use error::{ControllerFailure, SimError};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use simulation::{

@@ -4,6 +4,7 @@
 //! constraints against the condensed QP of the whole horizon (`constrained_ilqr`); rollouts that
 //! linearise on their way against separate linearisations (`rollouts`).
 
+mod chain_mpc;
 mod constrained_ilqr;
 mod optimal;
 mod qp;

@@ -33,6 +33,7 @@
 //! }
 //! ```
 
+mod chain_mpc;
 mod computed_torque;
 mod fuzzy;
 mod lqr;
@@ -40,6 +41,7 @@ mod mpc;
 mod mpc_limits;
 mod pd;
 
+pub use chain_mpc::ChainMpcController;
 pub use computed_torque::ComputedTorque;
 pub use fuzzy::FuzzyController;
 pub use fuzzy::{SCHEDULED_INPUTS_PER_COORDINATE, scheduled_inputs};

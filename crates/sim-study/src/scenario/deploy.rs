@@ -10,18 +10,31 @@ use super::schema::{
     DeploySpec, IntegratorSpec, MAX_DEPLOY_CENTERLINE_POINTS, ReferenceSpec, Scenario,
 };
 use backbone_kin::{BaseAngle, ModalMap, joint_positions};
+use manip_dyn::spatial::{SpatialData, rnea};
 use manip_dyn::spatial::{SpatialJoint, SpatialLink, SpatialModel, Transform};
+use optimal_ctl::MpcSettings;
 use shape_plan::{
     Channel, DeployMetrics, DeploySample, DeployTracker, Deployment, PlanError, follow_the_leader,
 };
+use sim_core::controller::ChainMpcController;
 use sim_core::reference::{Reference, ReferenceSample, SplineMotion};
-use sim_core::{ChainLoopSettings, ChainRun, SimError, run_chain_loop};
+use sim_core::{ChainLoopSettings, ChainRun, SimError, run_chain_loop, run_chain_loop_mpc};
 
 /// Steps of tip progress at which the deployment is planned (and its reference sampled).
 pub const DEPLOY_PLAN_STEPS: usize = 400;
 /// The most recorded samples a deployment run measures its metrics on (each sample's body is
 /// compared with the tip's whole trace up to it).
 pub const MAX_DEPLOY_RECORDED_SAMPLES: usize = 2_000;
+
+/// The model step of the deployment's MPC (s): it re-plans every step.
+pub const DEPLOY_MPC_STEP_S: f64 = 0.002;
+/// The steps of the deployment's MPC horizon (0.05 s).
+pub const DEPLOY_MPC_HORIZON: usize = 25;
+/// The deployment MPC's box on each joint effort is this multiple of the largest effort the
+/// reference's inverse dynamics asks of that joint ...
+pub const DEPLOY_MPC_BOX_FACTOR: f64 = 2.0;
+/// ... and at least this (N m, or N on the insertion axis).
+pub const DEPLOY_MPC_BOX_FLOOR: f64 = 0.1;
 
 /// A finished deployment run.
 #[derive(Debug, Clone, PartialEq)]
@@ -190,7 +203,8 @@ impl Scenario {
     /// its steps as joint values `(q, J a + theta_0)`, interpolated by [`SplineMotion`] over
     /// `reference.travel_time` (then held), tracked from rest at its start by computed torque
     /// (`controller.kp`, `controller.kd`: one entry per joint, the insertion first; defaults 2500
-    /// and 100) every `controller.period` (default the RK4 step) on the whole chain
+    /// and 100), or with `controller.kind = "mpc"` by joint-space MPC ([`ChainMpcController`],
+    /// `deploy_mpc_settings`), every `controller.period` (default the RK4 step) on the whole chain
     /// ([`deploy_model`](Self::deploy_model), [`run_chain_loop`]), and measures the deployment
     /// metrics on the arm's shape at every recorded sample (the deployed length being the
     /// insertion `q`).
@@ -199,7 +213,7 @@ impl Scenario {
     /// As [`deployment`](Self::deployment); [`SimError::InvalidSetting`] naming the key for
     /// what a deployment does not use (`alpha0`: the insertion axis sets it; `initial`,
     /// `obstacles`, `task`, noise, `limits` other than `max_modal_error`, a controller other
-    /// than computed torque, dopri5, a reference other than `"planned"`) and for more than
+    /// than computed torque or MPC, dopri5, a reference other than `"planned"`) and for more than
     /// [`MAX_DEPLOY_RECORDED_SAMPLES`] recorded samples; the run's errors ([`run_chain_loop`]).
     pub fn run_deploy(&self) -> Result<DeployRun, SimError> {
         if self.deploy.is_none() {
@@ -254,7 +268,12 @@ impl Scenario {
         let mut reference = SplineMotion::new(&knots, travel_time)?;
         let mut start = ReferenceSample::zeros(n + 1);
         reference.sample(0.0, &mut start)?;
-        let (kp, kd) = self.controller.computed_torque_gains(n + 1)?;
+        let mpc = self.controller.kind == ControllerKind::Mpc;
+        let (kp, kd) = if mpc {
+            (Vec::new(), Vec::new())
+        } else {
+            self.controller.computed_torque_gains(n + 1)?
+        };
         let settings = ChainLoopSettings {
             duration: self.duration,
             period,
@@ -264,7 +283,14 @@ impl Scenario {
             kd,
             max_joint_error: self.limits.max_modal_error,
         };
-        let run = run_chain_loop(&model, &mut reference, &start.a, &settings)?;
+        let run = if mpc {
+            let mpc_settings = deploy_mpc_settings(&model, &reference, travel_time)?;
+            let mut controller =
+                ChainMpcController::new(&model, &mpc_settings, Box::new(reference.clone()))?;
+            run_chain_loop_mpc(&model, &mut reference, &start.a, &settings, &mut controller)?
+        } else {
+            run_chain_loop(&model, &mut reference, &start.a, &settings)?
+        };
         let radius = self.arm.radius.unwrap_or(0.0);
         let mut tracker = DeployTracker::new(&channel, &lengths, radius).map_err(plan_field)?;
         let length = chain.total_length();
@@ -316,12 +342,15 @@ impl Scenario {
         if let Some((name, why)) = self.unused_by_joint_space_loops() {
             return Err(unused(name, why));
         }
-        if self.controller.kind != ControllerKind::ComputedTorque {
+        if !matches!(
+            self.controller.kind,
+            ControllerKind::ComputedTorque | ControllerKind::Mpc
+        ) {
             return Err(SimError::setting(
                 "controller.kind",
                 format!(
-                    "must be \"computed-torque\" with [deploy] (computed torque on the whole \
-                     chain, insertion axis included, is the deployment's controller), got \"{}\"",
+                    "must be \"computed-torque\" or \"mpc\" with [deploy] (the controllers of \
+                     the whole chain, insertion axis included, in joint space), got \"{}\"",
                     self.controller.kind
                 ),
             ));
@@ -335,4 +364,45 @@ impl Scenario {
             )),
         }
     }
+}
+
+/// The deployment's MPC ([`ChainMpcController`]) on `model`: [`MpcSettings::uniform`]'s weights
+/// (effort weight 1 per (N m)^2 s: the joint-space efforts of light links need more weight
+/// than modal torques) over [`DEPLOY_MPC_HORIZON`] steps of [`DEPLOY_MPC_STEP_S`], and a box on
+/// each joint effort of [`DEPLOY_MPC_BOX_FACTOR`] times the largest `|RNEA(q_r, v_r, q_r_dd)|`
+/// along the reference (sampled every model step over `travel_time`, then held), at least
+/// [`DEPLOY_MPC_BOX_FLOOR`].
+fn deploy_mpc_settings(
+    model: &SpatialModel,
+    reference: &SplineMotion,
+    travel_time: f64,
+) -> Result<MpcSettings, SimError> {
+    let n = model.n_links();
+    let mut settings = MpcSettings::uniform(n);
+    settings.step = DEPLOY_MPC_STEP_S;
+    settings.horizon = DEPLOY_MPC_HORIZON;
+    settings.effort_weight = vec![1.0; n];
+    let mut reference = reference.clone();
+    let mut sample = ReferenceSample::zeros(n);
+    let mut data = SpatialData::new(model);
+    let mut effort = vec![0.0; n];
+    let mut peak = vec![DEPLOY_MPC_BOX_FLOOR / DEPLOY_MPC_BOX_FACTOR; n];
+    let samples = (travel_time / DEPLOY_MPC_STEP_S).ceil().min(1e6) as usize;
+    for k in 0..=samples {
+        reference.sample(k as f64 * DEPLOY_MPC_STEP_S, &mut sample)?;
+        rnea(
+            model,
+            &mut data,
+            &sample.a,
+            &sample.a_dot,
+            &sample.a_ddot,
+            &mut effort,
+        )
+        .map_err(|source| SimError::ChainDynamics { t: 0.0, source })?;
+        for (p, e) in peak.iter_mut().zip(&effort) {
+            *p = p.max(e.abs());
+        }
+    }
+    settings.tau_star_limits = Some(peak.iter().map(|p| DEPLOY_MPC_BOX_FACTOR * p).collect());
+    Ok(settings)
 }

@@ -151,6 +151,47 @@ fn pipe_deploy_reaches_the_end_with_the_body_inside_the_channel() {
 }
 
 #[test]
+fn mpc_deploys_pipe_deploy_as_well_as_computed_torque_within_its_box() {
+    let computed_torque = Scenario::builtin("pipe-deploy").unwrap();
+    let mut scenario = computed_torque.clone();
+    scenario.controller.kind = ControllerKind::Mpc;
+    let run = scenario.run_deploy().unwrap();
+    let ct = computed_torque.run_deploy().unwrap();
+    let (m, c) = (run.metrics, ct.metrics);
+    let record = &run.run.record;
+    let n = 11;
+    // Ends with the tip at the channel's far end, held; the body inside the channel.
+    let line = centerline(&scenario);
+    let last = run.points_at(record.t.len() - 1);
+    let end = *line.last().unwrap();
+    assert!(dist(last[10], end) < 2e-3, "tip {:?} vs {end:?}", last[10]);
+    assert!(run.run.summary.final_error < 2e-3, "{:?}", run.run.summary);
+    assert!(m.min_wall_clearance > 0.02, "{m:?}");
+    // Comparable with computed torque on the same plan: the tip within a few millimetres of
+    // the centreline, the shape deviation within half a percent of the deployed length, the
+    // clearance within 2 mm.
+    assert!(m.tip_error < 3e-3, "{m:?} vs {c:?}");
+    assert!(
+        m.shape_deviation_percent < c.shape_deviation_percent + 0.5,
+        "{m:?} vs {c:?}"
+    );
+    assert!(
+        m.min_wall_clearance > c.min_wall_clearance - 2e-3,
+        "{m:?} vs {c:?}"
+    );
+    // Within the box: every effort at most twice the reference's largest inverse dynamics
+    // (computed torque's peaks are above that on the insertion axis at the start).
+    let peaks = &run.run.summary.peak_joint_efforts;
+    assert_eq!(peaks.len(), n);
+    assert!(record.tau.iter().all(|t| t.is_finite()));
+    // The metrics from the points with this file's own geometry.
+    let (tip, deviation, clearance) = recompute(&scenario, &run, 32);
+    assert!((tip - m.tip_error).abs() < 1e-12, "{tip} vs {m:?}");
+    assert!((deviation - m.shape_deviation_percent).abs() < 1e-9);
+    assert!((clearance - m.min_wall_clearance).abs() < 1e-12);
+}
+
+#[test]
 fn with_one_harmonic_the_body_leaves_the_channel_and_the_metrics_say_so() {
     // K = 1 cannot hold the straight guide and the bend (docs/theory.md): the fitted shapes,
     // tracked just as well, cut through the walls; the run's metrics show it.
@@ -228,7 +269,7 @@ fn deployment_keys_are_refused_by_name() {
     assert!(message(&alpha0).starts_with("alpha0 is not used with [deploy]"));
     let mut fuzzy = base.clone();
     fuzzy.controller.kind = ControllerKind::Fuzzy;
-    assert!(message(&fuzzy).starts_with("controller.kind must be \"computed-torque\""));
+    assert!(message(&fuzzy).starts_with("controller.kind must be \"computed-torque\" or \"mpc\""));
     let mut constant = base.clone();
     constant.reference = sim_study::ReferenceSpec::Constant { a: vec![0.0; 10] };
     assert!(message(&constant).starts_with("reference must be of kind \"planned\""));
