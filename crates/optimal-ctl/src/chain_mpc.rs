@@ -7,7 +7,7 @@ use manip_dyn::spatial::{SpatialData, SpatialDerivativeData, SpatialModel, rnea}
 use super::OptimalError;
 use super::chain_euler::ChainEuler;
 use super::ilqr::{Ilqr, IlqrReport, IlqrSettings};
-use super::mpc::{MpcSettings, plan_feedback, set_box, tracking_cost};
+use super::mpc::{MpcSettings, check_reference, plan_feedback, set_box, tracking_cost};
 
 /// Model-predictive control of a spatial chain (`n` joints, any kind): at each plan,
 ///
@@ -102,22 +102,7 @@ impl ChainMpc {
         q_dd: &[f64],
     ) -> Result<(), OptimalError> {
         let (n, horizon) = (self.n, self.horizon());
-        if k > horizon {
-            return Err(OptimalError::Dimension {
-                name: "reference node",
-                expected: horizon,
-                found: k,
-            });
-        }
-        for (name, values) in [("q", q), ("v", v), ("q_dd", q_dd)] {
-            if values.len() != n {
-                return Err(OptimalError::Dimension {
-                    name,
-                    expected: n,
-                    found: values.len(),
-                });
-            }
-        }
+        check_reference(k, horizon, n, [("q", q), ("v", v), ("q_dd", q_dd)])?;
         let x_ref = &mut self.ilqr.state_references_mut()[k * 2 * n..(k + 1) * 2 * n];
         x_ref[..n].copy_from_slice(q);
         x_ref[n..].copy_from_slice(v);

@@ -171,22 +171,7 @@ impl Mpc {
         a_ddot: &[f64],
     ) -> Result<(), OptimalError> {
         let (m, n) = (self.m, self.horizon());
-        if k > n {
-            return Err(OptimalError::Dimension {
-                name: "reference node",
-                expected: n,
-                found: k,
-            });
-        }
-        for (name, values) in [("a", a), ("a_dot", a_dot), ("a_ddot", a_ddot)] {
-            if values.len() != m {
-                return Err(OptimalError::Dimension {
-                    name,
-                    expected: m,
-                    found: values.len(),
-                });
-            }
-        }
+        check_reference(k, n, m, [("a", a), ("a_dot", a_dot), ("a_ddot", a_ddot)])?;
         let x_ref = &mut self.ilqr.state_references_mut()[k * 2 * m..(k + 1) * 2 * m];
         x_ref[..m].copy_from_slice(a);
         x_ref[m..].copy_from_slice(a_dot);
@@ -353,6 +338,33 @@ impl Mpc {
             tau_star,
         )
     }
+}
+
+/// Checks a reference at node `k` of a `horizon`-node plan (`k <= horizon`): the position, rate
+/// and acceleration `values`, `dim` each.
+pub(crate) fn check_reference(
+    k: usize,
+    horizon: usize,
+    dim: usize,
+    values: [(&'static str, &[f64]); 3],
+) -> Result<(), OptimalError> {
+    if k > horizon {
+        return Err(OptimalError::Dimension {
+            name: "reference node",
+            expected: horizon,
+            found: k,
+        });
+    }
+    for (name, values) in values {
+        if values.len() != dim {
+            return Err(OptimalError::Dimension {
+                name,
+                expected: dim,
+                found: values.len(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The [`TrackingCost`] of `settings` for `m` coordinates (the running weights times the step,
