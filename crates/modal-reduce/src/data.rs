@@ -16,12 +16,6 @@ use lane_math::check_len;
 /// `L_l cos(phi_l) phi_dot_l^2`, `L_l sin(phi_l) phi_dot_l^2`.
 pub(crate) const PRODUCTS: usize = 5;
 
-/// The most links whose angles and products one state's buffers hold: the pre-pass and the
-/// pass run over blocks of this many links, so that these values stay in the level-1 cache
-/// (48 bytes a link, 24 KiB a block) instead of going to memory and back on long chains. A
-/// multiple of [`LINK_PADDING`], so that the registers of the pre-pass hold the same links.
-pub(crate) const BLOCK_LINKS: usize = 512;
-
 /// An `(x, y)` pair: a column of the `2 x m` prefix sum `P_l`.
 pub(crate) type Pair<L> = [L; 2];
 
@@ -89,15 +83,12 @@ impl Projection {
     }
 }
 
-/// The per-link buffers of the default path (see [`crate::terms`]): every link's sine and
-/// cosine (read again by [`crate::derivatives`]), `n` rounded up to a whole number of the widest
-/// SIMD registers ([`LINK_PADDING`]), and the absolute angles and per-link products of a block
-/// of `block` links ([`BLOCK_LINKS`], or fewer for a shorter chain), so that they are computed
-/// in whole registers.
+/// The per-link buffers of the default path (see [`crate::terms`]): every link's absolute angle,
+/// its sine and cosine (read again by [`crate::derivatives`]) and the per-link products, `n`
+/// rounded up to a whole number of the widest SIMD registers ([`LINK_PADDING`]) each, so that
+/// they are computed in whole registers.
 #[derive(Debug, Clone)]
 pub(crate) struct OneStateLinks {
-    /// The links of a block: `angle` holds `block` values, `products` [`PRODUCTS`] rows of them.
-    pub(crate) block: usize,
     pub(crate) angle: CacheAligned,
     pub(crate) sin: CacheAligned,
     pub(crate) cos: CacheAligned,
@@ -134,7 +125,6 @@ impl ReducedData {
         let (n, m) = (model.n_links(), model.n_coords());
         let zeros = |len: usize| try_filled(len, 0.0, WHAT);
         let padded = n.next_multiple_of(LINK_PADDING);
-        let block = padded.min(BLOCK_LINKS);
         let aligned = |len: usize| CacheAligned::try_zeros(len, WHAT);
         Ok(Self {
             n_links: n,
@@ -146,11 +136,10 @@ impl ReducedData {
             rhs: zeros(m)?,
             iterate: zeros(m)?,
             links: OneStateLinks {
-                block,
-                angle: aligned(block)?,
+                angle: aligned(padded)?,
                 sin: aligned(padded)?,
                 cos: aligned(padded)?,
-                products: aligned(PRODUCTS * block)?,
+                products: aligned(PRODUCTS.saturating_mul(padded))?,
             },
             scratch: TermScratch {
                 mass: zeros(m * m)?,

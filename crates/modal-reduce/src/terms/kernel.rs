@@ -32,7 +32,7 @@ pub(crate) fn accumulate<Y: Layout>(
     a: &[Y::Value],
     a_dot: &[Y::Value],
     m: usize,
-    links: LinkBuffers<'_>,
+    mut links: LinkBuffers<'_>,
     terms: &mut Terms<'_, Y::Register>,
 ) {
     let (rc, vc) = (layout.register_context(), layout.value_context());
@@ -51,57 +51,42 @@ pub(crate) fn accumulate<Y: Layout>(
     let n = model.n_links();
     let rows = model.angle_rows();
     let mut q = [Y::Value::splat(vc, 0.0); 2];
+    layout.link_values(model, a, a_dot, &mut links);
+    // The pass: P_l, q_l, and the sums of M* and C*.
+    // Each link's rows zipped with its values, so that nothing is bounds-checked.
     let moment_rows = model.moment_rows();
     let width = Y::Value::WIDTH;
-    // Blocks of as many links as the buffers of angles and products hold: the pre-pass of a
-    // block, then the pass over it, while its values are still in cache.
-    let block = links.links.max(1);
-    for start in (0..n).step_by(block) {
-        let len = block.min(n - start);
-        let mut view = LinkBuffers {
-            angle: &mut *links.angle,
-            sin: &mut links.sin[start * width..],
-            cos: &mut links.cos[start * width..],
-            products: &mut *links.products,
-            links: block,
-        };
-        layout.link_values(model, start, len, a, a_dot, &mut view);
-        let (rows, moment_rows) = (&rows[start * m..], &moment_rows[start * m..]);
-        // The pass: P_l, q_l, and the sums of M* and C*.
-        // Each link's rows zipped with its values, so that nothing is bounds-checked.
-        let links_rows = padded_rows(rows, len, m).zip(padded_rows(moment_rows, len, m));
-        for ((row, moment_row), entries) in links_rows.zip(view.values(len, width)) {
-            let [sin, cos, moment_rate2, l_sin, l_cos, drop_x, drop_y]: [Y::Value; 2 + PRODUCTS] =
-                load_link(vc, entries);
-            // w_l . q_l, which S_l Phi_l multiplies.
-            // (No closures or array maps here: their bodies would be compiled without the
-            // instruction set of the dispatch, and its intrinsics called, not inlined.)
-            let force = layout.spread(sin.neg_mul_add(q[0], cos * q[1]));
-            let (sin, cos) = (layout.spread(sin), layout.spread(cos));
-            let moment_rate2 = layout.spread(moment_rate2);
-            add_gravity(layout, gravity, cos, moment_row);
-            let (l_sin, l_cos) = (layout.spread(l_sin), layout.spread(l_cos));
-            for c in 0..chunks {
-                let moment_phi = layout.constant_row(moment_row, c);
-                let [px, py] = joint[c];
-                v[c] = sin.neg_mul_add(px, cos * py);
-                let along = sin.mul_add(py, cos * px);
-                coriolis[c] =
-                    moment_rate2.neg_mul_add(along, force.mul_add(moment_phi, coriolis[c]));
-            }
-            // A += (S_l Phi_l)^T v_l^T, row by row.
-            for (j, &moment_phi_j) in moment_row[..m].iter().enumerate() {
-                let moment_phi_j = Y::Register::splat(rc, moment_phi_j);
-                for c in 0..chunks {
-                    let entry = &mut mass[j * chunks + c];
-                    *entry = v[c].mul_add(moment_phi_j, *entry);
-                }
-            }
-            for (c, pair) in joint.iter_mut().enumerate() {
-                *pair = layout.joint_step(*pair, [l_sin, l_cos], row, c);
-            }
-            q = [q[0] - drop_x, q[1] - drop_y];
+    let links_rows = padded_rows(rows, n, m).zip(padded_rows(moment_rows, n, m));
+    for ((row, moment_row), entries) in links_rows.zip(links.values(n, width)) {
+        let [sin, cos, moment_rate2, l_sin, l_cos, drop_x, drop_y]: [Y::Value; 2 + PRODUCTS] =
+            load_link(vc, entries);
+        // w_l . q_l, which S_l Phi_l multiplies.
+        // (No closures or array maps here: their bodies would be compiled without the
+        // instruction set of the dispatch, and its intrinsics called, not inlined.)
+        let force = layout.spread(sin.neg_mul_add(q[0], cos * q[1]));
+        let (sin, cos) = (layout.spread(sin), layout.spread(cos));
+        let moment_rate2 = layout.spread(moment_rate2);
+        add_gravity(layout, gravity, cos, moment_row);
+        let (l_sin, l_cos) = (layout.spread(l_sin), layout.spread(l_cos));
+        for c in 0..chunks {
+            let moment_phi = layout.constant_row(moment_row, c);
+            let [px, py] = joint[c];
+            v[c] = sin.neg_mul_add(px, cos * py);
+            let along = sin.mul_add(py, cos * px);
+            coriolis[c] = moment_rate2.neg_mul_add(along, force.mul_add(moment_phi, coriolis[c]));
         }
+        // A += (S_l Phi_l)^T v_l^T, row by row.
+        for (j, &moment_phi_j) in moment_row[..m].iter().enumerate() {
+            let moment_phi_j = Y::Register::splat(rc, moment_phi_j);
+            for c in 0..chunks {
+                let entry = &mut mass[j * chunks + c];
+                *entry = v[c].mul_add(moment_phi_j, *entry);
+            }
+        }
+        for (c, pair) in joint.iter_mut().enumerate() {
+            *pair = layout.joint_step(*pair, [l_sin, l_cos], row, c);
+        }
+        q = [q[0] - drop_x, q[1] - drop_y];
     }
     let g = model.chain().gravity();
     for value in gravity {

@@ -50,13 +50,10 @@ pub(crate) trait Layout: Registers {
         joint_step_by([px, py], [l_sin, l_cos], self.constant_row(row, chunk))
     }
 
-    /// The per-link values of the `len` links from link `start` into `links` (the pre-pass),
-    /// whose entry 0 is link `start`'s.
+    /// The per-link values of all links into `links` (the pre-pass).
     fn link_values(
         self,
         model: &ReducedModel,
-        start: usize,
-        len: usize,
         a: &[Self::Value],
         a_dot: &[Self::Value],
         links: &mut LinkBuffers<'_>,
@@ -125,13 +122,11 @@ impl<S: Simd> Layout for CoordinateLanes<S> {
     fn link_values(
         self,
         model: &ReducedModel,
-        start: usize,
-        len: usize,
         a: &[f64],
         a_dot: &[f64],
         links: &mut LinkBuffers<'_>,
     ) {
-        link_values_across_links(self.simd, model, start..start + len, a, a_dot, links);
+        link_values_across_links(self.simd, model, a, a_dot, links);
     }
 }
 
@@ -176,13 +171,11 @@ impl<S: Simd> Layout for OneStateScalar<S> {
     fn link_values(
         self,
         model: &ReducedModel,
-        start: usize,
-        len: usize,
         a: &[f64],
         a_dot: &[f64],
         links: &mut LinkBuffers<'_>,
     ) {
-        link_values_across_links(self.0, model, start..start + len, a, a_dot, links);
+        link_values_across_links(self.0, model, a, a_dot, links);
     }
 }
 
@@ -263,8 +256,6 @@ impl<S: Simd> Layout for StateLanes<S> {
     fn link_values(
         self,
         model: &ReducedModel,
-        start: usize,
-        n: usize,
         a: &[Pack<S>],
         a_dot: &[Pack<S>],
         links: &mut LinkBuffers<'_>,
@@ -273,9 +264,9 @@ impl<S: Simd> Layout for StateLanes<S> {
         let width = S::F64_LANES;
         let constants = model.link_constants();
         let m = a.len();
-        let links_range = start..start + n;
-        let rows = model.angle_rows()[start * m..(start + n) * m].chunks_exact(m);
-        let offsets = &constants.angle_offset[links_range.clone()];
+        let n = model.n_links();
+        let rows = model.angle_rows()[..n * m].chunks_exact(m);
+        let offsets = &constants.angle_offset[..n];
         let LinkBuffers {
             angle, products, ..
         } = links;
@@ -294,8 +285,7 @@ impl<S: Simd> Layout for StateLanes<S> {
             angle_l.store(angle);
             rate_l.store(rate);
         }
-        let moments = &constants.first_moment[links_range.clone()];
-        let lengths = &constants.length[links_range];
+        let (moments, lengths) = (&constants.first_moment[..n], &constants.length[..n]);
         let (angle, registers) = links.angles_and_registers(n, width);
         let per_link = angle.chunks_exact(width).zip(moments).zip(lengths);
         for (((angle, &moment), &length), out) in per_link.zip(registers) {

@@ -3,7 +3,6 @@
 
 use lane_math::{Lane, Pack, REDUCTION_LIMIT, sin_cos_lanes};
 use pulp::Simd;
-use std::ops::Range;
 
 use crate::data::PRODUCTS;
 use crate::model::{LINK_PADDING, ReducedModel};
@@ -23,8 +22,7 @@ pub(crate) fn angles_in_range<S: Simd>(simd: S, model: &ReducedModel, a: &[Pack<
     Pack::splat(simd, 0.5 * REDUCTION_LIMIT).all_greater(bound)
 }
 
-/// The pre-pass of one state over the links `range` (its start a multiple of [`LINK_PADDING`];
-/// entry 0 of `links` is the first's): [`link_angle_rate`], the sines and cosines, then
+/// The pre-pass of one state: [`link_angle_rate`], the sines and cosines, then
 /// [`link_products`], each a loop over registers of consecutive links (the last one padded with
 /// the zeros of the padded constants). Separate loops, so that the sines and cosines (long
 /// chains of dependent operations) run alone, short enough for the processor to overlap them.
@@ -32,16 +30,15 @@ pub(crate) fn angles_in_range<S: Simd>(simd: S, model: &ReducedModel, a: &[Pack<
 pub(super) fn link_values_across_links<S: Simd>(
     simd: S,
     model: &ReducedModel,
-    range: Range<usize>,
     a: &[f64],
     a_dot: &[f64],
     links: &mut LinkBuffers<'_>,
 ) {
     if S::F64_LANES > LINK_PADDING {
         // Wider registers than the padding: one link at a time.
-        across_links::<f64>((), model, range, a, a_dot, links);
+        across_links::<f64>((), model, a, a_dot, links);
     } else {
-        across_links::<Pack<S>>(simd, model, range, a, a_dot, links);
+        across_links::<Pack<S>>(simd, model, a, a_dot, links);
     }
 }
 
@@ -50,29 +47,28 @@ pub(super) fn link_values_across_links<S: Simd>(
 pub(super) fn across_links<L: Lane>(
     context: L::Context,
     model: &ReducedModel,
-    range: Range<usize>,
     a: &[f64],
     a_dot: &[f64],
     links: &mut LinkBuffers<'_>,
 ) {
     let constants = model.link_constants();
-    let (start, n) = (range.start, range.len());
+    let n = model.n_links();
     for l in (0..n).step_by(L::WIDTH) {
         let inputs = AcrossLinks::<L> {
             context,
             model,
             a,
             a_dot,
-            l: start + l,
+            l,
         };
-        let offset = L::load(context, &constants.angle_offset[start + l..]);
+        let offset = L::load(context, &constants.angle_offset[l..]);
         links.store_angle_rate(l, 1, link_angle_rate(context, offset, &inputs));
     }
     links.sin_cos::<L>(context, n.next_multiple_of(L::WIDTH));
     for l in (0..n).step_by(L::WIDTH) {
         let angles = links.load_trig_rate(context, l, 1);
-        let moment = L::load(context, &constants.first_moment[start + l..]);
-        let length = L::load(context, &constants.length[start + l..]);
+        let moment = L::load(context, &constants.first_moment[l..]);
+        let length = L::load(context, &constants.length[l..]);
         links.store_products(l, 1, link_products(angles, moment, length));
     }
 }

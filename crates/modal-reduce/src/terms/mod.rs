@@ -227,7 +227,7 @@ pub(crate) fn accumulate_in_data<S: Simd>(
         sin: links.sin.get_mut(),
         cos: links.cos.get_mut(),
         products: links.products.get_mut(),
-        links: links.block,
+        links: model.link_constants().padded,
     };
     accumulate(layout, model, a, a_dot, m, link_buffers, &mut terms);
     extract(layout, model, m, &terms, mass, coriolis, gravity);
@@ -282,7 +282,7 @@ impl<const M: usize> StackTerms<M> {
             sin: links.sin.get_mut(),
             cos: links.cos.get_mut(),
             products: links.products.get_mut(),
-            links: links.block,
+            links: model.link_constants().padded,
         };
         let mut terms = Terms {
             mass: mass.as_flattened_mut(),
