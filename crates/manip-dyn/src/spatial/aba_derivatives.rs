@@ -11,10 +11,10 @@ use faer::{MatMut, MatRef};
 use lane_math::{Lane, Pack};
 use pulp::{Simd, WithSimd};
 
-use super::aba::aba;
-use super::algebra::Transform;
+use super::algebra::{Force, Motion, Symmetric6, Transform};
 use super::data::SpatialData;
 use super::derivative_data::{MAX_LANES, SpatialDerivativeData, column_of, padded};
+use super::kinematics::{joint_placement, sin_cos_dispatched};
 use super::minv::inverse_mass_matrix;
 use super::model::SpatialModel;
 use super::rnea_derivatives::differentiate_at;
@@ -59,10 +59,9 @@ pub fn aba_derivatives(
         n,
     )?;
     let mut qdd = std::mem::take(&mut derivatives.accelerations);
-    let solved = aba(model, data, q, v, tau, &mut qdd).and_then(|()| {
-        poses_from_aba(data);
-        differentiate_at(model, data, derivatives, v, &qdd)
-    });
+    let solved = aba_base_frame(model, data, derivatives, [q, v, tau], &mut qdd)
+        .and_then(|()| check::finite_result("qdd", &qdd))
+        .and_then(|()| differentiate_at(model, data, derivatives, v, &qdd));
     derivatives.value.copy_from_slice(&qdd);
     derivatives.accelerations = qdd;
     solved?;
@@ -70,19 +69,13 @@ pub fn aba_derivatives(
         blocks,
         rhs,
         sweep,
+        joints,
         minv_columns,
         ..
     } = derivatives;
     let (jacobians, mut minv) = blocks.as_mut().split_at_col_mut(2 * n);
     rhs.copy_from(jacobians.as_ref());
-    inverse_mass_matrix(
-        data.arch,
-        model,
-        &data.articulated,
-        &data.poses,
-        sweep,
-        minv.as_mut(),
-    );
+    inverse_mass_matrix(data.arch, joints, sweep, minv.as_mut());
     let stride = padded(n);
     for k in 0..n {
         minv_columns[k * stride..k * stride + n].copy_from_slice(column_of(&mut minv, k));
@@ -95,19 +88,85 @@ pub fn aba_derivatives(
     check::finite_matrix("the derivatives", &blocks.as_mut())
 }
 
-/// The links' poses in the base frame, `oM_i = oM_{i-1} * {i-1}M_i`, from the placements the
-/// ABA has just computed (the same as [`update_poses`](super::kinematics::update_poses) at its
-/// `q`, without the sines, cosines and placements again).
-fn poses_from_aba(data: &mut SpatialData) {
-    let mut parent = Transform::IDENTITY;
-    for (pose, link) in data.poses.iter_mut().zip(&data.articulated) {
-        let placement = Transform {
-            rotation: link.rotation,
-            translation: link.translation,
-        };
-        parent = parent.compose(&placement);
-        *pose = parent;
+/// The articulated-body algorithm (as [`aba`](super::aba())) run in the base frame, as
+/// Pinocchio's `computeABADerivatives` runs it: `qdd` from `inputs` (`q`, `v`, `tau`), each
+/// link's pose into `data`, its base-frame inertia into `derivatives.composite` and each
+/// joint's [`BaseFrameJoint`](super::derivative_data::BaseFrameJoint) into `derivatives.joints`, for the RNEA derivatives and `M^-1`
+/// that follow. With every quantity in the base frame, the frame changes `X_i` of the
+/// link-frame algorithm are identities: base to tip, `v_i = v_{i-1} + S_i qd_i`,
+/// `c_i = v_i x S_i qd_i` and `p_i = v_i x* I_i v_i`; tip to base, `IA_i = I_i + IA'_{i+1}`,
+/// `pA_i = p_i + pA'_{i+1}`, `U_i = IA_i S_i`, `D_i = S_i . U_i`, `u_i = tau_i - S_i . pA_i`,
+/// `IA'_i = IA_i - U_i U_i^T / D_i`, `pA'_i = pA_i + IA'_i c_i + U_i u_i / D_i`; base to tip,
+/// `a_{-1} = -g`, `a'_i = a_{i-1} + c_i`, `qdd_i = (u_i - U_i . a'_i) / D_i`,
+/// `a_i = a'_i + S_i qdd_i`. Inputs finite, sizes checked by the caller.
+fn aba_base_frame(
+    model: &SpatialModel,
+    data: &mut SpatialData,
+    derivatives: &mut SpatialDerivativeData,
+    inputs: [&[f64]; 3],
+    qdd: &mut [f64],
+) -> Result<(), DynError> {
+    let [q, v, tau] = inputs;
+    let n = model.n_links();
+    let (joints, inertias) = (&mut derivatives.joints, &mut derivatives.composite);
+    sin_cos_dispatched(data.arch, q, &mut data.sin, &mut data.cos);
+    let mut pose = Transform::IDENTITY;
+    let mut velocity = Motion::default();
+    for i in 0..n {
+        let placement = joint_placement((), &model.joints()[i], q[i], data.sin[i], data.cos[i]);
+        pose = pose.compose(&placement);
+        data.poses[i] = pose;
+        let joint = &mut joints[i];
+        joint.axis = pose.act_motion(&model.axes[i]);
+        let joint_velocity = joint.axis.times(v[i]);
+        velocity = velocity.plus(&joint_velocity);
+        joint.bias = velocity.cross_motion(&joint_velocity);
+        // A massless link (the cross of a universal joint) has no inertia and no bias force.
+        if !model.massless[i] {
+            let inertia = pose.act_rigid_inertia(&model.inertias[i]);
+            joint.force = velocity.cross_force(&inertia.apply(&velocity));
+            inertias[i] = inertia;
+        }
     }
+    let mut carried_inertia = Symmetric6::default();
+    let mut carried_force = Force::default();
+    for i in (0..n).rev() {
+        let joint = &mut joints[i];
+        let (inertia, force) = if model.massless[i] {
+            (carried_inertia, carried_force)
+        } else {
+            (
+                carried_inertia.plus_rigid(&inertias[i]),
+                joint.force.plus(&carried_force),
+            )
+        };
+        let coupling = inertia.apply(&joint.axis);
+        let pivot = joint.axis.dot(&coupling);
+        check::pivot(pivot, model.pivot_scales[i]).map_err(|error| match error {
+            DynError::NotPositiveDefinite => DynError::SingularJoint { index: i },
+            other => other,
+        })?;
+        let inverse = 1.0 / pivot;
+        let residual = tau[i] - joint.axis.dot(&force);
+        joint.coupling = coupling;
+        joint.inverse = inverse;
+        joint.residual = residual;
+        carried_inertia = inertia.minus_outer(&coupling, inverse);
+        carried_force = force
+            .plus(&carried_inertia.apply(&joint.bias))
+            .plus(&coupling.times(residual * inverse));
+    }
+    let g = model.gravity();
+    let mut acceleration = Motion {
+        linear: [-g[0], -g[1], -g[2]],
+        angular: [0.0; 3],
+    };
+    for (joint, out) in joints.iter().zip(qdd.iter_mut()) {
+        acceleration = acceleration.plus(&joint.bias);
+        *out = (joint.residual - acceleration.dot(&joint.coupling)) * joint.inverse;
+        acceleration = acceleration.plus(&joint.axis.times(*out));
+    }
+    Ok(())
 }
 
 /// `out = -minv rhs` (`n x n` by `n x 2n`) under [`pulp::Arch::dispatch`]: a SIMD register of

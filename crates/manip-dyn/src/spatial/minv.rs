@@ -18,8 +18,8 @@
 //!
 //! Only the entries `j >= i` are computed (the rows of the subtree below each joint); the other
 //! half is the symmetric mirror. The sweeps run in the base frame, where `X_i` is the identity:
-//! with `S_i`, `U_i` carried there by link `i`'s pose (the pairings `S . F` and `U . a` are
-//! frame-free), `F_{i-1}[:, j] = F_i[:, j] + U_i m_ij` and `a_i[:, j] = a_{i-1}[:, j] +
+//! with `S_i`, `U_i` in the base frame (from the base-frame articulated-body algorithm of
+//! [`aba_derivatives`](super::aba_derivatives())), `F_{i-1}[:, j] = F_i[:, j] + U_i m_ij` and `a_i[:, j] = a_{i-1}[:, j] +
 //! S_i (M^-1)_ij`, so each entry costs two 6-vector dot products and two 6-vector updates,
 //! computed along the row `j = i..n`, a SIMD register of entries at a time, with the columns of
 //! `F` and `a` stored by component.
@@ -27,29 +27,21 @@
 use faer::MatMut;
 use pulp::{Arch, Simd, WithSimd};
 
-use super::algebra::{Force, Transform};
-use super::data::AbaLink;
-use super::derivative_data::{Six, column_of, padded};
-use super::model::SpatialModel;
+use super::derivative_data::{BaseFrameJoint, Six, column_of, padded};
 use lane_math::{Lane, Pack};
 
-/// `M^-1` into `minv` (`n x n`) from `links`, the articulated quantities of an
-/// [`aba`](super::aba()) at the same `q` (whose pivots it checked), and `poses`, the links'
-/// poses in the base frame at that `q`, with `sweep` (7 rows of
-/// [`padded`]`(n)`) as scratch.
+/// `M^-1` into `minv` (`n x n`) from `joints`, the base-frame articulated quantities `S_i`,
+/// `U_i` and `1 / D_i` of an articulated-body algorithm at the same `q` (whose pivots it
+/// checked), with `sweep` (7 rows of [`padded`]`(n)`) as scratch.
 /// Allocation-free.
 pub(crate) fn inverse_mass_matrix(
     arch: Arch,
-    model: &SpatialModel,
-    links: &[AbaLink<f64>],
-    poses: &[Transform],
+    joints: &[BaseFrameJoint],
     sweep: &mut [Vec<f64>; 7],
     minv: MatMut<'_, f64>,
 ) {
     arch.dispatch(Sweeps {
-        model,
-        links,
-        poses,
+        joints,
         sweep,
         minv,
     });
@@ -58,22 +50,15 @@ pub(crate) fn inverse_mass_matrix(
 /// The two sweeps under [`Arch::dispatch`] (the loops along a row vectorise with this
 /// processor's widest registers).
 struct Sweeps<'a> {
-    model: &'a SpatialModel,
-    links: &'a [AbaLink<f64>],
-    poses: &'a [Transform],
+    joints: &'a [BaseFrameJoint],
     sweep: &'a mut [Vec<f64>; 7],
     minv: MatMut<'a, f64>,
 }
 
 /// Joint `i`'s axis `S_i` and `U_i` in the base frame, as plain components.
 #[inline(always)]
-fn world(model: &SpatialModel, links: &[AbaLink<f64>], poses: &[Transform], i: usize) -> [Six; 2] {
-    let pose = &poses[i];
-    let s = pose.act_motion(&model.axes[i]);
-    let u = pose.act_force(&Force {
-        linear: links[i].coupling[0],
-        angular: links[i].coupling[1],
-    });
+fn world(joint: &BaseFrameJoint) -> [Six; 2] {
+    let (s, u) = (&joint.axis, &joint.coupling);
     [
         [
             s.linear[0],
@@ -100,13 +85,11 @@ impl WithSimd for Sweeps<'_> {
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
         let Sweeps {
-            model,
-            links,
-            poses,
+            joints,
             sweep,
             mut minv,
         } = self;
-        let n = model.n_links();
+        let n = joints.len();
         let width = Pack::<S>::WIDTH;
         let end = padded(n);
         // Rows 0-5: F (then a) by component; row 6: the entries of one row of the triangle.
@@ -127,8 +110,8 @@ impl WithSimd for Sweeps<'_> {
         // Entry (i, j), j >= i, is kept at (j, i): column i of the lower triangle, contiguous.
         // Tip to base (S1, S2).
         for i in (0..n).rev() {
-            let [s, u] = registers(simd, world(model, links, poses, i));
-            let inverse = Pack::splat(simd, -links[i].inverse);
+            let [s, u] = registers(simd, world(&joints[i]));
+            let inverse = Pack::splat(simd, -joints[i].inverse);
             let mut j = i;
             while j < n {
                 let mut dot = Pack::load(simd, &f[0][j..]) * s[0];
@@ -138,7 +121,7 @@ impl WithSimd for Sweeps<'_> {
                 (inverse * dot).store(&mut entries[j..]);
                 j += width;
             }
-            entries[i] = links[i].inverse;
+            entries[i] = joints[i].inverse;
             let mut j = i;
             while j < n {
                 let m = Pack::load(simd, &entries[j..]);
@@ -155,8 +138,8 @@ impl WithSimd for Sweeps<'_> {
             row.fill(0.0);
         }
         for i in 0..n {
-            let [s, u] = registers(simd, world(model, links, poses, i));
-            let inverse = Pack::splat(simd, links[i].inverse);
+            let [s, u] = registers(simd, world(&joints[i]));
+            let inverse = Pack::splat(simd, joints[i].inverse);
             let column = column_of(&mut minv, i);
             entries[i..n].copy_from_slice(&column[i..]);
             let mut j = i;

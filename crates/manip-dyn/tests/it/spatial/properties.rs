@@ -131,7 +131,11 @@ proptest! {
         aba_derivatives(&model, &mut data, &mut derivatives, &q, &v, &tau).unwrap();
         let mut qdd = vec![0.0; n];
         aba(&model, &mut data, &q, &v, &tau, &mut qdd).unwrap();
-        prop_assert_eq!(derivatives.value(), qdd.as_slice());
+        // The derivatives' qdd comes from the ABA run in the base frame: a second algorithm.
+        prop_assert!(
+            difference(derivatives.value(), &qdd) < 1e-10 * (1.0 + max_abs(&qdd)),
+            "{:?} vs {:?}", derivatives.value(), qdd
+        );
         let inverse = mass(&model, &mut data, &q).llt(Side::Lower).unwrap().inverse();
         for k in 0..n {
             let unit: Vec<f64> = (0..n).map(|i| f64::from(u8::from(i == k))).collect();
