@@ -17,7 +17,7 @@ use super::derivative_data::{MAX_LANES, SpatialDerivativeData, column_of, padded
 use super::kinematics::{joint_placement, sin_cos_dispatched};
 use super::minv::inverse_mass_matrix;
 use super::model::SpatialModel;
-use super::rnea_derivatives::differentiate_at;
+use super::rnea_derivatives::{carry_to_base, differentiate_at};
 use crate::check;
 use crate::error::DynError;
 
@@ -90,7 +90,8 @@ pub fn aba_derivatives(
 
 /// The articulated-body algorithm (as [`aba`](super::aba())) run in the base frame, as
 /// Pinocchio's `computeABADerivatives` runs it: `qdd` from `inputs` (`q`, `v`, `tau`), each
-/// link's pose into `data`, its base-frame inertia into `derivatives.composite` and each
+/// link's pose into `data`, its base-frame axis and inertia into `derivatives`
+/// ([`carry_to_base`]) and each
 /// joint's [`BaseFrameJoint`](super::derivative_data::BaseFrameJoint) into `derivatives.joints`, for the RNEA derivatives and `M^-1`
 /// that follow. With every quantity in the base frame, the frame changes `X_i` of the
 /// link-frame algorithm are identities: base to tip, `v_i = v_{i-1} + S_i qd_i`,
@@ -108,7 +109,6 @@ fn aba_base_frame(
 ) -> Result<(), DynError> {
     let [q, v, tau] = inputs;
     let n = model.n_links();
-    let (joints, inertias) = (&mut derivatives.joints, &mut derivatives.composite);
     sin_cos_dispatched(data.arch, q, &mut data.sin, &mut data.cos);
     let mut pose = Transform::IDENTITY;
     let mut velocity = Motion::default();
@@ -116,18 +116,19 @@ fn aba_base_frame(
         let placement = joint_placement((), &model.joints()[i], q[i], data.sin[i], data.cos[i]);
         pose = pose.compose(&placement);
         data.poses[i] = pose;
-        let joint = &mut joints[i];
-        joint.axis = pose.act_motion(&model.axes[i]);
+        let axis = carry_to_base(model, derivatives, i, &pose);
+        let joint = &mut derivatives.joints[i];
+        joint.axis = axis;
         let joint_velocity = joint.axis.times(v[i]);
         velocity = velocity.plus(&joint_velocity);
         joint.bias = velocity.cross_motion(&joint_velocity);
         // A massless link (the cross of a universal joint) has no inertia and no bias force.
         if !model.massless[i] {
-            let inertia = pose.act_rigid_inertia(&model.inertias[i]);
-            joint.force = velocity.cross_force(&inertia.apply(&velocity));
-            inertias[i] = inertia;
+            let momentum = derivatives.composite[i].apply(&velocity);
+            joint.force = velocity.cross_force(&momentum);
         }
     }
+    let (joints, inertias) = (&mut derivatives.joints, &derivatives.composite);
     let mut carried_inertia = Symmetric6::default();
     let mut carried_force = Force::default();
     for i in (0..n).rev() {

@@ -41,7 +41,8 @@ use lane_math::{Lane, Pack};
 use pulp::{Simd, WithSimd};
 
 use super::algebra::{
-    Force, Mat3, Motion, RigidSum, Vec3, add, cross, dot, mat_add, mat_t_vec, mat_vec, scale,
+    Force, Mat3, Motion, RigidSum, Transform, Vec3, add, cross, dot, mat_add, mat_t_vec, mat_vec,
+    scale,
 };
 use super::data::SpatialData;
 use super::derivative_data::{MAX_LANES, Six, SpatialDerivativeData, column_of, padded};
@@ -89,13 +90,36 @@ pub fn rnea_derivatives(
         n,
     )?;
     update_poses(model, data, q);
+    for (i, pose) in data.poses.iter().enumerate() {
+        carry_to_base(model, derivatives, i, pose);
+    }
     differentiate_at(model, data, derivatives, v, qdd)?;
     check::finite_matrix("the derivatives", &derivatives.blocks.as_mut())
 }
 
-/// [`rnea_derivatives`] on checked inputs with the links' poses at `q` already in `data`, but
-/// for the test of the matrices (which [`aba_derivatives`](super::aba_derivatives()) makes
-/// once, on its own results).
+/// Joint `i`'s axis `J_i` (into the component rows of `d`) and link `i`'s inertia `I_i` (into
+/// `d.composite`; a massless link has none) carried to the base frame by the link's pose, for
+/// [`differentiate_at`]; returns `J_i`.
+#[inline(always)]
+pub(crate) fn carry_to_base(
+    model: &SpatialModel,
+    d: &mut SpatialDerivativeData,
+    i: usize,
+    pose: &Transform,
+) -> Motion {
+    let axis = pose.act_motion(&model.axes[i]);
+    for (row, value) in d.rows.iter_mut().zip(six_motion(&axis)) {
+        row[i] = value;
+    }
+    if !model.massless[i] {
+        d.composite[i] = pose.act_rigid_inertia(&model.inertias[i]);
+    }
+    axis
+}
+
+/// [`rnea_derivatives`] on checked inputs with every link's axis and inertia at `q` already
+/// carried to the base frame ([`carry_to_base`]), but for the test of the matrices (which
+/// [`aba_derivatives`](super::aba_derivatives()) makes once, on its own results).
 pub(crate) fn differentiate_at(
     model: &SpatialModel,
     data: &mut SpatialData,
@@ -104,7 +128,7 @@ pub(crate) fn differentiate_at(
     qdd: &[f64],
 ) -> Result<(), DynError> {
     let d = derivatives;
-    newton_euler_base_frame(model, data, d, v, qdd);
+    newton_euler_base_frame(model, d, v, qdd);
     differentiate(model, d);
     check::finite_result("tau", &d.value)?;
     let n = model.n_links();
@@ -189,14 +213,13 @@ fn apply_coriolis(momentum: Vec3, d: &Mat3, m: &Motion) -> Force {
     }
 }
 
-/// The Newton-Euler forward sweep in the base frame, base to tip, on the poses in `data`:
-/// each joint's axis `J_i` (into the component rows), `w_i` and `beta_i`, and each link's own
-/// inertia `I_i`, momentum `I_i v_i`, Coriolis block and force `f_i = I_i a_i + v_i x* I_i v_i`
-/// (into `g`, until [`differentiate`] replaces it), with `v_i = v_{i-1} + J_i qd_i` and
-/// `a_i = a_{i-1} + J_i qdd_i + v_i x J_i qd_i` (a massless link has none of the four).
+/// The Newton-Euler forward sweep in the base frame, base to tip, on the axes `J_i` and
+/// inertias `I_i` of [`carry_to_base`] in `d`: each joint's `w_i` and `beta_i`, and each link's
+/// own momentum `I_i v_i`, Coriolis block and force `f_i = I_i a_i + v_i x* I_i v_i` (into `g`,
+/// until [`differentiate`] replaces it), with `v_i = v_{i-1} + J_i qd_i` and
+/// `a_i = a_{i-1} + J_i qdd_i + v_i x J_i qd_i` (a massless link has none of the three).
 fn newton_euler_base_frame(
     model: &SpatialModel,
-    data: &SpatialData,
     d: &mut SpatialDerivativeData,
     v: &[f64],
     qdd: &[f64],
@@ -208,8 +231,7 @@ fn newton_euler_base_frame(
         angular: [0.0; 3],
     };
     for i in 0..model.n_links() {
-        let pose = &data.poses[i];
-        let axis = pose.act_motion(&model.axes[i]);
+        let axis = motion_of(&entries(&d.rows[..6], i));
         let w = velocity.cross_motion(&axis);
         let beta = acceleration
             .cross_motion(&axis)
@@ -219,24 +241,19 @@ fn newton_euler_base_frame(
         acceleration = acceleration
             .plus(&axis.times(qdd[i]))
             .plus(&velocity.cross_motion(&joint_velocity));
-        for (row, value) in d.rows.iter_mut().zip(six_motion(&axis)) {
-            row[i] = value;
-        }
         d.w[i] = six_motion(&w);
         d.beta[i] = six_motion(&beta);
         if model.massless[i] {
             continue;
         }
-        let inertia = pose.act_rigid_inertia(&model.inertias[i]);
+        let inertia = &d.composite[i];
         let own = inertia.apply(&velocity);
-        d.coriolis[i] = coriolis_block(&inertia, &velocity, &own);
+        let force = inertia
+            .apply(&acceleration)
+            .plus(&velocity.cross_force(&own));
+        d.coriolis[i] = coriolis_block(inertia, &velocity, &own);
         d.momentum[i] = own.linear;
-        d.g[i] = six_force(
-            &inertia
-                .apply(&acceleration)
-                .plus(&velocity.cross_force(&own)),
-        );
-        d.composite[i] = inertia;
+        d.g[i] = six_force(&force);
     }
 }
 
