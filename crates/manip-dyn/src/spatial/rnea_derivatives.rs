@@ -93,7 +93,7 @@ pub fn rnea_derivatives(
     for (i, pose) in data.poses.iter().enumerate() {
         carry_to_base(model, derivatives, i, pose);
     }
-    differentiate_at(model, data, derivatives, v, qdd)?;
+    differentiate_at(model, data, derivatives, v, qdd, Jacobians::WithMass)?;
     check::finite_matrix("the derivatives", &derivatives.blocks.as_mut())
 }
 
@@ -117,15 +117,27 @@ pub(crate) fn carry_to_base(
     axis
 }
 
+/// Which matrices [`differentiate_at`] fills, and where.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Jacobians {
+    /// `d tau / d q`, `d tau / d v` and `M` into the blocks (`rnea_derivatives`).
+    WithMass,
+    /// `d tau / d q` and `d tau / d v` into `rhs`, for the product with `-M^-1` of
+    /// [`aba_derivatives`](super::aba_derivatives()), which needs no `M`.
+    IntoRhs,
+}
+
 /// [`rnea_derivatives`] on checked inputs with every link's axis and inertia at `q` already
-/// carried to the base frame ([`carry_to_base`]), but for the test of the matrices (which
-/// [`aba_derivatives`](super::aba_derivatives()) makes once, on its own results).
+/// carried to the base frame ([`carry_to_base`]), the matrices of `jacobians` only, and without
+/// the test of the matrices (which [`aba_derivatives`](super::aba_derivatives()) makes once, on
+/// its own results).
 pub(crate) fn differentiate_at(
     model: &SpatialModel,
     data: &mut SpatialData,
     derivatives: &mut SpatialDerivativeData,
     v: &[f64],
     qdd: &[f64],
+    jacobians: Jacobians,
 ) -> Result<(), DynError> {
     let d = derivatives;
     newton_euler_base_frame(model, d, v, qdd);
@@ -133,11 +145,19 @@ pub(crate) fn differentiate_at(
     check::finite_result("tau", &d.value)?;
     let n = model.n_links();
     // Moved out and back (no allocation) so that `Fill` reads the vectors while writing them.
-    let mut blocks = std::mem::replace(&mut d.blocks, Mat::new());
-    let (d_q, rest) = blocks.as_mut().split_at_col_mut(n);
+    let target = match jacobians {
+        Jacobians::WithMass => &mut d.blocks,
+        Jacobians::IntoRhs => &mut d.rhs,
+    };
+    let mut matrices = std::mem::replace(target, Mat::new());
+    let (d_q, rest) = matrices.as_mut().split_at_col_mut(n);
     let (d_v, mass) = rest.split_at_col_mut(n);
+    let mass = (jacobians == Jacobians::WithMass).then_some(mass);
     data.arch.dispatch(Fill { d, d_q, d_v, mass });
-    d.blocks = blocks;
+    match jacobians {
+        Jacobians::WithMass => d.blocks = matrices,
+        Jacobians::IntoRhs => d.rhs = matrices,
+    }
     Ok(())
 }
 
@@ -303,14 +323,14 @@ fn differentiate(model: &SpatialModel, d: &mut SpatialDerivativeData) {
     }
 }
 
-/// The entries of the three matrices from the per-link vectors, column by column, each entry
-/// a sum of products down the component rows in SIMD registers (under
+/// The entries of the matrices (`M` when `mass` is given) from the per-link vectors, column
+/// by column, each entry a sum of products down the component rows in SIMD registers (under
 /// [`pulp::Arch::dispatch`]), stored straight into the matrices.
 struct Fill<'a> {
     d: &'a SpatialDerivativeData,
     d_q: MatMut<'a, f64>,
     d_v: MatMut<'a, f64>,
-    mass: MatMut<'a, f64>,
+    mass: Option<MatMut<'a, f64>>,
 }
 
 impl WithSimd for Fill<'_> {
@@ -356,9 +376,11 @@ impl WithSimd for Fill<'_> {
             combine(simd, &mut column[..k], &axes, &d.h[k], 0);
             combine(simd, &mut column[k..], &pq, &dv, k);
             // M: i < k: J_i . P_k; i >= k: P_i . J_k.
-            let column = column_of(&mut mass, k);
-            combine(simd, &mut column[..k], &axes, &p_k, 0);
-            combine(simd, &mut column[k..], &p, &axis, k);
+            if let Some(mass) = mass.as_mut() {
+                let column = column_of(mass, k);
+                combine(simd, &mut column[..k], &axes, &p_k, 0);
+                combine(simd, &mut column[k..], &p, &axis, k);
+            }
         }
     }
 }
