@@ -13,7 +13,7 @@ use pulp::{Simd, WithSimd};
 
 use super::algebra::{Force, Motion, Symmetric6, Transform};
 use super::data::SpatialData;
-use super::derivative_data::{MAX_LANES, SpatialDerivativeData, column_of, padded};
+use super::derivative_data::{MAX_LANES, SpatialDerivativeData, column_of, padded, store_first};
 use super::kinematics::{joint_placement, sin_cos_dispatched};
 use super::minv::inverse_mass_matrix;
 use super::model::SpatialModel;
@@ -74,10 +74,10 @@ pub fn aba_derivatives(
         ..
     } = derivatives;
     let (jacobians, mut minv) = blocks.as_mut().split_at_col_mut(2 * n);
-    inverse_mass_matrix(data.arch, joints, sweep, minv.as_mut());
+    inverse_mass_matrix(data.arch, joints, sweep, minv_columns);
     let stride = padded(n);
     for k in 0..n {
-        minv_columns[k * stride..k * stride + n].copy_from_slice(column_of(&mut minv, k));
+        column_of(&mut minv, k).copy_from_slice(&minv_columns[k * stride..k * stride + n]);
     }
     // The product's entries test the three matrices: a NaN or infinity in column `k` of `M^-1`
     // (row `r`) reaches every entry `(r, c)` of the product (through `M^-1_rk rhs_kc`, NaN when
@@ -284,7 +284,7 @@ fn block<S: Simd, const R: usize, const G: usize>(
             } else {
                 let mut last = [0.0; MAX_LANES];
                 sum.store(&mut last);
-                column[first..n].copy_from_slice(&last[..n - first]);
+                store_first(&mut column[first..], &last, n - first);
             }
         }
     }

@@ -25,6 +25,18 @@ pub(crate) fn padded(n: usize) -> usize {
 /// The most `f64` lanes of a register (AVX-512).
 pub(crate) const MAX_LANES: usize = 8;
 
+/// `out[..rows]` from the first `rows` (at most [`MAX_LANES`]) of `lanes`, the last, partial
+/// register of a SIMD loop, stored entry by entry (at these lengths a library copy call costs
+/// more than the loop that fills the register).
+#[inline(always)]
+pub(crate) fn store_first(out: &mut [f64], lanes: &[f64; MAX_LANES], rows: usize) {
+    for (r, &value) in lanes.iter().enumerate() {
+        if r < rows {
+            out[r] = value;
+        }
+    }
+}
+
 /// One joint's articulated-body quantities in the base frame, from the base-frame
 /// articulated-body algorithm of [`aba_derivatives`](super::aba_derivatives()): what
 /// [`inverse_mass_matrix`](super::minv::inverse_mass_matrix) reads (`S_i`, `U_i`, `1 / D_i`) and
@@ -96,7 +108,7 @@ pub struct SpatialDerivativeData {
     /// `[d tau / d q | d tau / d v]` while `aba_derivatives` multiplies it by `-M^-1`.
     pub(crate) rhs: Mat<f64>,
     /// The force, then motion, columns of the `O(n^2)` `M^-1` by component (`aba_derivatives`).
-    pub(crate) sweep: [Vec<f64>; 7],
+    pub(crate) sweep: [Vec<f64>; 6],
     /// The joints' articulated-body quantities in the base frame (`aba_derivatives`).
     pub(crate) joints: Vec<BaseFrameJoint>,
     /// `M^-1`'s columns, each zero-padded to [`padded`] entries, for its product with the

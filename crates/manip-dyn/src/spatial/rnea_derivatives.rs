@@ -45,7 +45,9 @@ use super::algebra::{
     scale,
 };
 use super::data::SpatialData;
-use super::derivative_data::{MAX_LANES, Six, SpatialDerivativeData, column_of, padded};
+use super::derivative_data::{
+    MAX_LANES, Six, SpatialDerivativeData, column_of, padded, store_first,
+};
 use super::kinematics::update_poses;
 use super::model::SpatialModel;
 use crate::check;
@@ -386,8 +388,8 @@ impl WithSimd for Fill<'_> {
 }
 
 /// `out[j] = sum_c rows[c][first + j] x[c]`, a register of `S` at a time (the rows hold a
-/// whole register past `first + out.len()`; the last, partial register goes through a
-/// buffer).
+/// whole register past `first + out.len()`; the last, partial register goes through
+/// [`store_first`]).
 #[inline(always)]
 fn combine<S: Simd, const C: usize>(
     simd: S,
@@ -413,9 +415,8 @@ fn combine<S: Simd, const C: usize>(
         } else {
             let mut last = [0.0; MAX_LANES];
             sum.store(&mut last);
-            for (entry, value) in out[at..].iter_mut().zip(last) {
-                *entry = value;
-            }
+            let rows = out.len() - at;
+            store_first(&mut out[at..], &last, rows);
         }
         at += width;
     }
