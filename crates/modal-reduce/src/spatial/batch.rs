@@ -142,10 +142,9 @@ impl BatchKernel for Spatial<'_> {
         gravity: &mut [Pack<S>; M],
     ) -> bool {
         let zero = Pack::splat(simd, 0.0);
-        let mut jacobians = [[[zero; M]; 3]; 6];
-        let [omega, point, com, momentum, body, body_inertia] = &mut jacobians;
+        let mut jacobians = [[[zero; M]; 3]; 5];
+        let [point, com, momentum, body, body_inertia] = &mut jacobians;
         let work = TermsLanes {
-            omega_jacobian: omega.as_flattened_mut(),
             point_jacobian: point.as_flattened_mut(),
             com_jacobian: com.as_flattened_mut(),
             momentum_jacobian: momentum.as_flattened_mut(),
