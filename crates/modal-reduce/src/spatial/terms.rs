@@ -165,14 +165,35 @@ impl WithSimd for TermsOfOneState<'_> {
         let Some((tau_star, a_ddot)) = solve else {
             return true;
         };
-        factor.copy_from_slice(mass_matrix);
-        if !ldlt_in_place::<f64>((), factor, m) {
-            return false;
+        let terms: [&[f64]; 3] = [mass_matrix, coriolis, gravity];
+        // `m` a constant of the solve for the sizes of the batch.
+        match m {
+            4 => solve_in_place(factor, terms, tau_star, a_ddot, 4),
+            8 => solve_in_place(factor, terms, tau_star, a_ddot, 8),
+            m => solve_in_place(factor, terms, tau_star, a_ddot, m),
         }
-        right_hand_side(tau_star, coriolis, gravity, a_ddot);
-        ldlt_solve_in_place(factor, m, a_ddot);
-        true
     }
+}
+
+/// `a_ddot = M*^{-1} (tau* - C* - G*)` by an `L D L^T` factor of `M*` into `factor` (kept for the
+/// derivatives), `terms` `[M*, C*, G*]` of `m` coordinates. Gives `false` if `M*` is not
+/// numerically positive definite.
+#[inline(always)]
+fn solve_in_place(
+    factor: &mut [f64],
+    [mass_matrix, coriolis, gravity]: [&[f64]; 3],
+    tau_star: &[f64],
+    a_ddot: &mut [f64],
+    m: usize,
+) -> bool {
+    let factor = &mut factor[..m * m];
+    factor.copy_from_slice(&mass_matrix[..m * m]);
+    if !ldlt_in_place::<f64>((), factor, m) {
+        return false;
+    }
+    right_hand_side(tau_star, coriolis, gravity, a_ddot);
+    ldlt_solve_in_place(factor, m, a_ddot);
+    true
 }
 
 /// Where one state's terms go: `M*` (`m x m`, row-major), `C*`, `G*`.
