@@ -159,12 +159,13 @@ impl BatchKernel for Spatial<'_> {
             model: self.model,
             a,
             a_dot,
+            next: 0,
         };
         // M*'s lower triangle, all the solve reads.
         accumulate(
             StateLanes::new(simd, usize::MAX),
             self.model,
-            &turns,
+            turns,
             M,
             work,
         );

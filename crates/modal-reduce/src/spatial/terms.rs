@@ -51,6 +51,8 @@ use crate::terms::{CoordinateLanes, OneStateScalar, Registers, StateLanes};
 use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 use lane_math::{Lane, Pack, check_values, sin_cos, sin_cos_lanes};
 use pulp::{Simd, WithSimd};
+use std::iter::Zip;
+use std::slice;
 
 /// Computes `M*`, `C*` and `G*` at the modal state `(a, a_dot)` into `data` (read them with
 /// [`SpatialReducedData::mass_matrix`], [`coriolis`](SpatialReducedData::coriolis) and
@@ -124,12 +126,7 @@ impl WithSimd for TermsOfOneState<'_> {
         } = data;
         link_values(model, a, a_dot, link_angles, link_rates);
         sin_cos(link_angles, link_sin, link_cos);
-        let turns = TurnsOfLinks {
-            n: model.n_links(),
-            sin: link_sin,
-            cos: link_cos,
-            rates: link_rates,
-        };
+        let turns = TurnsOfLinks::new(model.n_links(), link_sin, link_cos, link_rates);
         let out = OneStateTerms {
             mass_matrix: &mut *mass_matrix,
             coriolis: &mut *coriolis,
@@ -139,11 +136,11 @@ impl WithSimd for TermsOfOneState<'_> {
         // in one register where they fit; `m` a constant of the solve for them.
         let m = match model.n_coords() {
             4 => {
-                on_stack::<S, 4>(simd, model, &turns, out);
+                on_stack::<S, 4>(simd, model, turns, out);
                 4
             }
             8 => {
-                on_stack::<S, 8>(simd, model, &turns, out);
+                on_stack::<S, 8>(simd, model, turns, out);
                 8
             }
             m => {
@@ -157,7 +154,7 @@ impl WithSimd for TermsOfOneState<'_> {
                     coriolis: out.coriolis,
                     gravity: out.gravity,
                 };
-                let work = accumulate(OneStateScalar(simd), model, &turns, m, work);
+                let work = accumulate(OneStateScalar(simd), model, turns, m, work);
                 mirror_lower(work.mass_matrix, m);
                 m
             }
@@ -210,7 +207,7 @@ struct OneStateTerms<'a> {
 fn on_stack<S: Simd, const M: usize>(
     simd: S,
     model: &SpatialReducedModel,
-    turns: &TurnsOfLinks<'_>,
+    turns: TurnsOfLinks<'_>,
     out: OneStateTerms<'_>,
 ) {
     if M == 4 && S::F64_LANES == 2 * M && S::F64_LANES <= LINK_PADDING {
@@ -228,7 +225,7 @@ fn on_stack<S: Simd, const M: usize>(
 fn in_layout<Y: MassRows<Value = f64>, const M: usize, const C: usize>(
     layout: Y,
     model: &SpatialReducedModel,
-    turns: &TurnsOfLinks<'_>,
+    turns: TurnsOfLinks<'_>,
     out: OneStateTerms<'_>,
 ) {
     let zero = Y::Register::splat(layout.register_context(), 0.0);
@@ -299,46 +296,66 @@ fn link_values(
     }
 }
 
-/// Each link's [`JointTurns`], for [`accumulate`].
-pub(crate) trait LinkTurns<L> {
-    /// Link `i`'s.
-    fn turns(&self, i: usize) -> JointTurns<L>;
-}
+/// Two slices side by side.
+type Pairs<'a> = Zip<slice::Iter<'a, f64>, slice::Iter<'a, f64>>;
 
 /// The turns of all links of one state, formed beforehand ([`link_values`], then
-/// [`sin_cos`] of all the angles): the `z` joints' `n` values, then the `y` joints'.
+/// [`sin_cos`] of all the angles: the `z` joints' `n` values, then the `y` joints'), link after
+/// link (one zip of the six slices, so one test of the end a link).
 struct TurnsOfLinks<'a> {
-    n: usize,
-    sin: &'a [f64],
-    cos: &'a [f64],
-    rates: &'a [f64],
+    links: Zip<Zip<Pairs<'a>, Pairs<'a>>, Pairs<'a>>,
 }
 
-impl LinkTurns<f64> for TurnsOfLinks<'_> {
+impl<'a> TurnsOfLinks<'a> {
+    /// The turns of `n` links from the buffers of [`SpatialReducedData`].
     #[inline(always)]
-    fn turns(&self, i: usize) -> JointTurns<f64> {
-        let (z, y) = (i, self.n + i);
-        JointTurns {
-            sin: [self.sin[z], self.sin[y]],
-            cos: [self.cos[z], self.cos[y]],
-            rates: [self.rates[z], self.rates[y]],
+    fn new(n: usize, sin: &'a [f64], cos: &'a [f64], rates: &'a [f64]) -> Self {
+        let pairs = |values: &'a [f64]| {
+            let (z, y) = values.split_at(n);
+            z.iter().zip(&y[..n])
+        };
+        Self {
+            links: pairs(sin).zip(pairs(cos)).zip(pairs(rates)),
         }
+    }
+}
+
+impl Iterator for TurnsOfLinks<'_> {
+    type Item = JointTurns<f64>;
+
+    #[inline(always)]
+    fn next(&mut self) -> Option<JointTurns<f64>> {
+        let (((&sin_z, &sin_y), (&cos_z, &cos_y)), (&rate_z, &rate_y)) = self.links.next()?;
+        Some(JointTurns {
+            sin: [sin_z, sin_y],
+            cos: [cos_z, cos_y],
+            rates: [rate_z, rate_y],
+        })
     }
 }
 
 /// The turns of a link formed as the kernel reaches it, from the modal state (`a`, `a_dot`, `m`
 /// values each): `theta = J a`, `J a_dot` by multiply-adds over the row of the planar map, then
-/// [`sin_cos_lanes`] (for a batch, whose registers hold states: nothing of size `n` is kept).
+/// [`sin_cos_lanes`] (for a batch, whose registers hold states: nothing of size `n` is kept),
+/// link after link from `next`.
 pub(crate) struct TurnsFromModes<'a, L: Lane> {
     pub(crate) context: L::Context,
     pub(crate) model: &'a SpatialReducedModel,
     pub(crate) a: &'a [L],
     pub(crate) a_dot: &'a [L],
+    pub(crate) next: usize,
 }
 
-impl<L: Lane> LinkTurns<L> for TurnsFromModes<'_, L> {
+impl<L: Lane> Iterator for TurnsFromModes<'_, L> {
+    type Item = JointTurns<L>;
+
     #[inline(always)]
-    fn turns(&self, i: usize) -> JointTurns<L> {
+    fn next(&mut self) -> Option<JointTurns<L>> {
+        let i = self.next;
+        if i == self.model.n_links() {
+            return None;
+        }
+        self.next += 1;
         let context = self.context;
         let half = self.model.n_coords() / 2;
         let zero = L::splat(context, 0.0);
@@ -356,11 +373,11 @@ impl<L: Lane> LinkTurns<L> for TurnsFromModes<'_, L> {
         }
         let (sin_z, cos_z) = sin_cos_lanes(context, angles[0]);
         let (sin_y, cos_y) = sin_cos_lanes(context, angles[1]);
-        JointTurns {
+        Some(JointTurns {
             sin: [sin_z, sin_y],
             cos: [cos_z, cos_y],
             rates,
-        }
+        })
     }
 }
 
@@ -396,7 +413,7 @@ pub(crate) struct TermsLanes<'w, R> {
 pub(crate) fn accumulate<'w, Y: MassRows>(
     layout: Y,
     model: &SpatialReducedModel,
-    turns: &impl LinkTurns<Y::Value>,
+    mut turns: impl Iterator<Item = JointTurns<Y::Value>>,
     m: usize,
     work: TermsLanes<'w, Y::Register>,
 ) -> TermsLanes<'w, Y::Register> {
@@ -451,7 +468,11 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
     let (mut omega, mut omega_dot, mut accel) = ([value_zero; 3], [value_zero; 3], [value_zero; 3]);
     let per_link = model.map().link_lengths().iter().zip(model.links());
     for (i, (&length, inertia)) in per_link.enumerate() {
-        let JointTurns { sin, cos, rates } = turns.turns(i);
+        // `next` called here, not through an iterator adapter: an adapter is compiled without the
+        // instruction set of the SIMD dispatch and would call the batch's intrinsics.
+        let Some(JointTurns { sin, cos, rates }) = turns.next() else {
+            break;
+        };
         let [sin_z, sin_y] = sin;
         let [cos_z, cos_y] = cos;
         let [rate_z, rate_y] = rates;
