@@ -293,6 +293,7 @@ impl Scenario {
         };
         let radius = self.arm.radius.unwrap_or(0.0);
         let mut tracker = DeployTracker::new(&channel, &lengths, radius).map_err(plan_field)?;
+        tracker.reserve(run.record.t.len()).map_err(plan_field)?;
         let length = chain.total_length();
         let (e, d) = (channel.entry(), axis);
         let mut points = vec![[0.0; 2]; run.record.t.len() * (n + 1)];
