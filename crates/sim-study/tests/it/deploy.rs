@@ -216,6 +216,11 @@ fn the_deployment_mpc_keeps_the_joint_torques_within_joint_torque_nm() {
         peak <= limit * (1.0 + 1e-12),
         "{peak} vs {limit} (free {free})"
     );
+    // Its summary names the controller that ran.
+    let run = limited.run_deploy().unwrap();
+    let summary = sim_study::summary_json::deploy(&limited, &run);
+    assert_eq!(summary["controller"], "mpc");
+    assert_eq!(summary["deploy_tip_error_m"], run.metrics.tip_error);
     let message = |s: &Scenario| s.run_deploy().unwrap_err().to_string();
     let mut short = scenario.clone();
     short.limits.joint_torque_nm = Some(TorqueLimit::PerJoint(vec![1.0; 9]));
