@@ -482,8 +482,9 @@ impl Ilqr {
     /// [`solve`](Self::solve) with the general linear constraints `G u_k <= g` of
     /// `constraints` on every step besides the box. The backward pass solves each step's QP
     /// `min 1/2 d^T (Q_uu + mu I) d + Q_u^T d` subject to the step's rows (at the nominal state)
-    /// and the box by [`LinearQp`](crate::LinearQp), with the feedback gain restricted to
-    /// the directions that keep the active rows active; the forward pass moves every control
+    /// and the box by [`LinearQp`](crate::LinearQp), with the feedback gain that keeps the
+    /// active rows active as the state moves (their state Jacobian by forward differences of
+    /// the rows); the forward pass moves every control
     /// to the closest one within the rows at its own state ([`PolytopeProjection`](crate::PolytopeProjection)).
     /// A step without rows is the box QP's, exactly. A step whose rows admit no control within
     /// the box (a warm start, or a state the momentum carries past them) is planned within the
