@@ -110,76 +110,20 @@ pub fn segment_segment(a: V3, b: V3, c: V3, d: V3) -> Closest {
 /// and `axes` (the columns of its rotation), and its signed distance.
 ///
 /// The box's signed distance along the segment, `f(t)`, is convex (the signed distance of a
-/// convex set is convex) and smooth between the breakpoints where a local coordinate crosses
-/// `0` or `+-h_k` or two faces' depths `|q_j| - h_j`, `|q_k| - h_k` tie: outside the box `f` is
-/// the root of a quadratic, inside the largest of linear functions. Its minimum is therefore
-/// one of the breakpoints or the stationary point of an outside piece; all are evaluated.
+/// convex set is convex). Where the segment meets the box (clipped to the slabs
+/// `|q_k| <= h_k`, Liang and Barsky) `f` is the largest of the affine depths `+-q_k(t) - h_k`,
+/// whose minimum on the clipped interval is at one of its ends or at a kink where two depths
+/// tie ([`deepest_inside`]). Elsewhere `f = sqrt(D)` with `D` the squared distance, a sum of
+/// convex, continuously differentiable per-axis pieces ([`nearest_outside`]).
 pub fn segment_box(a: V3, b: V3, center: V3, half: V3, axes: &[V3; 3]) -> Closest {
     let q0 = to_local(axes, sub(a, center));
     let dq = to_local(axes, sub(b, a));
     let at = |t: f64| [q0[0] + t * dq[0], q0[1] + t * dq[1], q0[2] + t * dq[2]];
-    let mut breaks = [0.0_f64; 26];
-    let mut count = 0;
-    let mut push = |t: f64| {
-        if t > 0.0 && t < 1.0 {
-            breaks[count] = t;
-            count += 1;
-        }
+    let t = match clip(q0, dq, half) {
+        Some((enter, exit)) => deepest_inside(q0, dq, half, enter, exit),
+        None => nearest_outside(q0, dq, half),
     };
-    for k in 0..3 {
-        if dq[k] != 0.0 {
-            push(-q0[k] / dq[k]);
-            if half[k].is_finite() {
-                push((half[k] - q0[k]) / dq[k]);
-                push((-half[k] - q0[k]) / dq[k]);
-            }
-        }
-    }
-    for (j, k) in [(0, 1), (0, 2), (1, 2)] {
-        if !(half[j].is_finite() && half[k].is_finite()) {
-            continue;
-        }
-        for (sj, sk) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
-            let slope = sj * dq[j] - sk * dq[k];
-            if slope != 0.0 {
-                push((half[j] - half[k] - sj * q0[j] + sk * q0[k]) / slope);
-            }
-        }
-    }
-    breaks[count] = 0.0;
-    breaks[count + 1] = 1.0;
-    let breaks = &mut breaks[..count + 2];
-    breaks.sort_unstable_by(f64::total_cmp);
-    let mut best = (0.0, f64::INFINITY);
-    let mut consider = |t: f64| {
-        let value = box_signed_distance(at(t), half);
-        if value < best.1 {
-            best = (t, value);
-        }
-    };
-    for window in breaks.windows(2) {
-        let (lo, hi) = (window[0], window[1]);
-        consider(lo);
-        // The stationary point of the squared outside distance of this piece.
-        let mid = at(0.5 * (lo + hi));
-        let (mut num, mut den) = (0.0, 0.0);
-        for k in 0..3 {
-            let bound = if mid[k] > half[k] {
-                half[k]
-            } else if mid[k] < -half[k] {
-                -half[k]
-            } else {
-                continue;
-            };
-            num -= (q0[k] - bound) * dq[k];
-            den += dq[k] * dq[k];
-        }
-        if den > 0.0 {
-            consider((num / den).clamp(lo, hi));
-        }
-    }
-    consider(1.0);
-    let (t, distance) = best;
+    let distance = box_signed_distance(at(t), half);
     let q = at(t);
     // The gradient of the box's signed distance at q: outward from the nearest surface point.
     let mut outside = [0.0; 3];
@@ -214,6 +158,123 @@ pub fn segment_box(a: V3, b: V3, center: V3, half: V3, axes: &[V3; 3]) -> Closes
         other: crate::vector::add(center, to_world(axes, surface)),
         distance,
         normal,
+    }
+}
+
+/// The parameters `[enter, exit]` of `[0, 1]` where `q0 + t dq` lies in the closed box
+/// `|q_k| <= h_k` (Liang and Barsky's slab clipping); `None` when the segment misses it.
+fn clip(q0: V3, dq: V3, half: V3) -> Option<(f64, f64)> {
+    let (mut enter, mut exit) = (0.0_f64, 1.0_f64);
+    for k in 0..3 {
+        if dq[k] == 0.0 {
+            if q0[k].abs() > half[k] {
+                return None;
+            }
+        } else {
+            let low = (-half[k] - q0[k]) / dq[k];
+            let high = (half[k] - q0[k]) / dq[k];
+            enter = enter.max(low.min(high));
+            exit = exit.min(low.max(high));
+        }
+    }
+    (enter <= exit).then_some((enter, exit))
+}
+
+/// The deepest point of the clipped segment `[enter, exit]` inside the box: the depth
+/// `g(t) = max_k (|q_k(t)| - h_k)` is the largest of six affine functions, so its minimum is at
+/// an end of the interval or at a kink, where `q_k` crosses `0` or two faces' depths
+/// `+-q_j - h_j`, `+-q_k - h_k` tie. Of equal depths the smallest `t` is kept.
+fn deepest_inside(q0: V3, dq: V3, half: V3, enter: f64, exit: f64) -> f64 {
+    let depth = |t: f64| {
+        let mut deepest = f64::NEG_INFINITY;
+        for k in 0..3 {
+            deepest = deepest.max((q0[k] + t * dq[k]).abs() - half[k]);
+        }
+        deepest
+    };
+    let mut best = (enter, depth(enter));
+    let mut consider = |t: f64| {
+        if t > enter && t <= exit {
+            let value = depth(t);
+            if value < best.1 || (value == best.1 && t < best.0) {
+                best = (t, value);
+            }
+        }
+    };
+    consider(exit);
+    for k in 0..3 {
+        if dq[k] != 0.0 {
+            consider(-q0[k] / dq[k]);
+        }
+    }
+    for (j, k) in [(0, 1), (0, 2), (1, 2)] {
+        if !(half[j].is_finite() && half[k].is_finite()) {
+            continue;
+        }
+        for (sj, sk) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+            let slope = sj * dq[j] - sk * dq[k];
+            if slope != 0.0 {
+                consider((half[j] - half[k] - sj * q0[j] + sk * q0[k]) / slope);
+            }
+        }
+    }
+    best.0
+}
+
+/// The point of a segment that misses the box nearest to it: the squared distance
+/// `D(t) = sum_k e_k(t)^2`, `e_k = q_k - clamp(q_k, -h_k, h_k)`, is convex and continuously
+/// differentiable with `D'(t) / 2 = sum_k e_k dq_k` piecewise affine between the parameters where
+/// a `q_k` crosses `+-h_k`. Bisecting on the sign of `D'` at those parameters finds the piece
+/// holding its zero, where `D' = 0` is solved in closed form.
+fn nearest_outside(q0: V3, dq: V3, half: V3) -> f64 {
+    let at = |t: f64| [q0[0] + t * dq[0], q0[1] + t * dq[1], q0[2] + t * dq[2]];
+    let slope = |t: f64| {
+        let q = at(t);
+        let mut sum = 0.0;
+        for k in 0..3 {
+            sum += (q[k] - q[k].clamp(-half[k], half[k])) * dq[k];
+        }
+        sum
+    };
+    if slope(0.0) >= 0.0 {
+        return 0.0;
+    }
+    if slope(1.0) <= 0.0 {
+        return 1.0;
+    }
+    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+    for k in 0..3 {
+        if dq[k] != 0.0 && half[k].is_finite() {
+            for bound in [half[k], -half[k]] {
+                let t = (bound - q0[k]) / dq[k];
+                if t > lo && t < hi {
+                    if slope(t) < 0.0 {
+                        lo = t;
+                    } else {
+                        hi = t;
+                    }
+                }
+            }
+        }
+    }
+    // On (lo, hi) each axis is below, within or above its slab throughout.
+    let mid = at(0.5 * (lo + hi));
+    let (mut num, mut den) = (0.0, 0.0);
+    for k in 0..3 {
+        let bound = if mid[k] > half[k] {
+            half[k]
+        } else if mid[k] < -half[k] {
+            -half[k]
+        } else {
+            continue;
+        };
+        num -= (q0[k] - bound) * dq[k];
+        den += dq[k] * dq[k];
+    }
+    if den > 0.0 {
+        (num / den).clamp(lo, hi)
+    } else {
+        hi
     }
 }
 
