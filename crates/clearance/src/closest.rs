@@ -9,7 +9,7 @@
 //! subgradient, and the clearance saturates at minus the radii.
 
 use crate::obstacle::{box_signed_distance, unit_or};
-use crate::vector::{V3, dot, lerp, sub, to_local, to_world};
+use crate::vector::{V3, add, dot, scale, sub, to_local, to_world};
 
 /// The closest point of the link's axis `a`-`b` to a core and the signed distance between them.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,18 +38,53 @@ fn direction(v: V3, scale: f64) -> (V3, f64) {
     }
 }
 
+/// A segment `a`-`b` with what every pair of it needs: its start `a`, its axis `b - a`, and the
+/// axis' squared length and length, computed once per link rather than once per pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Segment {
+    start: V3,
+    axis: V3,
+    length2: f64,
+    length: f64,
+}
+
+impl Segment {
+    /// The segment from `a` to `b`.
+    #[inline]
+    pub(crate) fn new(a: V3, b: V3) -> Self {
+        let axis = sub(b, a);
+        let length2 = dot(axis, axis);
+        Self {
+            start: a,
+            axis,
+            length2,
+            length: length2.sqrt(),
+        }
+    }
+
+    /// The point `a + t (b - a)`.
+    #[inline]
+    fn at(&self, t: f64) -> V3 {
+        add(self.start, scale(self.axis, t))
+    }
+}
+
 /// The closest point of the segment `a`-`b` to the point `o`.
 #[inline]
 pub fn segment_point(a: V3, b: V3, o: V3) -> Closest {
-    let axis = sub(b, a);
-    let length2 = dot(axis, axis);
-    let t = if length2 > 0.0 {
-        (dot(sub(o, a), axis) / length2).clamp(0.0, 1.0)
+    closest_to_point(&Segment::new(a, b), o)
+}
+
+/// [`segment_point`] of a prepared segment.
+#[inline]
+pub(crate) fn closest_to_point(link: &Segment, o: V3) -> Closest {
+    let t = if link.length2 > 0.0 {
+        (dot(sub(o, link.start), link.axis) / link.length2).clamp(0.0, 1.0)
     } else {
         0.0
     };
-    let point = lerp(a, b, t);
-    let (normal, distance) = direction(sub(point, o), length2.sqrt());
+    let point = link.at(t);
+    let (normal, distance) = direction(sub(point, o), link.length);
     Closest {
         t,
         point,
@@ -63,10 +98,15 @@ pub fn segment_point(a: V3, b: V3, o: V3) -> Closest {
 /// Detection*, 5.1.9, with the degenerate and parallel cases resolved).
 #[inline]
 pub fn segment_segment(a: V3, b: V3, c: V3, d: V3) -> Closest {
-    let d1 = sub(b, a);
-    let d2 = sub(d, c);
-    let r = sub(a, c);
-    let (aa, ee, f) = (dot(d1, d1), dot(d2, d2), dot(d2, r));
+    closest_to_segment(&Segment::new(a, b), &Segment::new(c, d))
+}
+
+/// [`segment_segment`] of two prepared segments.
+#[inline]
+pub(crate) fn closest_to_segment(link: &Segment, other: &Segment) -> Closest {
+    let (d1, d2) = (link.axis, other.axis);
+    let r = sub(link.start, other.start);
+    let (aa, ee, f) = (link.length2, other.length2, dot(d2, r));
     let (t, s) = if aa <= 0.0 && ee <= 0.0 {
         (0.0, 0.0)
     } else if aa <= 0.0 {
@@ -94,13 +134,12 @@ pub fn segment_segment(a: V3, b: V3, c: V3, d: V3) -> Closest {
             (t, s)
         }
     };
-    let point = lerp(a, b, t);
-    let other = lerp(c, d, s);
-    let (normal, distance) = direction(sub(point, other), aa.sqrt() + ee.sqrt());
+    let point = link.at(t);
+    let (normal, distance) = direction(sub(point, other.at(s)), link.length + other.length);
     Closest {
         t,
         point,
-        other,
+        other: other.at(s),
         distance,
         normal,
     }
@@ -116,8 +155,13 @@ pub fn segment_segment(a: V3, b: V3, c: V3, d: V3) -> Closest {
 /// tie ([`deepest_inside`]). Elsewhere `f = sqrt(D)` with `D` the squared distance, a sum of
 /// convex, continuously differentiable per-axis pieces ([`nearest_outside`]).
 pub fn segment_box(a: V3, b: V3, center: V3, half: V3, axes: &[V3; 3]) -> Closest {
-    let q0 = to_local(axes, sub(a, center));
-    let dq = to_local(axes, sub(b, a));
+    closest_to_box(&Segment::new(a, b), center, half, axes)
+}
+
+/// [`segment_box`] of a prepared segment.
+pub(crate) fn closest_to_box(link: &Segment, center: V3, half: V3, axes: &[V3; 3]) -> Closest {
+    let q0 = to_local(axes, sub(link.start, center));
+    let dq = to_local(axes, link.axis);
     let at = |t: f64| [q0[0] + t * dq[0], q0[1] + t * dq[1], q0[2] + t * dq[2]];
     let t = match clip(q0, dq, half) {
         Some((enter, exit)) => deepest_inside(q0, dq, half, enter, exit),
@@ -154,8 +198,8 @@ pub fn segment_box(a: V3, b: V3, center: V3, half: V3, axes: &[V3; 3]) -> Closes
     let normal = to_world(axes, local_normal);
     Closest {
         t,
-        point: lerp(a, b, t),
-        other: crate::vector::add(center, to_world(axes, surface)),
+        point: link.at(t),
+        other: add(center, to_world(axes, surface)),
         distance,
         normal,
     }
