@@ -9,7 +9,7 @@
 //! subgradient, and the clearance saturates at minus the radii.
 
 use crate::obstacle::{box_signed_distance, unit_or};
-use crate::vector::{V3, add, dot, scale, sub, to_local, to_world};
+use crate::vector::{V3, add, clamp_symmetric, dot, scale, sub, to_local, to_world};
 
 /// The closest point of the link's axis `a`-`b` to a core and the signed distance between them.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -173,7 +173,7 @@ pub(crate) fn closest_to_box(link: &Segment, center: V3, half: V3, axes: &[V3; 3
     let mut outside = [0.0; 3];
     let (mut deepest, mut face) = (f64::NEG_INFINITY, 0);
     for k in 0..3 {
-        outside[k] = q[k] - q[k].clamp(-half[k], half[k]);
+        outside[k] = q[k] - clamp_symmetric(q[k], half[k]);
         let gap = q[k].abs() - half[k];
         if gap > deepest {
             (deepest, face) = (gap, k);
@@ -190,7 +190,7 @@ pub(crate) fn closest_to_box(link: &Segment, center: V3, half: V3, axes: &[V3; 3
     let mut surface = q;
     if gap > 0.0 {
         for k in 0..3 {
-            surface[k] = q[k].clamp(-half[k], half[k]);
+            surface[k] = clamp_symmetric(q[k], half[k]);
         }
     } else {
         surface[face] = half[face].copysign(q[face]);
@@ -276,7 +276,7 @@ fn nearest_outside(q0: V3, dq: V3, half: V3) -> f64 {
         let q = at(t);
         let mut sum = 0.0;
         for k in 0..3 {
-            sum += (q[k] - q[k].clamp(-half[k], half[k])) * dq[k];
+            sum += (q[k] - clamp_symmetric(q[k], half[k])) * dq[k];
         }
         sum
     };
