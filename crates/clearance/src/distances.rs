@@ -31,9 +31,8 @@ pub fn distances(model: &ClearanceModel, data: &mut ClearanceData) -> (f64, f64)
             .zip(obstacle_closest.chunks_exact_mut(obstacles.len()))
         {
             for ((obstacle, distance), closest) in obstacles.iter().zip(distances).zip(closest) {
-                let (found, other_radius) = closest_to(obstacle, link);
-                *distance = found.distance - radius - other_radius;
-                *closest = found;
+                let other_radius = closest_to(obstacle, link, closest);
+                *distance = closest.distance - radius - other_radius;
                 near_obstacle = near_obstacle.min(*distance);
             }
         }
@@ -48,26 +47,33 @@ pub fn distances(model: &ClearanceModel, data: &mut ClearanceData) -> (f64, f64)
             .map(move |other| (link, other))
     });
     for ((distance, closest), (link, other)) in pairs.zip(others) {
-        let found = closest_to_segment(link, other);
-        *distance = found.distance - 2.0 * radius;
-        *closest = found;
+        *closest = closest_to_segment(link, other);
+        *distance = closest.distance - 2.0 * radius;
         near_self = near_self.min(*distance);
     }
     (near_obstacle, near_self)
 }
 
-/// The closest points of a link's segment to an obstacle's core and the obstacle's radius.
+/// Writes the closest points of a link's segment to an obstacle's core into `closest` and
+/// returns the obstacle's radius.
 #[inline]
-fn closest_to(obstacle: &Obstacle, link: &Segment) -> (Closest, f64) {
+fn closest_to(obstacle: &Obstacle, link: &Segment, closest: &mut Closest) -> f64 {
     match obstacle {
-        Obstacle::Sphere { center, radius } => (closest_to_point(link, *center), *radius),
+        Obstacle::Sphere { center, radius } => {
+            *closest = closest_to_point(link, *center);
+            *radius
+        }
         Obstacle::Capsule { from, to, radius } => {
-            (closest_to_segment(link, &Segment::new(*from, *to)), *radius)
+            *closest = closest_to_segment(link, &Segment::new(*from, *to));
+            *radius
         }
         Obstacle::Box {
             center,
             half_extents,
             axes,
-        } => (closest_to_box(link, *center, *half_extents, axes), 0.0),
+        } => {
+            *closest = closest_to_box(link, *center, *half_extents, axes);
+            0.0
+        }
     }
 }
