@@ -208,6 +208,13 @@ pub(crate) fn closest_to_box(link: &Segment, center: V3, half: V3, axes: &[V3; 3
 /// The parameters `[enter, exit]` of `[0, 1]` where `q0 + t dq` lies in the closed box
 /// `|q_k| <= h_k` (Liang and Barsky's slab clipping); `None` when the segment misses it.
 fn clip(q0: V3, dq: V3, half: V3) -> Option<(f64, f64)> {
+    // Both ends beyond the same face: no division needed.
+    for k in 0..3 {
+        let (from, to) = (q0[k], q0[k] + dq[k]);
+        if from.min(to) > half[k] || from.max(to) < -half[k] {
+            return None;
+        }
+    }
     let (mut enter, mut exit) = (0.0_f64, 1.0_f64);
     for k in 0..3 {
         if dq[k] == 0.0 {
