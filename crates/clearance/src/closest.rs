@@ -152,8 +152,8 @@ pub(crate) fn closest_to_segment(link: &Segment, other: &Segment) -> Closest {
 /// convex set is convex). Where the segment meets the box (clipped to the slabs
 /// `|q_k| <= h_k`, Liang and Barsky) `f` is the largest of the affine depths `+-q_k(t) - h_k`,
 /// whose minimum on the clipped interval is at one of its ends or at a kink where two depths
-/// tie ([`deepest_inside`]). Elsewhere `f = sqrt(D)` with `D` the squared distance, a sum of
-/// convex, continuously differentiable per-axis pieces ([`nearest_outside`]).
+/// tie (`deepest_inside`). Elsewhere `f = sqrt(D)` with `D` the squared distance, a sum of
+/// convex, continuously differentiable per-axis pieces (`nearest_outside`).
 pub fn segment_box(a: V3, b: V3, center: V3, half: V3, axes: &[V3; 3]) -> Closest {
     closest_to_box(&Segment::new(a, b), center, half, axes)
 }
