@@ -34,6 +34,7 @@
 //! unrolls; other sizes on the workspace's vectors.
 
 use faer::MatRef;
+use pulp::{Simd, WithSimd};
 
 use crate::data::ReducedData;
 use crate::error::{ReduceError, check_finite_result};
@@ -60,9 +61,9 @@ pub struct ReducedDerivatives {
     rate: Vec<f64>,
     accel: Vec<f64>,
     diagonal: Vec<f64>,
-    /// Scratch of the sizes without a stack version: [`VECTORS`] vectors of `m` and the
-    /// factor of `M*` (`m x m`).
-    vectors: [Vec<f64>; VECTORS],
+    /// Scratch of the sizes without a stack version: [`VECTORS`] vectors of `m`, one after
+    /// the other, and the factor of `M*` (`m x m`).
+    vectors: Vec<f64>,
     factor: Vec<f64>,
 }
 
@@ -88,7 +89,7 @@ impl ReducedDerivatives {
             rate: vec![0.0; n],
             accel: vec![0.0; n],
             diagonal: vec![0.0; n],
-            vectors: std::array::from_fn(|_| vec![0.0; if heap { m } else { 0 }]),
+            vectors: vec![0.0; if heap { VECTORS * m } else { 0 }],
             factor: vec![0.0; if heap { m * m } else { 0 }],
         }
     }
@@ -168,11 +169,14 @@ pub fn reduced_derivatives(
     )?;
     forward_dynamics(model, data, a, a_dot, tau_star, &mut derivatives.a_ddot)?;
     // `forward_dynamics` left each link's sine and cosine in `data.links`, and M* in `data`.
+    let arch = data.arch;
     let positive_definite = match model.n_coords() {
-        2 => on_stack::<2>(model, data, derivatives, a_dot),
-        3 => on_stack::<3>(model, data, derivatives, a_dot),
-        4 => on_stack::<4>(model, data, derivatives, a_dot),
-        5 => on_stack::<5>(model, data, derivatives, a_dot),
+        2..=MAX_STACK_COORDS => arch.dispatch(OnStack {
+            model,
+            data,
+            derivatives: &mut *derivatives,
+            a_dot,
+        }),
         m => {
             let ReducedDerivatives {
                 a_ddot,
@@ -189,7 +193,6 @@ pub fn reduced_derivatives(
                 accel,
                 diagonal,
             };
-            let vectors = vectors.each_mut().map(Vec::as_mut_slice);
             differentiate(
                 model, data, m, a_dot, a_ddot, links, vectors, factor, jacobians,
             )
@@ -206,6 +209,36 @@ struct LinkScratch<'a> {
     rate: &'a mut [f64],
     accel: &'a mut [f64],
     diagonal: &'a mut [f64],
+}
+
+/// [`differentiate`] for the sizes on stack arrays, run by [`pulp::Arch::dispatch`] so that it
+/// is compiled for the processor's instruction set (the same operations in the same order as
+/// without; no fused multiply-adds).
+struct OnStack<'a> {
+    model: &'a ReducedModel,
+    data: &'a ReducedData,
+    derivatives: &'a mut ReducedDerivatives,
+    a_dot: &'a [f64],
+}
+
+impl WithSimd for OnStack<'_> {
+    type Output = bool;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _simd: S) -> bool {
+        let Self {
+            model,
+            data,
+            derivatives,
+            a_dot,
+        } = self;
+        match model.n_coords() {
+            2 => on_stack::<2>(model, data, derivatives, a_dot),
+            3 => on_stack::<3>(model, data, derivatives, a_dot),
+            4 => on_stack::<4>(model, data, derivatives, a_dot),
+            _ => on_stack::<5>(model, data, derivatives, a_dot),
+        }
+    }
 }
 
 /// [`differentiate`] for a compile-time `M`, on local arrays; the Jacobians are copied into
@@ -239,7 +272,7 @@ fn on_stack<const M: usize>(
         a_dot,
         a_ddot,
         links,
-        vectors.each_mut().map(|vector| vector.as_mut_slice()),
+        vectors.as_flattened_mut(),
         factor.as_flattened_mut(),
         jacobians.as_flattened_mut().as_flattened_mut(),
     );
@@ -250,8 +283,8 @@ fn on_stack<const M: usize>(
 }
 
 /// The three Jacobians (row-major `m x 3m`, into `jacobians`) at the state of `data` (the sines
-/// and cosines of the link angles, `M*`) and the accelerations `a_ddot`; `vectors` are
-/// [`VECTORS`] `m`-vectors of scratch and `factor` `m x m`. `false` if `M*` is not numerically
+/// and cosines of the link angles, `M*`) and the accelerations `a_ddot`; `vectors` holds
+/// [`VECTORS`] `m`-vectors of scratch one after the other, and `factor` `m x m`. `false` if `M*` is not numerically
 /// positive definite.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
@@ -262,7 +295,7 @@ fn differentiate(
     a_dot: &[f64],
     a_ddot: &[f64],
     links: LinkScratch<'_>,
-    vectors: [&mut [f64]; VECTORS],
+    vectors: &mut [f64],
     factor: &mut [f64],
     jacobians: &mut [f64],
 ) -> bool {
@@ -296,28 +329,20 @@ fn differentiate(
     }
     // From the base: the prefix sums, and the rank-2 update of each partial, accumulated with
     // the opposite sign as the right-hand sides -D_a and -D_v.
-    let [
-        p_sin,
-        p_cos,
-        q_x,
-        q_y,
-        qf_x,
-        qf_y,
-        above_a,
-        above_v,
-        below_a,
-        below_v,
-    ] = vectors.map(|vector| &mut vector[..m]);
-    for prefix in [
-        &mut *p_sin,
-        &mut *p_cos,
-        &mut *q_x,
-        &mut *q_y,
-        &mut *qf_x,
-        &mut *qf_y,
-    ] {
-        prefix.fill(0.0);
-    }
+    // Split one after the other (an array of slices mapped from the scratch kept the compiler
+    // from holding the stack sizes' vectors in registers).
+    let vectors = &mut vectors[..VECTORS * m];
+    // The six prefix sums start at zero.
+    vectors[..6 * m].fill(0.0);
+    let (p_sin, rest) = vectors.split_at_mut(m);
+    let (p_cos, rest) = rest.split_at_mut(m);
+    let (q_x, rest) = rest.split_at_mut(m);
+    let (q_y, rest) = rest.split_at_mut(m);
+    let (qf_x, rest) = rest.split_at_mut(m);
+    let (qf_y, rest) = rest.split_at_mut(m);
+    let (above_a, rest) = rest.split_at_mut(m);
+    let (above_v, rest) = rest.split_at_mut(m);
+    let (below_a, below_v) = rest.split_at_mut(m);
     let width = 3 * m;
     let jacobians = &mut jacobians[..m * width];
     jacobians.fill(0.0);
