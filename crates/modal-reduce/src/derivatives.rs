@@ -105,25 +105,30 @@ impl ReducedDerivatives {
     }
 
     /// The modal accelerations `a_ddot` (eq 15) of the last call.
+    #[inline]
     pub fn a_ddot(&self) -> &[f64] {
         &self.a_ddot
     }
 
     /// `d a_ddot / d a` (`m x m`).
+    #[inline]
     pub fn d_a(&self) -> MatRef<'_, f64> {
         self.block(0)
     }
 
     /// `d a_ddot / d a_dot` (`m x m`).
+    #[inline]
     pub fn d_a_dot(&self) -> MatRef<'_, f64> {
         self.block(1)
     }
 
     /// `d a_ddot / d tau* = M*^-1` (`m x m`).
+    #[inline]
     pub fn d_tau_star(&self) -> MatRef<'_, f64> {
         self.block(2)
     }
 
+    #[inline]
     fn block(&self, index: usize) -> MatRef<'_, f64> {
         let m = self.n_coords;
         MatRef::from_row_major_slice_with_stride(&self.jacobians[index * m..], m, m, 3 * m)
@@ -311,8 +316,8 @@ fn differentiate(
     // From the tip: E_l, F_l, the part of X_ll from A_{l+1} and gravity, and L_l R^s_l,
     // L_l R^c_l from the suffix sums R^s_l, R^c_l (links beyond l).
     let mut suffix = [0.0; 2];
-    for (l, link) in links.chunks_exact_mut(stride).enumerate().rev() {
-        let phi = &rows[l * m..(l + 1) * m];
+    let tip_first = rows.chunks_exact(m).zip(links.chunks_exact_mut(stride));
+    for (l, (phi, link)) in tip_first.enumerate().rev() {
         let (mut w, mut alpha) = (0.0, 0.0);
         for k in 0..m {
             w = phi[k].mul_add(a_dot[k], w);
