@@ -375,6 +375,16 @@ impl PlantDerivatives {
         }
     }
 
+    /// The three Jacobians side by side, row-major `m x 3m`: row `i` is
+    /// `[d_a row i | d_a_dot row i | d_tau_star row i]`.
+    #[inline]
+    pub fn jacobians(&self) -> &[f64] {
+        match self {
+            PlantDerivatives::Planar(d) => d.jacobians(),
+            PlantDerivatives::Spatial(d) => d.jacobians(),
+        }
+    }
+
     /// `d a_ddot / d a` (`m x m`).
     #[inline]
     pub fn d_a(&self) -> MatRef<'_, f64> {
