@@ -9,7 +9,7 @@
 //! subgradient, and the clearance saturates at minus the radii.
 
 use crate::obstacle::{box_signed_distance, unit_or};
-use crate::vector::{V3, dot, lerp, sub, to_local, to_world};
+use crate::vector::{V3, add, clamp_symmetric, dot, scale, sub, to_local, to_world};
 
 /// The closest point of the link's axis `a`-`b` to a core and the signed distance between them.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,18 +38,53 @@ fn direction(v: V3, scale: f64) -> (V3, f64) {
     }
 }
 
+/// A segment `a`-`b` with what every pair of it needs: its start `a`, its axis `b - a`, and the
+/// axis' squared length and length, computed once per link rather than once per pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Segment {
+    start: V3,
+    axis: V3,
+    length2: f64,
+    length: f64,
+}
+
+impl Segment {
+    /// The segment from `a` to `b`.
+    #[inline]
+    pub(crate) fn new(a: V3, b: V3) -> Self {
+        let axis = sub(b, a);
+        let length2 = dot(axis, axis);
+        Self {
+            start: a,
+            axis,
+            length2,
+            length: length2.sqrt(),
+        }
+    }
+
+    /// The point `a + t (b - a)`.
+    #[inline]
+    fn at(&self, t: f64) -> V3 {
+        add(self.start, scale(self.axis, t))
+    }
+}
+
 /// The closest point of the segment `a`-`b` to the point `o`.
 #[inline]
 pub fn segment_point(a: V3, b: V3, o: V3) -> Closest {
-    let axis = sub(b, a);
-    let length2 = dot(axis, axis);
-    let t = if length2 > 0.0 {
-        (dot(sub(o, a), axis) / length2).clamp(0.0, 1.0)
+    closest_to_point(&Segment::new(a, b), o)
+}
+
+/// [`segment_point`] of a prepared segment.
+#[inline]
+pub(crate) fn closest_to_point(link: &Segment, o: V3) -> Closest {
+    let t = if link.length2 > 0.0 {
+        (dot(sub(o, link.start), link.axis) / link.length2).clamp(0.0, 1.0)
     } else {
         0.0
     };
-    let point = lerp(a, b, t);
-    let (normal, distance) = direction(sub(point, o), length2.sqrt());
+    let point = link.at(t);
+    let (normal, distance) = direction(sub(point, o), link.length);
     Closest {
         t,
         point,
@@ -63,10 +98,15 @@ pub fn segment_point(a: V3, b: V3, o: V3) -> Closest {
 /// Detection*, 5.1.9, with the degenerate and parallel cases resolved).
 #[inline]
 pub fn segment_segment(a: V3, b: V3, c: V3, d: V3) -> Closest {
-    let d1 = sub(b, a);
-    let d2 = sub(d, c);
-    let r = sub(a, c);
-    let (aa, ee, f) = (dot(d1, d1), dot(d2, d2), dot(d2, r));
+    closest_to_segment(&Segment::new(a, b), &Segment::new(c, d))
+}
+
+/// [`segment_segment`] of two prepared segments.
+#[inline]
+pub(crate) fn closest_to_segment(link: &Segment, other: &Segment) -> Closest {
+    let (d1, d2) = (link.axis, other.axis);
+    let r = sub(link.start, other.start);
+    let (aa, ee, f) = (link.length2, other.length2, dot(d2, r));
     let (t, s) = if aa <= 0.0 && ee <= 0.0 {
         (0.0, 0.0)
     } else if aa <= 0.0 {
@@ -94,13 +134,12 @@ pub fn segment_segment(a: V3, b: V3, c: V3, d: V3) -> Closest {
             (t, s)
         }
     };
-    let point = lerp(a, b, t);
-    let other = lerp(c, d, s);
-    let (normal, distance) = direction(sub(point, other), aa.sqrt() + ee.sqrt());
+    let point = link.at(t);
+    let (normal, distance) = direction(sub(point, other.at(s)), link.length + other.length);
     Closest {
         t,
         point,
-        other,
+        other: other.at(s),
         distance,
         normal,
     }
@@ -110,82 +149,31 @@ pub fn segment_segment(a: V3, b: V3, c: V3, d: V3) -> Closest {
 /// and `axes` (the columns of its rotation), and its signed distance.
 ///
 /// The box's signed distance along the segment, `f(t)`, is convex (the signed distance of a
-/// convex set is convex) and smooth between the breakpoints where a local coordinate crosses
-/// `0` or `+-h_k` or two faces' depths `|q_j| - h_j`, `|q_k| - h_k` tie: outside the box `f` is
-/// the root of a quadratic, inside the largest of linear functions. Its minimum is therefore
-/// one of the breakpoints or the stationary point of an outside piece; all are evaluated.
+/// convex set is convex). Where the segment meets the box (clipped to the slabs
+/// `|q_k| <= h_k`, Liang and Barsky) `f` is the largest of the affine depths `+-q_k(t) - h_k`,
+/// whose minimum on the clipped interval is at one of its ends or at a kink where two depths
+/// tie (`deepest_inside`). Elsewhere `f = sqrt(D)` with `D` the squared distance, a sum of
+/// convex, continuously differentiable per-axis pieces (`nearest_outside`).
 pub fn segment_box(a: V3, b: V3, center: V3, half: V3, axes: &[V3; 3]) -> Closest {
-    let q0 = to_local(axes, sub(a, center));
-    let dq = to_local(axes, sub(b, a));
+    closest_to_box(&Segment::new(a, b), center, half, axes)
+}
+
+/// [`segment_box`] of a prepared segment.
+pub(crate) fn closest_to_box(link: &Segment, center: V3, half: V3, axes: &[V3; 3]) -> Closest {
+    let q0 = to_local(axes, sub(link.start, center));
+    let dq = to_local(axes, link.axis);
     let at = |t: f64| [q0[0] + t * dq[0], q0[1] + t * dq[1], q0[2] + t * dq[2]];
-    let mut breaks = [0.0_f64; 26];
-    let mut count = 0;
-    let mut push = |t: f64| {
-        if t > 0.0 && t < 1.0 {
-            breaks[count] = t;
-            count += 1;
-        }
+    let t = match clip(q0, dq, half) {
+        Some((enter, exit)) => deepest_inside(q0, dq, half, enter, exit),
+        None => nearest_outside(q0, dq, half),
     };
-    for k in 0..3 {
-        if dq[k] != 0.0 {
-            push(-q0[k] / dq[k]);
-            if half[k].is_finite() {
-                push((half[k] - q0[k]) / dq[k]);
-                push((-half[k] - q0[k]) / dq[k]);
-            }
-        }
-    }
-    for (j, k) in [(0, 1), (0, 2), (1, 2)] {
-        if !(half[j].is_finite() && half[k].is_finite()) {
-            continue;
-        }
-        for (sj, sk) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
-            let slope = sj * dq[j] - sk * dq[k];
-            if slope != 0.0 {
-                push((half[j] - half[k] - sj * q0[j] + sk * q0[k]) / slope);
-            }
-        }
-    }
-    breaks[count] = 0.0;
-    breaks[count + 1] = 1.0;
-    let breaks = &mut breaks[..count + 2];
-    breaks.sort_unstable_by(f64::total_cmp);
-    let mut best = (0.0, f64::INFINITY);
-    let mut consider = |t: f64| {
-        let value = box_signed_distance(at(t), half);
-        if value < best.1 {
-            best = (t, value);
-        }
-    };
-    for window in breaks.windows(2) {
-        let (lo, hi) = (window[0], window[1]);
-        consider(lo);
-        // The stationary point of the squared outside distance of this piece.
-        let mid = at(0.5 * (lo + hi));
-        let (mut num, mut den) = (0.0, 0.0);
-        for k in 0..3 {
-            let bound = if mid[k] > half[k] {
-                half[k]
-            } else if mid[k] < -half[k] {
-                -half[k]
-            } else {
-                continue;
-            };
-            num -= (q0[k] - bound) * dq[k];
-            den += dq[k] * dq[k];
-        }
-        if den > 0.0 {
-            consider((num / den).clamp(lo, hi));
-        }
-    }
-    consider(1.0);
-    let (t, distance) = best;
+    let distance = box_signed_distance(at(t), half);
     let q = at(t);
     // The gradient of the box's signed distance at q: outward from the nearest surface point.
     let mut outside = [0.0; 3];
     let (mut deepest, mut face) = (f64::NEG_INFINITY, 0);
     for k in 0..3 {
-        outside[k] = q[k] - q[k].clamp(-half[k], half[k]);
+        outside[k] = q[k] - clamp_symmetric(q[k], half[k]);
         let gap = q[k].abs() - half[k];
         if gap > deepest {
             (deepest, face) = (gap, k);
@@ -202,7 +190,7 @@ pub fn segment_box(a: V3, b: V3, center: V3, half: V3, axes: &[V3; 3]) -> Closes
     let mut surface = q;
     if gap > 0.0 {
         for k in 0..3 {
-            surface[k] = q[k].clamp(-half[k], half[k]);
+            surface[k] = clamp_symmetric(q[k], half[k]);
         }
     } else {
         surface[face] = half[face].copysign(q[face]);
@@ -210,10 +198,134 @@ pub fn segment_box(a: V3, b: V3, center: V3, half: V3, axes: &[V3; 3]) -> Closes
     let normal = to_world(axes, local_normal);
     Closest {
         t,
-        point: lerp(a, b, t),
-        other: crate::vector::add(center, to_world(axes, surface)),
+        point: link.at(t),
+        other: add(center, to_world(axes, surface)),
         distance,
         normal,
+    }
+}
+
+/// The parameters `[enter, exit]` of `[0, 1]` where `q0 + t dq` lies in the closed box
+/// `|q_k| <= h_k` (Liang and Barsky's slab clipping); `None` when the segment misses it.
+fn clip(q0: V3, dq: V3, half: V3) -> Option<(f64, f64)> {
+    // Both ends beyond the same face: no division needed.
+    for k in 0..3 {
+        let (from, to) = (q0[k], q0[k] + dq[k]);
+        if from.min(to) > half[k] || from.max(to) < -half[k] {
+            return None;
+        }
+    }
+    let (mut enter, mut exit) = (0.0_f64, 1.0_f64);
+    for k in 0..3 {
+        if dq[k] == 0.0 {
+            if q0[k].abs() > half[k] {
+                return None;
+            }
+        } else {
+            let low = (-half[k] - q0[k]) / dq[k];
+            let high = (half[k] - q0[k]) / dq[k];
+            enter = enter.max(low.min(high));
+            exit = exit.min(low.max(high));
+        }
+    }
+    (enter <= exit).then_some((enter, exit))
+}
+
+/// The deepest point of the clipped segment `[enter, exit]` inside the box: the depth
+/// `g(t) = max_k (|q_k(t)| - h_k)` is the largest of six affine functions, so its minimum is at
+/// an end of the interval or at a kink, where `q_k` crosses `0` or two faces' depths
+/// `+-q_j - h_j`, `+-q_k - h_k` tie. Of equal depths the smallest `t` is kept.
+fn deepest_inside(q0: V3, dq: V3, half: V3, enter: f64, exit: f64) -> f64 {
+    let depth = |t: f64| {
+        let mut deepest = f64::NEG_INFINITY;
+        for k in 0..3 {
+            deepest = deepest.max((q0[k] + t * dq[k]).abs() - half[k]);
+        }
+        deepest
+    };
+    let mut best = (enter, depth(enter));
+    let mut consider = |t: f64| {
+        if t > enter && t <= exit {
+            let value = depth(t);
+            if value < best.1 || (value == best.1 && t < best.0) {
+                best = (t, value);
+            }
+        }
+    };
+    consider(exit);
+    for k in 0..3 {
+        if dq[k] != 0.0 {
+            consider(-q0[k] / dq[k]);
+        }
+    }
+    for (j, k) in [(0, 1), (0, 2), (1, 2)] {
+        if !(half[j].is_finite() && half[k].is_finite()) {
+            continue;
+        }
+        for (sj, sk) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+            let slope = sj * dq[j] - sk * dq[k];
+            if slope != 0.0 {
+                consider((half[j] - half[k] - sj * q0[j] + sk * q0[k]) / slope);
+            }
+        }
+    }
+    best.0
+}
+
+/// The point of a segment that misses the box nearest to it: the squared distance
+/// `D(t) = sum_k e_k(t)^2`, `e_k = q_k - clamp(q_k, -h_k, h_k)`, is convex and continuously
+/// differentiable with `D'(t) / 2 = sum_k e_k dq_k` piecewise affine between the parameters where
+/// a `q_k` crosses `+-h_k`. Bisecting on the sign of `D'` at those parameters finds the piece
+/// holding its zero, where `D' = 0` is solved in closed form.
+fn nearest_outside(q0: V3, dq: V3, half: V3) -> f64 {
+    let at = |t: f64| [q0[0] + t * dq[0], q0[1] + t * dq[1], q0[2] + t * dq[2]];
+    let slope = |t: f64| {
+        let q = at(t);
+        let mut sum = 0.0;
+        for k in 0..3 {
+            sum += (q[k] - clamp_symmetric(q[k], half[k])) * dq[k];
+        }
+        sum
+    };
+    if slope(0.0) >= 0.0 {
+        return 0.0;
+    }
+    if slope(1.0) <= 0.0 {
+        return 1.0;
+    }
+    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+    for k in 0..3 {
+        if dq[k] != 0.0 && half[k].is_finite() {
+            for bound in [half[k], -half[k]] {
+                let t = (bound - q0[k]) / dq[k];
+                if t > lo && t < hi {
+                    if slope(t) < 0.0 {
+                        lo = t;
+                    } else {
+                        hi = t;
+                    }
+                }
+            }
+        }
+    }
+    // On (lo, hi) each axis is below, within or above its slab throughout.
+    let mid = at(0.5 * (lo + hi));
+    let (mut num, mut den) = (0.0, 0.0);
+    for k in 0..3 {
+        let bound = if mid[k] > half[k] {
+            half[k]
+        } else if mid[k] < -half[k] {
+            -half[k]
+        } else {
+            continue;
+        };
+        num -= (q0[k] - bound) * dq[k];
+        den += dq[k] * dq[k];
+    }
+    if den > 0.0 {
+        (num / den).clamp(lo, hi)
+    } else {
+        hi
     }
 }
 

@@ -1,7 +1,7 @@
 //! What the clearance algorithms write: the chain's placement, distances, closest points and
 //! modal gradients, sized once from a model.
 
-use crate::closest::Closest;
+use crate::closest::{Closest, Segment};
 use crate::error::ClearanceError;
 use crate::model::ClearanceModel;
 use crate::vector::V3;
@@ -17,6 +17,8 @@ pub struct ClearanceData {
     pub(crate) points: Vec<V3>,
     /// `n` unit joint axes in world coordinates (`z` for a planar chain).
     pub(crate) axes: Vec<V3>,
+    /// `n` links' segments, prepared once per [`distances`](crate::distances) call.
+    pub(crate) segments: Vec<Segment>,
     /// The planar chain's points, from `backbone_kin::joint_positions`.
     pub(crate) planar: Vec<[f64; 2]>,
     /// Per pair: the signed clearance (distance between the surfaces, negative in contact).
@@ -57,6 +59,7 @@ impl ClearanceData {
         Ok(Self {
             points: vec![[0.0; 3]; n + 1],
             axes: vec![[0.0, 0.0, 1.0]; n],
+            segments: vec![Segment::new([0.0; 3], [0.0; 3]); n],
             planar: vec![[0.0; 2]; n + 1],
             distances: vec![f64::INFINITY; pairs],
             closest: vec![empty; pairs],

@@ -1,6 +1,6 @@
 //! The clearance of every pair: link capsules against obstacles and against each other.
 
-use crate::closest::{Closest, segment_box, segment_point, segment_segment};
+use crate::closest::{Closest, Segment, closest_to_box, closest_to_point, closest_to_segment};
 use crate::data::ClearanceData;
 use crate::model::ClearanceModel;
 use crate::obstacle::Obstacle;
@@ -14,7 +14,10 @@ use crate::obstacle::Obstacle;
 /// negative when they overlap. Allocation-free.
 pub fn distances(model: &ClearanceModel, data: &mut ClearanceData) -> (f64, f64) {
     let radius = model.radius();
-    let points = &data.points;
+    for (segment, link) in data.segments.iter_mut().zip(data.points.windows(2)) {
+        *segment = Segment::new(link[0], link[1]);
+    }
+    let segments = &data.segments;
     let obstacles = model.obstacles();
     // The pairs in the model's order: link-major against every obstacle, then (i, k >= i + 2).
     let split = model.n_obstacle_pairs();
@@ -22,46 +25,55 @@ pub fn distances(model: &ClearanceModel, data: &mut ClearanceData) -> (f64, f64)
     let (obstacle_closest, self_closest) = data.closest.split_at_mut(split);
     let mut near_obstacle = f64::INFINITY;
     if !obstacles.is_empty() {
-        for ((link, distances), closest) in points
-            .windows(2)
+        for ((link, distances), closest) in segments
+            .iter()
             .zip(obstacle_distances.chunks_exact_mut(obstacles.len()))
             .zip(obstacle_closest.chunks_exact_mut(obstacles.len()))
         {
-            let (a, b) = (link[0], link[1]);
             for ((obstacle, distance), closest) in obstacles.iter().zip(distances).zip(closest) {
-                let (found, other_radius) = closest_to(obstacle, a, b);
-                *distance = found.distance - radius - other_radius;
-                *closest = found;
+                let other_radius = closest_to(obstacle, link, closest);
+                *distance = closest.distance - radius - other_radius;
                 near_obstacle = near_obstacle.min(*distance);
             }
         }
     }
     let mut near_self = f64::INFINITY;
-    let mut pair = 0;
-    for link in 0..points.len().saturating_sub(1) {
-        let (a, b) = (points[link], points[link + 1]);
-        for other in points[link + 2..].windows(2) {
-            let found = segment_segment(a, b, other[0], other[1]);
-            let distance = found.distance - 2.0 * radius;
-            self_distances[pair] = distance;
-            self_closest[pair] = found;
-            near_self = near_self.min(distance);
-            pair += 1;
-        }
+    let pairs = self_distances.iter_mut().zip(self_closest.iter_mut());
+    let others = segments.iter().enumerate().flat_map(|(i, link)| {
+        segments
+            .get(i + 2..)
+            .unwrap_or(&[])
+            .iter()
+            .map(move |other| (link, other))
+    });
+    for ((distance, closest), (link, other)) in pairs.zip(others) {
+        *closest = closest_to_segment(link, other);
+        *distance = closest.distance - 2.0 * radius;
+        near_self = near_self.min(*distance);
     }
     (near_obstacle, near_self)
 }
 
-/// The closest points of the segment `a`-`b` to an obstacle's core and the obstacle's radius.
+/// Writes the closest points of a link's segment to an obstacle's core into `closest` and
+/// returns the obstacle's radius.
 #[inline]
-fn closest_to(obstacle: &Obstacle, a: [f64; 3], b: [f64; 3]) -> (Closest, f64) {
+fn closest_to(obstacle: &Obstacle, link: &Segment, closest: &mut Closest) -> f64 {
     match obstacle {
-        Obstacle::Sphere { center, radius } => (segment_point(a, b, *center), *radius),
-        Obstacle::Capsule { from, to, radius } => (segment_segment(a, b, *from, *to), *radius),
+        Obstacle::Sphere { center, radius } => {
+            *closest = closest_to_point(link, *center);
+            *radius
+        }
+        Obstacle::Capsule { from, to, radius } => {
+            *closest = closest_to_segment(link, &Segment::new(*from, *to));
+            *radius
+        }
         Obstacle::Box {
             center,
             half_extents,
             axes,
-        } => (segment_box(a, b, *center, *half_extents, axes), 0.0),
+        } => {
+            *closest = closest_to_box(link, *center, *half_extents, axes);
+            0.0
+        }
     }
 }

@@ -48,3 +48,15 @@ pub(crate) fn to_local(r: &[V3; 3], v: V3) -> V3 {
 pub(crate) fn to_world(r: &[V3; 3], v: V3) -> V3 {
     add(add(scale(r[0], v[0]), scale(r[1], v[1])), scale(r[2], v[2]))
 }
+
+/// `x` clamped to `[-h, h]` for `h >= 0`: `f64::clamp` without its run-time check of the bounds.
+#[inline]
+pub(crate) fn clamp_symmetric(x: f64, h: f64) -> f64 {
+    if x < -h {
+        -h
+    } else if x > h {
+        h
+    } else {
+        x
+    }
+}

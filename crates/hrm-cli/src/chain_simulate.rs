@@ -5,7 +5,6 @@
 use crate::console;
 use crate::output_dir::OutputDir;
 use lane_math::Compact;
-use serde_json::json;
 use sim_core::ChainRun;
 use sim_study::Scenario;
 use std::fmt::Write as _;
@@ -19,7 +18,7 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
     let n = summary.joint_error_rms.len();
     let staging = OutputDir::create(out, "simulate")?;
     let dir = staging.path();
-    let json = chain_summary(scenario, "urdf", &run);
+    let json = sim_study::summary_json::chain(scenario, "urdf", &run);
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
     write(&dir.join("summary.json"), &text)?;
     write(&dir.join("scenario.toml"), &scenario.to_toml())?;
@@ -38,24 +37,6 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
         summary.final_error,
         out.display()
     ))
-}
-
-/// The `summary.json` fields of a joint-space run of `scenario` on an arm of kind `arm`
-/// (`"urdf"`, `"deploy"`).
-pub fn chain_summary(scenario: &Scenario, arm: &str, run: &ChainRun) -> serde_json::Value {
-    let summary = &run.summary;
-    json!({
-        "scenario": scenario.name,
-        "controller": "computed-torque",
-        "arm": arm,
-        "joints": summary.joint_error_rms.len(),
-        "controller_samples": summary.controller_samples,
-        "steps": summary.steps,
-        "joint_error_rms": summary.joint_error_rms,
-        "joint_error_max": summary.joint_error_max,
-        "final_error": summary.final_error,
-        "peak_joint_efforts": summary.peak_joint_efforts,
-    })
 }
 
 /// The `timeseries.csv` of a joint-space run: `t`, then `q_i`, `q_ref_i`, `tau_i` per joint.

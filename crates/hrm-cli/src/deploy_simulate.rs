@@ -4,12 +4,11 @@
 //! (`t`, then `q_i`, `q_ref_i`, `tau_i` per joint, the insertion first) and `links.csv`; the main
 //! job also draws the arm in the channel and its clearance to the walls over time.
 
-use crate::chain_simulate::{chain_summary, chain_timeseries, write};
+use crate::chain_simulate::{chain_timeseries, write};
 use crate::output_dir::OutputDir;
 use crate::plot::{self, Labels, Series, Style};
 use crate::{console, report};
 use lane_math::Compact;
-use serde_json::json;
 use sim_study::{ControllerKind, DeployRun, Scenario};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -47,27 +46,9 @@ pub fn headline(scenario: &Scenario, run: &DeployRun) -> String {
     )
 }
 
-/// The run's `summary.json`: [`chain_summary`]'s fields, then `deploy_tip_error_m`,
-/// `deploy_shape_deviation_pct`, `deploy_min_wall_clearance_m` and `deploy_length_m` of the run
-/// (over every recorded sample, the rows of `links.csv`) and the same of the kinematic plan it
-/// tracked under `plan`.
+/// The run's `summary.json` ([`sim_study::summary_json::deploy`]).
 pub fn summary(scenario: &Scenario, run: &DeployRun) -> serde_json::Value {
-    let mut summary = chain_summary(scenario, "deploy", &run.run);
-    let metrics = |m: &sim_study::DeployMetrics| {
-        json!({
-            "deploy_tip_error_m": m.tip_error,
-            "deploy_shape_deviation_pct": m.shape_deviation_percent,
-            "deploy_min_wall_clearance_m": m.min_wall_clearance,
-            "deploy_length_m": m.deployed_length,
-        })
-    };
-    if let (Some(fields), serde_json::Value::Object(own)) =
-        (summary.as_object_mut(), metrics(&run.metrics))
-    {
-        fields.extend(own);
-        fields.insert("plan".into(), metrics(&run.plan));
-    }
-    summary
+    sim_study::summary_json::deploy(scenario, run)
 }
 
 /// Writes `scenario.toml`, `summary.json`, `timeseries.csv` and `links.csv` of `run` into

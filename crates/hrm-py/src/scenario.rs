@@ -889,6 +889,36 @@ impl Scenario {
         let result = result.map_err(Stopped::from);
         Run::new(py, &scenario, label, result)
     }
+
+    /// Runs the scenario's deployment (`[deploy]`: the arm on its insertion axis
+    /// follow-the-leader into the channel, in joint space, by computed torque or with
+    /// `controller.kind = "mpc"` by joint-space MPC) and returns a dict: `summary` (the
+    /// `summary.json` of `hrm simulate`: the joint-space run's fields, `deploy_tip_error_m`,
+    /// `deploy_shape_deviation_pct`, `deploy_min_wall_clearance_m`, `deploy_length_m` and the
+    /// plan's under `plan`), `t` (shape (K,)), `q`, `q_ref`, `tau` (shape (K, n + 1), the
+    /// insertion first) and `points` (shape (K, n + 1, 2): the base and every link's end, as
+    /// `links.csv`). Runs with the GIL released. A scenario without `[deploy]` or with keys a
+    /// deployment does not use raises InvalidInput naming the key; a run that diverges raises
+    /// the error of its class.
+    fn run_deploy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let scenario = self.get();
+        let run = pool::run(py, &Cancel::new(), || scenario.run_deploy())?.map_err(Error::from)?;
+        let out = PyDict::new(py);
+        let summary = sim_study::summary_json::deploy(&scenario, &run);
+        out.set_item("summary", crate::value::to_py(py, &summary)?)?;
+        let record = &run.run.record;
+        let joints = run.run.summary.joint_error_rms.len();
+        out.set_item("t", PyArray1::from_slice(py, &record.t))?;
+        out.set_item("q", matrix(py, record.q.clone(), joints))?;
+        out.set_item("q_ref", matrix(py, record.q_ref.clone(), joints))?;
+        out.set_item("tau", matrix(py, record.tau.clone(), joints))?;
+        let width = run.points.len().checked_div(record.t.len()).unwrap_or(0);
+        let flat: Vec<f64> = run.points.iter().flatten().copied().collect();
+        let points = numpy::ndarray::Array3::from_shape_vec((record.t.len(), width, 2), flat)
+            .map_err(|e| Error::numerical(format!("deployment points: {e}")))?;
+        out.set_item("points", points.into_pyarray(py))?;
+        Ok(out)
+    }
 }
 
 /// The height of a run's viewer in a notebook (pixels).

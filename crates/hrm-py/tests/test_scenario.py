@@ -339,3 +339,45 @@ def test_scenarios_pickle():
     scenario.seed = 7
     clone = pickle.loads(pickle.dumps(scenario))
     assert clone.to_dict() == scenario.to_dict()
+
+
+def test_pipe_deploy_runs_with_mpc_within_joint_torque_nm():
+    """`Scenario.run_deploy`: pipe-deploy with the joint-space MPC, 0.3 s of it, within a joint
+    torque limit set from Python; the arrays checked against each other and the arm."""
+    scenario = hrm.Scenario.builtin("pipe-deploy")
+    scenario.controller.kind = "mpc"
+    scenario.duration = 0.3
+    free = scenario.run_deploy()
+    n = scenario.arm.links
+    k = len(free["t"])
+    assert free["q"].shape == free["q_ref"].shape == free["tau"].shape == (k, n + 1)
+    assert free["points"].shape == (k, n + 1, 2)
+    summary = free["summary"]
+    assert summary["controller"] == "mpc" and summary["joints"] == n + 1
+    # Every link of the drawn arm has the arm's link length.
+    lengths = np.linalg.norm(np.diff(free["points"], axis=1), axis=2)
+    assert np.allclose(lengths, scenario.arm.link_length, atol=1e-12)
+    # The summary's final error and peaks from the time series.
+    assert math.isclose(
+        summary["final_error"],
+        float(np.linalg.norm(free["q"][-1] - free["q_ref"][-1])),
+        rel_tol=1e-12,
+        abs_tol=1e-15,
+    )
+    peaks = np.array(summary["peak_joint_efforts"])
+    assert np.all(peaks >= np.abs(free["tau"]).max(axis=0) - 1e-12)
+    for key in ("deploy_tip_error_m", "deploy_shape_deviation_pct", "deploy_min_wall_clearance_m"):
+        assert math.isfinite(summary[key]) and key in summary["plan"]
+    # Within [limits] joint_torque_nm, 60% of the free run's largest joint torque: every revolute
+    # joint's torque within it at every controller sample (the summary's peaks).
+    limit = 0.6 * float(peaks[1:].max())
+    scenario.limits.joint_torque_nm = limit
+    limited = scenario.run_deploy()
+    assert max(limited["summary"]["peak_joint_efforts"][1:]) <= limit * (1 + 1e-12)
+    assert np.abs(limited["tau"][:, 1:]).max() <= limit * (1 + 1e-12)
+    # Keys a deployment does not use are refused by name.
+    scenario.controller.kind = "computed-torque"
+    with pytest.raises(hrm.InvalidInput, match="limits.joint_torque_nm"):
+        scenario.run_deploy()
+    with pytest.raises(hrm.InvalidInput, match="deploy"):
+        hrm.Scenario.builtin("paper-tracking").run_deploy()

@@ -117,6 +117,7 @@ pub fn all_finite(values: &[f64]) -> bool {
 }
 
 /// Checks that the field `name` has `expected` entries: it has `found`.
+#[inline]
 pub fn check_len(name: &str, found: usize, expected: usize) -> Result<(), ShapeError<'_>> {
     if found == expected {
         Ok(())
@@ -147,7 +148,11 @@ pub fn check_finite(name: &str, value: f64) -> Result<(), ShapeError<'_>> {
 }
 
 /// Checks that every entry of the field `name` is finite; the error names the first that is not.
+#[inline]
 pub fn check_all_finite<'a>(name: &'a str, values: &[f64]) -> Result<(), ShapeError<'a>> {
+    if all_finite(values) {
+        return Ok(());
+    }
     match first_non_finite(values) {
         None => Ok(()),
         Some((index, value)) => Err(ShapeError {
@@ -168,6 +173,7 @@ pub fn check_all_finite<'a>(name: &'a str, values: &[f64]) -> Result<(), ShapeEr
 /// let error = check_values("q", &[1.0], 2).unwrap_err();
 /// assert_eq!(error.problem, ShapeProblem::Length { expected: 2, found: 1 });
 /// ```
+#[inline]
 pub fn check_values<'a>(
     name: &'a str,
     values: &[f64],

@@ -19,21 +19,31 @@
 //! ```
 //!
 //! `h_jl = L_min(j,l) S_max(j,l)`, `u_l = (c_l, s_l)`. Because `h_jl` factors, the projection
-//! splits into prefix sums, as `M*` does in [`crate::terms`]: with the `m`-vectors
-//! `P^s_j = sum_{l<j} L_l s_l Phi_l`, `P^c_j = sum_{l<j} L_l c_l Phi_l` and
-//! `Q_j = sum_{l<j} L_l E_l Phi_l` (two `m`-vectors), the part above the diagonal is
-//! `sum_j S_j (E_j^x P^s_j - E_j^y P^c_j) Phi_j^T`, the part below it
-//! `sum_j S_j Phi_j (s_j Q_j^x - c_j Q_j^y)^T`, and the diagonal `sum_j X_jj Phi_j Phi_j^T` with
-//! `X_jj = -L_j (s_j A_{j+1}^x - c_j A_{j+1}^y) - S_j (s_j B_j^x - c_j B_j^y) - g S_j s_j` from the
-//! scalar sums `A_k = sum_{l>=k} S_l E_l` and `B_j = sum_{l<j} L_l E_l`. `D_v` is the same with
-//! `F` for `E` and no diagonal. One pass from the tip (`A`) and one from the base (the rest),
-//! `O(m^2)` per link (`O(m)` for the vectors of the link, then a rank-2 update of each partial);
-//! then an `L D L^T` factorisation of `M*` and one substitution sweep over the rows of the
-//! `m x 3m` right-hand side `[-D_a | -D_v | 1]`, which gives the three Jacobians at once. The
+//! splits into prefix and suffix sums, as `M*` does in [`crate::terms`]. Off the diagonal,
+//! `sum_{j != l} X_jl Phi_j Phi_l^T = sum_l (E_l^x U^s_l - E_l^y U^c_l) Phi_l^T` with the
+//! `m`-vectors `U^s_l = sum_{j != l} h_jl s_j Phi_j` and `U^c_l` (the same with `c_j`), and
+//! `U_l = S_l P_l + L_l R_l` with the prefix sums `P^s_l = sum_{j<l} L_j s_j Phi_j` (and `P^c_l`)
+//! and the suffix sums `R^s_l = sum_{j>l} S_j s_j Phi_j` (and `R^c_l`). So, with `F` for `E` and
+//! no diagonal for `D_v`,
+//!
+//! ```text
+//! D_a = sum_l z^a_l Phi_l^T,   z^a_l = E_l^x U^s_l - E_l^y U^c_l + X_ll Phi_l,
+//! D_v = sum_l z^v_l Phi_l^T,   z^v_l = F_l^x U^s_l - F_l^y U^c_l,
+//! ```
+//!
+//! one rank-1 update of each partial a link, and the diagonal
+//! `X_ll = -L_l (s_l A_{l+1}^x - c_l A_{l+1}^y) - S_l (s_l B_l^x - c_l B_l^y) - g S_l s_l` from the
+//! scalar sums `A_k = sum_{j>=k} S_j E_j` and `B_l = sum_{j<l} L_j E_j`. One pass from the tip
+//! (`A`, `R`; it leaves `E_l`, `F_l`, the tip's part of `X_ll` and `L_l R_l` for each link) and
+//! one from the base (`B`, `P`, the updates), `O(m^2)` per link; then an `L D L^T`
+//! factorisation of `M*` and one substitution sweep over the rows of the `m x 3m` right-hand
+//! side `[-D_a | -D_v | 1]`, which gives the three Jacobians at once. The sums are taken with
+//! fused multiply-adds, the kernel compiled for the processor's instruction set. The
 //! paper's sizes (`m = 2` to `5`) run on stack arrays of compile-time size, which the compiler
 //! unrolls; other sizes on the workspace's vectors.
 
 use faer::MatRef;
+use pulp::{Simd, WithSimd};
 
 use crate::data::ReducedData;
 use crate::error::{ReduceError, check_finite_result};
@@ -42,8 +52,8 @@ use crate::model::ReducedModel;
 use lane_math::check_len;
 use lane_math::dense::{ldlt_in_place, ldlt_solve_rows_in_place};
 
-/// Results and scratch of [`reduced_derivatives`] for one [`ReducedModel`]: `O(n + m^2)` memory,
-/// built once; every call then fills it without allocating.
+/// Results and scratch of [`reduced_derivatives`] for one [`ReducedModel`]: `O(n m + m^2)`
+/// memory, built once; every call then fills it without allocating.
 ///
 /// After a call, [`a_ddot`](Self::a_ddot) holds the modal accelerations and
 /// [`d_a`](Self::d_a), [`d_a_dot`](Self::d_a_dot) and [`d_tau_star`](Self::d_tau_star) their
@@ -55,23 +65,26 @@ pub struct ReducedDerivatives {
     a_ddot: Vec<f64>,
     /// Row-major `m x 3m`: row `i` is `[d_a row i | d_a_dot row i | d_tau_star row i]`.
     jacobians: Vec<f64>,
-    /// Per link (`n` each): signed absolute rate `w_l`, acceleration `alpha_l`, and the
-    /// diagonal weight `X_ll`.
-    rate: Vec<f64>,
-    accel: Vec<f64>,
-    diagonal: Vec<f64>,
-    /// Scratch of the sizes without a stack version: [`VECTORS`] vectors of `m` and the
-    /// factor of `M*` (`m x m`).
-    vectors: [Vec<f64>; VECTORS],
+    /// What the pass from the tip leaves for the pass from the base, [`LINK_VALUES`]` + 2m`
+    /// numbers a link: `E_l`, `F_l`, `X_ll`'s part from the tip, then `L_l R^s_l` and
+    /// `L_l R^c_l`.
+    links: Vec<f64>,
+    /// Scratch of the sizes without a stack version: [`VECTORS`] vectors of `m`, one after
+    /// the other, and the factor of `M*` (`m x m`).
+    vectors: Vec<f64>,
     factor: Vec<f64>,
 }
 
-/// The `m`-vectors of the pass from the base: `P^s`, `P^c`, `Q^x`, `Q^y`, the `F` counterparts
-/// of `Q`, and the link's four update vectors (above and below the diagonal, for `D_a` and
-/// `D_v`).
-const VECTORS: usize = 10;
+/// The scalars a link keeps between the passes: `E_l` (2), `F_l` (2) and the part of `X_ll`
+/// from the tip.
+const LINK_VALUES: usize = 5;
 
-/// The most coordinates on stack arrays (`K = 2` harmonics with `alpha0` free).
+/// The `m`-vectors of the passes: `R^s`, `R^c` (from the tip), `P^s`, `P^c` (from the base),
+/// and the link's update vectors `z_a`, `z_v`.
+const VECTORS: usize = 6;
+
+/// The most coordinates on stack arrays (`K = 2` harmonics with `alpha0` free), each size
+/// matched in [`Differentiate`].
 const MAX_STACK_COORDS: usize = 5;
 
 impl ReducedDerivatives {
@@ -85,34 +98,44 @@ impl ReducedDerivatives {
             n_coords: m,
             a_ddot: vec![0.0; m],
             jacobians: vec![0.0; 3 * m * m],
-            rate: vec![0.0; n],
-            accel: vec![0.0; n],
-            diagonal: vec![0.0; n],
-            vectors: std::array::from_fn(|_| vec![0.0; if heap { m } else { 0 }]),
+            links: vec![0.0; n * (LINK_VALUES + 2 * m)],
+            vectors: vec![0.0; if heap { VECTORS * m } else { 0 }],
             factor: vec![0.0; if heap { m * m } else { 0 }],
         }
     }
 
     /// The modal accelerations `a_ddot` (eq 15) of the last call.
+    #[inline]
     pub fn a_ddot(&self) -> &[f64] {
         &self.a_ddot
     }
 
+    /// The three Jacobians side by side, row-major `m x 3m`: row `i` is
+    /// `[d_a row i | d_a_dot row i | d_tau_star row i]`.
+    #[inline]
+    pub fn jacobians(&self) -> &[f64] {
+        &self.jacobians
+    }
+
     /// `d a_ddot / d a` (`m x m`).
+    #[inline]
     pub fn d_a(&self) -> MatRef<'_, f64> {
         self.block(0)
     }
 
     /// `d a_ddot / d a_dot` (`m x m`).
+    #[inline]
     pub fn d_a_dot(&self) -> MatRef<'_, f64> {
         self.block(1)
     }
 
     /// `d a_ddot / d tau* = M*^-1` (`m x m`).
+    #[inline]
     pub fn d_tau_star(&self) -> MatRef<'_, f64> {
         self.block(2)
     }
 
+    #[inline]
     fn block(&self, index: usize) -> MatRef<'_, f64> {
         let m = self.n_coords;
         MatRef::from_row_major_slice_with_stride(&self.jacobians[index * m..], m, m, 3 * m)
@@ -168,48 +191,75 @@ pub fn reduced_derivatives(
     )?;
     forward_dynamics(model, data, a, a_dot, tau_star, &mut derivatives.a_ddot)?;
     // `forward_dynamics` left each link's sine and cosine in `data.links`, and M* in `data`.
-    let positive_definite = match model.n_coords() {
-        2 => on_stack::<2>(model, data, derivatives, a_dot),
-        3 => on_stack::<3>(model, data, derivatives, a_dot),
-        4 => on_stack::<4>(model, data, derivatives, a_dot),
-        5 => on_stack::<5>(model, data, derivatives, a_dot),
-        m => {
-            let ReducedDerivatives {
-                a_ddot,
-                jacobians,
-                rate,
-                accel,
-                diagonal,
-                vectors,
-                factor,
-                ..
-            } = derivatives;
-            let links = LinkScratch {
-                rate,
-                accel,
-                diagonal,
-            };
-            let vectors = vectors.each_mut().map(Vec::as_mut_slice);
-            differentiate(
-                model, data, m, a_dot, a_ddot, links, vectors, factor, jacobians,
-            )
-        }
-    };
+    let arch = data.arch;
+    let positive_definite = arch.dispatch(Differentiate {
+        model,
+        data,
+        derivatives: &mut *derivatives,
+        a_dot,
+    });
     if !positive_definite {
         return Err(ReduceError::NotPositiveDefinite);
     }
     check_finite_result("reduced dynamics derivatives", &derivatives.jacobians)
 }
 
-/// Per-link scratch of [`differentiate`] (`n` each): `w_l`, `alpha_l` and `X_ll`.
-struct LinkScratch<'a> {
-    rate: &'a mut [f64],
-    accel: &'a mut [f64],
-    diagonal: &'a mut [f64],
+/// The scratch of [`differentiate`]: the per-link values of the pass from the tip
+/// ([`LINK_VALUES`]` + 2m` a link), [`VECTORS`] `m`-vectors one after the other, and the factor
+/// of `M*` (`m x m`).
+struct Scratch<'a> {
+    links: &'a mut [f64],
+    vectors: &'a mut [f64],
+    factor: &'a mut [f64],
 }
 
-/// [`differentiate`] for a compile-time `M`, on local arrays; the Jacobians are copied into
-/// `derivatives`.
+/// [`differentiate`] run by [`pulp::Arch::dispatch`], so that it is compiled for the
+/// processor's instruction set (its fused multiply-adds among them).
+struct Differentiate<'a> {
+    model: &'a ReducedModel,
+    data: &'a ReducedData,
+    derivatives: &'a mut ReducedDerivatives,
+    a_dot: &'a [f64],
+}
+
+impl WithSimd for Differentiate<'_> {
+    type Output = bool;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _simd: S) -> bool {
+        let Self {
+            model,
+            data,
+            derivatives,
+            a_dot,
+        } = self;
+        match model.n_coords() {
+            2 => on_stack::<2>(model, data, derivatives, a_dot),
+            3 => on_stack::<3>(model, data, derivatives, a_dot),
+            4 => on_stack::<4>(model, data, derivatives, a_dot),
+            5 => on_stack::<5>(model, data, derivatives, a_dot),
+            m => {
+                let ReducedDerivatives {
+                    a_ddot,
+                    jacobians,
+                    links,
+                    vectors,
+                    factor,
+                    ..
+                } = derivatives;
+                let scratch = Scratch {
+                    links,
+                    vectors,
+                    factor,
+                };
+                differentiate(model, data, m, (a_dot, a_ddot), scratch, jacobians)
+            }
+        }
+    }
+}
+
+/// [`differentiate`] for a compile-time `M`, its vectors and factor on local arrays; the
+/// Jacobians are copied into `derivatives`.
 #[inline(always)]
 fn on_stack<const M: usize>(
     model: &ReducedModel,
@@ -220,27 +270,18 @@ fn on_stack<const M: usize>(
     let mut vectors = [[0.0; M]; VECTORS];
     let mut factor = [[0.0; M]; M];
     let mut jacobians = [[[0.0; M]; 3]; M];
-    let ReducedDerivatives {
-        a_ddot,
-        rate,
-        accel,
-        diagonal,
-        ..
-    } = derivatives;
-    let links = LinkScratch {
-        rate,
-        accel,
-        diagonal,
+    let ReducedDerivatives { a_ddot, links, .. } = derivatives;
+    let scratch = Scratch {
+        links,
+        vectors: vectors.as_flattened_mut(),
+        factor: factor.as_flattened_mut(),
     };
     let positive_definite = differentiate(
         model,
         data,
         M,
-        a_dot,
-        a_ddot,
-        links,
-        vectors.each_mut().map(|vector| vector.as_mut_slice()),
-        factor.as_flattened_mut(),
+        (a_dot, a_ddot),
+        scratch,
         jacobians.as_flattened_mut().as_flattened_mut(),
     );
     derivatives
@@ -250,20 +291,15 @@ fn on_stack<const M: usize>(
 }
 
 /// The three Jacobians (row-major `m x 3m`, into `jacobians`) at the state of `data` (the sines
-/// and cosines of the link angles, `M*`) and the accelerations `a_ddot`; `vectors` are
-/// [`VECTORS`] `m`-vectors of scratch and `factor` `m x m`. `false` if `M*` is not numerically
-/// positive definite.
-#[allow(clippy::too_many_arguments)]
+/// and cosines of the link angles, `M*`), the rates `a_dot` and the accelerations `a_ddot`.
+/// `false` if `M*` is not numerically positive definite.
 #[inline(always)]
 fn differentiate(
     model: &ReducedModel,
     data: &ReducedData,
     m: usize,
-    a_dot: &[f64],
-    a_ddot: &[f64],
-    links: LinkScratch<'_>,
-    vectors: [&mut [f64]; VECTORS],
-    factor: &mut [f64],
+    (a_dot, a_ddot): (&[f64], &[f64]),
+    scratch: Scratch<'_>,
     jacobians: &mut [f64],
 ) -> bool {
     let n = model.n_links();
@@ -273,92 +309,96 @@ fn differentiate(
     let rows = &model.angle_rows()[..n * m];
     let constants = model.link_constants();
     let (lengths, moments) = (&constants.length[..n], &constants.first_moment[..n]);
-    let (rate, accel, diagonal) = (
-        &mut links.rate[..n],
-        &mut links.accel[..n],
-        &mut links.diagonal[..n],
-    );
-    // From the tip: w_l, alpha_l, and the part of X_ll from A_{l+1} and gravity.
+    let stride = LINK_VALUES + 2 * m;
+    let links = &mut scratch.links[..n * stride];
+    let vectors = &mut scratch.vectors[..VECTORS * m];
+    vectors.fill(0.0);
+    // Split one after the other (an array of slices mapped from the scratch would keep the
+    // compiler from holding the stack sizes' vectors in registers).
+    let (r_sin, rest) = vectors.split_at_mut(m);
+    let (r_cos, rest) = rest.split_at_mut(m);
+    let (p_sin, rest) = rest.split_at_mut(m);
+    let (p_cos, rest) = rest.split_at_mut(m);
+    let (z_a, z_v) = rest.split_at_mut(m);
+    // From the tip: E_l, F_l, the part of X_ll from A_{l+1} and gravity, and L_l R^s_l,
+    // L_l R^c_l from the suffix sums R^s_l, R^c_l (links beyond l).
     let mut suffix = [0.0; 2];
-    for l in (0..n).rev() {
-        let phi = &rows[l * m..(l + 1) * m];
+    let tip_first = rows.chunks_exact(m).zip(links.chunks_exact_mut(stride));
+    for (l, (phi, link)) in tip_first.enumerate().rev() {
         let (mut w, mut alpha) = (0.0, 0.0);
         for k in 0..m {
-            w += phi[k] * a_dot[k];
-            alpha += phi[k] * a_ddot[k];
+            w = phi[k].mul_add(a_dot[k], w);
+            alpha = phi[k].mul_add(a_ddot[k], alpha);
         }
-        rate[l] = w;
-        accel[l] = alpha;
-        let (s, c, moment) = (sin[l], cos[l], moments[l]);
-        diagonal[l] = -lengths[l] * (s * suffix[0] - c * suffix[1]) - g * moment * s;
+        let (s, c, moment, length) = (sin[l], cos[l], moments[l], lengths[l]);
         let e = motion_e(c, s, w, alpha);
-        suffix = [suffix[0] + moment * e[0], suffix[1] + moment * e[1]];
+        let (values, vectors) = link.split_at_mut(LINK_VALUES);
+        values.copy_from_slice(&[
+            e[0],
+            e[1],
+            2.0 * w * c,
+            2.0 * w * s,
+            -length * (s * suffix[0] - c * suffix[1]) - g * moment * s,
+        ]);
+        let (l_r_sin, l_r_cos) = vectors.split_at_mut(m);
+        let (moment_sin, moment_cos) = (moment * s, moment * c);
+        for k in 0..m {
+            l_r_sin[k] = length * r_sin[k];
+            l_r_cos[k] = length * r_cos[k];
+            r_sin[k] = moment_sin.mul_add(phi[k], r_sin[k]);
+            r_cos[k] = moment_cos.mul_add(phi[k], r_cos[k]);
+        }
+        suffix = [
+            moment.mul_add(e[0], suffix[0]),
+            moment.mul_add(e[1], suffix[1]),
+        ];
     }
-    // From the base: the prefix sums, and the rank-2 update of each partial, accumulated with
-    // the opposite sign as the right-hand sides -D_a and -D_v.
-    let [
-        p_sin,
-        p_cos,
-        q_x,
-        q_y,
-        qf_x,
-        qf_y,
-        above_a,
-        above_v,
-        below_a,
-        below_v,
-    ] = vectors.map(|vector| &mut vector[..m]);
-    for prefix in [
-        &mut *p_sin,
-        &mut *p_cos,
-        &mut *q_x,
-        &mut *q_y,
-        &mut *qf_x,
-        &mut *qf_y,
-    ] {
-        prefix.fill(0.0);
-    }
+    // From the base: the prefix sums P^s_l, P^c_l (links before l) and B_l, and the rank-1
+    // update of each partial, accumulated with the opposite sign as the right-hand sides
+    // -D_a and -D_v.
     let width = 3 * m;
     let jacobians = &mut jacobians[..m * width];
     jacobians.fill(0.0);
     let mut before = [0.0; 2];
-    for (l, phi) in rows.chunks_exact(m).enumerate() {
-        let (s, c, w, alpha) = (sin[l], cos[l], rate[l], accel[l]);
-        let moment = moments[l];
-        let e = motion_e(c, s, w, alpha);
-        let f = [2.0 * w * c, 2.0 * w * s];
-        let weight = diagonal[l] - moment * (s * before[0] - c * before[1]);
-        // D += above ⊗ Phi + Phi ⊗ below.
+    for (l, (phi, link)) in rows
+        .chunks_exact(m)
+        .zip(links.chunks_exact(stride))
+        .enumerate()
+    {
+        let (s, c, moment, length) = (sin[l], cos[l], moments[l], lengths[l]);
+        let (values, vectors) = link.split_at(LINK_VALUES);
+        let (e, f) = ([values[0], values[1]], [values[2], values[3]]);
+        let weight = values[4] - moment * (s * before[0] - c * before[1]);
+        let (l_r_sin, l_r_cos) = vectors.split_at(m);
+        // z = -(E^x U^s - E^y U^c + X_ll Phi) with U = S_l P_l + L_l R_l, F for E in z_v.
         for i in 0..m {
-            above_a[i] = -(moment * (e[0] * p_sin[i] - e[1] * p_cos[i]) + weight * phi[i]);
-            above_v[i] = -(moment * (f[0] * p_sin[i] - f[1] * p_cos[i]));
-            below_a[i] = -(moment * (s * q_x[i] - c * q_y[i]));
-            below_v[i] = -(moment * (s * qf_x[i] - c * qf_y[i]));
+            let u_sin = moment.mul_add(p_sin[i], l_r_sin[i]);
+            let u_cos = moment.mul_add(p_cos[i], l_r_cos[i]);
+            z_a[i] = e[1].mul_add(u_cos, -weight.mul_add(phi[i], e[0] * u_sin));
+            z_v[i] = f[1].mul_add(u_cos, -(f[0] * u_sin));
         }
         for (i, row) in jacobians.chunks_exact_mut(width).enumerate() {
             let (d_a, d_v) = row[..2 * m].split_at_mut(m);
             for k in 0..m {
-                d_a[k] += above_a[i] * phi[k] + phi[i] * below_a[k];
-                d_v[k] += above_v[i] * phi[k] + phi[i] * below_v[k];
+                d_a[k] = z_a[i].mul_add(phi[k], d_a[k]);
+                d_v[k] = z_v[i].mul_add(phi[k], d_v[k]);
             }
         }
-        let length = lengths[l];
         for k in 0..m {
             let lp = length * phi[k];
-            p_sin[k] += s * lp;
-            p_cos[k] += c * lp;
-            q_x[k] += e[0] * lp;
-            q_y[k] += e[1] * lp;
-            qf_x[k] += f[0] * lp;
-            qf_y[k] += f[1] * lp;
+            p_sin[k] = s.mul_add(lp, p_sin[k]);
+            p_cos[k] = c.mul_add(lp, p_cos[k]);
         }
-        before = [before[0] + length * e[0], before[1] + length * e[1]];
+        before = [
+            length.mul_add(e[0], before[0]),
+            length.mul_add(e[1], before[1]),
+        ];
     }
     // The right-hand side of M*^-1 itself, then all 3m columns solved at once.
     for (i, row) in jacobians.chunks_exact_mut(width).enumerate() {
         row[2 * m + i] = 1.0;
     }
-    let factor = &mut factor[..m * m];
+    let factor = &mut scratch.factor[..m * m];
     factor.copy_from_slice(&data.mass[..m * m]);
     if !ldlt_in_place((), factor, m) {
         return false;
@@ -371,5 +411,5 @@ fn differentiate(
 #[inline(always)]
 fn motion_e(c: f64, s: f64, w: f64, alpha: f64) -> [f64; 2] {
     let w2 = w * w;
-    [c * alpha - s * w2, s * alpha + c * w2]
+    [c.mul_add(alpha, -(s * w2)), s.mul_add(alpha, c * w2)]
 }

@@ -367,6 +367,7 @@ impl PlantDerivatives {
     }
 
     /// The modal accelerations of the last call.
+    #[inline]
     pub fn a_ddot(&self) -> &[f64] {
         match self {
             PlantDerivatives::Planar(d) => d.a_ddot(),
@@ -374,7 +375,18 @@ impl PlantDerivatives {
         }
     }
 
+    /// The three Jacobians side by side, row-major `m x 3m`: row `i` is
+    /// `[d_a row i | d_a_dot row i | d_tau_star row i]`.
+    #[inline]
+    pub fn jacobians(&self) -> &[f64] {
+        match self {
+            PlantDerivatives::Planar(d) => d.jacobians(),
+            PlantDerivatives::Spatial(d) => d.jacobians(),
+        }
+    }
+
     /// `d a_ddot / d a` (`m x m`).
+    #[inline]
     pub fn d_a(&self) -> MatRef<'_, f64> {
         match self {
             PlantDerivatives::Planar(d) => d.d_a(),
@@ -383,6 +395,7 @@ impl PlantDerivatives {
     }
 
     /// `d a_ddot / d a_dot` (`m x m`).
+    #[inline]
     pub fn d_a_dot(&self) -> MatRef<'_, f64> {
         match self {
             PlantDerivatives::Planar(d) => d.d_a_dot(),
@@ -391,6 +404,7 @@ impl PlantDerivatives {
     }
 
     /// `d a_ddot / d tau* = M*^-1` (`m x m`).
+    #[inline]
     pub fn d_tau_star(&self) -> MatRef<'_, f64> {
         match self {
             PlantDerivatives::Planar(d) => d.d_tau_star(),

@@ -153,15 +153,16 @@ fn assemble<const M: usize>(
     let n = 2 * m;
     let (a, v) = (&x[..m], &x[m..n]);
     let (next, a_mat, b_mat) = (&mut next[..n], &mut a_mat[..n * n], &mut b_mat[..n * m]);
-    let (f_a, f_v, f_u) = (d.d_a(), d.d_a_dot(), d.d_tau_star());
+    // Row i of the plant's Jacobians: [F_a row i | F_v row i | F_u row i].
+    let jacobians = &d.jacobians()[..3 * m * m];
     let a_ddot = &d.a_ddot()[..m];
-    for i in 0..m {
+    for (i, row) in jacobians.chunks_exact(3 * m).enumerate() {
         let v_next = v[i] + h * a_ddot[i];
         next[m + i] = v_next;
         next[i] = a[i] + h * v_next;
         for j in 0..m {
             let identity = if i == j { 1.0 } else { 0.0 };
-            let (f_a, f_v, f_u) = (f_a[(i, j)], f_v[(i, j)], f_u[(i, j)]);
+            let (f_a, f_v, f_u) = (row[j], row[m + j], row[2 * m + j]);
             // Velocity rows: d v_next = h F d(.) + identity on v.
             a_mat[(m + i) * n + j] = h * f_a;
             a_mat[(m + i) * n + m + j] = identity + h * f_v;

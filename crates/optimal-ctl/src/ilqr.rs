@@ -6,6 +6,7 @@ use super::box_qp::{BoxQp, BoxQpSettings};
 use super::discrete::DiscreteDynamics;
 use super::step_constraints::{ConstrainedWork, StepConstraints};
 use lane_math::dense::{multiply, multiply_transposed, symmetrise};
+use pulp::{Arch, Simd, WithSimd};
 
 /// The most steps a horizon may have.
 pub const MAX_HORIZON: usize = 100_000;
@@ -482,8 +483,9 @@ impl Ilqr {
     /// [`solve`](Self::solve) with the general linear constraints `G u_k <= g` of
     /// `constraints` on every step besides the box. The backward pass solves each step's QP
     /// `min 1/2 d^T (Q_uu + mu I) d + Q_u^T d` subject to the step's rows (at the nominal state)
-    /// and the box by [`LinearQp`](crate::LinearQp), with the feedback gain restricted to
-    /// the directions that keep the active rows active; the forward pass moves every control
+    /// and the box by [`LinearQp`](crate::LinearQp), with the feedback gain that keeps the
+    /// active rows active as the state moves (their state Jacobian by forward differences of
+    /// the rows); the forward pass moves every control
     /// to the closest one within the rows at its own state ([`PolytopeProjection`](crate::PolytopeProjection)).
     /// A step without rows is the box QP's, exactly. A step whose rows admit no control within
     /// the box (a warm start, or a state the momentum carries past them) is planned within the
@@ -830,14 +832,12 @@ impl Ilqr {
         constrained: bool,
     ) -> Result<[f64; 2], OptimalError> {
         match (self.nx, self.nu) {
-            (4, 2) => {
-                let mut terms = StackTerms::<4, 2>::default();
-                self.backward_sized::<4, 2>(terms.slices(), mu, qp, constrained)
-            }
-            (6, 3) => {
-                let mut terms = StackTerms::<6, 3>::default();
-                self.backward_sized::<6, 3>(terms.slices(), mu, qp, constrained)
-            }
+            (4, 2) | (6, 3) => Arch::new().dispatch(BackwardOnStack {
+                ilqr: self,
+                mu,
+                qp,
+                constrained,
+            }),
             _ => {
                 // Taken out of the workspace for the pass (no allocation) and put back.
                 let mut terms = std::mem::take(&mut self.terms);
@@ -850,6 +850,23 @@ impl Ilqr {
                 self.terms = terms;
                 expected
             }
+        }
+    }
+
+    /// [`backward`](Self::backward) for the sizes with stack terms (`(4, 2)` and `(6, 3)`).
+    #[inline(always)]
+    fn backward_on_stack(
+        &mut self,
+        mu: f64,
+        qp: &BoxQpSettings,
+        constrained: bool,
+    ) -> Result<[f64; 2], OptimalError> {
+        if self.nx == 4 {
+            let mut terms = StackTerms::<4, 2>::default();
+            self.backward_sized::<4, 2>(terms.slices(), mu, qp, constrained)
+        } else {
+            let mut terms = StackTerms::<6, 3>::default();
+            self.backward_sized::<6, 3>(terms.slices(), mu, qp, constrained)
         }
     }
 
@@ -1091,6 +1108,31 @@ impl Ilqr {
             })
             .sum();
         total / self.horizon as f64
+    }
+}
+
+/// [`Ilqr::backward`] for the sizes with stack terms, run by [`pulp::Arch::dispatch`] so that
+/// its unrolled products are compiled for the processor's instruction set (the same operations
+/// in the same order: no fused multiply-adds, the same bits).
+struct BackwardOnStack<'a> {
+    ilqr: &'a mut Ilqr,
+    mu: f64,
+    qp: &'a BoxQpSettings,
+    constrained: bool,
+}
+
+impl WithSimd for BackwardOnStack<'_> {
+    type Output = Result<[f64; 2], OptimalError>;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _simd: S) -> Self::Output {
+        let Self {
+            ilqr,
+            mu,
+            qp,
+            constrained,
+        } = self;
+        ilqr.backward_on_stack(mu, qp, constrained)
     }
 }
 

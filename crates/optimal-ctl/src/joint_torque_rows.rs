@@ -4,7 +4,8 @@
 
 use crate::OptimalError;
 use crate::step_constraints::StepConstraints;
-use modal_reduce::{Plant, PlantData};
+use lane_math::dense::{cholesky, cholesky_solve};
+use modal_reduce::{Plant, PlantData, ReduceError};
 
 /// The limits `|tau_j| <= limit_j` of a modal arm and the working memory that writes their rows
 /// at a state, without the arm: [`rows`](Self::rows) takes it at each call, so a controller that
@@ -15,7 +16,9 @@ use modal_reduce::{Plant, PlantData};
 pub struct JointTorqueLimits {
     data: PlantData,
     limits: Vec<f64>,
-    unit: Vec<f64>,
+    /// `M*`'s Cholesky factor (`m x m`) and `M*^-1 [I, -(C* + G*)]` (`m x (m + 1)`).
+    factor: Vec<f64>,
+    solves: Vec<f64>,
     a_ddot: Vec<f64>,
     bias: Vec<f64>,
     tau: Vec<f64>,
@@ -47,7 +50,8 @@ impl JointTorqueLimits {
         Ok(Self {
             data: PlantData::new(plant),
             limits: limits.to_vec(),
-            unit: vec![0.0; m],
+            factor: vec![0.0; m * m],
+            solves: vec![0.0; m * (m + 1)],
             a_ddot: vec![0.0; m],
             bias: vec![0.0; n],
             tau: vec![0.0; n],
@@ -60,10 +64,14 @@ impl JointTorqueLimits {
     }
 
     /// Writes the rows `|A tau* + b| <= limits` of `plant` (the arm these limits were made for)
-    /// at the state `x = (a, a_dot)`: `b` the joint torques of zero modal torque, `A`'s columns
-    /// those of each unit modal torque less `b`, exactly (`m + 1` evaluations of the forward
-    /// dynamics and the joint torques); `rows` is `2n x m` row-major (joint `j`'s upper bound,
+    /// at the state `x = (a, a_dot)`; `rows` is `2n x m` row-major (joint `j`'s upper bound,
     /// then its lower one), `bounds` `2n`. Returns `2n`.
+    ///
+    /// With `a_ddot = M*^-1 (tau* - C* - G*)` (eq 15) and the joint torques
+    /// `tau = M J a_ddot + C + G` (eq 13) affine in `a_ddot`: one evaluation of `M*`, `C*`, `G*`
+    /// and one factorisation of `M*` give `a_ddot_0 = -M*^-1 (C* + G*)` and the columns
+    /// `y_i = M*^-1 e_i`; `b = tau(a_ddot_0)` and `A`'s column `i` is
+    /// `tau(a_ddot_0 + y_i) - b` (`m + 1` evaluations of eq 13).
     ///
     /// # Errors
     /// [`OptimalError::Dynamics`] when `plant` refuses the state or is not the arm these limits
@@ -75,14 +83,19 @@ impl JointTorqueLimits {
         rows: &mut [f64],
         bounds: &mut [f64],
     ) -> Result<usize, OptimalError> {
-        let m = self.unit.len();
-        let state = (&x[..m], &x[m..2 * m]);
-        self.unit.fill(0.0);
-        self.realise(plant, state, true)?;
+        let m = self.a_ddot.len();
+        let (a, a_dot) = (&x[..m], &x[m..2 * m]);
+        self.solve_accelerations(plant, a, a_dot)?;
+        // `solves` is `m x (m + 1)` row-major: the columns `y_i`, then `a_ddot_0`.
+        for (r, acc) in self.a_ddot.iter_mut().enumerate() {
+            *acc = self.solves[r * (m + 1) + m];
+        }
+        plant.joint_torques(&mut self.data, a, a_dot, &self.a_ddot, &mut self.bias)?;
         for i in 0..m {
-            self.unit.fill(0.0);
-            self.unit[i] = 1.0;
-            self.realise(plant, state, false)?;
+            for (r, acc) in self.a_ddot.iter_mut().enumerate() {
+                *acc = self.solves[r * (m + 1) + m] + self.solves[r * (m + 1) + i];
+            }
+            plant.joint_torques(&mut self.data, a, a_dot, &self.a_ddot, &mut self.tau)?;
             for (j, (tau, bias)) in self.tau.iter().zip(&self.bias).enumerate() {
                 rows[2 * j * m + i] = tau - bias;
                 rows[(2 * j + 1) * m + i] = bias - tau;
@@ -95,17 +108,32 @@ impl JointTorqueLimits {
         Ok(self.max_rows())
     }
 
-    /// The joint torques of the unit torque in `self.unit` at `(a, a_dot)` into `self.bias`
-    /// (`bias`) or `self.tau`.
-    fn realise(
+    /// `M*^-1 [e_1 ... e_m, -(C* + G*)]` at `(a, a_dot)` into `self.solves` (eq 15).
+    fn solve_accelerations(
         &mut self,
         plant: Plant<'_>,
-        (a, a_dot): (&[f64], &[f64]),
-        bias: bool,
+        a: &[f64],
+        a_dot: &[f64],
     ) -> Result<(), OptimalError> {
-        plant.forward_dynamics(&mut self.data, a, a_dot, &self.unit, &mut self.a_ddot)?;
-        let out = if bias { &mut self.bias } else { &mut self.tau };
-        plant.joint_torques(&mut self.data, a, a_dot, &self.a_ddot, out)?;
+        let m = a.len();
+        plant.terms(&mut self.data, a, a_dot)?;
+        let mass = self.data.mass_matrix();
+        for r in 0..m {
+            for c in 0..m {
+                self.factor[r * m + c] = mass[(r, c)];
+            }
+        }
+        if !cholesky(&mut self.factor, m) {
+            return Err(ReduceError::NotPositiveDefinite.into());
+        }
+        let (coriolis, gravity) = (self.data.coriolis(), self.data.gravity());
+        for r in 0..m {
+            let row = &mut self.solves[r * (m + 1)..(r + 1) * (m + 1)];
+            row.fill(0.0);
+            row[r] = 1.0;
+            row[m] = -(coriolis[r] + gravity[r]);
+        }
+        cholesky_solve(&self.factor, m, &mut self.solves, m + 1);
         Ok(())
     }
 }

@@ -19,7 +19,9 @@ pub trait StepConstraints {
     /// Writes the rows of step `k` at state `x` (`n_x`), around control `u` (`n_u`) with
     /// `b = dF/du` there (`n_x x n_u`, row-major): `rows` (`r x n_u`, row-major) and `bounds`
     /// (`r`), and returns `r <= max_rows()`. Called along the nominal trajectory before every
-    /// backward pass, and at every state of a forward pass (with the nominal `b`).
+    /// backward pass (and, with [`state_jacobian`](Self::state_jacobian), at `n_x` states a
+    /// small step from each nominal state: the same rows in the same order), and at every state
+    /// of a forward pass (with the nominal `b`).
     ///
     /// # Errors
     /// Whatever the model refuses at `x`.
@@ -32,10 +34,25 @@ pub trait StepConstraints {
         rows: &mut [f64],
         bounds: &mut [f64],
     ) -> Result<usize, OptimalError>;
+
+    /// Whether the feedback gain takes in the rows' state dependence: their state Jacobian
+    /// `D = d(G u - g)/dx` by forward differences, `n_x` more calls of [`rows`](Self::rows) at
+    /// each node of every iteration. Without it the gain keeps the active rows active only
+    /// where their bounds do not move with the state, and where they do, a forward pass's
+    /// projection undoes the feedback and the line search may find no decrease. `true`
+    /// unless said otherwise, for rows too costly to evaluate `n_x + 1` times a node.
+    fn state_jacobian(&self) -> bool {
+        true
+    }
 }
 
 /// Rows this far inside their bound count as active for the feedback gain (relative).
 const ACTIVE: f64 = 1e-9;
+/// The forward-difference step of the rows' state Jacobian (relative to `1 + |x_i|`).
+const STATE_STEP: f64 = 1e-7;
+/// A perturbed row whose coefficients differ from the nominal row's by more than this (relative
+/// to its largest) is another row.
+const SAME_ROW: f64 = 1e-3;
 
 /// The per-step working memory of a constrained solve: the rows of every step along the
 /// nominal trajectory, and the QP, projection and gain of one step. Allocation-free per use.
@@ -48,6 +65,16 @@ pub(crate) struct ConstrainedWork {
     pub(crate) rows: Vec<f64>,
     pub(crate) bounds: Vec<f64>,
     pub(crate) counts: Vec<usize>,
+    /// Per step: `D = d(G u - g)/dx` of each row at the nominal `(x, u)` (`max_rows x n_x`), by
+    /// forward differences; zero where a perturbed state gave another number of rows or
+    /// another row in a row's place.
+    state_jacobians: Vec<f64>,
+    /// A perturbed state and its rows.
+    perturbed: Vec<f64>,
+    perturbed_rows: Vec<f64>,
+    perturbed_bounds: Vec<f64>,
+    /// Which of the QP's rows are active: the step row's index, or `None` for a box row.
+    active_rows: Vec<Option<usize>>,
     /// One step's rows with the box appended (`max_rows + 2 n_u`), in the step `d` or in `u`.
     qp_rows: Vec<f64>,
     qp_bounds: Vec<f64>,
@@ -77,6 +104,11 @@ impl ConstrainedWork {
             rows: vec![0.0; horizon * max_rows * nu],
             bounds: vec![0.0; horizon * max_rows],
             counts: vec![0; horizon],
+            state_jacobians: vec![0.0; horizon * max_rows * nx],
+            perturbed: vec![0.0; nx],
+            perturbed_rows: vec![0.0; max_rows * nu],
+            perturbed_bounds: vec![0.0; max_rows],
+            active_rows: vec![None; nu],
             qp_rows: vec![0.0; total * nu],
             qp_bounds: vec![0.0; total],
             qp: LinearQp::new(nu, total),
@@ -98,14 +130,16 @@ impl ConstrainedWork {
         self.max_rows
     }
 
-    /// Evaluates the rows of step `k` at `(x, u)` with `b` into the step's storage.
+    /// Evaluates the rows of step `k` at `(x, u)` with `b` into the step's storage, and their
+    /// state Jacobian `D = d(G u - g)/dx` by forward differences (`n_x` more evaluations) when
+    /// the constraints ask for it (zero otherwise).
     pub(crate) fn evaluate(
         &mut self,
         constraints: &mut dyn StepConstraints,
         k: usize,
         (x, u, b): (&[f64], &[f64], &[f64]),
     ) -> Result<(), OptimalError> {
-        let (nu, max) = (self.nu, self.max_rows);
+        let (nx, nu, max) = (self.nx, self.nu, self.max_rows);
         let rows = &mut self.rows[k * max * nu..(k + 1) * max * nu];
         let bounds = &mut self.bounds[k * max..(k + 1) * max];
         let count = constraints.rows(k, x, u, b, rows, bounds)?;
@@ -117,6 +151,56 @@ impl ConstrainedWork {
             });
         }
         self.counts[k] = count;
+        let jacobian = &mut self.state_jacobians[k * max * nx..(k + 1) * max * nx];
+        jacobian.fill(0.0);
+        if !constraints.state_jacobian() {
+            return Ok(());
+        }
+        let residual = |rows: &[f64], bounds: &[f64], r: usize| -> f64 {
+            let g: f64 = rows[r * nu..(r + 1) * nu]
+                .iter()
+                .zip(u)
+                .map(|(g, u)| g * u)
+                .sum();
+            g - bounds[r]
+        };
+        for i in 0..nx {
+            self.perturbed.copy_from_slice(x);
+            let step = STATE_STEP * (1.0 + x[i].abs());
+            self.perturbed[i] += step;
+            let step = self.perturbed[i] - x[i];
+            let perturbed_count = constraints.rows(
+                k,
+                &self.perturbed,
+                u,
+                b,
+                &mut self.perturbed_rows,
+                &mut self.perturbed_bounds,
+            )?;
+            if perturbed_count != count {
+                jacobian.fill(0.0);
+                return Ok(());
+            }
+            for r in 0..count {
+                // A row that is not its nominal one (rows selected by rank, reordered by the
+                // step) keeps `D = 0`.
+                let (nominal, moved) = (
+                    &rows[r * nu..(r + 1) * nu],
+                    &self.perturbed_rows[r * nu..(r + 1) * nu],
+                );
+                let size = nominal.iter().fold(1.0f64, |s, g| s.max(g.abs()));
+                if nominal
+                    .iter()
+                    .zip(moved)
+                    .any(|(g, h)| (g - h).abs() > SAME_ROW * size)
+                {
+                    continue;
+                }
+                jacobian[r * nx + i] = (residual(&self.perturbed_rows, &self.perturbed_bounds, r)
+                    - residual(rows, bounds, r))
+                    / step;
+            }
+        }
         Ok(())
     }
 
@@ -158,10 +242,11 @@ impl ConstrainedWork {
     }
 
     /// The feed-forward step of step `k`: `ff = argmin 1/2 d^T H d + q^T d` subject to
-    /// `G (u + d) <= g` and the box, and the gain `K = -(H^-1 - H^-1 A^T (A H^-1 A^T)^-1 A H^-1)
-    /// Q_ux` that keeps the active rows `A` active to first order (zero when they leave no
-    /// freedom): the box QP's "zero gain on the clamped controls", for any rows. `false` (and
-    /// `ff`, `gain` unset) when the rows and the box admit no control.
+    /// `G (u + d) <= g` and the box, and the gain `K = -X + H^-1 A^T (A H^-1 A^T)^-1 (A X - D)`,
+    /// `X = H^-1 Q_ux`, that keeps the active rows `A` active to first order as the state moves
+    /// (`A K = -D`, `D` their state Jacobian; zero when they leave no freedom): the box QP's
+    /// "zero gain on the clamped controls", for any rows. `false` (and `ff`, `gain` unset) when
+    /// the rows and the box admit no control.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn feedforward(
         &mut self,
@@ -209,6 +294,7 @@ impl ConstrainedWork {
                     return Ok(true);
                 }
                 self.active[na * nu..(na + 1) * nu].copy_from_slice(row);
+                self.active_rows[na] = (r < count).then_some(r);
                 na += 1;
             }
         }
@@ -233,10 +319,14 @@ impl ConstrainedWork {
                         .map(|i| self.active[a * nu + i] * self.y_mat[i * na + b])
                         .sum();
                 }
+                // `A X - D`: the active rows stay active as the state moves.
+                let jacobian = self.active_rows[a]
+                    .map(|r| &self.state_jacobians[(k * max + r) * nx..(k * max + r + 1) * nx]);
                 for c in 0..nx {
-                    self.ax[a * nx + c] = (0..nu)
+                    let ax: f64 = (0..nu)
                         .map(|i| self.active[a * nu + i] * self.x_mat[i * nx + c])
                         .sum();
+                    self.ax[a * nx + c] = ax - jacobian.map_or(0.0, |d| d[c]);
                 }
             }
             if !cholesky(&mut self.s_mat[..na * na], na) {

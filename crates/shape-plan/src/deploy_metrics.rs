@@ -99,6 +99,20 @@ impl<'c> DeployTracker<'c> {
         })
     }
 
+    /// Reserves room for `shapes` more [`add`](Self::add)s, so that they allocate nothing.
+    ///
+    /// # Errors
+    /// [`PlanError::OutOfRange`] when the memory cannot be reserved.
+    pub fn reserve(&mut self, shapes: usize) -> Result<(), PlanError> {
+        self.traced
+            .try_reserve_exact(shapes)
+            .map_err(|_| PlanError::OutOfRange {
+                name: "deployment samples",
+                bound: "within the memory available",
+                value: shapes as f64,
+            })
+    }
+
     /// Adds the shape of joint points `points` (base first, the tip last, at least one) at the
     /// deployed length `deployed` (m) and returns its own metrics: the tip's distance from the
     /// centreline, the body's largest distance from the traced path (this tip included) over

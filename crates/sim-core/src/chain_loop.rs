@@ -244,6 +244,13 @@ fn run(
         peak_joint_efforts: vec![0.0; n],
     };
     let every = ((settings.record_period / settings.period).round() as usize).max(1);
+    // The recorded samples (every `every`-th and the last), reserved once: the loop allocates
+    // nothing per step (bounded by `check`).
+    let samples = periods / every + 2;
+    record.t.reserve_exact(samples);
+    for values in [&mut record.q, &mut record.q_ref, &mut record.tau] {
+        values.reserve_exact(samples * n);
+    }
     for k in 0..=periods {
         let t = (k as f64 * settings.period).min(settings.duration);
         reference.sample(t, &mut sample)?;

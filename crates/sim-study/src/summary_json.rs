@@ -4,11 +4,16 @@
 //! - [`run`]: one closed-loop run (`hrm simulate`, and each run of the main job): the fields of
 //!   [`Summary`](sim_core::Summary); a run that stopped adds its `error` and the time it
 //!   `stopped_at_s`; a scenario that could not be built has only its `error`.
+//! - [`chain`]: a joint-space run on a URDF arm (`hrm simulate` with `[arm] urdf`);
+//! - [`deploy`]: a deployment (`[deploy]`, `hrm simulate`, the main job, Python's
+//!   `Scenario.run_deploy`): [`chain`]'s fields and the deployment metrics;
 //! - [`sweep`]: a whole sweep (`hrm sweep`, `hrm sweep merge`): `{"config": ..., "cells": [...]}`
 //!   (`docs/sweep.md`).
 
 use crate::study::{Cell, RunOutcome, Stopped, SweepConfig};
+use crate::{DeployMetrics, DeployRun, Scenario};
 use serde_json::{Value, json};
+use sim_core::ChainRun;
 
 /// The `summary.json` of one run: its [`Summary`](sim_core::Summary)'s fields; for a run that
 /// stopped, those of the data up to the stop plus `error` (why and when) and `stopped_at_s`;
@@ -54,4 +59,43 @@ pub fn run(result: &RunOutcome) -> Value {
 /// ([`cells`](crate::study::cells) of the merged runs).
 pub fn sweep(config: &SweepConfig, cells: &[Cell]) -> Value {
     json!({ "config": config, "cells": cells })
+}
+
+/// The `summary.json` fields of a joint-space run of `scenario` on an arm of kind `arm`
+/// (`"urdf"`, `"deploy"`) under the scenario's controller.
+pub fn chain(scenario: &Scenario, arm: &str, run: &ChainRun) -> Value {
+    let summary = &run.summary;
+    json!({
+        "scenario": scenario.name,
+        "controller": scenario.controller.kind.name(),
+        "arm": arm,
+        "joints": summary.joint_error_rms.len(),
+        "controller_samples": summary.controller_samples,
+        "steps": summary.steps,
+        "joint_error_rms": summary.joint_error_rms,
+        "joint_error_max": summary.joint_error_max,
+        "final_error": summary.final_error,
+        "peak_joint_efforts": summary.peak_joint_efforts,
+    })
+}
+
+/// The `summary.json` of a deployment: [`chain`]'s fields, then `deploy_tip_error_m`,
+/// `deploy_shape_deviation_pct`, `deploy_min_wall_clearance_m` and `deploy_length_m` of the run
+/// (over every recorded sample, the rows of its `links.csv`) and the same of the kinematic plan
+/// it tracked under `plan`.
+pub fn deploy(scenario: &Scenario, run: &DeployRun) -> Value {
+    let mut summary = chain(scenario, "deploy", &run.run);
+    let metrics = |m: &DeployMetrics| {
+        json!({
+            "deploy_tip_error_m": m.tip_error,
+            "deploy_shape_deviation_pct": m.shape_deviation_percent,
+            "deploy_min_wall_clearance_m": m.min_wall_clearance,
+            "deploy_length_m": m.deployed_length,
+        })
+    };
+    if let (Some(fields), Value::Object(own)) = (summary.as_object_mut(), metrics(&run.metrics)) {
+        fields.extend(own);
+        fields.insert("plan".into(), metrics(&run.plan));
+    }
+    summary
 }

@@ -351,6 +351,10 @@ class Scenario:
         """Runs the closed loop with the scenario's controller, a built-in one by name, or a
         Python callable f(t, a, a_dot, ref) -> tau_star; `disturbance` f(t, a, a_dot) -> tau_d
         (joint torques, shape (n,), or None) pushes the arm between controller samples."""
+    def run_deploy(self) -> Dict[str, Any]:
+        """Runs the scenario's [deploy] (follow-the-leader on the insertion axis, computed torque
+        or joint-space MPC): {"summary": the summary.json of hrm simulate, "t": (K,), "q",
+        "q_ref", "tau": (K, n + 1), insertion first, "points": (K, n + 1, 2) as links.csv}."""
 
 class Sweep:
     """A Monte Carlo sweep over noise levels and seeds (hrm sweep), whole or by shards."""

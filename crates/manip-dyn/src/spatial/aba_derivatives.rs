@@ -11,13 +11,13 @@ use faer::{MatMut, MatRef};
 use lane_math::{Lane, Pack};
 use pulp::{Simd, WithSimd};
 
-use super::aba::aba;
-use super::algebra::Transform;
+use super::algebra::{Force, Motion, Symmetric6, Transform};
 use super::data::SpatialData;
-use super::derivative_data::{MAX_LANES, SpatialDerivativeData, column_of, padded};
+use super::derivative_data::{MAX_LANES, SpatialDerivativeData, column_of, padded, store_first};
+use super::kinematics::{joint_placement, sin_cos_dispatched};
 use super::minv::inverse_mass_matrix;
 use super::model::SpatialModel;
-use super::rnea_derivatives::differentiate_at;
+use super::rnea_derivatives::{Jacobians, carry_to_base, differentiate_at};
 use crate::check;
 use crate::error::DynError;
 
@@ -59,10 +59,9 @@ pub fn aba_derivatives(
         n,
     )?;
     let mut qdd = std::mem::take(&mut derivatives.accelerations);
-    let solved = aba(model, data, q, v, tau, &mut qdd).and_then(|()| {
-        poses_from_aba(data);
-        differentiate_at(model, data, derivatives, v, &qdd)
-    });
+    let solved = aba_base_frame(model, data, derivatives, [q, v, tau], &mut qdd)
+        .and_then(|()| check::finite_result("qdd", &qdd))
+        .and_then(|()| differentiate_at(model, data, derivatives, v, &qdd, Jacobians::IntoRhs));
     derivatives.value.copy_from_slice(&qdd);
     derivatives.accelerations = qdd;
     solved?;
@@ -70,117 +69,226 @@ pub fn aba_derivatives(
         blocks,
         rhs,
         sweep,
+        joints,
         minv_columns,
         ..
     } = derivatives;
     let (jacobians, mut minv) = blocks.as_mut().split_at_col_mut(2 * n);
-    rhs.copy_from(jacobians.as_ref());
-    inverse_mass_matrix(
-        data.arch,
-        model,
-        &data.articulated,
-        &data.poses,
-        sweep,
-        minv.as_mut(),
-    );
+    inverse_mass_matrix(data.arch, joints, sweep, minv_columns);
     let stride = padded(n);
     for k in 0..n {
-        minv_columns[k * stride..k * stride + n].copy_from_slice(column_of(&mut minv, k));
+        column_of(&mut minv, k).copy_from_slice(&minv_columns[k * stride..k * stride + n]);
     }
-    data.arch.dispatch(Product {
+    // The product's entries test the three matrices: a NaN or infinity in column `k` of `M^-1`
+    // (row `r`) reaches every entry `(r, c)` of the product (through `M^-1_rk rhs_kc`, NaN when
+    // `rhs_kc = 0`), one in `rhs_kc` reaches entry `(k, c)` (through `M^-1_kk > 0`).
+    let finite = data.arch.dispatch(Product {
         out: jacobians,
         columns: minv_columns,
         rhs: rhs.as_ref(),
     });
-    check::finite_matrix("the derivatives", &blocks.as_mut())
-}
-
-/// The links' poses in the base frame, `oM_i = oM_{i-1} * {i-1}M_i`, from the placements the
-/// ABA has just computed (the same as [`update_poses`](super::kinematics::update_poses) at its
-/// `q`, without the sines, cosines and placements again).
-fn poses_from_aba(data: &mut SpatialData) {
-    let mut parent = Transform::IDENTITY;
-    for (pose, link) in data.poses.iter_mut().zip(&data.articulated) {
-        let placement = Transform {
-            rotation: link.rotation,
-            translation: link.translation,
-        };
-        parent = parent.compose(&placement);
-        *pose = parent;
+    if finite {
+        Ok(())
+    } else {
+        Err(DynError::NonFiniteResult {
+            name: "the derivatives",
+        })
     }
 }
 
-/// `out = -minv rhs` (`n x n` by `n x 2n`) under [`pulp::Arch::dispatch`]: a SIMD register of
-/// rows of [`GROUP`] output columns at a time, the sums over `k` of `minv`'s column `k` times
-/// `rhs[(k, c)]` kept in registers (at these sizes faster than a general matrix product's
-/// packing). `columns` holds `minv`'s columns, each zero-padded to [`padded`]`(n)` entries, so
-/// that a whole register can be read at any row.
+/// The articulated-body algorithm (as [`aba`](super::aba())) run in the base frame, as
+/// Pinocchio's `computeABADerivatives` runs it: `qdd` from `inputs` (`q`, `v`, `tau`), each
+/// link's pose into `data`, its base-frame axis and inertia into `derivatives`
+/// ([`carry_to_base`]) and each
+/// joint's [`BaseFrameJoint`](super::derivative_data::BaseFrameJoint) into `derivatives.joints`, for the RNEA derivatives and `M^-1`
+/// that follow. With every quantity in the base frame, the frame changes `X_i` of the
+/// link-frame algorithm are identities: base to tip, `v_i = v_{i-1} + S_i qd_i`,
+/// `c_i = v_i x S_i qd_i` and `p_i = v_i x* I_i v_i`; tip to base, `IA_i = I_i + IA'_{i+1}`,
+/// `pA_i = p_i + pA'_{i+1}`, `U_i = IA_i S_i`, `D_i = S_i . U_i`, `u_i = tau_i - S_i . pA_i`,
+/// `IA'_i = IA_i - U_i U_i^T / D_i`, `pA'_i = pA_i + IA'_i c_i + U_i u_i / D_i`; base to tip,
+/// `a_{-1} = -g`, `a'_i = a_{i-1} + c_i`, `qdd_i = (u_i - U_i . a'_i) / D_i`,
+/// `a_i = a'_i + S_i qdd_i`. Inputs finite, sizes checked by the caller.
+fn aba_base_frame(
+    model: &SpatialModel,
+    data: &mut SpatialData,
+    derivatives: &mut SpatialDerivativeData,
+    inputs: [&[f64]; 3],
+    qdd: &mut [f64],
+) -> Result<(), DynError> {
+    let [q, v, tau] = inputs;
+    let n = model.n_links();
+    sin_cos_dispatched(data.arch, q, &mut data.sin, &mut data.cos);
+    let mut pose = Transform::IDENTITY;
+    let mut velocity = Motion::default();
+    for i in 0..n {
+        let placement = joint_placement((), &model.joints()[i], q[i], data.sin[i], data.cos[i]);
+        pose = pose.compose(&placement);
+        data.poses[i] = pose;
+        let axis = carry_to_base(model, derivatives, i, &pose);
+        let joint = &mut derivatives.joints[i];
+        joint.axis = axis;
+        let joint_velocity = joint.axis.times(v[i]);
+        velocity = velocity.plus(&joint_velocity);
+        joint.bias = velocity.cross_motion(&joint_velocity);
+        // A massless link (the cross of a universal joint) has no inertia and no bias force.
+        if !model.massless[i] {
+            let momentum = derivatives.composite[i].apply(&velocity);
+            joint.force = velocity.cross_force(&momentum);
+        }
+    }
+    let (joints, inertias) = (&mut derivatives.joints, &derivatives.composite);
+    let mut carried_inertia = Symmetric6::default();
+    let mut carried_force = Force::default();
+    for i in (0..n).rev() {
+        let joint = &mut joints[i];
+        let (inertia, force) = if model.massless[i] {
+            (carried_inertia, carried_force)
+        } else {
+            (
+                carried_inertia.plus_rigid(&inertias[i]),
+                joint.force.plus(&carried_force),
+            )
+        };
+        let coupling = inertia.apply(&joint.axis);
+        let pivot = joint.axis.dot(&coupling);
+        check::pivot(pivot, model.pivot_scales[i]).map_err(|error| match error {
+            DynError::NotPositiveDefinite => DynError::SingularJoint { index: i },
+            other => other,
+        })?;
+        let inverse = 1.0 / pivot;
+        let residual = tau[i] - joint.axis.dot(&force);
+        joint.coupling = coupling;
+        joint.inverse = inverse;
+        joint.residual = residual;
+        carried_inertia = inertia.minus_outer(&coupling, inverse);
+        carried_force = force
+            .plus(&carried_inertia.apply(&joint.bias))
+            .plus(&coupling.times(residual * inverse));
+    }
+    let g = model.gravity();
+    let mut acceleration = Motion {
+        linear: [-g[0], -g[1], -g[2]],
+        angular: [0.0; 3],
+    };
+    for (joint, out) in joints.iter().zip(qdd.iter_mut()) {
+        acceleration = acceleration.plus(&joint.bias);
+        *out = (joint.residual - acceleration.dot(&joint.coupling)) * joint.inverse;
+        acceleration = acceleration.plus(&joint.axis.times(*out));
+    }
+    Ok(())
+}
+
+/// `out = -minv rhs` (`n x n` by `n x 2n`) under [`pulp::Arch::dispatch`], returning whether
+/// every entry is finite: one or two SIMD registers of rows of [`GROUP`] output columns at a
+/// time, the sums over `k` of `minv`'s column `k` times `rhs[(k, c)]` kept in registers (at
+/// these sizes faster than a general matrix product's packing). `columns` holds `minv`'s
+/// columns, each zero-padded to [`padded`]`(n)` entries, so that a whole register can be read
+/// at any row.
 struct Product<'a> {
     out: MatMut<'a, f64>,
     columns: &'a [f64],
     rhs: MatRef<'a, f64>,
 }
 
-/// Output columns computed together (four register accumulators).
+/// Output columns computed together (four register accumulators a register of rows).
 const GROUP: usize = 4;
 
 impl WithSimd for Product<'_> {
-    type Output = ();
+    type Output = bool;
 
     #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) {
+    fn with_simd<S: Simd>(self, simd: S) -> bool {
         let Product {
             mut out,
             columns,
             rhs,
         } = self;
         let (n, width) = (out.nrows(), out.ncols());
+        let lanes = Pack::<S>::WIDTH;
+        // `x 0` summed: NaN if and only if an entry is not finite.
+        let mut check = Pack::splat(simd, 0.0);
         let mut row = 0;
         while row < n {
+            // Two registers of rows when the second holds rows of `out` and the columns' padding
+            // covers it.
+            let two = row + lanes < n && row + 2 * lanes <= padded(n);
             let mut c = 0;
-            while c + GROUP <= width {
-                columns_block::<S, GROUP>(simd, &mut out, columns, rhs, row, c);
-                c += GROUP;
-            }
             while c < width {
-                columns_block::<S, 1>(simd, &mut out, columns, rhs, row, c);
-                c += 1;
+                let at = Block { row, column: c };
+                check = match (two, c + GROUP <= width) {
+                    (true, true) => block::<S, 2, GROUP>(simd, &mut out, columns, rhs, at, check),
+                    (false, true) => block::<S, 1, GROUP>(simd, &mut out, columns, rhs, at, check),
+                    (true, false) => block::<S, 2, 1>(simd, &mut out, columns, rhs, at, check),
+                    (false, false) => block::<S, 1, 1>(simd, &mut out, columns, rhs, at, check),
+                };
+                c += if c + GROUP <= width { GROUP } else { 1 };
             }
-            row += Pack::<S>::WIDTH;
+            row += if two { 2 * lanes } else { lanes };
         }
+        Pack::splat(simd, 1.0).all_greater(check)
     }
 }
 
-/// Rows `row..row + WIDTH` (those below `n`) of the `G` output columns `c..c + G` of
-/// [`Product`], summed in `k` order from zero with fused multiply-adds, then negated.
+/// The first row and column of a block of [`Product`].
+#[derive(Clone, Copy)]
+struct Block {
+    row: usize,
+    column: usize,
+}
+
+/// Rows `row..row + R WIDTH` (those below `n`) of the `G` output columns `column..column + G`
+/// of [`Product`], summed in `k` order from zero with fused negated multiply-adds (the same
+/// bits as summing and negating); returns `check` with `0 x` each sum added.
 #[inline(always)]
-fn columns_block<S: Simd, const G: usize>(
+fn block<S: Simd, const R: usize, const G: usize>(
     simd: S,
     out: &mut MatMut<'_, f64>,
     columns: &[f64],
     rhs: MatRef<'_, f64>,
-    row: usize,
-    c: usize,
-) {
+    at: Block,
+    check: Pack<S>,
+) -> Pack<S> {
     let n = out.nrows();
-    let stride = padded(n);
+    let lanes = Pack::<S>::WIDTH;
+    let Block { row, column: c } = at;
     let factors: [&[f64]; G] = std::array::from_fn(|j| {
         let column = rhs.col(c + j).try_as_col_major();
         &column.expect(CONTIGUOUS).as_slice()[..n]
     });
-    let mut sums = [Pack::splat(simd, 0.0); G];
-    for k in 0..n {
-        let m = Pack::load(simd, &columns[k * stride + row..]);
-        for (sum, factor) in sums.iter_mut().zip(&factors) {
-            *sum = m.mul_add(Pack::splat(simd, factor[k]), *sum);
+    let zero = Pack::splat(simd, 0.0);
+    let mut sums = [[zero; G]; R];
+    for (k, column) in columns.chunks_exact(padded(n)).take(n).enumerate() {
+        let rows = &column[row..row + R * lanes];
+        let mut m = [zero; R];
+        for (r, m) in m.iter_mut().enumerate() {
+            *m = Pack::load(simd, &rows[r * lanes..]);
+        }
+        for (j, factor) in factors.iter().enumerate() {
+            let f = Pack::splat(simd, factor[k]);
+            for (sums, m) in sums.iter_mut().zip(&m) {
+                sums[j] = m.neg_mul_add(f, sums[j]);
+            }
         }
     }
-    let rows = (n - row).min(Pack::<S>::WIDTH);
-    for (j, sum) in sums.into_iter().enumerate() {
-        let mut lanes = [0.0; MAX_LANES];
-        (sum * Pack::splat(simd, -1.0)).store(&mut lanes);
-        column_of(out, c + j)[row..row + rows].copy_from_slice(&lanes[..rows]);
+    let mut check = check;
+    for (r, sums) in sums.into_iter().enumerate() {
+        let first = row + r * lanes;
+        for (j, sum) in sums.into_iter().enumerate() {
+            check = sum.mul_add(zero, check);
+            if first >= n {
+                continue;
+            }
+            let column = column_of(out, c + j);
+            if first + lanes <= n {
+                sum.store(&mut column[first..]);
+            } else {
+                let mut last = [0.0; MAX_LANES];
+                sum.store(&mut last);
+                store_first(&mut column[first..], &last, n - first);
+            }
+        }
     }
+    check
 }
 
 const CONTIGUOUS: &str = "the blocks of a faer Mat are column-major";

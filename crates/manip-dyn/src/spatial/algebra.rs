@@ -470,6 +470,29 @@ impl<T: Lane> Symmetric6<T> {
     }
 }
 
+impl Symmetric6 {
+    /// `self + body`, with the body's matrix `[[m E, -[h]x], [[h]x, C]]` added entry by entry
+    /// (its zeros skipped).
+    #[inline(always)]
+    pub(crate) fn plus_rigid(&self, body: &RigidSum) -> Symmetric6 {
+        let (m, [hx, hy, hz]) = (body.mass, body.moment);
+        let (a, b) = (&self.a, &self.b);
+        Symmetric6 {
+            a: [
+                [a[0][0] + m, a[0][1], a[0][2]],
+                [a[1][0], a[1][1] + m, a[1][2]],
+                [a[2][0], a[2][1], a[2][2] + m],
+            ],
+            b: [
+                [b[0][0], b[0][1] + hz, b[0][2] - hy],
+                [b[1][0] - hz, b[1][1], b[1][2] + hx],
+                [b[2][0] + hy, b[2][1] - hx, b[2][2]],
+            ],
+            c: mat_add(&self.c, &body.rotational),
+        }
+    }
+}
+
 /// `m - (s x) y^T`, row `r` being `m_r - y (s x_r)`.
 #[inline(always)]
 fn minus_scaled_outer<T: Lane>(m: &Mat3<T>, x: Vec3<T>, y: Vec3<T>, s: T) -> Mat3<T> {

@@ -4,7 +4,7 @@
 
 use faer::{Mat, MatMut, MatRef};
 
-use super::algebra::{Mat3, RigidSum, Vec3};
+use super::algebra::{Force, Mat3, Motion, RigidSum, Vec3};
 use super::model::SpatialModel;
 use crate::model::MAX_DENSE_LINKS;
 
@@ -24,6 +24,38 @@ pub(crate) fn padded(n: usize) -> usize {
 
 /// The most `f64` lanes of a register (AVX-512).
 pub(crate) const MAX_LANES: usize = 8;
+
+/// `out[..rows]` from the first `rows` (at most [`MAX_LANES`]) of `lanes`, the last, partial
+/// register of a SIMD loop, stored entry by entry (at these lengths a library copy call costs
+/// more than the loop that fills the register).
+#[inline(always)]
+pub(crate) fn store_first(out: &mut [f64], lanes: &[f64; MAX_LANES], rows: usize) {
+    for (r, &value) in lanes.iter().enumerate() {
+        if r < rows {
+            out[r] = value;
+        }
+    }
+}
+
+/// One joint's articulated-body quantities in the base frame, from the base-frame
+/// articulated-body algorithm of [`aba_derivatives`](super::aba_derivatives()): what
+/// [`inverse_mass_matrix`](super::minv::inverse_mass_matrix) reads (`S_i`, `U_i`, `1 / D_i`) and
+/// what the algorithm's own sweeps pass on (`c_i`, `p_i`, `u_i`).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct BaseFrameJoint {
+    /// The joint axis `S_i`.
+    pub(crate) axis: Motion,
+    /// The velocity-product acceleration `c_i = v_i x S_i qd_i`.
+    pub(crate) bias: Motion,
+    /// The link's bias force `p_i = v_i x* I_i v_i`.
+    pub(crate) force: Force,
+    /// `U_i = IA_i S_i`.
+    pub(crate) coupling: Force,
+    /// `1 / D_i`, `D_i = S_i . U_i`.
+    pub(crate) inverse: f64,
+    /// `u_i = tau_i - S_i . pA_i`.
+    pub(crate) residual: f64,
+}
 
 /// Column `k` of `m` as a slice (a faer `Mat`'s blocks are column-major), for the SIMD loops
 /// that fill the derivative matrices a column at a time.
@@ -76,7 +108,9 @@ pub struct SpatialDerivativeData {
     /// `[d tau / d q | d tau / d v]` while `aba_derivatives` multiplies it by `-M^-1`.
     pub(crate) rhs: Mat<f64>,
     /// The force, then motion, columns of the `O(n^2)` `M^-1` by component (`aba_derivatives`).
-    pub(crate) sweep: [Vec<f64>; 7],
+    pub(crate) sweep: [Vec<f64>; 6],
+    /// The joints' articulated-body quantities in the base frame (`aba_derivatives`).
+    pub(crate) joints: Vec<BaseFrameJoint>,
     /// `M^-1`'s columns, each zero-padded to [`padded`] entries, for its product with the
     /// RNEA derivatives (`aba_derivatives`).
     pub(crate) minv_columns: Vec<f64>,
@@ -115,6 +149,7 @@ impl SpatialDerivativeData {
             coriolis: vec![[[0.0; 3]; 3]; sized],
             rhs: Mat::zeros(sized, 2 * sized),
             sweep: std::array::from_fn(|_| vec![0.0; padded(sized)]),
+            joints: vec![BaseFrameJoint::default(); sized],
             minv_columns: vec![0.0; sized * padded(sized)],
         }
     }

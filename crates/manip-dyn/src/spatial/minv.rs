@@ -18,62 +18,48 @@
 //!
 //! Only the entries `j >= i` are computed (the rows of the subtree below each joint); the other
 //! half is the symmetric mirror. The sweeps run in the base frame, where `X_i` is the identity:
-//! with `S_i`, `U_i` carried there by link `i`'s pose (the pairings `S . F` and `U . a` are
-//! frame-free), `F_{i-1}[:, j] = F_i[:, j] + U_i m_ij` and `a_i[:, j] = a_{i-1}[:, j] +
+//! with `S_i`, `U_i` in the base frame (from the base-frame articulated-body algorithm of
+//! [`aba_derivatives`](super::aba_derivatives())), `F_{i-1}[:, j] = F_i[:, j] + U_i m_ij` and `a_i[:, j] = a_{i-1}[:, j] +
 //! S_i (M^-1)_ij`, so each entry costs two 6-vector dot products and two 6-vector updates,
 //! computed along the row `j = i..n`, a SIMD register of entries at a time, with the columns of
 //! `F` and `a` stored by component.
 
-use faer::MatMut;
 use pulp::{Arch, Simd, WithSimd};
 
-use super::algebra::{Force, Transform};
-use super::data::AbaLink;
-use super::derivative_data::{Six, column_of, padded};
-use super::model::SpatialModel;
+use super::derivative_data::{BaseFrameJoint, Six, padded};
 use lane_math::{Lane, Pack};
 
-/// `M^-1` into `minv` (`n x n`) from `links`, the articulated quantities of an
-/// [`aba`](super::aba()) at the same `q` (whose pivots it checked), and `poses`, the links'
-/// poses in the base frame at that `q`, with `sweep` (7 rows of
-/// [`padded`]`(n)`) as scratch.
+/// `M^-1` into `columns` (its `n` columns one after another, each zero-padded to
+/// [`padded`]`(n)` entries, the layout of the product that follows it) from `joints`, the
+/// base-frame articulated quantities `S_i`, `U_i` and `1 / D_i` of an articulated-body
+/// algorithm at the same `q` (whose pivots it checked), with `sweep` (6 rows of
+/// [`padded`]`(n)`) as scratch. The padding of `columns` must be zero, and stays zero.
 /// Allocation-free.
 pub(crate) fn inverse_mass_matrix(
     arch: Arch,
-    model: &SpatialModel,
-    links: &[AbaLink<f64>],
-    poses: &[Transform],
-    sweep: &mut [Vec<f64>; 7],
-    minv: MatMut<'_, f64>,
+    joints: &[BaseFrameJoint],
+    sweep: &mut [Vec<f64>; 6],
+    columns: &mut [f64],
 ) {
     arch.dispatch(Sweeps {
-        model,
-        links,
-        poses,
+        joints,
         sweep,
-        minv,
+        columns,
     });
 }
 
 /// The two sweeps under [`Arch::dispatch`] (the loops along a row vectorise with this
 /// processor's widest registers).
 struct Sweeps<'a> {
-    model: &'a SpatialModel,
-    links: &'a [AbaLink<f64>],
-    poses: &'a [Transform],
-    sweep: &'a mut [Vec<f64>; 7],
-    minv: MatMut<'a, f64>,
+    joints: &'a [BaseFrameJoint],
+    sweep: &'a mut [Vec<f64>; 6],
+    columns: &'a mut [f64],
 }
 
 /// Joint `i`'s axis `S_i` and `U_i` in the base frame, as plain components.
 #[inline(always)]
-fn world(model: &SpatialModel, links: &[AbaLink<f64>], poses: &[Transform], i: usize) -> [Six; 2] {
-    let pose = &poses[i];
-    let s = pose.act_motion(&model.axes[i]);
-    let u = pose.act_force(&Force {
-        linear: links[i].coupling[0],
-        angular: links[i].coupling[1],
-    });
+fn world(joint: &BaseFrameJoint) -> [Six; 2] {
+    let (s, u) = (&joint.axis, &joint.coupling);
     [
         [
             s.linear[0],
@@ -100,84 +86,80 @@ impl WithSimd for Sweeps<'_> {
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
         let Sweeps {
-            model,
-            links,
-            poses,
+            joints,
             sweep,
-            mut minv,
+            columns,
         } = self;
-        let n = model.n_links();
+        let n = joints.len();
         let width = Pack::<S>::WIDTH;
-        let end = padded(n);
-        // Rows 0-5: F (then a) by component; row 6: the entries of one row of the triangle.
-        // All start at zero and stay zero past `n`, so whole registers can be read anywhere.
+        let stride = padded(n);
+        // F (then a) by component. All start at zero and stay zero past `n`, as do the columns'
+        // paddings, so whole registers can be read anywhere.
         for row in sweep.iter_mut() {
-            row[..end].fill(0.0);
+            row[..stride].fill(0.0);
         }
-        let [r0, r1, r2, r3, r4, r5, entries] = sweep;
+        let [r0, r1, r2, r3, r4, r5] = sweep;
         let mut f = [
-            &mut r0[..end],
-            &mut r1[..end],
-            &mut r2[..end],
-            &mut r3[..end],
-            &mut r4[..end],
-            &mut r5[..end],
+            &mut r0[..stride],
+            &mut r1[..stride],
+            &mut r2[..stride],
+            &mut r3[..stride],
+            &mut r4[..stride],
+            &mut r5[..stride],
         ];
-        let entries = &mut entries[..end];
-        // Entry (i, j), j >= i, is kept at (j, i): column i of the lower triangle, contiguous.
-        // Tip to base (S1, S2).
+        // Entry (i, j), j >= i, is computed at (j, i): column i of the lower triangle.
+        // Tip to base (S1, S2): the m_ij.
         for i in (0..n).rev() {
-            let [s, u] = registers(simd, world(model, links, poses, i));
-            let inverse = Pack::splat(simd, -links[i].inverse);
+            let [s, u] = registers(simd, world(&joints[i]));
+            let inverse = Pack::splat(simd, -joints[i].inverse);
+            let column = &mut columns[i * stride..(i + 1) * stride];
             let mut j = i;
             while j < n {
                 let mut dot = Pack::load(simd, &f[0][j..]) * s[0];
                 for c in 1..6 {
                     dot = Pack::load(simd, &f[c][j..]).mul_add(s[c], dot);
                 }
-                (inverse * dot).store(&mut entries[j..]);
+                (inverse * dot).store(&mut column[j..]);
                 j += width;
             }
-            entries[i] = links[i].inverse;
+            column[i] = joints[i].inverse;
             let mut j = i;
             while j < n {
-                let m = Pack::load(simd, &entries[j..]);
+                let m = Pack::load(simd, &column[j..]);
                 for c in 0..6 {
                     let updated = m.mul_add(u[c], Pack::load(simd, &f[c][j..]));
                     updated.store(&mut f[c][j..]);
                 }
                 j += width;
             }
-            column_of(&mut minv, i)[i..].copy_from_slice(&entries[i..n]);
         }
-        // Base to tip (S3), a by component in the same rows.
+        // Base to tip (S3), a by component in the same rows: the m_ij become (M^-1)_ij.
         for row in f.iter_mut() {
             row.fill(0.0);
         }
         for i in 0..n {
-            let [s, u] = registers(simd, world(model, links, poses, i));
-            let inverse = Pack::splat(simd, links[i].inverse);
-            let column = column_of(&mut minv, i);
-            entries[i..n].copy_from_slice(&column[i..]);
+            let [s, u] = registers(simd, world(&joints[i]));
+            let inverse = Pack::splat(simd, joints[i].inverse);
+            let column = &mut columns[i * stride..(i + 1) * stride];
             let mut j = i;
             while j < n {
                 let mut dot = Pack::load(simd, &f[0][j..]) * u[0];
                 for c in 1..6 {
                     dot = Pack::load(simd, &f[c][j..]).mul_add(u[c], dot);
                 }
-                let entry = inverse.neg_mul_add(dot, Pack::load(simd, &entries[j..]));
-                entry.store(&mut entries[j..]);
+                let entry = inverse.neg_mul_add(dot, Pack::load(simd, &column[j..]));
+                entry.store(&mut column[j..]);
                 for c in 0..6 {
                     let updated = entry.mul_add(s[c], Pack::load(simd, &f[c][j..]));
                     updated.store(&mut f[c][j..]);
                 }
                 j += width;
             }
-            column[i..].copy_from_slice(&entries[i..n]);
         }
+        // The upper triangle by symmetry.
         for i in 0..n {
             for j in i + 1..n {
-                minv[(i, j)] = minv[(j, i)];
+                columns[j * stride + i] = columns[i * stride + j];
             }
         }
     }

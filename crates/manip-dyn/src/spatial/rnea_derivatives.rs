@@ -41,10 +41,13 @@ use lane_math::{Lane, Pack};
 use pulp::{Simd, WithSimd};
 
 use super::algebra::{
-    Force, Mat3, Motion, RigidSum, Vec3, add, cross, dot, mat_add, mat_t_vec, mat_vec, scale,
+    Force, Mat3, Motion, RigidSum, Transform, Vec3, add, cross, dot, mat_add, mat_t_vec, mat_vec,
+    scale,
 };
 use super::data::SpatialData;
-use super::derivative_data::{MAX_LANES, Six, SpatialDerivativeData, column_of, padded};
+use super::derivative_data::{
+    MAX_LANES, Six, SpatialDerivativeData, column_of, padded, store_first,
+};
 use super::kinematics::update_poses;
 use super::model::SpatialModel;
 use crate::check;
@@ -89,31 +92,74 @@ pub fn rnea_derivatives(
         n,
     )?;
     update_poses(model, data, q);
-    differentiate_at(model, data, derivatives, v, qdd)?;
+    for (i, pose) in data.poses.iter().enumerate() {
+        carry_to_base(model, derivatives, i, pose);
+    }
+    differentiate_at(model, data, derivatives, v, qdd, Jacobians::WithMass)?;
     check::finite_matrix("the derivatives", &derivatives.blocks.as_mut())
 }
 
-/// [`rnea_derivatives`] on checked inputs with the links' poses at `q` already in `data`, but
-/// for the test of the matrices (which [`aba_derivatives`](super::aba_derivatives()) makes
-/// once, on its own results).
+/// Joint `i`'s axis `J_i` (into the component rows of `d`) and link `i`'s inertia `I_i` (into
+/// `d.composite`; a massless link has none) carried to the base frame by the link's pose, for
+/// [`differentiate_at`]; returns `J_i`.
+#[inline(always)]
+pub(crate) fn carry_to_base(
+    model: &SpatialModel,
+    d: &mut SpatialDerivativeData,
+    i: usize,
+    pose: &Transform,
+) -> Motion {
+    let axis = pose.act_motion(&model.axes[i]);
+    for (row, value) in d.rows.iter_mut().zip(six_motion(&axis)) {
+        row[i] = value;
+    }
+    if !model.massless[i] {
+        d.composite[i] = pose.act_rigid_inertia(&model.inertias[i]);
+    }
+    axis
+}
+
+/// Which matrices [`differentiate_at`] fills, and where.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Jacobians {
+    /// `d tau / d q`, `d tau / d v` and `M` into the blocks (`rnea_derivatives`).
+    WithMass,
+    /// `d tau / d q` and `d tau / d v` into `rhs`, for the product with `-M^-1` of
+    /// [`aba_derivatives`](super::aba_derivatives()), which needs no `M`.
+    IntoRhs,
+}
+
+/// [`rnea_derivatives`] on checked inputs with every link's axis and inertia at `q` already
+/// carried to the base frame ([`carry_to_base`]), the matrices of `jacobians` only, and without
+/// the test of the matrices (which [`aba_derivatives`](super::aba_derivatives()) makes once, on
+/// its own results).
 pub(crate) fn differentiate_at(
     model: &SpatialModel,
     data: &mut SpatialData,
     derivatives: &mut SpatialDerivativeData,
     v: &[f64],
     qdd: &[f64],
+    jacobians: Jacobians,
 ) -> Result<(), DynError> {
     let d = derivatives;
-    newton_euler_base_frame(model, data, d, v, qdd);
+    newton_euler_base_frame(model, d, v, qdd);
     differentiate(model, d);
     check::finite_result("tau", &d.value)?;
     let n = model.n_links();
     // Moved out and back (no allocation) so that `Fill` reads the vectors while writing them.
-    let mut blocks = std::mem::replace(&mut d.blocks, Mat::new());
-    let (d_q, rest) = blocks.as_mut().split_at_col_mut(n);
+    let target = match jacobians {
+        Jacobians::WithMass => &mut d.blocks,
+        Jacobians::IntoRhs => &mut d.rhs,
+    };
+    let mut matrices = std::mem::replace(target, Mat::new());
+    let (d_q, rest) = matrices.as_mut().split_at_col_mut(n);
     let (d_v, mass) = rest.split_at_col_mut(n);
+    let mass = (jacobians == Jacobians::WithMass).then_some(mass);
     data.arch.dispatch(Fill { d, d_q, d_v, mass });
-    d.blocks = blocks;
+    match jacobians {
+        Jacobians::WithMass => d.blocks = matrices,
+        Jacobians::IntoRhs => d.rhs = matrices,
+    }
     Ok(())
 }
 
@@ -189,14 +235,13 @@ fn apply_coriolis(momentum: Vec3, d: &Mat3, m: &Motion) -> Force {
     }
 }
 
-/// The Newton-Euler forward sweep in the base frame, base to tip, on the poses in `data`:
-/// each joint's axis `J_i` (into the component rows), `w_i` and `beta_i`, and each link's own
-/// inertia `I_i`, momentum `I_i v_i`, Coriolis block and force `f_i = I_i a_i + v_i x* I_i v_i`
-/// (into `g`, until [`differentiate`] replaces it), with `v_i = v_{i-1} + J_i qd_i` and
-/// `a_i = a_{i-1} + J_i qdd_i + v_i x J_i qd_i` (a massless link has none of the four).
+/// The Newton-Euler forward sweep in the base frame, base to tip, on the axes `J_i` and
+/// inertias `I_i` of [`carry_to_base`] in `d`: each joint's `w_i` and `beta_i`, and each link's
+/// own momentum `I_i v_i`, Coriolis block and force `f_i = I_i a_i + v_i x* I_i v_i` (into `g`,
+/// until [`differentiate`] replaces it), with `v_i = v_{i-1} + J_i qd_i` and
+/// `a_i = a_{i-1} + J_i qdd_i + v_i x J_i qd_i` (a massless link has none of the three).
 fn newton_euler_base_frame(
     model: &SpatialModel,
-    data: &SpatialData,
     d: &mut SpatialDerivativeData,
     v: &[f64],
     qdd: &[f64],
@@ -208,8 +253,7 @@ fn newton_euler_base_frame(
         angular: [0.0; 3],
     };
     for i in 0..model.n_links() {
-        let pose = &data.poses[i];
-        let axis = pose.act_motion(&model.axes[i]);
+        let axis = motion_of(&entries(&d.rows[..6], i));
         let w = velocity.cross_motion(&axis);
         let beta = acceleration
             .cross_motion(&axis)
@@ -219,24 +263,19 @@ fn newton_euler_base_frame(
         acceleration = acceleration
             .plus(&axis.times(qdd[i]))
             .plus(&velocity.cross_motion(&joint_velocity));
-        for (row, value) in d.rows.iter_mut().zip(six_motion(&axis)) {
-            row[i] = value;
-        }
         d.w[i] = six_motion(&w);
         d.beta[i] = six_motion(&beta);
         if model.massless[i] {
             continue;
         }
-        let inertia = pose.act_rigid_inertia(&model.inertias[i]);
+        let inertia = &d.composite[i];
         let own = inertia.apply(&velocity);
-        d.coriolis[i] = coriolis_block(&inertia, &velocity, &own);
+        let force = inertia
+            .apply(&acceleration)
+            .plus(&velocity.cross_force(&own));
+        d.coriolis[i] = coriolis_block(inertia, &velocity, &own);
         d.momentum[i] = own.linear;
-        d.g[i] = six_force(
-            &inertia
-                .apply(&acceleration)
-                .plus(&velocity.cross_force(&own)),
-        );
-        d.composite[i] = inertia;
+        d.g[i] = six_force(&force);
     }
 }
 
@@ -286,14 +325,14 @@ fn differentiate(model: &SpatialModel, d: &mut SpatialDerivativeData) {
     }
 }
 
-/// The entries of the three matrices from the per-link vectors, column by column, each entry
-/// a sum of products down the component rows in SIMD registers (under
+/// The entries of the matrices (`M` when `mass` is given) from the per-link vectors, column
+/// by column, each entry a sum of products down the component rows in SIMD registers (under
 /// [`pulp::Arch::dispatch`]), stored straight into the matrices.
 struct Fill<'a> {
     d: &'a SpatialDerivativeData,
     d_q: MatMut<'a, f64>,
     d_v: MatMut<'a, f64>,
-    mass: MatMut<'a, f64>,
+    mass: Option<MatMut<'a, f64>>,
 }
 
 impl WithSimd for Fill<'_> {
@@ -339,16 +378,18 @@ impl WithSimd for Fill<'_> {
             combine(simd, &mut column[..k], &axes, &d.h[k], 0);
             combine(simd, &mut column[k..], &pq, &dv, k);
             // M: i < k: J_i . P_k; i >= k: P_i . J_k.
-            let column = column_of(&mut mass, k);
-            combine(simd, &mut column[..k], &axes, &p_k, 0);
-            combine(simd, &mut column[k..], &p, &axis, k);
+            if let Some(mass) = mass.as_mut() {
+                let column = column_of(mass, k);
+                combine(simd, &mut column[..k], &axes, &p_k, 0);
+                combine(simd, &mut column[k..], &p, &axis, k);
+            }
         }
     }
 }
 
 /// `out[j] = sum_c rows[c][first + j] x[c]`, a register of `S` at a time (the rows hold a
-/// whole register past `first + out.len()`; the last, partial register goes through a
-/// buffer).
+/// whole register past `first + out.len()`; the last, partial register goes through
+/// [`store_first`]).
 #[inline(always)]
 fn combine<S: Simd, const C: usize>(
     simd: S,
@@ -374,9 +415,8 @@ fn combine<S: Simd, const C: usize>(
         } else {
             let mut last = [0.0; MAX_LANES];
             sum.store(&mut last);
-            for (entry, value) in out[at..].iter_mut().zip(last) {
-                *entry = value;
-            }
+            let rows = out.len() - at;
+            store_first(&mut out[at..], &last, rows);
         }
         at += width;
     }

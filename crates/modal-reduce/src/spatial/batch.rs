@@ -4,8 +4,8 @@
 //! The driver is the planar batch's (`batch_driver.rs`): the states are taken `W` at a time
 //! (`W` the `f64` lanes of the widest instruction set [`pulp::Arch`] finds at run time, 8 with
 //! AVX-512, 4 with AVX2), lane `i` of every register holding state `i` of the group, and each
-//! group runs through the kernel of one state (`accumulate`, the recursion of
-//! [`motion`](super::motion)) and the `L D L^T` solve, written once over the register layouts of
+//! group runs through the kernel of one state (`accumulate`, the recursion in the links' frames
+//! of [`terms`](super::terms)) and the `L D L^T` solve, written once over the register layouts of
 //! the [`terms`](super::terms) module (one coordinate of the group's states a register here),
 //! with the same operations in the same order. A group whose inputs
 //! are not all finite, or one of whose states fails, is redone one state at a time by
@@ -142,10 +142,9 @@ impl BatchKernel for Spatial<'_> {
         gravity: &mut [Pack<S>; M],
     ) -> bool {
         let zero = Pack::splat(simd, 0.0);
-        let mut jacobians = [[[zero; M]; 3]; 6];
-        let [omega, point, com, momentum, body, body_inertia] = &mut jacobians;
+        let mut jacobians = [[[zero; M]; 3]; 5];
+        let [point, com, momentum, body, body_inertia] = &mut jacobians;
         let work = TermsLanes {
-            omega_jacobian: omega.as_flattened_mut(),
             point_jacobian: point.as_flattened_mut(),
             com_jacobian: com.as_flattened_mut(),
             momentum_jacobian: momentum.as_flattened_mut(),
@@ -160,12 +159,13 @@ impl BatchKernel for Spatial<'_> {
             model: self.model,
             a,
             a_dot,
+            next: 0,
         };
         // M*'s lower triangle, all the solve reads.
         accumulate(
             StateLanes::new(simd, usize::MAX),
             self.model,
-            &turns,
+            turns,
             M,
             work,
         );

@@ -24,11 +24,10 @@ pub struct SpatialReducedData {
     pub(crate) link_rates: Vec<f64>,
     pub(crate) link_sin: Vec<f64>,
     pub(crate) link_cos: Vec<f64>,
-    /// The angular-velocity Jacobian `Jw` and the velocity Jacobian of the link's joint point,
-    /// `Jp` (`3 x m` each, row-major), accumulated link by link; the
-    /// centre of mass's velocity Jacobian `Jv`, `m Jv`, the angular-velocity Jacobian in the
-    /// link's frame `Jb = R^T Jw` and `I_b Jb` of one link (`I_b` the principal moments).
-    pub(crate) omega_jacobian: Vec<f64>,
+    /// In the link's frame (`3 x m` each, row-major): the velocity Jacobian of the link's joint
+    /// point `Jp` and the angular-velocity Jacobian `Jb`, carried link by link; the centre of
+    /// mass's velocity Jacobian `Jv`, `m Jv` and `I_b Jb` of one link (`I_b` the principal
+    /// moments).
     pub(crate) point_jacobian: Vec<f64>,
     pub(crate) com_jacobian: Vec<f64>,
     pub(crate) momentum_jacobian: Vec<f64>,
@@ -69,7 +68,6 @@ impl SpatialReducedData {
             link_rates: vec![0.0; 2 * n],
             link_sin: vec![0.0; 2 * n],
             link_cos: vec![0.0; 2 * n],
-            omega_jacobian: vec![0.0; 3 * m],
             point_jacobian: vec![0.0; 3 * m],
             com_jacobian: vec![0.0; 3 * m],
             momentum_jacobian: vec![0.0; 3 * m],

@@ -64,6 +64,13 @@ impl SpatialReducedDerivatives {
         &self.a_ddot
     }
 
+    /// The three Jacobians side by side, row-major `m x 3m`: row `i` is
+    /// `[d_a row i | d_a_dot row i | d_tau_star row i]`.
+    #[inline]
+    pub fn jacobians(&self) -> &[f64] {
+        &self.jacobians
+    }
+
     /// `d a_ddot / d a` (`m x m`).
     pub fn d_a(&self) -> MatRef<'_, f64> {
         self.block(0)

@@ -5,8 +5,9 @@
 //!
 //! - [`model`]: [`SpatialReducedModel`], the arm (links, base pose, gravity) and its map;
 //!   [`data`]: [`SpatialReducedData`], the workspace.
-//! - [`motion`]: one link's step of the forward recursion (frames, joint axes, angular velocity
-//!   and acceleration, the acceleration of its centre of mass), which both algorithms share.
+//! - [`motion`]: one link's step of the forward recursion in the world frame (frames, joint axes,
+//!   angular velocity and acceleration, the acceleration of its centre of mass) for the joint
+//!   torques and the derivatives; [`terms`] runs its own in the links' frames.
 //! - [`terms`]: `M*`, `C*`, `G*` in `O(n m^2)` without the `2n x 2n` mass matrix.
 //! - [`projection`]: the same terms by projecting the chain's CRBA mass matrix and Newton-Euler
 //!   efforts (`J^T M J`, `O(n^2 m)`), the cross-check of [`terms`].

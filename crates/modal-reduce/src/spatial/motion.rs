@@ -1,5 +1,5 @@
-//! One link's step of the forward recursion of a universal-joint chain, shared by the reduced
-//! terms and the joint torques (`docs/theory.md`, section 8).
+//! One link's step of the forward recursion of a universal-joint chain in the world frame, for
+//! the joint torques and the derivatives (`docs/theory.md`, section 8).
 //!
 //! Entering link `i`: the frame `R` of link `i - 1` (the base's for the first link), the joint
 //! point `p = p_{i-1}`, the angular velocity `w` and acceleration `w_dot` of link `i - 1`, and

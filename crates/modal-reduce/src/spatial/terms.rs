@@ -1,20 +1,25 @@
 //! `M*`, `C*` and `G*` of a spatial modal arm in `O(n m^2)`, without the `2n x 2n` mass matrix
 //! (`docs/theory.md`, section 8).
 //!
-//! The modal rates move link `i` with angular velocity `w_i = Jw_i a_dot` and its centre of mass
-//! with velocity `v_i = Jv_i a_dot`, where `Jw_i = sum_j u_j J_j` (sum over the joints `j` up to
-//! link `i`, `u_j` the joint's axis, `J_j` its row of the modal map) and
-//! `Jv_i = Jp_i + Jw_i x (c_i - p_{i-1})`, `Jp_i` the velocity Jacobian of the joint point
-//! `p_{i-1}` (the link's two joints turn about it, so it moves with link `i - 1`):
-//! `Jp_{i+1} = Jp_i + Jw_i x (p_i - p_{i-1}) = 2 Jv_i - Jp_i` (the centre of mass at the
-//! midpoint), `3 x m` each, updated link by link in `O(m)`. Then, from the kinetic energy
-//! `T = (1/2) sum_i m_i |v_i|^2 + w_i^T I_i w_i` and the potential `V = -sum_i m_i g . c_i`,
+//! Everything is written in each link's own frame (axes `e_x` along the link, `e_y`, `e_z`),
+//! where its joints turn about coordinate axes and its inertia is diagonal. The modal rates move
+//! link `i` with angular velocity `w_i = Jb_i a_dot` and its centre of mass with velocity
+//! `v_i = Jv_i a_dot` (both in link `i`'s frame): entering the link, the carried Jacobians turn
+//! by `Rz(z_i)^T`, then by `Ry(y_i)^T` (two numbers of each row), and the joints add their
+//! columns, `Jb_i = Ry^T (Rz^T Jb_{i-1} + e_z [P_i, 0]) + e_y [0, P_i]` (`[P_i, 0]` and
+//! `[0, P_i]` the link's rows of the modal map, `P_i` row `i` of the planar one); the velocity
+//! Jacobian of the joint point `p_{i-1}`, `Jp`, turns alike (the joints turn about that point),
+//! `Jv_i = Jp_i + Jb_i x (L_i / 2) e_x` and the next joint's `Jp_{i+1} = Jp_i + Jb_i x L_i e_x`
+//! (two multiply-adds a row each), `3 x m` each, in `O(m)` a link. The angular velocity and
+//! acceleration, the acceleration of the joint point and gravity are carried and turned the same
+//! way. Then, from the kinetic energy `T = (1/2) sum_i m_i |v_i|^2 + w_i^T I_i w_i` and the
+//! potential `V = -sum_i m_i g . c_i`,
 //!
-//! - `M* = sum_i m_i Jv_i^T Jv_i + Jw_i^T I_i Jw_i` (`I_i` the inertia about the centre of mass
-//!   in the world frame),
-//! - `C* = sum_i Jv_i^T (m_i a_i) + Jw_i^T (I_i w_dot_i + w_i x I_i w_i)`, with `a_i` and
-//!   `w_dot_i` the accelerations at zero modal acceleration ([`motion`](super::motion)),
-//! - `G* = -sum_i m_i Jv_i^T g`,
+//! - `M* = sum_i m_i Jv_i^T Jv_i + Jb_i^T I_i Jb_i` (`I_i = diag(Ixx, Iyy, Izz)`, the principal
+//!   moments about the centre of mass),
+//! - `C* = sum_i Jv_i^T (m_i a_i) + Jb_i^T (I_i w_dot_i + w_i x I_i w_i)`, with `a_i` and
+//!   `w_dot_i` the accelerations at zero modal acceleration,
+//! - `G* = -sum_i m_i Jv_i^T g_i` (`g_i` gravity in link `i`'s frame),
 //!
 //! `O(m^2)` a link for `M*`, `O(m)` for the others. The tests hold them against the joint torques
 //! of the Newton-Euler recursion (`J^T tau`), the Lagrangian's finite differences, the planar
@@ -35,22 +40,19 @@
 //!   state gives the same bits alone and in a batch.
 //! - The rows of `J` per link (`[P_i, 0]`, `[0, P_i]`) are constants of the model, loaded as
 //!   registers.
-//! - The rotational terms are formed in the link's frame, where the inertia is diagonal:
-//!   `Jw^T I Jw = Jb^T I_b Jb` and `Jw^T (I w_dot + w x I w) = Jb^T (I_b w_dot_b + w_b x I_b w_b)`
-//!   with `Jb = R^T Jw` (`I_b` the principal moments), three multiply-adds a row where the
-//!   world-frame inertia `R I_b R^T` would take more than its nine entries.
 
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
-use super::motion::{Carried, JointTurns, cross_fused, link_step_turned};
+use super::motion::{JointTurns, cross_fused};
 use crate::error::{ReduceError, check_terms_finite};
 use crate::forward::right_hand_side;
 use crate::model::LINK_PADDING;
 use crate::terms::{CoordinateLanes, OneStateScalar, Registers, StateLanes};
-use backbone_kin::vec3;
 use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
 use lane_math::{Lane, Pack, check_values, sin_cos, sin_cos_lanes};
 use pulp::{Simd, WithSimd};
+use std::iter::Zip;
+use std::slice;
 
 /// Computes `M*`, `C*` and `G*` at the modal state `(a, a_dot)` into `data` (read them with
 /// [`SpatialReducedData::mass_matrix`], [`coriolis`](SpatialReducedData::coriolis) and
@@ -111,7 +113,6 @@ impl WithSimd for TermsOfOneState<'_> {
             link_rates,
             link_sin,
             link_cos,
-            omega_jacobian,
             point_jacobian,
             com_jacobian,
             momentum_jacobian,
@@ -125,12 +126,7 @@ impl WithSimd for TermsOfOneState<'_> {
         } = data;
         link_values(model, a, a_dot, link_angles, link_rates);
         sin_cos(link_angles, link_sin, link_cos);
-        let turns = TurnsOfLinks {
-            n: model.n_links(),
-            sin: link_sin,
-            cos: link_cos,
-            rates: link_rates,
-        };
+        let turns = TurnsOfLinks::new(model.n_links(), link_sin, link_cos, link_rates);
         let out = OneStateTerms {
             mass_matrix: &mut *mass_matrix,
             coriolis: &mut *coriolis,
@@ -140,16 +136,15 @@ impl WithSimd for TermsOfOneState<'_> {
         // in one register where they fit; `m` a constant of the solve for them.
         let m = match model.n_coords() {
             4 => {
-                on_stack::<S, 4>(simd, model, &turns, out);
+                on_stack::<S, 4>(simd, model, turns, out);
                 4
             }
             8 => {
-                on_stack::<S, 8>(simd, model, &turns, out);
+                on_stack::<S, 8>(simd, model, turns, out);
                 8
             }
             m => {
                 let work = TermsLanes {
-                    omega_jacobian,
                     point_jacobian,
                     com_jacobian,
                     momentum_jacobian,
@@ -159,7 +154,7 @@ impl WithSimd for TermsOfOneState<'_> {
                     coriolis: out.coriolis,
                     gravity: out.gravity,
                 };
-                let work = accumulate(OneStateScalar(simd), model, &turns, m, work);
+                let work = accumulate(OneStateScalar(simd), model, turns, m, work);
                 mirror_lower(work.mass_matrix, m);
                 m
             }
@@ -167,14 +162,35 @@ impl WithSimd for TermsOfOneState<'_> {
         let Some((tau_star, a_ddot)) = solve else {
             return true;
         };
-        factor.copy_from_slice(mass_matrix);
-        if !ldlt_in_place::<f64>((), factor, m) {
-            return false;
+        let terms: [&[f64]; 3] = [mass_matrix, coriolis, gravity];
+        // `m` a constant of the solve for the sizes of the batch.
+        match m {
+            4 => solve_in_place(factor, terms, tau_star, a_ddot, 4),
+            8 => solve_in_place(factor, terms, tau_star, a_ddot, 8),
+            m => solve_in_place(factor, terms, tau_star, a_ddot, m),
         }
-        right_hand_side(tau_star, coriolis, gravity, a_ddot);
-        ldlt_solve_in_place(factor, m, a_ddot);
-        true
     }
+}
+
+/// `a_ddot = M*^{-1} (tau* - C* - G*)` by an `L D L^T` factor of `M*` into `factor` (kept for the
+/// derivatives), `terms` `[M*, C*, G*]` of `m` coordinates. Gives `false` if `M*` is not
+/// numerically positive definite.
+#[inline(always)]
+fn solve_in_place(
+    factor: &mut [f64],
+    [mass_matrix, coriolis, gravity]: [&[f64]; 3],
+    tau_star: &[f64],
+    a_ddot: &mut [f64],
+    m: usize,
+) -> bool {
+    let factor = &mut factor[..m * m];
+    factor.copy_from_slice(&mass_matrix[..m * m]);
+    if !ldlt_in_place::<f64>((), factor, m) {
+        return false;
+    }
+    right_hand_side(tau_star, coriolis, gravity, a_ddot);
+    ldlt_solve_in_place(factor, m, a_ddot);
+    true
 }
 
 /// Where one state's terms go: `M*` (`m x m`, row-major), `C*`, `G*`.
@@ -191,7 +207,7 @@ struct OneStateTerms<'a> {
 fn on_stack<S: Simd, const M: usize>(
     simd: S,
     model: &SpatialReducedModel,
-    turns: &TurnsOfLinks<'_>,
+    turns: TurnsOfLinks<'_>,
     out: OneStateTerms<'_>,
 ) {
     if M == 4 && S::F64_LANES == 2 * M && S::F64_LANES <= LINK_PADDING {
@@ -209,17 +225,16 @@ fn on_stack<S: Simd, const M: usize>(
 fn in_layout<Y: MassRows<Value = f64>, const M: usize, const C: usize>(
     layout: Y,
     model: &SpatialReducedModel,
-    turns: &TurnsOfLinks<'_>,
+    turns: TurnsOfLinks<'_>,
     out: OneStateTerms<'_>,
 ) {
     let zero = Y::Register::splat(layout.register_context(), 0.0);
     debug_assert_eq!(layout.chunks(M), C);
-    let mut jacobians = [[[zero; C]; 3]; 6];
-    let [omega, point, com, momentum, body, body_inertia] = &mut jacobians;
+    let mut jacobians = [[[zero; C]; 3]; 5];
+    let [point, com, momentum, body, body_inertia] = &mut jacobians;
     let mut mass = [[zero; C]; M];
     let (mut coriolis, mut gravity) = ([zero; C], [zero; C]);
     let work = TermsLanes {
-        omega_jacobian: omega.as_flattened_mut(),
         point_jacobian: point.as_flattened_mut(),
         com_jacobian: com.as_flattened_mut(),
         momentum_jacobian: momentum.as_flattened_mut(),
@@ -281,46 +296,66 @@ fn link_values(
     }
 }
 
-/// Each link's [`JointTurns`], for [`accumulate`].
-pub(crate) trait LinkTurns<L> {
-    /// Link `i`'s.
-    fn turns(&self, i: usize) -> JointTurns<L>;
-}
+/// Two slices side by side.
+type Pairs<'a> = Zip<slice::Iter<'a, f64>, slice::Iter<'a, f64>>;
 
 /// The turns of all links of one state, formed beforehand ([`link_values`], then
-/// [`sin_cos`] of all the angles): the `z` joints' `n` values, then the `y` joints'.
+/// [`sin_cos`] of all the angles: the `z` joints' `n` values, then the `y` joints'), link after
+/// link (one zip of the six slices, so one test of the end a link).
 struct TurnsOfLinks<'a> {
-    n: usize,
-    sin: &'a [f64],
-    cos: &'a [f64],
-    rates: &'a [f64],
+    links: Zip<Zip<Pairs<'a>, Pairs<'a>>, Pairs<'a>>,
 }
 
-impl LinkTurns<f64> for TurnsOfLinks<'_> {
+impl<'a> TurnsOfLinks<'a> {
+    /// The turns of `n` links from the buffers of [`SpatialReducedData`].
     #[inline(always)]
-    fn turns(&self, i: usize) -> JointTurns<f64> {
-        let (z, y) = (i, self.n + i);
-        JointTurns {
-            sin: [self.sin[z], self.sin[y]],
-            cos: [self.cos[z], self.cos[y]],
-            rates: [self.rates[z], self.rates[y]],
+    fn new(n: usize, sin: &'a [f64], cos: &'a [f64], rates: &'a [f64]) -> Self {
+        let pairs = |values: &'a [f64]| {
+            let (z, y) = values.split_at(n);
+            z.iter().zip(&y[..n])
+        };
+        Self {
+            links: pairs(sin).zip(pairs(cos)).zip(pairs(rates)),
         }
+    }
+}
+
+impl Iterator for TurnsOfLinks<'_> {
+    type Item = JointTurns<f64>;
+
+    #[inline(always)]
+    fn next(&mut self) -> Option<JointTurns<f64>> {
+        let (((&sin_z, &sin_y), (&cos_z, &cos_y)), (&rate_z, &rate_y)) = self.links.next()?;
+        Some(JointTurns {
+            sin: [sin_z, sin_y],
+            cos: [cos_z, cos_y],
+            rates: [rate_z, rate_y],
+        })
     }
 }
 
 /// The turns of a link formed as the kernel reaches it, from the modal state (`a`, `a_dot`, `m`
 /// values each): `theta = J a`, `J a_dot` by multiply-adds over the row of the planar map, then
-/// [`sin_cos_lanes`] (for a batch, whose registers hold states: nothing of size `n` is kept).
+/// [`sin_cos_lanes`] (for a batch, whose registers hold states: nothing of size `n` is kept),
+/// link after link from `next`.
 pub(crate) struct TurnsFromModes<'a, L: Lane> {
     pub(crate) context: L::Context,
     pub(crate) model: &'a SpatialReducedModel,
     pub(crate) a: &'a [L],
     pub(crate) a_dot: &'a [L],
+    pub(crate) next: usize,
 }
 
-impl<L: Lane> LinkTurns<L> for TurnsFromModes<'_, L> {
+impl<L: Lane> Iterator for TurnsFromModes<'_, L> {
+    type Item = JointTurns<L>;
+
     #[inline(always)]
-    fn turns(&self, i: usize) -> JointTurns<L> {
+    fn next(&mut self) -> Option<JointTurns<L>> {
+        let i = self.next;
+        if i == self.model.n_links() {
+            return None;
+        }
+        self.next += 1;
         let context = self.context;
         let half = self.model.n_coords() / 2;
         let zero = L::splat(context, 0.0);
@@ -338,11 +373,11 @@ impl<L: Lane> LinkTurns<L> for TurnsFromModes<'_, L> {
         }
         let (sin_z, cos_z) = sin_cos_lanes(context, angles[0]);
         let (sin_y, cos_y) = sin_cos_lanes(context, angles[1]);
-        JointTurns {
+        Some(JointTurns {
             sin: [sin_z, sin_y],
             cos: [cos_z, cos_y],
             rates,
-        }
+        })
     }
 }
 
@@ -350,7 +385,6 @@ impl<L: Lane> LinkTurns<L> for TurnsFromModes<'_, L> {
 /// [`chunks`](Registers::chunks) of `m` coordinates): `3 x c` row-major Jacobians `Jw`, `Jo`, `Jv`,
 /// `m Jv`, `Jb` and `I_b Jb`, `M*` (as [`MassRows`] keeps it), `C*` and `G*` (`c` each).
 pub(crate) struct TermsLanes<'w, R> {
-    pub(crate) omega_jacobian: &'w mut [R],
     pub(crate) point_jacobian: &'w mut [R],
     pub(crate) com_jacobian: &'w mut [R],
     pub(crate) momentum_jacobian: &'w mut [R],
@@ -369,17 +403,17 @@ pub(crate) struct TermsLanes<'w, R> {
 /// [`StateLanes`](crate::terms::StateLanes)), the same operations in the same order for each
 /// entry in all of them. Returns `work`.
 ///
-/// What depends on the link alone (its frame, motion, inertia in the world frame, the torque
-/// and acceleration of `C*`) is one number of each state ([`Registers::Value`]); the rows of the
-/// Jacobians, of `M*`, `C*` and `G*` are registers of coordinates ([`Registers::Register`]). Row
-/// `2i` of `J` is `[P_i, 0]` and row `2i + 1` is `[0, P_i]` (`P_i` row `i` of the planar map),
-/// both constants of the model ([`SpatialReducedModel::joint_rows`]): the joints add
-/// `u_z [P_i, 0] + u_y [0, P_i]` to every row of `Jw`, a multiply-add a register each.
+/// What depends on the link alone (its motion, gravity in its frame, the torque and acceleration
+/// of `C*`) is one number of each state ([`Registers::Value`]); the rows of the Jacobians, of
+/// `M*`, `C*` and `G*` are registers of coordinates ([`Registers::Register`]). Row `2i` of `J` is
+/// `[P_i, 0]` and row `2i + 1` is `[0, P_i]` (`P_i` row `i` of the planar map), both constants
+/// of the model ([`SpatialReducedModel::joint_rows`]): the joints add them to the `z` and `y`
+/// rows of `Jb`, an addition a register each.
 #[inline(always)]
 pub(crate) fn accumulate<'w, Y: MassRows>(
     layout: Y,
     model: &SpatialReducedModel,
-    turns: &impl LinkTurns<Y::Value>,
+    mut turns: impl Iterator<Item = JointTurns<Y::Value>>,
     m: usize,
     work: TermsLanes<'w, Y::Register>,
 ) -> TermsLanes<'w, Y::Register> {
@@ -389,7 +423,6 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
     let zero = Y::Register::splat(layout.register_context(), 0.0);
     let chunks = layout.chunks(m);
     let TermsLanes {
-        omega_jacobian,
         point_jacobian,
         com_jacobian,
         momentum_jacobian,
@@ -400,8 +433,7 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
         gravity: gravity_terms,
     } = work;
     let rows = 3 * chunks;
-    let (omega_jacobian, point_jacobian) =
-        (&mut omega_jacobian[..rows], &mut point_jacobian[..rows]);
+    let point_jacobian = &mut point_jacobian[..rows];
     let (com_jacobian, momentum_jacobian) =
         (&mut com_jacobian[..rows], &mut momentum_jacobian[..rows]);
     let (body_jacobian, body_inertia_jacobian) = (
@@ -414,7 +446,7 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
         &mut gravity_terms[..chunks],
     );
     for buffer in [
-        &mut *omega_jacobian,
+        &mut *body_jacobian,
         &mut *point_jacobian,
         &mut *mass_matrix,
         &mut *coriolis,
@@ -422,98 +454,118 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
     ] {
         buffer.fill(zero);
     }
-    let gravity = model.gravity();
-    let weight = spread(
-        layout,
-        [
-            Y::Value::splat(context, gravity[0]),
-            Y::Value::splat(context, gravity[1]),
-            Y::Value::splat(context, gravity[2]),
-        ],
-    );
-    let mut carried = Carried::<Y::Value>::base(context, model.base_rotation(), model.base().xyz);
+    // Gravity in the base's frame, `R_0^T g`.
+    let (world_gravity, base) = (model.gravity(), model.base_rotation());
+    let value_zero = Y::Value::splat(context, 0.0);
+    let mut gravity = [value_zero; 3];
+    for (d, entry) in gravity.iter_mut().enumerate() {
+        let g = base[2][d].mul_add(
+            world_gravity[2],
+            base[1][d].mul_add(world_gravity[1], base[0][d] * world_gravity[0]),
+        );
+        *entry = Y::Value::splat(context, g);
+    }
+    let (mut omega, mut omega_dot, mut accel) = ([value_zero; 3], [value_zero; 3], [value_zero; 3]);
     let per_link = model.map().link_lengths().iter().zip(model.links());
     for (i, (&length, inertia)) in per_link.enumerate() {
-        let motion = link_step_turned(context, &mut carried, length, turns.turns(i), None);
-        // Jw += u_z [P_i, 0] + u_y [0, P_i], row by row.
-        let (u_z, u_y) = (spread(layout, motion.u_z), spread(layout, motion.u_y));
-        let joint_rows = model.joint_rows(i);
-        let (row_z, row_y) = (joint_rows, &joint_rows[m..]);
-        for c in 0..chunks {
-            let (p_z, p_y) = (layout.constant_row(row_z, c), layout.constant_row(row_y, c));
-            for d in 0..3 {
-                let w = &mut omega_jacobian[d * chunks + c];
-                *w = u_y[d].mul_add(p_y, u_z[d].mul_add(p_z, *w));
-            }
+        // `next` called here, not through an iterator adapter: an adapter is compiled without the
+        // instruction set of the SIMD dispatch and would call the batch's intrinsics.
+        let Some(JointTurns { sin, cos, rates }) = turns.next() else {
+            break;
+        };
+        let [sin_z, sin_y] = sin;
+        let [cos_z, cos_y] = cos;
+        let [rate_z, rate_y] = rates;
+        // Into the frame after the joint about z (`Rz^T`), that joint's motion, into the link's
+        // frame (`Ry^T`, the plane (z, x)).
+        for v in [&mut omega, &mut omega_dot, &mut accel, &mut gravity] {
+            to_child(v, [0, 1], sin_z, cos_z);
         }
-        // In the link's frame (axes `e_d`, the columns of `R_i`) the inertia is
-        // `diag(principal)`: `Jb = R_i^T Jw`, `w_b = R_i^T w`, `w_dot_b = R_i^T w_dot`, and
-        // `Jw^T (I w_dot + w x I w) = Jb^T (I_b w_dot_b + w_b x I_b w_b)`.
-        let axes = [
-            vec3::column(&motion.rotation, 0),
-            vec3::column(&motion.rotation, 1),
-            vec3::column(&motion.rotation, 2),
+        // w_dot += (w x e_z) z_dot; w += e_z z_dot; w_dot += (w x e_y) y_dot; w += e_y y_dot.
+        omega_dot[0] = omega[1].mul_add(rate_z, omega_dot[0]);
+        omega_dot[1] = omega[0].neg_mul_add(rate_z, omega_dot[1]);
+        omega[2] = omega[2] + rate_z;
+        omega_dot[0] = omega[2].neg_mul_add(rate_y, omega_dot[0]);
+        omega_dot[2] = omega[0].mul_add(rate_y, omega_dot[2]);
+        omega[1] = omega[1] + rate_y;
+        for v in [&mut omega, &mut omega_dot, &mut accel, &mut gravity] {
+            to_child(v, [2, 0], sin_y, cos_y);
+        }
+        // The acceleration along the link at zero joint accelerations: `a_p + r L change`,
+        // `change = w_dot x e_x + w x (w x e_x)` (`r = 1/2` at the centre of mass).
+        let (half_length, full) = (
+            Y::Value::splat(context, 0.5 * length),
+            Y::Value::splat(context, length),
+        );
+        let squares = omega[2].mul_add(omega[2], omega[1] * omega[1]);
+        let change_y = omega[0].mul_add(omega[1], omega_dot[2]);
+        let change_z = omega[0] * omega[2] - omega_dot[1];
+        let com_accel = [
+            squares.neg_mul_add(half_length, accel[0]),
+            change_y.mul_add(half_length, accel[1]),
+            change_z.mul_add(half_length, accel[2]),
         ];
-        // The centre of mass from the joint point, (L / 2) R_i e_x.
-        let half = Y::Value::splat(context, 0.5 * length);
-        let to_com = [axes[0][0] * half, axes[0][1] * half, axes[0][2] * half];
+        accel = [
+            squares.neg_mul_add(full, accel[0]),
+            change_y.mul_add(full, accel[1]),
+            change_z.mul_add(full, accel[2]),
+        ];
         let principal = [
             Y::Value::splat(context, inertia.principal[0]),
             Y::Value::splat(context, inertia.principal[1]),
             Y::Value::splat(context, inertia.principal[2]),
         ];
-        let (mut omega_body, mut omega_dot_body) = (motion.omega, motion.omega_dot);
-        for d in 0..3 {
-            omega_body[d] = dot_fused(axes[d], motion.omega);
-            omega_dot_body[d] = dot_fused(axes[d], motion.omega_dot);
-        }
         let spin = cross_fused(
-            omega_body,
+            omega,
             [
-                omega_body[0] * principal[0],
-                omega_body[1] * principal[1],
-                omega_body[2] * principal[2],
+                omega[0] * principal[0],
+                omega[1] * principal[1],
+                omega[2] * principal[2],
             ],
         );
         let mut torque = spin;
         for d in 0..3 {
-            torque[d] = principal[d].mul_add(omega_dot_body[d], spin[d]);
+            torque[d] = principal[d].mul_add(omega_dot[d], spin[d]);
         }
-        let axes = [
-            spread(layout, axes[0]),
-            spread(layout, axes[1]),
-            spread(layout, axes[2]),
-        ];
+        let weight = spread(layout, gravity);
+        let (torque, com_accel) = (spread(layout, torque), spread(layout, com_accel));
         let principal = spread(layout, principal);
-        let (torque, accel) = (spread(layout, torque), spread(layout, motion.com_accel));
-        let c = spread(layout, to_com); // c - p
         let mass = layout.spread(Y::Value::splat(context, inertia.mass));
-        // Jv = Jp + Jw x (c - p), the momentum Jacobian m Jv, Jb and I_b Jb, the next joint's
-        // Jp = 2 Jv - Jp; C* += (m Jv)^T a_c + Jb^T torque, G* -= (m Jv)^T g.
+        let (half_length, full) = (layout.spread(half_length), layout.spread(full));
+        let (sin_z, cos_z) = (layout.spread(sin_z), layout.spread(cos_z));
+        let (sin_y, cos_y) = (layout.spread(sin_y), layout.spread(cos_y));
+        let joint_rows = model.joint_rows(i);
+        // In the link's frame: Jb (turned, plus the joints' columns `e_z [P_i, 0]`,
+        // `e_y [0, P_i]`), Jp (turned); Jv = Jp + Jb x (L/2 e_x), the momentum Jacobian m Jv,
+        // I_b Jb; C* += (m Jv)^T a_c + Jb^T torque, G* -= (m Jv)^T g; the next joint's
+        // Jp = Jp + Jb x (L e_x).
         for k in 0..chunks {
-            let (w, o) = (
-                column(omega_jacobian, chunks, k),
+            let (mut body, mut point) = (
+                column(body_jacobian, chunks, k),
                 column(point_jacobian, chunks, k),
             );
+            to_child(&mut body, [0, 1], sin_z, cos_z);
+            to_child(&mut point, [0, 1], sin_z, cos_z);
+            body[2] = body[2] + layout.constant_row(joint_rows, k);
+            body[1] = body[1] + layout.constant_row(&joint_rows[m..], k);
+            to_child(&mut body, [2, 0], sin_y, cos_y);
+            to_child(&mut point, [2, 0], sin_y, cos_y);
             let v = [
-                w[2].neg_mul_add(c[1], w[1].mul_add(c[2], o[0])),
-                w[0].neg_mul_add(c[2], w[2].mul_add(c[0], o[1])),
-                w[1].neg_mul_add(c[0], w[0].mul_add(c[1], o[2])),
+                point[0],
+                body[2].mul_add(half_length, point[1]),
+                body[1].neg_mul_add(half_length, point[2]),
             ];
             let p = [v[0] * mass, v[1] * mass, v[2] * mass];
-            let body = [
-                dot_fused(axes[0], w),
-                dot_fused(axes[1], w),
-                dot_fused(axes[2], w),
-            ];
+            point[1] = body[2].mul_add(full, point[1]);
+            point[2] = body[1].neg_mul_add(full, point[2]);
             for d in 0..3 {
-                point_jacobian[d * chunks + k] = v[d] + v[d] - o[d];
+                body_jacobian[d * chunks + k] = body[d];
+                point_jacobian[d * chunks + k] = point[d];
                 com_jacobian[d * chunks + k] = v[d];
                 momentum_jacobian[d * chunks + k] = p[d];
-                body_jacobian[d * chunks + k] = body[d];
                 body_inertia_jacobian[d * chunks + k] = body[d] * principal[d];
             }
-            coriolis[k] = dot_add(body, torque, dot_add(p, accel, coriolis[k]));
+            coriolis[k] = dot_add(body, torque, dot_add(p, com_accel, coriolis[k]));
             gravity_terms[k] = gravity_terms[k] - dot_add(p, weight, zero);
         }
         // M* += (m Jv)^T Jv + Jb^T I_b Jb.
@@ -525,7 +577,6 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
         );
     }
     TermsLanes {
-        omega_jacobian,
         point_jacobian,
         com_jacobian,
         momentum_jacobian,
@@ -695,10 +746,14 @@ impl<S: Simd> MassRows for PairedCoordinates<S> {
     }
 }
 
-/// `a . b`, a product and two fused multiply-adds, `a[0] b[0]` first.
+/// Vector `v` (three numbers or three rows of registers) turned from a parent frame into its
+/// child's, turned from it by `(sin, cos)` in the plane of axes `(a, b)`: `v_a' = c v_a + s v_b`,
+/// `v_b' = c v_b - s v_a`.
 #[inline(always)]
-fn dot_fused<L: Lane>(a: [L; 3], b: [L; 3]) -> L {
-    a[2].mul_add(b[2], a[1].mul_add(b[1], a[0] * b[0]))
+fn to_child<L: Lane>(v: &mut [L], [a, b]: [usize; 2], sin: L, cos: L) {
+    let (va, vb) = (v[a], v[b]);
+    v[a] = vb.mul_add(sin, va * cos);
+    v[b] = va.neg_mul_add(sin, vb * cos);
 }
 
 /// `acc + a . b` in fused multiply-adds, `a[0] b[0]` first.

@@ -303,6 +303,81 @@ fn the_joint_torque_rows_are_the_chain_s_torques() {
     }
 }
 
+/// The rows `|A tau* + b| <= limits` by the second algorithm of the definition: `b` the joint
+/// torques (eq 13) of the forward dynamics (eq 15) under zero modal torque, `A`'s column `i`
+/// those under the unit torque `e_i` less `b` (`m + 1` forward-dynamics solves).
+fn rows_by_unit_torques(plant: modal_reduce::Plant<'_>, x: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let (n, m) = (plant.n_joints(), plant.n_coords());
+    let mut data = modal_reduce::PlantData::new(plant);
+    let (a, a_dot) = (&x[..m], &x[m..]);
+    let torques = |data: &mut modal_reduce::PlantData, unit: Option<usize>| {
+        let mut tau_star = vec![0.0; m];
+        if let Some(i) = unit {
+            tau_star[i] = 1.0;
+        }
+        let (mut a_ddot, mut tau) = (vec![0.0; m], vec![0.0; n]);
+        plant
+            .forward_dynamics(data, a, a_dot, &tau_star, &mut a_ddot)
+            .unwrap();
+        plant
+            .joint_torques(data, a, a_dot, &a_ddot, &mut tau)
+            .unwrap();
+        tau
+    };
+    let bias = torques(&mut data, None);
+    let mut columns = vec![0.0; n * m];
+    for i in 0..m {
+        for (j, tau) in torques(&mut data, Some(i)).iter().enumerate() {
+            columns[j * m + i] = tau - bias[j];
+        }
+    }
+    (columns, bias)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+    /// `JointTorqueLimits::rows` (one `M*`, `C*`, `G*` and a Cholesky solve) writes the rows of
+    /// the unit-torque construction to 1e-12 of their scale, planar (the paper's arm with and
+    /// without a free base angle) and spatial, at random states.
+    #[test]
+    fn the_joint_torque_rows_match_the_unit_torque_construction(
+        x in proptest::collection::vec(-2.0f64..2.0, 12),
+        family in 0usize..3,
+    ) {
+        let planar_free = modal_reduce::ReducedModel::new(
+            manip_dyn::ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
+            backbone_kin::ModalMap::paper(10).unwrap(),
+        )
+        .unwrap();
+        let (planar, spatial) = (
+            paper_arm(),
+            modal_reduce::spatial::SpatialReducedModel::uniform_rods(6, 1, 0.1, 0.1, [0.0, -9.81, 0.0])
+                .unwrap(),
+        );
+        let plant: modal_reduce::Plant<'_> = match family {
+            0 => (&planar).into(),
+            1 => (&planar_free).into(),
+            _ => (&spatial).into(),
+        };
+        let (n, m) = (plant.n_joints(), plant.n_coords());
+        let x = &x[..2 * m];
+        let limits: Vec<f64> = (0..n).map(|j| 1.0 + 0.1 * j as f64).collect();
+        let mut rows = optimal_ctl::JointTorqueLimits::new(plant, &limits).unwrap();
+        let (mut g, mut bounds) = (vec![0.0; 2 * n * m], vec![0.0; 2 * n]);
+        prop_assert_eq!(rows.rows(plant, x, &mut g, &mut bounds).unwrap(), 2 * n);
+        let (columns, bias) = rows_by_unit_torques(plant, x);
+        let scale = columns.iter().chain(&bias).fold(1.0f64, |s, v| s.max(v.abs()));
+        for j in 0..n {
+            for i in 0..m {
+                prop_assert!((g[2 * j * m + i] - columns[j * m + i]).abs() <= 1e-12 * scale);
+                prop_assert_eq!(g[(2 * j + 1) * m + i], -g[2 * j * m + i]);
+            }
+            prop_assert!((bounds[2 * j] - (limits[j] - bias[j])).abs() <= 1e-12 * scale);
+            prop_assert!((bounds[2 * j + 1] - (limits[j] + bias[j])).abs() <= 1e-12 * scale);
+        }
+    }
+}
+
 /// MPC on the paper's arm towards a bent shape: the unconstrained plan asks for joint torques
 /// beyond 3 N m; the plan within the joint-torque polytope keeps every node's joint torques
 /// (by RNEA, at the planned states) within them.
@@ -346,6 +421,73 @@ fn mpc_plans_within_the_joint_torque_limits() {
     assert!(peak <= limit * (1.0 + 1e-9), "{peak}");
     // ... and still moves towards the target.
     assert!(a1_end > 0.1, "{a1_end}");
+}
+
+/// The gain keeps the active joint-torque rows active as the state moves, the rows' own state
+/// dependence included (`A K = -D` for the active rows `A u <= g(x)`, `D = d(A u - g)/dx`): at
+/// every node of a converged plan within binding limits where one or two rows are active, a
+/// state step `dx` with the control `u + K dx` changes those rows' residuals by under 1% of
+/// `|dx|` (second order, and `D`'s forward differences). A gain blind to `D` changes them by
+/// `D dx` (58% of `|dx|` here), which the forward pass's projection then undoes, and its
+/// line searches fail.
+#[test]
+fn the_gain_keeps_the_active_joint_torque_rows_active_as_the_state_moves() {
+    let model = paper_arm();
+    let mut settings = optimal_ctl::MpcSettings::uniform(2);
+    settings.horizon = 30;
+    settings.solver.max_iterations = 60;
+    settings.solver.tolerance = 1e-9;
+    let limit = 3.0;
+    let mut mpc = optimal_ctl::Mpc::new(&model, &settings).unwrap();
+    for k in 0..=mpc.horizon() {
+        mpc.set_reference(&model, k, &[0.6, -0.4], &[0.0; 2], &[0.0; 2])
+            .unwrap();
+    }
+    let mut rows = optimal_ctl::JointTorqueRows::new(&model, &[limit; 10]).unwrap();
+    mpc.reserve_constraints(rows.max_rows()).unwrap();
+    let report = mpc
+        .solve_constrained(&model, &[0.0; 2], &[0.0; 2], &mut rows)
+        .unwrap();
+    assert!(report.converged, "{report:?}");
+    let ilqr = mpc.ilqr();
+    let (mut g, mut bounds) = (vec![0.0; 40], vec![0.0; 20]);
+    let (mut g_step, mut bounds_step) = (vec![0.0; 40], vec![0.0; 20]);
+    let residual = |g: &[f64], bounds: &[f64], r: usize, u: &[f64]| {
+        g[2 * r] * u[0] + g[2 * r + 1] * u[1] - bounds[r]
+    };
+    let mut checked = 0;
+    for k in 0..ilqr.horizon() {
+        let x = &ilqr.states()[k * 4..(k + 1) * 4];
+        let u = &ilqr.controls()[k * 2..(k + 1) * 2];
+        let gain = &ilqr.gains()[k * 8..(k + 1) * 8];
+        rows.rows(k, x, u, &[], &mut g, &mut bounds).unwrap();
+        let active: Vec<usize> = (0..20)
+            .filter(|&r| residual(&g, &bounds, r, u).abs() <= 1e-7 * (1.0 + bounds[r].abs()))
+            .collect();
+        if active.is_empty() || active.len() > 2 {
+            continue;
+        }
+        for direction in [[1.0, -0.5, 0.3, 0.8], [-0.2, 0.7, -1.0, 0.4]] {
+            let eps = 1e-5;
+            let dx = direction.map(|d| eps * d);
+            let moved: Vec<f64> = x.iter().zip(&dx).map(|(x, d)| x + d).collect();
+            let controlled: Vec<f64> = (0..2)
+                .map(|j| u[j] + (0..4).map(|i| gain[j * 4 + i] * dx[i]).sum::<f64>())
+                .collect();
+            rows.rows(k, &moved, &controlled, &[], &mut g_step, &mut bounds_step)
+                .unwrap();
+            for &r in &active {
+                let change =
+                    residual(&g_step, &bounds_step, r, &controlled) - residual(&g, &bounds, r, u);
+                assert!(
+                    change.abs() <= 1e-2 * eps,
+                    "node {k}, row {r}: the residual moved by {change:e} for |dx| ~ {eps:e}"
+                );
+            }
+        }
+        checked += 1;
+    }
+    assert!(checked >= 3, "{checked} nodes with active rows");
 }
 
 /// A receding-horizon warm start follows the previous plan's feedback: on `x' = 2 x + u` over

@@ -133,6 +133,9 @@ enum Placement {
 ///   `a_{k+1}(u)`, the [`MAX_CLEARANCE_ROWS`] with the least slack: a pair closes its gap over
 ///   the margin at most by the factor `rho` a step, and one already inside the margin may not
 ///   come closer.
+///
+/// The solve's gain takes in the joint rows' state dependence (their state Jacobian by forward
+/// differences, [`StepConstraints::state_jacobian`]) when there are no clearance rows.
 #[derive(Debug, Clone)]
 pub struct MpcConstraints {
     m: usize,
@@ -476,6 +479,12 @@ impl StepConstraints for BoundConstraints<'_> {
         bounds: &mut [f64],
     ) -> Result<usize, OptimalError> {
         self.constraints.rows(self.plant, (x, u), rows, bounds)
+    }
+
+    /// The joint rows' state Jacobian goes into the gain; with clearance rows (a distance and
+    /// its gradient per pair near the margin, each evaluation) it does not.
+    fn state_jacobian(&self) -> bool {
+        self.constraints.clearance.is_none()
     }
 }
 

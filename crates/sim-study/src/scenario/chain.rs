@@ -18,10 +18,17 @@ fn unused(name: &str, why: &str) -> SimError {
 
 impl Scenario {
     /// The first setting the joint-space loops (a URDF arm's and a deployment's) do not use,
-    /// as `(name, why)`: sensor noise, and any limit but `limits.max_modal_error`.
-    pub(super) fn unused_by_joint_space_loops(&self) -> Option<(&'static str, &'static str)> {
+    /// as `(name, why)`: sensor noise, and any limit but `limits.max_modal_error` (and
+    /// `limits.joint_torque_nm` when `torque_box`: the deployment MPC's box).
+    pub(super) fn unused_by_joint_space_loops(
+        &self,
+        torque_box: bool,
+    ) -> Option<(&'static str, &'static str)> {
         if self.noise != NoiseSpec::default() {
             return Some(("noise", "the joint-space loop is noise-free"));
+        }
+        if torque_box && self.limits.joint_angle_rad.is_none() && self.limits.tau_star.is_none() {
+            return None;
         }
         if self.limits.joint_torque_nm.is_some()
             || self.limits.joint_angle_rad.is_some()
@@ -142,7 +149,7 @@ impl Scenario {
                 "a joint-space reference is constant, step or sinusoid",
             ));
         }
-        if let Some((name, why)) = self.unused_by_joint_space_loops() {
+        if let Some((name, why)) = self.unused_by_joint_space_loops(false) {
             return Err(unused(name, why));
         }
         let mut reference =

@@ -7,7 +7,7 @@
 
 use super::controllers::ControllerKind;
 use super::schema::{
-    DeploySpec, IntegratorSpec, MAX_DEPLOY_CENTERLINE_POINTS, ReferenceSpec, Scenario,
+    DeploySpec, IntegratorSpec, MAX_DEPLOY_CENTERLINE_POINTS, ReferenceSpec, Scenario, TorqueLimit,
 };
 use backbone_kin::{BaseAngle, ModalMap, joint_positions};
 use manip_dyn::spatial::{SpatialData, rnea};
@@ -284,7 +284,10 @@ impl Scenario {
             max_joint_error: self.limits.max_modal_error,
         };
         let run = if mpc {
-            let mpc_settings = deploy_mpc_settings(&model, &reference, travel_time)?;
+            let mut mpc_settings = deploy_mpc_settings(&model, &reference, travel_time)?;
+            if let Some(limits) = &self.limits.joint_torque_nm {
+                set_joint_torque_box(&mut mpc_settings, limits, n)?;
+            }
             let mut controller =
                 ChainMpcController::new(&model, &mpc_settings, Box::new(reference.clone()))?;
             run_chain_loop_mpc(&model, &mut reference, &start.a, &settings, &mut controller)?
@@ -293,6 +296,7 @@ impl Scenario {
         };
         let radius = self.arm.radius.unwrap_or(0.0);
         let mut tracker = DeployTracker::new(&channel, &lengths, radius).map_err(plan_field)?;
+        tracker.reserve(run.record.t.len()).map_err(plan_field)?;
         let length = chain.total_length();
         let (e, d) = (channel.entry(), axis);
         let mut points = vec![[0.0; 2]; run.record.t.len() * (n + 1)];
@@ -339,7 +343,8 @@ impl Scenario {
         if self.task.is_some() {
             return Err(unused("task", "the deployment is the plan"));
         }
-        if let Some((name, why)) = self.unused_by_joint_space_loops() {
+        let mpc = self.controller.kind == ControllerKind::Mpc;
+        if let Some((name, why)) = self.unused_by_joint_space_loops(mpc) {
             return Err(unused(name, why));
         }
         if !matches!(
@@ -364,6 +369,49 @@ impl Scenario {
             )),
         }
     }
+}
+
+/// Sets the box of the deployment MPC's revolute joints (all but the insertion's, the last `n`
+/// of `settings`' limits) to `[limits] joint_torque_nm`: one number for every joint, or one per
+/// joint, base first.
+///
+/// # Errors
+/// [`SimError::InvalidSetting`] naming `limits.joint_torque_nm` for another number of limits
+/// than the arm's `n` joints, or a limit that is not positive and finite.
+fn set_joint_torque_box(
+    settings: &mut MpcSettings,
+    limits: &TorqueLimit,
+    n: usize,
+) -> Result<(), SimError> {
+    const FIELD: &str = "limits.joint_torque_nm";
+    let given = match limits {
+        TorqueLimit::All(limit) => std::slice::from_ref(limit),
+        TorqueLimit::PerJoint(limits) if limits.len() == n => limits.as_slice(),
+        TorqueLimit::PerJoint(limits) => {
+            return Err(SimError::setting(
+                FIELD,
+                format!(
+                    "has {} entries, the arm has {n} joints (the insertion's box is the \
+                     deployment MPC's own)",
+                    limits.len()
+                ),
+            ));
+        }
+    };
+    if let Some(l) = given.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
+        return Err(SimError::setting(
+            FIELD,
+            format!("must be positive and finite (N m), got {l}"),
+        ));
+    }
+    let Some(box_limits) = settings.tau_star_limits.as_mut() else {
+        return Err(SimError::setting(FIELD, "has no box to set"));
+    };
+    let joints = box_limits.len() - n;
+    for (j, limit) in box_limits[joints..].iter_mut().enumerate() {
+        *limit = given[j.min(given.len() - 1)];
+    }
+    Ok(())
 }
 
 /// The deployment's MPC ([`ChainMpcController`]) on `model`: [`MpcSettings::uniform`]'s weights

@@ -163,3 +163,35 @@ fn mpc_within_limits_and_clearance_allocates_nothing_per_step() {
     scenario.limits.joint_angle_rad = Some(sim_study::AngleLimit::All(3.0));
     assert_eq!(allocations(&scenario, 0.05), allocations(&scenario, 0.5));
 }
+
+/// The deployment's joint-space loop (`pipe-deploy`, `run_chain_loop_mpc` with
+/// `controller.kind = "mpc"` and `run_chain_loop` with computed torque) and its metrics
+/// allocate per run, never per step.
+#[test]
+fn deployment_mpc_allocates_nothing_per_step() {
+    assert!(is_counting());
+    let deploy_allocations = |scenario: &Scenario, duration: f64| {
+        let mut scenario = scenario.clone();
+        scenario.duration = duration;
+        let mut samples = 0;
+        let count = allocations_during(|| {
+            samples = scenario
+                .run_deploy()
+                .unwrap()
+                .run
+                .summary
+                .controller_samples;
+        });
+        assert!(samples > 1);
+        count
+    };
+    for kind in [ControllerKind::Mpc, ControllerKind::ComputedTorque] {
+        let mut scenario = Scenario::builtin("pipe-deploy").unwrap();
+        scenario.controller.kind = kind;
+        let (short, long) = (
+            deploy_allocations(&scenario, 0.02),
+            deploy_allocations(&scenario, 0.2),
+        );
+        assert_eq!(short, long, "{kind}: {short} vs {long} allocations");
+    }
+}

@@ -3,7 +3,7 @@
 //! inside it; the run's metrics are recomputed here from its link points with this file's own
 //! geometry; every refusal names its key.
 
-use sim_study::{ControllerKind, DeployRun, Scenario};
+use sim_study::{ControllerKind, DeployRun, Scenario, TorqueLimit};
 
 fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
@@ -189,6 +189,60 @@ fn mpc_deploys_pipe_deploy_as_well_as_computed_torque_within_its_box() {
     assert!((tip - m.tip_error).abs() < 1e-12, "{tip} vs {m:?}");
     assert!((deviation - m.shape_deviation_percent).abs() < 1e-9);
     assert!((clearance - m.min_wall_clearance).abs() < 1e-12);
+}
+
+/// `[limits] joint_torque_nm` is the deployment MPC's box on the revolute joints: over the
+/// first 0.3 s, the default box lets the largest joint torque reach `P`; within a limit of
+/// `0.6 P` on every joint (one number) every revolute joint's torque stays within it at every
+/// controller sample; per-joint limits of the wrong length or not positive, and the key with
+/// computed torque, are refused by name.
+#[test]
+fn the_deployment_mpc_keeps_the_joint_torques_within_joint_torque_nm() {
+    let mut scenario = Scenario::builtin("pipe-deploy").unwrap();
+    scenario.controller.kind = ControllerKind::Mpc;
+    scenario.duration = 0.3;
+    let revolute_peak = |s: &Scenario| {
+        let run = s.run_deploy().unwrap();
+        run.run.summary.peak_joint_efforts[1..]
+            .iter()
+            .fold(0.0f64, |p, e| p.max(*e))
+    };
+    let free = revolute_peak(&scenario);
+    let limit = 0.6 * free;
+    let mut limited = scenario.clone();
+    limited.limits.joint_torque_nm = Some(TorqueLimit::All(limit));
+    let peak = revolute_peak(&limited);
+    assert!(
+        peak <= limit * (1.0 + 1e-12),
+        "{peak} vs {limit} (free {free})"
+    );
+    // Its summary names the controller that ran.
+    let run = limited.run_deploy().unwrap();
+    let summary = sim_study::summary_json::deploy(&limited, &run);
+    assert_eq!(summary["controller"], "mpc");
+    assert_eq!(summary["deploy_tip_error_m"], run.metrics.tip_error);
+    let message = |s: &Scenario| s.run_deploy().unwrap_err().to_string();
+    let mut short = scenario.clone();
+    short.limits.joint_torque_nm = Some(TorqueLimit::PerJoint(vec![1.0; 9]));
+    assert!(
+        message(&short).starts_with("limits.joint_torque_nm has 9 entries, the arm has 10"),
+        "{}",
+        message(&short)
+    );
+    let mut negative = scenario.clone();
+    negative.limits.joint_torque_nm = Some(TorqueLimit::PerJoint(vec![-1.0; 10]));
+    assert!(
+        message(&negative).starts_with("limits.joint_torque_nm must be positive"),
+        "{}",
+        message(&negative)
+    );
+    let mut computed_torque = limited.clone();
+    computed_torque.controller.kind = ControllerKind::ComputedTorque;
+    assert!(
+        message(&computed_torque).starts_with("limits.joint_torque_nm"),
+        "{}",
+        message(&computed_torque)
+    );
 }
 
 #[test]
