@@ -1,6 +1,7 @@
 //! The memory bandwidth one core gets, STREAM-style, beside `reduced_fd/1000000` (issue 34):
-//! arrays of 2^23 `f64` (64 MiB each, twice the 32 MiB L3 cache of the benchmark machine), each
-//! kernel timed 7 times, the fastest kept. Prints `stream/<kernel> <GB/s> GB/s` for
+//! arrays of 2^25 `f64` (256 MiB each: on the benchmark machine a triad's speed stops falling from
+//! 128 MiB working sets up, although `lscpu` reports the host's shared 480 MiB L3), each kernel
+//! timed 7 times, the fastest kept. Prints `stream/<kernel> <GB/s> GB/s` for
 //!
 //! - `read`: `sum += a[i]` (8 bytes a value read),
 //! - `copy`: `b[i] = a[i]` (16 bytes a value: one read, one written),
@@ -18,7 +19,7 @@ use std::hint::black_box;
 use std::time::Instant;
 
 /// Values an array.
-const LEN: usize = 1 << 23;
+const LEN: usize = 1 << 25;
 /// Timed repetitions of each kernel.
 const REPEATS: usize = 7;
 
