@@ -18,9 +18,9 @@ pub struct SpatialReducedData {
     pub(crate) theta: Vec<f64>,
     pub(crate) theta_dot: Vec<f64>,
     pub(crate) theta_ddot: Vec<f64>,
-    /// Every link's joint angles (`theta = J a`) and rates, their sines and cosines (`2n` each:
-    /// the `z` joints', then the `y` joints').
-    pub(crate) link_angles: Vec<f64>,
+    /// Every link's joint rates (`J a_dot`) and the sines and cosines of its joint angles
+    /// (`theta = J a`): the `z` joints', then the `y` joints', each padded to a multiple of
+    /// [`LINK_PADDING`](crate::model::LINK_PADDING) links.
     pub(crate) link_rates: Vec<f64>,
     pub(crate) link_sin: Vec<f64>,
     pub(crate) link_cos: Vec<f64>,
@@ -48,6 +48,7 @@ impl SpatialReducedData {
     /// A workspace for `model`.
     pub fn new(model: &SpatialReducedModel) -> Self {
         let (n, m) = (model.n_links(), model.n_coords());
+        let padded = model.padded_links();
         let zero_motion = LinkMotion {
             u_z: [0.0; 3],
             u_y: [0.0; 3],
@@ -64,10 +65,9 @@ impl SpatialReducedData {
             theta: vec![0.0; 2 * n],
             theta_dot: vec![0.0; 2 * n],
             theta_ddot: vec![0.0; 2 * n],
-            link_angles: vec![0.0; 2 * n],
-            link_rates: vec![0.0; 2 * n],
-            link_sin: vec![0.0; 2 * n],
-            link_cos: vec![0.0; 2 * n],
+            link_rates: vec![0.0; 2 * padded],
+            link_sin: vec![0.0; 2 * padded],
+            link_cos: vec![0.0; 2 * padded],
             point_jacobian: vec![0.0; 3 * m],
             com_jacobian: vec![0.0; 3 * m],
             momentum_jacobian: vec![0.0; 3 * m],

@@ -2,9 +2,9 @@
 
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
-use super::terms::{TermsOfOneState, check_state, check_terms};
+use super::terms::{TermsOfOneState, check_shapes, check_state, check_terms};
 use crate::error::{ReduceError, check_finite_result};
-use lane_math::{check_len, check_values};
+use lane_math::{check_all_finite, check_len};
 
 /// The modal accelerations `a_ddot` (`m`) under the modal forces `tau_star` at `(a, a_dot)`:
 /// [`spatial_reduced_terms`](super::spatial_reduced_terms), then an `L D L^T` solve of `M*`, in
@@ -22,19 +22,26 @@ pub fn spatial_forward_dynamics(
     a_ddot: &mut [f64],
 ) -> Result<(), ReduceError> {
     let m = model.n_coords();
-    check_values("tau_star", tau_star, m)?;
+    check_len("tau_star", tau_star.len(), m)?;
     check_len("a_ddot", a_ddot.len(), m)?;
-    check_state(model, data, a, a_dot)?;
+    check_shapes(model, data, a, a_dot)?;
     let arch = data.arch;
-    let positive_definite = arch.dispatch(TermsOfOneState {
+    let outcome = arch.dispatch(TermsOfOneState {
         model,
         data: &mut *data,
         a,
         a_dot,
         solve: Some((tau_star, &mut *a_ddot)),
     });
+    if outcome.positive_definite && outcome.finite {
+        return Ok(());
+    }
+    // Name the first problem, the inputs' values first (one test of the results stood for their
+    // checks, see `TermsOfOneState`).
+    check_all_finite("tau_star", tau_star)?;
+    check_state(model, data, a, a_dot)?;
     check_terms(data)?;
-    if !positive_definite {
+    if !outcome.positive_definite {
         return Err(ReduceError::NotPositiveDefinite);
     }
     check_finite_result("modal acceleration a_ddot", a_ddot)

@@ -76,9 +76,9 @@ pub struct SpatialReducedModel {
     /// its joint about `y`, `P_i` row `i` of the planar map), `m` values each, followed by
     /// [`LINK_PADDING`] zeros so that a whole register loads from the start of any row.
     joint_rows: Vec<f64>,
-    /// The planar map transposed, `2K x n` row-major: column `k` of `P`, the weight of `a_k` in
-    /// every link's angle, so that the angles of all links are formed a register of links at a
-    /// time.
+    /// The planar map transposed, `2K` rows of [`padded_links`](Self::padded_links) values: column
+    /// `k` of `P`, the weight of `a_k` in every link's angle, then zeros, so that the angles of all
+    /// links are formed a whole register of links at a time.
     angle_columns: Vec<f64>,
 }
 
@@ -112,13 +112,14 @@ impl SpatialReducedModel {
         let (n, m) = (map.n_links(), map.n_coords());
         let half = m / 2;
         let mut joint_rows = vec![0.0; 2 * n * m + LINK_PADDING];
-        let mut angle_columns = vec![0.0; half * n];
+        let padded = n.next_multiple_of(LINK_PADDING);
+        let mut angle_columns = vec![0.0; half * padded];
         for (i, rows) in joint_rows.chunks_exact_mut(2 * m).take(n).enumerate() {
             let row = &map.planar().row(i)[..half];
             rows[..half].copy_from_slice(row);
             rows[m + half..].copy_from_slice(row);
             for (k, &value) in row.iter().enumerate() {
-                angle_columns[k * n + i] = value;
+                angle_columns[k * padded + i] = value;
             }
         }
         Ok(Self {
@@ -187,9 +188,15 @@ impl SpatialReducedModel {
         &self.joint_rows[2 * i * self.n_coords()..]
     }
 
-    /// Column `k` of the planar map (`n` values: `P_ik` for every link `i`).
+    /// The number of links rounded up to a multiple of [`LINK_PADDING`].
+    pub(crate) fn padded_links(&self) -> usize {
+        self.n_links().next_multiple_of(LINK_PADDING)
+    }
+
+    /// Column `k` of the planar map ([`padded_links`](Self::padded_links) values: `P_ik` for
+    /// every link `i`, then zeros).
     pub(crate) fn angle_column(&self, k: usize) -> &[f64] {
-        let n = self.n_links();
-        &self.angle_columns[k * n..(k + 1) * n]
+        let padded = self.padded_links();
+        &self.angle_columns[k * padded..(k + 1) * padded]
     }
 }

@@ -28,8 +28,9 @@
 //! # Evaluation
 //!
 //! - A pre-pass forms every link's joint angles and rates (`J a`, `J a_dot`, from the planar map
-//!   transposed, a register of links at a time) and their sines and cosines
-//!   ([`lane_math::sin_cos`]), so that the pass along the chain has no trigonometry left.
+//!   transposed, a register of links at a time) and the angles' sines and cosines in the same
+//!   registers ([`lane_math::sin_cos_lanes`]), so that the pass along the chain has no
+//!   trigonometry left.
 //! - The pass (`accumulate`) is written once over the planar kernel's register layouts
 //!   (`Registers`): one state of `m = 4` or `8` coordinates holds each row of the Jacobians, of
 //!   `M*`, `C*` and `G*` in one register (`CoordinateLanes`), so that a row's update is one
@@ -49,7 +50,7 @@ use crate::forward::right_hand_side;
 use crate::model::LINK_PADDING;
 use crate::terms::{CoordinateLanes, OneStateScalar, Registers, StateLanes};
 use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
-use lane_math::{Lane, Pack, check_values, sin_cos, sin_cos_lanes};
+use lane_math::{Lane, Pack, check_len, check_values, sin_cos_lanes};
 use pulp::{Simd, WithSimd};
 use std::iter::Zip;
 use std::slice;
@@ -66,15 +67,19 @@ pub fn spatial_reduced_terms(
     a: &[f64],
     a_dot: &[f64],
 ) -> Result<(), ReduceError> {
-    check_state(model, data, a, a_dot)?;
+    check_shapes(model, data, a, a_dot)?;
     let arch = data.arch;
-    arch.dispatch(TermsOfOneState {
+    let outcome = arch.dispatch(TermsOfOneState {
         model,
         data: &mut *data,
         a,
         a_dot,
         solve: None,
     });
+    if outcome.finite {
+        return Ok(());
+    }
+    check_state(model, data, a, a_dot)?;
     check_terms(data)
 }
 
@@ -86,7 +91,13 @@ pub(crate) fn check_terms(data: &SpatialReducedData) -> Result<(), ReduceError> 
 /// [`spatial_reduced_terms`] after its checks, and with `solve` the forward dynamics' `L D L^T`
 /// solve ([`spatial_forward_dynamics`](super::spatial_forward_dynamics)), run by
 /// [`pulp::Arch::dispatch`] so that the kernel and the solve are compiled for the processor's
-/// instruction set. Gives `false` if the solve found `M*` not numerically positive definite.
+/// instruction set.
+///
+/// Its inputs' values are not checked beforehand: a number that is not finite in `a`, `a_dot`
+/// or `tau_star` makes every term it enters not finite (NaN and infinity carry through every
+/// operation, even a product by zero, and the sine of an infinity is NaN; every angle and rate
+/// takes every coordinate), so one test of the results ([`Outcome::finite`]) stands for the
+/// checks of the inputs, which the caller names only when it fails.
 pub(crate) struct TermsOfOneState<'a> {
     pub(crate) model: &'a SpatialReducedModel,
     pub(crate) data: &'a mut SpatialReducedData,
@@ -96,11 +107,19 @@ pub(crate) struct TermsOfOneState<'a> {
     pub(crate) solve: Option<(&'a [f64], &'a mut [f64])>,
 }
 
+/// What [`TermsOfOneState`] found.
+pub(crate) struct Outcome {
+    /// Whether the solve, if any, found `M*` numerically positive definite.
+    pub(crate) positive_definite: bool,
+    /// Whether `M*`, `C*`, `G*` and the solve's `a_ddot` (where solved) are all finite.
+    pub(crate) finite: bool,
+}
+
 impl WithSimd for TermsOfOneState<'_> {
-    type Output = bool;
+    type Output = Outcome;
 
     #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) -> bool {
+    fn with_simd<S: Simd>(self, simd: S) -> Outcome {
         let Self {
             model,
             data,
@@ -109,7 +128,6 @@ impl WithSimd for TermsOfOneState<'_> {
             solve,
         } = self;
         let SpatialReducedData {
-            link_angles,
             link_rates,
             link_sin,
             link_cos,
@@ -124,9 +142,10 @@ impl WithSimd for TermsOfOneState<'_> {
             factor,
             ..
         } = data;
-        link_values(model, a, a_dot, link_angles, link_rates);
-        sin_cos(link_angles, link_sin, link_cos);
-        let turns = TurnsOfLinks::new(model.n_links(), link_sin, link_cos, link_rates);
+        let buffers = [&mut **link_sin, &mut **link_cos, &mut **link_rates];
+        link_values(simd, model, a, a_dot, buffers);
+        let (n, padded) = (model.n_links(), model.padded_links());
+        let turns = TurnsOfLinks::new(n, padded, link_sin, link_cos, link_rates);
         let out = OneStateTerms {
             mass_matrix: &mut *mass_matrix,
             coriolis: &mut *coriolis,
@@ -159,17 +178,37 @@ impl WithSimd for TermsOfOneState<'_> {
                 m
             }
         };
-        let Some((tau_star, a_ddot)) = solve else {
-            return true;
-        };
         let terms: [&[f64]; 3] = [mass_matrix, coriolis, gravity];
+        let Some((tau_star, a_ddot)) = solve else {
+            return Outcome {
+                positive_definite: true,
+                finite: all_finite(terms),
+            };
+        };
         // `m` a constant of the solve for the sizes of the batch.
-        match m {
+        let positive_definite = match m {
             4 => solve_in_place(factor, terms, tau_star, a_ddot, 4),
             8 => solve_in_place(factor, terms, tau_star, a_ddot, 8),
             m => solve_in_place(factor, terms, tau_star, a_ddot, m),
+        };
+        Outcome {
+            positive_definite,
+            finite: all_finite(terms) && all_finite([a_ddot]),
         }
     }
+}
+
+/// Whether every number of `values` is finite: one pass without an early exit, so that it
+/// vectorises.
+#[inline(always)]
+fn all_finite<const N: usize>(values: [&[f64]; N]) -> bool {
+    let mut bad = false;
+    for values in values {
+        for &x in values {
+            bad |= !x.is_finite();
+        }
+    }
+    !bad
 }
 
 /// `a_ddot = M*^{-1} (tau* - C* - G*)` by an `L D L^T` factor of `M*` into `factor` (kept for the
@@ -265,33 +304,57 @@ fn mirror_lower<L: Copy>(matrix: &mut [L], m: usize) {
     }
 }
 
-/// The joint angles (`theta = J a`) and rates (`J a_dot`) of every link, the `z` joints' (`n`)
-/// then the `y` joints': a register of links at a time, each angle the multiply-adds of
-/// [`TurnsFromModes`] in its order (so the same bits).
+/// The sines and cosines of every link's joint angles (`theta = J a`) and its joint rates
+/// (`J a_dot`) into `sin`, `cos` and `rates`, the `z` joints' (the model's
+/// [`padded_links`](SpatialReducedModel::padded_links) values), then the `y` joints': a register
+/// of links at a time, the padding links at angle zero, each angle the multiply-adds of
+/// [`TurnsFromModes`] in its order and [`sin_cos_lanes`] (so the same bits).
 #[inline(always)]
-fn link_values(
+fn link_values<S: Simd>(
+    simd: S,
     model: &SpatialReducedModel,
     a: &[f64],
     a_dot: &[f64],
-    angles: &mut [f64],
-    rates: &mut [f64],
+    [sin, cos, rates]: [&mut [f64]; 3],
 ) {
-    let (n, half) = (model.n_links(), model.n_coords() / 2);
-    angles.fill(0.0);
-    rates.fill(0.0);
-    let (angle_z, angle_y) = angles.split_at_mut(n);
-    let (rate_z, rate_y) = rates.split_at_mut(n);
-    for k in 0..half {
-        let (a_z, a_y) = (a[k], a[half + k]);
-        let (w_z, w_y) = (a_dot[k], a_dot[half + k]);
-        let column = model.angle_column(k);
-        let angles = angle_z.iter_mut().zip(angle_y.iter_mut());
-        let rates = rate_z.iter_mut().zip(rate_y.iter_mut());
-        for ((&p, (t_z, t_y)), (r_z, r_y)) in column.iter().zip(angles).zip(rates) {
-            *t_z = a_z.mul_add(p, *t_z);
-            *t_y = a_y.mul_add(p, *t_y);
-            *r_z = w_z.mul_add(p, *r_z);
-            *r_y = w_y.mul_add(p, *r_y);
+    if S::F64_LANES > LINK_PADDING {
+        // Wider registers than the padding: one link at a time.
+        links_in_registers::<f64>((), model, a, a_dot, [sin, cos, rates]);
+    } else {
+        links_in_registers::<Pack<S>>(simd, model, a, a_dot, [sin, cos, rates]);
+    }
+}
+
+/// [`link_values`] in registers of `L` (`L::WIDTH` at most [`LINK_PADDING`]).
+#[inline(always)]
+fn links_in_registers<L: Lane>(
+    context: L::Context,
+    model: &SpatialReducedModel,
+    a: &[f64],
+    a_dot: &[f64],
+    [sin, cos, rates]: [&mut [f64]; 3],
+) {
+    let (half, padded) = (model.n_coords() / 2, model.padded_links());
+    let zero = L::splat(context, 0.0);
+    for l in (0..model.n_links()).step_by(L::WIDTH) {
+        let (mut angles, mut link_rates) = ([zero; 2], [zero; 2]);
+        for k in 0..half {
+            let column = L::load(context, &model.angle_column(k)[l..]);
+            angles = [
+                L::splat(context, a[k]).mul_add(column, angles[0]),
+                L::splat(context, a[half + k]).mul_add(column, angles[1]),
+            ];
+            link_rates = [
+                L::splat(context, a_dot[k]).mul_add(column, link_rates[0]),
+                L::splat(context, a_dot[half + k]).mul_add(column, link_rates[1]),
+            ];
+        }
+        for (plane, (angle, rate)) in angles.into_iter().zip(link_rates).enumerate() {
+            let at = plane * padded + l;
+            let (s, c) = sin_cos_lanes(context, angle);
+            s.store(&mut sin[at..]);
+            c.store(&mut cos[at..]);
+            rate.store(&mut rates[at..]);
         }
     }
 }
@@ -299,20 +362,20 @@ fn link_values(
 /// Two slices side by side.
 type Pairs<'a> = Zip<slice::Iter<'a, f64>, slice::Iter<'a, f64>>;
 
-/// The turns of all links of one state, formed beforehand ([`link_values`], then
-/// [`sin_cos`] of all the angles: the `z` joints' `n` values, then the `y` joints'), link after
-/// link (one zip of the six slices, so one test of the end a link).
+/// The turns of all links of one state, formed beforehand ([`link_values`]), link after link
+/// (one zip of the six slices, so one test of the end a link).
 struct TurnsOfLinks<'a> {
     links: Zip<Zip<Pairs<'a>, Pairs<'a>>, Pairs<'a>>,
 }
 
 impl<'a> TurnsOfLinks<'a> {
-    /// The turns of `n` links from the buffers of [`SpatialReducedData`].
+    /// The turns of `n` links from the buffers of [`SpatialReducedData`] (the `z` joints' values
+    /// then the `y` joints', `padded` each).
     #[inline(always)]
-    fn new(n: usize, sin: &'a [f64], cos: &'a [f64], rates: &'a [f64]) -> Self {
+    fn new(n: usize, padded: usize, sin: &'a [f64], cos: &'a [f64], rates: &'a [f64]) -> Self {
         let pairs = |values: &'a [f64]| {
-            let (z, y) = values.split_at(n);
-            z.iter().zip(&y[..n])
+            let (z, y) = values.split_at(padded);
+            z[..n].iter().zip(&y[..n])
         };
         Self {
             links: pairs(sin).zip(pairs(cos)).zip(pairs(rates)),
@@ -779,5 +842,20 @@ pub(crate) fn check_state(
     let m = model.n_coords();
     check_values("a", a, m)?;
     check_values("a_dot", a_dot, m)?;
+    Ok(())
+}
+
+/// Checks that `data` was made for `model` and that `a` and `a_dot` are `m` values each (their
+/// values not looked at: see [`TermsOfOneState`]).
+pub(crate) fn check_shapes(
+    model: &SpatialReducedModel,
+    data: &SpatialReducedData,
+    a: &[f64],
+    a_dot: &[f64],
+) -> Result<(), ReduceError> {
+    data.check_model(model)?;
+    let m = model.n_coords();
+    check_len("a", a.len(), m)?;
+    check_len("a_dot", a_dot.len(), m)?;
     Ok(())
 }

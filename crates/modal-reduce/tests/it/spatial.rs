@@ -439,3 +439,59 @@ fn spatial_arms_refuse_bad_input() {
         Err(ReduceError::NonFiniteResult { .. })
     ));
 }
+
+/// The forward dynamics and the terms test their inputs' values only through their results
+/// (one test of the results, then the inputs named only when it fails): every NaN or infinity
+/// in any entry of `a`, `a_dot` or `tau_star` is still reported by the input's name and index,
+/// for `m = 4`, `8` (the sizes with their own code) and `12`, and a workspace that saw one gives
+/// the same bits on the next good call.
+#[test]
+fn a_non_finite_input_is_named_though_the_results_are_tested() {
+    for (k, n) in [(1, 10), (2, 11), (3, 13)] {
+        let model = arm(n, k, 7);
+        let m = model.n_coords();
+        let mut data = SpatialReducedData::new(&model);
+        let (a, a_dot, tau_star) = state(m, 3);
+        let mut good = vec![0.0; m];
+        spatial_forward_dynamics(&model, &mut data, &a, &a_dot, &tau_star, &mut good).unwrap();
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            for (input, name) in [(0, "a"), (1, "a_dot"), (2, "tau_star")] {
+                for index in 0..m {
+                    let mut inputs = [a.clone(), a_dot.clone(), tau_star.clone()];
+                    inputs[input][index] = bad;
+                    let [x, v, t] = &inputs;
+                    let mut out = vec![0.0; m];
+                    let err =
+                        spatial_forward_dynamics(&model, &mut data, x, v, t, &mut out).unwrap_err();
+                    assert!(
+                        matches!(err, ReduceError::NonFinite { name: found, index: Some(i), .. }
+                            if found == name && i == index),
+                        "m = {m}, {name}[{index}] = {bad}: {err}"
+                    );
+                    if input < 2 {
+                        let err = spatial_reduced_terms(&model, &mut data, x, v).unwrap_err();
+                        assert!(
+                            matches!(err, ReduceError::NonFinite { name: found, index: Some(i), .. }
+                                if found == name && i == index),
+                            "terms, m = {m}, {name}[{index}] = {bad}: {err}"
+                        );
+                    }
+                }
+            }
+        }
+        // Finite inputs too large for double precision: a result that is not finite, named.
+        let huge = vec![1e300; m];
+        let mut out = vec![0.0; m];
+        assert!(matches!(
+            spatial_forward_dynamics(&model, &mut data, &huge, &huge, &tau_star, &mut out),
+            Err(ReduceError::NonFiniteResult { .. })
+        ));
+        // A buffer for `a_ddot` holding NaN is only written to.
+        let mut again = vec![f64::NAN; m];
+        spatial_forward_dynamics(&model, &mut data, &a, &a_dot, &tau_star, &mut again).unwrap();
+        assert_eq!(
+            again.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            good.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+        );
+    }
+}
