@@ -34,9 +34,8 @@
 //! - The pass (`accumulate`) is written once over the planar kernel's register layouts
 //!   (`Registers`): one state of `m = 4` or `8` coordinates holds each row of the Jacobians, of
 //!   `M*`, `C*` and `G*` in one register (`CoordinateLanes`), so that a row's update is one
-//!   vector operation; `m = 4` in registers of 8 lanes holds each row twice and two rows of `M*`
-//!   a register (`PairedCoordinates`), which halves the work of `M*`; more coordinates go one a
-//!   number (`OneStateScalar`); a batch holds one coordinate of several states a register
+//!   vector operation (`m = 4` in registers of 4 lanes: AVX2 rather than AVX-512, see
+//!   `SpatialReducedData`'s instruction set); more coordinates go one a number (`OneStateScalar`); a batch holds one coordinate of several states a register
 //!   (`StateLanes`). Each entry gets the same operations in the same order in all of them, so a
 //!   state gives the same bits alone and in a batch.
 //! - The rows of `J` per link (`[P_i, 0]`, `[0, P_i]`) are constants of the model, loaded as
@@ -240,8 +239,7 @@ struct OneStateTerms<'a> {
 }
 
 /// [`accumulate`] of one state of `M` coordinates on stack registers, the coordinates side by
-/// side in one register of `S` where they fit ([`CoordinateLanes`]; twice over when they fill
-/// half of it, [`PairedCoordinates`]), else one a number.
+/// side in one register of `S` where they fit ([`CoordinateLanes`]), else one a number.
 #[inline(always)]
 fn on_stack<S: Simd, const M: usize>(
     simd: S,
@@ -249,9 +247,7 @@ fn on_stack<S: Simd, const M: usize>(
     turns: TurnsOfLinks<'_>,
     out: OneStateTerms<'_>,
 ) {
-    if M == 4 && S::F64_LANES == 2 * M && S::F64_LANES <= LINK_PADDING {
-        in_layout::<_, M, 1>(PairedCoordinates(simd), model, turns, out);
-    } else if M <= S::F64_LANES && S::F64_LANES <= LINK_PADDING {
+    if M <= S::F64_LANES && S::F64_LANES <= LINK_PADDING {
         in_layout::<_, M, 1>(CoordinateLanes::new(simd, M), model, turns, out);
     } else {
         in_layout::<_, M, M>(OneStateScalar(simd), model, turns, out);
@@ -732,82 +728,6 @@ impl<S: Simd> MassRows for CoordinateLanes<S> {}
 impl<S: Simd> MassRows for OneStateScalar<S> {}
 
 impl<S: Simd> MassRows for StateLanes<S> {}
-
-/// One state of 4 coordinates in registers of 8 lanes (AVX-512), each row twice (lanes 0-3 and
-/// 4-7), so that a register holds two rows of `M*`: the outer product `a b^T` adds
-/// `[a_0 a_0 a_0 a_0 a_1 a_1 a_1 a_1] * [b, b]` to rows 0 and 1 and likewise to rows 2 and 3,
-/// two spreads and two multiply-adds where a row a register takes four of each.
-#[derive(Clone, Copy)]
-pub(crate) struct PairedCoordinates<S: Simd>(pub(crate) S);
-
-impl<S: Simd> Registers for PairedCoordinates<S> {
-    type Register = Pack<S>;
-    type Value = f64;
-
-    #[inline(always)]
-    fn register_context(self) -> S {
-        self.0
-    }
-
-    #[inline(always)]
-    fn value_context(self) {}
-
-    #[inline(always)]
-    fn chunks(self, _: usize) -> usize {
-        1
-    }
-
-    #[inline(always)]
-    fn spread(self, value: f64) -> Pack<S> {
-        Pack::splat(self.0, value)
-    }
-
-    #[inline(always)]
-    fn constant_row(self, row: &[f64], _: usize) -> Pack<S> {
-        let mut lanes = [0.0; LINK_PADDING];
-        lanes[..4].copy_from_slice(&row[..4]);
-        lanes[4..].copy_from_slice(&row[..4]);
-        Pack::load(self.0, &lanes)
-    }
-
-    #[inline(always)]
-    fn coordinate(self, row: &[Pack<S>], k: usize) -> f64 {
-        row[0].lane(k)
-    }
-}
-
-impl<S: Simd> MassRows for PairedCoordinates<S> {
-    #[inline(always)]
-    fn mass_len(self, _: usize) -> usize {
-        2
-    }
-
-    #[inline(always)]
-    fn add_outers(
-        self,
-        mass: &mut [Pack<S>],
-        left: [&[Pack<S>]; 2],
-        right: [&[Pack<S>]; 2],
-        _: usize,
-    ) {
-        let mut lanes = [0.0; LINK_PADDING];
-        for (left, right) in left.iter().zip(right) {
-            for (&a, &b) in left[..3].iter().zip(&right[..3]) {
-                a.store(&mut lanes);
-                let [a0, a1, a2, a3, ..] = lanes;
-                let upper = [a0, a0, a0, a0, a1, a1, a1, a1];
-                let lower = [a2, a2, a2, a2, a3, a3, a3, a3];
-                mass[0] = Pack::load(self.0, &upper).mul_add(b, mass[0]);
-                mass[1] = Pack::load(self.0, &lower).mul_add(b, mass[1]);
-            }
-        }
-    }
-
-    #[inline(always)]
-    fn mass_entry(self, mass: &[Pack<S>], _: usize, k: usize, l: usize) -> f64 {
-        mass[k / 2].lane(4 * (k % 2) + l)
-    }
-}
 
 /// Vector `v` (three numbers or three rows of registers) turned from a parent frame into its
 /// child's, turned from it by `(sin, cos)` in the plane of axes `(a, b)`: `v_a' = c v_a + s v_b`,
