@@ -186,8 +186,8 @@ impl WithSimd for TermsOfOneState<'_> {
         };
         // `m` a constant of the solve for the sizes of the batch.
         let positive_definite = match m {
-            4 => solve_in_place(factor, terms, tau_star, a_ddot, 4),
-            8 => solve_in_place(factor, terms, tau_star, a_ddot, 8),
+            4 => solve_on_stack::<4>(factor, terms, tau_star, a_ddot),
+            8 => solve_on_stack::<8>(factor, terms, tau_star, a_ddot),
             m => solve_in_place(factor, terms, tau_star, a_ddot, m),
         };
         Outcome {
@@ -229,6 +229,26 @@ fn solve_in_place(
     right_hand_side(tau_star, coriolis, gravity, a_ddot);
     ldlt_solve_in_place(factor, m, a_ddot);
     true
+}
+
+/// [`solve_in_place`] of `M` coordinates on a copy of `M*` and of the right-hand side on the
+/// stack, so that the factorisation and the solve run in registers rather than through memory
+/// (the same operations, so the same bits); the factor is stored into `factor` after.
+#[inline(always)]
+fn solve_on_stack<const M: usize>(
+    factor: &mut [f64],
+    terms: [&[f64]; 3],
+    tau_star: &[f64],
+    a_ddot: &mut [f64],
+) -> bool {
+    let mut stack = [[0.0; M]; M];
+    let mut x = [0.0; M];
+    let solved = solve_in_place(stack.as_flattened_mut(), terms, tau_star, &mut x, M);
+    factor[..M * M].copy_from_slice(stack.as_flattened());
+    if solved {
+        a_ddot[..M].copy_from_slice(&x);
+    }
+    solved
 }
 
 /// Where one state's terms go: `M*` (`m x m`, row-major), `C*`, `G*`.
