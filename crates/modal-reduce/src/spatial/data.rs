@@ -38,6 +38,9 @@ pub struct SpatialReducedData {
     pub(crate) gravity: Vec<f64>,
     /// `L D L^T` of `M*` and the right-hand side of a solve.
     pub(crate) factor: Vec<f64>,
+    /// The solve's `a_ddot` before it is known to be finite (`m`; for `m` other than 4 and 8,
+    /// which solve on the stack).
+    pub(crate) solution: Vec<f64>,
     /// Every link's motion, for the backward pass of the joint torques.
     pub(crate) links: Vec<LinkMotion>,
     /// The instruction set the terms' kernel is dispatched to ([`one_state_arch`], found at
@@ -92,6 +95,7 @@ impl SpatialReducedData {
             coriolis: vec![0.0; m],
             gravity: vec![0.0; m],
             factor: vec![0.0; m * m],
+            solution: vec![0.0; m],
             links: vec![zero_motion; n],
             arch: one_state_arch(m),
         }

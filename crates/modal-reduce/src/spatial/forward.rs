@@ -3,7 +3,7 @@
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
 use super::terms::{TermsOfOneState, check_shapes, check_state, check_terms};
-use crate::error::{ReduceError, check_finite_result};
+use crate::error::ReduceError;
 use lane_math::{check_all_finite, check_len};
 
 /// The modal accelerations `a_ddot` (`m`) under the modal forces `tau_star` at `(a, a_dot)`:
@@ -12,7 +12,7 @@ use lane_math::{check_all_finite, check_len};
 ///
 /// Errors: as [`spatial_reduced_terms`](super::spatial_reduced_terms), `tau_star` or `a_ddot` of
 /// the wrong length, [`ReduceError::NotPositiveDefinite`] where `M*` is not numerically positive
-/// definite.
+/// definite. On an error `a_ddot` is left as it was.
 pub fn spatial_forward_dynamics(
     model: &SpatialReducedModel,
     data: &mut SpatialReducedData,
@@ -44,5 +44,7 @@ pub fn spatial_forward_dynamics(
     if !outcome.positive_definite {
         return Err(ReduceError::NotPositiveDefinite);
     }
-    check_finite_result("modal acceleration a_ddot", a_ddot)
+    Err(ReduceError::NonFiniteResult {
+        name: "modal acceleration a_ddot",
+    })
 }

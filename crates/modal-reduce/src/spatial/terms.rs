@@ -110,7 +110,8 @@ pub(crate) struct TermsOfOneState<'a> {
 pub(crate) struct Outcome {
     /// Whether the solve, if any, found `M*` numerically positive definite.
     pub(crate) positive_definite: bool,
-    /// Whether `M*`, `C*`, `G*` and the solve's `a_ddot` (where solved) are all finite.
+    /// Whether `M*`, `C*`, `G*` and the solve's `a_ddot` (where solved) are all finite (`a_ddot`
+    /// is written only where this and `positive_definite` hold).
     pub(crate) finite: bool,
 }
 
@@ -139,6 +140,7 @@ impl WithSimd for TermsOfOneState<'_> {
             coriolis,
             gravity,
             factor,
+            solution,
             ..
         } = data;
         let buffers = [&mut **link_sin, &mut **link_cos, &mut **link_rates];
@@ -185,15 +187,34 @@ impl WithSimd for TermsOfOneState<'_> {
             };
         };
         // `m` a constant of the solve for the sizes of the batch.
-        let positive_definite = match m {
+        match m {
             4 => solve_on_stack::<4>(factor, terms, tau_star, a_ddot),
             8 => solve_on_stack::<8>(factor, terms, tau_star, a_ddot),
-            m => solve_in_place(factor, terms, tau_star, a_ddot, m),
-        };
-        Outcome {
-            positive_definite,
-            finite: all_finite(terms) && all_finite([a_ddot]),
+            m => {
+                let positive_definite = solve_in_place(factor, terms, tau_star, solution, m);
+                finish(positive_definite, terms, solution, a_ddot)
+            }
         }
+    }
+}
+
+/// The outcome of a solve of `terms` into `solution`, which is copied to `a_ddot` only where
+/// `M*` was positive definite and the terms and the solution are finite, so that a call that
+/// fails leaves `a_ddot` as it was.
+#[inline(always)]
+fn finish(
+    positive_definite: bool,
+    terms: [&[f64]; 3],
+    solution: &[f64],
+    a_ddot: &mut [f64],
+) -> Outcome {
+    let finite = all_finite(terms) && all_finite([solution]);
+    if positive_definite && finite {
+        a_ddot.copy_from_slice(solution);
+    }
+    Outcome {
+        positive_definite,
+        finite,
     }
 }
 
@@ -233,22 +254,20 @@ fn solve_in_place(
 
 /// [`solve_in_place`] of `M` coordinates on a copy of `M*` and of the right-hand side on the
 /// stack, so that the factorisation and the solve run in registers rather than through memory
-/// (the same operations, so the same bits); the factor is stored into `factor` after.
+/// (the same operations, so the same bits); the factor is stored into `factor` after, the
+/// solution as [`finish`] says.
 #[inline(always)]
 fn solve_on_stack<const M: usize>(
     factor: &mut [f64],
     terms: [&[f64]; 3],
     tau_star: &[f64],
     a_ddot: &mut [f64],
-) -> bool {
+) -> Outcome {
     let mut stack = [[0.0; M]; M];
     let mut x = [0.0; M];
-    let solved = solve_in_place(stack.as_flattened_mut(), terms, tau_star, &mut x, M);
+    let positive_definite = solve_in_place(stack.as_flattened_mut(), terms, tau_star, &mut x, M);
     factor[..M * M].copy_from_slice(stack.as_flattened());
-    if solved {
-        a_ddot[..M].copy_from_slice(&x);
-    }
-    solved
+    finish(positive_definite, terms, &x, a_ddot)
 }
 
 /// Where one state's terms go: `M*` (`m x m`, row-major), `C*`, `G*`.

@@ -443,8 +443,8 @@ fn spatial_arms_refuse_bad_input() {
 /// The forward dynamics and the terms test their inputs' values only through their results
 /// (one test of the results, then the inputs named only when it fails): every NaN or infinity
 /// in any entry of `a`, `a_dot` or `tau_star` is still reported by the input's name and index,
-/// for `m = 4`, `8` (the sizes with their own code) and `12`, and a workspace that saw one gives
-/// the same bits on the next good call.
+/// for `m = 4`, `8` (the sizes with their own code) and `12`, `a_ddot` is left as it was, and a
+/// workspace that saw one gives the same bits on the next good call.
 #[test]
 fn a_non_finite_input_is_named_though_the_results_are_tested() {
     for (k, n) in [(1, 10), (2, 11), (3, 13)] {
