@@ -76,16 +76,12 @@ impl ChainIk {
         check_harmonics(harmonics)?;
         check_finite("alpha0", alpha0)?;
         let m = 2 * harmonics;
-        let rounding = 8.0 * link_lengths.len() as f64 * f64::EPSILON;
         Ok(Self {
             link_lengths: link_lengths.to_vec(),
             length,
             harmonics,
             alpha0,
-            options: IkOptions {
-                tolerance: IkOptions::default().tolerance.max(rounding),
-                ..IkOptions::default()
-            },
+            options: IkOptions::for_chain(link_lengths.len()),
             trial: vec![0.0; m],
             jacobian: vec![0.0; 2 * m],
             trial_jacobian: vec![0.0; 2 * m],

@@ -50,6 +50,17 @@ impl Default for IkOptions {
 }
 
 impl IkOptions {
+    /// The default options for the tip of a chain of `n_links` links: the tolerance is raised to
+    /// `8 n eps` where the rounding of summing the links' contributions would not reach it.
+    pub(crate) fn for_chain(n_links: usize) -> Self {
+        let rounding = 8.0 * n_links as f64 * f64::EPSILON;
+        let default = Self::default();
+        Self {
+            tolerance: default.tolerance.max(rounding),
+            ..default
+        }
+    }
+
     /// Checks that `tolerance` is positive and finite.
     pub(crate) fn validate(&self) -> Result<(), KinError> {
         check_finite("IK tolerance", self.tolerance)?;

@@ -59,15 +59,11 @@ impl SpatialIk {
         base.validate()?;
         let (n2, m) = (map.n_joints(), map.n_coords());
         let length = map.link_lengths().iter().sum();
-        let rounding = 8.0 * n2 as f64 * f64::EPSILON;
         Ok(Self {
             map,
             base,
             length,
-            options: IkOptions {
-                tolerance: IkOptions::default().tolerance.max(rounding),
-                ..IkOptions::default()
-            },
+            options: IkOptions::for_chain(n2),
             theta: vec![0.0; n2],
             joint_jacobian: vec![0.0; 3 * n2],
             trial: vec![0.0; m],

@@ -304,11 +304,14 @@ impl Arm {
         theta_ddot: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.n();
-        let inputs = [
-            States::read(theta, "theta", n)?,
-            States::read(theta_dot, "theta_dot", n)?,
-            States::read(theta_ddot, "theta_ddot", n)?,
-        ];
+        let inputs = States::read_all(
+            [
+                (theta, "theta"),
+                (theta_dot, "theta_dot"),
+                (theta_ddot, "theta_ddot"),
+            ],
+            n,
+        )?;
         let [q, v, qdd] = &inputs;
         let out = evaluate(
             py,
@@ -337,11 +340,10 @@ impl Arm {
         tau: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.n();
-        let inputs = [
-            States::read(theta, "theta", n)?,
-            States::read(theta_dot, "theta_dot", n)?,
-            States::read(tau, "tau", n)?,
-        ];
+        let inputs = States::read_all(
+            [(theta, "theta"), (theta_dot, "theta_dot"), (tau, "tau")],
+            n,
+        )?;
         let [q, v, t] = &inputs;
         let out = evaluate_chunks(
             py,

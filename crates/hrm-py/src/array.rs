@@ -95,6 +95,19 @@ impl<'py> States<'py> {
         })
     }
 
+    /// Reads each `(object, name)` argument as states of `width` values (see [`States::read`]);
+    /// the first argument that fails names itself in the error.
+    pub(crate) fn read_all<const K: usize>(
+        arguments: [(&Bound<'py, PyAny>, &'static str); K],
+        width: usize,
+    ) -> PyResult<[Self; K]> {
+        let mut states = Vec::with_capacity(K);
+        for (object, name) in arguments {
+            states.push(Self::read(object, name, width)?);
+        }
+        Ok(states.try_into().ok().expect("one States per argument"))
+    }
+
     /// The values, state after state.
     pub(crate) fn values(&self) -> &[f64] {
         match &self.copy {

@@ -144,11 +144,14 @@ impl Chain {
     ) -> PyResult<Bound<'py, PyTuple>> {
         self.dense("Chain derivatives (n x n matrices)")?;
         let n = self.n();
-        let inputs = [
-            States::read(inputs[0], names[0], n)?,
-            States::read(inputs[1], names[1], n)?,
-            States::read(inputs[2], names[2], n)?,
-        ];
+        let inputs = States::read_all(
+            [
+                (inputs[0], names[0]),
+                (inputs[1], names[1]),
+                (inputs[2], names[2]),
+            ],
+            n,
+        )?;
         let batch = inputs[0].is_batch();
         let [a, b, c] = &inputs;
         let matrices = if with_input { 3 } else { 2 };
@@ -372,11 +375,14 @@ impl Chain {
         theta_ddot: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.n();
-        let inputs = [
-            States::read(theta, "theta", n)?,
-            States::read(theta_dot, "theta_dot", n)?,
-            States::read(theta_ddot, "theta_ddot", n)?,
-        ];
+        let inputs = States::read_all(
+            [
+                (theta, "theta"),
+                (theta_dot, "theta_dot"),
+                (theta_ddot, "theta_ddot"),
+            ],
+            n,
+        )?;
         let [q, v, a] = &inputs;
         let out = evaluate(
             py,
@@ -404,11 +410,10 @@ impl Chain {
         tau: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.n();
-        let inputs = [
-            States::read(theta, "theta", n)?,
-            States::read(theta_dot, "theta_dot", n)?,
-            States::read(tau, "tau", n)?,
-        ];
+        let inputs = States::read_all(
+            [(theta, "theta"), (theta_dot, "theta_dot"), (tau, "tau")],
+            n,
+        )?;
         let [q, v, t] = &inputs;
         let out = evaluate_chunks(
             py,

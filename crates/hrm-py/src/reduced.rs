@@ -401,11 +401,7 @@ impl ReducedModel {
         tau_star: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let m = self.m();
-        let inputs = [
-            States::read(a, "a", m)?,
-            States::read(a_dot, "a_dot", m)?,
-            States::read(tau_star, "tau_star", m)?,
-        ];
+        let inputs = States::read_all([(a, "a"), (a_dot, "a_dot"), (tau_star, "tau_star")], m)?;
         let [a, a_dot, tau_star] = &inputs;
         let out = evaluate_chunks(
             py,
@@ -436,11 +432,7 @@ impl ReducedModel {
         a_ddot: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let m = self.m();
-        let inputs = [
-            States::read(a, "a", m)?,
-            States::read(a_dot, "a_dot", m)?,
-            States::read(a_ddot, "a_ddot", m)?,
-        ];
+        let inputs = States::read_all([(a, "a"), (a_dot, "a_dot"), (a_ddot, "a_ddot")], m)?;
         let [a, a_dot, a_ddot] = &inputs;
         let out = evaluate(
             py,

@@ -520,11 +520,7 @@ impl SpatialArm {
         tau_star: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let (m, joints) = (self.m(), self.joints_count());
-        let inputs = [
-            States::read(a, "a", m)?,
-            States::read(a_dot, "a_dot", m)?,
-            States::read(tau_star, "tau_star", m)?,
-        ];
+        let inputs = States::read_all([(a, "a"), (a_dot, "a_dot"), (tau_star, "tau_star")], m)?;
         let batch = inputs[0].is_batch();
         let [a, a_dot, tau] = &inputs;
         let per_state = m * m + 3 * m + joints;
@@ -578,11 +574,7 @@ impl SpatialArm {
         tau_star: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let m = self.m();
-        let inputs = [
-            States::read(a, "a", m)?,
-            States::read(a_dot, "a_dot", m)?,
-            States::read(tau_star, "tau_star", m)?,
-        ];
+        let inputs = States::read_all([(a, "a"), (a_dot, "a_dot"), (tau_star, "tau_star")], m)?;
         let [a, a_dot, tau] = &inputs;
         let out = evaluate(
             py,
@@ -613,11 +605,7 @@ impl SpatialArm {
         tau_star: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let m = self.m();
-        let inputs = [
-            States::read(a, "a", m)?,
-            States::read(a_dot, "a_dot", m)?,
-            States::read(tau_star, "tau_star", m)?,
-        ];
+        let inputs = States::read_all([(a, "a"), (a_dot, "a_dot"), (tau_star, "tau_star")], m)?;
         let batch = inputs[0].is_batch();
         let [a, a_dot, tau] = &inputs;
         let per_state = m + 3 * m * m;

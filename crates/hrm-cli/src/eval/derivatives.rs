@@ -29,8 +29,9 @@ pub(super) struct RneaDerivativesRequest {
 pub(super) fn rnea_derivatives(request: RneaDerivativesRequest) -> EvalResult {
     let chain = chain(&request.arm)?;
     joint_vectors(
-        &chain,
-        [
+        chain.n_links(),
+        "link",
+        &[
             ("theta", &request.theta),
             ("theta_dot", &request.theta_dot),
             ("theta_ddot", &request.theta_ddot),
@@ -63,8 +64,9 @@ pub(super) struct AbaDerivativesRequest {
 pub(super) fn aba_derivatives(request: AbaDerivativesRequest) -> EvalResult {
     let chain = chain(&request.arm)?;
     joint_vectors(
-        &chain,
-        [
+        chain.n_links(),
+        "link",
+        &[
             ("theta", &request.theta),
             ("theta_dot", &request.theta_dot),
             ("tau", &request.tau),
@@ -135,16 +137,17 @@ fn chain(arm: &ArmSpec) -> Result<ChainModel, EvalError> {
     Ok(chain)
 }
 
-/// Each joint-space vector has one entry per link (named by its request field).
-fn joint_vectors<const N: usize>(
-    chain: &ChainModel,
-    vectors: [(&str, &Vec<f64>); N],
+/// Each joint-space vector (named by its request field) has `n` entries, one per `unit` (a link
+/// of an arm, a movable joint of a URDF chain).
+pub(super) fn joint_vectors(
+    n: usize,
+    unit: &str,
+    vectors: &[(&str, &[f64])],
 ) -> Result<(), EvalError> {
-    let n = chain.n_links();
     for (name, values) in vectors {
         if values.len() != n {
             return Err(EvalError::input(format!(
-                "{name} has {} entries, expected {n} (one per link)",
+                "{name} has {} entries, expected {n} (one per {unit})",
                 values.len()
             )));
         }

@@ -9,7 +9,7 @@ use serde::Deserialize;
 use serde_json::json;
 use sim_study::ArmSpec;
 
-use super::derivatives::{MAX_DERIVATIVE_LINKS, aba_answer, rnea_answer, rows};
+use super::derivatives::{MAX_DERIVATIVE_LINKS, aba_answer, joint_vectors, rnea_answer, rows};
 use super::request::{EvalError, EvalResult, Kind, finite, json_fields};
 use lane_math::Classify;
 use manip_dyn::DynError;
@@ -71,19 +71,6 @@ fn joint_named(urdf: &str, error: DynError) -> EvalError {
     }
 }
 
-/// Each vector has one entry per movable joint.
-fn joint_vectors(n: usize, vectors: &[(&str, &[f64])]) -> Result<(), EvalError> {
-    for (name, values) in vectors {
-        if values.len() != n {
-            return Err(EvalError::input(format!(
-                "{name} has {} entries, expected {n} (one per movable joint)",
-                values.len()
-            )));
-        }
-    }
-    Ok(())
-}
-
 /// `dynamics` of a URDF chain.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -100,6 +87,7 @@ pub(super) fn dynamics(request: DynamicsRequest) -> EvalResult {
     let n = model.n_links();
     joint_vectors(
         n,
+        "movable joint",
         &[("theta", &request.theta), ("theta_dot", &request.theta_dot)],
     )?;
     let mut data = SpatialData::new(&model);
@@ -139,6 +127,7 @@ pub(super) fn rnea_derivatives(request: RneaDerivativesRequest) -> EvalResult {
     let model = model(&request.urdf, request.gravity)?;
     joint_vectors(
         model.n_links(),
+        "movable joint",
         &[
             ("theta", &request.theta),
             ("theta_dot", &request.theta_dot),
@@ -174,6 +163,7 @@ pub(super) fn aba_derivatives(request: AbaDerivativesRequest) -> EvalResult {
     let model = model(&request.urdf, request.gravity)?;
     joint_vectors(
         model.n_links(),
+        "movable joint",
         &[
             ("theta", &request.theta),
             ("theta_dot", &request.theta_dot),
@@ -210,7 +200,11 @@ pub(super) struct FramesRequest {
 /// base frame.
 pub(super) fn frames(request: FramesRequest) -> EvalResult {
     let model = model(&request.urdf, None)?;
-    joint_vectors(model.n_links(), &[("theta", &request.theta)])?;
+    joint_vectors(
+        model.n_links(),
+        "movable joint",
+        &[("theta", &request.theta)],
+    )?;
     let mut data = SpatialData::new(&model);
     spatial::forward_kinematics(&model, &mut data, &request.theta)?;
     let poses: Vec<_> = (0..model.n_links())

@@ -35,6 +35,22 @@ fn fails(args: &[&str]) -> String {
     err
 }
 
+/// `hrm arm export SOURCE --format mjcf --out OUT` with the `extra` flags, then the text of the
+/// file `OUT/FILE` it wrote.
+fn export_mjcf(source: &str, out: &Path, extra: &[&str], file: &str) -> String {
+    let args = [
+        "arm",
+        "export",
+        source,
+        "--format",
+        "mjcf",
+        "--out",
+        path(out),
+    ];
+    succeeds(&[&args[..], extra].concat());
+    std::fs::read_to_string(out.join(file)).unwrap()
+}
+
 /// The chain a URDF file holds.
 fn robot(file: &Path) -> Robot {
     read_urdf(&std::fs::read_to_string(file).unwrap())
@@ -127,16 +143,7 @@ fn an_exported_urdf_reads_back_to_the_same_chain_bit_for_bit() {
 fn the_mjcf_export_carries_gravity_and_every_joint() {
     let dir = scratch("arm-export-mjcf");
     let out = dir.join("urdf");
-    succeeds(&[
-        "arm",
-        "export",
-        path(&example()),
-        "--format",
-        "mjcf",
-        "--out",
-        path(&out),
-    ]);
-    let mjcf = std::fs::read_to_string(out.join("arm7.xml")).unwrap();
+    let mjcf = export_mjcf(path(&example()), &out, &[], "arm7.xml");
     assert!(
         mjcf.contains("<option gravity=\"0.0 0.0 -9.81\"/>"),
         "{mjcf}"
@@ -144,34 +151,19 @@ fn the_mjcf_export_carries_gravity_and_every_joint() {
     assert_eq!(mjcf.matches("<joint ").count(), 7, "{mjcf}");
     // A given gravity replaces ROS's default.
     let tilted = dir.join("tilted");
-    succeeds(&[
-        "arm",
-        "export",
+    let mjcf = export_mjcf(
         path(&example()),
-        "--format",
-        "mjcf",
-        "--out",
-        path(&tilted),
-        "--gravity",
-        "1,0,-9",
-    ]);
-    let mjcf = std::fs::read_to_string(tilted.join("arm7.xml")).unwrap();
+        &tilted,
+        &["--gravity", "1,0,-9"],
+        "arm7.xml",
+    );
     assert!(
         mjcf.contains("<option gravity=\"1.0 0.0 -9.0\"/>"),
         "{mjcf}"
     );
     // The paper's planar arm: in the base's x-y plane, joints about z, gravity along -y.
     let planar = dir.join("planar");
-    succeeds(&[
-        "arm",
-        "export",
-        "paper-tracking",
-        "--format",
-        "mjcf",
-        "--out",
-        path(&planar),
-    ]);
-    let mjcf = std::fs::read_to_string(planar.join("hrm_planar_arm.xml")).unwrap();
+    let mjcf = export_mjcf("paper-tracking", &planar, &[], "hrm_planar_arm.xml");
     assert!(
         mjcf.contains("<option gravity=\"0.0 -9.81 0.0\"/>"),
         "{mjcf}"
@@ -187,16 +179,7 @@ fn a_chain_past_the_nesting_limit_is_split_into_included_files() {
     let urdf = dir.join("long.urdf");
     std::fs::write(&urdf, long_chain(n)).unwrap();
     let out = dir.join("out");
-    succeeds(&[
-        "arm",
-        "export",
-        path(&urdf),
-        "--format",
-        "mjcf",
-        "--out",
-        path(&out),
-    ]);
-    let main = std::fs::read_to_string(out.join("long.xml")).unwrap();
+    let main = export_mjcf(path(&urdf), &out, &[], "long.xml");
     assert!(
         main.contains("<include file=\"long-part1.xml\"/>"),
         "{main}"
