@@ -1,11 +1,19 @@
 //! The joint-torque polytope as step constraints: at a modal state the joint torques that
 //! realise a modal torque are affine in it, `tau = A tau* + b` (eqs 13 and 15), so
-//! `|tau_j| <= limit_j` is `2n` linear rows on `tau*` ([`StepConstraints`]).
+//! `|tau_j| <= limit_j` is `2n` linear rows on `tau*` ([`StepConstraints`]), with their state
+//! Jacobian in closed form on a planar arm.
 
 use crate::OptimalError;
 use crate::step_constraints::StepConstraints;
 use lane_math::dense::{cholesky, cholesky_solve};
-use modal_reduce::{Plant, PlantData, ReduceError};
+use manip_dyn::{ChainData, DerivativeData, rnea_derivatives};
+use modal_reduce::{
+    Plant, PlantData, ReduceError, ReducedDerivatives, ReducedModel, reduced_derivatives,
+};
+
+/// The most joints of a planar arm whose rows get their state Jacobian in closed form: it
+/// costs `O(n^2 m)` against the forward differences' `O(n m^3)`, and its workspace `O(n^2)`.
+const CLOSED_FORM_MAX_JOINTS: usize = 64;
 
 /// The limits `|tau_j| <= limit_j` of a modal arm and the working memory that writes their rows
 /// at a state, without the arm: [`rows`](Self::rows) takes it at each call, so a controller that
@@ -22,6 +30,38 @@ pub struct JointTorqueLimits {
     a_ddot: Vec<f64>,
     bias: Vec<f64>,
     tau: Vec<f64>,
+    /// The closed-form state Jacobian's workspace (a planar arm of at most
+    /// [`CLOSED_FORM_MAX_JOINTS`] joints).
+    derivatives: Option<TorqueDerivatives>,
+}
+
+/// The workspace of [`JointTorqueLimits::state_jacobian`] on a planar arm.
+#[derive(Debug, Clone)]
+struct TorqueDerivatives {
+    reduced: ReducedDerivatives,
+    chain: ChainData,
+    rnea: DerivativeData,
+    /// The joint angles, rates and accelerations (`n` each).
+    theta: Vec<f64>,
+    theta_dot: Vec<f64>,
+    theta_ddot: Vec<f64>,
+    /// `d theta_ddot / dx = J [d a_ddot/d a | d a_ddot/d a_dot]` (`n x 2m`, row-major).
+    accel: Vec<f64>,
+}
+
+impl TorqueDerivatives {
+    fn new(model: &ReducedModel) -> Self {
+        let (n, m) = (model.n_links(), model.n_coords());
+        Self {
+            reduced: ReducedDerivatives::new(model),
+            chain: ChainData::new(model.chain()),
+            rnea: DerivativeData::new(model.chain()),
+            theta: vec![0.0; n],
+            theta_dot: vec![0.0; n],
+            theta_ddot: vec![0.0; n],
+            accel: vec![0.0; n * 2 * m],
+        }
+    }
 }
 
 impl JointTorqueLimits {
@@ -55,6 +95,10 @@ impl JointTorqueLimits {
             a_ddot: vec![0.0; m],
             bias: vec![0.0; n],
             tau: vec![0.0; n],
+            derivatives: plant
+                .planar()
+                .filter(|model| model.n_links() <= CLOSED_FORM_MAX_JOINTS)
+                .map(TorqueDerivatives::new),
         })
     }
 
@@ -106,6 +150,77 @@ impl JointTorqueLimits {
             bounds[2 * j + 1] = limit + bias;
         }
         Ok(self.max_rows())
+    }
+
+    /// Writes the state Jacobian `D = d(G u - g)/dx` of the rows of [`rows`](Self::rows) at
+    /// `x = (a, a_dot)` under the modal torque `u`, `2n x 2m` row-major (joint `j`'s upper row
+    /// `d tau_j/dx`, its lower row `-d tau_j/dx`), and returns `true`; `false`, writing nothing,
+    /// on a spatial arm or a planar one of more than 64 joints.
+    ///
+    /// `tau(x, u)` is the inverse dynamics (eq 13) at `theta = J a + theta_0`,
+    /// `theta_dot = J a_dot` and `theta_ddot = J a_ddot(x, u)` (eqs 8, 10, 11, 15), so
+    /// `d tau/d a = d_q tau J + M J d a_ddot/d a` and
+    /// `d tau/d a_dot = d_v tau J + M J d a_ddot/d a_dot`, from the chain's inverse-dynamics
+    /// derivatives ([`manip_dyn::rnea_derivatives`]: `d_q tau`, `d_v tau`, `M`) and the reduced
+    /// forward dynamics' ([`modal_reduce::reduced_derivatives`]).
+    ///
+    /// # Errors
+    /// [`OptimalError::Dynamics`] or [`OptimalError::ChainDynamics`] when `plant` refuses the
+    /// state or the torque or is not the arm these limits were made for.
+    pub fn state_jacobian(
+        &mut self,
+        plant: Plant<'_>,
+        x: &[f64],
+        u: &[f64],
+        jacobian: &mut [f64],
+    ) -> Result<bool, OptimalError> {
+        let (Plant::Planar(model), PlantData::Planar(data), Some(work)) =
+            (plant, &mut self.data, self.derivatives.as_mut())
+        else {
+            return Ok(false);
+        };
+        let (n, m) = (self.limits.len(), self.a_ddot.len());
+        let nx = 2 * m;
+        let (a, a_dot) = (&x[..m], &x[m..nx]);
+        reduced_derivatives(model, data, &mut work.reduced, a, a_dot, u)?;
+        let map = model.map();
+        map.joint_angles(a, &mut work.theta)
+            .map_err(ReduceError::from)?;
+        map.joint_rates(a_dot, &mut work.theta_dot)
+            .map_err(ReduceError::from)?;
+        map.joint_rates(work.reduced.a_ddot(), &mut work.theta_ddot)
+            .map_err(ReduceError::from)?;
+        rnea_derivatives(
+            model.chain(),
+            &mut work.chain,
+            &mut work.rnea,
+            &work.theta,
+            &work.theta_dot,
+            &work.theta_ddot,
+        )?;
+        let (d_a, d_a_dot) = (work.reduced.d_a(), work.reduced.d_a_dot());
+        for (k, accel) in work.accel.chunks_exact_mut(nx).enumerate() {
+            let row = map.row(k);
+            for c in 0..m {
+                accel[c] = (0..m).map(|i| row[i] * d_a[(i, c)]).sum();
+                accel[m + c] = (0..m).map(|i| row[i] * d_a_dot[(i, c)]).sum();
+            }
+        }
+        let (d_q, d_v, mass) = (work.rnea.d_q(), work.rnea.d_v(), work.rnea.d_input());
+        for j in 0..n {
+            for c in 0..nx {
+                // Column c of x is a_c (through d_q tau) or a_dot_{c - m} (through d_v tau).
+                let (partial, coord) = if c < m { (d_q, c) } else { (d_v, c - m) };
+                let d: f64 = (0..n)
+                    .map(|k| {
+                        partial[(j, k)] * map.row(k)[coord] + mass[(j, k)] * work.accel[k * nx + c]
+                    })
+                    .sum();
+                jacobian[2 * j * nx + c] = d;
+                jacobian[(2 * j + 1) * nx + c] = -d;
+            }
+        }
+        Ok(true)
     }
 
     /// `M*^-1 [e_1 ... e_m, -(C* + G*)]` at `(a, a_dot)` into `self.solves` (eq 15).
@@ -177,5 +292,16 @@ impl StepConstraints for JointTorqueRows<'_> {
         bounds: &mut [f64],
     ) -> Result<usize, OptimalError> {
         self.limits.rows(self.plant, x, rows, bounds)
+    }
+
+    fn analytic_state_jacobian(
+        &mut self,
+        _k: usize,
+        x: &[f64],
+        u: &[f64],
+        _b: &[f64],
+        jacobian: &mut [f64],
+    ) -> Result<bool, OptimalError> {
+        self.limits.state_jacobian(self.plant, x, u, jacobian)
     }
 }

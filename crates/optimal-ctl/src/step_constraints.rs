@@ -36,13 +36,32 @@ pub trait StepConstraints {
     ) -> Result<usize, OptimalError>;
 
     /// Whether the feedback gain takes in the rows' state dependence: their state Jacobian
-    /// `D = d(G u - g)/dx` by forward differences, `n_x` more calls of [`rows`](Self::rows) at
-    /// each node of every iteration. Without it the gain keeps the active rows active only
+    /// `D = d(G u - g)/dx` ([`analytic_state_jacobian`](Self::analytic_state_jacobian), or by
+    /// forward differences, `n_x` more calls of [`rows`](Self::rows) at each node of every
+    /// iteration). Without it the gain keeps the active rows active only
     /// where their bounds do not move with the state, and where they do, a forward pass's
     /// projection undoes the feedback and the line search may find no decrease. `true`
     /// unless said otherwise, for rows too costly to evaluate `n_x + 1` times a node.
     fn state_jacobian(&self) -> bool {
         true
+    }
+
+    /// Writes the state Jacobian `D = d(G u - g)/dx` (`r x n_x`, row-major) of the `r` rows
+    /// that [`rows`](Self::rows) last wrote, at the same `(k, x, u, b)`, in closed form and
+    /// returns `true`; or returns `false`, writing nothing, for rows without one (the solve
+    /// then takes forward differences). `false` unless said otherwise.
+    ///
+    /// # Errors
+    /// Whatever the model refuses at `x`.
+    fn analytic_state_jacobian(
+        &mut self,
+        _k: usize,
+        _x: &[f64],
+        _u: &[f64],
+        _b: &[f64],
+        _jacobian: &mut [f64],
+    ) -> Result<bool, OptimalError> {
+        Ok(false)
     }
 }
 
@@ -65,9 +84,9 @@ pub(crate) struct ConstrainedWork {
     pub(crate) rows: Vec<f64>,
     pub(crate) bounds: Vec<f64>,
     pub(crate) counts: Vec<usize>,
-    /// Per step: `D = d(G u - g)/dx` of each row at the nominal `(x, u)` (`max_rows x n_x`), by
-    /// forward differences; zero where a perturbed state gave another number of rows or
-    /// another row in a row's place.
+    /// Per step: `D = d(G u - g)/dx` of each row at the nominal `(x, u)` (`max_rows x n_x`), in
+    /// closed form or by forward differences; zero where a perturbed state gave another number
+    /// of rows or another row in a row's place.
     state_jacobians: Vec<f64>,
     /// A perturbed state and its rows.
     perturbed: Vec<f64>,
@@ -131,8 +150,9 @@ impl ConstrainedWork {
     }
 
     /// Evaluates the rows of step `k` at `(x, u)` with `b` into the step's storage, and their
-    /// state Jacobian `D = d(G u - g)/dx` by forward differences (`n_x` more evaluations) when
-    /// the constraints ask for it (zero otherwise).
+    /// state Jacobian `D = d(G u - g)/dx` when the constraints ask for it (zero otherwise): in
+    /// closed form where they have it, by forward differences (`n_x` more evaluations)
+    /// otherwise.
     pub(crate) fn evaluate(
         &mut self,
         constraints: &mut dyn StepConstraints,
@@ -153,7 +173,9 @@ impl ConstrainedWork {
         self.counts[k] = count;
         let jacobian = &mut self.state_jacobians[k * max * nx..(k + 1) * max * nx];
         jacobian.fill(0.0);
-        if !constraints.state_jacobian() {
+        if !constraints.state_jacobian()
+            || constraints.analytic_state_jacobian(k, x, u, b, &mut jacobian[..count * nx])?
+        {
             return Ok(());
         }
         let residual = |rows: &[f64], bounds: &[f64], r: usize| -> f64 {

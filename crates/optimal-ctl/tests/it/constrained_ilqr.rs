@@ -378,6 +378,69 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    /// `JointTorqueLimits::state_jacobian` (closed form) matches central differences of the
+    /// rows' residuals `G(x) u - g(x)` at a fixed modal torque `u` to 1e-6 of their scale on
+    /// the paper's arm with and without a free base angle, at random states and torques; on a
+    /// spatial arm it declines (`false`, the solve takes forward differences).
+    #[test]
+    fn the_joint_torque_rows_state_jacobian_matches_finite_differences(
+        x in proptest::collection::vec(-1.5f64..1.5, 6),
+        u in proptest::collection::vec(-2.0f64..2.0, 3),
+        free in any::<bool>(),
+    ) {
+        let planar_free = modal_reduce::ReducedModel::new(
+            manip_dyn::ChainModel::uniform(10, 0.1, 0.1, 9.81).unwrap(),
+            backbone_kin::ModalMap::paper(10).unwrap(),
+        )
+        .unwrap();
+        let planar = paper_arm();
+        let plant: modal_reduce::Plant<'_> =
+            if free { (&planar_free).into() } else { (&planar).into() };
+        let (n, m) = (plant.n_joints(), plant.n_coords());
+        let (x, u, nx) = (&x[..2 * m], &u[..m], 2 * m);
+        let limits: Vec<f64> = (0..n).map(|j| 1.0 + 0.1 * j as f64).collect();
+        let mut limits = optimal_ctl::JointTorqueLimits::new(plant, &limits).unwrap();
+        let mut jacobian = vec![0.0; 2 * n * nx];
+        prop_assert!(limits.state_jacobian(plant, x, u, &mut jacobian).unwrap());
+        let (mut g, mut bounds) = (vec![0.0; 2 * n * m], vec![0.0; 2 * n]);
+        let mut residuals = |x: &[f64]| -> Vec<f64> {
+            limits.rows(plant, x, &mut g, &mut bounds).unwrap();
+            (0..2 * n)
+                .map(|r| (0..m).map(|i| g[r * m + i] * u[i]).sum::<f64>() - bounds[r])
+                .collect()
+        };
+        let step = 1e-6;
+        let mut differences = vec![0.0; 2 * n * nx];
+        for c in 0..nx {
+            let (mut plus, mut minus) = (x.to_vec(), x.to_vec());
+            plus[c] += step;
+            minus[c] -= step;
+            let (up, down) = (residuals(&plus), residuals(&minus));
+            for r in 0..2 * n {
+                differences[r * nx + c] = (up[r] - down[r]) / (2.0 * step);
+            }
+        }
+        let scale = differences.iter().fold(1.0f64, |s, d| s.max(d.abs()));
+        for (analytic, difference) in jacobian.iter().zip(&differences) {
+            prop_assert!(
+                (analytic - difference).abs() <= 1e-6 * scale,
+                "{analytic} against {difference} (scale {scale})"
+            );
+        }
+        let spatial =
+            modal_reduce::spatial::SpatialReducedModel::uniform_rods(6, 1, 0.1, 0.1, [0.0, -9.81, 0.0])
+                .unwrap();
+        let plant: modal_reduce::Plant<'_> = (&spatial).into();
+        let (n, m) = (plant.n_joints(), plant.n_coords());
+        let mut limits = optimal_ctl::JointTorqueLimits::new(plant, &vec![1.0; n]).unwrap();
+        let mut jacobian = vec![7.0; 4 * n * m];
+        prop_assert!(!limits.state_jacobian(plant, &vec![0.1; 2 * m], &vec![0.0; m], &mut jacobian).unwrap());
+        prop_assert!(jacobian.iter().all(|&d| d == 7.0));
+    }
+}
+
 /// MPC on the paper's arm towards a bent shape: the unconstrained plan asks for joint torques
 /// beyond 3 N m; the plan within the joint-torque polytope keeps every node's joint torques
 /// (by RNEA, at the planned states) within them.
