@@ -199,25 +199,36 @@ impl JointTorqueLimits {
             &work.theta_ddot,
         )?;
         let (d_a, d_a_dot) = (work.reduced.d_a(), work.reduced.d_a_dot());
-        for (k, accel) in work.accel.chunks_exact_mut(nx).enumerate() {
-            let row = map.row(k);
+        let jac = map.jacobian();
+        for (row, accel) in jac.chunks_exact(m).zip(work.accel.chunks_exact_mut(nx)) {
             for c in 0..m {
                 accel[c] = (0..m).map(|i| row[i] * d_a[(i, c)]).sum();
                 accel[m + c] = (0..m).map(|i| row[i] * d_a_dot[(i, c)]).sum();
             }
         }
         let (d_q, d_v, mass) = (work.rnea.d_q(), work.rnea.d_v(), work.rnea.d_input());
-        for j in 0..n {
-            for c in 0..nx {
-                // Column c of x is a_c (through d_q tau) or a_dot_{c - m} (through d_v tau).
-                let (partial, coord) = if c < m { (d_q, c) } else { (d_v, c - m) };
-                let d: f64 = (0..n)
-                    .map(|k| {
-                        partial[(j, k)] * map.row(k)[coord] + mass[(j, k)] * work.accel[k * nx + c]
-                    })
-                    .sum();
-                jacobian[2 * j * nx + c] = d;
-                jacobian[(2 * j + 1) * nx + c] = -d;
+        for (j, rows) in jacobian.chunks_exact_mut(2 * nx).take(n).enumerate() {
+            let (upper, lower) = rows.split_at_mut(nx);
+            upper.fill(0.0);
+            let entries = d_q
+                .row(j)
+                .iter()
+                .zip(d_v.row(j).iter())
+                .zip(mass.row(j).iter());
+            for (((dq, dv), mk), (row, accel)) in
+                entries.zip(jac.chunks_exact(m).zip(work.accel.chunks_exact(nx)))
+            {
+                // d_q tau J and d_v tau J, then M J d a_ddot/dx.
+                for c in 0..m {
+                    upper[c] += dq * row[c];
+                    upper[m + c] += dv * row[c];
+                }
+                for (d, a) in upper.iter_mut().zip(accel) {
+                    *d += mk * a;
+                }
+            }
+            for (l, u) in lower.iter_mut().zip(upper.iter()) {
+                *l = -u;
             }
         }
         Ok(true)
