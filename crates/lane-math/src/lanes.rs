@@ -161,6 +161,23 @@ pub struct Pack<S: Simd> {
     value: S::f64s,
 }
 
+impl<S: Simd> Pack<S> {
+    /// The first `m` lanes (`m` at most the register's width) turned by `by`: lane `i < m` of the
+    /// result is lane `(i + by) % m` of `self`, the lanes from `m` on are zero. With `by` and `m`
+    /// constants the compiler makes it one permutation.
+    #[inline(always)]
+    pub fn rotate_lanes(self, by: usize, m: usize) -> Self {
+        let lanes: &[f64] = pulp::bytemuck::cast_slice(std::slice::from_ref(&self.value));
+        let mut out = Self::splat(self.simd, 0.0);
+        let turned: &mut [f64] =
+            pulp::bytemuck::cast_slice_mut(std::slice::from_mut(&mut out.value));
+        for (i, lane) in turned[..m].iter_mut().enumerate() {
+            *lane = lanes[(i + by) % m];
+        }
+        out
+    }
+}
+
 impl<S: Simd> Add for Pack<S> {
     type Output = Self;
 
@@ -510,6 +527,36 @@ mod tests {
         Arch::new().dispatch(Check);
         // The instruction-set-free fallback too.
         Check.with_simd(pulp::Scalar::new());
+    }
+
+    /// [`Pack::rotate_lanes`] against the index rule, every width `m` and turn `by`.
+    struct Rotate;
+
+    impl WithSimd for Rotate {
+        type Output = ();
+
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, simd: S) {
+            let width = Pack::<S>::WIDTH;
+            let lanes: Vec<f64> = (0..width).map(|i| 10.0 + i as f64).collect();
+            let pack = Pack::load(simd, &lanes);
+            for m in 1..=width {
+                for by in 0..=m {
+                    let mut got = vec![f64::NAN; width];
+                    pack.rotate_lanes(by, m).store(&mut got);
+                    for (i, &x) in got.iter().enumerate() {
+                        let want = if i < m { lanes[(i + by) % m] } else { 0.0 };
+                        assert_eq!(x, want, "lane {i} of {width}, m = {m}, by = {by}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rotate_lanes_turns_the_first_m_lanes_and_zeroes_the_rest() {
+        Arch::new().dispatch(Rotate);
+        Rotate.with_simd(pulp::Scalar::new());
     }
 
     #[test]

@@ -33,9 +33,10 @@
 //!   trigonometry left.
 //! - The pass (`accumulate`) is written once over the planar kernel's register layouts
 //!   (`Registers`): one state of `m = 4` or `8` coordinates holds each row of the Jacobians, of
-//!   `M*`, `C*` and `G*` in one register (`CoordinateLanes`), so that a row's update is one
-//!   vector operation (`m = 4` in registers of 4 lanes: AVX2 rather than AVX-512, see
-//!   `SpatialReducedData`'s instruction set); more coordinates go one a number (`OneStateScalar`); a batch holds one coordinate of several states a register
+//!   `C*` and `G*` and each diagonal of `M*` in one register (`CoordinateLanes`, `MassRows`),
+//!   so that a row's update is one vector operation (`m = 4` in registers of 4 lanes: AVX2
+//!   rather than AVX-512, see `SpatialReducedData`'s instruction set); more coordinates go one a
+//!   number (`OneStateScalar`); a batch holds one coordinate of several states a register
 //!   (`StateLanes`). Each entry gets the same operations in the same order in all of them, so a
 //!   state gives the same bits alone and in a batch.
 //! - The rows of `J` per link (`[P_i, 0]`, `[0, P_i]`) are constants of the model, loaded as
@@ -686,13 +687,6 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
     }
 }
 
-/// The registers of row `k` of `M*` that hold entries `(k, l)` with `l <= k`: all (one) when a
-/// register holds every coordinate, else `k + 1` (one coordinate a register).
-#[inline(always)]
-fn lower_chunks(chunks: usize, k: usize) -> usize {
-    if chunks == 1 { 1 } else { k + 1 }
-}
-
 /// `[x, y, z]` in every coordinate of a register each.
 #[inline(always)]
 fn spread<Y: Registers>(layout: Y, values: [Y::Value; 3]) -> [Y::Register; 3] {
@@ -703,29 +697,24 @@ fn spread<Y: Registers>(layout: Y, values: [Y::Value; 3]) -> [Y::Register; 3] {
     ]
 }
 
-/// Coordinate `k` of the three rows of a `3 x c` matrix of registers.
+/// The coordinates `(p, q)` whose products `left_p right_q` make entry `(k, l)`, `l <= k`, of
+/// `M*`'s sum of outer products (each term symmetric, so either order is the entry): `(l, k)`
+/// when `k - l <= m / 2`, else `(k, l)`. These are the products [`CoordinateLanes`] forms on its
+/// diagonals (lane `l` of diagonal `k - l`, or lane `k` of diagonal `m - (k - l)`), so that every
+/// layout gives each entry the same operations.
 #[inline(always)]
-fn coordinate<Y: Registers>(
-    layout: Y,
-    matrix: &[Y::Register],
-    chunks: usize,
-    k: usize,
-) -> [Y::Value; 3] {
-    [
-        layout.coordinate(&matrix[..chunks], k),
-        layout.coordinate(&matrix[chunks..2 * chunks], k),
-        layout.coordinate(&matrix[2 * chunks..], k),
-    ]
+fn product_coordinates(m: usize, k: usize, l: usize) -> (usize, usize) {
+    if k - l <= m / 2 { (l, k) } else { (k, l) }
 }
 
 /// How a layout keeps `M*` and adds the link's `(m Jv)^T Jv + Jb^T I_b Jb` to it: by default
-/// row `k` in the layout's registers of `m` coordinates, its lower triangle updated a row at a
-/// time from coordinate `k` of `m Jv` and `Jb` spread over a register.
+/// one coordinate a register, entry `(k, l)` of the lower triangle at `k m + l`, each from the
+/// products [`product_coordinates`] names.
 pub(crate) trait MassRows: Registers {
     /// The registers `M*` takes for `m` coordinates.
     #[inline(always)]
     fn mass_len(self, m: usize) -> usize {
-        m * self.chunks(m)
+        m * m
     }
 
     /// `M* += sum_r a_r b_r^T` on the lower triangle (at least), over the rows `r` of
@@ -739,16 +728,12 @@ pub(crate) trait MassRows: Registers {
         right: [&[Self::Register]; 2],
         m: usize,
     ) {
-        let chunks = self.chunks(m);
+        debug_assert_eq!(self.chunks(m), m);
         for k in 0..m {
-            let a = [
-                spread(self, coordinate(self, left[0], chunks, k)),
-                spread(self, coordinate(self, left[1], chunks, k)),
-            ];
-            let row = &mut mass[k * chunks..(k + 1) * chunks];
-            for (l, entry) in row.iter_mut().enumerate().take(lower_chunks(chunks, k)) {
-                for (a, right) in a.iter().zip(right) {
-                    *entry = dot_add(*a, column(right, chunks, l), *entry);
+            for (l, entry) in mass[k * m..=k * m + k].iter_mut().enumerate() {
+                let (p, q) = product_coordinates(m, k, l);
+                for (left, right) in left.iter().zip(right) {
+                    *entry = dot_add(column(left, m, p), column(right, m, q), *entry);
                 }
             }
         }
@@ -757,12 +742,48 @@ pub(crate) trait MassRows: Registers {
     /// Entry `(k, l)` of `M*`, `l <= k`.
     #[inline(always)]
     fn mass_entry(self, mass: &[Self::Register], m: usize, k: usize, l: usize) -> Self::Value {
-        let chunks = self.chunks(m);
-        self.coordinate(&mass[k * chunks..(k + 1) * chunks], l)
+        self.coordinate(&mass[k * m..(k + 1) * m], l)
     }
 }
 
-impl<S: Simd> MassRows for CoordinateLanes<S> {}
+/// All coordinates of a row in one register: `M*` kept as its diagonals `D_j`, lane `i` the
+/// entry `(i, (i + j) mod m)`, for `j = 0..=m/2` (the others are these by symmetry). A link adds
+/// `a_r * (b_r turned by j lanes)` to each: one multiply-add and one permutation a diagonal and
+/// row, where rows of `M*` would take a broadcast of each coordinate.
+impl<S: Simd> MassRows for CoordinateLanes<S> {
+    #[inline(always)]
+    fn mass_len(self, m: usize) -> usize {
+        m / 2 + 1
+    }
+
+    #[inline(always)]
+    fn add_outers(
+        self,
+        mass: &mut [Pack<S>],
+        left: [&[Pack<S>]; 2],
+        right: [&[Pack<S>]; 2],
+        m: usize,
+    ) {
+        let diagonals = &mut mass[..=m / 2];
+        for (left, right) in left.iter().zip(right) {
+            for (&a, &b) in left[..3].iter().zip(&right[..3]) {
+                for (j, diagonal) in diagonals.iter_mut().enumerate() {
+                    *diagonal = a.mul_add(b.rotate_lanes(j, m), *diagonal);
+                }
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn mass_entry(self, mass: &[Pack<S>], m: usize, k: usize, l: usize) -> f64 {
+        let d = k - l;
+        if d <= m / 2 {
+            mass[d].lane(l)
+        } else {
+            mass[m - d].lane(k)
+        }
+    }
+}
 
 impl<S: Simd> MassRows for OneStateScalar<S> {}
 
