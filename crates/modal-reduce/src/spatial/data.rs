@@ -43,23 +43,9 @@ pub struct SpatialReducedData {
     pub(crate) solution: Vec<f64>,
     /// Every link's motion, for the backward pass of the joint torques.
     pub(crate) links: Vec<LinkMotion>,
-    /// The instruction set the terms' kernel is dispatched to ([`one_state_arch`], found at
-    /// construction).
+    /// The processor's instruction set, found at construction (the terms' kernel runs on it as
+    /// `terms::dispatch_one_state` says).
     pub(crate) arch: Arch,
-}
-
-/// The instruction set for one state of `m` coordinates: the processor's best, but AVX2 rather
-/// than AVX-512 for `m = 4`, whose rows fill a register of 4 lanes: measured faster (10 links
-/// about 255 against 288 ns a call, 100 links no slower) than AVX-512 with each row twice in a
-/// register of 8 lanes and two rows of `M*` a register, and than half-filled registers of 8
-/// lanes (about 350 ns); the same bits, as on every instruction set.
-fn one_state_arch(m: usize) -> Arch {
-    let arch = Arch::new();
-    #[cfg(target_arch = "x86_64")]
-    if let (4, Arch::V4(v4)) = (m, arch) {
-        return Arch::V3(*v4);
-    }
-    arch
 }
 
 impl SpatialReducedData {
@@ -97,7 +83,7 @@ impl SpatialReducedData {
             factor: vec![0.0; m * m],
             solution: vec![0.0; m],
             links: vec![zero_motion; n],
-            arch: one_state_arch(m),
+            arch: Arch::new(),
         }
     }
 

@@ -2,7 +2,7 @@
 
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
-use super::terms::{TermsOfOneState, check_shapes, check_state, check_terms};
+use super::terms::{TermsOfOneState, check_shapes, check_state, check_terms, dispatch_one_state};
 use crate::error::ReduceError;
 use lane_math::{check_all_finite, check_len};
 
@@ -26,13 +26,17 @@ pub fn spatial_forward_dynamics(
     check_len("a_ddot", a_ddot.len(), m)?;
     check_shapes(model, data, a, a_dot)?;
     let arch = data.arch;
-    let outcome = arch.dispatch(TermsOfOneState {
-        model,
-        data: &mut *data,
-        a,
-        a_dot,
-        solve: Some((tau_star, &mut *a_ddot)),
-    });
+    let outcome = dispatch_one_state(
+        arch,
+        m,
+        TermsOfOneState {
+            model,
+            data: &mut *data,
+            a,
+            a_dot,
+            solve: Some((tau_star, &mut *a_ddot)),
+        },
+    );
     if outcome.positive_definite && outcome.finite {
         return Ok(());
     }
