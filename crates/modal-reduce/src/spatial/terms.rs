@@ -50,7 +50,7 @@ use crate::forward::right_hand_side;
 use crate::model::LINK_PADDING;
 use crate::terms::{CoordinateLanes, OneStateScalar, Registers, StateLanes};
 use lane_math::dense::{ldlt_in_place, ldlt_solve_in_place};
-use lane_math::{Lane, Pack, check_len, check_values, sin_cos_lanes};
+use lane_math::{Lane, Pack, check_all_finite, check_len, sin_cos_lanes};
 use pulp::{Arch, Simd, WithSimd};
 use std::iter::Zip;
 use std::slice;
@@ -853,10 +853,9 @@ pub(crate) fn check_state(
     a: &[f64],
     a_dot: &[f64],
 ) -> Result<(), ReduceError> {
-    data.check_model(model)?;
-    let m = model.n_coords();
-    check_values("a", a, m)?;
-    check_values("a_dot", a_dot, m)?;
+    check_shapes(model, data, a, a_dot)?;
+    check_all_finite("a", a)?;
+    check_all_finite("a_dot", a_dot)?;
     Ok(())
 }
 
