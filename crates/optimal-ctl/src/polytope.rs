@@ -47,8 +47,10 @@ pub struct PolytopeProjection {
     z: Vec<f64>,
     w: Vec<f64>,
     passive: Vec<bool>,
-    /// The passive columns, in order.
+    /// The passive columns, in order: the first `n_passive` (room for every column, so that a
+    /// clone too never grows it).
     order: Vec<usize>,
+    n_passive: usize,
     /// The least-squares subproblem: matrix `(m + 1) x k`, right-hand side, solution.
     qr: Vec<f64>,
     rhs: Vec<f64>,
@@ -77,7 +79,8 @@ impl PolytopeProjection {
             z: vec![0.0; rows],
             w: vec![0.0; rows],
             passive: vec![false; rows],
-            order: Vec::with_capacity(rows),
+            order: vec![0; rows],
+            n_passive: 0,
             qr: vec![0.0; height * height],
             rhs: vec![0.0; height],
             residual: vec![0.0; height],
@@ -150,12 +153,12 @@ impl PolytopeProjection {
         let tolerance = 1e-12 * scale;
         self.u[..p].fill(0.0);
         self.passive[..p].fill(false);
-        self.order.clear();
+        self.n_passive = 0;
         for _ in 0..3 * p + 10 {
             // w = E^T (f - E u).
             self.residual.fill(0.0);
             self.residual[height - 1] = 1.0;
-            for &j in &self.order {
+            for &j in &self.order[..self.n_passive] {
                 let column = &self.e[j * height..(j + 1) * height];
                 for (r, c) in self.residual.iter_mut().zip(column) {
                     *r -= c * self.u[j];
@@ -168,7 +171,7 @@ impl PolytopeProjection {
                 if !self.passive[j]
                     && self.w[j] > tolerance
                     && best.is_none_or(|b: usize| self.w[j] > self.w[b])
-                    && self.order.len() < height
+                    && self.n_passive < height
                 {
                     best = Some(j);
                 }
@@ -177,39 +180,45 @@ impl PolytopeProjection {
                 return Ok(());
             };
             self.passive[entering] = true;
-            self.order.push(entering);
+            self.order[self.n_passive] = entering;
+            self.n_passive += 1;
             loop {
                 if !self.solve_passive() {
-                    // Dependent columns: the entering one adds nothing.
+                    // Dependent columns: the entering one (the last) adds nothing.
                     self.passive[entering] = false;
-                    self.order.retain(|&j| j != entering);
+                    self.n_passive -= 1;
                     return Ok(());
                 }
-                if self.order.iter().all(|&j| self.z[j] > 0.0) {
-                    for &j in &self.order {
+                let order = &self.order[..self.n_passive];
+                if order.iter().all(|&j| self.z[j] > 0.0) {
+                    for &j in order {
                         self.u[j] = self.z[j];
                     }
                     break;
                 }
                 let mut alpha = f64::INFINITY;
-                for &j in &self.order {
+                for &j in order {
                     if self.z[j] <= 0.0 {
                         alpha = alpha.min(self.u[j] / (self.u[j] - self.z[j]));
                     }
                 }
-                for &j in &self.order {
+                for &j in order {
                     self.u[j] += alpha * (self.z[j] - self.u[j]);
                 }
-                let (u, passive) = (&mut self.u, &mut self.passive);
-                self.order.retain(|&j| {
-                    let keep = u[j] > tolerance;
-                    if !keep {
-                        u[j] = 0.0;
-                        passive[j] = false;
+                // The passive variables that reached zero leave, the others keep their order.
+                let mut kept = 0;
+                for i in 0..self.n_passive {
+                    let j = self.order[i];
+                    if self.u[j] > tolerance {
+                        self.order[kept] = j;
+                        kept += 1;
+                    } else {
+                        self.u[j] = 0.0;
+                        self.passive[j] = false;
                     }
-                    keep
-                });
-                if self.order.is_empty() {
+                }
+                self.n_passive = kept;
+                if kept == 0 {
                     break;
                 }
             }
@@ -221,8 +230,8 @@ impl PolytopeProjection {
     /// `false` when the columns are numerically dependent.
     fn solve_passive(&mut self) -> bool {
         let height = self.m + 1;
-        let k = self.order.len();
-        for (c, &j) in self.order.iter().enumerate() {
+        let k = self.n_passive;
+        for (c, &j) in self.order[..k].iter().enumerate() {
             self.qr[c * height..(c + 1) * height]
                 .copy_from_slice(&self.e[j * height..(j + 1) * height]);
         }

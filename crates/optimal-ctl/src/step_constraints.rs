@@ -21,7 +21,8 @@ pub trait StepConstraints {
     /// (`r`), and returns `r <= max_rows()`. Called along the nominal trajectory before every
     /// backward pass (and, with [`state_jacobian`](Self::state_jacobian), at `n_x` states a
     /// small step from each nominal state: the same rows in the same order), and at every state
-    /// of a forward pass (with the nominal `b`).
+    /// of a forward pass (with the nominal `b`); see also
+    /// [`rows_of_state_and_control`](Self::rows_of_state_and_control).
     ///
     /// # Errors
     /// Whatever the model refuses at `x`.
@@ -63,6 +64,15 @@ pub trait StepConstraints {
     ) -> Result<bool, OptimalError> {
         Ok(false)
     }
+
+    /// Whether a step's rows, and their [`analytic_state_jacobian`](Self::analytic_state_jacobian),
+    /// are a function of `(k, x, u)` alone: not of `b`, nor of the calls before. The solve then
+    /// keeps the rows each forward pass wrote at each node and, once the pass is accepted,
+    /// takes them as the rows of the nodes whose control they did not move (the same `x` and
+    /// `u`, to the bit) instead of evaluating them again. `false` unless said otherwise.
+    fn rows_of_state_and_control(&self) -> bool {
+        false
+    }
 }
 
 /// Rows this far inside their bound count as active for the feedback gain (relative).
@@ -100,9 +110,13 @@ pub(crate) struct ConstrainedWork {
     qp: LinearQp,
     projection: PolytopeProjection,
     projected: Vec<f64>,
-    /// The rows at a forward pass's state (the nominal ones stay for the next backward pass).
+    /// Per step: the rows at the last forward pass's state (the nominal ones stay for the next
+    /// backward pass), their number (`None` where the pass wrote none), and the `(x, u)` they
+    /// were evaluated at (`n_x + n_u`).
     forward_rows: Vec<f64>,
     forward_bounds: Vec<f64>,
+    forward_counts: Vec<Option<usize>>,
+    forward_at: Vec<f64>,
     /// The gain's linear algebra: `H`'s factor, `X = H^-1 Q_ux`, the active rows `A`,
     /// `Y = H^-1 A^T`, `S = A Y` and `A X`.
     factor: Vec<f64>,
@@ -133,8 +147,10 @@ impl ConstrainedWork {
             qp: LinearQp::new(nu, total),
             projection: PolytopeProjection::new(nu, total),
             projected: vec![0.0; nu],
-            forward_rows: vec![0.0; max_rows * nu],
-            forward_bounds: vec![0.0; max_rows],
+            forward_rows: vec![0.0; horizon * max_rows * nu],
+            forward_bounds: vec![0.0; horizon * max_rows],
+            forward_counts: vec![None; horizon],
+            forward_at: vec![0.0; horizon * (nx + nu)],
             factor: vec![0.0; nu * nu],
             x_mat: vec![0.0; nu * nx],
             active: vec![0.0; nu * nu],
@@ -152,7 +168,9 @@ impl ConstrainedWork {
     /// Evaluates the rows of step `k` at `(x, u)` with `b` into the step's storage, and their
     /// state Jacobian `D = d(G u - g)/dx` when the constraints ask for it (zero otherwise): in
     /// closed form where they have it, by forward differences (`n_x` more evaluations)
-    /// otherwise.
+    /// otherwise. Rows of `(k, x, u)` alone
+    /// ([`rows_of_state_and_control`](StepConstraints::rows_of_state_and_control)) that the
+    /// last forward pass wrote at this `(x, u)` are copied, not evaluated again.
     pub(crate) fn evaluate(
         &mut self,
         constraints: &mut dyn StepConstraints,
@@ -162,7 +180,20 @@ impl ConstrainedWork {
         let (nx, nu, max) = (self.nx, self.nu, self.max_rows);
         let rows = &mut self.rows[k * max * nu..(k + 1) * max * nu];
         let bounds = &mut self.bounds[k * max..(k + 1) * max];
-        let count = constraints.rows(k, x, u, b, rows, bounds)?;
+        let at = &self.forward_at[k * (nx + nu)..(k + 1) * (nx + nu)];
+        let count = match self.forward_counts[k] {
+            Some(count)
+                if constraints.rows_of_state_and_control()
+                    && same_bits(&at[..nx], x)
+                    && same_bits(&at[nx..], u) =>
+            {
+                rows[..count * nu]
+                    .copy_from_slice(&self.forward_rows[k * max * nu..(k * max + count) * nu]);
+                bounds[..count].copy_from_slice(&self.forward_bounds[k * max..k * max + count]);
+                count
+            }
+            _ => constraints.rows(k, x, u, b, rows, bounds)?,
+        };
         if count > max {
             return Err(OptimalError::Dimension {
                 name: "step constraint rows",
@@ -374,7 +405,7 @@ impl ConstrainedWork {
 
     /// Moves `u` (`n_u`) to the closest control within the rows of step `k` at the forward
     /// pass's state `x` (with the nominal `b`) and the box: whether it moved, or `None` (`u`
-    /// kept) when no control is within.
+    /// kept) when no control is within. The rows stay as step `k`'s of the pass.
     pub(crate) fn project(
         &mut self,
         constraints: &mut dyn StepConstraints,
@@ -383,9 +414,16 @@ impl ConstrainedWork {
         box_bounds: (&[f64], &[f64]),
         u: &mut [f64],
     ) -> Result<Option<bool>, OptimalError> {
-        let (nu, max) = (self.nu, self.max_rows);
-        let count =
-            constraints.rows(k, x, u, b, &mut self.forward_rows, &mut self.forward_bounds)?;
+        let (nx, nu, max) = (self.nx, self.nu, self.max_rows);
+        self.forward_counts[k] = None;
+        let count = constraints.rows(
+            k,
+            x,
+            u,
+            b,
+            &mut self.forward_rows[k * max * nu..(k + 1) * max * nu],
+            &mut self.forward_bounds[k * max..(k + 1) * max],
+        )?;
         if count > max {
             return Err(OptimalError::Dimension {
                 name: "step constraint rows",
@@ -393,9 +431,20 @@ impl ConstrainedWork {
                 found: count,
             });
         }
+        self.forward_counts[k] = Some(count);
+        let at = &mut self.forward_at[k * (nx + nu)..(k + 1) * (nx + nu)];
+        at[..nx].copy_from_slice(x);
+        at[nx..].copy_from_slice(u);
         let rows = std::mem::take(&mut self.forward_rows);
         let bounds = std::mem::take(&mut self.forward_bounds);
-        let n = self.assemble((&rows[..count * nu], &bounds[..count]), None, box_bounds);
+        let n = self.assemble(
+            (
+                &rows[k * max * nu..(k * max + count) * nu],
+                &bounds[k * max..k * max + count],
+            ),
+            None,
+            box_bounds,
+        );
         self.forward_rows = rows;
         self.forward_bounds = bounds;
         match self.projection.project(
@@ -411,4 +460,9 @@ impl ConstrainedWork {
             Err(_) => Ok(None),
         }
     }
+}
+
+/// Whether `x` and `y` hold the same bits.
+fn same_bits(x: &[f64], y: &[f64]) -> bool {
+    x.iter().zip(y).all(|(x, y)| x.to_bits() == y.to_bits())
 }
