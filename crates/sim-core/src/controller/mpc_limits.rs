@@ -81,9 +81,9 @@ struct ClearanceRows {
     retain: f64,
     placement: Placement,
     /// The joints' gradient of one pair's clearance (`n` planar, `2n` spatial), and the modal
-    /// map's `J` (`joints x m`, row-major).
+    /// map's `J^T` (`m x joints`, row-major).
     joint_gradient: Vec<f64>,
-    jacobian: Vec<f64>,
+    jacobian_t: Vec<f64>,
     /// Per pair: the modal gradient of its clearance (`m`, filled for the candidates).
     gradients: Vec<f64>,
     /// Room for every pair as a candidate: each one's slack at the next node and its index.
@@ -433,16 +433,12 @@ impl ClearanceRows {
                 &mut self.joint_gradient,
             ),
         }
-        let out = &mut self.gradients[p * m..(p + 1) * m];
-        out.fill(0.0);
-        for (&g, row) in self
-            .joint_gradient
-            .iter()
-            .zip(self.jacobian.chunks_exact(m))
+        let joints = self.joint_gradient.len();
+        for (out, column) in self.gradients[p * m..(p + 1) * m]
+            .iter_mut()
+            .zip(self.jacobian_t.chunks_exact(joints))
         {
-            for (o, &entry) in out.iter_mut().zip(row) {
-                *o += entry * g;
-            }
+            *out = dot(column, &self.joint_gradient);
         }
         Ok(())
     }
@@ -536,6 +532,14 @@ fn joint_jacobian(plant: Plant<'_>) -> Result<Vec<f64>, SimError> {
     Ok(jacobian)
 }
 
+/// The transpose of `a` (row-major, `columns` columns).
+fn transpose(a: &[f64], columns: usize) -> Vec<f64> {
+    let rows = a.len().checked_div(columns).unwrap_or(0);
+    (0..columns)
+        .flat_map(|c| (0..rows).map(move |r| a[r * columns + c]))
+        .collect()
+}
+
 /// The clearance rows of `plant` among `model` with `margin`.
 fn clearance_rows(
     plant: Plant<'_>,
@@ -591,7 +595,7 @@ fn clearance_rows(
         retain: (-step / CLEARANCE_APPROACH_S).exp(),
         placement,
         joint_gradient: vec![0.0; plant.n_joints()],
-        jacobian: joint_jacobian(plant)?,
+        jacobian_t: transpose(&joint_jacobian(plant)?, m),
         gradients: vec![0.0; pairs * m],
         candidates: vec![(0.0, 0); pairs],
         pairs: vec![0; pairs.min(MAX_CLEARANCE_ROWS)],
