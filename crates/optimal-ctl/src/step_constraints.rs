@@ -8,7 +8,7 @@
 
 use crate::OptimalError;
 use crate::linear_qp::{LinearQp, LinearQpFailure};
-use crate::polytope::PolytopeProjection;
+use crate::polytope::{PolytopeProjection, ProjectionFailure};
 use lane_math::dense::{cholesky, cholesky_solve};
 
 /// The constraints `G u_k <= g` of every step of a constrained [`Ilqr`](crate::Ilqr) solve.
@@ -111,12 +111,17 @@ pub(crate) struct ConstrainedWork {
     projection: PolytopeProjection,
     projected: Vec<f64>,
     /// Per step: the rows at the last forward pass's state (the nominal ones stay for the next
-    /// backward pass), their number (`None` where the pass wrote none), and the `(x, u)` they
-    /// were evaluated at (`n_x + n_u`).
+    /// backward pass), their number (`None` where the pass wrote none), the `(x, u)` they
+    /// were evaluated at (`n_x + n_u`), and whether their projection found them and the box
+    /// empty.
     forward_rows: Vec<f64>,
     forward_bounds: Vec<f64>,
     forward_counts: Vec<Option<usize>>,
     forward_at: Vec<f64>,
+    forward_empty: Vec<bool>,
+    /// Per step: whether the nominal rows are known to admit no control within the box (they
+    /// are a forward pass's rows whose projection found none).
+    empty: Vec<bool>,
     /// The gain's linear algebra: `H`'s factor, `X = H^-1 Q_ux`, the active rows `A`,
     /// `Y = H^-1 A^T`, `S = A Y` and `A X`.
     factor: Vec<f64>,
@@ -151,6 +156,8 @@ impl ConstrainedWork {
             forward_bounds: vec![0.0; horizon * max_rows],
             forward_counts: vec![None; horizon],
             forward_at: vec![0.0; horizon * (nx + nu)],
+            forward_empty: vec![false; horizon],
+            empty: vec![false; horizon],
             factor: vec![0.0; nu * nu],
             x_mat: vec![0.0; nu * nx],
             active: vec![0.0; nu * nu],
@@ -190,9 +197,13 @@ impl ConstrainedWork {
                 rows[..count * nu]
                     .copy_from_slice(&self.forward_rows[k * max * nu..(k * max + count) * nu]);
                 bounds[..count].copy_from_slice(&self.forward_bounds[k * max..k * max + count]);
+                self.empty[k] = self.forward_empty[k];
                 count
             }
-            _ => constraints.rows(k, x, u, b, rows, bounds)?,
+            _ => {
+                self.empty[k] = false;
+                constraints.rows(k, x, u, b, rows, bounds)?
+            }
         };
         if count > max {
             return Err(OptimalError::Dimension {
@@ -299,7 +310,8 @@ impl ConstrainedWork {
     /// `X = H^-1 Q_ux`, that keeps the active rows `A` active to first order as the state moves
     /// (`A K = -D`, `D` their state Jacobian; zero when they leave no freedom): the box QP's
     /// "zero gain on the clamped controls", for any rows. `false` (and `ff`, `gain` unset) when
-    /// the rows and the box admit no control.
+    /// the rows and the box admit no control: known without a QP for rows that a forward
+    /// pass's projection found so (the same rows and box, translated by `u`).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn feedforward(
         &mut self,
@@ -311,6 +323,9 @@ impl ConstrainedWork {
         gain: &mut [f64],
     ) -> Result<bool, OptimalError> {
         let (nx, nu, max) = (self.nx, self.nu, self.max_rows);
+        if self.empty[k] {
+            return Ok(false);
+        }
         let count = self.counts[k];
         let rows = std::mem::take(&mut self.rows);
         let step_bounds = std::mem::take(&mut self.bounds);
@@ -416,6 +431,7 @@ impl ConstrainedWork {
     ) -> Result<Option<bool>, OptimalError> {
         let (nx, nu, max) = (self.nx, self.nu, self.max_rows);
         self.forward_counts[k] = None;
+        self.forward_empty[k] = false;
         let count = constraints.rows(
             k,
             x,
@@ -457,7 +473,10 @@ impl ConstrainedWork {
                 u.copy_from_slice(&self.projected);
                 Ok(Some(moved))
             }
-            Err(_) => Ok(None),
+            Err(failure) => {
+                self.forward_empty[k] = failure == ProjectionFailure::Empty;
+                Ok(None)
+            }
         }
     }
 }

@@ -653,8 +653,10 @@ impl StepConstraints for Moving {
 }
 
 /// Rows of `(k, x, u)` alone that a forward pass wrote at the state and control an accepted
-/// pass keeps are reused, not evaluated again: the same plan to the bit, with fewer
-/// evaluations, with and without the rows' state Jacobian (by forward differences).
+/// pass keeps are reused, not evaluated again (nor their QP, where the projection found them
+/// empty): the same plan and relaxed nodes to the bit, with fewer evaluations, with and
+/// without the rows' state Jacobian (by forward differences), for rows active at many steps
+/// and for rows that admit no control while `x_1 < 0.5`.
 #[test]
 fn rows_of_the_accepted_forward_pass_are_reused_to_the_bit() {
     let cost = TrackingCost {
@@ -668,7 +670,15 @@ fn rows_of_the_accepted_forward_pass_are_reused_to_the_bit() {
         tolerance: 1e-14,
         ..IlqrSettings::default()
     };
-    for jacobian in [false, true] {
+    let cases = [
+        // u_1 + u_2 <= 0.4 + 0.2 x_1 and -u_1 <= 0.3 + 0.2 x_1: active at many steps.
+        (vec![1.0, 1.0, -1.0, 0.0], vec![0.4, 0.3], false),
+        // u_1 <= 0.1 + 0.2 x_1 and u_1 >= 0.3 - 0.2 x_1: empty while x_1 < 0.5.
+        (vec![1.0, 0.0, -1.0, 0.0], vec![0.1, -0.3], true),
+    ];
+    for ((g, bounds, empty), jacobian) in
+        cases.iter().flat_map(|case| [(case, false), (case, true)])
+    {
         let plan = |reusable: bool| {
             let mut sys = Linear {
                 a: vec![1.0, 0.1, -0.05, 0.98],
@@ -677,10 +687,9 @@ fn rows_of_the_accepted_forward_pass_are_reused_to_the_bit() {
                 nu: 2,
             };
             let mut rows = Moving {
-                // u_1 + u_2 <= 0.4 + 0.2 x_1 and -u_1 <= 0.3 + 0.2 x_1: active at many steps.
                 fixed: Fixed {
-                    rows: vec![1.0, 1.0, -1.0, 0.0],
-                    bounds: vec![0.4, 0.3],
+                    rows: g.clone(),
+                    bounds: bounds.clone(),
                 },
                 slope: 0.2,
                 reusable,
@@ -694,12 +703,19 @@ fn rows_of_the_accepted_forward_pass_are_reused_to_the_bit() {
                 .solve_constrained(&mut sys, &mut rows, &[0.0, 0.0], &settings)
                 .unwrap();
             assert!(report.iterations > 1, "{report:?}");
+            assert_eq!(report.relaxed_nodes > 0, *empty, "{report:?}");
             let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-            (bits(ilqr.controls()), bits(ilqr.states()), rows.calls)
+            (
+                bits(ilqr.controls()),
+                bits(ilqr.states()),
+                rows.calls,
+                report.relaxed_nodes,
+            )
         };
         let (fresh, reused) = (plan(false), plan(true));
         assert_eq!(fresh.0, reused.0, "controls (jacobian {jacobian})");
         assert_eq!(fresh.1, reused.1, "states (jacobian {jacobian})");
+        assert_eq!(fresh.3, reused.3, "relaxed nodes (jacobian {jacobian})");
         assert!(
             reused.2 < fresh.2,
             "{} evaluations reused vs {} fresh (jacobian {jacobian})",
