@@ -320,4 +320,8 @@ impl StepConstraints for JointTorqueRows<'_> {
     fn rows_of_state_and_control(&self) -> bool {
         true
     }
+
+    fn rows_of_state(&self) -> bool {
+        true
+    }
 }

@@ -73,6 +73,13 @@ pub trait StepConstraints {
     fn rows_of_state_and_control(&self) -> bool {
         false
     }
+
+    /// Whether the rows are moreover a function of `(k, x)` alone (not of `u`; their state
+    /// Jacobian may depend on `u`): the solve then takes a forward pass's rows at a node whose
+    /// control they moved, too. `false` unless said otherwise.
+    fn rows_of_state(&self) -> bool {
+        false
+    }
 }
 
 /// Rows this far inside their bound count as active for the feedback gain (relative).
@@ -177,7 +184,8 @@ impl ConstrainedWork {
     /// closed form where they have it, by forward differences (`n_x` more evaluations)
     /// otherwise. Rows of `(k, x, u)` alone
     /// ([`rows_of_state_and_control`](StepConstraints::rows_of_state_and_control)) that the
-    /// last forward pass wrote at this `(x, u)` are copied, not evaluated again.
+    /// last forward pass wrote at this `(x, u)` (at this `x`, for rows of `(k, x)` alone) are
+    /// copied, not evaluated again.
     pub(crate) fn evaluate(
         &mut self,
         constraints: &mut dyn StepConstraints,
@@ -192,7 +200,7 @@ impl ConstrainedWork {
             Some(count)
                 if constraints.rows_of_state_and_control()
                     && same_bits(&at[..nx], x)
-                    && same_bits(&at[nx..], u) =>
+                    && (constraints.rows_of_state() || same_bits(&at[nx..], u)) =>
             {
                 rows[..count * nu]
                     .copy_from_slice(&self.forward_rows[k * max * nu..(k * max + count) * nu]);

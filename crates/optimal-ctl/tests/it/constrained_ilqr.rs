@@ -611,12 +611,13 @@ fn a_warm_start_that_diverges_open_loop_follows_the_previous_plan() {
     );
 }
 
-/// Rows `G u <= g + s x_1` whose bounds move with the state, counting their evaluations; of
-/// `(k, x, u)` alone when `reusable` says so, with a state Jacobian when `jacobian` does.
+/// Rows `G u <= g + s x_1` whose bounds move with the state, counting their evaluations; said
+/// to be of `(k, x, u)` alone from `reuse` 1 on and of `(k, x)` alone at 2, with a state
+/// Jacobian when `jacobian` says so.
 struct Moving {
     fixed: Fixed,
     slope: f64,
-    reusable: bool,
+    reuse: u8,
     jacobian: bool,
     calls: usize,
 }
@@ -648,15 +649,20 @@ impl StepConstraints for Moving {
     }
 
     fn rows_of_state_and_control(&self) -> bool {
-        self.reusable
+        self.reuse >= 1
+    }
+
+    fn rows_of_state(&self) -> bool {
+        self.reuse >= 2
     }
 }
 
 /// Rows of `(k, x, u)` alone that a forward pass wrote at the state and control an accepted
 /// pass keeps are reused, not evaluated again (nor their QP, where the projection found them
-/// empty): the same plan and relaxed nodes to the bit, with fewer evaluations, with and
-/// without the rows' state Jacobian (by forward differences), for rows active at many steps
-/// and for rows that admit no control while `x_1 < 0.5`.
+/// empty), and rows of `(k, x)` alone at the state it keeps: the same plan and relaxed nodes
+/// to the bit, with fewer evaluations, with and without the rows' state Jacobian (by forward
+/// differences), for rows active at many steps and for rows that admit no control while
+/// `x_1 < 0.1`.
 #[test]
 fn rows_of_the_accepted_forward_pass_are_reused_to_the_bit() {
     let cost = TrackingCost {
@@ -671,15 +677,15 @@ fn rows_of_the_accepted_forward_pass_are_reused_to_the_bit() {
         ..IlqrSettings::default()
     };
     let cases = [
-        // u_1 + u_2 <= 0.4 + 0.2 x_1 and -u_1 <= 0.3 + 0.2 x_1: active at many steps.
+        // u_1 + u_2 <= 0.4 + x_1 and -u_1 <= 0.3 + x_1: active at many steps.
         (vec![1.0, 1.0, -1.0, 0.0], vec![0.4, 0.3], false),
-        // u_1 <= 0.1 + 0.2 x_1 and u_1 >= 0.3 - 0.2 x_1: empty while x_1 < 0.5.
+        // u_1 <= 0.1 + x_1 and u_1 >= 0.3 - x_1: empty while x_1 < 0.1.
         (vec![1.0, 0.0, -1.0, 0.0], vec![0.1, -0.3], true),
     ];
     for ((g, bounds, empty), jacobian) in
         cases.iter().flat_map(|case| [(case, false), (case, true)])
     {
-        let plan = |reusable: bool| {
+        let plan = |reuse: u8| {
             let mut sys = Linear {
                 a: vec![1.0, 0.1, -0.05, 0.98],
                 b: vec![0.0, 0.05, 0.1, 0.02],
@@ -691,8 +697,8 @@ fn rows_of_the_accepted_forward_pass_are_reused_to_the_bit() {
                     rows: g.clone(),
                     bounds: bounds.clone(),
                 },
-                slope: 0.2,
-                reusable,
+                slope: 1.0,
+                reuse,
                 jacobian,
                 calls: 0,
             };
@@ -712,15 +718,34 @@ fn rows_of_the_accepted_forward_pass_are_reused_to_the_bit() {
                 report.relaxed_nodes,
             )
         };
-        let (fresh, reused) = (plan(false), plan(true));
-        assert_eq!(fresh.0, reused.0, "controls (jacobian {jacobian})");
-        assert_eq!(fresh.1, reused.1, "states (jacobian {jacobian})");
-        assert_eq!(fresh.3, reused.3, "relaxed nodes (jacobian {jacobian})");
+        let fresh = plan(0);
+        let mut calls = vec![fresh.2];
+        for reuse in [1, 2] {
+            let reused = plan(reuse);
+            assert_eq!(
+                fresh.0, reused.0,
+                "controls (reuse {reuse}, jacobian {jacobian})"
+            );
+            assert_eq!(
+                fresh.1, reused.1,
+                "states (reuse {reuse}, jacobian {jacobian})"
+            );
+            assert_eq!(
+                fresh.3, reused.3,
+                "relaxed (reuse {reuse}, jacobian {jacobian})"
+            );
+            calls.push(reused.2);
+        }
+        // With the state Jacobian the gain moves the controls along the rows and the forward
+        // pass's projection moves some of them: only rows of `(k, x)` alone are reused there.
+        let fewer = if jacobian {
+            calls[2] < calls[1]
+        } else {
+            calls[2] <= calls[1]
+        };
         assert!(
-            reused.2 < fresh.2,
-            "{} evaluations reused vs {} fresh (jacobian {jacobian})",
-            reused.2,
-            fresh.2
+            fewer && calls[1] < calls[0],
+            "evaluations {calls:?} (jacobian {jacobian})"
         );
     }
 }
