@@ -126,9 +126,9 @@ pub(crate) struct ConstrainedWork {
     forward_counts: Vec<Option<usize>>,
     forward_at: Vec<f64>,
     forward_empty: Vec<bool>,
-    /// Per step: whether the nominal rows are known to admit no control within the box (they
-    /// are a forward pass's rows whose projection found none).
-    empty: Vec<bool>,
+    /// Per step: whether the nominal rows admit no control within the box, where known (they
+    /// are a forward pass's rows, whose projection found out).
+    empty: Vec<Option<bool>>,
     /// The gain's linear algebra: `H`'s factor, `X = H^-1 Q_ux`, the active rows `A`,
     /// `Y = H^-1 A^T`, `S = A Y` and `A X`.
     factor: Vec<f64>,
@@ -164,7 +164,7 @@ impl ConstrainedWork {
             forward_counts: vec![None; horizon],
             forward_at: vec![0.0; horizon * (nx + nu)],
             forward_empty: vec![false; horizon],
-            empty: vec![false; horizon],
+            empty: vec![None; horizon],
             factor: vec![0.0; nu * nu],
             x_mat: vec![0.0; nu * nx],
             active: vec![0.0; nu * nu],
@@ -205,11 +205,11 @@ impl ConstrainedWork {
                 rows[..count * nu]
                     .copy_from_slice(&self.forward_rows[k * max * nu..(k * max + count) * nu]);
                 bounds[..count].copy_from_slice(&self.forward_bounds[k * max..k * max + count]);
-                self.empty[k] = self.forward_empty[k];
+                self.empty[k] = Some(self.forward_empty[k]);
                 count
             }
             _ => {
-                self.empty[k] = false;
+                self.empty[k] = None;
                 constraints.rows(k, x, u, b, rows, bounds)?
             }
         };
@@ -319,7 +319,8 @@ impl ConstrainedWork {
     /// (`A K = -D`, `D` their state Jacobian; zero when they leave no freedom): the box QP's
     /// "zero gain on the clamped controls", for any rows. `false` (and `ff`, `gain` unset) when
     /// the rows and the box admit no control: known without a QP for rows that a forward
-    /// pass's projection found so (the same rows and box, translated by `u`).
+    /// pass's projection found so (the same rows and box, translated by `u`) and for a row
+    /// that no control within the box meets ([`row_outside_box`]).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn feedforward(
         &mut self,
@@ -331,10 +332,17 @@ impl ConstrainedWork {
         gain: &mut [f64],
     ) -> Result<bool, OptimalError> {
         let (nx, nu, max) = (self.nx, self.nu, self.max_rows);
-        if self.empty[k] {
+        let count = self.counts[k];
+        let empty = self.empty[k].unwrap_or_else(|| {
+            row_outside_box(
+                &self.rows[k * max * nu..(k * max + count) * nu],
+                &self.bounds[k * max..k * max + count],
+                bounds,
+            )
+        });
+        if empty {
             return Ok(false);
         }
-        let count = self.counts[k];
         let rows = std::mem::take(&mut self.rows);
         let step_bounds = std::mem::take(&mut self.bounds);
         let n = self.assemble(
@@ -428,7 +436,8 @@ impl ConstrainedWork {
 
     /// Moves `u` (`n_u`) to the closest control within the rows of step `k` at the forward
     /// pass's state `x` (with the nominal `b`) and the box: whether it moved, or `None` (`u`
-    /// kept) when no control is within. The rows stay as step `k`'s of the pass.
+    /// kept) when no control is within (without a projection for a row that no control within
+    /// the box meets, [`row_outside_box`]). The rows stay as step `k`'s of the pass.
     pub(crate) fn project(
         &mut self,
         constraints: &mut dyn StepConstraints,
@@ -459,6 +468,17 @@ impl ConstrainedWork {
         let at = &mut self.forward_at[k * (nx + nu)..(k + 1) * (nx + nu)];
         at[..nx].copy_from_slice(x);
         at[nx..].copy_from_slice(u);
+        let (step_rows, step_bounds) = (
+            &self.forward_rows[k * max * nu..(k * max + count) * nu],
+            &self.forward_bounds[k * max..k * max + count],
+        );
+        if within(step_rows, step_bounds, box_bounds, u) {
+            return Ok(Some(false));
+        }
+        if row_outside_box(step_rows, step_bounds, box_bounds) {
+            self.forward_empty[k] = true;
+            return Ok(None);
+        }
         let rows = std::mem::take(&mut self.forward_rows);
         let bounds = std::mem::take(&mut self.forward_bounds);
         let n = self.assemble(
@@ -489,7 +509,100 @@ impl ConstrainedWork {
     }
 }
 
+/// Rows this far (relative) beyond their bound at their least within the box prove the box
+/// and the rows empty; nearer ones are left to the projection.
+const OUTSIDE: f64 = 1e-9;
+
+/// Whether one of the rows `G u <= g` (`n_u` columns) is broken by every control within the box
+/// `(lower, upper)`: its least value over the box, `sum_i min(G_i lower_i, G_i upper_i)`,
+/// exceeds its bound by more than [`OUTSIDE`] of its size, so that the rows and the box
+/// admit no control. A row that an unbounded side of the box lets go to `-inf`, or a NaN,
+/// proves nothing.
+fn row_outside_box(rows: &[f64], bounds: &[f64], (lower, upper): (&[f64], &[f64])) -> bool {
+    let nu = lower.len();
+    rows.chunks_exact(nu.max(1))
+        .zip(bounds)
+        .any(|(row, &bound)| {
+            let least: f64 = row
+                .iter()
+                .zip(lower.iter().zip(upper))
+                .map(|(&g, (&l, &h))| {
+                    if g > 0.0 {
+                        g * l
+                    } else if g < 0.0 {
+                        g * h
+                    } else {
+                        0.0
+                    }
+                })
+                .sum();
+            least - bound > OUTSIDE * (1.0 + bound.abs() + least.abs())
+        })
+}
+
+/// Whether `u` is within the rows `G u <= g` (`g_r - G_r u` accumulated as the projection
+/// does) and the box: the projection would keep it.
+fn within(rows: &[f64], bounds: &[f64], (lower, upper): (&[f64], &[f64]), u: &[f64]) -> bool {
+    let in_box = u
+        .iter()
+        .zip(lower.iter().zip(upper))
+        .all(|(u, (l, h))| l <= u && u <= h);
+    in_box
+        && rows
+            .chunks_exact(u.len().max(1))
+            .zip(bounds)
+            .all(|(row, &bound)| {
+                let mut gu = 0.0;
+                for (g, u) in row.iter().zip(u) {
+                    gu += g * u;
+                }
+                gu <= bound
+            })
+}
+
 /// Whether `x` and `y` hold the same bits.
 fn same_bits(x: &[f64], y: &[f64]) -> bool {
     x.iter().zip(y).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(512))]
+        /// The shortcuts of `project` agree with the projection onto the rows and the box: a
+        /// control `within` them is one the projection keeps, and rows with one
+        /// `row_outside_box` are ones it finds empty.
+        #[test]
+        fn the_shortcuts_agree_with_the_projection(
+            rows in proptest::collection::vec(-1.0f64..1.0, 6),
+            bounds in proptest::collection::vec(-2.0f64..1.0, 3),
+            u in proptest::collection::vec(-1.0f64..1.0, 2),
+        ) {
+            let (lower, upper) = ([-1.0, -1.0], [1.0, 1.0]);
+            let mut all_rows = rows.clone();
+            let mut all_bounds = bounds.clone();
+            for j in 0..2 {
+                for (sign, bound) in [(1.0, upper[j]), (-1.0, -lower[j])] {
+                    let mut row = [0.0; 2];
+                    row[j] = sign;
+                    all_rows.extend_from_slice(&row);
+                    all_bounds.push(bound);
+                }
+            }
+            let mut projection = PolytopeProjection::new(2, all_bounds.len());
+            let mut x = [0.0; 2];
+            let projected = projection.project(&all_rows, &all_bounds, &u, &mut x);
+            if within(&rows, &bounds, (&lower, &upper), &u) {
+                prop_assert_eq!(projected, Ok(false));
+            } else {
+                prop_assert_ne!(projected, Ok(false));
+            }
+            if row_outside_box(&rows, &bounds, (&lower, &upper)) {
+                prop_assert_eq!(projected, Err(ProjectionFailure::Empty));
+            }
+        }
+    }
 }
