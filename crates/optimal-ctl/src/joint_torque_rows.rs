@@ -315,4 +315,13 @@ impl StepConstraints for JointTorqueRows<'_> {
     ) -> Result<bool, OptimalError> {
         self.limits.state_jacobian(self.plant, x, u, jacobian)
     }
+
+    /// The rows are those of the state `x`, the state Jacobian that of `(x, u)`.
+    fn rows_of_state_and_control(&self) -> bool {
+        true
+    }
+
+    fn rows_of_state(&self) -> bool {
+        true
+    }
 }

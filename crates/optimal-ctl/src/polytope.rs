@@ -45,10 +45,11 @@ pub struct PolytopeProjection {
     e: Vec<f64>,
     u: Vec<f64>,
     z: Vec<f64>,
-    w: Vec<f64>,
     passive: Vec<bool>,
-    /// The passive columns, in order.
+    /// The passive columns, in order: the first `n_passive` (room for every column, so that a
+    /// clone too never grows it).
     order: Vec<usize>,
+    n_passive: usize,
     /// The least-squares subproblem: matrix `(m + 1) x k`, right-hand side, solution.
     qr: Vec<f64>,
     rhs: Vec<f64>,
@@ -75,9 +76,9 @@ impl PolytopeProjection {
             e: vec![0.0; height * rows],
             u: vec![0.0; rows],
             z: vec![0.0; rows],
-            w: vec![0.0; rows],
             passive: vec![false; rows],
-            order: Vec::with_capacity(rows),
+            order: vec![0; rows],
+            n_passive: 0,
             qr: vec![0.0; height * height],
             rhs: vec![0.0; height],
             residual: vec![0.0; height],
@@ -105,16 +106,15 @@ impl PolytopeProjection {
         }
         let height = m + 1;
         let mut violated = false;
-        for i in 0..p {
+        for (i, (column, &bound)) in self.e.chunks_exact_mut(height).zip(g).enumerate() {
             let row = &constraints[i * m..(i + 1) * m];
-            let column = &mut self.e[i * height..(i + 1) * height];
             let mut gx = 0.0;
-            for k in 0..m {
-                column[k] = -row[k];
-                gx += row[k] * x0[k];
+            for ((e, &r), &x) in column.iter_mut().zip(row).zip(x0) {
+                *e = -r;
+                gx += r * x;
             }
-            column[m] = gx - g[i];
-            violated |= gx > g[i];
+            column[m] = gx - bound;
+            violated |= gx > bound;
         }
         x.copy_from_slice(x0);
         if !violated {
@@ -146,70 +146,80 @@ impl PolytopeProjection {
     /// Lawson and Hanson's NNLS on the first `p` columns of `E`, `f = e_{m+1}`, into `u`.
     fn nnls(&mut self, p: usize) -> Result<(), ProjectionFailure> {
         let height = self.m + 1;
-        let scale = (0..p * height).map(|i| self.e[i].abs()).fold(1.0, f64::max);
+        let scale = self.e[..p * height]
+            .iter()
+            .fold(1.0, |s, e| f64::max(s, e.abs()));
         let tolerance = 1e-12 * scale;
         self.u[..p].fill(0.0);
         self.passive[..p].fill(false);
-        self.order.clear();
+        self.n_passive = 0;
         for _ in 0..3 * p + 10 {
             // w = E^T (f - E u).
             self.residual.fill(0.0);
             self.residual[height - 1] = 1.0;
-            for &j in &self.order {
+            for &j in &self.order[..self.n_passive] {
                 let column = &self.e[j * height..(j + 1) * height];
                 for (r, c) in self.residual.iter_mut().zip(column) {
                     *r -= c * self.u[j];
                 }
             }
-            let mut best = None;
-            for j in 0..p {
-                let column = &self.e[j * height..(j + 1) * height];
-                self.w[j] = column.iter().zip(&self.residual).map(|(c, r)| c * r).sum();
-                if !self.passive[j]
-                    && self.w[j] > tolerance
-                    && best.is_none_or(|b: usize| self.w[j] > self.w[b])
-                    && self.order.len() < height
+            // The entering column: the largest dual gradient w_j = E_j . r above the tolerance.
+            let mut best: Option<(usize, f64)> = None;
+            if self.n_passive < height {
+                for ((j, column), &passive) in self.e[..p * height]
+                    .chunks_exact(height)
+                    .enumerate()
+                    .zip(&self.passive[..p])
                 {
-                    best = Some(j);
+                    let w: f64 = column.iter().zip(&self.residual).map(|(c, r)| c * r).sum();
+                    if !passive && w > tolerance && best.is_none_or(|(_, b)| w > b) {
+                        best = Some((j, w));
+                    }
                 }
             }
-            let Some(entering) = best else {
+            let Some((entering, _)) = best else {
                 return Ok(());
             };
             self.passive[entering] = true;
-            self.order.push(entering);
+            self.order[self.n_passive] = entering;
+            self.n_passive += 1;
             loop {
                 if !self.solve_passive() {
-                    // Dependent columns: the entering one adds nothing.
+                    // Dependent columns: the entering one (the last) adds nothing.
                     self.passive[entering] = false;
-                    self.order.retain(|&j| j != entering);
+                    self.n_passive -= 1;
                     return Ok(());
                 }
-                if self.order.iter().all(|&j| self.z[j] > 0.0) {
-                    for &j in &self.order {
+                let order = &self.order[..self.n_passive];
+                if order.iter().all(|&j| self.z[j] > 0.0) {
+                    for &j in order {
                         self.u[j] = self.z[j];
                     }
                     break;
                 }
                 let mut alpha = f64::INFINITY;
-                for &j in &self.order {
+                for &j in order {
                     if self.z[j] <= 0.0 {
                         alpha = alpha.min(self.u[j] / (self.u[j] - self.z[j]));
                     }
                 }
-                for &j in &self.order {
+                for &j in order {
                     self.u[j] += alpha * (self.z[j] - self.u[j]);
                 }
-                let (u, passive) = (&mut self.u, &mut self.passive);
-                self.order.retain(|&j| {
-                    let keep = u[j] > tolerance;
-                    if !keep {
-                        u[j] = 0.0;
-                        passive[j] = false;
+                // The passive variables that reached zero leave, the others keep their order.
+                let mut kept = 0;
+                for i in 0..self.n_passive {
+                    let j = self.order[i];
+                    if self.u[j] > tolerance {
+                        self.order[kept] = j;
+                        kept += 1;
+                    } else {
+                        self.u[j] = 0.0;
+                        self.passive[j] = false;
                     }
-                    keep
-                });
-                if self.order.is_empty() {
+                }
+                self.n_passive = kept;
+                if kept == 0 {
                     break;
                 }
             }
@@ -221,46 +231,37 @@ impl PolytopeProjection {
     /// `false` when the columns are numerically dependent.
     fn solve_passive(&mut self) -> bool {
         let height = self.m + 1;
-        let k = self.order.len();
-        for (c, &j) in self.order.iter().enumerate() {
+        let k = self.n_passive;
+        for (c, &j) in self.order[..k].iter().enumerate() {
             self.qr[c * height..(c + 1) * height]
                 .copy_from_slice(&self.e[j * height..(j + 1) * height]);
         }
         self.rhs.fill(0.0);
         self.rhs[height - 1] = 1.0;
         for c in 0..k {
-            let column = c * height;
-            let norm = (c..height)
-                .map(|r| self.qr[column + r] * self.qr[column + r])
-                .sum::<f64>()
-                .sqrt();
+            // v: column c's entries c.. (the Householder vector once its first entry is shifted).
+            let (done, later) = self.qr[..k * height].split_at_mut((c + 1) * height);
+            let v = &mut done[c * height + c..];
+            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
             if norm <= 1e-13 {
                 return false;
             }
-            let alpha = if self.qr[column + c] > 0.0 {
-                -norm
-            } else {
-                norm
-            };
-            self.qr[column + c] -= alpha;
-            let vv: f64 = (c..height).map(|r| self.qr[column + r].powi(2)).sum();
+            let alpha = if v[0] > 0.0 { -norm } else { norm };
+            v[0] -= alpha;
+            let vv: f64 = v.iter().map(|x| x * x).sum();
             // Apply I - 2 v v^T / v^T v to the later columns and the right-hand side.
-            for other in c + 1..k {
-                let o = other * height;
-                let dot: f64 = (c..height)
-                    .map(|r| self.qr[column + r] * self.qr[o + r])
-                    .sum();
+            let reflect = |target: &mut [f64]| {
+                let dot: f64 = v.iter().zip(target.iter()).map(|(a, b)| a * b).sum();
                 let factor = 2.0 * dot / vv;
-                for r in c..height {
-                    self.qr[o + r] -= factor * self.qr[column + r];
+                for (t, x) in target.iter_mut().zip(v.iter()) {
+                    *t -= factor * x;
                 }
+            };
+            for other in later.chunks_exact_mut(height) {
+                reflect(&mut other[c..]);
             }
-            let dot: f64 = (c..height).map(|r| self.qr[column + r] * self.rhs[r]).sum();
-            let factor = 2.0 * dot / vv;
-            for r in c..height {
-                self.rhs[r] -= factor * self.qr[column + r];
-            }
-            self.qr[column + c] = alpha;
+            reflect(&mut self.rhs[c..]);
+            v[0] = alpha;
         }
         for c in (0..k).rev() {
             let mut value = self.rhs[c];

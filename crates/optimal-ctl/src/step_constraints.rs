@@ -8,7 +8,7 @@
 
 use crate::OptimalError;
 use crate::linear_qp::{LinearQp, LinearQpFailure};
-use crate::polytope::PolytopeProjection;
+use crate::polytope::{PolytopeProjection, ProjectionFailure};
 use lane_math::dense::{cholesky, cholesky_solve};
 
 /// The constraints `G u_k <= g` of every step of a constrained [`Ilqr`](crate::Ilqr) solve.
@@ -21,7 +21,8 @@ pub trait StepConstraints {
     /// (`r`), and returns `r <= max_rows()`. Called along the nominal trajectory before every
     /// backward pass (and, with [`state_jacobian`](Self::state_jacobian), at `n_x` states a
     /// small step from each nominal state: the same rows in the same order), and at every state
-    /// of a forward pass (with the nominal `b`).
+    /// of a forward pass (with the nominal `b`); see also
+    /// [`rows_of_state_and_control`](Self::rows_of_state_and_control).
     ///
     /// # Errors
     /// Whatever the model refuses at `x`.
@@ -63,6 +64,22 @@ pub trait StepConstraints {
     ) -> Result<bool, OptimalError> {
         Ok(false)
     }
+
+    /// Whether a step's rows, and their [`analytic_state_jacobian`](Self::analytic_state_jacobian),
+    /// are a function of `(k, x, u)` alone: not of `b`, nor of the calls before. The solve then
+    /// keeps the rows each forward pass wrote at each node and, once the pass is accepted,
+    /// takes them as the rows of the nodes whose control they did not move (the same `x` and
+    /// `u`, to the bit) instead of evaluating them again. `false` unless said otherwise.
+    fn rows_of_state_and_control(&self) -> bool {
+        false
+    }
+
+    /// Whether the rows are moreover a function of `(k, x)` alone (not of `u`; their state
+    /// Jacobian may depend on `u`): the solve then takes a forward pass's rows at a node whose
+    /// control they moved, too. `false` unless said otherwise.
+    fn rows_of_state(&self) -> bool {
+        false
+    }
 }
 
 /// Rows this far inside their bound count as active for the feedback gain (relative).
@@ -100,9 +117,18 @@ pub(crate) struct ConstrainedWork {
     qp: LinearQp,
     projection: PolytopeProjection,
     projected: Vec<f64>,
-    /// The rows at a forward pass's state (the nominal ones stay for the next backward pass).
+    /// Per step: the rows at the last forward pass's state (the nominal ones stay for the next
+    /// backward pass), their number (`None` where the pass wrote none), the `(x, u)` they
+    /// were evaluated at (`n_x + n_u`), and whether their projection found them and the box
+    /// empty.
     forward_rows: Vec<f64>,
     forward_bounds: Vec<f64>,
+    forward_counts: Vec<Option<usize>>,
+    forward_at: Vec<f64>,
+    forward_empty: Vec<bool>,
+    /// Per step: whether the nominal rows admit no control within the box, where known (they
+    /// are a forward pass's rows, whose projection found out).
+    empty: Vec<Option<bool>>,
     /// The gain's linear algebra: `H`'s factor, `X = H^-1 Q_ux`, the active rows `A`,
     /// `Y = H^-1 A^T`, `S = A Y` and `A X`.
     factor: Vec<f64>,
@@ -133,8 +159,12 @@ impl ConstrainedWork {
             qp: LinearQp::new(nu, total),
             projection: PolytopeProjection::new(nu, total),
             projected: vec![0.0; nu],
-            forward_rows: vec![0.0; max_rows * nu],
-            forward_bounds: vec![0.0; max_rows],
+            forward_rows: vec![0.0; horizon * max_rows * nu],
+            forward_bounds: vec![0.0; horizon * max_rows],
+            forward_counts: vec![None; horizon],
+            forward_at: vec![0.0; horizon * (nx + nu)],
+            forward_empty: vec![false; horizon],
+            empty: vec![None; horizon],
             factor: vec![0.0; nu * nu],
             x_mat: vec![0.0; nu * nx],
             active: vec![0.0; nu * nu],
@@ -152,7 +182,10 @@ impl ConstrainedWork {
     /// Evaluates the rows of step `k` at `(x, u)` with `b` into the step's storage, and their
     /// state Jacobian `D = d(G u - g)/dx` when the constraints ask for it (zero otherwise): in
     /// closed form where they have it, by forward differences (`n_x` more evaluations)
-    /// otherwise.
+    /// otherwise. Rows of `(k, x, u)` alone
+    /// ([`rows_of_state_and_control`](StepConstraints::rows_of_state_and_control)) that the
+    /// last forward pass wrote at this `(x, u)` (at this `x`, for rows of `(k, x)` alone) are
+    /// copied, not evaluated again.
     pub(crate) fn evaluate(
         &mut self,
         constraints: &mut dyn StepConstraints,
@@ -162,7 +195,24 @@ impl ConstrainedWork {
         let (nx, nu, max) = (self.nx, self.nu, self.max_rows);
         let rows = &mut self.rows[k * max * nu..(k + 1) * max * nu];
         let bounds = &mut self.bounds[k * max..(k + 1) * max];
-        let count = constraints.rows(k, x, u, b, rows, bounds)?;
+        let at = &self.forward_at[k * (nx + nu)..(k + 1) * (nx + nu)];
+        let count = match self.forward_counts[k] {
+            Some(count)
+                if constraints.rows_of_state_and_control()
+                    && same_bits(&at[..nx], x)
+                    && (constraints.rows_of_state() || same_bits(&at[nx..], u)) =>
+            {
+                rows[..count * nu]
+                    .copy_from_slice(&self.forward_rows[k * max * nu..(k * max + count) * nu]);
+                bounds[..count].copy_from_slice(&self.forward_bounds[k * max..k * max + count]);
+                self.empty[k] = Some(self.forward_empty[k]);
+                count
+            }
+            _ => {
+                self.empty[k] = None;
+                constraints.rows(k, x, u, b, rows, bounds)?
+            }
+        };
         if count > max {
             return Err(OptimalError::Dimension {
                 name: "step constraint rows",
@@ -268,7 +318,9 @@ impl ConstrainedWork {
     /// `X = H^-1 Q_ux`, that keeps the active rows `A` active to first order as the state moves
     /// (`A K = -D`, `D` their state Jacobian; zero when they leave no freedom): the box QP's
     /// "zero gain on the clamped controls", for any rows. `false` (and `ff`, `gain` unset) when
-    /// the rows and the box admit no control.
+    /// the rows and the box admit no control: known without a QP for rows that a forward
+    /// pass's projection found so (the same rows and box, translated by `u`) and for a row
+    /// that no control within the box meets ([`row_outside_box`]).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn feedforward(
         &mut self,
@@ -281,6 +333,16 @@ impl ConstrainedWork {
     ) -> Result<bool, OptimalError> {
         let (nx, nu, max) = (self.nx, self.nu, self.max_rows);
         let count = self.counts[k];
+        let empty = self.empty[k].unwrap_or_else(|| {
+            row_outside_box(
+                &self.rows[k * max * nu..(k * max + count) * nu],
+                &self.bounds[k * max..k * max + count],
+                bounds,
+            )
+        });
+        if empty {
+            return Ok(false);
+        }
         let rows = std::mem::take(&mut self.rows);
         let step_bounds = std::mem::take(&mut self.bounds);
         let n = self.assemble(
@@ -374,7 +436,8 @@ impl ConstrainedWork {
 
     /// Moves `u` (`n_u`) to the closest control within the rows of step `k` at the forward
     /// pass's state `x` (with the nominal `b`) and the box: whether it moved, or `None` (`u`
-    /// kept) when no control is within.
+    /// kept) when no control is within (without a projection for a row that no control within
+    /// the box meets, [`row_outside_box`]). The rows stay as step `k`'s of the pass.
     pub(crate) fn project(
         &mut self,
         constraints: &mut dyn StepConstraints,
@@ -383,9 +446,17 @@ impl ConstrainedWork {
         box_bounds: (&[f64], &[f64]),
         u: &mut [f64],
     ) -> Result<Option<bool>, OptimalError> {
-        let (nu, max) = (self.nu, self.max_rows);
-        let count =
-            constraints.rows(k, x, u, b, &mut self.forward_rows, &mut self.forward_bounds)?;
+        let (nx, nu, max) = (self.nx, self.nu, self.max_rows);
+        self.forward_counts[k] = None;
+        self.forward_empty[k] = false;
+        let count = constraints.rows(
+            k,
+            x,
+            u,
+            b,
+            &mut self.forward_rows[k * max * nu..(k + 1) * max * nu],
+            &mut self.forward_bounds[k * max..(k + 1) * max],
+        )?;
         if count > max {
             return Err(OptimalError::Dimension {
                 name: "step constraint rows",
@@ -393,9 +464,31 @@ impl ConstrainedWork {
                 found: count,
             });
         }
+        self.forward_counts[k] = Some(count);
+        let at = &mut self.forward_at[k * (nx + nu)..(k + 1) * (nx + nu)];
+        at[..nx].copy_from_slice(x);
+        at[nx..].copy_from_slice(u);
+        let (step_rows, step_bounds) = (
+            &self.forward_rows[k * max * nu..(k * max + count) * nu],
+            &self.forward_bounds[k * max..k * max + count],
+        );
+        if within(step_rows, step_bounds, box_bounds, u) {
+            return Ok(Some(false));
+        }
+        if row_outside_box(step_rows, step_bounds, box_bounds) {
+            self.forward_empty[k] = true;
+            return Ok(None);
+        }
         let rows = std::mem::take(&mut self.forward_rows);
         let bounds = std::mem::take(&mut self.forward_bounds);
-        let n = self.assemble((&rows[..count * nu], &bounds[..count]), None, box_bounds);
+        let n = self.assemble(
+            (
+                &rows[k * max * nu..(k * max + count) * nu],
+                &bounds[k * max..k * max + count],
+            ),
+            None,
+            box_bounds,
+        );
         self.forward_rows = rows;
         self.forward_bounds = bounds;
         match self.projection.project(
@@ -408,7 +501,108 @@ impl ConstrainedWork {
                 u.copy_from_slice(&self.projected);
                 Ok(Some(moved))
             }
-            Err(_) => Ok(None),
+            Err(failure) => {
+                self.forward_empty[k] = failure == ProjectionFailure::Empty;
+                Ok(None)
+            }
+        }
+    }
+}
+
+/// Rows this far (relative) beyond their bound at their least within the box prove the box
+/// and the rows empty; nearer ones are left to the projection.
+const OUTSIDE: f64 = 1e-9;
+
+/// Whether one of the rows `G u <= g` (`n_u` columns) is broken by every control within the box
+/// `(lower, upper)`: its least value over the box, `sum_i min(G_i lower_i, G_i upper_i)`,
+/// exceeds its bound by more than [`OUTSIDE`] of its size, so that the rows and the box
+/// admit no control. A row that an unbounded side of the box lets go to `-inf`, or a NaN,
+/// proves nothing.
+fn row_outside_box(rows: &[f64], bounds: &[f64], (lower, upper): (&[f64], &[f64])) -> bool {
+    let nu = lower.len();
+    rows.chunks_exact(nu.max(1))
+        .zip(bounds)
+        .any(|(row, &bound)| {
+            let least: f64 = row
+                .iter()
+                .zip(lower.iter().zip(upper))
+                .map(|(&g, (&l, &h))| {
+                    if g > 0.0 {
+                        g * l
+                    } else if g < 0.0 {
+                        g * h
+                    } else {
+                        0.0
+                    }
+                })
+                .sum();
+            least - bound > OUTSIDE * (1.0 + bound.abs() + least.abs())
+        })
+}
+
+/// Whether `u` is within the rows `G u <= g` (`g_r - G_r u` accumulated as the projection
+/// does) and the box: the projection would keep it.
+fn within(rows: &[f64], bounds: &[f64], (lower, upper): (&[f64], &[f64]), u: &[f64]) -> bool {
+    let in_box = u
+        .iter()
+        .zip(lower.iter().zip(upper))
+        .all(|(u, (l, h))| l <= u && u <= h);
+    in_box
+        && rows
+            .chunks_exact(u.len().max(1))
+            .zip(bounds)
+            .all(|(row, &bound)| {
+                let mut gu = 0.0;
+                for (g, u) in row.iter().zip(u) {
+                    gu += g * u;
+                }
+                gu <= bound
+            })
+}
+
+/// Whether `x` and `y` hold the same bits.
+fn same_bits(x: &[f64], y: &[f64]) -> bool {
+    x.iter().zip(y).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(512))]
+        /// The shortcuts of `project` agree with the projection onto the rows and the box: a
+        /// control `within` them is one the projection keeps, and rows with one
+        /// `row_outside_box` are ones it finds empty.
+        #[test]
+        fn the_shortcuts_agree_with_the_projection(
+            rows in proptest::collection::vec(-1.0f64..1.0, 6),
+            bounds in proptest::collection::vec(-2.0f64..1.0, 3),
+            u in proptest::collection::vec(-1.0f64..1.0, 2),
+        ) {
+            let (lower, upper) = ([-1.0, -1.0], [1.0, 1.0]);
+            let mut all_rows = rows.clone();
+            let mut all_bounds = bounds.clone();
+            for j in 0..2 {
+                for (sign, bound) in [(1.0, upper[j]), (-1.0, -lower[j])] {
+                    let mut row = [0.0; 2];
+                    row[j] = sign;
+                    all_rows.extend_from_slice(&row);
+                    all_bounds.push(bound);
+                }
+            }
+            let mut projection = PolytopeProjection::new(2, all_bounds.len());
+            let mut x = [0.0; 2];
+            let projected = projection.project(&all_rows, &all_bounds, &u, &mut x);
+            if within(&rows, &bounds, (&lower, &upper), &u) {
+                prop_assert_eq!(projected, Ok(false));
+            } else {
+                prop_assert_ne!(projected, Ok(false));
+            }
+            if row_outside_box(&rows, &bounds, (&lower, &upper)) {
+                prop_assert_eq!(projected, Err(ProjectionFailure::Empty));
+            }
         }
     }
 }

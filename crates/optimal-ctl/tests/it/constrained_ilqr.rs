@@ -610,3 +610,186 @@ fn a_warm_start_that_diverges_open_loop_follows_the_previous_plan() {
         "{error}"
     );
 }
+
+/// Rows `G u <= g + s x_1` whose bounds move with the state, counting their evaluations; said
+/// to be of `(k, x, u)` alone from `reuse` 1 on and of `(k, x)` alone at 2, with a state
+/// Jacobian when `jacobian` says so.
+struct Moving {
+    fixed: Fixed,
+    slope: f64,
+    reuse: u8,
+    jacobian: bool,
+    calls: usize,
+}
+
+impl StepConstraints for Moving {
+    fn max_rows(&self) -> usize {
+        self.fixed.max_rows()
+    }
+
+    fn rows(
+        &mut self,
+        k: usize,
+        x: &[f64],
+        u: &[f64],
+        b: &[f64],
+        rows: &mut [f64],
+        bounds: &mut [f64],
+    ) -> Result<usize, OptimalError> {
+        self.calls += 1;
+        let count = self.fixed.rows(k, x, u, b, rows, bounds)?;
+        for bound in &mut bounds[..count] {
+            *bound += self.slope * x[0];
+        }
+        Ok(count)
+    }
+
+    fn state_jacobian(&self) -> bool {
+        self.jacobian
+    }
+
+    fn rows_of_state_and_control(&self) -> bool {
+        self.reuse >= 1
+    }
+
+    fn rows_of_state(&self) -> bool {
+        self.reuse >= 2
+    }
+}
+
+/// Rows of `(k, x, u)` alone that a forward pass wrote at the state and control an accepted
+/// pass keeps are reused, not evaluated again (nor their QP, where the projection found them
+/// empty), and rows of `(k, x)` alone at the state it keeps: the same plan and relaxed nodes
+/// to the bit, with fewer evaluations, with and without the rows' state Jacobian (by forward
+/// differences), for rows active at many steps and for rows that admit no control while
+/// `x_1 < 0.1`.
+#[test]
+fn rows_of_the_accepted_forward_pass_are_reused_to_the_bit() {
+    let cost = TrackingCost {
+        state: vec![2.0, 1.0],
+        control: vec![0.5, 0.5],
+        terminal: vec![4.0, 2.0],
+    };
+    let x_ref: Vec<f64> = (0..=8).flat_map(|k| [1.5 - 0.1 * k as f64, 0.3]).collect();
+    let settings = IlqrSettings {
+        max_iterations: 30,
+        tolerance: 1e-14,
+        ..IlqrSettings::default()
+    };
+    let cases = [
+        // u_1 + u_2 <= 0.4 + x_1 and -u_1 <= 0.3 + x_1: active at many steps.
+        (vec![1.0, 1.0, -1.0, 0.0], vec![0.4, 0.3], false),
+        // u_1 <= 0.1 + x_1 and u_1 >= 0.3 - x_1: empty while x_1 < 0.1.
+        (vec![1.0, 0.0, -1.0, 0.0], vec![0.1, -0.3], true),
+    ];
+    for ((g, bounds, empty), jacobian) in
+        cases.iter().flat_map(|case| [(case, false), (case, true)])
+    {
+        let plan = |reuse: u8| {
+            let mut sys = Linear {
+                a: vec![1.0, 0.1, -0.05, 0.98],
+                b: vec![0.0, 0.05, 0.1, 0.02],
+                nx: 2,
+                nu: 2,
+            };
+            let mut rows = Moving {
+                fixed: Fixed {
+                    rows: g.clone(),
+                    bounds: bounds.clone(),
+                },
+                slope: 1.0,
+                reuse,
+                jacobian,
+                calls: 0,
+            };
+            let mut ilqr = Ilqr::new(2, 2, 8, &cost).unwrap();
+            ilqr.reserve_constraints(2).unwrap();
+            ilqr.state_references_mut().copy_from_slice(&x_ref);
+            let report = ilqr
+                .solve_constrained(&mut sys, &mut rows, &[0.0, 0.0], &settings)
+                .unwrap();
+            assert!(report.iterations > 1, "{report:?}");
+            assert_eq!(report.relaxed_nodes > 0, *empty, "{report:?}");
+            let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            (
+                bits(ilqr.controls()),
+                bits(ilqr.states()),
+                rows.calls,
+                report.relaxed_nodes,
+            )
+        };
+        let fresh = plan(0);
+        let mut calls = vec![fresh.2];
+        for reuse in [1, 2] {
+            let reused = plan(reuse);
+            assert_eq!(
+                fresh.0, reused.0,
+                "controls (reuse {reuse}, jacobian {jacobian})"
+            );
+            assert_eq!(
+                fresh.1, reused.1,
+                "states (reuse {reuse}, jacobian {jacobian})"
+            );
+            assert_eq!(
+                fresh.3, reused.3,
+                "relaxed (reuse {reuse}, jacobian {jacobian})"
+            );
+            calls.push(reused.2);
+        }
+        // With the state Jacobian the gain moves the controls along the rows and the forward
+        // pass's projection moves some of them: only rows of `(k, x)` alone are reused there.
+        let fewer = if jacobian {
+            calls[2] < calls[1]
+        } else {
+            calls[2] <= calls[1]
+        };
+        assert!(
+            fewer && calls[1] < calls[0],
+            "evaluations {calls:?} (jacobian {jacobian})"
+        );
+    }
+}
+
+/// A constrained solve allocates nothing, on a clone of a solver too (a clone's working memory
+/// is sized as the original's, whatever the projections' active sets held before).
+#[test]
+fn a_constrained_solve_allocates_nothing_on_a_clone_too() {
+    assert!(test_support::alloc::is_counting());
+    let cost = TrackingCost {
+        state: vec![2.0, 1.0],
+        control: vec![0.5, 0.5],
+        terminal: vec![4.0, 2.0],
+    };
+    let mut sys = Linear {
+        a: vec![1.0, 0.1, -0.05, 0.98],
+        b: vec![0.0, 0.05, 0.1, 0.02],
+        nx: 2,
+        nu: 2,
+    };
+    // Four rows, two of them active together at the early steps.
+    let mut rows = Fixed {
+        rows: vec![1.0, 1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0],
+        bounds: vec![0.4, 0.3, 0.5, 0.35],
+    };
+    // The original plans at rest within the rows (no projection has an active set), the clone
+    // towards a reference that needs them.
+    let mut ilqr = Ilqr::new(2, 2, 8, &cost).unwrap();
+    ilqr.reserve_constraints(4).unwrap();
+    let settings = IlqrSettings::default();
+    ilqr.solve_constrained(&mut sys, &mut rows, &[0.0, 0.0], &settings)
+        .unwrap();
+    let mut clone = ilqr.clone();
+    clone.state_references_mut().fill(2.0);
+    let count = test_support::alloc::allocations_during(|| {
+        clone
+            .solve_constrained(&mut sys, &mut rows, &[0.1, 0.0], &settings)
+            .unwrap();
+    });
+    assert_eq!(count, 0);
+    let active = clone
+        .controls()
+        .chunks_exact(2)
+        .filter(|u| (u[0] + u[1] - 0.4).abs() < 1e-9 || (u[1] - 0.35).abs() < 1e-9)
+        .count();
+    assert!(active > 1, "{:?}", clone.controls());
+}

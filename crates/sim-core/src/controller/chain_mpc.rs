@@ -36,18 +36,12 @@ impl ChainMpcController {
         reference: Box<dyn Reference>,
     ) -> Result<Self, SimError> {
         let n = model.n_links();
-        if reference.n_coords() != n {
-            return Err(SimError::setting(
-                "controller.mpc",
-                format!(
-                    "previews a reference of {} coordinates, the chain has {n} joints",
-                    reference.n_coords()
-                ),
-            ));
-        }
-        let mpc = ChainMpc::new(model, settings)
-            .map_err(|error| SimError::setting("controller.mpc", error.to_string()))?;
-        let preview = ReferencePreview::new(reference, settings.horizon + 1, settings.step)?;
+        let (mpc, preview) = super::mpc::solver_and_preview(
+            settings,
+            reference,
+            (n, &format!("the chain has {n} joints")),
+            || ChainMpc::new(model, settings),
+        )?;
         Ok(Self {
             mpc,
             preview,

@@ -6,7 +6,30 @@ use super::{ControlContext, Controller, ControllerError, check_context};
 use crate::error::SimError;
 use crate::reference::{Reference, ReferencePreview};
 use modal_reduce::Plant;
-use optimal_ctl::{Mpc, MpcSettings};
+use optimal_ctl::{Mpc, MpcSettings, OptimalError};
+
+/// The solver that `build` makes (its refusal named `controller.mpc`) and the preview of
+/// `reference` over its horizon, for a model of `coords` coordinates (`have`: how the model
+/// counts them, in the refusal of a reference of another number).
+pub(super) fn solver_and_preview<T>(
+    settings: &MpcSettings,
+    reference: Box<dyn Reference>,
+    (coords, have): (usize, &str),
+    build: impl FnOnce() -> Result<T, OptimalError>,
+) -> Result<(T, ReferencePreview), SimError> {
+    if reference.n_coords() != coords {
+        return Err(SimError::setting(
+            "controller.mpc",
+            format!(
+                "previews a reference of {} coordinates, {have}",
+                reference.n_coords()
+            ),
+        ));
+    }
+    let solver = build().map_err(|error| SimError::setting("controller.mpc", error.to_string()))?;
+    let preview = ReferencePreview::new(reference, settings.horizon + 1, settings.step)?;
+    Ok((solver, preview))
+}
 
 /// Receding-horizon MPC ([`Mpc`]): at the first sample, and then at the first sample at least one
 /// model step `h` after the last plan, it previews the reference over the horizon
@@ -85,18 +108,12 @@ impl MpcController {
         let model = model.into();
         let m = model.n_coords();
         super::check_coordinate_count("controller.mpc", m)?;
-        if reference.n_coords() != m {
-            return Err(SimError::setting(
-                "controller.mpc",
-                format!(
-                    "previews a reference of {} coordinates, the model has {m}",
-                    reference.n_coords()
-                ),
-            ));
-        }
-        let mpc = Mpc::new(model, settings)
-            .map_err(|error| SimError::setting("controller.mpc", error.to_string()))?;
-        let preview = ReferencePreview::new(reference, settings.horizon + 1, settings.step)?;
+        let (mpc, preview) = solver_and_preview(
+            settings,
+            reference,
+            (m, &format!("the model has {m}")),
+            || Mpc::new(model, settings),
+        )?;
         Ok(Self {
             mpc,
             preview,

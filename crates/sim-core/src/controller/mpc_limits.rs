@@ -80,34 +80,38 @@ struct ClearanceRows {
     /// step.
     retain: f64,
     placement: Placement,
+    /// The joints' gradient of one pair's clearance (`n` planar, `2n` spatial), and the modal
+    /// map's `J^T` (`m x joints`, row-major).
+    joint_gradient: Vec<f64>,
+    jacobian_t: Vec<f64>,
     /// Per pair: the modal gradient of its clearance (`m`, filled for the candidates).
     gradients: Vec<f64>,
-    /// Per candidate pair: its slack at the next node and its index.
+    /// Room for every pair as a candidate: each one's slack at the next node and its index.
     candidates: Vec<(f64, usize)>,
-    /// The pairs of the rows written last, in row order.
+    /// The pairs of the rows written last, in row order (the first `n_rows`).
     pairs: Vec<usize>,
+    n_rows: usize,
 }
 
 /// How the chain is placed for its clearance, by family.
 #[derive(Debug, Clone)]
 enum Placement {
-    /// The planar chain: its link lengths and joint angles; the modal gradients from
-    /// `clearance::modal_gradients`.
+    /// The planar chain: its link lengths and joint angles; a pair's joint gradient from
+    /// `clearance::joint_gradient`.
     Planar {
         link_lengths: Vec<f64>,
         theta: Vec<f64>,
     },
     /// The spatial universal-joint chain: its `2n` joint angles, its `n + 1` points and each
     /// link's two joint axes (`z`, then `y`) in the world frame, walked as
-    /// `backbone_kin::spatial_joint_positions` walks them; the joints' clearance gradient
-    /// (`2n`) mapped by `J^T`.
+    /// `backbone_kin::spatial_joint_positions` walks them; a pair's joint gradient from
+    /// [`spatial_joint_gradient`].
     Spatial {
         theta: Vec<f64>,
         points: Vec<[f64; 3]>,
         axes: Vec<[[f64; 3]; 2]>,
         /// The `z` axes, for `clearance::place` (which distances do not use).
         place_axes: Vec<[f64; 3]>,
-        joint_gradient: Vec<f64>,
     },
 }
 
@@ -127,12 +131,11 @@ enum Placement {
 /// - clearance: `d(a_{k+1}(u')) ~ d(a_{k+1}(u)) + grad_a d . B_a (u' - u) >=
 ///   min(d(a), c + rho (d(a) - c))`, `rho = exp(-h / T)` with `T` =
 ///   [`CLEARANCE_APPROACH_S`], the first-order expansion about the predicted next coordinates
-///   (the modal gradient there: `clearance::modal_gradients` on a planar arm, the joints'
-///   gradient through `J^T` on a spatial one; `d(a)` to first order back from them), for every
-///   pair (link-obstacle and link-link) within [`CLEARANCE_ACTIVATION_M`] of the margin `c` at
-///   `a_{k+1}(u)`, the [`MAX_CLEARANCE_ROWS`] with the least slack: a pair closes its gap over
-///   the margin at most by the factor `rho` a step, and one already inside the margin may not
-///   come closer.
+///   (the modal gradient there: the pair's joint gradient through `J^T`, eq 14; `d(a)` to
+///   first order back from them), for every pair (link-obstacle and link-link) within
+///   [`CLEARANCE_ACTIVATION_M`] of the margin `c` at `a_{k+1}(u)`, the [`MAX_CLEARANCE_ROWS`]
+///   with the least slack: a pair closes its gap over the margin at most by the factor `rho` a
+///   step, and one already inside the margin may not come closer.
 ///
 /// The solve's gain takes in the joint rows' state dependence (their state Jacobian by forward
 /// differences, [`StepConstraints::state_jacobian`]) when there are no clearance rows.
@@ -227,7 +230,9 @@ impl MpcConstraints {
     /// The clearance pairs (indices into [`ClearanceModel::pairs`]) of the rows written last,
     /// in row order after the joint rows.
     pub fn clearance_pairs(&self) -> &[usize] {
-        self.clearance.as_ref().map_or(&[], |c| &c.pairs)
+        self.clearance
+            .as_ref()
+            .map_or(&[], |c| &c.pairs[..c.n_rows])
     }
 
     /// The rows with `plant` (the arm they were made for), as [`StepConstraints`].
@@ -336,32 +341,29 @@ impl ClearanceRows {
         self.place(plant, next_a)?;
         clearance::distances(&self.model, &mut self.data);
         let reach = self.margin + CLEARANCE_ACTIVATION_M;
-        self.candidates.clear();
+        let mut n_candidates = 0;
         for (p, &next) in self.data.distances().iter().enumerate() {
             if next < reach {
-                self.candidates.push((next, p));
+                self.candidates[n_candidates] = (next, p);
+                n_candidates += 1;
             }
         }
         // Their modal gradients there, and the slack over the floor
         // min(d(a), c + retain (d(a) - c)), d(a) to first order back from the next coordinates.
-        if !self.candidates.is_empty() {
-            self.prepare_gradients(plant)?;
-        }
-        for c in 0..self.candidates.len() {
+        for c in 0..n_candidates {
             let (next, p) = self.candidates[c];
-            self.gradient(plant, p)?;
+            self.gradient(m, p)?;
             let gradient = &self.gradients[p * m..(p + 1) * m];
             let now = next - dot_difference(gradient, next_a, a);
             let floor = now.min(self.margin + self.retain * (now - self.margin));
             self.candidates[c].0 = next - floor;
         }
-        if self.candidates.len() > MAX_CLEARANCE_ROWS {
-            self.candidates
+        if n_candidates > MAX_CLEARANCE_ROWS {
+            self.candidates[..n_candidates]
                 .select_nth_unstable_by(MAX_CLEARANCE_ROWS - 1, |x, y| x.0.total_cmp(&y.0));
-            self.candidates.truncate(MAX_CLEARANCE_ROWS);
+            n_candidates = MAX_CLEARANCE_ROWS;
         }
-        self.pairs.clear();
-        for (r, &(slack, p)) in self.candidates.iter().enumerate() {
+        for (r, &(slack, p)) in self.candidates[..n_candidates].iter().enumerate() {
             // d(a_{k+1}(u')) ~ d(a_{k+1}(u)) + c . (u' - u) >= floor, c = grad d . B_a:
             // -c . u' <= slack - c . u.
             let gradient = &self.gradients[p * m..(p + 1) * m];
@@ -370,9 +372,10 @@ impl ClearanceRows {
                 *value = -(0..m).map(|l| gradient[l] * b_a[l * m + i]).sum::<f64>();
             }
             bounds[r] = slack + dot(row, u);
-            self.pairs.push(p);
+            self.pairs[r] = p;
         }
-        Ok(self.candidates.len())
+        self.n_rows = n_candidates;
+        Ok(n_candidates)
     }
 
     /// Places the chain at the coordinates `a`.
@@ -414,43 +417,28 @@ impl ClearanceRows {
         Ok(())
     }
 
-    /// Readies the modal gradients after the distances: a planar arm's, every pair's at once
-    /// (`clearance::modal_gradients`, `O(m)` a pair after `O(n m)`).
-    fn prepare_gradients(&mut self, plant: Plant<'_>) -> Result<(), OptimalError> {
-        if let Plant::Planar(model) = plant {
-            clearance::modal_gradients(&self.model, &mut self.data, model.map())
-                .map_err(clearance_failure)?;
+    /// The modal gradient `d d / d a = J^T d d / d theta` of pair `p`'s clearance (after the
+    /// distances) into `gradients`: the pair's joint gradient through eq 14's `J^T`, `O(n m)`,
+    /// for the few pairs near the margin alone.
+    fn gradient(&mut self, m: usize, p: usize) -> Result<(), OptimalError> {
+        match &self.placement {
+            Placement::Planar { .. } => {
+                clearance::joint_gradient(&self.model, &self.data, p, &mut self.joint_gradient)
+                    .map_err(clearance_failure)?;
+            }
+            Placement::Spatial { points, axes, .. } => spatial_joint_gradient(
+                self.model.pairs()[p],
+                &self.data.closest()[p],
+                (points, axes),
+                &mut self.joint_gradient,
+            ),
         }
-        Ok(())
-    }
-
-    /// The modal gradient of pair `p`'s clearance (after [`prepare_gradients`](Self::prepare_gradients))
-    /// into `gradients`.
-    fn gradient(&mut self, plant: Plant<'_>, p: usize) -> Result<(), OptimalError> {
-        let m = plant.n_coords();
-        let out = &mut self.gradients[p * m..(p + 1) * m];
-        match (&mut self.placement, plant) {
-            (Placement::Planar { .. }, Plant::Planar(_)) => {
-                out.copy_from_slice(self.data.modal_gradient(p));
-            }
-            (
-                Placement::Spatial {
-                    points,
-                    axes,
-                    joint_gradient,
-                    ..
-                },
-                Plant::Spatial(_),
-            ) => {
-                spatial_joint_gradient(
-                    self.model.pairs()[p],
-                    &self.data.closest()[p],
-                    (points, axes),
-                    joint_gradient,
-                );
-                plant.project_torques(joint_gradient, out)?;
-            }
-            _ => unreachable!("the clearance rows are built for the arm's own family"),
+        let joints = self.joint_gradient.len();
+        for (out, column) in self.gradients[p * m..(p + 1) * m]
+            .iter_mut()
+            .zip(self.jacobian_t.chunks_exact(joints))
+        {
+            *out = dot(column, &self.joint_gradient);
         }
         Ok(())
     }
@@ -486,6 +474,11 @@ impl StepConstraints for BoundConstraints<'_> {
     fn state_jacobian(&self) -> bool {
         self.constraints.clearance.is_none()
     }
+
+    /// The rows are those of `(x, u)` (`B` from `x`, not the `b` handed in).
+    fn rows_of_state_and_control(&self) -> bool {
+        true
+    }
 }
 
 /// The angle rows of `plant` under `limits` with approach time `approach`.
@@ -510,14 +503,7 @@ fn angle_rows(plant: Plant<'_>, limits: &[f64], approach: f64) -> Result<AngleRo
             format!("must be positive and at most 1e3 s, got {approach}"),
         ));
     }
-    // Row j of J is J^T e_j (eq 14's projection of a unit joint torque); theta_0 = theta(0).
-    let mut jacobian = vec![0.0; n * m];
-    let mut unit = vec![0.0; n];
-    for (j, row) in jacobian.chunks_exact_mut(m).enumerate() {
-        unit.fill(0.0);
-        unit[j] = 1.0;
-        plant.project_torques(&unit, row).map_err(SimError::Model)?;
-    }
+    let jacobian = joint_jacobian(plant)?;
     let mut offset = vec![0.0; n];
     let zero = vec![0.0; m];
     match plant {
@@ -530,6 +516,28 @@ fn angle_rows(plant: Plant<'_>, limits: &[f64], approach: f64) -> Result<AngleRo
         offset,
         approach,
     })
+}
+
+/// The modal map's `J = d theta / d a` (`joints x m`, row-major; `theta = J a + theta_0`): row
+/// `j` is `J^T e_j`, eq 14's projection of a unit joint torque.
+fn joint_jacobian(plant: Plant<'_>) -> Result<Vec<f64>, SimError> {
+    let (n, m) = (plant.n_joints(), plant.n_coords());
+    let mut jacobian = vec![0.0; n * m];
+    let mut unit = vec![0.0; n];
+    for (j, row) in jacobian.chunks_exact_mut(m).enumerate() {
+        unit.fill(0.0);
+        unit[j] = 1.0;
+        plant.project_torques(&unit, row).map_err(SimError::Model)?;
+    }
+    Ok(jacobian)
+}
+
+/// The transpose of `a` (row-major, `columns` columns).
+fn transpose(a: &[f64], columns: usize) -> Vec<f64> {
+    let rows = a.len().checked_div(columns).unwrap_or(0);
+    (0..columns)
+        .flat_map(|c| (0..rows).map(move |r| a[r * columns + c]))
+        .collect()
 }
 
 /// The clearance rows of `plant` among `model` with `margin`.
@@ -555,8 +563,18 @@ fn clearance_rows(
             ),
         ));
     }
-    // Sized (and bounded: pairs x coordinates) as the data's own modal gradients.
-    let data = ClearanceData::new(model, m)
+    let pairs = model.pairs().len();
+    if pairs.saturating_mul(m) > clearance::MAX_GRADIENT_ENTRIES {
+        return Err(SimError::setting(
+            "obstacles",
+            format!(
+                "cannot be measured: {pairs} pairs x {m} coordinates exceed {} gradient entries",
+                clearance::MAX_GRADIENT_ENTRIES
+            ),
+        ));
+    }
+    // No modal gradients in the data: each candidate's comes from its joint gradient.
+    let data = ClearanceData::new(model, 0)
         .map_err(|e| SimError::setting("obstacles", format!("cannot be measured: {e}")))?;
     let placement = match plant {
         Plant::Planar(planar) => Placement::Planar {
@@ -568,7 +586,6 @@ fn clearance_rows(
             points: vec![[0.0; 3]; n + 1],
             axes: vec![[[0.0; 3]; 2]; n],
             place_axes: vec![[0.0; 3]; n],
-            joint_gradient: vec![0.0; 2 * n],
         },
     };
     Ok(ClearanceRows {
@@ -577,9 +594,12 @@ fn clearance_rows(
         margin,
         retain: (-step / CLEARANCE_APPROACH_S).exp(),
         placement,
-        gradients: vec![0.0; model.pairs().len() * m],
-        candidates: Vec::with_capacity(model.pairs().len()),
-        pairs: Vec::with_capacity(MAX_CLEARANCE_ROWS),
+        joint_gradient: vec![0.0; plant.n_joints()],
+        jacobian_t: transpose(&joint_jacobian(plant)?, m),
+        gradients: vec![0.0; pairs * m],
+        candidates: vec![(0.0, 0); pairs],
+        pairs: vec![0; pairs.min(MAX_CLEARANCE_ROWS)],
+        n_rows: 0,
     })
 }
 
