@@ -47,6 +47,7 @@ pub use fuzzy::FuzzyController;
 pub use fuzzy::{SCHEDULED_INPUTS_PER_COORDINATE, scheduled_inputs};
 pub use lqr::LqrController;
 pub use mpc::MpcController;
+pub(crate) use mpc_limits::joint_jacobian;
 pub use mpc_limits::{
     ANGLE_ACTIVATION_RAD, BoundConstraints, CLEARANCE_ACTIVATION_M, CLEARANCE_APPROACH_S,
     MAX_CLEARANCE_MARGIN_M, MAX_CLEARANCE_ROWS, MpcConstraints, MpcLimits,

@@ -520,7 +520,7 @@ fn angle_rows(plant: Plant<'_>, limits: &[f64], approach: f64) -> Result<AngleRo
 
 /// The modal map's `J = d theta / d a` (`joints x m`, row-major; `theta = J a + theta_0`): row
 /// `j` is `J^T e_j`, eq 14's projection of a unit joint torque.
-fn joint_jacobian(plant: Plant<'_>) -> Result<Vec<f64>, SimError> {
+pub(crate) fn joint_jacobian(plant: Plant<'_>) -> Result<Vec<f64>, SimError> {
     let (n, m) = (plant.n_joints(), plant.n_coords());
     let mut jacobian = vec![0.0; n * m];
     let mut unit = vec![0.0; n];

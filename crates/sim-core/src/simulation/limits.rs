@@ -3,6 +3,7 @@
 //! joint rates keep every joint within `limits.joint_angle_rad` (`docs/theory.md`, "Enforced
 //! joint limits").
 
+use crate::controller::joint_jacobian;
 use crate::error::SimError;
 use modal_reduce::{Plant, PlantData};
 use optimal_ctl::{PolytopeProjection, ProjectionFailure};
@@ -102,25 +103,15 @@ impl LimitProjection {
         let (n, m) = (plant.n_joints(), plant.n_coords());
         let angle = match angle {
             None => None,
-            Some(limits) => {
-                // Row j of J is J^T e_j (eq 14's projection of a unit joint torque).
-                let mut jacobian = vec![0.0; n * m];
-                let mut unit = vec![0.0; n];
-                for (j, row) in jacobian.chunks_exact_mut(m).enumerate() {
-                    unit.fill(0.0);
-                    unit[j] = 1.0;
-                    plant.project_torques(&unit, row).map_err(SimError::Model)?;
-                }
-                Some(AngleLimits {
-                    limits: limits.to_vec(),
-                    jacobian,
-                    approach: JOINT_ANGLE_APPROACH_S.max(period),
-                    theta: vec![0.0; n],
-                    rate: vec![0.0; n],
-                    next_rate: vec![0.0; n],
-                    column: vec![0.0; n],
-                })
-            }
+            Some(limits) => Some(AngleLimits {
+                limits: limits.to_vec(),
+                jacobian: joint_jacobian(plant)?,
+                approach: JOINT_ANGLE_APPROACH_S.max(period),
+                theta: vec![0.0; n],
+                rate: vec![0.0; n],
+                next_rate: vec![0.0; n],
+                column: vec![0.0; n],
+            }),
         };
         let rows = 4 * n + 2 * m;
         Ok(Some(Self {
