@@ -165,6 +165,10 @@ impl<S: Simd> Pack<S> {
     /// The first `m` lanes (`m` at most the register's width) turned by `by`: lane `i < m` of the
     /// result is lane `(i + by) % m` of `self`, the lanes from `m` on are zero. With `by` and `m`
     /// constants the compiler makes it one permutation.
+    ///
+    /// # Panics
+    /// If `m` is more than the register's lanes (a caller's bug: `m` is a constant of the
+    /// kernel, not an input).
     #[inline(always)]
     pub fn rotate_lanes(self, by: usize, m: usize) -> Self {
         let lanes: &[f64] = pulp::bytemuck::cast_slice(std::slice::from_ref(&self.value));

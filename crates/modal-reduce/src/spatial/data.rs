@@ -44,7 +44,7 @@ pub struct SpatialReducedData {
     /// Every link's motion, for the backward pass of the joint torques.
     pub(crate) links: Vec<LinkMotion>,
     /// The processor's instruction set, found at construction (the terms' kernel runs on it as
-    /// `terms::dispatch_one_state` says).
+    /// `terms::TermsOfOneState::run` says).
     pub(crate) arch: Arch,
 }
 

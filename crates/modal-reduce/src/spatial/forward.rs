@@ -2,7 +2,7 @@
 
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
-use super::terms::{TermsOfOneState, check_shapes, check_state, check_terms, dispatch_one_state};
+use super::terms::{TermsOfOneState, check_shapes, check_state, check_terms};
 use crate::error::ReduceError;
 use lane_math::{check_all_finite, check_len};
 
@@ -25,18 +25,14 @@ pub fn spatial_forward_dynamics(
     check_len("tau_star", tau_star.len(), m)?;
     check_len("a_ddot", a_ddot.len(), m)?;
     check_shapes(model, data, a, a_dot)?;
-    let arch = data.arch;
-    let outcome = dispatch_one_state(
-        arch,
-        m,
-        TermsOfOneState {
-            model,
-            data: &mut *data,
-            a,
-            a_dot,
-            solve: Some((tau_star, &mut *a_ddot)),
-        },
-    );
+    let outcome = TermsOfOneState {
+        model,
+        data: &mut *data,
+        a,
+        a_dot,
+        solve: Some((tau_star, &mut *a_ddot)),
+    }
+    .run();
     if outcome.positive_definite && outcome.finite {
         return Ok(());
     }

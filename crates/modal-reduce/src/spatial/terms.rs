@@ -35,7 +35,7 @@
 //!   (`Registers`): one state of `m = 4` or `8` coordinates holds each row of the Jacobians, of
 //!   `C*` and `G*` and each diagonal of `M*` in one register (`CoordinateLanes`, `MassRows`),
 //!   so that a row's update is one vector operation (`m = 4` in registers of 4 lanes, compiled
-//!   for AVX-512 where there is one: `dispatch_one_state`); more coordinates go one a
+//!   for AVX-512 where there is one: `TermsOfOneState::run`); more coordinates go one a
 //!   number (`OneStateScalar`); a batch holds one coordinate of several states a register
 //!   (`StateLanes`). Each entry gets the same operations in the same order in all of them, so a
 //!   state gives the same bits alone and in a batch.
@@ -68,18 +68,14 @@ pub fn spatial_reduced_terms(
     a_dot: &[f64],
 ) -> Result<(), ReduceError> {
     check_shapes(model, data, a, a_dot)?;
-    let (arch, m) = (data.arch, model.n_coords());
-    let outcome = dispatch_one_state(
-        arch,
-        m,
-        TermsOfOneState {
-            model,
-            data: &mut *data,
-            a,
-            a_dot,
-            solve: None,
-        },
-    );
+    let outcome = TermsOfOneState {
+        model,
+        data: &mut *data,
+        a,
+        a_dot,
+        solve: None,
+    }
+    .run();
     if outcome.finite {
         return Ok(());
     }
@@ -92,21 +88,24 @@ pub(crate) fn check_terms(data: &SpatialReducedData) -> Result<(), ReduceError> 
     check_terms_finite(&data.mass_matrix, &data.coriolis, &data.gravity)
 }
 
-/// Runs `op` on the instruction set `arch` for one state of `m` coordinates: on AVX-512 with
-/// `m = 4`, in AVX2's registers of 4 lanes, whose rows they fill (half-filled registers of 8
-/// lanes measured about 350 against 255 ns a call at 10 links), but compiled for AVX-512, whose
-/// 32 registers rather than 16 keep the pass along the links out of memory. The same bits, as
-/// on every instruction set.
-#[inline(always)]
-pub(crate) fn dispatch_one_state<Op: WithSimd>(arch: Arch, m: usize, op: Op) -> Op::Output {
-    #[cfg(target_arch = "x86_64")]
-    if let (4, Arch::V4(v4)) = (m, arch) {
-        return v4.vectorize(InAvx2Registers { v3: *v4, op });
+impl TermsOfOneState<'_> {
+    /// Runs the kernel on the workspace's instruction set: on AVX-512 with `m = 4`, in AVX2's
+    /// registers of 4 lanes, whose rows they fill (half-filled registers of 8 lanes measured
+    /// about 350 against 255 ns a call at 10 links), but compiled for AVX-512, whose 32 registers
+    /// rather than 16 keep the pass along the links out of memory. The same bits, as on every
+    /// instruction set.
+    #[inline(always)]
+    pub(crate) fn run(self) -> Outcome {
+        let arch = self.data.arch;
+        #[cfg(target_arch = "x86_64")]
+        if let (4, Arch::V4(v4)) = (self.model.n_coords(), arch) {
+            return v4.vectorize(InAvx2Registers { v3: *v4, op: self });
+        }
+        arch.dispatch(self)
     }
-    arch.dispatch(op)
 }
 
-/// `op` on AVX2's registers, called inside an AVX-512 dispatch ([`dispatch_one_state`]).
+/// `op` on AVX2's registers, called inside an AVX-512 dispatch ([`TermsOfOneState::run`]).
 #[cfg(target_arch = "x86_64")]
 struct InAvx2Registers<Op> {
     v3: pulp::x86::V3,
@@ -125,7 +124,7 @@ impl<Op: WithSimd> pulp::NullaryFnOnce for InAvx2Registers<Op> {
 
 /// [`spatial_reduced_terms`] after its checks, and with `solve` the forward dynamics' `L D L^T`
 /// solve ([`spatial_forward_dynamics`](super::spatial_forward_dynamics)), run by
-/// [`pulp::Arch::dispatch`] so that the kernel and the solve are compiled for the processor's
+/// [`run`](Self::run) so that the kernel and the solve are compiled for the processor's
 /// instruction set.
 ///
 /// Its inputs' values are not checked beforehand: a number that is not finite in `a`, `a_dot`
