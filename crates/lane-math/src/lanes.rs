@@ -180,6 +180,20 @@ impl<S: Simd> Pack<S> {
         }
         out
     }
+
+    /// `self` with lane `index` replaced by `value` (one blend or insertion with `index` a
+    /// constant).
+    ///
+    /// # Panics
+    /// If `index` is not a lane of the register (a caller's bug: the index is a constant of the
+    /// kernel, not an input).
+    #[inline(always)]
+    pub fn with_lane(mut self, index: usize, value: f64) -> Self {
+        let lanes: &mut [f64] =
+            pulp::bytemuck::cast_slice_mut(std::slice::from_mut(&mut self.value));
+        lanes[index] = value;
+        self
+    }
 }
 
 impl<S: Simd> Add for Pack<S> {
@@ -561,6 +575,38 @@ mod tests {
     fn rotate_lanes_turns_the_first_m_lanes_and_zeroes_the_rest() {
         Arch::new().dispatch(Rotate);
         Rotate.with_simd(pulp::Scalar::new());
+    }
+
+    /// [`Pack::with_lane`] replaces its lane and keeps the others, on every lane.
+    struct Replace;
+
+    impl WithSimd for Replace {
+        type Output = ();
+
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, simd: S) {
+            let width = Pack::<S>::WIDTH;
+            let lanes: Vec<f64> = (0..width).map(|i| 10.0 + i as f64).collect();
+            let pack = Pack::load(simd, &lanes);
+            for index in 0..width {
+                let mut got = vec![f64::NAN; width];
+                pack.with_lane(index, -0.0).store(&mut got);
+                for (i, &x) in got.iter().enumerate() {
+                    let want = if i == index { -0.0 } else { lanes[i] };
+                    assert_eq!(
+                        x.to_bits(),
+                        want.to_bits(),
+                        "lane {i} of {width}, index {index}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn with_lane_replaces_one_lane_and_keeps_the_rest() {
+        Arch::new().dispatch(Replace);
+        Replace.with_simd(pulp::Scalar::new());
     }
 
     #[test]

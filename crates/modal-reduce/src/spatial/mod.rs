@@ -8,7 +8,8 @@
 //! - [`motion`]: one link's step of the forward recursion in the world frame (frames, joint axes,
 //!   angular velocity and acceleration, the acceleration of its centre of mass) for the joint
 //!   torques and the derivatives; [`terms`] runs its own in the links' frames.
-//! - [`terms`]: `M*`, `C*`, `G*` in `O(n m^2)` without the `2n x 2n` mass matrix.
+//! - [`terms`]: `M*`, `C*`, `G*` in `O(n m^2)` without the `2n x 2n` mass matrix; `carried`:
+//!   the motion its pass carries from link to link.
 //! - [`projection`]: the same terms by projecting the chain's CRBA mass matrix and Newton-Euler
 //!   efforts (`J^T M J`, `O(n^2 m)`), the cross-check of [`terms`].
 //! - [`torques`]: the joint torques that realise a modal motion (Newton-Euler, `O(n)`).
@@ -18,6 +19,7 @@
 //!   [`derivatives`]: the analytic derivatives of the reduced forward dynamics, `O(n m^2)`.
 
 pub mod batch;
+mod carried;
 pub mod data;
 pub mod derivatives;
 pub mod forward;

@@ -80,6 +80,9 @@ pub struct SpatialReducedModel {
     /// `k` of `P`, the weight of `a_k` in every link's angle, then zeros, so that the angles of all
     /// links are formed a whole register of links at a time.
     angle_columns: Vec<f64>,
+    /// Each link's `[Izz - Iyy, Ixx - Izz, Iyy - Ixx]`, the factors of its gyroscopic torque
+    /// `w x I_b w` ([`spin_moments`](Self::spin_moments)).
+    spin_moments: Vec<[f64; 3]>,
 }
 
 impl SpatialReducedModel {
@@ -122,7 +125,15 @@ impl SpatialReducedModel {
                 angle_columns[k * padded + i] = value;
             }
         }
+        let spin_moments = links
+            .iter()
+            .map(|link| {
+                let [xx, yy, zz] = link.principal;
+                [zz - yy, xx - zz, yy - xx]
+            })
+            .collect();
         Ok(Self {
+            spin_moments,
             map,
             base_rotation: base.rotation(),
             base,
@@ -186,6 +197,12 @@ impl SpatialReducedModel {
     /// [`LINK_PADDING`] values.
     pub(crate) fn joint_rows(&self, i: usize) -> &[f64] {
         &self.joint_rows[2 * i * self.n_coords()..]
+    }
+
+    /// Each link's `[Izz - Iyy, Ixx - Izz, Iyy - Ixx]`: its gyroscopic torque in its own frame is
+    /// `w x I_b w = [(Izz - Iyy) w_y w_z, (Ixx - Izz) w_z w_x, (Iyy - Ixx) w_x w_y]`.
+    pub(crate) fn spin_moments(&self) -> &[[f64; 3]] {
+        &self.spin_moments
     }
 
     /// The number of links rounded up to a multiple of [`LINK_PADDING`].

@@ -41,10 +41,18 @@
 //!   state gives the same bits alone and in a batch.
 //! - The rows of `J` per link (`[P_i, 0]`, `[0, P_i]`) are constants of the model, loaded as
 //!   registers.
+//! - The motion carried from link to link (`w`, `w_dot`, the joint point's acceleration and
+//!   gravity) sits, for one state, in the lanes of one register a component
+//!   (module `carried`): its two turns a link are eight vector operations. The
+//!   gyroscopic torque is `w x I_b w = [(Izz - Iyy) w_y w_z, (Ixx - Izz) w_z w_x,
+//!   (Iyy - Ixx) w_x w_y]`, the differences of moments formed with the model.
 
+use super::carried::{
+    ACCEL, CarriedMotion, GRAVITY, OMEGA, OMEGA_DOT, PackedMotion, SeparateMotion, to_child,
+};
 use super::data::SpatialReducedData;
 use super::model::SpatialReducedModel;
-use super::motion::{JointTurns, cross_fused};
+use super::motion::JointTurns;
 use crate::error::{ReduceError, check_terms_finite};
 use crate::forward::right_hand_side;
 use crate::model::LINK_PADDING;
@@ -589,18 +597,18 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
     }
     // Gravity in the base's frame, `R_0^T g`.
     let (world_gravity, base) = (model.gravity(), model.base_rotation());
-    let value_zero = Y::Value::splat(context, 0.0);
-    let mut gravity = [value_zero; 3];
+    let mut gravity = [0.0; 3];
     for (d, entry) in gravity.iter_mut().enumerate() {
-        let g = base[2][d].mul_add(
+        *entry = base[2][d].mul_add(
             world_gravity[2],
             base[1][d].mul_add(world_gravity[1], base[0][d] * world_gravity[0]),
         );
-        *entry = Y::Value::splat(context, g);
     }
-    let (mut omega, mut omega_dot, mut accel) = ([value_zero; 3], [value_zero; 3], [value_zero; 3]);
-    let per_link = model.map().link_lengths().iter().zip(model.links());
-    for (i, (&length, inertia)) in per_link.enumerate() {
+    let mut motion = layout.motion_at_rest(gravity);
+    let per_link = (model.map().link_lengths().iter())
+        .zip(model.links())
+        .zip(model.spin_moments());
+    for (i, ((&length, inertia), spin_moments)) in per_link.enumerate() {
         // `next` called here, not through an iterator adapter: an adapter is compiled without the
         // instruction set of the SIMD dispatch and would call the batch's intrinsics.
         let Some(JointTurns { sin, cos, rates }) = turns.next() else {
@@ -611,56 +619,57 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
         let [rate_z, rate_y] = rates;
         // Into the frame after the joint about z (`Rz^T`), that joint's motion, into the link's
         // frame (`Ry^T`, the plane (z, x)).
-        for v in [&mut omega, &mut omega_dot, &mut accel, &mut gravity] {
-            to_child(v, [0, 1], sin_z, cos_z);
-        }
+        motion.turn([0, 1], sin_z, cos_z);
         // w_dot += (w x e_z) z_dot; w += e_z z_dot; w_dot += (w x e_y) y_dot; w += e_y y_dot.
-        omega_dot[0] = omega[1].mul_add(rate_z, omega_dot[0]);
-        omega_dot[1] = omega[0].neg_mul_add(rate_z, omega_dot[1]);
-        omega[2] = omega[2] + rate_z;
-        omega_dot[0] = omega[2].neg_mul_add(rate_y, omega_dot[0]);
-        omega_dot[2] = omega[0].mul_add(rate_y, omega_dot[2]);
-        omega[1] = omega[1] + rate_y;
-        for v in [&mut omega, &mut omega_dot, &mut accel, &mut gravity] {
-            to_child(v, [2, 0], sin_y, cos_y);
-        }
+        let [wx, wy, wz] = motion.vector(OMEGA);
+        let w_dot = motion.vector(OMEGA_DOT);
+        let w_dot_x = wy.mul_add(rate_z, w_dot[0]);
+        motion.set(OMEGA_DOT, 1, wx.neg_mul_add(rate_z, w_dot[1]));
+        let wz = wz + rate_z;
+        motion.set(OMEGA, 2, wz);
+        motion.set(OMEGA_DOT, 0, wz.neg_mul_add(rate_y, w_dot_x));
+        motion.set(OMEGA_DOT, 2, wx.mul_add(rate_y, w_dot[2]));
+        motion.set(OMEGA, 1, wy + rate_y);
+        motion.turn([2, 0], sin_y, cos_y);
+        let (omega, omega_dot, accel) = (
+            motion.vector(OMEGA),
+            motion.vector(OMEGA_DOT),
+            motion.vector(ACCEL),
+        );
         // The acceleration along the link at zero joint accelerations: `a_p + r L change`,
         // `change = w_dot x e_x + w x (w x e_x)` (`r = 1/2` at the centre of mass).
         let (half_length, full) = (
             Y::Value::splat(context, 0.5 * length),
             Y::Value::splat(context, length),
         );
+        let (xy, xz) = (omega[0] * omega[1], omega[0] * omega[2]);
         let squares = omega[2].mul_add(omega[2], omega[1] * omega[1]);
-        let change_y = omega[0].mul_add(omega[1], omega_dot[2]);
-        let change_z = omega[0] * omega[2] - omega_dot[1];
+        let change_y = xy + omega_dot[2];
+        let change_z = xz - omega_dot[1];
         let com_accel = [
             squares.neg_mul_add(half_length, accel[0]),
             change_y.mul_add(half_length, accel[1]),
             change_z.mul_add(half_length, accel[2]),
         ];
-        accel = [
-            squares.neg_mul_add(full, accel[0]),
-            change_y.mul_add(full, accel[1]),
-            change_z.mul_add(full, accel[2]),
-        ];
+        motion.set(ACCEL, 0, squares.neg_mul_add(full, accel[0]));
+        motion.set(ACCEL, 1, change_y.mul_add(full, accel[1]));
+        motion.set(ACCEL, 2, change_z.mul_add(full, accel[2]));
         let principal = [
             Y::Value::splat(context, inertia.principal[0]),
             Y::Value::splat(context, inertia.principal[1]),
             Y::Value::splat(context, inertia.principal[2]),
         ];
-        let spin = cross_fused(
-            omega,
-            [
-                omega[0] * principal[0],
-                omega[1] * principal[1],
-                omega[2] * principal[2],
-            ],
-        );
+        // w x I_b w.
+        let spin = [
+            Y::Value::splat(context, spin_moments[0]) * (omega[1] * omega[2]),
+            Y::Value::splat(context, spin_moments[1]) * xz,
+            Y::Value::splat(context, spin_moments[2]) * xy,
+        ];
         let mut torque = spin;
         for d in 0..3 {
             torque[d] = principal[d].mul_add(omega_dot[d], spin[d]);
         }
-        let weight = spread(layout, gravity);
+        let weight = spread(layout, motion.vector(GRAVITY));
         let (torque, com_accel) = (spread(layout, torque), spread(layout, com_accel));
         let principal = spread(layout, principal);
         let mass = layout.spread(Y::Value::splat(context, inertia.mass));
@@ -699,7 +708,10 @@ pub(crate) fn accumulate<'w, Y: MassRows>(
                 body_inertia_jacobian[d * chunks + k] = body[d] * principal[d];
             }
             coriolis[k] = dot_add(body, torque, dot_add(p, com_accel, coriolis[k]));
-            gravity_terms[k] = gravity_terms[k] - dot_add(p, weight, zero);
+            gravity_terms[k] = p[2].neg_mul_add(
+                weight[2],
+                p[1].neg_mul_add(weight[1], p[0].neg_mul_add(weight[0], gravity_terms[k])),
+            );
         }
         // M* += (m Jv)^T Jv + Jb^T I_b Jb.
         layout.add_outers(
@@ -745,6 +757,12 @@ fn product_coordinates(m: usize, k: usize, l: usize) -> (usize, usize) {
 /// one coordinate a register, entry `(k, l)` of the lower triangle at `k m + l`, each from the
 /// products [`product_coordinates`] names.
 pub(crate) trait MassRows: Registers {
+    /// How the layout keeps the motion the pass carries.
+    type Motion: CarriedMotion<Value = Self::Value>;
+
+    /// That motion at rest under `gravity` (in the base's frame).
+    fn motion_at_rest(self, gravity: [f64; 3]) -> Self::Motion;
+
     /// The registers `M*` takes for `m` coordinates.
     #[inline(always)]
     fn mass_len(self, m: usize) -> usize {
@@ -785,6 +803,13 @@ pub(crate) trait MassRows: Registers {
 /// `a_r * (b_r turned by j lanes)` to each: one multiply-add and one permutation a diagonal and
 /// row, where rows of `M*` would take a broadcast of each coordinate.
 impl<S: Simd> MassRows for CoordinateLanes<S> {
+    type Motion = PackedMotion<S>;
+
+    #[inline(always)]
+    fn motion_at_rest(self, gravity: [f64; 3]) -> PackedMotion<S> {
+        PackedMotion::at_rest(self.register_context(), gravity)
+    }
+
     #[inline(always)]
     fn mass_len(self, m: usize) -> usize {
         m / 2 + 1
@@ -819,18 +844,26 @@ impl<S: Simd> MassRows for CoordinateLanes<S> {
     }
 }
 
-impl<S: Simd> MassRows for OneStateScalar<S> {}
+impl<S: Simd> MassRows for OneStateScalar<S> {
+    type Motion = SeparateMotion<f64>;
 
-impl<S: Simd> MassRows for StateLanes<S> {}
+    #[inline(always)]
+    fn motion_at_rest(self, gravity: [f64; 3]) -> SeparateMotion<f64> {
+        SeparateMotion::at_rest(0.0, gravity)
+    }
+}
 
-/// Vector `v` (three numbers or three rows of registers) turned from a parent frame into its
-/// child's, turned from it by `(sin, cos)` in the plane of axes `(a, b)`: `v_a' = c v_a + s v_b`,
-/// `v_b' = c v_b - s v_a`.
-#[inline(always)]
-fn to_child<L: Lane>(v: &mut [L], [a, b]: [usize; 2], sin: L, cos: L) {
-    let (va, vb) = (v[a], v[b]);
-    v[a] = vb.mul_add(sin, va * cos);
-    v[b] = va.neg_mul_add(sin, vb * cos);
+impl<S: Simd> MassRows for StateLanes<S> {
+    type Motion = SeparateMotion<Pack<S>>;
+
+    #[inline(always)]
+    fn motion_at_rest(self, gravity: [f64; 3]) -> SeparateMotion<Pack<S>> {
+        let simd = self.value_context();
+        SeparateMotion::at_rest(
+            Pack::splat(simd, 0.0),
+            gravity.map(|g| Pack::splat(simd, g)),
+        )
+    }
 }
 
 /// `acc + a . b` in fused multiply-adds, `a[0] b[0]` first.
