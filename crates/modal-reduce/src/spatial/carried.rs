@@ -3,10 +3,12 @@
 //! modal acceleration), and gravity `g`, each in the frame of the link the pass has reached.
 //!
 //! Entering a link, all four turn by the same two rotations ([`CarriedMotion::turn`]), which is
-//! most of the pass's work on them. One state keeps the four side by side in the lanes of one
-//! register per component ([`PackedMotion`]), so that a turn is four vector operations rather
-//! than sixteen; a batch keeps one register of states a number ([`SeparateMotion`]). Every
-//! number gets the same operations in the same order in both, so the bits agree.
+//! most of the pass's work on them. One state keeps `w`, `w_dot` and `g` side by side in the
+//! lanes of one register per component ([`PackedMotion`]), so that their turn is four vector
+//! operations rather than twelve; `a`, which every link then changes by its own length, stays in
+//! numbers of its own, so that its update is not held up by moving lanes in and out of those
+//! registers. A batch keeps one register of states a number ([`SeparateMotion`]). Every number
+//! gets the same operations in the same order in both, so the bits agree.
 
 use lane_math::{Lane, Pack};
 use pulp::Simd;
@@ -15,12 +17,12 @@ use pulp::Simd;
 pub(crate) const OMEGA: usize = 0;
 /// The quantity `w_dot`.
 pub(crate) const OMEGA_DOT: usize = 1;
-/// The quantity `a`, the acceleration of the joint point.
-pub(crate) const ACCEL: usize = 2;
 /// The quantity `g`, gravity.
-pub(crate) const GRAVITY: usize = 3;
+pub(crate) const GRAVITY: usize = 2;
+/// The quantity `a`, the acceleration of the joint point.
+pub(crate) const ACCEL: usize = 3;
 
-/// `w`, `w_dot`, `a` and `g` (the quantities [`OMEGA`], [`OMEGA_DOT`], [`ACCEL`], [`GRAVITY`]),
+/// `w`, `w_dot`, `g` and `a` (the quantities [`OMEGA`], [`OMEGA_DOT`], [`GRAVITY`], [`ACCEL`]),
 /// three components each, in one link's frame.
 pub(crate) trait CarriedMotion: Copy {
     /// One number of each state.
@@ -51,7 +53,9 @@ impl<V: Lane> SeparateMotion<V> {
     /// At rest (`w`, `w_dot`, `a` zero) under `gravity`.
     #[inline(always)]
     pub(crate) fn at_rest(zero: V, gravity: [V; 3]) -> Self {
-        Self([[zero; 3], [zero; 3], [zero; 3], gravity])
+        let mut motion = Self([[zero; 3]; 4]);
+        motion.0[GRAVITY] = gravity;
+        motion
     }
 }
 
@@ -76,12 +80,13 @@ impl<V: Lane> CarriedMotion for SeparateMotion<V> {
     }
 }
 
-/// One state in registers of `S` (at least four lanes): register `d` holds component `d` of
-/// the four quantities, quantity `q` in lane `q`.
+/// One state in registers of `S` (at least three lanes): register `d` holds component `d` of
+/// `w`, `w_dot` and `g`, quantity `q` in lane `q`; `a` in numbers of its own.
 #[derive(Clone, Copy)]
 pub(crate) struct PackedMotion<S: Simd> {
     simd: S,
     components: [Pack<S>; 3],
+    accel: [f64; 3],
 }
 
 impl<S: Simd> PackedMotion<S> {
@@ -92,6 +97,7 @@ impl<S: Simd> PackedMotion<S> {
         Self {
             simd,
             components: gravity.map(|g| zero.with_lane(GRAVITY, g)),
+            accel: [0.0; 3],
         }
     }
 }
@@ -108,15 +114,23 @@ impl<S: Simd> CarriedMotion for PackedMotion<S> {
             Pack::splat(simd, sin),
             Pack::splat(simd, cos),
         );
+        to_child(&mut self.accel, plane, sin, cos);
     }
 
     #[inline(always)]
     fn get(&self, q: usize, d: usize) -> f64 {
+        if q == ACCEL {
+            return self.accel[d];
+        }
         self.components[d].lane(q)
     }
 
     #[inline(always)]
     fn set(&mut self, q: usize, d: usize, value: f64) {
+        if q == ACCEL {
+            self.accel[d] = value;
+            return;
+        }
         self.components[d] = self.components[d].with_lane(q, value);
     }
 }

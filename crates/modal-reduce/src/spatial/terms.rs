@@ -41,10 +41,10 @@
 //!   state gives the same bits alone and in a batch.
 //! - The rows of `J` per link (`[P_i, 0]`, `[0, P_i]`) are constants of the model, loaded as
 //!   registers.
-//! - The motion carried from link to link (`w`, `w_dot`, the joint point's acceleration and
-//!   gravity) sits, for one state, in the lanes of one register a component
-//!   (module `carried`): its two turns a link are eight vector operations. The
-//!   gyroscopic torque is `w x I_b w = [(Izz - Iyy) w_y w_z, (Ixx - Izz) w_z w_x,
+//! - Of the motion carried from link to link (module `carried`), one state keeps `w`, `w_dot`
+//!   and gravity in the lanes of one register a component, so that their two turns a link are
+//!   eight vector operations, and the joint point's acceleration in numbers. The gyroscopic
+//!   torque is `w x I_b w = [(Izz - Iyy) w_y w_z, (Ixx - Izz) w_z w_x,
 //!   (Iyy - Ixx) w_x w_y]`, the differences of moments formed with the model.
 
 use super::carried::{
