@@ -39,12 +39,14 @@ fn direction(v: V3, scale: f64) -> (V3, f64) {
 }
 
 /// A segment `a`-`b` with what every pair of it needs: its start `a`, its axis `b - a`, and the
-/// axis' squared length and length, computed once per link rather than once per pair.
+/// axis' squared length, its inverse (zero for a point) and its length, computed once per link
+/// rather than once per pair (a division or a square root costs several multiplications).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Segment {
     start: V3,
     axis: V3,
     length2: f64,
+    inverse_length2: f64,
     length: f64,
 }
 
@@ -58,6 +60,7 @@ impl Segment {
             start: a,
             axis,
             length2,
+            inverse_length2: if length2 > 0.0 { 1.0 / length2 } else { 0.0 },
             length: length2.sqrt(),
         }
     }
@@ -79,7 +82,7 @@ pub fn segment_point(a: V3, b: V3, o: V3) -> Closest {
 #[inline]
 pub(crate) fn closest_to_point(link: &Segment, o: V3) -> Closest {
     let t = if link.length2 > 0.0 {
-        (dot(sub(o, link.start), link.axis) / link.length2).clamp(0.0, 1.0)
+        (dot(sub(o, link.start), link.axis) * link.inverse_length2).clamp(0.0, 1.0)
     } else {
         0.0
     };
@@ -107,14 +110,15 @@ pub(crate) fn closest_to_segment(link: &Segment, other: &Segment) -> Closest {
     let (d1, d2) = (link.axis, other.axis);
     let r = sub(link.start, other.start);
     let (aa, ee, f) = (link.length2, other.length2, dot(d2, r));
+    let (inverse_aa, inverse_ee) = (link.inverse_length2, other.inverse_length2);
     let (t, s) = if aa <= 0.0 && ee <= 0.0 {
         (0.0, 0.0)
     } else if aa <= 0.0 {
-        (0.0, (f / ee).clamp(0.0, 1.0))
+        (0.0, (f * inverse_ee).clamp(0.0, 1.0))
     } else {
         let cc = dot(d1, r);
         if ee <= 0.0 {
-            ((-cc / aa).clamp(0.0, 1.0), 0.0)
+            ((-cc * inverse_aa).clamp(0.0, 1.0), 0.0)
         } else {
             let bb = dot(d1, d2);
             let denom = aa * ee - bb * bb;
@@ -123,13 +127,13 @@ pub(crate) fn closest_to_segment(link: &Segment, other: &Segment) -> Closest {
             } else {
                 0.0
             };
-            let mut s = (bb * t + f) / ee;
+            let mut s = (bb * t + f) * inverse_ee;
             if s < 0.0 {
                 s = 0.0;
-                t = (-cc / aa).clamp(0.0, 1.0);
+                t = (-cc * inverse_aa).clamp(0.0, 1.0);
             } else if s > 1.0 {
                 s = 1.0;
-                t = ((bb - cc) / aa).clamp(0.0, 1.0);
+                t = ((bb - cc) * inverse_aa).clamp(0.0, 1.0);
             }
             (t, s)
         }
