@@ -547,10 +547,11 @@ mod tests {
         Check.with_simd(pulp::Scalar::new());
     }
 
-    /// [`Pack::rotate_lanes`] against the index rule, every width `m` and turn `by`.
-    struct Rotate;
+    /// [`Pack::rotate_lanes`] against the index rule, every width `m` and turn `by`, and
+    /// [`Pack::with_lane`], which replaces its lane and keeps the others, on every lane.
+    struct LaneMoves;
 
-    impl WithSimd for Rotate {
+    impl WithSimd for LaneMoves {
         type Output = ();
 
         #[inline(always)]
@@ -558,9 +559,9 @@ mod tests {
             let width = Pack::<S>::WIDTH;
             let lanes: Vec<f64> = (0..width).map(|i| 10.0 + i as f64).collect();
             let pack = Pack::load(simd, &lanes);
+            let mut got = vec![f64::NAN; width];
             for m in 1..=width {
                 for by in 0..=m {
-                    let mut got = vec![f64::NAN; width];
                     pack.rotate_lanes(by, m).store(&mut got);
                     for (i, &x) in got.iter().enumerate() {
                         let want = if i < m { lanes[(i + by) % m] } else { 0.0 };
@@ -568,45 +569,21 @@ mod tests {
                     }
                 }
             }
-        }
-    }
-
-    #[test]
-    fn rotate_lanes_turns_the_first_m_lanes_and_zeroes_the_rest() {
-        Arch::new().dispatch(Rotate);
-        Rotate.with_simd(pulp::Scalar::new());
-    }
-
-    /// [`Pack::with_lane`] replaces its lane and keeps the others, on every lane.
-    struct Replace;
-
-    impl WithSimd for Replace {
-        type Output = ();
-
-        #[inline(always)]
-        fn with_simd<S: Simd>(self, simd: S) {
-            let width = Pack::<S>::WIDTH;
-            let lanes: Vec<f64> = (0..width).map(|i| 10.0 + i as f64).collect();
-            let pack = Pack::load(simd, &lanes);
             for index in 0..width {
-                let mut got = vec![f64::NAN; width];
                 pack.with_lane(index, -0.0).store(&mut got);
                 for (i, &x) in got.iter().enumerate() {
                     let want = if i == index { -0.0 } else { lanes[i] };
-                    assert_eq!(
-                        x.to_bits(),
-                        want.to_bits(),
-                        "lane {i} of {width}, index {index}"
-                    );
+                    let (x, want) = (x.to_bits(), want.to_bits());
+                    assert_eq!(x, want, "lane {i} of {width}, with lane {index} replaced");
                 }
             }
         }
     }
 
     #[test]
-    fn with_lane_replaces_one_lane_and_keeps_the_rest() {
-        Arch::new().dispatch(Replace);
-        Replace.with_simd(pulp::Scalar::new());
+    fn rotate_lanes_and_with_lane_follow_the_index_rules() {
+        Arch::new().dispatch(LaneMoves);
+        LaneMoves.with_simd(pulp::Scalar::new());
     }
 
     #[test]
