@@ -40,30 +40,44 @@ pub fn modal_gradients(
             data.prefix_moments[i * m + l] = add(prev_u, scale(moment, entry));
         }
     }
-    for ((pair, closest), gradient) in model
-        .pairs()
-        .iter()
-        .zip(&data.closest)
-        .zip(data.modal_gradient.chunks_exact_mut(m.max(1)))
-    {
-        let n = closest.normal;
-        match *pair {
-            Pair::Obstacle { link, .. } => {
+    if m == 0 {
+        return Ok(());
+    }
+    let (axes, moments) = (&data.prefix_axes, &data.prefix_moments);
+    let prefix = |i: usize| (&axes[i * m..(i + 1) * m], &moments[i * m..(i + 1) * m]);
+    let split = model.n_obstacle_pairs();
+    let (obstacle_gradients, self_gradients) = data.modal_gradient.split_at_mut(split * m);
+    let (obstacle_closest, self_closest) = data.closest.split_at(split);
+    // Link-major: each link's prefix sums serve all its obstacles.
+    let per_link = model.obstacles().len();
+    if per_link > 0 {
+        let links = obstacle_gradients
+            .chunks_exact_mut(per_link * m)
+            .zip(obstacle_closest.chunks_exact(per_link));
+        for (link, (gradients, closest)) in links.enumerate() {
+            let (w, u) = prefix(link);
+            for (gradient, closest) in gradients.chunks_exact_mut(m).zip(closest) {
+                let n = closest.normal;
                 let arm = cross(closest.point, n);
-                for (l, g) in gradient.iter_mut().enumerate() {
-                    let idx = link * m + l;
-                    *g = dot(data.prefix_axes[idx], arm) - dot(data.prefix_moments[idx], n);
+                for ((g, w), u) in gradient.iter_mut().zip(w).zip(u) {
+                    *g = dot(*w, arm) - dot(*u, n);
                 }
             }
-            Pair::Links { link, other } => {
-                let arm = cross(closest.other, n);
-                for (l, g) in gradient.iter_mut().enumerate() {
-                    let (lo, hi) = (link * m + l, other * m + l);
-                    let w = sub(data.prefix_axes[hi], data.prefix_axes[lo]);
-                    let u = sub(data.prefix_moments[hi], data.prefix_moments[lo]);
-                    *g = dot(u, n) - dot(w, arm);
-                }
-            }
+        }
+    }
+    let pairs = model.pairs()[split..].iter().zip(self_closest);
+    for ((pair, closest), gradient) in pairs.zip(self_gradients.chunks_exact_mut(m)) {
+        let Pair::Links { link, other } = *pair else {
+            continue;
+        };
+        let n = closest.normal;
+        let arm = cross(closest.other, n);
+        let ((w_lo, u_lo), (w_hi, u_hi)) = (prefix(link), prefix(other));
+        let sums = w_lo.iter().zip(u_lo).zip(w_hi.iter().zip(u_hi));
+        for (g, ((w_lo, u_lo), (w_hi, u_hi))) in gradient.iter_mut().zip(sums) {
+            let w = sub(*w_hi, *w_lo);
+            let u = sub(*u_hi, *u_lo);
+            *g = dot(u, n) - dot(w, arm);
         }
     }
     Ok(())
