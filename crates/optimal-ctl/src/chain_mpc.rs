@@ -180,25 +180,14 @@ impl ChainMpc {
         v: &[f64],
         tau: &mut [f64],
     ) -> Result<(), OptimalError> {
-        let n = self.n;
-        for (name, len) in [("q", q.len()), ("v", v.len()), ("tau", tau.len())] {
-            if len != n {
-                return Err(OptimalError::Dimension {
-                    name,
-                    expected: n,
-                    found: len,
-                });
-            }
-        }
         plan_feedback(
             &self.ilqr,
             self.planned,
             self.step,
             elapsed,
-            q,
-            v,
+            [("q", q), ("v", v)],
             &mut self.deviation,
-            tau,
+            ("tau", tau),
         )
     }
 }

@@ -1247,67 +1247,38 @@ impl<const NX: usize, const NU: usize> StackTerms<NX, NU> {
 struct HeapTerms(Vec<f64>);
 
 impl HeapTerms {
-    /// The sizes of the terms, in [`Terms`]' order.
-    fn sizes(nx: usize, nu: usize) -> [usize; 14] {
-        [
-            nx,
-            nx * nx,
-            nx,
-            nu,
-            nx * nx,
-            nu * nu,
-            nu * nx,
-            nx * nx,
-            nx * nu,
-            nu * nx,
-            nu,
-            nu * nu,
-            nu,
-            nu,
-        ]
+    /// The total size of the terms: `2 nx + 4 nu + 3 nx^2 + 2 nu^2 + 3 nu nx` (the lengths
+    /// [`Self::slices`] takes, in [`Terms`]' order).
+    fn len(nx: usize, nu: usize) -> usize {
+        2 * nx + 4 * nu + 3 * nx * nx + 2 * nu * nu + 3 * nu * nx
     }
 
     fn new(nx: usize, nu: usize) -> Self {
-        Self(vec![0.0; Self::sizes(nx, nu).iter().sum()])
+        Self(vec![0.0; Self::len(nx, nu)])
     }
 
     fn slices(&mut self, nx: usize, nu: usize) -> Terms<'_> {
         let mut rest = self.0.as_mut_slice();
-        let [
-            v_x,
-            v_xx,
-            q_x,
-            q_u,
-            q_xx,
-            q_uu,
-            q_ux,
-            va,
-            vb,
-            quu_gain,
-            quu_ff,
-            hessian,
-            step_lower,
-            step_upper,
-        ] = Self::sizes(nx, nu).map(|size| {
+        let mut take = |size: usize| {
             let (part, tail) = std::mem::take(&mut rest).split_at_mut(size);
             rest = tail;
             part
-        });
+        };
         Terms {
-            v_x,
-            v_xx,
-            q_x,
-            q_u,
-            q_xx,
-            q_uu,
-            q_ux,
-            va,
-            vb,
-            quu_gain,
-            quu_ff,
-            hessian,
-            step_lower,
-            step_upper,
+            v_x: take(nx),
+            v_xx: take(nx * nx),
+            q_x: take(nx),
+            q_u: take(nu),
+            q_xx: take(nx * nx),
+            q_uu: take(nu * nu),
+            q_ux: take(nu * nx),
+            va: take(nx * nx),
+            vb: take(nx * nu),
+            quu_gain: take(nu * nx),
+            quu_ff: take(nu),
+            hessian: take(nu * nu),
+            step_lower: take(nu),
+            step_upper: take(nu),
         }
     }
 }

@@ -313,29 +313,14 @@ impl Mpc {
         a_dot: &[f64],
         tau_star: &mut [f64],
     ) -> Result<(), OptimalError> {
-        let m = self.m;
-        for (name, len) in [
-            ("a", a.len()),
-            ("a_dot", a_dot.len()),
-            ("tau_star", tau_star.len()),
-        ] {
-            if len != m {
-                return Err(OptimalError::Dimension {
-                    name,
-                    expected: m,
-                    found: len,
-                });
-            }
-        }
         plan_feedback(
             &self.ilqr,
             self.planned,
             self.step,
             elapsed,
-            a,
-            a_dot,
+            [("a", a), ("a_dot", a_dot)],
             &mut self.deviation,
-            tau_star,
+            ("tau_star", tau_star),
         )
     }
 }
@@ -470,19 +455,35 @@ pub(crate) fn set_box(
 
 /// The plan's first control with its feedback about the planned state `elapsed` seconds after
 /// the plan (interpolated between nodes 0 and 1, `elapsed` clamped to `[0, step]`), for the
-/// measured `(a, a_dot)`, into `out`; `deviation` is its workspace (`2m` entries).
-#[allow(clippy::too_many_arguments)]
+/// measured `(a, a_dot)` (each named, `m` = half of `deviation`'s entries), into the named
+/// `out`; `deviation` is its workspace (`2m` entries).
+///
+/// # Errors
+/// [`OptimalError::Dimension`] naming a measurement or `out` whose length is not `m`,
+/// [`OptimalError::InvalidSetting`] before the first plan.
 pub(crate) fn plan_feedback(
     ilqr: &Ilqr,
     planned: bool,
     step: f64,
     elapsed: f64,
-    a: &[f64],
-    a_dot: &[f64],
+    [(a_name, a), (a_dot_name, a_dot)]: [(&'static str, &[f64]); 2],
     deviation: &mut [f64],
-    out: &mut [f64],
+    (out_name, out): (&'static str, &mut [f64]),
 ) -> Result<(), OptimalError> {
-    let m = a.len();
+    let m = deviation.len() / 2;
+    for (name, len) in [
+        (a_name, a.len()),
+        (a_dot_name, a_dot.len()),
+        (out_name, out.len()),
+    ] {
+        if len != m {
+            return Err(OptimalError::Dimension {
+                name,
+                expected: m,
+                found: len,
+            });
+        }
+    }
     if !planned {
         return Err(OptimalError::InvalidSetting {
             name: "plan",

@@ -132,3 +132,24 @@ fn chain_mpc_refuses_a_wrong_size_by_name() {
         "{e}"
     );
 }
+
+#[test]
+fn chain_mpc_control_names_a_wrong_length_and_refuses_before_a_plan() {
+    let model = deploying_arm();
+    let n = model.n_links();
+    let mut mpc = ChainMpc::new(&model, &MpcSettings::uniform(n)).unwrap();
+    let (q, v) = (vec![0.0; n], vec![0.0; n]);
+    let mut tau = vec![0.0; n];
+    for (name, e) in [
+        ("q", mpc.control(0.0, &q[1..], &v, &mut tau).unwrap_err()),
+        ("v", mpc.control(0.0, &q, &[0.0; 2], &mut tau).unwrap_err()),
+        ("tau", mpc.control(0.0, &q, &v, &mut [0.0; 1]).unwrap_err()),
+    ] {
+        assert!(e.to_string().starts_with(&format!("{name} has ")), "{e}");
+    }
+    let e = mpc.control(0.0, &q, &v, &mut tau).unwrap_err();
+    assert!(e.to_string().contains("plan"), "{e}");
+    mpc.solve(&model, &q, &v).unwrap();
+    mpc.control(0.0, &q, &v, &mut tau).unwrap();
+    assert!(tau.iter().all(|t| t.is_finite()), "{tau:?}");
+}
