@@ -33,6 +33,10 @@ pub struct ClearanceData {
     pub(crate) prefix_axes: Vec<V3>,
     /// Prefix sums `U_il = sum_{j <= i} J_jl (w_j x p_j)` (`n x m`).
     pub(crate) prefix_moments: Vec<V3>,
+    /// Whether every joint turns about `z` (placed by [`place_planar`](crate::place_planar)).
+    pub(crate) turns_about_z: bool,
+    /// A planar chain's prefix sums `T_il = sum_{j <= i} J_jl (p_jy, -p_jx, 1)` (`n x m`).
+    pub(crate) prefix_planar: Vec<V3>,
 }
 
 impl ClearanceData {
@@ -67,6 +71,8 @@ impl ClearanceData {
             modal_gradient: vec![0.0; pairs * n_coords],
             prefix_axes: vec![[0.0; 3]; n * n_coords],
             prefix_moments: vec![[0.0; 3]; n * n_coords],
+            turns_about_z: true,
+            prefix_planar: vec![[0.0; 3]; n * n_coords],
         })
     }
 

@@ -3,7 +3,7 @@
 use crate::data::ClearanceData;
 use crate::error::ClearanceError;
 use crate::model::{ClearanceModel, Pair};
-use crate::vector::{add, cross, dot, scale, sub};
+use crate::vector::{V3, add, cross, dot, scale, sub};
 use backbone_kin::ModalMap;
 use lane_math::check_len;
 
@@ -23,6 +23,89 @@ pub fn modal_gradients(
     check_len("modal map joints", map.n_joints(), model.n_links())?;
     check_len("modal map coordinates", map.n_coords(), data.n_coords)?;
     let m = data.n_coords;
+    if m == 0 {
+        return Ok(());
+    }
+    if data.turns_about_z {
+        planar_gradients(model, data, map);
+    } else {
+        spatial_gradients(model, data, map);
+    }
+    Ok(())
+}
+
+/// [`modal_gradients`] of a chain in the plane `z = 0` turning about `z`: joint `j`'s twist is
+/// `(v_j, w_j) = (p_j x z, z) = ((p_jy, -p_jx, 0), (0, 0, 1))`, so the prefix sums reduce to three
+/// numbers a coordinate, `T_il = sum_{j <= i} J_jl (p_jy, -p_jx, 1)`, and a pair's gradient is
+/// `T_il . (n_x, n_y, (c x n)_z)` (the normal's `z` and the moment's in-plane part meet zeros).
+fn planar_gradients(model: &ClearanceModel, data: &mut ClearanceData, map: &ModalMap) {
+    let m = data.n_coords;
+    let prefix = &mut data.prefix_planar;
+    for (i, point) in data.points[..model.n_links()].iter().enumerate() {
+        for (l, &entry) in map.row(i).iter().enumerate() {
+            let [x, y, s] = if i == 0 {
+                [0.0; 3]
+            } else {
+                prefix[(i - 1) * m + l]
+            };
+            prefix[i * m + l] = [x + entry * point[1], y - entry * point[0], s + entry];
+        }
+    }
+    match m {
+        2 => planar_pair_gradients::<2>(model, data),
+        3 => planar_pair_gradients::<3>(model, data),
+        4 => planar_pair_gradients::<4>(model, data),
+        _ => planar_pair_gradients::<0>(model, data),
+    }
+}
+
+/// Every pair's gradient from the planar prefix sums, `T_il . (n_x, n_y, (c x n)_z)`; `M` is the
+/// number of coordinates when it is small (the loops then unroll and a link's sums stay in
+/// registers across its obstacles), or 0 for any number.
+#[inline(always)]
+fn planar_pair_gradients<const M: usize>(model: &ClearanceModel, data: &mut ClearanceData) {
+    let m = data.n_coords;
+    let prefix = |i: usize| {
+        let sums = &data.prefix_planar[i * m..(i + 1) * m];
+        if M == 0 { sums } else { &sums[..M] }
+    };
+    let wrench = |point: V3, n: V3| [n[0], n[1], point[0] * n[1] - point[1] * n[0]];
+    let split = model.n_obstacle_pairs();
+    let (obstacle_gradients, self_gradients) = data.modal_gradient.split_at_mut(split * m);
+    let (obstacle_closest, self_closest) = data.closest.split_at(split);
+    let per_link = model.obstacles().len();
+    if per_link > 0 {
+        let links = obstacle_gradients
+            .chunks_exact_mut(per_link * m)
+            .zip(obstacle_closest.chunks_exact(per_link));
+        for (link, (gradients, closest)) in links.enumerate() {
+            let sums = prefix(link);
+            for (gradient, closest) in gradients.chunks_exact_mut(m).zip(closest) {
+                let f = wrench(closest.point, closest.normal);
+                for (g, t) in gradient.iter_mut().zip(sums) {
+                    *g = dot(*t, f);
+                }
+            }
+        }
+    }
+    let pairs = model.pairs()[split..].iter().zip(self_closest);
+    for ((pair, closest), gradient) in pairs.zip(self_gradients.chunks_exact_mut(m)) {
+        let Pair::Links { link, other } = *pair else {
+            continue;
+        };
+        let f = wrench(closest.other, closest.normal);
+        for (g, (lo, hi)) in gradient
+            .iter_mut()
+            .zip(prefix(link).iter().zip(prefix(other)))
+        {
+            *g = dot(sub(*lo, *hi), f);
+        }
+    }
+}
+
+/// [`modal_gradients`] of any chain, through the six-number prefix sums.
+fn spatial_gradients(model: &ClearanceModel, data: &mut ClearanceData, map: &ModalMap) {
+    let m = data.n_coords;
     for i in 0..model.n_links() {
         let w = data.axes[i];
         let moment = cross(w, data.points[i]);
@@ -39,9 +122,6 @@ pub fn modal_gradients(
             data.prefix_axes[i * m + l] = add(prev_w, scale(w, entry));
             data.prefix_moments[i * m + l] = add(prev_u, scale(moment, entry));
         }
-    }
-    if m == 0 {
-        return Ok(());
     }
     let (axes, moments) = (&data.prefix_axes, &data.prefix_moments);
     let prefix = |i: usize| (&axes[i * m..(i + 1) * m], &moments[i * m..(i + 1) * m]);
@@ -80,5 +160,4 @@ pub fn modal_gradients(
             *g = dot(u, n) - dot(w, arm);
         }
     }
-    Ok(())
 }

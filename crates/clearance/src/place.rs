@@ -20,6 +20,7 @@ pub fn place_planar(
         *point = [planar[0], planar[1], 0.0];
     }
     data.axes.fill([0.0, 0.0, 1.0]);
+    data.turns_about_z = true;
     Ok(())
 }
 
@@ -51,5 +52,6 @@ pub fn place(
     }
     data.points.copy_from_slice(points);
     data.axes.copy_from_slice(axes);
+    data.turns_about_z = false;
     Ok(())
 }

@@ -288,13 +288,25 @@ proptest! {
     }
 
     #[test]
-    fn modal_gradients_match_finite_differences(a in prop::collection::vec(-1.5..1.5f64, 5)) {
+    fn modal_gradients_match_finite_differences(
+        a in prop::collection::vec(-1.5..1.5f64, 5), harmonics in 1..=2usize, free in any::<bool>(),
+    ) {
         let (model, lengths) = planar_model();
-        let map = ModalMap::new(&lengths, 2, BaseAngle::Free).unwrap();
-        let mut data = ClearanceData::new(&model, 5).unwrap();
+        // Two to five coordinates: each count the gradients unroll for, and one they do not.
+        let base = if free { BaseAngle::Free } else { BaseAngle::Fixed(0.3) };
+        let map = ModalMap::new(&lengths, harmonics, base).unwrap();
+        let m = map.n_coords();
+        let a = a[..m].to_vec();
+        let mut data = ClearanceData::new(&model, m).unwrap();
         let mut theta = vec![0.0; 8];
         map.joint_angles(&a, &mut theta).unwrap();
         place_planar(&model, &mut data, &lengths, &theta).unwrap();
+        // The same chain placed as a general one: the six-number prefix sums.
+        let mut general = ClearanceData::new(&model, m).unwrap();
+        let (points, axes) = (data.points().to_vec(), data.axes().to_vec());
+        place(&model, &mut general, &points, &axes).unwrap();
+        distances(&model, &mut general);
+        modal_gradients(&model, &mut general, &map).unwrap();
         distances(&model, &mut data);
         modal_gradients(&model, &mut data, &map).unwrap();
         let at = |a: &[f64]| {
@@ -307,9 +319,10 @@ proptest! {
         for pair in 0..model.pairs().len() {
             // J^T of the joint gradient, the chain rule done the long way.
             joint_gradient(&model, &data, pair, &mut joint).unwrap();
-            for l in 0..5 {
+            for l in 0..m {
                 let chain: f64 = (0..8).map(|j| map.entry(j, l) * joint[j]).sum();
                 prop_assert!((data.modal_gradient(pair)[l] - chain).abs() < 1e-12);
+                prop_assert!((general.modal_gradient(pair)[l] - chain).abs() < 1e-12);
                 let (mut plus, mut minus) = (a.clone(), a.clone());
                 plus[l] += h;
                 minus[l] -= h;
