@@ -1,5 +1,6 @@
 //! The gradients of every pair's clearance with respect to the modal coordinates.
 
+use crate::closest::Closest;
 use crate::data::ClearanceData;
 use crate::error::ClearanceError;
 use crate::model::{ClearanceModel, Pair};
@@ -60,8 +61,8 @@ fn planar_gradients(model: &ClearanceModel, data: &mut ClearanceData, map: &Moda
 }
 
 /// Every pair's gradient from the planar prefix sums, `T_il . (n_x, n_y, (c x n)_z)`; `M` is the
-/// number of coordinates when it is small (the loops then unroll and a link's sums stay in
-/// registers across its obstacles), or 0 for any number.
+/// number of coordinates when it is small (the loops over them then unroll), or 0 for any
+/// number.
 #[inline(always)]
 fn planar_pair_gradients<const M: usize>(model: &ClearanceModel, data: &mut ClearanceData) {
     let m = data.n_coords;
@@ -70,35 +71,58 @@ fn planar_pair_gradients<const M: usize>(model: &ClearanceModel, data: &mut Clea
         if M == 0 { sums } else { &sums[..M] }
     };
     let wrench = |point: V3, n: V3| [n[0], n[1], point[0] * n[1] - point[1] * n[0]];
+    for_each_pair(
+        model,
+        data.n_coords,
+        (&data.closest, &mut data.modal_gradient),
+        |link, closest, gradient| {
+            let f = wrench(closest.point, closest.normal);
+            for (g, t) in gradient.iter_mut().zip(prefix(link)) {
+                *g = dot(*t, f);
+            }
+        },
+        |(link, other), closest, gradient| {
+            let f = wrench(closest.other, closest.normal);
+            for (g, (lo, hi)) in gradient
+                .iter_mut()
+                .zip(prefix(link).iter().zip(prefix(other)))
+            {
+                *g = dot(sub(*lo, *hi), f);
+            }
+        },
+    );
+}
+
+/// Calls `obstacle(link, closest, gradient)` for every link-obstacle pair and
+/// `links((link, other), closest, gradient)` for every self pair, `gradient` the pair's `m`
+/// entries of `gradients` and `closest` its closest points.
+#[inline(always)]
+fn for_each_pair(
+    model: &ClearanceModel,
+    m: usize,
+    (closest, gradients): (&[Closest], &mut [f64]),
+    mut obstacle: impl FnMut(usize, &Closest, &mut [f64]),
+    mut links: impl FnMut((usize, usize), &Closest, &mut [f64]),
+) {
     let split = model.n_obstacle_pairs();
-    let (obstacle_gradients, self_gradients) = data.modal_gradient.split_at_mut(split * m);
-    let (obstacle_closest, self_closest) = data.closest.split_at(split);
+    let (obstacle_gradients, self_gradients) = gradients.split_at_mut(split * m);
+    let (obstacle_closest, self_closest) = closest.split_at(split);
+    // Link-major: each link's prefix sums serve all its obstacles.
     let per_link = model.obstacles().len();
     if per_link > 0 {
-        let links = obstacle_gradients
+        let pairs = obstacle_gradients
             .chunks_exact_mut(per_link * m)
             .zip(obstacle_closest.chunks_exact(per_link));
-        for (link, (gradients, closest)) in links.enumerate() {
-            let sums = prefix(link);
+        for (link, (gradients, closest)) in pairs.enumerate() {
             for (gradient, closest) in gradients.chunks_exact_mut(m).zip(closest) {
-                let f = wrench(closest.point, closest.normal);
-                for (g, t) in gradient.iter_mut().zip(sums) {
-                    *g = dot(*t, f);
-                }
+                obstacle(link, closest, gradient);
             }
         }
     }
     let pairs = model.pairs()[split..].iter().zip(self_closest);
     for ((pair, closest), gradient) in pairs.zip(self_gradients.chunks_exact_mut(m)) {
-        let Pair::Links { link, other } = *pair else {
-            continue;
-        };
-        let f = wrench(closest.other, closest.normal);
-        for (g, (lo, hi)) in gradient
-            .iter_mut()
-            .zip(prefix(link).iter().zip(prefix(other)))
-        {
-            *g = dot(sub(*lo, *hi), f);
+        if let Pair::Links { link, other } = *pair {
+            links((link, other), closest, gradient);
         }
     }
 }
@@ -125,39 +149,28 @@ fn spatial_gradients(model: &ClearanceModel, data: &mut ClearanceData, map: &Mod
     }
     let (axes, moments) = (&data.prefix_axes, &data.prefix_moments);
     let prefix = |i: usize| (&axes[i * m..(i + 1) * m], &moments[i * m..(i + 1) * m]);
-    let split = model.n_obstacle_pairs();
-    let (obstacle_gradients, self_gradients) = data.modal_gradient.split_at_mut(split * m);
-    let (obstacle_closest, self_closest) = data.closest.split_at(split);
-    // Link-major: each link's prefix sums serve all its obstacles.
-    let per_link = model.obstacles().len();
-    if per_link > 0 {
-        let links = obstacle_gradients
-            .chunks_exact_mut(per_link * m)
-            .zip(obstacle_closest.chunks_exact(per_link));
-        for (link, (gradients, closest)) in links.enumerate() {
+    for_each_pair(
+        model,
+        m,
+        (&data.closest, &mut data.modal_gradient),
+        |link, closest, gradient| {
+            let n = closest.normal;
+            let arm = cross(closest.point, n);
             let (w, u) = prefix(link);
-            for (gradient, closest) in gradients.chunks_exact_mut(m).zip(closest) {
-                let n = closest.normal;
-                let arm = cross(closest.point, n);
-                for ((g, w), u) in gradient.iter_mut().zip(w).zip(u) {
-                    *g = dot(*w, arm) - dot(*u, n);
-                }
+            for ((g, w), u) in gradient.iter_mut().zip(w).zip(u) {
+                *g = dot(*w, arm) - dot(*u, n);
             }
-        }
-    }
-    let pairs = model.pairs()[split..].iter().zip(self_closest);
-    for ((pair, closest), gradient) in pairs.zip(self_gradients.chunks_exact_mut(m)) {
-        let Pair::Links { link, other } = *pair else {
-            continue;
-        };
-        let n = closest.normal;
-        let arm = cross(closest.other, n);
-        let ((w_lo, u_lo), (w_hi, u_hi)) = (prefix(link), prefix(other));
-        let sums = w_lo.iter().zip(u_lo).zip(w_hi.iter().zip(u_hi));
-        for (g, ((w_lo, u_lo), (w_hi, u_hi))) in gradient.iter_mut().zip(sums) {
-            let w = sub(*w_hi, *w_lo);
-            let u = sub(*u_hi, *u_lo);
-            *g = dot(u, n) - dot(w, arm);
-        }
-    }
+        },
+        |(link, other), closest, gradient| {
+            let n = closest.normal;
+            let arm = cross(closest.other, n);
+            let ((w_lo, u_lo), (w_hi, u_hi)) = (prefix(link), prefix(other));
+            let sums = w_lo.iter().zip(u_lo).zip(w_hi.iter().zip(u_hi));
+            for (g, ((w_lo, u_lo), (w_hi, u_hi))) in gradient.iter_mut().zip(sums) {
+                let w = sub(*w_hi, *w_lo);
+                let u = sub(*u_hi, *u_lo);
+                *g = dot(u, n) - dot(w, arm);
+            }
+        },
+    );
 }
