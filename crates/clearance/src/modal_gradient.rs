@@ -73,7 +73,7 @@ fn planar_pair_gradients<const M: usize>(model: &ClearanceModel, data: &mut Clea
     let wrench = |point: V3, n: V3| [n[0], n[1], point[0] * n[1] - point[1] * n[0]];
     for_each_pair(
         model,
-        data.n_coords,
+        m,
         (&data.closest, &mut data.modal_gradient),
         |link, closest, gradient| {
             let f = wrench(closest.point, closest.normal);
@@ -107,7 +107,7 @@ fn for_each_pair(
     let split = model.n_obstacle_pairs();
     let (obstacle_gradients, self_gradients) = gradients.split_at_mut(split * m);
     let (obstacle_closest, self_closest) = closest.split_at(split);
-    // Link-major: each link's prefix sums serve all its obstacles.
+    // The link-obstacle pairs, link-major, then the self pairs in the model's order.
     let per_link = model.obstacles().len();
     if per_link > 0 {
         let pairs = obstacle_gradients
