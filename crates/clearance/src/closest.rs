@@ -7,9 +7,12 @@
 //! (a link's axis through a sphere's centre, two crossing axes) the distance of the cores is
 //! zero and stays zero under small motions of crossing axes: the normal is then zero, a
 //! subgradient, and the clearance saturates at minus the radii.
+//!
+//! Each is written for `D`-vectors: a chain turning about `z` among obstacles of the plane
+//! runs them in two dimensions (the third coordinate only adds zeros), others in three.
 
 use crate::obstacle::{box_signed_distance, unit_or};
-use crate::vector::{V3, add, clamp_symmetric, dot, scale, sub, to_local, to_world};
+use crate::vector::{V, V3, add, clamp_symmetric, dot, scale, sub, to_local, to_world, widen};
 
 /// The closest point of the link's axis `a`-`b` to a core and the signed distance between them.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,10 +32,10 @@ pub struct Closest {
 /// The unit vector along `v` and its length; below the rounding of coordinates of size `scale`
 /// the cores meet, the direction is noise, and the normal is zero.
 #[inline]
-fn direction(v: V3, scale: f64) -> (V3, f64) {
-    let (normal, length) = unit_or(v, [0.0; 3]);
+fn direction<const D: usize>(v: V<D>, scale: f64) -> (V<D>, f64) {
+    let (normal, length) = unit_or(v, [0.0; D]);
     if length <= 1e-12 * scale {
-        ([0.0; 3], length)
+        ([0.0; D], length)
     } else {
         (normal, length)
     }
@@ -42,18 +45,18 @@ fn direction(v: V3, scale: f64) -> (V3, f64) {
 /// axis' squared length, its inverse (zero for a point) and its length, computed once per link
 /// rather than once per pair (a division or a square root costs several multiplications).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Segment {
-    start: V3,
-    axis: V3,
+pub(crate) struct Segment<const D: usize> {
+    start: V<D>,
+    axis: V<D>,
     length2: f64,
     inverse_length2: f64,
     length: f64,
 }
 
-impl Segment {
+impl<const D: usize> Segment<D> {
     /// The segment from `a` to `b`.
     #[inline]
-    pub(crate) fn new(a: V3, b: V3) -> Self {
+    pub(crate) fn new(a: V<D>, b: V<D>) -> Self {
         let axis = sub(b, a);
         let length2 = dot(axis, axis);
         Self {
@@ -67,7 +70,7 @@ impl Segment {
 
     /// The point `a + t (b - a)`.
     #[inline]
-    fn at(&self, t: f64) -> V3 {
+    fn at(&self, t: f64) -> V<D> {
         add(self.start, scale(self.axis, t))
     }
 }
@@ -79,8 +82,8 @@ pub fn segment_point(a: V3, b: V3, o: V3) -> Closest {
 }
 
 /// [`segment_point`] of a prepared segment.
-#[inline]
-pub(crate) fn closest_to_point(link: &Segment, o: V3) -> Closest {
+#[inline(always)]
+pub(crate) fn closest_to_point<const D: usize>(link: &Segment<D>, o: V<D>) -> Closest {
     let t = if link.length2 > 0.0 {
         (dot(sub(o, link.start), link.axis) * link.inverse_length2).clamp(0.0, 1.0)
     } else {
@@ -90,10 +93,10 @@ pub(crate) fn closest_to_point(link: &Segment, o: V3) -> Closest {
     let (normal, distance) = direction(sub(point, o), link.length);
     Closest {
         t,
-        point,
-        other: o,
+        point: widen(point),
+        other: widen(o),
         distance,
-        normal,
+        normal: widen(normal),
     }
 }
 
@@ -105,8 +108,8 @@ pub fn segment_segment(a: V3, b: V3, c: V3, d: V3) -> Closest {
 }
 
 /// [`segment_segment`] of two prepared segments.
-#[inline]
-pub(crate) fn closest_to_segment(link: &Segment, other: &Segment) -> Closest {
+#[inline(always)]
+pub(crate) fn closest_to_segment<const D: usize>(link: &Segment<D>, other: &Segment<D>) -> Closest {
     let (d1, d2) = (link.axis, other.axis);
     let r = sub(link.start, other.start);
     let (aa, ee, f) = (link.length2, other.length2, dot(d2, r));
@@ -138,14 +141,14 @@ pub(crate) fn closest_to_segment(link: &Segment, other: &Segment) -> Closest {
             (t, s)
         }
     };
-    let point = link.at(t);
-    let (normal, distance) = direction(sub(point, other.at(s)), link.length + other.length);
+    let (point, closest_other) = (link.at(t), other.at(s));
+    let (normal, distance) = direction(sub(point, closest_other), link.length + other.length);
     Closest {
         t,
-        point,
-        other: other.at(s),
+        point: widen(point),
+        other: widen(closest_other),
         distance,
-        normal,
+        normal: widen(normal),
     }
 }
 
@@ -163,10 +166,15 @@ pub fn segment_box(a: V3, b: V3, center: V3, half: V3, axes: &[V3; 3]) -> Closes
 }
 
 /// [`segment_box`] of a prepared segment.
-pub(crate) fn closest_to_box(link: &Segment, center: V3, half: V3, axes: &[V3; 3]) -> Closest {
+pub(crate) fn closest_to_box<const D: usize>(
+    link: &Segment<D>,
+    center: V<D>,
+    half: V<D>,
+    axes: &[V<D>; D],
+) -> Closest {
     let q0 = to_local(axes, sub(link.start, center));
     let dq = to_local(axes, link.axis);
-    let at = |t: f64| [q0[0] + t * dq[0], q0[1] + t * dq[1], q0[2] + t * dq[2]];
+    let at = |t: f64| along(q0, dq, t);
     let t = match clip(q0, dq, half) {
         Some((enter, exit)) => deepest_inside(q0, dq, half, enter, exit),
         None => nearest_outside(q0, dq, half),
@@ -174,9 +182,9 @@ pub(crate) fn closest_to_box(link: &Segment, center: V3, half: V3, axes: &[V3; 3
     let distance = box_signed_distance(at(t), half);
     let q = at(t);
     // The gradient of the box's signed distance at q: outward from the nearest surface point.
-    let mut outside = [0.0; 3];
+    let mut outside = [0.0; D];
     let (mut deepest, mut face) = (f64::NEG_INFINITY, 0);
-    for k in 0..3 {
+    for k in 0..D {
         outside[k] = q[k] - clamp_symmetric(q[k], half[k]);
         let gap = q[k].abs() - half[k];
         if gap > deepest {
@@ -184,7 +192,7 @@ pub(crate) fn closest_to_box(link: &Segment, center: V3, half: V3, axes: &[V3; 3
         }
     }
     let (mut local_normal, gap) = unit_or(outside, {
-        let mut n = [0.0; 3];
+        let mut n = [0.0; D];
         n[face] = if q[face] < 0.0 { -1.0 } else { 1.0 };
         n
     });
@@ -193,7 +201,7 @@ pub(crate) fn closest_to_box(link: &Segment, center: V3, half: V3, axes: &[V3; 3
     }
     let mut surface = q;
     if gap > 0.0 {
-        for k in 0..3 {
+        for k in 0..D {
             surface[k] = clamp_symmetric(q[k], half[k]);
         }
     } else {
@@ -202,25 +210,31 @@ pub(crate) fn closest_to_box(link: &Segment, center: V3, half: V3, axes: &[V3; 3
     let normal = to_world(axes, local_normal);
     Closest {
         t,
-        point: link.at(t),
-        other: add(center, to_world(axes, surface)),
+        point: widen(link.at(t)),
+        other: widen(add(center, to_world(axes, surface))),
         distance,
-        normal,
+        normal: widen(normal),
     }
+}
+
+/// `q0 + t dq`.
+#[inline]
+fn along<const D: usize>(q0: V<D>, dq: V<D>, t: f64) -> V<D> {
+    std::array::from_fn(|k| q0[k] + t * dq[k])
 }
 
 /// The parameters `[enter, exit]` of `[0, 1]` where `q0 + t dq` lies in the closed box
 /// `|q_k| <= h_k` (Liang and Barsky's slab clipping); `None` when the segment misses it.
-fn clip(q0: V3, dq: V3, half: V3) -> Option<(f64, f64)> {
+fn clip<const D: usize>(q0: V<D>, dq: V<D>, half: V<D>) -> Option<(f64, f64)> {
     // Both ends beyond the same face: no division needed.
-    for k in 0..3 {
+    for k in 0..D {
         let (from, to) = (q0[k], q0[k] + dq[k]);
         if from.min(to) > half[k] || from.max(to) < -half[k] {
             return None;
         }
     }
     let (mut enter, mut exit) = (0.0_f64, 1.0_f64);
-    for k in 0..3 {
+    for k in 0..D {
         if dq[k] == 0.0 {
             if q0[k].abs() > half[k] {
                 return None;
@@ -239,10 +253,10 @@ fn clip(q0: V3, dq: V3, half: V3) -> Option<(f64, f64)> {
 /// `g(t) = max_k (|q_k(t)| - h_k)` is the largest of six affine functions, so its minimum is at
 /// an end of the interval or at a kink, where `q_k` crosses `0` or two faces' depths
 /// `+-q_j - h_j`, `+-q_k - h_k` tie. Of equal depths the smallest `t` is kept.
-fn deepest_inside(q0: V3, dq: V3, half: V3, enter: f64, exit: f64) -> f64 {
+fn deepest_inside<const D: usize>(q0: V<D>, dq: V<D>, half: V<D>, enter: f64, exit: f64) -> f64 {
     let depth = |t: f64| {
         let mut deepest = f64::NEG_INFINITY;
-        for k in 0..3 {
+        for k in 0..D {
             deepest = deepest.max((q0[k] + t * dq[k]).abs() - half[k]);
         }
         deepest
@@ -257,13 +271,13 @@ fn deepest_inside(q0: V3, dq: V3, half: V3, enter: f64, exit: f64) -> f64 {
         }
     };
     consider(exit);
-    for k in 0..3 {
+    for k in 0..D {
         if dq[k] != 0.0 {
             consider(-q0[k] / dq[k]);
         }
     }
     for (j, k) in [(0, 1), (0, 2), (1, 2)] {
-        if !(half[j].is_finite() && half[k].is_finite()) {
+        if k >= D || !(half[j].is_finite() && half[k].is_finite()) {
             continue;
         }
         for (sj, sk) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
@@ -281,12 +295,12 @@ fn deepest_inside(q0: V3, dq: V3, half: V3, enter: f64, exit: f64) -> f64 {
 /// differentiable with `D'(t) / 2 = sum_k e_k dq_k` piecewise affine between the parameters where
 /// a `q_k` crosses `+-h_k`. Bisecting on the sign of `D'` at those parameters finds the piece
 /// holding its zero, where `D' = 0` is solved in closed form.
-fn nearest_outside(q0: V3, dq: V3, half: V3) -> f64 {
-    let at = |t: f64| [q0[0] + t * dq[0], q0[1] + t * dq[1], q0[2] + t * dq[2]];
+fn nearest_outside<const D: usize>(q0: V<D>, dq: V<D>, half: V<D>) -> f64 {
+    let at = |t: f64| along(q0, dq, t);
     let slope = |t: f64| {
         let q = at(t);
         let mut sum = 0.0;
-        for k in 0..3 {
+        for k in 0..D {
             sum += (q[k] - clamp_symmetric(q[k], half[k])) * dq[k];
         }
         sum
@@ -298,7 +312,7 @@ fn nearest_outside(q0: V3, dq: V3, half: V3) -> f64 {
         return 1.0;
     }
     let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
-    for k in 0..3 {
+    for k in 0..D {
         if dq[k] != 0.0 && half[k].is_finite() {
             for bound in [half[k], -half[k]] {
                 let t = (bound - q0[k]) / dq[k];
@@ -315,7 +329,7 @@ fn nearest_outside(q0: V3, dq: V3, half: V3) -> f64 {
     // On (lo, hi) each axis is below, within or above its slab throughout.
     let mid = at(0.5 * (lo + hi));
     let (mut num, mut den) = (0.0, 0.0);
-    for k in 0..3 {
+    for k in 0..D {
         let bound = if mid[k] > half[k] {
             half[k]
         } else if mid[k] < -half[k] {
@@ -337,18 +351,18 @@ fn nearest_outside(q0: V3, dq: V3, half: V3) -> f64 {
 /// `sigma q_k(t) - h_k`; at a minimum where two of them tie with slopes of opposite sign, the
 /// minimum's gradient is their normals' combination `lambda n_- + (1 - lambda) n_+` that makes
 /// the slope zero, `lambda s_- + (1 - lambda) s_+ = 0`. `None` when one piece is active.
-fn inside_kink_normal(q: V3, dq: V3, half: V3, deepest: f64) -> Option<V3> {
+fn inside_kink_normal<const D: usize>(q: V<D>, dq: V<D>, half: V<D>, deepest: f64) -> Option<V<D>> {
     let tolerance = 1e-9 * (1.0 + deepest.abs());
     // (slope, normal) of the active pieces with the smallest and the largest slope.
-    let mut falling: Option<(f64, V3)> = None;
-    let mut rising: Option<(f64, V3)> = None;
-    for k in 0..3 {
+    let mut falling: Option<(f64, V<D>)> = None;
+    let mut rising: Option<(f64, V<D>)> = None;
+    for k in 0..D {
         for sign in [-1.0, 1.0] {
             if (sign * q[k] - half[k] - deepest).abs() > tolerance {
                 continue;
             }
             let slope = sign * dq[k];
-            let mut normal = [0.0; 3];
+            let mut normal = [0.0; D];
             normal[k] = sign;
             if falling.is_none_or(|(s, _)| slope < s) {
                 falling = Some((slope, normal));
@@ -363,5 +377,7 @@ fn inside_kink_normal(q: V3, dq: V3, half: V3, deepest: f64) -> Option<V3> {
         return None;
     }
     let lambda = up / (up - down);
-    Some([0, 1, 2].map(|k| lambda * n_down[k] + (1.0 - lambda) * n_up[k]))
+    Some(std::array::from_fn(|k| {
+        lambda * n_down[k] + (1.0 - lambda) * n_up[k]
+    }))
 }

@@ -18,7 +18,9 @@ pub struct ClearanceData {
     /// `n` unit joint axes in world coordinates (`z` for a planar chain).
     pub(crate) axes: Vec<V3>,
     /// `n` links' segments, prepared once per [`distances`](crate::distances) call.
-    pub(crate) segments: Vec<Segment>,
+    pub(crate) segments: Vec<Segment<3>>,
+    /// The same in the plane, for a chain placed by [`place_planar`](crate::place_planar).
+    pub(crate) planar_segments: Vec<Segment<2>>,
     /// The planar chain's points, from `backbone_kin::joint_positions`.
     pub(crate) planar: Vec<[f64; 2]>,
     /// Per pair: the signed clearance (distance between the surfaces, negative in contact).
@@ -64,6 +66,7 @@ impl ClearanceData {
             points: vec![[0.0; 3]; n + 1],
             axes: vec![[0.0, 0.0, 1.0]; n],
             segments: vec![Segment::new([0.0; 3], [0.0; 3]); n],
+            planar_segments: vec![Segment::new([0.0; 2], [0.0; 2]); n],
             planar: vec![[0.0; 2]; n + 1],
             distances: vec![f64::INFINITY; pairs],
             closest: vec![empty; pairs],

@@ -3,7 +3,7 @@
 use crate::closest::{Closest, Segment, closest_to_box, closest_to_point, closest_to_segment};
 use crate::data::ClearanceData;
 use crate::model::ClearanceModel;
-use crate::obstacle::Obstacle;
+use crate::obstacle::{Obstacle, PlanarObstacle};
 
 /// Fills every pair's clearance and closest points for the placed chain and returns the smallest
 /// clearance to an obstacle and between links (each `+inf` when there is no such pair).
@@ -13,16 +13,56 @@ use crate::obstacle::Obstacle;
 /// radius `R`, the box's signed distance of `c` less `r`, `|c_i - c_k| - 2 r` for two links),
 /// negative when they overlap. Allocation-free.
 pub fn distances(model: &ClearanceModel, data: &mut ClearanceData) -> (f64, f64) {
+    let ClearanceData {
+        points,
+        planar,
+        segments,
+        planar_segments,
+        distances,
+        closest,
+        turns_about_z,
+        ..
+    } = data;
     let radius = model.radius();
-    for (segment, link) in data.segments.iter_mut().zip(data.points.windows(2)) {
-        *segment = Segment::new(link[0], link[1]);
+    let results = (distances.as_mut_slice(), closest.as_mut_slice());
+    match model.planar_obstacles() {
+        // A chain turning about `z` among obstacles of its plane: two dimensions suffice.
+        Some(obstacles) if *turns_about_z => {
+            for (segment, link) in planar_segments.iter_mut().zip(planar.windows(2)) {
+                *segment = Segment::new(link[0], link[1]);
+            }
+            every_pair(
+                radius,
+                planar_segments,
+                obstacles,
+                closest_to_planar,
+                results,
+            )
+        }
+        _ => {
+            for (segment, link) in segments.iter_mut().zip(points.windows(2)) {
+                *segment = Segment::new(link[0], link[1]);
+            }
+            every_pair(radius, segments, model.obstacles(), closest_to, results)
+        }
     }
-    let segments = &data.segments;
-    let obstacles = model.obstacles();
+}
+
+/// [`distances`] for the prepared segments of the links and obstacles of one kind:
+/// `closest_to` writes the closest points of a link to an obstacle and returns the obstacle's
+/// radius.
+#[inline]
+fn every_pair<const D: usize, O>(
+    radius: f64,
+    segments: &[Segment<D>],
+    obstacles: &[O],
+    closest_to: fn(&O, &Segment<D>, &mut Closest) -> f64,
+    (distances, closest): (&mut [f64], &mut [Closest]),
+) -> (f64, f64) {
     // The pairs in the model's order: link-major against every obstacle, then (i, k >= i + 2).
-    let split = model.n_obstacle_pairs();
-    let (obstacle_distances, self_distances) = data.distances.split_at_mut(split);
-    let (obstacle_closest, self_closest) = data.closest.split_at_mut(split);
+    let split = segments.len() * obstacles.len();
+    let (obstacle_distances, self_distances) = distances.split_at_mut(split);
+    let (obstacle_closest, self_closest) = closest.split_at_mut(split);
     let mut near_obstacle = f64::INFINITY;
     if !obstacles.is_empty() {
         for ((link, distances), closest) in segments
@@ -54,10 +94,33 @@ pub fn distances(model: &ClearanceModel, data: &mut ClearanceData) -> (f64, f64)
     (near_obstacle, near_self)
 }
 
+/// [`closest_to`] of an obstacle of the plane and a link's segment in it.
+#[inline]
+fn closest_to_planar(obstacle: &PlanarObstacle, link: &Segment<2>, closest: &mut Closest) -> f64 {
+    match obstacle {
+        PlanarObstacle::Circle { center, radius } => {
+            *closest = closest_to_point(link, *center);
+            *radius
+        }
+        PlanarObstacle::Capsule { from, to, radius } => {
+            *closest = closest_to_segment(link, &Segment::new(*from, *to));
+            *radius
+        }
+        PlanarObstacle::Rectangle {
+            center,
+            half_extents,
+            axes,
+        } => {
+            *closest = closest_to_box(link, *center, *half_extents, axes);
+            0.0
+        }
+    }
+}
+
 /// Writes the closest points of a link's segment to an obstacle's core into `closest` and
 /// returns the obstacle's radius.
 #[inline]
-fn closest_to(obstacle: &Obstacle, link: &Segment, closest: &mut Closest) -> f64 {
+fn closest_to(obstacle: &Obstacle, link: &Segment<3>, closest: &mut Closest) -> f64 {
     match obstacle {
         Obstacle::Sphere { center, radius } => {
             *closest = closest_to_point(link, *center);

@@ -1,7 +1,7 @@
 //! The constant part of a clearance problem: the links' radius, the obstacles and the pairs.
 
 use crate::error::ClearanceError;
-use crate::obstacle::Obstacle;
+use crate::obstacle::{Obstacle, PlanarObstacle};
 use lane_math::check_finite;
 
 /// The most obstacles a [`ClearanceModel`] accepts.
@@ -41,6 +41,8 @@ pub struct ClearanceModel {
     n_links: usize,
     radius: f64,
     obstacles: Vec<Obstacle>,
+    /// The obstacles' planar forms when every one lies in the plane `z = 0`.
+    planar_obstacles: Option<Vec<PlanarObstacle>>,
     pairs: Vec<Pair>,
 }
 
@@ -95,10 +97,12 @@ impl ClearanceModel {
                 pairs.push(Pair::Links { link, other });
             }
         }
+        let planar_obstacles = obstacles.iter().map(PlanarObstacle::of).collect();
         Ok(Self {
             n_links,
             radius,
             obstacles,
+            planar_obstacles,
             pairs,
         })
     }
@@ -116,6 +120,12 @@ impl ClearanceModel {
     /// The obstacles.
     pub fn obstacles(&self) -> &[Obstacle] {
         &self.obstacles
+    }
+
+    /// The obstacles in two dimensions, when every one lies in the plane `z = 0` (see
+    /// [`PlanarObstacle`]).
+    pub(crate) fn planar_obstacles(&self) -> Option<&[PlanarObstacle]> {
+        self.planar_obstacles.as_deref()
     }
 
     /// Every pair, in the order of the data's distances.

@@ -2,7 +2,7 @@
 //! to a point.
 
 use crate::error::ClearanceError;
-use crate::vector::{V3, dot, lerp, scale, sub, to_local};
+use crate::vector::{V, V3, dot, lerp, planar, scale, sub, to_local};
 use lane_math::check_finite;
 
 /// One obstacle, in world coordinates (a planar arm moves in the plane `z = 0`).
@@ -110,11 +110,65 @@ impl Obstacle {
     }
 }
 
+/// An obstacle of the plane `z = 0` that a chain turning about `z` meets the same way in two
+/// dimensions: a sphere centred in the plane (a circle), a capsule whose axis lies in it, or a
+/// box turned about `z` only, centred in the plane, of infinite half-height. Its distances to a
+/// planar chain are those of its [`Obstacle`], with the third coordinate's zeros left out.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum PlanarObstacle {
+    /// A circle.
+    Circle { center: V<2>, radius: f64 },
+    /// A capsule around the segment `from`-`to`.
+    Capsule { from: V<2>, to: V<2>, radius: f64 },
+    /// A rectangle: its centre, half-extents and axes (the columns of its rotation).
+    Rectangle {
+        center: V<2>,
+        half_extents: V<2>,
+        axes: [V<2>; 2],
+    },
+}
+
+impl PlanarObstacle {
+    /// The planar form of `obstacle`, or `None` when it reaches out of the plane `z = 0` (or is
+    /// a box not turned about `z` alone, or of finite height).
+    pub(crate) fn of(obstacle: &Obstacle) -> Option<Self> {
+        match *obstacle {
+            Obstacle::Sphere { center, radius } => (center[2] == 0.0).then_some(Self::Circle {
+                center: planar(center),
+                radius,
+            }),
+            Obstacle::Capsule { from, to, radius } => {
+                (from[2] == 0.0 && to[2] == 0.0).then_some(Self::Capsule {
+                    from: planar(from),
+                    to: planar(to),
+                    radius,
+                })
+            }
+            Obstacle::Box {
+                center,
+                half_extents,
+                axes,
+            } => {
+                let about_z = axes[0][2] == 0.0
+                    && axes[1][2] == 0.0
+                    && axes[2] == [0.0, 0.0, 1.0]
+                    && center[2] == 0.0
+                    && half_extents[2] == f64::INFINITY;
+                about_z.then_some(Self::Rectangle {
+                    center: planar(center),
+                    half_extents: planar(half_extents),
+                    axes: [planar(axes[0]), planar(axes[1])],
+                })
+            }
+        }
+    }
+}
+
 /// The signed distance of the local point `q` to the box `|q_k| <= h_k`.
-pub(crate) fn box_signed_distance(q: V3, h: V3) -> f64 {
+pub(crate) fn box_signed_distance<const D: usize>(q: V<D>, h: V<D>) -> f64 {
     let mut outside = 0.0;
     let mut deepest = f64::NEG_INFINITY;
-    for k in 0..3 {
+    for k in 0..D {
         let gap = q[k].abs() - h[k];
         outside += gap.max(0.0) * gap.max(0.0);
         deepest = deepest.max(gap);
@@ -122,12 +176,12 @@ pub(crate) fn box_signed_distance(q: V3, h: V3) -> f64 {
     outside.sqrt() + deepest.min(0.0)
 }
 
-pub(crate) fn norm(v: V3) -> f64 {
+pub(crate) fn norm<const D: usize>(v: V<D>) -> f64 {
     dot(v, v).sqrt()
 }
 
 /// `v / |v|`, or `fallback` when `v` is zero.
-pub(crate) fn unit_or(v: V3, fallback: V3) -> (V3, f64) {
+pub(crate) fn unit_or<const D: usize>(v: V<D>, fallback: V<D>) -> (V<D>, f64) {
     let length = norm(v);
     if length > 0.0 {
         (scale(v, 1.0 / length), length)

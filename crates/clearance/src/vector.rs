@@ -1,25 +1,35 @@
-//! Three-vector arithmetic on `[f64; 3]` (the planar arm lies in `z = 0`).
+//! Vector arithmetic on `[f64; D]`: three dimensions for spatial chains, two for the planar
+//! fast path (a planar arm lies in `z = 0`, where the third coordinate only adds zeros).
 
-pub(crate) type V3 = [f64; 3];
+/// A vector of `D` coordinates.
+pub(crate) type V<const D: usize> = [f64; D];
+
+/// A vector of space.
+pub(crate) type V3 = V<3>;
 
 #[inline]
-pub(crate) fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+pub(crate) fn sub<const D: usize>(a: V<D>, b: V<D>) -> V<D> {
+    std::array::from_fn(|k| a[k] - b[k])
 }
 
 #[inline]
-pub(crate) fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+pub(crate) fn add<const D: usize>(a: V<D>, b: V<D>) -> V<D> {
+    std::array::from_fn(|k| a[k] + b[k])
 }
 
 #[inline]
-pub(crate) fn scale(a: V3, s: f64) -> V3 {
-    [a[0] * s, a[1] * s, a[2] * s]
+pub(crate) fn scale<const D: usize>(a: V<D>, s: f64) -> V<D> {
+    a.map(|x| x * s)
 }
 
+/// `a . b`, summed from the first coordinate.
 #[inline]
-pub(crate) fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+pub(crate) fn dot<const D: usize>(a: V<D>, b: V<D>) -> f64 {
+    let mut sum = a[0] * b[0];
+    for k in 1..D {
+        sum += a[k] * b[k];
+    }
+    sum
 }
 
 #[inline]
@@ -33,20 +43,36 @@ pub(crate) fn cross(a: V3, b: V3) -> V3 {
 
 /// `a + t (b - a)`.
 #[inline]
-pub(crate) fn lerp(a: V3, b: V3, t: f64) -> V3 {
+pub(crate) fn lerp<const D: usize>(a: V<D>, b: V<D>, t: f64) -> V<D> {
     add(a, scale(sub(b, a), t))
 }
 
-/// `R^T v` for a rotation whose columns are `r[0], r[1], r[2]`.
+/// `R^T v` for a rotation whose columns are `r[0], ..., r[D - 1]`.
 #[inline]
-pub(crate) fn to_local(r: &[V3; 3], v: V3) -> V3 {
-    [dot(r[0], v), dot(r[1], v), dot(r[2], v)]
+pub(crate) fn to_local<const D: usize>(r: &[V<D>; D], v: V<D>) -> V<D> {
+    std::array::from_fn(|k| dot(r[k], v))
 }
 
-/// `R v` for a rotation whose columns are `r[0], r[1], r[2]`.
+/// `R v` for a rotation whose columns are `r[0], ..., r[D - 1]`.
 #[inline]
-pub(crate) fn to_world(r: &[V3; 3], v: V3) -> V3 {
-    add(add(scale(r[0], v[0]), scale(r[1], v[1])), scale(r[2], v[2]))
+pub(crate) fn to_world<const D: usize>(r: &[V<D>; D], v: V<D>) -> V<D> {
+    let mut sum = scale(r[0], v[0]);
+    for k in 1..D {
+        sum = add(sum, scale(r[k], v[k]));
+    }
+    sum
+}
+
+/// The first two coordinates of `v`.
+#[inline]
+pub(crate) fn planar(v: V3) -> V<2> {
+    [v[0], v[1]]
+}
+
+/// `v` in space: its coordinates, then zeros (for `D = 2`, the plane `z = 0`).
+#[inline]
+pub(crate) fn widen<const D: usize>(v: V<D>) -> V3 {
+    std::array::from_fn(|k| if k < D { v[k] } else { 0.0 })
 }
 
 /// `x` clamped to `[-h, h]` for `h >= 0`: `f64::clamp` without its run-time check of the bounds.

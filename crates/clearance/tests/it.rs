@@ -246,6 +246,28 @@ fn planar_model() -> (ClearanceModel, Vec<f64>) {
     )
 }
 
+/// Obstacles of the plane only (circles, a capsule, rectangles straight and turned), which
+/// `distances` measures in two dimensions for a chain placed by `place_planar`.
+fn in_plane_model() -> (ClearanceModel, Vec<f64>) {
+    let obstacles = vec![
+        Obstacle::circle([0.35, 0.25], 0.05).unwrap(),
+        Obstacle::circle([0.3, 0.1], 0.0).unwrap(),
+        Obstacle::capsule([0.1, -0.3, 0.0], [0.5, -0.2, 0.0], 0.03).unwrap(),
+        Obstacle::capsule([0.2, 0.2, 0.0], [0.2, 0.2, 0.0], 0.01).unwrap(),
+        Obstacle::cuboid(
+            [0.6, 0.1, 0.0],
+            [0.05, 0.08, f64::INFINITY],
+            [0.0, 0.0, 0.4],
+        )
+        .unwrap(),
+        Obstacle::cuboid([0.25, 0.3, 0.0], [0.1, 0.04, f64::INFINITY], [0.0; 3]).unwrap(),
+    ];
+    (
+        ClearanceModel::new(8, 0.012, obstacles).unwrap(),
+        vec![0.1, 0.12, 0.09, 0.1, 0.11, 0.1, 0.08, 0.1],
+    )
+}
+
 fn planar_distances(model: &ClearanceModel, lengths: &[f64], theta: &[f64]) -> Vec<f64> {
     let mut data = ClearanceData::new(model, 0).unwrap();
     place_planar(model, &mut data, lengths, theta).unwrap();
@@ -257,8 +279,28 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
 
     #[test]
-    fn joint_gradients_match_finite_differences(theta in prop::collection::vec(-1.2..1.2f64, 8)) {
-        let (model, lengths) = planar_model();
+    fn planar_chains_measure_the_same_in_two_dimensions(
+        theta in prop::collection::vec(-2.5..2.5f64, 8),
+    ) {
+        // The same chain placed as a general one is measured in three dimensions.
+        let (model, lengths) = in_plane_model();
+        let mut data = ClearanceData::new(&model, 0).unwrap();
+        place_planar(&model, &mut data, &lengths, &theta).unwrap();
+        let near = distances(&model, &mut data);
+        let mut general = ClearanceData::new(&model, 0).unwrap();
+        let (points, axes) = (data.points().to_vec(), data.axes().to_vec());
+        place(&model, &mut general, &points, &axes).unwrap();
+        prop_assert_eq!(near, distances(&model, &mut general));
+        prop_assert_eq!(data.distances(), general.distances());
+        prop_assert_eq!(data.closest(), general.closest());
+    }
+
+    #[test]
+    fn joint_gradients_match_finite_differences(
+        theta in prop::collection::vec(-1.2..1.2f64, 8), in_plane in any::<bool>(),
+    ) {
+        // With an obstacle out of the plane, or every one in it (two dimensions).
+        let (model, lengths) = if in_plane { in_plane_model() } else { planar_model() };
         let mut data = ClearanceData::new(&model, 0).unwrap();
         place_planar(&model, &mut data, &lengths, &theta).unwrap();
         distances(&model, &mut data);
