@@ -166,6 +166,7 @@ pub fn segment_box(a: V3, b: V3, center: V3, half: V3, axes: &[V3; 3]) -> Closes
 }
 
 /// [`segment_box`] of a prepared segment.
+#[inline(always)]
 pub(crate) fn closest_to_box<const D: usize>(
     link: &Segment<D>,
     center: V<D>,
