@@ -36,14 +36,14 @@ pub struct ReducedBatchData {
     /// Per link and lane (`[link][lane]`, `MAX_WIDTH` lanes): the absolute angle, its sine and
     /// cosine.
     angle: CacheAligned,
-    sin: CacheAligned,
-    cos: CacheAligned,
+    pub(crate) sin: CacheAligned,
+    pub(crate) cos: CacheAligned,
     /// Per product, link and lane: the products of [`crate::terms`].
     products: CacheAligned,
     /// The one-state workspace.
-    single: ReducedData,
+    pub(crate) single: ReducedData,
     /// The instruction set found at construction.
-    arch: Arch,
+    pub(crate) arch: Arch,
 }
 
 impl ReducedBatchData {
@@ -111,9 +111,9 @@ pub fn forward_dynamics_batch(
 }
 
 /// The planar family's part of a batch: the kernel of [`crate::terms`] and [`forward_dynamics`].
-struct Planar<'a> {
-    model: &'a ReducedModel,
-    data: &'a mut ReducedBatchData,
+pub(crate) struct Planar<'a> {
+    pub(crate) model: &'a ReducedModel,
+    pub(crate) data: &'a mut ReducedBatchData,
 }
 
 impl BatchKernel for Planar<'_> {

@@ -181,9 +181,26 @@ fn group<S: Simd, const M: usize, K: BatchKernel>(
     inputs: [&[f64]; 3],
     out: &mut [f64],
 ) -> bool {
+    let Some(lanes) = gather::<S, M>(simd, inputs) else {
+        return false;
+    };
+    match accelerations::<S, M, K>(simd, kernel, lanes) {
+        Some((a_ddot, _)) => scatter(&a_ddot, out),
+        None => false,
+    }
+}
+
+/// The inputs `a`, `a_dot`, `tau*` of one group of `S::F64_LANES` states (each slice holds
+/// exactly those, state after state) in lanes: lane `i` of every register holds state `i`.
+/// `None` if an input is not finite.
+#[inline(always)]
+pub(crate) fn gather<S: Simd, const M: usize>(
+    simd: S,
+    inputs: [&[f64]; 3],
+) -> Option<[[Pack<S>; M]; 3]> {
     let width = S::F64_LANES;
     if !(all_finite(inputs[0]) & all_finite(inputs[1]) & all_finite(inputs[2])) {
-        return false;
+        return None;
     }
     // Loops, not closures: a closure is compiled without the dispatch's instruction set.
     let zero = Pack::splat(simd, 0.0);
@@ -197,27 +214,55 @@ fn group<S: Simd, const M: usize, K: BatchKernel>(
             *pack = Pack::load(simd, &buffer);
         }
     }
-    let [a, a_dot, tau_star] = lanes;
+    Some(lanes)
+}
+
+/// The accelerations of one group in lanes (`[a, a_dot, tau*]`, [`gather`]ed): the kernel's
+/// `M*`, `C*` and `G*`, then `M* a_ddot = tau* - C* - G*` solved by `L D L^T` as in the
+/// one-state path. Returns `a_ddot` and `M*`; `None` if the kernel refuses the states or `M*`
+/// is not positive definite in some lane.
+#[inline(always)]
+#[allow(
+    clippy::type_complexity,
+    reason = "registers of one group: a vector and a matrix"
+)]
+pub(crate) fn accelerations<S: Simd, const M: usize, K: BatchKernel>(
+    simd: S,
+    kernel: &mut K,
+    [a, a_dot, tau_star]: [[Pack<S>; M]; 3],
+) -> Option<([Pack<S>; M], [[Pack<S>; M]; M])> {
+    let zero = Pack::splat(simd, 0.0);
     let mut mass = [[zero; M]; M];
     let (mut coriolis, mut gravity) = ([zero; M], [zero; M]);
     if !kernel.terms(simd, &a, &a_dot, &mut mass, &mut coriolis, &mut gravity) {
-        return false;
+        return None;
     }
     // The right-hand side tau* - C* - G* and the solve, as in the one-state path.
     let mut x = tau_star;
     for ((x, &c), &g) in x.iter_mut().zip(&coriolis).zip(&gravity) {
         *x = *x - c - g;
     }
-    if !ldlt_in_place(simd, mass.as_flattened_mut(), M) {
-        return false;
+    let mut factor = mass;
+    if !ldlt_in_place(simd, factor.as_flattened_mut(), M) {
+        return None;
     }
-    ldlt_solve_in_place(mass.as_flattened(), M, &mut x);
+    ldlt_solve_in_place(factor.as_flattened(), M, &mut x);
+    Some((x, mass))
+}
+
+/// Writes the values `packs` of one group into `out`, state after state (`packs.len()` values a
+/// state, lane `i` state `i`); `false` if any is not finite.
+#[inline(always)]
+pub(crate) fn scatter<S: Simd>(packs: &[Pack<S>], out: &mut [f64]) -> bool {
+    let width = S::F64_LANES;
+    let per_state = packs.len();
+    let mut buffer = [0.0; MAX_WIDTH];
     let mut finite = true;
-    for (k, value) in x.iter().enumerate() {
+    for (k, value) in packs.iter().enumerate() {
         value.store(&mut buffer);
         for (lane, &v) in buffer[..width].iter().enumerate() {
             finite &= v.is_finite();
-            out[lane * M + k] = v;
+            out[lane * per_state + k] = v;
         }
     }
     finite

@@ -49,8 +49,8 @@ use crate::data::ReducedData;
 use crate::error::{ReduceError, check_finite_result};
 use crate::forward::forward_dynamics;
 use crate::model::ReducedModel;
-use lane_math::check_len;
 use lane_math::dense::{ldlt_in_place, ldlt_solve_rows_in_place};
+use lane_math::{Lane, check_len};
 
 /// Results and scratch of [`reduced_derivatives`] for one [`ReducedModel`]: `O(n m + m^2)`
 /// memory, built once; every call then fills it without allocating.
@@ -77,11 +77,11 @@ pub struct ReducedDerivatives {
 
 /// The scalars a link keeps between the passes: `E_l` (2), `F_l` (2) and the part of `X_ll`
 /// from the tip.
-const LINK_VALUES: usize = 5;
+pub(crate) const LINK_VALUES: usize = 5;
 
 /// The `m`-vectors of the passes: `R^s`, `R^c` (from the tip), `P^s`, `P^c` (from the base),
 /// and the link's update vectors `z_a`, `z_v`.
-const VECTORS: usize = 6;
+pub(crate) const VECTORS: usize = 6;
 
 /// The most coordinates on stack arrays (`K = 2` harmonics with `alpha0` free), each size
 /// matched in [`Differentiate`].
@@ -204,13 +204,30 @@ pub fn reduced_derivatives(
     check_finite_result("reduced dynamics derivatives", &derivatives.jacobians)
 }
 
-/// The scratch of [`differentiate`]: the per-link values of the pass from the tip
-/// ([`LINK_VALUES`]` + 2m` a link), [`VECTORS`] `m`-vectors one after the other, and the factor
-/// of `M*` (`m x m`).
-struct Scratch<'a> {
-    links: &'a mut [f64],
-    vectors: &'a mut [f64],
-    factor: &'a mut [f64],
+/// The scratch of [`differentiate`] in the numbers `L` of one state or of a group of states:
+/// the per-link values of the pass from the tip ([`LINK_VALUES`]` + 2m` a link, each
+/// `L::WIDTH` lanes side by side in `links`), [`VECTORS`] `m`-vectors one after the other, and
+/// the factor of `M*` (`m x m`).
+pub(crate) struct Scratch<'a, L> {
+    pub(crate) links: &'a mut [f64],
+    pub(crate) vectors: &'a mut [L],
+    pub(crate) factor: &'a mut [L],
+}
+
+/// The sines and cosines of the links' absolute angles that the terms left: link `l`'s lanes
+/// at `sin[l * stride..]` and `cos[l * stride..]`.
+pub(crate) struct LinkTrig<'a> {
+    pub(crate) sin: &'a [f64],
+    pub(crate) cos: &'a [f64],
+    pub(crate) stride: usize,
+}
+
+/// What [`differentiate`] reads of a state (or of each state of a group): its rates, its
+/// accelerations and `M*` (row-major `m x m`).
+pub(crate) struct StateOf<'a, L> {
+    pub(crate) a_dot: &'a [L],
+    pub(crate) a_ddot: &'a [L],
+    pub(crate) mass: &'a [L],
 }
 
 /// [`differentiate`] run by [`pulp::Arch::dispatch`], so that it is compiled for the
@@ -252,9 +269,32 @@ impl WithSimd for Differentiate<'_> {
                     vectors,
                     factor,
                 };
-                differentiate(model, data, m, (a_dot, a_ddot), scratch, jacobians)
+                let state = StateOf {
+                    a_dot,
+                    a_ddot,
+                    mass: &data.mass,
+                };
+                differentiate(
+                    (),
+                    model,
+                    one_state_trig(data),
+                    m,
+                    state,
+                    scratch,
+                    jacobians,
+                )
             }
         }
+    }
+}
+
+/// The sines and cosines that the one-state terms left in `data`.
+#[inline(always)]
+fn one_state_trig(data: &ReducedData) -> LinkTrig<'_> {
+    LinkTrig {
+        sin: data.links.sin.get(),
+        cos: data.links.cos.get(),
+        stride: 1,
     }
 }
 
@@ -276,11 +316,17 @@ fn on_stack<const M: usize>(
         vectors: vectors.as_flattened_mut(),
         factor: factor.as_flattened_mut(),
     };
+    let state = StateOf {
+        a_dot,
+        a_ddot,
+        mass: &data.mass,
+    };
     let positive_definite = differentiate(
+        (),
         model,
-        data,
+        one_state_trig(data),
         M,
-        (a_dot, a_ddot),
+        state,
         scratch,
         jacobians.as_flattened_mut().as_flattened_mut(),
     );
@@ -290,29 +336,33 @@ fn on_stack<const M: usize>(
     positive_definite
 }
 
-/// The three Jacobians (row-major `m x 3m`, into `jacobians`) at the state of `data` (the sines
-/// and cosines of the link angles, `M*`), the rates `a_dot` and the accelerations `a_ddot`.
-/// `false` if `M*` is not numerically positive definite.
+/// The three Jacobians (row-major `m x 3m`, into `jacobians`) of one state (`L = f64`) or of
+/// a group of states side by side (the same operations in the same order in every lane), from
+/// the sines and cosines of the link angles `trig` and the state's rates, accelerations and
+/// `M*`. `false` if `M*` is not numerically positive definite (in any lane).
 #[inline(always)]
-fn differentiate(
+pub(crate) fn differentiate<L: Lane>(
+    context: L::Context,
     model: &ReducedModel,
-    data: &ReducedData,
+    trig: LinkTrig<'_>,
     m: usize,
-    (a_dot, a_ddot): (&[f64], &[f64]),
-    scratch: Scratch<'_>,
-    jacobians: &mut [f64],
+    state: StateOf<'_, L>,
+    scratch: Scratch<'_, L>,
+    jacobians: &mut [L],
 ) -> bool {
     let n = model.n_links();
+    let width = L::WIDTH;
+    let splat = |x: f64| L::splat(context, x);
+    let negative_zero = splat(-0.0);
     let g = model.chain().gravity();
-    let (a_dot, a_ddot) = (&a_dot[..m], &a_ddot[..m]);
-    let (sin, cos) = (&data.links.sin.get()[..n], &data.links.cos.get()[..n]);
+    let (a_dot, a_ddot) = (&state.a_dot[..m], &state.a_ddot[..m]);
     let rows = &model.angle_rows()[..n * m];
     let constants = model.link_constants();
     let (lengths, moments) = (&constants.length[..n], &constants.first_moment[..n]);
-    let stride = LINK_VALUES + 2 * m;
+    let stride = (LINK_VALUES + 2 * m) * width;
     let links = &mut scratch.links[..n * stride];
     let vectors = &mut scratch.vectors[..VECTORS * m];
-    vectors.fill(0.0);
+    vectors.fill(splat(0.0));
     // Split one after the other (an array of slices mapped from the scratch would keep the
     // compiler from holding the stack sizes' vectors in registers).
     let (r_sin, rest) = vectors.split_at_mut(m);
@@ -320,33 +370,40 @@ fn differentiate(
     let (p_sin, rest) = rest.split_at_mut(m);
     let (p_cos, rest) = rest.split_at_mut(m);
     let (z_a, z_v) = rest.split_at_mut(m);
+    let trig_of = |l: usize| {
+        let at = l * trig.stride;
+        (
+            L::load(context, &trig.sin[at..]),
+            L::load(context, &trig.cos[at..]),
+        )
+    };
     // From the tip: E_l, F_l, the part of X_ll from A_{l+1} and gravity, and L_l R^s_l,
     // L_l R^c_l from the suffix sums R^s_l, R^c_l (links beyond l).
-    let mut suffix = [0.0; 2];
+    let mut suffix = [splat(0.0); 2];
     let tip_first = rows.chunks_exact(m).zip(links.chunks_exact_mut(stride));
     for (l, (phi, link)) in tip_first.enumerate().rev() {
-        let (mut w, mut alpha) = (0.0, 0.0);
+        let (mut w, mut alpha) = (splat(0.0), splat(0.0));
         for k in 0..m {
-            w = phi[k].mul_add(a_dot[k], w);
-            alpha = phi[k].mul_add(a_ddot[k], alpha);
+            w = splat(phi[k]).mul_add(a_dot[k], w);
+            alpha = splat(phi[k]).mul_add(a_ddot[k], alpha);
         }
-        let (s, c, moment, length) = (sin[l], cos[l], moments[l], lengths[l]);
-        let e = motion_e(c, s, w, alpha);
-        let (values, vectors) = link.split_at_mut(LINK_VALUES);
-        values.copy_from_slice(&[
-            e[0],
-            e[1],
-            2.0 * w * c,
-            2.0 * w * s,
-            -length * (s * suffix[0] - c * suffix[1]) - g * moment * s,
-        ]);
-        let (l_r_sin, l_r_cos) = vectors.split_at_mut(m);
+        let (s, c) = trig_of(l);
+        let (moment, length) = (splat(moments[l]), splat(lengths[l]));
+        let e = motion_e(c, s, w, alpha, negative_zero);
+        let tip_part =
+            (splat(-lengths[l]) * (s * suffix[0] - c * suffix[1])) - splat(g) * moment * s;
+        let values = [e[0], e[1], splat(2.0) * w * c, splat(2.0) * w * s, tip_part];
+        let (stored, vectors) = link.split_at_mut(LINK_VALUES * width);
+        for (value, slot) in values.into_iter().zip(stored.chunks_exact_mut(width)) {
+            value.store(slot);
+        }
+        let (l_r_sin, l_r_cos) = vectors.split_at_mut(m * width);
         let (moment_sin, moment_cos) = (moment * s, moment * c);
         for k in 0..m {
-            l_r_sin[k] = length * r_sin[k];
-            l_r_cos[k] = length * r_cos[k];
-            r_sin[k] = moment_sin.mul_add(phi[k], r_sin[k]);
-            r_cos[k] = moment_cos.mul_add(phi[k], r_cos[k]);
+            (length * r_sin[k]).store(&mut l_r_sin[k * width..]);
+            (length * r_cos[k]).store(&mut l_r_cos[k * width..]);
+            r_sin[k] = moment_sin.mul_add(splat(phi[k]), r_sin[k]);
+            r_cos[k] = moment_cos.mul_add(splat(phi[k]), r_cos[k]);
         }
         suffix = [
             moment.mul_add(e[0], suffix[0]),
@@ -356,36 +413,39 @@ fn differentiate(
     // From the base: the prefix sums P^s_l, P^c_l (links before l) and B_l, and the rank-1
     // update of each partial, accumulated with the opposite sign as the right-hand sides
     // -D_a and -D_v.
-    let width = 3 * m;
-    let jacobians = &mut jacobians[..m * width];
-    jacobians.fill(0.0);
-    let mut before = [0.0; 2];
+    let columns = 3 * m;
+    let jacobians = &mut jacobians[..m * columns];
+    jacobians.fill(splat(0.0));
+    let mut before = [splat(0.0); 2];
     for (l, (phi, link)) in rows
         .chunks_exact(m)
         .zip(links.chunks_exact(stride))
         .enumerate()
     {
-        let (s, c, moment, length) = (sin[l], cos[l], moments[l], lengths[l]);
-        let (values, vectors) = link.split_at(LINK_VALUES);
-        let (e, f) = ([values[0], values[1]], [values[2], values[3]]);
-        let weight = values[4] - moment * (s * before[0] - c * before[1]);
-        let (l_r_sin, l_r_cos) = vectors.split_at(m);
+        let (s, c) = trig_of(l);
+        let (moment, length) = (splat(moments[l]), splat(lengths[l]));
+        let (stored, vectors) = link.split_at(LINK_VALUES * width);
+        let value = |j: usize| L::load(context, &stored[j * width..]);
+        let (e, f) = ([value(0), value(1)], [value(2), value(3)]);
+        let weight = value(4) - moment * (s * before[0] - c * before[1]);
+        let (l_r_sin, l_r_cos) = vectors.split_at(m * width);
         // z = -(E^x U^s - E^y U^c + X_ll Phi) with U = S_l P_l + L_l R_l, F for E in z_v.
         for i in 0..m {
-            let u_sin = moment.mul_add(p_sin[i], l_r_sin[i]);
-            let u_cos = moment.mul_add(p_cos[i], l_r_cos[i]);
-            z_a[i] = e[1].mul_add(u_cos, -weight.mul_add(phi[i], e[0] * u_sin));
-            z_v[i] = f[1].mul_add(u_cos, -(f[0] * u_sin));
+            let u_sin = moment.mul_add(p_sin[i], L::load(context, &l_r_sin[i * width..]));
+            let u_cos = moment.mul_add(p_cos[i], L::load(context, &l_r_cos[i * width..]));
+            let inner = weight.mul_add(splat(phi[i]), e[0] * u_sin);
+            z_a[i] = e[1].mul_add(u_cos, inner.xor_bits(negative_zero));
+            z_v[i] = f[1].mul_add(u_cos, (f[0] * u_sin).xor_bits(negative_zero));
         }
-        for (i, row) in jacobians.chunks_exact_mut(width).enumerate() {
+        for (i, row) in jacobians.chunks_exact_mut(columns).enumerate() {
             let (d_a, d_v) = row[..2 * m].split_at_mut(m);
             for k in 0..m {
-                d_a[k] = z_a[i].mul_add(phi[k], d_a[k]);
-                d_v[k] = z_v[i].mul_add(phi[k], d_v[k]);
+                d_a[k] = z_a[i].mul_add(splat(phi[k]), d_a[k]);
+                d_v[k] = z_v[i].mul_add(splat(phi[k]), d_v[k]);
             }
         }
         for k in 0..m {
-            let lp = length * phi[k];
+            let lp = length * splat(phi[k]);
             p_sin[k] = s.mul_add(lp, p_sin[k]);
             p_cos[k] = c.mul_add(lp, p_cos[k]);
         }
@@ -395,21 +455,24 @@ fn differentiate(
         ];
     }
     // The right-hand side of M*^-1 itself, then all 3m columns solved at once.
-    for (i, row) in jacobians.chunks_exact_mut(width).enumerate() {
-        row[2 * m + i] = 1.0;
+    for (i, row) in jacobians.chunks_exact_mut(columns).enumerate() {
+        row[2 * m + i] = splat(1.0);
     }
     let factor = &mut scratch.factor[..m * m];
-    factor.copy_from_slice(&data.mass[..m * m]);
-    if !ldlt_in_place((), factor, m) {
+    factor.copy_from_slice(&state.mass[..m * m]);
+    if !ldlt_in_place(context, factor, m) {
         return false;
     }
-    ldlt_solve_rows_in_place(factor, m, jacobians, width);
+    ldlt_solve_rows_in_place(factor, m, jacobians, columns);
     true
 }
 
-/// `E_l = (c alpha - s w^2, s alpha + c w^2)`.
+/// `E_l = (c alpha - s w^2, s alpha + c w^2)` (`negative_zero` flips a sign exactly).
 #[inline(always)]
-fn motion_e(c: f64, s: f64, w: f64, alpha: f64) -> [f64; 2] {
+fn motion_e<L: Lane>(c: L, s: L, w: L, alpha: L, negative_zero: L) -> [L; 2] {
     let w2 = w * w;
-    [c.mul_add(alpha, -(s * w2)), s.mul_add(alpha, c * w2)]
+    [
+        c.mul_add(alpha, (s * w2).xor_bits(negative_zero)),
+        s.mul_add(alpha, c * w2),
+    ]
 }

@@ -66,7 +66,7 @@ pub fn ldlt_solve_in_place<L: Lane>(factor: &[L], m: usize, x: &mut [L]) {
 /// [`ldlt_solve_in_place`] on whole rows, so each column gets the same operations in the same
 /// order (the same bits) as solved alone, and the inner loops run along contiguous rows.
 #[inline(always)]
-pub fn ldlt_solve_rows_in_place(factor: &[f64], m: usize, x: &mut [f64], columns: usize) {
+pub fn ldlt_solve_rows_in_place<L: Lane>(factor: &[L], m: usize, x: &mut [L], columns: usize) {
     let (f, x) = (&factor[..m * m], &mut x[..m * columns]);
     for i in 0..m {
         let (solved, rest) = x.split_at_mut(i * columns);
@@ -74,14 +74,14 @@ pub fn ldlt_solve_rows_in_place(factor: &[f64], m: usize, x: &mut [f64], columns
         for (k, other) in solved.chunks_exact(columns).enumerate() {
             let l = f[i * m + k];
             for (entry, &value) in row.iter_mut().zip(other) {
-                *entry -= l * value;
+                *entry = *entry - l * value;
             }
         }
     }
     for (i, row) in x.chunks_exact_mut(columns).enumerate() {
         let inverse = f[i * m + i];
         for entry in row {
-            *entry *= inverse;
+            *entry = *entry * inverse;
         }
     }
     for i in (0..m).rev() {
@@ -89,7 +89,7 @@ pub fn ldlt_solve_rows_in_place(factor: &[f64], m: usize, x: &mut [f64], columns
         for (k, other) in solved.chunks_exact(columns).enumerate() {
             let l = f[(i + 1 + k) * m + i];
             for (entry, &value) in row.iter_mut().zip(other) {
-                *entry -= l * value;
+                *entry = *entry - l * value;
             }
         }
     }
