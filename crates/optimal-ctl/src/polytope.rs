@@ -140,6 +140,11 @@ impl PolytopeProjection {
         for k in 0..m {
             x[k] = x0[k] - self.residual[k] / last;
         }
+        // Constraints that (nearly) admit no point leave a residual above the test's rounding
+        // and a point far outside them: refused as empty, never returned.
+        if !satisfies(constraints, g, x) {
+            return Err(ProjectionFailure::Empty);
+        }
         Ok(true)
     }
 
@@ -272,4 +277,20 @@ impl PolytopeProjection {
         }
         true
     }
+}
+
+/// Whether `x` satisfies every row of `G x <= g` (row-major, `x.len()` columns) to within the
+/// rounding of its terms (a relative `1e-9`).
+fn satisfies(constraints: &[f64], g: &[f64], x: &[f64]) -> bool {
+    constraints
+        .chunks_exact(x.len().max(1))
+        .zip(g)
+        .all(|(row, &bound)| {
+            let (mut gx, mut size) = (0.0, bound.abs());
+            for (&r, &x) in row.iter().zip(x) {
+                gx += r * x;
+                size += (r * x).abs();
+            }
+            gx - bound <= 1e-9 * (1.0 + size)
+        })
 }

@@ -171,6 +171,39 @@ fn an_empty_polytope_is_reported() {
 }
 
 #[test]
+fn a_polytope_empty_by_a_hair_is_reported_not_left_with_a_point_outside() {
+    // The box |x_j| <= 1 and 0.7312 x_0 + 0.9992 x_1 <= -1.73046, whose least value over the
+    // box is -1.73043: empty by 3e-5, which the dual's residual alone does not show.
+    let mut rows = vec![0.7312032087903603, 0.9992311263456333];
+    let mut bounds = vec![-1.7304630812143225];
+    for j in 0..2 {
+        for sign in [1.0, -1.0] {
+            let mut row = [0.0; 2];
+            row[j] = sign;
+            rows.extend_from_slice(&row);
+            bounds.push(1.0);
+        }
+    }
+    let mut projection = PolytopeProjection::new(2, bounds.len());
+    let mut x = [0.0; 2];
+    let result = projection.project(&rows, &bounds, &[0.0; 2], &mut x);
+    assert_eq!(result, Err(ProjectionFailure::Empty), "{x:?}");
+    // Loosened by 1e-4 it holds points, all near the corner (-1, -1): the projection finds one.
+    bounds[0] += 1e-4;
+    assert_eq!(
+        projection.project(&rows, &bounds, &[0.0; 2], &mut x),
+        Ok(true)
+    );
+    for (row, bound) in rows.chunks_exact(2).zip(&bounds) {
+        assert!(row[0] * x[0] + row[1] * x[1] <= bound + 1e-12, "{x:?}");
+    }
+    assert!(
+        (x[0] + 1.0).abs() < 1e-3 && (x[1] + 1.0).abs() < 1e-3,
+        "{x:?}"
+    );
+}
+
+#[test]
 fn sizes_that_disagree_and_indefinite_h_are_refused() {
     let mut projection = PolytopeProjection::new(2, 1);
     let mut x = [0.0; 2];
