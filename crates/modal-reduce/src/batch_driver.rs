@@ -42,6 +42,15 @@ pub enum BatchError {
     },
 }
 
+impl BatchError {
+    /// The [`ReduceError`] inside: the shape's, or the refused state's (its index dropped).
+    pub fn into_reduce_error(self) -> ReduceError {
+        match self {
+            Self::Shape(error) | Self::State { error, .. } => error,
+        }
+    }
+}
+
 impl Classify for BatchError {
     /// The class of the [`ReduceError`] inside.
     fn class(&self) -> ErrorClass {

@@ -2,7 +2,10 @@
 //! [`Ilqr`](super::Ilqr), and the reduced model (eq 15) discretised by semi-implicit Euler with
 //! its exact Jacobians from the analytic derivatives.
 
-use modal_reduce::{Plant, PlantData, PlantDerivatives};
+use modal_reduce::{
+    MAX_BATCH_COORDS, Plant, PlantData, PlantDerivatives, ReducedDerivativesBatch,
+    reduced_derivatives_batch,
+};
 
 use super::OptimalError;
 
@@ -34,6 +37,49 @@ pub trait DiscreteDynamics {
         a: &mut [f64],
         b: &mut [f64],
     ) -> Result<(), OptimalError>;
+
+    /// Whether [`linearise_trajectory`](Self::linearise_trajectory) takes a trajectory's
+    /// Jacobians faster than [`linearise`](Self::linearise) node by node: a solver then rolls
+    /// out with [`step`](Self::step) and linearises the trajectory it keeps, instead of
+    /// linearising on its way (which a rejected rollout wastes).
+    fn linearises_trajectories(&self) -> bool {
+        false
+    }
+
+    /// The Jacobians of the steps from the states `x` (`N x n_x`, row-major) under the controls
+    /// `u` (`N x n_u`): `A_k` into block `k` of `a` (`N` blocks of `n_x x n_x`) and `B_k` into
+    /// `b` (`N` blocks of `n_x x n_u`), with `next` (`n_x`) as scratch. By default
+    /// [`linearise`](Self::linearise) node by node.
+    ///
+    /// # Errors
+    /// As [`step`](Self::step).
+    fn linearise_trajectory(
+        &mut self,
+        x: &[f64],
+        u: &[f64],
+        next: &mut [f64],
+        a: &mut [f64],
+        b: &mut [f64],
+    ) -> Result<(), OptimalError> {
+        linearise_node_by_node(self, x, u, next, (a, b))
+    }
+}
+
+/// [`DiscreteDynamics::linearise_trajectory`] by [`DiscreteDynamics::linearise`] of each node.
+fn linearise_node_by_node<D: DiscreteDynamics + ?Sized>(
+    dynamics: &mut D,
+    x: &[f64],
+    u: &[f64],
+    next: &mut [f64],
+    (a, b): (&mut [f64], &mut [f64]),
+) -> Result<(), OptimalError> {
+    let (nx, nu) = (dynamics.state_dim(), dynamics.control_dim());
+    let nodes = x.chunks_exact(nx).zip(u.chunks_exact(nu));
+    let jacobians = a.chunks_exact_mut(nx * nx).zip(b.chunks_exact_mut(nx * nu));
+    for ((x, u), (a, b)) in nodes.zip(jacobians) {
+        dynamics.linearise(x, u, next, a, b)?;
+    }
+    Ok(())
 }
 
 /// The reduced dynamics `M*(a) a_ddot + C*(a, a_dot) + G*(a) = tau*` (eq 15) as a discrete
@@ -54,12 +100,15 @@ pub trait DiscreteDynamics {
 /// One dynamics evaluation per step (RK4 would take four, each with its own derivatives);
 /// symplectic Euler keeps the energy of the unforced arm bounded instead of letting it drift,
 /// and its local error `O(h^2)` is corrected at every re-plan of a receding horizon. It borrows
-/// the model (planar or spatial) and a workspace (`PlantData`, `PlantDerivatives`) for one solve.
+/// the model (planar or spatial) and a workspace (`PlantData`, `PlantDerivatives`) for one solve;
+/// with a batch workspace ([`with_batch`](Self::with_batch)), a planar model's trajectories are
+/// linearised SIMD across nodes.
 #[derive(Debug)]
 pub struct ReducedEuler<'a> {
     model: Plant<'a>,
     data: &'a mut PlantData,
     derivatives: &'a mut PlantDerivatives,
+    batch: Option<&'a mut ReducedDerivativesBatch>,
     step: f64,
 }
 
@@ -80,10 +129,26 @@ impl<'a> ReducedEuler<'a> {
             model: model.into(),
             data,
             derivatives,
+            batch: None,
             step,
         })
     }
+
+    /// The same map, whose trajectories [`linearise_trajectory`] linearises with
+    /// `modal_reduce::reduced_derivatives_batch` (SIMD across nodes, each node the same bits as
+    /// alone) when the model is planar, of at most [`MAX_BATCH_COORDS`] coordinates, and `work`
+    /// was built for it; node by node otherwise.
+    ///
+    /// [`linearise_trajectory`]: DiscreteDynamics::linearise_trajectory
+    pub fn with_batch(mut self, work: &'a mut ReducedDerivativesBatch) -> Self {
+        self.batch = Some(work);
+        self
+    }
 }
+
+/// The nodes a batch of [`ReducedEuler::linearise_trajectory`] linearises at once: a SIMD
+/// group of the widest instruction set.
+const BATCH_NODES: usize = 8;
 
 /// Checks an integration step of the discrete model (s).
 pub(crate) fn check_step(step: f64) -> Result<(), OptimalError> {
@@ -133,29 +198,111 @@ impl DiscreteDynamics for ReducedEuler<'_> {
             .derivatives(self.data, self.derivatives, a, v, u)?;
         let d = &*self.derivatives;
         let euler = (self.step, x, next, a_mat, b_mat);
-        match m {
-            2 => assemble::<2>(d, euler),
-            3 => assemble::<3>(d, euler),
-            _ => assemble::<0>(d, euler),
+        assemble_any(m, (d.a_ddot(), d.jacobians()), euler);
+        Ok(())
+    }
+
+    fn linearises_trajectories(&self) -> bool {
+        matches!(self.model, Plant::Planar(_))
+            && self.batch.is_some()
+            && self.model.n_coords() <= MAX_BATCH_COORDS
+            && self.model.batch_lanes() > 1
+    }
+
+    fn linearise_trajectory(
+        &mut self,
+        x: &[f64],
+        u: &[f64],
+        next: &mut [f64],
+        a_mat: &mut [f64],
+        b_mat: &mut [f64],
+    ) -> Result<(), OptimalError> {
+        let batched = self.linearises_trajectories();
+        let (Plant::Planar(model), Some(work), true) =
+            (self.model, self.batch.as_deref_mut(), batched)
+        else {
+            return linearise_node_by_node(self, x, u, next, (a_mat, b_mat));
+        };
+        let (m, h) = (model.n_coords(), self.step);
+        let (nx, nu) = (2 * m, m);
+        // Each group of nodes gathered into the batch's layout (`a`, `a_dot`, `tau*` state after
+        // state) on the stack, its accelerations and Jacobians assembled node by node.
+        let mut inputs = [[0.0; BATCH_NODES * MAX_BATCH_COORDS]; 3];
+        let mut a_ddot = [0.0; BATCH_NODES * MAX_BATCH_COORDS];
+        let mut jacobians = [0.0; BATCH_NODES * 3 * MAX_BATCH_COORDS * MAX_BATCH_COORDS];
+        let groups = x
+            .chunks(BATCH_NODES * nx)
+            .zip(u.chunks(BATCH_NODES * nu))
+            .zip(a_mat.chunks_mut(BATCH_NODES * nx * nx))
+            .zip(b_mat.chunks_mut(BATCH_NODES * nx * nu));
+        for (((x, u), a_mat), b_mat) in groups {
+            let [a, a_dot, tau_star] = &mut inputs;
+            // A last group of fewer nodes is filled up with its last node, so that every group
+            // runs SIMD; the copies' results are not read.
+            let (x_last, u_last) = (&x[x.len() - nx..], &u[u.len() - nu..]);
+            for k in 0..BATCH_NODES {
+                let state = x.get(k * nx..(k + 1) * nx).unwrap_or(x_last);
+                let control = u.get(k * nu..(k + 1) * nu).unwrap_or(u_last);
+                a[k * m..(k + 1) * m].copy_from_slice(&state[..m]);
+                a_dot[k * m..(k + 1) * m].copy_from_slice(&state[m..]);
+                tau_star[k * m..(k + 1) * m].copy_from_slice(control);
+            }
+            let values = BATCH_NODES * m;
+            reduced_derivatives_batch(
+                model,
+                work,
+                &a[..values],
+                &a_dot[..values],
+                &tau_star[..values],
+                &mut a_ddot[..values],
+                &mut jacobians[..values * 3 * m],
+            )
+            .map_err(modal_reduce::BatchError::into_reduce_error)?;
+            let per_node = x
+                .chunks_exact(nx)
+                .zip(a_mat.chunks_exact_mut(nx * nx))
+                .zip(b_mat.chunks_exact_mut(nx * nu))
+                .enumerate();
+            for (k, ((x, a_mat), b_mat)) in per_node {
+                let derivatives = (
+                    &a_ddot[k * m..(k + 1) * m],
+                    &jacobians[k * 3 * m * m..(k + 1) * 3 * m * m],
+                );
+                assemble_any(m, derivatives, (h, x, next, a_mat, b_mat));
+            }
         }
         Ok(())
     }
 }
 
-/// The Euler map's next state and Jacobians `(A, B)` from the plant's derivatives `d` at `x`
-/// (`(h, x, next, A, B)`), for `m = M` known at compile time, or any `m` when `M` is 0.
+/// [`assemble`] for `m` coordinates: unrolled for the reduced model's `m = 2` and `3`.
+#[inline(always)]
+fn assemble_any(
+    m: usize,
+    derivatives: (&[f64], &[f64]),
+    euler: (f64, &[f64], &mut [f64], &mut [f64], &mut [f64]),
+) {
+    match m {
+        2 => assemble::<2>(derivatives, euler),
+        3 => assemble::<3>(derivatives, euler),
+        _ => assemble::<0>(derivatives, euler),
+    }
+}
+
+/// The Euler map's next state and Jacobians `(A, B)` from the plant's accelerations and
+/// Jacobians at `x` (row `i` of the latter `[F_a row i | F_v row i | F_u row i]`), as
+/// `(h, x, next, A, B)`, for `m = M` known at compile time, or any `m` when `M` is 0.
 #[inline(always)]
 fn assemble<const M: usize>(
-    d: &PlantDerivatives,
+    (a_ddot, jacobians): (&[f64], &[f64]),
     (h, x, next, a_mat, b_mat): (f64, &[f64], &mut [f64], &mut [f64], &mut [f64]),
 ) {
-    let m = if M == 0 { d.a_ddot().len() } else { M };
+    let m = if M == 0 { a_ddot.len() } else { M };
     let n = 2 * m;
     let (a, v) = (&x[..m], &x[m..n]);
     let (next, a_mat, b_mat) = (&mut next[..n], &mut a_mat[..n * n], &mut b_mat[..n * m]);
-    // Row i of the plant's Jacobians: [F_a row i | F_v row i | F_u row i].
-    let jacobians = &d.jacobians()[..3 * m * m];
-    let a_ddot = &d.a_ddot()[..m];
+    let jacobians = &jacobians[..3 * m * m];
+    let a_ddot = &a_ddot[..m];
     for (i, row) in jacobians.chunks_exact(3 * m).enumerate() {
         let v_next = v[i] + h * a_ddot[i];
         next[m + i] = v_next;

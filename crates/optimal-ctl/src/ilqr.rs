@@ -544,14 +544,16 @@ impl Ilqr {
         self.x[..self.nx].copy_from_slice(x0);
         // Within rows, the warm start's rollout moves every control within its step's rows at
         // the state reached (as every forward pass does), so that the first nominal trajectory
-        // is feasible; without rows it linearises on its way. `jacobians_current`: the Jacobians
-        // computed on the way stand for the trajectory.
-        let unconstrained = constraints.is_none();
+        // is feasible; without rows it linearises on its way, unless the dynamics linearise a
+        // whole trajectory faster (then every kept trajectory is linearised at once, and a
+        // rejected rollout wastes no Jacobians). `jacobians_current`: the Jacobians computed on
+        // the way stand for the trajectory.
+        let on_the_fly = constraints.is_none() && !dynamics.linearises_trajectories();
         let (initial_cost, mut jacobians_current) =
-            match self.warm_rollout(dynamics, constraints.as_deref_mut(), follow, unconstrained) {
+            match self.warm_rollout(dynamics, constraints.as_deref_mut(), follow, on_the_fly) {
                 Err(error) if follow && diverged(&error) => {
                     self.u.copy_from_slice(&self.u_try);
-                    self.warm_rollout(dynamics, constraints.as_deref_mut(), false, unconstrained)?
+                    self.warm_rollout(dynamics, constraints.as_deref_mut(), false, on_the_fly)?
                 }
                 other => other?,
             };
@@ -598,7 +600,7 @@ impl Ilqr {
                 break;
             }
             // No linearisation follows the last iteration's line search.
-            let linearising = unconstrained && iterations < settings.max_iterations;
+            let linearising = on_the_fly && iterations < settings.max_iterations;
             let mut accepted = None;
             let mut alpha = 1.0;
             for _ in 0..steps {
@@ -808,16 +810,13 @@ impl Ilqr {
         dynamics: &mut D,
     ) -> Result<(), OptimalError> {
         let (nx, nu) = (self.nx, self.nu);
-        for k in 0..self.horizon {
-            dynamics.linearise(
-                &self.x[k * nx..(k + 1) * nx],
-                &self.u[k * nu..(k + 1) * nu],
-                &mut self.x_try[..nx],
-                &mut self.a[k * nx * nx..(k + 1) * nx * nx],
-                &mut self.b[k * nx * nu..(k + 1) * nx * nu],
-            )?;
-        }
-        Ok(())
+        dynamics.linearise_trajectory(
+            &self.x[..self.horizon * nx],
+            &self.u[..self.horizon * nu],
+            &mut self.x_try[..nx],
+            &mut self.a,
+            &mut self.b,
+        )
     }
 
     /// The backward pass with regularisation `mu`: gains, feed-forward steps and the expected

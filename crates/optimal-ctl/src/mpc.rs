@@ -2,7 +2,7 @@
 //! horizon of the semi-implicit Euler discretisation, re-planned from the measured state and
 //! warm-started from the previous plan shifted by the time elapsed.
 
-use modal_reduce::{Plant, PlantData, PlantDerivatives};
+use modal_reduce::{Plant, PlantData, PlantDerivatives, ReducedDerivativesBatch};
 
 use super::OptimalError;
 use super::discrete::{ReducedEuler, check_step};
@@ -86,6 +86,8 @@ pub struct Mpc {
     ilqr: Ilqr,
     data: PlantData,
     derivatives: PlantDerivatives,
+    /// A planar model's trajectories linearised SIMD across nodes.
+    batch: Option<ReducedDerivativesBatch>,
     /// `2m`: the state and its deviation from the plan.
     state: Vec<f64>,
     deviation: Vec<f64>,
@@ -117,6 +119,10 @@ impl Mpc {
             ilqr,
             data: PlantData::new(model),
             derivatives: PlantDerivatives::new(model),
+            batch: match model {
+                Plant::Planar(planar) => Some(ReducedDerivativesBatch::new(planar)),
+                Plant::Spatial(_) => None,
+            },
             state: vec![0.0; 2 * m],
             deviation: vec![0.0; 2 * m],
             lower: vec![0.0; m],
@@ -266,6 +272,9 @@ impl Mpc {
         self.state[m..].copy_from_slice(a_dot);
         let mut dynamics =
             ReducedEuler::new(model, &mut self.data, &mut self.derivatives, self.step)?;
+        if let Some(batch) = &mut self.batch {
+            dynamics = dynamics.with_batch(batch);
+        }
         let report = match constraints {
             None => self.ilqr.solve(&mut dynamics, &self.state, &self.solver)?,
             Some(rows) => {

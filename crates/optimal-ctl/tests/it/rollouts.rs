@@ -2,12 +2,14 @@
 //! Jacobians they leave are those a separate linearisation of the trajectory computes, so a
 //! solve whose rollouts cannot linearise (and fall back to stepping) ends on the same bits, and
 //! a warm-started solve evaluates each node's dynamics once. The reduced model's Euler map gives
-//! the same next state whether stepped or linearised, which the sharing relies on.
+//! the same next state whether stepped or linearised, which the sharing relies on. A planar map
+//! with a batch workspace linearises whole trajectories SIMD across nodes instead, to the same
+//! bits, so its solves end on the bits of those that linearise on their way.
 
 use backbone_kin::{BaseAngle, ModalMap};
 use manip_dyn::ChainModel;
 use modal_reduce::spatial::SpatialReducedModel;
-use modal_reduce::{Plant, PlantData, PlantDerivatives, ReducedModel};
+use modal_reduce::{Plant, PlantData, PlantDerivatives, ReducedDerivativesBatch, ReducedModel};
 use optimal_ctl::{
     DiscreteDynamics, Ilqr, IlqrReport, Mpc, MpcSettings, OptimalError, ReducedEuler,
 };
@@ -209,4 +211,92 @@ fn the_euler_map_linearised_steps_to_the_bits_of_its_step() {
             );
         }
     }
+}
+
+#[test]
+fn trajectories_linearised_in_batches_get_the_bits_of_each_node() {
+    // m = 2, 3, 5 and one beyond the batch's kernels (7), over 13 nodes: a last group of fewer
+    // nodes than a SIMD register holds.
+    for (harmonics, base) in [
+        (1, BaseAngle::Fixed(0.3)),
+        (1, BaseAngle::Free),
+        (2, BaseAngle::Free),
+        (3, BaseAngle::Free),
+    ] {
+        let model = ReducedModel::new(
+            ChainModel::uniform(12, 0.1, 0.1, 9.81).unwrap(),
+            ModalMap::new(&[0.1; 12], harmonics, base).unwrap(),
+        )
+        .unwrap();
+        let (m, nodes) = (model.n_coords(), 13);
+        let (nx, nu) = (2 * m, m);
+        let x: Vec<f64> = (0..nodes * nx)
+            .map(|i| 0.8 * (0.37 * i as f64).sin())
+            .collect();
+        let u: Vec<f64> = (0..nodes * nu)
+            .map(|i| 0.5 * (0.21 * i as f64).cos())
+            .collect();
+        let mut data = PlantData::new((&model).into());
+        let mut derivatives = PlantDerivatives::new((&model).into());
+        let mut work = ReducedDerivativesBatch::new(&model);
+        let mut batched = ReducedEuler::new(&model, &mut data, &mut derivatives, 0.005)
+            .unwrap()
+            .with_batch(&mut work);
+        assert_eq!(
+            batched.linearises_trajectories(),
+            m <= 5 && Plant::from(&model).batch_lanes() > 1
+        );
+        let (mut a, mut b) = (vec![0.0; nodes * nx * nx], vec![0.0; nodes * nx * nu]);
+        let mut next = vec![0.0; nx];
+        batched
+            .linearise_trajectory(&x, &u, &mut next, &mut a, &mut b)
+            .unwrap();
+        let (mut a_node, mut b_node) = (vec![0.0; nx * nx], vec![0.0; nx * nu]);
+        for k in 0..nodes {
+            let (state, control) = (&x[k * nx..(k + 1) * nx], &u[k * nu..(k + 1) * nu]);
+            batched
+                .linearise(state, control, &mut next, &mut a_node, &mut b_node)
+                .unwrap();
+            assert_eq!(
+                bits(&a[k * nx * nx..(k + 1) * nx * nx]),
+                bits(&a_node),
+                "m = {m}, node {k}"
+            );
+            assert_eq!(
+                bits(&b[k * nx * nu..(k + 1) * nx * nu]),
+                bits(&b_node),
+                "m = {m}, node {k}"
+            );
+        }
+        // A node the model refuses is an error, not a silent result.
+        let mut bad = x.clone();
+        bad[11 * nx + 1] = f64::NAN;
+        assert!(
+            batched
+                .linearise_trajectory(&bad, &u, &mut next, &mut a, &mut b)
+                .is_err()
+        );
+    }
+}
+
+#[test]
+fn solves_that_linearise_in_batches_end_on_the_bits_of_those_that_linearise_on_their_way() {
+    let model = arm();
+    let (mpc, x0) = warm_start(&model);
+    // `Counted` keeps the trait's node-by-node linearisation: it linearises on its way.
+    let (on_the_way, report, ..) = solve(&model, mpc.ilqr(), &x0, &[]);
+    let mut batched = mpc.ilqr().clone();
+    let mut data = PlantData::new((&model).into());
+    let mut derivatives = PlantDerivatives::new((&model).into());
+    let mut work = ReducedDerivativesBatch::new(&model);
+    let mut dynamics = ReducedEuler::new(&model, &mut data, &mut derivatives, 0.005)
+        .unwrap()
+        .with_batch(&mut work);
+    let batched_report = batched
+        .solve(&mut dynamics, &x0, &MpcSettings::uniform(2).solver)
+        .unwrap();
+    assert_eq!(report, batched_report);
+    assert_eq!(bits(on_the_way.controls()), bits(batched.controls()));
+    assert_eq!(bits(on_the_way.states()), bits(batched.states()));
+    assert_eq!(bits(on_the_way.gains()), bits(batched.gains()));
 }
