@@ -206,6 +206,44 @@ pub(crate) fn field<'py>(
     numpy.call_method1("ascontiguousarray", (reshaped,))
 }
 
+/// One state's reduced derivatives in the layout of [`derivatives_dict`]: `a_ddot`, then the
+/// blocks `d_a`, `d_a_dot`, `d_tau_star` (`m x m` each, row-major), from the rows
+/// `[d_a row i | d_a_dot row i | d_tau_star row i]` of `jacobians`.
+pub(crate) fn split_derivatives(m: usize, a_ddot: &[f64], jacobians: &[f64], out: &mut [f64]) {
+    let (value, blocks) = out.split_at_mut(m);
+    value.copy_from_slice(&a_ddot[..m]);
+    for (b, block) in blocks.chunks_exact_mut(m * m).enumerate() {
+        for (row, target) in jacobians.chunks_exact(3 * m).zip(block.chunks_exact_mut(m)) {
+            target.copy_from_slice(&row[b * m..(b + 1) * m]);
+        }
+    }
+}
+
+/// The results of `reduced_derivatives` (`m + 3 m^2` a state, [`split_derivatives`]) as a dict
+/// of `a_ddot` (m,) and `d_a`, `d_a_dot`, `d_tau_star` (m, m), each with a leading N for a
+/// batch.
+pub(crate) fn derivatives_dict<'py>(
+    py: Python<'py>,
+    out: Output,
+    batch: bool,
+    m: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let all = flat(py, out, m + 3 * m * m);
+    let dict = PyDict::new(py);
+    let mut first = 0;
+    for (name, shape) in [
+        ("a_ddot", &[m][..]),
+        ("d_a", &[m, m][..]),
+        ("d_a_dot", &[m, m][..]),
+        ("d_tau_star", &[m, m][..]),
+    ] {
+        let last = first + shape.iter().product::<usize>();
+        dict.set_item(name, field(&all, batch, first, last, shape)?)?;
+        first = last;
+    }
+    Ok(dict)
+}
+
 /// One flat result per state as a numpy array of shape (per_state,) or (N, per_state).
 fn flat<'py>(py: Python<'py>, out: Output, per_state: usize) -> Bound<'py, PyAny> {
     out.into_py(py, &[per_state])
@@ -626,37 +664,12 @@ impl SpatialArm {
                     tau,
                 )
                 .map_err(Error::from)?;
-                let (a_ddot, rest) = out.split_at_mut(m);
-                a_ddot.copy_from_slice(ws.derivatives.a_ddot());
                 let derivatives = &ws.derivatives;
-                for (block, matrix) in rest.chunks_exact_mut(m * m).zip([
-                    derivatives.d_a(),
-                    derivatives.d_a_dot(),
-                    derivatives.d_tau_star(),
-                ]) {
-                    for (i, row) in block.chunks_exact_mut(m).enumerate() {
-                        for (j, entry) in row.iter_mut().enumerate() {
-                            *entry = matrix[(i, j)];
-                        }
-                    }
-                }
+                split_derivatives(m, derivatives.a_ddot(), derivatives.jacobians(), out);
                 check_finite("reduced dynamics derivatives", out)
             },
         )?;
-        let all = flat(py, out, per_state);
-        let dict = PyDict::new(py);
-        let mut first = 0;
-        for (name, shape) in [
-            ("a_ddot", &[m][..]),
-            ("d_a", &[m, m][..]),
-            ("d_a_dot", &[m, m][..]),
-            ("d_tau_star", &[m, m][..]),
-        ] {
-            let last = first + shape.iter().product::<usize>();
-            dict.set_item(name, field(&all, batch, first, last, shape)?)?;
-            first = last;
-        }
-        Ok(dict)
+        derivatives_dict(py, out, batch, m)
     }
 
     /// The arm's chain as URDF text (hrm eval's `export`): per link `joint_i_z` about the

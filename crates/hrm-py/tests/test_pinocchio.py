@@ -81,3 +81,11 @@ def test_reduced_forward_dynamics_matches_pinocchio_through_the_modal_jacobian(h
         assert_close(reduced.mass_matrix(a), m_star)
         assert_close(reduced.coriolis(a, a_dot) + reduced.gravity(a), bias_star)
         assert_close(reduced.forward_dynamics(a, a_dot, tau_star), np.linalg.solve(m_star, tau_star - bias_star))
+        # The analytic derivatives: -M*^-1 J^T (d tau / d q, d tau / d v) J at the solution.
+        a_ddot = np.linalg.solve(m_star, tau_star - bias_star)
+        pin.computeRNEADerivatives(model, data, q, v, J @ a_ddot)
+        inverse = np.linalg.inv(m_star)
+        derivatives = reduced.reduced_derivatives(a, a_dot, tau_star)
+        assert_close(derivatives["d_a"], -inverse @ J.T @ data.dtau_dq @ J)
+        assert_close(derivatives["d_a_dot"], -inverse @ J.T @ data.dtau_dv @ J)
+        assert_close(derivatives["d_tau_star"], inverse)

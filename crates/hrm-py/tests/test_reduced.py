@@ -130,6 +130,32 @@ def test_forward_dynamics_and_joint_torques_agree(arm, rng):
     np.testing.assert_allclose(tau, arm.rnea(model.joint_angles(a), a_dot @ J.T, a_ddot @ J.T), rtol=1e-12, atol=1e-13)
 
 
+@pytest.mark.parametrize("harmonics,alpha0", [(1, None), (1, 0.8), (2, None)])
+def test_reduced_derivatives_are_those_of_the_forward_dynamics(arm, rng, harmonics, alpha0):
+    # Central differences of eq 15 in a and a_dot; d a_ddot / d tau* = M*^-1.
+    model = hrm.ReducedModel(arm, harmonics=harmonics, alpha0=alpha0)
+    m = model.n_coords
+    a, a_dot, tau_star = rng.normal(size=(3, m)) * 0.5
+    d = model.reduced_derivatives(a, a_dot, tau_star)
+    assert d["d_a"].shape == (m, m) and d["a_ddot"].shape == (m,)
+    np.testing.assert_array_equal(d["a_ddot"], model.forward_dynamics(a, a_dot, tau_star))
+    np.testing.assert_allclose(d["d_tau_star"] @ model.mass_matrix(a), np.eye(m), atol=1e-10)
+    h = 1e-6
+    for name, point in [("d_a", a), ("d_a_dot", a_dot)]:
+        for j in range(m):
+            step = np.zeros(m)
+            step[j] = h
+            if name == "d_a":
+                up = model.forward_dynamics(a + step, a_dot, tau_star)
+                down = model.forward_dynamics(a - step, a_dot, tau_star)
+            else:
+                up = model.forward_dynamics(a, a_dot + step, tau_star)
+                down = model.forward_dynamics(a, a_dot - step, tau_star)
+            column = (up - down) / (2 * h)
+            scale = np.abs(d[name]).max()
+            np.testing.assert_allclose(d[name][:, j], column, atol=1e-6 * scale, err_msg=name)
+
+
 @pytest.mark.parametrize("size", [5, 2000])
 def test_batch_equals_one_by_one(arm, rng, size):
     model = hrm.ReducedModel(arm, alpha0=1.0)
@@ -143,6 +169,9 @@ def test_batch_equals_one_by_one(arm, rng, size):
         "forward_dynamics": (model.forward_dynamics(a, a_dot, tau), lambda i: model.forward_dynamics(a[i], a_dot[i], tau[i])),
         "joint_torques": (model.joint_torques(a, a_dot, tau), lambda i: model.joint_torques(a[i], a_dot[i], tau[i])),
     }
+    derivatives = model.reduced_derivatives(a, a_dot, tau)
+    for key in ["a_ddot", "d_a", "d_a_dot", "d_tau_star"]:
+        outputs[key] = (derivatives[key], lambda i, key=key: model.reduced_derivatives(a[i], a_dot[i], tau[i])[key])
     # Ends of the backbone curves (reachable by construction; the chain's tips need not be).
     targets = np.array([curve_end(arm.lengths.sum(), row, 1.0) for row in a])
     outputs["ik"] = (model.ik(targets), lambda i: model.ik(targets[i]))

@@ -174,6 +174,10 @@ class ReducedModel:
         """G* = J^T G, shape (m,) or (N, m)."""
     def forward_dynamics(self, a: ArrayLike, a_dot: ArrayLike, tau_star: ArrayLike) -> Array:
         """a_ddot = M*^-1 (tau* - C* - G*), shape (m,) or (N, m)."""
+    def reduced_derivatives(
+        self, a: ArrayLike, a_dot: ArrayLike, tau_star: ArrayLike
+    ) -> Dict[str, Array]:
+        """a_ddot and its analytic derivatives d_a, d_a_dot, d_tau_star = M*^-1 (m, m each)."""
     def joint_torques(self, a: ArrayLike, a_dot: ArrayLike, a_ddot: ArrayLike) -> Array:
         """tau = M J a_ddot + C + G, shape (n,) or (N, n)."""
 
@@ -303,6 +307,10 @@ class SpatialArm:
         """mass_matrix, coriolis, gravity, a_ddot and joint_torques at (a, a_dot) under tau*."""
     def forward_dynamics(self, a: ArrayLike, a_dot: ArrayLike, tau_star: ArrayLike) -> Array:
         """a_ddot = M*^-1 (tau* - C* - G*), shape (m,) or (N, m)."""
+    def reduced_derivatives(
+        self, a: ArrayLike, a_dot: ArrayLike, tau_star: ArrayLike
+    ) -> Dict[str, Array]:
+        """a_ddot and its analytic derivatives d_a, d_a_dot, d_tau_star = M*^-1 (m, m each)."""
 
 class Scenario:
     """A closed-loop experiment; every key of its TOML file is an attribute."""
