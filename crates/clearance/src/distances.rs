@@ -3,7 +3,7 @@
 use crate::closest::{Closest, Segment, closest_to_box, closest_to_point, closest_to_segment};
 use crate::data::ClearanceData;
 use crate::model::ClearanceModel;
-use crate::obstacle::{Obstacle, PlanarObstacle};
+use crate::obstacle::Core;
 
 /// Fills every pair's clearance and closest points for the placed chain and returns the smallest
 /// clearance to an obstacle and between links (each `+inf` when there is no such pair).
@@ -25,38 +25,30 @@ pub fn distances(model: &ClearanceModel, data: &mut ClearanceData) -> (f64, f64)
     } = data;
     let radius = model.radius();
     let results = (distances.as_mut_slice(), closest.as_mut_slice());
-    match model.planar_obstacles() {
+    match model.planar_cores() {
         // A chain turning about `z` among obstacles of its plane: two dimensions suffice.
-        Some(obstacles) if *turns_about_z => {
+        Some(cores) if *turns_about_z => {
             for (segment, link) in planar_segments.iter_mut().zip(planar.windows(2)) {
                 *segment = Segment::new(link[0], link[1]);
             }
-            every_pair(
-                radius,
-                planar_segments,
-                obstacles,
-                closest_to_planar,
-                results,
-            )
+            every_pair(radius, planar_segments, cores, results)
         }
         _ => {
             for (segment, link) in segments.iter_mut().zip(points.windows(2)) {
                 *segment = Segment::new(link[0], link[1]);
             }
-            every_pair(radius, segments, model.obstacles(), closest_to, results)
+            every_pair(radius, segments, model.cores(), results)
         }
     }
 }
 
-/// [`distances`] for the prepared segments of the links and obstacles of one kind:
-/// `closest_to` writes the closest points of a link to an obstacle and returns the obstacle's
-/// radius.
+/// [`distances`] for the prepared segments of the links and the obstacles' cores, in `D`
+/// dimensions.
 #[inline]
-fn every_pair<const D: usize, O>(
+fn every_pair<const D: usize>(
     radius: f64,
     segments: &[Segment<D>],
-    obstacles: &[O],
-    closest_to: fn(&O, &Segment<D>, &mut Closest) -> f64,
+    obstacles: &[Core<D>],
     (distances, closest): (&mut [f64], &mut [Closest]),
 ) -> (f64, f64) {
     // The pairs in the model's order: link-major against every obstacle, then (i, k >= i + 2).
@@ -94,43 +86,20 @@ fn every_pair<const D: usize, O>(
     (near_obstacle, near_self)
 }
 
-/// [`closest_to`] of an obstacle of the plane and a link's segment in it.
-#[inline]
-fn closest_to_planar(obstacle: &PlanarObstacle, link: &Segment<2>, closest: &mut Closest) -> f64 {
-    match obstacle {
-        PlanarObstacle::Circle { center, radius } => {
-            *closest = closest_to_point(link, *center);
-            *radius
-        }
-        PlanarObstacle::Capsule { from, to, radius } => {
-            *closest = closest_to_segment(link, &Segment::new(*from, *to));
-            *radius
-        }
-        PlanarObstacle::Rectangle {
-            center,
-            half_extents,
-            axes,
-        } => {
-            *closest = closest_to_box(link, *center, *half_extents, axes);
-            0.0
-        }
-    }
-}
-
 /// Writes the closest points of a link's segment to an obstacle's core into `closest` and
 /// returns the obstacle's radius.
 #[inline]
-fn closest_to(obstacle: &Obstacle, link: &Segment<3>, closest: &mut Closest) -> f64 {
-    match obstacle {
-        Obstacle::Sphere { center, radius } => {
+fn closest_to<const D: usize>(core: &Core<D>, link: &Segment<D>, closest: &mut Closest) -> f64 {
+    match core {
+        Core::Point { center, radius } => {
             *closest = closest_to_point(link, *center);
             *radius
         }
-        Obstacle::Capsule { from, to, radius } => {
-            *closest = closest_to_segment(link, &Segment::new(*from, *to));
+        Core::Segment { axis, radius } => {
+            *closest = closest_to_segment(link, axis);
             *radius
         }
-        Obstacle::Box {
+        Core::Box {
             center,
             half_extents,
             axes,

@@ -1,7 +1,7 @@
 //! The constant part of a clearance problem: the links' radius, the obstacles and the pairs.
 
 use crate::error::ClearanceError;
-use crate::obstacle::{Obstacle, PlanarObstacle};
+use crate::obstacle::{Core, Obstacle};
 use lane_math::check_finite;
 
 /// The most obstacles a [`ClearanceModel`] accepts.
@@ -41,8 +41,9 @@ pub struct ClearanceModel {
     n_links: usize,
     radius: f64,
     obstacles: Vec<Obstacle>,
-    /// The obstacles' planar forms when every one lies in the plane `z = 0`.
-    planar_obstacles: Option<Vec<PlanarObstacle>>,
+    /// The obstacles' cores, and in two dimensions when every one lies in the plane `z = 0`.
+    cores: Vec<Core<3>>,
+    planar_cores: Option<Vec<Core<2>>>,
     pairs: Vec<Pair>,
 }
 
@@ -97,12 +98,14 @@ impl ClearanceModel {
                 pairs.push(Pair::Links { link, other });
             }
         }
-        let planar_obstacles = obstacles.iter().map(PlanarObstacle::of).collect();
+        let cores = obstacles.iter().map(Core::of).collect();
+        let planar_cores = obstacles.iter().map(Core::planar).collect();
         Ok(Self {
             n_links,
             radius,
             obstacles,
-            planar_obstacles,
+            cores,
+            planar_cores,
             pairs,
         })
     }
@@ -122,10 +125,15 @@ impl ClearanceModel {
         &self.obstacles
     }
 
-    /// The obstacles in two dimensions, when every one lies in the plane `z = 0` (see
-    /// [`PlanarObstacle`]).
-    pub(crate) fn planar_obstacles(&self) -> Option<&[PlanarObstacle]> {
-        self.planar_obstacles.as_deref()
+    /// The obstacles' cores, as [`obstacles`](Self::obstacles).
+    pub(crate) fn cores(&self) -> &[Core<3>] {
+        &self.cores
+    }
+
+    /// The obstacles' cores in two dimensions, when every one lies in the plane `z = 0` (see
+    /// [`Core::planar`]).
+    pub(crate) fn planar_cores(&self) -> Option<&[Core<2>]> {
+        self.planar_cores.as_deref()
     }
 
     /// Every pair, in the order of the data's distances.

@@ -143,26 +143,24 @@ impl<K: BatchKernel> Batch<'_, K> {
     /// time.
     #[inline(always)]
     pub(crate) fn groups<S: Simd, const M: usize>(mut self, simd: S) -> Result<(), BatchError> {
-        let width = S::F64_LANES;
         let states = self.a_ddot.len() / M;
-        if width > MAX_WIDTH {
-            return self.states(0, states);
-        }
-        let grouped = states - states % width;
-        for first in (0..grouped).step_by(width) {
-            let range = first * M..(first + width) * M;
-            let inputs = self.inputs.map(|x| &x[range.clone()]);
-            if !group::<S, M, K>(simd, &mut self.kernel, inputs, &mut self.a_ddot[range]) {
-                self.states(first, first + width)?;
-            }
-        }
-        self.states(grouped, states)
+        in_groups::<Self, S, M>(&mut self, simd, states)
     }
 
     /// Every state one at a time.
     pub(crate) fn one_at_a_time(mut self) -> Result<(), BatchError> {
         let states = self.a_ddot.len() / self.kernel.n_coords();
         self.states(0, states)
+    }
+}
+
+impl<K: BatchKernel> Groups for Batch<'_, K> {
+    #[inline(always)]
+    fn group<S: Simd, const M: usize>(&mut self, simd: S, first: usize) -> bool {
+        let width = S::F64_LANES;
+        let range = first * M..(first + width) * M;
+        let inputs = self.inputs.map(|x| &x[range.clone()]);
+        group::<S, M, K>(simd, &mut self.kernel, inputs, &mut self.a_ddot[range])
     }
 
     /// States `first..last` one at a time, by the kernel's one-state path.
@@ -177,6 +175,39 @@ impl<K: BatchKernel> Batch<'_, K> {
         }
         Ok(())
     }
+}
+
+/// A batch split into groups of SIMD lanes ([`in_groups`]): one group in lanes, or states one
+/// at a time.
+pub(crate) trait Groups {
+    /// The group of `S::F64_LANES` states from `first`, of `M` coordinates, in lanes; `false` if
+    /// it is to be redone one state at a time.
+    fn group<S: Simd, const M: usize>(&mut self, simd: S, first: usize) -> bool;
+
+    /// States `first..last` one at a time, which names a failure.
+    fn states(&mut self, first: usize, last: usize) -> Result<(), BatchError>;
+}
+
+/// The `states` of `batch`: whole groups of `S::F64_LANES` in SIMD (a group that fails redone
+/// one state at a time), the rest one at a time; all of them one at a time when the registers
+/// are wider than [`MAX_WIDTH`].
+#[inline(always)]
+pub(crate) fn in_groups<G: Groups, S: Simd, const M: usize>(
+    batch: &mut G,
+    simd: S,
+    states: usize,
+) -> Result<(), BatchError> {
+    let width = S::F64_LANES;
+    if width > MAX_WIDTH {
+        return batch.states(0, states);
+    }
+    let grouped = states - states % width;
+    for first in (0..grouped).step_by(width) {
+        if !batch.group::<S, M>(simd, first) {
+            batch.states(first, first + width)?;
+        }
+    }
+    batch.states(grouped, states)
 }
 
 /// One group of `S::F64_LANES` states of `M` coordinates (`inputs` and `out` hold exactly

@@ -14,7 +14,9 @@ use lane_math::{Lane, Pack, check_len};
 use pulp::{Simd, WithSimd};
 
 use crate::batch::{MAX_BATCH_COORDS, Planar, ReducedBatchData};
-use crate::batch_driver::{BatchError, MAX_WIDTH, accelerations, gather, scatter};
+use crate::batch_driver::{
+    BatchError, Groups, MAX_WIDTH, accelerations, gather, in_groups, scatter,
+};
 use crate::cache_aligned::CacheAligned;
 use crate::derivatives::{
     LINK_VALUES, LinkTrig, ReducedDerivatives, Scratch, StateOf, VECTORS, differentiate,
@@ -168,22 +170,20 @@ impl DerivativesBatch<'_> {
     /// time.
     #[inline(always)]
     fn groups<S: Simd, const M: usize>(mut self, simd: S) -> Result<(), BatchError> {
-        let width = S::F64_LANES;
         let states = self.a_ddot.len() / M;
-        if width > MAX_WIDTH {
-            return self.states(0, states);
-        }
-        let grouped = states - states % width;
-        for first in (0..grouped).step_by(width) {
-            let range = first * M..(first + width) * M;
-            let inputs = self.inputs.map(|x| &x[range.clone()]);
-            let blocks = first * 3 * M * M..(first + width) * 3 * M * M;
-            let outputs = (&mut self.a_ddot[range], &mut self.jacobians[blocks]);
-            if !group::<S, M>(simd, self.model, self.work, inputs, outputs) {
-                self.states(first, first + width)?;
-            }
-        }
-        self.states(grouped, states)
+        in_groups::<Self, S, M>(&mut self, simd, states)
+    }
+}
+
+impl Groups for DerivativesBatch<'_> {
+    #[inline(always)]
+    fn group<S: Simd, const M: usize>(&mut self, simd: S, first: usize) -> bool {
+        let width = S::F64_LANES;
+        let range = first * M..(first + width) * M;
+        let inputs = self.inputs.map(|x| &x[range.clone()]);
+        let blocks = first * 3 * M * M..(first + width) * 3 * M * M;
+        let outputs = (&mut self.a_ddot[range], &mut self.jacobians[blocks]);
+        group::<S, M>(simd, self.model, self.work, inputs, outputs)
     }
 
     /// States `first..last` one at a time, by [`reduced_derivatives`].
