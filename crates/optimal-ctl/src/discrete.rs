@@ -52,7 +52,8 @@ pub trait DiscreteDynamics {
     /// [`linearise`](Self::linearise) node by node.
     ///
     /// # Errors
-    /// As [`step`](Self::step).
+    /// As [`step`](Self::step); [`OptimalError::Dimension`] for slices that do not hold the
+    /// same number of whole nodes.
     fn linearise_trajectory(
         &mut self,
         x: &[f64],
@@ -65,6 +66,32 @@ pub trait DiscreteDynamics {
     }
 }
 
+/// Checks the slices of [`DiscreteDynamics::linearise_trajectory`]: `N = u.len() / n_u` nodes,
+/// `x` of `N` states, `a` and `b` of `N` blocks each, `next` of one state.
+fn check_trajectory(
+    (nx, nu): (usize, usize),
+    (x, u, next): (&[f64], &[f64], &[f64]),
+    (a, b): (&[f64], &[f64]),
+) -> Result<(), OptimalError> {
+    let nodes = u.len() / nu.max(1);
+    for (name, expected, found) in [
+        ("controls (whole nodes of n_u values)", nodes * nu, u.len()),
+        ("states (one a node)", nodes * nx, x.len()),
+        ("next", nx, next.len()),
+        ("state Jacobians (one a node)", nodes * nx * nx, a.len()),
+        ("control Jacobians (one a node)", nodes * nx * nu, b.len()),
+    ] {
+        if expected != found {
+            return Err(OptimalError::Dimension {
+                name,
+                expected,
+                found,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// [`DiscreteDynamics::linearise_trajectory`] by [`DiscreteDynamics::linearise`] of each node.
 fn linearise_node_by_node<D: DiscreteDynamics + ?Sized>(
     dynamics: &mut D,
@@ -74,6 +101,7 @@ fn linearise_node_by_node<D: DiscreteDynamics + ?Sized>(
     (a, b): (&mut [f64], &mut [f64]),
 ) -> Result<(), OptimalError> {
     let (nx, nu) = (dynamics.state_dim(), dynamics.control_dim());
+    check_trajectory((nx, nu), (x, u, next), (a, b))?;
     let nodes = x.chunks_exact(nx).zip(u.chunks_exact(nu));
     let jacobians = a.chunks_exact_mut(nx * nx).zip(b.chunks_exact_mut(nx * nu));
     for ((x, u), (a, b)) in nodes.zip(jacobians) {
@@ -225,6 +253,7 @@ impl DiscreteDynamics for ReducedEuler<'_> {
         };
         let (m, h) = (model.n_coords(), self.step);
         let (nx, nu) = (2 * m, m);
+        check_trajectory((nx, nu), (x, u, next), (a_mat, b_mat))?;
         // Each group of nodes gathered into the batch's layout (`a`, `a_dot`, `tau*` state after
         // state) on the stack, its accelerations and Jacobians assembled node by node.
         let mut inputs = [[0.0; BATCH_NODES * MAX_BATCH_COORDS]; 3];

@@ -276,6 +276,16 @@ fn trajectories_linearised_in_batches_get_the_bits_of_each_node() {
                 .linearise_trajectory(&bad, &u, &mut next, &mut a, &mut b)
                 .is_err()
         );
+        // Slices of other sizes are refused, the one at fault named.
+        let short = &x[..x.len() - 1];
+        let error = batched
+            .linearise_trajectory(short, &u, &mut next, &mut a, &mut b)
+            .unwrap_err();
+        assert!(error.to_string().contains("states"), "{error}");
+        let error = batched
+            .linearise_trajectory(&x, &u, &mut next, &mut a[1..], &mut b)
+            .unwrap_err();
+        assert!(error.to_string().contains("state Jacobians"), "{error}");
     }
 }
 
