@@ -1,9 +1,9 @@
 //! The clearance of every pair: link capsules against obstacles and against each other.
 
 use crate::closest::{Closest, Segment, closest_to_box, closest_to_point, closest_to_segment};
+use crate::cores::Core;
 use crate::data::ClearanceData;
 use crate::model::ClearanceModel;
-use crate::obstacle::Core;
 
 /// Fills every pair's clearance and closest points for the placed chain and returns the smallest
 /// clearance to an obstacle and between links (each `+inf` when there is no such pair).

@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 mod closest;
+mod cores;
 mod data;
 mod distances;
 mod error;

@@ -1,7 +1,8 @@
 //! The constant part of a clearance problem: the links' radius, the obstacles and the pairs.
 
+use crate::cores::Core;
 use crate::error::ClearanceError;
-use crate::obstacle::{Core, Obstacle};
+use crate::obstacle::Obstacle;
 use lane_math::check_finite;
 
 /// The most obstacles a [`ClearanceModel`] accepts.
