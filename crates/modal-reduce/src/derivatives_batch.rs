@@ -53,14 +53,22 @@ impl ReducedDerivativesBatch {
     /// refuses the memory.
     pub fn try_new(model: &ReducedModel) -> Result<Self, ReduceError> {
         const WHAT: &str = "the workspace of the reduced model's batch derivatives";
-        let m = model.n_coords().min(MAX_BATCH_COORDS);
-        let len = model.n_links() * (LINK_VALUES + 2 * m) * MAX_WIDTH;
         Ok(Self {
             batch: ReducedBatchData::try_new(model)?,
-            links: CacheAligned::try_zeros(len, WHAT)?,
+            links: CacheAligned::try_zeros(links_len(model), WHAT)?,
             single: ReducedDerivatives::new(model),
         })
     }
+}
+
+/// The per-link values of the pass from the tip for `model`'s groups: `5 + 2m` numbers a link
+/// in `MAX_WIDTH` lanes each, none for a model whose states go one at a time.
+fn links_len(model: &ReducedModel) -> usize {
+    let m = model.n_coords();
+    if m > MAX_BATCH_COORDS {
+        return 0;
+    }
+    model.n_links() * (LINK_VALUES + 2 * m) * MAX_WIDTH
 }
 
 /// [`reduced_derivatives`] of a batch of states: `a`, `a_dot`, `tau_star` and `a_ddot` hold `N`
@@ -111,7 +119,7 @@ pub fn reduced_derivatives_batch(
     check_len(
         "derivative workspace links",
         work.links.get().len(),
-        model.n_links() * (LINK_VALUES + 2 * model.n_coords().min(MAX_BATCH_COORDS)) * MAX_WIDTH,
+        links_len(model),
     )
     .map_err(|e| shape(e.into()))?;
     let m = model.n_coords();

@@ -102,7 +102,9 @@ impl Mpc {
     /// # Errors
     /// [`OptimalError::InvalidSetting`] or [`OptimalError::Dimension`] for settings out of their
     /// domain or of the wrong length (horizon above [`MAX_MPC_HORIZON`], a weight or limit that
-    /// is negative, zero where it must be positive, or not finite).
+    /// is negative, zero where it must be positive, or not finite);
+    /// [`OptimalError::Dynamics`] with `ReduceError::OutOfMemory` when the system refuses the
+    /// memory of a planar model's batch derivatives.
     pub fn new<'p>(
         model: impl Into<Plant<'p>>,
         settings: &MpcSettings,
@@ -120,7 +122,7 @@ impl Mpc {
             data: PlantData::new(model),
             derivatives: PlantDerivatives::new(model),
             batch: match model {
-                Plant::Planar(planar) => Some(ReducedDerivativesBatch::new(planar)),
+                Plant::Planar(planar) => Some(ReducedDerivativesBatch::try_new(planar)?),
                 Plant::Spatial(_) => None,
             },
             state: vec![0.0; 2 * m],
