@@ -100,8 +100,21 @@ pub(crate) fn run_batch<K: BatchKernel>(
     inputs: [&[f64]; 3],
     a_ddot: &mut [f64],
 ) -> Result<(), BatchError> {
-    let [a, a_dot, tau_star] = inputs;
-    let m = kernel.n_coords();
+    check_states(kernel.n_coords(), inputs, a_ddot)?;
+    arch.dispatch(Batch {
+        kernel,
+        inputs,
+        a_ddot,
+    })
+}
+
+/// Checks that `a`, `a_dot`, `tau_star` (`inputs`) and `a_ddot` hold the same whole number of
+/// states of `m` values each; returns that number of values.
+pub(crate) fn check_states(
+    m: usize,
+    [a, a_dot, tau_star]: [&[f64]; 3],
+    a_ddot: &[f64],
+) -> Result<usize, BatchError> {
     let values = a.len() - a.len() % m;
     let shape =
         |name, found| check_len(name, found, values).map_err(|e| BatchError::Shape(e.into()));
@@ -109,11 +122,7 @@ pub(crate) fn run_batch<K: BatchKernel>(
     shape("a_dot (as many values as a)", a_dot.len())?;
     shape("tau_star (as many values as a)", tau_star.len())?;
     shape("a_ddot (as many values as a)", a_ddot.len())?;
-    arch.dispatch(Batch {
-        kernel,
-        inputs,
-        a_ddot,
-    })
+    Ok(values)
 }
 
 /// One batch, run by [`pulp::Arch::dispatch`] with the processor's instruction set.

@@ -15,7 +15,7 @@ use pulp::{Simd, WithSimd};
 
 use crate::batch::{MAX_BATCH_COORDS, Planar, ReducedBatchData};
 use crate::batch_driver::{
-    BatchError, Groups, MAX_WIDTH, accelerations, gather, in_groups, scatter,
+    BatchError, Groups, MAX_WIDTH, accelerations, check_states, gather, in_groups, scatter,
 };
 use crate::cache_aligned::CacheAligned;
 use crate::derivatives::{
@@ -123,17 +123,13 @@ pub fn reduced_derivatives_batch(
     )
     .map_err(|e| shape(e.into()))?;
     let m = model.n_coords();
-    let values = a.len() - a.len() % m;
-    let whole = |name, found| check_len(name, found, values).map_err(|e| shape(e.into()));
-    whole("a (whole states of m values)", a.len())?;
-    whole("a_dot (as many values as a)", a_dot.len())?;
-    whole("tau_star (as many values as a)", tau_star.len())?;
-    whole("a_ddot (as many values as a)", a_ddot.len())?;
-    whole(
+    let values = check_states(m, [a, a_dot, tau_star], a_ddot)?;
+    check_len(
         "jacobians (3 m values for each value of a)",
-        jacobians.len() / (3 * m),
-    )?;
-    check_len("jacobians", jacobians.len(), 3 * m * values).map_err(|e| shape(e.into()))?;
+        jacobians.len(),
+        3 * m * values,
+    )
+    .map_err(|e| shape(e.into()))?;
     let arch = work.batch.arch;
     arch.dispatch(DerivativesBatch {
         model,
