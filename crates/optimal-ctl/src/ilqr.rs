@@ -908,17 +908,19 @@ impl Ilqr {
             for (j, q) in t.q_u.iter_mut().enumerate() {
                 *q += cost.control[j] * (u[j] - self.u_ref[k * nu + j]);
             }
-            // Q_xx, Q_uu, Q_ux.
-            multiply(t.v_xx, a, t.va, nx, nx, nx);
+            // Q_uu first, Q_xx and Q_ux after it: the copy of Q_uu below then reads values
+            // stored long before (a wide load of values just stored one by one waits for them
+            // to reach the cache).
             multiply(t.v_xx, b, t.vb, nx, nx, nu);
-            multiply_transposed(a, t.va, t.q_xx, nx, nx, nx);
             multiply_transposed(b, t.vb, t.q_uu, nu, nx, nu);
+            for j in 0..nu {
+                t.q_uu[j * nu + j] += cost.control[j];
+            }
+            multiply(t.v_xx, a, t.va, nx, nx, nx);
+            multiply_transposed(a, t.va, t.q_xx, nx, nx, nx);
             multiply_transposed(b, t.va, t.q_ux, nu, nx, nx);
             for i in 0..nx {
                 t.q_xx[i * nx + i] += cost.state[i];
-            }
-            for j in 0..nu {
-                t.q_uu[j * nu + j] += cost.control[j];
             }
             // The feed-forward step: the box QP on (Q_uu + mu I, Q_u).
             t.hessian.copy_from_slice(t.q_uu);
@@ -949,12 +951,12 @@ impl Ilqr {
             if !within_rows {
                 self.qp
                     .solve(t.hessian, t.q_u, t.step_lower, t.step_upper, ff, qp)?;
-                // The gain on the free controls, zero on the clamped ones.
-                gain.copy_from_slice(t.q_ux);
-                self.qp.solve_free(gain, nx);
-                for g in gain.iter_mut() {
-                    *g = -*g;
+                // The gain on the free controls, zero on the clamped ones (negated before the
+                // solve, which is exact: the solve's roundings are symmetric in sign).
+                for (g, q) in gain.iter_mut().zip(t.q_ux.iter()) {
+                    *g = -*q;
                 }
+                self.qp.solve_free(gain, nx);
             }
             // The value function.
             multiply(t.q_uu, gain, t.quu_gain, nu, nu, nx);
