@@ -46,11 +46,16 @@ fn direction<const D: usize>(v: V<D>, scale: f64) -> (V<D>, f64) {
 /// rather than once per pair (a division or a square root costs several multiplications).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Segment<const D: usize> {
-    start: V<D>,
-    axis: V<D>,
-    length2: f64,
-    inverse_length2: f64,
-    length: f64,
+    /// The first end.
+    pub(crate) start: V<D>,
+    /// From the first end to the second.
+    pub(crate) axis: V<D>,
+    /// `|axis|^2`.
+    pub(crate) length2: f64,
+    /// `1 / |axis|^2`, or 0 for a point.
+    pub(crate) inverse_length2: f64,
+    /// `|axis|`.
+    pub(crate) length: f64,
 }
 
 impl<const D: usize> Segment<D> {

@@ -2,6 +2,7 @@
 
 use crate::closest::Segment;
 use crate::obstacle::Obstacle;
+use crate::point_lanes::PointCores;
 use crate::vector::{V, planar};
 
 /// What a link is measured against, in `D` dimensions: an obstacle's core (a point, a segment
@@ -20,6 +21,24 @@ pub(crate) enum Core<const D: usize> {
         half_extents: V<D>,
         axes: [V<D>; D],
     },
+}
+
+/// The cores of a model's obstacles in `D` dimensions, in their order, and the point cores
+/// among them again, coordinate by coordinate, for measuring a link against all of them at once.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Cores<const D: usize> {
+    /// Every obstacle's core.
+    pub(crate) all: Vec<Core<D>>,
+    /// The point cores of [`all`](Self::all).
+    pub(crate) points: PointCores<D>,
+}
+
+impl<const D: usize> Cores<D> {
+    /// The cores `all`, with their point cores gathered.
+    pub(crate) fn new(all: Vec<Core<D>>) -> Self {
+        let points = PointCores::of(&all);
+        Self { all, points }
+    }
 }
 
 impl Core<3> {

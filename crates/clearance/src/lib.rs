@@ -10,6 +10,7 @@ mod modal_gradient;
 mod model;
 mod obstacle;
 mod place;
+mod point_lanes;
 mod vector;
 
 pub use closest::{Closest, segment_box, segment_point, segment_segment};

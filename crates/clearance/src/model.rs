@@ -1,6 +1,6 @@
 //! The constant part of a clearance problem: the links' radius, the obstacles and the pairs.
 
-use crate::cores::Core;
+use crate::cores::{Core, Cores};
 use crate::error::ClearanceError;
 use crate::obstacle::Obstacle;
 use lane_math::check_finite;
@@ -43,8 +43,8 @@ pub struct ClearanceModel {
     radius: f64,
     obstacles: Vec<Obstacle>,
     /// The obstacles' cores, and in two dimensions when every one lies in the plane `z = 0`.
-    cores: Vec<Core<3>>,
-    planar_cores: Option<Vec<Core<2>>>,
+    cores: Cores<3>,
+    planar_cores: Option<Cores<2>>,
     pairs: Vec<Pair>,
 }
 
@@ -99,8 +99,9 @@ impl ClearanceModel {
                 pairs.push(Pair::Links { link, other });
             }
         }
-        let cores = obstacles.iter().map(Core::of).collect();
-        let planar_cores = obstacles.iter().map(Core::planar).collect();
+        let cores = Cores::new(obstacles.iter().map(Core::of).collect());
+        let planar_cores = obstacles.iter().map(Core::planar).collect::<Option<_>>();
+        let planar_cores = planar_cores.map(Cores::new);
         Ok(Self {
             n_links,
             radius,
@@ -127,14 +128,14 @@ impl ClearanceModel {
     }
 
     /// The obstacles' cores, as [`obstacles`](Self::obstacles).
-    pub(crate) fn cores(&self) -> &[Core<3>] {
+    pub(crate) fn cores(&self) -> &Cores<3> {
         &self.cores
     }
 
     /// The obstacles' cores in two dimensions, when every one lies in the plane `z = 0` (see
     /// [`Core::planar`]).
-    pub(crate) fn planar_cores(&self) -> Option<&[Core<2>]> {
-        self.planar_cores.as_deref()
+    pub(crate) fn planar_cores(&self) -> Option<&Cores<2>> {
+        self.planar_cores.as_ref()
     }
 
     /// Every pair, in the order of the data's distances.

@@ -296,6 +296,74 @@ proptest! {
     }
 
     #[test]
+    fn point_cores_in_lanes_give_the_bits_of_one_pair(
+        points in prop::collection::vec(v3(), 4),
+        centers in prop::collection::vec(v3(), 1..12),
+        radius in 0.0..0.1f64,
+        snap in 0..4usize,
+        in_plane in any::<bool>(),
+    ) {
+        // Spheres (circles when in the plane) mixed with a capsule, measured a register of
+        // them at a time, against each pair alone; with a centre on a joint point and a link
+        // of zero length among the cases.
+        let flat = |v: V| if in_plane { [v[0], v[1], 0.0] } else { v };
+        let mut points: Vec<V> = points.into_iter().map(flat).collect();
+        let mut centers: Vec<V> = centers.into_iter().map(flat).collect();
+        if snap == 1 {
+            points[2] = points[1];
+        } else if snap == 2 {
+            centers[0] = points[1];
+        } else if snap == 3 {
+            // Off the joint, across link 1, by 3e-12 of its length: a normal kept, just.
+            let d = sub(points[2], points[1]);
+            let across = [-d[1], d[0], 0.0];
+            let scale = 3e-12 * norm(d) / norm(across);
+            centers[0] = flat(lerp(points[1], [points[1][0] + across[0], points[1][1] + across[1], points[1][2]], scale));
+        }
+        let mut obstacles: Vec<Obstacle> = centers
+            .iter()
+            .enumerate()
+            .map(|(i, &c)| Obstacle::sphere(c, 0.01 * i as f64).unwrap())
+            .collect();
+        obstacles.insert(1, Obstacle::capsule(flat([0.1, 0.2, 0.3]), flat([0.4, 0.1, 0.2]), 0.02).unwrap());
+        let model = ClearanceModel::new(3, radius, obstacles).unwrap();
+        let mut data = ClearanceData::new(&model, 0).unwrap();
+        if in_plane && snap != 1 {
+            // The points' planar chain, placed by angles (two dimensions; a planar chain has
+            // no link of zero length).
+            let mut lengths = vec![0.0; 3];
+            let mut theta = vec![0.0; 3];
+            let mut heading = 0.0;
+            for i in 0..3 {
+                let d = sub(points[i + 1], points[i]);
+                lengths[i] = (d[0] * d[0] + d[1] * d[1]).sqrt();
+                let angle = d[1].atan2(d[0]);
+                theta[i] = angle - heading;
+                heading = angle;
+            }
+            place_planar(&model, &mut data, &lengths, &theta).unwrap();
+            points = data.points().to_vec();
+        } else {
+            place(&model, &mut data, &points, &[[0.0, 0.0, 1.0]; 3]).unwrap();
+        }
+        distances(&model, &mut data);
+        for (pair, (&distance, closest)) in data.distances().iter().zip(data.closest()).enumerate() {
+            let Pair::Obstacle { link, obstacle } = model.pairs()[pair] else { continue };
+            let Obstacle::Sphere { center, radius: other } = model.obstacles()[obstacle] else {
+                continue;
+            };
+            let alone = segment_point(points[link], points[link + 1], center);
+            let bits = |c: &clearance::Closest| {
+                let fields = [c.t, c.distance];
+                let vectors = [c.point, c.other, c.normal];
+                fields.into_iter().chain(vectors.into_iter().flatten()).map(f64::to_bits).collect::<Vec<_>>()
+            };
+            prop_assert_eq!(bits(closest), bits(&alone), "pair {}", pair);
+            prop_assert_eq!(distance.to_bits(), (alone.distance - radius - other).to_bits());
+        }
+    }
+
+    #[test]
     fn joint_gradients_match_finite_differences(
         theta in prop::collection::vec(-1.2..1.2f64, 8), in_plane in any::<bool>(),
     ) {
