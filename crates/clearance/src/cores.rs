@@ -36,7 +36,12 @@ pub(crate) struct Cores<const D: usize> {
 impl<const D: usize> Cores<D> {
     /// The cores `all`, with their point cores gathered.
     pub(crate) fn new(all: Vec<Core<D>>) -> Self {
-        let points = PointCores::of(&all);
+        let points = PointCores::of(all.iter().enumerate().filter_map(
+            |(index, core)| match *core {
+                Core::Point { center, radius } => Some((index, center, radius)),
+                _ => None,
+            },
+        ));
         Self { all, points }
     }
 }

@@ -7,8 +7,7 @@
 use pulp::Simd;
 
 use crate::closest::{Closest, Segment};
-use crate::cores::Core;
-use crate::vector::widen;
+use crate::vector::{V, widen};
 
 /// The most lanes of a register (AVX-512); the coordinates are padded to a multiple of it, so
 /// that every register load of them is in bounds.
@@ -28,21 +27,19 @@ pub(crate) struct PointCores<const D: usize> {
 }
 
 impl<const D: usize> PointCores<D> {
-    /// The point cores among `cores`, in their order.
-    pub(crate) fn of(cores: &[Core<D>]) -> Self {
+    /// The point cores `(obstacle, center, radius)`, in their order.
+    pub(crate) fn of(cores: impl Iterator<Item = (usize, V<D>, f64)>) -> Self {
         let mut points = Self {
             coordinates: std::array::from_fn(|_| Vec::new()),
             obstacles: Vec::new(),
             radii: Vec::new(),
         };
-        for (index, core) in cores.iter().enumerate() {
-            if let Core::Point { center, radius } = *core {
-                for (coordinate, value) in points.coordinates.iter_mut().zip(center) {
-                    coordinate.push(value);
-                }
-                points.obstacles.push(index);
-                points.radii.push(radius);
+        for (obstacle, center, radius) in cores {
+            for (coordinate, value) in points.coordinates.iter_mut().zip(center) {
+                coordinate.push(value);
             }
+            points.obstacles.push(obstacle);
+            points.radii.push(radius);
         }
         let padded = points.obstacles.len().next_multiple_of(PADDING);
         for coordinate in &mut points.coordinates {
