@@ -321,7 +321,12 @@ fn nearest_outside<const D: usize>(q0: V<D>, dq: V<D>, half: V<D>) -> f64 {
     for k in 0..D {
         if dq[k] != 0.0 && half[k].is_finite() {
             for bound in [half[k], -half[k]] {
-                let t = (bound - q0[k]) / dq[k];
+                // A bound behind the start (`t <= 0 <= lo`) needs no division.
+                let ahead = bound - q0[k];
+                if ahead != 0.0 && (ahead > 0.0) != (dq[k] > 0.0) {
+                    continue;
+                }
+                let t = ahead / dq[k];
                 if t > lo && t < hi {
                     if slope(t) < 0.0 {
                         lo = t;
