@@ -185,7 +185,6 @@ pub(crate) fn closest_to_box<const D: usize>(
         Some((enter, exit)) => deepest_inside(q0, dq, half, enter, exit),
         None => nearest_outside(q0, dq, half),
     };
-    let distance = box_signed_distance(at(t), half);
     let q = at(t);
     // The gradient of the box's signed distance at q: outward from the nearest surface point.
     let mut outside = [0.0; D];
@@ -202,6 +201,14 @@ pub(crate) fn closest_to_box<const D: usize>(
         n[face] = if q[face] < 0.0 { -1.0 } else { 1.0 };
         n
     });
+    // Outside, the normal's length is the signed distance: the same squares summed in the
+    // same order (a positive length has no axis where an infinite `q_k` meets its infinite
+    // half-extent, which `box_signed_distance` leaves out).
+    let distance = if gap > 0.0 {
+        gap
+    } else {
+        box_signed_distance(q, half)
+    };
     if gap == 0.0 && t > 0.0 && t < 1.0 {
         local_normal = inside_kink_normal(q, dq, half, deepest).unwrap_or(local_normal);
     }
