@@ -115,11 +115,21 @@ pub fn segment_segment(a: V3, b: V3, c: V3, d: V3) -> Closest {
 /// [`segment_segment`] of two prepared segments.
 #[inline(always)]
 pub(crate) fn closest_to_segment<const D: usize>(link: &Segment<D>, other: &Segment<D>) -> Closest {
+    closest_at(link, other, segment_parameters(link, other))
+}
+
+/// The parameters `(t, s)` of the closest points of two prepared segments, on `link` and on
+/// `other`.
+#[inline(always)]
+pub(crate) fn segment_parameters<const D: usize>(
+    link: &Segment<D>,
+    other: &Segment<D>,
+) -> (f64, f64) {
     let (d1, d2) = (link.axis, other.axis);
     let r = sub(link.start, other.start);
     let (aa, ee, f) = (link.length2, other.length2, dot(d2, r));
     let (inverse_aa, inverse_ee) = (link.inverse_length2, other.inverse_length2);
-    let (t, s) = if aa <= 0.0 && ee <= 0.0 {
+    if aa <= 0.0 && ee <= 0.0 {
         (0.0, 0.0)
     } else if aa <= 0.0 {
         (0.0, (f * inverse_ee).clamp(0.0, 1.0))
@@ -145,7 +155,16 @@ pub(crate) fn closest_to_segment<const D: usize>(link: &Segment<D>, other: &Segm
             }
             (t, s)
         }
-    };
+    }
+}
+
+/// The closest points at the parameters `(t, s)` of [`segment_parameters`].
+#[inline(always)]
+pub(crate) fn closest_at<const D: usize>(
+    link: &Segment<D>,
+    other: &Segment<D>,
+    (t, s): (f64, f64),
+) -> Closest {
     let (point, closest_other) = (link.at(t), other.at(s));
     let (normal, distance) = direction(sub(point, closest_other), link.length + other.length);
     Closest {

@@ -27,6 +27,9 @@ pub struct ClearanceData {
     pub(crate) distances: Vec<f64>,
     /// Per pair: the closest points and the normal.
     pub(crate) closest: Vec<Closest>,
+    /// Per self pair: the parameters of its closest points, between the two passes of
+    /// [`distances`](crate::distances).
+    pub(crate) self_parameters: Vec<(f64, f64)>,
     /// The number of modal coordinates `m`.
     pub(crate) n_coords: usize,
     /// `pairs x m` modal gradients, row-major.
@@ -70,6 +73,7 @@ impl ClearanceData {
             planar: vec![[0.0; 2]; n + 1],
             distances: vec![f64::INFINITY; pairs],
             closest: vec![empty; pairs],
+            self_parameters: vec![(0.0, 0.0); pairs - model.n_obstacle_pairs()],
             n_coords,
             modal_gradient: vec![0.0; pairs * n_coords],
             prefix_axes: vec![[0.0; 3]; n * n_coords],

@@ -2,7 +2,9 @@
 
 use pulp::{Arch, Simd, WithSimd};
 
-use crate::closest::{Closest, Segment, closest_to_box, closest_to_segment};
+use crate::closest::{
+    Closest, Segment, closest_at, closest_to_box, closest_to_segment, segment_parameters,
+};
 use crate::cores::{Core, Cores};
 use crate::data::ClearanceData;
 use crate::model::ClearanceModel;
@@ -24,10 +26,15 @@ pub fn distances(model: &ClearanceModel, data: &mut ClearanceData) -> (f64, f64)
         distances,
         closest,
         turns_about_z,
+        self_parameters,
         ..
     } = data;
     let radius = model.radius();
-    let results = (distances.as_mut_slice(), closest.as_mut_slice());
+    let results = (
+        distances.as_mut_slice(),
+        closest.as_mut_slice(),
+        self_parameters.as_mut_slice(),
+    );
     match model.planar_cores() {
         // A chain turning about `z` among obstacles of its plane: two dimensions suffice.
         Some(cores) if *turns_about_z => {
@@ -72,7 +79,7 @@ struct EveryPair<'a, const D: usize> {
     radius: f64,
     segments: &'a [Segment<D>],
     cores: &'a Cores<D>,
-    results: (&'a mut [f64], &'a mut [Closest]),
+    results: (&'a mut [f64], &'a mut [Closest], &'a mut [(f64, f64)]),
 }
 
 impl<const D: usize> WithSimd for EveryPair<'_, D> {
@@ -98,7 +105,7 @@ fn every_pair<S: Simd, const D: usize>(
     radius: f64,
     segments: &[Segment<D>],
     cores: &Cores<D>,
-    (distances, closest): (&mut [f64], &mut [Closest]),
+    (distances, closest, self_parameters): (&mut [f64], &mut [Closest], &mut [(f64, f64)]),
 ) -> (f64, f64) {
     let obstacles = &cores.all;
     // The pairs in the model's order: link-major against every obstacle, then (i, k >= i + 2).
@@ -145,8 +152,16 @@ fn every_pair<S: Simd, const D: usize>(
             .iter()
             .map(move |other| (link, other))
     });
-    for ((distance, closest), (link, other)) in pairs.zip(others) {
-        *closest = closest_to_segment(link, other);
+    // Two passes, the parameters first: each has a shorter chain of dependent operations a
+    // pair, so that more pairs are in flight at once (ten links' 36 pairs: about 280 against
+    // 300 ns in one pass).
+    for (parameters, (link, other)) in self_parameters.iter_mut().zip(others.clone()) {
+        *parameters = segment_parameters(link, other);
+    }
+    for (((distance, closest), (link, other)), parameters) in
+        pairs.zip(others).zip(self_parameters.iter())
+    {
+        *closest = closest_at(link, other, *parameters);
         *distance = closest.distance - 2.0 * radius;
         near_self = near_self.min(*distance);
     }
