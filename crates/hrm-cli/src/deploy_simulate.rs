@@ -23,11 +23,28 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
     let staging = OutputDir::create(out, "simulate")?;
     write_run(staging.path(), scenario, &run)?;
     staging.commit()?;
+    if let Some(warning) = wall_warning(&run) {
+        eprintln!("warning: {warning}");
+    }
     console::print(&format!(
         "{}\nwrote {}\n",
         headline(scenario, &run),
         out.display()
     ))
+}
+
+/// A warning when the arm's capsules reach the channel's walls or beyond (a negative smallest
+/// wall clearance over the run), which the run reports rather than refuses: a channel narrower
+/// than the arm, or a bend sharper than its links follow.
+pub fn wall_warning(run: &DeployRun) -> Option<String> {
+    let clearance = run.metrics.min_wall_clearance;
+    (clearance < 0.0).then(|| {
+        format!(
+            "the arm reaches {:.2} mm into the channel's walls (smallest wall clearance); \
+             deploy.radius or the centreline's bends leave it no room",
+            -1e3 * clearance
+        )
+    })
 }
 
 /// One line on the run: the deployment metrics.
@@ -278,6 +295,7 @@ mod tests {
             );
         }
         assert!(summary["deploy_min_wall_clearance_m"].as_f64().unwrap() > 0.0);
+        assert_eq!(wall_warning(&scenario.run_deploy().unwrap()), None);
         let links = std::fs::read_to_string(dir.join("links.csv")).unwrap();
         assert_eq!(links.lines().count(), 1 + 101);
         assert_eq!(links.lines().next().unwrap().split(',').count(), 1 + 22);
@@ -290,5 +308,18 @@ mod tests {
         let svg = std::fs::read_to_string(dir.join("deploy_pipe-deploy.svg")).unwrap();
         assert!(svg.contains("channel walls"));
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_channel_narrower_than_the_arm_is_warned_of() {
+        let mut scenario = Scenario::builtin("pipe-deploy").unwrap();
+        scenario.duration = 0.2;
+        let deploy = scenario.deploy.as_mut().unwrap();
+        let arm_radius = scenario.arm.radius.unwrap();
+        deploy.radius = 0.5 * arm_radius;
+        let run = scenario.run_deploy().unwrap();
+        let warning = wall_warning(&run).unwrap();
+        assert!(warning.contains("into the channel's walls"), "{warning}");
+        assert!(run.metrics.min_wall_clearance <= -0.5 * arm_radius);
     }
 }
