@@ -64,7 +64,6 @@ pub fn solve_shape<A: Arm>(
     }
     let goal = options.needed() + 0.5 * options.check_slack;
     let rho = arm.length();
-    let n_pairs = clearance.pairs().len();
 
     arm.place(clearance, &mut data.current, &mut data.scratch, a)?;
     distances(clearance, &mut data.current);
@@ -107,28 +106,40 @@ pub fn solve_shape<A: Arm>(
         }
         let mut solved = false;
         for relaxed in [false, true] {
+            // A pair's row `-grad d_k . delta <= d_k - g_k` that the trust region implies
+            // (its bound at least twice the largest `|grad d_k|_1 Delta` the box allows) is left
+            // out: the same feasible set, and no bound far above the others' scale (a distant
+            // obstacle's) in the projection's tolerance.
+            let mut rows = 0;
             for (k, &d) in data.current.distances().iter().enumerate() {
-                let row = &mut data.rows[k * m..(k + 1) * m];
-                for (r, g) in row.iter_mut().zip(&data.gradients[k * m..(k + 1) * m]) {
+                let gradient = &data.gradients[k * m..(k + 1) * m];
+                let target_clearance = if relaxed { goal.min(d) } else { goal };
+                let bound = d - target_clearance;
+                let reach = radius * gradient.iter().map(|g| g.abs()).sum::<f64>();
+                if bound > 2.0 * reach {
+                    continue;
+                }
+                let row = &mut data.rows[rows * m..(rows + 1) * m];
+                for (r, g) in row.iter_mut().zip(gradient) {
                     *r = -g;
                 }
-                let target_clearance = if relaxed { goal.min(d) } else { goal };
-                data.bounds[k] = (d - target_clearance).min(f64::MAX);
+                data.bounds[rows] = bound.min(f64::MAX);
+                rows += 1;
             }
             for l in 0..m {
-                for (s, sign) in [(0, 1.0), (1, -1.0)] {
-                    let k = n_pairs + 2 * l + s;
-                    let row = &mut data.rows[k * m..(k + 1) * m];
+                for sign in [1.0, -1.0] {
+                    let row = &mut data.rows[rows * m..(rows + 1) * m];
                     row.fill(0.0);
                     row[l] = sign;
-                    data.bounds[k] = radius;
+                    data.bounds[rows] = radius;
+                    rows += 1;
                 }
             }
             match data.qp.solve(
                 &data.hessian,
                 &data.linear,
-                &data.rows,
-                &data.bounds,
+                &data.rows[..rows * m],
+                &data.bounds[..rows],
                 &mut data.step,
             ) {
                 Ok(_) => {

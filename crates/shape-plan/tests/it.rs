@@ -168,6 +168,22 @@ fn two_harmonics_reach_between_the_blocked_shapes_and_keep_the_margin() {
 }
 
 #[test]
+fn a_distant_obstacle_changes_no_plan() {
+    // A circle 1e15 m away is never near: its pairs' linearised rows, whose bounds are about
+    // 1.4e15 m, must not swamp the projection's tolerance and leave the near pairs unheld.
+    let circles = blocking_circles(TARGET);
+    let mut far = circles.clone();
+    far.push(Circle {
+        center: [1e15, 1e15],
+        radius: 0.03,
+    });
+    let near_plan = planner(2, &circles, options()).plan(&[0.0; 4], &TARGET).unwrap();
+    let far_plan = planner(2, &far, options()).plan(&[0.0; 4], &TARGET).unwrap();
+    assert_eq!(far_plan.goal, near_plan.goal);
+    assert_eq!(far_plan.path, near_plan.path);
+}
+
+#[test]
 fn one_harmonic_cannot_pass_and_says_so() {
     let circles = blocking_circles(TARGET);
     let mut planner = planner(1, &circles, options());
