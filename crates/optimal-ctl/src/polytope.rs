@@ -54,6 +54,8 @@ pub struct PolytopeProjection {
     qr: Vec<f64>,
     rhs: Vec<f64>,
     residual: Vec<f64>,
+    /// Each column's tolerance: `1e-12` times its largest entry (at least 1).
+    tolerances: Vec<f64>,
 }
 
 impl PolytopeProjection {
@@ -82,6 +84,7 @@ impl PolytopeProjection {
             qr: vec![0.0; height * height],
             rhs: vec![0.0; height],
             residual: vec![0.0; height],
+            tolerances: vec![0.0; rows],
         }
     }
 
@@ -149,12 +152,20 @@ impl PolytopeProjection {
     }
 
     /// Lawson and Hanson's NNLS on the first `p` columns of `E`, `f = e_{m+1}`, into `u`.
+    ///
+    /// A column's dual gradient and its variable are compared with `1e-12` times the column's
+    /// own scale (its largest entry, at least 1), the size of their rounding: a far-away
+    /// constraint's huge bound (a distant obstacle's clearance, a joint left practically
+    /// unlimited) then sets no tolerance but its own, where one scale over all columns would
+    /// let the others' gradients pass as zero.
     fn nnls(&mut self, p: usize) -> Result<(), ProjectionFailure> {
         let height = self.m + 1;
-        let scale = self.e[..p * height]
-            .iter()
-            .fold(1.0, |s, e| f64::max(s, e.abs()));
-        let tolerance = 1e-12 * scale;
+        for (tolerance, column) in self.tolerances[..p]
+            .iter_mut()
+            .zip(self.e.chunks_exact(height))
+        {
+            *tolerance = 1e-12 * column.iter().fold(1.0, |s, e| f64::max(s, e.abs()));
+        }
         self.u[..p].fill(0.0);
         self.passive[..p].fill(false);
         self.n_passive = 0;
@@ -171,10 +182,11 @@ impl PolytopeProjection {
             // The entering column: the largest dual gradient w_j = E_j . r above the tolerance.
             let mut best: Option<(usize, f64)> = None;
             if self.n_passive < height {
-                for ((j, column), &passive) in self.e[..p * height]
+                for (((j, column), &passive), &tolerance) in self.e[..p * height]
                     .chunks_exact(height)
                     .enumerate()
                     .zip(&self.passive[..p])
+                    .zip(&self.tolerances[..p])
                 {
                     let w: f64 = column.iter().zip(&self.residual).map(|(c, r)| c * r).sum();
                     if !passive && w > tolerance && best.is_none_or(|(_, b)| w > b) {
@@ -215,7 +227,7 @@ impl PolytopeProjection {
                 let mut kept = 0;
                 for i in 0..self.n_passive {
                     let j = self.order[i];
-                    if self.u[j] > tolerance {
+                    if self.u[j] > self.tolerances[j] {
                         self.order[kept] = j;
                         kept += 1;
                     } else {

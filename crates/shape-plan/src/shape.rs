@@ -8,7 +8,9 @@
 //! subject to `d_k + grad d_k . delta >= g_k` for every pair and `|delta|_inf <= Delta`,
 //!
 //! `e = p(a) - target`, `g_k = c + 3 epsilon / 2` (the margin, the check slack and half of it
-//! again for the linearisation); when that QP is empty (an iterate in collision whose
+//! again for the linearisation). A pair whose row the trust region already implies
+//! (`d_k - g_k >= |grad d_k|_1 Delta`, with a factor 2 to spare) is left out of the QP, which
+//! has the same solution with fewer rows; when that QP is empty (an iterate in collision whose
 //! linearisation cannot clear in one step) the goals become `min(g_k, d_k)`, which `delta = 0`
 //! meets. A step is accepted when the exact penalty `phi(a) = 1/2 |e|^2 + rho sum_k
 //! max(0, g_k - d_k)`, `rho` the arm's length, falls by at least a tenth of what the
@@ -108,8 +110,7 @@ pub fn solve_shape<A: Arm>(
         for relaxed in [false, true] {
             // A pair's row `-grad d_k . delta <= d_k - g_k` that the trust region implies
             // (its bound at least twice the largest `|grad d_k|_1 Delta` the box allows) is left
-            // out: the same feasible set, and no bound far above the others' scale (a distant
-            // obstacle's) in the projection's tolerance.
+            // out: the same feasible set with fewer rows.
             let mut rows = 0;
             for (k, &d) in data.current.distances().iter().enumerate() {
                 let gradient = &data.gradients[k * m..(k + 1) * m];

@@ -177,8 +177,12 @@ fn a_distant_obstacle_changes_no_plan() {
         center: [1e15, 1e15],
         radius: 0.03,
     });
-    let near_plan = planner(2, &circles, options()).plan(&[0.0; 4], &TARGET).unwrap();
-    let far_plan = planner(2, &far, options()).plan(&[0.0; 4], &TARGET).unwrap();
+    let near_plan = planner(2, &circles, options())
+        .plan(&[0.0; 4], &TARGET)
+        .unwrap();
+    let far_plan = planner(2, &far, options())
+        .plan(&[0.0; 4], &TARGET)
+        .unwrap();
     assert_eq!(far_plan.goal, near_plan.goal);
     assert_eq!(far_plan.path, near_plan.path);
 }

@@ -127,6 +127,37 @@ proptest! {
     }
 
     #[test]
+    fn a_far_away_constraint_changes_no_projection(
+        m in 1usize..5,
+        seed_rows in prop::collection::vec(prop::collection::vec(-1.0..1.0f64, 4), 2..11),
+        slack in prop::collection::vec(0.0..0.5f64, 11),
+        inside in prop::collection::vec(-1.0..1.0f64, 4),
+        x0 in prop::collection::vec(-3.0..3.0f64, 4),
+        far in prop::collection::vec(-1.0..1.0f64, 4),
+        distance in prop::sample::select(vec![1e6, 1e12, 1e100, 1e300]),
+    ) {
+        // A constraint that holds a long way beyond the polytope (a distant obstacle, a joint
+        // left practically unlimited) leaves the closest point where it was, to the rounding.
+        let (mut rows, mut g) = polytope(&seed_rows, m, &slack, &inside);
+        let flat: Vec<f64> = rows.iter().flatten().copied().collect();
+        let mut x = vec![0.0; m];
+        PolytopeProjection::new(m, rows.len())
+            .project(&flat, &g, &x0[..m], &mut x)
+            .unwrap();
+        let row = far[..m].to_vec();
+        g.push(dot(&row, &x0[..m]).abs() + 10.0 + distance);
+        rows.push(row);
+        let flat: Vec<f64> = rows.iter().flatten().copied().collect();
+        let mut with_far = vec![0.0; m];
+        PolytopeProjection::new(m, rows.len())
+            .project(&flat, &g, &x0[..m], &mut with_far)
+            .unwrap();
+        for (a, b) in with_far.iter().zip(&x) {
+            prop_assert!((a - b).abs() < 1e-9, "{:?} vs {:?}", with_far, x);
+        }
+    }
+
+    #[test]
     fn linear_qp_matches_enumeration(
         m in 1usize..5,
         factor in prop::collection::vec(-1.0..1.0f64, 16),

@@ -196,6 +196,27 @@ fn the_applied_torque_is_the_closest_within_the_joint_torque_limits() {
 }
 
 #[test]
+fn a_practically_free_joint_changes_no_projection() {
+    // The base joint's limit far above any torque it meets (here never reached, so the run is
+    // the one with 100 N m there) must leave the projection onto the other joints' limits as
+    // it was: each limit is its own scale in the projection's tolerance.
+    let limits = |base: f64| {
+        let mut limits = vec![3.0; 10];
+        limits[0] = base;
+        limits
+    };
+    let (_, reference) = step_run(|s| s.joint_torque_limits = Some(limits(100.0))).unwrap();
+    assert!(reference.iter().filter(|s| s.projected).count() > 10);
+    for base in [1e12, 1e300] {
+        let (_, samples) = step_run(|s| s.joint_torque_limits = Some(limits(base))).unwrap();
+        assert_eq!(samples.len(), reference.len());
+        for (sample, expected) in samples.iter().zip(&reference) {
+            assert_eq!(sample.tau_star, expected.tau_star, "t = {}", sample.t);
+        }
+    }
+}
+
+#[test]
 fn joint_angles_stay_within_their_limits() {
     let model = paper_model();
     let peak = |samples: &[ControlSample]| {
