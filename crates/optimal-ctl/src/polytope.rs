@@ -9,6 +9,14 @@
 //! empty. NNLS is the finite active-set method: a constraint enters the passive set while its
 //! dual gradient is positive, and a step that would make a passive variable negative stops at
 //! zero and returns it.
+//!
+//! Each constraint's row is scaled by a power of two to a norm in `(1/2, 1]` (exact: the same
+//! half-space), since rows of very different norms make the dual badly conditioned, and each
+//! dual gradient and multiplier is compared with `1e-12` times its own column's largest entry.
+//! The point is checked against the constraints before it is returned, to the rounding of its
+//! terms and of its own coordinates (estimated from the size of the terms summed in the
+//! residual): a polytope empty by more than that is reported empty, never left with a point
+//! outside.
 
 /// Why no point was found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -118,6 +126,15 @@ impl PolytopeProjection {
             }
             column[m] = gx - bound;
             violated |= gx > bound;
+            // The row scaled to a norm in (1/2, 1] by a power of two (exact, the same
+            // half-space): rows of very different norms make the dual badly conditioned.
+            let norm2: f64 = column[..m].iter().map(|e| e * e).sum();
+            if norm2 > 0.0 && norm2.is_finite() {
+                let scale = power_of_two_at_most(norm2.sqrt().recip());
+                for e in column.iter_mut() {
+                    *e *= scale;
+                }
+            }
         }
         x.copy_from_slice(x0);
         if !violated {
@@ -143,6 +160,7 @@ impl PolytopeProjection {
         for k in 0..m {
             x[k] = x0[k] - self.residual[k] / last;
         }
+        self.polish(x0, x);
         // Constraints that (nearly) admit no point leave a residual above the test's rounding
         // and a point far outside them: refused as empty, never returned.
         if !satisfies(constraints, g, x) {
@@ -244,6 +262,71 @@ impl PolytopeProjection {
         Err(ProjectionFailure::NoConvergence)
     }
 
+    /// Replaces `x` by `x0 + y`, `y` the shortest solution of the passive constraints held as
+    /// equalities, `G_P y = g_P - G_P x0` (their rows as scaled in `E`), by Householder QR of
+    /// `G_P^T`, where they are independent and fewer than `m + 1`. The closest point makes its
+    /// constraints with positive multipliers active, so this is the same point; computed from
+    /// the constraints directly, it keeps their digits where the residual's formula loses them
+    /// (large multipliers of nearly opposite rows in a badly conditioned problem).
+    fn polish(&mut self, x0: &[f64], x: &mut [f64]) {
+        let (m, height, k) = (self.m, self.m + 1, self.n_passive);
+        if k == 0 || k > m {
+            return;
+        }
+        // Column c of `G_P^T` (length m) into `qr`, its right-hand side into `rhs`.
+        for (c, &j) in self.order[..k].iter().enumerate() {
+            let column = &self.e[j * height..(j + 1) * height];
+            for (q, e) in self.qr[c * m..(c + 1) * m].iter_mut().zip(column) {
+                *q = -e;
+            }
+            self.rhs[c] = -column[m];
+        }
+        // Householder: column c's entries c.. become its reflection's vector, R's diagonal goes
+        // to `z` (indexed by position), R's entries above it stay in the later columns.
+        for c in 0..k {
+            let (done, later) = self.qr[..k * m].split_at_mut((c + 1) * m);
+            let v = &mut done[c * m + c..];
+            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if norm <= 1e-13 {
+                return;
+            }
+            let alpha = if v[0] > 0.0 { -norm } else { norm };
+            v[0] -= alpha;
+            let vv: f64 = v.iter().map(|x| x * x).sum();
+            for other in later.chunks_exact_mut(m) {
+                let target = &mut other[c..];
+                let dot: f64 = v.iter().zip(target.iter()).map(|(a, b)| a * b).sum();
+                let factor = 2.0 * dot / vv;
+                for (t, x) in target.iter_mut().zip(v.iter()) {
+                    *t -= factor * x;
+                }
+            }
+            self.z[c] = alpha;
+        }
+        // R^T w = b (w in `residual`), then y = Q [w; 0].
+        for c in 0..k {
+            let mut value = self.rhs[c];
+            for i in 0..c {
+                value -= self.qr[c * m + i] * self.residual[i];
+            }
+            self.residual[c] = value / self.z[c];
+        }
+        self.residual[k..m].fill(0.0);
+        for c in (0..k).rev() {
+            let v = &self.qr[c * m + c..(c + 1) * m];
+            let vv: f64 = v.iter().map(|x| x * x).sum();
+            let target = &mut self.residual[c..m];
+            let dot: f64 = v.iter().zip(target.iter()).map(|(a, b)| a * b).sum();
+            let factor = 2.0 * dot / vv;
+            for (t, x) in target.iter_mut().zip(v.iter()) {
+                *t -= factor * x;
+            }
+        }
+        for ((x, x0), y) in x.iter_mut().zip(x0).zip(&self.residual[..m]) {
+            *x = x0 + y;
+        }
+    }
+
     /// The least-squares solution `z` of `E_P z = f` over the passive columns by Householder QR;
     /// `false` when the columns are numerically dependent.
     fn solve_passive(&mut self) -> bool {
@@ -305,4 +388,10 @@ fn satisfies(constraints: &[f64], g: &[f64], x: &[f64]) -> bool {
             }
             gx - bound <= 1e-9 * (1.0 + size)
         })
+}
+
+/// The largest power of two at most `x` (positive and finite), within the normal range.
+fn power_of_two_at_most(x: f64) -> f64 {
+    let exponent = x.log2().floor().clamp(-1000.0, 1000.0);
+    2f64.powi(exponent as i32)
 }
