@@ -294,12 +294,7 @@ impl PolytopeProjection {
             v[0] -= alpha;
             let vv: f64 = v.iter().map(|x| x * x).sum();
             for other in later.chunks_exact_mut(m) {
-                let target = &mut other[c..];
-                let dot: f64 = v.iter().zip(target.iter()).map(|(a, b)| a * b).sum();
-                let factor = 2.0 * dot / vv;
-                for (t, x) in target.iter_mut().zip(v.iter()) {
-                    *t -= factor * x;
-                }
+                reflect(v, vv, &mut other[c..]);
             }
             self.z[c] = alpha;
         }
@@ -315,12 +310,7 @@ impl PolytopeProjection {
         for c in (0..k).rev() {
             let v = &self.qr[c * m + c..(c + 1) * m];
             let vv: f64 = v.iter().map(|x| x * x).sum();
-            let target = &mut self.residual[c..m];
-            let dot: f64 = v.iter().zip(target.iter()).map(|(a, b)| a * b).sum();
-            let factor = 2.0 * dot / vv;
-            for (t, x) in target.iter_mut().zip(v.iter()) {
-                *t -= factor * x;
-            }
+            reflect(v, vv, &mut self.residual[c..m]);
         }
         for ((x, x0), y) in x.iter_mut().zip(x0).zip(&self.residual[..m]) {
             *x = x0 + y;
@@ -350,17 +340,10 @@ impl PolytopeProjection {
             v[0] -= alpha;
             let vv: f64 = v.iter().map(|x| x * x).sum();
             // Apply I - 2 v v^T / v^T v to the later columns and the right-hand side.
-            let reflect = |target: &mut [f64]| {
-                let dot: f64 = v.iter().zip(target.iter()).map(|(a, b)| a * b).sum();
-                let factor = 2.0 * dot / vv;
-                for (t, x) in target.iter_mut().zip(v.iter()) {
-                    *t -= factor * x;
-                }
-            };
             for other in later.chunks_exact_mut(height) {
-                reflect(&mut other[c..]);
+                reflect(v, vv, &mut other[c..]);
             }
-            reflect(&mut self.rhs[c..]);
+            reflect(v, vv, &mut self.rhs[c..]);
             v[0] = alpha;
         }
         for c in (0..k).rev() {
@@ -371,6 +354,15 @@ impl PolytopeProjection {
             self.z[self.order[c]] = value / self.qr[c * height + c];
         }
         true
+    }
+}
+
+/// Applies the Householder reflection `I - 2 v v^T / v^T v` (`vv = v^T v`) to `target`.
+fn reflect(v: &[f64], vv: f64, target: &mut [f64]) {
+    let dot: f64 = v.iter().zip(target.iter()).map(|(a, b)| a * b).sum();
+    let factor = 2.0 * dot / vv;
+    for (t, x) in target.iter_mut().zip(v) {
+        *t -= factor * x;
     }
 }
 
