@@ -13,9 +13,11 @@
 //! Each constraint's row is scaled by a power of two to a norm in `(1/2, 1]` (exact: the same
 //! half-space), since rows of very different norms make the dual badly conditioned, and each
 //! dual gradient and multiplier is compared with `1e-12` times its own column's largest entry.
-//! The point is checked against the constraints before it is returned, to the rounding of its
-//! terms and of its own coordinates (estimated from the size of the terms summed in the
-//! residual): a polytope empty by more than that is reported empty, never left with a point
+//! The point from NNLS's residual is then polished: recomputed as the shortest solution of its
+//! active constraints held as equalities (`polish`), the same point with the constraints'
+//! digits, which the residual's formula loses when large multipliers of nearly opposite rows
+//! cancel. It is checked against the constraints before it is returned, to the rounding of its
+//! terms: a polytope empty by more than that is reported empty, never left with a point
 //! outside.
 
 /// Why no point was found.
@@ -286,13 +288,9 @@ impl PolytopeProjection {
         for c in 0..k {
             let (done, later) = self.qr[..k * m].split_at_mut((c + 1) * m);
             let v = &mut done[c * m + c..];
-            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if norm <= 1e-13 {
+            let Some((alpha, vv)) = reflector(v) else {
                 return;
-            }
-            let alpha = if v[0] > 0.0 { -norm } else { norm };
-            v[0] -= alpha;
-            let vv: f64 = v.iter().map(|x| x * x).sum();
+            };
             for other in later.chunks_exact_mut(m) {
                 reflect(v, vv, &mut other[c..]);
             }
@@ -332,13 +330,9 @@ impl PolytopeProjection {
             // v: column c's entries c.. (the Householder vector once its first entry is shifted).
             let (done, later) = self.qr[..k * height].split_at_mut((c + 1) * height);
             let v = &mut done[c * height + c..];
-            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if norm <= 1e-13 {
+            let Some((alpha, vv)) = reflector(v) else {
                 return false;
-            }
-            let alpha = if v[0] > 0.0 { -norm } else { norm };
-            v[0] -= alpha;
-            let vv: f64 = v.iter().map(|x| x * x).sum();
+            };
             // Apply I - 2 v v^T / v^T v to the later columns and the right-hand side.
             for other in later.chunks_exact_mut(height) {
                 reflect(v, vv, &mut other[c..]);
@@ -355,6 +349,20 @@ impl PolytopeProjection {
         }
         true
     }
+}
+
+/// Turns column `v` into the vector of the Householder reflection that maps it onto
+/// `alpha e_1` (its first entry shifted by `-alpha`), and returns `alpha` and `v^T v`; `None`
+/// when the column is numerically zero (dependent on the ones before it).
+fn reflector(v: &mut [f64]) -> Option<(f64, f64)> {
+    let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if norm <= 1e-13 {
+        return None;
+    }
+    let alpha = if v[0] > 0.0 { -norm } else { norm };
+    v[0] -= alpha;
+    let vv: f64 = v.iter().map(|x| x * x).sum();
+    Some((alpha, vv))
 }
 
 /// Applies the Householder reflection `I - 2 v v^T / v^T v` (`vv = v^T v`) to `target`.
