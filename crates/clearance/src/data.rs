@@ -3,6 +3,7 @@
 
 use crate::closest::{Closest, Segment};
 use crate::error::ClearanceError;
+use crate::modal_gradient::LANES;
 use crate::model::ClearanceModel;
 use crate::vector::V3;
 
@@ -40,8 +41,10 @@ pub struct ClearanceData {
     pub(crate) prefix_moments: Vec<V3>,
     /// Whether every joint turns about `z` (placed by [`place_planar`](crate::place_planar)).
     pub(crate) turns_about_z: bool,
-    /// A planar chain's prefix sums `T_il = sum_{j <= i} J_jl (p_jy, -p_jx, 1)` (`n x m`).
-    pub(crate) prefix_planar: Vec<V3>,
+    /// A planar chain's prefix sums `T_il = sum_{j <= i} J_jl (p_jy, -p_jx, 1)`, in blocks of
+    /// [`LANES`] coordinates (`[x; LANES], [y; LANES], [s; LANES]`, zero past `m`): `n` rows of
+    /// `ceil(m / LANES)` blocks.
+    pub(crate) prefix_planar: Vec<[[f64; LANES]; 3]>,
 }
 
 impl ClearanceData {
@@ -79,7 +82,7 @@ impl ClearanceData {
             prefix_axes: vec![[0.0; 3]; n * n_coords],
             prefix_moments: vec![[0.0; 3]; n * n_coords],
             turns_about_z: true,
-            prefix_planar: vec![[0.0; 3]; n * n_coords],
+            prefix_planar: vec![[[0.0; LANES]; 3]; n * n_coords.div_ceil(LANES)],
         })
     }
 

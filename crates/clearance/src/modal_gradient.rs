@@ -2,11 +2,19 @@
 
 use crate::closest::Closest;
 use crate::data::ClearanceData;
+use crate::distances::in_registers;
 use crate::error::ClearanceError;
-use crate::model::{ClearanceModel, Pair};
+use crate::model::ClearanceModel;
 use crate::vector::{V3, add, cross, dot, scale, sub};
 use backbone_kin::ModalMap;
 use lane_math::check_len;
+use pulp::{Simd, WithSimd};
+
+/// The coordinates of a block of the planar prefix sums: an AVX2 register of `f64`.
+pub(crate) const LANES: usize = 4;
+
+/// [`LANES`] coordinates of the planar prefix sums, coordinate by coordinate.
+pub(crate) type Block = [[f64; LANES]; 3];
 
 /// Fills every pair's `d d / d a = J^T d d / d theta` (after [`distances`](crate::distances)),
 /// for the constant modal map `theta = J a + theta_0` (eq 8). Allocation-free.
@@ -39,58 +47,115 @@ pub fn modal_gradients(
 /// `(v_j, w_j) = (p_j x z, z) = ((p_jy, -p_jx, 0), (0, 0, 1))`, so the prefix sums reduce to three
 /// numbers a coordinate, `T_il = sum_{j <= i} J_jl (p_jy, -p_jx, 1)`, and a pair's gradient is
 /// `T_il . (n_x, n_y, (c x n)_z)` (the normal's `z` and the moment's in-plane part meet zeros).
+/// The sums are kept [`LANES`] coordinates to a block, coordinate by coordinate, so that a pair's
+/// gradient takes a few register operations a block.
 fn planar_gradients(model: &ClearanceModel, data: &mut ClearanceData, map: &ModalMap) {
-    let m = data.n_coords;
+    let blocks = data.n_coords.div_ceil(LANES);
     let prefix = &mut data.prefix_planar;
     for (i, point) in data.points[..model.n_links()].iter().enumerate() {
-        for (l, &entry) in map.row(i).iter().enumerate() {
-            let [x, y, s] = if i == 0 {
-                [0.0; 3]
+        for (b, entries) in map.row(i).chunks(LANES).enumerate() {
+            // The padding lanes stay zero.
+            let previous = if i == 0 {
+                [[0.0; LANES]; 3]
             } else {
-                prefix[(i - 1) * m + l]
+                prefix[(i - 1) * blocks + b]
             };
-            prefix[i * m + l] = [x + entry * point[1], y - entry * point[0], s + entry];
+            let mut sums = previous;
+            for (l, &entry) in entries.iter().enumerate() {
+                sums[0][l] = previous[0][l] + entry * point[1];
+                sums[1][l] = previous[1][l] - entry * point[0];
+                sums[2][l] = previous[2][l] + entry;
+            }
+            prefix[i * blocks + b] = sums;
         }
     }
+    let m = data.n_coords;
+    let pairs = PlanarPairs { model, data };
     match m {
-        2 => planar_pair_gradients::<2>(model, data),
-        3 => planar_pair_gradients::<3>(model, data),
-        4 => planar_pair_gradients::<4>(model, data),
-        _ => planar_pair_gradients::<0>(model, data),
+        2 => in_registers(pairs.with_coords::<2>()),
+        3 => in_registers(pairs.with_coords::<3>()),
+        4 => in_registers(pairs.with_coords::<4>()),
+        _ => in_registers(pairs.with_coords::<0>()),
     }
 }
 
-/// Every pair's gradient from the planar prefix sums, `T_il . (n_x, n_y, (c x n)_z)`; `M` is the
-/// number of coordinates when it is small (the loops over them then unroll), or 0 for any
-/// number.
-#[inline(always)]
-fn planar_pair_gradients<const M: usize>(model: &ClearanceModel, data: &mut ClearanceData) {
-    let m = data.n_coords;
-    let prefix = |i: usize| {
-        let sums = &data.prefix_planar[i * m..(i + 1) * m];
-        if M == 0 { sums } else { &sums[..M] }
-    };
-    let wrench = |point: V3, n: V3| [n[0], n[1], point[0] * n[1] - point[1] * n[0]];
-    for_each_pair(
-        model,
-        m,
-        (&data.closest, &mut data.modal_gradient),
-        |link, closest, gradient| {
-            let f = wrench(closest.point, closest.normal);
-            for (g, t) in gradient.iter_mut().zip(prefix(link)) {
-                *g = dot(*t, f);
+/// Every pair's gradient from the planar prefix sums (a [`WithSimd`] operation, so that the
+/// blocks compile to registers of [`LANES`]); `M` is the number of coordinates when it is small
+/// (the loops over them then unroll), or 0 for any number.
+struct PlanarPairs<'a, const M: usize> {
+    model: &'a ClearanceModel,
+    data: &'a mut ClearanceData,
+}
+
+impl<'a> PlanarPairs<'a, 0> {
+    /// The same pairs, for `M` coordinates.
+    fn with_coords<const M: usize>(self) -> PlanarPairs<'a, M> {
+        PlanarPairs {
+            model: self.model,
+            data: self.data,
+        }
+    }
+}
+
+impl<const M: usize> WithSimd for PlanarPairs<'_, M> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let Self { model, data } = self;
+        let coords = if M == 0 { data.n_coords } else { M };
+        let blocks = coords.div_ceil(LANES);
+        let prefix = |i: usize| &data.prefix_planar[i * blocks..(i + 1) * blocks];
+        let wrench = |point: V3, n: V3| [n[0], n[1], point[0] * n[1] - point[1] * n[0]];
+        // `(T_lo - T_hi) . f` (`T_lo . f` without `T_hi`) for the coordinates of one block,
+        // summed as `dot` sums, the block in registers of `S`.
+        let apply = |lo: &Block, hi: Option<&Block>, f: V3, gradient: &mut [f64]| {
+            let mut sums = [0.0; LANES];
+            let (out, out_tail) = S::as_mut_simd_f64s(&mut sums);
+            let lanes = |k: usize| {
+                let (lo, lo_tail) = S::as_simd_f64s(&lo[k]);
+                let hi = hi.map(|hi| S::as_simd_f64s(&hi[k]));
+                (lo, lo_tail, hi)
+            };
+            let term = |k: usize, r: usize| {
+                let (lo, _, hi) = lanes(k);
+                let t = match hi {
+                    Some((hi, _)) => simd.sub_f64s(lo[r], hi[r]),
+                    None => lo[r],
+                };
+                simd.mul_f64s(t, simd.splat_f64s(f[k]))
+            };
+            for (r, out) in out.iter_mut().enumerate() {
+                *out = simd.add_f64s(simd.add_f64s(term(0, r), term(1, r)), term(2, r));
             }
-        },
-        |(link, other), closest, gradient| {
-            let f = wrench(closest.other, closest.normal);
-            for (g, (lo, hi)) in gradient
-                .iter_mut()
-                .zip(prefix(link).iter().zip(prefix(other)))
-            {
-                *g = dot(sub(*lo, *hi), f);
+            let head = LANES - out_tail.len();
+            for (l, out) in out_tail.iter_mut().enumerate() {
+                let t = |k: usize| lo[k][head + l] - hi.map_or(0.0, |hi| hi[k][head + l]);
+                *out = t(0) * f[0] + t(1) * f[1] + t(2) * f[2];
             }
-        },
-    );
+            gradient.copy_from_slice(&sums[..gradient.len()]);
+        };
+        for_each_pair(
+            model,
+            coords,
+            (&data.closest, &mut data.modal_gradient),
+            |link, closest, gradient| {
+                let f = wrench(closest.point, closest.normal);
+                for (g, t) in gradient.chunks_mut(LANES).zip(prefix(link)) {
+                    apply(t, None, f, g);
+                }
+            },
+            |(link, other), closest, gradient| {
+                let f = wrench(closest.other, closest.normal);
+                for (g, (lo, hi)) in gradient
+                    .chunks_mut(LANES)
+                    .zip(prefix(link).iter().zip(prefix(other)))
+                {
+                    apply(lo, Some(hi), f, g);
+                }
+            },
+        );
+    }
 }
 
 /// Calls `obstacle(link, closest, gradient)` for every link-obstacle pair and
@@ -119,10 +184,13 @@ fn for_each_pair(
             }
         }
     }
-    let pairs = model.pairs()[split..].iter().zip(self_closest);
-    for ((pair, closest), gradient) in pairs.zip(self_gradients.chunks_exact_mut(m)) {
-        if let Pair::Links { link, other } = *pair {
-            links((link, other), closest, gradient);
+    let n = model.n_links();
+    let mut pairs = self_closest.iter().zip(self_gradients.chunks_exact_mut(m));
+    for link in 0..n {
+        for other in link + 2..n {
+            if let Some((closest, gradient)) = pairs.next() {
+                links((link, other), closest, gradient);
+            }
         }
     }
 }
