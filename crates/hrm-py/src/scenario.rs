@@ -957,8 +957,9 @@ pub struct Run {
     failure: Option<String>,
     controller: String,
     coordinates: Vec<String>,
-    /// The run as the viewer draws it (`run-view`), with the scenario's name.
-    view: run_view::Scene,
+    /// The run as the viewer draws it (`run-view`), with the scenario's name; `None` for a run
+    /// that stopped before its first sample (nothing to draw).
+    view: Option<run_view::Scene>,
 }
 
 /// `values` (`rows x width`, row-major) as a numpy array of shape `(rows, width)`.
@@ -994,13 +995,17 @@ impl Run {
                 partial: None,
             }) => return Err(Error::from(error).into()),
         };
-        let view = run_view::Scene {
-            title: format!("{} with {controller}", scenario.name),
-            caption: scenario.description.clone(),
-            runs: vec![
-                run_view::from_record(scenario, controller, &run.record, failure.as_deref())
-                    .map_err(|e| Error::input(e.to_string()))?,
-            ],
+        let view = if run.record.is_empty() {
+            None
+        } else {
+            Some(run_view::Scene {
+                title: format!("{} with {controller}", scenario.name),
+                caption: scenario.description.clone(),
+                runs: vec![
+                    run_view::from_record(scenario, controller, &run.record, failure.as_deref())
+                        .map_err(|e| Error::input(e.to_string()))?,
+                ],
+            })
         };
         let r = run.record;
         let (m, n) = (r.n_coords, r.n_joints);
@@ -1043,7 +1048,7 @@ impl Run {
         failure: Option<String>,
         controller: String,
         coordinates: Vec<String>,
-        view: run_view::Scene,
+        view: Option<run_view::Scene>,
     ) -> PyResult<Self> {
         for array in &arrays {
             array
@@ -1203,20 +1208,32 @@ impl Run {
     /// The run as a self-contained HTML page (no network): the arm link by link, coloured by
     /// joint torque, the reference path and the tip's trace, played in sync with the tip error,
     /// modal coordinates, tau* and joint torques (what `hrm view` writes). Save it to a file
-    /// and open it in a browser.
+    /// and open it in a browser. A run that stopped before its first sample has nothing to draw:
+    /// InvalidInput.
     fn view_html(&self) -> PyResult<String> {
+        let Some(view) = &self.view else {
+            let failure = self.failure.as_deref().unwrap_or("no samples");
+            return Err(Error::input(format!(
+                "the run has no sample to show: it stopped at its start ({failure})"
+            ))
+            .into());
+        };
         run_view::page(
-            &self.view.title,
+            &view.title,
             "",
-            std::slice::from_ref(&self.view),
+            std::slice::from_ref(view),
             run_view::PAGE_SAMPLES,
         )
         .map_err(|e| Error::input(e.to_string()).into())
     }
 
-    /// The page of `view_html` in an iframe: what Jupyter shows for a Run.
-    fn _repr_html_(&self) -> PyResult<String> {
-        Ok(run_view::iframe(&self.view_html()?, VIEW_HEIGHT))
+    /// The page of `view_html` in an iframe: what Jupyter shows for a Run (None, so that
+    /// Jupyter shows `repr`, for a run without samples).
+    fn _repr_html_(&self) -> PyResult<Option<String>> {
+        if self.view.is_none() {
+            return Ok(None);
+        }
+        Ok(Some(run_view::iframe(&self.view_html()?, VIEW_HEIGHT)))
     }
 
     fn __repr__(&self, py: Python<'_>) -> String {

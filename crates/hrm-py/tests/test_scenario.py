@@ -3,6 +3,7 @@ paper's tracking figures, runs that stop, and the summary against the `hrm` comm
 
 import json
 import math
+import pickle
 import pathlib
 import subprocess
 
@@ -289,6 +290,19 @@ def test_a_run_that_diverges_keeps_its_data_up_to_the_stop():
         assert np.abs(run.a[-1] - run.a_ref[-1]).max() > 0.05
         assert np.abs(run.a[:-1] - run.a_ref[:-1]).max() <= 0.05
         assert len(run.t) == run.summary["recorded_samples"]
+
+
+def test_a_run_that_stops_before_its_first_sample_is_a_run_without_rows():
+    # A first torque that overflows the dynamics: the integrator fails inside the first step.
+    run = short_step(0.5).run(lambda t, a, a_dot, ref: np.full(2, 1e200))
+    assert run.failure is not None and "integration diverged" in run.failure
+    assert run.summary["error"] == run.failure and run.summary["recorded_samples"] == 0
+    assert run.t.shape == (0,) and run.a.shape == (0, 2) and run.tip.shape == (0, 2)
+    with pytest.raises(hrm.InvalidInput, match="no sample to show"):
+        run.view_html()
+    assert run._repr_html_() is None and "stopped" in repr(run)
+    clone = pickle.loads(pickle.dumps(run))
+    assert clone.failure == run.failure and clone.t.shape == (0,)
 
 
 def assert_close(actual, expected):

@@ -247,9 +247,11 @@ class Run:
     def coordinates(self) -> List[str]:
         """The names of the modal coordinates."""
     def view_html(self) -> str:
-        """The run as a self-contained HTML page: the arm animated beside its time series."""
-    def _repr_html_(self) -> str:
-        """The page of view_html in an iframe (what Jupyter shows)."""
+        """The run as a self-contained HTML page: the arm animated beside its time series.
+
+        Raises InvalidInput for a run that stopped before its first sample."""
+    def _repr_html_(self) -> Optional[str]:
+        """The page of view_html in an iframe (what Jupyter shows); None without samples."""
 
 def view_html(scene: str) -> str:
     """A scene as JSON text (docs/run-view.md) as a self-contained HTML page."""
