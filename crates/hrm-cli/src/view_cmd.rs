@@ -235,6 +235,12 @@ fn load_run(dir: &Path, label: Option<&str>) -> Result<(Scenario, RunView), Stri
         ));
     }
     let scenario = Scenario::load(&toml).map_err(|e| format!("{}: {e}", toml.display()))?;
+    // The arm the scenario describes (refused there, e.g. too many links).
+    let n_joints = scenario
+        .plant()
+        .map_err(|e| format!("{}: {e}", toml.display()))?
+        .plant()
+        .n_joints();
     let summary = dir.join("summary.json");
     let stopped = match read_text_file(&summary, MAX_INPUT_FILE_BYTES) {
         Ok(text) => serde_json::from_str::<serde_json::Value>(&text)
@@ -246,8 +252,8 @@ fn load_run(dir: &Path, label: Option<&str>) -> Result<(Scenario, RunView), Stri
     let csv = dir.join("timeseries.csv");
     let text = read_text_file(&csv, MAX_TIMESERIES_BYTES)
         .map_err(|e| format!("{}: {e}", csv.display()))?;
-    let record =
-        parse_timeseries(&text, &scenario).map_err(|e| format!("{}: {e}", csv.display()))?;
+    let record = parse_timeseries(&text, &scenario, n_joints)
+        .map_err(|e| format!("{}: {e}", csv.display()))?;
     let label = label.unwrap_or(scenario.controller.kind.name());
     let view = run_view::from_record(&scenario, label, &record, stopped.as_deref())
         .map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -255,8 +261,8 @@ fn load_run(dir: &Path, label: Option<&str>) -> Result<(Scenario, RunView), Stri
 }
 
 /// The columns of `timeseries.csv` the viewer needs, back into a [`Record`]: `t`, the
-/// coordinates and their `_ref`, `tau1..m`, the tips, and `joint_tau1..n` when present.
-fn parse_timeseries(text: &str, scenario: &Scenario) -> Result<Record, String> {
+/// coordinates and their `_ref`, `tau1..m`, the tips, and `joint_tau1..n_joints` when present.
+fn parse_timeseries(text: &str, scenario: &Scenario, n_joints: usize) -> Result<Record, String> {
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().ok_or("empty file")?.split(',').collect();
     let column = |name: &str| {
@@ -280,11 +286,6 @@ fn parse_timeseries(text: &str, scenario: &Scenario) -> Result<Record, String> {
     let (t, tip_x, tip_y, ref_x, ref_y) = (t?, tip_x?, tip_y?, ref_x?, ref_y?);
     // A spatial run's tip has z columns too; a planar run's z is zero.
     let [tip_z, ref_z] = ["tip_z", "tip_ref_z"].map(|name| column(name).ok());
-    let n_joints = scenario
-        .plant()
-        .map_err(|e| e.to_string())?
-        .plant()
-        .n_joints();
     let joint: Vec<usize> = (1..=n_joints)
         .map_while(|j| column(&format!("joint_tau{j}")).ok())
         .collect();

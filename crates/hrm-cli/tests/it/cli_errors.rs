@@ -770,6 +770,18 @@ fn hrm_view_writes_a_page_and_a_gif_and_replaces_only_its_own_files() {
         "{line}"
     );
     std::fs::write(&csv, text).unwrap();
+    // An arm the scenario file cannot have is that file's fault, not the time series'.
+    let toml = run.join("scenario.toml");
+    let scenario = std::fs::read_to_string(&toml).unwrap();
+    let links = scenario.replacen("[arm]\n", "[arm]\nlinks = 100000000\n", 1);
+    assert_ne!(links, scenario);
+    std::fs::write(&toml, links).unwrap();
+    let line = refused(&hrm(&["view", path(&run)]));
+    assert!(
+        line.contains("scenario.toml: arm.links must be at most"),
+        "{line}"
+    );
+    std::fs::write(&toml, scenario).unwrap();
     let line = refused(&hrm(&[
         "view",
         path(&run),
