@@ -282,6 +282,7 @@ fn fk(mut request: FkRequest) -> EvalResult {
     }?;
     let mut theta = vec![0.0; map.n_joints()];
     map.joint_angles(&request.a, &mut theta)?;
+    finite("theta", &theta)?;
     let lengths: Vec<f64> = chain.link_lengths().collect();
     let tip_chain = tip_position(&lengths, &theta)?;
     finite("tip", &[tip[0], tip[1], tip_chain[0], tip_chain[1]])?;

@@ -192,6 +192,7 @@ fn fk(request: StateRequest) -> EvalResult {
     let map = model.map();
     let mut theta = vec![0.0; map.n_joints()];
     map.joint_angles(&request.a, &mut theta)?;
+    finite("theta", &theta)?;
     let tip_chain = spatial_tip_position(map.link_lengths(), model.base(), &theta)?;
     let length: f64 = map.link_lengths().iter().sum();
     let curve = SpatialCurve::new(length, map.harmonics(), &request.a, *model.base())?;

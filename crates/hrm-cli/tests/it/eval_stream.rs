@@ -432,6 +432,9 @@ fn edge_case_lines_get_one_error_each_and_the_stream_goes_on() {
         // theta = J a overflows; a huge alpha0 alone does not (it is reduced modulo 2 pi).
         (r#"{"id":12,"op":"joints","harmonics":2,"a":[1.7e308,1.7e308,1.7e308,1.7e308,0]}"#.into(), "numerical"),
         (r#"{"id":12.5,"op":"joints","a":[0,0,1.7e308]}"#.into(), "ok"),
+        // The same overflow in `fk`'s chain, planar and spatial, is the same answer.
+        (r#"{"id":12.6,"op":"fk","arm":{"links":4},"a":[1.7e308,1.7e308],"alpha0":0}"#.into(), "numerical"),
+        (r#"{"id":12.7,"op":"fk","arm":{"kind":"spatial","links":4},"a":[1.7e308,1.7e308,1.7e308,1.7e308]}"#.into(), "numerical"),
         ("\u{feff}{\"id\":13,\"op\":\"fk\"}".into(), "parse"),
         (r#"{"id":-0,"op":"joints","a":[-0,-0,-0]}"#.into(), "ok"),
     ];
