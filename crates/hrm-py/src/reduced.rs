@@ -236,6 +236,7 @@ impl ReducedModel {
                     .map()
                     .joint_angles(a, &mut ws.theta)
                     .map_err(Error::from)?;
+                check_finite("theta", &ws.theta)?;
                 let tip =
                     backbone_kin::tip_position(&self.lengths, &ws.theta).map_err(Error::from)?;
                 out.copy_from_slice(&tip);

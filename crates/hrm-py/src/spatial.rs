@@ -462,6 +462,7 @@ impl SpatialArm {
             |ws, [a], out| {
                 let map = self.model.map();
                 map.joint_angles(a, &mut ws.theta).map_err(Error::from)?;
+                check_finite("theta", &ws.theta)?;
                 let tip_chain =
                     spatial_tip_position(map.link_lengths(), self.model.base(), &ws.theta)
                         .map_err(Error::from)?;

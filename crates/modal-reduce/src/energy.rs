@@ -1,7 +1,7 @@
 //! Kinetic and potential energy of the chain at a modal state.
 
 use crate::data::ReducedData;
-use crate::error::ReduceError;
+use crate::error::{ReduceError, check_finite_result};
 use crate::model::ReducedModel;
 use lane_math::check_values;
 
@@ -16,6 +16,7 @@ pub fn kinetic_energy(
     data.check_model(model)?;
     check_values("a_dot", a_dot, model.n_coords())?;
     model.map().joint_rates(a_dot, &mut data.theta_dot)?;
+    check_finite_result("theta_dot = J a_dot", &data.theta_dot)?;
     joint_angles(model, data, a)?;
     Ok(manip_dyn::kinetic_energy(
         model.chain(),
@@ -42,7 +43,8 @@ pub fn potential_energy(
     )?)
 }
 
-/// Fills `data.theta` with `J a + theta_0` after checking `a`.
+/// Fills `data.theta` with `J a + theta_0` after checking `a`; an overflow in the map is a
+/// [`ReduceError::NonFiniteResult`].
 fn joint_angles(
     model: &ReducedModel,
     data: &mut ReducedData,
@@ -50,5 +52,5 @@ fn joint_angles(
 ) -> Result<(), ReduceError> {
     check_values("a", a, model.n_coords())?;
     model.map().joint_angles(a, &mut data.theta)?;
-    Ok(())
+    check_finite_result("theta = J a + theta_0", &data.theta)
 }

@@ -7,7 +7,7 @@ use faer::{Accum, MatMut, Par};
 use manip_dyn::{DynError, MAX_DENSE_LINKS};
 
 use crate::data::{Projection, ReducedData};
-use crate::error::ReduceError;
+use crate::error::{ReduceError, check_finite_result};
 use crate::model::ReducedModel;
 use crate::torques::project;
 use lane_math::check_values;
@@ -41,6 +41,8 @@ pub fn reduced_terms_by_projection(
     }
     map.joint_angles(a, &mut data.theta)?;
     map.joint_rates(a_dot, &mut data.theta_dot)?;
+    check_finite_result("theta = J a + theta_0", &data.theta)?;
+    check_finite_result("theta_dot = J a_dot", &data.theta_dot)?;
     let Projection {
         joint_mass,
         mass_times_jacobian,

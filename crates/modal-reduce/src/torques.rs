@@ -3,7 +3,7 @@
 use backbone_kin::ModalMap;
 
 use crate::data::ReducedData;
-use crate::error::ReduceError;
+use crate::error::{ReduceError, check_finite_result};
 use crate::model::ReducedModel;
 use lane_math::{check_len, check_values};
 
@@ -33,6 +33,11 @@ pub fn joint_torques(
     map.joint_angles(a, &mut data.theta)?;
     map.joint_rates(a_dot, &mut data.theta_dot)?;
     map.joint_rates(a_ddot, &mut data.theta_ddot)?;
+    // Finite coordinates can overflow in the map: the joints' dynamics would then name their
+    // own input; the overflow is numerical.
+    check_finite_result("theta = J a + theta_0", &data.theta)?;
+    check_finite_result("theta_dot = J a_dot", &data.theta_dot)?;
+    check_finite_result("theta_ddot = J a_ddot", &data.theta_ddot)?;
     manip_dyn::rnea(
         model.chain(),
         &mut data.chain,

@@ -381,6 +381,84 @@ fn call_rows() -> Vec<Row<ReduceError>> {
             .unwrap_err(),
             |e| matches!(e, ReduceError::Dyn(_)),
         ),
+        // Finite coordinates whose joint values overflow in the map: numerical, not the joints'
+        // input refused by the chain's dynamics.
+        row(
+            "overflowing_result",
+            joint_torques(
+                &model,
+                &mut data,
+                &[f64::MAX; 3],
+                &[0.0; 3],
+                &[0.0; 3],
+                &mut [0.0; 10],
+            )
+            .unwrap_err(),
+            |e| {
+                matches!(
+                    e,
+                    ReduceError::NonFiniteResult {
+                        name: "theta = J a + theta_0"
+                    }
+                )
+            },
+        ),
+        row(
+            "overflowing_result",
+            joint_torques(
+                &model,
+                &mut data,
+                &[0.0; 3],
+                &[0.0; 3],
+                &[f64::MAX; 3],
+                &mut [0.0; 10],
+            )
+            .unwrap_err(),
+            |e| {
+                matches!(
+                    e,
+                    ReduceError::NonFiniteResult {
+                        name: "theta_ddot = J a_ddot"
+                    }
+                )
+            },
+        ),
+        row(
+            "overflowing_result",
+            kinetic_energy(&model, &mut data, &[0.0; 3], &[f64::MAX; 3]).unwrap_err(),
+            |e| {
+                matches!(
+                    e,
+                    ReduceError::NonFiniteResult {
+                        name: "theta_dot = J a_dot"
+                    }
+                )
+            },
+        ),
+        row(
+            "overflowing_result",
+            potential_energy(&model, &mut data, &[f64::MAX; 3]).unwrap_err(),
+            |e| {
+                matches!(
+                    e,
+                    ReduceError::NonFiniteResult {
+                        name: "theta = J a + theta_0"
+                    }
+                )
+            },
+        ),
+        row(
+            "overflowing_result",
+            reduced_terms_by_projection(&model, &mut data, &[f64::MAX; 3], &[0.0; 3]).unwrap_err(),
+            |e| {
+                matches!(
+                    e,
+                    ReduceError::NonFiniteResult {
+                        name: "theta = J a + theta_0"
+                    }
+                )
+            },
+        ),
         // The eq-18 iteration.
         words(
             "jacobi_iteration_diverges",
