@@ -206,3 +206,9 @@ def test_model_errors(arm):
         model.gravity([0.1, 0.2])
     with pytest.raises(hrm.InvalidInput, match=r"a_dot\[1\] must be finite, got NaN"):
         model.forward_dynamics(np.zeros(3), [0, np.nan, 0], np.zeros(3))
+    # Finite coordinates whose joint angles overflow: numerical, whichever method meets them.
+    huge = np.full(3, np.finfo(float).max)
+    with pytest.raises(hrm.NumericalError, match="theta came out non-finite"):
+        model.fk(huge)
+    with pytest.raises(hrm.NumericalError, match=r"theta = J a \+ theta_0 is not finite"):
+        model.joint_torques(huge, np.zeros(3), np.zeros(3))
