@@ -229,7 +229,8 @@ fn merged_shards_equal_the_unsharded_sweep_and_bad_merges_are_refused() {
     write(&cut_path, &moved.to_json().unwrap()).unwrap();
     let err = merge(&[shard(1), cut_path.clone(), shard(3)]);
     assert!(
-        err.contains("holds run 0, which is not run 1 of this sweep"),
+        err.contains("holds run 0 (controller fuzzy, ")
+            && err.contains("which is not run 1 of this sweep (controller fuzzy, "),
         "{err}"
     );
     // A hand-edited configuration that makes no sweep.
@@ -590,7 +591,31 @@ fn shard_files_are_streamed_and_checked_line_by_line() {
     );
     let err = check(&runs.replacen("\"index\":5,", "\"index\":18446744073709551615,", 1));
     assert!(
-        err.contains("holds run 18446744073709551615, which is not run 5"),
+        err.contains("holds run 18446744073709551615 (controller ")
+            && err.contains("which is not run 5 of this sweep (controller "),
+        "{err}"
+    );
+    // A run whose index is right and whose controller is not: the message says which differs.
+    let first = lines[1];
+    let controller = first
+        .split("\"controller\":\"")
+        .nth(1)
+        .unwrap()
+        .split('"')
+        .next()
+        .unwrap();
+    let other = if controller == "pd" { "lqr" } else { "pd" };
+    let edited = first.replacen(
+        &format!("\"controller\":\"{controller}\""),
+        &format!("\"controller\":\"{other}\""),
+        1,
+    );
+    let err = check(&runs.replacen(first, &edited, 1));
+    assert!(
+        err.contains(&format!("holds run 0 (controller {other}, "))
+            && err.contains(&format!(
+                "which is not run 0 of this sweep (controller {controller}, "
+            )),
         "{err}"
     );
     let older = "{\n  \"format\": \"hrm-sweep-shard/2\",\n  \"runs\": []\n}\n";

@@ -221,8 +221,8 @@ pub enum ShardProblem {
     },
     /// A run out of place.
     #[error(
-        ": line {line} holds run {run}, which is not run {expected} of this sweep, the next of \
-         its shard {shard}"
+        ": line {line} holds run {run} ({held}), which is not run {expected} of this sweep \
+         ({wanted}), the next of its shard {shard}"
     )]
     RunOutOfPlace {
         /// The line.
@@ -233,6 +233,10 @@ pub enum ShardProblem {
         expected: usize,
         /// The shard.
         shard: Shard,
+        /// The held run's controller, noise level and seed.
+        held: String,
+        /// The expected run's.
+        wanted: String,
     },
     /// A completed run with another number of modal errors than the scenario's coordinates.
     #[error(

@@ -12,6 +12,7 @@ use super::outcome::{RunMetrics, RunOutcome, Stopped};
 use super::plan::{RunId, SweepConfig};
 use super::shard::{FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, MAX_SHARDS, Shard};
 use crate::ControllerKind;
+use lane_math::Compact;
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Seek, SeekFrom, Write};
@@ -438,12 +439,20 @@ impl<R: ShardSource> ShardReader<R> {
             })
         })?;
         let i = shard.index - 1 + self.runs_read * shard.count;
-        if !run.matches(&self.header.config.run_at(i)) {
+        let wanted = self.header.config.run_at(i);
+        if !run.matches(&wanted) {
             return Err(refuse(ShardProblem::RunOutOfPlace {
                 line,
                 run: run.index,
                 expected: i,
                 shard,
+                held: position(run.controller, run.noise_level, run.seed_index, run.seed),
+                wanted: position(
+                    wanted.controller,
+                    wanted.noise_level,
+                    wanted.seed_index,
+                    wanted.seed,
+                ),
             }));
         }
         let m = self.header.config.scenario.n_coords();
@@ -653,4 +662,14 @@ pub fn merge_readers<R: ShardSource>(
         reader.input.release();
     }
     Ok(ShardHeader::new(&config, Shard::WHOLE))
+}
+
+/// A run's position fields as a message names them: "controller pd, noise level 0.01, seed index
+/// 2, seed 1234".
+fn position(controller: ControllerKind, noise_level: f64, seed_index: usize, seed: u64) -> String {
+    format!(
+        "controller {}, noise level {}, seed index {seed_index}, seed {seed}",
+        controller.name(),
+        Compact(noise_level)
+    )
 }
