@@ -381,84 +381,6 @@ fn call_rows() -> Vec<Row<ReduceError>> {
             .unwrap_err(),
             |e| matches!(e, ReduceError::Dyn(_)),
         ),
-        // Finite coordinates whose joint values overflow in the map: numerical, not the joints'
-        // input refused by the chain's dynamics.
-        row(
-            "overflowing_result",
-            joint_torques(
-                &model,
-                &mut data,
-                &[f64::MAX; 3],
-                &[0.0; 3],
-                &[0.0; 3],
-                &mut [0.0; 10],
-            )
-            .unwrap_err(),
-            |e| {
-                matches!(
-                    e,
-                    ReduceError::NonFiniteResult {
-                        name: "theta = J a + theta_0"
-                    }
-                )
-            },
-        ),
-        row(
-            "overflowing_result",
-            joint_torques(
-                &model,
-                &mut data,
-                &[0.0; 3],
-                &[0.0; 3],
-                &[f64::MAX; 3],
-                &mut [0.0; 10],
-            )
-            .unwrap_err(),
-            |e| {
-                matches!(
-                    e,
-                    ReduceError::NonFiniteResult {
-                        name: "theta_ddot = J a_ddot"
-                    }
-                )
-            },
-        ),
-        row(
-            "overflowing_result",
-            kinetic_energy(&model, &mut data, &[0.0; 3], &[f64::MAX; 3]).unwrap_err(),
-            |e| {
-                matches!(
-                    e,
-                    ReduceError::NonFiniteResult {
-                        name: "theta_dot = J a_dot"
-                    }
-                )
-            },
-        ),
-        row(
-            "overflowing_result",
-            potential_energy(&model, &mut data, &[f64::MAX; 3]).unwrap_err(),
-            |e| {
-                matches!(
-                    e,
-                    ReduceError::NonFiniteResult {
-                        name: "theta = J a + theta_0"
-                    }
-                )
-            },
-        ),
-        row(
-            "overflowing_result",
-            reduced_terms_by_projection(&model, &mut data, &[f64::MAX; 3], &[0.0; 3]).unwrap_err(),
-            |e| {
-                matches!(
-                    e,
-                    ReduceError::NonFiniteResult {
-                        name: "theta = J a + theta_0"
-                    }
-                )
-            },
-        ),
         // The eq-18 iteration.
         words(
             "jacobi_iteration_diverges",
@@ -476,6 +398,55 @@ fn call_rows() -> Vec<Row<ReduceError>> {
             &["solve M* a_ddot = rhs directly"],
         ),
     ];
+    // Finite coordinates whose joint values overflow in the map: numerical, not the joints'
+    // input refused by the chain's dynamics.
+    let huge = [f64::MAX; 3];
+    let overflows = [
+        (
+            joint_torques(
+                &model,
+                &mut data,
+                &huge,
+                &[0.0; 3],
+                &[0.0; 3],
+                &mut [0.0; 10],
+            ),
+            "theta = J a + theta_0",
+        ),
+        (
+            joint_torques(
+                &model,
+                &mut data,
+                &[0.0; 3],
+                &[0.0; 3],
+                &huge,
+                &mut [0.0; 10],
+            ),
+            "theta_ddot = J a_ddot",
+        ),
+        (
+            kinetic_energy(&model, &mut data, &[0.0; 3], &huge).map(drop),
+            "theta_dot = J a_dot",
+        ),
+        (
+            potential_energy(&model, &mut data, &huge).map(drop),
+            "theta = J a + theta_0",
+        ),
+        (
+            reduced_terms_by_projection(&model, &mut data, &huge, &[0.0; 3]),
+            "theta = J a + theta_0",
+        ),
+    ];
+    for (result, name) in overflows {
+        let error = result.unwrap_err();
+        assert!(
+            matches!(&error, ReduceError::NonFiniteResult { name: n } if *n == name),
+            "{name}: {error:?}"
+        );
+        rows.push(row("overflowing_result", error, |e| {
+            matches!(e, ReduceError::NonFiniteResult { .. })
+        }));
+    }
     let bad_settings = [
         (0.0, 10, "tolerance"),
         (f64::NAN, 10, "tolerance"),
