@@ -448,6 +448,22 @@ pub enum LearningProblem {
         /// The offending value.
         value: f64,
     },
+    /// A value of the data beyond [`MAX_MAGNITUDE`](crate::learn::MAX_MAGNITUDE) (the first one,
+    /// row by row).
+    #[error(
+        "row {} column {} is {}, beyond the {} in magnitude that learning handles",
+        .row + 1, .column + 1, lane_math::Compact(*.value), lane_math::Compact(*.limit)
+    )]
+    HugeValue {
+        /// The row (0-based).
+        row: usize,
+        /// The column (0-based: inputs, then outputs).
+        column: usize,
+        /// The offending value.
+        value: f64,
+        /// The largest magnitude.
+        limit: f64,
+    },
     /// The data's column names are not one per column.
     #[error("{names} column names for {columns} columns")]
     ColumnNameCount {
@@ -556,6 +572,22 @@ pub enum LearningProblem {
         /// The cluster (rule) limit.
         limit: usize,
     },
+    /// An input column spans less than [`MIN_INPUT_RANGE`](crate::learn::MIN_INPUT_RANGE): a
+    /// partition of it would divide by that width beyond double precision.
+    #[error(
+        "input {} spans only [{}, {}] over the data; a fuzzy partition needs a range of at least {}",
+        .input + 1, lane_math::Compact(*.lo), lane_math::Compact(*.hi), lane_math::Compact(*.min)
+    )]
+    NarrowInput {
+        /// The input (0-based).
+        input: usize,
+        /// Its smallest value.
+        lo: f64,
+        /// Its largest value.
+        hi: f64,
+        /// The narrowest range.
+        min: f64,
+    },
     /// An input column takes one value over the data, so no partition of it exists.
     #[error(
         "input {} is constant ({value}) over the data; a fuzzy partition needs a range",
@@ -606,7 +638,10 @@ pub enum LearningProblem {
     },
     /// The least-squares problem of the consequents (Jang's eq 15) holds a NaN or an infinity
     /// (its entries or their squares overflowed).
-    #[error("the least-squares problem for the consequents holds a non-finite value")]
+    #[error(
+        "the least-squares problem for the consequents holds a non-finite value: the data's \
+         scales overflow double precision; rescale the columns"
+    )]
     NonFiniteLeastSquares,
     /// Without a ridge, the data do not determine a consequent parameter (the least-squares
     /// matrix of eq 15 is rank deficient): too few samples where its rules fire, or collinear
@@ -624,7 +659,10 @@ pub enum LearningProblem {
         parameter: ConsequentParameter,
     },
     /// The premise gradient (Jang's eqs 5-8) came out NaN or infinite.
-    #[error("the premise gradient is not finite at epoch {epoch}")]
+    #[error(
+        "the premise gradient is not finite at epoch {epoch}: the data's scales overflow double \
+         precision (outputs large against narrow input ranges); rescale the columns"
+    )]
     NonFiniteGradient {
         /// The epoch (1-based, as [`EpochReport::epoch`](crate::learn::EpochReport::epoch)).
         epoch: usize,

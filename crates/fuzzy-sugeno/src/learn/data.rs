@@ -9,8 +9,12 @@ pub const MAX_ROWS: usize = 1_000_000;
 pub const MAX_INPUTS: usize = 64;
 /// The most outputs a data set may have.
 const MAX_OUTPUTS: usize = 64;
+/// The largest magnitude of a value: the least-squares fit sums products of values and the
+/// premise gradients divide by input ranges, all within double precision below it.
+pub const MAX_MAGNITUDE: f64 = 1e100;
 
-/// Rows of `n_inputs` input values followed by `n_outputs` output values, all finite.
+/// Rows of `n_inputs` input values followed by `n_outputs` output values, all finite and at most
+/// [`MAX_MAGNITUDE`] in magnitude.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainingData {
     n_inputs: usize,
@@ -62,6 +66,15 @@ impl TrainingData {
                 row: k / width,
                 column: k % width,
                 value,
+            }
+            .into());
+        }
+        if let Some(k) = values.iter().position(|v| v.abs() > MAX_MAGNITUDE) {
+            return Err(LearningProblem::HugeValue {
+                row: k / width,
+                column: k % width,
+                value: values[k],
+                limit: MAX_MAGNITUDE,
             }
             .into());
         }

@@ -13,6 +13,9 @@ use crate::{FuzzyError, LearningProblem};
 
 /// The most rules `genfis` builds (sets per input to the power of the inputs, or clusters).
 pub const MAX_RULES: usize = 4096;
+/// The narrowest range of an input a partition is built over: the premise gradients divide by
+/// the sets' widths, a fraction of it.
+pub const MIN_INPUT_RANGE: f64 = 1e-100;
 /// The most rows subtractive clustering accepts (its cost grows as the square of the rows).
 pub const MAX_CLUSTER_ROWS: usize = 10_000;
 /// The most sets per input of a grid partition.
@@ -416,17 +419,26 @@ fn subtractive_clustering(points: &[f64], dim: usize, ra: f64) -> Result<Vec<usi
     Ok(centres)
 }
 
-/// `[min, max]` of input `i` in the data, refused if the input is constant.
+/// `[min, max]` of input `i` in the data, refused if the input is constant or spans less than
+/// [`MIN_INPUT_RANGE`].
 fn input_range(data: &TrainingData, i: usize) -> Result<[f64; 2], FuzzyError> {
     let [lo, hi] = data.column_range(i);
-    if lo < hi {
-        Ok([lo, hi])
-    } else {
+    if lo >= hi {
         Err(LearningProblem::ConstantInput {
             input: i,
             value: lo,
         }
         .into())
+    } else if hi - lo < MIN_INPUT_RANGE {
+        Err(LearningProblem::NarrowInput {
+            input: i,
+            lo,
+            hi,
+            min: MIN_INPUT_RANGE,
+        }
+        .into())
+    } else {
+        Ok([lo, hi])
     }
 }
 

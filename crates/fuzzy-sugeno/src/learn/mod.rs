@@ -38,9 +38,10 @@ mod merge;
 mod premise;
 
 pub use anfis::{Anfis, AnfisOptions, EpochReport, Trained, anfis};
-pub use data::{MAX_INPUTS, MAX_ROWS, TrainingData};
+pub use data::{MAX_INPUTS, MAX_MAGNITUDE, MAX_ROWS, TrainingData};
 pub use genfis::{
-    ConsequentOrder, GridPartition, MAX_CLUSTER_ROWS, MAX_RULES, MAX_SETS_PER_INPUT, SetShape,
-    SubtractiveClustering, genfis_cluster, genfis_grid, genfis_grid_over,
+    ConsequentOrder, GridPartition, MAX_CLUSTER_ROWS, MAX_RULES, MAX_SETS_PER_INPUT,
+    MIN_INPUT_RANGE, SetShape, SubtractiveClustering, genfis_cluster, genfis_grid,
+    genfis_grid_over,
 };
 pub use merge::merge_outputs;

@@ -475,24 +475,33 @@ fn collinear_inputs_leave_a_coefficient_undetermined_without_ridge() {
 }
 
 #[test]
-fn overflowing_data_are_a_numerical_error_not_a_nan_system() {
-    // Finite inputs near 1e200: the first-order least-squares matrix holds their squares, inf.
+fn overflowing_data_are_refused_or_a_numerical_error_not_a_nan_system() {
+    // Values beyond 1e100 are refused where the data are given, by row and column.
     let values = (0..10).flat_map(|k| [k as f64 * 1e200, k as f64]).collect();
-    let huge_inputs = TrainingData::new(1, 1, values).unwrap();
-    let error = genfis_grid(&huge_inputs, 0, &GridPartition::default()).unwrap_err();
-    assert_eq!(
-        error,
-        FuzzyError::Learning(LearningProblem::NonFiniteLeastSquares)
-    );
+    let error = TrainingData::new(1, 1, values).unwrap_err();
     assert_eq!(
         error.to_string(),
-        "learning: the least-squares problem for the consequents holds a non-finite value"
+        "learning: row 2 column 1 is 1e200, beyond the 1e100 in magnitude that learning handles"
     );
-    assert!(error.is_numerical() && !error.is_invalid_input());
-    // Finite targets of +-1e300 that no system fits: the squared error and its gradient
-    // overflow, and the first premise step refuses them.
+    assert!(error.is_invalid_input());
+    // So is an input that spans less than 1e-100 (a partition divides by its width).
     let values = (0..10)
-        .flat_map(|k| [k as f64, if k % 2 == 0 { 1e300 } else { -1e300 }])
+        .flat_map(|k| [k as f64 * 1e-110, k as f64])
+        .collect();
+    let narrow = TrainingData::new(1, 1, values).unwrap();
+    let error = genfis_grid(&narrow, 0, &GridPartition::default()).unwrap_err();
+    assert!(
+        error
+            .to_string()
+            .starts_with("learning: input 1 spans only [0, 9e-110] over the data"),
+        "{error}"
+    );
+    assert!(error.is_invalid_input());
+    // Within the bounds, targets of +-1e60 over an input spanning 1e-98 that no system fits: the
+    // squared error's gradient with respect to the sets' widths overflows, and the first premise
+    // step refuses it.
+    let values = (0..10)
+        .flat_map(|k| [k as f64 * 1e-99, if k % 2 == 0 { 1e60 } else { -1e60 }])
         .collect();
     let huge_targets = TrainingData::new(1, 1, values).unwrap();
     let zero_order = GridPartition {
@@ -509,9 +518,11 @@ fn overflowing_data_are_a_numerical_error_not_a_nan_system() {
         error,
         FuzzyError::Learning(LearningProblem::NonFiniteGradient { epoch: 1 })
     );
-    assert_eq!(
-        error.to_string(),
-        "learning: the premise gradient is not finite at epoch 1"
+    assert!(
+        error
+            .to_string()
+            .starts_with("learning: the premise gradient is not finite at epoch 1: "),
+        "{error}"
     );
     assert!(error.is_numerical());
 }
