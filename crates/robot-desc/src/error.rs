@@ -43,6 +43,22 @@ pub enum DescError {
         /// The limit.
         max: usize,
     },
+    /// An element has more than [`MAX_ATTRIBUTES`](crate::MAX_ATTRIBUTES) attributes.
+    #[error("an element at line {line} has more than {max} attributes; URDF needs 6")]
+    TooManyAttributes {
+        /// The element's line.
+        line: u32,
+        /// The limit.
+        max: usize,
+    },
+    /// The text declares more than [`MAX_NAMESPACES`](crate::MAX_NAMESPACES) XML namespaces.
+    #[error("the text has {got} namespace declarations (xmlns), at most {max} allowed")]
+    TooManyNamespaces {
+        /// The declarations counted (every `xmlns` in the text).
+        got: usize,
+        /// The limit.
+        max: usize,
+    },
     /// An element is malformed or outside the model's domain (a NaN mass, a zero axis, an
     /// inertia breaking the triangle inequality, a missing attribute, a duplicated name).
     #[error("{element}: {problem}")]

@@ -20,7 +20,7 @@ pub use planar::from_planar;
 pub use spatial::to_spatial;
 pub use universal::from_spatial_arm;
 pub use urdf_read::{
-    MAX_ATTRIBUTE_BYTES, MAX_MAGNITUDE, MAX_URDF_BYTES, MAX_XML_DEPTH, MAX_XML_NODES, Merged,
-    ReadReport, Reading, read_urdf,
+    MAX_ATTRIBUTE_BYTES, MAX_ATTRIBUTES, MAX_MAGNITUDE, MAX_NAMESPACES, MAX_URDF_BYTES,
+    MAX_XML_DEPTH, MAX_XML_NODES, Merged, ReadReport, Reading, read_urdf,
 };
 pub use urdf_write::write_urdf;

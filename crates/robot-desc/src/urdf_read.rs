@@ -21,6 +21,14 @@ pub const MAX_XML_NODES: u32 = 1_000_000;
 /// Longest attribute value (bytes): a mesh file name is the longest legitimate one.
 pub const MAX_ATTRIBUTE_BYTES: usize = 4096;
 
+/// Most attributes an element may have (URDF's `<inertia>` has six): the XML parser's check
+/// for duplicated attributes takes time quadratic in their number.
+pub const MAX_ATTRIBUTES: usize = 64;
+
+/// Most namespace declarations (`xmlns`) a text may have (a xacro file has a few): the XML
+/// parser's namespace resolution takes time proportional to their number for every element.
+pub const MAX_NAMESPACES: usize = 64;
+
 /// Largest magnitude of any number read (lengths in m, masses in kg, inertias in kg m^2,
 /// limits): far beyond any robot, small enough that products of a few never overflow.
 pub const MAX_MAGNITUDE: f64 = 1e9;
@@ -62,9 +70,11 @@ pub struct Reading {
 
 /// Reads a URDF serial chain.
 ///
-/// Bounds first: at most [`MAX_URDF_BYTES`], no DTD (so no entity is ever expanded), at most
-/// [`MAX_XML_NODES`] nodes nested at most [`MAX_XML_DEPTH`] deep, attribute values of at most
-/// [`MAX_ATTRIBUTE_BYTES`]. Then the chain: `revolute`, `continuous` and `prismatic` joints are
+/// Bounds first: at most [`MAX_URDF_BYTES`], at most [`MAX_NAMESPACES`] namespace declarations
+/// and [`MAX_ATTRIBUTES`] attributes an element (counted on the text in one pass, before the
+/// XML parser, whose time grows faster than the text with either), no DTD (so no entity is ever
+/// expanded), at most [`MAX_XML_NODES`] nodes nested at most [`MAX_XML_DEPTH`] deep, attribute
+/// values of at most [`MAX_ATTRIBUTE_BYTES`]. Then the chain: `revolute`, `continuous` and `prismatic` joints are
 /// its degrees of freedom; links behind `fixed` joints are merged into their parent body (mass
 /// properties by the parallel-axis theorem, geometry moved into the parent's frame, the next
 /// joint's origin composed). Axes are normalised. Trees, closed loops, `floating` and `planar`
@@ -76,6 +86,7 @@ pub fn read_urdf(text: &str) -> Result<Reading, DescError> {
             max: MAX_URDF_BYTES,
         });
     }
+    check_markup(text)?;
     let options = ParsingOptions {
         allow_dtd: false,
         nodes_limit: MAX_XML_NODES,
@@ -105,6 +116,76 @@ pub fn read_urdf(text: &str) -> Result<Reading, DescError> {
     report.joints = joints.len();
     let robot = assemble(name, links, joints, &mut report)?;
     Ok(Reading { robot, report })
+}
+
+/// Namespace declarations and attributes an element, counted on the text in one pass: every
+/// `xmlns` (in markup or not: a description has a few), and in every tag the `=` outside quoted
+/// values (comments, CDATA sections and processing instructions skipped).
+fn check_markup(text: &str) -> Result<(), DescError> {
+    let namespaces = text.matches("xmlns").count();
+    if namespaces > MAX_NAMESPACES {
+        return Err(DescError::TooManyNamespaces {
+            got: namespaces,
+            max: MAX_NAMESPACES,
+        });
+    }
+    let bytes = text.as_bytes();
+    let mut line = 1u32;
+    let mut i = 0;
+    // Skips past `end` from `from`, counting lines; `None` when `end` never comes (the parser
+    // then refuses the text).
+    let skip = |from: usize, end: &str, line: &mut u32| {
+        let rest = &text[from..];
+        let at = rest.find(end)?;
+        *line += rest[..at].matches('\n').count() as u32;
+        Some(from + at + end.len())
+    };
+    while i < bytes.len() {
+        match bytes[i] {
+            b'\n' => {
+                line += 1;
+                i += 1;
+            }
+            b'<' => {
+                let rest = &text[i..];
+                let skipped = if rest.starts_with("<!--") {
+                    skip(i + 4, "-->", &mut line)
+                } else if rest.starts_with("<![CDATA[") {
+                    skip(i + 9, "]]>", &mut line)
+                } else if rest.starts_with("<?") {
+                    skip(i + 2, "?>", &mut line)
+                } else {
+                    let start = line;
+                    let (mut quote, mut attributes) = (None, 0);
+                    let mut j = i + 1;
+                    while j < bytes.len() {
+                        match (bytes[j], quote) {
+                            (b'\n', _) => line += 1,
+                            (b'"' | b'\'', None) => quote = Some(bytes[j]),
+                            (c, Some(q)) if c == q => quote = None,
+                            (b'=', None) => attributes += 1,
+                            (b'>', None) => break,
+                            _ => {}
+                        }
+                        j += 1;
+                    }
+                    if attributes > MAX_ATTRIBUTES {
+                        return Err(DescError::TooManyAttributes {
+                            line: start,
+                            max: MAX_ATTRIBUTES,
+                        });
+                    }
+                    Some(j + 1)
+                };
+                match skipped {
+                    Some(next) => i = next,
+                    None => return Ok(()),
+                }
+            }
+            _ => i += 1,
+        }
+    }
+    Ok(())
 }
 
 /// Depth and attribute lengths, checked on the parsed document in one pass in document order
@@ -305,25 +386,26 @@ fn read_link(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfLink, De
 fn read_inertial(node: Node<'_, '_>, link: &str) -> Result<Inertial, DescError> {
     let element = || format!("<inertial> of link '{link}'");
     let origin = origin(node, &element)?;
-    let mass = match single(node, "mass", &element)? {
-        Some(mass) => required_number(mass, "value", &|| format!("<mass> of link '{link}'"))?,
-        None => 0.0,
-    };
+    // As urdfdom (ROS, Pinocchio) reads it: <mass> and <inertia> with its six attributes are
+    // required, nothing defaults to zero.
+    let mass = single(node, "mass", &element)?
+        .ok_or_else(|| DescError::invalid(element(), "missing <mass>"))?;
+    let mass = required_number(mass, "value", &|| format!("<mass> of link '{link}'"))?;
     if mass < 0.0 {
         return Err(DescError::invalid(
             element(),
             format!("mass must be non-negative, got {mass}"),
         ));
     }
+    let tensor = single(node, "inertia", &element)?
+        .ok_or_else(|| DescError::invalid(element(), "missing <inertia>"))?;
     let mut inertia = [0.0; 6];
-    if let Some(tensor) = single(node, "inertia", &element)? {
-        let element = || format!("<inertia> of link '{link}'");
-        for (value, attribute) in inertia
-            .iter_mut()
-            .zip(["ixx", "ixy", "ixz", "iyy", "iyz", "izz"])
-        {
-            *value = optional_number(tensor, attribute, &element)?.unwrap_or(0.0);
-        }
+    let tensor_element = || format!("<inertia> of link '{link}'");
+    for (value, attribute) in inertia
+        .iter_mut()
+        .zip(["ixx", "ixy", "ixz", "iyy", "iyz", "izz"])
+    {
+        *value = required_number(tensor, attribute, &tensor_element)?;
     }
     let inertial = Inertial {
         origin,

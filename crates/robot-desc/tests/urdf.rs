@@ -46,7 +46,7 @@ const ARM: &str = r#"<?xml version="1.0"?>
     <origin xyz="0.3 0 0" rpy="0 0 0.5"/>
   </joint>
   <link name="tool">
-    <inertial><mass value="0.5"/><inertia ixx="0.0001" iyy="0.0001" izz="0.0001"/></inertial>
+    <inertial><mass value="0.5"/><inertia ixx="0.0001" ixy="0" ixz="0" iyy="0.0001" iyz="0" izz="0.0001"/></inertial>
     <collision><geometry><sphere radius="0.03"/></geometry></collision>
   </link>
   <transmission name="t1"><type>x</type></transmission>
@@ -130,10 +130,10 @@ fn two_welded_cubes_are_one_box() {
   <link name="base"/>
   <joint name="j" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/></joint>
   <link name="a"><inertial><origin xyz="{h} 0 0" rpy="0.3 0.2 0.1"/><mass value="{m}"/>
-    <inertia ixx="{cube}" iyy="{cube}" izz="{cube}"/></inertial></link>
+    <inertia ixx="{cube}" ixy="0" ixz="0" iyy="{cube}" iyz="0" izz="{cube}"/></inertial></link>
   <joint name="weld" type="fixed"><parent link="a"/><child link="b"/><origin xyz="{s} 0 0" rpy="1 2 3"/></joint>
   <link name="b"><inertial><origin xyz="0 0 0"/><mass value="{m}"/>
-    <inertia ixx="{cube}" iyy="{cube}" izz="{cube}"/></inertial></link>
+    <inertia ixx="{cube}" ixy="0" ixz="0" iyy="{cube}" iyz="0" izz="{cube}"/></inertial></link>
 </robot>"#,
         h = s / 2.0,
     );
@@ -228,7 +228,7 @@ fn random_urdf(seed: u64, n: usize) -> String {
         "<joint name=\"tool_mount\" type=\"fixed\"><parent link=\"l{n}\"/><child link=\"tool\"/>\
          <origin xyz=\"0.1 0.02 0\" rpy=\"0.3 0 0.2\"/></joint>\n\
          <link name=\"tool\"><inertial><origin xyz=\"0.01 0 0\"/><mass value=\"0.3\"/>\
-         <inertia ixx=\"0.001\" iyy=\"0.002\" izz=\"0.002\" ixy=\"0.0001\"/></inertial></link>\n</robot>\n"
+         <inertia ixx=\"0.001\" iyy=\"0.002\" izz=\"0.002\" ixy=\"0.0001\" ixz=\"0\" iyz=\"0\"/></inertial></link>\n</robot>\n"
     );
     text
 }
@@ -316,17 +316,53 @@ fn hostile_files_are_refused_in_milliseconds() {
         )
     };
     refused(
-        &inertia("ixx=\"1\" iyy=\"1\" izz=\"3\""),
+        &inertia("ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"3\""),
         &["<inertial> of link 'b'", "triangle inequality"],
     );
     refused(
-        &inertia("ixx=\"-1\" iyy=\"1\" izz=\"1\""),
+        &inertia("ixx=\"-1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\""),
         &["<inertial> of link 'b'", "positive semi-definite"],
     );
     // Off-diagonal terms that break positivity with a positive diagonal.
     refused(
-        &inertia("ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"2\""),
+        &inertia("ixx=\"1\" ixy=\"2\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\""),
         &["<inertial> of link 'b'", "positive semi-definite"],
+    );
+    // As urdfdom: <mass>, <inertia> and its six attributes are required (nothing defaults to 0,
+    // a misspelt attribute is a missing one).
+    refused(
+        &inertia("ixx=\"1\" iyy=\"1\" izz=\"1\""),
+        &["<inertia> of link 'b'", "ixy"],
+    );
+    refused(
+        &inertia("Ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\""),
+        &["<inertia> of link 'b'", "ixx"],
+    );
+    refused(
+        &chain_with("", "<inertial><mass value=\"1\"/></inertial>"),
+        &["<inertial> of link 'b'", "missing <inertia>"],
+    );
+    refused(
+        &chain_with(
+            "",
+            "<inertial><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>",
+        ),
+        &["<inertial> of link 'b'", "missing <mass>"],
+    );
+    // Attributes by the thousand, namespace declarations by the thousand: the XML parser's
+    // time grows faster than the text with either, so they are counted first.
+    let attributes: String = (0..80_000).map(|k| format!(" a{k}=\"\"")).collect();
+    refused(
+        &format!("<robot name=\"r\"><link name=\"b\"{attributes}/></robot>"),
+        &["line 1 has more than 64 attributes"],
+    );
+    let declarations: String = (0..2000).map(|k| format!(" xmlns:n{k}=\"u{k}\"")).collect();
+    refused(
+        &format!(
+            "<robot name=\"r\"{declarations}>{}</robot>",
+            "<x xmlns:z=\"v\"/>".repeat(2000)
+        ),
+        &["4000 namespace declarations", "at most 64"],
     );
 }
 

@@ -175,7 +175,7 @@ fn check(settings: &ChainLoopSettings, n: usize, gains: bool) -> Result<usize, S
 /// [`SimError::InvalidSetting`] for a setting out of its domain (named as in a scenario file) or
 /// a reference or `q0` of the wrong length; [`SimError::ChainDynamics`] if the dynamics fail at
 /// a controller sample, [`SimError::ChainIntegration`] if they fail or blow up between two,
-/// [`SimError::RunawayError`] past `max_joint_error` (its `coordinate` is the 1-based joint).
+/// [`SimError::JointRunaway`] past `max_joint_error`.
 pub fn run_chain_loop(
     model: &SpatialModel,
     reference: &mut dyn Reference,
@@ -258,9 +258,9 @@ fn run(
         for (i, (r, x)) in sample.a.iter().zip(q).enumerate() {
             let error = r - x;
             if error.abs() > settings.max_joint_error || !error.is_finite() {
-                return Err(SimError::RunawayError {
+                return Err(SimError::JointRunaway {
                     t,
-                    coordinate: i + 1,
+                    joint: i + 1,
                     error: error.abs(),
                     bound: settings.max_joint_error,
                 });
@@ -408,6 +408,34 @@ mod tests {
             run.summary.final_error < 3e-3,
             "{}",
             run.summary.final_error
+        );
+    }
+
+    #[test]
+    fn a_runaway_joint_is_named_in_joint_terms() {
+        let model = arm();
+        let target = [0.3, -0.2, 0.1, 0.4, -0.3, 0.2, 0.1];
+        let mut step = Step::new(&[0.0; 7], &target, 0.0).unwrap();
+        let mut s = settings(7);
+        s.max_joint_error = 0.35;
+        let e = run_chain_loop(&model, &mut step, &[0.0; 7], &s).unwrap_err();
+        // Joint 4's step of 0.4 rad is beyond the bound at once.
+        assert!(
+            matches!(
+                e,
+                SimError::JointRunaway {
+                    t: 0.0,
+                    joint: 4,
+                    bound: 0.35,
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        assert!(
+            e.to_string()
+                .starts_with("runaway tracking error at t = 0 s: |q4 - q4_ref| = 0.4 exceeds"),
+            "{e}"
         );
     }
 

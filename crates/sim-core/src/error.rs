@@ -175,6 +175,25 @@ pub enum SimError {
         /// The bound in force (rad).
         bound: f64,
     },
+    /// A joint's tracking error in a joint-space loop ([`run_chain_loop`](crate::run_chain_loop))
+    /// grew beyond the configured bound.
+    #[error(
+        "runaway tracking error at t = {} s: |q{joint} - q{joint}_ref| = {} exceeds the bound {} \
+         (limits.max_modal_error, in the joint's unit: rad, or m for a prismatic joint)",
+        Compact(*.t),
+        Compact(*.error),
+        Compact(*.bound)
+    )]
+    JointRunaway {
+        /// When (s).
+        t: f64,
+        /// Which joint (1-based).
+        joint: usize,
+        /// The error's magnitude.
+        error: f64,
+        /// The bound in force.
+        bound: f64,
+    },
     /// The enforced joint limits (`limits.joint_torque_nm`, `limits.joint_angle_rad`) could not
     /// be met at a controller sample: no modal torque keeps them at that state.
     #[error("joint limits at t = {t} s: {reason}")]
@@ -233,6 +252,7 @@ impl Classify for SimError {
             | Self::NonFiniteDisturbance { .. }
             | Self::Controller { .. }
             | Self::RunawayError { .. }
+            | Self::JointRunaway { .. }
             | Self::JointLimits { .. } => ErrorClass::Numerical,
             _ => ErrorClass::InvalidInput,
         }
