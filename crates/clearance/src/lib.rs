@@ -20,5 +20,5 @@ pub use error::ClearanceError;
 pub use joint_gradient::joint_gradient;
 pub use modal_gradient::modal_gradients;
 pub use model::{ClearanceModel, MAX_OBSTACLES, MAX_PAIRS, Pair};
-pub use obstacle::Obstacle;
+pub use obstacle::{MAX_OBSTACLE_EXTENT, Obstacle};
 pub use place::{place, place_planar};

@@ -58,16 +58,16 @@ impl Obstacle {
     }
 
     /// A box turned by roll, pitch and yaw (URDF's convention, `R = Rz(yaw) Ry(pitch) Rx(roll)`).
-    /// Half-extents must be positive; `f64::INFINITY` makes the box a slab (a planar rectangle
-    /// with an infinite `z` half-extent).
+    /// Half-extents must be positive, at most [`MAX_OBSTACLE_EXTENT`] or `f64::INFINITY`, which
+    /// makes the box a slab (a planar rectangle with an infinite `z` half-extent).
     pub fn cuboid(center: V3, half_extents: V3, rpy: V3) -> Result<Self, ClearanceError> {
         check_point("box center", center)?;
-        check_point("box rpy", rpy)?;
+        rpy.iter().try_for_each(|&x| check_finite("box rpy", x))?;
         for h in half_extents {
-            if h.is_nan() || h <= 0.0 {
+            if h.is_nan() || h <= 0.0 || (h > MAX_OBSTACLE_EXTENT && h.is_finite()) {
                 return Err(ClearanceError::OutOfRange {
                     name: "box half_extents",
-                    bound: "positive",
+                    bound: "positive, and at most 1e15 or infinite (m)",
                     value: h,
                 });
             }
@@ -136,17 +136,29 @@ pub(crate) fn unit_or<const D: usize>(v: V<D>, fallback: V<D>) -> (V<D>, f64) {
     }
 }
 
+/// The largest magnitude of an obstacle's coordinates, radius and finite half-extents (m): the
+/// squares and sums of the distances stay far from overflow (a clearance is then finite), and
+/// an obstacle a billion kilometres away is still one.
+pub const MAX_OBSTACLE_EXTENT: f64 = 1e15;
+
 fn check_point(name: &'static str, point: V3) -> Result<(), ClearanceError> {
     point.iter().try_for_each(|&x| check_finite(name, x))?;
+    if let Some(&value) = point.iter().find(|x| x.abs() > MAX_OBSTACLE_EXTENT) {
+        return Err(ClearanceError::OutOfRange {
+            name,
+            bound: "at most 1e15 in magnitude (m)",
+            value,
+        });
+    }
     Ok(())
 }
 
 fn check_radius(radius: f64) -> Result<(), ClearanceError> {
     check_finite("obstacle radius", radius)?;
-    if radius < 0.0 {
+    if !(0.0..=MAX_OBSTACLE_EXTENT).contains(&radius) {
         return Err(ClearanceError::OutOfRange {
             name: "obstacle radius",
-            bound: "non-negative",
+            bound: "non-negative and at most 1e15 (m)",
             value: radius,
         });
     }

@@ -2,7 +2,7 @@
 //! evaluates, every field checked and named (`obstacles[2].radius`) when it fails.
 
 use super::schema::{ObstacleSpec, Scenario};
-use clearance::{ClearanceModel, Obstacle};
+use clearance::{ClearanceModel, MAX_OBSTACLE_EXTENT, Obstacle};
 use sim_core::SimError;
 
 /// The most obstacles a scenario may hold. With the paper's 10 links every controller sample
@@ -113,30 +113,37 @@ impl ObstacleSpec {
         let field = |name: &str| format!("obstacles[{index}].{name}");
         let point = |name: &str, values: &[f64]| -> Result<[f64; 3], SimError> {
             if values.len() != workspace.dims() {
+                let words = match (name, workspace) {
+                    ("half_extents", Workspace::Planar) => "[hx, hy]",
+                    ("half_extents", Workspace::Spatial) => "[hx, hy, hz]",
+                    _ => workspace.point_words(),
+                };
+                return Err(SimError::setting(
+                    field(name),
+                    format!("must be {words}, got {}", numbers(values.len())),
+                ));
+            }
+            if let Some(v) = values.iter().find(|v| !(v.abs() <= MAX_OBSTACLE_EXTENT)) {
                 return Err(SimError::setting(
                     field(name),
                     format!(
-                        "must be {}, got {}",
-                        workspace.point_words(),
-                        numbers(values.len())
+                        "must be finite and at most 1e15 in magnitude (m), got {}",
+                        lane_math::Compact(*v)
                     ),
-                ));
-            }
-            if let Some(v) = values.iter().find(|v| !v.is_finite()) {
-                return Err(SimError::setting(
-                    field(name),
-                    format!("must be finite (m), got {v}"),
                 ));
             }
             Ok([values[0], values[1], values.get(2).copied().unwrap_or(0.0)])
         };
         let radius = |r: f64| {
-            if r.is_finite() && r >= 0.0 {
+            if (0.0..=MAX_OBSTACLE_EXTENT).contains(&r) {
                 Ok(r)
             } else {
                 Err(SimError::setting(
                     field("radius"),
-                    format!("must be non-negative and finite (m), got {r}"),
+                    format!(
+                        "must be non-negative, finite and at most 1e15 (m), got {}",
+                        lane_math::Compact(r)
+                    ),
                 ))
             }
         };

@@ -97,19 +97,19 @@ fn malformed_obstacles_are_refused_with_the_field_named() {
                 "{circle}[[obstacles]]\nkind = \"circle\"\ncenter = [0.3, 0.6]\nradius = -0.05\n"
             ),
             Workspace::Planar,
-            "obstacles[1].radius must be non-negative and finite (m), got -0.05",
+            "obstacles[1].radius must be non-negative, finite and at most 1e15 (m), got -0.05",
         ),
         (
             &format!(
                 "{circle}{circle}[[obstacles]]\nkind = \"circle\"\ncenter = [0.3, 0.6]\nradius = nan\n"
             ),
             Workspace::Planar,
-            "obstacles[2].radius must be non-negative and finite (m), got NaN",
+            "obstacles[2].radius must be non-negative, finite and at most 1e15 (m), got NaN",
         ),
         (
             "[[obstacles]]\nkind = \"capsule\"\nfrom = [0.0, inf]\nto = [0.5, 1.0]\nradius = 0.02\n",
             Workspace::Planar,
-            "obstacles[0].from must be finite (m), got inf",
+            "obstacles[0].from must be finite and at most 1e15 in magnitude (m), got inf",
         ),
         (
             "[[obstacles]]\nkind = \"capsule\"\nfrom = [0.0, 1.0, 0.0]\nto = [0.5, 1.0]\nradius = 0.02\n",
@@ -130,6 +130,22 @@ fn malformed_obstacles_are_refused_with_the_field_named() {
             "[[obstacles]]\nkind = \"box\"\ncenter = [0.0, 1.0]\nhalf_extents = [0.1, 0.1]\nrpy = [0.5]\n",
             Workspace::Planar,
             "obstacles[0].rpy must be three angles [roll, pitch, yaw] (rad), got 1 number",
+        ),
+        // Beyond 1e15 m the squared distances overflow: the clearance would not be finite.
+        (
+            "[[obstacles]]\nkind = \"circle\"\ncenter = [1e155, 0.0]\nradius = 0.05\n",
+            Workspace::Planar,
+            "obstacles[0].center must be finite and at most 1e15 in magnitude (m), got 1e155",
+        ),
+        (
+            "[[obstacles]]\nkind = \"circle\"\ncenter = [0.3, 0.6]\nradius = 1e306\n",
+            Workspace::Planar,
+            "obstacles[0].radius must be non-negative, finite and at most 1e15 (m), got 1e306",
+        ),
+        (
+            "[[obstacles]]\nkind = \"box\"\ncenter = [0.0, 1.0]\nhalf_extents = [0.1]\n",
+            Workspace::Planar,
+            "obstacles[0].half_extents must be [hx, hy], got 1 number",
         ),
         (
             "[arm]\nradius = -1.0\n",
