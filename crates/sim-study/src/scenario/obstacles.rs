@@ -123,7 +123,10 @@ impl ObstacleSpec {
                     format!("must be {words}, got {}", numbers(values.len())),
                 ));
             }
-            if let Some(v) = values.iter().find(|v| !(v.abs() <= MAX_OBSTACLE_EXTENT)) {
+            if let Some(v) = values
+                .iter()
+                .find(|v| !v.is_finite() || v.abs() > MAX_OBSTACLE_EXTENT)
+            {
                 return Err(SimError::setting(
                     field(name),
                     format!(
