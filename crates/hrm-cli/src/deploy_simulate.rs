@@ -35,14 +35,22 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
 
 /// A warning when the arm's capsules reach the channel's walls or beyond (a negative smallest
 /// wall clearance over the run), which the run reports rather than refuses: a channel narrower
-/// than the arm, or a bend sharper than its links follow.
+/// than the arm or a bend sharper than its links follow (the plan reaches the walls too), or a
+/// tracking error that the plan does not have.
 pub fn wall_warning(run: &DeployRun) -> Option<String> {
     let clearance = run.metrics.min_wall_clearance;
     (clearance < 0.0).then(|| {
         format!(
-            "the arm reaches {:.2} mm into the channel's walls (smallest wall clearance); \
-             deploy.radius or the centreline's bends leave it no room",
-            -1e3 * clearance
+            "the arm reaches {:.2} mm into the channel's walls (smallest wall clearance; the \
+             plan's {:.2} mm): {}",
+            -1e3 * clearance,
+            1e3 * run.plan.min_wall_clearance,
+            if run.plan.min_wall_clearance < 0.0 {
+                "deploy.radius or the centreline's bends leave it no room"
+            } else {
+                "the plan keeps within them, the tracking does not (a shorter controller period, \
+                 a longer travel_time or computed torque tracks closer)"
+            }
         )
     })
 }
@@ -319,7 +327,25 @@ mod tests {
         deploy.radius = 0.5 * arm_radius;
         let run = scenario.run_deploy().unwrap();
         let warning = wall_warning(&run).unwrap();
-        assert!(warning.contains("into the channel's walls"), "{warning}");
+        assert!(
+            warning.contains("into the channel's walls")
+                && warning.contains("deploy.radius or the centreline's bends leave it no room"),
+            "{warning}"
+        );
         assert!(run.metrics.min_wall_clearance <= -0.5 * arm_radius);
+    }
+
+    #[test]
+    fn a_run_that_strays_from_a_clear_plan_is_warned_of_as_tracking() {
+        // The deployment MPC hurried through the bend: the plan keeps 25 mm from the walls,
+        // the tracking does not.
+        let mut scenario = Scenario::builtin("pipe-deploy").unwrap();
+        scenario.controller.kind = ControllerKind::Mpc;
+        scenario.reference = sim_study::ReferenceSpec::Planned { travel_time: 0.4 };
+        scenario.duration = 0.6;
+        let run = scenario.run_deploy().unwrap();
+        assert!(run.plan.min_wall_clearance > 0.0);
+        let warning = wall_warning(&run).unwrap();
+        assert!(warning.contains("the tracking does not"), "{warning}");
     }
 }

@@ -18,7 +18,7 @@ fn unused(name: &str, why: &str) -> SimError {
 
 impl Scenario {
     /// The first setting the joint-space loops (a URDF arm's and a deployment's) do not use,
-    /// as `(name, why)`: sensor noise, and any limit but `limits.max_modal_error` (and
+    /// as `(name, why)`: sensor noise, a clearance margin, and any limit but `limits.max_modal_error` (and
     /// `limits.joint_torque_nm` when `torque_box`: the deployment MPC's box).
     pub(super) fn unused_by_joint_space_loops(
         &self,
@@ -26,6 +26,13 @@ impl Scenario {
     ) -> Option<(&'static str, &'static str)> {
         if self.noise != NoiseSpec::default() {
             return Some(("noise", "the joint-space loop is noise-free"));
+        }
+        if self.controller.clearance_m.is_some() {
+            return Some((
+                "controller.clearance_m",
+                "the joint-space loop keeps no clearance margin (a deployment's channel is \
+                 followed by its plan)",
+            ));
         }
         if torque_box && self.limits.joint_angle_rad.is_none() && self.limits.tau_star.is_none() {
             return None;

@@ -321,6 +321,16 @@ fn deployment_keys_are_refused_by_name() {
     let mut alpha0 = base.clone();
     alpha0.alpha0 = Some(sim_study::Alpha0::Fixed(1.0));
     assert!(message(&alpha0).starts_with("alpha0 is not used with [deploy]"));
+    for kind in [ControllerKind::ComputedTorque, ControllerKind::Mpc] {
+        let mut margin = base.clone();
+        margin.controller.kind = kind;
+        margin.controller.clearance_m = Some(0.5);
+        assert!(
+            message(&margin).starts_with("controller.clearance_m is not used with [deploy]"),
+            "{}",
+            message(&margin)
+        );
+    }
     let mut fuzzy = base.clone();
     fuzzy.controller.kind = ControllerKind::Fuzzy;
     assert!(message(&fuzzy).starts_with("controller.kind must be \"computed-torque\" or \"mpc\""));
