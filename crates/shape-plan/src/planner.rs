@@ -115,7 +115,9 @@ impl<A: Arm> Planner<A> {
             .map(|d| (goal_point[d] - base[d]).powi(2))
             .sum::<f64>()
             .sqrt();
-        if distance > arm.length() {
+        // A target at the arm's length is the straight arm's tip, whatever the rounding of the
+        // sum of its links.
+        if distance > arm.length() * (1.0 + 4.0 * f64::EPSILON) {
             return Err(PlanError::OutOfReach {
                 distance,
                 length: arm.length(),

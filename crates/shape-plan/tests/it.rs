@@ -246,6 +246,14 @@ fn refusals_name_the_problem() {
         matches!(far, PlanError::OutOfReach { .. }) && far.is_unreachable(),
         "{far}"
     );
+    // The straight arm's own tip, at the arm's length (its links' sum rounds below it): in
+    // reach, and the start is already there.
+    let length: f64 = lengths().iter().sum();
+    assert!(length < 1.0);
+    let tip = [ALPHA0.cos(), ALPHA0.sin()];
+    let mut clear = planner(2, &[], options());
+    let plan = clear.plan(&[0.0; 4], &tip).unwrap();
+    assert!(plan.tip_error <= 1e-9, "{}", plan.tip_error);
     let wrong = p.plan(&[0.0; 3], &TARGET).unwrap_err();
     assert!(
         wrong.is_invalid_input() && wrong.to_string().contains("initial shape"),

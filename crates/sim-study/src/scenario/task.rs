@@ -97,7 +97,15 @@ impl Scenario {
                 .map_err(|e| SimError::setting("arm", format!("cannot be measured: {e}")))?,
         };
         let mut planner = Planner::new(arm, clearance_model, options).map_err(task_field)?;
-        planner.plan(initial, target).map_err(task_field)
+        planner.plan(initial, target).map_err(|e| match e {
+            // The start the scenario gives, or the straight arm of its default start: the
+            // clearance asked for is what it cannot keep there.
+            PlanError::InitialTooClose { .. } if self.initial.is_none() => SimError::setting(
+                "task.clearance",
+                format!("cannot be met from the arm's start (a = 0, no [initial]): {e}"),
+            ),
+            e => task_field(e),
+        })
     }
 
     /// The reference of kind `"planned"`: the plan's waypoints in `travel_time`

@@ -108,6 +108,12 @@ fn tasks_and_planned_references_come_together_and_name_their_fields() {
         e.starts_with("task.clearance cannot be met: clearance must be non-negative"),
         "{e}"
     );
+    // A clearance the start (a = 0, no [initial]) cannot keep names the clearance.
+    let e = with(&|s| set(s, vec![0.35, 0.55], 1e300));
+    assert!(
+        e.starts_with("task.clearance cannot be met from the arm's start (a = 0, no [initial])"),
+        "{e}"
+    );
     // A target inside an obstacle: no collision-free shape, the best clearance reported.
     let e = with(&|s| set(s, vec![-0.14, 0.36], 0.01));
     assert!(
