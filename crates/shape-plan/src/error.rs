@@ -1,6 +1,6 @@
 //! The error type of this crate.
 
-use lane_math::{Classify, ErrorClass, ShapeError, ShapeProblem};
+use lane_math::{Classify, Compact, ErrorClass, ShapeError, ShapeProblem};
 
 /// Why a plan was refused or not found; every variant names the condition.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -9,8 +9,11 @@ pub enum PlanError {
     /// No start led to a shape that reaches the target with the clearance: the best shape
     /// reached is reported (the one with the smallest tip error, ties broken by clearance).
     #[error(
-        "no collision-free shape found: the best shape reached has clearance {best_clearance} m \
-         (needed {needed} m) with its tip {tip_error} m from the target, after {starts} starts"
+        "no collision-free shape found: the best shape reached (the nearest to the target) has \
+         clearance {} m (needed {} m) with its tip {} m from the target, after {starts} starts",
+        Compact(*.best_clearance),
+        Compact(*.needed),
+        Compact(*.tip_error)
     )]
     NoCollisionFreeShape {
         /// The smallest clearance (to obstacles and to itself) of the best shape reached, m.
@@ -25,8 +28,9 @@ pub enum PlanError {
     /// Collision-free shapes reach the target but no checked path leads to any of them.
     #[error(
         "no collision-free motion found: {shapes} collision-free shapes reach the target, but \
-         every path tried from the initial shape comes within {best_clearance} m of a collision \
-         (needed {needed} m)"
+         every path tried from the initial shape comes within {} m of a collision (needed {} m)",
+        Compact(*.best_clearance),
+        Compact(*.needed)
     )]
     NoCollisionFreeMotion {
         /// How many goal shapes were found.
@@ -38,8 +42,9 @@ pub enum PlanError {
     },
     /// The initial shape is already closer to an obstacle or to itself than the margin.
     #[error(
-        "the initial shape has clearance {clearance} m, less than the {needed} m the motion \
-         must keep"
+        "the initial shape has clearance {} m, less than the {} m the motion must keep",
+        Compact(*.clearance),
+        Compact(*.needed)
     )]
     InitialTooClose {
         /// The initial shape's smallest clearance, m.
@@ -48,7 +53,11 @@ pub enum PlanError {
         needed: f64,
     },
     /// The target is farther from the base than the arm is long.
-    #[error("target is {distance} m from the base, beyond the arm's length {length} m")]
+    #[error(
+        "target is {} m from the base, beyond the arm's length {} m",
+        Compact(*.distance),
+        Compact(*.length)
+    )]
     OutOfReach {
         /// Distance of the target from the base, m.
         distance: f64,
@@ -56,7 +65,7 @@ pub enum PlanError {
         length: f64,
     },
     /// A number outside its domain.
-    #[error("{name} must be {bound}, got {value}")]
+    #[error("{name} must be {bound}, got {}", Compact(*.value))]
     OutOfRange {
         /// Which input.
         name: &'static str,
