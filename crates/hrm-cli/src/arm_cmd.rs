@@ -6,7 +6,7 @@ use crate::console;
 use crate::output_dir::OutputDir;
 use clap::{Args, Subcommand, ValueEnum};
 use robot_desc::{Robot, read_urdf, write_mjcf_files, write_urdf};
-use sim_study::{ArmSpec, Scenario};
+use sim_study::{ArmKind, ArmSpec, Scenario};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -65,6 +65,10 @@ pub fn run(args: ArmArgs) -> Result<(), String> {
     }
 }
 
+/// Most links of a spatial arm that `hrm arm export` and eval's `export` write (about 0.7 MB of
+/// URDF per 1,000 links: well within [`robot_desc::MAX_URDF_BYTES`], so that it reads back).
+pub const MAX_SPATIAL_EXPORT_LINKS: usize = 10_000;
+
 /// The text of a URDF file, read up to [`robot_desc::MAX_URDF_BYTES`].
 fn read_urdf_file(path: &Path) -> Result<String, String> {
     sim_study::read_text_file(path, robot_desc::MAX_URDF_BYTES as u64)
@@ -121,7 +125,8 @@ fn check(path: &Path) -> Result<(), String> {
     console::print(&out)
 }
 
-/// The robot of a `.urdf` file (default gravity [`DEFAULT_GRAVITY`]) or of a scenario's arm.
+/// The robot of a `.urdf` file (default gravity [`DEFAULT_GRAVITY`]) or of a scenario's modal
+/// arm, planar or spatial (a scenario's URDF arm is its file).
 fn robot_of(source: &str) -> Result<(Robot, [f64; 3]), String> {
     let path = Path::new(source);
     if path
@@ -135,6 +140,27 @@ fn robot_of(source: &str) -> Result<(Robot, [f64; 3]), String> {
         return Ok((robot, DEFAULT_GRAVITY));
     }
     let scenario = Scenario::resolve(source).map_err(|e| e.to_string())?;
+    if let Some(urdf) = &scenario.arm.urdf {
+        return Err(format!(
+            "{source}: its arm is the URDF file arm.urdf = {:?}: export that file \
+             (hrm arm export FILE.urdf)",
+            urdf.display()
+        ));
+    }
+    if scenario.arm.kind == ArmKind::Spatial {
+        // The universal-joint snake, its movable joints in the order of theta.
+        let model = scenario
+            .spatial_model()
+            .map_err(|e| format!("{source}: {e}"))?;
+        if model.n_links() > MAX_SPATIAL_EXPORT_LINKS {
+            return Err(format!(
+                "{source}: arm.links must be at most {MAX_SPATIAL_EXPORT_LINKS} for export, got {}",
+                model.n_links()
+            ));
+        }
+        let robot = robot_desc::from_spatial_arm(&model, "hrm_spatial_arm");
+        return Ok((robot, model.gravity()));
+    }
     planar_robot(&scenario.arm, "hrm_planar_arm")
 }
 

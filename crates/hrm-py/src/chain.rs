@@ -68,7 +68,7 @@ impl Workspace {
 ///
 /// Build with `Chain.from_urdf(urdf, gravity=(0, 0, -9.81))` or `Arm.from_urdf(...)`; `urdf`
 /// is URDF text, a path-like object, or a string ending in `.urdf` naming a regular file of at
-/// most 8 MiB.
+/// most 32 MiB.
 ///
 /// Every method takes one state (arrays of shape (n,)) or a batch (shape (N, n)) and answers
 /// with the same leading dimension; a batch runs with the GIL released, on all cores from 512

@@ -8,8 +8,10 @@ use crate::pose::Pose;
 use roxmltree::{Document, Node, ParsingOptions};
 use std::collections::{BTreeMap, HashMap};
 
-/// Longest URDF text read (bytes). A chain of 1000 links with geometry takes about 1 MB.
-pub const MAX_URDF_BYTES: usize = 8 << 20;
+/// Longest URDF text read (bytes). A chain of 1000 links with geometry takes about 1 MB, and
+/// what [`write_urdf`](crate::write_urdf) writes of a chain read within this bound (about 400
+/// bytes a joint) fits in it up to some 80,000 joints.
+pub const MAX_URDF_BYTES: usize = 32 << 20;
 
 /// Deepest element nesting read. URDF needs five levels (`robot > link > visual > geometry >
 /// box`); a document nesting deeper is refused before anything is built from it.

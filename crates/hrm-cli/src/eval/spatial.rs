@@ -3,6 +3,7 @@
 //! (`docs/eval-protocol.md`, "Spatial arms").
 
 use super::request::{EvalError, EvalResult, finite, json_fields};
+use crate::arm_cmd::MAX_SPATIAL_EXPORT_LINKS;
 use backbone_kin::{
     BasePose, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, SpatialModalMap,
     spatial_tip_position,
@@ -23,9 +24,6 @@ const MAX_SPATIAL_HARMONICS: usize = 16;
 /// Most entries of an answer's Jacobian or of the work of `reduced` (`2n x 4K`, and `n m^2`):
 /// about 0.1 s of work and 64 MB of JSON at most.
 const MAX_SPATIAL_WORK: usize = 1 << 22;
-
-/// Most links of a spatial arm `export` writes (about 1.4 MB of URDF per 1,000 links).
-const MAX_SPATIAL_EXPORT_LINKS: usize = 10_000;
 
 /// Whether a request's `"arm"` is a spatial arm (`"kind": "spatial"`).
 pub(super) fn is_spatial(request: &Map<String, Value>) -> bool {

@@ -140,6 +140,38 @@ fn an_exported_urdf_reads_back_to_the_same_chain_bit_for_bit() {
 }
 
 #[test]
+fn a_spatial_scenarios_arm_exports_and_a_urdf_arm_is_its_file() {
+    let dir = scratch("arm-export-spatial");
+    let out = dir.join("out");
+    succeeds(&[
+        "arm",
+        "export",
+        "spatial-tracking",
+        "--format",
+        "urdf",
+        "--out",
+        path(&out),
+    ]);
+    // Ten universal joints: twenty movable joints, theta's order.
+    let robot = robot(&out.join("hrm_spatial_arm.urdf"));
+    assert_eq!(robot.n_joints(), 20);
+    let said = fails(&[
+        "arm",
+        "export",
+        path(&example().with_file_name("step.toml")),
+        "--format",
+        "urdf",
+        "--out",
+        path(&dir.join("urdf-arm")),
+    ]);
+    assert!(
+        said.contains("its arm is the URDF file arm.urdf") && said.contains("arm7.urdf"),
+        "{said}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn the_mjcf_export_carries_gravity_and_every_joint() {
     let dir = scratch("arm-export-mjcf");
     let out = dir.join("urdf");
