@@ -83,11 +83,11 @@ fn check(path: &Path) -> Result<(), String> {
     let _ = writeln!(
         out,
         "robot '{}': {} links and {} joints read; a serial chain of {} movable joints on base '{}'",
-        robot.name,
+        name(&robot.name),
         report.links,
         report.joints,
         robot.n_joints(),
-        robot.base.name
+        name(&robot.base.name)
     );
     for (i, joint) in robot.joints.iter().enumerate() {
         let _ = writeln!(
@@ -95,9 +95,9 @@ fn check(path: &Path) -> Result<(), String> {
             "  {:>3} {} '{}' axis {:?} -> link '{}' (mass {} kg){}",
             i + 1,
             joint.kind.urdf_name(),
-            joint.name,
+            name(&joint.name),
             joint.axis,
-            joint.child.name,
+            name(&joint.child.name),
             joint.child.inertial.mass,
             if joint.child.inertial.is_massless() {
                 ", massless"
@@ -113,16 +113,24 @@ fn check(path: &Path) -> Result<(), String> {
         let _ = writeln!(
             out,
             "merged: link '{}' into '{}' (fixed joint '{}')",
-            merged.link, merged.into, merged.joint
+            name(&merged.link),
+            name(&merged.into),
+            name(&merged.joint)
         );
     }
     if report.ignored.is_empty() {
         out.push_str("ignored: none\n");
     }
     for (path, count) in &report.ignored {
-        let _ = writeln!(out, "ignored: <{path}> x{count}");
+        let _ = writeln!(out, "ignored: <{}> x{count}", name(path));
     }
     console::print(&out)
+}
+
+/// A name from the file as one line of the report: a line break or tab in it escaped (`\n`),
+/// as the error messages quote names.
+fn name(text: &str) -> String {
+    console::escape_field(text)
 }
 
 /// The robot of a `.urdf` file (default gravity [`DEFAULT_GRAVITY`]) or of a scenario's modal

@@ -149,7 +149,8 @@ pub(crate) fn numbers(values: &[f64]) -> String {
     text
 }
 
-/// Text safe inside a double-quoted XML attribute.
+/// Text safe inside a double-quoted XML attribute, read back unchanged: a line break or tab is
+/// written as a character reference, since a reader normalises a literal one to a space.
 pub(crate) fn escape(text: &str) -> String {
     let mut escaped = String::with_capacity(text.len());
     for c in text.chars() {
@@ -159,6 +160,9 @@ pub(crate) fn escape(text: &str) -> String {
             '>' => escaped.push_str("&gt;"),
             '"' => escaped.push_str("&quot;"),
             '\'' => escaped.push_str("&apos;"),
+            '\n' => escaped.push_str("&#10;"),
+            '\r' => escaped.push_str("&#13;"),
+            '\t' => escaped.push_str("&#9;"),
             c => escaped.push(c),
         }
     }

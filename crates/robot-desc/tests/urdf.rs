@@ -249,6 +249,15 @@ fn read_write_read_is_the_same_model_bit_for_bit() {
         &arm,
         &read_urdf(&write_urdf(&arm)).unwrap().robot
     ));
+    // Names with a line break, a tab and markup characters, told apart from their spaced
+    // versions: written as character references, they read back as they were.
+    let names = chain_with("", "")
+        .replace("name=\"a\"", "name=\"p&#10;q\"")
+        .replace("link=\"a\"", "link=\"p&#10;q\"")
+        .replace("name=\"j\"", "name=\"j&#9;&lt;&amp;&quot;\"");
+    let robot = read_urdf(&names).unwrap().robot;
+    assert_eq!(robot.joints[0].name, "j\t<&\"");
+    assert_eq!(read_urdf(&write_urdf(&robot)).unwrap().robot, robot);
 }
 
 /// Refused, with a message containing every one of `needles`, in well under a second.

@@ -140,6 +140,27 @@ fn an_exported_urdf_reads_back_to_the_same_chain_bit_for_bit() {
 }
 
 #[test]
+fn check_quotes_names_with_line_breaks_on_one_line() {
+    let dir = scratch("arm-check-names");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("names.urdf");
+    std::fs::write(
+        &file,
+        "<robot name=\"r\"><link name=\"a&#10;hrm: fake\"/><joint name=\"j&#10;x\" \
+         type=\"continuous\"><parent link=\"a&#10;hrm: fake\"/><child link=\"b\"/></joint>\
+         <link name=\"b\"/></robot>",
+    )
+    .unwrap();
+    let said = succeeds(&["arm", "check", path(&file)]);
+    assert!(
+        said.contains("base 'a\\nhrm: fake'") && said.contains("'j\\nx'"),
+        "{said}"
+    );
+    assert!(!said.lines().any(|l| l.starts_with("hrm: fake")), "{said}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn a_spatial_scenarios_arm_exports_and_a_urdf_arm_is_its_file() {
     let dir = scratch("arm-export-spatial");
     let out = dir.join("out");
