@@ -108,7 +108,17 @@ pub fn read_urdf(text: &str) -> Result<Reading, DescError> {
     let mut links: Vec<UrdfLink> = Vec::new();
     let mut joints: Vec<UrdfJoint> = Vec::new();
     for child in root.children().filter(Node::is_element) {
-        match child.tag_name().name() {
+        let tag = child.tag_name();
+        // An element of another namespace (`xacro:property`) is not URDF's, whatever its name.
+        if tag.namespace() != root.tag_name().namespace() {
+            let prefix = tag.namespace().and_then(|uri| child.lookup_prefix(uri));
+            ignore(
+                &mut report,
+                &format!("{}:{}", prefix.unwrap_or_default(), tag.name()),
+            );
+            continue;
+        }
+        match tag.name() {
             "link" => links.push(read_link(child, &mut report)?),
             "joint" => joints.push(read_joint(child, &mut report)?),
             other => ignore(&mut report, other),

@@ -102,6 +102,22 @@ fn reads_joints_bodies_limits_geometry_and_reports_what_it_merged_and_ignored() 
     ] {
         assert!(reading.report.ignored.contains_key(ignored), "{ignored}");
     }
+    // An element of another namespace is not URDF's, whatever its local name: listed with its
+    // prefix, never read as a link.
+    let xacro = ARM
+        .replace(
+            "<robot name=\"arm\">",
+            "<robot name=\"arm\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">",
+        )
+        .replace(
+            "<gazebo reference=\"tool\"/>",
+            "<xacro:link name=\"zz\"/><xacro:property name=\"p\" value=\"1\"/>",
+        );
+    let reading = read_urdf(&xacro).unwrap();
+    assert_eq!(reading.robot, *robot);
+    for ignored in ["xacro:link", "xacro:property"] {
+        assert!(reading.report.ignored.contains_key(ignored), "{ignored}");
+    }
 }
 
 /// The forearm (1 kg, centre at x = 0.15) and tool (0.5 kg at x = 0.3): centre of mass and
