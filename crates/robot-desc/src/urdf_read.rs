@@ -838,10 +838,17 @@ fn weld(
             if joint.kind.is_some() {
                 if let Some((other, _)) = movable {
                     let other = chain.joints[other].as_ref().expect("still there");
+                    // The body the two hang from, and the link behind a fixed joint that
+                    // carries the second when it is another.
+                    let welded = if link_name == body.name {
+                        String::new()
+                    } else {
+                        format!(" (the second through link '{link_name}', fixed to it)")
+                    };
                     return Err(DescError::not_a_chain(
-                        format!("link '{link_name}'"),
+                        format!("link '{}'", body.name),
                         format!(
-                            "has two movable joints below it, '{}' and '{}' (a tree)",
+                            "has two movable joints below it, '{}' and '{}'{welded} (a tree)",
                             other.name, joint.name
                         ),
                     ));

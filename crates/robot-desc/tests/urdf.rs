@@ -416,6 +416,20 @@ fn what_is_not_a_serial_chain_is_refused_naming_the_element() {
         tree,
         &["link 'a'", "two movable joints", "'j1'", "'j2'", "tree"],
     );
+    // A tree hidden behind a fixed joint: the body both hang from is named, and the link the
+    // second hangs from.
+    let hidden = r#"<robot name="r"><link name="a"/><link name="s"/><link name="b"/><link name="c"/>
+      <joint name="j1" type="revolute"><parent link="a"/><child link="b"/></joint>
+      <joint name="f" type="fixed"><parent link="a"/><child link="s"/></joint>
+      <joint name="j2" type="revolute"><parent link="s"/><child link="c"/></joint></robot>"#;
+    refused(
+        hidden,
+        &[
+            "link 'a': has two movable joints",
+            "through link 's'",
+            "tree",
+        ],
+    );
     let diamond = r#"<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
       <joint name="j1" type="revolute"><parent link="a"/><child link="b"/></joint>
       <joint name="j2" type="revolute"><parent link="b"/><child link="c"/></joint>
