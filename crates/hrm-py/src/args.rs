@@ -10,7 +10,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyString};
 
 /// The `TypeError` for argument `name` given a `value` of the wrong type.
-fn wrong_type(name: &str, expected: &str, value: &Bound<'_, PyAny>) -> PyErr {
+pub(crate) fn wrong_type(name: &str, expected: &str, value: &Bound<'_, PyAny>) -> PyErr {
     let given = value
         .get_type()
         .name()
@@ -67,16 +67,19 @@ pub(crate) fn path(value: &Bound<'_, PyAny>, name: &str) -> PyResult<std::path::
     })
 }
 
-/// A 3-vector for argument `name` (a gravity vector, a position, roll-pitch-yaw angles).
+/// A finite 3-vector for argument `name` (a gravity vector, a position, roll-pitch-yaw angles).
 pub(crate) fn vec3(value: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; 3]> {
     let values = reals(value, name)?;
-    values.as_slice().try_into().map_err(|_| {
+    let vector: [f64; 3] = values.as_slice().try_into().map_err(|_| {
         Error::input(format!(
             "{name} must have 3 entries (x, y, z), got {}",
             values.len()
         ))
-        .into()
-    })
+    })?;
+    if let Some((i, v)) = vector.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(Error::input(format!("{name}[{i}] must be finite, got {v}")).into());
+    }
+    Ok(vector)
 }
 
 /// Rows of three real numbers for argument `name` (per-link principal inertias): an `(n, 3)`

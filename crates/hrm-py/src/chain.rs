@@ -31,11 +31,8 @@ fn urdf_text(source: &Bound<'_, PyAny>) -> PyResult<String> {
         }
         PathBuf::from(text)
     } else {
-        let kind = source.get_type().name()?.to_string();
         source.extract::<PathBuf>().map_err(|_| {
-            Error::input(format!(
-                "urdf must be URDF text or a path to a .urdf file, got a {kind}"
-            ))
+            crate::args::wrong_type("urdf", "URDF text or a path to a .urdf file", source)
         })?
     };
     sim_study::read_text_file(&path, MAX_URDF_BYTES as u64)

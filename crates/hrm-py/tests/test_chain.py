@@ -128,16 +128,17 @@ def test_from_urdf_reads_paths_and_text(tmp_path):
         hrm.Chain.from_urdf(tmp_path / "dir.urdf")
     big = tmp_path / "big.urdf"
     with big.open("wb") as f:
-        f.truncate((8 << 20) + 1)
+        f.truncate((32 << 20) + 1)
     with pytest.raises(hrm.InvalidInput, match="more than"):
         hrm.Chain.from_urdf(big)
     with pytest.raises(hrm.InvalidInput, match="urdf"):
         hrm.Chain.from_urdf("<robot")
     with pytest.raises(hrm.InvalidInput, match="no movable joint"):
         hrm.Chain.from_urdf('<robot name="r"><link name="a"/></robot>')
-    with pytest.raises(hrm.InvalidInput, match="URDF text or a path"):
-        hrm.Chain.from_urdf(42)
-    with pytest.raises(hrm.InvalidInput, match="gravity"):
+    for wrong in [42, None]:
+        with pytest.raises(TypeError, match="urdf must be URDF text or a path to a .urdf file, got a"):
+            hrm.Chain.from_urdf(wrong)
+    with pytest.raises(hrm.InvalidInput, match=r"^gravity\[1\] must be finite, got NaN$"):
         hrm.Chain.from_urdf(text, gravity=(0.0, float("nan"), 0.0))
 
 
