@@ -75,5 +75,10 @@ fn bias_terms(
     check::output("out", out, n)?;
     update_placements(model, data, q);
     newton_euler(model, data, v, None, with_gravity, out);
-    check::finite_result("out", out)
+    let name = match (v, with_gravity) {
+        (Some(_), true) => "nonlinear effects",
+        (Some(_), false) => "coriolis",
+        (None, _) => "gravity",
+    };
+    check::finite_result(name, out)
 }
