@@ -191,9 +191,10 @@ fn parse_gravity(text: &str) -> Result<[f64; 3], String> {
         })
         .collect::<Result<_, _>>()?;
     match values[..] {
-        [x, y, z] if values.iter().all(|v| v.is_finite()) => Ok([x, y, z]),
+        [x, y, z] if values.iter().all(|v| v.abs() <= robot_desc::MAX_MAGNITUDE) => Ok([x, y, z]),
         _ => Err(format!(
-            "--gravity must be three finite numbers \"gx gy gz\", got {text:?}"
+            "--gravity must be three finite numbers \"gx gy gz\" of at most 1e9 in magnitude, \
+             got {text:?}"
         )),
     }
 }
@@ -226,6 +227,12 @@ fn file_stem(name: &str) -> String {
 }
 
 fn export(source: &str, format: Format, out: &Path, gravity: Option<&str>) -> Result<(), String> {
+    if format == Format::Urdf && gravity.is_some() {
+        return Err(
+            "--gravity is written only to MJCF (URDF carries none): leave it out with --format urdf"
+                .to_string(),
+        );
+    }
     let (robot, default_gravity) = robot_of(source)?;
     let gravity = gravity
         .map(parse_gravity)
@@ -259,6 +266,7 @@ mod tests {
                 .contains("three finite numbers")
         );
         assert!(parse_gravity("0 0 NaN").is_err());
+        assert!(parse_gravity("0 0 1e308").unwrap_err().contains("1e9"));
         assert!(parse_gravity("0 0 x").unwrap_err().contains("\"x\""));
     }
 

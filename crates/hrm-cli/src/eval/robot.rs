@@ -32,13 +32,16 @@ fn robot(urdf: &str) -> Result<Robot, EvalError> {
     Ok(robot)
 }
 
-/// `"gravity"`: three finite numbers, or `default` when absent.
+/// `"gravity"`: three finite numbers of at most [`robot_desc::MAX_MAGNITUDE`] (the bound of a
+/// URDF's numbers), or `default` when absent.
 fn gravity(requested: Option<Vec<f64>>, default: [f64; 3]) -> Result<[f64; 3], EvalError> {
+    let bounded = |g: &f64| g.abs() <= robot_desc::MAX_MAGNITUDE;
     match requested.as_deref() {
         None => Ok(default),
-        Some(&[x, y, z]) if [x, y, z].iter().all(|g| g.is_finite()) => Ok([x, y, z]),
+        Some(&[x, y, z]) if [x, y, z].iter().all(bounded) => Ok([x, y, z]),
         Some(values) => Err(EvalError::input(format!(
-            "gravity must be three finite numbers [gx, gy, gz], got {values:?}"
+            "gravity must be three finite numbers [gx, gy, gz] of at most 1e9 in magnitude, got \
+             {values:?}"
         ))),
     }
 }
@@ -252,6 +255,11 @@ pub(super) fn export(request: ExportRequest) -> EvalResult {
             ));
         }
     };
+    if request.format == "urdf" && request.gravity.is_some() {
+        return Err(EvalError::input(
+            "gravity is written only to MJCF (URDF carries none): leave it out with format \"urdf\"",
+        ));
+    }
     let gravity = gravity(request.gravity, default_gravity)?;
     let text = match request.format.as_str() {
         "urdf" => robot_desc::write_urdf(&robot),

@@ -189,6 +189,19 @@ fn a_spatial_scenarios_arm_exports_and_a_urdf_arm_is_its_file() {
         said.contains("its arm is the URDF file arm.urdf") && said.contains("arm7.urdf"),
         "{said}"
     );
+    // URDF carries no gravity: --gravity with it is refused, not dropped.
+    let said = fails(&[
+        "arm",
+        "export",
+        "spatial-tracking",
+        "--format",
+        "urdf",
+        "--gravity",
+        "0 0 -1",
+        "--out",
+        path(&dir.join("gravity")),
+    ]);
+    assert!(said.contains("--gravity is written only to MJCF"), "{said}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -130,6 +130,14 @@ fn bad_robot_requests_get_one_clear_error() {
             json!({"op": "export", "urdf": massless, "format": "mjcf"}),
             "MuJoCo refuses massless moving bodies",
         ),
+        (
+            json!({"op": "export", "urdf": urdf, "format": "urdf", "gravity": [0.0, 0.0, -1.0]}),
+            "gravity is written only to MJCF",
+        ),
+        (
+            json!({"op": "export", "urdf": urdf, "format": "mjcf", "gravity": [0.0, 0.0, 1e308]}),
+            "at most 1e9 in magnitude",
+        ),
     ];
     let requests: Vec<Value> = cases.iter().map(|(r, _)| r.clone()).collect();
     for (answer, (_, needle)) in eval(&requests).iter().zip(&cases) {
