@@ -945,7 +945,8 @@ pub fn view_html(scene: &str) -> PyResult<String> {
 /// controller sample) and the summary metrics.
 ///
 /// A run that stopped early (runaway tracking error, integrator failure) has `failure` set to
-/// the reason and holds the data up to the stop, the failing sample included; its summary has
+/// the reason and holds the data up to the stop (a runaway error's sample included; a sample
+/// whose controller or integration failed has no torque and is not); its summary has
 /// the extra keys "error" and "stopped_at_s", as the summary.json of `hrm simulate` does.
 #[pyclass(module = "hrm", frozen)]
 pub struct Run {
