@@ -1,10 +1,11 @@
 //! `[task]`: what the arm must achieve, planned before the controller runs (`shape-plan`), and
 //! the reference of kind `"planned"` that follows the plan.
 
-use super::schema::{ReferenceSpec, Scenario, TaskSpec};
-use clearance::ClearanceModel;
+use super::schema::{AngleLimit, ReferenceSpec, Scenario, TaskSpec};
+use clearance::{ClearanceData, ClearanceModel};
+use lane_math::Compact;
 use modal_reduce::PlantModel;
-use shape_plan::{Arm, Plan, PlanError, PlanOptions, PlanarArm, Planner, SpatialArm};
+use shape_plan::{Arm, ArmScratch, Plan, PlanError, PlanOptions, PlanarArm, Planner, SpatialArm};
 use sim_core::SimError;
 use sim_core::reference::Waypoints;
 
@@ -97,7 +98,7 @@ impl Scenario {
                 .map_err(|e| SimError::setting("arm", format!("cannot be measured: {e}")))?,
         };
         let mut planner = Planner::new(arm, clearance_model, options).map_err(task_field)?;
-        planner.plan(initial, target).map_err(|e| match e {
+        let plan = planner.plan(initial, target).map_err(|e| match e {
             // The start the scenario gives, or the straight arm of its default start: the
             // clearance asked for is what it cannot keep there.
             PlanError::InitialTooClose { .. } if self.initial.is_none() => SimError::setting(
@@ -105,7 +106,45 @@ impl Scenario {
                 format!("cannot be met from the arm's start (a = 0, no [initial]): {e}"),
             ),
             e => task_field(e),
-        })
+        })?;
+        self.check_plan_angles(&planner, &plan)?;
+        Ok(plan)
+    }
+
+    /// Refuses a plan whose waypoints turn a joint beyond `limits.joint_angle_rad`: the planner
+    /// keeps clearance, not joint angles, and the run would stop at the first limit its
+    /// projection cannot keep.
+    fn check_plan_angles<A: Arm>(&self, planner: &Planner<A>, plan: &Plan) -> Result<(), SimError> {
+        let Some(limits) = &self.limits.joint_angle_rad else {
+            return Ok(());
+        };
+        let (arm, clearance) = (planner.arm(), planner.clearance());
+        let mut scratch = ArmScratch::new(arm);
+        let mut data = ClearanceData::new(clearance, arm.n_coords())
+            .map_err(|e| SimError::setting("arm", format!("cannot be measured: {e}")))?;
+        for (k, a) in plan.path.iter().enumerate() {
+            arm.place(clearance, &mut data, &mut scratch, a)
+                .map_err(task_field)?;
+            for (j, theta) in scratch.theta.iter().enumerate() {
+                let limit = match limits {
+                    AngleLimit::All(limit) => *limit,
+                    AngleLimit::PerJoint(limits) => limits.get(j).copied().unwrap_or(f64::INFINITY),
+                };
+                if theta.abs() > limit {
+                    return Err(SimError::setting(
+                        "limits.joint_angle_rad",
+                        format!(
+                            "cannot be kept by the [task]'s plan (the planner keeps clearance, not \
+                             joint angles): its waypoint {k} turns joint {} to {} rad, beyond {} rad",
+                            j + 1,
+                            Compact(*theta),
+                            Compact(limit)
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The reference of kind `"planned"`: the plan's waypoints in `travel_time`

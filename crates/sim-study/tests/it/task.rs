@@ -9,7 +9,9 @@ use backbone_kin::{
     spatial_joint_positions,
 };
 use sim_study::study::run_one;
-use sim_study::{ControllerKind, ObstacleSpec, ReferenceSpec, Scenario, TaskSpec, Workspace};
+use sim_study::{
+    AngleLimit, ControllerKind, ObstacleSpec, ReferenceSpec, Scenario, TaskSpec, Workspace,
+};
 
 fn target(scenario: &Scenario) -> [f64; 2] {
     let Some(TaskSpec::Reach { target, .. }) = &scenario.task else {
@@ -114,6 +116,21 @@ fn tasks_and_planned_references_come_together_and_name_their_fields() {
         e.starts_with("task.clearance cannot be met from the arm's start (a = 0, no [initial])"),
         "{e}"
     );
+    // The planner keeps clearance, not joint angles: a plan beyond limits.joint_angle_rad is
+    // refused by name, one within them builds.
+    let e = with(&|s| {
+        let mut limits = vec![0.3; 10];
+        limits[0] = 3.0;
+        s.limits.joint_angle_rad = Some(AngleLimit::PerJoint(limits));
+    });
+    assert!(
+        e.starts_with("limits.joint_angle_rad cannot be kept by the [task]'s plan")
+            && e.contains("beyond 0.3 rad"),
+        "{e}"
+    );
+    let mut roomy = base.clone();
+    roomy.limits.joint_angle_rad = Some(AngleLimit::All(3.0));
+    assert!(roomy.build().is_ok());
     // A target inside an obstacle: no collision-free shape, the best clearance reported.
     let e = with(&|s| set(s, vec![-0.14, 0.36], 0.01));
     assert!(
