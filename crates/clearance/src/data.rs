@@ -3,9 +3,14 @@
 
 use crate::closest::{Closest, Segment};
 use crate::error::ClearanceError;
-use crate::modal_gradient::LANES;
 use crate::model::ClearanceModel;
 use crate::vector::V3;
+
+/// The coordinates of a block of the planar prefix sums: an AVX2 register of `f64`.
+pub(crate) const LANES: usize = 4;
+
+/// [`LANES`] coordinates of the planar prefix sums, coordinate by coordinate.
+pub(crate) type Block = [[f64; LANES]; 3];
 
 /// The most modal gradient entries (pairs times coordinates) a [`ClearanceData`] holds: `2^25`.
 pub const MAX_GRADIENT_ENTRIES: usize = 1 << 25;
@@ -44,7 +49,7 @@ pub struct ClearanceData {
     /// A planar chain's prefix sums `T_il = sum_{j <= i} J_jl (p_jy, -p_jx, 1)`, in blocks of
     /// [`LANES`] coordinates (`[x; LANES], [y; LANES], [s; LANES]`, zero past `m`): `n` rows of
     /// `ceil(m / LANES)` blocks.
-    pub(crate) prefix_planar: Vec<[[f64; LANES]; 3]>,
+    pub(crate) prefix_planar: Vec<Block>,
 }
 
 impl ClearanceData {

@@ -1,7 +1,7 @@
 //! The gradients of every pair's clearance with respect to the modal coordinates.
 
 use crate::closest::Closest;
-use crate::data::ClearanceData;
+use crate::data::{Block, ClearanceData, LANES};
 use crate::distances::in_registers;
 use crate::error::ClearanceError;
 use crate::model::ClearanceModel;
@@ -9,12 +9,6 @@ use crate::vector::{V3, add, cross, dot, scale, sub};
 use backbone_kin::ModalMap;
 use lane_math::check_len;
 use pulp::{Simd, WithSimd};
-
-/// The coordinates of a block of the planar prefix sums: an AVX2 register of `f64`.
-pub(crate) const LANES: usize = 4;
-
-/// [`LANES`] coordinates of the planar prefix sums, coordinate by coordinate.
-pub(crate) type Block = [[f64; LANES]; 3];
 
 /// Fills every pair's `d d / d a = J^T d d / d theta` (after [`distances`](crate::distances)),
 /// for the constant modal map `theta = J a + theta_0` (eq 8). Allocation-free.
