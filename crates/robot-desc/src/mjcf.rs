@@ -15,7 +15,6 @@
 use crate::error::DescError;
 use crate::model::{Body, Inertial, Joint, JointKind, Robot, Shape};
 use crate::pose::{Mat3, Pose, mat_vec, matrix_quaternion, transpose};
-use crate::urdf_read::principal_moments;
 use crate::urdf_write::{escape, numbers};
 use std::fmt::Write;
 
@@ -134,7 +133,7 @@ fn bodies(robot: &Robot) -> Result<Vec<MjBody<'_>>, DescError> {
 
 /// MuJoCo's own requirement of a moving body: positive mass and a positive definite inertia.
 fn check_mass(body: &Body) -> Result<(), DescError> {
-    let moments = principal_moments(&body.inertial.inertia);
+    let moments = body.inertial.principal().values;
     if body.inertial.mass > 0.0 && moments[0] > 0.0 {
         return Ok(());
     }
