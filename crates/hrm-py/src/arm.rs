@@ -163,7 +163,8 @@ impl Arm {
     }
 
     /// The arm as one MJCF document for MuJoCo (as `to_urdf`), its gravity along -y in
-    /// `<option>`.
+    /// `<option>`. Raises InvalidInput, naming the link, for a mass or inertia below MuJoCo's
+    /// mjMINVAL (1e-15), which MuJoCo refuses.
     fn to_mjcf(&self) -> PyResult<String> {
         let (robot, gravity) = crate::chain::planar_robot(&self.chain);
         crate::chain::mjcf(&robot, gravity)

@@ -277,7 +277,9 @@ impl Chain {
     }
 
     /// The chain as one MJCF document for MuJoCo, the gravity vector in `<option>`. Raises
-    /// InvalidInput past the bodies MuJoCo's parser nests in one document (use `hrm arm export`).
+    /// InvalidInput past the bodies MuJoCo's parser nests in one document (use `hrm arm export`)
+    /// and, naming the link, for what MuJoCo refuses (a moving body's mass or principal moment
+    /// below mjMINVAL, 1e-15).
     fn to_mjcf(&self) -> PyResult<String> {
         mjcf(&self.robot, self.model.gravity())
     }

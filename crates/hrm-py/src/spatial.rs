@@ -682,8 +682,9 @@ impl SpatialArm {
     }
 
     /// The arm's chain as MJCF text for MuJoCo, its gravity in `<option>` (the two hinges of a
-    /// universal joint in one body). MuJoCo refuses singular inertias, so slender rods (the
-    /// default inertias, Ixx = 0) raise InvalidInput; give `inertias`. At most 495 links (MuJoCo's XML nesting).
+    /// universal joint in one body). MuJoCo refuses principal moments below mjMINVAL (1e-15),
+    /// zero included, so slender rods (the default inertias, Ixx = 0) raise InvalidInput; give
+    /// `inertias`. At most 495 links (MuJoCo's XML nesting).
     fn to_mjcf(&self) -> PyResult<String> {
         robot_desc::write_mjcf(&self.robot()?, self.model.gravity())
             .map_err(|e| Error::input(e.to_string()).into())

@@ -164,6 +164,14 @@ def test_pickle_and_urdf_round_trip():
     assert "<mujoco" in chain.to_mjcf() and 'gravity="0.0 -9.81 0.0"' in chain.to_mjcf()
 
 
+def test_an_arm_mujoco_would_refuse_raises_naming_the_link():
+    """MuJoCo refuses a moving body's mass or principal moment below mjMINVAL (1e-15): to_mjcf
+    raises, naming the link, instead of writing a file MuJoCo does not load."""
+    with pytest.raises(hrm.InvalidInput, match=r"^cannot export link 'link_1' to MJCF: MuJoCo needs a mass "
+                                                r"and principal moments of inertia of at least 1e-15"):
+        hrm.Arm(inertias=[1e-20, 1e-20]).to_mjcf()
+
+
 def test_a_planar_arm_exported_as_urdf_has_the_planar_dynamics():
     arm = hrm.Arm(lengths=[0.1, 0.12, 0.08, 0.1], masses=[0.1, 0.2, 0.15, 0.05])
     chain = hrm.Chain.from_urdf(arm.to_urdf(), gravity=(0.0, -arm.gravity_acceleration, 0.0))

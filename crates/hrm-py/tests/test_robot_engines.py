@@ -2,7 +2,10 @@
 matrix, C + G, ABA, the RNEA and ABA derivatives and link poses to 1e-9 relative, on random
 chains (random axes, origins, inertias, some prismatic joints, a fixed tool link, 1 to 30
 joints) and a 10-link universal-joint snake; the paper's arm exported as URDF gives in Pinocchio
-(gravity along -y) the planar `dynamics`. Drives `hrm eval` (JSON lines)."""
+(gravity along -y) the planar `dynamics`. Degenerate inertias (rods, spheres, plates) turned by
+random rotations read as Pinocchio reads them and export as MuJoCo loads them; what MuJoCo
+refuses (masses and moments below mjMINVAL) the export refuses; a root link `world` is MuJoCo's
+world body. Drives `hrm eval` (JSON lines)."""
 
 import json
 import os
@@ -38,11 +41,16 @@ def hrm_binary():
     pytest.skip("the hrm binary is not built (cargo build -p hrm-cli)")
 
 
-def hrm_eval(requests):
-    """Answers of `hrm eval` to a list of requests, each checked ok."""
+def hrm_answers(requests):
+    """Answers of `hrm eval` to a list of requests."""
     text = "".join(json.dumps(r) + "\n" for r in requests)
     out = subprocess.run([hrm_binary(), "eval"], input=text, capture_output=True, text=True, check=True)
-    answers = [json.loads(line) for line in out.stdout.splitlines()]
+    return [json.loads(line) for line in out.stdout.splitlines()]
+
+
+def hrm_eval(requests):
+    """Answers of `hrm eval` to a list of requests, each checked ok."""
+    answers = hrm_answers(requests)
     for answer in answers:
         assert answer["ok"], answer
     return answers
@@ -223,6 +231,133 @@ def test_the_paper_arm_as_urdf_in_pinocchio_gives_the_planar_dynamics():
         (mjcf,) = hrm_eval([{"op": "export", "arm": arm, "format": "mjcf"}])
         mj = mujoco.MjModel.from_xml_string(mjcf["text"])
         assert list(mj.opt.gravity) == [0.0, -9.81, 0.0]
+
+
+def one_link(inertial, root="b", extra=""):
+    """A chain of one continuous joint about z from `root` to link 'a', whose <inertial> holds
+    `inertial`; `extra` links and joints are added."""
+    return (f'<robot name="r"><link name="{root}"/><link name="a"><inertial>{inertial}</inertial></link>'
+            f'<joint name="j" type="continuous"><parent link="{root}"/><child link="a"/>'
+            f'<axis xyz="0 1 0"/></joint>{extra}</robot>')
+
+
+def inertial(tensor, rpy=(0.0, 0.0, 0.0), mass=1.0):
+    """An <inertial> of `mass` at (0.1, 0.05, 0) in a frame turned by `rpy`, the tensor's six
+    entries written exactly (repr)."""
+    t = [[repr(float(x)) for x in row] for row in np.asarray(tensor, float)]
+    r = " ".join(repr(float(x)) for x in rpy)
+    return (f'<origin xyz="0.1 0.05 0" rpy="{r}"/><mass value="{float(mass)!r}"/>'
+            f'<inertia ixx="{t[0][0]}" ixy="{t[0][1]}" ixz="{t[0][2]}" iyy="{t[1][1]}" '
+            f'iyz="{t[1][2]}" izz="{t[2][2]}"/>')
+
+
+def turned(moments, rng):
+    """diag(moments) turned by a random rotation."""
+    q = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+    return q @ np.diag(moments) @ q.T
+
+
+def degenerate_inertias(seed, axial):
+    """Rods (axial moment `axial` times I), spheres and thin plates, turned at random, and the
+    thin plate of a turned <inertial> frame that MuJoCo refused as a rotated fullinertia."""
+    rng = np.random.default_rng(seed)
+    cases = [inertial(np.diag([0.01, 0.01, 0.02]), rpy=(0.3, 0.4, 0.5))]
+    for _ in range(4):
+        i, a, b = rng.uniform(0.01, 1.0, 3)
+        for moments in ([axial * i, i, i], [i, i, i], [a, b, a + b]):
+            cases.append(inertial(turned(moments, rng), rpy=rng.uniform(-3, 3, 3)))
+            cases.append(inertial(turned(moments, rng)))
+    return cases
+
+
+def test_turned_slender_rods_read_as_pinocchio_reads_them():
+    """Rods (0, I, I), exactly singular, turned at random or along (3, 4, 5): hrm reads them
+    (the closed form of the cubic refused about 70%) and agrees with Pinocchio."""
+    require(pin is not None, "Pinocchio (pin)")
+    rods = degenerate_inertias(3, axial=0.0) + [
+        inertial([[0.82, -0.24, -0.3], [-0.24, 0.68, -0.4], [-0.3, -0.4, 0.5]]),
+        inertial(np.diag([0.0, 0.01, 0.01]), rpy=(0.0, 1.5707963267948966, 0.0)),
+    ]
+    for k, rod in enumerate(rods):
+        theta, v, a, tau = states(1, k)
+        compare_with_pinocchio(one_link(rod), theta, v, a, tau)
+
+
+def test_degenerate_inertias_export_as_mujoco_loads_them():
+    """Near-rods, spheres and plates turned by the <inertial> frame and as full tensors: the
+    MJCF loads (MuJoCo checks A + B >= C exactly, and refused the rounding of a turned
+    fullinertia), its diaginertia is MuJoCo's body_inertia, and mj_fullM and qfrc_bias agree with
+    hrm and Pinocchio."""
+    require(pin is not None and mujoco is not None, "Pinocchio (pin) and MuJoCo (mujoco)")
+    for k, case in enumerate(degenerate_inertias(4, axial=1e-3)):
+        urdf = one_link(case)
+        theta, v, a, tau = states(1, k)
+        compare_with_pinocchio(urdf, theta, v, a, tau)
+        compare_with_mujoco(urdf, theta, v)
+        (export,) = hrm_eval([{"op": "export", "urdf": urdf, "format": "mjcf"}])
+        line = next(l for l in export["text"].splitlines() if "<inertial " in l)
+        diagonal = [float(x) for x in line.split('diaginertia="')[1].split('"')[0].split()]
+        assert list(mujoco.MjModel.from_xml_string(export["text"]).body_inertia[-1]) == diagonal
+
+
+def test_what_mujoco_refuses_the_export_refuses_naming_the_link():
+    """MuJoCo refuses a moving body's mass or principal moment below mjMINVAL = 1e-15, zero
+    included (a slender rod's moment about its axis), and loads 1e-15: hrm's export refuses the
+    same, in one line naming the link."""
+    require(mujoco is not None, "MuJoCo (mujoco)")
+
+    def body(inertial_attributes):
+        return ('<mujoco><compiler inertiafromgeom="false"/><worldbody><body name="a">'
+                f'<joint type="hinge"/><inertial pos="0 0 0" {inertial_attributes}/></body></worldbody></mujoco>')
+
+    for attributes in ('mass="1" diaginertia="0 0.01 0.01"', 'mass="1" diaginertia="1e-16 1 1"',
+                       'mass="1e-16" diaginertia="1 1 1"'):
+        with pytest.raises(ValueError, match="mjMINVAL"):
+            mujoco.MjModel.from_xml_string(body(attributes))
+    for attributes in ('mass="1" diaginertia="1e-15 1 1"', 'mass="1e-15" diaginertia="1 1 1"'):
+        mujoco.MjModel.from_xml_string(body(attributes))
+    refused = [
+        inertial(np.diag([1e-16, 1e-16, 1e-16]), mass=1e-16),
+        inertial(np.diag([1e-300, 1.0, 1.0])),
+        inertial(np.diag([0.0, 0.01, 0.01]), rpy=(0.0, 1.5707963267948966, 0.0)),
+        inertial([[0.82, -0.24, -0.3], [-0.24, 0.68, -0.4], [-0.3, -0.4, 0.5]]),
+    ]
+    answers = hrm_answers([{"op": "export", "urdf": one_link(case), "format": "mjcf"} for case in refused])
+    for answer in answers:
+        assert not answer["ok"], answer
+        message = answer["error"]["message"]
+        assert "link 'a' to MJCF" in message and "at least 1e-15" in message, message
+
+
+def test_a_root_link_named_world_is_mujocos_world_body():
+    """ROS's root link `world`: MuJoCo refuses a body of that name, so it is the <worldbody>
+    itself, the chain attached there; the dynamics agree with hrm and Pinocchio."""
+    require(pin is not None and mujoco is not None, "Pinocchio (pin) and MuJoCo (mujoco)")
+    urdf = one_link(inertial(np.diag([0.1, 0.2, 0.25])), root="world")
+    theta, v, a, tau = states(1, 0)
+    compare_with_pinocchio(urdf, theta, v, a, tau)
+    compare_with_mujoco(urdf, theta, v)
+    (export,) = hrm_eval([{"op": "export", "urdf": urdf, "format": "mjcf"}])
+    mj = mujoco.MjModel.from_xml_string(export["text"])
+    assert [mj.body(i).name for i in range(mj.nbody)] == ["world", "a"]
+
+
+def test_a_massless_links_geometry_is_named_and_the_export_loads():
+    """The visual and collision shapes of a massless link whose joint moves the next body are
+    named in a comment (as geoms of that body they would move with its later joints); MuJoCo
+    loads the file, the two hinges in one body."""
+    require(mujoco is not None, "MuJoCo (mujoco)")
+    sphere = '<origin xyz="0.3 0 0"/><geometry><sphere radius="0.05"/></geometry>'
+    for element in ("visual", "collision"):
+        urdf = (f'<robot name="r"><link name="b"/><link name="m"><{element}>{sphere}</{element}></link>'
+                f'<link name="a"><inertial>{inertial(np.diag([0.1, 0.1, 0.1]))}</inertial></link>'
+                '<joint name="j1" type="continuous"><parent link="b"/><child link="m"/><axis xyz="0 0 1"/></joint>'
+                '<joint name="j2" type="continuous"><parent link="m"/><child link="a"/><origin xyz="0.2 0 0"/>'
+                '<axis xyz="0 0 1"/></joint></robot>')
+        (export,) = hrm_eval([{"op": "export", "urdf": urdf, "format": "mjcf"}])
+        assert "<!-- link 'm' (massless, its joint moves this body) has" in export["text"]
+        mj = mujoco.MjModel.from_xml_string(export["text"])
+        assert (mj.nbody, mj.njnt, mj.ngeom) == (3, 2, 0)
 
 
 def largest_differences():

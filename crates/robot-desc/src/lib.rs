@@ -12,7 +12,7 @@ mod urdf_write;
 
 pub use error::DescError;
 pub use mjcf::{
-    MJCF_BODIES_PER_FILE, MJCF_MAX_BODIES, MJCF_MAX_BODIES_ONE_FILE, MJCF_MAX_XML_DEPTH,
+    MJ_MINVAL, MJCF_BODIES_PER_FILE, MJCF_MAX_BODIES, MJCF_MAX_BODIES_ONE_FILE, MJCF_MAX_XML_DEPTH,
     write_mjcf, write_mjcf_files,
 };
 pub use model::{Body, Geometry, Inertial, Joint, JointDynamics, JointKind, Limits, Robot, Shape};

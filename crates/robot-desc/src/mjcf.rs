@@ -4,7 +4,15 @@
 //! (the middle link of a universal joint written as two revolute joints) is not a body of its
 //! own: its joint joins those of the next body that has mass, MuJoCo applying a body's joints
 //! in order, each about its own anchor and axis in the body frame. Every body frame is the URDF
-//! frame of its (last) link, so inertias and geometry keep their placements.
+//! frame of its (last) link, so inertias and geometry keep their placements. The geometry of
+//! such a massless link is not written: as a geom of the body it joins it would also move with
+//! that body's later joints; a comment in its place names it and says so.
+//!
+//! A body's inertia is written in its principal frame (`quat` and `diaginertia`, from
+//! [`Inertial::principal`](crate::Inertial::principal)), so that the numbers MuJoCo checks are
+//! the ones written: mass and moments at least [`MJ_MINVAL`], `A + B >= C` exactly. A root link
+//! named `world` (ROS's convention) is MuJoCo's `<worldbody>` itself, its children attached
+//! there.
 //!
 //! MuJoCo 4.0.1 parses XML with tinyxml2, which refuses elements nested deeper than
 //! [`MJCF_MAX_XML_DEPTH`]; a single document holds at most [`MJCF_MAX_BODIES_ONE_FILE`] moving
@@ -13,18 +21,26 @@
 //! MuJoCo's compiler accepts.
 
 use crate::error::DescError;
-use crate::model::{Body, Inertial, Joint, JointKind, Robot, Shape};
+use crate::model::{Body, Joint, JointKind, Robot, Shape};
 use crate::pose::{Mat3, Pose, mat_vec, matrix_quaternion, transpose};
-use crate::urdf_read::principal_moments;
 use crate::urdf_write::{escape, numbers};
 use std::fmt::Write;
+
+/// MuJoCo's `mjMINVAL`: the least mass and principal moment of inertia of a moving body it
+/// compiles ("mass and inertia of moving bodies must be larger than mjMINVAL"; measured with
+/// MuJoCo 4.0.1, `1e-15` loads and anything smaller, zero included, does not).
+pub const MJ_MINVAL: f64 = 1e-15;
+
+/// The name MuJoCo gives its world body (`<worldbody>`); no other body may have it.
+const WORLD: &str = "world";
 
 /// The deepest element nesting MuJoCo's XML parser reads (measured with MuJoCo 4.0.1:
 /// `<mujoco><worldbody>` and 496 nested `<body>`s, each with a `<joint>`, load; 497 do not).
 pub const MJCF_MAX_XML_DEPTH: usize = 499;
 
 /// The most moving bodies one MJCF document of this writer holds: `<mujoco>`, `<worldbody>`,
-/// the base `<body>` and the bodies' own children take four of [`MJCF_MAX_XML_DEPTH`] levels.
+/// the base `<body>` and the bodies' own children take four of [`MJCF_MAX_XML_DEPTH`] levels
+/// (a base named `world` is the `<worldbody>`, which leaves one level unused).
 pub const MJCF_MAX_BODIES_ONE_FILE: usize = MJCF_MAX_XML_DEPTH - 4;
 
 /// The most nested bodies below the world MuJoCo compiles, whatever the XML ("depth limit
@@ -36,7 +52,10 @@ pub const MJCF_MAX_BODIES: usize = 1022;
 pub const MJCF_BODIES_PER_FILE: usize = 400;
 
 /// The chain as one MJCF document, gravity `[gx, gy, gz]` (m/s^2) in `<option>`. Refused past
-/// [`MJCF_MAX_BODIES_ONE_FILE`] moving bodies (use [`write_mjcf_files`]).
+/// [`MJCF_MAX_BODIES_ONE_FILE`] moving bodies (use [`write_mjcf_files`]), and, naming the link,
+/// what MuJoCo would refuse: a massless last link, a moving body's mass or principal moment
+/// below [`MJ_MINVAL`], an inertia [`read_urdf`](crate::read_urdf) refuses, a moving link named
+/// `world`.
 pub fn write_mjcf(robot: &Robot, gravity: [f64; 3]) -> Result<String, DescError> {
     let bodies = bodies(robot)?;
     if bodies.len() > MJCF_MAX_BODIES_ONE_FILE {
@@ -56,7 +75,7 @@ pub fn write_mjcf(robot: &Robot, gravity: [f64; 3]) -> Result<String, DescError>
 /// The chain as MJCF files: `{stem}.xml`, and past [`MJCF_BODIES_PER_FILE`] moving bodies
 /// `{stem}-part1.xml`, `{stem}-part2.xml`... each included by the one before (MuJoCo resolves
 /// them relative to the first). Returns `(file name, text)` pairs, the main file first.
-/// Refused past [`MJCF_MAX_BODIES`].
+/// Refused past [`MJCF_MAX_BODIES`], and as [`write_mjcf`] for what MuJoCo would refuse.
 pub fn write_mjcf_files(
     robot: &Robot,
     gravity: [f64; 3],
@@ -73,11 +92,20 @@ pub fn write_mjcf_files(
 }
 
 /// One moving MuJoCo body: its pose in the previous body's frame, its joints (anchor and axis
-/// in its own frame) and the URDF body whose frame it has.
+/// in its own frame; the massless links before it are their children), the URDF body whose
+/// frame it has and its inertia as written.
 struct MjBody<'a> {
     pose: Pose,
     joints: Vec<(&'a Joint, [f64; 3], [f64; 3])>,
     body: &'a Body,
+    inertia: MjInertia,
+}
+
+/// A body's `<inertial>`: the principal frame's orientation in the body frame (`quat`,
+/// `[w, x, y, z]`) and the principal moments (`diaginertia`).
+struct MjInertia {
+    quat: [f64; 4],
+    diagonal: [f64; 3],
 }
 
 /// Groups the joints into bodies that have mass and checks what MuJoCo checks.
@@ -89,7 +117,13 @@ fn bodies(robot: &Robot) -> Result<Vec<MjBody<'_>>, DescError> {
         if joint.child.inertial.is_massless() {
             continue;
         }
-        check_mass(&joint.child)?;
+        if joint.child.name == WORLD {
+            return Err(DescError::export(
+                format!("link '{WORLD}' to MJCF"),
+                "MuJoCo reserves the name for its world body: only the root link may have it",
+            ));
+        }
+        let inertia = mj_inertia(&joint.child)?;
         // Body frame B = T_1 ... T_k at rest; joint i's anchor and axis in B are those of the
         // joint frame moved by S_i^-1, S_i = T_{i+1} ... T_k.
         let mut pose = Pose::IDENTITY;
@@ -111,6 +145,7 @@ fn bodies(robot: &Robot) -> Result<Vec<MjBody<'_>>, DescError> {
             pose,
             joints,
             body: &joint.child,
+            inertia,
         });
         group.clear();
     }
@@ -132,18 +167,31 @@ fn bodies(robot: &Robot) -> Result<Vec<MjBody<'_>>, DescError> {
     Ok(bodies)
 }
 
-/// MuJoCo's own requirement of a moving body: positive mass and a positive definite inertia.
-fn check_mass(body: &Body) -> Result<(), DescError> {
-    let moments = principal_moments(&body.inertial.inertia);
-    if body.inertial.mass > 0.0 && moments[0] > 0.0 {
-        return Ok(());
+/// A moving body's inertia as MuJoCo checks it: the principal moments of a physical inertia
+/// (within [`INERTIA_TOLERANCE`](crate::model::INERTIA_TOLERANCE), as
+/// [`read_urdf`](crate::read_urdf) checks), the largest lowered to the sum of the other two
+/// where it exceeds it by rounding (MuJoCo checks `A + B >= C` without a tolerance), then mass
+/// and moments at least [`MJ_MINVAL`].
+fn mj_inertia(body: &Body) -> Result<MjInertia, DescError> {
+    let element = || format!("link '{}' to MJCF", body.name);
+    let principal = body
+        .inertial
+        .physical(|problem| DescError::export(element(), problem))?;
+    let [a, b, c] = principal.values;
+    let diagonal = [a, b, c.min(a + b)];
+    let mass = body.inertial.mass;
+    if mass >= MJ_MINVAL && diagonal[0] >= MJ_MINVAL {
+        return Ok(MjInertia {
+            quat: matrix_quaternion(&principal.vectors),
+            diagonal,
+        });
     }
     Err(DescError::export(
-        format!("link '{}' to MJCF", body.name),
+        element(),
         format!(
-            "MuJoCo needs a positive mass and positive principal moments of inertia, got mass {} \
-             and moments {moments:?}",
-            body.inertial.mass
+            "MuJoCo needs a mass and principal moments of inertia of at least {MJ_MINVAL:e} \
+             (mjMINVAL; a slender rod's zero moment about its axis too), got mass {mass:?} and \
+             moments {diagonal:?}"
         ),
     ))
 }
@@ -161,6 +209,9 @@ fn assemble(
     } else {
         bodies.chunks(per_file).collect()
     };
+    // The base is a body of its own, or, named `world`, MuJoCo's world body.
+    let world = robot.base.name == WORLD;
+    let base_depth = if world { 2 } else { 3 };
     let mut files = Vec::with_capacity(chunks.len());
     for (k, chunk) in chunks.iter().enumerate() {
         let mut out = String::new();
@@ -172,9 +223,13 @@ fn assemble(
             );
             let _ = writeln!(out, "  <option gravity=\"{}\"/>", numbers(&gravity));
             out.push_str("  <worldbody>\n");
-            let _ = writeln!(out, "    <body name=\"{}\">", escape(&robot.base.name));
-            write_geoms(&mut out, "      ", &robot.base);
-            depth = 3;
+            if world {
+                write_geoms(&mut out, "    ", &robot.base);
+            } else {
+                let _ = writeln!(out, "    <body name=\"{}\">", escape(&robot.base.name));
+                write_geoms(&mut out, "      ", &robot.base);
+            }
+            depth = base_depth;
         } else {
             out.push_str("<mujoco>\n");
         }
@@ -192,8 +247,13 @@ fn assemble(
             for (joint, anchor, axis) in &body.joints {
                 write_joint(&mut out, &inner, joint, anchor, axis);
             }
-            write_inertial(&mut out, &inner, &body.body.inertial);
+            write_inertial(&mut out, &inner, body);
             write_geoms(&mut out, &inner, body.body);
+            if let Some((_, massless)) = body.joints.split_last() {
+                for (joint, _, _) in massless {
+                    write_dropped_geometry(&mut out, &inner, &joint.child, body.body);
+                }
+            }
         }
         if k + 1 < chunks.len() {
             let _ = writeln!(
@@ -204,13 +264,16 @@ fn assemble(
                 k + 1
             );
         }
-        let first = if k == 0 { 3 } else { 1 };
+        let first = if k == 0 { base_depth } else { 1 };
         while depth > first {
             let _ = writeln!(out, "{}</body>", "  ".repeat(depth));
             depth -= 1;
         }
         if k == 0 {
-            out.push_str("    </body>\n  </worldbody>\n");
+            if !world {
+                out.push_str("    </body>\n");
+            }
+            out.push_str("  </worldbody>\n");
         }
         out.push_str("</mujoco>\n");
         let name = if k == 0 {
@@ -254,17 +317,47 @@ fn write_joint(out: &mut String, indent: &str, joint: &Joint, anchor: &[f64; 3],
     out.push_str("/>\n");
 }
 
-/// MuJoCo takes `fullinertia` in the body frame only (not with `quat`): the tensor is rotated
-/// from the `<inertial>` frame into the link frame, `R I R^T`.
-fn write_inertial(out: &mut String, indent: &str, inertial: &Inertial) {
-    let (com, i) = inertial.in_link_frame();
+/// The inertia in its principal frame: `quat` the principal axes in the body frame, `diaginertia`
+/// the moments of [`mj_inertia`].
+fn write_inertial(out: &mut String, indent: &str, body: &MjBody<'_>) {
     let _ = writeln!(
         out,
-        "{indent}<inertial pos=\"{}\" mass=\"{:?}\" fullinertia=\"{}\"/>",
-        numbers(&com),
-        inertial.mass,
-        numbers(&[i[0][0], i[1][1], i[2][2], i[0][1], i[0][2], i[1][2]])
+        "{indent}<inertial pos=\"{}\" quat=\"{}\" mass=\"{:?}\" diaginertia=\"{}\"/>",
+        numbers(&body.body.inertial.origin.xyz),
+        numbers(&body.inertia.quat),
+        body.body.inertial.mass,
+        numbers(&body.inertia.diagonal)
     );
+}
+
+/// A comment in place of the geometry of the massless link `link`, whose joint moves `body`:
+/// as geoms of `body` its shapes would also move with the joints after its own.
+fn write_dropped_geometry(out: &mut String, indent: &str, link: &Body, body: &Body) {
+    let (visuals, collisions) = (link.visuals.len(), link.collisions.len());
+    if visuals + collisions == 0 {
+        return;
+    }
+    let _ = writeln!(
+        out,
+        "{indent}<!-- link '{}' (massless, its joint moves this body) has {visuals} visual and \
+         {collisions} collision shapes, not exported: as geoms of '{}' they would also move with \
+         its later joints -->",
+        comment_text(&link.name),
+        comment_text(&body.name),
+    );
+}
+
+/// `text` for the inside of an XML comment: escaped, and a space between consecutive dashes
+/// (a comment may not hold `--`).
+fn comment_text(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for ch in escape(text).chars() {
+        if ch == '-' && out.ends_with('-') {
+            out.push(' ');
+        }
+        out.push(ch);
+    }
+    out
 }
 
 /// Visual shapes as geoms that never collide (group 1), collision shapes as colliding geoms
@@ -283,7 +376,7 @@ fn write_geoms(out: &mut String, indent: &str, body: &Body) {
                     let _ = writeln!(
                         out,
                         "{indent}<!-- mesh {} not exported -->",
-                        escape(filename).replace("--", "- -")
+                        comment_text(filename)
                     );
                     continue;
                 }

@@ -1,7 +1,14 @@
 //! The description of a serial chain as read from URDF: bodies with inertia and geometry,
 //! joints with origins, axes and limits, fixed links already merged.
 
+use crate::error::DescError;
 use crate::pose::{Mat3, Pose, mat_mul, mat_vec, transpose};
+use manip_dyn::spatial::{SymmetricEigen, symmetric_eigen};
+
+/// Relative tolerance of the inertia checks of [`read_urdf`](crate::read_urdf) and the MJCF
+/// export, against the tensor's trace: rounding of the principal moments is about `1e-16` of
+/// it, CAD exports printed to 9 digits about `1e-9`.
+pub const INERTIA_TOLERANCE: f64 = 1e-9;
 
 /// A link's mass properties, as URDF's `<inertial>`: mass, centre-of-mass frame and the inertia
 /// tensor about the centre of mass in that frame.
@@ -33,6 +40,45 @@ impl Inertial {
         let r = self.origin.rotation();
         let rotated = mat_mul(&mat_mul(&r, &self.tensor()), &transpose(&r));
         (self.origin.xyz, rotated)
+    }
+
+    /// The principal moments of inertia (ascending) and the principal axes in the link frame:
+    /// [`symmetric_eigen`] of the tensor in the `origin` frame (as written, so a diagonal tensor
+    /// gives its diagonal exactly), its eigenvectors turned by the origin's rotation `R`, so that
+    /// `R I R^T = axes diag(moments) axes^T`.
+    pub fn principal(&self) -> SymmetricEigen {
+        let eigen = symmetric_eigen(&self.tensor());
+        SymmetricEigen {
+            values: eigen.values,
+            vectors: mat_mul(&self.origin.rotation(), &eigen.vectors),
+        }
+    }
+
+    /// [`principal`](Self::principal) of a physical inertia, or the error `refuse` makes of
+    /// the problem (one line): the principal moments non-negative and satisfying the triangle
+    /// inequalities `I_a <= I_b + I_c` (each moment is an integral of squared distances from two
+    /// of the axes, whose sum exceeds the squared distance from the third), each within
+    /// [`INERTIA_TOLERANCE`] of the trace.
+    pub(crate) fn physical(
+        &self,
+        refuse: impl FnOnce(String) -> DescError,
+    ) -> Result<SymmetricEigen, DescError> {
+        let principal = self.principal();
+        let moments = principal.values;
+        let trace: f64 = moments.iter().sum();
+        let tolerance = INERTIA_TOLERANCE * trace.abs();
+        if moments[0] < -tolerance {
+            return Err(refuse(format!(
+                "inertia must be positive semi-definite, its principal moments are {moments:?}"
+            )));
+        }
+        if moments[2] > moments[0] + moments[1] + tolerance {
+            return Err(refuse(format!(
+                "inertia breaks the triangle inequality: principal moments {moments:?}, the \
+                 largest exceeds the sum of the other two"
+            )));
+        }
+        Ok(principal)
     }
 
     /// The mass properties of a rigid union of `self` and `other`, whose link frame sits at

@@ -424,61 +424,8 @@ fn read_inertial(node: Node<'_, '_>, link: &str) -> Result<Inertial, DescError> 
         mass,
         inertia,
     };
-    check_inertia(&inertial, &element)?;
+    inertial.physical(|problem| DescError::invalid(element(), problem))?;
     Ok(inertial)
-}
-
-/// Relative tolerance of the inertia checks, against the tensor's trace: rounding of the
-/// eigenvalues is about `1e-16` of it, CAD exports printed to 9 digits about `1e-9`.
-const INERTIA_TOLERANCE: f64 = 1e-9;
-
-/// A physical inertia tensor: principal moments non-negative and satisfying the triangle
-/// inequalities `I_a <= I_b + I_c` (each moment is an integral of squared distances from two of
-/// the axes, whose sum exceeds the distance from the third). `element` names the `<inertial>`
-/// in the error.
-fn check_inertia(inertial: &Inertial, element: &dyn Fn() -> String) -> Result<(), DescError> {
-    let moments = principal_moments(&inertial.inertia);
-    let trace: f64 = moments.iter().sum();
-    let tolerance = INERTIA_TOLERANCE * trace.abs();
-    if moments[0] < -tolerance {
-        return Err(DescError::invalid(
-            element(),
-            format!(
-                "inertia must be positive semi-definite, its principal moments are {moments:?}"
-            ),
-        ));
-    }
-    if moments[2] > moments[0] + moments[1] + tolerance {
-        return Err(DescError::invalid(
-            element(),
-            format!(
-                "inertia breaks the triangle inequality: principal moments {moments:?}, the largest \
-             exceeds the sum of the other two"
-            ),
-        ));
-    }
-    Ok(())
-}
-
-/// Eigenvalues of the symmetric tensor `[ixx, ixy, ixz, iyy, iyz, izz]`, ascending (the
-/// trigonometric closed form of the characteristic cubic).
-pub(crate) fn principal_moments(&[xx, xy, xz, yy, yz, zz]: &[f64; 6]) -> [f64; 3] {
-    let off = xy * xy + xz * xz + yz * yz;
-    let mean = (xx + yy + zz) / 3.0;
-    if off == 0.0 {
-        let mut d = [xx, yy, zz];
-        d.sort_by(f64::total_cmp);
-        return d;
-    }
-    let (a, b, c) = (xx - mean, yy - mean, zz - mean);
-    let p = ((a * a + b * b + c * c + 2.0 * off) / 6.0).sqrt();
-    // det((I - mean E) / p) / 2, clamped to [-1, 1] against rounding.
-    let det = a * (b * c - yz * yz) - xy * (xy * c - yz * xz) + xz * (xy * yz - b * xz);
-    let r = (det / (2.0 * p * p * p)).clamp(-1.0, 1.0);
-    let phi = r.acos() / 3.0;
-    let largest = mean + 2.0 * p * phi.cos();
-    let smallest = mean + 2.0 * p * (phi + 2.0 * std::f64::consts::FRAC_PI_3).cos();
-    [smallest, 3.0 * mean - largest - smallest, largest]
 }
 
 fn read_geometry(

@@ -1,6 +1,8 @@
 //! Reading and writing URDF: what is kept, merged and refused, and the bit-for-bit round trip.
 
-use robot_desc::{DescError, JointKind, Robot, Shape, read_urdf, write_urdf};
+use proptest::prelude::*;
+use robot_desc::pose::{Mat3, rpy_matrix};
+use robot_desc::{DescError, JointKind, Robot, Shape, read_urdf, to_spatial, write_urdf};
 use std::time::{Duration, Instant};
 
 /// A 3-joint chain: a prismatic base axis, a revolute with limits, a continuous joint, a fixed
@@ -388,6 +390,123 @@ fn hostile_files_are_refused_in_milliseconds() {
             "<x xmlns:z=\"v\"/>".repeat(2000)
         ),
         &["4000 namespace declarations", "at most 64"],
+    );
+}
+
+/// A one-joint chain whose link 'b' has mass 1 and the inertia tensor `i` written as decimals
+/// in an `<inertial>` frame turned by `rpy`.
+fn inertia_chain(i: &Mat3, rpy: [f64; 3]) -> String {
+    chain_with(
+        "",
+        &format!(
+            "<inertial><origin xyz=\"0.1 0 0\" rpy=\"{:?} {:?} {:?}\"/><mass value=\"1\"/>\
+             <inertia ixx=\"{:?}\" ixy=\"{:?}\" ixz=\"{:?}\" iyy=\"{:?}\" iyz=\"{:?}\" izz=\"{:?}\"/>\
+             </inertial>",
+            rpy[0], rpy[1], rpy[2], i[0][0], i[0][1], i[0][2], i[1][1], i[1][2], i[2][2]
+        ),
+    )
+}
+
+/// `R diag(d) R^T`, exactly symmetric.
+fn turned(r: &Mat3, d: [f64; 3]) -> Mat3 {
+    [0, 1, 2].map(|i| [0, 1, 2].map(|j| (0..3).map(|k| d[k] * (r[i][k] * r[j][k])).sum()))
+}
+
+fn diagonal(d: [f64; 3]) -> Mat3 {
+    turned(&rpy_matrix([0.0; 3]), d)
+}
+
+/// Read, accepted as a dynamics model, its principal moments `expected` (ascending) to 1e-14 of
+/// the largest.
+fn read_with_moments(text: &str, expected: [f64; 3]) {
+    let robot = read_urdf(text).unwrap().robot;
+    to_spatial(&robot, [0.0, 0.0, -9.81]).unwrap();
+    let moments = robot.joints[0].child.inertial.principal().values;
+    for (got, want) in moments.iter().zip(expected) {
+        assert!(
+            (got - want).abs() <= 1e-14 * expected[2],
+            "{moments:?} vs {expected:?}"
+        );
+    }
+}
+
+/// Principal moments satisfying the triangle inequalities, of order one: general ones (from
+/// non-negative second moments), rods `(0, I, I)`, spheres `(I, I, I)`, plates `(a, b, a + b)`.
+fn moments() -> impl Strategy<Value = [f64; 3]> {
+    prop_oneof![
+        [0.0..1.0f64, 0.0..1.0f64, 0.0..1.0f64]
+            .prop_filter("not all small", |s| s.iter().sum::<f64>() > 0.01)
+            .prop_map(|[a, b, c]| [b + c, a + c, a + b]),
+        (0.01..1.0f64).prop_map(|i| [0.0, i, i]),
+        (0.01..1.0f64).prop_map(|i| [i, i, i]),
+        (0.01..1.0f64, 0.01..1.0f64).prop_map(|(a, b)| [a, b, a + b]),
+    ]
+}
+
+fn rpy() -> impl Strategy<Value = [f64; 3]> {
+    [-3.2..3.2f64, -3.2..3.2f64, -3.2..3.2f64]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1000))]
+
+    /// Physical inertias turned by any rotation, as the `<inertial>` frame's `rpy` or as the
+    /// decimals of the full tensor, read and are dynamics models, their principal moments
+    /// recovered to 1e-14 (about 70% of turned rods were refused when the moments came from
+    /// the closed form of the cubic).
+    #[test]
+    fn turned_physical_inertias_are_read(d in moments(), a in rpy(), b in rpy(), exponent in -6..=6i32) {
+        let d = d.map(|x| x * 10f64.powi(exponent));
+        let mut expected = d;
+        expected.sort_by(f64::total_cmp);
+        read_with_moments(&inertia_chain(&diagonal(d), a), expected);
+        read_with_moments(&inertia_chain(&turned(&rpy_matrix(b), d), [0.0; 3]), expected);
+        read_with_moments(&inertia_chain(&turned(&rpy_matrix(b), d), a), expected);
+    }
+
+    /// A moment beyond the sum of the other two, or negative, by 1e-6 of the moments is refused
+    /// however the tensor is turned.
+    #[test]
+    fn turned_unphysical_inertias_are_refused(a in 0.01..1.0f64, b in 0.01..1.0f64, r in rpy()) {
+        let r = rpy_matrix(r);
+        refused(
+            &inertia_chain(&turned(&r, [a, b, (a + b) * (1.0 + 1e-6)]), [0.0; 3]),
+            &["<inertial> of link 'b'", "triangle inequality"],
+        );
+        refused(
+            &inertia_chain(&turned(&r, [-1e-6 * a, a, a]), [0.0; 3]),
+            &["<inertial> of link 'b'", "positive semi-definite"],
+        );
+    }
+}
+
+/// The rods the closed form of the cubic refused: `(0, 0.01, 0.01)` turned by a quarter turn
+/// of pitch, and rods along `(3, 4, 5)` and `(1, 1, 3)` as exact decimals.
+#[test]
+fn turned_slender_rods_are_read() {
+    read_with_moments(
+        &inertia_chain(
+            &diagonal([0.0, 0.01, 0.01]),
+            [0.0, std::f64::consts::FRAC_PI_2, 0.0],
+        ),
+        [0.0, 0.01, 0.01],
+    );
+    read_with_moments(
+        &inertia_chain(
+            &[[0.82, -0.24, -0.3], [-0.24, 0.68, -0.4], [-0.3, -0.4, 0.5]],
+            [0.0; 3],
+        ),
+        [0.0, 1.0, 1.0],
+    );
+    let (a, b, c, d) = (
+        0.9090909090909091,
+        -0.09090909090909091,
+        -0.27272727272727276,
+        0.18181818181818177,
+    );
+    read_with_moments(
+        &inertia_chain(&[[a, b, c], [b, a, c], [c, c, d]], [0.0; 3]),
+        [0.0, 1.0, 1.0],
     );
 }
 

@@ -34,6 +34,10 @@
 //! | [`rnea_derivatives`] | `tau`, `d tau / d q`, `d tau / d v`, `M` into a [`SpatialDerivativeData`] |
 //! | [`aba_derivatives`] | `qdd`, `d qdd / d q`, `d qdd / d v`, `M^-1` (in `O(n^2)`) into a [`SpatialDerivativeData`] |
 //!
+//! [`symmetric_eigen`] gives the principal moments and axes of an inertia (cyclic Jacobi
+//! rotations, accurate when two moments are equal): [`SpatialModel::new`] checks the triangle
+//! inequalities on them, `robot-desc` its URDF inertias and MJCF principal frames.
+//!
 //! The `n x n` algorithms refuse chains of more than [`MAX_DENSE_LINKS`](crate::MAX_DENSE_LINKS)
 //! links; a model has at most [`MAX_LINKS`](crate::MAX_LINKS). The conventions and the derivative
 //! algorithms are derived in `docs/theory.md` ("Spatial chains").
@@ -46,6 +50,7 @@ mod bias;
 mod crba;
 mod data;
 mod derivative_data;
+mod eigen;
 mod energy;
 mod kinematics;
 mod minv;
@@ -61,6 +66,7 @@ pub use bias::{coriolis, gravity, nonlinear_effects};
 pub use crba::mass_matrix;
 pub use data::SpatialData;
 pub use derivative_data::SpatialDerivativeData;
+pub use eigen::{SymmetricEigen, symmetric_eigen};
 pub use energy::{kinetic_energy, potential_energy};
 pub use kinematics::{forward_kinematics, jacobian};
 pub use model::{JointKind, SpatialJoint, SpatialLink, SpatialModel};

@@ -1,6 +1,7 @@
 //! The immutable description of a spatial serial chain (the "Model" of the Model/Data split).
 
 use super::algebra::{IDENTITY, Mat3, Motion, RigidInertia, Symmetric6, Transform, Vec3, dot};
+use super::eigen::symmetric_eigen;
 use crate::error::DynError;
 use crate::model::{ChainModel, MAX_LINKS};
 
@@ -123,22 +124,16 @@ impl SpatialLink {
                 );
             }
         }
-        // The principal moments satisfy the triangle inequalities (and so are non-negative) iff
-        // the second moment of mass `tr(I)/2 E - I` is positive semidefinite: its eigenvalues are
-        // `(I_j + I_k - I_i) / 2`.
-        let half_trace = 0.5 * (i[0][0] + i[1][1] + i[2][2]);
-        let second_moment = [0, 1, 2].map(|r| {
-            [0, 1, 2].map(|c| {
-                let diagonal = if r == c { half_trace } else { 0.0 };
-                diagonal - 0.5 * (i[r][c] + i[c][r])
-            })
-        });
-        let smallest = smallest_eigenvalue(&second_moment);
-        if smallest < -tolerance {
+        // Sorted principal moments `a <= b <= c` satisfy the triangle inequalities (and so are
+        // non-negative: `c <= a + b` and `a < 0` would give `c < b`) iff `a + b - c >= 0`.
+        let [a, b, c] = symmetric_eigen(&self.rigid().inertia).values;
+        let excess = 0.5 * (a + b - c);
+        // Written so that a NaN (an inertia overflowing near f64::MAX) is refused too.
+        if excess.is_nan() || excess < -tolerance {
             return invalid(
                 "inertia (half the excess of the smallest principal-moment sum I_j + I_k - I_i)",
                 "non-negative (the triangle inequalities of the principal moments)",
-                smallest,
+                excess,
             );
         }
         Ok(())
@@ -153,23 +148,6 @@ impl SpatialLink {
             inertia: [0, 1, 2].map(|r| [0, 1, 2].map(|c| 0.5 * (i[r][c] + i[c][r]))),
         }
     }
-}
-
-/// The smallest eigenvalue of a symmetric 3 x 3 matrix (the trigonometric closed form).
-fn smallest_eigenvalue(m: &Mat3) -> f64 {
-    let p1 = m[0][1] * m[0][1] + m[0][2] * m[0][2] + m[1][2] * m[1][2];
-    let q = (m[0][0] + m[1][1] + m[2][2]) / 3.0;
-    if p1 == 0.0 {
-        return m[0][0].min(m[1][1]).min(m[2][2]);
-    }
-    let p2 = (0..3).map(|k| (m[k][k] - q).powi(2)).sum::<f64>() + 2.0 * p1;
-    let p = (p2 / 6.0).sqrt();
-    let b = [0, 1, 2].map(|r| [0, 1, 2].map(|c| (m[r][c] - if r == c { q } else { 0.0 }) / p));
-    let det = b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1])
-        - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0])
-        + b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0]);
-    let phi = (0.5 * det).clamp(-1.0, 1.0).acos() / 3.0;
-    q + 2.0 * p * (phi + 2.0 * std::f64::consts::FRAC_PI_3).cos()
 }
 
 /// A spatial serial chain with a fixed base: joint `i` joins link `i - 1` (the base for `i = 0`)
