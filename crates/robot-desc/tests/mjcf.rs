@@ -160,8 +160,9 @@ fn a_largest_moment_over_the_sum_by_rounding_is_lowered_to_it() {
 #[test]
 fn masses_and_moments_below_mjminval_are_refused_naming_the_link() {
     let diagonal = |d: [f64; 3]| turned(&rpy_matrix([0.0; 3]), d);
-    let tiny_mass =
-        one_link("<mass value=\"1e-16\"/><inertia ixx=\"1e-16\" iyy=\"1e-16\" izz=\"1e-16\"/>");
+    let tiny_mass = one_link(
+        "<mass value=\"1e-16\"/><inertia ixx=\"1e-16\" iyy=\"1e-16\" izz=\"1e-16\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>",
+    );
     let rod = one_link(&inertial(&diagonal([0.0, 0.01, 0.01]), [0.0, 1.2, 0.0]));
     let tiny_moment = one_link(&inertial(&diagonal([1e-300, 1.0, 1.0]), [0.0; 3]));
     for urdf in [tiny_mass, rod, tiny_moment] {
@@ -180,7 +181,9 @@ fn masses_and_moments_below_mjminval_are_refused_naming_the_link() {
         principal_frame_gives_the_tensor(&least, 0.0),
         [MJ_MINVAL, 1.0, 1.0]
     );
-    let light = one_link("<mass value=\"1e-15\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\"/>");
+    let light = one_link(
+        "<mass value=\"1e-15\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>",
+    );
     assert!(mjcf(&light).is_ok());
     // A planar arm of point-like links (`hrm.Arm(inertias=[1e-20, 1e-20]).to_mjcf()`).
     let link = Link::new(0.1, 0.1, 0.05, 1e-20).unwrap();
@@ -197,7 +200,7 @@ fn masses_and_moments_below_mjminval_are_refused_naming_the_link() {
 #[test]
 fn an_unphysical_inertia_built_in_code_is_refused() {
     let mut robot = read_urdf(&one_link(
-        "<mass value=\"1\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\"/>",
+        "<mass value=\"1\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>",
     ))
     .unwrap()
     .robot;
@@ -215,7 +218,7 @@ fn an_unphysical_inertia_built_in_code_is_refused() {
 #[test]
 fn a_root_link_named_world_is_the_world_body() {
     let urdf = r#"<robot name="r"><link name="world"><visual><geometry><box size="1 1 0.1"/></geometry></visual></link>
-<link name="a"><inertial><origin xyz="0.1 0 0"/><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1"/></inertial></link>
+<link name="a"><inertial><origin xyz="0.1 0 0"/><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
 <joint name="j" type="continuous"><parent link="world"/><child link="a"/><axis xyz="0 0 1"/></joint></robot>"#;
     let text = mjcf(urdf).unwrap();
     assert!(!text.contains("name=\"world\""), "{text}");
@@ -257,7 +260,7 @@ fn a_massless_links_geometry_is_named_in_a_comment() {
     let urdf = |geometry: &str, name: &str| {
         format!(
             r#"<robot name="r"><link name="b"/><link name="{name}">{geometry}</link>
-<link name="a"><inertial><origin xyz="0.1 0 0"/><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1"/></inertial></link>
+<link name="a"><inertial><origin xyz="0.1 0 0"/><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
 <joint name="j1" type="continuous"><parent link="b"/><child link="{name}"/><axis xyz="0 0 1"/></joint>
 <joint name="j2" type="continuous"><parent link="{name}"/><child link="a"/><origin xyz="0.2 0 0"/><axis xyz="0 0 1"/></joint></robot>"#
         )
