@@ -126,8 +126,56 @@ pub fn read_urdf(text: &str) -> Result<Reading, DescError> {
     }
     report.links = links.len();
     report.joints = joints.len();
+    ignore_unknown_attributes(root, &mut report);
     let robot = assemble(name, links, joints, &mut report)?;
     Ok(Reading { robot, report })
+}
+
+/// The attributes URDF gives each element this reader reads (the elements it skips are listed
+/// whole).
+const ATTRIBUTES: &[(&str, &[&str])] = &[
+    ("robot", &["name"]),
+    ("link", &["name"]),
+    ("joint", &["name", "type"]),
+    ("inertial", &[]),
+    ("origin", &["xyz", "rpy"]),
+    ("mass", &["value"]),
+    ("inertia", &["ixx", "ixy", "ixz", "iyy", "iyz", "izz"]),
+    ("visual", &["name"]),
+    ("collision", &["name"]),
+    ("geometry", &[]),
+    ("box", &["size"]),
+    ("cylinder", &["radius", "length"]),
+    ("sphere", &["radius"]),
+    ("mesh", &["filename", "scale"]),
+    ("parent", &["link"]),
+    ("child", &["link"]),
+    ("axis", &["xyz"]),
+    ("limit", &["lower", "upper", "effort", "velocity"]),
+    ("dynamics", &["damping", "friction"]),
+];
+
+/// Lists, as `<origin rpy_>`, every attribute URDF does not give an element this reader reads (a
+/// misspelt one reads as absent: its default), walking down from `root` through those elements
+/// only (at most [`MAX_XML_DEPTH`] deep, checked before).
+fn ignore_unknown_attributes(root: Node<'_, '_>, report: &mut ReadReport) {
+    let namespace = root.tag_name().namespace();
+    let mut pending = vec![root];
+    while let Some(node) = pending.pop() {
+        let tag = node.tag_name();
+        let Some((_, known)) = ATTRIBUTES.iter().find(|(name, _)| *name == tag.name()) else {
+            continue;
+        };
+        if tag.namespace() != namespace {
+            continue;
+        }
+        for attribute in node.attributes() {
+            if attribute.namespace().is_none() && !known.contains(&attribute.name()) {
+                ignore(report, &format!("{} {}", tag.name(), attribute.name()));
+            }
+        }
+        pending.extend(node.children().filter(Node::is_element));
+    }
 }
 
 /// Namespace declarations and attributes an element, counted on the text in one pass: every

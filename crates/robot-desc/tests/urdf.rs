@@ -120,6 +120,19 @@ fn reads_joints_bodies_limits_geometry_and_reports_what_it_merged_and_ignored() 
     for ignored in ["xacro:link", "xacro:property"] {
         assert!(reading.report.ignored.contains_key(ignored), "{ignored}");
     }
+    // The file's attributes are all URDF's; a misspelt one reads as absent and is listed.
+    assert!(
+        !reading.report.ignored.keys().any(|k| k.contains(' ')),
+        "{:?}",
+        reading.report.ignored
+    );
+    let typo = ARM.replace(
+        "<origin xyz=\"0.4 0 0\"/>",
+        "<origin xyz=\"0.4 0 0\" rpy_=\"0 0 1\"/>",
+    );
+    let reading = read_urdf(&typo).unwrap();
+    assert_eq!(reading.robot, *robot);
+    assert_eq!(reading.report.ignored.get("origin rpy_"), Some(&1));
 }
 
 /// The forearm (1 kg, centre at x = 0.15) and tool (0.5 kg at x = 0.3): centre of mass and
