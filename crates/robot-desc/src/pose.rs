@@ -190,24 +190,7 @@ mod tests {
             [0.0, 3.1, 0.0],
         ] {
             let r = rpy_matrix(rpy);
-            let [w, x, y, z] = matrix_quaternion(&r);
-            let q = [
-                [
-                    1.0 - 2.0 * (y * y + z * z),
-                    2.0 * (x * y - w * z),
-                    2.0 * (x * z + w * y),
-                ],
-                [
-                    2.0 * (x * y + w * z),
-                    1.0 - 2.0 * (x * x + z * z),
-                    2.0 * (y * z - w * x),
-                ],
-                [
-                    2.0 * (x * z - w * y),
-                    2.0 * (y * z + w * x),
-                    1.0 - 2.0 * (x * x + y * y),
-                ],
-            ];
+            let q = test_support::numeric::quaternion_matrix(matrix_quaternion(&r));
             assert!(close(&q, &r, 1e-14), "{rpy:?}");
         }
     }

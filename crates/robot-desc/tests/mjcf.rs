@@ -8,6 +8,7 @@ use manip_dyn::{ChainModel, Link};
 use proptest::prelude::*;
 use robot_desc::pose::{Mat3, matrix_quaternion, rpy_matrix};
 use robot_desc::{MJ_MINVAL, from_planar, read_urdf, write_mjcf};
+use test_support::numeric::quaternion_matrix;
 
 /// A one-joint chain: base 'b', link 'a' with the `<inertial>` content `inertial`.
 fn one_link(inertial: &str) -> String {
@@ -42,28 +43,6 @@ fn attribute(text: &str, name: &str) -> Vec<f64> {
         .collect()
 }
 
-/// The rotation of a unit quaternion `[w, x, y, z]`.
-fn quaternion_matrix(q: &[f64]) -> Mat3 {
-    let [w, x, y, z] = [q[0], q[1], q[2], q[3]];
-    [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-        ],
-        [
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-        ],
-        [
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ]
-}
-
 /// `R diag(d) R^T`, exactly symmetric.
 fn turned(r: &Mat3, d: [f64; 3]) -> Mat3 {
     [0, 1, 2].map(|i| [0, 1, 2].map(|j| (0..3).map(|k| d[k] * (r[i][k] * r[j][k])).sum()))
@@ -82,7 +61,10 @@ fn principal_frame_gives_the_tensor(urdf: &str, tolerance: f64) -> Vec<f64> {
     assert!(a + b >= c && a + c >= b && b + c >= a, "{line}");
     let norm = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
     assert!((norm - 1.0).abs() <= 1e-14, "{line}");
-    let back = turned(&quaternion_matrix(&quat), [a, b, c]);
+    let back = turned(
+        &quaternion_matrix([quat[0], quat[1], quat[2], quat[3]]),
+        [a, b, c],
+    );
     let (_, tensor) = robot.joints[0].child.inertial.in_link_frame();
     for i in 0..3 {
         for j in 0..3 {

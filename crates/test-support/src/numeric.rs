@@ -66,6 +66,28 @@ pub fn ridders(mut f: impl FnMut(f64) -> Vec<f64>, x: f64, h: f64) -> (Vec<f64>,
     (best, error)
 }
 
+/// The rotation matrix of the unit quaternion `[w, x, y, z]` (Hamilton's convention, the
+/// matrix acting on column vectors).
+pub fn quaternion_matrix([w, x, y, z]: [f64; 4]) -> [[f64; 3]; 3] {
+    [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -9,6 +9,7 @@ use manip_dyn::spatial::{
     Mat3, SpatialJoint, SpatialLink, SpatialModel, Transform, Vec3, symmetric_eigen,
 };
 use proptest::prelude::*;
+use test_support::numeric::quaternion_matrix;
 
 /// A random rotation: the matrix of a random unit quaternion.
 fn rotation() -> impl Strategy<Value = Mat3> {
@@ -18,24 +19,7 @@ fn rotation() -> impl Strategy<Value = Mat3> {
         })
         .prop_map(|q| {
             let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-            let [w, x, y, z] = q.map(|v| v / norm);
-            [
-                [
-                    1.0 - 2.0 * (y * y + z * z),
-                    2.0 * (x * y - w * z),
-                    2.0 * (x * z + w * y),
-                ],
-                [
-                    2.0 * (x * y + w * z),
-                    1.0 - 2.0 * (x * x + z * z),
-                    2.0 * (y * z - w * x),
-                ],
-                [
-                    2.0 * (x * z - w * y),
-                    2.0 * (y * z + w * x),
-                    1.0 - 2.0 * (x * x + y * y),
-                ],
-            ]
+            quaternion_matrix(q.map(|v| v / norm))
         })
 }
 
