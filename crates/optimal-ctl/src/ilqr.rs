@@ -490,8 +490,12 @@ impl Ilqr {
     /// A step without rows is the box QP's, exactly. A step whose rows admit no control within
     /// the box (a warm start, or a state the momentum carries past them) is planned within the
     /// box alone and counted ([`IlqrReport::relaxed_nodes`]); the forward pass keeps a control
-    /// whose rows admit none. Needs [`reserve_constraints`](Self::reserve_constraints) for
-    /// `constraints.max_rows()` first.
+    /// whose rows admit none. The warm start's rollout moves its controls within the rows too;
+    /// when every such rollout diverges, or the solve from it makes no step, the solve starts
+    /// again from the warm start rolled out without the rows, and from the control references
+    /// should that diverge as well (rows can ask for any torque the box allows, and a rollout
+    /// thrown far from the reference asks for ever more). Needs
+    /// [`reserve_constraints`](Self::reserve_constraints) for `constraints.max_rows()` first.
     ///
     /// # Errors
     /// As [`solve`](Self::solve); [`OptimalError::InvalidSetting`] without the reserved rows;
@@ -517,6 +521,18 @@ impl Ilqr {
         self.solve_with(dynamics, Some(constraints), x0, settings)
     }
 
+    /// Projects the warm start (the control references when `references`) onto the box.
+    fn clamp_to_box_from(&mut self, references: bool) {
+        if references {
+            self.u.copy_from_slice(&self.u_ref);
+        }
+        for chunk in self.u.chunks_exact_mut(self.nu) {
+            for ((u, l), h) in chunk.iter_mut().zip(&self.lower).zip(&self.upper) {
+                *u = if u.is_finite() { *u } else { 0.0 }.clamp(*l, *h);
+            }
+        }
+    }
+
     fn solve_with<D: DiscreteDynamics + ?Sized>(
         &mut self,
         dynamics: &mut D,
@@ -525,13 +541,7 @@ impl Ilqr {
         settings: &IlqrSettings,
     ) -> Result<IlqrReport, OptimalError> {
         self.check(dynamics, x0, settings)?;
-        let steps = settings.line_search_steps;
-        // The warm start, projected onto the box.
-        for chunk in self.u.chunks_exact_mut(self.nu) {
-            for ((u, l), h) in chunk.iter_mut().zip(&self.lower).zip(&self.upper) {
-                *u = if u.is_finite() { *u } else { 0.0 }.clamp(*l, *h);
-            }
-        }
+        self.clamp_to_box_from(false);
         // The previous plan's policy, which the warm start follows when there is one (its open
         // loop amplifies the measured state's offset on an unstable arm); the shifted controls
         // open loop otherwise, or when following diverges.
@@ -541,22 +551,96 @@ impl Ilqr {
             self.x_try.copy_from_slice(&self.x);
             self.u_try.copy_from_slice(&self.u);
         }
-        self.x[..self.nx].copy_from_slice(x0);
         // Within rows, the warm start's rollout moves every control within its step's rows at
         // the state reached (as every forward pass does), so that the first nominal trajectory
         // is feasible; without rows it linearises on its way, unless the dynamics linearise a
         // whole trajectory faster (then every kept trajectory is linearised at once, and a
-        // rejected rollout wastes no Jacobians). `jacobians_current`: the Jacobians computed on
-        // the way stand for the trajectory.
+        // rejected rollout wastes no Jacobians).
         let on_the_fly = constraints.is_none() && !dynamics.linearises_trajectories();
-        let (initial_cost, mut jacobians_current) =
-            match self.warm_rollout(dynamics, constraints.as_deref_mut(), follow, on_the_fly) {
-                Err(error) if follow && diverged(&error) => {
-                    self.u.copy_from_slice(&self.u_try);
-                    self.warm_rollout(dynamics, constraints.as_deref_mut(), false, on_the_fly)?
+        let work = match (&constraints, self.constrained.as_mut()) {
+            (Some(_), Some(work)) => work,
+            _ => {
+                let report =
+                    self.iterate(dynamics, None, (follow, false, on_the_fly), x0, settings)?;
+                self.policy = true;
+                return Ok(report);
+            }
+        };
+        // A rollout within rows may ask for any torque the box allows, and a trajectory thrown
+        // far from the reference asks for ever more: when every warm start within them diverges,
+        // or the solve from it makes no step, the solve starts again from the same warm start
+        // rolled out without them (the backward and forward passes keep the rows as before).
+        work.warm_states.copy_from_slice(&self.x_try);
+        work.warm_controls.copy_from_slice(&self.u);
+        let within = self.iterate(
+            dynamics,
+            constraints.as_deref_mut(),
+            (follow, true, on_the_fly),
+            x0,
+            settings,
+        );
+        let stalled = match &within {
+            Ok(report) => report.iterations == 0 && !report.converged,
+            Err(error) => diverged(error),
+        };
+        let report = match &self.constrained {
+            Some(work) if stalled => {
+                self.x_try.copy_from_slice(&work.warm_states);
+                self.u.copy_from_slice(&work.warm_controls);
+                self.u_try.copy_from_slice(&work.warm_controls);
+                let without = self.iterate(
+                    dynamics,
+                    constraints.as_deref_mut(),
+                    (follow, false, on_the_fly),
+                    x0,
+                    settings,
+                );
+                match without {
+                    Err(error) if diverged(&error) => {
+                        self.clamp_to_box_from(true);
+                        let start = (false, false, on_the_fly);
+                        self.iterate(dynamics, constraints, start, x0, settings)?
+                    }
+                    other => other?,
                 }
-                other => other?,
-            };
+            }
+            _ => within?,
+        };
+        self.policy = true;
+        Ok(report)
+    }
+
+    /// The iterations of [`solve_with`](Self::solve_with) from the warm start in `u` (following
+    /// the plan in `x_try`, `gain` when `follow`; its controls moved within `constraints` when
+    /// `project`; its Jacobians computed on the way when `on_the_fly`).
+    fn iterate<D: DiscreteDynamics + ?Sized>(
+        &mut self,
+        dynamics: &mut D,
+        mut constraints: Option<&mut (dyn StepConstraints + '_)>,
+        (follow, project, on_the_fly): (bool, bool, bool),
+        x0: &[f64],
+        settings: &IlqrSettings,
+    ) -> Result<IlqrReport, OptimalError> {
+        let steps = settings.line_search_steps;
+        self.x[..self.nx].copy_from_slice(x0);
+        // `jacobians_current`: the Jacobians computed on the way stand for the trajectory.
+        let (initial_cost, mut jacobians_current) = match self.warm_rollout(
+            dynamics,
+            constraints.as_deref_mut().filter(|_| project),
+            follow,
+            on_the_fly,
+        ) {
+            Err(error) if follow && diverged(&error) => {
+                self.u.copy_from_slice(&self.u_try);
+                self.warm_rollout(
+                    dynamics,
+                    constraints.as_deref_mut().filter(|_| project),
+                    false,
+                    on_the_fly,
+                )?
+            }
+            other => other?,
+        };
         let mut cost = initial_cost;
         let mut mu = settings.regularisation;
         let mut delta = 1.0;
@@ -642,7 +726,6 @@ impl Ilqr {
                 }
             }
         }
-        self.policy = true;
         Ok(IlqrReport {
             iterations,
             initial_cost,

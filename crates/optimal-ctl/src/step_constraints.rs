@@ -137,6 +137,10 @@ pub(crate) struct ConstrainedWork {
     y_mat: Vec<f64>,
     s_mat: Vec<f64>,
     ax: Vec<f64>,
+    /// The solve's warm start: the plan's states it follows (`(N + 1) n_x`) and its controls
+    /// (`N n_u`), for a second start without the rows.
+    pub(crate) warm_states: Vec<f64>,
+    pub(crate) warm_controls: Vec<f64>,
 }
 
 impl ConstrainedWork {
@@ -171,6 +175,8 @@ impl ConstrainedWork {
             y_mat: vec![0.0; nu * nu],
             s_mat: vec![0.0; nu * nu],
             ax: vec![0.0; nu * nx],
+            warm_states: vec![0.0; (horizon + 1) * nx],
+            warm_controls: vec![0.0; horizon * nu],
         }
     }
 

@@ -50,7 +50,7 @@ pub use mpc::MpcController;
 pub(crate) use mpc_limits::joint_jacobian;
 pub use mpc_limits::{
     ANGLE_ACTIVATION_RAD, BoundConstraints, CLEARANCE_ACTIVATION_M, CLEARANCE_APPROACH_S,
-    MAX_CLEARANCE_MARGIN_M, MAX_CLEARANCE_ROWS, MpcConstraints, MpcLimits,
+    CLEARANCE_LOOKAHEAD_M, MAX_CLEARANCE_MARGIN_M, MAX_CLEARANCE_ROWS, MpcConstraints, MpcLimits,
 };
 pub use pd::PdController;
 

@@ -12,10 +12,15 @@ use optimal_ctl::{JointTorqueLimits, OptimalError, StepConstraints};
 /// within this distance of the margin (m).
 pub const CLEARANCE_ACTIVATION_M: f64 = 0.02;
 
-/// The shortest time (s) in which a pair may close its gap to the clearance margin: at each
-/// node a pair's clearance over the margin may shrink at most by the factor `exp(-h / T)` in
-/// one step of `h` (a discrete-time control barrier function), so the arm slows down towards
-/// an obstacle instead of arriving at the margin at full speed.
+/// A pair's barrier is evaluated at a node when its clearance predicted for the next node is
+/// within this distance beyond [`CLEARANCE_ACTIVATION_M`] of the margin (m).
+pub const CLEARANCE_LOOKAHEAD_M: f64 = 0.05;
+
+/// The time constant `T` (s) of the clearance barrier `psi = d + T d_dot >= c`: a pair's
+/// clearance `d` approaches the margin `c` no faster than `(d - c) / T`, so the arm slows down
+/// towards an obstacle instead of arriving at the margin at full speed, and the torque that
+/// keeps the barrier acts through the next rate (`h T M*^-1`) as well as the next position
+/// (`h^2 M*^-1`).
 pub const CLEARANCE_APPROACH_S: f64 = 0.05;
 
 /// At most this many clearance rows a node: the pairs with the least slack (the arm's few
@@ -76,9 +81,6 @@ struct ClearanceRows {
     model: ClearanceModel,
     data: ClearanceData,
     margin: f64,
-    /// `exp(-h / CLEARANCE_APPROACH_S)`: the most of its gap over the margin a pair keeps in one
-    /// step.
-    retain: f64,
     placement: Placement,
     /// The joints' gradient of one pair's clearance (`n` planar, `2n` spatial), and the modal
     /// map's `J^T` (`m x joints`, row-major).
@@ -128,14 +130,15 @@ enum Placement {
 ///   `s_j(u) + J_j (B_a + T B_v) (u' - u)`, the rows `+-s_j(u') <= L_j` for every joint within
 ///   [`ANGLE_ACTIVATION_RAD`] of its limit at `a` or in `s_j(u)` (with semi-implicit Euler,
 ///   `s_j <= L_j` at every node keeps `theta_j <= L_j` at every node);
-/// - clearance: `d(a_{k+1}(u')) ~ d(a_{k+1}(u)) + grad_a d . B_a (u' - u) >=
-///   min(d(a), c + rho (d(a) - c))`, `rho = exp(-h / T)` with `T` =
-///   [`CLEARANCE_APPROACH_S`], the first-order expansion about the predicted next coordinates
-///   (the modal gradient there: the pair's joint gradient through `J^T`, eq 14; `d(a)` to
-///   first order back from them), for every pair (link-obstacle and link-link) within
-///   [`CLEARANCE_ACTIVATION_M`] of the margin `c` at `a_{k+1}(u)`, the [`MAX_CLEARANCE_ROWS`]
-///   with the least slack: a pair closes its gap over the margin at most by the factor `rho` a
-///   step, and one already inside the margin may not come closer.
+/// - clearance: with `psi(u') = d(a_{k+1}) + T g . a_dot_{k+1}`, `g = grad_a d` at the
+///   predicted next coordinates `a_{k+1}(u)` and `T` = [`CLEARANCE_APPROACH_S`], exactly
+///   `psi(u) + g (B_a + T B_v) (u' - u) >= min(d(a), c)` (the modal gradient: the pair's joint
+///   gradient through `J^T`, eq 14; `d(a)` to first order back from `a_{k+1}`), for every pair
+///   (link-obstacle and link-link) with `d(a_{k+1}(u))` or `psi(u)` within
+///   [`CLEARANCE_ACTIVATION_M`] of the margin `c` (the barrier evaluated for the pairs within
+///   [`CLEARANCE_LOOKAHEAD_M`] more), the [`MAX_CLEARANCE_ROWS`] with the least slack: a pair
+///   approaches the margin no faster than `(d - c) / T`, and one already inside the margin may
+///   not approach at all.
 ///
 /// The solve's gain takes in the joint rows' state dependence (their state Jacobian by forward
 /// differences, [`StepConstraints::state_jacobian`]) when there are no clearance rows.
@@ -192,12 +195,7 @@ impl MpcConstraints {
         };
         let clearance = match &limits.clearance {
             None => None,
-            Some(model) => Some(clearance_rows(
-                plant,
-                model,
-                limits.clearance_margin_m,
-                step,
-            )?),
+            Some(model) => Some(clearance_rows(plant, model, limits.clearance_margin_m)?),
         };
         Ok(Some(Self {
             m,
@@ -320,56 +318,69 @@ impl MpcConstraints {
         }
         if let Some(c) = &mut self.clearance {
             let (rows, bounds) = (&mut rows[count * m..], &mut bounds[count..]);
-            count += c.rows(plant, (a, &self.next[..m], u, b_a), rows, bounds)?;
+            let (next_a, next_v) = self.next.split_at(m);
+            count += c.rows(plant, (a, next_a, next_v, u), (b_a, b_v), rows, bounds)?;
         }
         Ok(count)
     }
 }
 
 impl ClearanceRows {
-    /// Writes the clearance rows at the node `a` whose next coordinates at `u` are `next_a`,
-    /// with `b_a = d a_{k+1} / d u`; returns their number.
+    /// Writes the clearance rows at the node `a` whose next coordinates and rates at `u` are
+    /// `next_a`, `next_v`, with `b_a = d a_{k+1} / d u`, `b_v = d a_dot_{k+1} / d u`; returns
+    /// their number.
     fn rows(
         &mut self,
         plant: Plant<'_>,
-        (a, next_a, u, b_a): (&[f64], &[f64], &[f64], &[f64]),
+        (a, next_a, next_v, u): (&[f64], &[f64], &[f64], &[f64]),
+        (b_a, b_v): (&[f64], &[f64]),
         rows: &mut [f64],
         bounds: &mut [f64],
     ) -> Result<usize, OptimalError> {
         let m = a.len();
+        let approach = CLEARANCE_APPROACH_S;
         // Every pair's clearance at the predicted next coordinates.
         self.place(plant, next_a)?;
         clearance::distances(&self.model, &mut self.data);
         let reach = self.margin + CLEARANCE_ACTIVATION_M;
         let mut n_candidates = 0;
         for (p, &next) in self.data.distances().iter().enumerate() {
-            if next < reach {
+            if next < reach + CLEARANCE_LOOKAHEAD_M {
                 self.candidates[n_candidates] = (next, p);
                 n_candidates += 1;
             }
         }
-        // Their modal gradients there, and the slack over the floor
-        // min(d(a), c + retain (d(a) - c)), d(a) to first order back from the next coordinates.
+        // Their modal gradients there, the barrier psi = d + T d_dot at the next node and its
+        // slack over the floor min(d(a), c), d(a) to first order back from the next
+        // coordinates; a pair neither near the margin nor approaching it fast is dropped.
+        let mut kept = 0;
         for c in 0..n_candidates {
             let (next, p) = self.candidates[c];
             self.gradient(m, p)?;
             let gradient = &self.gradients[p * m..(p + 1) * m];
             let now = next - dot_difference(gradient, next_a, a);
-            let floor = now.min(self.margin + self.retain * (now - self.margin));
-            self.candidates[c].0 = next - floor;
+            let psi = next + approach * dot(gradient, next_v);
+            if next.min(psi) >= reach {
+                continue;
+            }
+            self.candidates[kept] = (psi - now.min(self.margin), p);
+            kept += 1;
         }
+        n_candidates = kept;
         if n_candidates > MAX_CLEARANCE_ROWS {
             self.candidates[..n_candidates]
                 .select_nth_unstable_by(MAX_CLEARANCE_ROWS - 1, |x, y| x.0.total_cmp(&y.0));
             n_candidates = MAX_CLEARANCE_ROWS;
         }
         for (r, &(slack, p)) in self.candidates[..n_candidates].iter().enumerate() {
-            // d(a_{k+1}(u')) ~ d(a_{k+1}(u)) + c . (u' - u) >= floor, c = grad d . B_a:
+            // psi(u') ~ psi(u) + c . (u' - u) >= floor, c = grad d . (B_a + T B_v):
             // -c . u' <= slack - c . u.
             let gradient = &self.gradients[p * m..(p + 1) * m];
             let row = &mut rows[r * m..(r + 1) * m];
             for (i, value) in row.iter_mut().enumerate() {
-                *value = -(0..m).map(|l| gradient[l] * b_a[l * m + i]).sum::<f64>();
+                *value = -(0..m)
+                    .map(|l| gradient[l] * (b_a[l * m + i] + approach * b_v[l * m + i]))
+                    .sum::<f64>();
             }
             bounds[r] = slack + dot(row, u);
             self.pairs[r] = p;
@@ -545,7 +556,6 @@ fn clearance_rows(
     plant: Plant<'_>,
     model: &ClearanceModel,
     margin: f64,
-    step: f64,
 ) -> Result<ClearanceRows, SimError> {
     if !(margin.is_finite() && (0.0..=MAX_CLEARANCE_MARGIN_M).contains(&margin)) {
         return Err(SimError::setting(
@@ -592,7 +602,6 @@ fn clearance_rows(
         model: model.clone(),
         data,
         margin,
-        retain: (-step / CLEARANCE_APPROACH_S).exp(),
         placement,
         joint_gradient: vec![0.0; plant.n_joints()],
         jacobian_t: transpose(&joint_jacobian(plant)?, m),

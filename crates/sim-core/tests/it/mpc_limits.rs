@@ -65,22 +65,22 @@ fn clearances(plant: Plant<'_>, model: &ClearanceModel, a: &[f64]) -> Vec<f64> {
     data.distances().to_vec()
 }
 
-/// One semi-implicit Euler step of the plan's dynamics: the next coordinates `a_{k+1}`.
-fn next_coordinates(plant: Plant<'_>, x: &[f64], u: &[f64], h: f64) -> Vec<f64> {
+/// One semi-implicit Euler step of the plan's dynamics: the next state `(a_{k+1}, a_dot_{k+1})`.
+fn next_state(plant: Plant<'_>, x: &[f64], u: &[f64], h: f64) -> Vec<f64> {
     let (mut data, mut derivatives) = (PlantData::new(plant), PlantDerivatives::new(plant));
     let mut euler = ReducedEuler::new(plant, &mut data, &mut derivatives, h).unwrap();
     let mut next = vec![0.0; x.len()];
     euler.step(x, u, &mut next).unwrap();
-    next.truncate(x.len() / 2);
     next
 }
 
 /// Checks the clearance rows of `plant` at `(x, u)` among spheres set 5 mm (clearance) beside
 /// links 4 and 8 and one far away, with a 1 cm margin: every row is the first-order expansion
-/// in `u'` of its pair's clearance after one step of the dynamics, `d(a_{k+1}(u'))`: its
-/// coefficients are the central finite differences of the true clearance there, its value at
-/// `u` the true clearance there less the floor `min(d(a), margin + rho (d(a) - margin))`,
-/// `rho = exp(-h / CLEARANCE_APPROACH_S)`.
+/// in `u'` of its pair's barrier after one step of the dynamics,
+/// `psi(u') = d(a_{k+1}(u')) + T g . a_dot_{k+1}(u')` (`T` = `CLEARANCE_APPROACH_S`, `g` the
+/// clearance's modal gradient at `a_{k+1}(u)`, by central differences here): its coefficients
+/// are the central finite differences of the true `psi`, its value at `u` the true `psi` less
+/// the floor `min(d(a), margin)`.
 fn check_clearance_rows(plant: Plant<'_>, x: &[f64], u: &[f64]) {
     let (h, m) = (0.005, plant.n_coords());
     let a = &x[..m];
@@ -135,16 +135,32 @@ fn check_clearance_rows(plant: Plant<'_>, x: &[f64], u: &[f64]) {
     }
     assert!(pairs.iter().all(|&p| p >= 30 || p % 3 != 2), "{pairs:?}");
     let now = clearances(plant, &model, a);
-    let at_u = clearances(plant, &model, &next_coordinates(plant, x, u, h));
+    let next = next_state(plant, x, u, h);
     for (r, &pair) in pairs.iter().enumerate() {
         let row = &rows[r * m..(r + 1) * m];
-        // The row is -c . u' <= d(a_{k+1}(u)) - floor - c . u: its value at u is the clearance
-        // after the step less the floor (d(a) to first order: the step is a few mrad).
+        // The clearance's modal gradient at the predicted coordinates.
+        let gradient: Vec<f64> = (0..m)
+            .map(|i| {
+                let eps = 1e-6;
+                let (mut up, mut down) = (next[..m].to_vec(), next[..m].to_vec());
+                up[i] += eps;
+                down[i] -= eps;
+                let (d_up, d_down) = (
+                    clearances(plant, &model, &up),
+                    clearances(plant, &model, &down),
+                );
+                (d_up[pair] - d_down[pair]) / (2.0 * eps)
+            })
+            .collect();
+        let psi = |state: &[f64]| {
+            let rate: f64 = gradient.iter().zip(&state[m..]).map(|(g, v)| g * v).sum();
+            clearances(plant, &model, &state[..m])[pair] + CLEARANCE_APPROACH_S * rate
+        };
+        // The row is -c . u' <= psi(u) - floor - c . u: its value at u is the barrier after the
+        // step less the floor (d(a) to first order: the step is a few mrad).
         let cu: f64 = row.iter().zip(u).map(|(g, u)| g * u).sum();
         let value = bounds[r] - cu;
-        let rho = (-h / CLEARANCE_APPROACH_S).exp();
-        let floor = now[pair].min(margin + rho * (now[pair] - margin));
-        let expected = at_u[pair] - floor;
+        let expected = psi(&next) - now[pair].min(margin);
         assert!(
             (value - expected).abs() < 1e-5,
             "pair {pair}: {value} vs {expected}"
@@ -154,9 +170,8 @@ fn check_clearance_rows(plant: Plant<'_>, x: &[f64], u: &[f64]) {
             let (mut up, mut down) = (u.to_vec(), u.to_vec());
             up[i] += eps;
             down[i] -= eps;
-            let d_up = clearances(plant, &model, &next_coordinates(plant, x, &up, h))[pair];
-            let d_down = clearances(plant, &model, &next_coordinates(plant, x, &down, h))[pair];
-            let fd = (d_up - d_down) / (2.0 * eps);
+            let fd = (psi(&next_state(plant, x, &up, h)) - psi(&next_state(plant, x, &down, h)))
+                / (2.0 * eps);
             assert!(
                 (-row[i] - fd).abs() < 1e-6 * fd.abs().max(1e-6),
                 "pair {pair}, u{i}: {} vs {fd}",
