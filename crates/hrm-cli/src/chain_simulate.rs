@@ -5,20 +5,36 @@
 use crate::console;
 use crate::output_dir::OutputDir;
 use lane_math::Compact;
-use sim_core::ChainRun;
+use sim_core::{ChainFailure, ChainRun};
 use sim_study::Scenario;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Runs `scenario` (its arm a URDF chain) and writes its files into `out`; a run that fails
-/// writes nothing.
+/// Runs `scenario` (its arm a URDF chain) and writes its files into `out`; a run that stops
+/// writes them up to the stop (`summary.json` with its `error` and `stopped_at_s`) and fails with
+/// its error, one that fails before its first recorded sample writes nothing.
 pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
-    let run = scenario.run_chain().map_err(|e| e.to_string())?;
+    let (run, stop) = match scenario.run_chain() {
+        Ok(run) => (run, None),
+        Err(ChainFailure {
+            error,
+            partial: Some(run),
+        }) => (*run, Some(error)),
+        Err(ChainFailure {
+            error,
+            partial: None,
+        }) => return Err(error.to_string()),
+    };
     let summary = &run.summary;
     let n = summary.joint_error_rms.len();
     let staging = OutputDir::create(out, "simulate")?;
     let dir = staging.path();
-    let json = sim_study::summary_json::chain(scenario, "urdf", &run);
+    let mut json = sim_study::summary_json::chain(scenario, "urdf", &run);
+    let mut stopped = String::new();
+    if let Some(error) = &stop {
+        json = sim_study::summary_json::stopped(json, error, &run);
+        stopped = format!("stopped: {error}\n");
+    }
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
     write(&dir.join("summary.json"), &text)?;
     write(&dir.join("scenario.toml"), &scenario.to_toml())?;
@@ -27,7 +43,7 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
     let rms = |values: &[f64]| (values.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt();
     console::print(&format!(
         "{}: computed torque on a {n}-joint URDF chain: joint error RMS {:.3e} (over joints and \
-         time), max {:.3e}, final |q - q_ref| {:.3e}\nwrote {}\n",
+         time), max {:.3e}, final |q - q_ref| {:.3e}\n{stopped}wrote {}\n",
         scenario.name,
         rms(&summary.joint_error_rms),
         summary
@@ -36,7 +52,8 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
             .fold(0.0f64, |m, e| m.max(*e)),
         summary.final_error,
         out.display()
-    ))
+    ))?;
+    stop.map_or(Ok(()), |error| Err(error.to_string()))
 }
 
 /// The `timeseries.csv` of a joint-space run: `t`, then `q_i`, `q_ref_i`, `tau_i` per joint.

@@ -9,28 +9,45 @@ use crate::output_dir::OutputDir;
 use crate::plot::{self, Labels, Series, Style};
 use crate::{console, report};
 use lane_math::Compact;
-use sim_study::{ControllerKind, DeployRun, Scenario};
+use sim_core::SimError;
+use sim_study::{ControllerKind, DeployFailure, DeployRun, Scenario};
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// Interval between the drawn arm shapes (s).
 const SHAPE_INTERVAL_S: f64 = 0.5;
 
-/// Runs `scenario` (with a `[deploy]`) and writes its files into `out`; a run that fails writes
-/// nothing.
+/// Runs `scenario` (with a `[deploy]`) and writes its files into `out`; a run that stops writes
+/// them up to the stop (`summary.json` with its `error` and `stopped_at_s`) and fails with its
+/// error, one that fails before its first recorded sample writes nothing.
 pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
-    let run = scenario.run_deploy().map_err(|e| e.to_string())?;
+    let (run, stop) = match scenario.run_deploy() {
+        Ok(run) => (run, None),
+        Err(DeployFailure {
+            error,
+            partial: Some(run),
+        }) => (*run, Some(error)),
+        Err(DeployFailure {
+            error,
+            partial: None,
+        }) => return Err(error.to_string()),
+    };
     let staging = OutputDir::create(out, "simulate")?;
-    write_run(staging.path(), scenario, &run)?;
+    write_run(staging.path(), scenario, &run, stop.as_ref())?;
     staging.commit()?;
     if let Some(warning) = wall_warning(&run) {
         eprintln!("warning: {warning}");
     }
+    let stopped = match &stop {
+        Some(error) => format!("stopped: {error}\n"),
+        None => String::new(),
+    };
     console::print(&format!(
-        "{}\nwrote {}\n",
+        "{}\n{stopped}wrote {}\n",
         headline(scenario, &run),
         out.display()
-    ))
+    ))?;
+    stop.map_or(Ok(()), |error| Err(error.to_string()))
 }
 
 /// A warning when the arm's capsules reach the channel's walls or beyond (a negative smallest
@@ -71,16 +88,27 @@ pub fn headline(scenario: &Scenario, run: &DeployRun) -> String {
     )
 }
 
-/// The run's `summary.json` ([`sim_study::summary_json::deploy`]).
-pub fn summary(scenario: &Scenario, run: &DeployRun) -> serde_json::Value {
-    sim_study::summary_json::deploy(scenario, run)
+/// The run's `summary.json` ([`sim_study::summary_json::deploy`]), of a run that stopped with
+/// `stop` if given ([`sim_study::summary_json::stopped`]).
+pub fn summary(scenario: &Scenario, run: &DeployRun, stop: Option<&SimError>) -> serde_json::Value {
+    let summary = sim_study::summary_json::deploy(scenario, run);
+    match stop {
+        Some(error) => sim_study::summary_json::stopped(summary, error, &run.run),
+        None => summary,
+    }
 }
 
-/// Writes `scenario.toml`, `summary.json`, `timeseries.csv` and `links.csv` of `run` into
-/// `dir` (created if needed).
-pub fn write_run(dir: &Path, scenario: &Scenario, run: &DeployRun) -> Result<(), String> {
+/// Writes `scenario.toml`, `summary.json`, `timeseries.csv` and `links.csv` of `run` (one that
+/// stopped with `stop`, if given) into `dir` (created if needed).
+pub fn write_run(
+    dir: &Path,
+    scenario: &Scenario,
+    run: &DeployRun,
+    stop: Option<&SimError>,
+) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    let text = serde_json::to_string_pretty(&summary(scenario, run)).map_err(|e| e.to_string())?;
+    let text =
+        serde_json::to_string_pretty(&summary(scenario, run, stop)).map_err(|e| e.to_string())?;
     write(&dir.join("summary.json"), &(text + "\n"))?;
     write(&dir.join("scenario.toml"), &scenario.to_toml())?;
     write(&dir.join("timeseries.csv"), &chain_timeseries(&run.run))?;
@@ -347,5 +375,38 @@ mod tests {
         assert!(run.plan.min_wall_clearance > 0.0);
         let warning = wall_warning(&run).unwrap();
         assert!(warning.contains("the tracking does not"), "{warning}");
+    }
+
+    #[test]
+    fn a_deployment_that_stops_writes_its_files_up_to_the_stop() {
+        // The MPC hurrying through the bend strays past a joint bound of 5 cm (or rad).
+        let mut scenario = Scenario::builtin("pipe-deploy").unwrap();
+        scenario.controller.kind = ControllerKind::Mpc;
+        scenario.reference = sim_study::ReferenceSpec::Planned { travel_time: 0.4 };
+        scenario.duration = 0.6;
+        scenario.limits.max_modal_error = 0.05;
+        let failure = scenario.run_deploy().unwrap_err();
+        let run = failure.partial.as_deref().expect("samples before the stop");
+        let stop = run.run.record.t.last().copied().unwrap();
+        assert!(stop > 0.0 && stop < 0.6, "{stop}");
+        assert!(
+            failure.error.to_string().contains("runaway"),
+            "{}",
+            failure.error
+        );
+        let dir = std::env::temp_dir().join(format!("hrm-deploy-stopped-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let error = simulate(&scenario, &dir).unwrap_err();
+        assert_eq!(error, failure.error.to_string());
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["error"], error.as_str());
+        assert_eq!(summary["stopped_at_s"], stop);
+        assert_eq!(summary["deploy_tip_error_m"], run.metrics.tip_error);
+        let links = std::fs::read_to_string(dir.join("links.csv")).unwrap();
+        assert_eq!(links.lines().count(), 1 + run.run.record.t.len());
+        assert!(dir.join("timeseries.csv").is_file() && dir.join("scenario.toml").is_file());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

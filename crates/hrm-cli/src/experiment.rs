@@ -9,7 +9,7 @@ use serde_json::json;
 use sim_core::Run;
 use sim_study::imitation::{self, ImitationOptions};
 use sim_study::study::{self, ComparisonRun, run_one, run_prepared};
-use sim_study::{ArmKind, ControllerKind, ReferenceSpec, Scenario, Workspace};
+use sim_study::{ArmKind, ControllerKind, DeployFailure, ReferenceSpec, Scenario, Workspace};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -149,8 +149,9 @@ fn experiments(out: &Path, all: &[Scenario]) -> Result<(), String> {
 /// The deployment scenarios' runs (computed torque, then MPC, in joint space,
 /// [`Scenario::run_deploy`]): each run's files into `out/<scenario>/<controller>` and its
 /// figures into `out/figures`;
-/// returns their entries of the main `summary.json` (a run that fails: its `error`) and the
-/// report's figures.
+/// returns their entries of the main `summary.json` (a run that fails: its `error`, and the
+/// summary up to the stop of one that stopped after its first recorded sample, whose figures
+/// are not drawn) and the report's figures.
 fn deploy_runs(
     out: &Path,
     scenarios: &[Scenario],
@@ -172,12 +173,20 @@ fn deploy_runs(
         let dir = out.join(&scenario.name).join(controller);
         match scenario.run_deploy() {
             Ok(run) => {
-                deploy_simulate::write_run(&dir, scenario, &run)?;
+                deploy_simulate::write_run(&dir, scenario, &run, None)?;
                 figures.extend(deploy_simulate::figures(&figures_dir, scenario, &run)?);
-                let summary = deploy_simulate::summary(scenario, &run);
+                let summary = deploy_simulate::summary(scenario, &run, None);
                 summaries.push(json!({"scenario": scenario.name, "controller": controller, "summary": summary}));
             }
-            Err(e) => {
+            Err(DeployFailure {
+                error,
+                partial: Some(run),
+            }) => {
+                deploy_simulate::write_run(&dir, scenario, &run, Some(&error))?;
+                let summary = deploy_simulate::summary(scenario, &run, Some(&error));
+                summaries.push(json!({"scenario": scenario.name, "controller": controller, "error": error.to_string(), "summary": summary}));
+            }
+            Err(DeployFailure { error: e, .. }) => {
                 std::fs::create_dir_all(&dir)
                     .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
                 write(&dir.join("scenario.toml"), &scenario.to_toml())?;

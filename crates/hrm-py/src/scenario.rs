@@ -20,7 +20,7 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use sim_core::LoopHooks;
 use sim_core::controller::{ControlContext, Controller, ControllerError, ModalState};
 use sim_study::study::{RunOutcome, Stopped};
-use sim_study::{ControllerKind, ScenarioError};
+use sim_study::{ControllerKind, DeployFailure, ScenarioError};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 /// A closed-loop experiment: arm, modal family, reference, controller, integrator, noise and
@@ -898,13 +898,29 @@ impl Scenario {
     /// plan's under `plan`), `t` (shape (K,)), `q`, `q_ref`, `tau` (shape (K, n + 1), the
     /// insertion first) and `points` (shape (K, n + 1, 2): the base and every link's end, as
     /// `links.csv`). Runs with the GIL released. A scenario without `[deploy]` or with keys a
-    /// deployment does not use raises InvalidInput naming the key; a run that diverges raises
-    /// the error of its class.
+    /// deployment does not use raises InvalidInput naming the key. A run that stops (runaway
+    /// tracking error, integrator or controller failure) returns the data up to its last
+    /// recorded sample, its summary with the extra keys "error" and "stopped_at_s" as the
+    /// summary.json of `hrm simulate` (and `Run.failure` of `Scenario.run`); one that stops
+    /// before its first recorded sample raises the error of its class.
     fn run_deploy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let scenario = self.get();
-        let run = pool::run(py, &Cancel::new(), || scenario.run_deploy())?.map_err(Error::from)?;
+        let (run, stop) = match pool::run(py, &Cancel::new(), || scenario.run_deploy())? {
+            Ok(run) => (run, None),
+            Err(DeployFailure {
+                error,
+                partial: Some(run),
+            }) => (*run, Some(error)),
+            Err(DeployFailure {
+                error,
+                partial: None,
+            }) => return Err(Error::from(error).into()),
+        };
         let out = PyDict::new(py);
-        let summary = sim_study::summary_json::deploy(&scenario, &run);
+        let mut summary = sim_study::summary_json::deploy(&scenario, &run);
+        if let Some(error) = &stop {
+            summary = sim_study::summary_json::stopped(summary, error, &run.run);
+        }
         out.set_item("summary", crate::value::to_py(py, &summary)?)?;
         let record = &run.run.record;
         let joints = run.run.summary.joint_error_rms.len();

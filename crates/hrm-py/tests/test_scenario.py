@@ -355,6 +355,22 @@ def test_scenarios_pickle():
     assert clone.to_dict() == scenario.to_dict()
 
 
+def test_a_deployment_that_stops_returns_its_data_up_to_the_stop():
+    """`Scenario.run_deploy` of a run that stops on a runaway joint: the data up to the stop,
+    its summary with "error" and "stopped_at_s" (the last recorded time), as Scenario.run."""
+    scenario = hrm.Scenario.builtin("pipe-deploy")
+    scenario.duration = 0.5
+    scenario.limits.max_modal_error = 1e-7
+    stopped = scenario.run_deploy()
+    summary = stopped["summary"]
+    assert "runaway tracking error" in summary["error"]
+    k = len(stopped["t"])
+    assert 0 < k < 500 and summary["stopped_at_s"] == stopped["t"][-1]
+    assert stopped["q"].shape == (k, scenario.arm.links + 1)
+    assert stopped["points"].shape == (k, scenario.arm.links + 1, 2)
+    assert math.isfinite(summary["deploy_tip_error_m"])
+
+
 def test_pipe_deploy_runs_with_mpc_within_joint_torque_nm():
     """`Scenario.run_deploy`: pipe-deploy with the joint-space MPC, 0.3 s of it, within a joint
     torque limit set from Python; the arrays checked against each other and the arm."""

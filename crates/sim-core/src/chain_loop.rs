@@ -89,6 +89,41 @@ pub struct ChainRun {
     pub record: ChainRecord,
 }
 
+/// A chain run that stopped: why, and the run up to its last recorded sample (its metrics over
+/// the samples before the stop, `final_error` at the last recorded one), or `None` when it
+/// stopped before its first recorded sample (a setting out of its domain, or a failure at
+/// `t = 0`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainFailure {
+    /// Why and when the run stopped.
+    pub error: SimError,
+    /// The run up to the stop.
+    pub partial: Option<Box<ChainRun>>,
+}
+
+impl std::fmt::Display for ChainFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.error.fmt(f)
+    }
+}
+
+impl std::error::Error for ChainFailure {}
+
+impl From<SimError> for ChainFailure {
+    fn from(error: SimError) -> Self {
+        Self {
+            error,
+            partial: None,
+        }
+    }
+}
+
+impl From<ChainFailure> for SimError {
+    fn from(failure: ChainFailure) -> Self {
+        failure.error
+    }
+}
+
 /// The plant between two controller samples: `(q, v)' = (v, ABA(q, v, tau))`.
 struct Plant<'a> {
     model: &'a SpatialModel,
@@ -175,13 +210,14 @@ fn check(settings: &ChainLoopSettings, n: usize, gains: bool) -> Result<usize, S
 /// [`SimError::InvalidSetting`] for a setting out of its domain (named as in a scenario file) or
 /// a reference or `q0` of the wrong length; [`SimError::ChainDynamics`] if the dynamics fail at
 /// a controller sample, [`SimError::ChainIntegration`] if they fail or blow up between two,
-/// [`SimError::JointRunaway`] past `max_joint_error`.
+/// [`SimError::JointRunaway`] past `max_joint_error`; each in a [`ChainFailure`] with the run up
+/// to the stop when it stopped after its first controller sample.
 pub fn run_chain_loop(
     model: &SpatialModel,
     reference: &mut dyn Reference,
     q0: &[f64],
     settings: &ChainLoopSettings,
-) -> Result<ChainRun, SimError> {
+) -> Result<ChainRun, ChainFailure> {
     run(model, reference, q0, settings, None)
 }
 
@@ -197,7 +233,7 @@ pub fn run_chain_loop_mpc(
     q0: &[f64],
     settings: &ChainLoopSettings,
     mpc: &mut ChainMpcController,
-) -> Result<ChainRun, SimError> {
+) -> Result<ChainRun, ChainFailure> {
     run(model, reference, q0, settings, Some(mpc))
 }
 
@@ -208,7 +244,7 @@ fn run(
     q0: &[f64],
     settings: &ChainLoopSettings,
     mut mpc: Option<&mut ChainMpcController>,
-) -> Result<ChainRun, SimError> {
+) -> Result<ChainRun, ChainFailure> {
     let n = model.n_links();
     let periods = check(settings, n, mpc.is_none())?;
     if reference.n_coords() != n {
@@ -218,15 +254,17 @@ fn run(
                 "sets {} coordinates, expected one per joint of the URDF arm ({n})",
                 reference.n_coords()
             ),
-        ));
+        )
+        .into());
     }
     if q0.len() != n {
         return Err(SimError::setting(
             "initial.a",
             format!("has {} entries, expected one per joint ({n})", q0.len()),
-        ));
+        )
+        .into());
     }
-    check_all_finite("initial.a", q0)?;
+    check_all_finite("initial.a", q0).map_err(SimError::from)?;
     let mut data = SpatialData::new(model);
     let mut rk4 = Rk4::new(2 * n);
     let mut state = vec![0.0; 2 * n];
@@ -251,75 +289,95 @@ fn run(
     for values in [&mut record.q, &mut record.q_ref, &mut record.tau] {
         values.reserve_exact(samples * n);
     }
-    for k in 0..=periods {
-        let t = (k as f64 * settings.period).min(settings.duration);
-        reference.sample(t, &mut sample)?;
-        let (q, v) = state.split_at(n);
-        for (i, (r, x)) in sample.a.iter().zip(q).enumerate() {
-            let error = r - x;
-            if error.abs() > settings.max_joint_error || !error.is_finite() {
-                return Err(SimError::JointRunaway {
-                    t,
-                    joint: i + 1,
-                    error: error.abs(),
-                    bound: settings.max_joint_error,
-                });
-            }
-        }
-        match mpc.as_deref_mut() {
-            None => {
-                for i in 0..n {
-                    command[i] = sample.a_ddot[i]
-                        + settings.kd[i] * (sample.a_dot[i] - v[i])
-                        + settings.kp[i] * (sample.a[i] - q[i]);
+    // The samples, into `record` and `summary` (those up to a stop are kept).
+    let mut samples_of = || -> Result<(), SimError> {
+        for k in 0..=periods {
+            let t = (k as f64 * settings.period).min(settings.duration);
+            reference.sample(t, &mut sample)?;
+            let (q, v) = state.split_at(n);
+            for (i, (r, x)) in sample.a.iter().zip(q).enumerate() {
+                let error = r - x;
+                if error.abs() > settings.max_joint_error || !error.is_finite() {
+                    return Err(SimError::JointRunaway {
+                        t,
+                        joint: i + 1,
+                        error: error.abs(),
+                        bound: settings.max_joint_error,
+                    });
                 }
-                rnea(model, &mut data, q, v, &command, &mut tau)
-                    .map_err(|source| SimError::ChainDynamics { t, source })?;
             }
-            Some(mpc) => mpc
-                .command(model, t, q, v, &sample, &mut tau)
-                .map_err(|error| SimError::from_controller(t, error))?,
-        }
-        summary.controller_samples += 1;
-        for (peak, effort) in summary.peak_joint_efforts.iter_mut().zip(&tau) {
-            *peak = peak.max(effort.abs());
-        }
-        if k % every == 0 || k == periods {
-            record.t.push(t);
-            record.q.extend_from_slice(q);
-            record.q_ref.extend_from_slice(&sample.a);
-            record.tau.extend_from_slice(&tau);
-            for i in 0..n {
-                let error = (q[i] - sample.a[i]).abs();
-                squares[i] += error * error;
-                summary.joint_error_max[i] = summary.joint_error_max[i].max(error);
+            match mpc.as_deref_mut() {
+                None => {
+                    for i in 0..n {
+                        command[i] = sample.a_ddot[i]
+                            + settings.kd[i] * (sample.a_dot[i] - v[i])
+                            + settings.kp[i] * (sample.a[i] - q[i]);
+                    }
+                    rnea(model, &mut data, q, v, &command, &mut tau)
+                        .map_err(|source| SimError::ChainDynamics { t, source })?;
+                }
+                Some(mpc) => mpc
+                    .command(model, t, q, v, &sample, &mut tau)
+                    .map_err(|error| SimError::from_controller(t, error))?,
             }
+            summary.controller_samples += 1;
+            for (peak, effort) in summary.peak_joint_efforts.iter_mut().zip(&tau) {
+                *peak = peak.max(effort.abs());
+            }
+            if k % every == 0 || k == periods {
+                record.t.push(t);
+                record.q.extend_from_slice(q);
+                record.q_ref.extend_from_slice(&sample.a);
+                record.tau.extend_from_slice(&tau);
+                for i in 0..n {
+                    let error = (q[i] - sample.a[i]).abs();
+                    squares[i] += error * error;
+                    summary.joint_error_max[i] = summary.joint_error_max[i].max(error);
+                }
+            }
+            if k == periods {
+                summary.final_error = q
+                    .iter()
+                    .zip(&sample.a)
+                    .map(|(x, r)| (x - r).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                break;
+            }
+            let t1 = ((k + 1) as f64 * settings.period).min(settings.duration);
+            let mut plant = Plant {
+                model,
+                data: &mut data,
+                tau: &tau,
+            };
+            let stats = rk4
+                .integrate(&mut plant, t, t1, &mut state, settings.dt)
+                .map_err(SimError::ChainIntegration)?;
+            summary.steps += stats.accepted;
         }
-        if k == periods {
-            summary.final_error = q
-                .iter()
-                .zip(&sample.a)
-                .map(|(x, r)| (x - r).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            break;
-        }
-        let t1 = ((k + 1) as f64 * settings.period).min(settings.duration);
-        let mut plant = Plant {
-            model,
-            data: &mut data,
-            tau: &tau,
-        };
-        let stats = rk4
-            .integrate(&mut plant, t, t1, &mut state, settings.dt)
-            .map_err(SimError::ChainIntegration)?;
-        summary.steps += stats.accepted;
-    }
-    let samples = record.t.len() as f64;
+        Ok(())
+    };
+    let outcome = samples_of();
+    let samples = record.t.len();
     for (rms, square) in summary.joint_error_rms.iter_mut().zip(&squares) {
-        *rms = (square / samples).sqrt();
+        *rms = (square / samples as f64).sqrt();
     }
-    Ok(ChainRun { summary, record })
+    match outcome {
+        Ok(()) => Ok(ChainRun { summary, record }),
+        Err(error) => {
+            let partial = (samples > 0).then(|| {
+                let last = (samples - 1) * n..samples * n;
+                summary.final_error = record.q[last.clone()]
+                    .iter()
+                    .zip(&record.q_ref[last])
+                    .map(|(x, r)| (x - r).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                Box::new(ChainRun { summary, record })
+            });
+            Err(ChainFailure { error, partial })
+        }
+    }
 }
 
 #[cfg(test)]
@@ -412,14 +470,43 @@ mod tests {
     }
 
     #[test]
+    fn a_run_that_stops_keeps_its_samples_up_to_the_stop() {
+        let model = arm();
+        let target = [0.3, -0.2, 0.1, 0.4, -0.3, 0.2, 0.1];
+        let mut s = settings(7);
+        s.max_joint_error = 0.35;
+        s.record_period = 1e-2;
+        // The step at t = 0.25 s puts joint 4 beyond the bound at once.
+        let mut step = Step::new(&[0.0; 7], &target, 0.25).unwrap();
+        let failure = run_chain_loop(&model, &mut step, &[0.0; 7], &s).unwrap_err();
+        assert!(
+            matches!(failure.error, SimError::JointRunaway { joint: 4, t, .. } if (t - 0.25).abs() < 1e-12),
+            "{:?}",
+            failure.error
+        );
+        assert_eq!(failure.to_string(), failure.error.to_string());
+        let run = failure.partial.expect("samples before the stop");
+        // Every 100th controller sample of the 2500 before the step.
+        assert_eq!(run.record.t.len(), 25);
+        assert!((run.record.t[24] - 0.24).abs() < 1e-12);
+        assert_eq!(run.record.q.len(), 25 * 7);
+        assert_eq!(run.summary.controller_samples, 2500);
+        // At rest on a zero reference before the step: the errors over the samples are zero.
+        assert!(run.summary.joint_error_max.iter().all(|e| *e < 1e-12));
+        assert!(run.summary.final_error < 1e-12);
+    }
+
+    #[test]
     fn a_runaway_joint_is_named_in_joint_terms() {
         let model = arm();
         let target = [0.3, -0.2, 0.1, 0.4, -0.3, 0.2, 0.1];
         let mut step = Step::new(&[0.0; 7], &target, 0.0).unwrap();
         let mut s = settings(7);
         s.max_joint_error = 0.35;
-        let e = run_chain_loop(&model, &mut step, &[0.0; 7], &s).unwrap_err();
-        // Joint 4's step of 0.4 rad is beyond the bound at once.
+        let failure = run_chain_loop(&model, &mut step, &[0.0; 7], &s).unwrap_err();
+        // Joint 4's step of 0.4 rad is beyond the bound at once: nothing was recorded.
+        assert_eq!(failure.partial, None);
+        let e = failure.error;
         assert!(
             matches!(
                 e,

@@ -14,7 +14,8 @@ mod simulation;
 pub const MAX_COORDINATES: usize = 2 * backbone_kin::MAX_HARMONICS + 1;
 
 pub use chain_loop::{
-    ChainLoopSettings, ChainRecord, ChainRun, ChainSummary, run_chain_loop, run_chain_loop_mpc,
+    ChainFailure, ChainLoopSettings, ChainRecord, ChainRun, ChainSummary, run_chain_loop,
+    run_chain_loop_mpc,
 };
 pub use error::{ControllerFailure, SimError};
 pub use record::{Record, Summary, TorqueLimitExceeded};

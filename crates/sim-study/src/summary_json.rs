@@ -7,13 +7,14 @@
 //! - [`chain`]: a joint-space run on a URDF arm (`hrm simulate` with `[arm] urdf`);
 //! - [`deploy`]: a deployment (`[deploy]`, `hrm simulate`, the main job, Python's
 //!   `Scenario.run_deploy`): [`chain`]'s fields and the deployment metrics;
+//! - [`stopped`]: either of those for a run that stopped, with its `error` and `stopped_at_s`;
 //! - [`sweep`]: a whole sweep (`hrm sweep`, `hrm sweep merge`): `{"config": ..., "cells": [...]}`
 //!   (`docs/sweep.md`).
 
 use crate::study::{Cell, RunOutcome, Stopped, SweepConfig};
 use crate::{DeployMetrics, DeployRun, Scenario};
 use serde_json::{Value, json};
-use sim_core::ChainRun;
+use sim_core::{ChainRun, SimError};
 
 /// The `summary.json` of one run: its [`Summary`](sim_core::Summary)'s fields; for a run that
 /// stopped, those of the data up to the stop plus `error` (why and when) and `stopped_at_s`;
@@ -96,6 +97,17 @@ pub fn deploy(scenario: &Scenario, run: &DeployRun) -> Value {
     if let (Some(fields), Value::Object(own)) = (summary.as_object_mut(), metrics(&run.metrics)) {
         fields.extend(own);
         fields.insert("plan".into(), metrics(&run.plan));
+    }
+    summary
+}
+
+/// A [`chain`] or [`deploy`] document `summary` of `run`, a joint-space run that stopped with
+/// `error`: its fields over the samples up to the stop, plus `error` and `stopped_at_s` (the time
+/// of the run's last recorded sample), as [`run`] marks a modal run that stopped.
+pub fn stopped(mut summary: Value, error: &SimError, run: &ChainRun) -> Value {
+    if let Some(fields) = summary.as_object_mut() {
+        fields.insert("error".into(), json!(error.to_string()));
+        fields.insert("stopped_at_s".into(), json!(run.record.t.last()));
     }
     summary
 }

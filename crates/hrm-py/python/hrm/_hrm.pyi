@@ -364,7 +364,9 @@ class Scenario:
     def run_deploy(self) -> Dict[str, Any]:
         """Runs the scenario's [deploy] (follow-the-leader on the insertion axis, computed torque
         or joint-space MPC): {"summary": the summary.json of hrm simulate, "t": (K,), "q",
-        "q_ref", "tau": (K, n + 1), insertion first, "points": (K, n + 1, 2) as links.csv}."""
+        "q_ref", "tau": (K, n + 1), insertion first, "points": (K, n + 1, 2) as links.csv}.
+        A run that stops returns its data up to the stop, its summary with "error" and
+        "stopped_at_s"; one that stops before its first recorded sample raises."""
 
 class Sweep:
     """A Monte Carlo sweep over noise levels and seeds (hrm sweep), whole or by shards."""

@@ -6,7 +6,7 @@ use super::arm::{ArmKind, Gravity};
 use super::controllers::ControllerKind;
 use super::schema::{Alpha0, ArmSpec, IntegratorSpec, NoiseSpec, ReferenceSpec, Scenario};
 use manip_dyn::spatial::SpatialModel;
-use sim_core::{ChainLoopSettings, ChainRun, SimError, run_chain_loop};
+use sim_core::{ChainFailure, ChainLoopSettings, ChainRun, SimError, run_chain_loop};
 
 /// The refusal of a scenario key a URDF arm does not use.
 fn unused(name: &str, why: &str) -> SimError {
@@ -128,8 +128,9 @@ impl Scenario {
     /// As [`urdf_model`](Self::urdf_model) (and [`SimError::InvalidSetting`] naming `arm.urdf`
     /// for a planar arm); [`SimError::InvalidSetting`] naming the key for a controller other
     /// than computed torque, the dopri5 integrator, a path reference, noise, torque limits or
-    /// arrays of the wrong length; the run's errors ([`run_chain_loop`]).
-    pub fn run_chain(&self) -> Result<ChainRun, SimError> {
+    /// arrays of the wrong length; the run's errors ([`run_chain_loop`]), with the run up to the
+    /// stop ([`ChainFailure`]).
+    pub fn run_chain(&self) -> Result<ChainRun, ChainFailure> {
         let model = self.urdf_model()?.ok_or_else(|| {
             SimError::setting("arm.urdf", "is required to run a scenario in joint space")
         })?;
@@ -142,22 +143,25 @@ impl Scenario {
                      the full chain in joint space is the only controller), got \"{}\"",
                     self.controller.kind
                 ),
-            ));
+            )
+            .into());
         }
         let IntegratorSpec::Rk4 { dt } = self.integrator else {
             return Err(unused(
                 "integrator.method = \"dopri5\"",
                 "the joint-space loop integrates by RK4",
-            ));
+            )
+            .into());
         };
         if matches!(self.reference, ReferenceSpec::Path { .. }) {
             return Err(unused(
                 "reference.kind = \"path\"",
                 "a joint-space reference is constant, step or sinusoid",
-            ));
+            )
+            .into());
         }
         if let Some((name, why)) = self.unused_by_joint_space_loops(false) {
-            return Err(unused(name, why));
+            return Err(unused(name, why).into());
         }
         let mut reference =
             self.reference
@@ -165,7 +169,7 @@ impl Scenario {
         let q0 = match &self.initial {
             Some(initial) => {
                 if initial.a_dot.is_some() {
-                    return Err(unused("initial.a_dot", "the chain starts at rest"));
+                    return Err(unused("initial.a_dot", "the chain starts at rest").into());
                 }
                 initial.a.clone()
             }

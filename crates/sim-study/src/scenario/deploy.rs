@@ -18,7 +18,9 @@ use shape_plan::{
 };
 use sim_core::controller::ChainMpcController;
 use sim_core::reference::{Reference, ReferenceSample, SplineMotion};
-use sim_core::{ChainLoopSettings, ChainRun, SimError, run_chain_loop, run_chain_loop_mpc};
+use sim_core::{
+    ChainFailure, ChainLoopSettings, ChainRun, SimError, run_chain_loop, run_chain_loop_mpc,
+};
 
 /// Steps of tip progress at which the deployment is planned (and its reference sampled).
 pub const DEPLOY_PLAN_STEPS: usize = 400;
@@ -53,6 +55,40 @@ pub struct DeployRun {
     pub plan: DeployMetrics,
     /// The channel.
     pub channel: Channel,
+}
+
+/// A deployment that stopped: why, and the deployment up to its last recorded sample (its
+/// metrics over the samples before the stop), or `None` when it stopped before its first
+/// recorded sample (a setting out of its domain, or a failure at `t = 0`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeployFailure {
+    /// Why and when the run stopped.
+    pub error: SimError,
+    /// The deployment up to the stop.
+    pub partial: Option<Box<DeployRun>>,
+}
+
+impl std::fmt::Display for DeployFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.error.fmt(f)
+    }
+}
+
+impl std::error::Error for DeployFailure {}
+
+impl From<SimError> for DeployFailure {
+    fn from(error: SimError) -> Self {
+        Self {
+            error,
+            partial: None,
+        }
+    }
+}
+
+impl From<DeployFailure> for SimError {
+    fn from(failure: DeployFailure) -> Self {
+        failure.error
+    }
 }
 
 impl DeployRun {
@@ -215,19 +251,21 @@ impl Scenario {
     /// `obstacles`, `task`, noise, `limits` other than `max_modal_error`, a controller other
     /// than computed torque or MPC, dopri5, a reference other than `"planned"`) and for more than
     /// [`MAX_DEPLOY_RECORDED_SAMPLES`] recorded samples; the run's errors ([`run_chain_loop`]).
-    pub fn run_deploy(&self) -> Result<DeployRun, SimError> {
+    pub fn run_deploy(&self) -> Result<DeployRun, DeployFailure> {
         if self.deploy.is_none() {
             return Err(SimError::setting(
                 "deploy",
                 "is required to run a deployment ([deploy] centerline, radius)",
-            ));
+            )
+            .into());
         }
         let travel_time = self.check_deploy_keys()?;
         let IntegratorSpec::Rk4 { dt } = self.integrator else {
             return Err(unused(
                 "integrator.method = \"dopri5\"",
                 "the joint-space loop integrates by RK4",
-            ));
+            )
+            .into());
         };
         let period = self.controller.period.unwrap_or(dt);
         let record_period = self.record_period.unwrap_or(period);
@@ -241,7 +279,8 @@ impl Scenario {
                      deployment's metrics, got a duration of {} s recorded every {} s",
                     self.duration, record_period
                 ),
-            ));
+            )
+            .into());
         }
         let (channel, plan) = self
             .deployment()?
@@ -283,16 +322,28 @@ impl Scenario {
             kd,
             max_joint_error: self.limits.max_modal_error,
         };
-        let run = if mpc {
+        let outcome = if mpc {
             let mut mpc_settings = deploy_mpc_settings(&model, &reference, travel_time)?;
             if let Some(limits) = &self.limits.joint_torque_nm {
                 set_joint_torque_box(&mut mpc_settings, limits, n)?;
             }
             let mut controller =
                 ChainMpcController::new(&model, &mpc_settings, Box::new(reference.clone()))?;
-            run_chain_loop_mpc(&model, &mut reference, &start.a, &settings, &mut controller)?
+            run_chain_loop_mpc(&model, &mut reference, &start.a, &settings, &mut controller)
         } else {
-            run_chain_loop(&model, &mut reference, &start.a, &settings)?
+            run_chain_loop(&model, &mut reference, &start.a, &settings)
+        };
+        // A run that stopped is measured up to the stop.
+        let (run, stop) = match outcome {
+            Ok(run) => (run, None),
+            Err(ChainFailure {
+                error,
+                partial: Some(run),
+            }) => (*run, Some(error)),
+            Err(ChainFailure {
+                error,
+                partial: None,
+            }) => return Err(error.into()),
         };
         let radius = self.arm.radius.unwrap_or(0.0);
         let mut tracker = DeployTracker::new(&channel, &lengths, radius).map_err(plan_field)?;
@@ -313,14 +364,21 @@ impl Scenario {
             }
             samples.push(tracker.add(shape, q));
         }
-        Ok(DeployRun {
+        let deployed = DeployRun {
             metrics: tracker.metrics(),
             plan: plan.metrics,
             samples,
             run,
             points,
             channel,
-        })
+        };
+        match stop {
+            None => Ok(deployed),
+            Some(error) => Err(DeployFailure {
+                error,
+                partial: Some(Box::new(deployed)),
+            }),
+        }
     }
 
     /// Refuses the keys a deployment does not use; returns the reference's travel time.

@@ -101,7 +101,7 @@ pub use arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout};
 pub use controllers::{
     CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup, ControllerSpec, FuzzyInputRange,
 };
-pub use deploy::{DEPLOY_PLAN_STEPS, DeployRun, MAX_DEPLOY_RECORDED_SAMPLES};
+pub use deploy::{DEPLOY_PLAN_STEPS, DeployFailure, DeployRun, MAX_DEPLOY_RECORDED_SAMPLES};
 pub use file::ScenarioError;
 pub use obstacles::{MAX_SCENARIO_OBSTACLES, Workspace};
 pub use schema::{
