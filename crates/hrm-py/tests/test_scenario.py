@@ -360,12 +360,13 @@ def test_a_deployment_that_stops_returns_its_data_up_to_the_stop():
     its summary with "error" and "stopped_at_s" (the last recorded time), as Scenario.run."""
     scenario = hrm.Scenario.builtin("pipe-deploy")
     scenario.duration = 0.5
-    scenario.limits.max_modal_error = 1e-7
+    # Computed torque tracks the plan to 7e-8 over the 0.5 s: past 3e-8 at t = 0.025 s.
+    scenario.limits.max_modal_error = 3e-8
     stopped = scenario.run_deploy()
     summary = stopped["summary"]
     assert "runaway tracking error" in summary["error"]
     k = len(stopped["t"])
-    assert 0 < k < 500 and summary["stopped_at_s"] == stopped["t"][-1]
+    assert 1 < k < 10 and summary["stopped_at_s"] == stopped["t"][-1] < 0.025
     assert stopped["q"].shape == (k, scenario.arm.links + 1)
     assert stopped["points"].shape == (k, scenario.arm.links + 1, 2)
     assert math.isfinite(summary["deploy_tip_error_m"])
