@@ -14,17 +14,7 @@ use std::path::Path;
 /// writes them up to the stop (`summary.json` with its `error` and `stopped_at_s`) and fails with
 /// its error, one that fails before its first recorded sample writes nothing.
 pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
-    let (run, stop) = match scenario.run_chain() {
-        Ok(run) => (run, None),
-        Err(ChainFailure {
-            error,
-            partial: Some(run),
-        }) => (*run, Some(error)),
-        Err(ChainFailure {
-            error,
-            partial: None,
-        }) => return Err(error.to_string()),
-    };
+    let (run, stop) = ChainFailure::split(scenario.run_chain()).map_err(|e| e.to_string())?;
     let summary = &run.summary;
     let n = summary.joint_error_rms.len();
     let staging = OutputDir::create(out, "simulate")?;

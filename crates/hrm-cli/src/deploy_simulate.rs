@@ -21,17 +21,7 @@ const SHAPE_INTERVAL_S: f64 = 0.5;
 /// them up to the stop (`summary.json` with its `error` and `stopped_at_s`) and fails with its
 /// error, one that fails before its first recorded sample writes nothing.
 pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
-    let (run, stop) = match scenario.run_deploy() {
-        Ok(run) => (run, None),
-        Err(DeployFailure {
-            error,
-            partial: Some(run),
-        }) => (*run, Some(error)),
-        Err(DeployFailure {
-            error,
-            partial: None,
-        }) => return Err(error.to_string()),
-    };
+    let (run, stop) = DeployFailure::split(scenario.run_deploy()).map_err(|e| e.to_string())?;
     let staging = OutputDir::create(out, "simulate")?;
     write_run(staging.path(), scenario, &run, stop.as_ref())?;
     staging.commit()?;

@@ -905,17 +905,9 @@ impl Scenario {
     /// before its first recorded sample raises the error of its class.
     fn run_deploy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let scenario = self.get();
-        let (run, stop) = match pool::run(py, &Cancel::new(), || scenario.run_deploy())? {
-            Ok(run) => (run, None),
-            Err(DeployFailure {
-                error,
-                partial: Some(run),
-            }) => (*run, Some(error)),
-            Err(DeployFailure {
-                error,
-                partial: None,
-            }) => return Err(Error::from(error).into()),
-        };
+        let (run, stop) =
+            DeployFailure::split(pool::run(py, &Cancel::new(), || scenario.run_deploy())?)
+                .map_err(Error::from)?;
         let out = PyDict::new(py);
         let mut summary = sim_study::summary_json::deploy(&scenario, &run);
         if let Some(error) = &stop {

@@ -19,7 +19,7 @@
 //! coordinates.
 
 use crate::controller::ChainMpcController;
-use crate::error::{SimError, check_positive};
+use crate::error::{SimError, StoppedRun, check_positive};
 use crate::ode::{OdeSystem, Rk4};
 use crate::reference::{Reference, ReferenceSample};
 use crate::simulation::{MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS};
@@ -93,36 +93,7 @@ pub struct ChainRun {
 /// the samples before the stop, `final_error` at the last recorded one), or `None` when it
 /// stopped before its first recorded sample (a setting out of its domain, or a failure at
 /// `t = 0`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct ChainFailure {
-    /// Why and when the run stopped.
-    pub error: SimError,
-    /// The run up to the stop.
-    pub partial: Option<Box<ChainRun>>,
-}
-
-impl std::fmt::Display for ChainFailure {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self.error.fmt(f)
-    }
-}
-
-impl std::error::Error for ChainFailure {}
-
-impl From<SimError> for ChainFailure {
-    fn from(error: SimError) -> Self {
-        Self {
-            error,
-            partial: None,
-        }
-    }
-}
-
-impl From<ChainFailure> for SimError {
-    fn from(failure: ChainFailure) -> Self {
-        failure.error
-    }
-}
+pub type ChainFailure = StoppedRun<ChainRun>;
 
 /// The plant between two controller samples: `(q, v)' = (v, ABA(q, v, tau))`.
 struct Plant<'a> {

@@ -313,3 +313,58 @@ impl From<ShapeError<'_>> for SimError {
         Self::setting(error.name, error.problem.to_string())
     }
 }
+
+/// A joint-space run (`T`: a [`ChainRun`](crate::ChainRun), or a front end's run built on one)
+/// that stopped: why, and the run up to its last recorded sample, or `None` when it stopped
+/// before its first recorded sample (a setting out of its domain, or a failure at `t = 0`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StoppedRun<T> {
+    /// Why and when the run stopped.
+    pub error: SimError,
+    /// The run up to the stop.
+    pub partial: Option<Box<T>>,
+}
+
+impl<T> StoppedRun<T> {
+    /// `outcome` as the run (whole, or up to its stop) and why it stopped, if it did; the error
+    /// alone of a run that stopped before its first recorded sample.
+    ///
+    /// # Errors
+    /// The error of a run without a recorded sample.
+    pub fn split(outcome: Result<T, Self>) -> Result<(T, Option<SimError>), SimError> {
+        match outcome {
+            Ok(run) => Ok((run, None)),
+            Err(Self {
+                error,
+                partial: Some(run),
+            }) => Ok((*run, Some(error))),
+            Err(Self {
+                error,
+                partial: None,
+            }) => Err(error),
+        }
+    }
+}
+
+impl<T> fmt::Display for StoppedRun<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.error.fmt(f)
+    }
+}
+
+impl<T: fmt::Debug> std::error::Error for StoppedRun<T> {}
+
+impl<T> From<SimError> for StoppedRun<T> {
+    fn from(error: SimError) -> Self {
+        Self {
+            error,
+            partial: None,
+        }
+    }
+}
+
+impl<T> From<StoppedRun<T>> for SimError {
+    fn from(failure: StoppedRun<T>) -> Self {
+        failure.error
+    }
+}

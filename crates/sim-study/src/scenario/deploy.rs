@@ -19,7 +19,8 @@ use shape_plan::{
 use sim_core::controller::ChainMpcController;
 use sim_core::reference::{Reference, ReferenceSample, SplineMotion};
 use sim_core::{
-    ChainFailure, ChainLoopSettings, ChainRun, SimError, run_chain_loop, run_chain_loop_mpc,
+    ChainFailure, ChainLoopSettings, ChainRun, SimError, StoppedRun, run_chain_loop,
+    run_chain_loop_mpc,
 };
 
 /// Steps of tip progress at which the deployment is planned (and its reference sampled).
@@ -60,36 +61,7 @@ pub struct DeployRun {
 /// A deployment that stopped: why, and the deployment up to its last recorded sample (its
 /// metrics over the samples before the stop), or `None` when it stopped before its first
 /// recorded sample (a setting out of its domain, or a failure at `t = 0`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct DeployFailure {
-    /// Why and when the run stopped.
-    pub error: SimError,
-    /// The deployment up to the stop.
-    pub partial: Option<Box<DeployRun>>,
-}
-
-impl std::fmt::Display for DeployFailure {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self.error.fmt(f)
-    }
-}
-
-impl std::error::Error for DeployFailure {}
-
-impl From<SimError> for DeployFailure {
-    fn from(error: SimError) -> Self {
-        Self {
-            error,
-            partial: None,
-        }
-    }
-}
-
-impl From<DeployFailure> for SimError {
-    fn from(failure: DeployFailure) -> Self {
-        failure.error
-    }
-}
+pub type DeployFailure = StoppedRun<DeployRun>;
 
 impl DeployRun {
     /// The points of recorded sample `k`.
@@ -334,17 +306,7 @@ impl Scenario {
             run_chain_loop(&model, &mut reference, &start.a, &settings)
         };
         // A run that stopped is measured up to the stop.
-        let (run, stop) = match outcome {
-            Ok(run) => (run, None),
-            Err(ChainFailure {
-                error,
-                partial: Some(run),
-            }) => (*run, Some(error)),
-            Err(ChainFailure {
-                error,
-                partial: None,
-            }) => return Err(error.into()),
-        };
+        let (run, stop) = ChainFailure::split(outcome)?;
         let radius = self.arm.radius.unwrap_or(0.0);
         let mut tracker = DeployTracker::new(&channel, &lengths, radius).map_err(plan_field)?;
         tracker.reserve(run.record.t.len()).map_err(plan_field)?;
