@@ -211,7 +211,7 @@ fn assemble(
     };
     // The base is a body of its own, or, named `world`, MuJoCo's world body.
     let world = robot.base.name == WORLD;
-    let base_depth = if world { 2 } else { 3 };
+    let base_depth = if world { 1 } else { 2 };
     let mut files = Vec::with_capacity(chunks.len());
     for (k, chunk) in chunks.iter().enumerate() {
         let mut out = String::new();

@@ -218,7 +218,7 @@ fn a_root_link_named_world_is_the_world_body() {
     );
     assert_eq!(
         lines[lines.len() - 3..],
-        ["      </body>", "  </worldbody>", "</mujoco>"]
+        ["    </body>", "  </worldbody>", "</mujoco>"]
     );
     assert_eq!(
         text.matches("<body").count(),
