@@ -41,25 +41,39 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
 }
 
 /// A warning when the arm's capsules reach the channel's walls or beyond (a negative smallest
-/// wall clearance over the run), which the run reports rather than refuses: a channel narrower
-/// than the arm or a bend sharper than its links follow (the plan reaches the walls too), or a
-/// tracking error that the plan does not have.
+/// wall clearance over the run), which the run reports rather than refuses: a bend sharper than
+/// its links follow (the plan reaches the walls too), or a tracking error that the plan does not
+/// have; and when its links that share no joint overlap (the plan refuses shapes that do, so
+/// only the tracking can).
 pub fn wall_warning(run: &DeployRun) -> Option<String> {
     let clearance = run.metrics.min_wall_clearance;
-    (clearance < 0.0).then(|| {
+    let walls = (clearance < 0.0).then(|| {
         format!(
             "the arm reaches {:.2} mm into the channel's walls (smallest wall clearance; the \
              plan's {:.2} mm): {}",
             -1e3 * clearance,
             1e3 * run.plan.min_wall_clearance,
             if run.plan.min_wall_clearance < 0.0 {
-                "deploy.radius or the centreline's bends leave it no room"
+                "the centreline's bends leave it no room"
             } else {
                 "the plan keeps within them, the tracking does not (a shorter controller period, \
                  a longer travel_time or computed torque tracks closer)"
             }
         )
-    })
+    });
+    let folded = run.metrics.min_self_clearance;
+    let itself = (folded < 0.0).then(|| {
+        format!(
+            "links of the arm that share no joint overlap by {:.2} mm (smallest self clearance; \
+             the plan keeps {:.2} mm): the tracking folds the body onto itself",
+            -1e3 * folded,
+            1e3 * run.plan.min_self_clearance,
+        )
+    });
+    match (walls, itself) {
+        (Some(walls), Some(itself)) => Some(format!("{walls}; {itself}")),
+        (walls, itself) => walls.or(itself),
+    }
 }
 
 /// One line on the run: the deployment metrics.
@@ -68,12 +82,13 @@ pub fn headline(scenario: &Scenario, run: &DeployRun) -> String {
     format!(
         "{}: {} deploying the arm on its insertion axis: tip error {:.3} mm, \
          shape deviation {:.2}% of the deployed length, smallest wall clearance {:.2} mm, \
-         final |q - q_ref| {:.3e}",
+         smallest self clearance {:.2} mm, final |q - q_ref| {:.3e}",
         scenario.name,
         scenario.controller.kind.name(),
         1e3 * m.tip_error,
         m.shape_deviation_percent,
         1e3 * m.min_wall_clearance,
+        1e3 * m.min_self_clearance,
         run.run.summary.final_error
     )
 }
@@ -313,6 +328,7 @@ mod tests {
             "deploy_tip_error_m",
             "deploy_shape_deviation_pct",
             "deploy_min_wall_clearance_m",
+            "deploy_min_self_clearance_m",
             "deploy_length_m",
         ] {
             assert!(
@@ -337,20 +353,31 @@ mod tests {
     }
 
     #[test]
-    fn a_channel_narrower_than_the_arm_is_warned_of() {
+    fn a_channel_narrower_than_the_arm_is_refused() {
         let mut scenario = Scenario::builtin("pipe-deploy").unwrap();
         scenario.duration = 0.2;
         let deploy = scenario.deploy.as_mut().unwrap();
-        let arm_radius = scenario.arm.radius.unwrap();
-        deploy.radius = 0.5 * arm_radius;
-        let run = scenario.run_deploy().unwrap();
+        deploy.radius = 0.5 * scenario.arm.radius.unwrap();
+        let error = scenario.run_deploy().unwrap_err().error.to_string();
+        assert!(
+            error.contains("deploy radius (the arm must fit in the channel)"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn links_that_overlap_in_the_run_are_warned_of() {
+        let mut scenario = Scenario::builtin("pipe-deploy").unwrap();
+        scenario.duration = 0.2;
+        let mut run = scenario.run_deploy().unwrap();
+        assert!(run.metrics.min_self_clearance > 0.05 && run.plan.min_self_clearance > 0.05);
+        assert_eq!(wall_warning(&run), None);
+        run.metrics.min_self_clearance = -0.003;
         let warning = wall_warning(&run).unwrap();
         assert!(
-            warning.contains("into the channel's walls")
-                && warning.contains("deploy.radius or the centreline's bends leave it no room"),
+            warning.starts_with("links of the arm that share no joint overlap by 3.00 mm"),
             "{warning}"
         );
-        assert!(run.metrics.min_wall_clearance <= -0.5 * arm_radius);
     }
 
     #[test]

@@ -894,7 +894,8 @@ impl Scenario {
     /// follow-the-leader into the channel, in joint space, by computed torque or with
     /// `controller.kind = "mpc"` by joint-space MPC) and returns a dict: `summary` (the
     /// `summary.json` of `hrm simulate`: the joint-space run's fields, `deploy_tip_error_m`,
-    /// `deploy_shape_deviation_pct`, `deploy_min_wall_clearance_m`, `deploy_length_m` and the
+    /// `deploy_shape_deviation_pct`, `deploy_min_wall_clearance_m`,
+    /// `deploy_min_self_clearance_m` (`None` below three links), `deploy_length_m` and the
     /// plan's under `plan`), `t` (shape (K,)), `q`, `q_ref`, `tau` (shape (K, n + 1), the
     /// insertion first) and `points` (shape (K, n + 1, 2): the base and every link's end, as
     /// `links.csv`). Runs with the GIL released. A scenario without `[deploy]` or with keys a

@@ -397,8 +397,15 @@ def test_pipe_deploy_runs_with_mpc_within_joint_torque_nm():
     )
     peaks = np.array(summary["peak_joint_efforts"])
     assert np.all(peaks >= np.abs(free["tau"]).max(axis=0) - 1e-12)
-    for key in ("deploy_tip_error_m", "deploy_shape_deviation_pct", "deploy_min_wall_clearance_m"):
+    for key in (
+        "deploy_tip_error_m",
+        "deploy_shape_deviation_pct",
+        "deploy_min_wall_clearance_m",
+        "deploy_min_self_clearance_m",
+    ):
         assert math.isfinite(summary[key]) and key in summary["plan"]
+    # The body never lies over itself: links sharing no joint stay a link's width apart at least.
+    assert summary["deploy_min_self_clearance_m"] > 0.05
     # Within [limits] joint_torque_nm, 60% of the free run's largest joint torque: every revolute
     # joint's torque within it at every controller sample (the summary's peaks).
     limit = 0.6 * float(peaks[1:].max())

@@ -6,6 +6,10 @@ use lane_math::check_finite;
 
 /// The most centreline points a [`Channel`] accepts.
 pub const MAX_CENTERLINE_POINTS: usize = 100_000;
+/// The largest magnitude of a centreline coordinate (m): at `1e6` m a coordinate's rounding is
+/// `1e-10` m, so that the deployment's metrics keep their sub-micrometre meaning (a channel a
+/// million kilometres out would round them to millimetres).
+pub const MAX_CENTERLINE_EXTENT: f64 = 1e6;
 
 /// A planar channel: a centreline polyline (the plane `z = 0`) and its radius.
 #[derive(Debug, Clone, PartialEq)]
@@ -17,8 +21,8 @@ pub struct Channel {
 }
 
 impl Channel {
-    /// A channel along `centerline` (at least two points, consecutive points distinct) of
-    /// `radius` (positive).
+    /// A channel along `centerline` (at least two points, consecutive points distinct, each
+    /// coordinate within [`MAX_CENTERLINE_EXTENT`]) of `radius` (positive).
     pub fn new(centerline: &[[f64; 2]], radius: f64) -> Result<Self, PlanError> {
         if centerline.len() < 2 {
             return Err(PlanError::Dimension {
@@ -44,6 +48,13 @@ impl Channel {
         }
         for x in centerline.iter().flatten() {
             check_finite("deploy centerline coordinate", *x)?;
+            if x.abs() > MAX_CENTERLINE_EXTENT {
+                return Err(PlanError::OutOfRange {
+                    name: "deploy centerline coordinate",
+                    bound: "within 1e6 m of the origin",
+                    value: *x,
+                });
+            }
         }
         let mut arcs = vec![0.0];
         for pair in centerline.windows(2) {

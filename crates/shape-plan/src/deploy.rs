@@ -58,8 +58,10 @@ pub struct Deployment {
 /// (at most the centreline's length), fitting `harmonics` harmonics at each step.
 ///
 /// Errors: input errors for sizes and numbers (including a centreline longer than
-/// [`MAX_LENGTH_RATIO`] shortest links); [`PlanError::OutOfRange`] when `depth` exceeds
-/// the centreline or would pull the base past the entry (the arm is shorter than the depth).
+/// [`MAX_LENGTH_RATIO`] shortest links, a channel no wider than the links); [`PlanError::OutOfRange`] when `depth` exceeds
+/// the centreline or would pull the base past the entry (the arm is shorter than the depth);
+/// [`PlanError::DeployFoldsOnItself`] when a shape's links that share no joint overlap (the
+/// centreline turns back on itself within a few links).
 pub fn follow_the_leader(
     channel: &Channel,
     link_lengths: &[f64],
@@ -81,6 +83,14 @@ pub fn follow_the_leader(
             name: "deploy steps (at least 1)",
             got: steps,
             max: MAX_DEPLOY_STEPS,
+        });
+    }
+    // Not `>=`-negated: a NaN radius is the tracker's to refuse, by name.
+    if link_radius >= channel.radius() {
+        return Err(PlanError::OutOfRange {
+            name: "deploy radius (the arm must fit in the channel)",
+            bound: "larger than the arm's link radius",
+            value: channel.radius(),
         });
     }
     let shortest = link_lengths.iter().copied().fold(f64::INFINITY, f64::min);
@@ -157,7 +167,13 @@ pub fn follow_the_leader(
             p[0] += joints[0][0];
             p[1] += joints[0][1];
         }
-        tracker.add(&points, tau);
+        let sample = tracker.add(&points, tau);
+        if sample.self_clearance < 0.0 {
+            return Err(PlanError::DeployFoldsOnItself {
+                progress: tau,
+                clearance: sample.self_clearance,
+            });
+        }
         frames.push(DeployFrame {
             progress: tau,
             insertion: base_sigma + length,

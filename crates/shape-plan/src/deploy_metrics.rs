@@ -4,6 +4,7 @@
 
 use crate::channel::{Channel, dist, point_segment};
 use crate::error::PlanError;
+use clearance::segment_segment;
 use lane_math::check_finite;
 
 /// Points per link at which the body's distances to the path and the walls are sampled (both
@@ -24,6 +25,9 @@ pub struct DeployMetrics {
     /// [`SAMPLES_PER_LINK`] points a link; the sampling can overstate it by at most
     /// `L_max / 64`).
     pub min_wall_clearance: f64,
+    /// The smallest clearance between two links' capsules that share no joint, m (exact;
+    /// `+inf` below three links): negative where the body overlaps itself.
+    pub min_self_clearance: f64,
     /// The deployed length of the last shape, m.
     pub deployed_length: f64,
 }
@@ -37,6 +41,8 @@ pub struct DeploySample {
     pub shape_deviation_percent: f64,
     /// The body's smallest clearance to the walls, m.
     pub wall_clearance: f64,
+    /// The smallest clearance between two of its links that share no joint, m.
+    pub self_clearance: f64,
 }
 
 /// Accumulates [`DeployMetrics`] over the shapes of a deployment, in time order: each shape's
@@ -50,6 +56,7 @@ pub struct DeploySample {
 /// let metrics = tracker.metrics();
 /// assert!(metrics.tip_error < 1e-15 && metrics.shape_deviation_percent < 1e-12);
 /// assert!((metrics.min_wall_clearance - 0.04).abs() < 1e-15);
+/// assert_eq!(metrics.min_self_clearance, f64::INFINITY); // two links share their joint
 /// # Ok::<(), shape_plan::PlanError>(())
 /// ```
 #[derive(Debug, Clone)]
@@ -94,6 +101,7 @@ impl<'c> DeployTracker<'c> {
                 tip_error: 0.0,
                 shape_deviation_percent: 0.0,
                 min_wall_clearance: f64::INFINITY,
+                min_self_clearance: f64::INFINITY,
                 deployed_length: 0.0,
             },
         })
@@ -116,7 +124,8 @@ impl<'c> DeployTracker<'c> {
     /// Adds the shape of joint points `points` (base first, the tip last, at least one) at the
     /// deployed length `deployed` (m) and returns its own metrics: the tip's distance from the
     /// centreline, the body's largest distance from the traced path (this tip included) over
-    /// `max(deployed, shortest link)`, and the body's smallest clearance to the walls.
+    /// `max(deployed, shortest link)`, the body's smallest clearance to the walls and between
+    /// its links that share no joint.
     pub fn add(&mut self, points: &[[f64; 2]], deployed: f64) -> DeploySample {
         let tip = points.last().copied().unwrap_or(self.channel.entry());
         self.traced.push(tip);
@@ -125,6 +134,7 @@ impl<'c> DeployTracker<'c> {
             tip_error: channel.distance(tip),
             shape_deviation_percent: 0.0,
             wall_clearance: f64::INFINITY,
+            self_clearance: self_clearance(points, self.link_radius),
         };
         let mut deviation: f64 = 0.0;
         for pair in points.windows(2) {
@@ -147,6 +157,7 @@ impl<'c> DeployTracker<'c> {
             .shape_deviation_percent
             .max(sample.shape_deviation_percent);
         metrics.min_wall_clearance = metrics.min_wall_clearance.min(sample.wall_clearance);
+        metrics.min_self_clearance = metrics.min_self_clearance.min(sample.self_clearance);
         metrics.deployed_length = deployed;
         sample
     }
@@ -155,6 +166,48 @@ impl<'c> DeployTracker<'c> {
     pub fn metrics(&self) -> DeployMetrics {
         self.metrics
     }
+}
+
+/// The smallest clearance between two links of the chain of joint points `points` that share no
+/// joint (capsules of `radius`; `+inf` below three links), each pair's exact segment distance
+/// ([`clearance::segment_segment`]) unless a lower bound already exceeds the smallest found: a
+/// link lies within half its length of its midpoint, so two links are at least the distance
+/// of their midpoints less both half-lengths apart (most pairs of a body along a channel are
+/// then skipped after one square root).
+fn self_clearance(points: &[[f64; 2]], radius: f64) -> f64 {
+    let space = |p: [f64; 2]| [p[0], p[1], 0.0];
+    let mut smallest = f64::INFINITY;
+    for (i, link) in points.windows(2).enumerate() {
+        let middle = [
+            0.5 * (link[0][0] + link[1][0]),
+            0.5 * (link[0][1] + link[1][1]),
+        ];
+        let half = 0.5 * dist(link[0], link[1]);
+        for other in points.get(i + 2..).unwrap_or(&[]).windows(2) {
+            let other_middle = [
+                0.5 * (other[0][0] + other[1][0]),
+                0.5 * (other[0][1] + other[1][1]),
+            ];
+            let other_half = 0.5 * dist(other[0], other[1]);
+            // Less a slack far above the bound's rounding, so that no skipped pair held it.
+            let bound = dist(middle, other_middle)
+                - half
+                - other_half
+                - 2.0 * radius
+                - 1e-9 * (half + other_half);
+            if bound >= smallest {
+                continue;
+            }
+            let closest = segment_segment(
+                space(link[0]),
+                space(link[1]),
+                space(other[0]),
+                space(other[1]),
+            );
+            smallest = smallest.min(closest.distance - 2.0 * radius);
+        }
+    }
+    smallest
 }
 
 /// The distance of `x` from the tip's traced polyline joined to the entry and the guide behind

@@ -52,6 +52,21 @@ pub enum PlanError {
         /// The clearance every check point must keep, m.
         needed: f64,
     },
+    /// A follow-the-leader deployment would lay the arm over itself: its centreline turns back
+    /// within a few links' length, so that two links sharing no joint overlap.
+    #[error(
+        "deploy centerline folds the arm onto itself: at tip progress {} m two links that share \
+         no joint overlap by {} m (a path the body can follow turns back no sharper than its \
+         links and their thickness allow)",
+        Compact(*.progress),
+        Compact(-*.clearance)
+    )]
+    DeployFoldsOnItself {
+        /// The tip's progress along the centreline at the first overlapping shape, m.
+        progress: f64,
+        /// That shape's smallest clearance between links that share no joint, m (negative).
+        clearance: f64,
+    },
     /// The target is farther from the base than the arm is long.
     #[error(
         "target is {} m from the base, beyond the arm's length {} m",
@@ -103,12 +118,14 @@ pub enum PlanError {
 }
 
 impl Classify for PlanError {
-    /// A target without a collision-free shape or motion is unreachable; wrapped errors keep
+    /// A target without a collision-free shape or motion, or a channel the body cannot follow
+    /// without overlapping itself, is unreachable; wrapped errors keep
     /// their class; every other error is invalid input.
     fn class(&self) -> ErrorClass {
         match self {
             Self::NoCollisionFreeShape { .. }
             | Self::NoCollisionFreeMotion { .. }
+            | Self::DeployFoldsOnItself { .. }
             | Self::OutOfReach { .. } => ErrorClass::Unreachable,
             Self::Clearance(error) => error.class(),
             Self::Kinematics(error) => error.class(),

@@ -1,7 +1,11 @@
 //! Follow-the-leader deployment: exact on straight channels, the body on its tip's path in a
 //! bent one, the metrics against the test's own geometry.
 
-use shape_plan::{Channel, follow_the_leader};
+use clearance::segment_segment;
+use lane_math::{Classify, ErrorClass};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use shape_plan::{Channel, DeployTracker, PlanError, follow_the_leader};
 
 fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
@@ -87,7 +91,7 @@ fn in_a_bent_channel_the_body_follows_the_tip() {
 
 #[test]
 fn deployments_refuse_what_they_cannot_do() {
-    let text = |e: shape_plan::PlanError| e.to_string();
+    let text = |e: PlanError| e.to_string();
     assert!(text(Channel::new(&[[0.0, 0.0]], 0.03).unwrap_err()).contains("at least 2 points"));
     assert!(
         text(Channel::new(&[[0.0, 0.0], [0.0, 0.0]], 0.03).unwrap_err()).contains("segment length")
@@ -107,4 +111,77 @@ fn deployments_refuse_what_they_cannot_do() {
     assert!(text(steps).contains("deploy steps"));
     let tiny = follow_the_leader(&channel, &[1e-9; 10], 0.0, 1, 0.0, 10).unwrap_err();
     assert!(text(tiny).contains("shortest link"));
+    let far = Channel::new(&[[1e12, 0.0], [1e12, 1.0]], 0.03).unwrap_err();
+    assert!(text(far).contains("deploy centerline coordinate must be within 1e6 m"));
+    let narrow = follow_the_leader(&channel, &[0.1; 10], 0.03, 1, 0.5, 10).unwrap_err();
+    assert!(text(narrow).starts_with("deploy radius (the arm must fit in the channel)"));
+}
+
+#[test]
+fn a_centreline_that_turns_back_is_refused_as_the_body_would_fold() {
+    // Up 0.4 m, then straight back down: once the tip is a link past the turn, the last link
+    // lies over the one two before it.
+    let channel = Channel::new(&[[0.0, 0.0], [0.0, 0.4], [0.0, 0.2]], 0.04).unwrap();
+    let error = follow_the_leader(&channel, &[0.1; 10], 0.01, 5, 0.6, 60).unwrap_err();
+    assert!(
+        matches!(error, PlanError::DeployFoldsOnItself { progress, clearance }
+            if progress > 0.5 && progress < 0.52 && clearance < -0.019),
+        "{error:?}"
+    );
+    assert!(
+        error
+            .to_string()
+            .starts_with("deploy centerline folds the arm onto itself")
+    );
+    assert_eq!(error.class(), ErrorClass::Unreachable);
+    // The same turn on a hairpin wide enough for the body is followed.
+    let wide = Channel::new(&[[0.0, 0.0], [0.0, 0.4], [0.3, 0.4], [0.3, 0.2]], 0.04).unwrap();
+    let deployment = follow_the_leader(&wide, &[0.1; 10], 0.01, 5, 0.6, 60).unwrap();
+    assert!(deployment.metrics.min_self_clearance > 0.0);
+}
+
+#[test]
+fn self_clearance_is_the_smallest_over_links_that_share_no_joint() {
+    // A U of three links 0.3 m apart (links 0 and 2 parallel): 0.3 - 2 r.
+    let channel = Channel::new(&[[0.0, 0.0], [1.0, 0.0]], 1.0).unwrap();
+    let mut tracker = DeployTracker::new(&channel, &[1.0, 0.3, 1.0], 0.01).unwrap();
+    let sample = tracker.add(&[[0.0, 0.0], [1.0, 0.0], [1.0, 0.3], [0.0, 0.3]], 1.0);
+    assert!((sample.self_clearance - 0.28).abs() < 1e-15);
+    // Random chains: the skipped pairs never held the smallest (brute force over every pair).
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    for _ in 0..200 {
+        let n = rng.random_range(3..14);
+        let mut points = vec![[0.0, 0.0]];
+        let mut heading: f64 = 0.0;
+        for _ in 0..n {
+            heading += rng.random_range(-2.5..2.5);
+            let last = points[points.len() - 1];
+            let length = rng.random_range(0.05..0.2);
+            points.push([
+                last[0] + length * heading.cos(),
+                last[1] + length * heading.sin(),
+            ]);
+        }
+        let radius = rng.random_range(0.0..0.03);
+        let mut tracker = DeployTracker::new(&channel, &vec![0.1; n], radius).unwrap();
+        let found = tracker.add(&points, 1.0).self_clearance;
+        let space = |p: [f64; 2]| [p[0], p[1], 0.0];
+        let mut brute = f64::INFINITY;
+        for i in 0..n {
+            for k in i + 2..n {
+                let pair = segment_segment(
+                    space(points[i]),
+                    space(points[i + 1]),
+                    space(points[k]),
+                    space(points[k + 1]),
+                );
+                brute = brute.min(pair.distance - 2.0 * radius);
+            }
+        }
+        assert_eq!(found.to_bits(), brute.to_bits(), "{points:?}");
+        assert_eq!(
+            tracker.metrics().min_self_clearance.to_bits(),
+            brute.to_bits()
+        );
+    }
 }

@@ -81,9 +81,9 @@ pub fn chain(scenario: &Scenario, arm: &str, run: &ChainRun) -> Value {
 }
 
 /// The `summary.json` of a deployment: [`chain`]'s fields, then `deploy_tip_error_m`,
-/// `deploy_shape_deviation_pct`, `deploy_min_wall_clearance_m` and `deploy_length_m` of the run
-/// (over every recorded sample, the rows of its `links.csv`) and the same of the kinematic plan
-/// it tracked under `plan`.
+/// `deploy_shape_deviation_pct`, `deploy_min_wall_clearance_m`, `deploy_min_self_clearance_m`
+/// (`null` below three links) and `deploy_length_m` of the run (over every recorded sample, the
+/// rows of its `links.csv`) and the same of the kinematic plan it tracked under `plan`.
 pub fn deploy(scenario: &Scenario, run: &DeployRun) -> Value {
     let mut summary = chain(scenario, "deploy", &run.run);
     let metrics = |m: &DeployMetrics| {
@@ -91,6 +91,8 @@ pub fn deploy(scenario: &Scenario, run: &DeployRun) -> Value {
             "deploy_tip_error_m": m.tip_error,
             "deploy_shape_deviation_pct": m.shape_deviation_percent,
             "deploy_min_wall_clearance_m": m.min_wall_clearance,
+            // `+inf` (no two links that share no joint) is written `null`.
+            "deploy_min_self_clearance_m": m.min_self_clearance,
             "deploy_length_m": m.deployed_length,
         })
     };
