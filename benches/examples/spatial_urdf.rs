@@ -27,7 +27,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let robot = robot_desc::from_spatial_arm(&model, "spatial_arm");
         std::fs::write(
             folder.join(format!("spatial_{n}.urdf")),
-            robot_desc::write_urdf(&robot),
+            robot_desc::write_urdf(&robot)?,
         )?;
         let [a, a_dot, tau_star] = hrm_benches::spatial_state();
         let m = model.n_coords();

@@ -2,7 +2,7 @@
 
 use crate::cores::{Core, Cores};
 use crate::error::ClearanceError;
-use crate::obstacle::Obstacle;
+use crate::obstacle::{MAX_OBSTACLE_EXTENT, Obstacle};
 use lane_math::check_finite;
 
 /// The most obstacles a [`ClearanceModel`] accepts.
@@ -60,10 +60,10 @@ impl ClearanceModel {
             return Err(backbone_kin::KinError::NoLinks.into());
         }
         check_finite("link radius", radius)?;
-        if radius < 0.0 {
+        if !(0.0..=MAX_OBSTACLE_EXTENT).contains(&radius) {
             return Err(ClearanceError::OutOfRange {
                 name: "link radius",
-                bound: "non-negative",
+                bound: "non-negative and at most 1e15 (MAX_OBSTACLE_EXTENT)",
                 value: radius,
             });
         }

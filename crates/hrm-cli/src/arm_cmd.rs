@@ -177,7 +177,8 @@ fn robot_of(source: &str) -> Result<(Robot, [f64; 3]), String> {
 pub fn planar_robot(arm: &ArmSpec, name: &str) -> Result<(Robot, [f64; 3]), String> {
     let chain = arm.to_chain().map_err(|e| e.to_string())?;
     let gravity = [0.0, -chain.gravity(), 0.0];
-    Ok((robot_desc::from_planar(&chain, name), gravity))
+    let robot = robot_desc::from_planar(&chain, name).map_err(|e| e.to_string())?;
+    Ok((robot, gravity))
 }
 
 /// `"gx gy gz"` (spaces or commas), finite.
@@ -207,7 +208,10 @@ pub fn export_files(
 ) -> Result<Vec<(String, String)>, String> {
     let stem = file_stem(&robot.name);
     match format {
-        Format::Urdf => Ok(vec![(format!("{stem}.urdf"), write_urdf(robot))]),
+        Format::Urdf => Ok(vec![(
+            format!("{stem}.urdf"),
+            write_urdf(robot).map_err(|e| e.to_string())?,
+        )]),
         Format::Mjcf => write_mjcf_files(robot, gravity, &stem).map_err(|e| e.to_string()),
     }
 }

@@ -157,16 +157,18 @@ impl Arm {
     }
 
     /// The arm as URDF text: joints about z in the base's x-y plane, links along x. URDF has no
-    /// gravity: set it along -y (the arm's) in the engine that reads it.
-    fn to_urdf(&self) -> String {
-        robot_desc::write_urdf(&crate::chain::planar_robot(&self.chain).0)
+    /// gravity: set it along -y (the arm's) in the engine that reads it. Raises InvalidInput for
+    /// more than 50,000 links or a number the URDF reader would refuse (a mass above 1e9).
+    fn to_urdf(&self) -> PyResult<String> {
+        let (robot, _) = crate::chain::planar_robot(&self.chain)?;
+        Ok(robot_desc::write_urdf(&robot).map_err(|e| Error::input(e.to_string()))?)
     }
 
     /// The arm as one MJCF document for MuJoCo (as `to_urdf`), its gravity along -y in
     /// `<option>`. Raises InvalidInput, naming the link, for a mass or inertia below MuJoCo's
     /// mjMINVAL (1e-15), which MuJoCo refuses.
     fn to_mjcf(&self) -> PyResult<String> {
-        let (robot, gravity) = crate::chain::planar_robot(&self.chain);
+        let (robot, gravity) = crate::chain::planar_robot(&self.chain)?;
         crate::chain::mjcf(&robot, gravity)
     }
 

@@ -265,15 +265,15 @@ impl Chain {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let chain = slf.get();
         let constructor = slf.get_type().getattr("from_urdf")?;
-        let arguments = (robot_desc::write_urdf(&chain.robot), chain.model.gravity())
-            .into_pyobject(slf.py())?;
+        let text = robot_desc::write_urdf(&chain.robot).map_err(|e| Error::input(e.to_string()))?;
+        let arguments = (text, chain.model.gravity()).into_pyobject(slf.py())?;
         Ok((constructor, arguments))
     }
 
     /// The chain as URDF text (reading it back gives the same chain bit for bit; URDF has no
     /// gravity).
-    fn to_urdf(&self) -> String {
-        robot_desc::write_urdf(&self.robot)
+    fn to_urdf(&self) -> PyResult<String> {
+        Ok(robot_desc::write_urdf(&self.robot).map_err(|e| Error::input(e.to_string()))?)
     }
 
     /// The chain as one MJCF document for MuJoCo, the gravity vector in `<option>`. Raises
@@ -572,11 +572,10 @@ impl Chain {
 
 /// The planar arm `chain` as a description (joints about z, links along x, in the base's x-y
 /// plane) and its gravity vector (along -y).
-pub(crate) fn planar_robot(chain: &manip_dyn::ChainModel) -> (Robot, [f64; 3]) {
-    (
-        robot_desc::from_planar(chain, "hrm_planar_arm"),
-        [0.0, -chain.gravity(), 0.0],
-    )
+pub(crate) fn planar_robot(chain: &manip_dyn::ChainModel) -> PyResult<(Robot, [f64; 3])> {
+    let robot = robot_desc::from_planar(chain, "hrm_planar_arm")
+        .map_err(|e| Error::input(e.to_string()))?;
+    Ok((robot, [0.0, -chain.gravity(), 0.0]))
 }
 
 /// MJCF text of a description under `gravity`.

@@ -967,9 +967,10 @@ pub struct Run {
     failure: Option<String>,
     controller: String,
     coordinates: Vec<String>,
-    /// The run as the viewer draws it (`run-view`), with the scenario's name; `None` for a run
-    /// that stopped before its first sample (nothing to draw).
-    view: Option<run_view::Scene>,
+    /// The run as the viewer draws it (`run-view`), with the scenario's name, or why it cannot
+    /// be drawn (a run that stopped before its first sample, an arm of more links than the
+    /// viewer draws): the run itself stands either way.
+    view: Result<run_view::Scene, String>,
 }
 
 /// `values` (`rows x width`, row-major) as a numpy array of shape `(rows, width)`.
@@ -1006,16 +1007,18 @@ impl Run {
             }) => return Err(Error::from(error).into()),
         };
         let view = if run.record.is_empty() {
-            None
+            let failure = failure.as_deref().unwrap_or("no samples");
+            Err(format!(
+                "the run has no sample to show: it stopped at its start ({failure})"
+            ))
         } else {
-            Some(run_view::Scene {
-                title: format!("{} with {controller}", scenario.name),
-                caption: scenario.description.clone(),
-                runs: vec![
-                    run_view::from_record(scenario, controller, &run.record, failure.as_deref())
-                        .map_err(|e| Error::input(e.to_string()))?,
-                ],
-            })
+            run_view::from_record(scenario, controller, &run.record, failure.as_deref())
+                .map(|drawn| run_view::Scene {
+                    title: format!("{} with {controller}", scenario.name),
+                    caption: scenario.description.clone(),
+                    runs: vec![drawn],
+                })
+                .map_err(|e| format!("the viewer cannot draw the run: {e}"))
         };
         let r = run.record;
         let (m, n) = (r.n_coords, r.n_joints);
@@ -1058,7 +1061,7 @@ impl Run {
         failure: Option<String>,
         controller: String,
         coordinates: Vec<String>,
-        view: Option<run_view::Scene>,
+        view: Result<run_view::Scene, String>,
     ) -> PyResult<Self> {
         for array in &arrays {
             array
@@ -1218,16 +1221,13 @@ impl Run {
     /// The run as a self-contained HTML page (no network): the arm link by link, coloured by
     /// joint torque, the reference path and the tip's trace, played in sync with the tip error,
     /// modal coordinates, tau* and joint torques (what `hrm view` writes). Save it to a file
-    /// and open it in a browser. A run that stopped before its first sample has nothing to draw:
-    /// InvalidInput.
+    /// and open it in a browser. A run that stopped before its first sample, or that the
+    /// viewer cannot draw (an arm of more than 1,000 links), raises InvalidInput saying which.
     fn view_html(&self) -> PyResult<String> {
-        let Some(view) = &self.view else {
-            let failure = self.failure.as_deref().unwrap_or("no samples");
-            return Err(Error::input(format!(
-                "the run has no sample to show: it stopped at its start ({failure})"
-            ))
-            .into());
-        };
+        let view = self
+            .view
+            .as_ref()
+            .map_err(|reason| Error::input(reason.clone()))?;
         run_view::page(
             &view.title,
             "",
@@ -1238,9 +1238,9 @@ impl Run {
     }
 
     /// The page of `view_html` in an iframe: what Jupyter shows for a Run (None, so that
-    /// Jupyter shows `repr`, for a run without samples).
+    /// Jupyter shows `repr`, for a run the viewer cannot draw).
     fn _repr_html_(&self) -> PyResult<Option<String>> {
-        if self.view.is_none() {
+        if self.view.is_err() {
             return Ok(None);
         }
         Ok(Some(run_view::iframe(&self.view_html()?, VIEW_HEIGHT)))

@@ -678,7 +678,7 @@ impl SpatialArm {
     /// `link_i`), the movable joints in the order of theta, the first pair at the base pose. URDF
     /// carries no gravity: set the arm's `gravity` in the engine. At most 10,000 links.
     fn to_urdf(&self) -> PyResult<String> {
-        Ok(robot_desc::write_urdf(&self.robot()?))
+        Ok(robot_desc::write_urdf(&self.robot()?).map_err(|e| Error::input(e.to_string()))?)
     }
 
     /// The arm's chain as MJCF text for MuJoCo, its gravity in `<option>` (the two hinges of a

@@ -419,3 +419,21 @@ def test_pipe_deploy_runs_with_mpc_within_joint_torque_nm():
         scenario.run_deploy()
     with pytest.raises(hrm.InvalidInput, match="deploy"):
         hrm.Scenario.builtin("paper-tracking").run_deploy()
+
+
+def test_a_run_the_viewer_cannot_draw_still_returns_its_data():
+    # 1,200 links are more than the viewer draws (1,000): the run and its summary stand, the page
+    # says why it is missing, and a pickled copy says the same.
+    scenario = hrm.Scenario.builtin("paper-tracking")
+    scenario.arm.links = 1200
+    scenario.arm.link_length = 1.0 / 1200
+    scenario.arm.link_mass = 1.0 / 1200
+    scenario.duration = 0.01
+    scenario.controller.kind = "pd"
+    run = scenario.run()
+    assert run.failure is None and run.t.shape[0] > 1 and run.summary["recorded_samples"] > 1
+    with pytest.raises(hrm.InvalidInput, match="the viewer cannot draw the run"):
+        run.view_html()
+    assert run._repr_html_() is None
+    with pytest.raises(hrm.InvalidInput, match="the viewer cannot draw the run"):
+        pickle.loads(pickle.dumps(run)).view_html()

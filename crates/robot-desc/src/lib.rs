@@ -23,4 +23,4 @@ pub use urdf_read::{
     MAX_ATTRIBUTE_BYTES, MAX_ATTRIBUTES, MAX_MAGNITUDE, MAX_NAMESPACES, MAX_URDF_BYTES,
     MAX_XML_DEPTH, MAX_XML_NODES, Merged, ReadReport, Reading, read_urdf,
 };
-pub use urdf_write::write_urdf;
+pub use urdf_write::{MAX_EXPORT_JOINTS, write_urdf};

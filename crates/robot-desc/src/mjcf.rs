@@ -23,7 +23,8 @@
 use crate::error::DescError;
 use crate::model::{Body, Joint, JointKind, Robot, Shape};
 use crate::pose::{Mat3, Pose, mat_vec, matrix_quaternion, transpose};
-use crate::urdf_write::{escape, numbers};
+use crate::urdf_read::MAX_MAGNITUDE;
+use crate::urdf_write::{escape, numbers, write_urdf};
 use std::fmt::Write;
 
 /// MuJoCo's `mjMINVAL`: the least mass and principal moment of inertia of a moving body it
@@ -55,9 +56,10 @@ pub const MJCF_BODIES_PER_FILE: usize = 400;
 /// [`MJCF_MAX_BODIES_ONE_FILE`] moving bodies (use [`write_mjcf_files`]), and, naming the link,
 /// what MuJoCo would refuse: a massless last link, a moving body's mass or principal moment
 /// below [`MJ_MINVAL`], an inertia [`read_urdf`](crate::read_urdf) refuses, a moving link named
-/// `world`.
+/// `world`; and what [`write_urdf`](crate::write_urdf) refuses (a number `read_urdf` would not
+/// read), or a gravity component beyond [`MAX_MAGNITUDE`](crate::MAX_MAGNITUDE).
 pub fn write_mjcf(robot: &Robot, gravity: [f64; 3]) -> Result<String, DescError> {
-    let bodies = bodies(robot)?;
+    let bodies = bodies(robot, gravity)?;
     if bodies.len() > MJCF_MAX_BODIES_ONE_FILE {
         return Err(DescError::export(
             format!("robot '{}' as one MJCF document", robot.name),
@@ -81,7 +83,7 @@ pub fn write_mjcf_files(
     gravity: [f64; 3],
     stem: &str,
 ) -> Result<Vec<(String, String)>, DescError> {
-    let bodies = bodies(robot)?;
+    let bodies = bodies(robot, gravity)?;
     Ok(assemble(
         robot,
         &bodies,
@@ -108,8 +110,20 @@ struct MjInertia {
     diagonal: [f64; 3],
 }
 
-/// Groups the joints into bodies that have mass and checks what MuJoCo checks.
-fn bodies(robot: &Robot) -> Result<Vec<MjBody<'_>>, DescError> {
+/// Checks `gravity` and that the robot reads back as URDF, then groups the joints into bodies
+/// that have mass and checks what MuJoCo checks.
+fn bodies(robot: &Robot, gravity: [f64; 3]) -> Result<Vec<MjBody<'_>>, DescError> {
+    if let Some(g) = gravity
+        .iter()
+        .find(|g| !(g.is_finite() && g.abs() <= MAX_MAGNITUDE))
+    {
+        return Err(DescError::export(
+            "gravity to MJCF",
+            format!("each component must be finite and at most {MAX_MAGNITUDE:e} m/s^2, got {g}"),
+        ));
+    }
+    // What the URDF reader refuses, MuJoCo's loader would refuse or misread too.
+    write_urdf(robot)?;
     let mut bodies = Vec::new();
     let mut group: Vec<&Joint> = Vec::new();
     for joint in &robot.joints {

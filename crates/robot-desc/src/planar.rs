@@ -1,7 +1,9 @@
 //! The planar arms of `manip-dyn` as spatial chains.
 
+use crate::error::DescError;
 use crate::model::{Body, Inertial, Joint, JointKind, Robot};
 use crate::pose::Pose;
+use crate::urdf_write::MAX_EXPORT_JOINTS;
 use manip_dyn::ChainModel;
 
 /// The planar chain as a spatial one in the base's `x-y` plane: joint `i` about `z` at the end
@@ -11,7 +13,19 @@ use manip_dyn::ChainModel;
 /// (MuJoCo refuses a singular inertia, so a zero-thickness rod's `ixx = 0` would not export).
 /// Gravity is not part of a URDF: the chain's gravity acts along `-y`, which MJCF writes in
 /// `<option>` and URDF users set themselves.
-pub fn from_planar(chain: &ChainModel, name: &str) -> Robot {
+///
+/// # Errors
+/// [`DescError::Export`] for more than [`MAX_EXPORT_JOINTS`] links, before any is built.
+pub fn from_planar(chain: &ChainModel, name: &str) -> Result<Robot, DescError> {
+    if chain.n_links() > MAX_EXPORT_JOINTS {
+        return Err(DescError::export(
+            format!("robot '{name}'"),
+            format!(
+                "{} links exceed the {MAX_EXPORT_JOINTS} a description is written with",
+                chain.n_links()
+            ),
+        ));
+    }
     let mut joints = Vec::with_capacity(chain.n_links());
     let mut offset = 0.0;
     for (i, link) in chain.links().iter().enumerate() {
@@ -41,12 +55,12 @@ pub fn from_planar(chain: &ChainModel, name: &str) -> Robot {
         });
         offset = link.length;
     }
-    Robot {
+    Ok(Robot {
         name: name.to_string(),
         base: Body {
             name: "base".to_string(),
             ..Body::default()
         },
         joints,
-    }
+    })
 }

@@ -1,15 +1,49 @@
 //! Writing a chain as URDF, numbers in Rust's shortest round-trip form so that reading the text
 //! back gives the same model bit for bit.
 
+use crate::error::DescError;
 use crate::model::{Body, Geometry, Inertial, Robot, Shape};
 use crate::pose::Pose;
+use crate::urdf_read::read_urdf;
 use std::fmt::Write;
+
+/// The most movable joints a description is written with, checked before any text is: about
+/// 40 MB of URDF at most, beyond what [`read_urdf`] reads ([`MAX_URDF_BYTES`](crate::MAX_URDF_BYTES),
+/// which the read-back then refuses; a chain of 30,000 joints is written and read back).
+pub const MAX_EXPORT_JOINTS: usize = 50_000;
 
 /// The chain as a URDF document: the base link, then each movable joint and its child link.
 /// Fixed links were merged when the model was read, so none is written; reading the result
 /// gives back `robot` exactly (every `f64` is printed in its shortest form that parses back to
 /// the same bits).
-pub fn write_urdf(robot: &Robot) -> String {
+///
+/// # Errors
+/// [`DescError::Export`] for more than [`MAX_EXPORT_JOINTS`] joints (checked before anything is
+/// written) and for a robot whose document [`read_urdf`] would refuse (a number beyond
+/// [`MAX_MAGNITUDE`](crate::MAX_MAGNITUDE), an inertia that is not physical, ...): the text is
+/// read back before it is returned, so what this writes, this crate reads.
+pub fn write_urdf(robot: &Robot) -> Result<String, DescError> {
+    if robot.joints.len() > MAX_EXPORT_JOINTS {
+        return Err(DescError::export(
+            format!("robot '{}'", robot.name),
+            format!(
+                "{} movable joints exceed the {MAX_EXPORT_JOINTS} a description is written with",
+                robot.joints.len()
+            ),
+        ));
+    }
+    let text = urdf_text(robot);
+    read_urdf(&text).map_err(|e| {
+        DescError::export(
+            format!("robot '{}'", robot.name),
+            format!("its URDF would not read back: {e}"),
+        )
+    })?;
+    Ok(text)
+}
+
+/// [`write_urdf`]'s text, unchecked.
+fn urdf_text(robot: &Robot) -> String {
     let mut out = String::new();
     out.push_str("<?xml version=\"1.0\"?>\n");
     let _ = writeln!(out, "<robot name=\"{}\">", escape(&robot.name));

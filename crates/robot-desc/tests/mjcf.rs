@@ -7,7 +7,7 @@
 use manip_dyn::{ChainModel, Link};
 use proptest::prelude::*;
 use robot_desc::pose::{Mat3, matrix_quaternion, rpy_matrix};
-use robot_desc::{MJ_MINVAL, from_planar, read_urdf, write_mjcf};
+use robot_desc::{MAX_EXPORT_JOINTS, MJ_MINVAL, from_planar, read_urdf, write_mjcf, write_urdf};
 use test_support::numeric::quaternion_matrix;
 
 /// A one-joint chain: base 'b', link 'a' with the `<inertial>` content `inertial`.
@@ -169,7 +169,7 @@ fn masses_and_moments_below_mjminval_are_refused_naming_the_link() {
     assert!(mjcf(&light).is_ok());
     // A planar arm of point-like links (`hrm.Arm(inertias=[1e-20, 1e-20]).to_mjcf()`).
     let link = Link::new(0.1, 0.1, 0.05, 1e-20).unwrap();
-    let arm = from_planar(&ChainModel::new(vec![link; 2], 9.81).unwrap(), "arm");
+    let arm = from_planar(&ChainModel::new(vec![link; 2], 9.81).unwrap(), "arm").unwrap();
     let message = write_mjcf(&arm, [0.0, -9.81, 0.0]).unwrap_err().to_string();
     assert!(
         message.contains("link 'link_1' to MJCF") && message.contains("at least 1e-15"),
@@ -189,7 +189,7 @@ fn an_unphysical_inertia_built_in_code_is_refused() {
     robot.joints[0].child.inertial.inertia = [1.0, 0.0, 0.0, 1.0, 0.0, 2.001];
     let message = write_mjcf(&robot, [0.0; 3]).unwrap_err().to_string();
     assert!(
-        message.contains("link 'a' to MJCF") && message.contains("triangle inequality"),
+        message.contains("link 'a'") && message.contains("triangle inequality"),
         "{message}"
     );
 }
@@ -274,4 +274,42 @@ fn a_massless_links_geometry_is_named_in_a_comment() {
             assert!(!inside.contains("--"), "{inside}");
         }
     }
+}
+
+/// What is written reads back: a link mass beyond what `read_urdf` reads, a gravity beyond its
+/// bound and a chain beyond `MAX_EXPORT_JOINTS` are refused, naming the robot or the gravity,
+/// before any text is returned.
+#[test]
+fn what_the_reader_would_refuse_is_not_written() {
+    let heavy = from_planar(&ChainModel::uniform(3, 0.1, 1e10, 9.81).unwrap(), "heavy").unwrap();
+    let error = write_urdf(&heavy).unwrap_err().to_string();
+    assert!(
+        error.starts_with("cannot export robot 'heavy': its URDF would not read back: ")
+            && error.contains("at most 1e9"),
+        "{error}"
+    );
+    let error = write_mjcf(&heavy, [0.0, -9.81, 0.0])
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("its URDF would not read back"), "{error}");
+    let arm = from_planar(&ChainModel::uniform(3, 0.1, 0.1, 9.81).unwrap(), "arm").unwrap();
+    for gravity in [[0.0, -1e300, 0.0], [f64::NAN, 0.0, 0.0]] {
+        let error = write_mjcf(&arm, gravity).unwrap_err().to_string();
+        assert!(
+            error.starts_with("cannot export gravity to MJCF"),
+            "{error}"
+        );
+    }
+    assert!(write_mjcf(&arm, [0.0, -9.81, 0.0]).is_ok());
+    let long = ChainModel::uniform(MAX_EXPORT_JOINTS + 1, 1e-3, 1e-3, 9.81).unwrap();
+    let error = from_planar(&long, "long").unwrap_err().to_string();
+    assert!(error.contains("50001 links exceed the 50000"), "{error}");
+    let mut robot =
+        from_planar(&ChainModel::uniform(1, 1e-3, 1e-3, 9.81).unwrap(), "long").unwrap();
+    robot.joints = vec![robot.joints[0].clone(); MAX_EXPORT_JOINTS + 1];
+    let error = write_urdf(&robot).unwrap_err().to_string();
+    assert!(
+        error.contains("50001 movable joints exceed the 50000"),
+        "{error}"
+    );
 }

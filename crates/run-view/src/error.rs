@@ -122,6 +122,12 @@ pub enum FieldProblem {
         /// The value.
         value: f64,
     },
+    /// A value that must be finite and non-negative.
+    #[error("{value}, expected a finite non-negative number")]
+    Negative {
+        /// The value.
+        value: f64,
+    },
     /// A value that must be finite and positive.
     #[error("{value}, expected a finite positive number")]
     NotPositive {

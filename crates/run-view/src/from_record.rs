@@ -2,8 +2,9 @@
 //! from the recorded modal coordinates through the scenario's modal map (eq 8) and the chain's
 //! forward kinematics, the scenario's obstacles, and the series a reader checks first.
 
+use crate::decimate::strided;
 use crate::error::ViewError;
-use crate::view::{Obstacle, RunView, Series};
+use crate::view::{MAX_SAMPLES, Obstacle, RunView, Series};
 use clearance::{ClearanceData, ClearanceModel};
 use modal_reduce::PlantModel;
 use sim_core::Record;
@@ -20,7 +21,9 @@ use sim_study::{Scenario, TorqueLimit};
 /// clearance series (mm): at every recorded sample the smallest clearance of a link's capsule
 /// to an obstacle and between links that share no joint, measured by `clearance::distances`
 /// from the drawn joint points (the loop's own minima over every controller sample are in the
-/// run's summary). `stopped` is why a run stopped early.
+/// run's summary). A record of more than [`MAX_SAMPLES`] samples is drawn at evenly strided
+/// samples ([`strided`](crate::strided), the first and the last included). `stopped` is why a
+/// run stopped early.
 pub fn from_record(
     scenario: &Scenario,
     label: &str,
@@ -45,13 +48,15 @@ pub fn from_record(
             samples,
         });
     }
+    // A run longer than the viewer holds is drawn at evenly strided samples, the last included.
+    let picked = strided(samples, MAX_SAMPLES - 1);
     let mut theta = vec![0.0; n_joints];
-    let mut joints = Vec::with_capacity(samples);
+    let mut joints = Vec::with_capacity(picked.len());
     match &plant {
         PlantModel::Planar(model) => {
             let lengths: Vec<f64> = model.chain().link_lengths().collect();
             let mut points = vec![[0.0; 2]; n + 1];
-            for k in 0..samples {
+            for &k in &picked {
                 model.map().joint_angles(record.a_at(k), &mut theta)?;
                 backbone_kin::joint_positions(&lengths, &theta, &mut points)?;
                 joints.push(points.iter().flatten().copied().collect());
@@ -60,7 +65,7 @@ pub fn from_record(
         PlantModel::Spatial(model) => {
             let map = model.map();
             let mut points = vec![[0.0; 3]; n + 1];
-            for k in 0..samples {
+            for &k in &picked {
                 map.joint_angles(record.a_at(k), &mut theta)?;
                 backbone_kin::spatial_joint_positions(
                     map.link_lengths(),
@@ -81,8 +86,9 @@ pub fn from_record(
     };
     let names = scenario.coordinate_names();
     // In the plane z is zero and `hypot(d, 0) = |d|`.
-    let tip_error = (0..samples)
-        .map(|k| {
+    let tip_error = picked
+        .iter()
+        .map(|&k| {
             let (tip, reference) = (record.tip[k], record.tip_ref[k]);
             1e3 * (tip[0] - reference[0])
                 .hypot(tip[1] - reference[1])
@@ -90,7 +96,7 @@ pub fn from_record(
         })
         .collect();
     let modal = |series: fn(&Record, usize) -> &[f64], i: usize| -> Vec<f64> {
-        (0..samples).map(|k| series(record, k)[i]).collect()
+        picked.iter().map(|&k| series(record, k)[i]).collect()
     };
     let mut coordinates = Series {
         title: "modal coordinates".into(),
@@ -107,8 +113,9 @@ pub fn from_record(
             .extend([modal(Record::a_at, i), modal(Record::a_ref_at, i)]);
     }
     // A link's torque: its joint's, or the magnitude of its universal joint's two.
-    let joint_torque: Vec<Vec<f64>> = (0..samples)
-        .map(|k| match dims {
+    let joint_torque: Vec<Vec<f64>> = picked
+        .iter()
+        .map(|&k| match dims {
             2 => record.joint_torques_at(k).to_vec(),
             _ => record
                 .joint_torques_at(k)
@@ -142,13 +149,12 @@ pub fn from_record(
     let view = RunView {
         label: label.to_owned(),
         dims,
-        t: record.t.clone(),
+        t: picked.iter().map(|&k| record.t[k]).collect(),
         joints,
-        tip_ref: record
-            .tip_ref
+        tip_ref: picked
             .iter()
-            .zip(&record.tip_ref_z)
-            .map(|(p, &z)| {
+            .map(|&k| (record.tip_ref[k], record.tip_ref_z[k]))
+            .map(|(p, z)| {
                 if dims == 2 {
                     p.to_vec()
                 } else {

@@ -12,8 +12,9 @@ use serde::{Deserialize, Serialize};
 pub const MAX_SAMPLES: usize = 100_000;
 /// The most points (joints and base) an arm may have.
 pub const MAX_POINTS: usize = 1_001;
-/// The most obstacles, channels or series groups of a run.
-pub const MAX_ITEMS: usize = 1_000;
+/// The most obstacles (a scenario's most, [`sim_study::MAX_SCENARIO_OBSTACLES`]), channels or
+/// series groups of a run.
+pub const MAX_ITEMS: usize = sim_study::MAX_SCENARIO_OBSTACLES;
 /// The most runs a scene may compare.
 pub const MAX_RUNS: usize = 64;
 
@@ -283,7 +284,8 @@ impl RunView {
             for p in points {
                 point(&field, p, d)?;
             }
-            positive(&field, &lengths)?;
+            // A radius or half-side of zero, as a scenario allows, is drawn as a point or a line.
+            non_negative(&field, &lengths)?;
         }
         for (i, c) in self.channels.iter().enumerate() {
             let field = format!("channels[{i}]");
@@ -339,6 +341,14 @@ fn finite(field: &str, values: &[f64]) -> Result<(), ViewError> {
 pub(crate) fn positive(field: &str, values: &[f64]) -> Result<(), ViewError> {
     match values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
         Some(&value) => Err(ViewError::field(field, FieldProblem::NotPositive { value })),
+        None => Ok(()),
+    }
+}
+
+/// Finite non-negative `values`.
+fn non_negative(field: &str, values: &[f64]) -> Result<(), ViewError> {
+    match values.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+        Some(&value) => Err(ViewError::field(field, FieldProblem::Negative { value })),
         None => Ok(()),
     }
 }

@@ -2,8 +2,8 @@
 //! and the viewer script's own tests (node).
 
 use run_view::{
-    Camera, Channel, GifOptions, Obstacle, PAGE_SAMPLES, RunView, Scene, Series, from_record, page,
-    scene_html, write_gif,
+    Camera, Channel, GifOptions, MAX_SAMPLES, Obstacle, PAGE_SAMPLES, RunView, Scene, Series,
+    from_record, page, scene_html, strided, write_gif,
 };
 use sim_study::{ControllerKind, Scenario};
 
@@ -124,6 +124,33 @@ fn a_planar_run_is_drawn_from_its_modal_coordinates() {
 }
 
 #[test]
+fn a_record_longer_than_the_viewer_holds_is_drawn_at_strided_samples() {
+    let mut scenario = Scenario::builtin("paper-tracking").unwrap();
+    scenario.duration = 10.05;
+    scenario.controller.kind = ControllerKind::Pd;
+    scenario.record_period = Some(1e-4);
+    // An obstacle of radius zero (a point, as a scenario allows) is drawn too.
+    scenario.obstacles = vec![sim_study::ObstacleSpec::Circle {
+        center: vec![0.3, 0.3],
+        radius: 0.0,
+    }];
+    scenario.arm.radius = Some(0.01);
+    let run = scenario.build().unwrap().run().unwrap();
+    let samples = run.record.len();
+    assert!(samples > MAX_SAMPLES, "{samples}");
+    let view = from_record(&scenario, "pd", &run.record, None).unwrap();
+    let picked = strided(samples, MAX_SAMPLES - 1);
+    assert!(view.len() <= MAX_SAMPLES && view.len() == picked.len());
+    for (k, (&t, &sample)) in view.t.iter().zip(&picked).enumerate() {
+        assert_eq!(t, run.record.t[sample]);
+        let tip = &view.joints[k][20..];
+        assert!((tip[0] - run.record.tip[sample][0]).abs() < 1e-12);
+    }
+    assert_eq!(view.t.last(), run.record.t.last());
+    assert_eq!(view.obstacles.len(), 1);
+}
+
+#[test]
 fn bad_data_is_refused_naming_the_field() {
     let good = spatial(5, 4);
     good.check().unwrap();
@@ -190,10 +217,10 @@ fn bad_data_is_refused_naming_the_field() {
             }),
         ),
         (
-            "obstacles[1]: 0, expected a finite positive",
+            "obstacles[1]: -0.001, expected a finite non-negative",
             Box::new(|r| {
                 if let Obstacle::Capsule { radius, .. } = &mut r.obstacles[1] {
-                    *radius = 0.0;
+                    *radius = -0.001;
                 }
             }),
         ),
@@ -261,10 +288,7 @@ fn decimation_bounds_the_page_and_keeps_the_run_ends() {
         assert!((a - b).abs() <= 0.5e-4 + 1e-15, "{a} {b}");
     }
     let peak = 50.0;
-    for (&a, k) in small.series[0].values[0]
-        .iter()
-        .zip(run_view::strided(2001, 100))
-    {
+    for (&a, k) in small.series[0].values[0].iter().zip(strided(2001, 100)) {
         assert!((a - run.series[0].values[0][k]).abs() <= 0.5e-3 * peak / 10.0 + 1e-12);
     }
     let scene = Scene {

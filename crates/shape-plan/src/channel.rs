@@ -22,7 +22,8 @@ pub struct Channel {
 
 impl Channel {
     /// A channel along `centerline` (at least two points, consecutive points distinct, each
-    /// coordinate within [`MAX_CENTERLINE_EXTENT`]) of `radius` (positive).
+    /// coordinate within [`MAX_CENTERLINE_EXTENT`]) of `radius` (positive, at most
+    /// [`MAX_CENTERLINE_EXTENT`]).
     pub fn new(centerline: &[[f64; 2]], radius: f64) -> Result<Self, PlanError> {
         if centerline.len() < 2 {
             return Err(PlanError::Dimension {
@@ -39,10 +40,10 @@ impl Channel {
             });
         }
         check_finite("deploy radius", radius)?;
-        if radius <= 0.0 {
+        if !(radius > 0.0 && radius <= MAX_CENTERLINE_EXTENT) {
             return Err(PlanError::OutOfRange {
                 name: "deploy radius",
-                bound: "positive",
+                bound: "positive and at most 1e6 m",
                 value: radius,
             });
         }

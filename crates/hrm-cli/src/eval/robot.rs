@@ -247,7 +247,9 @@ pub(super) fn export(request: ExportRequest) -> EvalResult {
         (None, Some(arm)) => {
             let chain = arm.to_chain()?;
             let gravity = [0.0, -chain.gravity(), 0.0];
-            (robot_desc::from_planar(&chain, "hrm_planar_arm"), gravity)
+            let robot = robot_desc::from_planar(&chain, "hrm_planar_arm")
+                .map_err(|e| EvalError::input(format!("arm: {e}")))?;
+            (robot, gravity)
         }
         _ => {
             return Err(EvalError::input(
@@ -262,7 +264,7 @@ pub(super) fn export(request: ExportRequest) -> EvalResult {
     }
     let gravity = gravity(request.gravity, default_gravity)?;
     let text = match request.format.as_str() {
-        "urdf" => robot_desc::write_urdf(&robot),
+        "urdf" => robot_desc::write_urdf(&robot).map_err(|e| EvalError::input(e.to_string()))?,
         "mjcf" => {
             robot_desc::write_mjcf(&robot, gravity).map_err(|e| EvalError::input(e.to_string()))?
         }

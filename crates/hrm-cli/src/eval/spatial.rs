@@ -335,7 +335,7 @@ fn export(request: ExportRequest) -> EvalResult {
     }
     let robot = robot_desc::from_spatial_arm(&model, "hrm_spatial_arm");
     let text = match request.format.as_str() {
-        "urdf" => robot_desc::write_urdf(&robot),
+        "urdf" => robot_desc::write_urdf(&robot).map_err(|e| EvalError::input(e.to_string()))?,
         "mjcf" => robot_desc::write_mjcf(&robot, model.gravity())
             .map_err(|e| EvalError::input(e.to_string()))?,
         other => {

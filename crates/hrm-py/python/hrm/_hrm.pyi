@@ -249,9 +249,10 @@ class Run:
     def view_html(self) -> str:
         """The run as a self-contained HTML page: the arm animated beside its time series.
 
-        Raises InvalidInput for a run that stopped before its first sample."""
+        Raises InvalidInput for a run that stopped before its first sample or that the viewer
+        cannot draw (an arm of more than 1,000 links); the run's data stands either way."""
     def _repr_html_(self) -> Optional[str]:
-        """The page of view_html in an iframe (what Jupyter shows); None without samples."""
+        """The page of view_html in an iframe (what Jupyter shows); None when view_html raises."""
 
 def view_html(scene: str) -> str:
     """A scene as JSON text (docs/run-view.md) as a self-contained HTML page."""
@@ -313,6 +314,11 @@ class SpatialArm:
         self, a: ArrayLike, a_dot: ArrayLike, tau_star: ArrayLike
     ) -> Dict[str, Array]:
         """a_ddot and its analytic derivatives d_a, d_a_dot, d_tau_star = M*^-1 (m, m each)."""
+    def to_urdf(self) -> str:
+        """The arm's chain as URDF text (a universal joint as two revolute joints, the movable
+        joints in the order of theta); at most 10,000 links."""
+    def to_mjcf(self) -> str:
+        """The arm's chain as MJCF text for MuJoCo, its gravity in <option>; at most 495 links."""
 
 class Scenario:
     """A closed-loop experiment; every key of its TOML file is an attribute."""
@@ -331,6 +337,9 @@ class Scenario:
     integrator: Settings
     noise: Settings
     limits: Settings
+    obstacles: Optional[List[Dict[str, Any]]]
+    task: Optional[Settings]
+    deploy: Optional[Settings]
 
     @staticmethod
     def builtin(name: str) -> "Scenario":

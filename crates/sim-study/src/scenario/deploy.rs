@@ -99,7 +99,7 @@ impl Scenario {
     /// The channel of the scenario's `[deploy]` (`None` without one). Errors name
     /// `deploy.centerline` (fewer than two points, more than [`MAX_DEPLOY_CENTERLINE_POINTS`],
     /// a spatial `[x, y, z]` point, a non-finite coordinate, two equal consecutive points) or
-    /// `deploy.radius` (not positive and finite).
+    /// `deploy.radius` (not positive and finite, or above 1e6 m: [`shape_plan::MAX_CENTERLINE_EXTENT`]).
     pub fn channel(&self) -> Result<Option<Channel>, SimError> {
         let Some(DeploySpec { centerline, radius }) = &self.deploy else {
             return Ok(None);

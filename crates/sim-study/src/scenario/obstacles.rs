@@ -93,10 +93,13 @@ impl Scenario {
             return Ok(None);
         }
         let radius = self.arm.radius.unwrap_or(0.0);
-        if !(radius.is_finite() && radius >= 0.0) {
+        if !(0.0..=MAX_OBSTACLE_EXTENT).contains(&radius) {
             return Err(SimError::setting(
                 "arm.radius",
-                format!("must be non-negative and finite (m), got {radius}"),
+                format!(
+                    "must be non-negative and at most {MAX_OBSTACLE_EXTENT:e} (m, as an \
+                     obstacle's extent), got {radius}"
+                ),
             ));
         }
         let obstacles = self.obstacles(workspace)?;
