@@ -2,6 +2,7 @@
 //! entry, and distances to them.
 
 use crate::error::PlanError;
+use crate::polyline::Polyline;
 use lane_math::check_finite;
 
 /// The most centreline points a [`Channel`] accepts.
@@ -15,6 +16,8 @@ pub const MAX_CENTERLINE_EXTENT: f64 = 1e6;
 #[derive(Debug, Clone, PartialEq)]
 pub struct Channel {
     points: Vec<[f64; 2]>,
+    /// The same points, chunked for distance queries.
+    line: Polyline,
     /// Arc length at each point.
     arcs: Vec<f64>,
     radius: f64,
@@ -71,6 +74,7 @@ impl Channel {
         }
         Ok(Self {
             points: centerline.to_vec(),
+            line: Polyline::new(centerline),
             arcs,
             radius,
         })
@@ -119,11 +123,8 @@ impl Channel {
         let (e, d) = (self.entry(), self.axis());
         // The ray E - s d, s >= 0.
         let along = ((x[0] - e[0]) * d[0] + (x[1] - e[1]) * d[1]).min(0.0);
-        let mut best = dist(x, [e[0] + along * d[0], e[1] + along * d[1]]);
-        for pair in self.points.windows(2) {
-            best = best.min(point_segment(x, pair[0], pair[1]));
-        }
-        best
+        let guide = dist(x, [e[0] + along * d[0], e[1] + along * d[1]]);
+        guide.min(self.line.distance(x))
     }
 }
 
@@ -131,7 +132,15 @@ pub(crate) fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
+/// The distance of `x` from the segment `a`-`b`.
 pub(crate) fn point_segment(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    point_segment_squared(x, a, b).sqrt()
+}
+
+/// The squared distance of `x` from the segment `a`-`b` (coordinates within
+/// [`MAX_CENTERLINE_EXTENT`] and the arms' reach: the squares neither overflow nor, above
+/// `1e-150` m, underflow).
+pub(crate) fn point_segment_squared(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let d = [b[0] - a[0], b[1] - a[1]];
     let length2 = d[0] * d[0] + d[1] * d[1];
     let t = if length2 > 0.0 {
@@ -139,5 +148,6 @@ pub(crate) fn point_segment(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     } else {
         0.0
     };
-    dist(x, [a[0] + t * d[0], a[1] + t * d[1]])
+    let e = [x[0] - (a[0] + t * d[0]), x[1] - (a[1] + t * d[1])];
+    e[0] * e[0] + e[1] * e[1]
 }

@@ -17,7 +17,9 @@
 //! theta_FTL|`, exact when `2K = n`. The metrics are those of the chain the fit realises.
 
 use crate::channel::{Channel, dist};
-use crate::deploy_metrics::{DeployMetrics, DeployTracker};
+use crate::deploy_metrics::{
+    DeployMetrics, DeployTracker, MAX_DEPLOY_METRIC_WORK, deploy_metric_work,
+};
 use crate::error::PlanError;
 use backbone_kin::{BaseAngle, ModalMap, joint_positions};
 use lane_math::check_finite;
@@ -58,7 +60,8 @@ pub struct Deployment {
 /// (at most the centreline's length), fitting `harmonics` harmonics at each step.
 ///
 /// Errors: input errors for sizes and numbers (including a centreline longer than
-/// [`MAX_LENGTH_RATIO`] shortest links, a channel no wider than the links); [`PlanError::OutOfRange`] when `depth` exceeds
+/// [`MAX_LENGTH_RATIO`] shortest links, a channel no wider than the links, more than
+/// [`MAX_DEPLOY_METRIC_WORK`] to measure); [`PlanError::OutOfRange`] when `depth` exceeds
 /// the centreline or would pull the base past the entry (the arm is shorter than the depth);
 /// [`PlanError::DeployFoldsOnItself`] when a shape's links that share no joint overlap (the
 /// centreline turns back on itself within a few links).
@@ -91,6 +94,14 @@ pub fn follow_the_leader(
             name: "deploy radius (the arm must fit in the channel)",
             bound: "larger than the arm's link radius",
             value: channel.radius(),
+        });
+    }
+    let work = deploy_metric_work(link_lengths.len(), steps + 1);
+    if work > MAX_DEPLOY_METRIC_WORK {
+        return Err(PlanError::OutOfRange {
+            name: "deploy work (steps x links: the metrics of every shape)",
+            bound: "at most 2e9 (MAX_DEPLOY_METRIC_WORK: fewer links or steps)",
+            value: work,
         });
     }
     let shortest = link_lengths.iter().copied().fold(f64::INFINITY, f64::min);

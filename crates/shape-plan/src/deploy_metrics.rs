@@ -4,12 +4,27 @@
 
 use crate::channel::{Channel, dist, point_segment};
 use crate::error::PlanError;
+use crate::polyline::Polyline;
 use clearance::segment_segment;
 use lane_math::check_finite;
 
 /// Points per link at which the body's distances to the path and the walls are sampled (both
 /// ends included).
 pub const SAMPLES_PER_LINK: usize = 32;
+
+/// The most work the metrics of a deployment's shapes may take ([`deploy_metric_work`]): about
+/// 20 s on one core of 2026, so that a request for more is refused up front rather than hangs.
+pub const MAX_DEPLOY_METRIC_WORK: f64 = 2e9;
+
+/// The work of measuring `shapes` shapes of a chain of `links` links, in units of about 10 ns:
+/// per shape, ten for each of the body's sampled points ([`SAMPLES_PER_LINK`] + 1 a link, each
+/// measured against the channel and the traced path) and one for each pair of links (the self
+/// clearance's bound).
+pub fn deploy_metric_work(links: usize, shapes: usize) -> f64 {
+    let links = links as f64;
+    let points = links * (SAMPLES_PER_LINK + 1) as f64;
+    shapes as f64 * (10.0 * points + 0.5 * links * (links - 1.0).max(0.0))
+}
 
 /// What a deployment achieved, over all its shapes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,7 +79,8 @@ pub struct DeployTracker<'c> {
     channel: &'c Channel,
     link_radius: f64,
     shortest: f64,
-    traced: Vec<[f64; 2]>,
+    /// The tip's path so far.
+    traced: Polyline,
     metrics: DeployMetrics,
 }
 
@@ -96,7 +112,7 @@ impl<'c> DeployTracker<'c> {
             channel,
             link_radius,
             shortest,
-            traced: Vec::new(),
+            traced: Polyline::default(),
             metrics: DeployMetrics {
                 tip_error: 0.0,
                 shape_deviation_percent: 0.0,
@@ -113,7 +129,7 @@ impl<'c> DeployTracker<'c> {
     /// [`PlanError::OutOfRange`] when the memory cannot be reserved.
     pub fn reserve(&mut self, shapes: usize) -> Result<(), PlanError> {
         self.traced
-            .try_reserve_exact(shapes)
+            .try_reserve(shapes)
             .map_err(|_| PlanError::OutOfRange {
                 name: "deployment samples",
                 bound: "within the memory available",
@@ -170,32 +186,34 @@ impl<'c> DeployTracker<'c> {
 
 /// The smallest clearance between two links of the chain of joint points `points` that share no
 /// joint (capsules of `radius`; `+inf` below three links), each pair's exact segment distance
-/// ([`clearance::segment_segment`]) unless a lower bound already exceeds the smallest found: a
+/// ([`clearance::segment_segment`]) unless a lower bound already reaches the smallest found: a
 /// link lies within half its length of its midpoint, so two links are at least the distance
 /// of their midpoints less both half-lengths apart (most pairs of a body along a channel are
-/// then skipped after one square root).
+/// then skipped after a few multiplications and one square root).
 fn self_clearance(points: &[[f64; 2]], radius: f64) -> f64 {
     let space = |p: [f64; 2]| [p[0], p[1], 0.0];
-    let mut smallest = f64::INFINITY;
-    for (i, link) in points.windows(2).enumerate() {
-        let middle = [
+    let middle = |link: &[[f64; 2]]| {
+        [
             0.5 * (link[0][0] + link[1][0]),
             0.5 * (link[0][1] + link[1][1]),
-        ];
-        let half = 0.5 * dist(link[0], link[1]);
+        ]
+    };
+    let half = |link: &[[f64; 2]]| {
+        let d = [link[1][0] - link[0][0], link[1][1] - link[0][1]];
+        0.5 * (d[0] * d[0] + d[1] * d[1]).sqrt()
+    };
+    let mut smallest = f64::INFINITY;
+    for (i, link) in points.windows(2).enumerate() {
+        let (centre, reach_of_link) = (middle(link), half(link));
         for other in points.get(i + 2..).unwrap_or(&[]).windows(2) {
-            let other_middle = [
-                0.5 * (other[0][0] + other[1][0]),
-                0.5 * (other[0][1] + other[1][1]),
-            ];
-            let other_half = 0.5 * dist(other[0], other[1]);
-            // Less a slack far above the bound's rounding, so that no skipped pair held it.
-            let bound = dist(middle, other_middle)
-                - half
-                - other_half
-                - 2.0 * radius
-                - 1e-9 * (half + other_half);
-            if bound >= smallest {
+            let other_half = half(other);
+            // The pair is skipped when its midpoints lie at least `reach` apart; a relative
+            // slack far above the rounding keeps every pair that could hold the smallest.
+            let halves = reach_of_link + other_half;
+            let reach = smallest + halves + 2.0 * radius + 1e-9 * halves;
+            let offset = middle(other);
+            let apart2 = (offset[0] - centre[0]).powi(2) + (offset[1] - centre[1]).powi(2);
+            if reach <= 0.0 || apart2 >= reach * reach {
                 continue;
             }
             let closest = segment_segment(
@@ -212,15 +230,12 @@ fn self_clearance(points: &[[f64; 2]], radius: f64) -> f64 {
 
 /// The distance of `x` from the tip's traced polyline joined to the entry and the guide behind
 /// it.
-fn traced_distance(channel: &Channel, traced: &[[f64; 2]], x: [f64; 2]) -> f64 {
+fn traced_distance(channel: &Channel, traced: &Polyline, x: [f64; 2]) -> f64 {
     let (e, d) = (channel.entry(), channel.axis());
     let along = ((x[0] - e[0]) * d[0] + (x[1] - e[1]) * d[1]).min(0.0);
     let mut best = dist(x, [e[0] + along * d[0], e[1] + along * d[1]]);
     if let Some(first) = traced.first() {
-        best = best.min(point_segment(x, e, *first));
+        best = best.min(point_segment(x, e, first));
     }
-    for pair in traced.windows(2) {
-        best = best.min(point_segment(x, pair[0], pair[1]));
-    }
-    best
+    best.min(traced.distance(x))
 }

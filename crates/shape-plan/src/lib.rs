@@ -11,6 +11,7 @@ mod motion;
 mod options;
 mod planar;
 mod planner;
+mod polyline;
 mod shape;
 mod spatial;
 
@@ -18,7 +19,10 @@ pub use arm::{Arm, ArmScratch};
 pub use channel::{Channel, MAX_CENTERLINE_EXTENT, MAX_CENTERLINE_POINTS};
 pub use data::PlanData;
 pub use deploy::{DeployFrame, Deployment, MAX_DEPLOY_STEPS, MAX_LENGTH_RATIO, follow_the_leader};
-pub use deploy_metrics::{DeployMetrics, DeploySample, DeployTracker, SAMPLES_PER_LINK};
+pub use deploy_metrics::{
+    DeployMetrics, DeploySample, DeployTracker, MAX_DEPLOY_METRIC_WORK, SAMPLES_PER_LINK,
+    deploy_metric_work,
+};
 pub use error::PlanError;
 pub use generator::{
     MAX_PASSAGE_OBSTACLES, NarrowPassage, PassageSpec, narrow_passage, spatial_narrow_passage,

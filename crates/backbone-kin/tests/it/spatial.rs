@@ -335,3 +335,31 @@ fn the_spatial_family_refuses_bad_input() {
     ));
     let _ = SPATIAL_CURVE_TOLERANCE;
 }
+
+/// Arms of links of `1e-200` m (whose squared errors underflow) and `1e150` m (whose squares
+/// overflow): the solver never reports a target it did not reach as reached.
+#[test]
+fn the_residual_of_tiny_and_huge_arms_never_reads_as_zero() {
+    for scale in [1e-200, 1.0, 1e150] {
+        let map = SpatialModalMap::new(&[scale; 2], 1).unwrap();
+        let base = BasePose::default();
+        let target = [scale, 0.5 * scale, 0.3 * scale];
+        let mut ik = SpatialIk::new(map.clone(), base).unwrap();
+        let mut a = [0.25, 0.0, 0.25, 0.0];
+        let guess_tip = chain_tip(&map, &base, &a);
+        let miss = (0..3).fold(0.0_f64, |d, k| d.hypot(guess_tip[k] - target[k]));
+        assert!(miss > 0.1 * scale, "{scale}: the guess is {miss} away");
+        match ik.solve(target, &mut a) {
+            Ok(report) => {
+                let tip = chain_tip(&map, &base, &a);
+                let error = (0..3).fold(0.0_f64, |d, k| d.hypot(tip[k] - target[k]));
+                assert!(error <= 1e-12 * scale, "{scale}: {error}");
+                assert!(report.residual <= 1e-12 * scale && report.iterations > 0);
+            }
+            Err(error) => assert!(
+                matches!(error, KinError::NotConverged { residual, .. } if residual > 0.0),
+                "{scale}: {error:?}"
+            ),
+        }
+    }
+}

@@ -14,7 +14,8 @@ use manip_dyn::spatial::{SpatialData, rnea};
 use manip_dyn::spatial::{SpatialJoint, SpatialLink, SpatialModel, Transform};
 use optimal_ctl::MpcSettings;
 use shape_plan::{
-    Channel, DeployMetrics, DeploySample, DeployTracker, Deployment, PlanError, follow_the_leader,
+    Channel, DeployMetrics, DeploySample, DeployTracker, Deployment, MAX_DEPLOY_METRIC_WORK,
+    PlanError, deploy_metric_work, follow_the_leader,
 };
 use sim_core::controller::ChainMpcController;
 use sim_core::reference::{Reference, ReferenceSample, SplineMotion};
@@ -250,6 +251,23 @@ impl Scenario {
                     "must give at most {MAX_DEPLOY_RECORDED_SAMPLES} recorded samples for the \
                      deployment's metrics, got a duration of {} s recorded every {} s",
                     self.duration, record_period
+                ),
+            )
+            .into());
+        }
+        // The metrics of the plan's shapes and of every recorded one, bounded before any is
+        // computed.
+        let links = self.arm.link_count(None)?;
+        let shapes = DEPLOY_PLAN_STEPS + 2 + (self.duration / record_period) as usize;
+        let work = deploy_metric_work(links, shapes);
+        if work > MAX_DEPLOY_METRIC_WORK {
+            return Err(SimError::setting(
+                "arm.links",
+                format!(
+                    "is {links}: measured at {shapes} shapes (the plan's and one every \
+                     record_period), they take {work:.1e} units of work, more than the \
+                     {MAX_DEPLOY_METRIC_WORK:e} a deployment may: fewer links or a longer \
+                     record_period"
                 ),
             )
             .into());

@@ -303,6 +303,35 @@ fn deployment_keys_are_refused_by_name() {
             message(&bad)
         );
     }
+    let mut huge = base.clone();
+    huge.deploy.as_mut().unwrap().radius = 1e300;
+    assert!(
+        message(&huge).starts_with("deploy.radius cannot be deployed into: deploy radius must be positive and at most 1e6 m"),
+        "{}",
+        message(&huge)
+    );
+    let mut back = base.clone();
+    back.deploy.as_mut().unwrap().centerline = vec![vec![0.0, 0.0], vec![0.0, 0.4], vec![0.0, 0.2]];
+    assert!(
+        message(&back).starts_with(
+            "deploy.centerline cannot be deployed into: deploy centerline folds the arm onto itself"
+        ),
+        "{}",
+        message(&back)
+    );
+    // 100,000 links (each of 10 um) would take hours to measure: refused before anything runs.
+    let mut links = base.clone();
+    links.arm.links = Some(100_000);
+    links.arm.link_length = Some(1e-5);
+    links.duration = 0.001;
+    links.record_period = Some(0.0005);
+    let started = std::time::Instant::now();
+    assert!(
+        message(&links).starts_with("arm.links is 100000: measured at 404 shapes"),
+        "{}",
+        message(&links)
+    );
+    assert!(started.elapsed().as_secs_f64() < 5.0);
     let mut long = base.clone();
     long.deploy.as_mut().unwrap().centerline = vec![vec![0.0, 0.0], vec![0.0, 2.0]];
     assert!(
