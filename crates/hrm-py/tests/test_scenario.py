@@ -297,6 +297,9 @@ def test_a_run_that_stops_before_its_first_sample_is_a_run_without_rows():
     run = short_step(0.5).run(lambda t, a, a_dot, ref: np.full(2, 1e200))
     assert run.failure is not None and "integration diverged" in run.failure
     assert run.summary["error"] == run.failure and run.summary["recorded_samples"] == 0
+    # Statistics over no recorded sample are None, not zeros.
+    for key in ("tip_error_rms_m", "tip_error_max_m", "modal_error_rms_rad", "modal_error_max_rad"):
+        assert run.summary[key] is None, key
     assert run.t.shape == (0,) and run.a.shape == (0, 2) and run.tip.shape == (0, 2)
     with pytest.raises(hrm.InvalidInput, match="no sample to show"):
         run.view_html()

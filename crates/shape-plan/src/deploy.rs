@@ -178,7 +178,9 @@ pub fn follow_the_leader(
             p[0] += joints[0][0];
             p[1] += joints[0][1];
         }
-        let sample = tracker.add(&points, tau);
+        // The deployed length is the arm's length past the entry, the insertion, as a dynamic
+        // run measures it.
+        let sample = tracker.add(&points, base_sigma + length);
         if sample.self_clearance < 0.0 {
             return Err(PlanError::DeployFoldsOnItself {
                 progress: tau,

@@ -43,7 +43,8 @@ pub struct DeployMetrics {
     /// The smallest clearance between two links' capsules that share no joint, m (exact;
     /// `+inf` below three links): negative where the body overlaps itself.
     pub min_self_clearance: f64,
-    /// The deployed length of the last shape, m.
+    /// The deployed length of the last shape: the arm's length past the entry, its insertion
+    /// `q`, m (at most the tip's progress along the centreline, whose chords the links are).
     pub deployed_length: f64,
 }
 

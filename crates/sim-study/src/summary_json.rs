@@ -17,8 +17,9 @@ use serde_json::{Value, json};
 use sim_core::{ChainRun, SimError};
 
 /// The `summary.json` of one run: its [`Summary`](sim_core::Summary)'s fields; for a run that
-/// stopped, those of the data up to the stop plus `error` (why and when) and `stopped_at_s`;
-/// for a scenario that could not be built, `{"error": ...}` alone.
+/// stopped, those of the data up to the stop (`null` for the statistics of a run that stopped
+/// before its first recorded or controller sample) plus `error` (why and when) and
+/// `stopped_at_s`; for a scenario that could not be built, `{"error": ...}` alone.
 ///
 /// ```
 /// use sim_study::study::run_one;
@@ -48,6 +49,20 @@ pub fn run(result: &RunOutcome) -> Value {
         }) => {
             let mut summary = json!(run.summary);
             if let Some(fields) = summary.as_object_mut() {
+                // Statistics over no sample are not zeros: they are null.
+                let empty = [
+                    (run.summary.recorded_samples, &OVER_RECORDED_SAMPLES[..]),
+                    (run.summary.controller_samples, &OVER_CONTROLLER_SAMPLES[..]),
+                ];
+                for (samples, keys) in empty {
+                    if samples == 0 {
+                        for key in keys {
+                            if let Some(value) = fields.get_mut(*key) {
+                                *value = Value::Null;
+                            }
+                        }
+                    }
+                }
                 fields.insert("error".into(), json!(error.to_string()));
                 fields.insert("stopped_at_s".into(), json!(run.summary.simulated_s));
             }
@@ -55,6 +70,26 @@ pub fn run(result: &RunOutcome) -> Value {
         }
     }
 }
+
+/// The [`Summary`](sim_core::Summary) fields taken over the recorded samples.
+const OVER_RECORDED_SAMPLES: [&str; 4] = [
+    "tip_error_rms_m",
+    "tip_error_max_m",
+    "modal_error_rms_rad",
+    "modal_error_max_rad",
+];
+
+/// The [`Summary`](sim_core::Summary) fields taken over the controller samples.
+const OVER_CONTROLLER_SAMPLES: [&str; 8] = [
+    "peak_modal_torques_nm",
+    "peak_joint_torque_nm",
+    "peak_joint_torques_nm",
+    "control_effort_n2m2s",
+    "tau_star_clamped_fraction",
+    "torque_projection_share",
+    "min_clearance_m",
+    "min_self_clearance_m",
+];
 
 /// The `summary.json` of a whole sweep: its configuration and its cells
 /// ([`cells`](crate::study::cells) of the merged runs).
