@@ -7,10 +7,17 @@ use lane_math::{Classify, Compact, ErrorClass, ShapeError, ShapeProblem};
 #[non_exhaustive]
 pub enum PlanError {
     /// No start led to a shape that reaches the target with the clearance: the best shape
-    /// reached is reported (the one with the smallest tip error, ties broken by clearance).
+    /// reached is reported (the one with the smallest tip error, ties broken by clearance); when
+    /// that shape keeps the clearance, the message says the target was not reached.
     #[error(
-        "no collision-free shape found: the best shape reached (the nearest to the target) has \
-         clearance {} m (needed {} m) with its tip {} m from the target, after {starts} starts",
+        "{}: the best shape reached (the nearest to the target) has clearance {} m (needed {} m) \
+         with its tip {} m from the target, after {starts} starts",
+        if *.best_clearance >= *.needed {
+            "no shape found that reaches the target (the modal family may not reach it from this \
+             base angle)"
+        } else {
+            "no collision-free shape found"
+        },
         Compact(*.best_clearance),
         Compact(*.needed),
         Compact(*.tip_error)

@@ -28,7 +28,7 @@ pub struct PlanOptions {
     /// The largest distance of the goal shape's tip from the target (m); positive.
     /// Default `1e-6`.
     pub tip_tolerance: f64,
-    /// The most iterations of one shape solve. Default 200.
+    /// The most iterations of one shape solve, at least 1. Default 200.
     pub max_iterations: usize,
     /// The random starts of the shape solve after the deterministic ones, and the via points
     /// tried when a straight motion is blocked (one budget for the whole plan). Default 64.
@@ -92,12 +92,17 @@ impl PlanOptions {
                 return Err(PlanError::TooMany { name, got, max });
             }
         }
-        if self.max_checks == 0 {
-            return Err(PlanError::OutOfRange {
-                name: "max checks",
-                bound: "at least 1",
-                value: 0.0,
-            });
+        for (name, count) in [
+            ("max checks", self.max_checks),
+            ("max iterations", self.max_iterations),
+        ] {
+            if count == 0 {
+                return Err(PlanError::OutOfRange {
+                    name,
+                    bound: "at least 1",
+                    value: 0.0,
+                });
+            }
         }
         Ok(())
     }

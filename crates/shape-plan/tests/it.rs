@@ -204,10 +204,42 @@ fn one_harmonic_cannot_pass_and_says_so() {
     assert!(error.is_unreachable());
     assert!(starts == 3 + options().samples, "{starts}");
     assert!(best_clearance < needed || tip_error > options().tip_tolerance);
+    let opening = if best_clearance < needed {
+        "no collision-free shape found"
+    } else {
+        "no shape found that reaches the target"
+    };
+    assert!(error.to_string().starts_with(opening), "{error}");
+}
+
+#[test]
+fn a_target_the_family_cannot_reach_is_not_called_a_collision() {
+    // Nearly at the arm's length, 0.8 rad off the base's direction, in empty space: one
+    // harmonic's shapes about ALPHA0 reach the distance only straight up, so the best shape is
+    // clear of everything and short of the target, and the message says so.
+    let r = 0.999 * LENGTH * LINKS as f64;
+    let target = [r * (ALPHA0 - 0.8).cos(), r * (ALPHA0 - 0.8).sin()];
+    let options = PlanOptions {
+        samples: 8,
+        ..options()
+    };
+    let error = planner(1, &[], options)
+        .plan(&[0.0; 2], &target)
+        .unwrap_err();
+    let PlanError::NoCollisionFreeShape {
+        best_clearance,
+        needed,
+        tip_error,
+        ..
+    } = error
+    else {
+        panic!("{error}")
+    };
+    assert!(best_clearance >= needed && tip_error > 0.01, "{error}");
     assert!(
         error
             .to_string()
-            .starts_with("no collision-free shape found"),
+            .starts_with("no shape found that reaches the target"),
         "{error}"
     );
 }
@@ -313,6 +345,13 @@ fn refusals_name_the_problem() {
                 ..options()
             },
             "max checks must be at least 1",
+        ),
+        (
+            PlanOptions {
+                max_iterations: 0,
+                ..options()
+            },
+            "max iterations must be at least 1",
         ),
     ] {
         let model = ClearanceModel::new(LINKS, RADIUS, vec![]).unwrap();

@@ -34,19 +34,29 @@ impl Scenario {
                  followed by its plan)",
             ));
         }
-        if torque_box && self.limits.joint_angle_rad.is_none() && self.limits.tau_star.is_none() {
-            return None;
-        }
-        if self.limits.joint_torque_nm.is_some()
-            || self.limits.joint_angle_rad.is_some()
-            || self.limits.tau_star.is_some()
-        {
-            return Some((
-                "limits.joint_torque_nm, limits.joint_angle_rad and limits.tau_star",
-                "only limits.max_modal_error bounds the joint errors",
-            ));
-        }
-        None
+        // The first limit given that the loop does not keep, by its own key.
+        [
+            (
+                "limits.joint_angle_rad",
+                self.limits.joint_angle_rad.is_some(),
+            ),
+            ("limits.tau_star", self.limits.tau_star.is_some()),
+            (
+                "limits.joint_torque_nm",
+                !torque_box && self.limits.joint_torque_nm.is_some(),
+            ),
+        ]
+        .into_iter()
+        .find(|(_, given)| *given)
+        .map(|(name, _)| {
+            let why = if torque_box {
+                "only limits.joint_torque_nm (the MPC's box on the joint efforts) and \
+                 limits.max_modal_error bound a joint-space MPC"
+            } else {
+                "only limits.max_modal_error bounds the joint errors"
+            };
+            (name, why)
+        })
     }
 
     /// The dynamics model of the scenario's URDF arm (`arm.urdf`, a regular file of at most

@@ -5,6 +5,7 @@
 //! joint-space loop of [`sim_core::run_chain_loop`], and the run's deployment metrics are
 //! measured on the shapes the arm took.
 
+use super::arm::ArmKind;
 use super::controllers::ControllerKind;
 use super::schema::{
     DeploySpec, IntegratorSpec, MAX_DEPLOY_CENTERLINE_POINTS, ReferenceSpec, Scenario, TorqueLimit,
@@ -380,6 +381,13 @@ impl Scenario {
         }
         if self.task.is_some() {
             return Err(unused("task", "the deployment is the plan"));
+        }
+        if self.arm.kind == ArmKind::Spatial {
+            return Err(SimError::setting(
+                "arm.kind",
+                "is \"spatial\": a deployment's arm is planar (it moves in the plane z = 0 of \
+                 its channel)",
+            ));
         }
         let mpc = self.controller.kind == ControllerKind::Mpc;
         if let Some((name, why)) = self.unused_by_joint_space_loops(mpc) {

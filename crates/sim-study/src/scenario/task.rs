@@ -67,6 +67,18 @@ impl Scenario {
                 format!("must have {m} entries, got {}", initial.len()),
             ));
         }
+        // The plan interpolates from the initial shape: beyond a thousand radians a modal
+        // coordinate turns the joints by hundreds of turns, and its squares leave double
+        // precision long before 1e300.
+        if let Some(a) = initial.iter().find(|a| !(a.abs() <= MAX_TASK_INITIAL_RAD)) {
+            return Err(SimError::setting(
+                "initial.a",
+                format!(
+                    "must be finite and within {MAX_TASK_INITIAL_RAD} rad with a [task] (the plan \
+                     moves from it), got {a}"
+                ),
+            ));
+        }
         let plan = match model {
             PlantModel::Planar(planar) => {
                 let lengths: Vec<f64> = planar.chain().link_lengths().collect();
@@ -175,6 +187,9 @@ impl Scenario {
         }
     }
 }
+
+/// The largest modal coordinate of `initial.a` a `[task]` plans from (rad).
+const MAX_TASK_INITIAL_RAD: f64 = 1e3;
 
 /// A planner's error as a setting error naming the task's field it comes from.
 fn task_field(e: PlanError) -> SimError {

@@ -319,6 +319,22 @@ fn deployment_keys_are_refused_by_name() {
         "{}",
         message(&back)
     );
+    let mut spatial_arm = base.clone();
+    spatial_arm.arm.kind = sim_study::ArmKind::Spatial;
+    assert!(
+        message(&spatial_arm).starts_with("arm.kind is \"spatial\": a deployment's arm is planar"),
+        "{}",
+        message(&spatial_arm)
+    );
+    // A limit the joint-space MPC does not keep is named alone.
+    let mut angles = base.clone();
+    angles.controller.kind = ControllerKind::Mpc;
+    angles.limits.joint_angle_rad = Some(sim_study::AngleLimit::All(1.0));
+    assert!(
+        message(&angles).starts_with("limits.joint_angle_rad is not used with"),
+        "{}",
+        message(&angles)
+    );
     // 100,000 links (each of 10 um) would take hours to measure: refused before anything runs.
     let mut links = base.clone();
     links.arm.links = Some(100_000);

@@ -137,6 +137,26 @@ fn tasks_and_planned_references_come_together_and_name_their_fields() {
         e.starts_with("task cannot be met: no collision-free shape found"),
         "{e}"
     );
+    // A start a plan cannot move from, and zero iterations, are refused by their keys.
+    let e = with(&|s| {
+        s.initial = Some(sim_study::InitialSpec {
+            a: vec![1e300, 0.0, 0.0, 0.0],
+            a_dot: None,
+        })
+    });
+    assert!(
+        e.starts_with("initial.a must be finite and within 1000 rad with a [task]"),
+        "{e}"
+    );
+    let e = with(&|s| {
+        if let Some(TaskSpec::Reach { max_iterations, .. }) = &mut s.task {
+            *max_iterations = Some(0);
+        }
+    });
+    assert!(
+        e.starts_with("task.max_iterations cannot be met: max iterations must be at least 1"),
+        "{e}"
+    );
     // A spatial arm's target is a point in space: the plane's [x, y] is refused by name.
     let mut spatial = Scenario::builtin("spatial-clutter").unwrap();
     spatial.task = base.task.clone();
