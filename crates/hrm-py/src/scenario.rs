@@ -850,8 +850,9 @@ impl Scenario {
                     m: scenario.n_coords(),
                     raised: Arc::clone(&raised),
                 };
-                let mut simulation = scenario
-                    .build_with_controller(Box::new(controller))
+                // Planning a [task] may take seconds: without the GIL.
+                let mut simulation = py
+                    .detach(|| scenario.build_with_controller(Box::new(controller)))
                     .map_err(Error::from)?;
                 let result = run(&mut simulation, &mut hooks);
                 if let Some(error) = raised
@@ -869,16 +870,18 @@ impl Scenario {
                 }
                 let cancel = Cancel::new();
                 let flag = cancel.clone();
-                let mut simulation = scenario
-                    .build_wrapping(move |inner| {
+                // Built (a [task] planned) and run without the GIL.
+                let outcome = pool::run(py, &cancel, || {
+                    let mut simulation = scenario.build_wrapping(move |inner| {
                         Box::new(Interruptible {
                             inner,
                             cancel: flag.clone(),
                         })
-                    })
-                    .map_err(Error::from)?;
+                    })?;
+                    Ok::<_, sim_core::SimError>(run(&mut simulation, &mut hooks))
+                })?;
                 (
-                    pool::run(py, &cancel, || run(&mut simulation, &mut hooks))?,
+                    outcome.map_err(Error::from)?,
                     scenario.controller.kind.name(),
                 )
             }

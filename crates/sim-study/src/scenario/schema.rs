@@ -516,7 +516,10 @@ impl Default for LimitsSpec {
 
 /// A limit on the modal torques `tau*`: the same for every coordinate, or one per coordinate.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "a number (N m) or a list of numbers, one per modal coordinate"
+)]
 pub enum ModalTorqueLimit {
     /// The same limit for every coordinate (N m).
     All(f64),
@@ -526,7 +529,10 @@ pub enum ModalTorqueLimit {
 
 /// An angle limit for every joint, or one per joint.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "a number (rad) or a list of numbers, one per joint"
+)]
 pub enum AngleLimit {
     /// The same limit for every joint (rad).
     All(f64),
@@ -536,7 +542,10 @@ pub enum AngleLimit {
 
 /// A torque limit for every joint, or one per joint.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "a number (N m) or a list of numbers, one per joint"
+)]
 pub enum TorqueLimit {
     /// The same limit for every joint (N m).
     All(f64),

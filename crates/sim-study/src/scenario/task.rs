@@ -70,7 +70,10 @@ impl Scenario {
         // The plan interpolates from the initial shape: beyond a thousand radians a modal
         // coordinate turns the joints by hundreds of turns, and its squares leave double
         // precision long before 1e300.
-        if let Some(a) = initial.iter().find(|a| !(a.abs() <= MAX_TASK_INITIAL_RAD)) {
+        if let Some(a) = initial
+            .iter()
+            .find(|a| a.is_nan() || a.abs() > MAX_TASK_INITIAL_RAD)
+        {
             return Err(SimError::setting(
                 "initial.a",
                 format!(

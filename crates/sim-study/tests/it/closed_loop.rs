@@ -491,6 +491,15 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
         (base.replace("dt = 0.0001", "dtt = 0.0001"), "dtt"),
         (base.replace("time = 0.1", "time = 0.1\nspeed = 3"), "speed"),
         (format!("{base}\n[arm]\nlinks = \"ten\"\n"), "links"),
+        // A limit of the wrong type says what it takes, not how it is parsed.
+        (
+            format!("{base}\n[limits]\njoint_torque_nm = \"x\"\n"),
+            "a number (N m) or a list of numbers, one per joint",
+        ),
+        (
+            format!("{base}\n[limits]\njoint_angle_rad = true\n"),
+            "a number (rad) or a list of numbers, one per joint",
+        ),
     ];
     for (text, needle) in cases {
         let err = Scenario::from_toml(&text).unwrap_err();
