@@ -2,7 +2,7 @@
 //! entry, and distances to them.
 
 use crate::error::PlanError;
-use crate::polyline::Polyline;
+use crate::polyline::{Polyline, dist};
 use lane_math::check_finite;
 
 /// The most centreline points a [`Channel`] accepts.
@@ -126,28 +126,4 @@ impl Channel {
         let guide = dist(x, [e[0] + along * d[0], e[1] + along * d[1]]);
         guide.min(self.line.distance(x))
     }
-}
-
-pub(crate) fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
-}
-
-/// The distance of `x` from the segment `a`-`b`.
-pub(crate) fn point_segment(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    point_segment_squared(x, a, b).sqrt()
-}
-
-/// The squared distance of `x` from the segment `a`-`b` (coordinates within
-/// [`MAX_CENTERLINE_EXTENT`] and the arms' reach: the squares neither overflow nor, above
-/// `1e-150` m, underflow).
-pub(crate) fn point_segment_squared(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let length2 = d[0] * d[0] + d[1] * d[1];
-    let t = if length2 > 0.0 {
-        (((x[0] - a[0]) * d[0] + (x[1] - a[1]) * d[1]) / length2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let e = [x[0] - (a[0] + t * d[0]), x[1] - (a[1] + t * d[1])];
-    e[0] * e[0] + e[1] * e[1]
 }

@@ -16,11 +16,12 @@
 //! modal coordinates at each step are the least-squares fit `a = argmin |J a + theta_0 -
 //! theta_FTL|`, exact when `2K = n`. The metrics are those of the chain the fit realises.
 
-use crate::channel::{Channel, dist};
+use crate::channel::Channel;
 use crate::deploy_metrics::{
     DeployMetrics, DeployTracker, MAX_DEPLOY_METRIC_WORK, deploy_metric_work,
 };
 use crate::error::PlanError;
+use crate::polyline::dist;
 use backbone_kin::{BaseAngle, ModalMap, joint_positions};
 use lane_math::check_finite;
 use optimal_ctl::LinearQp;

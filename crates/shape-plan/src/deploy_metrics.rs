@@ -2,9 +2,9 @@
 //! kinematic plan ([`follow_the_leader`](crate::follow_the_leader)) and those of a dynamic run
 //! that tracks it (`docs/theory.md`, "Follow-the-leader deployment").
 
-use crate::channel::{Channel, dist, point_segment};
+use crate::channel::Channel;
 use crate::error::PlanError;
-use crate::polyline::Polyline;
+use crate::polyline::{Polyline, dist, point_segment};
 use clearance::segment_segment;
 use lane_math::check_finite;
 

@@ -1,8 +1,7 @@
 //! A planar polyline that answers "how far is this point" quickly: its segments in chunks of
 //! [`CHUNK`] with each chunk's bounding box, so that a query measures every segment only of the
-//! chunks whose box is nearer than the nearest segment found.
-
-use crate::channel::point_segment_squared;
+//! chunks whose box is nearer than the nearest segment found; and the distances of points from
+//! points and segments it is made of.
 
 /// Segments a chunk holds.
 const CHUNK: usize = 32;
@@ -64,7 +63,7 @@ impl Polyline {
     }
 
     /// The distance of `x` from the polyline (`+inf` without a segment): the least
-    /// [`point_segment`](crate::channel::point_segment) over its segments, the same number as
+    /// [`point_segment`] over its segments, the same number as
     /// measuring every one. The chunk whose box is nearest is measured first; then every chunk
     /// whose box is not farther than the nearest segment found (with a relative `1e-9` for the
     /// boxes' rounding). Squared distances throughout, one square root at the end.
@@ -97,10 +96,34 @@ impl Polyline {
     }
 }
 
+/// The distance between `a` and `b`.
+pub(crate) fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// The distance of `x` from the segment `a`-`b`.
+pub(crate) fn point_segment(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    point_segment_squared(x, a, b).sqrt()
+}
+
+/// The squared distance of `x` from the segment `a`-`b` (coordinates within
+/// [`MAX_CENTERLINE_EXTENT`](crate::MAX_CENTERLINE_EXTENT) and the arms' reach: the squares neither overflow nor, above
+/// `1e-150` m, underflow).
+pub(crate) fn point_segment_squared(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let length2 = d[0] * d[0] + d[1] * d[1];
+    let t = if length2 > 0.0 {
+        (((x[0] - a[0]) * d[0] + (x[1] - a[1]) * d[1]) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let e = [x[0] - (a[0] + t * d[0]), x[1] - (a[1] + t * d[1])];
+    e[0] * e[0] + e[1] * e[1]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::channel::point_segment;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
