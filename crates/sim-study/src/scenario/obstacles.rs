@@ -98,7 +98,8 @@ impl Scenario {
                 "arm.radius",
                 format!(
                     "must be non-negative and at most {MAX_OBSTACLE_EXTENT:e} (m, as an \
-                     obstacle's extent), got {radius}"
+                     obstacle's extent), got {}",
+                    lane_math::Compact(radius)
                 ),
             ));
         }

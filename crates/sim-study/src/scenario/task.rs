@@ -78,7 +78,8 @@ impl Scenario {
                 "initial.a",
                 format!(
                     "must be finite and within {MAX_TASK_INITIAL_RAD} rad with a [task] (the plan \
-                     moves from it), got {a}"
+                     moves from it), got {}",
+                    lane_math::Compact(*a)
                 ),
             ));
         }

@@ -150,7 +150,12 @@ fn malformed_obstacles_are_refused_with_the_field_named() {
         (
             "[arm]\nradius = -1.0\n",
             Workspace::Planar,
-            "arm.radius must be non-negative and finite (m), got -1",
+            "arm.radius must be non-negative and at most 1e15 (m, as an obstacle's extent), got -1",
+        ),
+        (
+            "[arm]\nradius = 1e308\n",
+            Workspace::Planar,
+            "arm.radius must be non-negative and at most 1e15 (m, as an obstacle's extent), got 1e308",
         ),
     ] {
         let scenario = with(extra);
