@@ -79,7 +79,7 @@ impl Scenario {
                 format!(
                     "must be finite and within {MAX_TASK_INITIAL_RAD} rad with a [task] (the plan \
                      moves from it), got {}",
-                    lane_math::Compact(*a)
+                    Compact(*a)
                 ),
             ));
         }
