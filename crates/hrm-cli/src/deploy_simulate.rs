@@ -82,13 +82,17 @@ pub fn headline(scenario: &Scenario, run: &DeployRun) -> String {
     format!(
         "{}: {} deploying the arm on its insertion axis: tip error {:.3} mm, \
          shape deviation {:.2}% of the deployed length, smallest wall clearance {:.2} mm, \
-         smallest self clearance {:.2} mm, final |q - q_ref| {:.3e}",
+         smallest self clearance {}, final |q - q_ref| {:.3e}",
         scenario.name,
         scenario.controller.kind.name(),
         1e3 * m.tip_error,
         m.shape_deviation_percent,
         1e3 * m.min_wall_clearance,
-        1e3 * m.min_self_clearance,
+        if m.min_self_clearance.is_finite() {
+            format!("{:.2} mm", 1e3 * m.min_self_clearance)
+        } else {
+            "none (no two links without a shared joint)".to_string()
+        },
         run.run.summary.final_error
     )
 }

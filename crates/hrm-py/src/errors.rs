@@ -104,13 +104,22 @@ impl<E: Classify + std::fmt::Display> From<E> for Error {
 
 /// A count argument (`links`, `harmonics`, `samples`) as a `usize`: a negative number or one
 /// beyond 64 bits is an [`InvalidInput`] naming `name`, not an `OverflowError`. `minimum` is
-/// the smallest count the message asks for; the libraries check the actual bounds.
+/// the smallest count the message asks for; the libraries check the actual bounds. A `bool` is
+/// refused.
 pub(crate) fn count(
     value: &pyo3::Bound<'_, pyo3::PyAny>,
     name: &str,
     minimum: u32,
 ) -> pyo3::PyResult<usize> {
-    use pyo3::types::PyAnyMethods;
+    use pyo3::types::{PyAnyMethods, PyBool};
+    // `bool` is an `int` to Python: `links=True` is a mistake, not one link.
+    if value.is_instance_of::<PyBool>() {
+        return Err(Error::input(format!(
+            "{name} must be a whole number, got a bool ({})",
+            value.repr()?
+        ))
+        .into());
+    }
     if let Ok(count) = value.extract::<usize>() {
         return Ok(count);
     }

@@ -165,16 +165,35 @@ fn build(
             "harmonics must be from 1 to {MAX_HARMONICS}, got {harmonics}"
         )));
     }
+    let lengths_given = lengths.is_some();
     let lengths = lengths.unwrap_or_else(|| vec![link_length; n]);
     let masses = masses.unwrap_or_else(|| vec![link_mass; n]);
     let map = SpatialModalMap::new(&lengths, harmonics).map_err(Error::from)?;
-    let inertias = inertias.unwrap_or_else(|| {
-        masses
-            .iter()
-            .zip(&lengths)
-            .map(|(&mass, &length)| SpatialLinkInertia::rod(mass, length).principal)
-            .collect()
-    });
+    let inertias = match inertias {
+        Some(inertias) => inertias,
+        None => {
+            let rods: Vec<[f64; 3]> = masses
+                .iter()
+                .zip(&lengths)
+                .map(|(&mass, &length)| SpatialLinkInertia::rod(mass, length).principal)
+                .collect();
+            // A rod's `m L^2 / 12` that overflows names the length the user gave.
+            if let Some(i) = rods.iter().position(|r| !r.iter().all(|v| v.is_finite())) {
+                let field = if lengths_given {
+                    format!("lengths[{i}]")
+                } else {
+                    "link_length".to_string()
+                };
+                return Err(Error::input(format!(
+                    "arm.{field} of {} m with a mass of {} kg gives a rod inertia m L^2 / 12 \
+                     beyond double precision",
+                    lane_math::Compact(lengths[i]),
+                    lane_math::Compact(masses[i])
+                )));
+            }
+            rods
+        }
+    };
     let links = masses
         .iter()
         .zip(&inertias)

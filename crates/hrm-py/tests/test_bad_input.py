@@ -443,6 +443,10 @@ def test_wrong_argument_types_name_the_argument():
         hrm.Arm(links="3")
     with pytest.raises(hrm.InvalidInput, match="^arm.links must be a whole number of at most 64 bits, got 3.0$"):
         hrm.Arm(links=3.0)
+    for call in [lambda: hrm.Arm(links=True), lambda: hrm.SpatialArm(links=True),
+                 lambda: hrm.Sweep(short_step(), noise_levels=[0.0], seeds=True)]:
+        with pytest.raises(hrm.InvalidInput, match=r"^(arm\.links|seeds) must be a whole number, got a bool \(True\)$"):
+            call()
 
 
 def test_merge_refuses_a_string():
@@ -475,6 +479,10 @@ def test_spatial_and_urdf_classes_follow_the_same_rules():
         hrm.SpatialArm(gravity=[1.0])
     with pytest.raises(hrm.InvalidInput, match=r"^inertias must be rows of three numbers, shape \(n, 3\)"):
         hrm.SpatialArm(inertias=[[1.0, 2.0]])
+    with pytest.raises(hrm.InvalidInput, match=r"^arm\.lengths\[1\] of 1e300 m .* rod inertia"):
+        hrm.SpatialArm(lengths=[0.1, 1e300])
+    with pytest.raises(hrm.InvalidInput, match=r"^arm\.link_length of 1e300 m .* rod inertia"):
+        hrm.SpatialArm(link_length=1e300)
     with pytest.raises(hrm.InvalidInput, match="^lengths is a masked array"):
         hrm.SpatialArm(lengths=np.ma.masked_array([0.1, 0.1], mask=[True, False]))
     urdf = random_chain(3, 4)

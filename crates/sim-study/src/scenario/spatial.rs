@@ -4,7 +4,7 @@
 use super::arm::{ArmKind, Gravity, Inertias};
 use super::schema::{Alpha0, ArmSpec, BranchSpec, HelixSpec, ReferenceSpec, Scenario};
 use backbone_kin::{BasePose, Branch, SpatialModalMap};
-use lane_math::check_all_finite;
+use lane_math::{Compact, check_all_finite};
 use manip_dyn::DynError;
 use modal_reduce::spatial::{SpatialLinkInertia, SpatialReducedModel};
 use modal_reduce::{PlantModel, ReduceError};
@@ -175,11 +175,24 @@ impl ArmSpec {
         check_all_finite("arm.gravity", &gravity)?;
         let map = SpatialModalMap::new(&lengths, k)
             .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))?;
-        // Lengths and masses are checked above: a link the model refuses has a bad inertia.
+        // Lengths and masses are checked above: a link the model refuses has a bad inertia,
+        // the user's or a rod's whose `m L^2 / 12` overflows.
         SpatialReducedModel::new(map, base, links, gravity).map_err(|e| match e {
-            ReduceError::Dyn(DynError::InvalidLink { index, .. }) => {
+            ReduceError::Dyn(DynError::InvalidLink { index, .. }) if inertias.is_some() => {
                 SimError::setting(format!("arm.inertias[{index}]"), format!("is invalid: {e}"))
             }
+            ReduceError::Dyn(DynError::InvalidLink { index, .. }) => SimError::setting(
+                match &self.lengths {
+                    Some(_) => format!("arm.lengths[{index}]"),
+                    None => "arm.link_length".to_string(),
+                },
+                format!(
+                    "of {} m with a mass of {} kg gives a rod inertia m L^2 / 12 beyond double \
+                     precision",
+                    Compact(lengths[index]),
+                    Compact(masses[index])
+                ),
+            ),
             e => SimError::setting("arm", format!("is invalid: {e}")),
         })
     }

@@ -162,6 +162,17 @@ fn spatial_keys_out_of_their_domain_are_named() {
         "arm.lengths[2]",
     );
     refused("link_mass = 0.1", "link_mass = nan", "arm.link_mass");
+    // A rod's inertia m L^2 / 12 overflows: the length the user gave is named.
+    refused(
+        "link_length = 0.1",
+        "link_length = 1e300",
+        "arm.link_length",
+    );
+    refused(
+        "link_length = 0.1",
+        "lengths = [0.1, 0.1, 1e300, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1]",
+        "arm.lengths[2]",
+    );
     refused("link_mass = 0.1", "masses = [0.1, 0.1]", "arm.masses");
     refused("links = 10", "links = 0", "arm.links");
     refused("links = 10", "links = 2000000", "arm.links");
