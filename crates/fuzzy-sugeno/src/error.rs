@@ -179,7 +179,7 @@ pub enum FuzzyError {
     /// The prefix of a C export is not a C identifier of at most `max` characters.
     #[error(
         "export: the prefix must be a C identifier of 1 to {max} ASCII letters, digits and \
-         underscores, not starting with a digit or two underscores; got {prefix:?}"
+         underscores, starting with a letter; got {prefix:?}"
     )]
     CPrefix {
         /// The prefix given.
@@ -623,10 +623,11 @@ pub enum LearningProblem {
     /// The system's sets cannot be indexed with 32 bits.
     #[error("too many sets to index with 32 bits")]
     TooManySets,
-    /// The least-squares matrix (samples times consequent parameters) would exceed its limit.
+    /// The least-squares matrix (samples plus consequent parameters, its ridge rows, times
+    /// consequent parameters) would exceed its limit.
     #[error(
-        "{samples} samples times {unknowns} consequent parameters exceed the least-squares \
-         limit of {limit} entries"
+        "{samples} samples and {unknowns} consequent parameters exceed the least-squares \
+         limit of {limit} entries ((samples + parameters) x parameters)"
     )]
     LeastSquaresTooLarge {
         /// The number of training samples.
@@ -634,6 +635,21 @@ pub enum LearningProblem {
         /// The number of consequent parameters.
         unknowns: usize,
         /// The largest number of entries allowed.
+        limit: usize,
+    },
+    /// The least-squares solve (a QR of `(samples + parameters) x parameters`, about
+    /// `(samples + parameters) parameters^2` multiply-adds) would exceed its limit of work.
+    #[error(
+        "{samples} samples and {unknowns} consequent parameters make a least-squares solve of \
+         more than {limit} multiply-adds ((samples + parameters) x parameters^2): use fewer \
+         sets per input or fewer inputs"
+    )]
+    LeastSquaresTooSlow {
+        /// The number of training samples.
+        samples: usize,
+        /// The number of consequent parameters.
+        unknowns: usize,
+        /// The most multiply-adds allowed.
         limit: usize,
     },
     /// The least-squares problem of the consequents (Jang's eq 15) holds a NaN or an infinity

@@ -67,13 +67,11 @@ impl FuzzySystem {
 
 fn check_prefix(prefix: &str) -> Result<(), FuzzyError> {
     let mut chars = prefix.chars();
-    let valid_start = chars
-        .next()
-        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
+    // Names are `{prefix}_{name}`: a leading underscore would make `__name`, reserved in C.
+    let valid_start = chars.next().is_some_and(|c| c.is_ascii_alphabetic());
     if !valid_start
         || !chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
         || prefix.len() > MAX_PREFIX
-        || prefix.starts_with("__")
     {
         return Err(FuzzyError::CPrefix {
             prefix: prefix.to_string(),

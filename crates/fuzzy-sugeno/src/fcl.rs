@@ -374,8 +374,28 @@ struct Variable {
     input_sets: Vec<FuzzySet>,
     /// The line of each `TERM`, in the order of its sets or terms.
     term_lines: Vec<usize>,
+    /// The names of its terms so far: rules name terms, so two may not share one.
+    term_names: std::collections::HashSet<String>,
     output_terms: Vec<OutputTerm>,
     defined: bool,
+}
+
+impl Variable {
+    /// Records a `TERM` named `name` at `line`, refusing a name it already has.
+    fn new_term(&mut self, line: usize, name: &str) -> Result<(), FuzzyError> {
+        if !self.term_names.insert(name.to_string()) {
+            return Err(error(
+                line,
+                format!(
+                    "variable '{}' already has a term named '{name}'; rules name terms, so \
+                     rename one",
+                    self.name
+                ),
+            ));
+        }
+        self.term_lines.push(line);
+        Ok(())
+    }
 }
 
 #[derive(Debug, Default)]
@@ -532,7 +552,7 @@ impl Reader {
             (Section::Fuzzify(k), "TERM") => {
                 let (name, value) = term_definition(line, rest)?;
                 let membership = input_term(line, value)?;
-                self.inputs[k].term_lines.push(line);
+                self.inputs[k].new_term(line, name)?;
                 self.inputs[k].input_sets.push(FuzzySet {
                     name: name.to_string(),
                     membership,
@@ -542,7 +562,7 @@ impl Reader {
                 let (name, value) = term_definition(line, rest)?;
                 let n_inputs = self.inputs.len();
                 let function = output_term(line, value, n_inputs)?;
-                self.outputs[k].term_lines.push(line);
+                self.outputs[k].new_term(line, name)?;
                 self.outputs[k].output_terms.push(OutputTerm {
                     name: name.to_string(),
                     function,

@@ -33,12 +33,13 @@ pub(crate) fn real(value: &Bound<'_, PyAny>, name: &str) -> PyResult<f64> {
 }
 
 /// A 1-D sequence of real numbers for argument `name` (a list, tuple or numpy array; not a
-/// string): a wrong type is a `TypeError`, another number of dimensions an `InvalidInput`.
-pub(crate) fn reals(value: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<f64>> {
+/// string) of at most `max_len` entries: a wrong type is a `TypeError`, another number of
+/// dimensions or more entries an `InvalidInput`.
+pub(crate) fn reals(value: &Bound<'_, PyAny>, name: &str, max_len: usize) -> PyResult<Vec<f64>> {
     if value.is_instance_of::<PyString>() || value.is_instance_of::<PyBytes>() {
         return Err(wrong_type(name, "a sequence of real numbers", value));
     }
-    crate::array::vector(value, name)
+    crate::array::vector(value, name, max_len)
 }
 
 /// A seed for argument `name`: a whole number from 0 to 2^64 - 1.
@@ -69,7 +70,7 @@ pub(crate) fn path(value: &Bound<'_, PyAny>, name: &str) -> PyResult<std::path::
 
 /// A finite 3-vector for argument `name` (a gravity vector, a position, roll-pitch-yaw angles).
 pub(crate) fn vec3(value: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; 3]> {
-    let values = reals(value, name)?;
+    let values = reals(value, name, 3)?;
     let vector: [f64; 3] = values.as_slice().try_into().map_err(|_| {
         Error::input(format!(
             "{name} must have 3 entries (x, y, z), got {}",
@@ -88,7 +89,7 @@ pub(crate) fn rows3(value: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f64; 
     if value.is_instance_of::<PyString>() || value.is_instance_of::<PyBytes>() {
         return Err(wrong_type(name, "rows of three real numbers", value));
     }
-    let array = crate::array::float64_array(value, name)?;
+    let array = crate::array::float64_array(value, name, 3 * backbone_kin::MAX_LINKS)?;
     let shape = array.shape().to_vec();
     if shape.len() != 2 || shape[1] != 3 {
         return Err(Error::input(format!(
@@ -96,7 +97,11 @@ pub(crate) fn rows3(value: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f64; 
         ))
         .into());
     }
-    let flat: Vec<f64> = crate::array::vector(&array.reshape([shape[0] * 3])?.into_any(), name)?;
+    let flat: Vec<f64> = crate::array::vector(
+        &array.reshape([shape[0] * 3])?.into_any(),
+        name,
+        3 * backbone_kin::MAX_LINKS,
+    )?;
     Ok(flat
         .chunks_exact(3)
         .map(|row| [row[0], row[1], row[2]])

@@ -88,7 +88,9 @@ impl Arm {
             real(gravity, "gravity", 9.81)?,
         );
         let per_link = |value: Option<&Bound<'_, PyAny>>, name| {
-            value.map(|v| args::reals(v, name)).transpose()
+            value
+                .map(|v| args::reals(v, name, backbone_kin::MAX_LINKS))
+                .transpose()
         };
         let (lengths, masses, inertias) = (
             per_link(lengths, "lengths")?,

@@ -53,7 +53,7 @@ impl<'py> States<'py> {
         name: &'static str,
         width: usize,
     ) -> PyResult<Self> {
-        let array = float64_array(object, name)?;
+        let array = float64_array(object, name, MAX_OUTPUT_VALUES)?;
         let array = array
             .try_readonly()
             .map_err(|e| Error::input(format!("{name}: {e}")))?;
@@ -156,10 +156,11 @@ fn aligned(array: &Bound<'_, PyArrayDyn<f64>>) -> bool {
 /// `numpy.asarray` if it holds booleans, integers or floats (an unaligned view is copied). A
 /// numpy masked array with masked entries is refused (its mask cannot be honoured), one
 /// without is read as its data. A `KeyboardInterrupt` or `MemoryError` raised while the object
-/// is converted propagates as it is.
+/// is converted propagates as it is. More than `max_len` values are refused before any copy.
 pub(crate) fn float64_array<'py>(
     object: &Bound<'py, PyAny>,
     name: &str,
+    max_len: usize,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let py = object.py();
     let exact = object.is_exact_instance_of::<PyUntypedArray>();
@@ -167,6 +168,7 @@ pub(crate) fn float64_array<'py>(
         && let Ok(array) = object.cast::<PyArrayDyn<f64>>()
         && aligned(array)
     {
+        check_size(array.len(), name, max_len)?;
         return Ok(array.clone());
     }
     let numpy = py.import("numpy")?;
@@ -203,6 +205,8 @@ pub(crate) fn float64_array<'py>(
         ))
         .into());
     }
+    // A broadcast view of a few bytes may stand for billions of values: bounded before the copy.
+    check_size(array.getattr("size")?.extract()?, name, max_len)?;
     // `astype` copies into a fresh, aligned array (also when the dtype already is float64).
     let converted = array.call_method1("astype", ("float64",))?;
     Ok(converted.cast_into::<PyArrayDyn<f64>>()?)
@@ -214,10 +218,20 @@ pub(crate) fn zeros(len: usize, what: &'static str) -> Result<Vec<f64>> {
     Ok(lane_math::try_filled(len, 0.0, what)?)
 }
 
+/// Refuses an argument `name` of `size` values beyond `max_len`.
+fn check_size(size: usize, name: &str, max_len: usize) -> Result<()> {
+    if size > max_len {
+        return Err(Error::input(format!(
+            "{name} has {size} values, more than the limit of {max_len}"
+        )));
+    }
+    Ok(())
+}
+
 /// `object` as a vector of float64 values (a 1-D array, list or tuple of real numbers, read as
-/// [`States`] are); `name` is the argument's name in messages.
-pub(crate) fn vector(object: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<f64>> {
-    let array = float64_array(object, name)?;
+/// [`States`] are) of at most `max_len` values; `name` is the argument's name in messages.
+pub(crate) fn vector(object: &Bound<'_, PyAny>, name: &str, max_len: usize) -> PyResult<Vec<f64>> {
+    let array = float64_array(object, name, max_len)?;
     let array = array
         .try_readonly()
         .map_err(|e| Error::input(format!("{name}: {e}")))?;

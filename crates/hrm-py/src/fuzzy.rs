@@ -6,7 +6,7 @@ use fuzzy_sugeno::{AnalysisOptions, AnalysisReport, Evaluator, FuzzyError, Fuzzy
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyPermissionError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use std::path::PathBuf;
+use std::path::Path;
 use std::sync::Mutex;
 
 /// A zero- or first-order Takagi-Sugeno fuzzy system (eqs 19-21), with MATLAB .fis interop.
@@ -29,10 +29,11 @@ impl System {
     }
 }
 
-/// Reads a `.fis` file as `hrm fis` does, the path in front of every error.
-fn read_fis(path: &PathBuf) -> PyResult<FuzzySystem> {
+/// Reads a `.fis` file as `hrm fis` does (a regular file of at most
+/// [`sim_study::MAX_INPUT_FILE_BYTES`]), the path in front of every error.
+fn read_fis(path: &Path) -> PyResult<(FuzzySystem, Vec<fuzzy_sugeno::FisNote>)> {
     let shown = path.display();
-    let text = std::fs::read_to_string(path).map_err(|e| {
+    let text = sim_study::read_text_file(path, sim_study::MAX_INPUT_FILE_BYTES).map_err(|e| {
         let message = format!("{shown}: {e}");
         match e.kind() {
             std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(message),
@@ -40,7 +41,22 @@ fn read_fis(path: &PathBuf) -> PyResult<FuzzySystem> {
             _ => PyOSError::new_err(message),
         }
     })?;
-    Ok(FuzzySystem::from_fis(&text).map_err(|e| Error::from(e).context(shown))?)
+    let (system, notes) =
+        FuzzySystem::from_fis_with_notes(&text).map_err(|e| Error::from(e).context(shown))?;
+    Ok((system, notes))
+}
+
+/// Issues a `UserWarning` per note of a `.fis` file (`hrm fis` prints them as warnings): what
+/// the file said that is accepted but neither kept nor used (an `AndMethod` no rule needs,
+/// parameters beyond a function's, unknown keys).
+fn warn_notes(py: Python<'_>, notes: &[fuzzy_sugeno::FisNote]) -> PyResult<()> {
+    let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+    for note in notes {
+        let text =
+            std::ffi::CString::new(format!(".fis {note}").replace('\0', " ")).unwrap_or_default();
+        PyErr::warn(py, &category, &text, 2)?;
+    }
+    Ok(())
 }
 
 #[pymethods]
@@ -48,15 +64,24 @@ impl System {
     /// Loads a MATLAB .fis system: `path_or_text` is a path (str or os.PathLike) or the text of a
     /// .fis file (a str with a line break, or starting with "["). Raises InvalidInput for a
     /// malformed or unsupported file (the message names the line), FileNotFoundError or OSError
-    /// when the file cannot be read.
+    /// when the file cannot be read (a path that is not a regular file, or of more than 16 MiB,
+    /// is refused). What the file says that is accepted but neither kept nor used (an
+    /// `AndMethod` no rule needs, parameters beyond a function's, unknown keys) is reported as a
+    /// `UserWarning` per line, as `hrm fis` prints it.
     #[staticmethod]
     fn from_fis(path_or_text: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let system = match path_or_text.extract::<String>() {
+        let (system, notes) = match path_or_text.extract::<String>() {
             Ok(text) if text.contains('\n') || text.trim_start().starts_with('[') => {
-                FuzzySystem::from_fis(&text).map_err(Error::from)?
+                FuzzySystem::from_fis_with_notes(&text).map_err(Error::from)?
+            }
+            Ok(text) if text.is_empty() => {
+                return Err(
+                    Error::input("path_or_text is empty: give a path or a .fis text").into(),
+                );
             }
             _ => read_fis(&crate::args::path(path_or_text, "path_or_text")?)?,
         };
+        warn_notes(path_or_text.py(), &notes)?;
         Ok(Self::wrap(system))
     }
 

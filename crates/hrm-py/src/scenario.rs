@@ -429,9 +429,9 @@ impl ReferenceSample {
         a_ddot: &Bound<'_, PyAny>,
     ) -> PyResult<Self> {
         let (a, a_dot, a_ddot) = (
-            crate::args::reals(a, "a")?,
-            crate::args::reals(a_dot, "a_dot")?,
-            crate::args::reals(a_ddot, "a_ddot")?,
+            crate::args::reals(a, "a", backbone_kin::MAX_LINKS)?,
+            crate::args::reals(a_dot, "a_dot", backbone_kin::MAX_LINKS)?,
+            crate::args::reals(a_ddot, "a_ddot", backbone_kin::MAX_LINKS)?,
         );
         if a_dot.len() != a.len() || a_ddot.len() != a.len() {
             return Err(Error::input(format!(
@@ -709,6 +709,12 @@ impl Scenario {
     fn from_toml(path_or_text: &Bound<'_, PyAny>) -> PyResult<Self> {
         let scenario = match path_or_text.extract::<String>() {
             Ok(text) if text.contains('\n') => sim_study::Scenario::from_toml(&text),
+            Ok(text) if text.is_empty() => {
+                return Err(Error::input(
+                    "path_or_text is empty: give a path or a scenario's TOML",
+                )
+                .into());
+            }
             _ => sim_study::Scenario::load(&crate::args::path(path_or_text, "path_or_text")?),
         };
         Ok(Self::wrap(scenario.map_err(scenario_error)?))

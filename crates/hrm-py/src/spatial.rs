@@ -306,7 +306,9 @@ impl SpatialArm {
             vec3(base_rpy, "base_rpy", [0.0; 3])?,
         );
         let per_link = |value: Option<&Bound<'_, PyAny>>, name| {
-            value.map(|v| args::reals(v, name)).transpose()
+            value
+                .map(|v| args::reals(v, name, backbone_kin::MAX_LINKS))
+                .transpose()
         };
         let (lengths, masses) = (per_link(lengths, "lengths")?, per_link(masses, "masses")?);
         let inertias = inertias.map(|v| args::rows3(v, "inertias")).transpose()?;

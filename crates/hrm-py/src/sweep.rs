@@ -96,7 +96,7 @@ impl Sweep {
         };
         let settings = SweepSettings {
             controllers,
-            noise_levels: crate::args::reals(noise_levels, "noise_levels")?,
+            noise_levels: crate::args::reals(noise_levels, "noise_levels", study::MAX_RUNS)?,
             rate_noise_ratio,
             reference_noise_ratio,
             seeds: crate::errors::count(seeds, "seeds", 1)?,

@@ -515,3 +515,15 @@ def test_messages_write_tiny_and_huge_numbers_compactly():
     scenario.limits.max_modal_error = 1e-300
     run = scenario.run("pd")
     assert run.failure is not None and "1e-300" in run.failure and len(run.failure) < 300, run.failure
+
+
+def test_broadcast_views_are_bounded_before_any_copy():
+    # A broadcast view of 8 bytes stands for billions of values: refused by its size, never
+    # copied (the copy aborted the interpreter).
+    huge = np.broadcast_to(0.0, (10**10,))
+    with pytest.raises(hrm.InvalidInput, match="^gravity has 10000000000 values, more than the limit of 3$"):
+        hrm.SpatialArm(gravity=huge)
+    with pytest.raises(hrm.InvalidInput, match="^lengths has 1000000000 values, more than the limit of"):
+        hrm.Arm(lengths=np.broadcast_to(np.ones(1), (10**9,)))
+    with pytest.raises(hrm.InvalidInput, match="^theta has 4000000000 values, more than the limit of 268435456$"):
+        hrm.Arm(links=5).gravity(np.broadcast_to(np.zeros(4, dtype=np.int64), (10**9, 4)))

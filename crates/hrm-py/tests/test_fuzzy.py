@@ -63,6 +63,17 @@ def test_errors(tmp_path):
     bad.write_text("[System]\nName='x'\nType='mamdani'\n")
     with pytest.raises(hrm.InvalidInput, match=r"bad.fis: line 3"):
         System.from_fis(bad)
+    # Not a regular file (a device would never end), an empty path.
+    with pytest.raises(OSError, match="not a regular file"):
+        System.from_fis("/dev/zero")
+    with pytest.raises(OSError, match="is a directory"):
+        System.from_fis(tmp_path)
+    with pytest.raises(hrm.InvalidInput, match="^path_or_text is empty"):
+        System.from_fis("")
+    # What a file says that is accepted but not used is a warning naming its line.
+    text = PAPER_FIS.read_text().replace("AndMethod='prod'", "AndMethod='prod'\nLockRange=0", 1)
+    with pytest.warns(UserWarning, match=r"^\.fis line \d+: .*LockRange"):
+        System.from_fis(text)
     with pytest.raises(hrm.InvalidInput, match=r"^x has 2 entries, expected 4$"):
         paper_controller().eval([0.0, 0.0])
     with pytest.raises(hrm.InvalidInput, match="must be finite|finite"):

@@ -24,8 +24,12 @@ use lane_math::dense::{LeastSquares, LeastSquaresError};
 
 /// The most epochs one training may run.
 const MAX_EPOCHS: usize = 1_000_000;
-/// The largest least-squares matrix, rows times unknowns (8 bytes each).
+/// The largest least-squares matrix, rows (samples and ridge rows) times unknowns (8 bytes
+/// each).
 const MAX_LEAST_SQUARES_ENTRIES: usize = 25_000_000;
+/// The most multiply-adds of one least-squares solve, rows times unknowns squared (about 15 s:
+/// 3,072 unknowns took 12 s on the development machine).
+const MAX_LEAST_SQUARES_WORK: usize = 40_000_000_000;
 /// Marks a "don't care" antecedent in the rule table.
 const ANY: u32 = u32::MAX;
 
@@ -288,11 +292,21 @@ impl Anfis {
         }
         let rows = train.rows();
         let unknowns = theta.len();
-        if rows.saturating_mul(unknowns) > MAX_LEAST_SQUARES_ENTRIES {
+        // The solver's matrix holds a ridge row per unknown below the samples' rows.
+        let entries = rows.saturating_add(unknowns).saturating_mul(unknowns);
+        if entries > MAX_LEAST_SQUARES_ENTRIES {
             return Err(LearningProblem::LeastSquaresTooLarge {
                 samples: rows,
                 unknowns,
                 limit: MAX_LEAST_SQUARES_ENTRIES,
+            }
+            .into());
+        }
+        if entries.saturating_mul(unknowns) > MAX_LEAST_SQUARES_WORK {
+            return Err(LearningProblem::LeastSquaresTooSlow {
+                samples: rows,
+                unknowns,
+                limit: MAX_LEAST_SQUARES_WORK,
             }
             .into());
         }

@@ -785,8 +785,34 @@ mod tests {
                 unknowns: 13 * 2,
                 limit: 25_000_000,
             },
-            "learning: 1000000 samples times 26 consequent parameters exceed the least-squares \
-             limit of 25000000 entries",
+            "learning: 1000000 samples and 26 consequent parameters exceed the least-squares \
+             limit of 25000000 entries ((samples + parameters) x parameters)",
+        );
+        // Few samples but many rules: the ridge rows count, and so does the solve's work.
+        let sets = |k| GridPartition {
+            sets_per_input: k,
+            ..GridPartition::default()
+        };
+        check(
+            genfis_grid(&plane(49), 0, &sets(45)),
+            LearningProblem::LeastSquaresTooLarge {
+                samples: 49,
+                unknowns: 45 * 45 * 3,
+                limit: 25_000_000,
+            },
+            "learning: 49 samples and 6075 consequent parameters exceed the least-squares \
+             limit of 25000000 entries ((samples + parameters) x parameters)",
+        );
+        check(
+            genfis_grid(&plane(49), 0, &sets(40)),
+            LearningProblem::LeastSquaresTooSlow {
+                samples: 49,
+                unknowns: 40 * 40 * 3,
+                limit: 40_000_000_000,
+            },
+            "learning: 49 samples and 4800 consequent parameters make a least-squares solve of \
+             more than 40000000000 multiply-adds ((samples + parameters) x parameters^2): use \
+             fewer sets per input or fewer inputs",
         );
         check(
             genfis_grid(&data, 1, &GridPartition::default()),

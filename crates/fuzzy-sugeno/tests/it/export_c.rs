@@ -248,13 +248,18 @@ fn the_source_is_self_contained() {
             "file-scope line {line:?}"
         );
     }
-    let bad = paper_controller()
-        .to_c("9lives", &EvalOptions::default())
-        .unwrap_err();
-    assert!(
-        bad.to_string()
-            .starts_with("export: the prefix must be a C identifier")
-    );
+    // A leading digit, and a leading underscore (`_` would write `__eval`, `_H` `__H`: names C
+    // reserves), are refused.
+    for prefix in ["9lives", "_", "_x", "__x"] {
+        let bad = paper_controller()
+            .to_c(prefix, &EvalOptions::default())
+            .unwrap_err();
+        assert!(
+            bad.to_string()
+                .starts_with("export: the prefix must be a C identifier"),
+            "{prefix}: {bad}"
+        );
+    }
 }
 
 /// An input with no sets and a point output range (both allowed by validation) export and

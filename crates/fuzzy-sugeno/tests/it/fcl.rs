@@ -197,6 +197,14 @@ fn malformed_files_name_the_line_and_the_problem() {
         ),
         "FCL line 19: Bell with height 0.5: only height 1 is supported"
     );
+    // Two terms of one variable under one name: rules could not tell them apart.
+    assert_eq!(
+        swap(
+            "TERM P := Bell 0.300 0.300 2.000;",
+            "TERM P := Bell 0.300 0.300 2.000;\n    TERM N := Bell 0.300 0.010 2.000;"
+        ),
+        "FCL line 21: variable 'da1' already has a term named 'N'; rules name terms, so rename one"
+    );
     assert_eq!(
         swap("if da1 is N and", "if da1 is very N and"),
         "FCL line 64: input 'da1' has no term 'very' (hedges other than NOT are not supported)"
