@@ -289,6 +289,14 @@ fn parse_timeseries(text: &str, scenario: &Scenario, n_joints: usize) -> Result<
     let joint: Vec<usize> = (1..=n_joints)
         .map_while(|j| column(&format!("joint_tau{j}")).ok())
         .collect();
+    // Torque columns for another arm: the folder's scenario.toml was not the run's.
+    let written = header.iter().filter(|h| h.starts_with("joint_tau")).count();
+    if written > 0 && (joint.len() != n_joints || written != n_joints) {
+        return Err(format!(
+            "{written} joint torque columns (joint_tau1, ...) but the arm of scenario.toml has \
+             {n_joints} joints: the folder's scenario.toml is not the one this run wrote"
+        ));
+    }
     let mut record = Record {
         n_joints,
         n_coords: m,

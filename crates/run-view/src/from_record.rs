@@ -112,9 +112,12 @@ pub fn from_record(
             .values
             .extend([modal(Record::a_at, i), modal(Record::a_ref_at, i)]);
     }
-    // A link's torque: its joint's, or the magnitude of its universal joint's two.
+    // A link's torque: its joint's, or the magnitude of its universal joint's two (none when
+    // the record has no joint torques for every sample).
+    let has_torques = record.joint_torques.len() == samples * n_joints;
     let joint_torque: Vec<Vec<f64>> = picked
         .iter()
+        .filter(|_| has_torques)
         .map(|&k| match dims {
             2 => record.joint_torques_at(k).to_vec(),
             _ => record
@@ -162,11 +165,7 @@ pub fn from_record(
                 }
             })
             .collect(),
-        joint_torque: if record.joint_torques.len() == samples * n_joints {
-            joint_torque
-        } else {
-            Vec::new()
-        },
+        joint_torque,
         torque_limit,
         series,
         obstacles,

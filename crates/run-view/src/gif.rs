@@ -431,16 +431,18 @@ pub fn write_gif(run: &RunView, options: &GifOptions, out: impl Write) -> Result
     run.check()?;
     options.check()?;
     let (t0, t1) = (run.t[0], run.t[run.len() - 1]);
-    let frames = ((t1 - t0) / options.speed * f64::from(options.fps)).ceil() as usize + 1;
-    if frames > MAX_FRAMES {
+    // Counted in floating point: a count beyond `usize` saturates rather than wrapping to 0.
+    let needed = ((t1 - t0) / options.speed * f64::from(options.fps)).ceil() + 1.0;
+    if !(needed <= MAX_FRAMES as f64) {
         return Err(ViewError::TooManyFrames {
             seconds: t1 - t0,
             fps: options.fps,
             speed: options.speed,
-            frames,
+            frames: needed as usize,
             max: MAX_FRAMES,
         });
     }
+    let frames = needed as usize;
     let (w, h) = (options.width, options.height);
     let mut pixmap = Pixmap::new(w, h).ok_or(ViewError::Picture)?;
     let camera = Camera::fit(&world_points(run), run.dims, f64::from(w), f64::from(h));

@@ -390,16 +390,18 @@ fn the_gif_shows_the_arm_moving_over_its_path() {
     let colour = pixel(link);
     assert!(colour != [255, 255, 255], "a link at {link:?}");
     // Refusals: options and an overlong animation.
-    let slow = GifOptions {
-        speed: 1e-4,
-        ..options
-    };
-    assert!(
-        write_gif(&run, &slow, Vec::new())
-            .unwrap_err()
-            .to_string()
-            .contains("frames")
-    );
+    // 1e-19 asks for more frames than `usize` counts (the count once wrapped to 0 and wrote an
+    // empty GIF).
+    for speed in [1e-4, 1e-19, 1e-300] {
+        let slow = GifOptions { speed, ..options };
+        assert!(
+            write_gif(&run, &slow, Vec::new())
+                .unwrap_err()
+                .to_string()
+                .contains("frames"),
+            "{speed}"
+        );
+    }
     let wide = GifOptions {
         width: 0,
         ..options

@@ -781,6 +781,19 @@ fn hrm_view_writes_a_page_and_a_gif_and_replaces_only_its_own_files() {
         line.contains("scenario.toml: arm.links must be at most"),
         "{line}"
     );
+    // A scenario.toml of another arm than the time series' torque columns.
+    for links in [3, 11] {
+        let other = scenario.replacen("[arm]\n", &format!("[arm]\nlinks = {links}\n"), 1);
+        std::fs::write(&toml, other).unwrap();
+        let line = refused(&hrm(&["view", path(&run)]));
+        assert!(
+            line.contains(&format!(
+                "10 joint torque columns (joint_tau1, ...) but the arm of scenario.toml has \
+                 {links} joints"
+            )),
+            "{line}"
+        );
+    }
     std::fs::write(&toml, scenario).unwrap();
     let line = refused(&hrm(&[
         "view",

@@ -146,3 +146,30 @@ fn bad_robot_requests_get_one_clear_error() {
         assert!(message.contains(needle), "{message:?} lacks {needle:?}");
     }
 }
+
+/// A joint that moves no mass has a singular mass matrix: `dynamics` and `rnea_derivatives`
+/// answer (zeros: nothing to accelerate or hold), `aba_derivatives` refuses it (above).
+#[test]
+fn a_massless_chain_has_zero_dynamics() {
+    let massless = r#"<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+        <joint name="j1" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/></joint>
+        <joint name="j2" type="revolute"><parent link="b"/><child link="c"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint></robot>"#;
+    let answers = eval(&[
+        json!({"op": "dynamics", "urdf": massless, "theta": [0.3, -0.2], "theta_dot": [1.0, 2.0]}),
+        json!({"op": "rnea_derivatives", "urdf": massless, "theta": [0.3, -0.2], "theta_dot": [1.0, 2.0], "theta_ddot": [0.5, 0.5]}),
+    ]);
+    for answer in &answers {
+        assert_eq!(answer["ok"], true, "{answer}");
+        let values: Vec<f64> = answer
+            .as_object()
+            .unwrap()
+            .iter()
+            .filter(|(key, _)| !["ok", "id"].contains(&key.as_str()))
+            .flat_map(|(_, value)| numbers(value))
+            .collect();
+        assert!(
+            !values.is_empty() && values.iter().all(|&v| v == 0.0),
+            "{answer}"
+        );
+    }
+}
