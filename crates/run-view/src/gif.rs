@@ -433,7 +433,7 @@ pub fn write_gif(run: &RunView, options: &GifOptions, out: impl Write) -> Result
     let (t0, t1) = (run.t[0], run.t[run.len() - 1]);
     // Counted in floating point: a count beyond `usize` saturates rather than wrapping to 0.
     let needed = ((t1 - t0) / options.speed * f64::from(options.fps)).ceil() + 1.0;
-    if !(needed <= MAX_FRAMES as f64) {
+    if needed.is_nan() || needed > MAX_FRAMES as f64 {
         return Err(ViewError::TooManyFrames {
             seconds: t1 - t0,
             fps: options.fps,
