@@ -70,6 +70,24 @@ pub enum DynError {
         /// The offending value.
         value: f64,
     },
+    /// The chain's total mass, or its inertia bound (total mass x total length^2), or its
+    /// gravity torque bound (total mass x |g| x total length), is beyond double precision: every
+    /// link is valid, but the chain's dynamics would overflow.
+    #[error(
+        "the chain's total mass {} kg over its length {} m under gravity {} m/s^2 overflows \
+         double precision (total mass, mass x length^2 and mass x g x length must be finite)",
+        Compact(*total_mass),
+        Compact(*total_length),
+        Compact(*gravity)
+    )]
+    ChainOverflows {
+        /// The sum of the link masses (kg).
+        total_mass: f64,
+        /// The sum of the link lengths (m).
+        total_length: f64,
+        /// The gravitational acceleration's magnitude (m/s^2).
+        gravity: f64,
+    },
     /// The gravitational acceleration (or a component of it) was not finite.
     #[error("gravity must be finite, got {}", Compact(*.0))]
     InvalidGravity(f64),

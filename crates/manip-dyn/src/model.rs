@@ -124,6 +124,22 @@ impl ChainModel {
         if !gravity.is_finite() {
             return Err(DynError::InvalidGravity(gravity));
         }
+        // Every entry of M is at most the total mass times the total length squared (plus the
+        // links' own inertias), every gravity torque the total mass times g times the length.
+        let total_mass: f64 = links.iter().map(|l| l.mass).sum();
+        let total_length: f64 = links.iter().map(|l| l.length).sum();
+        let bounds = [
+            total_mass,
+            total_mass * total_length * total_length,
+            total_mass * gravity.abs() * total_length,
+        ];
+        if !bounds.iter().all(|b| b.is_finite()) {
+            return Err(DynError::ChainOverflows {
+                total_mass,
+                total_length,
+                gravity: gravity.abs(),
+            });
+        }
         Ok(Self { links, gravity })
     }
 

@@ -14,7 +14,7 @@ use pulp::{Simd, WithSimd};
 use super::algebra::{Force, Motion, Symmetric6, Transform};
 use super::data::SpatialData;
 use super::derivative_data::{MAX_LANES, SpatialDerivativeData, column_of, padded, store_first};
-use super::kinematics::{joint_placement, sin_cos_dispatched};
+use super::kinematics::{placement_about_first_joint, sin_cos_dispatched};
 use super::minv::inverse_mass_matrix;
 use super::model::SpatialModel;
 use super::rnea_derivatives::{Jacobians, carry_to_base, differentiate_at};
@@ -96,7 +96,8 @@ pub fn aba_derivatives(
     }
 }
 
-/// The articulated-body algorithm (as [`aba`](super::aba())) run in the base frame, as
+/// The articulated-body algorithm (as [`aba`](super::aba())) run in the base frame (its origin
+/// at the first joint's, [`placement_about_first_joint`]), as
 /// Pinocchio's `computeABADerivatives` runs it: `qdd` from `inputs` (`q`, `v`, `tau`), each
 /// link's pose into `data`, its base-frame axis and inertia into `derivatives`
 /// ([`carry_to_base`]) and each
@@ -121,7 +122,7 @@ fn aba_base_frame(
     let mut pose = Transform::IDENTITY;
     let mut velocity = Motion::default();
     for i in 0..n {
-        let placement = joint_placement((), &model.joints()[i], q[i], data.sin[i], data.cos[i]);
+        let placement = placement_about_first_joint(model, data, q, i);
         pose = pose.compose(&placement);
         data.poses[i] = pose;
         let axis = carry_to_base(model, derivatives, i, &pose);

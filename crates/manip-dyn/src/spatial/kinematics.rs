@@ -88,6 +88,42 @@ pub(crate) fn update_poses(model: &SpatialModel, data: &mut SpatialData, q: &[f6
     }
 }
 
+/// Link `i`'s placement as [`joint_placement`], the first joint's origin moved to the base
+/// frame's origin (`i = 0`): the frame in which the derivatives sum their base-frame quantities.
+/// A translation of the origin changes no joint-space quantity, and a first joint far from the
+/// base (a URDF's `1e6` m offset) would otherwise leave those sums few correct digits (terms of
+/// `m |p|^2` cancelling to `m L^2`).
+#[inline(always)]
+pub(crate) fn placement_about_first_joint(
+    model: &SpatialModel,
+    data: &SpatialData,
+    q: &[f64],
+    i: usize,
+) -> Transform {
+    let mut joint = model.joints()[i];
+    if i == 0 {
+        joint.origin.translation = [0.0; 3];
+    }
+    joint_placement((), &joint, q[i], data.sin[i], data.cos[i])
+}
+
+/// Poses as [`update_poses`] in the base frame moved to the first joint's origin (see
+/// [`placement_about_first_joint`]).
+pub(crate) fn update_poses_about_first_joint(
+    model: &SpatialModel,
+    data: &mut SpatialData,
+    q: &[f64],
+) {
+    sin_cos_dispatched(data.arch, q, &mut data.sin, &mut data.cos);
+    let mut parent = Transform::IDENTITY;
+    for i in 0..model.n_links() {
+        let placement = placement_about_first_joint(model, data, q, i);
+        data.placements[i] = placement;
+        parent = parent.compose(&placement);
+        data.poses[i] = parent;
+    }
+}
+
 /// Forward kinematics at the joint values `q`: every link's pose in the base frame, read with
 /// [`SpatialData::link_pose`].
 ///

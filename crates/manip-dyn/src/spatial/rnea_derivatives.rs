@@ -23,7 +23,9 @@
 //! `Q_i = Bc_i^T J_i`; for `i < k`, `J_i . G_k` and `J_i . H_k` with column constants `G_k`,
 //! `H_k`: six to nine multiply-adds an entry, computed down each column over the links.
 //!
-//! Everything runs in the base frame: one sweep base to tip gives `J_i`, `v_i`, `a_i`, `w_i`,
+//! Everything runs in the base frame, its origin moved to the first joint's (a translation of
+//! the origin changes no joint-space quantity, and keeps the sums' digits when the first joint
+//! sits far from the base; `data`'s poses are left in that frame): one sweep base to tip gives `J_i`, `v_i`, `a_i`, `w_i`,
 //! `beta_i` and each link's own force `f_i = I_i a_i + v_i x* I_i v_i` (the Newton-Euler
 //! recursion with the base-frame axes, `v_i = v_{i-1} + J_i qd_i`,
 //! `a_i = a_{i-1} + J_i qdd_i + v_i x J_i qd_i`, no per-link frame change), one sweep tip to
@@ -48,7 +50,7 @@ use super::data::SpatialData;
 use super::derivative_data::{
     MAX_LANES, Six, SpatialDerivativeData, column_of, padded, store_first,
 };
-use super::kinematics::update_poses;
+use super::kinematics::update_poses_about_first_joint;
 use super::model::SpatialModel;
 use crate::check;
 use crate::error::DynError;
@@ -91,7 +93,7 @@ pub fn rnea_derivatives(
         derivatives.n_links(),
         n,
     )?;
-    update_poses(model, data, q);
+    update_poses_about_first_joint(model, data, q);
     for (i, pose) in data.poses.iter().enumerate() {
         carry_to_base(model, derivatives, i, pose);
     }

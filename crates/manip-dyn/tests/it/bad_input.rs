@@ -33,6 +33,20 @@ fn model_rows() -> Vec<Row<DynError>> {
             ChainModel::new(vec![good; MAX_LINKS + 1], 9.81).unwrap_err(),
             |e| matches!(e, DynError::TooManyLinks { .. }),
         ),
+        // Valid links whose sums overflow: the total mass, M's bound, the gravity torques.
+        exactly(
+            "total_mass_overflows",
+            ChainModel::uniform(8, 0.125, 1e308, 9.81).unwrap_err(),
+            |e| matches!(e, DynError::ChainOverflows { .. }),
+            "the chain's total mass inf kg over its length 1 m under gravity 9.81 m/s^2 \
+             overflows double precision (total mass, mass x length^2 and mass x g x length must \
+             be finite)",
+        ),
+        row(
+            "gravity_torque_overflows",
+            ChainModel::uniform(2, 1.0, 1e300, 1e10).unwrap_err(),
+            |e| matches!(e, DynError::ChainOverflows { .. }),
+        ),
         // A point mass on the joint axis: the joint would drive nothing, M would be singular.
         words(
             "point_mass_on_the_joint",

@@ -1,6 +1,6 @@
 //! Reading scenarios: TOML text and files, with one-line errors.
 
-use super::schema::Scenario;
+use super::schema::{Scenario, TaskSpec};
 use std::path::{Path, PathBuf};
 
 /// Why a scenario could not be read.
@@ -84,6 +84,42 @@ impl Scenario {
 /// Parses scenario text; a refusal is one line: `line L, column C (`<that line>`): <what is
 /// wrong>` (toml's own message spans several lines around the quoted text).
 pub(super) fn parse(text: &str, origin: &str) -> Result<Scenario, ScenarioError> {
+    let scenario = parse_text(text, origin)?;
+    // A count beyond TOML's integers (2^63 - 1) reads into a `usize` but cannot be written
+    // back (nor into a shard, nor Python's dict): refused here, whatever its later bound.
+    let counts = [
+        ("arm.links", scenario.arm.links),
+        ("modal.harmonics", Some(scenario.modal.harmonics)),
+    ]
+    .into_iter()
+    .chain(scenario.task.iter().flat_map(|task| match task {
+        TaskSpec::Reach {
+            samples,
+            max_iterations,
+            ..
+        } => [
+            ("task.samples", *samples),
+            ("task.max_iterations", *max_iterations),
+        ],
+    }));
+    for (name, count) in counts {
+        if let Some(count) = count
+            && i64::try_from(count).is_err()
+        {
+            return Err(ScenarioError::Parse {
+                origin: origin.to_string(),
+                message: format!(
+                    "{name} = {count} is beyond TOML's integers (at most 2^63 - 1, and far less \
+                     where it is used)"
+                ),
+            });
+        }
+    }
+    Ok(scenario)
+}
+
+/// [`parse`]'s reading of the text.
+fn parse_text(text: &str, origin: &str) -> Result<Scenario, ScenarioError> {
     toml::from_str(text).map_err(|e| {
         let what = e.message().trim_end().replace('\n', "; ");
         let message = match e.span() {

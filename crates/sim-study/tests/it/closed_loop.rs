@@ -491,6 +491,15 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
         (base.replace("dt = 0.0001", "dtt = 0.0001"), "dtt"),
         (base.replace("time = 0.1", "time = 0.1\nspeed = 3"), "speed"),
         (format!("{base}\n[arm]\nlinks = \"ten\"\n"), "links"),
+        // A count TOML cannot write back (it would fail every later to_toml).
+        (
+            format!("{base}\n[arm]\nlinks = 18446744073709551615\n"),
+            "arm.links = 18446744073709551615 is beyond TOML's integers",
+        ),
+        (
+            format!("{base}\n[modal]\nharmonics = 9223372036854775808\n"),
+            "modal.harmonics = 9223372036854775808 is beyond",
+        ),
         // A limit of the wrong type says what it takes, not how it is parsed.
         (
             format!("{base}\n[limits]\njoint_torque_nm = \"x\"\n"),
