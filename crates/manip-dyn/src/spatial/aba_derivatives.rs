@@ -121,14 +121,14 @@ fn aba_base_frame(
     sin_cos_dispatched(data.arch, q, &mut data.sin, &mut data.cos);
     let mut pose = Transform::IDENTITY;
     let mut velocity = Motion::default();
-    for i in 0..n {
+    for (i, &speed) in v.iter().enumerate().take(n) {
         let placement = placement_about_first_joint(model, data, q, i);
         pose = pose.compose(&placement);
         data.poses[i] = pose;
         let axis = carry_to_base(model, derivatives, i, &pose);
         let joint = &mut derivatives.joints[i];
         joint.axis = axis;
-        let joint_velocity = joint.axis.times(v[i]);
+        let joint_velocity = joint.axis.times(speed);
         velocity = velocity.plus(&joint_velocity);
         joint.bias = velocity.cross_motion(&joint_velocity);
         // A massless link (the cross of a universal joint) has no inertia and no bias force.
