@@ -683,6 +683,19 @@ pub enum LearningProblem {
         /// The epoch (1-based, as [`EpochReport::epoch`](crate::learn::EpochReport::epoch)).
         epoch: usize,
     },
+    /// The premise step (Jang's `kappa`, the initial step grown by the step increase) moved a
+    /// set's parameters beyond double precision.
+    #[error(
+        "the premise step {} at epoch {epoch} moves the sets' parameters beyond double \
+         precision; use a smaller initial step (or step increase)",
+        lane_math::Compact(*step)
+    )]
+    StepOverflow {
+        /// The epoch (1-based).
+        epoch: usize,
+        /// The step length at that epoch.
+        step: f64,
+    },
     /// ANFIS was given a system with other than one output.
     #[error(
         "ANFIS trains single-output systems; this one has {outputs} outputs (train one system \

@@ -98,7 +98,7 @@ fn check(path: &Path) -> Result<(), String> {
             name(&joint.name),
             joint.axis,
             name(&joint.child.name),
-            joint.child.inertial.mass,
+            lane_math::Compact(joint.child.inertial.mass),
             if joint.child.inertial.is_massless() {
                 ", massless"
             } else {

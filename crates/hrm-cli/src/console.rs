@@ -52,17 +52,42 @@ pub fn escape_field(text: &str) -> String {
 }
 
 /// The one line `hrm` writes to standard error for a failure: control characters escaped and
-/// very long numbers in exponent form ([`lane_math::compact_numbers`]).
+/// the message [`shown`].
 pub fn error_line(message: &str) -> String {
-    format!(
-        "hrm: {}",
-        lane_math::compact_numbers(&escape_controls(message, &[]))
-    )
+    format!("hrm: {}", shown(&escape_controls(message, &[])))
+}
+
+/// Characters of a message shown whole: an error quoting a user's list (a shard header's
+/// 100,000 noise levels) is cut after them.
+const MAX_MESSAGE_CHARS: usize = 2000;
+
+/// A failure's message as `hrm` shows it (on standard error and in `hrm eval`'s answers): very
+/// long numbers in exponent form ([`lane_math::compact_numbers`]) and at most
+/// [`MAX_MESSAGE_CHARS`] characters, a longer one cut with the count of what was left out.
+pub fn shown(message: &str) -> String {
+    let compact = lane_math::compact_numbers(message);
+    match compact.char_indices().nth(MAX_MESSAGE_CHARS) {
+        None => compact,
+        Some((cut, _)) => format!(
+            "{} ... ({} more characters)",
+            &compact[..cut],
+            compact[cut..].chars().count()
+        ),
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn long_messages_are_cut() {
+        let list = vec!["0.5"; 100_000].join(", ");
+        let line = error_line(&format!("noise levels [{list}] differ"));
+        assert!(line.len() < 2100, "{}", line.len());
+        assert!(line.ends_with(" ... (498020 more characters)"), "{line}");
+        assert_eq!(shown("short"), "short");
+    }
 
     #[test]
     fn control_characters_are_escaped_and_text_kept() {

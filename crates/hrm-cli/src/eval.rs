@@ -101,7 +101,8 @@ fn read_line(
 }
 
 fn error_answer(id: Value, error: &EvalError) -> Value {
-    json!({"id": id, "ok": false, "error": {"kind": error.kind.as_str(), "message": error.message}})
+    let message = crate::console::shown(&error.message);
+    json!({"id": id, "ok": false, "error": {"kind": error.kind.as_str(), "message": message}})
 }
 
 /// A JSON value read with every object's keys distinct: `{"op": "fk", "op": "ik"}` is refused

@@ -142,7 +142,7 @@ pub fn run(args: FisArgs) -> Result<(), String> {
         } => {
             let lines: String = eval(read_system(&file)?, &inputs, out_of_range)?
                 .into_iter()
-                .map(|(name, value)| format!("{name} = {value}\n"))
+                .map(|(name, value)| format!("{name} = {}\n", lane_math::Compact(value)))
                 .collect();
             console::print(&lines)
         }

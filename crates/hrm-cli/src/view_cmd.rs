@@ -260,6 +260,9 @@ fn load_run(dir: &Path, label: Option<&str>) -> Result<(Scenario, RunView), Stri
     Ok((scenario, view))
 }
 
+/// The largest magnitude of a value of `timeseries.csv` (m, rad, N m, s).
+const MAX_VALUE: f64 = 1e15;
+
 /// The columns of `timeseries.csv` the viewer needs, back into a [`Record`]: `t`, the
 /// coordinates and their `_ref`, `tau1..m`, the tips, and `joint_tau1..n_joints` when present.
 fn parse_timeseries(text: &str, scenario: &Scenario, n_joints: usize) -> Result<Record, String> {
@@ -306,13 +309,26 @@ fn parse_timeseries(text: &str, scenario: &Scenario, n_joints: usize) -> Result<
     for (line, text) in lines.enumerate() {
         row.clear();
         for (k, cell) in text.split(',').enumerate() {
-            let value: f64 = cell.parse().map_err(|_| {
-                format!(
-                    "line {}: column {}: {cell:?} is not a number",
+            let Some(name) = header.get(k) else {
+                return Err(format!(
+                    "line {}: more values than the {} columns",
                     line + 2,
-                    header.get(k).unwrap_or(&"?")
-                )
+                    header.len()
+                ));
+            };
+            let value: f64 = cell.parse().map_err(|_| {
+                format!("line {}: column {name}: {cell:?} is not a number", line + 2)
             })?;
+            // hrm writes no value beyond its runaway bounds; a hand-edited 1e308 would make
+            // the drawn distances overflow.
+            if value.is_nan() || value.abs() > MAX_VALUE {
+                return Err(format!(
+                    "line {}: column {name}: {} is beyond the {} a run writes",
+                    line + 2,
+                    lane_math::Compact(value),
+                    lane_math::Compact(MAX_VALUE)
+                ));
+            }
             row.push(value);
         }
         if row.len() != header.len() {

@@ -565,6 +565,13 @@ impl Anfis {
             for (p, g) in params[..count].iter_mut().zip(&self.grad[offset..]) {
                 *p -= eta * g;
             }
+            if !params[..count].iter().all(|p| p.is_finite()) {
+                return Err(LearningProblem::StepOverflow {
+                    epoch: self.epoch,
+                    step: self.step,
+                }
+                .into());
+            }
             let before = *mf;
             *mf = mf.with_params(&params[..count]);
             repair(mf, &before, self.mf_span[m]);

@@ -259,6 +259,36 @@ fn training_is_deterministic_and_keeps_the_best_check_epoch() {
     assert!(a.history.last().unwrap().training_rmse < a.history[0].training_rmse);
 }
 
+/// A premise step that throws the sets' parameters beyond double precision is an error naming
+/// the step, not a set's "parameters must be finite".
+#[test]
+fn a_step_beyond_double_precision_is_named() {
+    let train = surface_data(80, 0);
+    let grid = GridPartition {
+        sets_per_input: 3,
+        shape: SetShape::Bell,
+        order: ConsequentOrder::First,
+    };
+    let options = AnfisOptions {
+        epochs: 3,
+        initial_step: 1e308,
+        ..AnfisOptions::default()
+    };
+    let error = anfis(
+        genfis_grid(&train, 0, &grid).unwrap(),
+        &train,
+        None,
+        0,
+        &options,
+    )
+    .unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "learning: the premise step 1e308 at epoch 1 moves the sets' parameters beyond double \
+         precision; use a smaller initial step (or step increase)"
+    );
+}
+
 #[test]
 fn undetermined_consequents_are_an_error_without_ridge_and_finite_with_it() {
     // Triangles: rules whose sets no sample reaches have no data at all (nine constants, four

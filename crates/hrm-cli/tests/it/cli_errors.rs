@@ -769,6 +769,20 @@ fn hrm_view_writes_a_page_and_a_gif_and_replaces_only_its_own_files() {
         line.contains("timeseries.csv: line 2: column t: \"zero\" is not a number"),
         "{line}"
     );
+    // A value no run writes (the drawing would overflow), a line longer than the header.
+    std::fs::write(&csv, text.replacen("\n0,", "\n1e300,", 1)).unwrap();
+    let line = refused(&hrm(&["view", path(&run)]));
+    assert!(
+        line.contains("line 2: column t: 1e300 is beyond the 1e15 a run writes"),
+        "{line}"
+    );
+    std::fs::write(
+        &csv,
+        text.replacen("\n0,", &format!("\n0,{}", "1,".repeat(10_000)), 1),
+    )
+    .unwrap();
+    let line = refused(&hrm(&["view", path(&run)]));
+    assert!(line.contains("line 2: more values than the"), "{line}");
     std::fs::write(&csv, text).unwrap();
     // An arm the scenario file cannot have is that file's fault, not the time series'.
     let toml = run.join("scenario.toml");
