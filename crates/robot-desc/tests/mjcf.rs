@@ -292,6 +292,20 @@ fn what_the_reader_would_refuse_is_not_written() {
         .unwrap_err()
         .to_string();
     assert!(error.contains("its URDF would not read back"), "{error}");
+    // Within MAX_EXPORT_JOINTS but more XML than the reader reads back: said with the joints.
+    let long = from_planar(
+        &ChainModel::uniform(45_000, 0.1, 0.1, 9.81).unwrap(),
+        "long",
+    )
+    .unwrap();
+    let error = write_urdf(&long).unwrap_err().to_string();
+    assert!(
+        error.starts_with(
+            "cannot export robot 'long': its URDF of 45000 movable joints is larger than a URDF \
+             is read back (at most 1000000 XML nodes"
+        ),
+        "{error}"
+    );
     let arm = from_planar(&ChainModel::uniform(3, 0.1, 0.1, 9.81).unwrap(), "arm").unwrap();
     for gravity in [[0.0, -1e300, 0.0], [f64::NAN, 0.0, 0.0]] {
         let error = write_mjcf(&arm, gravity).unwrap_err().to_string();
