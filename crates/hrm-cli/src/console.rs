@@ -10,7 +10,7 @@ use std::io::Write;
 pub fn print(text: &str) -> Result<(), String> {
     let mut out = std::io::stdout().lock();
     match out
-        .write_all(escape_controls(text, &['\n', '\t']).as_bytes())
+        .write_all(lane_math::escape_controls(text, &['\n', '\t']).as_bytes())
         .and_then(|()| out.flush())
     {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
@@ -20,60 +20,17 @@ pub fn print(text: &str) -> Result<(), String> {
     }
 }
 
-/// `text` with every control character except those in `keep`, and every bidirectional
-/// formatting character (U+202E reverses the text after it), written as a Rust escape (`\n`,
-/// `\u{1b}`, `\u{202e}`), so that a message quoting a file cannot move the cursor, recolour
-/// the terminal, break into several lines or read backwards.
-pub fn escape_controls(text: &str, keep: &[char]) -> String {
-    let mut escaped = String::with_capacity(text.len());
-    for c in text.chars() {
-        if (c.is_control() || is_bidi_control(c)) && !keep.contains(&c) {
-            escaped.extend(c.escape_default());
-        } else {
-            escaped.push(c);
-        }
-    }
-    escaped
-}
-
-/// Whether `c` is a bidirectional formatting character of Unicode (UAX #9): the marks, the
-/// embeddings and overrides, the isolates.
-fn is_bidi_control(c: char) -> bool {
-    matches!(
-        c,
-        '\u{061c}' | '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}'
-    )
-}
-
 /// Escapes the characters of a user's text (a scenario name, a CSV header) that would break a
-/// table row or reorder it: newline and tab too, besides what [`escape_controls`] escapes.
+/// table row or reorder it: newline and tab too, besides what [`lane_math::escape_controls`] escapes.
 pub fn escape_field(text: &str) -> String {
-    escape_controls(text, &[])
+    lane_math::escape_controls(text, &[])
 }
 
-/// The one line `hrm` writes to standard error for a failure: control characters escaped and
-/// the message [`shown`].
+/// The one line `hrm` writes to standard error for a failure: the message as
+/// [`lane_math::one_line`] shows it (control characters escaped, long numbers with exponents,
+/// cut after 2,000 characters).
 pub fn error_line(message: &str) -> String {
-    format!("hrm: {}", shown(&escape_controls(message, &[])))
-}
-
-/// Characters of a message shown whole: an error quoting a user's list (a shard header's
-/// 100,000 noise levels) is cut after them.
-const MAX_MESSAGE_CHARS: usize = 2000;
-
-/// A failure's message as `hrm` shows it (on standard error and in `hrm eval`'s answers): very
-/// long numbers in exponent form ([`lane_math::compact_numbers`]) and at most
-/// [`MAX_MESSAGE_CHARS`] characters, a longer one cut with the count of what was left out.
-pub fn shown(message: &str) -> String {
-    let compact = lane_math::compact_numbers(message);
-    match compact.char_indices().nth(MAX_MESSAGE_CHARS) {
-        None => compact,
-        Some((cut, _)) => format!(
-            "{} ... ({} more characters)",
-            &compact[..cut],
-            compact[cut..].chars().count()
-        ),
-    }
+    format!("hrm: {}", lane_math::one_line(message))
 }
 
 #[cfg(test)]
@@ -81,23 +38,10 @@ mod tests {
     use super::*;
 
     #[test]
-    fn long_messages_are_cut() {
-        let list = vec!["0.5"; 100_000].join(", ");
-        let line = error_line(&format!("noise levels [{list}] differ"));
-        assert!(line.len() < 2100, "{}", line.len());
-        assert!(line.ends_with(" ... (498020 more characters)"), "{line}");
-        assert_eq!(shown("short"), "short");
-    }
-
-    #[test]
     fn control_characters_are_escaped_and_text_kept() {
         assert_eq!(
             error_line("line 2: found `\u{1b}[31mred\r\nx` in é"),
             "hrm: line 2: found `\\u{1b}[31mred\\r\\nx` in é"
-        );
-        assert_eq!(
-            escape_controls("a\tb\nc\u{7}", &['\n', '\t']),
-            "a\tb\nc\\u{7}"
         );
     }
 

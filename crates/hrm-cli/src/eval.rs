@@ -101,7 +101,7 @@ fn read_line(
 }
 
 fn error_answer(id: Value, error: &EvalError) -> Value {
-    let message = crate::console::shown(&error.message);
+    let message = lane_math::one_line(&error.message);
     json!({"id": id, "ok": false, "error": {"kind": error.kind.as_str(), "message": message}})
 }
 

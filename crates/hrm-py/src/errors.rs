@@ -77,12 +77,12 @@ impl Error {
     }
 }
 
-/// The exception of the error's class, its message with any number written out in full by a
-/// library (`1e-300` as 302 characters) in exponent form ([`lane_math::compact_numbers`]), as
-/// the CLI prints it.
+/// The exception of the error's class, its message one line as the CLI prints it
+/// ([`lane_math::one_line`]: control characters escaped, any number written out in full by a
+/// library, `1e-300` as 302 characters, in exponent form, cut after 2,000 characters).
 impl From<Error> for PyErr {
     fn from(error: Error) -> PyErr {
-        let message = lane_math::compact_numbers(&error.message);
+        let message = lane_math::one_line(&error.message);
         match error.kind {
             ErrorClass::Unreachable => Unreachable::new_err(message),
             ErrorClass::Numerical => NumericalError::new_err(message),

@@ -7,6 +7,7 @@ pub mod dense;
 mod error_class;
 mod instruction_sets;
 mod lanes;
+mod message;
 mod trig;
 
 pub use alloc::{OutOfMemory, try_filled, try_reserve, try_with_capacity};
@@ -18,4 +19,5 @@ pub use compact::{Compact, compact_numbers};
 pub use error_class::{Classify, ErrorClass};
 pub use instruction_sets::instruction_sets;
 pub use lanes::{Lane, Pack};
+pub use message::{escape_controls, one_line};
 pub use trig::{REDUCTION_LIMIT, sin_cos, sin_cos_in_range, sin_cos_lanes};

@@ -635,6 +635,13 @@ fn shard_files_are_streamed_and_checked_line_by_line() {
     let edited = runs.replacen("\"duration\":0.02", "\"duration\":0.03", 1);
     let err = check(&edited);
     assert!(err.contains("SHA-256 does not match its content"), "{err}");
+    // A current header that is no longer JSON (a NaN written in) is malformed, not "older".
+    let err = check(&runs.replacen("\"duration\":0.02", "\"duration\":NaN", 1));
+    assert!(
+        err.contains("has a malformed header: its first line is not JSON")
+            && !err.contains("older versions"),
+        "{err}"
+    );
     // Issue 32: a hand-edited metric is checked like any input, by field, before it is averaged.
     let metric = |key: &str, value: &str| {
         let line = lines[3];

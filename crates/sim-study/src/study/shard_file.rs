@@ -369,7 +369,11 @@ impl<R: ShardSource> ShardReader<R> {
                 // An older shard file is one pretty-printed object: `{`, then its format.
                 let ahead = input.fill_buf().unwrap_or_default();
                 let start = [&line[..], &ahead[..ahead.len().min(4096)]].concat();
+                // A current header that is not JSON (a NaN written in by hand) is malformed.
                 return Err(refuse(match declared_format(&start) {
+                    Some(format) if format == FORMAT => ShardProblem::MalformedHeader {
+                        cause: format!("its first line is not JSON ({e})"),
+                    },
                     Some(format) => ShardProblem::Format {
                         format: Some(format),
                     },
