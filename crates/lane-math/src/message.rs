@@ -36,7 +36,7 @@ const MAX_MESSAGE_CHARS: usize = 2000;
 
 /// `message` as one line a person reads: control and bidirectional characters escaped
 /// ([`escape_controls`]), very long numbers in exponent form ([`compact_numbers`]), and at most
-/// [`MAX_MESSAGE_CHARS`] characters, a longer one cut with the count of what was left out.
+/// 2,000 characters, a longer one cut with the count of what was left out.
 pub fn one_line(message: &str) -> String {
     let compact = compact_numbers(&escape_controls(message, &[]));
     match compact.char_indices().nth(MAX_MESSAGE_CHARS) {
