@@ -29,7 +29,7 @@ pub use modal_map::{
     BaseAngle, MAX_HARMONICS, MAX_LINKS, MAX_MAP_ENTRIES, ModalMap, harmonic_basis,
 };
 pub use spatial_chain::{
-    BasePose, spatial_joint_positions, spatial_tip_jacobian, spatial_tip_position,
+    BasePose, MAX_BASE_OFFSET, spatial_joint_positions, spatial_tip_jacobian, spatial_tip_position,
 };
 pub use spatial_curve::{CurveTip, MAX_CURVE_STEPS, SPATIAL_CURVE_TOLERANCE, SpatialCurve};
 pub use spatial_ik::SpatialIk;

@@ -24,13 +24,20 @@ pub struct BasePose {
     pub rpy: [f64; 3],
 }
 
+/// The farthest a base sits from the origin in each coordinate (m), as a URDF's numbers
+/// (`robot_desc::MAX_MAGNITUDE`): a base at `1e308` would leave the arm's points no digits.
+pub const MAX_BASE_OFFSET: f64 = 1e9;
+
 impl BasePose {
-    /// Checks that every number is finite.
+    /// Checks that every number is finite and the position within [`MAX_BASE_OFFSET`].
     pub fn validate(&self) -> Result<(), KinError> {
         for (name, values) in [("base xyz", self.xyz), ("base rpy", self.rpy)] {
             for value in values {
                 check_finite(name, value)?;
             }
+        }
+        if let Some(&value) = self.xyz.iter().find(|v| v.abs() > MAX_BASE_OFFSET) {
+            return Err(KinError::BaseTooFar { value });
         }
         Ok(())
     }

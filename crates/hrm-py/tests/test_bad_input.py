@@ -483,6 +483,8 @@ def test_spatial_and_urdf_classes_follow_the_same_rules():
         hrm.SpatialArm(lengths=[0.1, 1e300])
     with pytest.raises(hrm.InvalidInput, match=r"^arm\.link_length of 1e300 m .* rod inertia"):
         hrm.SpatialArm(link_length=1e300)
+    with pytest.raises(hrm.InvalidInput, match=r"base xyz must be at most 1000000000 m from the origin in each coordinate, got 1e308"):
+        hrm.SpatialArm(base_xyz=[1e308, 0.0, 0.0])
     with pytest.raises(hrm.InvalidInput, match="^lengths is a masked array"):
         hrm.SpatialArm(lengths=np.ma.masked_array([0.1, 0.1], mask=[True, False]))
     urdf = random_chain(3, 4)

@@ -171,6 +171,8 @@ impl ArmSpec {
         let base: BasePose = self.base.unwrap_or_default().into();
         check_all_finite("arm.base.xyz", &base.xyz)?;
         check_all_finite("arm.base.rpy", &base.rpy)?;
+        base.validate()
+            .map_err(|e| SimError::setting("arm.base.xyz", format!("is invalid: {e}")))?;
         let gravity = self.gravity.map_or(DEFAULT_GRAVITY, Gravity::spatial);
         check_all_finite("arm.gravity", &gravity)?;
         let map = SpatialModalMap::new(&lengths, k)

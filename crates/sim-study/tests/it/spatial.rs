@@ -162,6 +162,11 @@ fn spatial_keys_out_of_their_domain_are_named() {
         "arm.lengths[2]",
     );
     refused("link_mass = 0.1", "link_mass = nan", "arm.link_mass");
+    refused(
+        "xyz = [0.0, 0.0, 0.0]",
+        "xyz = [0.0, 1e308, 0.0]",
+        "arm.base.xyz is invalid: base xyz must be at most 1000000000 m from the origin",
+    );
     // A rod's inertia m L^2 / 12 overflows: the length the user gave is named.
     refused(
         "link_length = 0.1",
