@@ -27,12 +27,14 @@ pub enum KinError {
     /// in a coordinate: the arm's points would lose their digits to it.
     #[error(
         "base xyz must be at most {} m from the origin in each coordinate, got {}",
-        lane_math::Compact(crate::MAX_BASE_OFFSET),
+        lane_math::Compact(*max),
         lane_math::Compact(*value)
     )]
     BaseTooFar {
         /// The offending coordinate.
         value: f64,
+        /// The bound.
+        max: f64,
     },
     /// A length (a link, the whole curve) was zero, negative or non-finite.
     #[error("{name} must be positive and finite, got {value}")]

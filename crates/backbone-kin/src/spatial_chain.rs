@@ -37,7 +37,10 @@ impl BasePose {
             }
         }
         if let Some(&value) = self.xyz.iter().find(|v| v.abs() > MAX_BASE_OFFSET) {
-            return Err(KinError::BaseTooFar { value });
+            return Err(KinError::BaseTooFar {
+                value,
+                max: MAX_BASE_OFFSET,
+            });
         }
         Ok(())
     }
