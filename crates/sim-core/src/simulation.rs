@@ -1010,6 +1010,45 @@ pub fn check_loop_work(n_links: usize, m: usize) -> Result<(), SimError> {
     Ok(())
 }
 
+/// The most work a whole run may take, in the units of [`MAX_LOOP_WORK`] (multiply-adds of the
+/// reduced dynamics, about 1.4e9 a second here): about ten minutes of computing. Each bound on
+/// its own (the work of one evaluation, the steps, the records) lets through runs whose product
+/// would take hours (4,096 links with `K = 32` for 100 s: eleven hours).
+pub const MAX_RUN_WORK: f64 = 1e12;
+
+/// The work of one clearance pair measured at a controller sample, in [`MAX_LOOP_WORK`]'s units
+/// (about 30 ns against 0.7 ns a multiply-add of the dynamics).
+const CLEARANCE_PAIR_WORK: f64 = 64.0;
+
+/// Refuses a run whose estimated work exceeds [`MAX_RUN_WORK`]: the evaluations of the reduced
+/// dynamics (four an RK4 step, at least seven a Dormand-Prince step of `h_max`) times their
+/// `n m^2`, and the clearance pairs measured at every controller sample. The controller's own
+/// work (an MPC's solves) is not counted.
+fn check_run_work(s: &LoopSettings, n_joints: usize, m: usize) -> Result<(), SimError> {
+    let evaluations = match s.integrator {
+        Integrator::Rk4 { dt } => 4.0 * (s.duration / dt).ceil(),
+        Integrator::DormandPrince(tol) => 7.0 * (s.duration / tol.h_max).ceil(),
+    };
+    let per_evaluation = (n_joints as f64) * (m as f64).powi(2).max(1.0);
+    let samples = (s.duration / s.controller_period).round();
+    let pairs = s.clearance.as_ref().map_or(0, |c| c.pairs().len()) as f64;
+    let work = evaluations * per_evaluation + samples * pairs * CLEARANCE_PAIR_WORK;
+    if work > MAX_RUN_WORK {
+        return Err(SimError::setting(
+            "duration",
+            format!(
+                "= {} s would take an estimated {work:.2e} operations ({evaluations:.2e} \
+                 evaluations of the reduced dynamics of {per_evaluation:.2e} each, {samples:.2e} \
+                 clearance measures of {pairs} pairs), more than the {MAX_RUN_WORK:e} a run may \
+                 take (about ten minutes): simulate less, or use fewer links, harmonics or \
+                 obstacles",
+                Compact(s.duration)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The most fixed steps an RK4 run may take (`duration / integrator.dt`): about half an hour of
 /// computing for a 10-link arm, so a step typed `1e-12` for `1e-4` is refused up front rather
 /// than running for days. A Dormand-Prince run whose `h_max` forces more steps
@@ -1270,6 +1309,7 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
             ),
         ));
     }
+    check_run_work(s, n_joints, m)?;
     if let Some(limits) = &s.tau_star_limits {
         if limits.len() != m {
             return Err(SimError::setting(

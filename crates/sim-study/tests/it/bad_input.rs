@@ -10,8 +10,8 @@ use sim_core::controller::{ComputedTorque, FuzzyController, PdController};
 use sim_core::ode::{DormandPrince, OdeError, OdeSystem, Rk4, Tolerances};
 use sim_core::reference::{CartesianPath, PathShape, Sinusoid, Step};
 use sim_core::{
-    Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS, SimError,
-    Simulation,
+    Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS,
+    MAX_RUN_WORK, SimError, Simulation,
 };
 use std::f64::consts::FRAC_PI_2;
 
@@ -275,6 +275,30 @@ fn run_that_would_never_end() {
              got 1e300 s"
         )
     );
+}
+
+/// Each bound on its own passes (the steps, the records, one evaluation's work), their product
+/// does not: 2,000 links measuring their 2 million self pairs at 20,000 controller samples (21
+/// minutes) is refused before the run, naming the duration and the estimate.
+#[test]
+fn a_run_whose_total_work_is_hours_is_refused() {
+    let base = sim_study::Scenario::builtin_text("paper-responses-step").unwrap();
+    let text = format!(
+        "{base}\n[arm]\nlinks = 2000\nlink_length = 0.0005\nlink_mass = 0.0005\nradius = 1e-5\n"
+    );
+    let scenario = sim_study::Scenario::from_toml(&text).unwrap();
+    let error = scenario.build().err().unwrap();
+    let message = error.to_string();
+    assert!(
+        message.starts_with("duration = 2 s would take an estimated 2.56e12 operations")
+            && message.contains("2.00e4 clearance measures of 1997001 pairs")
+            && message.contains(&format!("more than the {MAX_RUN_WORK:e} a run may take")),
+        "{message}"
+    );
+    // A tenth of it runs.
+    let short =
+        sim_study::Scenario::from_toml(&text.replace("duration = 2.0", "duration = 0.2")).unwrap();
+    assert!(short.build().is_ok());
 }
 
 #[test]
