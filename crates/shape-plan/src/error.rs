@@ -106,6 +106,23 @@ pub enum PlanError {
         /// The limit.
         max: usize,
     },
+    /// The shape solves a plan may run ([`MAX_PLAN_WORK`](crate::MAX_PLAN_WORK)) would take too
+    /// long: `(2 + samples) x max_iterations x pairs x (coordinates + 1)`.
+    #[error(
+        "samples and max iterations allow {:.2e} operations of shape solves ((2 + samples) x \
+         max iterations x {pairs} clearance pairs x (coordinates + 1)), more than the {:e} a \
+         plan may take (about ten minutes): fewer samples or iterations, links or obstacles",
+        work,
+        max
+    )]
+    TooMuchWork {
+        /// The estimate.
+        work: f64,
+        /// The clearance pairs of one shape.
+        pairs: usize,
+        /// The limit.
+        max: f64,
+    },
     /// A slice had the wrong number of entries.
     #[error("{name} has {found} entries, expected {expected}")]
     Dimension {

@@ -30,6 +30,6 @@ pub use generator::{
 pub use motion::{SegmentCheck, check_segment};
 pub use options::{MAX_CHECKS, MAX_ITERATIONS, MAX_SAMPLES, PlanOptions};
 pub use planar::PlanarArm;
-pub use planner::{Plan, Planner};
+pub use planner::{MAX_PLAN_WORK, Plan, Planner};
 pub use shape::{ShapeOutcome, solve_shape};
 pub use spatial::SpatialArm;

@@ -359,6 +359,26 @@ fn refusals_name_the_problem() {
         let error = Planner::new(arm, model, bad).unwrap_err();
         assert!(error.to_string().contains(field), "{error}");
     }
+    // Counts within their limits whose product is hours of shape solves.
+    let ring: Vec<Obstacle> = (0..16)
+        .map(|i| {
+            let angle = f64::from(i) * std::f64::consts::TAU / 16.0;
+            Obstacle::circle([0.5 * angle.cos(), 0.5 * angle.sin()], 0.01).unwrap()
+        })
+        .collect();
+    let model = ClearanceModel::new(LINKS, RADIUS, ring).unwrap();
+    let arm = PlanarArm::new(&lengths(), 2, BaseAngle::Fixed(ALPHA0)).unwrap();
+    let heavy = PlanOptions {
+        samples: 100_000,
+        max_iterations: 100_000,
+        ..options()
+    };
+    let error = Planner::new(arm, model, heavy).unwrap_err();
+    assert!(
+        matches!(error, PlanError::TooMuchWork { .. })
+            && error.to_string().contains("more than the 1e11 a plan may take"),
+        "{error}"
+    );
     // A clearance model of another chain.
     let model = ClearanceModel::new(LINKS + 1, RADIUS, vec![]).unwrap();
     let arm = PlanarArm::new(&lengths(), 2, BaseAngle::Fixed(ALPHA0)).unwrap();

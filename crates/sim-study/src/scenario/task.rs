@@ -206,6 +206,7 @@ fn task_field(e: PlanError) -> SimError {
             "target coordinate" => "task.target",
             _ => "task",
         },
+        PlanError::TooMuchWork { .. } => "task.samples",
         PlanError::OutOfReach { .. } => "task.target",
         PlanError::InitialTooClose { .. } => "initial.a",
         _ => "task",
