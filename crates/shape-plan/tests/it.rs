@@ -376,7 +376,9 @@ fn refusals_name_the_problem() {
     let error = Planner::new(arm, model, heavy).unwrap_err();
     assert!(
         matches!(error, PlanError::TooMuchWork { .. })
-            && error.to_string().contains("more than the 1e11 a plan may take"),
+            && error
+                .to_string()
+                .contains("more than the 1e11 a plan may take"),
         "{error}"
     );
     // A clearance model of another chain.

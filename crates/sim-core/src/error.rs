@@ -157,6 +157,26 @@ pub enum SimError {
         /// The controller's error.
         source: ControllerFailure,
     },
+    /// A modal coordinate, measured or referenced, beyond
+    /// [`MAX_MODAL_MAGNITUDE`](crate::MAX_MODAL_MAGNITUDE): double precision no longer resolves
+    /// its motion (at `1e20` rad every step rounds away), so the run would report nonsense.
+    #[error(
+        "a{coordinate} (or its reference) is {} rad at t = {} s, beyond the {} rad a run \
+         resolves: the initial state or the reference is out of scale",
+        Compact(*.value),
+        Compact(*.t),
+        Compact(*.bound)
+    )]
+    OutOfScale {
+        /// When (s).
+        t: f64,
+        /// Which coordinate (1-based).
+        coordinate: usize,
+        /// The larger magnitude of the coordinate and its reference (rad).
+        value: f64,
+        /// The bound (rad).
+        bound: f64,
+    },
     /// A modal tracking error grew beyond the configured bound.
     #[error(
         "runaway tracking error at t = {} s: |a{coordinate} - a{coordinate}_ref| = {} rad exceeds \

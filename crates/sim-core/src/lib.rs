@@ -21,7 +21,7 @@ pub use error::{ControllerFailure, SimError, StoppedRun};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use simulation::{
     ControlSample, ControllerFactory, Integrator, JOINT_ANGLE_APPROACH_S, Lockstep, LoopHooks,
-    LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_LOOP_WORK, MAX_RECORDED_VALUES, MAX_RK4_STEPS,
-    MAX_RUN_WORK, NoHooks, Observation, Prepared, ReferenceFactory, Run, RunFailure, RunNoise,
-    Simulation, check_loop_work,
+    LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_LOOP_WORK, MAX_MODAL_MAGNITUDE, MAX_RECORDED_VALUES,
+    MAX_RK4_STEPS, MAX_RUN_WORK, NoHooks, Observation, Prepared, ReferenceFactory, Run, RunFailure,
+    RunNoise, Simulation, check_loop_work,
 };

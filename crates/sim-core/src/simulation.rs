@@ -829,6 +829,18 @@ impl Simulation {
             Some(reference) => sample.reference.copy_from(reference),
             None => self.reference.sample(t, &mut sample.reference)?,
         }
+        // Before the controller sees them: at 1e20 rad every step would round away.
+        if let Some((i, value)) = (0..m)
+            .map(|i| (i, sample.state.a[i].abs().max(sample.reference.a[i].abs())))
+            .find(|&(_, v)| v > MAX_MODAL_MAGNITUDE)
+        {
+            return Err(SimError::OutOfScale {
+                t,
+                coordinate: i + 1,
+                value,
+                bound: MAX_MODAL_MAGNITUDE,
+            });
+        }
         sample.command.copy_from(&sample.reference);
         if let Some(noise) = &mut self.reference_noise {
             noise.perturb(&mut sample.command.a);
@@ -1009,6 +1021,11 @@ pub fn check_loop_work(n_links: usize, m: usize) -> Result<(), SimError> {
     }
     Ok(())
 }
+
+/// The largest magnitude of a modal coordinate or its reference a run resolves (rad): at `1e6`
+/// double precision still keeps `1e-10` rad, at `1e20` every step of a run rounds away. A run
+/// reaching beyond stops ([`SimError::OutOfScale`]).
+pub const MAX_MODAL_MAGNITUDE: f64 = 1e6;
 
 /// The most work a whole run may take, in the units of [`MAX_LOOP_WORK`] (multiply-adds of the
 /// reduced dynamics, about 1.4e9 a second here): about ten minutes of computing. Each bound on

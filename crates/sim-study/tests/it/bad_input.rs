@@ -10,8 +10,8 @@ use sim_core::controller::{ComputedTorque, FuzzyController, PdController};
 use sim_core::ode::{DormandPrince, OdeError, OdeSystem, Rk4, Tolerances};
 use sim_core::reference::{CartesianPath, PathShape, Sinusoid, Step};
 use sim_core::{
-    Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS,
-    MAX_RUN_WORK, SimError, Simulation,
+    Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_MODAL_MAGNITUDE, MAX_RECORDED_VALUES,
+    MAX_RK4_STEPS, MAX_RUN_WORK, SimError, Simulation,
 };
 use std::f64::consts::FRAC_PI_2;
 
@@ -396,6 +396,38 @@ fn non_finite_initial_state() {
         }),
     );
     assert_eq!(invalid(result).0, "initial.a");
+}
+
+/// A state (or reference) of `1e20` rad: every step rounds away and the run would report a
+/// frozen coordinate tracking perfectly; it stops at once, naming the coordinate and the bound.
+#[test]
+fn out_of_scale_states_and_references_stop_the_run() {
+    for (initial, target) in [(1e20, 1e20), (0.0, 1e300)] {
+        let failure = Simulation::new(
+            paper_model(),
+            Box::new(Step::new(&[initial, 0.0], &[target, -0.2], 0.0).unwrap()),
+            Box::new(PdController::new(&[0.0; 2], &[5.0, 5.0], &[1.0, 1.0]).unwrap()),
+            LoopSettings {
+                max_modal_error: 1e308,
+                ..settings()
+            },
+            Some(sim_core::controller::ModalState {
+                a: vec![initial, 0.0],
+                a_dot: vec![0.0; 2],
+            }),
+        )
+        .unwrap()
+        .run()
+        .unwrap_err();
+        assert!(
+            matches!(
+                failure.error,
+                SimError::OutOfScale { coordinate: 1, bound: MAX_MODAL_MAGNITUDE, t, .. } if t == 0.0
+            ),
+            "{}",
+            failure.error
+        );
+    }
 }
 
 #[test]
