@@ -22,6 +22,7 @@ pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use simulation::{
     ControlSample, ControllerFactory, Integrator, JOINT_ANGLE_APPROACH_S, Lockstep, LoopHooks,
     LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_LOOP_WORK, MAX_MODAL_MAGNITUDE, MAX_RECORDED_VALUES,
-    MAX_RK4_STEPS, MAX_RUN_WORK, NoHooks, Observation, Prepared, ReferenceFactory, Run, RunFailure,
-    RunNoise, Simulation, check_loop_work,
+    MAX_RK4_STEPS, MAX_RUN_WORK, MIN_JOINT_TORQUE_LIMIT_NM, NoHooks, Observation, Prepared,
+    ReferenceFactory, Run, RunFailure, RunNoise, Simulation, check_joint_torque_limit,
+    check_loop_work,
 };

@@ -1022,6 +1022,28 @@ pub fn check_loop_work(n_links: usize, m: usize) -> Result<(), SimError> {
     Ok(())
 }
 
+/// The smallest joint-torque limit (N m) a loop enforces: the projection onto the limits and
+/// the checks of the torques it realises resolve torques to about `1e-10` N m (a limit of
+/// `1e-10` was exceeded 2.5 times over, silently), so limits are refused below a margin of that.
+pub const MIN_JOINT_TORQUE_LIMIT_NM: f64 = 1e-6;
+
+/// Refuses a joint-torque limit that is not positive and finite, or below
+/// [`MIN_JOINT_TORQUE_LIMIT_NM`], naming `limits.joint_torque_nm`.
+pub fn check_joint_torque_limit(limit: f64) -> Result<(), SimError> {
+    check_positive("limits.joint_torque_nm", limit)?;
+    if limit < MIN_JOINT_TORQUE_LIMIT_NM {
+        return Err(SimError::setting(
+            "limits.joint_torque_nm",
+            format!(
+                "must be at least {} N m (the loop resolves joint torques no finer), got {}",
+                Compact(MIN_JOINT_TORQUE_LIMIT_NM),
+                Compact(limit)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The largest magnitude of a modal coordinate or its reference a run resolves (rad): at `1e6`
 /// double precision still keeps `1e-10` rad, at `1e20` every step of a run rounds away. A run
 /// reaching beyond stops ([`SimError::OutOfScale`]).
@@ -1093,7 +1115,7 @@ fn sample_counts(s: &LoopSettings) -> (usize, usize) {
 }
 
 /// Checks the noise of the settings of a loop of `m` coordinates: `m` reference and `2m` sensor
-/// standard deviations (or none), non-negative and finite.
+/// standard deviations (or none), non-negative and at most [`MAX_MODAL_MAGNITUDE`].
 fn validate_noise(s: &LoopSettings, m: usize) -> Result<(), SimError> {
     for (name, values, len) in [
         ("noise.reference_std", &s.reference_noise_std, m),
@@ -1110,6 +1132,17 @@ fn validate_noise(s: &LoopSettings, m: usize) -> Result<(), SimError> {
         }
         for &v in values {
             check_non_negative(name, v)?;
+            // Noise of the scale a run resolves at most (`1e308` overflowed in the controller).
+            if v > MAX_MODAL_MAGNITUDE {
+                return Err(SimError::setting(
+                    name,
+                    format!(
+                        "must be at most {} (rad, rad/s), got {}",
+                        Compact(MAX_MODAL_MAGNITUDE),
+                        Compact(v)
+                    ),
+                ));
+            }
         }
     }
     Ok(())
@@ -1298,7 +1331,7 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
             ));
         }
         for &l in limits {
-            check_positive("limits.joint_torque_nm", l)?;
+            check_joint_torque_limit(l)?;
         }
     }
     if let Some(limits) = &s.joint_angle_limits {

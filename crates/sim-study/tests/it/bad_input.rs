@@ -196,6 +196,18 @@ fn noise_negative_or_non_finite() {
         ..settings()
     };
     assert_eq!(invalid(build(s)).0, "noise.sensor_std");
+    // Finite but beyond what a run resolves: it overflowed in the controller, unnamed.
+    let s = LoopSettings {
+        reference_noise_std: vec![1e308, 0.02],
+        ..settings()
+    };
+    assert_eq!(
+        invalid(build(s)),
+        (
+            "noise.reference_std".to_string(),
+            "noise.reference_std must be at most 1000000 (rad, rad/s), got 1e308".to_string()
+        )
+    );
 }
 
 #[test]
@@ -396,6 +408,34 @@ fn non_finite_initial_state() {
         }),
     );
     assert_eq!(invalid(result).0, "initial.a");
+}
+
+/// A joint-torque limit finer than the loop resolves (`1e-10` N m was exceeded 2.5 times over,
+/// silently) is refused, for the modal loop and the deployment MPC's box alike.
+#[test]
+fn joint_torque_limits_below_the_resolution_are_refused() {
+    for (name, extra) in [
+        ("paper-tracking", "\n[limits]\njoint_torque_nm = 1e-10\n"),
+        ("pipe-deploy", "\n[limits]\njoint_torque_nm = 1e-300\n"),
+    ] {
+        let text = format!(
+            "{}{extra}",
+            sim_study::Scenario::builtin_text(name).unwrap()
+        );
+        let mut scenario = sim_study::Scenario::from_toml(&text).unwrap();
+        if name == "pipe-deploy" {
+            scenario.controller.kind = sim_study::ControllerKind::Mpc;
+        }
+        let message = if scenario.deploy.is_some() {
+            scenario.run_deploy().err().unwrap().to_string()
+        } else {
+            scenario.build().err().unwrap().to_string()
+        };
+        assert!(
+            message.starts_with("limits.joint_torque_nm must be at least 1e-6 N m"),
+            "{name}: {message}"
+        );
+    }
 }
 
 /// A state (or reference) of `1e20` rad: every step rounds away and the run would report a
