@@ -28,7 +28,7 @@ pub use generator::{
     MAX_PASSAGE_OBSTACLES, NarrowPassage, PassageSpec, narrow_passage, spatial_narrow_passage,
 };
 pub use motion::{SegmentCheck, check_segment};
-pub use options::{MAX_CHECKS, MAX_ITERATIONS, MAX_SAMPLES, PlanOptions};
+pub use options::{MAX_CHECKS, MAX_ITERATIONS, MAX_LENGTH_M, MAX_SAMPLES, PlanOptions};
 pub use planar::PlanarArm;
 pub use planner::{MAX_PLAN_WORK, Plan, Planner};
 pub use shape::{ShapeOutcome, solve_shape};

@@ -7,6 +7,8 @@ use lane_math::check_finite;
 pub const MAX_ITERATIONS: usize = 100_000;
 /// The most random samples (starts and via points) [`PlanOptions`] accepts.
 pub const MAX_SAMPLES: usize = 100_000;
+/// The largest clearance, check slack and tip tolerance [`PlanOptions`] accepts (m).
+pub const MAX_LENGTH_M: f64 = 1e6;
 /// The most check points of one path segment [`PlanOptions`] accepts.
 pub const MAX_CHECKS: usize = 10_000_000;
 
@@ -79,6 +81,20 @@ impl PlanOptions {
                 return Err(PlanError::OutOfRange {
                     name,
                     bound: "positive",
+                    value,
+                });
+            }
+        }
+        // Lengths beyond any workspace (a slack of 1e300 m read as a clearance never met).
+        for (name, value) in [
+            ("clearance", self.clearance),
+            ("check slack", self.check_slack),
+            ("tip tolerance", self.tip_tolerance),
+        ] {
+            if value > MAX_LENGTH_M {
+                return Err(PlanError::OutOfRange {
+                    name,
+                    bound: "at most 1e6 m",
                     value,
                 });
             }

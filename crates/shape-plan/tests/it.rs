@@ -348,6 +348,13 @@ fn refusals_name_the_problem() {
         ),
         (
             PlanOptions {
+                check_slack: 1e300,
+                ..options()
+            },
+            "check slack must be at most 1e6 m, got 1e300",
+        ),
+        (
+            PlanOptions {
                 max_iterations: 0,
                 ..options()
             },

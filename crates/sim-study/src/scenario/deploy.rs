@@ -242,6 +242,20 @@ impl Scenario {
             .into());
         };
         let period = self.controller.period.unwrap_or(dt);
+        // A deployment faster than one controller period is one jump: its accelerations
+        // overflow (1e-300 s gave a NaN joint acceleration at t = 0).
+        if travel_time < period {
+            return Err(SimError::setting(
+                "reference.travel_time",
+                format!(
+                    "= {} s is shorter than one controller period ({} s): the deployment would \
+                     be a single jump",
+                    lane_math::Compact(travel_time),
+                    lane_math::Compact(period)
+                ),
+            )
+            .into());
+        }
         let record_period = self.record_period.unwrap_or(period);
         if !(record_period > 0.0 && self.duration > 0.0)
             || self.duration / record_period > MAX_DEPLOY_RECORDED_SAMPLES as f64

@@ -287,6 +287,17 @@ fn deployment_keys_are_refused_by_name() {
         "{}",
         message(&repeated)
     );
+    // A deployment faster than one controller period (its accelerations overflowed to NaN).
+    let text = base
+        .to_toml()
+        .replace("travel_time = 4.0", "travel_time = 1e-300");
+    let fast = Scenario::from_toml(&text).unwrap();
+    assert!(
+        message(&fast)
+            .starts_with("reference.travel_time = 1e-300 s is shorter than one controller period"),
+        "{}",
+        message(&fast)
+    );
     let mut many = base.clone();
     many.deploy.as_mut().unwrap().centerline = vec![vec![0.0, 0.0]; 20_000];
     assert!(
