@@ -458,8 +458,11 @@ fn set_joint_torque_box(
             ));
         }
     };
-    for &l in given {
-        sim_core::check_joint_torque_limit(l)?;
+    if let Some(l) = given.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
+        return Err(SimError::setting(
+            FIELD,
+            format!("must be positive and finite (N m), got {l}"),
+        ));
     }
     let Some(box_limits) = settings.tau_star_limits.as_mut() else {
         return Err(SimError::setting(FIELD, "has no box to set"));
