@@ -1029,7 +1029,7 @@ pub const MIN_JOINT_TORQUE_LIMIT_NM: f64 = 1e-6;
 
 /// Refuses a joint-torque limit that is not positive and finite, or below
 /// [`MIN_JOINT_TORQUE_LIMIT_NM`], naming `limits.joint_torque_nm`.
-pub fn check_joint_torque_limit(limit: f64) -> Result<(), SimError> {
+fn check_joint_torque_limit(limit: f64) -> Result<(), SimError> {
     check_positive("limits.joint_torque_nm", limit)?;
     if limit < MIN_JOINT_TORQUE_LIMIT_NM {
         return Err(SimError::setting(

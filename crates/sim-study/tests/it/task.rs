@@ -111,9 +111,15 @@ fn tasks_and_planned_references_come_together_and_name_their_fields() {
         "{e}"
     );
     // A clearance the start (a = 0, no [initial]) cannot keep names the clearance.
-    let e = with(&|s| set(s, vec![0.35, 0.55], 1e300));
+    let e = with(&|s| set(s, vec![0.35, 0.55], 10.0));
     assert!(
         e.starts_with("task.clearance cannot be met from the arm's start (a = 0, no [initial])"),
+        "{e}"
+    );
+    // One beyond any workspace is refused as such.
+    let e = with(&|s| set(s, vec![0.35, 0.55], 1e300));
+    assert!(
+        e.starts_with("task.clearance cannot be met: clearance must be at most 1e6 m, got 1e300"),
         "{e}"
     );
     // The planner keeps clearance, not joint angles: a plan beyond limits.joint_angle_rad is
