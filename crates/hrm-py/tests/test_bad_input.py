@@ -234,6 +234,10 @@ INTERRUPT = textwrap.dedent("""
     import numpy as np
     import hrm
 
+    # Python leaves SIGINT ignored when it starts ignored (a job started in the background by
+    # a shell without job control): the test is of hrm's response to Ctrl-C, so it restores it.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+
     def interrupted_after(call):
         timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
         start = time.monotonic()
