@@ -1069,7 +1069,7 @@ fn check_run_work(s: &LoopSettings, n_joints: usize, m: usize) -> Result<(), Sim
         Integrator::DormandPrince(tol) => 7.0 * (s.duration / tol.h_max).ceil(),
     };
     let per_evaluation = (n_joints as f64) * (m as f64).powi(2).max(1.0);
-    let samples = (s.duration / s.controller_period).round();
+    let samples = sample_counts(s).0 as f64;
     let pairs = s.clearance.as_ref().map_or(0, |c| c.pairs().len()) as f64;
     let work = evaluations * per_evaluation + samples * pairs * CLEARANCE_PAIR_WORK;
     if work > MAX_RUN_WORK {

@@ -81,6 +81,11 @@ pub(crate) fn sin_cos_dispatched(arch: Arch, angle: &[f64], sin: &mut [f64], cos
 /// Placements, then poses `oM_i = oM_{i-1} * {i-1}M_i`, base first.
 pub(crate) fn update_poses(model: &SpatialModel, data: &mut SpatialData, q: &[f64]) {
     update_placements(model, data, q);
+    compose_poses(data);
+}
+
+/// Poses from the placements, base first: `oM_i = oM_{i-1} * {i-1}M_i`.
+fn compose_poses(data: &mut SpatialData) {
     let mut parent = Transform::IDENTITY;
     for (pose, placement) in data.poses.iter_mut().zip(&data.placements) {
         parent = parent.compose(placement);
@@ -114,14 +119,9 @@ pub(crate) fn update_poses_about_first_joint(
     data: &mut SpatialData,
     q: &[f64],
 ) {
-    sin_cos_dispatched(data.arch, q, &mut data.sin, &mut data.cos);
-    let mut parent = Transform::IDENTITY;
-    for i in 0..model.n_links() {
-        let placement = placement_about_first_joint(model, data, q, i);
-        data.placements[i] = placement;
-        parent = parent.compose(&placement);
-        data.poses[i] = parent;
-    }
+    update_placements(model, data, q);
+    data.placements[0] = placement_about_first_joint(model, data, q, 0);
+    compose_poses(data);
 }
 
 /// Forward kinematics at the joint values `q`: every link's pose in the base frame, read with
