@@ -129,10 +129,9 @@ impl<A: Arm> Planner<A> {
         let mut goal_point = [0.0; 3];
         goal_point[..target.len()].copy_from_slice(target);
         let base = arm.base();
-        let distance = (0..3)
-            .map(|d| (goal_point[d] - base[d]).powi(2))
-            .sum::<f64>()
-            .sqrt();
+        // `hypot` keeps a target far beyond the arm (1e300 m) finite in the message.
+        let offset: [f64; 3] = std::array::from_fn(|d| goal_point[d] - base[d]);
+        let distance = offset[0].hypot(offset[1]).hypot(offset[2]);
         // A target at the arm's length is the straight arm's tip, whatever the rounding of the
         // sum of its links.
         if distance > arm.length() * (1.0 + 4.0 * f64::EPSILON) {

@@ -278,6 +278,14 @@ fn refusals_name_the_problem() {
         matches!(far, PlanError::OutOfReach { .. }) && far.is_unreachable(),
         "{far}"
     );
+    // A target whose squared distance overflows is still that far in the message.
+    let very_far = p.plan(&[0.0; 4], &[1e300, -1e300]).unwrap_err();
+    assert!(
+        very_far
+            .to_string()
+            .starts_with("target is 1.4142135623730952e300 m from the base"),
+        "{very_far}"
+    );
     // The straight arm's own tip, at the arm's length (its links' sum rounds below it): in
     // reach, and the start is already there.
     let length: f64 = lengths().iter().sum();

@@ -483,6 +483,7 @@ impl Simulation {
     ) -> Result<Self, SimError> {
         let plant = model.plant();
         let (m, n) = (plant.n_coords(), plant.n_joints());
+        check_run_work(&settings, n, m, controller.work(settings.duration, n))?;
         let tips = Tips::new(&model)?;
         let mut limits = LimitProjection::new(
             plant,
@@ -1061,9 +1062,14 @@ const CLEARANCE_PAIR_WORK: f64 = 64.0;
 
 /// Refuses a run whose estimated work exceeds [`MAX_RUN_WORK`]: the evaluations of the reduced
 /// dynamics (four an RK4 step, at least seven a Dormand-Prince step of `h_max`) times their
-/// `n m^2`, and the clearance pairs measured at every controller sample. The controller's own
-/// work (an MPC's solves) is not counted.
-fn check_run_work(s: &LoopSettings, n_joints: usize, m: usize) -> Result<(), SimError> {
+/// `n m^2`, the clearance pairs measured at every controller sample, and the controller's own
+/// `controller_work` ([`Controller::work`]: an MPC's solves; 0 before the controller is built).
+fn check_run_work(
+    s: &LoopSettings,
+    n_joints: usize,
+    m: usize,
+    controller_work: f64,
+) -> Result<(), SimError> {
     let evaluations = match s.integrator {
         Integrator::Rk4 { dt } => 4.0 * (s.duration / dt).ceil(),
         Integrator::DormandPrince(tol) => 7.0 * (s.duration / tol.h_max).ceil(),
@@ -1071,17 +1077,30 @@ fn check_run_work(s: &LoopSettings, n_joints: usize, m: usize) -> Result<(), Sim
     let per_evaluation = (n_joints as f64) * (m as f64).powi(2).max(1.0);
     let samples = sample_counts(s).0 as f64;
     let pairs = s.clearance.as_ref().map_or(0, |c| c.pairs().len()) as f64;
-    let work = evaluations * per_evaluation + samples * pairs * CLEARANCE_PAIR_WORK;
+    let work =
+        evaluations * per_evaluation + samples * pairs * CLEARANCE_PAIR_WORK + controller_work;
     if work > MAX_RUN_WORK {
+        let mut parts = format!(
+            "{evaluations:.2e} evaluations of the reduced dynamics of {per_evaluation:.2e} each"
+        );
+        if pairs > 0.0 {
+            parts += &format!(", {samples:.2e} clearance measures of {pairs} pairs");
+        }
+        if controller_work > 0.0 {
+            parts += &format!(", {controller_work:.2e} of the controller's own");
+        }
         return Err(SimError::setting(
             "duration",
             format!(
-                "= {} s would take an estimated {work:.2e} operations ({evaluations:.2e} \
-                 evaluations of the reduced dynamics of {per_evaluation:.2e} each, {samples:.2e} \
-                 clearance measures of {pairs} pairs), more than the {MAX_RUN_WORK:e} a run may \
-                 take (about ten minutes): simulate less, or use fewer links, harmonics or \
-                 obstacles",
-                Compact(s.duration)
+                "= {} s would take an estimated {work:.2e} operations ({parts}), more than the \
+                 {MAX_RUN_WORK:e} a run may take (about ten minutes): simulate less, or use \
+                 fewer links, harmonics or obstacles{}",
+                Compact(s.duration),
+                if controller_work > 0.0 {
+                    ", or a shorter MPC horizon or fewer iterations"
+                } else {
+                    ""
+                }
             ),
         ));
     }
@@ -1264,9 +1283,9 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
                 ));
             }
         }
-        Integrator::DormandPrince(tol) => tol
-            .check()
-            .map_err(|reason| SimError::setting("integrator", format!("setting: {reason}")))?,
+        Integrator::DormandPrince(tol) => tol.check().map_err(|(name, requirement)| {
+            SimError::setting(format!("integrator.{name}"), requirement)
+        })?,
     }
     validate_noise(s, m)?;
     if s.max_modal_error.is_nan() || s.max_modal_error <= 0.0 {
@@ -1359,7 +1378,7 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
             ),
         ));
     }
-    check_run_work(s, n_joints, m)?;
+    check_run_work(s, n_joints, m, 0.0)?;
     if let Some(limits) = &s.tau_star_limits {
         if limits.len() != m {
             return Err(SimError::setting(

@@ -137,6 +137,16 @@ pub trait Controller: Send {
     fn n_coords(&self) -> Option<usize> {
         None
     }
+
+    /// An estimate of the controller's own work over `duration` seconds of a run of an arm of
+    /// `n_joints` joints, in the units of [`MAX_RUN_WORK`](crate::MAX_RUN_WORK) (multiply-adds
+    /// of the reduced dynamics): [`Simulation::new`](crate::Simulation::new) counts it in the
+    /// run's work bound. The default, 0, suits a law of a few operations a sample (its cost is
+    /// within the loop's own); a controller that plans (an MPC) counts its solves.
+    fn work(&self, duration: f64, n_joints: usize) -> f64 {
+        let _ = (duration, n_joints);
+        0.0
+    }
 }
 
 /// Checks that `ctx` has the `m` coordinates a controller was built for, and that `tau_star`

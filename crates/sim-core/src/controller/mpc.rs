@@ -219,4 +219,14 @@ impl Controller for MpcController {
     fn n_coords(&self) -> Option<usize> {
         Some(self.mpc.n_coords())
     }
+
+    /// A solve every model step (and one at the start), each at most
+    /// [`Mpc::solve_work`](optimal_ctl::Mpc::solve_work) with the constraints' rows.
+    fn work(&self, duration: f64, n_joints: usize) -> f64 {
+        let rows = self
+            .constraints
+            .as_ref()
+            .map_or(0, MpcConstraints::max_rows);
+        ((duration / self.mpc.step()).ceil() + 1.0) * self.mpc.solve_work(n_joints, rows)
+    }
 }

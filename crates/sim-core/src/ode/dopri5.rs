@@ -81,27 +81,38 @@ impl Default for Tolerances {
     }
 }
 
+/// The smallest relative tolerance, 100 machine epsilons (SciPy's floor for `solve_ivp`): a
+/// tighter one asks for digits the arithmetic does not carry, and the step size would fall to
+/// its minimum instead.
+pub const MIN_RTOL: f64 = 100.0 * f64::EPSILON;
+
 impl Tolerances {
-    /// The condition the settings fail, if any (checked by every
+    /// The setting that fails and the condition it fails, if any (checked by every
     /// [`DormandPrince::integrate`] call and when a simulation is built).
-    pub(crate) fn check(&self) -> Result<(), &'static str> {
+    pub(crate) fn check(&self) -> Result<(), (&'static str, &'static str)> {
         let positive = |v: f64| v.is_finite() && v > 0.0;
-        if !(positive(self.rtol) && positive(self.atol)) {
-            return Err("rtol and atol must be positive and finite");
+        if !(positive(self.rtol) && self.rtol >= MIN_RTOL) {
+            return Err((
+                "rtol",
+                "must be finite and at least 2.2e-14 (100 machine epsilons)",
+            ));
+        }
+        if !positive(self.atol) {
+            return Err(("atol", "must be positive and finite"));
         }
         if !(self.h_min >= 0.0 && self.h_min.is_finite()) {
-            return Err("h_min must be non-negative and finite");
+            return Err(("h_min", "must be non-negative and finite"));
         }
         if !(self.h_max > 0.0 && self.h_max >= self.h_min) {
-            return Err("h_max must be positive and at least h_min");
+            return Err(("h_max", "must be positive and at least h_min"));
         }
         if let Some(h) = self.h_init
             && !positive(h)
         {
-            return Err("h_init must be positive and finite");
+            return Err(("h_init", "must be positive and finite"));
         }
         if self.max_steps == 0 {
-            return Err("max_steps must be at least 1");
+            return Err(("max_steps", "must be at least 1"));
         }
         Ok(())
     }
@@ -186,7 +197,9 @@ impl DormandPrince {
         y: &mut [f64],
     ) -> Result<Stats, OdeError<S::Error>> {
         check_call(self.dim(), y, t0, t1)?;
-        self.tolerances.check().map_err(OdeError::InvalidSetting)?;
+        self.tolerances
+            .check()
+            .map_err(|(name, requirement)| OdeError::InvalidTolerance { name, requirement })?;
         let tol = self.tolerances;
         let mut stats = Stats::default();
         if t1 == t0 {

@@ -14,7 +14,7 @@
 mod dopri5;
 mod rk4;
 
-pub use dopri5::{DormandPrince, Tolerances};
+pub use dopri5::{DormandPrince, MIN_RTOL, Tolerances};
 pub use rk4::Rk4;
 
 use lane_math::{Classify, Compact, ErrorClass};
@@ -88,9 +88,17 @@ pub enum OdeError<E> {
         /// The state's length.
         found: usize,
     },
-    /// The interval, step size or tolerances were not usable.
+    /// The interval or step size was not usable.
     #[error("invalid integration setting: {0}")]
     InvalidSetting(&'static str),
+    /// A setting of [`Tolerances`] was not usable.
+    #[error("invalid integration setting: {name} {requirement}")]
+    InvalidTolerance {
+        /// The setting's field (`rtol`, `atol`, ...).
+        name: &'static str,
+        /// What it must be.
+        requirement: &'static str,
+    },
 }
 
 impl<E: Classify> Classify for OdeError<E> {
@@ -104,7 +112,9 @@ impl<E: Classify> Classify for OdeError<E> {
             Self::NonFinite { .. } | Self::StepTooSmall { .. } | Self::MaxSteps { .. } => {
                 ErrorClass::Numerical
             }
-            Self::Dimension { .. } | Self::InvalidSetting(_) => ErrorClass::InvalidInput,
+            Self::Dimension { .. } | Self::InvalidSetting(_) | Self::InvalidTolerance { .. } => {
+                ErrorClass::InvalidInput
+            }
         }
     }
 }

@@ -7,12 +7,36 @@ use super::{Reference, ReferenceSample};
 use crate::error::{SimError, check_positive};
 use backbone_kin::vec3::{cross, dot, sub};
 use backbone_kin::{BasePose, Branch, KinError, SpatialIk, SpatialModalMap, inverse_kinematics};
-use lane_math::check_all_finite;
+use lane_math::{Compact, check_all_finite};
 
 /// Intervals of the continuation's time grid.
 const GRID_INTERVALS: usize = 2000;
 /// `J J^T` counts as singular below this ratio of its determinant to the cube of its trace.
 const SINGULAR_RATIO: f64 = 1e-12;
+
+/// The largest magnitude of a helix's coordinates and pitch (m): a path a million metres out is
+/// already beyond any arm, and the helix's arithmetic stays far from overflow.
+pub const MAX_HELIX_EXTENT_M: f64 = 1e6;
+
+/// Refuses a value that is not finite or beyond [`MAX_HELIX_EXTENT_M`], naming `name[k]`.
+fn check_extent(name: &str, values: &[f64]) -> Result<(), SimError> {
+    check_all_finite(name, values)?;
+    match values.iter().position(|x| x.abs() > MAX_HELIX_EXTENT_M) {
+        Some(k) => Err(SimError::setting(
+            if values.len() == 1 {
+                name.to_string()
+            } else {
+                format!("{name}[{k}]")
+            },
+            format!(
+                "must be at most {} m in magnitude, got {}",
+                Compact(MAX_HELIX_EXTENT_M),
+                Compact(values[k])
+            ),
+        )),
+        None => Ok(()),
+    }
+}
 
 /// A helix in space: from `start`, turning right-handedly about the line through `center` along
 /// `axis` for `turns` turns and rising `pitch` metres per turn along `axis`; `pitch = 0` is a
@@ -44,10 +68,10 @@ struct HelixFrame {
 
 impl Helix {
     fn frame(&self) -> Result<HelixFrame, SimError> {
-        check_all_finite("reference.helix.center", &self.center)?;
+        check_extent("reference.helix.center", &self.center)?;
         check_all_finite("reference.helix.axis", &self.axis)?;
-        check_all_finite("reference.helix.start", &self.start)?;
-        check_all_finite("reference.helix.pitch", &[self.pitch])?;
+        check_extent("reference.helix.start", &self.start)?;
+        check_extent("reference.helix.pitch", &[self.pitch])?;
         check_positive("reference.helix.turns", self.turns)?;
         if self.turns > 1e3 {
             return Err(SimError::setting(
@@ -55,14 +79,18 @@ impl Helix {
                 format!("must be at most 1000, got {}", self.turns),
             ));
         }
-        let norm = dot(self.axis, self.axis).sqrt();
-        if !(norm > 0.0 && norm.is_finite()) {
+        // Scaled by its largest component first, any finite non-zero axis has a unit direction
+        // (`[1e308, 1e308, 0]` as well as `[1e-310, 0, 0]`).
+        let largest = self.axis.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+        if largest == 0.0 {
             return Err(SimError::setting(
                 "reference.helix.axis",
                 "must be a non-zero direction",
             ));
         }
-        let w = self.axis.map(|x| x / norm);
+        let scaled = self.axis.map(|x| x / largest);
+        let norm = dot(scaled, scaled).sqrt();
+        let w = scaled.map(|x| x / norm);
         let offset = sub(self.start, self.center);
         let along = dot(offset, w);
         let u: [f64; 3] = std::array::from_fn(|d| offset[d] - along * w[d]);

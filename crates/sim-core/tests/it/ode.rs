@@ -373,7 +373,7 @@ fn bad_calls_are_refused() {
         let err = DormandPrince::new(2, tol)
             .integrate(&mut osc, 0.0, 1.0, &mut y)
             .unwrap_err();
-        assert!(matches!(err, OdeError::InvalidSetting(_)), "{tol:?}");
+        assert!(matches!(err, OdeError::InvalidTolerance { .. }), "{tol:?}");
     }
     // An empty interval is no work, not an error.
     let stats = dp5.integrate(&mut osc, 2.0, 2.0, &mut y).unwrap();

@@ -2,9 +2,17 @@
 //! kind and joint layout, the base pose, gravity (a magnitude or a vector) and the link inertias
 //! (one number per link or a principal triple per link).
 
+use lane_math::Compact;
 use serde::de::{Error, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use sim_core::SimError;
 use std::fmt;
+
+/// The largest gravity a scenario takes, in magnitude or in any component of the vector
+/// (m/s^2, about 100,000 g): beyond it the paper's arm under a bounded controller accelerates out
+/// of double precision within a step, and the run would stop on a non-finite `a_ddot` instead of
+/// naming `arm.gravity`.
+pub const MAX_GRAVITY: f64 = 1e6;
 
 /// Which modal arm a scenario runs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -73,6 +81,30 @@ impl Gravity {
         match self {
             Gravity::Magnitude(g) => [0.0, 0.0, -g],
             Gravity::Vector(v) => v,
+        }
+    }
+
+    /// Refuses a magnitude or a component that is not finite or beyond [`MAX_GRAVITY`], naming
+    /// `arm.gravity` (or `arm.gravity[k]`).
+    pub fn check(self) -> Result<(), SimError> {
+        let bad = |name: String, value: f64| {
+            SimError::setting(
+                name,
+                format!(
+                    "must be finite and at most {} m/s^2 in magnitude, got {}",
+                    Compact(MAX_GRAVITY),
+                    Compact(value)
+                ),
+            )
+        };
+        let within = |x: f64| x.abs() <= MAX_GRAVITY;
+        match self {
+            Gravity::Magnitude(g) if !within(g) => Err(bad("arm.gravity".into(), g)),
+            Gravity::Vector(v) => match v.iter().position(|&x| !within(x)) {
+                Some(k) => Err(bad(format!("arm.gravity[{k}]"), v[k])),
+                None => Ok(()),
+            },
+            Gravity::Magnitude(_) => Ok(()),
         }
     }
 }

@@ -121,7 +121,9 @@ impl Scenario {
                 path.display()
             )));
         }
-        let gravity = gravity.map_or([0.0, 0.0, -9.81], Gravity::spatial);
+        let gravity = gravity.unwrap_or(Gravity::Magnitude(9.81));
+        gravity.check()?;
+        let gravity = gravity.spatial();
         robot_desc::to_spatial(&robot, gravity)
             .map(Some)
             .map_err(|e| invalid(format!("({}): {e}", path.display())))

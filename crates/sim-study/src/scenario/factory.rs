@@ -307,7 +307,10 @@ impl ArmSpec {
         }
         let gravity = match self.gravity {
             None => 9.81,
-            Some(Gravity::Magnitude(g)) => g,
+            Some(gravity @ Gravity::Magnitude(g)) => {
+                gravity.check()?;
+                g
+            }
             Some(Gravity::Vector(_)) => {
                 return Err(SimError::setting(
                     "arm.gravity",

@@ -97,7 +97,7 @@ mod schema;
 mod spatial;
 mod task;
 
-pub use arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout};
+pub use arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout, MAX_GRAVITY};
 pub use controllers::{
     CONTROLLERS, ControllerEntry, ControllerKind, ControllerSetup, ControllerSpec, FuzzyInputRange,
 };

@@ -173,8 +173,9 @@ impl ArmSpec {
         check_all_finite("arm.base.rpy", &base.rpy)?;
         base.validate()
             .map_err(|e| SimError::setting("arm.base.xyz", format!("is invalid: {e}")))?;
-        let gravity = self.gravity.map_or(DEFAULT_GRAVITY, Gravity::spatial);
-        check_all_finite("arm.gravity", &gravity)?;
+        let gravity = self.gravity.unwrap_or(Gravity::Vector(DEFAULT_GRAVITY));
+        gravity.check()?;
+        let gravity = gravity.spatial();
         let map = SpatialModalMap::new(&lengths, k)
             .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))?;
         // Lengths and masses are checked above: a link the model refuses has a bad inertia,

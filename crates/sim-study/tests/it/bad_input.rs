@@ -7,12 +7,13 @@ use lane_math::Classify;
 use manip_dyn::ChainModel;
 use modal_reduce::ReducedModel;
 use sim_core::controller::{ComputedTorque, FuzzyController, PdController};
-use sim_core::ode::{DormandPrince, OdeError, OdeSystem, Rk4, Tolerances};
+use sim_core::ode::{DormandPrince, MIN_RTOL, OdeError, OdeSystem, Rk4, Tolerances};
 use sim_core::reference::{CartesianPath, PathShape, Sinusoid, Step};
 use sim_core::{
     Integrator, LoopSettings, MAX_CONTROLLER_SAMPLES, MAX_MODAL_MAGNITUDE, MAX_RECORDED_VALUES,
     MAX_RK4_STEPS, MAX_RUN_WORK, SimError, Simulation,
 };
+use sim_study::MAX_GRAVITY;
 use std::f64::consts::FRAC_PI_2;
 
 fn paper_model() -> ReducedModel {
@@ -146,41 +147,149 @@ fn rk4_step_not_positive_or_not_dividing_the_period() {
 fn dormand_prince_tolerances_out_of_domain() {
     let base = Tolerances::default();
     let bad = [
-        Tolerances { rtol: 0.0, ..base },
-        Tolerances {
-            atol: f64::NAN,
-            ..base
-        },
-        Tolerances { h_max: 0.0, ..base },
-        Tolerances {
-            h_min: -1.0,
-            ..base
-        },
-        Tolerances {
-            h_init: Some(-1e-3),
-            ..base
-        },
-        Tolerances {
-            max_steps: 0,
-            ..base
-        },
+        ("rtol", Tolerances { rtol: 0.0, ..base }),
+        // Below 100 machine epsilons the step size would fall to its minimum at t = 0.
+        (
+            "rtol",
+            Tolerances {
+                rtol: 1e-320,
+                atol: 1e-320,
+                ..base
+            },
+        ),
+        (
+            "rtol",
+            Tolerances {
+                rtol: 1e-15,
+                ..base
+            },
+        ),
+        (
+            "atol",
+            Tolerances {
+                atol: f64::NAN,
+                ..base
+            },
+        ),
+        ("h_max", Tolerances { h_max: 0.0, ..base }),
+        (
+            "h_min",
+            Tolerances {
+                h_min: -1.0,
+                ..base
+            },
+        ),
+        (
+            "h_init",
+            Tolerances {
+                h_init: Some(-1e-3),
+                ..base
+            },
+        ),
+        (
+            "max_steps",
+            Tolerances {
+                max_steps: 0,
+                ..base
+            },
+        ),
     ];
-    for tolerances in bad {
-        // Refused when the simulation is built, not at the first step of a run...
+    for (field, tolerances) in bad {
+        // Refused when the simulation is built, naming the field, not at the first step of a
+        // run...
         let s = LoopSettings {
             integrator: Integrator::DormandPrince(tolerances),
             ..settings()
         };
         let (name, message) = invalid(build(s));
-        assert_eq!(name, "integrator", "{tolerances:?}");
-        assert!(message.starts_with("integrator setting: "), "{message}");
+        assert_eq!(name, format!("integrator.{field}"), "{tolerances:?}");
+        assert!(
+            message.starts_with(&format!("integrator.{field} must ")),
+            "{message}"
+        );
         // ...and by the integrator itself.
         let mut y = [1.0];
         let err = DormandPrince::new(1, tolerances)
             .integrate(&mut Decay, 0.0, 1.0, &mut y)
             .unwrap_err();
-        assert!(matches!(err, OdeError::InvalidSetting(_)), "{err:?}");
+        assert!(
+            matches!(err, OdeError::InvalidTolerance { name, .. } if name == field),
+            "{err:?}"
+        );
         assert_eq!(y, [1.0]);
+    }
+    // The tightest relative tolerance runs.
+    let s = LoopSettings {
+        integrator: Integrator::DormandPrince(Tolerances {
+            rtol: MIN_RTOL,
+            ..base
+        }),
+        ..settings()
+    };
+    assert!(build(s).is_ok());
+}
+
+/// Gravity beyond 1e6 m/s^2 (planar magnitude, spatial vector component) is refused naming
+/// `arm.gravity`: beyond it the run stopped on a non-finite `a_ddot` at t = 0.
+#[test]
+fn gravity_beyond_its_bound_is_named() {
+    let base = sim_study::Scenario::builtin_text("paper-responses-step").unwrap();
+    for (value, shown) in [("1e308", "1e308"), ("-2e6", "-2000000"), ("nan", "NaN")] {
+        let text = format!("{base}\n[arm]\ngravity = {value}\n");
+        let scenario = sim_study::Scenario::from_toml(&text).unwrap();
+        let (name, message) = invalid(scenario.build());
+        assert_eq!(name, "arm.gravity");
+        assert_eq!(
+            message,
+            format!(
+                "arm.gravity must be finite and at most 1000000 m/s^2 in magnitude, got {shown}"
+            )
+        );
+    }
+    let spatial = sim_study::Scenario::builtin_text("spatial-tracking").unwrap();
+    let text = spatial.replace(
+        "gravity = [0.0, 0.0, -9.81]",
+        "gravity = [0.0, 1e300, -9.81]",
+    );
+    assert_ne!(text, spatial);
+    let (name, _) = invalid(sim_study::Scenario::from_toml(&text).unwrap().build());
+    assert_eq!(name, "arm.gravity[1]");
+    // At the bound it runs.
+    let text = format!("{base}\n[arm]\ngravity = {MAX_GRAVITY:e}\n");
+    assert!(
+        sim_study::Scenario::from_toml(&text)
+            .unwrap()
+            .build()
+            .is_ok()
+    );
+}
+
+/// A helix's coordinates and pitch beyond 1e6 m are named (a pitch of 1e300 failed in the
+/// inverse kinematics' initial guess); an axis of any finite non-zero length is a direction.
+#[test]
+fn helix_out_of_scale() {
+    let spatial = sim_study::Scenario::builtin_text("spatial-tracking").unwrap();
+    let helix = "[reference.helix]\n";
+    assert!(spatial.contains(helix));
+    let with = |line: &str| {
+        let text = spatial.replace(helix, &format!("{helix}{line}\n"));
+        sim_study::Scenario::from_toml(&text).map(|s| s.build())
+    };
+    let (name, message) = invalid(with("pitch = 1e300").unwrap());
+    assert_eq!(name, "reference.helix.pitch");
+    assert_eq!(
+        message,
+        "reference.helix.pitch must be at most 1000000 m in magnitude, got 1e300"
+    );
+    let text = spatial.replace("center = [0.8, 0.0, 0.0]", "center = [0.8, -1e20, 0.0]");
+    assert_ne!(text, spatial);
+    let (name, _) = invalid(sim_study::Scenario::from_toml(&text).unwrap().build());
+    assert_eq!(name, "reference.helix.center[1]");
+    for axis in ["[1e308, 0.0, 0.0]", "[1e-310, 0.0, 0.0]"] {
+        let text = spatial.replace("axis = [1.0, 0.0, 0.0]", &format!("axis = {axis}"));
+        assert_ne!(text, spatial);
+        let built = sim_study::Scenario::from_toml(&text).unwrap().build();
+        assert!(built.is_ok(), "{axis}: {:?}", built.err());
     }
 }
 
@@ -310,6 +419,40 @@ fn a_run_whose_total_work_is_hours_is_refused() {
     // A tenth of it runs.
     let short =
         sim_study::Scenario::from_toml(&text.replace("duration = 2.0", "duration = 0.2")).unwrap();
+    assert!(short.build().is_ok());
+}
+
+/// An MPC's solves count in the run's work: 2,000 links with four harmonics a solve of an
+/// estimated 5.3e9 every 5 ms for 1 s (the dynamics of the run alone 5.1e9) is refused when the
+/// controller is built, naming the duration and the controller's share; a tenth of it runs.
+#[test]
+fn an_mpc_whose_solves_take_hours_is_refused() {
+    let base = sim_study::Scenario::builtin_text("paper-responses-step").unwrap();
+    let base = base
+        .replace("duration = 2.0", "duration = 1.0")
+        .replace("kind = \"fuzzy\"", "kind = \"mpc\"")
+        .replace(
+            "initial = [0.0, 0.0]",
+            "initial = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]",
+        )
+        .replace(
+            "target = [0.2, -0.2]",
+            "target = [0.2, -0.2, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]",
+        );
+    let text = format!(
+        "{base}\n[arm]\nlinks = 2000\nlink_length = 0.0005\nlink_mass = 0.0005\n\n[modal]\nharmonics = 4\n"
+    );
+    let scenario = sim_study::Scenario::from_toml(&text).unwrap();
+    let error = scenario.build().err().unwrap();
+    let message = error.to_string();
+    assert!(
+        message.starts_with("duration = 1 s would take an estimated 1.07e12 operations")
+            && message.contains("1.28e5 each, 1.07e12 of the controller's own)")
+            && message.contains(&format!("more than the {MAX_RUN_WORK:e} a run may take")),
+        "{message}"
+    );
+    let short =
+        sim_study::Scenario::from_toml(&text.replace("duration = 1.0", "duration = 0.1")).unwrap();
     assert!(short.build().is_ok());
 }
 
