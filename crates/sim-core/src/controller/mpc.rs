@@ -181,18 +181,44 @@ impl MpcController {
             self.mpc.set_limits(Some(limits))?;
         }
         let (a, a_dot) = (&ctx.measured.a, &ctx.measured.a_dot);
+        let constrained = self.constraints.is_some();
         match &mut self.constraints {
             None => {
-                self.mpc.solve(ctx.model, a, a_dot)?;
+                self.mpc
+                    .solve(ctx.model, a, a_dot)
+                    .map_err(|e| plan_failure(e, constrained))?;
             }
             Some(constraints) => {
                 let mut rows = constraints.bind(ctx.model);
-                let report = self.mpc.solve_constrained(ctx.model, a, a_dot, &mut rows)?;
+                let report = self
+                    .mpc
+                    .solve_constrained(ctx.model, a, a_dot, &mut rows)
+                    .map_err(|e| plan_failure(e, constrained))?;
                 self.relaxed += report.relaxed_nodes;
             }
         }
         self.plan_time = t;
         Ok(())
+    }
+}
+
+/// A solve's failure as the loop reports it: one whose every trajectory left double precision
+/// (the dynamics refused a state of the rollout) says that the plan diverged and, with rows,
+/// that they may admit no motion from the measured state (a clearance margin beyond the arm's
+/// clearance, say); any other failure as it is.
+fn plan_failure(error: OptimalError, constrained: bool) -> ControllerError {
+    match error {
+        OptimalError::Dynamics(_) => format!(
+            "the plan from the measured state diverged ({error}){}",
+            if constrained {
+                ": the limits and the clearance margin it keeps may admit no motion from this \
+                 state"
+            } else {
+                ""
+            }
+        )
+        .into(),
+        other => other.into(),
     }
 }
 

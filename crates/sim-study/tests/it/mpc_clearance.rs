@@ -108,6 +108,26 @@ fn the_mpc_clearance_margin_is_refused_out_of_its_domain_by_name() {
     assert!(e.to_string().starts_with("controller.clearance_m"), "{e}");
 }
 
+/// A margin the arm cannot keep (20 cm about `narrow-gap`'s planned motion between circles 3 cm
+/// from its path): the plans diverge, and the run stops saying so and pointing at the margin
+/// rather than at the non-finite dynamics alone.
+#[test]
+fn a_margin_no_motion_keeps_stops_the_run_naming_the_plan() {
+    let mut scenario = Scenario::builtin("narrow-gap").unwrap();
+    scenario.duration = 0.5;
+    scenario.controller.kind = ControllerKind::Mpc;
+    scenario.controller.clearance_m = Some(0.2);
+    let failure = scenario.build().unwrap().run().unwrap_err();
+    let message = failure.error.to_string();
+    assert!(
+        message.contains("the plan from the measured state diverged (reduced dynamics: ")
+            && message.ends_with(
+                "the limits and the clearance margin it keeps may admit no motion from this state"
+            ),
+        "{message}"
+    );
+}
+
 /// The paper's arm (`K = 2`) tracking a sinusoid from rest (its rates start 1-3 rad/s off the
 /// reference's) with a circle of `radius` at `center` out of its way, by MPC without a `tau*`
 /// box within a 1 cm margin, or in free space.
