@@ -57,6 +57,44 @@ impl LqrController {
     /// The default re-linearisation period (s).
     pub const DEFAULT_RELINEARISE_PERIOD: f64 = 0.01;
 
+    /// Checks the settings [`new`](Self::new) takes, naming the scenario key that fails: a
+    /// design frequency positive and at most `1e4` rad/s, a re-linearisation period positive and
+    /// at least the controller period (itself positive). A scenario checks them whichever
+    /// controller it runs, since a sweep may run this one on it.
+    ///
+    /// # Errors
+    /// [`SimError::InvalidSetting`] naming `controller.period`, `controller.lqr_frequency` or
+    /// `controller.lqr_relinearise`.
+    pub fn check_settings(
+        period: f64,
+        frequency: f64,
+        relinearise_period: f64,
+    ) -> Result<(), SimError> {
+        check_positive("controller.period", period)?;
+        check_positive("controller.lqr_frequency", frequency)?;
+        if frequency > MAX_FREQUENCY {
+            return Err(SimError::setting(
+                "controller.lqr_frequency",
+                format!(
+                    "must be at most {MAX_FREQUENCY:e} rad/s, got {}",
+                    Compact(frequency)
+                ),
+            ));
+        }
+        check_positive("controller.lqr_relinearise", relinearise_period)?;
+        if relinearise_period < period {
+            return Err(SimError::setting(
+                "controller.lqr_relinearise",
+                format!(
+                    "must be at least the controller period ({} s), got {} s",
+                    Compact(period),
+                    Compact(relinearise_period)
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// An LQR for `model`'s `m` coordinates sampled every `period` seconds, with design
     /// frequency `frequency` (rad/s, at most 1e4) and a new linearisation every
     /// `relinearise_period` seconds (at least `period`).
@@ -95,27 +133,7 @@ impl LqrController {
         let m = model.n_coords();
         check_coordinate_count("controller", m)?;
         check_positive("controller.period", period)?;
-        check_positive("controller.lqr_frequency", frequency)?;
-        if frequency > MAX_FREQUENCY {
-            return Err(SimError::setting(
-                "controller.lqr_frequency",
-                format!(
-                    "must be at most {MAX_FREQUENCY:e} rad/s, got {}",
-                    Compact(frequency)
-                ),
-            ));
-        }
-        check_positive("controller.lqr_relinearise", relinearise_period)?;
-        if relinearise_period < period {
-            return Err(SimError::setting(
-                "controller.lqr_relinearise",
-                format!(
-                    "must be at least the controller period ({} s), got {} s",
-                    Compact(period),
-                    Compact(relinearise_period)
-                ),
-            ));
-        }
+        Self::check_settings(period, frequency, relinearise_period)?;
         let mut data = PlantData::new(model);
         model
             .terms(&mut data, &vec![0.0; m], &vec![0.0; m])

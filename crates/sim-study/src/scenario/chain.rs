@@ -18,7 +18,8 @@ fn unused(name: &str, why: &str) -> SimError {
 
 impl Scenario {
     /// The first setting the joint-space loops (a URDF arm's and a deployment's) do not use,
-    /// as `(name, why)`: sensor noise, a clearance margin, and any limit but `limits.max_modal_error` (and
+    /// as `(name, why)`: sensor noise, a clearance margin, the modal controllers' keys (`fis`,
+    /// `out_of_range`, `pd_*`, `lqr_*`), and any limit but `limits.max_modal_error` (and
     /// `limits.joint_torque_nm` when `torque_box`: the deployment MPC's box).
     pub(super) fn unused_by_joint_space_loops(
         &self,
@@ -32,6 +33,26 @@ impl Scenario {
                 "controller.clearance_m",
                 "the joint-space loop keeps no clearance margin (a deployment's channel is \
                  followed by its plan)",
+            ));
+        }
+        // The modal controllers' own keys: the joint-space loop runs computed torque (`kp`,
+        // `kd` per joint) or MPC.
+        let c = &self.controller;
+        if let Some((name, _)) = [
+            ("controller.fis", c.fis.is_some()),
+            ("controller.out_of_range", c.out_of_range.is_some()),
+            ("controller.pd_kp", c.pd_kp.is_some()),
+            ("controller.pd_kd", c.pd_kd.is_some()),
+            ("controller.lqr_frequency", c.lqr_frequency.is_some()),
+            ("controller.lqr_relinearise", c.lqr_relinearise.is_some()),
+        ]
+        .into_iter()
+        .find(|(_, given)| *given)
+        {
+            return Some((
+                name,
+                "the joint-space loop runs computed torque (kp, kd per joint) or MPC, not the \
+                 modal controllers this key sets",
             ));
         }
         // The first limit given that the loop does not keep, by its own key.

@@ -151,13 +151,33 @@ impl ControllerSetup<'_> {
     }
 
     /// The controller of `spec.kind` for the model, prepared for any number of runs: checks
-    /// every per-coordinate gain array of `spec` (whichever controller uses it) to have `m`
-    /// entries, then calls the kind's constructor in [`CONTROLLERS`].
+    /// every per-coordinate gain array of `spec` to have `m` entries, the LQR's settings to be in
+    /// their domain and the `fis` file to be a fuzzy system (whichever controller uses them: a
+    /// sweep may run any on the scenario), then calls the kind's constructor in [`CONTROLLERS`].
     pub fn prepare(&self) -> Result<ControllerFactory, SimError> {
         let m = m(self);
         self.spec.computed_torque_gains(m)?;
         per_coordinate("controller.pd_kp", self.spec.pd_kp.as_deref(), m)?;
         per_coordinate("controller.pd_kd", self.spec.pd_kd.as_deref(), m)?;
+        if self.spec.lqr_frequency.is_some() || self.spec.lqr_relinearise.is_some() {
+            LqrController::check_settings(
+                self.period,
+                self.spec
+                    .lqr_frequency
+                    .unwrap_or(LqrController::DEFAULT_FREQUENCY),
+                self.spec
+                    .lqr_relinearise
+                    .unwrap_or(LqrController::DEFAULT_RELINEARISE_PERIOD),
+            )?;
+        }
+        // The fuzzy kinds read `fis` themselves; the others check it can be read and parsed.
+        let reads_fis = matches!(
+            self.spec.kind,
+            ControllerKind::Fuzzy | ControllerKind::Pd | ControllerKind::FuzzyGc
+        );
+        if self.spec.fis.is_some() && !reads_fis {
+            self.fuzzy_system()?;
+        }
         self.spec.kind.entry().prepare(self)
     }
 }

@@ -229,6 +229,42 @@ fn dormand_prince_tolerances_out_of_domain() {
     assert!(build(s).is_ok());
 }
 
+/// A scenario's controller keys are checked whichever controller runs (a sweep may run any on
+/// it): a computed-torque run refuses an LQR frequency out of its domain and a `fis` file that
+/// cannot be read, as the per-coordinate gains were.
+#[test]
+fn controller_keys_are_checked_whichever_controller_runs() {
+    let base = sim_study::Scenario::builtin_text("paper-responses-step").unwrap();
+    let base = base.replace("kind = \"fuzzy\"", "kind = \"computed-torque\"");
+    for (line, name, problem) in [
+        (
+            "lqr_frequency = -5.0",
+            "controller.lqr_frequency",
+            "must be positive and finite, got -5",
+        ),
+        (
+            "lqr_relinearise = 1e-9",
+            "controller.lqr_relinearise",
+            "must be at least the controller period (0.0001 s), got 1e-9 s",
+        ),
+        ("pd_kp = [1.0]", "controller.pd_kp", "has 1 entries"),
+        (
+            "fis = \"/nonexistent/paper.fis\"",
+            "controller.fis",
+            "cannot be read from",
+        ),
+    ] {
+        let text = base.replace("[controller]\n", &format!("[controller]\n{line}\n"));
+        assert_ne!(text, base);
+        let (found, message) = invalid(sim_study::Scenario::from_toml(&text).unwrap().build());
+        assert_eq!(found, name, "{line}");
+        assert!(
+            message.starts_with(&format!("{name} {problem}")),
+            "{message}"
+        );
+    }
+}
+
 /// Gravity beyond 1e6 m/s^2 (planar magnitude, spatial vector component) is refused naming
 /// `arm.gravity`: beyond it the run stopped on a non-finite `a_ddot` at t = 0.
 #[test]

@@ -387,6 +387,26 @@ fn deployment_keys_are_refused_by_name() {
             message(&margin)
         );
     }
+    // The modal controllers' keys, which a modal run checks whichever controller it runs.
+    type SetKey = fn(&mut sim_study::ControllerSpec);
+    let modal_keys: [(&str, SetKey); 5] = [
+        ("controller.pd_kp", |c| c.pd_kp = Some(vec![1.0])),
+        ("controller.pd_kd", |c| c.pd_kd = Some(vec![1.0])),
+        ("controller.lqr_frequency", |c| c.lqr_frequency = Some(-5.0)),
+        ("controller.lqr_relinearise", |c| {
+            c.lqr_relinearise = Some(0.1)
+        }),
+        ("controller.fis", |c| c.fis = Some("paper.fis".into())),
+    ];
+    for (name, set) in modal_keys {
+        let mut modal = base.clone();
+        set(&mut modal.controller);
+        assert!(
+            message(&modal).starts_with(&format!("{name} is not used with [deploy]")),
+            "{}",
+            message(&modal)
+        );
+    }
     let mut fuzzy = base.clone();
     fuzzy.controller.kind = ControllerKind::Fuzzy;
     assert!(message(&fuzzy).starts_with("controller.kind must be \"computed-torque\" or \"mpc\""));
