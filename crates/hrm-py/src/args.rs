@@ -32,6 +32,14 @@ pub(crate) fn real(value: &Bound<'_, PyAny>, name: &str) -> PyResult<f64> {
     })
 }
 
+/// A string for argument `name` (a Python `str`).
+pub(crate) fn text(value: &Bound<'_, PyAny>, name: &str) -> PyResult<String> {
+    match value.cast::<PyString>() {
+        Ok(s) => Ok(s.to_cow()?.into_owned()),
+        Err(_) => Err(wrong_type(name, "a str", value)),
+    }
+}
+
 /// A 1-D sequence of real numbers for argument `name` (a list, tuple or numpy array; not a
 /// string) of at most `max_len` entries: a wrong type is a `TypeError`, another number of
 /// dimensions or more entries an `InvalidInput`.

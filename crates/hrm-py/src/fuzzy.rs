@@ -166,16 +166,23 @@ impl System {
     /// `samples`: evenly spaced samples per input (set landmarks are added); `max_jump`: the
     /// largest allowed jump between neighbouring rules, as a fraction of the output's range.
     #[pyo3(
-        signature = (coverage=0.5, samples=None, max_jump=1.0),
+        signature = (coverage=None, samples=None, max_jump=None),
         text_signature = "($self, coverage=0.5, samples=21, max_jump=1.0)"
     )]
     fn check<'py>(
         &self,
         py: Python<'py>,
-        coverage: f64,
+        coverage: Option<&Bound<'py, PyAny>>,
         samples: Option<&Bound<'py, PyAny>>,
-        max_jump: f64,
+        max_jump: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let real_or = |value: Option<&Bound<'py, PyAny>>, name: &str, default: f64| {
+            value.map_or(Ok(default), |v| crate::args::real(v, name))
+        };
+        let (coverage, max_jump) = (
+            real_or(coverage, "coverage", 0.5)?,
+            real_or(max_jump, "max_jump", 1.0)?,
+        );
         let options = AnalysisOptions {
             coverage,
             samples_per_input: samples.map_or(Ok(21), |s| count(s, "samples", 0))?,

@@ -106,9 +106,10 @@ impl ReducedModel {
         py: Python<'_>,
         arm: &Arm,
         harmonics: Option<&Bound<'_, PyAny>>,
-        alpha0: Option<f64>,
+        alpha0: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let harmonics = harmonics.map_or(Ok(1), |k| count(k, "harmonics", 1))?;
+        let alpha0 = alpha0.map(|a| crate::args::real(a, "alpha0")).transpose()?;
         let chain = arm.chain().clone();
         let base = alpha0.map_or(BaseAngle::Free, |a| BaseAngle::Fixed(reduce_angle(a)));
         // O(n m^2) and more: other Python threads run meanwhile.
@@ -258,15 +259,22 @@ impl ReducedModel {
     /// coordinate of the result, reduced to (-pi, pi] when it is outside, as the model's fixed
     /// alpha0 is). Raises Unreachable for a target the curve cannot reach and
     /// NumericalError if the iteration does not converge.
-    #[pyo3(signature = (target, alpha0=None, branch="positive"))]
+    #[pyo3(
+        signature = (target, alpha0=None, branch=None),
+        text_signature = "($self, target, alpha0=None, branch=\"positive\")"
+    )]
     fn ik<'py>(
         &self,
         py: Python<'py>,
         target: &Bound<'py, PyAny>,
-        alpha0: Option<f64>,
-        branch: &str,
+        alpha0: Option<&Bound<'py, PyAny>>,
+        branch: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let branch = match branch {
+        let alpha0 = alpha0.map(|a| crate::args::real(a, "alpha0")).transpose()?;
+        let branch = branch.map_or(Ok("positive".to_string()), |b| {
+            crate::args::text(b, "branch")
+        })?;
+        let branch = match branch.as_str() {
             "positive" => Branch::Positive,
             "negative" => Branch::Negative,
             other => {

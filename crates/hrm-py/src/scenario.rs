@@ -689,9 +689,10 @@ impl Scenario {
     /// arms), and "narrow-gap" and "spatial-clutter" (a [task] planned between obstacles, then
     /// tracked, by a planar and a spatial arm).
     #[staticmethod]
-    fn builtin(name: &str) -> PyResult<Self> {
+    fn builtin(name: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let name = crate::args::text(name, "name")?;
         Ok(Self::wrap(
-            sim_study::Scenario::builtin(name).map_err(scenario_error)?,
+            sim_study::Scenario::builtin(&name).map_err(scenario_error)?,
         ))
     }
 

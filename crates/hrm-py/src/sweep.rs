@@ -48,7 +48,11 @@ fn summary<'py>(py: Python<'py>, whole: &ShardFile) -> PyResult<Bound<'py, PyDic
 }
 
 /// A shard `index` of `count`, checked as `hrm sweep --shard K/N` checks it.
-fn shard(index: usize, count: usize) -> PyResult<Shard> {
+fn shard(index: &Bound<'_, PyAny>, count: &Bound<'_, PyAny>) -> PyResult<Shard> {
+    let (index, count) = (
+        crate::errors::count(index, "index", 1)?,
+        crate::errors::count(count, "count", 1)?,
+    );
     format!("{index}/{count}").parse().map_err(input)
 }
 
@@ -66,8 +70,8 @@ impl Sweep {
 impl Sweep {
     #[new]
     #[pyo3(signature = (
-        scenario, noise_levels, seeds, controllers=None, base_seed=None, rate_noise_ratio=10.0,
-        reference_noise_ratio=0.0
+        scenario, noise_levels, seeds, controllers=None, base_seed=None, rate_noise_ratio=None,
+        reference_noise_ratio=None
     ), text_signature = "(scenario, noise_levels, seeds, controllers=None, base_seed=1, \
         rate_noise_ratio=10.0, reference_noise_ratio=0.0)")]
     #[allow(clippy::too_many_arguments)]
@@ -77,9 +81,14 @@ impl Sweep {
         seeds: &Bound<'_, PyAny>,
         controllers: Option<Vec<String>>,
         base_seed: Option<&Bound<'_, PyAny>>,
-        rate_noise_ratio: f64,
-        reference_noise_ratio: f64,
+        rate_noise_ratio: Option<&Bound<'_, PyAny>>,
+        reference_noise_ratio: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let ratio = |value: Option<&Bound<'_, PyAny>>, name: &str, default: f64| {
+            value.map_or(Ok(default), |v| crate::args::real(v, name))
+        };
+        let rate_noise_ratio = ratio(rate_noise_ratio, "rate_noise_ratio", 10.0)?;
+        let reference_noise_ratio = ratio(reference_noise_ratio, "reference_noise_ratio", 0.0)?;
         let scenario = match scenario.cast::<Scenario>() {
             Ok(s) => s.get().get(),
             Err(_) => {
@@ -114,7 +123,11 @@ impl Sweep {
 
     /// The indices of the runs shard `index` of `count` takes (1 <= index <= count): the runs i
     /// with i % count == index - 1, as `hrm sweep --shard index/count`.
-    fn shard_runs(&self, index: usize, count: usize) -> PyResult<Vec<usize>> {
+    fn shard_runs(
+        &self,
+        index: &Bound<'_, PyAny>,
+        count: &Bound<'_, PyAny>,
+    ) -> PyResult<Vec<usize>> {
         Ok(shard(index, count)?.indices(self.n_runs()).collect())
     }
 
@@ -123,9 +136,15 @@ impl Sweep {
     /// writes to shard-index-of-count.json. Runs that diverge are recorded as failed, not raised.
     /// Ctrl-C raises KeyboardInterrupt within 0.05 s; the runs under way finish in the background
     /// first (no new lock-step group starts).
-    #[pyo3(signature = (index=1, count=1))]
-    fn run_shard(&self, py: Python<'_>, index: usize, count: usize) -> PyResult<String> {
-        let shard = shard(index, count)?;
+    #[pyo3(signature = (index=None, count=None), text_signature = "($self, index=1, count=1)")]
+    fn run_shard(
+        &self,
+        py: Python<'_>,
+        index: Option<&Bound<'_, PyAny>>,
+        count: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<String> {
+        let one = 1_usize.into_pyobject(py)?.into_any();
+        let shard = shard(index.unwrap_or(&one), count.unwrap_or(&one))?;
         let cancel = Cancel::new();
         let file = pool::run(py, &cancel, || {
             study::run_shard_until(&self.config, shard, || {}, || cancel.is_set())
@@ -137,7 +156,7 @@ impl Sweep {
     /// Runs the whole sweep and returns its summary: the dict `hrm sweep` writes to
     /// summary.json ({"config": ..., "cells": [...]}, one cell per noise level and controller).
     fn run<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let text = self.run_shard(py, 1, 1)?;
+        let text = self.run_shard(py, None, None)?;
         // As `hrm sweep` does: the report from the runs as read back, like a merge's.
         let whole = ShardFile::parse(&text, Path::new("runs.json")).map_err(input)?;
         summary(py, &whole)

@@ -453,6 +453,33 @@ def test_wrong_argument_types_name_the_argument():
             call()
 
 
+def test_arguments_once_converted_by_pyo3_name_themselves():
+    # alpha0, branch, the fuzzy check's options, the sweep's ratios and shards, a builtin's name:
+    # a TypeError or InvalidInput whose message names the argument, not only its note.
+    model = hrm.ReducedModel(hrm.Arm(links=10), alpha0=1.5)
+    sweep = hrm.Sweep(short_step(0.01), noise_levels=[0.0], seeds=1, controllers=["pd"])
+    system = hrm.fuzzy.paper_controller()
+    cases = [
+        (lambda: hrm.ReducedModel(hrm.Arm(links=10), alpha0="x"), TypeError, "^alpha0 must be a real number, got a str$"),
+        (lambda: model.ik([0.3, 0.5], branch=1), TypeError, "^branch must be a str, got a int$"),
+        (lambda: model.ik([0.3, 0.5], alpha0=[1.0]), TypeError, "^alpha0 must be a real number, got a list$"),
+        (lambda: system.check(coverage="x"), TypeError, "^coverage must be a real number, got a str$"),
+        (lambda: system.check(max_jump="y"), TypeError, "^max_jump must be a real number, got a str$"),
+        (lambda: hrm.Sweep(short_step(), noise_levels=[0.0], seeds=1, rate_noise_ratio="x"), TypeError,
+         "^rate_noise_ratio must be a real number, got a str$"),
+        (lambda: sweep.shard_runs(-1, 2), hrm.InvalidInput, "^index must be at least 1, got -1$"),
+        (lambda: sweep.run_shard(1, 2**70), hrm.InvalidInput, "^count must be a whole number of at most 64 bits"),
+        (lambda: hrm.Scenario.builtin(5), TypeError, "^name must be a str, got a int$"),
+    ]
+    for call, error, message in cases:
+        with pytest.raises(error, match=message):
+            call()
+    # The defaults stand.
+    assert sweep.shard_runs(1, 1) == list(range(sweep.n_runs))
+    assert isinstance(system.check(), dict)
+    assert len(model.ik([0.3, 0.5], branch="negative")) == 2
+
+
 def test_merge_refuses_a_string():
     text = hrm.Sweep(short_step(0.01), noise_levels=[0.0], seeds=1, controllers=["pd"]).run_shard()
     with pytest.raises(TypeError, match=r"^shards must be a list .* got a str: give \[text\] for one shard$"):
