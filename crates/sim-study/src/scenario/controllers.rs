@@ -160,15 +160,8 @@ impl ControllerSetup<'_> {
         per_coordinate("controller.pd_kp", self.spec.pd_kp.as_deref(), m)?;
         per_coordinate("controller.pd_kd", self.spec.pd_kd.as_deref(), m)?;
         if self.spec.lqr_frequency.is_some() || self.spec.lqr_relinearise.is_some() {
-            LqrController::check_settings(
-                self.period,
-                self.spec
-                    .lqr_frequency
-                    .unwrap_or(LqrController::DEFAULT_FREQUENCY),
-                self.spec
-                    .lqr_relinearise
-                    .unwrap_or(LqrController::DEFAULT_RELINEARISE_PERIOD),
-            )?;
+            let (frequency, relinearise) = self.spec.lqr_settings();
+            LqrController::check_settings(self.period, frequency, relinearise)?;
         }
         // The fuzzy kinds read `fis` themselves; the others check it can be read and parsed.
         let reads_fis = matches!(
@@ -254,15 +247,12 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         description: "LQR about the reference (feedforward M* a_ref_dd + C* + G*), re-linearised \
                       along it every lqr_relinearise s, design frequency lqr_frequency",
         prepare: |s| {
+            let (frequency, relinearise) = s.spec.lqr_settings();
             Ok(Prepared::controller_clones(LqrController::new(
                 s.model.plant(),
                 s.period,
-                s.spec
-                    .lqr_frequency
-                    .unwrap_or(LqrController::DEFAULT_FREQUENCY),
-                s.spec
-                    .lqr_relinearise
-                    .unwrap_or(LqrController::DEFAULT_RELINEARISE_PERIOD),
+                frequency,
+                relinearise,
             )?))
         },
     },
@@ -382,6 +372,17 @@ const DEFAULT_KP: f64 = 2500.0;
 const DEFAULT_KD: f64 = 100.0;
 
 impl ControllerSpec {
+    /// The LQR's design frequency and re-linearisation period: the keys given, else
+    /// [`LqrController`]'s defaults.
+    fn lqr_settings(&self) -> (f64, f64) {
+        (
+            self.lqr_frequency
+                .unwrap_or(LqrController::DEFAULT_FREQUENCY),
+            self.lqr_relinearise
+                .unwrap_or(LqrController::DEFAULT_RELINEARISE_PERIOD),
+        )
+    }
+
     /// The fuzzy system: the `.fis` file if given, else the paper's.
     fn fuzzy_system(&self) -> Result<FuzzySystem, SimError> {
         match &self.fis {
