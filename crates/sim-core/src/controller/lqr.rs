@@ -132,7 +132,6 @@ impl LqrController {
         let model = model.into();
         let m = model.n_coords();
         check_coordinate_count("controller", m)?;
-        check_positive("controller.period", period)?;
         Self::check_settings(period, frequency, relinearise_period)?;
         let mut data = PlantData::new(model);
         model
