@@ -24,8 +24,16 @@ use crate::validate::check_length;
 use crate::vec3::{Rotation, column, distance, mat_mul};
 use lane_math::check_values;
 
-/// The most Runge-Kutta steps [`SpatialCurve::tip`] takes over the curve (2^22).
+/// The most Runge-Kutta steps [`SpatialCurve::tip`] takes over the curve with one harmonic per
+/// plane (2^22); with `K` it takes at most `MAX_CURVE_STEPS / K`, since a step's work grows with
+/// `K` (a refusal takes about as long for every `K`: about a second).
 pub const MAX_CURVE_STEPS: usize = 1 << 22;
+
+/// The most the frame may turn in one step (rad) of the first pair of integrations: below it
+/// Richardson's estimate is in its asymptotic range, where the step-doubling cannot be fooled by
+/// steps that sample the oscillation at the same phase (`a = 3000` was answered from two such
+/// coarse grids, metres from the converged tip).
+const MAX_STEP_TURN: f64 = 0.5;
 
 /// The default tip tolerance of [`SpatialCurve::tip`], relative to the curve length.
 pub const SPATIAL_CURVE_TOLERANCE: f64 = 1e-12;
@@ -73,6 +81,19 @@ impl SpatialCurve {
         self.length
     }
 
+    /// A bound on the turning rate `|w(s)|` over the curve (rad/m): each harmonic's
+    /// `omega_k (|a_k| + |b_k|)`, summed over both planes.
+    fn turning_bound(&self) -> f64 {
+        self.modes
+            .chunks_exact(2 * self.harmonics)
+            .flat_map(|plane| plane.chunks_exact(2).enumerate())
+            .map(|(k, pair)| {
+                let omega = std::f64::consts::TAU * (k + 1) as f64 / self.length;
+                omega * (pair[0].abs() + pair[1].abs())
+            })
+            .sum()
+    }
+
     /// The body-frame turning rate `w(s) = (0, alpha_y'(s), alpha_z'(s))` at arc length `s`.
     pub fn rate(&self, s: f64) -> [f64; 3] {
         let (a_z, a_y) = self.modes.split_at(2 * self.harmonics);
@@ -80,14 +101,27 @@ impl SpatialCurve {
     }
 
     /// The tip, integrated to `tolerance` (metres, absolute; positive and finite), e.g.
-    /// `SPATIAL_CURVE_TOLERANCE * l`.
+    /// `SPATIAL_CURVE_TOLERANCE * l`, starting from steps that turn the frame at most
+    /// `MAX_STEP_TURN` each.
     ///
-    /// Errors: [`KinError::TooOscillatory`] if meeting the tolerance would take more than
-    /// [`MAX_CURVE_STEPS`] steps; [`KinError::NonPositiveLength`] for a tolerance that is not
+    /// Errors: [`KinError::TooOscillatory`] if resolving the turning or meeting the tolerance
+    /// would take more than `MAX_CURVE_STEPS / K` steps; [`KinError::NonPositiveLength`] for a tolerance that is not
     /// positive and finite.
     pub fn tip(&self, tolerance: f64) -> Result<CurveTip, KinError> {
         check_length("curve tip tolerance", tolerance)?;
-        let mut steps = 8 * self.harmonics;
+        let max_steps = MAX_CURVE_STEPS / self.harmonics;
+        // Steps that resolve the fastest turning `|w| <= sum_k omega_k (|a_k| + |b_k|)` (both
+        // planes), known before any integration: a curve that needs more is refused at once.
+        let resolving = (self.turning_bound() * self.length / MAX_STEP_TURN).ceil();
+        // A bound that overflows (amplitudes of 1e308) is refused too.
+        let within_budget = 2.0 * resolving <= max_steps as f64;
+        if !within_budget {
+            return Err(KinError::TooOscillatory {
+                needed: (2.0 * resolving).min(f64::MAX),
+                max: max_steps,
+            });
+        }
+        let mut steps = (8 * self.harmonics).max(resolving as usize);
         let mut coarse = self.integrate(steps);
         loop {
             let fine = self.integrate(2 * steps);
@@ -101,10 +135,10 @@ impl SpatialCurve {
                 });
             }
             steps *= 2;
-            if 2 * steps > MAX_CURVE_STEPS {
+            if 2 * steps > max_steps {
                 return Err(KinError::TooOscillatory {
                     needed: (2 * steps) as f64,
-                    max: MAX_CURVE_STEPS,
+                    max: max_steps,
                 });
             }
             coarse = fine;

@@ -3,9 +3,9 @@
 //! against chains of many links, and the tip's inverse kinematics.
 
 use backbone_kin::{
-    BackboneCurve, BaseAngle, BasePose, KinError, ModalMap, SPATIAL_CURVE_TOLERANCE, SpatialCurve,
-    SpatialIk, SpatialModalMap, joint_positions, spatial_joint_positions, spatial_tip_jacobian,
-    spatial_tip_position,
+    BackboneCurve, BaseAngle, BasePose, KinError, MAX_CURVE_STEPS, ModalMap,
+    SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, SpatialModalMap, joint_positions,
+    spatial_joint_positions, spatial_tip_jacobian, spatial_tip_position,
 };
 use proptest::prelude::*;
 
@@ -320,6 +320,27 @@ fn the_spatial_family_refuses_bad_input() {
         wild.tip(0.0),
         Err(KinError::NonPositiveLength { .. })
     ));
+    // Amplitudes of 3000 turn the frame 2 pi 12000 rad over the curve: grids of 8, 16, ...
+    // steps sample the oscillation at one phase and agree on a wrong tip, so the steps start
+    // where they resolve the turning (here beyond the budget: refused, not answered).
+    let aliased = SpatialCurve::new(1.0, 1, &[3000.0; 4], base).unwrap();
+    match aliased.tip(1e-12) {
+        Err(KinError::TooOscillatory { needed, max }) => {
+            assert_eq!(max, MAX_CURVE_STEPS);
+            assert!(needed > 4.8e6, "{needed}");
+        }
+        other => panic!("{other:?}"),
+    }
+    // The budget shrinks with the harmonics, whose steps cost more.
+    let fast = SpatialCurve::new(1.0, 16, &[30.0; 64], base).unwrap();
+    assert!(matches!(
+        fast.tip(1e-12),
+        Err(KinError::TooOscillatory { max, .. }) if max == MAX_CURVE_STEPS / 16
+    ));
+    // A moderate curve starts at the steps that resolve its turning, 2 pi 3.8 / 0.5 = 48.
+    let moderate = SpatialCurve::new(1.0, 1, &[2.0, -1.0, 0.5, 0.3], base).unwrap();
+    let tip = moderate.tip(1e-12).unwrap();
+    assert!(tip.error_estimate <= 1e-12 && tip.steps >= 96, "{tip:?}");
     let mut ik = SpatialIk::new(map, base).unwrap();
     let mut a = [0.1; 4];
     assert!(matches!(
