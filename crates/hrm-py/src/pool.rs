@@ -96,7 +96,8 @@ impl Cancel {
 }
 
 /// Runs `work` inside the package's pool on a thread of its own, the GIL released; the calling
-/// thread checks for signals every [`SIGNAL_POLL`]. A signal whose handler raises (Ctrl-C's
+/// thread checks for signals every [`SIGNAL_POLL`]. On a worker of the pool already, `work`
+/// runs on it. A signal whose handler raises (Ctrl-C's
 /// `KeyboardInterrupt`) sets `cancel`, waits for `work` to return (it checks `cancel` between
 /// chunks) and is raised in place of the result.
 pub(crate) fn run<T: Send>(
@@ -104,6 +105,12 @@ pub(crate) fn run<T: Send>(
     cancel: &Cancel,
     work: impl FnOnce() -> T + Send,
 ) -> PyResult<T> {
+    // Called on one of the pool's workers (a run started from a Python callback of a run):
+    // waiting there for another worker can take the pool's last thread and wait forever, so the
+    // work runs here, the GIL released; the outer call's thread watches for signals.
+    if rayon::current_thread_index().is_some() {
+        return Ok(py.detach(work));
+    }
     let pool = pool()?;
     let (value, interrupt) = py.detach(|| {
         std::thread::scope(|scope| {

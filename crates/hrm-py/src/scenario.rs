@@ -21,6 +21,7 @@ use sim_core::LoopHooks;
 use sim_core::controller::{ControlContext, Controller, ControllerError, ModalState};
 use sim_study::study::{RunOutcome, Stopped};
 use sim_study::{ControllerKind, DeployFailure, ScenarioError};
+use std::cell::Cell;
 use std::sync::{Arc, Mutex, MutexGuard};
 
 /// A closed-loop experiment: arm, modal family, reference, controller, integrator, noise and
@@ -825,6 +826,7 @@ impl Scenario {
         controller: Option<&Bound<'_, PyAny>>,
         disturbance: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Run> {
+        let _nested = NestedRun::enter()?;
         let mut scenario = self.get();
         let choice = Choice::read(controller)?;
         let mut hooks = match disturbance {
@@ -915,6 +917,7 @@ impl Scenario {
     /// summary.json of `hrm simulate` (and `Run.failure` of `Scenario.run`); one that stops
     /// before its first recorded sample raises the error of its class.
     fn run_deploy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let _nested = NestedRun::enter()?;
         let scenario = self.get();
         let (run, stop) =
             DeployFailure::split(pool::run(py, &Cancel::new(), || scenario.run_deploy())?)
@@ -1268,5 +1271,41 @@ impl Run {
                 self.controller
             ),
         }
+    }
+}
+
+thread_local! {
+    /// The runs in progress on this thread: a Python controller or disturbance that runs a
+    /// scenario nests them.
+    static NESTED_RUNS: Cell<usize> = const { Cell::new(0) };
+}
+
+/// The most runs one thread may nest: each level takes Rust stack that Python's recursion limit
+/// does not count (a controller that runs its own scenario again crashed the interpreter at
+/// about 480 levels).
+const MAX_NESTED_RUNS: usize = 16;
+
+/// One level of [`NESTED_RUNS`], left when dropped.
+struct NestedRun;
+
+impl NestedRun {
+    /// Enters a run, or raises `RecursionError` beyond [`MAX_NESTED_RUNS`].
+    fn enter() -> PyResult<Self> {
+        NESTED_RUNS.with(|runs| {
+            if runs.get() >= MAX_NESTED_RUNS {
+                return Err(pyo3::exceptions::PyRecursionError::new_err(format!(
+                    "runs nested more than {MAX_NESTED_RUNS} deep: a controller or disturbance \
+                     that runs a scenario runs one again"
+                )));
+            }
+            runs.set(runs.get() + 1);
+            Ok(NestedRun)
+        })
+    }
+}
+
+impl Drop for NestedRun {
+    fn drop(&mut self) {
+        NESTED_RUNS.with(|runs| runs.set(runs.get() - 1));
     }
 }

@@ -440,3 +440,39 @@ def test_a_run_the_viewer_cannot_draw_still_returns_its_data():
     assert run._repr_html_() is None
     with pytest.raises(hrm.InvalidInput, match="the viewer cannot draw the run"):
         pickle.loads(pickle.dumps(run)).view_html()
+
+
+def test_nested_runs_are_bounded_and_do_not_wait_on_the_pool():
+    # A controller that runs its own scenario again crashed the interpreter (Rust stack that
+    # Python's recursion limit does not count): a RecursionError after 16 nested runs.
+    scenario = hrm.Scenario.builtin("paper-tracking")
+    scenario.duration = 0.001
+    depth = [0]
+
+    def again(t, a, a_dot, reference):
+        depth[0] += 1
+        scenario.run(again)
+        return np.zeros(2)
+
+    with pytest.raises(RecursionError, match="^runs nested more than 16 deep"):
+        scenario.run(again)
+    assert depth[0] == 16
+
+    # Built-in runs nested three deep through disturbances waited forever for the pool's workers
+    # on two cores: a run started on a worker runs there.
+    returned = []
+
+    def nest(level):
+        started = [False]
+
+        def disturbance(t, a, a_dot):
+            if level < 3 and not started[0]:
+                started[0] = True
+                scenario.copy().run("pd", disturbance=nest(level + 1))
+                returned.append(level)
+            return None
+
+        return disturbance
+
+    run = scenario.run("pd", disturbance=nest(0))
+    assert run.failure is None and returned == [2, 1, 0]
