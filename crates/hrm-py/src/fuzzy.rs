@@ -191,7 +191,18 @@ impl System {
         };
         let report = py
             .detach(|| self.system.analyze(&options))
-            .map_err(Error::from)?;
+            .map_err(|e| match e {
+                // The library's option by the name this method gives it.
+                FuzzyError::AnalysisOption {
+                    name: "max_relative_jump",
+                    requirement,
+                    value,
+                } => Error::input(format!(
+                    "max_jump must {requirement}, got {}",
+                    lane_math::Compact(value)
+                )),
+                other => Error::from(other),
+            })?;
         report_dict(py, &report)
     }
 }

@@ -465,6 +465,7 @@ def test_arguments_once_converted_by_pyo3_name_themselves():
         (lambda: model.ik([0.3, 0.5], alpha0=[1.0]), TypeError, "^alpha0 must be a real number, got a list$"),
         (lambda: system.check(coverage="x"), TypeError, "^coverage must be a real number, got a str$"),
         (lambda: system.check(max_jump="y"), TypeError, "^max_jump must be a real number, got a str$"),
+        (lambda: system.check(max_jump=-1.0), hrm.InvalidInput, "^max_jump must be positive, got -1$"),
         (lambda: hrm.Sweep(short_step(), noise_levels=[0.0], seeds=1, rate_noise_ratio="x"), TypeError,
          "^rate_noise_ratio must be a real number, got a str$"),
         (lambda: sweep.shard_runs(-1, 2), hrm.InvalidInput, "^index must be at least 1, got -1$"),
