@@ -471,6 +471,8 @@ def test_arguments_once_converted_by_pyo3_name_themselves():
         (lambda: sweep.shard_runs(-1, 2), hrm.InvalidInput, "^index must be at least 1, got -1$"),
         (lambda: sweep.run_shard(1, 2**70), hrm.InvalidInput, "^count must be a whole number of at most 64 bits"),
         (lambda: hrm.Scenario.builtin(5), TypeError, "^name must be a str, got a int$"),
+        (lambda: hrm.ReferenceSample([float("nan")], [0.0], [0.0]), hrm.InvalidInput, "^a\\[0\\] must be finite"),
+        (lambda: hrm.ReferenceSample([0.0], [float("inf")], [0.0]), hrm.InvalidInput, "^a_dot\\[0\\] must be finite"),
     ]
     for call, error, message in cases:
         with pytest.raises(error, match=message):
