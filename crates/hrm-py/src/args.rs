@@ -32,6 +32,11 @@ pub(crate) fn real(value: &Bound<'_, PyAny>, name: &str) -> PyResult<f64> {
     })
 }
 
+/// An optional real number for argument `name` ([`real`]), `default` when not given.
+pub(crate) fn real_or(value: Option<&Bound<'_, PyAny>>, name: &str, default: f64) -> PyResult<f64> {
+    value.map_or(Ok(default), |v| real(v, name))
+}
+
 /// A string for argument `name` (a Python `str`).
 pub(crate) fn text(value: &Bound<'_, PyAny>, name: &str) -> PyResult<String> {
     match value.cast::<PyString>() {

@@ -176,12 +176,9 @@ impl System {
         samples: Option<&Bound<'py, PyAny>>,
         max_jump: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let real_or = |value: Option<&Bound<'py, PyAny>>, name: &str, default: f64| {
-            value.map_or(Ok(default), |v| crate::args::real(v, name))
-        };
         let (coverage, max_jump) = (
-            real_or(coverage, "coverage", 0.5)?,
-            real_or(max_jump, "max_jump", 1.0)?,
+            crate::args::real_or(coverage, "coverage", 0.5)?,
+            crate::args::real_or(max_jump, "max_jump", 1.0)?,
         );
         let options = AnalysisOptions {
             coverage,

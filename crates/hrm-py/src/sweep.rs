@@ -47,12 +47,13 @@ fn summary<'py>(py: Python<'py>, whole: &ShardFile) -> PyResult<Bound<'py, PyDic
     Ok(crate::value::to_py(py, &value)?.cast_into::<PyDict>()?)
 }
 
-/// A shard `index` of `count`, checked as `hrm sweep --shard K/N` checks it.
-fn shard(index: &Bound<'_, PyAny>, count: &Bound<'_, PyAny>) -> PyResult<Shard> {
-    let (index, count) = (
-        crate::errors::count(index, "index", 1)?,
-        crate::errors::count(count, "count", 1)?,
-    );
+/// A shard `index` of `count` (each 1 when not given), checked as `hrm sweep --shard K/N`
+/// checks it.
+fn shard(index: Option<&Bound<'_, PyAny>>, count: Option<&Bound<'_, PyAny>>) -> PyResult<Shard> {
+    let number = |value: Option<&Bound<'_, PyAny>>, name: &str| {
+        value.map_or(Ok(1), |v| crate::errors::count(v, name, 1))
+    };
+    let (index, count) = (number(index, "index")?, number(count, "count")?);
     format!("{index}/{count}").parse().map_err(input)
 }
 
@@ -84,11 +85,9 @@ impl Sweep {
         rate_noise_ratio: Option<&Bound<'_, PyAny>>,
         reference_noise_ratio: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let ratio = |value: Option<&Bound<'_, PyAny>>, name: &str, default: f64| {
-            value.map_or(Ok(default), |v| crate::args::real(v, name))
-        };
-        let rate_noise_ratio = ratio(rate_noise_ratio, "rate_noise_ratio", 10.0)?;
-        let reference_noise_ratio = ratio(reference_noise_ratio, "reference_noise_ratio", 0.0)?;
+        let rate_noise_ratio = crate::args::real_or(rate_noise_ratio, "rate_noise_ratio", 10.0)?;
+        let reference_noise_ratio =
+            crate::args::real_or(reference_noise_ratio, "reference_noise_ratio", 0.0)?;
         let scenario = match scenario.cast::<Scenario>() {
             Ok(s) => s.get().get(),
             Err(_) => {
@@ -128,7 +127,9 @@ impl Sweep {
         index: &Bound<'_, PyAny>,
         count: &Bound<'_, PyAny>,
     ) -> PyResult<Vec<usize>> {
-        Ok(shard(index, count)?.indices(self.n_runs()).collect())
+        Ok(shard(Some(index), Some(count))?
+            .indices(self.n_runs())
+            .collect())
     }
 
     /// Runs shard `index` of `count` (the whole sweep by default) on all cores, with the GIL
@@ -143,8 +144,7 @@ impl Sweep {
         index: Option<&Bound<'_, PyAny>>,
         count: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<String> {
-        let one = 1_usize.into_pyobject(py)?.into_any();
-        let shard = shard(index.unwrap_or(&one), count.unwrap_or(&one))?;
+        let shard = shard(index, count)?;
         let cancel = Cancel::new();
         let file = pool::run(py, &cancel, || {
             study::run_shard_until(&self.config, shard, || {}, || cancel.is_set())

@@ -181,19 +181,18 @@ impl MpcController {
             self.mpc.set_limits(Some(limits))?;
         }
         let (a, a_dot) = (&ctx.measured.a, &ctx.measured.a_dot);
-        let constrained = self.constraints.is_some();
         match &mut self.constraints {
             None => {
                 self.mpc
                     .solve(ctx.model, a, a_dot)
-                    .map_err(|e| plan_failure(e, constrained))?;
+                    .map_err(|e| plan_failure(e, false))?;
             }
             Some(constraints) => {
                 let mut rows = constraints.bind(ctx.model);
                 let report = self
                     .mpc
                     .solve_constrained(ctx.model, a, a_dot, &mut rows)
-                    .map_err(|e| plan_failure(e, constrained))?;
+                    .map_err(|e| plan_failure(e, true))?;
                 self.relaxed += report.relaxed_nodes;
             }
         }
