@@ -14,6 +14,10 @@ use lane_math::{check_len, check_values};
 /// `positions[i]` the distal end of link `i` (0-based: of `link_lengths[i - 1]`), and
 /// `positions[n]` the tip. `positions` must hold `n + 1` points. Allocation-free.
 ///
+/// # Errors
+/// [`KinError`] for link lengths that are not positive and finite, joint angles that are not
+/// `n` finite numbers, or finite ones whose running sum (a link's absolute angle) overflows.
+///
 /// ```
 /// use backbone_kin::joint_positions;
 /// use std::f64::consts::FRAC_PI_2;
@@ -34,11 +38,13 @@ pub fn joint_positions(
     walk(link_lengths, theta, |point| {
         i += 1;
         positions[i] = point;
-    });
-    Ok(())
+    })
 }
 
 /// The tip (the distal end of the last link) of the chain with joint angles `theta`.
+///
+/// # Errors
+/// As [`joint_positions`].
 ///
 /// ```
 /// use backbone_kin::tip_position;
@@ -49,19 +55,32 @@ pub fn joint_positions(
 pub fn tip_position(link_lengths: &[f64], theta: &[f64]) -> Result<[f64; 2], KinError> {
     check_chain(link_lengths, theta)?;
     let mut tip = [0.0; 2];
-    walk(link_lengths, theta, |point| tip = point);
+    walk(link_lengths, theta, |point| tip = point)?;
     Ok(tip)
 }
 
-/// Visits the distal end of every link, base to tip.
-fn walk(link_lengths: &[f64], theta: &[f64], mut visit: impl FnMut([f64; 2])) {
+/// Visits the distal end of every link, base to tip; refuses joint angles whose running sum
+/// (a link's absolute angle) overflows.
+fn walk(
+    link_lengths: &[f64],
+    theta: &[f64],
+    mut visit: impl FnMut([f64; 2]),
+) -> Result<(), KinError> {
     let (mut phi, mut point) = (0.0, [0.0; 2]);
-    for (&length, &angle) in link_lengths.iter().zip(theta) {
+    for (i, (&length, &angle)) in link_lengths.iter().zip(theta).enumerate() {
         phi += angle;
+        if !phi.is_finite() {
+            return Err(KinError::NonFinite {
+                name: "absolute link angles (running sums of the joint angles)",
+                index: Some(i),
+                value: phi,
+            });
+        }
         let (sin, cos) = phi.sin_cos();
         point = [point[0] + length * cos, point[1] + length * sin];
         visit(point);
     }
+    Ok(())
 }
 
 fn check_chain(link_lengths: &[f64], theta: &[f64]) -> Result<(), KinError> {

@@ -244,7 +244,13 @@ fn resolution(length: f64, modes: &[f64], tolerance: f64) -> Result<Resolution, 
         let (mut previous, mut current, twice_cosh) = (0.0, 0.5 * (grow - shrink), grow + shrink);
         let mut total = 0.0;
         for pair in modes.chunks_exact(2) {
-            let amplitude = (pair[0] * pair[0] + pair[1] * pair[1]).sqrt();
+            let square = pair[0] * pair[0] + pair[1] * pair[1];
+            // `hypot` only where the square overflows (the same bits below).
+            let amplitude = if square.is_finite() {
+                square.sqrt()
+            } else {
+                pair[0].hypot(pair[1])
+            };
             if amplitude > 0.0 {
                 total += amplitude * current;
             }

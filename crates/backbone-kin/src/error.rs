@@ -92,7 +92,8 @@ pub enum KinError {
     /// The curve's modal amplitudes are so large that quadrature to the documented accuracy
     /// would need more nodes than the crate allows.
     #[error(
-        "the curve oscillates too fast for quadrature to the documented accuracy: {needed} nodes needed, at most {max} allowed"
+        "the curve oscillates too fast for quadrature to the documented accuracy: {} nodes needed, at most {max} allowed",
+        NodeCount(*needed)
     )]
     TooOscillatory {
         /// Quadrature nodes the error bound asks for over the whole curve.
@@ -183,6 +184,20 @@ impl Classify for KinError {
 
 /// A refused shape or non-finite input as [`KinError::Dimension`] or [`KinError::NonFinite`],
 /// with the same message.
+/// A number of quadrature nodes in a message: compact, and "more than 1e308" where the count
+/// overflowed.
+struct NodeCount(f64);
+
+impl std::fmt::Display for NodeCount {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.0.is_finite() {
+            write!(f, "{}", lane_math::Compact(self.0))
+        } else {
+            f.write_str("more than 1e308")
+        }
+    }
+}
+
 impl From<ShapeError<'static>> for KinError {
     fn from(error: ShapeError<'static>) -> Self {
         let name = error.name;

@@ -7,7 +7,7 @@
 //! is documented in `docs/eval-protocol.md`.
 
 use backbone_kin::{
-    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, end_point, inverse_kinematics,
+    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, KinError, end_point, inverse_kinematics,
     reduce_angle, tip_position,
 };
 use fuzzy_sugeno::FuzzySystem;
@@ -278,14 +278,21 @@ fn fk(mut request: FkRequest) -> EvalResult {
     let length = chain.total_length();
     // The closed form takes any amplitude; quadrature refuses amplitudes it cannot resolve.
     let tip = match *modes {
-        [a1, a2] => end_point(length, [a1, a2], alpha0),
-        _ => BackboneCurve::new(length, modes, alpha0).map(|curve| curve.end_point()),
+        [a1, a2] => end_point(length, [a1, a2], alpha0).map_err(EvalError::from),
+        _ => BackboneCurve::new(length, modes, alpha0)
+            .map(|curve| curve.end_point())
+            .map_err(|e| match e {
+                KinError::TooOscillatory { .. } => EvalError::input(format!("a: {e}")),
+                other => other.into(),
+            }),
     }?;
     let mut theta = vec![0.0; map.n_joints()];
     map.joint_angles(&request.a, &mut theta)?;
     finite("theta", &theta)?;
     let lengths: Vec<f64> = chain.link_lengths().collect();
-    let tip_chain = tip_position(&lengths, &theta)?;
+    // Finite joint angles can still sum past double precision: the chain's absolute angles.
+    let tip_chain =
+        tip_position(&lengths, &theta).map_err(|e| EvalError::input(format!("a: {e}")))?;
     finite("tip", &[tip[0], tip[1], tip_chain[0], tip_chain[1]])?;
     Ok(json_fields([
         ("tip", json!(tip)),
@@ -407,6 +414,11 @@ fn dynamics(request: DynamicsRequest) -> EvalResult {
             manip_dyn::MAX_DENSE_LINKS
         )));
     }
+    derivatives::joint_vectors(
+        n,
+        "link",
+        &[("theta", &request.theta), ("theta_dot", &request.theta_dot)],
+    )?;
     let mut data = ChainData::new(&chain);
     let mut mass = Mat::<f64>::zeros(n, n);
     let (mut coriolis, mut gravity) = (vec![0.0; n], vec![0.0; n]);
@@ -530,6 +542,13 @@ fn fuzzy(request: FuzzyRequest) -> EvalResult {
         ..fuzzy_sugeno::EvalOptions::default()
     };
     let mut evaluator = fuzzy_sugeno::Evaluator::with_options(system, options)?;
+    let expected = evaluator.system().inputs().len();
+    if request.inputs.len() != expected {
+        return Err(EvalError::input(format!(
+            "inputs has {} entries, expected {expected} (one per input of the system)",
+            request.inputs.len()
+        )));
+    }
     let mut outputs = vec![0.0; evaluator.system().outputs().len()];
     evaluator.eval(&request.inputs, &mut outputs)?;
     crate::fis_cmd::warn_outside_range(&evaluator);
@@ -728,6 +747,49 @@ mod tests {
             "arm.masses[1] is invalid: link 1: mass must be positive and finite, got -1"
         );
         assert_eq!(answers[0]["id"], "x");
+    }
+
+    #[test]
+    fn refusals_name_the_request_field() {
+        let ten = [0.1; 10];
+        for (request, message) in [
+            (
+                json!({"op": "dynamics", "theta": &ten[..9], "theta_dot": ten}),
+                "theta has 9 entries, expected 10 (one per link)",
+            ),
+            (
+                json!({"op": "dynamics", "theta": ten, "theta_dot": [0.1]}),
+                "theta_dot has 1 entries, expected 10 (one per link)",
+            ),
+            (
+                json!({"op": "dynamics", "arm": {"links": 2, "inertias": [-1, 0]},
+                    "theta": [0.1, 0.1], "theta_dot": [0.1, 0.1]}),
+                "arm.inertias[0] is invalid: link 0: inertia must be non-negative and finite, \
+                 got -1",
+            ),
+            // Finite joint angles whose running sums overflow: the tip of the chain.
+            (
+                json!({"op": "fk", "a": [0, 1e308], "alpha0": 0}),
+                "a: absolute link angles (running sums of the joint angles)[4] must be finite, \
+                 got inf",
+            ),
+            (
+                json!({"op": "fuzzy", "controller": "paper", "inputs": [0.1, 0.1, 0.1]}),
+                "inputs has 3 entries, expected 4 (one per input of the system)",
+            ),
+        ] {
+            let answer = self::request(request);
+            assert_eq!(answer["error"]["kind"], "invalid_input", "{answer}");
+            assert_eq!(answer["error"]["message"], message);
+        }
+        // A first harmonic of 1e308: no quadrature resolves it.
+        let answer = request(json!({"op": "fk", "a": [1e308, 2, 3, 4, 5], "harmonics": 2}));
+        let message = answer["error"]["message"].as_str().unwrap();
+        assert!(
+            message.starts_with("a: the curve oscillates too fast")
+                && message.contains("more than 1e308 nodes"),
+            "{message}"
+        );
     }
 
     #[test]

@@ -141,6 +141,19 @@ fn rows() -> Vec<Row<KinError>> {
             |e| matches!(e, KinError::NonPositiveLength { .. }),
             &["link length", "-0.1"],
         ),
+        // Finite joint angles whose running sum (a link's absolute angle) overflows.
+        exactly(
+            "non_finite",
+            tip_position(&[0.5, 0.5, 0.5], &[1e308, 1e308, 0.0]).unwrap_err(),
+            |e| matches!(e, KinError::NonFinite { index: Some(1), .. }),
+            "absolute link angles (running sums of the joint angles)[1] must be finite, got inf",
+        ),
+        words(
+            "non_finite",
+            joint_positions(&[0.5, 0.5], &[-1e308, -1e308], &mut [[0.0; 2]; 3]).unwrap_err(),
+            |e| matches!(e, KinError::NonFinite { index: Some(1), .. }),
+            &["absolute link angles", "-inf"],
+        ),
         words(
             "non_positive_link_length",
             ModalMap::new(&[0.1, f64::INFINITY], 1, BaseAngle::Free).unwrap_err(),
@@ -370,6 +383,12 @@ fn rows() -> Vec<Row<KinError>> {
                 .and_then(|curve| curve.point(1.0))
                 .unwrap_err(),
             |e| matches!(e, KinError::TooOscillatory { .. }),
+        ),
+        words(
+            "curve_too_oscillatory",
+            BackboneCurve::new(1.0, &[1e308, 2.0, 3.0, 4.0], 0.0).unwrap_err(),
+            |e| matches!(e, KinError::TooOscillatory { .. }),
+            &["oscillates too fast", "more than 1e308 nodes needed"],
         ),
         words(
             "curve_too_oscillatory",

@@ -8,6 +8,8 @@ use backbone_kin::{
     BasePose, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, SpatialModalMap,
     spatial_tip_position,
 };
+use manip_dyn::DynError;
+use modal_reduce::ReduceError;
 use modal_reduce::spatial::{
     SpatialLinkInertia, SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel,
     spatial_forward_dynamics, spatial_joint_torques, spatial_reduced_derivatives,
@@ -157,7 +159,14 @@ impl SpatialArmSpec {
         sim_study::Gravity::Vector(gravity)
             .check()
             .map_err(|e| EvalError::input(e.to_string()))?;
-        Ok(SpatialReducedModel::new(map, base, links, gravity)?)
+        // A link the model refuses with the user's inertias has a bad inertia (its mass is
+        // checked with the lengths above).
+        SpatialReducedModel::new(map, base, links, gravity).map_err(|e| match e {
+            ReduceError::Dyn(DynError::InvalidLink { index, .. }) if self.inertias.is_some() => {
+                EvalError::input(format!("arm.inertias[{index}] is invalid: {e}"))
+            }
+            e => e.into(),
+        })
     }
 }
 
@@ -569,7 +578,8 @@ mod tests {
             ),
             (
                 json!({"op": "joints", "arm": {"kind": "spatial", "inertias": [[1.0, 0.1, 0.1]]}, "a": [0, 0, 0, 0]}),
-                "triangle",
+                "arm.inertias[0] is invalid: chain dynamics: link 0: principal inertia must be at \
+                 most the sum of the other two (triangle",
             ),
             (
                 json!({"op": "fk", "arm": {"kind": "spatial"}, "a": [0, 0, 0]}),

@@ -352,6 +352,10 @@ impl ArmSpec {
                     Some(_) => format!("arm.masses[{i}]"),
                     None => "arm.link_mass".to_string(),
                 },
+                manip_dyn::DynError::InvalidLinkParameter {
+                    quantity: "inertia",
+                    ..
+                } if inertias.is_some() => format!("arm.inertias[{i}]"),
                 _ => "arm".to_string(),
             };
             SimError::setting(field, format!("is invalid: {}", e.at_link(i)))

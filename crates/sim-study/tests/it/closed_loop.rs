@@ -571,6 +571,14 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
         err.contains("arm.lengths[1] is invalid: link 1: length"),
         "{err}"
     );
+    let err = invalid(|s| {
+        s.arm.links = Some(2);
+        s.arm.inertias = Some(sim_study::Inertias::PerLink(vec![-1.0, 0.0]));
+    });
+    assert!(
+        err.contains("arm.inertias[0] is invalid: link 0: inertia must be non-negative"),
+        "{err}"
+    );
     assert!(
         invalid(|s| s.limits.joint_torque_nm = Some(TorqueLimit::PerJoint(vec![1.0; 3])))
             .contains("joint_torque_nm")
