@@ -6,7 +6,7 @@ use crate::args;
 use crate::array::{Output, States, evaluate};
 use crate::errors::{Error, check_finite, count};
 use backbone_kin::{
-    BasePose, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, SpatialModalMap,
+    BasePose, MAX_CURVE_STEPS, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, SpatialModalMap,
     spatial_tip_position,
 };
 use modal_reduce::spatial::{
@@ -31,6 +31,9 @@ const MAX_GUESS: f64 = 10.0;
 /// Most links `to_urdf` and `to_mjcf` write, as `hrm eval`'s `export` (about 1.4 MB of URDF per
 /// 1,000 links).
 const MAX_EXPORT_LINKS: usize = 10_000;
+
+/// Operations of one Runge-Kutta step of the curve's frame, for `fk`'s work estimate.
+const CURVE_STEP_WORK: usize = 256;
 
 /// The workspace of one thread: the reduced model's data and derivatives, the joint angles of
 /// one state, the modal accelerations of `reduced` and the inverse-kinematics solver.
@@ -109,6 +112,14 @@ impl SpatialArm {
             .n_links()
             .saturating_mul(self.m())
             .saturating_mul(self.m())
+    }
+
+    /// The work of one state of `fk`: the chain's terms and, at worst, the curve's
+    /// [`MAX_CURVE_STEPS`] Runge-Kutta steps of a few hundred operations each (about a second),
+    /// so that the driver runs a batch a state a chunk with Ctrl-C checked between them.
+    fn fk_work(&self) -> usize {
+        self.work()
+            .saturating_add(MAX_CURVE_STEPS.saturating_mul(CURVE_STEP_WORK))
     }
 
     fn joints_count(&self) -> usize {
@@ -301,6 +312,10 @@ impl SpatialArm {
             value.map_or(Ok(default), |v| args::vec3(v, name))
         };
         let gravity = vec3(gravity, "gravity", [0.0, 0.0, -9.81])?;
+        // A scenario's bound (accelerations under 1e308 m/s^2 came back as 1e307).
+        sim_study::Gravity::Vector(gravity)
+            .check()
+            .map_err(|e| Error::input(e.to_string()))?;
         let (base_xyz, base_rpy) = (
             vec3(base_xyz, "base_xyz", [0.0; 3])?,
             vec3(base_rpy, "base_rpy", [0.0; 3])?,
@@ -477,7 +492,7 @@ impl SpatialArm {
             py,
             [&a],
             6,
-            self.work(),
+            self.fk_work(),
             &self.workspace,
             || self.fresh(),
             |ws, [a], out| {

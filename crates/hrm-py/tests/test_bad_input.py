@@ -257,10 +257,13 @@ INTERRUPT = textwrap.dedent("""
      "model.mass_matrix(a)"),
     ("model = hrm.ReducedModel(hrm.Arm(links=3000), harmonics=30); a = np.zeros((500, 61))",
      "model.mass_matrix(a)"),
+    # Some 0.1 s of the curve's quadrature a state, far below the 2^24 operations of the
+    # chain's terms from which a batch is interruptible.
+    ("arm = hrm.SpatialArm(); a = np.full((400, 4), 30.0)", "arm.fk(a)"),
     ("s = hrm.Scenario.builtin('paper-tracking'); s.duration = 200.0", "s.run()"),
     ("s = hrm.Scenario.builtin('paper-responses-step'); s.duration = 2.0; "
      "sweep = hrm.Sweep(s, noise_levels=[0.0, 0.01], seeds=200, controllers=['fuzzy', 'pd'])", "sweep.run()"),
-], ids=["parallel-batch", "serial-batch", "scenario-run", "sweep-run"])
+], ids=["parallel-batch", "serial-batch", "curve-quadrature-batch", "scenario-run", "sweep-run"])
 def test_ctrl_c_interrupts_long_calls_promptly(setup, call):
     code = INTERRUPT + f"\n{setup}\ndef call():\n    {call}\ninterrupted_after(call)\n"
     done = run_python(code, timeout=300)

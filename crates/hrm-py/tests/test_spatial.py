@@ -121,6 +121,7 @@ def test_pickling_keeps_the_arm():
         ({"links": 4, "inertias": [[1.0, 0.1, 0.1]] * 4}, "triangle"),
         ({"link_mass": -1.0}, "mass"),
         ({"gravity": (0.0, float("nan"), 0.0)}, "gravity"),
+        ({"gravity": (0.0, 0.0, -1e308)}, r"arm.gravity\[2\] must be finite and at most 1000000 m/s\^2"),
         ({"base_xyz": (float("inf"), 0.0, 0.0)}, r"base_xyz\[0\] must be finite, got inf"),
     ],
 )

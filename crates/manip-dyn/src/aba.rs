@@ -126,10 +126,15 @@ impl<S: Simd> AbaLane for Pack<S> {
     #[inline(always)]
     fn check_pivot(simd: S, pivot: Self, scale: Self) -> Result<(), DynError> {
         // pivot > PIVOT_FLOOR * scale by the sign of their difference (exact for finite
-        // doubles), and pivot below infinity: two vector compares. A NaN fails both.
+        // doubles), pivot below infinity and above the largest subnormal (`check::pivot`):
+        // three vector compares. A NaN fails them all.
         let margin = pivot - scale * check::PIVOT_FLOOR;
         let finite = Self::splat(simd, f64::INFINITY).all_greater(pivot);
-        if finite && margin.all_greater(Self::splat(simd, 0.0)) {
+        let largest_subnormal = f64::from_bits(f64::MIN_POSITIVE.to_bits() - 1);
+        if finite
+            && margin.all_greater(Self::splat(simd, 0.0))
+            && pivot.all_greater(Self::splat(simd, largest_subnormal))
+        {
             Ok(())
         } else {
             Err(DynError::NotPositiveDefinite)

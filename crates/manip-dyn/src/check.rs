@@ -123,13 +123,14 @@ pub(crate) const PIVOT_FLOOR: f64 = 1e3 * f64::EPSILON;
 
 /// A pivot of a factorisation of `M` (a Cholesky pivot `L_ii^2`, or an articulated inertia
 /// about a joint axis) must be finite and positive beyond rounding relative to `diagonal`, the
-/// scale of its rounding ([`PIVOT_FLOOR`]).
+/// scale of its rounding ([`PIVOT_FLOOR`]), and normal, so that its reciprocal is finite (a
+/// link inertia of `1e-320` about its joint gave an infinite acceleration).
 pub(crate) fn pivot(pivot: f64, diagonal: f64) -> Result<(), DynError> {
     if !(pivot.is_finite() && diagonal.is_finite()) {
         Err(DynError::NonFiniteResult {
             name: "mass matrix",
         })
-    } else if pivot > PIVOT_FLOOR * diagonal {
+    } else if pivot > PIVOT_FLOOR * diagonal && pivot >= f64::MIN_POSITIVE {
         Ok(())
     } else {
         Err(DynError::NotPositiveDefinite)

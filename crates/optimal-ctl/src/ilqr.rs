@@ -242,11 +242,7 @@ impl Ilqr {
                 value: horizon as f64,
             });
         }
-        let per_step = nx
-            .saturating_mul(nx)
-            .saturating_mul(2)
-            .saturating_add(nx.saturating_mul(nu).saturating_mul(3));
-        if horizon.saturating_mul(per_step) > MAX_WORKSPACE {
+        if !workspace_fits(nx, nu, horizon) {
             return Err(OptimalError::InvalidSetting {
                 name: "horizon",
                 requirement: "small enough for horizon * (2 n_x^2 + 3 n_x n_u) <= 2^25",
@@ -1221,6 +1217,16 @@ impl WithSimd for BackwardOnStack<'_> {
 }
 
 /// Moves the nodes of `buffer` (`width` numbers each) `s` nodes earlier, repeating the last.
+/// Whether the workspace of `n_x` states, `n_u` controls and `horizon` steps,
+/// `horizon * (2 n_x^2 + 3 n_x n_u)` numbers, is within [`MAX_WORKSPACE`].
+pub(crate) fn workspace_fits(nx: usize, nu: usize, horizon: usize) -> bool {
+    let per_step = nx
+        .saturating_mul(nx)
+        .saturating_mul(2)
+        .saturating_add(nx.saturating_mul(nu).saturating_mul(3));
+    horizon.saturating_mul(per_step) <= MAX_WORKSPACE
+}
+
 fn shift_nodes(buffer: &mut [f64], width: usize, s: usize) {
     let nodes = buffer.len() / width;
     buffer.copy_within(s * width.., 0);

@@ -56,6 +56,19 @@ impl MpcSettings {
             },
         }
     }
+
+    /// The most modal coordinates `m` whose plan over `horizon` steps (`2m` states, `m`
+    /// controls) the solver's workspace holds ([`MAX_WORKSPACE`](crate::MAX_WORKSPACE)
+    /// numbers): 199 for the default 60 steps.
+    pub fn max_coords(&self) -> usize {
+        let horizon = self.horizon.max(1);
+        // `horizon * 14 m^2` numbers: from the square root's estimate, down to the first fit.
+        let mut m = (crate::MAX_WORKSPACE as f64 / (14.0 * horizon as f64)).sqrt() as usize + 1;
+        while m > 0 && !crate::ilqr::workspace_fits(2 * m, m, horizon) {
+            m -= 1;
+        }
+        m
+    }
 }
 
 /// The most steps of an MPC horizon.

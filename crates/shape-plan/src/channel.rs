@@ -12,6 +12,11 @@ pub const MAX_CENTERLINE_POINTS: usize = 100_000;
 /// million kilometres out would round them to millimetres).
 pub const MAX_CENTERLINE_EXTENT: f64 = 1e6;
 
+/// The shortest centreline segment and the smallest radius (m): a nanometre, ten times the
+/// rounding of a coordinate at [`MAX_CENTERLINE_EXTENT`] (points `1e-320` m apart made a channel
+/// whose deployed length came out negative).
+pub const MIN_CENTERLINE_SCALE: f64 = 1e-9;
+
 /// A planar channel: a centreline polyline (the plane `z = 0`) and its radius.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Channel {
@@ -24,9 +29,9 @@ pub struct Channel {
 }
 
 impl Channel {
-    /// A channel along `centerline` (at least two points, consecutive points distinct, each
-    /// coordinate within [`MAX_CENTERLINE_EXTENT`]) of `radius` (positive, at most
-    /// [`MAX_CENTERLINE_EXTENT`]).
+    /// A channel along `centerline` (at least two points, consecutive points at least
+    /// [`MIN_CENTERLINE_SCALE`] apart, each coordinate within [`MAX_CENTERLINE_EXTENT`]) of
+    /// `radius` (from [`MIN_CENTERLINE_SCALE`] to [`MAX_CENTERLINE_EXTENT`]).
     pub fn new(centerline: &[[f64; 2]], radius: f64) -> Result<Self, PlanError> {
         if centerline.len() < 2 {
             return Err(PlanError::Dimension {
@@ -43,10 +48,10 @@ impl Channel {
             });
         }
         check_finite("deploy radius", radius)?;
-        if !(radius > 0.0 && radius <= MAX_CENTERLINE_EXTENT) {
+        if !(MIN_CENTERLINE_SCALE..=MAX_CENTERLINE_EXTENT).contains(&radius) {
             return Err(PlanError::OutOfRange {
                 name: "deploy radius",
-                bound: "positive and at most 1e6 m",
+                bound: "from 1e-9 m to 1e6 m",
                 value: radius,
             });
         }
@@ -63,10 +68,10 @@ impl Channel {
         let mut arcs = vec![0.0];
         for pair in centerline.windows(2) {
             let step = dist(pair[0], pair[1]);
-            if step.is_nan() || step <= 0.0 {
+            if step.is_nan() || step < MIN_CENTERLINE_SCALE {
                 return Err(PlanError::OutOfRange {
                     name: "deploy centerline segment length",
-                    bound: "positive (consecutive points distinct)",
+                    bound: "at least 1e-9 m (consecutive points distinct)",
                     value: step,
                 });
             }

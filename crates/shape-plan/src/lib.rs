@@ -16,7 +16,7 @@ mod shape;
 mod spatial;
 
 pub use arm::{Arm, ArmScratch};
-pub use channel::{Channel, MAX_CENTERLINE_EXTENT, MAX_CENTERLINE_POINTS};
+pub use channel::{Channel, MAX_CENTERLINE_EXTENT, MAX_CENTERLINE_POINTS, MIN_CENTERLINE_SCALE};
 pub use data::PlanData;
 pub use deploy::{DeployFrame, Deployment, MAX_DEPLOY_STEPS, MAX_LENGTH_RATIO, follow_the_leader};
 pub use deploy_metrics::{

@@ -99,6 +99,18 @@ fn deployments_refuse_what_they_cannot_do() {
     assert!(
         text(Channel::new(&[[0.0, 0.0], [0.0, 1.0]], 0.0).unwrap_err()).contains("deploy radius")
     );
+    // Points closer than a nanometre, and a radius below one.
+    let close = [[0.0, 0.0], [0.0, 1e-320], [0.0, 2e-320]];
+    assert_eq!(
+        text(Channel::new(&close, 0.03).unwrap_err()),
+        "deploy centerline segment length must be at least 1e-9 m (consecutive points distinct), \
+         got 1e-320"
+    );
+    assert!(Channel::new(&[[0.0, 0.0], [0.0, 1e-9]], 1e-9).is_ok());
+    assert_eq!(
+        text(Channel::new(&[[0.0, 0.0], [0.0, 1.0]], 1e-316).unwrap_err()),
+        "deploy radius must be from 1e-9 m to 1e6 m, got 1e-316"
+    );
     assert!(
         text(Channel::new(&[[f64::NAN, 0.0], [0.0, 1.0]], 0.1).unwrap_err()).contains("finite")
     );

@@ -149,6 +149,20 @@ pub enum SimError {
         /// The joint torques it produced, one entry per joint.
         tau: Vec<f64>,
     },
+    /// A disturbance hook's finite joint torques whose modal force `J^T tau_d`, or its sum with
+    /// the controller's `tau*`, overflows.
+    #[error(
+        "the disturbance hook's joint torques at t = {} s give a modal force J^T tau_d (added to \
+         tau*) beyond double precision: {}",
+        Compact(*.t),
+        lane_math::compact_numbers(&format!("{force:?}"))
+    )]
+    DisturbanceOverflow {
+        /// When (s).
+        t: f64,
+        /// `tau* + J^T tau_d`, one entry per modal coordinate.
+        force: Vec<f64>,
+    },
     /// A controller failed with an error of its own (one that is not a [`SimError`]).
     #[error("the controller failed at t = {} s: {source}", Compact(*.t))]
     Controller {
@@ -270,6 +284,7 @@ impl Classify for SimError {
             | Self::ChainIntegration(_)
             | Self::NonFiniteControl { .. }
             | Self::NonFiniteDisturbance { .. }
+            | Self::DisturbanceOverflow { .. }
             | Self::Controller { .. }
             | Self::RunawayError { .. }
             | Self::JointRunaway { .. }

@@ -899,6 +899,12 @@ impl Simulation {
             for (tau, f) in self.plant.tau_star.iter_mut().zip(&sample.disturbance) {
                 *tau += f;
             }
+            if !self.plant.tau_star.iter().all(|v| v.is_finite()) {
+                return Err(SimError::DisturbanceOverflow {
+                    t,
+                    force: self.plant.tau_star.clone(),
+                });
+            }
             self.disturbed = true;
         } else if self.disturbed {
             sample.disturbance.fill(0.0);
@@ -1097,7 +1103,8 @@ fn check_run_work(
                  fewer links, harmonics or obstacles{}",
                 Compact(s.duration),
                 if controller_work > 0.0 {
-                    ", or a shorter MPC horizon or fewer iterations"
+                    ", or a controller of less work (another kind than this MPC, or in Rust \
+                     MpcSettings of a shorter horizon or fewer iterations)"
                 } else {
                     ""
                 }

@@ -1147,6 +1147,46 @@ fn spatial_rows() -> Vec<Row<DynError>> {
             |e| *e == DynError::SingularJoint { index: 2 } && e.is_numerical(),
             &["joint 2: the articulated inertia about its axis is not positive"],
         ),
+        // A subnormal inertia about the tip joint's axis (its mass on the axis): a pivot whose
+        // reciprocal overflows, alone and in a batch (it gave an infinite acceleration).
+        words(
+            "spatial_massless_joint",
+            {
+                let tiny = SpatialLink {
+                    mass: 1.0,
+                    com: [0.0; 3],
+                    inertia: [[1e-320, 0.0, 0.0], [0.0, 1e-320, 0.0], [0.0, 0.0, 1e-320]],
+                };
+                let arm = SpatialModel::new(vec![joint; 2], vec![link, tiny], [0.0; 3]).unwrap();
+                let error = manip_dyn::spatial::aba_batch(
+                    &arm,
+                    &mut manip_dyn::spatial::SpatialBatchData::new(&arm),
+                    &[0.1; 16],
+                    &[0.0; 16],
+                    &[0.0; 16],
+                    &mut [0.0; 16],
+                )
+                .unwrap_err();
+                assert_eq!(
+                    error,
+                    manip_dyn::BatchError::State {
+                        state: 0,
+                        error: DynError::SingularJoint { index: 1 }
+                    }
+                );
+                manip_dyn::spatial::aba(
+                    &arm,
+                    &mut SpatialData::new(&arm),
+                    &[0.0; 2],
+                    &[0.0; 2],
+                    &[0.0; 2],
+                    &mut [0.0; 2],
+                )
+                .unwrap_err()
+            },
+            |e| *e == DynError::SingularJoint { index: 1 },
+            &["joint 1: the articulated inertia about its axis is not positive"],
+        ),
     ]
 }
 

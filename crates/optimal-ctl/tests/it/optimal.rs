@@ -285,3 +285,31 @@ fn bad_settings_are_refused() {
             .is_err()
     );
 }
+
+#[test]
+fn mpc_max_coords_is_the_largest_plan_the_workspace_holds() {
+    use optimal_ctl::{Ilqr, MpcSettings, TrackingCost};
+    let cost = |m: usize| TrackingCost {
+        state: vec![1.0; 2 * m],
+        control: vec![1.0; m],
+        terminal: vec![1.0; 2 * m],
+    };
+    for horizon in [60, 1000] {
+        let mut settings = MpcSettings::uniform(1);
+        settings.horizon = horizon;
+        let m = settings.max_coords();
+        // 60 steps: 60 * 14 m^2 <= 2^25 up to m = 199.
+        if horizon == 60 {
+            assert_eq!(m, 199);
+        }
+        assert!(Ilqr::new(2 * m, m, horizon, &cost(m)).is_ok(), "{horizon}");
+        let err = Ilqr::new(2 * (m + 1), m + 1, horizon, &cost(m + 1)).unwrap_err();
+        assert!(matches!(
+            err,
+            OptimalError::InvalidSetting {
+                name: "horizon",
+                ..
+            }
+        ));
+    }
+}

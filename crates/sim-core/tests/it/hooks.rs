@@ -357,6 +357,29 @@ fn a_non_finite_disturbance_stops_the_run() {
     assert_eq!(failure.summary.simulated_s, 0.049);
 }
 
+#[test]
+fn a_finite_disturbance_whose_modal_force_overflows_is_named() {
+    let mut sim = simulation(model(9.81), Box::new(pd()));
+    let mut push = Push {
+        tau: vec![1e308; 10],
+        from: 0.05,
+    };
+    let failure = sim.run_with(&mut push).unwrap_err();
+    assert!(
+        matches!(failure.error, SimError::DisturbanceOverflow { t, .. } if t == 0.05),
+        "{}",
+        failure.error
+    );
+    let message = failure.error.to_string();
+    assert!(
+        message
+            .starts_with("the disturbance hook's joint torques at t = 0.05 s give a modal force")
+            && message.contains("inf"),
+        "{message}"
+    );
+    assert!(failure.error.is_numerical());
+}
+
 /// The PD controller on a step of the arm under gravity, prepared for runs of `duration`.
 fn prepared_step(duration: f64) -> Prepared {
     let reference = Step::new(&[0.1, -0.05], &[0.3, -0.2], 0.05).unwrap();

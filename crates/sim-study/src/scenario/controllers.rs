@@ -263,6 +263,19 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
                       within the joint limits and the clearance margin (clearance_m)",
         prepare: |s| {
             let settings = MpcSettings::uniform(m(s));
+            // The scenario's key that sets `m` (2K or 2K + 1 planar, 4K spatial).
+            if m(s) > settings.max_coords() {
+                return Err(SimError::setting(
+                    "modal.harmonics",
+                    format!(
+                        "gives {} modal coordinates, more than the {} whose plan over MPC's \
+                         {}-step horizon the solver holds",
+                        m(s),
+                        settings.max_coords(),
+                        settings.horizon
+                    ),
+                ));
+            }
             let (model, reference) = (s.model.clone(), Arc::clone(s.reference));
             let limits = s.limits.clone();
             let build = move || -> Result<Box<dyn Controller>, SimError> {

@@ -273,6 +273,24 @@ impl Scenario {
         // The metrics of the plan's shapes and of every recorded one, bounded before any is
         // computed.
         let links = self.arm.link_count(None)?;
+        if self.controller.kind == ControllerKind::Mpc {
+            // The insertion and every revolute joint, refused before the plan is made.
+            let mut settings = MpcSettings::uniform(1);
+            settings.horizon = DEPLOY_MPC_HORIZON;
+            let max = settings.max_coords();
+            if links + 1 > max {
+                return Err(SimError::setting(
+                    "arm.links",
+                    format!(
+                        "is {links}: with the insertion, {} joints, more than the {max} whose \
+                         plan over the deployment MPC's {DEPLOY_MPC_HORIZON}-step horizon the \
+                         solver holds",
+                        links + 1
+                    ),
+                )
+                .into());
+            }
+        }
         let shapes = DEPLOY_PLAN_STEPS + 2 + (self.duration / record_period) as usize;
         let work = deploy_metric_work(links, shapes);
         if work > MAX_DEPLOY_METRIC_WORK {

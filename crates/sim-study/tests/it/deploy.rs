@@ -317,7 +317,9 @@ fn deployment_keys_are_refused_by_name() {
     let mut huge = base.clone();
     huge.deploy.as_mut().unwrap().radius = 1e300;
     assert!(
-        message(&huge).starts_with("deploy.radius cannot be deployed into: deploy radius must be positive and at most 1e6 m"),
+        message(&huge).starts_with(
+            "deploy.radius cannot be deployed into: deploy radius must be from 1e-9 m to 1e6 m"
+        ),
         "{}",
         message(&huge)
     );

@@ -939,3 +939,43 @@ fn mpc_at_least_halves_clamped_computed_torque_on_the_fast_path() {
         clamped * 1e3
     );
 }
+
+/// A model of more coordinates than MPC's workspace plans over its horizon is refused by the
+/// scenario key that set them, before any run.
+#[test]
+fn mpc_on_too_many_coordinates_names_the_harmonics() {
+    let mut scenario = Scenario::builtin("paper-tracking").unwrap();
+    scenario.arm.links = Some(400);
+    scenario.modal.harmonics = 100;
+    scenario.duration = 1e-4;
+    scenario.reference = sim_study::ReferenceSpec::Step {
+        initial: None,
+        target: vec![0.0; 200],
+        time: 0.0,
+    };
+    scenario.controller.kind = ControllerKind::Mpc;
+    let Err(error) = scenario.build() else {
+        panic!("built")
+    };
+    let message = error.to_string();
+    assert!(
+        message.contains("modal.harmonics")
+            && message.contains("gives 200 modal coordinates, more than the 199"),
+        "{message}"
+    );
+    // One harmonic fewer fits the workspace; its solves are then counted in the run's work.
+    scenario.modal.harmonics = 99;
+    scenario.reference = sim_study::ReferenceSpec::Step {
+        initial: None,
+        target: vec![0.0; 198],
+        time: 0.0,
+    };
+    let Err(error) = scenario.build() else {
+        panic!("built")
+    };
+    let message = error.to_string();
+    assert!(
+        message.contains("of the controller's own") && message.contains("another kind than"),
+        "{message}"
+    );
+}
