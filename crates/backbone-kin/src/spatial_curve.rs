@@ -117,7 +117,7 @@ impl SpatialCurve {
         let within_budget = 2.0 * resolving <= max_steps as f64;
         if !within_budget {
             return Err(KinError::TooOscillatory {
-                needed: (2.0 * resolving).min(f64::MAX),
+                needed: 2.0 * resolving,
                 max: max_steps,
             });
         }

@@ -7,7 +7,7 @@
 //! is documented in `docs/eval-protocol.md`.
 
 use backbone_kin::{
-    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, KinError, end_point, inverse_kinematics,
+    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, end_point, inverse_kinematics,
     reduce_angle, tip_position,
 };
 use fuzzy_sugeno::FuzzySystem;
@@ -26,8 +26,8 @@ mod robot;
 mod spatial;
 
 use request::{
-    EvalError, EvalResult, Kind, MAX_GUESS, arm_object, finite, harmonics, json_fields, modal_map,
-    parse,
+    EvalError, EvalResult, Kind, MAX_GUESS, arm_object, curve_error, finite, harmonics,
+    json_fields, modal_map, parse,
 };
 
 /// Longest request line accepted (bytes); longer lines are skipped with a `line_too_long` error.
@@ -281,10 +281,7 @@ fn fk(mut request: FkRequest) -> EvalResult {
         [a1, a2] => end_point(length, [a1, a2], alpha0).map_err(EvalError::from),
         _ => BackboneCurve::new(length, modes, alpha0)
             .map(|curve| curve.end_point())
-            .map_err(|e| match e {
-                KinError::TooOscillatory { .. } => EvalError::input(format!("a: {e}")),
-                other => other.into(),
-            }),
+            .map_err(curve_error),
     }?;
     let mut theta = vec![0.0; map.n_joints()];
     map.joint_angles(&request.a, &mut theta)?;

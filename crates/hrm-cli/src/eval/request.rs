@@ -2,7 +2,7 @@
 //! fields read with the JSON path of the one at fault, `"arm"` objects, the modal map of a
 //! request's coordinates, and the checks and layout of an answer.
 
-use backbone_kin::{BaseAngle, ModalMap, reduce_angle};
+use backbone_kin::{BaseAngle, KinError, ModalMap, reduce_angle};
 use lane_math::{Classify, ErrorClass};
 use manip_dyn::ChainModel;
 use serde::de::DeserializeOwned;
@@ -250,6 +250,15 @@ pub(super) const MAX_MAP_ANSWER: usize = 1 << 22;
 /// Most work `n m^2` of a modal request (`M* = J^T M J` of `reduced` and its derivatives), about
 /// a tenth of a second.
 pub(super) const MAX_MAP_WORK: usize = 1 << 25;
+
+/// A backbone curve's error as an answer: one that quadrature refuses for its amplitudes names
+/// the request's `a`.
+pub(super) fn curve_error(error: KinError) -> EvalError {
+    match error {
+        KinError::TooOscillatory { .. } => EvalError::input(format!("a: {error}")),
+        other => other.into(),
+    }
+}
 
 /// Refuses to answer with a non-finite number (JSON has none).
 pub(super) fn finite(name: &str, values: &[f64]) -> Result<(), EvalError> {

@@ -2,7 +2,7 @@
 //! `joints`, `fk`, `ik`, `reduced`, `reduced_derivatives` and `export`
 //! (`docs/eval-protocol.md`, "Spatial arms").
 
-use super::request::{EvalError, EvalResult, finite, json_fields};
+use super::request::{EvalError, EvalResult, curve_error, finite, json_fields};
 use crate::arm_cmd::MAX_SPATIAL_EXPORT_LINKS;
 use backbone_kin::{
     BasePose, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, SpatialModalMap,
@@ -208,7 +208,10 @@ fn fk(request: StateRequest) -> EvalResult {
     let tip_chain = spatial_tip_position(map.link_lengths(), model.base(), &theta)?;
     let length: f64 = map.link_lengths().iter().sum();
     let curve = SpatialCurve::new(length, map.harmonics(), &request.a, *model.base())?;
-    let tip = curve.tip(SPATIAL_CURVE_TOLERANCE * length)?.position;
+    let tip = curve
+        .tip(SPATIAL_CURVE_TOLERANCE * length)
+        .map_err(curve_error)?
+        .position;
     finite("tip", &[tip, tip_chain].concat())?;
     Ok(json_fields([
         ("tip", json!(tip)),
@@ -432,8 +435,17 @@ mod tests {
             "a": vec![30.0; 64], "harmonics": 16}));
         let message = answer["error"]["message"].as_str().unwrap();
         assert!(
-            message.starts_with("the curve oscillates too fast")
+            message.starts_with("a: the curve oscillates too fast")
                 && message.ends_with("at most 262144 allowed"),
+            "{message}"
+        );
+        // Amplitudes whose turning bound overflows.
+        let answer = request(json!({"op": "fk", "arm": {"kind": "spatial"},
+            "a": [1e308, 1e308, 0.0, 0.0]}));
+        let message = answer["error"]["message"].as_str().unwrap();
+        assert!(
+            message.starts_with("a: the curve oscillates too fast")
+                && message.contains("more than 1e308 nodes needed"),
             "{message}"
         );
     }
