@@ -797,6 +797,39 @@ fn messages_say_what_failed() {
 }
 
 /// Every refusal of a bad spatial model, joint or link, and of a bad spatial call.
+/// The error of `arm`'s ABA at rest alone, checked to be the first state's error in a batch of
+/// eight states (`q = 0.1`) as well.
+fn aba_error_alone_and_in_a_batch(arm: &manip_dyn::spatial::SpatialModel) -> DynError {
+    use manip_dyn::spatial::SpatialData;
+    let n = arm.n_links();
+    let error = manip_dyn::spatial::aba(
+        arm,
+        &mut SpatialData::new(arm),
+        &vec![0.0; n],
+        &vec![0.0; n],
+        &vec![0.0; n],
+        &mut vec![0.0; n],
+    )
+    .unwrap_err();
+    let batch = manip_dyn::spatial::aba_batch(
+        arm,
+        &mut manip_dyn::spatial::SpatialBatchData::new(arm),
+        &vec![0.1; 8 * n],
+        &vec![0.0; 8 * n],
+        &vec![0.0; 8 * n],
+        &mut vec![0.0; 8 * n],
+    )
+    .unwrap_err();
+    assert_eq!(
+        batch,
+        manip_dyn::BatchError::State {
+            state: 0,
+            error: error.clone()
+        }
+    );
+    error
+}
+
 fn spatial_rows() -> Vec<Row<DynError>> {
     use manip_dyn::spatial::{
         SpatialData, SpatialDerivativeData, SpatialJoint, SpatialLink, SpatialModel, Transform,
@@ -1118,31 +1151,7 @@ fn spatial_rows() -> Vec<Row<DynError>> {
                 };
                 let arm = SpatialModel::new(vec![joint; 3], vec![link, link, massless], [0.0; 3])
                     .unwrap();
-                let error = manip_dyn::spatial::aba_batch(
-                    &arm,
-                    &mut manip_dyn::spatial::SpatialBatchData::new(&arm),
-                    &[0.1; 24],
-                    &[0.0; 24],
-                    &[0.0; 24],
-                    &mut [0.0; 24],
-                )
-                .unwrap_err();
-                assert_eq!(
-                    error,
-                    manip_dyn::BatchError::State {
-                        state: 0,
-                        error: DynError::SingularJoint { index: 2 }
-                    }
-                );
-                manip_dyn::spatial::aba(
-                    &arm,
-                    &mut SpatialData::new(&arm),
-                    &[0.0; 3],
-                    &[0.0; 3],
-                    &[0.0; 3],
-                    &mut [0.0; 3],
-                )
-                .unwrap_err()
+                aba_error_alone_and_in_a_batch(&arm)
             },
             |e| *e == DynError::SingularJoint { index: 2 } && e.is_numerical(),
             &["joint 2: the articulated inertia about its axis is not positive"],
@@ -1158,31 +1167,7 @@ fn spatial_rows() -> Vec<Row<DynError>> {
                     inertia: [[1e-320, 0.0, 0.0], [0.0, 1e-320, 0.0], [0.0, 0.0, 1e-320]],
                 };
                 let arm = SpatialModel::new(vec![joint; 2], vec![link, tiny], [0.0; 3]).unwrap();
-                let error = manip_dyn::spatial::aba_batch(
-                    &arm,
-                    &mut manip_dyn::spatial::SpatialBatchData::new(&arm),
-                    &[0.1; 16],
-                    &[0.0; 16],
-                    &[0.0; 16],
-                    &mut [0.0; 16],
-                )
-                .unwrap_err();
-                assert_eq!(
-                    error,
-                    manip_dyn::BatchError::State {
-                        state: 0,
-                        error: DynError::SingularJoint { index: 1 }
-                    }
-                );
-                manip_dyn::spatial::aba(
-                    &arm,
-                    &mut SpatialData::new(&arm),
-                    &[0.0; 2],
-                    &[0.0; 2],
-                    &[0.0; 2],
-                    &mut [0.0; 2],
-                )
-                .unwrap_err()
+                aba_error_alone_and_in_a_batch(&arm)
             },
             |e| *e == DynError::SingularJoint { index: 1 },
             &["joint 1: the articulated inertia about its axis is not positive"],
