@@ -338,6 +338,24 @@ impl MembershipFn {
                     "sigma1 and sigma2 must be positive, got {sigma1} and {sigma2}"
                 ));
             }
+            // The evaluation's `1 / (2 sigma^2)` must be finite and normal: a sigma of 1e308
+            // or 1e-300 gave NaN degrees, read as rules that did not fire.
+            Self::Gaussian { sigma, .. } | Self::Gaussian2 { sigma1: sigma, .. }
+                if !gauss_scale_fits(sigma) =>
+            {
+                return fail(format!(
+                    "sigma must be within [1e-154, 1e153] (1 / (2 sigma^2) in double precision), \
+                     got {}",
+                    lane_math::Compact(sigma)
+                ));
+            }
+            Self::Gaussian2 { sigma2, .. } if !gauss_scale_fits(sigma2) => {
+                return fail(format!(
+                    "sigma2 must be within [1e-154, 1e153] (1 / (2 sigma^2) in double precision), \
+                     got {}",
+                    lane_math::Compact(sigma2)
+                ));
+            }
             Self::Triangle { left, peak, right } if !(left <= peak && peak <= right) => {
                 return fail(format!(
                     "corners must satisfy a <= b <= c, got {}",
@@ -400,7 +418,6 @@ impl MembershipFn {
     /// Validates the function and picks its evaluation form ([`CompiledMf`]).
     pub(crate) fn compile(&self) -> Result<CompiledMf, FuzzyError> {
         self.validate()?;
-        let gauss_k = |sigma: f64| 1.0 / (2.0 * sigma * sigma);
         Ok(match *self {
             MembershipFn::Bell {
                 width,
@@ -679,6 +696,18 @@ pub(crate) static KINDS: [Kind; 12] = [
         landmarks: |_| Vec::new(),
     },
 ];
+
+/// A Gaussian's evaluation constant `1 / (2 sigma^2)`.
+fn gauss_k(sigma: f64) -> f64 {
+    1.0 / (2.0 * sigma * sigma)
+}
+
+/// Whether a Gaussian's `sigma` gives a finite, normal [`gauss_k`]: from about `5e-155` to
+/// `4.7e153` (messages quote [1e-154, 1e153]).
+fn gauss_scale_fits(sigma: f64) -> bool {
+    let k = gauss_k(sigma);
+    k.is_finite() && k >= f64::MIN_POSITIVE
+}
 
 /// Formats parameters the way a `.fis` file shows them: `[0.3 2 -0.3]`.
 pub(crate) fn format_params(params: &[f64]) -> String {

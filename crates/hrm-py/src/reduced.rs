@@ -238,8 +238,9 @@ impl ReducedModel {
                     .joint_angles(a, &mut ws.theta)
                     .map_err(Error::from)?;
                 check_finite("theta", &ws.theta)?;
-                let tip =
-                    backbone_kin::tip_position(&self.lengths, &ws.theta).map_err(Error::from)?;
+                // Finite joint angles whose running sums overflow: named by `a`.
+                let tip = backbone_kin::tip_position(&self.lengths, &ws.theta)
+                    .map_err(|e| Error::input(format!("a: {e}")))?;
                 out.copy_from_slice(&tip);
                 check_finite("tip", out)
             },

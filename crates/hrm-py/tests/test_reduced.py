@@ -210,5 +210,9 @@ def test_model_errors(arm):
     huge = np.full(3, np.finfo(float).max)
     with pytest.raises(hrm.NumericalError, match="theta came out non-finite"):
         model.fk(huge)
+    # Finite joint angles whose running sums (the links' absolute angles) overflow.
+    fixed = hrm.ReducedModel(arm, alpha0=0.0)
+    with pytest.raises(hrm.InvalidInput, match=r"^a: absolute link angles .*\[\d+\] must be finite, got inf$"):
+        fixed.fk([0.0, 1e308])
     with pytest.raises(hrm.NumericalError, match=r"theta = J a \+ theta_0 is not finite"):
         model.joint_torques(huge, np.zeros(3), np.zeros(3))

@@ -149,6 +149,24 @@ pub enum SimError {
         /// The joint torques it produced, one entry per joint.
         tau: Vec<f64>,
     },
+    /// A reference whose sample came out NaN or infinite: parameters beyond what double
+    /// precision resolves (checked before the controller sees it).
+    #[error(
+        "the reference's {name}[{index}] came out {} at t = {} s: its parameters are beyond \
+         double precision",
+        Compact(*.value),
+        Compact(*.t)
+    )]
+    NonFiniteReference {
+        /// When (s).
+        t: f64,
+        /// `"a"`, `"a_dot"` or `"a_ddot"`.
+        name: &'static str,
+        /// The coordinate (0-based).
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
     /// A disturbance hook's finite joint torques whose modal force `J^T tau_d`, or its sum with
     /// the controller's `tau*`, overflows.
     #[error(

@@ -830,6 +830,7 @@ impl Simulation {
             Some(reference) => sample.reference.copy_from(reference),
             None => self.reference.sample(t, &mut sample.reference)?,
         }
+        check_reference(t, &sample.reference)?;
         // Before the controller sees them: at 1e20 rad every step would round away.
         if let Some((i, value)) = (0..m)
             .map(|i| (i, sample.state.a[i].abs().max(sample.reference.a[i].abs())))
@@ -1047,6 +1048,25 @@ fn check_joint_torque_limit(limit: f64) -> Result<(), SimError> {
                 Compact(limit)
             ),
         ));
+    }
+    Ok(())
+}
+
+/// Refuses a reference sample with a NaN or infinite entry, naming the first.
+fn check_reference(t: f64, reference: &ReferenceSample) -> Result<(), SimError> {
+    for (name, values) in [
+        ("a", &reference.a),
+        ("a_dot", &reference.a_dot),
+        ("a_ddot", &reference.a_ddot),
+    ] {
+        if let Some((index, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(SimError::NonFiniteReference {
+                t,
+                name,
+                index,
+                value,
+            });
+        }
     }
     Ok(())
 }

@@ -54,6 +54,31 @@ fn membership_zero_width() {
     );
 }
 
+/// A Gaussian whose `1 / (2 sigma^2)` leaves double precision gave NaN degrees (read as rules
+/// that did not fire: a wrong answer, no error); refused, while the ends of the range evaluate.
+#[test]
+fn membership_gaussian_scale_beyond_double_precision() {
+    for sigma in [1e308, 1e154, 1e-160, 1e-300] {
+        let reason = membership_reason(MembershipFn::gaussian(sigma, 0.0));
+        assert!(
+            reason.starts_with("sigma must be within [1e-154, 1e153]"),
+            "{reason}"
+        );
+    }
+    let two = MembershipFn::Gaussian2 {
+        sigma1: 1.0,
+        center1: 0.0,
+        sigma2: 1e-300,
+        center2: 1.0,
+    };
+    assert!(membership_reason(two).contains("sigma2 must be within"));
+    for (sigma, x) in [(1e153, 1e153), (1e-154, 1e-154), (1e153, 1.7e308)] {
+        let degree = MembershipFn::gaussian(sigma, 0.0).degree(x).unwrap();
+        let expected = (-0.5 * (x / sigma) * (x / sigma)).exp();
+        assert!((degree - expected).abs() < 1e-12, "{sigma} {x}: {degree}");
+    }
+}
+
 #[test]
 fn membership_non_positive_slope() {
     assert!(

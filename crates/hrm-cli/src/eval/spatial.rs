@@ -2,20 +2,17 @@
 //! `joints`, `fk`, `ik`, `reduced`, `reduced_derivatives` and `export`
 //! (`docs/eval-protocol.md`, "Spatial arms").
 
-use super::request::{EvalError, EvalResult, curve_error, finite, json_fields};
+use super::request::{EvalError, EvalResult, arm_object, curve_error, finite, json_fields};
 use crate::arm_cmd::MAX_SPATIAL_EXPORT_LINKS;
-use backbone_kin::{
-    BasePose, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, SpatialModalMap,
-    spatial_tip_position,
-};
-use manip_dyn::DynError;
-use modal_reduce::ReduceError;
+use backbone_kin::{SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, spatial_tip_position};
 use modal_reduce::spatial::{
-    SpatialLinkInertia, SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel,
-    spatial_forward_dynamics, spatial_joint_torques, spatial_reduced_derivatives,
+    SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel, spatial_forward_dynamics,
+    spatial_joint_torques, spatial_reduced_derivatives,
 };
 use serde::Deserialize;
 use serde_json::{Map, Value, json};
+use sim_core::SimError;
+use sim_study::{ArmSpec, Inertias};
 
 /// Most links of a spatial arm in a request (`2n` joints).
 const MAX_SPATIAL_LINKS: usize = 100_000;
@@ -51,75 +48,29 @@ pub(super) fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
     }
 }
 
-/// `"base"` of a spatial arm.
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct BaseSpec {
-    #[serde(default)]
-    xyz: [f64; 3],
-    #[serde(default)]
-    rpy: [f64; 3],
-}
-
-/// A spatial arm as requests give it.
+/// A spatial arm as requests give it: the fields of a scenario's `[arm]` with
+/// `kind = "spatial"` ([`ArmSpec::to_spatial`], whose refusals name the field), within the
+/// request bounds of [`MAX_SPATIAL_LINKS`] links and [`MAX_SPATIAL_WORK`].
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SpatialArmSpec {
-    #[allow(dead_code, reason = "checked by is_spatial: always \"spatial\" here")]
-    kind: String,
-    joints: Option<String>,
-    links: Option<usize>,
-    link_length: Option<f64>,
-    lengths: Option<Vec<f64>>,
-    link_mass: Option<f64>,
-    masses: Option<Vec<f64>>,
-    inertias: Option<Vec<[f64; 3]>>,
-    gravity: Option<[f64; 3]>,
-    #[serde(default)]
-    base: BaseSpec,
-}
+#[serde(transparent)]
+struct SpatialArmSpec(#[serde(deserialize_with = "arm_object")] ArmSpec);
 
 impl SpatialArmSpec {
     /// The arm's reduced model with `harmonics` harmonics per plane; the defaults are the
     /// paper's link size (10 links of 0.1 m and 0.1 kg, slender rods) under gravity along `-z`.
     fn model(&self, harmonics: usize) -> Result<SpatialReducedModel, EvalError> {
-        if let Some(joints) = self.joints.as_deref().filter(|j| *j != "universal") {
-            return Err(EvalError::input(format!(
-                "arm.joints must be \"universal\", got {joints:?}"
-            )));
+        let arm = &self.0;
+        if arm.radius.is_some() {
+            return Err(EvalError::input(
+                "arm.radius is not used by the ops of a spatial arm (it is a scenario's clearance)",
+            ));
         }
-        let n = match (&self.lengths, &self.masses, &self.inertias) {
-            (Some(v), _, _) => v.len(),
-            (_, Some(v), _) => v.len(),
-            (_, _, Some(v)) => v.len(),
-            _ => self.links.unwrap_or(10),
-        };
-        if n == 0 || n > MAX_SPATIAL_LINKS {
+        let n = arm.link_count(arm.inertias.as_ref().map(Inertias::len))?;
+        if n > MAX_SPATIAL_LINKS {
             return Err(EvalError::input(format!(
                 "arm.links must be from 1 to {MAX_SPATIAL_LINKS}, got {n}"
             )));
         }
-        if self.links.is_some_and(|links| links != n) {
-            return Err(EvalError::input(format!(
-                "arm.links is {} but the per-link lists have {n} entries",
-                self.links.unwrap_or(0)
-            )));
-        }
-        let per_link =
-            |name: &str, list: &Option<Vec<f64>>, one: Option<f64>, default: f64| match (list, one)
-            {
-                (Some(_), Some(_)) => Err(EvalError::input(format!(
-                    "give arm.{name}s or arm.link_{name}, not both"
-                ))),
-                (Some(list), None) if list.len() != n => Err(EvalError::input(format!(
-                    "arm.{name}s has {} entries, expected {n}",
-                    list.len()
-                ))),
-                (Some(list), None) => Ok(list.clone()),
-                (None, one) => Ok(vec![one.unwrap_or(default); n]),
-            };
-        let lengths = per_link("length", &self.lengths, self.link_length, 0.1)?;
-        let masses = per_link("masse", &self.masses, self.link_mass, 0.1)?;
         let work = (2 * n)
             .saturating_mul(4 * harmonics)
             .saturating_mul(4 * harmonics);
@@ -130,40 +81,10 @@ impl SpatialArmSpec {
                 MAX_SPATIAL_WORK / 2
             )));
         }
-        let map = SpatialModalMap::new(&lengths, harmonics)?;
-        let links = match &self.inertias {
-            Some(inertias) if inertias.len() != n => {
-                return Err(EvalError::input(format!(
-                    "arm.inertias has {} entries, expected {n}",
-                    inertias.len()
-                )));
-            }
-            Some(inertias) => masses
-                .iter()
-                .zip(inertias)
-                .map(|(&mass, &principal)| SpatialLinkInertia { mass, principal })
-                .collect(),
-            None => masses
-                .iter()
-                .zip(&lengths)
-                .map(|(&mass, &length)| SpatialLinkInertia::rod(mass, length))
-                .collect(),
-        };
-        let base = BasePose {
-            xyz: self.base.xyz,
-            rpy: self.base.rpy,
-        };
-        // A scenario's bound on `arm.gravity` (a spatial arm's accelerations under 1e308 m/s^2
-        // came back as answers of 1e307).
-        let gravity = self.gravity.unwrap_or([0.0, 0.0, -9.81]);
-        sim_study::Gravity::Vector(gravity)
-            .check()
-            .map_err(|e| EvalError::input(e.to_string()))?;
-        // A link the model refuses with the user's inertias has a bad inertia (its mass is
-        // checked with the lengths above).
-        SpatialReducedModel::new(map, base, links, gravity).map_err(|e| match e {
-            ReduceError::Dyn(DynError::InvalidLink { index, .. }) if self.inertias.is_some() => {
-                EvalError::input(format!("arm.inertias[{index}] is invalid: {e}"))
+        // The scenario's `modal.harmonics` is the request's `harmonics`.
+        arm.to_spatial(harmonics).map_err(|e| match e {
+            SimError::InvalidSetting { name, requirement } if name == "modal.harmonics" => {
+                EvalError::input(format!("harmonics {requirement}"))
             }
             e => e.into(),
         })
@@ -187,6 +108,7 @@ struct StateRequest {
 fn joints(request: StateRequest) -> EvalResult {
     let model = request.arm.model(harmonics(request.harmonics)?)?;
     let map = model.map();
+    lane_math::check_values("a", &request.a, map.n_coords())?;
     let mut theta = vec![0.0; map.n_joints()];
     map.joint_angles(&request.a, &mut theta)?;
     finite("theta", &theta)?;
@@ -202,6 +124,7 @@ fn joints(request: StateRequest) -> EvalResult {
 fn fk(request: StateRequest) -> EvalResult {
     let model = request.arm.model(harmonics(request.harmonics)?)?;
     let map = model.map();
+    lane_math::check_values("a", &request.a, map.n_coords())?;
     let mut theta = vec![0.0; map.n_joints()];
     map.joint_angles(&request.a, &mut theta)?;
     finite("theta", &theta)?;
@@ -235,7 +158,10 @@ fn ik(request: IkRequest) -> EvalResult {
     let model = request.arm.model(harmonics(request.harmonics)?)?;
     let m = model.n_coords();
     let mut a = match request.guess {
-        Some(guess) => guess,
+        Some(guess) => {
+            lane_math::check_len("guess", guess.len(), m)?;
+            guess
+        }
         None => (0..m)
             .map(|j| if j % 2 == 0 { 0.25 } else { 0.0 })
             .collect(),
@@ -573,7 +499,7 @@ mod tests {
             ),
             (
                 json!({"op": "joints", "arm": {"kind": "spatial", "joints": "alternating"}, "a": [0, 0, 0, 0]}),
-                "arm.joints must be \"universal\"",
+                "arm.joints: unknown variant `alternating`, expected `universal`",
             ),
             (
                 json!({"op": "joints", "arm": {"kind": "spatial", "links": 100_000}, "a": [], "harmonics": 16}),
@@ -581,15 +507,15 @@ mod tests {
             ),
             (
                 json!({"op": "joints", "arm": {"kind": "spatial", "links": 0}, "a": [0, 0, 0, 0]}),
-                "arm.links must be from 1",
+                "arm.links must be at least 1",
             ),
             (
                 json!({"op": "joints", "arm": {"kind": "spatial", "lengths": [0.1, 0.2], "masses": [0.1]},
                     "a": [0, 0, 0, 0]}),
-                "arm.masses has 1 entries, expected 2",
+                "arm.masses has 1 entries but the arm has 2 links",
             ),
             (
-                json!({"op": "joints", "arm": {"kind": "spatial", "inertias": [[1.0, 0.1, 0.1]]}, "a": [0, 0, 0, 0]}),
+                json!({"op": "joints", "arm": {"kind": "spatial", "inertias": [[1.0, 0.1, 0.1], [1.0, 0.1, 0.1]]}, "a": [0, 0, 0, 0]}),
                 "arm.inertias[0] is invalid: chain dynamics: link 0: principal inertia must be at \
                  most the sum of the other two (triangle",
             ),
@@ -608,6 +534,33 @@ mod tests {
             (
                 json!({"op": "ik", "arm": {"kind": "spatial"}, "target": [5.0, 0.0, 0.0]}),
                 "out of reach",
+            ),
+            // The fields a scenario's spatial arm names, through the same checks.
+            (
+                json!({"op": "fk", "arm": {"kind": "spatial", "link_length": -0.0}, "a": [0, 0, 0, 0]}),
+                "arm.link_length must be positive and finite, got -0",
+            ),
+            (
+                json!({"op": "fk", "arm": {"kind": "spatial", "link_length": 1e300}, "a": [0, 0, 0, 0]}),
+                "arm.link_length of 1e300 m with a mass of 0.1 kg gives a rod inertia",
+            ),
+            (
+                json!({"op": "fk", "arm": {"kind": "spatial", "base": {"xyz": [1e300, 0, 0]}},
+                    "a": [0, 0, 0, 0]}),
+                "arm.base.xyz is invalid",
+            ),
+            (
+                json!({"op": "fk", "arm": {"kind": "spatial", "radius": 0.01}, "a": [0, 0, 0, 0]}),
+                "arm.radius is not used",
+            ),
+            (
+                json!({"op": "joints", "arm": {"kind": "spatial"}, "a": [0, 0, 0, 0, 0]}),
+                "a has 5 entries, expected 4",
+            ),
+            (
+                json!({"op": "ik", "arm": {"kind": "spatial"}, "target": [0.5, 0.1, 0.1],
+                    "guess": [0.1, 0.1, 0.1]}),
+                "guess has 3 entries, expected 4",
             ),
             (
                 json!({"op": "joints", "arm": {"kind": "spatial", "colour": 1}, "a": [0, 0, 0, 0]}),

@@ -22,7 +22,31 @@ pub use spline::{MAX_SPLINE_SAMPLES, SplineMotion};
 pub use waypoints::{MAX_WAYPOINTS, Waypoints};
 
 use crate::error::{SimError, check_non_negative};
-use lane_math::check_all_finite;
+use lane_math::{Compact, check_all_finite};
+
+/// The shortest travel time of a moving reference (s): its rates scale with its inverse and its
+/// accelerations with its inverse square (`5e-324` s gave NaN rates).
+pub const MIN_TRAVEL_TIME_S: f64 = 1e-6;
+
+/// The highest frequency of a [`Sinusoid`] (Hz): its accelerations scale with the square
+/// (`1e300` Hz gave a NaN acceleration at `t = 0`).
+pub const MAX_REFERENCE_FREQUENCY_HZ: f64 = 1e6;
+
+/// Checks that the travel time `name` is finite and at least [`MIN_TRAVEL_TIME_S`].
+pub(crate) fn check_travel_time(name: &str, value: f64) -> Result<(), SimError> {
+    if value.is_finite() && value >= MIN_TRAVEL_TIME_S {
+        Ok(())
+    } else {
+        Err(SimError::setting(
+            name,
+            format!(
+                "must be finite and at least {} s, got {}",
+                Compact(MIN_TRAVEL_TIME_S),
+                Compact(value)
+            ),
+        ))
+    }
+}
 
 /// The desired modal motion at one instant, `m` entries per field.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -177,8 +201,8 @@ pub struct Sinusoid {
 }
 
 impl Sinusoid {
-    /// A sinusoid per coordinate (equal lengths); `frequency_hz` in Hz (non-negative), `phase`
-    /// in rad.
+    /// A sinusoid per coordinate (equal lengths); `frequency_hz` in Hz (non-negative, at most
+    /// [`MAX_REFERENCE_FREQUENCY_HZ`]), `phase` in rad.
     ///
     /// ```
     /// use sim_core::reference::{Reference, ReferenceSample, Sinusoid};
@@ -203,6 +227,16 @@ impl Sinusoid {
         ])?;
         for &f in frequency_hz {
             check_non_negative("reference.frequency_hz", f)?;
+            if f > MAX_REFERENCE_FREQUENCY_HZ {
+                return Err(SimError::setting(
+                    "reference.frequency_hz",
+                    format!(
+                        "must be at most {} Hz, got {}",
+                        Compact(MAX_REFERENCE_FREQUENCY_HZ),
+                        Compact(f)
+                    ),
+                ));
+            }
         }
         Ok(Self {
             offset: offset.to_vec(),

@@ -109,7 +109,7 @@ impl CartesianPath {
         base: BaseAngle,
         branch: Branch,
     ) -> Result<Self, SimError> {
-        check_positive("reference.travel_time", travel_time)?;
+        super::check_travel_time("reference.travel_time", travel_time)?;
         check_positive("arm length", length)?;
         if let BaseAngle::Fixed(alpha0) = base {
             check_all_finite("alpha0", &[alpha0])?;

@@ -224,7 +224,7 @@ impl SpatialPath {
         base: BasePose,
         branch: Branch,
     ) -> Result<Self, SimError> {
-        check_positive("reference.travel_time", travel_time)?;
+        super::check_travel_time("reference.travel_time", travel_time)?;
         let frame = helix.frame()?;
         let m = map.n_coords();
         let length: f64 = map.link_lengths().iter().sum();

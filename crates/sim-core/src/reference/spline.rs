@@ -2,7 +2,7 @@
 //! follow-the-leader deployment, sampled by its tip's progress), interpolated smoothly and timed.
 
 use super::{Reference, ReferenceSample, check_lengths, minimum_jerk};
-use crate::error::{SimError, check_positive};
+use crate::error::SimError;
 
 /// The most samples a [`SplineMotion`] accepts.
 pub const MAX_SPLINE_SAMPLES: usize = 65_536;
@@ -48,7 +48,7 @@ impl SplineMotion {
                 ),
             ));
         }
-        check_positive("reference travel time", travel_time)?;
+        super::check_travel_time("reference travel time", travel_time)?;
         let arrays: Vec<(&str, &[f64])> = samples
             .iter()
             .map(|s| ("reference sample", s.as_slice()))

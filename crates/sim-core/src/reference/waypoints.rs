@@ -2,7 +2,7 @@
 //! plan (`shape-plan`) returns, followed in time.
 
 use super::{Reference, ReferenceSample, check_lengths, minimum_jerk};
-use crate::error::{SimError, check_positive};
+use crate::error::SimError;
 
 /// The most waypoints a [`Waypoints`] reference accepts.
 pub const MAX_WAYPOINTS: usize = 65_536;
@@ -45,7 +45,7 @@ impl Waypoints {
                 ),
             ));
         }
-        check_positive("reference travel time", travel_time)?;
+        super::check_travel_time("reference travel time", travel_time)?;
         let mut arrays = vec![("reference waypoint", points[0].as_slice())];
         arrays.extend(
             points[1..]

@@ -495,3 +495,51 @@ fn a_spatial_group_gives_each_run_alone() {
         assert_eq!(together[k].tape.samples, alone.tape.samples, "run {k}");
     }
 }
+
+/// A step whose rate turns NaN from `from` seconds on (a user's reference gone bad).
+struct SpoiledStep {
+    step: Step,
+    from: f64,
+}
+
+impl sim_core::reference::Reference for SpoiledStep {
+    fn n_coords(&self) -> usize {
+        self.step.n_coords()
+    }
+
+    fn sample(
+        &mut self,
+        t: f64,
+        s: &mut sim_core::reference::ReferenceSample,
+    ) -> Result<(), SimError> {
+        self.step.sample(t, s)?;
+        if t >= self.from {
+            s.a_dot[1] = f64::NAN;
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn a_non_finite_reference_stops_the_run_before_the_controller_sees_it() {
+    let reference = SpoiledStep {
+        step: Step::new(&[0.1, -0.05], &[0.3, -0.2], 0.05).unwrap(),
+        from: 0.1,
+    };
+    let settings = LoopSettings::new(Integrator::Rk4 { dt: 5e-4 }, 1e-3, 0.2);
+    let mut sim = Simulation::new(
+        model(9.81),
+        Box::new(reference),
+        Box::new(pd()),
+        settings,
+        None,
+    )
+    .unwrap();
+    let failure = sim.run().unwrap_err();
+    assert_eq!(
+        failure.error.to_string(),
+        "the reference's a_dot[1] came out NaN at t = 0.1 s: its parameters are beyond double \
+         precision"
+    );
+    assert_eq!(failure.summary.simulated_s, 0.099);
+}

@@ -214,6 +214,41 @@ fn bad_paths_are_refused_with_the_reason() {
     }
 }
 
+/// Parameters whose rates or accelerations double precision cannot hold are refused up front:
+/// a travel time of `5e-324` s gave NaN rates, a frequency of `1e300` Hz a NaN acceleration.
+#[test]
+fn references_beyond_double_precision_are_refused() {
+    let line = || PathShape::Polyline(vec![[0.3, 0.3], [0.2, 0.4]]);
+    let base = BaseAngle::Fixed(FRAC_PI_2);
+    for time in [5e-324, 1e-300, 9.9e-7] {
+        let err = CartesianPath::new(line(), time, 1.0, 1, base, Branch::Positive).unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("reference.travel_time must be finite and at least 1e-6 s, got"),
+            "{err}"
+        );
+    }
+    assert!(CartesianPath::new(line(), 1e-6, 1.0, 1, base, Branch::Positive).is_ok());
+    let waypoints = sim_core::reference::Waypoints::new(&[vec![0.0], vec![1.0]], 1e-300);
+    assert!(
+        waypoints
+            .unwrap_err()
+            .to_string()
+            .contains("at least 1e-6 s")
+    );
+    let spline = sim_core::reference::SplineMotion::new(&[vec![0.0], vec![1.0]], 5e-324);
+    assert!(spline.unwrap_err().to_string().contains("at least 1e-6 s"));
+    let err = Sinusoid::new(&[0.0; 2], &[0.1; 2], &[1e300, 1.0], &[0.0; 2]).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "reference.frequency_hz must be at most 1000000 Hz, got 1e300"
+    );
+    // The highest frequency: accelerations of 0.1 (2 pi 1e6)^2, finite.
+    let mut sine = Sinusoid::new(&[0.0], &[0.1], &[1e6], &[0.5]).unwrap();
+    let sample = at(&mut sine, 0.25);
+    assert!(sample.a_ddot[0].is_finite() && sample.a_ddot[0].abs() > 1e11);
+}
+
 /// The paper's path for a family of `harmonics` harmonics with `alpha0` fixed at pi/2 or free.
 fn family_path(harmonics: usize, free: bool) -> CartesianPath {
     let shape = PathShape::Sine {

@@ -379,7 +379,10 @@ impl ArmSpec {
     /// The number of links: `links`, or the length of the per-link lists given (`lengths`,
     /// `masses`, and `inertias` of `inertias` entries), which must agree; 10 by default, at least
     /// 1 and at most [`manip_dyn::MAX_LINKS`]. Checked before any per-link array is allocated.
-    pub(super) fn link_count(&self, inertias: Option<usize>) -> Result<usize, SimError> {
+    ///
+    /// # Errors
+    /// [`SimError::InvalidSetting`] naming the list whose count disagrees, or `arm.links`.
+    pub fn link_count(&self, inertias: Option<usize>) -> Result<usize, SimError> {
         let mut n = self.links;
         for (name, count) in [
             ("arm.lengths", self.lengths.as_ref().map(Vec::len)),
