@@ -195,6 +195,7 @@ impl Chain {
         gravity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let gravity = gravity.map_or(Ok(DEFAULT_GRAVITY), |g| crate::args::vec3(g, "gravity"))?;
+        robot_desc::check_gravity(gravity).map_err(Error::from)?;
         let text = urdf_text(urdf)?;
         Ok(Self::read(&text, gravity)?)
     }

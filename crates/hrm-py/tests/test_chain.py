@@ -152,6 +152,9 @@ def test_bad_states_are_refused():
         chain.aba([np.nan, 0.0], [0.0, 0.0], [0.0, 0.0])
     with pytest.raises(hrm.InvalidInput, match="state 1"):
         chain.aba_derivatives([[0.0, 0.0], [np.inf, 0.0]], np.zeros((2, 2)), np.zeros((2, 2)))
+    # A gravity beyond the bound of a URDF's numbers (1e9), as hrm eval refuses it.
+    with pytest.raises(hrm.InvalidInput, match=r"^gravity: must be three finite numbers .* got \[0, 0, 1.7e308\]$"):
+        hrm.Chain.from_urdf(random_chain(1, 2), gravity=(0.0, 0.0, 1.7e308))
 
 
 def test_pickle_and_urdf_round_trip():

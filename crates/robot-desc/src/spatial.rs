@@ -11,6 +11,7 @@ use manip_dyn::spatial::{SpatialJoint, SpatialLink, SpatialModel, Transform};
 /// written as two revolute joints) is kept as it is: `manip-dyn`'s forward dynamics refuse, naming
 /// the joint, only a joint that moves nothing with mass (`DynError::SingularJoint`).
 pub fn to_spatial(robot: &Robot, gravity: [f64; 3]) -> Result<SpatialModel, DescError> {
+    check_gravity(gravity)?;
     let mut joints = Vec::with_capacity(robot.n_joints());
     let mut links = Vec::with_capacity(robot.n_joints());
     for joint in &robot.joints {
@@ -41,4 +42,36 @@ pub fn to_spatial(robot: &Robot, gravity: [f64; 3]) -> Result<SpatialModel, Desc
             format!("not a dynamics model: {e}"),
         )
     })
+}
+
+/// Checks a gravity vector for [`to_spatial`]: three finite numbers of at most
+/// [`MAX_MAGNITUDE`](crate::MAX_MAGNITUDE) (the bound of a URDF's numbers) in magnitude.
+///
+/// # Errors
+/// [`DescError::Invalid`] naming `gravity`: "gravity: must be three finite numbers [gx, gy,
+/// gz] of at most 1e9 in magnitude, got [0, 0, 1e308]".
+///
+/// ```
+/// assert!(robot_desc::check_gravity([0.0, 0.0, -9.81]).is_ok());
+/// let error = robot_desc::check_gravity([0.0, f64::NAN, 1e308]).unwrap_err();
+/// assert_eq!(
+///     error.to_string(),
+///     "gravity: must be three finite numbers [gx, gy, gz] of at most 1e9 in magnitude, got \
+///      [0, NaN, 1e308]"
+/// );
+/// ```
+pub fn check_gravity(gravity: [f64; 3]) -> Result<(), DescError> {
+    if gravity.iter().all(|g| g.abs() <= crate::MAX_MAGNITUDE) {
+        Ok(())
+    } else {
+        Err(DescError::invalid(
+            "gravity",
+            format!(
+                "must be three finite numbers [gx, gy, gz] of at most 1e9 in magnitude, got [{}]",
+                gravity
+                    .map(|g| lane_math::Compact(g).to_string())
+                    .join(", ")
+            ),
+        ))
+    }
 }

@@ -33,15 +33,17 @@ fn robot(urdf: &str) -> Result<Robot, EvalError> {
 }
 
 /// `"gravity"`: three finite numbers of at most [`robot_desc::MAX_MAGNITUDE`] (the bound of a
-/// URDF's numbers), or `default` when absent.
+/// URDF's numbers, [`robot_desc::check_gravity`]), or `default` when absent.
 fn gravity(requested: Option<Vec<f64>>, default: [f64; 3]) -> Result<[f64; 3], EvalError> {
-    let bounded = |g: &f64| g.abs() <= robot_desc::MAX_MAGNITUDE;
     match requested.as_deref() {
         None => Ok(default),
-        Some(&[x, y, z]) if [x, y, z].iter().all(bounded) => Ok([x, y, z]),
+        Some(&[x, y, z]) => {
+            robot_desc::check_gravity([x, y, z])?;
+            Ok([x, y, z])
+        }
         Some(values) => Err(EvalError::input(format!(
-            "gravity must be three finite numbers [gx, gy, gz] of at most 1e9 in magnitude, got \
-             {values:?}"
+            "gravity must be three finite numbers [gx, gy, gz], got {} entries",
+            values.len()
         ))),
     }
 }

@@ -135,12 +135,19 @@ fn bad_settings_are_refused_before_running() {
     .unwrap_err();
     assert_eq!(
         err,
-        "--noise 10 times --rate-noise-ratio 1e308 is not finite"
+        "--noise 10 times --rate-noise-ratio 1e308 is inf, more than the 1000000 (rad, rad/s) a \
+         run's noise may be"
+    );
+    let err = hrm_sweep(&with(SMALL, &["--noise", "1e6", "--out", out])).unwrap_err();
+    assert_eq!(
+        err,
+        "--noise 1000000 times --rate-noise-ratio 10 is 10000000, more than the 1000000 (rad, \
+         rad/s) a run's noise may be"
     );
     let err = hrm_sweep(&with(SMALL, &["--noise", "1e308", "--out", out])).unwrap_err();
     assert_eq!(
         err,
-        "--noise 1e308 times --rate-noise-ratio 10 is not finite"
+        "--noise must be at most 1000000 (rad, rad/s), got 1e308"
     );
     let err = hrm_sweep(&with(SMALL, &["--rate-noise-ratio", "-1", "--out", out])).unwrap_err();
     assert_eq!(

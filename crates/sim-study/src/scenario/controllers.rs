@@ -157,8 +157,7 @@ impl ControllerSetup<'_> {
     pub fn prepare(&self) -> Result<ControllerFactory, SimError> {
         let m = m(self);
         self.spec.computed_torque_gains(m)?;
-        per_coordinate("controller.pd_kp", self.spec.pd_kp.as_deref(), m)?;
-        per_coordinate("controller.pd_kd", self.spec.pd_kd.as_deref(), m)?;
+        self.spec.pd_gains(m)?;
         if self.spec.lqr_frequency.is_some() || self.spec.lqr_relinearise.is_some() {
             let (frequency, relinearise) = self.spec.lqr_settings();
             LqrController::check_settings(self.period, frequency, relinearise)?;
@@ -205,10 +204,9 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         prepare: |s| {
             let m = m(s);
             let slope = PdController::from_fuzzy_slope(&s.fuzzy_system()?, m)?;
-            let kp = per_coordinate("controller.pd_kp", s.spec.pd_kp.as_deref(), m)?
-                .unwrap_or_else(|| slope.kp().to_vec());
-            let kd = per_coordinate("controller.pd_kd", s.spec.pd_kd.as_deref(), m)?
-                .unwrap_or_else(|| slope.kd().to_vec());
+            let (kp, kd) = s.spec.pd_gains(m)?;
+            let kp = kp.unwrap_or_else(|| slope.kp().to_vec());
+            let kd = kd.unwrap_or_else(|| slope.kd().to_vec());
             Ok(Prepared::controller_clones(PdController::new(
                 slope.offset(),
                 &kp,
@@ -413,6 +411,32 @@ impl ControllerSpec {
         }
     }
 
+    /// The PD gains `pd_kp`, `pd_kd` for `m` coordinates where given, each non-negative and
+    /// finite (a negative stiffness pushes the arm away from its reference).
+    fn pd_gains(&self, m: usize) -> Result<(GivenGains, GivenGains), SimError> {
+        let gains = |name: &str, values: &Option<Vec<f64>>| {
+            let values = per_coordinate(name, values.as_deref(), m)?;
+            match values
+                .iter()
+                .flatten()
+                .find(|v| !(v.is_finite() && **v >= 0.0))
+            {
+                Some(bad) => Err(SimError::setting(
+                    name,
+                    format!(
+                        "must be non-negative and finite, got {}",
+                        lane_math::Compact(*bad)
+                    ),
+                )),
+                None => Ok(values),
+            }
+        };
+        Ok((
+            gains("controller.pd_kp", &self.pd_kp)?,
+            gains("controller.pd_kd", &self.pd_kd)?,
+        ))
+    }
+
     /// The computed-torque gains `kp`, `kd` for `m` coordinates (defaults where not given).
     pub(super) fn computed_torque_gains(&self, m: usize) -> Result<(Vec<f64>, Vec<f64>), SimError> {
         let gains = |name: &str, values: &Option<Vec<f64>>, default: f64| {
@@ -425,6 +449,9 @@ impl ControllerSpec {
         ))
     }
 }
+
+/// Per-coordinate gains a scenario gives, if it does.
+type GivenGains = Option<Vec<f64>>;
 
 /// `values` if given, checked to have exactly `m` entries (one per modal coordinate); the
 /// error names the field.

@@ -146,19 +146,36 @@ impl SweepSettings {
                 ));
             }
         }
-        // A run's rate and reference noise are a level times a ratio: finite too.
+        // A run's noise is a level, and a level times a ratio: each within the scale a run
+        // resolves (`sim_core::MAX_MODAL_MAGNITUDE`), which the scenario would refuse by its
+        // own keys.
         let largest = self.noise_levels[self.noise_levels.len() - 1];
+        let bound = sim_core::MAX_MODAL_MAGNITUDE;
+        if largest > bound {
+            return Err(SettingError::new(
+                "noise_levels",
+                format!(
+                    "must be at most {} (rad, rad/s), got {}",
+                    Compact(bound),
+                    Compact(largest)
+                ),
+            ));
+        }
         for (name, ratio) in [
             ("rate_noise_ratio", self.rate_noise_ratio),
             ("reference_noise_ratio", self.reference_noise_ratio),
         ] {
-            if !(largest * ratio).is_finite() {
+            let product = largest * ratio;
+            if product > bound {
                 return Err(SettingError::new(
                     "noise_levels",
                     format!(
-                        "{} times {name} = {} is not finite",
+                        "{} times {name} = {} is {}, more than the {} (rad, rad/s) a run's noise \
+                         may be",
                         Compact(largest),
-                        Compact(ratio)
+                        Compact(ratio),
+                        Compact(product),
+                        Compact(bound)
                     ),
                 ));
             }
@@ -416,7 +433,13 @@ mod tests {
         c.settings.noise_levels = vec![0.0, 1e308];
         assert_eq!(
             c.validate().unwrap_err().to_string(),
-            "noise_levels 1e308 times rate_noise_ratio = 10 is not finite"
+            "noise_levels must be at most 1000000 (rad, rad/s), got 1e308"
+        );
+        c.settings.noise_levels = vec![0.0, 1e6];
+        assert_eq!(
+            c.validate().unwrap_err().to_string(),
+            "noise_levels 1000000 times rate_noise_ratio = 10 is 10000000, more than the 1000000 \
+             (rad, rad/s) a run's noise may be"
         );
         let err = config(0, 2, 1).validate().unwrap_err().to_string();
         assert_eq!(err, "noise_levels must hold at least one noise level");

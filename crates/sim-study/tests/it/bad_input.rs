@@ -739,6 +739,26 @@ fn controller_gains_out_of_domain() {
         ComputedTorque::new(&paper_model(), &[-1.0, 1.0], &[1.0, 1.0]),
         Err(SimError::InvalidSetting { ref name, .. }) if name == "controller.kp"
     ));
+    // A scenario's PD gains, whichever controller runs.
+    let mut scenario = sim_study::Scenario::builtin("paper-tracking").unwrap();
+    scenario.controller.pd_kp = Some(vec![-1e6, -1e6]);
+    let Err(error) = scenario.build() else {
+        panic!("built")
+    };
+    assert_eq!(
+        error.to_string(),
+        "controller.pd_kp must be non-negative and finite, got -1000000"
+    );
+    scenario.controller.pd_kp = None;
+    scenario.controller.pd_kd = Some(vec![1.0, -1.0]);
+    let Err(error) = scenario.build() else {
+        panic!("built")
+    };
+    assert!(
+        error
+            .to_string()
+            .starts_with("controller.pd_kd must be non-negative")
+    );
 }
 
 #[test]
