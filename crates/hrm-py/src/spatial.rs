@@ -6,12 +6,12 @@ use crate::args;
 use crate::array::{Output, States, evaluate};
 use crate::errors::{Error, check_finite, count};
 use backbone_kin::{
-    BasePose, MAX_CURVE_STEPS, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, SpatialModalMap,
+    BasePose, MAX_CURVE_STEPS, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk,
     spatial_tip_position,
 };
 use modal_reduce::spatial::{
-    SpatialLinkInertia, SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel,
-    spatial_forward_dynamics, spatial_joint_torques, spatial_reduced_derivatives,
+    SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel, spatial_forward_dynamics,
+    spatial_joint_torques, spatial_reduced_derivatives,
 };
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
@@ -131,8 +131,10 @@ impl SpatialArm {
     }
 }
 
-/// The model of the constructor's arguments (`SpatialArm`'s docs), checked in the order of the
-/// planar `hrm.Arm`: sizes agree, then the count is bounded before any per-link list is built.
+/// The model of the constructor's arguments (`SpatialArm`'s docs): a scenario's spatial
+/// `[arm]` ([`sim_study::ArmSpec::spatial_model`], whose refusals name the field as a scenario
+/// would, `harmonics` for its `modal.harmonics`), and the principal inertias it resolved (the
+/// rods' when none were given).
 #[allow(
     clippy::too_many_arguments,
     reason = "the constructor's keyword arguments"
@@ -148,69 +150,33 @@ fn build(
     base: BasePose,
     harmonics: usize,
 ) -> crate::errors::Result<(SpatialReducedModel, Vec<[f64; 3]>)> {
-    let mut n = links;
-    for (name, size) in [
-        ("lengths", lengths.as_ref().map(Vec::len)),
-        ("masses", masses.as_ref().map(Vec::len)),
-        ("inertias", inertias.as_ref().map(Vec::len)),
-    ] {
-        match (n, size) {
-            (Some(k), Some(size)) if k != size => {
-                return Err(Error::input(format!(
-                    "arm.{name} has {size} entries but the arm has {k} links"
-                )));
-            }
-            (_, Some(size)) => n = Some(size),
-            _ => {}
-        }
-    }
-    let n = n.unwrap_or(10);
-    if n == 0 || n > backbone_kin::MAX_LINKS {
-        return Err(Error::input(format!(
-            "arm.links must be from 1 to {}, got {n}",
-            backbone_kin::MAX_LINKS
-        )));
-    }
     if !(1..=MAX_HARMONICS).contains(&harmonics) {
         return Err(Error::input(format!(
             "harmonics must be from 1 to {MAX_HARMONICS}, got {harmonics}"
         )));
     }
-    let lengths_given = lengths.is_some();
-    let lengths = lengths.unwrap_or_else(|| vec![link_length; n]);
-    let masses = masses.unwrap_or_else(|| vec![link_mass; n]);
-    let map = SpatialModalMap::new(&lengths, harmonics).map_err(Error::from)?;
-    let inertias = match inertias {
-        Some(inertias) => inertias,
-        None => {
-            let rods: Vec<[f64; 3]> = masses
-                .iter()
-                .zip(&lengths)
-                .map(|(&mass, &length)| SpatialLinkInertia::rod(mass, length).principal)
-                .collect();
-            // A rod's `m L^2 / 12` that overflows names the length the user gave.
-            if let Some(i) = rods.iter().position(|r| !r.iter().all(|v| v.is_finite())) {
-                let field = if lengths_given {
-                    format!("lengths[{i}]")
-                } else {
-                    "link_length".to_string()
-                };
-                return Err(Error::input(format!(
-                    "arm.{field} of {} m with a mass of {} kg gives a rod inertia m L^2 / 12 \
-                     beyond double precision",
-                    lane_math::Compact(lengths[i]),
-                    lane_math::Compact(masses[i])
-                )));
-            }
-            rods
-        }
+    let arm = sim_study::ArmSpec {
+        kind: sim_study::ArmKind::Spatial,
+        links,
+        link_length: Some(link_length),
+        link_mass: Some(link_mass),
+        gravity: Some(sim_study::Gravity::Vector(gravity)),
+        lengths,
+        masses,
+        inertias: inertias.map(sim_study::Inertias::Principal),
+        base: Some(sim_study::BaseSpec {
+            xyz: base.xyz,
+            rpy: base.rpy,
+        }),
+        ..sim_study::ArmSpec::default()
     };
-    let links = masses
-        .iter()
-        .zip(&inertias)
-        .map(|(&mass, &principal)| SpatialLinkInertia { mass, principal })
-        .collect();
-    let model = SpatialReducedModel::new(map, base, links, gravity).map_err(Error::from)?;
+    let model = arm.spatial_model(harmonics).map_err(|e| match e {
+        sim_core::SimError::InvalidSetting { name, requirement } if name == "modal.harmonics" => {
+            Error::input(format!("harmonics {requirement}"))
+        }
+        e => Error::from(e),
+    })?;
+    let inertias = model.links().iter().map(|link| link.principal).collect();
     Ok((model, inertias))
 }
 
@@ -312,10 +278,6 @@ impl SpatialArm {
             value.map_or(Ok(default), |v| args::vec3(v, name))
         };
         let gravity = vec3(gravity, "gravity", [0.0, 0.0, -9.81])?;
-        // A scenario's bound (accelerations under 1e308 m/s^2 came back as 1e307).
-        sim_study::Gravity::Vector(gravity)
-            .check()
-            .map_err(|e| Error::input(e.to_string()))?;
         let (base_xyz, base_rpy) = (
             vec3(base_xyz, "base_xyz", [0.0; 3])?,
             vec3(base_rpy, "base_rpy", [0.0; 3])?,

@@ -113,13 +113,15 @@ def test_pickling_keeps_the_arm():
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"links": 0}, "arm.links must be from 1"),
+        ({"links": 0}, "arm.links must be at least 1"),
         ({"links": -3}, "arm.links must be at least 1"),
         ({"harmonics": 17}, "harmonics must be from 1 to 16"),
-        ({"links": 1}, "column-rank-deficient"),
+        ({"links": 1}, "harmonics = 1 gives 2 coordinates per bending plane, more than the arm's 1 links"),
         ({"lengths": [0.1] * 4, "masses": [0.1] * 5}, "arm.masses has 5 entries"),
         ({"links": 4, "inertias": [[1.0, 0.1, 0.1]] * 4}, "triangle"),
-        ({"link_mass": -1.0}, "mass"),
+        ({"link_mass": -1.0}, r"^arm.link_mass must be positive and finite, got -1"),
+        ({"link_length": -0.0}, r"^arm.link_length must be positive and finite, got -0"),
+        ({"base_xyz": (1e300, 0.0, 0.0)}, r"^arm.base.xyz is invalid: base xyz must be at most"),
         ({"gravity": (0.0, float("nan"), 0.0)}, "gravity"),
         ({"gravity": (0.0, 0.0, -1e308)}, r"arm.gravity\[2\] must be finite and at most 1000000 m/s\^2"),
         ({"base_xyz": (float("inf"), 0.0, 0.0)}, r"base_xyz\[0\] must be finite, got inf"),

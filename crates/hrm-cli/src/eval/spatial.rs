@@ -49,7 +49,7 @@ pub(super) fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
 }
 
 /// A spatial arm as requests give it: the fields of a scenario's `[arm]` with
-/// `kind = "spatial"` ([`ArmSpec::to_spatial`], whose refusals name the field), within the
+/// `kind = "spatial"` ([`ArmSpec::spatial_model`], whose refusals name the field), within the
 /// request bounds of [`MAX_SPATIAL_LINKS`] links and [`MAX_SPATIAL_WORK`].
 #[derive(Deserialize)]
 #[serde(transparent)]
@@ -82,7 +82,7 @@ impl SpatialArmSpec {
             )));
         }
         // The scenario's `modal.harmonics` is the request's `harmonics`.
-        arm.to_spatial(harmonics).map_err(|e| match e {
+        arm.spatial_model(harmonics).map_err(|e| match e {
             SimError::InvalidSetting { name, requirement } if name == "modal.harmonics" => {
                 EvalError::input(format!("harmonics {requirement}"))
             }

@@ -117,8 +117,20 @@ impl ArmSpec {
     /// [`SimError::InvalidSetting`] naming the field: lists of different lengths, no link or too many, a non-positive or non-finite length or
     /// mass (`arm.lengths[3]`), an inertia that is negative, not finite or breaks the triangle
     /// inequality (`arm.inertias[3]`), a non-finite base pose or gravity, a URDF, and harmonics
-    /// out of range (`modal.harmonics`).
+    /// out of range (`modal.harmonics`); a model whose reduced dynamics exceed the work a
+    /// closed-loop run's evaluation may take (`sim_core::check_loop_work`).
     pub fn to_spatial(&self, harmonics: usize) -> Result<SpatialReducedModel, SimError> {
+        let model = self.spatial_model(harmonics)?;
+        sim_core::check_loop_work(2 * model.n_links(), model.n_coords())?;
+        Ok(model)
+    }
+
+    /// [`to_spatial`](Self::to_spatial) without the bound of a closed-loop run's work: the
+    /// model to evaluate (`hrm eval`, Python's `SpatialArm`), whose callers bound their own.
+    ///
+    /// # Errors
+    /// As [`to_spatial`](Self::to_spatial), but for the run's work.
+    pub fn spatial_model(&self, harmonics: usize) -> Result<SpatialReducedModel, SimError> {
         if self.urdf.is_some() {
             return Err(SimError::setting(
                 "arm.urdf",
@@ -153,7 +165,6 @@ impl ArmSpec {
                 ),
             ));
         }
-        sim_core::check_loop_work(2 * n, 4 * k)?;
         let lengths = per_link("length", &self.lengths, self.link_length, n)?;
         let masses = per_link("mass", &self.masses, self.link_mass, n)?;
         let links: Vec<SpatialLinkInertia> = match inertias {
