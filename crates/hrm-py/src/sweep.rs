@@ -80,7 +80,7 @@ impl Sweep {
         scenario: &Bound<'_, PyAny>,
         noise_levels: &Bound<'_, PyAny>,
         seeds: &Bound<'_, PyAny>,
-        controllers: Option<Vec<String>>,
+        controllers: Option<&Bound<'_, PyAny>>,
         base_seed: Option<&Bound<'_, PyAny>>,
         rate_noise_ratio: Option<&Bound<'_, PyAny>>,
         reference_noise_ratio: Option<&Bound<'_, PyAny>>,
@@ -97,14 +97,15 @@ impl Sweep {
         };
         let controllers = match controllers {
             None => ControllerKind::ALL.to_vec(),
-            Some(names) => names
-                .iter()
-                .map(|n| n.parse().map_err(Error::from))
-                .collect::<Result<_, _>>()?,
+            Some(names) => controller_kinds(names)?,
         };
         let settings = SweepSettings {
             controllers,
-            noise_levels: crate::args::reals(noise_levels, "noise_levels", study::MAX_RUNS)?,
+            noise_levels: crate::args::reals(
+                noise_levels,
+                "noise_levels",
+                study::MAX_NOISE_LEVELS,
+            )?,
             rate_noise_ratio,
             reference_noise_ratio,
             seeds: crate::errors::count(seeds, "seeds", 1)?,
@@ -250,4 +251,34 @@ impl Sweep {
             self.n_runs()
         )
     }
+}
+
+/// The controller kinds of `controllers`: a sequence of names (not one string), each a known
+/// kind, the wrong type a `TypeError` and an unknown name an `InvalidInput`, both naming it.
+fn controller_kinds(controllers: &Bound<'_, PyAny>) -> PyResult<Vec<ControllerKind>> {
+    use pyo3::types::{PyBytes, PyString};
+    let expected = "a sequence of controller names";
+    if controllers.is_instance_of::<PyString>() || controllers.is_instance_of::<PyBytes>() {
+        return Err(crate::args::wrong_type(
+            "controllers",
+            expected,
+            controllers,
+        ));
+    }
+    let items = controllers
+        .try_iter()
+        .map_err(|_| crate::args::wrong_type("controllers", expected, controllers))?;
+    let mut kinds = Vec::new();
+    for (i, item) in items.enumerate() {
+        if i >= ControllerKind::ALL.len() {
+            return Err(Error::input(format!(
+                "controllers lists more than the {} kinds there are (each once)",
+                ControllerKind::ALL.len()
+            ))
+            .into());
+        }
+        let name = crate::args::text(&item?, &format!("controllers[{i}]"))?;
+        kinds.push(name.parse::<ControllerKind>().map_err(Error::from)?);
+    }
+    Ok(kinds)
 }

@@ -38,6 +38,14 @@ def test_plan():
         hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, controllers=["pd", "fuzzy", "pd"])
     with pytest.raises(hrm.InvalidInput, match="^rate_noise_ratio must be finite and non-negative, got -1$"):
         hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, rate_noise_ratio=-1.0)
+    with pytest.raises(TypeError, match="^controllers must be a sequence of controller names, got a str$"):
+        hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, controllers="pd")
+    with pytest.raises(TypeError, match=r"^controllers\[1\] must be a str, got a int$"):
+        hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, controllers=["pd", 3])
+    with pytest.raises(hrm.InvalidInput, match="noise_levels"):
+        hrm.Sweep("paper-responses-step", noise_levels=[i * 1e-6 for i in range(1001)], seeds=1)
+    with pytest.raises(hrm.InvalidInput, match="more than the 1000000"):
+        hrm.Sweep("paper-responses-step", noise_levels=[1e6], seeds=1, controllers=["pd"])
 
 
 def test_shards_scheduled_by_concurrent_futures_merge_to_the_unsharded_sweep(tmp_path):

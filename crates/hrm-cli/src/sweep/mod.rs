@@ -133,20 +133,19 @@ pub fn run(cli: SweepCli) -> Result<(), String> {
     }
 }
 
-/// Most noise levels a sweep takes.
-const MAX_NOISE_LEVELS: usize = 1000;
 /// Most noise realisations per cell.
 const MAX_SEEDS: usize = 1_000_000;
 
 /// The command line's counts checked before anything is built: `--seeds` and `--base-seed` in
-/// range, at most [`MAX_NOISE_LEVELS`] noise levels, at most [`study::MAX_RUNS`] runs.
+/// range, at most [`study::MAX_NOISE_LEVELS`] noise levels, at most [`study::MAX_RUNS`] runs.
 fn check_counts(args: &SweepArgs) -> Result<(usize, u64), String> {
     let seeds = crate::args::count("--seeds", args.seeds, 1, MAX_SEEDS)?;
     let base_seed = crate::args::count("--base-seed", args.base_seed, 0, usize::MAX)? as u64;
-    if args.noise.len() > MAX_NOISE_LEVELS {
+    if args.noise.len() > study::MAX_NOISE_LEVELS {
         return Err(format!(
-            "--noise lists {} levels, more than the {MAX_NOISE_LEVELS} a sweep takes",
-            args.noise.len()
+            "--noise lists {} levels, more than the {} a sweep takes",
+            args.noise.len(),
+            study::MAX_NOISE_LEVELS
         ));
     }
     let runs = args.noise.len() * args.controllers.len() * seeds;

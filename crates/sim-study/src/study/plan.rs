@@ -15,6 +15,9 @@ const SPLITMIX_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
 /// Most runs in a sweep (noise levels x controllers x seeds), checked by
 /// [`SweepConfig::validate`] before any per-run buffer exists.
 pub const MAX_RUNS: usize = 10_000_000;
+
+/// The most noise levels a sweep takes.
+pub const MAX_NOISE_LEVELS: usize = 1000;
 // A shard holds one run at least, so a sweep never splits into more shards than runs.
 const _: () = assert!(MAX_SHARDS <= MAX_RUNS);
 
@@ -124,6 +127,15 @@ impl SweepSettings {
             return Err(SettingError::new(
                 "noise_levels",
                 format!("must be finite and non-negative, got {}", Compact(*bad)),
+            ));
+        }
+        if self.noise_levels.len() > MAX_NOISE_LEVELS {
+            return Err(SettingError::new(
+                "noise_levels",
+                format!(
+                    "lists {} levels, more than the {MAX_NOISE_LEVELS} a sweep takes",
+                    self.noise_levels.len()
+                ),
             ));
         }
         if self.noise_levels.windows(2).any(|w| w[0] >= w[1]) {
