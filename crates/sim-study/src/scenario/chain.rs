@@ -196,6 +196,13 @@ impl Scenario {
         if let Some((name, why)) = self.unused_by_joint_space_loops(false) {
             return Err(unused(name, why).into());
         }
+        if self.modal.harmonics != 1 {
+            return Err(unused(
+                "modal.harmonics",
+                "the chain's joints are its coordinates, no modal family",
+            )
+            .into());
+        }
         let mut reference =
             self.reference
                 .build(0.0, self.modal.harmonics, Alpha0::Fixed(0.0), n)?()?;
@@ -284,11 +291,18 @@ mod tests {
         scenario.arm.links = None;
         scenario.controller.kp = Some(vec![1.0; 6]);
         assert!(
-            message(&scenario).starts_with("controller.kp has 6 entries"),
+            message(&scenario).starts_with("controller.kp has 6 entries, the model has 7"),
             "{}",
             message(&scenario)
         );
         scenario.controller.kp = None;
+        scenario.modal.harmonics = 3;
+        assert_eq!(
+            message(&scenario),
+            "modal.harmonics is not used with a URDF arm ([arm] urdf): the chain's joints are \
+             its coordinates, no modal family"
+        );
+        scenario.modal.harmonics = 1;
         scenario.arm.urdf = Some(example("missing.urdf"));
         assert!(message(&scenario).starts_with("arm.urdf cannot be read from"));
         scenario.arm.urdf = Some(example("step.toml"));

@@ -466,7 +466,7 @@ pub(super) fn per_coordinate(
         Some(values) => Err(SimError::setting(
             name,
             format!(
-                "has {} entries, the modal family has {m} coordinates (one entry each)",
+                "has {} entries, the model has {m} coordinates (one entry each)",
                 values.len()
             ),
         )),
