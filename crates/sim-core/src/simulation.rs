@@ -1242,7 +1242,8 @@ fn initial_state(
     Ok(initial)
 }
 
-/// Checks that an initial state has `m` finite entries per field.
+/// Checks that an initial state has `m` finite entries per field, its rates within
+/// [`MAX_MODAL_MAGNITUDE`].
 fn check_initial(initial: &ModalState, m: usize) -> Result<(), SimError> {
     for (name, values) in [("initial.a", &initial.a), ("initial.a_dot", &initial.a_dot)] {
         if values.len() != m {
@@ -1255,6 +1256,23 @@ fn check_initial(initial: &ModalState, m: usize) -> Result<(), SimError> {
             ));
         }
         check_all_finite(name, values)?;
+    }
+    // Rates of the scale a run resolves (`1e300` overflowed the first C*); a coordinate beyond
+    // it stops the run at its first sample (`SimError::OutOfScale`).
+    if let Some((i, v)) = initial
+        .a_dot
+        .iter()
+        .enumerate()
+        .find(|(_, v)| v.abs() > MAX_MODAL_MAGNITUDE)
+    {
+        return Err(SimError::setting(
+            format!("initial.a_dot[{i}]"),
+            format!(
+                "must be at most {} rad/s in magnitude, got {}",
+                Compact(MAX_MODAL_MAGNITUDE),
+                Compact(*v)
+            ),
+        ));
     }
     Ok(())
 }

@@ -643,6 +643,22 @@ fn out_of_scale_states_and_references_stop_the_run() {
 }
 
 #[test]
+fn initial_rates_beyond_the_scale_of_a_run_are_refused() {
+    let mut scenario = sim_study::Scenario::builtin("paper-tracking").unwrap();
+    scenario.initial = Some(sim_study::InitialSpec {
+        a: vec![1.0, 0.0],
+        a_dot: Some(vec![1e300, 0.0]),
+    });
+    let Err(error) = scenario.build() else {
+        panic!("built")
+    };
+    assert_eq!(
+        error.to_string(),
+        "initial.a_dot[0] must be at most 1000000 rad/s in magnitude, got 1e300"
+    );
+}
+
+#[test]
 fn step_reference_non_finite_or_negative_time() {
     assert!(matches!(
         Step::new(&[f64::NAN, 0.0], &[0.0; 2], 0.0),
