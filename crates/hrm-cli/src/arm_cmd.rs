@@ -192,7 +192,7 @@ fn parse_gravity(text: &str) -> Result<[f64; 3], String> {
         })
         .collect::<Result<_, _>>()?;
     match values[..] {
-        [x, y, z] if values.iter().all(|v| v.abs() <= robot_desc::MAX_MAGNITUDE) => Ok([x, y, z]),
+        [x, y, z] if robot_desc::check_gravity([x, y, z]).is_ok() => Ok([x, y, z]),
         _ => Err(format!(
             "--gravity must be three finite numbers \"gx gy gz\" of at most 1e9 in magnitude, \
              got {text:?}"

@@ -6,8 +6,7 @@ use crate::args;
 use crate::array::{Output, States, evaluate};
 use crate::errors::{Error, check_finite, count};
 use backbone_kin::{
-    BasePose, MAX_CURVE_STEPS, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk,
-    spatial_tip_position,
+    MAX_CURVE_STEPS, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, spatial_tip_position,
 };
 use modal_reduce::spatial::{
     SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel, spatial_forward_dynamics,
@@ -147,7 +146,7 @@ fn build(
     lengths: Option<Vec<f64>>,
     masses: Option<Vec<f64>>,
     inertias: Option<Vec<[f64; 3]>>,
-    base: BasePose,
+    base: sim_study::BaseSpec,
     harmonics: usize,
 ) -> crate::errors::Result<(SpatialReducedModel, Vec<[f64; 3]>)> {
     if !(1..=MAX_HARMONICS).contains(&harmonics) {
@@ -164,18 +163,12 @@ fn build(
         lengths,
         masses,
         inertias: inertias.map(sim_study::Inertias::Principal),
-        base: Some(sim_study::BaseSpec {
-            xyz: base.xyz,
-            rpy: base.rpy,
-        }),
+        base: Some(base),
         ..sim_study::ArmSpec::default()
     };
-    let model = arm.spatial_model(harmonics).map_err(|e| match e {
-        sim_core::SimError::InvalidSetting { name, requirement } if name == "modal.harmonics" => {
-            Error::input(format!("harmonics {requirement}"))
-        }
-        e => Error::from(e),
-    })?;
+    let model = arm
+        .spatial_model(harmonics)
+        .map_err(|e| Error::from(e.renamed("modal.harmonics", "harmonics")))?;
     let inertias = model.links().iter().map(|link| link.principal).collect();
     Ok((model, inertias))
 }
@@ -290,7 +283,7 @@ impl SpatialArm {
         let (lengths, masses) = (per_link(lengths, "lengths")?, per_link(masses, "masses")?);
         let inertias = inertias.map(|v| args::rows3(v, "inertias")).transpose()?;
         let harmonics = harmonics.map_or(Ok(1), |k| count(k, "harmonics", 1))?;
-        let base = BasePose {
+        let base = sim_study::BaseSpec {
             xyz: base_xyz,
             rpy: base_rpy,
         };

@@ -332,6 +332,29 @@ impl SimError {
             requirement: requirement.into(),
         }
     }
+
+    /// This error with its setting `from` named `to`, for a front end that spells the setting
+    /// otherwise (`modal.harmonics` is a request's `harmonics`); any other error as it is.
+    ///
+    /// ```
+    /// use sim_core::SimError;
+    /// let error = SimError::setting("modal.harmonics", "must be at least 1");
+    /// assert_eq!(
+    ///     error.renamed("modal.harmonics", "harmonics").to_string(),
+    ///     "harmonics must be at least 1"
+    /// );
+    /// let other = SimError::setting("arm.links", "must be at least 1");
+    /// assert_eq!(other.renamed("modal.harmonics", "harmonics").to_string(), "arm.links must be at least 1");
+    /// ```
+    pub fn renamed(self, from: &str, to: &str) -> Self {
+        match self {
+            Self::InvalidSetting { name, requirement } if name == from => Self::InvalidSetting {
+                name: to.to_string(),
+                requirement,
+            },
+            other => other,
+        }
+    }
 }
 
 /// Checks that `value` is positive and finite.
@@ -346,8 +369,11 @@ pub(crate) fn check_positive(name: &str, value: f64) -> Result<(), SimError> {
     }
 }
 
-/// Checks that `value` is non-negative and finite.
-pub(crate) fn check_non_negative(name: &str, value: f64) -> Result<(), SimError> {
+/// Checks that the setting `name`'s `value` is non-negative and finite.
+///
+/// # Errors
+/// [`SimError::InvalidSetting`]: "controller.pd_kp must be non-negative and finite, got -1".
+pub fn check_non_negative(name: &str, value: f64) -> Result<(), SimError> {
     if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {

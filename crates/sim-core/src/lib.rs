@@ -17,7 +17,7 @@ pub use chain_loop::{
     ChainFailure, ChainLoopSettings, ChainRecord, ChainRun, ChainSummary, run_chain_loop,
     run_chain_loop_mpc,
 };
-pub use error::{ControllerFailure, SimError, StoppedRun};
+pub use error::{ControllerFailure, SimError, StoppedRun, check_non_negative};
 pub use record::{Record, Summary, TorqueLimitExceeded};
 pub use simulation::{
     ControlSample, ControllerFactory, Integrator, JOINT_ANGLE_APPROACH_S, Lockstep, LoopHooks,

@@ -1059,7 +1059,7 @@ fn check_reference(t: f64, reference: &ReferenceSample) -> Result<(), SimError> 
         ("a_dot", &reference.a_dot),
         ("a_ddot", &reference.a_ddot),
     ] {
-        if let Some((index, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        if let Some((index, value)) = lane_math::first_non_finite(values) {
             return Err(SimError::NonFiniteReference {
                 t,
                 name,

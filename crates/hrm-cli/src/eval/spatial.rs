@@ -11,7 +11,6 @@ use modal_reduce::spatial::{
 };
 use serde::Deserialize;
 use serde_json::{Map, Value, json};
-use sim_core::SimError;
 use sim_study::{ArmSpec, Inertias};
 
 /// Most links of a spatial arm in a request (`2n` joints).
@@ -65,6 +64,18 @@ impl SpatialArmSpec {
                 "arm.radius is not used by the ops of a spatial arm (it is a scenario's clearance)",
             ));
         }
+        // A list and its scalar both given is ambiguous (a scenario takes the list).
+        for (list, scalar, name) in [
+            (arm.lengths.is_some(), arm.link_length.is_some(), "length"),
+            (arm.masses.is_some(), arm.link_mass.is_some(), "mass"),
+        ] {
+            if list && scalar {
+                let plural = if name == "mass" { "masses" } else { "lengths" };
+                return Err(EvalError::input(format!(
+                    "give arm.{plural} or arm.link_{name}, not both"
+                )));
+            }
+        }
         let n = arm.link_count(arm.inertias.as_ref().map(Inertias::len))?;
         if n > MAX_SPATIAL_LINKS {
             return Err(EvalError::input(format!(
@@ -82,12 +93,8 @@ impl SpatialArmSpec {
             )));
         }
         // The scenario's `modal.harmonics` is the request's `harmonics`.
-        arm.spatial_model(harmonics).map_err(|e| match e {
-            SimError::InvalidSetting { name, requirement } if name == "modal.harmonics" => {
-                EvalError::input(format!("harmonics {requirement}"))
-            }
-            e => e.into(),
-        })
+        arm.spatial_model(harmonics)
+            .map_err(|e| e.renamed("modal.harmonics", "harmonics").into())
     }
 }
 
@@ -552,6 +559,16 @@ mod tests {
             (
                 json!({"op": "fk", "arm": {"kind": "spatial", "radius": 0.01}, "a": [0, 0, 0, 0]}),
                 "arm.radius is not used",
+            ),
+            (
+                json!({"op": "joints", "arm": {"kind": "spatial", "lengths": [0.1, 0.1, 0.1, 0.1],
+                    "link_length": 0.2}, "a": [0, 0, 0, 0]}),
+                "give arm.lengths or arm.link_length, not both",
+            ),
+            (
+                json!({"op": "joints", "arm": {"kind": "spatial", "masses": [0.1, 0.1, 0.1, 0.1],
+                    "link_mass": 0.2}, "a": [0, 0, 0, 0]}),
+                "give arm.masses or arm.link_mass, not both",
             ),
             (
                 json!({"op": "joints", "arm": {"kind": "spatial"}, "a": [0, 0, 0, 0, 0]}),

@@ -416,20 +416,10 @@ impl ControllerSpec {
     fn pd_gains(&self, m: usize) -> Result<(GivenGains, GivenGains), SimError> {
         let gains = |name: &str, values: &Option<Vec<f64>>| {
             let values = per_coordinate(name, values.as_deref(), m)?;
-            match values
-                .iter()
-                .flatten()
-                .find(|v| !(v.is_finite() && **v >= 0.0))
-            {
-                Some(bad) => Err(SimError::setting(
-                    name,
-                    format!(
-                        "must be non-negative and finite, got {}",
-                        lane_math::Compact(*bad)
-                    ),
-                )),
-                None => Ok(values),
+            for &value in values.iter().flatten() {
+                sim_core::check_non_negative(name, value)?;
             }
+            Ok::<_, SimError>(values)
         };
         Ok((
             gains("controller.pd_kp", &self.pd_kp)?,
