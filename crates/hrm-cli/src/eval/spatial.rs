@@ -545,11 +545,32 @@ mod tests {
             // The fields a scenario's spatial arm names, through the same checks.
             (
                 json!({"op": "fk", "arm": {"kind": "spatial", "link_length": -0.0}, "a": [0, 0, 0, 0]}),
-                "arm.link_length must be positive and finite, got -0",
+                "arm.link_length is invalid: link 0: length must be positive and finite, got -0",
             ),
+            // A length or mass whose rod inertia m L^2 / 12 under- or overflows, and a chain
+            // whose sums overflow, are refused as a planar arm's are.
             (
                 json!({"op": "fk", "arm": {"kind": "spatial", "link_length": 1e300}, "a": [0, 0, 0, 0]}),
-                "arm.link_length of 1e300 m with a mass of 0.1 kg gives a rod inertia",
+                "arm.link_length is invalid: link 0: length must be such that the beam's inertia",
+            ),
+            (
+                json!({"op": "fk", "arm": {"kind": "spatial", "link_length": 5e-324}, "a": [0, 0, 0, 0]}),
+                "arm.link_length is invalid: link 0: length must be such that the beam's inertia",
+            ),
+            (
+                json!({"op": "reduced", "arm": {"kind": "spatial", "lengths": [0.1, 0.1, 0.1, 1e-300]},
+                    "a": [0, 0, 0, 0], "a_dot": [0, 0, 0, 0], "tau_star": [0, 0, 0, 0]}),
+                "arm.lengths[3] is invalid: link 3: length must be such that the beam's inertia",
+            ),
+            (
+                json!({"op": "reduced", "arm": {"kind": "spatial", "link_mass": 5e-324},
+                    "a": [0, 0, 0, 0], "a_dot": [0, 0, 0, 0], "tau_star": [0, 0, 0, 0]}),
+                "arm.link_mass is invalid: link 0: mass must be such that the beam's inertia",
+            ),
+            (
+                json!({"op": "reduced", "arm": {"kind": "spatial", "link_length": 1e154},
+                    "a": [0, 0, 0, 0], "a_dot": [0, 0, 0, 0], "tau_star": [0, 0, 0, 0]}),
+                "arm is invalid: the chain's total mass",
             ),
             (
                 json!({"op": "fk", "arm": {"kind": "spatial", "base": {"xyz": [1e300, 0, 0]}},

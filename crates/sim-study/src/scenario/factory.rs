@@ -330,6 +330,22 @@ impl ArmSpec {
             }
         };
         let n = self.link_count(inertias.map(Vec::len))?;
+        let links = self.links(n, inertias.map(Vec::as_slice))?;
+        ChainModel::new(links, gravity)
+            .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))
+    }
+}
+
+impl ArmSpec {
+    /// The `n` links of `lengths` and `masses` (or `link_length` and `link_mass`, default 0.1 m
+    /// and 0.1 kg), each checked as a uniform beam (`Link::uniform_beam`: positive and finite,
+    /// with a beam inertia `m L^2 / 12` positive and finite in double precision, which bounds a
+    /// link's length away from underflow and overflow), with the planar `inertias` about the
+    /// joints replacing the beams' where given. A spatial arm's links are checked the same way.
+    ///
+    /// # Errors
+    /// [`SimError::InvalidSetting`] naming the list entry or the scalar that is out of range.
+    pub(crate) fn links(&self, n: usize, inertias: Option<&[f64]>) -> Result<Vec<Link>, SimError> {
         const WHAT: &str = "the arm's per-link arrays";
         let per_link = |array: &Option<Vec<f64>>, scalar: f64| match array {
             Some(values) => Ok(values.clone()),
@@ -370,12 +386,9 @@ impl ArmSpec {
             };
             links.push(link);
         }
-        ChainModel::new(links, gravity)
-            .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))
+        Ok(links)
     }
-}
 
-impl ArmSpec {
     /// The number of links: `links`, or the length of the per-link lists given (`lengths`,
     /// `masses`, and `inertias` of `inertias` entries), which must agree; 10 by default, at least
     /// 1 and at most [`manip_dyn::MAX_LINKS`]. Checked before any per-link array is allocated.

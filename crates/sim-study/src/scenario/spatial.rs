@@ -4,8 +4,8 @@
 use super::arm::{ArmKind, Gravity, Inertias};
 use super::schema::{Alpha0, ArmSpec, BranchSpec, HelixSpec, ReferenceSpec, Scenario};
 use backbone_kin::{BasePose, Branch, SpatialModalMap};
-use lane_math::{Compact, check_all_finite};
-use manip_dyn::DynError;
+use lane_math::check_all_finite;
+use manip_dyn::{ChainModel, DynError};
 use modal_reduce::spatial::{SpatialLinkInertia, SpatialReducedModel};
 use modal_reduce::{PlantModel, ReduceError};
 use sim_core::reference::{Helix, SpatialPath};
@@ -165,8 +165,18 @@ impl ArmSpec {
                 ),
             ));
         }
-        let lengths = per_link("length", &self.lengths, self.link_length, n)?;
-        let masses = per_link("mass", &self.masses, self.link_mass, n)?;
+        let gravity = self.gravity.unwrap_or(Gravity::Vector(DEFAULT_GRAVITY));
+        gravity.check()?;
+        let gravity = gravity.spatial();
+        // The links checked as a planar arm's beams, and their sums (total mass, mass x length^2,
+        // mass x |g| x length) finite as a planar chain's: a length whose square under- or
+        // overflows leaves no curve to resolve and no mass matrix.
+        let beams = self.links(n, None)?;
+        let lengths: Vec<f64> = beams.iter().map(|link| link.length).collect();
+        let masses: Vec<f64> = beams.iter().map(|link| link.mass).collect();
+        let g = gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
+        ChainModel::new(beams, g)
+            .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))?;
         let links: Vec<SpatialLinkInertia> = match inertias {
             Some(values) => masses
                 .iter()
@@ -184,63 +194,15 @@ impl ArmSpec {
         check_all_finite("arm.base.rpy", &base.rpy)?;
         base.validate()
             .map_err(|e| SimError::setting("arm.base.xyz", format!("is invalid: {e}")))?;
-        let gravity = self.gravity.unwrap_or(Gravity::Vector(DEFAULT_GRAVITY));
-        gravity.check()?;
-        let gravity = gravity.spatial();
         let map = SpatialModalMap::new(&lengths, k)
             .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))?;
-        // Lengths and masses are checked above: a link the model refuses has a bad inertia,
-        // the user's or a rod's whose `m L^2 / 12` overflows.
+        // Lengths and masses are checked above (a rod's `m L^2 / 12` is the beam's): a link the
+        // model refuses has a bad inertia of the user's.
         SpatialReducedModel::new(map, base, links, gravity).map_err(|e| match e {
             ReduceError::Dyn(DynError::InvalidLink { index, .. }) if inertias.is_some() => {
                 SimError::setting(format!("arm.inertias[{index}]"), format!("is invalid: {e}"))
             }
-            ReduceError::Dyn(DynError::InvalidLink { index, .. }) => SimError::setting(
-                match &self.lengths {
-                    Some(_) => format!("arm.lengths[{index}]"),
-                    None => "arm.link_length".to_string(),
-                },
-                format!(
-                    "of {} m with a mass of {} kg gives a rod inertia m L^2 / 12 beyond double \
-                     precision",
-                    Compact(lengths[index]),
-                    Compact(masses[index])
-                ),
-            ),
             e => SimError::setting("arm", format!("is invalid: {e}")),
         })
     }
-}
-
-/// The per-link `quantity` (`"length"` or `"mass"`): the list `arm.{quantity}s` if given, else
-/// `n` copies of `arm.link_{quantity}` (default 0.1), each positive and finite; the error names
-/// the entry or the scalar.
-fn per_link(
-    quantity: &str,
-    list: &Option<Vec<f64>>,
-    scalar: Option<f64>,
-    n: usize,
-) -> Result<Vec<f64>, SimError> {
-    let plural = if quantity == "mass" {
-        "masses"
-    } else {
-        "lengths"
-    };
-    let values = match list {
-        Some(values) => values.clone(),
-        None => vec![scalar.unwrap_or(0.1); n],
-    };
-    for (i, &value) in values.iter().enumerate() {
-        if !(value.is_finite() && value > 0.0) {
-            let field = match list {
-                Some(_) => format!("arm.{plural}[{i}]"),
-                None => format!("arm.link_{quantity}"),
-            };
-            return Err(SimError::setting(
-                field,
-                format!("must be positive and finite, got {value}"),
-            ));
-        }
-    }
-    Ok(values)
 }
