@@ -11,7 +11,7 @@ use backbone_kin::{
     reduce_angle, tip_position,
 };
 use fuzzy_sugeno::FuzzySystem;
-use lane_math::Classify;
+use lane_math::{Classify, ErrorClass};
 use manip_dyn::ChainData;
 use manip_dyn::faer::Mat;
 use modal_reduce::{ReducedData, ReducedModel};
@@ -203,8 +203,21 @@ fn answer(line: &[u8]) -> Value {
         }
     };
     let id = request.remove("id");
+    // The fields the user gave, for a computation that failed numerically (a result that
+    // overflowed, a matrix singular in double precision): no one of them alone is at fault, so
+    // the message names them all.
+    let given: Vec<String> = request.keys().filter(|k| *k != "op").cloned().collect();
     let result = match request.remove("op") {
-        Some(Value::String(op)) => dispatch(&op, request),
+        Some(Value::String(op)) => dispatch(&op, request).map_err(|mut error| {
+            if error.kind == Kind::Library(ErrorClass::Numerical) {
+                error.message = format!(
+                    "{} (computed from the request's {})",
+                    error.message,
+                    given.join(", ")
+                );
+            }
+            error
+        }),
         Some(_) => Err(EvalError::new(
             Kind::InvalidRequest,
             "\"op\" must be a string",
@@ -224,6 +237,7 @@ fn answer(line: &[u8]) -> Value {
 const OPS: &str = "fk, ik, joints, dynamics, reduced, fuzzy, rnea_derivatives, aba_derivatives, reduced_derivatives, frames, export";
 
 fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
+    request::check_rates(&request)?;
     // `"urdf"` in place of `"arm"`: the spatial chain of a robot description.
     let urdf = request.contains_key("urdf");
     if spatial::is_spatial(&request) {
@@ -1000,8 +1014,8 @@ mod tests {
     #[test]
     fn overflow_is_numerical_and_a_non_object_arm_is_refused() {
         let answer = request(
-            json!({"op": "dynamics", "arm": {"links": 2}, "theta": [0.1, 0.2],
-            "theta_dot": [1e200, 1e200]}),
+            json!({"op": "dynamics", "arm": {"links": 2, "link_mass": 1e300}, "theta": [0.1, 0.2],
+            "theta_dot": [1e6, 1e6]}),
         );
         assert_eq!(answer["error"]["kind"], "numerical", "{answer}");
         for arm in [json!([10]), json!(5), json!("paper"), json!(null)] {
@@ -1067,16 +1081,60 @@ mod tests {
     fn an_overflowing_result_is_numerical_in_every_dynamics_op() {
         // Finite inputs whose result overflows: the library's NonFiniteResult, classified by
         // its is_numerical(), for the full chain and for the reduced model alike.
-        for line in [
-            json!({"op": "dynamics", "theta": vec![0.1; 10], "theta_dot": vec![1e200; 10]}),
-            json!({"op": "reduced", "a": [0.1, 0.2, 0.3], "a_dot": [1e200, 1e200, 1e200],
-                "tau_star": [0.0, 0.0, 0.0]}),
+        // The message names the request's fields it was computed from.
+        for (line, fields) in [
+            (
+                json!({"op": "aba_derivatives", "arm": {"link_mass": 1e200},
+                    "theta": vec![0.1; 10], "theta_dot": vec![0.1; 10], "tau": vec![0.1; 10]}),
+                "(computed from the request's arm, tau, theta, theta_dot)",
+            ),
+            (
+                json!({"op": "reduced", "a": [0.1, 0.2, 0.3], "a_dot": [0.0, 0.0, 0.0],
+                    "tau_star": [1e308, 0.0, 0.0]}),
+                "(computed from the request's a, a_dot, tau_star)",
+            ),
         ] {
             let answer = request(line);
             assert_eq!(answer["error"]["kind"], "numerical", "{answer}");
             let message = answer["error"]["message"].as_str().unwrap();
-            assert!(message.contains("not finite"), "{answer}");
+            assert!(message.contains("finite"), "{answer}");
+            assert!(message.ends_with(fields), "{answer}");
         }
+    }
+
+    #[test]
+    fn rates_beyond_what_a_run_resolves_are_refused_by_name() {
+        // 1e300 rad/s overflowed the Coriolis terms and was reported by their internal names.
+        for (line, message) in [
+            (
+                json!({"op": "dynamics", "theta": vec![0.1; 10], "theta_dot": [0, 1e300, 0, 0, 0, 0, 0, 0, 0, 0]}),
+                "theta_dot[1] must be at most 1000000 in magnitude (rad/s, m/s for a prismatic joint), got 1e300",
+            ),
+            (
+                json!({"op": "reduced_derivatives", "a": [0.1, 0.2, 0.3], "a_dot": [-2e6, 0, 0],
+                    "tau_star": [0, 0, 0]}),
+                "a_dot[0] must be at most 1000000 in magnitude",
+            ),
+            (
+                json!({"op": "reduced", "arm": {"kind": "spatial"}, "a": [0.1, 0.2, 0.1, 0.2],
+                    "a_dot": [1e154, 0, 0, 0], "tau_star": [0, 0, 0, 0]}),
+                "a_dot[0] must be at most 1000000 in magnitude",
+            ),
+        ] {
+            let answer = request(line);
+            assert_eq!(answer["error"]["kind"], "invalid_input", "{answer}");
+            assert!(
+                answer["error"]["message"]
+                    .as_str()
+                    .unwrap()
+                    .starts_with(message),
+                "{answer}"
+            );
+        }
+        // At the bound the answer is finite.
+        let answer = request(json!({"op": "aba_derivatives", "theta": vec![0.1; 10],
+            "theta_dot": vec![1e6; 10], "tau": vec![0.0; 10]}));
+        assert_eq!(answer["ok"], true, "{answer}");
     }
 
     #[test]
