@@ -323,7 +323,10 @@ fn run(
             };
             let stats = rk4
                 .integrate(&mut plant, t, t1, &mut state, settings.dt)
-                .map_err(SimError::ChainIntegration)?;
+                .map_err(|source| SimError::ChainIntegration {
+                    tau: tau.clone(),
+                    source,
+                })?;
             summary.steps += stats.accepted;
         }
         Ok(())

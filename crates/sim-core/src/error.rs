@@ -111,8 +111,19 @@ pub enum SimError {
     #[error("fuzzy controller: {0}")]
     Fuzzy(#[from] fuzzy_sugeno::FuzzyError),
     /// The integrator stopped: the dynamics failed or the state blew up between two samples.
-    #[error("integration diverged: {0}")]
-    Integration(OdeError<ReduceError>),
+    /// The message shows the modal force held over the period (the controller's `tau*`, with a
+    /// disturbance's `J^T tau_d`): a divergence from finite inputs is most often a force, or the
+    /// gains behind it, beyond the arm's scale.
+    #[error(
+        "integration diverged under the held modal force tau* = {} N m: {source}",
+        lane_math::compact_numbers(&format!("{tau_star:?}"))
+    )]
+    Integration {
+        /// The modal force held over the period, one entry per coordinate.
+        tau_star: Vec<f64>,
+        /// Why the integrator stopped.
+        source: OdeError<ReduceError>,
+    },
     /// The spatial chain's dynamics refused a computation at a controller sample (the joint-space
     /// loop of a URDF arm, [`run_chain_loop`](crate::run_chain_loop)).
     #[error("chain dynamics at t = {} s: {source}", Compact(*.t))]
@@ -123,9 +134,18 @@ pub enum SimError {
         source: manip_dyn::DynError,
     },
     /// The joint-space loop's integrator stopped: the chain's dynamics failed or the state blew
-    /// up between two controller samples.
-    #[error("integration diverged: {0}")]
-    ChainIntegration(OdeError<manip_dyn::DynError>),
+    /// up between two controller samples; the message shows the joint torques held over the
+    /// period.
+    #[error(
+        "integration diverged under the held joint torques tau = {}: {source}",
+        lane_math::compact_numbers(&format!("{tau:?}"))
+    )]
+    ChainIntegration {
+        /// The joint torques (N m, N for a prismatic joint) held over the period.
+        tau: Vec<f64>,
+        /// Why the integrator stopped.
+        source: OdeError<manip_dyn::DynError>,
+    },
     /// The controller produced a NaN or infinite torque.
     #[error(
         "the controller produced a non-finite modal torque {tau_star:?} at t = {} s",
@@ -298,8 +318,8 @@ impl Classify for SimError {
             Self::Fuzzy(e) => e.class(),
             Self::ChainDynamics { source, .. } => source.class(),
             Self::OutOfMemory(e) => e.class(),
-            Self::Integration(_)
-            | Self::ChainIntegration(_)
+            Self::Integration { .. }
+            | Self::ChainIntegration { .. }
             | Self::NonFiniteControl { .. }
             | Self::NonFiniteDisturbance { .. }
             | Self::DisturbanceOverflow { .. }

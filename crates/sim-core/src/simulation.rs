@@ -924,7 +924,11 @@ impl Simulation {
             Stepper::Rk4(rk4, dt) => rk4.integrate(plant, t, t1, &mut self.y, *dt),
             Stepper::DormandPrince(dp) => dp.integrate(plant, t, t1, &mut self.y),
         };
-        self.advance(stats.map_err(SimError::Integration)?);
+        let stats = stats.map_err(|source| SimError::Integration {
+            tau_star: self.plant.tau_star.clone(),
+            source,
+        })?;
+        self.advance(stats);
         Ok(())
     }
 

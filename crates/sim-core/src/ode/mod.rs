@@ -44,7 +44,7 @@ pub struct Stats {
 #[non_exhaustive]
 pub enum OdeError<E> {
     /// The right-hand side reported an error.
-    #[error("the right-hand side failed at t = {t}: {source}")]
+    #[error("the right-hand side failed at t = {}: {source}", Compact(*.t))]
     Rhs {
         /// Time of the failing evaluation.
         t: f64,

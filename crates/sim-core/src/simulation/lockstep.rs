@@ -359,7 +359,12 @@ impl Lockstep {
                     plan = Some((t0, p));
                     self.slots.push(r);
                 }
-                Err(error) => *stopped = Some(SimError::Integration(error)),
+                Err(source) => {
+                    *stopped = Some(SimError::Integration {
+                        tau_star: run.plant.tau_star.clone(),
+                        source,
+                    })
+                }
             }
         }
         let Some((t0, plan)) = plan else {
@@ -377,8 +382,11 @@ impl Lockstep {
                 let run = &mut runs[r];
                 match rk4(&mut run.stepper).finish_step(i, t, &mut run.y, h) {
                     Ok(()) => true,
-                    Err(error) => {
-                        stopped[r] = Some(SimError::Integration(error));
+                    Err(source) => {
+                        stopped[r] = Some(SimError::Integration {
+                            tau_star: run.plant.tau_star.clone(),
+                            source,
+                        });
                         false
                     }
                 }
@@ -461,8 +469,10 @@ impl Lockstep {
                     &mut a_ddot[slot.clone()],
                 );
                 if let Err(source) = evaluated {
-                    let error = OdeError::Rhs { t: t_s, source };
-                    stopped[r] = Some(SimError::Integration(error));
+                    stopped[r] = Some(SimError::Integration {
+                        tau_star: tau_star[slot].to_vec(),
+                        source: OdeError::Rhs { t: t_s, source },
+                    });
                     return false;
                 }
             }

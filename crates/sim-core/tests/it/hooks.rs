@@ -380,6 +380,31 @@ fn a_finite_disturbance_whose_modal_force_overflows_is_named() {
     assert!(failure.error.is_numerical());
 }
 
+#[test]
+fn a_divergence_shows_the_modal_force_held_over_the_period() {
+    // A finite push far beyond the arm's scale: the state leaves double precision within the
+    // period, and the message shows the force that drove it there (it named only C*).
+    let mut sim = simulation(model(9.81), Box::new(pd()));
+    let mut push = Push {
+        tau: vec![1e100; 10],
+        from: 0.05,
+    };
+    let failure = sim.run_with(&mut push).unwrap_err();
+    let SimError::Integration { tau_star, .. } = &failure.error else {
+        panic!("{}", failure.error);
+    };
+    // The held force is the controller's plus J^T tau_d: of the push's scale.
+    assert!(tau_star.iter().any(|f| f.abs() > 1e99), "{tau_star:?}");
+    let message = failure.error.to_string();
+    assert!(
+        message.starts_with("integration diverged under the held modal force tau* = [")
+            && message.contains(&format!("{:?}", tau_star[0]))
+            && message.contains("N m: the right-hand side failed at t = 0.05"),
+        "{message}"
+    );
+    assert!(failure.error.is_numerical());
+}
+
 /// The PD controller on a step of the arm under gravity, prepared for runs of `duration`.
 fn prepared_step(duration: f64) -> Prepared {
     let reference = Step::new(&[0.1, -0.05], &[0.3, -0.2], 0.05).unwrap();

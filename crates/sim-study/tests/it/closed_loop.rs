@@ -297,7 +297,7 @@ fn non_finite_torques_and_blow_ups_stop_the_run() {
     // A torque of 1e300 N m overflows the state within a step or two.
     let failure = build([1e300, 0.0]).run().unwrap_err();
     assert!(
-        matches!(failure.error, SimError::Integration(_)),
+        matches!(failure.error, SimError::Integration { .. }),
         "{}",
         failure.error
     );
