@@ -83,7 +83,7 @@ impl AbaLane for f64 {
 
     #[inline(always)]
     fn check_pivot((): (), pivot: f64, scale: f64) -> Result<(), DynError> {
-        check::pivot(pivot, scale)
+        check::pivot("articulated inertia", pivot, scale)
     }
 
     #[inline(always)]

@@ -121,15 +121,14 @@ pub(crate) fn finite_matrix(name: &'static str, m: &MatMut<'_, f64>) -> Result<(
 /// computed from it, has no reliable digits.
 pub(crate) const PIVOT_FLOOR: f64 = 1e3 * f64::EPSILON;
 
-/// A pivot of a factorisation of `M` (a Cholesky pivot `L_ii^2`, or an articulated inertia
-/// about a joint axis) must be finite and positive beyond rounding relative to `diagonal`, the
-/// scale of its rounding ([`PIVOT_FLOOR`]), and normal, so that its reciprocal is finite (a
-/// link inertia of `1e-320` about its joint gave an infinite acceleration).
-pub(crate) fn pivot(pivot: f64, diagonal: f64) -> Result<(), DynError> {
+/// A pivot of a factorisation of `M` (`name`: a Cholesky pivot `L_ii^2` of the "mass matrix",
+/// or an "articulated inertia" about a joint axis) must be finite and positive beyond rounding
+/// relative to `diagonal`, the scale of its rounding ([`PIVOT_FLOOR`]), and normal, so that its
+/// reciprocal is finite (a link inertia of `1e-320` about its joint gave an infinite
+/// acceleration).
+pub(crate) fn pivot(name: &'static str, pivot: f64, diagonal: f64) -> Result<(), DynError> {
     if !(pivot.is_finite() && diagonal.is_finite()) {
-        Err(DynError::NonFiniteResult {
-            name: "mass matrix",
-        })
+        Err(DynError::NonFiniteResult { name })
     } else if pivot > PIVOT_FLOOR * diagonal && pivot >= f64::MIN_POSITIVE {
         Ok(())
     } else {

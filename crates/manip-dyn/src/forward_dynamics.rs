@@ -79,7 +79,11 @@ pub fn forward_dynamics(
     .map_err(|_| DynError::NotPositiveDefinite)?;
     // The assembly left M_ii in the composite bodies; the pivots are L_ii^2.
     for (i, subtree) in subtrees.iter().enumerate() {
-        check::pivot(mass_factor[(i, i)].powi(2), subtree.second_moment)?;
+        check::pivot(
+            "mass matrix",
+            mass_factor[(i, i)].powi(2),
+            subtree.second_moment,
+        )?;
     }
     llt::solve::solve_in_place(
         mass_factor.as_ref(),

@@ -152,9 +152,11 @@ fn aba_base_frame(
         };
         let coupling = inertia.apply(&joint.axis);
         let pivot = joint.axis.dot(&coupling);
-        check::pivot(pivot, model.pivot_scales[i]).map_err(|error| match error {
-            DynError::NotPositiveDefinite => DynError::SingularJoint { index: i },
-            other => other,
+        check::pivot("articulated inertia", pivot, model.pivot_scales[i]).map_err(|error| {
+            match error {
+                DynError::NotPositiveDefinite => DynError::SingularJoint { index: i },
+                other => other,
+            }
         })?;
         let inverse = 1.0 / pivot;
         let residual = tau[i] - joint.axis.dot(&force);

@@ -777,6 +777,23 @@ fn a_numerically_singular_mass_matrix_is_reported() {
 }
 
 #[test]
+fn an_overflowing_pivot_names_the_factor_it_belongs_to() {
+    // Links of 1e200 kg: the mass matrix is finite (about 3e200), but the articulated inertias
+    // of ABA pass through U U^T, beyond double precision. The error names what overflowed.
+    let arm = ChainModel::uniform(10, 0.1, 1e200, 9.81).unwrap();
+    let mut data = ChainData::new(&arm);
+    let (q, mut qdd) = ([0.1; 10], [0.0; 10]);
+    let mut m = Mat::zeros(10, 10);
+    assert_eq!(mass_matrix(&arm, &mut data, &q, m.as_mut()), Ok(()));
+    assert_eq!(
+        aba(&arm, &mut data, &q, &q, &q, &mut qdd),
+        Err(DynError::NonFiniteResult {
+            name: "articulated inertia"
+        })
+    );
+}
+
+#[test]
 fn messages_say_what_failed() {
     let arm = arm();
     let mut data = ChainData::new(&arm);
