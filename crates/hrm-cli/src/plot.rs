@@ -440,8 +440,12 @@ fn tick_format(range: &Range<f64>) -> impl Fn(&f64) -> String {
     }
 }
 
+/// The widest span of values a chart scales: under a sixteenth of `f64::MAX`, so that its
+/// margins and tick steps stay finite.
+const MAX_SPAN: f64 = 1e307;
+
 /// The range spanned by `values`, widened when they are all equal; an error for no or
-/// non-finite values.
+/// non-finite values, or a span beyond [`MAX_SPAN`].
 fn span(values: impl Iterator<Item = f64>, axis: &str) -> Result<Range<f64>, String> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values {
@@ -454,14 +458,15 @@ fn span(values: impl Iterator<Item = f64>, axis: &str) -> Result<Range<f64>, Str
     if lo > hi {
         return Err(format!("nothing to plot: no {axis} values"));
     }
-    // A span beyond double precision (values near ±f64::MAX) cannot be scaled to a chart.
+    // A span near double precision's end (values near ±f64::MAX) cannot be scaled to a chart:
+    // the axis' margins and tick steps overflow (a span of 1.8e308 drew forever).
     let unplottable = |range: Range<f64>| {
-        if (range.end - range.start).is_finite() {
+        if range.end - range.start <= MAX_SPAN {
             Ok(range)
         } else {
             Err(format!(
                 "cannot plot a non-finite {axis} span: the values run from {lo:e} to {hi:e}, \
-                 beyond double precision"
+                 a span beyond the {MAX_SPAN:e} a chart resolves in double precision"
             ))
         }
     };
@@ -494,6 +499,9 @@ mod tests {
         );
         let err = span([f64::MAX, f64::MAX].into_iter(), "z").unwrap_err();
         assert!(err.contains("non-finite z span"), "{err}");
+        // A finite span whose margins and ticks overflow drew forever.
+        let err = span([-9.5e307, 9.5e307].into_iter(), "y").unwrap_err();
+        assert!(err.contains("non-finite y span"), "{err}");
         assert_eq!(span([1e300, 2e300].into_iter(), "z").unwrap(), 1e300..2e300);
     }
 
