@@ -2,7 +2,7 @@
 //! IEC 61131-7 FCL (`fuzzy_sugeno`'s `to_c` and `to_fcl`; docs/fuzzy-formats.md says what each
 //! format carries).
 
-use crate::fis_input::{RangePolicy, read_system};
+use crate::fis_input::{self, RangePolicy, read_system};
 use crate::output_dir;
 use clap::{Args, ValueEnum};
 use fuzzy_sugeno::{EvalOptions, NoRuleFired};
@@ -81,7 +81,11 @@ pub fn run(args: ExportArgs) -> Result<(), String> {
         .map(|(name, text)| (Path::new(&args.out).join(name), text))
         .collect();
     let paths: Vec<PathBuf> = files.iter().map(|(path, _)| path.clone()).collect();
-    output_dir::refuse_foreign_files(&paths, "fis export")?;
+    output_dir::refuse_foreign_files(
+        &paths,
+        "fis export",
+        (fis_input::RECOGNISED_BYTES, fis_input::written_by_hrm),
+    )?;
     output_dir::write_files(&files, "fis export")?;
     for (path, _) in &files {
         crate::console::print(&format!("{}\n", path.display()))?;

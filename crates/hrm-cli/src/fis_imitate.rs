@@ -2,7 +2,7 @@
 //! (`sim_study::imitation`), written as a MATLAB `.fis` file that any scenario with the same
 //! modal coordinates takes as its `controller.fis`.
 
-use crate::{args, output_dir, progress};
+use crate::{args, fis_input, output_dir, progress};
 use clap::Args;
 use sim_study::imitation::{self, ImitationOptions, MAX_EPOCHS, MAX_SETS, MAX_STRIDE};
 use sim_study::{ControllerKind, Scenario};
@@ -76,6 +76,11 @@ pub fn run(args: ImitateArgs) -> Result<(), String> {
         let grid = parse_offsets(text)?;
         scenarios = imitation::shifted_grid(&scenarios, &grid).map_err(|e| e.to_string())?;
     }
+    output_dir::refuse_foreign_file(
+        &args.out,
+        fis_input::RECOGNISED_BYTES,
+        fis_input::written_by_hrm,
+    )?;
     let data = imitation::record(&scenarios, &options).map_err(|e| e.to_string())?;
     let m = data.n_outputs();
     println!(

@@ -56,3 +56,22 @@ pub(crate) fn read_system_with_notes(
     };
     system.map_err(|e| format!("{}: {e}", path.display()))
 }
+
+/// The most bytes of an existing file read to tell whether hrm wrote it as a fuzzy system
+/// ([`sim_study::MAX_INPUT_FILE_BYTES`], what the readers take).
+pub(crate) const RECOGNISED_BYTES: usize = sim_study::MAX_INPUT_FILE_BYTES as usize;
+
+/// Whether `text` is a fuzzy system file hrm wrote: a `.fis` or FCL text whose system, written
+/// back by hrm's writer, is the same text byte for byte (the writers are canonical; a
+/// hand-made or MATLAB-written file almost never is), or the C that `hrm fis export` writes
+/// (its opening comment says so).
+pub(crate) fn written_by_hrm(text: &[u8]) -> bool {
+    let Ok(text) = std::str::from_utf8(text) else {
+        return false;
+    };
+    let opening = &text[..text.floor_char_boundary(512)];
+    opening.contains("exported by hrm (fuzzy-sugeno) as C99")
+        || FuzzySystem::from_fis(text).is_ok_and(|system| system.to_fis() == text)
+        || FuzzySystem::from_fcl(text)
+            .is_ok_and(|system| system.to_fcl().is_ok_and(|fcl| fcl == text))
+}

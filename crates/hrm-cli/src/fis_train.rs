@@ -5,7 +5,7 @@
 //! with an optional header line of column names (taken as the variables' names). Every size is
 //! bounded before it is used: the file, its rows and columns, the epochs and the rule count.
 
-use crate::{console, output_dir, progress};
+use crate::{console, fis_input, output_dir, progress};
 use clap::Args;
 use fuzzy_sugeno::learn::{
     Anfis, AnfisOptions, ConsequentOrder, GridPartition, MAX_INPUTS, MAX_ROWS, MAX_SETS_PER_INPUT,
@@ -67,6 +67,11 @@ pub fn run(args: TrainArgs) -> Result<(), String> {
     let mut inputs = vec![("--data", args.data.as_path())];
     inputs.extend(args.check.as_deref().map(|check| ("--check", check)));
     output_dir::refuse_input_as_output(&args.out, &inputs)?;
+    output_dir::refuse_foreign_file(
+        &args.out,
+        fis_input::RECOGNISED_BYTES,
+        fis_input::written_by_hrm,
+    )?;
     let train = read_csv(&args.data)?;
     let check = args.check.as_deref().map(read_csv).transpose()?;
     if let Some(check) = &check

@@ -221,9 +221,14 @@ pub fn refuse_input_as_output(out: &Path, inputs: &[(&str, &Path)]) -> Result<()
 }
 
 /// Refuses, before any work, to replace existing files in a folder `hrm {command}` did not
-/// create (one without its [`MARKER`]): `fis export --out DIR` into a folder of the user's never
-/// overwrites the user's own `hrm_fis.c`.
-pub fn refuse_foreign_files(paths: &[PathBuf], command: &str) -> Result<(), String> {
+/// create (one without its [`MARKER`]) unless `written_by_hrm` recognises the file's first
+/// `within` bytes as hrm's: `fis export --out DIR` into a folder of the user's never overwrites
+/// the user's own `hrm_fis.c`, and replaces its own export.
+pub fn refuse_foreign_files(
+    paths: &[PathBuf],
+    command: &str,
+    (within, written_by_hrm): (usize, impl Fn(&[u8]) -> bool),
+) -> Result<(), String> {
     for path in paths {
         let dir = path.parent().unwrap_or(Path::new("."));
         let dir = if dir.as_os_str().is_empty() {
@@ -233,6 +238,7 @@ pub fn refuse_foreign_files(paths: &[PathBuf], command: &str) -> Result<(), Stri
         };
         if std::fs::symlink_metadata(path).is_ok()
             && marker_command(dir).is_none_or(|other| other != command)
+            && !file_written_by_hrm(path, within, &written_by_hrm)
         {
             return Err(format!(
                 "{} exists in a folder that `hrm {command}` did not create (no {MARKER} marker \
@@ -242,6 +248,44 @@ pub fn refuse_foreign_files(paths: &[PathBuf], command: &str) -> Result<(), Stri
         }
     }
     Ok(())
+}
+
+/// Whether the regular file `path` holds a text `written_by_hrm` recognises, from its first
+/// `within` bytes (a folder or an unreadable file is not hrm's).
+fn file_written_by_hrm(path: &Path, within: usize, written_by_hrm: impl Fn(&[u8]) -> bool) -> bool {
+    use std::io::Read;
+    let Ok(file) = std::fs::File::open(path) else {
+        return false;
+    };
+    if !file.metadata().is_ok_and(|meta| meta.is_file()) {
+        return false;
+    }
+    let mut start = Vec::new();
+    file.take(within as u64).read_to_end(&mut start).is_ok() && written_by_hrm(&start)
+}
+
+/// Refuses, before any work, to replace an existing `path` that hrm did not write: a folder, or
+/// a file whose first `within` bytes `written_by_hrm` does not recognise (`hrm view`'s pages by
+/// their signature, `hrm fis train`'s systems by their whole text).
+pub fn refuse_foreign_file(
+    path: &Path,
+    within: usize,
+    written_by_hrm: impl Fn(&[u8]) -> bool,
+) -> Result<(), String> {
+    if std::fs::symlink_metadata(path).is_err() {
+        return Ok(());
+    }
+    if path.is_dir() {
+        return Err(format!("{}: is a folder", path.display()));
+    }
+    if file_written_by_hrm(path, within, written_by_hrm) {
+        Ok(())
+    } else {
+        Err(format!(
+            "{}: exists and hrm did not write it; choose another file or remove this one",
+            path.display()
+        ))
+    }
 }
 
 /// Writes the file `path` whole with the contents `text`, as [`write_file_with`] does.
@@ -702,13 +746,28 @@ mod tests {
         let mine = root.join("mine/hrm_fis.c");
         std::fs::create_dir_all(root.join("mine")).unwrap();
         std::fs::write(&mine, "my code").unwrap();
-        let err = refuse_foreign_files(std::slice::from_ref(&mine), "fis export").unwrap_err();
+        let err = refuse_foreign_files(
+            std::slice::from_ref(&mine),
+            "fis export",
+            (0, |_: &[u8]| false),
+        )
+        .unwrap_err();
         assert!(err.contains("did not create"), "{err}");
         // A folder `fis export` created may be written again.
         let ours = root.join("ours/hrm_fis.c");
         write_files(&[(ours.clone(), String::from("v1"))], "fis export").unwrap();
-        refuse_foreign_files(std::slice::from_ref(&ours), "fis export").unwrap();
-        refuse_foreign_files(&[root.join("mine/new.c")], "fis export").unwrap();
+        refuse_foreign_files(
+            std::slice::from_ref(&ours),
+            "fis export",
+            (0, |_: &[u8]| false),
+        )
+        .unwrap();
+        refuse_foreign_files(
+            &[root.join("mine/new.c")],
+            "fis export",
+            (0, |_: &[u8]| false),
+        )
+        .unwrap();
         // The same file by another path is an input.
         let data = root.join("mine/data.csv");
         std::fs::write(&data, "1,2\n").unwrap();

@@ -127,10 +127,10 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
         },
     )
     .map_err(|e| e.to_string())?;
-    refuse_foreign(&out)?;
+    output_dir::refuse_foreign_file(&out, run_view::SIGNATURE_WITHIN, run_view::written_by_hrm)?;
     let mut files = vec![(out.clone(), page.into_bytes())];
     if let Some(gif) = &args.gif {
-        refuse_foreign(gif)?;
+        output_dir::refuse_foreign_file(gif, run_view::SIGNATURE_WITHIN, run_view::written_by_hrm)?;
         let mut bytes = Vec::new();
         run_view::write_gif(&gif_run, &options, &mut bytes).map_err(|e| e.to_string())?;
         files.push((gif.clone(), bytes));
@@ -142,29 +142,6 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
         crate::console::print(&format!("wrote {}\n", gif.display()))?;
     }
     Ok(())
-}
-
-/// Refuses to replace an existing `path` that hrm did not write (no [`run_view::SIGNATURE`]).
-fn refuse_foreign(path: &Path) -> Result<(), String> {
-    use std::io::Read;
-    let Ok(file) = std::fs::File::open(path) else {
-        return Ok(());
-    };
-    if path.is_dir() {
-        return Err(format!("{}: is a folder", path.display()));
-    }
-    let mut start = Vec::with_capacity(run_view::SIGNATURE_WITHIN);
-    file.take(run_view::SIGNATURE_WITHIN as u64)
-        .read_to_end(&mut start)
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    if run_view::written_by_hrm(&start) {
-        Ok(())
-    } else {
-        Err(format!(
-            "{}: exists and hrm did not write it; choose another file or remove this one",
-            path.display()
-        ))
-    }
 }
 
 /// The runs of a main job's output folder: one scene per scenario folder, its controllers in

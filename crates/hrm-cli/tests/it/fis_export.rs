@@ -39,6 +39,30 @@ fn fcl_export_evaluates_like_the_fis_file() {
     assert_eq!(eval(FUZZYLITE_FCL), expected);
 }
 
+/// Into a folder of the user's (no marker of hrm's), an export replaces the files a previous
+/// export wrote (C by its opening comment, FCL by its text) and never a file of the user's.
+#[test]
+fn export_again_replaces_its_own_files_and_never_the_users() {
+    let dir = scratch("fis-export-again");
+    let out = dir.to_str().unwrap();
+    for format in ["c", "fcl", "c", "fcl"] {
+        stdout(&hrm(&[
+            "fis", "export", "--format", format, PAPER_FIS, "--out", out,
+        ]));
+    }
+    for (name, format) in [("hrm_fis.c", "c"), ("paper.fcl", "fcl")] {
+        std::fs::write(dir.join(name), "/* the user's own */\n").unwrap();
+        let refused = hrm(&["fis", "export", "--format", format, PAPER_FIS, "--out", out]);
+        assert_eq!(refused.status.code(), Some(1));
+        let stderr = String::from_utf8_lossy(&refused.stderr);
+        assert!(stderr.contains("did not create"), "{stderr}");
+        assert_eq!(
+            std::fs::read_to_string(dir.join(name)).unwrap(),
+            "/* the user's own */\n"
+        );
+    }
+}
+
 /// A name FCL cannot carry (a variable named `END_VAR`) is a one-line error naming it, exit 1,
 /// and nothing is written.
 #[test]

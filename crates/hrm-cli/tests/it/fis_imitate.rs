@@ -152,6 +152,21 @@ fn bad_options_are_one_line_errors_and_leave_the_old_file() {
             && stderr.lines().count() == 1,
         "{stderr}"
     );
+    // A file hrm did not write is never replaced, whatever the options.
+    let run = hrm(&[
+        "fis",
+        "imitate",
+        "--scenario",
+        "paper-responses-step",
+        "--out",
+        out,
+    ]);
+    assert_eq!(
+        String::from_utf8_lossy(&run.stderr),
+        format!(
+            "hrm: {out}: exists and hrm did not write it; choose another file or remove this one\n"
+        )
+    );
     assert_eq!(std::fs::read_to_string(out).unwrap(), "earlier");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -67,6 +67,58 @@ fn trains_writes_and_evaluates() {
 }
 
 #[test]
+fn out_replaces_its_own_system_and_never_a_file_of_the_users() {
+    let dir = scratch("fis-train-foreign-out");
+    let (train, out, notes) = (
+        dir.join("train.csv"),
+        dir.join("learned.fis"),
+        dir.join("notes.txt"),
+    );
+    write_csv(&train, 60, 0, false);
+    let train_into = |out: &PathBuf| {
+        hrm(&[
+            "fis",
+            "train",
+            "--data",
+            train.to_str().unwrap(),
+            "--mfs",
+            "2",
+            "--epochs",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    // Twice into the same file: the second run replaces what the first wrote.
+    for _ in 0..2 {
+        let run = train_into(&out);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    }
+    // A file hrm did not write (notes, or a .fis written by hand) stays as it was.
+    let hand_written = std::fs::read_to_string(&out)
+        .unwrap()
+        .replace("Version=2.0", "Version=2.0 ");
+    for (path, text) in [
+        (&notes, "the user's notes\n"),
+        (&out, hand_written.as_str()),
+    ] {
+        std::fs::write(path, text).unwrap();
+        let run = train_into(path);
+        assert_eq!(run.status.code(), Some(1));
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(
+            stderr.contains("exists and hrm did not write it"),
+            "{stderr}"
+        );
+        assert_eq!(std::fs::read_to_string(path).unwrap(), text);
+    }
+}
+
+#[test]
 fn bad_input_is_one_line() {
     let dir = scratch("fis-train-bad");
     let (csv, out) = (dir.join("bad.csv"), dir.join("x.fis"));
