@@ -46,7 +46,8 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
 }
 
 /// The main job: every shipped scenario with every controller (see [`experiments`]), each cut
-/// at `duration` seconds when given (finite, positive).
+/// at `duration` seconds when given (finite, positive), rounded down to a whole number of the
+/// scenario's controller periods ([`cut_to_whole_periods`]).
 pub fn main_job(out: &Path, duration: Option<f64>) -> Result<(), String> {
     let mut scenarios = study::builtin_scenarios().map_err(|e| e.to_string())?;
     if let Some(cut) = duration {
@@ -56,10 +57,35 @@ pub fn main_job(out: &Path, duration: Option<f64>) -> Result<(), String> {
             ));
         }
         for scenario in &mut scenarios {
-            scenario.duration = scenario.duration.min(cut);
+            let period = scenario.controller_period().map_err(|e| e.to_string())?;
+            if cut < scenario.duration {
+                scenario.duration = cut_to_whole_periods(cut, period).ok_or_else(|| {
+                    format!(
+                        "--duration: {} s is shorter than one controller period ({} s) of \
+                         '{}'",
+                        Compact(cut),
+                        Compact(period),
+                        scenario.name
+                    )
+                })?;
+            }
         }
     }
     experiments(out, &scenarios)
+}
+
+/// `cut` as a run's duration with controller period `period`: `cut` itself when it is a whole
+/// number of periods (within rounding), otherwise the whole periods below it; `None` below one
+/// period.
+fn cut_to_whole_periods(cut: f64, period: f64) -> Option<f64> {
+    let ratio = cut / period;
+    let whole = ratio.round();
+    if whole >= 1.0 && (ratio - whole).abs() <= 1e-9 * whole {
+        Some(cut)
+    } else {
+        let below = ratio.floor();
+        (below >= 1.0).then(|| below * period)
+    }
 }
 
 /// Runs `scenarios` with every controller, in parallel (results in a fixed order), then writes
@@ -723,6 +749,22 @@ fn write(path: &Path, text: &str) -> Result<(), String> {
 mod tests {
     use super::*;
     use fuzzy_sugeno::FuzzySystem;
+
+    #[test]
+    fn a_duration_cut_is_whole_controller_periods_or_refused_up_front() {
+        assert_eq!(cut_to_whole_periods(0.15, 1e-3), Some(0.15));
+        assert_eq!(cut_to_whole_periods(0.0015, 1e-3), Some(1e-3));
+        assert_eq!(cut_to_whole_periods(5e-4, 1e-3), None);
+        // Below every scenario's period: refused before anything is written (it made a report
+        // of 67 runs each "stopped" by a settings error).
+        let dir = std::env::temp_dir().join(format!("hrm-main-job-cut-{}", std::process::id()));
+        let err = main_job(&dir, Some(1e-5)).unwrap_err();
+        assert!(
+            err.starts_with("--duration: 1e-5 s is shorter than one controller period ("),
+            "{err}"
+        );
+        assert!(!dir.exists());
+    }
 
     #[test]
     fn simulate_writes_the_summary_keys_and_a_time_series() {

@@ -43,8 +43,8 @@ enum Command {
         /// Output folder.
         #[arg(long, default_value = "hrm-output")]
         out: PathBuf,
-        /// Run each scenario for at most this many seconds: a quick look at the report (the
-        /// paper's numbers need the full durations).
+        /// Run each scenario for at most this many seconds, rounded down to whole controller
+        /// periods: a quick look at the report (the paper's numbers need the full durations).
         #[arg(long)]
         duration: Option<f64>,
     },

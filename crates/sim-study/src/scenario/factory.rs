@@ -186,16 +186,7 @@ impl Scenario {
             )?,
             (None, PlantModel::Spatial(spatial)) => self.spatial_reference(spatial)?,
         };
-        let period = match (self.controller.period, self.integrator) {
-            (Some(period), _) => period,
-            (None, IntegratorSpec::Rk4 { dt }) => dt,
-            (None, IntegratorSpec::Dopri5 { .. }) => {
-                return Err(SimError::setting(
-                    "controller.period",
-                    "is required with the dopri5 integrator",
-                ));
-            }
-        };
+        let period = self.controller_period()?;
         let mut settings = LoopSettings::new(self.integrator.build(), period, self.duration);
         settings.record_period = self.record_period.unwrap_or(period);
         let noise = self.run_noise()?;
@@ -333,6 +324,24 @@ impl ArmSpec {
         let links = self.links(n, inertias.map(Vec::as_slice))?;
         ChainModel::new(links, gravity)
             .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))
+    }
+}
+
+impl Scenario {
+    /// The controller's sampling period (s): `controller.period`, or the RK4 step without it.
+    ///
+    /// # Errors
+    /// [`SimError::InvalidSetting`] naming `controller.period` when the `dopri5` integrator has
+    /// none.
+    pub fn controller_period(&self) -> Result<f64, SimError> {
+        match (self.controller.period, self.integrator) {
+            (Some(period), _) => Ok(period),
+            (None, IntegratorSpec::Rk4 { dt }) => Ok(dt),
+            (None, IntegratorSpec::Dopri5 { .. }) => Err(SimError::setting(
+                "controller.period",
+                "is required with the dopri5 integrator",
+            )),
+        }
     }
 }
 
