@@ -84,7 +84,7 @@ fn cut_to_whole_periods(cut: f64, period: f64) -> Option<f64> {
         Some(cut)
     } else {
         let below = ratio.floor();
-        (below >= 1.0).then(|| below * period)
+        (below >= 1.0).then_some(below * period)
     }
 }
 
