@@ -652,6 +652,21 @@ pub enum LearningProblem {
         /// The most multiply-adds allowed.
         limit: usize,
     },
+    /// The epochs of a training, each a least-squares solve of `per_epoch` multiply-adds, would
+    /// exceed the limit of a whole training's work.
+    #[error(
+        "{epochs} epochs of a least-squares solve of {per_epoch} multiply-adds each exceed the \
+         {limit} multiply-adds a training may take (about six minutes): use fewer epochs, or \
+         fewer sets per input or inputs"
+    )]
+    TrainingTooSlow {
+        /// The epochs asked for.
+        epochs: usize,
+        /// The multiply-adds of one epoch's least-squares solve.
+        per_epoch: usize,
+        /// The most multiply-adds allowed.
+        limit: usize,
+    },
     /// The least-squares problem of the consequents (Jang's eq 15) holds a NaN or an infinity
     /// (its entries or their squares overflowed).
     #[error(

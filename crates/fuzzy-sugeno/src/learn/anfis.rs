@@ -30,6 +30,9 @@ const MAX_LEAST_SQUARES_ENTRIES: usize = 25_000_000;
 /// The most multiply-adds of one least-squares solve, rows times unknowns squared (about 15 s:
 /// 3,072 unknowns took 12 s on the development machine).
 const MAX_LEAST_SQUARES_WORK: usize = 40_000_000_000;
+/// The most multiply-adds of a whole training's least-squares solves, epochs times the solve's
+/// (about six minutes: 25 times [`MAX_LEAST_SQUARES_WORK`]).
+const MAX_TRAINING_WORK: usize = 1_000_000_000_000;
 /// Marks a "don't care" antecedent in the rule table.
 const ANY: u32 = u32::MAX;
 
@@ -307,6 +310,15 @@ impl Anfis {
                 samples: rows,
                 unknowns,
                 limit: MAX_LEAST_SQUARES_WORK,
+            }
+            .into());
+        }
+        let per_epoch = entries.saturating_mul(unknowns);
+        if per_epoch.saturating_mul(options.epochs) > MAX_TRAINING_WORK {
+            return Err(LearningProblem::TrainingTooSlow {
+                epochs: options.epochs,
+                per_epoch,
+                limit: MAX_TRAINING_WORK,
             }
             .into());
         }

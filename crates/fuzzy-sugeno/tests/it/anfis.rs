@@ -259,6 +259,57 @@ fn training_is_deterministic_and_keeps_the_best_check_epoch() {
     assert!(a.history.last().unwrap().training_rmse < a.history[0].training_rmse);
 }
 
+/// A training whose epochs together take more than the bound (each solve within its own) is
+/// refused before its first epoch: 100,000 samples and 128 consequents make 1.6e9 multiply-adds
+/// an epoch, so 600 epochs pass and 1,000 do not.
+#[test]
+fn the_work_of_all_epochs_is_bounded_up_front() {
+    let sets = 64;
+    let mut fis = format!(
+        "[System]\nName='wide'\nType='sugeno'\nNumInputs=1\nNumOutputs=1\nNumRules={sets}\n\
+         AndMethod='prod'\nOrMethod='probor'\nImpMethod='prod'\nAggMethod='sum'\n\
+         DefuzzMethod='wtaver'\n\n[Input1]\nName='x'\nRange=[0 1]\nNumMFs={sets}\n"
+    );
+    for k in 1..=sets {
+        fis += &format!("MF{k}='s{k}':'gaussmf',[0.01 {}]\n", k as f64 / sets as f64);
+    }
+    fis += &format!("\n[Output1]\nName='y'\nRange=[0 1]\nNumMFs={sets}\n");
+    for k in 1..=sets {
+        fis += &format!("MF{k}='o{k}':'linear',[0 0]\n");
+    }
+    fis += "\n[Rules]\n";
+    for k in 1..=sets {
+        fis += &format!("{k}, {k} (1) : 1\n");
+    }
+    let system = FuzzySystem::from_fis(&fis).unwrap();
+    let rows = 100_000;
+    let values = (0..rows)
+        .flat_map(|r| {
+            let x = r as f64 / rows as f64;
+            [x, x * x]
+        })
+        .collect();
+    let data = TrainingData::new(1, 1, values).unwrap();
+    let options = |epochs| AnfisOptions {
+        epochs,
+        ..AnfisOptions::default()
+    };
+    let start = Instant::now();
+    let error = fuzzy_sugeno::learn::Anfis::new(system.clone(), &data, None, 0, options(1000))
+        .map(|_| ())
+        .unwrap_err();
+    assert!(
+        matches!(
+            error,
+            FuzzyError::Learning(LearningProblem::TrainingTooSlow { epochs: 1000, .. })
+        ),
+        "{error}"
+    );
+    assert!(error.to_string().contains("1000 epochs of a least-squares solve of "), "{error}");
+    assert!(start.elapsed().as_secs() < 5);
+    assert!(fuzzy_sugeno::learn::Anfis::new(system, &data, None, 0, options(600)).is_ok());
+}
+
 /// A premise step that throws the sets' parameters beyond double precision is an error naming
 /// the step, not a set's "parameters must be finite".
 #[test]
