@@ -106,6 +106,11 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
             (Some(run), _) => run,
             (None, None) => scenes[0].runs[0].clone(),
             (None, Some(_)) => {
+                // A run folder that exists but is not animated says why.
+                let folder = dir.join(name).join(controller);
+                if folder.join("timeseries.csv").is_file() {
+                    load_run(&folder, None)?;
+                }
                 return Err(format!(
                     "--run {}: no such run in {} (its folders are SCENARIO/CONTROLLER)",
                     args.run,
@@ -212,6 +217,20 @@ fn load_run(dir: &Path, label: Option<&str>) -> Result<(Scenario, RunView), Stri
         ));
     }
     let scenario = Scenario::load(&toml).map_err(|e| format!("{}: {e}", toml.display()))?;
+    let joint_space = if scenario.deploy.is_some() {
+        Some("a deployment on an insertion axis ([deploy]), which the main job draws as figures")
+    } else if scenario.arm.urdf.is_some() {
+        Some("a URDF arm's run in joint space (arm.urdf)")
+    } else {
+        None
+    };
+    if let Some(what) = joint_space {
+        return Err(format!(
+            "{}: {what}: `hrm view` animates the runs in modal coordinates of `hrm simulate` \
+             and the main job, not this one",
+            dir.display()
+        ));
+    }
     // The arm the scenario describes (refused there, e.g. too many links).
     let n_joints = scenario
         .plant()

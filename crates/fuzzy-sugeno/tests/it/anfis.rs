@@ -305,7 +305,12 @@ fn the_work_of_all_epochs_is_bounded_up_front() {
         ),
         "{error}"
     );
-    assert!(error.to_string().contains("1000 epochs of a least-squares solve of "), "{error}");
+    assert!(
+        error
+            .to_string()
+            .contains("1000 epochs of a least-squares solve of "),
+        "{error}"
+    );
     assert!(start.elapsed().as_secs() < 5);
     assert!(fuzzy_sugeno::learn::Anfis::new(system, &data, None, 0, options(600)).is_ok());
 }

@@ -758,6 +758,39 @@ fn hrm_view_writes_a_page_and_a_gif_and_replaces_only_its_own_files() {
     );
     assert_eq!(std::fs::read_to_string(&mine).unwrap(), "<p>my notes</p>");
     assert!(!gif.exists());
+    // Runs in joint space (a deployment, a URDF arm) are named, not misread as modal runs.
+    let joint_space = dir.join("joint-space");
+    std::fs::create_dir_all(&joint_space).unwrap();
+    std::fs::copy(
+        run.join("timeseries.csv"),
+        joint_space.join("timeseries.csv"),
+    )
+    .unwrap();
+    let examples = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/urdf-arm");
+    std::fs::copy(
+        format!("{examples}/arm7.urdf"),
+        joint_space.join("arm7.urdf"),
+    )
+    .unwrap();
+    for (scenario, expected) in [
+        (
+            sim_study::Scenario::builtin("pipe-deploy")
+                .unwrap()
+                .to_toml(),
+            "joint-space: a deployment on an insertion axis ([deploy])",
+        ),
+        (
+            std::fs::read_to_string(format!("{examples}/step.toml")).unwrap(),
+            "joint-space: a URDF arm's run in joint space (arm.urdf)",
+        ),
+    ] {
+        std::fs::write(joint_space.join("scenario.toml"), scenario).unwrap();
+        let line = refused(&hrm(&["view", path(&joint_space)]));
+        assert!(
+            line.contains(expected) && line.contains("`hrm view` animates"),
+            "{line}"
+        );
+    }
     // Not a run; a broken time series; bad GIF options.
     let line = refused(&hrm(&["view", path(&dir)]));
     assert!(line.contains("neither an `hrm simulate` output"), "{line}");
