@@ -82,6 +82,7 @@ enum FisCommand {
 
 /// Warns on standard error, as MATLAB's `evalfis` does, when `evaluator` has evaluated an input
 /// outside its range as given: once per process (a `hrm eval` session answers many requests).
+/// Inputs are numbered from 0, as in the library's errors.
 pub(crate) fn warn_outside_range(evaluator: &Evaluator) {
     static WARNED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
     if let Some(outside) = evaluator.first_outside_range()
@@ -91,7 +92,7 @@ pub(crate) fn warn_outside_range(evaluator: &Evaluator) {
         let line = format!(
             "warning: input {} ('{}') = {} is outside its range [{}, {}]; evaluated as given, as \
              MATLAB's evalfis does (--out-of-range clamp evaluates at the nearest end)",
-            outside.index + 1,
+            outside.index,
             input.name,
             outside.value,
             input.range[0],

@@ -1,6 +1,6 @@
 //! The error type of this crate.
 
-use lane_math::{Classify, ErrorClass};
+use lane_math::{Classify, Compact, ErrorClass};
 
 /// Why a run or scene could not be drawn: a field outside the format (named as in the JSON of
 /// `docs/run-view.md`), a record that does not fit its scenario, or a GIF or page that could not
@@ -38,8 +38,9 @@ pub enum ViewError {
     },
     /// A GIF would need more frames than [`MAX_FRAMES`](crate::MAX_FRAMES).
     #[error(
-        "gif: {seconds:.3} s of run at {fps} frames a second and speed {speed} make {frames} \
-         frames, more than {max}; raise the speed or lower the rate"
+        "gif: {seconds:.3} s of run at {fps} frames a second and speed {} make {frames:.4e} \
+         frames, more than {max}; raise the speed or lower the rate",
+        Compact(*.speed)
     )]
     TooManyFrames {
         /// The run's duration (s).
@@ -48,10 +49,27 @@ pub enum ViewError {
         fps: u32,
         /// Seconds of run a second of GIF.
         speed: f64,
-        /// The frames needed.
-        frames: usize,
+        /// The frames needed (counted in floating point: beyond `usize` when the speed is tiny).
+        frames: f64,
         /// The limit.
         max: usize,
+    },
+    /// The frames of a GIF times its pixels exceed what one is drawn with.
+    #[error(
+        "gif: {frames} frames of {width} x {height} pixels make {pixels:.3e} pixels to draw, \
+         more than {max:e}; lower the size, the rate or the run's length shown (raise the speed)"
+    )]
+    TooManyPixels {
+        /// The frames.
+        frames: usize,
+        /// Width (pixels).
+        width: u32,
+        /// Height (pixels).
+        height: u32,
+        /// Frames times width times height.
+        pixels: f64,
+        /// The limit.
+        max: f64,
     },
     /// The picture of a GIF's frames could not be allocated.
     #[error("gif: cannot allocate the picture")]

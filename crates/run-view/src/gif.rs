@@ -13,6 +13,9 @@ use tiny_skia::{
 pub const MAX_FRAMES: usize = 2_000;
 /// The largest width or height (pixels).
 pub const MAX_SIDE: u32 = 2_000;
+/// The most pixels a GIF's frames may hold together, frames times width times height (about
+/// half a minute of drawing: 100 frames of 2000 x 2000 pixels took 5.7 s).
+pub const MAX_PIXELS: f64 = 2e9;
 
 /// How a GIF is drawn.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -426,7 +429,7 @@ fn index(rgba: &[u8]) -> u8 {
 /// Writes `run` as an animated GIF to `out`: frames `1 / fps` s apart showing `speed` s of the
 /// run a second, from its first sample to its last, looping. The run and the options are
 /// checked first; at most [`MAX_FRAMES`] frames (an error names the duration, rate and speed
-/// that need more).
+/// that need more) and [`MAX_PIXELS`] pixels in all.
 pub fn write_gif(run: &RunView, options: &GifOptions, out: impl Write) -> Result<(), ViewError> {
     run.check()?;
     options.check()?;
@@ -438,12 +441,22 @@ pub fn write_gif(run: &RunView, options: &GifOptions, out: impl Write) -> Result
             seconds: t1 - t0,
             fps: options.fps,
             speed: options.speed,
-            frames: needed as usize,
+            frames: needed,
             max: MAX_FRAMES,
         });
     }
     let frames = needed as usize;
     let (w, h) = (options.width, options.height);
+    let pixels = needed * f64::from(w) * f64::from(h);
+    if pixels > MAX_PIXELS {
+        return Err(ViewError::TooManyPixels {
+            frames,
+            width: w,
+            height: h,
+            pixels,
+            max: MAX_PIXELS,
+        });
+    }
     let mut pixmap = Pixmap::new(w, h).ok_or(ViewError::Picture)?;
     let camera = Camera::fit(&world_points(run), run.dims, f64::from(w), f64::from(h));
     let mut encoder = gif::Encoder::new(out, w as u16, h as u16, &palette())?;

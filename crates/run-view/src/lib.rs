@@ -10,7 +10,9 @@ mod view;
 pub use decimate::{round_decimal, strided};
 pub use error::{FieldProblem, ViewError};
 pub use from_record::from_record;
-pub use gif::{Camera, GifOptions, MAX_FRAMES, MAX_SIDE, draw_frame, torque_colour, write_gif};
+pub use gif::{
+    Camera, GifOptions, MAX_FRAMES, MAX_PIXELS, MAX_SIDE, draw_frame, torque_colour, write_gif,
+};
 pub use page::{
     PAGE_SAMPLES, REPORT_SAMPLES, SCRIPT, SIGNATURE, SIGNATURE_WITHIN, STYLE, escape, head, iframe,
     page, scene_html, tail, written_by_hrm,

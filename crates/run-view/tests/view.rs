@@ -402,6 +402,26 @@ fn the_gif_shows_the_arm_moving_over_its_path() {
             "{speed}"
         );
     }
+    // The count is the true one, not a saturated integer.
+    let slowest = GifOptions {
+        speed: 1e-300,
+        ..options
+    };
+    let message = write_gif(&run, &slowest, Vec::new()).unwrap_err().to_string();
+    assert!(message.contains("speed 1e-300 make 1.0000e301 frames"), "{message}");
+    // Frames within their bound whose pixels together are not: refused before drawing.
+    let large = GifOptions {
+        width: 2000,
+        height: 2000,
+        fps: 50,
+        speed: 0.0126,
+    };
+    let message = write_gif(&run, &large, Vec::new()).unwrap_err().to_string();
+    assert!(
+        message.contains(" frames of 2000 x 2000 pixels make ")
+            && message.contains("pixels to draw, more than 2e9"),
+        "{message}"
+    );
     let wide = GifOptions {
         width: 0,
         ..options
