@@ -92,11 +92,7 @@ pub(crate) fn warn_outside_range(evaluator: &Evaluator) {
         let line = format!(
             "warning: input {} ('{}') = {} is outside its range [{}, {}]; evaluated as given, as \
              MATLAB's evalfis does (--out-of-range clamp evaluates at the nearest end)",
-            outside.index,
-            input.name,
-            outside.value,
-            input.range[0],
-            input.range[1]
+            outside.index, input.name, outside.value, input.range[0], input.range[1]
         );
         eprintln!("{}", console::error_line(&line));
     }

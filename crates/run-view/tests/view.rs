@@ -407,8 +407,13 @@ fn the_gif_shows_the_arm_moving_over_its_path() {
         speed: 1e-300,
         ..options
     };
-    let message = write_gif(&run, &slowest, Vec::new()).unwrap_err().to_string();
-    assert!(message.contains("speed 1e-300 make 1.0000e301 frames"), "{message}");
+    let message = write_gif(&run, &slowest, Vec::new())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("speed 1e-300 make 1.0000e301 frames"),
+        "{message}"
+    );
     // Frames within their bound whose pixels together are not: refused before drawing.
     let large = GifOptions {
         width: 2000,

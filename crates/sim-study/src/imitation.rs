@@ -38,7 +38,7 @@ use fuzzy_sugeno::learn::{
     Anfis, AnfisOptions, ConsequentOrder, EpochReport, GridPartition, MAX_INPUTS, MAX_ROWS,
     SetShape, TrainingData, genfis_grid_over, merge_outputs,
 };
-use fuzzy_sugeno::{Evaluator, FuzzySystem};
+use fuzzy_sugeno::{Evaluator, FuzzyError, FuzzySystem, LearningProblem};
 use sim_core::SimError;
 use sim_core::controller::{SCHEDULED_INPUTS_PER_COORDINATE, scheduled_inputs};
 
@@ -295,8 +295,21 @@ pub fn train(
         ..AnfisOptions::default()
     };
     let (mut systems, mut history, mut best_epoch) = (Vec::new(), Vec::new(), Vec::new());
+    // A constant column is named (the library counts inputs from 1, which says little here).
+    let named = |error: FuzzyError| match error {
+        FuzzyError::Learning(LearningProblem::ConstantInput { input, value }) => SimError::setting(
+            "imitation data",
+            format!(
+                "input '{}' is constant ({value}) over the demonstrations: the teacher's runs \
+                 never vary it, so no partition of it can be learned; add scenarios (or \
+                 imitation.offsets) that move it",
+                data.column_name(input)
+            ),
+        ),
+        other => other.into(),
+    };
     for output in 0..m {
-        let initial = genfis_grid_over(data, output, &grid, &coordinates)?;
+        let initial = genfis_grid_over(data, output, &grid, &coordinates).map_err(named)?;
         let mut trainer = Anfis::new(initial, data, None, output, anfis)?;
         let mut reports = Vec::with_capacity(options.epochs);
         for _ in 0..options.epochs {
@@ -349,14 +362,26 @@ pub fn shifted_grid(
         .try_fold(1usize, |n, list| n.checked_mul(list.len()))
         .unwrap_or(usize::MAX);
     let total = points.saturating_mul(scenarios.len());
-    if points == 0 || total > MAX_DEMONSTRATIONS {
+    if points == 0 {
+        return Err(SimError::setting(
+            name,
+            "must give at least one offset per coordinate, got an empty list",
+        ));
+    }
+    if total > MAX_DEMONSTRATIONS {
+        let sizes: Vec<String> = offsets.iter().map(|l| l.len().to_string()).collect();
         return Err(SimError::setting(
             name,
             format!(
-                "must give at least one offset per coordinate and make at most \
-                 {MAX_DEMONSTRATIONS} scenarios, got {} lists for {} scenarios",
-                offsets.len(),
-                scenarios.len()
+                "must make at most {MAX_DEMONSTRATIONS} scenarios, got a grid of {} offsets \
+                 for {} scenarios ({} in all)",
+                sizes.join(" x "),
+                scenarios.len(),
+                if total == usize::MAX {
+                    "beyond counting".to_string()
+                } else {
+                    total.to_string()
+                }
             ),
         ));
     }

@@ -308,10 +308,15 @@ fn operating_points_shift_the_reference_and_nothing_else() {
         imitation::shifted_grid(std::slice::from_ref(&sine), &[vec![0.0], vec![]])
             .unwrap_err()
             .to_string(),
-        "imitation.offsets must give at least one offset per coordinate and make at most 10000 scenarios, got 2 lists for 1 scenarios"
+        "imitation.offsets must give at least one offset per coordinate, got an empty list"
     );
     let huge = vec![vec![0.0; 1000], vec![0.0; 1000]];
-    assert!(imitation::shifted_grid(std::slice::from_ref(&sine), &huge).is_err());
+    assert_eq!(
+        imitation::shifted_grid(std::slice::from_ref(&sine), &huge)
+            .unwrap_err()
+            .to_string(),
+        "imitation.offsets must make at most 10000 scenarios, got a grid of 1000 x 1000 offsets for 1 scenarios (1000000 in all)"
+    );
     assert_eq!(
         imitation::shifted_grid(&[sine], &[vec![f64::NAN], vec![0.0]])
             .unwrap_err()
@@ -365,6 +370,20 @@ fn bad_requests_are_refused_by_name() {
     ] {
         assert_eq!(message(std::slice::from_ref(&step), options), text);
     }
+    // A step alone never moves the reference's accelerations: the constant input is named.
+    let mut short = step.clone();
+    short.duration = 0.5;
+    let options = ImitationOptions { epochs: 1, ..d };
+    let data = imitation::record(std::slice::from_ref(&short), &options).unwrap();
+    let constant = imitation::train(&data, &options, |_, _| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        constant.starts_with(
+            "imitation data input 'a1_ref_ddot' is constant (0) over the demonstrations"
+        ),
+        "{constant}"
+    );
     // Too many rows for the learner, refused before anything runs.
     let mut long = step.clone();
     long.duration = 200.0;
