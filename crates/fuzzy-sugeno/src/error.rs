@@ -555,6 +555,16 @@ pub enum LearningProblem {
         /// The offending value.
         value: f64,
     },
+    /// A real option of [`AnfisOptions`](crate::learn::AnfisOptions) above its maximum.
+    #[error("{name} must be at most {max:e}, got {value:e}")]
+    AboveMaximum {
+        /// `"the ridge"`.
+        name: &'static str,
+        /// The largest value allowed.
+        max: f64,
+        /// The offending value.
+        value: f64,
+    },
     /// Subtractive clustering was given more than
     /// [`MAX_CLUSTER_ROWS`](crate::learn::MAX_CLUSTER_ROWS) rows.
     #[error("subtractive clustering takes at most {limit} rows, got {rows}")]

@@ -33,6 +33,9 @@ const MAX_LEAST_SQUARES_WORK: usize = 40_000_000_000;
 /// The most multiply-adds of a whole training's least-squares solves, epochs times the solve's
 /// (about six minutes: 25 times [`MAX_LEAST_SQUARES_WORK`]).
 const MAX_TRAINING_WORK: usize = 1_000_000_000_000;
+/// The largest ridge, relative to the mean squared column norm: beyond it the consequents are
+/// all but zero (and `1e308` overflowed the regularised problem).
+const MAX_RIDGE: f64 = 1e6;
 /// Marks a "don't care" antecedent in the rule table.
 const ANY: u32 = u32::MAX;
 
@@ -90,6 +93,14 @@ impl AnfisOptions {
         finite_at_least("the initial step", self.initial_step, 0.0)?;
         finite_at_least("the step increase", self.step_increase, 1.0)?;
         finite_at_least("the ridge", self.ridge, 0.0)?;
+        if self.ridge > MAX_RIDGE {
+            return Err(LearningProblem::AboveMaximum {
+                name: "the ridge",
+                max: MAX_RIDGE,
+                value: self.ridge,
+            }
+            .into());
+        }
         finite_at_least("the target RMSE", self.target_rmse, 0.0)?;
         if !(self.step_decrease > 0.0 && self.step_decrease <= 1.0) {
             return Err(LearningProblem::OutsideUnitInterval {
@@ -1031,6 +1042,12 @@ mod tests {
         assert_eq!(
             ridge.to_string(),
             "learning: the ridge must be finite and at least 0, got -1"
+        );
+        // A ridge that overwhelms the data (1e308 overflowed and was reported as a rank
+        // deficiency, "use a ridge > 0").
+        assert_eq!(
+            with(|o| o.ridge = 1e308).to_string(),
+            "learning: the ridge must be at most 1e6, got 1e308"
         );
         assert!(matches!(
             with(|o| o.step_increase = f64::NAN),
