@@ -188,7 +188,7 @@ impl Sweep {
                         ShardFile::parse(&text, &origin).map_err(input)?,
                     ));
                 }
-                _ => paths.push(item.extract::<PathBuf>()?),
+                _ => paths.push(shard_path(&item, k)?),
             }
         }
         for path in study::shard_paths(&paths).map_err(input)? {
@@ -281,4 +281,23 @@ fn controller_kinds(controllers: &Bound<'_, PyAny>) -> PyResult<Vec<ControllerKi
         kinds.push(name.parse::<ControllerKind>().map_err(Error::from)?);
     }
     Ok(kinds)
+}
+
+/// Item `k` of `Sweep.merge`'s shards as a path: a `str`, `bytes` (the file system's own
+/// encoding) or an `os.PathLike`; anything else is a TypeError naming the item and its type.
+fn shard_path(item: &Bound<'_, PyAny>, k: usize) -> PyResult<PathBuf> {
+    if let Ok(bytes) = item.cast::<pyo3::types::PyBytes>() {
+        use std::os::unix::ffi::OsStrExt;
+        return Ok(PathBuf::from(std::ffi::OsStr::from_bytes(bytes.as_bytes())));
+    }
+    item.extract::<PathBuf>().map_err(|_| {
+        let kind = item
+            .get_type()
+            .name()
+            .map_or_else(|_| "?".to_owned(), |name| name.to_string());
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "shards[{k}] must be a shard file's text, or a path (str, bytes or os.PathLike) to \
+             a shard file or a directory of them, got a {kind}"
+        ))
+    })
 }

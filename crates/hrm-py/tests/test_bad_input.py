@@ -493,6 +493,14 @@ def test_merge_refuses_a_string():
     assert hrm.Sweep.merge([text])["cells"]
 
 
+def test_merge_takes_bytes_paths_and_names_an_item_of_another_type(tmp_path):
+    text = hrm.Sweep(short_step(0.01), noise_levels=[0.0], seeds=1, controllers=["pd"]).run_shard()
+    (tmp_path / "shard-1-of-1.json").write_text(text)
+    assert hrm.Sweep.merge([os.fsencode(tmp_path)]) == hrm.Sweep.merge([tmp_path])
+    with pytest.raises(TypeError, match=r"^shards\[1\] must be a shard file's text, or a path \(str, bytes or os.PathLike\) .*, got a NoneType$"):
+        hrm.Sweep.merge([tmp_path, None])
+
+
 def test_every_controller_is_listed_in_the_docs():
     names = hrm.Sweep(short_step(0.01), noise_levels=[0.0], seeds=1).config["settings"]["controllers"]
     assert len(names) == 6
