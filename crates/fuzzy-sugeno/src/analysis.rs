@@ -378,6 +378,13 @@ impl FuzzySystem {
                     let jump = (output.terms[ta].function.value(&point)?
                         - output.terms[tb].function.value(&point)?)
                     .abs();
+                    if !jump.is_finite() {
+                        return Err(FuzzyError::JumpOverflow {
+                            index: o,
+                            name: output.name.clone(),
+                            rules: [i, j],
+                        });
+                    }
                     // A point range ([0 0] in some MATLAB files) makes any jump infinite.
                     let relative = if jump == 0.0 {
                         0.0
@@ -776,6 +783,26 @@ mod tests {
             .rule(["mid", "A"], ["zero"]);
         let jump = self::report(&smooth.build().unwrap()).continuity.outputs[0].unwrap();
         assert_eq!((jump.jump, jump.relative), (1.0, 0.5));
+    }
+
+    #[test]
+    fn a_jump_beyond_double_precision_is_an_error_not_an_infinity() {
+        // Neighbours concluding 1e308 and -1e308: their jump, 2e308, is no double (the report
+        // read "largest jump inf").
+        let text = "[System]\nName='pm'\nType='sugeno'\nNumInputs=1\nNumOutputs=1\nNumRules=2\n\
+            AndMethod='prod'\nOrMethod='probor'\nImpMethod='prod'\nAggMethod='sum'\n\
+            DefuzzMethod='wtaver'\n\n[Input1]\nName='x1'\nRange=[-1 1]\nNumMFs=2\n\
+            MF1='m0':'gaussmf',[0.5 0]\nMF2='m1':'gaussmf',[0.5 1]\n\n[Output1]\nName='y1'\n\
+            Range=[-1 1]\nNumMFs=2\nMF1='o0':'constant',[1e308]\nMF2='o1':'constant',[-1e308]\n\n\
+            [Rules]\n1, 1 (1) : 1\n2, 2 (1) : 1\n";
+        let system = crate::FuzzySystem::from_fis(text).unwrap();
+        let error = system.analyze(&AnalysisOptions::default()).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "analysis: the consequents of rules 0 and 1 on output 0 ('y1') differ by more than \
+             double precision holds"
+        );
+        assert!(lane_math::Classify::is_numerical(&error));
     }
 
     #[test]

@@ -84,6 +84,22 @@ pub enum FuzzyError {
         /// The offending value.
         value: f64,
     },
+    /// Two neighbouring rules' consequents on an output differ by more than double precision
+    /// holds (constants of `1e308` and `-1e308`), so the continuity check has no finite jump.
+    #[error(
+        "analysis: the consequents of rules {} and {} on output {index} ('{name}') differ by more \
+         than double precision holds",
+        .rules[0],
+        .rules[1]
+    )]
+    JumpOverflow {
+        /// The output's position (0-based).
+        index: usize,
+        /// The output's name.
+        name: String,
+        /// The two rules (0-based).
+        rules: [usize; 2],
+    },
     /// The fallback values of [`NoRuleFired::Values`](crate::NoRuleFired::Values) do not hold
     /// one value per output.
     #[error("evaluation options: no-rule-fired values have {found} entries for {expected} outputs")]
@@ -233,7 +249,7 @@ impl Classify for FuzzyError {
     /// [`Unreachable`](ErrorClass::Unreachable).
     fn class(&self) -> ErrorClass {
         match self {
-            Self::NonFiniteOutput { .. } => ErrorClass::Numerical,
+            Self::NonFiniteOutput { .. } | Self::JumpOverflow { .. } => ErrorClass::Numerical,
             Self::Learning(problem) => problem.class(),
             Self::Batch { source, .. } => source.class(),
             _ => ErrorClass::InvalidInput,
