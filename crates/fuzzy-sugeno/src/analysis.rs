@@ -795,7 +795,7 @@ mod tests {
             MF1='m0':'gaussmf',[0.5 0]\nMF2='m1':'gaussmf',[0.5 1]\n\n[Output1]\nName='y1'\n\
             Range=[-1 1]\nNumMFs=2\nMF1='o0':'constant',[1e308]\nMF2='o1':'constant',[-1e308]\n\n\
             [Rules]\n1, 1 (1) : 1\n2, 2 (1) : 1\n";
-        let system = crate::FuzzySystem::from_fis(text).unwrap();
+        let system = FuzzySystem::from_fis(text).unwrap();
         let error = system.analyze(&AnalysisOptions::default()).unwrap_err();
         assert_eq!(
             error.to_string(),
