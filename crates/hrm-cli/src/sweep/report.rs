@@ -80,7 +80,15 @@ pub fn table(config: &SweepConfig, cells: &[Cell]) -> String {
                 let _ = write!(s, " {text:>9}");
             }
         };
-        let mm = |v: f64| format!("{v:.4}");
+        // Millimetres to four decimals; a value of a kilometre or more (a hand-edited shard's
+        // 1e300 printed 300 digits) in scientific notation.
+        let mm = |v: f64| {
+            if v.abs() < 1e6 {
+                format!("{v:.4}")
+            } else {
+                format!("{v:.3e}")
+            }
+        };
         let rad = |v: f64| format!("{v:.3e}");
         cols(
             &mut s,
@@ -172,4 +180,39 @@ pub fn plot(path: &Path, config: &SweepConfig, cells: &[Cell]) -> Result<bool, S
     };
     line_chart(path, &labels, &means, None)?;
     Ok(true)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sim_study::Scenario;
+    use sim_study::study::SweepSettings;
+
+    #[test]
+    fn a_huge_tip_error_is_written_in_scientific_notation() {
+        // A hand-edited shard's 1e300 mm printed three hundred digits in one cell.
+        let config = SweepConfig::new(
+            Scenario::builtin("paper-tracking").unwrap(),
+            SweepSettings::default(),
+        )
+        .unwrap();
+        let huge = Stats::of(&[1e300]);
+        let cell = Cell {
+            noise_level: 0.0,
+            controller: sim_study::ControllerKind::Pd,
+            runs: 1,
+            failed: 0,
+            tip_error_rms_mm: huge,
+            tip_error_max_mm: Stats::of(&[4.25]),
+            modal_error_rms_rad: vec![Stats::of(&[1e-3]); 2],
+            peak_joint_torque_nm: None,
+            failures: Vec::new(),
+        };
+        let text = table(&config, &[cell]);
+        assert!(
+            text.contains("1.000e300") && text.contains("4.2500"),
+            "{text}"
+        );
+        assert!(text.lines().all(|line| line.len() < 300), "{text}");
+    }
 }
