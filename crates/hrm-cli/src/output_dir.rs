@@ -272,7 +272,8 @@ pub fn refuse_foreign_file(
     within: usize,
     written_by_hrm: impl Fn(&[u8]) -> bool,
 ) -> Result<(), String> {
-    if std::fs::symlink_metadata(path).is_err() {
+    // Nothing there (or a dangling link, which the new file replaces): nothing to keep.
+    if std::fs::metadata(path).is_err() {
         return Ok(());
     }
     if path.is_dir() {
