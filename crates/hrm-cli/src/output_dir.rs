@@ -251,15 +251,16 @@ pub fn refuse_foreign_files(
 }
 
 /// Whether the regular file `path` holds a text `written_by_hrm` recognises, from its first
-/// `within` bytes (a folder or an unreadable file is not hrm's).
+/// `within` bytes (a folder, a FIFO, which opening would wait on, or an unreadable file is not
+/// hrm's).
 fn file_written_by_hrm(path: &Path, within: usize, written_by_hrm: impl Fn(&[u8]) -> bool) -> bool {
     use std::io::Read;
+    if !std::fs::metadata(path).is_ok_and(|meta| meta.is_file()) {
+        return false;
+    }
     let Ok(file) = std::fs::File::open(path) else {
         return false;
     };
-    if !file.metadata().is_ok_and(|meta| meta.is_file()) {
-        return false;
-    }
     let mut start = Vec::new();
     file.take(within as u64).read_to_end(&mut start).is_ok() && written_by_hrm(&start)
 }

@@ -116,6 +116,13 @@ fn out_replaces_its_own_system_and_never_a_file_of_the_users() {
         );
         assert_eq!(std::fs::read_to_string(path).unwrap(), text);
     }
+    // A FIFO is refused at once (opening it to read would wait for a writer).
+    let fifo = dir.join("fifo.fis");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+    let run = train_into(&fifo);
+    assert_eq!(run.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("exists and hrm did not write it"));
 }
 
 #[test]
