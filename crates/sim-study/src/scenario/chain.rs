@@ -220,7 +220,7 @@ impl Scenario {
             }
         };
         let (kp, kd) = self.controller.computed_torque_gains(n)?;
-        let period = self.controller.period.unwrap_or(dt);
+        let period = self.controller_period()?;
         let settings = ChainLoopSettings {
             duration: self.duration,
             period,

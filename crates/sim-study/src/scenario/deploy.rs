@@ -241,7 +241,7 @@ impl Scenario {
             )
             .into());
         };
-        let period = self.controller.period.unwrap_or(dt);
+        let period = self.controller_period()?;
         // A deployment faster than one controller period is one jump: its accelerations
         // overflow (1e-300 s gave a NaN joint acceleration at t = 0).
         if travel_time < period {

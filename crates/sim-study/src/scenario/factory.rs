@@ -245,6 +245,22 @@ impl Scenario {
         };
         Ok((model, reference, controller, settings, initial))
     }
+
+    /// The controller's sampling period (s): `controller.period`, or the RK4 step without it.
+    ///
+    /// # Errors
+    /// [`SimError::InvalidSetting`] naming `controller.period` when the `dopri5` integrator has
+    /// none.
+    pub fn controller_period(&self) -> Result<f64, SimError> {
+        match (self.controller.period, self.integrator) {
+            (Some(period), _) => Ok(period),
+            (None, IntegratorSpec::Rk4 { dt }) => Ok(dt),
+            (None, IntegratorSpec::Dopri5 { .. }) => Err(SimError::setting(
+                "controller.period",
+                "is required with the dopri5 integrator",
+            )),
+        }
+    }
 }
 
 impl NoiseSpec {
@@ -325,27 +341,7 @@ impl ArmSpec {
         ChainModel::new(links, gravity)
             .map_err(|e| SimError::setting("arm", format!("is invalid: {e}")))
     }
-}
 
-impl Scenario {
-    /// The controller's sampling period (s): `controller.period`, or the RK4 step without it.
-    ///
-    /// # Errors
-    /// [`SimError::InvalidSetting`] naming `controller.period` when the `dopri5` integrator has
-    /// none.
-    pub fn controller_period(&self) -> Result<f64, SimError> {
-        match (self.controller.period, self.integrator) {
-            (Some(period), _) => Ok(period),
-            (None, IntegratorSpec::Rk4 { dt }) => Ok(dt),
-            (None, IntegratorSpec::Dopri5 { .. }) => Err(SimError::setting(
-                "controller.period",
-                "is required with the dopri5 integrator",
-            )),
-        }
-    }
-}
-
-impl ArmSpec {
     /// The `n` links of `lengths` and `masses` (or `link_length` and `link_mass`, default 0.1 m
     /// and 0.1 kg), each checked as a uniform beam (`Link::uniform_beam`: positive and finite,
     /// with a beam inertia `m L^2 / 12` positive and finite in double precision, which bounds a
