@@ -17,8 +17,9 @@ use numpy::{IntoPyArray, PyArray1};
 use pyo3::exceptions::{PyAttributeError, PyFileNotFoundError, PyOSError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
-use sim_core::LoopHooks;
 use sim_core::controller::{ControlContext, Controller, ControllerError, ModalState};
+use sim_core::reference::Reference;
+use sim_core::{LoopHooks, SimError};
 use sim_study::study::{RunOutcome, Stopped};
 use sim_study::{ControllerKind, DeployFailure, ScenarioError};
 use std::cell::Cell;
@@ -607,6 +608,30 @@ impl Controller for Interruptible {
     }
 }
 
+/// A deployment's reference that fails at its next sample once the user pressed Ctrl-C, so that
+/// an interrupted deployment stops (the interrupt is raised in place of the run's result).
+struct InterruptibleReference {
+    inner: Box<dyn Reference>,
+    cancel: Cancel,
+}
+
+impl Reference for InterruptibleReference {
+    fn n_coords(&self) -> usize {
+        self.inner.n_coords()
+    }
+
+    fn sample(
+        &mut self,
+        t: f64,
+        out: &mut sim_core::reference::ReferenceSample,
+    ) -> Result<(), SimError> {
+        if self.cancel.is_set() {
+            return Err(SimError::from_controller(t, Box::new(Interrupted)));
+        }
+        self.inner.sample(t, out)
+    }
+}
+
 impl Controller for PythonController {
     fn control(
         &mut self,
@@ -890,7 +915,7 @@ impl Scenario {
                             cancel: flag.clone(),
                         })
                     })?;
-                    Ok::<_, sim_core::SimError>(run(&mut simulation, &mut hooks))
+                    Ok::<_, SimError>(run(&mut simulation, &mut hooks))
                 })?;
                 (
                     outcome.map_err(Error::from)?,
@@ -918,13 +943,22 @@ impl Scenario {
     /// tracking error, integrator or controller failure) returns the data up to its last
     /// recorded sample, its summary with the extra keys "error" and "stopped_at_s" as the
     /// summary.json of `hrm simulate` (and `Run.failure` of `Scenario.run`); one that stops
-    /// before its first recorded sample raises the error of its class.
+    /// before its first recorded sample raises the error of its class. Ctrl-C stops the loop
+    /// within about 0.05 s (KeyboardInterrupt); the plan before it runs to its end.
     fn run_deploy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let _nested = NestedRun::enter()?;
         let scenario = self.get();
-        let (run, stop) =
-            DeployFailure::split(pool::run(py, &Cancel::new(), || scenario.run_deploy())?)
-                .map_err(Error::from)?;
+        let cancel = Cancel::new();
+        let flag = cancel.clone();
+        let (run, stop) = DeployFailure::split(pool::run(py, &cancel, || {
+            scenario.run_deploy_wrapping(|inner| {
+                Box::new(InterruptibleReference {
+                    inner,
+                    cancel: flag,
+                })
+            })
+        })?)
+        .map_err(Error::from)?;
         let out = PyDict::new(py);
         let mut summary = sim_study::summary_json::deploy(&scenario, &run);
         if let Some(error) = &stop {

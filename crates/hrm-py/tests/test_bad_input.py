@@ -263,7 +263,11 @@ INTERRUPT = textwrap.dedent("""
     ("s = hrm.Scenario.builtin('paper-tracking'); s.duration = 200.0", "s.run()"),
     ("s = hrm.Scenario.builtin('paper-responses-step'); s.duration = 2.0; "
      "sweep = hrm.Sweep(s, noise_levels=[0.0, 0.01], seeds=200, controllers=['fuzzy', 'pd'])", "sweep.run()"),
-], ids=["parallel-batch", "serial-batch", "curve-quadrature-batch", "scenario-run", "sweep-run"])
+    # Some 4 s uninterrupted (a minute under MPC).
+    ("s = hrm.Scenario.builtin('pipe-deploy'); s.duration = 60.0; s.record_period = 0.05",
+     "s.run_deploy()"),
+], ids=["parallel-batch", "serial-batch", "curve-quadrature-batch", "scenario-run", "sweep-run",
+        "deploy-run"])
 def test_ctrl_c_interrupts_long_calls_promptly(setup, call):
     code = INTERRUPT + f"\n{setup}\ndef call():\n    {call}\ninterrupted_after(call)\n"
     done = run_python(code, timeout=300)

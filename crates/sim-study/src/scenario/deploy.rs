@@ -226,6 +226,20 @@ impl Scenario {
     /// than computed torque or MPC, dopri5, a reference other than `"planned"`) and for more than
     /// [`MAX_DEPLOY_RECORDED_SAMPLES`] recorded samples; the run's errors ([`run_chain_loop`]).
     pub fn run_deploy(&self) -> Result<DeployRun, DeployFailure> {
+        self.run_deploy_wrapping(|reference| reference)
+    }
+
+    /// Runs the deployment as [`run_deploy`](Self::run_deploy) does, with the reference the
+    /// loop tracks passed through `wrap`, which the loop samples at every controller sample (e.g.
+    /// a wrapper that stops the run when a Python user presses Ctrl-C). The MPC's own horizon
+    /// samples the plan unwrapped.
+    ///
+    /// # Errors
+    /// As [`run_deploy`](Self::run_deploy), and the wrapped reference's.
+    pub fn run_deploy_wrapping(
+        &self,
+        wrap: impl FnOnce(Box<dyn Reference>) -> Box<dyn Reference>,
+    ) -> Result<DeployRun, DeployFailure> {
         if self.deploy.is_none() {
             return Err(SimError::setting(
                 "deploy",
@@ -345,16 +359,23 @@ impl Scenario {
             kd,
             max_joint_error: self.limits.max_modal_error,
         };
+        let mut tracked = wrap(Box::new(reference.clone()));
         let outcome = if mpc {
             let mut mpc_settings = deploy_mpc_settings(&model, &reference, travel_time)?;
             if let Some(limits) = &self.limits.joint_torque_nm {
                 set_joint_torque_box(&mut mpc_settings, limits, n)?;
             }
             let mut controller =
-                ChainMpcController::new(&model, &mpc_settings, Box::new(reference.clone()))?;
-            run_chain_loop_mpc(&model, &mut reference, &start.a, &settings, &mut controller)
+                ChainMpcController::new(&model, &mpc_settings, Box::new(reference))?;
+            run_chain_loop_mpc(
+                &model,
+                tracked.as_mut(),
+                &start.a,
+                &settings,
+                &mut controller,
+            )
         } else {
-            run_chain_loop(&model, &mut reference, &start.a, &settings)
+            run_chain_loop(&model, tracked.as_mut(), &start.a, &settings)
         };
         // A run that stopped is measured up to the stop.
         let (run, stop) = ChainFailure::split(outcome)?;

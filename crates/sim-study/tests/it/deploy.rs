@@ -435,3 +435,59 @@ fn deployment_keys_are_refused_by_name() {
     let e = Scenario::from_toml(&text).unwrap_err().to_string();
     assert!(e.contains("depth"), "{e}");
 }
+
+/// A reference that counts its samples and fails from `stop_at` on.
+struct Stopping {
+    inner: Box<dyn sim_core::reference::Reference>,
+    samples: std::sync::Arc<std::sync::atomic::AtomicUsize>,
+    stop_at: f64,
+}
+
+impl sim_core::reference::Reference for Stopping {
+    fn n_coords(&self) -> usize {
+        self.inner.n_coords()
+    }
+
+    fn sample(
+        &mut self,
+        t: f64,
+        out: &mut sim_core::reference::ReferenceSample,
+    ) -> Result<(), sim_core::SimError> {
+        self.samples
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        if t >= self.stop_at {
+            return Err(sim_core::SimError::setting("stop", "reached"));
+        }
+        self.inner.sample(t, out)
+    }
+}
+
+#[test]
+fn the_wrapped_reference_is_sampled_at_every_controller_sample_and_can_stop_the_loop() {
+    let mut scenario = Scenario::builtin("pipe-deploy").unwrap();
+    scenario.duration = 1.0;
+    let samples = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+    let wrap = |stop_at: f64| {
+        let samples = std::sync::Arc::clone(&samples);
+        move |inner| -> Box<dyn sim_core::reference::Reference> {
+            Box::new(Stopping {
+                inner,
+                samples,
+                stop_at,
+            })
+        }
+    };
+    // Unstopped: the same run as without the wrapper, one sample every 0.5 ms and the last.
+    let whole = scenario.run_deploy_wrapping(wrap(f64::INFINITY)).unwrap();
+    assert_eq!(samples.load(std::sync::atomic::Ordering::Relaxed), 2001);
+    assert_eq!(whole.run, scenario.run_deploy().unwrap().run);
+    // Stopped at 0.5 s: the wrapper's error, the run up to its last recorded sample before it.
+    let stopped = scenario.run_deploy_wrapping(wrap(0.5)).unwrap_err();
+    assert_eq!(
+        stopped.error,
+        sim_core::SimError::setting("stop", "reached")
+    );
+    let partial = stopped.partial.expect("stopped after its first sample");
+    let t = &partial.run.record.t;
+    assert!((t[t.len() - 1] - 0.49).abs() < 1e-9, "{t:?}");
+}
