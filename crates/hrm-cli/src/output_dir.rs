@@ -220,6 +220,41 @@ pub fn refuse_input_as_output(out: &Path, inputs: &[(&str, &Path)]) -> Result<()
     Ok(())
 }
 
+/// Refuses, before any work, two outputs of one command that name the same file (`hrm view
+/// DIR --gif DIR/view.html`): each would replace the other. `outputs` are `(option, path)`.
+pub fn refuse_shared_outputs(outputs: &[(&str, &Path)]) -> Result<(), String> {
+    for (k, (option, path)) in outputs.iter().enumerate() {
+        if let Some((other, _)) = outputs[..k].iter().find(|(_, p)| same_file(p, path)) {
+            return Err(format!(
+                "{option} {} is the {other} file: the one would replace the other; choose another \
+                 {option}",
+                path.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Whether `a` and `b` name one file: the same device and inode where both exist, otherwise the
+/// same name in the same resolved folder.
+fn same_file(a: &Path, b: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    if let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+        return (x.dev(), x.ino()) == (y.dev(), y.ino());
+    }
+    let resolved = |path: &Path| {
+        let dir = path
+            .parent()
+            .filter(|dir| !dir.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        match (std::fs::canonicalize(dir), path.file_name()) {
+            (Ok(dir), Some(name)) => dir.join(name),
+            _ => path.to_path_buf(),
+        }
+    };
+    resolved(a) == resolved(b)
+}
+
 /// Refuses, before any work, to replace existing files in a folder `hrm {command}` did not
 /// create (one without its [`MARKER`]) unless `written_by_hrm` recognises the file's first
 /// `within` bytes as hrm's: `fis export --out DIR` into a folder of the user's never overwrites
@@ -311,9 +346,11 @@ pub fn write_file_with(
 
 /// Writes several files whole, all or none: each `(path, text)` goes to a temporary sibling
 /// first, and only when every one is written are they renamed over their paths. A failure
-/// before the renames leaves every existing file as it was. Folders are created as by
-/// [`write_file_with`].
+/// before the renames leaves every existing file as it was, and so do two paths that name one
+/// file ([`refuse_shared_outputs`]). Folders are created as by [`write_file_with`].
 pub fn write_files(files: &[(PathBuf, impl AsRef<[u8]>)], command: &str) -> Result<(), String> {
+    let outputs: Vec<(&str, &Path)> = files.iter().map(|(path, _)| ("output", &**path)).collect();
+    refuse_shared_outputs(&outputs)?;
     let mut staged = Vec::with_capacity(files.len());
     for (path, contents) in files {
         match stage_file(path, command, |out| {

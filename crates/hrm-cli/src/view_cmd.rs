@@ -66,6 +66,10 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     if !dir.is_dir() {
         return Err(format!("{}: not a folder", dir.display()));
     }
+    let out = args.out.clone().unwrap_or_else(|| dir.join("view.html"));
+    if let Some(gif) = &args.gif {
+        output_dir::refuse_shared_outputs(&[("--out", &out), ("--gif", gif)])?;
+    }
     let is_sweep = crate::view_sweep::is_sweep(dir);
     if (args.list || args.runs.is_some()) && !is_sweep {
         return Err(format!(
@@ -120,7 +124,6 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
         };
         ("hrm: every run of the main job".to_owned(), scenes, gif_run)
     };
-    let out = args.out.clone().unwrap_or_else(|| dir.join("view.html"));
     let page = run_view::page(
         &title,
         "The arm link by link (links coloured by joint torque), the reference path and the tip's trace, in sync with the time series. Space plays and pauses, the arrows step, drag pans (or orbits a spatial arm), the wheel zooms.",

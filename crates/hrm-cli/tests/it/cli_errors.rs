@@ -758,6 +758,30 @@ fn hrm_view_writes_a_page_and_a_gif_and_replaces_only_its_own_files() {
     );
     assert_eq!(std::fs::read_to_string(&mine).unwrap(), "<p>my notes</p>");
     assert!(!gif.exists());
+    // The GIF aimed at the page (by another path to it, or at a new file): refused, the page
+    // kept, nothing new written.
+    let page_before = std::fs::read(run.join("view.html")).unwrap();
+    let same = run.join(".").join("view.html");
+    let line = refused(&hrm(&["view", path(&run), "--gif", path(&same)]));
+    assert!(
+        line.contains("view.html is the --out file") && line.contains("choose another --gif"),
+        "{line}"
+    );
+    assert_eq!(std::fs::read(run.join("view.html")).unwrap(), page_before);
+    let new = dir.join("new.html");
+    refused(&hrm(&[
+        "view",
+        path(&run),
+        "--out",
+        path(&new),
+        "--gif",
+        path(
+            &dir.join("..")
+                .join(dir.file_name().unwrap())
+                .join("new.html"),
+        ),
+    ]));
+    assert!(!new.exists());
     // Runs in joint space (a deployment, a URDF arm) are named, not misread as modal runs.
     let joint_space = dir.join("joint-space");
     std::fs::create_dir_all(&joint_space).unwrap();
