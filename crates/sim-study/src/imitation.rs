@@ -170,7 +170,9 @@ pub fn output_names(coordinates: &[String]) -> Vec<String> {
 /// controller samples: the `4m` scheduled inputs of what the teacher measured and was commanded
 /// (noise included), then the `m` torques it chose. Every scenario must have the same modal
 /// coordinates. Fails if a scenario cannot be built, if its run fails or a tracking error exceeds
-/// its runaway bound, or if the rows would exceed [`MAX_ROWS`] (checked before any is recorded).
+/// its runaway bound, or if the rows would exceed [`MAX_ROWS`] or the runs' estimated work
+/// ([`Simulation::work`](sim_core::Simulation::work)) [`MAX_RUN_WORK`](sim_core::MAX_RUN_WORK)
+/// (checked before any is recorded).
 pub fn record(
     scenarios: &[Scenario],
     options: &ImitationOptions,
@@ -196,6 +198,7 @@ pub fn record(
     }
     let mut simulations = Vec::with_capacity(scenarios.len());
     let mut rows = 0usize;
+    let mut work = 0.0;
     let coordinates = first.coordinate_names();
     for scenario in scenarios {
         // The same names: the same family (planar or spatial), harmonics and alpha0 freedom.
@@ -215,6 +218,21 @@ pub fn record(
         let mut teacher = scenario.clone();
         teacher.controller.kind = options.teacher;
         let simulation = teacher.build()?;
+        // Bounded as one run is, before any runs.
+        work += simulation.work();
+        if work > sim_core::MAX_RUN_WORK {
+            return Err(SimError::setting(
+                "imitation.scenarios",
+                format!(
+                    "make {} teacher runs, whose first {} already take an estimated {work:.2e} \
+                     operations, more than the {:e} the runs of one imitation may take (about \
+                     ten minutes): fewer or shorter scenarios, or fewer offsets",
+                    scenarios.len(),
+                    simulations.len() + 1,
+                    sim_core::MAX_RUN_WORK
+                ),
+            ));
+        }
         let s = simulation.settings();
         // A whole number of periods, checked when the simulation was built.
         let samples = (s.duration / s.controller_period).round() as usize;

@@ -447,14 +447,38 @@ fn a_run_whose_total_work_is_hours_is_refused() {
     let error = scenario.build().err().unwrap();
     let message = error.to_string();
     assert!(
-        message.starts_with("duration = 2 s would take an estimated 2.56e12 operations")
-            && message.contains("2.00e4 clearance measures of 1997001 pairs")
+        message.starts_with("duration = 2 s would take an estimated 2.57e12 operations")
+            && message.contains("of 1.36e5 each, 2.00e4 clearance measures of 1997001 pairs")
             && message.contains(&format!("more than the {MAX_RUN_WORK:e} a run may take")),
         "{message}"
     );
     // A tenth of it runs.
     let short =
         sim_study::Scenario::from_toml(&text.replace("duration = 2.0", "duration = 0.2")).unwrap();
+    assert!(short.build().is_ok());
+}
+
+/// Each link costs its evaluations more than its `m^2` share of `M*`: 100,000 links with `K = 1`
+/// for 5 s in steps of 0.1 ms (10 ms a step measured: 8 minutes, where `n m^2` alone counted 1.1
+/// minutes) is refused; half a second runs.
+#[test]
+fn a_long_run_of_many_links_and_few_coordinates_is_refused() {
+    let base = sim_study::Scenario::builtin_text("paper-tracking-fast").unwrap();
+    let text = base
+        .replace("duration = 1.5", "duration = 5.0")
+        .replace("record_period = 0.001", "record_period = 0.5")
+        .replace("links = 10\n", "links = 100000\n")
+        .replace("link_length = 0.1", "link_length = 1e-5")
+        .replace("link_mass = 0.1", "link_mass = 1e-5");
+    let scenario = sim_study::Scenario::from_toml(&text).unwrap();
+    let message = scenario.build().err().unwrap().to_string();
+    assert!(
+        message.starts_with("duration = 5 s would take an estimated 1.36e12 operations")
+            && message.contains("2.00e5 evaluations of the reduced dynamics of 6.80e6 each"),
+        "{message}"
+    );
+    let short =
+        sim_study::Scenario::from_toml(&text.replace("duration = 5.0", "duration = 0.5")).unwrap();
     assert!(short.build().is_ok());
 }
 
@@ -482,8 +506,8 @@ fn an_mpc_whose_solves_take_hours_is_refused() {
     let error = scenario.build().err().unwrap();
     let message = error.to_string();
     assert!(
-        message.starts_with("duration = 1 s would take an estimated 1.07e12 operations")
-            && message.contains("1.28e5 each, 1.07e12 of the controller's own)")
+        message.starts_with("duration = 1 s would take an estimated 1.08e12 operations")
+            && message.contains("2.56e5 each, 1.07e12 of the controller's own)")
             && message.contains(&format!("more than the {MAX_RUN_WORK:e} a run may take")),
         "{message}"
     );

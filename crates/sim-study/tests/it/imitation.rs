@@ -391,6 +391,23 @@ fn bad_requests_are_refused_by_name() {
         message(&[long], ImitationOptions { stride: 1, ..d }),
         "imitation.stride = 1 records 2000000 rows from these scenarios, more than 1000000; use a larger stride"
     );
+    // Runs each within a run's bound whose sum is not: refused at the build that passes it,
+    // before any runs (a 2,000-link step of 2 s is an estimated 1.09e10 operations, 1.9 s).
+    let text = Scenario::builtin_text("paper-responses-step")
+        .unwrap()
+        .to_owned()
+        + "\n[arm]\nlinks = 2000\nlink_length = 0.0005\nlink_mass = 0.0005\n";
+    let many = imitation::shifted_grid(
+        &[Scenario::from_toml(&text).unwrap()],
+        &[(0..100).map(|i| 1e-3 * f64::from(i)).collect(), vec![0.0]],
+    )
+    .unwrap();
+    assert_eq!(
+        message(&many, d),
+        "imitation.scenarios make 100 teacher runs, whose first 92 already take an estimated \
+         1.00e12 operations, more than the 1e12 the runs of one imitation may take (about ten \
+         minutes): fewer or shorter scenarios, or fewer offsets"
+    );
     // A teacher that does not hold the step: the runaway bound stops the recording.
     let mut tight = step;
     tight.limits.max_modal_error = 0.01;
