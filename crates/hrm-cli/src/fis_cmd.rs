@@ -197,6 +197,9 @@ const MAX_PLOTS: usize = 1000;
 const MAX_SVG_BYTES: f64 = (1u64 << 30) as f64;
 /// Bytes of SVG per heat map cell (a filled rectangle), measured.
 const SVG_BYTES_PER_CELL: f64 = 90.0;
+/// Most rule evaluations the surfaces of `fis surface` may take (about half a minute: 2.8 ns a
+/// rule of 8 inputs, measured).
+const MAX_SURFACE_WORK: f64 = 1e10;
 
 /// The analysis report and whether it passed; a note says when the even samples were thinned
 /// to keep the grid within [`AnalysisOptions::max_grid_points`] and
@@ -303,6 +306,16 @@ fn surface(
              --resolution",
             bytes / 1e9,
             MAX_SVG_BYTES / 1e9
+        ));
+    }
+    let rules = system.rules().len();
+    let work = surfaces * (resolution * resolution) as f64 * rules as f64;
+    if work > MAX_SURFACE_WORK {
+        return Err(format!(
+            "--resolution {resolution} would evaluate the system's {rules} rules at {surfaces} \
+             surfaces of {resolution} x {resolution} points, {work:.2e} rule evaluations, more \
+             than the {MAX_SURFACE_WORK:e} fis surface may take (about half a minute): lower \
+             --resolution"
         ));
     }
     let names = PlotNames::new(system);

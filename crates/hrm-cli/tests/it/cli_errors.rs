@@ -381,7 +381,44 @@ fn counts_are_bounded_before_use_with_the_option_named() {
     let out = dir.join("out");
     let noise: Vec<String> = (0..1001).map(|k| format!("{}", k as f64 * 1e-4)).collect();
     let noise = noise.join(",");
+    // 10,000 rules of 4 inputs: 6 surfaces of 600 x 600 points are 2.16e10 rule evaluations.
+    let mut text = String::from(
+        "[System]\nName='many'\nType='sugeno'\nNumInputs=4\nNumOutputs=1\nNumRules=10000\n\
+         AndMethod='prod'\nOrMethod='max'\nImpMethod='prod'\nAggMethod='sum'\n\
+         DefuzzMethod='wtaver'\n\n",
+    );
+    for i in 1..=4 {
+        text += &format!(
+            "[Input{i}]\nName='x{i}'\nRange=[-1 1]\nNumMFs=3\nMF1='n':'gaussmf',[0.5 -1]\n\
+             MF2='z':'gaussmf',[0.5 0]\nMF3='p':'gaussmf',[0.5 1]\n\n"
+        );
+    }
+    text += "[Output1]\nName='y'\nRange=[-1 1]\nNumMFs=1\nMF1='a':'constant',[1]\n\n[Rules]\n";
+    for r in 0..10_000 {
+        text += &format!(
+            "{} {} {} {}, 1 (1) : 1\n",
+            r % 3 + 1,
+            r / 3 % 3 + 1,
+            r / 9 % 3 + 1,
+            2
+        );
+    }
+    let many = dir.join("many.fis");
+    std::fs::write(&many, text).unwrap();
     for (args, expected) in [
+        (
+            vec![
+                "fis",
+                "surface",
+                path(&many),
+                "--out",
+                path(&out),
+                "--resolution",
+                "600",
+            ],
+            "--resolution 600 would evaluate the system's 10000 rules at 6 surfaces of 600 x 600 \
+             points, 2.16e10 rule evaluations, more than the 1e10 fis surface may take",
+        ),
         (
             vec!["fis", "check", "--samples", "1000000000000", fis],
             "--samples must be at least 2 and at most 1000000, got 1000000000000",
