@@ -414,34 +414,34 @@ impl ControllerSpec {
     /// The PD gains `pd_kp`, `pd_kd` for `m` coordinates where given, each non-negative and
     /// finite (a negative stiffness pushes the arm away from its reference).
     fn pd_gains(&self, m: usize) -> Result<(GivenGains, GivenGains), SimError> {
-        let gains = |name: &str, values: &Option<Vec<f64>>| {
-            let values = per_coordinate(name, values.as_deref(), m)?;
-            for &value in values.iter().flatten() {
-                sim_core::check_non_negative(name, value)?;
-            }
-            Ok::<_, SimError>(values)
-        };
         Ok((
-            gains("controller.pd_kp", &self.pd_kp)?,
-            gains("controller.pd_kd", &self.pd_kd)?,
+            gains("controller.pd_kp", &self.pd_kp, m)?,
+            gains("controller.pd_kd", &self.pd_kd, m)?,
         ))
     }
 
-    /// The computed-torque gains `kp`, `kd` for `m` coordinates (defaults where not given).
+    /// The computed-torque gains `kp`, `kd` for `m` coordinates (defaults where not given), each
+    /// non-negative and finite.
     pub(super) fn computed_torque_gains(&self, m: usize) -> Result<(Vec<f64>, Vec<f64>), SimError> {
-        let gains = |name: &str, values: &Option<Vec<f64>>, default: f64| {
-            per_coordinate(name, values.as_deref(), m)
-                .map(|v| v.unwrap_or_else(|| vec![default; m]))
-        };
         Ok((
-            gains("controller.kp", &self.kp, DEFAULT_KP)?,
-            gains("controller.kd", &self.kd, DEFAULT_KD)?,
+            gains("controller.kp", &self.kp, m)?.unwrap_or_else(|| vec![DEFAULT_KP; m]),
+            gains("controller.kd", &self.kd, m)?.unwrap_or_else(|| vec![DEFAULT_KD; m]),
         ))
     }
 }
 
 /// Per-coordinate gains a scenario gives, if it does.
 type GivenGains = Option<Vec<f64>>;
+
+/// The gains `values` of the key `name` if given: `m` entries ([`per_coordinate`]), each
+/// non-negative and finite.
+fn gains(name: &str, values: &Option<Vec<f64>>, m: usize) -> Result<GivenGains, SimError> {
+    let values = per_coordinate(name, values.as_deref(), m)?;
+    for &value in values.iter().flatten() {
+        sim_core::check_non_negative(name, value)?;
+    }
+    Ok(values)
+}
 
 /// `values` if given, checked to have exactly `m` entries (one per modal coordinate); the
 /// error names the field.

@@ -799,6 +799,27 @@ fn controller_gains_out_of_domain() {
             .to_string()
             .starts_with("controller.pd_kd must be non-negative")
     );
+    // Its computed-torque gains likewise (they were copied into the output's scenario.toml).
+    scenario.controller.pd_kd = None;
+    for (kp, kd, expected) in [
+        (
+            vec![f64::NAN, f64::NAN],
+            None,
+            "controller.kp must be non-negative and finite, got NaN",
+        ),
+        (
+            vec![1.0, 1.0],
+            Some(vec![f64::NEG_INFINITY, 1e308]),
+            "controller.kd must be non-negative and finite, got -inf",
+        ),
+    ] {
+        scenario.controller.kp = Some(kp);
+        scenario.controller.kd = kd;
+        let Err(error) = scenario.build() else {
+            panic!("built")
+        };
+        assert_eq!(error.to_string(), expected);
+    }
 }
 
 #[test]
