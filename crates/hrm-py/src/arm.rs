@@ -13,12 +13,14 @@ use std::sync::Mutex;
 /// A planar serial chain of revolute joints under gravity along -y (the paper's eq 12:
 /// tau = M(theta) theta_ddot + C(theta, theta_dot) + G(theta)).
 ///
-/// Arm(links=None, link_length=0.1, link_mass=0.1, gravity=9.81, lengths=None, masses=None,
+/// Arm(links=None, link_length=None, link_mass=None, gravity=9.81, lengths=None, masses=None,
 /// inertias=None)
 ///
 /// `links` uniform beams (10 when neither `links` nor a per-link array is given) of
-/// `link_length` (m) and `link_mass` (kg), centre of mass at mid-link and inertia m L^2 / 12;
-/// `lengths`, `masses` and `inertias` (about the centre of mass, kg m^2) override them per link.
+/// `link_length` (m, default 0.1) and `link_mass` (kg, default 0.1), centre of mass at mid-link
+/// and inertia m L^2 / 12; `lengths` and `masses` give them per link instead (a list and its
+/// scalar together raise InvalidInput), `inertias` (about the centre of mass, kg m^2) the
+/// beams' inertias.
 /// theta_i is the angle of link i relative to link i - 1 (theta_1 from the x axis).
 ///
 /// Every method takes one state (arrays of shape (n,)) or a batch (shape (N, n)) and answers
@@ -67,7 +69,7 @@ impl Arm {
     #[new]
     #[pyo3(
         signature = (links=None, link_length=None, link_mass=None, gravity=None, lengths=None, masses=None, inertias=None),
-        text_signature = "(links=None, link_length=0.1, link_mass=0.1, gravity=9.81, lengths=None, masses=None, inertias=None)"
+        text_signature = "(links=None, link_length=None, link_mass=None, gravity=9.81, lengths=None, masses=None, inertias=None)"
     )]
     fn new(
         links: Option<&Bound<'_, PyAny>>,
@@ -82,9 +84,11 @@ impl Arm {
         let real = |value: Option<&Bound<'_, PyAny>>, name, default| {
             value.map_or(Ok(default), |v| args::real(v, name))
         };
+        let given =
+            |value: Option<&Bound<'_, PyAny>>, name| value.map(|v| args::real(v, name)).transpose();
         let (link_length, link_mass, gravity) = (
-            real(link_length, "link_length", 0.1)?,
-            real(link_mass, "link_mass", 0.1)?,
+            given(link_length, "link_length")?,
+            given(link_mass, "link_mass")?,
             real(gravity, "gravity", 9.81)?,
         );
         let per_link = |value: Option<&Bound<'_, PyAny>>, name| {
@@ -99,8 +103,8 @@ impl Arm {
         );
         let spec = ArmSpec {
             links,
-            link_length: Some(link_length),
-            link_mass: Some(link_mass),
+            link_length,
+            link_mass,
             gravity: Some(Gravity::Magnitude(gravity)),
             lengths,
             masses,
@@ -184,15 +188,23 @@ impl Arm {
         slf: &Bound<'py, Self>,
     ) -> PyResult<(
         Bound<'py, PyAny>,
-        (Option<usize>, f64, f64, f64, Vec<f64>, Vec<f64>, Vec<f64>),
+        (
+            Option<usize>,
+            Option<f64>,
+            Option<f64>,
+            f64,
+            Vec<f64>,
+            Vec<f64>,
+            Vec<f64>,
+        ),
     )> {
         let arm = slf.get();
         Ok((
             slf.get_type().into_any(),
             (
                 None,
-                0.1,
-                0.1,
+                None,
+                None,
                 arm.chain.gravity(),
                 arm.column(|l| l.length),
                 arm.column(|l| l.mass),

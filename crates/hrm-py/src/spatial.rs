@@ -62,13 +62,14 @@ impl Workspace {
 /// Jacobian J (2n x 4K), and the reduced dynamics M*(a) a_ddot + C*(a, a_dot) + G*(a) = tau*
 /// (eqs 13-15) with M* = J^T M J, C* = J^T C, G* = J^T G.
 ///
-/// SpatialArm(links=None, link_length=0.1, link_mass=0.1, gravity=(0, 0, -9.81), lengths=None,
+/// SpatialArm(links=None, link_length=None, link_mass=None, gravity=(0, 0, -9.81), lengths=None,
 /// masses=None, inertias=None, base_xyz=(0, 0, 0), base_rpy=(0, 0, 0), harmonics=1)
 ///
 /// `links` equal slender rods (10 when neither `links` nor a per-link list is given) of
-/// `link_length` (m) and `link_mass` (kg), principal inertias (0, m L^2 / 12, m L^2 / 12) about
-/// the mid-link centre of mass; `lengths`, `masses` and `inertias` (n rows of principal moments
-/// [Ixx, Iyy, Izz], kg m^2, x along the link) override them per link. `gravity` is the world
+/// `link_length` (m, default 0.1) and `link_mass` (kg, default 0.1), principal inertias (0,
+/// m L^2 / 12, m L^2 / 12) about the mid-link centre of mass; `lengths` and `masses` give them
+/// per link instead (a list and its scalar together raise InvalidInput), `inertias` (n rows of
+/// principal moments [Ixx, Iyy, Izz], kg m^2, x along the link) the rods' inertias. `gravity` is the world
 /// acceleration vector (m/s^2); the base sits at `base_xyz` (m) rotated by roll, pitch and yaw
 /// `base_rpy` (rad, R = Rz Ry Rx), the straight arm along the base's x axis. The coordinates are
 /// a = (a_z, a_y): 2K for the yaw plane then 2K for the pitch plane; theta is
@@ -140,8 +141,8 @@ impl SpatialArm {
 )]
 fn build(
     links: Option<usize>,
-    link_length: f64,
-    link_mass: f64,
+    link_length: Option<f64>,
+    link_mass: Option<f64>,
     gravity: [f64; 3],
     lengths: Option<Vec<f64>>,
     masses: Option<Vec<f64>>,
@@ -157,8 +158,8 @@ fn build(
     let arm = sim_study::ArmSpec {
         kind: sim_study::ArmKind::Spatial,
         links,
-        link_length: Some(link_length),
-        link_mass: Some(link_mass),
+        link_length,
+        link_mass,
         gravity: Some(sim_study::Gravity::Vector(gravity)),
         lengths,
         masses,
@@ -242,7 +243,7 @@ fn flat<'py>(py: Python<'py>, out: Output, per_state: usize) -> Bound<'py, PyAny
 impl SpatialArm {
     #[new]
     #[pyo3(signature = (links=None, link_length=None, link_mass=None, gravity=None, lengths=None, masses=None, inertias=None, base_xyz=None, base_rpy=None, harmonics=None),
-           text_signature = "(links=None, link_length=0.1, link_mass=0.1, gravity=(0, 0, -9.81), lengths=None, masses=None, inertias=None, base_xyz=(0, 0, 0), base_rpy=(0, 0, 0), harmonics=1)")]
+           text_signature = "(links=None, link_length=None, link_mass=None, gravity=(0, 0, -9.81), lengths=None, masses=None, inertias=None, base_xyz=(0, 0, 0), base_rpy=(0, 0, 0), harmonics=1)")]
     #[allow(
         clippy::too_many_arguments,
         reason = "the constructor's keyword arguments"
@@ -260,12 +261,11 @@ impl SpatialArm {
         harmonics: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let links = links.map(|n| count(n, "arm.links", 1)).transpose()?;
-        let real = |value: Option<&Bound<'_, PyAny>>, name, default| {
-            value.map_or(Ok(default), |v| args::real(v, name))
-        };
+        let given =
+            |value: Option<&Bound<'_, PyAny>>, name| value.map(|v| args::real(v, name)).transpose();
         let (link_length, link_mass) = (
-            real(link_length, "link_length", 0.1)?,
-            real(link_mass, "link_mass", 0.1)?,
+            given(link_length, "link_length")?,
+            given(link_mass, "link_mass")?,
         );
         let vec3 = |value: Option<&Bound<'_, PyAny>>, name, default| {
             value.map_or(Ok(default), |v| args::vec3(v, name))
@@ -391,8 +391,8 @@ impl SpatialArm {
         let masses: Vec<f64> = arm.model.links().iter().map(|l| l.mass).collect();
         let arguments = (
             arm.n_links(),
-            0.1,
-            0.1,
+            None::<f64>,
+            None::<f64>,
             arm.model.gravity(),
             arm.model.map().link_lengths().to_vec(),
             masses,

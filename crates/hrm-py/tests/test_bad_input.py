@@ -538,6 +538,15 @@ def test_spatial_and_urdf_classes_follow_the_same_rules():
         hrm.SpatialArm(link_mass=5e-324)
     with pytest.raises(hrm.InvalidInput, match=r"^arm is invalid: the chain's total mass"):
         hrm.SpatialArm(link_length=1e154)
+    # A per-link list and its scalar: refused (the scalar was silently unused); pickles keep
+    # only the lists.
+    for make in (hrm.Arm, hrm.SpatialArm):
+        with pytest.raises(hrm.InvalidInput, match=r"^arm\.link_length = 7 is not used beside arm\.lengths"):
+            make(link_length=7.0, lengths=[0.1, 0.1])
+        with pytest.raises(hrm.InvalidInput, match=r"^arm\.link_mass = 0\.1 is not used beside arm\.masses"):
+            make(link_mass=0.1, masses=[0.1, 0.2])
+        arm = make(lengths=[0.1, 0.2], masses=[0.3, 0.4])
+        assert np.array_equal(pickle.loads(pickle.dumps(arm)).lengths, arm.lengths)
     with pytest.raises(hrm.InvalidInput, match=r"base xyz must be at most 1000000000 m from the origin in each coordinate, got 1e308"):
         hrm.SpatialArm(base_xyz=[1e308, 0.0, 0.0])
     with pytest.raises(hrm.InvalidInput, match="^lengths is a masked array"):

@@ -64,18 +64,6 @@ impl SpatialArmSpec {
                 "arm.radius is not used by the ops of a spatial arm (it is a scenario's clearance)",
             ));
         }
-        // A list and its scalar both given is ambiguous (a scenario takes the list).
-        for (list, scalar, name) in [
-            (arm.lengths.is_some(), arm.link_length.is_some(), "length"),
-            (arm.masses.is_some(), arm.link_mass.is_some(), "mass"),
-        ] {
-            if list && scalar {
-                let plural = if name == "mass" { "masses" } else { "lengths" };
-                return Err(EvalError::input(format!(
-                    "give arm.{plural} or arm.link_{name}, not both"
-                )));
-            }
-        }
         let n = arm.link_count(arm.inertias.as_ref().map(Inertias::len))?;
         if n > MAX_SPATIAL_LINKS {
             return Err(EvalError::input(format!(
@@ -585,6 +573,12 @@ mod tests {
                 json!({"op": "joints", "arm": {"kind": "spatial", "lengths": [0.1, 0.1, 0.1, 0.1],
                     "link_length": 0.2}, "a": [0, 0, 0, 0]}),
                 "give arm.lengths or arm.link_length, not both",
+            ),
+            (
+                json!({"op": "dynamics", "arm": {"link_length": 7, "lengths": [0.1, 0.1]},
+                    "theta": [0, 0], "theta_dot": [0, 0]}),
+                "arm.link_length = 7 is not used beside arm.lengths (one per link): give \
+                 arm.lengths or arm.link_length, not both",
             ),
             (
                 json!({"op": "joints", "arm": {"kind": "spatial", "masses": [0.1, 0.1, 0.1, 0.1],

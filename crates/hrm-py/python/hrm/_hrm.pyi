@@ -28,8 +28,8 @@ class Arm:
     def __init__(
         self,
         links: Optional[int] = None,
-        link_length: float = 0.1,
-        link_mass: float = 0.1,
+        link_length: Optional[float] = None,
+        link_mass: Optional[float] = None,
         gravity: float = 9.81,
         lengths: Optional[Sequence[float]] = None,
         masses: Optional[Sequence[float]] = None,
@@ -263,8 +263,8 @@ class SpatialArm:
     def __init__(
         self,
         links: Optional[int] = None,
-        link_length: float = 0.1,
-        link_mass: float = 0.1,
+        link_length: Optional[float] = None,
+        link_mass: Optional[float] = None,
         gravity: Sequence[float] = (0.0, 0.0, -9.81),
         lengths: Optional[Sequence[float]] = None,
         masses: Optional[Sequence[float]] = None,

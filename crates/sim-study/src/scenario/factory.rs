@@ -349,9 +349,31 @@ impl ArmSpec {
     /// joints replacing the beams' where given. A spatial arm's links are checked the same way.
     ///
     /// # Errors
-    /// [`SimError::InvalidSetting`] naming the list entry or the scalar that is out of range.
+    /// [`SimError::InvalidSetting`] naming the list entry or the scalar that is out of range, or
+    /// the scalar given beside its list (`link_length` with `lengths`, `link_mass` with `masses`).
     pub(crate) fn links(&self, n: usize, inertias: Option<&[f64]>) -> Result<Vec<Link>, SimError> {
         const WHAT: &str = "the arm's per-link arrays";
+        // A list and its scalar both given is ambiguous: the scalar would be silently unused.
+        for (list, scalar, name, plural) in [
+            (
+                self.lengths.is_some(),
+                self.link_length,
+                "length",
+                "lengths",
+            ),
+            (self.masses.is_some(), self.link_mass, "mass", "masses"),
+        ] {
+            if let (true, Some(value)) = (list, scalar) {
+                return Err(SimError::setting(
+                    format!("arm.link_{name}"),
+                    format!(
+                        "= {} is not used beside arm.{plural} (one per link): give arm.{plural} \
+                         or arm.link_{name}, not both",
+                        lane_math::Compact(value)
+                    ),
+                ));
+            }
+        }
         let per_link = |array: &Option<Vec<f64>>, scalar: f64| match array {
             Some(values) => Ok(values.clone()),
             None => lane_math::try_filled(n, scalar, WHAT),

@@ -571,6 +571,37 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
         err.contains("arm.lengths[1] is invalid: link 1: length"),
         "{err}"
     );
+    // A list and its scalar: the scalar was unused, NaN or not (and copied into outputs).
+    let nan: fn(&mut Scenario) = |s| {
+        s.arm.lengths = Some(vec![0.1; 10]);
+        s.arm.link_length = Some(f64::NAN);
+    };
+    let seven: fn(&mut Scenario) = |s| {
+        s.arm.lengths = Some(vec![0.1; 10]);
+        s.arm.link_length = Some(7.0);
+    };
+    for (edit, expected) in [
+        (
+            nan,
+            "arm.link_length = NaN is not used beside arm.lengths (one per link)",
+        ),
+        (seven, "arm.link_length = 7 is not used beside arm.lengths"),
+    ] {
+        let err = invalid(edit);
+        assert!(
+            err.contains(expected)
+                && err.ends_with("give arm.lengths or arm.link_length, not both"),
+            "{err}"
+        );
+    }
+    let err = invalid(|s| {
+        s.arm.masses = Some(vec![0.1; 10]);
+        s.arm.link_mass = Some(f64::NEG_INFINITY);
+    });
+    assert!(
+        err.contains("arm.link_mass = -inf is not used beside arm.masses"),
+        "{err}"
+    );
     let err = invalid(|s| {
         s.arm.links = Some(2);
         s.arm.inertias = Some(sim_study::Inertias::PerLink(vec![-1.0, 0.0]));
