@@ -1183,7 +1183,8 @@ fn sample_counts(s: &LoopSettings) -> (usize, usize) {
 }
 
 /// Checks the noise of the settings of a loop of `m` coordinates: `m` reference and `2m` sensor
-/// standard deviations (or none), non-negative and at most [`MAX_MODAL_MAGNITUDE`].
+/// standard deviations (or none), non-negative and at most [`MAX_MODAL_MAGNITUDE`]; an entry out
+/// of its domain is named by the scenario's key (`noise.sensor_a_dot_std[1]`).
 fn validate_noise(s: &LoopSettings, m: usize) -> Result<(), SimError> {
     for (name, values, len) in [
         ("noise.reference_std", &s.reference_noise_std, m),
@@ -1198,8 +1199,14 @@ fn validate_noise(s: &LoopSettings, m: usize) -> Result<(), SimError> {
                 ),
             ));
         }
-        for &v in values {
-            check_non_negative(name, v)?;
+        for (i, &v) in values.iter().enumerate() {
+            // The scenario's key of the entry: the sensors' first `m` are the coordinates'.
+            let name = match (name, i.checked_sub(m)) {
+                ("noise.sensor_std", None) => format!("noise.sensor_a_std[{i}]"),
+                ("noise.sensor_std", Some(rate)) => format!("noise.sensor_a_dot_std[{rate}]"),
+                _ => format!("{name}[{i}]"),
+            };
+            check_non_negative(&name, v)?;
             // Noise of the scale a run resolves at most (`1e308` overflowed in the controller).
             if v > MAX_MODAL_MAGNITUDE {
                 return Err(SimError::setting(
@@ -1310,7 +1317,8 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
         return Err(SimError::setting(
             "duration",
             format!(
-                "must be at most {MAX_CONTROLLER_SAMPLES:e} controller periods ({} s), got {:e} s",
+                "must be at most {MAX_CONTROLLER_SAMPLES:e} controller periods \
+                 (controller.period = {} s), got {:e} s",
                 Compact(s.controller_period),
                 s.duration
             ),
@@ -1339,11 +1347,25 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
     match s.integrator {
         Integrator::Rk4 { dt } => {
             check_positive("integrator.dt", dt)?;
+            // Before the periods' ratio: a step of `5e-324` makes no whole number of steps.
+            let steps = s.duration / dt;
+            if steps > MAX_RK4_STEPS {
+                return Err(SimError::setting(
+                    "integrator.dt",
+                    format!(
+                        "= {} s would take {steps:.3e} RK4 steps over {} s, more than the \
+                         {MAX_RK4_STEPS:e} a run may take (hours of computing): use a larger \
+                         step or simulate less",
+                        Compact(dt),
+                        Compact(s.duration)
+                    ),
+                ));
+            }
             if whole_ratio(s.controller_period, dt).is_none() {
                 return Err(SimError::setting(
                     "controller.period",
                     format!(
-                        "must be a whole number of RK4 steps ({} s), got {} s",
+                        "must be a whole number of RK4 steps (integrator.dt = {} s), got {} s",
                         Compact(dt),
                         Compact(s.controller_period)
                     ),
@@ -1386,20 +1408,6 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
                      or simulate less",
                     Compact(tol.h_max),
                     Compact(steps.round()),
-                    Compact(s.duration)
-                ),
-            ));
-        }
-    }
-    if let Integrator::Rk4 { dt } = s.integrator {
-        let steps = s.duration / dt;
-        if steps > MAX_RK4_STEPS {
-            return Err(SimError::setting(
-                "integrator.dt",
-                format!(
-                    "would take {steps:.3e} RK4 steps over {} s, more than the \
-                     {MAX_RK4_STEPS:e} a run may take (hours of computing): use a larger step \
-                     or simulate less",
                     Compact(s.duration)
                 ),
             ));

@@ -140,7 +140,43 @@ fn rk4_step_not_positive_or_not_dividing_the_period() {
     };
     let (name, message) = invalid(build(s));
     assert_eq!(name, "controller.period");
-    assert!(message.contains("whole number of RK4 steps"));
+    assert!(message.contains("whole number of RK4 steps (integrator.dt = 0.0003 s)"));
+    // A step too small to count the steps of is named, not the period it cannot divide.
+    let s = LoopSettings {
+        integrator: Integrator::Rk4 { dt: 5e-324 },
+        ..settings()
+    };
+    let (name, message) = invalid(build(s));
+    assert_eq!(name, "integrator.dt");
+    assert!(
+        message.starts_with("integrator.dt = 5e-324 s would take inf RK4 steps"),
+        "{message}"
+    );
+}
+
+/// Each sensor noise entry out of its domain is named by its scenario key and index.
+#[test]
+fn sensor_noise_entries_are_named_by_their_key() {
+    let base = sim_study::Scenario::builtin_text("paper-responses-step").unwrap();
+    for (line, expected) in [
+        (
+            "sensor_a_dot_std = [0.0, -1.0]",
+            "noise.sensor_a_dot_std[1] must be non-negative and finite, got -1",
+        ),
+        (
+            "sensor_a_std = [inf, 0.0]",
+            "noise.sensor_a_std[0] must be non-negative and finite, got inf",
+        ),
+        (
+            "reference_std = [0.0, 1e7]",
+            "noise.reference_std[1] must be at most 1000000 (rad, rad/s), got 10000000",
+        ),
+    ] {
+        let text = format!("{base}\n[noise]\n{line}\n");
+        let scenario = sim_study::Scenario::from_toml(&text).unwrap();
+        let message = scenario.build().err().unwrap().to_string();
+        assert_eq!(message, expected);
+    }
 }
 
 #[test]
@@ -335,12 +371,12 @@ fn noise_negative_or_non_finite() {
         reference_noise_std: vec![0.0, -0.1],
         ..settings()
     };
-    assert_eq!(invalid(build(s)).0, "noise.reference_std");
+    assert_eq!(invalid(build(s)).0, "noise.reference_std[1]");
     let s = LoopSettings {
         sensor_noise_std: vec![0.0, 0.0, f64::INFINITY, 0.0],
         ..settings()
     };
-    assert_eq!(invalid(build(s)).0, "noise.sensor_std");
+    assert_eq!(invalid(build(s)).0, "noise.sensor_a_dot_std[0]");
     // Finite but beyond what a run resolves: it overflowed in the controller, unnamed.
     let s = LoopSettings {
         reference_noise_std: vec![1e308, 0.02],
@@ -349,8 +385,8 @@ fn noise_negative_or_non_finite() {
     assert_eq!(
         invalid(build(s)),
         (
-            "noise.reference_std".to_string(),
-            "noise.reference_std must be at most 1000000 (rad, rad/s), got 1e308".to_string()
+            "noise.reference_std[0]".to_string(),
+            "noise.reference_std[0] must be at most 1000000 (rad, rad/s), got 1e308".to_string()
         )
     );
 }
@@ -428,7 +464,8 @@ fn run_that_would_never_end() {
     assert_eq!(
         message,
         format!(
-            "duration must be at most {MAX_CONTROLLER_SAMPLES:e} controller periods (0.001 s), \
+            "duration must be at most {MAX_CONTROLLER_SAMPLES:e} controller periods \
+             (controller.period = 0.001 s), \
              got 1e300 s"
         )
     );

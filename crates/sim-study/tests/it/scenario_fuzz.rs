@@ -345,7 +345,7 @@ mod regressions {
             .to_string();
         assert_eq!(
             message,
-            "duration must be at most 1e9 controller periods (0.001 s), got 1e300 s"
+            "duration must be at most 1e9 controller periods (controller.period = 0.001 s), got 1e300 s"
         );
     }
 
@@ -383,7 +383,10 @@ mod regressions {
                 "noise = { reference_std = [-0.1, 0.0] }",
                 "noise.reference_std",
             ),
-            ("noise = { sensor_a_std = [nan, 0.0] }", "noise.sensor_std"),
+            (
+                "noise = { sensor_a_std = [nan, 0.0] }",
+                "noise.sensor_a_std[0]",
+            ),
             (
                 "limits = { max_modal_error = 0.0 }",
                 "limits.max_modal_error",
