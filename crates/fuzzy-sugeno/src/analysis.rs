@@ -23,6 +23,7 @@ use crate::eval::Evaluator;
 use crate::membership::MembershipFn;
 use crate::options::{EvalOptions, OutOfRange};
 use crate::system::{AndMethod, Antecedent, FuzzySystem, InputVariable};
+use lane_math::Compact;
 use std::fmt;
 
 /// The relative rounding allowance of the completeness check: a weakest strength within
@@ -550,7 +551,7 @@ impl fmt::Display for AnalysisReport {
             f,
             "completeness: {} (threshold {}, grid {} points)",
             verdict(c.passed()),
-            c.threshold,
+            Compact(c.threshold),
             grid.join(" x ")
         )?;
         for (coverage, (output, _)) in c.outputs.iter().zip(&names.outputs) {
@@ -558,12 +559,12 @@ impl fmt::Display for AnalysisReport {
                 .inputs
                 .iter()
                 .zip(&coverage.weakest_point)
-                .map(|(name, x)| format!("{name} = {x}"))
+                .map(|(name, x)| format!("{name} = {}", Compact(*x)))
                 .collect();
             write!(
                 f,
                 "  {output}: weakest strength {} at ({})",
-                coverage.weakest_strength,
+                Compact(coverage.weakest_strength),
                 at.join(", ")
             )?;
             if coverage.weakest_strength < c.threshold && c.covered(coverage.weakest_strength) {
@@ -571,7 +572,7 @@ impl fmt::Display for AnalysisReport {
                     f,
                     " (below the threshold {} by {:.1e}, within the relative rounding allowance \
                      {COVERAGE_ROUNDING:e})",
-                    c.threshold,
+                    Compact(c.threshold),
                     c.threshold - coverage.weakest_strength
                 )?;
             }
@@ -607,7 +608,7 @@ impl fmt::Display for AnalysisReport {
             f,
             "continuity: {} (jump / output range between neighbouring rules must stay below {})",
             verdict(continuity.passed()),
-            continuity.max_relative_jump
+            Compact(continuity.max_relative_jump)
         )?;
         for (jump, (output, range)) in continuity.outputs.iter().zip(&names.outputs) {
             match jump {
@@ -617,10 +618,10 @@ impl fmt::Display for AnalysisReport {
                     writeln!(
                         f,
                         "  {output}: largest jump {} ({} of range [{}, {}]) between rules {} and {} ({}: {} -> {})",
-                        j.jump,
-                        j.relative,
-                        range[0],
-                        range[1],
+                        Compact(j.jump),
+                        Compact(j.relative),
+                        Compact(range[0]),
+                        Compact(range[1]),
                         j.rules[0] + 1,
                         j.rules[1] + 1,
                         names.inputs[j.input],

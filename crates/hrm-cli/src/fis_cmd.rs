@@ -109,10 +109,16 @@ pub fn run(args: FisArgs) -> Result<(), String> {
         } => {
             // The options by their CLI names (the library names its fields).
             if !(coverage > 0.0 && coverage <= 1.0) {
-                return Err(format!("--coverage must lie in (0, 1], got {coverage}"));
+                return Err(format!(
+                    "--coverage must lie in (0, 1], got {}",
+                    lane_math::Compact(coverage)
+                ));
             }
-            if max_jump.is_nan() || max_jump <= 0.0 {
-                return Err(format!("--max-jump must be positive, got {max_jump}"));
+            if !(max_jump > 0.0 && max_jump.is_finite()) {
+                return Err(format!(
+                    "--max-jump must be positive and finite, got {}",
+                    lane_math::Compact(max_jump)
+                ));
             }
             let options = AnalysisOptions {
                 coverage,

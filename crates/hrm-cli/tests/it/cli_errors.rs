@@ -243,6 +243,25 @@ fn fis_check_options_are_named_as_given() {
         line.contains("--coverage") && line.contains("got 2"),
         "{line}"
     );
+    let line = refused(&hrm(&["fis", "check", path(&file), "--max-jump", "inf"]));
+    assert!(
+        line.ends_with("--max-jump must be positive and finite, got inf"),
+        "{line}"
+    );
+    // Extreme values are echoed compactly (1e-320 was 324 digits, 1e300 301).
+    for (option, value, shown) in [
+        ("--max-jump", "1e-320", "must stay below 1e-320)"),
+        ("--max-jump", "1e300", "must stay below 1e300)"),
+    ] {
+        let output = hrm(&["fis", "check", path(&file), option, value]);
+        let text = stdout(&output);
+        assert!(text.contains(shown), "{option} {value}: {text}");
+        let digits = text
+            .split(|c: char| !c.is_ascii_digit())
+            .map(str::len)
+            .max();
+        assert!(digits < Some(40), "{text}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
