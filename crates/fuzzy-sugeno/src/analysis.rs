@@ -800,7 +800,7 @@ mod tests {
         let error = system.analyze(&AnalysisOptions::default()).unwrap_err();
         assert_eq!(
             error.to_string(),
-            "analysis: the consequents of rules 0 and 1 on output 0 ('y1') differ by more than \
+            "analysis: the consequents of rules 1 and 2 on output 1 ('y1') differ by more than \
              double precision holds"
         );
         assert!(lane_math::Classify::is_numerical(&error));

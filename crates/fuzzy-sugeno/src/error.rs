@@ -3,7 +3,9 @@
 use lane_math::{Classify, ErrorClass};
 
 /// Everything that can go wrong when building, evaluating, reading or analysing a fuzzy system.
-/// Every message says which condition failed and where.
+/// Every message says which condition failed and where. The fields hold 0-based positions, as
+/// the API takes them; the messages count inputs, outputs, rules and rows from 1, as a `.fis`
+/// file (`[Input3]`) and the analysis report do.
 ///
 /// [`ErrorClass::Numerical`] and [`ErrorClass::InvalidInput`] are the two classes
 /// ([`Classify::class`]) its variants fall into.
@@ -43,7 +45,7 @@ pub enum FuzzyError {
         found: usize,
     },
     /// An input is NaN or infinite.
-    #[error("input {index} ('{name}') is not finite: {value}")]
+    #[error("input {} ('{name}') is not finite: {value}", .index + 1)]
     NonFiniteInput {
         /// The input's position (0-based).
         index: usize,
@@ -53,7 +55,10 @@ pub enum FuzzyError {
         value: f64,
     },
     /// An input lies outside its range under [`OutOfRange::Error`](crate::OutOfRange::Error).
-    #[error("input {index} ('{name}') = {value} lies outside its range [{min}, {max}]")]
+    #[error(
+        "input {} ('{name}') = {value} lies outside its range [{min}, {max}]",
+        .index + 1
+    )]
     InputOutOfRange {
         /// The input's position (0-based).
         index: usize,
@@ -67,7 +72,7 @@ pub enum FuzzyError {
         max: f64,
     },
     /// No rule contributing to an output fired, under [`NoRuleFired::Error`](crate::NoRuleFired::Error).
-    #[error("no rule fired for output {index} ('{name}')")]
+    #[error("no rule fired for output {} ('{name}')", .index + 1)]
     NoRuleFired {
         /// The output's position (0-based).
         index: usize,
@@ -75,7 +80,7 @@ pub enum FuzzyError {
         name: String,
     },
     /// An output came out NaN or infinite (a first-order consequent overflowed).
-    #[error("output {index} ('{name}') came out non-finite ({value})")]
+    #[error("output {} ('{name}') came out non-finite ({value})", .index + 1)]
     NonFiniteOutput {
         /// The output's position (0-based).
         index: usize,
@@ -87,10 +92,11 @@ pub enum FuzzyError {
     /// Two neighbouring rules' consequents on an output differ by more than double precision
     /// holds (constants of `1e308` and `-1e308`), so the continuity check has no finite jump.
     #[error(
-        "analysis: the consequents of rules {} and {} on output {index} ('{name}') differ by more \
+        "analysis: the consequents of rules {} and {} on output {} ('{name}') differ by more \
          than double precision holds",
-        .rules[0],
-        .rules[1]
+        .rules[0] + 1,
+        .rules[1] + 1,
+        .index + 1
     )]
     JumpOverflow {
         /// The output's position (0-based).
@@ -125,7 +131,7 @@ pub enum FuzzyError {
         inputs: usize,
     },
     /// One row of a batch evaluation failed.
-    #[error("batch row {row}: {source}")]
+    #[error("batch row {}: {source}", .row + 1)]
     Batch {
         /// The row (0-based).
         row: usize,

@@ -82,7 +82,7 @@ enum FisCommand {
 
 /// Warns on standard error, as MATLAB's `evalfis` does, when `evaluator` has evaluated an input
 /// outside its range as given: once per process (a `hrm eval` session answers many requests).
-/// Inputs are numbered from 0, as in the library's errors.
+/// Inputs are numbered from 1, as in the library's errors and the `.fis` file.
 pub(crate) fn warn_outside_range(evaluator: &Evaluator) {
     static WARNED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
     if let Some(outside) = evaluator.first_outside_range()
@@ -92,7 +92,11 @@ pub(crate) fn warn_outside_range(evaluator: &Evaluator) {
         let line = format!(
             "warning: input {} ('{}') = {} is outside its range [{}, {}]; evaluated as given, as \
              MATLAB's evalfis does (--out-of-range clamp evaluates at the nearest end)",
-            outside.index, input.name, outside.value, input.range[0], input.range[1]
+            outside.index + 1,
+            input.name,
+            outside.value,
+            input.range[0],
+            input.range[1]
         );
         eprintln!("{}", console::error_line(&line));
     }
@@ -687,7 +691,7 @@ mod tests {
                 RangePolicy::Error
             )
             .unwrap_err(),
-            "input 0 ('da1') = 0.5 lies outside its range [-0.3, 0.3]"
+            "input 1 ('da1') = 0.5 lies outside its range [-0.3, 0.3]"
         );
     }
 

@@ -273,7 +273,7 @@ fn no_rule_fires_under_the_error_policy() {
     let mut out = [SENTINEL];
     let err = evaluator.eval(&[0.8], &mut out).unwrap_err();
     assert!(matches!(&err, FuzzyError::NoRuleFired { index: 0, name } if name == "y"));
-    assert_eq!(err.to_string(), "no rule fired for output 0 ('y')");
+    assert_eq!(err.to_string(), "no rule fired for output 1 ('y')");
     assert_eq!(out, [SENTINEL]);
     evaluator.eval(&[0.2], &mut out).unwrap();
     assert_eq!(out, [1.0]);
@@ -406,7 +406,7 @@ fn batch_with_a_bad_row() {
         matches!(&err, FuzzyError::Batch { row: 1, source } if matches!(**source, FuzzyError::NonFiniteInput { index: 1, .. })),
         "{err:?}"
     );
-    assert!(err.to_string().starts_with("batch row 1: input 1"));
+    assert!(err.to_string().starts_with("batch row 2: input 2"));
     // Row 0 holds its result, rows 1 and 2 are untouched.
     assert!(out[..2].iter().all(|v| v.is_finite() && *v != SENTINEL));
     assert_eq!(out[2..], [SENTINEL; 4]);

@@ -113,7 +113,7 @@ fn the_no_rule_fired_policy_is_applied() {
         [-1.0]
     );
     let error = eval_with(gapped(), options(NoRuleFired::Error), &[0.5]).unwrap_err();
-    assert_eq!(error.to_string(), "no rule fired for output 0 ('y')");
+    assert_eq!(error.to_string(), "no rule fired for output 1 ('y')");
     // Where a rule fires the policy does not matter: at x = 0.2, lo = 1/2 alone gives 2.
     assert_eq!(
         eval_with(gapped(), options(NoRuleFired::Error), &[0.2]).unwrap(),
@@ -149,7 +149,7 @@ fn a_system_without_rules_fires_none() {
         ..EvalOptions::default()
     };
     let error = eval_with(empty, options, &[0.2]).unwrap_err();
-    assert_eq!(error.to_string(), "no rule fired for output 0 ('y')");
+    assert_eq!(error.to_string(), "no rule fired for output 1 ('y')");
 }
 
 #[test]
@@ -175,7 +175,7 @@ fn the_out_of_range_policy_is_applied() {
     let error = eval_with(gapped(), options(OutOfRange::Error), &[1.5]).unwrap_err();
     assert_eq!(
         error.to_string(),
-        "input 0 ('x') = 1.5 lies outside its range [0, 1]"
+        "input 1 ('x') = 1.5 lies outside its range [0, 1]"
     );
     assert_eq!(
         eval_with(gapped(), options(OutOfRange::Error), &[1.0]).unwrap(),
@@ -213,7 +213,7 @@ fn bad_arguments_are_errors_never_nan() {
         .unwrap_err();
     assert_eq!(
         error.to_string(),
-        "batch row 1: input 0 ('x') is not finite: NaN"
+        "batch row 2: input 1 ('x') is not finite: NaN"
     );
     let paper = Evaluator::new(fuzzy_sugeno::paper_controller())
         .eval_batch(&[0.0; 6], &mut [0.0; 2])
@@ -253,7 +253,7 @@ fn an_overflowing_first_order_consequent_is_an_error() {
     let error = evaluator.eval(&[10.0], &mut out).unwrap_err();
     assert_eq!(
         error.to_string(),
-        "output 0 ('y') came out non-finite (inf)"
+        "output 1 ('y') came out non-finite (inf)"
     );
 }
 

@@ -150,7 +150,7 @@ fn eval_takes_inputs_outside_their_ranges_as_given_with_a_warning() {
     assert_eq!(warning.lines().count(), 1, "{warning}");
     assert!(
         warning
-            .starts_with("hrm: warning: input 0 ('da1') = -0.414 is outside its range [-0.3, 0.3]"),
+            .starts_with("hrm: warning: input 1 ('da1') = -0.414 is outside its range [-0.3, 0.3]"),
         "{warning}"
     );
     let clamped = hrm(&[
