@@ -11,6 +11,7 @@ use fuzzy_sugeno::learn::{
     Anfis, AnfisOptions, ConsequentOrder, GridPartition, MAX_INPUTS, MAX_ROWS, MAX_SETS_PER_INPUT,
     SetShape, SubtractiveClustering, TrainingData, genfis_cluster, genfis_grid,
 };
+use fuzzy_sugeno::{FuzzyError, LearningProblem};
 use std::path::{Path, PathBuf};
 
 /// The largest CSV file read, in bytes.
@@ -189,6 +190,8 @@ fn parse_csv(text: &str) -> Result<TrainingData, String> {
     let is_header = head.iter().any(|f| f.parse::<f64>().is_err());
     let mut values = Vec::new();
     let mut rows = 0;
+    // The file's line of every data row, for the library's errors that name a row.
+    let mut row_lines = Vec::new();
     let body = (!is_header).then_some((first_number, first));
     for (index, line) in body.into_iter().chain(lines) {
         let row = fields(line);
@@ -203,6 +206,7 @@ fn parse_csv(text: &str) -> Result<TrainingData, String> {
         if rows > MAX_ROWS {
             return Err(format!("more than {MAX_ROWS} rows"));
         }
+        row_lines.push(index + 1);
         for (c, field) in row.iter().enumerate() {
             let value: f64 = field.parse().map_err(|_| {
                 format!(
@@ -224,7 +228,22 @@ fn parse_csv(text: &str) -> Result<TrainingData, String> {
     if rows == 0 {
         return Err("no samples: only a header line".to_string());
     }
-    let data = TrainingData::new(columns - 1, 1, values).map_err(|e| e.to_string())?;
+    let data = TrainingData::new(columns - 1, 1, values).map_err(|e| match e {
+        // Named by the file's line, as the parse errors above are.
+        FuzzyError::Learning(LearningProblem::HugeValue {
+            row,
+            column,
+            value,
+            limit,
+        }) => format!(
+            "line {} column {}: {} is beyond the {} in magnitude that learning handles",
+            row_lines[row],
+            column + 1,
+            lane_math::Compact(value),
+            lane_math::Compact(limit)
+        ),
+        e => e.to_string(),
+    })?;
     if is_header {
         let names = head.iter().map(|s| s.to_string()).collect();
         data.with_names(names)
@@ -271,6 +290,12 @@ mod tests {
         assert_eq!(
             message("a,a\n1,2\n"),
             "line 1: learning: column 2: another column is also named 'a'"
+        );
+        // A value too large to learn from: the file's line (past a header and a blank line),
+        // not the data row.
+        assert_eq!(
+            message("x,y\n1,2\n\n3,1e200\n"),
+            "line 4 column 2: 1e200 is beyond the 1e100 in magnitude that learning handles"
         );
     }
 }
