@@ -133,9 +133,30 @@ fn name(text: &str) -> String {
     console::escape_field(text)
 }
 
+/// The most links of a scenario's modal arm written as `format`, and why: MJCF's nested bodies
+/// (one a link) or the joints a URDF is written with (two a link of a spatial arm, whose links
+/// [`MAX_SPATIAL_EXPORT_LINKS`] bounds).
+fn max_export_links(format: Format, kind: ArmKind) -> (usize, &'static str) {
+    match (format, kind) {
+        (Format::Mjcf, _) => (
+            robot_desc::MJCF_MAX_BODIES,
+            "MJCF: the nested bodies MuJoCo compiles",
+        ),
+        (Format::Urdf, ArmKind::Spatial) => (
+            MAX_SPATIAL_EXPORT_LINKS,
+            "URDF: two joints a link of a spatial arm",
+        ),
+        (Format::Urdf, _) => (
+            robot_desc::MAX_EXPORT_JOINTS,
+            "URDF: the joints a description is written with and read back",
+        ),
+    }
+}
+
 /// The robot of a `.urdf` file (default gravity [`DEFAULT_GRAVITY`]) or of a scenario's modal
-/// arm, planar or spatial (a scenario's URDF arm is its file).
-fn robot_of(source: &str) -> Result<(Robot, [f64; 3]), String> {
+/// arm, planar or spatial (a scenario's URDF arm is its file), whose links are refused beyond
+/// what `format` is written with ([`max_export_links`]) before the robot is built.
+fn robot_of(source: &str, format: Format) -> Result<(Robot, [f64; 3]), String> {
     let path = Path::new(source);
     if path
         .extension()
@@ -155,17 +176,21 @@ fn robot_of(source: &str) -> Result<(Robot, [f64; 3]), String> {
             urdf.display()
         ));
     }
+    let links = scenario
+        .arm
+        .link_count(scenario.arm.inertias.as_ref().map(sim_study::Inertias::len))
+        .map_err(|e| format!("{source}: {e}"))?;
+    let (max, why) = max_export_links(format, scenario.arm.kind);
+    if links > max {
+        return Err(format!(
+            "{source}: arm.links must be at most {max} for export ({why}), got {links}"
+        ));
+    }
     if scenario.arm.kind == ArmKind::Spatial {
         // The universal-joint snake, its movable joints in the order of theta.
         let model = scenario
             .spatial_model()
             .map_err(|e| format!("{source}: {e}"))?;
-        if model.n_links() > MAX_SPATIAL_EXPORT_LINKS {
-            return Err(format!(
-                "{source}: arm.links must be at most {MAX_SPATIAL_EXPORT_LINKS} for export, got {}",
-                model.n_links()
-            ));
-        }
         let robot = robot_desc::from_spatial_arm(&model, "hrm_spatial_arm");
         return Ok((robot, model.gravity()));
     }
@@ -237,7 +262,7 @@ fn export(source: &str, format: Format, out: &Path, gravity: Option<&str>) -> Re
                 .to_string(),
         );
     }
-    let (robot, default_gravity) = robot_of(source)?;
+    let (robot, default_gravity) = robot_of(source, format)?;
     let gravity = gravity
         .map(parse_gravity)
         .transpose()?

@@ -164,7 +164,7 @@ impl Arm {
 
     /// The arm as URDF text: joints about z in the base's x-y plane, links along x. URDF has no
     /// gravity: set it along -y (the arm's) in the engine that reads it. Raises InvalidInput for
-    /// more than 50,000 links or a number the URDF reader would refuse (a mass above 1e9).
+    /// more than 40,000 links (`robot_desc::MAX_EXPORT_JOINTS`) or a number the URDF reader would refuse (a mass above 1e9).
     fn to_urdf(&self) -> PyResult<String> {
         let (robot, _) = crate::chain::planar_robot(&self.chain)?;
         Ok(robot_desc::write_urdf(&robot).map_err(|e| Error::input(e.to_string()))?)

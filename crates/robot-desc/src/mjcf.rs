@@ -122,6 +122,16 @@ fn bodies(robot: &Robot, gravity: [f64; 3]) -> Result<Vec<MjBody<'_>>, DescError
             format!("each component must be finite and at most {MAX_MAGNITUDE:e} m/s^2, got {g}"),
         ));
     }
+    // Counted before the URDF is written: a chain of 50,000 links is refused as MJCF, not as
+    // a URDF too large to read back.
+    let massive = robot
+        .joints
+        .iter()
+        .filter(|joint| !joint.child.inertial.is_massless())
+        .count();
+    if massive > MJCF_MAX_BODIES {
+        return Err(too_many_bodies(robot, massive));
+    }
     // What the URDF reader refuses, MuJoCo's loader would refuse or misread too.
     write_urdf(robot)?;
     let mut bodies = Vec::new();
@@ -169,16 +179,15 @@ fn bodies(robot: &Robot, gravity: [f64; 3]) -> Result<Vec<MjBody<'_>>, DescError
             "it has no mass and no heavier link follows it: MuJoCo refuses massless moving bodies",
         ));
     }
-    if bodies.len() > MJCF_MAX_BODIES {
-        return Err(DescError::export(
-            format!("robot '{}' to MJCF", robot.name),
-            format!(
-                "{} nested bodies exceed the {MJCF_MAX_BODIES} MuJoCo compiles",
-                bodies.len()
-            ),
-        ));
-    }
     Ok(bodies)
+}
+
+/// The error of `bodies` moving bodies, more than [`MJCF_MAX_BODIES`].
+fn too_many_bodies(robot: &Robot, bodies: usize) -> DescError {
+    DescError::export(
+        format!("robot '{}' to MJCF", robot.name),
+        format!("{bodies} nested bodies exceed the {MJCF_MAX_BODIES} MuJoCo compiles"),
+    )
 }
 
 /// A moving body's inertia as MuJoCo checks it: the principal moments of a physical inertia

@@ -7,10 +7,11 @@ use crate::pose::Pose;
 use crate::urdf_read::read_urdf;
 use std::fmt::Write;
 
-/// The most movable joints a description is written with, checked before any text is: about
-/// 40 MB of URDF at most, beyond what [`read_urdf`] reads ([`MAX_URDF_BYTES`](crate::MAX_URDF_BYTES),
-/// which the read-back then refuses; a chain of 30,000 joints is written and read back).
-pub const MAX_EXPORT_JOINTS: usize = 50_000;
+/// The most movable joints a description is written with, checked before any text is: what
+/// [`read_urdf`] reads back (its [`MAX_XML_NODES`](crate::MAX_XML_NODES), about 23 a joint of a
+/// planar chain: 43,478 joints are the most it reads), so that every planar arm within it is
+/// written; a chain of heavier links may still be refused by the read-back.
+pub const MAX_EXPORT_JOINTS: usize = 40_000;
 
 /// The chain as a URDF document: the base link, then each movable joint and its child link.
 /// Fixed links were merged when the model was read, so none is written; reading the result

@@ -292,19 +292,39 @@ fn what_the_reader_would_refuse_is_not_written() {
         .unwrap_err()
         .to_string();
     assert!(error.contains("its URDF would not read back"), "{error}");
-    // Within MAX_EXPORT_JOINTS but more XML than the reader reads back: said with the joints.
-    let long = from_planar(
-        &ChainModel::uniform(45_000, 0.1, 0.1, 9.81).unwrap(),
+    // Within MAX_EXPORT_JOINTS but more XML than the reader reads back (names of 2,000
+    // characters: some 40 MB): said with the joints.
+    let mut long = from_planar(
+        &ChainModel::uniform(10_000, 0.1, 0.1, 9.81).unwrap(),
         "long",
     )
     .unwrap();
+    for (k, joint) in long.joints.iter_mut().enumerate() {
+        joint.name = format!("j{k}{}", "_".repeat(2000));
+        joint.child.name = format!("l{k}{}", "_".repeat(2000));
+    }
     let error = write_urdf(&long).unwrap_err().to_string();
     assert!(
         error.starts_with(
-            "cannot export robot 'long': its URDF of 45000 movable joints is larger than a URDF \
+            "cannot export robot 'long': its URDF of 10000 movable joints is larger than a URDF \
              is read back (at most 1000000 XML nodes"
         ),
         "{error}"
+    );
+    // The most joints written: a planar arm of MAX_EXPORT_JOINTS links reads back.
+    let most = from_planar(
+        &ChainModel::uniform(MAX_EXPORT_JOINTS, 1e-3, 1e-3, 9.81).unwrap(),
+        "most",
+    )
+    .unwrap();
+    assert!(write_urdf(&most).is_ok());
+    // MJCF: refused by its bodies before the URDF is written.
+    let error = write_mjcf(&most, [0.0, -9.81, 0.0])
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        error,
+        "cannot export robot 'most' to MJCF: 40000 nested bodies exceed the 1022 MuJoCo compiles"
     );
     let arm = from_planar(&ChainModel::uniform(3, 0.1, 0.1, 9.81).unwrap(), "arm").unwrap();
     for gravity in [[0.0, -1e300, 0.0], [f64::NAN, 0.0, 0.0]] {
@@ -317,13 +337,13 @@ fn what_the_reader_would_refuse_is_not_written() {
     assert!(write_mjcf(&arm, [0.0, -9.81, 0.0]).is_ok());
     let long = ChainModel::uniform(MAX_EXPORT_JOINTS + 1, 1e-3, 1e-3, 9.81).unwrap();
     let error = from_planar(&long, "long").unwrap_err().to_string();
-    assert!(error.contains("50001 links exceed the 50000"), "{error}");
+    assert!(error.contains("40001 links exceed the 40000"), "{error}");
     let mut robot =
         from_planar(&ChainModel::uniform(1, 1e-3, 1e-3, 9.81).unwrap(), "long").unwrap();
     robot.joints = vec![robot.joints[0].clone(); MAX_EXPORT_JOINTS + 1];
     let error = write_urdf(&robot).unwrap_err().to_string();
     assert!(
-        error.contains("50001 movable joints exceed the 50000"),
+        error.contains("40001 movable joints exceed the 40000"),
         "{error}"
     );
 }

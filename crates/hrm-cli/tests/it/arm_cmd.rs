@@ -202,6 +202,47 @@ fn a_spatial_scenarios_arm_exports_and_a_urdf_arm_is_its_file() {
         path(&dir.join("gravity")),
     ]);
     assert!(said.contains("--gravity is written only to MJCF"), "{said}");
+    // An arm beyond what the format is written with: the format's own limit, at once.
+    for (links, base, format, expected) in [
+        (
+            1_000_000,
+            "paper-responses-step",
+            "mjcf",
+            "arm.links must be at most 1022 for export (MJCF: the nested bodies MuJoCo \
+             compiles), got 1000000",
+        ),
+        (
+            50_000,
+            "paper-responses-step",
+            "urdf",
+            "arm.links must be at most 40000 for export (URDF: the joints a description is \
+             written with and read back), got 50000",
+        ),
+        (
+            10_001,
+            "spatial-tracking",
+            "urdf",
+            "arm.links must be at most 10000 for export (URDF: two joints a link of a spatial \
+             arm), got 10001",
+        ),
+    ] {
+        let mut arm = sim_study::Scenario::builtin(base).unwrap();
+        arm.arm.links = Some(links);
+        arm.arm.link_length = Some(1e-3);
+        let scenario = dir.join(format!("arm{links}.toml"));
+        std::fs::write(&scenario, arm.to_toml()).unwrap();
+        let said = fails(&[
+            "arm",
+            "export",
+            path(&scenario),
+            "--format",
+            format,
+            "--out",
+            path(&dir.join("many")),
+        ]);
+        assert!(said.trim_end().ends_with(expected), "{said}");
+    }
+    assert!(!dir.join("many").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
