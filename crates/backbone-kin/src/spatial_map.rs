@@ -17,6 +17,8 @@
 
 use crate::error::KinError;
 use crate::modal_map::{BaseAngle, MAX_MAP_ENTRIES, ModalMap};
+use crate::spatial_chain::BasePose;
+use crate::spatial_curve::{SPATIAL_CURVE_TOLERANCE, SpatialCurve};
 use crate::validate::check_count;
 use lane_math::{check_len, check_values};
 
@@ -99,6 +101,18 @@ impl SpatialModalMap {
     /// The link lengths the map was built from, base first.
     pub fn link_lengths(&self) -> &[f64] {
         self.planar.link_lengths()
+    }
+
+    /// The tip (m) of the backbone curve of `a` leaving `base`, as long as the links together,
+    /// integrated to [`SPATIAL_CURVE_TOLERANCE`] of that length ([`SpatialCurve::tip`]).
+    ///
+    /// # Errors
+    /// As [`SpatialCurve::new`] and [`SpatialCurve::tip`]: [`KinError::TooOscillatory`] for a
+    /// curve that turns too fast for the quadrature.
+    pub fn curve_tip(&self, a: &[f64], base: BasePose) -> Result<[f64; 3], KinError> {
+        let length: f64 = self.link_lengths().iter().sum();
+        let curve = SpatialCurve::new(length, self.harmonics(), a, base)?;
+        Ok(curve.tip(SPATIAL_CURVE_TOLERANCE * length)?.position)
     }
 
     /// The planar map (`alpha0` fixed at 0) both planes share.

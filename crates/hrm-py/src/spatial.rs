@@ -5,9 +5,7 @@
 use crate::args;
 use crate::array::{Output, States, evaluate};
 use crate::errors::{Error, check_finite, count};
-use backbone_kin::{
-    MAX_CURVE_STEPS, SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, spatial_tip_position,
-};
+use backbone_kin::{KinError, MAX_CURVE_STEPS, SpatialIk, spatial_tip_position};
 use modal_reduce::spatial::{
     SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel, spatial_forward_dynamics,
     spatial_joint_torques, spatial_reduced_derivatives,
@@ -442,7 +440,6 @@ impl SpatialArm {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let a = States::read(a, "a", self.m())?;
         let batch = a.is_batch();
-        let length = self.total_length();
         let out = evaluate(
             py,
             [&a],
@@ -457,12 +454,7 @@ impl SpatialArm {
                 let tip_chain =
                     spatial_tip_position(map.link_lengths(), self.model.base(), &ws.theta)
                         .map_err(Error::from)?;
-                let curve = SpatialCurve::new(length, map.harmonics(), a, *self.model.base())
-                    .map_err(Error::from)?;
-                let tip = curve
-                    .tip(SPATIAL_CURVE_TOLERANCE * length)
-                    .map_err(Error::from)?
-                    .position;
+                let tip = map.curve_tip(a, *self.model.base()).map_err(Error::from)?;
                 out[..3].copy_from_slice(&tip);
                 out[3..].copy_from_slice(&tip_chain);
                 check_finite("tip", out)
@@ -480,7 +472,8 @@ impl SpatialArm {
     /// (shape (m,) or (N, m), entries at most 10 in magnitude; default a quarter bend in each
     /// plane's first coefficient, away from the straight arm's singularity). Raises Unreachable
     /// for a target farther from the base than the arm is long and NumericalError if the
-    /// iteration does not converge.
+    /// iteration does not converge or converges to coordinates whose curve `fk` cannot integrate
+    /// (it oscillates beyond the quadrature's nodes: a guess far out).
     #[pyo3(signature = (target, guess=None))]
     fn ik<'py>(
         &self,
@@ -506,10 +499,21 @@ impl SpatialArm {
                     }
                 }
             }
-            ws.ik
+            let report = ws
+                .ik
                 .solve([target[0], target[1], target[2]], out)
                 .map_err(Error::from)?;
-            check_finite("a", out)
+            check_finite("a", out)?;
+            // An answer `fk` evaluates: a guess far out can converge to coordinates whose curve
+            // oscillates beyond the quadrature's nodes.
+            match self.model.map().curve_tip(out, *self.model.base()) {
+                Err(error @ KinError::TooOscillatory { .. }) => Err(Error::numerical(format!(
+                    "the solution's curve ({} iterations, residual {:.1e} m) cannot be \
+                     evaluated by fk: {error}; start from a guess of smaller coordinates",
+                    report.iterations, report.residual
+                ))),
+                _ => Ok(()),
+            }
         };
         let out = match guess {
             None => evaluate(

@@ -538,6 +538,11 @@ def test_spatial_and_urdf_classes_follow_the_same_rules():
         hrm.SpatialArm(link_mass=5e-324)
     with pytest.raises(hrm.InvalidInput, match=r"^arm is invalid: the chain's total mass"):
         hrm.SpatialArm(link_length=1e154)
+    # An ik answer is one fk evaluates: from a guess of 10s, ik converges to coordinates whose
+    # curve needs more quadrature nodes than fk allows.
+    snake = hrm.SpatialArm(links=512, link_length=1e-3, harmonics=16)
+    with pytest.raises(hrm.NumericalError, match=r"^the solution's curve \(.* cannot be evaluated by fk: the curve oscillates too fast"):
+        snake.ik([0.1, 0.1, 0.1], guess=np.full(64, 10.0))
     # A per-link list and its scalar: refused (the scalar was silently unused); pickles keep
     # only the lists.
     for make in (hrm.Arm, hrm.SpatialArm):

@@ -2,9 +2,10 @@
 //! `joints`, `fk`, `ik`, `reduced`, `reduced_derivatives` and `export`
 //! (`docs/eval-protocol.md`, "Spatial arms").
 
-use super::request::{EvalError, EvalResult, arm_object, curve_error, finite, json_fields};
+use super::request::{EvalError, EvalResult, Kind, arm_object, curve_error, finite, json_fields};
 use crate::arm_cmd::MAX_SPATIAL_EXPORT_LINKS;
-use backbone_kin::{SPATIAL_CURVE_TOLERANCE, SpatialCurve, SpatialIk, spatial_tip_position};
+use backbone_kin::{KinError, SpatialIk, spatial_tip_position};
+use lane_math::ErrorClass;
 use modal_reduce::spatial::{
     SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel, spatial_forward_dynamics,
     spatial_joint_torques, spatial_reduced_derivatives,
@@ -124,12 +125,9 @@ fn fk(request: StateRequest) -> EvalResult {
     map.joint_angles(&request.a, &mut theta)?;
     finite("theta", &theta)?;
     let tip_chain = spatial_tip_position(map.link_lengths(), model.base(), &theta)?;
-    let length: f64 = map.link_lengths().iter().sum();
-    let curve = SpatialCurve::new(length, map.harmonics(), &request.a, *model.base())?;
-    let tip = curve
-        .tip(SPATIAL_CURVE_TOLERANCE * length)
-        .map_err(curve_error)?
-        .position;
+    let tip = map
+        .curve_tip(&request.a, *model.base())
+        .map_err(curve_error)?;
     finite("tip", &[tip, tip_chain].concat())?;
     Ok(json_fields([
         ("tip", json!(tip)),
@@ -170,6 +168,18 @@ fn ik(request: IkRequest) -> EvalResult {
     let mut solver = SpatialIk::new(model.map().clone(), *model.base())?;
     let report = solver.solve(request.target, &mut a)?;
     finite("a", &a)?;
+    // An answer `fk` evaluates: a guess far out can converge to coordinates whose curve
+    // oscillates beyond the quadrature's nodes.
+    if let Err(error @ KinError::TooOscillatory { .. }) = model.map().curve_tip(&a, *model.base()) {
+        return Err(EvalError::new(
+            Kind::Library(ErrorClass::Numerical),
+            format!(
+                "the solution's curve ({} iterations, residual {:.1e} m) cannot be evaluated by \
+                 fk: {error}; start from a guess of smaller coordinates",
+                report.iterations, report.residual
+            ),
+        ));
+    }
     Ok(json_fields([
         ("a", json!(a)),
         ("iterations", json!(report.iterations)),
@@ -358,6 +368,19 @@ mod tests {
         assert!(
             message.starts_with("a: the curve oscillates too fast")
                 && message.ends_with("at most 262144 allowed"),
+            "{message}"
+        );
+        // An ik answer is one fk evaluates: from a guess of 10s, ik converges (residual 1e-15)
+        // to coordinates whose curve needs 271,928 nodes.
+        let answer = request(json!({"op": "ik",
+            "arm": {"kind": "spatial", "links": 512, "link_length": 1e-3}, "harmonics": 16,
+            "target": [0.1, 0.1, 0.1], "guess": vec![10.0; 64]}));
+        assert_eq!(answer["error"]["kind"], "numerical");
+        let message = answer["error"]["message"].as_str().unwrap();
+        assert!(
+            message.starts_with("the solution's curve (")
+                && message.contains("cannot be evaluated by fk: the curve oscillates too fast")
+                && message.contains("start from a guess of smaller coordinates"),
             "{message}"
         );
         // Amplitudes whose turning bound overflows.
