@@ -106,6 +106,9 @@ fn check(path: &Path) -> Result<(), String> {
             }
         );
     }
+    for joint in unlimited(&robot) {
+        let _ = writeln!(out, "note: {}", unlimited_note(joint));
+    }
     if report.merged.is_empty() {
         out.push_str("merged: none\n");
     }
@@ -125,6 +128,33 @@ fn check(path: &Path) -> Result<(), String> {
         let _ = writeln!(out, "ignored: <{}> x{count}", name(path));
     }
     console::print(&out)
+}
+
+/// The revolute and prismatic joints without `<limit>`, which the URDF specification requires
+/// of them (urdfdom, and with it ROS and Pinocchio, refuses such a file); hrm reads them as
+/// unlimited.
+fn unlimited(robot: &Robot) -> impl Iterator<Item = &robot_desc::Joint> {
+    robot.joints.iter().filter(|joint| {
+        matches!(
+            joint.kind,
+            robot_desc::JointKind::Revolute | robot_desc::JointKind::Prismatic
+        ) && joint.limits.is_none()
+    })
+}
+
+/// What [`unlimited`] says of `joint`.
+fn unlimited_note(joint: &robot_desc::Joint) -> String {
+    format!(
+        "joint '{}' is {} without <limit>, which URDF requires (urdfdom, ROS and Pinocchio refuse \
+         it): hrm reads it as unlimited{}",
+        name(&joint.name),
+        joint.kind.urdf_name(),
+        if joint.kind == robot_desc::JointKind::Revolute {
+            " (type=\"continuous\" says so)"
+        } else {
+            ""
+        }
+    )
 }
 
 /// A name from the file as one line of the report: a line break or tab in it escaped (`\n`),
@@ -268,6 +298,17 @@ fn export(source: &str, format: Format, out: &Path, gravity: Option<&str>) -> Re
         .transpose()?
         .unwrap_or(default_gravity);
     let files = export_files(&robot, format, gravity)?;
+    if format == Format::Urdf {
+        for joint in unlimited(&robot) {
+            eprintln!(
+                "{}",
+                console::error_line(&format!(
+                    "warning: written as read: {}",
+                    unlimited_note(joint)
+                ))
+            );
+        }
+    }
     let staging = OutputDir::create(out, "arm export")?;
     for (name, text) in &files {
         std::fs::write(staging.path().join(name), text)

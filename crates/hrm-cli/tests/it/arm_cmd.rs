@@ -305,6 +305,45 @@ fn a_chain_past_the_nesting_limit_is_split_into_included_files() {
     assert_eq!(joints, n);
 }
 
+/// A revolute or prismatic joint without `<limit>` (which URDF requires: urdfdom refuses it) is
+/// read as unlimited, and said so by `check` and, when it is written back, by `export`.
+#[test]
+fn joints_without_the_limits_urdf_requires_are_noted() {
+    let dir = scratch("arm-unlimited");
+    let file = dir.join("r.urdf");
+    std::fs::write(
+        &file,
+        "<robot name=\"r\"><link name=\"base\"/><joint name=\"j1\" type=\"revolute\">\
+         <parent link=\"base\"/><child link=\"l1\"/><axis xyz=\"0 0 1\"/></joint>\
+         <link name=\"l1\"><inertial><mass value=\"1\"/><inertia ixx=\"0.01\" ixy=\"0\" \
+         ixz=\"0\" iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link></robot>",
+    )
+    .unwrap();
+    let note = "joint 'j1' is revolute without <limit>, which URDF requires (urdfdom, ROS and \
+                Pinocchio refuse it): hrm reads it as unlimited (type=\"continuous\" says so)";
+    let report = succeeds(&["arm", "check", path(&file)]);
+    assert!(report.contains(&format!("note: {note}\n")), "{report}");
+    let run = hrm(&[
+        "arm",
+        "export",
+        path(&file),
+        "--format",
+        "urdf",
+        "--out",
+        path(&dir.join("out")),
+    ]);
+    assert!(run.status.success());
+    let said = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(
+        said.trim_end(),
+        format!("hrm: warning: written as read: {note}")
+    );
+    // The paper's arm (continuous joints) has nothing to note.
+    let report = succeeds(&["arm", "check", path(&example())]);
+    assert!(!report.contains("note:"), "{report}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn bad_arm_commands_get_one_line_naming_the_problem() {
     let dir = scratch("arm-errors");
