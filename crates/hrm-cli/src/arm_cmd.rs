@@ -106,7 +106,7 @@ fn check(path: &Path) -> Result<(), String> {
             }
         );
     }
-    for joint in unlimited(&robot) {
+    for joint in unlimited(robot) {
         let _ = writeln!(out, "note: {}", unlimited_note(joint));
     }
     if report.merged.is_empty() {
