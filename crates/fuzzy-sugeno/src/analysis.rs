@@ -202,10 +202,10 @@ impl FuzzySystem {
                 value: options.coverage,
             });
         }
-        if options.max_relative_jump.is_nan() || options.max_relative_jump <= 0.0 {
+        if !(options.max_relative_jump > 0.0 && options.max_relative_jump.is_finite()) {
             return Err(FuzzyError::AnalysisOption {
                 name: "max_relative_jump",
-                requirement: "be positive",
+                requirement: "be positive and finite",
                 value: options.max_relative_jump,
             });
         }
@@ -236,6 +236,15 @@ impl FuzzySystem {
             AndMethod::Product => options.coverage.powi(n as i32),
             AndMethod::Minimum => options.coverage,
         };
+        // A threshold that underflows would pass every point (`1e-320` over two inputs is 0).
+        if threshold < f64::MIN_POSITIVE {
+            return Err(FuzzyError::AnalysisOption {
+                name: "coverage",
+                requirement: "give a threshold (coverage, raised to the number of inputs under \
+                              the product) of at least 2.2e-308",
+                value: options.coverage,
+            });
+        }
         // Work left for the grid once the rule pairs are counted (bounds every loop here).
         let rules = self.rules().len() as u64;
         let pairs = rules * rules.saturating_sub(1) / 2;

@@ -147,7 +147,7 @@ pub enum FuzzyError {
         message: String,
     },
     /// An option of a rule-base analysis is out of its domain.
-    #[error("analysis: {name} must {requirement}, got {value}")]
+    #[error("analysis: {name} must {requirement}, got {}", lane_math::Compact(*.value))]
     AnalysisOption {
         /// Which option of [`AnalysisOptions`](crate::AnalysisOptions).
         name: &'static str,

@@ -231,6 +231,20 @@ fn check(system: &FuzzySystem, options: &AnalysisOptions) -> Result<(String, boo
                 .collect::<Vec<_>>()
                 .join(" x ")
         ),
+        // The options by their CLI names.
+        FuzzyError::AnalysisOption {
+            name,
+            requirement,
+            value,
+        } => format!(
+            "--{} must {requirement}, got {}",
+            if name == "coverage" {
+                "coverage"
+            } else {
+                "max-jump"
+            },
+            lane_math::Compact(value)
+        ),
         e => e.to_string(),
     })?;
     let mut text = report.to_string();

@@ -248,6 +248,15 @@ fn fis_check_options_are_named_as_given() {
         line.ends_with("--max-jump must be positive and finite, got inf"),
         "{line}"
     );
+    // A coverage whose threshold (coverage^2 under the product) underflows: every point passed.
+    let line = refused(&hrm(&["fis", "check", path(&file), "--coverage", "1e-200"]));
+    assert!(
+        line.ends_with(
+            "--coverage must give a threshold (coverage, raised to the number of inputs under \
+             the product) of at least 2.2e-308, got 1e-200"
+        ),
+        "{line}"
+    );
     // Extreme values are echoed compactly (1e-320 was 324 digits, 1e300 301).
     for (option, value, shown) in [
         ("--max-jump", "1e-320", "must stay below 1e-320)"),
