@@ -111,19 +111,7 @@ pub fn run(args: FisArgs) -> Result<(), String> {
             samples,
             max_jump,
         } => {
-            // The options by their CLI names (the library names its fields).
-            if !(coverage > 0.0 && coverage <= 1.0) {
-                return Err(format!(
-                    "--coverage must lie in (0, 1], got {}",
-                    lane_math::Compact(coverage)
-                ));
-            }
-            if !(max_jump > 0.0 && max_jump.is_finite()) {
-                return Err(format!(
-                    "--max-jump must be positive and finite, got {}",
-                    lane_math::Compact(max_jump)
-                ));
-            }
+            // Their domains are the library's (`check` names them as options).
             let options = AnalysisOptions {
                 coverage,
                 samples_per_input: args::count("--samples", samples, 2, MAX_SAMPLES)?,
@@ -231,9 +219,9 @@ fn check(system: &FuzzySystem, options: &AnalysisOptions) -> Result<(String, boo
                 .collect::<Vec<_>>()
                 .join(" x ")
         ),
-        // The options by their CLI names.
+        // The options by their CLI names (the library names its fields).
         FuzzyError::AnalysisOption {
-            name,
+            name: name @ ("coverage" | "max_relative_jump"),
             requirement,
             value,
         } => format!(

@@ -201,14 +201,11 @@ impl Drop for OutputDir {
 /// --out data.csv --data data.csv` would overwrite the training data): `out` names the same
 /// file as an input (the same device and inode, whatever the path).
 pub fn refuse_input_as_output(out: &Path, inputs: &[(&str, &Path)]) -> Result<(), String> {
-    use std::os::unix::fs::MetadataExt;
-    let Ok(target) = std::fs::metadata(out) else {
+    if std::fs::metadata(out).is_err() {
         return Ok(());
-    };
+    }
     for (option, input) in inputs {
-        if let Ok(meta) = std::fs::metadata(input)
-            && (meta.dev(), meta.ino()) == (target.dev(), target.ino())
-        {
+        if same_file(out, input) {
             return Err(format!(
                 "--out {} is the {option} file {}: writing it would overwrite an input; choose \
                  another --out",
