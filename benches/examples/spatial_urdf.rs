@@ -24,7 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all(&folder)?;
     for n in [10, 100] {
         let model = hrm_benches::spatial_arm(n);
-        let robot = robot_desc::from_spatial_arm(&model, "spatial_arm");
+        let robot = robot_desc::from_spatial_arm(&model, "spatial_arm")?;
         std::fs::write(
             folder.join(format!("spatial_{n}.urdf")),
             robot_desc::write_urdf(&robot)?,

@@ -101,6 +101,32 @@ pub enum KinError {
         /// The allowed maximum.
         max: usize,
     },
+    /// An inverse-kinematics guess entry beyond the solver's bound (`MAX_IK_GUESS` rad).
+    #[error("guess entries must be at most {max} in magnitude, got {value}")]
+    GuessTooLarge {
+        /// 0-based index of the first offending entry.
+        index: usize,
+        /// The offending value.
+        value: f64,
+        /// The bound.
+        max: f64,
+    },
+    /// Inverse kinematics converged to coordinates whose backbone curve turns too fast for the
+    /// quadrature of its forward kinematics ([`KinError::TooOscillatory`] of the answer).
+    #[error(
+        "the solution's curve ({iterations} iterations, residual {residual:.1e} m) cannot be evaluated by fk: the curve oscillates too fast for quadrature to the documented accuracy: {} nodes needed, at most {max} allowed; start from a guess of smaller coordinates",
+        NodeCount(*needed)
+    )]
+    AnswerTooOscillatory {
+        /// Iterations the solve took.
+        iterations: usize,
+        /// Its end-point error (m).
+        residual: f64,
+        /// Quadrature nodes the answer's curve asks for.
+        needed: f64,
+        /// The allowed maximum.
+        max: usize,
+    },
     /// The restricted inverse of `J0` was asked for a value outside `J0`'s range `[0, 1]` on its
     /// first branch.
     #[error("the restricted inverse of J0 needs a value in [0, 1], got {value}")]
@@ -165,7 +191,9 @@ impl Classify for KinError {
     /// ([`OutOfReach`]: no curve of this length can; [`AtBase`]: its direction is undefined;
     /// [`A2ExceedsAmplitude`]: not on the first branch of `J0` with this `alpha0`);
     /// [`Numerical`](ErrorClass::Numerical) when a numerical inverse kinematics did not reach its
-    /// tolerance ([`NotConverged`](KinError::NotConverged)); otherwise the input was malformed or
+    /// tolerance ([`NotConverged`](KinError::NotConverged)) or converged to coordinates its
+    /// forward kinematics cannot evaluate ([`AnswerTooOscillatory`](KinError::AnswerTooOscillatory));
+    /// otherwise the input was malformed or
     /// outside the model's domain.
     ///
     /// [`OutOfReach`]: KinError::OutOfReach
@@ -176,7 +204,7 @@ impl Classify for KinError {
             Self::OutOfReach { .. } | Self::AtBase { .. } | Self::A2ExceedsAmplitude { .. } => {
                 ErrorClass::Unreachable
             }
-            Self::NotConverged { .. } => ErrorClass::Numerical,
+            Self::NotConverged { .. } | Self::AnswerTooOscillatory { .. } => ErrorClass::Numerical,
             _ => ErrorClass::InvalidInput,
         }
     }

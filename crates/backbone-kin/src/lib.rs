@@ -32,6 +32,6 @@ pub use spatial_chain::{
     BasePose, MAX_BASE_OFFSET, spatial_joint_positions, spatial_tip_jacobian, spatial_tip_position,
 };
 pub use spatial_curve::{CurveTip, MAX_CURVE_STEPS, SPATIAL_CURVE_TOLERANCE, SpatialCurve};
-pub use spatial_ik::SpatialIk;
+pub use spatial_ik::{MAX_IK_GUESS, SpatialIk};
 pub use spatial_map::SpatialModalMap;
 pub use vec3::Rotation;

@@ -17,6 +17,11 @@ use crate::spatial_map::SpatialModalMap;
 use crate::vec3::distance;
 use lane_math::{check_finite, check_len, check_values};
 
+/// Largest magnitude of a guess entry (rad) [`SpatialIk::solve_evaluable`] starts from: the
+/// iteration is local and takes steps of at most 0.5 rad, so this bounds the amplitudes it visits,
+/// and with them the quadrature's cost of the answer's curve.
+pub const MAX_IK_GUESS: f64 = 10.0;
+
 /// Reusable inverse kinematics of a universal-joint chain on the spatial modal family. Created
 /// once; [`solve`](Self::solve) allocates nothing.
 ///
@@ -128,6 +133,60 @@ impl SpatialIk {
             },
             |modes, jacobian| modal_tip_jacobian(map, base, modes, theta, joint_jacobian, jacobian),
         )
+    }
+
+    /// As [`solve`](Self::solve) from `guess` (default [`default_guess`](Self::default_guess)),
+    /// for an answer the backbone curve's forward kinematics evaluates
+    /// ([`SpatialModalMap::curve_tip`]): a guess far out can converge to coordinates whose curve
+    /// turns too fast for the quadrature. `a` receives the solution (`4K` entries).
+    ///
+    /// Errors: as [`solve`](Self::solve); [`KinError::GuessTooLarge`] for a guess entry beyond
+    /// [`MAX_IK_GUESS`] (rad), before any iteration; [`KinError::AnswerTooOscillatory`] for an
+    /// answer whose curve cannot be evaluated.
+    pub fn solve_evaluable(
+        &mut self,
+        target: [f64; 3],
+        guess: Option<&[f64]>,
+        a: &mut [f64],
+    ) -> Result<IkReport, KinError> {
+        check_len("modal coordinates", a.len(), self.trial.len())?;
+        match guess {
+            Some(guess) => {
+                check_len("guess", guess.len(), a.len())?;
+                if let Some((index, &value)) = guess
+                    .iter()
+                    .enumerate()
+                    .find(|(_, v)| v.abs() > MAX_IK_GUESS)
+                {
+                    return Err(KinError::GuessTooLarge {
+                        index,
+                        value,
+                        max: MAX_IK_GUESS,
+                    });
+                }
+                a.copy_from_slice(guess);
+            }
+            None => Self::default_guess(a),
+        }
+        let report = self.solve(target, a)?;
+        match self.map.curve_tip(a, self.base) {
+            Err(KinError::TooOscillatory { needed, max }) => Err(KinError::AnswerTooOscillatory {
+                iterations: report.iterations,
+                residual: report.residual,
+                needed,
+                max,
+            }),
+            _ => Ok(report),
+        }
+    }
+
+    /// The guess [`solve_evaluable`](Self::solve_evaluable) starts from when given none: a
+    /// quarter bend (0.25 rad) in each plane's first coordinate of every harmonic, away from the
+    /// straight arm's singularity.
+    pub fn default_guess(a: &mut [f64]) {
+        for (j, value) in a.iter_mut().enumerate() {
+            *value = if j % 2 == 0 { 0.25 } else { 0.0 };
+        }
     }
 
     /// The chain's tip at the modal coordinates `a` (`4K`) and its Jacobian

@@ -65,10 +65,6 @@ pub fn run(args: ArmArgs) -> Result<(), String> {
     }
 }
 
-/// Most links of a spatial arm that `hrm arm export` and eval's `export` write (about 0.7 MB of
-/// URDF per 1,000 links: well within [`robot_desc::MAX_URDF_BYTES`], so that it reads back).
-pub const MAX_SPATIAL_EXPORT_LINKS: usize = 10_000;
-
 /// The text of a URDF file, read up to [`robot_desc::MAX_URDF_BYTES`].
 fn read_urdf_file(path: &Path) -> Result<String, String> {
     sim_study::read_text_file(path, robot_desc::MAX_URDF_BYTES as u64)
@@ -165,7 +161,7 @@ fn name(text: &str) -> String {
 
 /// The most links of a scenario's modal arm written as `format`, and why: MJCF's nested bodies
 /// (one a link) or the joints a URDF is written with (two a link of a spatial arm, whose links
-/// [`MAX_SPATIAL_EXPORT_LINKS`] bounds).
+/// [`robot_desc::MAX_SPATIAL_EXPORT_LINKS`] bounds).
 fn max_export_links(format: Format, kind: ArmKind) -> (usize, &'static str) {
     match (format, kind) {
         (Format::Mjcf, _) => (
@@ -173,7 +169,7 @@ fn max_export_links(format: Format, kind: ArmKind) -> (usize, &'static str) {
             "MJCF: the nested bodies MuJoCo compiles",
         ),
         (Format::Urdf, ArmKind::Spatial) => (
-            MAX_SPATIAL_EXPORT_LINKS,
+            robot_desc::MAX_SPATIAL_EXPORT_LINKS,
             "URDF: two joints a link of a spatial arm",
         ),
         (Format::Urdf, _) => (
@@ -221,7 +217,8 @@ fn robot_of(source: &str, format: Format) -> Result<(Robot, [f64; 3]), String> {
         let model = scenario
             .spatial_model()
             .map_err(|e| format!("{source}: {e}"))?;
-        let robot = robot_desc::from_spatial_arm(&model, "hrm_spatial_arm");
+        let robot = robot_desc::from_spatial_arm(&model, "hrm_spatial_arm")
+            .map_err(|e| format!("{source}: {e}"))?;
         return Ok((robot, model.gravity()));
     }
     planar_robot(&scenario.arm, "hrm_planar_arm")

@@ -7,8 +7,8 @@
 //! is documented in `docs/eval-protocol.md`.
 
 use backbone_kin::{
-    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, end_point, inverse_kinematics,
-    reduce_angle, tip_position,
+    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, MAX_IK_GUESS, end_point,
+    inverse_kinematics, reduce_angle, tip_position,
 };
 use fuzzy_sugeno::FuzzySystem;
 use lane_math::{Classify, ErrorClass};
@@ -26,8 +26,8 @@ mod robot;
 mod spatial;
 
 use request::{
-    EvalError, EvalResult, Kind, MAX_GUESS, arm_object, curve_error, finite, harmonics,
-    json_fields, modal_map, parse,
+    EvalError, EvalResult, Kind, arm_object, curve_error, finite, harmonics, json_fields,
+    modal_map, parse,
 };
 
 /// Longest request line accepted (bytes); longer lines are skipped with a `line_too_long` error.
@@ -336,9 +336,9 @@ fn ik(request: IkRequest) -> EvalResult {
     let guessed = request.guess.is_some();
     let start = match request.guess {
         Some(guess) if guess.len() == 2 * k => {
-            if let Some(x) = guess.iter().find(|x| x.abs() > MAX_GUESS) {
+            if let Some(x) = guess.iter().find(|x| x.abs() > MAX_IK_GUESS) {
                 return Err(EvalError::input(format!(
-                    "guess entries must lie within [-{MAX_GUESS}, {MAX_GUESS}] rad, got {x:e}"
+                    "guess entries must lie within [-{MAX_IK_GUESS}, {MAX_IK_GUESS}] rad, got {x:e}"
                 )));
             }
             guess

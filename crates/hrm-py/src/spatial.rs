@@ -5,7 +5,7 @@
 use crate::args;
 use crate::array::{Output, States, evaluate};
 use crate::errors::{Error, check_finite, count};
-use backbone_kin::{KinError, MAX_CURVE_STEPS, SpatialIk, spatial_tip_position};
+use backbone_kin::{MAX_CURVE_STEPS, SpatialIk, spatial_tip_position};
 use modal_reduce::spatial::{
     SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel, spatial_forward_dynamics,
     spatial_joint_torques, spatial_reduced_derivatives,
@@ -20,14 +20,6 @@ use std::sync::Mutex;
 /// keeps `ik` (up to 100 evaluations of the tip and its `3 x m` Jacobian) and the `O(n m^2)`
 /// reduced terms within a second for arms of thousands of links.
 const MAX_HARMONICS: usize = 16;
-
-/// Largest magnitude of an `ik` guess entry (rad), as in `hrm eval`: the solver is local and
-/// takes bounded steps, so this bounds the amplitudes it visits.
-const MAX_GUESS: f64 = 10.0;
-
-/// Most links `to_urdf` and `to_mjcf` write, as `hrm eval`'s `export` (about 1.4 MB of URDF per
-/// 1,000 links).
-const MAX_EXPORT_LINKS: usize = 10_000;
 
 /// Operations of one Runge-Kutta step of the curve's frame, for `fk`'s work estimate.
 const CURVE_STEP_WORK: usize = 256;
@@ -89,15 +81,11 @@ impl SpatialArm {
         Workspace::new(&self.model)
     }
 
-    /// The arm's chain as a description, refused past [`MAX_EXPORT_LINKS`].
+    /// The arm's chain as a description, refused past
+    /// [`robot_desc::MAX_SPATIAL_EXPORT_LINKS`].
     fn robot(&self) -> crate::errors::Result<robot_desc::Robot> {
-        let n = self.model.n_links();
-        if n > MAX_EXPORT_LINKS {
-            return Err(Error::input(format!(
-                "an arm of {n} links; to_urdf and to_mjcf write at most {MAX_EXPORT_LINKS}"
-            )));
-        }
-        Ok(robot_desc::from_spatial_arm(&self.model, "hrm_spatial_arm"))
+        robot_desc::from_spatial_arm(&self.model, "hrm_spatial_arm")
+            .map_err(|e| Error::input(format!("links: {e}")))
     }
 
     fn m(&self) -> usize {
@@ -484,36 +472,10 @@ impl SpatialArm {
         let m = self.m();
         let target = States::read(target, "target", 3)?;
         let solve = |ws: &mut Workspace, target: &[f64], guess: Option<&[f64]>, out: &mut [f64]| {
-            match guess {
-                Some(guess) => {
-                    if let Some(bad) = guess.iter().find(|v| v.abs() > MAX_GUESS) {
-                        return Err(Error::input(format!(
-                            "guess entries must be at most {MAX_GUESS} in magnitude, got {bad}"
-                        )));
-                    }
-                    out.copy_from_slice(guess);
-                }
-                None => {
-                    for (j, value) in out.iter_mut().enumerate() {
-                        *value = if j % 2 == 0 { 0.25 } else { 0.0 };
-                    }
-                }
-            }
-            let report = ws
-                .ik
-                .solve([target[0], target[1], target[2]], out)
+            ws.ik
+                .solve_evaluable([target[0], target[1], target[2]], guess, out)
                 .map_err(Error::from)?;
-            check_finite("a", out)?;
-            // An answer `fk` evaluates: a guess far out can converge to coordinates whose curve
-            // oscillates beyond the quadrature's nodes.
-            match self.model.map().curve_tip(out, *self.model.base()) {
-                Err(error @ KinError::TooOscillatory { .. }) => Err(Error::numerical(format!(
-                    "the solution's curve ({} iterations, residual {:.1e} m) cannot be \
-                     evaluated by fk: {error}; start from a guess of smaller coordinates",
-                    report.iterations, report.residual
-                ))),
-                _ => Ok(()),
-            }
+            check_finite("a", out)
         };
         let out = match guess {
             None => evaluate(

@@ -111,5 +111,6 @@ def test_reduced_dynamics_agree_with_mujoco(seed, links, harmonics):
 
 
 def test_exports_are_bounded():
-    with pytest.raises(hrm.InvalidInput, match="at most 10000"):
+    message = "^links: cannot export robot 'hrm_spatial_arm': 10001 links exceed the 10000 a spatial arm is written with$"
+    with pytest.raises(hrm.InvalidInput, match=message):
         hrm.SpatialArm(links=10_001).to_urdf()

@@ -18,7 +18,7 @@ pub use mjcf::{
 pub use model::{Body, Geometry, Inertial, Joint, JointDynamics, JointKind, Limits, Robot, Shape};
 pub use planar::from_planar;
 pub use spatial::{check_gravity, to_spatial};
-pub use universal::from_spatial_arm;
+pub use universal::{MAX_SPATIAL_EXPORT_LINKS, from_spatial_arm};
 pub use urdf_read::{
     MAX_ATTRIBUTE_BYTES, MAX_ATTRIBUTES, MAX_MAGNITUDE, MAX_NAMESPACES, MAX_URDF_BYTES,
     MAX_XML_DEPTH, MAX_XML_NODES, Merged, ReadReport, Reading, read_urdf,

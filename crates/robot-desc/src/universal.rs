@@ -1,8 +1,14 @@
 //! The universal-joint arms of `modal-reduce`'s spatial modal family as descriptions.
 
+use crate::error::DescError;
 use crate::model::{Body, Inertial, Joint, JointKind, Robot};
 use crate::pose::Pose;
 use modal_reduce::spatial::SpatialReducedModel;
+
+/// The most links of a spatial modal arm [`from_spatial_arm`] describes: two joints a link, about
+/// 0.7 MB of URDF per 1,000 links, well within [`MAX_URDF_BYTES`](crate::MAX_URDF_BYTES) and
+/// [`MAX_EXPORT_JOINTS`](crate::MAX_EXPORT_JOINTS), so that what is written reads back.
+pub const MAX_SPATIAL_EXPORT_LINKS: usize = 10_000;
 
 /// The chain of the spatial modal arm `model` leaving its base pose (the first joints' frame in
 /// the world: position and URDF's roll-pitch-yaw, the convention of `BasePose`), link `i` joined to link `i - 1` by a universal joint: `joint_i_z` about the
@@ -11,7 +17,19 @@ use modal_reduce::spatial::SpatialReducedModel;
 /// the order of the spatial family's `theta = [z_1, y_1, z_2, y_2, ...]`, all `continuous`;
 /// link `i`'s mass at its midpoint with its principal moments in the link frame. Gravity is not
 /// part of a URDF (MJCF writes it in `<option>`).
-pub fn from_spatial_arm(model: &SpatialReducedModel, name: &str) -> Robot {
+///
+/// # Errors
+/// [`DescError::Export`] for more than [`MAX_SPATIAL_EXPORT_LINKS`] links, before any is built.
+pub fn from_spatial_arm(model: &SpatialReducedModel, name: &str) -> Result<Robot, DescError> {
+    if model.n_links() > MAX_SPATIAL_EXPORT_LINKS {
+        return Err(DescError::export(
+            format!("robot '{name}'"),
+            format!(
+                "{} links exceed the {MAX_SPATIAL_EXPORT_LINKS} a spatial arm is written with",
+                model.n_links()
+            ),
+        ));
+    }
     let mut joints = Vec::with_capacity(2 * model.n_links());
     let base = model.base();
     let mut origin = Pose {
@@ -70,12 +88,12 @@ pub fn from_spatial_arm(model: &SpatialReducedModel, name: &str) -> Robot {
             rpy: [0.0; 3],
         };
     }
-    Robot {
+    Ok(Robot {
         name: name.to_string(),
         base: Body {
             name: "base".to_string(),
             ..Body::default()
         },
         joints,
-    }
+    })
 }

@@ -629,3 +629,19 @@ fn what_is_written_of_a_long_chain_reads_back() {
     assert!(written.len() > text.len() && written.len() < robot_desc::MAX_URDF_BYTES);
     assert_eq!(read_urdf(&written).unwrap().robot, robot);
 }
+
+#[test]
+fn the_longest_spatial_arm_is_written_and_read_back_and_a_longer_refused() {
+    use modal_reduce::spatial::SpatialReducedModel;
+    use robot_desc::{MAX_SPATIAL_EXPORT_LINKS, from_spatial_arm};
+    let arm = |n| SpatialReducedModel::uniform_rods(n, 1, 0.1, 0.1, [0.0, 0.0, -9.81]).unwrap();
+    let robot = from_spatial_arm(&arm(MAX_SPATIAL_EXPORT_LINKS), "longest").unwrap();
+    assert_eq!(robot.n_joints(), 2 * MAX_SPATIAL_EXPORT_LINKS);
+    let written = write_urdf(&robot).unwrap();
+    assert_eq!(read_urdf(&written).unwrap().robot, robot);
+    let error = from_spatial_arm(&arm(MAX_SPATIAL_EXPORT_LINKS + 1), "longer").unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "cannot export robot 'longer': 10001 links exceed the 10000 a spatial arm is written with"
+    );
+}

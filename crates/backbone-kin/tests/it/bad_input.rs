@@ -5,8 +5,9 @@
 //! sentinel-filled buffer, which must come back untouched.
 
 use backbone_kin::{
-    BackboneCurve, BaseAngle, Branch, HarmonicIk, IkOptions, KinError, MAX_HARMONICS, MAX_LINKS,
-    ModalMap, end_point, inverse_j0, inverse_kinematics, joint_positions, tip_position,
+    BackboneCurve, BaseAngle, BasePose, Branch, HarmonicIk, IkOptions, KinError, MAX_HARMONICS,
+    MAX_LINKS, ModalMap, SpatialIk, SpatialModalMap, end_point, inverse_j0, inverse_kinematics,
+    joint_positions, tip_position,
 };
 use lane_math::Classify;
 use std::collections::BTreeSet;
@@ -31,11 +32,13 @@ fn variant(error: &KinError) -> &'static str {
         KinError::A2ExceedsAmplitude { .. } => "A2ExceedsAmplitude",
         KinError::NotConverged { .. } => "NotConverged",
         KinError::TooMany { .. } => "TooMany",
+        KinError::GuessTooLarge { .. } => "GuessTooLarge",
+        KinError::AnswerTooOscillatory { .. } => "AnswerTooOscillatory",
         other => panic!("a variant this test does not cover: {other:?}"),
     }
 }
 
-const ALL: [&str; 14] = [
+const ALL: [&str; 16] = [
     "NonFinite",
     "NonPositiveLength",
     "NoLinks",
@@ -50,7 +53,15 @@ const ALL: [&str; 14] = [
     "A2ExceedsAmplitude",
     "NotConverged",
     "TooMany",
+    "GuessTooLarge",
+    "AnswerTooOscillatory",
 ];
+
+/// The spatial solver of `n` links of 1 mm with `k` harmonics per plane at the default base.
+fn spatial_ik(n: usize, k: usize) -> SpatialIk {
+    let map = SpatialModalMap::new(&vec![1e-3; n], k).unwrap();
+    SpatialIk::new(map, BasePose::default()).unwrap()
+}
 
 /// Every refusal.
 fn rows() -> Vec<Row<KinError>> {
@@ -396,6 +407,29 @@ fn rows() -> Vec<Row<KinError>> {
             |e| matches!(e, KinError::TooOscillatory { .. }),
             &["oscillates too fast", "nodes needed"],
         ),
+        // The spatial inverse kinematics from a guess: bounded before it iterates, and an answer
+        // whose curve fk cannot evaluate (from a guess of 10s on 512 links of 1 mm, K = 16, the
+        // solve converges to a residual of 1e-15 m) is refused.
+        exactly(
+            "spatial_ik_guess_too_large",
+            spatial_ik(2, 1)
+                .solve_evaluable([0.1, 0.0, 0.0], Some(&[0.0, 10.5, 0.0, 0.0]), &mut [0.0; 4])
+                .unwrap_err(),
+            |e| matches!(e, KinError::GuessTooLarge { index: 1, .. }),
+            "guess entries must be at most 10 in magnitude, got 10.5",
+        ),
+        words(
+            "spatial_ik_answer_too_oscillatory",
+            spatial_ik(512, 16)
+                .solve_evaluable([0.1, 0.1, 0.1], Some(&[10.0; 64]), &mut [0.0; 64])
+                .unwrap_err(),
+            |e| matches!(e, KinError::AnswerTooOscillatory { .. }),
+            &[
+                "the solution's curve (",
+                "cannot be evaluated by fk: the curve oscillates too fast",
+                "start from a guess of smaller coordinates",
+            ],
+        ),
         // The inverse of J0 and the closed-form inverse kinematics.
         words(
             "inverse_j0_outside_its_range",
@@ -668,7 +702,7 @@ fn every_error_is_in_exactly_one_class() {
             variant(&error),
             "OutOfReach" | "AtBase" | "A2ExceedsAmplitude"
         );
-        let numerical = variant(&error) == "NotConverged";
+        let numerical = matches!(variant(&error), "NotConverged" | "AnswerTooOscillatory");
         assert_eq!(error.is_unreachable(), unreachable, "{name}: {error}");
         assert_eq!(error.is_numerical(), numerical, "{name}: {error}");
         assert_eq!(

@@ -260,6 +260,33 @@ fn the_tip_inverse_kinematics_lands_on_reachable_targets() {
 }
 
 #[test]
+fn solve_evaluable_starts_from_a_quarter_bend_and_lands_where_the_curve_is_evaluated() {
+    // From its default guess (a quarter bend in each plane) on the chain of 10 links of 0.1 m,
+    // K = 2: the chain's tip lands on the target, the answer's curve is evaluated, and with a
+    // guess it is the solve from that guess.
+    let base = BasePose::default();
+    let map = SpatialModalMap::new(&[0.1; 10], 2).unwrap();
+    let mut ik = SpatialIk::new(map.clone(), base).unwrap();
+    let known = [0.6, -0.2, 0.3, 0.1, -0.1, 0.05, 0.2, -0.1];
+    let target = chain_tip(&map, &base, &known);
+    let mut quarter = [1.0; 8];
+    SpatialIk::default_guess(&mut quarter);
+    assert_eq!(quarter, [0.25, 0.0, 0.25, 0.0, 0.25, 0.0, 0.25, 0.0]);
+    let mut a = [f64::NAN; 8];
+    let report = ik.solve_evaluable(target, None, &mut a).unwrap();
+    assert!(distance(chain_tip(&map, &base, &a), target) <= ik.options().tolerance + 1e-15);
+    let mut from_quarter = quarter;
+    assert_eq!(ik.solve(target, &mut from_quarter).unwrap(), report);
+    assert_eq!(a, from_quarter);
+    map.curve_tip(&a, base).unwrap();
+    let guess = [0.5, -0.1, 0.2, 0.0, 0.0, 0.0, 0.1, 0.0];
+    let mut from_guess = guess;
+    ik.solve(target, &mut from_guess).unwrap();
+    ik.solve_evaluable(target, Some(&guess), &mut a).unwrap();
+    assert_eq!(a, from_guess);
+}
+
+#[test]
 fn the_spatial_family_refuses_bad_input() {
     let base = BasePose::default();
     assert!(matches!(

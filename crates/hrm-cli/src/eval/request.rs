@@ -173,10 +173,6 @@ pub(super) fn json_type(value: &Value) -> &'static str {
 /// under about a second; the library's own limit ([`backbone_kin::MAX_HARMONICS`]) is far larger.
 pub(super) const MAX_REQUEST_HARMONICS: usize = 64;
 
-/// Largest magnitude of an `ik` guess entry (rad). The solvers are local and take steps of at
-/// most 0.5 rad, so this bounds the amplitudes they visit, and with them the quadrature's cost.
-pub(super) const MAX_GUESS: f64 = 10.0;
-
 /// `"harmonics"`: `K >= 1` (default 1), at most `max`.
 pub(super) fn harmonics(requested: Option<usize>, max: usize) -> Result<usize, EvalError> {
     match requested.unwrap_or(1) {

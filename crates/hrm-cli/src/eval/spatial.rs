@@ -2,10 +2,8 @@
 //! `joints`, `fk`, `ik`, `reduced`, `reduced_derivatives` and `export`
 //! (`docs/eval-protocol.md`, "Spatial arms").
 
-use super::request::{EvalError, EvalResult, Kind, arm_object, curve_error, finite, json_fields};
-use crate::arm_cmd::MAX_SPATIAL_EXPORT_LINKS;
-use backbone_kin::{KinError, SpatialIk, spatial_tip_position};
-use lane_math::ErrorClass;
+use super::request::{EvalError, EvalResult, arm_object, curve_error, finite, json_fields};
+use backbone_kin::{SpatialIk, spatial_tip_position};
 use modal_reduce::spatial::{
     SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel, spatial_forward_dynamics,
     spatial_joint_torques, spatial_reduced_derivatives,
@@ -149,37 +147,10 @@ struct IkRequest {
 /// singularity).
 fn ik(request: IkRequest) -> EvalResult {
     let model = request.arm.model(harmonics(request.harmonics)?)?;
-    let m = model.n_coords();
-    let mut a = match request.guess {
-        Some(guess) => {
-            lane_math::check_len("guess", guess.len(), m)?;
-            guess
-        }
-        None => (0..m)
-            .map(|j| if j % 2 == 0 { 0.25 } else { 0.0 })
-            .collect(),
-    };
-    if let Some(bad) = a.iter().find(|v| v.abs() > super::request::MAX_GUESS) {
-        return Err(EvalError::input(format!(
-            "guess entries must be at most {} in magnitude, got {bad}",
-            super::request::MAX_GUESS
-        )));
-    }
+    let mut a = vec![0.0; model.n_coords()];
     let mut solver = SpatialIk::new(model.map().clone(), *model.base())?;
-    let report = solver.solve(request.target, &mut a)?;
+    let report = solver.solve_evaluable(request.target, request.guess.as_deref(), &mut a)?;
     finite("a", &a)?;
-    // An answer `fk` evaluates: a guess far out can converge to coordinates whose curve
-    // oscillates beyond the quadrature's nodes.
-    if let Err(error @ KinError::TooOscillatory { .. }) = model.map().curve_tip(&a, *model.base()) {
-        return Err(EvalError::new(
-            Kind::Library(ErrorClass::Numerical),
-            format!(
-                "the solution's curve ({} iterations, residual {:.1e} m) cannot be evaluated by \
-                 fk: {error}; start from a guess of smaller coordinates",
-                report.iterations, report.residual
-            ),
-        ));
-    }
     Ok(json_fields([
         ("a", json!(a)),
         ("iterations", json!(report.iterations)),
@@ -275,13 +246,8 @@ struct ExportRequest {
 /// order of `theta`; the MJCF carries the arm's gravity, a URDF none).
 fn export(request: ExportRequest) -> EvalResult {
     let model = request.arm.model(harmonics(request.harmonics)?)?;
-    if model.n_links() > MAX_SPATIAL_EXPORT_LINKS {
-        return Err(EvalError::input(format!(
-            "arm.links must be at most {MAX_SPATIAL_EXPORT_LINKS} for export, got {}",
-            model.n_links()
-        )));
-    }
-    let robot = robot_desc::from_spatial_arm(&model, "hrm_spatial_arm");
+    let robot = robot_desc::from_spatial_arm(&model, "hrm_spatial_arm")
+        .map_err(|e| EvalError::input(format!("arm.links: {e}")))?;
     let text = match request.format.as_str() {
         "urdf" => robot_desc::write_urdf(&robot).map_err(|e| EvalError::input(e.to_string()))?,
         "mjcf" => robot_desc::write_mjcf(&robot, model.gravity())
@@ -543,7 +509,8 @@ mod tests {
             ),
             (
                 json!({"op": "export", "arm": {"kind": "spatial", "links": 20_000}, "format": "urdf"}),
-                "at most 10000 for export",
+                "arm.links: cannot export robot 'hrm_spatial_arm': 20000 links exceed the 10000 \
+                 a spatial arm is written with",
             ),
             (
                 json!({"op": "export", "arm": {"kind": "spatial"}, "format": "sdf"}),
