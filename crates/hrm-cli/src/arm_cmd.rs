@@ -289,6 +289,7 @@ fn export(source: &str, format: Format, out: &Path, gravity: Option<&str>) -> Re
                 .to_string(),
         );
     }
+    crate::output_dir::refuse_inputs_inside(out, &[("source file", Path::new(source))])?;
     let (robot, default_gravity) = robot_of(source, format)?;
     let gravity = gravity
         .map(parse_gravity)

@@ -18,6 +18,7 @@ use std::path::Path;
 /// (diverges) writes its data up to the stop, then fails with the reason.
 pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Result<(), String> {
     let mut scenario = Scenario::resolve(name_or_path).map_err(|e| e.to_string())?;
+    refuse_scenario_inputs_inside(out, name_or_path, &scenario)?;
     if let Some(kind) = controller {
         scenario.controller.kind = kind
             .parse()
@@ -43,6 +44,23 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
         .result
         .map(|_| ())
         .map_err(|stopped| stopped.error.to_string())
+}
+
+/// Refuses an output folder `out` that holds the files of the scenario `name_or_path`: the
+/// scenario file itself, its `controller.fis` and its `arm.urdf`.
+pub fn refuse_scenario_inputs_inside(
+    out: &Path,
+    name_or_path: &str,
+    scenario: &Scenario,
+) -> Result<(), String> {
+    let mut inputs = vec![("scenario file", Path::new(name_or_path))];
+    if let Some(fis) = &scenario.controller.fis {
+        inputs.push(("controller.fis file", fis));
+    }
+    if let Some(urdf) = &scenario.arm.urdf {
+        inputs.push(("arm.urdf file", urdf));
+    }
+    crate::output_dir::refuse_inputs_inside(out, &inputs)
 }
 
 /// The main job: every shipped scenario with every controller (see [`experiments`]), each cut

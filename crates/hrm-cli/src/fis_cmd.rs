@@ -152,6 +152,7 @@ pub fn run(args: FisArgs) -> Result<(), String> {
         } => {
             let resolution = args::count("--resolution", resolution, 2, MAX_RESOLUTION)?;
             let system = read_system(&file)?;
+            crate::output_dir::refuse_inputs_inside(&out, &[("FIS file", &file)])?;
             let staging = OutputDir::create(&out, "fis surface")?;
             let written = surface(&system, staging.path(), resolution, reference.as_deref())?;
             staging.commit()?;

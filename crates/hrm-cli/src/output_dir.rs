@@ -217,6 +217,26 @@ pub fn refuse_input_as_output(out: &Path, inputs: &[(&str, &Path)]) -> Result<()
     Ok(())
 }
 
+/// Refuses, before any work, an output folder that holds one of the command's input files
+/// (`hrm simulate --scenario S/my.toml --out S`): replacing the folder would delete it.
+/// `inputs` are `(what, path)`; paths that do not exist are not inputs yet.
+pub fn refuse_inputs_inside(out: &Path, inputs: &[(&str, &Path)]) -> Result<(), String> {
+    let Ok(folder) = std::fs::canonicalize(out) else {
+        return Ok(());
+    };
+    for (what, input) in inputs {
+        if std::fs::canonicalize(input).is_ok_and(|file| file.starts_with(&folder)) {
+            return Err(format!(
+                "--out {}: holds the {what} {}, which replacing the folder would delete; choose \
+                 another --out or move the file out of it",
+                out.display(),
+                input.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Refuses, before any work, two outputs of one command that name the same file (`hrm view
 /// DIR --gif DIR/view.html`): each would replace the other. `outputs` are `(option, path)`.
 pub fn refuse_shared_outputs(outputs: &[(&str, &Path)]) -> Result<(), String> {
@@ -280,6 +300,21 @@ pub fn refuse_foreign_files(
         }
     }
     Ok(())
+}
+
+/// Refuses, before any work, to write a file of `hrm {command}` into `dir` when it is the output
+/// folder of another command ([`MARKER`]): that command replaces its folder whole, so the file
+/// would be lost (`hrm sweep --shard 1/2 --out S` after `hrm simulate --out S`). `what` names
+/// the file.
+pub fn refuse_marked_folder(dir: &Path, command: &str, what: &str) -> Result<(), String> {
+    match marker_command(dir) {
+        Some(other) if other != command => Err(format!(
+            "--out {}: holds the output of `hrm {other}`, which replaces its folder whole; \
+             write {what} into a folder of its own",
+            dir.display()
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Whether the regular file `path` holds a text `written_by_hrm` recognises, from its first

@@ -88,6 +88,9 @@ struct SweepArgs {
     out: PathBuf,
 }
 
+/// How a shard file hrm wrote begins: the first key of its header line.
+const SHARD_START: &[u8] = b"{\"format\":\"hrm-sweep-shard/";
+
 /// Runs `hrm sweep` or `hrm sweep merge`.
 pub fn run(cli: SweepCli) -> Result<(), String> {
     match cli.command {
@@ -108,6 +111,11 @@ pub fn run(cli: SweepCli) -> Result<(), String> {
                     let path = args
                         .out
                         .join(format!("shard-{}-of-{}.json", shard.index, shard.count));
+                    // Shards share a folder of their own, and replace only shard files.
+                    output_dir::refuse_marked_folder(&args.out, "sweep --shard", "the shard file")?;
+                    output_dir::refuse_foreign_file(&path, SHARD_START.len(), |start| {
+                        start == SHARD_START
+                    })?;
                     let mut counts = (0, 0);
                     output_dir::write_file_with(&path, "sweep --shard", |out| {
                         counts = write_shard(&config, shard, out)?;
@@ -205,6 +213,10 @@ fn configure(args: &SweepArgs) -> Result<SweepConfig, String> {
     };
     settings.check().map_err(|e| in_options(&e))?;
     let mut scenario = Scenario::resolve(&args.scenario).map_err(|e| e.to_string())?;
+    if args.shard.is_none() {
+        // The whole sweep replaces its folder; shards only add their files to theirs.
+        crate::experiment::refuse_scenario_inputs_inside(&args.out, &args.scenario, &scenario)?;
+    }
     if let Some(duration) = args.duration {
         scenario.duration = duration;
     }

@@ -681,3 +681,70 @@ fn shard_files_are_streamed_and_checked_line_by_line() {
     );
     std::fs::remove_dir_all(&root).unwrap();
 }
+
+#[test]
+fn a_shard_replaces_only_its_own_file_and_never_enters_another_commands_folder() {
+    let root = temp_dir("shard-guards");
+    let shard_args = |out: &Path| {
+        let out = out.to_str().unwrap().to_string();
+        move |extra: &[&str]| {
+            let mut args = vec![
+                "--scenario",
+                "paper-responses-step",
+                "--controllers",
+                "pd",
+                "--noise",
+                "0",
+                "--seeds",
+                "2",
+                "--duration",
+                "0.05",
+                "--shard",
+                "1/2",
+                "--out",
+            ];
+            args.push(&out);
+            args.extend_from_slice(extra);
+            hrm_sweep(&args)
+        }
+    };
+    // The user's own file of that name is refused, and left as it was.
+    let user = root.join("user");
+    std::fs::create_dir_all(&user).unwrap();
+    let mine = user.join("shard-1-of-2.json");
+    std::fs::write(&mine, "my notes").unwrap();
+    let err = shard_args(&user)(&[]).unwrap_err();
+    assert!(
+        err.contains("shard-1-of-2.json: exists and hrm did not write it"),
+        "{err}"
+    );
+    assert_eq!(read(&mine), "my notes");
+    // A shard file of hrm's is replaced (a shard run again).
+    std::fs::remove_file(&mine).unwrap();
+    shard_args(&user)(&[]).unwrap();
+    let first = read(&mine);
+    assert!(
+        first.starts_with("{\"format\":\"hrm-sweep-shard/"),
+        "{first}"
+    );
+    shard_args(&user)(&[]).unwrap();
+    assert_eq!(read(&mine), first);
+    // The output folder of another command, which replaces it whole, is refused.
+    let simulated = root.join("simulated");
+    std::fs::create_dir_all(&simulated).unwrap();
+    std::fs::write(
+        simulated.join(output_dir::MARKER),
+        "written by `hrm simulate`\n",
+    )
+    .unwrap();
+    let err = shard_args(&simulated)(&[]).unwrap_err();
+    assert!(
+        err.ends_with(
+            "simulated: holds the output of `hrm simulate`, which replaces its folder whole; \
+             write the shard file into a folder of its own"
+        ),
+        "{err}"
+    );
+    assert!(!simulated.join("shard-1-of-2.json").exists());
+    let _ = std::fs::remove_dir_all(&root);
+}

@@ -310,6 +310,80 @@ fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
 }
 
 #[test]
+fn an_output_folder_holding_the_commands_input_is_refused_before_it_is_replaced() {
+    // The scenario (and a FIS file) saved in an earlier output folder, then run into it: the
+    // replaced folder would take its inputs with it.
+    let dir = scratch("errors-input-inside-out");
+    let out = dir.join("out");
+    let first = hrm(&[
+        "simulate",
+        "--scenario",
+        path(&short_scenario(&dir)),
+        "--out",
+        path(&out),
+    ]);
+    assert!(first.status.success(), "{first:?}");
+    let inside = short_scenario(&out);
+    let before = snapshot(&out);
+    let line = refused(&hrm(&[
+        "simulate",
+        "--scenario",
+        path(&inside),
+        "--out",
+        path(&out),
+    ]));
+    assert!(
+        line.ends_with(&format!(
+            "out: holds the scenario file {}, which replacing the folder would delete; choose \
+             another --out or move the file out of it",
+            inside.display()
+        )),
+        "{line}"
+    );
+    let line = refused(&hrm(&[
+        "sweep",
+        "--scenario",
+        path(&inside),
+        "--seeds",
+        "1",
+        "--out",
+        path(&out),
+    ]));
+    assert!(line.contains("holds the scenario file"), "{line}");
+    let fis = out.join("mine.fis");
+    std::fs::copy(
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../fuzzy-sugeno/data/paper.fis"
+        ),
+        &fis,
+    )
+    .unwrap();
+    let line = refused(&hrm(&["fis", "surface", path(&fis), "--out", path(&out)]));
+    assert!(line.contains("holds the FIS file"), "{line}");
+    let with_fis = dir.join("with-fis.toml");
+    let text = std::fs::read_to_string(&inside).unwrap();
+    let text = text.replace(
+        "kind = \"fuzzy\"",
+        &format!("kind = \"fuzzy\"\nfis = {:?}", path(&fis)),
+    );
+    std::fs::write(&with_fis, text).unwrap();
+    let line = refused(&hrm(&[
+        "simulate",
+        "--scenario",
+        path(&with_fis),
+        "--out",
+        path(&out),
+    ]));
+    assert!(line.contains("holds the controller.fis file"), "{line}");
+    let mut after = before.clone();
+    after.push((fis.clone(), std::fs::read(&fis).unwrap()));
+    after.sort();
+    assert_eq!(snapshot(&out), after, "the output folder changed");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn a_failing_simulate_leaves_the_earlier_output_and_a_success_replaces_it() {
     let dir = scratch("errors-simulate-replace");
     let (scenario, out) = (short_scenario(&dir), dir.join("out"));
