@@ -353,6 +353,23 @@ impl SimError {
         }
     }
 
+    /// The setting error of entry `index` of the list `values` named by the setting: the name
+    /// gains `[index]` (0-based) where the entries differ, and is left whole where they are one
+    /// number (a scenario's single value for every joint). Other errors are returned as they are.
+    pub(crate) fn with_entry(self, values: &[f64], index: usize) -> Self {
+        match self {
+            Self::InvalidSetting { name, requirement }
+                if values.iter().any(|v| v.to_bits() != values[index].to_bits()) =>
+            {
+                Self::InvalidSetting {
+                    name: format!("{name}[{index}]"),
+                    requirement,
+                }
+            }
+            other => other,
+        }
+    }
+
     /// This error with its setting `from` named `to`, for a front end that spells the setting
     /// otherwise (`modal.harmonics` is a request's `harmonics`); any other error as it is.
     ///

@@ -1424,8 +1424,8 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
                 ),
             ));
         }
-        for &l in limits {
-            check_joint_torque_limit(l)?;
+        for (i, &l) in limits.iter().enumerate() {
+            check_joint_torque_limit(l).map_err(|e| e.with_entry(limits, i))?;
         }
     }
     if let Some(limits) = &s.joint_angle_limits {
@@ -1438,8 +1438,8 @@ fn validate(s: &LoopSettings, plant: Plant<'_>) -> Result<(), SimError> {
                 ),
             ));
         }
-        for &l in limits {
-            check_positive("limits.joint_angle_rad", l)?;
+        for (i, &l) in limits.iter().enumerate() {
+            check_positive("limits.joint_angle_rad", l).map_err(|e| e.with_entry(limits, i))?;
         }
     }
     if let Some(model) = &s.clearance

@@ -278,8 +278,19 @@ fn limits_that_cannot_hold_the_arm_stop_the_run_and_a_start_beyond_them_is_refus
             "limits.joint_angle_rad has 9 entries, the arm has 10 joints",
         ),
         (vec![-1.0; 10], "limits.joint_angle_rad must be positive"),
+        (
+            vec![2.0, 2.0, 2.0, -1.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0],
+            "limits.joint_angle_rad[3] must be positive and finite, got -1",
+        ),
     ] {
         let error = refused(step_run(|s| s.joint_angle_limits = Some(limits)));
         assert!(error.to_string().starts_with(message), "{error}");
     }
+    let mut limits = vec![100.0; 10];
+    limits[9] = f64::NAN;
+    let error = refused(step_run(|s| s.joint_torque_limits = Some(limits)));
+    assert_eq!(
+        error.to_string(),
+        "limits.joint_torque_nm[9] must be positive and finite, got NaN"
+    );
 }
