@@ -359,7 +359,9 @@ impl SimError {
     pub(crate) fn with_entry(self, values: &[f64], index: usize) -> Self {
         match self {
             Self::InvalidSetting { name, requirement }
-                if values.iter().any(|v| v.to_bits() != values[index].to_bits()) =>
+                if values
+                    .iter()
+                    .any(|v| v.to_bits() != values[index].to_bits()) =>
             {
                 Self::InvalidSetting {
                     name: format!("{name}[{index}]"),

@@ -748,3 +748,64 @@ fn a_shard_replaces_only_its_own_file_and_never_enters_another_commands_folder()
     assert!(!simulated.join("shard-1-of-2.json").exists());
     let _ = std::fs::remove_dir_all(&root);
 }
+
+#[test]
+fn a_shard_edited_with_its_digest_is_still_checked_as_a_sweep() {
+    // A hand-edited header whose digest was recomputed reads, but a scenario `hrm sweep` would
+    // refuse is not merged; nor is a failed run that stopped after its scenario's end.
+    let root = temp_dir("shard-edited");
+    let out = root.join("shards");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    hrm_sweep(&[
+        "--scenario",
+        "paper-responses-step",
+        "--controllers",
+        "pd",
+        "--noise",
+        "0",
+        "--seeds",
+        "2",
+        "--duration",
+        "0.05",
+        "--shard",
+        "1/1",
+        "--out",
+        &s(&out),
+    ])
+    .unwrap();
+    let path = out.join("shard-1-of-1.json");
+    let file = ShardFile::parse(&read(&path), &path).unwrap();
+    let mut bad = file.clone();
+    bad.config.scenario.duration = -1.0;
+    bad.config.inputs = sim_study::study::input_digests(&bad.config.scenario).unwrap();
+    let err = study::merge(vec![(path.clone(), bad)])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("shard-1-of-1.json holds an invalid sweep configuration: ")
+            && err.contains("duration"),
+        "{err}"
+    );
+    let mut late = file.clone();
+    late.runs[1].outcome = StoredOutcome::Failed {
+        error: "runaway".into(),
+        simulated_s: 1e308,
+    };
+    let err = study::merge(vec![(path.clone(), late)])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(
+            "run 1: simulated_s = 1e308 must be finite, non-negative and at most the scenario's \
+             duration, 0.05 s"
+        ),
+        "{err}"
+    );
+    let mut on_time = file;
+    on_time.runs[1].outcome = StoredOutcome::Failed {
+        error: "runaway".into(),
+        simulated_s: 0.05,
+    };
+    study::merge(vec![(path, on_time)]).unwrap();
+    let _ = std::fs::remove_dir_all(&root);
+}

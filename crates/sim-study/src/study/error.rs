@@ -260,9 +260,14 @@ pub enum ShardProblem {
         /// Which metric and why.
         source: MetricError,
     },
-    /// A failed run's simulated time that is negative or not finite.
-    #[error(": line {line}: run {run}: simulated_s = {value:e} must be finite and non-negative")]
+    /// A failed run's simulated time that is negative, not finite or past the scenario's
+    /// duration.
+    #[error(
+        ": line {line}: run {run}: simulated_s = {value:e} must be finite, non-negative and at most the scenario's duration, {duration} s"
+    )]
     SimulatedTime {
+        /// The scenario's duration (s).
+        duration: f64,
         /// The line.
         line: usize,
         /// The run.

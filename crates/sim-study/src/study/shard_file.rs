@@ -478,10 +478,15 @@ impl<R: ShardSource> ShardReader<R> {
                     })
                 })?;
         }
+        let duration = self.header.config.scenario.duration;
+        // A run stops at or before its end (the clock's rounding aside).
         if let StoredOutcome::Failed { simulated_s, .. } = &run.outcome
-            && !(simulated_s.is_finite() && *simulated_s >= 0.0)
+            && !(simulated_s.is_finite()
+                && *simulated_s >= 0.0
+                && *simulated_s <= duration * (1.0 + 1e-9))
         {
             return Err(refuse(ShardProblem::SimulatedTime {
+                duration,
                 line,
                 run: run.index,
                 value: *simulated_s,
@@ -626,6 +631,16 @@ pub fn merge_readers<R: ShardSource>(
             });
         }
     }
+    // The scenario as `hrm sweep` checks it: a header edited by hand (with its digest) is
+    // read, but a sweep that could not have run is not merged.
+    config.check_builds().map_err(|source| {
+        StudyError::shard_file(
+            &first_path,
+            ShardProblem::InvalidConfig {
+                source: Box::new(source),
+            },
+        )
+    })?;
     shards.sort_by_key(|s| s.header.shard.index);
     if let Some(pair) = shards
         .windows(2)
