@@ -777,7 +777,7 @@ fn a_shard_edited_with_its_digest_is_still_checked_as_a_sweep() {
     let file = ShardFile::parse(&read(&path), &path).unwrap();
     let mut bad = file.clone();
     bad.config.scenario.duration = -1.0;
-    bad.config.inputs = sim_study::study::input_digests(&bad.config.scenario).unwrap();
+    bad.config.inputs = study::input_digests(&bad.config.scenario).unwrap();
     let err = study::merge(vec![(path.clone(), bad)])
         .unwrap_err()
         .to_string();
