@@ -248,7 +248,10 @@ mod tests {
     #[test]
     fn the_example_step_converges_in_joint_space() {
         let scenario = Scenario::load(&example("step.toml")).unwrap();
-        assert_eq!(scenario.arm.urdf, Some(example("arm7.urdf")));
+        assert_eq!(
+            scenario.arm.urdf,
+            Some(std::fs::canonicalize(example("arm7.urdf")).unwrap())
+        );
         let run = scenario.run_chain().unwrap();
         let summary = &run.summary;
         // e'' + 40 e' + 400 e = 0 after the step at 0.1 s: (1 + 20 t) exp(-20 t) of the step's

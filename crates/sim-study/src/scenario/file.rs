@@ -53,7 +53,9 @@ impl Scenario {
     }
 
     /// Reads a scenario file; a relative `controller.fis` or `arm.urdf` path is taken relative to
-    /// the file.
+    /// the file, and made absolute (its links resolved where it exists), so that the scenario an
+    /// output writes back
+    /// ([`to_toml`](Self::to_toml)) runs again from wherever it is.
     pub fn load(path: &Path) -> Result<Self, ScenarioError> {
         let text = crate::read_text_file(path, crate::MAX_INPUT_FILE_BYTES).map_err(|e| {
             ScenarioError::Io {
@@ -68,7 +70,10 @@ impl Scenario {
                 .flatten()
             {
                 if file.is_relative() {
-                    *file = dir.join(&*file);
+                    let joined = dir.join(&*file);
+                    *file = std::fs::canonicalize(&joined)
+                        .or_else(|_| std::path::absolute(&joined))
+                        .unwrap_or(joined);
                 }
             }
         }

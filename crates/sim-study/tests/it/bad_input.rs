@@ -418,7 +418,7 @@ fn torque_limits_wrong_length_or_not_positive() {
             joint_torque_limits: Some(limits),
             ..settings()
         };
-        assert_eq!(invalid(build(s)).0, "limits.joint_torque_nm", "{bad}");
+        assert_eq!(invalid(build(s)).0, "limits.joint_torque_nm[3]", "{bad}");
     }
 }
 

@@ -678,6 +678,18 @@ fn a_fis_file_replaces_the_paper_system() {
         loaded.controller.fis.as_deref(),
         Some(dir.join("soft.fis").as_path())
     );
+    // Loaded by a path relative to the working folder (the package's, under cargo), the file's
+    // path is absolute, so that the scenario written back elsewhere runs again.
+    let cwd = std::env::current_dir().unwrap();
+    let up = "../".repeat(cwd.components().count() - 1);
+    let relative = std::path::PathBuf::from(up).join(dir.strip_prefix("/").unwrap());
+    let again = Scenario::load(&relative.join("soft.toml")).unwrap();
+    assert_eq!(again.controller.fis, loaded.controller.fis);
+    let elsewhere = dir.join("elsewhere");
+    std::fs::create_dir_all(&elsewhere).unwrap();
+    std::fs::write(elsewhere.join("scenario.toml"), again.to_toml()).unwrap();
+    let written_back = Scenario::load(&elsewhere.join("scenario.toml")).unwrap();
+    assert_eq!(written_back.controller.fis, loaded.controller.fis);
     let with_file = loaded.build().unwrap().run().unwrap();
     let mut paper = loaded.clone();
     paper.controller.fis = None;
