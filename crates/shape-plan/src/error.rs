@@ -86,6 +86,25 @@ pub enum PlanError {
         /// The arm's length, m.
         length: f64,
     },
+    /// The target is nearer an obstacle than a link's capsule around it may be: no shape whose
+    /// tip is there keeps the clearance.
+    #[error(
+        "target is within obstacles[{obstacle}]'s margin: a link ending there (radius {} m) \
+         keeps {} m from it, less than the {} m every link must keep",
+        Compact(*.radius),
+        Compact(*.clearance),
+        Compact(*.needed)
+    )]
+    TargetTooClose {
+        /// The obstacle's index (0-based, in the model's order).
+        obstacle: usize,
+        /// The links' radius, m.
+        radius: f64,
+        /// The clearance of a link ending at the target from that obstacle, m.
+        clearance: f64,
+        /// The clearance every shape must keep, m.
+        needed: f64,
+    },
     /// A number outside its domain.
     #[error("{name} must be {bound}, got {}", Compact(*.value))]
     OutOfRange {
@@ -150,6 +169,7 @@ impl Classify for PlanError {
             Self::NoCollisionFreeShape { .. }
             | Self::NoCollisionFreeMotion { .. }
             | Self::DeployFoldsOnItself { .. }
+            | Self::TargetTooClose { .. }
             | Self::OutOfReach { .. } => ErrorClass::Unreachable,
             Self::Clearance(error) => error.class(),
             Self::Kinematics(error) => error.class(),

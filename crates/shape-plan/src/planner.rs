@@ -112,6 +112,8 @@ impl<A: Arm> Planner<A> {
     ///
     /// Errors: [`PlanError::InitialTooClose`] when `initial` keeps less than `c + epsilon`;
     /// [`PlanError::OutOfReach`] for a target beyond the arm's length;
+    /// [`PlanError::TargetTooClose`] for a target whose link would come nearer an obstacle than
+    /// the clearance;
     /// [`PlanError::NoCollisionFreeShape`] (with the best shape reached) when no start reaches
     /// the target with the clearance; [`PlanError::NoCollisionFreeMotion`] when goals were found
     /// but no checked path leads to one; input errors for sizes and non-finite numbers.
@@ -145,6 +147,23 @@ impl<A: Arm> Planner<A> {
         if initial_clearance < needed {
             return Err(PlanError::InitialTooClose {
                 clearance: initial_clearance,
+                needed,
+            });
+        }
+        // The tip ends a link, whose capsule keeps the margin only if the target does.
+        let radius = self.clearance.radius();
+        let near = self
+            .clearance
+            .obstacles()
+            .iter()
+            .map(|obstacle| obstacle.signed_distance(goal_point) - radius)
+            .enumerate()
+            .find(|&(_, clearance)| clearance < needed);
+        if let Some((obstacle, clearance)) = near {
+            return Err(PlanError::TargetTooClose {
+                obstacle,
+                radius,
+                clearance,
                 needed,
             });
         }

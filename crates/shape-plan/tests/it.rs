@@ -278,6 +278,34 @@ fn refusals_name_the_problem() {
         matches!(far, PlanError::OutOfReach { .. }) && far.is_unreachable(),
         "{far}"
     );
+    // A target within an obstacle's margin (the second circle's surface plus the links' radius
+    // and half the clearance): no link can end there, and the message says which obstacle.
+    let [_, second] = [circles[0], circles[1]];
+    let gap = RADIUS + 0.5 * options().clearance;
+    let near = [second.center[0] + second.radius + gap, second.center[1]];
+    let close = p.plan(&[0.0; 4], &near).unwrap_err();
+    let PlanError::TargetTooClose {
+        obstacle,
+        clearance,
+        needed,
+        ..
+    } = close
+    else {
+        panic!("{close}")
+    };
+    assert_eq!(obstacle, 1);
+    assert!(
+        (clearance - 0.5 * options().clearance).abs() < 1e-15,
+        "{clearance}"
+    );
+    assert_eq!(needed, options().needed());
+    assert!(close.is_unreachable());
+    assert!(
+        close
+            .to_string()
+            .starts_with("target is within obstacles[1]'s margin: a link ending there (radius "),
+        "{close}"
+    );
     // A target whose squared distance overflows is still that far in the message.
     let very_far = p.plan(&[0.0; 4], &[1e300, -1e300]).unwrap_err();
     assert!(

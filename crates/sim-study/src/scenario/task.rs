@@ -207,7 +207,7 @@ fn task_field(e: PlanError) -> SimError {
             _ => "task",
         },
         PlanError::TooMuchWork { .. } => "task.samples",
-        PlanError::OutOfReach { .. } => "task.target",
+        PlanError::OutOfReach { .. } | PlanError::TargetTooClose { .. } => "task.target",
         PlanError::InitialTooClose { .. } => "initial.a",
         _ => "task",
     };

@@ -137,10 +137,12 @@ fn tasks_and_planned_references_come_together_and_name_their_fields() {
     let mut roomy = base.clone();
     roomy.limits.joint_angle_rad = Some(AngleLimit::All(3.0));
     assert!(roomy.build().is_ok());
-    // A target inside an obstacle: no collision-free shape, the best clearance reported.
+    // A target inside an obstacle, or within its margin: refused before any start, naming the
+    // obstacle.
     let e = with(&|s| set(s, vec![-0.14, 0.36], 0.01));
     assert!(
-        e.starts_with("task cannot be met: no collision-free shape found"),
+        e.starts_with("task.target cannot be met: target is within obstacles[")
+            && e.ends_with("less than the 0.011 m every link must keep"),
         "{e}"
     );
     // A start a plan cannot move from, and zero iterations, are refused by their keys.
@@ -192,7 +194,7 @@ fn tasks_and_planned_references_come_together_and_name_their_fields() {
         s.build().err().unwrap().to_string()
     };
     assert!(
-        e.starts_with("task cannot be met: no collision-free shape found"),
+        e.starts_with("task.target cannot be met: target is within obstacles[0]'s margin"),
         "{e}"
     );
     let text = base.to_toml();
