@@ -85,6 +85,16 @@ impl Channel {
         })
     }
 
+    /// The centreline's polyline.
+    pub(crate) fn line(&self) -> &Polyline {
+        &self.line
+    }
+
+    /// The number of centreline points.
+    pub(crate) fn n_points(&self) -> usize {
+        self.points.len()
+    }
+
     /// The centreline's length.
     pub fn length(&self) -> f64 {
         self.arcs.last().copied().unwrap_or(0.0)
@@ -125,10 +135,13 @@ impl Channel {
 
     /// The distance of `x` from the guide (the axis behind the entry) and the centreline.
     pub fn distance(&self, x: [f64; 2]) -> f64 {
+        self.guide_distance(x).min(self.line.distance(x))
+    }
+
+    /// The distance of `x` from the guide, the ray `E - s d`, `s >= 0`.
+    pub(crate) fn guide_distance(&self, x: [f64; 2]) -> f64 {
         let (e, d) = (self.entry(), self.axis());
-        // The ray E - s d, s >= 0.
         let along = ((x[0] - e[0]) * d[0] + (x[1] - e[1]) * d[1]).min(0.0);
-        let guide = dist(x, [e[0] + along * d[0], e[1] + along * d[1]]);
-        guide.min(self.line.distance(x))
+        dist(x, [e[0] + along * d[0], e[1] + along * d[1]])
     }
 }

@@ -4,12 +4,13 @@
 
 use crate::channel::Channel;
 use crate::error::PlanError;
+use crate::farthest::FarthestScratch;
 use crate::polyline::{Polyline, dist, point_segment};
 use clearance::segment_segment;
 use lane_math::check_finite;
 
-/// Points per link at which the body's distances to the path and the walls are sampled (both
-/// ends included).
+/// Points per link at which the body's distance to the traced path is sampled (both ends
+/// included).
 pub const SAMPLES_PER_LINK: usize = 32;
 
 /// The most work the metrics of a deployment's shapes may take ([`deploy_metric_work`]): about
@@ -34,11 +35,13 @@ pub struct DeployMetrics {
     pub tip_error: f64,
     /// The largest distance of the body from the path its tip traced (joined to the entry and
     /// the guide behind it), as a percentage of the deployed length at that shape (at least the
-    /// shortest link).
+    /// shortest link), sampled at [`SAMPLES_PER_LINK`] + 1 points a link.
     pub shape_deviation_percent: f64,
-    /// The smallest clearance of the links' capsules to the channel's walls, m (sampled at
-    /// [`SAMPLES_PER_LINK`] points a link; the sampling can overstate it by at most
-    /// `L_max / 64`).
+    /// The smallest clearance of the links' capsules to the channel's walls, m: the channel's
+    /// radius less the link radius and the largest distance of a link's point from the
+    /// centreline and the guide ([`Channel::farthest`]: exact to `1e-14` of a link's length or
+    /// coordinates; where more than [`MAX_NEAR_FEATURES`](crate::MAX_NEAR_FEATURES) centreline
+    /// segments lie near a link, at most `L / 128` below the exact one, never above it).
     pub min_wall_clearance: f64,
     /// The smallest clearance between two links' capsules that share no joint, m (exact;
     /// `+inf` below three links): negative where the body overlaps itself.
@@ -82,6 +85,8 @@ pub struct DeployTracker<'c> {
     shortest: f64,
     /// The tip's path so far.
     traced: Polyline,
+    /// The work of the wall clearance's [`Channel::farthest`].
+    farthest: FarthestScratch,
     metrics: DeployMetrics,
 }
 
@@ -114,6 +119,7 @@ impl<'c> DeployTracker<'c> {
             link_radius,
             shortest,
             traced: Polyline::default(),
+            farthest: FarthestScratch::for_channel(channel)?,
             metrics: DeployMetrics {
                 tip_error: 0.0,
                 shape_deviation_percent: 0.0,
@@ -155,15 +161,16 @@ impl<'c> DeployTracker<'c> {
         };
         let mut deviation: f64 = 0.0;
         for pair in points.windows(2) {
+            let farthest = channel.farthest(pair[0], pair[1], &mut self.farthest);
+            sample.wall_clearance = sample
+                .wall_clearance
+                .min(channel.radius() - self.link_radius - farthest);
             for s in 0..=SAMPLES_PER_LINK {
                 let t = s as f64 / SAMPLES_PER_LINK as f64;
                 let x = [
                     pair[0][0] + t * (pair[1][0] - pair[0][0]),
                     pair[0][1] + t * (pair[1][1] - pair[0][1]),
                 ];
-                sample.wall_clearance = sample
-                    .wall_clearance
-                    .min(channel.radius() - self.link_radius - channel.distance(x));
                 deviation = deviation.max(traced_distance(channel, &self.traced, x));
             }
         }

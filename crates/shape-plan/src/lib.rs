@@ -6,6 +6,7 @@ mod data;
 mod deploy;
 mod deploy_metrics;
 mod error;
+mod farthest;
 mod generator;
 mod motion;
 mod options;
@@ -24,6 +25,7 @@ pub use deploy_metrics::{
     deploy_metric_work,
 };
 pub use error::PlanError;
+pub use farthest::{FALLBACK_SAMPLES, FarthestScratch, MAX_FARTHEST_INTERVALS, MAX_NEAR_FEATURES};
 pub use generator::{
     MAX_PASSAGE_OBSTACLES, NarrowPassage, PassageSpec, narrow_passage, spatial_narrow_passage,
 };

@@ -62,6 +62,27 @@ impl Polyline {
         self.points.first().copied()
     }
 
+    /// Calls `visit` with every segment of the chunks whose box lies within `reach` of the box
+    /// `low`-`high` (a superset of the segments within `reach` of any point of that box).
+    pub(crate) fn segments_near(
+        &self,
+        [low, high]: [[f64; 2]; 2],
+        reach: f64,
+        mut visit: impl FnMut([f64; 2], [f64; 2]),
+    ) {
+        for (c, [box_low, box_high]) in self.boxes.iter().enumerate() {
+            let dx = (box_low[0] - high[0]).max(low[0] - box_high[0]).max(0.0);
+            let dy = (box_low[1] - high[1]).max(low[1] - box_high[1]).max(0.0);
+            if dx.hypot(dy) > reach {
+                continue;
+            }
+            let end = ((c + 1) * CHUNK + 1).min(self.points.len());
+            for pair in self.points[c * CHUNK..end].windows(2) {
+                visit(pair[0], pair[1]);
+            }
+        }
+    }
+
     /// The distance of `x` from the polyline (`+inf` without a segment): the least
     /// [`point_segment`] over its segments, the same number as
     /// measuring every one. The chunk whose box is nearest is measured first; then every chunk

@@ -197,3 +197,96 @@ fn self_clearance_is_the_smallest_over_links_that_share_no_joint() {
         );
     }
 }
+
+/// The distance of `x` from the guide behind `centerline[0]` (the ray back along the first
+/// segment) and the centreline, measured as the test's own geometry: every segment.
+fn centreline_distance(centerline: &[[f64; 2]], x: [f64; 2]) -> f64 {
+    let point_segment = |a: [f64; 2], b: [f64; 2]| {
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let t = (((x[0] - a[0]) * d[0] + (x[1] - a[1]) * d[1]) / (d[0] * d[0] + d[1] * d[1]))
+            .clamp(0.0, 1.0);
+        dist(x, [a[0] + t * d[0], a[1] + t * d[1]])
+    };
+    let (e, f) = (centerline[0], centerline[1]);
+    let u = [(f[0] - e[0]) / dist(e, f), (f[1] - e[1]) / dist(e, f)];
+    let behind = ((x[0] - e[0]) * u[0] + (x[1] - e[1]) * u[1]).min(0.0);
+    let guide = dist(x, [e[0] + behind * u[0], e[1] + behind * u[1]]);
+    centerline.windows(2).fold(guide, |best, pair| {
+        best.min(point_segment(pair[0], pair[1]))
+    })
+}
+
+#[test]
+fn the_farthest_point_of_a_link_cutting_a_corner_is_where_both_walls_are_equally_far() {
+    // A right-angle corner: along the link from (0, 0.3) to (0.6, 1) the distances to the two
+    // legs are 0.6 t and 0.7 (1 - t), equal at t = 7/13, where the link is 0.42/1.3 from the
+    // centreline; the 33 samples of the traced path miss that point by 2 mm.
+    let channel = Channel::new(&[[0.0, 0.0], [0.0, 1.0], [1.0, 1.0]], 0.5).unwrap();
+    let mut scratch = shape_plan::FarthestScratch::default();
+    let farthest = channel.farthest([0.0, 0.3], [0.6, 1.0], &mut scratch);
+    assert!((farthest - 0.42 / 1.3).abs() < 1e-13, "{farthest}");
+    let sampled = (0..=32)
+        .map(|s| {
+            let t = f64::from(s) / 32.0;
+            channel.distance([0.6 * t, 0.3 + 0.7 * t])
+        })
+        .fold(0.0, f64::max);
+    assert!(farthest - sampled > 1e-3, "{sampled}");
+}
+
+#[test]
+fn the_farthest_point_of_random_links_in_random_channels_is_the_dense_samples_largest() {
+    // Random walks of 3 to 40 points as centrelines and random segments around them: the answer
+    // lies between the largest of 20,001 samples of the segment (less 1e-14 of its scale) and
+    // that largest plus the half sample spacing the distance (1-Lipschitz) can rise between two
+    // samples.
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let mut scratch = shape_plan::FarthestScratch::default();
+    for case in 0..300 {
+        let mut centerline = vec![[0.0, 0.0]];
+        for _ in 0..rng.random_range(2..40) {
+            let last = centerline[centerline.len() - 1];
+            let angle: f64 = rng.random_range(-3.0..3.0);
+            let step = rng.random_range(0.01..0.3);
+            centerline.push([last[0] + step * angle.cos(), last[1] + step * angle.sin()]);
+        }
+        let channel = Channel::new(&centerline, 0.1).unwrap();
+        let mut around = || [rng.random_range(-1.0..1.5), rng.random_range(-1.0..1.5)];
+        let (p, q) = (around(), around());
+        let farthest = channel.farthest(p, q, &mut scratch);
+        let samples = 20_000;
+        let sampled = (0..=samples)
+            .map(|s| {
+                let t = f64::from(s) / f64::from(samples);
+                let x = [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
+                centreline_distance(&centerline, x)
+            })
+            .fold(0.0, f64::max);
+        let length = dist(p, q);
+        assert!(
+            farthest >= sampled - 1e-14 * length.max(1.5) - 1e-15
+                && farthest <= sampled + 0.5 * length / f64::from(samples) + 1e-15,
+            "case {case}: {farthest} against {sampled} sampled"
+        );
+    }
+}
+
+#[test]
+fn a_link_among_more_centreline_segments_than_the_bound_takes_is_never_overstated() {
+    // 2,000 collinear points: every segment within reach of the link, more than
+    // MAX_NEAR_FEATURES, so the distance is sampled, and the answer is never below the exact
+    // farthest distance (0.03 m, at the link's end) nor above it by more than L / 128.
+    let centerline: Vec<[f64; 2]> = (0..2000).map(|k| [f64::from(k) / 1999.0, 0.0]).collect();
+    let channel = Channel::new(&centerline, 0.1).unwrap();
+    let mut scratch = shape_plan::FarthestScratch::default();
+    let (p, q) = ([0.2, 0.01], [0.5, 0.03]);
+    let farthest = channel.farthest(p, q, &mut scratch);
+    let length = dist(p, q);
+    assert!(
+        farthest >= 0.03 && farthest <= 0.03 + length / 128.0,
+        "{farthest}"
+    );
+    // A few segments near it: exact.
+    let sparse = Channel::new(&[[0.0, 0.0], [0.4, 0.0], [1.0, 0.0]], 0.1).unwrap();
+    assert!((sparse.farthest(p, q, &mut scratch) - 0.03).abs() < 1e-16);
+}

@@ -130,9 +130,9 @@ fn pipe_deploy_reaches_the_end_with_the_body_inside_the_channel() {
         run.plan
     );
     // The metrics from the points with this file's own geometry: the same tip error and
-    // deviation at the same 32 points a link; denser sampling can only find less clearance, by
-    // at most L / 64.
-    let (tip, deviation, clearance) = recompute(&scenario, &run, 32);
+    // deviation at the same 32 points a link; the wall clearance is exact, so samples of the
+    // links (256 a link of 0.1 m) find at least as much, at most half their spacing more.
+    let (tip, deviation, _) = recompute(&scenario, &run, 32);
     assert!(
         (tip - m.tip_error).abs() < 1e-12,
         "{tip} vs {}",
@@ -142,12 +142,11 @@ fn pipe_deploy_reaches_the_end_with_the_body_inside_the_channel() {
         (deviation - m.shape_deviation_percent).abs() < 1e-9,
         "{deviation} vs {m:?}"
     );
-    assert!(
-        (clearance - m.min_wall_clearance).abs() < 1e-12,
-        "{clearance} vs {m:?}"
-    );
     let (_, _, dense) = recompute(&scenario, &run, 256);
-    assert!(dense <= m.min_wall_clearance + 1e-12 && dense > m.min_wall_clearance - 0.1 / 64.0);
+    assert!(
+        m.min_wall_clearance <= dense + 1e-12 && dense <= m.min_wall_clearance + 0.1 / 512.0,
+        "{dense} vs {m:?}"
+    );
 }
 
 #[test]
@@ -188,7 +187,10 @@ fn mpc_deploys_pipe_deploy_as_well_as_computed_torque_within_its_box() {
     let (tip, deviation, clearance) = recompute(&scenario, &run, 32);
     assert!((tip - m.tip_error).abs() < 1e-12, "{tip} vs {m:?}");
     assert!((deviation - m.shape_deviation_percent).abs() < 1e-9);
-    assert!((clearance - m.min_wall_clearance).abs() < 1e-12);
+    assert!(
+        m.min_wall_clearance <= clearance + 1e-12 && clearance <= m.min_wall_clearance + 0.1 / 64.0,
+        "{clearance} vs {m:?}"
+    );
 }
 
 /// `[limits] joint_torque_nm` is the deployment MPC's box on the revolute joints: over the
