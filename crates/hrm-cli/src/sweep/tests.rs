@@ -50,6 +50,20 @@ const SMALL: &[&str] = &[
     "42",
 ];
 
+/// The smallest sweep: one controller, no noise, 2 seeds of 0.05 s.
+const TINY: &[&str] = &[
+    "--scenario",
+    "paper-responses-step",
+    "--controllers",
+    "pd",
+    "--noise",
+    "0",
+    "--seeds",
+    "2",
+    "--duration",
+    "0.05",
+];
+
 fn with<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
     base.iter().chain(extra).copied().collect()
 }
@@ -687,33 +701,14 @@ fn a_shard_replaces_only_its_own_file_and_never_enters_another_commands_folder()
     let root = temp_dir("shard-guards");
     let shard_args = |out: &Path| {
         let out = out.to_str().unwrap().to_string();
-        move |extra: &[&str]| {
-            let mut args = vec![
-                "--scenario",
-                "paper-responses-step",
-                "--controllers",
-                "pd",
-                "--noise",
-                "0",
-                "--seeds",
-                "2",
-                "--duration",
-                "0.05",
-                "--shard",
-                "1/2",
-                "--out",
-            ];
-            args.push(&out);
-            args.extend_from_slice(extra);
-            hrm_sweep(&args)
-        }
+        move || hrm_sweep(&with(TINY, &["--shard", "1/2", "--out", &out]))
     };
     // The user's own file of that name is refused, and left as it was.
     let user = root.join("user");
     std::fs::create_dir_all(&user).unwrap();
     let mine = user.join("shard-1-of-2.json");
     std::fs::write(&mine, "my notes").unwrap();
-    let err = shard_args(&user)(&[]).unwrap_err();
+    let err = shard_args(&user)().unwrap_err();
     assert!(
         err.contains("shard-1-of-2.json: exists and hrm did not write it"),
         "{err}"
@@ -721,13 +716,13 @@ fn a_shard_replaces_only_its_own_file_and_never_enters_another_commands_folder()
     assert_eq!(read(&mine), "my notes");
     // A shard file of hrm's is replaced (a shard run again).
     std::fs::remove_file(&mine).unwrap();
-    shard_args(&user)(&[]).unwrap();
+    shard_args(&user)().unwrap();
     let first = read(&mine);
     assert!(
         first.starts_with("{\"format\":\"hrm-sweep-shard/"),
         "{first}"
     );
-    shard_args(&user)(&[]).unwrap();
+    shard_args(&user)().unwrap();
     assert_eq!(read(&mine), first);
     // The output folder of another command, which replaces it whole, is refused.
     let simulated = root.join("simulated");
@@ -737,7 +732,7 @@ fn a_shard_replaces_only_its_own_file_and_never_enters_another_commands_folder()
         "written by `hrm simulate`\n",
     )
     .unwrap();
-    let err = shard_args(&simulated)(&[]).unwrap_err();
+    let err = shard_args(&simulated)().unwrap_err();
     assert!(
         err.ends_with(
             "simulated: holds the output of `hrm simulate`, which replaces its folder whole; \
@@ -756,23 +751,7 @@ fn a_shard_edited_with_its_digest_is_still_checked_as_a_sweep() {
     let root = temp_dir("shard-edited");
     let out = root.join("shards");
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    hrm_sweep(&[
-        "--scenario",
-        "paper-responses-step",
-        "--controllers",
-        "pd",
-        "--noise",
-        "0",
-        "--seeds",
-        "2",
-        "--duration",
-        "0.05",
-        "--shard",
-        "1/1",
-        "--out",
-        &s(&out),
-    ])
-    .unwrap();
+    hrm_sweep(&with(TINY, &["--shard", "1/1", "--out", &s(&out)])).unwrap();
     let path = out.join("shard-1-of-1.json");
     let file = ShardFile::parse(&read(&path), &path).unwrap();
     let mut bad = file.clone();

@@ -351,14 +351,7 @@ fn an_output_folder_holding_the_commands_input_is_refused_before_it_is_replaced(
     ]));
     assert!(line.contains("holds the scenario file"), "{line}");
     let fis = out.join("mine.fis");
-    std::fs::copy(
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../fuzzy-sugeno/data/paper.fis"
-        ),
-        &fis,
-    )
-    .unwrap();
+    std::fs::write(&fis, include_str!("../../../fuzzy-sugeno/data/paper.fis")).unwrap();
     let line = refused(&hrm(&["fis", "surface", path(&fis), "--out", path(&out)]));
     assert!(line.contains("holds the FIS file"), "{line}");
     let with_fis = dir.join("with-fis.toml");
