@@ -482,11 +482,27 @@ fn check_name_length(shown: &Path, name_bytes: usize, what: &str) -> Result<(), 
 }
 
 /// The command named by the [`MARKER`] of `dir` (`simulate`, `sweep --shard`), if it has one.
+/// Only a regular file's first [`MARKER_BYTES`] are read (a FIFO, `/dev/zero` linked in, or a
+/// gigabyte of zeros is no marker).
 fn marker_command(dir: &Path) -> Option<String> {
-    let text = std::fs::read_to_string(dir.join(MARKER)).ok()?;
-    let command = text.split('`').nth(1)?.strip_prefix("hrm ")?;
-    Some(command.to_string())
+    use std::io::Read;
+    let path = dir.join(MARKER);
+    if !std::fs::metadata(&path).is_ok_and(|meta| meta.is_file()) {
+        return None;
+    }
+    let mut start = Vec::new();
+    std::fs::File::open(&path)
+        .ok()?
+        .take(MARKER_BYTES)
+        .read_to_end(&mut start)
+        .ok()?;
+    let text = std::str::from_utf8(&start).ok()?;
+    let command = text.lines().next()?.strip_prefix("written by `hrm ")?;
+    Some(command.strip_suffix('`')?.to_string())
 }
+
+/// The most bytes of a [`MARKER`] read: its line names one command.
+const MARKER_BYTES: u64 = 256;
 
 /// The kind of output a command writes: `sweep` and `sweep merge` write the same.
 fn kind(command: &str) -> &str {
@@ -582,9 +598,9 @@ fn make_writable(dir: &Path) {
     }
 }
 
-/// Whether `dir` holds the [`MARKER`].
+/// Whether `dir` holds a [`MARKER`] naming a command.
 fn is_output(dir: &Path) -> bool {
-    dir.join(MARKER).is_file()
+    marker_command(dir).is_some()
 }
 
 /// Whether the folder `dir` may be replaced: it is an output folder, or holds only output
@@ -654,6 +670,36 @@ mod tests {
             .collect();
         names.sort();
         names
+    }
+
+    #[test]
+    fn only_a_small_regular_marker_naming_a_command_marks_a_folder() {
+        // A FIFO (reading it waited for ever), `/dev/zero` linked in (read without end) and a
+        // marker of zeros are no markers: the folder is the user's, and is not replaced.
+        let root = scratch("marker-kinds");
+        let fifo = root.join("fifo");
+        std::fs::create_dir_all(&fifo).unwrap();
+        let made = std::process::Command::new("mkfifo")
+            .arg(fifo.join(MARKER))
+            .status();
+        assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+        let zero = root.join("zero");
+        std::fs::create_dir_all(&zero).unwrap();
+        std::os::unix::fs::symlink("/dev/zero", zero.join(MARKER)).unwrap();
+        let zeros = root.join("zeros");
+        std::fs::create_dir_all(&zeros).unwrap();
+        std::fs::write(zeros.join(MARKER), vec![0u8; 1 << 20]).unwrap();
+        for dir in [&fifo, &zero, &zeros] {
+            assert_eq!(marker_command(dir), None, "{}", dir.display());
+            assert!(!replaceable(dir), "{}", dir.display());
+            assert!(refuse_marked_folder(dir, "sweep --shard", "a file").is_ok());
+        }
+        let marked = root.join("marked");
+        std::fs::create_dir_all(&marked).unwrap();
+        std::fs::write(marked.join(MARKER), "written by `hrm sweep --shard`\n").unwrap();
+        assert_eq!(marker_command(&marked).as_deref(), Some("sweep --shard"));
+        assert!(refuse_marked_folder(&marked, "simulate", "a file").is_err());
+        std::fs::remove_dir_all(&root).unwrap();
     }
 
     #[test]

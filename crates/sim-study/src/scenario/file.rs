@@ -65,15 +65,35 @@ impl Scenario {
         })?;
         let mut scenario = parse(&text, &path.display().to_string())?;
         if let Some(dir) = path.parent() {
-            for file in [&mut scenario.controller.fis, &mut scenario.arm.urdf]
-                .into_iter()
-                .flatten()
-            {
-                if file.is_relative() {
-                    let joined = dir.join(&*file);
-                    *file = std::fs::canonicalize(&joined)
-                        .or_else(|_| std::path::absolute(&joined))
-                        .unwrap_or(joined);
+            let fields = [
+                ("controller.fis", &mut scenario.controller.fis),
+                ("arm.urdf", &mut scenario.arm.urdf),
+            ];
+            for (field, file) in fields {
+                let Some(file) = file.as_mut().filter(|file| file.is_relative()) else {
+                    continue;
+                };
+                let joined = dir.join(&*file);
+                let absolute = std::fs::canonicalize(&joined)
+                    .or_else(|_| std::path::absolute(&joined))
+                    .unwrap_or_else(|_| joined.clone());
+                // A folder name that is not UTF-8 above the working folder keeps the path
+                // relative; one the scenario's text cannot hold is refused here, not when an
+                // output writes the scenario back.
+                *file = if absolute.to_str().is_some() {
+                    absolute
+                } else {
+                    joined
+                };
+                if file.to_str().is_none() {
+                    return Err(ScenarioError::Parse {
+                        origin: path.display().to_string(),
+                        message: format!(
+                            "{field}: the path {} is not UTF-8, which a scenario written back as \
+                             TOML cannot hold: move the scenario or the file to a UTF-8 path",
+                            file.display()
+                        ),
+                    });
                 }
             }
         }

@@ -659,6 +659,7 @@ fn malformed_scenarios_are_refused_with_the_problem_named() {
 
 #[test]
 fn a_fis_file_replaces_the_paper_system() {
+    use std::os::unix::ffi::OsStrExt;
     let dir = std::env::temp_dir().join(format!("sim-core-fis-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let soft = fuzzy_sugeno::PaperController {
@@ -690,6 +691,18 @@ fn a_fis_file_replaces_the_paper_system() {
     std::fs::write(elsewhere.join("scenario.toml"), again.to_toml()).unwrap();
     let written_back = Scenario::load(&elsewhere.join("scenario.toml")).unwrap();
     assert_eq!(written_back.controller.fis, loaded.controller.fis);
+    // In a folder whose name is not UTF-8 the file's path cannot be written back: refused on
+    // load (an output's scenario.toml panicked).
+    let odd = dir.join(std::ffi::OsStr::from_bytes(b"odd\xff"));
+    std::fs::create_dir_all(&odd).unwrap();
+    std::fs::copy(dir.join("soft.toml"), odd.join("soft.toml")).unwrap();
+    let e = Scenario::load(&odd.join("soft.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("is malformed: controller.fis: the path ") && e.contains(" is not UTF-8"),
+        "{e}"
+    );
     let with_file = loaded.build().unwrap().run().unwrap();
     let mut paper = loaded.clone();
     paper.controller.fis = None;
