@@ -28,7 +28,7 @@ pub const MAX_FARTHEST_INTERVALS: usize = 1_000;
 /// measures every one): past it (a centreline of thousands of points within a link's reach), the distance is
 /// sampled at [`FALLBACK_SAMPLES`] + 1 points and the answer is their largest plus half their
 /// spacing, at or above the exact one.
-pub const MAX_NEAR_FEATURES: usize = 64;
+pub const MAX_NEAR_FEATURES: usize = 256;
 
 /// Intervals of the sampled answer past [`MAX_NEAR_FEATURES`].
 pub const FALLBACK_SAMPLES: usize = 64;
