@@ -7,7 +7,6 @@
 //! A branch and bound over `t` keeps intervals whose bound exceeds the largest distance found
 //! by more than a tolerance, and halves them; on an interval the distance is at most
 //!
-//! - the least over the features of their larger end value (each is convex);
 //! - the largest of `min(d_i, d_j)` for the features `i`, `j` nearest at its ends, found exactly
 //!   where the two cross (their squares are quadratics in `t` between the breakpoints where the
 //!   nearest point of a feature passes one of its ends), so that a bend's corner, where the two
@@ -19,7 +18,7 @@
 
 use crate::channel::Channel;
 use crate::error::PlanError;
-use crate::polyline::point_segment;
+use crate::polyline::{point_segment, point_segment_squared};
 
 /// Most intervals [`Channel::farthest`] halves on one segment before it answers with its bound.
 pub const MAX_FARTHEST_INTERVALS: usize = 1_000;
@@ -142,15 +141,24 @@ impl Channel {
                 point_segment(x, feature.a, feature.b)
             }
         };
-        // The distance at `x` and the feature nearest there: the same number as `distance`,
-        // every feature that can be nearest on the segment being in `near`.
+        // The distance at `x` and the feature nearest there, as `Channel::distance` measures it
+        // (the segments' squares, one square root), every feature that can be nearest on the
+        // segment being in `near` (the guide first).
         let nearest = |x: [f64; 2]| {
-            near.iter()
+            let (square, segment) = near
+                .iter()
                 .enumerate()
-                .map(|(k, feature)| (distance(feature, x), k))
+                .skip(1)
+                .map(|(k, feature)| (point_segment_squared(x, feature.a, feature.b), k))
                 .fold((f64::INFINITY, 0), |best, this| {
                     if this.0 < best.0 { this } else { best }
-                })
+                });
+            let guide = self.guide_distance(x);
+            if guide <= square.sqrt() {
+                (guide, 0)
+            } else {
+                (square.sqrt(), segment)
+            }
         };
         let (_, n0) = nearest(p);
         let (_, n1) = nearest(q);
@@ -164,11 +172,7 @@ impl Channel {
         let mut examined = 0;
         while let Some(interval) = intervals.pop() {
             let ([t0, t1], [d0, d1]) = (interval.t, interval.d);
-            let (x0, x1) = (at(t0), at(t1));
             let lipschitz = 0.5 * (d0 + d1 + (t1 - t0) * length);
-            let convex = near.iter().fold(f64::INFINITY, |least, feature| {
-                least.min(distance(feature, x0).max(distance(feature, x1)))
-            });
             let [i, j] = interval.nearest.map(|k| near[k]);
             let pair = pair_bound(
                 &i,
@@ -182,7 +186,7 @@ impl Channel {
                 p,
                 v,
             );
-            let bound = lipschitz.min(convex).min(pair);
+            let bound = lipschitz.min(pair);
             if bound <= best + tolerance {
                 continue;
             }
