@@ -321,15 +321,23 @@ pub fn refuse_marked_folder(dir: &Path, command: &str, what: &str) -> Result<(),
 /// `within` bytes (a folder, a FIFO, which opening would wait on, or an unreadable file is not
 /// hrm's).
 fn file_written_by_hrm(path: &Path, within: usize, written_by_hrm: impl Fn(&[u8]) -> bool) -> bool {
+    regular_file_start(path, within).is_some_and(|start| written_by_hrm(&start))
+}
+
+/// The first `within` bytes of `path` if it is a readable regular file (a folder, a FIFO, which
+/// opening would wait on, or a device such as `/dev/zero` is not read).
+fn regular_file_start(path: &Path, within: usize) -> Option<Vec<u8>> {
     use std::io::Read;
     if !std::fs::metadata(path).is_ok_and(|meta| meta.is_file()) {
-        return false;
+        return None;
     }
-    let Ok(file) = std::fs::File::open(path) else {
-        return false;
-    };
     let mut start = Vec::new();
-    file.take(within as u64).read_to_end(&mut start).is_ok() && written_by_hrm(&start)
+    std::fs::File::open(path)
+        .ok()?
+        .take(within as u64)
+        .read_to_end(&mut start)
+        .ok()?;
+    Some(start)
 }
 
 /// Refuses, before any work, to replace an existing `path` that hrm did not write: a folder, or
@@ -485,24 +493,14 @@ fn check_name_length(shown: &Path, name_bytes: usize, what: &str) -> Result<(), 
 /// Only a regular file's first [`MARKER_BYTES`] are read (a FIFO, `/dev/zero` linked in, or a
 /// gigabyte of zeros is no marker).
 fn marker_command(dir: &Path) -> Option<String> {
-    use std::io::Read;
-    let path = dir.join(MARKER);
-    if !std::fs::metadata(&path).is_ok_and(|meta| meta.is_file()) {
-        return None;
-    }
-    let mut start = Vec::new();
-    std::fs::File::open(&path)
-        .ok()?
-        .take(MARKER_BYTES)
-        .read_to_end(&mut start)
-        .ok()?;
+    let start = regular_file_start(&dir.join(MARKER), MARKER_BYTES)?;
     let text = std::str::from_utf8(&start).ok()?;
     let command = text.lines().next()?.strip_prefix("written by `hrm ")?;
     Some(command.strip_suffix('`')?.to_string())
 }
 
 /// The most bytes of a [`MARKER`] read: its line names one command.
-const MARKER_BYTES: u64 = 256;
+const MARKER_BYTES: usize = 256;
 
 /// The kind of output a command writes: `sweep` and `sweep merge` write the same.
 fn kind(command: &str) -> &str {

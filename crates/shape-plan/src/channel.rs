@@ -90,11 +90,6 @@ impl Channel {
         &self.line
     }
 
-    /// The number of centreline points.
-    pub(crate) fn n_points(&self) -> usize {
-        self.points.len()
-    }
-
     /// The centreline's length.
     pub fn length(&self) -> f64 {
         self.arcs.last().copied().unwrap_or(0.0)

@@ -119,7 +119,7 @@ impl<'c> DeployTracker<'c> {
             link_radius,
             shortest,
             traced: Polyline::default(),
-            farthest: FarthestScratch::for_channel(channel)?,
+            farthest: FarthestScratch::default(),
             metrics: DeployMetrics {
                 tip_error: 0.0,
                 shape_deviation_percent: 0.0,

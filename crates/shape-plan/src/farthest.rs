@@ -17,7 +17,6 @@
 //! last bound of the whole segment, found by the centreline's chunk boxes.
 
 use crate::channel::Channel;
-use crate::error::PlanError;
 use crate::polyline::{point_segment, point_segment_squared};
 
 /// Most intervals [`Channel::farthest`] halves on one segment before it answers with its bound.
@@ -55,36 +54,21 @@ struct Interval {
 }
 
 /// The reusable work of [`Channel::farthest`]: the features near the segment measured, and the
-/// intervals left to examine.
-#[derive(Debug, Clone, Default)]
+/// intervals left to examine. [`Default`] grows it to what any call needs
+/// ([`MAX_NEAR_FEATURES`], and the intervals of the deepest halving a double's parameter
+/// allows), so that the calls allocate nothing.
+#[derive(Debug, Clone)]
 pub struct FarthestScratch {
     near: Vec<Feature>,
     intervals: Vec<Interval>,
 }
 
-impl FarthestScratch {
-    /// The work of [`Channel::farthest`] in `channel`, grown in advance to what any call needs
-    /// ([`MAX_NEAR_FEATURES`], and the intervals of the deepest halving a double's parameter
-    /// allows), so that the calls allocate nothing.
-    ///
-    /// # Errors
-    /// [`PlanError::OutOfRange`] when the memory cannot be reserved.
-    pub fn for_channel(channel: &Channel) -> Result<Self, PlanError> {
-        let mut scratch = Self::default();
-        let refused = |_| PlanError::OutOfRange {
-            name: "deploy centerline points",
-            bound: "within the memory available",
-            value: channel.n_points() as f64,
-        };
-        scratch
-            .near
-            .try_reserve_exact(MAX_NEAR_FEATURES)
-            .map_err(refused)?;
-        scratch
-            .intervals
-            .try_reserve_exact(MAX_HALVINGS + 2)
-            .map_err(refused)?;
-        Ok(scratch)
+impl Default for FarthestScratch {
+    fn default() -> Self {
+        Self {
+            near: Vec::with_capacity(MAX_NEAR_FEATURES),
+            intervals: Vec::with_capacity(MAX_HALVINGS + 2),
+        }
     }
 }
 
@@ -94,8 +78,7 @@ impl Channel {
     /// below the exact one. Past [`MAX_FARTHEST_INTERVALS`] intervals (never met by the tests'
     /// channels and links), the largest bound left, and past [`MAX_NEAR_FEATURES`] features
     /// near the segment, the sampled bound: at or above the exact one. `scratch` holds
-    /// the work, so that calls allocate nothing once it has grown
-    /// ([`FarthestScratch::for_channel`]).
+    /// the work ([`FarthestScratch::default`]), so that calls allocate nothing.
     pub fn farthest(&self, p: [f64; 2], q: [f64; 2], scratch: &mut FarthestScratch) -> f64 {
         let v = [q[0] - p[0], q[1] - p[1]];
         let length = v[0].hypot(v[1]);
