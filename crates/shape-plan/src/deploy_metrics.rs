@@ -4,7 +4,7 @@
 
 use crate::channel::Channel;
 use crate::error::PlanError;
-use crate::farthest::FarthestScratch;
+use crate::farthest::{FARTHEST_ALLOWANCE, FarthestScratch};
 use crate::polyline::{Polyline, dist, point_segment};
 use clearance::segment_segment;
 use lane_math::check_finite;
@@ -19,12 +19,14 @@ pub const MAX_DEPLOY_METRIC_WORK: f64 = 2e9;
 
 /// The work of measuring `shapes` shapes of a chain of `links` links, in units of about 10 ns:
 /// per shape, ten for each of the body's sampled points ([`SAMPLES_PER_LINK`] + 1 a link, each
-/// measured against the channel and the traced path) and one for each pair of links (the self
-/// clearance's bound).
+/// measured against the channel and the traced path), a quarter for each measurement of the
+/// wall clearance's allowance ([`FARTHEST_ALLOWANCE`] a link, the most its calls spend on
+/// average), and one for each pair of links (the self clearance's bound).
 pub fn deploy_metric_work(links: usize, shapes: usize) -> f64 {
     let links = links as f64;
     let points = links * (SAMPLES_PER_LINK + 1) as f64;
-    shapes as f64 * (10.0 * points + 0.5 * links * (links - 1.0).max(0.0))
+    let farthest = links * FARTHEST_ALLOWANCE as f64 / 4.0;
+    shapes as f64 * (10.0 * points + farthest + 0.5 * links * (links - 1.0).max(0.0))
 }
 
 /// What a deployment achieved, over all its shapes.

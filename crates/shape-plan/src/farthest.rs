@@ -15,12 +15,23 @@
 //!
 //! Only features near enough to be nearest somewhere on the segment enter: those within the
 //! last bound of the whole segment, found by the centreline's chunk boxes.
+//!
+//! The work is bounded twice: by [`MAX_FARTHEST_INTERVALS`] a call, and by an allowance of
+//! measurements (a point against a feature) that grows by [`FARTHEST_ALLOWANCE`] a call and
+//! carries over between the calls of one [`FarthestScratch`], so that a costly link is paid for
+//! by cheap ones and `k` calls measure at most `k` allowances whatever the centreline. A call
+//! that runs out answers with a bound at or above the exact distance.
 
 use crate::channel::Channel;
 use crate::polyline::{point_segment, point_segment_squared};
 
 /// Most intervals [`Channel::farthest`] halves on one segment before it answers with its bound.
 pub const MAX_FARTHEST_INTERVALS: usize = 1_000;
+
+/// Measurements of a point against a feature that each call of [`Channel::farthest`] adds to
+/// its scratch's allowance (the module documentation): some 10 us, against a mean of about
+/// 2,900 for links among centrelines of a point every 0.1 to 0.3 mm.
+pub const FARTHEST_ALLOWANCE: usize = 4_096;
 
 /// Most features near a segment (the guide among them) for the branch and bound (each interval
 /// measures every one): past it (a centreline of thousands of points within a link's reach), the distance is
@@ -53,14 +64,16 @@ struct Interval {
     nearest: [usize; 2],
 }
 
-/// The reusable work of [`Channel::farthest`]: the features near the segment measured, and the
-/// intervals left to examine. [`Default`] grows it to what any call needs
-/// ([`MAX_NEAR_FEATURES`], and the intervals of the deepest halving a double's parameter
-/// allows), so that the calls allocate nothing.
+/// The reusable work of [`Channel::farthest`]: the features near the segment measured, the
+/// intervals left to examine, and the measurements the calls so far have left unspent (the
+/// module documentation). [`Default`] grows it to what any call needs ([`MAX_NEAR_FEATURES`],
+/// and the intervals of the deepest halving a double's parameter allows), so that the calls
+/// allocate nothing, and starts with no allowance.
 #[derive(Debug, Clone)]
 pub struct FarthestScratch {
     near: Vec<Feature>,
     intervals: Vec<Interval>,
+    allowance: usize,
 }
 
 impl Default for FarthestScratch {
@@ -68,16 +81,27 @@ impl Default for FarthestScratch {
         Self {
             near: Vec::with_capacity(MAX_NEAR_FEATURES),
             intervals: Vec::with_capacity(MAX_HALVINGS + 2),
+            allowance: 0,
         }
+    }
+}
+
+impl FarthestScratch {
+    /// The measurements of a point against a feature that later calls may spend beyond their
+    /// own [`FARTHEST_ALLOWANCE`].
+    pub fn allowance(&self) -> usize {
+        self.allowance
     }
 }
 
 impl Channel {
     /// The largest [`distance`](Self::distance) of a point of the segment `p`-`q` (the module's
     /// branch and bound): at most `1e-14` of the segment's length or its largest coordinate
-    /// below the exact one. Past [`MAX_FARTHEST_INTERVALS`] intervals (never met by the tests'
-    /// channels and links), the largest bound left, and past [`MAX_NEAR_FEATURES`] features
-    /// near the segment, the sampled bound: at or above the exact one. `scratch` holds
+    /// below the exact one. Past [`MAX_FARTHEST_INTERVALS`] intervals or the scratch's
+    /// allowance of measurements (never met by the tests' channels and links but one built to
+    /// exhaust it), the smaller of the largest bound left and the sampled bound, and past
+    /// [`MAX_NEAR_FEATURES`] features near the segment, the sampled bound (the largest of
+    /// [`FALLBACK_SAMPLES`] + 1 samples plus half their spacing): at or above the exact one. `scratch` holds
     /// the work ([`FarthestScratch::default`]), so that calls allocate nothing.
     pub fn farthest(&self, p: [f64; 2], q: [f64; 2], scratch: &mut FarthestScratch) -> f64 {
         let v = [q[0] - p[0], q[1] - p[1]];
@@ -96,7 +120,12 @@ impl Channel {
             [p[0].min(q[0]), p[1].min(q[1])],
             [p[0].max(q[0]), p[1].max(q[1])],
         ];
-        let FarthestScratch { near, intervals } = scratch;
+        let FarthestScratch {
+            near,
+            intervals,
+            allowance,
+        } = scratch;
+        *allowance = allowance.saturating_add(FARTHEST_ALLOWANCE);
         near.clear();
         near.push(Feature {
             a: self.entry(),
@@ -111,11 +140,16 @@ impl Channel {
                 crowded = true;
             }
         });
-        if crowded {
+        // The largest of the samples plus half their spacing (the distance is 1-Lipschitz along
+        // the segment): at or above the exact answer, for a bounded cost.
+        let sampled = || {
             let largest = (0..=FALLBACK_SAMPLES)
                 .map(|k| self.distance(at(k as f64 / FALLBACK_SAMPLES as f64)))
                 .fold(0.0, f64::max);
-            return largest + 0.5 * length / FALLBACK_SAMPLES as f64;
+            largest + 0.5 * length / FALLBACK_SAMPLES as f64
+        };
+        if crowded {
+            return sampled();
         }
         let distance = |feature: &Feature, x: [f64; 2]| {
             if feature.ray {
@@ -143,6 +177,8 @@ impl Channel {
                 (square.sqrt(), segment)
             }
         };
+        // Within the allowance just added: two measurements of at most MAX_NEAR_FEATURES.
+        *allowance -= 2 * near.len();
         let (_, n0) = nearest(p);
         let (_, n1) = nearest(q);
         let mut best = f0.max(f1);
@@ -174,14 +210,15 @@ impl Channel {
                 continue;
             }
             examined += 1;
-            if examined > MAX_FARTHEST_INTERVALS {
+            if examined > MAX_FARTHEST_INTERVALS || *allowance < near.len() {
                 let left = intervals
                     .iter()
                     .map(|i| 0.5 * (i.d[0] + i.d[1] + (i.t[1] - i.t[0]) * length))
                     .fold(bound, f64::max);
-                return best.max(left);
+                return best.max(left).min(sampled());
             }
             let middle = 0.5 * (t0 + t1);
+            *allowance -= near.len();
             let (dm, nm) = nearest(at(middle));
             best = best.max(dm);
             intervals.push(Interval {

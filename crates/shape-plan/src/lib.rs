@@ -25,7 +25,10 @@ pub use deploy_metrics::{
     deploy_metric_work,
 };
 pub use error::PlanError;
-pub use farthest::{FALLBACK_SAMPLES, FarthestScratch, MAX_FARTHEST_INTERVALS, MAX_NEAR_FEATURES};
+pub use farthest::{
+    FALLBACK_SAMPLES, FARTHEST_ALLOWANCE, FarthestScratch, MAX_FARTHEST_INTERVALS,
+    MAX_NEAR_FEATURES,
+};
 pub use generator::{
     MAX_PASSAGE_OBSTACLES, NarrowPassage, PassageSpec, narrow_passage, spatial_narrow_passage,
 };

@@ -5,7 +5,7 @@ use clearance::segment_segment;
 use lane_math::{Classify, ErrorClass};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use shape_plan::{Channel, DeployTracker, PlanError, follow_the_leader};
+use shape_plan::{Channel, DeployTracker, MAX_NEAR_FEATURES, PlanError, follow_the_leader};
 
 fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
@@ -289,4 +289,46 @@ fn a_link_among_more_centreline_segments_than_the_bound_takes_is_never_overstate
     // A few segments near it: exact.
     let sparse = Channel::new(&[[0.0, 0.0], [0.4, 0.0], [1.0, 0.0]], 0.1).unwrap();
     assert!((sparse.farthest(p, q, &mut scratch) - 0.03).abs() < 1e-16);
+}
+
+#[test]
+fn a_link_along_a_zigzag_spends_no_more_than_its_allowance_and_never_overstates() {
+    // 200 segments zigzagging across the link: a hundred humps of the distance, nearly equal,
+    // each for the branch and bound to resolve, past one call's allowance.
+    let centerline: Vec<[f64; 2]> = (0..=200)
+        .map(|k| [f64::from(k) * 1e-3, if k % 2 == 0 { 2e-3 } else { -2e-3 }])
+        .collect();
+    let channel = Channel::new(&centerline, 0.1).unwrap();
+    let (p, q) = ([0.02, 1e-4], [0.18, -1e-4]);
+    let samples = 200_000;
+    let sampled = (0..=samples)
+        .map(|s| {
+            let t = f64::from(s) / f64::from(samples);
+            channel.distance([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])])
+        })
+        .fold(0.0, f64::max);
+    let spacing = dist(p, q) / f64::from(samples);
+    let mut fresh = shape_plan::FarthestScratch::default();
+    let capped = channel.farthest(p, q, &mut fresh);
+    assert!(
+        fresh.allowance() < MAX_NEAR_FEATURES,
+        "{}",
+        fresh.allowance()
+    );
+    assert!(capped >= sampled - 1e-15, "{capped} against {sampled}");
+    // What cheap calls left unspent pays for it: the exact answer.
+    let mut funded = shape_plan::FarthestScratch::default();
+    for _ in 0..200 {
+        channel.farthest([0.1, 0.5], [0.1, 0.5001], &mut funded);
+    }
+    let exact = channel.farthest(p, q, &mut funded);
+    assert!(
+        exact >= sampled - 1e-15 && exact <= sampled + 0.5 * spacing,
+        "{exact} against {sampled}"
+    );
+    // Past the allowance: a bound, at or above the exact answer and within the sampled bound.
+    assert!(
+        capped >= exact - 1e-15 && capped <= exact + dist(p, q) / 64.0,
+        "{capped} against {exact}"
+    );
 }
