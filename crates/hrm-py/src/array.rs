@@ -4,7 +4,8 @@
 //! answers with the same leading dimension. Inputs are read as float64 in C order without a copy
 //! when they already are; other layouts (Fortran order, strided views) are copied once, and other
 //! real dtypes (integers, booleans, float32, lists) are converted; anything else (complex,
-//! strings, objects) is refused with [`InvalidInput`](crate::errors::InvalidInput). A batch runs
+//! strings, objects) is refused with [`InvalidInput`](crate::errors::InvalidInput), and so are
+//! rates beyond the scale a run resolves, as `hrm eval` refuses them. A batch runs
 //! with the GIL released, on all cores (rayon) from [`PARALLEL_MIN_STATES`] states on, each
 //! worker with its own workspace; its first failing state (the lowest index) names itself in the
 //! error message.
@@ -35,6 +36,10 @@ const WORK_PER_CHUNK: usize = 1 << 22;
 /// The most values one result may hold (2 GiB of float64); a larger batch is refused before
 /// anything is allocated.
 pub(crate) const MAX_OUTPUT_VALUES: usize = 1 << 28;
+
+/// The arguments that hold joint or modal rates, refused beyond the scale a run resolves
+/// ([`sim_core::check_rates`]) as `hrm eval` refuses them.
+const RATE_NAMES: [&str; 2] = ["theta_dot", "a_dot"];
 
 /// One input argument: a float64 array of one state `(width,)` or a batch `(N, width)`.
 pub(crate) struct States<'py> {
@@ -87,12 +92,17 @@ impl<'py> States<'py> {
             copy.extend(view.iter().copied());
             Some(copy)
         };
-        Ok(Self {
+        let states = Self {
             name,
             array,
             copy,
             batch,
-        })
+        };
+        if RATE_NAMES.contains(&name) {
+            sim_core::check_rates(name, states.values(), width)
+                .map_err(|e| Error::input(e.to_string()))?;
+        }
+        Ok(states)
     }
 
     /// Reads each `(object, name)` argument as states of `width` values (see [`States::read`]);

@@ -13,7 +13,7 @@ use modal_reduce::spatial::{
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PySlice, PyTuple};
+use pyo3::types::{PyDict, PyFloat, PyInt, PySlice, PyTuple};
 use std::sync::Mutex;
 
 /// Most harmonics per plane (`m = 4K` coordinates): the bound of `hrm eval` on spatial arms, which
@@ -60,7 +60,7 @@ impl Workspace {
 /// m L^2 / 12, m L^2 / 12) about the mid-link centre of mass; `lengths` and `masses` give them
 /// per link instead (a list and its scalar together raise InvalidInput), `inertias` (n rows of
 /// principal moments [Ixx, Iyy, Izz], kg m^2, x along the link) the rods' inertias. `gravity` is the world
-/// acceleration vector (m/s^2); the base sits at `base_xyz` (m) rotated by roll, pitch and yaw
+/// acceleration vector (m/s^2), or one number g for (0, 0, -g) as in a scenario; the base sits at `base_xyz` (m) rotated by roll, pitch and yaw
 /// `base_rpy` (rad, R = Rz Ry Rx), the straight arm along the base's x axis. The coordinates are
 /// a = (a_z, a_y): 2K for the yaw plane then 2K for the pitch plane; theta is
 /// (z_1, y_1, z_2, y_2, ...).
@@ -129,7 +129,7 @@ fn build(
     links: Option<usize>,
     link_length: Option<f64>,
     link_mass: Option<f64>,
-    gravity: [f64; 3],
+    gravity: sim_study::Gravity,
     lengths: Option<Vec<f64>>,
     masses: Option<Vec<f64>>,
     inertias: Option<Vec<[f64; 3]>>,
@@ -146,7 +146,7 @@ fn build(
         links,
         link_length,
         link_mass,
-        gravity: Some(sim_study::Gravity::Vector(gravity)),
+        gravity: Some(gravity),
         lengths,
         masses,
         inertias: inertias.map(sim_study::Inertias::Principal),
@@ -256,7 +256,10 @@ impl SpatialArm {
         let vec3 = |value: Option<&Bound<'_, PyAny>>, name, default| {
             value.map_or(Ok(default), |v| args::vec3(v, name))
         };
-        let gravity = vec3(gravity, "gravity", [0.0, 0.0, -9.81])?;
+        let gravity = match gravity {
+            Some(g) if is_scalar(g) => sim_study::Gravity::Magnitude(args::real(g, "gravity")?),
+            other => sim_study::Gravity::Vector(vec3(other, "gravity", [0.0, 0.0, -9.81])?),
+        };
         let (base_xyz, base_rpy) = (
             vec3(base_xyz, "base_xyz", [0.0; 3])?,
             vec3(base_rpy, "base_rpy", [0.0; 3])?,
@@ -646,4 +649,15 @@ impl SpatialArm {
         robot_desc::write_mjcf(&self.robot()?, self.model.gravity())
             .map_err(|e| Error::input(e.to_string()).into())
     }
+}
+
+/// Whether `value` is one number (a Python `int` or `float`, or a numpy scalar or 0-d array),
+/// which `gravity` reads as `g` along `-z` as a scenario and `hrm eval` do.
+fn is_scalar(value: &Bound<'_, PyAny>) -> bool {
+    value.is_instance_of::<PyFloat>()
+        || value.is_instance_of::<PyInt>()
+        || value
+            .getattr("ndim")
+            .and_then(|ndim| ndim.extract::<usize>())
+            .is_ok_and(|ndim| ndim == 0)
 }

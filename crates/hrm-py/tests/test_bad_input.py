@@ -600,3 +600,27 @@ def test_broadcast_views_are_bounded_before_any_copy():
         hrm.Arm(lengths=np.broadcast_to(np.ones(1), (10**9,)))
     with pytest.raises(hrm.InvalidInput, match="^theta has 4000000000 values, more than the limit of 268435456$"):
         hrm.Arm(links=5).gravity(np.broadcast_to(np.zeros(4, dtype=np.int64), (10**9, 4)))
+
+
+def test_rates_and_spatial_gravity_are_read_as_hrm_eval_reads_them():
+    # Rates beyond the scale a run resolves, refused by the same check as hrm eval's (1e7 rad/s
+    # gave accelerations of 1e14 here while eval refused it); a batch names the state.
+    arm = hrm.Arm(links=3)
+    unit = r"in magnitude \(rad/s, m/s for a prismatic joint\), got "
+    with pytest.raises(hrm.InvalidInput, match=r"^theta_dot\[0\] must be at most 1000000 " + unit + "10000000$"):
+        arm.coriolis([0.0, 0.0, 0.0], [1e7, 0.0, 0.0])
+    with pytest.raises(hrm.InvalidInput, match=r"^theta_dot\[1, 2\] must be at most 1000000 " + unit):
+        arm.aba(np.zeros((2, 3)), np.array([[0.0, 0.0, 0.0], [0.0, 0.0, -2e6]]), np.zeros((2, 3)))
+    with pytest.raises(hrm.InvalidInput, match=r"^a_dot\[3\] must be at most 1000000 " + unit):
+        hrm.SpatialArm().forward_dynamics([0.1] * 4, [0.0, 0.0, 0.0, 1e7], [0.0] * 4)
+    with pytest.raises(hrm.InvalidInput, match=r"^a_dot\[0\] must be at most 1000000 "):
+        hrm.ReducedModel(hrm.Arm(links=10)).forward_dynamics([0.1] * 3, [-1e300, 0.0, 0.0], [0.0] * 3)
+    assert np.all(np.isfinite(arm.coriolis([0.0, 0.0, 0.0], [1e6, -1e6, 0.0])))
+    # One number as a spatial arm's gravity: g along -z, as a scenario and hrm eval read it.
+    for g in (9.81, np.float64(9.81), np.float32(9.81), np.array(9.81), 3):
+        expected = (0.0, 0.0, -float(np.float64(g)))
+        assert hrm.SpatialArm(links=2, gravity=g).gravity == expected, g
+    with pytest.raises(hrm.InvalidInput, match=r"^arm\.gravity must be"):
+        hrm.SpatialArm(gravity=1e7)
+    with pytest.raises(hrm.InvalidInput, match=r"^gravity must have 3 entries \(x, y, z\), got 1$"):
+        hrm.SpatialArm(gravity=np.array([9.81]))

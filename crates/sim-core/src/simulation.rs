@@ -1286,24 +1286,39 @@ fn check_initial(initial: &ModalState, m: usize) -> Result<(), SimError> {
         }
         check_all_finite(name, values)?;
     }
-    // Rates of the scale a run resolves (`1e300` overflowed the first C*); a coordinate beyond
-    // it stops the run at its first sample (`SimError::OutOfScale`).
-    if let Some((i, v)) = initial
-        .a_dot
+    // A coordinate beyond the scale stops the run at its first sample (`SimError::OutOfScale`).
+    check_rates("initial.a_dot", &initial.a_dot, m)
+}
+
+/// Refuses rates beyond [`MAX_MODAL_MAGNITUDE`] in magnitude, the scale a run resolves (`1e300`
+/// overflowed the Coriolis terms): `rates` holds states of `width` entries (joint or modal
+/// rates), and the error names the first such entry, `name[i]` in one state and `name[k, i]`
+/// in state `k` of several. For a run's initial state and the rates the front ends are given
+/// (`hrm eval`'s and Python's `theta_dot` and `a_dot`).
+///
+/// # Errors
+/// [`SimError::InvalidSetting`] naming the entry.
+pub fn check_rates(name: &str, rates: &[f64], width: usize) -> Result<(), SimError> {
+    let Some((flat, value)) = rates
         .iter()
         .enumerate()
         .find(|(_, v)| v.abs() > MAX_MODAL_MAGNITUDE)
-    {
-        return Err(SimError::setting(
-            format!("initial.a_dot[{i}]"),
-            format!(
-                "must be at most {} rad/s in magnitude, got {}",
-                Compact(MAX_MODAL_MAGNITUDE),
-                Compact(*v)
-            ),
-        ));
-    }
-    Ok(())
+    else {
+        return Ok(());
+    };
+    let entry = if rates.len() <= width {
+        format!("{name}[{flat}]")
+    } else {
+        format!("{name}[{}, {}]", flat / width.max(1), flat % width.max(1))
+    };
+    Err(SimError::setting(
+        entry,
+        format!(
+            "must be at most {} in magnitude (rad/s, m/s for a prismatic joint), got {}",
+            Compact(MAX_MODAL_MAGNITUDE),
+            Compact(*value)
+        ),
+    ))
 }
 
 /// Checks the settings of a loop of `m` coordinates for a chain of `n_joints` (`n` planar, `2n`

@@ -3,7 +3,7 @@
 //! request's coordinates, and the checks and layout of an answer.
 
 use backbone_kin::{BaseAngle, KinError, ModalMap, reduce_angle};
-use lane_math::{Classify, Compact, ErrorClass};
+use lane_math::{Classify, ErrorClass};
 use manip_dyn::ChainModel;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer};
@@ -259,27 +259,17 @@ pub(super) fn curve_error(error: KinError) -> EvalError {
 /// The request fields that hold joint or modal rates.
 const RATE_FIELDS: [&str; 2] = ["theta_dot", "a_dot"];
 
-/// Refuses rates (`theta_dot`, `a_dot`, in every op that takes them) beyond
-/// [`sim_core::MAX_MODAL_MAGNITUDE`] in magnitude, the scale a run resolves (`1e300` overflowed
-/// the Coriolis terms); a field that is not a list of numbers is left to the op's own parsing.
+/// Refuses rates (`theta_dot`, `a_dot`, in every op that takes them) beyond the scale a run
+/// resolves ([`sim_core::check_rates`]); an entry that is not a number is left to the op's own
+/// parsing.
 pub(super) fn check_rates(request: &Map<String, Value>) -> Result<(), EvalError> {
-    let bound = sim_core::MAX_MODAL_MAGNITUDE;
     for name in RATE_FIELDS {
         let Some(Value::Array(values)) = request.get(name) else {
             continue;
         };
-        let too_fast = values
-            .iter()
-            .enumerate()
-            .find_map(|(i, v)| v.as_f64().filter(|v| v.abs() > bound).map(|v| (i, v)));
-        if let Some((i, v)) = too_fast {
-            return Err(EvalError::input(format!(
-                "{name}[{i}] must be at most {} in magnitude (rad/s, m/s for a prismatic \
-                 joint), got {}",
-                Compact(bound),
-                Compact(v)
-            )));
-        }
+        let rates: Vec<f64> = values.iter().map(|v| v.as_f64().unwrap_or(0.0)).collect();
+        sim_core::check_rates(name, &rates, rates.len())
+            .map_err(|e| EvalError::input(e.to_string()))?;
     }
     Ok(())
 }

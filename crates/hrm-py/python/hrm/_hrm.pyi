@@ -265,7 +265,7 @@ class SpatialArm:
         links: Optional[int] = None,
         link_length: Optional[float] = None,
         link_mass: Optional[float] = None,
-        gravity: Sequence[float] = (0.0, 0.0, -9.81),
+        gravity: Union[float, Sequence[float]] = (0.0, 0.0, -9.81),
         lengths: Optional[Sequence[float]] = None,
         masses: Optional[Sequence[float]] = None,
         inertias: Optional[Sequence[Sequence[float]]] = None,

@@ -715,7 +715,7 @@ fn initial_rates_beyond_the_scale_of_a_run_are_refused() {
     };
     assert_eq!(
         error.to_string(),
-        "initial.a_dot[0] must be at most 1000000 rad/s in magnitude, got 1e300"
+        "initial.a_dot[0] must be at most 1000000 in magnitude (rad/s, m/s for a prismatic joint), got 1e300"
     );
 }
 
