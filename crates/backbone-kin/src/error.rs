@@ -184,6 +184,28 @@ pub enum KinError {
         /// The end-point error asked for.
         tolerance: f64,
     },
+    /// A numerical inverse kinematics met coordinates where the end point does not move to
+    /// first order (a zero Jacobian: the straight arm of modes that all integrate to zero, or
+    /// an arm so small that the Jacobian's squares underflow), so no step is defined.
+    #[error(
+        "numerical inverse kinematics cannot move from {}: the end point does not change to first order with the coordinates there (a zero Jacobian, as at the straight arm), end-point error {residual:e}; start from another guess",
+        stationary_point(*.iterations)
+    )]
+    Stationary {
+        /// Iterations spent before it (0: the guess itself).
+        iterations: usize,
+        /// The end-point error there.
+        residual: f64,
+    },
+}
+
+/// Where [`KinError::Stationary`] stopped.
+fn stationary_point(iterations: usize) -> String {
+    if iterations == 0 {
+        "the guess".to_string()
+    } else {
+        format!("its iterate after {iterations} iterations")
+    }
 }
 
 impl Classify for KinError {
@@ -191,7 +213,8 @@ impl Classify for KinError {
     /// ([`OutOfReach`]: no curve of this length can; [`AtBase`]: its direction is undefined;
     /// [`A2ExceedsAmplitude`]: not on the first branch of `J0` with this `alpha0`);
     /// [`Numerical`](ErrorClass::Numerical) when a numerical inverse kinematics did not reach its
-    /// tolerance ([`NotConverged`](KinError::NotConverged)) or converged to coordinates its
+    /// tolerance ([`NotConverged`](KinError::NotConverged)), met coordinates where no step is
+    /// defined ([`Stationary`](KinError::Stationary)) or converged to coordinates its
     /// forward kinematics cannot evaluate ([`AnswerTooOscillatory`](KinError::AnswerTooOscillatory));
     /// otherwise the input was malformed or
     /// outside the model's domain.
@@ -204,7 +227,9 @@ impl Classify for KinError {
             Self::OutOfReach { .. } | Self::AtBase { .. } | Self::A2ExceedsAmplitude { .. } => {
                 ErrorClass::Unreachable
             }
-            Self::NotConverged { .. } | Self::AnswerTooOscillatory { .. } => ErrorClass::Numerical,
+            Self::NotConverged { .. }
+            | Self::Stationary { .. }
+            | Self::AnswerTooOscillatory { .. } => ErrorClass::Numerical,
             _ => ErrorClass::InvalidInput,
         }
     }

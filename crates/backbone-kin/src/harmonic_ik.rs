@@ -301,14 +301,17 @@ pub(crate) fn least_squares<const D: usize>(
     let mut iterations = 0;
     while residual > tolerance {
         let error: [f64; D] = std::array::from_fn(|d| point[d] - target[d]);
-        if iterations == max_iterations
-            || damping > DAMPING_MAX
-            || !damped_step(jacobian, error, damping, a, trial)
-        {
+        if iterations == max_iterations || damping > DAMPING_MAX {
             return Err(KinError::NotConverged {
                 iterations,
                 residual,
                 tolerance,
+            });
+        }
+        if !damped_step(jacobian, error, damping, a, trial) {
+            return Err(KinError::Stationary {
+                iterations,
+                residual,
             });
         }
         iterations += 1;

@@ -925,6 +925,28 @@ mod tests {
     }
 
     #[test]
+    fn ik_from_the_straight_arm_says_no_step_is_defined_there() {
+        // The paper's modes move the tip by nothing to first order at a = 0: the answer said
+        // "did not converge ... after 0 iterations".
+        let answer = request(
+            json!({"op": "ik", "arm": {"links": 3}, "target": [0.1, 0.1],
+            "alpha0": 0.7, "guess": [0, 0]}),
+        );
+        assert_eq!(answer["error"]["kind"], "numerical", "{answer}");
+        let message = answer["error"]["message"].as_str().unwrap();
+        assert!(
+            message.starts_with("numerical inverse kinematics cannot move from the guess: ")
+                && message.contains("start from another guess"),
+            "{message}"
+        );
+        let moved = request(
+            json!({"op": "ik", "arm": {"links": 3}, "target": [0.1, 0.1],
+            "alpha0": 0.7, "guess": [0.01, 0]}),
+        );
+        assert!(moved.get("error").is_none(), "{moved}");
+    }
+
+    #[test]
     fn ik_keeps_the_curves_answer_when_the_chain_cannot_follow() {
         // The closed form (eqs 5-6) reaches this target with the curve; the 3-link chain on
         // the K = 1 family misses it by 3e-5 m, which must not take `a` with it.

@@ -9,7 +9,7 @@ use backbone_kin::{
     MAX_LINKS, ModalMap, SpatialIk, SpatialModalMap, end_point, inverse_j0, inverse_kinematics,
     joint_positions, tip_position,
 };
-use lane_math::Classify;
+use lane_math::{Classify, ErrorClass};
 use std::collections::BTreeSet;
 use std::f64::consts::FRAC_PI_2;
 use test_support::refusal::{Row, SENTINEL, check, exactly, row, starts, untouched, words};
@@ -31,6 +31,7 @@ fn variant(error: &KinError) -> &'static str {
         KinError::AtBase { .. } => "AtBase",
         KinError::A2ExceedsAmplitude { .. } => "A2ExceedsAmplitude",
         KinError::NotConverged { .. } => "NotConverged",
+        KinError::Stationary { .. } => "Stationary",
         KinError::TooMany { .. } => "TooMany",
         KinError::GuessTooLarge { .. } => "GuessTooLarge",
         KinError::AnswerTooOscillatory { .. } => "AnswerTooOscillatory",
@@ -38,7 +39,7 @@ fn variant(error: &KinError) -> &'static str {
     }
 }
 
-const ALL: [&str; 16] = [
+const ALL: [&str; 17] = [
     "NonFinite",
     "NonPositiveLength",
     "NoLinks",
@@ -52,6 +53,7 @@ const ALL: [&str; 16] = [
     "AtBase",
     "A2ExceedsAmplitude",
     "NotConverged",
+    "Stationary",
     "TooMany",
     "GuessTooLarge",
     "AnswerTooOscillatory",
@@ -529,12 +531,16 @@ fn rows() -> Vec<Row<KinError>> {
             |e| matches!(e, KinError::Dimension { .. }),
             &["initial guess", "expected 4"],
         ),
-        // From the straight guess the end point cannot move along the base direction.
+        // From the straight guess the end point cannot move at all (to first order).
         words(
-            "numerical_ik_not_converged",
+            "numerical_ik_from_a_stationary_guess",
             straight.solve([0.5, 0.0], &mut [0.0; 4]).unwrap_err(),
-            |e| matches!(e, KinError::NotConverged { .. }),
-            &["did not converge", "end-point error"],
+            |e| matches!(e, KinError::Stationary { iterations: 0, .. }),
+            &[
+                "cannot move from the guess",
+                "end-point error",
+                "another guess",
+            ],
         ),
         words(
             "numerical_ik_not_converged",
@@ -702,7 +708,10 @@ fn every_error_is_in_exactly_one_class() {
             variant(&error),
             "OutOfReach" | "AtBase" | "A2ExceedsAmplitude"
         );
-        let numerical = matches!(variant(&error), "NotConverged" | "AnswerTooOscillatory");
+        let numerical = matches!(
+            variant(&error),
+            "NotConverged" | "Stationary" | "AnswerTooOscillatory"
+        );
         assert_eq!(error.is_unreachable(), unreachable, "{name}: {error}");
         assert_eq!(error.is_numerical(), numerical, "{name}: {error}");
         assert_eq!(
@@ -754,6 +763,30 @@ fn numerical_ik_not_converged() {
     );
     assert!(message.contains("did not converge"));
     assert!(a.iter().all(|x| x.is_finite()));
+}
+
+/// `numerical_ik_from_a_stationary_guess`: the straight arm, where the paper's modes move the
+/// tip by nothing to first order, is named as the cause (it read "did not converge ... after 0
+/// iterations").
+#[test]
+fn numerical_ik_from_a_stationary_guess() {
+    let mut ik = HarmonicIk::new(0.3, 1, 0.7).unwrap();
+    let mut a = [0.0, 0.0];
+    let err = ik.solve([0.1, 0.1], &mut a).unwrap_err();
+    assert!(
+        matches!(err, KinError::Stationary { iterations: 0, residual } if residual > 0.1),
+        "{err:?}"
+    );
+    assert_eq!(err.class(), ErrorClass::Numerical);
+    let message = err.to_string();
+    assert!(
+        message.starts_with("numerical inverse kinematics cannot move from the guess: ")
+            && message.ends_with("start from another guess"),
+        "{message}"
+    );
+    // A guess off the straight arm solves it.
+    let mut a = [0.01, 0.0];
+    assert!(ik.solve([0.1, 0.1], &mut a).is_ok());
 }
 
 #[test]

@@ -404,8 +404,10 @@ fn the_residual_of_tiny_and_huge_arms_never_reads_as_zero() {
                 assert!(error <= 1e-12 * scale, "{scale}: {error}");
                 assert!(report.residual <= 1e-12 * scale && report.iterations > 0);
             }
+            // At 1e-200 m the Jacobian's squares underflow: no step is defined.
             Err(error) => assert!(
-                matches!(error, KinError::NotConverged { residual, .. } if residual > 0.0),
+                matches!(error, KinError::NotConverged { residual, .. }
+                    | KinError::Stationary { residual, .. } if residual > 0.0),
                 "{scale}: {error:?}"
             ),
         }
