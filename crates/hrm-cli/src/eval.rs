@@ -604,6 +604,14 @@ mod tests {
         assert_eq!(answers[3]["id"], 7);
         assert_eq!(answers[4]["id"], 8);
         assert_eq!(answers[5]["id"], 9);
+        // An id is echoed as read: a number as the double it is (docs/eval-protocol.md).
+        let ids = run(
+            b"{\"id\":12345678901234567890123,\"op\":\"x\"}\n{\"id\":1.0e2,\"op\":\"x\"}\n\
+            {\"id\":\"run 7\",\"op\":\"x\"}\n",
+        );
+        assert_eq!(ids[0]["id"].as_f64(), Some(1.2345678901234568e22));
+        assert_eq!(ids[1]["id"].to_string(), "100.0");
+        assert_eq!(ids[2]["id"], "run 7");
     }
 
     #[test]
