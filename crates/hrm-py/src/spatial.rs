@@ -59,9 +59,10 @@ impl Workspace {
 /// `link_length` (m, default 0.1) and `link_mass` (kg, default 0.1), principal inertias (0,
 /// m L^2 / 12, m L^2 / 12) about the mid-link centre of mass; `lengths` and `masses` give them
 /// per link instead (a list and its scalar together raise InvalidInput), `inertias` (n rows of
-/// principal moments [Ixx, Iyy, Izz], kg m^2, x along the link) the rods' inertias. `gravity` is the world
-/// acceleration vector (m/s^2), or one number g for (0, 0, -g) as in a scenario; the base sits at `base_xyz` (m) rotated by roll, pitch and yaw
-/// `base_rpy` (rad, R = Rz Ry Rx), the straight arm along the base's x axis. The coordinates are
+/// principal moments [Ixx, Iyy, Izz], kg m^2, x along the link) the rods' inertias. `gravity`
+/// is the world acceleration vector (m/s^2), or one number g for (0, 0, -g) as in a scenario;
+/// the base sits at `base_xyz` (m) rotated by roll, pitch and yaw `base_rpy` (rad,
+/// R = Rz Ry Rx), the straight arm along the base's x axis. The coordinates are
 /// a = (a_z, a_y): 2K for the yaw plane then 2K for the pitch plane; theta is
 /// (z_1, y_1, z_2, y_2, ...).
 ///

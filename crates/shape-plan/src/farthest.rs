@@ -101,8 +101,8 @@ impl Channel {
     /// allowance of measurements (never met by the tests' channels and links but one built to
     /// exhaust it), the smaller of the largest bound left and the sampled bound, and past
     /// [`MAX_NEAR_FEATURES`] features near the segment, the sampled bound (the largest of
-    /// [`FALLBACK_SAMPLES`] + 1 samples plus half their spacing): at or above the exact one. `scratch` holds
-    /// the work ([`FarthestScratch::default`]), so that calls allocate nothing.
+    /// [`FALLBACK_SAMPLES`] + 1 samples plus half their spacing): at or above the exact one.
+    /// `scratch` holds the work ([`FarthestScratch::default`]), so that calls allocate nothing.
     pub fn farthest(&self, p: [f64; 2], q: [f64; 2], scratch: &mut FarthestScratch) -> f64 {
         let v = [q[0] - p[0], q[1] - p[1]];
         let length = v[0].hypot(v[1]);
