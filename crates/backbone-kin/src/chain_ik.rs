@@ -23,7 +23,7 @@
 //! the iteration is Newton's method, which from the closed-form start converges in a few steps
 //! whenever the chain is close to its curve (at most 5 in the tests).
 
-use crate::closed_form::{Branch, inverse_kinematics};
+use crate::closed_form::{Branch, RATIO_UNCERTAINTY, inverse_kinematics};
 use crate::error::KinError;
 use crate::harmonic_ik::{IkOptions, IkReport, Workspace, least_squares};
 use crate::modal_map::{check_harmonics, harmonic_basis};
@@ -119,7 +119,7 @@ impl ChainIk {
         check_finite("target y", target[1])?;
         check_values("initial guess", a, self.trial.len())?;
         let r = target[0].hypot(target[1]);
-        if r > self.length {
+        if r > self.length * (1.0 + RATIO_UNCERTAINTY) {
             return Err(KinError::OutOfReach {
                 r,
                 length: self.length,

@@ -23,8 +23,10 @@ pub enum Branch {
 }
 
 /// Relative uncertainty of `r / l` as the inverse sees it: the rounding of `hypot` and of the
-/// division, and the error of `libm::j0` in a round trip.
-const RATIO_UNCERTAINTY: f64 = 4.0 * f64::EPSILON;
+/// division, and the error of `libm::j0` in a round trip. The numerical solvers allow a target
+/// as far beyond the length (a rounded sum of the links'), so that a target at the nominal
+/// length is reached whatever the method.
+pub(crate) const RATIO_UNCERTAINTY: f64 = 4.0 * f64::EPSILON;
 
 /// The end point of the two-mode backbone curve of length `length` (eqs 3-4, corrected):
 /// `l J0(A) (cos(alpha0 + a2), sin(alpha0 + a2))`, `a = [a1, a2]`, `A = |a|`.

@@ -174,7 +174,7 @@ pub enum KinError {
     },
     /// A numerical inverse kinematics did not reach its tolerance.
     #[error(
-        "numerical inverse kinematics did not converge: end-point error {residual:e} after {iterations} iterations (tolerance {tolerance:e})"
+        "numerical inverse kinematics did not converge: end-point error {residual:e} after {iterations} iterations (tolerance {tolerance:e}); from another guess it may"
     )]
     NotConverged {
         /// Iterations spent.

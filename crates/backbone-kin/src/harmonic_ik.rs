@@ -22,7 +22,7 @@
 //! fixed list of other starts: it reaches every end point of 200 random `K = 2` and `K = 3`
 //! curves with coordinates in `[-0.5, 0.5]` (test `unguided_ik_reaches_what_the_family_reaches`).
 
-use crate::closed_form::{Branch, inverse_kinematics};
+use crate::closed_form::{Branch, RATIO_UNCERTAINTY, inverse_kinematics};
 use crate::curve::BackboneCurve;
 use crate::error::KinError;
 use crate::modal_map::check_harmonics;
@@ -165,7 +165,7 @@ impl HarmonicIk {
         check_values("initial guess", a, self.trial.len())?;
         let length = self.curve.length();
         let r = target[0].hypot(target[1]);
-        if r > length {
+        if r > length * (1.0 + RATIO_UNCERTAINTY) {
             return Err(KinError::OutOfReach { r, length });
         }
         let tolerance = self.options.tolerance * length;

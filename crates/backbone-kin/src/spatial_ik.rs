@@ -10,6 +10,7 @@
 //! solver returns a solution near the guess. The method is local: the straight arm (`a = 0`) is
 //! a singular start for targets on its axis, so give a bent guess for those.
 
+use crate::closed_form::RATIO_UNCERTAINTY;
 use crate::error::KinError;
 use crate::harmonic_ik::{IkOptions, IkReport, Workspace, least_squares};
 use crate::spatial_chain::{BasePose, spatial_tip_jacobian};
@@ -108,7 +109,7 @@ impl SpatialIk {
         }
         check_values("initial guess", a, self.trial.len())?;
         let r = distance(target, self.base.xyz);
-        if r > self.length {
+        if r > self.length * (1.0 + RATIO_UNCERTAINTY) {
             return Err(KinError::OutOfReach {
                 r,
                 length: self.length,

@@ -622,5 +622,11 @@ def test_rates_and_spatial_gravity_are_read_as_hrm_eval_reads_them():
         assert hrm.SpatialArm(links=2, gravity=g).gravity == expected, g
     with pytest.raises(hrm.InvalidInput, match=r"^arm\.gravity must be"):
         hrm.SpatialArm(gravity=1e7)
+    for flag in (True, np.bool_(False), np.array(True)):
+        with pytest.raises(TypeError, match=r"^gravity must be a number g or a vector \(x, y, z\), got a "):
+            hrm.SpatialArm(gravity=flag)
+    # A reference sample's rate, as a run's reference would reach it.
+    with pytest.raises(hrm.InvalidInput, match=r"^a_dot\[2\] must be at most 1000000 " + unit):
+        hrm.ReferenceSample(np.zeros(3), [0.0, 0.0, 1e7], np.zeros(3))
     with pytest.raises(hrm.InvalidInput, match=r"^gravity must have 3 entries \(x, y, z\), got 1$"):
         hrm.SpatialArm(gravity=np.array([9.81]))

@@ -3,8 +3,9 @@
 //! for any link lengths; and the curve-versus-chain error it removes obeys the derived bound.
 
 use backbone_kin::{
-    BackboneCurve, BaseAngle, Branch, ChainIk, IkOptions, KinError, ModalMap,
-    chain_inverse_kinematics, end_point, inverse_kinematics, tip_position,
+    BackboneCurve, BaseAngle, BasePose, Branch, ChainIk, HarmonicIk, IkOptions, KinError, ModalMap,
+    SpatialIk, SpatialModalMap, chain_inverse_kinematics, end_point, inverse_kinematics,
+    tip_position,
 };
 use lane_math::Classify;
 use proptest::prelude::*;
@@ -73,6 +74,41 @@ fn chain_ik_needs_few_newton_steps_and_reports_them() {
     assert!((1..=5).contains(&report.iterations), "{report:?}");
     assert!(report.residual <= ik.options().tolerance);
     assert!(distance(chain_tip(&lengths, &a, FRAC_PI_2), [0.3, 0.5]) <= 1e-14);
+}
+
+#[test]
+fn a_target_at_the_nominal_length_is_reached_whatever_the_method() {
+    // Ten links of 0.1 m sum to 0.9999999999999999: a target at the nominal 1 m is within the
+    // rounding of that sum, and every solver reaches it as the closed form does (the numerical
+    // ones refused it as out of reach, so the answer depended on K).
+    let lengths = [0.1; 10];
+    let length: f64 = lengths.iter().sum();
+    assert!(length < 1.0);
+    let target = [0.0, 1.0];
+    assert!(inverse_kinematics(length, target, FRAC_PI_2, Branch::Positive).is_ok());
+    for k in 1..=3 {
+        let mut a = vec![0.0; 2 * k];
+        let report = HarmonicIk::new(length, k, FRAC_PI_2)
+            .unwrap()
+            .solve(target, &mut a)
+            .unwrap();
+        assert!(report.residual <= 1e-15, "K = {k}: {report:?}");
+        let mut a = vec![0.0; 2 * k];
+        let mut chain = ChainIk::new(&lengths, k, FRAC_PI_2).unwrap();
+        chain.solve(target, &mut a).unwrap();
+        assert!(distance(chain_tip(&lengths, &a, FRAC_PI_2), target) <= 1e-15);
+    }
+    let map = SpatialModalMap::new(&lengths, 1).unwrap();
+    let mut spatial = SpatialIk::new(map, BasePose::default()).unwrap();
+    spatial.solve([1.0, 0.0, 0.0], &mut [0.0; 4]).unwrap();
+    // Past the rounding: out of reach.
+    let beyond = HarmonicIk::new(length, 2, FRAC_PI_2)
+        .unwrap()
+        .solve([0.0, 1.0 + 1e-15], &mut [0.0; 4]);
+    assert!(
+        matches!(beyond, Err(KinError::OutOfReach { .. })),
+        "{beyond:?}"
+    );
 }
 
 #[test]
