@@ -23,7 +23,7 @@
 //! the iteration is Newton's method, which from the closed-form start converges in a few steps
 //! whenever the chain is close to its curve (at most 5 in the tests).
 
-use crate::closed_form::{Branch, RATIO_UNCERTAINTY, inverse_kinematics};
+use crate::closed_form::{Branch, check_reach, inverse_kinematics};
 use crate::error::KinError;
 use crate::harmonic_ik::{IkOptions, IkReport, Workspace, least_squares};
 use crate::modal_map::{check_harmonics, harmonic_basis};
@@ -110,21 +110,17 @@ impl ChainIk {
     /// the initial guess on entry and the solution on success (the best iterate after
     /// [`KinError::NotConverged`]).
     ///
-    /// Errors: [`KinError::OutOfReach`] if `|target| > l`; [`KinError::NotConverged`] if the
-    /// iteration stalls or runs out of steps (a target the chain cannot reach on this family
-    /// and `alpha0`, or a poor guess); input errors for a non-finite target or guess, or a guess
+    /// Errors: [`KinError::OutOfReach`] if `|target| > l` beyond rounding;
+    /// [`KinError::NotConverged`] if the iteration stalls or runs out of steps (a target the
+    /// chain cannot reach on this family and `alpha0`, or a poor guess); [`KinError::Stationary`]
+    /// where no step is defined (a zero Jacobian); input errors for a non-finite target or guess, or a guess
     /// of the wrong size.
     pub fn solve(&mut self, target: [f64; 2], a: &mut [f64]) -> Result<IkReport, KinError> {
         check_finite("target x", target[0])?;
         check_finite("target y", target[1])?;
         check_values("initial guess", a, self.trial.len())?;
         let r = target[0].hypot(target[1]);
-        if r > self.length * (1.0 + RATIO_UNCERTAINTY) {
-            return Err(KinError::OutOfReach {
-                r,
-                length: self.length,
-            });
-        }
+        check_reach(r, self.length)?;
         let (lengths, length, alpha0) = (&self.link_lengths, self.length, self.alpha0);
         least_squares(
             target,

@@ -23,10 +23,19 @@ pub enum Branch {
 }
 
 /// Relative uncertainty of `r / l` as the inverse sees it: the rounding of `hypot` and of the
-/// division, and the error of `libm::j0` in a round trip. The numerical solvers allow a target
-/// as far beyond the length (a rounded sum of the links'), so that a target at the nominal
-/// length is reached whatever the method.
-pub(crate) const RATIO_UNCERTAINTY: f64 = 4.0 * f64::EPSILON;
+/// division, and the error of `libm::j0` in a round trip.
+const RATIO_UNCERTAINTY: f64 = 4.0 * f64::EPSILON;
+
+/// Refuses a target at distance `r` from the base beyond the arm's `length` by more than
+/// [`RATIO_UNCERTAINTY`]: the reach of every inverse kinematics, closed-form and numerical, so
+/// that a target at the nominal length (the length is a rounded sum of the links') is reached
+/// whatever the method.
+pub(crate) fn check_reach(r: f64, length: f64) -> Result<(), KinError> {
+    if r > length * (1.0 + RATIO_UNCERTAINTY) {
+        return Err(KinError::OutOfReach { r, length });
+    }
+    Ok(())
+}
 
 /// The end point of the two-mode backbone curve of length `length` (eqs 3-4, corrected):
 /// `l J0(A) (cos(alpha0 + a2), sin(alpha0 + a2))`, `a = [a1, a2]`, `A = |a|`.
@@ -94,9 +103,7 @@ pub fn inverse_kinematics(
     check_finite("target y", target[1])?;
     check_finite("alpha0", alpha0)?;
     let r = target[0].hypot(target[1]);
-    if r > length * (1.0 + RATIO_UNCERTAINTY) {
-        return Err(KinError::OutOfReach { r, length });
-    }
+    check_reach(r, length)?;
     if r <= length * f64::EPSILON {
         return Err(KinError::AtBase { r, length });
     }

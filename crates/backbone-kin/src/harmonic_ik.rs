@@ -22,7 +22,7 @@
 //! fixed list of other starts: it reaches every end point of 200 random `K = 2` and `K = 3`
 //! curves with coordinates in `[-0.5, 0.5]` (test `unguided_ik_reaches_what_the_family_reaches`).
 
-use crate::closed_form::{Branch, RATIO_UNCERTAINTY, inverse_kinematics};
+use crate::closed_form::{Branch, check_reach, inverse_kinematics};
 use crate::curve::BackboneCurve;
 use crate::error::KinError;
 use crate::modal_map::check_harmonics;
@@ -153,21 +153,19 @@ impl HarmonicIk {
     /// initial guess on entry and the solution on success; after [`KinError::NotConverged`] they
     /// hold the best iterate found.
     ///
-    /// Errors: [`KinError::OutOfReach`] if `|target| > l` (no curve of length `l` reaches it);
-    /// [`KinError::NotConverged`] if the tolerance is not met within the iteration budget or the
-    /// iteration stalls (for instance from the straight guess `a = 0` towards a target on the
-    /// base direction, where the end point is stationary, or for a target the family cannot
-    /// reach with this `alpha0`); input errors for a non-finite target or guess, or a guess of
-    /// the wrong size.
+    /// Errors: [`KinError::OutOfReach`] if `|target| > l` beyond rounding (no curve of length `l`
+    /// reaches it); [`KinError::NotConverged`] if the tolerance is not met within the iteration
+    /// budget or the iteration stalls (for a target the family cannot reach with this `alpha0`);
+    /// [`KinError::Stationary`] where no step is defined (from the straight guess `a = 0`, where
+    /// the end point does not move to first order); input errors for a non-finite target or
+    /// guess, or a guess of the wrong size.
     pub fn solve(&mut self, target: [f64; 2], a: &mut [f64]) -> Result<IkReport, KinError> {
         check_finite("target x", target[0])?;
         check_finite("target y", target[1])?;
         check_values("initial guess", a, self.trial.len())?;
         let length = self.curve.length();
         let r = target[0].hypot(target[1]);
-        if r > length * (1.0 + RATIO_UNCERTAINTY) {
-            return Err(KinError::OutOfReach { r, length });
-        }
+        check_reach(r, length)?;
         let tolerance = self.options.tolerance * length;
         let curve = &mut self.curve;
         least_squares(

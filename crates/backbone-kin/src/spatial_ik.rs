@@ -10,7 +10,7 @@
 //! solver returns a solution near the guess. The method is local: the straight arm (`a = 0`) is
 //! a singular start for targets on its axis, so give a bent guess for those.
 
-use crate::closed_form::RATIO_UNCERTAINTY;
+use crate::closed_form::check_reach;
 use crate::error::KinError;
 use crate::harmonic_ik::{IkOptions, IkReport, Workspace, least_squares};
 use crate::spatial_chain::{BasePose, spatial_tip_jacobian};
@@ -101,20 +101,16 @@ impl SpatialIk {
     /// [`KinError::NotConverged`]).
     ///
     /// Errors: [`KinError::OutOfReach`] if the target is farther from the base than the chain is
-    /// long; [`KinError::NotConverged`] if the iteration stalls or runs out of steps; input
-    /// errors for a non-finite target or guess, or a guess of the wrong size.
+    /// long (beyond rounding); [`KinError::NotConverged`] if the iteration stalls or runs out of
+    /// steps; [`KinError::Stationary`] where no step is defined (a zero Jacobian); input errors
+    /// for a non-finite target or guess, or a guess of the wrong size.
     pub fn solve(&mut self, target: [f64; 3], a: &mut [f64]) -> Result<IkReport, KinError> {
         for (name, value) in ["target x", "target y", "target z"].into_iter().zip(target) {
             check_finite(name, value)?;
         }
         check_values("initial guess", a, self.trial.len())?;
         let r = distance(target, self.base.xyz);
-        if r > self.length * (1.0 + RATIO_UNCERTAINTY) {
-            return Err(KinError::OutOfReach {
-                r,
-                length: self.length,
-            });
-        }
+        check_reach(r, self.length)?;
         let Self {
             map,
             base,
