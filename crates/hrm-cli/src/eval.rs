@@ -241,6 +241,7 @@ fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
     // `"urdf"` in place of `"arm"`: the spatial chain of a robot description.
     let urdf = request.contains_key("urdf");
     if spatial::is_spatial(&request) {
+        request::check_spatial_coordinates(&request)?;
         return spatial::dispatch(op, request);
     }
     match op {
@@ -786,11 +787,15 @@ mod tests {
                 "arm.inertias[0] is invalid: link 0: inertia must be non-negative and finite, \
                  got -1",
             ),
-            // Finite joint angles whose running sums overflow: the tip of the chain.
+            // A mode beyond the scale a run resolves (in `J a` it rounds the others away);
+            // the base angle is reduced instead (`a_huge_alpha0_gives_the_answer_of_its_angle`).
             (
                 json!({"op": "fk", "a": [0, 1e308], "alpha0": 0}),
-                "a: absolute link angles (running sums of the joint angles)[4] must be finite, \
-                 got inf",
+                "a[1] must be at most 1000000 in magnitude (rad), got 1e308",
+            ),
+            (
+                json!({"op": "joints", "a": [0.1, -1e17, 0.2], "harmonics": 1}),
+                "a[1] must be at most 1000000 in magnitude (rad), got -1e17",
             ),
             (
                 json!({"op": "fuzzy", "controller": "paper", "inputs": [0.1, 0.1, 0.1]}),
@@ -801,8 +806,8 @@ mod tests {
             assert_eq!(answer["error"]["kind"], "invalid_input", "{answer}");
             assert_eq!(answer["error"]["message"], message);
         }
-        // A first harmonic of 1e308: no quadrature resolves it.
-        let answer = request(json!({"op": "fk", "a": [1e308, 2, 3, 4, 5], "harmonics": 2}));
+        // A first harmonic at the bound: no quadrature resolves it.
+        let answer = request(json!({"op": "fk", "a": [1e6, 2, 3, 4, 5], "harmonics": 2}));
         let message = answer["error"]["message"].as_str().unwrap();
         assert!(
             message.starts_with("a: the curve oscillates too fast")

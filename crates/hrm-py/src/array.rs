@@ -38,7 +38,9 @@ const WORK_PER_CHUNK: usize = 1 << 22;
 pub(crate) const MAX_OUTPUT_VALUES: usize = 1 << 28;
 
 /// The arguments that hold joint or modal rates, refused beyond the scale a run resolves
-/// ([`sim_core::check_rates`]) as `hrm eval` refuses them.
+/// ([`sim_core::check_rates`]) as `hrm eval` refuses them; the modal coordinates `a` likewise
+/// ([`sim_core::check_coordinates`]; a free base angle, the last entry, with them: a run bounds
+/// it too).
 const RATE_NAMES: [&str; 2] = ["theta_dot", "a_dot"];
 
 /// One input argument: a float64 array of one state `(width,)` or a batch `(N, width)`.
@@ -98,10 +100,14 @@ impl<'py> States<'py> {
             copy,
             batch,
         };
-        if RATE_NAMES.contains(&name) {
+        let scale = if RATE_NAMES.contains(&name) {
             sim_core::check_rates(name, states.values(), width)
-                .map_err(|e| Error::input(e.to_string()))?;
-        }
+        } else if name == "a" {
+            sim_core::check_coordinates(name, states.values(), width)
+        } else {
+            Ok(())
+        };
+        scale.map_err(|e| Error::input(e.to_string()))?;
         Ok(states)
     }
 

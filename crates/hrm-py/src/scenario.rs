@@ -447,7 +447,8 @@ impl ReferenceSample {
         for (name, values) in [("a", &a), ("a_dot", &a_dot), ("a_ddot", &a_ddot)] {
             lane_math::check_all_finite(name, values).map_err(|e| Error::input(e.to_string()))?;
         }
-        sim_core::check_rates("a_dot", &a_dot, a_dot.len())
+        sim_core::check_coordinates("a", &a, a.len())
+            .and_then(|()| sim_core::check_rates("a_dot", &a_dot, a_dot.len()))
             .map_err(|e| Error::input(e.to_string()))?;
         Ok(Self {
             a: PyArray1::from_vec(py, a).unbind(),

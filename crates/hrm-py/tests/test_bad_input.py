@@ -630,3 +630,21 @@ def test_rates_and_spatial_gravity_are_read_as_hrm_eval_reads_them():
         hrm.ReferenceSample(np.zeros(3), [0.0, 0.0, 1e7], np.zeros(3))
     with pytest.raises(hrm.InvalidInput, match=r"^gravity must have 3 entries \(x, y, z\), got 1$"):
         hrm.SpatialArm(gravity=np.array([9.81]))
+
+
+def test_modal_coordinates_are_bounded_as_a_run_bounds_them():
+    # A mode of 1e17 rounds the others away in theta = J a + theta_0: refused beyond the 1e6
+    # at which a run stops, as hrm eval refuses it; a batch names the state.
+    unit = r" must be at most 1000000 in magnitude \(rad\), got "
+    reduced = hrm.ReducedModel(hrm.Arm(links=10))
+    with pytest.raises(hrm.InvalidInput, match=r"^a\[1\]" + unit + "1e17$"):
+        reduced.joint_angles([0.1, 1e17, 0.0])
+    with pytest.raises(hrm.InvalidInput, match=r"^a\[1, 0\]" + unit + "-2000000$"):
+        reduced.fk(np.array([[0.1, 0.2, 0.0], [-2e6, 0.0, 0.0]]))
+    with pytest.raises(hrm.InvalidInput, match=r"^a\[3\]" + unit):
+        hrm.SpatialArm().forward_dynamics([0.1, 0.0, 0.0, 1e300], [0.0] * 4, [0.0] * 4)
+    with pytest.raises(hrm.InvalidInput, match=r"^a\[0\]" + unit):
+        hrm.ReferenceSample([1e7, 0.0], np.zeros(2), np.zeros(2))
+    # At the bound the answer is the arithmetic's: theta = J a + theta_0 to rounding.
+    a = np.array([1e6, -1e6, 0.5])
+    assert np.allclose(reduced.joint_angles(a), reduced.jacobian @ a, rtol=0, atol=1e-9)

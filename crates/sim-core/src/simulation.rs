@@ -1299,14 +1299,32 @@ fn check_initial(initial: &ModalState, m: usize) -> Result<(), SimError> {
 /// # Errors
 /// [`SimError::InvalidSetting`] naming the entry.
 pub fn check_rates(name: &str, rates: &[f64], width: usize) -> Result<(), SimError> {
-    let Some((flat, value)) = rates
+    check_scale(name, rates, width, "rad/s, m/s for a prismatic joint")
+}
+
+/// Refuses modal coordinates beyond [`MAX_MODAL_MAGNITUDE`] in magnitude, where a run stops
+/// ([`SimError::OutOfScale`]): in `J a` (eq 8) a coordinate of `1e17` rounds the others away.
+/// Named as [`check_rates`] names its entries; for the coordinates the front ends are given
+/// (`hrm eval`'s and Python's `a`). A base angle `alpha0` that a front end reduces to
+/// `(-pi, pi]` first is not a coordinate this bounds.
+///
+/// # Errors
+/// [`SimError::InvalidSetting`] naming the entry.
+pub fn check_coordinates(name: &str, coordinates: &[f64], width: usize) -> Result<(), SimError> {
+    check_scale(name, coordinates, width, "rad")
+}
+
+/// [`check_rates`] and [`check_coordinates`]: the first entry beyond [`MAX_MODAL_MAGNITUDE`],
+/// its unit named in the message.
+fn check_scale(name: &str, values: &[f64], width: usize, unit: &str) -> Result<(), SimError> {
+    let Some((flat, value)) = values
         .iter()
         .enumerate()
         .find(|(_, v)| v.abs() > MAX_MODAL_MAGNITUDE)
     else {
         return Ok(());
     };
-    let entry = if rates.len() <= width {
+    let entry = if values.len() <= width {
         format!("{name}[{flat}]")
     } else {
         format!("{name}[{}, {}]", flat / width.max(1), flat % width.max(1))
@@ -1314,7 +1332,7 @@ pub fn check_rates(name: &str, rates: &[f64], width: usize) -> Result<(), SimErr
     Err(SimError::setting(
         entry,
         format!(
-            "must be at most {} in magnitude (rad/s, m/s for a prismatic joint), got {}",
+            "must be at most {} in magnitude ({unit}), got {}",
             Compact(MAX_MODAL_MAGNITUDE),
             Compact(*value)
         ),

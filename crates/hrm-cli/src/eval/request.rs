@@ -219,6 +219,10 @@ pub(super) fn modal_map(
             )));
         }
     };
+    // The base angle is reduced above; the modes are not, and one of 1e17 would round the
+    // others away in `J a`.
+    sim_core::check_coordinates("a", &a[..2 * k], 2 * k)
+        .map_err(|e| EvalError::input(e.to_string()))?;
     let (n, m) = (chain.n_links(), a.len());
     let entries = n.saturating_mul(m);
     if entries > MAX_MAP_ANSWER {
@@ -272,6 +276,17 @@ pub(super) fn check_rates(request: &Map<String, Value>) -> Result<(), EvalError>
             .map_err(|e| EvalError::input(e.to_string()))?;
     }
     Ok(())
+}
+
+/// Refuses a spatial request's modal coordinates `a` beyond the scale a run resolves
+/// ([`sim_core::check_coordinates`]), as [`check_rates`] refuses rates; a planar request's are
+/// checked by [`modal_map`], which knows whether the last entry is the base angle.
+pub(super) fn check_spatial_coordinates(request: &Map<String, Value>) -> Result<(), EvalError> {
+    let Some(Value::Array(values)) = request.get("a") else {
+        return Ok(());
+    };
+    let a: Vec<f64> = values.iter().map(|v| v.as_f64().unwrap_or(0.0)).collect();
+    sim_core::check_coordinates("a", &a, a.len()).map_err(|e| EvalError::input(e.to_string()))
 }
 
 /// Refuses to answer with a non-finite number (JSON has none).

@@ -349,15 +349,25 @@ mod tests {
                 && message.contains("start from a guess of smaller coordinates"),
             "{message}"
         );
-        // Amplitudes whose turning bound overflows.
+        // Amplitudes at the bound of a run's scale: no quadrature resolves them; beyond it
+        // they are refused before any quadrature.
         let answer = request(json!({"op": "fk", "arm": {"kind": "spatial"},
-            "a": [1e308, 1e308, 0.0, 0.0]}));
+            "a": [1e6, 1e6, 0.0, 0.0]}));
         let message = answer["error"]["message"].as_str().unwrap();
         assert!(
             message.starts_with("a: the curve oscillates too fast")
-                && message.contains("more than 1e308 nodes needed"),
+                && message.contains("50265484 nodes needed"),
             "{message}"
         );
+        for op in ["fk", "joints", "reduced"] {
+            let answer = request(json!({"op": op, "arm": {"kind": "spatial"},
+                "a": [0.1, 0.2, 0.3, -1e17], "a_dot": [0, 0, 0, 0], "tau_star": [0, 0, 0, 0]}));
+            assert_eq!(
+                answer["error"]["message"],
+                "a[3] must be at most 1000000 in magnitude (rad), got -1e17",
+                "{op}"
+            );
+        }
     }
 
     #[test]

@@ -420,7 +420,8 @@ fn edge_case_lines_get_one_error_each_and_the_stream_goes_on() {
         (r#"{"id":2,"op":"fk","a":[1e400,0],"alpha0":0}"#.into(), "parse"),
         (format!(r#"{{"id":3,"op":"fk","a":[{},0],"alpha0":0}}"#, "1".repeat(5000)), "parse"),
         (format!(r#"{{"id":3.5,"op":"fk","a":[0.{}1,0],"alpha0":0}}"#, "0".repeat(5000)), "ok"),
-        (format!(r#"{{"id":3.7,"op":"fk","a":[{},0],"alpha0":0}}"#, "1".repeat(30)), "ok"),
+        // A 30-digit integer is read as a number, and refused as a modal coordinate.
+        (format!(r#"{{"id":3.7,"op":"fk","a":[{},0],"alpha0":0}}"#, "1".repeat(30)), "invalid_input"),
         (r#"{"id":4,"op":"joints","arm":{"links":1000000000},"a":[0,0,0]}"#.into(), "invalid_input"),
         (r#"{"id":5,"op":"dynamics","arm":{"links":1000000000000},"theta":[0],"theta_dot":[0]}"#.into(), "invalid_input"),
         (r#"{"id":6,"op":"reduced","arm":{"links":18446744073709551615},"a":[0,0,0],"a_dot":[0,0,0],"tau_star":[0,0,0]}"#.into(), "invalid_input"),
@@ -429,12 +430,13 @@ fn edge_case_lines_get_one_error_each_and_the_stream_goes_on() {
         (r#"{"id":9,"op":"fk","a":["NaN",0],"alpha0":0}"#.into(), "invalid_request"),
         (r#"{"id":10,"op":"dynamics","theta":[],"theta_dot":[]}"#.into(), "invalid_input"),
         (format!(r#"{{"id":11,"op":"fuzzy","fis":{huge_fis},"inputs":[0,0,0,0]}}"#), "invalid_input"),
-        // theta = J a overflows; a huge alpha0 alone does not (it is reduced modulo 2 pi).
-        (r#"{"id":12,"op":"joints","harmonics":2,"a":[1.7e308,1.7e308,1.7e308,1.7e308,0]}"#.into(), "numerical"),
+        // Modes beyond the scale of a run (theta = J a would overflow); a huge alpha0 alone
+        // is answered (it is reduced modulo 2 pi).
+        (r#"{"id":12,"op":"joints","harmonics":2,"a":[1.7e308,1.7e308,1.7e308,1.7e308,0]}"#.into(), "invalid_input"),
         (r#"{"id":12.5,"op":"joints","a":[0,0,1.7e308]}"#.into(), "ok"),
-        // The same overflow in `fk`'s chain, planar and spatial, is the same answer.
-        (r#"{"id":12.6,"op":"fk","arm":{"links":4},"a":[1.7e308,1.7e308],"alpha0":0}"#.into(), "numerical"),
-        (r#"{"id":12.7,"op":"fk","arm":{"kind":"spatial","links":4},"a":[1.7e308,1.7e308,1.7e308,1.7e308]}"#.into(), "numerical"),
+        // The same in `fk`, planar and spatial, is the same answer.
+        (r#"{"id":12.6,"op":"fk","arm":{"links":4},"a":[1.7e308,1.7e308],"alpha0":0}"#.into(), "invalid_input"),
+        (r#"{"id":12.7,"op":"fk","arm":{"kind":"spatial","links":4},"a":[1.7e308,1.7e308,1.7e308,1.7e308]}"#.into(), "invalid_input"),
         ("\u{feff}{\"id\":13,\"op\":\"fk\"}".into(), "parse"),
         (r#"{"id":-0,"op":"joints","a":[-0,-0,-0]}"#.into(), "ok"),
     ];
