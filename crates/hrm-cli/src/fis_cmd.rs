@@ -75,7 +75,12 @@ enum FisCommand {
         #[arg(long, default_value_t = 41, allow_negative_numbers = true)]
         resolution: i128,
         /// Values of the inputs not on a surface's axes, comma-separated (default: the middle of each range).
-        #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+        #[arg(
+            long,
+            value_delimiter = ',',
+            action = clap::ArgAction::Set,
+            allow_hyphen_values = true
+        )]
         reference: Option<Vec<f64>>,
     },
 }

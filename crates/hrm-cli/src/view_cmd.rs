@@ -32,7 +32,7 @@ pub struct ViewArgs {
     /// A sweep's runs to show (their numbers in `--list`), at most 12; they are run again from
     /// the sweep's configuration. Default: the first seed of every controller at the lowest and
     /// the highest noise level. The GIF shows the first.
-    #[arg(long, value_delimiter = ',', value_name = "I,J,...")]
+    #[arg(long, value_delimiter = ',', action = clap::ArgAction::Set, value_name = "I,J,...")]
     runs: Option<Vec<usize>>,
     /// List a sweep's runs (number, noise level, controller, seed, outcome) and write nothing.
     #[arg(long)]

@@ -54,6 +54,7 @@ struct SweepArgs {
     #[arg(
         long,
         value_delimiter = ',',
+        action = clap::ArgAction::Set,
         default_value = crate::args::ALL_CONTROLLERS.as_str()
     )]
     controllers: Vec<ControllerKind>,
@@ -61,6 +62,7 @@ struct SweepArgs {
     #[arg(
         long,
         value_delimiter = ',',
+        action = clap::ArgAction::Set,
         allow_negative_numbers = true,
         default_value = "0,0.005,0.01,0.02,0.05,0.1"
     )]

@@ -88,6 +88,32 @@ fn help_shows_list_defaults_as_they_are_typed() {
 }
 
 #[test]
+fn a_repeated_option_keeps_its_last_value() {
+    let cli = parse(&[
+        "--noise",
+        "0,0.01",
+        "--noise",
+        "0.02",
+        "--controllers",
+        "pd",
+        "--controllers",
+        "fuzzy",
+        "--seeds",
+        "1",
+        "--seeds",
+        "2",
+    ])
+    .unwrap();
+    let a = &cli.sweep;
+    assert_eq!(a.noise, [0.02]);
+    assert_eq!(a.controllers, [ControllerKind::Fuzzy]);
+    assert_eq!(a.seeds, 2);
+    // A list typed valid last is valid, whatever came before.
+    let cli = parse(&["--noise", "0,0.01", "--noise", "0"]).unwrap();
+    assert_eq!(cli.sweep.noise, [0.0]);
+}
+
+#[test]
 fn the_command_line_parses_with_defaults_and_merge() {
     let cli = parse(&[]).unwrap();
     assert!(cli.command.is_none());
