@@ -3,10 +3,12 @@
 //! fails leaves an existing output folder exactly as it was; one that succeeds replaces it
 //! whole, so no file of an earlier run is left beside the new ones.
 //!
-//! Every output folder holds a marker file, [`MARKER`]. An existing folder is replaced only if
-//! it is empty, carries the marker, or holds nothing but marked folders (the parent of nested
-//! outputs, such as `hrm-output` after `hrm simulate`), so `--out .` or a typo never deletes a
-//! user's files. Marked folders nested in a replaced folder (`hrm-output/simulate` inside the
+//! Every output folder holds a marker file, [`MARKER`], naming the command that wrote it and
+//! listing every entry it wrote. An existing folder is replaced only if it is empty, carries the
+//! marker and holds nothing the marker does not list (besides pages and GIFs of `hrm view`), or
+//! holds nothing but marked folders (the parent of nested outputs, such as `hrm-output` after
+//! `hrm simulate`), so `--out .`, a typo or a note the user saved into an output never deletes
+//! a user's files. Marked folders nested in a replaced folder (`hrm-output/simulate` inside the
 //! main job's `hrm-output`) are the outputs of other commands: they are carried into the new
 //! folder unless it has an entry of the same name.
 
@@ -27,6 +29,8 @@ pub struct OutputDir {
     target: PathBuf,
     /// The staging folder, a sibling of `target`.
     staging: PathBuf,
+    /// The command writing the folder, as its [`MARKER`] names it.
+    command: String,
     /// Whether the staging folder became the output.
     committed: bool,
 }
@@ -86,6 +90,13 @@ impl OutputDir {
                         shown.display()
                     ));
                 }
+                if let Some(entry) = unlisted_entry(&target)? {
+                    return Err(format!(
+                        "output folder {}: holds {entry}, which hrm did not write; move it out \
+                         of the folder or choose another --out",
+                        shown.display()
+                    ));
+                }
             }
         }
         remove_abandoned(&target, "staging");
@@ -103,6 +114,7 @@ impl OutputDir {
             shown: shown.clone(),
             target,
             staging,
+            command: command.to_string(),
             committed: false,
         };
         std::fs::write(
@@ -144,6 +156,8 @@ impl OutputDir {
         let old = sibling(&self.target, "old");
         let had_old = self.target.exists();
         let fail = |what: &str, e: std::io::Error| format!("{what} {}: {e}", self.shown.display());
+        write_manifest(&self.staging, &self.command)
+            .map_err(|e| fail("cannot write the marker of", e))?;
         if had_old {
             if old.exists() {
                 std::fs::remove_dir_all(&old)
@@ -596,6 +610,116 @@ fn make_writable(dir: &Path) {
     }
 }
 
+/// The line of a [`MARKER`] after which the entries of the output are listed, one a line, as
+/// paths relative to the folder with `/` between names and after a folder's name.
+const MANIFEST_HEADER: &str = "# every entry of this folder that hrm wrote, one a line:";
+
+/// The most entries an output folder's check walks (and a manifest lists): far beyond the main
+/// job's few hundred files, and a bound on the work of the check.
+const MAX_MANIFEST_ENTRIES: usize = 1 << 20;
+
+/// The most bytes of a [`MARKER`] read with its manifest (`MAX_MANIFEST_ENTRIES` paths of 64
+/// bytes).
+const MAX_MANIFEST_BYTES: usize = 64 << 20;
+
+/// Rewrites the [`MARKER`] of the staging folder `dir` with the list of every entry in it
+/// ([`MANIFEST_HEADER`]), so that a later command can tell them from files the user adds.
+fn write_manifest(dir: &Path, command: &str) -> std::io::Result<()> {
+    let mut entries = Vec::new();
+    let mut count = 0;
+    walk(dir, &mut count, &mut |_, relative, is_dir| {
+        if relative != MARKER {
+            entries.push(relative.to_string());
+        }
+        Ok(is_dir)
+    })?;
+    entries.sort_unstable();
+    let mut text = format!("written by `hrm {command}`\n{MANIFEST_HEADER}\n");
+    for entry in entries {
+        text.push_str(&entry);
+        text.push('\n');
+    }
+    std::fs::write(dir.join(MARKER), text)
+}
+
+/// The first entry of the marked output folder `dir` that its [`MARKER`] does not list and hrm
+/// did not write (a file or folder the user put there), as a path relative to `dir`; `None`
+/// when there is none, or when the marker lists nothing (a folder that another hrm command
+/// marked with its name alone). Nested outputs of other commands, carried over by a commit,
+/// and pages and GIFs of `hrm view` are hrm's.
+///
+/// # Errors
+/// A folder holding more than [`MAX_MANIFEST_ENTRIES`] entries, or one that cannot be read.
+fn unlisted_entry(dir: &Path) -> Result<Option<String>, String> {
+    let Some(marker) = regular_file_start(&dir.join(MARKER), MAX_MANIFEST_BYTES) else {
+        return Ok(None);
+    };
+    let marker = String::from_utf8_lossy(&marker);
+    let mut lines = marker.lines().skip(1);
+    if lines.next() != Some(MANIFEST_HEADER) {
+        return Ok(None);
+    }
+    let listed: std::collections::HashSet<&str> = lines.collect();
+    let mut unlisted = None;
+    let mut count = 0;
+    let walked = walk(dir, &mut count, &mut |path, relative, is_dir| {
+        let hrm_wrote = relative == MARKER
+            || listed.contains(relative)
+            || (!is_dir
+                && regular_file_start(path, run_view::SIGNATURE_WITHIN)
+                    .is_some_and(|start| run_view::written_by_hrm(&start)));
+        let nested_output = is_dir && is_output(path) && !is_output_of_parent(path);
+        if nested_output || !hrm_wrote {
+            if !nested_output {
+                unlisted = Some(relative.trim_end_matches('/').to_string());
+            }
+            return Ok(false);
+        }
+        Ok(is_dir)
+    });
+    match walked {
+        Ok(()) => Ok(unlisted),
+        Err(e) => Err(format!("output folder {}: {e}", dir.display())),
+    }
+}
+
+/// Visits every entry under `root` (symbolic links not followed), each folder's in sorted order,
+/// with its path,
+/// its path relative to `root` (`/` between names, and after a folder's name) and whether it is
+/// a folder; `visit` says whether to go into a folder, and may stop the walk by returning an
+/// error. `count` counts the entries visited, at most [`MAX_MANIFEST_ENTRIES`]; names that are
+/// not UTF-8 are read lossily (so no manifest lists them).
+fn walk(
+    root: &Path,
+    count: &mut usize,
+    visit: &mut dyn FnMut(&Path, &str, bool) -> std::io::Result<bool>,
+) -> std::io::Result<()> {
+    let mut pending = vec![(root.to_path_buf(), String::new())];
+    while let Some((dir, prefix)) = pending.pop() {
+        let mut entries: Vec<_> = std::fs::read_dir(&dir)?.collect::<Result<_, _>>()?;
+        entries.sort_by_key(|entry| entry.file_name());
+        for entry in entries {
+            *count += 1;
+            if *count > MAX_MANIFEST_ENTRIES {
+                return Err(std::io::Error::other(format!(
+                    "holds more than {MAX_MANIFEST_ENTRIES} entries"
+                )));
+            }
+            let is_dir = entry.file_type()?.is_dir();
+            let name = entry.file_name().to_string_lossy().into_owned();
+            let relative = if is_dir {
+                format!("{prefix}{name}/")
+            } else {
+                format!("{prefix}{name}")
+            };
+            if visit(&entry.path(), &relative, is_dir)? && is_dir {
+                pending.push((entry.path(), relative));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Whether `dir` holds a [`MARKER`] naming a command.
 fn is_output(dir: &Path) -> bool {
     marker_command(dir).is_some()
@@ -727,6 +851,69 @@ mod tests {
             OutputDir::create(&out, "test").unwrap().commit().unwrap();
             assert_eq!(names(&root.join("a")), ["out"]);
         }
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn files_the_user_adds_to_an_output_are_never_replaced() {
+        let root = scratch("added");
+        let out = root.join("out");
+        let write = |command: &str| {
+            let dir = OutputDir::create(&out, command)?;
+            std::fs::create_dir_all(dir.path().join("figures/svg")).unwrap();
+            std::fs::write(dir.path().join("summary.json"), "{}").unwrap();
+            std::fs::write(dir.path().join("figures/svg/a.svg"), "<svg/>").unwrap();
+            dir.commit()
+        };
+        write("run").unwrap();
+        let marker = std::fs::read_to_string(out.join(MARKER)).unwrap();
+        assert_eq!(
+            marker,
+            format!(
+                "written by `hrm run`\n{MANIFEST_HEADER}\nfigures/\nfigures/svg/\n\
+                 figures/svg/a.svg\nsummary.json\n"
+            )
+        );
+        // hrm's own files, edited, and a page of `hrm view` beside them: replaced.
+        std::fs::write(out.join("summary.json"), "edited").unwrap();
+        let page = format!("<html>{}</html>", run_view::head());
+        std::fs::write(out.join("view.html"), page).unwrap();
+        write("run").unwrap();
+        assert_eq!(names(&out), [MARKER, "figures", "summary.json"]);
+        // Anything else the user put there, at any depth, is named and kept, the output as it was.
+        for added in ["notes.txt", "figures/svg/mine.svg", "figures/mine/"] {
+            let path = out.join(added);
+            if added.ends_with('/') {
+                std::fs::create_dir_all(&path).unwrap();
+            } else {
+                std::fs::write(&path, "mine").unwrap();
+            }
+            let before = std::fs::read_to_string(out.join(MARKER)).unwrap();
+            let err = write("run").unwrap_err();
+            let shown = added.trim_end_matches('/');
+            assert_eq!(
+                err,
+                format!(
+                    "output folder {}: holds {shown}, which hrm did not write; move it out of \
+                     the folder or choose another --out",
+                    out.display()
+                )
+            );
+            assert!(path.exists());
+            assert_eq!(std::fs::read_to_string(out.join(MARKER)).unwrap(), before);
+            if added.ends_with('/') {
+                std::fs::remove_dir(&path).unwrap();
+            } else {
+                std::fs::remove_file(&path).unwrap();
+            }
+        }
+        write("run").unwrap();
+        // A marker naming its command alone (written by `hrm fis train` into a folder it made)
+        // lists nothing: the folder is replaced as before.
+        std::fs::write(out.join(MARKER), "written by `hrm run`\n").unwrap();
+        std::fs::write(out.join("notes.txt"), "x").unwrap();
+        write("run").unwrap();
+        assert_eq!(names(&out), [MARKER, "figures", "summary.json"]);
         std::fs::remove_dir_all(&root).unwrap();
     }
 

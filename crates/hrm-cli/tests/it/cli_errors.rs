@@ -392,7 +392,6 @@ fn a_failing_simulate_leaves_the_earlier_output_and_a_success_replaces_it() {
     let first = run(&scenario);
     assert!(first.status.success(), "{first:?}");
     assert!(stdout(&first).contains("wrote"));
-    std::fs::write(out.join("stale.txt"), "from an earlier run").unwrap();
     let before = snapshot(&out);
     // A scenario that fails validation (not a whole number of periods): refused, nothing
     // touched, no "wrote".
@@ -404,9 +403,24 @@ fn a_failing_simulate_leaves_the_earlier_output_and_a_success_replaces_it() {
     assert!(line.contains("duration must be a whole number"), "{line}");
     assert!(!stdout(&output).contains("wrote"), "{output:?}");
     assert_eq!(snapshot(&out), before, "the earlier output changed");
-    // A success replaces the folder whole: the stale file is gone.
+    // A file the user saved into the output: named, kept, nothing touched.
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let before = snapshot(&out);
+    let line = refused(&run(&scenario));
+    assert!(
+        line.contains("holds notes.txt, which hrm did not write"),
+        "{line}"
+    );
+    assert_eq!(snapshot(&out), before, "the earlier output changed");
+    // Without it, a success replaces the folder whole: a file of the earlier output that the
+    // new one does not write is gone.
+    std::fs::remove_file(out.join("notes.txt")).unwrap();
+    std::fs::remove_file(out.join("timeseries.csv")).unwrap();
+    let marker = std::fs::read_to_string(out.join(".hrm-output")).unwrap();
+    std::fs::write(out.join("stale.csv"), "from an earlier run").unwrap();
+    std::fs::write(out.join(".hrm-output"), marker + "stale.csv\n").unwrap();
     assert!(run(&scenario).status.success());
-    assert!(!out.join("stale.txt").exists());
+    assert!(!out.join("stale.csv").exists());
     assert!(out.join("timeseries.csv").is_file() && out.join(".hrm-output").is_file());
     // A folder that hrm did not write is never replaced.
     let mine = dir.join("mine");
