@@ -95,6 +95,7 @@ mod file;
 mod obstacles;
 mod schema;
 mod spatial;
+mod tagged;
 mod task;
 
 pub use arm::{ArmKind, BaseSpec, Gravity, Inertias, JointLayout, MAX_GRAVITY};
@@ -105,7 +106,8 @@ pub use deploy::{DEPLOY_PLAN_STEPS, DeployFailure, DeployRun, MAX_DEPLOY_RECORDE
 pub use file::ScenarioError;
 pub use obstacles::{MAX_SCENARIO_OBSTACLES, Workspace};
 pub use schema::{
-    Alpha0, AngleLimit, ArmSpec, BranchSpec, DeploySpec, HelixSpec, InitialSpec, IntegratorSpec,
-    LimitsSpec, MAX_DEPLOY_CENTERLINE_POINTS, ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec,
-    ReferenceSpec, Scenario, SineSpec, TaskSpec, TorqueLimit,
+    Alpha0, AngleLimit, ArmSpec, BranchSpec, DEFAULT_ATOL, DEFAULT_RTOL, DeploySpec, HelixSpec,
+    InitialSpec, IntegratorSpec, LimitsSpec, MAX_DEPLOY_CENTERLINE_POINTS, ModalSpec,
+    ModalTorqueLimit, NoiseSpec, ObstacleSpec, ReferenceSpec, Scenario, SineSpec, TaskSpec,
+    TorqueLimit,
 };

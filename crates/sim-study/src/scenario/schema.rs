@@ -91,7 +91,11 @@ pub const MAX_DEPLOY_CENTERLINE_POINTS: usize = 10_000;
 /// circles, capsules and boxes given by `[x, y]` points; a spatial arm's are spheres, capsules
 /// and boxes given by `[x, y, z]` points ([`Scenario::obstacles`] checks them).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+#[serde(
+    tag = "kind",
+    rename_all = "kebab-case",
+    try_from = "super::tagged::ObstacleTable"
+)]
 pub enum ObstacleSpec {
     /// A disc of the arm's plane (planar arms).
     Circle {
@@ -269,7 +273,11 @@ pub struct InitialSpec {
 
 /// The reference for the `m` modal coordinates, tagged by `kind`; every array has `m` entries.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+#[serde(
+    tag = "kind",
+    rename_all = "kebab-case",
+    try_from = "super::tagged::ReferenceTable"
+)]
 pub enum ReferenceSpec {
     /// A constant `a` (rad).
     Constant {
@@ -330,7 +338,11 @@ pub enum ReferenceSpec {
 
 /// A task planned before the controller runs, tagged by `kind`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+#[serde(
+    tag = "kind",
+    rename_all = "kebab-case",
+    try_from = "super::tagged::TaskTable"
+)]
 pub enum TaskSpec {
     /// Reach `target` with the chain's tip, every link at least `clearance` from every obstacle
     /// and from the other links, on the goal shape and all along the motion to it
@@ -412,7 +424,11 @@ pub struct SineSpec {
 
 /// The integrator between controller samples, tagged by `method`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "method", rename_all = "kebab-case", deny_unknown_fields)]
+#[serde(
+    tag = "method",
+    rename_all = "kebab-case",
+    try_from = "super::tagged::IntegratorTable"
+)]
 pub enum IntegratorSpec {
     /// Fixed-step RK4.
     Rk4 {
@@ -421,11 +437,9 @@ pub enum IntegratorSpec {
     },
     /// Adaptive Dormand-Prince 5(4).
     Dopri5 {
-        /// Relative tolerance (default 1e-9).
-        #[serde(default = "default_rtol")]
+        /// Relative tolerance (default [`DEFAULT_RTOL`]).
         rtol: f64,
-        /// Absolute tolerance (default 1e-12).
-        #[serde(default = "default_atol")]
+        /// Absolute tolerance (default [`DEFAULT_ATOL`]).
         atol: f64,
         /// Largest step (s, default unbounded).
         #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -436,13 +450,11 @@ pub enum IntegratorSpec {
     },
 }
 
-fn default_rtol() -> f64 {
-    1e-9
-}
+/// The default relative tolerance of `dopri5`.
+pub const DEFAULT_RTOL: f64 = 1e-9;
 
-fn default_atol() -> f64 {
-    1e-12
-}
+/// The default absolute tolerance of `dopri5`.
+pub const DEFAULT_ATOL: f64 = 1e-12;
 
 /// Standard deviations of the seeded Gaussian noise, `m` entries each (all default to zero).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]

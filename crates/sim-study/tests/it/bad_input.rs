@@ -154,6 +154,93 @@ fn rk4_step_not_positive_or_not_dividing_the_period() {
     );
 }
 
+/// A wrongly typed key of a table tagged by `kind` or `method` is named by its own line (it was
+/// named by the table's header), and a key of another kind is refused as serde refused it.
+#[test]
+fn keys_of_tagged_tables_are_named_by_their_line() {
+    let gap = sim_study::Scenario::builtin_text("narrow-gap").unwrap();
+    let step = sim_study::Scenario::builtin_text("paper-responses-step").unwrap();
+    for (base, from, to, expected) in [
+        (
+            &gap,
+            "clearance = 0.01",
+            "clearance = \"0.01\"",
+            "(`clearance = \"0.01\"`): invalid type: string \"0.01\", expected f64",
+        ),
+        (
+            &gap,
+            "radius = 0.03",
+            "radius = \"0.03\"",
+            "(`radius = \"0.03\"`): invalid type: string \"0.03\", expected f64",
+        ),
+        (
+            &gap,
+            "travel_time = 3.0",
+            "travel_time = [3.0]",
+            "(`travel_time = [3.0]`): invalid type: sequence, expected f64",
+        ),
+        (
+            &step,
+            "dt = 0.0001",
+            "dt = true",
+            "(`dt = true`): invalid type: boolean `true`, expected f64",
+        ),
+        (
+            &gap,
+            "kind = \"reach\"",
+            "kind = \"reach\"\nsamples = -3",
+            "(`samples = -3`): invalid value: integer `-3`, expected usize",
+        ),
+        (
+            &gap,
+            "kind = \"circle\"",
+            "kind = \"blob\"",
+            "(`kind = \"blob\"`): unknown variant `blob`, expected one of `circle`, `sphere`, \
+             `capsule`, `box`",
+        ),
+        (
+            &gap,
+            "radius = 0.03",
+            "radius = 0.03\nhalf_extents = [0.1, 0.1]",
+            "(`[[obstacles]]`): unknown field `half_extents`, expected `center` or `radius`",
+        ),
+        (
+            &gap,
+            "radius = 0.03",
+            "colour = 3",
+            "(`colour = 3`): unknown field `colour`, expected one of `kind`, `center`, `radius`, \
+             `from`, `to`, `half_extents`, `rpy`",
+        ),
+        (
+            &gap,
+            "clearance = 0.01",
+            "",
+            "(`[task]`): missing field `clearance`",
+        ),
+        (
+            &step,
+            "dt = 0.0001",
+            "rtol = 1e-6",
+            "(`[integrator]`): unknown field `rtol`, expected `dt`",
+        ),
+    ] {
+        assert!(base.contains(from), "{from}");
+        let text = base.replacen(from, to, 1);
+        let message = sim_study::Scenario::from_toml(&text)
+            .unwrap_err()
+            .to_string();
+        assert!(message.ends_with(expected), "{from} -> {to}: {message}");
+    }
+    // The tables read back as they were written, their defaults filled in.
+    for name in sim_study::Scenario::builtin_names() {
+        let scenario = sim_study::Scenario::builtin(name).unwrap();
+        assert_eq!(
+            sim_study::Scenario::from_toml(&scenario.to_toml()).unwrap(),
+            scenario
+        );
+    }
+}
+
 /// Each sensor noise entry out of its domain is named by its scenario key and index.
 #[test]
 fn sensor_noise_entries_are_named_by_their_key() {
