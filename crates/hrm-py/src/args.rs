@@ -7,7 +7,7 @@ use crate::errors::Error;
 use numpy::{PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PyString};
+use pyo3::types::{PyBool, PyBytes, PyFloat, PyInt, PyString};
 
 /// The `TypeError` for argument `name` given a `value` of the wrong type.
 pub(crate) fn wrong_type(name: &str, expected: &str, value: &Bound<'_, PyAny>) -> PyErr {
@@ -119,4 +119,41 @@ pub(crate) fn rows3(value: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f64; 
         .chunks_exact(3)
         .map(|row| [row[0], row[1], row[2]])
         .collect())
+}
+
+/// A spatial arm's `gravity` (`SpatialArm`, `Chain.from_urdf`): one number `g` along `-z`, as a
+/// scenario and `hrm eval` read it, or a vector `(x, y, z)` (default `(0, 0, -9.81)`); a `bool`
+/// is a `TypeError`.
+pub(crate) fn spatial_gravity(value: Option<&Bound<'_, PyAny>>) -> PyResult<sim_study::Gravity> {
+    Ok(match value {
+        None => sim_study::Gravity::Vector([0.0, 0.0, -9.81]),
+        Some(g) if is_bool(g) => {
+            return Err(wrong_type("gravity", "a number g or a vector (x, y, z)", g));
+        }
+        Some(g) if is_scalar(g) => sim_study::Gravity::Magnitude(real(g, "gravity")?),
+        Some(g) => sim_study::Gravity::Vector(vec3(g, "gravity")?),
+    })
+}
+
+/// Whether `value` is one Python or numpy `bool` (or a 0-d array of one), which `gravity`
+/// does not take for a number.
+fn is_bool(value: &Bound<'_, PyAny>) -> bool {
+    value.is_instance_of::<PyBool>()
+        || (is_scalar(value)
+            && value
+                .getattr("dtype")
+                .and_then(|dtype| dtype.getattr("kind"))
+                .and_then(|kind| kind.extract::<String>())
+                .is_ok_and(|kind| kind == "b"))
+}
+
+/// Whether `value` is one number (a Python `int` or `float`, or a numpy scalar or 0-d array),
+/// which `gravity` reads as `g` along `-z` as a scenario and `hrm eval` do.
+fn is_scalar(value: &Bound<'_, PyAny>) -> bool {
+    value.is_instance_of::<PyFloat>()
+        || value.is_instance_of::<PyInt>()
+        || value
+            .getattr("ndim")
+            .and_then(|ndim| ndim.extract::<usize>())
+            .is_ok_and(|ndim| ndim == 0)
 }

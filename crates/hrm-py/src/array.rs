@@ -37,12 +37,6 @@ const WORK_PER_CHUNK: usize = 1 << 22;
 /// anything is allocated.
 pub(crate) const MAX_OUTPUT_VALUES: usize = 1 << 28;
 
-/// The arguments that hold joint or modal rates, refused beyond the scale a run resolves
-/// ([`sim_core::check_rates`]) as `hrm eval` refuses them; the modal coordinates `a` likewise
-/// ([`sim_core::check_coordinates`]; a free base angle, the last entry, with them: a run bounds
-/// it too).
-const RATE_NAMES: [&str; 2] = ["theta_dot", "a_dot"];
-
 /// One input argument: a float64 array of one state `(width,)` or a batch `(N, width)`.
 pub(crate) struct States<'py> {
     name: &'static str,
@@ -100,7 +94,10 @@ impl<'py> States<'py> {
             copy,
             batch,
         };
-        let scale = if RATE_NAMES.contains(&name) {
+        // Rates and modal coordinates beyond the scale a run resolves are refused as `hrm eval`
+        // refuses them (a free base angle, the last entry of `a`, with the coordinates: a run
+        // bounds it too).
+        let scale = if sim_core::RATE_NAMES.contains(&name) {
             sim_core::check_rates(name, states.values(), width)
         } else if name == "a" {
             sim_core::check_coordinates(name, states.values(), width)

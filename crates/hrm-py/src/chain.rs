@@ -17,9 +17,6 @@ use robot_desc::{JointKind, MAX_URDF_BYTES, Robot, read_urdf};
 use std::path::PathBuf;
 use std::sync::Mutex;
 
-/// ROS's gravity, the default of a URDF chain (URDF carries none).
-const DEFAULT_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
-
 /// The URDF text of `source`: the file it names when it is a path-like object, or a string
 /// ending in `.urdf` naming an existing file; otherwise the string itself. A file is read only
 /// if it is a regular file of at most [`MAX_URDF_BYTES`] bytes.
@@ -187,14 +184,15 @@ impl Chain {
 #[pymethods]
 impl Chain {
     /// The chain of a URDF description (text, a path-like object, or a string ending in `.urdf`
-    /// naming a file) under the gravity vector `gravity` (m/s^2, base frame).
+    /// naming a file) under the gravity vector `gravity` (m/s^2, base frame; one number `g` is
+    /// `(0, 0, -g)`, as `SpatialArm` and `hrm eval` read it).
     #[staticmethod]
     #[pyo3(signature = (urdf, gravity=None), text_signature = "(urdf, gravity=(0, 0, -9.81))")]
     pub(crate) fn from_urdf(
         urdf: &Bound<'_, PyAny>,
         gravity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let gravity = gravity.map_or(Ok(DEFAULT_GRAVITY), |g| crate::args::vec3(g, "gravity"))?;
+        let gravity = crate::args::spatial_gravity(gravity)?.spatial();
         robot_desc::check_gravity(gravity).map_err(Error::from)?;
         let text = urdf_text(urdf)?;
         Ok(Self::read(&text, gravity)?)

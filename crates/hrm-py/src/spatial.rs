@@ -13,7 +13,7 @@ use modal_reduce::spatial::{
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PySlice, PyTuple};
+use pyo3::types::{PyDict, PySlice, PyTuple};
 use std::sync::Mutex;
 
 /// Most harmonics per plane (`m = 4K` coordinates): the bound of `hrm eval` on spatial arms, which
@@ -257,17 +257,7 @@ impl SpatialArm {
         let vec3 = |value: Option<&Bound<'_, PyAny>>, name, default| {
             value.map_or(Ok(default), |v| args::vec3(v, name))
         };
-        let gravity = match gravity {
-            Some(g) if is_bool(g) => {
-                return Err(args::wrong_type(
-                    "gravity",
-                    "a number g or a vector (x, y, z)",
-                    g,
-                ));
-            }
-            Some(g) if is_scalar(g) => sim_study::Gravity::Magnitude(args::real(g, "gravity")?),
-            other => sim_study::Gravity::Vector(vec3(other, "gravity", [0.0, 0.0, -9.81])?),
-        };
+        let gravity = args::spatial_gravity(gravity)?;
         let (base_xyz, base_rpy) = (
             vec3(base_xyz, "base_xyz", [0.0; 3])?,
             vec3(base_rpy, "base_rpy", [0.0; 3])?,
@@ -657,27 +647,4 @@ impl SpatialArm {
         robot_desc::write_mjcf(&self.robot()?, self.model.gravity())
             .map_err(|e| Error::input(e.to_string()).into())
     }
-}
-
-/// Whether `value` is one Python or numpy `bool` (or a 0-d array of one), which `gravity`
-/// does not take for a number.
-fn is_bool(value: &Bound<'_, PyAny>) -> bool {
-    value.is_instance_of::<PyBool>()
-        || (is_scalar(value)
-            && value
-                .getattr("dtype")
-                .and_then(|dtype| dtype.getattr("kind"))
-                .and_then(|kind| kind.extract::<String>())
-                .is_ok_and(|kind| kind == "b"))
-}
-
-/// Whether `value` is one number (a Python `int` or `float`, or a numpy scalar or 0-d array),
-/// which `gravity` reads as `g` along `-z` as a scenario and `hrm eval` do.
-fn is_scalar(value: &Bound<'_, PyAny>) -> bool {
-    value.is_instance_of::<PyFloat>()
-        || value.is_instance_of::<PyInt>()
-        || value
-            .getattr("ndim")
-            .and_then(|ndim| ndim.extract::<usize>())
-            .is_ok_and(|ndim| ndim == 0)
 }

@@ -5,6 +5,7 @@ the messages of wrong arguments. Whatever could hang or kill the interpreter run
 subprocess with a timeout."""
 
 import copy
+import math
 import os
 import pickle
 import subprocess
@@ -625,6 +626,14 @@ def test_rates_and_spatial_gravity_are_read_as_hrm_eval_reads_them():
     for flag in (True, np.bool_(False), np.array(True)):
         with pytest.raises(TypeError, match=r"^gravity must be a number g or a vector \(x, y, z\), got a "):
             hrm.SpatialArm(gravity=flag)
+        with pytest.raises(TypeError, match=r"^gravity must be a number g or a vector \(x, y, z\), got a "):
+            hrm.Chain.from_urdf(hrm.SpatialArm(links=2).to_urdf(), gravity=flag)
+    # A URDF chain reads one number as the spatial arm does; zero gravity is +0, not -0.
+    urdf = hrm.SpatialArm(links=2).to_urdf()
+    assert hrm.Chain.from_urdf(urdf, gravity=9.81).gravity_vector == (0.0, 0.0, -9.81)
+    assert hrm.Chain.from_urdf(urdf).gravity_vector == (0.0, 0.0, -9.81)
+    for zero in (hrm.SpatialArm(gravity=0).gravity[2], hrm.Chain.from_urdf(urdf, gravity=0.0).gravity_vector[2]):
+        assert zero == 0.0 and math.copysign(1.0, zero) == 1.0
     # A reference sample's rate, as a run's reference would reach it.
     with pytest.raises(hrm.InvalidInput, match=r"^a_dot\[2\] must be at most 1000000 " + unit):
         hrm.ReferenceSample(np.zeros(3), [0.0, 0.0, 1e7], np.zeros(3))

@@ -1290,6 +1290,10 @@ fn check_initial(initial: &ModalState, m: usize) -> Result<(), SimError> {
     check_rates("initial.a_dot", &initial.a_dot, m)
 }
 
+/// The names under which the front ends (`hrm eval`'s fields, Python's arguments) take joint or
+/// modal rates, each checked by [`check_rates`].
+pub const RATE_NAMES: [&str; 2] = ["theta_dot", "a_dot"];
+
 /// Refuses rates beyond [`MAX_MODAL_MAGNITUDE`] in magnitude, the scale a run resolves (`1e300`
 /// overflowed the Coriolis terms): `rates` holds states of `width` entries (joint or modal
 /// rates), and the error names the first such entry, `name[i]` in one state and `name[k, i]`

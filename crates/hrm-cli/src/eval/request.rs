@@ -260,14 +260,11 @@ pub(super) fn curve_error(error: KinError) -> EvalError {
     }
 }
 
-/// The request fields that hold joint or modal rates.
-const RATE_FIELDS: [&str; 2] = ["theta_dot", "a_dot"];
-
 /// Refuses rates (`theta_dot`, `a_dot`, in every op that takes them) beyond the scale a run
 /// resolves ([`sim_core::check_rates`]); an entry that is not a number is left to the op's own
 /// parsing.
 pub(super) fn check_rates(request: &Map<String, Value>) -> Result<(), EvalError> {
-    for name in RATE_FIELDS {
+    for name in sim_core::RATE_NAMES {
         let Some(Value::Array(values)) = request.get(name) else {
             continue;
         };

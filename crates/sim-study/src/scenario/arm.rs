@@ -76,10 +76,11 @@ pub enum Gravity {
 }
 
 impl Gravity {
-    /// The world-frame vector of a spatial arm: `[0, 0, -g]` for a magnitude.
+    /// The world-frame vector of a spatial arm: `[0, 0, -g]` for a magnitude (`+0` for `g = 0`,
+    /// not `-0`).
     pub fn spatial(self) -> [f64; 3] {
         match self {
-            Gravity::Magnitude(g) => [0.0, 0.0, -g],
+            Gravity::Magnitude(g) => [0.0, 0.0, 0.0 - g],
             Gravity::Vector(v) => v,
         }
     }
