@@ -395,6 +395,16 @@ mod tests {
             message(bad_range),
             "input 'x': range must be finite with min < max, got [1, 1]"
         );
+        let wide_range = two_by_two().input(
+            "x",
+            [-1e308, 1e308],
+            [("A", MembershipFn::gaussian(1.0, 0.0))],
+        );
+        assert_eq!(
+            message(wide_range),
+            "input 'x': range must be finite with a width max - min within double precision, \
+             got [-1e308, 1e308]"
+        );
         let duplicate =
             two_by_two().input("e", [0.0, 1.0], [("A", MembershipFn::gaussian(1.0, 0.0))]);
         assert_eq!(

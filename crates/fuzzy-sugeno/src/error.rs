@@ -295,9 +295,9 @@ pub enum SystemProblem {
     #[error("another variable has the same name")]
     DuplicateVariable,
     /// A variable's range is not finite, or not ordered.
-    #[error("range must be finite with {order}, got [{min}, {max}]")]
+    #[error("range must be finite with {order}, got [{}, {}]", lane_math::Compact(*min), lane_math::Compact(*max))]
     Range {
-        /// `"min < max"` (inputs) or `"min <= max"` (outputs).
+        /// `"min < max"` (inputs) or `"min <= max"` (outputs), or the width's bound.
         order: &'static str,
         /// The range's lower end.
         min: f64,

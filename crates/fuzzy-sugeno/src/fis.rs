@@ -751,7 +751,21 @@ impl<'a> Keys<'a> {
                     && max.is_finite()
                     && (min < max || point_allowed && min == max) =>
             {
-                Ok([min, max])
+                // Ends within double precision whose width is not ([-1e308 1e308]): every grid
+                // over the range would step by infinity.
+                if (max - min).is_finite() {
+                    Ok([min, max])
+                } else {
+                    Err(error(
+                        line,
+                        format!(
+                            "Range width max - min must be finite (within double precision), \
+                             found [{} {}]",
+                            lane_math::Compact(min),
+                            lane_math::Compact(max)
+                        ),
+                    ))
+                }
             }
             [min, max] => Err(error(
                 line,
@@ -1255,6 +1269,11 @@ mod tests {
             (
                 TINY.replace("Range=[-5 5]", "Range=[5 -5]"),
                 "line 16: Range must be finite with min < max, found [5 -5]",
+            ),
+            (
+                TINY.replace("Range=[-5 5]", "Range=[-1e308 1e308]"),
+                "line 16: Range width max - min must be finite (within double precision), found \
+                 [-1e308 1e308]",
             ),
             (
                 TINY.replace("[4 -5]", "[0 -5]"),

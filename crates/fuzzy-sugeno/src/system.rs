@@ -274,6 +274,13 @@ fn check_variable<'a>(
         };
         return Err(SystemProblem::Range { order, min, max });
     }
+    if !(max - min).is_finite() {
+        return Err(SystemProblem::Range {
+            order: "a width max - min within double precision",
+            min,
+            max,
+        });
+    }
     let mut count = 0;
     for term in term_names {
         check_name("set", term)?;

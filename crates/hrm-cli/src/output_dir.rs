@@ -571,10 +571,15 @@ fn remove_abandoned(target: &Path, what: &str) {
         };
         if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
             let path = entry.path();
-            let _ = if path.is_dir() {
+            // A staging folder carries the marker from its first moment on (or is empty, killed
+            // before it), an old copy was a replaceable output: a folder of the user's that
+            // merely has such a name is left alone.
+            let _ = if !path.is_dir() {
+                std::fs::remove_file(&path)
+            } else if replaceable(&path) {
                 remove_tree(&path)
             } else {
-                std::fs::remove_file(&path)
+                Ok(())
             };
         }
     }
@@ -642,51 +647,49 @@ fn write_manifest(dir: &Path, command: &str) -> std::io::Result<()> {
     std::fs::write(dir.join(MARKER), text)
 }
 
-/// The first entry of the marked output folder `dir` that its [`MARKER`] does not list and hrm
-/// did not write (a file or folder the user put there), as a path relative to `dir`; `None`
-/// when there is none, or when the marker lists nothing (a folder that another hrm command
-/// marked with its name alone). Nested outputs of other commands, carried over by a commit,
-/// and pages and GIFs of `hrm view` are hrm's.
+/// The first entry (in [`walk`]'s order) of the marked output folder `dir` that its [`MARKER`]
+/// does not list, as a path relative to `dir`: a file or folder the user put there; `None` when
+/// there is none. A marker without the list ([`MANIFEST_HEADER`]) lists nothing. The outputs of
+/// other commands directly inside `dir`, which a commit carries over, and the pages and GIFs of
+/// `hrm view` ([`run_view::written_by_hrm`]) are hrm's.
 ///
 /// # Errors
 /// A folder holding more than [`MAX_MANIFEST_ENTRIES`] entries, or one that cannot be read.
 fn unlisted_entry(dir: &Path) -> Result<Option<String>, String> {
-    let Some(marker) = regular_file_start(&dir.join(MARKER), MAX_MANIFEST_BYTES) else {
-        return Ok(None);
-    };
+    let marker = regular_file_start(&dir.join(MARKER), MAX_MANIFEST_BYTES).unwrap_or_default();
     let marker = String::from_utf8_lossy(&marker);
     let mut lines = marker.lines().skip(1);
-    if lines.next() != Some(MANIFEST_HEADER) {
-        return Ok(None);
-    }
-    let listed: std::collections::HashSet<&str> = lines.collect();
+    let listed: std::collections::HashSet<&str> = if lines.next() == Some(MANIFEST_HEADER) {
+        lines.collect()
+    } else {
+        std::collections::HashSet::new()
+    };
     let mut unlisted = None;
     let mut count = 0;
     let walked = walk(dir, &mut count, &mut |path, relative, is_dir| {
-        let hrm_wrote = relative == MARKER
-            || listed.contains(relative)
-            || (!is_dir
-                && regular_file_start(path, run_view::SIGNATURE_WITHIN)
-                    .is_some_and(|start| run_view::written_by_hrm(&start)));
-        let nested_output = is_dir && is_output(path) && !is_output_of_parent(path);
-        if nested_output || !hrm_wrote {
-            if !nested_output {
-                unlisted = Some(relative.trim_end_matches('/').to_string());
-            }
+        if relative == MARKER || listed.contains(relative) {
+            return Ok(is_dir);
+        }
+        let carried = is_dir && !relative.trim_end_matches('/').contains('/') && is_output(path);
+        let page = !is_dir
+            && regular_file_start(path, run_view::SIGNATURE_WITHIN)
+                .is_some_and(|start| run_view::written_by_hrm(&start));
+        if carried || page {
             return Ok(false);
         }
-        Ok(is_dir)
+        unlisted = Some(relative.trim_end_matches('/').to_string());
+        Err(std::io::Error::other("stopped at an unlisted entry"))
     });
-    match walked {
-        Ok(()) => Ok(unlisted),
-        Err(e) => Err(format!("output folder {}: {e}", dir.display())),
+    match (unlisted, walked) {
+        (Some(entry), _) => Ok(Some(entry)),
+        (None, Ok(())) => Ok(None),
+        (None, Err(e)) => Err(format!("output folder {}: {e}", dir.display())),
     }
 }
 
 /// Visits every entry under `root` (symbolic links not followed), each folder's in sorted order,
-/// with its path,
-/// its path relative to `root` (`/` between names, and after a folder's name) and whether it is
-/// a folder; `visit` says whether to go into a folder, and may stop the walk by returning an
+/// with its path, its path relative to `root` (`/` between names, and after a folder's name) and
+/// whether it is a folder; `visit` says whether to go into a folder, and may stop the walk by returning an
 /// error. `count` counts the entries visited, at most [`MAX_MANIFEST_ENTRIES`]; names that are
 /// not UTF-8 are read lossily (so no manifest lists them).
 fn walk(
@@ -876,7 +879,7 @@ mod tests {
         );
         // hrm's own files, edited, and a page of `hrm view` beside them: replaced.
         std::fs::write(out.join("summary.json"), "edited").unwrap();
-        let page = format!("<html>{}</html>", run_view::head());
+        let page = format!("<!DOCTYPE html><html>{}</html>", run_view::head());
         std::fs::write(out.join("view.html"), page).unwrap();
         write("run").unwrap();
         assert_eq!(names(&out), [MARKER, "figures", "summary.json"]);
@@ -908,12 +911,33 @@ mod tests {
             }
         }
         write("run").unwrap();
-        // A marker naming its command alone (written by `hrm fis train` into a folder it made)
-        // lists nothing: the folder is replaced as before.
-        std::fs::write(out.join(MARKER), "written by `hrm run`\n").unwrap();
+        // A marker naming its command alone, or whose list lost its header, lists nothing: the
+        // first entry in the order of names is named.
         std::fs::write(out.join("notes.txt"), "x").unwrap();
+        for marker in [
+            "written by `hrm run`\n".to_string(),
+            format!("written by `hrm run`\n{MANIFEST_HEADER} \nnotes.txt\n"),
+        ] {
+            std::fs::write(out.join(MARKER), marker).unwrap();
+            let err = write("run").unwrap_err();
+            assert!(
+                err.contains(": holds figures, which hrm did not write"),
+                "{err}"
+            );
+        }
+        // A note that mentions hrm is no page of `hrm view`; a folder of the user's named as a
+        // killed command's staging folder is no staging folder.
+        std::fs::remove_dir_all(&out).unwrap();
         write("run").unwrap();
-        assert_eq!(names(&out), [MARKER, "figures", "summary.json"]);
+        std::fs::write(out.join("a.txt"), "these files were written by hrm").unwrap();
+        let err = write("run").unwrap_err();
+        assert!(err.contains(": holds a.txt, which hrm"), "{err}");
+        std::fs::remove_file(out.join("a.txt")).unwrap();
+        let lookalike = root.join(".out.hrm-staging-4294967295");
+        std::fs::create_dir_all(&lookalike).unwrap();
+        std::fs::write(lookalike.join("thesis.tex"), "x").unwrap();
+        write("run").unwrap();
+        assert!(lookalike.join("thesis.tex").is_file());
         std::fs::remove_dir_all(&root).unwrap();
     }
 
@@ -1033,6 +1057,7 @@ mod tests {
         // An old copy a killed command left is removed by the next command.
         let dead = root.join(format!(".out.hrm-old-{}", u32::MAX));
         std::fs::create_dir_all(dead.join("sub")).unwrap();
+        std::fs::write(dead.join(MARKER), "written by `hrm simulate`\n").unwrap();
         std::fs::set_permissions(dead.join("sub"), std::fs::Permissions::from_mode(0o555)).unwrap();
         OutputDir::create(&out, "simulate")
             .unwrap()

@@ -61,10 +61,20 @@ pub fn scene_html(scene: &Scene, samples: usize) -> Result<String, ViewError> {
 pub const SIGNATURE: &str = "written by hrm";
 
 /// Whether a file beginning with `start` (its first [`SIGNATURE_WITHIN`] bytes or fewer) is a
-/// page or GIF hrm wrote.
+/// page or GIF hrm wrote: a GIF carrying the [`SIGNATURE`] as a comment extension, or an HTML
+/// document carrying it as the `generator` meta element of [`head`]. A text that merely
+/// mentions the signature (a user's notes) is not one.
 pub fn written_by_hrm(start: &[u8]) -> bool {
-    let needle = SIGNATURE.as_bytes();
-    start.windows(needle.len()).any(|w| w == needle)
+    let contains = |needle: &[u8]| start.windows(needle.len()).any(|w| w == needle);
+    if start.starts_with(b"GIF8") {
+        // The comment: its introducer and label, the length of its one block, the text.
+        let mut comment = vec![0x21, 0xFE, SIGNATURE.len() as u8];
+        comment.extend_from_slice(SIGNATURE.as_bytes());
+        contains(&comment)
+    } else {
+        start.starts_with(b"<!DOCTYPE html>")
+            && contains(format!("<meta name=\"generator\" content=\"{SIGNATURE}\">").as_bytes())
+    }
 }
 
 /// How far into a page or GIF its [`SIGNATURE`] is: within the first 2 KiB.

@@ -328,6 +328,16 @@ fn the_page_is_self_contained_and_its_data_cannot_end_the_script() {
     let scene: Scene = serde_json::from_str(&html[start..end]).unwrap();
     assert_eq!(scene.runs[1].label, "pd </script><script>alert(1)</script>");
     scene.check().unwrap();
+    // hrm knows its page, and only its page, by the signature in its head.
+    let start = |text: &[u8]| text[..text.len().min(run_view::SIGNATURE_WITHIN)].to_vec();
+    assert!(run_view::written_by_hrm(&start(html.as_bytes())));
+    for other in [
+        "my notes: the files here were written by hrm, run 3 looked odd",
+        "<!DOCTYPE html><p>written by hrm</p>",
+        "<html><meta name=\"generator\" content=\"written by hrm\">",
+    ] {
+        assert!(!run_view::written_by_hrm(other.as_bytes()), "{other}");
+    }
     let frame = run_view::iframe(&html, 600);
     assert!(frame.starts_with("<iframe srcdoc=\"&lt;!DOCTYPE html&gt;"));
     assert!(!frame[8..].contains('"') || frame.matches('"').count() == 6);
@@ -344,6 +354,10 @@ fn the_gif_shows_the_arm_moving_over_its_path() {
     };
     let mut bytes = Vec::new();
     write_gif(&run, &options, &mut bytes).unwrap();
+    assert!(run_view::written_by_hrm(
+        &bytes[..bytes.len().min(run_view::SIGNATURE_WITHIN)]
+    ));
+    assert!(!run_view::written_by_hrm(b"GIF89a written by hrm"));
     let mut decoder = gif::DecodeOptions::new();
     decoder.set_color_output(gif::ColorOutput::RGBA);
     let mut decoder = decoder.read_info(&bytes[..]).unwrap();
