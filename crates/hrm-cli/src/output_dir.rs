@@ -150,14 +150,16 @@ impl OutputDir {
     /// the nested outputs of other commands are carried over, the new one takes its name and
     /// the old one is deleted. On failure the old folder is put back.
     pub fn commit(mut self) -> Result<(), String> {
+        let fail = |what: &str, e: std::io::Error| format!("{what} {}: {e}", self.shown.display());
+        // The list of what the command wrote, while an interruption still removes the staging
+        // folder.
+        write_manifest(&self.staging, &self.command)
+            .map_err(|e| fail("cannot write the marker of", e))?;
         // From here an interruption leaves the staging folder to the next command's cleanup
         // rather than removing it between the two renames.
         crate::signals::unregister(&self.staging);
         let old = sibling(&self.target, "old");
         let had_old = self.target.exists();
-        let fail = |what: &str, e: std::io::Error| format!("{what} {}: {e}", self.shown.display());
-        write_manifest(&self.staging, &self.command)
-            .map_err(|e| fail("cannot write the marker of", e))?;
         if had_old {
             if old.exists() {
                 std::fs::remove_dir_all(&old)
