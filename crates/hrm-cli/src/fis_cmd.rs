@@ -731,14 +731,20 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
-    /// A two-input, one-output system with the given names and constant outputs `lo`, `hi`.
+    /// A two-input, one-output system with the given names and constant outputs `lo`, `hi`
+    /// (the output's range, unless its width leaves double precision: then `[-1, 1]`).
     fn two_inputs(x: &str, y: &str, u: &str, [lo, hi]: [f64; 2]) -> FuzzySystem {
+        let (low, high) = if (hi - lo).is_finite() {
+            (lo, hi)
+        } else {
+            (-1.0, 1.0)
+        };
         let text = format!(
             "[System]\nName='two'\nType='sugeno'\nNumInputs=2\nNumOutputs=1\nNumRules=2\nAndMethod='prod'\n\
              OrMethod='probor'\nImpMethod='prod'\nAggMethod='sum'\nDefuzzMethod='wtaver'\n\
              [Input1]\nName='{x}'\nRange=[0 1]\nNumMFs=2\nMF1='lo':'trimf',[-1 0 1]\nMF2='hi':'trimf',[0 1 2]\n\
              [Input2]\nName='{y}'\nRange=[0 1]\nNumMFs=1\nMF1='all':'trimf',[-1 0.5 2]\n\
-             [Output1]\nName='{u}'\nRange=[{lo:e} {hi:e}]\nNumMFs=2\nMF1='a':'constant',[{lo:e}]\nMF2='b':'constant',[{hi:e}]\n\
+             [Output1]\nName='{u}'\nRange=[{low:e} {high:e}]\nNumMFs=2\nMF1='a':'constant',[{lo:e}]\nMF2='b':'constant',[{hi:e}]\n\
              [Rules]\n1 1, 1 (1) : 1\n2 1, 2 (1) : 1\n"
         );
         load_system(&text).unwrap()
@@ -778,7 +784,8 @@ mod tests {
 
     #[test]
     fn outputs_too_large_to_plot_get_the_non_finite_error() {
-        // Finite outputs from -1.7e308 to 1.7e308: their span overflows double precision.
+        // Finite outputs from -1.7e308 to 1.7e308 (constants beyond the output's range, as
+        // Sugeno systems may have): their span overflows double precision.
         let system = two_inputs("x", "y", "u", [-1.7e308, 1.7e308]);
         let dir = temp_dir("huge-outputs");
         let err = surface(&system, &dir, 3, None).unwrap_err();

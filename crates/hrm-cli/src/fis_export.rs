@@ -72,7 +72,10 @@ pub fn run(args: ExportArgs) -> Result<(), String> {
                 .file_stem()
                 .map_or("system".into(), |s| s.to_string_lossy());
             let text = system.to_fcl().map_err(|e| e.to_string())?;
-            vec![(format!("{stem}.fcl"), text)]
+            vec![(
+                format!("{stem}.fcl"),
+                format!("{}{text}", fis_input::FCL_SIGNATURE),
+            )]
         }
     };
     // All files whole or none: a failure leaves the folder's existing files as they were.

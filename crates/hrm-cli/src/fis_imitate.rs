@@ -123,7 +123,8 @@ pub fn run(args: ImitateArgs) -> Result<(), String> {
             data.column_name(data.n_inputs() + output)
         );
     }
-    output_dir::write_file(&args.out, &learned.system.to_fis(), "fis imitate")?;
+    let text = format!("{}{}", fis_input::FIS_SIGNATURE, learned.system.to_fis());
+    output_dir::write_file(&args.out, &text, "fis imitate")?;
     println!("wrote {}", args.out.display());
     Ok(())
 }

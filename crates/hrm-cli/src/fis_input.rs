@@ -61,17 +61,30 @@ pub(crate) fn read_system_with_notes(
 /// ([`sim_study::MAX_INPUT_FILE_BYTES`], what the readers take).
 pub(crate) const RECOGNISED_BYTES: usize = sim_study::MAX_INPUT_FILE_BYTES as usize;
 
-/// Whether `text` is a fuzzy system file hrm wrote: a `.fis` or FCL text whose system, written
-/// back by hrm's writer, is the same text byte for byte (the writers are canonical; a
-/// hand-made or MATLAB-written file almost never is), or the C that `hrm fis export` writes
-/// (its opening comment says so).
+/// The first line of the `.fis` files `hrm fis train` and `hrm fis imitate` write: a comment,
+/// which MATLAB, fuzzylite and hrm skip, by which hrm knows its own file.
+pub(crate) const FIS_SIGNATURE: &str = "% written by hrm\n";
+
+/// The first line of the FCL files `hrm fis export --format fcl` writes (a comment fuzzylite
+/// and hrm skip).
+pub(crate) const FCL_SIGNATURE: &str = "// written by hrm\n";
+
+/// Whether `text` is a fuzzy system file hrm wrote: a `.fis` or FCL text that opens with hrm's
+/// signature ([`FIS_SIGNATURE`], [`FCL_SIGNATURE`]) and whose system, written back by hrm's
+/// writer, is the rest of the text byte for byte (a copy of the shipped `paper.fis`, which the
+/// canonical writer reproduces, is the user's), or the C that `hrm fis export` writes (its
+/// opening comment says so).
 pub(crate) fn written_by_hrm(text: &[u8]) -> bool {
     let Ok(text) = std::str::from_utf8(text) else {
         return false;
     };
     let opening = &text[..text.floor_char_boundary(512)];
     opening.contains("exported by hrm (fuzzy-sugeno) as C99")
-        || FuzzySystem::from_fis(text).is_ok_and(|system| system.to_fis() == text)
-        || FuzzySystem::from_fcl(text)
-            .is_ok_and(|system| system.to_fcl().is_ok_and(|fcl| fcl == text))
+        || text.strip_prefix(FIS_SIGNATURE).is_some_and(|fis| {
+            FuzzySystem::from_fis(fis).is_ok_and(|system| system.to_fis() == fis)
+        })
+        || text.strip_prefix(FCL_SIGNATURE).is_some_and(|fcl| {
+            FuzzySystem::from_fcl(fcl)
+                .is_ok_and(|system| system.to_fcl().is_ok_and(|text| text == fcl))
+        })
 }

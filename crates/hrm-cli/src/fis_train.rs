@@ -148,7 +148,8 @@ pub fn run(args: TrainArgs) -> Result<(), String> {
         ))?;
         trainer.best_system().map_err(|e| e.to_string())?
     };
-    output_dir::write_file(&args.out, &system.to_fis(), "fis train")?;
+    let text = format!("{}{}", fis_input::FIS_SIGNATURE, system.to_fis());
+    output_dir::write_file(&args.out, &text, "fis train")?;
     console::print(&format!("wrote {}\n", args.out.display()))?;
     Ok(())
 }

@@ -108,8 +108,12 @@ impl OutputDir {
         if staging.exists() {
             std::fs::remove_dir_all(&staging).map_err(|e| fail("cannot clear staging for", e))?;
         }
-        std::fs::create_dir(&staging).map_err(|e| fail("cannot create staging for", e))?;
+        // Registered first: an interruption between the two would leave the folder behind.
         crate::signals::register(&staging);
+        if let Err(e) = std::fs::create_dir(&staging) {
+            crate::signals::unregister(&staging);
+            return Err(fail("cannot create staging for", e));
+        }
         let dir = OutputDir {
             shown: shown.clone(),
             target,

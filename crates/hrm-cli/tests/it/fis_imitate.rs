@@ -80,9 +80,10 @@ fn writes_the_library_system_and_it_drives_a_scenario() {
     let grid = [vec![0.0, 0.5], vec![-0.25]];
     let shifted = imitation::shifted_grid(&library, &grid).unwrap();
     let learned = imitation::imitate(&shifted, &options, |_, _| {}).unwrap();
+    // The library's system, after hrm's signature (a comment).
     assert_eq!(
         std::fs::read_to_string(&out).unwrap(),
-        learned.system.to_fis()
+        format!("% written by hrm\n{}", learned.system.to_fis())
     );
     // A scenario file pointing at it runs.
     let mut scenario = Scenario::builtin("paper-tracking").unwrap();

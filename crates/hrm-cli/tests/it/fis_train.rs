@@ -98,13 +98,23 @@ fn out_replaces_its_own_system_and_never_a_file_of_the_users() {
             String::from_utf8_lossy(&run.stderr)
         );
     }
-    // A file hrm did not write (notes, or a .fis written by hand) stays as it was.
+    // A file hrm did not write (notes, a .fis written by hand, the user's copy of the shipped
+    // controller, which hrm's writer reproduces but which lacks hrm's signature) stays as it was.
     let hand_written = std::fs::read_to_string(&out)
         .unwrap()
         .replace("Version=2.0", "Version=2.0 ");
+    let copy = dir.join("my-controller.fis");
+    let shipped = include_str!("../../../fuzzy-sugeno/data/paper.fis");
+    assert_eq!(
+        fuzzy_sugeno::FuzzySystem::from_fis(shipped)
+            .unwrap()
+            .to_fis(),
+        shipped
+    );
     for (path, text) in [
         (&notes, "the user's notes\n"),
         (&out, hand_written.as_str()),
+        (&copy, shipped),
     ] {
         std::fs::write(path, text).unwrap();
         let run = train_into(path);
