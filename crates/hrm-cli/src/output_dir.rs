@@ -637,8 +637,7 @@ const MAX_MANIFEST_BYTES: usize = 64 << 20;
 /// ([`MANIFEST_HEADER`]), so that a later command can tell them from files the user adds.
 fn write_manifest(dir: &Path, command: &str) -> std::io::Result<()> {
     let mut entries = Vec::new();
-    let mut count = 0;
-    walk(dir, &mut count, &mut |_, relative, is_dir| {
+    walk(dir, &mut |_, relative, is_dir| {
         if relative != MARKER {
             entries.push(relative.to_string());
         }
@@ -671,8 +670,7 @@ fn unlisted_entry(dir: &Path) -> Result<Option<String>, String> {
         std::collections::HashSet::new()
     };
     let mut unlisted = None;
-    let mut count = 0;
-    let walked = walk(dir, &mut count, &mut |path, relative, is_dir| {
+    let walked = walk(dir, &mut |path, relative, is_dir| {
         if relative == MARKER || listed.contains(relative) {
             return Ok(is_dir);
         }
@@ -695,21 +693,21 @@ fn unlisted_entry(dir: &Path) -> Result<Option<String>, String> {
 
 /// Visits every entry under `root` (symbolic links not followed), each folder's in sorted order,
 /// with its path, its path relative to `root` (`/` between names, and after a folder's name) and
-/// whether it is a folder; `visit` says whether to go into a folder, and may stop the walk by returning an
-/// error. `count` counts the entries visited, at most [`MAX_MANIFEST_ENTRIES`]; names that are
-/// not UTF-8 are read lossily (so no manifest lists them).
+/// whether it is a folder; `visit` says whether to go into a folder, and may stop the walk by
+/// returning an error. At most [`MAX_MANIFEST_ENTRIES`] entries are visited; names that are not
+/// UTF-8 are read lossily (so no manifest lists them).
 fn walk(
     root: &Path,
-    count: &mut usize,
     visit: &mut dyn FnMut(&Path, &str, bool) -> std::io::Result<bool>,
 ) -> std::io::Result<()> {
+    let mut count = 0;
     let mut pending = vec![(root.to_path_buf(), String::new())];
     while let Some((dir, prefix)) = pending.pop() {
         let mut entries: Vec<_> = std::fs::read_dir(&dir)?.collect::<Result<_, _>>()?;
         entries.sort_by_key(|entry| entry.file_name());
         for entry in entries {
-            *count += 1;
-            if *count > MAX_MANIFEST_ENTRIES {
+            count += 1;
+            if count > MAX_MANIFEST_ENTRIES {
                 return Err(std::io::Error::other(format!(
                     "holds more than {MAX_MANIFEST_ENTRIES} entries"
                 )));
