@@ -265,12 +265,10 @@ pub(super) fn curve_error(error: KinError) -> EvalError {
 /// parsing.
 pub(super) fn check_rates(request: &Map<String, Value>) -> Result<(), EvalError> {
     for name in sim_core::RATE_NAMES {
-        let Some(Value::Array(values)) = request.get(name) else {
-            continue;
-        };
-        let rates: Vec<f64> = values.iter().map(|v| v.as_f64().unwrap_or(0.0)).collect();
-        sim_core::check_rates(name, &rates, rates.len())
-            .map_err(|e| EvalError::input(e.to_string()))?;
+        if let Some(rates) = numbers(request, name) {
+            sim_core::check_rates(name, &rates, rates.len())
+                .map_err(|e| EvalError::input(e.to_string()))?;
+        }
     }
     Ok(())
 }
@@ -279,11 +277,22 @@ pub(super) fn check_rates(request: &Map<String, Value>) -> Result<(), EvalError>
 /// ([`sim_core::check_coordinates`]), as [`check_rates`] refuses rates; a planar request's are
 /// checked by [`modal_map`], which knows whether the last entry is the base angle.
 pub(super) fn check_spatial_coordinates(request: &Map<String, Value>) -> Result<(), EvalError> {
-    let Some(Value::Array(values)) = request.get("a") else {
-        return Ok(());
-    };
-    let a: Vec<f64> = values.iter().map(|v| v.as_f64().unwrap_or(0.0)).collect();
-    sim_core::check_coordinates("a", &a, a.len()).map_err(|e| EvalError::input(e.to_string()))
+    match numbers(request, "a") {
+        Some(a) => sim_core::check_coordinates("a", &a, a.len())
+            .map_err(|e| EvalError::input(e.to_string())),
+        None => Ok(()),
+    }
+}
+
+/// The array field `name` of a request as numbers, an entry that is not one read as zero (left
+/// to the op's own parsing); `None` when the field is not an array.
+fn numbers(request: &Map<String, Value>, name: &str) -> Option<Vec<f64>> {
+    match request.get(name) {
+        Some(Value::Array(values)) => {
+            Some(values.iter().map(|v| v.as_f64().unwrap_or(0.0)).collect())
+        }
+        _ => None,
+    }
 }
 
 /// Refuses to answer with a non-finite number (JSON has none).
