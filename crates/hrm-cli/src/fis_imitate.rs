@@ -123,7 +123,7 @@ pub fn run(args: ImitateArgs) -> Result<(), String> {
             data.column_name(data.n_inputs() + output)
         );
     }
-    let text = format!("{}{}", fis_input::FIS_SIGNATURE, learned.system.to_fis());
+    let text = fis_input::signed_fis(&learned.system);
     output_dir::write_file(&args.out, &text, "fis imitate")?;
     println!("wrote {}", args.out.display());
     Ok(())

@@ -65,6 +65,12 @@ pub(crate) const RECOGNISED_BYTES: usize = sim_study::MAX_INPUT_FILE_BYTES as us
 /// which MATLAB, fuzzylite and hrm skip, by which hrm knows its own file.
 pub(crate) const FIS_SIGNATURE: &str = "% written by hrm\n";
 
+/// The `.fis` text of `system` as `hrm fis train` and `hrm fis imitate` write it: hrm's
+/// signature, then the system.
+pub(crate) fn signed_fis(system: &FuzzySystem) -> String {
+    format!("{FIS_SIGNATURE}{}", system.to_fis())
+}
+
 /// The first line of the FCL files `hrm fis export --format fcl` writes (a comment fuzzylite
 /// and hrm skip).
 pub(crate) const FCL_SIGNATURE: &str = "// written by hrm\n";

@@ -148,7 +148,7 @@ pub fn run(args: TrainArgs) -> Result<(), String> {
         ))?;
         trainer.best_system().map_err(|e| e.to_string())?
     };
-    let text = format!("{}{}", fis_input::FIS_SIGNATURE, system.to_fis());
+    let text = fis_input::signed_fis(&system);
     output_dir::write_file(&args.out, &text, "fis train")?;
     console::print(&format!("wrote {}\n", args.out.display()))?;
     Ok(())

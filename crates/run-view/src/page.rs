@@ -72,9 +72,13 @@ pub fn written_by_hrm(start: &[u8]) -> bool {
         comment.extend_from_slice(SIGNATURE.as_bytes());
         contains(&comment)
     } else {
-        start.starts_with(b"<!DOCTYPE html>")
-            && contains(format!("<meta name=\"generator\" content=\"{SIGNATURE}\">").as_bytes())
+        start.starts_with(b"<!DOCTYPE html>") && contains(generator().as_bytes())
     }
+}
+
+/// The `generator` meta element that carries the [`SIGNATURE`] in a page's head.
+fn generator() -> String {
+    format!("<meta name=\"generator\" content=\"{SIGNATURE}\">")
 }
 
 /// How far into a page or GIF its [`SIGNATURE`] is: within the first 2 KiB.
@@ -84,7 +88,7 @@ pub const SIGNATURE_WITHIN: usize = 2048;
 /// in the `<head>` (it opens it, right after the charset) and [`tail`] at the end of the
 /// `<body>`.
 pub fn head() -> String {
-    format!("<meta name=\"generator\" content=\"{SIGNATURE}\">\n<style>{STYLE}</style>\n")
+    format!("{}\n<style>{STYLE}</style>\n", generator())
 }
 
 /// The viewer's script, to close the `<body>` of a page with scenes.
