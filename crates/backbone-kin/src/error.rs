@@ -235,10 +235,8 @@ impl Classify for KinError {
     }
 }
 
-/// A refused shape or non-finite input as [`KinError::Dimension`] or [`KinError::NonFinite`],
-/// with the same message.
-/// A number of quadrature nodes in a message: compact, and "more than 1e308" where the count
-/// overflowed.
+/// A number of quadrature nodes in a message: compact, and "an overflowing number of" where the
+/// estimate overflowed (the bound's terms exceed `f64`'s range long before the count does).
 struct NodeCount(f64);
 
 impl std::fmt::Display for NodeCount {
@@ -246,11 +244,13 @@ impl std::fmt::Display for NodeCount {
         if self.0.is_finite() {
             write!(f, "{}", lane_math::Compact(self.0))
         } else {
-            f.write_str("more than 1e308")
+            f.write_str("an overflowing number of")
         }
     }
 }
 
+/// A refused shape or non-finite input as [`KinError::Dimension`] or [`KinError::NonFinite`],
+/// with the same message.
 impl From<ShapeError<'static>> for KinError {
     fn from(error: ShapeError<'static>) -> Self {
         let name = error.name;

@@ -811,7 +811,7 @@ mod tests {
         let message = answer["error"]["message"].as_str().unwrap();
         assert!(
             message.starts_with("a: the curve oscillates too fast")
-                && message.contains("more than 1e308 nodes"),
+                && message.contains("an overflowing number of nodes"),
             "{message}"
         );
     }
