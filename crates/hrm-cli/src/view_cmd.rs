@@ -260,7 +260,7 @@ fn load_run(dir: &Path, label: Option<&str>) -> Result<(Scenario, RunView), Stri
 }
 
 /// The largest magnitude of a value of `timeseries.csv` (m, rad, N m, s).
-const MAX_VALUE: f64 = 1e15;
+const MAX_VALUE: f64 = run_view::MAX_MAGNITUDE;
 
 /// The columns of `timeseries.csv` the viewer needs, back into a [`Record`]: `t`, the
 /// coordinates and their `_ref`, `tau1..m`, the tips, and `joint_tau1..n_joints` when present.

@@ -230,3 +230,8 @@ def test_a_run_shows_itself_in_jupyter():
         hrm.view_html(json.dumps(bad))
     with pytest.raises(hrm.InvalidInput, match="scene"):
         hrm.view_html("{")
+    # Finite, but beyond what the page's rounding holds: was written into the page as null.
+    with pytest.raises(hrm.InvalidInput, match=r"t: value 1 is 1e304, more than 1e15 in magnitude"):
+        huge = spatial_scene(4, 2)
+        huge["runs"][0]["t"][1] = 1e304
+        hrm.view_html(json.dumps(huge))

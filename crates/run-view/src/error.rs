@@ -132,6 +132,20 @@ pub enum FieldProblem {
         /// The limit.
         max: usize,
     },
+    /// A value beyond the magnitude a run's numbers may have.
+    #[error(
+        "value {index} is {}, more than {} in magnitude",
+        lane_math::Compact(*value),
+        lane_math::Compact(*max)
+    )]
+    TooLarge {
+        /// Its index (0-based).
+        index: usize,
+        /// The value.
+        value: f64,
+        /// The largest magnitude allowed.
+        max: f64,
+    },
     /// A value that is not finite.
     #[error("value {index} is {value}, not finite")]
     NotFinite {

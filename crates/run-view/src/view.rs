@@ -17,6 +17,10 @@ pub const MAX_POINTS: usize = 1_001;
 pub const MAX_ITEMS: usize = sim_study::MAX_SCENARIO_OBSTACLES;
 /// The most runs a scene may compare.
 pub const MAX_RUNS: usize = 64;
+/// The largest magnitude of a number of a run (s, m, rad, N m): beyond the runaway bounds of
+/// any run hrm writes, and far below where the page's rounding to 0.1 mm or the drawing's
+/// distances overflow.
+pub const MAX_MAGNITUDE: f64 = 1e15;
 
 /// A run as drawn: the arm's points, the reference and the time series, sample by sample.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -169,8 +173,9 @@ impl RunView {
 
     /// Checks the sizes and values: `dims` 2 or 3, at least one sample, increasing finite
     /// times, one row of the right length a sample in every per-sample field, finite
-    /// coordinates, positive finite radii, widths and limits, and the sizes within
-    /// [`MAX_SAMPLES`], [`MAX_POINTS`] and [`MAX_ITEMS`]. The error names the field.
+    /// coordinates, positive finite radii, widths and limits, every number at most
+    /// [`MAX_MAGNITUDE`] in magnitude, and the sizes within [`MAX_SAMPLES`], [`MAX_POINTS`] and
+    /// [`MAX_ITEMS`]. The error names the field.
     pub fn check(&self) -> Result<(), ViewError> {
         let d = self.dims;
         if d != 2 && d != 3 {
@@ -328,28 +333,44 @@ pub(crate) fn count(
 
 /// Every value of `values` finite.
 fn finite(field: &str, values: &[f64]) -> Result<(), ViewError> {
-    match lane_math::first_non_finite(values) {
-        Some((index, value)) => Err(ViewError::field(
+    if let Some((index, value)) = lane_math::first_non_finite(values) {
+        return Err(ViewError::field(
             field,
             FieldProblem::NotFinite { index, value },
+        ));
+    }
+    bounded(field, values)
+}
+
+/// Every value of `values` at most [`MAX_MAGNITUDE`] in magnitude (NaN passes: the callers
+/// refuse it with their own message first).
+fn bounded(field: &str, values: &[f64]) -> Result<(), ViewError> {
+    match values.iter().position(|v| v.abs() > MAX_MAGNITUDE) {
+        Some(index) => Err(ViewError::field(
+            field,
+            FieldProblem::TooLarge {
+                index,
+                value: values[index],
+                max: MAX_MAGNITUDE,
+            },
         )),
         None => Ok(()),
     }
 }
 
-/// Every value of `values` finite and positive.
+/// Every value of `values` finite, positive and at most [`MAX_MAGNITUDE`].
 pub(crate) fn positive(field: &str, values: &[f64]) -> Result<(), ViewError> {
     match values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
         Some(&value) => Err(ViewError::field(field, FieldProblem::NotPositive { value })),
-        None => Ok(()),
+        None => bounded(field, values),
     }
 }
 
-/// Finite non-negative `values`.
+/// Finite non-negative `values`, at most [`MAX_MAGNITUDE`].
 fn non_negative(field: &str, values: &[f64]) -> Result<(), ViewError> {
     match values.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
         Some(&value) => Err(ViewError::field(field, FieldProblem::Negative { value })),
-        None => Ok(()),
+        None => bounded(field, values),
     }
 }
 

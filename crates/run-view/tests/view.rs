@@ -176,6 +176,23 @@ fn bad_data_is_refused_naming_the_field() {
             "joints[2]: value 0 is inf",
             Box::new(|r| r.joints[2][0] = f64::INFINITY),
         ),
+        // Finite, but beyond what the page's rounding (to 0.1 mm) and drawing can hold.
+        (
+            "joints[2]: value 1 is 2e304, more than 1e15 in magnitude",
+            Box::new(|r| r.joints[2][1] = 2e304),
+        ),
+        (
+            "t: value 4 is 1e16, more than 1e15 in magnitude",
+            Box::new(|r| r.t[4] = 1e16),
+        ),
+        (
+            "obstacles[1]: value 0 is 1e300, more than 1e15 in magnitude",
+            Box::new(|r| {
+                if let Obstacle::Capsule { radius, .. } = &mut r.obstacles[1] {
+                    *radius = 1e300;
+                }
+            }),
+        ),
         (
             "tip_ref[0]: 2 numbers",
             Box::new(|r| {

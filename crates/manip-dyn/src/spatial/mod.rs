@@ -69,15 +69,16 @@ pub use derivative_data::SpatialDerivativeData;
 pub use eigen::{SymmetricEigen, symmetric_eigen};
 pub use energy::{kinetic_energy, potential_energy};
 pub use kinematics::{forward_kinematics, jacobian};
-pub use model::{JointKind, SpatialJoint, SpatialLink, SpatialModel};
+pub use model::{JointKind, MAX_PRISMATIC_POSITION, SpatialJoint, SpatialLink, SpatialModel};
 pub use rnea::rnea;
 pub use rnea_derivatives::rnea_derivatives;
 
 use crate::check;
 use crate::error::DynError;
 
-/// The preamble of every algorithm: `data` built for `model` and each named input `n` finite
-/// entries. Returns `n`.
+/// The preamble of every algorithm: `data` built for `model`, each named input `n` finite
+/// entries, and the positions `q` (the first input) of prismatic joints at most
+/// [`MAX_PRISMATIC_POSITION`] in magnitude. Returns `n`.
 fn check_inputs(
     model: &SpatialModel,
     data: &SpatialData,
@@ -90,5 +91,26 @@ fn check_inputs(
         n,
     )?;
     check::vectors(n, inputs)?;
+    if let Some(&("q", q)) = inputs.first() {
+        let prismatic = model
+            .joints()
+            .iter()
+            .map(|j| j.kind == JointKind::Prismatic);
+        if let Some((index, &value)) =
+            q.iter()
+                .zip(prismatic)
+                .enumerate()
+                .find_map(|(i, (q, prismatic))| {
+                    (prismatic && q.abs() > MAX_PRISMATIC_POSITION).then_some((i, q))
+                })
+        {
+            return Err(DynError::InvalidJoint {
+                index,
+                quantity: "position q",
+                requirement: "at most 1e9 m in magnitude (a prismatic joint)",
+                value,
+            });
+        }
+    }
     Ok(n)
 }

@@ -14,6 +14,12 @@ pub enum JointKind {
     Prismatic,
 }
 
+/// The largest magnitude of a prismatic joint's position `q` (m) the algorithms take: the bound of
+/// a URDF's numbers (`robot_desc::MAX_MAGNITUDE`), far beyond any robot, so that the products
+/// of a few positions and inertias stay within double precision (at `1e160` the derivatives'
+/// intermediate terms overflowed where `rnea` still answered).
+pub const MAX_PRISMATIC_POSITION: f64 = 1e9;
+
 /// One joint: link `i`'s frame is its parent's frame moved by `origin`, then by the joint's
 /// motion `q` about or along `axis` (both in the joint frame). At `q = 0` link `i`'s frame is the
 /// joint frame.

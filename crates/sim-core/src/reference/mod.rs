@@ -17,7 +17,7 @@ mod waypoints;
 
 pub use path::{CartesianPath, FREE_BASE_START, PathShape};
 pub use preview::{MAX_PREVIEW_SAMPLES, ReferencePreview};
-pub use spatial_path::{Helix, MAX_HELIX_EXTENT_M, SpatialPath};
+pub use spatial_path::{Helix, MAX_HELIX_EXTENT_M, MAX_SPATIAL_PATH_WORK, SpatialPath};
 pub use spline::{MAX_SPLINE_SAMPLES, SplineMotion};
 pub use waypoints::{MAX_WAYPOINTS, Waypoints};
 

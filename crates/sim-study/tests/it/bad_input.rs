@@ -452,6 +452,32 @@ fn helix_out_of_scale() {
     }
 }
 
+/// A path reference's continuation costs about links x coordinates a node at 2001 nodes: 100,000
+/// links (within a scenario's 10^6) took 153 s before the run's first step, and could not be
+/// interrupted; the bound names the arm's size.
+#[test]
+fn spatial_path_work_is_bounded() {
+    let spatial = sim_study::Scenario::builtin_text("spatial-tracking").unwrap();
+    let with = |links: usize| {
+        let text = spatial.replace("links = 10", &format!("links = {links}"));
+        assert_ne!(text, spatial);
+        sim_study::Scenario::from_toml(&text).map(|s| s.build())
+    };
+    let (name, message) = invalid(with(8193).unwrap());
+    assert_eq!(name, "arm.links");
+    assert!(
+        message.starts_with(
+            "arm.links x modal coordinates must be at most 32768 for a path reference"
+        ) && message.ends_with("got 8193 x 4: fewer links or harmonics"),
+        "{message}"
+    );
+    assert_eq!(
+        sim_core::reference::MAX_SPATIAL_PATH_WORK,
+        8192 * 4,
+        "the bound's documented sizes"
+    );
+}
+
 #[test]
 fn noise_negative_or_non_finite() {
     let s = LoopSettings {

@@ -438,3 +438,38 @@ fn derivatives_do_not_depend_on_the_base_offset() {
         );
     }
 }
+
+/// A prismatic joint's position beyond `MAX_PRISMATIC_POSITION` is refused by every algorithm
+/// alike, naming the joint (at `1e160` `rnea` answered while `rnea_derivatives` said "tau is not
+/// finite"); revolute angles of any finite size are taken.
+#[test]
+fn far_prismatic_positions_are_refused_alike() {
+    use manip_dyn::spatial::{MAX_PRISMATIC_POSITION, SpatialJoint, SpatialLink, Transform};
+    let slide = SpatialJoint::prismatic([0.0, 0.0, 1.0], Transform::translation([0.1, 0.0, 0.0]));
+    let turn = SpatialJoint::revolute([0.0, 0.0, 1.0], Transform::translation([0.1, 0.0, 0.0]));
+    let link = SpatialLink::cuboid(1.0, [0.1, 0.02, 0.02], [0.05, 0.0, 0.0]);
+    let model = SpatialModel::new(vec![turn, slide], vec![link; 2], [0.0, 0.0, -9.81]).unwrap();
+    let mut data = SpatialData::new(&model);
+    let mut derivatives = SpatialDerivativeData::new(&model);
+    let zero = [0.0; 2];
+    let mut out = [0.0; 2];
+    let at_bound = [1e200, MAX_PRISMATIC_POSITION];
+    rnea(&model, &mut data, &at_bound, &zero, &zero, &mut out).unwrap();
+    rnea_derivatives(&model, &mut data, &mut derivatives, &at_bound, &zero, &zero).unwrap();
+    let far = [0.0, -1e160];
+    let expected = "joint 1: position q must be at most 1e9 m in magnitude (a prismatic joint), \
+                    got -1e160";
+    let errors = [
+        rnea(&model, &mut data, &far, &zero, &zero, &mut out).unwrap_err(),
+        rnea_derivatives(&model, &mut data, &mut derivatives, &far, &zero, &zero).unwrap_err(),
+        aba(&model, &mut data, &far, &zero, &zero, &mut out).unwrap_err(),
+        potential_energy(&model, &mut data, &far).unwrap_err(),
+    ];
+    for error in errors {
+        assert!(
+            matches!(error, DynError::InvalidJoint { index: 1, .. }),
+            "{error:?}"
+        );
+        assert_eq!(error.to_string(), expected);
+    }
+}
