@@ -109,6 +109,11 @@ impl ReducedModel {
         alpha0: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let harmonics = harmonics.map_or(Ok(1), |k| count(k, "harmonics", 1))?;
+        if harmonics == 0 {
+            // The modal map's own message ("a modal family needs at least one harmonic") names
+            // no argument.
+            return Err(Error::input("harmonics must be at least 1, got 0").into());
+        }
         let alpha0 = alpha0.map(|a| crate::args::real(a, "alpha0")).transpose()?;
         let chain = arm.chain().clone();
         let base = alpha0.map_or(BaseAngle::Free, |a| BaseAngle::Fixed(reduce_angle(a)));

@@ -654,6 +654,13 @@ def test_modal_coordinates_are_bounded_as_a_run_bounds_them():
         hrm.SpatialArm().forward_dynamics([0.1, 0.0, 0.0, 1e300], [0.0] * 4, [0.0] * 4)
     with pytest.raises(hrm.InvalidInput, match=r"^a\[0\]" + unit):
         hrm.ReferenceSample([1e7, 0.0], np.zeros(2), np.zeros(2))
+    # A NaN is named by the argument too (it was "modal coordinates[0] must be finite").
+    with pytest.raises(hrm.InvalidInput, match=r"^a\[0\] must be finite, got NaN$"):
+        reduced.fk([float("nan"), 0.0, 0.0])
+    with pytest.raises(hrm.InvalidInput, match=r"^harmonics must be at least 1, got 0$"):
+        hrm.ReducedModel(hrm.Arm(links=10), harmonics=0)
+    with pytest.raises(hrm.InvalidInput, match=r"^a_dot\[1, 2\] must be finite, got inf$"):
+        reduced.forward_dynamics(np.zeros((2, 3)), [[0.0] * 3, [0.0, 0.0, np.inf]], np.zeros((2, 3)))
     # At the bound the answer is the arithmetic's: theta = J a + theta_0 to rounding.
     a = np.array([1e6, -1e6, 0.5])
     assert np.allclose(reduced.joint_angles(a), reduced.jacobian @ a, rtol=0, atol=1e-9)

@@ -1294,9 +1294,9 @@ fn check_initial(initial: &ModalState, m: usize) -> Result<(), SimError> {
 /// modal rates, each checked by [`check_rates`].
 pub const RATE_NAMES: [&str; 2] = ["theta_dot", "a_dot"];
 
-/// Refuses rates beyond [`MAX_MODAL_MAGNITUDE`] in magnitude, the scale a run resolves (`1e300`
-/// overflowed the Coriolis terms): `rates` holds states of `width` entries (joint or modal
-/// rates), and the error names the first such entry, `name[i]` in one state and `name[k, i]`
+/// Refuses rates that are not finite or beyond [`MAX_MODAL_MAGNITUDE`] in magnitude, the scale a
+/// run resolves (`1e300` overflowed the Coriolis terms): `rates` holds states of `width` entries
+/// (joint or modal rates), and the error names the first such entry, `name[i]` in one state and `name[k, i]`
 /// in state `k` of several. For a run's initial state and the rates the front ends are given
 /// (`hrm eval`'s and Python's `theta_dot` and `a_dot`).
 ///
@@ -1306,7 +1306,8 @@ pub fn check_rates(name: &str, rates: &[f64], width: usize) -> Result<(), SimErr
     check_scale(name, rates, width, "rad/s, m/s for a prismatic joint")
 }
 
-/// Refuses modal coordinates beyond [`MAX_MODAL_MAGNITUDE`] in magnitude, where a run stops
+/// Refuses modal coordinates that are not finite or beyond [`MAX_MODAL_MAGNITUDE`] in magnitude,
+/// where a run stops
 /// ([`SimError::OutOfScale`]): in `J a` (eq 8) a coordinate of `1e17` rounds the others away.
 /// Named as [`check_rates`] names its entries; for the coordinates the front ends are given
 /// (`hrm eval`'s and Python's `a`). A base angle `alpha0` that a front end reduces to
@@ -1318,13 +1319,13 @@ pub fn check_coordinates(name: &str, coordinates: &[f64], width: usize) -> Resul
     check_scale(name, coordinates, width, "rad")
 }
 
-/// [`check_rates`] and [`check_coordinates`]: the first entry beyond [`MAX_MODAL_MAGNITUDE`],
-/// its unit named in the message.
+/// [`check_rates`] and [`check_coordinates`]: the first entry not finite or beyond
+/// [`MAX_MODAL_MAGNITUDE`], its unit named in the message.
 fn check_scale(name: &str, values: &[f64], width: usize, unit: &str) -> Result<(), SimError> {
     let Some((flat, value)) = values
         .iter()
         .enumerate()
-        .find(|(_, v)| v.abs() > MAX_MODAL_MAGNITUDE)
+        .find(|(_, v)| !v.is_finite() || v.abs() > MAX_MODAL_MAGNITUDE)
     else {
         return Ok(());
     };
@@ -1333,14 +1334,16 @@ fn check_scale(name: &str, values: &[f64], width: usize, unit: &str) -> Result<(
     } else {
         format!("{name}[{}, {}]", flat / width.max(1), flat % width.max(1))
     };
-    Err(SimError::setting(
-        entry,
+    let requirement = if value.is_finite() {
         format!(
             "must be at most {} in magnitude ({unit}), got {}",
             Compact(MAX_MODAL_MAGNITUDE),
             Compact(*value)
-        ),
-    ))
+        )
+    } else {
+        format!("must be finite, got {value}")
+    };
+    Err(SimError::setting(entry, requirement))
 }
 
 /// Checks the settings of a loop of `m` coordinates for a chain of `n_joints` (`n` planar, `2n`

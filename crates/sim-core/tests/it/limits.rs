@@ -294,3 +294,27 @@ fn limits_that_cannot_hold_the_arm_stop_the_run_and_a_start_beyond_them_is_refus
         "limits.joint_torque_nm[9] must be positive and finite, got NaN"
     );
 }
+
+/// The front ends' checks of coordinates and rates name the entry of one state or of a batch,
+/// for a value beyond the scale a run resolves and for one that is not finite.
+#[test]
+fn front_end_coordinates_and_rates_name_the_entry() {
+    let message = |r: Result<(), SimError>| r.unwrap_err().to_string();
+    assert_eq!(
+        message(sim_core::check_coordinates("a", &[0.1, f64::NAN], 2)),
+        "a[1] must be finite, got NaN"
+    );
+    assert_eq!(
+        message(sim_core::check_rates(
+            "a_dot",
+            &[0.0, 0.0, 0.0, f64::INFINITY],
+            2
+        )),
+        "a_dot[1, 1] must be finite, got inf"
+    );
+    assert_eq!(
+        message(sim_core::check_coordinates("a", &[-1e17], 1)),
+        "a[0] must be at most 1000000 in magnitude (rad), got -1e17"
+    );
+    assert!(sim_core::check_coordinates("a", &[1e6, -1e6], 2).is_ok());
+}
