@@ -90,6 +90,19 @@ pub enum ViewError {
         /// The record's samples.
         samples: usize,
     },
+    /// The scenario's arm does not put the tip where the record says it was.
+    #[error(
+        "the arm of scenario {scenario} puts the tip {} m from the recorded tip at t = {t} s: the record was not made with this arm",
+        lane_math::Compact(*distance)
+    )]
+    TipMismatch {
+        /// The scenario's name.
+        scenario: String,
+        /// The first sample's time where the tips differ (s).
+        t: f64,
+        /// Their distance (m).
+        distance: f64,
+    },
     /// The scenario's model could not be built.
     #[error(transparent)]
     Model(#[from] sim_core::SimError),

@@ -51,7 +51,7 @@ pub fn from_record(
     // A run longer than the viewer holds is drawn at evenly strided samples, the last included.
     let picked = strided(samples, MAX_SAMPLES - 1);
     let mut theta = vec![0.0; n_joints];
-    let mut joints = Vec::with_capacity(picked.len());
+    let mut joints: Vec<Vec<f64>> = Vec::with_capacity(picked.len());
     match &plant {
         PlantModel::Planar(model) => {
             let lengths: Vec<f64> = model.chain().link_lengths().collect();
@@ -75,6 +75,27 @@ pub fn from_record(
                 )?;
                 joints.push(points.iter().flatten().copied().collect());
             }
+        }
+    }
+    // The arm drawn is the scenario's: its tip must be the recorded one (the chain's, computed
+    // by the same kinematics), or the folder's scenario is not the run's (a changed link length).
+    let length: f64 = match &plant {
+        PlantModel::Planar(model) => model.chain().link_lengths().sum(),
+        PlantModel::Spatial(model) => model.map().link_lengths().iter().sum(),
+    };
+    for (&k, points) in picked.iter().zip(&joints) {
+        let drawn = &points[points.len() - dims..];
+        let recorded = [record.tip[k][0], record.tip[k][1], record.tip_z[k]];
+        let distance = (0..dims)
+            .map(|i| (drawn[i] - recorded[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        if distance.is_nan() || distance > 1e-9 * (1.0 + length) {
+            return Err(ViewError::TipMismatch {
+                scenario: scenario.name.clone(),
+                t: record.t[k],
+                distance,
+            });
         }
     }
     let (obstacles, clearance) = match scenario.clearance_model(n, scenario.workspace())? {

@@ -121,6 +121,19 @@ fn a_planar_run_is_drawn_from_its_modal_coordinates() {
     let mut other = Scenario::builtin("paper-tracking").unwrap();
     other.arm.links = Some(12);
     assert!(from_record(&other, "x", &run.record, None).is_err());
+    // An arm of the same links but another length draws another tip: refused, not drawn wrong.
+    let mut longer = Scenario::builtin("paper-tracking").unwrap();
+    longer.arm.link_length = Some(0.2);
+    let message = from_record(&longer, "x", &run.record, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.starts_with("the arm of scenario paper-tracking puts the tip 0.36")
+            && message.ends_with(
+                "m from the recorded tip at t = 0 s: the record was not made with this arm"
+            ),
+        "{message}"
+    );
 }
 
 #[test]
