@@ -259,7 +259,7 @@ fn load_run(dir: &Path, label: Option<&str>) -> Result<(Scenario, RunView), Stri
     Ok((scenario, view))
 }
 
-/// The largest magnitude of a value of `timeseries.csv` (m, rad, N m, s).
+/// The largest magnitude of a value of `timeseries.csv` (s, rad, m), the torques' (N m) apart.
 const MAX_VALUE: f64 = run_view::MAX_MAGNITUDE;
 
 /// The columns of `timeseries.csv` the viewer needs, back into a [`Record`]: `t`, the
@@ -318,14 +318,20 @@ fn parse_timeseries(text: &str, scenario: &Scenario, n_joints: usize) -> Result<
             let value: f64 = cell.parse().map_err(|_| {
                 format!("line {}: column {name}: {cell:?} is not a number", line + 2)
             })?;
-            // hrm writes no value beyond its runaway bounds; a hand-edited 1e308 would make
-            // the drawn distances overflow.
-            if value.is_nan() || value.abs() > MAX_VALUE {
+            // hrm writes no time, coordinate or rate beyond its runaway bounds (a hand-edited
+            // 1e308 would make the drawn distances overflow); torques grow with the arm's masses
+            // and are only rounded.
+            let max = if name.starts_with("tau") || name.starts_with("joint_tau") {
+                run_view::MAX_VALUE
+            } else {
+                MAX_VALUE
+            };
+            if value.is_nan() || value.abs() > max {
                 return Err(format!(
                     "line {}: column {name}: {} is beyond the {} a run writes",
                     line + 2,
                     lane_math::Compact(value),
-                    lane_math::Compact(MAX_VALUE)
+                    lane_math::Compact(max)
                 ));
             }
             row.push(value);

@@ -24,7 +24,11 @@ pub fn strided(n: usize, max: usize) -> Vec<usize> {
 /// `v` rounded to a multiple of `10^exponent`, as the double nearest that decimal (so that it
 /// prints as the short decimal, not `0.30000000000000004`).
 pub fn round_decimal(v: f64, exponent: i32) -> f64 {
-    if exponent < 0 {
+    if exponent < -300 {
+        // `10^-exponent` overflows for a peak near the subnormals: scale in two steps.
+        let (first, second) = (10f64.powi(300), 10f64.powi(-exponent - 300));
+        (v * first * second).round() / second / first
+    } else if exponent < 0 {
         let scale = 10f64.powi(-exponent);
         (v * scale).round() / scale
     } else {
@@ -123,5 +127,11 @@ mod tests {
         assert_eq!(round_decimal(31_234.7, 2), 31_200.0);
         assert_eq!(exponent_for([0.5, -31.2].into_iter(), 4), -2);
         assert_eq!(exponent_for([0.0].into_iter(), 4), 0);
+        // A peak near the subnormals: 10^327 overflows, the two-step scaling does not.
+        let tiny = f64::from_bits(1);
+        let exponent = exponent_for([tiny].into_iter(), 4);
+        assert_eq!(exponent, -327);
+        assert_eq!(round_decimal(tiny, exponent), tiny);
+        assert_eq!(round_decimal(-1.2345678e-310, -313), -1.235e-310);
     }
 }

@@ -53,7 +53,7 @@ impl GifOptions {
         if !(1..=50).contains(&self.fps) {
             return Err(count("gif fps", self.fps as usize, "", 1, 50));
         }
-        positive("gif speed", &[self.speed])?;
+        positive("gif speed", &[self.speed], f64::MAX)?;
         Ok(())
     }
 }

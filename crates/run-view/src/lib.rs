@@ -18,6 +18,6 @@ pub use page::{
     page, scene_html, tail, written_by_hrm,
 };
 pub use view::{
-    Channel, MAX_ITEMS, MAX_MAGNITUDE, MAX_POINTS, MAX_RUNS, MAX_SAMPLES, Obstacle, RunView, Scene,
-    Series,
+    Channel, MAX_ITEMS, MAX_MAGNITUDE, MAX_POINTS, MAX_RUNS, MAX_SAMPLES, MAX_VALUE, Obstacle,
+    RunView, Scene, Series,
 };

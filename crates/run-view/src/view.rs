@@ -17,10 +17,14 @@ pub const MAX_POINTS: usize = 1_001;
 pub const MAX_ITEMS: usize = sim_study::MAX_SCENARIO_OBSTACLES;
 /// The most runs a scene may compare.
 pub const MAX_RUNS: usize = 64;
-/// The largest magnitude of a number of a run (s, m, rad, N m): beyond the runaway bounds of
+/// The largest magnitude of a time or a coordinate of a run (s, m): beyond the runaway bounds of
 /// any run hrm writes, and far below where the page's rounding to 0.1 mm or the drawing's
 /// distances overflow.
 pub const MAX_MAGNITUDE: f64 = 1e15;
+/// The largest magnitude of a series value, a joint torque or a torque limit: a run of an arm
+/// of heavy links writes torques beyond [`MAX_MAGNITUDE`] (`2e21` N m for links of `1e9` kg and
+/// `1e4` m), and these are only rounded to significant digits.
+pub const MAX_VALUE: f64 = 1e100;
 
 /// A run as drawn: the arm's points, the reference and the time series, sample by sample.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -173,9 +177,10 @@ impl RunView {
 
     /// Checks the sizes and values: `dims` 2 or 3, at least one sample, increasing finite
     /// times, one row of the right length a sample in every per-sample field, finite
-    /// coordinates, positive finite radii, widths and limits, every number at most
-    /// [`MAX_MAGNITUDE`] in magnitude, and the sizes within [`MAX_SAMPLES`], [`MAX_POINTS`] and
-    /// [`MAX_ITEMS`]. The error names the field.
+    /// coordinates, positive finite radii, widths and limits, times and coordinates at most
+    /// [`MAX_MAGNITUDE`] in magnitude and series values, torques and limits at most
+    /// [`MAX_VALUE`], and the sizes within [`MAX_SAMPLES`], [`MAX_POINTS`] and [`MAX_ITEMS`]. The
+    /// error names the field.
     pub fn check(&self) -> Result<(), ViewError> {
         let d = self.dims;
         if d != 2 && d != 3 {
@@ -185,7 +190,7 @@ impl RunView {
         if n == 0 || n > MAX_SAMPLES {
             return Err(count("t", n, "samples", 1, MAX_SAMPLES));
         }
-        finite("t", &self.t)?;
+        finite("t", &self.t, MAX_MAGNITUDE)?;
         if let Some(k) = self.t.windows(2).position(|w| w[1] <= w[0]) {
             return Err(ViewError::field(
                 "t",
@@ -203,13 +208,13 @@ impl RunView {
                 },
             ));
         }
-        rows("joints", &self.joints, n, width)?;
+        rows("joints", &self.joints, (n, width), MAX_MAGNITUDE)?;
         if !self.tip_ref.is_empty() {
-            rows("tip_ref", &self.tip_ref, n, d)?;
+            rows("tip_ref", &self.tip_ref, (n, d), MAX_MAGNITUDE)?;
         }
         let links = width / d - 1;
         if !self.joint_torque.is_empty() {
-            rows("joint_torque", &self.joint_torque, n, links)?;
+            rows("joint_torque", &self.joint_torque, (n, links), MAX_VALUE)?;
         }
         if !self.torque_limit.is_empty() {
             if self.torque_limit.len() != links {
@@ -221,7 +226,7 @@ impl RunView {
                     },
                 ));
             }
-            positive("torque_limit", &self.torque_limit)?;
+            positive("torque_limit", &self.torque_limit, MAX_VALUE)?;
         }
         for (what, count) in [
             ("series", self.series.len()),
@@ -261,7 +266,7 @@ impl RunView {
                         },
                     ));
                 }
-                finite(&field, values)?;
+                finite(&field, values, MAX_VALUE)?;
             }
         }
         for (i, o) in self.obstacles.iter().enumerate() {
@@ -306,7 +311,7 @@ impl RunView {
             for p in &c.points {
                 point(&field, p, d)?;
             }
-            positive(&format!("{field}.width"), &[c.width])?;
+            positive(&format!("{field}.width"), &[c.width], MAX_MAGNITUDE)?;
         }
         Ok(())
     }
@@ -332,45 +337,45 @@ pub(crate) fn count(
 }
 
 /// Every value of `values` finite.
-fn finite(field: &str, values: &[f64]) -> Result<(), ViewError> {
+fn finite(field: &str, values: &[f64], max: f64) -> Result<(), ViewError> {
     if let Some((index, value)) = lane_math::first_non_finite(values) {
         return Err(ViewError::field(
             field,
             FieldProblem::NotFinite { index, value },
         ));
     }
-    bounded(field, values)
+    bounded(field, values, max)
 }
 
-/// Every value of `values` at most [`MAX_MAGNITUDE`] in magnitude (NaN passes: the callers
-/// refuse it with their own message first).
-fn bounded(field: &str, values: &[f64]) -> Result<(), ViewError> {
-    match values.iter().position(|v| v.abs() > MAX_MAGNITUDE) {
+/// Every value of `values` at most `max` in magnitude (NaN passes: the callers refuse it with
+/// their own message first).
+fn bounded(field: &str, values: &[f64], max: f64) -> Result<(), ViewError> {
+    match values.iter().position(|v| v.abs() > max) {
         Some(index) => Err(ViewError::field(
             field,
             FieldProblem::TooLarge {
                 index,
                 value: values[index],
-                max: MAX_MAGNITUDE,
+                max,
             },
         )),
         None => Ok(()),
     }
 }
 
-/// Every value of `values` finite, positive and at most [`MAX_MAGNITUDE`].
-pub(crate) fn positive(field: &str, values: &[f64]) -> Result<(), ViewError> {
+/// Every value of `values` finite, positive and at most `max`.
+pub(crate) fn positive(field: &str, values: &[f64], max: f64) -> Result<(), ViewError> {
     match values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
         Some(&value) => Err(ViewError::field(field, FieldProblem::NotPositive { value })),
-        None => bounded(field, values),
+        None => bounded(field, values, max),
     }
 }
 
-/// Finite non-negative `values`, at most [`MAX_MAGNITUDE`].
+/// Finite non-negative `values`, at most [`MAX_MAGNITUDE`] (lengths).
 fn non_negative(field: &str, values: &[f64]) -> Result<(), ViewError> {
     match values.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
         Some(&value) => Err(ViewError::field(field, FieldProblem::Negative { value })),
-        None => bounded(field, values),
+        None => bounded(field, values, MAX_MAGNITUDE),
     }
 }
 
@@ -385,11 +390,16 @@ fn point(field: &str, p: &[f64], d: usize) -> Result<(), ViewError> {
             },
         ));
     }
-    finite(field, p)
+    finite(field, p, MAX_MAGNITUDE)
 }
 
 /// `n` rows of `width` finite numbers.
-fn rows(field: &str, rows: &[Vec<f64>], n: usize, width: usize) -> Result<(), ViewError> {
+fn rows(
+    field: &str,
+    rows: &[Vec<f64>],
+    (n, width): (usize, usize),
+    max: f64,
+) -> Result<(), ViewError> {
     if rows.len() != n {
         return Err(ViewError::field(
             field,
@@ -410,7 +420,7 @@ fn rows(field: &str, rows: &[Vec<f64>], n: usize, width: usize) -> Result<(), Vi
                 },
             ));
         }
-        finite(&format!("{field}[{k}]"), row)?;
+        finite(&format!("{field}[{k}]"), row, max)?;
     }
     Ok(())
 }

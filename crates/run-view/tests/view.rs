@@ -331,6 +331,28 @@ fn decimation_bounds_the_page_and_keeps_the_run_ends() {
     assert!(cut * 10 < full, "{cut} vs {full}");
 }
 
+/// Torques of heavy arms (a run of 1e9 kg links writes 2e21 N m) and series near the subnormals
+/// are drawn: the page's data holds numbers, never `null` (the rounding of a peak of `5e-324`
+/// to four digits overflowed its scale).
+#[test]
+fn extreme_but_recorded_values_reach_the_page_as_numbers() {
+    let mut run = spatial(5, 4);
+    for (k, row) in run.joint_torque.iter_mut().enumerate() {
+        row[0] = -2.12e21 * (k as f64 + 1.0);
+    }
+    run.torque_limit[0] = 1e22;
+    run.series[0].values[0] = vec![0.0, f64::from_bits(1), 1e-310, 0.0, 1e-310];
+    run.check().unwrap();
+    let scene = Scene {
+        title: "extremes".into(),
+        caption: String::new(),
+        runs: vec![run],
+    };
+    let html = scene_html(&scene, 100).unwrap();
+    assert!(!html.contains("null"), "{html}");
+    assert!(html.contains("[-1.06e+22,"), "{html}");
+}
+
 #[test]
 fn the_page_is_self_contained_and_its_data_cannot_end_the_script() {
     let (_, fuzzy) = planar(0.2, ControllerKind::Fuzzy);
