@@ -90,6 +90,18 @@ pub enum ViewError {
         /// The record's samples.
         samples: usize,
     },
+    /// An arm with more links than the viewer draws.
+    #[error(
+        "arm.links: the viewer draws at most {max} links, the arm of scenario {scenario} has {links}"
+    )]
+    TooManyLinks {
+        /// The scenario's name.
+        scenario: String,
+        /// The arm's links.
+        links: usize,
+        /// The most the viewer draws (`MAX_POINTS - 1`).
+        max: usize,
+    },
     /// The scenario's arm does not put the tip where the record says it was.
     #[error(
         "the arm of scenario {scenario} puts the tip {} m from the recorded tip at t = {t} s: the record was not made with this arm",

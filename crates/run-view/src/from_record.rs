@@ -4,7 +4,7 @@
 
 use crate::decimate::strided;
 use crate::error::ViewError;
-use crate::view::{MAX_SAMPLES, Obstacle, RunView, Series};
+use crate::view::{MAX_POINTS, MAX_SAMPLES, Obstacle, RunView, Series};
 use clearance::{ClearanceData, ClearanceModel};
 use modal_reduce::PlantModel;
 use sim_core::Record;
@@ -36,6 +36,13 @@ pub fn from_record(
         PlantModel::Planar(model) => (model.n_links(), model.n_links(), 2),
         PlantModel::Spatial(model) => (model.n_links(), 2 * model.n_links(), 3),
     };
+    if n + 1 > MAX_POINTS {
+        return Err(ViewError::TooManyLinks {
+            scenario: scenario.name.clone(),
+            links: n,
+            max: MAX_POINTS - 1,
+        });
+    }
     let (m, samples) = (record.n_coords, record.len());
     if record.n_joints != n_joints
         || record.a.len() != samples * m

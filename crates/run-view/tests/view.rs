@@ -121,6 +121,15 @@ fn a_planar_run_is_drawn_from_its_modal_coordinates() {
     let mut other = Scenario::builtin("paper-tracking").unwrap();
     other.arm.links = Some(12);
     assert!(from_record(&other, "x", &run.record, None).is_err());
+    // An arm beyond what the viewer draws is refused naming the links, not the page's field.
+    let mut long = Scenario::builtin("paper-tracking").unwrap();
+    long.arm.links = Some(1001);
+    assert_eq!(
+        from_record(&long, "x", &run.record, None)
+            .unwrap_err()
+            .to_string(),
+        "arm.links: the viewer draws at most 1000 links, the arm of scenario paper-tracking has 1001"
+    );
     // An arm of the same links but another length draws another tip: refused, not drawn wrong.
     let mut longer = Scenario::builtin("paper-tracking").unwrap();
     longer.arm.link_length = Some(0.2);
