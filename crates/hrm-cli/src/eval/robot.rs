@@ -59,18 +59,25 @@ fn model(urdf: &str, requested: Option<Vec<f64>>) -> Result<SpatialModel, EvalEr
 }
 
 /// A library error as an answer, a [`DynError::SingularJoint`] with the URDF name of its joint
-/// ("urdf: joint 'yaw3': joint 4: the articulated inertia ...").
+/// ("urdf: joint 'yaw3': joint 4: the articulated inertia ..."), a prismatic position out of
+/// range with the request's entry too ("theta[1]: joint 'slide': joint 1: position q ...").
 fn joint_named(urdf: &str, error: DynError) -> EvalError {
-    let name = match error {
-        DynError::SingularJoint { index } => robot(urdf)
-            .ok()
-            .and_then(|robot| robot.joints.get(index).map(|joint| joint.name.clone())),
-        _ => None,
+    let (field, index) = match error {
+        DynError::SingularJoint { index } => ("urdf".to_string(), index),
+        DynError::InvalidJoint {
+            index,
+            quantity: "position q",
+            ..
+        } => (format!("theta[{index}]"), index),
+        _ => return error.into(),
     };
+    let name = robot(urdf)
+        .ok()
+        .and_then(|robot| robot.joints.get(index).map(|joint| joint.name.clone()));
     match name {
         Some(name) => EvalError::new(
             Kind::Library(error.class()),
-            format!("urdf: joint '{name}': {error}"),
+            format!("{field}: joint '{name}': {error}"),
         ),
         None => error.into(),
     }
@@ -98,15 +105,18 @@ pub(super) fn dynamics(request: DynamicsRequest) -> EvalResult {
     let mut data = SpatialData::new(&model);
     let mut mass = Mat::<f64>::zeros(n, n);
     let (mut coriolis, mut gravity) = (vec![0.0; n], vec![0.0; n]);
-    spatial::mass_matrix(&model, &mut data, &request.theta, mass.as_mut())?;
+    spatial::mass_matrix(&model, &mut data, &request.theta, mass.as_mut())
+        .map_err(|error| joint_named(&request.urdf, error))?;
     spatial::coriolis(
         &model,
         &mut data,
         &request.theta,
         &request.theta_dot,
         &mut coriolis,
-    )?;
-    spatial::gravity(&model, &mut data, &request.theta, &mut gravity)?;
+    )
+    .map_err(|error| joint_named(&request.urdf, error))?;
+    spatial::gravity(&model, &mut data, &request.theta, &mut gravity)
+        .map_err(|error| joint_named(&request.urdf, error))?;
     finite("coriolis", &coriolis)?;
     finite("gravity", &gravity)?;
     Ok(json_fields([
@@ -147,7 +157,8 @@ pub(super) fn rnea_derivatives(request: RneaDerivativesRequest) -> EvalResult {
         &request.theta,
         &request.theta_dot,
         &request.theta_ddot,
-    )?;
+    )
+    .map_err(|error| joint_named(&request.urdf, error))?;
     rnea_answer(derivatives.value(), derivatives.d_q(), derivatives.d_v())
 }
 
@@ -211,7 +222,8 @@ pub(super) fn frames(request: FramesRequest) -> EvalResult {
         &[("theta", &request.theta)],
     )?;
     let mut data = SpatialData::new(&model);
-    spatial::forward_kinematics(&model, &mut data, &request.theta)?;
+    spatial::forward_kinematics(&model, &mut data, &request.theta)
+        .map_err(|error| joint_named(&request.urdf, error))?;
     let poses: Vec<_> = (0..model.n_links())
         .filter_map(|i| data.link_pose(i).copied())
         .collect();

@@ -101,6 +101,10 @@ fn bad_robot_requests_get_one_clear_error() {
     let urdf = exported_urdf();
     let massless = r#"<robot name="r"><link name="a"/><link name="b"/>
         <joint name="j" type="revolute"><parent link="a"/><child link="b"/></joint></robot>"#;
+    let slide = r#"<robot name="r"><link name="a"/><link name="b"><inertial><mass value="1"/>
+        <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+        <joint name="s" type="prismatic"><parent link="a"/><child link="b"/><axis xyz="1 0 0"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"#;
     let cases = [
         (
             json!({"op": "frames", "urdf": "<!DOCTYPE r [<!ENTITY a \"b\">]><robot name=\"&a;\"/>", "theta": []}),
@@ -113,6 +117,18 @@ fn bad_robot_requests_get_one_clear_error() {
         (
             json!({"op": "aba_derivatives", "urdf": massless, "theta": [0.0], "theta_dot": [0.0], "tau": [0.0]}),
             "urdf: joint 'j': joint 0: the articulated inertia about its axis is not positive",
+        ),
+        (
+            json!({"op": "frames", "urdf": slide, "theta": [-2e9]}),
+            "theta[0]: joint 's': joint 0: position q must be at most 1e9 m in magnitude (a prismatic joint), got -2000000000",
+        ),
+        (
+            json!({"op": "dynamics", "urdf": slide, "theta": [1e160], "theta_dot": [0.0]}),
+            "theta[0]: joint 's': joint 0: position q must be at most 1e9 m",
+        ),
+        (
+            json!({"op": "rnea_derivatives", "urdf": slide, "theta": [1e160], "theta_dot": [0.0], "theta_ddot": [0.0]}),
+            "theta[0]: joint 's': joint 0: position q must be at most 1e9 m",
         ),
         (
             json!({"op": "export", "urdf": urdf, "arm": arm(), "format": "urdf"}),
