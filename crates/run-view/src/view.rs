@@ -271,14 +271,23 @@ impl RunView {
         }
         for (i, o) in self.obstacles.iter().enumerate() {
             let field = format!("obstacles[{i}]");
-            let (points, lengths): (Vec<&Vec<f64>>, Vec<f64>) = match o {
-                Obstacle::Circle { centre, radius } if d == 2 => (vec![centre], vec![*radius]),
-                Obstacle::Sphere { centre, radius } if d == 3 => (vec![centre], vec![*radius]),
+            // The points and the lengths (radius or half sides), each with its key.
+            let (points, lengths) = match o {
+                Obstacle::Circle { centre, radius } if d == 2 => {
+                    (vec![("centre", centre)], ("radius", vec![*radius]))
+                }
+                Obstacle::Sphere { centre, radius } if d == 3 => {
+                    (vec![("centre", centre)], ("radius", vec![*radius]))
+                }
                 Obstacle::Circle { .. } | Obstacle::Sphere { .. } => {
                     return Err(ViewError::field(field, FieldProblem::Shape { dims: d }));
                 }
-                Obstacle::Capsule { a, b, radius } => (vec![a, b], vec![*radius]),
-                Obstacle::Box { centre, half } => (vec![centre], half.clone()),
+                Obstacle::Capsule { a, b, radius } => {
+                    (vec![("a", a), ("b", b)], ("radius", vec![*radius]))
+                }
+                Obstacle::Box { centre, half } => {
+                    (vec![("centre", centre)], ("half", half.clone()))
+                }
             };
             if let Obstacle::Box { half, .. } = o
                 && half.len() != d
@@ -291,11 +300,11 @@ impl RunView {
                     },
                 ));
             }
-            for p in points {
-                point(&field, p, d)?;
+            for (key, p) in points {
+                point(&format!("{field}.{key}"), p, d)?;
             }
             // A radius or half-side of zero, as a scenario allows, is drawn as a point or a line.
-            non_negative(&field, &lengths)?;
+            non_negative(&format!("{field}.{}", lengths.0), &lengths.1)?;
         }
         for (i, c) in self.channels.iter().enumerate() {
             let field = format!("channels[{i}]");
@@ -308,8 +317,8 @@ impl RunView {
                     MAX_SAMPLES,
                 ));
             }
-            for p in &c.points {
-                point(&field, p, d)?;
+            for (j, p) in c.points.iter().enumerate() {
+                point(&format!("{field}.points[{j}]"), p, d)?;
             }
             positive(&format!("{field}.width"), &[c.width], MAX_MAGNITUDE)?;
         }

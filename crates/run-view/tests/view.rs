@@ -208,7 +208,7 @@ fn bad_data_is_refused_naming_the_field() {
             Box::new(|r| r.t[4] = 1e16),
         ),
         (
-            "obstacles[1]: value 0 is 1e300, more than 1e15 in magnitude",
+            "obstacles[1].radius: value 0 is 1e300, more than 1e15 in magnitude",
             Box::new(|r| {
                 if let Obstacle::Capsule { radius, .. } = &mut r.obstacles[1] {
                     *radius = 1e300;
@@ -256,7 +256,7 @@ fn bad_data_is_refused_naming_the_field() {
             }),
         ),
         (
-            "obstacles[1]: -0.001, expected a finite non-negative",
+            "obstacles[1].radius: -0.001, expected a finite non-negative",
             Box::new(|r| {
                 if let Obstacle::Capsule { radius, .. } = &mut r.obstacles[1] {
                     *radius = -0.001;
@@ -276,6 +276,18 @@ fn bad_data_is_refused_naming_the_field() {
             Box::new(|r| {
                 r.channels[0].points.pop();
             }),
+        ),
+        (
+            "obstacles[2].half: value 1 is 2e15, more than 1e15 in magnitude",
+            Box::new(|r| {
+                if let Obstacle::Box { half, .. } = &mut r.obstacles[2] {
+                    half[1] = 2e15;
+                }
+            }),
+        ),
+        (
+            "channels[0].points[1]: value 0 is NaN, not finite",
+            Box::new(|r| r.channels[0].points[1][0] = f64::NAN),
         ),
         (
             "channels[0].width: NaN",
