@@ -259,9 +259,6 @@ fn load_run(dir: &Path, label: Option<&str>) -> Result<(Scenario, RunView), Stri
     Ok((scenario, view))
 }
 
-/// The largest magnitude of a value of `timeseries.csv` (s, rad, m), the torques' (N m) apart.
-const MAX_VALUE: f64 = run_view::MAX_MAGNITUDE;
-
 /// The columns of `timeseries.csv` the viewer needs, back into a [`Record`]: `t`, the
 /// coordinates and their `_ref`, `tau1..m`, the tips, and `joint_tau1..n_joints` when present.
 fn parse_timeseries(text: &str, scenario: &Scenario, n_joints: usize) -> Result<Record, String> {
@@ -324,7 +321,7 @@ fn parse_timeseries(text: &str, scenario: &Scenario, n_joints: usize) -> Result<
             let max = if name.starts_with("tau") || name.starts_with("joint_tau") {
                 run_view::MAX_VALUE
             } else {
-                MAX_VALUE
+                run_view::MAX_MAGNITUDE
             };
             if value.is_nan() || value.abs() > max {
                 return Err(format!(

@@ -345,7 +345,7 @@ pub(crate) fn count(
     )
 }
 
-/// Every value of `values` finite.
+/// Every value of `values` finite and at most `max` in magnitude.
 fn finite(field: &str, values: &[f64], max: f64) -> Result<(), ViewError> {
     if let Some((index, value)) = lane_math::first_non_finite(values) {
         return Err(ViewError::field(
@@ -402,7 +402,7 @@ fn point(field: &str, p: &[f64], d: usize) -> Result<(), ViewError> {
     finite(field, p, MAX_MAGNITUDE)
 }
 
-/// `n` rows of `width` finite numbers.
+/// `n` rows of `width` finite numbers, each at most `max` in magnitude.
 fn rows(
     field: &str,
     rows: &[Vec<f64>],

@@ -91,26 +91,23 @@ fn check_inputs(
         n,
     )?;
     check::vectors(n, inputs)?;
-    if let Some(&("q", q)) = inputs.first() {
-        let prismatic = model
-            .joints()
-            .iter()
-            .map(|j| j.kind == JointKind::Prismatic);
-        if let Some((index, &value)) =
-            q.iter()
-                .zip(prismatic)
+    if let Some(&("q", q)) = inputs.first()
+        && let Some((index, (_, &value))) =
+            model
+                .joints()
+                .iter()
+                .zip(q)
                 .enumerate()
-                .find_map(|(i, (q, prismatic))| {
-                    (prismatic && q.abs() > MAX_PRISMATIC_POSITION).then_some((i, q))
+                .find(|(_, (joint, q))| {
+                    joint.kind == JointKind::Prismatic && q.abs() > MAX_PRISMATIC_POSITION
                 })
-        {
-            return Err(DynError::InvalidJoint {
-                index,
-                quantity: "position q",
-                requirement: "at most 1e9 m in magnitude (a prismatic joint)",
-                value,
-            });
-        }
+    {
+        return Err(DynError::InvalidJoint {
+            index,
+            quantity: "position q",
+            requirement: "at most 1e9 m in magnitude (a prismatic joint)",
+            value,
+        });
     }
     Ok(n)
 }
