@@ -5,7 +5,7 @@
 use crate::batch::BatchWorkspace;
 use crate::error::FuzzyError;
 use crate::kernel::{self, Workspace};
-use crate::options::{EvalOptions, OutOfRange, load_input, output_value};
+use crate::options::{EvalOptions, OutOfRange, defuzzify, fired_output, load_input};
 use crate::system::FuzzySystem;
 
 /// Evaluates a [`FuzzySystem`] with its own scratch space: after [`Evaluator::new`], evaluating
@@ -198,8 +198,8 @@ impl Evaluator {
     }
 }
 
-/// Checks one point's inputs, applies the range policy into `work.x` and fires the rules;
-/// whether an input lies outside its range.
+/// Checks one point's inputs, applies the range policy and fires the rules; whether an input
+/// lies outside its range.
 #[inline]
 fn fire_point(
     system: &FuzzySystem,
@@ -207,27 +207,39 @@ fn fire_point(
     work: &mut Workspace<1>,
     inputs: &[f64],
 ) -> Result<bool, FuzzyError> {
-    let outside = load_inputs(system, options, work, inputs)?;
+    let loaded = load_inputs(system, options, work, inputs)?;
     let methods = system.methods();
-    kernel::fire::<f64, 1>(
-        (),
-        system.compiled(),
-        methods.and,
-        methods.or,
-        &mut work.slots(),
-    );
-    Ok(outside)
+    let mut slots = work.slots_at(loaded.kernel_inputs(inputs));
+    kernel::fire::<f64, 1>((), system.compiled(), methods.and, methods.or, &mut slots);
+    Ok(loaded.outside)
 }
 
-/// Checks one point's inputs and applies the range policy into `work.x`; whether an input lies
-/// outside its range (as given).
+/// What [`load_inputs`] found.
+struct Loaded {
+    /// Whether an input lies outside its range (as given).
+    outside: bool,
+    /// Whether the inputs were clamped into the workspace's `x` ([`OutOfRange::Clamp`] and an
+    /// input outside its range); else the kernel evaluates them as given.
+    clamped: bool,
+}
+
+impl Loaded {
+    /// The inputs the kernel evaluates: `None` (the workspace's clamped `x`) or `inputs`.
+    #[inline(always)]
+    fn kernel_inputs<'a>(&self, inputs: &'a [f64]) -> Option<&'a [[f64; 1]]> {
+        (!self.clamped).then_some(inputs.as_chunks::<1>().0)
+    }
+}
+
+/// Checks one point's inputs against the range policy and, where it clamps them, writes them
+/// clamped into `work.x`.
 #[inline(always)]
 fn load_inputs(
     system: &FuzzySystem,
     options: &EvalOptions,
     work: &mut Workspace<1>,
     inputs: &[f64],
-) -> Result<bool, FuzzyError> {
+) -> Result<Loaded, FuzzyError> {
     let variables = system.inputs();
     if inputs.len() != variables.len() {
         return Err(FuzzyError::InputCount {
@@ -235,19 +247,40 @@ fn load_inputs(
             found: inputs.len(),
         });
     }
-    let mut outside = false;
-    for (index, ((slot, &value), variable)) in
-        work.x.iter_mut().zip(inputs).zip(variables).enumerate()
-    {
-        slot[0] = load_input(system, options, index, value)?;
+    // Every input within its range, and so finite: evaluated as given under every policy.
+    let mut inside = true;
+    for (&value, variable) in inputs.iter().zip(variables) {
         let [min, max] = variable.range;
-        outside |= (value < min) | (value > max);
+        inside &= (value >= min) & (value <= max);
     }
-    Ok(outside)
+    if inside {
+        return Ok(Loaded {
+            outside: false,
+            clamped: false,
+        });
+    }
+    let finite = inputs.iter().all(|value| value.is_finite());
+    let outside = (inputs.iter().zip(variables))
+        .any(|(&value, variable)| value < variable.range[0] || value > variable.range[1]);
+    let clamped = options.out_of_range == OutOfRange::Clamp;
+    if finite && !(outside && options.out_of_range == OutOfRange::Error) {
+        if clamped {
+            for ((slot, &value), variable) in work.x.iter_mut().zip(inputs).zip(variables) {
+                let [min, max] = variable.range;
+                slot[0] = value.clamp(min, max);
+            }
+        }
+        return Ok(Loaded { outside, clamped });
+    }
+    // An input refused: the first, as `load_input` words it.
+    for (index, (slot, &value)) in work.x.iter_mut().zip(inputs).enumerate() {
+        slot[0] = load_input(system, options, index, value)?;
+    }
+    Ok(Loaded { outside, clamped })
 }
 
 /// [`Evaluator::eval`] with the evaluator's parts; whether an input lies outside its range.
-#[inline]
+#[inline(always)]
 fn eval_point(
     system: &FuzzySystem,
     options: &EvalOptions,
@@ -262,21 +295,33 @@ fn eval_point(
             found: outputs.len(),
         });
     }
-    let outside = load_inputs(system, options, work, inputs)?;
+    let loaded = load_inputs(system, options, work, inputs)?;
     let c = system.compiled();
-    if !kernel::separable_sums::<f64, 1>((), c, &mut work.slots()) {
+    let mut slots = work.slots_at(loaded.kernel_inputs(inputs));
+    if !kernel::separable_sums::<f64, 1>((), c, &mut slots) {
         let methods = system.methods();
-        kernel::fire::<f64, 1>((), c, methods.and, methods.or, &mut work.slots());
-        kernel::sums::<f64, 1>((), c, &mut work.slots());
+        kernel::fire::<f64, 1>((), c, methods.and, methods.or, &mut slots);
+        kernel::sums::<f64, 1>((), c, &mut slots);
     }
-    // Every output is checked before the first is written; each replaces its weighted sum.
-    for (o, pair) in work.sums.chunks_exact_mut(2).enumerate() {
-        pair[0][0] = output_value(system, options, o, pair[0][0], pair[1][0])?;
+    // Every output is checked before the first is written; each replaces its weighted sum. All
+    // defuzzified first, the policies applied only if a total is not positive or a value not
+    // finite.
+    let method = system.methods().defuzzification;
+    let mut fired = true;
+    for pair in work.sums.chunks_exact_mut(2) {
+        let (value, total) = (defuzzify(method, pair[0][0], pair[1][0]), pair[1][0]);
+        fired &= (total > 0.0) & value.is_finite();
+        pair[0][0] = value;
+    }
+    if !fired {
+        for (o, pair) in work.sums.chunks_exact_mut(2).enumerate() {
+            pair[0][0] = fired_output(system, options, o, pair[0][0], pair[1][0])?;
+        }
     }
     for (out, pair) in outputs.iter_mut().zip(work.sums.chunks_exact(2)) {
         *out = pair[0][0];
     }
-    Ok(outside)
+    Ok(loaded.outside)
 }
 
 #[cfg(test)]

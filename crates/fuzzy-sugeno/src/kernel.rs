@@ -261,57 +261,98 @@ fn separable_grid<L: Lane, const N: usize>(
     let one = L::splat(cx, 1.0);
     let n_sets = s.sets.len();
     let mut largest = one;
-    for (i, bounds) in s.set_offsets.windows(2).enumerate() {
-        let x: L = get(cx, slots.x, i);
-        let sets = &s.sets[bounds[0]..bounds[1]];
-        let grades = (&mut *slots.grades, bounds[0]);
-        // `Separable::slots_in_bounds`: 1 to `MAX_SEPARABLE_SETS` sets an input.
-        let sum = match sets.len() {
-            1 => input_grades::<L, N, 1>(cx, sets, x, power, &mut largest, grades),
-            2 => input_grades::<L, N, 2>(cx, sets, x, power, &mut largest, grades),
-            3 => input_grades::<L, N, 3>(cx, sets, x, power, &mut largest, grades),
-            _ => input_grades::<L, N, MAX_SEPARABLE_SETS>(cx, sets, x, power, &mut largest, grades),
-        };
-        set(slots.grades, n_sets + i, sum);
+    // Every input with the same number of sets: the sets in arrays of that length.
+    match s.sets_per_input {
+        Some(1) => uniform_grades::<L, N, 1>(cx, s, slots, power, &mut largest),
+        Some(2) => uniform_grades::<L, N, 2>(cx, s, slots, power, &mut largest),
+        Some(3) => uniform_grades::<L, N, 3>(cx, s, slots, power, &mut largest),
+        _ => {
+            for (i, bounds) in s.set_offsets.windows(2).enumerate() {
+                let x: L = get(cx, slots.x, i);
+                let sets = &s.sets[bounds[0]..bounds[1]];
+                let grades = (&mut *slots.grades, bounds[0]);
+                // `Separable::slots_in_bounds`: 1 to `MAX_SEPARABLE_SETS` sets an input.
+                let sum = match sets.len() {
+                    1 => input_grades::<L, N, 1>(cx, chunk(sets), x, power, &mut largest, grades),
+                    2 => input_grades::<L, N, 2>(cx, chunk(sets), x, power, &mut largest, grades),
+                    3 => input_grades::<L, N, 3>(cx, chunk(sets), x, power, &mut largest, grades),
+                    _ => input_grades::<L, N, MAX_SEPARABLE_SETS>(
+                        cx,
+                        chunk(sets),
+                        x,
+                        power,
+                        &mut largest,
+                        grades,
+                    ),
+                };
+                set(slots.grades, n_sets + i, sum);
+            }
+        }
     }
     if !L::splat(cx, s.limit).all_greater(largest) {
         return false;
     }
     for (o, grid) in s.outputs.iter().enumerate() {
         let grades = &*slots.grades;
-        let weighted = match grid.inputs.len() {
-            1 => grid_sum::<L, N, 1>(cx, grid, grades),
-            2 => grid_sum::<L, N, 2>(cx, grid, grades),
-            3 => grid_sum::<L, N, 3>(cx, grid, grades),
-            4 => grid_sum::<L, N, 4>(cx, grid, grades),
-            _ => grid_sum_any(cx, grid, grades),
+        let [weighted, total] = match (s.sets_per_input, grid.inputs.len()) {
+            (Some(2), 1) => uniform_grid_sum::<L, N, 2, 1>(cx, grid, n_sets, grades),
+            (Some(2), 2) => uniform_grid_sum::<L, N, 2, 2>(cx, grid, n_sets, grades),
+            (Some(2), 3) => uniform_grid_sum::<L, N, 2, 3>(cx, grid, n_sets, grades),
+            (Some(3), 1) => uniform_grid_sum::<L, N, 3, 1>(cx, grid, n_sets, grades),
+            (Some(3), 2) => uniform_grid_sum::<L, N, 3, 2>(cx, grid, n_sets, grades),
+            (_, 1) => grid_sum::<L, N, 1>(cx, grid, n_sets, grades),
+            (_, 2) => grid_sum::<L, N, 2>(cx, grid, n_sets, grades),
+            (_, 3) => grid_sum::<L, N, 3>(cx, grid, n_sets, grades),
+            (_, 4) => grid_sum::<L, N, 4>(cx, grid, n_sets, grades),
+            _ => grid_sum_any(cx, grid, n_sets, grades),
         };
-        let mut total = one;
-        for &i in &grid.inputs {
-            total = total * get::<L, N>(cx, slots.grades, n_sets + i);
-        }
         set(slots.sums, 2 * o, weighted);
         set(slots.sums, 2 * o + 1, total);
     }
     true
 }
 
-/// One input's `C` sets (`sets`, `C` entries) at `x`: `A_k = 1 + |u_k|^(2b)` (the largest so
-/// far into `largest`), the grades `P_k = prod_{j != k} A_j` into the grade slots from
-/// `grades.1`; returns their sum `S_i`, summed in set order.
+/// The first `C` sets of `sets`, which has `C` (the caller matched the count).
+#[inline(always)]
+fn chunk<const C: usize>(sets: &[[f64; 2]]) -> &[[f64; 2]; C] {
+    let Some(sets) = sets.first_chunk::<C>() else {
+        unreachable!("the caller matched the count of sets");
+    };
+    sets
+}
+
+/// [`input_grades`] for every input, each with `C` sets ([`Separable::sets_per_input`]), the
+/// sums `S_i` into their grade slots.
+#[inline(always)]
+fn uniform_grades<L: Lane, const N: usize, const C: usize>(
+    cx: L::Context,
+    s: &Separable,
+    slots: &mut Slots<'_, N>,
+    power: impl Fn(L) -> L + Copy,
+    largest: &mut L,
+) {
+    let n_sets = s.sets.len();
+    let (sets, _) = s.sets.as_chunks::<C>();
+    for (i, (sets, x)) in sets.iter().zip(slots.x).enumerate() {
+        let x = L::load(cx, x);
+        let sum = input_grades::<L, N, C>(cx, sets, x, power, largest, (slots.grades, i * C));
+        set(slots.grades, n_sets + i, sum);
+    }
+}
+
+/// One input's `C` sets at `x`: `A_k = 1 + |u_k|^(2b)` (the largest so far into `largest`), the
+/// grades `P_k = prod_{j != k} A_j` into the grade slots from `grades.1`; returns their sum
+/// `S_i`, summed in set order.
 #[inline(always)]
 fn input_grades<L: Lane, const N: usize, const C: usize>(
     cx: L::Context,
-    sets: &[[f64; 2]],
+    sets: &[[f64; 2]; C],
     x: L,
     power: impl Fn(L) -> L,
     largest: &mut L,
     (grades, first): (&mut [[f64; N]], usize),
 ) -> L {
     let one = L::splat(cx, 1.0);
-    let Some(sets) = sets.first_chunk::<C>() else {
-        unreachable!("the caller matched the count of sets");
-    };
     let mut a = [one; C];
     for (a, &[center, inverse_width]) in a.iter_mut().zip(sets) {
         *a = one + power((x - L::splat(cx, center)) * inverse_width);
@@ -331,21 +372,60 @@ fn input_grades<L: Lane, const N: usize, const C: usize>(
     sum
 }
 
-/// `sum_k z_k prod P` over the terms of `grid`, whose entries have `D` factors each (`grid`
-/// depends on `D` inputs): [`weighted_terms`] with the factors in arrays of `D`.
+/// `[sum_k z_k prod P, prod_i S_i]` over the terms of `grid` and its inputs, whose entries have
+/// `D` factors each (`grid` depends on `D` inputs): [`weighted_terms`] with the factors in
+/// arrays of `D`; the sums `S_i` are the grade slots from `n_sets`.
 #[inline(always)]
 fn grid_sum<L: Lane, const N: usize, const D: usize>(
     cx: L::Context,
     grid: &OutputGrid,
+    n_sets: usize,
     grades: &[[f64; N]],
-) -> L {
+) -> [L; 2] {
     let (factors, _) = grid.factors.as_chunks::<D>();
-    weighted_terms(
+    let weighted = weighted_terms(
         cx,
         &grid.terms,
         factors.iter().map(|f| f.as_slice()),
         grades,
-    )
+    );
+    let Some(inputs) = grid.inputs.first_chunk::<D>() else {
+        unreachable!("the caller matched the count of inputs");
+    };
+    [weighted, total_grade(cx, inputs, n_sets, grades)]
+}
+
+/// [`grid_sum`] when every input has `C` sets ([`Separable::sets_per_input`]): the factors of
+/// entry `e` are the sets of `e`'s digits in base `C` (the last input's the least significant),
+/// slot `C i + k` for set `k` of input `i`, so that the `C^D` terms are unrolled and read no
+/// factor table; the same operations in the same order as [`weighted_terms`].
+#[inline(always)]
+fn uniform_grid_sum<L: Lane, const N: usize, const C: usize, const D: usize>(
+    cx: L::Context,
+    grid: &OutputGrid,
+    n_sets: usize,
+    grades: &[[f64; N]],
+) -> [L; 2] {
+    let entries = C.pow(D as u32);
+    let Some(inputs) = grid.inputs.first_chunk::<D>() else {
+        unreachable!("the caller matched the count of inputs");
+    };
+    // `Separable::slots_in_bounds`.
+    if grid.terms.len() != entries {
+        unreachable!("a grid of D inputs of C sets has C^D entries");
+    }
+    let mut weighted = L::splat(cx, 0.0);
+    for e in 0..entries {
+        let mut term = L::splat(cx, grid.terms[e]);
+        let mut place = entries;
+        for &i in inputs {
+            place /= C;
+            let k = (e / place) % C;
+            term = term * get::<L, N>(cx, grades, C * i + k);
+        }
+        weighted = weighted + term;
+    }
+    [weighted, total_grade(cx, inputs, n_sets, grades)]
 }
 
 /// [`grid_sum`] for any number of inputs.
@@ -353,11 +433,28 @@ fn grid_sum<L: Lane, const N: usize, const D: usize>(
 fn grid_sum_any<L: Lane, const N: usize>(
     cx: L::Context,
     grid: &OutputGrid,
+    n_sets: usize,
     grades: &[[f64; N]],
-) -> L {
+) -> [L; 2] {
     let d = grid.inputs.len();
     let factors = (0..grid.terms.len()).map(|k| &grid.factors[k * d..(k + 1) * d]);
-    weighted_terms(cx, &grid.terms, factors, grades)
+    let weighted = weighted_terms(cx, &grid.terms, factors, grades);
+    [weighted, total_grade(cx, &grid.inputs, n_sets, grades)]
+}
+
+/// `prod_{i in inputs} S_i`, in input order, the sums `S_i` in the grade slots from `n_sets`.
+#[inline(always)]
+fn total_grade<L: Lane, const N: usize>(
+    cx: L::Context,
+    inputs: &[usize],
+    n_sets: usize,
+    grades: &[[f64; N]],
+) -> L {
+    let mut total = L::splat(cx, 1.0);
+    for &i in inputs {
+        total = total * get::<L, N>(cx, grades, n_sets + i);
+    }
+    total
 }
 
 /// `sum_k z_k prod_{slot in factors_k} P_slot`, in term order, each term's factors in order.
@@ -414,8 +511,15 @@ impl<const N: usize> Workspace<N> {
     /// The buffers as the kernel takes them.
     #[inline(always)]
     pub(crate) fn slots(&mut self) -> Slots<'_, N> {
+        self.slots_at(None)
+    }
+
+    /// The buffers as the kernel takes them, with the inputs read from `x` instead of
+    /// [`Workspace::x`] if given (it must have one slot per input).
+    #[inline(always)]
+    pub(crate) fn slots_at<'a>(&'a mut self, x: Option<&'a [[f64; N]]>) -> Slots<'a, N> {
         Slots {
-            x: &self.x,
+            x: x.unwrap_or(&self.x),
             values: &mut self.values,
             terms: &mut self.terms,
             sums: &mut self.sums,

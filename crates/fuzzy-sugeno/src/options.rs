@@ -109,11 +109,32 @@ pub(crate) fn output_value(
     weighted: f64,
     total: f64,
 ) -> Result<f64, FuzzyError> {
+    let value = defuzzify(system.methods().defuzzification, weighted, total);
+    fired_output(system, options, o, value, total)
+}
+
+/// The output from the weighted sum and the total strength by `method` (eq 21, or the weighted
+/// sum); meaningful when `total > 0`.
+#[inline(always)]
+pub(crate) fn defuzzify(method: Defuzzification, weighted: f64, total: f64) -> f64 {
+    match method {
+        Defuzzification::WeightedAverage => weighted / total,
+        Defuzzification::WeightedSum => weighted,
+    }
+}
+
+/// Output `o` given `value`, its [`defuzzify`]d value when the total strength `total` is
+/// positive: the policy when no rule fires; refuses a non-finite value.
+#[inline(always)]
+pub(crate) fn fired_output(
+    system: &FuzzySystem,
+    options: &EvalOptions,
+    o: usize,
+    value: f64,
+    total: f64,
+) -> Result<f64, FuzzyError> {
     let value = if total > 0.0 {
-        match system.methods().defuzzification {
-            Defuzzification::WeightedAverage => weighted / total,
-            Defuzzification::WeightedSum => weighted,
-        }
+        value
     } else {
         let variable = &system.outputs()[o];
         match &options.no_rule_fired {

@@ -41,6 +41,9 @@ pub(crate) struct Separable {
     pub exponent: u32,
     /// Input `i`'s sets are `sets[set_offsets[i]..set_offsets[i + 1]]`.
     pub set_offsets: Vec<usize>,
+    /// The number of sets of every input when all inputs have the same (the paper's 2), which
+    /// lets the kernel take the inputs' sets in arrays of that length.
+    pub sets_per_input: Option<usize>,
     /// One grid per output.
     pub outputs: Vec<OutputGrid>,
     /// The largest `A_{ik}` for which a point takes the separable form.
@@ -201,10 +204,12 @@ impl Separable {
         if per_factor < 8.0 {
             return None;
         }
+        let sets_per_input = Some(counts[0]).filter(|&c| counts.iter().all(|&k| k == c));
         Some(Self {
             sets,
             exponent: exponent?,
             set_offsets,
+            sets_per_input,
             outputs,
             limit: per_factor.exp2(),
         })
@@ -219,6 +224,11 @@ impl Separable {
             && (self.set_offsets.windows(2))
                 .all(|w| w[0] < w[1] && w[1] - w[0] <= MAX_SEPARABLE_SETS)
             && self.set_offsets.last() == Some(&n_sets)
+            && self.sets_per_input.is_none_or(|c| {
+                c * n_in == n_sets
+                    && (self.outputs.iter())
+                        .all(|g| Some(g.terms.len()) == c.checked_pow(g.inputs.len() as u32))
+            })
             && self.outputs.iter().all(|g| {
                 g.inputs.iter().all(|&i| i < n_in)
                     && g.factors.len() == g.terms.len() * g.inputs.len()
@@ -367,6 +377,84 @@ mod tests {
             .eval(&[0.3, -0.2, 0.9], &mut out)
             .unwrap();
         assert_eq!(out[1], 4.0);
+    }
+
+    /// A complete grid of `n_in` inputs with `c` bells each (`b = 2`) over `[-1, 1]` and one
+    /// output per entry of `depends`, whose conclusions are distinct for every combination of
+    /// the sets of the inputs it lists.
+    fn uniform_grid(n_in: usize, c: usize, depends: &[&[usize]]) -> FuzzySystem {
+        let step = 2.0 / (c - 1).max(1) as f64;
+        let sets: Vec<_> = (0..c)
+            .map(|k| {
+                (
+                    format!("S{k}"),
+                    MembershipFn::bell(0.4 * step, 2.0, k as f64 * step - 1.0),
+                )
+            })
+            .collect();
+        let cells = c.pow(n_in as u32);
+        let mut builder = FuzzySystem::builder("uniform");
+        for i in 0..n_in {
+            builder = builder.input(format!("x{i}"), [-1.0, 1.0], sets.clone());
+        }
+        for o in 0..depends.len() {
+            let terms = (0..cells).map(|k| {
+                (
+                    format!("z{k}"),
+                    OutputFn::Constant(3.1 * k as f64 - 7.0 * o as f64),
+                )
+            });
+            builder = builder.output(format!("y{o}"), [-500.0, 500.0], terms.collect::<Vec<_>>());
+        }
+        for cell in 0..cells {
+            let digits: Vec<usize> = (0..n_in)
+                .map(|i| cell / c.pow((n_in - 1 - i) as u32) % c)
+                .collect();
+            let consequents = depends
+                .iter()
+                .map(|inputs| Some(inputs.iter().fold(0, |t, &i| t * c + digits[i])))
+                .collect();
+            builder = builder.indexed_rule(Rule {
+                antecedents: digits.iter().map(|&k| Antecedent::Is(k)).collect(),
+                consequents,
+                weight: 1.0,
+                connective: Connective::And,
+            });
+        }
+        builder.build().unwrap()
+    }
+
+    /// Inputs with the same number of sets take the unrolled grids of the kernel: the same bits
+    /// as the factor tables, alone and in a batch, for every count of sets and inputs it unrolls
+    /// and beyond.
+    #[test]
+    fn uniform_sets_give_the_bits_of_the_factor_tables() {
+        let systems = [
+            paper_controller(),
+            uniform_grid(3, 2, &[&[0], &[0, 2], &[2, 0, 1], &[]]),
+            uniform_grid(3, 3, &[&[1], &[2, 0], &[0, 1, 2]]),
+            uniform_grid(2, 4, &[&[0, 1], &[1]]),
+            uniform_grid(4, 2, &[&[0, 1, 2, 3]]),
+        ];
+        let bits = |y: &[f64]| y.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        let mut state = 11;
+        for system in systems {
+            let s = system.compiled().separable.clone().unwrap();
+            assert!(s.sets_per_input.is_some(), "{}", system.name());
+            let (n_in, n_out) = (system.inputs().len(), system.outputs().len());
+            let mut uniform = Evaluator::new(system.clone());
+            let mut tables = Evaluator::new(system.without_uniform_sets());
+            let rows: Vec<f64> = (0..n_in * 37).map(|_| 1.5 * draw(&mut state)).collect();
+            let (mut y, mut y_ref) = (vec![0.0; n_out * 37], vec![0.0; n_out * 37]);
+            uniform.eval_batch(&rows, &mut y).unwrap();
+            tables.eval_batch(&rows, &mut y_ref).unwrap();
+            assert_eq!(bits(&y), bits(&y_ref));
+            for (x, y_ref) in rows.chunks_exact(n_in).zip(y_ref.chunks_exact(n_out)) {
+                let mut alone = vec![0.0; n_out];
+                uniform.eval(x, &mut alone).unwrap();
+                assert_eq!(bits(&alone), bits(y_ref));
+            }
+        }
     }
 
     /// Far outside the ranges, where an `A` exceeds the limit, the point goes to the general

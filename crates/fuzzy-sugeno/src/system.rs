@@ -215,6 +215,16 @@ impl FuzzySystem {
         self.compiled.separable = None;
         self
     }
+
+    /// The system with its separable form read through the factor tables, as if its inputs had
+    /// different numbers of sets (for tests).
+    #[cfg(test)]
+    pub(crate) fn without_uniform_sets(mut self) -> Self {
+        if let Some(s) = &mut self.compiled.separable {
+            s.sets_per_input = None;
+        }
+        self
+    }
 }
 
 fn invalid(context: &str, problem: SystemProblem) -> FuzzyError {
