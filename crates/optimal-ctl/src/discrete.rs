@@ -205,9 +205,13 @@ impl DiscreteDynamics for ReducedEuler<'_> {
         let (a, v) = x.split_at(m);
         let (a_next, v_next) = next.split_at_mut(m);
         self.model.forward_dynamics(self.data, a, v, u, v_next)?;
-        for i in 0..m {
-            v_next[i] = v[i] + h * v_next[i];
-            a_next[i] = a[i] + h * v_next[i];
+        let state = a_next
+            .iter_mut()
+            .zip(v_next.iter_mut())
+            .zip(a.iter().zip(v));
+        for ((a_next, v_next), (&a, &v)) in state {
+            *v_next = v + h * *v_next;
+            *a_next = a + h * *v_next;
         }
         Ok(())
     }

@@ -1080,13 +1080,23 @@ impl Ilqr {
         let (nx, nu) = (self.nx, self.nu);
         self.x_try[..nx].copy_from_slice(&self.x[..nx]);
         for k in 0..self.horizon {
-            for j in 0..nu {
-                let row = &self.gain[(k * nu + j) * nx..(k * nu + j + 1) * nx];
-                let mut u = self.u[k * nu + j] + alpha * self.feedforward[k * nu + j];
-                for (i, g) in row.iter().enumerate() {
-                    u += g * (self.x_try[k * nx + i] - self.x[k * nx + i]);
-                }
-                self.u_try[k * nu + j] = u.clamp(self.lower[j], self.upper[j]);
+            let policy = (
+                &self.gain[k * nu * nx..(k + 1) * nu * nx],
+                &self.u[k * nu..(k + 1) * nu],
+                &self.feedforward[k * nu..(k + 1) * nu],
+            );
+            let states = (
+                &self.x_try[k * nx..(k + 1) * nx],
+                &self.x[k * nx..(k + 1) * nx],
+            );
+            let (bounds, out) = (
+                (&self.lower[..], &self.upper[..]),
+                &mut self.u_try[k * nu..(k + 1) * nu],
+            );
+            match (nx, nu) {
+                (4, 2) => policy_control::<4, 2>(policy, states, bounds, alpha, out),
+                (6, 3) => policy_control::<6, 3>(policy, states, bounds, alpha, out),
+                _ => policy_control::<0, 0>(policy, states, bounds, alpha, out),
             }
             if let (Some(c), Some(work)) = (constraints.as_deref_mut(), &mut self.constrained) {
                 // A control whose rows admit none is kept, as in the warm start; a state the
@@ -1370,6 +1380,36 @@ impl HeapTerms {
             step_lower: take(nu),
             step_upper: take(nu),
         }
+    }
+}
+
+/// The forward pass's control at one node, `u + alpha k + K (x_try - x)` summed term by term in
+/// that order, clamped to the box: `policy` is `(K, u, k)` of the node (`n_u x n_x`, `n_u`,
+/// `n_u`), `states` its `(x_try, x)`. For `n_x = NX`, `n_u = NU` known at compile time, or the
+/// slices' sizes when both are 0.
+#[inline(always)]
+fn policy_control<const NX: usize, const NU: usize>(
+    (gain, u, feedforward): (&[f64], &[f64], &[f64]),
+    (x_try, x): (&[f64], &[f64]),
+    (lower, upper): (&[f64], &[f64]),
+    alpha: f64,
+    out: &mut [f64],
+) {
+    let (nx, nu) = if NX == 0 {
+        (x.len(), u.len())
+    } else {
+        (NX, NU)
+    };
+    let (x_try, x) = (&x_try[..nx], &x[..nx]);
+    let rows = gain[..nu * nx].chunks_exact(nx);
+    let controls = u[..nu].iter().zip(&feedforward[..nu]);
+    let bounds = lower[..nu].iter().zip(&upper[..nu]);
+    for (((row, (&u, &f)), (&lower, &upper)), out) in rows.zip(controls).zip(bounds).zip(out) {
+        let mut u = u + alpha * f;
+        for ((g, &x_try), &x) in row.iter().zip(x_try).zip(x) {
+            u += g * (x_try - x);
+        }
+        *out = u.clamp(lower, upper);
     }
 }
 
