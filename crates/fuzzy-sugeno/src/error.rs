@@ -684,17 +684,19 @@ pub enum LearningProblem {
         /// The most multiply-adds allowed.
         limit: usize,
     },
-    /// The epochs of a training, each a least-squares solve of `per_epoch` multiply-adds, would
-    /// exceed the limit of a whole training's work.
+    /// The epochs of a training, each a least-squares solve and an evaluation of the training
+    /// and check rows of `per_epoch` multiply-adds, would exceed the limit of a whole training's
+    /// work.
     #[error(
-        "{epochs} epochs of a least-squares solve of {per_epoch} multiply-adds each exceed the \
-         {limit} multiply-adds a training may take (about six minutes): use fewer epochs, or \
-         fewer sets per input or inputs"
+        "{epochs} epochs of {per_epoch} multiply-adds each (the least-squares solve and the \
+         evaluation of the training and check rows) exceed the {limit} multiply-adds a training \
+         may take (about six minutes): use fewer epochs, fewer check rows, or fewer sets per \
+         input or inputs"
     )]
     TrainingTooSlow {
         /// The epochs asked for.
         epochs: usize,
-        /// The multiply-adds of one epoch's least-squares solve.
+        /// The multiply-adds of one epoch: its least-squares solve and its evaluations.
         per_epoch: usize,
         /// The most multiply-adds allowed.
         limit: usize,

@@ -853,11 +853,26 @@ impl FunctionLine<'_> {
                     self.name,
                     self.kind,
                     if needed == 1 { "" } else { "s" },
-                    format_params(&extra)
+                    extra_params(&extra)
                 ),
             );
         }
     }
+}
+
+/// The parameters a line gives beyond those its function takes, as a note shows them: the
+/// first eight and how many more (a line of a hundred thousand would make a note of as many).
+fn extra_params(extra: &[f64]) -> String {
+    const SHOWN: usize = 8;
+    if extra.len() <= SHOWN {
+        return format_params(extra);
+    }
+    let head = format_params(&extra[..SHOWN]);
+    format!(
+        "{} ... and {} more]",
+        &head[..head.len() - 1],
+        extra.len() - SHOWN
+    )
 }
 
 /// An integer written as such or as an integer-valued decimal (`1.000`, `2e0`), within
@@ -1227,6 +1242,35 @@ mod tests {
 
     fn parse_error(text: &str) -> String {
         FuzzySystem::from_fis(text).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn extra_parameters_are_noted_in_a_line_of_bounded_length() {
+        let extra = vec!["1"; 100_000].join(" ");
+        let text = TINY.replace(
+            "MF1='low':'gaussmf',[4 -5]",
+            &format!("MF1='low':'gaussmf',[4 -5 {extra}]"),
+        );
+        let (system, notes) = FuzzySystem::from_fis_with_notes(&text).unwrap();
+        assert_eq!(
+            system.inputs()[0].sets[0].membership,
+            MembershipFn::Gaussian {
+                sigma: 4.0,
+                center: -5.0
+            }
+        );
+        let message = &notes[0].message;
+        assert!(
+            message.ends_with("takes 2 parameters; the extra [1 1 1 1 1 1 1 1 ... and 99992 more] ignored, as MATLAB does")
+                && message.len() < 200,
+            "{message}"
+        );
+        let (_, notes) =
+            FuzzySystem::from_fis_with_notes(&TINY.replace("[4 -5]", "[4 -5 0 0]")).unwrap();
+        assert!(
+            notes[0].message.contains("the extra [0 0] ignored"),
+            "{notes:?}"
+        );
     }
 
     #[test]

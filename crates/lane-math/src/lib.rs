@@ -19,5 +19,5 @@ pub use compact::{Compact, compact_numbers};
 pub use error_class::{Classify, ErrorClass};
 pub use instruction_sets::instruction_sets;
 pub use lanes::{Lane, Pack};
-pub use message::{escape_controls, one_line};
+pub use message::{escape_controls, is_one_line, one_line};
 pub use trig::{REDUCTION_LIMIT, sin_cos, sin_cos_in_range, sin_cos_lanes};

@@ -49,9 +49,34 @@ pub fn one_line(message: &str) -> String {
     }
 }
 
+/// Whether `text` could be a message [`one_line`] gave: no control or bidirectional formatting
+/// character, and no longer than a cut message (what a file that claims to hold such a message
+/// must meet before it is shown).
+pub fn is_one_line(text: &str) -> bool {
+    // A cut message: the kept characters, then " ... (N more characters)".
+    const CUT_SUFFIX_CHARS: usize = 64;
+    text.chars().count() <= MAX_MESSAGE_CHARS + CUT_SUFFIX_CHARS
+        && !text.chars().any(|c| c.is_control() || is_bidi_control(c))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn one_line_gives_one_line_messages() {
+        for text in [
+            "short",
+            "a\nb\u{1b}[31m\u{202e}",
+            &"9".repeat(5000),
+            &"x".repeat(10_000),
+        ] {
+            assert!(is_one_line(&one_line(text)), "{text}");
+        }
+        assert!(!is_one_line("a\nb"));
+        assert!(!is_one_line("a\u{202e}b"));
+        assert!(!is_one_line(&"x".repeat(3000)));
+    }
 
     #[test]
     fn long_messages_are_cut() {

@@ -201,6 +201,20 @@ pub enum SimError {
         /// `tau* + J^T tau_d`, one entry per modal coordinate.
         force: Vec<f64>,
     },
+    /// Finite modal torques whose control effort (the integral of `|tau*|^2`) passes double
+    /// precision: an arm or gains so large that the squares of the torques overflow.
+    #[error(
+        "the control effort (the integral of |tau*|^2) overflowed at t = {} s under tau* = {} N m: \
+         the arm's masses and lengths, or the controller's gains, are beyond double precision",
+        Compact(*.t),
+        lane_math::compact_numbers(&format!("{tau_star:?}"))
+    )]
+    EffortOverflow {
+        /// When (s).
+        t: f64,
+        /// The controller's `tau*` at that sample.
+        tau_star: Vec<f64>,
+    },
     /// A controller failed with an error of its own (one that is not a [`SimError`]).
     #[error("the controller failed at t = {} s: {source}", Compact(*.t))]
     Controller {
@@ -323,6 +337,7 @@ impl Classify for SimError {
             | Self::NonFiniteControl { .. }
             | Self::NonFiniteDisturbance { .. }
             | Self::DisturbanceOverflow { .. }
+            | Self::EffortOverflow { .. }
             | Self::Controller { .. }
             | Self::RunawayError { .. }
             | Self::JointRunaway { .. }

@@ -1,6 +1,7 @@
 //! What a closed-loop run records: time series at the recording rate, and summary metrics over
 //! every controller sample.
 
+use crate::error::SimError;
 use lane_math::{OutOfMemory, try_reserve};
 use serde::Serialize;
 
@@ -360,7 +361,8 @@ impl Metrics {
 
     /// Counts the controller sample at `t` whose torque `tau_star` (with its clamping flags and
     /// the joint torques at the sample) is held for `hold` seconds: its clamping, effort, torque peaks and limit checks, which therefore
-    /// cover every controller sample whether it is recorded or not.
+    /// cover every controller sample whether it is recorded or not. Refuses an effort that
+    /// overflows ([`SimError::EffortOverflow`]), which a summary could not report.
     pub(crate) fn add_control(
         &mut self,
         t: f64,
@@ -368,7 +370,7 @@ impl Metrics {
         clamped: &[bool],
         joint_torques: &[f64],
         hold: f64,
-    ) {
+    ) -> Result<(), SimError> {
         self.controller_samples += 1;
         for (count, &c) in self.clamped.iter_mut().zip(clamped) {
             *count += usize::from(c);
@@ -378,7 +380,14 @@ impl Metrics {
         for tau in tau_star {
             square += tau * tau;
         }
-        self.effort += square * hold;
+        let effort = self.effort + square * hold;
+        if !effort.is_finite() {
+            return Err(SimError::EffortOverflow {
+                t,
+                tau_star: tau_star.to_vec(),
+            });
+        }
+        self.effort = effort;
         for (peak, tau) in self.peak_tau_star.iter_mut().zip(tau_star) {
             *peak = peak.max(tau.abs());
         }
@@ -397,6 +406,7 @@ impl Metrics {
                 entry.samples_over += 1;
             }
         }
+        Ok(())
     }
 
     /// Adds recorded sample `s` (already counted by [`add_control`](Self::add_control)) to the

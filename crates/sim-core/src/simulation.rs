@@ -786,7 +786,7 @@ impl Simulation {
             &sample.clamped,
             &self.joint_torques,
             held,
-        );
+        )?;
         if k.is_multiple_of(progress.record_every) || last || runaway.is_some() {
             let (tip, tip_ref) = self.sample_tips()?;
             let sample = &self.sample;

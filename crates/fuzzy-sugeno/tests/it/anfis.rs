@@ -308,11 +308,26 @@ fn the_work_of_all_epochs_is_bounded_up_front() {
     assert!(
         error
             .to_string()
-            .contains("1000 epochs of a least-squares solve of "),
+            .contains("1000 epochs of 2050097152 multiply-adds each (the least-squares solve"),
         "{error}"
     );
     assert!(start.elapsed().as_secs() < 5);
-    assert!(fuzzy_sugeno::learn::Anfis::new(system, &data, None, 0, options(600)).is_ok());
+    assert!(fuzzy_sugeno::learn::Anfis::new(system.clone(), &data, None, 0, options(480)).is_ok());
+    // The check rows are evaluated every epoch too: a million of them bound the epochs as well.
+    let check = TrainingData::new(1, 1, vec![0.5; 2_000_000]).unwrap();
+    let with_check = |epochs| {
+        fuzzy_sugeno::learn::Anfis::new(system.clone(), &data, Some(&check), 0, options(epochs))
+    };
+    assert!(with_check(100).is_ok());
+    let error = with_check(200).map(|_| ()).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            FuzzyError::Learning(LearningProblem::TrainingTooSlow { epochs: 200, .. })
+        ) && error.to_string().contains("fewer check rows"),
+        "{error}"
+    );
+    assert!(fuzzy_sugeno::learn::Anfis::new(system, &data, None, 0, options(200)).is_ok());
 }
 
 /// A premise step that throws the sets' parameters beyond double precision is an error naming

@@ -806,6 +806,48 @@ fn a_shard_edited_with_its_digest_is_still_checked_as_a_sweep() {
         ),
         "{err}"
     );
+    // A failed run's message as a sweep writes it: one line, of bounded length.
+    for error in [
+        "x\nforged line".into(),
+        "x\u{1b}[31m\u{202e}".into(),
+        "A".repeat(3000),
+    ] {
+        let mut bad = file.clone();
+        bad.runs[1].outcome = StoredOutcome::Failed {
+            error,
+            simulated_s: 0.05,
+        };
+        let err = study::merge(vec![(path.clone(), bad)])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("run 1: outcome.failed.error is not a message a sweep writes")
+                && !err.contains("forged"),
+            "{err}"
+        );
+    }
+    // A negative zero is not the sweep's noise level 0, nor a time reached.
+    let mut signed = file.clone();
+    signed.runs[0].noise_level = -0.0;
+    let err = study::merge(vec![(path.clone(), signed)])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("line 2") && err.contains("run 0"), "{err}");
+    let mut signed = file.clone();
+    signed.runs[1].outcome = StoredOutcome::Failed {
+        error: "runaway".into(),
+        simulated_s: -0.0,
+    };
+    let err = study::merge(vec![(path.clone(), signed)])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("run 1: simulated_s = -0e0 must be"), "{err}");
+    // A key given twice in the header, as in a run's line.
+    let text = read(&path);
+    let doubled = text.replacen("{\"format\":", "{\"format\":\"x\",\"format\":", 1);
+    assert_ne!(doubled, text);
+    let err = ShardFile::parse(&doubled, &path).unwrap_err().to_string();
+    assert!(err.contains("duplicate field `format`"), "{err}");
     let mut on_time = file;
     on_time.runs[1].outcome = StoredOutcome::Failed {
         error: "runaway".into(),

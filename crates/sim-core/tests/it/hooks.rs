@@ -2,7 +2,8 @@
 //! plant by another path, at rest without gravity it accelerates the arm by `M*^-1 f` (eq 15,
 //! `M*` from the kinetic energy) and does the work `f . (a - a0)` (work-energy theorem); an
 //! observer sees every controller sample, in order; hooks that do nothing change nothing; a
-//! lock-step group with hooks gives each run with its hooks alone, for planar and spatial arms.
+//! lock-step group with hooks gives each run with its hooks alone, for planar and spatial arms;
+//! forces beyond double precision (a disturbance's, an effort's squares) stop the run, named.
 
 use backbone_kin::ModalMap;
 use lane_math::Classify;
@@ -378,6 +379,44 @@ fn a_finite_disturbance_whose_modal_force_overflows_is_named() {
         "{message}"
     );
     assert!(failure.error.is_numerical());
+}
+
+#[test]
+fn a_control_effort_that_overflows_stops_the_run() {
+    // Links of 1e300 kg take finite torques of 1e160 N m in their stride, whose squares are not:
+    // the effort the summary reports would be infinite, so the run stops naming it.
+    let heavy = |push: f64| {
+        let model = ReducedModel::new(
+            ChainModel::uniform(10, 0.1, 1e300, 9.81).unwrap(),
+            ModalMap::paper_fixed_alpha0(10, FRAC_PI_2).unwrap(),
+        )
+        .unwrap();
+        let controller = PlusForce {
+            inner: pd(),
+            f: vec![push, 0.0],
+            from: 0.1,
+        };
+        simulation(model, Box::new(controller))
+    };
+    let mut sim = heavy(1e160);
+    let failure = sim.run().unwrap_err();
+    assert!(
+        matches!(failure.error, SimError::EffortOverflow { t, .. } if t == 0.1),
+        "{}",
+        failure.error
+    );
+    let message = failure.error.to_string();
+    assert!(
+        message
+            .starts_with("the control effort (the integral of |tau*|^2) overflowed at t = 0.1 s")
+            && message.contains("1e160"),
+        "{message}"
+    );
+    assert!(failure.error.is_numerical());
+    assert!(failure.summary.control_effort_n2m2s.is_finite());
+    // 1e150 N m squares to a finite effort.
+    let summary = heavy(1e150).run().unwrap().summary;
+    assert!(summary.control_effort_n2m2s.is_finite() && summary.control_effort_n2m2s > 1e297);
 }
 
 #[test]

@@ -275,6 +275,18 @@ pub enum ShardProblem {
         /// The time written.
         value: f64,
     },
+    /// A failed run's message that is not one line of at most about 2,000 characters, as a sweep
+    /// writes it ([`lane_math::one_line`]).
+    #[error(
+        ": line {line}: run {run}: outcome.failed.error is not a message a sweep writes: it must \
+         be one line without control characters, of at most about 2000 characters"
+    )]
+    FailureMessage {
+        /// The line.
+        line: usize,
+        /// The run.
+        run: usize,
+    },
     /// A line longer than [`MAX_SHARD_LINE_BYTES`].
     #[error(
         ": line {line} is longer than the {MAX_SHARD_LINE_BYTES} bytes a shard file's line may \

@@ -21,8 +21,13 @@ pub enum RunError {
     Simulation(#[from] SimError),
     /// The run completed, but a summary metric came out non-finite (a sweep keeps finite
     /// metrics only).
-    #[error("the run's summary metrics are not finite: {0:?}")]
-    NonFiniteMetrics(RunMetrics),
+    #[error("the run's summary metric {name} came out {value}, not finite")]
+    NonFiniteMetric {
+        /// The metric's key (`summary.json`'s).
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
 }
 
 impl Classify for RunError {
@@ -31,7 +36,7 @@ impl Classify for RunError {
     fn class(&self) -> ErrorClass {
         match self {
             Self::Simulation(error) => error.class(),
-            Self::NonFiniteMetrics(_) => ErrorClass::Numerical,
+            Self::NonFiniteMetric { .. } => ErrorClass::Numerical,
         }
     }
 }
@@ -114,7 +119,8 @@ pub struct RunMetrics {
 }
 
 impl RunMetrics {
-    /// The kept metrics of `summary`, or [`RunError::NonFiniteMetrics`] if one is not finite.
+    /// The kept metrics of `summary`, or [`RunError::NonFiniteMetric`] naming the first that is
+    /// not finite.
     pub fn from_summary(s: &Summary) -> Result<Self, RunError> {
         let m = RunMetrics {
             tip_error_rms_m: s.tip_error_rms_m,
@@ -123,20 +129,23 @@ impl RunMetrics {
             peak_joint_torque_nm: s.peak_joint_torque_nm,
             control_effort_n2m2s: s.control_effort_n2m2s,
         };
-        let values = [
-            m.tip_error_rms_m,
-            m.tip_error_max_m,
-            m.peak_joint_torque_nm,
-            m.control_effort_n2m2s,
-        ];
-        if values
-            .iter()
-            .chain(&m.modal_error_rms_rad)
-            .all(|v| v.is_finite())
-        {
-            Ok(m)
-        } else {
-            Err(RunError::NonFiniteMetrics(m))
+        let non_finite = m.named().find(|(_, value)| !value.is_finite());
+        match non_finite {
+            None => Ok(m),
+            Some((name, value)) => Err(RunError::NonFiniteMetric { name, value }),
         }
+    }
+
+    /// Every metric with its key, in `summary.json`'s order of fields (the modal RMS one a
+    /// coordinate).
+    pub(crate) fn named(&self) -> impl Iterator<Item = (&'static str, f64)> + '_ {
+        let named = [
+            ("tip_error_rms_m", self.tip_error_rms_m),
+            ("tip_error_max_m", self.tip_error_max_m),
+            ("peak_joint_torque_nm", self.peak_joint_torque_nm),
+            ("control_effort_n2m2s", self.control_effort_n2m2s),
+        ];
+        let modal = (self.modal_error_rms_rad.iter()).map(|&v| ("modal_error_rms_rad", v));
+        named.into_iter().chain(modal)
     }
 }

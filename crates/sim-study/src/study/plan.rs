@@ -122,7 +122,7 @@ impl SweepSettings {
         if let Some(bad) = self
             .noise_levels
             .iter()
-            .find(|l| !(l.is_finite() && **l >= 0.0))
+            .find(|l| !(l.is_finite() && l.is_sign_positive()))
         {
             return Err(SettingError::new(
                 "noise_levels",
@@ -426,6 +426,9 @@ mod tests {
         assert_eq!(err, "noise_levels must be finite and non-negative, got -1");
         c.settings.noise_levels[1] = f64::NAN;
         assert!(c.validate().unwrap_err().to_string().contains("got NaN"));
+        c.settings.noise_levels = vec![-0.0, 0.01];
+        let err = c.validate().unwrap_err().to_string();
+        assert_eq!(err, "noise_levels must be finite and non-negative, got -0");
         c.settings.noise_levels = vec![0.01, 0.0];
         let err = c.validate().unwrap_err().to_string();
         assert!(err.starts_with("noise_levels must be distinct and ascending"));

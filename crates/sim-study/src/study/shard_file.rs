@@ -91,7 +91,7 @@ impl StoredOutcome {
             Err(stopped) => stopped,
         };
         StoredOutcome::Failed {
-            error: stopped.error.to_string(),
+            error: lane_math::one_line(&stopped.error.to_string()),
             simulated_s: stopped.simulated_s(),
         }
     }
@@ -103,17 +103,7 @@ impl RunMetrics {
     /// over the same samples); each modal RMS within the runaway bound `max_modal_error` that
     /// every sample of a completed run kept to. The error names the field and the value.
     pub fn check(&self, max_modal_error: f64) -> Result<(), MetricError> {
-        let named = [
-            ("tip_error_rms_m", self.tip_error_rms_m),
-            ("tip_error_max_m", self.tip_error_max_m),
-            ("peak_joint_torque_nm", self.peak_joint_torque_nm),
-            ("control_effort_n2m2s", self.control_effort_n2m2s),
-        ];
-        let modal = self
-            .modal_error_rms_rad
-            .iter()
-            .map(|&v| ("modal_error_rms_rad", v));
-        for (name, value) in named.into_iter().chain(modal) {
+        for (name, value) in self.named() {
             if !(0.0..=MAX_SHARD_METRIC).contains(&value) {
                 return Err(MetricError::OutOfRange { name, value });
             }
@@ -151,7 +141,7 @@ impl RunResult {
     /// Whether the entry's position fields agree with run `id`.
     fn matches(&self, id: &RunId) -> bool {
         self.index == id.index
-            && self.noise_level == id.noise_level
+            && self.noise_level.to_bits() == id.noise_level.to_bits()
             && self.controller == id.controller
             && self.seed_index == id.seed_index
             && self.seed == id.seed
@@ -391,7 +381,9 @@ impl<R: ShardSource> ShardReader<R> {
                 }));
             }
         }
-        let header: ShardHeader = serde_json::from_value(value).map_err(|e| {
+        // From the line itself, not the parsed value: a key given twice is refused, as in a
+        // run's line (the value keeps the last).
+        let header: ShardHeader = serde_json::from_slice(&line).map_err(|e| {
             refuse(ShardProblem::MalformedHeader {
                 cause: e.to_string(),
             })
@@ -478,11 +470,22 @@ impl<R: ShardSource> ShardReader<R> {
                     })
                 })?;
         }
+        // A failed run's message is what a sweep writes: one line, its length bounded, so
+        // that neither the terminal nor `table.txt` shows a shard's control characters and no
+        // merge carries a message of megabytes into every output.
+        if let StoredOutcome::Failed { error, .. } = &run.outcome
+            && !lane_math::is_one_line(error)
+        {
+            return Err(refuse(ShardProblem::FailureMessage {
+                line,
+                run: run.index,
+            }));
+        }
         let duration = self.header.config.scenario.duration;
         // A run stops at or before its end (the clock's rounding aside).
         if let StoredOutcome::Failed { simulated_s, .. } = &run.outcome
             && !(simulated_s.is_finite()
-                && *simulated_s >= 0.0
+                && simulated_s.is_sign_positive()
                 && *simulated_s <= duration * (1.0 + 1e-9))
         {
             return Err(refuse(ShardProblem::SimulatedTime {
