@@ -31,6 +31,11 @@ use std::fmt;
 /// half-power point gives `0.49999999999999994`, not `0.5`), and the report says so.
 pub const COVERAGE_ROUNDING: f64 = 1e-12;
 
+/// The most evenly spaced samples per input a front end asks [`FuzzySystem::analyze`] for
+/// (`hrm fis check --samples`, Python's `System.check(samples=...)`): the grid holds at most
+/// [`AnalysisOptions::max_grid_points`] points anyway, and takes at least 2 a input.
+pub const MAX_SAMPLES_PER_INPUT: usize = 1_000_000;
+
 /// The thresholds and resolution of [`FuzzySystem::analyze`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct AnalysisOptions {

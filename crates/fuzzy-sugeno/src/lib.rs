@@ -22,7 +22,7 @@ mod rules;
 mod separable;
 mod system;
 
-pub use analysis::{AnalysisOptions, AnalysisReport, COVERAGE_ROUNDING};
+pub use analysis::{AnalysisOptions, AnalysisReport, COVERAGE_ROUNDING, MAX_SAMPLES_PER_INPUT};
 pub use builder::SystemBuilder;
 pub use error::{ConsequentParameter, FuzzyError, LearningProblem, SystemProblem};
 pub use eval::{Evaluator, OutsideRange};

@@ -20,6 +20,7 @@ use crate::plot::{self, Grid, Labels, Series};
 use clap::{Args, Subcommand};
 use fuzzy_sugeno::{
     AnalysisOptions, EvalOptions, Evaluator, FisNote, FuzzyError, FuzzySystem, InputVariable,
+    MAX_SAMPLES_PER_INPUT,
 };
 use std::path::{Path, PathBuf};
 
@@ -119,7 +120,7 @@ pub fn run(args: FisArgs) -> Result<(), String> {
             // Their domains are the library's (`check` names them as options).
             let options = AnalysisOptions {
                 coverage,
-                samples_per_input: args::count("--samples", samples, 2, MAX_SAMPLES)?,
+                samples_per_input: args::count("--samples", samples, 2, MAX_SAMPLES_PER_INPUT)?,
                 max_relative_jump: max_jump,
                 ..Default::default()
             };
@@ -190,9 +191,6 @@ fn ignored_report(file: &Path, notes: &[FisNote]) -> String {
     report
 }
 
-/// Largest `--samples`: the completeness grid holds at most this many points
-/// ([`AnalysisOptions::max_grid_points`]).
-const MAX_SAMPLES: usize = 1_000_000;
 /// Largest `--resolution`: a heat map cell per pixel of the 660-pixel-wide map.
 const MAX_RESOLUTION: usize = 600;
 /// Most SVG files `fis surface` writes (membership charts and surfaces).

@@ -54,6 +54,26 @@ impl<'py> States<'py> {
         name: &'static str,
         width: usize,
     ) -> PyResult<Self> {
+        Self::read_shaped(object, name, width, false)
+    }
+
+    /// Reads `object` as one state of `width` values (a callable's return value: a batch is
+    /// refused as any other shape).
+    pub(crate) fn read_one(
+        object: &Bound<'py, PyAny>,
+        name: &'static str,
+        width: usize,
+    ) -> PyResult<Self> {
+        Self::read_shaped(object, name, width, true)
+    }
+
+    /// [`read`](Self::read), or [`read_one`](Self::read_one) when `one_state`.
+    fn read_shaped(
+        object: &Bound<'py, PyAny>,
+        name: &'static str,
+        width: usize,
+        one_state: bool,
+    ) -> PyResult<Self> {
         let array = float64_array(object, name, MAX_OUTPUT_VALUES)?;
         let array = array
             .try_readonly()
@@ -64,6 +84,12 @@ impl<'py> States<'py> {
                 return Err(
                     Error::input(format!("{name} has {w} entries, expected {width}")).into(),
                 );
+            }
+            ref shape if one_state => {
+                return Err(Error::input(format!(
+                    "{name} must have shape ({width},), got an array of shape {shape:?}"
+                ))
+                .into());
             }
             [n, w] if w == width => Some(n),
             [n, w] => {

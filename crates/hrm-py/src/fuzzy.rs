@@ -2,7 +2,9 @@
 
 use crate::array::{States, evaluate_chunks};
 use crate::errors::{Error, count};
-use fuzzy_sugeno::{AnalysisOptions, AnalysisReport, Evaluator, FuzzyError, FuzzySystem};
+use fuzzy_sugeno::{
+    AnalysisOptions, AnalysisReport, Evaluator, FuzzyError, FuzzySystem, MAX_SAMPLES_PER_INPUT,
+};
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyPermissionError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -180,9 +182,16 @@ impl System {
             crate::args::real_or(coverage, "coverage", 0.5)?,
             crate::args::real_or(max_jump, "max_jump", 1.0)?,
         );
+        let samples = samples.map_or(Ok(21), |s| count(s, "samples", 2))?;
+        if !(2..=MAX_SAMPLES_PER_INPUT).contains(&samples) {
+            return Err(Error::input(format!(
+                "samples must be at least 2 and at most {MAX_SAMPLES_PER_INPUT}, got {samples}"
+            ))
+            .into());
+        }
         let options = AnalysisOptions {
             coverage,
-            samples_per_input: samples.map_or(Ok(21), |s| count(s, "samples", 0))?,
+            samples_per_input: samples,
             max_relative_jump: max_jump,
             ..AnalysisOptions::default()
         };

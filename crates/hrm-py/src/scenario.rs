@@ -549,20 +549,13 @@ impl PythonController {
                 "the controller's return value at t = {t} s: {message}"
             ))
         };
-        let values = States::read(&out, "tau_star", self.m).map_err(|e| {
+        let values = States::read_one(&out, "tau_star", self.m).map_err(|e| {
             if crate::array::passes_through(py, &e) {
                 return e;
             }
             let message = e.value(py).str().map(|s| s.to_string()).unwrap_or_default();
             PyErr::from(context(message))
         })?;
-        if values.is_batch() {
-            return Err(context(format!(
-                "tau_star must have shape ({},), got a batch",
-                self.m
-            ))
-            .into());
-        }
         let values = values.values();
         if values.iter().any(|v| !v.is_finite()) {
             return Err(NumericalError::new_err(format!(
@@ -681,13 +674,10 @@ impl PythonDisturbance {
                 "the disturbance's return value at t = {t} s: {message}"
             ))
         };
-        let values = States::read(&out, "tau", self.n).map_err(|e| {
+        let values = States::read_one(&out, "tau", self.n).map_err(|e| {
             let message = e.value(py).str().map(|s| s.to_string()).unwrap_or_default();
             PyErr::from(context(message))
         })?;
-        if values.is_batch() {
-            return Err(context(format!("tau must have shape ({},), got a batch", self.n)).into());
-        }
         let values = values.values();
         if values.iter().any(|v| !v.is_finite()) {
             return Err(NumericalError::new_err(format!(

@@ -146,11 +146,21 @@ impl Sweep {
         count: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<String> {
         let shard = shard(index, count)?;
+        // The files the scenario references as the configuration records them, before the runs
+        // (a sweep configured, or unpickled, where the `.fis` has other contents) and after.
+        if let Some(changed) = study::changed_input(&self.config).map_err(input)? {
+            return Err(input(study::StudyError::InputChangedSinceConfigured {
+                input: changed,
+            }));
+        }
         let cancel = Cancel::new();
         let file = pool::run(py, &cancel, || {
             study::run_shard_until(&self.config, shard, || {}, || cancel.is_set())
         })?
         .ok_or_else(|| input(study::StudyError::Stopped))?;
+        if let Some(changed) = study::changed_input(&self.config).map_err(input)? {
+            return Err(input(study::StudyError::InputChanged { input: changed }));
+        }
         file.to_json().map_err(input)
     }
 
@@ -288,7 +298,15 @@ fn controller_kinds(controllers: &Bound<'_, PyAny>) -> PyResult<Vec<ControllerKi
 fn shard_path(item: &Bound<'_, PyAny>, k: usize) -> PyResult<PathBuf> {
     if let Ok(bytes) = item.cast::<pyo3::types::PyBytes>() {
         use std::os::unix::ffi::OsStrExt;
-        return Ok(PathBuf::from(std::ffi::OsStr::from_bytes(bytes.as_bytes())));
+        let bytes = bytes.as_bytes();
+        // A shard file's text read in binary mode is not a path (it would be "read" as one).
+        if bytes.trim_ascii_start().starts_with(b"{") {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "shards[{k}] is bytes holding a shard file's text, not a path: give the text as a \
+                 str (bytes.decode())"
+            )));
+        }
+        return Ok(PathBuf::from(std::ffi::OsStr::from_bytes(bytes)));
     }
     item.extract::<PathBuf>().map_err(|_| {
         let kind = item

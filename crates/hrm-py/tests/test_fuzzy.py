@@ -80,5 +80,9 @@ def test_errors(tmp_path):
         paper_controller().eval([0.0, np.nan, 0.0, 0.0])
     with pytest.raises(hrm.InvalidInput, match=r"coverage must lie in \(0, 1\], got 0"):
         paper_controller().check(coverage=0.0)
-    with pytest.raises(hrm.InvalidInput, match="^samples must be at least 0, got -1$"):
+    with pytest.raises(hrm.InvalidInput, match="^samples must be at least 2, got -1$"):
         paper_controller().check(samples=-1)
+    # As `hrm fis check --samples`: a grid of 0 or 1 samples an input is not one.
+    for samples in (0, 1, 10**6 + 1):
+        with pytest.raises(hrm.InvalidInput, match=f"^samples must be at least 2 and at most 1000000, got {samples}$"):
+            paper_controller().check(samples=samples)

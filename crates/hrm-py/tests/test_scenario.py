@@ -201,7 +201,8 @@ def test_an_exception_in_the_controller_propagates_with_its_traceback():
     "returned, error, message",
     [
         (np.zeros(3), hrm.InvalidInput, r"return value at t = 0 s: tau_star has 3 entries, expected 2"),
-        (np.zeros((1, 2)), hrm.InvalidInput, r"tau_star must have shape \(2,\), got a batch"),
+        (np.zeros((1, 2)), hrm.InvalidInput, r"tau_star must have shape \(2,\), got an array of shape \[1, 2\]"),
+        (np.zeros((2, 1)), hrm.InvalidInput, r"tau_star must have shape \(2,\), got an array of shape \[2, 1\]"),
         ("abc", hrm.InvalidInput, r"return value at t = 0 s: tau_star must hold real numbers"),
         (np.array([1j, 0]), hrm.InvalidInput, "tau_star must hold real numbers"),
         (None, hrm.InvalidInput, "tau_star"),

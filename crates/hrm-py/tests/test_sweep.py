@@ -84,6 +84,33 @@ def test_the_merge_refuses_incomplete_or_foreign_shards():
         hrm.Sweep.merge([])
 
 
+def test_a_controller_file_changed_after_the_sweep_was_configured_is_refused(tmp_path):
+    # The sweep records the .fis's SHA-256: a shard run with other contents (edited since, or
+    # another copy where an unpickled sweep runs) would merge as the same sweep.
+    fis = tmp_path / "mine.fis"
+    fis.write_text(hrm.fuzzy.paper_controller().to_fis())
+    scenario = hrm.Scenario.builtin("paper-tracking")
+    scenario.duration = 0.02
+    scenario.controller.fis = str(fis)
+    sweep = hrm.Sweep(scenario, noise_levels=[0.0], seeds=2, controllers=["fuzzy"])
+    first = sweep.run_shard(1, 2)
+    shipped = pickle.dumps(sweep)
+    fis.write_text(fis.read_text().replace("[-100]", "[-90]", 1))
+    for stale in (sweep, pickle.loads(shipped)):
+        with pytest.raises(hrm.InvalidInput, match=r"controller.fis \(.*mine.fis\) changed since the sweep was configured"):
+            stale.run_shard(2, 2)
+    # Configured again, it runs the new contents, and its shards do not merge with the old.
+    again = hrm.Sweep(scenario, noise_levels=[0.0], seeds=2, controllers=["fuzzy"])
+    with pytest.raises(hrm.InvalidInput, match="different contents of controller.fis"):
+        hrm.Sweep.merge([first, again.run_shard(2, 2)])
+
+
+def test_a_shard_given_as_bytes_of_its_text_is_a_type_error():
+    text = small_sweep().run_shard(1, 1)
+    with pytest.raises(TypeError, match=r"^shards\[0\] is bytes holding a shard file's text, not a path"):
+        hrm.Sweep.merge([text.encode()])
+
+
 def test_sweeps_pickle_for_process_pools_and_clusters():
     sweep = small_sweep()
     clone = pickle.loads(pickle.dumps(sweep))

@@ -402,7 +402,8 @@ class Sweep:
     def shard_runs(self, index: int, count: int) -> List[int]:
         """The run indices of shard index of count."""
     def run_shard(self, index: int = 1, count: int = 1) -> str:
-        """Runs one shard (GIL released) and returns the shard file's JSON text."""
+        """Runs one shard (GIL released) and returns the shard file's JSON text; InvalidInput if
+        a file the scenario references changed since the sweep was configured."""
     def run(self) -> Dict[str, Any]:
         """Runs the whole sweep and returns its summary.json as a dict."""
     @staticmethod

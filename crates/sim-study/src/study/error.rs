@@ -99,6 +99,16 @@ pub enum StudyError {
         /// The input, described.
         input: String,
     },
+    /// A file the scenario references changed after the sweep was configured (its runs would not
+    /// be those of the digest its shards record).
+    #[error(
+        "{input} changed since the sweep was configured, whose configuration records its former \
+         SHA-256: configure the sweep again to run the new contents"
+    )]
+    InputChangedSinceConfigured {
+        /// The input, described.
+        input: String,
+    },
     /// The caller's `stop` ended the runs.
     #[error("the sweep was stopped before all its runs were done")]
     Stopped,

@@ -256,6 +256,16 @@ pub fn run_shard_until(
     })
 }
 
+/// The first file the scenario references whose contents no longer have the SHA-256 that the
+/// sweep's configuration records ([`SweepConfig::inputs`]), described; `None` if none changed.
+///
+/// # Errors
+/// [`StudyError::Io`] for a file that cannot be read.
+pub fn changed_input(config: &SweepConfig) -> Result<Option<String>, StudyError> {
+    let now = input_digests(&config.scenario)?;
+    Ok(first_changed(&config.inputs, &now).map(|(input, _)| input.describe()))
+}
+
 /// Runs the runs of `shard` and writes its shard file to `out` as they finish (the header, then
 /// one line per run, in index order), so that memory does not grow with the number of runs.
 /// Afterwards the files the scenario references are read again: if one changed while the
@@ -274,11 +284,8 @@ pub fn write_shard<W: Write + ?Sized>(
         stopped += usize::from(matches!(run.outcome, StoredOutcome::Failed { .. }));
         write_json_line(out, &run)
     })?;
-    let now = input_digests(&config.scenario)?;
-    if let Some((input, _)) = first_changed(&config.inputs, &now) {
-        return Err(StudyError::InputChanged {
-            input: input.describe(),
-        });
+    if let Some(input) = changed_input(config)? {
+        return Err(StudyError::InputChanged { input });
     }
     out.flush().map_err(|e| StudyError::Write {
         cause: e.to_string(),
