@@ -5,7 +5,9 @@ use super::OptimalError;
 use super::box_qp::{BoxQp, BoxQpSettings};
 use super::discrete::DiscreteDynamics;
 use super::step_constraints::{ConstrainedWork, StepConstraints};
-use lane_math::dense::{multiply, multiply_transposed, symmetrise};
+use lane_math::dense::{
+    multiply, multiply_sized, multiply_transposed, multiply_transposed_sized, symmetrise,
+};
 use pulp::{Arch, Simd, WithSimd};
 
 /// The most steps a horizon may have.
@@ -953,7 +955,7 @@ impl Ilqr {
     #[inline(always)]
     fn backward_sized<const NX: usize, const NU: usize>(
         &mut self,
-        t: Terms<'_>,
+        mut t: Terms<'_>,
         mu: f64,
         qp: &BoxQpSettings,
         constrained: bool,
@@ -979,8 +981,8 @@ impl Ilqr {
             let b = &self.b[k * nx * nu..(k + 1) * nx * nu];
             let u = &self.u[k * nu..(k + 1) * nu];
             // Q_x, Q_u.
-            multiply_transposed(a, t.v_x, t.q_x, nx, nx, 1);
-            multiply_transposed(b, t.v_x, t.q_u, nu, nx, 1);
+            product_transposed::<NX, NX, 1>(a, t.v_x, t.q_x, (nx, nx, 1));
+            product_transposed::<NU, NX, 1>(b, t.v_x, t.q_u, (nu, nx, 1));
             for i in 0..nx {
                 t.q_x[i] += cost.state[i] * (self.x[k * nx + i] - self.x_ref[k * nx + i]);
             }
@@ -990,14 +992,14 @@ impl Ilqr {
             // Q_uu first, Q_xx and Q_ux after it: the copy of Q_uu below then reads values
             // stored long before (a wide load of values just stored one by one waits for them
             // to reach the cache).
-            multiply(t.v_xx, b, t.vb, nx, nx, nu);
-            multiply_transposed(b, t.vb, t.q_uu, nu, nx, nu);
+            product::<NX, NX, NU>(t.v_xx, b, t.vb, (nx, nx, nu));
+            product_transposed::<NU, NX, NU>(b, t.vb, t.q_uu, (nu, nx, nu));
             for j in 0..nu {
                 t.q_uu[j * nu + j] += cost.control[j];
             }
-            multiply(t.v_xx, a, t.va, nx, nx, nx);
-            multiply_transposed(a, t.va, t.q_xx, nx, nx, nx);
-            multiply_transposed(b, t.va, t.q_ux, nu, nx, nx);
+            product::<NX, NX, NX>(t.v_xx, a, t.va, (nx, nx, nx));
+            product_transposed::<NX, NX, NX>(a, t.va, t.q_xx, (nx, nx, nx));
+            product_transposed::<NU, NX, NX>(b, t.va, t.q_ux, (nu, nx, nx));
             for i in 0..nx {
                 t.q_xx[i * nx + i] += cost.state[i];
             }
@@ -1038,29 +1040,13 @@ impl Ilqr {
                 self.qp.solve_free(gain, nx);
             }
             // The value function.
-            multiply(t.q_uu, gain, t.quu_gain, nu, nu, nx);
-            multiply(t.q_uu, ff, t.quu_ff, nu, nu, 1);
+            product::<NU, NU, NX>(t.q_uu, gain, t.quu_gain, (nu, nu, nx));
+            product::<NU, NU, 1>(t.q_uu, ff, t.quu_ff, (nu, nu, 1));
             for (j, f) in ff.iter().enumerate() {
                 expected[0] += f * t.q_u[j];
                 expected[1] += 0.5 * f * t.quu_ff[j];
             }
-            for i in 0..nx {
-                let mut s = t.q_x[i];
-                for j in 0..nu {
-                    s += gain[j * nx + i] * (t.quu_ff[j] + t.q_u[j]) + t.q_ux[j * nx + i] * ff[j];
-                }
-                t.v_x[i] = s;
-            }
-            for i in 0..nx {
-                for l in 0..nx {
-                    let mut s = t.q_xx[i * nx + l];
-                    for j in 0..nu {
-                        s += gain[j * nx + i] * (t.quu_gain[j * nx + l] + t.q_ux[j * nx + l])
-                            + t.q_ux[j * nx + i] * gain[j * nx + l];
-                    }
-                    t.v_xx[i * nx + l] = s;
-                }
-            }
+            value_function::<NX, NU>(&mut t, gain, ff, (nx, nu));
             symmetrise(t.v_xx, nx);
         }
         Ok(expected)
@@ -1226,7 +1212,93 @@ impl WithSimd for BackwardOnStack<'_> {
     }
 }
 
-/// Moves the nodes of `buffer` (`width` numbers each) `s` nodes earlier, repeating the last.
+/// The value function's derivatives after a step's gains, into `t.v_x` and `t.v_xx`:
+/// `V_x = Q_x + K^T (Q_uu k + Q_u) + Q_ux^T k` and `V_xx = Q_xx + K^T (Q_uu K + Q_ux) + Q_ux^T K`,
+/// each entry summed over the controls in their order. For `n_x = NX`, `n_u = NU` known at
+/// compile time the sums run in local arrays (kept in vector registers), or in `t` when both
+/// are 0.
+#[inline(always)]
+fn value_function<const NX: usize, const NU: usize>(
+    t: &mut Terms<'_>,
+    gain: &[f64],
+    ff: &[f64],
+    (nx, nu): (usize, usize),
+) {
+    let (q, gain, ff) = ((&*t.q_x, &*t.q_xx), &gain[..nu * nx], &ff[..nu]);
+    let steps = (&*t.quu_ff, &*t.q_u, &*t.quu_gain, &*t.q_ux);
+    if NX == 0 {
+        value_rows(q, steps, (gain, ff), (t.v_x, t.v_xx));
+    } else {
+        let (mut v_x, mut v_xx) = ([0.0; NX], [[0.0; NX]; NX]);
+        value_rows(q, steps, (gain, ff), (&mut v_x, v_xx.as_flattened_mut()));
+        t.v_x.copy_from_slice(&v_x);
+        t.v_xx.copy_from_slice(v_xx.as_flattened());
+    }
+}
+
+/// [`value_function`] into `(v_x, v_xx)` from `(Q_x, Q_xx)`, `(Q_uu k, Q_u, Q_uu K, Q_ux)` and
+/// the gains `(K, k)`, row by row.
+#[inline(always)]
+fn value_rows(
+    (q_x, q_xx): (&[f64], &[f64]),
+    (quu_ff, q_u, quu_gain, q_ux): (&[f64], &[f64], &[f64], &[f64]),
+    (gain, ff): (&[f64], &[f64]),
+    (v_x, v_xx): (&mut [f64], &mut [f64]),
+) {
+    let nx = v_x.len();
+    v_x.copy_from_slice(q_x);
+    v_xx.copy_from_slice(q_xx);
+    let controls = gain.chunks_exact(nx).zip(q_ux.chunks_exact(nx));
+    let steps = quu_gain
+        .chunks_exact(nx)
+        .zip(ff.iter().zip(quu_ff.iter().zip(q_u)));
+    for ((gain_row, q_ux_row), (step_row, (&f, (&quu_f, &q_u)))) in controls.zip(steps) {
+        let w = quu_f + q_u;
+        for ((v, &g), &q) in v_x.iter_mut().zip(gain_row).zip(q_ux_row) {
+            *v += g * w + q * f;
+        }
+        for ((v_row, &g), &q) in v_xx.chunks_exact_mut(nx).zip(gain_row).zip(q_ux_row) {
+            let columns = v_row
+                .iter_mut()
+                .zip(step_row.iter().zip(q_ux_row).zip(gain_row));
+            for (v, ((&qg, &qu), &gl)) in columns {
+                *v += g * (qg + qu) + q * gl;
+            }
+        }
+    }
+}
+
+/// `out = a b` (`a` `r x k`, `b` `k x c`): [`multiply_sized`] for sizes known at compile time,
+/// [`multiply`] when `R` is 0.
+#[inline(always)]
+fn product<const R: usize, const K: usize, const C: usize>(
+    a: &[f64],
+    b: &[f64],
+    out: &mut [f64],
+    (r, k, c): (usize, usize, usize),
+) {
+    if R == 0 {
+        multiply(a, b, out, r, k, c);
+    } else {
+        multiply_sized::<R, K, C>(a, b, out);
+    }
+}
+
+/// `out = a^T b` (`a` `k x r`, `b` `k x c`), as [`product`].
+#[inline(always)]
+fn product_transposed<const R: usize, const K: usize, const C: usize>(
+    a: &[f64],
+    b: &[f64],
+    out: &mut [f64],
+    (r, k, c): (usize, usize, usize),
+) {
+    if R == 0 {
+        multiply_transposed(a, b, out, r, k, c);
+    } else {
+        multiply_transposed_sized::<R, K, C>(a, b, out);
+    }
+}
+
 /// Whether the workspace of `n_x` states, `n_u` controls and `horizon` steps,
 /// `horizon * (2 n_x^2 + 3 n_x n_u)` numbers, is within [`MAX_WORKSPACE`].
 pub(crate) fn workspace_fits(nx: usize, nu: usize, horizon: usize) -> bool {
@@ -1237,6 +1309,7 @@ pub(crate) fn workspace_fits(nx: usize, nu: usize, horizon: usize) -> bool {
     horizon.saturating_mul(per_step) <= MAX_WORKSPACE
 }
 
+/// Moves the nodes of `buffer` (`width` numbers each) `s` nodes earlier, repeating the last.
 fn shift_nodes(buffer: &mut [f64], width: usize, s: usize) {
     let nodes = buffer.len() / width;
     buffer.copy_within(s * width.., 0);
@@ -1446,5 +1519,81 @@ fn decrease(mu: &mut f64, delta: &mut f64, settings: &IlqrSettings) {
     *mu *= *delta;
     if *mu < settings.min_regularisation {
         *mu = 0.0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `count` pseudo-random numbers in `[-1, 1)` (a linear congruential sequence from `seed`).
+    fn numbers(count: usize, seed: u64) -> Vec<f64> {
+        let mut state = seed;
+        (0..count)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+            })
+            .collect()
+    }
+
+    /// A workspace of `n_u` controls and `2 n_u` states with pseudo-random Jacobians, trajectory,
+    /// references and previous feed-forward steps, and a box that clamps some of the steps.
+    fn scrambled(nu: usize, seed: u64) -> Ilqr {
+        let nx = 2 * nu;
+        let cost = TrackingCost {
+            state: numbers(nx, seed).iter().map(|w| 2.0 + w).collect(),
+            control: numbers(nu, seed + 1)
+                .iter()
+                .map(|w| 0.1 + 0.05 * w)
+                .collect(),
+            terminal: numbers(nx, seed + 2).iter().map(|w| 5.0 + w).collect(),
+        };
+        let mut ilqr = Ilqr::new(nx, nu, 12, &cost).unwrap();
+        for (i, buffer) in [
+            &mut ilqr.x,
+            &mut ilqr.u,
+            &mut ilqr.x_ref,
+            &mut ilqr.u_ref,
+            &mut ilqr.a,
+            &mut ilqr.b,
+            &mut ilqr.feedforward,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let len = buffer.len();
+            buffer.copy_from_slice(&numbers(len, seed + 3 + i as u64));
+        }
+        ilqr.set_bounds(&vec![-1.2; nu], &vec![1.1; nu]).unwrap();
+        ilqr
+    }
+
+    #[test]
+    fn stack_backward_passes_have_the_bits_of_the_general_one() {
+        let qp = BoxQpSettings::default();
+        for (nu, seed) in [(2, 1), (2, 40), (3, 7), (3, 90)] {
+            let mut stacked = scrambled(nu, seed);
+            let mut general = stacked.clone();
+            let expected = stacked.backward(1e-3, &qp, false).unwrap();
+            let mut terms = std::mem::take(&mut general.terms);
+            let slices = terms.slices(2 * nu, nu);
+            let general_expected = general
+                .backward_sized::<0, 0>(slices, 1e-3, &qp, false)
+                .unwrap();
+            let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&expected), bits(&general_expected), "n_u = {nu}");
+            assert_eq!(bits(&stacked.gain), bits(&general.gain), "n_u = {nu}");
+            assert_eq!(
+                bits(&stacked.feedforward),
+                bits(&general.feedforward),
+                "n_u = {nu}"
+            );
+            // Some steps are clamped, some gains free: both kinds of node are compared.
+            assert!(stacked.gain.contains(&0.0));
+            assert!(stacked.gain.iter().any(|&g| g != 0.0));
+        }
     }
 }

@@ -31,7 +31,10 @@ pub use exponential::exponential;
 pub use ldlt::{ldlt_in_place, ldlt_solve_in_place, ldlt_solve_rows_in_place};
 pub use least_squares::{LeastSquares, LeastSquaresError};
 pub use lu::lu_solve;
-pub use products::{multiply, multiply_by_transposed, multiply_transposed, symmetrise};
+pub use products::{
+    multiply, multiply_by_transposed, multiply_sized, multiply_transposed,
+    multiply_transposed_sized, symmetrise,
+};
 
 #[cfg(test)]
 /// A deterministic `r x c` matrix with entries in [-1, 1].

@@ -33,6 +33,47 @@ pub fn multiply_transposed(a: &[f64], b: &[f64], out: &mut [f64], r: usize, k: u
     }
 }
 
+/// [`multiply`] for sizes known at compile time (`a` `R x K`, `b` `K x C`): the same operations
+/// in the same order, accumulated in a local array that the compiler keeps in vector registers
+/// (a row of `C` values at a time) instead of in `out`.
+#[inline(always)]
+pub fn multiply_sized<const R: usize, const K: usize, const C: usize>(
+    a: &[f64],
+    b: &[f64],
+    out: &mut [f64],
+) {
+    let (a, b) = (&a[..R * K], &b[..K * C]);
+    let mut product = [[0.0; C]; R];
+    for (row, a_row) in product.iter_mut().zip(a.chunks_exact(K)) {
+        for (&x, b_row) in a_row.iter().zip(b.chunks_exact(C)) {
+            for (o, &y) in row.iter_mut().zip(b_row) {
+                *o += x * y;
+            }
+        }
+    }
+    out[..R * C].copy_from_slice(product.as_flattened());
+}
+
+/// [`multiply_transposed`] for sizes known at compile time (`a` `K x R`, `b` `K x C`), as
+/// [`multiply_sized`].
+#[inline(always)]
+pub fn multiply_transposed_sized<const R: usize, const K: usize, const C: usize>(
+    a: &[f64],
+    b: &[f64],
+    out: &mut [f64],
+) {
+    let (a, b) = (&a[..K * R], &b[..K * C]);
+    let mut product = [[0.0; C]; R];
+    for (a_row, b_row) in a.chunks_exact(R).zip(b.chunks_exact(C)) {
+        for (row, &x) in product.iter_mut().zip(a_row) {
+            for (o, &y) in row.iter_mut().zip(b_row) {
+                *o += x * y;
+            }
+        }
+    }
+    out[..R * C].copy_from_slice(product.as_flattened());
+}
+
 /// `out = a b^T` with `a` `r x k`, `b` `c x k`.
 #[inline]
 pub fn multiply_by_transposed(a: &[f64], b: &[f64], out: &mut [f64], r: usize, k: usize, c: usize) {
@@ -65,6 +106,20 @@ pub fn symmetrise(a: &mut [f64], n: usize) {
 mod tests {
     use super::*;
     use crate::dense::test_matrix as matrix;
+
+    #[test]
+    fn sized_products_have_the_bits_of_the_general_ones() {
+        let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        let (a, b) = (matrix(3, 4, 3), matrix(4, 5, 5));
+        let (mut sized, mut general) = (vec![0.0; 15], vec![0.0; 15]);
+        multiply_sized::<3, 4, 5>(&a, &b, &mut sized);
+        multiply(&a, &b, &mut general, 3, 4, 5);
+        assert_eq!(bits(&sized), bits(&general));
+        // `a` read as 4 x 3: `a^T b` is 3 x 5.
+        multiply_transposed_sized::<3, 4, 5>(&a, &b, &mut sized);
+        multiply_transposed(&a, &b, &mut general, 3, 4, 5);
+        assert_eq!(bits(&sized), bits(&general));
+    }
 
     #[test]
     fn multiply_by_transposed_is_the_product_with_the_transpose() {
