@@ -230,14 +230,25 @@ impl ModalMap {
     fn apply(&self, a: &[f64], out: &mut [f64], with_offset: bool) -> Result<(), KinError> {
         check_values("modal coordinates", a, self.n_coords)?;
         check_len("joint output", out.len(), self.n_joints)?;
-        for (i, o) in out.iter_mut().enumerate() {
-            let dot: f64 = self.row(i).iter().zip(a).map(|(j, x)| j * x).sum();
-            *o = if with_offset {
-                dot + self.offset[i]
-            } else {
-                dot
-            };
+        match self.n_coords {
+            2 => self.apply_sized::<2>(a, out, with_offset),
+            3 => self.apply_sized::<3>(a, out, with_offset),
+            _ => self.apply_sized::<0>(a, out, with_offset),
         }
         Ok(())
+    }
+
+    /// [`apply`](Self::apply) after its checks, for `M` coordinates known at compile time (the
+    /// shipped families' 2 and 3: each row's sum unrolled, the same operations in the same
+    /// order), or any number when `M` is 0.
+    #[inline(always)]
+    fn apply_sized<const M: usize>(&self, a: &[f64], out: &mut [f64], with_offset: bool) {
+        let m = if M == 0 { self.n_coords } else { M };
+        let a = &a[..m];
+        for (i, (o, &offset)) in out.iter_mut().zip(&self.offset).enumerate() {
+            let row = &self.jacobian[i * m..(i + 1) * m];
+            let dot: f64 = row.iter().zip(a).map(|(j, x)| j * x).sum();
+            *o = if with_offset { dot + offset } else { dot };
+        }
     }
 }

@@ -390,8 +390,35 @@ fn satisfies(constraints: &[f64], g: &[f64], x: &[f64]) -> bool {
         })
 }
 
-/// The largest power of two at most `x` (positive and finite), within the normal range.
+/// The largest power of two at most `x` (positive, finite and normal, as the inverse of a
+/// finite positive norm is): `x` with its significand's bits cleared.
 fn power_of_two_at_most(x: f64) -> f64 {
-    let exponent = x.log2().floor().clamp(-1000.0, 1000.0);
-    2f64.powi(exponent as i32)
+    const SIGN_AND_EXPONENT: u64 = 0xfff0_0000_0000_0000;
+    f64::from_bits(x.to_bits() & SIGN_AND_EXPONENT)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::power_of_two_at_most;
+
+    #[test]
+    fn powers_of_two_at_most_bracket_their_argument() {
+        // Exact powers, their neighbours a rounding away, and inverses of norms from the
+        // smallest positive to the largest finite square.
+        let mut xs = vec![1.0, 2.0, 0.5, 1024.0, f64::MIN_POSITIVE];
+        for k in -300..300 {
+            let power = 2f64.powi(k);
+            xs.extend([power, power.next_down(), power.next_up(), 3.0 * power]);
+        }
+        xs.extend([f64::from_bits(1).sqrt().recip(), f64::MAX.sqrt().recip()]);
+        for x in xs {
+            let p = power_of_two_at_most(x);
+            assert!(p <= x && x < 2.0 * p, "{x}: {p}");
+            assert_eq!(
+                p.to_bits() & ((1 << 52) - 1),
+                0,
+                "{x}: {p} is not a power of two"
+            );
+        }
+    }
 }
