@@ -5,6 +5,7 @@
 
 use crate::OptimalError;
 use crate::step_constraints::StepConstraints;
+use faer::MatRef;
 use lane_math::dense::{cholesky, cholesky_solve};
 use manip_dyn::{ChainData, DerivativeData, rnea_derivatives};
 use modal_reduce::{
@@ -179,7 +180,7 @@ impl JointTorqueLimits {
         else {
             return Ok(false);
         };
-        let (n, m) = (self.limits.len(), self.a_ddot.len());
+        let m = self.a_ddot.len();
         let nx = 2 * m;
         let (a, a_dot) = (&x[..m], &x[m..nx]);
         reduced_derivatives(model, data, &mut work.reduced, a, a_dot, u)?;
@@ -206,30 +207,12 @@ impl JointTorqueLimits {
                 accel[m + c] = (0..m).map(|i| row[i] * d_a_dot[(i, c)]).sum();
             }
         }
-        let (d_q, d_v, mass) = (work.rnea.d_q(), work.rnea.d_v(), work.rnea.d_input());
-        for (j, rows) in jacobian.chunks_exact_mut(2 * nx).take(n).enumerate() {
-            let (upper, lower) = rows.split_at_mut(nx);
-            upper.fill(0.0);
-            let entries = d_q
-                .row(j)
-                .iter()
-                .zip(d_v.row(j).iter())
-                .zip(mass.row(j).iter());
-            for (((dq, dv), mk), (row, accel)) in
-                entries.zip(jac.chunks_exact(m).zip(work.accel.chunks_exact(nx)))
-            {
-                // d_q tau J and d_v tau J, then M J d a_ddot/dx.
-                for c in 0..m {
-                    upper[c] += dq * row[c];
-                    upper[m + c] += dv * row[c];
-                }
-                for (d, a) in upper.iter_mut().zip(accel) {
-                    *d += mk * a;
-                }
-            }
-            for (l, u) in lower.iter_mut().zip(upper.iter()) {
-                *l = -u;
-            }
+        let chain = (work.rnea.d_q(), work.rnea.d_v(), work.rnea.d_input());
+        let products = (jac, &work.accel[..]);
+        match m {
+            2 => chain_rows::<2>(2, chain, products, jacobian),
+            3 => chain_rows::<3>(3, chain, products, jacobian),
+            _ => chain_rows::<0>(m, chain, products, jacobian),
         }
         Ok(true)
     }
@@ -261,6 +244,47 @@ impl JointTorqueLimits {
         }
         cholesky_solve(&self.factor, m, &mut self.solves, m + 1);
         Ok(())
+    }
+}
+
+/// The rows of [`JointTorqueLimits::state_jacobian`] from the chain's derivatives
+/// `(d_q tau, d_v tau, M)` and `(J, J d a_ddot/dx)` (`n x m` and `n x 2m`, row-major): joint
+/// `j`'s upper row `d_q tau_j J | d_v tau_j J + (M J d a_ddot/dx)_j`, its lower row the
+/// negation; for `m = M` known at compile time (the loops over the coordinates unrolled), or
+/// any `m` when `M` is 0.
+#[inline(always)]
+fn chain_rows<const M: usize>(
+    m: usize,
+    (d_q, d_v, mass): (MatRef<'_, f64>, MatRef<'_, f64>, MatRef<'_, f64>),
+    (jac, accel): (&[f64], &[f64]),
+    jacobian: &mut [f64],
+) {
+    let m = if M == 0 { m } else { M };
+    let nx = 2 * m;
+    let joints = jacobian.chunks_exact_mut(2 * nx).take(d_q.nrows());
+    for (j, rows) in joints.enumerate() {
+        let (upper, lower) = rows.split_at_mut(nx);
+        upper.fill(0.0);
+        let entries = d_q
+            .row(j)
+            .iter()
+            .zip(d_v.row(j).iter())
+            .zip(mass.row(j).iter());
+        for (((dq, dv), mk), (row, accel)) in
+            entries.zip(jac.chunks_exact(m).zip(accel.chunks_exact(nx)))
+        {
+            // d_q tau J and d_v tau J, then M J d a_ddot/dx.
+            for c in 0..m {
+                upper[c] += dq * row[c];
+                upper[m + c] += dv * row[c];
+            }
+            for (d, a) in upper.iter_mut().zip(accel) {
+                *d += mk * a;
+            }
+        }
+        for (l, u) in lower.iter_mut().zip(upper.iter()) {
+            *l = -u;
+        }
     }
 }
 
