@@ -82,6 +82,18 @@ impl ChainMpc {
         self.ilqr.horizon()
     }
 
+    /// The estimated work of one solve, in multiply-adds (the unit of
+    /// [`Mpc::solve_work`](crate::Mpc::solve_work)): at most `max_iterations` iterations of the
+    /// horizon's nodes, each node's backward pass on `2n` states (`16 n^3`: `A^T V_xx A` and
+    /// the gains) and its rollouts and linearisation (the articulated-body algorithm and its
+    /// derivatives, `256 n` a trial of the line search and `2048 n` for the Jacobians).
+    pub fn solve_work(&self) -> f64 {
+        let n = self.n as f64;
+        let trials = self.solver.line_search_steps as f64;
+        let per_node = 16.0 * n.powi(3) + 256.0 * n * (trials + 8.0);
+        self.solver.max_iterations as f64 * self.horizon() as f64 * per_node
+    }
+
     /// The iLQR workspace: the last plan's controls, states and gains.
     pub fn ilqr(&self) -> &Ilqr {
         &self.ilqr

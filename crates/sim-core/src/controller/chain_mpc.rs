@@ -49,6 +49,12 @@ impl ChainMpcController {
         })
     }
 
+    /// The estimated work of its solves over `duration` seconds of a run (one a model step),
+    /// in the units of [`MAX_RUN_WORK`](crate::MAX_RUN_WORK) ([`ChainMpc::solve_work`]).
+    pub fn work(&self, duration: f64) -> f64 {
+        ((duration / self.mpc.step()).ceil() + 1.0) * self.mpc.solve_work()
+    }
+
     /// The MPC workspace: the last plan.
     pub fn mpc(&self) -> &ChainMpc {
         &self.mpc
