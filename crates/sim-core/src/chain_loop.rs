@@ -48,6 +48,18 @@ pub struct ChainLoopSettings {
     pub kd: Vec<f64>,
     /// Runaway bound on `|q_i - q_r,i|` (rad or m): the run stops past it.
     pub max_joint_error: f64,
+    /// The actuators' largest effort per joint (N m or N; positive, infinity for none), or
+    /// empty for none: the commanded effort is clamped to `[-limit, limit]` at every controller
+    /// sample, as a saturating actuator delivers it.
+    pub effort_limits: Vec<f64>,
+    /// Each joint's position range `[lower, upper]` (rad or m; infinite ends for none), or
+    /// empty for none: a reference sample or initial position outside it stops the run (the
+    /// plant has no hard stops; the controller is not asked to drive a joint past its range).
+    pub position_limits: Vec<[f64; 2]>,
+    /// Viscous damping per joint (N m s/rad or N s/m; non-negative), or empty for none: the
+    /// plant's joint `i` receives `tau_i - damping_i v_i` (URDF's `<dynamics damping>`, as
+    /// MuJoCo's `damping`).
+    pub damping: Vec<f64>,
 }
 
 /// The recorded time series of a chain run, `n` values per sample in each joint series.
@@ -76,8 +88,12 @@ pub struct ChainSummary {
     pub joint_error_max: Vec<f64>,
     /// `|q - q_r|` (Euclidean, over the joints) at the final time.
     pub final_error: f64,
-    /// Largest `|tau_i|` per joint over the controller samples.
+    /// Largest `|tau_i|` per joint over the controller samples (the delivered efforts, within
+    /// the effort limits).
     pub peak_joint_efforts: Vec<f64>,
+    /// The share of controller samples at which an effort limit clamped the command (0 without
+    /// limits).
+    pub effort_limited_share: f64,
 }
 
 /// A finished chain run.
@@ -95,11 +111,14 @@ pub struct ChainRun {
 /// `t = 0`).
 pub type ChainFailure = StoppedRun<ChainRun>;
 
-/// The plant between two controller samples: `(q, v)' = (v, ABA(q, v, tau))`.
+/// The plant between two controller samples: `(q, v)' = (v, ABA(q, v, tau - damping v))`
+/// (`applied` holds the damped efforts; without damping `tau` goes in as it is).
 struct Plant<'a> {
     model: &'a SpatialModel,
     data: &'a mut SpatialData,
     tau: &'a [f64],
+    damping: &'a [f64],
+    applied: &'a mut [f64],
 }
 
 impl OdeSystem for Plant<'_> {
@@ -110,7 +129,17 @@ impl OdeSystem for Plant<'_> {
         let (q, v) = y.split_at(n);
         let (q_dot, v_dot) = dy.split_at_mut(n);
         q_dot.copy_from_slice(v);
-        aba(self.model, self.data, q, v, self.tau, v_dot)
+        if self.damping.is_empty() {
+            return aba(self.model, self.data, q, v, self.tau, v_dot);
+        }
+        let joints = self
+            .applied
+            .iter_mut()
+            .zip(self.tau.iter().zip(self.damping));
+        for ((applied, (&tau, &damping)), &v) in joints.zip(v) {
+            *applied = tau - damping * v;
+        }
+        aba(self.model, self.data, q, v, self.applied, v_dot)
     }
 }
 
@@ -155,6 +184,7 @@ fn check(
             check_positive(name, g)?;
         }
     }
+    check_joint_limits(settings, n)?;
     let periods = (settings.duration / settings.period).ceil();
     let steps = periods * (settings.period / settings.dt).ceil();
     let recorded = (periods / (settings.record_period / settings.period).round().max(1.0) + 2.0)
@@ -178,6 +208,82 @@ fn check(
     }
     check_chain_work(settings, n, (periods, steps), controller_work)?;
     Ok(periods as usize)
+}
+
+/// Checks the per-joint limits and damping: each list empty or one entry per joint, efforts
+/// positive (infinity allowed), ranges ordered and not NaN, damping non-negative and finite.
+fn check_joint_limits(settings: &ChainLoopSettings, n: usize) -> Result<(), SimError> {
+    for (name, len) in [
+        ("effort limits", settings.effort_limits.len()),
+        ("position limits", settings.position_limits.len()),
+        ("damping", settings.damping.len()),
+    ] {
+        if len != 0 && len != n {
+            return Err(SimError::setting(
+                name,
+                format!("has {len} entries, expected one per joint ({n}) or none"),
+            ));
+        }
+    }
+    let joint =
+        |i: usize, what: String| SimError::setting("arm.urdf", format!("joint {}: {what}", i + 1));
+    for (i, &limit) in settings.effort_limits.iter().enumerate() {
+        if limit.is_nan() || limit <= 0.0 {
+            return Err(joint(
+                i,
+                format!("effort limit must be positive, got {limit}"),
+            ));
+        }
+    }
+    for (i, &[lower, upper]) in settings.position_limits.iter().enumerate() {
+        if lower.is_nan() || upper.is_nan() || lower > upper {
+            return Err(joint(
+                i,
+                format!("position limits must be ordered, got [{lower}, {upper}]"),
+            ));
+        }
+    }
+    for (i, &damping) in settings.damping.iter().enumerate() {
+        if !(damping.is_finite() && damping >= 0.0) {
+            return Err(joint(
+                i,
+                format!("damping must be non-negative and finite, got {damping}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses joint values outside their position limits: the first joint of `values` (at time
+/// `t`, as `what`) beyond its range.
+fn check_within_range(
+    limits: &[[f64; 2]],
+    values: &[f64],
+    t: f64,
+    what: &str,
+) -> Result<(), SimError> {
+    let outside = limits
+        .iter()
+        .zip(values)
+        .position(|(&[lower, upper], &x)| !(lower <= x && x <= upper));
+    match outside {
+        None => Ok(()),
+        Some(i) => {
+            let [lower, upper] = limits[i];
+            Err(SimError::setting(
+                what,
+                format!(
+                    "sets joint {} to {} at t = {} s, outside its position limits [{}, {}] \
+                     (the URDF's <limit>)",
+                    i + 1,
+                    Compact(values[i]),
+                    Compact(t),
+                    Compact(lower),
+                    Compact(upper)
+                ),
+            ))
+        }
+    }
 }
 
 /// The work of one joint in one articulated-body evaluation of the plant, in the units of
@@ -289,12 +395,15 @@ fn run(
         .into());
     }
     check_all_finite("initial.a", q0).map_err(SimError::from)?;
+    check_within_range(&settings.position_limits, q0, 0.0, "initial.a")?;
     let mut data = SpatialData::new(model);
     let mut rk4 = Rk4::new(2 * n);
     let mut state = vec![0.0; 2 * n];
     state[..n].copy_from_slice(q0);
     let mut sample = ReferenceSample::zeros(n);
     let (mut command, mut tau) = (vec![0.0; n], vec![0.0; n]);
+    let mut applied = vec![0.0; n];
+    let mut limited_samples = 0usize;
     let mut record = ChainRecord::default();
     let mut squares = vec![0.0; n];
     let mut summary = ChainSummary {
@@ -304,6 +413,7 @@ fn run(
         joint_error_max: vec![0.0; n],
         final_error: 0.0,
         peak_joint_efforts: vec![0.0; n],
+        effort_limited_share: 0.0,
     };
     let every = ((settings.record_period / settings.period).round() as usize).max(1);
     // The recorded samples (every `every`-th and the last), reserved once: the loop allocates
@@ -318,6 +428,7 @@ fn run(
         for k in 0..=periods {
             let t = (k as f64 * settings.period).min(settings.duration);
             reference.sample(t, &mut sample)?;
+            check_within_range(&settings.position_limits, &sample.a, t, "reference")?;
             let (q, v) = state.split_at(n);
             for (i, (r, x)) in sample.a.iter().zip(q).enumerate() {
                 let error = r - x;
@@ -345,6 +456,14 @@ fn run(
                     .map_err(|error| SimError::from_controller(t, error))?,
             }
             summary.controller_samples += 1;
+            let mut limited = false;
+            for (effort, &limit) in tau.iter_mut().zip(&settings.effort_limits) {
+                if effort.abs() > limit {
+                    *effort = effort.clamp(-limit, limit);
+                    limited = true;
+                }
+            }
+            limited_samples += usize::from(limited);
             for (peak, effort) in summary.peak_joint_efforts.iter_mut().zip(&tau) {
                 *peak = peak.max(effort.abs());
             }
@@ -373,6 +492,8 @@ fn run(
                 model,
                 data: &mut data,
                 tau: &tau,
+                damping: &settings.damping,
+                applied: &mut applied,
             };
             let stats = rk4
                 .integrate(&mut plant, t, t1, &mut state, settings.dt)
@@ -385,6 +506,9 @@ fn run(
         Ok(())
     };
     let outcome = samples_of();
+    if summary.controller_samples > 0 {
+        summary.effort_limited_share = limited_samples as f64 / summary.controller_samples as f64;
+    }
     let samples = record.t.len();
     for (rms, square) in summary.joint_error_rms.iter_mut().zip(&squares) {
         *rms = (square / samples as f64).sqrt();
@@ -439,6 +563,9 @@ mod tests {
             kp: vec![400.0; n],
             kd: vec![40.0; n],
             max_joint_error: 3.0,
+            effort_limits: Vec::new(),
+            position_limits: Vec::new(),
+            damping: Vec::new(),
         }
     }
 
@@ -578,6 +705,134 @@ mod tests {
         s.duration = 1e12;
         let e = run_chain_loop(&model, &mut step, &[0.0; 7], &s).unwrap_err();
         assert!(e.to_string().contains("past the loop's limits"), "{e}");
+    }
+
+    #[test]
+    fn efforts_saturate_at_their_limits() {
+        let model = arm();
+        let target = [0.3, -0.2, 0.1, 0.4, -0.3, 0.2, 0.1];
+        let mut step = Step::new(&[0.0; 7], &target, 0.0).unwrap();
+        let free = run_chain_loop(&model, &mut step, &[0.0; 7], &settings(7)).unwrap();
+        assert_eq!(free.summary.effort_limited_share, 0.0);
+        // 90% of the second joint's free peak (the others free): the step's first samples
+        // saturate, the hold does not.
+        let mut s = settings(7);
+        s.effort_limits = vec![f64::INFINITY; 7];
+        s.effort_limits[1] = 0.9 * free.summary.peak_joint_efforts[1];
+        let mut step = Step::new(&[0.0; 7], &target, 0.0).unwrap();
+        let limited = run_chain_loop(&model, &mut step, &[0.0; 7], &s).unwrap();
+        let share = limited.summary.effort_limited_share;
+        assert!(share > 0.0 && share < 0.5, "{share}");
+        for ((peak, limit), tau) in limited
+            .summary
+            .peak_joint_efforts
+            .iter()
+            .zip(&s.effort_limits)
+            .zip(limited.record.tau.chunks_exact(7).flat_map(|t| t.iter()))
+        {
+            assert!(
+                *peak <= *limit && tau.abs() <= *limit,
+                "{peak} {limit} {tau}"
+            );
+        }
+        // Within its limits the arm moves otherwise but still gets there.
+        assert!(limited.summary.final_error < 1e-3, "{:?}", limited.summary);
+        assert_ne!(limited.record.q, free.record.q);
+    }
+
+    #[test]
+    fn damping_opposes_each_joint_rate() {
+        let model = arm();
+        let (q, v) = (
+            [0.2, -0.1, 0.3, 0.0, 0.5, -0.4, 0.1],
+            [1.0, -2.0, 0.5, 3.0, -1.0, 0.2, 2.0],
+        );
+        let tau = [1.0, 2.0, -1.0, 0.5, 0.2, -0.3, 0.1];
+        let damping = [0.5, 1.0, 2.0, 0.0, 0.3, 0.1, 4.0];
+        let mut data = SpatialData::new(&model);
+        let mut applied = [0.0; 7];
+        let mut plant = Plant {
+            model: &model,
+            data: &mut data,
+            tau: &tau,
+            damping: &damping,
+            applied: &mut applied,
+        };
+        let y: Vec<f64> = q.iter().chain(&v).copied().collect();
+        let mut dy = [0.0; 14];
+        plant.rhs(0.0, &y, &mut dy).unwrap();
+        // The same as the undamped plant under tau - damping v.
+        let damped: Vec<f64> = (0..7).map(|i| tau[i] - damping[i] * v[i]).collect();
+        let mut expected = [0.0; 7];
+        aba(
+            &model,
+            &mut SpatialData::new(&model),
+            &q,
+            &v,
+            &damped,
+            &mut expected,
+        )
+        .unwrap();
+        assert_eq!(&dy[..7], &v);
+        assert_eq!(&dy[7..], &expected);
+        // Under gravity compensation alone the undamped arm holds still; the damping is
+        // not in the controller's model, so the damped arm's run differs.
+        let mut s = settings(7);
+        (s.kp, s.kd) = (vec![1e-6; 7], vec![1e-6; 7]);
+        s.duration = 0.5;
+        s.damping = vec![1e-3; 7];
+        let mut hold = Step::constant(&[0.3; 7]).unwrap();
+        let run = run_chain_loop(&model, &mut hold, &[0.0; 7], &s).unwrap();
+        s.damping.clear();
+        let mut hold = Step::constant(&[0.3; 7]).unwrap();
+        let free = run_chain_loop(&model, &mut hold, &[0.0; 7], &s).unwrap();
+        assert_ne!(run.record.q, free.record.q);
+    }
+
+    #[test]
+    fn references_outside_the_position_limits_stop_the_run() {
+        let model = arm();
+        let mut s = settings(7);
+        s.position_limits = vec![[-1.0, 1.0]; 7];
+        s.position_limits[3] = [-0.2, 0.2];
+        let mut step = Step::new(&[0.0; 7], &[0.1, 0.1, 0.1, 0.3, 0.1, 0.1, 0.1], 0.1).unwrap();
+        let e = run_chain_loop(&model, &mut step, &[0.0; 7], &s).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "reference sets joint 4 to 0.3 at t = 0.1 s, outside its position limits [-0.2, \
+             0.2] (the URDF's <limit>)"
+        );
+        // The run up to the stop is kept.
+        assert!(e.partial.is_some_and(|run| run.record.t.len() == 1000));
+        let mut inside = Step::constant(&[0.0; 7]).unwrap();
+        let e = run_chain_loop(
+            &model,
+            &mut inside,
+            &[0.0, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0],
+            &s,
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("initial.a sets joint 4 to 0.5 at t = 0 s"),
+            "{e}"
+        );
+        // Limits out of their domain are named.
+        s.position_limits[2] = [1.0, -1.0];
+        let e = run_chain_loop(&model, &mut inside, &[0.0; 7], &s).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("joint 3: position limits must be ordered"),
+            "{e}"
+        );
+        let mut s = settings(7);
+        s.effort_limits = vec![0.0; 7];
+        let e = run_chain_loop(&model, &mut inside, &[0.0; 7], &s).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("joint 1: effort limit must be positive"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -101,7 +101,7 @@ pub fn sweep(config: &SweepConfig, cells: &[Cell]) -> Value {
 /// (`"urdf"`, `"deploy"`) under the scenario's controller.
 pub fn chain(scenario: &Scenario, arm: &str, run: &ChainRun) -> Value {
     let summary = &run.summary;
-    json!({
+    let mut fields = json!({
         "scenario": scenario.name,
         "controller": scenario.controller.kind.name(),
         "arm": arm,
@@ -112,7 +112,12 @@ pub fn chain(scenario: &Scenario, arm: &str, run: &ChainRun) -> Value {
         "joint_error_max": summary.joint_error_max,
         "final_error": summary.final_error,
         "peak_joint_efforts": summary.peak_joint_efforts,
-    })
+    });
+    // A URDF arm's actuators saturate at their `<limit effort>`: how often they did.
+    if arm == "urdf" {
+        fields["effort_limited_share"] = json!(summary.effort_limited_share);
+    }
+    fields
 }
 
 /// The `summary.json` of a deployment: [`chain`]'s fields, then `deploy_tip_error_m`,

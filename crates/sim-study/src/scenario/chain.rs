@@ -89,6 +89,15 @@ impl Scenario {
     /// a URDF serial chain with at least one movable joint, and naming a planar arm key given
     /// with it.
     pub fn urdf_model(&self) -> Result<Option<SpatialModel>, SimError> {
+        Ok(self.urdf_arm()?.map(|(_, model)| model))
+    }
+
+    /// [`urdf_model`](Self::urdf_model) with the URDF's chain it was built from (its joints'
+    /// `<limit>` and `<dynamics>`).
+    ///
+    /// # Errors
+    /// As [`urdf_model`](Self::urdf_model).
+    pub fn urdf_arm(&self) -> Result<Option<(robot_desc::Robot, SpatialModel)>, SimError> {
         let ArmSpec {
             urdf: Some(path),
             kind,
@@ -145,9 +154,9 @@ impl Scenario {
         let gravity = gravity.unwrap_or(Gravity::Magnitude(9.81));
         gravity.check()?;
         let gravity = gravity.spatial();
-        robot_desc::to_spatial(&robot, gravity)
-            .map(Some)
-            .map_err(|e| invalid(format!("({}): {e}", path.display())))
+        let model = robot_desc::to_spatial(&robot, gravity)
+            .map_err(|e| invalid(format!("({}): {e}", path.display())))?;
+        Ok(Some((robot, model)))
     }
 
     /// Runs the scenario on its URDF arm: computed torque (`controller.kp`, `controller.kd`, one
@@ -164,9 +173,10 @@ impl Scenario {
     /// arrays of the wrong length; the run's errors ([`run_chain_loop`]), with the run up to the
     /// stop ([`ChainFailure`]).
     pub fn run_chain(&self) -> Result<ChainRun, ChainFailure> {
-        let model = self.urdf_model()?.ok_or_else(|| {
+        let (robot, model) = self.urdf_arm()?.ok_or_else(|| {
             SimError::setting("arm.urdf", "is required to run a scenario in joint space")
         })?;
+        let joint_limits = JointLimits::of(&robot)?;
         let n = model.n_links();
         if self.controller.kind != ControllerKind::ComputedTorque {
             return Err(SimError::setting(
@@ -229,8 +239,86 @@ impl Scenario {
             kp,
             kd,
             max_joint_error: self.limits.max_modal_error,
+            effort_limits: joint_limits.efforts,
+            position_limits: joint_limits.positions,
+            damping: joint_limits.damping,
         };
         run_chain_loop(&model, reference.as_mut(), &q0, &settings)
+    }
+}
+
+/// What the joint-space loop keeps of a URDF's `<limit>` and `<dynamics>`, one entry per
+/// movable joint (each list empty when no joint sets it): the effort limits (`effort`; absent
+/// or 0, urdfdom's default, for none), the position ranges (`lower`, `upper` of revolute and
+/// prismatic joints; a continuous joint's is unbounded) and the viscous damping.
+struct JointLimits {
+    efforts: Vec<f64>,
+    positions: Vec<[f64; 2]>,
+    damping: Vec<f64>,
+}
+
+impl JointLimits {
+    /// The limits of `robot`'s joints.
+    ///
+    /// # Errors
+    /// [`SimError::InvalidSetting`] naming `arm.urdf` and the joint for a dry friction
+    /// (`<dynamics friction>` above 0), which the loop does not simulate.
+    fn of(robot: &robot_desc::Robot) -> Result<Self, SimError> {
+        let joints = &robot.joints;
+        if let Some((i, joint, friction)) = joints.iter().enumerate().find_map(|(i, joint)| {
+            let friction = joint.dynamics.and_then(|d| d.friction)?;
+            (friction > 0.0).then_some((i, joint, friction))
+        }) {
+            return Err(SimError::setting(
+                "arm.urdf",
+                format!(
+                    "joint {} ({}): <dynamics friction=\"{friction}\"> (dry friction) is not \
+                     simulated by the joint-space loop: remove it or set it to 0",
+                    i + 1,
+                    lane_math::one_line(&joint.name),
+                ),
+            ));
+        }
+        let limit = |joint: &robot_desc::Joint| joint.limits.unwrap_or_default();
+        let efforts: Vec<f64> = joints
+            .iter()
+            .map(|joint| match limit(joint).effort {
+                Some(effort) if effort > 0.0 => effort,
+                _ => f64::INFINITY,
+            })
+            .collect();
+        let positions: Vec<[f64; 2]> = joints
+            .iter()
+            .map(|joint| match joint.kind {
+                robot_desc::JointKind::Continuous => [f64::NEG_INFINITY, f64::INFINITY],
+                _ => [
+                    limit(joint).lower.unwrap_or(f64::NEG_INFINITY),
+                    limit(joint).upper.unwrap_or(f64::INFINITY),
+                ],
+            })
+            .collect();
+        let damping: Vec<f64> = joints
+            .iter()
+            .map(|joint| joint.dynamics.and_then(|d| d.damping).unwrap_or(0.0))
+            .collect();
+        let any = |values: &[f64], none: f64| values.iter().any(|&v| v != none);
+        Ok(Self {
+            efforts: if any(&efforts, f64::INFINITY) {
+                efforts
+            } else {
+                Vec::new()
+            },
+            positions: if positions.iter().flatten().any(|v| v.is_finite()) {
+                positions
+            } else {
+                Vec::new()
+            },
+            damping: if any(&damping, 0.0) {
+                damping
+            } else {
+                Vec::new()
+            },
+        })
     }
 }
 
@@ -272,6 +360,45 @@ mod tests {
             .run_chain()
             .unwrap();
         assert!(sine.summary.final_error < 5e-3, "{:?}", sine.summary);
+    }
+
+    #[test]
+    fn the_urdf_limits_and_damping_act_on_the_run() {
+        // arm7.urdf's efforts: 150, 150, 80, 80, 40, 20, 10 N m; the sine asks more of joints
+        // 2, 4 and 6, which saturate at theirs.
+        let sine = Scenario::load(&example("sine.toml")).unwrap();
+        let run = sine.run_chain().unwrap();
+        let efforts = [150.0, 150.0, 80.0, 80.0, 40.0, 20.0, 10.0];
+        let peaks = &run.summary.peak_joint_efforts;
+        assert!(peaks.iter().zip(efforts).all(|(p, e)| *p <= e), "{peaks:?}");
+        for joint in [1, 3, 5] {
+            assert_eq!(peaks[joint], efforts[joint]);
+        }
+        assert!(run.summary.effort_limited_share > 0.0);
+        // The same arm written with damping and with friction.
+        let text = std::fs::read_to_string(example("arm7.urdf")).unwrap();
+        let dir = std::env::temp_dir().join(format!("hrm-chain-dynamics-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let with = |dynamics: &str| {
+            let path = dir.join("arm.urdf");
+            let edited = text.replacen("</joint>", &format!("{dynamics}</joint>"), 1);
+            std::fs::write(&path, edited).unwrap();
+            let mut scenario = Scenario::load(&example("step.toml")).unwrap();
+            scenario.arm.urdf = Some(path);
+            scenario.run_chain()
+        };
+        let step = Scenario::load(&example("step.toml"))
+            .unwrap()
+            .run_chain()
+            .unwrap();
+        let damped = with("<dynamics damping=\"0.5\"/>").unwrap();
+        assert_ne!(damped.record.q, step.record.q);
+        let e = with("<dynamics friction=\"2\"/>").unwrap_err().to_string();
+        assert!(
+            e.starts_with("arm.urdf joint 1 (joint1): <dynamics friction=\"2\"> (dry friction)"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

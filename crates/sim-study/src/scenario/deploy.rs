@@ -358,6 +358,9 @@ impl Scenario {
             kp,
             kd,
             max_joint_error: self.limits.max_modal_error,
+            effort_limits: Vec::new(),
+            position_limits: Vec::new(),
+            damping: Vec::new(),
         };
         let mut tracked = wrap(Box::new(reference.clone()));
         let outcome = if mpc {
