@@ -194,6 +194,10 @@ fn load_main_job(dir: &Path) -> Result<Vec<Scene>, String> {
             });
         }
     }
+    let csv = dir.join("timeseries.csv");
+    if scenes.is_empty() && csv.exists() && !csv.is_file() {
+        return Err(format!("{}: not a regular file", csv.display()));
+    }
     if scenes.is_empty() {
         return Err(format!(
             "{}: neither an `hrm simulate` output (no timeseries.csv) nor a main job's (no SCENARIO/CONTROLLER/timeseries.csv)",
@@ -251,7 +255,9 @@ fn load_run(dir: &Path, label: Option<&str>) -> Result<(Scenario, RunView), Stri
     let csv = dir.join("timeseries.csv");
     let text = read_text_file(&csv, MAX_TIMESERIES_BYTES)
         .map_err(|e| format!("{}: {e}", csv.display()))?;
-    let record = parse_timeseries(&text, &scenario, n_joints)
+    // A byte-order mark (an editor's) before the header is not part of the column `t`.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let record = parse_timeseries(text, &scenario, n_joints)
         .map_err(|e| format!("{}: {e}", csv.display()))?;
     let label = label.unwrap_or(scenario.controller.kind.name());
     let view = run_view::from_record(&scenario, label, &record, stopped.as_deref())
@@ -323,7 +329,13 @@ fn parse_timeseries(text: &str, scenario: &Scenario, n_joints: usize) -> Result<
             } else {
                 run_view::MAX_MAGNITUDE
             };
-            if value.is_nan() || value.abs() > max {
+            if value.is_nan() {
+                return Err(format!(
+                    "line {}: column {name}: NaN is not a value a run writes",
+                    line + 2
+                ));
+            }
+            if value.abs() > max {
                 return Err(format!(
                     "line {}: column {name}: {} is beyond the {} a run writes",
                     line + 2,

@@ -246,7 +246,7 @@ impl Chain {
     fn __repr__(&self) -> String {
         let mass: f64 = self.model.links().iter().map(|l| l.mass).sum();
         format!(
-            "Chain(name={:?}, joints={}, moving_mass={mass}, gravity={:?})",
+            "Chain(name={:?}, joints={}, moving_mass={mass:?}, gravity={:?})",
             self.robot.name,
             self.n(),
             self.model.gravity()

@@ -242,10 +242,9 @@ fn to_toml_at(value: &Bound<'_, PyAny>, name: &str, depth: usize) -> PyResult<to
         }
         return match value.extract::<u64>() {
             Ok(u) => Ok(toml::Value::String(u.to_string())),
-            Err(_) => Err(Error::input(format!(
-                "{name}: the integer {value} does not fit 64 bits"
-            ))
-            .into()),
+            Err(_) => {
+                Err(Error::input(format!("{name}: an integer that does not fit 64 bits")).into())
+            }
         };
     }
     if let Ok(f) = value.cast::<PyFloat>() {

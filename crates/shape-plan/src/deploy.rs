@@ -143,8 +143,8 @@ pub fn follow_the_leader(
         let base_sigma = sigma[0];
         if base_sigma > 1e-12 * length {
             return Err(PlanError::OutOfRange {
-                name: "deploy depth (the base would pass the entry: the arm is too short)",
-                bound: "reachable with the base behind the entry",
+                name: "deploy.centerline's length (the base would pass the entry: the arm is too short for it)",
+                bound: "at most what the arm reaches with its base behind the entry",
                 value: depth,
             });
         }

@@ -986,6 +986,24 @@ fn hrm_view_writes_a_page_and_a_gif_and_replaces_only_its_own_files() {
     .unwrap();
     let line = refused(&hrm(&["view", path(&run)]));
     assert!(line.contains("line 2: more values than the"), "{line}");
+    std::fs::write(&csv, text.replacen("\n0,", "\nNaN,", 1)).unwrap();
+    let line = refused(&hrm(&["view", path(&run)]));
+    assert!(
+        line.contains("line 2: column t: NaN is not a value a run writes"),
+        "{line}"
+    );
+    // An editor's byte-order mark before the header is no part of the column `t`.
+    std::fs::write(&csv, format!("\u{feff}{text}")).unwrap();
+    assert!(hrm(&["view", path(&run)]).status.success());
+    // A time series that is not a regular file is named as such, not as missing.
+    std::fs::remove_file(&csv).unwrap();
+    std::fs::create_dir(&csv).unwrap();
+    let line = refused(&hrm(&["view", path(&run)]));
+    assert!(
+        line.ends_with("timeseries.csv: not a regular file"),
+        "{line}"
+    );
+    std::fs::remove_dir(&csv).unwrap();
     std::fs::write(&csv, text).unwrap();
     // An arm the scenario file cannot have is that file's fault, not the time series'.
     let toml = run.join("scenario.toml");

@@ -178,6 +178,16 @@ impl Scenario {
         })?;
         let joint_limits = JointLimits::of(&robot)?;
         let n = model.n_links();
+        if n > sim_core::MAX_COORDINATES {
+            return Err(SimError::setting(
+                "arm.urdf",
+                format!(
+                    "has {n} movable joints, more than the {} a joint-space run follows",
+                    sim_core::MAX_COORDINATES
+                ),
+            )
+            .into());
+        }
         if self.controller.kind != ControllerKind::ComputedTorque {
             return Err(SimError::setting(
                 "controller.kind",

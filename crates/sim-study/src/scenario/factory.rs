@@ -292,7 +292,7 @@ impl ArmSpec {
             return Err(SimError::setting(
                 "arm.urdf",
                 "names a spatial chain, which runs only in the joint-space loop \
-                 (Scenario::run_chain, as `hrm simulate` runs it), not as a planar arm",
+                 (`hrm simulate --scenario FILE` runs it; Python and sweeps run modal arms), not as a planar arm",
             ));
         }
         if self.kind == ArmKind::Spatial {
