@@ -97,7 +97,8 @@ pub fn read_urdf(text: &str) -> Result<Reading, DescError> {
     let doc = Document::parse_with_options(text, options).map_err(DescError::Xml)?;
     check_shape(&doc)?;
     let root = doc.root_element();
-    if root.tag_name().name() != "robot" {
+    // A prefixed `<x:robot>` is another vocabulary's element, as `<xacro:link>` is no link.
+    if root.tag_name().name() != "robot" || root.tag_name().namespace().is_some() {
         return Err(DescError::invalid(
             format!("<{}>", root.tag_name().name()),
             "the document's element must be <robot>",
@@ -778,10 +779,11 @@ fn assemble(
     while let Some((j, placement)) = next {
         let joint = chain.joints[j].take().expect("a joint has one parent link");
         let (body, after) = weld(chain.child_of[j], &mut chain, &mut visited, report)?;
+        let origin = within_bounds(placement.compose(&joint.origin), &joint.name)?;
         movable.push(Joint {
             name: joint.name,
             kind: joint.kind.expect("weld hands on movable joints only"),
-            origin: placement.compose(&joint.origin),
+            origin,
             axis: joint.axis,
             limits: joint.limits,
             dynamics: joint.dynamics,
@@ -857,7 +859,7 @@ fn weld(
             let welded = chain.links[child]
                 .take()
                 .expect("a link has one parent joint");
-            let at = placement.compose(&joint.origin);
+            let at = within_bounds(placement.compose(&joint.origin), &joint.name)?;
             if !welded.body.inertial.is_massless() {
                 body.inertial = body.inertial.merged(&welded.body.inertial, &at);
             }
@@ -879,6 +881,22 @@ fn weld(
         }
     }
     Ok((body, movable))
+}
+
+/// `origin`, the frame of joint `name` composed through the fixed joints before it, if its
+/// translation is within [`MAX_MAGNITUDE`] as every written origin is (2,000 fixed joints of
+/// `1e9` m each compose to `2e12`, which no URDF written back could hold).
+fn within_bounds(origin: Pose, name: &str) -> Result<Pose, DescError> {
+    match origin.xyz.iter().find(|x| x.abs() > MAX_MAGNITUDE) {
+        None => Ok(origin),
+        Some(x) => Err(DescError::invalid(
+            format!("joint '{}'", lane_math::one_line(name)),
+            format!(
+                "its origin composed through the fixed joints before it is {x:e} m from the \
+                 base, more than {MAX_MAGNITUDE:e}"
+            ),
+        )),
+    }
 }
 
 /// The links and joints not yet taken into bodies, and the chain's connectivity.

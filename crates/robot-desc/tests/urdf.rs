@@ -599,6 +599,32 @@ fn what_is_not_a_serial_chain_is_refused_naming_the_element() {
     );
     refused("<model name=\"x\"/>", &["<model>", "must be <robot>"]);
     refused(
+        "<x:robot xmlns:x=\"urn:x\" name=\"r\"><x:link name=\"a\"/></x:robot>",
+        &["<robot>", "must be <robot>"],
+    );
+    // 2,000 fixed joints of 1e9 m each: every origin within its bound, their composition not.
+    let mut deep = String::from("<robot name=\"r\"><link name=\"l0\"/>");
+    for i in 0..2000 {
+        deep += &format!(
+            "<joint name=\"f{i}\" type=\"fixed\"><origin xyz=\"1e9 0 0\"/><parent link=\"l{i}\"/>\
+             <child link=\"l{}\"/></joint><link name=\"l{}\"/>",
+            i + 1,
+            i + 1
+        );
+    }
+    deep += "<joint name=\"j\" type=\"continuous\"><parent link=\"l2000\"/><child link=\"t\"/></joint>\
+             <link name=\"t\"><inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" \
+             iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link></robot>";
+    refused(
+        &deep,
+        &[
+            "joint 'f1'",
+            "composed through the fixed joints",
+            "2e9 m",
+            "more than 1e9",
+        ],
+    );
+    refused(
         "<robot name=\"x\"><link name=\"a\">",
         &["not a readable XML document"],
     );
