@@ -1526,16 +1526,10 @@ fn decrease(mu: &mut f64, delta: &mut f64, settings: &IlqrSettings) {
 mod tests {
     use super::*;
 
-    /// `count` pseudo-random numbers in `[-1, 1)` (a linear congruential sequence from `seed`).
+    /// `count` scrambled numbers in `[-1, 1]`: sines of an irrational progression from `seed`.
     fn numbers(count: usize, seed: u64) -> Vec<f64> {
-        let mut state = seed;
         (0..count)
-            .map(|_| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-            })
+            .map(|i| (1e3 * (seed as f64 + 0.618_034 * i as f64)).sin())
             .collect()
     }
 
