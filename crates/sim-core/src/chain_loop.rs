@@ -22,7 +22,9 @@ use crate::controller::ChainMpcController;
 use crate::error::{SimError, StoppedRun, check_positive};
 use crate::ode::{OdeSystem, Rk4};
 use crate::reference::{Reference, ReferenceSample};
-use crate::simulation::{MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS, MAX_RUN_WORK};
+use crate::simulation::{
+    MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS, MAX_RUN_WORK, run_work_refusal,
+};
 use lane_math::Compact;
 use lane_math::check_all_finite;
 use manip_dyn::DynError;
@@ -318,15 +320,15 @@ fn check_chain_work(
     } else {
         format!(", {law:.2e} of the control law")
     };
-    Err(SimError::setting(
-        "duration",
-        format!(
-            "= {} s would take an estimated {work:.2e} operations ({plant:.2e} for {} RK4 steps \
-             of the {n}-joint chain{controller}), more than the {MAX_RUN_WORK:e} a run may take \
-             (about ten minutes): simulate less, or use a longer integrator.dt or fewer joints",
-            Compact(settings.duration),
-            Compact(steps),
-        ),
+    let parts = format!(
+        "{plant:.2e} for {} RK4 steps of the {n}-joint chain{controller}",
+        Compact(steps)
+    );
+    Err(run_work_refusal(
+        settings.duration,
+        work,
+        &parts,
+        "a longer integrator.dt or fewer joints",
     ))
 }
 

@@ -1137,23 +1137,29 @@ fn check_run_work(
         if controller_work > 0.0 {
             parts += &format!(", {controller_work:.2e} of the controller's own");
         }
-        return Err(SimError::setting(
-            "duration",
-            format!(
-                "= {} s would take an estimated {work:.2e} operations ({parts}), more than the \
-                 {MAX_RUN_WORK:e} a run may take (about ten minutes): simulate less, or use \
-                 fewer links, harmonics or obstacles{}",
-                Compact(s.duration),
-                if controller_work > 0.0 {
-                    ", or a controller of less work (another kind than this MPC, or in Rust \
-                     MpcSettings of a shorter horizon or fewer iterations)"
-                } else {
-                    ""
-                }
-            ),
-        ));
+        let advice = if controller_work > 0.0 {
+            "fewer links, harmonics or obstacles, or a controller of less work (another kind \
+             than this MPC, or in Rust MpcSettings of a shorter horizon or fewer iterations)"
+        } else {
+            "fewer links, harmonics or obstacles"
+        };
+        return Err(run_work_refusal(s.duration, work, &parts, advice));
     }
     Ok(work)
+}
+
+/// The refusal of a run of `duration` seconds whose estimated `work` (made of `parts`) exceeds
+/// [`MAX_RUN_WORK`], with `advice` on what to use instead (the modal loop's and the joint-space
+/// loop's).
+pub(crate) fn run_work_refusal(duration: f64, work: f64, parts: &str, advice: &str) -> SimError {
+    SimError::setting(
+        "duration",
+        format!(
+            "= {} s would take an estimated {work:.2e} operations ({parts}), more than the \
+             {MAX_RUN_WORK:e} a run may take (about ten minutes): simulate less, or use {advice}",
+            Compact(duration),
+        ),
+    )
 }
 
 /// The most fixed steps an RK4 run may take (`duration / integrator.dt`): about half an hour of
