@@ -159,23 +159,24 @@ pub enum FieldProblem {
     },
     /// A value beyond the magnitude a run's numbers may have.
     #[error(
-        "value {index} is {}, more than {} in magnitude",
+        "{}{}, more than {} in magnitude",
+        value_at(*index),
         lane_math::Compact(*value),
         lane_math::Compact(*max)
     )]
     TooLarge {
-        /// Its index (0-based).
-        index: usize,
+        /// Its index (0-based) in a list of numbers, `None` for a single number.
+        index: Option<usize>,
         /// The value.
         value: f64,
         /// The largest magnitude allowed.
         max: f64,
     },
     /// A value that is not finite.
-    #[error("value {index} is {value}, not finite")]
+    #[error("{}{value}, not finite", value_at(*index))]
     NotFinite {
-        /// Its index (0-based).
-        index: usize,
+        /// Its index (0-based) in a list of numbers, `None` for a single number.
+        index: Option<usize>,
         /// The value.
         value: f64,
     },
@@ -289,4 +290,9 @@ impl Classify for ViewError {
             _ => ErrorClass::InvalidInput,
         }
     }
+}
+
+/// `value 3 is ` before the 4th value of a list, nothing before a single number.
+fn value_at(index: Option<usize>) -> String {
+    index.map_or_else(String::new, |index| format!("value {index} is "))
 }

@@ -348,6 +348,7 @@ pub(crate) fn count(
 /// Every value of `values` finite and at most `max` in magnitude.
 fn finite(field: &str, values: &[f64], max: f64) -> Result<(), ViewError> {
     if let Some((index, value)) = lane_math::first_non_finite(values) {
+        let index = listed(values, index);
         return Err(ViewError::field(
             field,
             FieldProblem::NotFinite { index, value },
@@ -363,13 +364,18 @@ fn bounded(field: &str, values: &[f64], max: f64) -> Result<(), ViewError> {
         Some(index) => Err(ViewError::field(
             field,
             FieldProblem::TooLarge {
-                index,
+                index: listed(values, index),
                 value: values[index],
                 max,
             },
         )),
         None => Ok(()),
     }
+}
+
+/// The index of a value in a list of several, `None` for a field of one number.
+fn listed(values: &[f64], index: usize) -> Option<usize> {
+    (values.len() > 1).then_some(index)
 }
 
 /// Every value of `values` finite, positive and at most `max`.

@@ -208,7 +208,7 @@ fn bad_data_is_refused_naming_the_field() {
             Box::new(|r| r.t[4] = 1e16),
         ),
         (
-            "obstacles[1].radius: value 0 is 1e300, more than 1e15 in magnitude",
+            "obstacles[1].radius: 1e300, more than 1e15 in magnitude",
             Box::new(|r| {
                 if let Obstacle::Capsule { radius, .. } = &mut r.obstacles[1] {
                     *radius = 1e300;
