@@ -157,7 +157,7 @@ impl Sweep {
         let file = pool::run(py, &cancel, || {
             study::run_shard_until(&self.config, shard, || {}, || cancel.is_set())
         })?
-        .ok_or_else(|| input(study::StudyError::Stopped))?;
+        .map_err(input)?;
         if let Some(changed) = study::changed_input(&self.config).map_err(input)? {
             return Err(input(study::StudyError::InputChanged { input: changed }));
         }

@@ -5,6 +5,7 @@ the messages of wrong arguments. Whatever could hang or kill the interpreter run
 subprocess with a timeout."""
 
 import copy
+import json
 import math
 import os
 import pickle
@@ -664,3 +665,14 @@ def test_modal_coordinates_are_bounded_as_a_run_bounds_them():
     # At the bound the answer is the arithmetic's: theta = J a + theta_0 to rounding.
     a = np.array([1e6, -1e6, 0.5])
     assert np.allclose(reduced.joint_angles(a), reduced.jacobian @ a, rtol=0, atol=1e-9)
+
+
+def test_a_sweep_of_too_much_work_is_refused_until_split_into_shards():
+    # Ten million runs of 2 s: refused at once; a shard of ten of them runs.
+    levels = [0.01 * k for k in range(10)]
+    sweep = hrm.Sweep("paper-responses-step", noise_levels=levels, seeds=10**6, controllers=["pd"])
+    with pytest.raises(hrm.InvalidInput, match=r"^runs: the 10000000 runs of shard 1/1 would take an estimated .* more than the 1e14 one shard may take"):
+        sweep.run()
+    lines = sweep.run_shard(3, 10**6).splitlines()
+    assert len(lines) == 11
+    assert json.loads(lines[0])["shard"] == {"index": 3, "count": 10**6}

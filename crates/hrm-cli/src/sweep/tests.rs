@@ -200,6 +200,30 @@ fn bad_settings_are_refused_before_running() {
     ))
     .unwrap_err();
     assert_eq!(err, "--controllers lists pd twice");
+    // Ten million runs of 2 s: refused before any runs, without a folder; the same sweep split
+    // into a million shards runs its shard.
+    let huge = [
+        "--scenario",
+        "paper-responses-step",
+        "--controllers",
+        "pd",
+        "--noise",
+        "0,0.01,0.02,0.03,0.04,0.05,0.06,0.07,0.08,0.09",
+        "--seeds",
+        "1000000",
+    ];
+    let fresh = temp_dir("too-much-work");
+    let fresh_out = fresh.join("out");
+    let err = hrm_sweep(&with(&huge, &["--out", fresh_out.to_str().unwrap()])).unwrap_err();
+    assert!(
+        err.starts_with("runs: the 10000000 runs of shard 1/1 would take an estimated"),
+        "{err}"
+    );
+    assert!(!fresh_out.exists());
+    let sharded = with(&huge, &["--duration", "0.01", "--shard", "7/1000000"]);
+    hrm_sweep(&with(&sharded, &["--out", fresh_out.to_str().unwrap()])).unwrap();
+    let shard = read(&fresh_out.join("shard-7-of-1000000.json"));
+    assert_eq!(shard.lines().count(), 11, "a header and ten runs");
 }
 
 /// The acceptance test of sharding: three shards merged give exactly the unsharded report.
@@ -331,7 +355,7 @@ fn small_config(levels: &[f64], seeds: usize) -> SweepConfig {
 #[test]
 fn a_run_in_a_sweep_is_the_scenario_run_alone_with_its_seed() {
     let config = small_config(&[0.0, 0.01], 2);
-    let whole = study::run_shard(&config, Shard::WHOLE, || {});
+    let whole = study::run_shard(&config, Shard::WHOLE, || {}).unwrap();
     for run in &whole.runs {
         let mut scenario = Scenario::builtin("paper-responses-step").unwrap();
         scenario.duration = 0.15;
@@ -352,7 +376,7 @@ fn a_run_in_a_sweep_is_the_scenario_run_alone_with_its_seed() {
 #[test]
 fn noise_spreads_the_errors_and_no_noise_does_not() {
     let config = small_config(&[0.0, 0.01], 4);
-    let whole = study::run_shard(&config, Shard::WHOLE, || {});
+    let whole = study::run_shard(&config, Shard::WHOLE, || {}).unwrap();
     let cells = study::cells(&config, &whole.runs);
     let kinds = ControllerKind::ALL.len();
     assert_eq!(cells.len(), 2 * kinds);
@@ -429,7 +453,7 @@ fn a_thousand_short_runs_complete_without_nan() {
     .unwrap();
     let config = configure(&args.sweep).unwrap();
     assert_eq!(config.runs(), Some(1000));
-    let whole = study::run_shard(&config, Shard::WHOLE, || {});
+    let whole = study::run_shard(&config, Shard::WHOLE, || {}).unwrap();
     let text = whole.to_json().unwrap();
     let parsed = ShardFile::parse(&text, Path::new("memory")).unwrap();
     let cells = study::cells(&parsed.config, &parsed.runs);

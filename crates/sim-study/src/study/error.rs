@@ -112,6 +112,23 @@ pub enum StudyError {
     /// The caller's `stop` ended the runs.
     #[error("the sweep was stopped before all its runs were done")]
     Stopped,
+    /// The runs one invocation would run exceed [`MAX_SHARD_WORK`](super::MAX_SHARD_WORK).
+    #[error(
+        "runs: the {runs} runs of shard {shard} would take an estimated {work:.2e} operations, \
+         more than the {max:e} one shard may take (about a day of computing): split the sweep \
+         into more shards (--shard K/N under Slurm, Sweep.run_shard(k, n) under Dask) or give \
+         fewer seeds, noise levels or controllers"
+    )]
+    TooMuchWork {
+        /// The shard, `K/N` (`1/1` for the whole sweep).
+        shard: Shard,
+        /// Its runs.
+        runs: usize,
+        /// Their estimated work, in the units of [`sim_core::MAX_RUN_WORK`].
+        work: f64,
+        /// The limit.
+        max: f64,
+    },
     /// A file or folder cannot be read, listed or written.
     #[error("cannot {action} {}: {cause}", path.display())]
     Io {

@@ -19,12 +19,13 @@
 //!     ..SweepSettings::default()
 //! };
 //! let config = SweepConfig::new(scenario, settings)?;
-//! let whole = run_shard(&config, Shard::WHOLE, || {});
+//! let whole = run_shard(&config, Shard::WHOLE, || {})?;
 //! let halves = (1..=2).map(|index| {
 //!     let shard = Shard { index, count: 2 };
-//!     (std::path::PathBuf::from(format!("shard-{index}")), run_shard(&config, shard, || {}))
+//!     let file = run_shard(&config, shard, || {})?;
+//!     Ok((std::path::PathBuf::from(format!("shard-{index}")), file))
 //! });
-//! let merged = merge(halves.collect())?;
+//! let merged = merge(halves.collect::<Result<_, sim_study::study::StudyError>>()?)?;
 //! assert_eq!(merged, whole);
 //! let table = cells(&config, &whole.runs);
 //! assert_eq!(table.len(), 2); // one cell per noise level and controller
@@ -66,6 +67,12 @@ use std::io::Write;
 /// every core busy, few enough that the batch's results take little memory (a few hundred
 /// kilobytes).
 const BATCH_RUNS: usize = 1024;
+
+/// The most work one shard (or a whole sweep run as one) may take, in the units of
+/// [`sim_core::MAX_RUN_WORK`] (which bounds a run at about ten minutes): about a day of
+/// computing, so that a count typed `10000000` for `1000` is refused up front rather than
+/// running for months; a larger study splits into shards (Slurm, Dask).
+pub const MAX_SHARD_WORK: f64 = 1e14;
 
 /// The toolkit version recorded in a sweep's configuration: shards merge only when theirs agree.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -198,6 +205,7 @@ pub fn for_each_run_until(
             prepared.push((kind, config.prepare(kind)));
         }
     }
+    check_shard_work(config, shard, &prepared)?;
     loop {
         let batch: Vec<usize> = indices.by_ref().take(BATCH_RUNS).collect();
         if batch.is_empty() {
@@ -227,28 +235,80 @@ pub fn for_each_run_until(
     }
 }
 
-/// Runs the runs of `shard` and keeps them in memory (see [`write_shard`] to stream them to a
-/// file); the results are in index order. [`Shard::WHOLE`] runs the whole sweep.
-pub fn run_shard(config: &SweepConfig, shard: Shard, progress: impl Fn() + Sync) -> ShardFile {
-    run_shard_until(config, shard, progress, || false)
-        .expect("pushing to a vector cannot fail and nothing stops the runs")
+/// Refuses a shard whose runs' estimated work exceeds [`MAX_SHARD_WORK`]: each run's
+/// [`Simulation::work`](sim_core::Simulation::work), built from its controller's `prepared`
+/// simulation at the noise of the shard's first run of that controller (a controller that
+/// cannot be built makes runs that fail at once: no work).
+fn check_shard_work(
+    config: &SweepConfig,
+    shard: Shard,
+    prepared: &[(ControllerKind, Result<Prepared, SimError>)],
+) -> Result<(), StudyError> {
+    let runs = config.runs().unwrap_or(0);
+    let mut work_of = Vec::with_capacity(prepared.len());
+    for (kind, prepared) in prepared {
+        let first = shard
+            .indices(runs)
+            .map(|i| config.run_at(i))
+            .find(|id| id.controller == *kind);
+        let work = match (first, prepared) {
+            (Some(id), Ok(prepared)) => config
+                .run_noise(&id)
+                .and_then(|noise| prepared.simulation(&noise))
+                .map_or(0.0, |simulation| simulation.work()),
+            _ => 0.0,
+        };
+        work_of.push((*kind, work));
+    }
+    let work: f64 = shard
+        .indices(runs)
+        .map(|i| {
+            let controller = config.run_at(i).controller;
+            work_of
+                .iter()
+                .find(|(kind, _)| *kind == controller)
+                .map_or(0.0, |(_, work)| *work)
+        })
+        .sum();
+    if work > MAX_SHARD_WORK {
+        return Err(StudyError::TooMuchWork {
+            shard,
+            runs: shard.run_count(runs),
+            work,
+            max: MAX_SHARD_WORK,
+        });
+    }
+    Ok(())
 }
 
-/// [`run_shard`], checking `stop` before each lock-step group ([`for_each_run_until`]): `None`
-/// once it returned true.
+/// Runs the runs of `shard` and keeps them in memory (see [`write_shard`] to stream them to a
+/// file); the results are in index order. [`Shard::WHOLE`] runs the whole sweep.
+///
+/// # Errors
+/// [`StudyError::TooMuchWork`] for a shard of more than [`MAX_SHARD_WORK`].
+pub fn run_shard(
+    config: &SweepConfig,
+    shard: Shard,
+    progress: impl Fn() + Sync,
+) -> Result<ShardFile, StudyError> {
+    run_shard_until(config, shard, progress, || false)
+}
+
+/// [`run_shard`], checking `stop` before each lock-step group ([`for_each_run_until`]):
+/// [`StudyError::Stopped`] once it returned true.
 pub fn run_shard_until(
     config: &SweepConfig,
     shard: Shard,
     progress: impl Fn() + Sync,
     stop: impl Fn() -> bool + Sync,
-) -> Option<ShardFile> {
-    let mut runs = Vec::with_capacity(shard.run_count(config.runs().unwrap_or(0)));
+) -> Result<ShardFile, StudyError> {
+    let runs_in_shard = shard.run_count(config.runs().unwrap_or(0));
+    let mut runs = Vec::with_capacity(runs_in_shard.min(BATCH_RUNS));
     for_each_run_until(config, shard, progress, stop, |run| {
         runs.push(run);
         Ok(())
-    })
-    .ok()?;
-    Some(ShardFile {
+    })?;
+    Ok(ShardFile {
         format: FORMAT.into(),
         config: config.clone(),
         shard,

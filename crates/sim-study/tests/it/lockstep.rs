@@ -364,7 +364,7 @@ fn a_sweep_in_lock_step_gives_every_run_as_run_alone() {
     let config = SweepConfig::new(scenario, settings).unwrap();
     assert_eq!(study::lockstep_size(&config), lanes);
     for shard in [Shard::WHOLE, Shard { index: 2, count: 3 }] {
-        let whole = study::run_shard(&config, shard, || {});
+        let whole = study::run_shard(&config, shard, || {}).unwrap();
         let indices: Vec<usize> = shard.indices(config.runs().unwrap()).collect();
         assert_eq!(whole.runs.len(), indices.len());
         let mut failed = 0;
