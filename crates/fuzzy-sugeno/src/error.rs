@@ -209,6 +209,20 @@ pub enum FuzzyError {
         /// The longest prefix allowed.
         max: usize,
     },
+    /// A C export's prefix that names its header like a C standard header (`math.h`, which the
+    /// source includes; any, in any case, which a compiler given the export's folder with `-I`
+    /// would take instead of the system's).
+    #[error(
+        "export: the prefix {prefix:?} would write {prefix}.h, which shadows the C standard \
+         header <{standard}.h> for code compiled with the export's folder on its include path; \
+         choose another prefix"
+    )]
+    CPrefixShadowsHeader {
+        /// The prefix given.
+        prefix: String,
+        /// The standard header's name without `.h`.
+        standard: &'static str,
+    },
     /// A name of the system cannot be written in FCL.
     #[error(
         "export: the {kind} name '{name}' cannot be written in FCL: a name must be ASCII \

@@ -78,8 +78,53 @@ fn check_prefix(prefix: &str) -> Result<(), FuzzyError> {
             max: MAX_PREFIX,
         });
     }
-    Ok(())
+    match STANDARD_HEADERS
+        .iter()
+        .find(|name| name.eq_ignore_ascii_case(prefix))
+    {
+        Some(standard) => Err(FuzzyError::CPrefixShadowsHeader {
+            prefix: prefix.to_string(),
+            standard,
+        }),
+        None => Ok(()),
+    }
 }
+
+/// The headers of the C standard library (C99, C11, C23) without `.h`: a prefix naming one
+/// (in any case, for case-insensitive file systems) would write a header that shadows it.
+const STANDARD_HEADERS: [&str; 31] = [
+    "assert",
+    "complex",
+    "ctype",
+    "errno",
+    "fenv",
+    "float",
+    "inttypes",
+    "iso646",
+    "limits",
+    "locale",
+    "math",
+    "setjmp",
+    "signal",
+    "stdalign",
+    "stdarg",
+    "stdatomic",
+    "stdbit",
+    "stdbool",
+    "stdckdint",
+    "stddef",
+    "stdint",
+    "stdio",
+    "stdlib",
+    "stdnoreturn",
+    "string",
+    "tgmath",
+    "threads",
+    "time",
+    "uchar",
+    "wchar",
+    "wctype",
+];
 
 /// A C double literal that reads back as exactly `v` (Rust's shortest round-trip form, which
 /// is valid C), parenthesised when negative so that `x - (-1)` never becomes `x--1`.
@@ -91,9 +136,26 @@ fn lit(v: f64) -> String {
     }
 }
 
-/// A C comment's text: no `*/` inside.
+/// A C comment's text: no `*/` inside, and control, zero-width and bidirectional formatting
+/// characters written as `\u{202e}` (a right-to-left override in a name would make the
+/// source read otherwise than it compiles).
 fn comment(text: &str) -> String {
-    text.replace("*/", "* /")
+    let mut out = String::with_capacity(text.len());
+    for c in text.replace("*/", "* /").chars() {
+        if c.is_control() || is_invisible_format(c) {
+            let _ = write!(out, "{}", c.escape_unicode());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// Unicode's zero-width and bidirectional formatting characters (category `Cf` in the ranges
+/// that reorder or hide text): U+061C, U+200B to U+200F, U+202A to U+202E, U+2060 to U+2069,
+/// U+FEFF.
+fn is_invisible_format(c: char) -> bool {
+    matches!(c, '\u{061c}' | '\u{200b}'..='\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2060}'..='\u{2069}' | '\u{feff}')
 }
 
 fn header(system: &FuzzySystem, prefix: &str, options: &EvalOptions) -> String {

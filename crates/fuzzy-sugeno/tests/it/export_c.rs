@@ -297,3 +297,41 @@ fn a_system_without_rules_in_c_matches_rust() {
         "no-rules",
     );
 }
+
+/// Names with zero-width and bidirectional formatting characters (a right-to-left override
+/// would make the source read otherwise than it compiles) are written escaped in the export's
+/// comments, so that the compiler, warning on such characters under `-Werror`, takes it; a
+/// prefix naming a C standard header, in any case, is refused.
+#[test]
+fn hostile_names_are_escaped_and_standard_header_prefixes_refused() {
+    let text = include_str!("../../data/paper.fis")
+        .replacen("Name='da1'", "Name='da1 \u{202e}ltr'", 1)
+        .replacen("[System]\nName='", "[System]\nName='\u{200f}*/", 1);
+    let system = FuzzySystem::from_fis(&text).unwrap();
+    let c = system.to_c("hostile", &EvalOptions::default()).unwrap();
+    for text in [&c.header, &c.source] {
+        assert!(!text.contains(['\u{202e}', '\u{200f}']));
+    }
+    assert!(c.header.contains("da1 \\u{202e}ltr"), "{}", c.header);
+    assert!(c.source.contains("'\\u{200f}* /"), "{}", c.source);
+    let mut rng = Rng::new(3);
+    let points = (0..100)
+        .map(|_| (0, random_point(&system, &mut rng)))
+        .collect();
+    compare(vec![(system, EvalOptions::default())], points, "hostile");
+    for prefix in ["math", "Math", "stdio", "STDINT", "string"] {
+        let err = paper_controller()
+            .to_c(prefix, &EvalOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with(&format!(
+                "export: the prefix {prefix:?} would write {prefix}.h"
+            )),
+            "{err}"
+        );
+    }
+    paper_controller()
+        .to_c("mathematics", &EvalOptions::default())
+        .unwrap();
+}
