@@ -132,16 +132,22 @@ pub(super) const SERDE_MESSAGES: [&str; 7] = [
 /// mark.
 pub(super) const NESTED_PATH: &str = "\u{1}nested:";
 
-/// `"arm"`: an object of [`ArmSpec`] fields. Serde would also read a struct from an array of its
+/// `"arm"`: an object of [`ArmSpec`] fields but `radius` (a scenario's clearance, which no op
+/// uses: refused rather than ignored). Serde would also read a struct from an array of its
 /// fields in order, which no user means; anything but an object is refused.
 pub(super) fn arm_object<'de, D: Deserializer<'de>>(deserializer: D) -> Result<ArmSpec, D::Error> {
     match Value::deserialize(deserializer)? {
-        Value::Object(fields) => located(fields).map_err(|(path, message)| {
-            serde::de::Error::custom(match path {
+        Value::Object(fields) => match located::<ArmSpec>(fields) {
+            Ok(arm) if arm.radius.is_some() => Err(serde::de::Error::custom(format!(
+                "{NESTED_PATH}radius\u{1}not used by any op of hrm eval (it is a scenario's \
+                 clearance): remove it"
+            ))),
+            Ok(arm) => Ok(arm),
+            Err((path, message)) => Err(serde::de::Error::custom(match path {
                 Some(path) => format!("{NESTED_PATH}{path}\u{1}{message}"),
                 None => message,
-            })
-        }),
+            })),
+        },
         other => Err(serde::de::Error::custom(format!(
             "\"arm\" must be an object of arm fields, got {}",
             json_type(&other)

@@ -58,11 +58,6 @@ impl SpatialArmSpec {
     /// paper's link size (10 links of 0.1 m and 0.1 kg, slender rods) under gravity along `-z`.
     fn model(&self, harmonics: usize) -> Result<SpatialReducedModel, EvalError> {
         let arm = &self.0;
-        if arm.radius.is_some() {
-            return Err(EvalError::input(
-                "arm.radius is not used by the ops of a spatial arm (it is a scenario's clearance)",
-            ));
-        }
         let n = arm.link_count(arm.inertias.as_ref().map(Inertias::len))?;
         if n > MAX_SPATIAL_LINKS {
             return Err(EvalError::input(format!(
@@ -567,7 +562,17 @@ mod tests {
             ),
             (
                 json!({"op": "fk", "arm": {"kind": "spatial", "radius": 0.01}, "a": [0, 0, 0, 0]}),
-                "arm.radius is not used",
+                "arm.radius: not used by any op of hrm eval (it is a scenario's clearance): \
+                 remove it",
+            ),
+            (
+                json!({"op": "fk", "arm": {"radius": -1}, "a": [0.1, 0.2], "alpha0": 0}),
+                "arm.radius: not used by any op",
+            ),
+            (
+                json!({"op": "dynamics", "arm": {"radius": 1e308, "links": 1}, "theta": [0],
+                    "theta_dot": [0]}),
+                "arm.radius: not used by any op",
             ),
             (
                 json!({"op": "joints", "arm": {"kind": "spatial", "lengths": [0.1, 0.1, 0.1, 0.1],
