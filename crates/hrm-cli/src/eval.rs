@@ -195,6 +195,16 @@ fn answer(line: &[u8]) -> Value {
                 &EvalError::new(Kind::InvalidRequest, "a request must be a JSON object"),
             );
         }
+        Err(_) if text.starts_with('\u{feff}') => {
+            return error_answer(
+                Value::Null,
+                &EvalError::new(
+                    Kind::Parse,
+                    "malformed JSON: the line starts with a byte-order mark (U+FEFF), which a \
+                     JSON-lines request does not hold: write UTF-8 without a BOM",
+                ),
+            );
+        }
         Err(e) => {
             return error_answer(
                 Value::Null,

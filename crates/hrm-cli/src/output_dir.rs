@@ -76,7 +76,7 @@ impl OutputDir {
             Ok(_) if !replaceable(&target) => {
                 return Err(format!(
                     "output folder {}: exists and holds files that hrm did not write (no {MARKER} \
-                     marker); choose a new folder or empty this one",
+                     marker of hrm's); choose a new folder or empty this one",
                     shown.display()
                 ));
             }
@@ -454,6 +454,12 @@ fn stage_file(
         std::fs::create_dir_all(dir).map_err(|e| fail("cannot create the folder of", &e))?;
         std::fs::write(dir.join(MARKER), format!("written by `hrm {command}`\n"))
             .map_err(|e| fail("cannot create the folder of", &e))?;
+    }
+    if !dir.as_os_str().is_empty() && !dir.is_dir() {
+        return Err(format!(
+            "output folder {}: exists and is not a folder",
+            dir.display()
+        ));
     }
     check_name_length(path, name.len(), "partial")?;
     let path = dir.join(name);

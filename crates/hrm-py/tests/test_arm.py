@@ -173,6 +173,8 @@ def test_arm_parameters_are_checked_as_the_cli_does():
         hrm.Arm(links=0)
     with pytest.raises(hrm.InvalidInput, match=r"^arm.links must be at least 1, got -3$"):
         hrm.Arm(links=-3)
+    with pytest.raises(hrm.InvalidInput, match=r"^arm.lengths is empty: an arm has at least 1 link$"):
+        hrm.Arm(lengths=[])
     with pytest.raises(hrm.InvalidInput, match=r"^arm.links must be at most 1000000, got 1000000000$"):
         hrm.Arm(links=10**9)
     with pytest.raises(hrm.InvalidInput, match=r"^arm.links must be a whole number of at most 64 bits, got 10{30}$"):

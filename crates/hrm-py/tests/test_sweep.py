@@ -24,8 +24,14 @@ def test_plan():
     shards = [sweep.shard_runs(k, 5) for k in range(1, 6)]
     assert sorted(i for shard in shards for i in shard) == list(range(sweep.n_runs))
     assert shards[1] == [1, 6, 11]
-    with pytest.raises(hrm.InvalidInput, match="K/N"):
+    with pytest.raises(hrm.InvalidInput, match=r"^index must be from 1 to count \(5\), got 6$"):
         sweep.shard_runs(6, 5)
+    with pytest.raises(hrm.InvalidInput, match=r"^index must be from 1 to count \(2\), got 0$"):
+        sweep.run_shard(0, 2)
+    with pytest.raises(hrm.InvalidInput, match=r"^count must be from 1 to 10000000, got 0$"):
+        sweep.shard_runs(1, 0)
+    with pytest.raises(hrm.InvalidInput, match=r"^count must be from 1 to 10000000, got 10000001$"):
+        sweep.shard_runs(1, 10**7 + 1)
     assert sweep.config["settings"]["noise_levels"] == [0.0, 0.01] and sweep.scenario.duration == 0.1
     assert sweep.config["settings"]["controllers"] == ["pd", "fuzzy"] and sweep.config["settings"]["base_seed"] == 5
     with pytest.raises(hrm.InvalidInput, match="ascending"):

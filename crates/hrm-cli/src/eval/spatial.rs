@@ -499,6 +499,14 @@ mod tests {
                 "arm.links must be at least 1",
             ),
             (
+                json!({"op": "fk", "arm": {"lengths": []}, "a": [0.1, 0.2], "alpha0": 0}),
+                "arm.lengths is empty: an arm has at least 1 link",
+            ),
+            (
+                json!({"op": "joints", "arm": {"kind": "spatial", "masses": []}, "a": [0, 0, 0, 0]}),
+                "arm.masses is empty: an arm has at least 1 link",
+            ),
+            (
                 json!({"op": "joints", "arm": {"kind": "spatial", "lengths": [0.1, 0.2], "masses": [0.1]},
                     "a": [0, 0, 0, 0]}),
                 "arm.masses has 1 entries but the arm has 2 links",

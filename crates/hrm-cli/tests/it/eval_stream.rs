@@ -452,6 +452,15 @@ fn edge_case_lines_get_one_error_each_and_the_stream_goes_on() {
         let got = answer["error"]["kind"].as_str().unwrap_or("ok");
         assert_eq!(got, *kind, "{} -> {answer}", &line[..line.len().min(200)]);
     }
+    let bom = cases
+        .iter()
+        .position(|(line, _)| line.starts_with('\u{feff}'));
+    assert!(
+        answers[bom.unwrap()]["error"]["message"]
+            .as_str()
+            .unwrap()
+            .starts_with("malformed JSON: the line starts with a byte-order mark (U+FEFF)")
+    );
     assert_eq!(answers[cases.len()]["error"]["kind"], "invalid_utf8");
     assert_eq!(answers[cases.len() + 1], good_requests()[2].1);
 }

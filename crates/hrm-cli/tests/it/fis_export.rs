@@ -126,6 +126,26 @@ fn c_export_writes_the_header_and_source() {
     let stderr = String::from_utf8_lossy(&refused.stderr);
     assert_eq!(stderr.lines().count(), 1);
     assert!(stderr.starts_with("hrm: export: the prefix must be a C identifier"));
+    // An --out that is a file is named as such, and left as it was.
+    let file = dir.join("ctl.h");
+    let refused = hrm(&[
+        "fis",
+        "export",
+        "--format",
+        "c",
+        PAPER_FIS,
+        "--out",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8_lossy(&refused.stderr),
+        format!(
+            "hrm: output folder {}: exists and is not a folder\n",
+            file.display()
+        )
+    );
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), header);
 }
 
 /// `hrm fis check` reads an FCL file: the same analysis as for the `.fis` file, without the

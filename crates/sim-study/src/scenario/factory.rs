@@ -423,7 +423,8 @@ impl ArmSpec {
     /// # Errors
     /// [`SimError::InvalidSetting`] naming the list whose count disagrees, or `arm.links`.
     pub fn link_count(&self, inertias: Option<usize>) -> Result<usize, SimError> {
-        let mut n = self.links;
+        // The count and the field that gave it first.
+        let mut n = self.links.map(|k| (k, "arm.links"));
         for (name, count) in [
             ("arm.lengths", self.lengths.as_ref().map(Vec::len)),
             ("arm.masses", self.masses.as_ref().map(Vec::len)),
@@ -431,19 +432,25 @@ impl ArmSpec {
         ] {
             if let Some(count) = count {
                 match n {
-                    Some(k) if k != count => {
+                    Some((k, _)) if k != count => {
                         return Err(SimError::setting(
                             name,
                             format!("has {count} entries but the arm has {k} links"),
                         ));
                     }
-                    _ => n = Some(count),
+                    Some(_) => {}
+                    None => n = Some((count, name)),
                 }
             }
         }
-        let n = n.unwrap_or(10);
+        let (n, given_by) = n.unwrap_or((10, "arm.links"));
         if n == 0 {
-            return Err(SimError::setting("arm.links", "must be at least 1"));
+            let problem = if given_by == "arm.links" {
+                "must be at least 1"
+            } else {
+                "is empty: an arm has at least 1 link"
+            };
+            return Err(SimError::setting(given_by, problem));
         }
         if n > manip_dyn::MAX_LINKS {
             return Err(SimError::setting(
