@@ -136,7 +136,9 @@ pub enum KinError {
     },
     /// The target is farther from the base than the curve is long (`r > l`).
     #[error(
-        "target out of reach: its distance from the base r = {r} exceeds the curve length l = {length}"
+        "target out of reach: its distance from the base r = {} exceeds the curve length l = {}",
+        lane_math::Compact(*r),
+        lane_math::Compact(*length)
     )]
     OutOfReach {
         /// Distance of the target from the base.

@@ -395,21 +395,11 @@ fn solve_symmetric<const D: usize>(g: &[[f64; D]; D], e: [f64; D]) -> Option<[f6
     Some(y)
 }
 
-/// `|p - q|`; in three dimensions the square root of the summed squares, or, where that sum
-/// underflows or overflows (an arm of links of `1e-200` m or `1e200` m), the scaled `hypot`, so
-/// that a nonzero error never reads as zero.
+/// `|p - q|`: `hypot` in the plane, [`vec3::distance`](crate::vec3::distance) in space (safe
+/// from underflow and overflow both).
 fn distance<const D: usize>(p: [f64; D], q: [f64; D]) -> f64 {
     match D {
         2 => (p[0] - q[0]).hypot(p[1] - q[1]),
-        _ => {
-            let squares = p.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum::<f64>();
-            if (f64::MIN_POSITIVE..f64::INFINITY).contains(&squares) {
-                squares.sqrt()
-            } else {
-                p.iter()
-                    .zip(&q)
-                    .fold(0.0_f64, |length, (a, b)| length.hypot(a - b))
-            }
-        }
+        _ => crate::vec3::distance(std::array::from_fn(|k| p[k]), std::array::from_fn(|k| q[k])),
     }
 }

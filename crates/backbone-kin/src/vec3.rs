@@ -45,10 +45,17 @@ pub fn cross<L: Lane>(a: [L; 3], b: [L; 3]) -> [L; 3] {
     ]
 }
 
-/// `|a - b|`.
+/// `|a - b|`: the square root of the summed squares, or, where that sum underflows or overflows
+/// (an arm of links of `1e-200` m, a target `1e308` m away), the scaled `hypot`, so that a
+/// nonzero distance never reads as zero nor a finite one as infinite.
 pub fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
     let d = sub(a, b);
-    dot(d, d).sqrt()
+    let squares = dot(d, d);
+    if (f64::MIN_POSITIVE..f64::INFINITY).contains(&squares) {
+        squares.sqrt()
+    } else {
+        d[0].hypot(d[1]).hypot(d[2])
+    }
 }
 
 /// `A v`.

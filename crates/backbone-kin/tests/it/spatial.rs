@@ -374,6 +374,13 @@ fn the_spatial_family_refuses_bad_input() {
         ik.solve([3.0, 0.0, 0.1], &mut a),
         Err(KinError::OutOfReach { .. })
     ));
+    // A target at the edge of double precision is that far, not infinitely far (the sum of
+    // squares overflows; the scaled distance does not).
+    let far = ik.solve([1e308, 0.0, 0.0], &mut a).unwrap_err();
+    assert!(matches!(far, KinError::OutOfReach { r, .. } if r == 1e308));
+    assert!(far.to_string().contains("r = 1e308 exceeds"), "{far}");
+    let near = [1e-200, 2e-200, 2e-200];
+    assert_eq!(backbone_kin::vec3::distance(near, [0.0; 3]), 3e-200);
     assert!(matches!(
         ik.solve([0.3, f64::NAN, 0.1], &mut a),
         Err(KinError::NonFinite {
