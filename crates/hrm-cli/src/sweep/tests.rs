@@ -650,6 +650,24 @@ fn shard_files_are_streamed_and_checked_line_by_line() {
     let lines: Vec<&str> = runs.lines().collect();
     let err = check(&runs[..runs.len() - 10]);
     assert!(err.contains("f.json: line 71 is not a run"), "{err}");
+    // A malformed run names the field at fault.
+    let completed = lines[2].find("\"outcome\":{").unwrap() + "\"outcome\":".len();
+    let blank = format!("{}{{}}}}", &lines[2][..completed]);
+    let err = check(&runs.replacen(lines[2], &blank, 1));
+    assert!(
+        err.contains("f.json: line 3 is not a run: outcome: "),
+        "{err}"
+    );
+    let typed = lines[2].replacen(
+        "\"tip_error_rms_m\":",
+        "\"tip_error_rms_m\":\"a\",\"x\":",
+        1,
+    );
+    let err = check(&runs.replacen(lines[2], &typed, 1));
+    assert!(
+        err.contains("line 3 is not a run: outcome.completed.tip_error_rms_m: invalid type"),
+        "{err}"
+    );
     let err = check(&(lines[..70].join("\n") + "\n"));
     assert!(
         err.contains("cut short: it holds 69 of the 70 runs"),
@@ -725,7 +743,7 @@ fn shard_files_are_streamed_and_checked_line_by_line() {
     };
     let err = metric("tip_error_rms_m", "-1.586");
     assert!(
-        err.contains("f.json: line 4: run 2: tip_error_rms_m = -1.586e0"),
+        err.contains("f.json: line 4: run 2: tip_error_rms_m = -1.586"),
         "{err}"
     );
     let err = metric("peak_joint_torque_nm", "1e308");
@@ -735,7 +753,7 @@ fn shard_files_are_streamed_and_checked_line_by_line() {
     );
     let err = metric("tip_error_max_m", "0");
     assert!(
-        err.contains("tip_error_max_m = 0e0 is below tip_error_rms_m"),
+        err.contains("tip_error_max_m = 0 is below tip_error_rms_m"),
         "{err}"
     );
     let err = metric("modal_error_rms_rad", "[4");
@@ -865,7 +883,7 @@ fn a_shard_edited_with_its_digest_is_still_checked_as_a_sweep() {
     let err = study::merge(vec![(path.clone(), signed)])
         .unwrap_err()
         .to_string();
-    assert!(err.contains("run 1: simulated_s = -0e0 must be"), "{err}");
+    assert!(err.contains("run 1: simulated_s = -0 must be"), "{err}");
     // A key given twice in the header, as in a run's line.
     let text = read(&path);
     let doubled = text.replacen("{\"format\":", "{\"format\":\"x\",\"format\":", 1);

@@ -4,7 +4,7 @@
 
 use super::shard::{FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, MAX_SHARDS, Shard};
 use crate::ControllerKind;
-use lane_math::{Classify, ErrorClass};
+use lane_math::{Classify, Compact, ErrorClass};
 use sim_core::SimError;
 use std::path::PathBuf;
 
@@ -290,7 +290,10 @@ pub enum ShardProblem {
     /// A failed run's simulated time that is negative, not finite or past the scenario's
     /// duration.
     #[error(
-        ": line {line}: run {run}: simulated_s = {value:e} must be finite, non-negative and at most the scenario's duration, {duration} s"
+        ": line {line}: run {run}: simulated_s = {} must be finite, non-negative and at most \
+         the scenario's duration, {} s",
+        Compact(*value),
+        Compact(*duration)
     )]
     SimulatedTime {
         /// The scenario's duration (s).
@@ -331,8 +334,8 @@ pub enum ShardProblem {
 pub enum MetricError {
     /// Outside `[0, MAX_SHARD_METRIC]`.
     #[error(
-        "{name} = {value:e} is not a metric a run gives: it must lie in [0, \
-         {MAX_SHARD_METRIC:e}]"
+        "{name} = {} is not a metric a run gives: it must lie in [0, {MAX_SHARD_METRIC:e}]",
+        Compact(*value)
     )]
     OutOfRange {
         /// The metric.
@@ -342,8 +345,10 @@ pub enum MetricError {
     },
     /// A modal RMS above the runaway bound a completed run kept to.
     #[error(
-        "{name} = {value:e} exceeds the scenario's runaway bound limits.max_modal_error = \
-         {bound:e}, which a completed run keeps to"
+        "{name} = {} exceeds the scenario's runaway bound limits.max_modal_error = {}, which a \
+         completed run keeps to",
+        Compact(*value),
+        Compact(*bound)
     )]
     AboveRunaway {
         /// The metric.
@@ -355,8 +360,10 @@ pub enum MetricError {
     },
     /// A largest tip error below its RMS.
     #[error(
-        "tip_error_max_m = {max:e} is below tip_error_rms_m = {rms:e}: a maximum is at least \
-         the RMS of the same samples"
+        "tip_error_max_m = {} is below tip_error_rms_m = {}: a maximum is at least the RMS of \
+         the same samples",
+        Compact(*max),
+        Compact(*rms)
     )]
     MaxBelowRms {
         /// The largest tip error (m).

@@ -428,12 +428,8 @@ impl<R: ShardSource> ShardReader<R> {
                 shard,
             }));
         }
-        let run: RunResult = serde_json::from_slice(&self.line).map_err(|e| {
-            refuse(ShardProblem::NotARun {
-                line,
-                cause: e.to_string(),
-            })
-        })?;
+        let run = run_from_json(&self.line)
+            .map_err(|cause| refuse(ShardProblem::NotARun { line, cause }))?;
         let i = shard.index - 1 + self.runs_read * shard.count;
         let wanted = self.header.config.run_at(i);
         if !run.matches(&wanted) {
@@ -694,4 +690,21 @@ fn position(controller: ControllerKind, noise_level: f64, seed_index: usize, see
         controller.name(),
         Compact(noise_level)
     )
+}
+
+/// A run line read as JSON; the error names the field at fault (`outcome: ...`) where the
+/// parser's message does not.
+fn run_from_json(line: &[u8]) -> Result<RunResult, String> {
+    let mut parser = serde_json::Deserializer::from_slice(line);
+    let run = serde_path_to_error::deserialize(&mut parser).map_err(|e| {
+        let path = e.path().to_string();
+        let cause = e.into_inner().to_string();
+        if path == "." {
+            cause
+        } else {
+            format!("{path}: {cause}")
+        }
+    })?;
+    parser.end().map_err(|e| e.to_string())?;
+    Ok(run)
 }
