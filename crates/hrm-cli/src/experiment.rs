@@ -724,22 +724,25 @@ fn list(values: &[f64], format: impl Fn(f64) -> String) -> String {
         .join(", ")
 }
 
-/// The comparison table as text: the two name columns left-aligned, numbers right-aligned.
+/// The comparison table as text: the two name columns left-aligned, numbers right-aligned
+/// (padded by characters, so that a name of any length, `std::fmt`'s widths stopping at
+/// 65,535, lines up).
 fn table(rows: &[report::Row]) -> String {
-    let mut widths = HEADERS.map(str::len);
+    let mut widths = HEADERS.map(|header| header.chars().count());
     for row in rows {
         for (width, cell) in widths.iter_mut().zip(&row.cells) {
-            *width = (*width).max(cell.len());
+            *width = (*width).max(cell.chars().count());
         }
     }
     let line = |cells: &[String], error: Option<&String>| {
         let mut s = String::new();
         for (k, (cell, width)) in cells.iter().zip(widths).enumerate() {
-            let _ = if k < 2 {
-                write!(s, "{cell:<width$}  ")
+            let padding = " ".repeat(width - cell.chars().count());
+            if k < 2 {
+                s += &format!("{cell}{padding}  ");
             } else {
-                write!(s, "{cell:>width$}  ")
-            };
+                s += &format!("{padding}{cell}  ");
+            }
         }
         if let Some(e) = error {
             let _ = write!(s, "stopped: {e}");
@@ -819,9 +822,16 @@ mod tests {
         );
         // A scenario name with a newline and a right-to-left override stays on its row, escaped.
         outcome.scenario = "step\nlimit \u{202e}".into();
-        let text = table(&table_rows(&[outcome], &[]));
+        let text = table(&table_rows(std::slice::from_ref(&outcome), &[]));
         assert_eq!(text.lines().count(), 2, "{text}");
         assert!(text.contains("step\\nlimit \\u{202e}"), "{text}");
+        // A name beyond `std::fmt`'s widths (65,535) lines up too, and non-ASCII names by
+        // characters: the header pads to the name's 70,000 characters.
+        outcome.scenario = "é".repeat(70_000);
+        let text = table(&table_rows(&[outcome], &[]));
+        let (header, row) = text.split_once('\n').unwrap();
+        assert_eq!(header.find("controller"), Some(70_002));
+        assert_eq!(row.chars().position(|c| c != 'é'), Some(70_000));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
