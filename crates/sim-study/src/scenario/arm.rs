@@ -49,10 +49,10 @@ pub enum JointLayout {
 #[serde(deny_unknown_fields)]
 pub struct BaseSpec {
     /// Position of the first joint (m).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "super::exact::numbers")]
     pub xyz: [f64; 3],
     /// Roll, pitch, yaw (rad).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "super::exact::numbers")]
     pub rpy: [f64; 3],
 }
 

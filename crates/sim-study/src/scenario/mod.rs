@@ -90,6 +90,7 @@ mod builtin;
 mod chain;
 mod controllers;
 mod deploy;
+mod exact;
 mod factory;
 mod file;
 mod obstacles;

@@ -373,10 +373,13 @@ pub enum TaskSpec {
 #[serde(deny_unknown_fields)]
 pub struct HelixSpec {
     /// A point on the axis (m).
+    #[serde(deserialize_with = "super::exact::numbers")]
     pub center: [f64; 3],
     /// The axis direction (any length but zero).
+    #[serde(deserialize_with = "super::exact::numbers")]
     pub axis: [f64; 3],
     /// The first point (m), off the axis.
+    #[serde(deserialize_with = "super::exact::numbers")]
     pub start: [f64; 3],
     /// Rise per turn along the axis (m, default 0: a circle).
     #[serde(default)]

@@ -163,6 +163,7 @@ pub(super) struct ReferenceTable {
     travel_time: Option<f64>,
     branch: Option<BranchSpec>,
     sine: Option<SineSpec>,
+    #[serde(default, deserialize_with = "super::exact::optional_points")]
     points: Option<Vec<[f64; 2]>>,
     helix: Option<HelixSpec>,
 }

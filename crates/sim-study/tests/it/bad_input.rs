@@ -154,6 +154,51 @@ fn rk4_step_not_positive_or_not_dividing_the_period() {
     );
 }
 
+/// A list of fixed length given longer (a quaternion for roll-pitch-yaw, a 3-D point in a planar
+/// path) is refused by its line, not read as its first entries: TOML's reader of `[f64; N]`
+/// dropped the rest without a word.
+#[test]
+fn fixed_length_lists_are_read_whole() {
+    let spatial = sim_study::Scenario::builtin_text("spatial-tracking").unwrap();
+    let planar = "name = \"p\"\nduration = 0.1\nalpha0 = 1.5707963267948966\n\
+                  integrator = { method = \"rk4\", dt = 0.001 }\n\
+                  [reference]\nkind = \"path\"\ntravel_time = 0.1\n\
+                  points = [[0.3, 0.5], [0.3, 0.6]]\n";
+    sim_study::Scenario::from_toml(planar).unwrap();
+    for (base, from, to, expected) in [
+        (
+            spatial,
+            "rpy = [0.0, 0.0, 0.0]",
+            "rpy = [0.0, 0.0, 0.0, 1.0]",
+            "(`rpy = [0.0, 0.0, 0.0, 1.0]`): invalid length 4, expected 3 numbers",
+        ),
+        (
+            spatial,
+            "rpy = [0.0, 0.0, 0.0]",
+            "rpy = [0.0, 0.0]",
+            "(`rpy = [0.0, 0.0]`): invalid length 2, expected 3 numbers",
+        ),
+        (
+            spatial,
+            "start = [0.8, 0.15, 0.0]",
+            "start = [0.8, 0.15, 0.0, 99.0]",
+            "(`start = [0.8, 0.15, 0.0, 99.0]`): invalid length 4, expected 3 numbers",
+        ),
+        (
+            planar,
+            "[0.3, 0.6]]",
+            "[0.3, 0.6, 9.0]]",
+            "(`points = [[0.3, 0.5], [0.3, 0.6, 9.0]]`): point 1 has 3 numbers, expected 2",
+        ),
+    ] {
+        assert!(base.contains(from), "{from}");
+        let message = sim_study::Scenario::from_toml(&base.replacen(from, to, 1))
+            .unwrap_err()
+            .to_string();
+        assert!(message.ends_with(expected), "{to}: {message}");
+    }
+}
+
 /// A wrongly typed key of a table tagged by `kind` or `method` is named by its own line (it was
 /// named by the table's header), and a key of another kind is refused as serde refused it.
 #[test]
