@@ -15,7 +15,8 @@ use std::path::Path;
 
 /// Runs `scenario` with `controller` (or the scenario's own) and writes its files into `out`.
 /// A scenario that cannot be built is refused before anything is written; a run that stops
-/// (diverges) writes its data up to the stop, then fails with the reason.
+/// (diverges) writes its data up to the stop, then fails with the reason, and one that stops
+/// before its first recorded sample writes nothing (as a URDF arm's or a deployment's).
 pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Result<(), String> {
     let mut scenario = Scenario::resolve(name_or_path).map_err(|e| e.to_string())?;
     refuse_scenario_inputs_inside(out, name_or_path, &scenario)?;
@@ -33,6 +34,14 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
     scenario.build().map_err(|e| e.to_string())?;
     let staging = OutputDir::create(out, "simulate")?;
     let outcome = run_one(&scenario, scenario.controller.kind);
+    if let Err(stopped) = &outcome.result
+        && stopped
+            .partial
+            .as_ref()
+            .is_none_or(|run| run.record.is_empty())
+    {
+        return Err(stopped.error.to_string());
+    }
     write_outcome(&outcome, &scenario, staging.path())?;
     staging.commit()?;
     console::print(&table(&table_rows(

@@ -85,7 +85,10 @@ pub enum ReduceError {
     #[error("the reduced mass matrix M* is not numerically positive definite")]
     NotPositiveDefinite,
     /// A computed quantity overflowed although every input was finite.
-    #[error("the computed {name} is not finite (inputs too large for double precision)")]
+    #[error(
+        "the computed {name} is not finite (inputs beyond double precision: too large, or a \
+         mass or length too small to divide by)"
+    )]
     NonFiniteResult {
         /// Which quantity.
         name: &'static str,

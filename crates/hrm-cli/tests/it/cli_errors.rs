@@ -477,6 +477,17 @@ fn a_diverging_simulate_writes_its_data_up_to_the_stop() {
         csv.lines().count() > 5 && (last_t - stopped).abs() < 1e-12,
         "{csv}"
     );
+    // A run that stops before its first recorded sample (links of 1e-100 m, whose C* overflows
+    // at the first step) writes nothing: the earlier output stays as it was.
+    let before = snapshot(&out);
+    let tiny = dir.join("tiny.toml");
+    let text = std::fs::read_to_string(short_scenario(&dir)).unwrap();
+    std::fs::write(&tiny, text + "\n[arm]\nlink_length = 1e-100\n").unwrap();
+    let output = hrm(&["simulate", "--scenario", path(&tiny), "--out", path(&out)]);
+    let line = refused(&output);
+    assert!(line.contains("C* is not finite"), "{line}");
+    assert!(!stdout(&output).contains("wrote"), "{output:?}");
+    assert_eq!(snapshot(&out), before, "the earlier output changed");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
