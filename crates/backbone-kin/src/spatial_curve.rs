@@ -21,7 +21,7 @@ use crate::error::KinError;
 use crate::modal_map::check_harmonics;
 use crate::spatial_chain::BasePose;
 use crate::validate::check_length;
-use crate::vec3::{Rotation, column, distance, mat_mul};
+use crate::vec3::{Rotation, add, column, distance, mat_mul};
 use lane_math::check_values;
 
 /// The most Runge-Kutta steps [`SpatialCurve::tip`] takes over the curve with one harmonic per
@@ -100,7 +100,8 @@ impl SpatialCurve {
         [0.0, slope(a_y, s, self.length), slope(a_z, s, self.length)]
     }
 
-    /// The tip, integrated to `tolerance` (metres, absolute; positive and finite), e.g.
+    /// The tip, its displacement from the base integrated to `tolerance` (metres, absolute;
+    /// positive and finite; the base position is added after, with its own rounding), e.g.
     /// `SPATIAL_CURVE_TOLERANCE * l`, starting from steps that turn the frame at most
     /// `MAX_STEP_TURN` each.
     ///
@@ -125,10 +126,12 @@ impl SpatialCurve {
         let mut coarse = self.integrate(steps);
         loop {
             let fine = self.integrate(2 * steps);
+            // Estimated on the curve's own displacement: the base's offset (a base at 1e9 m)
+            // would add its rounding to both and never let the estimate fall.
             let error = distance(fine.0, coarse.0) / 15.0;
             if error <= tolerance {
                 return Ok(CurveTip {
-                    position: fine.0,
+                    position: add(self.base.xyz, fine.0),
                     rotation: fine.1,
                     error_estimate: error,
                     steps: 2 * steps,
@@ -145,11 +148,11 @@ impl SpatialCurve {
         }
     }
 
-    /// The position and frame at `s = l` after `steps` classical Runge-Kutta steps of the frame
-    /// equation.
+    /// The displacement from the base and the frame at `s = l` after `steps` classical
+    /// Runge-Kutta steps of the frame equation.
     fn integrate(&self, steps: usize) -> ([f64; 3], Rotation) {
         let h = self.length / steps as f64;
-        let (mut p, mut r) = (self.base.xyz, self.base.rotation());
+        let (mut p, mut r) = ([0.0; 3], self.base.rotation());
         let derivative = |r: &Rotation, s: f64| (mat_mul(*r, skew(self.rate(s))), column(r, 0));
         for step in 0..steps {
             let s = step as f64 * h;

@@ -193,6 +193,29 @@ fn the_error_estimate_is_honest() {
 /// 4.1, 2.1, 1.05 cm at 16, 32, 64, 128 links for this pose, ratios 1.95-1.99). Bending in one
 /// plane, the splitting is exact and the chain is the planar midpoint rule, spectrally accurate
 /// with equal links.
+/// A base far from the origin (`1e9` m, within the bounds of a base) moves the tip and nothing
+/// else: the displacement is integrated from the base, so the base's rounding never reaches
+/// the error estimate (it was refused as "too oscillatory" at `1e9` m, and off by `5e-10` m at
+/// `1e6`).
+#[test]
+fn a_far_base_moves_the_curve_whole() {
+    let a = [0.1; 8];
+    let rpy = [0.2, 0.4, -0.3];
+    let near = SpatialCurve::new(1.0, 2, &a, BasePose { xyz: [0.0; 3], rpy }).unwrap();
+    let near = near.tip(1e-12).unwrap();
+    for x in [1e6, 1e9] {
+        let xyz = [x, -x, 0.5 * x];
+        let far = SpatialCurve::new(1.0, 2, &a, BasePose { xyz, rpy }).unwrap();
+        let far = far.tip(1e-12).unwrap();
+        assert_eq!(far.steps, near.steps);
+        assert_eq!(far.error_estimate, near.error_estimate);
+        assert_eq!(far.rotation, near.rotation);
+        for d in 0..3 {
+            assert_eq!(far.position[d], xyz[d] + near.position[d]);
+        }
+    }
+}
+
 #[test]
 fn chains_of_more_links_converge_to_the_curve() {
     let a = [0.9, -0.5, -0.7, 0.6];
