@@ -210,9 +210,8 @@ fn a_far_base_moves_the_curve_whole() {
         assert_eq!(far.steps, near.steps);
         assert_eq!(far.error_estimate, near.error_estimate);
         assert_eq!(far.rotation, near.rotation);
-        for d in 0..3 {
-            assert_eq!(far.position[d], xyz[d] + near.position[d]);
-        }
+        let moved: [f64; 3] = std::array::from_fn(|d| xyz[d] + near.position[d]);
+        assert_eq!(far.position, moved);
     }
 }
 
