@@ -2,6 +2,7 @@
 //! *Solving Ordinary Differential Equations I*, section II.5, the `DOPRI5` code).
 
 use super::{OdeError, OdeSystem, Stats, check_call, combine, eval};
+use lane_math::Compact;
 
 /// Nodes `c_i` of the Butcher tableau.
 const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
@@ -87,32 +88,39 @@ impl Default for Tolerances {
 pub const MIN_RTOL: f64 = 100.0 * f64::EPSILON;
 
 impl Tolerances {
-    /// The setting that fails and the condition it fails, if any (checked by every
-    /// [`DormandPrince::integrate`] call and when a simulation is built).
-    pub(crate) fn check(&self) -> Result<(), (&'static str, &'static str)> {
+    /// The setting that fails and what it must be, with the value given, if any (checked by
+    /// every [`DormandPrince::integrate`] call and when a simulation is built).
+    pub(crate) fn check(&self) -> Result<(), (&'static str, String)> {
         let positive = |v: f64| v.is_finite() && v > 0.0;
+        let refuse = |name, requirement: &str, value: f64| {
+            Err((name, format!("{requirement}, got {}", Compact(value))))
+        };
         if !(positive(self.rtol) && self.rtol >= MIN_RTOL) {
-            return Err((
+            return refuse(
                 "rtol",
-                "must be finite and at least 2.2e-14 (100 machine epsilons)",
-            ));
+                &format!(
+                    "must be finite and at least {} (100 machine epsilons)",
+                    Compact(MIN_RTOL)
+                ),
+                self.rtol,
+            );
         }
         if !positive(self.atol) {
-            return Err(("atol", "must be positive and finite"));
+            return refuse("atol", "must be positive and finite", self.atol);
         }
         if !(self.h_min >= 0.0 && self.h_min.is_finite()) {
-            return Err(("h_min", "must be non-negative and finite"));
+            return refuse("h_min", "must be non-negative and finite", self.h_min);
         }
         if !(self.h_max > 0.0 && self.h_max >= self.h_min) {
-            return Err(("h_max", "must be positive and at least h_min"));
+            return refuse("h_max", "must be positive and at least h_min", self.h_max);
         }
         if let Some(h) = self.h_init
             && !positive(h)
         {
-            return Err(("h_init", "must be positive and finite"));
+            return refuse("h_init", "must be positive and finite", h);
         }
         if self.max_steps == 0 {
-            return Err(("max_steps", "must be at least 1"));
+            return Err(("max_steps", "must be at least 1, got 0".into()));
         }
         Ok(())
     }

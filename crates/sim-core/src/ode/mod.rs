@@ -59,7 +59,8 @@ pub enum OdeError<E> {
     },
     /// The adaptive step size fell below the minimum allowed step.
     #[error(
-        "the step size fell to {h:e} at t = {}, below the minimum {h_min:e} (stiff or singular problem)",
+        "the step size fell to {h:e} at t = {}, below the minimum {h_min:e} (a stiff or singular \
+         problem, or an atol too small for the state's rounding)",
         Compact(*.t)
     )]
     StepTooSmall {
@@ -96,8 +97,8 @@ pub enum OdeError<E> {
     InvalidTolerance {
         /// The setting's field (`rtol`, `atol`, ...).
         name: &'static str,
-        /// What it must be.
-        requirement: &'static str,
+        /// What it must be, and the value given.
+        requirement: String,
     },
 }
 

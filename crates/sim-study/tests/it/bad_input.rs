@@ -372,7 +372,7 @@ fn dormand_prince_tolerances_out_of_domain() {
         let (name, message) = invalid(build(s));
         assert_eq!(name, format!("integrator.{field}"), "{tolerances:?}");
         assert!(
-            message.starts_with(&format!("integrator.{field} must ")),
+            message.starts_with(&format!("integrator.{field} must ")) && message.contains(", got "),
             "{message}"
         );
         // ...and by the integrator itself.
@@ -386,6 +386,20 @@ fn dormand_prince_tolerances_out_of_domain() {
         );
         assert_eq!(y, [1.0]);
     }
+    // Just below the floor, the floor is written in full and the value given echoed.
+    let s = LoopSettings {
+        integrator: Integrator::DormandPrince(Tolerances {
+            rtol: 2.2e-14,
+            ..base
+        }),
+        ..settings()
+    };
+    let (_, message) = invalid(build(s));
+    assert_eq!(
+        message,
+        "integrator.rtol must be finite and at least 2.220446049250313e-14 (100 machine \
+         epsilons), got 2.2e-14"
+    );
     // The tightest relative tolerance runs.
     let s = LoopSettings {
         integrator: Integrator::DormandPrince(Tolerances {
