@@ -406,7 +406,9 @@ impl ControllerSpec {
                             format!("cannot be read from {}: {e}", path.display()),
                         )
                     })?;
-                Ok(FuzzySystem::from_fis(&text)?)
+                FuzzySystem::from_fis(&text).map_err(|e| {
+                    SimError::setting("controller.fis", format!("({}): {e}", path.display()))
+                })
             }
         }
     }

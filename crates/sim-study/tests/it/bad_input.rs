@@ -435,6 +435,12 @@ fn controller_keys_are_checked_whichever_controller_runs() {
             "controller.fis",
             "cannot be read from",
         ),
+        // A file that is not a FIS: the file named beside the reader's line.
+        (
+            concat!("fis = \"", env!("CARGO_MANIFEST_DIR"), "/Cargo.toml\""),
+            "controller.fis",
+            concat!("(", env!("CARGO_MANIFEST_DIR"), "/Cargo.toml): line "),
+        ),
     ] {
         let text = base.replace("[controller]\n", &format!("[controller]\n{line}\n"));
         assert_ne!(text, base);
