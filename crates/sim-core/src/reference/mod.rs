@@ -15,7 +15,7 @@ mod spatial_path;
 mod spline;
 mod waypoints;
 
-pub use path::{CartesianPath, FREE_BASE_START, PathShape};
+pub use path::{CartesianPath, FREE_BASE_START, MAX_SINE_PHASE, PathShape};
 pub use preview::{MAX_PREVIEW_SAMPLES, ReferencePreview};
 pub use spatial_path::{Helix, MAX_HELIX_EXTENT_M, MAX_SPATIAL_PATH_WORK, SpatialPath};
 pub use spline::{MAX_SPLINE_SAMPLES, SplineMotion};

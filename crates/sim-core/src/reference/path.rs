@@ -6,13 +6,18 @@ use super::continuation::{Family, TipMotion, resolve};
 use super::{Reference, ReferenceSample};
 use crate::error::{SimError, check_positive};
 use backbone_kin::{BaseAngle, Branch, inverse_kinematics};
-use lane_math::check_all_finite;
+use lane_math::{Compact, check_all_finite};
 
 /// How finely [`CartesianPath::new`] checks the path for reachability and singular points; also
 /// the number of intervals of the continuation grid.
 const CHECK_SAMPLES: usize = 2000;
 /// Below this `|a1|` (rad) or `J1(A)` the inverse kinematics is treated as singular.
 const SINGULAR_TOLERANCE: f64 = 1e-8;
+
+/// The most phase a sine path may turn through between `x_start` and `x_end` (rad): some
+/// 160,000 periods, where the paper's path turns through 1.6 rad; beyond it `sin` of the phase
+/// has lost its digits and the path's derivatives (`k A`, `k^2 A`) their meaning.
+pub const MAX_SINE_PHASE: f64 = 1e6;
 /// The base angle a free `alpha0` starts the continuation from (rad): the paper's `pi/2`.
 pub const FREE_BASE_START: f64 = std::f64::consts::FRAC_PI_2;
 
@@ -320,8 +325,20 @@ fn validate_shape(shape: &PathShape) -> Result<Vec<f64>, SimError> {
             )?;
             if x_start == x_end {
                 return Err(SimError::setting(
-                    "reference.x_end",
-                    format!("must differ from x_start, both are {x_start}"),
+                    "reference.sine.x_end",
+                    format!("must differ from x_start, both are {}", Compact(*x_start)),
+                ));
+            }
+            let turned = (wavenumber * (x_end - x_start)).abs();
+            if !(turned <= MAX_SINE_PHASE) {
+                return Err(SimError::setting(
+                    "reference.sine.wavenumber",
+                    format!(
+                        "= {} turns the sine through {turned:.3e} rad from x_start to x_end, \
+                         more than {MAX_SINE_PHASE:e}: its slope and curvature leave double \
+                         precision",
+                        Compact(*wavenumber),
+                    ),
                 ));
             }
             Ok(Vec::new())

@@ -4,7 +4,9 @@
 use backbone_kin::{BackboneCurve, BaseAngle, Branch, end_point};
 use proptest::prelude::*;
 use sim_core::SimError;
-use sim_core::reference::{CartesianPath, PathShape, Reference, ReferenceSample, Sinusoid, Step};
+use sim_core::reference::{
+    CartesianPath, MAX_SINE_PHASE, PathShape, Reference, ReferenceSample, Sinusoid, Step,
+};
 use std::f64::consts::FRAC_PI_2;
 
 fn paper_path(branch: Branch) -> CartesianPath {
@@ -212,6 +214,35 @@ fn bad_paths_are_refused_with_the_reason() {
         .unwrap_err();
         assert!(matches!(err, SimError::InvalidSetting { .. }), "{err}");
     }
+    // A sine turning through more than MAX_SINE_PHASE between its ends (its NaN acceleration
+    // named no field): refused naming the wavenumber; just within, the path is built (a tiny
+    // amplitude keeps it reachable).
+    let fast = |wavenumber: f64| PathShape::Sine {
+        amplitude: 1e-9,
+        wavenumber,
+        phase: 0.0,
+        offset: 0.2,
+        x_start: 0.08,
+        x_end: 0.4,
+    };
+    let new = |shape| {
+        CartesianPath::new(
+            shape,
+            5.0,
+            1.0,
+            1,
+            BaseAngle::Fixed(FRAC_PI_2),
+            Branch::Positive,
+        )
+    };
+    let err = new(fast(1e300)).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        "reference.sine.wavenumber = 1e300 turns the sine through 3.200e299 rad from x_start \
+         to x_end, more than 1e6: its slope and curvature leave double precision"
+    );
+    assert!(new(fast(MAX_SINE_PHASE / 0.32 * 1.001)).is_err());
+    new(fast(1e3)).unwrap();
 }
 
 /// Parameters whose rates or accelerations double precision cannot hold are refused up front:
