@@ -330,7 +330,7 @@ fn validate_shape(shape: &PathShape) -> Result<Vec<f64>, SimError> {
                 ));
             }
             let turned = (wavenumber * (x_end - x_start)).abs();
-            if !(turned <= MAX_SINE_PHASE) {
+            if turned > MAX_SINE_PHASE {
                 return Err(SimError::setting(
                     "reference.sine.wavenumber",
                     format!(
