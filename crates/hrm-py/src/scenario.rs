@@ -209,8 +209,9 @@ const MAX_SETTING_DEPTH: usize = 16;
 /// The most items a list (or array) of a setting may have, checked before it is converted.
 const MAX_SETTING_ITEMS: usize = 1 << 20;
 
-/// A Python value as a TOML value for setting `name`: bools, integers (beyond 64 bits signed
-/// as a decimal string, as TOML writes large seeds), floats, strings, paths, dicts, and lists,
+/// A Python value as a TOML value for setting `name`: bools, integers (the `seed` beyond 64
+/// bits signed as a decimal string, as TOML writes large seeds; any other setting refused
+/// there), floats, strings, paths, dicts, and lists,
 /// tuples and numpy arrays of those, nested at most [`MAX_SETTING_DEPTH`] deep with at most
 /// [`MAX_SETTING_ITEMS`] items per list.
 fn py_to_toml(value: &Bound<'_, PyAny>, name: &str) -> PyResult<toml::Value> {
@@ -240,8 +241,14 @@ fn to_toml_at(value: &Bound<'_, PyAny>, name: &str, depth: usize) -> PyResult<to
         if let Ok(i) = value.extract::<i64>() {
             return Ok(toml::Value::Integer(i));
         }
+        // The seed alone is a `u64`, which TOML writes beyond `i64` as a decimal string.
         return match value.extract::<u64>() {
-            Ok(u) => Ok(toml::Value::String(u.to_string())),
+            Ok(u) if name == "seed" => Ok(toml::Value::String(u.to_string())),
+            Ok(u) => Err(Error::input(format!(
+                "{name} must be at most {} (the largest integer a scenario setting holds), got {u}",
+                i64::MAX
+            ))
+            .into()),
             Err(_) => {
                 Err(Error::input(format!("{name}: an integer that does not fit 64 bits")).into())
             }

@@ -76,6 +76,10 @@ def test_settings_read_and_write_through():
     assert scenario.controller.kp == [100.0, 200.0]
     assert hrm.Scenario.from_toml(scenario.to_toml()).to_dict() == scenario.to_dict()
     assert scenario.seed == str(2**64 - 1)
+    # Any other integer setting stops at TOML's largest integer, named.
+    for table, key in [(scenario.arm, "links"), (scenario.modal, "harmonics")]:
+        with pytest.raises(hrm.InvalidInput, match=rf"^\w+\.{key} must be at most 9223372036854775807 \(the largest integer a scenario setting holds\), got 9223372036854775808$"):
+            setattr(table, key, 2**63)
     scenario.initial = {"a": [0.1, 0.0]}
     assert scenario.initial.a == [0.1, 0.0] and scenario.initial.a_dot is None
     del scenario.initial
