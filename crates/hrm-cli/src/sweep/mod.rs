@@ -99,11 +99,9 @@ pub fn run(cli: SweepCli) -> Result<(), String> {
         Some(SweepCommand::Merge { out, shards }) => {
             let staging = OutputDir::create(&out, "sweep merge")?;
             let table = merge_files(&shards, staging.path(), &out)?;
+            let wrote = wrote(&out, staging.path());
             staging.commit()?;
-            console::print(&format!(
-                "{table}wrote {} (runs.json, summary.json, table.txt, tip_error_rms.svg)\n",
-                out.display()
-            ))
+            console::print(&format!("{table}{wrote}"))
         }
         None => {
             let args = cli.sweep;
@@ -132,11 +130,9 @@ pub fn run(cli: SweepCli) -> Result<(), String> {
                 None => {
                     let staging = OutputDir::create(&args.out, "sweep")?;
                     let table = sweep_whole(&config, staging.path())?;
+                    let wrote = wrote(&args.out, staging.path());
                     staging.commit()?;
-                    console::print(&format!(
-                        "{table}wrote {} (runs.json, summary.json, table.txt, tip_error_rms.svg)\n",
-                        args.out.display()
-                    ))
+                    console::print(&format!("{table}{wrote}"))
                 }
             }
         }
@@ -323,6 +319,20 @@ fn write_report(config: &SweepConfig, cells: &[Cell], out: &Path) -> Result<Stri
     }
     write(&out.join("table.txt"), &table)?;
     Ok(table)
+}
+
+/// The line naming the files of a whole sweep's report in `out`, as `staged` holds them (no plot
+/// when no run completed).
+fn wrote(out: &Path, staged: &Path) -> String {
+    let plot = if staged.join("tip_error_rms.svg").exists() {
+        ", tip_error_rms.svg"
+    } else {
+        ""
+    };
+    format!(
+        "wrote {} (runs.json, summary.json, table.txt{plot})\n",
+        out.display()
+    )
 }
 
 /// Writes `text` to `path`, creating its folder.

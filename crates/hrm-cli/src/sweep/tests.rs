@@ -431,6 +431,21 @@ fn diverging_runs_are_counted_per_cell_not_fatal() {
     let table = read(&out.join("table.txt"));
     assert!(table.contains("4 runs stopped before the end"), "{table}");
     assert!(table.contains("0/2"), "{table}");
+    assert!(out.join("tip_error_rms.svg").exists());
+    assert!(wrote(&out, &out).ends_with(", tip_error_rms.svg)\n"));
+    // Every run failing: no plot, and the line naming the files does not name one.
+    let all_failed = root.join("all-failed");
+    let noisy = with(
+        &args[..10],
+        &["--noise", "2", "--out", all_failed.to_str().unwrap()],
+    );
+    hrm_sweep(&noisy).unwrap();
+    assert!(read(&all_failed.join("table.txt")).contains("no run completed: no plot drawn"));
+    assert!(!all_failed.join("tip_error_rms.svg").exists());
+    assert_eq!(
+        wrote(Path::new("D"), &all_failed),
+        "wrote D (runs.json, summary.json, table.txt)\n"
+    );
     std::fs::remove_dir_all(&root).unwrap();
 }
 
@@ -650,6 +665,20 @@ fn shard_files_are_streamed_and_checked_line_by_line() {
     let lines: Vec<&str> = runs.lines().collect();
     let err = check(&runs[..runs.len() - 10]);
     assert!(err.contains("f.json: line 71 is not a run"), "{err}");
+    // An editor's final blank line, a CRLF copy, a byte-order mark: the same shard.
+    let parsed = |text: &str| ShardFile::parse(text, Path::new("f.json")).unwrap();
+    let reference = parsed(&runs);
+    assert_eq!(parsed(&(runs.clone() + "\n \r\n")), reference);
+    assert_eq!(parsed(&runs.replace('\n', "\r\n")), reference);
+    assert_eq!(parsed(&format!("\u{feff}{runs}")), reference);
+    // A blank line between runs is skipped and counted in the lines of later messages.
+    let spaced = runs.replacen(lines[2], &format!("\n{}", lines[2]), 1);
+    assert_eq!(parsed(&spaced), reference);
+    let err = check(&(spaced + lines[70] + "\n"));
+    assert!(
+        err.contains("line 73: more lines than the 70 runs"),
+        "{err}"
+    );
     // A malformed run names the field at fault.
     let completed = lines[2].find("\"outcome\":{").unwrap() + "\"outcome\":".len();
     let blank = format!("{}{{}}}}", &lines[2][..completed]);

@@ -324,6 +324,9 @@ pub struct ShardReader<R> {
     origin: PathBuf,
     header: ShardHeader,
     runs_read: usize,
+    /// Blank lines (only ASCII whitespace: an editor's final newline, a CRLF copy's lone `\r`)
+    /// skipped so far, counted into the line numbers of messages.
+    blank_lines: usize,
     line: Vec<u8>,
 }
 
@@ -352,6 +355,10 @@ impl<R: ShardSource> ShardReader<R> {
         let mut line = Vec::new();
         if read_line(&mut input, &mut line, origin, 1)? == 0 {
             return Err(refuse(ShardProblem::Empty));
+        }
+        // A byte-order mark an editor put before the header.
+        if line.starts_with(b"\xef\xbb\xbf") {
+            line.drain(..3);
         }
         let value: serde_json::Value = match serde_json::from_slice(&line) {
             Ok(value) => value,
@@ -394,6 +401,7 @@ impl<R: ShardSource> ShardReader<R> {
             origin: origin.to_path_buf(),
             header,
             runs_read: 0,
+            blank_lines: 0,
             line,
         })
     }
@@ -405,13 +413,19 @@ impl<R: ShardSource> ShardReader<R> {
 
     /// The shard's next run, `None` after its last. Refuses a malformed line, a run that is not
     /// the shard's next, a completed run with a modal error count other than the scenario's,
-    /// a file cut short and lines after the last run.
+    /// a file cut short and lines after the last run; blank lines are skipped.
     pub fn next_run(&mut self) -> Result<Option<RunResult>, StudyError> {
-        let line = self.runs_read + 2;
+        let mut line = self.runs_read + self.blank_lines + 2;
+        let mut read = read_line(&mut self.input, &mut self.line, &self.origin, line)?;
+        while read > 0 && self.line.iter().all(u8::is_ascii_whitespace) {
+            self.blank_lines += 1;
+            line += 1;
+            read = read_line(&mut self.input, &mut self.line, &self.origin, line)?;
+        }
         let refuse = |problem| StudyError::shard_file(&self.origin, problem);
         let shard = self.header.shard;
         let expected = self.header.run_count();
-        if read_line(&mut self.input, &mut self.line, &self.origin, line)? == 0 {
+        if read == 0 {
             if self.runs_read < expected {
                 return Err(refuse(ShardProblem::CutShort {
                     held: self.runs_read,
