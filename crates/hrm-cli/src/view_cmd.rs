@@ -64,7 +64,12 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     }
     let dir = &args.dir;
     if !dir.is_dir() {
-        return Err(format!("{}: not a folder", dir.display()));
+        let problem = if dir.exists() {
+            "not a folder"
+        } else {
+            "no such folder"
+        };
+        return Err(format!("{}: {problem}", dir.display()));
     }
     let out = args.out.clone().unwrap_or_else(|| dir.join("view.html"));
     if let Some(gif) = &args.gif {

@@ -876,6 +876,12 @@ fn hrm_view_writes_a_page_and_a_gif_and_replaces_only_its_own_files() {
         .status
         .success()
     );
+    // A folder that is not there, and a file given for one.
+    let missing = dir.join("missing");
+    let line = refused(&hrm(&["view", path(&missing)]));
+    assert_eq!(line, format!("hrm: {}: no such folder", missing.display()));
+    let line = refused(&hrm(&["view", path(&run.join("summary.json"))]));
+    assert!(line.ends_with("summary.json: not a folder"), "{line}");
     let gif = dir.join("run.gif");
     let output = hrm(&[
         "view",
