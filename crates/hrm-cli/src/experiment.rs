@@ -25,11 +25,16 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
             .parse()
             .map_err(|e: sim_core::SimError| e.to_string())?;
     }
+    // A controller the URDF or deployment loop refuses is the option's, when it gave it.
+    let named = |error: String| match (controller, error.strip_prefix("controller.kind ")) {
+        (Some(_), Some(problem)) => format!("--controller {problem}"),
+        _ => error,
+    };
     if scenario.arm.urdf.is_some() {
-        return crate::chain_simulate::simulate(&scenario, out);
+        return crate::chain_simulate::simulate(&scenario, out).map_err(named);
     }
     if scenario.deploy.is_some() {
-        return deploy_simulate::simulate(&scenario, out);
+        return deploy_simulate::simulate(&scenario, out).map_err(named);
     }
     scenario.build().map_err(|e| e.to_string())?;
     let staging = OutputDir::create(out, "simulate")?;

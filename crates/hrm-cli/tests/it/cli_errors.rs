@@ -120,6 +120,22 @@ fn simulate_unknown_controller() {
         !dir.join("out").exists(),
         "nothing is written for a refused run"
     );
+    // A controller the URDF arm's loop does not take is the option's, named so.
+    let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/urdf-arm/step.toml");
+    let line = refused(&hrm(&[
+        "simulate",
+        "--scenario",
+        urdf,
+        "--controller",
+        "fuzzy",
+        "--out",
+        path(&dir.join("out")),
+    ]));
+    assert!(
+        line.starts_with("hrm: --controller must be \"computed-torque\" with a URDF arm"),
+        "{line}"
+    );
+    assert!(!dir.join("out").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
