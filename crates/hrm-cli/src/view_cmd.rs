@@ -37,17 +37,17 @@ pub struct ViewArgs {
     /// List a sweep's runs (number, noise level, controller, seed, outcome) and write nothing.
     #[arg(long)]
     list: bool,
-    /// GIF width (pixels).
-    #[arg(long, default_value_t = 480)]
+    /// GIF width (pixels); with `--gif` only, as the height, rate and speed.
+    #[arg(long, default_value_t = 480, requires = "gif")]
     width: u32,
     /// GIF height (pixels).
-    #[arg(long, default_value_t = 360)]
+    #[arg(long, default_value_t = 360, requires = "gif")]
     height: u32,
     /// GIF frames a second.
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = 20, requires = "gif")]
     fps: u32,
     /// Seconds of the run a second of the GIF shows (1 is real time).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, requires = "gif")]
     speed: f64,
 }
 

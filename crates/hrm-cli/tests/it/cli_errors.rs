@@ -121,7 +121,10 @@ fn simulate_unknown_controller() {
         "nothing is written for a refused run"
     );
     // A controller the URDF arm's loop does not take is the option's, named so.
-    let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/urdf-arm/step.toml");
+    let urdf = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/urdf-arm/step.toml"
+    );
     let line = refused(&hrm(&[
         "simulate",
         "--scenario",
@@ -898,6 +901,18 @@ fn hrm_view_writes_a_page_and_a_gif_and_replaces_only_its_own_files() {
     assert_eq!(line, format!("hrm: {}: no such folder", missing.display()));
     let line = refused(&hrm(&["view", path(&run.join("summary.json"))]));
     assert!(line.ends_with("summary.json: not a folder"), "{line}");
+    // A GIF's size, rate or speed without --gif is refused by clap, not ignored.
+    for option in ["--width", "--height", "--fps", "--speed"] {
+        let output = hrm(&["view", path(&run), option, "2"]);
+        assert_eq!(output.status.code(), Some(2), "{option}");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            stderr.contains("required arguments were not provided"),
+            "{stderr}"
+        );
+        assert!(stderr.contains("--gif <GIF>"), "{stderr}");
+    }
+    assert!(!run.join("view.html").exists());
     let gif = dir.join("run.gif");
     let output = hrm(&[
         "view",
