@@ -442,8 +442,7 @@ impl<R: ShardSource> ShardReader<R> {
                 shard,
             }));
         }
-        let run = run_from_json(&self.line)
-            .map_err(|cause| refuse(ShardProblem::NotARun { line, cause }))?;
+        let run = run_from_json(&self.line).map_err(|cause| refuse(cause.at(line)))?;
         let i = shard.index - 1 + self.runs_read * shard.count;
         let wanted = self.header.config.run_at(i);
         if !run.matches(&wanted) {
@@ -708,17 +707,30 @@ fn position(controller: ControllerKind, noise_level: f64, seed_index: usize, see
 
 /// A run line read as JSON; the error names the field at fault (`outcome: ...`) where the
 /// parser's message does not.
-fn run_from_json(line: &[u8]) -> Result<RunResult, String> {
+fn run_from_json(line: &[u8]) -> Result<RunResult, NotARun> {
     let mut parser = serde_json::Deserializer::from_slice(line);
     let run = serde_path_to_error::deserialize(&mut parser).map_err(|e| {
         let path = e.path().to_string();
         let cause = e.into_inner().to_string();
-        if path == "." {
+        NotARun(if path == "." {
             cause
         } else {
             format!("{path}: {cause}")
-        }
+        })
     })?;
-    parser.end().map_err(|e| e.to_string())?;
+    parser.end().map_err(|e| NotARun(e.to_string()))?;
     Ok(run)
+}
+
+/// Why a line is not a run, before its line number is known.
+struct NotARun(String);
+
+impl NotARun {
+    /// The [`ShardProblem::NotARun`] of line `line`.
+    fn at(self, line: usize) -> ShardProblem {
+        ShardProblem::NotARun {
+            line,
+            cause: self.0,
+        }
+    }
 }
