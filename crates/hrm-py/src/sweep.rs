@@ -54,18 +54,7 @@ fn shard(index: Option<&Bound<'_, PyAny>>, count: Option<&Bound<'_, PyAny>>) -> 
         value.map_or(Ok(1), |v| crate::errors::count(v, name, 1))
     };
     let (index, count) = (number(index, "index")?, number(count, "count")?);
-    if !(1..=study::MAX_SHARDS).contains(&count) {
-        return Err(input(format!(
-            "count must be from 1 to {}, got {count}",
-            study::MAX_SHARDS
-        )));
-    }
-    if !(1..=count).contains(&index) {
-        return Err(input(format!(
-            "index must be from 1 to count ({count}), got {index}"
-        )));
-    }
-    Ok(Shard { index, count })
+    Shard::new(index, count).map_err(input)
 }
 
 impl Sweep {

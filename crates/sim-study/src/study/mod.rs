@@ -52,6 +52,7 @@ pub use outcome::{RunError, RunMetrics, RunOutcome, Stopped, run_scenario};
 pub use plan::{MAX_NOISE_LEVELS, MAX_RUNS, RunId, SweepConfig, SweepSettings, run_seed};
 pub use shard::{
     FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, MAX_SHARDS, Shard, ShardParseError,
+    ShardRangeError,
 };
 pub use shard_file::{
     RunResult, ShardFile, ShardHeader, ShardInput, ShardReader, ShardSource, StoredOutcome, merge,

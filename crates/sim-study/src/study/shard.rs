@@ -60,6 +60,36 @@ impl fmt::Display for Shard {
     }
 }
 
+/// A shard's index or count out of `1 <= index <= count <= MAX_SHARDS`, named.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ShardRangeError {
+    /// A count of 0 or beyond [`MAX_SHARDS`].
+    #[error("count must be from 1 to {MAX_SHARDS}, got {0}")]
+    Count(usize),
+    /// An index of 0 or beyond the count.
+    #[error("index must be from 1 to count ({count}), got {index}")]
+    Index {
+        /// The index given.
+        index: usize,
+        /// The count given.
+        count: usize,
+    },
+}
+
+impl Shard {
+    /// Shard `index` of `count`, checked: `1 <= index <= count <= MAX_SHARDS`.
+    pub fn new(index: usize, count: usize) -> Result<Self, ShardRangeError> {
+        if !(1..=MAX_SHARDS).contains(&count) {
+            return Err(ShardRangeError::Count(count));
+        }
+        if !(1..=count).contains(&index) {
+            return Err(ShardRangeError::Index { index, count });
+        }
+        Ok(Shard { index, count })
+    }
+}
+
 /// A shard written otherwise than `K/N` with `1 <= K <= N <= MAX_SHARDS`.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("a shard is written K/N with 1 <= K <= N <= {MAX_SHARDS}, got '{text}'")]
@@ -79,10 +109,7 @@ impl FromStr for Shard {
         let (k, n) = s.split_once('/').ok_or_else(bad)?;
         let index: usize = k.trim().parse().map_err(|_| bad())?;
         let count: usize = n.trim().parse().map_err(|_| bad())?;
-        if index == 0 || index > count || count > MAX_SHARDS {
-            return Err(bad());
-        }
-        Ok(Shard { index, count })
+        Shard::new(index, count).map_err(|_| bad())
     }
 }
 
@@ -104,6 +131,20 @@ mod tests {
             );
         }
         assert_eq!(Shard { index: 2, count: 3 }.to_string(), "2/3");
+        // Checked from numbers, the one at fault named.
+        assert_eq!(Shard::new(2, 3), Ok(Shard { index: 2, count: 3 }));
+        for (index, count, message) in [
+            (0, 2, "index must be from 1 to count (2), got 0"),
+            (3, 2, "index must be from 1 to count (2), got 3"),
+            (1, 0, "count must be from 1 to 10000000, got 0"),
+            (
+                1,
+                MAX_SHARDS + 1,
+                "count must be from 1 to 10000000, got 10000001",
+            ),
+        ] {
+            assert_eq!(Shard::new(index, count).unwrap_err().to_string(), message);
+        }
     }
 
     proptest! {
