@@ -142,10 +142,10 @@ pub fn follow_the_leader(
         }
         let base_sigma = sigma[0];
         if base_sigma > 1e-12 * length {
-            return Err(PlanError::OutOfRange {
-                name: "deploy.centerline's length (the base would pass the entry: the arm is too short for it)",
-                bound: "at most what the arm reaches with its base behind the entry",
-                value: depth,
+            let reached = depth * step.saturating_sub(1) as f64 / steps as f64;
+            return Err(PlanError::ArmTooShort {
+                depth,
+                reach: reach(channel, link_lengths, reached, tau),
             });
         }
         let mut theta = vec![0.0; n];
@@ -224,6 +224,33 @@ fn chord_back(channel: &Channel, from: f64, joint: [f64; 2], chord: f64) -> f64 
         }
     }
     0.5 * (lo + hi)
+}
+
+/// The most tip progress (m) at which the chain of `link_lengths`, its joints on the centreline
+/// from the tip back, keeps its base at the entry: bisected between `within` (a progress that
+/// keeps it) and `beyond` (one that does not).
+fn reach(channel: &Channel, link_lengths: &[f64], within: f64, beyond: f64) -> f64 {
+    let base_at = |tau: f64| {
+        let (mut sigma, mut joint) = (tau, channel.point_at(tau));
+        for &chord in link_lengths.iter().rev() {
+            sigma = chord_back(channel, sigma, joint, chord);
+            joint = channel.point_at(sigma);
+        }
+        sigma
+    };
+    let (mut lo, mut hi) = (within, beyond);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if mid == lo || mid == hi {
+            break;
+        }
+        if base_at(mid) > 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    lo
 }
 
 /// `angle` moved by whole turns to within `pi` of `previous`.

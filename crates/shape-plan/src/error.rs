@@ -105,6 +105,19 @@ pub enum PlanError {
         /// The clearance every shape must keep, m.
         needed: f64,
     },
+    /// A deployment deeper than the arm reaches along the channel with its base at the entry.
+    #[error(
+        "deploy.centerline's length {} m is more than the arm reaches along it with its base at \
+         the entry, {} m (the base would pass the entry: the arm is too short for it)",
+        Compact(*.depth),
+        Compact(*.reach)
+    )]
+    ArmTooShort {
+        /// The depth asked for (m of tip progress).
+        depth: f64,
+        /// The most tip progress with the base at the entry (m).
+        reach: f64,
+    },
     /// A number outside its domain.
     #[error("{name} must be {bound}, got {}", Compact(*.value))]
     OutOfRange {

@@ -116,7 +116,18 @@ fn deployments_refuse_what_they_cannot_do() {
     );
     let channel = Channel::new(&[[0.0, 0.0], [0.0, 3.0]], 0.03).unwrap();
     let short = follow_the_leader(&channel, &[0.1; 10], 0.01, 1, 2.0, 10).unwrap_err();
-    assert!(text(short).contains("too short"));
+    // A straight channel: the arm's 1 m, found by bisection on the tip's progress.
+    let PlanError::ArmTooShort { depth, reach } = short else {
+        panic!("{short:?}");
+    };
+    assert_eq!(depth, 2.0);
+    assert!((reach - 1.0).abs() <= 1e-12, "{reach}");
+    let short = text(short);
+    assert!(
+        short.starts_with("deploy.centerline's length 2 m is more than the arm reaches"),
+        "{short}"
+    );
+    assert!(short.contains("too short"));
     let deep = follow_the_leader(&channel, &[0.1; 10], 0.01, 1, 4.0, 10).unwrap_err();
     assert!(text(deep).contains("deploy depth"));
     let steps = follow_the_leader(&channel, &[0.1; 10], 0.01, 1, 0.5, usize::MAX).unwrap_err();
