@@ -957,7 +957,7 @@ fn path_degenerate() {
                 x_start: 0.2,
                 x_end: 0.2,
             },
-            "reference.x_end",
+            "reference.sine.x_end",
         ),
     ];
     for (shape, setting) in cases {
