@@ -146,7 +146,14 @@ pub(super) fn parse(text: &str, origin: &str) -> Result<Scenario, ScenarioError>
 /// [`parse`]'s reading of the text.
 fn parse_text(text: &str, origin: &str) -> Result<Scenario, ScenarioError> {
     toml::from_str(text).map_err(|e| {
-        let what = e.message().trim_end().replace('\n', "; ");
+        let mut what = e.message().trim_end().replace('\n', "; ");
+        // A date or time reaches serde as a map: say what the user wrote.
+        let given = e.span().and_then(|span| text.get(span));
+        if let (Some(rest), Some(given)) = (what.strip_prefix("invalid type: map,"), given)
+            && given.trim().parse::<toml::value::Datetime>().is_ok()
+        {
+            what = format!("invalid type: date-time,{rest}");
+        }
         let message = match e.span() {
             Some(span) => {
                 let mut end = span.start.min(text.len());

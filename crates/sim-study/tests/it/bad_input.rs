@@ -199,6 +199,24 @@ fn fixed_length_lists_are_read_whole() {
     }
 }
 
+/// A TOML date or time where a number is expected is called one (serde saw "a map").
+#[test]
+fn a_date_where_a_number_is_expected_is_called_a_date() {
+    let step = sim_study::Scenario::builtin_text("paper-responses-step").unwrap();
+    for value in ["1979-05-27T07:32:00Z", "1979-05-27", "07:32:00"] {
+        let text = step.replacen("duration = 2.0", &format!("duration = {value}"), 1);
+        let message = sim_study::Scenario::from_toml(&text)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.ends_with(&format!(
+                "(`duration = {value}`): invalid type: date-time, expected f64"
+            )),
+            "{message}"
+        );
+    }
+}
+
 /// A wrongly typed key of a table tagged by `kind` or `method` is named by its own line (it was
 /// named by the table's header), and a key of another kind is refused as serde refused it.
 #[test]
