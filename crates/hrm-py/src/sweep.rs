@@ -191,7 +191,14 @@ impl Sweep {
         for (k, item) in shards.try_iter()?.enumerate() {
             let item = item?;
             match item.extract::<String>() {
-                Ok(text) if text.trim_start().starts_with('{') => {
+                // A shard's text starts with its header's `{` (after a byte-order mark an
+                // editor may have put there), a path does not.
+                Ok(text)
+                    if text
+                        .trim_start_matches('\u{feff}')
+                        .trim_start()
+                        .starts_with('{') =>
+                {
                     let origin = PathBuf::from(format!("shards[{k}]"));
                     files.push((
                         origin.clone(),

@@ -88,6 +88,9 @@ def test_the_merge_refuses_incomplete_or_foreign_shards():
         hrm.Sweep.merge([texts[0], other.run_shard(2, 2)])
     with pytest.raises(hrm.InvalidInput, match="nothing to merge"):
         hrm.Sweep.merge([])
+    # Texts an editor saved: a byte-order mark and CRLF line ends read as the same shards.
+    edited = ["\ufeff" + text.replace("\n", "\r\n") for text in texts]
+    assert hrm.Sweep.merge(edited) == hrm.Sweep.merge(texts)
 
 
 def test_a_controller_file_changed_after_the_sweep_was_configured_is_refused(tmp_path):
