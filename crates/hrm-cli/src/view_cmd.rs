@@ -26,9 +26,10 @@ pub struct ViewArgs {
     /// Also write an animated GIF of the run (of a main job's folder: of `--run`).
     #[arg(long)]
     gif: Option<PathBuf>,
-    /// The run of a main job's folder the GIF shows, as SCENARIO/CONTROLLER.
-    #[arg(long, default_value = "paper-tracking/fuzzy")]
-    run: String,
+    /// The run of a main job's folder the GIF shows, as SCENARIO/CONTROLLER (default
+    /// `paper-tracking/fuzzy`).
+    #[arg(long)]
+    run: Option<String>,
     /// A sweep's runs to show (their numbers in `--list`), at most 12; they are run again from
     /// the sweep's configuration. Default: the first seed of every controller at the lowest and
     /// the highest noise level. The GIF shows the first.
@@ -85,12 +86,26 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     if args.list {
         return crate::view_sweep::list(dir);
     }
+    let is_run = dir.join("timeseries.csv").is_file();
+    if let Some(run) = &args.run
+        && (is_sweep || is_run)
+    {
+        return Err(format!(
+            "--run {run}: takes a main job's output folder (hrm run); {} is {}",
+            dir.display(),
+            if is_sweep {
+                "a sweep's (choose its runs with --runs)"
+            } else {
+                "one run's"
+            }
+        ));
+    }
     let (title, scenes, gif_run) = if is_sweep {
         let scenes = crate::view_sweep::load(dir, args.runs.as_deref())?;
         let gif_run = scenes[0].runs[0].clone();
         let title = format!("hrm: runs of the sweep in {}", dir.display());
         (title, scenes, gif_run)
-    } else if dir.join("timeseries.csv").is_file() {
+    } else if is_run {
         let (scenario, run) = load_run(dir, None)?;
         let title = format!("{} with {}", scenario.name, run.label);
         let scene = Scene {
@@ -101,10 +116,10 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
         (title, vec![scene], run)
     } else {
         let scenes = load_main_job(dir)?;
-        let (name, controller) = args
-            .run
+        let chosen = args.run.as_deref().unwrap_or("paper-tracking/fuzzy");
+        let (name, controller) = chosen
             .split_once('/')
-            .ok_or_else(|| format!("--run {}: expected SCENARIO/CONTROLLER", args.run))?;
+            .ok_or_else(|| format!("--run {chosen}: expected SCENARIO/CONTROLLER"))?;
         let gif_run = scenes
             .iter()
             .filter(|s| s.title == name)
@@ -121,8 +136,7 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
                     load_run(&folder, None)?;
                 }
                 return Err(format!(
-                    "--run {}: no such run in {} (its folders are SCENARIO/CONTROLLER)",
-                    args.run,
+                    "--run {chosen}: no such run in {} (its folders are SCENARIO/CONTROLLER)",
                     dir.display()
                 ));
             }

@@ -913,6 +913,16 @@ fn hrm_view_writes_a_page_and_a_gif_and_replaces_only_its_own_files() {
         assert!(stderr.contains("--gif <GIF>"), "{stderr}");
     }
     assert!(!run.join("view.html").exists());
+    // --run chooses among a main job's runs: on one run's folder it is refused, not ignored.
+    let line = refused(&hrm(&["view", path(&run), "--run", "paper-tracking/pd"]));
+    assert!(
+        line.ends_with(&format!(
+            "--run paper-tracking/pd: takes a main job's output folder (hrm run); {} is one \
+             run's",
+            run.display()
+        )),
+        "{line}"
+    );
     let gif = dir.join("run.gif");
     let output = hrm(&[
         "view",
