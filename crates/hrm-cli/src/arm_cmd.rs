@@ -298,13 +298,10 @@ fn export(source: &str, format: Format, out: &Path, gravity: Option<&str>) -> Re
     let files = export_files(&robot, format, gravity)?;
     if format == Format::Urdf {
         for joint in unlimited(&robot) {
-            eprintln!(
-                "{}",
-                console::error_line(&format!(
-                    "warning: written as read: {}",
-                    unlimited_note(joint)
-                ))
-            );
+            console::to_stderr(&console::error_line(&format!(
+                "warning: written as read: {}",
+                unlimited_note(joint)
+            )));
         }
     }
     let staging = OutputDir::create(out, "arm export")?;

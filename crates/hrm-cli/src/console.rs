@@ -20,6 +20,13 @@ pub fn print(text: &str) -> Result<(), String> {
     }
 }
 
+/// Writes `line` and a newline to standard error. A standard error that cannot be written
+/// (closed by the reader, `2>/dev/full`) drops the line rather than stop the command: a warning
+/// is not worth a crash, and a failure's exit status still tells.
+pub fn to_stderr(line: &str) {
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
+}
+
 /// Escapes the characters of a user's text (a scenario name, a CSV header) that would break a
 /// table row or reorder it: newline and tab too, besides what [`lane_math::escape_controls`] escapes.
 pub fn escape_field(text: &str) -> String {

@@ -26,7 +26,7 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
     write_run(staging.path(), scenario, &run, stop.as_ref())?;
     staging.commit()?;
     if let Some(warning) = wall_warning(&run) {
-        eprintln!("warning: {warning}");
+        console::to_stderr(&format!("warning: {warning}"));
     }
     let stopped = match &stop {
         Some(error) => format!("stopped: {error}\n"),

@@ -104,7 +104,7 @@ pub(crate) fn warn_outside_range(evaluator: &Evaluator) {
             input.range[0],
             input.range[1]
         );
-        eprintln!("{}", console::error_line(&line));
+        console::to_stderr(&console::error_line(&line));
     }
 }
 

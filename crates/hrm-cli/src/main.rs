@@ -96,7 +96,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
-            eprintln!("{}", console::error_line(&message));
+            console::to_stderr(&console::error_line(&message));
             ExitCode::FAILURE
         }
     }

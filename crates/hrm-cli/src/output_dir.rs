@@ -194,15 +194,12 @@ impl OutputDir {
         if had_old && let Err(e) = remove_tree(&old) {
             // The new output is in place; the old copy (read-only, say) is only in the way: say
             // where it is rather than leave it unnoticed.
-            eprintln!(
-                "{}",
-                crate::console::error_line(&format!(
-                    "warning: wrote {}, but its previous copy, moved to {}, cannot be removed \
+            crate::console::to_stderr(&crate::console::error_line(&format!(
+                "warning: wrote {}, but its previous copy, moved to {}, cannot be removed \
                      ({e}); remove it by hand",
-                    self.shown.display(),
-                    old.display()
-                ))
-            );
+                self.shown.display(),
+                old.display()
+            )));
         }
         Ok(())
     }

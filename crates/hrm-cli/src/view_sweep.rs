@@ -162,7 +162,10 @@ pub fn load(dir: &Path, chosen: Option<&[usize]>) -> Result<Vec<Scene>, String> 
                 config.hrm_version,
                 study::VERSION
             );
-            eprintln!("warning: {}", lane_math::escape_controls(&warning, &[]));
+            console::to_stderr(&format!(
+                "warning: {}",
+                lane_math::escape_controls(&warning, &[])
+            ));
             named.push_str(", which did not give the metrics the sweep stored");
         }
         let key = (id.level_index, id.seed_index);

@@ -1230,3 +1230,39 @@ fn hrm_view_of_a_sweep_runs_the_chosen_runs_again() {
     assert_eq!(std::fs::read(sweep.join("view.html")).unwrap(), before);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A standard error that cannot be written (full, or its reader gone) drops hrm's warnings and
+/// error lines: the command ends with its own status, and `hrm eval` answers every request
+/// (a warning to a closed pipe made it panic with "failed printing to stderr", exit 101).
+#[test]
+fn an_unwritable_standard_error_is_no_crash() {
+    let paper = concat!(env!("CARGO_MANIFEST_DIR"), "/../fuzzy-sugeno/data/paper.fis");
+    let full = || std::fs::File::create("/dev/full").unwrap();
+    for (args, status) in [
+        (vec!["fis", "eval", paper, "0", "0", "0"], 1),
+        (vec!["fis", "eval", paper, "9", "0", "0", "0"], 0),
+    ] {
+        let output = Command::new(env!("CARGO_BIN_EXE_hrm"))
+            .args(&args)
+            .stderr(full())
+            .output()
+            .unwrap();
+        assert_eq!(output.status.code(), Some(status), "{args:?}");
+    }
+    let (reader, writer) = std::io::pipe().unwrap();
+    let mut server = Command::new(env!("CARGO_BIN_EXE_hrm"))
+        .arg("eval")
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(writer)
+        .spawn()
+        .unwrap();
+    drop(reader);
+    let requests = "{\"id\":1,\"op\":\"fuzzy\",\"controller\":\"paper\",\"inputs\":[5,0,0,0]}\n\
+                    {\"id\":2,\"op\":\"fuzzy\",\"controller\":\"paper\",\"inputs\":[0,0,0,0]}\n";
+    std::io::Write::write_all(&mut server.stdin.take().unwrap(), requests.as_bytes()).unwrap();
+    let output = server.wait_with_output().unwrap();
+    assert!(output.status.success(), "{:?}", output.status);
+    let answers = String::from_utf8(output.stdout).unwrap();
+    assert_eq!(answers.lines().count(), 2, "{answers}");
+}
