@@ -136,12 +136,13 @@ fn lit(v: f64) -> String {
     }
 }
 
-/// A C comment's text: no `*/` inside, and control, zero-width and bidirectional formatting
+/// A C comment's text: no `*/` (which would end it) nor `/*` (which `-Wcomment` warns of)
+/// inside, and control, zero-width and bidirectional formatting
 /// characters written as `\u{202e}` (a right-to-left override in a name would make the
 /// source read otherwise than it compiles).
 fn comment(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
-    for c in text.replace("*/", "* /").chars() {
+    for c in text.replace("*/", "* /").replace("/*", "/ *").chars() {
         if c.is_control() || is_invisible_format(c) {
             let _ = write!(out, "{}", c.escape_unicode());
         } else {

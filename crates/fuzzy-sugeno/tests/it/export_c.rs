@@ -306,14 +306,14 @@ fn a_system_without_rules_in_c_matches_rust() {
 fn hostile_names_are_escaped_and_standard_header_prefixes_refused() {
     let text = include_str!("../../data/paper.fis")
         .replacen("Name='da1'", "Name='da1 \u{202e}ltr'", 1)
-        .replacen("[System]\nName='", "[System]\nName='\u{200f}*/", 1);
+        .replacen("[System]\nName='", "[System]\nName='\u{200f}*/ /*", 1);
     let system = FuzzySystem::from_fis(&text).unwrap();
     let c = system.to_c("hostile", &EvalOptions::default()).unwrap();
     for text in [&c.header, &c.source] {
         assert!(!text.contains(['\u{202e}', '\u{200f}']));
     }
     assert!(c.header.contains("da1 \\u{202e}ltr"), "{}", c.header);
-    assert!(c.source.contains("'\\u{200f}* /"), "{}", c.source);
+    assert!(c.source.contains("'\\u{200f}* / / *"), "{}", c.source);
     let mut rng = Rng::new(3);
     let points = (0..100)
         .map(|_| (0, random_point(&system, &mut rng)))
