@@ -45,7 +45,7 @@ enum Command {
         out: PathBuf,
         /// Run each scenario for at most this many seconds, rounded down to whole controller
         /// periods: a quick look at the report (the paper's numbers need the full durations).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         duration: Option<f64>,
     },
     /// Run one scenario (a shipped name such as `paper-tracking`, or a TOML file).

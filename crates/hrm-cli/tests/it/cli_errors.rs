@@ -1236,7 +1236,10 @@ fn hrm_view_of_a_sweep_runs_the_chosen_runs_again() {
 /// (a warning to a closed pipe made it panic with "failed printing to stderr", exit 101).
 #[test]
 fn an_unwritable_standard_error_is_no_crash() {
-    let paper = concat!(env!("CARGO_MANIFEST_DIR"), "/../fuzzy-sugeno/data/paper.fis");
+    let paper = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../fuzzy-sugeno/data/paper.fis"
+    );
     let full = || std::fs::File::create("/dev/full").unwrap();
     for (args, status) in [
         (vec!["fis", "eval", paper, "0", "0", "0"], 1),
@@ -1265,4 +1268,18 @@ fn an_unwritable_standard_error_is_no_crash() {
     assert!(output.status.success(), "{:?}", output.status);
     let answers = String::from_utf8(output.stdout).unwrap();
     assert_eq!(answers.lines().count(), 2, "{answers}");
+}
+
+/// A negative `hrm run --duration` reaches hrm's own check (clap took `-1` for an option).
+#[test]
+fn a_negative_main_job_duration_is_named() {
+    let dir = scratch("errors-run-duration");
+    let out = dir.join("out");
+    let line = refused(&hrm(&["run", "--duration", "-1", "--out", path(&out)]));
+    assert_eq!(
+        line,
+        "hrm: --duration: -1, expected a finite positive number of seconds"
+    );
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
 }
