@@ -20,7 +20,7 @@ use crate::plot::{self, Grid, Labels, Series};
 use clap::{Args, Subcommand};
 use fuzzy_sugeno::{
     AnalysisOptions, EvalOptions, Evaluator, FisNote, FuzzyError, FuzzySystem, InputVariable,
-    MAX_SAMPLES_PER_INPUT,
+    MAX_SAMPLES_PER_INPUT, NoRuleFired,
 };
 use std::path::{Path, PathBuf};
 
@@ -274,12 +274,28 @@ fn eval(
         out_of_range: policy.policy(),
         ..EvalOptions::default()
     };
+    // Evaluated once more where no rule may fire, to say so as MATLAB's evalfis does.
+    let strict = EvalOptions {
+        no_rule_fired: NoRuleFired::Error,
+        ..options.clone()
+    };
     let mut evaluator = Evaluator::with_options(system, options).map_err(|e| e.to_string())?;
     let mut outputs = vec![0.0; evaluator.system().outputs().len()];
     evaluator
         .eval(inputs, &mut outputs)
         .map_err(|e| e.to_string())?;
     warn_outside_range(&evaluator);
+    let mut unfired =
+        Evaluator::with_options(evaluator.system().clone(), strict).map_err(|e| e.to_string())?;
+    if let Err(FuzzyError::NoRuleFired { index, name }) =
+        unfired.eval(inputs, &mut vec![0.0; outputs.len()])
+    {
+        console::to_stderr(&console::error_line(&format!(
+            "warning: no rule fired for output {} ('{name}') at these inputs: its value is the \
+             middle of its range, as MATLAB's evalfis gives",
+            index + 1
+        )));
+    }
     let names = evaluator.system().outputs().iter().map(|o| o.name.clone());
     Ok(names.zip(outputs).collect())
 }

@@ -1283,3 +1283,27 @@ fn a_negative_main_job_duration_is_named() {
     assert!(!out.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Where no rule fires, `hrm fis eval` gives the middle of the output's range and says so on
+/// standard error, as MATLAB's evalfis warns; where one fires, nothing is said.
+#[test]
+fn fis_eval_warns_where_no_rule_fires() {
+    let dir = scratch("errors-fis-unfired");
+    let file = dir.join("grid.fis");
+    // Triangles [-1 0 1] and [0 1 2] on [0, 2]: at 2 neither fires.
+    std::fs::write(&file, grid_fis(2)).unwrap();
+    let unfired = hrm(&["fis", "eval", path(&file), "2", "2"]);
+    assert!(unfired.status.success(), "{unfired:?}");
+    assert_eq!(String::from_utf8_lossy(&unfired.stdout), "y = 0.5\n");
+    assert_eq!(
+        String::from_utf8_lossy(&unfired.stderr),
+        "hrm: warning: no rule fired for output 1 ('y') at these inputs: its value is the middle \
+         of its range, as MATLAB's evalfis gives\n"
+    );
+    let fired = hrm(&["fis", "eval", path(&file), "0.5", "0.5"]);
+    assert!(
+        fired.status.success() && fired.stderr.is_empty(),
+        "{fired:?}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
