@@ -26,6 +26,20 @@ pub static CONTROLLER_LONG_HELP: LazyLock<String> = LazyLock::new(|| {
     help
 });
 
+/// `message` with the library's name of a setting at its start (`learning: the ridge`,
+/// `imitation.margin`) replaced by the option the user gave it with (`--ridge`, `--margin`):
+/// the first of `names` (library name, option) that starts it.
+pub fn as_option(message: String, names: &[(&str, &str)]) -> String {
+    names
+        .iter()
+        .find_map(|(library, option)| {
+            message
+                .strip_prefix(library)
+                .map(|rest| format!("{option}{rest}"))
+        })
+        .unwrap_or(message)
+}
+
 /// `value` of option `option` as a count from `min` to `max`, or the one-line message
 /// "`option` must be at least `min` and at most `max`, got `value`".
 pub fn count(option: &str, value: i128, min: usize, max: usize) -> Result<usize, String> {

@@ -13,6 +13,17 @@ const LONG_RUN_EPOCHS: usize = 50;
 /// The most training scenarios.
 const MAX_SCENARIOS: usize = 64;
 
+/// The library's names of the imitation's settings and the options that give them.
+const OPTIONS: &[(&str, &str)] = &[
+    ("imitation.margin", "--margin"),
+    ("imitation.step", "--step"),
+    ("imitation.offsets", "--offsets"),
+    ("imitation.stride", "--stride"),
+    ("imitation.sets", "--sets"),
+    ("imitation.epochs", "--epochs"),
+    ("imitation.scenarios", "--scenario"),
+];
+
 /// The arguments of `hrm fis imitate`.
 #[derive(Debug, Args)]
 pub struct ImitateArgs {
@@ -66,7 +77,9 @@ pub fn run(args: ImitateArgs) -> Result<(), String> {
         step: args.step,
         margin: args.margin,
     };
-    options.validate().map_err(|e| e.to_string())?;
+    options
+        .validate()
+        .map_err(|e| args::as_option(e.to_string(), OPTIONS))?;
     let mut scenarios = args
         .scenarios
         .iter()
@@ -74,14 +87,16 @@ pub fn run(args: ImitateArgs) -> Result<(), String> {
         .collect::<Result<Vec<_>, _>>()?;
     if let Some(text) = &args.offsets {
         let grid = parse_offsets(text)?;
-        scenarios = imitation::shifted_grid(&scenarios, &grid).map_err(|e| e.to_string())?;
+        scenarios = imitation::shifted_grid(&scenarios, &grid)
+            .map_err(|e| args::as_option(e.to_string(), OPTIONS))?;
     }
     output_dir::refuse_foreign_file(
         &args.out,
         fis_input::RECOGNISED_BYTES,
         fis_input::written_by_hrm,
     )?;
-    let data = imitation::record(&scenarios, &options).map_err(|e| e.to_string())?;
+    let data = imitation::record(&scenarios, &options)
+        .map_err(|e| args::as_option(e.to_string(), OPTIONS))?;
     let m = data.n_outputs();
     println!(
         "{} training pairs from {} runs of {} with {teacher}; {} inputs, {} rules per output",

@@ -16,6 +16,14 @@ use std::path::{Path, PathBuf};
 
 /// The largest CSV file read, in bytes.
 const MAX_CSV_BYTES: u64 = 64 << 20;
+
+/// The learning library's names of the settings `hrm fis train` takes and their options.
+const OPTIONS: &[(&str, &str)] = &[
+    ("learning: the cluster radius", "--cluster-radius"),
+    ("learning: the initial step", "--step"),
+    ("learning: the ridge", "--ridge"),
+    ("learning: sigmf partitions", "--mfs: sigmf partitions"),
+];
 /// The most epochs a training may run from the command line.
 const MAX_EPOCHS: usize = 100_000;
 /// From this many epochs on, a progress bar shows on a terminal.
@@ -65,6 +73,15 @@ pub fn run(args: TrainArgs) -> Result<(), String> {
         1 => ConsequentOrder::First,
         other => return Err(format!("--order must be 0 or 1, got {other}")),
     };
+    let options = AnfisOptions {
+        epochs: epochs.max(1),
+        initial_step: args.step,
+        ridge: args.ridge,
+        ..AnfisOptions::default()
+    };
+    options
+        .validate()
+        .map_err(|e| crate::args::as_option(e.to_string(), OPTIONS))?;
     let mut inputs = vec![("--data", args.data.as_path())];
     inputs.extend(args.check.as_deref().map(|check| ("--check", check)));
     output_dir::refuse_input_as_output(&args.out, &inputs)?;
@@ -96,7 +113,7 @@ pub fn run(args: TrainArgs) -> Result<(), String> {
             genfis_grid(&train, 0, &grid)
         }),
     }
-    .map_err(|e| e.to_string())?;
+    .map_err(|e| crate::args::as_option(e.to_string(), OPTIONS))?;
     console::print(&format!(
         "{} inputs, {} rules, {} training samples{}\n",
         initial.inputs().len(),
@@ -109,15 +126,10 @@ pub fn run(args: TrainArgs) -> Result<(), String> {
     let system = if epochs == 0 {
         initial
     } else {
-        let options = AnfisOptions {
-            epochs,
-            initial_step: args.step,
-            ridge: args.ridge,
-            ..AnfisOptions::default()
-        };
+        let options = AnfisOptions { epochs, ..options };
         let bar = (epochs >= LONG_RUN_EPOCHS).then(|| progress::bar(epochs as u64, "epochs"));
-        let mut trainer =
-            Anfis::new(initial, &train, check.as_ref(), 0, options).map_err(|e| e.to_string())?;
+        let mut trainer = Anfis::new(initial, &train, check.as_ref(), 0, options)
+            .map_err(|e| crate::args::as_option(e.to_string(), OPTIONS))?;
         for _ in 0..epochs {
             let report = trainer.epoch().map_err(|e| e.to_string())?;
             let line = match report.check_rmse {

@@ -78,7 +78,8 @@ impl Default for AnfisOptions {
 }
 
 impl AnfisOptions {
-    fn validate(&self) -> Result<(), FuzzyError> {
+    /// Checks the options as [`Anfis::new`] does, before any data are read or systems built.
+    pub fn validate(&self) -> Result<(), FuzzyError> {
         if !(1..=MAX_EPOCHS).contains(&self.epochs) {
             return Err(LearningProblem::CountOutOfRange {
                 name: "epochs",

@@ -132,11 +132,11 @@ fn bad_options_are_one_line_errors_and_leave_the_old_file() {
         ),
         (
             vec!["--margin", "nan"],
-            "hrm: imitation.margin must lie in [0, 100], got NaN",
+            "hrm: --margin must lie in [0, 100], got NaN",
         ),
         (
             vec!["--offsets", "0,1"],
-            "hrm: imitation.offsets has 1 lists, 'paper-responses-step' has 2 modal coordinates (one list each)",
+            "hrm: --offsets has 1 lists, 'paper-responses-step' has 2 modal coordinates (one list each)",
         ),
     ] {
         let mut full = vec!["fis", "imitate", "--scenario", "paper-responses-step"];

@@ -190,6 +190,39 @@ fn bad_input_is_one_line() {
         with(["--order", "-1"]),
         "hrm: --order must be 0 or 1, got -1\n"
     );
+    // The learning library's refusals of a setting name the option that gave it, before any
+    // system is built (nothing on standard output).
+    for (option, value, message) in [
+        (
+            "--ridge",
+            "-1",
+            "hrm: --ridge must be finite and at least 0, got -1\n",
+        ),
+        (
+            "--ridge",
+            "1e308",
+            "hrm: --ridge must be at most 1e6, got 1e308\n",
+        ),
+        (
+            "--step",
+            "NaN",
+            "hrm: --step must be finite and at least 0, got NaN\n",
+        ),
+        (
+            "--cluster-radius",
+            "2",
+            "hrm: --cluster-radius must lie in (0, 1], got 2\n",
+        ),
+    ] {
+        let mut a = args.to_vec();
+        a.extend([option, value]);
+        let output = hrm(&a);
+        assert_eq!(String::from_utf8_lossy(&output.stderr), message);
+        assert!(output.stdout.is_empty(), "{option} {value}");
+    }
+    let mut a = args.to_vec();
+    a.extend(["--mf-type", "sigmf", "--mfs", "3"]);
+    assert!(refused(&a).starts_with("hrm: --mfs: sigmf partitions have exactly 2 sets per input"));
     // An endless stream (its size reads 0) stops at the 64 MiB limit instead of filling memory.
     if std::path::Path::new("/dev/zero").exists() {
         let endless = [
