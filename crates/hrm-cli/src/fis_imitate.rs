@@ -27,7 +27,7 @@ const OPTIONS: &[(&str, &str)] = &[
 /// The arguments of `hrm fis imitate`.
 #[derive(Debug, Args)]
 pub struct ImitateArgs {
-    /// The controller to imitate: fuzzy, pd, computed-torque or fuzzy-gc.
+    /// The controller to imitate: fuzzy, pd, computed-torque, fuzzy-gc, lqr or mpc.
     #[arg(long, default_value = "computed-torque")]
     teacher: String,
     /// Training scenarios (shipped names or TOML files), all with the same modal coordinates.

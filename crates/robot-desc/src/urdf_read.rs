@@ -99,9 +99,16 @@ pub fn read_urdf(text: &str) -> Result<Reading, DescError> {
     let root = doc.root_element();
     // A prefixed `<x:robot>` is another vocabulary's element, as `<xacro:link>` is no link.
     if root.tag_name().name() != "robot" || root.tag_name().namespace().is_some() {
+        let problem = match root.tag_name().namespace() {
+            Some(namespace) => format!(
+                "the document's element must be <robot> in no namespace, not in namespace \
+                 {namespace:?}"
+            ),
+            None => "the document's element must be <robot>".to_string(),
+        };
         return Err(DescError::invalid(
             format!("<{}>", root.tag_name().name()),
-            "the document's element must be <robot>",
+            problem,
         ));
     }
     let name = required(root, "name", || "<robot>".to_string())?.to_string();

@@ -600,7 +600,10 @@ fn what_is_not_a_serial_chain_is_refused_naming_the_element() {
     refused("<model name=\"x\"/>", &["<model>", "must be <robot>"]);
     refused(
         "<x:robot xmlns:x=\"urn:x\" name=\"r\"><x:link name=\"a\"/></x:robot>",
-        &["<robot>", "must be <robot>"],
+        &[
+            "<robot>",
+            "must be <robot> in no namespace, not in namespace \"urn:x\"",
+        ],
     );
     // 2,000 fixed joints of 1e9 m each: every origin within its bound, their composition not.
     let mut deep = String::from("<robot name=\"r\"><link name=\"l0\"/>");
