@@ -194,9 +194,15 @@ fn parse_csv(text: &str) -> Result<TrainingData, String> {
     let head = fields(first);
     let columns = head.len();
     if !(2..=MAX_INPUTS + 1).contains(&columns) {
+        // A file of one column that holds tabs or semicolons was written with another separator.
+        let separator = match first.find(['\t', ';']) {
+            Some(_) if columns == 1 => " (columns are separated by commas, not tabs or semicolons)",
+            _ => "",
+        };
         return Err(format!(
-            "line {}: {columns} columns; expected 2 to {} (the inputs, then the output)",
+            "line {}: {columns} column{}; expected 2 to {} (the inputs, then the output){separator}",
             first_number + 1,
+            if columns == 1 { "" } else { "s" },
             MAX_INPUTS + 1
         ));
     }
@@ -210,9 +216,10 @@ fn parse_csv(text: &str) -> Result<TrainingData, String> {
         let row = fields(line);
         if row.len() != columns {
             return Err(format!(
-                "line {}: {} columns, expected {columns}",
+                "line {}: {} column{}, expected {columns}",
                 index + 1,
-                row.len()
+                row.len(),
+                if row.len() == 1 { "" } else { "s" }
             ));
         }
         rows += 1;
@@ -287,7 +294,7 @@ mod tests {
         let message = |text: &str| parse_csv(text).unwrap_err();
         assert_eq!(message(""), "no samples: the file is empty");
         assert_eq!(message("a,b\n"), "no samples: only a header line");
-        assert_eq!(message("1,2\n3\n"), "line 2: 1 columns, expected 2");
+        assert_eq!(message("1,2\n3\n"), "line 2: 1 column, expected 2");
         assert_eq!(
             message("1,2\n3,x\n"),
             "line 2 column 2: expected a number, found 'x'"
@@ -298,7 +305,12 @@ mod tests {
         );
         assert_eq!(
             message("7\n"),
-            "line 1: 1 columns; expected 2 to 65 (the inputs, then the output)"
+            "line 1: 1 column; expected 2 to 65 (the inputs, then the output)"
+        );
+        assert_eq!(
+            message("x\ty\n1\t2\n"),
+            "line 1: 1 column; expected 2 to 65 (the inputs, then the output) (columns are \
+             separated by commas, not tabs or semicolons)"
         );
         assert_eq!(
             message("a,a\n1,2\n"),
