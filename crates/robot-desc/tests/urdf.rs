@@ -598,6 +598,12 @@ fn what_is_not_a_serial_chain_is_refused_naming_the_element() {
         &["<robot>", "missing attribute \"name\""],
     );
     refused("<model name=\"x\"/>", &["<model>", "must be <robot>"]);
+    // Past the node limit: named by its number, not in the parser's words.
+    let crowded = format!("<robot name=\"r\">{}</robot>", "<a/>".repeat(1_000_000));
+    refused(
+        &crowded,
+        &["more than the 1000000 XML nodes a robot description may have"],
+    );
     refused(
         "<x:robot xmlns:x=\"urn:x\" name=\"r\"><x:link name=\"a\"/></x:robot>",
         &[
