@@ -15,10 +15,15 @@ pub enum DescError {
         /// The limit.
         max: usize,
     },
-    /// The text is not well-formed XML, or uses a DTD (refused: no entity is ever expanded),
-    /// or has more than [`MAX_XML_NODES`](crate::MAX_XML_NODES) nodes.
-    #[error("{}", xml_problem(.0))]
+    /// The text is not well-formed XML, or uses a DTD (refused: no entity is ever expanded).
+    #[error("not a readable XML document: {0}")]
     Xml(roxmltree::Error),
+    /// More XML nodes than [`MAX_XML_NODES`](crate::MAX_XML_NODES).
+    #[error("more than the {max} XML nodes a robot description may have")]
+    TooManyNodes {
+        /// The limit.
+        max: u32,
+    },
     /// Elements nest deeper than [`MAX_XML_DEPTH`](crate::MAX_XML_DEPTH).
     #[error("elements nest deeper than {max} levels (at line {line}); URDF needs 5")]
     TooDeep {
@@ -121,16 +126,5 @@ impl DescError {
             element: element.into(),
             problem: problem.into(),
         }
-    }
-}
-
-/// What [`DescError::Xml`] says: the node limit by its number, anything else as the parser's.
-fn xml_problem(error: &roxmltree::Error) -> String {
-    match error {
-        roxmltree::Error::NodesLimitReached => format!(
-            "more than the {} XML nodes a robot description may have",
-            crate::MAX_XML_NODES
-        ),
-        other => format!("not a readable XML document: {other}"),
     }
 }

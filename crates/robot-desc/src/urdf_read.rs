@@ -94,7 +94,10 @@ pub fn read_urdf(text: &str) -> Result<Reading, DescError> {
         nodes_limit: MAX_XML_NODES,
         ..ParsingOptions::default()
     };
-    let doc = Document::parse_with_options(text, options).map_err(DescError::Xml)?;
+    let doc = Document::parse_with_options(text, options).map_err(|e| match e {
+        roxmltree::Error::NodesLimitReached => DescError::TooManyNodes { max: MAX_XML_NODES },
+        other => DescError::Xml(other),
+    })?;
     check_shape(&doc)?;
     let root = doc.root_element();
     // A prefixed `<x:robot>` is another vocabulary's element, as `<xacro:link>` is no link.

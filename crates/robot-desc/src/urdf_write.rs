@@ -39,13 +39,15 @@ pub fn write_urdf(robot: &Robot) -> Result<String, DescError> {
             format!("robot '{}'", robot.name),
             match e {
                 // Too large a document: say so with the joints, not only as the XML limit.
-                DescError::Xml(_) | DescError::TooLarge { .. } => format!(
-                    "its URDF of {} movable joints is larger than a URDF is read back (at most \
-                     {} XML nodes, about 25 a joint, and {} MiB): {e}",
-                    robot.joints.len(),
-                    crate::MAX_XML_NODES,
-                    crate::MAX_URDF_BYTES >> 20
-                ),
+                DescError::Xml(_) | DescError::TooLarge { .. } | DescError::TooManyNodes { .. } => {
+                    format!(
+                        "its URDF of {} movable joints is larger than a URDF is read back (at most \
+                         {} XML nodes, about 25 a joint, and {} MiB): {e}",
+                        robot.joints.len(),
+                        crate::MAX_XML_NODES,
+                        crate::MAX_URDF_BYTES >> 20
+                    )
+                }
                 e => format!("its URDF would not read back: {e}"),
             },
         )
