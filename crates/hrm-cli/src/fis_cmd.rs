@@ -274,28 +274,31 @@ fn eval(
         out_of_range: policy.policy(),
         ..EvalOptions::default()
     };
-    // Evaluated once more where no rule may fire, to say so as MATLAB's evalfis does.
+    // Evaluated where no rule may fire, to say so as MATLAB's evalfis does; then, only there,
+    // again under the default (the middle of the output's range).
     let strict = EvalOptions {
         no_rule_fired: NoRuleFired::Error,
         ..options.clone()
     };
-    let mut evaluator = Evaluator::with_options(system, options).map_err(|e| e.to_string())?;
+    let mut evaluator = Evaluator::with_options(system, strict).map_err(|e| e.to_string())?;
     let mut outputs = vec![0.0; evaluator.system().outputs().len()];
-    evaluator
-        .eval(inputs, &mut outputs)
-        .map_err(|e| e.to_string())?;
-    warn_outside_range(&evaluator);
-    let mut unfired =
-        Evaluator::with_options(evaluator.system().clone(), strict).map_err(|e| e.to_string())?;
-    if let Err(FuzzyError::NoRuleFired { index, name }) =
-        unfired.eval(inputs, &mut vec![0.0; outputs.len()])
-    {
-        console::to_stderr(&console::error_line(&format!(
-            "warning: no rule fired for output {} ('{name}') at these inputs: its value is the \
-             middle of its range, as MATLAB's evalfis gives",
-            index + 1
-        )));
+    match evaluator.eval(inputs, &mut outputs) {
+        Ok(()) => {}
+        Err(FuzzyError::NoRuleFired { index, name }) => {
+            console::to_stderr(&console::error_line(&format!(
+                "warning: no rule fired for output {} ('{name}') at these inputs: its value is \
+                 the middle of its range, as MATLAB's evalfis gives",
+                index + 1
+            )));
+            evaluator = Evaluator::with_options(evaluator.system().clone(), options)
+                .map_err(|e| e.to_string())?;
+            evaluator
+                .eval(inputs, &mut outputs)
+                .map_err(|e| e.to_string())?;
+        }
+        Err(other) => return Err(other.to_string()),
     }
+    warn_outside_range(&evaluator);
     let names = evaluator.system().outputs().iter().map(|o| o.name.clone());
     Ok(names.zip(outputs).collect())
 }
