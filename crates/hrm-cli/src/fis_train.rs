@@ -184,8 +184,12 @@ fn parse_csv(text: &str) -> Result<TrainingData, String> {
         line.split(',').map(str::trim).collect()
     }
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    // Lines end in `\n` (or `\r\n`); a file without any `\n` may end them in `\r` alone
+    // (classic Mac OS).
+    let end = if text.contains('\n') { '\n' } else { '\r' };
     let mut lines = text
-        .lines()
+        .split(end)
+        .map(|line| line.strip_suffix('\r').unwrap_or(line))
         .enumerate()
         .filter(|(_, line)| !line.trim().is_empty());
     let Some((first_number, first)) = lines.next() else {
@@ -284,6 +288,11 @@ mod tests {
         assert_eq!(data.n_inputs(), 2);
         assert_eq!(data.column_name(2), "u");
         assert_eq!(data.inputs(1), [-1.0, 0.002]);
+        let classic_mac = parse_csv("e,u\r0.5,1\r2,3\r").unwrap();
+        assert_eq!(classic_mac.rows(), 2);
+        assert_eq!(classic_mac.target(1, 0), 3.0);
+        let windows = parse_csv("e,u\r\n0.5,1\r\n2,x\r\n").unwrap_err();
+        assert_eq!(windows, "line 3 column 2: expected a number, found 'x'");
         let bare = parse_csv("1,2\n3,4").unwrap();
         assert_eq!(bare.column_name(0), "in1");
         assert_eq!(bare.target(1, 0), 4.0);
