@@ -20,6 +20,8 @@
 //!   `// SAFETY:` comment.
 //! - `sim-core` depends on none of [`LOOP_FORBIDS`].
 //! - No import circles among the modules of a crate ([`crate::imports`]).
+//! - The command line writes through its `console` module only: no `print!`, `println!`,
+//!   `eprint!` or `eprintln!` elsewhere in `hrm-cli` (they panic when the reader has gone away).
 //! - `cargo doc --workspace --no-deps` with `RUSTDOCFLAGS=-D warnings`.
 //!
 //! Each check is a function of file contents (the file system is read in [`run`] only), with a
@@ -161,6 +163,21 @@ pub fn run(root: &Path, doc: impl FnOnce() -> Result<(), String>) -> Vec<String>
             let source = std::fs::read_to_string(&file).unwrap_or_default();
             let relative = file.strip_prefix(root).unwrap_or(&file);
             problems.extend(string_problems(&relative.display().to_string(), &source));
+        }
+    }
+
+    let cli = Path::new("crates/hrm-cli/src");
+    for file in rust_files(&root.join(cli)) {
+        let relative = file.strip_prefix(root).unwrap_or(&file);
+        if relative == cli.join("console.rs") {
+            continue;
+        }
+        let source = std::fs::read_to_string(&file).unwrap_or_default();
+        for line in print_macros(&source) {
+            problems.push(format!(
+                "{}:{line}: prints with a std macro, not through `console` (a broken pipe panics)",
+                relative.display()
+            ));
         }
     }
 
@@ -439,6 +456,30 @@ pub fn string_results(source: &str) -> Vec<usize> {
         }
     }
     found
+}
+
+/// The lines (1-based) of `source`'s code (tests aside) that use `print!`, `println!`,
+/// `eprint!` or `eprintln!`.
+pub fn print_macros(source: &str) -> Vec<usize> {
+    let is_print = |line: &str| {
+        line.match_indices("print").any(|(at, _)| {
+            let before = line[..at].strip_suffix('e').unwrap_or(&line[..at]);
+            let after = line[at + "print".len()..]
+                .strip_prefix("ln")
+                .unwrap_or(&line[at + 5..]);
+            after.starts_with('!')
+                && !before
+                    .chars()
+                    .next_back()
+                    .is_some_and(|c| c.is_alphanumeric() || c == '_')
+        })
+    };
+    library_code(source)
+        .iter()
+        .enumerate()
+        .filter(|(_, line)| is_print(line))
+        .map(|(i, _)| i + 1)
+        .collect()
 }
 
 /// The variants of `source`'s error enums (public or not, named `...Error`) that carry only a
@@ -844,6 +885,15 @@ mod tests {
                       #[cfg(test)]\n\
                       mod tests {\n    fn h() -> Result<(), String> {}\n}\n";
         assert_eq!(string_results(source), [2, 3, 9]);
+    }
+
+    #[test]
+    fn print_macros_are_found() {
+        let source = "fn a() {\n    println!(\"x\");\n    eprint!(\"y\");\n\
+                      console::print(\"z\");\n    writeln!(out, \"w\");\n\
+                      // println!(\"comment\")\n    print!(\"v\");\n    eprintln!(\"u\");\n}\n\
+                      #[cfg(test)]\nmod tests {\n    fn t() { println!(\"t\") }\n}\n";
+        assert_eq!(print_macros(source), [2, 3, 7, 8]);
     }
 
     #[test]

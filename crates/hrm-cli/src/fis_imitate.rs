@@ -2,7 +2,7 @@
 //! (`sim_study::imitation`), written as a MATLAB `.fis` file that any scenario with the same
 //! modal coordinates takes as its `controller.fis`.
 
-use crate::{args, fis_input, output_dir, progress};
+use crate::{args, console, fis_input, output_dir, progress};
 use clap::Args;
 use sim_study::imitation::{self, ImitationOptions, MAX_EPOCHS, MAX_SETS, MAX_STRIDE};
 use sim_study::{ControllerKind, Scenario};
@@ -98,16 +98,18 @@ pub fn run(args: ImitateArgs) -> Result<(), String> {
     let data = imitation::record(&scenarios, &options)
         .map_err(|e| args::as_option(e.to_string(), OPTIONS))?;
     let m = data.n_outputs();
-    println!(
-        "{} training pairs from {} runs of {} with {teacher}; {} inputs, {} rules per output",
+    console::print(&format!(
+        "{} training pairs from {} runs of {} with {teacher}; {} inputs, {} rules per output\n",
         data.rows(),
         scenarios.len(),
         args.scenarios.join(", "),
         data.n_inputs(),
         options.sets.pow(m as u32)
-    );
+    ))?;
     let total = options.epochs * m;
     let bar = (total >= LONG_RUN_EPOCHS).then(|| progress::bar(total as u64, "epochs"));
+    // The first failure to write a line (not a reader gone away), reported once training ends.
+    let mut printed = Ok(());
     let learned = imitation::train(&data, &options, |output, report| {
         let line = format!(
             "{} epoch {}: training RMSE {:.6e}",
@@ -115,15 +117,21 @@ pub fn run(args: ImitateArgs) -> Result<(), String> {
             report.epoch,
             report.training_rmse
         );
-        match &bar {
+        let line = format!("{line}\n");
+        let result = match &bar {
             Some(bar) => {
-                bar.suspend(|| println!("{line}"));
+                let result = bar.suspend(|| console::print(&line));
                 bar.inc(1);
+                result
             }
-            None => println!("{line}"),
+            None => console::print(&line),
+        };
+        if printed.is_ok() {
+            printed = result;
         }
     })
     .map_err(|e| e.to_string())?;
+    printed?;
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
@@ -133,14 +141,14 @@ pub fn run(args: ImitateArgs) -> Result<(), String> {
         .zip(&learned.training_rmse)
         .enumerate()
     {
-        println!(
-            "{}: kept epoch {epoch}, RMSE against the teacher {rmse:.6e} N m",
+        console::print(&format!(
+            "{}: kept epoch {epoch}, RMSE against the teacher {rmse:.6e} N m\n",
             data.column_name(data.n_inputs() + output)
-        );
+        ))?;
     }
     let text = fis_input::signed_fis(&learned.system);
     output_dir::write_file(&args.out, &text, "fis imitate")?;
-    println!("wrote {}", args.out.display());
+    console::print(&format!("wrote {}\n", args.out.display()))?;
     Ok(())
 }
 
