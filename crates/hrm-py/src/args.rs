@@ -15,7 +15,12 @@ pub(crate) fn wrong_type(name: &str, expected: &str, value: &Bound<'_, PyAny>) -
         .get_type()
         .name()
         .map_or_else(|_| "object".to_string(), |n| n.to_string());
-    PyTypeError::new_err(format!("{name} must be {expected}, got a {given}"))
+    let article = if given.starts_with(['a', 'e', 'i', 'o', 'u']) {
+        "an"
+    } else {
+        "a"
+    };
+    PyTypeError::new_err(format!("{name} must be {expected}, got {article} {given}"))
 }
 
 /// A real number for argument `name` (a Python or numpy int or float).
@@ -75,6 +80,9 @@ pub(crate) fn path(value: &Bound<'_, PyAny>, name: &str) -> PyResult<std::path::
     value.extract().map_err(|e| {
         if passes_through(value.py(), &e) {
             e
+        } else if value.is_instance_of::<PyString>() {
+            // A str the file system cannot encode (a lone surrogate): the codec says where.
+            Error::input(format!("{name} is not a usable file name: {e}")).into()
         } else {
             wrong_type(name, "a str or an os.PathLike", value)
         }

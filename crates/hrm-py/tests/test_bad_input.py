@@ -444,10 +444,12 @@ def test_wrong_argument_types_name_the_argument():
         hrm.Arm(lengths=np.ones((2, 2)))
     with pytest.raises(TypeError, match="^noise_levels must be a sequence of real numbers, got a str$"):
         hrm.Sweep("paper-responses-step", noise_levels="abc", seeds=1)
-    with pytest.raises(TypeError, match="^path_or_text must be a str or an os.PathLike, got a int$"):
+    with pytest.raises(TypeError, match="^path_or_text must be a str or an os.PathLike, got an int$"):
         hrm.Scenario.from_toml(5)
     with pytest.raises(TypeError, match="^path_or_text must be a str or an os.PathLike"):
         hrm.fuzzy.System.from_fis(5)
+    with pytest.raises(hrm.InvalidInput, match="^path_or_text is not a usable file name: .*surrogates not allowed"):
+        hrm.fuzzy.System.from_fis("\ud800.fis")
     with pytest.raises(hrm.InvalidInput, match="^base_seed must be a whole number from 0 to 2\\^64 - 1, got -1$"):
         hrm.Sweep(short_step(), noise_levels=[0.0], seeds=1, base_seed=-1)
     with pytest.raises(TypeError, match="^base_seed must be a whole number, got a float$"):
@@ -470,7 +472,7 @@ def test_arguments_once_converted_by_pyo3_name_themselves():
     system = hrm.fuzzy.paper_controller()
     cases = [
         (lambda: hrm.ReducedModel(hrm.Arm(links=10), alpha0="x"), TypeError, "^alpha0 must be a real number, got a str$"),
-        (lambda: model.ik([0.3, 0.5], branch=1), TypeError, "^branch must be a str, got a int$"),
+        (lambda: model.ik([0.3, 0.5], branch=1), TypeError, "^branch must be a str, got an int$"),
         (lambda: model.ik([0.3, 0.5], alpha0=[1.0]), TypeError, "^alpha0 must be a real number, got a list$"),
         (lambda: system.check(coverage="x"), TypeError, "^coverage must be a real number, got a str$"),
         (lambda: system.check(max_jump="y"), TypeError, "^max_jump must be a real number, got a str$"),
@@ -481,7 +483,7 @@ def test_arguments_once_converted_by_pyo3_name_themselves():
          "^rate_noise_ratio must be a real number, got a str$"),
         (lambda: sweep.shard_runs(-1, 2), hrm.InvalidInput, "^index must be at least 1, got -1$"),
         (lambda: sweep.run_shard(1, 2**70), hrm.InvalidInput, "^count must be a whole number of at most 64 bits"),
-        (lambda: hrm.Scenario.builtin(5), TypeError, "^name must be a str, got a int$"),
+        (lambda: hrm.Scenario.builtin(5), TypeError, "^name must be a str, got an int$"),
         (lambda: hrm.ReferenceSample([float("nan")], [0.0], [0.0]), hrm.InvalidInput, "^a\\[0\\] must be finite"),
         (lambda: hrm.ReferenceSample([0.0], [float("inf")], [0.0]), hrm.InvalidInput, "^a_dot\\[0\\] must be finite"),
     ]

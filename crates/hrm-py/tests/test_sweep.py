@@ -46,7 +46,7 @@ def test_plan():
         hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, rate_noise_ratio=-1.0)
     with pytest.raises(TypeError, match="^controllers must be a sequence of controller names, got a str$"):
         hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, controllers="pd")
-    with pytest.raises(TypeError, match=r"^controllers\[1\] must be a str, got a int$"):
+    with pytest.raises(TypeError, match=r"^controllers\[1\] must be a str, got an int$"):
         hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, controllers=["pd", 3])
     with pytest.raises(hrm.InvalidInput, match="noise_levels"):
         hrm.Sweep("paper-responses-step", noise_levels=[i * 1e-6 for i in range(1001)], seeds=1)
