@@ -239,6 +239,7 @@ impl Scenario {
                 sample.a
             }
         };
+        check_moves_mass(&robot, &model, &q0)?;
         let (kp, kd) = self.controller.computed_torque_gains(n)?;
         let period = self.controller_period()?;
         let settings = ChainLoopSettings {
@@ -254,6 +255,45 @@ impl Scenario {
             damping: joint_limits.damping,
         };
         run_chain_loop(&model, reference.as_mut(), &q0, &settings)
+    }
+}
+
+/// Refuses, before the run, a chain whose mass matrix is singular at the initial joint
+/// positions `q0`: a joint that moves no mass or inertia there (every link beyond it massless,
+/// or only point masses on its axis), which the forward dynamics could not integrate from
+/// `t = 0`. Other problems of `q0` (its length, a value out of range) are the loop's to name.
+///
+/// # Errors
+/// [`SimError::InvalidSetting`] naming `arm.urdf`, the joint (by its URDF name and its place
+/// in the chain, counted from 1) and its child link.
+fn check_moves_mass(
+    robot: &robot_desc::Robot,
+    model: &SpatialModel,
+    q0: &[f64],
+) -> Result<(), SimError> {
+    let n = model.n_links();
+    if q0.len() != n {
+        return Ok(());
+    }
+    let mut data = manip_dyn::spatial::SpatialData::new(model);
+    let zeros = vec![0.0; n];
+    let mut qdd = vec![0.0; n];
+    match manip_dyn::spatial::aba(model, &mut data, q0, &zeros, &zeros, &mut qdd) {
+        Err(manip_dyn::DynError::SingularJoint { index }) => {
+            let joint = &robot.joints[index];
+            Err(SimError::setting(
+                "arm.urdf",
+                format!(
+                    "joint {} ({}): moves no mass or inertia at the initial positions (its link \
+                     {} and every link beyond massless, or their masses on its axis), so the \
+                     chain's mass matrix is singular: give a link beyond it a mass and inertia",
+                    index + 1,
+                    lane_math::one_line(&joint.name),
+                    lane_math::one_line(&joint.child.name),
+                ),
+            ))
+        }
+        _ => Ok(()),
     }
 }
 
@@ -403,6 +443,22 @@ mod tests {
             .unwrap();
         let damped = with("<dynamics damping=\"0.5\"/>").unwrap();
         assert_ne!(damped.record.q, step.record.q);
+        // The last link and the tool welded to it without their inertials: refused before the
+        // run, by name.
+        let mut massless_tip = text.clone();
+        for _ in 0..2 {
+            let tip = massless_tip.rfind("<inertial>").unwrap();
+            let end = massless_tip.rfind("</inertial>").unwrap() + "</inertial>".len();
+            massless_tip.replace_range(tip..end, "");
+        }
+        std::fs::write(dir.join("tip.urdf"), &massless_tip).unwrap();
+        let mut scenario = Scenario::load(&example("step.toml")).unwrap();
+        scenario.arm.urdf = Some(dir.join("tip.urdf"));
+        let e = scenario.run_chain().unwrap_err().to_string();
+        assert!(
+            e.starts_with("arm.urdf joint 7 (joint7): moves no mass or inertia at the initial"),
+            "{e}"
+        );
         let e = with("<dynamics friction=\"2\"/>").unwrap_err().to_string();
         assert!(
             e.starts_with("arm.urdf joint 1 (joint1): <dynamics friction=\"2\"> (dry friction)"),
