@@ -419,6 +419,9 @@ pub fn write_files(files: &[(PathBuf, impl AsRef<[u8]>)], command: &str) -> Resu
                     let _ = std::fs::remove_file(temporary);
                     crate::signals::unregister(temporary);
                 }
+                for (path, _) in files {
+                    crate::signals::remove_bare_folder(path.parent().unwrap_or(Path::new("")));
+                }
                 return Err(e);
             }
         }
@@ -436,8 +439,20 @@ pub fn write_files(files: &[(PathBuf, impl AsRef<[u8]>)], command: &str) -> Resu
 }
 
 /// Writes `path`'s contents with `write` into its temporary sibling (after removing the
-/// temporaries of killed commands) and returns the sibling's path; on failure nothing is left.
+/// temporaries of killed commands) and returns the sibling's path; on failure nothing is left,
+/// not even the folder it created for `path`.
 fn stage_file(
+    path: &Path,
+    command: &str,
+    write: impl FnOnce(&mut dyn Write) -> Result<(), String>,
+) -> Result<PathBuf, String> {
+    stage_file_in_folder(path, command, write).inspect_err(|_| {
+        crate::signals::remove_bare_folder(path.parent().unwrap_or(Path::new("")));
+    })
+}
+
+/// [`stage_file`], creating `path`'s folder (with its [`MARKER`]) when it does not exist.
+fn stage_file_in_folder(
     path: &Path,
     command: &str,
     write: impl FnOnce(&mut dyn Write) -> Result<(), String>,
@@ -451,6 +466,7 @@ fn stage_file(
         std::fs::create_dir_all(dir).map_err(|e| fail("cannot create the folder of", &e))?;
         std::fs::write(dir.join(MARKER), format!("written by `hrm {command}`\n"))
             .map_err(|e| fail("cannot create the folder of", &e))?;
+        crate::signals::register_folder(dir, MARKER);
     }
     if !dir.as_os_str().is_empty() && !dir.is_dir() {
         return Err(format!(
@@ -487,6 +503,7 @@ fn stage_file(
 fn put_in_place(temporary: &Path, path: &Path) -> Result<(), String> {
     let renamed = std::fs::rename(temporary, path).map_err(|e| {
         let _ = std::fs::remove_file(temporary);
+        crate::signals::remove_bare_folder(path.parent().unwrap_or(Path::new("")));
         format!("cannot write {}: {e}", path.display())
     });
     crate::signals::unregister(temporary);
@@ -1132,6 +1149,24 @@ mod tests {
         assert_eq!(err, "the runs stopped");
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "{\"a\":1}");
         assert_eq!(names(&root.join("shards")), [MARKER, "shard-1-of-2.json"]);
+        // A writer that fails into a folder it created leaves no folder; into a folder holding
+        // another file (a shard another task wrote meanwhile), the folder stays.
+        let fresh = root.join("fresh/shard-1-of-2.json");
+        let fail = |out: &mut dyn Write| {
+            out.write_all(b"{").map_err(|e| e.to_string())?;
+            Err("the runs stopped".to_string())
+        };
+        assert!(write_file_with(&fresh, "sweep --shard", fail).is_err());
+        assert!(!root.join("fresh").exists());
+        let shared = root.join("shared/shard-1-of-2.json");
+        assert!(
+            write_file_with(&shared, "sweep --shard", |out| {
+                std::fs::write(root.join("shared/shard-2-of-2.json"), "{}").unwrap();
+                fail(out)
+            })
+            .is_err()
+        );
+        assert_eq!(names(&root.join("shared")), [MARKER, "shard-2-of-2.json"]);
         std::fs::remove_dir_all(&root).unwrap();
     }
 

@@ -47,6 +47,46 @@ pub fn install() {
     }
 }
 
+/// Folders created for an output, with the name of the marker file put in each: removed on a
+/// signal (or by [`remove_bare_folder`]) while the marker is all they hold.
+static CREATED: Mutex<Vec<(PathBuf, String)>> = Mutex::new(Vec::new());
+
+/// Records `dir` as created by this command, holding only the file `marker` so far.
+pub fn register_folder(dir: &Path, marker: &str) {
+    if let Ok(mut created) = CREATED.lock() {
+        created.push((dir.to_path_buf(), marker.to_string()));
+    }
+}
+
+/// Removes `dir` if this command created it ([`register_folder`]) and it still holds nothing
+/// but its marker: a failed command leaves no empty output folder behind. A folder another
+/// process has written into meanwhile (shards sharing a folder) stays.
+pub fn remove_bare_folder(dir: &Path) {
+    let marker = match CREATED.lock() {
+        Ok(created) => created
+            .iter()
+            .find(|(created, _)| created == dir)
+            .map(|(_, marker)| marker.clone()),
+        Err(_) => None,
+    };
+    if let Some(marker) = marker {
+        remove_if_only(dir, &marker);
+    }
+}
+
+/// Removes `dir` and its file `marker` when that file is all it holds.
+fn remove_if_only(dir: &Path, marker: &str) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let names: Vec<_> = entries.flatten().take(2).map(|e| e.file_name()).collect();
+    if names.len() == 1 && names[0] == marker {
+        let _ = std::fs::remove_file(dir.join(marker));
+        // Fails, and keeps the folder, if a file arrived since.
+        let _ = std::fs::remove_dir(dir);
+    }
+}
+
 /// Records `path` (a staging folder or temporary file) as being written.
 pub fn register(path: &Path) {
     if let Ok(mut staged) = STAGED.lock() {
@@ -73,5 +113,12 @@ fn clean_up() {
         } else {
             std::fs::remove_file(&path)
         };
+    }
+    let created = match CREATED.lock() {
+        Ok(created) => created.clone(),
+        Err(poisoned) => poisoned.into_inner().clone(),
+    };
+    for (dir, marker) in created {
+        remove_if_only(&dir, &marker);
     }
 }
