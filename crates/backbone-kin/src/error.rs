@@ -199,6 +199,9 @@ pub enum KinError {
         /// The end-point error there.
         residual: f64,
     },
+    /// The system refused the memory of a map's or a solver's arrays.
+    #[error(transparent)]
+    OutOfMemory(#[from] lane_math::OutOfMemory),
 }
 
 /// Where [`KinError::Stationary`] stopped.
@@ -218,6 +221,7 @@ impl Classify for KinError {
     /// tolerance ([`NotConverged`](KinError::NotConverged)), met coordinates where no step is
     /// defined ([`Stationary`](KinError::Stationary)) or converged to coordinates its
     /// forward kinematics cannot evaluate ([`AnswerTooOscillatory`](KinError::AnswerTooOscillatory));
+    /// [`OutOfMemory`](ErrorClass::OutOfMemory) for memory the system refused;
     /// otherwise the input was malformed or
     /// outside the model's domain.
     ///
@@ -232,6 +236,7 @@ impl Classify for KinError {
             Self::NotConverged { .. }
             | Self::Stationary { .. }
             | Self::AnswerTooOscillatory { .. } => ErrorClass::Numerical,
+            Self::OutOfMemory(e) => e.class(),
             _ => ErrorClass::InvalidInput,
         }
     }

@@ -128,7 +128,7 @@ impl ModalMap {
             MAX_MAP_ENTRIES,
         )?;
         // Rows of the inclination map phi = Phi a (+ alpha0), then theta_i = phi_i - phi_{i-1}.
-        let mut jacobian = vec![0.0; n * m];
+        let mut jacobian = lane_math::try_filled(n * m, 0.0, "the modal map's Jacobian")?;
         let mut previous = vec![0.0; m];
         let mut start = 0.0;
         for (i, &len) in link_lengths.iter().enumerate() {
@@ -149,7 +149,7 @@ impl ModalMap {
                 *prev = phi;
             }
         }
-        let mut offset = vec![0.0; n];
+        let mut offset = lane_math::try_filled(n, 0.0, "the modal map's joint offsets")?;
         if let BaseAngle::Fixed(alpha0) = base {
             offset[0] = alpha0;
         }
@@ -158,9 +158,21 @@ impl ModalMap {
             n_coords: m,
             harmonics,
             base,
-            link_lengths: link_lengths.to_vec(),
+            link_lengths: lane_math::try_copied(link_lengths, "the modal map's link lengths")?,
             jacobian,
             offset,
+        })
+    }
+
+    /// A copy of the map, or [`KinError::OutOfMemory`] when the system refuses the memory
+    /// (`clone` aborts then).
+    pub fn try_clone(&self) -> Result<Self, KinError> {
+        const WHAT: &str = "a copy of the modal map";
+        Ok(Self {
+            link_lengths: lane_math::try_copied(&self.link_lengths, WHAT)?,
+            jacobian: lane_math::try_copied(&self.jacobian, WHAT)?,
+            offset: lane_math::try_copied(&self.offset, WHAT)?,
+            ..*self
         })
     }
 

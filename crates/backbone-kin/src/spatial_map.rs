@@ -69,13 +69,28 @@ impl SpatialModalMap {
             rows.saturating_mul(cols),
             MAX_MAP_ENTRIES,
         )?;
-        let mut jacobian = vec![0.0; rows * cols];
+        let mut jacobian = lane_math::try_filled(rows * cols, 0.0, "the spatial modal Jacobian")?;
         for (i, pair) in jacobian.chunks_exact_mut(2 * cols).enumerate() {
             let (z_row, y_row) = pair.split_at_mut(cols);
             z_row[..k2].copy_from_slice(planar.row(i));
             y_row[k2..].copy_from_slice(planar.row(i));
         }
         Ok(Self { planar, jacobian })
+    }
+
+    /// A copy of the map, or [`KinError::OutOfMemory`] when the system refuses the memory
+    /// (`clone` aborts then).
+    ///
+    /// ```
+    /// let map = backbone_kin::SpatialModalMap::uniform(12, 2)?;
+    /// assert_eq!(map.try_clone()?, map);
+    /// # Ok::<(), backbone_kin::KinError>(())
+    /// ```
+    pub fn try_clone(&self) -> Result<Self, KinError> {
+        Ok(Self {
+            planar: self.planar.try_clone()?,
+            jacobian: lane_math::try_copied(&self.jacobian, "a copy of the spatial modal map")?,
+        })
     }
 
     /// Number of links `n`.

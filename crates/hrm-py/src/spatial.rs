@@ -37,11 +37,12 @@ struct Workspace {
 impl Workspace {
     fn new(model: &SpatialReducedModel) -> crate::errors::Result<Self> {
         Ok(Self {
-            data: SpatialReducedData::new(model),
-            derivatives: SpatialReducedDerivatives::new(model),
+            data: SpatialReducedData::try_new(model).map_err(Error::from)?,
+            derivatives: SpatialReducedDerivatives::try_new(model).map_err(Error::from)?,
             theta: vec![0.0; model.map().n_joints()],
             a_ddot: vec![0.0; model.n_coords()],
-            ik: SpatialIk::new(model.map().clone(), *model.base()).map_err(Error::from)?,
+            ik: SpatialIk::new(model.map().try_clone().map_err(Error::from)?, *model.base())
+                .map_err(Error::from)?,
         })
     }
 }

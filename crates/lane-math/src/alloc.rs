@@ -53,6 +53,18 @@ pub fn try_filled<T: Clone>(
     Ok(values)
 }
 
+/// A copy of `values`, or [`OutOfMemory`] naming `what` when the system refuses the memory.
+///
+/// ```
+/// assert_eq!(lane_math::try_copied(&[1.0, 2.0], "x")?, [1.0, 2.0]);
+/// # Ok::<(), lane_math::OutOfMemory>(())
+/// ```
+pub fn try_copied<T: Clone>(values: &[T], what: &'static str) -> Result<Vec<T>, OutOfMemory> {
+    let mut copy = try_with_capacity(values.len(), what)?;
+    copy.extend_from_slice(values);
+    Ok(copy)
+}
+
 /// An empty vector with room for exactly `capacity` values, or [`OutOfMemory`] naming `what`.
 pub fn try_with_capacity<T>(capacity: usize, what: &'static str) -> Result<Vec<T>, OutOfMemory> {
     let mut values = Vec::new();

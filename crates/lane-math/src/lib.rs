@@ -10,7 +10,7 @@ mod lanes;
 mod message;
 mod trig;
 
-pub use alloc::{OutOfMemory, try_filled, try_reserve, try_with_capacity};
+pub use alloc::{OutOfMemory, try_copied, try_filled, try_reserve, try_with_capacity};
 pub use checks::{
     EntryIndex, ShapeError, ShapeProblem, all_finite, check_all_finite, check_finite, check_len,
     check_values, first_non_finite,

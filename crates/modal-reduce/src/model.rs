@@ -134,18 +134,20 @@ impl ReducedModel {
         check_column_rank(&map)?;
         // mu_l, the mass beyond link l (see the module `terms` for this and S_l, h_ll and K).
         let chain_links = chain.links();
-        let mut beyond = vec![0.0; n];
+        let zeros = |len: usize, what| lane_math::try_filled(len, 0.0, what);
+        let mut beyond = zeros(n, "the reduced model's link masses")?;
         for l in (0..n - 1).rev() {
             beyond[l] = beyond[l + 1] + chain_links[l + 1].mass;
         }
-        let mut angle_rows = vec![0.0; n * m + LINK_PADDING];
-        let mut moment_rows = vec![0.0; n * m + LINK_PADDING];
+        let rows = n * m + LINK_PADDING;
+        let mut angle_rows = zeros(rows, "the reduced model's angle rows")?;
+        let mut moment_rows = zeros(rows, "the reduced model's moment rows")?;
         let padded = n.next_multiple_of(LINK_PADDING);
         let mut links = LinkConstants {
-            length: vec![0.0; padded],
-            first_moment: vec![0.0; padded],
-            angle_offset: vec![0.0; padded],
-            angle_columns: vec![0.0; m * padded],
+            length: zeros(padded, "the reduced model's link lengths")?,
+            first_moment: zeros(padded, "the reduced model's first moments")?,
+            angle_offset: zeros(padded, "the reduced model's angle offsets")?,
+            angle_columns: zeros(m * padded, "the reduced model's angle columns")?,
             padded,
         };
         let mut constant_mass = vec![0.0; m * m + LINK_PADDING];

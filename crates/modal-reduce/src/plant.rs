@@ -284,11 +284,19 @@ pub enum PlantData {
 
 impl PlantData {
     /// A workspace for `plant`.
+    ///
+    /// # Panics
+    /// When the system refuses the memory; [`PlantData::try_new`] returns the error.
     pub fn new(plant: Plant<'_>) -> Self {
-        match plant {
-            Plant::Planar(model) => PlantData::Planar(ReducedData::new(model)),
-            Plant::Spatial(model) => PlantData::Spatial(SpatialReducedData::new(model)),
-        }
+        Self::try_new(plant).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`PlantData::new`], or [`ReduceError::OutOfMemory`] when the system refuses the memory.
+    pub fn try_new(plant: Plant<'_>) -> Result<Self, ReduceError> {
+        Ok(match plant {
+            Plant::Planar(model) => PlantData::Planar(ReducedData::try_new(model)?),
+            Plant::Spatial(model) => PlantData::Spatial(SpatialReducedData::try_new(model)?),
+        })
     }
 
     /// `M*` (`m x m`) of the last computation.
@@ -334,11 +342,22 @@ pub enum PlantBatchData {
 
 impl PlantBatchData {
     /// A workspace for `plant`.
+    ///
+    /// # Panics
+    /// When the system refuses the memory; [`PlantBatchData::try_new`] returns the error.
     pub fn new(plant: Plant<'_>) -> Self {
-        match plant {
-            Plant::Planar(model) => PlantBatchData::Planar(ReducedBatchData::new(model)),
-            Plant::Spatial(model) => PlantBatchData::Spatial(SpatialReducedBatchData::new(model)),
-        }
+        Self::try_new(plant).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`PlantBatchData::new`], or [`ReduceError::OutOfMemory`] when the system refuses the
+    /// memory.
+    pub fn try_new(plant: Plant<'_>) -> Result<Self, ReduceError> {
+        Ok(match plant {
+            Plant::Planar(model) => PlantBatchData::Planar(ReducedBatchData::try_new(model)?),
+            Plant::Spatial(model) => {
+                PlantBatchData::Spatial(SpatialReducedBatchData::try_new(model)?)
+            }
+        })
     }
 }
 

@@ -348,6 +348,15 @@ impl Classify for SimError {
 }
 
 impl SimError {
+    /// The error of building a workspace of the plant: [`SimError::OutOfMemory`] when the system
+    /// refused its memory, otherwise [`SimError::Model`].
+    pub(crate) fn workspace(error: ReduceError) -> Self {
+        match error {
+            ReduceError::OutOfMemory(e) => Self::OutOfMemory(e),
+            e => Self::Model(e),
+        }
+    }
+
     /// The run's error for a controller failure at `t`: a [`SimError`] (the built-in
     /// controllers') as it is, any other error as [`SimError::Controller`].
     pub fn from_controller(t: f64, error: ControllerError) -> Self {

@@ -506,7 +506,7 @@ impl Simulation {
                 vec![[0.0, 0.0, 1.0]; c.n_links()],
             )),
         };
-        let data = PlantData::new(plant);
+        let data = PlantData::try_new(plant).map_err(SimError::workspace)?;
         let stepper = Stepper::new(settings.integrator, 2 * m);
         let mut simulation = Self {
             plant: Dynamics {

@@ -49,11 +49,21 @@ pub struct SpatialReducedBatchData {
 
 impl SpatialReducedBatchData {
     /// A workspace sized for `model`, for the instruction set of this processor.
+    ///
+    /// # Panics
+    /// When the system refuses the memory; [`SpatialReducedBatchData::try_new`] returns the
+    /// error.
     pub fn new(model: &SpatialReducedModel) -> Self {
-        Self {
-            single: SpatialReducedData::new(model),
+        Self::try_new(model).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`SpatialReducedBatchData::new`], or [`ReduceError::OutOfMemory`] when the system
+    /// refuses the memory.
+    pub fn try_new(model: &SpatialReducedModel) -> Result<Self, ReduceError> {
+        Ok(Self {
+            single: SpatialReducedData::try_new(model)?,
             arch: Arch::new(),
-        }
+        })
     }
 }
 

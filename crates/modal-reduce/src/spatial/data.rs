@@ -50,7 +50,18 @@ pub struct SpatialReducedData {
 
 impl SpatialReducedData {
     /// A workspace for `model`.
+    ///
+    /// # Panics
+    /// When the system refuses the memory; [`SpatialReducedData::try_new`] returns the error.
     pub fn new(model: &SpatialReducedModel) -> Self {
+        Self::try_new(model).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`SpatialReducedData::new`], or [`ReduceError::OutOfMemory`] when the system refuses the
+    /// memory.
+    pub fn try_new(model: &SpatialReducedModel) -> Result<Self, ReduceError> {
+        const WHAT: &str = "the workspace of the spatial reduced model";
+        let zeros = |len: usize| lane_math::try_filled(len, 0.0, WHAT);
         let (n, m) = (model.n_links(), model.n_coords());
         let padded = model.padded_links();
         let zero_motion = LinkMotion {
@@ -63,28 +74,28 @@ impl SpatialReducedData {
             com: [0.0; 3],
             com_accel: [0.0; 3],
         };
-        Self {
+        Ok(Self {
             n_links: n,
             n_coords: m,
-            theta: vec![0.0; 2 * n],
-            theta_dot: vec![0.0; 2 * n],
-            theta_ddot: vec![0.0; 2 * n],
-            link_rates: vec![0.0; 2 * padded],
-            link_sin: vec![0.0; 2 * padded],
-            link_cos: vec![0.0; 2 * padded],
-            point_jacobian: vec![0.0; 3 * m],
-            com_jacobian: vec![0.0; 3 * m],
-            momentum_jacobian: vec![0.0; 3 * m],
-            body_jacobian: vec![0.0; 3 * m],
-            body_inertia_jacobian: vec![0.0; 3 * m],
-            mass_matrix: vec![0.0; m * m],
-            coriolis: vec![0.0; m],
-            gravity: vec![0.0; m],
-            factor: vec![0.0; m * m],
-            solution: vec![0.0; m],
-            links: vec![zero_motion; n],
+            theta: zeros(2 * n)?,
+            theta_dot: zeros(2 * n)?,
+            theta_ddot: zeros(2 * n)?,
+            link_rates: zeros(2 * padded)?,
+            link_sin: zeros(2 * padded)?,
+            link_cos: zeros(2 * padded)?,
+            point_jacobian: zeros(3 * m)?,
+            com_jacobian: zeros(3 * m)?,
+            momentum_jacobian: zeros(3 * m)?,
+            body_jacobian: zeros(3 * m)?,
+            body_inertia_jacobian: zeros(3 * m)?,
+            mass_matrix: zeros(m * m)?,
+            coriolis: zeros(m)?,
+            gravity: zeros(m)?,
+            factor: zeros(m * m)?,
+            solution: zeros(m)?,
+            links: lane_math::try_filled(n, zero_motion, WHAT)?,
             arch: Arch::new(),
-        }
+        })
     }
 
     /// The reduced mass matrix `M* = J^T M J` (`m x m`, row-major) of the last computation.

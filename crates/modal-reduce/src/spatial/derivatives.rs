@@ -46,17 +46,29 @@ pub struct SpatialReducedDerivatives {
 
 impl SpatialReducedDerivatives {
     /// A workspace sized for `model`.
+    ///
+    /// # Panics
+    /// When the system refuses the memory; [`SpatialReducedDerivatives::try_new`] returns the
+    /// error.
     pub fn new(model: &SpatialReducedModel) -> Self {
+        Self::try_new(model).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`SpatialReducedDerivatives::new`], or [`ReduceError::OutOfMemory`] when the system
+    /// refuses the memory.
+    pub fn try_new(model: &SpatialReducedModel) -> Result<Self, ReduceError> {
+        const WHAT: &str = "the workspace of the spatial reduced derivatives";
+        let zeros = |len: usize| lane_math::try_filled(len, 0.0, WHAT);
         let (n, m) = (model.n_links(), model.n_coords());
-        Self {
+        Ok(Self {
             n_links: n,
             n_coords: m,
-            a_ddot: vec![0.0; m],
-            jacobians: vec![0.0; 3 * m * m],
-            tau: vec![0.0; 2 * n],
-            d_tau: vec![0.0; 2 * n],
-            tangents: vec![LinkTangent::default(); n],
-        }
+            a_ddot: zeros(m)?,
+            jacobians: zeros(3 * m * m)?,
+            tau: zeros(2 * n)?,
+            d_tau: zeros(2 * n)?,
+            tangents: lane_math::try_filled(n, LinkTangent::default(), WHAT)?,
+        })
     }
 
     /// The modal accelerations `a_ddot` (eq 15) of the last call.

@@ -114,9 +114,10 @@ impl SpatialReducedModel {
         lane_math::check_all_finite("gravity", &gravity)?;
         let (n, m) = (map.n_links(), map.n_coords());
         let half = m / 2;
-        let mut joint_rows = vec![0.0; 2 * n * m + LINK_PADDING];
+        let zeros = |len: usize, what| lane_math::try_filled(len, 0.0, what);
+        let mut joint_rows = zeros(2 * n * m + LINK_PADDING, "the reduced model's joint rows")?;
         let padded = n.next_multiple_of(LINK_PADDING);
-        let mut angle_columns = vec![0.0; half * padded];
+        let mut angle_columns = zeros(half * padded, "the reduced model's angle columns")?;
         for (i, rows) in joint_rows.chunks_exact_mut(2 * m).take(n).enumerate() {
             let row = &map.planar().row(i)[..half];
             rows[..half].copy_from_slice(row);
@@ -125,13 +126,11 @@ impl SpatialReducedModel {
                 angle_columns[k * padded + i] = value;
             }
         }
-        let spin_moments = links
-            .iter()
-            .map(|link| {
-                let [xx, yy, zz] = link.principal;
-                [zz - yy, xx - zz, yy - xx]
-            })
-            .collect();
+        let mut spin_moments = lane_math::try_with_capacity(n, "the reduced model's spin moments")?;
+        spin_moments.extend(links.iter().map(|link| {
+            let [xx, yy, zz] = link.principal;
+            [zz - yy, xx - zz, yy - xx]
+        }));
         Ok(Self {
             spin_moments,
             map,

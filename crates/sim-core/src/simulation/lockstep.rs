@@ -126,8 +126,8 @@ impl Lockstep {
         }
         Ok(Self {
             stopped: vec![None; runs.len()],
-            batch: PlantBatchData::new(plant),
-            single: PlantData::new(plant),
+            batch: PlantBatchData::try_new(plant).map_err(SimError::workspace)?,
+            single: PlantData::try_new(plant).map_err(SimError::workspace)?,
             slots: Vec::with_capacity(runs.len()),
             a: vec![0.0; values],
             a_dot: vec![0.0; values],
