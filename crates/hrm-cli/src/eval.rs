@@ -248,11 +248,15 @@ const OPS: &str = "fk, ik, joints, dynamics, reduced, fuzzy, rnea_derivatives, a
 
 fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
     request::check_rates(&request)?;
+    request::check_arm_kind(&request)?;
     // `"urdf"` in place of `"arm"`: the spatial chain of a robot description.
     let urdf = request.contains_key("urdf");
     if spatial::is_spatial(&request) {
         request::check_spatial_coordinates(&request)?;
         return spatial::dispatch(op, request);
+    }
+    if !urdf {
+        request::check_joint_angles(&request)?;
     }
     match op {
         "dynamics" if urdf => robot::dynamics(parse(request)?),
@@ -327,7 +331,8 @@ fn fk(mut request: FkRequest) -> EvalResult {
 struct IkRequest {
     #[serde(default, deserialize_with = "arm_object")]
     arm: ArmSpec,
-    target: [f64; 2],
+    /// Read whole: serde's `[f64; 2]` says "expected fewer elements in array" of three.
+    target: Vec<f64>,
     alpha0: f64,
     harmonics: Option<usize>,
     guess: Option<Vec<f64>>,
@@ -340,6 +345,15 @@ struct IkRequest {
 /// entries) both solvers start there instead, which reaches targets off the closed form's first
 /// branch of `J0`.
 fn ik(request: IkRequest) -> EvalResult {
+    let target: [f64; 2] = request.target.as_slice().try_into().map_err(|_| {
+        EvalError::new(
+            Kind::InvalidRequest,
+            format!(
+                "target must have 2 entries [x, y] (a planar arm), got {}",
+                request.target.len()
+            ),
+        )
+    })?;
     let chain = request.arm.to_chain()?;
     let k = harmonics(request.harmonics, MAX_IK_HARMONICS)?;
     let (length, alpha0) = (chain.total_length(), reduce_angle(request.alpha0));
@@ -362,7 +376,7 @@ fn ik(request: IkRequest) -> EvalResult {
             )));
         }
         None => {
-            let closed = inverse_kinematics(length, request.target, alpha0, Branch::Positive)?;
+            let closed = inverse_kinematics(length, target, alpha0, Branch::Positive)?;
             let mut start = vec![0.0; 2 * k];
             start[..2].copy_from_slice(&closed);
             start
@@ -370,13 +384,12 @@ fn ik(request: IkRequest) -> EvalResult {
     };
     let mut a = start.clone();
     if k > 1 || guessed {
-        HarmonicIk::new(length, k, alpha0)
-            .and_then(|mut solver| solver.solve(request.target, &mut a))?;
+        HarmonicIk::new(length, k, alpha0).and_then(|mut solver| solver.solve(target, &mut a))?;
     }
     finite("a", &a)?;
     let mut a_chain = start;
     match ChainIk::new(&lengths, k, alpha0)
-        .and_then(|mut solver| solver.solve(request.target, &mut a_chain))
+        .and_then(|mut solver| solver.solve(target, &mut a_chain))
     {
         Ok(_) => {
             finite("a_chain", &a_chain)?;
@@ -573,7 +586,7 @@ fn fuzzy(request: FuzzyRequest) -> EvalResult {
     }
     let mut outputs = vec![0.0; evaluator.system().outputs().len()];
     evaluator.eval(&request.inputs, &mut outputs)?;
-    crate::fis_cmd::warn_outside_range(&evaluator);
+    crate::fis_cmd::warn_outside_range(&evaluator, "\"out_of_range\": \"clamp\"");
     finite("outputs", &outputs)?;
     Ok(json_fields([("outputs", json!(outputs))]))
 }
@@ -1110,6 +1123,10 @@ mod tests {
                 "\"arm\" must be an object of arm fields, got an array",
             ),
             (json!({"op": "fk", "alpha0": 0}), "missing field `a`"),
+            (
+                json!({"op": "ik", "target": [0.3, 0.5, 0.0], "alpha0": 1.57}),
+                "target must have 2 entries [x, y] (a planar arm), got 3",
+            ),
         ] {
             let answer = request(line.clone());
             assert_eq!(
@@ -1145,6 +1162,11 @@ mod tests {
             assert!(message.contains("finite"), "{answer}");
             assert!(message.ends_with(fields), "{answer}");
         }
+        // The accelerations by the request's name, not the library's `qdd`.
+        let answer = request(json!({"op": "aba_derivatives", "arm": {"links": 3},
+            "theta": [0, 1, 0.5], "theta_dot": [0, 0, 0], "tau": [1e308, -1e308, 1e308]}));
+        let message = answer["error"]["message"].as_str().unwrap();
+        assert!(message.starts_with("theta_ddot is not finite"), "{answer}");
     }
 
     #[test]
@@ -1154,6 +1176,11 @@ mod tests {
             (
                 json!({"op": "dynamics", "theta": vec![0.1; 10], "theta_dot": [0, 1e300, 0, 0, 0, 0, 0, 0, 0, 0]}),
                 "theta_dot[1] must be at most 1000000 in magnitude (rad/s, m/s for a prismatic joint), got 1e300",
+            ),
+            (
+                json!({"op": "dynamics", "arm": {"links": 3}, "theta": [1e17, 1.0, 0.5],
+                    "theta_dot": [0, 0, 0]}),
+                "theta[0] must be at most 1000000 in magnitude (rad), got 1e17",
             ),
             (
                 json!({"op": "reduced_derivatives", "a": [0.1, 0.2, 0.3], "a_dot": [-2e6, 0, 0],
@@ -1175,6 +1202,27 @@ mod tests {
                     .starts_with(message),
                 "{answer}"
             );
+        }
+        // A planar arm's angles at the bound: the mass matrix depends on the relative angles
+        // alone, as the straight-started one says.
+        let mass = |theta: [f64; 3]| {
+            request(
+                json!({"op": "dynamics", "arm": {"links": 3}, "theta": theta,
+                "theta_dot": [0, 0, 0]}),
+            )["mass_matrix"]
+                .clone()
+        };
+        let (far, near) = (mass([1e6, 1.0, 0.5]), mass([0.0, 1.0, 0.5]));
+        for (row_far, row_near) in far.as_array().unwrap().iter().zip(near.as_array().unwrap()) {
+            for (x, y) in row_far
+                .as_array()
+                .unwrap()
+                .iter()
+                .zip(row_near.as_array().unwrap())
+            {
+                let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+                assert!((x - y).abs() < 1e-9 * y.abs().max(1e-3), "{far} {near}");
+            }
         }
         // At the bound the answer is finite.
         let answer = request(json!({"op": "aba_derivatives", "theta": vec![0.1; 10],

@@ -88,8 +88,10 @@ enum FisCommand {
 
 /// Warns on standard error, as MATLAB's `evalfis` does, when `evaluator` has evaluated an input
 /// outside its range as given: once per process (a `hrm eval` session answers many requests).
-/// Inputs are numbered from 1, as in the library's errors and the `.fis` file.
-pub(crate) fn warn_outside_range(evaluator: &Evaluator) {
+/// Inputs are numbered from 1, as in the library's errors and the `.fis` file; `clamp` is how
+/// the caller asks for the other policy (`--out-of-range clamp`, or a request's
+/// `"out_of_range": "clamp"`).
+pub(crate) fn warn_outside_range(evaluator: &Evaluator, clamp: &str) {
     static WARNED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
     if let Some(outside) = evaluator.first_outside_range()
         && !WARNED.swap(true, std::sync::atomic::Ordering::Relaxed)
@@ -97,7 +99,7 @@ pub(crate) fn warn_outside_range(evaluator: &Evaluator) {
         let input = &evaluator.system().inputs()[outside.index];
         let line = format!(
             "warning: input {} ('{}') = {} is outside its range [{}, {}]; evaluated as given, as \
-             MATLAB's evalfis does (--out-of-range clamp evaluates at the nearest end)",
+             MATLAB's evalfis does ({clamp} evaluates at the nearest end)",
             outside.index + 1,
             input.name,
             outside.value,
@@ -298,7 +300,7 @@ fn eval(
         }
         Err(other) => return Err(other.to_string()),
     }
-    warn_outside_range(&evaluator);
+    warn_outside_range(&evaluator, "--out-of-range clamp");
     let names = evaluator.system().outputs().iter().map(|o| o.name.clone());
     Ok(names.zip(outputs).collect())
 }

@@ -116,7 +116,7 @@ def test_pickling_keeps_the_arm():
         ({"links": 0}, "arm.links must be at least 1"),
         ({"links": -3}, "arm.links must be at least 1"),
         ({"harmonics": 17}, "harmonics must be from 1 to 16"),
-        ({"links": 1}, "harmonics = 1 gives 2 coordinates per bending plane, more than the arm's 1 links"),
+        ({"links": 1}, "arm.links must be at least 2 for a spatial arm"),
         ({"lengths": [0.1] * 4, "masses": [0.1] * 5}, "arm.masses has 5 entries"),
         ({"links": 4, "inertias": [[1.0, 0.1, 0.1]] * 4}, "triangle"),
         ({"link_mass": -1.0}, r"^arm.link_mass is invalid: link 0: mass must be positive and finite, got -1"),

@@ -80,7 +80,8 @@ pub(super) fn aba_derivatives(request: AbaDerivativesRequest) -> EvalResult {
         &request.theta,
         &request.theta_dot,
         &request.tau,
-    )?;
+    )
+    .map_err(accelerations_named)?;
     aba_answer(
         derivatives.value(),
         derivatives.d_q(),
@@ -153,6 +154,21 @@ pub(super) fn joint_vectors(
         }
     }
     Ok(())
+}
+
+/// A library error of `aba_derivatives` as an answer, the accelerations by the request's name
+/// (`theta_ddot`, the library's `qdd`).
+pub(super) fn accelerations_named(error: manip_dyn::DynError) -> EvalError {
+    match error {
+        manip_dyn::DynError::NonFiniteResult { name: "qdd" } => {
+            let class = lane_math::Classify::class(&error);
+            EvalError::new(
+                super::request::Kind::Library(class),
+                error.to_string().replacen("qdd", "theta_ddot", 1),
+            )
+        }
+        other => other.into(),
+    }
 }
 
 /// The answer of `rnea_derivatives` (of an arm or a URDF chain): `tau` and its Jacobians in

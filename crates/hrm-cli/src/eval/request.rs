@@ -290,6 +290,29 @@ pub(super) fn check_spatial_coordinates(request: &Map<String, Value>) -> Result<
     }
 }
 
+/// Refuses an `arm.kind` that is not a string: serde would also read a unit variant from the
+/// map `{"spatial": null}`, which [`is_spatial`](super::spatial::is_spatial) does not see.
+pub(super) fn check_arm_kind(request: &Map<String, Value>) -> Result<(), EvalError> {
+    match request.get("arm").and_then(|arm| arm.get("kind")) {
+        Some(kind) if !kind.is_string() => Err(EvalError::new(
+            Kind::InvalidRequest,
+            format!("arm.kind must be \"planar\" or \"spatial\", got {kind}"),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Refuses a planar arm's joint angles `theta` beyond the scale a run resolves
+/// ([`sim_core::check_coordinates`]): its dynamics sum them into absolute link angles, where
+/// `1e17` rounds the others away (the mass matrix came out as the straight arm's).
+pub(super) fn check_joint_angles(request: &Map<String, Value>) -> Result<(), EvalError> {
+    match numbers(request, "theta") {
+        Some(theta) => sim_core::check_coordinates("theta", &theta, theta.len())
+            .map_err(|e| EvalError::input(e.to_string())),
+        None => Ok(()),
+    }
+}
+
 /// The array field `name` of a request as numbers, an entry that is not one read as zero (left
 /// to the op's own parsing); `None` when the field is not an array.
 fn numbers(request: &Map<String, Value>, name: &str) -> Option<Vec<f64>> {

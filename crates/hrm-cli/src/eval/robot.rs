@@ -195,7 +195,10 @@ pub(super) fn aba_derivatives(request: AbaDerivativesRequest) -> EvalResult {
         &request.theta_dot,
         &request.tau,
     )
-    .map_err(|error| joint_named(&request.urdf, error))?;
+    .map_err(|error| match error {
+        DynError::NonFiniteResult { .. } => super::derivatives::accelerations_named(error),
+        error => joint_named(&request.urdf, error),
+    })?;
     aba_answer(
         derivatives.value(),
         derivatives.d_q(),

@@ -234,13 +234,13 @@ fn reduced_derivatives(request: ReducedRequest) -> EvalResult {
 struct ExportRequest {
     arm: SpatialArmSpec,
     format: String,
-    harmonics: Option<usize>,
 }
 
 /// `export`: the arm as URDF or MJCF ([`robot_desc::from_spatial_arm`]: its movable joints in the
 /// order of `theta`; the MJCF carries the arm's gravity, a URDF none).
 fn export(request: ExportRequest) -> EvalResult {
-    let model = request.arm.model(harmonics(request.harmonics)?)?;
+    // The chain does not depend on the modal family: the model of one harmonic describes it.
+    let model = request.arm.model(1)?;
     let robot = robot_desc::from_spatial_arm(&model, "hrm_spatial_arm")
         .map_err(|e| EvalError::input(format!("arm.links: {e}")))?;
     let text = match request.format.as_str() {
@@ -528,6 +528,22 @@ mod tests {
             (
                 json!({"op": "export", "arm": {"kind": "spatial"}, "format": "sdf"}),
                 "format must be",
+            ),
+            (
+                json!({"op": "export", "arm": {"kind": "spatial"}, "format": "urdf", "harmonics": 2}),
+                "harmonics: unknown field `harmonics`",
+            ),
+            (
+                json!({"op": "fk", "arm": {"kind": "spatial", "links": 1}, "a": [0, 0, 0, 0]}),
+                "arm.links must be at least 2 for a spatial arm",
+            ),
+            (
+                json!({"op": "fk", "arm": {"kind": "spatial", "gravity": [0, 0]}, "a": [0, 0, 0, 0]}),
+                "arm.gravity must have 3 entries [gx, gy, gz], got 2",
+            ),
+            (
+                json!({"op": "fk", "arm": {"kind": {"spatial": null}}, "a": [0, 0, 0, 0]}),
+                "arm.kind must be \"planar\" or \"spatial\", got {\"spatial\":null}",
             ),
             (
                 json!({"op": "ik", "arm": {"kind": "spatial"}, "target": [5.0, 0.0, 0.0]}),

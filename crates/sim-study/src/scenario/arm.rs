@@ -137,7 +137,7 @@ impl<'de> Deserialize<'de> for Gravity {
                 Ok(Gravity::Magnitude(v as f64))
             }
             fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Gravity, A::Error> {
-                triple(seq, "gravity", "[gx, gy, gz]").map(Gravity::Vector)
+                triple(seq, "arm.gravity", "[gx, gy, gz]").map(Gravity::Vector)
             }
         }
         deserializer.deserialize_any(GravityVisitor)

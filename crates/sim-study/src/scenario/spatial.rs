@@ -154,6 +154,15 @@ impl ArmSpec {
         if k == 0 {
             return Err(SimError::setting("modal.harmonics", "must be at least 1"));
         }
+        if n < 2 {
+            return Err(SimError::setting(
+                "arm.links",
+                format!(
+                    "must be at least 2 for a spatial arm (one harmonic takes 2 coordinates per \
+                     bending plane, which must not outnumber the links), got {n}"
+                ),
+            ));
+        }
         if k > n / 2 {
             return Err(SimError::setting(
                 "modal.harmonics",
