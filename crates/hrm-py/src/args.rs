@@ -25,7 +25,11 @@ pub(crate) fn wrong_type(name: &str, expected: &str, value: &Bound<'_, PyAny>) -
 
 /// A real number for argument `name` (a Python or numpy int or float).
 pub(crate) fn real(value: &Bound<'_, PyAny>, name: &str) -> PyResult<f64> {
-    if value.is_instance_of::<PyString>() || value.is_instance_of::<PyBytes>() {
+    // A bool is an int to Python, but `link_length=True` is a slip, not a length of 1.
+    if value.is_instance_of::<PyString>()
+        || value.is_instance_of::<PyBytes>()
+        || value.is_instance_of::<PyBool>()
+    {
         return Err(wrong_type(name, "a real number", value));
     }
     value.extract::<f64>().map_err(|e| {

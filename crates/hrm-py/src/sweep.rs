@@ -295,7 +295,10 @@ fn controller_kinds(controllers: &Bound<'_, PyAny>) -> PyResult<Vec<ControllerKi
             .into());
         }
         let name = crate::args::text(&item?, &format!("controllers[{i}]"))?;
-        kinds.push(name.parse::<ControllerKind>().map_err(Error::from)?);
+        let kind = name.parse::<ControllerKind>();
+        kinds.push(
+            kind.map_err(|e| Error::from(e.renamed("controller", &format!("controllers[{i}]"))))?,
+        );
     }
     Ok(kinds)
 }

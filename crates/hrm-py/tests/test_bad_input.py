@@ -436,6 +436,10 @@ def test_runs_settings_and_reference_samples_pickle():
 
 
 def test_wrong_argument_types_name_the_argument():
+    with pytest.raises(TypeError, match="^link_length must be a real number, got a bool$"):
+        hrm.Arm(link_length=True)
+    with pytest.raises(TypeError, match="^alpha0 must be a real number, got a bool$"):
+        hrm.ReducedModel(hrm.Arm(links=10), alpha0=False)
     with pytest.raises(TypeError, match="^link_length must be a real number, got a str$"):
         hrm.Arm(link_length="x")
     with pytest.raises(TypeError, match="^gravity must be a real number"):
@@ -444,6 +448,8 @@ def test_wrong_argument_types_name_the_argument():
         hrm.Arm(lengths=np.ones((2, 2)))
     with pytest.raises(TypeError, match="^noise_levels must be a sequence of real numbers, got a str$"):
         hrm.Sweep("paper-responses-step", noise_levels="abc", seeds=1)
+    with pytest.raises(hrm.InvalidInput, match=r"^controllers\[1\] must be one of fuzzy, pd, .*got 'zzz'$"):
+        hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, controllers=["pd", "zzz"])
     with pytest.raises(TypeError, match="^path_or_text must be a str or an os.PathLike, got an int$"):
         hrm.Scenario.from_toml(5)
     with pytest.raises(TypeError, match="^path_or_text must be a str or an os.PathLike"):

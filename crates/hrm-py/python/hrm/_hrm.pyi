@@ -194,6 +194,9 @@ class Settings:
 class ReferenceSample:
     """The reference a Python controller receives at a sample (reference noise included)."""
 
+    def __init__(self, a: ArrayLike, a_dot: ArrayLike, a_ddot: ArrayLike) -> None:
+        """A reference sample of a, a_dot and a_ddot (each m numbers; copied), e.g. to test a
+        controller outside a run."""
     @property
     def a(self) -> Array:
         """Desired modal coordinates (rad), shape (m,)."""
