@@ -882,6 +882,8 @@ fn a_shard_edited_with_its_digest_is_still_checked_as_a_sweep() {
         "x\nforged line".into(),
         "x\u{1b}[31m\u{202e}".into(),
         "A".repeat(3000),
+        String::new(),
+        "  ".into(),
     ] {
         let mut bad = file.clone();
         bad.runs[1].outcome = StoredOutcome::Failed {

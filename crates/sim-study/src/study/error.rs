@@ -309,7 +309,7 @@ pub enum ShardProblem {
     /// writes it ([`lane_math::one_line`]).
     #[error(
         ": line {line}: run {run}: outcome.failed.error is not a message a sweep writes: it must \
-         be one line without control characters, of at most about 2000 characters"
+         be one line without control characters, not blank, of at most about 2000 characters"
     )]
     FailureMessage {
         /// The line.
@@ -391,8 +391,8 @@ pub enum MergeProblem {
         first: PathBuf,
         /// The other.
         other: PathBuf,
-        /// The first setting that differs.
-        field: &'static str,
+        /// The first setting that differs (a scenario's key by its path, `scenario.duration`).
+        field: String,
     },
     /// Two shards run with different contents of an input.
     #[error(

@@ -321,8 +321,9 @@ impl SweepConfig {
         )
     }
 
-    /// The name of the first field in which `other` differs, if any.
-    pub fn first_difference(&self, other: &Self) -> Option<&'static str> {
+    /// The name of the first field in which `other` differs, if any: a scenario's key by its
+    /// path (`scenario.duration`, `scenario.controller.fis`).
+    pub fn first_difference(&self, other: &Self) -> Option<String> {
         let (a, b) = (&self.settings, &other.settings);
         [
             ("hrm_version", self.hrm_version == other.hrm_version),
@@ -340,7 +341,51 @@ impl SweepConfig {
         ]
         .into_iter()
         .find(|(_, equal)| !equal)
-        .map(|(name, _)| name)
+        .map(|(name, _)| match name {
+            "scenario" => {
+                let tree = |scenario: &Scenario| serde_json::to_value(scenario).ok();
+                match (tree(&self.scenario), tree(&other.scenario)) {
+                    (Some(here), Some(there)) => {
+                        first_different_key(&here, &there, "scenario".to_string())
+                    }
+                    _ => "scenario".to_string(),
+                }
+            }
+            name => name.to_string(),
+        })
+    }
+}
+
+/// The path (`scenario.reference.sine.amplitude`, `scenario.arm.lengths[3]`) of the first entry
+/// where two trees differ, `path` itself where they differ as a whole.
+fn first_different_key(
+    here: &serde_json::Value,
+    there: &serde_json::Value,
+    path: String,
+) -> String {
+    use serde_json::Value;
+    match (here, there) {
+        (Value::Object(a), Value::Object(b)) => {
+            let keys = a.keys().chain(b.keys().filter(|k| !a.contains_key(*k)));
+            for key in keys {
+                match (a.get(key), b.get(key)) {
+                    (Some(x), Some(y)) if x == y => {}
+                    (Some(x), Some(y)) => {
+                        return first_different_key(x, y, format!("{path}.{key}"));
+                    }
+                    _ => return format!("{path}.{key}"),
+                }
+            }
+            path
+        }
+        (Value::Array(a), Value::Array(b)) if a.len() == b.len() => a
+            .iter()
+            .zip(b)
+            .position(|(x, y)| x != y)
+            .map_or(path.clone(), |i| {
+                first_different_key(&a[i], &b[i], format!("{path}[{i}]"))
+            }),
+        _ => path,
     }
 }
 
@@ -525,9 +570,15 @@ mod tests {
         assert_eq!(a.first_difference(&a.clone()), None);
         let mut b = a.clone();
         b.settings.base_seed = 10;
-        assert_eq!(a.first_difference(&b), Some("base_seed"));
+        assert_eq!(a.first_difference(&b).as_deref(), Some("base_seed"));
         b.scenario.duration = 0.5;
-        assert_eq!(a.first_difference(&b), Some("scenario"));
+        assert_eq!(a.first_difference(&b).as_deref(), Some("scenario.duration"));
+        let mut c = a.clone();
+        c.scenario.controller.fis = Some("/elsewhere/tuned.fis".into());
+        assert_eq!(
+            a.first_difference(&c).as_deref(),
+            Some("scenario.controller.fis")
+        );
     }
 
     proptest! {

@@ -483,7 +483,7 @@ impl<R: ShardSource> ShardReader<R> {
         // that neither the terminal nor `table.txt` shows a shard's control characters and no
         // merge carries a message of megabytes into every output.
         if let StoredOutcome::Failed { error, .. } = &run.outcome
-            && !lane_math::is_one_line(error)
+            && (!lane_math::is_one_line(error) || error.trim().is_empty())
         {
             return Err(refuse(ShardProblem::FailureMessage {
                 line,
@@ -606,7 +606,7 @@ pub fn merge_readers<R: ShardSource>(
     let refuse = |problem| Err(StudyError::Merge(problem));
     for other in &shards {
         let (first, other_path) = (first_path.clone(), other.origin.clone());
-        match config.first_difference(&other.header.config) {
+        match config.first_difference(&other.header.config).as_deref() {
             None => {}
             Some("inputs") => {
                 let (here, there) = (&config.inputs, &other.header.config.inputs);
@@ -622,7 +622,7 @@ pub fn merge_readers<R: ShardSource>(
                     None => MergeProblem::DifferentSweeps {
                         first,
                         other: other_path,
-                        field: "inputs",
+                        field: "inputs".to_string(),
                     },
                 });
             }
@@ -630,7 +630,7 @@ pub fn merge_readers<R: ShardSource>(
                 return refuse(MergeProblem::DifferentSweeps {
                     first,
                     other: other_path,
-                    field,
+                    field: field.to_string(),
                 });
             }
         }
