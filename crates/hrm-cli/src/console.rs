@@ -35,7 +35,7 @@ pub fn escape_field(text: &str) -> String {
 
 /// The one line `hrm` writes to standard error for a failure: the message as
 /// [`lane_math::one_line`] shows it (control characters escaped, long numbers with exponents,
-/// cut after 2,000 characters).
+/// cut to 2,000 characters).
 pub fn error_line(message: &str) -> String {
     format!("hrm: {}", lane_math::one_line(message))
 }

@@ -79,7 +79,7 @@ impl Error {
 
 /// The exception of the error's class, its message one line as the CLI prints it
 /// ([`lane_math::one_line`]: control characters escaped, any number written out in full by a
-/// library, `1e-300` as 302 characters, in exponent form, cut after 2,000 characters).
+/// library, `1e-300` as 302 characters, in exponent form, cut to 2,000 characters).
 impl From<Error> for PyErr {
     fn from(error: Error) -> PyErr {
         let message = lane_math::one_line(&error.message);

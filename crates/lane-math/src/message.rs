@@ -34,28 +34,46 @@ fn is_bidi_control(c: char) -> bool {
 /// 100,000 noise levels) is cut after them.
 const MAX_MESSAGE_CHARS: usize = 2000;
 
+/// Characters kept from the end of a cut message: what a message says last (serde's
+/// "expected one of ..." after a 100 kB field name) survives the cut.
+const KEPT_TAIL_CHARS: usize = 400;
+
 /// `message` as one line a person reads: control and bidirectional characters escaped
 /// ([`escape_controls`]), very long numbers in exponent form ([`compact_numbers`]), and at most
-/// 2,000 characters, a longer one cut with the count of what was left out.
+/// 2,000 characters: a longer one keeps its start and its last 400 characters around the count
+/// of what was left out.
 pub fn one_line(message: &str) -> String {
     let compact = compact_numbers(&escape_controls(message, &[]));
-    match compact.char_indices().nth(MAX_MESSAGE_CHARS) {
-        None => compact,
-        Some((cut, _)) => format!(
-            "{} ... ({} more characters)",
-            &compact[..cut],
-            compact[cut..].chars().count()
-        ),
+    let total = compact.chars().count();
+    if total <= MAX_MESSAGE_CHARS {
+        return compact;
     }
+    let marker = |left_out: usize| format!(" ... ({left_out} characters left out) ... ");
+    // The marker's length for the largest count it can show.
+    let head = MAX_MESSAGE_CHARS - KEPT_TAIL_CHARS - marker(total).chars().count();
+    let left_out = total - head - KEPT_TAIL_CHARS;
+    let at = |chars: usize| {
+        compact
+            .char_indices()
+            .nth(chars)
+            .map_or(compact.len(), |(i, _)| i)
+    };
+    format!(
+        "{}{}{}",
+        &compact[..at(head)],
+        marker(left_out),
+        &compact[at(total - KEPT_TAIL_CHARS)..]
+    )
 }
 
 /// Whether `text` could be a message [`one_line`] gave: no control or bidirectional formatting
 /// character, and no longer than a cut message (what a file that claims to hold such a message
 /// must meet before it is shown).
 pub fn is_one_line(text: &str) -> bool {
-    // A cut message: the kept characters, then " ... (N more characters)".
-    const CUT_SUFFIX_CHARS: usize = 64;
-    text.chars().count() <= MAX_MESSAGE_CHARS + CUT_SUFFIX_CHARS
+    // With room for the marker of an earlier version's cut (" ... (N more characters)" after
+    // the first 2,000), as shard files written before keep.
+    const EARLIER_CUT_CHARS: usize = 64;
+    text.chars().count() <= MAX_MESSAGE_CHARS + EARLIER_CUT_CHARS
         && !text.chars().any(|c| c.is_control() || is_bidi_control(c))
 }
 
@@ -73,6 +91,17 @@ mod tests {
         ] {
             assert!(is_one_line(&one_line(text)), "{text}");
         }
+        // A cut message is at most 2,000 characters and keeps both ends.
+        let long = format!(
+            "unknown field `{}`, expected `arm` or `format`",
+            "é".repeat(100_000)
+        );
+        let cut = one_line(&long);
+        assert!(cut.chars().count() <= MAX_MESSAGE_CHARS);
+        assert!(cut.starts_with("unknown field `éé"), "{cut}");
+        assert!(cut.ends_with("éé`, expected `arm` or `format`"), "{cut}");
+        assert!(cut.contains(" characters left out) ... "), "{cut}");
+        assert_eq!(one_line(&"x".repeat(2000)), "x".repeat(2000));
         assert!(!is_one_line("a\nb"));
         assert!(!is_one_line("a\u{202e}b"));
         assert!(!is_one_line(&"x".repeat(3000)));
@@ -82,8 +111,10 @@ mod tests {
     fn long_messages_are_cut() {
         let list = vec!["0.5"; 100_000].join(", ");
         let line = one_line(&format!("noise levels [{list}] differ"));
-        assert!(line.len() < 2100, "{}", line.len());
-        assert!(line.ends_with(" ... (498020 more characters)"), "{line}");
+        assert!(line.chars().count() <= 2000, "{}", line.len());
+        assert!(line.starts_with("noise levels [0.5, 0.5"), "{line}");
+        assert!(line.contains(" characters left out) ... "), "{line}");
+        assert!(line.ends_with("0.5, 0.5] differ"), "{line}");
         assert_eq!(one_line("short"), "short");
     }
 
