@@ -112,6 +112,19 @@ fn with_setting(
         .map_err(|e| Error::input(format!("{dotted}: {}", e.message().trim_end())))
 }
 
+/// Refuses a view of the table at `path` that the scenario no longer has (replaced by a value,
+/// or removed with its parent), as writing through it is refused.
+fn check_table(current: &toml::Table, path: &[String]) -> Result<(), Error> {
+    match lookup(current, path) {
+        _ if path.is_empty() => Ok(()),
+        Some(toml::Value::Table(_)) => Ok(()),
+        _ => Err(Error::input(format!(
+            "{}: the scenario has no such table",
+            path.join(".")
+        ))),
+    }
+}
+
 /// `path.key` as a scenario file spells it.
 fn dotted(path: &[String], key: &str) -> String {
     path.iter()
@@ -131,6 +144,7 @@ fn read_setting(
     key: &str,
 ) -> PyResult<Py<PyAny>> {
     let current = table(&scenario.get().lock())?;
+    check_table(&current, path)?;
     let mut full = path.to_vec();
     full.push(key.to_string());
     match lookup(&current, &full) {
@@ -364,6 +378,7 @@ impl Settings {
     /// The table as a dict (a copy: writing to it does not change the scenario).
     fn to_dict(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         let current = table(&self.scenario.get().lock())?;
+        check_table(&current, &self.path)?;
         let value = lookup(&current, &self.path)
             .cloned()
             .unwrap_or(toml::Value::Table(toml::Table::new()));

@@ -89,6 +89,16 @@ def test_settings_read_and_write_through():
     assert scenario.duration == 0.5
 
 
+def test_a_view_of_a_table_the_scenario_no_longer_has_is_refused():
+    scenario = hrm.Scenario.builtin("paper-tracking")
+    sine = scenario.reference.sine
+    assert sine.amplitude is not None
+    scenario.reference = {"kind": "step", "target": [0.2, -0.2], "time": 0.1}
+    for read in (lambda: sine.amplitude, sine.to_dict):
+        with pytest.raises(hrm.InvalidInput, match="^reference.sine: the scenario has no such table$"):
+            read()
+
+
 def test_settings_are_checked_with_the_library_messages():
     scenario = hrm.Scenario.builtin("paper-tracking")
     with pytest.raises(hrm.InvalidInput, match="^duration: .*f64"):
