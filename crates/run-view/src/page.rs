@@ -106,7 +106,14 @@ pub fn page(
 ) -> Result<String, ViewError> {
     let mut body = String::new();
     for scene in scenes {
-        body.push_str(&scene_html(scene, samples)?);
+        let html = scene_html(scene, samples)?;
+        // A page of one scene under the scene's own title does not repeat it.
+        let repeated = format!("<h3>{}</h3>\n", escape(&scene.title));
+        if scenes.len() == 1 && scene.title == title {
+            body.push_str(&html.replacen(&repeated, "", 1));
+        } else {
+            body.push_str(&html);
+        }
     }
     Ok(format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n{1}<title>{0}</title>\n<style>body{{font-family:sans-serif;margin:1.5em;max-width:1500px;color:#222}}</style>\n</head>\n<body>\n<h1>{0}</h1>\n<p>{2}</p>\n{body}{3}</body>\n</html>\n",

@@ -394,6 +394,15 @@ fn the_page_is_self_contained_and_its_data_cannot_end_the_script() {
         "only the data's and the viewer's"
     );
     assert!(html.contains("<h3>paper-tracking &lt;short&gt;</h3>"));
+    // One scene under its own title: the heading is not repeated.
+    let (_, run) = planar(0.2, ControllerKind::Pd);
+    let alone = Scene {
+        title: "paper-tracking".into(),
+        caption: "one run".into(),
+        runs: vec![run],
+    };
+    let single = page("paper-tracking", "intro", &[alone], PAGE_SAMPLES).unwrap();
+    assert!(single.contains("<h1>paper-tracking</h1>") && !single.contains("<h3>"));
     assert!(!run_view::SCRIPT.contains("</script"));
     // The data parses back to the decimated runs.
     let start = html.find("application/json\">").unwrap() + "application/json\">".len();
