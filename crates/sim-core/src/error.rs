@@ -228,7 +228,8 @@ pub enum SimError {
     /// its motion (at `1e20` rad every step rounds away), so the run would report nonsense.
     #[error(
         "a{coordinate} (or its reference) is {} rad at t = {} s, beyond the {} rad a run \
-         resolves: the initial state or the reference is out of scale",
+         resolves: the run diverged (the noise or the gains too large), or its initial state \
+         or reference is out of scale",
         Compact(*.value),
         Compact(*.t),
         Compact(*.bound)
