@@ -347,6 +347,19 @@ fn source(system: &FuzzySystem, prefix: &str, options: &EvalOptions) -> String {
             }
         }
     }
+    // A system whose degrees all are constants reads no input: `x` is then set and unused,
+    // which `-Wall -Wextra -Werror` refuses.
+    if !c
+        .mfs
+        .iter()
+        .any(|mf| !matches!(mf, CompiledMf::Constant(_)))
+        && !uses_linear
+    {
+        let _ = writeln!(
+            s,
+            "    (void)x; /* no degree or output depends on an input */"
+        );
+    }
     // Membership degrees, then complements and the neutral elements (Evaluator::fire).
     let _ = writeln!(s, "    /* layer 1: membership degrees */");
     for (k, (mf, &i)) in c.mfs.iter().zip(&c.mf_inputs).enumerate() {

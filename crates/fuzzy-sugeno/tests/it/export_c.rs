@@ -298,6 +298,24 @@ fn a_system_without_rules_in_c_matches_rust() {
     );
 }
 
+/// A system whose degrees are all constants reads no input: its C still compiles under
+/// `-Werror` (the inputs array was set and unused) and matches Rust.
+#[test]
+fn a_system_that_reads_no_input_in_c_matches_rust() {
+    let text = "[System]\nName='u'\nType='sugeno'\nNumInputs=1\nNumOutputs=1\nNumRules=1\n\
+                AndMethod='prod'\nOrMethod='probor'\nDefuzzMethod='wtaver'\n\n[Input1]\n\
+                Name='x'\nRange=[-1 1]\nNumMFs=1\nMF1='always':'constant',[0.5]\n\n\
+                [Output1]\nName='y'\nRange=[-5 5]\nNumMFs=1\nMF1='k':'constant',[2]\n\n\
+                [Rules]\n1, 1 (1) : 1\n";
+    let system = FuzzySystem::from_fis(text).unwrap();
+    let points = (0..=4).map(|k| (0, vec![k as f64 / 2.0 - 1.0])).collect();
+    compare(
+        vec![(system, EvalOptions::default())],
+        points,
+        "constant-degrees",
+    );
+}
+
 /// Names with zero-width and bidirectional formatting characters (a right-to-left override
 /// would make the source read otherwise than it compiles) are written escaped in the export's
 /// comments, so that the compiler, warning on such characters under `-Werror`, takes it; a
