@@ -56,8 +56,9 @@ pub fn wall_warning(run: &DeployRun) -> Option<String> {
             if run.plan.min_wall_clearance < 0.0 {
                 "the centreline's bends leave it no room"
             } else {
-                "the plan keeps within them, the tracking does not (a shorter controller period, \
-                 a longer travel_time or computed torque tracks closer)"
+                "the plan keeps within them at its frames, the run does not: the reference \
+                 between the frames or the tracking leaves the channel (compare q and q_ref in \
+                 timeseries.csv; a shorter controller period or computed torque tracks closer)"
             }
         )
     });
@@ -395,7 +396,10 @@ mod tests {
         let run = scenario.run_deploy().unwrap();
         assert!(run.plan.min_wall_clearance > 0.0);
         let warning = wall_warning(&run).unwrap();
-        assert!(warning.contains("the tracking does not"), "{warning}");
+        assert!(
+            warning.contains("the plan keeps within them at its frames, the run does not"),
+            "{warning}"
+        );
     }
 
     #[test]

@@ -13,6 +13,26 @@ use sim_study::{ArmKind, ControllerKind, DeployFailure, ReferenceSpec, Scenario,
 use std::fmt::Write as _;
 use std::path::Path;
 
+/// A warning when the arm entered an obstacle or itself (a negative smallest clearance over the
+/// controller samples, `min_clearance_m` and `min_self_clearance_m`), which a run reports rather
+/// than refuses: a planned motion tracked too loosely, or a controller that keeps no margin.
+pub fn collision_warning(summary: &sim_core::Summary) -> Option<String> {
+    let depth = |clearance: Option<f64>| clearance.filter(|c| *c < 0.0).map(|c| -1e3 * c);
+    let obstacles = depth(summary.min_clearance_m)
+        .map(|mm| format!("the arm reaches {mm:.2} mm into an obstacle"));
+    let itself = depth(summary.min_self_clearance_m)
+        .map(|mm| format!("links of the arm that share no joint overlap by {mm:.2} mm"));
+    let what = match (obstacles, itself) {
+        (Some(obstacles), Some(itself)) => format!("{obstacles}; {itself}"),
+        (obstacles, itself) => obstacles.or(itself)?,
+    };
+    Some(format!(
+        "{what} (smallest clearances over the controller samples, summary.json): the tracking \
+         leaves the planned margin (a slower motion, a shorter controller period or a \
+         controller that keeps clearance, mpc with controller.clearance_m, tracks closer)"
+    ))
+}
+
 /// Runs `scenario` with `controller` (or the scenario's own) and writes its files into `out`.
 /// A scenario that cannot be built is refused before anything is written; a run that stops
 /// (diverges) writes its data up to the stop, then fails with the reason, and one that stops
@@ -49,6 +69,13 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
     }
     write_outcome(&outcome, &scenario, staging.path())?;
     staging.commit()?;
+    let run = match &outcome.result {
+        Ok(run) => Some(run),
+        Err(stopped) => stopped.partial.as_deref(),
+    };
+    if let Some(warning) = run.and_then(|run| collision_warning(&run.summary)) {
+        console::to_stderr(&format!("warning: {warning}"));
+    }
     console::print(&table(&table_rows(
         std::slice::from_ref(&outcome),
         std::slice::from_ref(&scenario),

@@ -89,3 +89,45 @@ fn links_csv_holds_the_points_the_clearance_is_measured_from() {
         "{least_self}"
     );
 }
+
+/// The same step with the disc on the arm's final tip: the run enters it, and says so on
+/// standard error (it reports a collision rather than refuses it).
+#[test]
+fn a_run_that_enters_an_obstacle_warns() {
+    let dir = scratch("simulate-collision");
+    let scenario = dir.join("collision.toml");
+    std::fs::write(
+        &scenario,
+        SCENARIO.replace("center = [0.25, 0.85]", "center = [0.19, 0.95]"),
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let output = hrm(&[
+        "simulate",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{output:?}");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.starts_with("warning: the arm reaches ") && stderr.contains(" mm into an obstacle"),
+        "{stderr}"
+    );
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    // Clear of the disc, nothing is said.
+    std::fs::write(&scenario, SCENARIO).unwrap();
+    let output = hrm(&[
+        "simulate",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        output.status.success() && output.stderr.is_empty(),
+        "{output:?}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
