@@ -12,8 +12,8 @@ pub use scenario::{
     ControllerKind, ControllerSetup, ControllerSpec, DEFAULT_ATOL, DEFAULT_RTOL, DEPLOY_PLAN_STEPS,
     DeployFailure, DeployRun, DeploySpec, FuzzyInputRange, Gravity, HelixSpec, Inertias,
     InitialSpec, IntegratorSpec, JointLayout, LimitsSpec, MAX_DEPLOY_CENTERLINE_POINTS,
-    MAX_DEPLOY_RECORDED_SAMPLES, MAX_GRAVITY, MAX_SCENARIO_OBSTACLES, ModalSpec, ModalTorqueLimit,
-    NoiseSpec, ObstacleSpec, ReferenceSpec, Scenario, ScenarioError, SineSpec, TaskSpec,
-    TorqueLimit, Workspace,
+    MAX_DEPLOY_RECORDED_SAMPLES, MAX_GRAVITY, MAX_SCENARIO_EXTENT, MAX_SCENARIO_OBSTACLES,
+    ModalSpec, ModalTorqueLimit, NoiseSpec, ObstacleSpec, ReferenceSpec, Scenario, ScenarioError,
+    SineSpec, TaskSpec, TorqueLimit, Workspace,
 };
 pub use shape_plan::{Channel, DeployMetrics, DeploySample};

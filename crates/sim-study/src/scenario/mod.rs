@@ -105,7 +105,7 @@ pub use controllers::{
 };
 pub use deploy::{DEPLOY_PLAN_STEPS, DeployFailure, DeployRun, MAX_DEPLOY_RECORDED_SAMPLES};
 pub use file::ScenarioError;
-pub use obstacles::{MAX_SCENARIO_OBSTACLES, Workspace};
+pub use obstacles::{MAX_SCENARIO_EXTENT, MAX_SCENARIO_OBSTACLES, Workspace};
 pub use schema::{
     Alpha0, AngleLimit, ArmSpec, BranchSpec, DEFAULT_ATOL, DEFAULT_RTOL, DeploySpec, HelixSpec,
     InitialSpec, IntegratorSpec, LimitsSpec, MAX_DEPLOY_CENTERLINE_POINTS, ModalSpec,

@@ -2,12 +2,19 @@
 //! evaluates, every field checked and named (`obstacles[2].radius`) when it fails.
 
 use super::schema::{ObstacleSpec, Scenario};
-use clearance::{ClearanceModel, MAX_OBSTACLE_EXTENT, Obstacle};
+use clearance::{ClearanceModel, Obstacle};
 use sim_core::SimError;
 
 /// The most obstacles a scenario may hold. With the paper's 10 links every controller sample
 /// measures `10 x 1024` link-obstacle pairs at most, a few hundred microseconds.
 pub const MAX_SCENARIO_OBSTACLES: usize = 1024;
+
+/// The largest magnitude of a scenario obstacle's coordinates, radius and half-extents, and of
+/// `arm.radius` (m): the scale a run resolves, as for a deployment's centreline. Beyond it the
+/// rounding of the closest points reaches the arm's millimetres (a capsule 1e14 m long read
+/// 3.6 mm farther than it was); the library's own bound, `clearance::MAX_OBSTACLE_EXTENT`, only
+/// keeps the distances finite.
+pub const MAX_SCENARIO_EXTENT: f64 = 1e6;
 
 /// Where an arm moves, which decides how its obstacles are given.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -93,11 +100,11 @@ impl Scenario {
             return Ok(None);
         }
         let radius = self.arm.radius.unwrap_or(0.0);
-        if !(0.0..=MAX_OBSTACLE_EXTENT).contains(&radius) {
+        if !(0.0..=MAX_SCENARIO_EXTENT).contains(&radius) {
             return Err(SimError::setting(
                 "arm.radius",
                 format!(
-                    "must be non-negative and at most {MAX_OBSTACLE_EXTENT:e} (m, as an \
+                    "must be non-negative and at most {MAX_SCENARIO_EXTENT:e} (m, as an \
                      obstacle's extent), got {}",
                     lane_math::Compact(radius)
                 ),
@@ -129,12 +136,13 @@ impl ObstacleSpec {
             }
             if let Some(v) = values
                 .iter()
-                .find(|v| !v.is_finite() || v.abs() > MAX_OBSTACLE_EXTENT)
+                .find(|v| !v.is_finite() || v.abs() > MAX_SCENARIO_EXTENT)
             {
                 return Err(SimError::setting(
                     field(name),
                     format!(
-                        "must be finite and at most 1e15 in magnitude (m), got {}",
+                        "must be finite and at most 1e6 in magnitude (m, the scale a run \
+                         resolves), got {}",
                         lane_math::Compact(*v)
                     ),
                 ));
@@ -142,13 +150,13 @@ impl ObstacleSpec {
             Ok([values[0], values[1], values.get(2).copied().unwrap_or(0.0)])
         };
         let radius = |r: f64| {
-            if (0.0..=MAX_OBSTACLE_EXTENT).contains(&r) {
+            if (0.0..=MAX_SCENARIO_EXTENT).contains(&r) {
                 Ok(r)
             } else {
                 Err(SimError::setting(
                     field("radius"),
                     format!(
-                        "must be non-negative, finite and at most 1e15 (m), got {}",
+                        "must be non-negative, finite and at most 1e6 (m), got {}",
                         lane_math::Compact(r)
                     ),
                 ))

@@ -97,19 +97,19 @@ fn malformed_obstacles_are_refused_with_the_field_named() {
                 "{circle}[[obstacles]]\nkind = \"circle\"\ncenter = [0.3, 0.6]\nradius = -0.05\n"
             ),
             Workspace::Planar,
-            "obstacles[1].radius must be non-negative, finite and at most 1e15 (m), got -0.05",
+            "obstacles[1].radius must be non-negative, finite and at most 1e6 (m), got -0.05",
         ),
         (
             &format!(
                 "{circle}{circle}[[obstacles]]\nkind = \"circle\"\ncenter = [0.3, 0.6]\nradius = nan\n"
             ),
             Workspace::Planar,
-            "obstacles[2].radius must be non-negative, finite and at most 1e15 (m), got NaN",
+            "obstacles[2].radius must be non-negative, finite and at most 1e6 (m), got NaN",
         ),
         (
             "[[obstacles]]\nkind = \"capsule\"\nfrom = [0.0, inf]\nto = [0.5, 1.0]\nradius = 0.02\n",
             Workspace::Planar,
-            "obstacles[0].from must be finite and at most 1e15 in magnitude (m), got inf",
+            "obstacles[0].from must be finite and at most 1e6 in magnitude (m, the scale a run resolves), got inf",
         ),
         (
             "[[obstacles]]\nkind = \"capsule\"\nfrom = [0.0, 1.0, 0.0]\nto = [0.5, 1.0]\nradius = 0.02\n",
@@ -131,16 +131,26 @@ fn malformed_obstacles_are_refused_with_the_field_named() {
             Workspace::Planar,
             "obstacles[0].rpy must be three angles [roll, pitch, yaw] (rad), got 1 number",
         ),
-        // Beyond 1e15 m the squared distances overflow: the clearance would not be finite.
+        // Beyond 1e6 m the closest points' rounding reaches the arm's millimetres.
         (
             "[[obstacles]]\nkind = \"circle\"\ncenter = [1e155, 0.0]\nradius = 0.05\n",
             Workspace::Planar,
-            "obstacles[0].center must be finite and at most 1e15 in magnitude (m), got 1e155",
+            "obstacles[0].center must be finite and at most 1e6 in magnitude (m, the scale a run resolves), got 1e155",
+        ),
+        (
+            "[[obstacles]]\nkind = \"capsule\"\nfrom = [-1e14, 1.03]\nto = [7e13, 1.03]\nradius = 0.01\n",
+            Workspace::Planar,
+            "obstacles[0].from must be finite and at most 1e6 in magnitude (m, the scale a run resolves), got -100000000000000",
+        ),
+        (
+            "[[obstacles]]\nkind = \"box\"\ncenter = [0.0, 1.0]\nhalf_extents = [1e14, 0.1]\n",
+            Workspace::Planar,
+            "obstacles[0].half_extents must be finite and at most 1e6 in magnitude (m, the scale a run resolves), got 100000000000000",
         ),
         (
             "[[obstacles]]\nkind = \"circle\"\ncenter = [0.3, 0.6]\nradius = 1e306\n",
             Workspace::Planar,
-            "obstacles[0].radius must be non-negative, finite and at most 1e15 (m), got 1e306",
+            "obstacles[0].radius must be non-negative, finite and at most 1e6 (m), got 1e306",
         ),
         (
             "[[obstacles]]\nkind = \"box\"\ncenter = [0.0, 1.0]\nhalf_extents = [0.1]\n",
@@ -150,12 +160,12 @@ fn malformed_obstacles_are_refused_with_the_field_named() {
         (
             "[arm]\nradius = -1.0\n",
             Workspace::Planar,
-            "arm.radius must be non-negative and at most 1e15 (m, as an obstacle's extent), got -1",
+            "arm.radius must be non-negative and at most 1e6 (m, as an obstacle's extent), got -1",
         ),
         (
             "[arm]\nradius = 1e308\n",
             Workspace::Planar,
-            "arm.radius must be non-negative and at most 1e15 (m, as an obstacle's extent), got 1e308",
+            "arm.radius must be non-negative and at most 1e6 (m, as an obstacle's extent), got 1e308",
         ),
     ] {
         let scenario = with(extra);
