@@ -134,6 +134,21 @@ fn tasks_and_planned_references_come_together_and_name_their_fields() {
             && e.contains("beyond 0.3 rad"),
         "{e}"
     );
+    // A limit out of its domain is named as without a [task].
+    let e = with(&|s| {
+        let mut limits = vec![2.0; 10];
+        limits[8] = -1.0;
+        s.limits.joint_angle_rad = Some(AngleLimit::PerJoint(limits));
+    });
+    assert_eq!(
+        e,
+        "limits.joint_angle_rad[8] must be positive and finite, got -1"
+    );
+    let e = with(&|s| s.limits.joint_angle_rad = Some(AngleLimit::All(0.0)));
+    assert_eq!(
+        e,
+        "limits.joint_angle_rad must be positive and finite, got 0"
+    );
     let mut roomy = base.clone();
     roomy.limits.joint_angle_rad = Some(AngleLimit::All(3.0));
     assert!(roomy.build().is_ok());
