@@ -1107,6 +1107,12 @@ enum ValueError {
         /// The item.
         found: String,
     },
+    /// Two commas with no number between them (or a comma at either end of the list).
+    #[error("expected a number between the commas of `{found}`")]
+    EmptyEntry {
+        /// The list.
+        found: String,
+    },
     /// A quoted part of a membership function `'name':'type',[parameters]` is malformed.
     #[error("{FUNCTION_SHAPE}: {quote}")]
     FunctionQuote {
@@ -1149,6 +1155,14 @@ fn bracketed(value: &str) -> Result<Vec<f64>, ValueError> {
         .ok_or_else(|| ValueError::NotBracketed {
             found: value.to_string(),
         })?;
+    // Commas separate entries as spaces do, but a comma with no number on one side is a slip
+    // (`[1 , , 0]` is not `[1 0]`).
+    let parts: Vec<&str> = inner.split(',').collect();
+    if parts.len() > 1 && parts.iter().any(|part| part.trim().is_empty()) {
+        return Err(ValueError::EmptyEntry {
+            found: value.trim().to_string(),
+        });
+    }
     inner
         .split(|c: char| c.is_whitespace() || c == ',')
         .filter(|t| !t.is_empty())
@@ -1515,6 +1529,14 @@ mod tests {
             assert_eq!(number(text), expected, "{text}");
         }
         assert_eq!(bracketed("[-pi/4, pi/4]").unwrap(), [-PI / 4.0, PI / 4.0]);
+        assert_eq!(bracketed("[ 1 , 2  0]").unwrap(), [1.0, 2.0, 0.0]);
+        assert_eq!(bracketed("[]").unwrap(), [] as [f64; 0]);
+        for list in ["[1 , , 0]", "[1, 2,]", "[,1]", "[,]"] {
+            assert_eq!(
+                bracketed(list).unwrap_err().to_string(),
+                format!("expected a number between the commas of `{list}`")
+            );
+        }
     }
 
     #[test]
