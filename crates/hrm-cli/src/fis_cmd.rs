@@ -162,7 +162,14 @@ pub fn run(args: FisArgs) -> Result<(), String> {
             let system = read_system(&file)?;
             crate::output_dir::refuse_inputs_inside(&out, &[("FIS file", &file)])?;
             let staging = OutputDir::create(&out, "fis surface")?;
-            let written = surface(&system, staging.path(), resolution, reference.as_deref())?;
+            // A file that cannot be drawn is named where it would have been written.
+            let written = surface(&system, staging.path(), resolution, reference.as_deref())
+                .map_err(|e| {
+                    e.replace(
+                        &staging.path().display().to_string(),
+                        &out.display().to_string(),
+                    )
+                })?;
             staging.commit()?;
             let lines: String = written
                 .iter()

@@ -67,6 +67,13 @@ impl OutputDir {
         match std::fs::symlink_metadata(&target) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
             Err(e) => return Err(fail("output folder", e)),
+            // The link would be replaced by a folder, not the folder it points to written.
+            Ok(meta) if meta.file_type().is_symlink() => {
+                return Err(format!(
+                    "output folder {}: is a symbolic link; give the folder it points to",
+                    shown.display()
+                ));
+            }
             Ok(meta) if !meta.is_dir() => {
                 return Err(format!(
                     "output folder {}: exists and is not a folder",
@@ -1127,6 +1134,20 @@ mod tests {
         assert!(err.contains("is the --data file"), "{err}");
         refuse_input_as_output(&root.join("mine/out.fis"), &[("--data", &data)]).unwrap();
         assert_eq!(std::fs::read_to_string(&mine).unwrap(), "my code");
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn a_symbolic_link_for_the_folder_is_named_as_such() {
+        let root = scratch("link");
+        std::fs::create_dir(root.join("real")).unwrap();
+        std::os::unix::fs::symlink(root.join("real"), root.join("link")).unwrap();
+        let err = OutputDir::create(&root.join("link"), "run").err().unwrap();
+        assert!(
+            err.ends_with("link: is a symbolic link; give the folder it points to"),
+            "{err}"
+        );
+        assert!(root.join("link").is_symlink() && names(&root.join("real")).is_empty());
         std::fs::remove_dir_all(&root).unwrap();
     }
 

@@ -96,6 +96,29 @@ fn fis_surface_out_folder_under_a_regular_file() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A surface that cannot be drawn (its outputs span beyond double precision) is named in the
+/// folder the user gave, not the staging folder that the failure removes; nothing is written.
+#[test]
+fn fis_surface_names_the_file_in_the_out_folder() {
+    let dir = scratch("errors-surface-span");
+    let fis = dir.join("huge.fis");
+    std::fs::write(
+        &fis,
+        "[System]\nName='b'\nType='sugeno'\nNumInputs=1\nNumOutputs=1\nNumRules=2\n\
+         AndMethod='prod'\nOrMethod='probor'\nDefuzzMethod='wtsum'\n\n[Input1]\nName='x'\n\
+         Range=[-1 1]\nNumMFs=2\nMF1='a':'gaussmf',[0.5 -1]\nMF2='b':'trimf',[-1 1 1]\n\n\
+         [Output1]\nName='y'\nRange=[-1e307 1e307]\nNumMFs=2\nMF1='k':'constant',[1e308]\n\
+         MF2='j':'constant',[1e308]\n\n[Rules]\n1, 1 (1) : 1\n2, 2 (1) : 1\n",
+    )
+    .unwrap();
+    let out = dir.join("surface");
+    let line = refused(&hrm(&["fis", "surface", path(&fis), "--out", path(&out)]));
+    let expected = format!("hrm: {}: cannot plot", path(&out.join("curve_y_x.svg")));
+    assert!(line.starts_with(&expected), "{line}");
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn simulate_unknown_scenario() {
     let line = refused(&hrm(&["simulate", "--scenario", "no-such-scenario"]));
