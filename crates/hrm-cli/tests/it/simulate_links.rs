@@ -29,19 +29,24 @@ method = "rk4"
 dt = 0.001
 "#;
 
+/// `hrm simulate --scenario SCENARIO --out OUT`.
+fn simulate(scenario: &std::path::Path, out: &std::path::Path) -> std::process::Output {
+    hrm(&[
+        "simulate",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}
+
 #[test]
 fn links_csv_holds_the_points_the_clearance_is_measured_from() {
     let dir = scratch("simulate-links");
     let scenario = dir.join("obstacle.toml");
     std::fs::write(&scenario, SCENARIO).unwrap();
     let out = dir.join("out");
-    let output = hrm(&[
-        "simulate",
-        "--scenario",
-        scenario.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let output = simulate(&scenario, &out);
     assert!(output.status.success(), "{output:?}");
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
@@ -102,13 +107,7 @@ fn a_run_that_enters_an_obstacle_warns() {
     )
     .unwrap();
     let out = dir.join("out");
-    let output = hrm(&[
-        "simulate",
-        "--scenario",
-        scenario.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let output = simulate(&scenario, &out);
     assert!(output.status.success(), "{output:?}");
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(
@@ -118,13 +117,7 @@ fn a_run_that_enters_an_obstacle_warns() {
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
     // Clear of the disc, nothing is said.
     std::fs::write(&scenario, SCENARIO).unwrap();
-    let output = hrm(&[
-        "simulate",
-        "--scenario",
-        scenario.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let output = simulate(&scenario, &out);
     assert!(
         output.status.success() && output.stderr.is_empty(),
         "{output:?}"
