@@ -91,6 +91,16 @@ pub struct LoopSettings {
 }
 
 impl LoopSettings {
+    /// Checks the settings for `plant` as [`Simulation::new`] does, before a reference or a
+    /// controller exists: their sizes, bounds and the run's work without the controller's own
+    /// (so that a front end refuses a run of hours before it plans its reference).
+    ///
+    /// # Errors
+    /// [`SimError::InvalidSetting`] naming the setting.
+    pub fn check(&self, plant: Plant<'_>) -> Result<(), SimError> {
+        validate(self, plant)
+    }
+
     /// Settings without noise or limits, recording every sample, with a runaway bound of pi rad.
     pub fn new(integrator: Integrator, controller_period: f64, duration: f64) -> Self {
         Self {

@@ -176,16 +176,6 @@ impl Scenario {
         }
         let model = self.plant()?;
         let m = model.plant().n_coords();
-        let reference = match (self.planned_reference(&model)?, &model) {
-            (Some(planned), _) => Prepared::reference_clones(planned),
-            (None, PlantModel::Planar(planar)) => self.reference.build(
-                planar.chain().total_length(),
-                self.modal.harmonics,
-                self.planar_alpha0()?,
-                m,
-            )?,
-            (None, PlantModel::Spatial(spatial)) => self.spatial_reference(spatial)?,
-        };
         let period = self.controller_period()?;
         let mut settings = LoopSettings::new(self.integrator.build(), period, self.duration);
         settings.record_period = self.record_period.unwrap_or(period);
@@ -218,6 +208,19 @@ impl Scenario {
             Some(ModalTorqueLimit::PerCoordinate(limits)) => {
                 per_coordinate("limits.tau_star", Some(limits), m)?
             }
+        };
+        // The settings, the run's work among them, are checked before a [task]'s plan, which
+        // may take seconds.
+        settings.check(model.plant())?;
+        let reference = match (self.planned_reference(&model)?, &model) {
+            (Some(planned), _) => Prepared::reference_clones(planned),
+            (None, PlantModel::Planar(planar)) => self.reference.build(
+                planar.chain().total_length(),
+                self.modal.harmonics,
+                self.planar_alpha0()?,
+                m,
+            )?,
+            (None, PlantModel::Spatial(spatial)) => self.spatial_reference(spatial)?,
         };
         let limits = MpcLimits {
             joint_torque_limits: settings.joint_torque_limits.clone(),

@@ -134,6 +134,19 @@ fn tasks_and_planned_references_come_together_and_name_their_fields() {
             && e.contains("beyond 0.3 rad"),
         "{e}"
     );
+    // A run of hours is refused before its plan (which would refuse this target as out of
+    // reach, after planning over the 1,000 links).
+    let e = with(&|s| {
+        s.arm.links = Some(1000);
+        s.arm.link_length = Some(0.001);
+        s.arm.link_mass = Some(0.001);
+        s.arm.radius = Some(1e-4);
+        set(s, vec![5.0, 5.0], 0.0);
+    });
+    assert!(
+        e.starts_with("duration = 4 s would take an estimated") && e.contains("clearance measures"),
+        "{e}"
+    );
     // A limit out of its domain is named as without a [task].
     let e = with(&|s| {
         let mut limits = vec![2.0; 10];
