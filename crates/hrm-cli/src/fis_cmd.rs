@@ -127,10 +127,11 @@ pub fn run(args: FisArgs) -> Result<(), String> {
                 ..Default::default()
             };
             let (system, notes) = read_system_with_notes(&file)?;
+            // The options are checked (with the system's inputs) before anything is printed.
+            let (report, passed) = check(&system, &options)?;
             if let Some(notes) = notes {
                 console::print(&ignored_report(&file, &notes))?;
             }
-            let (report, passed) = check(&system, &options)?;
             console::print(&report)?;
             if passed {
                 Ok(())

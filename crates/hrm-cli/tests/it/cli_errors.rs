@@ -280,11 +280,14 @@ fn fis_check_options_are_named_as_given() {
         line.contains("--max-jump") && line.contains("NaN"),
         "{line}"
     );
-    let line = refused(&hrm(&["fis", "check", path(&file), "--coverage", "2"]));
+    let output = hrm(&["fis", "check", path(&file), "--coverage", "2"]);
+    let line = refused(&output);
     assert!(
         line.contains("--coverage") && line.contains("got 2"),
         "{line}"
     );
+    // Refused before any of the report is printed.
+    assert!(output.stdout.is_empty(), "{output:?}");
     let line = refused(&hrm(&["fis", "check", path(&file), "--max-jump", "inf"]));
     assert!(
         line.ends_with("--max-jump must be positive and finite, got inf"),

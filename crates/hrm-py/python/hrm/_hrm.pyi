@@ -163,9 +163,10 @@ class ReducedModel:
         self,
         target: ArrayLike,
         alpha0: Optional[float] = None,
-        branch: Literal["positive", "negative"] = "positive",
+        branch: Optional[Literal["positive", "negative"]] = "positive",
     ) -> Array:
-        """Modal coordinates whose backbone curve ends at target, shape (m,) or (N, m)."""
+        """Modal coordinates whose backbone curve ends at target, shape (m,) or (N, m)
+        (branch None is the default, "positive")."""
     def mass_matrix(self, a: ArrayLike) -> Array:
         """M* = J^T M J, shape (m, m) or (N, m, m)."""
     def coriolis(self, a: ArrayLike, a_dot: ArrayLike) -> Array:
