@@ -84,6 +84,8 @@ pub fn run(args: ExportArgs) -> Result<(), String> {
         .map(|(name, text)| (Path::new(&args.out).join(name), text))
         .collect();
     let paths: Vec<PathBuf> = files.iter().map(|(path, _)| path.clone()).collect();
+    // Not into another command's output, which that command replaces whole.
+    output_dir::refuse_marked_folder(Path::new(&args.out), "fis export", "the exported files")?;
     output_dir::refuse_foreign_files(
         &paths,
         "fis export",

@@ -63,6 +63,32 @@ fn export_again_replaces_its_own_files_and_never_the_users() {
     }
 }
 
+/// Not into another command's output folder (a `simulate` folder, replaced whole by the next
+/// `simulate`, which would then find files it did not write): refused before anything is written.
+#[test]
+fn export_into_another_commands_output_is_refused() {
+    let dir = scratch("fis-export-marked");
+    let out = dir.join("sim");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join(".hrm-output"), "written by `hrm simulate`\n").unwrap();
+    let refused = hrm(&[
+        "fis",
+        "export",
+        "--format",
+        "c",
+        PAPER_FIS,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("holds the output of `hrm simulate`, which replaces its folder whole"),
+        "{stderr}"
+    );
+    assert!(!out.join("hrm_fis.c").exists());
+}
+
 /// A name FCL cannot carry (a variable named `END_VAR`) is a one-line error naming it, exit 1,
 /// and nothing is written.
 #[test]
