@@ -13,6 +13,12 @@ const FUZZYLITE_FCL: &str = concat!(
     "/../fuzzy-sugeno/data/paper.fuzzylite.fcl"
 );
 
+/// `hrm fis export --format FORMAT PAPER_FIS --out OUT` and the `extra` options.
+fn export_paper(format: &str, out: &str, extra: &[&str]) -> Output {
+    let args = ["fis", "export", "--format", format, PAPER_FIS, "--out", out];
+    hrm(&[&args[..], extra].concat())
+}
+
 fn stdout(output: &Output) -> String {
     assert!(
         output.status.success(),
@@ -26,9 +32,7 @@ fn stdout(output: &Output) -> String {
 fn fcl_export_evaluates_like_the_fis_file() {
     let dir = scratch("fis-export-fcl");
     let out = dir.to_str().unwrap();
-    let written = stdout(&hrm(&[
-        "fis", "export", "--format", "fcl", PAPER_FIS, "--out", out,
-    ]));
+    let written = stdout(&export_paper("fcl", out, &[]));
     let fcl = written.trim();
     assert!(fcl.ends_with("paper.fcl"));
     let x = ["0.15", "-0.1", "-0.5", "0.2"];
@@ -46,13 +50,11 @@ fn export_again_replaces_its_own_files_and_never_the_users() {
     let dir = scratch("fis-export-again");
     let out = dir.to_str().unwrap();
     for format in ["c", "fcl", "c", "fcl"] {
-        stdout(&hrm(&[
-            "fis", "export", "--format", format, PAPER_FIS, "--out", out,
-        ]));
+        stdout(&export_paper(format, out, &[]));
     }
     for (name, format) in [("hrm_fis.c", "c"), ("paper.fcl", "fcl")] {
         std::fs::write(dir.join(name), "/* the user's own */\n").unwrap();
-        let refused = hrm(&["fis", "export", "--format", format, PAPER_FIS, "--out", out]);
+        let refused = export_paper(format, out, &[]);
         assert_eq!(refused.status.code(), Some(1));
         let stderr = String::from_utf8_lossy(&refused.stderr);
         assert!(stderr.contains("did not create"), "{stderr}");
@@ -71,15 +73,7 @@ fn export_into_another_commands_output_is_refused() {
     let out = dir.join("sim");
     std::fs::create_dir(&out).unwrap();
     std::fs::write(out.join(".hrm-output"), "written by `hrm simulate`\n").unwrap();
-    let refused = hrm(&[
-        "fis",
-        "export",
-        "--format",
-        "c",
-        PAPER_FIS,
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let refused = export_paper("c", out.to_str().unwrap(), &[]);
     assert_eq!(refused.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&refused.stderr);
     assert!(
@@ -123,19 +117,11 @@ fn fcl_export_refuses_a_keyword_name_and_writes_nothing() {
 fn c_export_writes_the_header_and_source() {
     let dir = scratch("fis-export-c");
     let out = dir.to_str().unwrap();
-    let written = stdout(&hrm(&[
-        "fis",
-        "export",
-        "--format",
+    let written = stdout(&export_paper(
         "c",
-        PAPER_FIS,
-        "--out",
         out,
-        "--prefix",
-        "ctl",
-        "--no-rule-fired",
-        "error",
-    ]));
+        &["--prefix", "ctl", "--no-rule-fired", "error"],
+    ));
     assert_eq!(written.lines().count(), 2);
     let header = std::fs::read_to_string(dir.join("ctl.h")).unwrap();
     assert!(header.contains("int ctl_eval(const double *in, double *out);"));
@@ -145,24 +131,14 @@ fn c_export_writes_the_header_and_source() {
             .unwrap()
             .contains("#include <math.h>")
     );
-    let refused = hrm(&[
-        "fis", "export", "--format", "c", PAPER_FIS, "--out", out, "--prefix", "a-b",
-    ]);
+    let refused = export_paper("c", out, &["--prefix", "a-b"]);
     assert_eq!(refused.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&refused.stderr);
     assert_eq!(stderr.lines().count(), 1);
     assert!(stderr.starts_with("hrm: export: the prefix must be a C identifier"));
     // An --out that is a file is named as such, and left as it was.
     let file = dir.join("ctl.h");
-    let refused = hrm(&[
-        "fis",
-        "export",
-        "--format",
-        "c",
-        PAPER_FIS,
-        "--out",
-        file.to_str().unwrap(),
-    ]);
+    let refused = export_paper("c", file.to_str().unwrap(), &[]);
     assert_eq!(refused.status.code(), Some(1));
     assert_eq!(
         String::from_utf8_lossy(&refused.stderr),
