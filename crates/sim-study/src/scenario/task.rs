@@ -134,26 +134,6 @@ impl Scenario {
         let Some(limits) = &self.limits.joint_angle_rad else {
             return Ok(());
         };
-        // A limit out of its domain is named as the run names it, not as one the plan breaks.
-        let (entries, per_joint) = match limits {
-            AngleLimit::All(limit) => (std::slice::from_ref(limit), false),
-            AngleLimit::PerJoint(limits) => (limits.as_slice(), true),
-        };
-        if let Some((i, limit)) = entries
-            .iter()
-            .enumerate()
-            .find(|(_, l)| !(l.is_finite() && **l > 0.0))
-        {
-            let name = if per_joint {
-                format!("limits.joint_angle_rad[{i}]")
-            } else {
-                "limits.joint_angle_rad".to_string()
-            };
-            return Err(SimError::setting(
-                name,
-                format!("must be positive and finite, got {}", Compact(*limit)),
-            ));
-        }
         let (arm, clearance) = (planner.arm(), planner.clearance());
         let mut scratch = ArmScratch::new(arm);
         let mut data = ClearanceData::new(clearance, arm.n_coords())
