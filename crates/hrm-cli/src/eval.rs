@@ -252,11 +252,11 @@ fn dispatch(op: &str, request: Map<String, Value>) -> EvalResult {
     // `"urdf"` in place of `"arm"`: the spatial chain of a robot description.
     let urdf = request.contains_key("urdf");
     if spatial::is_spatial(&request) {
-        request::check_spatial_coordinates(&request)?;
+        request::check_angles(&request, "a")?;
         return spatial::dispatch(op, request);
     }
     if !urdf {
-        request::check_joint_angles(&request)?;
+        request::check_angles(&request, "theta")?;
     }
     match op {
         "dynamics" if urdf => robot::dynamics(parse(request)?),

@@ -279,12 +279,15 @@ pub(super) fn check_rates(request: &Map<String, Value>) -> Result<(), EvalError>
     Ok(())
 }
 
-/// Refuses a spatial request's modal coordinates `a` beyond the scale a run resolves
-/// ([`sim_core::check_coordinates`]), as [`check_rates`] refuses rates; a planar request's are
-/// checked by [`modal_map`], which knows whether the last entry is the base angle.
-pub(super) fn check_spatial_coordinates(request: &Map<String, Value>) -> Result<(), EvalError> {
-    match numbers(request, "a") {
-        Some(a) => sim_core::check_coordinates("a", &a, a.len())
+/// Refuses the angles of array field `name` beyond the scale a run resolves
+/// ([`sim_core::check_coordinates`]), as [`check_rates`] refuses rates: a spatial request's
+/// modal coordinates `a` (a planar request's are checked by [`modal_map`], which knows whether
+/// the last entry is the base angle), and a planar arm's joint angles `theta`, which its
+/// dynamics sum into absolute link angles, where `1e17` rounds the others away (the mass matrix
+/// came out as the straight arm's).
+pub(super) fn check_angles(request: &Map<String, Value>, name: &str) -> Result<(), EvalError> {
+    match numbers(request, name) {
+        Some(values) => sim_core::check_coordinates(name, &values, values.len())
             .map_err(|e| EvalError::input(e.to_string())),
         None => Ok(()),
     }
@@ -299,17 +302,6 @@ pub(super) fn check_arm_kind(request: &Map<String, Value>) -> Result<(), EvalErr
             format!("arm.kind must be \"planar\" or \"spatial\", got {kind}"),
         )),
         _ => Ok(()),
-    }
-}
-
-/// Refuses a planar arm's joint angles `theta` beyond the scale a run resolves
-/// ([`sim_core::check_coordinates`]): its dynamics sum them into absolute link angles, where
-/// `1e17` rounds the others away (the mass matrix came out as the straight arm's).
-pub(super) fn check_joint_angles(request: &Map<String, Value>) -> Result<(), EvalError> {
-    match numbers(request, "theta") {
-        Some(theta) => sim_core::check_coordinates("theta", &theta, theta.len())
-            .map_err(|e| EvalError::input(e.to_string())),
-        None => Ok(()),
     }
 }
 
