@@ -23,7 +23,7 @@ const SHAPE_INTERVAL_S: f64 = 0.5;
 pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
     let (run, stop) = DeployFailure::split(scenario.run_deploy()).map_err(|e| e.to_string())?;
     let staging = OutputDir::create(out, "simulate")?;
-    write_run(staging.path(), scenario, &run, stop.as_ref())?;
+    write_run(staging.path(), scenario, &run, stop.as_ref()).map_err(|e| staging.named(e))?;
     staging.commit()?;
     if let Some(warning) = wall_warning(&run) {
         console::to_stderr(&format!("warning: {warning}"));

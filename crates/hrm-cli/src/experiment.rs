@@ -67,7 +67,7 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
     {
         return Err(stopped.error.to_string());
     }
-    write_outcome(&outcome, &scenario, staging.path())?;
+    write_outcome(&outcome, &scenario, staging.path()).map_err(|e| staging.named(e))?;
     staging.commit()?;
     let run = match &outcome.result {
         Ok(run) => Some(run),

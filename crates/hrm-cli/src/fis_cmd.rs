@@ -163,14 +163,8 @@ pub fn run(args: FisArgs) -> Result<(), String> {
             let system = read_system(&file)?;
             crate::output_dir::refuse_inputs_inside(&out, &[("FIS file", &file)])?;
             let staging = OutputDir::create(&out, "fis surface")?;
-            // A file that cannot be drawn is named where it would have been written.
             let written = surface(&system, staging.path(), resolution, reference.as_deref())
-                .map_err(|e| {
-                    e.replace(
-                        &staging.path().display().to_string(),
-                        &out.display().to_string(),
-                    )
-                })?;
+                .map_err(|e| staging.named(e))?;
             staging.commit()?;
             let lines: String = written
                 .iter()

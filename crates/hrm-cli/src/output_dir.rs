@@ -157,6 +157,15 @@ impl OutputDir {
         &self.staging
     }
 
+    /// `message` (a failure to write into [`path`](Self::path)) with the staging folder, which
+    /// the failure removes, named as the output folder the user gave.
+    pub fn named(&self, message: String) -> String {
+        message.replace(
+            &self.staging.display().to_string(),
+            &self.shown.display().to_string(),
+        )
+    }
+
     /// Puts the staging folder in place of the output folder: the old folder is moved aside,
     /// the nested outputs of other commands are carried over, the new one takes its name and
     /// the old one is deleted. On failure the old folder is put back.

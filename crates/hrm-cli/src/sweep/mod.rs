@@ -98,7 +98,7 @@ pub fn run(cli: SweepCli) -> Result<(), String> {
     match cli.command {
         Some(SweepCommand::Merge { out, shards }) => {
             let staging = OutputDir::create(&out, "sweep merge")?;
-            let table = merge_files(&shards, staging.path(), &out)?;
+            let table = merge_files(&shards, staging.path(), &out).map_err(|e| staging.named(e))?;
             let wrote = wrote(&out, staging.path());
             staging.commit()?;
             console::print(&format!("{table}{wrote}"))
@@ -129,7 +129,8 @@ pub fn run(cli: SweepCli) -> Result<(), String> {
                 }
                 None => {
                     let staging = OutputDir::create(&args.out, "sweep")?;
-                    let table = sweep_whole(&config, staging.path())?;
+                    let table =
+                        sweep_whole(&config, staging.path()).map_err(|e| staging.named(e))?;
                     let wrote = wrote(&args.out, staging.path());
                     staging.commit()?;
                     console::print(&format!("{table}{wrote}"))
