@@ -8,7 +8,7 @@ use lane_math::Compact;
 use serde_json::json;
 use sim_core::Run;
 use sim_study::imitation::{self, ImitationOptions};
-use sim_study::study::{self, ComparisonRun, run_one, run_prepared};
+use sim_study::study::{self, ComparisonRun, run_one_with, run_prepared};
 use sim_study::{ArmKind, ControllerKind, DeployFailure, ReferenceSpec, Scenario, Workspace};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -58,7 +58,9 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
     }
     scenario.build().map_err(|e| e.to_string())?;
     let staging = OutputDir::create(out, "simulate")?;
-    let outcome = run_one(&scenario, scenario.controller.kind);
+    let mut progress = progress::SampleProgress::new(controller_samples(&scenario));
+    let outcome = run_one_with(&scenario, scenario.controller.kind, &mut progress);
+    progress.finish();
     if let Err(stopped) = &outcome.result
         && stopped
             .partial
@@ -85,6 +87,16 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
         .result
         .map(|_| ())
         .map_err(|stopped| stopped.error.to_string())
+}
+
+/// The number of controller samples of a run of `scenario` (one more than its whole controller
+/// periods), the length of its progress bar; zero when the scenario has no controller period.
+fn controller_samples(scenario: &Scenario) -> u64 {
+    let periods = scenario
+        .controller_period()
+        .map_or(0.0, |period| (scenario.duration / period).round());
+    // A built scenario's work is bounded, so its periods fit; `as` saturates regardless.
+    periods as u64 + 1
 }
 
 /// Refuses an output folder `out` that holds the files of the scenario `name_or_path`: the
@@ -833,7 +845,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("hrm-simulate-test-{}", std::process::id()));
         let mut scenario = Scenario::builtin("paper-responses-step").unwrap();
         scenario.duration = 0.2;
-        let outcome = run_one(&scenario, ControllerKind::ComputedTorque);
+        let outcome = study::run_one(&scenario, ControllerKind::ComputedTorque);
         write_outcome(&outcome, &scenario, &dir).unwrap();
         let summary: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap())

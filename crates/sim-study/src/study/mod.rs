@@ -42,7 +42,9 @@ mod shard;
 mod shard_file;
 
 pub use aggregate::{Cell, CellBuilder, FailedRun, MAX_LISTED_FAILURES, Stats, cells};
-pub use comparison::{ComparisonRun, builtin_scenarios, compare, run_one, run_prepared};
+pub use comparison::{
+    ComparisonRun, builtin_scenarios, compare, run_one, run_one_with, run_prepared,
+};
 pub use error::SettingError;
 pub use error::{MergeProblem, MetricError, ShardProblem, StudyError};
 pub use inputs::{
