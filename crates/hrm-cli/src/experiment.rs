@@ -219,7 +219,7 @@ fn experiments(out: &Path, all: &[Scenario]) -> Result<(), String> {
     }
     let groups = groups(scenarios, &outcomes, &learned, &rows)?;
     let intro = format!(
-        "Every scenario ({}) run with every controller ({}; a follow-the-leader deployment with computed torque and MPC): a table and an animation per scenario, then figures in the spirit of the paper's section 5. The {LEARNED} row of {LEARNED_ON} is a fuzzy controller learned by imitation of computed torque on the step and sine responses about a grid of operating points, never on the path ({LEARNED}.fis next to this page). Per-run time series and metrics are in <scenario>/<controller>/timeseries.csv and summary.json next to this page.",
+        "Every scenario ({}) run with every controller ({}; a follow-the-leader deployment with computed torque and MPC): a table and an animation per scenario in modal coordinates (the deployment, in joint space, is in the figures), then figures in the spirit of the paper's section 5. The {LEARNED} row of {LEARNED_ON} is a fuzzy controller learned by imitation of computed torque on the step and sine responses about a grid of operating points, never on the path ({LEARNED}.fis next to this page). Per-run time series and metrics are in <scenario>/<controller>/timeseries.csv and summary.json next to this page.",
         all.iter()
             .map(|s| s.name.as_str())
             .collect::<Vec<_>>()

@@ -299,10 +299,14 @@ fn draw_xy<'c>(
         .x_label_area_size(X_LABELS)
         .y_label_area_size(Y_LABELS)
         .build_cartesian_2d(x_range.clone(), y_range.clone())?;
+    // At most a label every 50 pixels across and 30 down, so that a narrow view's labels
+    // ("-0.25") do not run together.
     chart
         .configure_mesh()
         .x_desc(labels.x)
         .y_desc(labels.y)
+        .x_labels((pixels.0 / 50).clamp(2, 10) as usize)
+        .y_labels((pixels.1 / 30).clamp(2, 10) as usize)
         .label_style(TICK_FONT)
         .axis_desc_style(AXIS_FONT)
         .x_label_formatter(&x_ticks)

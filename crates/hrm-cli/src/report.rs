@@ -59,10 +59,10 @@ pub struct Section {
 
 /// Inline style sheet: the page carries its own.
 const STYLE: &str = "body{font-family:sans-serif;margin:2em;max-width:1500px;color:#222}\
-table{border-collapse:collapse;font-size:0.9em;margin:0.4em 0}th,td{border:1px solid #bbb;padding:0.25em 0.6em}\
+table{border-collapse:collapse;font-size:0.9em;margin:0.4em 0;display:block;overflow-x:auto;max-width:100%}th,td{border:1px solid #bbb;padding:0.25em 0.6em}\
 td.num{text-align:right;font-variant-numeric:tabular-nums}td.best{font-weight:bold;background:#e8f4e8}\
 td.error{color:#a00}th{background:#eee;font-weight:normal}\
-figure{display:inline-block;vertical-align:top;margin:0.5em;width:620px}\
+figure{display:inline-block;vertical-align:top;margin:0.5em;width:620px;max-width:calc(100% - 1em)}\
 figure img{width:100%;border:1px solid #ddd}figcaption{font-size:0.9em}";
 
 /// Writes the report with `title`, an `intro` paragraph, a table and an animation per

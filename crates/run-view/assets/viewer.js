@@ -85,6 +85,36 @@
     return { ticks, step };
   }
 
+  /** The multiples of `step` in [lo, hi], as `niceTicks` gives them. */
+  function multiples(lo, hi, step) {
+    const ticks = [];
+    for (let k = Math.ceil(lo / step - 1e-9); k * step <= hi + step * 1e-9; k++) {
+      ticks.push(k === 0 ? 0 : k * step);
+    }
+    return ticks;
+  }
+
+  /**
+   * The square grid of a planar arm's panel of `width` x `height` pixels showing [x0, x1] x
+   * [y0, y1] at one scale: one step on both axes (the finer of the two axes' nice steps, so that
+   * neither shows a single line), and on each axis every `every`-th line labelled, so that labels
+   * stay `minX` (x) and `minY` (y) pixels apart.
+   */
+  function squareGrid(x0, x1, y0, y1, width, height) {
+    const xs = niceTicks(x0, x1, Math.max(2, Math.floor(width / 90)));
+    const ys = niceTicks(y0, y1, Math.max(2, Math.floor(height / 70)));
+    const step = Math.min(xs.step, ys.step);
+    const pixels = (step * width) / (x1 - x0);
+    const every = (min) => Math.max(1, Math.ceil(min / pixels));
+    return {
+      step,
+      x: multiples(x0, x1, step),
+      y: multiples(y0, y1, step),
+      xEvery: every(45),
+      yEvery: every(20),
+    };
+  }
+
   /** The fewest decimals that write every multiple of `step` exactly (0.25 -> 2, 50 -> 0). */
   function decimalsOf(step) {
     for (let d = 0; d < 12; d++) {
@@ -279,29 +309,30 @@
       const x1 = x0 + camera.width / camera.scale;
       const y1 = camera.target[1] + (camera.height / 2 + camera.panY) / camera.scale;
       const y0 = y1 - camera.height / camera.scale;
-      const xs = niceTicks(x0, x1, Math.max(2, Math.floor(camera.width / 90)));
-      const ys = niceTicks(y0, y1, Math.max(2, Math.floor(camera.height / 70)));
-      const step = Math.max(xs.step, ys.step);
-      const gx = niceTicks(x0, x1, Math.max(1, Math.round((x1 - x0) / step)));
-      const gy = niceTicks(y0, y1, Math.max(1, Math.round((y1 - y0) / step)));
+      const grid = squareGrid(x0, x1, y0, y1, camera.width, camera.height);
+      const labelled = (v, every) => Math.round(v / grid.step) % every === 0;
       ctx.strokeStyle = "#e6e6e6";
       ctx.fillStyle = "#777";
       ctx.lineWidth = 1;
-      for (const x of gx.ticks) {
+      for (const x of grid.x) {
         const s = project(camera, [x, 0, 0], b)[0];
         ctx.beginPath();
         ctx.moveTo(s, 0);
         ctx.lineTo(s, camera.height);
         ctx.stroke();
-        if (s > 2 && s < camera.width - 30) ctx.fillText(formatTick(x, gx.step), s + 2, camera.height - 4);
+        if (s > 2 && s < camera.width - 30 && labelled(x, grid.xEvery)) {
+          ctx.fillText(formatTick(x, grid.step), s + 2, camera.height - 4);
+        }
       }
-      for (const y of gy.ticks) {
+      for (const y of grid.y) {
         const s = project(camera, [0, y, 0], b)[1];
         ctx.beginPath();
         ctx.moveTo(0, s);
         ctx.lineTo(camera.width, s);
         ctx.stroke();
-        if (s > 24 && s < camera.height - 16) ctx.fillText(formatTick(y, gy.step), 3, s - 3);
+        if (s > 14 && s < camera.height - 16 && labelled(y, grid.yEvery)) {
+          ctx.fillText(formatTick(y, grid.step), 3, s - 3);
+        }
       }
       ctx.fillText("x, y (m)", camera.width - 52, 12);
     } else {
@@ -894,6 +925,7 @@
     lerpRow,
     points,
     niceTicks,
+    squareGrid,
     formatTick,
     formatValue,
     torqueColour,

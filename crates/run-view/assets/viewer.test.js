@@ -47,6 +47,26 @@ test("ticks are round, cover the range and print in plain notation", () => {
   assert.equal(v.formatValue(123456789, 3), "123456789");
 });
 
+test("a planar arm's grid is square, with lines on both axes and labels apart", () => {
+  // The report's side-by-side panel: 1.2 m wide and 1.1 m tall at 400 px a metre.
+  for (const [x0, x1, y0, y1, w, h] of [
+    [-0.6, 0.6, -0.05, 1.05, 480, 440],
+    [-0.05, 0.5, -0.1, 1.3, 300, 763],
+    [-3, 3, -0.5, 0.5, 900, 150],
+  ]) {
+    const g = v.squareGrid(x0, x1, y0, y1, w, h);
+    assert.ok(g.x.length >= 2 && g.y.length >= 2, JSON.stringify(g));
+    const pixels = (g.step * w) / (x1 - x0);
+    assert.ok(pixels * g.xEvery >= 45 && pixels * g.yEvery >= 20);
+    for (const [ticks, lo, hi] of [[g.x, x0, x1], [g.y, y0, y1]]) {
+      ticks.forEach((t, k) => {
+        assert.ok(t >= lo - 1e-12 && t <= hi + 1e-12);
+        if (k > 0) assert.ok(Math.abs(t - ticks[k - 1] - g.step) < 1e-12);
+      });
+    }
+  }
+});
+
 test("torque colours run from blue at rest to red at the limit, darker beyond", () => {
   assert.deepEqual(v.torqueColour(0), [49, 99, 170]);
   assert.deepEqual(v.torqueColour(1), [214, 39, 40]);

@@ -166,7 +166,7 @@ pub fn from_record(
         Series {
             title: "modal torques tau*".into(),
             unit: "N m".into(),
-            names: names.iter().map(|n| format!("tau*_{}", &n[1..])).collect(),
+            names: names.iter().map(|n| modal_torque_name(n)).collect(),
             values: (0..m).map(|i| modal(Record::tau_star_at, i)).collect(),
         },
     ];
@@ -202,6 +202,18 @@ pub fn from_record(
     };
     view.check()?;
     Ok(view)
+}
+
+/// The curve name of the modal torque that drives coordinate `coordinate`: `tau*_1` for `a1`,
+/// `tau*_z1` for `az1`, `tau*_alpha0` for a free base angle `alpha0`.
+fn modal_torque_name(coordinate: &str) -> String {
+    let index = match coordinate.strip_prefix('a') {
+        Some(rest) if rest.starts_with(|c: char| c.is_ascii_digit() || c == 'y' || c == 'z') => {
+            rest
+        }
+        _ => coordinate,
+    };
+    format!("tau*_{index}")
 }
 
 /// The clearance series (mm) of the drawn samples `joints` (each `n + 1` points of `dims`

@@ -398,11 +398,17 @@ fn convex_hull(pts: &mut [[f64; 3]]) -> Vec<[f64; 3]> {
     hull
 }
 
-/// The GIF's palette: 6 x 7 x 6 levels of red, green and blue (252 colours), index 255 left
-/// for "unchanged since the previous frame" (transparent).
+/// The GIF's palette: 6 x 7 x 6 levels of red, green and blue (252 colours), then the
+/// [`GREYS`], index 255 left for "unchanged since the previous frame" (transparent).
 const LEVELS: [usize; 3] = [6, 7, 6];
+/// Three greys of the palette after the cube, which has no grey between black and white (its
+/// red and blue levels are multiples of 51, its green ones of 42.5): the obstacles' fill over
+/// white (190) and darker outlines, which the cube would turn lilac.
+const GREYS: [u8; 3] = [96, 144, 190];
 /// The transparent index.
 const UNCHANGED: u8 = 255;
+/// How far apart a colour's channels may be for it to be drawn in one of the [`GREYS`].
+const GREY_SPREAD: u8 = 24;
 
 fn palette() -> Vec<u8> {
     let mut out = Vec::with_capacity(3 * 256);
@@ -415,15 +421,41 @@ fn palette() -> Vec<u8> {
             }
         }
     }
+    for grey in GREYS {
+        out.extend([grey; 3]);
+    }
     out.resize(3 * 256, 255);
     out
 }
 
-/// The palette index nearest an RGB colour (premultiplied over white: the pixmap is opaque).
+/// The palette index nearest an RGB colour (premultiplied over white: the pixmap is opaque): the
+/// cube's, or for a grey (channels within [`GREY_SPREAD`]) the nearest of the cube's black and
+/// white and the [`GREYS`].
 fn index(rgba: &[u8]) -> u8 {
     let level = |c: u8, n: usize| (usize::from(c) * (n - 1) + 127) / 255;
     let [r, g, b] = [0, 1, 2].map(|i| level(rgba[i], LEVELS[i]));
-    (r * LEVELS[1] * LEVELS[2] + g * LEVELS[2] + b) as u8
+    let cube = (r * LEVELS[1] * LEVELS[2] + g * LEVELS[2] + b) as u8;
+    let (low, high) = (rgba[..3].iter().min(), rgba[..3].iter().max());
+    let (Some(&low), Some(&high)) = (low, high) else {
+        return cube;
+    };
+    if high - low > GREY_SPREAD {
+        return cube;
+    }
+    let mean = (u16::from(low) + u16::from(high)) / 2;
+    let cube_size = (LEVELS[0] * LEVELS[1] * LEVELS[2]) as u8;
+    let greys = [(0, 0)]
+        .into_iter()
+        .chain(
+            GREYS
+                .iter()
+                .enumerate()
+                .map(|(i, &v)| (cube_size + i as u8, v)),
+        )
+        .chain([(cube_size - 1, 255)]);
+    greys
+        .min_by_key(|&(_, v)| mean.abs_diff(u16::from(v)))
+        .map_or(cube, |(i, _)| i)
 }
 
 /// Writes `run` as an animated GIF to `out`: frames `1 / fps` s apart showing `speed` s of the
@@ -525,5 +557,33 @@ fn changed_part(
         transparent: Some(UNCHANGED),
         dispose: gif::DisposalMethod::Keep,
         ..gif::Frame::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The palette's colour at index `i`.
+    fn colour(i: u8) -> [u8; 3] {
+        let p = palette();
+        let at = 3 * usize::from(i);
+        [p[at], p[at + 1], p[at + 2]]
+    }
+
+    #[test]
+    fn greys_stay_grey_and_colours_keep_the_cube() {
+        // The obstacles' fill (110 at alpha 115 over white) was drawn lilac, (204, 170, 204).
+        let fill = (110.0 * 115.0 / 255.0 + 255.0 * (1.0 - 115.0 / 255.0)) as u8;
+        assert_eq!(colour(index(&[fill, fill, fill, 255])), [190; 3]);
+        assert_eq!(colour(index(&[100, 95, 90, 255])), [96; 3]);
+        assert_eq!(colour(index(&[0, 0, 0, 255])), [0; 3]);
+        assert_eq!(colour(index(&[255, 250, 252, 255])), [255; 3]);
+        // A colour keeps its nearest cube entry: the viewer's red, green and a channel blue.
+        assert_eq!(colour(index(&[214, 39, 40, 255])), [204, 42, 51]);
+        assert_eq!(colour(index(&[44, 160, 44, 255])), [51, 170, 51]);
+        assert_eq!(colour(index(&[190, 215, 235, 255])), [204, 212, 255]);
+        assert_eq!(palette().len(), 3 * 256);
+        assert!(index(&[128, 128, 128, 255]) < UNCHANGED);
     }
 }

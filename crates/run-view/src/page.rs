@@ -84,11 +84,14 @@ fn generator() -> String {
 /// How far into a page or GIF its [`SIGNATURE`] is: within the first 2 KiB.
 pub const SIGNATURE_WITHIN: usize = 2048;
 
-/// The signature, style sheet and script every page with scenes carries once: put [`head`]
-/// in the `<head>` (it opens it, right after the charset) and [`tail`] at the end of the
-/// `<body>`.
+/// The signature, the viewport (so that a phone lays the page out at its own width), style
+/// sheet and script every page with scenes carries once: put [`head`] in the `<head>` (it opens
+/// it, right after the charset) and [`tail`] at the end of the `<body>`.
 pub fn head() -> String {
-    format!("{}\n<style>{STYLE}</style>\n", generator())
+    format!(
+        "{}\n<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<style>{STYLE}</style>\n",
+        generator()
+    )
 }
 
 /// The viewer's script, to close the `<body>` of a page with scenes.

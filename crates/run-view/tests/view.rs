@@ -111,6 +111,16 @@ fn a_planar_run_is_drawn_from_its_modal_coordinates() {
         titles,
         ["tip error", "modal coordinates", "modal torques tau*"]
     );
+    assert_eq!(view.series[2].names, ["tau*_1", "tau*_2"]);
+    // A free base angle's torque keeps the angle's whole name.
+    let mut free = Scenario::builtin("free-base-tracking").unwrap();
+    free.duration = 0.01;
+    let free_run = free.build().unwrap().run().unwrap();
+    let free_view = from_record(&free, "pd", &free_run.record, None).unwrap();
+    assert_eq!(
+        free_view.series[2].names,
+        ["tau*_1", "tau*_2", "tau*_alpha0"]
+    );
     // The tip error series is the distance from the tip to the reference, in mm.
     let k = view.len() - 1;
     let (tip, reference) = (run.record.tip[k], run.record.tip_ref[k]);
