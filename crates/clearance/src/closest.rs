@@ -81,6 +81,10 @@ impl<const D: usize> Segment<D> {
 }
 
 /// The closest point of the segment `a`-`b` to the point `o`.
+///
+/// For coordinates up to [`MAX_OBSTACLE_EXTENT`](crate::MAX_OBSTACLE_EXTENT) in magnitude, which
+/// [`place`](crate::place) and the obstacles keep; beyond, the squared lengths can overflow to a
+/// NaN result.
 #[inline]
 pub fn segment_point(a: V3, b: V3, o: V3) -> Closest {
     closest_to_point(&Segment::new(a, b), o)
@@ -107,6 +111,10 @@ pub(crate) fn closest_to_point<const D: usize>(link: &Segment<D>, o: V<D>) -> Cl
 
 /// The closest points of the segments `a`-`b` and `c`-`d` (Ericson, *Real-Time Collision
 /// Detection*, 5.1.9, with the degenerate and parallel cases resolved).
+///
+/// For coordinates up to [`MAX_OBSTACLE_EXTENT`](crate::MAX_OBSTACLE_EXTENT) in magnitude, which
+/// [`place`](crate::place) and the obstacles keep; beyond, the squared lengths can overflow to a
+/// NaN result.
 #[inline]
 pub fn segment_segment(a: V3, b: V3, c: V3, d: V3) -> Closest {
     closest_to_segment(&Segment::new(a, b), &Segment::new(c, d))
@@ -185,6 +193,10 @@ pub(crate) fn closest_at<const D: usize>(
 /// whose minimum on the clipped interval is at one of its ends or at a kink where two depths
 /// tie (`deepest_inside`). Elsewhere `f = sqrt(D)` with `D` the squared distance, a sum of
 /// convex, continuously differentiable per-axis pieces (`nearest_outside`).
+///
+/// For coordinates up to [`MAX_OBSTACLE_EXTENT`](crate::MAX_OBSTACLE_EXTENT) in magnitude, which
+/// [`place`](crate::place) and the obstacles keep; beyond, the squared lengths can overflow to a
+/// NaN result.
 pub fn segment_box(a: V3, b: V3, center: V3, half: V3, axes: &[V3; 3]) -> Closest {
     closest_to_box(&Segment::new(a, b), center, half, axes)
 }

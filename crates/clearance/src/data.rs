@@ -91,6 +91,47 @@ impl ClearanceData {
         })
     }
 
+    /// `Ok` when this data was made for a model of `model`'s links and pairs (by
+    /// [`new`](Self::new)); otherwise [`ClearanceError::Dimension`] naming what disagrees.
+    pub fn check_model(&self, model: &ClearanceModel) -> Result<(), ClearanceError> {
+        let pairs = model.pairs().len();
+        let self_pairs = pairs - model.n_obstacle_pairs();
+        for (name, expected, found) in [
+            (
+                "clearance data's joint points (made for another model)",
+                model.n_links() + 1,
+                self.points.len(),
+            ),
+            (
+                "clearance data's pairs (made for another model)",
+                pairs,
+                self.distances.len(),
+            ),
+            (
+                "clearance data's self pairs (made for another model)",
+                self_pairs,
+                self.self_parameters.len(),
+            ),
+        ] {
+            if expected != found {
+                return Err(ClearanceError::Dimension {
+                    name,
+                    expected,
+                    found,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Panics with [`check_model`](Self::check_model)'s message when this data was not made for
+    /// `model`: the guard of the algorithms that return no `Result`.
+    pub(crate) fn assert_model(&self, model: &ClearanceModel) {
+        if let Err(error) = self.check_model(model) {
+            panic!("{error}");
+        }
+    }
+
     /// The joint points, base to tip.
     pub fn points(&self) -> &[V3] {
         &self.points
@@ -122,12 +163,20 @@ impl ClearanceData {
     }
 
     /// The smallest clearance to an obstacle (`+inf` with no obstacle).
+    ///
+    /// # Panics
+    /// If this data was not made for `model` ([`check_model`](Self::check_model)).
     pub fn min_obstacle_clearance(&self, model: &ClearanceModel) -> f64 {
+        self.assert_model(model);
         min(&self.distances[..model.n_obstacle_pairs()])
     }
 
     /// The smallest clearance between links that share no joint (`+inf` below three links).
+    ///
+    /// # Panics
+    /// If this data was not made for `model` ([`check_model`](Self::check_model)).
     pub fn min_self_clearance(&self, model: &ClearanceModel) -> f64 {
+        self.assert_model(model);
         min(&self.distances[model.n_obstacle_pairs()..])
     }
 }

@@ -17,7 +17,12 @@ use crate::point_lanes::closest_to_points;
 /// distance between the cores less the radii (`|c - o| - r - R` for a sphere or capsule of
 /// radius `R`, the box's signed distance of `c` less `r`, `|c_i - c_k| - 2 r` for two links),
 /// negative when they overlap. Allocation-free.
+///
+/// # Panics
+/// If `data` was not made for `model` ([`ClearanceData::check_model`]; [`place`](crate::place)
+/// and [`place_planar`](crate::place_planar) refuse such data with an error first).
 pub fn distances(model: &ClearanceModel, data: &mut ClearanceData) -> (f64, f64) {
+    data.assert_model(model);
     let ClearanceData {
         points,
         planar,

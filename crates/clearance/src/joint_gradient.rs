@@ -21,12 +21,13 @@ pub fn joint_gradient(
     pair: usize,
     gradient: &mut [f64],
 ) -> Result<(), ClearanceError> {
+    data.check_model(model)?;
     check_len("joint gradient", gradient.len(), model.n_links())?;
     let Some(&which) = model.pairs().get(pair) else {
-        return Err(ClearanceError::Dimension {
-            name: "pair index (as a count of pairs)",
-            expected: model.pairs().len(),
-            found: pair + 1,
+        return Err(ClearanceError::OutOfRange {
+            name: "pair index",
+            bound: "less than the model's number of pairs",
+            value: pair as f64,
         });
     };
     let closest = &data.closest[pair];

@@ -23,6 +23,7 @@ pub fn modal_gradients(
     data: &mut ClearanceData,
     map: &ModalMap,
 ) -> Result<(), ClearanceError> {
+    data.check_model(model)?;
     check_len("modal map joints", map.n_joints(), model.n_links())?;
     check_len("modal map coordinates", map.n_coords(), data.n_coords)?;
     let m = data.n_coords;

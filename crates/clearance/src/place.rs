@@ -3,6 +3,7 @@
 use crate::data::ClearanceData;
 use crate::error::ClearanceError;
 use crate::model::ClearanceModel;
+use crate::obstacle::MAX_OBSTACLE_EXTENT;
 use crate::vector::{V3, dot};
 use lane_math::{check_finite, check_len};
 
@@ -14,10 +15,12 @@ pub fn place_planar(
     link_lengths: &[f64],
     theta: &[f64],
 ) -> Result<(), ClearanceError> {
+    data.check_model(model)?;
     check_len("link lengths", link_lengths.len(), model.n_links())?;
     backbone_kin::joint_positions(link_lengths, theta, &mut data.planar)?;
     for (point, planar) in data.points.iter_mut().zip(&data.planar) {
         *point = [planar[0], planar[1], 0.0];
+        point.iter().try_for_each(|&x| check_extent(x))?;
     }
     data.axes.fill([0.0, 0.0, 1.0]);
     data.turns_about_z = true;
@@ -33,12 +36,11 @@ pub fn place(
     points: &[V3],
     axes: &[V3],
 ) -> Result<(), ClearanceError> {
+    data.check_model(model)?;
     check_len("joint points", points.len(), model.n_links() + 1)?;
     check_len("joint axes", axes.len(), model.n_links())?;
     for point in points {
-        point
-            .iter()
-            .try_for_each(|&x| check_finite("joint point", x))?;
+        point.iter().try_for_each(|&x| check_extent(x))?;
     }
     for axis in axes {
         let length = dot(*axis, *axis).sqrt();
@@ -53,5 +55,19 @@ pub fn place(
     data.points.copy_from_slice(points);
     data.axes.copy_from_slice(axes);
     data.turns_about_z = false;
+    Ok(())
+}
+
+/// Refuses a joint point coordinate that is not finite or beyond [`MAX_OBSTACLE_EXTENT`] in
+/// magnitude, where the closest points' products would lose the links' scale.
+fn check_extent(x: f64) -> Result<(), ClearanceError> {
+    check_finite("joint point", x)?;
+    if x.abs() > MAX_OBSTACLE_EXTENT {
+        return Err(ClearanceError::OutOfRange {
+            name: "joint point coordinate",
+            bound: "at most 1e15 m in magnitude (MAX_OBSTACLE_EXTENT)",
+            value: x,
+        });
+    }
     Ok(())
 }

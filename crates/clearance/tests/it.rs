@@ -583,3 +583,49 @@ fn bad_input_is_refused_with_the_field_named() {
     let mut gradient = [0.0; 3];
     assert!(joint_gradient(&model, &data, 1, &mut gradient).is_err());
 }
+
+#[test]
+fn data_of_another_model_and_chains_beyond_the_extent_are_refused() {
+    let circle = |x: f64| Obstacle::circle([x, 0.0], 1.0).unwrap();
+    let one = ClearanceModel::new(3, 0.01, vec![circle(5.0)]).unwrap();
+    let three = ClearanceModel::new(3, 0.01, vec![circle(5.0), circle(6.0), circle(7.0)]).unwrap();
+    let mut data = ClearanceData::new(&one, 0).unwrap();
+    let message = place_planar(&three, &mut data, &[0.1; 3], &[0.1; 3])
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        message,
+        "clearance data's pairs (made for another model) has 4 entries, expected 10"
+    );
+    assert!(place(&three, &mut data, &[[0.0; 3]; 4], &[[0.0, 0.0, 1.0]; 3]).is_err());
+    place_planar(&one, &mut data, &[0.1; 3], &[0.1; 3]).unwrap();
+    let mut gradient = [0.0; 3];
+    assert!(joint_gradient(&three, &data, 0, &mut gradient).is_err());
+    let map = ModalMap::new(&[0.1; 3], 1, BaseAngle::Fixed(0.0)).unwrap();
+    assert!(modal_gradients(&three, &mut data, &map).is_err());
+    let distances = std::panic::catch_unwind(|| {
+        distances(&three, &mut data.clone());
+    });
+    assert!(distances.is_err());
+    assert!(std::panic::catch_unwind(|| data.min_obstacle_clearance(&three)).is_err());
+    // A pair index past the last is named as such, usize::MAX included.
+    let message = joint_gradient(&one, &data, usize::MAX, &mut gradient)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.starts_with("pair index must be less than"),
+        "{message}"
+    );
+    // Links of 1e300 m put the chain beyond the extent the geometry keeps to scale.
+    let message = place_planar(&one, &mut data, &[1e300; 3], &[0.1; 3])
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("joint point coordinate"), "{message}");
+    let far = [
+        [0.0; 3],
+        [2e15, 0.0, 0.0],
+        [3e15, 0.0, 0.0],
+        [4e15, 0.0, 0.0],
+    ];
+    assert!(place(&one, &mut data, &far, &[[0.0, 0.0, 1.0]; 3]).is_err());
+}

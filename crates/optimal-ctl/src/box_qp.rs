@@ -351,6 +351,9 @@ impl BoxQp {
     /// rows of the last solution and zero on the clamped rows: the feedback gain of
     /// control-limited DDP, `K_f = -Q_uu,ff^-1 Q_ux,f`, `K_c = 0` (Tassa et al. 2014, eq 7),
     /// is `-` this applied to `Q_ux`.
+    ///
+    /// # Panics
+    /// If `rhs` has fewer than `n x c` entries, like slice indexing.
     pub fn solve_free(&mut self, rhs: &mut [f64], c: usize) {
         let k = self.n_free;
         for col in 0..c {

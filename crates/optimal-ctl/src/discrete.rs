@@ -180,12 +180,12 @@ const BATCH_NODES: usize = 8;
 
 /// Checks an integration step of the discrete model (s).
 pub(crate) fn check_step(step: f64) -> Result<(), OptimalError> {
-    if step.is_finite() && step > 0.0 && step <= 10.0 {
+    if (1e-9..=10.0).contains(&step) {
         Ok(())
     } else {
         Err(OptimalError::InvalidSetting {
             name: "step",
-            requirement: "positive and at most 10 s",
+            requirement: "between 1e-9 s and 10 s",
             value: step,
         })
     }

@@ -245,10 +245,12 @@ impl Ilqr {
             });
         }
         if !workspace_fits(nx, nu, horizon) {
+            // The workspace's size, in floating point so that it cannot wrap.
+            let (x, u) = (nx as f64, nu as f64);
             return Err(OptimalError::InvalidSetting {
-                name: "horizon",
-                requirement: "small enough for horizon * (2 n_x^2 + 3 n_x n_u) <= 2^25",
-                value: horizon as f64,
+                name: "horizon * (2 n_x^2 + 3 n_x n_u) (the workspace's numbers)",
+                requirement: "at most 2^25",
+                value: horizon as f64 * (2.0 * x * x + 3.0 * x * u),
             });
         }
         for (name, weights, len, positive) in [

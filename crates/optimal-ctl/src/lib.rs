@@ -43,7 +43,7 @@ pub enum OptimalError {
     #[error("chain dynamics: {0}")]
     ChainDynamics(#[from] manip_dyn::DynError),
     /// A setting was out of its domain.
-    #[error("{name} must be {requirement}, got {value}")]
+    #[error("{name} must be {requirement}, got {}", lane_math::Compact(*.value))]
     InvalidSetting {
         /// Which setting.
         name: &'static str,

@@ -89,12 +89,15 @@ impl Lqr {
     /// [`OptimalError::Dimension`] for wrong sizes, [`OptimalError::InvalidSetting`] for a
     /// non-finite or asymmetric weight, [`OptimalError::NotPositiveDefinite`] if `r` is not.
     pub fn new(m: usize, q: &[f64], r: &[f64]) -> Result<Self, OptimalError> {
-        let n = 2 * m;
+        // `2m` and `(2m)^2` are counts of `Q`'s entries: a count that overflows is no size `q`
+        // can have.
+        let n = m.saturating_mul(2);
         for (name, values, size) in [("Q", q, n), ("R", r, m)] {
-            if values.len() != size * size {
+            let expected = size.saturating_mul(size);
+            if values.len() != expected || expected == usize::MAX {
                 return Err(OptimalError::Dimension {
                     name,
-                    expected: size * size,
+                    expected,
                     found: values.len(),
                 });
             }

@@ -441,6 +441,14 @@ pub(crate) fn tracking_cost(
         }
     }
     let h = settings.step;
+    // A weight times the step must stay a positive number: 5e-324 * 0.005 is zero.
+    if let Some(&w) = settings.effort_weight.iter().find(|w| **w * h <= 0.0) {
+        return Err(OptimalError::InvalidSetting {
+            name: "effort_weight",
+            requirement: "large enough that effort_weight * step is a positive number",
+            value: w,
+        });
+    }
     let state: Vec<f64> = settings
         .position_weight
         .iter()

@@ -113,9 +113,9 @@ impl Channel {
     }
 
     /// `Gamma(sigma)`: on the axis behind the entry for `sigma <= 0`, on the centreline beyond
-    /// (held at its end past its length).
+    /// (held at its end past its length); NaN coordinates for a NaN `sigma`.
     pub fn point_at(&self, sigma: f64) -> [f64; 2] {
-        if sigma <= 0.0 {
+        if sigma <= 0.0 || sigma.is_nan() {
             let (e, d) = (self.entry(), self.axis());
             return [e[0] + sigma * d[0], e[1] + sigma * d[1]];
         }

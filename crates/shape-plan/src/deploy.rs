@@ -105,6 +105,16 @@ pub fn follow_the_leader(
             value: work,
         });
     }
+    for &length in link_lengths {
+        check_finite("link length", length)?;
+        if length <= 0.0 {
+            return Err(PlanError::OutOfRange {
+                name: "link length",
+                bound: "positive",
+                value: length,
+            });
+        }
+    }
     let shortest = link_lengths.iter().copied().fold(f64::INFINITY, f64::min);
     if channel.length() + link_lengths.iter().sum::<f64>() > MAX_LENGTH_RATIO * shortest {
         return Err(PlanError::OutOfRange {

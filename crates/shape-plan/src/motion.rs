@@ -32,8 +32,9 @@ pub struct SegmentCheck {
 /// module docs, both ends included, stopping at the first check point closer than
 /// `c + epsilon`. Allocation-free.
 ///
-/// Errors: [`PlanError::TooMany`] when the segment needs more than `max_checks` points; sizes
-/// that disagree; non-finite coordinates.
+/// Errors: options that [`PlanOptions::validate`] refuses; [`PlanError::TooMany`] when the
+/// segment needs more than `max_checks` points; sizes that disagree (the clearance data of
+/// `data` made for another model included); non-finite coordinates.
 pub fn check_segment<A: Arm>(
     arm: &A,
     clearance: &ClearanceModel,
@@ -42,6 +43,7 @@ pub fn check_segment<A: Arm>(
     from: &[f64],
     to: &[f64],
 ) -> Result<SegmentCheck, PlanError> {
+    options.validate()?;
     let m = arm.n_coords();
     check_len("segment start", from.len(), m)?;
     check_len("segment end", to.len(), m)?;

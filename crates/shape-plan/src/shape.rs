@@ -20,7 +20,7 @@
 use crate::arm::Arm;
 use crate::data::PlanData;
 use crate::error::PlanError;
-use crate::options::PlanOptions;
+use crate::options::{MAX_LENGTH_M, PlanOptions};
 use clearance::{ClearanceModel, distances};
 use optimal_ctl::{LinearQpFailure, ProjectionFailure};
 
@@ -49,8 +49,9 @@ pub struct ShapeOutcome {
 /// `c + epsilon` (module docs), from the modal coordinates in `a`, which receive the last
 /// accepted iterate. Allocation-free.
 ///
-/// Returns the outcome whether or not it reached the target; errors are for bad input (a
-/// non-finite start, sizes that disagree).
+/// Returns the outcome whether or not it reached the target; errors are for bad input (options
+/// that [`PlanOptions::validate`] refuses, a non-finite start, a target coordinate not finite or
+/// beyond [`MAX_LENGTH_M`], sizes that disagree).
 pub fn solve_shape<A: Arm>(
     arm: &A,
     clearance: &ClearanceModel,
@@ -59,10 +60,21 @@ pub fn solve_shape<A: Arm>(
     target: [f64; 3],
     a: &mut [f64],
 ) -> Result<ShapeOutcome, PlanError> {
+    options.validate()?;
     let m = arm.n_coords();
     lane_math::check_len("modal coordinates", a.len(), m)?;
     for &x in a.iter() {
         lane_math::check_finite("start coordinate", x)?;
+    }
+    for x in target {
+        lane_math::check_finite("target coordinate", x)?;
+        if x.abs() > MAX_LENGTH_M {
+            return Err(PlanError::OutOfRange {
+                name: "target coordinate",
+                bound: "at most 1e6 m in magnitude",
+                value: x,
+            });
+        }
     }
     let goal = options.needed() + 0.5 * options.check_slack;
     let rho = arm.length();

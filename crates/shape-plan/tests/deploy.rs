@@ -25,6 +25,7 @@ fn bent() -> Vec<[f64; 2]> {
 #[test]
 fn a_straight_channel_is_followed_exactly() {
     let channel = Channel::new(&[[0.0, 0.0], [0.0, 1.0]], 0.03).unwrap();
+    assert!(channel.point_at(f64::NAN).iter().all(|x| x.is_nan()));
     let deployment = follow_the_leader(&channel, &[0.1; 10], 0.01, 1, 0.6, 12).unwrap();
     for frame in &deployment.frames {
         assert!((frame.insertion - frame.progress).abs() < 1e-12);
@@ -99,6 +100,10 @@ fn deployments_refuse_what_they_cannot_do() {
     assert!(
         text(Channel::new(&[[0.0, 0.0], [0.0, 1.0]], 0.0).unwrap_err()).contains("deploy radius")
     );
+    // A link of no length is named, not read as an infinite centreline ratio.
+    let straight = Channel::new(&[[0.0, 0.0], [0.0, 1.0]], 0.03).unwrap();
+    let zero = follow_the_leader(&straight, &[0.1, 0.0, 0.1], 0.01, 1, 0.1, 4).unwrap_err();
+    assert_eq!(text(zero), "link length must be positive, got 0");
     // Points closer than a nanometre, and a radius below one.
     let close = [[0.0, 0.0], [0.0, 1e-320], [0.0, 2e-320]];
     assert_eq!(

@@ -535,6 +535,51 @@ fn a_segment_through_an_obstacle_is_caught_and_a_clear_one_passes() {
     let error =
         check_segment(p.arm(), p.clearance(), &tight, &mut data, &[1.2, 0.0], &to).unwrap_err();
     assert!(error.to_string().contains("max checks"), "{error}");
+    // Options the planner refuses are refused here too, before any check point.
+    let unbounded = PlanOptions {
+        max_checks: usize::MAX,
+        check_slack: -1.0,
+        ..options()
+    };
+    let error = check_segment(
+        p.arm(),
+        p.clearance(),
+        &unbounded,
+        &mut data,
+        &[1.2, 0.0],
+        &to,
+    )
+    .unwrap_err();
+    assert!(error.to_string().contains("check slack"), "{error}");
+    // Plan data sized for another clearance model is refused, not read as this one's.
+    let other = planner(1, &[circles[0], circles[0], circles[0]], options());
+    let error = check_segment(
+        p.arm(),
+        other.clearance(),
+        p.options(),
+        &mut data,
+        &[1.2, 0.0],
+        &to,
+    )
+    .unwrap_err();
+    assert!(
+        error.to_string().contains("made for another model"),
+        "{error}"
+    );
+    // A target that is not a point of space is refused by the shape solve.
+    for target in [[f64::NAN, 0.5, 0.0], [1e300, 0.0, 0.0]] {
+        let mut a = [0.0; 2];
+        let error = shape_plan::solve_shape(
+            p.arm(),
+            p.clearance(),
+            p.options(),
+            &mut data,
+            target,
+            &mut a,
+        )
+        .unwrap_err();
+        assert!(error.to_string().contains("target coordinate"), "{error}");
+    }
 }
 
 #[test]

@@ -20,10 +20,10 @@
 
 use crate::controller::ChainMpcController;
 use crate::error::{SimError, StoppedRun, check_positive};
-use crate::ode::{OdeSystem, Rk4};
+use crate::ode::{MAX_RK4_STEPS, OdeSystem, Rk4};
 use crate::reference::{Reference, ReferenceSample};
 use crate::simulation::{
-    MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RK4_STEPS, MAX_RUN_WORK, run_work_refusal,
+    MAX_CONTROLLER_SAMPLES, MAX_RECORDED_VALUES, MAX_RUN_WORK, run_work_refusal,
 };
 use lane_math::Compact;
 use lane_math::check_all_finite;

@@ -5,7 +5,7 @@
 use crate::controller::{ControlContext, Controller, ModalState};
 use crate::error::{SimError, check_non_negative, check_positive};
 use crate::noise::GaussianNoise;
-use crate::ode::{DormandPrince, OdeSystem, Rk4, Stats, Tolerances};
+use crate::ode::{DormandPrince, MAX_RK4_STEPS, OdeSystem, Rk4, Stats, Tolerances};
 use crate::record::{Metrics, Record, Sample, Summary};
 use crate::reference::continuation::Family;
 use crate::reference::{Reference, ReferenceSample};
@@ -1171,12 +1171,6 @@ pub(crate) fn run_work_refusal(duration: f64, work: f64, parts: &str, advice: &s
         ),
     )
 }
-
-/// The most fixed steps an RK4 run may take (`duration / integrator.dt`): about half an hour of
-/// computing for a 10-link arm, so a step typed `1e-12` for `1e-4` is refused up front rather
-/// than running for days. A Dormand-Prince run whose `h_max` forces more steps
-/// (`duration / h_max`) is refused the same way.
-pub const MAX_RK4_STEPS: f64 = 1e9;
 
 /// The most numbers a run may record (1 GiB of `f64`): [`Simulation::new`] refuses a duration and
 /// recording period that would record more, instead of failing to allocate during the run.

@@ -152,7 +152,15 @@ impl SpatialReducedModel {
         mass: f64,
         gravity: [f64; 3],
     ) -> Result<Self, ReduceError> {
-        let map = SpatialModalMap::new(&vec![length; n.min(backbone_kin::MAX_LINKS)], harmonics)?;
+        if n > backbone_kin::MAX_LINKS {
+            return Err(backbone_kin::KinError::TooMany {
+                what: "links",
+                got: n,
+                max: backbone_kin::MAX_LINKS,
+            }
+            .into());
+        }
+        let map = SpatialModalMap::new(&vec![length; n], harmonics)?;
         let links = vec![SpatialLinkInertia::rod(mass, length); map.n_links()];
         Self::new(map, BasePose::default(), links, gravity)
     }

@@ -112,11 +112,14 @@ fn model_rows() -> Vec<Row<ReduceError>> {
             |e| matches!(e, ReduceError::RankDeficient { .. }),
         ));
     }
-    // Three coordinates on two links; seven coordinates on five links.
+    // Three coordinates on two links; seven coordinates on five links; the most harmonics a
+    // map may have on ten links (refused at once, before the O(m^3) eigenvalues that took
+    // minutes for 4,097 coordinates).
     for (n, harmonics, base) in [
         (2, 1, BaseAngle::Free),
         (1, 1, BaseAngle::Fixed(0.0)),
         (5, 3, BaseAngle::Free),
+        (10, backbone_kin::MAX_HARMONICS, BaseAngle::Free),
     ] {
         rows.push(words(
             "more_harmonics_than_the_links_resolve",

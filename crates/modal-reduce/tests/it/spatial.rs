@@ -368,6 +368,11 @@ fn spatial_arms_refuse_bad_input() {
     let rod = SpatialLinkInertia::rod(0.1, 1.0);
     let base = BasePose::default();
     let g = [0.0, 0.0, -9.81];
+    // More links than a map holds is refused, not cut to the limit.
+    let message = SpatialReducedModel::uniform_rods(usize::MAX, 1, 0.1, 0.1, g)
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("links"), "{message}");
     assert!(matches!(
         SpatialReducedModel::new(map.clone(), base, vec![rod; 2], g),
         Err(ReduceError::Dimension {

@@ -268,6 +268,13 @@ fn bad_settings_are_refused() {
         Lqr::new(m, &q[1..], &r),
         Err(OptimalError::Dimension { name: "Q", .. })
     ));
+    // A size whose entry count wraps around (2^32 squared is 0 in 64 bits) is refused by name.
+    for huge in [1 << 32, usize::MAX] {
+        assert!(matches!(
+            Lqr::new(huge, &[], &[]),
+            Err(OptimalError::Dimension { name: "Q", .. })
+        ));
+    }
     let mut lqr = Lqr::new(m, &q, &r).unwrap();
     lin.linearise(&model, &[0.1, 0.2, 1.0], &[0.0; 3], &[0.0; 3], 0.01)
         .unwrap();
@@ -304,12 +311,33 @@ fn mpc_max_coords_is_the_largest_plan_the_workspace_holds() {
         }
         assert!(Ilqr::new(2 * m, m, horizon, &cost(m)).is_ok(), "{horizon}");
         let err = Ilqr::new(2 * (m + 1), m + 1, horizon, &cost(m + 1)).unwrap_err();
-        assert!(matches!(
-            err,
-            OptimalError::InvalidSetting {
-                name: "horizon",
-                ..
-            }
-        ));
+        assert!(
+            err.to_string()
+                .starts_with("horizon * (2 n_x^2 + 3 n_x n_u) (the workspace's numbers) must be"),
+            "{err}"
+        );
     }
+    // A state too large for any horizon is named with the workspace it needs, not the horizon.
+    let err = Ilqr::new(usize::MAX, 1, 1, &cost(1)).unwrap_err();
+    assert!(err.to_string().contains("workspace"), "{err}");
+}
+
+#[test]
+fn mpc_weights_and_steps_that_vanish_are_refused_by_name() {
+    use optimal_ctl::{Mpc, MpcSettings};
+    let model = model(1, BaseAngle::Free);
+    let mut settings = MpcSettings::uniform(3);
+    settings.effort_weight = vec![5e-324; 3];
+    let err = Mpc::new(&model, &settings).unwrap_err().to_string();
+    assert!(
+        err.starts_with("effort_weight must be large enough"),
+        "{err}"
+    );
+    let mut settings = MpcSettings::uniform(3);
+    settings.step = 5e-324;
+    let err = Mpc::new(&model, &settings).unwrap_err().to_string();
+    assert!(
+        err.starts_with("step must be between 1e-9 s and 10 s"),
+        "{err}"
+    );
 }

@@ -15,7 +15,7 @@ mod dopri5;
 mod rk4;
 
 pub use dopri5::{DormandPrince, MIN_RTOL, Tolerances};
-pub use rk4::Rk4;
+pub use rk4::{MAX_RK4_STEPS, Rk4};
 
 use lane_math::{Classify, Compact, ErrorClass};
 

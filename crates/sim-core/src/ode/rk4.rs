@@ -2,6 +2,12 @@
 
 use super::{OdeError, OdeSystem, Stats, check_call, combine, eval};
 
+/// The most fixed steps an RK4 run may take (`duration / integrator.dt`), and one
+/// [`Rk4::integrate`] call: about half an hour of computing for a 10-link arm, so a step typed
+/// `1e-12` for `1e-4` is refused up front rather than running for days. A Dormand-Prince run
+/// whose `h_max` forces more steps (`duration / h_max`) is refused the same way.
+pub const MAX_RK4_STEPS: f64 = 1e9;
+
 /// The nodes `c_s` of the classical tableau: stage `s` is evaluated at `t + c_s h` and
 /// `y + h c_s k_{s-1}` (the first at `(t, y)` itself).
 const NODES: [f64; Rk4::STAGES] = [0.0, 0.5, 0.5, 1.0];
@@ -56,7 +62,8 @@ impl Rk4 {
     }
 
     /// Integrates from `t0` to exactly `t1` in equal steps no longer than `max_step`, updating `y`
-    /// in place. Returns the work done; `t1 == t0` takes no step.
+    /// in place. Returns the work done; `t1 == t0` takes no step, and an interval that needs more
+    /// than [`MAX_RK4_STEPS`] steps is refused before the first.
     pub fn integrate<S: OdeSystem>(
         &mut self,
         system: &mut S,
@@ -109,9 +116,9 @@ impl Rk4 {
         // A relative slack keeps `span / max_step = 1 + 1e-12` (the rounding of `t1 - t0` far from
         // the origin) from costing a second step; a step that much longer is harmless.
         let steps = ((span / max_step) * (1.0 - 1e-9)).ceil().max(1.0);
-        if steps > usize::MAX as f64 / 2.0 {
+        if steps > MAX_RK4_STEPS {
             return Err(OdeError::InvalidSetting(
-                "the RK4 step is too small for the interval",
+                "the RK4 step is too small for the interval: more than 1e9 steps (MAX_RK4_STEPS)",
             ));
         }
         let steps = steps as usize;

@@ -334,6 +334,12 @@ fn bad_calls_are_refused() {
         rk4.integrate(&mut osc, 1.0, 0.0, &mut y, 0.1),
         Err(OdeError::InvalidSetting(_))
     ));
+    // A step that would take more than MAX_RK4_STEPS steps (hours of work) is refused at once.
+    let refused = rk4
+        .integrate(&mut osc, 0.0, 1.0, &mut y, 1e-12)
+        .unwrap_err();
+    assert!(refused.to_string().contains("MAX_RK4_STEPS"), "{refused}");
+    assert_eq!(y, [1.0, 0.0]);
     assert!(matches!(
         dp5.integrate(&mut osc, 0.0, f64::NAN, &mut y),
         Err(OdeError::InvalidSetting(_))
