@@ -400,7 +400,9 @@ impl MembershipFn {
         Ok(())
     }
 
-    /// The degree of membership of `x`, or an error if the parameters are invalid.
+    /// The degree of membership of `x`, or an error if the parameters are invalid or `x` is NaN
+    /// ([`FuzzyError::NonFiniteInput`] naming the input `x`; an infinite `x` has the function's
+    /// limit).
     ///
     /// Systems evaluate their sets through a compiled form made once at build time; this is
     /// the same code, for plotting or checking a single function.
@@ -409,10 +411,20 @@ impl MembershipFn {
     /// use fuzzy_sugeno::MembershipFn;
     /// let n = MembershipFn::bell(0.3, 2.0, -0.3);
     /// assert_eq!(n.degree(0.0)?, 0.5); // |(0 + 0.3) / 0.3|^4 = 1
+    /// assert_eq!(n.degree(f64::INFINITY)?, 0.0);
+    /// assert!(n.degree(f64::NAN).is_err());
     /// # Ok::<(), fuzzy_sugeno::FuzzyError>(())
     /// ```
     pub fn degree(&self, x: f64) -> Result<f64, FuzzyError> {
-        Ok(self.compile()?.eval(x))
+        let compiled = self.compile()?;
+        if x.is_nan() {
+            return Err(FuzzyError::NonFiniteInput {
+                index: 0,
+                name: "x".into(),
+                value: x,
+            });
+        }
+        Ok(compiled.eval(x))
     }
 
     /// Validates the function and picks its evaluation form ([`CompiledMf`]).

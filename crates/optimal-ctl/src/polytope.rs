@@ -31,6 +31,9 @@ pub enum ProjectionFailure {
     /// The sizes disagree: `G` is not `g.len() x m`, `x0` or `x` not `m` long, or more rows than
     /// the working memory was made for.
     Dimension,
+    /// A number of `G`, `g` or `x0` is NaN, or one of `G` or `x0` is infinite (an infinite
+    /// bound `g_i` is a row that never binds).
+    NonFinite,
 }
 
 impl std::fmt::Display for ProjectionFailure {
@@ -39,6 +42,9 @@ impl std::fmt::Display for ProjectionFailure {
             Self::Empty => "the constraints admit no point",
             Self::NoConvergence => "the active-set iterations did not converge",
             Self::Dimension => "the constraint matrix, bounds and points disagree in size",
+            Self::NonFinite => {
+                "a constraint row or the point holds a number that is not finite, or a bound is NaN"
+            }
         })
     }
 }
@@ -105,7 +111,8 @@ impl PolytopeProjection {
     /// # Errors
     /// [`ProjectionFailure::Empty`] when no point satisfies the constraints,
     /// [`ProjectionFailure::NoConvergence`] when the iterations do not settle,
-    /// [`ProjectionFailure::Dimension`] when the sizes disagree.
+    /// [`ProjectionFailure::Dimension`] when the sizes disagree, [`ProjectionFailure::NonFinite`]
+    /// for a NaN anywhere or an infinite row entry or `x0` (it was reported as empty).
     pub fn project(
         &mut self,
         constraints: &[f64],
@@ -116,6 +123,10 @@ impl PolytopeProjection {
         let (m, p) = (self.m, g.len());
         if p > self.rows || constraints.len() != p * m || x0.len() != m || x.len() != m {
             return Err(ProjectionFailure::Dimension);
+        }
+        let finite = constraints.iter().chain(x0).all(|v| v.is_finite());
+        if !finite || g.iter().any(|v| v.is_nan()) {
+            return Err(ProjectionFailure::NonFinite);
         }
         let height = m + 1;
         let mut violated = false;

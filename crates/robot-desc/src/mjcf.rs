@@ -77,12 +77,26 @@ pub fn write_mjcf(robot: &Robot, gravity: [f64; 3]) -> Result<String, DescError>
 /// The chain as MJCF files: `{stem}.xml`, and past [`MJCF_BODIES_PER_FILE`] moving bodies
 /// `{stem}-part1.xml`, `{stem}-part2.xml`... each included by the one before (MuJoCo resolves
 /// them relative to the first). Returns `(file name, text)` pairs, the main file first.
-/// Refused past [`MJCF_MAX_BODIES`], and as [`write_mjcf`] for what MuJoCo would refuse.
+/// Refused past [`MJCF_MAX_BODIES`], as [`write_mjcf`] for what MuJoCo would refuse, and for a
+/// `stem` that is not a plain file name (empty, `.` or `..`, a path separator or a control
+/// character: the names are the files' and the `<include>`s').
 pub fn write_mjcf_files(
     robot: &Robot,
     gravity: [f64; 3],
     stem: &str,
 ) -> Result<Vec<(String, String)>, DescError> {
+    if stem.is_empty()
+        || stem == "."
+        || stem == ".."
+        || stem
+            .chars()
+            .any(|c| c == '/' || c == '\\' || c.is_control())
+    {
+        return Err(DescError::export(
+            "MJCF file stem",
+            format!("{stem:?} is not a plain file name (no path separators or control characters)"),
+        ));
+    }
     let bodies = bodies(robot, gravity)?;
     Ok(assemble(
         robot,

@@ -39,7 +39,11 @@ pub fn write_urdf(robot: &Robot) -> Result<String, DescError> {
             format!("robot '{}'", robot.name),
             match e {
                 // Too large a document: say so with the joints, not only as the XML limit.
-                DescError::Xml(_) | DescError::TooLarge { .. } | DescError::TooManyNodes { .. } => {
+                DescError::Xml(_) => format!(
+                    "its URDF would not read back (a name or path holding a character XML cannot \
+                     carry, such as a control character): {e}"
+                ),
+                DescError::TooLarge { .. } | DescError::TooManyNodes { .. } => {
                     format!(
                         "its URDF of {} movable joints is larger than a URDF is read back (at most \
                          {} XML nodes, about 25 a joint, and {} MiB): {e}",

@@ -347,3 +347,25 @@ fn what_the_reader_would_refuse_is_not_written() {
         "{error}"
     );
 }
+
+#[test]
+fn a_file_stem_that_is_not_a_plain_name_is_refused() {
+    let robot = read_urdf(&one_link(&inertial(
+        &[[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]],
+        [0.0; 3],
+    )))
+    .unwrap()
+    .robot;
+    let g = [0.0, 0.0, -9.81];
+    for stem in ["", ".", "..", "../../etc/x", "a\\b", "x\0", "tab\t"] {
+        let error = robot_desc::write_mjcf_files(&robot, g, stem).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .starts_with("cannot export MJCF file stem"),
+            "{stem:?}: {error}"
+        );
+    }
+    let files = robot_desc::write_mjcf_files(&robot, g, "snake-10").unwrap();
+    assert_eq!(files[0].0, "snake-10.xml");
+}

@@ -680,3 +680,17 @@ fn the_longest_spatial_arm_is_written_and_read_back_and_a_longer_refused() {
         "cannot export robot 'longer': 10001 links exceed the 10000 a spatial arm is written with"
     );
 }
+
+#[test]
+fn a_name_xml_cannot_carry_is_named_as_such_not_as_a_size() {
+    let text = r#"<robot name="r"><link name="b"/><link name="a"><inertial><mass value="1"/>
+<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+<joint name="j" type="continuous"><parent link="b"/><child link="a"/><axis xyz="0 0 1"/></joint></robot>"#;
+    let mut robot = read_urdf(text).unwrap().robot;
+    robot.joints[0].name = "j\0".into();
+    let message = write_urdf(&robot).unwrap_err().to_string();
+    assert!(
+        message.contains("a character XML cannot carry") && !message.contains("larger than"),
+        "{message}"
+    );
+}

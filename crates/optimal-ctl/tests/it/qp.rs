@@ -240,6 +240,25 @@ fn sizes_that_disagree_and_indefinite_h_are_refused() {
     let mut x = [0.0; 2];
     let result = projection.project(&[1.0, 0.0, 1.0, 0.0], &[1.0, 1.0], &[0.0; 2], &mut x);
     assert_eq!(result, Err(ProjectionFailure::Dimension));
+    // A NaN is not an empty polytope; an infinite bound is a row that never binds.
+    for (row, bound, x0) in [
+        ([1.0, 0.0], f64::NAN, [0.0; 2]),
+        ([f64::NAN, 0.0], 1.0, [0.0; 2]),
+        ([f64::INFINITY, 0.0], 1.0, [0.0; 2]),
+        ([1.0, 0.0], 1.0, [f64::NAN, 0.0]),
+    ] {
+        let result = projection.project(&row, &[bound], &x0, &mut x);
+        assert_eq!(
+            result,
+            Err(ProjectionFailure::NonFinite),
+            "{row:?} {bound} {x0:?}"
+        );
+    }
+    assert_eq!(
+        projection.project(&[1.0, 0.0], &[f64::INFINITY], &[5.0, 0.0], &mut x),
+        Ok(false)
+    );
+    assert_eq!(x, [5.0, 0.0]);
     let mut qp = LinearQp::new(2, 1);
     let result = qp.solve(
         &[1.0, 0.0, 0.0, -1.0],

@@ -89,6 +89,10 @@ pub trait Reference: Send {
 
     /// Writes the desired motion at time `t` (s) into `out` (`m` entries per field). `&mut self`
     /// only for workspaces: the sample is a function of `t` alone.
+    ///
+    /// # Panics
+    /// Implementations may panic, like slice copying, when `out` was not made for
+    /// [`n_coords`](Self::n_coords) coordinates (`ReferenceSample::zeros(reference.n_coords())`).
     fn sample(&mut self, t: f64, out: &mut ReferenceSample) -> Result<(), SimError>;
 }
 

@@ -273,6 +273,11 @@ impl LimitProjection {
                 reason: "no modal torque keeps every joint within limits.joint_torque_nm and \
                          limits.joint_angle_rad",
             }),
+            Err(ProjectionFailure::NonFinite) => Err(SimError::JointLimits {
+                t,
+                reason: "the joint limits' rows or the controller's modal torque are not finite \
+                         numbers",
+            }),
             Err(_) => Err(SimError::JointLimits {
                 t,
                 reason: "the projection onto the joint limits did not converge",
