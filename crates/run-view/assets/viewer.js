@@ -145,6 +145,25 @@
   /** Curve colours (Tableau 10). */
   const PALETTE = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
 
+  /** Ten more colours after the `PALETTE` for panels of many curves (a spatial arm's 16 coordinates). */
+  const MORE_COLOURS = ["#393b79", "#637939", "#8c6d31", "#843c39", "#7b4173", "#3182bd", "#31a354", "#756bb1", "#e6550d", "#636363"];
+
+  /**
+   * The colour and line of each curve of a panel named `names`: a curve named `X ref` is drawn
+   * dotted in the colour of `X`, every other curve in the next colour of `PALETTE` and then
+   * `MORE_COLOURS` (repeating past twenty).
+   */
+  function curveStyles(names) {
+    const colours = PALETTE.concat(MORE_COLOURS);
+    const index = new Map();
+    for (const n of names) if (!n.endsWith(" ref") && !index.has(n)) index.set(n, index.size);
+    return names.map((n) => {
+      const reference = n.endsWith(" ref") && index.has(n.slice(0, -4));
+      const k = reference ? index.get(n.slice(0, -4)) : index.has(n) ? index.get(n) : index.size;
+      return { colour: colours[k % colours.length], reference };
+    });
+  }
+
   /**
    * The colour of a link whose joint torque is `ratio` of its limit: blue at rest, through
    * green and amber to red at the limit, dark red beyond it. Returns [r, g, b].
@@ -581,9 +600,10 @@
     runs.forEach((run, r) => {
       const s = run.series[g];
       if (!s) return;
-      ctx.setLineDash(r === 0 ? [] : [5, 3]);
+      const styles = curveStyles(s.names);
       s.values.forEach((values, i) => {
-        ctx.strokeStyle = PALETTE[i % PALETTE.length];
+        ctx.setLineDash(styles[i].reference ? [1.5, 2.5] : r === 0 ? [] : [5, 3]);
+        ctx.strokeStyle = styles[i].colour;
         ctx.lineWidth = 1.5;
         ctx.beginPath();
         values.forEach((v, k) => (k ? ctx.lineTo(sx(run.t[k]), sy(v)) : ctx.moveTo(sx(run.t[k]), sy(v))));
@@ -699,8 +719,8 @@
       const keep = state.cameras && state.cameras.length === armCanvases.length && state.cameras[0].width === width ? state.cameras : null;
       state.cameras = keep || armCanvases.map(() => fitCamera(everything, list[0].dims, width, height, state.view));
       legend.textContent = "";
-      const key = (colour, text, dashed) => element(doc, "span", { class: "hrm-key" }, [element(doc, "i", { style: "border-top:3px " + (dashed ? "dashed " : "solid ") + colour }), doc.createTextNode(text)]);
-      if (list[0].tip_ref && list[0].tip_ref.length) legend.appendChild(key("#d62728", "reference path (ring: reference now)", true));
+      const key = (colour, text, line) => element(doc, "span", { class: "hrm-key" }, [element(doc, "i", { style: "border-top:3px " + (line || "solid") + " " + colour }), doc.createTextNode(text)]);
+      if (list[0].tip_ref && list[0].tip_ref.length) legend.appendChild(key("#d62728", "reference path (ring: reference now)", "dashed"));
       if (list.length > 1 && state.layout === "overlay") {
         list.forEach((run, r) => legend.appendChild(key(PALETTE[r], run.label + ": arm and tip trace")));
       } else {
@@ -718,7 +738,8 @@
       for (let g = 0; g < groups; g++) {
         const s = list[0].series[g];
         const head = element(doc, "div", { class: "hrm-panel-title", text: s.title + " (" + s.unit + ")" });
-        const keys = element(doc, "div", { class: "hrm-panel-keys" }, s.names.map((n, i) => key(PALETTE[i % PALETTE.length], n)));
+        const styles = curveStyles(s.names);
+        const keys = element(doc, "div", { class: "hrm-panel-keys" }, s.names.map((n, i) => key(styles[i].colour, n, styles[i].reference ? "dotted" : "solid")));
         const canvas = element(doc, "canvas", { class: "hrm-plot" });
         panels.append(head, keys, canvas);
         const height = s.names.length > 4 ? 150 : 120;
@@ -926,6 +947,7 @@
     points,
     niceTicks,
     squareGrid,
+    curveStyles,
     formatTick,
     formatValue,
     torqueColour,

@@ -67,6 +67,18 @@ test("a planar arm's grid is square, with lines on both axes and labels apart", 
   }
 });
 
+test("a reference curve is dotted in its coordinate's colour; twenty colours before a repeat", () => {
+  const styles = v.curveStyles(["a1", "a1 ref", "a2", "a2 ref", "orphan ref"]);
+  assert.equal(styles[0].colour, styles[1].colour);
+  assert.equal(styles[2].colour, styles[3].colour);
+  assert.notEqual(styles[0].colour, styles[2].colour);
+  assert.deepEqual(styles.map((s) => s.reference), [false, true, false, true, false]);
+  const names = [];
+  for (let i = 1; i <= 16; i++) names.push("az" + i, "az" + i + " ref");
+  const colours = v.curveStyles(names).filter((s) => !s.reference).map((s) => s.colour);
+  assert.equal(new Set(colours).size, 16);
+});
+
 test("torque colours run from blue at rest to red at the limit, darker beyond", () => {
   assert.deepEqual(v.torqueColour(0), [49, 99, 170]);
   assert.deepEqual(v.torqueColour(1), [214, 39, 40]);
