@@ -78,7 +78,8 @@ impl LinearQp {
     ///
     /// # Errors
     /// [`LinearQpFailure::NotPositiveDefinite`] for an `H` without a Cholesky factor, and the
-    /// projection's failures (an empty polytope, sizes that disagree).
+    /// projection's failures (an empty polytope, sizes that disagree, a NaN in `q`, `G` or `g`:
+    /// [`ProjectionFailure::NonFinite`]).
     pub fn solve(
         &mut self,
         h: &[f64],

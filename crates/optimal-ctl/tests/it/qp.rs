@@ -199,6 +199,12 @@ fn an_empty_polytope_is_reported() {
         result,
         Err(LinearQpFailure::Projection(ProjectionFailure::Empty))
     );
+    // A NaN in the linear term is not a solution: it returned Ok with a NaN point.
+    let result = qp.solve(&[2.0], &[f64::NAN], &[1.0, -1.0], &[1.0, 1.0], &mut x);
+    assert_eq!(
+        result,
+        Err(LinearQpFailure::Projection(ProjectionFailure::NonFinite))
+    );
 }
 
 #[test]
