@@ -133,8 +133,9 @@ impl BoxQp {
     ///
     /// # Errors
     /// [`OptimalError::Dimension`] for wrong sizes, [`OptimalError::InvalidSetting`] for bad
-    /// settings, NaN bounds or `lower > upper`, [`OptimalError::NotPositiveDefinite`] if `H` on a
-    /// free set is not (numerically) positive definite.
+    /// settings, a number of `g` that is not finite, NaN bounds or `lower > upper`,
+    /// [`OptimalError::NotPositiveDefinite`] if `H` on a free set is not (numerically) positive
+    /// definite.
     pub fn solve(
         &mut self,
         h: &[f64],
@@ -181,6 +182,14 @@ impl BoxQp {
         }
         settings.validate()?;
         let (h, g, lower, upper, x) = (&h[..n * n], &g[..n], &lower[..n], &upper[..n], &mut x[..n]);
+        // A NaN or infinite `H` fails its factorisation; a NaN `g` would pass as a value.
+        if let Some(&value) = g.iter().find(|v| !v.is_finite()) {
+            return Err(OptimalError::InvalidSetting {
+                name: "box QP gradient g",
+                requirement: "finite",
+                value,
+            });
+        }
         for i in 0..n {
             if lower[i].is_nan() || upper[i].is_nan() || lower[i] > upper[i] {
                 return Err(OptimalError::InvalidSetting {

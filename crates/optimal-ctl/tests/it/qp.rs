@@ -274,4 +274,24 @@ fn sizes_that_disagree_and_indefinite_h_are_refused() {
         &mut x,
     );
     assert_eq!(result, Err(LinearQpFailure::NotPositiveDefinite));
+    // The box QP refuses a NaN gradient: it returned Ok with a NaN value at the warm start.
+    let mut box_qp = optimal_ctl::BoxQp::new(2);
+    let settings = optimal_ctl::BoxQpSettings::default();
+    let mut u = [0.0; 2];
+    let h = [1.0, 0.0, 0.0, 1.0];
+    let (lower, upper) = ([-1.0; 2], [1.0; 2]);
+    let error = box_qp
+        .solve(&h, &[f64::NAN, 1.0], &lower, &upper, &mut u, &settings)
+        .unwrap_err();
+    assert!(
+        error
+            .to_string()
+            .starts_with("box QP gradient g must be finite"),
+        "{error}"
+    );
+    let report = box_qp
+        .solve(&h, &[2.0, 0.0], &lower, &upper, &mut u, &settings)
+        .unwrap();
+    assert!(report.value.is_finite());
+    assert_eq!(u, [-1.0, 0.0]);
 }
