@@ -586,7 +586,7 @@ fn fuzzy(request: FuzzyRequest) -> EvalResult {
     }
     let mut outputs = vec![0.0; evaluator.system().outputs().len()];
     evaluator.eval(&request.inputs, &mut outputs)?;
-    crate::fis_cmd::warn_outside_range(&evaluator, "\"out_of_range\": \"clamp\"");
+    crate::fis_cmd::warn_outside_range(&evaluator, &request.inputs, "\"out_of_range\": \"clamp\"");
     finite("outputs", &outputs)?;
     Ok(json_fields([("outputs", json!(outputs))]))
 }

@@ -87,27 +87,40 @@ enum FisCommand {
 }
 
 /// Warns on standard error, as MATLAB's `evalfis` does, when `evaluator` has evaluated an input
-/// outside its range as given: once per process (a `hrm eval` session answers many requests).
-/// Inputs are numbered from 1, as in the library's errors and the `.fis` file; `clamp` is how
-/// the caller asks for the other policy (`--out-of-range clamp`, or a request's
-/// `"out_of_range": "clamp"`).
-pub(crate) fn warn_outside_range(evaluator: &Evaluator, clamp: &str) {
+/// of the row `inputs` outside its range as given, naming every such input: once per process (a
+/// `hrm eval` session answers many requests). Inputs are numbered from 1, as in the library's
+/// errors and the `.fis` file; `clamp` is how the caller asks for the other policy
+/// (`--out-of-range clamp`, or a request's `"out_of_range": "clamp"`).
+pub(crate) fn warn_outside_range(evaluator: &Evaluator, inputs: &[f64], clamp: &str) {
     static WARNED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-    if let Some(outside) = evaluator.first_outside_range()
-        && !WARNED.swap(true, std::sync::atomic::Ordering::Relaxed)
+    if evaluator.first_outside_range().is_none()
+        || WARNED.swap(true, std::sync::atomic::Ordering::Relaxed)
     {
-        let input = &evaluator.system().inputs()[outside.index];
-        let line = format!(
-            "warning: input {} ('{}') = {} is outside its range [{}, {}]; evaluated as given, as \
-             MATLAB's evalfis does ({clamp} evaluates at the nearest end)",
-            outside.index + 1,
-            input.name,
-            outside.value,
-            input.range[0],
-            input.range[1]
-        );
-        console::to_stderr(&console::error_line(&line));
+        return;
     }
+    let outside: Vec<String> = evaluator
+        .system()
+        .inputs()
+        .iter()
+        .zip(inputs)
+        .enumerate()
+        .filter(|(_, (input, value))| **value < input.range[0] || **value > input.range[1])
+        .map(|(i, (input, value))| {
+            format!(
+                "input {} ('{}') = {value} is outside its range [{}, {}]",
+                i + 1,
+                input.name,
+                input.range[0],
+                input.range[1]
+            )
+        })
+        .collect();
+    let line = format!(
+        "warning: {}; evaluated as given, as MATLAB's evalfis does ({clamp} evaluates at the \
+         nearest end)",
+        outside.join(", ")
+    );
+    console::to_stderr(&console::error_line(&line));
 }
 
 /// Runs `hrm fis ...`.
@@ -302,7 +315,7 @@ fn eval(
         }
         Err(other) => return Err(other.to_string()),
     }
-    warn_outside_range(&evaluator, "--out-of-range clamp");
+    warn_outside_range(&evaluator, inputs, "--out-of-range clamp");
     let names = evaluator.system().outputs().iter().map(|o| o.name.clone());
     Ok(names.zip(outputs).collect())
 }

@@ -182,4 +182,15 @@ fn eval_takes_inputs_outside_their_ranges_as_given_with_a_warning() {
     .concat());
     assert!(stdout(&clamped).starts_with("tau1 = 71.320"));
     assert!(clamped.stderr.is_empty());
+    // Every input outside its range is named, in one line.
+    let two = hrm(&[PAPER_FIS_EVAL, &["-0.414", "-0.263", "5", "0.246"][..]].concat());
+    let warning = String::from_utf8_lossy(&two.stderr);
+    assert_eq!(warning.lines().count(), 1, "{warning}");
+    assert!(
+        warning.contains("input 1 ('da1') = -0.414 is outside its range [-0.3, 0.3], input 3"),
+        "{warning}"
+    );
 }
+
+/// `hrm fis eval` of the paper's system, before its inputs.
+const PAPER_FIS_EVAL: &[&str] = &["fis", "eval", PAPER_FIS];
