@@ -26,7 +26,8 @@ enum ArmCommand {
     },
     /// Write a URDF chain, or a scenario's planar arm (shipped name or TOML file), as URDF or MJCF.
     Export {
-        /// A `.urdf` file, or a scenario (its `[arm]` is exported in the base's x-y plane).
+        /// A `.urdf` file, or a scenario (its planar `[arm]` in the base's x-y plane, a spatial one
+        /// as its chain of universal joints).
         file: String,
         /// What to write.
         #[arg(long, value_enum)]

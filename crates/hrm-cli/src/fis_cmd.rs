@@ -391,6 +391,27 @@ fn surface(
                     inputs[k].name
                 ));
             }
+            let outside: Vec<String> = values
+                .iter()
+                .zip(inputs)
+                .enumerate()
+                .filter(|(_, (v, input))| **v < input.range[0] || **v > input.range[1])
+                .map(|(k, (v, input))| {
+                    format!(
+                        "--reference value {} (input '{}') = {v} is outside its range [{}, {}]",
+                        k + 1,
+                        input.name,
+                        input.range[0],
+                        input.range[1]
+                    )
+                })
+                .collect();
+            if !outside.is_empty() {
+                console::to_stderr(&console::error_line(&format!(
+                    "warning: {}; the surfaces hold it there, evaluated as given",
+                    outside.join(", ")
+                )));
+            }
             values.to_vec()
         }
     };

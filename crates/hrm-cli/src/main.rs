@@ -67,7 +67,7 @@ enum Command {
     Eval,
     /// Check, evaluate, plot, train and export Takagi-Sugeno systems (MATLAB .fis or FCL files).
     Fis(fis_cmd::FisArgs),
-    /// Robot descriptions: check a URDF chain, export one (or a scenario's planar arm) as URDF or MJCF.
+    /// Robot descriptions: check a URDF chain, export one (or a scenario's arm) as URDF or MJCF.
     Arm(arm_cmd::ArmArgs),
     /// Monte Carlo over noise levels and seeds: mean and spread of the errors per controller (docs/sweep.md).
     Sweep(sweep::SweepCli),

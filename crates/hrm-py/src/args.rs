@@ -25,11 +25,9 @@ pub(crate) fn wrong_type(name: &str, expected: &str, value: &Bound<'_, PyAny>) -
 
 /// A real number for argument `name` (a Python or numpy int or float).
 pub(crate) fn real(value: &Bound<'_, PyAny>, name: &str) -> PyResult<f64> {
-    // A bool is an int to Python, but `link_length=True` is a slip, not a length of 1.
-    if value.is_instance_of::<PyString>()
-        || value.is_instance_of::<PyBytes>()
-        || value.is_instance_of::<PyBool>()
-    {
+    // A bool is an int to Python, but `link_length=True` is a slip, not a length of 1 (numpy's
+    // `np.True_` too).
+    if value.is_instance_of::<PyString>() || value.is_instance_of::<PyBytes>() || is_bool(value) {
         return Err(wrong_type(name, "a real number", value));
     }
     value.extract::<f64>().map_err(|e| {
@@ -44,6 +42,34 @@ pub(crate) fn real(value: &Bound<'_, PyAny>, name: &str) -> PyResult<f64> {
 /// An optional real number for argument `name` ([`real`]), `default` when not given.
 pub(crate) fn real_or(value: Option<&Bound<'_, PyAny>>, name: &str, default: f64) -> PyResult<f64> {
     value.map_or(Ok(default), |v| real(v, name))
+}
+
+/// A count argument (`links`, `harmonics`, `samples`) as a `usize`: a negative number or one
+/// beyond 64 bits is an [`InvalidInput`](crate::errors::InvalidInput) naming `name`, not an `OverflowError`. `minimum` is
+/// the smallest count the message asks for; the libraries check the actual bounds. A `bool` is
+/// refused.
+pub(crate) fn count(value: &Bound<'_, PyAny>, name: &str, minimum: u32) -> PyResult<usize> {
+    // `bool` is an `int` to Python: `links=True` is a mistake, not one link (numpy's too).
+    if is_bool(value) {
+        return Err(Error::input(format!(
+            "{name} must be a whole number, got a bool ({})",
+            value.repr()?
+        ))
+        .into());
+    }
+    if let Ok(count) = value.extract::<usize>() {
+        return Ok(count);
+    }
+    match value.extract::<i128>() {
+        Ok(n) if n < 0 => {
+            Err(Error::input(format!("{name} must be at least {minimum}, got {n}")).into())
+        }
+        _ => Err(Error::input(format!(
+            "{name} must be a whole number of at most 64 bits, got {}",
+            value.repr()?
+        ))
+        .into()),
+    }
 }
 
 /// A string for argument `name` (a Python `str`).
@@ -149,7 +175,7 @@ pub(crate) fn spatial_gravity(value: Option<&Bound<'_, PyAny>>) -> PyResult<sim_
 
 /// Whether `value` is one Python or numpy `bool` (or a 0-d array of one), which `gravity`
 /// does not take for a number.
-fn is_bool(value: &Bound<'_, PyAny>) -> bool {
+pub(crate) fn is_bool(value: &Bound<'_, PyAny>) -> bool {
     value.is_instance_of::<PyBool>()
         || (is_scalar(value)
             && value

@@ -1,8 +1,9 @@
 //! `hrm.Arm`: the planar chain and its dynamics (eq 12), from `manip-dyn`.
 
 use crate::args;
+use crate::args::count;
 use crate::array::{Output, States, evaluate, evaluate_chunks};
-use crate::errors::{Error, check_finite, count};
+use crate::errors::{Error, check_finite};
 use manip_dyn::faer::MatMut;
 use manip_dyn::{AbaBatchData, BatchError, ChainData, ChainModel, DynError, MAX_DENSE_LINKS};
 use numpy::{IntoPyArray, PyArray1};

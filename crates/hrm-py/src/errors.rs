@@ -102,39 +102,6 @@ impl<E: Classify + std::fmt::Display> From<E> for Error {
     }
 }
 
-/// A count argument (`links`, `harmonics`, `samples`) as a `usize`: a negative number or one
-/// beyond 64 bits is an [`InvalidInput`] naming `name`, not an `OverflowError`. `minimum` is
-/// the smallest count the message asks for; the libraries check the actual bounds. A `bool` is
-/// refused.
-pub(crate) fn count(
-    value: &pyo3::Bound<'_, pyo3::PyAny>,
-    name: &str,
-    minimum: u32,
-) -> pyo3::PyResult<usize> {
-    use pyo3::types::{PyAnyMethods, PyBool};
-    // `bool` is an `int` to Python: `links=True` is a mistake, not one link.
-    if value.is_instance_of::<PyBool>() {
-        return Err(Error::input(format!(
-            "{name} must be a whole number, got a bool ({})",
-            value.repr()?
-        ))
-        .into());
-    }
-    if let Ok(count) = value.extract::<usize>() {
-        return Ok(count);
-    }
-    match value.extract::<i128>() {
-        Ok(n) if n < 0 => {
-            Err(Error::input(format!("{name} must be at least {minimum}, got {n}")).into())
-        }
-        _ => Err(Error::input(format!(
-            "{name} must be a whole number of at most 64 bits, got {}",
-            value.repr()?
-        ))
-        .into()),
-    }
-}
-
 /// Refuses a computed vector with a non-finite entry, as `hrm eval` does: "{name} came out
 /// non-finite ({value})". A check of a result, not of an input: the libraries checked the inputs
 /// ([`lane_math::check_values`], an [`InvalidInput`]), so a non-finite result is an overflow, a

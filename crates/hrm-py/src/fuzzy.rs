@@ -1,7 +1,8 @@
 //! `hrm.fuzzy`: Takagi-Sugeno systems (eqs 19-24), from `fuzzy-sugeno`.
 
+use crate::args::count;
 use crate::array::{States, evaluate_chunks};
-use crate::errors::{Error, count};
+use crate::errors::Error;
 use fuzzy_sugeno::{
     AnalysisOptions, AnalysisReport, Evaluator, FuzzyError, FuzzySystem, MAX_SAMPLES_PER_INPUT,
 };

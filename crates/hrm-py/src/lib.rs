@@ -35,7 +35,11 @@ fn _hrm(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add("__version__", env!("CARGO_PKG_VERSION"))?;
     let fuzzy = PyModule::new(py, "fuzzy")?;
     fuzzy.add_class::<fuzzy::System>()?;
-    fuzzy.add_function(wrap_pyfunction!(fuzzy::paper_controller, &fuzzy)?)?;
+    let paper_controller = wrap_pyfunction!(fuzzy::paper_controller, &fuzzy)?;
+    // Pickled by reference where users import it (`hrm.fuzzy`), not as the extension's
+    // submodule `fuzzy`, which no import finds (a Dask worker could not unpickle it).
+    paper_controller.setattr("__module__", "hrm.fuzzy")?;
+    fuzzy.add_function(paper_controller)?;
     module.add_submodule(&fuzzy)?;
     Ok(())
 }

@@ -1,9 +1,10 @@
 //! `hrm.ReducedModel`: the arm constrained to the backbone curve's modal coordinates (eqs 7-18),
 //! from `backbone-kin` and `modal-reduce`.
 
+use crate::args::count;
 use crate::arm::Arm;
 use crate::array::{States, evaluate, evaluate_chunks, zeros};
-use crate::errors::{Error, check_finite, count};
+use crate::errors::{Error, check_finite};
 use crate::spatial::{derivatives_dict, split_derivatives};
 use backbone_kin::{BaseAngle, Branch, HarmonicIk, ModalMap, reduce_angle};
 use modal_reduce::{

@@ -3,8 +3,9 @@
 //! `modal-reduce::spatial`.
 
 use crate::args;
+use crate::args::count;
 use crate::array::{Output, States, evaluate};
-use crate::errors::{Error, check_finite, count};
+use crate::errors::{Error, check_finite};
 use backbone_kin::{MAX_CURVE_STEPS, SpatialIk, spatial_tip_position};
 use modal_reduce::spatial::{
     SpatialReducedData, SpatialReducedDerivatives, SpatialReducedModel, spatial_forward_dynamics,

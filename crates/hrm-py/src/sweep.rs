@@ -51,7 +51,7 @@ fn summary<'py>(py: Python<'py>, whole: &ShardFile) -> PyResult<Bound<'py, PyDic
 /// checks it.
 fn shard(index: Option<&Bound<'_, PyAny>>, count: Option<&Bound<'_, PyAny>>) -> PyResult<Shard> {
     let number = |value: Option<&Bound<'_, PyAny>>, name: &str| {
-        value.map_or(Ok(1), |v| crate::errors::count(v, name, 1))
+        value.map_or(Ok(1), |v| crate::args::count(v, name, 1))
     };
     let (index, count) = (number(index, "index")?, number(count, "count")?);
     Shard::new(index, count).map_err(input)
@@ -108,7 +108,7 @@ impl Sweep {
             )?,
             rate_noise_ratio,
             reference_noise_ratio,
-            seeds: crate::errors::count(seeds, "seeds", 1)?,
+            seeds: crate::args::count(seeds, "seeds", 1)?,
             base_seed: base_seed.map_or(Ok(1), |s| crate::args::seed(s, "base_seed"))?,
         };
         let config = SweepConfig::new(scenario, settings).map_err(input)?;

@@ -440,6 +440,11 @@ def test_wrong_argument_types_name_the_argument():
         hrm.Arm(link_length=True)
     with pytest.raises(TypeError, match="^alpha0 must be a real number, got a bool$"):
         hrm.ReducedModel(hrm.Arm(links=10), alpha0=False)
+    # numpy's bools are bools too (np.True_ built a 10 m arm as 1.0).
+    with pytest.raises(TypeError, match="^link_length must be a real number, got a"):
+        hrm.Arm(link_length=np.True_)
+    with pytest.raises(hrm.InvalidInput, match=r"^harmonics must be a whole number, got a bool"):
+        hrm.ReducedModel(hrm.Arm(links=10), harmonics=np.True_)
     with pytest.raises(TypeError, match="^link_length must be a real number, got a str$"):
         hrm.Arm(link_length="x")
     with pytest.raises(TypeError, match="^gravity must be a real number"):

@@ -24,6 +24,14 @@ def test_paper_controller_outputs():
     np.testing.assert_allclose(system.eval(-x), -system.eval(x), rtol=1e-12, atol=1e-12)
 
 
+def test_paper_controller_pickles_by_reference():
+    # A Dask worker unpickles what it is sent: the function must name an importable module.
+    import pickle
+
+    assert paper_controller.__module__ == "hrm.fuzzy"
+    assert pickle.loads(pickle.dumps(paper_controller)) is paper_controller
+
+
 @pytest.mark.parametrize("size", [3, 3000])
 def test_batch_equals_one_by_one(size):
     system = paper_controller()

@@ -114,6 +114,28 @@ def test_a_controller_file_changed_after_the_sweep_was_configured_is_refused(tmp
         hrm.Sweep.merge([first, again.run_shard(2, 2)])
 
 
+def test_a_relative_controller_file_is_kept_absolute_and_versions_are_checked(tmp_path, monkeypatch):
+    # A .fis given relative to the working directory is configured absolute, so that an
+    # unpickled sweep run from elsewhere (a Dask worker) reads the same file.
+    (tmp_path / "fisdir").mkdir()
+    (tmp_path / "fisdir" / "c.fis").write_text(hrm.fuzzy.paper_controller().to_fis())
+    monkeypatch.chdir(tmp_path)
+    scenario = hrm.Scenario.builtin("paper-tracking")
+    scenario.duration = 0.02
+    scenario.controller.fis = "fisdir/c.fis"
+    sweep = hrm.Sweep(scenario, noise_levels=[0.0], seeds=1, controllers=["fuzzy"])
+    assert sweep.config["scenario"]["controller"]["fis"] == str(tmp_path / "fisdir" / "c.fis")
+    shipped = pickle.dumps(sweep)
+    monkeypatch.chdir(tmp_path / "fisdir")
+    assert pickle.loads(shipped).run_shard(1, 1) == sweep.run_shard(1, 1)
+    # A configuration another hrm version made reads back, but does not run under this one's name.
+    config = json.loads(sweep.to_json())
+    config["hrm_version"] = "9.9.9"
+    other = hrm.Sweep.from_json(json.dumps(config))
+    with pytest.raises(hrm.InvalidInput, match=r"^hrm_version: the sweep was configured by hrm 9\.9\.9"):
+        other.run_shard(1, 1)
+
+
 def test_a_shard_given_as_bytes_of_its_text_is_a_type_error():
     text = small_sweep().run_shard(1, 1)
     with pytest.raises(TypeError, match=r"^shards\[0\] is bytes holding a shard file's text, not a path"):

@@ -234,10 +234,10 @@ class Run:
         """Joint torques tau = M J a_ddot + C + G (N m), shape (K, n)."""
     @property
     def tip(self) -> Array:
-        """The chain's tip (m), shape (K, 2)."""
+        """The discrete chain's tip (m), shape (K, 2); (K, 3) for a spatial arm."""
     @property
     def tip_ref(self) -> Array:
-        """The reference tip (m), shape (K, 2)."""
+        """The reference tip (m), shape (K, 2); (K, 3) for a spatial arm."""
     @property
     def summary(self) -> Dict[str, Any]:
         """The summary metrics, with the keys of `hrm simulate`'s summary.json."""
@@ -330,8 +330,10 @@ class Scenario:
     name: str
     description: str
     duration: float
-    alpha0: Union[float, str]
-    seed: int
+    alpha0: Optional[Union[float, str]]
+    """The base angle (rad), "free" when it is a coordinate, None for a spatial arm."""
+    seed: Union[int, str]
+    """The noise seed: an int, read back as a decimal str above 2**63 - 1 (as TOML holds it)."""
     record_period: Optional[float]
     modal: Settings
     arm: Settings

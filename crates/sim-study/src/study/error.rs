@@ -112,6 +112,18 @@ pub enum StudyError {
     /// The caller's `stop` ended the runs.
     #[error("the sweep was stopped before all its runs were done")]
     Stopped,
+    /// A configuration made by another `hrm` version was asked to run: its shards would carry
+    /// that version's name for this version's results.
+    #[error(
+        "hrm_version: the sweep was configured by hrm {configured}, this is hrm {running}: \
+         configure it again with this version (hrm sweep, hrm.Sweep) to run it"
+    )]
+    OtherVersion {
+        /// The version the configuration records.
+        configured: String,
+        /// This library's version.
+        running: &'static str,
+    },
     /// The runs one invocation would run exceed [`MAX_SHARD_WORK`](super::MAX_SHARD_WORK).
     #[error(
         "runs: the {runs} runs of shard {shard} would take an estimated {work:.2e} operations, \

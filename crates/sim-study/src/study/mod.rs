@@ -191,7 +191,8 @@ pub fn for_each_run(
 
 /// [`for_each_run`], checking `stop` before each lock-step group: once it returns true, no
 /// further group starts and the call fails with [`StudyError::Stopped`] (a Python caller's
-/// Ctrl-C).
+/// Ctrl-C). A configuration another `hrm` version made is refused before any run
+/// ([`StudyError::OtherVersion`]).
 pub fn for_each_run_until(
     config: &SweepConfig,
     shard: Shard,
@@ -199,6 +200,12 @@ pub fn for_each_run_until(
     stop: impl Fn() -> bool + Sync,
     mut sink: impl FnMut(RunResult) -> Result<(), StudyError>,
 ) -> Result<(), StudyError> {
+    if config.hrm_version != VERSION {
+        return Err(StudyError::OtherVersion {
+            configured: config.hrm_version.clone(),
+            running: VERSION,
+        });
+    }
     let mut indices = shard.indices(config.runs().unwrap_or(0));
     let size = lockstep_size(config);
     // Each controller's simulation, prepared once for all of its runs.

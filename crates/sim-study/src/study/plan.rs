@@ -213,7 +213,8 @@ impl SweepSettings {
 
 impl SweepConfig {
     /// The sweep of `scenario` (its duration applies; its noise and seed are cleared, then set
-    /// per run) under `settings`, with the SHA-256 of its inputs: `settings` are checked
+    /// per run) under `settings`, with the SHA-256 of its inputs (its `controller.fis` and
+    /// `arm.urdf` made absolute against the working directory): `settings` are checked
     /// ([`SweepSettings::check`]), then the scenario ([`validate`](Self::validate): every setting
     /// JSON can hold), and every controller's simulation is built once
     /// ([`check_builds`](Self::check_builds)), so a bad setting fails here rather than in every
@@ -223,6 +224,17 @@ impl SweepConfig {
         let mut scenario = scenario;
         scenario.noise = NoiseSpec::default();
         scenario.seed = 0;
+        // A file given relative to the working directory (Python's `controller.fis = "c.fis"`)
+        // is kept absolute, so that a task elsewhere (a Dask worker, an unpickled sweep) reads
+        // the same file or none.
+        for path in [&mut scenario.controller.fis, &mut scenario.arm.urdf]
+            .into_iter()
+            .flatten()
+        {
+            if let Ok(absolute) = std::path::absolute(&*path) {
+                *path = absolute;
+            }
+        }
         inputs::check_json_safe(&scenario)?;
         let config = SweepConfig {
             hrm_version: super::VERSION.to_string(),

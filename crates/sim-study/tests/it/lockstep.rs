@@ -375,6 +375,16 @@ fn a_sweep_in_lock_step_gives_every_run_as_run_alone() {
         }
         assert!(failed > 0, "some runs must stop mid-way");
     }
+    // A configuration another version made is not run under this version's name.
+    let mut other = config.clone();
+    other.hrm_version = "9.9.9".into();
+    let error = study::run_shard(&other, Shard::WHOLE, || {}).unwrap_err();
+    assert!(
+        error
+            .to_string()
+            .starts_with("hrm_version: the sweep was configured by hrm 9.9.9, this is hrm "),
+        "{error}"
+    );
 }
 
 /// The runs of one prepared scenario that differ in noise and seed share their reference
