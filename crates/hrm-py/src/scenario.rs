@@ -353,7 +353,8 @@ impl Settings {
     }
 
     /// `pickle` and `copy.deepcopy` support: the view rebuilt as `functools.reduce(getattr,
-    /// path, scenario)`, on a copy of its scenario.
+    /// path, scenario)`, on a copy of its scenario; a stale view (its table removed) raises as
+    /// its reads do, rather than pickling to `None`.
     #[allow(
         clippy::type_complexity,
         reason = "pickle's (callable, arguments) pair"
@@ -365,6 +366,7 @@ impl Settings {
         Bound<'py, PyAny>,
         (Bound<'py, PyAny>, Vec<String>, Py<Scenario>),
     )> {
+        check_table(&table(&self.scenario.get().lock())?, &self.path)?;
         Ok((
             py.import("functools")?.getattr("reduce")?,
             (

@@ -94,7 +94,10 @@ def test_a_view_of_a_table_the_scenario_no_longer_has_is_refused():
     sine = scenario.reference.sine
     assert sine.amplitude is not None
     scenario.reference = {"kind": "step", "target": [0.2, -0.2], "time": 0.1}
-    for read in (lambda: sine.amplitude, sine.to_dict):
+    import copy
+    import pickle
+
+    for read in (lambda: sine.amplitude, sine.to_dict, lambda: pickle.dumps(sine), lambda: copy.deepcopy(sine)):
         with pytest.raises(hrm.InvalidInput, match="^reference.sine: the scenario has no such table$"):
             read()
 
