@@ -35,7 +35,7 @@ pub struct ViewArgs {
     /// the highest noise level. The GIF shows the first.
     #[arg(long, value_delimiter = ',', action = clap::ArgAction::Set, value_name = "I,J,...")]
     runs: Option<Vec<usize>>,
-    /// List a sweep's runs (number, noise level, controller, seed, outcome) and write nothing.
+    /// List a sweep's runs (number, noise level, controller, seed number, outcome) and write nothing.
     #[arg(long)]
     list: bool,
     /// GIF width (pixels); with `--gif` only, as the height, rate and speed.

@@ -23,21 +23,21 @@ fn open(dir: &Path) -> Result<ShardReader<study::ShardInput>, String> {
     ShardReader::open(&dir.join("runs.json")).map_err(|e| e.to_string())
 }
 
-/// Prints the runs of the sweep in `dir`, one a line: index, noise level, controller, seed,
-/// and the tip error RMS or why the run stopped; streamed, as a sweep may hold millions.
+/// Prints the runs of the sweep in `dir`, one a line: index, noise level, controller, seed
+/// number (1 to `seeds`; `runs.json` holds the seed itself), and the tip error RMS or why the run stopped; streamed, as a sweep may hold millions.
 pub fn list(dir: &Path) -> Result<(), String> {
     let mut reader = open(dir)?;
     let config = reader.header().config.clone();
     let mut text = format!(
         "sweep of {} ({} runs); `hrm view {} --runs I,J,...` shows up to {MAX_RERUNS} of them\n\
-         {:>8}  {:>10}  {:<16} {:>5}  outcome\n",
+         {:>8}  {:>10}  {:<16} {:>8}  outcome\n",
         console::escape_field(&config.scenario.name),
         config.runs().unwrap_or(0),
         dir.display(),
         "run",
         "L (rad)",
         "controller",
-        "seed",
+        "seed no.",
     );
     while let Some(run) = reader.next_run().map_err(|e| e.to_string())? {
         let outcome = match &run.outcome {
@@ -49,7 +49,7 @@ pub fn list(dir: &Path) -> Result<(), String> {
         };
         let _ = writeln!(
             text,
-            "{:>8}  {:>10}  {:<16} {:>5}  {}",
+            "{:>8}  {:>10}  {:<16} {:>8}  {}",
             run.index,
             lane_math::Compact(run.noise_level).to_string(),
             run.controller.name(),
