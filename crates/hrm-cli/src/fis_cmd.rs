@@ -75,7 +75,7 @@ enum FisCommand {
         /// Samples per axis of each surface (2 to 600).
         #[arg(long, default_value_t = 41, allow_negative_numbers = true)]
         resolution: i128,
-        /// Values of the inputs not on a surface's axes, comma-separated (default: the middle of each range).
+        /// Values of the inputs not on a surface's axes, comma-separated (default: the middle of each range; a value outside its range is drawn as given, with a warning).
         #[arg(
             long,
             value_delimiter = ',',
@@ -98,11 +98,21 @@ pub(crate) fn warn_outside_range(evaluator: &Evaluator, inputs: &[f64], clamp: &
     {
         return;
     }
-    let outside: Vec<String> = evaluator
-        .system()
+    let line = format!(
+        "warning: {}; evaluated as given, as MATLAB's evalfis does ({clamp} evaluates at the \
+         nearest end)",
+        outside_ranges(evaluator.system(), inputs).join(", ")
+    );
+    console::to_stderr(&console::error_line(&line));
+}
+
+/// Each value of `values` (one per input of `system`) outside its input's range, described:
+/// "input 1 ('da1') = 5 is outside its range [-0.3, 0.3]".
+fn outside_ranges(system: &FuzzySystem, values: &[f64]) -> Vec<String> {
+    system
         .inputs()
         .iter()
-        .zip(inputs)
+        .zip(values)
         .enumerate()
         .filter(|(_, (input, value))| **value < input.range[0] || **value > input.range[1])
         .map(|(i, (input, value))| {
@@ -114,13 +124,7 @@ pub(crate) fn warn_outside_range(evaluator: &Evaluator, inputs: &[f64], clamp: &
                 input.range[1]
             )
         })
-        .collect();
-    let line = format!(
-        "warning: {}; evaluated as given, as MATLAB's evalfis does ({clamp} evaluates at the \
-         nearest end)",
-        outside.join(", ")
-    );
-    console::to_stderr(&console::error_line(&line));
+        .collect()
 }
 
 /// Runs `hrm fis ...`.
@@ -391,24 +395,10 @@ fn surface(
                     inputs[k].name
                 ));
             }
-            let outside: Vec<String> = values
-                .iter()
-                .zip(inputs)
-                .enumerate()
-                .filter(|(_, (v, input))| **v < input.range[0] || **v > input.range[1])
-                .map(|(k, (v, input))| {
-                    format!(
-                        "--reference value {} (input '{}') = {v} is outside its range [{}, {}]",
-                        k + 1,
-                        input.name,
-                        input.range[0],
-                        input.range[1]
-                    )
-                })
-                .collect();
+            let outside = outside_ranges(system, values);
             if !outside.is_empty() {
                 console::to_stderr(&console::error_line(&format!(
-                    "warning: {}; the surfaces hold it there, evaluated as given",
+                    "warning: --reference: {}; the surfaces hold it there, evaluated as given",
                     outside.join(", ")
                 )));
             }

@@ -96,6 +96,36 @@ fn fis_surface_out_folder_under_a_regular_file() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A `--reference` value outside its input's range is drawn as given, with one warning line
+/// naming it.
+#[test]
+fn fis_surface_warns_of_a_reference_outside_its_range() {
+    let dir = scratch("surface-reference-range");
+    let out = dir.join("surface");
+    let fis = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../fuzzy-sugeno/data/paper.fis"
+    );
+    let output = hrm(&[
+        "fis",
+        "surface",
+        fis,
+        "--out",
+        path(&out),
+        "--resolution",
+        "3",
+        "--reference=5,0,0,0",
+    ]);
+    assert!(output.status.success(), "{output:?}");
+    let warning = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(
+        warning.trim_end(),
+        "hrm: warning: --reference: input 1 ('da1') = 5 is outside its range [-0.3, 0.3]; the \
+         surfaces hold it there, evaluated as given"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A surface that cannot be drawn (its outputs span beyond double precision) is named in the
 /// folder the user gave, not the staging folder that the failure removes; nothing is written.
 #[test]
