@@ -7,6 +7,12 @@ use crate::common::{hrm, scratch};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+/// The paper's controller as a `.fis` file.
+const PAPER_FIS: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../fuzzy-sugeno/data/paper.fis"
+);
+
 /// A regular file `blocker` in `dir`: `blocker/out` can never be created as a folder, even by
 /// root (permission bits would not stop the tests, which run as root).
 fn blocked_folder(dir: &Path) -> PathBuf {
@@ -79,21 +85,23 @@ fn simulate_out_folder_under_a_regular_file() {
 fn fis_surface_out_folder_under_a_regular_file() {
     let dir = scratch("errors-surface-out");
     let out = blocked_folder(&dir);
-    let fis = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../fuzzy-sugeno/data/paper.fis"
-    );
-    let line = refused(&hrm(&[
-        "fis",
-        "surface",
-        fis,
-        "--out",
-        path(&out),
-        "--resolution",
-        "3",
-    ]));
+    let line = refused(&paper_surface(&out, &[]));
     assert!(line.contains("blocker"), "{line}");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `hrm fis surface` of the paper's controller at resolution 3 into `out`, with `extra`.
+fn paper_surface(out: &Path, extra: &[&str]) -> Output {
+    let args = [
+        "fis",
+        "surface",
+        PAPER_FIS,
+        "--out",
+        path(out),
+        "--resolution",
+        "3",
+    ];
+    hrm(&[&args[..], extra].concat())
 }
 
 /// A `--reference` value outside its input's range is drawn as given, with one warning line
@@ -101,21 +109,7 @@ fn fis_surface_out_folder_under_a_regular_file() {
 #[test]
 fn fis_surface_warns_of_a_reference_outside_its_range() {
     let dir = scratch("surface-reference-range");
-    let out = dir.join("surface");
-    let fis = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../fuzzy-sugeno/data/paper.fis"
-    );
-    let output = hrm(&[
-        "fis",
-        "surface",
-        fis,
-        "--out",
-        path(&out),
-        "--resolution",
-        "3",
-        "--reference=5,0,0,0",
-    ]);
+    let output = paper_surface(&dir.join("surface"), &["--reference=5,0,0,0"]);
     assert!(output.status.success(), "{output:?}");
     let warning = String::from_utf8_lossy(&output.stderr);
     assert_eq!(
@@ -568,12 +562,9 @@ fn a_diverging_simulate_writes_its_data_up_to_the_stop() {
 
 #[test]
 fn counts_are_bounded_before_use_with_the_option_named() {
-    let fis = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../fuzzy-sugeno/data/paper.fis"
-    );
     let dir = scratch("errors-counts");
     let out = dir.join("out");
+    let fis = PAPER_FIS;
     let noise: Vec<String> = (0..1001).map(|k| format!("{}", k as f64 * 1e-4)).collect();
     let noise = noise.join(",");
     // 10,000 rules of 4 inputs: 6 surfaces of 600 x 600 points are 2.16e10 rule evaluations.
@@ -794,12 +785,9 @@ fn with_reader_gone(args: &[&str], stdin: &[u8]) -> Output {
 
 #[test]
 fn output_ends_quietly_when_the_reader_goes_away() {
-    let fis = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../fuzzy-sugeno/data/paper.fis"
-    );
     let requests = "{\"op\":\"fk\",\"a\":[0.3,-0.2],\"alpha0\":1.2}\n".repeat(2000);
     let dir = scratch("reader-gone");
+    let fis = PAPER_FIS;
     let csv = dir.join("train.csv");
     let rows: String = (0..20)
         .map(|i| {
@@ -1170,14 +1158,7 @@ fn hrm_view_of_a_sweep_runs_the_chosen_runs_again() {
     let dir = scratch("errors-view-sweep");
     // The short step response with its own copy of the paper's fuzzy system.
     let fis = dir.join("mine.fis");
-    std::fs::copy(
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../fuzzy-sugeno/data/paper.fis"
-        ),
-        &fis,
-    )
-    .unwrap();
+    std::fs::copy(PAPER_FIS, &fis).unwrap();
     let scenario = short_scenario(&dir);
     let text = std::fs::read_to_string(&scenario).unwrap();
     std::fs::write(
@@ -1292,10 +1273,7 @@ fn hrm_view_of_a_sweep_runs_the_chosen_runs_again() {
 /// (a warning to a closed pipe made it panic with "failed printing to stderr", exit 101).
 #[test]
 fn an_unwritable_standard_error_is_no_crash() {
-    let paper = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../fuzzy-sugeno/data/paper.fis"
-    );
+    let paper = PAPER_FIS;
     let full = || std::fs::File::create("/dev/full").unwrap();
     for (args, status) in [
         (vec!["fis", "eval", paper, "0", "0", "0"], 1),
