@@ -7,7 +7,7 @@ use lane_math::{Classify, ErrorClass, ShapeError, ShapeProblem};
 #[non_exhaustive]
 pub enum ClearanceError {
     /// An input that must be finite was NaN or infinite.
-    #[error("{name} must be finite, got {value}")]
+    #[error("{name} must be finite, got {}", lane_math::Compact(*.value))]
     NonFinite {
         /// Which input.
         name: &'static str,
@@ -15,7 +15,7 @@ pub enum ClearanceError {
         value: f64,
     },
     /// A radius or half-extent was negative (or, where zero is refused, zero).
-    #[error("{name} must be {bound}, got {value}")]
+    #[error("{name} must be {bound}, got {}", lane_math::Compact(*.value))]
     OutOfRange {
         /// Which input.
         name: &'static str,
