@@ -37,7 +37,7 @@ fn _hrm(module: &Bound<'_, PyModule>) -> PyResult<()> {
     fuzzy.add_class::<fuzzy::System>()?;
     let paper_controller = wrap_pyfunction!(fuzzy::paper_controller, &fuzzy)?;
     // Pickled by reference where users import it (`hrm.fuzzy`), not as the extension's
-    // submodule `fuzzy`, which no import finds (a Dask worker could not unpickle it).
+    // submodule `fuzzy`, which no import finds, so that a Dask worker can unpickle it.
     paper_controller.setattr("__module__", "hrm.fuzzy")?;
     fuzzy.add_function(paper_controller)?;
     module.add_submodule(&fuzzy)?;

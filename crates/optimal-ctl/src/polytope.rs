@@ -112,7 +112,7 @@ impl PolytopeProjection {
     /// [`ProjectionFailure::Empty`] when no point satisfies the constraints,
     /// [`ProjectionFailure::NoConvergence`] when the iterations do not settle,
     /// [`ProjectionFailure::Dimension`] when the sizes disagree, [`ProjectionFailure::NonFinite`]
-    /// for a NaN anywhere or an infinite row entry or `x0` (it was reported as empty).
+    /// for a NaN anywhere or an infinite row entry or `x0` (no polytope to call empty).
     pub fn project(
         &mut self,
         constraints: &[f64],

@@ -573,7 +573,8 @@ mod tests {
 
     #[test]
     fn greys_stay_grey_and_colours_keep_the_cube() {
-        // The obstacles' fill (110 at alpha 115 over white) was drawn lilac, (204, 170, 204).
+        // The obstacles' fill (110 at alpha 115 over white), which the cube alone draws lilac
+        // (204, 170, 204).
         let fill = (110.0 * 115.0 / 255.0 + 255.0 * (1.0 - 115.0 / 255.0)) as u8;
         assert_eq!(colour(index(&[fill, fill, fill, 255])), [190; 3]);
         assert_eq!(colour(index(&[100, 95, 90, 255])), [96; 3]);
