@@ -19,8 +19,10 @@ pub fn place_planar(
     check_len("link lengths", link_lengths.len(), model.n_links())?;
     backbone_kin::joint_positions(link_lengths, theta, &mut data.planar)?;
     for (point, planar) in data.points.iter_mut().zip(&data.planar) {
+        if !within_extent(planar[0]) || !within_extent(planar[1]) {
+            return check_extents(planar);
+        }
         *point = [planar[0], planar[1], 0.0];
-        point.iter().try_for_each(|&x| check_extent(x))?;
     }
     data.axes.fill([0.0, 0.0, 1.0]);
     data.turns_about_z = true;
@@ -39,9 +41,7 @@ pub fn place(
     data.check_model(model)?;
     check_len("joint points", points.len(), model.n_links() + 1)?;
     check_len("joint axes", axes.len(), model.n_links())?;
-    for point in points {
-        point.iter().try_for_each(|&x| check_extent(x))?;
-    }
+    check_extents(points.iter().flatten())?;
     for axis in axes {
         let length = dot(*axis, *axis).sqrt();
         if (length - 1.0).abs() > 1e-9 || length.is_nan() {
@@ -58,16 +58,25 @@ pub fn place(
     Ok(())
 }
 
-/// Refuses a joint point coordinate that is not finite or beyond [`MAX_OBSTACLE_EXTENT`] in
-/// magnitude, where the closest points' products would lose the links' scale.
-fn check_extent(x: f64) -> Result<(), ClearanceError> {
-    check_finite("joint point", x)?;
-    if x.abs() > MAX_OBSTACLE_EXTENT {
-        return Err(ClearanceError::OutOfRange {
-            name: "joint point coordinate",
-            bound: "at most 1e15 m in magnitude (MAX_OBSTACLE_EXTENT)",
-            value: x,
-        });
+/// Refuses the first joint point coordinate of `coordinates` that is not finite or beyond
+/// [`MAX_OBSTACLE_EXTENT`] in magnitude, where the closest points' products would lose the links'
+/// scale: one comparison a coordinate (NaN fails it too), the error's kind found after.
+fn check_extents<'a>(coordinates: impl IntoIterator<Item = &'a f64>) -> Result<(), ClearanceError> {
+    match coordinates.into_iter().find(|x| !within_extent(**x)) {
+        None => Ok(()),
+        Some(&x) => {
+            check_finite("joint point", x)?;
+            Err(ClearanceError::OutOfRange {
+                name: "joint point coordinate",
+                bound: "at most 1e15 m in magnitude (MAX_OBSTACLE_EXTENT)",
+                value: x,
+            })
+        }
     }
-    Ok(())
+}
+
+/// Whether `x` is a number within [`MAX_OBSTACLE_EXTENT`] in magnitude (false for NaN).
+#[inline]
+fn within_extent(x: f64) -> bool {
+    x.abs() <= MAX_OBSTACLE_EXTENT
 }
