@@ -56,9 +56,13 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
     if scenario.deploy.is_some() {
         return deploy_simulate::simulate(&scenario, out).map_err(named);
     }
-    scenario.build().map_err(|e| e.to_string())?;
+    let samples = scenario
+        .build()
+        .map_err(|e| e.to_string())?
+        .settings()
+        .controller_samples();
     let staging = OutputDir::create(out, "simulate")?;
-    let mut progress = progress::SampleProgress::new(controller_samples(&scenario));
+    let mut progress = progress::SampleProgress::new(samples as u64);
     let outcome = run_one_with(&scenario, scenario.controller.kind, &mut progress);
     progress.finish();
     if let Err(stopped) = &outcome.result
@@ -87,16 +91,6 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
         .result
         .map(|_| ())
         .map_err(|stopped| stopped.error.to_string())
-}
-
-/// The number of controller samples of a run of `scenario` (one more than its whole controller
-/// periods), the length of its progress bar; zero when the scenario has no controller period.
-fn controller_samples(scenario: &Scenario) -> u64 {
-    let periods = scenario
-        .controller_period()
-        .map_or(0.0, |period| (scenario.duration / period).round());
-    // A built scenario's work is bounded, so its periods fit; `as` saturates regardless.
-    periods as u64 + 1
 }
 
 /// Refuses an output folder `out` that holds the files of the scenario `name_or_path`: the

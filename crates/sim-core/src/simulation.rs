@@ -91,6 +91,13 @@ pub struct LoopSettings {
 }
 
 impl LoopSettings {
+    /// The controller samples a run of these settings takes: one at every whole controller
+    /// period and the final one (what a [`LoopHooks`] observer sees; 1 for settings whose
+    /// duration is not a whole number of periods, which [`check`](Self::check) refuses).
+    pub fn controller_samples(&self) -> usize {
+        sample_counts(self).0 + 1
+    }
+
     /// Checks the settings for `plant` as [`Simulation::new`] does, before a reference or a
     /// controller exists: their sizes, bounds and the run's work without the controller's own
     /// (so that a front end refuses a run of hours before it plans its reference).

@@ -302,6 +302,8 @@ fn an_observer_sees_every_controller_sample_in_order() {
     let run = sim.run_with(&mut tape).unwrap();
     let samples = &tape.samples;
     assert_eq!(samples.len(), run.summary.controller_samples);
+    // The settings say so before the run (a progress bar's length).
+    assert_eq!(samples.len(), sim.settings().controller_samples());
     assert_eq!(
         samples.len(),
         run.record.t.len(),
