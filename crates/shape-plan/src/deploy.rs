@@ -105,16 +105,10 @@ pub fn follow_the_leader(
             value: work,
         });
     }
-    for &length in link_lengths {
-        check_finite("link length", length)?;
-        if length <= 0.0 {
-            return Err(PlanError::OutOfRange {
-                name: "link length",
-                bound: "positive",
-                value: length,
-            });
-        }
-    }
+    let axis = channel.axis();
+    let alpha0 = axis[1].atan2(axis[0]);
+    // The map checks the link lengths (each positive and finite) before their ratio is taken.
+    let map = ModalMap::new(link_lengths, harmonics, BaseAngle::Fixed(alpha0))?;
     let shortest = link_lengths.iter().copied().fold(f64::INFINITY, f64::min);
     if channel.length() + link_lengths.iter().sum::<f64>() > MAX_LENGTH_RATIO * shortest {
         return Err(PlanError::OutOfRange {
@@ -123,9 +117,6 @@ pub fn follow_the_leader(
             value: channel.length() / shortest,
         });
     }
-    let axis = channel.axis();
-    let alpha0 = axis[1].atan2(axis[0]);
-    let map = ModalMap::new(link_lengths, harmonics, BaseAngle::Fixed(alpha0))?;
     let (n, m) = (link_lengths.len(), map.n_coords());
     let length: f64 = link_lengths.iter().sum();
     // The normal equations of the fit, J^T J (constant), through LinearQp without constraints.

@@ -103,7 +103,7 @@ fn deployments_refuse_what_they_cannot_do() {
     // A link of no length is named, not read as an infinite centreline ratio.
     let straight = Channel::new(&[[0.0, 0.0], [0.0, 1.0]], 0.03).unwrap();
     let zero = follow_the_leader(&straight, &[0.1, 0.0, 0.1], 0.01, 1, 0.1, 4).unwrap_err();
-    assert_eq!(text(zero), "link length must be positive, got 0");
+    assert_eq!(text(zero), "link length must be positive and finite, got 0");
     // Points closer than a nanometre, and a radius below one.
     let close = [[0.0, 0.0], [0.0, 1e-320], [0.0, 2e-320]];
     assert_eq!(
