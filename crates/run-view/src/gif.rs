@@ -435,10 +435,8 @@ fn index(rgba: &[u8]) -> u8 {
     let level = |c: u8, n: usize| (usize::from(c) * (n - 1) + 127) / 255;
     let [r, g, b] = [0, 1, 2].map(|i| level(rgba[i], LEVELS[i]));
     let cube = (r * LEVELS[1] * LEVELS[2] + g * LEVELS[2] + b) as u8;
-    let (low, high) = (rgba[..3].iter().min(), rgba[..3].iter().max());
-    let (Some(&low), Some(&high)) = (low, high) else {
-        return cube;
-    };
+    let low = rgba[0].min(rgba[1]).min(rgba[2]);
+    let high = rgba[0].max(rgba[1]).max(rgba[2]);
     if high - low > GREY_SPREAD {
         return cube;
     }
