@@ -173,7 +173,7 @@ fn walls(run: &DeployRun, behind: f64) -> [Vec<(f64, f64)>; 2] {
 }
 
 /// Draws the run into `dir`: `deploy_<name>.svg` (the walls, the arm every
-/// [`SHAPE_INTERVAL_S`] light to dark, the tip's trace) and `deploy_clearance_<name>.svg` (the
+/// [`SHAPE_INTERVAL_S`] light to dark over the tip's path) and `deploy_clearance_<name>.svg` (the
 /// smallest wall clearance and the tip's distance from the centreline over time, mm); returns
 /// the report's figures.
 pub fn figures(
@@ -215,6 +215,23 @@ pub fn figures(
             },
         ));
     }
+    // The tip's path under the arms, as a wide band: a body that follows it lies inside.
+    curves.push((
+        Series {
+            label: "tip's path".into(),
+            points: (0..t.len())
+                .map(|k| {
+                    let tip = run.points_at(k).last().copied().unwrap_or_default();
+                    (tip[0], tip[1])
+                })
+                .collect(),
+        },
+        Style {
+            colour: (150, 220, 160),
+            width: 8,
+            dots: false,
+        },
+    ));
     let every =
         ((SHAPE_INTERVAL_S / (t[1.min(t.len() - 1)] - t[0]).max(1e-12)).round() as usize).max(1);
     let shown: Vec<usize> = (0..t.len()).step_by(every).chain([t.len() - 1]).collect();
@@ -237,22 +254,6 @@ pub fn figures(
             },
         ));
     }
-    curves.push((
-        Series {
-            label: "tip".into(),
-            points: (0..t.len())
-                .map(|k| {
-                    let tip = run.points_at(k).last().copied().unwrap_or_default();
-                    (tip[0], tip[1])
-                })
-                .collect(),
-        },
-        Style {
-            colour: (20, 150, 60),
-            width: 1,
-            dots: false,
-        },
-    ));
     let shapes = format!("deploy_{name}{suffix}.svg");
     let title = format!("{name}: the arm every {SHAPE_INTERVAL_S} s in the channel ({controller})");
     plot::xy_chart(
