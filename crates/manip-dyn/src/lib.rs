@@ -34,6 +34,6 @@ pub use derivative_data::DerivativeData;
 pub use energy::{kinetic_energy, potential_energy};
 pub use error::DynError;
 pub use forward_dynamics::forward_dynamics;
-pub use model::{ChainModel, Link, MAX_DENSE_LINKS, MAX_LINKS};
+pub use model::{ChainModel, Link, MAX_DENSE_LINKS, MAX_LINKS, MIN_LINK_SCALE};
 pub use rnea::rnea;
 pub use rnea_derivatives::rnea_derivatives;

@@ -7,7 +7,7 @@ use crate::error::DynError;
 pub struct Link {
     /// Length from this link's joint to the next joint (m), positive.
     pub length: f64,
-    /// Mass (kg), positive.
+    /// Mass (kg), at least [`MIN_LINK_SCALE`], as is `mass * length` (kg m).
     pub mass: f64,
     /// Distance of the centre of mass from the link's joint, along the link (m).
     pub com: f64,
@@ -69,6 +69,19 @@ impl Link {
                 return invalid(quantity, "positive and finite", value);
             }
         }
+        // The articulated-body algorithm forms products of two masses and of two first moments
+        // (`mass * length` sets their scale): below this scale they fall out of the normal
+        // numbers and its results lose every digit.
+        if self.mass < MIN_LINK_SCALE {
+            return invalid("mass", MIN_SCALE_REQUIREMENT, self.mass);
+        }
+        if self.mass * self.length < MIN_LINK_SCALE {
+            return invalid(
+                "mass * length",
+                MIN_SCALE_REQUIREMENT,
+                self.mass * self.length,
+            );
+        }
         if !(self.inertia.is_finite() && self.inertia >= 0.0) {
             return invalid("inertia", "non-negative and finite", self.inertia);
         }
@@ -86,6 +99,15 @@ impl Link {
         Ok(())
     }
 }
+
+/// The smallest mass (kg) and first moment `mass * length` (kg m) of a link: `1e-150`, whose
+/// square is still a normal double. The dynamics' algorithms multiply two of either (the
+/// articulated-body inertias' updates), which below this scale lose their digits to underflow.
+pub const MIN_LINK_SCALE: f64 = 1e-150;
+
+/// What a link's mass and first moment must be.
+const MIN_SCALE_REQUIREMENT: &str = "at least 1e-150 (MIN_LINK_SCALE: the dynamics multiply \
+                                     two of them, whose product must stay a normal number)";
 
 /// The most links a chain may have: the workspace's one limit, `backbone_kin::MAX_LINKS`
 /// (10^6). A chain, a [`ChainData`](crate::ChainData) and the `O(n)` algorithms (RNEA, ABA, the

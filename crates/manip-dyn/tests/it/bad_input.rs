@@ -106,6 +106,35 @@ fn model_rows() -> Vec<Row<DynError>> {
             },
             &["link mass must be such that", "got 5e-324"],
         ),
+        // Below the smallest link scale, the articulated inertias' products underflow.
+        words(
+            "mass_below_the_link_scale",
+            Link::new(1.0, 1e-160, 0.5, 0.0).unwrap_err(),
+            |e| {
+                matches!(
+                    e,
+                    DynError::InvalidLinkParameter {
+                        quantity: "mass",
+                        ..
+                    }
+                )
+            },
+            &["link mass must be at least 1e-150", "got 1e-160"],
+        ),
+        words(
+            "first_moment_below_the_link_scale",
+            Link::uniform_beam(1e-60, 1e-100).unwrap_err(),
+            |e| {
+                matches!(
+                    e,
+                    DynError::InvalidLinkParameter {
+                        quantity: "mass * length",
+                        ..
+                    }
+                )
+            },
+            &["link mass * length must be at least 1e-150", "got 1e-160"],
+        ),
         row(
             "non_finite_centre_of_mass",
             ChainModel::new(

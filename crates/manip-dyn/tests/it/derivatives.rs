@@ -176,6 +176,54 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(scaled(48))]
+
+    /// Scaling every mass and inertia by `s` and the torques with them leaves the accelerations
+    /// and their state Jacobians unchanged and divides `d qdd / d tau` by `s`: so down to the
+    /// smallest link scale the chain accepts (`MIN_LINK_SCALE`, a mass of 1e-150 kg), where the
+    /// articulated inertias' products would lose their digits below it.
+    #[test]
+    fn aba_derivatives_keep_their_digits_down_to_the_smallest_link_scale(
+        (arm, q, v, tau) in arm_and_state(12)
+    ) {
+        let smallest = arm.links().iter().map(|l| l.mass.min(l.mass * l.length)).fold(f64::INFINITY, f64::min);
+        // Just above the bound (the product of the scaled mass and length rounds).
+        let s = manip_dyn::MIN_LINK_SCALE / smallest * (1.0 + 1e-12);
+        let light = ChainModel::new(
+            arm.links()
+                .iter()
+                .map(|l| manip_dyn::Link { mass: l.mass * s, inertia: l.inertia * s, ..*l })
+                .collect(),
+            arm.gravity(),
+        )
+        .unwrap();
+        let light_tau: Vec<f64> = tau.iter().map(|t| t * s).collect();
+        let mut data = ChainData::new(&arm);
+        let (mut heavy, mut scaled_down) = (DerivativeData::new(&arm), DerivativeData::new(&arm));
+        aba_derivatives(&arm, &mut data, &mut heavy, &q, &v, &tau).unwrap();
+        aba_derivatives(&light, &mut data, &mut scaled_down, &q, &v, &light_tau).unwrap();
+        let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-9 * scale;
+        let qdd_scale = heavy.value().iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        for (a, b) in heavy.value().iter().zip(scaled_down.value()) {
+            prop_assert!(close(*a, *b, qdd_scale), "qdd {a} against {b}");
+        }
+        for (a, b, unscale) in [
+            (heavy.d_q(), scaled_down.d_q(), 1.0),
+            (heavy.d_v(), scaled_down.d_v(), 1.0),
+            (heavy.d_input(), scaled_down.d_input(), s),
+        ] {
+            let scale = max_abs_mat(&a.to_owned());
+            for i in 0..arm.n_links() {
+                for j in 0..arm.n_links() {
+                    prop_assert!(close(a[(i, j)], b[(i, j)] * unscale, scale),
+                        "[{i}][{j}]: {} against {}", a[(i, j)], b[(i, j)] * unscale);
+                }
+            }
+        }
+    }
+}
+
 /// The paper's arm, with both workspaces reused across calls and chains of different sizes
 /// refused.
 #[test]
