@@ -7,7 +7,7 @@
 //! is documented in `docs/eval-protocol.md`.
 
 use backbone_kin::{
-    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, MAX_IK_GUESS, end_point,
+    BackboneCurve, BaseAngle, Branch, ChainIk, HarmonicIk, KinError, MAX_IK_GUESS, end_point,
     inverse_kinematics, reduce_angle, tip_position,
 };
 use fuzzy_sugeno::FuzzySystem;
@@ -359,6 +359,8 @@ fn ik(request: IkRequest) -> EvalResult {
     let (length, alpha0) = (chain.total_length(), reduce_angle(request.alpha0));
     let lengths: Vec<f64> = chain.link_lengths().collect();
     let guessed = request.guess.is_some();
+    // Where both solvers start: the guess, or the closed form padded with zeros (`None` when
+    // the closed form's branch misses a target a K-harmonic curve may still reach).
     let start = match request.guess {
         Some(guess) if guess.len() == 2 * k => {
             if let Some(x) = guess.iter().find(|x| x.abs() > MAX_IK_GUESS) {
@@ -366,7 +368,7 @@ fn ik(request: IkRequest) -> EvalResult {
                     "guess entries must lie within [-{MAX_IK_GUESS}, {MAX_IK_GUESS}] rad, got {x:e}"
                 )));
             }
-            guess
+            Some(guess)
         }
         Some(guess) => {
             return Err(EvalError::input(format!(
@@ -375,17 +377,34 @@ fn ik(request: IkRequest) -> EvalResult {
                 2 * k
             )));
         }
-        None => {
-            let closed = inverse_kinematics(length, target, alpha0, Branch::Positive)?;
-            let mut start = vec![0.0; 2 * k];
-            start[..2].copy_from_slice(&closed);
-            start
-        }
+        None => match inverse_kinematics(length, target, alpha0, Branch::Positive) {
+            Ok(closed) => {
+                let mut start = vec![0.0; 2 * k];
+                start[..2].copy_from_slice(&closed);
+                Some(start)
+            }
+            Err(error)
+                if k > 1
+                    && error.is_unreachable()
+                    && !matches!(error, KinError::OutOfReach { .. }) =>
+            {
+                None
+            }
+            Err(error) => return Err(error.into()),
+        },
     };
-    let mut a = start.clone();
-    if k > 1 || guessed {
+    let mut a = start.clone().unwrap_or_else(|| vec![0.0; 2 * k]);
+    if guessed {
         HarmonicIk::new(length, k, alpha0).and_then(|mut solver| solver.solve(target, &mut a))?;
+    } else if k > 1 {
+        // From the closed form, then (if it misses or does not converge) the other branch and a
+        // list of moderate curves: the answer of Python's `ReducedModel.ik`.
+        HarmonicIk::new(length, k, alpha0)
+            .and_then(|mut solver| solver.solve_unguided(target, Branch::Positive, &mut a))?;
     }
+    // The chain starts where the curve did, or on the curve's solution when the closed form
+    // had no answer.
+    let start = start.unwrap_or_else(|| a.clone());
     finite("a", &a)?;
     let mut a_chain = start;
     match ChainIk::new(&lengths, k, alpha0)
@@ -1053,6 +1072,24 @@ mod tests {
         let wrong = request(json!({"op": "ik", "target": target, "alpha0": alpha0,
             "guess": [3.0]}));
         assert_eq!(wrong["error"]["kind"], "invalid_input");
+        // A two-harmonic curve's tip that the closed form's branch misses (|a2| > A): found
+        // without a guess by the unguided solver's other starts, as Python's `ik` finds it.
+        let alpha0 = 1.9686465720275468;
+        let tip = request(
+            json!({"op": "fk", "a": [0.1, -0.45, -0.2, -0.9], "alpha0": alpha0,
+            "harmonics": 2}),
+        )["tip"]
+            .clone();
+        let solved = request(json!({"op": "ik", "target": tip, "alpha0": alpha0, "harmonics": 2}));
+        assert_eq!(solved["ok"], true, "{solved}");
+        let fk = request(json!({"op": "fk", "a": solved["a"], "alpha0": alpha0, "harmonics": 2}));
+        assert!(distance(&vector(&fk["tip"]), &vector(&tip)) < 1e-13, "{fk}");
+        let fk = request(json!({"op": "fk", "a": solved["a_chain"], "alpha0": alpha0,
+            "harmonics": 2}));
+        assert!(
+            distance(&vector(&fk["tip_chain"]), &vector(&tip)) < 1e-13,
+            "{fk}"
+        );
     }
 
     #[test]
