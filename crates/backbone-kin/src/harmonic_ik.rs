@@ -333,6 +333,12 @@ pub(crate) fn least_squares<const D: usize>(
 /// `trial = a - J^T (J J^T + mu I)^{-1} error` with `mu = damping * trace(J J^T)`, `J` the
 /// `D x m` row-major end-point Jacobian, the step shortened to at most [`MAX_STEP`]. Returns
 /// false when the step is undefined (`J J^T + mu I` singular, e.g. `J = 0`).
+///
+/// The step is the same for `s J` and `s error`: `J` and `error` are scaled by the power of two
+/// `s` that brings `J`'s largest entry near 1, so that the Gram matrix's determinant (the
+/// fourth or sixth power of `J`'s scale) neither overflows for a chain of 1e80 m nor
+/// underflows for one of 1e-90 m; a power of two scales every product exactly, so the step's
+/// bits are those of the unscaled formula wherever that does not leave the normal numbers.
 fn damped_step<const D: usize>(
     jacobian: &[f64],
     error: [f64; D],
@@ -341,10 +347,17 @@ fn damped_step<const D: usize>(
     trial: &mut [f64],
 ) -> bool {
     let m = a.len();
-    let row = |d: usize| &jacobian[d * m..(d + 1) * m];
-    let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(p, q)| p * q).sum::<f64>();
-    let mut gram: [[f64; D]; D] =
-        std::array::from_fn(|i| std::array::from_fn(|j| dot(row(i), row(j))));
+    let largest = jacobian.iter().fold(0.0f64, |big, x| big.max(x.abs()));
+    if !(largest > 0.0 && largest.is_finite()) {
+        return false;
+    }
+    let s = power_of_two_near_inverse(largest);
+    let error = error.map(|e| e * s);
+    let scaled: [&[f64]; D] = std::array::from_fn(|d| &jacobian[d * m..(d + 1) * m]);
+    let row = |d: usize| scaled[d].iter().map(move |x| x * s);
+    let mut gram: [[f64; D]; D] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| row(i).zip(row(j)).map(|(p, q)| p * q).sum::<f64>())
+    });
     let mu = damping * (0..D).map(|d| gram[d][d]).sum::<f64>();
     for (d, g) in gram.iter_mut().enumerate() {
         g[d] += mu;
@@ -352,13 +365,20 @@ fn damped_step<const D: usize>(
     let Some(y) = solve_symmetric(&gram, error) else {
         return false;
     };
-    let step = |j: usize| (0..D).map(|d| row(d)[j] * y[d]).sum::<f64>();
+    let step = |j: usize| (0..D).map(|d| scaled[d][j] * s * y[d]).sum::<f64>();
     let norm = (0..m).map(|j| step(j).powi(2)).sum::<f64>().sqrt();
     let scale = (MAX_STEP / norm).min(1.0);
     for (j, (t, &aj)) in trial.iter_mut().zip(a).enumerate() {
         *t = aj - scale * step(j);
     }
     true
+}
+
+/// A power of two within a factor of two of `1 / x`, for a positive finite `x` (at most
+/// `2^1022`, so never infinite; `2^-1022` at least, so never zero).
+fn power_of_two_near_inverse(x: f64) -> f64 {
+    let exponent = ((x.to_bits() >> 52) & 0x7ff) as i32 - 1023;
+    2f64.powi((-exponent).clamp(-1022, 1022))
 }
 
 /// `G^{-1} e` for a symmetric `2 x 2` or `3 x 3` matrix `G` by its adjugate (Cramer's rule), or

@@ -225,3 +225,32 @@ fn equal_links_agree_with_the_closed_form_to_the_aliasing_error() {
         assert!(distance(chain_tip(&lengths, &polished, FRAC_PI_2), target) < 1e-15);
     }
 }
+
+#[test]
+fn chain_ik_is_the_same_at_every_scale() {
+    // The problem is dimensionless: links of 1e80 m or 1e-90 m give the coordinates of links
+    // of 0.1 m (the Gram matrix's determinant, the fourth power of the scale, is taken on a
+    // Jacobian scaled near 1).
+    let solve = |scale: f64| {
+        let lengths: Vec<f64> = tapered().iter().map(|l| l * scale).collect();
+        let target = [0.3 * scale, 0.5 * scale];
+        let mut a = [0.0; 4];
+        ChainIk::new(&lengths, 2, 0.7)
+            .unwrap()
+            .solve_from_closed_form(target, Branch::Positive, &mut a)
+            .unwrap();
+        let reached = distance(chain_tip(&lengths, &a, 0.7), target);
+        assert!(reached <= 1e-14 * scale, "scale {scale:e}: {reached:e}");
+        a
+    };
+    let unit = solve(1.0);
+    for scale in [1e80, 1e-90, 1e300, 1e-300] {
+        let a = solve(scale);
+        for (x, y) in a.iter().zip(unit) {
+            assert!(
+                (x - y).abs() < 1e-9,
+                "scale {scale:e}: {a:?} against {unit:?}"
+            );
+        }
+    }
+}
