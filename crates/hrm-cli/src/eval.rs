@@ -53,7 +53,9 @@ pub fn serve(mut input: impl BufRead, mut output: impl Write) -> std::io::Result
             continue;
         }
         let answer = if complete {
-            answer(&line)
+            // The blank lines' whitespace (form feed included, which JSON's is not) may also
+            // surround a request.
+            answer(line.trim_ascii())
         } else {
             error_answer(
                 Value::Null,
@@ -655,6 +657,10 @@ mod tests {
         assert_eq!(ids[0]["id"].as_f64(), Some(1.2345678901234568e22));
         assert_eq!(ids[1]["id"].to_string(), "100.0");
         assert_eq!(ids[2]["id"], "run 7");
+        // The blank lines' whitespace around a request, form feed included (not JSON's).
+        let fed = run(b"\x0c {\"id\":10,\"op\":\"joints\",\"a\":[0.1,0.2,0.3]}\x0c\t\n\x0c\n");
+        assert_eq!(fed.len(), 1);
+        assert_eq!(fed[0]["ok"], true, "{}", fed[0]);
     }
 
     #[test]
