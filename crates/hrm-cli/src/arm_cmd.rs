@@ -106,6 +106,9 @@ fn check(path: &Path) -> Result<(), String> {
     for joint in unlimited(robot) {
         let _ = writeln!(out, "note: {}", unlimited_note(joint));
     }
+    for note in robot.joints.iter().filter_map(partial_limit_note) {
+        let _ = writeln!(out, "note: {note}");
+    }
     if report.merged.is_empty() {
         out.push_str("merged: none\n");
     }
@@ -152,6 +155,41 @@ fn unlimited_note(joint: &robot_desc::Joint) -> String {
             ""
         }
     )
+}
+
+/// What `check` says of a `<limit>` that lacks attributes: a missing `lower` or `upper` of a
+/// revolute or prismatic joint reads as 0 (the joint's range is then `[lower, 0]`, `[0, upper]`
+/// or the single position 0), and urdfdom refuses a `<limit>` without `effort` or `velocity`.
+fn partial_limit_note(joint: &robot_desc::Joint) -> Option<String> {
+    let limits = joint.limits?;
+    let mut missing: Vec<&str> = Vec::new();
+    if joint.kind != robot_desc::JointKind::Continuous {
+        missing.extend(limits.lower.is_none().then_some("lower"));
+        missing.extend(limits.upper.is_none().then_some("upper"));
+    }
+    let bounds = missing.len();
+    missing.extend(limits.effort.is_none().then_some("effort"));
+    missing.extend(limits.velocity.is_none().then_some("velocity"));
+    if missing.is_empty() {
+        return None;
+    }
+    let [lower, upper] = joint.position_range();
+    let mut note = format!(
+        "joint '{}' has <limit> without {}",
+        name(&joint.name),
+        missing.join(", ")
+    );
+    if bounds > 0 {
+        let _ = write!(
+            note,
+            ": URDF reads a missing bound as 0, so it moves within [{lower}, {upper}]"
+        );
+    }
+    if missing.len() > bounds {
+        note.push_str(if bounds > 0 { "; " } else { ": " });
+        note.push_str("urdfdom (ROS, Pinocchio) refuses a <limit> without effort or velocity");
+    }
+    Some(note)
 }
 
 /// A name from the file as one line of the report: a line break or tab in it escaped (`\n`),

@@ -21,7 +21,7 @@
 //! MuJoCo's compiler accepts.
 
 use crate::error::DescError;
-use crate::model::{Body, Joint, JointKind, Robot, Shape};
+use crate::model::{Body, Joint, Robot, Shape};
 use crate::pose::{Mat3, Pose, mat_vec, matrix_quaternion, transpose};
 use crate::urdf_read::MAX_MAGNITUDE;
 use crate::urdf_write::{escape, numbers, write_urdf};
@@ -151,6 +151,17 @@ fn bodies(robot: &Robot, gravity: [f64; 3]) -> Result<Vec<MjBody<'_>>, DescError
     let mut bodies = Vec::new();
     let mut group: Vec<&Joint> = Vec::new();
     for joint in &robot.joints {
+        let [lower, upper] = joint.position_range();
+        if lower == upper {
+            return Err(DescError::export(
+                format!("joint '{}' to MJCF", joint.name),
+                format!(
+                    "its <limit> holds it at {lower} (a missing lower or upper reads as 0), \
+                     which MJCF cannot say: MuJoCo needs range[0] < range[1] (give the joint \
+                     its lower and upper, or make it fixed)"
+                ),
+            ));
+        }
         group.push(joint);
         if joint.child.inertial.is_massless() {
             continue;
@@ -336,11 +347,8 @@ fn write_joint(out: &mut String, indent: &str, joint: &Joint, anchor: &[f64; 3],
         numbers(anchor),
         numbers(axis)
     );
-    if joint.kind != JointKind::Continuous
-        && let Some(limits) = &joint.limits
-        && let (Some(lower), Some(upper)) = (limits.lower, limits.upper)
-        && lower < upper
-    {
+    let [lower, upper] = joint.position_range();
+    if lower.is_finite() && upper.is_finite() && lower < upper {
         let _ = write!(out, " range=\"{}\"", numbers(&[lower, upper]));
     }
     if let Some(dynamics) = &joint.dynamics {

@@ -249,6 +249,20 @@ pub struct Joint {
     pub child: Body,
 }
 
+impl Joint {
+    /// The joint's position range `[lower, upper]` (rad or m) as URDF reads it: unbounded for a
+    /// continuous joint, and for a revolute or prismatic one without `<limit>` (which urdfdom
+    /// refuses; hrm reads it as unlimited); otherwise `<limit>`'s `lower` and `upper`, each 0
+    /// when missing (the specification's default, urdfdom's and Pinocchio's reading: a
+    /// `<limit>` with neither holds the joint at 0).
+    pub fn position_range(&self) -> [f64; 2] {
+        match (self.kind, self.limits) {
+            (JointKind::Continuous, _) | (_, None) => [f64::NEG_INFINITY, f64::INFINITY],
+            (_, Some(limits)) => [limits.lower.unwrap_or(0.0), limits.upper.unwrap_or(0.0)],
+        }
+    }
+}
+
 /// A serial chain with a fixed base: the base body and the movable joints in chain order, one
 /// degree of freedom each.
 #[derive(Debug, Clone, PartialEq)]

@@ -602,6 +602,48 @@ fn read_joint(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfJoint, 
     };
     let (parent, child) = (link_of("parent")?, link_of("child")?);
     let origin = origin(node, &element)?;
+    // A fixed joint has no axis, limits or dynamics (urdfdom reads none of them there, so an
+    // exporter's `<axis xyz="0 0 0"/>` on one is no error): listed as ignored.
+    let (axis, limits, dynamics) = if kind.is_some() {
+        movable_parts(node, &name)?
+    } else {
+        for tag in ["axis", "limit", "dynamics"] {
+            if single(node, tag, &element)?.is_some() {
+                ignore(report, &format!("fixed joint/{tag}"));
+            }
+        }
+        ([1.0, 0.0, 0.0], None, None)
+    };
+    for child in node.children().filter(Node::is_element) {
+        let tag = child.tag_name().name();
+        if !matches!(
+            tag,
+            "parent" | "child" | "origin" | "axis" | "limit" | "dynamics"
+        ) {
+            ignore(report, &format!("joint/{tag}"));
+        }
+    }
+    Ok(UrdfJoint {
+        name,
+        kind,
+        parent,
+        child,
+        origin,
+        axis,
+        limits,
+        dynamics,
+    })
+}
+
+/// A movable joint's unit axis, `<limit>` and `<dynamics>`.
+type MovableParts = ([f64; 3], Option<Limits>, Option<JointDynamics>);
+
+/// The `<axis>` (default `x`), `<limit>` and `<dynamics>` of the movable joint `name`.
+fn movable_parts(
+    node: Node<'_, '_>,
+    name: &str,
+) -> Result<MovableParts, DescError> {
+    let element = || format!("joint '{name}'");
     let axis = match single(node, "axis", &element)? {
         Some(axis) => {
             let element = || format!("<axis> of joint '{name}'");
@@ -641,25 +683,7 @@ fn read_joint(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfJoint, 
             Ok(values)
         })
         .transpose()?;
-    for child in node.children().filter(Node::is_element) {
-        let tag = child.tag_name().name();
-        if !matches!(
-            tag,
-            "parent" | "child" | "origin" | "axis" | "limit" | "dynamics"
-        ) {
-            ignore(report, &format!("joint/{tag}"));
-        }
-    }
-    Ok(UrdfJoint {
-        name,
-        kind,
-        parent,
-        child,
-        origin,
-        axis,
-        limits,
-        dynamics,
-    })
+    Ok((axis, limits, dynamics))
 }
 
 /// The `<limit>` of a joint ordered and non-negative; `element` names it in the error.

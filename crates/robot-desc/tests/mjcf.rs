@@ -369,3 +369,33 @@ fn a_file_stem_that_is_not_a_plain_name_is_refused() {
     let files = robot_desc::write_mjcf_files(&robot, g, "snake-10").unwrap();
     assert_eq!(files[0].0, "snake-10.xml");
 }
+
+/// A joint whose `<limit>` holds it at one position (no `lower`, no `upper`: both 0) has no
+/// MJCF range (MuJoCo needs `range[0] < range[1]`): refused by name rather than written
+/// unlimited; a one-sided limit is written as `[lower, 0]`.
+#[test]
+fn a_joint_held_by_its_limit_is_refused_and_a_one_sided_one_written() {
+    let urdf = |limit: &str| {
+        format!(
+            r#"<robot name="r"><link name="a"/>
+      <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>{limit}</joint>
+      <link name="b"><inertial><origin xyz="0.1 0 0"/><mass value="1"/>
+        <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>"#
+        )
+    };
+    let held = read_urdf(&urdf("<limit effort=\"1\" velocity=\"1\"/>"))
+        .unwrap()
+        .robot;
+    let message = write_mjcf(&held, [0.0, 0.0, -9.81])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("joint 'j' to MJCF") && message.contains("holds it at 0"),
+        "{message}"
+    );
+    let one_sided = read_urdf(&urdf("<limit lower=\"-1\" effort=\"1\" velocity=\"1\"/>"))
+        .unwrap()
+        .robot;
+    let text = write_mjcf(&one_sided, [0.0, 0.0, -9.81]).unwrap();
+    assert!(text.contains("range=\"-1.0 0.0\""), "{text}");
+}

@@ -694,3 +694,66 @@ fn a_name_xml_cannot_carry_is_named_as_such_not_as_a_size() {
         "{message}"
     );
 }
+
+/// A `<limit>` read as urdfdom (and with it ROS and Pinocchio) reads it: a missing `lower` or
+/// `upper` is 0; a continuous joint and a joint without `<limit>` are unbounded.
+#[test]
+fn position_ranges_read_a_missing_bound_as_zero() {
+    let range = |joint: &str, limit: &str| {
+        let text = chain_with(limit, "<inertial><mass value=\"1\"/><inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>")
+            .replace("type=\"revolute\"", &format!("type=\"{joint}\""));
+        read_urdf(&text).unwrap().robot.joints[0].position_range()
+    };
+    let free = [f64::NEG_INFINITY, f64::INFINITY];
+    assert_eq!(
+        range(
+            "revolute",
+            "<limit lower=\"-1\" upper=\"2\" effort=\"1\" velocity=\"1\"/>"
+        ),
+        [-1.0, 2.0]
+    );
+    assert_eq!(
+        range("revolute", "<limit effort=\"1\" velocity=\"1\"/>"),
+        [0.0, 0.0]
+    );
+    assert_eq!(
+        range(
+            "prismatic",
+            "<limit lower=\"-1\" effort=\"1\" velocity=\"1\"/>"
+        ),
+        [-1.0, 0.0]
+    );
+    assert_eq!(range("revolute", "<limit upper=\"0.5\"/>"), [0.0, 0.5]);
+    assert_eq!(
+        range("continuous", "<limit effort=\"1\" velocity=\"1\"/>"),
+        free
+    );
+    assert_eq!(range("revolute", ""), free);
+}
+
+/// A fixed joint's `<axis>`, `<limit>` and `<dynamics>` mean nothing (urdfdom reads none): a
+/// zero axis or an inverted limit there is listed as ignored, not refused.
+#[test]
+fn a_fixed_joints_axis_and_limit_are_ignored() {
+    let text = r#"<robot name="r"><link name="a"/>
+      <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/></joint>
+      <link name="b"><inertial><mass value="1"/>
+        <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+      <joint name="tool" type="fixed"><parent link="b"/><child link="c"/><axis xyz="0 0 0"/>
+        <limit lower="0" upper="-1" effort="1" velocity="1"/><dynamics damping="-3"/></joint>
+      <link name="c"/></robot>"#;
+    let reading = read_urdf(text).unwrap();
+    assert_eq!(reading.robot.joints.len(), 1);
+    for tag in ["axis", "limit", "dynamics"] {
+        assert_eq!(
+            reading.report.ignored.get(&format!("fixed joint/{tag}")),
+            Some(&1),
+            "{tag}"
+        );
+    }
+    // On a movable joint the same elements are read and refused.
+    refused(
+        &chain_with("<axis xyz=\"0 0 0\"/>", ""),
+        &["<axis> of joint 'j'", "must not be zero"],
+    );
+}

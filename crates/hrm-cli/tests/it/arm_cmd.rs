@@ -389,3 +389,26 @@ fn bad_arm_commands_get_one_line_naming_the_problem() {
     assert!(err.contains("--gravity"), "{err}");
     assert!(!out.exists(), "nothing is written on an error");
 }
+
+/// A `<limit>` without `lower` or `upper` reads them as 0 (as urdfdom does), one without
+/// `effort` or `velocity` is one urdfdom refuses: `check` says both.
+#[test]
+fn partial_limits_are_noted_with_the_range_they_give() {
+    let dir = scratch("arm-partial-limits");
+    let file = dir.join("r.urdf");
+    std::fs::write(
+        &file,
+        "<robot name=\"r\"><link name=\"base\"/><joint name=\"j1\" type=\"revolute\">\
+         <parent link=\"base\"/><child link=\"l1\"/><axis xyz=\"0 0 1\"/>\
+         <limit lower=\"-1\"/></joint>\
+         <link name=\"l1\"><inertial><mass value=\"1\"/><inertia ixx=\"0.01\" ixy=\"0\" \
+         ixz=\"0\" iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link></robot>",
+    )
+    .unwrap();
+    let report = succeeds(&["arm", "check", path(&file)]);
+    let note = "note: joint 'j1' has <limit> without upper, effort, velocity: URDF reads a \
+                missing bound as 0, so it moves within [-1, 0]; urdfdom (ROS, Pinocchio) \
+                refuses a <limit> without effort or velocity\n";
+    assert!(report.contains(note), "{report}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -299,8 +299,8 @@ fn check_moves_mass(
 
 /// What the joint-space loop keeps of a URDF's `<limit>` and `<dynamics>`, one entry per
 /// movable joint (each list empty when no joint sets it): the effort limits (`effort`; absent
-/// or 0, urdfdom's default, for none), the position ranges (`lower`, `upper` of revolute and
-/// prismatic joints; a continuous joint's is unbounded) and the viscous damping.
+/// or 0, urdfdom's default, for none), the position ranges ([`robot_desc::Joint::position_range`]:
+/// a missing `lower` or `upper` is 0) and the viscous damping.
 struct JointLimits {
     efforts: Vec<f64>,
     positions: Vec<[f64; 2]>,
@@ -339,13 +339,7 @@ impl JointLimits {
             .collect();
         let positions: Vec<[f64; 2]> = joints
             .iter()
-            .map(|joint| match joint.kind {
-                robot_desc::JointKind::Continuous => [f64::NEG_INFINITY, f64::INFINITY],
-                _ => [
-                    limit(joint).lower.unwrap_or(f64::NEG_INFINITY),
-                    limit(joint).upper.unwrap_or(f64::INFINITY),
-                ],
-            })
+            .map(robot_desc::Joint::position_range)
             .collect();
         let damping: Vec<f64> = joints
             .iter()
