@@ -83,9 +83,12 @@ impl Separable {
             return None;
         }
         let n_in = mf_inputs.last()? + 1;
+        let mut counts = vec![0usize; n_in];
+        for &j in mf_inputs {
+            counts[j] += 1;
+        }
         let mut set_offsets = vec![0];
-        for i in 0..n_in {
-            let count = mf_inputs.iter().filter(|&&j| j == i).count();
+        for (i, &count) in counts.iter().enumerate() {
             if count == 0 || count > MAX_SEPARABLE_SETS {
                 return None;
             }

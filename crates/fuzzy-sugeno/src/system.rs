@@ -8,6 +8,7 @@ pub use crate::rules::{
     AndMethod, Antecedent, Connective, Defuzzification, Methods, OrMethod, Rule,
 };
 use crate::separable::Separable;
+use std::collections::HashSet;
 
 /// An input variable: a name, the range it was designed for, and its fuzzy sets.
 #[derive(Debug, Clone, PartialEq)]
@@ -129,7 +130,7 @@ impl FuzzySystem {
         if inputs.is_empty() || outputs.is_empty() {
             return Err(invalid("system", SystemProblem::NoVariables));
         }
-        let mut variable_names: Vec<&str> = Vec::new();
+        let mut variable_names: HashSet<&str> = HashSet::new();
         for input in &inputs {
             let context = format!("input '{}'", input.name);
             check_variable(
@@ -264,14 +265,13 @@ fn check_variable<'a>(
     name: &'a str,
     range: [f64; 2],
     term_names: impl Iterator<Item = &'a str>,
-    variable_names: &mut Vec<&'a str>,
+    variable_names: &mut HashSet<&'a str>,
     kind: VariableKind,
 ) -> Result<(), SystemProblem> {
     check_name("variable", name)?;
-    if variable_names.contains(&name) {
+    if !variable_names.insert(name) {
         return Err(SystemProblem::DuplicateVariable);
     }
-    variable_names.push(name);
     let [min, max] = range;
     let ordered = match kind {
         VariableKind::Input => min < max,

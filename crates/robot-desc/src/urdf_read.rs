@@ -639,10 +639,7 @@ fn read_joint(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfJoint, 
 type MovableParts = ([f64; 3], Option<Limits>, Option<JointDynamics>);
 
 /// The `<axis>` (default `x`), `<limit>` and `<dynamics>` of the movable joint `name`.
-fn movable_parts(
-    node: Node<'_, '_>,
-    name: &str,
-) -> Result<MovableParts, DescError> {
+fn movable_parts(node: Node<'_, '_>, name: &str) -> Result<MovableParts, DescError> {
     let element = || format!("joint '{name}'");
     let axis = match single(node, "axis", &element)? {
         Some(axis) => {

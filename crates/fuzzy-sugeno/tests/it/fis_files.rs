@@ -59,3 +59,33 @@ fn a_matlab_mamdani_file_is_refused() {
         "{error}"
     );
 }
+
+/// A file of 20,000 inputs (one set each, one rule over all of them) loads and evaluates: the
+/// reader indexes sections and names, so its work grows with the file (a scan per section made
+/// 10^5 inputs a minute's load).
+#[test]
+fn a_file_of_many_inputs_loads_and_evaluates() {
+    let n = 20_000;
+    let mut text = format!(
+        "[System]\nName='wide'\nType='sugeno'\nNumInputs={n}\nNumOutputs=1\nNumRules=1\n\
+         AndMethod='prod'\nOrMethod='probor'\nDefuzzMethod='wtaver'\n"
+    );
+    for i in 0..n {
+        text += &format!(
+            "[Input{}]\nName='x{i}'\nRange=[0 1]\nNumMFs=1\nMF1='a':'trimf',[0 0.5 1]\n",
+            i + 1
+        );
+    }
+    text += "[Output1]\nName='y'\nRange=[0 1]\nNumMFs=1\nMF1='c':'constant',[0.5]\n[Rules]\n";
+    text += &"1 ".repeat(n);
+    text += ", 1 (1) : 1\n";
+    let system = FuzzySystem::from_fis(&text).unwrap();
+    let mut evaluator = Evaluator::new(system);
+    let mut out = [0.0];
+    evaluator.eval(&vec![0.5; n], &mut out).unwrap();
+    assert_eq!(out, [0.5]);
+    // A name used twice among them is still caught, with its first line.
+    let twice = text.replacen("Name='x19999'", "Name='x3'", 1);
+    let message = FuzzySystem::from_fis(&twice).unwrap_err().to_string();
+    assert!(message.contains("variable name 'x3' is already used at line"), "{message}");
+}
