@@ -60,9 +60,9 @@ fn a_matlab_mamdani_file_is_refused() {
     );
 }
 
-/// A file of 20,000 inputs (one set each, one rule over all of them) loads and evaluates: the
-/// reader indexes sections and names, so its work grows with the file (a scan per section made
-/// 10^5 inputs a minute's load).
+/// A file of 20,000 inputs (one set each, one rule over all of them) loads and evaluates, as
+/// .fis and as FCL: the readers index sections and names, so their work grows with the file (a
+/// scan per section made 10^5 inputs a minute's load).
 #[test]
 fn a_file_of_many_inputs_loads_and_evaluates() {
     let n = 20_000;
@@ -80,6 +80,8 @@ fn a_file_of_many_inputs_loads_and_evaluates() {
     text += &"1 ".repeat(n);
     text += ", 1 (1) : 1\n";
     let system = FuzzySystem::from_fis(&text).unwrap();
+    // The same system through FCL, whose reader indexes its variables likewise.
+    assert_eq!(FuzzySystem::from_fcl(&system.to_fcl().unwrap()).unwrap(), system);
     let mut evaluator = Evaluator::new(system);
     let mut out = [0.0];
     evaluator.eval(&vec![0.5; n], &mut out).unwrap();
@@ -87,5 +89,8 @@ fn a_file_of_many_inputs_loads_and_evaluates() {
     // A name used twice among them is still caught, with its first line.
     let twice = text.replacen("Name='x19999'", "Name='x3'", 1);
     let message = FuzzySystem::from_fis(&twice).unwrap_err().to_string();
-    assert!(message.contains("variable name 'x3' is already used at line"), "{message}");
+    assert!(
+        message.contains("variable name 'x3' is already used at line"),
+        "{message}"
+    );
 }
