@@ -893,15 +893,23 @@ fn weld(
             let at = within_bounds(placement.compose(&joint.origin), &joint.name)?;
             if !welded.body.inertial.is_massless() {
                 body.inertial = body.inertial.merged(&welded.body.inertial, &at);
+                merged_within_bounds(&body.inertial, &body.name, &joint.name)?;
             }
             for (from, to) in [
                 (welded.body.visuals, &mut body.visuals),
                 (welded.body.collisions, &mut body.collisions),
             ] {
-                to.extend(from.into_iter().map(|g| Geometry {
-                    origin: at.compose(&g.origin),
-                    ..g
-                }));
+                for geometry in from {
+                    let origin = at.compose(&geometry.origin);
+                    if let Some(x) = origin.xyz.iter().find(|x| x.abs() > MAX_MAGNITUDE) {
+                        return Err(beyond_bounds(
+                            &body.name,
+                            &joint.name,
+                            format!("a shape's origin at {x:e} m"),
+                        ));
+                    }
+                    to.push(Geometry { origin, ..geometry });
+                }
             }
             report.merged.push(Merged {
                 joint: joint.name,
@@ -928,6 +936,47 @@ fn within_bounds(origin: Pose, name: &str) -> Result<Pose, DescError> {
             ),
         )),
     }
+}
+
+/// `inertial`, link `body`'s mass properties with a link fixed to it by joint `joint` merged in,
+/// if every number of it is within [`MAX_MAGNITUDE`] as every written one is (two links of
+/// `1e9` kg merge to `2e9`, which no URDF written back could hold).
+fn merged_within_bounds(inertial: &Inertial, body: &str, joint: &str) -> Result<(), DescError> {
+    let numbers = [
+        ("a mass of", "kg", inertial.mass),
+        ("a centre of mass at", "m", inertial.origin.xyz[0]),
+        ("a centre of mass at", "m", inertial.origin.xyz[1]),
+        ("a centre of mass at", "m", inertial.origin.xyz[2]),
+    ]
+    .into_iter()
+    .chain(
+        inertial
+            .inertia
+            .map(|i| ("an inertia entry of", "kg m^2", i)),
+    );
+    for (what, unit, value) in numbers {
+        if value.abs() > MAX_MAGNITUDE {
+            return Err(beyond_bounds(
+                body,
+                joint,
+                format!("{what} {value:e} {unit}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The error of a link whose merge through fixed joint `joint` gives it `what`, beyond
+/// [`MAX_MAGNITUDE`].
+fn beyond_bounds(body: &str, joint: &str, what: String) -> DescError {
+    DescError::invalid(
+        format!("link '{}'", lane_math::one_line(body)),
+        format!(
+            "merged with the links fixed to it (through joint '{}'), it has {what}, more than \
+             {MAX_MAGNITUDE:e} (the bound of every number a URDF holds)",
+            lane_math::one_line(joint)
+        ),
+    )
 }
 
 /// The links and joints not yet taken into bodies, and the chain's connectivity.

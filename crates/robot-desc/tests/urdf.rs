@@ -757,3 +757,40 @@ fn a_fixed_joints_axis_and_limit_are_ignored() {
         &["<axis> of joint 'j'", "must not be zero"],
     );
 }
+
+/// A link merged with those fixed to it holds only numbers a URDF can hold (each within 1e9, as
+/// every written one): two links of 1e9 kg, or a shape 1e9 m beyond a fixed joint 1e9 m out,
+/// are refused when read, naming the link and the joint, not later by an export.
+#[test]
+fn merged_links_stay_within_the_bounds_of_a_urdf() {
+    let inertia = "<inertia ixx=\"1e8\" ixy=\"0\" ixz=\"0\" iyy=\"1e8\" iyz=\"0\" izz=\"1e8\"/>";
+    let robot = |fixed_origin: &str, tip: &str| {
+        format!(
+            r#"<robot name="r"><link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="a"><inertial><mass value="1e9"/>{inertia}</inertial></link>
+  <joint name="f" type="fixed"><parent link="a"/><child link="t"/><origin xyz="{fixed_origin}"/></joint>
+  <link name="t">{tip}</link></robot>"#
+        )
+    };
+    let heavy = format!("<inertial><mass value=\"1e9\"/>{inertia}</inertial>");
+    refused(
+        &robot("0 0 0", &heavy),
+        &[
+            "link 'a'",
+            "through joint 'f'",
+            "a mass of 2e9 kg",
+            "more than 1e9",
+        ],
+    );
+    let far =
+        "<visual><origin xyz=\"1e9 0 0\"/><geometry><sphere radius=\"1\"/></geometry></visual>";
+    refused(
+        &robot("1e9 0 0", far),
+        &["link 'a'", "a shape's origin at 2e9 m"],
+    );
+    // Within the bounds, the merged link reads and writes back.
+    let reading = read_urdf(&robot("0.5 0 0", &heavy.replace("\"1e9\"", "\"1\""))).unwrap();
+    assert!(read_urdf(&write_urdf(&reading.robot).unwrap()).is_ok());
+}

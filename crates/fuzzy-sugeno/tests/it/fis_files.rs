@@ -81,7 +81,10 @@ fn a_file_of_many_inputs_loads_and_evaluates() {
     text += ", 1 (1) : 1\n";
     let system = FuzzySystem::from_fis(&text).unwrap();
     // The same system through FCL, whose reader indexes its variables likewise.
-    assert_eq!(FuzzySystem::from_fcl(&system.to_fcl().unwrap()).unwrap(), system);
+    assert_eq!(
+        FuzzySystem::from_fcl(&system.to_fcl().unwrap()).unwrap(),
+        system
+    );
     let mut evaluator = Evaluator::new(system);
     let mut out = [0.0];
     evaluator.eval(&vec![0.5; n], &mut out).unwrap();
