@@ -17,19 +17,19 @@ use robot_desc::{JointKind, MAX_URDF_BYTES, Robot, read_urdf};
 use std::path::PathBuf;
 use std::sync::Mutex;
 
-/// The URDF text of `source`: the file it names when it is a path-like object, or a string
-/// ending in `.urdf` naming an existing file; otherwise the string itself. A file is read only
-/// if it is a regular file of at most [`MAX_URDF_BYTES`] bytes.
+/// The URDF text of `source`: a string holding `<` is the text itself (no path holds one, all
+/// URDF text does); any other string or a path-like object names the file to read, which is
+/// read only if it is a regular file of at most [`MAX_URDF_BYTES`] bytes.
 fn urdf_text(source: &Bound<'_, PyAny>) -> PyResult<String> {
     let path = if let Ok(text) = source.cast::<PyString>() {
         let text: String = text.extract()?;
-        if !text.ends_with(".urdf") || text.contains('<') {
+        if text.contains('<') {
             return Ok(text);
         }
         PathBuf::from(text)
     } else {
         source.extract::<PathBuf>().map_err(|_| {
-            crate::args::wrong_type("urdf", "URDF text or a path to a .urdf file", source)
+            crate::args::wrong_type("urdf", "URDF text or a path to a URDF file", source)
         })?
     };
     sim_study::read_text_file(&path, MAX_URDF_BYTES as u64)
@@ -61,8 +61,8 @@ impl Workspace {
 /// order (torques for revolute joints, forces for prismatic ones).
 ///
 /// Build with `Chain.from_urdf(urdf, gravity=(0, 0, -9.81))` or `Arm.from_urdf(...)`; `urdf`
-/// is URDF text, a path-like object, or a string ending in `.urdf` naming a regular file of at
-/// most 32 MiB.
+/// is URDF text (a string holding `<`), or a path-like object or other string naming a regular
+/// file of at most 32 MiB.
 ///
 /// Every method takes one state (arrays of shape (n,)) or a batch (shape (N, n)) and answers
 /// with the same leading dimension; a batch runs with the GIL released, on all cores from 512
@@ -183,8 +183,8 @@ impl Chain {
 
 #[pymethods]
 impl Chain {
-    /// The chain of a URDF description (text, a path-like object, or a string ending in `.urdf`
-    /// naming a file) under the gravity vector `gravity` (m/s^2, base frame; one number `g` is
+    /// The chain of a URDF description (text, which holds `<`, or a path-like object or other
+    /// string naming a file) under the gravity vector `gravity` (m/s^2, base frame; one number `g` is
     /// `(0, 0, -g)`, as `SpatialArm` and `hrm eval` read it).
     #[staticmethod]
     #[pyo3(signature = (urdf, gravity=None), text_signature = "(urdf, gravity=(0, 0, -9.81))")]

@@ -118,8 +118,13 @@ def test_from_urdf_reads_paths_and_text(tmp_path):
     path = tmp_path / "arm.urdf"
     path.write_text(text)
     want = hrm.Chain.from_urdf(text).mass_matrix([0.1, 0.2])
-    for source in (str(path), path):
+    # A string holding no '<' names a file, whatever its extension.
+    other = tmp_path / "ROBOT.XML"
+    other.write_text(text)
+    for source in (str(path), path, str(other)):
         assert np.array_equal(hrm.Chain.from_urdf(source).mass_matrix([0.1, 0.2]), want)
+    with pytest.raises(hrm.InvalidInput, match=r"urdf file .*arm\.urdf : "):
+        hrm.Chain.from_urdf(str(path) + " ")
     assert isinstance(hrm.Arm.from_urdf(path), hrm.Chain)
     with pytest.raises(hrm.InvalidInput, match="urdf file .*missing.urdf"):
         hrm.Chain.from_urdf(str(tmp_path / "missing.urdf"))
@@ -136,7 +141,7 @@ def test_from_urdf_reads_paths_and_text(tmp_path):
     with pytest.raises(hrm.InvalidInput, match="no movable joint"):
         hrm.Chain.from_urdf('<robot name="r"><link name="a"/></robot>')
     for wrong in [42, None]:
-        with pytest.raises(TypeError, match="urdf must be URDF text or a path to a .urdf file, got a"):
+        with pytest.raises(TypeError, match="urdf must be URDF text or a path to a URDF file, got a"):
             hrm.Chain.from_urdf(wrong)
     with pytest.raises(hrm.InvalidInput, match=r"^gravity\[1\] must be finite, got NaN$"):
         hrm.Chain.from_urdf(text, gravity=(0.0, float("nan"), 0.0))

@@ -330,6 +330,23 @@ fn required<'a>(
         .ok_or_else(|| DescError::invalid(element(), format!("missing attribute {attribute:?}")))
 }
 
+/// A name (of a link or joint, or the link a joint names): [`required`], and not empty, which
+/// urdfdom refuses and no joint could name.
+fn required_name<'a>(
+    node: Node<'a, '_>,
+    attribute: &str,
+    element: impl Fn() -> String,
+) -> Result<&'a str, DescError> {
+    let name = required(node, attribute, &element)?;
+    if name.is_empty() {
+        return Err(DescError::invalid(
+            element(),
+            format!("attribute {attribute:?} must not be empty"),
+        ));
+    }
+    Ok(name)
+}
+
 /// One number, finite and at most [`MAX_MAGNITUDE`] in magnitude.
 fn number(text: &str, what: &str, element: &dyn Fn() -> String) -> Result<f64, DescError> {
     let value: f64 = text.trim().parse().map_err(|_| {
@@ -430,7 +447,8 @@ fn single<'a, 'i>(
 }
 
 fn read_link(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfLink, DescError> {
-    let name = required(node, "name", || format!("<link> at line {}", line_of(node)))?.to_string();
+    let name =
+        required_name(node, "name", || format!("<link> at line {}", line_of(node)))?.to_string();
     let element = || format!("link '{name}'");
     let mut body = Body {
         name: name.clone(),
@@ -572,7 +590,7 @@ fn read_geometry(
 }
 
 fn read_joint(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfJoint, DescError> {
-    let name = required(node, "name", || {
+    let name = required_name(node, "name", || {
         format!("<joint> at line {}", line_of(node))
     })?
     .to_string();
@@ -598,7 +616,7 @@ fn read_joint(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfJoint, 
     let link_of = |tag: &str| -> Result<String, DescError> {
         let child = single(node, tag, &element)?
             .ok_or_else(|| DescError::invalid(element(), format!("missing <{tag}>")))?;
-        Ok(required(child, "link", || format!("<{tag}> of joint '{name}'"))?.to_string())
+        Ok(required_name(child, "link", || format!("<{tag}> of joint '{name}'"))?.to_string())
     };
     let (parent, child) = (link_of("parent")?, link_of("child")?);
     let origin = origin(node, &element)?;

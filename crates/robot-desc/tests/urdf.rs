@@ -593,6 +593,17 @@ fn what_is_not_a_serial_chain_is_refused_naming_the_element() {
         &chain_with("<limit lower=\"1\" upper=\"-1\"/>", ""),
         &["<limit> of joint 'j'", "must not exceed"],
     );
+    // An empty name (urdfdom refuses it; no joint could name such a link).
+    refused(
+        &chain_with("", "")
+            .replace("<link name=\"b\">", "<link name=\"\">")
+            .replace("<child link=\"b\"/>", "<child link=\"\"/>"),
+        &["attribute \"link\" must not be empty"],
+    );
+    refused(
+        &chain_with("", "").replace("<link name=\"b\">", "<link name=\"\">"),
+        &["<link> at line", "attribute \"name\" must not be empty"],
+    );
     refused(
         "<robot><link name=\"a\"/></robot>",
         &["<robot>", "missing attribute \"name\""],

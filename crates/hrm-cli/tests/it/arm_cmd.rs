@@ -412,3 +412,24 @@ fn partial_limits_are_noted_with_the_range_they_give() {
     assert!(report.contains(note), "{report}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A chain whose links are all massless reads (a kinematic chain), and `check` says that its
+/// dynamics refuse it, naming the joint that moves nothing.
+#[test]
+fn a_chain_that_moves_no_mass_is_noted() {
+    let dir = scratch("arm-massless");
+    let file = dir.join("r.urdf");
+    std::fs::write(
+        &file,
+        "<robot name=\"r\"><link name=\"base\"/><joint name=\"j1\" type=\"continuous\">\
+         <parent link=\"base\"/><child link=\"l1\"/><axis xyz=\"0 0 1\"/></joint>\
+         <link name=\"l1\"/></robot>",
+    )
+    .unwrap();
+    let report = succeeds(&["arm", "check", path(&file)]);
+    assert!(
+        report.contains("note: joint 'j1' moves no mass or inertia at the zero positions"),
+        "{report}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

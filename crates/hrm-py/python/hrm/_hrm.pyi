@@ -83,8 +83,9 @@ class Chain:
     def from_urdf(
         urdf: Union[str, "PathLike[str]"], gravity: Sequence[float] = (0.0, 0.0, -9.81)
     ) -> "Chain":
-        """The chain of URDF text, a path-like object, or a string ending in .urdf naming a
-        regular file (at most 32 MiB), under the world gravity vector (m/s^2)."""
+        """The chain of URDF text (a string holding '<'), or of the regular file (at most
+        32 MiB) a path-like object or other string names, under the world gravity vector
+        (m/s^2)."""
     @property
     def n_joints(self) -> int:
         """Number of movable joints n."""
