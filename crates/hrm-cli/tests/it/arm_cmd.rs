@@ -311,14 +311,7 @@ fn a_chain_past_the_nesting_limit_is_split_into_included_files() {
 fn joints_without_the_limits_urdf_requires_are_noted() {
     let dir = scratch("arm-unlimited");
     let file = dir.join("r.urdf");
-    std::fs::write(
-        &file,
-        "<robot name=\"r\"><link name=\"base\"/><joint name=\"j1\" type=\"revolute\">\
-         <parent link=\"base\"/><child link=\"l1\"/><axis xyz=\"0 0 1\"/></joint>\
-         <link name=\"l1\"><inertial><mass value=\"1\"/><inertia ixx=\"0.01\" ixy=\"0\" \
-         ixz=\"0\" iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link></robot>",
-    )
-    .unwrap();
+    std::fs::write(&file, one_joint("revolute", "", HEAVY)).unwrap();
     let note = "joint 'j1' is revolute without <limit>, which URDF requires (urdfdom, ROS and \
                 Pinocchio refuse it): hrm reads it as unlimited (type=\"continuous\" says so)";
     let report = succeeds(&["arm", "check", path(&file)]);
@@ -390,46 +383,51 @@ fn bad_arm_commands_get_one_line_naming_the_problem() {
     assert!(!out.exists(), "nothing is written on an error");
 }
 
+/// A link of 1 kg with its inertia, as `one_joint`'s link.
+const HEAVY: &str = "<inertial><mass value=\"1\"/><inertia ixx=\"0.01\" ixy=\"0\" ixz=\"0\" \
+                     iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial>";
+
+/// A robot of one joint `j1` of `kind` (its `<limit>` or other elements `joint_extra`) moving
+/// link `l1` (holding `link`).
+fn one_joint(kind: &str, joint_extra: &str, link: &str) -> String {
+    format!(
+        "<robot name=\"r\"><link name=\"base\"/><joint name=\"j1\" type=\"{kind}\">\
+         <parent link=\"base\"/><child link=\"l1\"/><axis xyz=\"0 0 1\"/>{joint_extra}</joint>\
+         <link name=\"l1\">{link}</link></robot>"
+    )
+}
+
+/// `hrm arm check`'s report of the URDF `text`, written in a scratch folder `label`.
+fn check_report(label: &str, text: &str) -> String {
+    let dir = scratch(label);
+    let file = dir.join("r.urdf");
+    std::fs::write(&file, text).unwrap();
+    let report = succeeds(&["arm", "check", path(&file)]);
+    std::fs::remove_dir_all(&dir).unwrap();
+    report
+}
+
 /// A `<limit>` without `lower` or `upper` reads them as 0 (as urdfdom does), one without
 /// `effort` or `velocity` is one urdfdom refuses: `check` says both.
 #[test]
 fn partial_limits_are_noted_with_the_range_they_give() {
-    let dir = scratch("arm-partial-limits");
-    let file = dir.join("r.urdf");
-    std::fs::write(
-        &file,
-        "<robot name=\"r\"><link name=\"base\"/><joint name=\"j1\" type=\"revolute\">\
-         <parent link=\"base\"/><child link=\"l1\"/><axis xyz=\"0 0 1\"/>\
-         <limit lower=\"-1\"/></joint>\
-         <link name=\"l1\"><inertial><mass value=\"1\"/><inertia ixx=\"0.01\" ixy=\"0\" \
-         ixz=\"0\" iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link></robot>",
-    )
-    .unwrap();
-    let report = succeeds(&["arm", "check", path(&file)]);
+    let report = check_report(
+        "arm-partial-limits",
+        &one_joint("revolute", "<limit lower=\"-1\"/>", HEAVY),
+    );
     let note = "note: joint 'j1' has <limit> without upper, effort, velocity: URDF reads a \
                 missing bound as 0, so it moves within [-1, 0]; urdfdom (ROS, Pinocchio) \
                 refuses a <limit> without effort or velocity\n";
     assert!(report.contains(note), "{report}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// A chain whose links are all massless reads (a kinematic chain), and `check` says that its
 /// dynamics refuse it, naming the joint that moves nothing.
 #[test]
 fn a_chain_that_moves_no_mass_is_noted() {
-    let dir = scratch("arm-massless");
-    let file = dir.join("r.urdf");
-    std::fs::write(
-        &file,
-        "<robot name=\"r\"><link name=\"base\"/><joint name=\"j1\" type=\"continuous\">\
-         <parent link=\"base\"/><child link=\"l1\"/><axis xyz=\"0 0 1\"/></joint>\
-         <link name=\"l1\"/></robot>",
-    )
-    .unwrap();
-    let report = succeeds(&["arm", "check", path(&file)]);
+    let report = check_report("arm-massless", &one_joint("continuous", "", ""));
     assert!(
         report.contains("note: joint 'j1' moves no mass or inertia at the zero positions"),
         "{report}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
