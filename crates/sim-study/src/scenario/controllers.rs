@@ -159,7 +159,7 @@ impl ControllerSetup<'_> {
         self.spec.computed_torque_gains(m)?;
         self.spec.pd_gains(m)?;
         if self.spec.lqr_frequency.is_some() || self.spec.lqr_relinearise.is_some() {
-            let (frequency, relinearise) = self.spec.lqr_settings();
+            let (frequency, relinearise) = self.spec.lqr_settings(self.period);
             LqrController::check_settings(self.period, frequency, relinearise)?;
         }
         // The fuzzy kinds read `fis` themselves; the others check it can be read and parsed.
@@ -245,7 +245,7 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
         description: "LQR about the reference (feedforward M* a_ref_dd + C* + G*), re-linearised \
                       along it every lqr_relinearise s, design frequency lqr_frequency",
         prepare: |s| {
-            let (frequency, relinearise) = s.spec.lqr_settings();
+            let (frequency, relinearise) = s.spec.lqr_settings(s.period);
             Ok(Prepared::controller_clones(LqrController::new(
                 s.model.plant(),
                 s.period,
@@ -383,14 +383,16 @@ const DEFAULT_KP: f64 = 2500.0;
 const DEFAULT_KD: f64 = 100.0;
 
 impl ControllerSpec {
-    /// The LQR's design frequency and re-linearisation period: the keys given, else
-    /// [`LqrController`]'s defaults.
-    fn lqr_settings(&self) -> (f64, f64) {
+    /// The LQR's design frequency and re-linearisation period for a controller sampled every
+    /// `period` seconds: the keys given, else [`LqrController`]'s defaults (the
+    /// re-linearisation at least every sample: a controller period above the default's 10 ms
+    /// re-linearises at every sample).
+    fn lqr_settings(&self, period: f64) -> (f64, f64) {
         (
             self.lqr_frequency
                 .unwrap_or(LqrController::DEFAULT_FREQUENCY),
             self.lqr_relinearise
-                .unwrap_or(LqrController::DEFAULT_RELINEARISE_PERIOD),
+                .unwrap_or(LqrController::DEFAULT_RELINEARISE_PERIOD.max(period)),
         )
     }
 

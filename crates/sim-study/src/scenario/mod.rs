@@ -66,7 +66,7 @@
 //! period = 0.0001         # s, default: the RK4 step
 //! # kp = [2500.0, 2500.0]   computed torque (1/s^2), kd = [100.0, 100.0] (1/s)
 //! # pd_kp = [600.0, 300.0]  PD (N m/rad), pd_kd = [20.0, 10.0] (N m s/rad); default: fuzzy slope
-//! # lqr_frequency = 50.0    LQR design frequency (rad/s), lqr_relinearise = 0.01 (s)
+//! # lqr_frequency = 50.0    LQR design frequency (rad/s), lqr_relinearise = 0.01 (s, or the period)
 //! # out_of_range = "as-given"  fuzzy inputs outside their ranges: "as-given" (MATLAB) | "clamp"
 //!
 //! [integrator]            # method = "rk4" (dt) | "dopri5" (rtol, atol, h_max, max_steps)

@@ -469,6 +469,19 @@ fn controller_keys_are_checked_whichever_controller_runs() {
             "{message}"
         );
     }
+    // A controller period above the default re-linearisation's 10 ms, with no LQR key: the
+    // LQR re-linearises at every sample (it was refused, blaming the key nobody gave).
+    let slow = base
+        .replace("kind = \"computed-torque\"", "kind = \"lqr\"")
+        .replace("period = 0.0001", "period = 0.02")
+        .replace("record_period = 0.001", "record_period = 0.02");
+    let scenario = sim_study::Scenario::from_toml(&slow).unwrap();
+    assert!(scenario.build().is_ok());
+    assert!(
+        sim_study::study::run_one(&scenario, sim_study::ControllerKind::Lqr)
+            .result
+            .is_ok()
+    );
 }
 
 /// Gravity beyond 1e6 m/s^2 (planar magnitude, spatial vector component) is refused naming
