@@ -1014,6 +1014,11 @@ impl Ilqr {
             }
             let ff = &mut self.feedforward[k * nu..(k + 1) * nu];
             let gain = &mut self.gain[k * nu * nx..(k + 1) * nu * nx];
+            // Penalties beyond double precision (a margin no motion keeps) overflow the
+            // gradient: named here rather than as a QP's malformed input.
+            if !t.q_u.iter().all(|g| g.is_finite()) {
+                return Err(OptimalError::NonFinite("the backward pass's gradient Q_u"));
+            }
             // The step's rows and the box: the general QP and the gain that keeps the active
             // rows active; the box alone without rows, or where they admit no control.
             let within_rows = match &mut self.constrained {

@@ -76,18 +76,25 @@ pub enum OptimalError {
     /// A matrix that must be positive definite (`R + B^T P B`) was not, numerically.
     #[error("{0} is not numerically positive definite")]
     NotPositiveDefinite(&'static str),
+    /// A term of a solve left double precision: costs or constraint penalties so large (a
+    /// margin no motion keeps, say) that the backward pass's gradient overflowed.
+    #[error("{0} is not finite: the costs or constraint penalties left double precision")]
+    NonFinite(&'static str),
 }
 
 impl Classify for OptimalError {
     /// [`Numerical`](ErrorClass::Numerical) when a computation on valid input failed: a Riccati
-    /// recursion that did not converge, or a matrix that is not numerically positive definite; a
+    /// recursion that did not converge, a matrix that is not numerically positive definite, or
+    /// a backward pass that left double precision; a
     /// wrapped [`ReduceError`] keeps its own class; otherwise the input was malformed or outside
     /// its domain.
     fn class(&self) -> ErrorClass {
         match self {
             Self::Dynamics(e) => e.class(),
             Self::ChainDynamics(e) => e.class(),
-            Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) => ErrorClass::Numerical,
+            Self::NoConvergence { .. } | Self::NotPositiveDefinite(_) | Self::NonFinite(_) => {
+                ErrorClass::Numerical
+            }
             _ => ErrorClass::InvalidInput,
         }
     }

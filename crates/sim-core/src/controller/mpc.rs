@@ -202,12 +202,12 @@ impl MpcController {
 }
 
 /// A solve's failure as the loop reports it: one whose every trajectory left double precision
-/// (the dynamics refused a state of the rollout) says that the plan diverged and, with rows,
-/// that they may admit no motion from the measured state (a clearance margin beyond the arm's
-/// clearance, say); any other failure as it is.
+/// (the dynamics refused a state of the rollout, or the penalties overflowed the backward pass)
+/// says that the plan diverged and, with rows, that they may admit no motion from the measured
+/// state (a clearance margin beyond the arm's clearance, say); any other failure as it is.
 fn plan_failure(error: OptimalError, constrained: bool) -> ControllerError {
     match error {
-        OptimalError::Dynamics(_) => format!(
+        OptimalError::Dynamics(_) | OptimalError::NonFinite(_) => format!(
             "the plan from the measured state diverged ({error}){}",
             if constrained {
                 ": the limits and the clearance margin it keeps may admit no motion from this \

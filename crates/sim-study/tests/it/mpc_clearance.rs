@@ -108,8 +108,8 @@ fn the_mpc_clearance_margin_is_refused_out_of_its_domain_by_name() {
     assert!(e.to_string().starts_with("controller.clearance_m"), "{e}");
 }
 
-/// A margin the arm cannot keep (20 cm about `narrow-gap`'s planned motion between circles 3 cm
-/// from its path): the plans diverge, and the run stops saying so and pointing at the margin
+/// A margin the arm cannot keep (20 cm, 100 m, 1000 m about `narrow-gap`'s planned motion
+/// between circles 3 cm from its path): the plans diverge, and the run stops saying so and pointing at the margin
 /// rather than at the non-finite dynamics alone.
 #[test]
 fn a_margin_no_motion_keeps_stops_the_run_naming_the_plan() {
@@ -126,6 +126,20 @@ fn a_margin_no_motion_keeps_stops_the_run_naming_the_plan() {
             ),
         "{message}"
     );
+    // Margins up to the largest accepted (1000 m) overflow the penalties of the backward pass
+    // itself: the same stop (it read "box QP gradient g must be finite, got NaN").
+    for margin in [100.0, 1000.0] {
+        scenario.controller.clearance_m = Some(margin);
+        let failure = scenario.build().unwrap().run().unwrap_err();
+        let message = failure.error.to_string();
+        assert!(
+            message.contains(
+                "the plan from the measured state diverged (the backward pass's gradient Q_u is \
+                 not finite"
+            ) && message.ends_with("may admit no motion from this state"),
+            "{margin}: {message}"
+        );
+    }
 }
 
 /// The paper's arm (`K = 2`) tracking a sinusoid from rest (its rates start 1-3 rad/s off the
