@@ -14,7 +14,7 @@
 
 use std::ffi::OsString;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 /// The marker file of an output folder; it names the command that wrote the folder.
 pub const MARKER: &str = ".hrm-output";
@@ -33,6 +33,52 @@ pub struct OutputDir {
     command: String,
     /// Whether the staging folder became the output.
     committed: bool,
+    /// The parent folders `create` made, removed after the staging folder when the output is
+    /// not committed (declared last: dropped after [`OutputDir`]'s own drop).
+    new_parents: NewParents,
+}
+
+/// The missing ancestors of a folder about to be created, deepest first (each named without a
+/// trailing `..` or `.`, so that none names a folder that existed): unless kept, removed again
+/// when dropped, each only while empty, so that a failing command leaves no folders behind.
+#[derive(Debug, Default)]
+struct NewParents(Vec<PathBuf>);
+
+impl NewParents {
+    /// The ancestors of `dir` (itself included) that do not exist yet.
+    fn of(dir: &Path) -> Self {
+        Self(
+            dir.ancestors()
+                .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+                .filter(|a| matches!(a.components().next_back(), Some(Component::Normal(_))))
+                .map(Path::to_path_buf)
+                .collect(),
+        )
+    }
+
+    /// Removes at once (while empty) the folders made only to pass through, which `parent`
+    /// (canonical) does not lie in: `a/x` of `--out a/x/../q`.
+    fn remove_detours(&mut self, parent: &Path) {
+        self.0.retain(|dir| match std::fs::canonicalize(dir) {
+            Ok(resolved) if !parent.starts_with(&resolved) => std::fs::remove_dir(dir).is_err(),
+            _ => true,
+        });
+    }
+
+    /// Keeps the folders: the output they hold is in place.
+    fn keep(&mut self) {
+        self.0.clear();
+    }
+}
+
+impl Drop for NewParents {
+    fn drop(&mut self) {
+        for dir in &self.0 {
+            if std::fs::remove_dir(dir).is_err() {
+                break;
+            }
+        }
+    }
 }
 
 impl OutputDir {
@@ -60,9 +106,12 @@ impl OutputDir {
             ));
         }
         check_name_length(&shown, name.len(), "staging")?;
+        // From here a failure removes the parent folders made for the output.
+        let mut new_parents = NewParents::of(parent);
         std::fs::create_dir_all(parent).map_err(|e| fail("cannot create the parent of", e))?;
         // `..` and symbolic links are resolved, so that the staging folder is a true sibling.
         let parent = std::fs::canonicalize(parent).map_err(|e| fail("output folder", e))?;
+        new_parents.remove_detours(&parent);
         let target = parent.join(name);
         match std::fs::symlink_metadata(&target) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
@@ -127,6 +176,7 @@ impl OutputDir {
             staging,
             command: command.to_string(),
             committed: false,
+            new_parents,
         };
         std::fs::write(
             dir.staging.join(MARKER),
@@ -207,6 +257,7 @@ impl OutputDir {
             return Err(fail("cannot put in place the output folder", e));
         }
         self.committed = true;
+        self.new_parents.keep();
         if had_old && let Err(e) = remove_tree(&old) {
             // The new output is in place; the old copy (read-only, say) is only in the way: say
             // where it is rather than leave it unnoticed.
@@ -835,6 +886,28 @@ mod tests {
             .collect();
         names.sort();
         names
+    }
+
+    #[test]
+    fn the_parent_folders_made_for_an_output_go_with_a_failure() {
+        let root = scratch("new-parents");
+        // Dropped without a commit (the command failed): the folders it made are gone.
+        let failed = OutputDir::create(&root.join("a/b/out"), "run").unwrap();
+        assert!(root.join("a/b").is_dir());
+        drop(failed);
+        assert!(names(&root).is_empty(), "{:?}", names(&root));
+        // A parent that holds something else by then stays.
+        let failed = OutputDir::create(&root.join("a/b/out"), "run").unwrap();
+        std::fs::write(root.join("a/note.txt"), "mine").unwrap();
+        drop(failed);
+        assert_eq!(names(&root.join("a")), ["note.txt"]);
+        std::fs::remove_dir_all(root.join("a")).unwrap();
+        // Committed, they stay; a folder made only to pass through (`x` of `x/../q`) does not.
+        let done = OutputDir::create(&root.join("x/../q/out"), "run").unwrap();
+        done.commit().unwrap();
+        assert_eq!(names(&root), ["q"]);
+        assert_eq!(names(&root.join("q/out")), [MARKER]);
+        std::fs::remove_dir_all(&root).unwrap();
     }
 
     #[test]
