@@ -375,7 +375,7 @@ fn export(source: &str, format: Format, out: &Path, gravity: Option<&str>) -> Re
     staging.commit()?;
     let mut message = String::new();
     for (name, _) in &files {
-        let _ = writeln!(message, "wrote {}", out.join(name).display());
+        let _ = writeln!(message, "wrote {}", console::shown(&out.join(name)));
     }
     console::print(&message)
 }

@@ -41,7 +41,7 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
             .iter()
             .fold(0.0f64, |m, e| m.max(*e)),
         summary.final_error,
-        out.display()
+        console::shown(out)
     ))?;
     stop.map_or(Ok(()), |error| Err(error.to_string()))
 }

@@ -33,6 +33,12 @@ pub fn escape_field(text: &str) -> String {
     lane_math::escape_controls(text, &[])
 }
 
+/// A path as the reports name it: on one line, its control characters escaped as in
+/// [`escape_field`] (`--out $'a\nb'` is shown `a\nb`).
+pub fn shown(path: &std::path::Path) -> String {
+    escape_field(&path.display().to_string())
+}
+
 /// The one line `hrm` writes to standard error for a failure: the message as
 /// [`lane_math::one_line`] shows it (control characters escaped, long numbers with exponents,
 /// cut to 2,000 characters).
@@ -59,6 +65,8 @@ mod tests {
             "hrm: scenario \\u{202e}gnirts\\u{2066}x\\u{200f}"
         );
         assert_eq!(escape_field("name\nwith\tbreaks"), "name\\nwith\\tbreaks");
+        // The paths of the `wrote` lines likewise (`--out $'mm\nx'`).
+        assert_eq!(shown(std::path::Path::new("mm\nx")), "mm\\nx");
     }
 
     #[test]

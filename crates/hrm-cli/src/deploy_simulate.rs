@@ -35,7 +35,7 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<(), String> {
     console::print(&format!(
         "{}\n{stopped}wrote {}\n",
         headline(scenario, &run),
-        out.display()
+        console::shown(out)
     ))?;
     stop.map_or(Ok(()), |error| Err(error.to_string()))
 }

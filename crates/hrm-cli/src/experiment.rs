@@ -86,7 +86,7 @@ pub fn simulate(name_or_path: &str, controller: Option<&str>, out: &Path) -> Res
         std::slice::from_ref(&outcome),
         std::slice::from_ref(&scenario),
     )))?;
-    console::print(&format!("wrote {}\n", out.display()))?;
+    console::print(&format!("wrote {}\n", console::shown(out)))?;
     outcome
         .result
         .map(|_| ())
@@ -232,8 +232,8 @@ fn experiments(out: &Path, all: &[Scenario]) -> Result<(), String> {
     console::print(&text)?;
     console::print(&format!(
         "wrote {} (summary.json, comparison.txt, figures/, learned.fis, one folder per run)\nreport: {}\n",
-        out.display(),
-        out.join("report.html").display()
+        console::shown(out),
+        console::shown(&out.join("report.html"))
     ))
 }
 

@@ -148,7 +148,7 @@ pub fn run(args: ImitateArgs) -> Result<(), String> {
     }
     let text = fis_input::signed_fis(&learned.system);
     output_dir::write_file(&args.out, &text, "fis imitate")?;
-    console::print(&format!("wrote {}\n", args.out.display()))?;
+    console::print(&format!("wrote {}\n", console::shown(&args.out)))?;
     Ok(())
 }
 

@@ -162,7 +162,7 @@ pub fn run(args: TrainArgs) -> Result<(), String> {
     };
     let text = fis_input::signed_fis(&system);
     output_dir::write_file(&args.out, &text, "fis train")?;
-    console::print(&format!("wrote {}\n", args.out.display()))?;
+    console::print(&format!("wrote {}\n", console::shown(&args.out)))?;
     Ok(())
 }
 

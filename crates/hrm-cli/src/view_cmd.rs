@@ -164,9 +164,9 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     }
     // The page and the GIF: both or neither.
     output_dir::write_files(&files, "view")?;
-    crate::console::print(&format!("wrote {}\n", out.display()))?;
+    crate::console::print(&format!("wrote {}\n", crate::console::shown(&out)))?;
     if let Some(gif) = &args.gif {
-        crate::console::print(&format!("wrote {}\n", gif.display()))?;
+        crate::console::print(&format!("wrote {}\n", crate::console::shown(gif)))?;
     }
     Ok(())
 }

@@ -124,7 +124,7 @@ pub fn run(cli: SweepCli) -> Result<(), String> {
                     let (runs, stopped) = counts;
                     console::print(&format!(
                         "wrote {} ({runs} runs, {stopped} stopped)\n",
-                        path.display()
+                        console::shown(&path)
                     ))
                 }
                 None => {
@@ -217,6 +217,12 @@ fn configure(args: &SweepArgs) -> Result<SweepConfig, String> {
         crate::experiment::refuse_scenario_inputs_inside(&args.out, &args.scenario, &scenario)?;
     }
     if let Some(duration) = args.duration {
+        if !(duration.is_finite() && duration > 0.0) {
+            return Err(format!(
+                "--duration must be positive and finite (s), got {}",
+                lane_math::Compact(duration)
+            ));
+        }
         scenario.duration = duration;
     }
     SweepConfig::new(scenario, settings).map_err(|e| e.to_string())
@@ -332,7 +338,7 @@ fn wrote(out: &Path, staged: &Path) -> String {
     };
     format!(
         "wrote {} (runs.json, summary.json, table.txt{plot})\n",
-        out.display()
+        console::shown(out)
     )
 }
 

@@ -160,6 +160,13 @@ fn bad_settings_are_refused_before_running() {
     // 0.00015 s is not a whole number of the 1e-4 s controller periods.
     let err = hrm_sweep(&with(SMALL, &["--duration", "0.00015", "--out", out])).unwrap_err();
     assert!(err.contains("duration"), "{err}");
+    for (value, shown) in [("0", "0"), ("nan", "NaN"), ("-1", "-1"), ("inf", "inf")] {
+        let err = hrm_sweep(&with(SMALL, &["--duration", value, "--out", out])).unwrap_err();
+        assert_eq!(
+            err,
+            format!("--duration must be positive and finite (s), got {shown}")
+        );
+    }
     // The library's refusals, named by the option.
     let err = hrm_sweep(&with(SMALL, &["--noise", "0.01,0", "--out", out])).unwrap_err();
     assert!(
