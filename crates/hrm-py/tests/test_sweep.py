@@ -38,6 +38,9 @@ def test_plan():
         hrm.Sweep("paper-responses-step", noise_levels=[0.01, 0.0], seeds=1)
     with pytest.raises(hrm.InvalidInput, match="seeds must be at least 1"):
         hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=-1)
+    # The bound `hrm sweep --seeds` has (the library's).
+    with pytest.raises(hrm.InvalidInput, match="^seeds must be at most 1000000, got 2000000$"):
+        hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=2 * 10**6, controllers=["pd"])
     with pytest.raises(hrm.InvalidInput, match="must be one of"):
         hrm.Sweep("paper-responses-step", noise_levels=[0.0], seeds=1, controllers=["lqr?"])
     with pytest.raises(hrm.InvalidInput, match="^controllers lists pd twice$"):

@@ -140,13 +140,10 @@ pub fn run(cli: SweepCli) -> Result<(), String> {
     }
 }
 
-/// Most noise realisations per cell.
-const MAX_SEEDS: usize = 1_000_000;
-
 /// The command line's counts checked before anything is built: `--seeds` and `--base-seed` in
 /// range, at most [`study::MAX_NOISE_LEVELS`] noise levels, at most [`study::MAX_RUNS`] runs.
 fn check_counts(args: &SweepArgs) -> Result<(usize, u64), String> {
-    let seeds = crate::args::count("--seeds", args.seeds, 1, MAX_SEEDS)?;
+    let seeds = crate::args::count("--seeds", args.seeds, 1, study::MAX_SEEDS)?;
     let base_seed = crate::args::count("--base-seed", args.base_seed, 0, usize::MAX)? as u64;
     if args.noise.len() > study::MAX_NOISE_LEVELS {
         return Err(format!(

@@ -51,7 +51,9 @@ pub use inputs::{
     InputDigest, SCENARIO_INPUT, check_digests, check_json_safe, first_changed, input_digests,
 };
 pub use outcome::{RunError, RunMetrics, RunOutcome, Stopped, run_scenario};
-pub use plan::{MAX_NOISE_LEVELS, MAX_RUNS, RunId, SweepConfig, SweepSettings, run_seed};
+pub use plan::{
+    MAX_NOISE_LEVELS, MAX_RUNS, MAX_SEEDS, RunId, SweepConfig, SweepSettings, run_seed,
+};
 pub use shard::{
     FORMAT, MAX_SHARD_LINE_BYTES, MAX_SHARD_METRIC, MAX_SHARDS, Shard, ShardParseError,
     ShardRangeError,

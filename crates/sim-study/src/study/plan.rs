@@ -18,6 +18,9 @@ pub const MAX_RUNS: usize = 10_000_000;
 
 /// The most noise levels a sweep takes.
 pub const MAX_NOISE_LEVELS: usize = 1000;
+
+/// The most seeds (noise realisations per cell) a sweep takes.
+pub const MAX_SEEDS: usize = 1_000_000;
 // A shard holds one run at least, so a sweep never splits into more shards than runs.
 const _: () = assert!(MAX_SHARDS <= MAX_RUNS);
 
@@ -100,7 +103,8 @@ impl SweepSettings {
 
     /// Checks the settings: at least one controller and none twice, at least one noise level,
     /// all finite, non-negative, distinct and ascending, finite non-negative ratios whose products
-    /// with the largest level are finite, at least one seed, and at most [`MAX_RUNS`] runs.
+    /// with the largest level are finite, from one seed to [`MAX_SEEDS`], and at most
+    /// [`MAX_RUNS`] runs.
     pub fn check(&self) -> Result<(), SettingError> {
         if self.controllers.is_empty() {
             return Err(SettingError::new(
@@ -194,6 +198,12 @@ impl SweepSettings {
         }
         if self.seeds == 0 {
             return Err(SettingError::new("seeds", "must be at least 1"));
+        }
+        if self.seeds > MAX_SEEDS {
+            return Err(SettingError::new(
+                "seeds",
+                format!("must be at most {MAX_SEEDS}, got {}", self.seeds),
+            ));
         }
         match self.runs() {
             Some(runs) if runs <= MAX_RUNS => Ok(()),
@@ -524,8 +534,14 @@ mod tests {
             err,
             format!("controllers lists {} twice", twice.settings.controllers[0])
         );
-        let err = config(2, 2, MAX_RUNS).validate().unwrap_err().to_string();
-        assert!(err.starts_with("seeds = 10000000 with 2 noise levels x 2 controllers makes more than the 10000000 runs"), "{err}");
+        let err = config(20, 1, MAX_SEEDS).validate().unwrap_err().to_string();
+        assert!(err.starts_with("seeds = 1000000 with 20 noise levels x 1 controllers makes more than the 10000000 runs"), "{err}");
+        // Python's `Sweep` and `hrm sweep --seeds` share the bound on seeds.
+        let err = config(1, 1, MAX_SEEDS + 1)
+            .validate()
+            .unwrap_err()
+            .to_string();
+        assert_eq!(err, "seeds must be at most 1000000, got 1000001");
         // The error says which setting, for a front end to name it its own way.
         let settings = SweepSettings {
             seeds: 0,
