@@ -139,7 +139,7 @@ def test_the_documented_job_array_and_merge_give_the_one_machine_sweep(tmp_path,
     (work / "sweep.sbatch").write_text(sbatch)
     (work / "submit-sweep.sh").write_text(submit)
     env = dict(slurm, PATH=f"{binary.parent}{os.pathsep}{slurm['PATH']}")
-    # As the docs say: ./submit-sweep.sh in the folder holding both scripts.
+    # As the docs say: bash submit-sweep.sh in the folder holding both scripts.
     subprocess.run(["bash", "submit-sweep.sh"], cwd=work, env=env, check=True, timeout=60)
     deadline = time.monotonic() + 600
     while run_quietly(["squeue", "-h"], env=env).stdout.strip():
