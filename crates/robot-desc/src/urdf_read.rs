@@ -622,8 +622,8 @@ fn read_joint(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfJoint, 
     let origin = origin(node, &element)?;
     // A fixed joint has no axis, limits or dynamics (urdfdom reads none of them there, so an
     // exporter's `<axis xyz="0 0 0"/>` on one is no error): listed as ignored.
-    let (axis, limits, dynamics) = if kind.is_some() {
-        movable_parts(node, &name)?
+    let (axis, limits, dynamics) = if let Some(kind) = kind {
+        movable_parts(node, &name, kind)?
     } else {
         for tag in ["axis", "limit", "dynamics"] {
             if single(node, tag, &element)?.is_some() {
@@ -657,7 +657,11 @@ fn read_joint(node: Node<'_, '_>, report: &mut ReadReport) -> Result<UrdfJoint, 
 type MovableParts = ([f64; 3], Option<Limits>, Option<JointDynamics>);
 
 /// The `<axis>` (default `x`), `<limit>` and `<dynamics>` of the movable joint `name`.
-fn movable_parts(node: Node<'_, '_>, name: &str) -> Result<MovableParts, DescError> {
+fn movable_parts(
+    node: Node<'_, '_>,
+    name: &str,
+    kind: JointKind,
+) -> Result<MovableParts, DescError> {
     let element = || format!("joint '{name}'");
     let axis = match single(node, "axis", &element)? {
         Some(axis) => {
@@ -676,7 +680,7 @@ fn movable_parts(node: Node<'_, '_>, name: &str) -> Result<MovableParts, DescErr
                 effort: optional_number(limit, "effort", &element)?,
                 velocity: optional_number(limit, "velocity", &element)?,
             };
-            check_limits(&limits, &element)?;
+            check_limits(&limits, kind, &element)?;
             Ok::<_, DescError>(limits)
         })
         .transpose()?;
@@ -701,14 +705,28 @@ fn movable_parts(node: Node<'_, '_>, name: &str) -> Result<MovableParts, DescErr
     Ok((axis, limits, dynamics))
 }
 
-/// The `<limit>` of a joint ordered and non-negative; `element` names it in the error.
-fn check_limits(limits: &Limits, element: &dyn Fn() -> String) -> Result<(), DescError> {
-    if let (Some(lower), Some(upper)) = (limits.lower, limits.upper)
-        && lower > upper
-    {
+/// The `<limit>` of a joint of `kind` ordered (a missing bound read as 0, as
+/// [`Joint::position_range`](crate::Joint::position_range) reads it; a continuous joint's bounds
+/// are not read) and non-negative; `element` names it in the error.
+fn check_limits(
+    limits: &Limits,
+    kind: JointKind,
+    element: &dyn Fn() -> String,
+) -> Result<(), DescError> {
+    let (lower, upper) = (limits.lower.unwrap_or(0.0), limits.upper.unwrap_or(0.0));
+    if kind != JointKind::Continuous && lower > upper {
+        let shown = |value: Option<f64>| {
+            value.map_or("0, the default of a missing bound".to_string(), |v| {
+                v.to_string()
+            })
+        };
         return Err(DescError::invalid(
             element(),
-            format!("lower ({lower}) must not exceed upper ({upper})"),
+            format!(
+                "lower ({}) must not exceed upper ({})",
+                shown(limits.lower),
+                shown(limits.upper)
+            ),
         ));
     }
     for (what, value) in [("effort", limits.effort), ("velocity", limits.velocity)] {

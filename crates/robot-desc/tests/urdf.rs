@@ -740,6 +740,17 @@ fn position_ranges_read_a_missing_bound_as_zero() {
         free
     );
     assert_eq!(range("revolute", ""), free);
+    // A lone lower bound above the missing upper's 0 gives no range: refused, as an inverted
+    // pair is; a continuous joint's bounds are not read.
+    refused(
+        &chain_with("<limit lower=\"1\" effort=\"1\" velocity=\"1\"/>", ""),
+        &[
+            "<limit> of joint 'j'",
+            "lower (1) must not exceed upper (0, the default of a missing bound)",
+        ],
+    );
+    let lone = "<limit lower=\"1\" effort=\"1\" velocity=\"1\"/>";
+    assert_eq!(range("continuous", lone), free);
 }
 
 /// A fixed joint's `<axis>`, `<limit>` and `<dynamics>` mean nothing (urdfdom reads none): a
