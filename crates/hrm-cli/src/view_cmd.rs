@@ -35,8 +35,9 @@ pub struct ViewArgs {
     /// the highest noise level. The GIF shows the first.
     #[arg(long, value_delimiter = ',', action = clap::ArgAction::Set, value_name = "I,J,...")]
     runs: Option<Vec<usize>>,
-    /// List a sweep's runs (number, noise level, controller, seed number, outcome) and write nothing.
-    #[arg(long)]
+    /// List a sweep's runs (number, noise level, controller, seed number, outcome) and write
+    /// nothing (so not with `--out`, `--gif` or `--runs`).
+    #[arg(long, conflicts_with_all = ["out", "gif", "runs"])]
     list: bool,
     /// GIF width (pixels); with `--gif` only, as the height, rate and speed.
     #[arg(long, default_value_t = 480, requires = "gif")]

@@ -1197,6 +1197,15 @@ fn hrm_view_of_a_sweep_runs_the_chosen_runs_again() {
         "{list}"
     );
     assert!(!sweep.join("view.html").exists(), "--list writes nothing");
+    // And so it refuses the options of what it would not write.
+    let gif = sweep.join("want.gif");
+    let output = hrm(&["view", path(&sweep), "--list", "--gif", path(&gif)]);
+    assert!(!output.status.success() && !gif.exists(), "{output:?}");
+    let said = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        said.contains("'--list' cannot be used with '--gif"),
+        "{said}"
+    );
     // By default the first seed of both controllers at both noise levels, run again: their
     // metrics are those the sweep stored, bit for bit (no warning).
     let output = hrm(&["view", path(&sweep)]);
