@@ -200,20 +200,14 @@ fn partial_limit_note(joint: &robot_desc::Joint) -> Option<String> {
 /// dynamics, and so `hrm simulate` and the dynamics ops, refuse.
 fn singular_note(robot: &Robot) -> Option<String> {
     let model = robot_desc::to_spatial(robot, [0.0; 3]).ok()?;
-    let n = model.n_links();
-    let mut data = manip_dyn::spatial::SpatialData::new(&model);
-    let zeros = vec![0.0; n];
-    let mut qdd = vec![0.0; n];
-    match manip_dyn::spatial::aba(&model, &mut data, &zeros, &zeros, &zeros, &mut qdd) {
-        Err(manip_dyn::DynError::SingularJoint { index }) => Some(format!(
-            "joint '{}' moves no mass or inertia at the zero positions (its link '{}' and every \
-             link beyond massless, or their masses on its axis): the chain's mass matrix is \
-             singular there, and its forward dynamics (hrm simulate, the dynamics ops) refuse it",
-            name(&robot.joints[index].name),
-            name(&robot.joints[index].child.name),
-        )),
-        _ => None,
-    }
+    let index = manip_dyn::spatial::singular_joint(&model, &vec![0.0; model.n_links()])?;
+    Some(format!(
+        "joint '{}' moves no mass or inertia at the zero positions (its link '{}' and every link \
+         beyond massless, or their masses on its axis): the chain's mass matrix is singular \
+         there, and its forward dynamics (hrm simulate, the dynamics ops) refuse it",
+        name(&robot.joints[index].name),
+        name(&robot.joints[index].child.name),
+    ))
 }
 
 /// A name from the file as one line of the report: a line break or tab in it escaped (`\n`),

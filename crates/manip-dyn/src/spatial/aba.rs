@@ -69,6 +69,22 @@ pub fn aba(
     check::finite_result("qdd", qdd)
 }
 
+/// The joint, if any, that moves no mass or inertia at the positions `q` (its link and every link
+/// beyond massless, or their masses on its axis), so that the mass matrix is singular there:
+/// [`aba`] at rest with no torque, its [`DynError::SingularJoint`]. `None` as well when [`aba`]
+/// refuses `q` for another reason (its length, a non-finite entry), which is the caller's to
+/// name. Allocates its workspace: a check before a run, not per-step code.
+pub fn singular_joint(model: &SpatialModel, q: &[f64]) -> Option<usize> {
+    let n = model.n_links();
+    let mut data = SpatialData::new(model);
+    let zeros = vec![0.0; n];
+    let mut qdd = vec![0.0; n];
+    match aba(model, &mut data, q, &zeros, &zeros, &mut qdd) {
+        Err(DynError::SingularJoint { index }) => Some(index),
+        _ => None,
+    }
+}
+
 /// The per-link workspace of [`kernel`] for `L::WIDTH` states: `angle`, `sin` and `cos` hold `n`
 /// values of `WIDTH` lanes each (`[link][lane]`), `links` one slot a link.
 pub(crate) struct AbaBuffers<'a, T> {

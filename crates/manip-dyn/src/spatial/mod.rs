@@ -58,7 +58,7 @@ mod model;
 mod rnea;
 mod rnea_derivatives;
 
-pub use aba::aba;
+pub use aba::{aba, singular_joint};
 pub use aba_batch::{SpatialBatchData, aba_batch};
 pub use aba_derivatives::aba_derivatives;
 pub use algebra::{Force, Mat3, Motion, Transform, Vec3};

@@ -271,15 +271,8 @@ fn check_moves_mass(
     model: &SpatialModel,
     q0: &[f64],
 ) -> Result<(), SimError> {
-    let n = model.n_links();
-    if q0.len() != n {
-        return Ok(());
-    }
-    let mut data = manip_dyn::spatial::SpatialData::new(model);
-    let zeros = vec![0.0; n];
-    let mut qdd = vec![0.0; n];
-    match manip_dyn::spatial::aba(model, &mut data, q0, &zeros, &zeros, &mut qdd) {
-        Err(manip_dyn::DynError::SingularJoint { index }) => {
+    match manip_dyn::spatial::singular_joint(model, q0) {
+        Some(index) => {
             let joint = &robot.joints[index];
             Err(SimError::setting(
                 "arm.urdf",
@@ -293,7 +286,7 @@ fn check_moves_mass(
                 ),
             ))
         }
-        _ => Ok(()),
+        None => Ok(()),
     }
 }
 

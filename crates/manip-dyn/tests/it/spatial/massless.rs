@@ -138,4 +138,12 @@ fn a_joint_moving_only_massless_links_is_named() {
             .to_string()
             .starts_with("joint 20: the articulated inertia")
     );
+    // The check before a run names the same joint, and none of a chain with mass beyond each.
+    assert_eq!(spatial::singular_joint(&model, &zeros), Some(20));
+    assert_eq!(
+        spatial::singular_joint(&snake, &vec![0.0; snake.n_links()]),
+        None
+    );
+    // A position vector of the wrong length is the caller's to name.
+    assert_eq!(spatial::singular_joint(&model, &zeros[1..]), None);
 }
